@@ -1,0 +1,120 @@
+"""Collision times and reflections in the unit circular table (pure numba kernels).
+
+Conventions (design.md, "The physics, precisely"): the table has radius 1, a disk of
+radius ``r`` keeps its centre in ``|x| <= rho`` with ``rho = 1 - r``; two disks touch
+when their centres are ``sigma = 2 r`` apart. Every function takes plain floats and
+returns plain floats or tuples, so numba inlines them into the event loops.
+
+The quadratic roots are evaluated in cancellation-free form: of the two algebraically
+equal expressions ``(-b + sqrt(D)) / a`` and ``c / (b + sqrt(D))`` we use the one that
+adds numbers of the same sign. This matters right after a collision, where the naive
+formula subtracts two nearly equal numbers and can return a spurious tiny root.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+INF = np.inf
+
+
+@njit(cache=True)
+def boundary_hit_time(x, y, vx, vy, rho):
+    """Time until a centre at ``(x, y)`` with velocity ``(vx, vy)`` reaches ``|x| = rho``.
+
+    Solves ``|x + v t| = rho`` for the positive root,
+    ``t = (-(x.v) + sqrt((x.v)^2 + |v|^2 (rho^2 - |x|^2))) / |v|^2``.
+    For unit speed this is design.md's ``t = -x.v + sqrt((x.v)^2 - |x|^2 + rho^2)``.
+    Returns ``inf`` for a disk at rest and ``0`` for a centre that round-off has put a
+    hair outside the table while it moves outward (it is reflected at once).
+    """
+    vv = vx * vx + vy * vy
+    if vv == 0.0:
+        return INF
+    b = x * vx + y * vy
+    c = rho * rho - (x * x + y * y)
+    disc = b * b + vv * c
+    if disc < 0.0:
+        disc = 0.0
+    if b > 0.0:
+        # moving outward: -b + sqrt(disc) would cancel, use the conjugate form
+        t = c / (b + math.sqrt(disc))
+    else:
+        t = (-b + math.sqrt(disc)) / vv
+    if t < 0.0:
+        return 0.0
+    return t
+
+
+@njit(cache=True)
+def pair_hit_time(dx, dy, wx, wy, sigma):
+    """Time until two centres ``d = x1 - x2`` apart, relative velocity ``w = v1 - v2``, touch.
+
+    First contact is the smaller root of ``|d + w t| = sigma`` while approaching
+    (``d.w < 0``), in the cancellation-free form of design.md,
+    ``t = (|d|^2 - sigma^2) / (-(d.w) + sqrt((d.w)^2 - |w|^2 (|d|^2 - sigma^2)))``.
+    Returns ``inf`` if the disks separate or miss, ``0`` if round-off has made them
+    overlap by a hair while approaching.
+    """
+    b = dx * wx + dy * wy
+    if b >= 0.0:
+        return INF
+    ww = wx * wx + wy * wy
+    c = dx * dx + dy * dy - sigma * sigma
+    disc = b * b - ww * c
+    if disc <= 0.0:
+        return INF
+    t = c / (-b + math.sqrt(disc))
+    if t < 0.0:
+        return 0.0
+    return t
+
+
+@njit(cache=True)
+def reflect(vx, vy, nx, ny):
+    """Specular reflection ``v' = v - 2 (v.n) n`` for a unit normal ``n``."""
+    p = 2.0 * (vx * nx + vy * ny)
+    return vx - p * nx, vy - p * ny
+
+
+@njit(cache=True)
+def boundary_normal(x, y):
+    """Outward unit normal of the table at the contact point of a centre at ``(x, y)``."""
+    rr = math.sqrt(x * x + y * y)
+    return x / rr, y / rr
+
+
+@njit(cache=True)
+def collide_mirror(vx1, vy1, vx2, vy2, nx, ny):
+    """The paper's rule: each disk reflects off the other as off a fixed wall.
+
+    ``v_i' = v_i - 2 (v_i.n) n`` with the same ``n = d/|d|`` for both disks. Speeds are
+    kept, momentum is not, and applying the map twice is the identity.
+    """
+    ax, ay = reflect(vx1, vy1, nx, ny)
+    bx, by = reflect(vx2, vy2, nx, ny)
+    return ax, ay, bx, by
+
+
+@njit(cache=True)
+def collide_elastic(vx1, vy1, vx2, vy2, nx, ny):
+    """Equal-mass elastic collision: exchange the normal components of the velocities.
+
+    ``v1' = v1 - (w.n) n``, ``v2' = v2 + (w.n) n`` with ``w = v1 - v2``; conserves
+    kinetic energy and momentum.
+    """
+    p = (vx1 - vx2) * nx + (vy1 - vy2) * ny
+    return vx1 - p * nx, vy1 - p * ny, vx2 + p * nx, vy2 + p * ny
+
+
+@njit(cache=True)
+def sin_theta_at(x, y, vx, vy, rho):
+    """Tangential component of the unit incoming velocity at a boundary contact.
+
+    ``sin_theta = (x vy - y vx) / (rho |v|)`` = ``L / rho`` for unit speed: the
+    component along the counter-clockwise tangent ``(-sin s, cos s)``.
+    """
+    return (x * vy - y * vx) / (rho * math.sqrt(vx * vx + vy * vy))

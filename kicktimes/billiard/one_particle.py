@@ -1,0 +1,330 @@
+"""The randomly perturbed ("kicked") one-disk circular billiard.
+
+One disk of radius ``r`` moves in the unit table; at each kick time its velocity
+direction is changed (design.md, "Perturbed one-particle billiard"). Kicks are events of
+the event loop, applied at their exact times.
+
+Ties: a kick at the same instant as a boundary collision is applied *after* the
+reflection. If the new direction points out of the table, the disk is reflected again
+at once (a second boundary collision at the same time, logged as such). This makes the
+outcome a deterministic function of the kick times and angles.
+
+State layout: ``st = [t, x, y, vx, vy]``, ``ev = [t_boundary]`` (absolute),
+``cnt = [n_kicks_applied, n_boundary, seq_hash]``.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from kicktimes.billiard import _checks as chk
+from kicktimes.billiard.geometry import boundary_hit_time, reflect
+from kicktimes.billiard.runs import BoundaryLog, OneParticleRun
+from kicktimes.billiard.two_particle import HASH_MOD, _grow
+
+KICK_ANGLES = {"uniform": 0, "gaussian": 1}
+
+
+@njit(cache=True)
+def apply_kick(st, angle, kick_mode):
+    """Replace the direction by ``angle`` (mode 0) or rotate it by ``angle`` (mode 1)."""
+    vx = st[3]
+    vy = st[4]
+    if kick_mode == 0:
+        speed = math.sqrt(vx * vx + vy * vy)
+        st[3] = speed * math.cos(angle)
+        st[4] = speed * math.sin(angle)
+    else:
+        c = math.cos(angle)
+        s = math.sin(angle)
+        st[3] = c * vx - s * vy
+        st[4] = s * vx + c * vy
+
+
+@njit(cache=True)
+def next_event_one(ev, kicks, cnt):
+    """``(is_kick, time)`` of the next event; a tie goes to the boundary collision."""
+    ik = cnt[0]
+    tk = kicks[ik] if ik < kicks.shape[0] else np.inf
+    if tk < ev[0]:
+        return True, tk
+    return False, ev[0]
+
+
+@njit(cache=True)
+def process_event_one(st, ev, is_kick, te, rho, angle, kick_mode, unit_speed):
+    """Move the disk to ``te`` and apply a kick or a boundary collision (returning the
+    incoming ``sin_theta`` for the latter). Updates ``ev``."""
+    dt = te - st[0]
+    st[0] = te
+    x = st[1] + st[3] * dt
+    y = st[2] + st[4] * dt
+    sin_theta = 0.0
+    if is_kick:
+        st[1] = x
+        st[2] = y
+        apply_kick(st, angle, kick_mode)
+        ev[0] = te + boundary_hit_time(x, y, st[3], st[4], rho)
+    else:
+        # see process_event_two: Newton step back onto |x| = rho, chord time
+        scale = 1.5 - 0.5 * (x * x + y * y) / (rho * rho)
+        x *= scale
+        y *= scale
+        st[1] = x
+        st[2] = y
+        vx = st[3]
+        vy = st[4]
+        vv = vx * vx + vy * vy
+        if unit_speed:
+            sin_theta = (x * vy - y * vx) / rho
+        else:
+            sin_theta = (x * vy - y * vx) / (rho * math.sqrt(vv))
+        vx, vy = reflect(vx, vy, x / rho, y / rho)
+        st[3] = vx
+        st[4] = vy
+        ev[0] = te - 2.0 * (x * vx + y * vy) / vv
+    return sin_theta
+
+
+@njit(cache=True)
+def advance_one(st, ev, t_end, rho, kicks, angles, kick_mode, cnt):
+    """Advance the kicked disk to ``t_end``, processing every event at time ``<= t_end``.
+
+    Counts events in ``cnt = [n_kicks_applied, n_boundary, seq_hash]`` without logging
+    them; used by twin-trajectory diagnostics.
+    """
+    while True:
+        is_kick, te = next_event_one(ev, kicks, cnt)
+        if te > t_end:
+            break
+        angle = angles[cnt[0]] if is_kick else 0.0
+        process_event_one(st, ev, is_kick, te, rho, angle, kick_mode, False)
+        if is_kick:
+            cnt[0] += 1
+            code = 3
+        else:
+            cnt[1] += 1
+            code = 0
+        cnt[2] = (cnt[2] * 4 + code + 1) % HASH_MOD
+    dt = t_end - st[0]
+    st[0] = t_end
+    st[1] += st[3] * dt
+    st[2] += st[4] * dt
+
+
+@njit(cache=True)
+def _event_loop_one(st, ev, rho, kicks, angles, kick_mode, unit_speed, t_end, mode, tau, bt, bx,
+                    by, bs, stimes, samples, cnt, next_s):
+    """Logging/sampling loop (see ``_event_loop_two``); ``cnt = [n_kicks, n_b, k]``."""
+    n_b = cnt[1]
+    k = cnt[2]
+    ns = stimes.shape[0]
+    ns_next = next_s[0]
+    done = False
+    while True:
+        is_kick, te = next_event_one(ev, kicks, cnt)
+        while k < ns and ns_next < te:
+            dt = ns_next - st[0]
+            stimes[k] = ns_next
+            samples[k, 0] = st[1] + st[3] * dt
+            samples[k, 1] = st[2] + st[4] * dt
+            k += 1
+            ns_next = k * tau if mode == 1 else ns_next + tau
+        if (mode == 2 and k >= ns) or te > t_end:
+            done = True
+            break
+        if is_kick:
+            process_event_one(st, ev, True, te, rho, angles[cnt[0]], kick_mode, unit_speed)
+            cnt[0] += 1
+        else:
+            if n_b >= bt.shape[0]:
+                break
+            bs[n_b] = process_event_one(st, ev, False, te, rho, 0.0, kick_mode, unit_speed)
+            bt[n_b] = te
+            bx[n_b] = st[1]
+            by[n_b] = st[2]
+            n_b += 1
+        if mode == 2 and k < ns:
+            stimes[k] = te
+            samples[k, 0] = st[1]
+            samples[k, 1] = st[2]
+            k += 1
+            ns_next = te + tau
+    cnt[1] = n_b
+    cnt[2] = k
+    next_s[0] = ns_next
+    return done
+
+
+@njit(cache=True)
+def simulate_one_kernel(st, rho, kicks, angles, kick_mode, t_max, mode, n_steps, tau, b_cap):
+    """Run the kicked one-disk billiard (``mode``: 0 none, 1 uniform, 2 paper sampling).
+
+    Returns ``(b_time, b_x, b_y, b_sin, sample_times, samples, n_kicks_applied, t_end)``.
+    """
+    ev = np.empty(1)
+    ev[0] = st[0] + boundary_hit_time(st[1], st[2], st[3], st[4], rho)
+    unit_speed = abs(st[3] * st[3] + st[4] * st[4] - 1.0) < 1e-12
+    bt = np.empty(b_cap)
+    bx = np.empty(b_cap)
+    by = np.empty(b_cap)
+    bs = np.empty(b_cap)
+    ns = n_steps + 1 if mode > 0 else 0
+    stimes = np.empty(ns)
+    samples = np.empty((ns, 2))
+    cnt = np.zeros(3, dtype=np.int64)
+    next_s = np.zeros(1)
+    t_end = t_max if mode < 2 else np.inf
+    while not _event_loop_one(st, ev, rho, kicks, angles, kick_mode, unit_speed, t_end, mode, tau,
+                              bt, bx, by, bs, stimes, samples, cnt, next_s):
+        bt = _grow(bt)
+        bx = _grow(bx)
+        by = _grow(by)
+        bs = _grow(bs)
+    if mode == 2:
+        t_end = stimes[ns - 1]
+    dt = t_end - st[0]
+    st[0] = t_end
+    st[1] += st[3] * dt
+    st[2] += st[4] * dt
+    n = cnt[1]
+    return bt[:n], bx[:n], by[:n], bs[:n], stimes, samples, cnt[0], t_end
+
+
+def check_one_particle_state(state, r: float, name: str = "state") -> np.ndarray:
+    arr = chk.check_state(name, state, (4,))
+    chk.check_inside(name, arr[0], arr[1], 1.0 - r, r, "the disk's")
+    if math.hypot(arr[2], arr[3]) == 0.0:
+        raise ValueError(f"{name}: the velocity (vx, vy) must be non-zero, got (0, 0)")
+    return arr
+
+
+def check_kick_times(kicks, t_max: float | None, name: str = "kicks") -> np.ndarray:
+    """Sorted, finite, non-negative kick times, none beyond ``t_max`` (if known)."""
+    times = np.array(kicks, dtype=np.float64, copy=True).ravel()
+    if not np.isfinite(times).all():
+        raise ValueError(f"{name} must be finite; got NaN or inf")
+    if times.size and times[0] < 0.0:
+        raise ValueError(f"{name} must be >= 0, got {times.min()!r}")
+    if times.size > 1 and (np.diff(times) < 0.0).any():
+        raise ValueError(f"{name} must be sorted in increasing order")
+    if t_max is not None and times.size and times[-1] > t_max:
+        raise ValueError(f"{name} must lie in [0, t_max={t_max!r}], got a kick at {times[-1]!r}")
+    return times
+
+
+def draw_kick_angles(n: int, kick_angle: str, sigma: float, rng: np.random.Generator):
+    """Kick angles for ``n`` kicks: new directions (uniform) or rotations (gaussian)."""
+    if kick_angle == "uniform":
+        return rng.uniform(0.0, 2.0 * np.pi, size=n)
+    return rng.normal(0.0, sigma, size=n)
+
+
+def simulate_one_particle(state, r, *, t_max=None, kicks=None, kick_angle="uniform",
+                          kick_angles=None, sigma=1.0, rng=None, sampling="uniform",
+                          n_steps=None, tau=None, seed=None) -> OneParticleRun:
+    """Simulate one disk of radius ``r`` in the unit table, kicked at given times.
+
+    Parameters
+    ----------
+    state : array_like, shape (4,)
+        ``(x, y, vx, vy)`` at ``t = 0``; ``|x| <= 1 - r``, non-zero velocity (the speed is
+        kept by boundary collisions and kicks).
+    r : float
+        Disk radius, ``0 < r < 1``.
+    t_max, sampling, n_steps, tau
+        As in `simulate_two_particle`. Under ``sampling="paper"`` a step is cut short by a
+        boundary collision or a kick.
+    kicks : array_like or schedule, optional
+        Kick times (sorted, in ``[0, t_max]``), or a schedule object with a
+        ``sample(t_max, rng)`` method (see `kicktimes.schedules`), sampled here with
+        ``rng``. ``None``: no kicks (the integrable billiard).
+    kick_angle : {"uniform", "gaussian"}
+        ``"uniform"``: a kick replaces the direction by an angle uniform on [0, 2 pi)
+        (the paper's choice). ``"gaussian"``: a kick rotates it by ``N(0, sigma^2)``.
+    kick_angles : array_like, optional
+        Explicit angles, one per kick (new directions for ``"uniform"``, rotations for
+        ``"gaussian"``), e.g. ``run.kick_angles`` of another run, so that two runs share
+        their kicks (common random numbers). Drawn from ``rng`` when omitted.
+    sigma : float
+        Standard deviation of the gaussian rotation (``> 0``).
+    rng : numpy.random.Generator or int, optional
+        Source of the schedule's times (first) and the kick angles (second).
+    seed : int, optional
+        Recorded in the run's metadata.
+
+    Returns
+    -------
+    OneParticleRun
+        ``kick_times``, ``kick_angles`` (what was applied), ``boundary`` (DataFrame
+        ``time, s, sin_theta``), ``final_state``, ``sample_times``, ``samples``.
+
+    Notes
+    -----
+    A kick at the same instant as a boundary collision is applied after the reflection;
+    a kick exactly at the end of the run is applied.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from kicktimes import simulate_one_particle, schedules
+    >>> state = np.array([0.1, 0.2, 0.6, 0.8])
+    >>> run = simulate_one_particle(state, 0.02, t_max=100.0, kicks=schedules.Poisson(0.1),
+    ...                             rng=1)
+    >>> bool(np.all(run.kick_times <= 100.0))
+    True
+    """
+    r = chk.check_real("r", r, low=0.0, high=1.0)
+    chk.check_choice("kick_angle", kick_angle, KICK_ANGLES)
+    sigma = chk.check_real("sigma", sigma, low=0.0)
+    t_max, n_steps, tau, mode = chk.check_sampling(t_max, n_steps, tau, sampling)
+    state = check_one_particle_state(state, r)
+    horizon = t_max if mode < 2 else n_steps * tau  # paper steps are at most tau long
+    gen = None
+    if kicks is None:
+        times = np.empty(0)
+    elif hasattr(kicks, "sample"):
+        gen = np.random.default_rng(rng)
+        times = check_kick_times(kicks.sample(horizon, gen), horizon)
+    else:
+        times = check_kick_times(kicks, t_max if mode < 2 else None)
+    if kick_angles is None:
+        if times.size and gen is None:
+            gen = np.random.default_rng(rng)
+        angles = draw_kick_angles(times.size, kick_angle, sigma, gen) if times.size else times
+    else:
+        angles = np.array(kick_angles, dtype=np.float64, copy=True).ravel()
+        if angles.shape != times.shape:
+            raise ValueError(
+                f"kick_angles must have one angle per kick ({times.size}), got {angles.size}"
+            )
+        if not np.isfinite(angles).all():
+            raise ValueError("kick_angles must be finite; got NaN or inf")
+    st = np.empty(5)
+    st[0] = 0.0
+    st[1:] = state
+    bt, bx, by, bs, stimes, samples, n_applied, t_end = simulate_one_kernel(
+        st, 1.0 - r, times, angles, KICK_ANGLES[kick_angle], 0.0 if mode == 2 else t_max, mode,
+        n_steps if n_steps is not None else 0, tau if tau is not None else 0.0,
+        int(3.0 * horizon) + 64,
+    )
+    return OneParticleRun(
+        r=r,
+        t_max=float(t_end),
+        sampling=sampling if mode > 0 else None,
+        tau=tau,
+        n_steps=n_steps,
+        ic=state,
+        final_state=st[1:].copy(),
+        boundary_log=BoundaryLog(bt, np.zeros(bt.shape[0], dtype=np.int8), bx, by, bs),
+        sample_times=stimes,
+        samples=samples,
+        seed=seed,
+        kick_angle=kick_angle,
+        sigma=sigma if kick_angle == "gaussian" else None,
+        kick_times=times[:n_applied],
+        kick_angles=angles[:n_applied],
+    )

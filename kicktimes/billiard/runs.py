@@ -1,0 +1,266 @@
+"""Run records of the billiard simulators and their Parquet I/O.
+
+A run is a frozen dataclass of plain arrays plus the parameters that produced it. The
+boundary-collision table is built lazily (the kernels return contact coordinates; the
+DataFrame with the arclength ``s`` is made on first access), so a sweep that only needs
+``pp_times`` pays nothing for it.
+
+On disk a run is one Parquet file holding a single row whose columns are the arrays
+(Arrow list columns) and whose schema metadata holds the parameters as JSON. Files are
+written atomically: a temporary file in the same folder, then ``os.replace``.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import tempfile
+from dataclasses import dataclass, field, fields
+from functools import cached_property
+from typing import ClassVar, NamedTuple
+
+import numpy as np
+import pandas as pd
+
+from kicktimes import __version__
+
+TWO_PI = 2.0 * np.pi
+
+
+class BoundaryLog(NamedTuple):
+    """Raw boundary-collision log: contact centre ``(x, y)``, time, disk, ``sin_theta``."""
+
+    time: np.ndarray
+    particle: np.ndarray  # int8; all zeros for a one-particle run
+    x: np.ndarray
+    y: np.ndarray
+    sin_theta: np.ndarray
+
+
+def _arclength(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """Polar angle of the contact point in ``[0, 2 pi)`` (= arclength on the unit table)."""
+    s = np.arctan2(y, x)
+    s[s < 0.0] += TWO_PI
+    # arctan2 of a tiny negative y gives -0.0 + 2 pi = 2 pi exactly; keep the half-open range
+    s[s >= TWO_PI] = 0.0
+    return s
+
+
+@dataclass(frozen=True, repr=False)
+class _Run:
+    r: float
+    t_max: float
+    sampling: str | None
+    tau: float | None
+    n_steps: int | None
+    ic: np.ndarray
+    final_state: np.ndarray
+    boundary_log: BoundaryLog
+    sample_times: np.ndarray
+    samples: np.ndarray
+    seed: int | None = None
+    version: str = field(default=__version__)
+
+    kind: ClassVar[str] = "run"
+    _array_fields: ClassVar[tuple[str, ...]] = ()
+    _scalar_fields: ClassVar[tuple[str, ...]] = ()
+
+    @property
+    def n_boundary(self) -> int:
+        """Number of disk-boundary collisions in ``[0, t_max]``."""
+        return int(self.boundary_log.time.shape[0])
+
+    def theta(self, particle: int | None = None) -> np.ndarray:
+        """Boundary-collision angles ``arcsin(sin_theta)`` of one disk, in time order."""
+        log = self.boundary_log
+        st = log.sin_theta
+        if particle is not None:
+            st = st[log.particle == particle]
+        return np.arcsin(np.clip(st, -1.0, 1.0))
+
+    @property
+    def meta(self) -> dict:
+        """The parameters of the run as a JSON-serialisable dict."""
+        out = {"kind": self.kind}
+        for name in self._scalar_fields:
+            value = getattr(self, name)
+            out[name] = value.item() if isinstance(value, np.generic) else value
+        return out
+
+    def _arrays(self) -> dict[str, np.ndarray]:
+        arrays = {name: np.asarray(getattr(self, name)) for name in self._array_fields}
+        arrays["ic"] = np.asarray(self.ic).ravel()
+        arrays["final_state"] = np.asarray(self.final_state).ravel()
+        for name, arr in self.boundary_log._asdict().items():
+            arrays[f"boundary_{name}"] = arr
+        arrays["sample_times"] = self.sample_times
+        arrays["samples"] = np.asarray(self.samples).ravel()
+        return arrays
+
+    def to_parquet(self, path: str | os.PathLike) -> None:
+        """Write the run to one Parquet file (atomically). Read it back with `read_run`."""
+        import pyarrow as pa
+        import pyarrow.parquet as pq
+
+        columns = {
+            name: pa.array([arr], type=pa.list_(pa.from_numpy_dtype(arr.dtype)))
+            for name, arr in self._arrays().items()
+        }
+        meta = {b"kicktimes": json.dumps(self.meta).encode()}
+        table = pa.table(columns).replace_schema_metadata(meta)
+        _atomic_write(path, lambda tmp: pq.write_table(table, tmp))
+
+    def __repr__(self) -> str:
+        params = ", ".join(f"{k}={v!r}" for k, v in self.meta.items() if k != "kind")
+        return f"{type(self).__name__}({params}, {self._summary_counts()})"
+
+    def _summary_counts(self) -> str:
+        return f"n_boundary={self.n_boundary}, n_samples={self.sample_times.shape[0]}"
+
+
+@dataclass(frozen=True, repr=False)
+class TwoParticleRun(_Run):
+    """Result of `simulate_two_particle`.
+
+    Attributes
+    ----------
+    r, rule, t_max, sampling, tau, n_steps, track, seed, version
+        The parameters of the run (``seed`` is ``None`` unless the caller recorded it).
+    ic, final_state : ndarray, shape (2, 4)
+        Rows ``(x, y, vx, vy)`` of each disk at ``t = 0`` and at ``t = t_max``.
+    pp_times : ndarray
+        Every disk-disk collision time, increasing, in ``(0, t_max]``.
+    boundary : DataFrame
+        Columns ``time, particle, s, sin_theta`` (design.md conventions), time order.
+    sample_times, samples : ndarray, shapes (n,) and (n, 2)
+        Sample times and the tracked disk's centre at them (empty without sampling).
+    """
+
+    rule: str = "mirror"
+    track: int = 0
+    pp_times: np.ndarray = field(default_factory=lambda: np.empty(0))
+
+    kind = "two_particle"
+    _array_fields = ("pp_times",)
+    _scalar_fields = ("r", "rule", "t_max", "sampling", "tau", "n_steps", "track", "seed",
+                      "version")
+
+    @cached_property
+    def boundary(self) -> pd.DataFrame:
+        log = self.boundary_log
+        return pd.DataFrame(
+            {
+                "time": log.time,
+                "particle": log.particle,
+                "s": _arclength(log.x, log.y),
+                "sin_theta": log.sin_theta,
+            }
+        )
+
+    @property
+    def n_pp(self) -> int:
+        """Number of disk-disk collisions in ``(0, t_max]``."""
+        return int(self.pp_times.shape[0])
+
+    def _summary_counts(self) -> str:
+        return f"n_pp={self.n_pp}, " + super()._summary_counts()
+
+
+@dataclass(frozen=True, repr=False)
+class OneParticleRun(_Run):
+    """Result of `simulate_one_particle`.
+
+    Attributes
+    ----------
+    r, t_max, sampling, tau, n_steps, kick_angle, sigma, seed, version
+        The parameters of the run.
+    ic, final_state : ndarray, shape (4,)
+        ``(x, y, vx, vy)`` at ``t = 0`` and ``t = t_max``.
+    kick_times, kick_angles : ndarray
+        The kicks applied, so that a twin run can reuse them (common random numbers).
+        For ``kick_angle="uniform"`` the angle is the new velocity direction; for
+        ``"gaussian"`` it is the rotation applied to the current direction.
+    boundary : DataFrame
+        Columns ``time, s, sin_theta``.
+    sample_times, samples : ndarray
+        Sample times and the disk's centre at them.
+    """
+
+    kick_angle: str = "uniform"
+    sigma: float | None = None
+    kick_times: np.ndarray = field(default_factory=lambda: np.empty(0))
+    kick_angles: np.ndarray = field(default_factory=lambda: np.empty(0))
+
+    kind = "one_particle"
+    _array_fields = ("kick_times", "kick_angles")
+    _scalar_fields = ("r", "t_max", "sampling", "tau", "n_steps", "kick_angle", "sigma", "seed",
+                      "version")
+
+    @cached_property
+    def boundary(self) -> pd.DataFrame:
+        log = self.boundary_log
+        return pd.DataFrame(
+            {"time": log.time, "s": _arclength(log.x, log.y), "sin_theta": log.sin_theta}
+        )
+
+    @property
+    def n_kicks(self) -> int:
+        return int(self.kick_times.shape[0])
+
+    def _summary_counts(self) -> str:
+        return f"n_kicks={self.n_kicks}, " + super()._summary_counts()
+
+
+_KINDS = {cls.kind: cls for cls in (TwoParticleRun, OneParticleRun)}
+
+
+def read_run(path: str | os.PathLike) -> TwoParticleRun | OneParticleRun:
+    """Read a run written by ``run.to_parquet(path)``.
+
+    Raises
+    ------
+    ValueError
+        If the file is not a kicktimes run.
+    """
+    import pyarrow.parquet as pq
+
+    table = pq.read_table(path)
+    raw = (table.schema.metadata or {}).get(b"kicktimes")
+    if raw is None:
+        raise ValueError(f"path: {os.fspath(path)!r} is not a kicktimes run file")
+    meta = json.loads(raw)
+    cls = _KINDS.get(meta.pop("kind", None))
+    if cls is None:
+        raise ValueError(f"path: {os.fspath(path)!r} holds an unknown run kind")
+    arr = {name: table.column(name)[0].values.to_numpy(zero_copy_only=False)
+           for name in table.column_names}
+    ic_shape = (2, 4) if cls is TwoParticleRun else (4,)
+    log = BoundaryLog(*(arr[f"boundary_{name}"] for name in BoundaryLog._fields))
+    kwargs = dict(meta)
+    kwargs.update(
+        ic=arr["ic"].reshape(ic_shape),
+        final_state=arr["final_state"].reshape(ic_shape),
+        boundary_log=log,
+        sample_times=arr["sample_times"],
+        samples=arr["samples"].reshape(-1, 2),
+    )
+    for name in cls._array_fields:
+        kwargs[name] = arr[name]
+    known = {f.name for f in fields(cls)}
+    return cls(**{k: v for k, v in kwargs.items() if k in known})
+
+
+def _atomic_write(path: str | os.PathLike, write) -> None:
+    """Call ``write(tmp_path)`` then move the file into place; never leave a partial file."""
+    path = os.fspath(path)
+    folder = os.path.dirname(os.path.abspath(path))
+    os.makedirs(folder, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=folder, prefix=".tmp-", suffix=".parquet")
+    os.close(fd)
+    try:
+        write(tmp)
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.remove(tmp)
+        raise

@@ -1,0 +1,366 @@
+"""Event-driven simulation of two equal hard disks in the unit circular table.
+
+The kernel advances from event to event (boundary collision of either disk, disk-disk
+collision) with exact collision times; samples at fixed times are interpolated along the
+free flight between events. Nothing is ever stepped through time and tested for overlap.
+
+State layout used by every kernel here (flat float64 arrays, so numba keeps them in
+registers and the Lyapunov twin runs can reuse the same functions):
+
+* ``st = [t, x0, y0, vx0, vy0, x1, y1, vx1, vy1]`` — current time and both disks;
+* ``ev = [tb0, tb1, tpp]`` — absolute times of the next boundary collision of each disk
+  and of the next disk-disk collision (``inf`` if none is scheduled);
+* ``cnt = [n_pp, n_boundary, n_boundary_0, n_boundary_1, seq_hash]`` — event counters
+  and an order-sensitive hash of the event sequence (used to tell whether a reference
+  and a twin trajectory have processed the same collisions).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from kicktimes.billiard import _checks as chk
+from kicktimes.billiard.geometry import (
+    boundary_hit_time,
+    collide_elastic,
+    collide_mirror,
+    pair_hit_time,
+    reflect,
+)
+from kicktimes.billiard.runs import BoundaryLog, TwoParticleRun
+
+HASH_MOD = 2305843009213693951  # 2**61 - 1, keeps seq_hash * 8 inside int64
+
+
+@njit(cache=True)
+def init_events_two(st, ev, rho, sigma):
+    """Fill ``ev`` with the absolute next-event times of the state ``st``."""
+    t = st[0]
+    ev[0] = t + boundary_hit_time(st[1], st[2], st[3], st[4], rho)
+    ev[1] = t + boundary_hit_time(st[5], st[6], st[7], st[8], rho)
+    ev[2] = t + pair_hit_time(st[1] - st[5], st[2] - st[6], st[3] - st[7], st[4] - st[8], sigma)
+
+
+@njit(cache=True)
+def process_event_two(st, ev, k, te, rho, sigma, rule):
+    """Move both disks to the event time ``te`` and apply event ``k``.
+
+    ``k`` is 0 or 1 for a boundary collision of that disk (returns the incoming
+    ``sin_theta``) and 2 for a disk-disk collision (returns 0). Updates ``ev``.
+    """
+    dt = te - st[0]
+    st[0] = te
+    st[1] += st[3] * dt
+    st[2] += st[4] * dt
+    st[5] += st[7] * dt
+    st[6] += st[8] * dt
+    sin_theta = 0.0
+    if k < 2:
+        o = 1 + 4 * k
+        x = st[o]
+        y = st[o + 1]
+        # The contact lies on |x| = rho: remove the flight's round-off with one Newton
+        # step of 1/sqrt (|x|^2 = rho^2 (1 + e), e ~ 1e-16, so the error is O(e^2)).
+        scale = 1.5 - 0.5 * (x * x + y * y) / (rho * rho)
+        x *= scale
+        y *= scale
+        st[o] = x
+        st[o + 1] = y
+        vx = st[o + 2]
+        vy = st[o + 3]
+        vv = vx * vx + vy * vy
+        if rule == 0:
+            # the mirror rule keeps unit speeds: skip the square root
+            sin_theta = (x * vy - y * vx) / rho
+        else:
+            sin_theta = (x * vy - y * vx) / (rho * math.sqrt(vv))
+        vx, vy = reflect(vx, vy, x / rho, y / rho)
+        st[o + 2] = vx
+        st[o + 3] = vy
+        # from a point on the circle the next boundary hit is the chord, the exact root of
+        # the quadratic with c = 0: t = -2 (x.v) / |v|^2 (no square root needed)
+        ev[k] = te - 2.0 * (x * vx + y * vy) / vv
+    else:
+        dx = st[1] - st[5]
+        dy = st[2] - st[6]
+        dd = math.sqrt(dx * dx + dy * dy)
+        nx = dx / dd
+        ny = dy / dd
+        if rule == 0:
+            a, b, c, d = collide_mirror(st[3], st[4], st[7], st[8], nx, ny)
+        else:
+            a, b, c, d = collide_elastic(st[3], st[4], st[7], st[8], nx, ny)
+        st[3] = a
+        st[4] = b
+        st[7] = c
+        st[8] = d
+        ev[0] = te + boundary_hit_time(st[1], st[2], a, b, rho)
+        ev[1] = te + boundary_hit_time(st[5], st[6], c, d, rho)
+    # both kinds of event change the pair's relative motion
+    ev[2] = te + pair_hit_time(st[1] - st[5], st[2] - st[6], st[3] - st[7], st[4] - st[8], sigma)
+    return sin_theta
+
+
+@njit(cache=True)
+def next_event_two(ev):
+    """Index (0, 1: boundary of that disk; 2: disk-disk) and time of the next event."""
+    k = 0
+    te = ev[0]
+    if ev[1] < te:
+        k = 1
+        te = ev[1]
+    if ev[2] < te:
+        k = 2
+        te = ev[2]
+    return k, te
+
+
+@njit(cache=True)
+def advance_two(st, ev, t_end, rho, sigma, rule, cnt):
+    """Advance the two-disk state to ``t_end``, processing every event at time ``<= t_end``.
+
+    Counts events in ``cnt`` (``[n_pp, n_boundary, n_boundary_0, n_boundary_1,
+    seq_hash]``) without logging them; used by twin-trajectory diagnostics.
+    """
+    while True:
+        k, te = next_event_two(ev)
+        if te > t_end:
+            break
+        process_event_two(st, ev, k, te, rho, sigma, rule)
+        if k == 2:
+            cnt[0] += 1
+        else:
+            cnt[1] += 1
+            cnt[2 + k] += 1
+        cnt[4] = (cnt[4] * 4 + k + 1) % HASH_MOD
+    dt = t_end - st[0]
+    st[0] = t_end
+    st[1] += st[3] * dt
+    st[2] += st[4] * dt
+    st[5] += st[7] * dt
+    st[6] += st[8] * dt
+
+
+@njit(cache=True)
+def _grow(a):
+    out = np.empty(2 * a.shape[0] + 16, dtype=a.dtype)
+    out[: a.shape[0]] = a
+    return out
+
+
+@njit(cache=True)
+def _event_loop_two(st, ev, rho, sigma, rule, t_end, mode, tau, o, pp, bt, bp, bx, by, bs,
+                    stimes, samples, cnt, next_s):
+    """The logging/sampling event loop; returns True when done, False when a buffer is full.
+
+    Growing a buffer reassigns the array, and an array reassigned inside a numba loop
+    costs reference counting on every iteration (it halved the speed): so this loop
+    only detects a full buffer and returns, and the caller grows it outside.
+    ``cnt = [n_pp, n_b, k]`` and ``next_s[0]`` (the next sample time) carry the loop's
+    position between calls.
+    """
+    n_pp = cnt[0]
+    n_b = cnt[1]
+    k = cnt[2]
+    ns = stimes.shape[0]
+    ns_next = next_s[0]
+    done = False
+    while True:
+        ke, te = next_event_two(ev)
+        # samples strictly before the next event lie on the current free flight
+        while k < ns and ns_next < te:
+            dt = ns_next - st[0]
+            stimes[k] = ns_next
+            samples[k, 0] = st[o] + st[o + 2] * dt
+            samples[k, 1] = st[o + 1] + st[o + 3] * dt
+            k += 1
+            ns_next = k * tau if mode == 1 else ns_next + tau
+        if (mode == 2 and k >= ns) or te > t_end:
+            done = True
+            break
+        if (ke == 2 and n_pp >= pp.shape[0]) or (ke < 2 and n_b >= bt.shape[0]):
+            break
+        sin_theta = process_event_two(st, ev, ke, te, rho, sigma, rule)
+        if ke == 2:
+            pp[n_pp] = te
+            n_pp += 1
+        else:
+            bt[n_b] = te
+            bp[n_b] = ke
+            bx[n_b] = st[1 + 4 * ke]
+            by[n_b] = st[2 + 4 * ke]
+            bs[n_b] = sin_theta
+            n_b += 1
+        if mode == 2 and k < ns:
+            # the paper's step is cut short by this collision: sample at it
+            stimes[k] = te
+            samples[k, 0] = st[o]
+            samples[k, 1] = st[o + 1]
+            k += 1
+            ns_next = te + tau
+    cnt[0] = n_pp
+    cnt[1] = n_b
+    cnt[2] = k
+    next_s[0] = ns_next
+    return done
+
+
+@njit(cache=True)
+def simulate_two_kernel(st, rho, sigma, rule, t_max, mode, n_steps, tau, track, pp_cap, b_cap):
+    """Run the two-disk billiard, logging every event and sampling the tracked disk.
+
+    ``mode``: 0 no samples (run to ``t_max``), 1 uniform samples at ``k tau`` (run to
+    ``t_max``), 2 the paper's collision-truncated steps (run until ``n_steps`` are done).
+    Samples are interpolated along the free flight, inside the event loop.
+
+    Returns ``(pp_times, b_time, b_part, b_x, b_y, b_sin, sample_times, samples, t_end)``.
+    """
+    ev = np.empty(3)
+    init_events_two(st, ev, rho, sigma)
+    pp = np.empty(pp_cap)
+    bt = np.empty(b_cap)
+    bp = np.empty(b_cap, dtype=np.int8)
+    bx = np.empty(b_cap)
+    by = np.empty(b_cap)
+    bs = np.empty(b_cap)
+    ns = n_steps + 1 if mode > 0 else 0
+    stimes = np.empty(ns)
+    samples = np.empty((ns, 2))
+    cnt = np.zeros(3, dtype=np.int64)
+    next_s = np.zeros(1)
+    t_end = t_max if mode < 2 else np.inf
+    while not _event_loop_two(st, ev, rho, sigma, rule, t_end, mode, tau, 1 + 4 * track, pp, bt,
+                              bp, bx, by, bs, stimes, samples, cnt, next_s):
+        if cnt[0] >= pp.shape[0]:
+            pp = _grow(pp)
+        if cnt[1] >= bt.shape[0]:
+            bt = _grow(bt)
+            bp = _grow(bp)
+            bx = _grow(bx)
+            by = _grow(by)
+            bs = _grow(bs)
+    if mode == 2:
+        t_end = stimes[ns - 1]
+    dt = t_end - st[0]
+    st[0] = t_end
+    st[1] += st[3] * dt
+    st[2] += st[4] * dt
+    st[5] += st[7] * dt
+    st[6] += st[8] * dt
+    n_pp = cnt[0]
+    n_b = cnt[1]
+    # views, not copies: the buffers are at most about twice the size needed
+    return pp[:n_pp], bt[:n_b], bp[:n_b], bx[:n_b], by[:n_b], bs[:n_b], stimes, samples, t_end
+
+
+def check_two_particle_ic(ic, r: float, rule: str, name: str = "ic") -> np.ndarray:
+    """Validate a two-disk initial condition; returns a float64 (2, 4) copy."""
+    arr = chk.check_state(name, ic, (2, 4))
+    rho = 1.0 - r
+    for i in range(2):
+        chk.check_inside(name, arr[i, 0], arr[i, 1], rho, r, f"disk {i}")
+        speed = math.hypot(arr[i, 2], arr[i, 3])
+        if rule == "mirror":
+            chk.check_unit_speed(name, arr[i, 2], arr[i, 3], f"disk {i}")
+        elif speed == 0.0 and math.hypot(arr[1 - i, 2], arr[1 - i, 3]) == 0.0:
+            raise ValueError(f"{name}: both disks are at rest; give a non-zero velocity")
+    gap = math.hypot(arr[0, 0] - arr[1, 0], arr[0, 1] - arr[1, 1])
+    if gap < 2.0 * r - chk.CONTACT_TOL:
+        raise ValueError(
+            f"{name}: the disks overlap (centre distance {gap:.15g} < 2 r = {2 * r:.15g})"
+        )
+    return arr
+
+
+def simulate_two_particle(ic, r, *, t_max=None, rule="mirror", sampling="uniform", n_steps=None,
+                          tau=None, track=0, seed=None) -> TwoParticleRun:
+    """Simulate two disks of radius ``r`` in the unit circular table.
+
+    Event-driven and exact: the disks move freely between collisions whose times are
+    roots of quadratics (design.md); boundary collisions are specular, disk-disk
+    collisions follow ``rule``.
+
+    Parameters
+    ----------
+    ic : array_like, shape (2, 4)
+        Rows ``(x, y, vx, vy)`` of disk 0 and disk 1. Centres must lie in the table
+        (``|x| <= 1 - r``) without overlap; speeds must be 1 under the mirror rule.
+    r : float
+        Disk radius, ``0 < r < 0.5``.
+    t_max : float, optional
+        End time. With ``n_steps`` and ``tau`` (uniform sampling) it defaults to
+        ``n_steps * tau``; it must not be given with ``sampling="paper"``.
+    rule : {"mirror", "elastic"}
+        Disk-disk collision rule: ``"mirror"`` (the paper's: each disk reflects off the
+        other as off a fixed wall, speeds stay 1) or ``"elastic"`` (equal masses).
+    sampling : {"uniform", "paper"}
+        ``"uniform"``: the tracked disk's centre at ``t_k = k tau``, ``k = 0..n_steps``.
+        ``"paper"``: step ``k`` ends at ``min(t_{k-1} + tau, next collision)``, samples at
+        step ends; the run ends after ``n_steps`` steps (``t_max`` is that time).
+    n_steps : int, optional
+        Number of sampling steps (``>= 1``).
+    tau : float, optional
+        Step length (``> 0``).
+    track : {0, 1}
+        The disk whose centre is sampled.
+    seed : int, optional
+        Recorded in the run's metadata (the simulation itself is deterministic).
+
+    Returns
+    -------
+    TwoParticleRun
+        ``pp_times``, ``boundary`` (DataFrame ``time, particle, s, sin_theta``),
+        ``final_state``, ``sample_times``, ``samples`` and the parameters.
+
+    Notes
+    -----
+    ``sin_theta = L / (1 - r)`` is the tangential component of the incoming unit
+    velocity at a boundary collision (``L = x vy - y vx``); ``s`` is the polar angle of
+    the contact point in ``[0, 2 pi)``. Events at exactly ``t_max`` are included.
+
+    Examples
+    --------
+    >>> from kicktimes import simulate_two_particle, initial_conditions
+    >>> ic = initial_conditions(1, 0.02, seed=1)[0]
+    >>> run = simulate_two_particle(ic, 0.02, t_max=200.0)
+    >>> bool((run.pp_times > 0).all() and (run.pp_times <= 200.0).all())
+    True
+    """
+    r = chk.check_real("r", r, low=0.0, high=0.5)
+    chk.check_choice("rule", rule, chk.RULES)
+    t_max, n_steps, tau, mode = chk.check_sampling(t_max, n_steps, tau, sampling)
+    track = chk.check_int("track", track, low=0)
+    if track > 1:
+        raise ValueError(f"track must be 0 or 1, got {track}")
+    ic = check_two_particle_ic(ic, r, rule)
+    st = np.empty(9)
+    st[0] = 0.0
+    st[1:] = ic.ravel()
+    horizon = t_max if mode < 2 else n_steps * tau
+    # capacities are only a first guess: the kernel grows its buffers when needed
+    b_cap = int(3.0 * horizon) + 64
+    pp_cap = int(20.0 * r * horizon) + 16
+    pp, bt, bp, bx, by, bs, stimes, samples, t_end = simulate_two_kernel(
+        st, 1.0 - r, 2.0 * r, chk.RULES[rule], 0.0 if mode == 2 else t_max, mode,
+        n_steps if n_steps is not None else 0, tau if tau is not None else 0.0, track,
+        pp_cap, b_cap,
+    )
+    return TwoParticleRun(
+        r=r,
+        t_max=float(t_end),
+        sampling=sampling if mode > 0 else None,
+        tau=tau,
+        n_steps=n_steps,
+        ic=ic,
+        final_state=st[1:].reshape(2, 4).copy(),
+        boundary_log=BoundaryLog(bt, bp, bx, by, bs),
+        sample_times=stimes,
+        samples=samples,
+        seed=seed,
+        rule=rule,
+        track=track,
+        pp_times=pp,
+    )
