@@ -9,7 +9,8 @@ reflection. If the new direction points out of the table, the disk is reflected 
 at once (a second boundary collision at the same time, logged as such). This makes the
 outcome a deterministic function of the kick times and angles.
 
-State layout: ``st = [t, x, y, vx, vy]``, ``ev = [t_boundary]`` (absolute),
+State layout: ``st = [t, x, y, vx, vy, c]`` (``c``: Kahan compensation of the clock),
+``ev = [time from now to the next boundary collision]``,
 ``cnt = [n_kicks_applied, n_boundary, seq_hash]``.
 """
 
@@ -45,48 +46,69 @@ def apply_kick(st, angle, kick_mode):
 
 
 @njit(cache=True)
-def next_event_one(ev, kicks, cnt):
-    """``(is_kick, time)`` of the next event; a tie goes to the boundary collision."""
+def drift_one(st, ev, dt):
+    """Free flight for ``dt``; event time relative to now; Kahan-compensated clock."""
+    st[1] += st[3] * dt
+    st[2] += st[4] * dt
+    ev[0] -= dt
+    y = dt - st[5]
+    t = st[0] + y
+    st[5] = (t - st[0]) - y
+    st[0] = t
+
+
+@njit(cache=True)
+def next_event_one(st, ev, kicks, cnt):
+    """``(is_kick, time from now)`` of the next event; a tie goes to the boundary."""
     ik = cnt[0]
-    tk = kicks[ik] if ik < kicks.shape[0] else np.inf
-    if tk < ev[0]:
-        return True, tk
+    if ik < kicks.shape[0]:
+        dk = kicks[ik] - st[0]
+        if dk < ev[0]:
+            return True, dk
     return False, ev[0]
 
 
 @njit(cache=True)
-def process_event_one(st, ev, is_kick, te, rho, angle, kick_mode, unit_speed):
-    """Move the disk to ``te`` and apply a kick or a boundary collision (returning the
-    incoming ``sin_theta`` for the latter). Updates ``ev``."""
-    dt = te - st[0]
-    st[0] = te
-    x = st[1] + st[3] * dt
-    y = st[2] + st[4] * dt
-    sin_theta = 0.0
+def process_event_one(st, ev, is_kick, dt, rho, kick_time, angle, kick_mode, unit_speed):
+    """Fly ``dt`` and apply a kick (at ``kick_time``) or a boundary collision.
+
+    Returns the incoming ``sin_theta`` of a boundary collision (0 for a kick).
+    """
+    drift_one(st, ev, dt)
     if is_kick:
-        st[1] = x
-        st[2] = y
+        # the kick times are the user's: put the clock exactly on them
+        st[0] = kick_time
+        st[5] = 0.0
         apply_kick(st, angle, kick_mode)
-        ev[0] = te + boundary_hit_time(x, y, st[3], st[4], rho)
+        ev[0] = boundary_hit_time(st[1], st[2], st[3], st[4], rho)
+        return 0.0
+    # see process_event_two: Newton step back onto |x| = rho, chord time
+    x = st[1]
+    y = st[2]
+    scale = 1.5 - 0.5 * (x * x + y * y) / (rho * rho)
+    x *= scale
+    y *= scale
+    st[1] = x
+    st[2] = y
+    vx = st[3]
+    vy = st[4]
+    vv = vx * vx + vy * vy
+    if unit_speed:
+        sin_theta = (x * vy - y * vx) / rho
     else:
-        # see process_event_two: Newton step back onto |x| = rho, chord time
-        scale = 1.5 - 0.5 * (x * x + y * y) / (rho * rho)
-        x *= scale
-        y *= scale
-        st[1] = x
-        st[2] = y
-        vx = st[3]
-        vy = st[4]
-        vv = vx * vx + vy * vy
-        if unit_speed:
-            sin_theta = (x * vy - y * vx) / rho
-        else:
-            sin_theta = (x * vy - y * vx) / (rho * math.sqrt(vv))
-        vx, vy = reflect(vx, vy, x / rho, y / rho)
-        st[3] = vx
-        st[4] = vy
-        ev[0] = te - 2.0 * (x * vx + y * vy) / vv
+        sin_theta = (x * vy - y * vx) / (rho * math.sqrt(vv))
+    vx, vy = reflect(vx, vy, x / rho, y / rho)
+    st[3] = vx
+    st[4] = vy
+    ev[0] = -2.0 * (x * vx + y * vy) / vv
     return sin_theta
+
+
+@njit(cache=True)
+def finish_one_at(st, ev, t_end):
+    drift_one(st, ev, t_end - st[0])
+    st[0] = t_end
+    st[5] = 0.0
 
 
 @njit(cache=True)
@@ -97,22 +119,20 @@ def advance_one(st, ev, t_end, rho, kicks, angles, kick_mode, cnt):
     them; used by twin-trajectory diagnostics.
     """
     while True:
-        is_kick, te = next_event_one(ev, kicks, cnt)
-        if te > t_end:
+        is_kick, dt = next_event_one(st, ev, kicks, cnt)
+        if st[0] + dt > t_end:
             break
-        angle = angles[cnt[0]] if is_kick else 0.0
-        process_event_one(st, ev, is_kick, te, rho, angle, kick_mode, False)
         if is_kick:
+            ik = cnt[0]
+            process_event_one(st, ev, True, dt, rho, kicks[ik], angles[ik], kick_mode, False)
             cnt[0] += 1
             code = 3
         else:
+            process_event_one(st, ev, False, dt, rho, 0.0, 0.0, kick_mode, False)
             cnt[1] += 1
             code = 0
         cnt[2] = (cnt[2] * 4 + code + 1) % HASH_MOD
-    dt = t_end - st[0]
-    st[0] = t_end
-    st[1] += st[3] * dt
-    st[2] += st[4] * dt
+    finish_one_at(st, ev, t_end)
 
 
 @njit(cache=True)
@@ -125,34 +145,36 @@ def _event_loop_one(st, ev, rho, kicks, angles, kick_mode, unit_speed, t_end, mo
     ns_next = next_s[0]
     done = False
     while True:
-        is_kick, te = next_event_one(ev, kicks, cnt)
-        while k < ns and ns_next < te:
-            dt = ns_next - st[0]
+        is_kick, dte = next_event_one(st, ev, kicks, cnt)
+        while k < ns and ns_next - st[0] < dte:
+            ds = ns_next - st[0]
             stimes[k] = ns_next
-            samples[k, 0] = st[1] + st[3] * dt
-            samples[k, 1] = st[2] + st[4] * dt
+            samples[k, 0] = st[1] + st[3] * ds
+            samples[k, 1] = st[2] + st[4] * ds
             k += 1
             ns_next = k * tau if mode == 1 else ns_next + tau
-        if (mode == 2 and k >= ns) or te > t_end:
+        if (mode == 2 and k >= ns) or st[0] + dte > t_end:
             done = True
             break
         if is_kick:
-            process_event_one(st, ev, True, te, rho, angles[cnt[0]], kick_mode, unit_speed)
+            ik = cnt[0]
+            process_event_one(st, ev, True, dte, rho, kicks[ik], angles[ik], kick_mode,
+                              unit_speed)
             cnt[0] += 1
         else:
             if n_b >= bt.shape[0]:
                 break
-            bs[n_b] = process_event_one(st, ev, False, te, rho, 0.0, kick_mode, unit_speed)
-            bt[n_b] = te
+            bs[n_b] = process_event_one(st, ev, False, dte, rho, 0.0, 0.0, kick_mode, unit_speed)
+            bt[n_b] = st[0]
             bx[n_b] = st[1]
             by[n_b] = st[2]
             n_b += 1
         if mode == 2 and k < ns:
-            stimes[k] = te
+            stimes[k] = st[0]
             samples[k, 0] = st[1]
             samples[k, 1] = st[2]
             k += 1
-            ns_next = te + tau
+            ns_next = st[0] + tau
     cnt[1] = n_b
     cnt[2] = k
     next_s[0] = ns_next
@@ -163,10 +185,11 @@ def _event_loop_one(st, ev, rho, kicks, angles, kick_mode, unit_speed, t_end, mo
 def simulate_one_kernel(st, rho, kicks, angles, kick_mode, t_max, mode, n_steps, tau, b_cap):
     """Run the kicked one-disk billiard (``mode``: 0 none, 1 uniform, 2 paper sampling).
 
+    ``st`` is ``[t, x, y, vx, vy, clock compensation]``.
     Returns ``(b_time, b_x, b_y, b_sin, sample_times, samples, n_kicks_applied, t_end)``.
     """
     ev = np.empty(1)
-    ev[0] = st[0] + boundary_hit_time(st[1], st[2], st[3], st[4], rho)
+    ev[0] = boundary_hit_time(st[1], st[2], st[3], st[4], rho)
     unit_speed = abs(st[3] * st[3] + st[4] * st[4] - 1.0) < 1e-12
     bt = np.empty(b_cap)
     bx = np.empty(b_cap)
@@ -186,10 +209,7 @@ def simulate_one_kernel(st, rho, kicks, angles, kick_mode, t_max, mode, n_steps,
         bs = _grow(bs)
     if mode == 2:
         t_end = stimes[ns - 1]
-    dt = t_end - st[0]
-    st[0] = t_end
-    st[1] += st[3] * dt
-    st[2] += st[4] * dt
+    finish_one_at(st, ev, t_end)
     n = cnt[1]
     return bt[:n], bx[:n], by[:n], bs[:n], stimes, samples, cnt[0], t_end
 
@@ -303,9 +323,8 @@ def simulate_one_particle(state, r, *, t_max=None, kicks=None, kick_angle="unifo
             )
         if not np.isfinite(angles).all():
             raise ValueError("kick_angles must be finite; got NaN or inf")
-    st = np.empty(5)
-    st[0] = 0.0
-    st[1:] = state
+    st = np.zeros(6)
+    st[1:5] = state
     bt, bx, by, bs, stimes, samples, n_applied, t_end = simulate_one_kernel(
         st, 1.0 - r, times, angles, KICK_ANGLES[kick_angle], 0.0 if mode == 2 else t_max, mode,
         n_steps if n_steps is not None else 0, tau if tau is not None else 0.0,
@@ -318,7 +337,7 @@ def simulate_one_particle(state, r, *, t_max=None, kicks=None, kick_angle="unifo
         tau=tau,
         n_steps=n_steps,
         ic=state,
-        final_state=st[1:].copy(),
+        final_state=st[1:5].copy(),
         boundary_log=BoundaryLog(bt, np.zeros(bt.shape[0], dtype=np.int8), bx, by, bs),
         sample_times=stimes,
         samples=samples,

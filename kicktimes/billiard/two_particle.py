@@ -7,9 +7,10 @@ free flight between events. Nothing is ever stepped through time and tested for 
 State layout used by every kernel here (flat float64 arrays, so numba keeps them in
 registers and the Lyapunov twin runs can reuse the same functions):
 
-* ``st = [t, x0, y0, vx0, vy0, x1, y1, vx1, vy1]`` — current time and both disks;
-* ``ev = [tb0, tb1, tpp]`` — absolute times of the next boundary collision of each disk
-  and of the next disk-disk collision (``inf`` if none is scheduled);
+* ``st = [t, x0, y0, vx0, vy0, x1, y1, vx1, vy1, c, e0]`` — current time, both disks,
+  the Kahan compensation ``c`` of the clock and the initial kinetic energy ``e0``;
+* ``ev = [tb0, tb1, tpp]`` — times *from now* to the next boundary collision of each
+  disk and to the next disk-disk collision (``inf`` if none is scheduled);
 * ``cnt = [n_pp, n_boundary, n_boundary_0, n_boundary_1, seq_hash]`` — event counters
   and an order-sensitive hash of the event sequence (used to tell whether a reference
   and a twin trajectory have processed the same collisions).
@@ -37,26 +38,40 @@ HASH_MOD = 2305843009213693951  # 2**61 - 1, keeps seq_hash * 8 inside int64
 
 @njit(cache=True)
 def init_events_two(st, ev, rho, sigma):
-    """Fill ``ev`` with the absolute next-event times of the state ``st``."""
-    t = st[0]
-    ev[0] = t + boundary_hit_time(st[1], st[2], st[3], st[4], rho)
-    ev[1] = t + boundary_hit_time(st[5], st[6], st[7], st[8], rho)
-    ev[2] = t + pair_hit_time(st[1] - st[5], st[2] - st[6], st[3] - st[7], st[4] - st[8], sigma)
+    """Fill ``ev`` with the times from now to the next events of the state ``st``."""
+    ev[0] = boundary_hit_time(st[1], st[2], st[3], st[4], rho)
+    ev[1] = boundary_hit_time(st[5], st[6], st[7], st[8], rho)
+    ev[2] = pair_hit_time(st[1] - st[5], st[2] - st[6], st[3] - st[7], st[4] - st[8], sigma)
 
 
 @njit(cache=True)
-def process_event_two(st, ev, k, te, rho, sigma, rule):
-    """Move both disks to the event time ``te`` and apply event ``k``.
+def drift_two(st, ev, dt):
+    """Free flight of both disks for ``dt``; the clock is summed with Kahan compensation.
 
-    ``k`` is 0 or 1 for a boundary collision of that disk (returns the incoming
-    ``sin_theta``) and 2 for a disk-disk collision (returns 0). Updates ``ev``.
+    Event times are kept relative to the current time: absolute times lose digits as
+    the clock grows (at t ~ 1e6 their spacing is 1e-10, enough to make disks overlap).
     """
-    dt = te - st[0]
-    st[0] = te
     st[1] += st[3] * dt
     st[2] += st[4] * dt
     st[5] += st[7] * dt
     st[6] += st[8] * dt
+    ev[0] -= dt
+    ev[1] -= dt
+    ev[2] -= dt
+    y = dt - st[9]
+    t = st[0] + y
+    st[9] = (t - st[0]) - y
+    st[0] = t
+
+
+@njit(cache=True)
+def process_event_two(st, ev, k, rho, sigma, rule):
+    """Fly both disks to event ``k`` and apply it; returns the incoming ``sin_theta``.
+
+    ``k`` is 0 or 1 for a boundary collision of that disk and 2 for a disk-disk
+    collision (which returns 0). Updates ``ev``.
+    """
+    drift_two(st, ev, ev[k])
     sin_theta = 0.0
     if k < 2:
         o = 1 + 4 * k
@@ -73,7 +88,12 @@ def process_event_two(st, ev, k, te, rho, sigma, rule):
         vy = st[o + 3]
         vv = vx * vx + vy * vy
         if rule == 0:
-            # the mirror rule keeps unit speeds: skip the square root
+            # The mirror rule keeps unit speeds: skip the square root, and stop the
+            # round-off of 10^6 reflections from drifting the speed (one Newton step).
+            sv = 1.5 - 0.5 * vv
+            vx *= sv
+            vy *= sv
+            vv = 1.0
             sin_theta = (x * vy - y * vx) / rho
         else:
             sin_theta = (x * vy - y * vx) / (rho * math.sqrt(vv))
@@ -82,7 +102,7 @@ def process_event_two(st, ev, k, te, rho, sigma, rule):
         st[o + 3] = vy
         # from a point on the circle the next boundary hit is the chord, the exact root of
         # the quadratic with c = 0: t = -2 (x.v) / |v|^2 (no square root needed)
-        ev[k] = te - 2.0 * (x * vx + y * vy) / vv
+        ev[k] = -2.0 * (x * vx + y * vy) / vv
     else:
         dx = st[1] - st[5]
         dy = st[2] - st[6]
@@ -91,31 +111,55 @@ def process_event_two(st, ev, k, te, rho, sigma, rule):
         ny = dy / dd
         if rule == 0:
             a, b, c, d = collide_mirror(st[3], st[4], st[7], st[8], nx, ny)
+            s1 = 1.5 - 0.5 * (a * a + b * b)
+            s2 = 1.5 - 0.5 * (c * c + d * d)
+            a *= s1
+            b *= s1
+            c *= s2
+            d *= s2
         else:
             a, b, c, d = collide_elastic(st[3], st[4], st[7], st[8], nx, ny)
         st[3] = a
         st[4] = b
         st[7] = c
         st[8] = d
-        ev[0] = te + boundary_hit_time(st[1], st[2], a, b, rho)
-        ev[1] = te + boundary_hit_time(st[5], st[6], c, d, rho)
+        ev[0] = boundary_hit_time(st[1], st[2], a, b, rho)
+        ev[1] = boundary_hit_time(st[5], st[6], c, d, rho)
+    if rule != 0:
+        # Anchor the kinetic energy to its initial value st[10] (one Newton step):
+        # correcting each event relative to the previous one lets the rounding bias of
+        # 10^6 events accumulate to 1e-10.
+        e = st[3] * st[3] + st[4] * st[4] + st[7] * st[7] + st[8] * st[8]
+        f = 1.5 - 0.5 * e / st[10]
+        st[3] *= f
+        st[4] *= f
+        st[7] *= f
+        st[8] *= f
     # both kinds of event change the pair's relative motion
-    ev[2] = te + pair_hit_time(st[1] - st[5], st[2] - st[6], st[3] - st[7], st[4] - st[8], sigma)
+    ev[2] = pair_hit_time(st[1] - st[5], st[2] - st[6], st[3] - st[7], st[4] - st[8], sigma)
     return sin_theta
 
 
 @njit(cache=True)
 def next_event_two(ev):
-    """Index (0, 1: boundary of that disk; 2: disk-disk) and time of the next event."""
+    """Index (0, 1: boundary of that disk; 2: disk-disk) and time to the next event."""
     k = 0
-    te = ev[0]
-    if ev[1] < te:
+    dt = ev[0]
+    if ev[1] < dt:
         k = 1
-        te = ev[1]
-    if ev[2] < te:
+        dt = ev[1]
+    if ev[2] < dt:
         k = 2
-        te = ev[2]
-    return k, te
+        dt = ev[2]
+    return k, dt
+
+
+@njit(cache=True)
+def finish_at(st, ev, t_end):
+    """Fly to ``t_end`` (no event before it) and set the clock to exactly ``t_end``."""
+    drift_two(st, ev, t_end - st[0])
+    st[0] = t_end
+    st[9] = 0.0
 
 
 @njit(cache=True)
@@ -126,22 +170,17 @@ def advance_two(st, ev, t_end, rho, sigma, rule, cnt):
     seq_hash]``) without logging them; used by twin-trajectory diagnostics.
     """
     while True:
-        k, te = next_event_two(ev)
-        if te > t_end:
+        k, dt = next_event_two(ev)
+        if st[0] + dt > t_end:
             break
-        process_event_two(st, ev, k, te, rho, sigma, rule)
+        process_event_two(st, ev, k, rho, sigma, rule)
         if k == 2:
             cnt[0] += 1
         else:
             cnt[1] += 1
             cnt[2 + k] += 1
         cnt[4] = (cnt[4] * 4 + k + 1) % HASH_MOD
-    dt = t_end - st[0]
-    st[0] = t_end
-    st[1] += st[3] * dt
-    st[2] += st[4] * dt
-    st[5] += st[7] * dt
-    st[6] += st[8] * dt
+    finish_at(st, ev, t_end)
 
 
 @njit(cache=True)
@@ -169,26 +208,26 @@ def _event_loop_two(st, ev, rho, sigma, rule, t_end, mode, tau, o, pp, bt, bp, b
     ns_next = next_s[0]
     done = False
     while True:
-        ke, te = next_event_two(ev)
+        ke, dte = next_event_two(ev)
         # samples strictly before the next event lie on the current free flight
-        while k < ns and ns_next < te:
-            dt = ns_next - st[0]
+        while k < ns and ns_next - st[0] < dte:
+            ds = ns_next - st[0]
             stimes[k] = ns_next
-            samples[k, 0] = st[o] + st[o + 2] * dt
-            samples[k, 1] = st[o + 1] + st[o + 3] * dt
+            samples[k, 0] = st[o] + st[o + 2] * ds
+            samples[k, 1] = st[o + 1] + st[o + 3] * ds
             k += 1
             ns_next = k * tau if mode == 1 else ns_next + tau
-        if (mode == 2 and k >= ns) or te > t_end:
+        if (mode == 2 and k >= ns) or st[0] + dte > t_end:
             done = True
             break
         if (ke == 2 and n_pp >= pp.shape[0]) or (ke < 2 and n_b >= bt.shape[0]):
             break
-        sin_theta = process_event_two(st, ev, ke, te, rho, sigma, rule)
+        sin_theta = process_event_two(st, ev, ke, rho, sigma, rule)
         if ke == 2:
-            pp[n_pp] = te
+            pp[n_pp] = st[0]
             n_pp += 1
         else:
-            bt[n_b] = te
+            bt[n_b] = st[0]
             bp[n_b] = ke
             bx[n_b] = st[1 + 4 * ke]
             by[n_b] = st[2 + 4 * ke]
@@ -196,11 +235,11 @@ def _event_loop_two(st, ev, rho, sigma, rule, t_end, mode, tau, o, pp, bt, bp, b
             n_b += 1
         if mode == 2 and k < ns:
             # the paper's step is cut short by this collision: sample at it
-            stimes[k] = te
+            stimes[k] = st[0]
             samples[k, 0] = st[o]
             samples[k, 1] = st[o + 1]
             k += 1
-            ns_next = te + tau
+            ns_next = st[0] + tau
     cnt[0] = n_pp
     cnt[1] = n_b
     cnt[2] = k
@@ -212,6 +251,7 @@ def _event_loop_two(st, ev, rho, sigma, rule, t_end, mode, tau, o, pp, bt, bp, b
 def simulate_two_kernel(st, rho, sigma, rule, t_max, mode, n_steps, tau, track, pp_cap, b_cap):
     """Run the two-disk billiard, logging every event and sampling the tracked disk.
 
+    ``st`` is ``[t, x0, y0, vx0, vy0, x1, y1, vx1, vy1, clock compensation, energy]``.
     ``mode``: 0 no samples (run to ``t_max``), 1 uniform samples at ``k tau`` (run to
     ``t_max``), 2 the paper's collision-truncated steps (run until ``n_steps`` are done).
     Samples are interpolated along the free flight, inside the event loop.
@@ -244,12 +284,7 @@ def simulate_two_kernel(st, rho, sigma, rule, t_max, mode, n_steps, tau, track, 
             bs = _grow(bs)
     if mode == 2:
         t_end = stimes[ns - 1]
-    dt = t_end - st[0]
-    st[0] = t_end
-    st[1] += st[3] * dt
-    st[2] += st[4] * dt
-    st[5] += st[7] * dt
-    st[6] += st[8] * dt
+    finish_at(st, ev, t_end)
     n_pp = cnt[0]
     n_b = cnt[1]
     # views, not copies: the buffers are at most about twice the size needed
@@ -336,9 +371,9 @@ def simulate_two_particle(ic, r, *, t_max=None, rule="mirror", sampling="uniform
     if track > 1:
         raise ValueError(f"track must be 0 or 1, got {track}")
     ic = check_two_particle_ic(ic, r, rule)
-    st = np.empty(9)
-    st[0] = 0.0
-    st[1:] = ic.ravel()
+    st = np.zeros(11)
+    st[1:9] = ic.ravel()
+    st[10] = (ic[:, 2:] ** 2).sum()
     horizon = t_max if mode < 2 else n_steps * tau
     # capacities are only a first guess: the kernel grows its buffers when needed
     b_cap = int(3.0 * horizon) + 64
@@ -355,7 +390,7 @@ def simulate_two_particle(ic, r, *, t_max=None, rule="mirror", sampling="uniform
         tau=tau,
         n_steps=n_steps,
         ic=ic,
-        final_state=st[1:].reshape(2, 4).copy(),
+        final_state=st[1:9].reshape(2, 4).copy(),
         boundary_log=BoundaryLog(bt, bp, bx, by, bs),
         sample_times=stimes,
         samples=samples,

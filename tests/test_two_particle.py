@@ -1,0 +1,269 @@
+"""The two-disk simulator: invariants, records, sampling, determinism and bad input."""
+
+import math
+
+import numpy as np
+import pytest
+from numba import njit
+
+from kicktimes import initial_conditions, read_run, simulate_two_particle
+from kicktimes.billiard.two_particle import init_events_two, next_event_two, process_event_two
+
+
+@njit  # not cached: numba's cache does not see changes in the kernels it calls
+def _invariant_violations(st, r, rule, n_events):
+    """Run ``n_events`` events of the production event code and track the worst violations.
+
+    Returns (outside, overlap, speed_error, energy_error, n_pp).
+    """
+    rho = 1.0 - r
+    sigma = 2.0 * r
+    ev = np.empty(3)
+    init_events_two(st, ev, rho, sigma)
+    e0 = st[3] ** 2 + st[4] ** 2 + st[7] ** 2 + st[8] ** 2
+    outside = 0.0
+    overlap = 0.0
+    speed_err = 0.0
+    energy_err = 0.0
+    n_pp = 0
+    for _ in range(n_events):
+        k, _ = next_event_two(ev)
+        process_event_two(st, ev, k, rho, sigma, rule)
+        n_pp += k == 2
+        for i in range(2):
+            o = 1 + 4 * i
+            outside = max(outside, math.hypot(st[o], st[o + 1]) - rho)
+            if rule == 0:
+                speed_err = max(speed_err, abs(math.hypot(st[o + 2], st[o + 3]) - 1.0))
+        overlap = max(overlap, sigma - math.hypot(st[1] - st[5], st[2] - st[6]))
+        e = st[3] ** 2 + st[4] ** 2 + st[7] ** 2 + st[8] ** 2
+        energy_err = max(energy_err, abs(e - e0))
+    return outside, overlap, speed_err, energy_err, n_pp
+
+
+@pytest.mark.parametrize("rule", ["mirror", "elastic"])
+def test_invariants_hold_over_a_million_events(rule):
+    r = 0.05  # large disks: many disk-disk collisions per boundary collision
+    method = "paper" if rule == "mirror" else "uniform"
+    ic = initial_conditions(1, r, seed=11, method=method, rule=rule)[0]
+    st = np.concatenate([[0.0], ic.ravel(), [0.0, (ic[:, 2:] ** 2).sum()]])
+    outside, overlap, speed_err, energy_err, n_pp = _invariant_violations(
+        st, r, 0 if rule == "mirror" else 1, 1_000_000
+    )
+    assert outside <= 1e-12
+    assert overlap <= 1e-12
+    assert speed_err <= 1e-12
+    if rule == "elastic":
+        assert energy_err <= 1e-12
+    assert n_pp > 10_000  # the disks really interacted
+
+
+@pytest.mark.parametrize("rule", ["mirror", "elastic"])
+def test_sin_theta_unchanged_between_boundary_collisions_without_disk_disk_collision(rule):
+    r = 0.03
+    ic = initial_conditions(1, r, seed=5, method="uniform", rule=rule)[0]
+    run = simulate_two_particle(ic, r, t_max=20000.0, rule=rule)
+    b = run.boundary
+    changed_any = False
+    for p in (0, 1):
+        rows = b[b.particle == p]
+        t = rows.time.to_numpy()
+        s = rows.sin_theta.to_numpy()
+        # a disk-disk collision between consecutive boundary collisions of disk p?
+        n_between = np.searchsorted(run.pp_times, t[1:]) - np.searchsorted(run.pp_times, t[:-1])
+        free = n_between == 0
+        assert free.sum() > 1000
+        np.testing.assert_allclose(s[1:][free], s[:-1][free], rtol=0, atol=1e-12)
+        changed_any |= bool((np.abs(s[1:][~free] - s[:-1][~free]) > 1e-6).any())
+    assert changed_any
+
+
+def test_disk_on_a_diameter_with_radial_velocity_bounces_between_antipodes():
+    r = 0.01
+    # disk 1 parked far off the diameter, moving along a parallel chord, never meets disk 0
+    ic = [[0.2, 0.0, 1.0, 0.0], [0.0, 0.5, 1.0, 0.0]]
+    run = simulate_two_particle(ic, r, t_max=10.0)
+    b = run.boundary[run.boundary.particle == 0]
+    rho = 1 - r
+    expected = (rho - 0.2) + 2 * rho * np.arange(len(b))
+    np.testing.assert_allclose(b.time, expected, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(b.sin_theta, 0.0, atol=1e-15)
+    np.testing.assert_allclose(b.s.to_numpy()[::2], 0.0, atol=1e-12)
+    np.testing.assert_allclose(b.s.to_numpy()[1::2], np.pi, atol=1e-12)
+
+
+def test_head_on_disks_collide_at_the_hand_worked_time():
+    r = 0.05
+    ic = [[-0.5, 0.0, 1.0, 0.0], [0.5, 0.0, -1.0, 0.0]]
+    run = simulate_two_particle(ic, r, t_max=0.6, rule="elastic")
+    # gap 1.0 - 2r closes at relative speed 2
+    assert run.pp_times == pytest.approx([(1.0 - 2 * r) / 2])
+    # elastic head-on: the velocities are exchanged
+    np.testing.assert_allclose(run.final_state[:, 2], [-1.0, 1.0], atol=1e-15)
+
+
+def test_disks_starting_nearly_in_contact_collide_at_once_when_approaching():
+    r = 0.02
+    gap = 2 * r + 1e-13
+    ic = [[-gap / 2, 0.0, 1.0, 0.0], [gap / 2, 0.0, -1.0, 0.0]]
+    run = simulate_two_particle(ic, r, t_max=0.1)
+    assert run.n_pp == 1 and run.pp_times[0] < 1e-12
+    # and separating disks in contact do not collide
+    ic = [[-gap / 2, 0.0, -1.0, 0.0], [gap / 2, 0.0, 1.0, 0.0]]
+    assert simulate_two_particle(ic, r, t_max=0.1).n_pp == 0
+
+
+def test_mirror_rule_is_time_reversible():
+    r = 0.04
+    ic = initial_conditions(1, r, seed=2)[0]
+    fwd = simulate_two_particle(ic, r, t_max=30.0)
+    assert fwd.n_pp >= 1
+    back_ic = fwd.final_state.copy()
+    back_ic[:, 2:] *= -1.0
+    back = simulate_two_particle(back_ic, r, t_max=30.0)
+    np.testing.assert_allclose(back.final_state[:, :2], ic[:, :2], atol=1e-8)
+    np.testing.assert_allclose(-back.final_state[:, 2:], ic[:, 2:], atol=1e-8)
+    np.testing.assert_allclose(30.0 - back.pp_times[::-1], fwd.pp_times, atol=1e-8)
+
+
+def test_records_have_the_documented_shapes_and_ranges():
+    r = 0.02
+    ic = initial_conditions(1, r, seed=3)[0]
+    run = simulate_two_particle(ic, r, t_max=500.0)
+    assert run.pp_times.dtype == np.float64
+    assert (np.diff(run.pp_times) > 0).all()
+    assert ((run.pp_times > 0) & (run.pp_times <= 500.0)).all()
+    b = run.boundary
+    assert list(b.columns) == ["time", "particle", "s", "sin_theta"]
+    assert (np.diff(b.time) >= 0).all()
+    assert set(b.particle.unique()) <= {0, 1}
+    assert ((b.s >= 0) & (b.s < 2 * np.pi)).all()
+    assert (np.abs(b.sin_theta) <= 1).all()
+    assert run.final_state.shape == (2, 4)
+    assert run.sample_times.shape == (0,)
+
+
+def test_final_state_continues_the_run():
+    r = 0.02
+    ic = initial_conditions(1, r, seed=4)[0]
+    whole = simulate_two_particle(ic, r, t_max=200.0)
+    first = simulate_two_particle(ic, r, t_max=120.0)
+    rest = simulate_two_particle(first.final_state, r, t_max=80.0)
+    np.testing.assert_allclose(np.r_[first.pp_times, 120.0 + rest.pp_times], whole.pp_times,
+                               atol=1e-9)
+
+
+def test_uniform_sampling_gives_n_steps_plus_one_samples_on_the_grid():
+    r = 0.02
+    ic = initial_conditions(1, r, seed=6)[0]
+    run = simulate_two_particle(ic, r, n_steps=1000, tau=0.3, track=1)
+    assert run.t_max == pytest.approx(300.0)
+    np.testing.assert_allclose(run.sample_times, 0.3 * np.arange(1001))
+    assert run.samples.shape == (1001, 2)
+    np.testing.assert_allclose(run.samples[0], ic[1, :2])
+    np.testing.assert_allclose(run.samples[-1], run.final_state[1, :2], atol=1e-12)
+    assert (np.hypot(*run.samples.T) <= 1 - r + 1e-12).all()
+    # unit speed: consecutive samples are at most tau apart
+    assert (np.hypot(*np.diff(run.samples, axis=0).T) <= 0.3 + 1e-12).all()
+
+
+def test_paper_sampling_cuts_steps_at_every_collision():
+    r = 0.02
+    ic = initial_conditions(1, r, seed=7)[0]
+    run = simulate_two_particle(ic, r, n_steps=3000, tau=0.3, sampling="paper")
+    steps = np.diff(run.sample_times)
+    assert run.sample_times.shape == (3001,)
+    assert (steps <= 0.3 + 1e-12).all() and (steps >= 0).all()
+    assert run.t_max == pytest.approx(run.sample_times[-1])
+    assert run.t_max < 3000 * 0.3
+    collisions = np.sort(np.r_[run.pp_times, run.boundary.time.to_numpy()])
+    # every collision ends a step, so it is a sample time
+    assert np.isin(collisions, run.sample_times).all()
+    # and a step is shorter than tau only when it ends at a collision
+    short = steps < 0.3 - 1e-9
+    assert np.isin(run.sample_times[1:][short], collisions).all()
+
+
+def test_same_input_gives_identical_arrays():
+    ic = initial_conditions(1, 0.02, seed=8)[0]
+    a = simulate_two_particle(ic, 0.02, n_steps=500, tau=0.2)
+    b = simulate_two_particle(ic, 0.02, n_steps=500, tau=0.2)
+    assert np.array_equal(a.pp_times, b.pp_times)
+    assert a.boundary.equals(b.boundary)
+    assert np.array_equal(a.samples, b.samples)
+
+
+def test_run_round_trips_through_parquet(tmp_path):
+    ic = initial_conditions(1, 0.02, seed=9)[0]
+    run = simulate_two_particle(ic, 0.02, n_steps=200, tau=0.3, rule="elastic", seed=9)
+    path = tmp_path / "run.parquet"
+    run.to_parquet(path)
+    back = read_run(path)
+    assert back.meta == run.meta
+    assert back.meta["seed"] == 9 and back.meta["rule"] == "elastic"
+    assert back.meta["version"]
+    assert np.array_equal(back.pp_times, run.pp_times)
+    assert back.boundary.equals(run.boundary)
+    assert np.array_equal(back.samples, run.samples)
+    assert np.array_equal(back.ic, run.ic) and np.array_equal(back.final_state, run.final_state)
+    assert [p.name for p in tmp_path.iterdir()] == ["run.parquet"]
+
+
+def test_reading_a_foreign_parquet_file_is_refused(tmp_path):
+    import pandas as pd
+
+    path = tmp_path / "other.parquet"
+    pd.DataFrame({"a": [1, 2]}).to_parquet(path)
+    with pytest.raises(ValueError, match="not a kicktimes run"):
+        read_run(path)
+
+
+GOOD_IC = [[0.1, 0.2, 0.6, 0.8], [-0.3, -0.1, 0.0, 1.0]]
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "match"),
+    [
+        (dict(r=0.0, t_max=1.0), "r must lie in"),
+        (dict(r=0.5, t_max=1.0), "r must lie in"),
+        (dict(r=float("nan"), t_max=1.0), "r must be finite"),
+        (dict(r=0.02, t_max=0.0), "t_max must lie in"),
+        (dict(r=0.02, t_max=float("inf")), "t_max must be finite"),
+        (dict(r=0.02, n_steps=0, tau=0.3), "n_steps must be an integer >= 1"),
+        (dict(r=0.02, n_steps=10, tau=-0.3), "tau must lie in"),
+        (dict(r=0.02, n_steps=10), "tau must be given"),
+        (dict(r=0.02, t_max=1.0, rule="sticky"), "rule must be one of"),
+        (dict(r=0.02, t_max=1.0, sampling="random"), "sampling must be one of"),
+        (dict(r=0.02, n_steps=10, tau=0.3, sampling="paper", t_max=3.0), "do not pass t_max"),
+        (dict(r=0.02, t_max=1.0, track=2), "track must be 0 or 1"),
+        (dict(r=0.02), "give t_max"),
+    ],
+)
+def test_bad_arguments_raise_value_errors_naming_them(kwargs, match):
+    with pytest.raises(ValueError, match=match):
+        simulate_two_particle(GOOD_IC, **kwargs)
+
+
+@pytest.mark.parametrize(
+    ("ic", "match"),
+    [
+        ([[0.99, 0.0, 1.0, 0.0], [0.0, 0.0, 1.0, 0.0]], "outside the table"),
+        ([[0.0, 0.0, 1.0, 0.0], [0.03, 0.0, 1.0, 0.0]], "overlap"),
+        ([[0.0, 0.0, 2.0, 0.0], [0.5, 0.0, 1.0, 0.0]], "speed must be 1"),
+        ([[0.0, 0.0, 0.0, 0.0], [0.5, 0.0, 1.0, 0.0]], "speed must be 1"),
+        ([[0.0, np.nan, 1.0, 0.0], [0.5, 0.0, 1.0, 0.0]], "finite"),
+        ([[0.0, 0.0, 1.0, 0.0]], "shape"),
+    ],
+)
+def test_bad_initial_conditions_raise(ic, match):
+    with pytest.raises(ValueError, match=match):
+        simulate_two_particle(ic, 0.02, t_max=1.0)
+
+
+def test_elastic_rule_accepts_any_speeds_but_not_both_at_rest():
+    ic = [[0.0, 0.0, 0.0, 0.0], [0.5, 0.0, -1.3, 0.0]]
+    run = simulate_two_particle(ic, 0.02, t_max=0.5, rule="elastic")
+    assert run.pp_times == pytest.approx([(0.5 - 0.04) / 1.3])
+    np.testing.assert_allclose(run.final_state[:, 2], [-1.3, 0.0], atol=1e-15)
+    with pytest.raises(ValueError, match="at rest"):
+        simulate_two_particle([[0, 0, 0, 0], [0.5, 0, 0, 0]], 0.02, t_max=2.0, rule="elastic")
