@@ -122,3 +122,129 @@ def schedule_command(
 
 
 # --- end schedule command ------------------------------------------------------------
+
+
+# --- experiment commands ---
+def _run_one(experiment, out, workers, scheduler, progress):
+    """Run or resume one sweep, printing store warnings as plain lines; returns the store."""
+    import warnings
+
+    from kicktimes.experiment import StoreWarning, run_experiment
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", StoreWarning)
+        try:
+            store = run_experiment(
+                experiment, out, workers=workers, scheduler=scheduler, progress=progress
+            )
+        finally:
+            for w in caught:
+                click.echo(f"warning: {w.message}", err=True)
+    return store
+
+
+_workers_option = click.option(
+    "--workers",
+    type=click.IntRange(min=1),
+    default=None,
+    help="Local worker processes (default: all cores; 1 runs in this process).",
+)
+_scheduler_option = click.option(
+    "--scheduler",
+    metavar="ADDRESS",
+    default=None,
+    help="Run on a Dask distributed cluster, e.g. tcp://host:8786 (needs kicktimes[dask]).",
+)
+_progress_option = click.option(
+    "--progress/--no-progress",
+    default=None,
+    help="Progress bar (default: on a terminal, off when CI is set).",
+)
+
+
+@main.command("run")
+@click.argument("experiment", type=click.Path(exists=True, dir_okay=False))
+@click.option("--out", "out", type=click.Path(file_okay=False), required=True,
+              help="Store directory (created; rerunning resumes it).")
+@_workers_option
+@_scheduler_option
+@_progress_option
+def run_command(experiment, out, workers, scheduler, progress):
+    """Run (or resume) the sweep of EXPERIMENT.toml into the store --out.
+
+    \b
+    Examples:
+      kicktimes run analysis/quick_a.toml --out stores/quick_a
+      kicktimes run analysis/family_b.toml --out stores/b --scheduler tcp://host:8786
+    """
+    from kicktimes.experiment import Experiment
+
+    if workers is not None and scheduler is not None:
+        raise click.UsageError("--workers sizes the local pool; it cannot go with --scheduler")
+    try:
+        exp = Experiment.from_toml(experiment)
+        click.echo(exp.summary())
+        store = _run_one(exp, out, workers, scheduler, progress)
+    except (ValueError, TypeError, ImportError) as exc:
+        raise click.ClickException(str(exc)) from None
+    click.echo(store.summary())
+
+
+def _build_report(stores, out):
+    try:
+        from kicktimes.report import build_report
+    except ImportError as exc:
+        raise click.ClickException(f"the report module is not available: {exc}") from None
+    target = stores[0] if len(stores) == 1 else list(stores)
+    return build_report(target, out)
+
+
+@main.command("report")
+@click.argument("stores", nargs=-1, required=True, type=click.Path(exists=True, file_okay=False))
+@click.option("--out", "out", type=click.Path(file_okay=False), required=True,
+              help="Report directory (HTML page, figures, tables).")
+def report_command(stores, out):
+    """Build the report of one or more result STORES into --out."""
+    try:
+        path = _build_report(stores, out)
+    except (ValueError, TypeError) as exc:
+        raise click.ClickException(str(exc)) from None
+    click.echo(f"report written to {path if path is not None else out}")
+
+
+@main.command("reproduce")
+@click.option("--scale", type=click.Choice(["quick", "paper"]), default="quick", show_default=True,
+              help="quick: small versions of both families; paper: the paper's full scale.")
+@click.option("--out", "out", type=click.Path(file_okay=False), required=True,
+              help="Directory for the stores (store-<name>) and the report (report/).")
+@_workers_option
+@_scheduler_option
+@_progress_option
+def reproduce_command(scale, out, workers, scheduler, progress):
+    """Run the paper's two experiment families and build the report.
+
+    Reruns resume the stores in --out. The experiments are the built-in presets, the
+    same as analysis/<name>.toml.
+    """
+    import os
+
+    from kicktimes.experiment.presets import SCALES, preset
+
+    if workers is not None and scheduler is not None:
+        raise click.UsageError("--workers sizes the local pool; it cannot go with --scheduler")
+    stores = []
+    try:
+        for name in SCALES[scale]:
+            exp = preset(name)
+            path = os.path.join(out, f"store-{name}")
+            click.echo(exp.summary())
+            store = _run_one(exp, path, workers, scheduler, progress)
+            click.echo(store.summary())
+            stores.append(path)
+        report = _build_report(stores, os.path.join(out, "report"))
+    except (ValueError, TypeError, ImportError) as exc:
+        raise click.ClickException(str(exc)) from None
+    click.echo(f"report written to {report if report is not None else os.path.join(out, 'report')}")
+
+
+# --- end experiment commands ---

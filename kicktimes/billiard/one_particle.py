@@ -45,7 +45,7 @@ def apply_kick(st, angle, kick_mode):
         st[4] = s * vx + c * vy
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def drift_one(st, ev, dt):
     """Free flight for ``dt``; event time relative to now; Kahan-compensated clock."""
     st[1] += st[3] * dt
@@ -57,7 +57,7 @@ def drift_one(st, ev, dt):
     st[0] = t
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def next_event_one(st, ev, kicks, cnt):
     """``(is_kick, time from now)`` of the next event; a tie goes to the boundary."""
     ik = cnt[0]
@@ -97,27 +97,30 @@ def process_event_one(st, ev, is_kick, dt, rho, kick_time, angle, kick_mode, uni
         sin_theta = (x * vy - y * vx) / rho
     else:
         sin_theta = (x * vy - y * vx) / (rho * math.sqrt(vv))
-    vx, vy = reflect(vx, vy, x / rho, y / rho)
-    st[3] = vx
-    st[4] = vy
-    ev[0] = -2.0 * (x * vx + y * vy) / vv
+    xv = x * vx + y * vy
+    if xv > 0.0:
+        vx, vy = reflect(vx, vy, x / rho, y / rho)
+        st[3] = vx
+        st[4] = vy
+        ev[0] = 2.0 * xv / vv
+    else:
+        # a twin moving inward: no reflection (see process_event_two)
+        ev[0] = boundary_hit_time(x, y, vx, vy, rho)
     return sin_theta
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def finish_one_at(st, ev, t_end):
     drift_one(st, ev, t_end - st[0])
     st[0] = t_end
     st[5] = 0.0
 
 
-@njit(cache=True)
-def advance_one(st, ev, t_end, rho, kicks, angles, kick_mode, cnt):
-    """Advance the kicked disk to ``t_end``, processing every event at time ``<= t_end``.
-
-    Counts events in ``cnt = [n_kicks_applied, n_boundary, seq_hash]`` without logging
-    them; used by twin-trajectory diagnostics.
-    """
+@njit(cache=True, inline="always")
+def advance_events_one(st, ev, t_end, rho, kicks, angles, kick_mode, cnt):
+    """Process every event (kick or boundary collision) at time ``<= t_end``; the state
+    stays at the last event. Counts events in ``cnt = [n_kicks_applied, n_boundary,
+    seq_hash]`` without logging them."""
     while True:
         is_kick, dt = next_event_one(st, ev, kicks, cnt)
         if st[0] + dt > t_end:
@@ -132,6 +135,12 @@ def advance_one(st, ev, t_end, rho, kicks, angles, kick_mode, cnt):
             cnt[1] += 1
             code = 0
         cnt[2] = (cnt[2] * 4 + code + 1) % HASH_MOD
+
+
+@njit(cache=True, inline="always")
+def advance_one(st, ev, t_end, rho, kicks, angles, kick_mode, cnt):
+    """`advance_events_one`, then fly on to exactly ``t_end``."""
+    advance_events_one(st, ev, t_end, rho, kicks, angles, kick_mode, cnt)
     finish_one_at(st, ev, t_end)
 
 

@@ -36,7 +36,7 @@ from kicktimes.billiard.runs import BoundaryLog, TwoParticleRun
 HASH_MOD = 2305843009213693951  # 2**61 - 1, keeps seq_hash * 8 inside int64
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def init_events_two(st, ev, rho, sigma):
     """Fill ``ev`` with the times from now to the next events of the state ``st``."""
     ev[0] = boundary_hit_time(st[1], st[2], st[3], st[4], rho)
@@ -44,7 +44,7 @@ def init_events_two(st, ev, rho, sigma):
     ev[2] = pair_hit_time(st[1] - st[5], st[2] - st[6], st[3] - st[7], st[4] - st[8], sigma)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def drift_two(st, ev, dt):
     """Free flight of both disks for ``dt``; the clock is summed with Kahan compensation.
 
@@ -97,12 +97,19 @@ def process_event_two(st, ev, k, rho, sigma, rule):
             sin_theta = (x * vy - y * vx) / rho
         else:
             sin_theta = (x * vy - y * vx) / (rho * math.sqrt(vv))
-        vx, vy = reflect(vx, vy, x / rho, y / rho)
+        xv = x * vx + y * vy
+        if xv > 0.0:
+            vx, vy = reflect(vx, vy, x / rho, y / rho)
+            # from a point on the circle the next boundary hit is the chord, the exact
+            # root of the quadratic with c = 0: t = -2 (x.v') / |v|^2 = 2 (x.v) / |v|^2
+            ev[k] = 2.0 * xv / vv
+        else:
+            # Never reflect a disk that is already moving inward (only a perturbed twin of
+            # a Lyapunov computation can get here): it would turn it outward, into a
+            # negative chord time.
+            ev[k] = boundary_hit_time(x, y, vx, vy, rho)
         st[o + 2] = vx
         st[o + 3] = vy
-        # from a point on the circle the next boundary hit is the chord, the exact root of
-        # the quadratic with c = 0: t = -2 (x.v) / |v|^2 (no square root needed)
-        ev[k] = -2.0 * (x * vx + y * vy) / vv
     else:
         dx = st[1] - st[5]
         dy = st[2] - st[6]
@@ -140,7 +147,7 @@ def process_event_two(st, ev, k, rho, sigma, rule):
     return sin_theta
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def next_event_two(ev):
     """Index (0, 1: boundary of that disk; 2: disk-disk) and time to the next event."""
     k = 0
@@ -154,7 +161,7 @@ def next_event_two(ev):
     return k, dt
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def finish_at(st, ev, t_end):
     """Fly to ``t_end`` (no event before it) and set the clock to exactly ``t_end``."""
     drift_two(st, ev, t_end - st[0])
@@ -162,12 +169,14 @@ def finish_at(st, ev, t_end):
     st[9] = 0.0
 
 
-@njit(cache=True)
-def advance_two(st, ev, t_end, rho, sigma, rule, cnt):
-    """Advance the two-disk state to ``t_end``, processing every event at time ``<= t_end``.
+@njit(cache=True, inline="always")
+def advance_events_two(st, ev, t_end, rho, sigma, rule, cnt):
+    """Process every event at time ``<= t_end``; the state stays at the last event.
 
     Counts events in ``cnt`` (``[n_pp, n_boundary, n_boundary_0, n_boundary_1,
-    seq_hash]``) without logging them; used by twin-trajectory diagnostics.
+    seq_hash]``, the hash being order-sensitive) without logging them. Not flying on to
+    ``t_end`` keeps the trajectory bitwise equal to `simulate_two_kernel`'s, whose sample
+    positions are interpolated, never integrated.
     """
     while True:
         k, dt = next_event_two(ev)
@@ -180,6 +189,12 @@ def advance_two(st, ev, t_end, rho, sigma, rule, cnt):
             cnt[1] += 1
             cnt[2 + k] += 1
         cnt[4] = (cnt[4] * 4 + k + 1) % HASH_MOD
+
+
+@njit(cache=True, inline="always")
+def advance_two(st, ev, t_end, rho, sigma, rule, cnt):
+    """`advance_events_two`, then fly on to exactly ``t_end``."""
+    advance_events_two(st, ev, t_end, rho, sigma, rule, cnt)
     finish_at(st, ev, t_end)
 
 

@@ -1,0 +1,203 @@
+"""Benchmark: recurrence rate (cell list, numba) against cKDTree and brute force.
+
+Run as ``python benchmarks/bench_recurrence.py [--quick] [--max-n N]``.
+
+Point sets: a billiard-like trajectory (a point particle in the unit disk, straight
+chords sampled every tau = 0.2, direction redrawn at every wall hit, so the chords fill
+the disk as a kicked trajectory does) and points uniform in the unit disk; eps = 1e-3.
+
+References, measured in the same run:
+* ``scipy.spatial.cKDTree(points).count_neighbors(tree, eps)`` (build + count; the count
+  of ordered pairs including the diagonal, i.e. N^2 RR) and the count alone;
+* brute force with numpy (row blocks of the distance matrix) at a smaller N, scaled by
+  (N / n_small)^2.
+Then the scaling of our code to N = 10^6 and 10^7 with its extra peak memory (growth
+of the peak resident set during the call, each N in a fresh process).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import statistics
+import subprocess
+import sys
+import time
+
+import numpy as np
+from numba import njit
+from scipy.spatial import cKDTree
+
+from kicktimes.diagnostics import recurrence_rate
+
+
+@njit(cache=True)
+def kicked_chords(n, tau, seed):
+    """Centre of a point particle in the unit disk sampled at k * tau, k = 0..n-1."""
+    # numba's own generator: the legacy API is the one it supports inside njit code
+    np.random.seed(seed)  # noqa: NPY002
+    x, y = 0.3, -0.2
+    a = np.random.uniform(0.0, 2.0 * np.pi)  # noqa: NPY002
+    vx, vy = np.cos(a), np.sin(a)
+    pts = np.empty((n, 2))
+    t = 0.0
+    k = 0
+    while k < n:
+        b = x * vx + y * vy
+        dt = -b + np.sqrt(b * b - (x * x + y * y) + 1.0)
+        while k < n and k * tau <= t + dt:
+            s = k * tau - t
+            pts[k, 0] = x + s * vx
+            pts[k, 1] = y + s * vy
+            k += 1
+        x += dt * vx
+        y += dt * vy
+        t += dt
+        # new inward direction, uniform within the half-plane facing the centre
+        a = np.arctan2(y, x) + np.pi + np.random.uniform(-0.5 * np.pi, 0.5 * np.pi)  # noqa: NPY002
+        vx, vy = np.cos(a), np.sin(a)
+    return pts
+
+
+def uniform_disk(n, seed):
+    rng = np.random.default_rng(seed)
+    r = np.sqrt(rng.uniform(size=n))
+    a = rng.uniform(0.0, 2.0 * np.pi, n)
+    return np.column_stack([r * np.cos(a), r * np.sin(a)])
+
+
+def timeit(fn, repeat):
+    times = []
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        out = fn()
+        times.append(time.perf_counter() - t0)
+    return min(times), statistics.median(times), out
+
+
+def brute_count(pts, eps, block=1024):
+    eps2 = eps * eps
+    total = 0
+    for lo in range(0, len(pts), block):
+        p = pts[lo : lo + block]
+        dx = p[:, None, 0] - pts[None, :, 0]
+        dy = p[:, None, 1] - pts[None, :, 1]
+        total += int(np.count_nonzero(dx * dx + dy * dy <= eps2))
+    return total
+
+
+def scaling_row(size, eps):
+    """Time and extra peak memory of one N, measured in a fresh process (see --child)."""
+    out = subprocess.run(
+        [sys.executable, __file__, "--child", str(size), "--eps", repr(eps)],
+        check=True,
+        capture_output=True,
+        text=True,
+    )
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+def _status_kb(field):
+    with open("/proc/self/status") as fh:
+        for line in fh:
+            if line.startswith(field + ":"):
+                return int(line.split()[1])
+    raise RuntimeError(f"{field} not in /proc/self/status")
+
+
+def child(size, eps):
+    """Generate the points, then report RR, its time, and the peak RSS it added.
+
+    The kernel's peak-RSS mark (VmHWM) is reset to the current RSS just before the call
+    (``/proc/self/clear_refs``), so its growth is the extra peak memory of the call.
+    """
+    recurrence_rate(uniform_disk(100, 0), eps)
+    pts = kicked_chords(size, 0.2, 3)
+    with open("/proc/self/clear_refs", "w") as fh:
+        fh.write("5")
+    before = _status_kb("VmRSS")
+    t0 = time.perf_counter()
+    rr = recurrence_rate(pts, eps)
+    dt = time.perf_counter() - t0
+    extra = (_status_kb("VmHWM") - before) * 1024
+    row = {"n": size, "rr": rr, "time": dt, "extra_bytes": extra}
+    if size <= 10**6:
+        row["time"] = min(dt, timeit(lambda: recurrence_rate(pts, eps), 5)[0])
+        k_dt, _, count = timeit(lambda: (lambda tr: tr.count_neighbors(tr, eps))(cKDTree(pts)), 1)
+        assert count == round(rr * size * size)
+        row["kdtree_time"] = k_dt
+    print(json.dumps(row))
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--quick", action="store_true", help="fewer repeats, N <= 10^6")
+    parser.add_argument("--max-n", type=float, default=1e7, help="largest N of the scaling")
+    parser.add_argument("--child", type=int, default=0, help=argparse.SUPPRESS)
+    parser.add_argument("--eps", type=float, default=1e-3, help="recurrence threshold")
+    args = parser.parse_args()
+    eps = args.eps
+    if args.child:
+        child(args.child, eps)
+        return
+    n = 25_000
+    n_brute = 5_000
+    rep = 5 if args.quick else 30
+
+    recurrence_rate(uniform_disk(100, 0), eps)  # compile / load the cache outside timings
+    kicked_chords(10, 0.2, 0)
+
+    print(f"Recurrence rate, eps = {eps:g}, N = {n}  (times: min / median of {rep} runs)")
+    header = (
+        f"{'point set':<12} {'RR':>11} {'ours [ms]':>15} {'cKDTree [ms]':>17} "
+        f"{'KDT count [ms]':>15} {'brute* [ms]':>12} {'KDT/ours':>9} {'brute/ours':>11}"
+    )
+    print(header)
+    print("-" * len(header))
+    for name, pts in [("trajectory", kicked_chords(n, 0.2, 1)), ("uniform", uniform_disk(n, 2))]:
+        t_min, t_med, rr = timeit(lambda p=pts: recurrence_rate(p, eps), rep)
+        tree = cKDTree(pts)
+        k_min, k_med, count = timeit(
+            lambda p=pts: (lambda tr: tr.count_neighbors(tr, eps))(cKDTree(p)), rep
+        )
+        c_min, _, _ = timeit(lambda tr=tree: tr.count_neighbors(tr, eps), rep)
+        assert count == round(rr * n * n), (count, rr * n * n)
+        small = pts[:n_brute]
+        b_min, _, bcount = timeit(lambda s=small: brute_count(s, eps), 3)
+        assert bcount == round(recurrence_rate(small, eps) * n_brute**2)
+        b_scaled = b_min * (n / n_brute) ** 2
+        print(
+            f"{name:<12} {rr:11.4e} {t_min * 1e3:7.3f} / {t_med * 1e3:5.3f} "
+            f"{k_min * 1e3:8.2f} / {k_med * 1e3:6.2f} {c_min * 1e3:15.2f} "
+            f"{b_scaled * 1e3:12.0f} {k_min / t_min:9.1f} {b_scaled / t_min:11.0f}"
+        )
+    print(
+        f"* brute force with numpy at N = {n_brute}, scaled by (N / {n_brute})^2; "
+        "cKDTree = build + count_neighbors, KDT count = count_neighbors on a built tree"
+    )
+
+    print()
+    print(f"Scaling (trajectory, eps = {eps:g}), each N in a fresh process; memory = peak RSS")
+    print("added by the call (input points, 16 B/point, not included)")
+    header = (
+        f"{'N':>10} {'RR':>11} {'ours [s]':>9} {'ns/point':>9} {'mem [MB]':>9} "
+        f"{'B/point':>8} {'cKDTree [s]':>12} {'KDT/ours':>9}"
+    )
+    print(header)
+    print("-" * len(header))
+    sizes = [25_000, 10**5, 10**6] + ([10**7] if not args.quick else [])
+    for size in [s for s in sizes if s <= args.max_n]:
+        row = scaling_row(size, eps)
+        dt, mem = row["time"], row["extra_bytes"]
+        if "kdtree_time" in row:
+            kdt = f"{row['kdtree_time']:12.3f} {row['kdtree_time'] / dt:9.1f}"
+        else:
+            kdt = f"{'-':>12} {'-':>9}"
+        print(
+            f"{size:>10} {row['rr']:11.4e} {dt:9.4f} {dt / size * 1e9:9.1f} "
+            f"{mem / 2**20:9.1f} {mem / size:8.1f} {kdt}"
+        )
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,27 @@
+"""Chaos diagnostics of sampled trajectories and boundary-collision series.
+
+Recurrence rate and recurrence plots (`recurrence_rate`, `recurrence_pairs`), the paper's
+autocorrelation of the boundary-collision angles (`autocorrelation`,
+`autocorrelation_many`, `boundary_angles`) and finite-time Lyapunov exponents
+(`lyapunov`, Benettin twins with common random numbers); see docs/diagnostics.md.
+"""
+
+from kicktimes.diagnostics.autocorrelation import (
+    UndefinedDiagnosticWarning,
+    autocorrelation,
+    autocorrelation_many,
+    boundary_angles,
+)
+from kicktimes.diagnostics.lyapunov import LyapunovResult, lyapunov
+from kicktimes.diagnostics.recurrence import recurrence_pairs, recurrence_rate
+
+__all__ = [
+    "LyapunovResult",
+    "UndefinedDiagnosticWarning",
+    "autocorrelation",
+    "autocorrelation_many",
+    "boundary_angles",
+    "lyapunov",
+    "recurrence_pairs",
+    "recurrence_rate",
+]

@@ -1,0 +1,491 @@
+"""Recurrence rate and recurrence plots of a sampled planar trajectory.
+
+The recurrence matrix of N points ``x_1..x_N`` in the plane is
+``R_ij = Theta(eps - |x_i - x_j|)`` (L2 norm) and the recurrence rate is its density,
+``RR(eps) = (1/N^2) sum_ij R_ij``. Neither is ever built as an N x N matrix: pairs closer
+than ``eps`` are found with a cell list of square cells of side just above ``eps``, so
+that every recurrent pair lies in the same or in adjacent cells. The occupied cells are
+found by an O(N) radix sort of integer cell keys (a dense grid of ``(2/eps)^2`` cells
+would not fit in memory for small ``eps``), and one sweep over the sorted cells visits
+each cell's own points and its four "forward" neighbours (the other four are visited
+from the other side), so every unordered pair is examined once. Memory is O(N), time is
+O(N + number of candidate pairs), and by a packing argument the candidate pairs (all
+within ``2 sqrt(2) eps``) are at most a constant times ``N`` plus the recurrent pairs.
+
+Conventions (see docs/diagnostics.md):
+
+* the distance test is ``dx*dx + dy*dy <= eps*eps`` in float64, i.e. Theta(0) = 1 as in
+  Marwan et al. (2007), and brute force with the same expression agrees exactly;
+* the main diagonal (the line of identity) is included unless a Theiler window is set,
+  so RR >= 1/N;
+* with a Theiler window ``w >= 1`` the pairs with ``|i - j| < w`` are excluded from the
+  count *and* from the normalisation, which becomes the number of admissible entries
+  ``(N - w)(N - w + 1)`` (Webber & Zbilut 2005; Marwan & Webber 2015; the convention of
+  RecurrenceAnalysis.jl). ``w = 0`` means no exclusion and the 1/N^2 of the paper.
+"""
+
+from __future__ import annotations
+
+import numbers
+
+import numpy as np
+from numba import njit
+
+__all__ = ["recurrence_pairs", "recurrence_rate"]
+
+# Cells are a hair larger than eps so that round-off in the cell coordinate
+# (x - xmin) / h (at most a few 2^-53 relative, i.e. < 1e-7 cells with the cap below)
+# can never put two points with |dx| <= eps two cells apart.
+_CELL_PAD = 1.0 + 1e-6
+# At most 2^26 cells per axis: keys stay below 2^53 and round-off stays far below 1 cell.
+# Only reached for eps < 3e-8 * extent, where the coarser cells cost nothing in practice.
+_MAX_CELLS_PER_AXIS = float(2**26)
+_RADIX_BITS = 11
+
+# Modes of the pair sweep.
+_COUNT, _DEGREE, _FILL = 0, 1, 2
+
+
+# --------------------------------------------------------------------------- kernels
+
+
+@njit(cache=True)
+def _bounding_box(points):
+    """(xmin, xmax, ymin, ymax, all finite) of an (N, 2) array, in one pass."""
+    xmin = np.inf
+    xmax = -np.inf
+    ymin = np.inf
+    ymax = -np.inf
+    finite = True
+    for k in range(points.shape[0]):
+        x = points[k, 0]
+        y = points[k, 1]
+        if not (np.isfinite(x) and np.isfinite(y)):
+            finite = False
+            break
+        xmin = min(xmin, x)
+        xmax = max(xmax, x)
+        ymin = min(ymin, y)
+        ymax = max(ymax, y)
+    return xmin, xmax, ymin, ymax, finite
+
+
+@njit(cache=True)
+def _radix_argsort(keys, n_bits):
+    """Stable LSD radix argsort of non-negative int64 keys below ``2**n_bits``.
+
+    Returns ``(perm, sorted keys)``; ``keys`` is used as scratch space (overwritten).
+    O(N) per 11-bit digit: for the cell keys of eps = 1e-3 in the unit disk (22 bits)
+    that is two passes, faster than a comparison sort for N ~ 10^5..10^7.
+    """
+    n = keys.shape[0]
+    nbuck = 1 << _RADIX_BITS
+    mask = nbuck - 1
+    perm = np.arange(n)
+    k_cur = keys
+    k_tmp = np.empty_like(keys)
+    p_tmp = np.empty_like(perm)
+    count = np.empty(nbuck, np.int64)
+    shift = 0
+    while shift < n_bits:
+        count[:] = 0
+        for a in range(n):
+            count[(k_cur[a] >> shift) & mask] += 1
+        total = 0
+        for b in range(nbuck):
+            c = count[b]
+            count[b] = total
+            total += c
+        for a in range(n):
+            d = (k_cur[a] >> shift) & mask
+            pos = count[d]
+            count[d] = pos + 1
+            k_tmp[pos] = k_cur[a]
+            p_tmp[pos] = perm[a]
+        k_cur, k_tmp = k_tmp, k_cur
+        perm, p_tmp = p_tmp, perm
+        shift += _RADIX_BITS
+    return perm, k_cur
+
+
+@njit(cache=True)
+def _build_cells(points, xmin, ymin, inv_h, ncx, n_bits):
+    """Sort the points by cell; return sorted coordinates, permutation and cell table.
+
+    Cell ``(cx, cy)`` (1-based, so that the neighbour ``cx +- 1`` of a border cell is an
+    empty padding column and never aliases the next row) has key ``cy * ncx + cx``.
+    Returns ``xs, ys, perm, cell_start, cell_key`` with the points of cell ``c`` at
+    sorted positions ``cell_start[c] : cell_start[c + 1]`` and original indices ``perm``.
+    """
+    n = points.shape[0]
+    keys = np.empty(n, np.int64)
+    for a in range(n):
+        cx = np.int64((points[a, 0] - xmin) * inv_h) + 1
+        cy = np.int64((points[a, 1] - ymin) * inv_h) + 1
+        keys[a] = cy * ncx + cx
+    perm, skeys = _radix_argsort(keys, n_bits)
+    xs = np.empty(n)
+    ys = np.empty(n)
+    n_cells = 0
+    for a in range(n):
+        xs[a] = points[perm[a], 0]
+        ys[a] = points[perm[a], 1]
+        if a == 0 or skeys[a] != skeys[a - 1]:
+            n_cells += 1
+    cell_start = np.empty(n_cells + 1, np.int64)
+    cell_key = np.empty(n_cells, np.int64)
+    c = 0
+    for a in range(n):
+        if a == 0 or skeys[a] != skeys[a - 1]:
+            cell_start[c] = a
+            cell_key[c] = skeys[a]
+            c += 1
+    cell_start[n_cells] = n
+    return xs, ys, perm, cell_start, cell_key
+
+
+@njit(cache=True, inline="always")
+def _visit_block(xs, ys, perm, a0, a1, b0, b1, same, eps2, w, mode, deg, cursor, out_j):
+    """Examine the pairs (a in [a0, a1), b in [b0, b1)) of sorted positions.
+
+    ``same`` marks a block of one cell with itself: then only a < b is examined.
+    Counts the unordered pairs with squared distance <= eps2 and ``|i - j| >= w``
+    (``w >= 1``), and in the other modes records them for both orders.
+    """
+    count = 0
+    for a in range(a0, a1):
+        xa = xs[a]
+        ya = ys[a]
+        ia = perm[a]
+        start = a + 1 if same else b0
+        for b in range(start, b1):
+            dx = xa - xs[b]
+            dy = ya - ys[b]
+            if dx * dx + dy * dy <= eps2:
+                ib = perm[b]
+                if w > 1 and abs(ia - ib) < w:
+                    continue
+                count += 1
+                if mode == _DEGREE:
+                    deg[ia] += 1
+                    deg[ib] += 1
+                elif mode == _FILL:
+                    out_j[cursor[ia]] = ib
+                    cursor[ia] += 1
+                    out_j[cursor[ib]] = ia
+                    cursor[ib] += 1
+    return count
+
+
+@njit(cache=True)
+def _sweep(xs, ys, perm, cell_start, cell_key, ncx, eps2, w, mode, deg, cursor, out_j):
+    """Visit every unordered pair of distinct points in the same or adjacent cells once.
+
+    Half stencil: a cell is paired with itself, with ``(cx+1, cy)`` and with the three
+    cells of the row above. Their keys are ``key + 1`` and ``key + ncx + (-1, 0, 1)``,
+    which grow with ``key``, so a single forward pointer finds the upper-row cells.
+    """
+    n_cells = cell_key.shape[0]
+    total = 0
+    q = 0
+    for c in range(n_cells):
+        key = cell_key[c]
+        s0 = cell_start[c]
+        s1 = cell_start[c + 1]
+        total += _visit_block(xs, ys, perm, s0, s1, s0, s1, True, eps2, w, mode, deg, cursor, out_j)
+        if c + 1 < n_cells and cell_key[c + 1] == key + 1:
+            total += _visit_block(
+                xs,
+                ys,
+                perm,
+                s0,
+                s1,
+                s1,
+                cell_start[c + 2],
+                False,
+                eps2,
+                w,
+                mode,
+                deg,
+                cursor,
+                out_j,
+            )
+        lo = key + ncx - 1
+        hi = key + ncx + 1
+        while q < n_cells and cell_key[q] < lo:
+            q += 1
+        r = q
+        while r < n_cells and cell_key[r] <= hi:
+            total += _visit_block(
+                xs,
+                ys,
+                perm,
+                s0,
+                s1,
+                cell_start[r],
+                cell_start[r + 1],
+                False,
+                eps2,
+                w,
+                mode,
+                deg,
+                cursor,
+                out_j,
+            )
+            r += 1
+    return total
+
+
+@njit(cache=True)
+def _sort_rows(offsets, out_j):
+    """Sort each row ``out_j[offsets[i]:offsets[i+1]]`` in place (rows are short)."""
+    for i in range(offsets.shape[0] - 1):
+        lo = offsets[i]
+        hi = offsets[i + 1]
+        if hi - lo > 32:
+            out_j[lo:hi] = np.sort(out_j[lo:hi])
+            continue
+        for a in range(lo + 1, hi):  # insertion sort
+            v = out_j[a]
+            b = a - 1
+            while b >= lo and out_j[b] > v:
+                out_j[b + 1] = out_j[b]
+                b -= 1
+            out_j[b + 1] = v
+
+
+# ------------------------------------------------------------------------- front end
+
+
+def _as_points(points) -> np.ndarray:
+    """(N, 2) float64 C-contiguous view of ``points`` (no copy when already so)."""
+    if hasattr(points, "samples") and not isinstance(points, np.ndarray):
+        # a run record: its samples are the tracked disk's centres at the sample times
+        points = points.samples
+    try:
+        arr = np.asarray(points)
+    except Exception as exc:  # e.g. ragged lists
+        raise TypeError(f"points: expected an (N, 2) array of floats, got {points!r}") from exc
+    if arr.dtype == object or not (
+        np.issubdtype(arr.dtype, np.floating) or np.issubdtype(arr.dtype, np.integer)
+    ):
+        raise TypeError(f"points: expected a real (N, 2) array, got dtype {arr.dtype}")
+    if arr.ndim != 2 or arr.shape[1] != 2:
+        raise ValueError(
+            f"points: expected shape (N, 2) (planar positions; other dimensions are not "
+            f"supported), got shape {arr.shape}"
+        )
+    if arr.shape[0] == 0:
+        raise ValueError("points: need at least one point, got N = 0")
+    return np.ascontiguousarray(arr, dtype=np.float64)
+
+
+def _check_eps(eps) -> float:
+    if isinstance(eps, np.ndarray) and eps.ndim == 0:
+        eps = eps.item()
+    if isinstance(eps, bool) or not isinstance(eps, numbers.Real):
+        raise TypeError(f"eps: expected a positive finite float, got {eps!r}")
+    eps = float(eps)
+    if not (np.isfinite(eps) and eps > 0.0):
+        raise ValueError(f"eps: must be positive and finite (0 < eps < inf), got {eps!r}")
+    return eps
+
+
+def _check_theiler(theiler, n: int) -> int:
+    if isinstance(theiler, bool) or not isinstance(theiler, numbers.Integral):
+        raise TypeError(f"theiler: expected a non-negative int, got {theiler!r}")
+    theiler = int(theiler)
+    if theiler < 0:
+        raise ValueError(f"theiler: must be >= 0 (0 = no exclusion), got {theiler}")
+    if theiler >= n:
+        raise ValueError(
+            f"theiler: a window of {theiler} excludes every pair of N = {n} points; "
+            f"need 0 <= theiler < N"
+        )
+    return theiler
+
+
+def _cells(pts: np.ndarray, eps: float):
+    xmin, xmax, ymin, ymax, finite = _bounding_box(pts)
+    if not finite:
+        bad = np.flatnonzero(~np.isfinite(pts).all(axis=1))
+        raise ValueError(
+            f"points: must be finite; row {bad[0]} is {pts[bad[0]].tolist()} "
+            f"({bad.size} non-finite rows)"
+        )
+    extent = max(xmax - xmin, ymax - ymin)
+    h = max(eps * _CELL_PAD, extent / _MAX_CELLS_PER_AXIS)
+    inv_h = 1.0 / h
+    ncx = int(np.floor((xmax - xmin) * inv_h)) + 3  # 1-based columns plus padding
+    ncy = int(np.floor((ymax - ymin) * inv_h)) + 3
+    n_bits = max(1, int(ncx * ncy - 1).bit_length())
+    return (*_build_cells(pts, xmin, ymin, inv_h, ncx, n_bits), ncx)
+
+
+_EMPTY = np.empty(0, np.int64)
+
+
+def recurrence_rate(points, eps=1e-3, *, theiler=0):
+    r"""Recurrence rate of a sampled planar trajectory.
+
+    .. math::
+
+        RR(\varepsilon) = \frac{1}{N^2} \sum_{i,j=1}^{N}
+            \Theta\bigl(\varepsilon - \lVert x_i - x_j \rVert_2\bigr),
+        \qquad \Theta(0) = 1,
+
+    over all ordered pairs including the main diagonal, so ``RR >= 1/N``. Computed with
+    a cell list in O(N) memory, exactly equal to brute-force counting.
+
+    Parameters
+    ----------
+    points : array_like, shape (N, 2), or a run record
+        Sampled positions (e.g. ``run.samples``, the tracked disk's centre at the sample
+        times; a run record is accepted directly). Only planar points are supported.
+    eps : float or array_like of float, default 1e-3
+        Recurrence threshold(s) ``eps > 0``. A pair is recurrent when
+        ``dx**2 + dy**2 <= eps**2`` in float64. An array gives one RR per threshold.
+    theiler : int, default 0
+        Theiler window ``w``: pairs with ``|i - j| < w`` are excluded (``w = 0``: none;
+        ``w = 1``: the main diagonal only). For ``w >= 1`` the normalisation is the number
+        of admissible entries, ``(N - w)(N - w + 1)``, not ``N^2``; requires ``w < N``.
+
+    Returns
+    -------
+    float or ndarray
+        RR in ``[1/N, 1]`` for ``theiler=0``, in ``[0, 1]`` otherwise; an array when
+        ``eps`` is an array.
+
+    Raises
+    ------
+    ValueError
+        Points not of shape (N, 2), empty or non-finite; ``eps`` not positive and finite;
+        ``theiler`` negative or ``>= N``.
+    TypeError
+        Non-numeric points, eps or theiler.
+
+    Notes
+    -----
+    Cells of side ``h`` slightly above ``eps`` are keyed by ``cy * ncx + cx`` and sorted by
+    an O(N) radix sort; a sweep visits each cell's own pairs and its four forward
+    neighbours. Time O(N + pairs within ``2 sqrt(2) eps``), memory about 45 bytes/point.
+
+    References
+    ----------
+    N. Marwan, M. C. Romano, M. Thiel, J. Kurths, "Recurrence plots for the analysis of
+    complex systems", Phys. Rep. 438, 237 (2007). C. L. Webber, J. P. Zbilut, "Recurrence
+    quantification analysis of nonlinear dynamical systems" (2005), for the Theiler
+    window normalisation.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from kicktimes.diagnostics import recurrence_rate
+    >>> pts = np.array([[0.0, 0.0], [0.0005, 0.0], [0.5, 0.5]])
+    >>> recurrence_rate(pts, eps=1e-3) * 9      # 3 diagonal entries + the pair, twice
+    5.0
+    >>> recurrence_rate(pts, eps=1e-3, theiler=1) * 6   # (N - 1) N admissible entries
+    2.0
+    """
+    pts = _as_points(points)
+    n = pts.shape[0]
+    w = _check_theiler(theiler, n)
+    if np.ndim(eps) == 0:
+        return _recurrence_rate_one(pts, _check_eps(eps), w)
+    eps_arr = np.asarray(eps)
+    if eps_arr.ndim != 1 or eps_arr.size == 0:
+        raise ValueError(
+            f"eps: expected a float or a non-empty 1-D array, got shape {eps_arr.shape}"
+        )
+    return np.array([_recurrence_rate_one(pts, _check_eps(e.item()), w) for e in eps_arr])
+
+
+def _recurrence_rate_one(pts: np.ndarray, eps: float, w: int) -> float:
+    n = pts.shape[0]
+    xs, ys, perm, cell_start, cell_key, ncx = _cells(pts, eps)
+    pairs = _sweep(
+        xs,
+        ys,
+        perm,
+        cell_start,
+        cell_key,
+        ncx,
+        eps * eps,
+        max(w, 1),
+        _COUNT,
+        _EMPTY,
+        _EMPTY,
+        _EMPTY,
+    )
+    if w == 0:
+        # Python ints: N^2 overflows nothing, and the division is correctly rounded
+        return (n + 2 * int(pairs)) / (n * n)
+    k = n - w
+    return 2 * int(pairs) / (k * (k + 1))
+
+
+def recurrence_pairs(points, eps=1e-3, *, theiler=0):
+    r"""The recurrence plot as index pairs: every ``(i, j)`` with ``|x_i - x_j| <= eps``.
+
+    Returns the nonzero entries of the recurrence matrix
+    ``R_ij = Theta(eps - |x_i - x_j|)`` (both orders, main diagonal included unless a
+    Theiler window removes it), never the N x N matrix. ``len(i) / N**2`` equals
+    ``recurrence_rate(points, eps)`` for ``theiler=0``.
+
+    Parameters
+    ----------
+    points : array_like, shape (N, 2), or a run record
+        Sampled planar positions.
+    eps : float, default 1e-3
+        Recurrence threshold, ``eps > 0`` (pairs with ``dx**2 + dy**2 <= eps**2``).
+    theiler : int, default 0
+        Exclude pairs with ``|i - j| < theiler`` (0: none; 1: the main diagonal).
+
+    Returns
+    -------
+    i, j : ndarray of int64
+        Row and column indices, sorted lexicographically by ``(i, j)``; the matrix is
+        symmetric, so ``(j, i)`` is present whenever ``(i, j)`` is.
+
+    Raises
+    ------
+    ValueError, TypeError
+        As `recurrence_rate`.
+
+    Notes
+    -----
+    Two sweeps of the cell list: the first counts each point's recurrences (the row
+    lengths), the second fills the rows in place, which are then sorted. Memory is
+    O(N + pairs); beware that for large ``eps`` the pair count approaches ``N^2``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from kicktimes.diagnostics import recurrence_pairs
+    >>> i, j = recurrence_pairs(np.array([[0.0, 0.0], [0.0005, 0.0], [0.5, 0.5]]), 1e-3)
+    >>> i.tolist(), j.tolist()
+    ([0, 0, 1, 1, 2], [0, 1, 0, 1, 2])
+
+    A recurrence plot: ``plt.scatter(i, j, s=0.1)`` (or a sparse matrix,
+    ``scipy.sparse.coo_array((np.ones(i.size, bool), (i, j)), shape=(N, N))``).
+    """
+    pts = _as_points(points)
+    n = pts.shape[0]
+    w = _check_theiler(theiler, n)
+    eps = _check_eps(eps)
+    xs, ys, perm, cell_start, cell_key, ncx = _cells(pts, eps)
+    deg = np.zeros(n, np.int64) if w > 0 else np.ones(n, np.int64)
+    _sweep(
+        xs, ys, perm, cell_start, cell_key, ncx, eps * eps, max(w, 1), _DEGREE, deg, _EMPTY, _EMPTY
+    )
+    offsets = np.zeros(n + 1, np.int64)
+    np.cumsum(deg, out=offsets[1:])
+    out_j = np.empty(offsets[-1], np.int64)
+    cursor = offsets[:-1].copy()
+    if w == 0:
+        out_j[cursor] = np.arange(n)
+        cursor += 1
+    _sweep(xs, ys, perm, cell_start, cell_key, ncx, eps * eps, max(w, 1), _FILL, deg, cursor, out_j)
+    _sort_rows(offsets, out_j)
+    out_i = np.repeat(np.arange(n, dtype=np.int64), deg)
+    return out_i, out_j

@@ -1,0 +1,362 @@
+"""Specification of the paper's autocorrelation and of the boundary-angle series."""
+
+from __future__ import annotations
+
+import types
+import warnings
+
+import numpy as np
+import pandas as pd
+import pytest
+from numpy.testing import assert_allclose, assert_array_equal
+from statsmodels.tsa.stattools import acf
+
+from kicktimes.diagnostics import (
+    UndefinedDiagnosticWarning,
+    autocorrelation,
+    autocorrelation_many,
+    boundary_angles,
+)
+
+
+def paper_formula(x: np.ndarray, lag: int) -> float:
+    """R_l exactly as written in the paper (1-based sums rewritten 0-based)."""
+    n = len(x)
+    xbar = sum(x) / n
+    num = sum((x[i] - xbar) * (x[i + lag] - xbar) for i in range(n - lag))
+    den = sum((x[i] - xbar) ** 2 for i in range(n))
+    return num / den
+
+
+def ar1(phi: float, n: int, seed: int) -> np.ndarray:
+    rng = np.random.default_rng(seed)
+    e = rng.normal(size=n)
+    x = np.empty(n)
+    x[0] = e[0] / np.sqrt(1.0 - phi**2)  # stationary start
+    for t in range(1, n):
+        x[t] = phi * x[t - 1] + e[t]
+    return x
+
+
+def point_billiard_sin_theta(n_hits: int, seed: int, kick_prob: float = 0.0) -> np.ndarray:
+    """sin(theta) at the boundary hits of a point particle in the unit disk.
+
+    Without kicks the orbit is integrable and sin(theta) = x × v is constant up to
+    round-off; with probability kick_prob per hit the direction is redrawn.
+    """
+    rng = np.random.default_rng(seed)
+    x = np.array([0.3, -0.2])
+    a = rng.uniform(0.0, 2.0 * np.pi)
+    v = np.array([np.cos(a), np.sin(a)])
+    out = np.empty(n_hits)
+    for k in range(n_hits):
+        b = x @ v
+        x = x + (-b + np.sqrt(b * b - x @ x + 1.0)) * v
+        out[k] = x[0] * v[1] - x[1] * v[0]
+        nrm = x / np.linalg.norm(x)
+        v = v - 2.0 * (v @ nrm) * nrm
+        if rng.uniform() < kick_prob:
+            a = np.arctan2(x[1], x[0]) + np.pi + rng.uniform(-0.5 * np.pi, 0.5 * np.pi)
+            v = np.array([np.cos(a), np.sin(a)])
+    return out
+
+
+# ------------------------------------------------------------------ the definition
+
+
+@pytest.mark.parametrize("lag", [0, 1, 2, 7, 49])
+def test_equals_the_paper_formula(lag):
+    x = np.random.default_rng(1).normal(size=50).cumsum()
+    assert_allclose(autocorrelation(x, lag), paper_formula(x, lag), rtol=1e-12, atol=1e-14)
+
+
+def test_equals_statsmodels_acf_with_its_default_normalisation():
+    for seed, x in enumerate([ar1(0.7, 5000, 2), np.random.default_rng(3).uniform(size=777)]):
+        ref = acf(x, nlags=20, adjusted=False, fft=False)
+        ours = [autocorrelation(x, lag) for lag in range(21)]
+        assert_allclose(ours, ref, rtol=1e-10, atol=1e-13, err_msg=f"series {seed}")
+
+
+def test_lag_zero_is_one():
+    assert autocorrelation(np.array([0.1, -2.0, 3.0]), 0) == pytest.approx(1.0, abs=1e-15)
+
+
+def test_known_small_values():
+    assert autocorrelation([1.0, 2.0, 3.0, 4.0]) == 0.25
+    assert autocorrelation([1.0, -1.0, 1.0, -1.0]) == -0.75
+
+
+@pytest.mark.parametrize("phi", [-0.6, 0.0, 0.3, 0.8])
+def test_ar1_series_has_lag_one_autocorrelation_phi(phi):
+    n = 40_000
+    r1 = autocorrelation(ar1(phi, n, seed=4), 1)
+    se = np.sqrt((1.0 - phi**2) / n)
+    assert abs(r1 - phi) < 4.0 * se + (1.0 + 4.0 * abs(phi)) / n  # + the O(1/N) bias
+
+
+def test_ar1_higher_lags_decay_as_phi_to_the_lag():
+    x = ar1(0.8, 40_000, seed=5)
+    for lag in (2, 3, 5):
+        assert autocorrelation(x, lag) == pytest.approx(0.8**lag, abs=0.03)
+
+
+def test_invariant_under_affine_changes_of_the_series():
+    x = np.random.default_rng(6).normal(size=300)
+    ref = autocorrelation(x, 2)
+    assert autocorrelation(3.0 * x + 10.0, 2) == pytest.approx(ref, rel=1e-10)
+    assert autocorrelation(-x, 2) == pytest.approx(ref, rel=1e-12)
+
+
+# ------------------------------------------------------------------ undefined values
+
+
+def test_constant_series_gives_nan_with_a_warning_that_says_why():
+    with pytest.warns(UndefinedDiagnosticWarning, match="constant series"):
+        assert np.isnan(autocorrelation(np.full(100, 0.42)))
+
+
+def test_constant_series_reason_without_a_warning():
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # any warning would fail the test
+        value, reason = autocorrelation(np.zeros(10), return_reason=True)
+    assert np.isnan(value)
+    assert reason.startswith("constant series")
+    value, reason = autocorrelation(np.arange(10.0), return_reason=True)
+    assert reason is None and np.isfinite(value)
+
+
+def test_round_off_around_a_constant_is_still_constant():
+    # the unkicked (integrable) billiard: sin(theta) is conserved up to round-off, and
+    # dividing round-off by round-off must not produce a number
+    theta = np.arcsin(point_billiard_sin_theta(3000, seed=7))
+    assert 0.0 < theta.std() < 1e-12
+    value, reason = autocorrelation(theta, return_reason=True)
+    assert np.isnan(value) and reason.startswith("constant")
+
+
+def test_kicked_billiard_angles_are_valid_and_tolerance_is_adjustable():
+    theta = np.arcsin(point_billiard_sin_theta(3000, seed=8, kick_prob=0.05))
+    assert np.isfinite(autocorrelation(theta))
+    tiny = 0.5 + 1e-13 * np.random.default_rng(9).normal(size=500)
+    assert np.isnan(autocorrelation(tiny, return_reason=True)[0])
+    assert np.isfinite(autocorrelation(tiny, rtol=0.0, atol=0.0))  # exact zero only
+
+
+def test_warning_can_be_silenced_for_ensembles():
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        warnings.simplefilter("ignore", UndefinedDiagnosticWarning)
+        assert np.isnan(autocorrelation(np.ones(5)))
+
+
+@pytest.mark.parametrize(("n", "lag"), [(0, 1), (1, 1), (3, 3), (3, 5), (1, 0)])
+def test_too_short_series_give_nan_with_reason(n, lag):
+    value, reason = autocorrelation(np.arange(float(n)), lag, return_reason=True)
+    assert np.isnan(value)
+    assert reason.startswith("series too short")
+    with pytest.warns(UndefinedDiagnosticWarning, match="too short"):
+        autocorrelation(np.arange(float(n)), lag)
+
+
+# ------------------------------------------------------------------ batches
+
+
+def test_many_equals_one_by_one_for_ragged_series():
+    rng = np.random.default_rng(10)
+    series = [rng.normal(size=k).cumsum() for k in (5, 50, 500)] + [np.ones(7), [1.0]]
+    df = autocorrelation_many(series, lag=2)
+    for k, x in enumerate(series):
+        value, reason = autocorrelation(x, 2, return_reason=True)
+        assert_array_equal(df["autocorrelation"].iloc[k], value)
+        assert df["valid"].iloc[k] == (reason is None)
+    assert df["reason"].tolist() == ["ok", "ok", "ok", "constant", "too_short"]
+    assert df["n"].tolist() == [5, 50, 500, 7, 1]
+    assert df.attrs["lag"] == 2
+
+
+def test_many_accepts_a_2d_array_and_a_mapping():
+    arr = np.random.default_rng(11).normal(size=(4, 30))
+    df = autocorrelation_many(arr)
+    assert_allclose(df["autocorrelation"], [autocorrelation(row) for row in arr], rtol=0)
+    by_ic = autocorrelation_many({17: arr[0], 23: arr[1]})
+    assert by_ic.index.tolist() == [17, 23]
+    assert by_ic.loc[23, "autocorrelation"] == autocorrelation(arr[1])
+
+
+def test_many_ensemble_mean_counts_valid_values():
+    series = [ar1(0.5, 2000, seed=s) for s in range(20)] + [np.zeros(100)] * 5
+    df = autocorrelation_many(series)
+    assert df["valid"].sum() == 20
+    assert df["autocorrelation"].mean() == pytest.approx(0.5, abs=0.05)  # NaN skipped
+
+
+def test_many_rejects_non_finite_values_naming_the_series():
+    with pytest.raises(ValueError, match=r"series\[1\]: must be finite; element 2"):
+        autocorrelation_many([np.ones(4), [0.0, 1.0, np.nan]])
+    with pytest.raises(ValueError, match="row 1, element 0"):
+        autocorrelation_many(np.array([[1.0, 2.0], [np.inf, 1.0]]))
+    with pytest.raises(TypeError, match="series"):
+        autocorrelation_many(3.0)
+
+
+# ------------------------------------------------------------------ bad input
+
+
+@pytest.mark.parametrize("bad", [np.nan, np.inf, -np.inf])
+def test_non_finite_series_raise_value_error(bad):
+    with pytest.raises(ValueError, match="series: must be finite; element 1"):
+        autocorrelation([0.0, bad, 1.0])
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "error", "match"),
+    [
+        ({"series": np.zeros((3, 3))}, ValueError, "1-D"),
+        ({"series": ["a", "b"]}, TypeError, "series"),
+        ({"series": np.array([1j, 2j])}, TypeError, "series"),
+        ({"lag": -1}, ValueError, "lag: must be >= 0"),
+        ({"lag": 1.5}, TypeError, "lag"),
+        ({"rtol": -1e-3}, ValueError, "rtol"),
+        ({"atol": np.nan}, ValueError, "atol"),
+    ],
+)
+def test_bad_arguments_raise(kwargs, error, match):
+    args = {"series": np.arange(5.0), **kwargs}
+    with pytest.raises(error, match=match):
+        autocorrelation(**args)
+
+
+# ------------------------------------------------------------------ boundary angles
+
+
+def two_particle_table(shuffle: bool = False) -> pd.DataFrame:
+    rng = np.random.default_rng(12)
+    n = 200
+    df = pd.DataFrame(
+        {
+            "time": np.sort(rng.uniform(0.0, 50.0, n)),
+            "particle": rng.integers(0, 2, n).astype(np.int8),
+            "s": rng.uniform(0.0, 2 * np.pi, n),
+            "sin_theta": rng.uniform(-1.0, 1.0, n),
+        }
+    )
+    return df.sample(frac=1.0, random_state=1) if shuffle else df
+
+
+def test_angles_of_the_tracked_disk_in_time_order():
+    df = two_particle_table()
+    run = types.SimpleNamespace(boundary=df, track=1)
+    expected = np.arcsin(df.loc[df["particle"] == 1, "sin_theta"].to_numpy())
+    assert_array_equal(boundary_angles(run), expected)
+    assert_array_equal(
+        boundary_angles(run, particle=0),
+        np.arcsin(df.loc[df["particle"] == 0, "sin_theta"].to_numpy()),
+    )
+    assert_array_equal(boundary_angles(df), boundary_angles(run, particle=0))  # disk 0
+
+
+def test_unsorted_records_are_put_in_time_order():
+    df = two_particle_table()
+    shuffled = two_particle_table(shuffle=True)
+    assert_array_equal(boundary_angles(shuffled, particle=1), boundary_angles(df, particle=1))
+
+
+def test_one_particle_table_uses_every_row():
+    df = two_particle_table().drop(columns="particle")
+    run = types.SimpleNamespace(boundary=df)
+    assert_array_equal(boundary_angles(run), np.arcsin(df["sin_theta"].to_numpy()))
+    assert_array_equal(boundary_angles(run, particle=0), boundary_angles(run))
+    with pytest.raises(ValueError, match="no 'particle' column"):
+        boundary_angles(run, particle=1)
+
+
+class _RawRun:
+    """A run exposing the raw boundary log; building its DataFrame is an error."""
+
+    def __init__(self, df: pd.DataFrame, track=None):
+        self.boundary_log = types.SimpleNamespace(
+            time=df["time"].to_numpy(),
+            particle=df["particle"].to_numpy(),
+            x=np.zeros(len(df)),
+            y=np.zeros(len(df)),
+            sin_theta=df["sin_theta"].to_numpy(),
+        )
+        if track is not None:
+            self.track = track
+
+    @property
+    def boundary(self):
+        raise AssertionError("the boundary DataFrame should not be built")
+
+
+def test_raw_boundary_log_is_read_without_building_the_table():
+    df = two_particle_table()
+    assert_array_equal(boundary_angles(_RawRun(df, track=1)), boundary_angles(df, particle=1))
+    one = df.assign(particle=np.int8(0))
+    assert_array_equal(boundary_angles(_RawRun(one)), np.arcsin(one["sin_theta"].to_numpy()))
+
+
+def test_real_run_records_work():
+    from kicktimes.billiard import runs
+
+    df = two_particle_table()
+    log = runs.BoundaryLog(
+        df["time"].to_numpy(),
+        df["particle"].to_numpy(),
+        np.cos(df["s"].to_numpy()),
+        np.sin(df["s"].to_numpy()),
+        df["sin_theta"].to_numpy(),
+    )
+    common = dict(
+        r=0.03,
+        t_max=50.0,
+        sampling=None,
+        tau=None,
+        n_steps=None,
+        ic=np.zeros((2, 4)),
+        final_state=np.zeros((2, 4)),
+        boundary_log=log,
+        sample_times=np.empty(0),
+        samples=np.empty((0, 2)),
+    )
+    run = runs.TwoParticleRun(**common, track=1)
+    assert_array_equal(boundary_angles(run), boundary_angles(df, particle=1))
+
+
+def test_round_off_beyond_one_is_clipped_but_real_violations_raise():
+    df = pd.DataFrame({"time": [0.0, 1.0], "s": [0.0, 1.0], "sin_theta": [1.0 + 1e-15, -1.0]})
+    assert_array_equal(boundary_angles(df), [np.pi / 2, -np.pi / 2])
+    with pytest.raises(ValueError, match=r"sin_theta: must lie in \[-1, 1\]"):
+        boundary_angles(df.assign(sin_theta=[1.1, 0.0]))
+    with pytest.raises(ValueError, match="sin_theta: must be finite"):
+        boundary_angles(df.assign(sin_theta=[np.nan, 0.0]))
+
+
+def test_bad_runs_and_particles_raise():
+    df = two_particle_table()
+    with pytest.raises(ValueError, match="particle: must be 0 or 1"):
+        boundary_angles(df, particle=2)
+    with pytest.raises(ValueError, match="sin_theta"):
+        boundary_angles(df.drop(columns="sin_theta"))
+    with pytest.raises(TypeError, match="run"):
+        boundary_angles(np.zeros(3))
+
+
+def test_angle_series_feeds_the_autocorrelation():
+    theta = boundary_angles(
+        pd.DataFrame({"time": np.arange(3000.0), "sin_theta": point_billiard_sin_theta(3000, 13)})
+    )
+    value, reason = autocorrelation(theta, return_reason=True)
+    assert np.isnan(value) and reason.startswith("constant")
+
+
+def test_simulated_runs_unkicked_disk_is_constant_and_two_disks_are_not():
+    import kicktimes as kt
+
+    ic = kt.initial_conditions(1, 0.03, seed=3)[0]
+    two = kt.simulate_two_particle(ic, 0.03, n_steps=5000, tau=0.2)
+    one = kt.simulate_one_particle(ic[0], 0.03, n_steps=5000, tau=0.2)
+    value, reason = autocorrelation(boundary_angles(one), return_reason=True)
+    assert np.isnan(value) and reason.startswith("constant")  # integrable: sin(theta) fixed
+    r1 = autocorrelation(boundary_angles(two))
+    assert np.isfinite(r1) and -1.0 <= r1 <= 1.0
