@@ -419,8 +419,9 @@ def lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rule
     offsets, measure = _twin_offsets(
         variant, d0, lambda dx, dy: math.hypot(state[0] + dx, state[1] + dy) <= rho
     )
-    st = np.zeros(6)
+    st = np.zeros(7)
     st[1:5] = state
+    st[6] = state[2] ** 2 + state[3] ** 2
     out = ftle_one_kernel(st, rho, times, angles, KICK_ANGLES[kick_angle], mode, n_steps, tau,
                           offsets, measure, d0, max_defer)
     return _result(out, variant, d0)

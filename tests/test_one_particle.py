@@ -1,0 +1,158 @@
+"""The kicked one-disk billiard."""
+
+import math
+
+import numpy as np
+import pytest
+
+from kicktimes import read_run, schedules, simulate_one_particle
+
+STATE = np.array([0.12, -0.31, 0.6, 0.8])
+
+
+def test_sin_theta_is_conserved_without_kicks_over_a_million_collisions():
+    r = 0.01
+    run = simulate_one_particle(STATE, r, t_max=2.0e6)
+    s = run.boundary.sin_theta.to_numpy()
+    assert s.size > 1_000_000
+    expected = (STATE[0] * STATE[3] - STATE[1] * STATE[2]) / (1 - r)
+    assert np.abs(s - expected).max() <= 1e-12
+    # the centre stays on |x| = 1 - r at every contact
+    log = run.boundary_log
+    assert np.abs(np.hypot(log.x, log.y) - (1 - r)).max() <= 1e-12
+
+
+def test_sin_theta_changes_only_across_kicks():
+    rng = np.random.default_rng(2)
+    kicks = np.sort(rng.uniform(0, 5000, 200))
+    run = simulate_one_particle(STATE, 0.02, t_max=5000.0, kicks=kicks, rng=3)
+    b = run.boundary
+    t = b.time.to_numpy()
+    s = b.sin_theta.to_numpy()
+    kicked = np.searchsorted(kicks, t[1:]) > np.searchsorted(kicks, t[:-1])
+    np.testing.assert_allclose(s[1:][~kicked], s[:-1][~kicked], rtol=0, atol=1e-12)
+    assert (np.abs(s[1:][kicked] - s[:-1][kicked]) > 1e-9).mean() > 0.9
+    assert run.n_kicks == 200
+
+
+def test_uniform_kick_sets_the_velocity_direction_to_the_given_angle():
+    run = simulate_one_particle(STATE, 0.02, t_max=0.05, kicks=[0.01], kick_angles=[1.0])
+    np.testing.assert_allclose(run.final_state[2:], [math.cos(1.0), math.sin(1.0)], atol=1e-15)
+    np.testing.assert_allclose(
+        run.final_state[:2], STATE[:2] + 0.01 * STATE[2:] + 0.04 * run.final_state[2:], atol=1e-15
+    )
+
+
+def test_gaussian_kick_rotates_the_velocity_and_keeps_the_speed():
+    state = np.array([0.0, 0.0, 1.5, 0.0])
+    run = simulate_one_particle(state, 0.02, t_max=0.1, kicks=[0.05], kick_angle="gaussian",
+                                kick_angles=[0.3])
+    np.testing.assert_allclose(run.final_state[2:], [1.5 * math.cos(0.3), 1.5 * math.sin(0.3)])
+    run = simulate_one_particle(state, 0.02, t_max=0.1, kicks=[0.05], kick_angle="gaussian",
+                                sigma=0.2, rng=1)
+    assert run.sigma == 0.2 and run.kick_angles.shape == (1,)
+
+
+def test_kick_at_the_instant_of_a_boundary_collision_comes_after_the_reflection():
+    r = 0.02
+    state = np.array([0.0, 0.0, 1.0, 0.0])
+    t_hit = 1 - r
+    # a kick exactly at the contact, pointing straight back inward
+    run = simulate_one_particle(state, r, t_max=1.5, kicks=[t_hit], kick_angles=[np.pi])
+    b = run.boundary
+    assert b.time.iloc[0] == t_hit
+    assert b.sin_theta.iloc[0] == 0.0  # logged with the incoming velocity
+    np.testing.assert_allclose(run.final_state, [(1 - r) - (1.5 - t_hit), 0, -1, 0], atol=1e-12)
+    # a kick at the contact pointing outward: the reflection already happened, so the
+    # disk is reflected again at once (a second logged collision at the same time)
+    run = simulate_one_particle(state, r, t_max=1.5, kicks=[t_hit], kick_angles=[0.3])
+    assert run.boundary.time.iloc[1] == pytest.approx(t_hit, abs=1e-15)
+    assert run.final_state[2] < 0
+    # and the outcome is deterministic
+    again = simulate_one_particle(state, r, t_max=1.5, kicks=[t_hit], kick_angles=[0.3])
+    assert np.array_equal(again.final_state, run.final_state)
+
+
+def test_common_random_numbers_keep_nearby_runs_together_until_the_next_boundary_collision():
+    r = 0.02
+    rng = np.random.default_rng(5)
+    kicks = np.sort(rng.uniform(0, 50, 30))
+    a = simulate_one_particle(STATE, r, t_max=50.0, kicks=kicks, rng=7, n_steps=250, tau=0.2)
+    twin = STATE + np.array([1e-6, 0, 0, 0])
+    b = simulate_one_particle(twin, r, t_max=50.0, kicks=a.kick_times, kick_angles=a.kick_angles,
+                              n_steps=250, tau=0.2)
+    first_hit = a.boundary.time.iloc[0]
+    early = a.sample_times < first_hit
+    sep = np.hypot(*(a.samples - b.samples).T)
+    assert (sep[early] <= 1e-6 * (1 + 1e-9)).all()
+    # without shared angles the first kick separates them by O(1)
+    c = simulate_one_particle(twin, r, t_max=50.0, kicks=a.kick_times, rng=8, n_steps=250,
+                              tau=0.2)
+    assert np.hypot(*(a.samples - c.samples).T).max() > 0.1
+
+
+def test_schedules_drive_the_billiard_reproducibly():
+    sched = schedules.Poisson(0.05)
+    a = simulate_one_particle(STATE, 0.02, t_max=1000.0, kicks=sched, rng=11)
+    b = simulate_one_particle(STATE, 0.02, t_max=1000.0, kicks=sched, rng=11)
+    assert np.array_equal(a.kick_times, b.kick_times)
+    assert np.array_equal(a.kick_angles, b.kick_angles)
+    assert a.boundary.equals(b.boundary)
+    assert 20 < a.n_kicks < 90
+    assert ((a.kick_angles >= 0) & (a.kick_angles < 2 * np.pi)).all()
+
+
+def test_paper_sampling_ends_steps_at_kicks_and_collisions():
+    kicks = [1.234, 7.5]
+    run = simulate_one_particle(STATE, 0.02, n_steps=200, tau=0.3, sampling="paper", kicks=kicks,
+                                rng=1)
+    assert np.isin(kicks, run.sample_times).all()
+    assert np.isin(run.boundary.time, run.sample_times).all()
+    assert (np.diff(run.sample_times) <= 0.3 + 1e-12).all()
+
+
+def test_uniform_sampling_interpolates_on_the_grid():
+    run = simulate_one_particle(STATE, 0.02, n_steps=100, tau=0.25)
+    np.testing.assert_allclose(run.sample_times, 0.25 * np.arange(101))
+    np.testing.assert_allclose(run.samples[0], STATE[:2])
+    # speed 1: consecutive samples at most tau apart, and the disk stays inside
+    assert (np.hypot(*np.diff(run.samples, axis=0).T) <= 0.25 + 1e-12).all()
+    assert (np.hypot(*run.samples.T) <= 0.98 + 1e-12).all()
+
+
+def test_run_round_trips_through_parquet(tmp_path):
+    run = simulate_one_particle(STATE, 0.02, t_max=100.0, kicks=schedules.Poisson(0.1), rng=3,
+                                kick_angle="gaussian", sigma=0.5, seed=3)
+    run.to_parquet(tmp_path / "one.parquet")
+    back = read_run(tmp_path / "one.parquet")
+    assert back.meta == run.meta
+    assert np.array_equal(back.kick_times, run.kick_times)
+    assert np.array_equal(back.kick_angles, run.kick_angles)
+    assert back.boundary.equals(run.boundary)
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "match"),
+    [
+        (dict(r=1.0, t_max=1.0), "r must lie in"),
+        (dict(r=0.02, t_max=10.0, kicks=[2.0, 1.0]), "sorted"),
+        (dict(r=0.02, t_max=10.0, kicks=[-1.0]), ">= 0"),
+        (dict(r=0.02, t_max=10.0, kicks=[11.0]), r"\[0, t_max"),
+        (dict(r=0.02, t_max=10.0, kicks=[np.nan]), "finite"),
+        (dict(r=0.02, t_max=10.0, kicks=[1.0], kick_angles=[1.0, 2.0]), "one angle per kick"),
+        (dict(r=0.02, t_max=10.0, kick_angle="cauchy"), "kick_angle must be one of"),
+        (dict(r=0.02, t_max=10.0, sigma=0.0), "sigma must lie in"),
+    ],
+)
+def test_bad_arguments_raise(kwargs, match):
+    with pytest.raises(ValueError, match=match):
+        simulate_one_particle(STATE, **kwargs)
+
+
+def test_bad_states_raise():
+    with pytest.raises(ValueError, match="outside the table"):
+        simulate_one_particle([0.99, 0.0, 1.0, 0.0], 0.02, t_max=1.0)
+    with pytest.raises(ValueError, match="non-zero"):
+        simulate_one_particle([0.0, 0.0, 0.0, 0.0], 0.02, t_max=1.0)
+    with pytest.raises(ValueError, match="shape"):
+        simulate_one_particle(np.zeros((2, 4)), 0.02, t_max=1.0)
