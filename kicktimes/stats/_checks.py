@@ -1,0 +1,116 @@
+"""Argument checks for the statistics layer.
+
+Every message names the argument, the offending value and the valid range
+(design.md, "Bad input"); NaN and inf are rejected, never propagated.
+"""
+
+from __future__ import annotations
+
+import math
+from numbers import Integral, Real
+
+import numpy as np
+
+
+def _show(arr: np.ndarray, mask: np.ndarray) -> str:
+    """The first offending entry, as ``name[i] = value``-ready text."""
+    i = int(np.flatnonzero(mask)[0])
+    return f"[{i}] = {arr[i]!r}"
+
+
+def check_real(name: str, value, *, low=None, high=None, low_open=True, high_open=True) -> float:
+    """A finite real number inside the given (open by default) interval."""
+    if isinstance(value, bool) or not isinstance(value, Real | np.floating | np.integer):
+        raise TypeError(f"{name} must be a real number, got {type(value).__name__}")
+    x = float(value)
+    if not math.isfinite(x):
+        raise ValueError(f"{name} must be finite, got {x!r}")
+    bad_low = low is not None and (x <= low if low_open else x < low)
+    bad_high = high is not None and (x >= high if high_open else x > high)
+    if bad_low or bad_high:
+        lo = "-inf" if low is None else repr(low)
+        hi = "inf" if high is None else repr(high)
+        span = f"{'(' if low_open else '['}{lo}, {hi}{')' if high_open else ']'}"
+        raise ValueError(f"{name} must lie in {span}, got {x!r}")
+    return x
+
+
+def check_int(name: str, value, *, low: int) -> int:
+    """An integer (not a bool) no smaller than ``low``."""
+    if isinstance(value, bool) or not isinstance(value, Integral | np.integer):
+        raise TypeError(f"{name} must be an integer, got {type(value).__name__}")
+    n = int(value)
+    if n < low:
+        raise ValueError(f"{name} must be an integer >= {low}, got {n}")
+    return n
+
+
+def check_choice(name: str, value, choices) -> str:
+    """One of a fixed set of strings."""
+    if not isinstance(value, str) or value not in choices:
+        raise ValueError(f"{name} must be one of {list(choices)!r}, got {value!r}")
+    return value
+
+
+def as_1d_float(name: str, value, *, allow_empty: bool = True) -> np.ndarray:
+    """A finite 1-D float64 array (a fresh copy)."""
+    if isinstance(value, str | bytes):
+        raise TypeError(f"{name} must be a 1-D array of numbers, got {type(value).__name__}")
+    try:
+        arr = np.array(value, dtype=np.float64, copy=True)
+    except (TypeError, ValueError) as exc:
+        raise TypeError(f"{name} must be a 1-D array of numbers ({exc})") from None
+    if arr.ndim == 0:
+        arr = arr.reshape(1)
+    if arr.ndim != 1:
+        raise ValueError(f"{name} must be 1-D, got shape {arr.shape}")
+    if not allow_empty and arr.size == 0:
+        raise ValueError(f"{name} must not be empty")
+    bad = ~np.isfinite(arr)
+    if bad.any():
+        raise ValueError(f"{name} must be finite, got {name}{_show(arr, bad)}")
+    return arr
+
+
+def check_intervals(name: str, value, *, allow_zero: bool = False, allow_empty=True):
+    """Finite interval lengths, positive (or non-negative with ``allow_zero``)."""
+    arr = as_1d_float(name, value, allow_empty=allow_empty)
+    bad = arr < 0 if allow_zero else arr <= 0
+    if bad.any():
+        rng = "[0, inf)" if allow_zero else "(0, inf)"
+        raise ValueError(f"{name} must lie in {rng}, got {name}{_show(arr, bad)}")
+    return arr
+
+
+def check_times(name: str, value, t_window: float) -> np.ndarray:
+    """Event times: finite, strictly increasing, inside the window ``[0, t_window]``."""
+    arr = as_1d_float(name, value)
+    outside = (arr < 0) | (arr > t_window)
+    if outside.any():
+        raise ValueError(
+            f"{name} must lie in the window [0, t_window] = [0, {t_window!r}], "
+            f"got {name}{_show(arr, outside)}"
+        )
+    if arr.size > 1:
+        step = np.diff(arr)
+        bad = step <= 0
+        if bad.any():
+            i = int(np.flatnonzero(bad)[0])
+            raise ValueError(
+                f"{name} must be strictly increasing, got {name}[{i}] = {arr[i]!r} "
+                f">= {name}[{i + 1}] = {arr[i + 1]!r}"
+            )
+    return arr
+
+
+def check_rng(rng) -> np.random.Generator:
+    """A numpy Generator from a Generator, an integer seed, a SeedSequence or None."""
+    if rng is None or isinstance(rng, np.random.Generator | np.random.SeedSequence):
+        return np.random.default_rng(rng)
+    if isinstance(rng, Integral | np.integer) and not isinstance(rng, bool):
+        if int(rng) < 0:
+            raise ValueError(f"rng seed must be a non-negative integer, got {rng!r}")
+        return np.random.default_rng(int(rng))
+    raise TypeError(
+        f"rng must be None, an integer seed or a numpy.random.Generator, got {type(rng).__name__}"
+    )

@@ -1,0 +1,392 @@
+r"""Is an event sequence a homogeneous Poisson process? Intervals and one-sequence tests.
+
+Conventions (see also :mod:`kicktimes.stats.iid_tests`):
+
+* a sequence is event times ``0 <= t_1 < ... < t_n <= T`` observed in ``[0, T]``;
+* every single-sequence test is **conditional on n** and has an exact null (exact
+  distribution, or Monte Carlo with ``n_mc`` samples, which is exact up to its
+  Monte Carlo resolution); Laplace's trend test alone uses its normal limit;
+* interval tests use the ``n - 1`` inner intervals: the first time ``t_1`` is a
+  forward recurrence time and ``T - t_n`` is censored, so both are left out;
+* tests are per sequence (one initial condition); :func:`~kicktimes.stats.test_poisson_ensemble`
+  runs them on every sequence, combines their p-values, controls the false
+  discovery rate across sequences and tests whether all sequences share one rate.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import NamedTuple
+
+import numpy as np
+import pandas as pd
+from statsmodels.stats.multitest import multipletests
+
+from . import iid_tests as iid
+from ._checks import check_choice, check_int, check_real, check_rng, check_times
+
+TESTS = (
+    "uniformity_ks",
+    "laplace_trend",
+    "exponential_ks",
+    "exponential_ad",
+    "ljung_box",
+    "runs",
+    "dispersion",
+)
+_NULL = {
+    "uniformity_ks": "exact KS (given n)",
+    "laplace_trend": "asymptotic normal",
+    "exponential_ks": "Monte Carlo (given n)",
+    "exponential_ad": "Monte Carlo (given n)",
+    "ljung_box": "Monte Carlo (given n)",
+    "runs": "exact runs law (given n)",
+    "dispersion": "Monte Carlo multinomial (given n)",
+}
+_MIN_EVENTS = {
+    "uniformity_ks": 2,
+    "laplace_trend": 3,
+    "exponential_ks": 5,
+    "exponential_ad": 5,
+    "ljung_box": 11,
+    "runs": 11,
+    "dispersion": 10,
+}
+COMBINE_METHODS = ("fisher", "pearson", "tippett", "stouffer", "mudholkar_george")
+FDR_METHODS = ("fdr_bh", "fdr_by", "bonferroni", "holm", "fdr_tsbh", "fdr_tsbky")
+
+
+class Intervals(NamedTuple):
+    """Complete and right-censored intervals of one or several sequences."""
+
+    complete: np.ndarray
+    censored: np.ndarray
+
+
+def _is_ensemble(times) -> bool:
+    if isinstance(times, np.ndarray):
+        return times.dtype == object
+    return (
+        isinstance(times, list | tuple)
+        and len(times) > 0
+        and all(np.ndim(t) == 1 and not isinstance(t, str) for t in times)
+    )
+
+
+def _windows(windows, k):
+    if np.ndim(windows) == 0:
+        w = check_real("t_window", windows, low=0.0)
+        return np.full(k, w)
+    arr = np.asarray(windows, dtype=float)
+    if arr.shape != (k,):
+        raise ValueError(
+            f"windows must be a scalar or hold one window per sequence ({k}), got shape {arr.shape}"
+        )
+    for i, w in enumerate(arr):
+        check_real(f"windows[{i}]", w, low=0.0)
+    return arr
+
+
+def intervals_from_times(times, t_window, *, first="drop") -> Intervals:
+    r"""Complete and right-censored intervals of event sequences observed on ``[0, T]``.
+
+    Parameters
+    ----------
+    times : array_like or list of array_like
+        Strictly increasing event times in ``[0, t_window]``; a list of such arrays
+        pools several sequences (e.g. one per initial condition).
+    t_window : float or sequence of float
+        Window length ``T`` (one per sequence, or common).
+    first : {"drop", "keep"}, optional
+        The first time ``t_1`` is a forward recurrence time when observation starts
+        at an arbitrary instant (a stationary process): its law is the equilibrium
+        law :math:`S(x)/\mu`, not the interval law, so ``"drop"`` (default) leaves it
+        out. ``"keep"`` counts it as a complete interval, which is right only when an
+        event (a renewal) happened at time 0; then an empty window also gives one
+        censored interval ``T``.
+
+    Returns
+    -------
+    Intervals
+        ``complete``: ``t_{k+1} - t_k`` (and ``t_1`` with ``first="keep"``);
+        ``censored``: ``T - t_n`` per sequence (the interval running at the end of the
+        window, right-censored), dropped when exactly 0.
+
+    Examples
+    --------
+    >>> from kicktimes import stats
+    >>> stats.intervals_from_times([1.0, 1.5, 3.0], 4.0)
+    Intervals(complete=array([0.5, 1.5]), censored=array([1.]))
+    """
+    check_choice("first", first, ("drop", "keep"))
+    if _is_ensemble(times):
+        seqs = list(times)
+        ws = _windows(t_window, len(seqs))
+        parts = [intervals_from_times(s, w, first=first) for s, w in zip(seqs, ws, strict=True)]
+        return Intervals(
+            np.concatenate([p.complete for p in parts]),
+            np.concatenate([p.censored for p in parts]),
+        )
+    t_window = check_real("t_window", t_window, low=0.0)
+    t = check_times("times", times, t_window)
+    if first == "keep":
+        t = np.concatenate([[0.0], t])
+        complete = np.diff(t)
+        if complete.size and complete[0] == 0:
+            complete = complete[1:]  # an event at 0 is the renewal itself
+    else:
+        complete = np.diff(t)
+    last = t[-1] if t.size else None
+    censored = np.empty(0) if last is None or t_window - last == 0 else np.array([t_window - last])
+    return Intervals(complete, censored)
+
+
+def _default_lags(m):
+    return int(min(10, m // 5))
+
+
+def _default_bins(n):
+    return int(min(20, max(2, n // 5)))
+
+
+MC_TESTS = ("exponential_ks", "exponential_ad", "ljung_box", "dispersion")
+
+
+@dataclass
+class _Group:
+    """The sequences with one number of events ``n``: they share the Monte Carlo nulls."""
+
+    members: np.ndarray
+    n: int
+    lags: int
+    n_bins: int
+    notes: dict
+    stat: dict = field(default_factory=dict)
+    null: dict = field(default_factory=dict)
+    draws: dict = field(default_factory=dict)
+    exact: dict = field(default_factory=dict)
+
+    def pvalue(self, name):
+        if name in ("exponential_ks", "exponential_ad", "ljung_box"):
+            return iid.mc_pvalue(self.stat[name], self.null[name])
+        if name == "dispersion":
+            return iid.mc_pvalue(
+                self.stat[name], self.null[name], two_sided=True, u=self.draws[name]
+            )
+        runs, n1 = self.stat["runs"], self.stat["runs_n1"]
+        m = self.n - 1
+        draws = self.draws["runs"]
+        draws = [None] * len(runs) if draws is None else draws
+        return np.array(
+            [iid.runs_pvalue(r, a, m - a, d) for r, a, d in zip(runs, n1, draws, strict=True)]
+        )
+
+    def extend(self, name, size, rng):
+        more = iid.simulate_null(name, self.n, size, rng, lags=self.lags, n_bins=self.n_bins)
+        self.null[name] = np.concatenate([self.null[name], more])
+
+
+def _make_group(times, t_window, members, *, lags, n_bins, n_mc, rng, randomize):
+    """Statistics, exact p-values and Monte Carlo nulls of ``k`` sequences with ``n`` events."""
+    k, n = times.shape
+    m = n - 1
+    h = _default_lags(m) if lags is None else lags
+    bins = _default_bins(n) if n_bins is None else n_bins
+    notes = {}
+    for name in TESTS:
+        need = _MIN_EVENTS[name]
+        if n < need:
+            notes[name] = f"needs at least {need} events, got {n}"
+        elif name == "ljung_box" and (h < 1 or m < h + 5):
+            notes[name] = f"needs at least lags + 5 = {h + 5} intervals, got {m}"
+        elif name == "dispersion" and n < 2 * bins:
+            notes[name] = f"needs at least 2 events per sub-window ({2 * bins}), got {n}"
+    g = _Group(members=members, n=n, lags=h, n_bins=bins, notes=notes)
+    u = times / t_window[:, None]
+    x = np.diff(times, axis=1)
+    funs = {
+        "exponential_ks": lambda: iid.exponential_ks(x),
+        "exponential_ad": lambda: iid.exponential_ad(x),
+        "ljung_box": lambda: iid.ljung_box(x, h),
+        "dispersion": lambda: iid.dispersion_index(u, bins),
+    }
+    for name in MC_TESTS:
+        if name not in notes:
+            g.stat[name] = funs[name]()
+            g.null[name] = iid.simulate_null(name, n, n_mc, rng, lags=h, n_bins=bins)
+    if "runs" not in notes:
+        g.stat["runs"], g.stat["runs_n1"] = iid.runs_count(x)
+    for name in ("dispersion", "runs"):
+        g.draws[name] = rng.uniform(size=k) if randomize else None
+    if "uniformity_ks" not in notes:
+        g.stat["uniformity_ks"], g.exact["uniformity_ks"] = iid.uniformity_ks(u)
+    if "laplace_trend" not in notes:
+        g.stat["laplace_trend"], g.exact["laplace_trend"] = iid.laplace_trend(u)
+    return g
+
+
+def _run_tests(seqs, ws, *, lags, n_bins, n_mc, rng, randomize, refine=None):
+    """Per-sequence statistics, p-values and notes.
+
+    Sequences are grouped by their number of events so that each ``n`` gets one
+    Monte Carlo null. With ``refine = (alpha, fdr_method, n_mc_max)`` the nulls of
+    groups holding a sequence whose p-value is at the Monte Carlo floor but above the
+    running FDR cut-off are extended (doubling, up to ``n_mc_max`` samples), so that a
+    strong signal in a large ensemble is not lost to Monte Carlo resolution.
+    """
+    k = len(seqs)
+    stat = np.full((k, len(TESTS)), np.nan)
+    pval = np.full((k, len(TESTS)), np.nan)
+    notes = [dict() for _ in range(k)]
+    settings = [dict() for _ in range(k)]
+    counts = np.array([s.size for s in seqs])
+    groups = []
+    for n in np.unique(counts):
+        members = np.flatnonzero(counts == n)
+        if n == 0:
+            for i in members:
+                notes[i] = {name: "no events in the window" for name in TESTS}
+            continue
+        block = np.vstack([seqs[i] for i in members])
+        g = _make_group(
+            block,
+            ws[members],
+            members,
+            lags=lags,
+            n_bins=n_bins,
+            n_mc=n_mc,
+            rng=rng,
+            randomize=randomize,
+        )
+        groups.append(g)
+        for i in members:
+            notes[i], settings[i] = dict(g.notes), {"lags": g.lags, "n_bins": g.n_bins}
+        for j, name in enumerate(TESTS):
+            if name in g.notes:
+                continue
+            stat[members, j] = g.stat[name]
+            pval[members, j] = g.exact[name] if name in g.exact else g.pvalue(name)
+            for i in members[~np.isfinite(pval[members, j])]:
+                notes[i][name] = "degenerate: all inner intervals are equal"
+    if refine is not None:
+        _refine(groups, pval, refine, rng)
+    return stat, pval, notes, settings
+
+
+def _refine(groups, pval, refine, rng):
+    alpha, method, n_mc_max = refine
+    for name in MC_TESTS:
+        j = TESTS.index(name)
+        while True:
+            p = pval[:, j]
+            ok = np.isfinite(p)
+            if not ok.any():
+                break
+            n_reject = int(multipletests(p[ok], alpha=alpha, method=method)[0].sum())
+            cutoff = alpha * (n_reject + 1) / ok.sum()
+            todo = []
+            for g in groups:
+                if name not in g.null or g.null[name].size >= n_mc_max:
+                    continue
+                pg = pval[g.members, j]
+                # Fewer than ~10 null exceedances: the p-value is too coarse to compare
+                # with the cut-off.
+                if np.any((pg > cutoff) & (pg * (g.null[name].size + 1) < 11)):
+                    todo.append(g)
+            if not todo:
+                break
+            for g in todo:
+                g.extend(name, min(g.null[name].size + 1, n_mc_max - g.null[name].size), rng)
+                pval[g.members, j] = g.pvalue(name)
+
+
+def _check_options(n_mc, lags, n_bins):
+    n_mc = check_int("n_mc", n_mc, low=19)
+    if lags is not None:
+        lags = check_int("lags", lags, low=1)
+    if n_bins is not None:
+        n_bins = check_int("n_bins", n_bins, low=2)
+    return n_mc, lags, n_bins
+
+
+def test_poisson(times, t_window, *, n_mc=999, lags=None, n_bins=None, randomize=True, rng=None):
+    r"""Test whether one event sequence is a homogeneous Poisson process.
+
+    Parameters
+    ----------
+    times : array_like
+        Strictly increasing event times in ``[0, t_window]``.
+    t_window : float
+        Observation window ``T``.
+    n_mc : int, optional
+        Monte Carlo samples of the conditional nulls (p-value resolution
+        ``1/(n_mc + 1)``).
+    lags : int, optional
+        Ljung-Box lags (default ``min(10, (n - 1) // 5)``).
+    n_bins : int, optional
+        Equal sub-windows of the dispersion test (default ``clip(n // 5, 2, 20)``,
+        about five expected events per sub-window).
+    randomize : bool, optional
+        Break ties of the discrete statistics (runs, dispersion) at random so that
+        those tests have exactly their nominal size; ``False`` gives conservative
+        p-values.
+    rng : Generator or int, optional
+        Source of randomness for the Monte Carlo.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Indexed by test (``TESTS``), columns ``statistic``, ``pvalue``, ``null`` (how the
+        p-value is computed) and ``note`` (why a test could not run: its row is NaN).
+        ``attrs`` holds ``n_events``, ``t_window``, ``rate``, ``lags``, ``n_bins``.
+
+    Notes
+    -----
+    ``uniformity_ks``: KS distance of :math:`t_i/T` from U(0, 1). ``laplace_trend``:
+    :math:`z = (\bar t/T - 1/2)\sqrt{12 n}`. ``exponential_ks``: KS distance of the
+    inner intervals from an exponential with rate 1/mean (Lilliefors);
+    ``exponential_ad``: the Anderson-Darling distance, more powerful in the tails.
+    ``ljung_box``: :math:`Q` of the inner intervals. ``runs``: number of runs
+    above/below the median of the inner intervals (Wald-Wolfowitz). ``dispersion``:
+    variance-to-mean ratio of counts in equal sub-windows (two-sided). All are
+    conditional on n (see the module notes).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from kicktimes import stats
+    >>> rng = np.random.default_rng(0)
+    >>> t = np.sort(rng.uniform(0, 100, size=rng.poisson(100)))
+    >>> res = stats.test_poisson(t, 100.0, rng=1)
+    >>> list(res.index)[:2]
+    ['uniformity_ks', 'laplace_trend']
+    """
+    t_window = check_real("t_window", t_window, low=0.0)
+    t = check_times("times", times, t_window)
+    n_mc, lags, n_bins = _check_options(n_mc, lags, n_bins)
+    rng = check_rng(rng)
+    stat, pval, notes, used = _run_tests(
+        [t],
+        np.array([t_window]),
+        lags=lags,
+        n_bins=n_bins,
+        n_mc=n_mc,
+        rng=rng,
+        randomize=randomize,
+    )
+    table = pd.DataFrame(
+        {
+            "statistic": stat[0],
+            "pvalue": pval[0],
+            "null": [_NULL[name] for name in TESTS],
+            "note": [notes[0].get(name, "") for name in TESTS],
+        },
+        index=pd.Index(TESTS, name="test"),
+    )
+    table.attrs.update(
+        n_events=int(t.size), t_window=t_window, rate=t.size / t_window, n_mc=n_mc, **used[0]
+    )
+    return table
+
+
+test_poisson.__test__ = False  # a library function, not a pytest test

@@ -1,0 +1,85 @@
+"""Initial-condition ensembles and the exact kinetic-theory check of the simulator."""
+
+import numpy as np
+import pytest
+
+from kicktimes import initial_conditions, simulate_two_particle
+from kicktimes.stats import kinetic_rate
+
+
+@pytest.mark.parametrize("method", ["paper", "uniform"])
+def test_ics_are_valid_at_r_max_and_have_unit_speeds(method):
+    r_max = 0.03
+    ics = initial_conditions(500, r_max, seed=4, method=method)
+    assert ics.shape == (500, 2, 4)
+    assert (np.hypot(ics[:, :, 0], ics[:, :, 1]) <= 1 - r_max).all()
+    gap = np.hypot(ics[:, 0, 0] - ics[:, 1, 0], ics[:, 0, 1] - ics[:, 1, 1])
+    assert (gap >= 2 * r_max).all()
+    np.testing.assert_allclose(np.hypot(ics[:, :, 2], ics[:, :, 3]), 1.0, atol=1e-15)
+
+
+def test_ic_i_does_not_depend_on_chunking():
+    whole = initial_conditions(40, 0.02, seed=9)
+    parts = np.concatenate([initial_conditions(n, 0.02, seed=9, start=s)
+                            for s, n in [(0, 7), (7, 20), (27, 13)]])
+    assert np.array_equal(whole, parts)
+    assert not np.array_equal(whole, initial_conditions(40, 0.02, seed=10))
+
+
+def test_paper_method_draws_distance_uniform_not_area_uniform():
+    ics = initial_conditions(4000, 0.01, seed=1, method="paper")
+    dist = np.hypot(ics[:, 0, 0], ics[:, 0, 1])
+    # distance uniform on (0, 0.99): median ~0.495; area-uniform would give ~0.70
+    assert abs(np.median(dist) - 0.495) < 0.03
+
+
+def test_uniform_method_is_area_uniform():
+    ics = initial_conditions(4000, 0.01, seed=1, method="uniform")
+    dist = np.hypot(ics[:, 0, 0], ics[:, 0, 1])
+    assert abs(np.median(dist) - 0.99 / np.sqrt(2)) < 0.03
+
+
+def test_elastic_invariant_measure_has_total_energy_two():
+    ics = initial_conditions(300, 0.02, seed=2, method="uniform", rule="elastic")
+    np.testing.assert_allclose((ics[:, :, 2:] ** 2).sum(axis=(1, 2)), 2.0)
+    speeds = np.hypot(ics[:, :, 2], ics[:, :, 3])
+    assert speeds.std() > 0.1  # speeds vary, unlike the mirror rule
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "match"),
+    [
+        (dict(n=0, r_max=0.02), "n must be an integer >= 1"),
+        (dict(n=3, r_max=0.5), "r_max must lie in"),
+        (dict(n=3, r_max=0.02, method="grid"), "method must be one of"),
+        (dict(n=3, r_max=0.02, seed=-1), "seed must be an integer >= 0"),
+        (dict(n=3, r_max=0.02, rule="soft"), "rule must be one of"),
+    ],
+)
+def test_bad_arguments_raise(kwargs, match):
+    with pytest.raises(ValueError, match=match):
+        initial_conditions(**kwargs)
+
+
+@pytest.mark.parametrize("rule", ["mirror", "elastic"])
+@pytest.mark.parametrize("r", [0.02, 0.05])
+def test_collision_rate_matches_kinetic_theory_under_the_invariant_measure(rule, r):
+    # E[N(T)] = Gamma T exactly for ICs drawn from the invariant measure (design.md)
+    n, t_max = 600, 100.0
+    ics = initial_conditions(n, r, seed=123, method="uniform", rule=rule)
+    counts = np.array([simulate_two_particle(ic, r, t_max=t_max, rule=rule).n_pp for ic in ics])
+    expected = kinetic_rate(r, rule=rule) * t_max
+    sem = counts.std(ddof=1) / np.sqrt(n)
+    assert abs(counts.mean() - expected) < 3 * sem, (counts.mean(), expected, sem)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("rule", ["mirror", "elastic"])
+@pytest.mark.parametrize("r", [0.01, 0.02, 0.05])
+def test_collision_rate_matches_kinetic_theory_with_many_ics(rule, r):
+    n, t_max = 20000, 200.0
+    ics = initial_conditions(n, r, seed=7, method="uniform", rule=rule)
+    counts = np.array([simulate_two_particle(ic, r, t_max=t_max, rule=rule).n_pp for ic in ics])
+    expected = kinetic_rate(r, rule=rule) * t_max
+    sem = counts.std(ddof=1) / np.sqrt(n)
+    assert abs(counts.mean() - expected) < 3 * sem, (counts.mean(), expected, sem)

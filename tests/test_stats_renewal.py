@@ -1,0 +1,385 @@
+"""Renewal-model fits, comparison, Vuong's test and goodness of fit (kicktimes.stats)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+import scipy.stats
+from scipy import integrate
+
+from kicktimes import stats
+from kicktimes.stats import distributions
+from kicktimes.stats.gof import km_ks
+
+TRUE_LAWS = {
+    "exponential": (scipy.stats.expon(scale=1.0), {"rate": 1.0}),
+    "gamma": (scipy.stats.gamma(0.5, scale=2.0), {"shape": 0.5, "scale": 2.0}),
+    "weibull": (scipy.stats.weibull_min(0.7, scale=1.0), {"shape": 0.7, "scale": 1.0}),
+    "lognormal": (scipy.stats.lognorm(1.0, scale=1.0), {"mu": 0.0, "sigma": 1.0}),
+    "lomax": (scipy.stats.lomax(2.5, scale=1.5), {"shape": 2.5, "scale": 1.5}),
+    "hyperexponential": (
+        stats.hyperexpon(0.3, 5.0, 0.5),
+        {"p": 0.3, "rate1": 5.0, "rate2": 0.5},
+    ),
+}
+
+
+def censor_independently(x, mean_censoring, rng):
+    c = rng.exponential(mean_censoring, size=x.size)
+    return x[x <= c], c[x > c]
+
+
+def renewal_windows(dist, t_window, n_windows, rng, per_window=32):
+    """Ordinary renewal processes (a renewal at 0) on [0, T]: complete + censored."""
+    t = np.cumsum(dist.rvs(size=(n_windows, per_window), random_state=rng), axis=1)
+    assert (t[:, -1] > t_window).all(), "draw more intervals per window"
+    iv = stats.intervals_from_times([row[row <= t_window] for row in t], t_window, first="keep")
+    return iv.complete, iv.censored
+
+
+# --- the hyperexponential distribution ------------------------------------------------
+
+
+def test_hyperexpon_is_a_normalised_distribution_with_consistent_methods():
+    d = stats.hyperexpon(0.3, 5.0, 0.5)
+    assert integrate.quad(d.pdf, 0, np.inf)[0] == pytest.approx(1.0, abs=1e-10)
+    x = np.array([1e-6, 0.1, 1.0, 10.0, 50.0])
+    np.testing.assert_allclose(d.cdf(x) + d.sf(x), 1.0, rtol=1e-14)
+    np.testing.assert_allclose(np.exp(d.logpdf(x)), d.pdf(x), rtol=1e-12)
+    np.testing.assert_allclose(np.exp(d.logsf(x)), d.sf(x), rtol=1e-12)
+    q = np.array([1e-12, 1e-3, 0.25, 0.5, 0.9, 1 - 1e-9])
+    np.testing.assert_allclose(d.cdf(d.ppf(q)), q, rtol=1e-9)
+    s = np.array([1e-200, 1e-12, 0.3])
+    np.testing.assert_allclose(d.sf(d.isf(s)), s, rtol=1e-9)
+    assert d.mean() == pytest.approx(0.3 / 5 + 0.7 / 0.5)
+    second = 2 * (0.3 / 25 + 0.7 / 0.25)
+    assert d.var() == pytest.approx(second - d.mean() ** 2)
+    sample = d.rvs(size=4000, random_state=np.random.default_rng(1))
+    assert scipy.stats.kstest(sample, d.cdf).pvalue > 0.01
+
+
+def test_frozen_hyperexpon_resolves_by_its_name():
+    frozen = stats.hyperexpon(0.2, 3.0, 0.4)
+    name, args, kwds = frozen.dist.name, frozen.args, frozen.kwds
+    family = getattr(scipy.stats, name, None) or getattr(distributions, name)
+    assert family(*args, **kwds).sf(2.0) == pytest.approx(frozen.sf(2.0))
+
+
+def test_hyperexponential_fit_recovers_a_known_two_rate_mixture():
+    rng = np.random.default_rng(2)
+    x = stats.hyperexpon(0.3, 5.0, 0.5).rvs(size=6000, random_state=rng)
+    fit = stats.fit_renewal(x, "hyperexponential")
+    for name, true in {"p": 0.3, "rate1": 5.0, "rate2": 0.5}.items():
+        assert abs(fit.params[name] - true) < 4 * fit.stderr[name], name
+    # The same with heavy right censoring (about 40% of observations censored).
+    xc, c = censor_independently(x, 1.5, rng)
+    assert c.size > 0.35 * x.size
+    fitc = stats.fit_renewal(xc, "hyperexponential", censored=c)
+    for name, true in {"p": 0.3, "rate1": 5.0, "rate2": 0.5}.items():
+        assert abs(fitc.params[name] - true) < 4 * fitc.stderr[name], name
+
+
+def test_hyperexpon_fit_method_accepts_censored_data():
+    rng = np.random.default_rng(3)
+    x = stats.hyperexpon(0.4, 4.0, 0.5).rvs(size=3000, random_state=rng)
+    xc, c = censor_independently(x, 4.0, rng)
+    p, lam1, lam2, loc, scale = stats.hyperexpon.fit(
+        scipy.stats.CensoredData(uncensored=xc, right=c), floc=0
+    )
+    assert (loc, scale) == (0.0, 1.0)
+    assert lam1 > lam2
+    assert p == pytest.approx(0.4, abs=0.08)
+
+
+# --- censored fits: closed forms, scaling, recovery ------------------------------------
+
+
+def test_exponential_censored_fit_matches_the_closed_form():
+    rng = np.random.default_rng(4)
+    x, c = censor_independently(rng.exponential(2.0, 500), 2.0, rng)
+    fit = stats.fit_renewal(x, "exponential", censored=c)
+    rate = x.size / (x.sum() + c.sum())
+    assert fit.params["rate"] == pytest.approx(rate, rel=1e-12)
+    assert fit.stderr["rate"] == pytest.approx(rate / math.sqrt(x.size), rel=1e-12)
+    loglik = x.size * math.log(rate) - rate * (x.sum() + c.sum())
+    assert fit.loglik == pytest.approx(loglik, rel=1e-12)
+    assert (fit.n, fit.n_censored, fit.k) == (x.size, c.size, 1)
+    assert fit.aic == pytest.approx(2 - 2 * loglik)
+    assert fit.bic == pytest.approx(math.log(x.size + c.size) - 2 * loglik)
+
+
+@pytest.mark.parametrize("model", list(TRUE_LAWS))
+def test_censored_fit_recovers_parameters_within_its_standard_errors(model):
+    law, truth = TRUE_LAWS[model]
+    rng = np.random.default_rng(5)
+    x, c = censor_independently(law.rvs(size=8000, random_state=rng), 2.0 * law.mean(), rng)
+    fit = stats.fit_renewal(x, model, censored=c)
+    for name, value in truth.items():
+        assert math.isfinite(fit.stderr[name]) and fit.stderr[name] > 0
+        assert abs(fit.params[name] - value) < 4.5 * fit.stderr[name], (name, fit.params)
+    assert fit.dist.mean() == pytest.approx(law.mean(), rel=0.15)
+
+
+def test_fit_is_equivariant_under_a_change_of_time_unit():
+    rng = np.random.default_rng(6)
+    x, c = censor_independently(rng.weibull(0.6, 600), 2.0, rng)
+    a = stats.fit_renewal(x, "weibull", censored=c)
+    b = stats.fit_renewal(1000 * x, "weibull", censored=1000 * c)
+    assert b.params["shape"] == pytest.approx(a.params["shape"], rel=1e-4)
+    assert b.params["scale"] == pytest.approx(1000 * a.params["scale"], rel=1e-4)
+    assert b.stderr["scale"] == pytest.approx(1000 * a.stderr["scale"], rel=1e-3)
+    assert b.loglik == pytest.approx(a.loglik - x.size * math.log(1000), rel=1e-6)
+    ln_a = stats.fit_renewal(x, "lognormal", censored=c)
+    ln_b = stats.fit_renewal(1000 * x, "lognormal", censored=1000 * c)
+    assert ln_b.params["mu"] == pytest.approx(ln_a.params["mu"] + math.log(1000), abs=1e-4)
+
+
+def test_censored_weibull_fit_is_unbiased_under_heavy_censoring():
+    # Renewal windows of about one mean interval: 40% of all intervals are censored.
+    law = scipy.stats.weibull_min(0.7, scale=1.0)
+    rng = np.random.default_rng(7)
+    shapes, naive, ses = [], [], []
+    for _ in range(40):
+        x, c = renewal_windows(law, 1.2, 800, rng)
+        fit = stats.fit_renewal(x, "weibull", censored=c)
+        shapes.append(fit.params["shape"])
+        ses.append(fit.stderr["shape"])
+        naive.append(stats.fit_renewal(x, "weibull").params["shape"])
+    assert c.size / (x.size + c.size) > 0.38
+    shapes = np.asarray(shapes)
+    mc_error = shapes.std(ddof=1) / math.sqrt(shapes.size)
+    assert abs(shapes.mean() - 0.7) < 3.5 * mc_error + 0.003
+    # The Hessian standard error matches the scatter of the estimates.
+    assert np.mean(ses) == pytest.approx(shapes.std(ddof=1), rel=0.35)
+    # Dropping the censored intervals instead biases the fit well beyond that error.
+    assert abs(np.mean(naive) - 0.7) > 10 * mc_error
+
+
+def test_hyperexponential_on_exponential_data_nests_the_exponential():
+    x = np.random.default_rng(8).exponential(2.0, 400)
+    hyper = stats.fit_renewal(x, "hyperexponential")
+    expo = stats.fit_renewal(x, "exponential")
+    # The mixture contains the exponential: its maximum is at least as high, and on
+    # exponential data not much higher (LR of a few units at most).
+    assert expo.loglik - 1e-6 <= hyper.loglik <= expo.loglik + 8
+    assert hyper.dist.mean() == pytest.approx(x.mean(), rel=0.05)
+
+
+def test_summary_and_repr_name_the_model_and_parameters():
+    fit = stats.fit_renewal(np.random.default_rng(9).gamma(2.0, 1.0, 300), "gamma")
+    text = fit.summary()
+    assert "gamma" in text and "shape" in text and "AIC" in text
+    assert "RenewalFit(model='gamma'" in repr(fit)
+
+
+# --- power-law tail ----------------------------------------------------------------------
+
+
+def pareto_with_body(n, alpha, x_min, body_fraction, rng):
+    n_body = int(body_fraction * n)
+    body = rng.uniform(0.05, x_min, n_body)
+    tail = scipy.stats.pareto(alpha - 1, scale=x_min).rvs(n - n_body, random_state=rng)
+    return rng.permutation(np.concatenate([body, tail]))
+
+
+def test_powerlaw_tail_recovers_alpha_and_x_min():
+    rng = np.random.default_rng(10)
+    x = pareto_with_body(4000, 2.5, 1.0, 0.4, rng)
+    fit = stats.fit_renewal(x, "powerlaw")
+    assert fit.x_min == pytest.approx(1.0, rel=0.1)
+    assert abs(fit.params["alpha"] - 2.5) < 4 * fit.stderr["alpha"]
+    assert fit.dist.dist.name == "pareto"
+    assert fit.dist.kwds["scale"] == fit.x_min
+    assert fit.n + fit.n_excluded == x.size
+
+
+def test_powerlaw_censored_mle_is_the_closed_form_and_maximises_the_likelihood():
+    rng = np.random.default_rng(11)
+    x = scipy.stats.pareto(1.8, scale=1.0).rvs(3000, random_state=rng)
+    xc, c = censor_independently(x, 20.0, rng)
+    fit = stats.fit_renewal(xc, "powerlaw", censored=c, x_min=1.0)
+    c = c[c >= 1.0]  # censored below x_min: no information about the tail
+    b = xc.size / (np.log(xc).sum() + np.log(c).sum())
+    assert fit.params["alpha"] == pytest.approx(1 + b, rel=1e-12)
+
+    def loglik(alpha):
+        d = scipy.stats.pareto(alpha - 1, scale=1.0)
+        return d.logpdf(xc).sum() + d.logsf(c).sum()
+
+    assert fit.loglik == pytest.approx(loglik(fit.params["alpha"]), rel=1e-10)
+    assert loglik(fit.params["alpha"]) > max(
+        loglik(fit.params["alpha"] * (1 + e)) for e in (-1e-3, 1e-3)
+    )
+    assert abs(fit.params["alpha"] - 2.8) < 4 * fit.stderr["alpha"]
+
+
+def test_powerlaw_ks_distance_equals_the_kaplan_meier_ks_on_the_tail():
+    rng = np.random.default_rng(12)
+    xc, c = censor_independently(pareto_with_body(2000, 2.2, 0.5, 0.3, rng), 5.0, rng)
+    fit = stats.fit_renewal(xc, "powerlaw", censored=c)
+    from kicktimes.stats.powerlaw import fit_powerlaw_tail
+
+    raw = fit_powerlaw_tail(xc, c, x_min=fit.x_min)
+    assert raw["ks"] == pytest.approx(km_ks(*fit.sample, fit.dist.cdf), rel=1e-9)
+
+
+# --- comparison ----------------------------------------------------------------------------
+
+
+def test_compare_models_table_is_sorted_with_akaike_weights():
+    x = scipy.stats.gamma(0.5, scale=2.0).rvs(800, random_state=np.random.default_rng(13))
+    table = stats.compare_models(x)
+    assert list(table.index) == sorted(table.index, key=lambda m: table.loc[m, "aic"])
+    assert set(table.index) == set(stats.FULL_SAMPLE_MODELS)
+    assert table["weight"].sum() == pytest.approx(1.0)
+    assert table["delta_aic"].min() == 0.0
+    assert table.loc["gamma", "delta_aic"] <= 2.0
+    assert table.loc["exponential", "weight"] < 1e-6
+    assert table.attrs["footing"] == "full sample"
+
+
+def test_compare_models_with_the_power_law_compares_on_the_tail():
+    x = pareto_with_body(2000, 2.5, 1.0, 0.4, np.random.default_rng(14))
+    table = stats.compare_models(x, models=["powerlaw", "exponential", "lognormal"])
+    assert table.attrs["footing"] == "tail"
+    assert table["n"].nunique() == 1  # every model sees the same tail
+    assert table.loc["exponential", "delta_aic"] > 10
+    assert table.loc["powerlaw", "delta_aic"] <= 2
+
+
+def _aic_recovery(model, n_rep, rng):
+    law = TRUE_LAWS[model][0]
+    hits = 0
+    for _ in range(n_rep):
+        table = stats.compare_models(law.rvs(800, random_state=rng))
+        hits += table.loc[model, "delta_aic"] <= 2.0
+    return hits / n_rep
+
+
+@pytest.mark.parametrize("model", list(TRUE_LAWS))
+def test_true_model_is_within_two_aic_units_of_the_best(model):
+    assert _aic_recovery(model, 8, np.random.default_rng(15)) >= 6 / 8
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("model", list(TRUE_LAWS))
+def test_true_model_is_within_two_aic_units_of_the_best_in_most_replicates(model):
+    # The exponential is nested in four of the other models, each of which can gain
+    # up to chi-square noise; P(all within 2 AIC units) is about 0.91 in theory.
+    floor = 0.85 if model == "exponential" else 0.9
+    assert _aic_recovery(model, 200, np.random.default_rng(16)) >= floor
+
+
+def test_vuong_is_antisymmetric_and_prefers_the_true_model():
+    rng = np.random.default_rng(17)
+    x, c = censor_independently(rng.lognormal(0.0, 1.0, 3000), 5.0, rng)
+    ab = stats.vuong(x, "lognormal", "weibull", censored=c)
+    ba = stats.vuong(x, "weibull", "lognormal", censored=c)
+    assert ab.statistic == pytest.approx(-ba.statistic, rel=1e-12)
+    assert ab.pvalue == pytest.approx(ba.pvalue)
+    assert ab.preferred == ba.preferred == "lognormal"
+    for corr in ("aic", "bic"):
+        one = stats.vuong(x, "gamma", "hyperexponential", censored=c, correction=corr)
+        two = stats.vuong(x, "hyperexponential", "gamma", censored=c, correction=corr)
+        assert one.statistic == pytest.approx(-two.statistic, rel=1e-9)
+        assert one.preferred == two.preferred
+
+
+def test_vuong_flags_nested_models_and_handles_the_power_law_on_the_tail():
+    rng = np.random.default_rng(18)
+    res = stats.vuong(rng.exponential(1.0, 500), "exponential", "gamma")
+    assert "nested" in res.note
+    x = pareto_with_body(2000, 2.5, 1.0, 0.4, rng)
+    pl = stats.vuong(x, "powerlaw", "exponential")
+    assert pl.x_min is not None and pl.preferred == "powerlaw"
+
+
+# --- goodness of fit -----------------------------------------------------------------------
+
+
+def test_goodness_of_fit_accepts_the_true_model_and_rejects_a_wrong_one():
+    rng = np.random.default_rng(19)
+    x = rng.weibull(0.6, 400)
+    good = stats.goodness_of_fit(stats.fit_renewal(x, "weibull"), n_mc=99, rng=1)
+    bad = stats.goodness_of_fit(stats.fit_renewal(x, "exponential"), n_mc=99, rng=1)
+    assert good.pvalue > 0.05 and good.method == "scipy.stats.goodness_of_fit"
+    assert bad.pvalue <= 0.02
+
+
+def test_censored_goodness_of_fit_uses_the_bootstrap_and_detects_a_wrong_model():
+    rng = np.random.default_rng(20)
+    x, c = censor_independently(rng.weibull(0.5, 500), 3.0, rng)
+    good = stats.goodness_of_fit(stats.fit_renewal(x, "weibull", censored=c), n_mc=49, rng=2)
+    bad = stats.goodness_of_fit(stats.fit_renewal(x, "exponential", censored=c), n_mc=49, rng=2)
+    assert "bootstrap" in good.method and good.pvalue > 0.05
+    assert bad.pvalue <= 0.04
+    with pytest.raises(ValueError, match="statistic"):
+        stats.goodness_of_fit(stats.fit_renewal(x, "weibull", censored=c), statistic="ad")
+
+
+def test_censored_bootstrap_pvalues_are_calibrated_under_the_null():
+    # Exponential fits refit in closed form, so many bootstrap tests are cheap.
+    rng = np.random.default_rng(21)
+    pvalues = []
+    for _ in range(150):
+        x, c = censor_independently(rng.exponential(1.0, 150), 1.5, rng)
+        fit = stats.fit_renewal(x, "exponential", censored=c)
+        pvalues.append(stats.goodness_of_fit(fit, n_mc=39, rng=rng).pvalue)
+    pvalues = np.asarray(pvalues)
+    # P(p <= 0.2) = 0.2 for a valid Monte Carlo test with n_mc + 1 = 40.
+    rate = np.mean(pvalues <= 0.2)
+    assert abs(rate - 0.2) < 3 * math.sqrt(0.2 * 0.8 / pvalues.size)
+
+
+def test_km_ks_equals_the_plain_ks_statistic_without_censoring():
+    x = np.random.default_rng(22).exponential(1.0, 300)
+    cdf = scipy.stats.expon(scale=1.1).cdf
+    assert km_ks(x, np.empty(0), cdf) == pytest.approx(scipy.stats.kstest(x, cdf).statistic)
+
+
+def test_powerlaw_goodness_of_fit_runs_the_csn_bootstrap():
+    x = pareto_with_body(1500, 2.5, 1.0, 0.4, np.random.default_rng(23))
+    res = stats.goodness_of_fit(stats.fit_renewal(x, "powerlaw"), n_mc=19, rng=3)
+    assert res.method == "CSN semi-parametric bootstrap"
+    assert res.pvalue > 0.05 and res.null_distribution.size + res.n_failed == 19
+
+
+# --- bad input -----------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("intervals", "censored", "match"),
+    [
+        ([1.0, np.nan, 2.0], None, "intervals"),
+        ([1.0, -1.0, 2.0], None, "intervals"),
+        ([1.0, 0.0, 2.0], None, "intervals"),
+        ([1.0, 2.0, 3.0], [np.inf], "censored"),
+        ([1.0, 2.0, 3.0], [-0.5], "censored"),
+        ([], None, "intervals"),
+    ],
+)
+def test_fit_renewal_rejects_bad_intervals(intervals, censored, match):
+    with pytest.raises(ValueError, match=match):
+        stats.fit_renewal(intervals, "weibull", censored=censored)
+
+
+def test_bad_model_names_and_options_are_rejected():
+    x = np.random.default_rng(24).exponential(1.0, 100)
+    with pytest.raises(ValueError, match="model"):
+        stats.fit_renewal(x, "pareto")
+    with pytest.raises(ValueError, match="models"):
+        stats.compare_models(x, models=["weibull", "weibull"])
+    with pytest.raises(ValueError, match="model1 and model2"):
+        stats.vuong(x, "gamma", "gamma")
+    with pytest.raises(ValueError, match="x_min"):
+        stats.fit_renewal(x, "weibull", x_min=-1.0)
+    with pytest.raises(ValueError, match="at least"):
+        stats.fit_renewal(x[:2], "gamma")
+    with pytest.raises(ValueError, match="min_tail"):
+        stats.fit_renewal(x[:30], "powerlaw")
+    with pytest.raises(TypeError, match="fit"):
+        stats.goodness_of_fit("weibull")
+    with pytest.raises(TypeError, match="rng"):
+        stats.goodness_of_fit(stats.fit_renewal(x, "exponential"), rng="seed")
