@@ -1,0 +1,103 @@
+"""Speed of the billiard simulators and of the FTLE, against references in the same run.
+
+Workload (issue 2): r = 0.01, tau = 0.3, 15 000 uniform samples, 200 paper-procedure ICs,
+one `simulate_two_particle` call per IC as a user would make it. Reference: the paper's
+time-stepped algorithm in plain NumPy (benchmarks/paper_timestep.py) on a few of the same
+ICs, scaled per trajectory. Also: the Poisson-kicked one-disk billiard on the same
+workload, and the FTLE cost relative to the bare simulation.
+
+Run: python benchmarks/bench_simulators.py [--n-ics 200]
+"""
+
+import argparse
+import os
+import sys
+import time
+
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(__file__))
+from paper_timestep import paper_timestep  # noqa: E402
+
+from kicktimes import initial_conditions, schedules, simulate_one_particle, simulate_two_particle
+from kicktimes.diagnostics import lyapunov
+
+
+def best_of(fn, repeat=3):
+    times = []
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        out = fn()
+        times.append(time.perf_counter() - t0)
+    return min(times), out
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--n-ics", type=int, default=200)
+    ap.add_argument("--n-ref", type=int, default=3, help="ICs for the slow NumPy reference")
+    args = ap.parse_args()
+    r, tau, n_steps = 0.01, 0.3, 15000
+    ics = initial_conditions(args.n_ics, r, seed=2026, method="paper")
+
+    # warm-up: compile (or load from the numba cache)
+    simulate_two_particle(ics[0], r, n_steps=10, tau=tau)
+    simulate_one_particle(ics[0, 0], r, n_steps=10, tau=tau, kicks=[0.1], rng=0)
+    lyapunov(ics[0], r, n_steps=10, tau=tau)
+    lyapunov(ics[0, 0], r, n_steps=10, tau=tau, kicks=[0.1], rng=0)
+
+    def two():
+        return [simulate_two_particle(ic, r, n_steps=n_steps, tau=tau) for ic in ics]
+
+    t_two, runs = best_of(two)
+    events = sum(run.n_pp + run.n_boundary for run in runs)
+    rates = [schedules.Poisson.from_run(run) for run in runs]
+
+    def one():
+        return [simulate_one_particle(ic[0], r, n_steps=n_steps, tau=tau, kicks=rate, rng=i)
+                for i, (ic, rate) in enumerate(zip(ics, rates, strict=True))]
+
+    t_one, ones = best_of(one)
+    events_one = sum(run.n_boundary + run.n_kicks for run in ones)
+
+    n_ftle = min(50, args.n_ics)
+    t_ftle_norm, _ = best_of(lambda: [lyapunov(ic, r, n_steps=n_steps, tau=tau)
+                                      for ic in ics[:n_ftle]], repeat=1)
+    t_ftle_paper, _ = best_of(lambda: [lyapunov(ic, r, n_steps=n_steps, tau=tau, variant="paper")
+                                       for ic in ics[:n_ftle]], repeat=1)
+    t_ftle_one, _ = best_of(lambda: [lyapunov(o) for o in ones[:n_ftle]], repeat=1)
+
+    t0 = time.perf_counter()
+    for ic in ics[: args.n_ref]:
+        paper_timestep(ic, r, n_steps, tau)
+    t_ref = (time.perf_counter() - t0) / args.n_ref
+    # the paper-sampled kicktimes run does the same steps: compare like with like
+    t_paper_mode, _ = best_of(lambda: [simulate_two_particle(ic, r, n_steps=n_steps, tau=tau,
+                                                             sampling="paper")
+                                       for ic in ics[: args.n_ref]])
+    t_paper_mode /= args.n_ref
+
+    ms = 1e3 / args.n_ics
+    print(f"workload: r={r}, tau={tau}, n_steps={n_steps}, {args.n_ics} paper ICs, "
+          f"{os.cpu_count()} cores (one used)")
+    print(f"{'what':46s} {'ms/traj':>9s} {'events/s':>12s} {'ratio':>8s}")
+    print(f"{'simulate_two_particle (uniform sampling)':46s} {t_two * ms:9.3f} "
+          f"{events / t_two:12.3e} {'1':>8s}")
+    print(f"{'simulate_one_particle (Poisson kicks)':46s} {t_one * ms:9.3f} "
+          f"{events_one / t_one:12.3e} {t_one / t_two:8.2f}")
+    per = 1e3 / n_ftle
+    print(f"{'lyapunov two-particle, norm (1 twin)':46s} {t_ftle_norm * per:9.3f} "
+          f"{'':12s} {t_ftle_norm / n_ftle / (t_two / args.n_ics):8.2f}")
+    print(f"{'lyapunov two-particle, paper (2 twins)':46s} {t_ftle_paper * per:9.3f} "
+          f"{'':12s} {t_ftle_paper / n_ftle / (t_two / args.n_ics):8.2f}")
+    print(f"{'lyapunov one-particle, norm (1 twin)':46s} {t_ftle_one * per:9.3f} "
+          f"{'':12s} {t_ftle_one / n_ftle / (t_one / args.n_ics):8.2f} (vs one-particle sim)")
+    print(f"{'simulate_two_particle (paper sampling)':46s} {t_paper_mode * 1e3:9.3f}")
+    print(f"{'paper time-stepped algorithm, plain NumPy':46s} {t_ref * 1e3:9.3f} {'':12s} "
+          f"{t_ref / t_paper_mode:8.0f}x slower than kicktimes (same steps)")
+    print(f"mean events per trajectory: {events / args.n_ics:.0f}; "
+          f"mean disk-disk collisions: {np.mean([run.n_pp for run in runs]):.1f}")
+
+
+if __name__ == "__main__":
+    main()
