@@ -1,0 +1,174 @@
+"""Wall time of the whole paper: both experiment families at full scale, plus the report.
+
+Runs ``family_a`` (12 radii x 200 ICs x 25000 steps of 0.2) and ``family_b`` (10 radii x
+1000 ICs x 15000 steps of 0.3) on the local process pool, three systems and three
+diagnostics each, then builds the report (if ``kicktimes.report`` is available), and
+prints the wall times with a breakdown by stage (summed over tasks, i.e. worker-seconds,
+from the timings each task records in the store manifest).
+
+Reference measured in the same run: a subset of family A (3 radii x 16 ICs, the full
+25000 steps) with one worker and with all workers, giving the parallel speed-up and the
+per-IC cost of each stage.
+
+Usage::
+
+    python benchmarks/bench_paper.py                 # full scale (minutes)
+    python benchmarks/bench_paper.py --scale quick   # the quick presets (seconds)
+    python benchmarks/bench_paper.py --out DIR --keep --json timings.json
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import json
+import os
+import shutil
+import tempfile
+import time
+from pathlib import Path
+
+import pandas as pd
+
+from kicktimes.experiment import execute_task, preset, run_experiment
+from kicktimes.experiment.presets import SCALES
+
+STAGES = [
+    ("simulation_two_particle", "simulation: two-particle runs"),
+    ("simulation_one_particle", "simulation: kicked one-particle runs (+ kick draws)"),
+    ("lyapunov_two_particle", "diagnostic: FTLE, two-particle (twins)"),
+    ("lyapunov_kicked", "diagnostic: FTLE, kicked (twins)"),
+    ("recurrence_rate", "diagnostic: recurrence rate"),
+    ("autocorrelation", "diagnostic: autocorrelation"),
+    ("tables", "tidy tables"),
+]
+
+
+def stage_table(store) -> pd.DataFrame:
+    sums = store.timings.sum()
+    total = float(sums.get("total", 0.0))
+    rows = []
+    for key, label in STAGES:
+        sec = float(sums.get(key, 0.0))
+        rows.append({"stage": label, "worker_s": sec, "share": sec / total if total else 0.0})
+    other = total - sum(r["worker_s"] for r in rows)
+    rows.append({"stage": "other (ICs, loop)", "worker_s": other, "share": other / total})
+    rows.append({"stage": "total (worker-seconds)", "worker_s": total, "share": 1.0})
+    return pd.DataFrame(rows)
+
+
+def reference(workers: int, root: Path) -> dict:
+    """Subset of family A with 1 worker and with ``workers``: speed-up and per-IC costs."""
+    exp = dataclasses.replace(
+        preset("family_a"), name="ref_a", radii=[0.008, 0.02, 0.03], n_ics=16, block_size=4
+    )
+    out = {}
+    for w in sorted({1, workers}):
+        path = root / f"ref-{w}"
+        t0 = time.perf_counter()
+        store = run_experiment(exp, path, workers=w, progress=False)
+        out[w] = time.perf_counter() - t0
+    n_pairs = len(exp.radii) * exp.n_ics
+    per_ic = (store.timings.sum() / n_pairs * 1e3).round(2).to_dict()
+    return {"experiment": exp, "wall": out, "per_ic_ms": per_ic, "n_pairs": n_pairs}
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--scale", choices=sorted(SCALES), default="paper")
+    parser.add_argument("--workers", type=int, default=os.cpu_count())
+    parser.add_argument("--out", type=Path, default=None, help="keep stores/report here")
+    parser.add_argument("--keep", action="store_true", help="do not delete --out afterwards")
+    parser.add_argument("--no-report", action="store_true")
+    parser.add_argument("--json", type=Path, default=None, help="also write the numbers here")
+    args = parser.parse_args()
+
+    root = args.out or Path(tempfile.mkdtemp(prefix="bench-paper-"))
+    root.mkdir(parents=True, exist_ok=True)
+    load0 = os.getloadavg()[0]
+    print(
+        f"kicktimes paper benchmark: scale {args.scale}, {args.workers} workers, "
+        f"{os.cpu_count()} cores, load average at start {load0:.2f}"
+    )
+
+    # numba kernels load from the on-disk cache (or compile) once per process; do it here
+    # so the first task's time is not a compilation
+    t0 = time.perf_counter()
+    warm = dataclasses.replace(preset("quick_a"), n_ics=1, n_steps=50, block_size=1)
+    execute_task(warm, warm.tasks()[0])
+    warmup = time.perf_counter() - t0
+
+    results = {
+        "scale": args.scale,
+        "workers": args.workers,
+        "warmup_s": warmup,
+        "load_start": load0,
+        "families": {},
+    }
+    stores = []
+    t_all = time.perf_counter()
+    for name in SCALES[args.scale]:
+        exp = preset(name)
+        path = root / f"store-{name}"
+        t0 = time.perf_counter()
+        store = run_experiment(exp, path, workers=args.workers, progress=False)
+        wall = time.perf_counter() - t0
+        stores.append(path)
+        table = stage_table(store)
+        n_pairs = len(exp.radii) * exp.n_ics
+        results["families"][name] = {
+            "wall_s": wall,
+            "n_radius_ic": n_pairs,
+            "ms_per_radius_ic": wall / n_pairs * 1e3,
+            "stages": table.to_dict(orient="records"),
+        }
+        print(
+            f"\n{name}: {len(exp.radii)} radii x {exp.n_ics} ICs x {exp.n_steps} steps "
+            f"(tau {exp.tau}), {len(exp.tasks())} tasks: wall {wall:.1f} s "
+            f"({wall / n_pairs * 1e3:.1f} ms per radius-IC, 3 systems)"
+        )
+        print(table.to_string(index=False, float_format=lambda x: f"{x:.3f}"))
+    sweep_wall = time.perf_counter() - t_all
+
+    report_wall = None
+    if not args.no_report:
+        try:
+            from kicktimes.report import build_report
+        except ImportError:
+            print("\nkicktimes.report is not available: report not timed")
+        else:
+            t0 = time.perf_counter()
+            build_report(stores, root / "report", workers=args.workers, progress=False)
+            report_wall = time.perf_counter() - t0
+            timings = root / "report" / "report_timings.csv"
+            print(f"\nreport (statistics + figures + HTML): wall {report_wall:.1f} s")
+            if timings.exists():
+                print(pd.read_csv(timings).to_string(index=False))
+                results["report_stages"] = pd.read_csv(timings).to_dict(orient="records")
+    results["sweep_wall_s"] = sweep_wall
+    results["report_wall_s"] = report_wall
+    total = sweep_wall + (report_wall or 0.0)
+    results["total_wall_s"] = total
+
+    print("\nreference (same run): subset of family A, 3 radii x 16 ICs x 25000 steps")
+    ref = reference(args.workers, root)
+    w1 = ref["wall"][1]
+    wn = ref["wall"][args.workers]
+    print(f"  1 worker: {w1:.2f} s   {args.workers} workers: {wn:.2f} s   speed-up {w1 / wn:.2f}x")
+    print(f"  per radius-IC (all three systems), ms: {ref['per_ic_ms']}")
+    results["reference"] = {"wall": ref["wall"], "speedup": w1 / wn, "per_ic_ms": ref["per_ic_ms"]}
+
+    print(
+        f"\nTOTAL: sweeps {sweep_wall:.1f} s + report "
+        f"{report_wall if report_wall is not None else float('nan'):.1f} s = {total:.1f} s "
+        f"({total / 60:.2f} min; target < 10 min, aim < 2 min); "
+        f"load average at end {os.getloadavg()[0]:.2f}"
+    )
+    if args.json:
+        args.json.write_text(json.dumps(results, indent=1, default=str))
+    if args.out is None or not args.keep:
+        shutil.rmtree(root, ignore_errors=True)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,317 @@
+"""An experiment: the parameters of one ensemble sweep, as a frozen dataclass and a TOML file.
+
+The TOML file is flat (one key per field, see docs/experiments.md)::
+
+    name = "family_a"
+    radii = [0.008, 0.010, 0.012]
+    n_ics = 200
+    n_steps = 25000
+    tau = 0.2
+    sampling = "paper"
+
+Unknown keys are refused (a typo must not silently fall back to a default). The
+experiment's identity is `Experiment.hash`, a SHA-256 of its canonical JSON; a store
+records it and refuses to mix results of two experiments.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import numbers
+import os
+import re
+from dataclasses import asdict, dataclass, field, fields
+
+__all__ = ["DIAGNOSTICS", "SYSTEMS", "Experiment"]
+
+SYSTEMS = ("two_particle", "poisson", "actual")
+DIAGNOSTICS = ("lyapunov", "recurrence_rate", "autocorrelation")
+IC_METHODS = ("paper", "uniform")
+SAMPLINGS = ("uniform", "paper")
+RULES = ("mirror", "elastic")
+LYAPUNOV_VARIANTS = ("norm", "paper")
+KICK_ANGLES = ("uniform", "gaussian")
+
+_REQUIRED = ("name", "radii", "n_ics", "n_steps", "tau")
+_NAME_RE = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]*$")
+
+
+def _real(name, value, *, low=None, high=None, low_open=True):
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise TypeError(f"{name}: expected a real number, got {value!r}")
+    value = float(value)
+    if not math.isfinite(value):
+        raise ValueError(f"{name}: must be finite, got {value!r}")
+    if low is not None and (value <= low if low_open else value < low):
+        bound = f"> {low}" if low_open else f">= {low}"
+        raise ValueError(f"{name}: must be {bound}, got {value!r}")
+    if high is not None and value >= high:
+        raise ValueError(f"{name}: must be < {high}, got {value!r}")
+    return value
+
+
+def _int(name, value, *, low):
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral):
+        raise TypeError(f"{name}: expected an integer, got {value!r}")
+    if value < low:
+        raise ValueError(f"{name}: must be >= {low}, got {value!r}")
+    return int(value)
+
+
+def _choice(name, value, choices):
+    if not isinstance(value, str) or value not in choices:
+        raise ValueError(f"{name}: must be one of {', '.join(map(repr, choices))}; got {value!r}")
+    return value
+
+
+def _subset(name, value, choices):
+    if isinstance(value, str) or not hasattr(value, "__iter__"):
+        raise TypeError(f"{name}: expected a list of names from {list(choices)}, got {value!r}")
+    items = list(value)
+    if not items:
+        raise ValueError(f"{name}: must name at least one of {list(choices)}, got []")
+    for item in items:
+        _choice(f"{name} entry", item, choices)
+    if len(set(items)) != len(items):
+        raise ValueError(f"{name}: duplicate entries in {items}")
+    # canonical order, so that the same set always hashes the same
+    return tuple(c for c in choices if c in items)
+
+
+@dataclass(frozen=True)
+class Experiment:
+    """The parameters of an ensemble sweep over radii (the same object as a TOML file).
+
+    Parameters
+    ----------
+    name : str
+        Identifier (letters, digits, ``_ . -``), used in store and report names.
+    radii : sequence of float
+        Disk radii ``0 < r < 0.5``, distinct; stored sorted increasingly.
+    n_ics : int
+        Number of initial conditions (``>= 1``), drawn once at ``max(radii)`` and used
+        unchanged for every radius (the paper's procedure).
+    n_steps : int
+        Sampling steps per run (``>= 1``).
+    tau : float
+        Step length (``> 0``).
+    ic_method : {"paper", "uniform"}
+        See `kicktimes.initial_conditions`.
+    seed : int
+        Root seed (``>= 0``) of the ICs and of every kick schedule and kick angle.
+    sampling : {"uniform", "paper"}
+        ``"paper"``: collision-truncated steps (the paper's algorithm, so ``n_steps``
+        steps cover less than ``n_steps * tau``); ``"uniform"``: samples at ``k tau``.
+    rule : {"mirror", "elastic"}
+        Disk-disk collision rule.
+    eps : float
+        Recurrence threshold ``> 0`` (the paper: 0.001).
+    lag : int
+        Autocorrelation lag ``>= 1``.
+    d0 : float
+        Initial separation of the Lyapunov twins, ``0 < d0 < 0.1`` (the paper: 1/5000).
+    lyapunov_variant : {"norm", "paper"}
+        ``"paper"``: ``max(lambda_x, lambda_y)`` (also stores both); ``"norm"``: 2-norm.
+    kick_angle : {"uniform", "gaussian"}
+        Kick law of the one-particle billiards; ``sigma`` (``> 0``) is the standard
+        deviation of the gaussian rotation (unused for ``"uniform"``).
+    systems : sequence of str
+        Subset of ``("two_particle", "poisson", "actual")`` whose diagnostics are stored.
+        The two-particle run is always simulated (its collision times are stored and
+        drive the other two).
+    diagnostics : sequence of str
+        Subset of ``("lyapunov", "recurrence_rate", "autocorrelation")``.
+    block_size : int
+        Initial conditions per task (``>= 1``); a task is one radius times one block.
+    description : str
+        Free text for the report.
+
+    Examples
+    --------
+    >>> exp = Experiment(name="demo", radii=[0.02, 0.01], n_ics=4, n_steps=500, tau=0.3)
+    >>> exp.radii
+    (0.01, 0.02)
+    >>> Experiment.from_toml_string(exp.to_toml()) == exp
+    True
+    >>> len(exp.hash())
+    16
+    """
+
+    name: str
+    radii: tuple
+    n_ics: int
+    n_steps: int
+    tau: float
+    ic_method: str = "paper"
+    seed: int = 0
+    sampling: str = "uniform"
+    rule: str = "mirror"
+    eps: float = 1e-3
+    lag: int = 1
+    d0: float = 1.0 / 5000.0
+    lyapunov_variant: str = "norm"
+    kick_angle: str = "uniform"
+    sigma: float = 1.0
+    systems: tuple = SYSTEMS
+    diagnostics: tuple = DIAGNOSTICS
+    block_size: int = 25
+    description: str = field(default="")
+
+    def __post_init__(self):
+        def put(name, value):
+            object.__setattr__(self, name, value)
+
+        if not isinstance(self.name, str) or not _NAME_RE.match(self.name):
+            raise ValueError(
+                f"name: must be a non-empty identifier of letters, digits, '_', '.', '-' "
+                f"(it names files), got {self.name!r}"
+            )
+        radii = self.radii
+        if isinstance(radii, (str, bytes)) or not hasattr(radii, "__iter__"):
+            raise TypeError(f"radii: expected a list of radii, got {radii!r}")
+        radii = [_real(f"radii[{k}]", r, low=0.0, high=0.5) for k, r in enumerate(radii)]
+        if not radii:
+            raise ValueError("radii: must contain at least one radius, got []")
+        if len(set(radii)) != len(radii):
+            raise ValueError(f"radii: must be distinct, got {radii}")
+        put("radii", tuple(sorted(radii)))
+        put("n_ics", _int("n_ics", self.n_ics, low=1))
+        put("n_steps", _int("n_steps", self.n_steps, low=1))
+        put("tau", _real("tau", self.tau, low=0.0))
+        _choice("ic_method", self.ic_method, IC_METHODS)
+        put("seed", _int("seed", self.seed, low=0))
+        _choice("sampling", self.sampling, SAMPLINGS)
+        _choice("rule", self.rule, RULES)
+        put("eps", _real("eps", self.eps, low=0.0))
+        put("lag", _int("lag", self.lag, low=1))
+        put("d0", _real("d0", self.d0, low=0.0, high=0.1))
+        _choice("lyapunov_variant", self.lyapunov_variant, LYAPUNOV_VARIANTS)
+        _choice("kick_angle", self.kick_angle, KICK_ANGLES)
+        put("sigma", _real("sigma", self.sigma, low=0.0))
+        put("systems", _subset("systems", self.systems, SYSTEMS))
+        put("diagnostics", _subset("diagnostics", self.diagnostics, DIAGNOSTICS))
+        put("block_size", _int("block_size", self.block_size, low=1))
+        if not isinstance(self.description, str):
+            raise TypeError(f"description: expected a string, got {self.description!r}")
+
+    # ------------------------------------------------------------------ derived
+    @property
+    def r_max(self) -> float:
+        """The largest radius: the ICs are drawn (and valid) at it."""
+        return self.radii[-1]
+
+    @property
+    def horizon(self) -> float:
+        """``n_steps * tau``: the duration of a uniform run, an upper bound for a paper run."""
+        return self.n_steps * self.tau
+
+    def tasks(self):
+        """All tasks of the sweep (radius-major, then IC block); see `kicktimes.experiment.Task`."""
+        from kicktimes.experiment.tasks import make_tasks
+
+        return make_tasks(self)
+
+    # -------------------------------------------------------------- conversions
+    def to_dict(self) -> dict:
+        """JSON/TOML-ready dict of every field (tuples become lists)."""
+        out = asdict(self)
+        for key in ("radii", "systems", "diagnostics"):
+            out[key] = list(out[key])
+        return out
+
+    @classmethod
+    def from_dict(cls, d) -> Experiment:
+        """Experiment from `to_dict` output (or a parsed TOML file); unknown keys are refused."""
+        if not isinstance(d, dict):
+            raise TypeError(f"expected a dict of experiment fields, got {type(d).__name__}")
+        known = [f.name for f in fields(cls)]
+        unknown = sorted(set(d) - set(known))
+        if unknown:
+            raise ValueError(
+                f"unknown experiment key(s) {unknown}; valid keys are {', '.join(known)}"
+            )
+        missing = [k for k in _REQUIRED if k not in d]
+        if missing:
+            raise ValueError(f"missing required experiment key(s) {missing}")
+        return cls(**d)
+
+    def hash(self) -> str:
+        """Stable identity: the first 16 hex digits of SHA-256 of the canonical JSON."""
+        text = json.dumps(self.to_dict(), sort_keys=True, separators=(",", ":"), allow_nan=False)
+        return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+    def to_toml(self) -> str:
+        """The experiment as TOML text (flat keys, in field order); `from_toml_string` reads it."""
+        lines = []
+        for key, value in self.to_dict().items():
+            lines.append(f"{key} = {_toml_value(value)}")
+        return "\n".join(lines) + "\n"
+
+    def write_toml(self, path: str | os.PathLike) -> None:
+        """Write `to_toml` to ``path``."""
+        with open(path, "w", encoding="utf-8") as fh:
+            fh.write(self.to_toml())
+
+    @classmethod
+    def from_toml_string(cls, text: str) -> Experiment:
+        """Experiment from TOML text."""
+        try:
+            data = _tomllib().loads(text)
+        except _tomllib().TOMLDecodeError as exc:
+            raise ValueError(f"invalid TOML: {exc}") from None
+        return cls.from_dict(data)
+
+    @classmethod
+    def from_toml(cls, path: str | os.PathLike) -> Experiment:
+        """Read an experiment TOML file; errors name the file."""
+        path = os.fspath(path)
+        try:
+            with open(path, encoding="utf-8") as fh:
+                text = fh.read()
+        except OSError as exc:
+            raise ValueError(f"path: cannot read experiment file {path!r}: {exc}") from None
+        try:
+            return cls.from_toml_string(text)
+        except (ValueError, TypeError) as exc:
+            raise type(exc)(f"{path}: {exc}") from None
+
+    def summary(self) -> str:
+        """A few lines describing the sweep."""
+        n_tasks = len(self.tasks())
+        radii = ", ".join(f"{r:g}" for r in self.radii)
+        return (
+            f"Experiment {self.name!r} (hash {self.hash()})\n"
+            f"  radii ({len(self.radii)}): {radii}\n"
+            f"  {self.n_ics} ICs ({self.ic_method}, seed {self.seed}, drawn at r_max = "
+            f"{self.r_max:g}); {self.n_steps} steps of tau = {self.tau:g} ({self.sampling} "
+            f"sampling); rule {self.rule}\n"
+            f"  systems: {', '.join(self.systems)}; diagnostics: {', '.join(self.diagnostics)}"
+            f" (eps = {self.eps:g}, lag = {self.lag}, d0 = {self.d0:g}, Lyapunov variant "
+            f"{self.lyapunov_variant}; kicks {self.kick_angle})\n"
+            f"  {n_tasks} tasks of up to {self.block_size} ICs"
+        )
+
+
+def _toml_value(value) -> str:
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, int):
+        return str(value)
+    if isinstance(value, float):
+        return repr(value)  # shortest round-trip form; valid TOML for finite floats
+    if isinstance(value, str):
+        # JSON string escapes are valid TOML basic-string escapes
+        return json.dumps(value, ensure_ascii=False)
+    if isinstance(value, list):
+        return "[" + ", ".join(_toml_value(v) for v in value) + "]"
+    raise TypeError(f"cannot write {value!r} as TOML")
+
+
+def _tomllib():
+    try:
+        import tomllib
+    except ModuleNotFoundError:  # Python 3.10
+        import tomli as tomllib
+    return tomllib

@@ -1,0 +1,176 @@
+"""Run a sweep on any ``concurrent.futures`` executor, streaming finished tasks to the store."""
+
+from __future__ import annotations
+
+import os
+import sys
+from concurrent.futures import FIRST_COMPLETED, Executor, ProcessPoolExecutor, wait
+
+from kicktimes.experiment.config import Experiment
+from kicktimes.experiment.store import Store, StoreWriter, load_store
+from kicktimes.experiment.tasks import execute_task
+
+__all__ = ["run_experiment"]
+
+
+def _progress_enabled(progress) -> bool:
+    if progress is not None:
+        return bool(progress)
+    # a bar on an interactive terminal only: CI logs and pipes stay quiet
+    return sys.stderr.isatty() and not os.environ.get("CI")
+
+
+def _dask_executor(scheduler: str):
+    try:
+        from distributed import Client
+    except ImportError:
+        raise ImportError(
+            "scheduler: running on a Dask cluster needs the optional dependency "
+            "dask[distributed]; install it with  pip install 'kicktimes[dask]'"
+        ) from None
+    client = Client(scheduler)
+    return client, client.get_executor()
+
+
+def run_experiment(
+    experiment,
+    store,
+    *,
+    executor: Executor | None = None,
+    workers: int | None = None,
+    scheduler: str | None = None,
+    progress: bool | None = None,
+) -> Store:
+    """Run (or resume) a sweep and stream each finished task to the store.
+
+    Parameters
+    ----------
+    experiment : Experiment or path-like
+        The sweep, or the path of its TOML file.
+    store : path-like
+        Store directory (created if needed). If it already holds this experiment the run
+        resumes: finished tasks whose parts are intact are skipped, damaged or foreign
+        parts are reported (`StoreWarning`) and recomputed. A store of another
+        experiment is refused.
+    executor : concurrent.futures.Executor, optional
+        Run the tasks on it (it is not shut down). Default: a local process pool.
+    workers : int, optional
+        Size of the local process pool (default ``os.cpu_count()``); ``workers=1`` runs
+        the tasks in this process, one after the other.
+    scheduler : str, optional
+        Address of a Dask distributed scheduler (e.g. ``"tcp://host:8786"``): the tasks
+        run on that cluster through ``distributed.Client(address).get_executor()``.
+        Needs the optional dependency ``dask[distributed]``.
+    progress : bool, optional
+        Show a tqdm progress bar; default: only on a terminal and not when the ``CI``
+        environment variable is set.
+
+    Returns
+    -------
+    Store
+        The loaded store (`load_store`).
+
+    Raises
+    ------
+    ValueError
+        Bad arguments, or a store of a different experiment.
+    RuntimeError
+        A task failed; the tasks finished before it are kept, so a rerun resumes.
+
+    Notes
+    -----
+    Results are identical for every executor and worker count: each task is a pure
+    function of the experiment and its IC range, and every random number comes from a
+    seed sequence keyed by (IC, radius, system). Workers return their tables to this
+    process, which alone writes the store (the cluster needs no shared disk).
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from kicktimes.experiment import Experiment, run_experiment
+    >>> exp = Experiment(name="demo", radii=[0.02], n_ics=2, n_steps=100, tau=0.3,
+    ...                  diagnostics=["recurrence_rate"])
+    >>> store = run_experiment(exp, tempfile.mkdtemp(), workers=1, progress=False)
+    >>> store.complete, sorted(store.results["system"].unique())
+    (True, ['actual', 'poisson', 'two_particle'])
+    """
+    if isinstance(experiment, (str, os.PathLike)):
+        experiment = Experiment.from_toml(experiment)
+    if not isinstance(experiment, Experiment):
+        raise TypeError(
+            f"experiment: expected an Experiment or a TOML path, got {type(experiment).__name__}"
+        )
+    if not isinstance(store, (str, os.PathLike)):
+        raise TypeError(f"store: expected a directory path, got {type(store).__name__}")
+    if executor is not None and scheduler is not None:
+        raise ValueError("give either executor or scheduler, not both")
+    if workers is not None:
+        if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
+            raise ValueError(f"workers: must be an integer >= 1, got {workers!r}")
+        if executor is not None or scheduler is not None:
+            raise ValueError(
+                "workers: sizes the local process pool; it cannot be combined "
+                "with executor or scheduler"
+            )
+    if scheduler is not None and not isinstance(scheduler, str):
+        raise TypeError(f"scheduler: expected an address string, got {scheduler!r}")
+
+    writer = StoreWriter(store, experiment)
+    pending = writer.pending()
+    if pending:
+        _run_pending(writer, pending, executor, workers, scheduler, _progress_enabled(progress))
+    return load_store(store)
+
+
+def _run_pending(writer, pending, executor, workers, scheduler, show):
+    from tqdm.auto import tqdm
+
+    experiment = writer.experiment
+    total = len(writer.all_tasks)
+    bar = tqdm(
+        total=total,
+        initial=total - len(pending),
+        unit="task",
+        desc=experiment.name,
+        disable=not show,
+        dynamic_ncols=True,
+    )
+    client = None
+    own_pool = None
+    try:
+        if executor is None and scheduler is None and (workers or os.cpu_count() or 1) == 1:
+            for task in pending:
+                writer.write(execute_task(experiment, task))
+                bar.update()
+            return
+        if scheduler is not None:
+            client, executor = _dask_executor(scheduler)
+        elif executor is None:
+            own_pool = executor = ProcessPoolExecutor(max_workers=workers or os.cpu_count())
+        futures = {executor.submit(execute_task, experiment, task): task for task in pending}
+        not_done = set(futures)
+        try:
+            while not_done:
+                done, not_done = wait(not_done, return_when=FIRST_COMPLETED)
+                for fut in done:
+                    task = futures[fut]
+                    exc = fut.exception()
+                    if exc is not None:
+                        raise RuntimeError(
+                            f"task {task.id} (radius {task.radius:g}, ICs {task.ic_start}.."
+                            f"{task.ic_stop - 1}) failed: {exc!r}; the finished tasks are in "
+                            "the store, rerun to resume"
+                        ) from exc
+                    # stream: each task is on disk as soon as it finishes
+                    writer.write(fut.result())
+                    bar.update()
+        except BaseException:
+            for fut in not_done:
+                fut.cancel()
+            raise
+    finally:
+        bar.close()
+        if own_pool is not None:
+            own_pool.shutdown(wait=True, cancel_futures=True)
+        if client is not None:
+            client.close()

@@ -1,0 +1,322 @@
+"""Tasks of a sweep: one radius times one block of initial conditions.
+
+`run_task` does all the physics of a task, for each IC of its block:
+
+1. the two-particle run (disk 0 tracked): its diagnostics, and its disk-disk collision
+   times for the collision-time table;
+2. the Poisson-kicked one-particle billiard started from disk 0's IC, kicked at the rate
+   ``n_pp / t_max`` of that IC's two-particle run (the paper's per-IC estimate);
+3. the actual-time one-particle billiard, kicked at that run's disk-disk collision times.
+
+Every random number of (IC, radius, system) comes from its own
+``SeedSequence(seed, spawn_key=(KICK_DOMAIN, ic, radius bits, system code))``, so the
+results do not depend on the block size, the worker count or the executor, nor on which
+other radii the experiment holds. The kick angles are drawn once and given to both the
+run and its Lyapunov twins (common random numbers).
+"""
+
+from __future__ import annotations
+
+import math
+import struct
+import time
+from contextlib import contextmanager
+from dataclasses import dataclass, field
+
+import numpy as np
+import pandas as pd
+
+from kicktimes.experiment.config import Experiment
+
+__all__ = [
+    "COLLISION_COLUMNS",
+    "RESULT_COLUMNS",
+    "Task",
+    "TaskOutput",
+    "execute_task",
+    "kick_rng",
+    "make_tasks",
+    "run_task",
+]
+
+RESULT_COLUMNS = ("radius", "ic", "system", "diagnostic", "value", "note")
+COLLISION_COLUMNS = ("radius", "ic", "t_window", "n_pp", "pp_times")
+
+#: First spawn-key word of the kick streams; IC streams use ``spawn_key=(i,)``, so the two
+#: families of streams can never coincide (their keys differ in length and content).
+KICK_DOMAIN = 0x6B69636B  # "kick"
+SYSTEM_CODES = {"two_particle": 0, "poisson": 1, "actual": 2}
+
+
+@dataclass(frozen=True)
+class Task:
+    """One unit of work: radius ``radii[radius_index]`` and ICs ``ic_start .. ic_stop - 1``."""
+
+    radius_index: int
+    radius: float
+    ic_start: int
+    ic_stop: int
+
+    @property
+    def id(self) -> str:
+        """Stable name, e.g. ``"r003-ic000050-000100"`` (used for part files)."""
+        return f"r{self.radius_index:03d}-ic{self.ic_start:06d}-{self.ic_stop:06d}"
+
+    @property
+    def n_ics(self) -> int:
+        return self.ic_stop - self.ic_start
+
+
+def make_tasks(experiment: Experiment) -> list[Task]:
+    """Every task of ``experiment``, radius-major then by IC block."""
+    out = []
+    for ri, r in enumerate(experiment.radii):
+        for start in range(0, experiment.n_ics, experiment.block_size):
+            out.append(Task(ri, r, start, min(start + experiment.block_size, experiment.n_ics)))
+    return out
+
+
+def _radius_key(radius: float) -> int:
+    # the float's bit pattern: a stream is tied to the radius value, not to its index
+    return struct.unpack("<Q", struct.pack("<d", float(radius)))[0]
+
+
+def kick_rng(seed: int, ic: int, radius: float, system: str) -> np.random.Generator:
+    """The generator of the kick times and angles of one (IC, radius, system)."""
+    key = (KICK_DOMAIN, int(ic), _radius_key(radius), SYSTEM_CODES[system])
+    return np.random.default_rng(np.random.SeedSequence(seed, spawn_key=key))
+
+
+class _Timer:
+    """Accumulates wall time per named stage of a task (aggregated by the benchmark)."""
+
+    def __init__(self):
+        self.seconds: dict[str, float] = {}
+
+    @contextmanager
+    def __call__(self, name):
+        t0 = time.perf_counter()
+        try:
+            yield
+        finally:
+            self.seconds[name] = self.seconds.get(name, 0.0) + time.perf_counter() - t0
+
+
+@dataclass
+class TaskOutput:
+    """What a worker returns: the task's two tables and its stage timings (seconds)."""
+
+    task: Task
+    results: pd.DataFrame
+    collisions: pd.DataFrame
+    timings: dict = field(default_factory=dict)
+
+
+def _check_task(experiment, task):
+    if not isinstance(experiment, Experiment):
+        raise TypeError(f"experiment: expected an Experiment, got {type(experiment).__name__}")
+    if not isinstance(task, Task):
+        raise TypeError(f"task: expected a Task, got {type(task).__name__}")
+    ri = task.radius_index
+    if not (0 <= ri < len(experiment.radii)) or experiment.radii[ri] != task.radius:
+        raise ValueError(
+            f"task: radius index {ri} / radius {task.radius!r} is not one of the experiment's "
+            f"radii {list(experiment.radii)}"
+        )
+    if not (0 <= task.ic_start < task.ic_stop <= experiment.n_ics):
+        raise ValueError(
+            f"task: IC range [{task.ic_start}, {task.ic_stop}) must lie in [0, "
+            f"{experiment.n_ics}) and be non-empty"
+        )
+
+
+def run_task(experiment: Experiment, task: Task) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """Simulate one task and compute its diagnostics.
+
+    Parameters
+    ----------
+    experiment : Experiment
+    task : Task
+        One of ``experiment.tasks()``.
+
+    Returns
+    -------
+    results : DataFrame
+        Tidy rows ``radius, ic, system, diagnostic, value, note`` (docs/experiments.md
+        lists the diagnostics); ``value`` is NaN where undefined and ``note`` says why.
+    collisions : DataFrame
+        One row per IC: ``radius, ic, t_window`` (the two-particle run's duration),
+        ``n_pp`` and ``pp_times`` (array of disk-disk collision times in ``(0, t_window]``).
+
+    Examples
+    --------
+    >>> from kicktimes.experiment import Experiment, run_task
+    >>> exp = Experiment(name="demo", radii=[0.02], n_ics=2, n_steps=200, tau=0.3,
+    ...                  diagnostics=["recurrence_rate"])
+    >>> results, collisions = run_task(exp, exp.tasks()[0])
+    >>> sorted(results["system"].unique())
+    ['actual', 'poisson', 'two_particle']
+    """
+    out = execute_task(experiment, task)
+    return out.results, out.collisions
+
+
+def execute_task(experiment: Experiment, task: Task) -> TaskOutput:
+    """`run_task` plus the per-stage timings, as a `TaskOutput` (what workers return)."""
+    from kicktimes.billiard.initial import initial_conditions
+
+    _check_task(experiment, task)
+    timer = _Timer()
+    t0 = time.perf_counter()
+    ics = initial_conditions(
+        task.n_ics,
+        experiment.r_max,
+        seed=experiment.seed,
+        method=experiment.ic_method,
+        rule=experiment.rule,
+        start=task.ic_start,
+    )
+    rows: list[tuple] = []
+    coll: list[tuple] = []
+    for k in range(task.n_ics):
+        _run_ic(experiment, task.radius, task.ic_start + k, ics[k], rows, coll, timer)
+    with timer("tables"):
+        results = pd.DataFrame(rows, columns=list(RESULT_COLUMNS))
+        results = results.astype({"radius": "float64", "ic": "int64", "value": "float64"})
+        collisions = pd.DataFrame(coll, columns=list(COLLISION_COLUMNS))
+        collisions = collisions.astype(
+            {"radius": "float64", "ic": "int64", "t_window": "float64", "n_pp": "int64"}
+        )
+    timer.seconds["total"] = time.perf_counter() - t0
+    return TaskOutput(task, results, collisions, timer.seconds)
+
+
+def _lyapunov():
+    # the module path, not the package attribute: works whatever the package exports
+    from kicktimes.diagnostics.lyapunov import lyapunov
+
+    return lyapunov
+
+
+def _run_ic(exp: Experiment, r: float, ic_index: int, ic: np.ndarray, rows, coll, timer):
+    from kicktimes.billiard.one_particle import draw_kick_angles, simulate_one_particle
+    from kicktimes.billiard.two_particle import simulate_two_particle
+    from kicktimes.diagnostics import autocorrelation, boundary_angles, recurrence_rate
+    from kicktimes.schedules import Poisson
+
+    steps = {"n_steps": exp.n_steps, "tau": exp.tau, "sampling": exp.sampling}
+    diags = exp.diagnostics
+
+    def add(system, diagnostic, value, note=""):
+        value = float(value)
+        if not math.isfinite(value) and not note:
+            note = f"{diagnostic} is not finite ({value!r})"
+        rows.append((r, ic_index, system, diagnostic, value, note))
+
+    def diagnose(system, run, ftle):
+        if "recurrence_rate" in diags:
+            with timer("recurrence_rate"):
+                add(system, "recurrence_rate", recurrence_rate(run.samples, exp.eps))
+        if "autocorrelation" in diags:
+            with timer("autocorrelation"):
+                value, reason = autocorrelation(
+                    boundary_angles(run, 0 if system == "two_particle" else None),
+                    exp.lag,
+                    return_reason=True,
+                )
+            add(system, "autocorrelation", value, reason or "")
+        if "lyapunov" in diags:
+            with timer(f"lyapunov_{'two_particle' if system == 'two_particle' else 'kicked'}"):
+                res = ftle()
+            add(system, "lyapunov", res.lam)
+            if exp.lyapunov_variant == "paper":
+                add(system, "lyapunov_x", res.lam_x)
+                add(system, "lyapunov_y", res.lam_y)
+            add(system, "lyapunov_n_renorm", res.n_renorm)
+            add(system, "lyapunov_n_forced", res.n_forced)
+
+    with timer("simulation_two_particle"):
+        two = simulate_two_particle(ic, r, rule=exp.rule, track=0, seed=exp.seed, **steps)
+    n_b0 = int(np.count_nonzero(two.boundary_log.particle == 0))
+    coll.append((r, ic_index, two.t_max, two.n_pp, np.array(two.pp_times, dtype=np.float64)))
+    if "two_particle" in exp.systems:
+        add("two_particle", "t_max", two.t_max)
+        add("two_particle", "n_pp", two.n_pp)
+        add("two_particle", "n_boundary", n_b0)
+        diagnose(
+            "two_particle",
+            two,
+            lambda: _lyapunov()(
+                ic, r, rule=exp.rule, track=0, d0=exp.d0, variant=exp.lyapunov_variant, **steps
+            ),
+        )
+
+    horizon = exp.horizon
+    kick = {"kick_angle": exp.kick_angle, "sigma": exp.sigma}
+    for system in ("poisson", "actual"):
+        if system not in exp.systems:
+            continue
+        rng = kick_rng(exp.seed, ic_index, r, system)
+        if system == "actual":
+            with timer("simulation_two_particle"):
+                kick_times = _actual_times(exp, ic, r, two)
+        with timer("simulation_one_particle"):
+            if system == "poisson":
+                rate = two.n_pp / two.t_max
+                kick_times = Poisson(rate).sample(horizon, rng)
+            kick_angles = draw_kick_angles(kick_times.size, exp.kick_angle, exp.sigma, rng)
+            one = simulate_one_particle(
+                ic[0],
+                r,
+                kicks=kick_times,
+                kick_angles=kick_angles,
+                seed=exp.seed,
+                **kick,
+                **steps,
+            )
+        add(system, "t_max", one.t_max)
+        if system == "poisson":
+            add(system, "kick_rate", rate)
+        add(system, "n_kicks", one.n_kicks)
+        add(system, "n_boundary", one.n_boundary)
+        diagnose(
+            system,
+            one,
+            lambda kick_times=kick_times, kick_angles=kick_angles: _lyapunov()(
+                ic[0],
+                r,
+                kicks=kick_times,
+                kick_angles=kick_angles,
+                d0=exp.d0,
+                variant=exp.lyapunov_variant,
+                **kick,
+                **steps,
+            ),
+        )
+
+
+def _actual_times(exp: Experiment, ic: np.ndarray, r: float, two) -> np.ndarray:
+    """The disk-disk collision times that kick the actual-time billiard, up to the horizon.
+
+    With uniform sampling every run lasts ``n_steps * tau`` and the two-particle run's
+    times cover it. With the paper's collision-truncated steps the one-particle run (fewer
+    collisions, so fewer truncated steps) lasts longer than the two-particle run; the
+    two-particle billiard is continued to ``n_steps * tau`` (an upper bound of any paper
+    run) so that the replayed times cover the whole kicked run instead of stopping early.
+    """
+    if exp.sampling == "uniform":
+        return np.array(two.pp_times, dtype=np.float64)
+    from kicktimes.billiard.two_particle import simulate_two_particle
+
+    if two.t_max >= exp.horizon:
+        return np.array(two.pp_times, dtype=np.float64)
+    longer = simulate_two_particle(ic, r, t_max=exp.horizon, rule=exp.rule)
+    times = np.array(longer.pp_times, dtype=np.float64)
+    # the event sequence does not depend on sampling: the continuation must start with
+    # exactly the collisions of the sampled run
+    if not np.array_equal(times[: two.n_pp], two.pp_times):
+        raise RuntimeError(
+            f"the continued two-particle run of r={r!r} does not reproduce the sampled run's "
+            "collision times (simulator inconsistency)"
+        )
+    return times

@@ -1,0 +1,401 @@
+"""Specification of the sweep engine: experiments, tasks, executors, the store and resuming."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+import shutil
+import signal
+import subprocess
+import sys
+import time
+import warnings
+from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from kicktimes.experiment import (
+    COLLISION_COLUMNS,
+    PRESETS,
+    RESULT_COLUMNS,
+    Experiment,
+    StoreWarning,
+    kick_rng,
+    load_store,
+    run_experiment,
+    run_task,
+)
+from kicktimes.experiment.tasks import _actual_times
+
+REPO = Path(__file__).resolve().parents[1]
+
+TINY = Experiment(
+    name="tiny",
+    radii=[0.01, 0.025],
+    n_ics=4,
+    n_steps=400,
+    tau=0.3,
+    seed=7,
+    sampling="paper",
+    lyapunov_variant="paper",
+    block_size=2,
+)
+
+
+def run_quiet(exp, path, **kw):
+    kw.setdefault("progress", False)
+    return run_experiment(exp, path, **kw)
+
+
+@pytest.fixture(scope="module")
+def reference(tmp_path_factory):
+    """The tiny experiment run in this process (workers=1): the reference for equality."""
+    return run_quiet(TINY, tmp_path_factory.mktemp("ref") / "store", workers=1)
+
+
+def assert_same_store(a, b):
+    pd.testing.assert_frame_equal(a.results, b.results)
+    pd.testing.assert_frame_equal(
+        a.collisions.drop(columns="pp_times"), b.collisions.drop(columns="pp_times")
+    )
+    for x, y in zip(a.collisions["pp_times"], b.collisions["pp_times"], strict=True):
+        np.testing.assert_array_equal(x, y)
+
+
+# ------------------------------------------------------------------------ experiments
+
+
+def test_toml_round_trip_preserves_the_experiment_and_its_hash(tmp_path):
+    exp = dataclasses.replace(TINY, description='quotes " and \\ and unicode: é', eps=1e-5)
+    path = tmp_path / "exp.toml"
+    exp.write_toml(path)
+    back = Experiment.from_toml(path)
+    assert back == exp
+    assert back.hash() == exp.hash()
+    assert Experiment.from_dict(json.loads(json.dumps(exp.to_dict()))) == exp
+
+
+def test_analysis_files_are_the_builtin_presets_with_the_papers_parameters():
+    for name, exp in PRESETS.items():
+        assert Experiment.from_toml(REPO / "analysis" / f"{name}.toml") == exp
+    a, b = PRESETS["family_a"], PRESETS["family_b"]
+    assert a.radii == tuple(k / 1000 for k in range(8, 31, 2)) and len(a.radii) == 12
+    assert (a.n_ics, a.n_steps, a.tau) == (200, 25000, 0.2)
+    assert b.radii == tuple(k / 1000 for k in range(8, 27, 2)) and len(b.radii) == 10
+    assert (b.n_ics, b.n_steps, b.tau) == (1000, 15000, 0.3)
+    for exp in (a, b):
+        assert exp.sampling == "paper" and exp.ic_method == "paper"
+        assert exp.d0 == 1 / 5000 and exp.eps == 1e-3 and exp.lyapunov_variant == "paper"
+
+
+@pytest.mark.parametrize(
+    ("change", "match"),
+    [
+        ({"radii": []}, "radii"),
+        ({"radii": [0.01, 0.6]}, "radii"),
+        ({"radii": [0.01, 0.01]}, "distinct"),
+        ({"n_ics": 0}, "n_ics"),
+        ({"n_steps": 2.5}, "n_steps"),
+        ({"tau": -0.1}, "tau"),
+        ({"tau": math.nan}, "tau"),
+        ({"eps": math.inf}, "eps"),
+        ({"sampling": "daily"}, "sampling"),
+        ({"systems": ["two_particle", "kicked"]}, "systems"),
+        ({"diagnostics": []}, "diagnostics"),
+        ({"lyapunov_variant": "max"}, "lyapunov_variant"),
+        ({"block_size": True}, "block_size"),
+        ({"name": "a b/c"}, "name"),
+    ],
+)
+def test_invalid_fields_are_refused_with_the_field_name(change, match):
+    with pytest.raises((ValueError, TypeError), match=match):
+        dataclasses.replace(TINY, **change)
+
+
+def test_unknown_or_missing_toml_keys_are_refused():
+    text = TINY.to_toml()
+    with pytest.raises(ValueError, match="unknown experiment key.*n_ic\\b"):
+        Experiment.from_toml_string(text + "n_ic = 3\n")
+    with pytest.raises(ValueError, match="missing required.*tau"):
+        Experiment.from_toml_string(text.replace("tau = 0.3\n", ""))
+    with pytest.raises(ValueError, match="invalid TOML"):
+        Experiment.from_toml_string("name = ")
+
+
+def test_hash_changes_with_every_parameter_but_not_with_the_order_of_radii():
+    assert dataclasses.replace(TINY, radii=[0.025, 0.01]).hash() == TINY.hash()
+    for change in ({"seed": 8}, {"tau": 0.31}, {"rule": "elastic"}, {"block_size": 3}):
+        assert dataclasses.replace(TINY, **change).hash() != TINY.hash()
+
+
+# ----------------------------------------------------------------------------- tasks
+
+
+def test_tidy_tables_have_the_documented_columns_and_one_row_per_value(reference):
+    res, coll = reference.results, reference.collisions
+    assert tuple(res.columns) == RESULT_COLUMNS
+    assert tuple(coll.columns) == COLLISION_COLUMNS
+    assert res["radius"].dtype == np.float64 and res["ic"].dtype == np.int64
+    assert res["value"].dtype == np.float64
+    assert not res.duplicated(["radius", "ic", "system", "diagnostic"]).any()
+    per_system = {
+        "two_particle": {"t_max", "n_pp", "n_boundary"},
+        "poisson": {"t_max", "kick_rate", "n_kicks", "n_boundary"},
+        "actual": {"t_max", "n_kicks", "n_boundary"},
+    }
+    common = {
+        "recurrence_rate",
+        "autocorrelation",
+        "lyapunov",
+        "lyapunov_x",
+        "lyapunov_y",
+        "lyapunov_n_renorm",
+        "lyapunov_n_forced",
+    }
+    for (system, _, _), group in res.groupby(["system", "radius", "ic"]):
+        assert set(group["diagnostic"]) == per_system[system] | common
+    # NaN only with a reason, reasons only with NaN
+    assert (res["value"].isna() == (res["note"] != "")).all()
+    assert len(coll) == TINY.n_ics * len(TINY.radii)
+    assert coll["n_pp"].tolist() == [len(t) for t in coll["pp_times"]]
+    for row in coll.itertuples():
+        assert np.all(np.diff(row.pp_times) > 0) and (row.pp_times <= row.t_window).all()
+
+
+def test_poisson_rate_and_window_come_from_the_same_ics_two_particle_run(reference):
+    res = reference.results.set_index(["radius", "ic", "system", "diagnostic"])["value"]
+    for row in reference.collisions.itertuples():
+        assert res[(row.radius, row.ic, "two_particle", "t_max")] == row.t_window
+        assert res[(row.radius, row.ic, "two_particle", "n_pp")] == row.n_pp
+        assert res[(row.radius, row.ic, "poisson", "kick_rate")] == row.n_pp / row.t_window
+
+
+def test_ics_are_drawn_once_at_the_largest_radius_and_shared_by_all_radii():
+    from kicktimes import initial_conditions, simulate_two_particle
+
+    exp = dataclasses.replace(TINY, systems=["two_particle"], diagnostics=["recurrence_rate"])
+    _, coll = run_task(exp, exp.tasks()[0])  # r = 0.01, ICs 0 and 1
+    ic = initial_conditions(2, 0.025, seed=7)[1]
+    run = simulate_two_particle(ic, 0.01, sampling="paper", n_steps=400, tau=0.3)
+    np.testing.assert_array_equal(coll["pp_times"][1], run.pp_times)
+
+
+def test_actual_kicks_cover_the_whole_paper_sampled_one_particle_run():
+    from kicktimes import initial_conditions, simulate_two_particle
+
+    ic = initial_conditions(1, 0.03, seed=3)[0]
+    two = simulate_two_particle(ic, 0.03, sampling="paper", n_steps=2000, tau=0.3)
+    times = _actual_times(dataclasses.replace(TINY, n_steps=2000), ic, 0.03, two)
+    # the sampled run ends before n_steps * tau; its collisions are the continuation's start
+    assert two.t_max < 600.0 and times[-1] > two.t_max and times[-1] <= 600.0
+    np.testing.assert_array_equal(times[: two.n_pp], two.pp_times)
+
+
+def test_kick_streams_differ_by_ic_radius_and_system_and_ignore_the_radius_list():
+    draws = {
+        key: kick_rng(7, *key).random()
+        for key in [
+            (0, 0.01, "poisson"),
+            (1, 0.01, "poisson"),
+            (0, 0.02, "poisson"),
+            (0, 0.01, "actual"),
+        ]
+    }
+    assert len(set(draws.values())) == 4
+    one = dataclasses.replace(TINY, radii=[0.025])
+    res_one, _ = run_task(one, one.tasks()[0])
+    res_two, _ = run_task(TINY, TINY.tasks()[2])  # radius 0.025 of the two-radius family
+    pd.testing.assert_frame_equal(res_one, res_two)
+
+
+def test_run_task_rejects_a_task_of_another_experiment():
+    task = dataclasses.replace(TINY, radii=[0.02]).tasks()[0]
+    with pytest.raises(ValueError, match="radius"):
+        run_task(TINY, task)
+
+
+# -------------------------------------------------------------------------- executors
+
+
+def test_results_are_identical_for_one_or_two_processes_and_threads(reference, tmp_path):
+    two = run_quiet(TINY, tmp_path / "two", workers=2)
+    assert_same_store(reference, two)
+    with ThreadPoolExecutor(max_workers=3) as pool:
+        threads = run_quiet(TINY, tmp_path / "threads", executor=pool)
+    assert_same_store(reference, threads)
+
+
+def test_results_are_identical_on_a_dask_local_cluster(reference, tmp_path):
+    distributed = pytest.importorskip("distributed")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # dask's own start-up chatter (ports, versions)
+        with distributed.LocalCluster(
+            n_workers=2, processes=True, threads_per_worker=1, dashboard_address=None
+        ) as cluster:
+            with distributed.Client(cluster) as client:
+                on_dask = run_quiet(TINY, tmp_path / "dask", executor=client.get_executor())
+            via_address = run_quiet(TINY, tmp_path / "addr", scheduler=cluster.scheduler_address)
+    assert_same_store(reference, on_dask)
+    assert_same_store(reference, via_address)
+
+
+def test_results_do_not_depend_on_the_block_size(reference, tmp_path):
+    other = run_quiet(dataclasses.replace(TINY, block_size=3), tmp_path / "b3", workers=1)
+    assert_same_store(reference, other)
+
+
+def test_missing_dask_gives_a_clear_error(tmp_path, monkeypatch):
+    monkeypatch.setitem(sys.modules, "distributed", None)
+    with pytest.raises(ImportError, match=r"kicktimes\[dask\]"):
+        run_quiet(TINY, tmp_path / "s", scheduler="tcp://127.0.0.1:1")
+
+
+def test_bad_runner_arguments_are_refused(tmp_path):
+    with pytest.raises(ValueError, match="workers"):
+        run_quiet(TINY, tmp_path / "s", workers=0)
+    with pytest.raises(ValueError, match="workers"):
+        with ThreadPoolExecutor(1) as pool:
+            run_quiet(TINY, tmp_path / "s", workers=2, executor=pool)
+
+
+# ------------------------------------------------------------------- store and resume
+
+
+def test_store_layout_manifest_and_no_temporary_files(reference):
+    root = reference.path
+    names = sorted(p.relative_to(root).as_posix() for p in root.rglob("*") if p.is_file())
+    ids = [t.id for t in TINY.tasks()]
+    expected = ["manifest.json"]
+    expected += [f"collisions/{i}.parquet" for i in ids] + [f"results/{i}.parquet" for i in ids]
+    assert names == sorted(expected)
+    manifest = json.loads((root / "manifest.json").read_text())
+    assert manifest["experiment_hash"] == TINY.hash()
+    assert Experiment.from_dict(manifest["experiment"]) == TINY
+    assert set(manifest["tasks"]) == set(ids)
+    entry = manifest["tasks"][ids[0]]
+    assert {"file", "sha256", "rows", "collisions_file", "collisions_sha256"} <= set(entry)
+    assert reference.complete and reference.missing_tasks == []
+
+
+def test_rerunning_a_finished_store_recomputes_nothing(reference, tmp_path):
+    path = tmp_path / "s"
+    shutil.copytree(reference.path, path)
+    before = {p: p.stat().st_mtime_ns for p in path.rglob("*.parquet")}
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", StoreWarning)
+        again = run_quiet(TINY, path, workers=1)
+    assert {p: p.stat().st_mtime_ns for p in path.rglob("*.parquet")} == before
+    assert_same_store(reference, again)
+
+
+def test_resume_after_a_killed_run_equals_an_uninterrupted_run(tmp_path):
+    exp = dataclasses.replace(TINY, n_ics=24, block_size=1, n_steps=1500)
+    toml = tmp_path / "exp.toml"
+    exp.write_toml(toml)
+    store = tmp_path / "store"
+    proc = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "kicktimes",
+            "run",
+            str(toml),
+            "--out",
+            str(store),
+            "--workers",
+            "1",
+            "--no-progress",
+        ],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
+    manifest = store / "manifest.json"
+    deadline = time.monotonic() + 60
+    try:
+        while time.monotonic() < deadline:
+            if manifest.exists() and len(json.loads(manifest.read_text())["tasks"]) >= 3:
+                break
+            time.sleep(0.02)
+        proc.send_signal(signal.SIGKILL)
+    finally:
+        proc.wait(30)
+    done = len(json.loads(manifest.read_text())["tasks"])
+    assert 3 <= done < len(exp.tasks()), "the run was not stopped midway"
+    partial = load_store(store)
+    assert len(partial.missing_tasks) == len(exp.tasks()) - done
+    resumed = run_quiet(exp, store, workers=2)
+    whole = run_quiet(exp, tmp_path / "whole", workers=1)
+    assert_same_store(whole, resumed)
+    assert not list(store.rglob(".tmp-*"))
+
+
+def test_a_part_written_but_not_yet_in_the_manifest_is_recomputed_once(reference, tmp_path):
+    path = tmp_path / "s"
+    shutil.copytree(reference.path, path)
+    manifest = json.loads((path / "manifest.json").read_text())
+    del manifest["tasks"][TINY.tasks()[1].id]  # as if killed between part and manifest
+    (path / "manifest.json").write_text(json.dumps(manifest))
+    (path / "results" / ".tmp-abc.parquet").write_bytes(b"half a file")
+    with pytest.warns(StoreWarning, match="leftover temporary"):
+        resumed = run_quiet(TINY, path, workers=1)
+    assert_same_store(reference, resumed)
+    assert len(list((path / "results").iterdir())) == len(TINY.tasks())
+
+
+def test_a_damaged_part_is_refused_by_load_and_recomputed_by_run(reference, tmp_path):
+    path = tmp_path / "s"
+    shutil.copytree(reference.path, path)
+    victim = path / "results" / f"{TINY.tasks()[2].id}.parquet"
+    victim.write_bytes(victim.read_bytes()[:-40])
+    with pytest.raises(ValueError, match=f"damaged store.*{TINY.tasks()[2].id}"):
+        load_store(path)
+    with pytest.warns(StoreWarning, match="damaged"):
+        repaired = run_quiet(TINY, path, workers=1)
+    assert_same_store(reference, repaired)
+
+
+def test_a_foreign_part_is_detected_and_recomputed(reference, tmp_path):
+    other = dataclasses.replace(TINY, seed=8)
+    foreign = run_quiet(other, tmp_path / "other", workers=1)
+    path = tmp_path / "s"
+    shutil.copytree(reference.path, path)
+    tid = TINY.tasks()[0].id
+    # a foreign part swapped in together with a manifest entry that matches its checksum
+    for part in ("results", "collisions"):
+        shutil.copy(foreign.path / part / f"{tid}.parquet", path / part / f"{tid}.parquet")
+    manifest = json.loads((path / "manifest.json").read_text())
+    manifest["tasks"][tid] = json.loads((foreign.path / "manifest.json").read_text())["tasks"][tid]
+    (path / "manifest.json").write_text(json.dumps(manifest))
+    with pytest.raises(ValueError, match="foreign"):
+        load_store(path)
+    with pytest.warns(StoreWarning, match="foreign"):
+        repaired = run_quiet(TINY, path, workers=1)
+    assert_same_store(reference, repaired)
+    # a foreign part lying in the store without a manifest entry is reported too
+    del manifest["tasks"][tid]
+    (path / "manifest.json").write_text(json.dumps(manifest))
+    shutil.copy(foreign.path / "results" / f"{tid}.parquet", path / "results" / f"{tid}.parquet")
+    with pytest.warns(StoreWarning, match="foreign part"):
+        repaired = run_quiet(TINY, path, workers=1)
+    assert_same_store(reference, repaired)
+
+
+def test_a_store_of_another_experiment_is_refused_naming_both(reference, tmp_path):
+    other = dataclasses.replace(TINY, name="tiny_other", n_steps=401)
+    with pytest.raises(ValueError) as info:
+        run_quiet(other, reference.path, workers=1)
+    message = str(info.value)
+    for text in ("tiny", "tiny_other", TINY.hash(), other.hash()):
+        assert text in message
+
+
+def test_a_directory_that_is_not_a_store_is_refused(tmp_path):
+    (tmp_path / "notes.txt").write_text("my thesis")
+    with pytest.raises(ValueError, match="not a kicktimes store"):
+        run_quiet(TINY, tmp_path, workers=1)
+    with pytest.raises(ValueError, match="not a kicktimes store"):
+        load_store(tmp_path)

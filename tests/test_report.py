@@ -1,0 +1,221 @@
+"""Specification of kicktimes.report.build_report on a tiny real sweep."""
+
+from __future__ import annotations
+
+import base64
+import re
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from kicktimes import __version__
+from kicktimes.experiment import Experiment, load_store, run_experiment
+from kicktimes.report import build_report
+
+EXPERIMENT = Experiment(
+    name="tiny_report",
+    radii=[0.008, 0.014, 0.02],
+    n_ics=6,
+    n_steps=2500,
+    tau=0.3,
+    sampling="paper",
+    seed=7,
+    lyapunov_variant="paper",
+    block_size=3,
+    description="report test",
+)
+FIGURES = {
+    "fig01_poincare_sections",
+    "fig02_recurrence_plot",
+    "fig03_kick_times_vs_collision_times",
+    "fig04_counts_vs_radius",
+    "fig05_lyapunov_vs_radius",
+    "fig06_recurrence_rate_vs_radius",
+    "fig07_autocorrelation_vs_radius",
+    "fig08_poisson_rejection_rates",
+    "fig09_renewal_model_comparison",
+    "fig10_rate_heterogeneity",
+}
+TABLES = {
+    "poincare_runs",
+    "kick_times_fit",
+    "counts_by_radius",
+    "count_regression",
+    "count_overdispersion",
+    "diagnostics_summary",
+    "diagnostics_vs_two_particle",
+    "lyapunov_by_radius",
+    "recurrence_rate_by_radius",
+    "autocorrelation_by_radius",
+    "poisson_tests",
+    "rate_homogeneity",
+    "renewal_best_share",
+    "renewal_pooled",
+    "renewal_per_ic",
+    "renewal_best_per_ic",
+    "experiment",
+    "report_timings",
+    "sweep_timings",
+}
+
+
+OPTIONS = {"n_mc": 99, "max_ics_model_fits": 2, "dpi": 50}
+
+
+@pytest.fixture(scope="module")
+def store_path(tmp_path_factory):
+    path = tmp_path_factory.mktemp("store")
+    run_experiment(EXPERIMENT, path, workers=1, progress=False)
+    return path
+
+
+@pytest.fixture(scope="module")
+def built(store_path, tmp_path_factory):
+    out = tmp_path_factory.mktemp("report")
+    stages = []
+    path = build_report(
+        store_path,
+        out,
+        progress=lambda stage, done, total: stages.append((stage, done, total)),
+        **OPTIONS,
+        workers=2,  # the multi-store build below uses 1: results must agree
+    )
+    return path, out, stages
+
+
+def test_report_html_is_self_contained_with_one_embedded_image_per_figure(built):
+    path, out, _ = built
+    page = path.read_text(encoding="utf-8")
+    images = re.findall(r'<img[^>]*src="([^"]+)"', page)
+    assert len(images) == len(FIGURES)
+    for src in images:
+        assert src.startswith("data:image/png;base64,")
+        assert base64.b64decode(src.split(",", 1)[1])[:8] == b"\x89PNG\r\n\x1a\n"
+    assert "<link" not in page and "<script" not in page  # nothing to fetch
+
+
+def test_every_figure_is_saved_as_png_and_pdf(built):
+    _, out, _ = built
+    assert {p.stem for p in out.glob("*.png")} == FIGURES
+    for name in FIGURES:
+        assert (out / f"{name}.pdf").read_bytes()[:5] == b"%PDF-"
+
+
+def test_every_table_is_saved_as_csv(built):
+    _, out, _ = built
+    assert {p.stem for p in out.glob("*.csv")} == TABLES
+    page = (out / "report.html").read_text(encoding="utf-8")
+    assert page.count('<table class="dataframe">') >= 8
+
+
+def test_report_records_experiment_seed_rule_version_and_store(built, store_path):
+    path, out, _ = built
+    page = path.read_text(encoding="utf-8")
+    for text in ("tiny_report", EXPERIMENT.hash(), "mirror", __version__, str(store_path)):
+        assert text in page
+    assert re.search(r"<b>seed</b></td><td>7</td>", page)
+    assert Experiment.from_toml(out / "experiment.toml") == EXPERIMENT
+
+
+def test_numbers_come_from_the_store(built, store_path):
+    _, out, _ = built
+    store = load_store(store_path)
+    counts = pd.read_csv(out / "counts_by_radius.csv").set_index("radius")
+    expected = store.collisions.groupby("radius")["n_pp"].mean()
+    assert np.allclose(counts["mean_count"], expected)
+    summary = pd.read_csv(out / "diagnostics_summary.csv")
+    res = store.results
+    sel = (res["diagnostic"] == "autocorrelation") & (res["system"] == "poisson")
+    mine = summary[(summary["diagnostic"] == "autocorrelation") & (summary["system"] == "poisson")]
+    assert np.allclose(mine["mean"], res[sel].groupby("radius")["value"].mean(), equal_nan=True)
+    assert list(mine["n_valid"]) == list(res[sel].groupby("radius")["value"].count())
+    tests = pd.read_csv(out / "poisson_tests.csv")
+    assert (tests["n_tested"] <= EXPERIMENT.n_ics).all()
+    assert set(tests["radius"]) == set(EXPERIMENT.radii)
+
+
+def test_recurrence_plot_is_the_stored_trajectory_of_ic_0(built):
+    page = built[0].read_text(encoding="utf-8")
+    assert "identical: the plot is the stored trajectory" in page
+
+
+def test_lyapunov_section_names_the_paper_variant(built):
+    page = built[0].read_text(encoding="utf-8")
+    assert "paper variant: max(λˣ, λʸ)" in page
+
+
+def test_subsampling_is_stated_in_the_report(built):
+    page = built[0].read_text(encoding="utf-8")
+    assert "Per-IC renewal-model comparison: the first 2 ICs" in page
+    best = pd.read_csv(built[1] / "renewal_best_per_ic.csv")
+    assert set(best["ic"]) == {0, 1}
+
+
+def test_progress_callable_sees_every_stage_in_order(built):
+    stages = built[2]
+    assert [done for _, done, _ in stages] == list(range(len(stages)))
+    assert stages[0][0] == "load store" and stages[-1][0] == "write files"
+
+
+def test_no_figure_is_left_open(built):
+    import matplotlib.pyplot as plt
+
+    assert plt.get_fignums() == []
+
+
+SECOND = Experiment(
+    name="tiny_report_b",
+    radii=[0.01, 0.016],
+    n_ics=4,
+    n_steps=1000,
+    tau=0.2,
+    seed=8,
+    diagnostics=["autocorrelation"],
+    block_size=4,
+)
+
+
+def test_several_stores_give_one_report_with_a_part_per_experiment(built, store_path, tmp_path):
+    # in this process (the single-store build used two workers): same numbers
+    second = tmp_path / "store_b"
+    run_experiment(SECOND, second, workers=1, progress=False)
+    out = tmp_path / "both"
+    path = build_report([store_path, second], out, progress=False, **OPTIONS, workers=1)
+    page = path.read_text(encoding="utf-8")
+    assert "Experiment tiny_report</h2>" in page and "Experiment tiny_report_b</h2>" in page
+    assert re.search(r"<b>seed</b></td><td>8</td>", page)
+    assert (out / "families_autocorrelation_vs_radius.png").is_file()  # paper's top/bottom
+    assert (out / "tiny_report_b_fig07_autocorrelation_vs_radius.pdf").is_file()
+    assert not (out / "tiny_report_b_fig06_recurrence_rate_vs_radius.png").exists()
+    single = built[1]
+    for name in ("poisson_tests", "rate_homogeneity", "renewal_pooled", "renewal_per_ic"):
+        a = pd.read_csv(single / f"{name}.csv")
+        b = pd.read_csv(out / f"tiny_report_{name}.csv")
+        pd.testing.assert_frame_equal(a, b)
+
+
+def test_stores_of_the_same_experiment_name_are_refused(store_path, tmp_path):
+    with pytest.raises(ValueError, match="distinct names"):
+        build_report([store_path, store_path], tmp_path, progress=False, workers=1)
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "error", "match"),
+    [
+        ({"alpha": 1.5}, ValueError, "alpha"),
+        ({"n_mc": 5}, ValueError, "n_mc"),
+        ({"max_ics_model_fits": 0}, ValueError, "max_ics_model_fits"),
+        ({"workers": 0}, ValueError, "workers"),
+        ({"dpi": 10.5}, TypeError, "dpi"),
+        ({"progress": "yes"}, TypeError, "progress"),
+    ],
+)
+def test_build_report_rejects_bad_arguments(store_path, tmp_path, kwargs, error, match):
+    with pytest.raises(error, match=match):
+        build_report(store_path, tmp_path, **kwargs)
+
+
+def test_build_report_refuses_a_directory_that_is_not_a_store(tmp_path):
+    with pytest.raises(ValueError, match="not a kicktimes store"):
+        build_report(tmp_path, tmp_path / "out", progress=False)
