@@ -63,6 +63,13 @@ def test_run_objects_are_accepted_and_reuse_their_kicks(ics):
     assert lyapunov(two) == lyapunov(ics[0], 0.03, n_steps=2000, tau=0.2)
 
 
+def test_a_run_longer_than_its_samples_is_accepted(ics):
+    run = simulate_one_particle(ics[0, 0], 0.03, t_max=100.0, n_steps=300, tau=0.3,
+                                kicks=np.array([10.0, 95.0]), rng=1)
+    res = lyapunov(run)
+    assert res.total_time <= 90.0 and np.isfinite(res.lam)
+
+
 def test_results_are_deterministic(ics):
     assert lyapunov(ics[2], 0.03, n_steps=3000, tau=0.2) == lyapunov(ics[2], 0.03, n_steps=3000,
                                                                      tau=0.2)

@@ -360,7 +360,11 @@ def lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rule
         if isinstance(run, TwoParticleRun):
             rule, track, system = run.rule, run.track, run.ic
         else:
-            kicks, kick_angles, kick_angle = run.kick_times, run.kick_angles, run.kick_angle
+            # the FTLE covers n_steps samples; a run may have gone on beyond them
+            horizon = n_steps * tau
+            keep = run.kick_times <= horizon
+            kicks, kick_angles = run.kick_times[keep], run.kick_angles[keep]
+            kick_angle = run.kick_angle
             sigma = run.sigma if run.sigma is not None else 1.0
             system = run.ic
     chk.check_choice("variant", variant, VARIANTS)
