@@ -52,6 +52,17 @@ def test_kicks_make_the_one_particle_billiard_chaotic_only_with_shared_angles(ic
     assert res.lam != unkicked.lam
 
 
+def test_independent_twin_kicks_separate_the_twins_at_every_kick(ics):
+    kicks = np.sort(np.random.default_rng(3).uniform(0, 2000, 40))
+    shared = lyapunov(ics[1, 0], 0.03, n_steps=10000, tau=0.2, kicks=kicks, rng=5)
+    indep = lyapunov(ics[1, 0], 0.03, n_steps=10000, tau=0.2, kicks=kicks, rng=5,
+                     twin_kicks="independent")
+    # each independent kick adds about log(O(1) / d0) ~ 7 over 2000 time units
+    assert indep.lam > shared.lam + 0.05
+    with pytest.raises(ValueError, match="twin_kicks must be one of"):
+        lyapunov(ics[1, 0], 0.03, n_steps=10, tau=0.2, twin_kicks="some")
+
+
 def test_run_objects_are_accepted_and_reuse_their_kicks(ics):
     run = simulate_one_particle(ics[0, 0], 0.03, n_steps=2000, tau=0.2,
                                 kicks=np.array([10.0, 20.0, 30.0]), rng=4)

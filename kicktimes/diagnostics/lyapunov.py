@@ -205,9 +205,13 @@ def ftle_two_kernel(st0, rho, sigma, rule, mode, n_steps, tau, track, offsets, m
 
 
 @njit(cache=True)
-def ftle_one_kernel(st0, rho, kicks, angles, kick_mode, mode, n_steps, tau, offsets, measure, d0,
-                    max_defer):
-    """Benettin FTLE for the kicked one-disk billiard; twins share kicks and angles."""
+def ftle_one_kernel(st0, rho, kicks, angles, twin_angles, kick_mode, mode, n_steps, tau, offsets,
+                    measure, d0, max_defer):
+    """Benettin FTLE for the kicked one-disk billiard.
+
+    Twins share the kick times; their kick angles are ``twin_angles[j]`` (equal to
+    ``angles`` for common random numbers).
+    """
     m = offsets.shape[0]
     unit_speed = abs(st0[3] * st0[3] + st0[4] * st0[4] - 1.0) < 1e-12
     ref = st0.copy()
@@ -242,7 +246,7 @@ def ftle_one_kernel(st0, rho, kicks, angles, kick_mode, mode, n_steps, tau, offs
         py = ref[2] + ref[4] * ds
         for j in range(m):
             t = tw[j]
-            advance_one(t, ev_tw[j], tk, rho, kicks, angles, kick_mode, cnt_tw[j])
+            advance_one(t, ev_tw[j], tk, rho, kicks, twin_angles[j], kick_mode, cnt_tw[j])
             d = _separation(t[1] - px, t[2] - py, measure[j])
             same = cnt_tw[j, 0] == cnt_ref[0] and cnt_tw[j, 1] == cnt_ref[1] and (
                 cnt_tw[j, 2] == cnt_ref[2])
@@ -305,7 +309,7 @@ def _result(out, variant, d0) -> LyapunovResult:
 
 def lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rule="mirror",
              track=0, kicks=None, kick_angles=None, kick_angle="uniform", sigma=1.0, rng=None,
-             d0=1.0 / 5000.0, variant="norm", max_defer=10) -> LyapunovResult:
+             d0=1.0 / 5000.0, variant="norm", max_defer=10, twin_kicks="shared") -> LyapunovResult:
     """Finite-time Lyapunov exponent of a two-disk or a kicked one-disk billiard.
 
     Parameters
@@ -332,6 +336,13 @@ def lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rule
         in x and in y, separations ``|dx|`` and ``|dy|``, ``lam = max(lam_x, lam_y)``.
     max_defer : int
         Consecutive deferred renormalisations after which one is forced.
+    twin_kicks : {"shared", "independent"}
+        One-disk only. ``"shared"`` (default, design.md): twins get the reference's kick
+        angles, so kicks are common random numbers and only the dynamics between them
+        separates the twins. ``"independent"``: each twin draws its own angles from
+        ``rng``, so every kick separates the pair by O(1) (each kick then contributes about
+        ``log(O(1) / d0)``); the paper does not say which it used, and its agreement
+        between kicked and two-disk exponents is what independent angles produce.
 
     Returns
     -------
@@ -419,13 +430,20 @@ def lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rule
         angles = np.asarray(kick_angles, dtype=np.float64).ravel()
         if angles.shape != times.shape or not np.isfinite(angles).all():
             raise ValueError(f"kick_angles must be {times.size} finite angles, one per kick")
+    chk.check_choice("twin_kicks", twin_kicks, ("shared", "independent"))
     rho = 1.0 - r
     offsets, measure = _twin_offsets(
         variant, d0, lambda dx, dy: math.hypot(state[0] + dx, state[1] + dy) <= rho
     )
+    if twin_kicks == "shared":
+        twin_angles = np.broadcast_to(angles, (offsets.shape[0], angles.size)).copy()
+    else:
+        gen = gen if gen is not None else np.random.default_rng(rng)
+        twin_angles = np.stack([draw_kick_angles(times.size, kick_angle, sigma, gen)
+                                for _ in range(offsets.shape[0])])
     st = np.zeros(7)
     st[1:5] = state
     st[6] = state[2] ** 2 + state[3] ** 2
-    out = ftle_one_kernel(st, rho, times, angles, KICK_ANGLES[kick_angle], mode, n_steps, tau,
-                          offsets, measure, d0, max_defer)
+    out = ftle_one_kernel(st, rho, times, angles, twin_angles, KICK_ANGLES[kick_angle], mode,
+                          n_steps, tau, offsets, measure, d0, max_defer)
     return _result(out, variant, d0)
