@@ -399,3 +399,45 @@ def test_a_directory_that_is_not_a_store_is_refused(tmp_path):
         run_quiet(TINY, tmp_path, workers=1)
     with pytest.raises(ValueError, match="not a kicktimes store"):
         load_store(tmp_path)
+
+
+# --------------------------------------------------------------------------------- CLI
+
+
+def test_progress_bar_is_off_in_ci_and_can_be_forced(monkeypatch):
+    from kicktimes.experiment.runner import _progress_enabled
+
+    monkeypatch.setenv("CI", "true")
+    assert _progress_enabled(None) is False
+    assert _progress_enabled(True) is True and _progress_enabled(False) is False
+
+
+def test_cli_run_writes_a_store_and_refuses_another_experiment(reference, tmp_path):
+    from click.testing import CliRunner
+
+    from kicktimes.cli import main
+
+    toml = tmp_path / "tiny.toml"
+    TINY.write_toml(toml)
+    out = tmp_path / "store"
+    result = CliRunner().invoke(main, ["run", str(toml), "--out", str(out), "--workers", "1"])
+    assert result.exit_code == 0, result.output
+    assert "4/4 tasks finished" in result.output
+    assert_same_store(reference, load_store(out))
+    dataclasses.replace(TINY, seed=99).write_toml(toml)
+    result = CliRunner().invoke(main, ["run", str(toml), "--out", str(out)])
+    assert result.exit_code != 0
+    assert "refusing to mix" in result.output and TINY.hash() in result.output
+
+
+@pytest.mark.slow
+def test_reproduce_quick_runs_both_quick_families_and_builds_the_report(tmp_path):
+    from click.testing import CliRunner
+
+    from kicktimes.cli import main
+
+    result = CliRunner().invoke(main, ["reproduce", "--scale", "quick", "--out", str(tmp_path)])
+    assert result.exit_code == 0, result.output
+    for name in ("quick_a", "quick_b"):
+        assert load_store(tmp_path / f"store-{name}").experiment == PRESETS[name]
+    assert (tmp_path / "report" / "report.html").is_file()

@@ -17,7 +17,8 @@ def _progress_enabled(progress) -> bool:
     if progress is not None:
         return bool(progress)
     # a bar on an interactive terminal only: CI logs and pipes stay quiet
-    return sys.stderr.isatty() and not os.environ.get("CI")
+    ci = os.environ.get("CI", "").strip().lower()
+    return sys.stderr.isatty() and ci in ("", "0", "false", "no")
 
 
 def _dask_executor(scheduler: str):
@@ -123,7 +124,7 @@ def run_experiment(
 
 
 def _run_pending(writer, pending, executor, workers, scheduler, show):
-    from tqdm.auto import tqdm
+    from tqdm import tqdm
 
     experiment = writer.experiment
     total = len(writer.all_tasks)
