@@ -41,23 +41,22 @@ import numpy as np
 from numba import njit
 
 from kicktimes.billiard import _checks as chk
-from kicktimes.billiard.geometry import boundary_hit_time
+from kicktimes.billiard.geometry import boundary_hit_time, pair_hit_time
 from kicktimes.billiard.one_particle import (
     KICK_ANGLES,
-    advance_events_one,
-    advance_one,
     check_kick_times,
     check_one_particle_state,
     draw_kick_angles,
     next_event_one,
+    process_event_one,
 )
 from kicktimes.billiard.runs import OneParticleRun, TwoParticleRun
 from kicktimes.billiard.two_particle import (
-    advance_events_two,
-    advance_two,
+    HASH_MOD,
     check_two_particle_ic,
     init_events_two,
     next_event_two,
+    process_event_two,
 )
 
 VARIANTS = ("norm", "paper")
@@ -98,22 +97,30 @@ class LyapunovResult:
 
 
 @njit(cache=True)
-def _rescale_disk(tw, o, px, py, vx_ref, vy_ref, f, unit_speed):
-    """Scale the twin disk at offset ``o`` towards the reference (at ``px, py``) by ``f``."""
-    tw[o] = px + (tw[o] - px) * f
-    tw[o + 1] = py + (tw[o + 1] - py) * f
-    wx = vx_ref + (tw[o + 2] - vx_ref) * f
-    wy = vy_ref + (tw[o + 3] - vy_ref) * f
+def _rescaled(x, y, vx, vy, px, py, vx_ref, vy_ref, f, unit_speed):
+    """A twin disk scaled towards the reference disk (at ``px, py``) by ``f``.
+
+    Positions scale linearly; the velocity difference scales linearly and the result is
+    renormalised to the rescaled speed (first order: the angle difference scales by f).
+    Scalar in, scalar out, so numba inlines it in the per-sample loop.
+    """
+    x = px + (x - px) * f
+    y = py + (y - py) * f
+    wx = vx_ref + (vx - vx_ref) * f
+    wy = vy_ref + (vy - vy_ref) * f
     if unit_speed:
         speed = 1.0
     else:
         s_ref = math.sqrt(vx_ref * vx_ref + vy_ref * vy_ref)
-        s_tw = math.sqrt(tw[o + 2] * tw[o + 2] + tw[o + 3] * tw[o + 3])
+        s_tw = math.sqrt(vx * vx + vy * vy)
         speed = s_ref + (s_tw - s_ref) * f
     norm = math.sqrt(wx * wx + wy * wy)
     if norm > 0.0:
-        tw[o + 2] = wx * (speed / norm)
-        tw[o + 3] = wy * (speed / norm)
+        wx *= speed / norm
+        wy *= speed / norm
+    else:
+        wx, wy = vx, vy
+    return x, y, wx, wy
 
 
 @njit(cache=True)
@@ -125,6 +132,11 @@ def _separation(dx, dy, measure):
     return abs(dy)
 
 
+# The per-sample loops below are written out rather than calling advance_* helpers: a
+# numba call with array arguments costs ~50 ns, as much as the rest of a sample's work,
+# and there are 25 000 samples per run. Array-taking kernels are called only per event.
+
+
 @njit(cache=True)
 def ftle_two_kernel(st0, rho, sigma, rule, mode, n_steps, tau, track, offsets, measure, d0,
                     max_defer):
@@ -133,11 +145,12 @@ def ftle_two_kernel(st0, rho, sigma, rule, mode, n_steps, tau, track, offsets, m
     Returns ``(log_sum, n_renorm, n_forced, n_deferred, t_last)`` per twin.
     """
     m = offsets.shape[0]
+    nst = st0.shape[0]
     ref = st0.copy()
     ev_ref = np.empty(3)
     init_events_two(ref, ev_ref, rho, sigma)
     cnt_ref = np.zeros(5, dtype=np.int64)
-    tw = np.empty((m, st0.shape[0]))
+    tw = np.empty((m, nst))
     ev_tw = np.empty((m, 3))
     cnt_tw = np.zeros((m, 5), dtype=np.int64)
     o = 1 + 4 * track
@@ -159,18 +172,56 @@ def ftle_two_kernel(st0, rho, sigma, rule, mode, n_steps, tau, track, offsets, m
         if mode == 1:
             tk = k * tau
         else:
-            _, dtn = next_event_two(ev_ref)
-            tk = min(t_prev + tau, ref[0] + dtn)
-        advance_events_two(ref, ev_ref, tk, rho, sigma, rule, cnt_ref)
+            tk = min(t_prev + tau, ref[0] + min(ev_ref[0], min(ev_ref[1], ev_ref[2])))
+        # the reference: every event at time <= tk, no flight on (positions interpolated)
+        while True:
+            ke, dt = next_event_two(ev_ref)
+            if ref[0] + dt > tk:
+                break
+            process_event_two(ref, ev_ref, ke, rho, sigma, rule)
+            if ke == 2:
+                cnt_ref[0] += 1
+            else:
+                cnt_ref[1] += 1
+                cnt_ref[2 + ke] += 1
+            cnt_ref[4] = (cnt_ref[4] * 4 + ke + 1) % HASH_MOD
         ds = tk - ref[0]
         for i in range(2):
             q = 1 + 4 * i
             pos[2 * i] = ref[q] + ref[q + 2] * ds
             pos[2 * i + 1] = ref[q + 1] + ref[q + 3] * ds
         for j in range(m):
-            t = tw[j]
-            advance_two(t, ev_tw[j], tk, rho, sigma, rule, cnt_tw[j])
-            d = _separation(t[o] - pos[2 * track], t[o + 1] - pos[2 * track + 1], measure[j])
+            while True:
+                ke = 0
+                dt = ev_tw[j, 0]
+                if ev_tw[j, 1] < dt:
+                    ke = 1
+                    dt = ev_tw[j, 1]
+                if ev_tw[j, 2] < dt:
+                    ke = 2
+                    dt = ev_tw[j, 2]
+                if tw[j, 0] + dt > tk:
+                    break
+                process_event_two(tw[j], ev_tw[j], ke, rho, sigma, rule)
+                if ke == 2:
+                    cnt_tw[j, 0] += 1
+                else:
+                    cnt_tw[j, 1] += 1
+                    cnt_tw[j, 2 + ke] += 1
+                cnt_tw[j, 4] = (cnt_tw[j, 4] * 4 + ke + 1) % HASH_MOD
+            # fly the twin on to tk
+            dt = tk - tw[j, 0]
+            tw[j, 1] += tw[j, 3] * dt
+            tw[j, 2] += tw[j, 4] * dt
+            tw[j, 5] += tw[j, 7] * dt
+            tw[j, 6] += tw[j, 8] * dt
+            ev_tw[j, 0] -= dt
+            ev_tw[j, 1] -= dt
+            ev_tw[j, 2] -= dt
+            tw[j, 0] = tk
+            tw[j, 9] = 0.0
+            d = _separation(tw[j, o] - pos[2 * track], tw[j, o + 1] - pos[2 * track + 1],
+                            measure[j])
             same = True
             for c in range(5):
                 if cnt_tw[j, c] != cnt_ref[c]:
@@ -178,7 +229,8 @@ def ftle_two_kernel(st0, rho, sigma, rule, mode, n_steps, tau, track, offsets, m
             if d > 0.0 and (same or n_defer_now[j] >= max_defer):
                 if not same:
                     n_forced[j] += 1
-                    cnt_tw[j] = cnt_ref
+                    for c in range(5):
+                        cnt_tw[j, c] = cnt_ref[c]
                 log_sum[j] += math.log(d / m_plus[j])
                 n_renorm[j] += 1
                 t_last[j] = tk
@@ -186,17 +238,26 @@ def ftle_two_kernel(st0, rho, sigma, rule, mode, n_steps, tau, track, offsets, m
                 big = d
                 for i in range(2):
                     q = 1 + 4 * i
-                    ex = t[q] - pos[2 * i]
-                    ey = t[q + 1] - pos[2 * i + 1]
+                    ex = tw[j, q] - pos[2 * i]
+                    ey = tw[j, q + 1] - pos[2 * i + 1]
                     big = max(big, math.sqrt(ex * ex + ey * ey))
                 f = d0 / big
                 m_plus[j] = d * f
                 for i in range(2):
                     q = 1 + 4 * i
-                    _rescale_disk(t, q, pos[2 * i], pos[2 * i + 1], ref[q + 2], ref[q + 3], f,
-                                  rule == 0)
-                t[10] = t[3] * t[3] + t[4] * t[4] + t[7] * t[7] + t[8] * t[8]
-                init_events_two(t, ev_tw[j], rho, sigma)
+                    a, b, c2, d2 = _rescaled(tw[j, q], tw[j, q + 1], tw[j, q + 2], tw[j, q + 3],
+                                             pos[2 * i], pos[2 * i + 1], ref[q + 2], ref[q + 3],
+                                             f, rule == 0)
+                    tw[j, q] = a
+                    tw[j, q + 1] = b
+                    tw[j, q + 2] = c2
+                    tw[j, q + 3] = d2
+                tw[j, 10] = (tw[j, 3] * tw[j, 3] + tw[j, 4] * tw[j, 4] + tw[j, 7] * tw[j, 7]
+                             + tw[j, 8] * tw[j, 8])
+                ev_tw[j, 0] = boundary_hit_time(tw[j, 1], tw[j, 2], tw[j, 3], tw[j, 4], rho)
+                ev_tw[j, 1] = boundary_hit_time(tw[j, 5], tw[j, 6], tw[j, 7], tw[j, 8], rho)
+                ev_tw[j, 2] = pair_hit_time(tw[j, 1] - tw[j, 5], tw[j, 2] - tw[j, 6],
+                                            tw[j, 3] - tw[j, 7], tw[j, 4] - tw[j, 8], sigma)
             else:
                 n_defer_now[j] += 1
                 n_deferred[j] += 1
@@ -213,6 +274,7 @@ def ftle_one_kernel(st0, rho, kicks, angles, twin_angles, kick_mode, mode, n_ste
     ``angles`` for common random numbers).
     """
     m = offsets.shape[0]
+    nk = kicks.shape[0]
     unit_speed = abs(st0[3] * st0[3] + st0[4] * st0[4] - 1.0) < 1e-12
     ref = st0.copy()
     ev_ref = np.empty(1)
@@ -240,30 +302,75 @@ def ftle_one_kernel(st0, rho, kicks, angles, twin_angles, kick_mode, mode, n_ste
         else:
             _, dtn = next_event_one(ref, ev_ref, kicks, cnt_ref)
             tk = min(t_prev + tau, ref[0] + dtn)
-        advance_events_one(ref, ev_ref, tk, rho, kicks, angles, kick_mode, cnt_ref)
+        while True:
+            ik = cnt_ref[0]
+            is_kick = False
+            dt = ev_ref[0]
+            if ik < nk and kicks[ik] - ref[0] < dt:
+                is_kick = True
+                dt = kicks[ik] - ref[0]
+            if ref[0] + dt > tk:
+                break
+            if is_kick:
+                process_event_one(ref, ev_ref, True, dt, rho, kicks[ik], angles[ik], kick_mode,
+                                  False)
+                cnt_ref[0] += 1
+                cnt_ref[2] = (cnt_ref[2] * 4 + 4) % HASH_MOD
+            else:
+                process_event_one(ref, ev_ref, False, dt, rho, 0.0, 0.0, kick_mode, False)
+                cnt_ref[1] += 1
+                cnt_ref[2] = (cnt_ref[2] * 4 + 1) % HASH_MOD
         ds = tk - ref[0]
         px = ref[1] + ref[3] * ds
         py = ref[2] + ref[4] * ds
         for j in range(m):
-            t = tw[j]
-            advance_one(t, ev_tw[j], tk, rho, kicks, twin_angles[j], kick_mode, cnt_tw[j])
-            d = _separation(t[1] - px, t[2] - py, measure[j])
-            same = cnt_tw[j, 0] == cnt_ref[0] and cnt_tw[j, 1] == cnt_ref[1] and (
-                cnt_tw[j, 2] == cnt_ref[2])
+            while True:
+                ik = cnt_tw[j, 0]
+                is_kick = False
+                dt = ev_tw[j, 0]
+                if ik < nk and kicks[ik] - tw[j, 0] < dt:
+                    is_kick = True
+                    dt = kicks[ik] - tw[j, 0]
+                if tw[j, 0] + dt > tk:
+                    break
+                if is_kick:
+                    process_event_one(tw[j], ev_tw[j], True, dt, rho, kicks[ik],
+                                      twin_angles[j, ik], kick_mode, False)
+                    cnt_tw[j, 0] += 1
+                    cnt_tw[j, 2] = (cnt_tw[j, 2] * 4 + 4) % HASH_MOD
+                else:
+                    process_event_one(tw[j], ev_tw[j], False, dt, rho, 0.0, 0.0, kick_mode, False)
+                    cnt_tw[j, 1] += 1
+                    cnt_tw[j, 2] = (cnt_tw[j, 2] * 4 + 1) % HASH_MOD
+            dt = tk - tw[j, 0]
+            tw[j, 1] += tw[j, 3] * dt
+            tw[j, 2] += tw[j, 4] * dt
+            ev_tw[j, 0] -= dt
+            tw[j, 0] = tk
+            tw[j, 5] = 0.0
+            d = _separation(tw[j, 1] - px, tw[j, 2] - py, measure[j])
+            same = (cnt_tw[j, 0] == cnt_ref[0] and cnt_tw[j, 1] == cnt_ref[1]
+                    and cnt_tw[j, 2] == cnt_ref[2])
             if d > 0.0 and (same or n_defer_now[j] >= max_defer):
                 if not same:
                     n_forced[j] += 1
-                    cnt_tw[j] = cnt_ref
+                    for c in range(3):
+                        cnt_tw[j, c] = cnt_ref[c]
                 log_sum[j] += math.log(d / m_plus[j])
                 n_renorm[j] += 1
                 t_last[j] = tk
                 n_defer_now[j] = 0
-                ex = t[1] - px
-                ey = t[2] - py
+                ex = tw[j, 1] - px
+                ey = tw[j, 2] - py
                 f = d0 / max(d, math.sqrt(ex * ex + ey * ey))
                 m_plus[j] = d * f
-                _rescale_disk(t, 1, px, py, ref[3], ref[4], f, unit_speed)
-                ev_tw[j, 0] = boundary_hit_time(t[1], t[2], t[3], t[4], rho)
+                a, b, c2, d2 = _rescaled(tw[j, 1], tw[j, 2], tw[j, 3], tw[j, 4], px, py, ref[3],
+                                         ref[4], f, unit_speed)
+                tw[j, 1] = a
+                tw[j, 2] = b
+                tw[j, 3] = c2
+                tw[j, 4] = d2
+                ev_tw[j, 0] = boundary_hit_time(a, b, c2, d2, rho)
             else:
                 n_defer_now[j] += 1
                 n_deferred[j] += 1
