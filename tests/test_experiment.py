@@ -292,6 +292,7 @@ def test_rerunning_a_finished_store_recomputes_nothing(reference, tmp_path):
     assert_same_store(reference, again)
 
 
+@pytest.mark.filterwarnings("ignore:.*leftover temporary file")
 def test_resume_after_a_killed_run_equals_an_uninterrupted_run(tmp_path):
     exp = dataclasses.replace(TINY, n_ics=24, block_size=1, n_steps=1500)
     toml = tmp_path / "exp.toml"

@@ -61,25 +61,23 @@ def test_bad_arguments_raise(kwargs, match):
         initial_conditions(**kwargs)
 
 
-@pytest.mark.parametrize("rule", ["mirror", "elastic"])
-@pytest.mark.parametrize("r", [0.02, 0.05])
-def test_collision_rate_matches_kinetic_theory_under_the_invariant_measure(rule, r):
+def assert_mean_count_matches_kinetic_theory(rule, r, n, t_max, seed):
     # E[N(T)] = Gamma T exactly for ICs drawn from the invariant measure (design.md)
-    n, t_max = 600, 100.0
-    ics = initial_conditions(n, r, seed=123, method="uniform", rule=rule)
+    ics = initial_conditions(n, r, seed=seed, method="uniform", rule=rule)
     counts = np.array([simulate_two_particle(ic, r, t_max=t_max, rule=rule).n_pp for ic in ics])
     expected = kinetic_rate(r, rule=rule) * t_max
     sem = counts.std(ddof=1) / np.sqrt(n)
     assert abs(counts.mean() - expected) < 3 * sem, (counts.mean(), expected, sem)
+
+
+@pytest.mark.parametrize("rule", ["mirror", "elastic"])
+@pytest.mark.parametrize("r", [0.02, 0.05])
+def test_collision_rate_matches_kinetic_theory_under_the_invariant_measure(rule, r):
+    assert_mean_count_matches_kinetic_theory(rule, r, n=600, t_max=100.0, seed=123)
 
 
 @pytest.mark.slow
 @pytest.mark.parametrize("rule", ["mirror", "elastic"])
 @pytest.mark.parametrize("r", [0.01, 0.02, 0.05])
 def test_collision_rate_matches_kinetic_theory_with_many_ics(rule, r):
-    n, t_max = 20000, 200.0
-    ics = initial_conditions(n, r, seed=7, method="uniform", rule=rule)
-    counts = np.array([simulate_two_particle(ic, r, t_max=t_max, rule=rule).n_pp for ic in ics])
-    expected = kinetic_rate(r, rule=rule) * t_max
-    sem = counts.std(ddof=1) / np.sqrt(n)
-    assert abs(counts.mean() - expected) < 3 * sem, (counts.mean(), expected, sem)
+    assert_mean_count_matches_kinetic_theory(rule, r, n=20000, t_max=200.0, seed=7)

@@ -4,45 +4,17 @@ the offending value and the valid range (design.md, "Bad input")."""
 from __future__ import annotations
 
 import math
-from numbers import Integral, Real
 
 import numpy as np
+
+from kicktimes._validation import check_choice, check_int, check_real
+
+__all__ = ["check_choice", "check_int", "check_real", "check_state", "check_inside",
+           "check_unit_speed", "check_sampling", "RULES", "SAMPLINGS", "CONTACT_TOL"]
 
 RULES = {"mirror": 0, "elastic": 1}
 SAMPLINGS = ("uniform", "paper")
 CONTACT_TOL = 1e-12
-
-
-def check_real(name: str, value, *, low=None, high=None, low_open=True, high_open=True) -> float:
-    """A finite real number inside the given (open by default) interval."""
-    if isinstance(value, bool) or not isinstance(value, Real | np.floating | np.integer):
-        raise TypeError(f"{name} must be a real number, got {type(value).__name__}")
-    x = float(value)
-    if not math.isfinite(x):
-        raise ValueError(f"{name} must be finite, got {x!r}")
-    bad_low = low is not None and (x <= low if low_open else x < low)
-    bad_high = high is not None and (x >= high if high_open else x > high)
-    if bad_low or bad_high:
-        lo = "-inf" if low is None else repr(low)
-        hi = "inf" if high is None else repr(high)
-        rng = f"{'(' if low_open else '['}{lo}, {hi}{')' if high_open else ']'}"
-        raise ValueError(f"{name} must lie in {rng}, got {x!r}")
-    return x
-
-
-def check_int(name: str, value, *, low: int) -> int:
-    if isinstance(value, bool) or not isinstance(value, Integral | np.integer):
-        raise TypeError(f"{name} must be an integer, got {type(value).__name__}")
-    n = int(value)
-    if n < low:
-        raise ValueError(f"{name} must be an integer >= {low}, got {n}")
-    return n
-
-
-def check_choice(name: str, value, choices) -> str:
-    if value not in choices:
-        raise ValueError(f"{name} must be one of {sorted(choices)!r}, got {value!r}")
-    return value
 
 
 def check_state(name: str, value, shape: tuple[int, ...]) -> np.ndarray:

@@ -25,7 +25,7 @@ from numba import njit
 from kicktimes.billiard import _checks as chk
 from kicktimes.billiard.geometry import boundary_hit_time, reflect
 from kicktimes.billiard.runs import BoundaryLog, OneParticleRun
-from kicktimes.billiard.two_particle import HASH_MOD, _grow
+from kicktimes.billiard.two_particle import _grow
 
 KICK_ANGLES = {"uniform": 0, "gaussian": 1}
 
@@ -124,34 +124,6 @@ def finish_one_at(st, ev, t_end):
     drift_one(st, ev, t_end - st[0])
     st[0] = t_end
     st[5] = 0.0
-
-
-@njit(cache=True, inline="always")
-def advance_events_one(st, ev, t_end, rho, kicks, angles, kick_mode, cnt):
-    """Process every event (kick or boundary collision) at time ``<= t_end``; the state
-    stays at the last event. Counts events in ``cnt = [n_kicks_applied, n_boundary,
-    seq_hash]`` without logging them."""
-    while True:
-        is_kick, dt = next_event_one(st, ev, kicks, cnt)
-        if st[0] + dt > t_end:
-            break
-        if is_kick:
-            ik = cnt[0]
-            process_event_one(st, ev, True, dt, rho, kicks[ik], angles[ik], kick_mode, False)
-            cnt[0] += 1
-            code = 3
-        else:
-            process_event_one(st, ev, False, dt, rho, 0.0, 0.0, kick_mode, False)
-            cnt[1] += 1
-            code = 0
-        cnt[2] = (cnt[2] * 4 + code + 1) % HASH_MOD
-
-
-@njit(cache=True, inline="always")
-def advance_one(st, ev, t_end, rho, kicks, angles, kick_mode, cnt):
-    """`advance_events_one`, then fly on to exactly ``t_end``."""
-    advance_events_one(st, ev, t_end, rho, kicks, angles, kick_mode, cnt)
-    finish_one_at(st, ev, t_end)
 
 
 @njit(cache=True)
@@ -262,6 +234,36 @@ def draw_kick_angles(n: int, kick_angle: str, sigma: float, rng: np.random.Gener
     return rng.normal(0.0, sigma, size=n)
 
 
+def resolve_kicks(kicks, kick_angles, *, kick_angle, sigma, rng, horizon, t_max):
+    """Kick times and angles of a run, and the generator used (``None`` if none was).
+
+    ``kicks`` is ``None``, an array of times (checked against ``t_max`` when it is not
+    ``None``) or a schedule sampled on ``(0, horizon]`` with ``rng``. ``kick_angles`` is
+    given (one per kick) or drawn from the same generator, after the times.
+    """
+    gen = None
+    if kicks is None:
+        times = np.empty(0)
+    elif hasattr(kicks, "sample"):
+        gen = np.random.default_rng(rng)
+        times = check_kick_times(kicks.sample(horizon, gen), horizon)
+    else:
+        times = check_kick_times(kicks, t_max)
+    if kick_angles is None:
+        if not times.size:
+            return times, times.copy(), gen
+        gen = gen if gen is not None else np.random.default_rng(rng)
+        return times, draw_kick_angles(times.size, kick_angle, sigma, gen), gen
+    angles = np.array(kick_angles, dtype=np.float64, copy=True).ravel()
+    if angles.shape != times.shape:
+        raise ValueError(
+            f"kick_angles must have one angle per kick ({times.size}), got {angles.size}"
+        )
+    if not np.isfinite(angles).all():
+        raise ValueError("kick_angles must be finite; got NaN or inf")
+    return times, angles, gen
+
+
 def simulate_one_particle(state, r, *, t_max=None, kicks=None, kick_angle="uniform",
                           kick_angles=None, sigma=1.0, rng=None, sampling="uniform",
                           n_steps=None, tau=None, seed=None) -> OneParticleRun:
@@ -322,26 +324,9 @@ def simulate_one_particle(state, r, *, t_max=None, kicks=None, kick_angle="unifo
     t_max, n_steps, tau, mode = chk.check_sampling(t_max, n_steps, tau, sampling)
     state = check_one_particle_state(state, r)
     horizon = t_max if mode < 2 else n_steps * tau  # paper steps are at most tau long
-    gen = None
-    if kicks is None:
-        times = np.empty(0)
-    elif hasattr(kicks, "sample"):
-        gen = np.random.default_rng(rng)
-        times = check_kick_times(kicks.sample(horizon, gen), horizon)
-    else:
-        times = check_kick_times(kicks, t_max if mode < 2 else None)
-    if kick_angles is None:
-        if times.size and gen is None:
-            gen = np.random.default_rng(rng)
-        angles = draw_kick_angles(times.size, kick_angle, sigma, gen) if times.size else times
-    else:
-        angles = np.array(kick_angles, dtype=np.float64, copy=True).ravel()
-        if angles.shape != times.shape:
-            raise ValueError(
-                f"kick_angles must have one angle per kick ({times.size}), got {angles.size}"
-            )
-        if not np.isfinite(angles).all():
-            raise ValueError("kick_angles must be finite; got NaN or inf")
+    times, angles, _ = resolve_kicks(kicks, kick_angles, kick_angle=kick_angle, sigma=sigma,
+                                     rng=rng, horizon=horizon,
+                                     t_max=t_max if mode < 2 else None)
     st = np.zeros(7)
     st[1:5] = state
     st[6] = state[2] ** 2 + state[3] ** 2

@@ -169,35 +169,6 @@ def finish_at(st, ev, t_end):
     st[9] = 0.0
 
 
-@njit(cache=True, inline="always")
-def advance_events_two(st, ev, t_end, rho, sigma, rule, cnt):
-    """Process every event at time ``<= t_end``; the state stays at the last event.
-
-    Counts events in ``cnt`` (``[n_pp, n_boundary, n_boundary_0, n_boundary_1,
-    seq_hash]``, the hash being order-sensitive) without logging them. Not flying on to
-    ``t_end`` keeps the trajectory bitwise equal to `simulate_two_kernel`'s, whose sample
-    positions are interpolated, never integrated.
-    """
-    while True:
-        k, dt = next_event_two(ev)
-        if st[0] + dt > t_end:
-            break
-        process_event_two(st, ev, k, rho, sigma, rule)
-        if k == 2:
-            cnt[0] += 1
-        else:
-            cnt[1] += 1
-            cnt[2 + k] += 1
-        cnt[4] = (cnt[4] * 4 + k + 1) % HASH_MOD
-
-
-@njit(cache=True, inline="always")
-def advance_two(st, ev, t_end, rho, sigma, rule, cnt):
-    """`advance_events_two`, then fly on to exactly ``t_end``."""
-    advance_events_two(st, ev, t_end, rho, sigma, rule, cnt)
-    finish_at(st, ev, t_end)
-
-
 @njit(cache=True)
 def _grow(a):
     out = np.empty(2 * a.shape[0] + 16, dtype=a.dtype)

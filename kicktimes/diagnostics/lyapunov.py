@@ -44,11 +44,11 @@ from kicktimes.billiard import _checks as chk
 from kicktimes.billiard.geometry import boundary_hit_time, pair_hit_time
 from kicktimes.billiard.one_particle import (
     KICK_ANGLES,
-    check_kick_times,
     check_one_particle_state,
     draw_kick_angles,
     next_event_one,
     process_event_one,
+    resolve_kicks,
 )
 from kicktimes.billiard.runs import OneParticleRun, TwoParticleRun
 from kicktimes.billiard.two_particle import (
@@ -132,7 +132,7 @@ def _separation(dx, dy, measure):
     return abs(dy)
 
 
-# The per-sample loops below are written out rather than calling advance_* helpers: a
+# The per-sample loops below are written out rather than calling a helper per sample: a
 # numba call with array arguments costs ~50 ns, as much as the rest of a sample's work,
 # and there are 25 000 samples per run. Array-taking kernels are called only per event.
 
@@ -522,21 +522,9 @@ def lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rule
     chk.check_choice("kick_angle", kick_angle, KICK_ANGLES)
     state = check_one_particle_state(arr, r, name="system")
     horizon = n_steps * tau
-    gen = None
-    if kicks is None:
-        times = np.empty(0)
-    elif hasattr(kicks, "sample"):
-        gen = np.random.default_rng(rng)
-        times = check_kick_times(kicks.sample(horizon, gen), horizon)
-    else:
-        times = check_kick_times(kicks, horizon if mode == 1 else None)
-    if kick_angles is None:
-        gen = gen if gen is not None else np.random.default_rng(rng)
-        angles = draw_kick_angles(times.size, kick_angle, sigma, gen)
-    else:
-        angles = np.asarray(kick_angles, dtype=np.float64).ravel()
-        if angles.shape != times.shape or not np.isfinite(angles).all():
-            raise ValueError(f"kick_angles must be {times.size} finite angles, one per kick")
+    times, angles, gen = resolve_kicks(kicks, kick_angles, kick_angle=kick_angle, sigma=sigma,
+                                       rng=rng, horizon=horizon,
+                                       t_max=horizon if mode == 1 else None)
     chk.check_choice("twin_kicks", twin_kicks, ("shared", "independent"))
     rho = 1.0 - r
     offsets, measure = _twin_offsets(

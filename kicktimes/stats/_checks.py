@@ -6,50 +6,22 @@ Every message names the argument, the offending value and the valid range
 
 from __future__ import annotations
 
-import math
-from numbers import Integral, Real
+from numbers import Integral
 
 import numpy as np
+
+from kicktimes._validation import check_choice, check_int, check_real
+
+__all__ = [
+    "as_1d_float", "check_choice", "check_int", "check_intervals", "check_real", "check_rng",
+    "check_times",
+]
 
 
 def _show(arr: np.ndarray, mask: np.ndarray) -> str:
     """The first offending entry, as ``name[i] = value``-ready text."""
     i = int(np.flatnonzero(mask)[0])
     return f"[{i}] = {arr[i]!r}"
-
-
-def check_real(name: str, value, *, low=None, high=None, low_open=True, high_open=True) -> float:
-    """A finite real number inside the given (open by default) interval."""
-    if isinstance(value, bool) or not isinstance(value, Real | np.floating | np.integer):
-        raise TypeError(f"{name} must be a real number, got {type(value).__name__}")
-    x = float(value)
-    if not math.isfinite(x):
-        raise ValueError(f"{name} must be finite, got {x!r}")
-    bad_low = low is not None and (x <= low if low_open else x < low)
-    bad_high = high is not None and (x >= high if high_open else x > high)
-    if bad_low or bad_high:
-        lo = "-inf" if low is None else repr(low)
-        hi = "inf" if high is None else repr(high)
-        span = f"{'(' if low_open else '['}{lo}, {hi}{')' if high_open else ']'}"
-        raise ValueError(f"{name} must lie in {span}, got {x!r}")
-    return x
-
-
-def check_int(name: str, value, *, low: int) -> int:
-    """An integer (not a bool) no smaller than ``low``."""
-    if isinstance(value, bool) or not isinstance(value, Integral | np.integer):
-        raise TypeError(f"{name} must be an integer, got {type(value).__name__}")
-    n = int(value)
-    if n < low:
-        raise ValueError(f"{name} must be an integer >= {low}, got {n}")
-    return n
-
-
-def check_choice(name: str, value, choices) -> str:
-    """One of a fixed set of strings."""
-    if not isinstance(value, str) or value not in choices:
-        raise ValueError(f"{name} must be one of {list(choices)!r}, got {value!r}")
-    return value
 
 
 def as_1d_float(name: str, value, *, allow_empty: bool = True) -> np.ndarray:
