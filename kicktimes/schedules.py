@@ -36,6 +36,7 @@ Schedules compare by value, have a readable ``repr``, serialise with ``to_json()
 
 from __future__ import annotations
 
+import abc
 import importlib
 import json
 import math
@@ -452,14 +453,14 @@ def _renewal_times(draw, t_max, *, first=None, mean=None, max_kicks):
 
 
 # ---------------------------------------------------------------------------- schedules
-class Schedule:
+class Schedule(abc.ABC):
     """Base class of kick schedules: ``sample``, value semantics and JSON."""
 
     _type = ""
 
+    @abc.abstractmethod
     def sample(self, t_max, rng=None, *, max_kicks=DEFAULT_MAX_KICKS):
         """Sorted float64 kick times in ``(0, t_max]`` (see the subclass)."""
-        raise NotImplementedError
 
     def to_dict(self):
         """JSON-ready dict ``{"kicktimes_schedule": 1, "type": ..., ...parameters}``."""
