@@ -44,6 +44,33 @@ def system_style(system, k=0):
     return _SYSTEM_STYLE.get(system, {"color": f"C{k + 3}", "marker": "D"})
 
 
+def plain_ticks(axis):
+    """Tick labels as plain numbers with 3 significant figures (no offset text, which
+    would collide with the title)."""
+    axis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:.3g}"))
+
+
+def shared_legend(fig, axes):
+    """Move the legend of ``axes[0]`` below the panels (outside: it never covers data) and
+    drop every panel's own legend."""
+    handles, labels = axes[0].get_legend_handles_labels()
+    legend = axes[0].get_legend()
+    if legend is not None:
+        # artists keep their markers; the legend's extra proxy entries come after them
+        texts = [t.get_text() for t in legend.get_texts()]
+        extra = [
+            (h, t) for h, t in zip(legend.legend_handles, texts, strict=True) if t not in labels
+        ]
+        handles = handles + [h for h, _ in extra]
+        labels = labels + [t for _, t in extra]
+    for ax in axes:
+        if ax.get_legend() is not None:
+            ax.get_legend().remove()
+    fig.legend(
+        handles, labels, loc="outside lower center", ncol=min(4, len(labels)), fontsize="small"
+    )
+
+
 def plain_log_ticks(axis):
     """Log-axis tick labels as plain numbers (0.5, 2, 20), never "2x10^0"; no minor labels
     when the axis spans more than a decade (they would overlap)."""

@@ -27,6 +27,7 @@ from kicktimes.report._common import REFERENCE, Section, fmt, kicked_systems, wi
 from kicktimes.report._figures import (
     DIAGNOSTIC_LABELS,
     dodge,
+    shared_legend,
     system_label,
     system_style,
 )
@@ -149,8 +150,9 @@ def _lag1_figure(summary, predicted, lag):
         medians=True,
         title=DIAGNOSTIC_LABELS["autocorrelation"][0] + f" (lag {lag})",
     )
+    fig.set_size_inches(7.4, 5.4)
+    ax = fig.axes[0]
     if lag == 1 and not predicted.empty:
-        ax = fig.axes[0]
         pred = predicted.groupby(["radius", "system"])["value"].mean()
         systems = list(dict.fromkeys(summary["system"]))
         order = [s for s in (REFERENCE, *kicked_systems(summary)) if s in systems]
@@ -174,7 +176,7 @@ def _lag1_figure(summary, predicted, lag):
                 color=style["color"],
                 label=f"{system_label(system)}: built-in 1 − n_pert/n_boundary",
             )
-        ax.legend(fontsize="x-small")
+    shared_legend(fig, [ax])
     return fig
 
 
@@ -300,7 +302,11 @@ def effects(ctx):
                 estimate=tot["ratio"],
                 ci_low=tot["ci_low"],
                 ci_high=tot["ci_high"],
-                verdict=f"{verdict} ({BUILT_IN}: kick rate = collision rate)",
+                verdict=(
+                    f"{verdict} ({BUILT_IN}: kick rate = collision rate)"
+                    if verdict == "agrees"
+                    else f"{verdict} (an agreement would be {BUILT_IN}: kick rate = collision rate)"
+                ),
                 rule=RATIO_RULE.format(t=ctx.tolerance),
                 method=f"paired bootstrap over {tot['n_ics']} ICs",
                 detail=detail,

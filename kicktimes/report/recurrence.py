@@ -27,7 +27,7 @@ from kicktimes.report._common import (
     kicked_systems,
     wide,
 )
-from kicktimes.report._figures import RADIUS_LABEL
+from kicktimes.report._figures import RADIUS_LABEL, plain_ticks, shared_legend
 from kicktimes.report.effects import RATIO_RULE, Effect, paired_ratio, ratio_verdict
 from kicktimes.report.summary import diagnostic_summary, diagnostic_vs_radius
 
@@ -139,18 +139,20 @@ def rr_figure(rows, exp, *, radii=None, title=None):
                 title=f"{_QUANTITIES[q][0]}, ε = {e:g}",
                 ylabel=_QUANTITIES[q][1],
             )
+            plain_ticks(ax.yaxis)
             if q == "rr":
+                # from 0: the paper's RR is mostly the diagonal 1/N, and the axis shows it
+                ax.set_ylim(bottom=0.0)
                 ax.axhline(1.0 / n, color="grey", linestyle="--", linewidth=0.8)
-                ax.annotate(
-                    "1/N: the diagonal alone",
-                    (0.02, 1.0 / n),
-                    xycoords=("axes fraction", "data"),
+                ax.text(
+                    0.02,
+                    0.45,
+                    f"dashed: 1/N = {1.0 / n:.3g}, the main diagonal alone",
+                    transform=ax.transAxes,
                     fontsize="x-small",
                     color="grey",
-                    va="bottom",
                 )
-            if (i, j) != (0, 0):
-                ax.get_legend().remove()
+    shared_legend(fig, axes.ravel())
     if title:
         fig.suptitle(title)
     return fig
@@ -189,9 +191,9 @@ def sections(ctx):
     sec.figure(
         "fig06_recurrence_rate_vs_radius",
         rr_figure(rows, exp),
-        "Per threshold ε (rows): the paper's recurrence rate (all pairs; the dashed line is "
-        "1/N, the main diagonal alone), the off-diagonal rate (pairs i ≠ j) and DET, per "
-        "system: mean over ICs (filled; thick pale bars ± std/10 as in the paper, thin capped "
+        "Per threshold ε (rows): the paper's recurrence rate (all pairs, axis from 0; "
+        "dashed: 1/N, the main diagonal alone), the off-diagonal rate (pairs i ≠ j) and DET, "
+        "per system: mean over ICs (filled; thick pale bars ± std/10 as in the paper, thin capped "
         "bars ± s.e.m.) and median (open, dotted). " + sampling_statement(exp),
     )
     sec.text(sampling_statement(exp))
@@ -245,12 +247,16 @@ def family_figure(stores):
                 title=f"{exp.name}, {where}: {_QUANTITIES[q][0]}",
                 ylabel=_QUANTITIES[q][1],
             )
-            if (i, j) != (0, 0):
-                axes[i, j].get_legend().remove()
+            plain_ticks(axes[i, j].yaxis)
+            if q == "rr":
+                axes[i, j].set_ylim(bottom=0.0)
+                axes[i, j].axhline(1.0 / n_samples(exp), color="grey", linestyle="--", lw=0.8)
+    shared_legend(fig, axes.ravel())
     return fig, (
         f"Recurrence rates of {exp.name} at ε = {e:g} in the paper's Fig. 7 layout: top all "
         f"radii, bottom a zoom on r ≤ {small.max():g}; left the paper's RR (diagonal "
-        "included), right the off-diagonal rate. " + sampling_statement(exp)
+        "included, axis from 0, dashed: 1/N), right the off-diagonal rate. "
+        + sampling_statement(exp)
     )
 
 
