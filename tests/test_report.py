@@ -46,8 +46,11 @@ TABLES = {
     "diagnostics_summary",
     "diagnostics_vs_two_particle",
     "lyapunov_by_radius",
-    "recurrence_rate_by_radius",
-    "autocorrelation_by_radius",
+    "lyapunov_stretching",
+    "recurrence_by_radius",
+    "autocorrelation_summary",
+    "sticky_ics",
+    "findings",
     "poisson_tests",
     "rate_homogeneity",
     "renewal_best_share",
@@ -188,6 +191,12 @@ def test_several_stores_give_one_report_with_a_part_per_experiment(built, store_
     assert (out / "families_autocorrelation_vs_radius.png").is_file()  # paper's top/bottom
     assert (out / "tiny_report_b_fig07_autocorrelation_vs_radius.pdf").is_file()
     assert not (out / "tiny_report_b_fig06_recurrence_rate_vs_radius.png").exists()
+    # the paper's Fig. 7 layout: family A (the first store) on top and zoomed below
+    assert (out / "families_recurrence_rate_vs_radius.png").is_file()
+    # the Findings of both stores come before any experiment's details
+    first_detail = page.index("Experiment tiny_report</h2>")
+    assert page.index("Findings: tiny_report<") < first_detail
+    assert page.index("Findings: tiny_report_b<") < first_detail
     single = built[1]
     for name in ("poisson_tests", "rate_homogeneity", "renewal_pooled", "renewal_per_ic"):
         a = pd.read_csv(single / f"{name}.csv")
@@ -219,3 +228,79 @@ def test_build_report_rejects_bad_arguments(store_path, tmp_path, kwargs, error,
 def test_build_report_refuses_a_directory_that_is_not_a_store(tmp_path):
     with pytest.raises(ValueError, match="not a kicktimes store"):
         build_report(tmp_path, tmp_path / "out", progress=False)
+
+
+# ------------------------------------------------------------------ findings first
+
+
+def test_the_page_opens_with_the_findings_and_a_below_paper_scale_banner(built):
+    page = built[0].read_text(encoding="utf-8")
+    findings = page.index('id="findings"')
+    assert findings < page.index('id="poincare"')
+    assert '<p class="banner">Below paper scale: tiny_report: 6 ICs' in page
+    assert "Verdict rules." in page and "the 95 % CI of the ratio lies inside" in page
+
+
+def test_every_finding_has_an_effect_a_confidence_interval_and_a_ruled_verdict(built):
+    table = pd.read_csv(built[1] / "findings.csv")
+    questions = set(table["question"])
+    assert {"FTLE", "Lag-1 ACF of boundary angles", "Off-diagonal RR (ε = 0.001)"} <= questions
+    assert "Collision counts against kinetic theory" in questions
+    assert set(table.loc[table["system"].notna(), "system"]) == {"poisson", "actual"}
+    ratios = table[table["question"] != "Poisson collision times?"]
+    ok = ratios["ci_low"].notna()
+    assert (ratios.loc[ok, "ci_low"] <= ratios.loc[ok, "estimate"]).all()
+    assert (ratios.loc[ok, "estimate"] <= ratios.loc[ok, "ci_high"]).all()
+    for row in table.itertuples():
+        assert row.verdict.split(" ")[0] in {"agrees", "differs", "inconclusive"} or any(
+            w in row.verdict for w in ("Poisson", "model", "majority", "exponential")
+        )
+    acf = table[table["question"].str.startswith("Lag-1 ACF")]
+    assert acf["verdict"].str.contains("built in").all()  # never a confirmation
+
+
+def test_the_ftle_finding_is_the_mean_over_radii_of_the_ratio_of_means(built, store_path):
+    res = load_store(store_path).results
+    lam = res[res["diagnostic"] == "lyapunov"].pivot_table(
+        index=["radius", "ic"], columns="system", values="value"
+    )
+    ratio = lam.groupby(level="radius").sum()
+    expected = (ratio["poisson"] / ratio["two_particle"]).mean()
+    table = pd.read_csv(built[1] / "findings.csv")
+    row = table[(table["question"] == "FTLE") & (table["system"] == "poisson")].iloc[0]
+    assert row["estimate"] == pytest.approx(expected, rel=1e-12)
+
+
+def test_old_stores_get_the_off_diagonal_rate_derived_from_the_paper_rr(built, store_path):
+    res = load_store(store_path).results
+    rr = res[(res["diagnostic"] == "recurrence_rate") & (res["system"] == "poisson")]
+    n = EXPERIMENT.n_steps + 1
+    expected = ((n * rr["value"] - 1) / (n - 1)).groupby(rr["radius"]).mean()
+    table = pd.read_csv(built[1] / "recurrence_by_radius.csv")
+    off = table[(table["quantity"] == "rr_offdiag@0.001") & (table["system"] == "poisson")]
+    assert np.allclose(off.set_index("radius")["mean"], expected)
+    page = built[0].read_text(encoding="utf-8")
+    assert "derived from the stored RR as (N·RR − 1)/(N − 1) with N = 2501" in page
+    assert "collision-truncated steps" in page  # which sampling the RR uses
+
+
+def test_tables_are_rounded_and_scroll_instead_of_stretching_the_page(built):
+    page = built[0].read_text(encoding="utf-8")
+    assert page.count('<div class="table-wrap"><table') >= 8
+    cells = re.findall(r"<td>(-?\d\.\d+)(?:e[-+]\d+)?</td>", page)
+    assert cells and max(len(c.replace("-", "").replace(".", "")) for c in cells) <= 4
+
+
+def test_write_results_gives_pngs_and_a_generated_findings_page(store_path, tmp_path):
+    from kicktimes.report import write_results
+
+    path = write_results(store_path, tmp_path, dpi=40, n_mc=19, max_ics_model_fits=1)
+    text = path.read_text(encoding="utf-8")
+    assert text.startswith("# What the reproduction shows (generated)")
+    assert "**Below paper scale**" in text and "### Findings" in text
+    assert "FTLE, Poisson vs two-particle: ratio of mean λ" in text
+    pngs = {p.name for p in tmp_path.glob("*.png")}
+    assert "tiny_report_fig05_lyapunov_vs_radius.png" in pngs
+    for name in pngs:
+        assert f"]({name})" in text
+    assert (tmp_path / "tiny_report_findings.csv").is_file()

@@ -50,7 +50,7 @@ def plain_ticks(axis):
     axis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:.3g}"))
 
 
-def shared_legend(fig, axes):
+def shared_legend(fig, axes, *, ncol=4):
     """Move the legend of ``axes[0]`` below the panels (outside: it never covers data) and
     drop every panel's own legend."""
     handles, labels = axes[0].get_legend_handles_labels()
@@ -67,7 +67,7 @@ def shared_legend(fig, axes):
         if ax.get_legend() is not None:
             ax.get_legend().remove()
     fig.legend(
-        handles, labels, loc="outside lower center", ncol=min(4, len(labels)), fontsize="small"
+        handles, labels, loc="outside lower center", ncol=min(ncol, len(labels)), fontsize="small"
     )
 
 

@@ -176,7 +176,7 @@ def _lag1_figure(summary, predicted, lag):
                 color=style["color"],
                 label=f"{system_label(system)}: built-in 1 − n_pert/n_boundary",
             )
-    shared_legend(fig, [ax])
+    shared_legend(fig, [ax], ncol=2)
     return fig
 
 
