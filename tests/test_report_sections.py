@@ -1,0 +1,240 @@
+"""Specification of the report's section modules on a synthetic store with the new rows
+(RR/off-diagonal RR/DET at several eps, ACF curves, stretching per perturbation) and of
+the effect sizes and verdict rules of the Findings."""
+
+from __future__ import annotations
+
+from types import SimpleNamespace
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from kicktimes import stats
+from kicktimes.report import autocorrelation, counts, findings, lyapunov, recurrence, summary
+from kicktimes.report._common import Context
+from kicktimes.report.effects import (
+    clopper_pearson,
+    paired_ratio,
+    ratio_verdict,
+    share_verdict,
+)
+
+RADII = (0.008, 0.014, 0.02)
+EPS = (0.001, 0.01)
+LAGS = 6
+SYSTEMS = ("two_particle", "poisson", "actual", "poisson_scatter")
+
+
+def synthetic_store(n_ics=16, seed=0, sticky=(0.014, 3)):
+    """Tidy rows as the sweep writes them (store contract of H4/H1), with known effects:
+    kicked FTLE = 1/3 of the two-particle FTLE, DET identical in 'actual', off-diagonal RR
+    1.5x in 'poisson'; one sticky IC (collision rate 20x kinetic)."""
+    rng = np.random.default_rng(seed)
+    rows, coll = [], []
+    t = 1000.0
+    for r in RADII:
+        gamma = float(stats.kinetic_rate(r))
+        for ic in range(n_ics):
+            n_pp = rng.poisson(gamma * t) + 1
+            if (r, ic) == sticky:
+                n_pp = int(20 * gamma * t)
+            coll.append((r, ic, t, n_pp, np.sort(rng.uniform(0, t, n_pp))))
+            lam2 = 0.1 * (1 + 10 * r) * rng.lognormal(0, 0.1)
+            det2 = rng.uniform(0.2, 0.4)
+            off2 = 1e-5 * rng.lognormal(0, 0.2)
+            for system in SYSTEMS:
+                n = n_pp
+                lam = lam2 if system == "two_particle" else lam2 / 3
+                add = [("t_max", t), ("n_boundary", 500.0)]
+                add.append(("n_pp" if system == "two_particle" else "n_kicks", float(n)))
+                add += [("lyapunov", lam), ("lyapunov_per_perturbation", lam * t / n)]
+                for e in EPS:
+                    off = off2 * (1.5 if system == "poisson" else 1.0) * (10 if e > 0.005 else 1)
+                    nn = 3001
+                    add += [
+                        (f"rr@{e:g}", (1 + (nn - 1) * off) / nn),
+                        (f"rr_offdiag@{e:g}", off),
+                        (f"det@{e:g}", det2),
+                        (f"l_mean@{e:g}", 2.5),
+                        (f"l_max@{e:g}", 7.0),
+                    ]
+                # the paper's RR at eps[0], as the old row
+                add.append(("recurrence_rate", dict(add)[f"rr@{EPS[0]:g}"]))
+                r1 = 1 - n / 500.0
+                add += [(f"acf@{lag}", r1**lag) for lag in range(1, LAGS + 1)]
+                add += [("autocorrelation", r1), ("decorrelation_lag", np.nan), ("tau_int", 9.0)]
+                rows += [(r, ic, system, d, float(v), "") for d, v in add]
+    results = pd.DataFrame(rows, columns=["radius", "ic", "system", "diagnostic", "value", "note"])
+    collisions = pd.DataFrame(coll, columns=["radius", "ic", "t_window", "n_pp", "pp_times"])
+    exp = SimpleNamespace(
+        name="synthetic",
+        radii=list(RADII),
+        n_ics=n_ics,
+        n_steps=3000,
+        tau=0.3,
+        seed=5,
+        sampling="paper",
+        rr_sampling="run",
+        rule="mirror",
+        eps=EPS,
+        lag=1,
+        ic_method="paper",
+        lyapunov_variant="tangent",
+    )
+    return SimpleNamespace(experiment=exp, results=results, collisions=collisions)
+
+
+@pytest.fixture(scope="module")
+def ctx():
+    context = Context(synthetic_store(), n_boot=300)
+    context.sections = {}
+    for module in (counts, summary, lyapunov, recurrence, autocorrelation):
+        context.sections[module.__name__.rsplit(".", 1)[1]] = module.sections(context)
+    context.findings = findings.section(context)
+    return context
+
+
+def _effect(ctx, question, system):
+    matches = [e for e in ctx.found["effects"] if e.question == question and e.system == system]
+    assert len(matches) == 1, (question, system)
+    return matches[0]
+
+
+# ------------------------------------------------------------------- effect sizes
+
+
+def test_ratio_verdict_follows_the_printed_rule():
+    assert ratio_verdict(0.91, 1.09) == "agrees"
+    assert ratio_verdict(0.2, 0.89) == "differs" and ratio_verdict(1.11, 3.0) == "differs"
+    assert ratio_verdict(0.85, 1.05) == "inconclusive"
+    assert ratio_verdict(np.nan, 1.0) == "inconclusive"
+    assert ratio_verdict(0.75, 1.2, tolerance=0.25) == "agrees"
+
+
+def test_share_verdict_and_clopper_pearson():
+    low, high = clopper_pearson(30, 100)
+    assert low < 0.3 < high and share_verdict(low, high, 0.05) == "above"
+    assert share_verdict(*clopper_pearson(5, 100), 0.05) == "inconclusive"
+    assert clopper_pearson(0, 10)[0] == 0.0 and clopper_pearson(10, 10)[1] == 1.0
+
+
+def test_paired_ratio_covers_the_true_ratio_and_is_seeded():
+    idx = pd.MultiIndex.from_product([[0.01, 0.02], range(200)], names=["radius", "ic"])
+    rng = np.random.default_rng(0)
+    y = pd.Series(rng.lognormal(0, 0.5, idx.size), index=idx)
+    x = 0.7 * y * rng.lognormal(0, 0.3, idx.size) / np.exp(0.045)  # E[x/y] = 0.7
+    a = paired_ratio(x, y, rng=np.random.default_rng(1), n_boot=500)
+    b = paired_ratio(x, y, rng=np.random.default_rng(1), n_boot=500)
+    assert a[1] == b[1]
+    assert a[1]["ci_low"] < 0.7 < a[1]["ci_high"]
+    assert a[1]["ci_high"] - a[1]["ci_low"] < 0.2
+    assert list(a[0]["n_pairs"]) == [200, 200]
+
+
+def test_paired_ratio_skips_pairs_with_a_missing_value():
+    idx = pd.MultiIndex.from_product([[0.01], range(4)], names=["radius", "ic"])
+    x = pd.Series([1.0, 2.0, np.nan, 4.0], index=idx)
+    y = pd.Series([1.0, 1.0, 100.0, 2.0], index=idx)
+    per_radius, overall = paired_ratio(x, y, rng=np.random.default_rng(0), n_boot=100)
+    assert per_radius.loc[0, "n_pairs"] == 3
+    assert overall["ratio"] == pytest.approx(7.0 / 4.0)
+
+
+# ------------------------------------------------------------------- sections
+
+
+def test_findings_compare_every_kicked_system_including_new_ones(ctx):
+    systems = {e.system for e in ctx.found["effects"] if e.system}
+    assert systems == {"poisson", "actual", "poisson_scatter"}
+
+
+def test_ftle_finding_recovers_the_built_in_third_and_says_differs(ctx):
+    e = _effect(ctx, "FTLE", "poisson")
+    assert e.estimate == pytest.approx(1 / 3, rel=1e-9)
+    assert e.verdict == "differs"
+    assert "stretching per perturbation" in e.detail
+
+
+def test_recurrence_findings_at_every_eps_off_diagonal_and_det(ctx):
+    for eps in ("0.001", "0.01"):
+        off = _effect(ctx, f"Off-diagonal RR (ε = {eps})", "poisson")
+        assert off.estimate == pytest.approx(1.5, rel=1e-9) and off.verdict == "differs"
+        det = _effect(ctx, f"DET (ε = {eps})", "actual")
+        assert det.estimate == pytest.approx(1.0) and det.verdict == "agrees"
+
+
+def test_acf_finding_is_marked_built_in(ctx):
+    e = _effect(ctx, "Lag-1 ACF of boundary angles", "actual")
+    assert e.verdict.startswith("agrees") and "built in" in e.verdict
+    assert "built-in prediction" in e.detail
+
+
+def test_recurrence_figure_has_a_row_per_eps_and_rr_offdiag_det_columns(ctx):
+    (sec,) = ctx.sections["recurrence"]
+    name, fig, caption = sec.figures[0]
+    axes = [ax for ax in fig.axes if ax.get_visible()]
+    assert len(axes) == len(EPS) * 3
+    titles = [ax.get_title() for ax in axes]
+    assert any("off-diagonal" in t and "ε = 0.01" in t for t in titles)
+    assert any(t.startswith("DET") for t in titles)
+    rr_axes = [ax for ax in axes if ax.get_title().startswith("paper's RR")]
+    assert all(ax.get_ylim()[0] == 0 for ax in rr_axes)  # no zoom into 1 % of 1/N
+    assert "1/N" in caption and "collision-truncated" in caption
+
+
+def test_recurrence_table_gives_medians_and_flags_the_sticky_ic(ctx):
+    (sec,) = ctx.sections["recurrence"]
+    table = {name: df for name, df, _, _ in sec.tables}["recurrence_by_radius"]
+    assert {"mean", "median", "n_sticky", "mean_without_sticky"} <= set(table.columns)
+    sticky = table[(table["radius"] == 0.014) & (table["system"] == "two_particle")]
+    assert (sticky["n_sticky"] == 1).all()
+    assert (table.loc[table["radius"] != 0.014, "n_sticky"] == 0).all()
+
+
+def test_sticky_ics_are_those_above_five_times_the_kinetic_rate():
+    store = synthetic_store()
+    flags = counts.sticky_ics(store.collisions, "mirror")
+    assert flags["sticky"].sum() == 1
+    assert flags.loc[flags["sticky"], ["radius", "ic"]].values.tolist() == [[0.014, 3]]
+
+
+def test_acf_curves_figure_draws_each_radius_with_the_prediction(ctx):
+    (sec,) = ctx.sections["autocorrelation"]
+    names = [name for name, _, _ in sec.figures]
+    assert names == ["fig07_autocorrelation_vs_radius", "fig07b_autocorrelation_curves"]
+    fig = sec.figures[1][1]
+    axes = [ax for ax in fig.axes if ax.get_visible()]
+    assert [ax.get_title() for ax in axes] == [f"r = {r:g}" for r in RADII]
+    table = {name: df for name, df, _, _ in sec.tables}["autocorrelation_summary"]
+    assert np.allclose(table["R1_mean"], table["predicted_lag1"])
+    assert (table["decorrelation_lag_n_undefined"] == 16).all()
+
+
+def test_stretching_per_perturbation_is_mean_lambda_over_the_pooled_rate(ctx):
+    table = lyapunov.stretching_table(ctx.results)
+    res = ctx.results
+    part = res[(res["radius"] == 0.008) & (res["system"] == "two_particle")]
+    lam = part[part["diagnostic"] == "lyapunov"]["value"].mean()
+    n = part[part["diagnostic"] == "n_pp"]["value"].sum()
+    t = part[part["diagnostic"] == "t_max"]["value"].sum()
+    row = table[(table["radius"] == 0.008) & (table["system"] == "two_particle")].iloc[0]
+    assert row["stretch_per_perturbation"] == pytest.approx(lam / (n / t))
+    assert row["ln_inv_r"] == pytest.approx(np.log(1 / 0.008))
+
+
+def test_lyapunov_figure_shows_lambda_stretching_and_the_ln_inverse_r_relation(ctx):
+    (sec,) = ctx.sections["lyapunov"]
+    fig = sec.figures[0][1]
+    assert len(fig.axes) == 3
+    assert "ln(1/r)" in fig.axes[2].get_xlabel()
+    assert "nats" in fig.axes[1].get_ylabel()
+
+
+def test_findings_section_states_the_rules_and_the_scale(ctx):
+    sec = ctx.findings
+    kinds = [kind for kind, _ in sec.blocks]
+    assert kinds[0] == "banner" and "ul" in kinds
+    banner = sec.blocks[0][1]
+    assert "16 ICs" in banner and "smoke test" in banner
+    assert any("Verdict rules" in p for p in sec.paragraphs)
