@@ -322,19 +322,36 @@ def test_rejection_table_gives_clopper_pearson_intervals():
         plots.rejection_table(df.assign(n_reject=[101, 0]))
 
 
-def test_poisson_rejection_rates_marks_alpha_and_every_test():
-    rows = [
-        {"radius": r, "test": t, "n_tested": 50, "n_reject": k}
-        for r in RADII
-        for k, t in enumerate(stats.TESTS)
-    ]
-    fig = plots.poisson_rejection_rates(pd.DataFrame(rows), alpha=0.05)
-    assert_labelled(fig)
-    ax = fig.axes[0]
-    assert len(ax.containers) == len(stats.TESTS)
-    assert any(np.allclose(ln.get_ydata(), 0.05) for ln in ax.get_lines())
+def _rejection_rows():
+    return pd.DataFrame(
+        [
+            {"radius": r, "test": t, "n_tested": 50, "n_reject": k}
+            for r in RADII
+            for k, t in enumerate(stats.TESTS)
+        ]
+    )
+
+
+def test_poisson_rejection_rates_draws_one_panel_per_test_with_alpha():
+    fig = plots.poisson_rejection_rates(_rejection_rows(), alpha=0.05)
+    axes = [ax for ax in fig.axes if ax.get_visible()]
+    assert len(axes) == len(stats.TESTS)  # small multiples: no offsets between tests
+    for ax, test in zip(axes, stats.TESTS, strict=True):
+        assert ax.get_title() == test.replace("_", " ")
+        assert len(ax.containers) == 1
+        assert any(np.allclose(ln.get_ydata(), 0.05) for ln in ax.get_lines())
+        # every point sits at its radius, not shifted
+        assert np.allclose(ax.containers[0].lines[0].get_xdata(), RADII)
+    assert all(ax.get_ylabel() for ax in axes[::4])
     with pytest.raises(ValueError, match="alpha"):
-        plots.poisson_rejection_rates(pd.DataFrame(rows), alpha=1.5)
+        plots.poisson_rejection_rates(_rejection_rows(), alpha=1.5)
+
+
+def test_poisson_rejection_rates_can_overlay_the_tests_in_a_given_axes():
+    fig = Figure()
+    ax = fig.add_subplot()
+    assert plots.poisson_rejection_rates(_rejection_rows(), ax=ax) is fig
+    assert len(ax.containers) == len(stats.TESTS) and ax.get_legend() is not None
 
 
 def test_model_comparison_shares_add_up_to_one():
@@ -363,6 +380,32 @@ def test_model_comparison_shares_add_up_to_one():
         plots.model_comparison(per_ic, pooled.assign(delta_aic=-1.0))
 
 
+def test_model_comparison_keeps_legend_off_the_data_and_no_negative_delta_aic_band():
+    per_ic = pd.DataFrame({"radius": [0.01, 0.02], "best_model": ["exponential", "gamma"]})
+    pooled = pd.DataFrame(
+        {"radius": [0.01, 0.01], "model": ["exponential", "gamma"], "delta_aic": [0.0, 150.0]}
+    )
+    fig = plots.model_comparison(per_ic, pooled)
+    ax1, ax2 = fig.axes
+    assert ax1.get_legend() is None and ax2.get_legend() is None
+    assert len(fig.legends) == 1  # one legend, outside the panels
+    assert ax2.get_ylim()[0] == 0 and ax2.get_ylim()[1] >= 150
+
+
+def test_log_axes_have_plain_tick_labels():
+    fig = plots.rate_heterogeneity(make_collisions(n_ics=20))
+    fig.canvas.draw()
+    for ax in fig.axes:
+        labels = [t.get_text() for t in ax.get_yticklabels() + ax.get_yminorticklabels()]
+        assert not any("times" in lab or "^" in lab for lab in labels), labels
+
+
+def test_kick_times_labels_have_one_level_of_parentheses():
+    fig = plots.kick_times_vs_collision_times(np.arange(1.0, 9), np.arange(1.0, 9))
+    for label in (fig.axes[0].get_xlabel(), fig.axes[0].get_ylabel()):
+        assert label.count("(") == 1 and label.endswith("(time units)")
+
+
 def test_model_comparison_says_so_when_no_ic_could_be_fitted():
     per_ic = pd.DataFrame({"radius": [], "best_model": []})
     pooled = pd.DataFrame(
@@ -383,7 +426,13 @@ def test_rate_heterogeneity_draws_zero_rate_ics_at_the_floor_and_p_values():
     ax1, ax2 = fig.axes
     labels = [t.get_text() for t in ax1.get_legend().get_texts()]
     assert any("without collisions" in lab for lab in labels)
-    assert {t.get_text() for t in ax2.texts} >= {"p<1e-300", "p=0.01"}
+    # p-values on a second x axis on top (never over a marker), one per radius
+    (top,) = ax2.child_axes
+    assert [t.get_text() for t in top.get_xticklabels()] == ["p<1e-300", "0.01", "0.2", "0.5"]
+    assert "asymptotic" in top.get_xlabel()
+    mc = hom.assign(pvalue_mc=[0.005, 0.02, 0.3, 0.6])
+    (top,) = plots.rate_heterogeneity(coll, homogeneity=mc).axes[1].child_axes
+    assert "Monte Carlo" in top.get_xlabel() and top.get_xticklabels()[0].get_text() == "0.005"
     with pytest.raises(ValueError, match="pvalue"):
         plots.rate_heterogeneity(coll, homogeneity=hom.rename(columns={"pvalue": "p"}))
 
