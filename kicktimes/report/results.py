@@ -125,6 +125,15 @@ def write_results(
                 f"{time.perf_counter() - t0:.0f} s.",
                 "",
             ]
+        if len(stores) > 1:
+            from kicktimes.report.pipeline import families_section
+
+            families = families_section(stores)
+            if families is not None:
+                lines += ["## All experiments, the paper's layout", ""]
+                for fname, fig, caption in families.figures:
+                    fig.savefig(out / f"{fname}.png", dpi=dpi)
+                    lines += [_md_escape(caption), "", f"![{fname}]({fname}.png)", ""]
     finally:
         pool.close()
     path = out / "README.md"
