@@ -238,3 +238,18 @@ def test_findings_section_states_the_rules_and_the_scale(ctx):
     banner = sec.blocks[0][1]
     assert "16 ICs" in banner and "smoke test" in banner
     assert any("Verdict rules" in p for p in sec.paragraphs)
+
+
+def test_sections_of_a_new_store_are_written_as_png_pdf_and_csv(ctx, tmp_path):
+    from kicktimes.report.html import write_outputs
+
+    secs = [ctx.findings] + [s for v in ctx.sections.values() for s in v]
+    page = write_outputs(secs, tmp_path, 40)
+    for name in (
+        "fig05_lyapunov_vs_radius",
+        "fig06_recurrence_rate_vs_radius",
+        "fig07b_autocorrelation_curves",
+    ):
+        assert (tmp_path / f"{name}.png").is_file() and (tmp_path / f"{name}.pdf").is_file()
+    assert (tmp_path / "findings.csv").is_file()
+    assert '<p class="banner">' in page and '<ul class="findings">' in page

@@ -93,7 +93,7 @@ def store_header(store, notes):
     )
     params = pd.DataFrame(
         [
-            (k, ", ".join(map(str, v)) if isinstance(v, list) else str(v))
+            (k, ", ".join(map(str, v)) if isinstance(v, list | tuple) else str(v))
             for k, v in exp.to_dict().items()
         ],
         columns=["parameter", "value"],

@@ -142,7 +142,7 @@ def rr_figure(rows, exp, *, radii=None, title=None):
             plain_ticks(ax.yaxis)
             if q == "rr":
                 # from 0: the paper's RR is mostly the diagonal 1/N, and the axis shows it
-                ax.set_ylim(bottom=0.0)
+                ax.set_ylim(0.0, 1.05 * ax.get_ylim()[1])
                 ax.axhline(1.0 / n, color="grey", linestyle="--", linewidth=0.8)
                 ax.text(
                     0.02,
@@ -249,7 +249,7 @@ def family_figure(stores):
             )
             plain_ticks(axes[i, j].yaxis)
             if q == "rr":
-                axes[i, j].set_ylim(bottom=0.0)
+                axes[i, j].set_ylim(0.0, 1.05 * axes[i, j].get_ylim()[1])
                 axes[i, j].axhline(1.0 / n_samples(exp), color="grey", linestyle="--", lw=0.8)
     shared_legend(fig, axes.ravel())
     return fig, (
