@@ -121,8 +121,10 @@ def rate_heterogeneity(collisions, *, homogeneity=None, rule="mirror", max_point
     )
     ax2.axhline(1.0, color="grey", linestyle=":", label="Poisson, common rate")
     ax2.set_yscale("log")
-    lo = float(np.nanmin([dispersion.min(), 1.0]))
-    hi = float(np.nanmax([dispersion.max(), 1.0]))
+    # log axis: only positive, finite dispersions set the range (0 when all counts agree)
+    shown = dispersion[np.isfinite(dispersion) & (dispersion > 0)].to_numpy()
+    lo = float(min(shown.min(), 1.0)) if shown.size else 1.0
+    hi = float(max(shown.max(), 1.0)) if shown.size else 1.0
     ax2.set_ylim(lo / 1.5, hi * 1.5)
     plain_log_ticks(ax2.yaxis)
     if homogeneity is not None:
