@@ -69,8 +69,7 @@ def _poisson(res):
     lo, hi = _clopper_pearson(k, n)
     share = f"{k}/{n} sequences ({100 * k / n:.0f} %, 95 % CI {100 * lo:.0f}-{100 * hi:.0f} %)"
     if n_cells == 0:
-        return Finding("Poisson?", "inconclusive", "No sequence has enough events for a test.",
-                       "—")
+        return Finding("Poisson?", "inconclusive", "No sequence has enough events for a test.", "—")
     if bad.empty:
         verdict = "consistent with Poisson"
         text = (
@@ -100,11 +99,14 @@ def _poisson(res):
 
 def _renewal(res):
     pooled = res.renewal_pooled
-    rule = ("best model: lowest AIC of the censored fits; decisive when the runner-up's "
-            "ΔAIC > 10, weak when < 2.")
+    rule = (
+        "best model: lowest AIC of the censored fits; decisive when the runner-up's "
+        "ΔAIC > 10, weak when < 2."
+    )
     if pooled.empty or pooled["aic"].notna().sum() == 0:
-        return Finding("Which renewal model?", "inconclusive",
-                       "No group has enough intervals for a fit.", rule)
+        return Finding(
+            "Which renewal model?", "inconclusive", "No group has enough intervals for a fit.", rule
+        )
     parts, verdicts = [], []
     for g, t in pooled.groupby("group", sort=False):
         t = t.dropna(subset=["aic"]).sort_values("aic")
@@ -113,10 +115,11 @@ def _renewal(res):
         strength = "decisive" if gap > 10 else ("weak" if gap < 2 else "clear")
         d_exp = t.loc[t["model"] == "exponential", "delta_aic"]
         label = "" if res.group is None else f"{res.group} = {g}: "
+        second = runner["model"] if runner is not None else "—"
+        d_e = float(d_exp.iloc[0]) if len(d_exp) else math.nan
         parts.append(
-            f"{label}{best['model']} ({strength}; runner-up {runner['model'] if runner is not None else '—'} "
-            f"ΔAIC = {gap:.3g}; exponential ΔAIC = {float(d_exp.iloc[0]) if len(d_exp) else math.nan:.4g}, "
-            f"{int(best['n'])} intervals)"
+            f"{label}{best['model']} ({strength}; runner-up {second} ΔAIC = {gap:.3g}; "
+            f"exponential ΔAIC = {d_e:.4g}, {int(best['n'])} intervals)"
         )
         verdicts.append(best["model"])
     top = max(set(verdicts), key=verdicts.count)
@@ -132,21 +135,33 @@ def _renewal(res):
             + f"; exponential best for {100 * k / len(per):.0f} % (95 % CI "
             f"{100 * lo:.0f}-{100 * hi:.0f} %)."
         )
-    text += (" A pooled sample mixes sequences with different rates, which alone makes it "
-             "heavier-tailed than exponential: read it with the rate heterogeneity.")
-    return Finding("Which renewal model?", f"{top} (pooled, {verdicts.count(top)}/{len(verdicts)} "
-                   "groups)", text, rule)
+    text += (
+        " A pooled sample mixes sequences with different rates, which alone makes it "
+        "heavier-tailed than exponential: read it with the rate heterogeneity."
+    )
+    return Finding(
+        "Which renewal model?",
+        f"{top} (pooled, {verdicts.count(top)}/{len(verdicts)} groups)",
+        text,
+        rule,
+    )
 
 
 def _heterogeneity(res):
     het = res.heterogeneity
     ok = het[het["n_sequences"] > 1]
     cut = res.alpha / max(len(ok), 1)
-    rule = (f"heterogeneous when the exact (Monte Carlo) Pearson p-value of a common rate is "
-            f"below alpha / groups = {cut:.3g} in some group.")
+    rule = (
+        f"heterogeneous when the exact (Monte Carlo) Pearson p-value of a common rate is "
+        f"below alpha / groups = {cut:.3g} in some group."
+    )
     if ok.empty:
-        return Finding("One rate for all sequences?", "inconclusive",
-                       "Every group has a single sequence.", rule)
+        return Finding(
+            "One rate for all sequences?",
+            "inconclusive",
+            "Every group has a single sequence.",
+            rule,
+        )
     rejected = ok[ok["pvalue_mc"] < cut]
     verdict = "heterogeneous" if len(rejected) else "consistent with one rate per group"
     text = (
@@ -163,8 +178,10 @@ def _reference(res):
     ref = res.reference
     if ref is None or ref.empty:
         return None
-    rule = ("agrees: the 95 % CI of observed / reference rate lies inside [0.9, 1.1]; differs: "
-            "the CI excludes [0.9, 1.1] entirely; inconclusive otherwise.")
+    rule = (
+        "agrees: the 95 % CI of observed / reference rate lies inside [0.9, 1.1]; differs: "
+        "the CI excludes [0.9, 1.1] entirely; inconclusive otherwise."
+    )
     verdicts, parts = [], []
     for r in ref.itertuples():
         if r.ci_low >= 0.9 and r.ci_high <= 1.1:
@@ -176,10 +193,16 @@ def _reference(res):
         verdicts.append(v)
         label = "" if res.group is None else f"{res.group} = {r.group}: "
         parts.append(f"{label}{r.ratio:.3f} [{r.ci_low:.3f}, {r.ci_high:.3f}]")
-    verdict = verdicts[0] if len(set(verdicts)) == 1 else (
-        f"{verdicts.count('agrees')}/{len(verdicts)} groups agree")
-    text = (f"Observed / reference rate ({res.reference_column}) with 95 % CI: "
-            + "; ".join(parts) + ".")
+    verdict = (
+        verdicts[0]
+        if len(set(verdicts)) == 1
+        else (f"{verdicts.count('agrees')}/{len(verdicts)} groups agree")
+    )
+    text = (
+        f"Observed / reference rate ({res.reference_column}) with 95 % CI: "
+        + "; ".join(parts)
+        + "."
+    )
     return Finding("Rate against the reference?", verdict, text, rule)
 
 
@@ -212,8 +235,10 @@ def _regressions(res):
             f"{od['pearson_dispersion']:.3g}, NB alpha = {od['alpha']:.3g} (LR p = "
             f"{_p(od['lr_pvalue'])})."
         )
-        rule = ("increases / decreases when the 95 % CI of the slope (negative binomial, or "
-                "Poisson when the NB fit has alpha = 0) excludes 0.")
+        rule = (
+            "increases / decreases when the 95 % CI of the slope (negative binomial, or "
+            "Poisson when the NB fit has alpha = 0) excludes 0."
+        )
         out.append(Finding(f"Counts against {cov}?", f"rate {verdict} with {cov}", text, rule))
     return out
 

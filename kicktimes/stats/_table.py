@@ -73,9 +73,7 @@ def _numeric(df, col, *, allow_missing=False):
     bad = np.isnan(values) & ~missing
     if bad.any():
         i = int(np.flatnonzero(bad)[0])
-        raise ValueError(
-            f"{_where(df, i)}: column {col!r} must be numeric, got {raw.iloc[i]!r}"
-        )
+        raise ValueError(f"{_where(df, i)}: column {col!r} must be numeric, got {raw.iloc[i]!r}")
     if missing.any() and not allow_missing:
         i = int(np.flatnonzero(missing)[0])
         raise ValueError(f"{_where(df, i)}: column {col!r} has a missing value")
@@ -389,11 +387,7 @@ def _check_order(df, ids, t):
         if bad.any():
             k = int(np.flatnonzero(bad.to_numpy())[0])
             i, j = int(frame["row"].iloc[k]), int(prev_row.iloc[k])
-            what = (
-                "repeats the time of"
-                if kind == "duplicate"
-                else "is earlier than the time of"
-            )
+            what = "repeats the time of" if kind == "duplicate" else "is earlier than the time of"
             raise ValueError(
                 f"{_where(df, i)}: {kind} times in sequence {ids[i]!r}: {t[i]!r} {what} "
                 f"row {j} ({t[j]!r}); times must increase strictly within a sequence"

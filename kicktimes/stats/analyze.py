@@ -255,7 +255,8 @@ def analyze(
     seqs = seqs.merge(pd.concat(seq_p), on="sequence", how="left")
     per_seq = pd.DataFrame(per_rows, columns=_RENEWAL_COLS)
     best = (
-        per_seq.loc[per_seq["delta_aic"] == 0].drop_duplicates("sequence")
+        per_seq.loc[per_seq["delta_aic"] == 0]
+        .drop_duplicates("sequence")
         .set_index("sequence")["model"]
         if not per_seq.empty
         else pd.Series(dtype=object)
@@ -344,8 +345,19 @@ def _poisson(part, g, *, alpha, n_mc, rng):
 
 # ----------------------------------------------------------------- renewal models
 
-_RENEWAL_COLS = ["group", "sequence", "model", "loglik", "k", "aic", "delta_aic", "weight",
-                 "n", "n_censored", "note"]
+_RENEWAL_COLS = [
+    "group",
+    "sequence",
+    "model",
+    "loglik",
+    "k",
+    "aic",
+    "delta_aic",
+    "weight",
+    "n",
+    "n_censored",
+    "note",
+]
 
 
 def _compare(complete, censored):
@@ -376,14 +388,13 @@ def _renewal(part, g, *, max_fits, max_pooled):
             )
             continue
         if max_fits is not None and n_fitted >= max_fits:
-            skipped.append(
-                (row.sequence, "renewal fit", f"beyond max_fits_per_group = {max_fits}")
-            )
+            skipped.append((row.sequence, "renewal fit", f"beyond max_fits_per_group = {max_fits}"))
             continue
         n_fitted += 1
         for model, t in _compare(iv.complete, iv.censored).iterrows():
-            per.append({"group": g, "sequence": row.sequence, "model": model,
-                        **{c: t[c] for c in cols}})
+            per.append(
+                {"group": g, "sequence": row.sequence, "model": model, **{c: t[c] for c in cols}}
+            )
     return per, pooled, skipped
 
 
@@ -414,9 +425,18 @@ def _reference(seqs, col):
             lo, hi = ratio * math.exp(-half), ratio * math.exp(half)
         else:
             lo, hi = 0.0, 3.688879454113936 / expected
-        rows.append({"group": g, "n_sequences": n.size, "n_events": int(total),
-                     "expected": expected, "ratio": ratio, "dispersion": phi,
-                     "ci_low": lo, "ci_high": hi})
+        rows.append(
+            {
+                "group": g,
+                "n_sequences": n.size,
+                "n_events": int(total),
+                "expected": expected,
+                "ratio": ratio,
+                "dispersion": phi,
+                "ci_low": lo,
+                "ci_high": hi,
+            }
+        )
     return pd.DataFrame(rows)
 
 
@@ -455,8 +475,9 @@ def _regressions(tab, seqs):
             linear = model == "ols" or not log
             shift = a if linear else math.log(c)
             scale = c if linear else 1.0
-            rows += _back_transform(res, cov, model, "log" if log and not linear else "linear",
-                                    shift, scale)
+            rows += _back_transform(
+                res, cov, model, "log" if log and not linear else "linear", shift, scale
+            )
         od = reg.overdispersion()
         od_rows.append({"covariate": cov, **od.to_dict()})
     cols = ["covariate", "g", "model", "term", "estimate", "stderr", "ci_low", "ci_high"]
@@ -485,9 +506,24 @@ def _back_transform(res, cov, model, g, shift, scale):
     se0 = math.sqrt(var0) if var0 >= 0 else math.nan
     b1, se1 = b[1] * scale, se[1] * scale
     return [
-        {"covariate": cov, "g": g, "model": model, "term": "intercept", "estimate": b0,
-         "stderr": se0, "ci_low": b0 - q * se0, "ci_high": b0 + q * se0},
-        {"covariate": cov, "g": g, "model": model, "term": "slope", "estimate": b1,
-         "stderr": se1, "ci_low": b1 - q * se1, "ci_high": b1 + q * se1},
+        {
+            "covariate": cov,
+            "g": g,
+            "model": model,
+            "term": "intercept",
+            "estimate": b0,
+            "stderr": se0,
+            "ci_low": b0 - q * se0,
+            "ci_high": b0 + q * se0,
+        },
+        {
+            "covariate": cov,
+            "g": g,
+            "model": model,
+            "term": "slope",
+            "estimate": b1,
+            "stderr": se1,
+            "ci_low": b1 - q * se1,
+            "ci_high": b1 + q * se1,
+        },
     ]
-
