@@ -26,6 +26,13 @@ class Finding:
     rule: str
 
 
+def _v(value):
+    """A group value for the text: numbers with 4 significant digits."""
+    if isinstance(value, int | float | np.integer | np.floating):
+        return f"{float(value):.4g}"
+    return str(value)
+
+
 def _p(p):
     if not np.isfinite(p):
         return "n/a"
@@ -80,7 +87,7 @@ def _poisson(res):
     else:
         verdict = "not Poisson"
         items = [
-            f"{r.test} ({'' if res.group is None else f'{res.group} = {r.group}: '}"
+            f"{r.test} ({'' if res.group is None else f'{res.group} = {_v(r.group)}: '}"
             f"p = {_p(r.combined_pvalue)}, {r.n_reject_fdr}/{r.n_tested} sequences after FDR)"
             for r in bad.head(4).itertuples()
         ]
@@ -114,7 +121,7 @@ def _renewal(res):
         gap = runner["delta_aic"] if runner is not None else math.inf
         strength = "decisive" if gap > 10 else ("weak" if gap < 2 else "clear")
         d_exp = t.loc[t["model"] == "exponential", "delta_aic"]
-        label = "" if res.group is None else f"{res.group} = {g}: "
+        label = "" if res.group is None else f"{res.group} = {_v(g)}: "
         second = runner["model"] if runner is not None else "—"
         d_e = float(d_exp.iloc[0]) if len(d_exp) else math.nan
         parts.append(
@@ -191,7 +198,7 @@ def _reference(res):
         else:
             v = "inconclusive"
         verdicts.append(v)
-        label = "" if res.group is None else f"{res.group} = {r.group}: "
+        label = "" if res.group is None else f"{res.group} = {_v(r.group)}: "
         parts.append(f"{label}{r.ratio:.3f} [{r.ci_low:.3f}, {r.ci_high:.3f}]")
     verdict = (
         verdicts[0]
