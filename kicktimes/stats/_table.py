@@ -80,7 +80,9 @@ def _numeric(df, col, *, allow_missing=False):
     inf = np.isinf(values)
     if inf.any():
         i = int(np.flatnonzero(inf)[0])
-        raise ValueError(f"{_where(df, i)}: column {col!r} must be finite, got {values[i]!r}")
+        raise ValueError(
+            f"{_where(df, i)}: column {col!r} must be finite, got {float(values[i])!r}"
+        )
     return values
 
 
@@ -110,8 +112,8 @@ def _per_sequence(df, ids, values, col):
     if not same.all():
         i = int(np.flatnonzero(~same)[0])
         raise ValueError(
-            f"{_where(df, i)}: column {col!r} must be constant within sequence {ids[i]!r}, "
-            f"got {values[i]!r} after {first[i]!r}"
+            f"{_where(df, i)}: column {col!r} must be constant within sequence {str(ids[i])!r}, "
+            f"got {float(values[i])!r} after {float(first[i])!r}"
         )
     out = pd.Series(values, index=ids)
     return out[~out.index.duplicated()]
@@ -272,7 +274,7 @@ def event_table(
         dup = pd.Series(wid).duplicated().to_numpy()
         if dup.any():
             i = int(np.flatnonzero(dup)[0])
-            raise ValueError(f"{_where(win, i)}: sequence {wid[i]!r} is listed twice")
+            raise ValueError(f"{_where(win, i)}: sequence {str(wid[i])!r} is listed twice")
         t0 = pd.Series(_numeric(win, start), index=wid)
         t1 = pd.Series(_numeric(win, end), index=wid)
         _check_windows(win, wid, t0.to_numpy(), t1.to_numpy(), start, end)
@@ -318,8 +320,8 @@ def event_table(
         if outside.any():
             i = int(np.flatnonzero(outside)[0])
             raise ValueError(
-                f"{_where(df, i)}: column {time!r} = {t[i]!r} lies outside the window "
-                f"[{lo[i]!r}, {hi[i]!r}] of sequence {ids[i]!r}"
+                f"{_where(df, i)}: column {time!r} = {float(t[i])!r} lies outside the window "
+                f"[{float(lo[i])!r}, {float(hi[i])!r}] of sequence {str(ids[i])!r}"
             )
         for s, idx in pd.Series(np.arange(ids.size)).groupby(ids, sort=False):
             vals = t[idx.to_numpy()]
@@ -357,9 +359,11 @@ def event_table(
             cov_values[col] = series if prev is None else prev.combine_first(series)
         if not found:
             raise ValueError(f"covariates: no table has a column {col!r}")
-    for col, series in cov_values.items():
+    for col, series in list(cov_values.items()):
         lacking = [s for s in order if s not in series.index]
-        if lacking:
+        if lacking and auto:
+            del cov_values[col]  # e.g. an event-table column, absent for empty sequences
+        elif lacking:
             raise ValueError(f"covariate {col!r} has no value for sequence {lacking[0]!r}")
         if col in _RESERVED:
             raise ValueError(f"covariate column {col!r} clashes with a reserved column name")
@@ -389,8 +393,9 @@ def _check_order(df, ids, t):
             i, j = int(frame["row"].iloc[k]), int(prev_row.iloc[k])
             what = "repeats the time of" if kind == "duplicate" else "is earlier than the time of"
             raise ValueError(
-                f"{_where(df, i)}: {kind} times in sequence {ids[i]!r}: {t[i]!r} {what} "
-                f"row {j} ({t[j]!r}); times must increase strictly within a sequence"
+                f"{_where(df, i)}: {kind} times in sequence {str(ids[i])!r}: "
+                f"{float(t[i])!r} {what} "
+                f"row {j} ({float(t[j])!r}); times must increase strictly within a sequence"
             )
     # a row without time declares an empty sequence; next to events it is a missing value
     empty_rows = np.flatnonzero(~ok)
@@ -399,7 +404,7 @@ def _check_order(df, ids, t):
         for i in empty_rows:
             if ids[i] in with_events:
                 raise ValueError(
-                    f"{_where(df, int(i))}: missing time in sequence {ids[i]!r}, which has "
+                    f"{_where(df, int(i))}: missing time in sequence {str(ids[i])!r}, which has "
                     "events (a row without time may only declare an empty sequence)"
                 )
 
@@ -409,6 +414,6 @@ def _check_windows(df, ids, a, b, start, end):
     if bad.any():
         i = int(np.flatnonzero(bad)[0])
         raise ValueError(
-            f"{_where(df, i)}: window of sequence {ids[i]!r} must satisfy {start} < {end}, "
-            f"got [{a[i]!r}, {b[i]!r}]"
+            f"{_where(df, i)}: window of sequence {str(ids[i])!r} must satisfy {start} < {end}, "
+            f"got [{float(a[i])!r}, {float(b[i])!r}]"
         )
