@@ -1,0 +1,273 @@
+r"""Number of disk-disk collisions against radius, its regressions and the kinetic theory
+(the paper's Fig. 5), and the sticky ICs whose collision rate is far above the kinetic one.
+"""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import pandas as pd
+
+from kicktimes.report._common import Section, fmt_p
+from kicktimes.report._figures import RADIUS_LABEL, check_frame, check_radii, finite, new_axes
+
+__all__ = ["counts_by_radius", "counts_vs_radius", "sticky_ics", "STICKY_FACTOR", "sections"]
+
+#: an IC is "sticky" when its disk-disk collision rate exceeds this multiple of the
+#: kinetic rate (the disks stay close together for long stretches)
+STICKY_FACTOR = 5.0
+
+
+def sticky_ics(collisions, rule="mirror", *, factor=STICKY_FACTOR) -> pd.DataFrame:
+    """Per (radius, IC): collision rate, kinetic rate and whether the IC is sticky.
+
+    Parameters
+    ----------
+    collisions : pandas.DataFrame
+        ``radius, ic, n_pp, t_window`` (a store's collision table).
+    rule : {"mirror", "elastic"}
+        Rule of the kinetic rate :func:`kicktimes.stats.kinetic_rate`.
+    factor : float
+        Threshold: sticky when ``n_pp / t_window > factor * kinetic_rate(r, rule)``.
+
+    Returns
+    -------
+    pandas.DataFrame
+        ``radius, ic, rate, kinetic_rate, rate_over_kinetic, sticky``.
+
+    Examples
+    --------
+    >>> import pandas as pd
+    >>> from kicktimes.report.counts import sticky_ics
+    >>> df = pd.DataFrame({"radius": [0.01, 0.01], "ic": [0, 1], "n_pp": [10, 400],
+    ...                    "t_window": [1000.0, 1000.0]})
+    >>> sticky_ics(df)["sticky"].tolist()
+    [False, True]
+    """
+    from kicktimes import stats
+
+    df = check_frame("collisions", collisions, ["radius", "ic", "n_pp", "t_window"])
+    out = df[["radius", "ic"]].copy()
+    out["rate"] = df["n_pp"].to_numpy(float) / df["t_window"].to_numpy(float)
+    out["kinetic_rate"] = stats.kinetic_rate(df["radius"].to_numpy(float), rule)
+    out["rate_over_kinetic"] = out["rate"] / out["kinetic_rate"]
+    out["sticky"] = out["rate_over_kinetic"] > factor
+    return out.reset_index(drop=True)
+
+
+# ------------------------------------------------------------- counts vs radius
+
+
+def counts_by_radius(collisions) -> pd.DataFrame:
+    """Per radius: ``n_ics``, ``mean_count``, ``std_count``, ``sem``, ``mean_t_window``.
+
+    ``collisions`` has one row per (radius, IC) with ``radius``, ``n_pp``, ``t_window``.
+    """
+    df = check_frame("collisions", collisions, ["radius", "n_pp", "t_window"])
+    check_radii("collisions['radius']", df["radius"])
+    n_pp = finite("collisions['n_pp']", df["n_pp"])
+    if (n_pp < 0).any():
+        raise ValueError("collisions['n_pp'] must be non-negative")
+    if (finite("collisions['t_window']", df["t_window"]) <= 0).any():
+        raise ValueError("collisions['t_window'] must be positive")
+    g = df.groupby("radius")
+    out = pd.DataFrame(
+        {
+            "n_ics": g.size(),
+            "mean_count": g["n_pp"].mean(),
+            "std_count": g["n_pp"].std(ddof=1),
+            "mean_t_window": g["t_window"].mean(),
+        }
+    )
+    out["sem"] = out["std_count"] / np.sqrt(out["n_ics"])
+    return out
+
+
+def counts_vs_radius(collisions, regression=None, *, rule="mirror", ax=None):
+    r"""Mean number of disk-disk collisions against radius, with the fitted curves.
+
+    Parameters
+    ----------
+    collisions : pandas.DataFrame
+        One row per (radius, IC): ``radius``, ``n_pp`` (collision count) and
+        ``t_window`` (observation time of that run).
+    regression : CountRegression, optional
+        From :func:`kicktimes.stats.regress_counts` on the same data (computed with
+        ``rule`` when omitted).
+    rule : {"mirror", "elastic"}
+        Collision rule of the kinetic-theory curve (the regression's rule wins when it
+        has one).
+    ax : matplotlib Axes, optional
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Means ± s.e.m. over ICs; the paper's least-squares line, the Poisson and
+        negative-binomial regressions (``log E[N] = b0 + b1 g(r) + log T``) and the
+        kinetic rate :math:`\Gamma(r)\,T`, every curve evaluated at the mean window
+        :math:`\bar T(r)` of each radius (linearly interpolated between radii).
+    """
+    from kicktimes import stats
+
+    table = counts_by_radius(collisions)
+    if regression is None:
+        frame = collisions[["radius", "n_pp", "t_window"]].rename(columns={"n_pp": "count"})
+        regression = stats.regress_counts(frame, rule=rule)
+    elif not hasattr(regression, "predict") or not hasattr(regression, "negbin"):
+        raise TypeError(
+            f"regression must be a CountRegression (stats.regress_counts), got "
+            f"{type(regression).__name__}"
+        )
+    r = table.index.to_numpy()
+    grid = np.linspace(r.min(), r.max(), 200) if r.size > 1 else r
+    t_grid = np.interp(grid, r, table["mean_t_window"].to_numpy())
+    pred = regression.predict(grid, t_window=t_grid)
+    kinetic_rule = regression.rule or rule
+    kinetic = stats.kinetic_rate(grid, kinetic_rule) * t_grid
+    fig, ax = new_axes(ax, (6.0, 4.4))
+    ax.errorbar(
+        r,
+        table["mean_count"],
+        yerr=table["sem"],
+        linestyle="none",
+        marker="o",
+        color="black",
+        capsize=3,
+        label="mean over ICs ± s.e.m.",
+    )
+    ax.plot(grid, pred["ols"], color="tab:red", label="least-squares line (paper)")
+    ax.plot(grid, pred["poisson"], color="tab:green", linestyle="--", label="Poisson regression")
+    ax.plot(
+        grid,
+        pred["negbin"],
+        color="tab:purple",
+        linestyle="-.",
+        label=f"negative binomial (α = {regression.alpha:.3g})",
+    )
+    ax.plot(
+        grid, kinetic, color="grey", linestyle=":", label=f"kinetic theory Γ(r)·T ({kinetic_rule})"
+    )
+    ax.set_xlabel(RADIUS_LABEL)
+    ax.set_ylabel("disk-disk collisions per run (count)")
+    ax.set_title("Mean number of disk-disk collisions")
+    ax.legend(fontsize="small")
+    return fig
+
+
+def sections(ctx):
+    """Counts per radius, their regressions, over-dispersion and sticky ICs."""
+    from kicktimes import stats
+
+    exp, coll = ctx.exp, ctx.store.collisions
+    table = counts_by_radius(coll)
+    grouped = coll.groupby("radius")
+    table["pooled_rate"] = grouped["n_pp"].sum() / grouped["t_window"].sum()
+    table["kinetic_rate"] = stats.kinetic_rate(table.index.to_numpy(), exp.rule)
+    table["rate_over_kinetic"] = table["pooled_rate"] / table["kinetic_rate"]
+    table["dispersion_index"] = grouped["n_pp"].var(ddof=1) / grouped["n_pp"].mean()
+    sticky = sticky_ics(coll, exp.rule)
+    ctx.found["sticky"] = sticky
+    table["n_sticky"] = sticky.groupby("radius")["sticky"].sum().astype(int)
+    sec = Section("counts", "Number of disk-disk collisions against radius")
+    sec.table("counts_by_radius", table.reset_index(), "Counts per radius")
+    sec.table("sticky_ics", sticky[sticky["sticky"]], "Sticky ICs", show=False)
+    n_sticky = int(sticky["sticky"].sum())
+    sec.text(
+        f"Sticky ICs (collision rate above {STICKY_FACTOR:g} × the kinetic rate Γ(r), "
+        f"{exp.rule} rule): {n_sticky} of {len(sticky)} (radius, IC) runs"
+        + (
+            " ("
+            + ", ".join(f"{int(k)} at r = {r:g}" for r, k in table["n_sticky"].items() if k > 0)
+            + "); they are flagged in the recurrence and autocorrelation tables, which give "
+            "medians beside the means because a few such runs can move a mean."
+            if n_sticky
+            else "."
+        )
+    )
+    if coll["radius"].nunique() < 2:
+        sec.text("One radius only: no regression on radius.")
+        return [sec]
+    frame = coll[["radius", "n_pp", "t_window"]].rename(columns={"n_pp": "count"})
+    with warnings.catch_warnings():
+        # two radii leave the line no residual degree of freedom: its standard errors
+        # are undefined (NaN in the table), which statsmodels warns about
+        warnings.simplefilter("ignore", RuntimeWarning)
+        reg = stats.regress_counts(frame, rule=exp.rule)
+        coef = reg.coefficients()
+        od = reg.overdispersion()
+    sec.figure(
+        "fig04_counts_vs_radius",
+        counts_vs_radius(coll, reg, rule=exp.rule),
+        "Mean number of disk-disk collisions per run against radius (± s.e.m. over ICs) with "
+        "the paper's least-squares line, Poisson and negative-binomial regressions and the "
+        f"kinetic-theory count Γ(r)·T ({exp.rule} rule), curves at the mean window T(r).",
+    )
+    b1 = coef.loc[("negbin", reg.covariate)]
+    sec.text(
+        f"Least-squares line of the pooled rate on r: slope {reg.ols.params[1]:.4g} per unit r "
+        f"per time unit, R² = {reg.ols.rsquared:.4f} over {len(table)} radii. Counts are "
+        + ("over-dispersed" if od["lr_pvalue"] < 0.05 else "not significantly over-dispersed")
+        + f" across ICs: Poisson Pearson dispersion {od['pearson_dispersion']:.3g}, "
+        f"negative-binomial α = {od['alpha']:.3g} (LR test of α = 0: p = "
+        f"{fmt_p(od['lr_pvalue'])}); AIC Poisson {reg.poisson.aic:.6g} vs negative binomial "
+        f"{reg.negbin.aic:.6g}. The negative-binomial exponent of r is {b1['estimate']:.3f} "
+        f"(95% CI {b1['ci_low']:.3f} to {b1['ci_high']:.3f}; kinetic theory: about 1). The "
+        f"pooled rate is {table['rate_over_kinetic'].min():.3g} to "
+        f"{table['rate_over_kinetic'].max():.3g} times the kinetic-theory rate "
+        f"(the {exp.ic_method} ICs are "
+        + (
+            "drawn from the invariant measure, so the ratio should be 1)."
+            if exp.ic_method == "uniform"
+            else "not from the invariant measure, so the ratio need not be 1)."
+        )
+    )
+    sec.table("count_regression", coef.reset_index(), "Count regressions (coefficients)")
+    sec.table(
+        "count_overdispersion",
+        od.to_frame("value").reset_index(names="quantity"),
+        "Over-dispersion",
+    )
+    ctx.found["count_regression"] = reg
+    return [sec]
+
+
+def effects(ctx):
+    """Observed disk-disk collision counts over the kinetic-theory counts Γ(r)·T."""
+    from kicktimes import stats
+    from kicktimes.report.effects import RATIO_RULE, Effect, paired_ratio, ratio_verdict
+
+    coll = ctx.store.collisions.set_index(["radius", "ic"])
+    r = coll.index.get_level_values("radius").to_numpy(float)
+    expected = stats.kinetic_rate(r, ctx.exp.rule) * coll["t_window"].to_numpy(float)
+    per_r, tot = paired_ratio(
+        coll["n_pp"].astype(float),
+        pd.Series(expected, index=coll.index),
+        rng=ctx.rng(3, 20),
+        n_boot=ctx.n_boot,
+    )
+    sticky = ctx.found.get("sticky")
+    n_sticky = int(sticky["sticky"].sum()) if sticky is not None else 0
+    return [
+        Effect(
+            question="Collision counts against kinetic theory",
+            system="",
+            quantity=f"ratio ΣN / Σ Γ(r)T ({ctx.exp.rule} rule, averaged over radii)",
+            estimate=tot["ratio"],
+            ci_low=tot["ci_low"],
+            ci_high=tot["ci_high"],
+            verdict=ratio_verdict(tot["ci_low"], tot["ci_high"], ctx.tolerance),
+            rule=RATIO_RULE.format(t=ctx.tolerance),
+            method=f"bootstrap over {tot['n_ics']} ICs",
+            detail=(
+                f"per-radius ratio {per_r['ratio'].min():.3g} to {per_r['ratio'].max():.3g}; "
+                f"{n_sticky} sticky runs (rate > {STICKY_FACTOR:g} Γ); ICs are "
+                + (
+                    "drawn from the invariant measure"
+                    if ctx.exp.ic_method == "uniform"
+                    else f"{ctx.exp.ic_method} ICs, not the invariant measure, so the ratio "
+                    "need not be 1"
+                )
+            ),
+        )
+    ]

@@ -1,0 +1,225 @@
+r"""Effect sizes with 95 % confidence intervals and the verdict rules of the Findings.
+
+Every comparison of the report is a ratio (a kicked system over the two-particle system,
+or an observed rate over the kinetic rate) with a 95 % confidence interval, and every
+verdict follows one printed rule (:data:`RATIO_RULE`, :data:`SHARE_RULE`), so no verdict
+is typed by hand.
+
+The bootstrap resamples initial conditions: the same IC index is the same initial
+condition in every system and at every radius (the paper's design), so one resample of IC
+indices is applied to all systems and radii at once (a paired, clustered bootstrap).
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+
+__all__ = [
+    "Effect",
+    "RATIO_RULE",
+    "SHARE_RULE",
+    "BUILT_IN",
+    "ratio_verdict",
+    "share_verdict",
+    "paired_ratio",
+    "clopper_pearson",
+]
+
+#: how a ratio's verdict is decided, with ``{t}`` the tolerance
+RATIO_RULE = (
+    "agrees: the 95 % CI of the ratio lies inside [1 − {t:g}, 1 + {t:g}]; differs: the CI "
+    "lies entirely outside that band; inconclusive otherwise"
+)
+#: how a share's verdict is decided against a reference level ``{level}``
+SHARE_RULE = (
+    "above: the 95 % CI of the share lies above {level:g}; below: it lies below {level:g}; "
+    "inconclusive: it contains {level:g}"
+)
+#: appended to a verdict whose agreement is guaranteed by how the kicked system is built
+BUILT_IN = "built in"
+
+
+@dataclass(frozen=True)
+class Effect:
+    """One finding: an effect size, its 95 % CI, how the CI was computed and the verdict.
+
+    Attributes
+    ----------
+    question : str
+        The question answered (e.g. ``"FTLE"``).
+    system : str
+        The kicked system compared with the two-particle one, or ``""``.
+    quantity : str
+        What ``estimate`` is (e.g. ``"ratio of means, kicked / two-particle"``).
+    estimate, ci_low, ci_high : float
+        The effect and its 95 % confidence interval.
+    verdict : str
+        From the printed rule; ``"… (built in)"`` when the agreement holds by construction.
+    rule : str
+        The rule that turned the interval into the verdict.
+    method : str
+        How the interval was computed.
+    detail : str
+        The supporting numbers (per radius, medians, predictions).
+    """
+
+    question: str
+    system: str
+    quantity: str
+    estimate: float
+    ci_low: float
+    ci_high: float
+    verdict: str
+    rule: str
+    method: str
+    detail: str = ""
+
+    def statement(self) -> str:
+        """One sentence: question, effect, CI and verdict."""
+        from kicktimes.report._figures import system_label
+
+        who = f", {system_label(self.system)} vs two-particle" if self.system else ""
+        ci = (
+            f" (95 % CI {_g(self.ci_low)} to {_g(self.ci_high)}, {self.method})"
+            if np.isfinite(self.ci_low)
+            else ""
+        )
+        return f"{self.question}{who}: {self.quantity} {_g(self.estimate)}{ci}: {self.verdict}."
+
+
+def _g(x):
+    return "n/a" if not np.isfinite(x) else f"{x:.3g}"
+
+
+def ratio_verdict(low, high, tolerance=0.1):
+    """``agrees``/``differs``/``inconclusive`` for a ratio's CI (:data:`RATIO_RULE`).
+
+    >>> ratio_verdict(0.95, 1.04), ratio_verdict(0.3, 0.4), ratio_verdict(0.85, 1.0)
+    ('agrees', 'differs', 'inconclusive')
+    """
+    if not (np.isfinite(low) and np.isfinite(high)):
+        return "inconclusive"
+    if low >= 1 - tolerance and high <= 1 + tolerance:
+        return "agrees"
+    if high < 1 - tolerance or low > 1 + tolerance:
+        return "differs"
+    return "inconclusive"
+
+
+def share_verdict(low, high, level):
+    """``above``/``below``/``inconclusive`` for a share's CI against ``level``."""
+    if not (np.isfinite(low) and np.isfinite(high)):
+        return "inconclusive"
+    if low > level:
+        return "above"
+    if high < level:
+        return "below"
+    return "inconclusive"
+
+
+def clopper_pearson(k, n, level=0.95):
+    """Exact binomial interval of ``k`` successes in ``n`` trials (NaN when n = 0)."""
+    from scipy import stats as sps
+
+    if n <= 0:
+        return math.nan, math.nan
+    a = 1 - level
+    low = 0.0 if k == 0 else float(sps.beta.ppf(a / 2, k, n - k + 1))
+    high = 1.0 if k == n else float(sps.beta.ppf(1 - a / 2, k + 1, n - k))
+    return low, high
+
+
+def _matrix(frame, column, radii, ics):
+    return frame[column].unstack("ic").reindex(index=radii, columns=ics).to_numpy(float)
+
+
+def paired_ratio(numerator, denominator, *, rng, n_boot=2000, level=0.95):
+    r"""Ratio of ensemble means per radius and averaged over radii, with bootstrap CIs.
+
+    Parameters
+    ----------
+    numerator, denominator : pandas.Series
+        Indexed by ``(radius, ic)``; a pair enters where both are finite.
+    rng : numpy.random.Generator
+        The bootstrap's stream (seeded by the caller: the report is deterministic).
+    n_boot : int
+        Bootstrap resamples of the IC indices.
+    level : float
+        Confidence level of the percentile intervals.
+
+    Returns
+    -------
+    (pandas.DataFrame, dict)
+        Per radius ``radius, n_pairs, ratio, ci_low, ci_high`` and the overall
+        ``{"ratio", "ci_low", "ci_high", "n_ics", "n_radii"}``.
+
+    Notes
+    -----
+    Per radius :math:`\rho_r = \sum_i x_{ri} / \sum_i y_{ri}` over the paired ICs; overall
+    :math:`\bar\rho = \frac{1}{R}\sum_r \rho_r` (each radius weighs the same). One
+    bootstrap resample draws IC indices with replacement and applies them at every
+    radius, so the correlation of one IC across radii is kept.
+
+    Examples
+    --------
+    >>> import numpy as np, pandas as pd
+    >>> idx = pd.MultiIndex.from_product([[0.01, 0.02], range(50)], names=["radius", "ic"])
+    >>> y = pd.Series(np.random.default_rng(0).uniform(1, 2, 100), index=idx)
+    >>> per_radius, overall = paired_ratio(0.5 * y, y, rng=np.random.default_rng(1))
+    >>> round(overall["ratio"], 12), round(overall["ci_high"], 12)
+    (0.5, 0.5)
+    """
+    frame = pd.concat({"x": numerator, "y": denominator}, axis=1)
+    radii = np.sort(frame.index.get_level_values("radius").unique().to_numpy())
+    ics = np.sort(frame.index.get_level_values("ic").unique().to_numpy())
+    x, y = _matrix(frame, "x", radii, ics), _matrix(frame, "y", radii, ics)
+    ok = np.isfinite(x) & np.isfinite(y)
+    x, y = np.where(ok, x, 0.0), np.where(ok, y, 0.0)
+    n = ics.size
+    counts = rng.multinomial(n, np.full(n, 1.0 / n), size=n_boot).astype(float)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        point = x.sum(axis=1) / y.sum(axis=1)
+        boot = (counts @ x.T) / (counts @ y.T)  # (n_boot, n_radii)
+    point = np.where(ok.any(axis=1), point, np.nan)
+    a = (1 - level) / 2 * 100
+    usable = np.isfinite(point)
+    finite_boot = np.where(np.isfinite(boot), boot, np.nan)
+    low = high = np.full(radii.size, np.nan)
+    if n_boot:
+        with warnings.catch_warnings():
+            # a radius without any usable resample gives an all-NaN column: its CI is NaN
+            warnings.simplefilter("ignore", RuntimeWarning)
+            low = np.nanpercentile(finite_boot, a, axis=0)
+            high = np.nanpercentile(finite_boot, 100 - a, axis=0)
+    per_radius = pd.DataFrame(
+        {
+            "radius": radii,
+            "n_pairs": ok.sum(axis=1),
+            "ratio": point,
+            "ci_low": low,
+            "ci_high": high,
+        }
+    )
+    if not usable.any():
+        return per_radius, {
+            "ratio": math.nan,
+            "ci_low": math.nan,
+            "ci_high": math.nan,
+            "n_ics": n,
+            "n_radii": 0,
+        }
+    overall_boot = boot[:, usable].mean(axis=1)
+    overall_boot = overall_boot[np.isfinite(overall_boot)]
+    overall = {
+        "ratio": float(point[usable].mean()),
+        "ci_low": float(np.percentile(overall_boot, a)) if overall_boot.size else math.nan,
+        "ci_high": float(np.percentile(overall_boot, 100 - a)) if overall_boot.size else math.nan,
+        "n_ics": n,
+        "n_radii": int(usable.sum()),
+    }
+    return per_radius, overall

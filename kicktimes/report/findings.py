@@ -1,0 +1,96 @@
+r"""The Findings: one computed statement per question, with its effect size, 95 % CI and
+verdict, opening the report (and ``docs/results/``).
+
+Questions, in order: are the collision times Poisson; which renewal model; do the counts
+follow kinetic theory; and, for every kicked system against the two-particle system, the
+FTLE, the off-diagonal recurrence rate and DET at each ε, and the lag-1 autocorrelation
+(whose agreement is built in). Each section module provides its own ``effects(ctx)``;
+this module only gathers them, states the rules and the scale.
+"""
+
+from __future__ import annotations
+
+import pandas as pd
+
+from kicktimes.report import autocorrelation, counts, lyapunov, poisson, recurrence, renewal
+from kicktimes.report._common import PAPER_SCALE, Section, is_paper_scale
+from kicktimes.report.effects import BUILT_IN, RATIO_RULE, SHARE_RULE
+
+__all__ = ["collect", "scale_statement", "section", "EFFECT_MODULES"]
+
+#: the modules whose ``effects(ctx)`` make the Findings, in the order of the questions
+EFFECT_MODULES = (poisson, renewal, counts, lyapunov, recurrence, autocorrelation)
+
+
+def collect(ctx):
+    """Every module's effects, in question order."""
+    out = []
+    for module in EFFECT_MODULES:
+        out += module.effects(ctx)
+    return out
+
+
+def scale_statement(store):
+    """``(is_paper_scale, sentence)`` describing the store's size."""
+    exp = store.experiment
+    coll = store.collisions
+    per_ic = coll.groupby("radius")["n_pp"].mean()
+    r0 = float(per_ic.index.min())
+    text = (
+        f"{exp.name}: {exp.n_ics} ICs × {len(exp.radii)} radii, {exp.n_steps} steps of "
+        f"τ = {exp.tau:g}; {per_ic.loc[r0]:.3g} disk-disk collisions per IC at r = {r0:g} "
+        f"({per_ic.max():.3g} at most)"
+    )
+    return is_paper_scale(exp), text
+
+
+def rules_text(ctx):
+    return (
+        "Verdict rules. Ratios (kicked / two-particle, observed / kinetic): "
+        + RATIO_RULE.format(t=ctx.tolerance)
+        + ". Shares (of rejections against α, of fitted ICs against 1/2): "
+        + SHARE_RULE.format(level=0.5).replace("0.5", "the level")
+        + ". Ratios average the per-radius ratios of ensemble means; their CIs come from "
+        f"{ctx.n_boot} bootstrap resamples of the IC indices (seeded from the experiment's "
+        "seed, one resample applied to all systems and radii). "
+        f"'{BUILT_IN}' marks agreement the kicked system has by construction (kick rate = "
+        "collision rate): it is not a confirmation."
+    )
+
+
+def section(ctx):
+    """The Findings section of one store, and its effects as a table."""
+    effects = collect(ctx)
+    paper, scale = scale_statement(ctx.store)
+    sec = Section("findings", f"Findings: {ctx.exp.name}")
+    if not paper:
+        sec.banner(
+            f"Below paper scale: {scale}. The paper's smaller family has {PAPER_SCALE['n_ics']} "
+            f"ICs and {PAPER_SCALE['n_steps']}+ steps. The quick scale (20 ICs, a few "
+            "collisions per IC) is a smoke test: its numbers check the pipeline, its verdicts "
+            "are not evidence."
+        )
+    else:
+        sec.text(f"Scale: {scale}.")
+    sec.bullets(e.statement() + (f" ({e.detail}.)" if e.detail else "") for e in effects)
+    sec.text(rules_text(ctx))
+    table = pd.DataFrame(
+        [
+            {
+                "question": e.question,
+                "system": e.system,
+                "quantity": e.quantity,
+                "estimate": e.estimate,
+                "ci_low": e.ci_low,
+                "ci_high": e.ci_high,
+                "verdict": e.verdict,
+                "method": e.method,
+                "rule": e.rule,
+                "detail": e.detail,
+            }
+            for e in effects
+        ]
+    )
+    sec.table("findings", table, "Findings (effect, 95 % CI, verdict)", show=False)
+    ctx.found["effects"] = effects
+    return sec

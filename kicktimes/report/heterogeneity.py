@@ -1,0 +1,188 @@
+r"""Collision rates across ICs: per-IC rates, the index of dispersion and the test of a
+common rate (the Monte Carlo p-value, the one the text promises)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pandas as pd
+from matplotlib.figure import Figure
+
+from kicktimes.report._common import Section, fmt
+from kicktimes.report._figures import RADIUS_LABEL, check_frame, plain_log_ticks
+from kicktimes.report.counts import counts_by_radius
+
+__all__ = ["rate_heterogeneity", "sections"]
+
+
+def rate_heterogeneity(collisions, *, homogeneity=None, rule="mirror", max_points=4000):
+    r"""Collision rates across ICs: per-IC rates and their dispersion, per radius.
+
+    Parameters
+    ----------
+    collisions : pandas.DataFrame
+        One row per (radius, IC): ``radius``, ``n_pp``, ``t_window``.
+    homogeneity : pandas.DataFrame, optional
+        Indexed or keyed by ``radius`` with a column ``pvalue_mc`` (used when present)
+        or ``pvalue``: the p-value of the test that every IC at that radius has the same
+        rate (the Pearson dispersion test of
+        :func:`kicktimes.stats.test_poisson_ensemble`); printed on top of panel (b).
+    rule : {"mirror", "elastic"}
+        Rule of the kinetic-theory rate.
+    max_points : int
+        At most this many per-IC points are drawn per radius (every k-th IC in index
+        order; the summaries use all).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        (a) per-IC rates ``n_pp / t_window`` (log axis; ICs without collisions at the
+        bottom edge as ▽), the pooled rate :math:`\sum N / \sum T`, the median and the
+        kinetic rate; (b) the index of dispersion of the counts, variance / mean
+        (1 for a common Poisson rate and equal windows), with the p-values.
+    """
+    from kicktimes import stats
+
+    df = check_frame("collisions", collisions, ["radius", "n_pp", "t_window"])
+    table = counts_by_radius(df)
+    if isinstance(max_points, bool) or not isinstance(max_points, int) or max_points < 1:
+        raise ValueError(f"max_points must be a positive integer, got {max_points!r}")
+    rate = df["n_pp"].to_numpy(float) / df["t_window"].to_numpy(float)
+    positive = rate[rate > 0]
+    floor = 0.5 * positive.min() if positive.size else 1e-6
+    fig = Figure(figsize=(11.0, 4.4), layout="constrained")
+    ax1, ax2 = fig.subplots(1, 2)
+    radii = table.index.to_numpy()
+    jitter = 0.25 * (np.min(np.diff(radii)) if radii.size > 1 else 0.004)
+    rng = np.random.default_rng(0)  # jitter only: the figure is reproducible
+    zero_labelled = False
+    for k, r in enumerate(radii):
+        sel = np.flatnonzero(df["radius"].to_numpy() == r)
+        sel = sel[:: max(1, math.ceil(sel.size / max_points))]
+        y = rate[sel]
+        x = r + rng.uniform(-jitter, jitter, sel.size)
+        lab = "per-IC rate" if k == 0 else None
+        ax1.plot(
+            x[y > 0],
+            y[y > 0],
+            linestyle="none",
+            marker=".",
+            markersize=2,
+            alpha=0.4,
+            color="tab:blue",
+            label=lab,
+            rasterized=True,
+        )
+        if (y == 0).any():
+            ax1.plot(
+                x[y == 0],
+                np.full((y == 0).sum(), floor),
+                linestyle="none",
+                marker="v",
+                markersize=3,
+                color="tab:red",
+                label=None if zero_labelled else "IC without collisions (at the floor)",
+            )
+            zero_labelled = True
+    grouped = df.groupby("radius")
+    pooled = grouped["n_pp"].sum() / grouped["t_window"].sum()
+    median = pd.Series(rate, index=df.index).groupby(df["radius"]).median()
+    ax1.plot(pooled.index, pooled.to_numpy(), marker="o", color="black", label="pooled ΣN/ΣT")
+    ax1.plot(
+        median.index,
+        median.to_numpy(),
+        marker="_",
+        markersize=12,
+        linestyle="none",
+        color="tab:green",
+        label="median over ICs",
+    )
+    grid = np.linspace(radii.min(), radii.max(), 100) if radii.size > 1 else radii
+    ax1.plot(
+        grid,
+        stats.kinetic_rate(grid, rule),
+        color="grey",
+        linestyle=":",
+        label=f"kinetic theory Γ(r) ({rule})",
+    )
+    ax1.set_yscale("log")
+    ax1.set_xlabel(RADIUS_LABEL)
+    ax1.set_ylabel("disk-disk collision rate (1 / time unit)")
+    ax1.set_title("(a) rates of the individual ICs")
+    ax1.legend(fontsize="x-small")
+    dispersion = grouped["n_pp"].var(ddof=1) / grouped["n_pp"].mean()
+    ax2.plot(
+        dispersion.index.to_numpy(),
+        dispersion.to_numpy(),
+        marker="o",
+        color="black",
+        label="variance / mean of counts",
+    )
+    ax2.axhline(1.0, color="grey", linestyle=":", label="Poisson, common rate")
+    ax2.set_yscale("log")
+    lo = float(np.nanmin([dispersion.min(), 1.0]))
+    hi = float(np.nanmax([dispersion.max(), 1.0]))
+    ax2.set_ylim(lo / 1.5, hi * 1.5)
+    plain_log_ticks(ax2.yaxis)
+    if homogeneity is not None:
+        hom = homogeneity
+        if not isinstance(hom, pd.DataFrame):
+            raise TypeError(f"homogeneity must be a DataFrame, got {type(hom).__name__}")
+        if "radius" in hom.columns:
+            hom = hom.set_index("radius")
+        column = "pvalue_mc" if "pvalue_mc" in hom.columns else "pvalue"
+        if column not in hom.columns:
+            raise ValueError("homogeneity must have a column 'pvalue' or 'pvalue_mc'")
+        p = hom[column].reindex(dispersion.index)
+        # the p-values go on a second x axis on top, one per radius: never over a marker
+        top = ax2.secondary_xaxis("top")
+        top.set_xticks(
+            dispersion.index.to_numpy(),
+            ["p<1e-300" if v == 0 else ("" if not np.isfinite(v) else f"{v:.2g}") for v in p],
+            rotation=90,
+            fontsize="x-small",
+        )
+        top.set_xlabel(
+            "p of a common rate ("
+            + ("Monte Carlo" if column == "pvalue_mc" else "asymptotic")
+            + ")",
+            fontsize="small",
+        )
+    ax2.set_xlabel(RADIUS_LABEL)
+    ax2.set_ylabel("index of dispersion of counts across ICs")
+    ax2.set_title("(b) over-dispersion")
+    ax2.legend(fontsize="x-small")
+    plain_log_ticks(ax1.yaxis)
+    return fig
+
+
+def sections(ctx):
+    """Rate heterogeneity, from the homogeneity tests the Poisson section ran."""
+    exp = ctx.exp
+    het = ctx.found.get("homogeneity")
+    if het is None or het.empty:
+        return []
+    alpha, n_mc = ctx.alpha, ctx.n_mc
+    sec = Section("heterogeneity", "Rate heterogeneity across ICs")
+    sec.figure(
+        "fig10_rate_heterogeneity",
+        rate_heterogeneity(ctx.store.collisions, homogeneity=het, rule=exp.rule),
+        "(a) Disk-disk collision rate n_pp / t_window of every IC, the pooled and median rates "
+        f"and the kinetic rate ({exp.rule}); (b) index of dispersion of the counts across ICs; "
+        "on top, the Monte Carlo p-value of the Pearson test of a common rate (given the total).",
+    )
+    sec.text(
+        f"A common rate across ICs is rejected at α = {alpha:g} at "
+        f"{int((het['pvalue_mc'] < alpha).sum())}/{len(het)} radii (Pearson χ² given the total, "
+        f"Monte Carlo p-value at resolution 1/{n_mc + 1}; the asymptotic χ² p-value, in the "
+        f"table, rejects at {int((het['pvalue'] < alpha).sum())}); the index of dispersion of "
+        f"the counts ranges from {fmt(het['dispersion_index'].min())} to "
+        f"{fmt(het['dispersion_index'].max())} (1 for a common Poisson rate); "
+        f"{int(het['n_flagged_fdr'].sum())} (IC, radius) pairs have a rate incompatible with "
+        "the pooled one after FDR control. The median per-IC rate is "
+        f"{fmt((het['median_rate'] / het['kinetic_rate']).min())} to "
+        f"{fmt((het['median_rate'] / het['kinetic_rate']).max())} times the kinetic rate."
+    )
+    sec.table("rate_homogeneity", het, "Rate homogeneity per radius")
+    return [sec]

@@ -1,0 +1,111 @@
+"""Writing the report: figures (PNG + PDF), tables (CSV), and the HTML of the sections."""
+
+from __future__ import annotations
+
+import base64
+import html
+import os
+from pathlib import Path
+
+import pandas as pd
+
+from kicktimes import __version__
+
+__all__ = ["write_outputs", "store_header", "table_html", "CSS"]
+
+#: 4 significant figures in every HTML table (the CSV files keep full precision)
+_FLOAT = "{:.4g}".format
+
+CSS = """
+body{font-family:sans-serif;max-width:70em;margin:2em auto;padding:0 1em;color:#222}
+h1{font-size:1.6em}h2{font-size:1.25em;border-bottom:1px solid #ccc;margin-top:2em}
+table.dataframe{border-collapse:collapse;font-size:.8em;margin:.5em 0 1em}
+table.dataframe td,table.dataframe th{border:1px solid #ccc;padding:2px 6px;text-align:right}
+figure{margin:1em 0}figure img{max-width:100%}figcaption{font-size:.9em;color:#444}
+.meta td{padding:1px 8px;vertical-align:top}.note{background:#fff6dd;padding:.5em}
+.banner{background:#ffe3e3;border:1px solid #d66;padding:.6em;font-weight:bold}
+.table-wrap{overflow-x:auto;max-width:100%;max-height:32em;overflow-y:auto}
+ul.findings li{margin:.3em 0}
+"""
+
+
+def table_html(df):
+    """A table with 4 significant figures in a scrollable container (wide tables scroll
+    instead of stretching the page)."""
+    inner = df.to_html(index=False, float_format=_FLOAT, na_rep="NaN", border=0)
+    return f'<div class="table-wrap">{inner}</div>'
+
+
+def write_outputs(sections, out, dpi, prefix=""):
+    """Save figures (PNG + PDF) and tables (CSV); return the HTML of the sections."""
+    body = []
+    for sec in sections:
+        body.append(f'<h3 id="{prefix}{sec.key}">{html.escape(sec.title)}</h3>')
+        for name, fig, caption in sec.figures:
+            name = prefix + name
+            fig.savefig(out / f"{name}.png", dpi=dpi)
+            fig.savefig(out / f"{name}.pdf")
+            data = base64.b64encode((out / f"{name}.png").read_bytes()).decode("ascii")
+            body.append(
+                f'<figure><img alt="{html.escape(name)}" src="data:image/png;base64,{data}">'
+                f'<figcaption>{html.escape(caption)} Files: <a href="{name}.png">PNG</a>, '
+                f'<a href="{name}.pdf">PDF</a>.</figcaption></figure>'
+            )
+        for kind, block in sec.blocks:
+            if kind == "banner":
+                body.append(f'<p class="banner">{html.escape(block)}</p>')
+            elif kind == "ul":
+                items = "".join(f"<li>{html.escape(item)}</li>" for item in block)
+                body.append(f'<ul class="findings">{items}</ul>')
+            else:
+                body.append(f"<p>{html.escape(block)}</p>")
+        for name, df, title, show in sec.tables:
+            name = prefix + name
+            df.to_csv(out / f"{name}.csv", index=False)
+            link = f'<a href="{name}.csv">{name}.csv</a>'
+            if show:
+                body.append(f"<h4>{html.escape(title)} ({link})</h4>{table_html(df)}")
+            else:
+                body.append(f"<p>{html.escape(title)}: {link} ({len(df)} rows).</p>")
+        sec.figures.clear()  # drop the Figure objects: nothing stays alive
+    return "\n".join(body)
+
+
+def store_header(store, notes):
+    """Metadata of one store and its experiment: (HTML, parameter table)."""
+    exp = store.experiment
+    man = store.manifest
+    meta = [
+        ("experiment", f"{exp.name} (hash {man.get('experiment_hash', exp.hash())})"),
+        ("description", exp.description or "—"),
+        ("seed", str(exp.seed)),
+        ("rule", exp.rule),
+        ("IC method", f"{exp.ic_method}, {exp.n_ics} ICs drawn at r_max = {exp.r_max:g}"),
+        ("steps", f"{exp.n_steps} steps of τ = {exp.tau:g} ({exp.sampling} sampling)"),
+        ("kicktimes version (store)", str(man.get("kicktimes_version", "unknown"))),
+        ("kicktimes version (report)", __version__),
+        ("store", os.fspath(Path(store.path).resolve())),
+        ("store created / updated", f"{man.get('created', '?')} / {man.get('updated', '?')}"),
+        ("tasks", f"{len(exp.tasks()) - len(store.missing_tasks)}/{len(exp.tasks())} finished"),
+    ]
+    rows = "".join(
+        f"<tr><td><b>{html.escape(k)}</b></td><td>{html.escape(v)}</td></tr>" for k, v in meta
+    )
+    params = pd.DataFrame(
+        [
+            (k, ", ".join(map(str, v)) if isinstance(v, list) else str(v))
+            for k, v in exp.to_dict().items()
+        ],
+        columns=["parameter", "value"],
+    )
+    parts = [f'<table class="meta">{rows}</table>']
+    if store.missing_tasks:
+        parts.append(
+            f'<p class="note">The store is unfinished: {len(store.missing_tasks)} tasks '
+            "are missing; every number below uses the finished tasks only.</p>"
+        )
+    if notes:
+        items = "".join(f"<li>{html.escape(n)}</li>" for n in notes)
+        parts.append(f'<div class="note"><b>Subsampling (deterministic):</b><ul>{items}</ul></div>')
+    parts.append("<h3>Parameters</h3>" + table_html(params))
+    return "\n".join(parts), params

@@ -1,0 +1,320 @@
+r"""Poisson tests of the disk-disk collision times, per IC (one panel per test), and the
+rate heterogeneity across ICs.
+
+Per radius, :func:`kicktimes.stats.test_poisson_ensemble` tests every IC's collision times
+(each test conditional on the IC's own number of collisions) and the hypothesis of a common
+rate across ICs (Pearson χ² given the total, with an exact Monte Carlo p-value).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pandas as pd
+from matplotlib.figure import Figure
+
+from kicktimes.report._common import Section, fmt_rho, pct, seeded_rng, spearman
+from kicktimes.report._figures import (
+    RADIUS_LABEL,
+    check_alpha,
+    check_frame,
+    check_radii,
+    dodge,
+    finite,
+    new_axes,
+)
+from kicktimes.report.effects import SHARE_RULE, Effect, clopper_pearson, share_verdict
+from kicktimes.stats.poisson import _NULL
+
+__all__ = [
+    "binomial_ci",
+    "rejection_table",
+    "poisson_rejection_rates",
+    "sections",
+    "effects",
+    "HEADLINE_TEST",
+]
+
+#: the test of the Findings: given n, the times of a homogeneous Poisson process are
+#: uniform on the window (exact, conditional KS); the others are listed beside it
+HEADLINE_TEST = "uniformity_ks"
+
+
+def binomial_ci(k, n, level=0.95):
+    """Clopper-Pearson interval of ``k`` successes in ``n`` trials (NaN where n = 0)."""
+    from statsmodels.stats.proportion import proportion_confint
+
+    k = np.asarray(k, dtype=float)
+    n = np.asarray(n, dtype=float)
+    ok = n > 0
+    low = np.full(k.shape, np.nan)
+    high = np.full(k.shape, np.nan)
+    if ok.any():
+        lo, hi = proportion_confint(k[ok], n[ok], alpha=1 - level, method="beta")
+        low[ok], high[ok] = lo, hi
+    return low, high
+
+
+def rejection_table(rejections, *, level=0.95) -> pd.DataFrame:
+    """Add ``rate`` and Clopper-Pearson ``ci_low``/``ci_high`` to counts of rejections.
+
+    ``rejections`` has columns ``radius, test, n_tested, n_reject``.
+    """
+    df = check_frame("rejections", rejections, ["radius", "test", "n_tested", "n_reject"])
+    n = finite("rejections['n_tested']", df["n_tested"])
+    k = finite("rejections['n_reject']", df["n_reject"])
+    if ((k < 0) | (k > n)).any():
+        raise ValueError("rejections must satisfy 0 <= n_reject <= n_tested")
+    out = df.copy()
+    with np.errstate(invalid="ignore", divide="ignore"):
+        out["rate"] = np.where(n > 0, k / np.where(n > 0, n, 1), np.nan)
+    out["ci_low"], out["ci_high"] = binomial_ci(k, n, level)
+    return out
+
+
+def poisson_rejection_rates(rejections, *, alpha=0.05, ncols=4, ax=None):
+    """Rejection rate of each Poisson test per radius, one panel per test (small multiples).
+
+    Parameters
+    ----------
+    rejections : pandas.DataFrame
+        ``radius, test, n_tested, n_reject`` (sequences tested and rejected at level
+        ``alpha``); ``rate``/``ci_low``/``ci_high`` are computed when absent
+        (Clopper-Pearson, :func:`rejection_table`).
+    alpha : float
+        The level of the tests; drawn in every panel as the rate expected if every IC
+        were Poisson.
+    ncols : int
+        Panels per row.
+    ax : matplotlib Axes, optional
+        Draw every test into this one Axes instead (overlaid, slightly shifted along r,
+        with a legend): a compact form for a grid of such plots.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        One panel per test, shared axes, rate ± 95 % Clopper-Pearson interval at each radius.
+    """
+    alpha = check_alpha(alpha)
+    if isinstance(rejections, pd.DataFrame) and {"rate", "ci_low", "ci_high"} <= set(
+        rejections.columns
+    ):
+        table = check_frame("rejections", rejections, ["radius", "test", "rate"])
+    else:
+        table = rejection_table(rejections)
+    check_radii("rejections['radius']", table["radius"])
+    tests = list(dict.fromkeys(table["test"]))
+    if ax is not None:
+        return _overlaid(table, tests, alpha, ax)
+    ncols = min(ncols, len(tests))
+    nrows = math.ceil(len(tests) / ncols)
+    fig = Figure(figsize=(3.3 * ncols, 2.9 * nrows), layout="constrained")
+    axes = np.atleast_1d(fig.subplots(nrows, ncols, sharex=True, sharey=True, squeeze=False))
+    axes = axes.ravel()
+    for k, (ax, test) in enumerate(zip(axes, tests, strict=False)):
+        part = table[table["test"] == test].sort_values("radius")
+        rate = part["rate"].to_numpy()
+        err = np.vstack([rate - part["ci_low"].to_numpy(), part["ci_high"].to_numpy() - rate])
+        ax.errorbar(
+            part["radius"],
+            rate,
+            yerr=err,
+            marker="o",
+            markersize=4,
+            capsize=2,
+            linewidth=1,
+            color="C0",
+        )
+        ax.axhline(alpha, color="black", linestyle=":", linewidth=0.8)
+        ax.set_title(test.replace("_", " "), fontsize="medium")
+        ax.set_ylim(0.0, 1.0)
+        if k % ncols == 0:
+            ax.set_ylabel(f"share rejected at α = {alpha:g}")
+        if k >= len(tests) - ncols:
+            ax.set_xlabel(RADIUS_LABEL)
+            ax.tick_params(axis="x", labelbottom=True)
+    for ax in axes[len(tests) :]:
+        ax.set_visible(False)
+    fig.suptitle(
+        f"Poisson tests of the disk-disk collision times, per IC (dotted: α = {alpha:g}, "
+        "the share expected if every IC were Poisson)",
+        fontsize="medium",
+    )
+    return fig
+
+
+def _overlaid(table, tests, alpha, ax):
+    fig, ax = new_axes(ax, (6.4, 4.4))
+    radii = table["radius"].to_numpy()
+    for k, test in enumerate(tests):
+        part = table[table["test"] == test].sort_values("radius")
+        x = part["radius"].to_numpy() + dodge(radii, k, len(tests))
+        rate = part["rate"].to_numpy()
+        err = np.vstack([rate - part["ci_low"].to_numpy(), part["ci_high"].to_numpy() - rate])
+        ax.errorbar(
+            x,
+            rate,
+            yerr=err,
+            marker="o",
+            markersize=4,
+            capsize=2,
+            linewidth=1,
+            label=test.replace("_", " "),
+            color=f"C{k}",
+        )
+    ax.axhline(alpha, color="black", linestyle=":", label=f"α = {alpha:g} (all ICs Poisson)")
+    ax.set_ylim(0.0, 1.0)
+    ax.set_xlabel(RADIUS_LABEL)
+    ax.set_ylabel(f"share of ICs rejected at α = {alpha:g}")
+    ax.legend(fontsize="x-small", ncol=2)
+    return fig
+
+
+def subsample(part, limit):
+    ics = np.sort(part["ic"].unique())
+    return part[part["ic"].isin(ics[:limit])] if limit is not None and ics.size > limit else part
+
+
+def _poisson_job(job):
+    """Poisson tests and rate homogeneity of one radius (runs in a worker process)."""
+    from kicktimes import stats
+
+    r, seqs, windows, alpha, n_mc, seed_key, rule = job
+    ens = stats.test_poisson_ensemble(
+        seqs, windows, alpha=alpha, n_mc=n_mc, rng=seeded_rng(*seed_key)
+    )
+    rows = []
+    for test in stats.TESTS:
+        p = ens.per_sequence[f"p_{test}"].to_numpy()
+        ok = np.isfinite(p)
+        comb = ens.combined.loc[test]
+        rows.append(
+            {
+                "radius": r,
+                "test": test,
+                "n_tested": int(ok.sum()),
+                "n_reject": int((p[ok] < alpha).sum()),
+                "n_reject_fdr": int(comb["n_reject_fdr"]),
+                "combined_pvalue": float(comb["pvalue"]),
+            }
+        )
+    hom = ens.rate_homogeneity
+    counts = np.array([t.size for t in seqs], dtype=float)
+    hom_row = {
+        "radius": r,
+        "n_ics": len(seqs),
+        "pooled_rate": counts.sum() / windows.sum(),
+        "median_rate": float(np.median(counts / windows)),
+        "kinetic_rate": float(stats.kinetic_rate(r, rule)),
+        "dispersion_index": counts.var(ddof=1) / counts.mean() if counts.mean() > 0 else math.nan,
+        "pearson_statistic": hom.loc["pearson", "statistic"],
+        "df": hom.loc["pearson", "df"],
+        "pvalue": hom.loc["pearson", "pvalue"],
+        "pvalue_mc": hom.loc["pearson", "pvalue_mc"],
+        "lr_pvalue": hom.loc["likelihood_ratio", "pvalue"],
+        "n_flagged_fdr": int(ens.reject["rate"].sum()),
+    }
+    return rows, hom_row
+
+
+def sections(ctx):
+    """Per-IC Poisson tests at every radius (one job per radius, seeded per radius)."""
+    exp, coll = ctx.exp, ctx.store.collisions
+    alpha, n_mc, max_ics_tests = ctx.alpha, ctx.n_mc, ctx.max_ics_tests
+    jobs = []
+    for ri, (r, part) in enumerate(coll.groupby("radius")):
+        part = subsample(part.sort_values("ic"), max_ics_tests)
+        seqs = [np.asarray(t, dtype=float) for t in part["pp_times"]]
+        # one Monte Carlo stream per radius: identical results for any worker count
+        key = (exp.seed, 1, ri)
+        jobs.append((r, seqs, part["t_window"].to_numpy(float), alpha, n_mc, key, exp.rule))
+    rej_rows, hom_rows = [], []
+    for rows, hom_row in ctx.pmap(_poisson_job, jobs):
+        rej_rows += rows
+        hom_rows.append(hom_row)
+    rejections = rejection_table(pd.DataFrame(rej_rows))
+    homogeneity = pd.DataFrame(hom_rows)
+    if max_ics_tests is not None and coll.groupby("radius")["ic"].nunique().max() > max_ics_tests:
+        ctx.notes.append(
+            f"Poisson tests and rate homogeneity: the first {max_ics_tests} ICs (by index) "
+            "per radius."
+        )
+    sec = Section("poisson_tests", "Poisson tests of the collision times, per IC")
+    sec.figure(
+        "fig08_poisson_rejection_rates",
+        poisson_rejection_rates(rejections, alpha=alpha),
+        f"Share of ICs whose disk-disk collision times reject a homogeneous Poisson process at "
+        f"α = {alpha:g}, one panel per test, per radius, with 95% Clopper-Pearson intervals. Each "
+        "test conditions on the IC's own number of collisions; nulls: "
+        + "; ".join(f"{t} {_NULL[t]}" for t in rejections["test"].unique() if t in _NULL)
+        + f" (Monte Carlo with n_mc = {n_mc}).",
+    )
+    lines = []
+    for test, t in rejections.groupby("test", sort=False):
+        t = t.sort_values("radius")
+        rho, p = spearman(t["radius"], t["rate"])
+        lines.append(
+            f"{test}: {pct(t['rate'].iloc[0])} at r = {t['radius'].iloc[0]:g}, "
+            f"{pct(t['rate'].iloc[-1])} at r = {t['radius'].iloc[-1]:g} "
+            f"(Spearman ρ with r: {fmt_rho(rho, p)})"
+        )
+    above = rejections[rejections["ci_low"] > alpha]
+    tested = rejections[rejections["n_tested"] > 0]
+    sec.text(
+        f"Under the null each test rejects {pct(alpha)} of ICs. Rejection rates — "
+        + "; ".join(lines)
+        + f". The 95% interval lies above α for {len(above)} of {len(tested)} "
+        f"(test, radius) cells with tested ICs; the Fisher-combined p-value is below {alpha:g} for "
+        f"{int((rejections['combined_pvalue'] < alpha).sum())} of them. Tests with too few "
+        "events in an IC are not run on it (n_tested counts the ICs tested)."
+    )
+    sec.table("poisson_tests", rejections, "Rejections per radius and test")
+    ctx.found["rejections"] = rejections
+    ctx.found["homogeneity"] = homogeneity
+    return [sec]
+
+
+def effects(ctx):
+    """Share of (IC, radius) runs whose collision times reject a Poisson process."""
+    rej = ctx.found.get("rejections")
+    if rej is None or rej.empty:
+        return []
+    totals = rej.groupby("test", sort=False)[["n_reject", "n_tested"]].sum()
+    if HEADLINE_TEST not in totals.index or totals.loc[HEADLINE_TEST, "n_tested"] == 0:
+        return []
+    k, n = (int(v) for v in totals.loc[HEADLINE_TEST])
+    low, high = clopper_pearson(k, n)
+    verdict = share_verdict(low, high, ctx.alpha)
+    words = {
+        "above": "Poisson rejected (more rejections than α)",
+        "below": "fewer rejections than α (conservative test)",
+        "inconclusive": "consistent with Poisson at this sample size",
+    }[verdict]
+    others = "; ".join(
+        f"{t} {pct(row.n_reject / row.n_tested)}"
+        for t, row in totals.iterrows()
+        if t != HEADLINE_TEST and row.n_tested > 0
+    )
+    by_r = rej[rej["test"] == HEADLINE_TEST].sort_values("radius")
+    return [
+        Effect(
+            question="Poisson collision times?",
+            system="",
+            quantity=(
+                f"share of runs rejected by the {HEADLINE_TEST} test at α = {ctx.alpha:g} "
+                "(pooled over radii)"
+            ),
+            estimate=k / n,
+            ci_low=low,
+            ci_high=high,
+            verdict=words,
+            rule=SHARE_RULE.format(level=ctx.alpha) + " (level: α, the share under Poisson)",
+            method=f"Clopper-Pearson, {n} runs",
+            detail=(
+                f"{pct(by_r['rate'].iloc[0])} at r = {by_r['radius'].iloc[0]:g}, "
+                f"{pct(by_r['rate'].iloc[-1])} at r = {by_r['radius'].iloc[-1]:g}; other "
+                f"tests (pooled): {others}"
+            ),
+        )
+    ]
