@@ -28,19 +28,20 @@ __all__ = ["write_analysis"]
 
 def _report_api():
     """The report's section record, figure functions and HTML writer."""
-    from kicktimes import plots
-    from kicktimes import report as rep
+    from types import SimpleNamespace
 
-    section = getattr(rep, "_Section", None) or getattr(rep, "Section", None)
-    if section is None:
-        from kicktimes.report._common import Section as section
-    writer = getattr(rep, "_write_outputs", None)
-    if writer is None:
-        from kicktimes.report.html import write_outputs as writer
-    css = getattr(rep, "_CSS", None)
-    if css is None:
-        from kicktimes.report.html import CSS as css
-    return section, plots, writer, css
+    from kicktimes.report import heterogeneity, poisson, renewal
+    from kicktimes.report._common import Section
+    from kicktimes.report._figures import RADIUS_LABEL
+    from kicktimes.report.html import CSS, write_outputs
+
+    figures = SimpleNamespace(
+        RADIUS_LABEL=RADIUS_LABEL,
+        poisson_rejection_rates=poisson.poisson_rejection_rates,
+        model_comparison=renewal.model_comparison,
+        rate_heterogeneity=heterogeneity.rate_heterogeneity,
+    )
+    return Section, figures, write_outputs, CSS
 
 
 def _as_radius(groups):
@@ -79,8 +80,9 @@ def _as_radius(groups):
 
 def _relabel_figure(fig, relabel, name, radius_label):
     for ax in fig.axes:
-        if ax.get_xlabel() == radius_label or ax.get_xlabel() == "":
-            relabel(ax, name)
+        label = ax.get_xlabel()
+        if label in (radius_label, ""):
+            relabel(ax, name if label else "")
 
 
 def _sections(res, Section, plots):
@@ -99,8 +101,7 @@ def _sections(res, Section, plots):
 
     fs = findings(res)
     sec = Section("findings", "Findings")
-    for f in fs:
-        sec.text(f"{f.question} — {f.verdict}. {f.statement} (Rule: {f.rule})")
+    sec.bullets(f"{f.question} — {f.verdict}. {f.statement} (Rule: {f.rule})" for f in fs)
     table = pd.DataFrame([f.__dict__ for f in fs])
     sec.table("findings", table, "Findings", show=False)
     secs.append(sec)
@@ -158,6 +159,19 @@ def _sections(res, Section, plots):
 
     # ---- heterogeneity
     sec = Section("heterogeneity", "Rate heterogeneity across sequences")
+    coll = radius(res.sequences[["group", "n_events", "t_window"]]).rename(
+        columns={"n_events": "n_pp"}
+    )
+    hom = radius(res.heterogeneity)
+    fig = plots.rate_heterogeneity(coll, homogeneity=hom, rule=None)
+    _relabel_figure(fig, relabel, group_name, radius_label)
+    sec.figure(
+        "rate_heterogeneity",
+        fig,
+        "(a) Event rate n / t_window of every sequence with the pooled and median rates per "
+        f"{group_name}; (b) index of dispersion of the counts across the sequences of a group, "
+        "annotated with the p-value of the Pearson test of a common rate (given the total).",
+    )
     sec.table("rate_homogeneity", res.heterogeneity, "Rate homogeneity per group")
     if res.reference is not None:
         sec.table("reference_rate", res.reference, f"Observed / {res.reference_column}")
