@@ -36,6 +36,7 @@
 # %%
 import os
 import tempfile
+import time
 
 import numpy as np
 import pandas as pd
@@ -47,6 +48,7 @@ SMALL = os.environ.get("KICKTIMES_NOTEBOOK_SIZE", "small") != "full"
 N_PER_GROUP = 6 if SMALL else 40
 T_END = 100.0 if SMALL else 1000.0
 rng = np.random.default_rng(2024)
+t_start = time.perf_counter()
 
 # %% [markdown]
 # ## 1. A tidy table
@@ -171,3 +173,6 @@ if HAVE_BILLIARDS:
         max_fits_per_group=2,
     )
     print(box.summary())
+
+# %%
+print(f"\nnotebook computed in {time.perf_counter() - t_start:.1f} s")
