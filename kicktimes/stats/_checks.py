@@ -13,12 +13,7 @@ import numpy as np
 from kicktimes._validation import check_choice, check_int, check_real
 
 __all__ = [
-    "as_1d_float",
-    "check_choice",
-    "check_int",
-    "check_intervals",
-    "check_real",
-    "check_rng",
+    "as_1d_float", "check_choice", "check_int", "check_intervals", "check_real", "check_rng",
     "check_times",
 ]
 
