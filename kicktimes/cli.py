@@ -391,3 +391,6 @@ def reproduce_command(scale, out, workers, scheduler, progress):
 
 
 # --- end experiment commands ---
+
+
+from kicktimes import _cli_analyze  # noqa: E402, F401  (registers "kicktimes analyze")

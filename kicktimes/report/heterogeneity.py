@@ -28,8 +28,8 @@ def rate_heterogeneity(collisions, *, homogeneity=None, rule="mirror", max_point
         or ``pvalue``: the p-value of the test that every IC at that radius has the same
         rate (the Pearson dispersion test of
         :func:`kicktimes.stats.test_poisson_ensemble`); printed on top of panel (b).
-    rule : {"mirror", "elastic"}
-        Rule of the kinetic-theory rate.
+    rule : {"mirror", "elastic"} or None
+        Rule of the kinetic-theory rate (None: no kinetic curve).
     max_points : int
         At most this many per-IC points are drawn per radius (every k-th IC in index
         order; the summaries use all).
@@ -99,13 +99,14 @@ def rate_heterogeneity(collisions, *, homogeneity=None, rule="mirror", max_point
         label="median over ICs",
     )
     grid = np.linspace(radii.min(), radii.max(), 100) if radii.size > 1 else radii
-    ax1.plot(
-        grid,
-        stats.kinetic_rate(grid, rule),
-        color="grey",
-        linestyle=":",
-        label=f"kinetic theory Γ(r) ({rule})",
-    )
+    if rule is not None:  # None: sequences from elsewhere (kicktimes analyze), no Γ(r)
+        ax1.plot(
+            grid,
+            stats.kinetic_rate(grid, rule),
+            color="grey",
+            linestyle=":",
+            label=f"kinetic theory Γ(r) ({rule})",
+        )
     ax1.set_yscale("log")
     ax1.set_xlabel(RADIUS_LABEL)
     ax1.set_ylabel("disk-disk collision rate (1 / time unit)")

@@ -13,6 +13,7 @@ It takes event times and observation windows only (no billiard knowledge):
 See ``docs/statistics.md`` for the conventions.
 """
 
+from .analyze import Analysis, analyze
 from .comparison import VuongResult, compare_models, vuong
 from .counts import CountRegression, kinetic_rate, regress_counts
 from .distributions import hyperexpon
@@ -26,6 +27,8 @@ __all__ = [
     "FULL_SAMPLE_MODELS",
     "PARAM_NAMES",
     "TESTS",
+    "analyze",
+    "Analysis",
     "fit_renewal",
     "compare_models",
     "vuong",

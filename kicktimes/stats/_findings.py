@@ -1,0 +1,260 @@
+r"""Findings of an :class:`~kicktimes.stats.analyze.Analysis`: one computed statement per question.
+
+Every statement is built from the result's tables (never typed), carries its effect size
+with a 95 % interval where one exists, and a verdict reached by a rule that is printed
+beside it (``Finding.rule``).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import stats as sps
+
+__all__ = ["Finding", "findings"]
+
+
+@dataclass(frozen=True)
+class Finding:
+    """One answered question: ``question``, ``verdict``, ``statement`` and the ``rule``."""
+
+    question: str
+    verdict: str
+    statement: str
+    rule: str
+
+
+def _v(value):
+    """A group value for the text: numbers with 4 significant digits."""
+    if isinstance(value, int | float | np.integer | np.floating):
+        return f"{float(value):.4g}"
+    return str(value)
+
+
+def _p(p):
+    if not np.isfinite(p):
+        return "n/a"
+    return "< 1e-300" if p == 0 else f"{p:.3g}"
+
+
+def _clopper_pearson(k, n):
+    if n == 0:
+        return math.nan, math.nan
+    lo = sps.beta.ppf(0.025, k, n - k + 1) if k > 0 else 0.0
+    hi = sps.beta.ppf(0.975, k + 1, n - k) if k < n else 1.0
+    return float(lo), float(hi)
+
+
+def _input(res):
+    s = res.sequences
+    n_empty = int((s["n_events"] == 0).sum())
+    groups = s["group"].nunique()
+    text = (
+        f"{len(s)} sequences in {groups} group{'s' if groups > 1 else ''}"
+        + (f" (by {res.group})" if res.group else "")
+        + f", {int(s['n_events'].sum())} events over a total window of "
+        f"{s['t_window'].sum():.4g}; {n_empty} sequence{'s' if n_empty != 1 else ''} without "
+        "events (counted in the rates and regressions, skipped by the tests and fits)"
+    )
+    covs = list(res.events.covariates)
+    text += f"; covariates: {', '.join(covs) if covs else 'none'}."
+    return Finding("Data", "—", text, "Every sequence of the input is counted.")
+
+
+def _poisson(res):
+    pt = res.poisson
+    tested = pt[pt["n_tested"] > 0]
+    n_cells = len(tested)
+    cut = res.alpha / max(n_cells, 1)
+    bad = tested[tested["combined_pvalue"] < cut].sort_values("combined_pvalue")
+    s = res.sequences
+    has_events = s["n_events"] > 0
+    k = int(s.loc[has_events, "reject_any_fdr"].sum())
+    n = int(has_events.sum())
+    lo, hi = _clopper_pearson(k, n)
+    share = f"{k}/{n} sequences ({100 * k / n:.0f} %, 95 % CI {100 * lo:.0f}-{100 * hi:.0f} %)"
+    if n_cells == 0:
+        return Finding("Poisson?", "inconclusive", "No sequence has enough events for a test.", "—")
+    if bad.empty:
+        verdict = "consistent with Poisson"
+        text = (
+            f"No test rejects over the ensemble: the smallest Fisher-combined p-value is "
+            f"{_p(tested['combined_pvalue'].min())} ({n_cells} test x group cells); "
+            f"{share} are rejected by some test after FDR."
+        )
+    else:
+        verdict = "not Poisson"
+        items = [
+            f"{r.test} ({'' if res.group is None else f'{res.group} = {_v(r.group)}: '}"
+            f"p = {_p(r.combined_pvalue)}, {r.n_reject_fdr}/{r.n_tested} sequences after FDR)"
+            for r in bad.head(4).itertuples()
+        ]
+        text = (
+            f"{len(bad)} of {n_cells} test x group cells reject a homogeneous Poisson process: "
+            + "; ".join(items)
+            + ("; ..." if len(bad) > 4 else "")
+            + f". Rejected by some test after FDR: {share}."
+        )
+    rule = (
+        f"not Poisson when some test's Fisher-combined p-value over a group's sequences is "
+        f"below alpha / (tests x groups) = {cut:.3g} (Bonferroni); consistent otherwise."
+    )
+    return Finding("Poisson?", verdict, text, rule)
+
+
+def _renewal(res):
+    pooled = res.renewal_pooled
+    rule = (
+        "best model: lowest AIC of the censored fits; decisive when the runner-up's "
+        "ΔAIC > 10, weak when < 2."
+    )
+    if pooled.empty or pooled["aic"].notna().sum() == 0:
+        return Finding(
+            "Which renewal model?", "inconclusive", "No group has enough intervals for a fit.", rule
+        )
+    parts, verdicts = [], []
+    for g, t in pooled.groupby("group", sort=False):
+        t = t.dropna(subset=["aic"]).sort_values("aic")
+        best, runner = t.iloc[0], t.iloc[1] if len(t) > 1 else None
+        gap = runner["delta_aic"] if runner is not None else math.inf
+        strength = "decisive" if gap > 10 else ("weak" if gap < 2 else "clear")
+        d_exp = t.loc[t["model"] == "exponential", "delta_aic"]
+        label = "" if res.group is None else f"{res.group} = {_v(g)}: "
+        second = runner["model"] if runner is not None else "—"
+        d_e = float(d_exp.iloc[0]) if len(d_exp) else math.nan
+        parts.append(
+            f"{label}{best['model']} ({strength}; runner-up {second} ΔAIC = {gap:.3g}; "
+            f"exponential ΔAIC = {d_e:.4g}, {int(best['n'])} intervals)"
+        )
+        verdicts.append(best["model"])
+    top = max(set(verdicts), key=verdicts.count)
+    per = res.sequences["best_model"].dropna()
+    text = "Pooled per group: " + "; ".join(parts) + "."
+    if len(per):
+        k = int((per == "exponential").sum())
+        lo, hi = _clopper_pearson(k, len(per))
+        counts = per.value_counts()
+        text += (
+            f" Per sequence ({len(per)} fitted): "
+            + ", ".join(f"{m} best for {c}" for m, c in counts.items())
+            + f"; exponential best for {100 * k / len(per):.0f} % (95 % CI "
+            f"{100 * lo:.0f}-{100 * hi:.0f} %)."
+        )
+    text += (
+        " A pooled sample mixes sequences with different rates, which alone makes it "
+        "heavier-tailed than exponential: read it with the rate heterogeneity."
+    )
+    return Finding(
+        "Which renewal model?",
+        f"{top} (pooled, {verdicts.count(top)}/{len(verdicts)} groups)",
+        text,
+        rule,
+    )
+
+
+def _heterogeneity(res):
+    het = res.heterogeneity
+    ok = het[het["n_sequences"] > 1]
+    cut = res.alpha / max(len(ok), 1)
+    rule = (
+        f"heterogeneous when the exact (Monte Carlo) Pearson p-value of a common rate is "
+        f"below alpha / groups = {cut:.3g} in some group."
+    )
+    if ok.empty:
+        return Finding(
+            "One rate for all sequences?",
+            "inconclusive",
+            "Every group has a single sequence.",
+            rule,
+        )
+    rejected = ok[ok["pvalue_mc"] < cut]
+    verdict = "heterogeneous" if len(rejected) else "consistent with one rate per group"
+    text = (
+        f"A common rate is rejected in {len(rejected)}/{len(ok)} groups (Pearson χ², exact "
+        f"p-value at resolution 1/{res.n_mc + 1}); index of dispersion of the counts "
+        f"{ok['dispersion_index'].min():.3g} to {ok['dispersion_index'].max():.3g} (1 for a "
+        f"common Poisson rate); {int(ok['n_flagged_fdr'].sum())} sequences have a rate "
+        "incompatible with their group's after FDR."
+    )
+    return Finding("One rate for all sequences?", verdict, text, rule)
+
+
+def _reference(res):
+    ref = res.reference
+    if ref is None or ref.empty:
+        return None
+    rule = (
+        "agrees: the 95 % CI of observed / reference rate lies inside [0.9, 1.1]; differs: "
+        "the CI excludes [0.9, 1.1] entirely; inconclusive otherwise."
+    )
+    verdicts, parts = [], []
+    for r in ref.itertuples():
+        if r.ci_low >= 0.9 and r.ci_high <= 1.1:
+            v = "agrees"
+        elif r.ci_high < 0.9 or r.ci_low > 1.1:
+            v = "differs"
+        else:
+            v = "inconclusive"
+        verdicts.append(v)
+        label = "" if res.group is None else f"{res.group} = {_v(r.group)}: "
+        parts.append(f"{label}{r.ratio:.3f} [{r.ci_low:.3f}, {r.ci_high:.3f}]")
+    verdict = (
+        verdicts[0]
+        if len(set(verdicts)) == 1
+        else (f"{verdicts.count('agrees')}/{len(verdicts)} groups agree")
+    )
+    text = (
+        f"Observed / reference rate ({res.reference_column}) with 95 % CI: "
+        + "; ".join(parts)
+        + "."
+    )
+    return Finding("Rate against the reference?", verdict, text, rule)
+
+
+def _regressions(res):
+    reg = res.regressions
+    out = []
+    for cov, t in reg.groupby("covariate", sort=False):
+        nb = t[(t["model"] == "negbin") & (t["term"] == "slope")].iloc[0]
+        po = t[(t["model"] == "poisson") & (t["term"] == "slope")].iloc[0]
+        main, label = nb, "negative binomial"
+        if not (np.isfinite(nb["ci_low"]) and np.isfinite(nb["ci_high"])):
+            # alpha -> 0 (no overdispersion): the NB Hessian is singular and the NB model
+            # is the Poisson one; its interval is the Poisson GLM's
+            main, label = po, "Poisson GLM; the NB fit sits at alpha = 0"
+        od = res.overdispersion.set_index("covariate").loc[cov]
+        lo, hi = main["ci_low"], main["ci_high"]
+        if main["g"] == "log":
+            what = f"rate ∝ {cov}^b: b = {main['estimate']:.3f} [{lo:.3f}, {hi:.3f}]"
+        else:
+            what = f"log rate = a + b {cov}: b = {main['estimate']:.4g} [{lo:.4g}, {hi:.4g}]"
+        if lo > 0:
+            verdict = "increases"
+        elif hi < 0:
+            verdict = "decreases"
+        else:
+            verdict = "no detectable trend"
+        text = (
+            f"{what} (95 % CI; {label}; Poisson GLM: {po['estimate']:.4g} "
+            f"[{po['ci_low']:.4g}, {po['ci_high']:.4g}]); Poisson Pearson dispersion "
+            f"{od['pearson_dispersion']:.3g}, NB alpha = {od['alpha']:.3g} (LR p = "
+            f"{_p(od['lr_pvalue'])})."
+        )
+        rule = (
+            "increases / decreases when the 95 % CI of the slope (negative binomial, or "
+            "Poisson when the NB fit has alpha = 0) excludes 0."
+        )
+        out.append(Finding(f"Counts against {cov}?", f"rate {verdict} with {cov}", text, rule))
+    return out
+
+
+def findings(res) -> list:
+    """The findings of an analysis, data first, then each question."""
+    out = [_input(res), _poisson(res), _renewal(res), _heterogeneity(res)]
+    ref = _reference(res)
+    if ref is not None:
+        out.append(ref)
+    out += _regressions(res)
+    return out
