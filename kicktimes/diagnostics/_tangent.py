@@ -140,7 +140,7 @@ def _renormalise(U, log_scale, j):
     s = 0.0
     for i in range(U.shape[1]):
         s += U[j, i] * U[j, i]
-    if s > BIG2 or s < 1.0 / BIG2:
+    if s > BIG2 or (s < 1.0 / BIG2 and s > 0.0):
         nrm = math.sqrt(s)
         log_scale[j] += math.log(nrm)
         for i in range(U.shape[1]):
