@@ -160,3 +160,21 @@ def test_two_particle_exponent_at_r_003_with_paper_scale_runs():
     sem = lam.std(ddof=1) / np.sqrt(len(lam))
     assert lam.mean() > 10 * sem
     assert abs(lam.mean() - lam_half.mean()) < 4 * sem
+
+
+def test_sweeps_pass_the_lyapunov_method_through():
+    from kicktimes.experiment.config import Experiment
+    from kicktimes.experiment.tasks import run_task
+
+    values = {}
+    for method in ("tangent", "twin"):
+        exp = Experiment(name="m", radii=[0.02], n_ics=1, n_steps=300, tau=0.3,
+                         lyapunov_method=method, systems=("two_particle",),
+                         diagnostics=("lyapunov",))
+        results, _ = run_task(exp, exp.tasks()[0])
+        values[method] = results.loc[results.diagnostic == "lyapunov", "value"].item()
+    ic = initial_conditions(1, 0.02, seed=0)[0]
+    assert values["tangent"] == lyapunov(ic, 0.02, n_steps=300, tau=0.3).lam
+    assert values["twin"] == lyapunov(ic, 0.02, n_steps=300, tau=0.3, method="twin").lam
+    with pytest.raises(ValueError, match="lyapunov_method"):
+        Experiment(name="m", radii=[0.02], n_ics=1, n_steps=3, tau=0.3, lyapunov_method="qr")
