@@ -11,6 +11,7 @@ from kicktimes.billiard.two_particle import init_events_two, next_event_two, pro
 from kicktimes.diagnostics import lyapunov
 from kicktimes.diagnostics._tangent import tangent_one_kernel, tangent_two_kernel
 from kicktimes.diagnostics._twin import ftle_one_kernel
+from kicktimes.diagnostics.lyapunov import lyapunov_spectrum
 
 R = 0.05
 RHO, SIG = 1.0 - R, 2.0 * R
@@ -29,7 +30,7 @@ def flow_two(st0, t_end, rule, U=None):
     """State (and tangent vectors) at ``t_end`` through the kernel actually used."""
     st = st0.copy()
     U = np.zeros((1, 8)) if U is None else U.copy()
-    out = tangent_two_kernel(st, RHO, SIG, rule, 1, 1, t_end, U, 10**6)
+    out = tangent_two_kernel(st, RHO, SIG, rule, 1, 1, t_end, U, 10**6, 0)
     assert out[4] == 0
     return st, U, out
 
@@ -291,3 +292,26 @@ def test_tangent_agrees_with_the_twin_at_paper_scale(system):
         tangent = fn(ic, **steps)
         twin = fn(ic, method="twin", d0=1e-8, **steps)
         assert abs(tangent.lam - twin.lam) <= 0.02 * abs(twin.lam)
+
+
+# ------------------------------------------------------------------------- the spectrum
+@pytest.mark.parametrize("rule", ["elastic", "mirror"])
+def test_spectrum_top_exponent_is_the_ftle_and_phase_volume_is_conserved(ics20, rule):
+    t = 2000.0
+    for ic in ics20[:3]:
+        spec = lyapunov_spectrum(ic, R_AGREE, t_max=t, rule=rule).exponents
+        lam = lyapunov(ic, R_AGREE, n_steps=10000, tau=0.2, rule=rule).lam
+        assert spec[0] == pytest.approx(lam, rel=0.02)
+        assert spec[0] > 0.05
+        assert abs(spec.sum()) < 1e-6  # both rules preserve phase-space volume
+        if rule == "elastic":  # symplectic: lambda_1 = -lambda_8 (no such theorem for mirror)
+            assert spec[0] + spec[-1] == pytest.approx(0.0, abs=0.01 * spec[0])
+        # time translation (and, elastic: energy, rotation, angular momentum) give zeros
+        small = np.abs(spec) < 5 * math.log(t) / t
+        assert small.sum() >= (4 if rule == "elastic" else 3)
+
+
+def test_elastic_spectrum_comes_in_pairs_summing_to_zero(ics20):
+    spec = lyapunov_spectrum(ics20[0], R_AGREE, t_max=2000.0, rule="elastic").exponents
+    np.testing.assert_allclose(spec + spec[::-1], 0.0, atol=1e-3)
+    assert spec[1] > 10 * abs(spec[2])  # two positive exponents, well above the zeros

@@ -150,14 +150,37 @@ def _renormalise(U, log_scale, j):
 
 
 @njit(cache=True)
-def tangent_two_kernel(st, rho, sigma, rule, mode, n_steps, tau, U, max_events):
+def _gram_schmidt(U, log_scale):
+    """Modified Gram-Schmidt on the rows of ``U``; ``log_scale[j] += log |R_jj|``."""
+    m = U.shape[0]
+    for j in range(m):
+        for i in range(j):
+            p = 0.0
+            for c in range(U.shape[1]):
+                p += U[i, c] * U[j, c]
+            for c in range(U.shape[1]):
+                U[j, c] -= p * U[i, c]
+        s = 0.0
+        for c in range(U.shape[1]):
+            s += U[j, c] * U[j, c]
+        nrm = math.sqrt(s)
+        log_scale[j] += math.log(nrm)
+        for c in range(U.shape[1]):
+            U[j, c] /= nrm
+
+
+@njit(cache=True)
+def tangent_two_kernel(st, rho, sigma, rule, mode, n_steps, tau, U, max_events, n_orth):
     """Carry the tangent vectors ``U`` (m, 8) along the two-disk trajectory from ``st``.
 
     ``mode`` 1: up to ``n_steps * tau``; mode 2: through ``n_steps`` of the paper's
     collision-truncated steps (``t_k = min(t_{k-1} + tau, next event)``). Events at
     times ``<= t_end`` are applied, then everything flies on to ``t_end``. ``st`` and
     ``U`` are updated in place; ``U[j]`` is rescaled now and then and
-    ``log_scale[j]`` collects the logarithms of the factors taken out.
+    ``log_scale[j]`` collects the logarithms of the factors taken out. With
+    ``n_orth > 0`` (mode 1 only) the rows are re-orthonormalised by Gram-Schmidt at
+    ``n_orth`` equally spaced times, the last at ``t_end`` (for the spectrum: then
+    ``log_scale[j]`` sums ``log |R_jj|``).
 
     Returns ``(log_scale, n_rescaled, n_pp, t_end, status)``.
     """
@@ -170,11 +193,11 @@ def tangent_two_kernel(st, rho, sigma, rule, mode, n_steps, tau, U, max_events):
     n_ev = 0
     n_same = 0
     status = 0
-    n_loop = 1 if mode == 1 else n_steps
+    n_loop = max(1, n_orth) if mode == 1 else n_steps
     t_prev = 0.0
-    for _ in range(n_loop):
+    for i_loop in range(n_loop):
         if mode == 1:
-            tk = n_steps * tau
+            tk = n_steps * tau if i_loop == n_loop - 1 else (i_loop + 1) * (n_steps * tau / n_loop)
         else:
             tk = min(t_prev + tau, st[0] + min(ev[0], min(ev[1], ev[2])))
         while True:
@@ -226,6 +249,9 @@ def tangent_two_kernel(st, rho, sigma, rule, mode, n_steps, tau, U, max_events):
                         n_resc += _renormalise(U, log_scale, j)
         if status != 0:
             break
+        if n_orth > 0 and i_loop < n_loop - 1:
+            # all rows are at the time st[0] of the last event: orthonormalise there
+            _gram_schmidt(U, log_scale)
         t_prev = tk
     dt = t_prev - st[0]
     for j in range(m):
@@ -233,6 +259,8 @@ def tangent_two_kernel(st, rho, sigma, rule, mode, n_steps, tau, U, max_events):
         U[j, 1] += U[j, 3] * dt
         U[j, 4] += U[j, 6] * dt
         U[j, 5] += U[j, 7] * dt
+    if n_orth > 0:
+        _gram_schmidt(U, log_scale)
     st[1] += st[3] * dt
     st[2] += st[4] * dt
     st[5] += st[7] * dt
