@@ -12,16 +12,23 @@ from kicktimes.diagnostics.autocorrelation import (
     autocorrelation_many,
     boundary_angles,
 )
-from kicktimes.diagnostics.lyapunov import LyapunovResult, lyapunov
+from kicktimes.diagnostics.lyapunov import (
+    LyapunovResult,
+    LyapunovSpectrum,
+    lyapunov,
+    lyapunov_spectrum,
+)
 from kicktimes.diagnostics.recurrence import recurrence_pairs, recurrence_rate
 
 __all__ = [
     "LyapunovResult",
+    "LyapunovSpectrum",
     "UndefinedDiagnosticWarning",
     "autocorrelation",
     "autocorrelation_many",
     "boundary_angles",
     "lyapunov",
+    "lyapunov_spectrum",
     "recurrence_pairs",
     "recurrence_rate",
 ]
