@@ -37,7 +37,7 @@ from kicktimes.billiard.two_particle import (
     next_event_two,
     process_event_two,
 )
-from kicktimes.diagnostics._tangent import MAX_SAME_INSTANT
+from kicktimes.diagnostics._tangent import _budget
 
 
 @njit(cache=True)
@@ -65,22 +65,6 @@ def _rescaled(x, y, vx, vy, px, py, vx_ref, vy_ref, f, unit_speed):
     else:
         wx, wy = vx, vy
     return x, y, wx, wy
-
-
-@njit(cache=True, inline="always")
-def _budget(dt, n_ev, n_same, max_events):
-    """Event-loop guard: ``(status, n_same)`` after one more event ``dt`` from now."""
-    if dt != dt:
-        return 3, n_same
-    if dt == 0.0:
-        n_same += 1
-        if n_same > MAX_SAME_INSTANT:
-            return 2, n_same
-    else:
-        n_same = 0
-    if n_ev > max_events:
-        return 1, n_same
-    return 0, n_same
 
 
 @njit(cache=True)
@@ -146,9 +130,12 @@ def ftle_two_kernel(st0, rho, sigma, rule, mode, n_steps, tau, track, offsets, m
                 status = 3 if dt != dt else 0
                 break
             n_ev += 1
-            status, n_same = _budget(dt, n_ev, n_same, max_events)
-            if status != 0:
-                break
+            if dt > 0.0 and n_ev <= max_events:
+                n_same = 0
+            else:
+                status, n_same = _budget(dt, n_ev, n_same, max_events)
+                if status != 0:
+                    break
             process_event_two(ref, ev_ref, ke, rho, sigma, rule)
             if ke == 2:
                 cnt_ref[0] += 1
@@ -177,9 +164,12 @@ def ftle_two_kernel(st0, rho, sigma, rule, mode, n_steps, tau, track, offsets, m
                     status = 3 if dt != dt else 0
                     break
                 n_ev += 1
-                status, n_same = _budget(dt, n_ev, n_same, max_events)
-                if status != 0:
-                    break
+                if dt > 0.0 and n_ev <= max_events:
+                    n_same = 0
+                else:
+                    status, n_same = _budget(dt, n_ev, n_same, max_events)
+                    if status != 0:
+                        break
                 process_event_two(tw[j], ev_tw[j], ke, rho, sigma, rule)
                 if ke == 2:
                     cnt_tw[j, 0] += 1
@@ -300,9 +290,12 @@ def ftle_one_kernel(st0, rho, kicks, angles, kick_mode, mode, n_steps, tau, offs
                 status = 3 if dt != dt else 0
                 break
             n_ev += 1
-            status, n_same = _budget(dt, n_ev, n_same, max_events)
-            if status != 0:
-                break
+            if dt > 0.0 and n_ev <= max_events:
+                n_same = 0
+            else:
+                status, n_same = _budget(dt, n_ev, n_same, max_events)
+                if status != 0:
+                    break
             if is_kick:
                 process_event_one(ref, ev_ref, True, dt, rho, kicks[ik], angles[ik], kick_mode,
                                   False)
@@ -329,9 +322,12 @@ def ftle_one_kernel(st0, rho, kicks, angles, kick_mode, mode, n_steps, tau, offs
                     status = 3 if dt != dt else 0
                     break
                 n_ev += 1
-                status, n_same = _budget(dt, n_ev, n_same, max_events)
-                if status != 0:
-                    break
+                if dt > 0.0 and n_ev <= max_events:
+                    n_same = 0
+                else:
+                    status, n_same = _budget(dt, n_ev, n_same, max_events)
+                    if status != 0:
+                        break
                 if is_kick:
                     process_event_one(tw[j], ev_tw[j], True, dt, rho, kicks[ik], angles[ik],
                                       kick_mode, False)
