@@ -4,7 +4,8 @@ Workload (issue 2): r = 0.01, tau = 0.3, 15 000 uniform samples, 200 paper-proce
 one `simulate_two_particle` call per IC as a user would make it. Reference: the paper's
 time-stepped algorithm in plain NumPy (benchmarks/paper_timestep.py) on a few of the same
 ICs, scaled per trajectory. Also: the Poisson-kicked one-disk billiard on the same
-workload, and the FTLE cost relative to the bare simulation.
+workload, and the FTLE cost (default tangent method; see bench_lyapunov.py for both
+methods) relative to the bare simulation.
 
 Run: python benchmarks/bench_simulators.py [--n-ics 200]
 """
@@ -94,11 +95,11 @@ def main():
     print(f"{'simulate_one_particle (Poisson kicks)':46s} {t_one * ms:9.3f} "
           f"{events_one / t_one:12.3e} {t_one / t_two:8.2f}")
     per = 1e3 / n_ftle
-    print(f"{'lyapunov two-particle, norm (1 twin)':46s} {t_ftle_norm * per:9.3f} "
+    print(f"{'lyapunov two-particle, norm (tangent)':46s} {t_ftle_norm * per:9.3f} "
           f"{'':12s} {t_ftle_norm / n_ftle / (t_two / args.n_ics):8.2f}")
-    print(f"{'lyapunov two-particle, paper (2 twins)':46s} {t_ftle_paper * per:9.3f} "
+    print(f"{'lyapunov two-particle, paper (tangent)':46s} {t_ftle_paper * per:9.3f} "
           f"{'':12s} {t_ftle_paper / n_ftle / (t_two / args.n_ics):8.2f}")
-    print(f"{'lyapunov one-particle, norm (1 twin)':46s} {t_ftle_one * per:9.3f} "
+    print(f"{'lyapunov one-particle, norm (tangent)':46s} {t_ftle_one * per:9.3f} "
           f"{'':12s} {t_ftle_one / n_ftle / (t_one / args.n_ics):8.2f} (vs one-particle sim)")
     print(f"{'simulate_two_particle (paper sampling)':46s} {t_paper_mode * 1e3:9.3f}")
     print(f"{'paper time-stepped algorithm, plain NumPy':46s} {t_ref * 1e3:9.3f} {'':12s} "

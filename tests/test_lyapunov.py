@@ -1,10 +1,15 @@
-"""Finite-time Lyapunov exponents (Benettin twins)."""
+"""Finite-time Lyapunov exponents: the public API, both methods, validation."""
+
+import math
 
 import numpy as np
 import pytest
 
 from kicktimes import initial_conditions, simulate_one_particle, simulate_two_particle
 from kicktimes.diagnostics import lyapunov
+from kicktimes.diagnostics._tangent import MAX_SAME_INSTANT, tangent_two_kernel
+from kicktimes.diagnostics._twin import ftle_two_kernel
+from kicktimes.diagnostics.lyapunov import _check_status
 
 
 @pytest.fixture(scope="module")
@@ -12,66 +17,71 @@ def ics():
     return initial_conditions(6, 0.03, seed=3)
 
 
-def test_unkicked_one_particle_exponent_tends_to_zero(ics):
-    short = np.mean([lyapunov(ic[0], 0.03, n_steps=2500, tau=0.2).lam for ic in ics])
-    long = np.mean([lyapunov(ic[0], 0.03, n_steps=25000, tau=0.2).lam for ic in ics])
+@pytest.mark.parametrize("method", ["tangent", "twin"])
+def test_unkicked_one_particle_exponent_tends_to_zero(ics, method):
+    short = np.mean([lyapunov(ic[0], 0.03, n_steps=2500, tau=0.2, method=method).lam
+                     for ic in ics])
+    long = np.mean([lyapunov(ic[0], 0.03, n_steps=25000, tau=0.2, method=method).lam
+                    for ic in ics])
     assert long < short
     assert 0 <= long < 0.01
 
 
-def test_two_particle_exponent_is_positive_and_stable_to_halving_d0(ics):
-    lam = np.array([lyapunov(ic, 0.03, n_steps=10000, tau=0.2).lam for ic in ics])
-    lam_half = np.array([lyapunov(ic, 0.03, n_steps=10000, tau=0.2, d0=1e-4).lam for ic in ics])
+def test_two_particle_twin_exponent_is_positive_and_stable_to_halving_d0(ics):
+    lam = np.array([lyapunov(ic, 0.03, n_steps=10000, tau=0.2, method="twin").lam for ic in ics])
+    lam_half = np.array([lyapunov(ic, 0.03, n_steps=10000, tau=0.2, method="twin", d0=1e-4).lam
+                         for ic in ics])
     assert (lam > 0.1).all()
     assert abs(lam.mean() - lam_half.mean()) < 0.1 * lam.mean()
 
 
-def test_paper_variant_is_the_maximum_of_its_parts(ics):
-    res = lyapunov(ics[0], 0.03, n_steps=5000, tau=0.2, variant="paper")
-    assert res.variant == "paper"
+@pytest.mark.parametrize("method", ["tangent", "twin"])
+def test_paper_variant_is_the_maximum_of_its_parts(ics, method):
+    res = lyapunov(ics[0], 0.03, n_steps=5000, tau=0.2, variant="paper", method=method)
+    assert res.variant == "paper" and res.method == method
     assert res.lam == max(res.lam_x, res.lam_y)
-    assert np.isnan(lyapunov(ics[0], 0.03, n_steps=100, tau=0.2).lam_x)
+    assert np.isnan(lyapunov(ics[0], 0.03, n_steps=100, tau=0.2, method=method).lam_x)
 
 
 @pytest.mark.parametrize("sampling", ["uniform", "paper"])
 def test_both_sampling_modes_give_positive_two_particle_exponents(ics, sampling):
-    res = lyapunov(ics[1], 0.03, n_steps=10000, tau=0.2, sampling=sampling)
+    res = lyapunov(ics[1], 0.03, n_steps=10000, tau=0.2, sampling=sampling, method="twin")
     assert res.lam > 0.05
     assert res.n_renorm > 0.5 * 10000
+    tangent = lyapunov(ics[1], 0.03, n_steps=10000, tau=0.2, sampling=sampling)
+    assert tangent.lam > 0.05 and tangent.total_time == res.total_time
     if sampling == "paper":
         assert res.total_time < 10000 * 0.2
 
 
-def test_kicks_make_the_one_particle_billiard_chaotic_only_with_shared_angles(ics):
-    rng = np.random.default_rng(1)
-    kicks = np.sort(rng.uniform(0, 2000, 40))
-    res = lyapunov(ics[0, 0], 0.03, n_steps=10000, tau=0.2, kicks=kicks, rng=2)
+@pytest.mark.parametrize("kick_angle", ["uniform", "gaussian"])
+def test_kicks_make_the_one_particle_billiard_chaotic(ics, kick_angle):
+    kicks = np.sort(np.random.default_rng(1).uniform(0, 2000, 40))
+    res = lyapunov(ics[0, 0], 0.03, n_steps=10000, tau=0.2, kicks=kicks, rng=2,
+                   kick_angle=kick_angle)
     unkicked = lyapunov(ics[0, 0], 0.03, n_steps=10000, tau=0.2)
-    # kicks randomise the direction but are shared: the exponent stays finite and small
-    assert np.isfinite(res.lam) and res.n_forced < 0.01 * res.n_renorm
-    assert res.lam != unkicked.lam
+    assert res.n_perturbations == 40 and unkicked.n_perturbations == 0
+    assert res.lam > 5 * unkicked.lam
 
 
-def test_independent_twin_kicks_separate_the_twins_at_every_kick(ics):
-    kicks = np.sort(np.random.default_rng(3).uniform(0, 2000, 40))
-    shared = lyapunov(ics[1, 0], 0.03, n_steps=10000, tau=0.2, kicks=kicks, rng=5)
-    indep = lyapunov(ics[1, 0], 0.03, n_steps=10000, tau=0.2, kicks=kicks, rng=5,
-                     twin_kicks="independent")
-    # each independent kick adds about log(O(1) / d0) ~ 7 over 2000 time units
-    assert indep.lam > shared.lam + 0.05
-    with pytest.raises(ValueError, match="twin_kicks must be one of"):
-        lyapunov(ics[1, 0], 0.03, n_steps=10, tau=0.2, twin_kicks="some")
+def test_independent_twin_kicks_are_gone(ics):
+    # each independent kick threw the twin O(1) away: lam ~ Gamma ln(tau / d0), no exponent
+    with pytest.raises(TypeError, match="twin_kicks"):
+        lyapunov(ics[1, 0], 0.03, n_steps=10, tau=0.2, twin_kicks="independent")
 
 
-def test_run_objects_are_accepted_and_reuse_their_kicks(ics):
-    run = simulate_one_particle(ics[0, 0], 0.03, n_steps=2000, tau=0.2,
-                                kicks=np.array([10.0, 20.0, 30.0]), rng=4)
-    a = lyapunov(run)
+@pytest.mark.parametrize("method", ["tangent", "twin"])
+def test_run_objects_are_accepted_and_reuse_their_kicks(ics, method):
+    run = simulate_one_particle(ics[0, 0], 0.03, n_steps=2000, tau=0.2, kick_angle="gaussian",
+                                sigma=0.3, kicks=np.array([10.0, 20.0, 30.0]), rng=4)
+    a = lyapunov(run, method=method)
     b = lyapunov(ics[0, 0], 0.03, n_steps=2000, tau=0.2, kicks=run.kick_times,
-                 kick_angles=run.kick_angles)
-    assert a == b
-    two = simulate_two_particle(ics[0], 0.03, n_steps=2000, tau=0.2)
-    assert lyapunov(two) == lyapunov(ics[0], 0.03, n_steps=2000, tau=0.2)
+                 kick_angles=run.kick_angles, kick_angle="gaussian", method=method)
+    assert a == b and a.n_perturbations == 3
+    two = simulate_two_particle(ics[0], 0.03, n_steps=2000, tau=0.2, rule="elastic")
+    assert lyapunov(two, method=method) == lyapunov(ics[0], 0.03, n_steps=2000, tau=0.2,
+                                                    rule="elastic", method=method)
+    assert lyapunov(two, method=method).n_perturbations == two.n_pp
 
 
 def test_a_run_longer_than_its_samples_is_accepted(ics):
@@ -81,16 +91,24 @@ def test_a_run_longer_than_its_samples_is_accepted(ics):
     assert res.total_time <= 90.0 and np.isfinite(res.lam)
 
 
-def test_results_are_deterministic(ics):
-    assert lyapunov(ics[2], 0.03, n_steps=3000, tau=0.2) == lyapunov(ics[2], 0.03, n_steps=3000,
-                                                                     tau=0.2)
+@pytest.mark.parametrize("method", ["tangent", "twin"])
+def test_results_are_deterministic(ics, method):
+    assert (lyapunov(ics[2], 0.03, n_steps=3000, tau=0.2, method=method)
+            == lyapunov(ics[2], 0.03, n_steps=3000, tau=0.2, method=method))
 
 
 @pytest.mark.parametrize(
     ("kwargs", "match"),
     [
         (dict(n_steps=10, tau=0.2, variant="max"), "variant must be one of"),
-        (dict(n_steps=10, tau=0.2, d0=0.0), "d0 must lie in"),
+        (dict(n_steps=10, tau=0.2, method="twin", d0=0.0), "d0 must lie in"),
+        (dict(n_steps=10, tau=0.2, method="twin", d0=5e-324), "d0 must lie in"),
+        (dict(n_steps=10, tau=0.2, method="twin", d0=1e-12), "d0 must lie in"),
+        (dict(n_steps=10, tau=0.2, method="twin", d0=0.05), "d0 must lie in"),
+        (dict(n_steps=10, tau=0.2, d0=1e-8), "d0 applies to method='twin' only"),
+        (dict(n_steps=10, tau=0.2, method="benettin"), "method must be one of"),
+        (dict(n_steps=10**9, tau=0.2), "horizon n_steps \\* tau must be at most"),
+        (dict(n_steps=10, tau=1e307), "horizon n_steps \\* tau must be at most"),
         (dict(tau=0.2), "n_steps"),
         (dict(n_steps=10, tau=0.2, kicks=[1.0]), "one-disk"),
     ],
@@ -100,11 +118,63 @@ def test_bad_arguments_raise(ics, kwargs, match):
         lyapunov(ics[0], 0.03, **kwargs)
 
 
+@pytest.mark.parametrize("sigma", [math.inf, math.nan, 0.0, -1.0])
+@pytest.mark.parametrize("method", ["tangent", "twin"])
+def test_bad_sigma_is_refused_not_a_hang(ics, sigma, method):
+    with pytest.raises(ValueError, match="sigma must"):
+        lyapunov(ics[0, 0], 0.03, n_steps=100, tau=0.2, kicks=[1.0, 2.0],
+                 kick_angle="gaussian", sigma=sigma, method=method)
+
+
+@pytest.mark.parametrize("method", ["tangent", "twin"])
+def test_a_pile_of_simultaneous_events_is_an_error_not_a_hang(ics, method):
+    kicks = np.full(MAX_SAME_INSTANT + 5, 3.0)
+    with pytest.raises(RuntimeError, match="consecutive events at the same instant"):
+        lyapunov(ics[0, 0], 0.03, n_steps=100, tau=0.2, kicks=kicks, method=method)
+    # a few simultaneous kicks are fine
+    assert np.isfinite(lyapunov(ics[0, 0], 0.03, n_steps=100, tau=0.2, kicks=kicks[:50],
+                                method=method).lam)
+
+
+def test_every_event_loop_has_a_budget(ics):
+    st = np.zeros(11)
+    st[1:9] = ics[0].ravel()
+    st[10] = 2.0
+    out = tangent_two_kernel(st.copy(), 0.97, 0.06, 0, 1, 1000, 0.2, np.eye(8)[[0]], 50, 0)
+    assert out[4] == 1
+    out = ftle_two_kernel(st, 0.97, 0.06, 0, 1, 1000, 0.2, 0, np.array([[1e-8, 0.0]]),
+                          np.array([0]), 1e-8, 10, 50)
+    assert out[6] == 1
+    with pytest.raises(RuntimeError, match="budget of 50 events"):
+        _check_status(1, 200.0, 50)
+    with pytest.raises(ValueError, match="non-finite event time"):
+        _check_status(3, 200.0, 50)
+
+
 @pytest.mark.slow
 def test_two_particle_exponent_at_r_003_with_paper_scale_runs():
     ics = initial_conditions(50, 0.03, seed=8)
     lam = np.array([lyapunov(ic, 0.03, n_steps=25000, tau=0.2).lam for ic in ics])
-    lam_half = np.array([lyapunov(ic, 0.03, n_steps=25000, tau=0.2, d0=1e-4).lam for ic in ics])
+    lam_half = np.array([lyapunov(ic, 0.03, n_steps=25000, tau=0.2, method="twin", d0=1e-4).lam
+                         for ic in ics])
     sem = lam.std(ddof=1) / np.sqrt(len(lam))
     assert lam.mean() > 10 * sem
     assert abs(lam.mean() - lam_half.mean()) < 4 * sem
+
+
+def test_sweeps_pass_the_lyapunov_method_through():
+    from kicktimes.experiment.config import Experiment
+    from kicktimes.experiment.tasks import run_task
+
+    values = {}
+    for method in ("tangent", "twin"):
+        exp = Experiment(name="m", radii=[0.02], n_ics=1, n_steps=300, tau=0.3,
+                         lyapunov_method=method, systems=("two_particle",),
+                         diagnostics=("lyapunov",))
+        results, _ = run_task(exp, exp.tasks()[0])
+        values[method] = results.loc[results.diagnostic == "lyapunov", "value"].item()
+    ic = initial_conditions(1, 0.02, seed=0)[0]
+    assert values["tangent"] == lyapunov(ic, 0.02, n_steps=300, tau=0.3).lam
+    assert values["twin"] == lyapunov(ic, 0.02, n_steps=300, tau=0.3, method="twin").lam
+    with pytest.raises(ValueError, match="lyapunov_method"):
+        Experiment(name="m", radii=[0.02], n_ics=1, n_steps=3, tau=0.3, lyapunov_method="qr")

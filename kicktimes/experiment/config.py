@@ -32,13 +32,14 @@ IC_METHODS = ("paper", "uniform")
 SAMPLINGS = ("uniform", "paper")
 RULES = ("mirror", "elastic")
 LYAPUNOV_VARIANTS = ("norm", "paper")
+LYAPUNOV_METHODS = ("tangent", "twin")
 KICK_ANGLES = ("uniform", "gaussian")
 
 _REQUIRED = ("name", "radii", "n_ics", "n_steps", "tau")
 _NAME_RE = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]*$")
 
 
-def _real(name, value, *, low=None, high=None, low_open=True):
+def _real(name, value, *, low=None, high=None, low_open=True, high_open=True):
     if isinstance(value, bool) or not isinstance(value, numbers.Real):
         raise TypeError(f"{name}: expected a real number, got {value!r}")
     value = float(value)
@@ -47,8 +48,9 @@ def _real(name, value, *, low=None, high=None, low_open=True):
     if low is not None and (value <= low if low_open else value < low):
         bound = f"> {low}" if low_open else f">= {low}"
         raise ValueError(f"{name}: must be {bound}, got {value!r}")
-    if high is not None and value >= high:
-        raise ValueError(f"{name}: must be < {high}, got {value!r}")
+    if high is not None and (value >= high if high_open else value > high):
+        bound = f"< {high}" if high_open else f"<= {high}"
+        raise ValueError(f"{name}: must be {bound}, got {value!r}")
     return value
 
 
@@ -111,7 +113,11 @@ class Experiment:
     lag : int
         Autocorrelation lag ``>= 1``.
     d0 : float
-        Initial separation of the Lyapunov twins, ``0 < d0 < 0.1`` (the paper: 1/5000).
+        Initial separation of the Lyapunov twins, ``1e-10 <= d0 <= 1e-2`` (the paper:
+        1/5000); used only with ``lyapunov_method = "twin"``.
+    lyapunov_method : {"tangent", "twin"}
+        ``"tangent"``: exact tangent vectors (no ``d0``); ``"twin"``: Benettin twins at
+        distance ``d0`` (the paper's method). See `kicktimes.diagnostics.lyapunov`.
     lyapunov_variant : {"norm", "paper"}
         ``"paper"``: ``max(lambda_x, lambda_y)`` (also stores both); ``"norm"``: 2-norm.
     kick_angle : {"uniform", "gaussian"}
@@ -152,6 +158,7 @@ class Experiment:
     lag: int = 1
     d0: float = 1.0 / 5000.0
     lyapunov_variant: str = "norm"
+    lyapunov_method: str = "tangent"
     kick_angle: str = "uniform"
     sigma: float = 1.0
     systems: tuple = SYSTEMS
@@ -186,8 +193,9 @@ class Experiment:
         _choice("rule", self.rule, RULES)
         put("eps", _real("eps", self.eps, low=0.0))
         put("lag", _int("lag", self.lag, low=1))
-        put("d0", _real("d0", self.d0, low=0.0, high=0.1))
+        put("d0", _real("d0", self.d0, low=1e-10, high=1e-2, low_open=False, high_open=False))
         _choice("lyapunov_variant", self.lyapunov_variant, LYAPUNOV_VARIANTS)
+        _choice("lyapunov_method", self.lyapunov_method, LYAPUNOV_METHODS)
         _choice("kick_angle", self.kick_angle, KICK_ANGLES)
         put("sigma", _real("sigma", self.sigma, low=0.0))
         put("systems", _subset("systems", self.systems, SYSTEMS))
@@ -288,7 +296,8 @@ class Experiment:
             f"{self.r_max:g}); {self.n_steps} steps of tau = {self.tau:g} ({self.sampling} "
             f"sampling); rule {self.rule}\n"
             f"  systems: {', '.join(self.systems)}; diagnostics: {', '.join(self.diagnostics)}"
-            f" (eps = {self.eps:g}, lag = {self.lag}, d0 = {self.d0:g}, Lyapunov variant "
+            f" (eps = {self.eps:g}, lag = {self.lag}; Lyapunov {self.lyapunov_method}"
+            f"{f' d0 = {self.d0:g}' if self.lyapunov_method == 'twin' else ''}, variant "
             f"{self.lyapunov_variant}; kicks {self.kick_angle})\n"
             f"  {n_tasks} tasks of up to {self.block_size} ICs"
         )

@@ -205,6 +205,9 @@ def _run_ic(exp: Experiment, r: float, ic_index: int, ic: np.ndarray, rows, coll
     from kicktimes.schedules import Poisson
 
     steps = {"n_steps": exp.n_steps, "tau": exp.tau, "sampling": exp.sampling}
+    ftle_method = {"method": exp.lyapunov_method}
+    if exp.lyapunov_method == "twin":
+        ftle_method["d0"] = exp.d0
     diags = exp.diagnostics
 
     def add(system, diagnostic, value, note=""):
@@ -247,7 +250,8 @@ def _run_ic(exp: Experiment, r: float, ic_index: int, ic: np.ndarray, rows, coll
             "two_particle",
             two,
             lambda: _lyapunov()(
-                ic, r, rule=exp.rule, track=0, d0=exp.d0, variant=exp.lyapunov_variant, **steps
+                ic, r, rule=exp.rule, track=0, variant=exp.lyapunov_variant, **ftle_method,
+                **steps,
             ),
         )
 
@@ -287,8 +291,8 @@ def _run_ic(exp: Experiment, r: float, ic_index: int, ic: np.ndarray, rows, coll
                 r,
                 kicks=kick_times,
                 kick_angles=kick_angles,
-                d0=exp.d0,
                 variant=exp.lyapunov_variant,
+                **ftle_method,
                 **kick,
                 **steps,
             ),
