@@ -373,10 +373,11 @@ display(
 # The kicked runs share their ICs with the two-disk runs, so each kicked system is compared
 # with the two-disk system by the **paired** differences over ICs (mean ± standard error).
 #
-# When reading the FTLE, remember what a shared `"uniform"` kick does to the twins: both
-# get the *same new direction*, so the kick erases their velocity difference and only their
-# position offset survives it. Separation in the kicked billiards therefore grows only
-# between kicks, while disk-disk collisions of the two-disk billiard amplify it.
+# When reading the FTLE, remember what separates nearby trajectories. A disk-disk
+# collision between two round disks *defocuses*: it multiplies a small deviation by about
+# 1/r, so it stretches by about ln(1/r) nats. A state-blind kick (a new direction drawn
+# whatever the state) has no such amplification: it only turns the deviation it finds.
+# So the kicked FTLE is smaller, by about that much per perturbation (`lam_per_perturbation`).
 
 # %%
 wide = results.pivot_table(index=["diagnostic", "ic"], columns="system", values="value")
