@@ -1,0 +1,384 @@
+"""Benettin's twin-trajectory FTLE kernels (``lyapunov(..., method="twin")``).
+
+A twin starts ``d0`` away from the reference in the tracked disk's position. At every
+sample time ``t_k`` the separation ``d_k`` of the tracked disk's centres is measured,
+``log(d_k / d0)`` is added to a running sum and the twin's whole phase-space difference is
+scaled by ``f = d0 / max(d_k, |dx_i| for every disk i)`` (positions of every disk;
+velocity differences linearly, then renormalised to the rescaled speed, which scales the
+velocity *angle* difference to first order). The guard in ``f`` never blows a component
+up beyond ``d0``; the sum then telescopes over the actual growth factors
+``log(d_k / d_{k-1}^+)``, ``d^+`` the separation right after the previous rescaling.
+
+Billiard flows are discontinuous. When the reference and the twin straddle a collision
+at ``t_k`` (one has processed it, the other not yet), the renormalisation is *deferred*
+to the next sample at which both have processed the same sequence of events (event
+counts and an order-sensitive hash). After ``max_defer`` consecutive deferrals it is
+*forced* (the twin has left the reference) and its logarithm counted (``n_forced``).
+
+Kicked twins share the reference's kick times and angles (common random numbers).
+
+Every event loop has a budget: the kernels return a status (0 ok, 1 event budget
+exhausted, 2 too many events at one instant, 3 a non-finite event time) for the Python
+layer to turn into an error naming the input.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from kicktimes.billiard.geometry import boundary_hit_time, pair_hit_time
+from kicktimes.billiard.one_particle import next_event_one, process_event_one
+from kicktimes.billiard.two_particle import (
+    HASH_MOD,
+    init_events_two,
+    next_event_two,
+    process_event_two,
+)
+from kicktimes.diagnostics._tangent import MAX_SAME_INSTANT
+
+
+@njit(cache=True)
+def _rescaled(x, y, vx, vy, px, py, vx_ref, vy_ref, f, unit_speed):
+    """A twin disk scaled towards the reference disk (at ``px, py``) by ``f``.
+
+    Positions scale linearly; the velocity difference scales linearly and the result is
+    renormalised to the rescaled speed (first order: the angle difference scales by f).
+    Scalar in, scalar out, so numba inlines it in the per-sample loop.
+    """
+    x = px + (x - px) * f
+    y = py + (y - py) * f
+    wx = vx_ref + (vx - vx_ref) * f
+    wy = vy_ref + (vy - vy_ref) * f
+    if unit_speed:
+        speed = 1.0
+    else:
+        s_ref = math.sqrt(vx_ref * vx_ref + vy_ref * vy_ref)
+        s_tw = math.sqrt(vx * vx + vy * vy)
+        speed = s_ref + (s_tw - s_ref) * f
+    norm = math.sqrt(wx * wx + wy * wy)
+    if norm > 0.0:
+        wx *= speed / norm
+        wy *= speed / norm
+    else:
+        wx, wy = vx, vy
+    return x, y, wx, wy
+
+
+@njit(cache=True, inline="always")
+def _budget(dt, n_ev, n_same, max_events):
+    """Event-loop guard: ``(status, n_same)`` after one more event ``dt`` from now."""
+    if dt != dt:
+        return 3, n_same
+    if dt == 0.0:
+        n_same += 1
+        if n_same > MAX_SAME_INSTANT:
+            return 2, n_same
+    else:
+        n_same = 0
+    if n_ev > max_events:
+        return 1, n_same
+    return 0, n_same
+
+
+@njit(cache=True)
+def _separation(dx, dy, measure):
+    if measure == 0:
+        return math.sqrt(dx * dx + dy * dy)
+    if measure == 1:
+        return abs(dx)
+    return abs(dy)
+
+
+# The per-sample loops below are written out rather than calling a helper per sample: a
+# numba call with array arguments costs ~50 ns, as much as the rest of a sample's work,
+# and there are 25 000 samples per run. Array-taking kernels are called only per event.
+
+
+@njit(cache=True)
+def ftle_two_kernel(st0, rho, sigma, rule, mode, n_steps, tau, track, offsets, measure, d0,
+                    max_defer, max_events):
+    """Benettin FTLE for the two-disk billiard with ``len(offsets)`` twins.
+
+    Returns ``(log_sum, n_renorm, n_forced, n_deferred, t_last, n_pert, status)``; the
+    first five per twin, ``n_pert[j]`` the reference's disk-disk collisions up to
+    ``t_last[j]``.
+    """
+    m = offsets.shape[0]
+    nst = st0.shape[0]
+    ref = st0.copy()
+    ev_ref = np.empty(3)
+    init_events_two(ref, ev_ref, rho, sigma)
+    cnt_ref = np.zeros(5, dtype=np.int64)
+    tw = np.empty((m, nst))
+    ev_tw = np.empty((m, 3))
+    cnt_tw = np.zeros((m, 5), dtype=np.int64)
+    o = 1 + 4 * track
+    for j in range(m):
+        tw[j] = st0
+        tw[j, o] += offsets[j, 0]
+        tw[j, o + 1] += offsets[j, 1]
+        init_events_two(tw[j], ev_tw[j], rho, sigma)
+    log_sum = np.zeros(m)
+    n_renorm = np.zeros(m, dtype=np.int64)
+    n_forced = np.zeros(m, dtype=np.int64)
+    n_deferred = np.zeros(m, dtype=np.int64)
+    n_defer_now = np.zeros(m, dtype=np.int64)
+    t_last = np.zeros(m)
+    m_plus = np.full(m, d0)  # measured separation right after the last renormalisation
+    n_pert = np.zeros(m, dtype=np.int64)
+    pos = np.empty(4)
+    t_prev = 0.0
+    n_ev = 0
+    n_same = 0
+    status = 0
+    for k in range(1, n_steps + 1):
+        if mode == 1:
+            tk = k * tau
+        else:
+            tk = min(t_prev + tau, ref[0] + min(ev_ref[0], min(ev_ref[1], ev_ref[2])))
+        # the reference: every event at time <= tk, no flight on (positions interpolated)
+        while True:
+            ke, dt = next_event_two(ev_ref)
+            if not ref[0] + dt <= tk:
+                status = 3 if dt != dt else 0
+                break
+            n_ev += 1
+            status, n_same = _budget(dt, n_ev, n_same, max_events)
+            if status != 0:
+                break
+            process_event_two(ref, ev_ref, ke, rho, sigma, rule)
+            if ke == 2:
+                cnt_ref[0] += 1
+            else:
+                cnt_ref[1] += 1
+                cnt_ref[2 + ke] += 1
+            cnt_ref[4] = (cnt_ref[4] * 4 + ke + 1) % HASH_MOD
+        if status != 0:
+            break
+        ds = tk - ref[0]
+        for i in range(2):
+            q = 1 + 4 * i
+            pos[2 * i] = ref[q] + ref[q + 2] * ds
+            pos[2 * i + 1] = ref[q + 1] + ref[q + 3] * ds
+        for j in range(m):
+            while True:
+                ke = 0
+                dt = ev_tw[j, 0]
+                if ev_tw[j, 1] < dt:
+                    ke = 1
+                    dt = ev_tw[j, 1]
+                if ev_tw[j, 2] < dt:
+                    ke = 2
+                    dt = ev_tw[j, 2]
+                if not tw[j, 0] + dt <= tk:
+                    status = 3 if dt != dt else 0
+                    break
+                n_ev += 1
+                status, n_same = _budget(dt, n_ev, n_same, max_events)
+                if status != 0:
+                    break
+                process_event_two(tw[j], ev_tw[j], ke, rho, sigma, rule)
+                if ke == 2:
+                    cnt_tw[j, 0] += 1
+                else:
+                    cnt_tw[j, 1] += 1
+                    cnt_tw[j, 2 + ke] += 1
+                cnt_tw[j, 4] = (cnt_tw[j, 4] * 4 + ke + 1) % HASH_MOD
+            if status != 0:
+                break
+            # fly the twin on to tk
+            dt = tk - tw[j, 0]
+            tw[j, 1] += tw[j, 3] * dt
+            tw[j, 2] += tw[j, 4] * dt
+            tw[j, 5] += tw[j, 7] * dt
+            tw[j, 6] += tw[j, 8] * dt
+            ev_tw[j, 0] -= dt
+            ev_tw[j, 1] -= dt
+            ev_tw[j, 2] -= dt
+            tw[j, 0] = tk
+            tw[j, 9] = 0.0
+            d = _separation(tw[j, o] - pos[2 * track], tw[j, o + 1] - pos[2 * track + 1],
+                            measure[j])
+            same = True
+            for c in range(5):
+                if cnt_tw[j, c] != cnt_ref[c]:
+                    same = False
+            if d > 0.0 and (same or n_defer_now[j] >= max_defer):
+                if not same:
+                    n_forced[j] += 1
+                    for c in range(5):
+                        cnt_tw[j, c] = cnt_ref[c]
+                log_sum[j] += math.log(d / m_plus[j])
+                n_renorm[j] += 1
+                t_last[j] = tk
+                n_pert[j] = cnt_ref[0]
+                n_defer_now[j] = 0
+                big = d
+                for i in range(2):
+                    q = 1 + 4 * i
+                    ex = tw[j, q] - pos[2 * i]
+                    ey = tw[j, q + 1] - pos[2 * i + 1]
+                    big = max(big, math.sqrt(ex * ex + ey * ey))
+                f = d0 / big
+                m_plus[j] = d * f
+                for i in range(2):
+                    q = 1 + 4 * i
+                    a, b, c2, d2 = _rescaled(tw[j, q], tw[j, q + 1], tw[j, q + 2], tw[j, q + 3],
+                                             pos[2 * i], pos[2 * i + 1], ref[q + 2], ref[q + 3],
+                                             f, rule == 0)
+                    tw[j, q] = a
+                    tw[j, q + 1] = b
+                    tw[j, q + 2] = c2
+                    tw[j, q + 3] = d2
+                tw[j, 10] = (tw[j, 3] * tw[j, 3] + tw[j, 4] * tw[j, 4] + tw[j, 7] * tw[j, 7]
+                             + tw[j, 8] * tw[j, 8])
+                ev_tw[j, 0] = boundary_hit_time(tw[j, 1], tw[j, 2], tw[j, 3], tw[j, 4], rho)
+                ev_tw[j, 1] = boundary_hit_time(tw[j, 5], tw[j, 6], tw[j, 7], tw[j, 8], rho)
+                ev_tw[j, 2] = pair_hit_time(tw[j, 1] - tw[j, 5], tw[j, 2] - tw[j, 6],
+                                            tw[j, 3] - tw[j, 7], tw[j, 4] - tw[j, 8], sigma)
+            else:
+                n_defer_now[j] += 1
+                n_deferred[j] += 1
+        t_prev = tk
+        if status != 0:
+            break
+    return log_sum, n_renorm, n_forced, n_deferred, t_last, n_pert, status
+
+
+@njit(cache=True)
+def ftle_one_kernel(st0, rho, kicks, angles, kick_mode, mode, n_steps, tau, offsets, measure, d0,
+                    max_defer, max_events):
+    """Benettin FTLE for the kicked one-disk billiard.
+
+    Twins share the kick times and angles (common random numbers). Returns as
+    `ftle_two_kernel`, ``n_pert`` counting the kicks applied.
+    """
+    m = offsets.shape[0]
+    nk = kicks.shape[0]
+    unit_speed = abs(st0[3] * st0[3] + st0[4] * st0[4] - 1.0) < 1e-12
+    ref = st0.copy()
+    ev_ref = np.empty(1)
+    ev_ref[0] = boundary_hit_time(ref[1], ref[2], ref[3], ref[4], rho)
+    cnt_ref = np.zeros(3, dtype=np.int64)
+    tw = np.empty((m, st0.shape[0]))
+    ev_tw = np.empty((m, 1))
+    cnt_tw = np.zeros((m, 3), dtype=np.int64)
+    for j in range(m):
+        tw[j] = st0
+        tw[j, 1] += offsets[j, 0]
+        tw[j, 2] += offsets[j, 1]
+        ev_tw[j, 0] = boundary_hit_time(tw[j, 1], tw[j, 2], tw[j, 3], tw[j, 4], rho)
+    log_sum = np.zeros(m)
+    n_renorm = np.zeros(m, dtype=np.int64)
+    n_forced = np.zeros(m, dtype=np.int64)
+    n_deferred = np.zeros(m, dtype=np.int64)
+    n_defer_now = np.zeros(m, dtype=np.int64)
+    t_last = np.zeros(m)
+    m_plus = np.full(m, d0)
+    n_pert = np.zeros(m, dtype=np.int64)
+    t_prev = 0.0
+    n_ev = 0
+    n_same = 0
+    status = 0
+    for k in range(1, n_steps + 1):
+        if mode == 1:
+            tk = k * tau
+        else:
+            _, dtn = next_event_one(ref, ev_ref, kicks, cnt_ref)
+            tk = min(t_prev + tau, ref[0] + dtn)
+        while True:
+            ik = cnt_ref[0]
+            is_kick = False
+            dt = ev_ref[0]
+            if ik < nk and kicks[ik] - ref[0] < dt:
+                is_kick = True
+                dt = kicks[ik] - ref[0]
+            if not ref[0] + dt <= tk:
+                status = 3 if dt != dt else 0
+                break
+            n_ev += 1
+            status, n_same = _budget(dt, n_ev, n_same, max_events)
+            if status != 0:
+                break
+            if is_kick:
+                process_event_one(ref, ev_ref, True, dt, rho, kicks[ik], angles[ik], kick_mode,
+                                  False)
+                cnt_ref[0] += 1
+                cnt_ref[2] = (cnt_ref[2] * 4 + 4) % HASH_MOD
+            else:
+                process_event_one(ref, ev_ref, False, dt, rho, 0.0, 0.0, kick_mode, False)
+                cnt_ref[1] += 1
+                cnt_ref[2] = (cnt_ref[2] * 4 + 1) % HASH_MOD
+        if status != 0:
+            break
+        ds = tk - ref[0]
+        px = ref[1] + ref[3] * ds
+        py = ref[2] + ref[4] * ds
+        for j in range(m):
+            while True:
+                ik = cnt_tw[j, 0]
+                is_kick = False
+                dt = ev_tw[j, 0]
+                if ik < nk and kicks[ik] - tw[j, 0] < dt:
+                    is_kick = True
+                    dt = kicks[ik] - tw[j, 0]
+                if not tw[j, 0] + dt <= tk:
+                    status = 3 if dt != dt else 0
+                    break
+                n_ev += 1
+                status, n_same = _budget(dt, n_ev, n_same, max_events)
+                if status != 0:
+                    break
+                if is_kick:
+                    process_event_one(tw[j], ev_tw[j], True, dt, rho, kicks[ik], angles[ik],
+                                      kick_mode, False)
+                    cnt_tw[j, 0] += 1
+                    cnt_tw[j, 2] = (cnt_tw[j, 2] * 4 + 4) % HASH_MOD
+                else:
+                    process_event_one(tw[j], ev_tw[j], False, dt, rho, 0.0, 0.0, kick_mode, False)
+                    cnt_tw[j, 1] += 1
+                    cnt_tw[j, 2] = (cnt_tw[j, 2] * 4 + 1) % HASH_MOD
+            if status != 0:
+                break
+            dt = tk - tw[j, 0]
+            tw[j, 1] += tw[j, 3] * dt
+            tw[j, 2] += tw[j, 4] * dt
+            ev_tw[j, 0] -= dt
+            tw[j, 0] = tk
+            tw[j, 5] = 0.0
+            d = _separation(tw[j, 1] - px, tw[j, 2] - py, measure[j])
+            same = (cnt_tw[j, 0] == cnt_ref[0] and cnt_tw[j, 1] == cnt_ref[1]
+                    and cnt_tw[j, 2] == cnt_ref[2])
+            if d > 0.0 and (same or n_defer_now[j] >= max_defer):
+                if not same:
+                    n_forced[j] += 1
+                    for c in range(3):
+                        cnt_tw[j, c] = cnt_ref[c]
+                log_sum[j] += math.log(d / m_plus[j])
+                n_renorm[j] += 1
+                t_last[j] = tk
+                n_pert[j] = cnt_ref[0]
+                n_defer_now[j] = 0
+                ex = tw[j, 1] - px
+                ey = tw[j, 2] - py
+                f = d0 / max(d, math.sqrt(ex * ex + ey * ey))
+                m_plus[j] = d * f
+                a, b, c2, d2 = _rescaled(tw[j, 1], tw[j, 2], tw[j, 3], tw[j, 4], px, py, ref[3],
+                                         ref[4], f, unit_speed)
+                tw[j, 1] = a
+                tw[j, 2] = b
+                tw[j, 3] = c2
+                tw[j, 4] = d2
+                ev_tw[j, 0] = boundary_hit_time(a, b, c2, d2, rho)
+            else:
+                n_defer_now[j] += 1
+                n_deferred[j] += 1
+        t_prev = tk
+        if status != 0:
+            break
+    return log_sum, n_renorm, n_forced, n_deferred, t_last, n_pert, status
+
+
