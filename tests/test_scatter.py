@@ -271,3 +271,47 @@ def test_scatter_needs_two_disks_that_fit():
     with pytest.raises(ValueError, match="r must be < 0.5"):
         simulate_one_particle([0.0, 0.0, 1.0, 0.0], 0.6, t_max=10.0, kicks=[1.0],
                               kick_angle="scatter")
+
+
+# --- Lyapunov exponents of scatter-kicked runs ------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def scatter_run():
+    return simulate_one_particle(STATE, 0.02, kicks=schedules.Poisson(0.05),
+                                 kick_angle="scatter", rng=11, n_steps=5000, tau=0.2)
+
+
+def test_lyapunov_of_a_scatter_run_agrees_between_tangent_and_small_twin(scatter_run):
+    from kicktimes.diagnostics import lyapunov
+
+    tangent = lyapunov(scatter_run)
+    twin = lyapunov(scatter_run, method="twin", d0=1e-9)
+    assert tangent.n_perturbations == scatter_run.n_kicks > 20
+    assert tangent.lam > 0.05
+    assert twin.lam == pytest.approx(tangent.lam, rel=0.02)
+
+
+def test_scatter_kicks_stretch_more_than_state_blind_kicks(scatter_run):
+    from kicktimes.diagnostics import lyapunov
+
+    blind = lyapunov(STATE, 0.02, kicks=scatter_run.kick_times, n_steps=5000, tau=0.2, rng=1)
+    assert lyapunov(scatter_run).lam > 2.0 * blind.lam
+
+
+@pytest.mark.parametrize("rule", ["mirror", "elastic"])
+def test_tangent_scatter_exponent_matches_twin_for_both_rules(rule):
+    from kicktimes.diagnostics import lyapunov
+
+    kw = dict(kicks=schedules.Poisson(0.05), kick_angle="scatter", rule=rule, rng=5,
+              n_steps=4000, tau=0.2)
+    tangent = lyapunov(STATE, 0.02, **kw)
+    twin = lyapunov(STATE, 0.02, method="twin", d0=1e-9, **kw)
+    assert twin.lam == pytest.approx(tangent.lam, rel=0.02)
+
+
+def test_lyapunov_refuses_scatter_options_without_scatter_kicks():
+    from kicktimes.diagnostics import lyapunov
+
+    with pytest.raises(ValueError, match="kick_angle='scatter'"):
+        lyapunov(STATE, 0.02, kicks=[1.0], rule="elastic", n_steps=10, tau=0.2)

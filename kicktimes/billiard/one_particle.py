@@ -29,6 +29,7 @@ from kicktimes.billiard.scatter import (
     PARTNER_LAWS,
     draw_scatter_uniforms,
     scatter_kick,
+    twin_meets_partner,
 )
 from kicktimes.billiard.two_particle import _grow
 
@@ -137,6 +138,28 @@ def process_scatter_one(st, ev, dt, rho, kick_time, a, b, sp, out):
     st[5] = 0.0
     scatter_kick(st, a, b, sp[0], rho, int(sp[1]), sp[2], int(sp[3]), out)
     ev[0] = boundary_hit_time(st[1], st[2], st[3], st[4], rho)
+
+
+@njit(cache=True)
+def process_twin_scatter_one(st, ev, dt, rho, kick_time, partner, sp):
+    """Fly a Lyapunov twin ``dt`` to ``kick_time`` and let it meet the reference's partner.
+
+    ``partner = [px, py, ux, uy]``: the partner's centre and velocity at the kick time,
+    placed in contact with the reference (`kicktimes.billiard.scatter.twin_meets_partner`).
+    Returns True if the twin hit the partner, False if it missed it (unchanged).
+    """
+    drift_one(st, ev, dt)
+    st[0] = kick_time
+    st[5] = 0.0
+    x, y, vx, vy, hit = twin_meets_partner(st[1], st[2], st[3], st[4], partner[0], partner[1],
+                                           partner[2], partner[3], sp[0], int(sp[1]))
+    st[1] = x
+    st[2] = y
+    st[3] = vx
+    st[4] = vy
+    st[6] = vx * vx + vy * vy
+    ev[0] = boundary_hit_time(x, y, vx, vy, rho)
+    return hit
 
 
 @njit(cache=True, inline="always")
