@@ -1,6 +1,7 @@
 """Chaos diagnostics of sampled trajectories and boundary-collision series.
 
-Recurrence rate and recurrence plots (`recurrence_rate`, `recurrence_pairs`), the paper's
+Recurrence rate and recurrence plots (`recurrence_rate`, `recurrence_pairs`), recurrence
+quantification (`rqa`: determinism, line lengths, laminarity), the paper's
 autocorrelation of the boundary-collision angles (`autocorrelation`,
 `autocorrelation_many`, `boundary_angles`) and finite-time Lyapunov exponents
 (`lyapunov`, Benettin twins with common random numbers); see docs/diagnostics.md.
@@ -14,9 +15,11 @@ from kicktimes.diagnostics.autocorrelation import (
 )
 from kicktimes.diagnostics.lyapunov import LyapunovResult, lyapunov
 from kicktimes.diagnostics.recurrence import recurrence_pairs, recurrence_rate
+from kicktimes.diagnostics.rqa import RQAResult, rqa
 
 __all__ = [
     "LyapunovResult",
+    "RQAResult",
     "UndefinedDiagnosticWarning",
     "autocorrelation",
     "autocorrelation_many",
@@ -24,4 +27,5 @@ __all__ = [
     "lyapunov",
     "recurrence_pairs",
     "recurrence_rate",
+    "rqa",
 ]
