@@ -3,8 +3,10 @@
 Recurrence rate and recurrence plots (`recurrence_rate`, `recurrence_pairs`), recurrence
 quantification (`rqa`: determinism, line lengths, laminarity), the paper's
 autocorrelation of the boundary-collision angles (`autocorrelation`,
-`autocorrelation_many`, `boundary_angles`) and finite-time Lyapunov exponents
-(`lyapunov`, Benettin twins with common random numbers); see docs/diagnostics.md.
+`autocorrelation_many`, `boundary_angles`), its curve over lags and decay
+(`autocorrelation_function`, `decorrelation_lag`, `integrated_autocorrelation_time`)
+and finite-time Lyapunov exponents (`lyapunov`, Benettin twins with common random
+numbers); see docs/diagnostics.md.
 """
 
 from kicktimes.diagnostics.autocorrelation import (
@@ -12,6 +14,11 @@ from kicktimes.diagnostics.autocorrelation import (
     autocorrelation,
     autocorrelation_many,
     boundary_angles,
+)
+from kicktimes.diagnostics.decorrelation import (
+    autocorrelation_function,
+    decorrelation_lag,
+    integrated_autocorrelation_time,
 )
 from kicktimes.diagnostics.lyapunov import LyapunovResult, lyapunov
 from kicktimes.diagnostics.recurrence import recurrence_pairs, recurrence_rate
@@ -22,8 +29,11 @@ __all__ = [
     "RQAResult",
     "UndefinedDiagnosticWarning",
     "autocorrelation",
+    "autocorrelation_function",
     "autocorrelation_many",
     "boundary_angles",
+    "decorrelation_lag",
+    "integrated_autocorrelation_time",
     "lyapunov",
     "recurrence_pairs",
     "recurrence_rate",
