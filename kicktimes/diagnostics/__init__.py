@@ -1,9 +1,12 @@
 """Chaos diagnostics of sampled trajectories and boundary-collision series.
 
-Recurrence rate and recurrence plots (`recurrence_rate`, `recurrence_pairs`), the paper's
+Recurrence rate and recurrence plots (`recurrence_rate`, `recurrence_pairs`), recurrence
+quantification (`rqa`: determinism, line lengths, laminarity), the paper's
 autocorrelation of the boundary-collision angles (`autocorrelation`,
-`autocorrelation_many`, `boundary_angles`) and finite-time Lyapunov exponents
-(`lyapunov`, Benettin twins with common random numbers); see docs/diagnostics.md.
+`autocorrelation_many`, `boundary_angles`), its curve over lags and decay
+(`autocorrelation_function`, `decorrelation_lag`, `integrated_autocorrelation_time`)
+and finite-time Lyapunov exponents (`lyapunov`, Benettin twins with common random
+numbers); see docs/diagnostics.md.
 """
 
 from kicktimes.diagnostics.autocorrelation import (
@@ -12,16 +15,27 @@ from kicktimes.diagnostics.autocorrelation import (
     autocorrelation_many,
     boundary_angles,
 )
+from kicktimes.diagnostics.decorrelation import (
+    autocorrelation_function,
+    decorrelation_lag,
+    integrated_autocorrelation_time,
+)
 from kicktimes.diagnostics.lyapunov import LyapunovResult, lyapunov
 from kicktimes.diagnostics.recurrence import recurrence_pairs, recurrence_rate
+from kicktimes.diagnostics.rqa import RQAResult, rqa
 
 __all__ = [
     "LyapunovResult",
+    "RQAResult",
     "UndefinedDiagnosticWarning",
     "autocorrelation",
+    "autocorrelation_function",
     "autocorrelation_many",
     "boundary_angles",
+    "decorrelation_lag",
+    "integrated_autocorrelation_time",
     "lyapunov",
     "recurrence_pairs",
     "recurrence_rate",
+    "rqa",
 ]

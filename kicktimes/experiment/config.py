@@ -33,6 +33,13 @@ SAMPLINGS = ("uniform", "paper")
 RULES = ("mirror", "elastic")
 LYAPUNOV_VARIANTS = ("norm", "paper")
 KICK_ANGLES = ("uniform", "gaussian")
+RR_SAMPLINGS = ("run", "uniform")
+
+#: Fields added after the first store layout, with the value that reproduces the earlier
+#: results: `Experiment.hash` leaves a field out while it has that value (and writes a
+#: single ``eps`` as a float, as before), so stores written before the field existed keep
+#: their hash and still load. Their results simply lack the rows added since.
+_LATER_FIELDS = {"acf_max_lag": 20, "rr_sampling": "run"}
 
 _REQUIRED = ("name", "radii", "n_ics", "n_steps", "tau")
 _NAME_RE = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]*$")
@@ -64,6 +71,20 @@ def _choice(name, value, choices):
     if not isinstance(value, str) or value not in choices:
         raise ValueError(f"{name}: must be one of {', '.join(map(repr, choices))}; got {value!r}")
     return value
+
+
+def _eps_tuple(value):
+    """A positive threshold or a non-empty list of distinct ones, as a tuple (order kept)."""
+    if isinstance(value, (str, bytes)):
+        raise TypeError(f"eps: expected a float or a list of floats, got {value!r}")
+    if not hasattr(value, "__iter__"):
+        return (_real("eps", value, low=0.0),)
+    items = [_real(f"eps[{k}]", e, low=0.0) for k, e in enumerate(value)]
+    if not items:
+        raise ValueError("eps: must contain at least one recurrence threshold, got []")
+    if len(set(items)) != len(items):
+        raise ValueError(f"eps: thresholds must be distinct, got {items}")
+    return tuple(items)
 
 
 def _subset(name, value, choices):
@@ -106,10 +127,21 @@ class Experiment:
         steps cover less than ``n_steps * tau``); ``"uniform"``: samples at ``k tau``.
     rule : {"mirror", "elastic"}
         Disk-disk collision rule.
-    eps : float
-        Recurrence threshold ``> 0`` (the paper: 0.001).
+    eps : float or sequence of float
+        Recurrence thresholds ``> 0``, distinct (a single float is stored as a 1-tuple).
+        ``eps[0]`` is the threshold of the ``recurrence_rate`` row (the paper: 0.001);
+        every threshold gets the ``rr@``/``rr_offdiag@``/``det@``/``l_mean@``/``l_max@``
+        rows (docs/experiments.md).
+    rr_sampling : {"run", "uniform"}
+        The samples the recurrence rows use. ``"run"``: the run's own samples (under
+        ``sampling="paper"`` the paper's collision-truncated steps); ``"uniform"``: samples
+        at ``k tau`` over the run's duration, from a uniformly sampled re-run of the same
+        trajectory with the same kicks (identical to ``"run"`` when
+        ``sampling="uniform"``).
     lag : int
-        Autocorrelation lag ``>= 1``.
+        Autocorrelation lag ``>= 1`` of the ``autocorrelation`` row.
+    acf_max_lag : int
+        Largest lag ``>= 1`` of the autocorrelation curve (rows ``acf@1..acf@L``).
     d0 : float
         Initial separation of the Lyapunov twins, ``0 < d0 < 0.1`` (the paper: 1/5000).
     lyapunov_variant : {"norm", "paper"}
@@ -148,8 +180,10 @@ class Experiment:
     seed: int = 0
     sampling: str = "uniform"
     rule: str = "mirror"
-    eps: float = 1e-3
+    eps: tuple = (1e-3, 1e-2)
+    rr_sampling: str = "run"
     lag: int = 1
+    acf_max_lag: int = 20
     d0: float = 1.0 / 5000.0
     lyapunov_variant: str = "norm"
     kick_angle: str = "uniform"
@@ -184,8 +218,10 @@ class Experiment:
         put("seed", _int("seed", self.seed, low=0))
         _choice("sampling", self.sampling, SAMPLINGS)
         _choice("rule", self.rule, RULES)
-        put("eps", _real("eps", self.eps, low=0.0))
+        put("eps", _eps_tuple(self.eps))
+        _choice("rr_sampling", self.rr_sampling, RR_SAMPLINGS)
         put("lag", _int("lag", self.lag, low=1))
+        put("acf_max_lag", _int("acf_max_lag", self.acf_max_lag, low=1))
         put("d0", _real("d0", self.d0, low=0.0, high=0.1))
         _choice("lyapunov_variant", self.lyapunov_variant, LYAPUNOV_VARIANTS)
         _choice("kick_angle", self.kick_angle, KICK_ANGLES)
@@ -217,7 +253,7 @@ class Experiment:
     def to_dict(self) -> dict:
         """JSON/TOML-ready dict of every field (tuples become lists)."""
         out = asdict(self)
-        for key in ("radii", "systems", "diagnostics"):
+        for key in ("radii", "eps", "systems", "diagnostics"):
             out[key] = list(out[key])
         return out
 
@@ -238,8 +274,19 @@ class Experiment:
         return cls(**d)
 
     def hash(self) -> str:
-        """Stable identity: the first 16 hex digits of SHA-256 of the canonical JSON."""
-        text = json.dumps(self.to_dict(), sort_keys=True, separators=(",", ":"), allow_nan=False)
+        """Stable identity: the first 16 hex digits of SHA-256 of the canonical JSON.
+
+        The canonical form is `to_dict` except that fields added later are left out while
+        they keep the value that reproduces the earlier results, and a single ``eps`` is
+        written as a float: stores written before those fields existed keep their hash.
+        """
+        record = self.to_dict()
+        for key, legacy in _LATER_FIELDS.items():
+            if record[key] == legacy:
+                del record[key]
+        if len(record["eps"]) == 1:
+            record["eps"] = record["eps"][0]
+        text = json.dumps(record, sort_keys=True, separators=(",", ":"), allow_nan=False)
         return hashlib.sha256(text.encode()).hexdigest()[:16]
 
     def to_toml(self) -> str:
@@ -288,7 +335,8 @@ class Experiment:
             f"{self.r_max:g}); {self.n_steps} steps of tau = {self.tau:g} ({self.sampling} "
             f"sampling); rule {self.rule}\n"
             f"  systems: {', '.join(self.systems)}; diagnostics: {', '.join(self.diagnostics)}"
-            f" (eps = {self.eps:g}, lag = {self.lag}, d0 = {self.d0:g}, Lyapunov variant "
+            f" (eps = {', '.join(f'{e:g}' for e in self.eps)} on {self.rr_sampling} samples, "
+            f"lag = {self.lag}, ACF to lag {self.acf_max_lag}, d0 = {self.d0:g}, Lyapunov variant "
             f"{self.lyapunov_variant}; kicks {self.kick_angle})\n"
             f"  {n_tasks} tasks of up to {self.block_size} ICs"
         )
