@@ -315,3 +315,30 @@ def test_lyapunov_refuses_scatter_options_without_scatter_kicks():
 
     with pytest.raises(ValueError, match="kick_angle='scatter'"):
         lyapunov(STATE, 0.02, kicks=[1.0], rule="elastic", n_steps=10, tau=0.2)
+
+
+# --- scatter-kicked systems in an experiment ---------------------------------------------
+
+
+def test_experiment_scatter_systems_leave_the_papers_systems_bitwise_unchanged():
+    from kicktimes.experiment import Experiment, run_task
+
+    base = dict(name="sc", radii=[0.02], n_ics=2, n_steps=300, tau=0.3, sampling="paper",
+                diagnostics=["recurrence_rate", "autocorrelation"])
+    paper = Experiment(**base)
+    both = Experiment(**base, systems=["two_particle", "poisson", "actual", "poisson_scatter",
+                                       "actual_scatter"])
+    assert paper.systems == ("two_particle", "poisson", "actual")
+    res_paper, coll_paper = run_task(paper, paper.tasks()[0])
+    res_both, coll_both = run_task(both, both.tasks()[0])
+    old = res_both[res_both.system.isin(paper.systems)].reset_index(drop=True)
+    assert old.equals(res_paper)
+    assert coll_both.equals(coll_paper)
+    new = res_both[res_both.system.str.endswith("_scatter")]
+    assert set(new.system) == {"poisson_scatter", "actual_scatter"}
+    kicks = new[new.diagnostic == "n_kicks"].set_index(["ic", "system"]).value
+    assert (kicks > 0).all()
+    # the actual-time scatter system replays the two-disk collision times
+    actual = res_both[res_both.diagnostic == "n_kicks"].set_index(["ic", "system"]).value
+    for ic in (0, 1):
+        assert actual[(ic, "actual_scatter")] == actual[(ic, "actual")]

@@ -24,9 +24,11 @@ import os
 import re
 from dataclasses import asdict, dataclass, field, fields
 
-__all__ = ["DIAGNOSTICS", "SYSTEMS", "Experiment"]
+__all__ = ["DEFAULT_SYSTEMS", "DIAGNOSTICS", "SYSTEMS", "Experiment"]
 
-SYSTEMS = ("two_particle", "poisson", "actual")
+SYSTEMS = ("two_particle", "poisson", "actual", "poisson_scatter", "actual_scatter")
+#: The paper's systems, run when an experiment names none (scattering kicks are opt-in)
+DEFAULT_SYSTEMS = ("two_particle", "poisson", "actual")
 DIAGNOSTICS = ("lyapunov", "recurrence_rate", "autocorrelation")
 IC_METHODS = ("paper", "uniform")
 SAMPLINGS = ("uniform", "paper")
@@ -150,9 +152,12 @@ class Experiment:
         Kick law of the one-particle billiards; ``sigma`` (``> 0``) is the standard
         deviation of the gaussian rotation (unused for ``"uniform"``).
     systems : sequence of str
-        Subset of ``("two_particle", "poisson", "actual")`` whose diagnostics are stored.
-        The two-particle run is always simulated (its collision times are stored and
-        drive the other two).
+        Subset of ``("two_particle", "poisson", "actual", "poisson_scatter",
+        "actual_scatter")`` whose diagnostics are stored (default the first three, the
+        paper's). The two-particle run is always simulated (its collision times are
+        stored and drive the others). The ``*_scatter`` systems are kicked at the same
+        kinds of times but by scattering kicks (a collision with a virtual partner under
+        ``rule``, docs/scatter.md) instead of ``kick_angle``.
     diagnostics : sequence of str
         Subset of ``("lyapunov", "recurrence_rate", "autocorrelation")``.
     block_size : int
@@ -188,7 +193,7 @@ class Experiment:
     lyapunov_variant: str = "norm"
     kick_angle: str = "uniform"
     sigma: float = 1.0
-    systems: tuple = SYSTEMS
+    systems: tuple = DEFAULT_SYSTEMS
     diagnostics: tuple = DIAGNOSTICS
     block_size: int = 25
     description: str = field(default="")

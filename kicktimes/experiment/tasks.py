@@ -6,7 +6,9 @@
    times for the collision-time table;
 2. the Poisson-kicked one-particle billiard started from disk 0's IC, kicked at the rate
    ``n_pp / t_max`` of that IC's two-particle run (the paper's per-IC estimate);
-3. the actual-time one-particle billiard, kicked at that run's disk-disk collision times.
+3. the actual-time one-particle billiard, kicked at that run's disk-disk collision times;
+4. optionally (``poisson_scatter``, ``actual_scatter``) the same two kinds of kick times
+   with scattering kicks, a collision with a virtual partner (docs/scatter.md).
 
 Every random number of (IC, radius, system) comes from its own
 ``SeedSequence(seed, spawn_key=(KICK_DOMAIN, ic, radius bits, system code))``, so the
@@ -45,7 +47,8 @@ COLLISION_COLUMNS = ("radius", "ic", "t_window", "n_pp", "pp_times")
 #: First spawn-key word of the kick streams; IC streams use ``spawn_key=(i,)``, so the two
 #: families of streams can never coincide (their keys differ in length and content).
 KICK_DOMAIN = 0x6B69636B  # "kick"
-SYSTEM_CODES = {"two_particle": 0, "poisson": 1, "actual": 2}
+SYSTEM_CODES = {"two_particle": 0, "poisson": 1, "actual": 2, "poisson_scatter": 3,
+                "actual_scatter": 4}
 
 
 @dataclass(frozen=True)
@@ -255,19 +258,22 @@ def _run_ic(exp: Experiment, r: float, ic_index: int, ic: np.ndarray, rows, coll
         )
 
     horizon = exp.horizon
-    kick = {"kick_angle": exp.kick_angle, "sigma": exp.sigma}
-    for system in ("poisson", "actual"):
+    actual_times = None
+    for system in ("poisson", "actual", "poisson_scatter", "actual_scatter"):
         if system not in exp.systems:
             continue
+        kick = _kick_law(exp, system, ic)
         rng = kick_rng(exp.seed, ic_index, r, system)
-        if system == "actual":
-            with timer("simulation_two_particle"):
-                kick_times = _actual_times(exp, ic, r, two)
+        if system.startswith("actual"):
+            if actual_times is None:
+                with timer("simulation_two_particle"):
+                    actual_times = _actual_times(exp, ic, r, two)
+            kick_times = actual_times
         with timer("simulation_one_particle"):
-            if system == "poisson":
+            if system.startswith("poisson"):
                 rate = two.n_pp / two.t_max
                 kick_times = Poisson(rate).sample(horizon, rng)
-            kick_angles = draw_kick_angles(kick_times.size, exp.kick_angle, exp.sigma, rng)
+            kick_angles = draw_kick_angles(kick_times.size, kick["kick_angle"], exp.sigma, rng)
             one = simulate_one_particle(
                 ic[0],
                 r,
@@ -278,14 +284,14 @@ def _run_ic(exp: Experiment, r: float, ic_index: int, ic: np.ndarray, rows, coll
                 **steps,
             )
         add(system, "t_max", one.t_max)
-        if system == "poisson":
+        if system.startswith("poisson"):
             add(system, "kick_rate", rate)
         add(system, "n_kicks", one.n_kicks)
         add(system, "n_boundary", one.n_boundary)
         diagnose(
             system,
             one,
-            lambda kick_times=kick_times, kick_angles=kick_angles: _lyapunov()(
+            lambda kick_times=kick_times, kick_angles=kick_angles, kick=kick: _lyapunov()(
                 ic[0],
                 r,
                 kicks=kick_times,
@@ -296,6 +302,19 @@ def _run_ic(exp: Experiment, r: float, ic_index: int, ic: np.ndarray, rows, coll
                 **steps,
             ),
         )
+
+
+def _kick_law(exp: Experiment, system: str, ic: np.ndarray) -> dict:
+    """Keyword arguments of the kicks of a one-particle ``system``.
+
+    The paper's systems use ``exp.kick_angle``; the ``*_scatter`` systems collide with a
+    virtual partner under the experiment's rule, with the two-disk IC's kinetic energy
+    (elastic rule).
+    """
+    if not system.endswith("_scatter"):
+        return {"kick_angle": exp.kick_angle, "sigma": exp.sigma}
+    e0 = 0.5 * float((ic[:, 2:] ** 2).sum()) if exp.rule == "elastic" else None
+    return {"kick_angle": "scatter", "sigma": exp.sigma, "rule": exp.rule, "e0": e0}
 
 
 def eps_label(eps: float) -> str:
@@ -392,9 +411,8 @@ def _uniform_samples(exp: Experiment, system: str, ic: np.ndarray, r: float, run
             tau=exp.tau,
             kicks=run.kick_times,
             kick_angles=run.kick_angles,
-            kick_angle=exp.kick_angle,
-            sigma=exp.sigma,
             sampling="uniform",
+            **_kick_law(exp, system, ic),
         )
     return again.samples
 
