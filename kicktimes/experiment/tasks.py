@@ -253,7 +253,8 @@ def _run_ic(exp: Experiment, r: float, ic_index: int, ic: np.ndarray, rows, coll
             "two_particle",
             two,
             lambda: _lyapunov()(
-                ic, r, rule=exp.rule, track=0, d0=exp.d0, variant=exp.lyapunov_variant, **steps
+                ic, r, rule=exp.rule, track=0, method="twin", d0=exp.d0,
+                variant=exp.lyapunov_variant, **steps,
             ),
         )
 
@@ -296,6 +297,7 @@ def _run_ic(exp: Experiment, r: float, ic_index: int, ic: np.ndarray, rows, coll
                 r,
                 kicks=kick_times,
                 kick_angles=kick_angles,
+                method="twin",
                 d0=exp.d0,
                 variant=exp.lyapunov_variant,
                 **kick,
