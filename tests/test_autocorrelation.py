@@ -14,8 +14,11 @@ from statsmodels.tsa.stattools import acf
 from kicktimes.diagnostics import (
     UndefinedDiagnosticWarning,
     autocorrelation,
+    autocorrelation_function,
     autocorrelation_many,
     boundary_angles,
+    decorrelation_lag,
+    integrated_autocorrelation_time,
 )
 
 
@@ -360,3 +363,143 @@ def test_simulated_runs_unkicked_disk_is_constant_and_two_disks_are_not():
     assert np.isnan(value) and reason.startswith("constant")  # integrable: sin(theta) fixed
     r1 = autocorrelation(boundary_angles(two))
     assert np.isfinite(r1) and -1.0 <= r1 <= 1.0
+
+
+# ------------------------------------------------------------------ extreme magnitudes
+
+
+@pytest.mark.parametrize("scale", [1e308, 1e200, 1e-200, 5e-324])
+def test_huge_and_tiny_series_do_not_overflow_or_underflow(scale):
+    x = np.array([1.0, -1.0, 1.0])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # neither NaN nor an overflow warning
+        value = autocorrelation(x * scale, rtol=0.0, atol=0.0)
+    assert value == pytest.approx(-2.0 / 3.0, rel=1e-15)
+
+
+def test_scaling_is_exact_so_ordinary_values_are_unchanged():
+    x = ar1(0.5, 5000, seed=3)
+    for lag in (1, 2, 5):
+        for power in (600, -600, 1000):  # a power of two: exactly the same sums, scaled
+            scaled = autocorrelation(x * 2.0**power, lag, atol=0.0)  # atol is absolute
+            assert scaled == autocorrelation(x, lag)
+        assert autocorrelation(x, lag) == pytest.approx(paper_formula(x, lag), abs=1e-12)
+
+
+# ------------------------------------------------------------------ the curve R_1..R_L
+
+
+def test_curve_is_bitwise_the_lag_by_lag_autocorrelation():
+    x = ar1(0.8, 3000, seed=4)
+    curve = autocorrelation_function(x, 25)
+    assert curve.shape == (25,)
+    assert_array_equal(curve, [autocorrelation(x, lag) for lag in range(1, 26)])
+
+
+def test_curve_equals_statsmodels_acf():
+    x = ar1(-0.4, 2000, seed=5)
+    assert_allclose(autocorrelation_function(x, 20), acf(x, nlags=20)[1:], atol=1e-12)
+
+
+def test_curve_of_ar1_decays_as_phi_to_the_lag():
+    x = ar1(0.7, 40_000, seed=6)
+    curve = autocorrelation_function(x, 8)
+    assert_allclose(curve, 0.7 ** np.arange(1, 9), atol=0.03)
+
+
+def test_curve_of_a_constant_series_is_nan_with_one_warning():
+    with pytest.warns(UndefinedDiagnosticWarning, match="constant series") as record:
+        curve = autocorrelation_function(np.full(50, 0.3), 5)
+    assert len(record) == 1 and np.isnan(curve).all()
+    curve, reason = autocorrelation_function(np.full(50, 0.3), 5, return_reason=True)
+    assert np.isnan(curve).all() and reason.startswith("constant series")
+
+
+def test_curve_of_a_short_series_is_nan_beyond_its_length():
+    x = np.array([1.0, 3.0, 2.0, 5.0])
+    curve, reason = autocorrelation_function(x, 6, return_reason=True)
+    assert_array_equal(curve[:3], [autocorrelation(x, lag) for lag in (1, 2, 3)])
+    assert np.isnan(curve[3:]).all() and "lags 4..6 are NaN" in reason
+    curve, reason = autocorrelation_function([1.0], 2, return_reason=True)
+    assert np.isnan(curve).all() and "N = 1 < 2" in reason
+    _, reason = autocorrelation_function(x, 3, return_reason=True)
+    assert reason is None
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "error", "match"),
+    [
+        ({"max_lag": 0}, ValueError, "max_lag: must be >= 1"),
+        ({"max_lag": 2.0}, TypeError, "max_lag"),
+        ({"rtol": -1.0}, ValueError, "rtol"),
+    ],
+)
+def test_curve_bad_arguments_raise(kwargs, error, match):
+    with pytest.raises(error, match=match):
+        autocorrelation_function(np.arange(10.0), **kwargs)
+
+
+def test_curve_rejects_non_finite_series():
+    with pytest.raises(ValueError, match="element 1"):
+        autocorrelation_function([0.0, np.inf, 1.0], 2)
+
+
+# ------------------------------------------------------------------ decay summaries
+
+
+def test_decorrelation_lag_is_the_first_lag_below_the_threshold():
+    assert decorrelation_lag([0.9, 0.6, 0.3, 0.1]) == 3.0
+    assert decorrelation_lag([0.9, 0.6, 0.3, 0.1], threshold=0.7) == 2.0
+    assert decorrelation_lag([0.2]) == 1.0
+    assert decorrelation_lag([0.9, np.exp(-1.0), 0.3]) == 3.0  # "below" is strict
+
+
+def test_decorrelation_lag_of_ar1_is_about_minus_one_over_log_phi():
+    x = ar1(0.9, 40_000, seed=7)  # R_l = 0.9^l < 1/e from l = 10 (0.9^10 = 0.349)
+    assert decorrelation_lag(autocorrelation_function(x, 30)) in (9.0, 10.0, 11.0)
+
+
+def test_decorrelation_lag_not_reached_or_undefined_is_nan_with_reason():
+    with pytest.warns(UndefinedDiagnosticWarning, match="not reached"):
+        assert np.isnan(decorrelation_lag([0.9, 0.8]))
+    value, reason = decorrelation_lag([0.9, np.nan, 0.1], return_reason=True)
+    assert np.isnan(value) and "R_2 is undefined" in reason
+
+
+def test_integrated_time_truncates_before_the_first_non_positive_lag():
+    assert integrated_autocorrelation_time([0.5, 0.25, -0.1, 0.2]) == 1.25
+    assert integrated_autocorrelation_time([0.5, 0.0, 0.4]) == 1.0
+    assert integrated_autocorrelation_time([-0.2, 0.9]) == 0.5
+    value, note = integrated_autocorrelation_time([0.5, 0.25], return_reason=True)
+    assert value == 1.25 and "lower bound" in note
+    assert integrated_autocorrelation_time([0.5, -0.1], return_reason=True) == (1.0, None)
+
+
+def test_integrated_time_of_ar1_is_one_plus_phi_over_two_one_minus_phi():
+    phi = 0.6
+    x = ar1(phi, 100_000, seed=8)
+    tau = integrated_autocorrelation_time(autocorrelation_function(x, 60))
+    assert tau == pytest.approx((1 + phi) / (2 * (1 - phi)), rel=0.1)
+
+
+def test_integrated_time_with_an_undefined_lag_first_is_nan_with_reason():
+    with pytest.warns(UndefinedDiagnosticWarning, match="undefined"):
+        assert np.isnan(integrated_autocorrelation_time([0.5, np.nan, -0.1]))
+
+
+@pytest.mark.parametrize(
+    ("call", "error", "match"),
+    [
+        (lambda: decorrelation_lag([]), ValueError, "acf: expected a non-empty"),
+        (lambda: decorrelation_lag([[0.5]]), ValueError, "acf"),
+        (lambda: decorrelation_lag(["a"]), TypeError, "acf"),
+        (lambda: decorrelation_lag([0.5, np.inf]), ValueError, "element 1"),
+        (lambda: decorrelation_lag([0.5], threshold=2.0), ValueError, "threshold"),
+        (lambda: decorrelation_lag([0.5], threshold=np.nan), ValueError, "threshold"),
+        (lambda: decorrelation_lag([0.5], threshold="x"), TypeError, "threshold"),
+        (lambda: integrated_autocorrelation_time([]), ValueError, "acf"),
+    ],
+)
+def test_decay_summaries_reject_bad_input(call, error, match):
+    with pytest.raises(error, match=match):
+        call()

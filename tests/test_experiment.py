@@ -89,7 +89,8 @@ def test_analysis_files_are_the_builtin_presets_with_the_papers_parameters():
     assert (b.n_ics, b.n_steps, b.tau) == (1000, 15000, 0.3)
     for exp in (a, b):
         assert exp.sampling == "paper" and exp.ic_method == "paper"
-        assert exp.d0 == 1 / 5000 and exp.eps == 1e-3 and exp.lyapunov_variant == "paper"
+        assert exp.d0 == 1 / 5000 and exp.lyapunov_variant == "paper"
+        assert exp.eps == (1e-3, 1e-2) and exp.rr_sampling == "run" and exp.acf_max_lag == 20
 
 
 @pytest.mark.parametrize(
@@ -103,6 +104,13 @@ def test_analysis_files_are_the_builtin_presets_with_the_papers_parameters():
         ({"tau": -0.1}, "tau"),
         ({"tau": math.nan}, "tau"),
         ({"eps": math.inf}, "eps"),
+        ({"eps": []}, "eps"),
+        ({"eps": [0.001, 0.001]}, "eps: thresholds must be distinct"),
+        ({"eps": [0.001, -0.01]}, "eps\\[1\\]"),
+        ({"eps": "0.001"}, "eps"),
+        ({"rr_sampling": "paper"}, "rr_sampling"),
+        ({"acf_max_lag": 0}, "acf_max_lag"),
+        ({"acf_max_lag": 2.5}, "acf_max_lag"),
         ({"sampling": "daily"}, "sampling"),
         ({"systems": ["two_particle", "kicked"]}, "systems"),
         ({"diagnostics": []}, "diagnostics"),
@@ -128,8 +136,56 @@ def test_unknown_or_missing_toml_keys_are_refused():
 
 def test_hash_changes_with_every_parameter_but_not_with_the_order_of_radii():
     assert dataclasses.replace(TINY, radii=[0.025, 0.01]).hash() == TINY.hash()
-    for change in ({"seed": 8}, {"tau": 0.31}, {"rule": "elastic"}, {"block_size": 3}):
+    for change in (
+        {"seed": 8},
+        {"tau": 0.31},
+        {"rule": "elastic"},
+        {"block_size": 3},
+        {"eps": 0.001},
+        {"eps": (0.01, 0.001)},
+        {"rr_sampling": "uniform"},
+        {"acf_max_lag": 21},
+    ):
         assert dataclasses.replace(TINY, **change).hash() != TINY.hash()
+
+
+def test_a_single_eps_is_accepted_and_kept_as_a_tuple():
+    exp = dataclasses.replace(TINY, eps=0.002)
+    assert exp.eps == (0.002,)
+    assert Experiment.from_toml_string(exp.to_toml()) == exp
+    text = TINY.to_toml().replace("eps = [0.001, 0.01]", "eps = 0.001")
+    assert Experiment.from_toml_string(text).eps == (0.001,)
+
+
+def legacy_record(exp: Experiment) -> dict:
+    """The experiment record a store written before eps lists, acf_max_lag, rr_sampling holds."""
+    record = exp.to_dict()
+    del record["acf_max_lag"], record["rr_sampling"]
+    record["eps"] = record["eps"][0]
+    return record
+
+
+def test_experiments_of_the_old_format_keep_their_hash():
+    import hashlib
+
+    old = dataclasses.replace(TINY, eps=0.001)
+    record = legacy_record(old)
+    text = json.dumps(record, sort_keys=True, separators=(",", ":"))
+    assert old.hash() == hashlib.sha256(text.encode()).hexdigest()[:16]
+    assert Experiment.from_dict(record) == old
+    assert old.hash() == "21f9b7ce323e6659"  # computed by kicktimes before this change
+
+
+def test_a_store_written_before_the_new_rows_still_loads(tmp_path):
+    old = dataclasses.replace(
+        TINY, eps=0.001, radii=[0.02], n_ics=1, n_steps=50, diagnostics=["recurrence_rate"]
+    )
+    run_quiet(old, tmp_path / "s", workers=1)
+    manifest = json.loads((tmp_path / "s" / "manifest.json").read_text())
+    manifest["experiment"] = legacy_record(old)  # what an older kicktimes wrote
+    (tmp_path / "s" / "manifest.json").write_text(json.dumps(manifest))
+    store = load_store(tmp_path / "s")
+    assert store.experiment == old and store.complete
 
 
 # ----------------------------------------------------------------------------- tasks
@@ -150,20 +206,94 @@ def test_tidy_tables_have_the_documented_columns_and_one_row_per_value(reference
     common = {
         "recurrence_rate",
         "autocorrelation",
+        "decorrelation_lag",
+        "tau_int",
         "lyapunov",
         "lyapunov_x",
         "lyapunov_y",
         "lyapunov_n_renorm",
         "lyapunov_n_forced",
     }
+    common |= {f"{name}@{e}" for name in ("rr", "rr_offdiag", "det", "l_mean", "l_max")
+               for e in ("0.001", "0.01")}
+    common |= {f"acf@{lag}" for lag in range(1, 21)}
     for (system, _, _), group in res.groupby(["system", "radius", "ic"]):
         assert set(group["diagnostic"]) == per_system[system] | common
-    # NaN only with a reason, reasons only with NaN
-    assert (res["value"].isna() == (res["note"] != "")).all()
+    # NaN only with a reason; reasons only with NaN, except tau_int's "lower bound" remark
+    assert (res["note"][res["value"].isna()] != "").all()
+    finite_noted = res[res["value"].notna() & (res["note"] != "")]
+    assert set(finite_noted["diagnostic"]) <= {"tau_int"}
+    assert finite_noted["note"].str.contains("lower bound").all()
     assert len(coll) == TINY.n_ics * len(TINY.radii)
     assert coll["n_pp"].tolist() == [len(t) for t in coll["pp_times"]]
     for row in coll.itertuples():
         assert np.all(np.diff(row.pp_times) > 0) and (row.pp_times <= row.t_window).all()
+
+
+def test_recurrence_and_acf_rows_are_the_library_diagnostics_of_the_run():
+    from kicktimes import initial_conditions, simulate_two_particle
+    from kicktimes.diagnostics import (
+        autocorrelation,
+        autocorrelation_function,
+        boundary_angles,
+        recurrence_rate,
+        rqa,
+    )
+
+    exp = dataclasses.replace(TINY, systems=["two_particle"], diagnostics=["recurrence_rate",
+                              "autocorrelation"], acf_max_lag=5, eps=(0.01, 0.05))
+    res, _ = run_task(exp, exp.tasks()[3])  # r = 0.025, ICs 2 and 3
+    got = res[res.ic == 2].set_index("diagnostic")["value"]
+    ic = initial_conditions(4, 0.025, seed=7)[2]
+    run = simulate_two_particle(ic, 0.025, sampling="paper", n_steps=400, tau=0.3)
+    pts, n = run.samples, len(run.samples)
+    assert got["recurrence_rate"] == got["rr@0.01"] == recurrence_rate(pts, 0.01)
+    for e in (0.01, 0.05):
+        q = rqa(pts, e)
+        assert got[f"rr@{e:g}"] == recurrence_rate(pts, e)
+        assert got[f"rr_offdiag@{e:g}"] == q.rr == recurrence_rate(pts, e, theiler=1)
+        assert n * got[f"rr@{e:g}"] - 1 == pytest.approx((n - 1) * q.rr, rel=1e-12)
+        np.testing.assert_equal([got[f"det@{e:g}"], got[f"l_max@{e:g}"]], [q.det, q.l_max])
+    theta = boundary_angles(run, 0)
+    assert got["autocorrelation"] == got["acf@1"] == autocorrelation(theta, 1)
+    np.testing.assert_array_equal(
+        got[[f"acf@{lag}" for lag in range(1, 6)]], autocorrelation_function(theta, 5)
+    )
+    assert "acf@6" not in got.index
+
+
+def test_uniform_rr_sampling_uses_a_uniform_rerun_of_the_same_trajectory():
+    from kicktimes import initial_conditions, simulate_two_particle
+    from kicktimes.diagnostics import recurrence_rate
+    from kicktimes.experiment.tasks import _uniform_samples
+
+    exp = dataclasses.replace(TINY, diagnostics=["recurrence_rate"], n_ics=2)
+    uni = dataclasses.replace(exp, rr_sampling="uniform")
+    by_run, _ = run_task(exp, exp.tasks()[0])
+    by_uni, _ = run_task(uni, uni.tasks()[0])
+    key = ["radius", "ic", "system", "diagnostic"]
+    a, b = by_run.set_index(key)["value"], by_uni.set_index(key)["value"]
+    rr_rows = a.index.get_level_values("diagnostic").str.contains("rr|recurrence|det|l_")
+    pd.testing.assert_series_equal(a[~rr_rows], b[~rr_rows])  # nothing else changes
+    assert (a[rr_rows] != b[rr_rows]).any()
+    ic = initial_conditions(2, 0.025, seed=7)[0]
+    run = simulate_two_particle(ic, 0.01, sampling="paper", n_steps=400, tau=0.3)
+    again = simulate_two_particle(ic, 0.01, t_max=run.t_max, tau=0.3, sampling="uniform")
+    assert b[(0.01, 0, "two_particle", "rr@0.001")] == recurrence_rate(again.samples, 1e-3)
+    # the uniform re-run retraces the paper-sampled run's trajectory, kicks included
+    from kicktimes import simulate_one_particle
+
+    kicked = simulate_one_particle(ic[0], 0.01, kicks=np.array([3.0, 50.0, 77.7]),
+                                   sampling="paper", n_steps=400, tau=0.3, rng=5)
+    pts = _uniform_samples(uni, "poisson", ic, 0.01, kicked)
+    assert len(pts) == int(np.floor(kicked.t_max / 0.3 * (1 + 1e-12))) + 1
+    same_times = np.isin(kicked.sample_times, np.arange(len(pts)) * 0.3)
+    assert same_times.any()
+    idx = np.round(kicked.sample_times[same_times] / 0.3).astype(int)
+    np.testing.assert_allclose(kicked.samples[same_times], pts[idx], atol=1e-9)
+    # with uniform sampling there is nothing to re-run
+    flat = dataclasses.replace(uni, sampling="uniform")
+    assert _uniform_samples(flat, "poisson", ic, 0.01, kicked) is kicked.samples
 
 
 def test_poisson_rate_and_window_come_from_the_same_ics_two_particle_run(reference):

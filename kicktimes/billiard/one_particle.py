@@ -25,9 +25,16 @@ from numba import njit
 from kicktimes.billiard import _checks as chk
 from kicktimes.billiard.geometry import boundary_hit_time, reflect
 from kicktimes.billiard.runs import BoundaryLog, OneParticleRun
+from kicktimes.billiard.scatter import (
+    PARTNER_LAWS,
+    draw_scatter_uniforms,
+    scatter_kick,
+    twin_meets_partner,
+)
 from kicktimes.billiard.two_particle import _grow
 
-KICK_ANGLES = {"uniform": 0, "gaussian": 1}
+KICK_ANGLES = {"uniform": 0, "gaussian": 1, "scatter": 2}
+SCATTER = KICK_ANGLES["scatter"]
 
 
 @njit(cache=True)
@@ -119,6 +126,42 @@ def process_event_one(st, ev, is_kick, dt, rho, kick_time, angle, kick_mode, uni
     return sin_theta
 
 
+@njit(cache=True)
+def process_scatter_one(st, ev, dt, rho, kick_time, a, b, sp, out):
+    """Fly ``dt`` to ``kick_time`` and apply a scattering kick (kicktimes.billiard.scatter).
+
+    ``sp = [sigma = 2 r, rule code, e0, partner law code]``; ``out`` receives the kick's
+    log row (``runs.KICK_LOG_COLUMNS``).
+    """
+    drift_one(st, ev, dt)
+    st[0] = kick_time
+    st[5] = 0.0
+    scatter_kick(st, a, b, sp[0], rho, int(sp[1]), sp[2], int(sp[3]), out)
+    ev[0] = boundary_hit_time(st[1], st[2], st[3], st[4], rho)
+
+
+@njit(cache=True)
+def process_twin_scatter_one(st, ev, dt, rho, kick_time, partner, sp):
+    """Fly a Lyapunov twin ``dt`` to ``kick_time`` and let it meet the reference's partner.
+
+    ``partner = [px, py, ux, uy]``: the partner's centre and velocity at the kick time,
+    placed in contact with the reference (`kicktimes.billiard.scatter.twin_meets_partner`).
+    Returns True if the twin hit the partner, False if it missed it (unchanged).
+    """
+    drift_one(st, ev, dt)
+    st[0] = kick_time
+    st[5] = 0.0
+    x, y, vx, vy, hit = twin_meets_partner(st[1], st[2], st[3], st[4], partner[0], partner[1],
+                                           partner[2], partner[3], sp[0], int(sp[1]))
+    st[1] = x
+    st[2] = y
+    st[3] = vx
+    st[4] = vy
+    st[6] = vx * vx + vy * vy
+    ev[0] = boundary_hit_time(x, y, vx, vy, rho)
+    return hit
+
+
 @njit(cache=True, inline="always")
 def finish_one_at(st, ev, t_end):
     drift_one(st, ev, t_end - st[0])
@@ -128,8 +171,12 @@ def finish_one_at(st, ev, t_end):
 
 @njit(cache=True)
 def _event_loop_one(st, ev, rho, kicks, angles, kick_mode, unit_speed, t_end, mode, tau, bt, bx,
-                    by, bs, stimes, samples, cnt, next_s):
-    """Logging/sampling loop (see ``_event_loop_two``); ``cnt = [n_kicks, n_b, k]``."""
+                    by, bs, stimes, samples, cnt, next_s, kick_u, sp, klog):
+    """Logging/sampling loop (see ``_event_loop_two``); ``cnt = [n_kicks, n_b, k]``.
+
+    Scattering kicks (``kick_mode == 2``) use ``kick_u[i]`` and ``sp`` and log to
+    ``klog[i]`` (see `process_scatter_one`).
+    """
     n_b = cnt[1]
     k = cnt[2]
     ns = stimes.shape[0]
@@ -149,8 +196,12 @@ def _event_loop_one(st, ev, rho, kicks, angles, kick_mode, unit_speed, t_end, mo
             break
         if is_kick:
             ik = cnt[0]
-            process_event_one(st, ev, True, dte, rho, kicks[ik], angles[ik], kick_mode,
-                              unit_speed)
+            if kick_mode == SCATTER:
+                process_scatter_one(st, ev, dte, rho, kicks[ik], kick_u[ik, 0], kick_u[ik, 1],
+                                    sp, klog[ik])
+            else:
+                process_event_one(st, ev, True, dte, rho, kicks[ik], angles[ik], kick_mode,
+                                  unit_speed)
             cnt[0] += 1
         else:
             if n_b >= bt.shape[0]:
@@ -173,15 +224,22 @@ def _event_loop_one(st, ev, rho, kicks, angles, kick_mode, unit_speed, t_end, mo
 
 
 @njit(cache=True)
-def simulate_one_kernel(st, rho, kicks, angles, kick_mode, t_max, mode, n_steps, tau, b_cap):
+def simulate_one_kernel(st, rho, kicks, angles, kick_mode, t_max, mode, n_steps, tau, b_cap,
+                        kick_u, sp):
     """Run the kicked one-disk billiard (``mode``: 0 none, 1 uniform, 2 paper sampling).
 
-    ``st`` is ``[t, x, y, vx, vy, clock compensation, squared speed]``.
-    Returns ``(b_time, b_x, b_y, b_sin, sample_times, samples, n_kicks_applied, t_end)``.
+    ``st`` is ``[t, x, y, vx, vy, clock compensation, squared speed]``. Scattering kicks
+    (``kick_mode == 2``) take their random numbers from ``kick_u`` (shape (n_kicks, 2))
+    and their parameters from ``sp`` (see `process_scatter_one`).
+    Returns ``(b_time, b_x, b_y, b_sin, sample_times, samples, n_kicks_applied, t_end,
+    kick_log)``; ``kick_log`` has one row per applied scattering kick (else none).
     """
     ev = np.empty(1)
     ev[0] = boundary_hit_time(st[1], st[2], st[3], st[4], rho)
-    unit_speed = abs(st[3] * st[3] + st[4] * st[4] - 1.0) < 1e-12
+    # elastic scattering changes the speed, so the unit-speed shortcut does not hold
+    unit_speed = (abs(st[3] * st[3] + st[4] * st[4] - 1.0) < 1e-12
+                  and not (kick_mode == SCATTER and sp[1] != 0.0))
+    klog = np.zeros((kicks.shape[0] if kick_mode == SCATTER else 0, 9))
     bt = np.empty(b_cap)
     bx = np.empty(b_cap)
     by = np.empty(b_cap)
@@ -193,7 +251,7 @@ def simulate_one_kernel(st, rho, kicks, angles, kick_mode, t_max, mode, n_steps,
     next_s = np.zeros(1)
     t_end = t_max if mode < 2 else np.inf
     while not _event_loop_one(st, ev, rho, kicks, angles, kick_mode, unit_speed, t_end, mode, tau,
-                              bt, bx, by, bs, stimes, samples, cnt, next_s):
+                              bt, bx, by, bs, stimes, samples, cnt, next_s, kick_u, sp, klog):
         bt = _grow(bt)
         bx = _grow(bx)
         by = _grow(by)
@@ -202,7 +260,7 @@ def simulate_one_kernel(st, rho, kicks, angles, kick_mode, t_max, mode, n_steps,
         t_end = stimes[ns - 1]
     finish_one_at(st, ev, t_end)
     n = cnt[1]
-    return bt[:n], bx[:n], by[:n], bs[:n], stimes, samples, cnt[0], t_end
+    return bt[:n], bx[:n], by[:n], bs[:n], stimes, samples, cnt[0], t_end, klog[: cnt[0]]
 
 
 def check_one_particle_state(state, r: float, name: str = "state") -> np.ndarray:
@@ -228,10 +286,37 @@ def check_kick_times(kicks, t_max: float | None, name: str = "kicks") -> np.ndar
 
 
 def draw_kick_angles(n: int, kick_angle: str, sigma: float, rng: np.random.Generator):
-    """Kick angles for ``n`` kicks: new directions (uniform) or rotations (gaussian)."""
+    """Kick angles for ``n`` kicks: new directions (uniform) or rotations (gaussian).
+
+    For ``"scatter"`` the per-kick numbers are two uniforms on (-1, 1), shape ``(n, 2)``
+    (`kicktimes.billiard.scatter.draw_scatter_uniforms`).
+    """
     if kick_angle == "uniform":
         return rng.uniform(0.0, 2.0 * np.pi, size=n)
+    if kick_angle == "scatter":
+        return draw_scatter_uniforms(n, rng)
     return rng.normal(0.0, sigma, size=n)
+
+
+def _check_kick_angles(kick_angles, times: np.ndarray, kick_angle: str) -> np.ndarray:
+    if kick_angle == "scatter":
+        arr = np.array(kick_angles, dtype=np.float64, copy=True, order="C")
+        if arr.shape != (times.size, 2):
+            raise ValueError(
+                f"kick_angles of scattering kicks must have shape ({times.size}, 2) (two "
+                f"uniforms on (-1, 1) per kick), got {arr.shape}"
+            )
+        if not np.isfinite(arr).all() or (np.abs(arr) > 1.0).any():
+            raise ValueError("kick_angles of scattering kicks must lie in [-1, 1]")
+        return arr
+    angles = np.array(kick_angles, dtype=np.float64, copy=True).ravel()
+    if angles.shape != times.shape:
+        raise ValueError(
+            f"kick_angles must have one angle per kick ({times.size}), got {angles.size}"
+        )
+    if not np.isfinite(angles).all():
+        raise ValueError("kick_angles must be finite; got NaN or inf")
+    return angles
 
 
 def resolve_kicks(kicks, kick_angles, *, kick_angle, sigma, rng, horizon, t_max):
@@ -239,7 +324,8 @@ def resolve_kicks(kicks, kick_angles, *, kick_angle, sigma, rng, horizon, t_max)
 
     ``kicks`` is ``None``, an array of times (checked against ``t_max`` when it is not
     ``None``) or a schedule sampled on ``(0, horizon]`` with ``rng``. ``kick_angles`` is
-    given (one per kick) or drawn from the same generator, after the times.
+    given (one per kick; shape ``(n, 2)`` for scattering kicks) or drawn from the same
+    generator, after the times.
     """
     gen = None
     if kicks is None:
@@ -251,22 +337,51 @@ def resolve_kicks(kicks, kick_angles, *, kick_angle, sigma, rng, horizon, t_max)
         times = check_kick_times(kicks, t_max)
     if kick_angles is None:
         if not times.size:
-            return times, times.copy(), gen
+            empty = np.empty((0, 2)) if kick_angle == "scatter" else times.copy()
+            return times, empty, gen
         gen = gen if gen is not None else np.random.default_rng(rng)
         return times, draw_kick_angles(times.size, kick_angle, sigma, gen), gen
-    angles = np.array(kick_angles, dtype=np.float64, copy=True).ravel()
-    if angles.shape != times.shape:
-        raise ValueError(
-            f"kick_angles must have one angle per kick ({times.size}), got {angles.size}"
-        )
-    if not np.isfinite(angles).all():
-        raise ValueError("kick_angles must be finite; got NaN or inf")
-    return times, angles, gen
+    return times, _check_kick_angles(kick_angles, times, kick_angle), gen
+
+
+def check_scatter_options(state, r, kick_angle, rule, e0, partner):
+    """Validate the scattering-kick options; returns ``(sp, rule, e0, partner)``.
+
+    ``sp = [2 r, rule code, e0, partner-law code]`` for the kernels. Raises ValueError
+    for options that only make sense with ``kick_angle="scatter"``.
+    """
+    chk.check_choice("rule", rule, chk.RULES)
+    chk.check_choice("partner", partner, PARTNER_LAWS)
+    if kick_angle != "scatter":
+        if rule != "mirror" or e0 is not None or partner != "weighted":
+            raise ValueError(
+                f"rule, e0 and partner describe scattering kicks; they need "
+                f"kick_angle='scatter', got kick_angle={kick_angle!r}"
+            )
+        return np.zeros(4), None, None, None
+    if not r < 0.5:
+        raise ValueError(f"r must be < 0.5 for scattering kicks (two disks), got {r!r}")
+    v2 = float(state[2] ** 2 + state[3] ** 2)
+    if rule == "mirror":
+        if e0 is not None:
+            raise ValueError("e0 (the pair's kinetic energy) applies to rule='elastic' only")
+        e0_val = 0.0
+    else:
+        e0_val = 1.0 if e0 is None else chk.check_real("e0", e0, low=0.0)
+        if v2 > 2.0 * e0_val * (1.0 + 1e-12):
+            raise ValueError(
+                f"e0={e0_val!r}: the pair's kinetic energy must be at least the disk's, "
+                f"|v|^2 / 2 = {v2 / 2.0!r}"
+            )
+        e0 = e0_val
+    sp = np.array([2.0 * r, chk.RULES[rule], e0_val, PARTNER_LAWS[partner]], dtype=np.float64)
+    return sp, rule, e0, partner
 
 
 def simulate_one_particle(state, r, *, t_max=None, kicks=None, kick_angle="uniform",
                           kick_angles=None, sigma=1.0, rng=None, sampling="uniform",
-                          n_steps=None, tau=None, seed=None) -> OneParticleRun:
+                          n_steps=None, tau=None, seed=None, rule="mirror", e0=None,
+                          partner="weighted") -> OneParticleRun:
     """Simulate one disk of radius ``r`` in the unit table, kicked at given times.
 
     Parameters
@@ -283,19 +398,31 @@ def simulate_one_particle(state, r, *, t_max=None, kicks=None, kick_angle="unifo
         Kick times (sorted, in ``[0, t_max]``), or a schedule object with a
         ``sample(t_max, rng)`` method (see `kicktimes.schedules`), sampled here with
         ``rng``. ``None``: no kicks (the integrable billiard).
-    kick_angle : {"uniform", "gaussian"}
+    kick_angle : {"uniform", "gaussian", "scatter"}
         ``"uniform"``: a kick replaces the direction by an angle uniform on [0, 2 pi)
         (the paper's choice). ``"gaussian"``: a kick rotates it by ``N(0, sigma^2)``.
+        ``"scatter"``: a kick is a collision with a virtual partner disk of radius ``r``
+        drawn from the two-disk collision statistics (docs/scatter.md).
     kick_angles : array_like, optional
         Explicit angles, one per kick (new directions for ``"uniform"``, rotations for
-        ``"gaussian"``), e.g. ``run.kick_angles`` of another run, so that two runs share
-        their kicks (common random numbers). Drawn from ``rng`` when omitted.
+        ``"gaussian"``, shape (n, 2) uniforms on (-1, 1) for ``"scatter"``), e.g.
+        ``run.kick_angles`` of another run, so that two runs share their kicks (common
+        random numbers). Drawn from ``rng`` when omitted.
     sigma : float
         Standard deviation of the gaussian rotation (``> 0``).
     rng : numpy.random.Generator or int, optional
         Source of the schedule's times (first) and the kick angles (second).
     seed : int, optional
         Recorded in the run's metadata.
+    rule : {"mirror", "elastic"}
+        Scattering kicks: the collision rule with the partner. The mirror partner has the
+        disk's speed; the elastic partner has speed ``sqrt(2 e0 - |v|^2)``.
+    e0 : float, optional
+        Scattering kicks with ``rule="elastic"``: the pair's kinetic energy
+        ``(|v|^2 + |u|^2) / 2`` (default 1, the two-disk invariant measure's).
+    partner : {"weighted", "uniform"}
+        Scattering kicks: the partner's direction, weighted by ``|v - u|`` as at a real
+        collision (default) or uniform, independent of ``|v - u|``.
 
     Returns
     -------
@@ -306,7 +433,8 @@ def simulate_one_particle(state, r, *, t_max=None, kicks=None, kick_angle="unifo
     Notes
     -----
     A kick at the same instant as a boundary collision is applied after the reflection;
-    a kick exactly at the end of the run is applied.
+    a kick exactly at the end of the run is applied. The random numbers are drawn after
+    the schedule's times, from the same generator, whatever the kick law.
 
     Examples
     --------
@@ -317,12 +445,17 @@ def simulate_one_particle(state, r, *, t_max=None, kicks=None, kick_angle="unifo
     ...                             rng=1)
     >>> bool(np.all(run.kick_times <= 100.0))
     True
+    >>> hit = simulate_one_particle(state, 0.02, t_max=100.0, kicks=schedules.Poisson(0.1),
+    ...                             kick_angle="scatter", rng=1)
+    >>> hit.kick_log.shape[0] == hit.n_kicks
+    True
     """
     r = chk.check_real("r", r, low=0.0, high=1.0)
     chk.check_choice("kick_angle", kick_angle, KICK_ANGLES)
     sigma = chk.check_real("sigma", sigma, low=0.0)
     t_max, n_steps, tau, mode = chk.check_sampling(t_max, n_steps, tau, sampling)
     state = check_one_particle_state(state, r)
+    sp, rule, e0, partner = check_scatter_options(state, r, kick_angle, rule, e0, partner)
     horizon = t_max if mode < 2 else n_steps * tau  # paper steps are at most tau long
     times, angles, _ = resolve_kicks(kicks, kick_angles, kick_angle=kick_angle, sigma=sigma,
                                      rng=rng, horizon=horizon,
@@ -330,10 +463,12 @@ def simulate_one_particle(state, r, *, t_max=None, kicks=None, kick_angle="unifo
     st = np.zeros(7)
     st[1:5] = state
     st[6] = state[2] ** 2 + state[3] ** 2
-    bt, bx, by, bs, stimes, samples, n_applied, t_end = simulate_one_kernel(
-        st, 1.0 - r, times, angles, KICK_ANGLES[kick_angle], 0.0 if mode == 2 else t_max, mode,
+    scatter = kick_angle == "scatter"
+    bt, bx, by, bs, stimes, samples, n_applied, t_end, klog = simulate_one_kernel(
+        st, 1.0 - r, times, np.zeros(times.size) if scatter else angles,
+        KICK_ANGLES[kick_angle], 0.0 if mode == 2 else t_max, mode,
         n_steps if n_steps is not None else 0, tau if tau is not None else 0.0,
-        int(3.0 * horizon) + 64,
+        int(3.0 * horizon) + 64, angles if scatter else np.zeros((0, 2)), sp,
     )
     return OneParticleRun(
         r=r,
@@ -351,4 +486,8 @@ def simulate_one_particle(state, r, *, t_max=None, kicks=None, kick_angle="unifo
         sigma=sigma if kick_angle == "gaussian" else None,
         kick_times=times[:n_applied],
         kick_angles=angles[:n_applied],
+        rule=rule,
+        e0=e0,
+        partner=partner,
+        kick_log_array=klog,
     )

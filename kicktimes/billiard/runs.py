@@ -26,6 +26,13 @@ from kicktimes import __version__
 
 TWO_PI = 2.0 * np.pi
 
+#: Columns of a two-disk collision log (``log_collisions=True``): contact centres,
+#: pre-collision velocities, post-collision velocities.
+PP_LOG_COLUMNS = ("x0", "y0", "x1", "y1", "vx0", "vy0", "vx1", "vy1",
+                  "vx0_post", "vy0_post", "vx1_post", "vy1_post")
+#: Columns of a scattering-kick log (kicktimes.billiard.scatter.KICK_LOG_COLUMNS).
+KICK_LOG_COLUMNS = ("vx", "vy", "vx_post", "vy_post", "nx", "ny", "ux", "uy", "outside")
+
 
 class BoundaryLog(NamedTuple):
     """Raw boundary-collision log: contact centre ``(x, y)``, time, disk, ``sin_theta``."""
@@ -63,6 +70,8 @@ class _Run:
 
     kind: ClassVar[str] = "run"
     _array_fields: ClassVar[tuple[str, ...]] = ()
+    #: 2-D array fields and their column count (stored flat in Parquet)
+    _array_columns: ClassVar[dict[str, int]] = {}
     _scalar_fields: ClassVar[tuple[str, ...]] = ()
 
     @property
@@ -88,7 +97,7 @@ class _Run:
         return out
 
     def _arrays(self) -> dict[str, np.ndarray]:
-        arrays = {name: np.asarray(getattr(self, name)) for name in self._array_fields}
+        arrays = {name: np.asarray(getattr(self, name)).ravel() for name in self._array_fields}
         arrays["ic"] = np.asarray(self.ic).ravel()
         arrays["final_state"] = np.asarray(self.final_state).ravel()
         for name, arr in self.boundary_log._asdict().items():
@@ -134,14 +143,20 @@ class TwoParticleRun(_Run):
         Columns ``time, particle, s, sin_theta`` (design.md conventions), time order.
     sample_times, samples : ndarray, shapes (n,) and (n, 2)
         Sample times and the tracked disk's centre at them (empty without sampling).
+    pp_log : ndarray, shape (n_pp, 12) or (0, 12)
+        With ``log_collisions=True``, one row per disk-disk collision (`PP_LOG_COLUMNS`):
+        both centres at contact and both velocities before and after; `collisions` is
+        the same as a DataFrame with the time and the contact normal.
     """
 
     rule: str = "mirror"
     track: int = 0
     pp_times: np.ndarray = field(default_factory=lambda: np.empty(0))
+    pp_log: np.ndarray = field(default_factory=lambda: np.empty((0, 12)))
 
     kind = "two_particle"
-    _array_fields = ("pp_times",)
+    _array_fields = ("pp_times", "pp_log")
+    _array_columns = {"pp_log": 12}
     _scalar_fields = ("r", "rule", "t_max", "sampling", "tau", "n_steps", "track", "seed",
                       "version")
 
@@ -156,6 +171,26 @@ class TwoParticleRun(_Run):
                 "sin_theta": log.sin_theta,
             }
         )
+
+    @cached_property
+    def collisions(self) -> pd.DataFrame:
+        """The disk-disk collision log (needs ``log_collisions=True``).
+
+        Columns ``time``, `PP_LOG_COLUMNS` and the unit contact normal ``nx, ny`` from
+        disk 0's centre towards disk 1's.
+        """
+        if self.pp_log.shape[0] != self.n_pp:
+            raise ValueError(
+                "this run has no collision log; simulate with log_collisions=True"
+            )
+        df = pd.DataFrame(self.pp_log, columns=list(PP_LOG_COLUMNS))
+        df.insert(0, "time", self.pp_times)
+        dx = df["x1"] - df["x0"]
+        dy = df["y1"] - df["y0"]
+        dd = np.hypot(dx, dy)
+        df["nx"] = dx / dd
+        df["ny"] = dy / dd
+        return df
 
     @property
     def n_pp(self) -> int:
@@ -179,7 +214,16 @@ class OneParticleRun(_Run):
     kick_times, kick_angles : ndarray
         The kicks applied, so that a twin run can reuse them (common random numbers).
         For ``kick_angle="uniform"`` the angle is the new velocity direction; for
-        ``"gaussian"`` it is the rotation applied to the current direction.
+        ``"gaussian"`` it is the rotation applied to the current direction; for
+        ``"scatter"`` it is an array of shape (n_kicks, 2), the two uniform numbers on
+        (-1, 1) that fix each kick's partner and contact normal.
+    rule, e0, partner : str, float, str or None
+        Scattering kicks only: the collision rule, the pair's kinetic energy (elastic)
+        and the partner law (docs/scatter.md).
+    kick_log : DataFrame
+        Scattering kicks only: per kick the time, the velocity before and after, the
+        contact normal ``n``, the partner's velocity ``u`` and whether the partner's
+        centre lay outside the table.
     boundary : DataFrame
         Columns ``time, s, sin_theta``.
     sample_times, samples : ndarray
@@ -190,11 +234,24 @@ class OneParticleRun(_Run):
     sigma: float | None = None
     kick_times: np.ndarray = field(default_factory=lambda: np.empty(0))
     kick_angles: np.ndarray = field(default_factory=lambda: np.empty(0))
+    rule: str | None = None
+    e0: float | None = None
+    partner: str | None = None
+    kick_log_array: np.ndarray = field(default_factory=lambda: np.empty((0, 9)))
 
     kind = "one_particle"
-    _array_fields = ("kick_times", "kick_angles")
+    _array_fields = ("kick_times", "kick_angles", "kick_log_array")
+    _array_columns = {"kick_log_array": 9}
     _scalar_fields = ("r", "t_max", "sampling", "tau", "n_steps", "kick_angle", "sigma", "seed",
-                      "version")
+                      "version", "rule", "e0", "partner")
+
+    @cached_property
+    def kick_log(self) -> pd.DataFrame:
+        """Per scattering kick: ``time`` and `KICK_LOG_COLUMNS` (empty for other kicks)."""
+        df = pd.DataFrame(self.kick_log_array, columns=list(KICK_LOG_COLUMNS))
+        df["outside"] = df["outside"].astype(bool)
+        df.insert(0, "time", self.kick_times[: df.shape[0]])
+        return df
 
     @cached_property
     def boundary(self) -> pd.DataFrame:
@@ -245,7 +302,13 @@ def read_run(path: str | os.PathLike) -> TwoParticleRun | OneParticleRun:
         samples=arr["samples"].reshape(-1, 2),
     )
     for name in cls._array_fields:
+        if name not in arr:
+            continue  # written by an older version without this field
         kwargs[name] = arr[name]
+        if name in cls._array_columns:
+            kwargs[name] = arr[name].reshape(-1, cls._array_columns[name])
+    if meta.get("kick_angle") == "scatter":
+        kwargs["kick_angles"] = kwargs["kick_angles"].reshape(-1, 2)
     known = {f.name for f in fields(cls)}
     return cls(**{k: v for k, v in kwargs.items() if k in known})
 

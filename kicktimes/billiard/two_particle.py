@@ -177,15 +177,23 @@ def _grow(a):
 
 
 @njit(cache=True)
+def _grow_rows(a):
+    out = np.empty((2 * a.shape[0] + 16, a.shape[1]), dtype=a.dtype)
+    out[: a.shape[0]] = a
+    return out
+
+
+@njit(cache=True)
 def _event_loop_two(st, ev, rho, sigma, rule, t_end, mode, tau, o, pp, bt, bp, bx, by, bs,
-                    stimes, samples, cnt, next_s):
+                    stimes, samples, cnt, next_s, log_pp, ppl):
     """The logging/sampling event loop; returns True when done, False when a buffer is full.
 
     Growing a buffer reassigns the array, and an array reassigned inside a numba loop
     costs reference counting on every iteration (it halved the speed): so this loop
     only detects a full buffer and returns, and the caller grows it outside.
     ``cnt = [n_pp, n_b, k]`` and ``next_s[0]`` (the next sample time) carry the loop's
-    position between calls.
+    position between calls. With ``log_pp`` every disk-disk collision also fills a row
+    of ``ppl`` (``runs.PP_LOG_COLUMNS``); only disk-disk events pay for the check.
     """
     n_pp = cnt[0]
     n_b = cnt[1]
@@ -208,9 +216,23 @@ def _event_loop_two(st, ev, rho, sigma, rule, t_end, mode, tau, o, pp, bt, bp, b
             break
         if (ke == 2 and n_pp >= pp.shape[0]) or (ke < 2 and n_b >= bt.shape[0]):
             break
+        if ke == 2 and log_pp:
+            ppl[n_pp, 4] = st[3]
+            ppl[n_pp, 5] = st[4]
+            ppl[n_pp, 6] = st[7]
+            ppl[n_pp, 7] = st[8]
         sin_theta = process_event_two(st, ev, ke, rho, sigma, rule)
         if ke == 2:
             pp[n_pp] = st[0]
+            if log_pp:
+                ppl[n_pp, 0] = st[1]
+                ppl[n_pp, 1] = st[2]
+                ppl[n_pp, 2] = st[5]
+                ppl[n_pp, 3] = st[6]
+                ppl[n_pp, 8] = st[3]
+                ppl[n_pp, 9] = st[4]
+                ppl[n_pp, 10] = st[7]
+                ppl[n_pp, 11] = st[8]
             n_pp += 1
         else:
             bt[n_b] = st[0]
@@ -234,7 +256,8 @@ def _event_loop_two(st, ev, rho, sigma, rule, t_end, mode, tau, o, pp, bt, bp, b
 
 
 @njit(cache=True)
-def simulate_two_kernel(st, rho, sigma, rule, t_max, mode, n_steps, tau, track, pp_cap, b_cap):
+def simulate_two_kernel(st, rho, sigma, rule, t_max, mode, n_steps, tau, track, pp_cap, b_cap,
+                        log_pp=False):
     """Run the two-disk billiard, logging every event and sampling the tracked disk.
 
     ``st`` is ``[t, x0, y0, vx0, vy0, x1, y1, vx1, vy1, clock compensation, energy]``.
@@ -242,11 +265,13 @@ def simulate_two_kernel(st, rho, sigma, rule, t_max, mode, n_steps, tau, track, 
     ``t_max``), 2 the paper's collision-truncated steps (run until ``n_steps`` are done).
     Samples are interpolated along the free flight, inside the event loop.
 
-    Returns ``(pp_times, b_time, b_part, b_x, b_y, b_sin, sample_times, samples, t_end)``.
+    Returns ``(pp_times, b_time, b_part, b_x, b_y, b_sin, sample_times, samples, t_end,
+    pp_log)``; ``pp_log`` has a row per disk-disk collision if ``log_pp``, else none.
     """
     ev = np.empty(3)
     init_events_two(st, ev, rho, sigma)
     pp = np.empty(pp_cap)
+    ppl = np.empty((pp_cap if log_pp else 0, 12))
     bt = np.empty(b_cap)
     bp = np.empty(b_cap, dtype=np.int8)
     bx = np.empty(b_cap)
@@ -259,9 +284,11 @@ def simulate_two_kernel(st, rho, sigma, rule, t_max, mode, n_steps, tau, track, 
     next_s = np.zeros(1)
     t_end = t_max if mode < 2 else np.inf
     while not _event_loop_two(st, ev, rho, sigma, rule, t_end, mode, tau, 1 + 4 * track, pp, bt,
-                              bp, bx, by, bs, stimes, samples, cnt, next_s):
+                              bp, bx, by, bs, stimes, samples, cnt, next_s, log_pp, ppl):
         if cnt[0] >= pp.shape[0]:
             pp = _grow(pp)
+            if log_pp:
+                ppl = _grow_rows(ppl)
         if cnt[1] >= bt.shape[0]:
             bt = _grow(bt)
             bp = _grow(bp)
@@ -274,7 +301,8 @@ def simulate_two_kernel(st, rho, sigma, rule, t_max, mode, n_steps, tau, track, 
     n_pp = cnt[0]
     n_b = cnt[1]
     # views, not copies: the buffers are at most about twice the size needed
-    return pp[:n_pp], bt[:n_b], bp[:n_b], bx[:n_b], by[:n_b], bs[:n_b], stimes, samples, t_end
+    return (pp[:n_pp], bt[:n_b], bp[:n_b], bx[:n_b], by[:n_b], bs[:n_b], stimes, samples, t_end,
+            ppl[: n_pp if log_pp else 0])
 
 
 def check_two_particle_ic(ic, r: float, rule: str, name: str = "ic") -> np.ndarray:
@@ -297,7 +325,7 @@ def check_two_particle_ic(ic, r: float, rule: str, name: str = "ic") -> np.ndarr
 
 
 def simulate_two_particle(ic, r, *, t_max=None, rule="mirror", sampling="uniform", n_steps=None,
-                          tau=None, track=0, seed=None) -> TwoParticleRun:
+                          tau=None, track=0, seed=None, log_collisions=False) -> TwoParticleRun:
     """Simulate two disks of radius ``r`` in the unit circular table.
 
     Event-driven and exact: the disks move freely between collisions whose times are
@@ -329,6 +357,9 @@ def simulate_two_particle(ic, r, *, t_max=None, rule="mirror", sampling="uniform
         The disk whose centre is sampled.
     seed : int, optional
         Recorded in the run's metadata (the simulation itself is deterministic).
+    log_collisions : bool
+        Also log every disk-disk collision: contact centres and both velocities before
+        and after (``run.pp_log``, ``run.collisions`` with the contact normal).
 
     Returns
     -------
@@ -356,6 +387,8 @@ def simulate_two_particle(ic, r, *, t_max=None, rule="mirror", sampling="uniform
     track = chk.check_int("track", track, low=0)
     if track > 1:
         raise ValueError(f"track must be 0 or 1, got {track}")
+    if not isinstance(log_collisions, bool | np.bool_):
+        raise TypeError(f"log_collisions must be a bool, got {type(log_collisions).__name__}")
     ic = check_two_particle_ic(ic, r, rule)
     st = np.zeros(11)
     st[1:9] = ic.ravel()
@@ -364,10 +397,10 @@ def simulate_two_particle(ic, r, *, t_max=None, rule="mirror", sampling="uniform
     # capacities are only a first guess: the kernel grows its buffers when needed
     b_cap = int(3.0 * horizon) + 64
     pp_cap = int(20.0 * r * horizon) + 16
-    pp, bt, bp, bx, by, bs, stimes, samples, t_end = simulate_two_kernel(
+    pp, bt, bp, bx, by, bs, stimes, samples, t_end, ppl = simulate_two_kernel(
         st, 1.0 - r, 2.0 * r, chk.RULES[rule], 0.0 if mode == 2 else t_max, mode,
         n_steps if n_steps is not None else 0, tau if tau is not None else 0.0, track,
-        pp_cap, b_cap,
+        pp_cap, b_cap, bool(log_collisions),
     )
     return TwoParticleRun(
         r=r,
@@ -384,4 +417,5 @@ def simulate_two_particle(ic, r, *, t_max=None, rule="mirror", sampling="uniform
         rule=rule,
         track=track,
         pp_times=pp,
+        pp_log=ppl,
     )

@@ -1,9 +1,13 @@
 """Chaos diagnostics of sampled trajectories and boundary-collision series.
 
-Recurrence rate and recurrence plots (`recurrence_rate`, `recurrence_pairs`), the paper's
+Recurrence rate and recurrence plots (`recurrence_rate`, `recurrence_pairs`), recurrence
+quantification (`rqa`: determinism, line lengths, laminarity), the paper's
 autocorrelation of the boundary-collision angles (`autocorrelation`,
-`autocorrelation_many`, `boundary_angles`) and finite-time Lyapunov exponents
-(`lyapunov`, exact tangent vectors, or Benettin twins); see docs/diagnostics.md.
+`autocorrelation_many`, `boundary_angles`), its curve over lags and decay
+(`autocorrelation_function`, `decorrelation_lag`, `integrated_autocorrelation_time`)
+and finite-time Lyapunov exponents (`lyapunov`: exact tangent vectors by default, or
+Benettin twins; `lyapunov_spectrum`: all exponents of the two-disk billiard); see
+docs/diagnostics.md.
 """
 
 from kicktimes.diagnostics.autocorrelation import (
@@ -12,6 +16,11 @@ from kicktimes.diagnostics.autocorrelation import (
     autocorrelation_many,
     boundary_angles,
 )
+from kicktimes.diagnostics.decorrelation import (
+    autocorrelation_function,
+    decorrelation_lag,
+    integrated_autocorrelation_time,
+)
 from kicktimes.diagnostics.lyapunov import (
     LyapunovResult,
     LyapunovSpectrum,
@@ -19,16 +28,22 @@ from kicktimes.diagnostics.lyapunov import (
     lyapunov_spectrum,
 )
 from kicktimes.diagnostics.recurrence import recurrence_pairs, recurrence_rate
+from kicktimes.diagnostics.rqa import RQAResult, rqa
 
 __all__ = [
     "LyapunovResult",
     "LyapunovSpectrum",
+    "RQAResult",
     "UndefinedDiagnosticWarning",
     "autocorrelation",
+    "autocorrelation_function",
     "autocorrelation_many",
     "boundary_angles",
+    "decorrelation_lag",
+    "integrated_autocorrelation_time",
     "lyapunov",
     "lyapunov_spectrum",
     "recurrence_pairs",
     "recurrence_rate",
+    "rqa",
 ]

@@ -30,7 +30,8 @@ import numpy as np
 from numba import njit
 
 from kicktimes.billiard.geometry import boundary_hit_time
-from kicktimes.billiard.one_particle import process_event_one
+from kicktimes.billiard.one_particle import SCATTER, process_event_one, process_scatter_one
+from kicktimes.billiard.scatter import scatter_tangent
 from kicktimes.billiard.two_particle import init_events_two, next_event_two, process_event_two
 
 MAX_SAME_INSTANT = 1000
@@ -284,19 +285,25 @@ def tangent_two_kernel(st, rho, sigma, rule, mode, n_steps, tau, U, max_events, 
 
 
 @njit(cache=True)
-def tangent_one_kernel(st, rho, kicks, angles, kick_mode, mode, n_steps, tau, U, max_events):
+def tangent_one_kernel(st, rho, kicks, angles, kick_mode, mode, n_steps, tau, U, max_events,
+                       kick_u, sp):
     """Carry the tangent vectors ``U`` (m, 4) along the kicked one-disk trajectory.
 
     As `tangent_two_kernel`; kicks at ``kicks`` (sorted times) with ``angles`` are
     applied with `kick_tangent` (a tie with a boundary collision goes to the boundary
-    first, as in `simulate_one_particle`). A new kick kind needs one more branch where
-    `kick_tangent` is called (e.g. a scatter kick: `pair_tangent` with a fixed partner).
+    first, as in `simulate_one_particle`). Scattering kicks (``kick_mode == 2``, numbers
+    ``kick_u``, parameters ``sp`` as in `process_scatter_one`) are linearised by
+    `kicktimes.billiard.scatter.scatter_tangent`: a disk-disk collision with a partner
+    whose deviation is zero.
 
     Returns ``(log_scale, n_rescaled, n_kicks, t_end, status)``.
     """
     m = U.shape[0]
     nk = kicks.shape[0]
-    unit_speed = abs(st[3] * st[3] + st[4] * st[4] - 1.0) < 1e-12
+    scatter = kick_mode == SCATTER
+    unit_speed = (abs(st[3] * st[3] + st[4] * st[4] - 1.0) < 1e-12
+                  and not (scatter and sp[1] != 0.0))
+    row = np.empty(9)
     ev = np.empty(1)
     ev[0] = boundary_hit_time(st[1], st[2], st[3], st[4], rho)
     log_scale = np.zeros(m)
@@ -338,7 +345,17 @@ def tangent_one_kernel(st, rho, kicks, angles, kick_mode, mode, n_steps, tau, U,
                 U[j, 1] += U[j, 3] * dt
             vx = st[3]
             vy = st[4]
-            if is_kick:
+            if is_kick and scatter:
+                process_scatter_one(st, ev, dt, rho, kicks[ik], kick_u[ik, 0], kick_u[ik, 1],
+                                    sp, row)
+                if row[4] != 0.0 or row[5] != 0.0:
+                    for j in range(m):
+                        U[j, 0], U[j, 1], U[j, 2], U[j, 3] = scatter_tangent(
+                            vx, vy, row[6], row[7], row[4], row[5], sp[0], int(sp[1]), U[j, 0],
+                            U[j, 1], U[j, 2], U[j, 3])
+                        n_resc += _renormalise(U, log_scale, j)
+                ik += 1
+            elif is_kick:
                 process_event_one(st, ev, True, dt, rho, kicks[ik], angles[ik], kick_mode,
                                   unit_speed)
                 for j in range(m):

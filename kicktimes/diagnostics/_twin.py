@@ -30,7 +30,13 @@ import numpy as np
 from numba import njit
 
 from kicktimes.billiard.geometry import boundary_hit_time, pair_hit_time
-from kicktimes.billiard.one_particle import next_event_one, process_event_one
+from kicktimes.billiard.one_particle import (
+    SCATTER,
+    next_event_one,
+    process_event_one,
+    process_scatter_one,
+    process_twin_scatter_one,
+)
 from kicktimes.billiard.two_particle import (
     HASH_MOD,
     init_events_two,
@@ -240,15 +246,23 @@ def ftle_two_kernel(st0, rho, sigma, rule, mode, n_steps, tau, track, offsets, m
 
 @njit(cache=True)
 def ftle_one_kernel(st0, rho, kicks, angles, kick_mode, mode, n_steps, tau, offsets, measure, d0,
-                    max_defer, max_events):
+                    max_defer, max_events, kick_u, sp):
     """Benettin FTLE for the kicked one-disk billiard.
 
     Twins share the kick times and angles (common random numbers). Returns as
-    `ftle_two_kernel`, ``n_pert`` counting the kicks applied.
+    `ftle_two_kernel`, ``n_pert`` counting the kicks applied. Scattering kicks
+    (``kick_mode == 2``, numbers ``kick_u``, parameters ``sp`` as in
+    `process_scatter_one`): the reference draws the partner, placed in contact with it,
+    and every twin meets that same partner at its own contact time, or misses it.
     """
     m = offsets.shape[0]
     nk = kicks.shape[0]
-    unit_speed = abs(st0[3] * st0[3] + st0[4] * st0[4] - 1.0) < 1e-12
+    scatter = kick_mode == SCATTER
+    unit_speed = (abs(st0[3] * st0[3] + st0[4] * st0[4] - 1.0) < 1e-12
+                  and not (scatter and sp[1] != 0.0))
+    # the partner of each scattering kick: centre and velocity at the kick time
+    partners = np.zeros((nk if scatter else 0, 4))
+    row = np.empty(9)
     ref = st0.copy()
     ev_ref = np.empty(1)
     ev_ref[0] = boundary_hit_time(ref[1], ref[2], ref[3], ref[4], rho)
@@ -296,7 +310,17 @@ def ftle_one_kernel(st0, rho, kicks, angles, kick_mode, mode, n_steps, tau, offs
                 status, n_same = _budget(dt, n_ev, n_same, max_events)
                 if status != 0:
                     break
-            if is_kick:
+            if is_kick and scatter:
+                process_scatter_one(ref, ev_ref, dt, rho, kicks[ik], kick_u[ik, 0],
+                                    kick_u[ik, 1], sp, row)
+                # the kick does not move the centre: the partner touches it along n
+                partners[ik, 0] = ref[1] + sp[0] * row[4]
+                partners[ik, 1] = ref[2] + sp[0] * row[5]
+                partners[ik, 2] = row[6]
+                partners[ik, 3] = row[7]
+                cnt_ref[0] += 1
+                cnt_ref[2] = (cnt_ref[2] * 4 + 4) % HASH_MOD
+            elif is_kick:
                 process_event_one(ref, ev_ref, True, dt, rho, kicks[ik], angles[ik], kick_mode,
                                   False)
                 cnt_ref[0] += 1
@@ -328,7 +352,13 @@ def ftle_one_kernel(st0, rho, kicks, angles, kick_mode, mode, n_steps, tau, offs
                     status, n_same = _budget(dt, n_ev, n_same, max_events)
                     if status != 0:
                         break
-                if is_kick:
+                if is_kick and scatter:
+                    hit = process_twin_scatter_one(tw[j], ev_tw[j], dt, rho, kicks[ik],
+                                                   partners[ik], sp)
+                    cnt_tw[j, 0] += 1
+                    # a missed partner is a different event sequence: defer, then force
+                    cnt_tw[j, 2] = (cnt_tw[j, 2] * 4 + (4 if hit else 2)) % HASH_MOD
+                elif is_kick:
                     process_event_one(tw[j], ev_tw[j], True, dt, rho, kicks[ik], angles[ik],
                                       kick_mode, False)
                     cnt_tw[j, 0] += 1

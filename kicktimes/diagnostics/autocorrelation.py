@@ -15,6 +15,7 @@ that ensemble means can count the valid values.
 
 from __future__ import annotations
 
+import math
 import numbers
 import warnings
 from collections.abc import Mapping
@@ -58,8 +59,8 @@ class UndefinedDiagnosticWarning(RuntimeWarning):
 
 
 @njit(cache=True)
-def _centred_sums(values, lo, hi, lag, mean):
-    """(sum d_i^2, sum_{i < n-lag} d_i d_{i+lag}) with d_i = x_i - mean, over [lo, hi).
+def _centred_sums(values, lo, hi, lag, mean, f):
+    """(sum d_i^2, sum_{i < n-lag} d_i d_{i+lag}) with d_i = f x_i - mean, over [lo, hi).
 
     Four independent accumulators: they break the add-latency chain (about 4x faster)
     and, as a side effect, sum in a slightly more accurate blocked order.
@@ -69,56 +70,90 @@ def _centred_sums(values, lo, hi, lag, mean):
     m = hi - lag  # products exist for i < m
     i = lo
     while i + 3 < m:
-        a0 = values[i] - mean
-        a1 = values[i + 1] - mean
-        a2 = values[i + 2] - mean
-        a3 = values[i + 3] - mean
+        a0 = values[i] * f - mean
+        a1 = values[i + 1] * f - mean
+        a2 = values[i + 2] * f - mean
+        a3 = values[i + 3] * f - mean
         d0 += a0 * a0
         d1 += a1 * a1
         d2 += a2 * a2
         d3 += a3 * a3
-        c0 += a0 * (values[i + lag] - mean)
-        c1 += a1 * (values[i + 1 + lag] - mean)
-        c2 += a2 * (values[i + 2 + lag] - mean)
-        c3 += a3 * (values[i + 3 + lag] - mean)
+        c0 += a0 * (values[i + lag] * f - mean)
+        c1 += a1 * (values[i + 1 + lag] * f - mean)
+        c2 += a2 * (values[i + 2 + lag] * f - mean)
+        c3 += a3 * (values[i + 3 + lag] * f - mean)
         i += 4
     while i < m:
-        a0 = values[i] - mean
+        a0 = values[i] * f - mean
         d0 += a0 * a0
-        c0 += a0 * (values[i + lag] - mean)
+        c0 += a0 * (values[i + lag] * f - mean)
         i += 1
     while i < hi:
-        a0 = values[i] - mean
+        a0 = values[i] * f - mean
         d0 += a0 * a0
         i += 1
     return (d0 + d1) + (d2 + d3), (c0 + c1) + (c2 + c3)
 
 
 @njit(cache=True)
-def _sum_and_max_abs(values, lo, hi, shift):
-    """(sum (x_i - shift), max |x_i|) over [lo, hi), four independent accumulators each."""
-    s0 = s1 = s2 = s3 = 0.0
+def _max_abs(values, lo, hi):
+    """max |x_i| over [lo, hi) (0 for an empty range)."""
     b0 = b1 = b2 = b3 = 0.0
     i = lo
     while i + 3 < hi:
-        v0 = values[i]
-        v1 = values[i + 1]
-        v2 = values[i + 2]
-        v3 = values[i + 3]
-        s0 += v0 - shift
-        s1 += v1 - shift
-        s2 += v2 - shift
-        s3 += v3 - shift
-        b0 = max(b0, abs(v0))
-        b1 = max(b1, abs(v1))
-        b2 = max(b2, abs(v2))
-        b3 = max(b3, abs(v3))
+        b0 = max(b0, abs(values[i]))
+        b1 = max(b1, abs(values[i + 1]))
+        b2 = max(b2, abs(values[i + 2]))
+        b3 = max(b3, abs(values[i + 3]))
         i += 4
     while i < hi:
-        s0 += values[i] - shift
         b0 = max(b0, abs(values[i]))
         i += 1
-    return (s0 + s1) + (s2 + s3), max(max(b0, b1), max(b2, b3))
+    return max(max(b0, b1), max(b2, b3))
+
+
+@njit(cache=True)
+def _shifted_sum(values, lo, hi, f, shift):
+    """sum (f x_i - shift) over [lo, hi), four independent accumulators."""
+    s0 = s1 = s2 = s3 = 0.0
+    i = lo
+    while i + 3 < hi:
+        s0 += values[i] * f - shift
+        s1 += values[i + 1] * f - shift
+        s2 += values[i + 2] * f - shift
+        s3 += values[i + 3] * f - shift
+        i += 4
+    while i < hi:
+        s0 += values[i] * f - shift
+        i += 1
+    return (s0 + s1) + (s2 + s3)
+
+
+@njit(cache=True)
+def _prepare(values, lo, hi):
+    """(mean of f x, f, max|x|) of a segment, with f an exact power of two.
+
+    The series is scaled by ``f = 2^-e`` with ``max|x| = m 2^e``, ``0.5 <= m < 1``, so
+    that sums of squares cannot overflow (``[1e308, -1e308]``) nor underflow; scaling by
+    a power of two is exact, so ``R_l`` is bitwise what the unscaled sums would give
+    whenever those are finite. ``e`` is capped at -1000 below so that ``f`` stays finite.
+    """
+    n = hi - lo
+    scale = _max_abs(values, lo, hi)
+    e = 0
+    if scale > 0.0:
+        e = max(math.frexp(scale)[1], -1000)
+    f = math.ldexp(1.0, -e)
+    mean = _shifted_sum(values, lo, hi, f, 0.0) / n
+    # two-pass mean: the second pass corrects the round-off of the first
+    mean += _shifted_sum(values, lo, hi, f, mean) / n
+    return mean, f, scale
+
+
+@njit(cache=True)
+def _is_constant(den, n, f, scale, rtol, atol):
+    """std <= atol + rtol max|x|, evaluated in the scaled units (no overflow)."""
+    return np.sqrt(den / n) <= atol * f + rtol * scale * f
 
 
 @njit(cache=True)
@@ -132,18 +167,41 @@ def _acf_segments(values, offsets, lag, rtol, atol, out, code):
             out[s] = np.nan
             code[s] = 2
             continue
-        total, scale = _sum_and_max_abs(values, lo, hi, 0.0)
-        mean = total / n
-        # two-pass mean: the second pass corrects the round-off of the first
-        resid, _ = _sum_and_max_abs(values, lo, hi, mean)
-        mean += resid / n
-        den, num = _centred_sums(values, lo, hi, lag, mean)
-        if np.sqrt(den / n) <= atol + rtol * scale:
+        mean, f, scale = _prepare(values, lo, hi)
+        den, num = _centred_sums(values, lo, hi, lag, mean, f)
+        if _is_constant(den, n, f, scale, rtol, atol):
             out[s] = np.nan
             code[s] = 1
             continue
         out[s] = num / den
         code[s] = 0
+
+
+@njit(cache=True)
+def _acf_curve(values, max_lag, rtol, atol, out, code):
+    """R_1..R_max_lag of one series into ``out[0..max_lag-1]``, codes as `_acf_segments`.
+
+    The mean is computed once; each lag then calls the very kernel of `_acf_segments`, so
+    ``out[l - 1]`` is bitwise ``autocorrelation(values, l)``.
+    """
+    n = values.shape[0]
+    if n < 2:
+        out[:] = np.nan
+        code[:] = 2
+        return
+    mean, f, scale = _prepare(values, 0, n)
+    for lag in range(1, max_lag + 1):
+        if n <= lag:
+            out[lag - 1] = np.nan
+            code[lag - 1] = 2
+            continue
+        den, num = _centred_sums(values, 0, n, lag, mean, f)
+        if _is_constant(den, n, f, scale, rtol, atol):
+            out[lag - 1] = np.nan
+            code[lag - 1] = 1
+        else:
+            out[lag - 1] = num / den
+            code[lag - 1] = 0
 
 
 # ------------------------------------------------------------------------- validation

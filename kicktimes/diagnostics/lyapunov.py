@@ -23,7 +23,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from kicktimes.billiard import _checks as chk
-from kicktimes.billiard.one_particle import KICK_ANGLES, check_one_particle_state, resolve_kicks
+from kicktimes.billiard.one_particle import (
+    KICK_ANGLES,
+    check_one_particle_state,
+    check_scatter_options,
+    resolve_kicks,
+)
 from kicktimes.billiard.runs import OneParticleRun, TwoParticleRun
 from kicktimes.billiard.two_particle import check_two_particle_ic
 from kicktimes.diagnostics._tangent import MAX_SAME_INSTANT, tangent_one_kernel, tangent_two_kernel
@@ -189,7 +194,8 @@ def _start_vectors(variant: str, size: int, offset: int) -> np.ndarray:
 
 def lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rule="mirror",
              track=0, kicks=None, kick_angles=None, kick_angle="uniform", sigma=1.0, rng=None,
-             method="tangent", variant="norm", d0=None, max_defer=10) -> LyapunovResult:
+             method="tangent", variant="norm", d0=None, max_defer=10, e0=None,
+             partner="weighted") -> LyapunovResult:
     """Finite-time Lyapunov exponent of a two-disk or a kicked one-disk billiard.
 
     Parameters
@@ -204,11 +210,17 @@ def lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rule
         ``n_steps`` collision-truncated steps. The twin method renormalises at these
         sample times. ``n_steps * tau`` must be at most 1e8.
     rule, track
-        Two-disk collision rule and the disk whose position deviation is measured.
-    kicks, kick_angles, kick_angle, sigma, rng
+        Two-disk collision rule and the disk whose position deviation is measured. For a
+        one-disk state with ``kick_angle="scatter"``, ``rule`` is the rule of the
+        collision with the virtual partner.
+    kicks, kick_angles, kick_angle, sigma, rng, e0, partner
         One-disk kicks, as in `simulate_one_particle` (``sigma`` finite, ``> 0``). Kick
         times and angles are given data, the same for every perturbed trajectory (common
-        random numbers): a kick is linearised at fixed time and angle.
+        random numbers): a kick is linearised at fixed time and angle. A scattering kick
+        (``kick_angle="scatter"``) is a collision with a virtual partner placed in
+        contact with the reference: the tangent vector goes through the linearised
+        collision with a partner of zero deviation; a twin meets the same partner at its
+        own contact time, or misses it (docs/scatter.md).
     method : {"tangent", "twin"}
         ``"tangent"``: exact propagation of tangent vectors. ``"twin"``: Benettin's twin at
         distance ``d0`` (the paper's method; converges to the tangent value as ``d0 -> 0``
@@ -271,6 +283,8 @@ def lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rule
             kicks, kick_angles = run.kick_times[keep], run.kick_angles[keep]
             kick_angle = run.kick_angle
             sigma = run.sigma if run.sigma is not None else 1.0
+            if kick_angle == "scatter":
+                rule, e0, partner = run.rule, run.e0, run.partner
             system = run.ic
     chk.check_choice("method", method, METHODS)
     chk.check_choice("variant", variant, VARIANTS)
@@ -326,6 +340,7 @@ def lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rule
     chk.check_choice("kick_angle", kick_angle, KICK_ANGLES)
     sigma = chk.check_real("sigma", sigma, low=0.0)
     state = check_one_particle_state(arr, r, name="system")
+    sp, _, _, _ = check_scatter_options(state, r, kick_angle, rule, e0, partner)
     times, angles, _ = resolve_kicks(kicks, kick_angles, kick_angle=kick_angle, sigma=sigma,
                                      rng=rng, horizon=horizon,
                                      t_max=horizon if mode == 1 else None)
@@ -333,16 +348,21 @@ def lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rule
     st = np.zeros(7)
     st[1:5] = state
     st[6] = state[2] ** 2 + state[3] ** 2
+    # scattering kicks take (n, 2) numbers; the other kinds one angle per kick
+    if kick_angle == "scatter":
+        kick_u, angles = angles, np.zeros(times.size)
+    else:
+        kick_u = np.zeros((0, 2))
     if method == "tangent":
         U = _start_vectors(variant, 4, 0)
         out = tangent_one_kernel(st, rho, times, angles, KICK_ANGLES[kick_angle], mode, n_steps,
-                                 tau, U, max_events)
+                                 tau, U, max_events, kick_u, sp)
         return _tangent_result(out, U, (0, 1), variant, horizon, max_events)
     offsets, measure = _twin_offsets(
         variant, d0, lambda dx, dy: math.hypot(state[0] + dx, state[1] + dy) <= rho
     )
     out = ftle_one_kernel(st, rho, times, angles, KICK_ANGLES[kick_angle], mode, n_steps, tau,
-                          offsets, measure, d0, max_defer, max_events)
+                          offsets, measure, d0, max_defer, max_events, kick_u, sp)
     return _twin_result(out, variant, d0, horizon, max_events)
 
 

@@ -473,6 +473,17 @@ def recurrence_pairs(points, eps=1e-3, *, theiler=0):
     n = pts.shape[0]
     w = _check_theiler(theiler, n)
     eps = _check_eps(eps)
+    offsets, out_j = _pairs_csr(pts, eps, w)
+    out_i = np.repeat(np.arange(n, dtype=np.int64), np.diff(offsets))
+    return out_i, out_j
+
+
+def _pairs_csr(pts: np.ndarray, eps: float, w: int):
+    """The recurrence plot as sorted rows: ``cols[offsets[i]:offsets[i+1]]`` are the ``j``.
+
+    Both orders of every pair, and the diagonal when ``w == 0``; rows sorted increasingly.
+    """
+    n = pts.shape[0]
     xs, ys, perm, cell_start, cell_key, ncx = _cells(pts, eps)
     deg = np.zeros(n, np.int64) if w > 0 else np.ones(n, np.int64)
     _sweep(
@@ -487,5 +498,4 @@ def recurrence_pairs(points, eps=1e-3, *, theiler=0):
         cursor += 1
     _sweep(xs, ys, perm, cell_start, cell_key, ncx, eps * eps, max(w, 1), _FILL, deg, cursor, out_j)
     _sort_rows(offsets, out_j)
-    out_i = np.repeat(np.arange(n, dtype=np.int64), deg)
-    return out_i, out_j
+    return offsets, out_j

@@ -24,9 +24,11 @@ import os
 import re
 from dataclasses import asdict, dataclass, field, fields
 
-__all__ = ["DIAGNOSTICS", "SYSTEMS", "Experiment"]
+__all__ = ["DEFAULT_SYSTEMS", "DIAGNOSTICS", "SYSTEMS", "Experiment"]
 
-SYSTEMS = ("two_particle", "poisson", "actual")
+SYSTEMS = ("two_particle", "poisson", "actual", "poisson_scatter", "actual_scatter")
+#: The paper's systems, run when an experiment names none (scattering kicks are opt-in)
+DEFAULT_SYSTEMS = ("two_particle", "poisson", "actual")
 DIAGNOSTICS = ("lyapunov", "recurrence_rate", "autocorrelation")
 IC_METHODS = ("paper", "uniform")
 SAMPLINGS = ("uniform", "paper")
@@ -34,6 +36,13 @@ RULES = ("mirror", "elastic")
 LYAPUNOV_VARIANTS = ("norm", "paper")
 LYAPUNOV_METHODS = ("tangent", "twin")
 KICK_ANGLES = ("uniform", "gaussian")
+RR_SAMPLINGS = ("run", "uniform")
+
+#: Fields added after the first store layout, with the value that reproduces the earlier
+#: results: `Experiment.hash` leaves a field out while it has that value (and writes a
+#: single ``eps`` as a float, as before), so stores written before the field existed keep
+#: their hash and still load. Their results simply lack the rows added since.
+_LATER_FIELDS = {"acf_max_lag": 20, "rr_sampling": "run", "lyapunov_method": "twin"}
 
 _REQUIRED = ("name", "radii", "n_ics", "n_steps", "tau")
 _NAME_RE = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]*$")
@@ -66,6 +75,20 @@ def _choice(name, value, choices):
     if not isinstance(value, str) or value not in choices:
         raise ValueError(f"{name}: must be one of {', '.join(map(repr, choices))}; got {value!r}")
     return value
+
+
+def _eps_tuple(value):
+    """A positive threshold or a non-empty list of distinct ones, as a tuple (order kept)."""
+    if isinstance(value, (str, bytes)):
+        raise TypeError(f"eps: expected a float or a list of floats, got {value!r}")
+    if not hasattr(value, "__iter__"):
+        return (_real("eps", value, low=0.0),)
+    items = [_real(f"eps[{k}]", e, low=0.0) for k, e in enumerate(value)]
+    if not items:
+        raise ValueError("eps: must contain at least one recurrence threshold, got []")
+    if len(set(items)) != len(items):
+        raise ValueError(f"eps: thresholds must be distinct, got {items}")
+    return tuple(items)
 
 
 def _subset(name, value, choices):
@@ -108,10 +131,21 @@ class Experiment:
         steps cover less than ``n_steps * tau``); ``"uniform"``: samples at ``k tau``.
     rule : {"mirror", "elastic"}
         Disk-disk collision rule.
-    eps : float
-        Recurrence threshold ``> 0`` (the paper: 0.001).
+    eps : float or sequence of float
+        Recurrence thresholds ``> 0``, distinct (a single float is stored as a 1-tuple).
+        ``eps[0]`` is the threshold of the ``recurrence_rate`` row (the paper: 0.001);
+        every threshold gets the ``rr@``/``rr_offdiag@``/``det@``/``l_mean@``/``l_max@``
+        rows (docs/experiments.md).
+    rr_sampling : {"run", "uniform"}
+        The samples the recurrence rows use. ``"run"``: the run's own samples (under
+        ``sampling="paper"`` the paper's collision-truncated steps); ``"uniform"``: samples
+        at ``k tau`` over the run's duration, from a uniformly sampled re-run of the same
+        trajectory with the same kicks (identical to ``"run"`` when
+        ``sampling="uniform"``).
     lag : int
-        Autocorrelation lag ``>= 1``.
+        Autocorrelation lag ``>= 1`` of the ``autocorrelation`` row.
+    acf_max_lag : int
+        Largest lag ``>= 1`` of the autocorrelation curve (rows ``acf@1..acf@L``).
     d0 : float
         Initial separation of the Lyapunov twins, ``1e-10 <= d0 <= 1e-2`` (the paper:
         1/5000); used only with ``lyapunov_method = "twin"``.
@@ -124,9 +158,12 @@ class Experiment:
         Kick law of the one-particle billiards; ``sigma`` (``> 0``) is the standard
         deviation of the gaussian rotation (unused for ``"uniform"``).
     systems : sequence of str
-        Subset of ``("two_particle", "poisson", "actual")`` whose diagnostics are stored.
-        The two-particle run is always simulated (its collision times are stored and
-        drive the other two).
+        Subset of ``("two_particle", "poisson", "actual", "poisson_scatter",
+        "actual_scatter")`` whose diagnostics are stored (default the first three, the
+        paper's). The two-particle run is always simulated (its collision times are
+        stored and drive the others). The ``*_scatter`` systems are kicked at the same
+        kinds of times but by scattering kicks (a collision with a virtual partner under
+        ``rule``, docs/scatter.md) instead of ``kick_angle``.
     diagnostics : sequence of str
         Subset of ``("lyapunov", "recurrence_rate", "autocorrelation")``.
     block_size : int
@@ -154,14 +191,16 @@ class Experiment:
     seed: int = 0
     sampling: str = "uniform"
     rule: str = "mirror"
-    eps: float = 1e-3
+    eps: tuple = (1e-3, 1e-2)
+    rr_sampling: str = "run"
     lag: int = 1
+    acf_max_lag: int = 20
     d0: float = 1.0 / 5000.0
     lyapunov_variant: str = "norm"
     lyapunov_method: str = "tangent"
     kick_angle: str = "uniform"
     sigma: float = 1.0
-    systems: tuple = SYSTEMS
+    systems: tuple = DEFAULT_SYSTEMS
     diagnostics: tuple = DIAGNOSTICS
     block_size: int = 25
     description: str = field(default="")
@@ -191,8 +230,10 @@ class Experiment:
         put("seed", _int("seed", self.seed, low=0))
         _choice("sampling", self.sampling, SAMPLINGS)
         _choice("rule", self.rule, RULES)
-        put("eps", _real("eps", self.eps, low=0.0))
+        put("eps", _eps_tuple(self.eps))
+        _choice("rr_sampling", self.rr_sampling, RR_SAMPLINGS)
         put("lag", _int("lag", self.lag, low=1))
+        put("acf_max_lag", _int("acf_max_lag", self.acf_max_lag, low=1))
         put("d0", _real("d0", self.d0, low=1e-10, high=1e-2, low_open=False, high_open=False))
         _choice("lyapunov_variant", self.lyapunov_variant, LYAPUNOV_VARIANTS)
         _choice("lyapunov_method", self.lyapunov_method, LYAPUNOV_METHODS)
@@ -225,7 +266,7 @@ class Experiment:
     def to_dict(self) -> dict:
         """JSON/TOML-ready dict of every field (tuples become lists)."""
         out = asdict(self)
-        for key in ("radii", "systems", "diagnostics"):
+        for key in ("radii", "eps", "systems", "diagnostics"):
             out[key] = list(out[key])
         return out
 
@@ -246,8 +287,19 @@ class Experiment:
         return cls(**d)
 
     def hash(self) -> str:
-        """Stable identity: the first 16 hex digits of SHA-256 of the canonical JSON."""
-        text = json.dumps(self.to_dict(), sort_keys=True, separators=(",", ":"), allow_nan=False)
+        """Stable identity: the first 16 hex digits of SHA-256 of the canonical JSON.
+
+        The canonical form is `to_dict` except that fields added later are left out while
+        they keep the value that reproduces the earlier results, and a single ``eps`` is
+        written as a float: stores written before those fields existed keep their hash.
+        """
+        record = self.to_dict()
+        for key, legacy in _LATER_FIELDS.items():
+            if record[key] == legacy:
+                del record[key]
+        if len(record["eps"]) == 1:
+            record["eps"] = record["eps"][0]
+        text = json.dumps(record, sort_keys=True, separators=(",", ":"), allow_nan=False)
         return hashlib.sha256(text.encode()).hexdigest()[:16]
 
     def to_toml(self) -> str:
@@ -296,7 +348,8 @@ class Experiment:
             f"{self.r_max:g}); {self.n_steps} steps of tau = {self.tau:g} ({self.sampling} "
             f"sampling); rule {self.rule}\n"
             f"  systems: {', '.join(self.systems)}; diagnostics: {', '.join(self.diagnostics)}"
-            f" (eps = {self.eps:g}, lag = {self.lag}; Lyapunov {self.lyapunov_method}"
+            f" (eps = {', '.join(f'{e:g}' for e in self.eps)} on {self.rr_sampling} samples, "
+            f"lag = {self.lag}, ACF to lag {self.acf_max_lag}; Lyapunov {self.lyapunov_method}"
             f"{f' d0 = {self.d0:g}' if self.lyapunov_method == 'twin' else ''}, variant "
             f"{self.lyapunov_variant}; kicks {self.kick_angle})\n"
             f"  {n_tasks} tasks of up to {self.block_size} ICs"

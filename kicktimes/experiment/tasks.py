@@ -6,7 +6,9 @@
    times for the collision-time table;
 2. the Poisson-kicked one-particle billiard started from disk 0's IC, kicked at the rate
    ``n_pp / t_max`` of that IC's two-particle run (the paper's per-IC estimate);
-3. the actual-time one-particle billiard, kicked at that run's disk-disk collision times.
+3. the actual-time one-particle billiard, kicked at that run's disk-disk collision times;
+4. optionally (``poisson_scatter``, ``actual_scatter``) the same two kinds of kick times
+   with scattering kicks, a collision with a virtual partner (docs/scatter.md).
 
 Every random number of (IC, radius, system) comes from its own
 ``SeedSequence(seed, spawn_key=(KICK_DOMAIN, ic, radius bits, system code))``, so the
@@ -45,7 +47,8 @@ COLLISION_COLUMNS = ("radius", "ic", "t_window", "n_pp", "pp_times")
 #: First spawn-key word of the kick streams; IC streams use ``spawn_key=(i,)``, so the two
 #: families of streams can never coincide (their keys differ in length and content).
 KICK_DOMAIN = 0x6B69636B  # "kick"
-SYSTEM_CODES = {"two_particle": 0, "poisson": 1, "actual": 2}
+SYSTEM_CODES = {"two_particle": 0, "poisson": 1, "actual": 2, "poisson_scatter": 3,
+                "actual_scatter": 4}
 
 
 @dataclass(frozen=True)
@@ -201,7 +204,7 @@ def _lyapunov():
 def _run_ic(exp: Experiment, r: float, ic_index: int, ic: np.ndarray, rows, coll, timer):
     from kicktimes.billiard.one_particle import draw_kick_angles, simulate_one_particle
     from kicktimes.billiard.two_particle import simulate_two_particle
-    from kicktimes.diagnostics import autocorrelation, boundary_angles, recurrence_rate
+    from kicktimes.diagnostics import boundary_angles
     from kicktimes.schedules import Poisson
 
     steps = {"n_steps": exp.n_steps, "tau": exp.tau, "sampling": exp.sampling}
@@ -218,16 +221,19 @@ def _run_ic(exp: Experiment, r: float, ic_index: int, ic: np.ndarray, rows, coll
 
     def diagnose(system, run, ftle):
         if "recurrence_rate" in diags:
+            points = run.samples
+            if exp.rr_sampling == "uniform":
+                with timer("recurrence_resampling"):
+                    points = _uniform_samples(exp, system, ic, r, run)
             with timer("recurrence_rate"):
-                add(system, "recurrence_rate", recurrence_rate(run.samples, exp.eps))
+                for diagnostic, value, note in recurrence_rows(points, exp.eps):
+                    add(system, diagnostic, value, note)
         if "autocorrelation" in diags:
             with timer("autocorrelation"):
-                value, reason = autocorrelation(
-                    boundary_angles(run, 0 if system == "two_particle" else None),
-                    exp.lag,
-                    return_reason=True,
-                )
-            add(system, "autocorrelation", value, reason or "")
+                theta = boundary_angles(run, 0 if system == "two_particle" else None)
+                acf_rows = autocorrelation_rows(theta, exp.lag, exp.acf_max_lag)
+            for diagnostic, value, note in acf_rows:
+                add(system, diagnostic, value, note)
         if "lyapunov" in diags:
             with timer(f"lyapunov_{'two_particle' if system == 'two_particle' else 'kicked'}"):
                 res = ftle()
@@ -256,19 +262,22 @@ def _run_ic(exp: Experiment, r: float, ic_index: int, ic: np.ndarray, rows, coll
         )
 
     horizon = exp.horizon
-    kick = {"kick_angle": exp.kick_angle, "sigma": exp.sigma}
-    for system in ("poisson", "actual"):
+    actual_times = None
+    for system in ("poisson", "actual", "poisson_scatter", "actual_scatter"):
         if system not in exp.systems:
             continue
+        kick = _kick_law(exp, system, ic)
         rng = kick_rng(exp.seed, ic_index, r, system)
-        if system == "actual":
-            with timer("simulation_two_particle"):
-                kick_times = _actual_times(exp, ic, r, two)
+        if system.startswith("actual"):
+            if actual_times is None:
+                with timer("simulation_two_particle"):
+                    actual_times = _actual_times(exp, ic, r, two)
+            kick_times = actual_times
         with timer("simulation_one_particle"):
-            if system == "poisson":
+            if system.startswith("poisson"):
                 rate = two.n_pp / two.t_max
                 kick_times = Poisson(rate).sample(horizon, rng)
-            kick_angles = draw_kick_angles(kick_times.size, exp.kick_angle, exp.sigma, rng)
+            kick_angles = draw_kick_angles(kick_times.size, kick["kick_angle"], exp.sigma, rng)
             one = simulate_one_particle(
                 ic[0],
                 r,
@@ -279,14 +288,14 @@ def _run_ic(exp: Experiment, r: float, ic_index: int, ic: np.ndarray, rows, coll
                 **steps,
             )
         add(system, "t_max", one.t_max)
-        if system == "poisson":
+        if system.startswith("poisson"):
             add(system, "kick_rate", rate)
         add(system, "n_kicks", one.n_kicks)
         add(system, "n_boundary", one.n_boundary)
         diagnose(
             system,
             one,
-            lambda kick_times=kick_times, kick_angles=kick_angles: _lyapunov()(
+            lambda kick_times=kick_times, kick_angles=kick_angles, kick=kick: _lyapunov()(
                 ic[0],
                 r,
                 kicks=kick_times,
@@ -297,6 +306,119 @@ def _run_ic(exp: Experiment, r: float, ic_index: int, ic: np.ndarray, rows, coll
                 **steps,
             ),
         )
+
+
+def _kick_law(exp: Experiment, system: str, ic: np.ndarray) -> dict:
+    """Keyword arguments of the kicks of a one-particle ``system``.
+
+    The paper's systems use ``exp.kick_angle``; the ``*_scatter`` systems collide with a
+    virtual partner under the experiment's rule, with the two-disk IC's kinetic energy
+    (elastic rule).
+    """
+    if not system.endswith("_scatter"):
+        return {"kick_angle": exp.kick_angle, "sigma": exp.sigma}
+    e0 = 0.5 * float((ic[:, 2:] ** 2).sum()) if exp.rule == "elastic" else None
+    return {"kick_angle": "scatter", "sigma": exp.sigma, "rule": exp.rule, "e0": e0}
+
+
+def eps_label(eps: float) -> str:
+    """The threshold as written in row names: ``f"{eps:g}"``, e.g. ``0.001``."""
+    return f"{eps:g}"
+
+
+def recurrence_rows(points: np.ndarray, eps: tuple) -> list[tuple]:
+    """The recurrence rows ``(diagnostic, value, note)`` of one run's samples.
+
+    ``recurrence_rate`` (at ``eps[0]``, the paper's RR with the main diagonal), then for
+    each threshold ``e``: ``rr@e`` (the same RR), ``rr_offdiag@e`` (Theiler window 1:
+    pairs ``i != j``), ``det@e``, ``l_mean@e``, ``l_max@e`` (Theiler 1, ``l_min = 2``).
+    One `rqa` call per threshold; ``rr@e = (N + R) / N^2`` from its ``R`` recurrent
+    off-diagonal entries is bitwise ``recurrence_rate(points, e)``.
+    """
+    from kicktimes.diagnostics import rqa
+
+    n = int(points.shape[0])
+    rows = []
+    for k, e in enumerate(eps):
+        tag = eps_label(e)
+        if n == 1:  # RR = 1 (the diagonal); nothing off the diagonal to compare
+            if k == 0:
+                rows.append(("recurrence_rate", 1.0, ""))
+            rows.append((f"rr@{tag}", 1.0, ""))
+            for name in ("rr_offdiag", "det", "l_mean", "l_max"):
+                rows.append((f"{name}@{tag}", math.nan, "a single sample: no pair i != j"))
+            continue
+        res = rqa(points, e, theiler=1, l_min=2)
+        # Python ints: the expression of recurrence_rate(points, e), so bitwise equal
+        rr = (n + res.n_recurrent) / (n * n)
+        if k == 0:
+            rows.append(("recurrence_rate", rr, ""))
+        rows.append((f"rr@{tag}", rr, ""))
+        rows.append((f"rr_offdiag@{tag}", res.rr, ""))
+        rows.append((f"det@{tag}", res.det, res.undefined.get("det", "")))
+        rows.append((f"l_mean@{tag}", res.l_mean, res.undefined.get("l_mean", "")))
+        rows.append((f"l_max@{tag}", float(res.l_max), ""))
+    return rows
+
+
+def autocorrelation_rows(theta: np.ndarray, lag: int, max_lag: int) -> list[tuple]:
+    """The autocorrelation rows ``(diagnostic, value, note)`` of one angle series.
+
+    ``autocorrelation`` (``R_lag``), ``acf@l`` for ``l = 1..max_lag``,
+    ``decorrelation_lag`` (first ``l`` with ``R_l < 1/e``) and ``tau_int`` (truncated at
+    the first ``R_l <= 0``; a finite value whose note says "lower bound" had no
+    ``R_l <= 0`` up to ``max_lag``). NaN values carry the reason.
+    """
+    from kicktimes.diagnostics import (
+        autocorrelation,
+        autocorrelation_function,
+        decorrelation_lag,
+        integrated_autocorrelation_time,
+    )
+
+    value, reason = autocorrelation(theta, lag, return_reason=True)
+    rows = [("autocorrelation", value, reason or "")]
+    acf, reason = autocorrelation_function(theta, max_lag, return_reason=True)
+    for k, value in enumerate(acf):
+        rows.append((f"acf@{k + 1}", value, (reason or "") if math.isnan(value) else ""))
+    value, reason = decorrelation_lag(acf, return_reason=True)
+    rows.append(("decorrelation_lag", value, reason or ""))
+    value, reason = integrated_autocorrelation_time(acf, return_reason=True)
+    rows.append(("tau_int", value, reason or ""))
+    return rows
+
+
+def _uniform_samples(exp: Experiment, system: str, ic: np.ndarray, r: float, run) -> np.ndarray:
+    """Samples at ``k tau``, ``k = 0..floor(t_max / tau)``, of the trajectory of ``run``.
+
+    The same trajectory (same IC and, for a kicked system, the very kick times and angles
+    that ``run`` applied) re-simulated with uniform sampling over ``run``'s duration. For
+    ``sampling="uniform"`` these are ``run``'s own samples.
+    """
+    if exp.sampling == "uniform":
+        return run.samples
+    if run.t_max < exp.tau:  # not even one step: the start is the only sample
+        return run.samples[:1]
+    if system == "two_particle":
+        from kicktimes.billiard.two_particle import simulate_two_particle
+
+        again = simulate_two_particle(
+            ic, r, t_max=run.t_max, tau=exp.tau, rule=exp.rule, track=0, sampling="uniform"
+        )
+    else:
+        from kicktimes.billiard.one_particle import simulate_one_particle
+
+        again = simulate_one_particle(
+            ic[0],
+            r,
+            t_max=run.t_max,
+            tau=exp.tau,
+            kicks=run.kick_times,
+            kick_angles=run.kick_angles,
+            sampling="uniform",
+            **_kick_law(exp, system, ic),
+        )
+    return again.samples
 
 
 def _actual_times(exp: Experiment, ic: np.ndarray, r: float, two) -> np.ndarray:

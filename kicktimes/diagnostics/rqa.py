@@ -1,0 +1,270 @@
+"""Recurrence quantification analysis (RQA) without an N x N matrix.
+
+The recurrence matrix ``R_ij = Theta(eps - |x_i - x_j|)`` of N planar points is symmetric.
+Its recurrent entries are found by the cell-list pair enumeration of
+`kicktimes.diagnostics.recurrence` and kept as sorted rows (compressed sparse rows, both
+orders of every pair); the line statistics are then read off those rows in one pass:
+
+* a **diagonal line** is a maximal run of recurrent entries ``(i + k, j + k)``,
+  ``k = 0..l-1``, along one diagonal ``j - i = d``; the run continues from row ``i`` to
+  row ``i + 1`` when ``j + 1`` is in row ``i + 1`` (a two-pointer merge of the two sorted
+  rows), so each line's length is carried forward and counted where it ends;
+* a **vertical line** is a maximal run of recurrent entries ``(i + k, j)`` in one
+  column; by symmetry column ``j`` equals row ``j``, so these are runs of consecutive
+  column indices within a sorted row.
+
+Memory is O(N) plus two integers per recurrent entry; time O(N + candidate pairs +
+recurrent entries). See `rqa` for the exact conventions, and docs/diagnostics.md.
+"""
+
+from __future__ import annotations
+
+import numbers
+from dataclasses import asdict, dataclass, field
+
+import numpy as np
+from numba import njit
+
+from kicktimes.diagnostics.recurrence import _as_points, _check_eps, _check_theiler, _pairs_csr
+
+__all__ = ["RQAResult", "rqa"]
+
+
+@njit(cache=True)
+def _line_histograms(offsets, cols, n, w):
+    """Histograms of line lengths from the sorted rows of a symmetric recurrence matrix.
+
+    Returns ``(diag, vert)``: ``diag[l]`` counts the diagonal lines of length ``l`` in the
+    upper triangle, on diagonals ``j - i >= max(w, 1)`` (the main diagonal is left to the
+    caller); ``vert[v]`` counts the vertical lines of length ``v`` of the whole matrix
+    (every column, admissible entries only: the rows hold no entry with ``|i - j| < w``,
+    so the Theiler band breaks the runs by itself).
+    """
+    dmin = max(w, 1)
+    diag = np.zeros(n + 1, np.int64)
+    vert = np.zeros(n + 1, np.int64)
+    # length of the diagonal line ending at each entry, propagated to (i + 1, j + 1)
+    run = np.ones(cols.shape[0], np.int64)
+    for i in range(n):
+        lo = offsets[i]
+        hi = offsets[i + 1]
+        a = lo
+        while a < hi:  # runs of consecutive columns in row i = vertical lines of column i
+            b = a + 1
+            while b < hi and cols[b] == cols[b - 1] + 1:
+                b += 1
+            vert[b - a] += 1
+            a = b
+        a = lo
+        while a < hi and cols[a] < i + dmin:
+            a += 1
+        p = hi  # start of row i + 1
+        p_hi = offsets[i + 2] if i + 1 < n else hi
+        for e in range(a, hi):
+            target = cols[e] + 1
+            while p < p_hi and cols[p] < target:
+                p += 1
+            if p < p_hi and cols[p] == target:
+                run[p] = run[e] + 1
+            else:
+                diag[run[e]] += 1
+    return diag, vert
+
+
+@dataclass(frozen=True)
+class RQAResult:
+    """Recurrence quantification measures of one point set (see `rqa` for the definitions).
+
+    Attributes
+    ----------
+    eps, theiler, l_min : float, int, int
+        The threshold, Theiler window and minimal line length used.
+    n_points : int
+        ``N``.
+    n_admissible : int
+        Entries of the matrix outside the Theiler window: ``N^2`` for ``theiler = 0``,
+        ``(N - w)(N - w + 1)`` otherwise.
+    n_recurrent : int
+        Recurrent admissible entries (ordered pairs, so twice the unordered pairs, plus
+        the ``N`` diagonal entries when ``theiler = 0``).
+    rr : float
+        ``n_recurrent / n_admissible``.
+    det, l_mean, l_max, n_lines : float, float, int, int
+        Determinism, mean and maximal diagonal line length, number of diagonal lines of
+        length ``>= l_min``.
+    lam, tt, v_max : float, float, int
+        Laminarity, trapping time and longest vertical line.
+    undefined : dict
+        ``{field: reason}`` for every field that is NaN (empty when all are defined).
+    """
+
+    eps: float
+    theiler: int
+    l_min: int
+    n_points: int
+    n_admissible: int
+    n_recurrent: int
+    rr: float
+    det: float
+    l_mean: float
+    l_max: int
+    n_lines: int
+    lam: float
+    tt: float
+    v_max: int
+    undefined: dict = field(default_factory=dict)
+
+    def to_dict(self) -> dict:
+        """The fields as a plain dict (``undefined`` included)."""
+        return asdict(self)
+
+
+def _check_l_min(l_min) -> int:
+    if isinstance(l_min, bool) or not isinstance(l_min, numbers.Integral):
+        raise TypeError(f"l_min: expected an int >= 1, got {l_min!r}")
+    if l_min < 1:
+        raise ValueError(f"l_min: must be >= 1 (the shortest line that counts), got {l_min}")
+    return int(l_min)
+
+
+def rqa(points, eps=1e-3, *, theiler=1, l_min=2):
+    r"""Recurrence quantification analysis: RR, determinism, line lengths, laminarity.
+
+    Parameters
+    ----------
+    points : array_like, shape (N, 2), or a run record
+        Sampled planar positions (a run record's ``samples`` are used).
+    eps : float, default 1e-3
+        Recurrence threshold ``> 0``; ``(i, j)`` is recurrent when
+        ``dx**2 + dy**2 <= eps**2`` in float64 (the test of `recurrence_rate`).
+    theiler : int, default 1
+        Theiler window ``w``, ``0 <= w < N``: the entries with ``|i - j| < w`` are removed
+        from the matrix (``w = 1``: the main diagonal only, the usual choice).
+    l_min : int, default 2
+        Minimal length of a diagonal (and of a vertical) line, ``>= 1``.
+
+    Returns
+    -------
+    RQAResult
+        ``rr, det, l_mean, l_max, n_lines, lam, tt, v_max`` and the counts behind them.
+        A measure that is undefined (no recurrence; no line of length ``>= l_min``) is
+        NaN and ``result.undefined`` says why.
+
+    Raises
+    ------
+    ValueError, TypeError
+        As `recurrence_rate`, and for ``l_min`` not an int ``>= 1``.
+
+    Notes
+    -----
+    All measures are taken over the *admissible* entries ``A_w = {(i, j) : |i - j| >= w}``
+    of the full, symmetric ``N x N`` matrix (both triangles; the diagonal only when
+    ``w = 0``). With ``R`` the number of recurrent admissible entries,
+
+    .. math::
+
+        RR = \frac{R}{|A_w|},\qquad
+        DET = \frac{\sum_{l \ge l_{min}} l\, P(l)}{R},\qquad
+        L = \frac{\sum_{l \ge l_{min}} l\, P(l)}{\sum_{l \ge l_{min}} P(l)},\qquad
+        L_{max} = \max\{l : P(l) > 0\},
+
+    .. math::
+
+        LAM = \frac{\sum_{v \ge l_{min}} v\, P_V(v)}{R},\qquad
+        TT = \frac{\sum_{v \ge l_{min}} v\, P_V(v)}{\sum_{v \ge l_{min}} P_V(v)},
+
+    where ``P(l)`` counts the diagonal lines of length exactly ``l``: maximal runs of
+    recurrent admissible entries ``(i + k, j + k)``, ``k = 0..l-1``, on one diagonal
+    ``j - i = d`` with ``|d| >= w``; and ``P_V(v)`` counts the vertical lines, maximal
+    runs ``(i + k, j)``, ``k = 0..v-1``, of recurrent admissible entries in one column
+    (an excluded entry ends a run). ``|A_w| = N^2`` for ``w = 0`` and
+    ``(N - w)(N - w + 1)`` for ``w >= 1``, so ``rr`` equals
+    ``recurrence_rate(points, eps, theiler=w)``. The window removes whole diagonals, so
+    it never cuts a diagonal line. By symmetry every line below the diagonal mirrors one
+    above it, so ``P`` is twice the upper triangle's count, plus, for ``w = 0``, the main
+    diagonal: one line of length ``N`` (then ``l_max = N``; use ``w >= 1`` for line
+    statistics that describe the dynamics). ``DET = 1`` when every recurrent entry has a
+    recurrent diagonal neighbour; ``DET`` and ``LAM`` are NaN when ``R = 0``, ``L`` and
+    ``TT`` when no line reaches ``l_min``; ``l_max`` and ``v_max`` are 0 when ``R = 0``.
+
+    Cost: O(N) memory plus 16 bytes per recurrent entry (the sorted rows and a run
+    length), never an ``N x N`` matrix; time O(N + candidate pairs + recurrent entries).
+
+    References
+    ----------
+    N. Marwan, M. C. Romano, M. Thiel, J. Kurths, "Recurrence plots for the analysis of
+    complex systems", Phys. Rep. 438, 237 (2007), Sec. 3.2 (DET, L, LAM, TT).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from kicktimes.diagnostics import rqa
+    >>> pts = np.array([[0.0, 0.0], [0.5, 0.0], [0.0, 0.0], [0.5, 0.0], [0.9, 0.9]])
+    >>> res = rqa(pts, eps=0.1)            # the pairs (0, 2), (1, 3): one line of length 2
+    >>> res.n_recurrent, res.det, res.l_mean, res.l_max
+    (4, 1.0, 2.0, 2)
+    >>> res.rr == 4 / (4 * 5)             # (N - 1) N admissible entries for theiler = 1
+    True
+    """
+    pts = _as_points(points)
+    n = pts.shape[0]
+    w = _check_theiler(theiler, n)
+    eps = _check_eps(eps)
+    l_min = _check_l_min(l_min)
+    offsets, cols = _pairs_csr(pts, eps, w)
+    diag_up, vert = _line_histograms(offsets, cols, n, w)
+
+    # Python ints from here on: exact counts, correctly rounded ratios
+    n_rec = int(cols.shape[0])
+    n_adm = n * n if w == 0 else (n - w) * (n - w + 1)
+    lengths = np.arange(n + 1, dtype=np.int64)
+    long_d = lengths >= l_min
+    lines = 2 * int(diag_up[long_d].sum())
+    on_lines = 2 * int((lengths * diag_up)[long_d].sum())
+    nz = np.flatnonzero(diag_up)
+    l_max = int(nz[-1]) if nz.size else 0
+    if w == 0:  # the main diagonal: one line of length N
+        l_max = n
+        if n >= l_min:
+            lines += 1
+            on_lines += n
+    v_lines = int(vert[long_d].sum())
+    on_v_lines = int((lengths * vert)[long_d].sum())
+    nzv = np.flatnonzero(vert)
+    v_max = int(nzv[-1]) if nzv.size else 0
+
+    undefined = {}
+    if n_rec == 0:
+        reason = f"no recurrent pair at eps = {eps:g} (theiler = {w})"
+        det = lam = np.nan
+        undefined["det"] = undefined["lam"] = reason
+    else:
+        det = on_lines / n_rec
+        lam = on_v_lines / n_rec
+    if lines == 0:
+        l_mean = np.nan
+        undefined["l_mean"] = f"no diagonal line of length >= l_min = {l_min}"
+    else:
+        l_mean = on_lines / lines
+    if v_lines == 0:
+        tt = np.nan
+        undefined["tt"] = f"no vertical line of length >= l_min = {l_min}"
+    else:
+        tt = on_v_lines / v_lines
+    return RQAResult(
+        eps=eps,
+        theiler=w,
+        l_min=l_min,
+        n_points=n,
+        n_admissible=n_adm,
+        n_recurrent=n_rec,
+        rr=n_rec / n_adm,
+        det=det,
+        l_mean=l_mean,
+        l_max=l_max,
+        n_lines=lines,
+        lam=lam,
+        tt=tt,
+        v_max=v_max,
+        undefined=undefined,
+    )

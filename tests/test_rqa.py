@@ -1,0 +1,234 @@
+"""Specification of the recurrence quantification analysis (kicktimes.diagnostics.rqa).
+
+The reference is the definition applied to the full N x N boolean matrix: every diagonal
+and every column is scanned for maximal runs of recurrent admissible entries.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from kicktimes.diagnostics import RQAResult, recurrence_rate, rqa
+
+# ------------------------------------------------------------------ reference
+
+
+def runs(mask: np.ndarray) -> list[int]:
+    """Lengths of the maximal runs of True in a 1-D boolean array."""
+    out, k = [], 0
+    for v in mask:
+        if v:
+            k += 1
+        elif k:
+            out.append(k)
+            k = 0
+    if k:
+        out.append(k)
+    return out
+
+
+def brute_rqa(points: np.ndarray, eps: float, theiler: int, l_min: int) -> dict:
+    """RQA from the definition on the full matrix (same float expression as the code)."""
+    n = len(points)
+    dx = points[:, None, 0] - points[None, :, 0]
+    dy = points[:, None, 1] - points[None, :, 1]
+    mat = dx * dx + dy * dy <= eps * eps
+    i, j = np.indices((n, n))
+    mat &= np.abs(i - j) >= theiler
+    n_rec = int(mat.sum())
+    diag = [length for d in range(-(n - 1), n) for length in runs(np.diagonal(mat, d))]
+    vert = [length for col in range(n) for length in runs(mat[:, col])]
+    long_d = [length for length in diag if length >= l_min]
+    long_v = [v for v in vert if v >= l_min]
+    n_adm = n * n if theiler == 0 else (n - theiler) * (n - theiler + 1)
+    return {
+        "n_recurrent": n_rec,
+        "n_admissible": n_adm,
+        "rr": n_rec / n_adm,
+        "det": sum(long_d) / n_rec if n_rec else np.nan,
+        "l_mean": sum(long_d) / len(long_d) if long_d else np.nan,
+        "l_max": max(diag, default=0),
+        "n_lines": len(long_d),
+        "lam": sum(long_v) / n_rec if n_rec else np.nan,
+        "tt": sum(long_v) / len(long_v) if long_v else np.nan,
+        "v_max": max(vert, default=0),
+    }
+
+
+def assert_matches_brute_force(points, eps, theiler, l_min):
+    res = rqa(points, eps, theiler=theiler, l_min=l_min)
+    ref = brute_rqa(np.asarray(points, dtype=float), eps, theiler, l_min)
+    for key, value in ref.items():
+        got = getattr(res, key)
+        if isinstance(value, float) and np.isnan(value):
+            assert np.isnan(got), (key, got)
+            assert key in res.undefined
+        else:
+            assert got == value, (key, got, value)  # exact: same integers, same division
+    assert set(res.undefined) == {k for k, v in ref.items() if isinstance(v, float) and v != v}
+
+
+# ------------------------------------------------------------------ point sets
+
+
+def trajectory(n: int, seed: int, tau: float = 0.05) -> np.ndarray:
+    """A point particle in the unit disk sampled every tau, direction redrawn at the wall.
+
+    Short steps make consecutive samples recur, so there are long diagonal lines.
+    """
+    rng = np.random.default_rng(seed)
+    x = np.array([0.3, -0.2])
+    a = rng.uniform(0.0, 2.0 * np.pi)
+    v = np.array([np.cos(a), np.sin(a)])
+    pts = np.empty((n, 2))
+    t, k = 0.0, 0
+    while k < n:
+        b = x @ v
+        dt = -b + np.sqrt(b * b - x @ x + 1.0)
+        while k < n and k * tau <= t + dt:
+            pts[k] = x + (k * tau - t) * v
+            k += 1
+        x = x + dt * v
+        a = np.arctan2(x[1], x[0]) + np.pi + rng.uniform(-0.5 * np.pi, 0.5 * np.pi)
+        v = np.array([np.cos(a), np.sin(a)])
+        t += dt
+    return pts
+
+
+def periodic_with_duplicates(n: int) -> np.ndarray:
+    """A period-7 orbit on a coarse grid: exact duplicates, ties at distance eps."""
+    k = np.arange(n)
+    return np.column_stack([0.01 * (k % 7), 0.01 * ((k * 3) % 5)])
+
+
+RNG = np.random.default_rng(11)
+POINT_SETS = {
+    "uniform": RNG.uniform(-1, 1, (300, 2)),
+    "trajectory": trajectory(350, seed=1),
+    "periodic_duplicates": periodic_with_duplicates(200),
+    "clumps": np.round(RNG.uniform(0, 0.05, (250, 2)), 2),  # many ties and duplicates
+}
+
+
+# ------------------------------------------------------------------ exactness
+
+
+@pytest.mark.parametrize("name", sorted(POINT_SETS))
+@pytest.mark.parametrize("eps", [0.01, 0.05, 0.2])
+@pytest.mark.parametrize("theiler", [0, 1, 5])
+@pytest.mark.parametrize("l_min", [2, 3])
+def test_rqa_equals_the_definition_on_the_full_matrix(name, eps, theiler, l_min):
+    assert_matches_brute_force(POINT_SETS[name], eps, theiler, l_min)
+
+
+@settings(max_examples=150, deadline=None)
+@given(
+    data=st.lists(
+        st.tuples(
+            st.sampled_from([0.0, 0.001, 0.002, 0.01, -0.003]),
+            st.sampled_from([0.0, 0.001, 0.0015, 0.004]),
+        ),
+        min_size=1,
+        max_size=40,
+    ),
+    eps=st.sampled_from([1e-4, 1e-3, 0.0015, 2e-3, 5e-3, 0.05]),
+    theiler=st.integers(0, 4),
+    l_min=st.integers(1, 4),
+)
+def test_property_rqa_equals_the_definition(data, eps, theiler, l_min):
+    pts = np.array(data, dtype=float)
+    assert_matches_brute_force(pts, eps, min(theiler, len(pts) - 1), l_min)
+
+
+def test_rr_is_the_recurrence_rate_with_the_same_theiler_window():
+    pts = trajectory(2000, seed=5)
+    for w in (0, 1, 4):
+        assert rqa(pts, 0.02, theiler=w).rr == recurrence_rate(pts, 0.02, theiler=w)
+
+
+def test_off_diagonal_rate_is_n_rr_minus_one_over_n_minus_one():
+    # N * RR - 1 = (N - 1) * RR_offdiag: the paper's RR minus its main diagonal
+    pts = trajectory(3000, seed=6, tau=0.2)
+    n = len(pts)
+    for eps in (1e-3, 1e-2):
+        rr = recurrence_rate(pts, eps)
+        off = recurrence_rate(pts, eps, theiler=1)
+        assert off > 0
+        assert n * rr - 1 == pytest.approx((n - 1) * off, rel=1e-12)
+        assert rqa(pts, eps).rr == off
+
+
+# ------------------------------------------------------------------ meaning
+
+
+def test_a_repeated_segment_is_one_diagonal_line_on_each_side():
+    seg = np.column_stack([np.linspace(0, 0.9, 10), np.zeros(10)])
+    far = np.array([[0.0, 0.9], [0.3, 0.9], [0.6, 0.9]])
+    pts = np.vstack([seg, far, seg])  # samples 0..9 recur as 13..22
+    res = rqa(pts, 1e-3)
+    assert res.n_recurrent == 20
+    assert (res.det, res.l_mean, res.l_max, res.n_lines) == (1.0, 10.0, 10, 2)
+    assert res.lam == 0.0 and np.isnan(res.tt) and res.v_max == 1
+
+
+def test_isolated_recurrences_have_zero_determinism():
+    pts = np.array([[0.0, 0.0], [0.5, 0.0], [0.0, 0.9], [0.0, 0.0]])
+    res = rqa(pts, 1e-3)
+    assert res.n_recurrent == 2 and res.det == 0.0 and res.l_max == 1
+    assert np.isnan(res.l_mean) and "l_mean" in res.undefined
+
+
+def test_a_point_at_rest_is_one_vertical_block():
+    pts = np.zeros((6, 2))
+    res = rqa(pts, 1e-3, theiler=0)
+    assert res.rr == 1.0 and res.lam == 1.0 and res.tt == 6.0 and res.v_max == 6
+    # the main diagonal counts for theiler = 0; the corners (0, 5), (5, 0) are lines of 1
+    assert res.l_max == 6 and res.det == 34 / 36 and res.n_lines == 9
+
+
+def test_no_recurrence_gives_nan_with_reasons():
+    pts = np.array([[0.0, 0.0], [0.5, 0.0], [0.0, 0.5]])
+    res = rqa(pts, 1e-3)
+    assert res.n_recurrent == 0 and res.rr == 0.0 and res.l_max == 0 and res.v_max == 0
+    assert np.isnan(res.det) and np.isnan(res.lam)
+    assert "no recurrent pair" in res.undefined["det"]
+    assert isinstance(res, RQAResult) and res.to_dict()["n_points"] == 3
+
+
+def test_theiler_window_removes_the_lines_along_the_trajectory():
+    pts = trajectory(1000, seed=2, tau=0.002)  # consecutive samples recur: long lines
+    near = rqa(pts, 0.01, theiler=1)
+    far = rqa(pts, 0.01, theiler=5)
+    assert near.l_max > 900 and far.l_max < near.l_max
+    assert near.det > far.det
+
+
+# ------------------------------------------------------------------ bad input
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "error", "match"),
+    [
+        ({"l_min": 0}, ValueError, "l_min: must be >= 1"),
+        ({"l_min": 2.0}, TypeError, "l_min"),
+        ({"l_min": True}, TypeError, "l_min"),
+        ({"theiler": 5}, ValueError, "theiler"),
+        ({"theiler": -1}, ValueError, "theiler"),
+        ({"eps": 0.0}, ValueError, "eps"),
+        ({"eps": np.nan}, ValueError, "eps"),
+    ],
+)
+def test_bad_arguments_raise(kwargs, error, match):
+    pts = np.zeros((5, 2))
+    with pytest.raises(error, match=match):
+        rqa(pts, **{"eps": 1e-3, **kwargs})
+
+
+def test_bad_points_raise():
+    with pytest.raises(ValueError, match="points"):
+        rqa(np.zeros((4, 3)), 1e-3)
+    with pytest.raises(ValueError, match="finite"):
+        rqa(np.array([[0.0, np.nan], [0.0, 0.0]]), 1e-3)
