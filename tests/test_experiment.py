@@ -158,9 +158,9 @@ def test_a_single_eps_is_accepted_and_kept_as_a_tuple():
 
 
 def legacy_record(exp: Experiment) -> dict:
-    """The experiment record a store written before eps lists, acf_max_lag, rr_sampling holds."""
+    """The record a store written before eps lists, acf_max_lag, rr_sampling, lyapunov_method holds."""
     record = exp.to_dict()
-    del record["acf_max_lag"], record["rr_sampling"]
+    del record["acf_max_lag"], record["rr_sampling"], record["lyapunov_method"]
     record["eps"] = record["eps"][0]
     return record
 
@@ -168,17 +168,19 @@ def legacy_record(exp: Experiment) -> dict:
 def test_experiments_of_the_old_format_keep_their_hash():
     import hashlib
 
-    old = dataclasses.replace(TINY, eps=0.001)
+    old = dataclasses.replace(TINY, eps=0.001, lyapunov_method="twin")
     record = legacy_record(old)
     text = json.dumps(record, sort_keys=True, separators=(",", ":"))
     assert old.hash() == hashlib.sha256(text.encode()).hexdigest()[:16]
-    assert Experiment.from_dict(record) == old
+    assert Experiment.from_record(record) == old
+    assert Experiment.from_dict(record).lyapunov_method == "tangent"  # a TOML gets the default
     assert old.hash() == "21f9b7ce323e6659"  # computed by kicktimes before this change
 
 
 def test_a_store_written_before_the_new_rows_still_loads(tmp_path):
     old = dataclasses.replace(
-        TINY, eps=0.001, radii=[0.02], n_ics=1, n_steps=50, diagnostics=["recurrence_rate"]
+        TINY, eps=0.001, radii=[0.02], n_ics=1, n_steps=50, diagnostics=["recurrence_rate"],
+        lyapunov_method="twin",
     )
     run_quiet(old, tmp_path / "s", workers=1)
     manifest = json.loads((tmp_path / "s" / "manifest.json").read_text())

@@ -84,7 +84,8 @@ def one_state(s):
 def flow_one(st0, t_end, kicks, angles, mode, U=None):
     st = st0.copy()
     U = np.zeros((1, 4)) if U is None else U.copy()
-    out = tangent_one_kernel(st, RHO, kicks, angles, mode, 1, 1, t_end, U, 10**6)
+    out = tangent_one_kernel(st, RHO, kicks, angles, mode, 1, 1, t_end, U, 10**6, NO_SCATTER,
+                             NO_PARTNER)
     assert out[4] == 0
     return st, U, out
 
@@ -171,6 +172,8 @@ def test_non_unit_speed_survives_a_uniform_kick_as_a_speed_deviation():
 
 # ------------------------------------------------------------ against the twin method
 R_AGREE = 0.03
+NO_SCATTER = np.zeros((0, 2))  # kernels' scatter arguments when kicks are not scattering
+NO_PARTNER = np.zeros(4)
 STEPS = dict(n_steps=10000, tau=0.2)
 
 SYSTEMS = {
@@ -246,7 +249,7 @@ def test_unkicked_disk_exponent_is_below_the_round_off_driven_twin(ics20):
             tangent = lyapunov(ic[0], R_AGREE, n_steps=n, tau=0.2).lam
             out = ftle_one_kernel(st.copy(), 1.0 - R_AGREE, np.empty(0), np.empty(0), 0, 1, n,
                                   0.2, np.array([[1e-14, 0.0]]), np.array([0]), 1e-14, 10,
-                                  10**8)
+                                  10**8, NO_SCATTER, NO_PARTNER)
             twin_tiny = out[0][0] / out[4][0]
             assert tangent < 0.75 * twin_tiny
 

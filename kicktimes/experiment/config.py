@@ -286,6 +286,18 @@ class Experiment:
             raise ValueError(f"missing required experiment key(s) {missing}")
         return cls(**d)
 
+    @classmethod
+    def from_record(cls, d) -> Experiment:
+        """Experiment from a store's record: fields the record predates get their legacy value.
+
+        A store written before a field existed (``_LATER_FIELDS``) was computed with the
+        value that reproduces the earlier results (e.g. ``lyapunov_method = "twin"``), not
+        with today's default; a TOML file, by contrast, gets the defaults (`from_dict`).
+        """
+        if not isinstance(d, dict):
+            raise TypeError(f"expected a dict of experiment fields, got {type(d).__name__}")
+        return cls.from_dict({**{k: v for k, v in _LATER_FIELDS.items() if k not in d}, **d})
+
     def hash(self) -> str:
         """Stable identity: the first 16 hex digits of SHA-256 of the canonical JSON.
 

@@ -411,7 +411,7 @@ def load_store(path: str | os.PathLike, *, verify: bool = True) -> Store:
         raise ValueError(f"path: {os.fspath(root)!r} is not a kicktimes store (no {MANIFEST})")
     manifest = _read_manifest(root)
     try:
-        experiment = Experiment.from_dict(manifest["experiment"])
+        experiment = Experiment.from_record(manifest["experiment"])
     except (TypeError, ValueError) as exc:
         raise ValueError(
             f"damaged store {os.fspath(root)!r}: bad experiment record ({exc})"
