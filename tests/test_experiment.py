@@ -158,7 +158,7 @@ def test_a_single_eps_is_accepted_and_kept_as_a_tuple():
 
 
 def legacy_record(exp: Experiment) -> dict:
-    """The record a store written before eps lists, acf_max_lag, rr_sampling, lyapunov_method holds."""
+    """The record of a store written before eps lists, acf_max_lag, rr_sampling, lyapunov_method."""
     record = exp.to_dict()
     del record["acf_max_lag"], record["rr_sampling"], record["lyapunov_method"]
     record["eps"] = record["eps"][0]
