@@ -181,17 +181,18 @@ def _lock_holder(fd: int) -> str:
         return ""
 
 
-def _acquire_lock(root: Path, wait) -> int | None:
-    """Hold the store's advisory write lock; returns its file descriptor.
+def _acquire_lock(root: Path, wait) -> tuple[int | None, bool]:
+    """Hold the store's advisory write lock; returns its file descriptor and whether the
+    store is writable.
 
-    None when the store is read-only (no lock file can be created): nothing will be
-    written then, and none is needed. ``wait``: False refuses at once, True blocks, a
+    The descriptor is None when no lock file exists and none can be created (a
+    read-only store): nothing will be written then, so none is needed. ``wait``: False refuses at once, True blocks, a
     number is a timeout in seconds.
     """
     try:
         import fcntl
     except ImportError:  # not POSIX: no advisory locks; one writer is the user's duty
-        return None
+        return None, True
     path = root / LOCK
     try:
         fd = os.open(path, os.O_RDWR | os.O_CREAT | getattr(os, "O_CLOEXEC", 0), 0o666)
@@ -200,7 +201,7 @@ def _acquire_lock(root: Path, wait) -> int | None:
         if exc.errno not in _READ_ONLY_ERRNOS:
             raise
         if not path.exists():
-            return None
+            return None, False
         fd = os.open(path, os.O_RDONLY | getattr(os, "O_CLOEXEC", 0))
         writable = False
     deadline = None if wait is True else time.monotonic() + float(wait or 0.0)
@@ -227,7 +228,7 @@ def _acquire_lock(root: Path, wait) -> int | None:
         info = {"pid": os.getpid(), "host": socket.gethostname(), "since": _now()}
         os.ftruncate(fd, 0)
         os.pwrite(fd, json.dumps(info).encode("utf-8"), 0)
-    return fd
+    return fd, writable
 
 
 def _release_lock(fd: int | None) -> None:
@@ -276,8 +277,8 @@ class StoreWriter:
                 f"{MANIFEST}; it is not a kicktimes store (choose an empty or new directory)"
             )
         self.root.mkdir(parents=True, exist_ok=True)
-        self._lock = _acquire_lock(self.root, wait)
-        self.writable = self._lock is not None and os.access(self.root, os.W_OK)
+        self._lock, writable = _acquire_lock(self.root, wait)
+        self.writable = writable and os.access(self.root, os.W_OK)
         try:
             self._open(manifest_path)
         except BaseException:
