@@ -186,8 +186,8 @@ def _acquire_lock(root: Path, wait) -> tuple[int | None, bool]:
     store is writable.
 
     The descriptor is None when no lock file exists and none can be created (a
-    read-only store): nothing will be written then, so none is needed. ``wait``: False refuses at once, True blocks, a
-    number is a timeout in seconds.
+    read-only store): nothing will be written then, so none is needed. ``wait``: False
+    refuses at once, True blocks, a number is a timeout in seconds.
     """
     try:
         import fcntl

@@ -474,7 +474,7 @@ def _fit(x, c, model, x_min, *, min_tail=50, max_candidates=500, covariance=True
     n_used = x.size if x_min is None else int((x >= x_min).sum())
     if model != "powerlaw" and n_used < need:
         raise ValueError(
-            f"model {model!r} needs at least {need} complete intervals"
+            f"intervals: model {model!r} needs at least {need} complete intervals"
             + ("" if x_min is None else f" at or above x_min={x_min!r}")
             + f", got {n_used}"
         )
@@ -512,7 +512,8 @@ def _fit(x, c, model, x_min, *, min_tail=50, max_candidates=500, covariance=True
         cov = np.full((len(theta), len(theta)), np.nan)
     names = PARAM_NAMES[model]
     factor = np.array([unit ** _TIME_POWER.get(name, 0) for name in names], dtype=float)
-    theta_out = theta * factor
+    with np.errstate(over="ignore"):  # an overflow shows as inf and is flagged below
+        theta_out = theta * factor
     if model == "lognormal":
         theta_out[0] = theta[0] + math.log(unit)
     with np.errstate(over="ignore", invalid="ignore"):
