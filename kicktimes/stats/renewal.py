@@ -172,12 +172,13 @@ def _direct_fit(model, x, c, x_min, start, trouble=None):
             theta = _from_free(model, free)
             return -_total_loglik(model, theta, x, c, x_min) / (x.size + c.size)
 
-    res = optimize.minimize(
-        nll,
-        _to_free(model, start),
-        method="Nelder-Mead",
-        options={"xatol": 1e-9, "fatol": 1e-12, "maxiter": 4000, "maxfev": 8000},
-    )
+    with np.errstate(all="ignore"):  # inf - inf among simplex values on wild data
+        res = optimize.minimize(
+            nll,
+            _to_free(model, start),
+            method="Nelder-Mead",
+            options={"xatol": 1e-9, "fatol": 1e-12, "maxiter": 4000, "maxfev": 8000},
+        )
     if trouble is not None and not res.success:
         trouble.append(f"Nelder-Mead: {res.message}")
     return _from_free(model, res.x)
