@@ -1,10 +1,81 @@
-"""The ``kicktimes`` command line (click)."""
+"""The ``kicktimes`` command line (click).
+
+Errors reach the user as one line naming the command-line option (``--radius``, not the
+library's ``r``), with plain numbers; file-system errors (read-only folder, full disk)
+too, never as a traceback.
+"""
 
 from __future__ import annotations
+
+import contextlib
+import math
+import re
 
 import click
 
 from kicktimes import __version__
+
+# numpy 2 reprs ("np.float64(-2.0)") leak into messages built with !r
+_NUMPY_REPR = re.compile(r"\bnp\.(?:float|int|uint|bool_?)\d*\((.*?)\)")
+
+
+def _plain(message: str, options: dict | None = None) -> str:
+    """``message`` with numpy scalar reprs unwrapped and a leading library argument name
+    replaced by its command-line option (``t_max must ...`` -> ``--t-max must ...``)."""
+    message = _NUMPY_REPR.sub(r"\1", message)
+    for name, option in (options or {}).items():
+        pattern = rf"^{re.escape(name)}(?=[\s:\[]|$)"
+        if re.match(pattern, message):
+            return re.sub(pattern, option, message, count=1)
+    return message
+
+
+def _os_message(exc: OSError) -> str:
+    """One line for a file-system error: what failed and on which path."""
+    what = exc.strerror or str(exc)
+    if exc.filename is not None:
+        return f"{what}: {exc.filename}"
+    return what
+
+
+@contextlib.contextmanager
+def _cli_errors(options: dict | None = None):
+    """Turn library and file-system errors into one-line click errors."""
+    from kicktimes.experiment.store import StoreLockedError
+
+    try:
+        yield
+    except click.ClickException:
+        raise
+    except OSError as exc:
+        raise click.ClickException(_plain(_os_message(exc), options)) from None
+    except (ValueError, TypeError, ImportError, StoreLockedError, RuntimeError) as exc:
+        raise click.ClickException(_plain(str(exc), options)) from None
+
+
+class _Real(click.ParamType):
+    """A finite float in an open interval, checked by click so errors name the option."""
+
+    name = "float"
+
+    def __init__(self, low=None, high=None):
+        self.low, self.high = low, high
+
+    def convert(self, value, param, ctx):
+        if isinstance(value, float):
+            x = value
+        else:
+            try:
+                x = float(value)
+            except (TypeError, ValueError):
+                self.fail(f"{value!r} is not a number", param, ctx)
+        if not math.isfinite(x):
+            self.fail(f"must be finite, got {x}", param, ctx)
+        if (self.low is not None and x <= self.low) or (self.high is not None and x >= self.high):
+            lo = "-inf" if self.low is None else f"{self.low:g}"
+            hi = "inf" if self.high is None else f"{self.high:g}"
+            self.fail(f"must lie in ({lo}, {hi}), got {x:g}", param, ctx)
+        return x
 
 
 @click.group(context_settings={"help_option_names": ["-h", "--help"]})
@@ -19,7 +90,7 @@ def main():
     "--radius",
     "-r",
     "radii",
-    type=float,
+    type=_Real(0.0, 0.5),
     multiple=True,
     default=(0.01, 0.02),
     show_default=True,
@@ -27,13 +98,17 @@ def main():
 )
 @click.option(
     "--n-ics",
-    type=int,
+    type=click.IntRange(min=1),
     default=100,
     show_default=True,
     help="Number of initial conditions (drawn once, at the largest radius).",
 )
-@click.option("--t-max", type=float, default=1000.0, show_default=True, help="Run time per IC.")
-@click.option("--seed", type=int, default=0, show_default=True, help="Ensemble seed.")
+@click.option(
+    "--t-max", type=_Real(0.0), default=1000.0, show_default=True, help="Run time per IC."
+)
+@click.option(
+    "--seed", type=click.IntRange(min=0), default=0, show_default=True, help="Ensemble seed."
+)
 @click.option(
     "--rule",
     type=click.Choice(["mirror", "elastic"]),
@@ -70,19 +145,22 @@ def simulate_command(radii, n_ics, t_max, seed, rule, ic_method, out, save_runs)
     from tqdm.auto import tqdm
 
     from kicktimes import initial_conditions, simulate_two_particle
-    from kicktimes.billiard.runs import _atomic_write
+    from kicktimes.experiment.store import _atomic_write
     from kicktimes.stats import kinetic_rate
 
-    try:
+    # the options are range-checked by click; this maps anything the library still
+    # refuses back to the option that caused it
+    options = {"r_max": "--radius", "r": "--radius", "n": "--n-ics", "t_max": "--t-max",
+               "seed": "--seed", "rule": "--rule", "method": "--ic-method"}
+    with _cli_errors(options):
         ics = initial_conditions(n_ics, max(radii), seed=seed, method=ic_method, rule=rule)
         for r in radii:
             simulate_two_particle(ics[0], r, t_max=t_max, rule=rule)  # validates r, t_max
-    except ValueError as exc:
-        raise click.BadParameter(str(exc)) from exc
-    os.makedirs(out, exist_ok=True)
+        os.makedirs(out, exist_ok=True)
     rows = []
     quiet = bool(os.environ.get("CI")) or not os.isatty(2)
-    with tqdm(total=len(radii) * n_ics, disable=quiet, desc="simulate") as bar:
+    with _cli_errors(options), tqdm(total=len(radii) * n_ics, disable=quiet,
+                                    desc="simulate") as bar:
         for r in radii:
             for i, ic in enumerate(ics):
                 run = simulate_two_particle(ic, r, t_max=t_max, rule=rule, seed=seed)
@@ -110,7 +188,8 @@ def simulate_command(radii, n_ics, t_max, seed, rule, ic_method, out, save_runs)
     )
     table = table.replace_schema_metadata({b"kicktimes": json.dumps(meta).encode()})
     path = os.path.join(out, "collisions.parquet")
-    _atomic_write(path, lambda tmp: pq.write_table(table, tmp))
+    with _cli_errors():
+        _atomic_write(path, lambda tmp: pq.write_table(table, tmp))
     df = pd.DataFrame({"radius": table["radius"].to_numpy(), "n_pp": table["n_pp"].to_numpy()})
     summary = df.groupby("radius").n_pp.agg(["mean", "std", "count"])
     summary["sem"] = summary["std"] / np.sqrt(summary["count"])
@@ -144,6 +223,10 @@ def _parse_schedule_params(params):
     return parsed
 
 
+_SCHEDULE_OPTIONS = {"t_max": "--t-max", "seed": "--seed", "window": "--window",
+                     "times": "--input", "dist": "--dist", "path": "--output"}
+
+
 @main.command("schedule")
 @click.argument(
     "model", type=click.Choice(["poisson", "renewal", "bootstrap", "replay", "json"], False)
@@ -170,11 +253,11 @@ def _parse_schedule_params(params):
 )
 @click.option(
     "--window",
-    type=float,
+    type=_Real(0.0),
     default=None,
     help="replay: observation window of the input times (sampling beyond it is an error).",
 )
-@click.option("--t-max", "t_max", type=float, required=True, help="Horizon: kicks in (0, T].")
+@click.option("--t-max", "t_max", type=_Real(0.0), required=True, help="Horizon: kicks in (0, T].")
 @click.option(
     "--seed",
     type=click.IntRange(min=0),
@@ -226,7 +309,9 @@ def schedule_command(
         times = schedule.sample(t_max, seed)
         path = schedules.write_kick_times(times, output, t_max=t_max, schedule=schedule, seed=seed)
     except (ValueError, TypeError) as exc:
-        raise click.UsageError(str(exc)) from None
+        raise click.UsageError(_plain(str(exc), _SCHEDULE_OPTIONS)) from None
+    except OSError as exc:
+        raise click.ClickException(_plain(_os_message(exc))) from None
     mean = f"{np.diff(times).mean():.6g}" if times.size > 1 else "n/a"
     click.echo(
         f"{schedule!r}: {times.size} kicks in (0, {t_max:g}], mean interval {mean}, "
@@ -240,7 +325,7 @@ def schedule_command(
 
 
 # --- experiment commands ---
-def _run_one(experiment, out, workers, scheduler, progress):
+def _run_one(experiment, out, workers, scheduler, progress, wait=False):
     """Run or resume one sweep, printing store warnings as plain lines; returns the store."""
     import warnings
 
@@ -250,7 +335,8 @@ def _run_one(experiment, out, workers, scheduler, progress):
         warnings.simplefilter("always", StoreWarning)
         try:
             store = run_experiment(
-                experiment, out, workers=workers, scheduler=scheduler, progress=progress
+                experiment, out, workers=workers, scheduler=scheduler, progress=progress,
+                wait=wait,
             )
         finally:
             for w in caught:
@@ -275,6 +361,14 @@ _progress_option = click.option(
     default=None,
     help="Progress bar (default: on a terminal, off when CI is set).",
 )
+_wait_option = click.option(
+    "--wait",
+    is_flag=True,
+    help="If another run is writing the store, wait for it instead of stopping.",
+)
+# library argument names -> the options that set them
+_RUN_OPTIONS = {"store": "--out", "workers": "--workers", "scheduler": "--scheduler",
+                "path": "--out"}
 
 
 @main.command("run")
@@ -289,7 +383,8 @@ _progress_option = click.option(
 @_workers_option
 @_scheduler_option
 @_progress_option
-def run_command(experiment, out, workers, scheduler, progress):
+@_wait_option
+def run_command(experiment, out, workers, scheduler, progress, wait):
     """Run (or resume) the sweep of EXPERIMENT.toml into the store --out.
 
     \b
@@ -301,12 +396,10 @@ def run_command(experiment, out, workers, scheduler, progress):
 
     if workers is not None and scheduler is not None:
         raise click.UsageError("--workers sizes the local pool; it cannot go with --scheduler")
-    try:
+    with _cli_errors(_RUN_OPTIONS):
         exp = Experiment.from_toml(experiment)
         click.echo(exp.summary())
-        store = _run_one(exp, out, workers, scheduler, progress)
-    except (ValueError, TypeError, ImportError) as exc:
-        raise click.ClickException(str(exc)) from None
+        store = _run_one(exp, out, workers, scheduler, progress, wait)
     click.echo(store.summary())
 
 
@@ -338,10 +431,8 @@ def report_command(stores, out, workers, progress):
       kicktimes report stores/quick_a --out report-a
       kicktimes report stores/family_a stores/family_b --out report
     """
-    try:
+    with _cli_errors(_RUN_OPTIONS):
         path = _build_report(stores, out, workers, progress)
-    except (ValueError, TypeError) as exc:
-        raise click.ClickException(str(exc)) from None
     click.echo(f"report written to {path if path is not None else out}")
 
 
@@ -363,7 +454,8 @@ def report_command(stores, out, workers, progress):
 @_workers_option
 @_scheduler_option
 @_progress_option
-def reproduce_command(scale, out, workers, scheduler, progress):
+@_wait_option
+def reproduce_command(scale, out, workers, scheduler, progress, wait):
     """Run the paper's two experiment families and build the report.
 
     Reruns resume the stores in --out. The experiments are the built-in presets, the
@@ -376,17 +468,15 @@ def reproduce_command(scale, out, workers, scheduler, progress):
     if workers is not None and scheduler is not None:
         raise click.UsageError("--workers sizes the local pool; it cannot go with --scheduler")
     stores = []
-    try:
+    with _cli_errors(_RUN_OPTIONS):
         for name in SCALES[scale]:
             exp = preset(name)
             path = os.path.join(out, f"store-{name}")
             click.echo(exp.summary())
-            store = _run_one(exp, path, workers, scheduler, progress)
+            store = _run_one(exp, path, workers, scheduler, progress, wait)
             click.echo(store.summary())
             stores.append(path)
         report = _build_report(stores, os.path.join(out, "report"), workers, progress)
-    except (ValueError, TypeError, ImportError) as exc:
-        raise click.ClickException(str(exc)) from None
     click.echo(f"report written to {report if report is not None else os.path.join(out, 'report')}")
 
 

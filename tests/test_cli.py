@@ -5,9 +5,11 @@ import subprocess
 import sys
 
 import pyarrow.parquet as pq
+import pytest
 from click.testing import CliRunner
 
-from kicktimes.cli import main
+from kicktimes.cli import _plain, main
+from kicktimes.experiment import Experiment
 
 
 def test_simulate_writes_collisions_and_prints_the_kinetic_expectation(tmp_path):
@@ -29,7 +31,88 @@ def test_simulate_writes_collisions_and_prints_the_kinetic_expectation(tmp_path)
 def test_simulate_rejects_a_bad_radius(tmp_path):
     result = CliRunner().invoke(main, ["simulate", "-r", "0.7", "--out", str(tmp_path / "x")])
     assert result.exit_code != 0
-    assert "r_max must lie in" in result.output or "r must lie in" in result.output
+    assert "'--radius'" in result.output and "must lie in (0, 0.5), got 0.7" in result.output
+
+
+@pytest.mark.parametrize(
+    ("args", "option"),
+    [
+        (["-r", "nan"], "--radius"),
+        (["-r", "-0.1"], "--radius"),
+        (["--n-ics", "0"], "--n-ics"),
+        (["--t-max", "-2"], "--t-max"),
+        (["--t-max", "inf"], "--t-max"),
+        (["--seed", "-1"], "--seed"),
+    ],
+)
+def test_simulate_errors_name_the_option_never_the_library_argument(tmp_path, args, option):
+    result = CliRunner().invoke(main, ["simulate", *args, "--out", str(tmp_path / "x")])
+    assert result.exit_code == 2
+    assert f"'{option}'" in result.output
+    for internal in ("r_max", "t_max", " n must", "np.float64", "Traceback"):
+        assert internal not in result.output
+
+
+def test_schedule_errors_name_the_option_and_show_plain_numbers(tmp_path):
+    out = str(tmp_path / "k.csv")
+    result = CliRunner().invoke(main, ["schedule", "poisson", "-p", "rate=1", "--t-max", "-2",
+                                       "-o", out])
+    assert result.exit_code == 2 and "'--t-max'" in result.output
+    result = CliRunner().invoke(main, ["schedule", "poisson", "-p", "rate=-2", "--t-max", "5",
+                                       "-o", out])
+    assert result.exit_code != 0 and "rate" in result.output
+    assert "np.float64" not in result.output
+
+
+def test_plain_unwraps_numpy_reprs_and_maps_leading_argument_names():
+    assert _plain("x must lie in (0, 1), got np.float64(-2.0)") == "x must lie in (0, 1), got -2.0"
+    assert _plain("t_max must be positive", {"t_max": "--t-max"}) == "--t-max must be positive"
+    assert _plain("n must be >= 1", {"n": "--n-ics"}) == "--n-ics must be >= 1"
+    # only a leading name is an argument name; words inside the text are left alone
+    assert _plain("count n must be >= 1", {"n": "--n-ics"}) == "count n must be >= 1"
+
+
+def test_file_system_errors_are_one_line_messages(tmp_path):
+    blocker = tmp_path / "file"
+    blocker.write_text("not a folder")
+    result = CliRunner().invoke(main, ["simulate", "--n-ics", "2", "--t-max", "5",
+                                       "--out", str(blocker / "sub")])
+    assert result.exit_code == 1
+    assert result.output.strip().splitlines() == [f"Error: Not a directory: {blocker / 'sub'}"]
+
+
+def test_run_on_a_full_disk_prints_one_line(tmp_path, monkeypatch):
+    import errno
+
+    import pyarrow.parquet
+
+    def full(*args, **kwargs):
+        raise OSError(errno.ENOSPC, "No space left on device", str(tmp_path / "store"))
+
+    toml = tmp_path / "e.toml"
+    Experiment(name="tiny", radii=[0.02], n_ics=2, n_steps=100, tau=0.3).write_toml(toml)
+    monkeypatch.setattr(pyarrow.parquet, "write_table", full)
+    result = CliRunner().invoke(main, ["run", str(toml), "--out", str(tmp_path / "store"),
+                                       "--workers", "1", "--no-progress"])
+    assert result.exit_code == 1
+    assert result.output.strip().splitlines()[-1] == (
+        f"Error: No space left on device: {tmp_path / 'store'}"
+    )
+    assert "Traceback" not in result.output
+
+
+def test_run_on_a_locked_store_says_so_in_one_line(tmp_path):
+    from kicktimes.experiment.store import StoreWriter
+
+    exp = Experiment(name="tiny", radii=[0.02], n_ics=2, n_steps=100, tau=0.3)
+    toml = tmp_path / "e.toml"
+    exp.write_toml(toml)
+    with StoreWriter(tmp_path / "store", exp):
+        result = CliRunner().invoke(main, ["run", str(toml), "--out", str(tmp_path / "store"),
+                                           "--workers", "1"])
+    assert result.exit_code == 1
+    assert "being written by another kicktimes run" in result.output
+    assert "--wait" in result.output and "Traceback" not in result.output
 
 
 def test_python_dash_m_runs_the_cli():

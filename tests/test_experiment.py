@@ -3,12 +3,15 @@
 from __future__ import annotations
 
 import dataclasses
+import errno
 import json
 import math
+import os
 import shutil
 import signal
 import subprocess
 import sys
+import threading
 import time
 import warnings
 from concurrent.futures import ThreadPoolExecutor
@@ -23,12 +26,14 @@ from kicktimes.experiment import (
     PRESETS,
     RESULT_COLUMNS,
     Experiment,
+    StoreLockedError,
     StoreWarning,
     kick_rng,
     load_store,
     run_experiment,
     run_task,
 )
+from kicktimes.experiment.store import StoreWriter
 from kicktimes.experiment.tasks import _actual_times
 
 REPO = Path(__file__).resolve().parents[1]
@@ -401,7 +406,7 @@ def test_store_layout_manifest_and_no_temporary_files(reference):
     root = reference.path
     names = sorted(p.relative_to(root).as_posix() for p in root.rglob("*") if p.is_file())
     ids = [t.id for t in TINY.tasks()]
-    expected = ["manifest.json"]
+    expected = [".lock", "manifest.json"]
     expected += [f"collisions/{i}.parquet" for i in ids] + [f"results/{i}.parquet" for i in ids]
     assert names == sorted(expected)
     manifest = json.loads((root / "manifest.json").read_text())
@@ -532,6 +537,210 @@ def test_a_directory_that_is_not_a_store_is_refused(tmp_path):
         run_quiet(TINY, tmp_path, workers=1)
     with pytest.raises(ValueError, match="not a kicktimes store"):
         load_store(tmp_path)
+
+
+# ---------------------------------------------------------------- store hardening
+
+
+def _edit_manifest(path, edit):
+    manifest = json.loads((path / "manifest.json").read_text())
+    edit(manifest)
+    (path / "manifest.json").write_text(json.dumps(manifest))
+
+
+def test_a_second_writer_is_refused_and_leaves_the_first_writers_files_alone(reference, tmp_path):
+    path = tmp_path / "s"
+    shutil.copytree(reference.path, path)
+    with StoreWriter(path, TINY):
+        in_flight = path / "results" / ".tmp-in-flight.parquet"
+        in_flight.write_bytes(b"being written")
+        with pytest.raises(StoreLockedError, match=r"being written by another kicktimes run \(pid"):
+            run_quiet(TINY, path, workers=1)
+        assert in_flight.exists()
+        in_flight.unlink()
+    assert run_quiet(TINY, path, workers=1).complete  # the lock is released on close
+
+
+def test_a_second_writer_can_wait_for_the_lock(reference, tmp_path):
+    path = tmp_path / "s"
+    shutil.copytree(reference.path, path)
+    writer = StoreWriter(path, TINY)
+    with pytest.raises(StoreLockedError, match="after waiting 0.2 s"):
+        run_quiet(TINY, path, workers=1, wait=0.2)
+    timer = threading.Timer(0.3, writer.close)
+    timer.start()
+    start = time.monotonic()
+    assert run_quiet(TINY, path, workers=1, wait=True).complete
+    assert time.monotonic() - start >= 0.25
+    timer.join()
+
+
+@pytest.mark.parametrize("wait", [-1, float("nan"), "yes"])
+def test_a_bad_wait_is_refused(tmp_path, wait):
+    with pytest.raises(ValueError, match="wait: must be"):
+        run_quiet(TINY, tmp_path / "s", workers=1, wait=wait)
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc")
+def test_pool_workers_exit_when_the_driver_is_killed(tmp_path):
+    exp = dataclasses.replace(TINY, n_ics=40, block_size=1, n_steps=20000)
+    script = (
+        "import sys\nfrom kicktimes.experiment import Experiment, run_experiment\n"
+        f"run_experiment(Experiment.from_toml({str(tmp_path / 'e.toml')!r}), "
+        f"{str(tmp_path / 'store')!r}, workers=2, progress=False)\n"
+    )
+    exp.write_toml(tmp_path / "e.toml")
+    proc = subprocess.Popen([sys.executable, "-c", script])
+    children_file = Path(f"/proc/{proc.pid}/task/{proc.pid}/children")
+    children = []
+    deadline = time.monotonic() + 60
+    try:
+        while time.monotonic() < deadline and len(children) < 2:
+            time.sleep(0.1)
+            children = children_file.read_text().split() if children_file.exists() else []
+        assert len(children) >= 2, "the pool did not start"
+    finally:
+        proc.kill()
+        proc.wait(30)
+    deadline = time.monotonic() + 10
+    while time.monotonic() < deadline and any(Path(f"/proc/{c}").exists() for c in children):
+        time.sleep(0.1)
+    alive = [c for c in children if Path(f"/proc/{c}").exists()]
+    for c in alive:  # do not leak them if the test fails
+        os.kill(int(c), signal.SIGKILL)
+    assert not alive, f"pool workers {alive} outlived the killed driver"
+
+
+@pytest.mark.parametrize("bad", ["../../x.parquet", "/etc/passwd", "results/other.parquet"])
+def test_manifest_entries_may_only_name_their_own_files(reference, tmp_path, bad):
+    path = tmp_path / "s"
+    shutil.copytree(reference.path, path)
+    tid = TINY.tasks()[0].id
+
+    def point_elsewhere(m):
+        m["tasks"][tid]["file"] = bad
+
+    _edit_manifest(path, point_elsewhere)
+    with pytest.raises(ValueError, match="may only name their own files"):
+        load_store(path)
+    with pytest.warns(StoreWarning, match=f"task {tid}: .*may only name their own files"):
+        repaired = run_quiet(TINY, path, workers=1)
+    assert_same_store(reference, repaired)
+    manifest = json.loads((path / "manifest.json").read_text())
+    assert manifest["tasks"][tid]["file"] == f"results/{tid}.parquet"
+
+
+@pytest.mark.parametrize(
+    ("edit", "match"),
+    [
+        (lambda m: m.update(layout=2), "layout 2 .* upgrade kicktimes"),
+        (lambda m: m.update(layout=0), "layout 0 .* not a valid layout"),
+        (lambda m: m.update(layout="1"), "'layout' must be a JSON integer"),
+        (lambda m: m.pop("layout"), "has no 'layout' entry"),
+        (lambda m: m.update(tasks=[]), "'tasks' must be a JSON object"),
+        (lambda m: m.update(experiment=None), "'experiment' must be a JSON object"),
+        (lambda m: m["experiment"].update(radii=[]), "bad experiment record"),
+    ],
+)
+def test_a_corrupt_manifest_is_refused_with_a_clear_message(reference, tmp_path, edit, match):
+    path = tmp_path / "s"
+    shutil.copytree(reference.path, path)
+    _edit_manifest(path, edit)
+    with pytest.raises(ValueError, match=match):
+        load_store(path)
+    with pytest.raises(ValueError, match=match if "record" not in match else "."):
+        run_quiet(TINY, path, workers=1)
+
+
+def test_a_manifest_that_is_not_an_object_is_refused(reference, tmp_path):
+    path = tmp_path / "s"
+    shutil.copytree(reference.path, path)
+    (path / "manifest.json").write_text("[]")
+    with pytest.raises(ValueError, match="holds a JSON list, not an object"):
+        load_store(path)
+
+
+def test_a_null_task_entry_is_refused_by_load_and_recomputed_by_run(reference, tmp_path):
+    path = tmp_path / "s"
+    shutil.copytree(reference.path, path)
+    tid = TINY.tasks()[1].id
+    _edit_manifest(path, lambda m: m["tasks"].update({tid: None}))
+    with pytest.raises(ValueError, match=f"task {tid}: manifest entry is a JSON NoneType"):
+        load_store(path)
+    with pytest.warns(StoreWarning, match="it will be recomputed"):
+        assert_same_store(reference, run_quiet(TINY, path, workers=1))
+
+
+def test_opening_a_complete_store_writes_nothing(reference, tmp_path):
+    path = tmp_path / "s"
+    shutil.copytree(reference.path, path)
+    before = {p: (p.stat().st_mtime_ns, p.read_bytes()) for p in path.rglob("*") if p.is_file()}
+    run_quiet(TINY, path, workers=1)
+    after = {p: (p.stat().st_mtime_ns, p.read_bytes()) for p in path.rglob("*") if p.is_file()}
+    assert {p: v for p, v in after.items() if p.name != ".lock"} == {
+        p: v for p, v in before.items() if p.name != ".lock"
+    }
+
+
+def _read_only(monkeypatch, root):
+    """Make the store look read-only (the tests may run as root, which ignores modes)."""
+    import kicktimes.experiment.store as store_module
+
+    real_open = os.open
+
+    def refuse_writes(path, flags, *args):
+        if Path(path).parent == Path(root) and flags & (os.O_WRONLY | os.O_RDWR | os.O_CREAT):
+            raise PermissionError(errno.EROFS, "Read-only file system", os.fspath(path))
+        return real_open(path, flags, *args)
+
+    monkeypatch.setattr(store_module.os, "open", refuse_writes)
+
+
+def test_a_complete_read_only_store_can_be_resumed_and_loaded(reference, tmp_path, monkeypatch):
+    path = tmp_path / "s"
+    shutil.copytree(reference.path, path)
+    _read_only(monkeypatch, path)
+    assert_same_store(reference, run_quiet(TINY, path, workers=1))
+
+
+def test_an_unfinished_read_only_store_names_the_write_it_cannot_do(reference, tmp_path,
+                                                                    monkeypatch):
+    path = tmp_path / "s"
+    shutil.copytree(reference.path, path)
+    tid = TINY.tasks()[0].id
+    _edit_manifest(path, lambda m: m["tasks"].pop(tid))
+    _read_only(monkeypatch, path)
+    with pytest.raises(PermissionError, match="is read-only; cannot"):
+        run_quiet(TINY, path, workers=1)
+    assert len(load_store(path).missing_tasks) == 1
+
+
+@pytest.mark.skipif(os.name != "posix" or os.geteuid() == 0, reason="root ignores file modes")
+def test_a_complete_store_in_a_read_only_folder_loads(reference, tmp_path):
+    path = tmp_path / "s"
+    shutil.copytree(reference.path, path)
+    (path / ".lock").unlink()
+    folders = [path, path / "results", path / "collisions"]
+    for folder in folders:
+        folder.chmod(0o555)
+    try:
+        assert_same_store(reference, run_quiet(TINY, path, workers=1))
+    finally:
+        for folder in folders:
+            folder.chmod(0o755)
+
+
+@pytest.mark.skipif(os.name != "posix", reason="POSIX modes")
+@pytest.mark.parametrize(("umask", "mode"), [(0o022, 0o644), (0o077, 0o600), (0o002, 0o664)])
+def test_store_files_get_the_permissions_of_the_umask(tmp_path, umask, mode):
+    old = os.umask(umask)
+    try:
+        store = run_quiet(dataclasses.replace(TINY, n_ics=2, radii=[0.02]), tmp_path / "s",
+                          workers=1)
+    finally:
+        os.umask(old)
+    files = [p for p in store.path.rglob("*") if p.is_file() and p.name != ".lock"]
+    assert files and {oct(p.stat().st_mode & 0o777) for p in files} == {oct(mode)}
 
 
 # --------------------------------------------------------------------------------- CLI

@@ -21,7 +21,7 @@ Examples
 from kicktimes.experiment.config import DIAGNOSTICS, SYSTEMS, Experiment
 from kicktimes.experiment.presets import PRESETS, preset
 from kicktimes.experiment.runner import run_experiment
-from kicktimes.experiment.store import Store, StoreWarning, load_store
+from kicktimes.experiment.store import Store, StoreLockedError, StoreWarning, load_store
 from kicktimes.experiment.tasks import (
     COLLISION_COLUMNS,
     RESULT_COLUMNS,
@@ -41,6 +41,7 @@ __all__ = [
     "SYSTEMS",
     "Experiment",
     "Store",
+    "StoreLockedError",
     "StoreWarning",
     "Task",
     "TaskOutput",

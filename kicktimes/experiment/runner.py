@@ -2,8 +2,12 @@
 
 from __future__ import annotations
 
+import ctypes
 import os
+import signal
 import sys
+import threading
+import time
 from concurrent.futures import FIRST_COMPLETED, Executor, ProcessPoolExecutor, wait
 
 from kicktimes.experiment.config import Experiment
@@ -19,6 +23,50 @@ def _progress_enabled(progress) -> bool:
     # a bar on an interactive terminal only: CI logs and pipes stay quiet
     ci = os.environ.get("CI", "").strip().lower()
     return sys.stderr.isatty() and ci in ("", "0", "false", "no")
+
+
+_PR_SET_PDEATHSIG = 1  # <linux/prctl.h>
+
+
+def _exit_with_parent(parent_pid: int, poll: float = 1.0) -> None:
+    """Pool-worker initializer: the worker ends when the driver process ends.
+
+    A ``ProcessPoolExecutor`` worker waits on a pipe that it shares with its siblings,
+    so it never sees the driver die (SIGKILL, OOM killer) and would live on, holding
+    memory. On Linux the kernel sends SIGKILL to the worker when its parent dies
+    (``prctl(PR_SET_PDEATHSIG)``); everywhere, a daemon thread also checks the parent
+    pid every ``poll`` seconds, which also covers a parent that died before the prctl.
+    """
+    if sys.platform.startswith("linux"):
+        try:
+            libc = ctypes.CDLL(None, use_errno=True)
+            libc.prctl(_PR_SET_PDEATHSIG, int(signal.SIGKILL), 0, 0, 0)
+        except (OSError, AttributeError):  # no usable libc: the watcher below suffices
+            pass
+
+    # Under "fork" and "spawn" the parent is the driver; under "forkserver" it is the
+    # server process, which itself exits when the driver does.
+    first_parent = os.getppid()
+
+    def driver_alive() -> bool:
+        if os.getppid() != first_parent:
+            return False  # re-parented: our parent has died
+        try:
+            os.kill(parent_pid, 0)
+        except ProcessLookupError:
+            return False
+        except PermissionError:
+            pass  # it exists
+        return True
+
+    def watch():
+        while driver_alive():
+            time.sleep(poll)
+        os._exit(1)  # orphaned: nobody will read our results
+
+    if not driver_alive():
+        os._exit(1)
+    threading.Thread(target=watch, name="kicktimes-parent-watch", daemon=True).start()
 
 
 def _dask_executor(scheduler: str):
@@ -41,6 +89,7 @@ def run_experiment(
     workers: int | None = None,
     scheduler: str | None = None,
     progress: bool | None = None,
+    wait: bool | float = False,
 ) -> Store:
     """Run (or resume) a sweep and stream each finished task to the store.
 
@@ -65,6 +114,10 @@ def run_experiment(
     progress : bool, optional
         Show a tqdm progress bar; default: only on a terminal and not when the ``CI``
         environment variable is set.
+    wait : bool or float, default False
+        One run writes a store at a time (an advisory lock in the store). If another
+        run holds it: False raises `StoreLockedError` at once, True waits for it, a
+        number waits at most that many seconds.
 
     Returns
     -------
@@ -77,13 +130,19 @@ def run_experiment(
         Bad arguments, or a store of a different experiment.
     RuntimeError
         A task failed; the tasks finished before it are kept, so a rerun resumes.
+    StoreLockedError
+        Another run is writing the store (a `RuntimeError`).
+    OSError
+        The store cannot be written (read-only folder, full disk); a complete store
+        on a read-only disk loads without writing.
 
     Notes
     -----
     Results are identical for every executor and worker count: each task is a pure
     function of the experiment and its IC range, and every random number comes from a
     seed sequence keyed by (IC, radius, system). Workers return their tables to this
-    process, which alone writes the store (the cluster needs no shared disk).
+    process, which alone writes the store (the cluster needs no shared disk). Workers of
+    the local pool end with this process, even when it is killed.
 
     Examples
     --------
@@ -115,11 +174,15 @@ def run_experiment(
             )
     if scheduler is not None and not isinstance(scheduler, str):
         raise TypeError(f"scheduler: expected an address string, got {scheduler!r}")
+    if not isinstance(wait, bool):
+        if not isinstance(wait, (int, float)) or not 0 <= wait < float("inf"):
+            raise ValueError(f"wait: must be True, False or a number of seconds >= 0, got {wait!r}")
 
-    writer = StoreWriter(store, experiment)
-    pending = writer.pending()
-    if pending:
-        _run_pending(writer, pending, executor, workers, scheduler, _progress_enabled(progress))
+    with StoreWriter(store, experiment, wait=wait) as writer:
+        pending = writer.pending()
+        if pending:
+            show = _progress_enabled(progress)
+            _run_pending(writer, pending, executor, workers, scheduler, show)
     return load_store(store)
 
 
@@ -147,7 +210,11 @@ def _run_pending(writer, pending, executor, workers, scheduler, show):
         if scheduler is not None:
             client, executor = _dask_executor(scheduler)
         elif executor is None:
-            own_pool = executor = ProcessPoolExecutor(max_workers=workers or os.cpu_count())
+            own_pool = executor = ProcessPoolExecutor(
+                max_workers=workers or os.cpu_count(),
+                initializer=_exit_with_parent,
+                initargs=(os.getpid(),),
+            )
         futures = {executor.submit(execute_task, experiment, task): task for task in pending}
         not_done = set(futures)
         try:

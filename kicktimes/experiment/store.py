@@ -7,7 +7,14 @@ Layout (docs/experiments.md)::
     STORE/collisions/<task id>.parquet    disk-disk collision times of the task
 
 Every file is written to a temporary name in the same folder and moved into place with
-``os.replace`` (atomic on POSIX and Windows), so a killed run leaves whole files or none.
+``os.replace`` (atomic on POSIX and Windows), so a killed run leaves whole files or none;
+files get the permissions the umask allows (as ``open`` would), not ``mkstemp``'s 0600.
+One writer at a time: `StoreWriter` holds an advisory lock (``fcntl.flock`` on
+``STORE/.lock``), so a second run on the same store is refused (or waits) instead of
+deleting the first run's in-flight temporary files. Readers take no lock (every write is
+atomic). Opening a complete, intact store writes nothing, so a read-only store can be
+loaded and "resumed". Manifest entries must name the task's own files: a path that
+points elsewhere (``../x.parquet``, an absolute path) is refused, never read.
 The parts carry the experiment hash and the task id in their Parquet schema metadata and
 their SHA-256 is in the manifest: a damaged part (bad checksum, unreadable) or a foreign
 one (another experiment's) is detected, reported and recomputed on the next run, and
@@ -17,10 +24,13 @@ one (another experiment's) is detected, reported and recomputed on the next run,
 from __future__ import annotations
 
 import datetime as _dt
+import errno
 import hashlib
 import json
 import os
+import socket
 import tempfile
+import time
 import warnings
 from dataclasses import dataclass
 from pathlib import Path
@@ -31,17 +41,24 @@ from kicktimes import __version__
 from kicktimes.experiment.config import Experiment
 from kicktimes.experiment.tasks import COLLISION_COLUMNS, RESULT_COLUMNS, Task, TaskOutput
 
-__all__ = ["Store", "StoreWarning", "load_store"]
+__all__ = ["Store", "StoreLockedError", "StoreWarning", "load_store"]
 
 MANIFEST = "manifest.json"
+LOCK = ".lock"
 LAYOUT_VERSION = 1
 PARTS = ("results", "collisions")
 _TMP_PREFIX = ".tmp-"
 _META_KEY = b"kicktimes"
+# errors that mean "this store cannot be written here" rather than a bug
+_READ_ONLY_ERRNOS = {errno.EACCES, errno.EPERM, errno.EROFS}
 
 
 class StoreWarning(UserWarning):
     """A store problem that a run repairs: damaged or foreign part, leftover temp file."""
+
+
+class StoreLockedError(RuntimeError):
+    """Another process is writing the store (it holds the store's lock)."""
 
 
 def _now() -> str:
@@ -56,8 +73,28 @@ def _sha256(path: str | os.PathLike) -> str:
     return h.hexdigest()
 
 
+def _umask() -> int:
+    """The process umask, read without changing it where the OS allows (Linux)."""
+    try:
+        with open("/proc/self/status", encoding="ascii") as fh:
+            for line in fh:
+                if line.startswith("Umask:"):
+                    return int(line.split()[1], 8)
+    except (OSError, ValueError):
+        pass
+    # os.umask can only be read by setting it; put it straight back
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
+
+
 def _atomic_write(path: Path, write) -> None:
-    """``write(tmp)`` into a temp file beside ``path``, fsync, then ``os.replace``."""
+    """``write(tmp)`` into a temp file beside ``path``, fsync, then ``os.replace``.
+
+    ``mkstemp`` creates the file 0600; it is given ``0666 & ~umask`` before the move,
+    the mode ``open(path, "w")`` would have produced.
+    """
+    path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=_TMP_PREFIX, suffix=path.suffix)
     os.close(fd)
@@ -65,6 +102,7 @@ def _atomic_write(path: Path, write) -> None:
         write(tmp)
         with open(tmp, "rb+") as fh:
             os.fsync(fh.fileno())
+            os.chmod(tmp, 0o666 & ~_umask())
         os.replace(tmp, path)
     except BaseException:
         if os.path.exists(tmp):
@@ -122,36 +160,138 @@ def _read_part_meta(path: Path) -> dict:
     if raw is None:
         raise ValueError("no kicktimes metadata (not a part file of a kicktimes store)")
     try:
-        return json.loads(raw)
-    except json.JSONDecodeError as exc:
+        meta = json.loads(raw)
+    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
         raise ValueError(f"corrupt kicktimes metadata ({exc})") from None
+    if not isinstance(meta, dict):
+        raise ValueError(f"corrupt kicktimes metadata (a {type(meta).__name__}, not an object)")
+    return meta
 
 
 def _part_path(root: Path, part: str, task_id: str) -> Path:
     return root / part / f"{task_id}.parquet"
 
 
+def _lock_holder(fd: int) -> str:
+    """What the lock file says about the process holding it (best effort)."""
+    try:
+        info = json.loads(os.pread(fd, 4096, 0).decode("utf-8") or "{}")
+        return f" (pid {info['pid']} on {info['host']}, since {info['since']})"
+    except (OSError, ValueError, KeyError, TypeError, AttributeError):
+        return ""
+
+
+def _acquire_lock(root: Path, wait) -> tuple[int | None, bool]:
+    """Hold the store's advisory write lock; returns its file descriptor and whether the
+    store is writable.
+
+    The descriptor is None when no lock file exists and none can be created (a
+    read-only store): nothing will be written then, so none is needed. ``wait``: False
+    refuses at once, True blocks, a number is a timeout in seconds.
+    """
+    try:
+        import fcntl
+    except ImportError:  # not POSIX: no advisory locks; one writer is the user's duty
+        return None, True
+    path = root / LOCK
+    try:
+        fd = os.open(path, os.O_RDWR | os.O_CREAT | getattr(os, "O_CLOEXEC", 0), 0o666)
+        writable = True
+    except OSError as exc:
+        if exc.errno not in _READ_ONLY_ERRNOS:
+            raise
+        if not path.exists():
+            return None, False
+        fd = os.open(path, os.O_RDONLY | getattr(os, "O_CLOEXEC", 0))
+        writable = False
+    deadline = None if wait is True else time.monotonic() + float(wait or 0.0)
+    while True:
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | (0 if deadline is None else fcntl.LOCK_NB))
+            break
+        except BlockingIOError:
+            if time.monotonic() < deadline:
+                time.sleep(0.1)
+                continue
+            holder = _lock_holder(fd)
+            os.close(fd)
+            waited = "" if not wait else f" after waiting {float(wait):g} s"
+            raise StoreLockedError(
+                f"store {os.fspath(root)!r} is being written by another kicktimes run"
+                f"{holder}{waited}; wait for it to finish, or let this run wait for it "
+                "(run_experiment(..., wait=True), kicktimes run --wait)"
+            ) from None
+        except BaseException:
+            os.close(fd)
+            raise
+    if writable:
+        info = {"pid": os.getpid(), "host": socket.gethostname(), "since": _now()}
+        os.ftruncate(fd, 0)
+        os.pwrite(fd, json.dumps(info).encode("utf-8"), 0)
+    return fd, writable
+
+
+def _release_lock(fd: int | None) -> None:
+    if fd is None:
+        return
+    import fcntl
+
+    try:
+        fcntl.flock(fd, fcntl.LOCK_UN)
+    finally:
+        os.close(fd)
+
+
+def _only_leftovers(root: Path) -> bool:
+    """True if the folder holds nothing but a lock and temporary files (an aborted start)."""
+    return all(p.name == LOCK or p.name.startswith(_TMP_PREFIX) for p in root.iterdir())
+
+
 class StoreWriter:
     """Opens (creating or resuming) the store of one experiment and writes finished tasks.
 
     Only the driver process writes: workers return their tables, so the store may live on
-    a disk the workers cannot see (a Dask cluster).
+    a disk the workers cannot see (a Dask cluster). The writer holds the store's lock
+    from construction to `close` (it is a context manager); ``wait`` says what to do
+    when another writer holds it (False: raise `StoreLockedError`, True: wait, a number:
+    wait at most that many seconds).
+
+    A store that cannot be written (read-only folder or file system) opens if it is
+    complete and intact; anything that would need a write raises `PermissionError`.
     """
 
-    def __init__(self, path: str | os.PathLike, experiment: Experiment):
+    def __init__(self, path: str | os.PathLike, experiment: Experiment, *, wait=False):
         self.root = Path(path)
         self.experiment = experiment
         self.hash = experiment.hash()
         self.all_tasks = {t.id: t for t in experiment.tasks()}
         self.problems: list[str] = []
+        self._lock = None
         if self.root.exists() and not self.root.is_dir():
             raise ValueError(f"store: {os.fspath(self.root)!r} exists and is not a directory")
         manifest_path = self.root / MANIFEST
+        # refuse a foreign folder before leaving a lock file in it
+        if self.root.is_dir() and not manifest_path.exists() and not _only_leftovers(self.root):
+            raise ValueError(
+                f"store: {os.fspath(self.root)!r} is a non-empty directory without a "
+                f"{MANIFEST}; it is not a kicktimes store (choose an empty or new directory)"
+            )
+        self.root.mkdir(parents=True, exist_ok=True)
+        self._lock, writable = _acquire_lock(self.root, wait)
+        self.writable = writable and os.access(self.root, os.W_OK)
+        try:
+            self._open(manifest_path)
+        except BaseException:
+            self.close()
+            raise
+
+    def _open(self, manifest_path: Path) -> None:
+        experiment = self.experiment
         if manifest_path.exists():
             self.manifest = _read_manifest(self.root)
             old_hash = self.manifest.get("experiment_hash")
             if old_hash != self.hash:
-                old_name = self.manifest.get("experiment", {}).get("name", "?")
+                old_name = self.manifest["experiment"].get("name", "?")
                 raise ValueError(
                     f"store {os.fspath(self.root)!r} holds experiment {old_name!r} (hash "
                     f"{old_hash}), not experiment {experiment.name!r} (hash {self.hash}); "
@@ -164,11 +304,6 @@ class StoreWriter:
                     f"resuming with {__version__}"
                 )
         else:
-            if self.root.is_dir() and any(self.root.iterdir()):
-                raise ValueError(
-                    f"store: {os.fspath(self.root)!r} is a non-empty directory without a "
-                    f"{MANIFEST}; it is not a kicktimes store (choose an empty or new directory)"
-                )
             created = _now()
             self.manifest = {
                 "layout": LAYOUT_VERSION,
@@ -185,6 +320,24 @@ class StoreWriter:
         self._verify_finished()
         self._check_strays()
 
+    def close(self) -> None:
+        """Release the store's lock (idempotent)."""
+        fd, self._lock = self._lock, None
+        _release_lock(fd)
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+    def _need_write(self, action: str) -> None:
+        if not self.writable:
+            raise PermissionError(
+                errno.EACCES,
+                f"store {os.fspath(self.root)!r} is read-only; cannot {action}",
+            )
+
     # ----------------------------------------------------------------- checking
     def _report(self, message: str) -> None:
         self.problems.append(message)
@@ -195,23 +348,32 @@ class StoreWriter:
             if not folder.is_dir():
                 continue
             for tmp in folder.glob(f"{_TMP_PREFIX}*"):
+                # we hold the lock, so no other writer owns this file: it is a leftover
+                self._need_write(f"remove the leftover temporary file {tmp.name}")
                 self._report(f"removing leftover temporary file {tmp.name} of an interrupted run")
                 tmp.unlink()
 
     def _verify_finished(self) -> None:
         tasks = self.manifest["tasks"]
+        changed = False
         for task_id in list(tasks):
             if task_id not in self.all_tasks:
+                self._need_write(f"drop the manifest entry {task_id!r}")
                 self._report(
                     f"manifest entry {task_id!r} is not a task of this experiment; dropped"
                 )
                 del tasks[task_id]
+                changed = True
                 continue
             problem = _check_entry(self.root, task_id, tasks[task_id], self.hash)
             if problem is not None:
+                self._need_write(f"recompute task {task_id} ({problem})")
                 self._report(f"task {task_id}: {problem}; it will be recomputed")
                 del tasks[task_id]
-        self._write_manifest()
+                changed = True
+        # an intact store is left untouched: reading must work on a read-only disk
+        if changed:
+            self._write_manifest()
 
     def _check_strays(self) -> None:
         """Part files not in the manifest: a kill between part and manifest, or foreign."""
@@ -226,10 +388,12 @@ class StoreWriter:
                 try:
                     meta = _read_part_meta(path)
                 except ValueError as exc:
+                    self._need_write(f"remove the damaged part {part}/{path.name}")
                     self._report(f"{part}/{path.name}: {exc}; it will be recomputed")
                     path.unlink()
                     continue
                 if meta.get("experiment_hash") != self.hash or task_id not in self.all_tasks:
+                    self._need_write(f"remove the foreign part {part}/{path.name}")
                     self._report(
                         f"{part}/{path.name} is a foreign part (experiment "
                         f"{meta.get('experiment_name')!r}, hash {meta.get('experiment_hash')}); "
@@ -253,6 +417,7 @@ class StoreWriter:
         import pyarrow as pa
         import pyarrow.parquet as pq
 
+        self._need_write(f"write task {output.task.id}")
         task = output.task
         entry = {
             "radius_index": task.radius_index,
@@ -277,6 +442,7 @@ class StoreWriter:
         self._write_manifest()
 
     def _write_manifest(self) -> None:
+        self._need_write(f"write its {MANIFEST}")
         self.manifest["updated"] = _now()
         text = json.dumps(self.manifest, indent=1, allow_nan=False)
 
@@ -287,30 +453,72 @@ class StoreWriter:
         _atomic_write(self.root / MANIFEST, write)
 
 
+_MANIFEST_TYPES = {
+    "layout": int,
+    "experiment": dict,
+    "experiment_hash": str,
+    "tasks": dict,
+    "kicktimes_version": str,
+}
+
+
 def _read_manifest(root: Path) -> dict:
+    """The manifest, its structure and layout checked; ValueError naming what is wrong."""
     path = root / MANIFEST
+    where = f"store {os.fspath(root)!r}"
     try:
         with open(path, encoding="utf-8") as fh:
             manifest = json.load(fh)
-    except (OSError, json.JSONDecodeError) as exc:
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise ValueError(f"damaged {where}: cannot read {MANIFEST} ({exc})") from None
+    if not isinstance(manifest, dict):
         raise ValueError(
-            f"damaged store {os.fspath(root)!r}: cannot read {MANIFEST} ({exc})"
-        ) from None
-    for key in ("experiment", "experiment_hash", "tasks", "kicktimes_version"):
+            f"damaged {where}: {MANIFEST} holds a JSON {type(manifest).__name__}, not an object"
+        )
+    for key, kind in _MANIFEST_TYPES.items():
         if key not in manifest:
-            raise ValueError(f"damaged store {os.fspath(root)!r}: {MANIFEST} has no {key!r} entry")
+            raise ValueError(f"damaged {where}: {MANIFEST} has no {key!r} entry")
+        value = manifest[key]
+        if isinstance(value, bool) or not isinstance(value, kind):
+            raise ValueError(
+                f"damaged {where}: {MANIFEST} entry {key!r} must be a JSON "
+                f"{ {int: 'integer', dict: 'object', str: 'string'}[kind]}, got {value!r:.80}"
+            )
+    layout = manifest["layout"]
+    if layout != LAYOUT_VERSION:
+        newer = layout > LAYOUT_VERSION
+        raise ValueError(
+            f"{where} has layout {layout} (written by kicktimes "
+            f"{manifest['kicktimes_version']}); kicktimes {__version__} reads layout "
+            f"{LAYOUT_VERSION} only"
+            + ("; upgrade kicktimes to read it" if newer else "; it is not a valid layout")
+        )
     return manifest
 
 
-def _check_entry(root: Path, task_id: str, entry: dict, exp_hash: str) -> str | None:
-    """None if both parts of a finished task are intact and ours, else what is wrong."""
+def _check_entry(root: Path, task_id: str, entry, exp_hash: str) -> str | None:
+    """None if both parts of a finished task are intact and ours, else what is wrong.
+
+    The part files of a task have fixed names; an entry naming any other file (another
+    task's, ``../x.parquet``, an absolute path) is refused without opening that file.
+    """
+    if not isinstance(entry, dict):
+        return f"manifest entry is a JSON {type(entry).__name__}, not an object"
     for part in PARTS:
         prefix = "" if part == "results" else "collisions_"
         rel = entry.get(f"{prefix}file")
         sha = entry.get(f"{prefix}sha256")
         if rel is None or sha is None:
             return f"manifest entry lacks the {part} part"
-        path = root / rel
+        expected = f"{part}/{task_id}.parquet"
+        if rel != expected:
+            return (
+                f"manifest entry names the file {rel!r:.200} for its {part} part, not "
+                f"{expected!r}; a store's entries may only name their own files"
+            )
+        path = _part_path(root, part, task_id)
+        if path.is_symlink():
+            return f"part {rel} is a symbolic link; a store's parts must be regular files"
         if not path.is_file():
             return f"part {rel} is missing"
         if _sha256(path) != sha:
@@ -412,7 +620,7 @@ def load_store(path: str | os.PathLike, *, verify: bool = True) -> Store:
     manifest = _read_manifest(root)
     try:
         experiment = Experiment.from_record(manifest["experiment"])
-    except (TypeError, ValueError) as exc:
+    except (TypeError, ValueError, KeyError, IndexError, AttributeError) as exc:
         raise ValueError(
             f"damaged store {os.fspath(root)!r}: bad experiment record ({exc})"
         ) from None
@@ -428,17 +636,20 @@ def load_store(path: str | os.PathLike, *, verify: bool = True) -> Store:
     tables = {part: [] for part in PARTS}
     for tid in finished:
         entry = entries[tid]
-        if verify:
-            problem = _check_entry(root, tid, entry, manifest["experiment_hash"])
-            if problem is not None:
-                raise ValueError(
-                    f"damaged store {os.fspath(root)!r}: task {tid}: {problem}. Rerun the "
-                    "experiment on this store to recompute it"
-                )
+        problem = _check_entry(root, tid, entry, manifest["experiment_hash"]) if verify else None
+        if problem is None and not verify and not isinstance(entry, dict):
+            problem = f"manifest entry is a JSON {type(entry).__name__}, not an object"
+        if problem is not None:
+            raise ValueError(
+                f"damaged store {os.fspath(root)!r}: task {tid}: {problem}. Rerun the "
+                "experiment on this store to recompute it"
+            )
         for part in PARTS:
-            rel = entry["file" if part == "results" else "collisions_file"]
+            # the file name is the task's, never the manifest's (see _check_entry)
+            path = _part_path(root, part, tid)
+            rel = f"{part}/{path.name}"
             try:
-                table = pq.read_table(root / rel, schema=schemas[part])
+                table = pq.read_table(path, schema=schemas[part])
             except Exception as exc:
                 raise ValueError(
                     f"damaged store {os.fspath(root)!r}: cannot read {rel} ({exc})"

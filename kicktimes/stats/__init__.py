@@ -20,7 +20,14 @@ from .distributions import hyperexpon
 from .ensemble import PoissonEnsembleResult, test_poisson_ensemble
 from .gof import GofResult, goodness_of_fit
 from .poisson import TESTS, Intervals, intervals_from_times, test_poisson
-from .renewal import FULL_SAMPLE_MODELS, MODELS, PARAM_NAMES, RenewalFit, fit_renewal
+from .renewal import (
+    FULL_SAMPLE_MODELS,
+    MODELS,
+    PARAM_NAMES,
+    FitWarning,
+    RenewalFit,
+    fit_renewal,
+)
 
 __all__ = [
     "MODELS",
@@ -45,4 +52,5 @@ __all__ = [
     "Intervals",
     "PoissonEnsembleResult",
     "CountRegression",
+    "FitWarning",
 ]

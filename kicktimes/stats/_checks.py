@@ -21,7 +21,7 @@ __all__ = [
 def _show(arr: np.ndarray, mask: np.ndarray) -> str:
     """The first offending entry, as ``name[i] = value``-ready text."""
     i = int(np.flatnonzero(mask)[0])
-    return f"[{i}] = {arr[i]!r}"
+    return f"[{i}] = {float(arr[i])!r}"
 
 
 def as_1d_float(name: str, value, *, allow_empty: bool = True) -> np.ndarray:
@@ -69,8 +69,8 @@ def check_times(name: str, value, t_window: float) -> np.ndarray:
         if bad.any():
             i = int(np.flatnonzero(bad)[0])
             raise ValueError(
-                f"{name} must be strictly increasing, got {name}[{i}] = {arr[i]!r} "
-                f">= {name}[{i + 1}] = {arr[i + 1]!r}"
+                f"{name} must be strictly increasing, got {name}[{i}] = {float(arr[i])!r} "
+                f">= {name}[{i + 1}] = {float(arr[i + 1])!r}"
             )
     return arr
 

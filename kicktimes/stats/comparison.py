@@ -14,6 +14,7 @@ only describes ``x >= x_min``. Comparisons are therefore made on one footing:
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -21,7 +22,7 @@ import pandas as pd
 from scipy import stats
 
 from ._checks import check_choice, check_int, check_real, check_rng
-from .renewal import FULL_SAMPLE_MODELS, MODELS, _fit, check_sample
+from .renewal import FULL_SAMPLE_MODELS, MODELS, FitWarning, _fit, check_sample
 
 # (nested, nesting): the first is a limit or special case of the second, where
 # Vuong's normal null does not hold if the smaller model is true.
@@ -88,9 +89,15 @@ def compare_models(
     pandas.DataFrame
         Indexed by model, sorted by AIC, with columns ``loglik``, ``k``, ``aic``,
         ``bic``, ``delta_aic``, ``weight`` (Akaike weight), ``delta_bic``, ``n``,
-        ``n_censored``, ``gof_pvalue`` (if asked) and ``note`` (why a model could not
-        be fitted). ``attrs`` holds ``x_min`` and ``footing`` (``"full sample"`` or
-        ``"tail"``).
+        ``n_censored``, ``gof_pvalue`` (if asked), ``converged`` (False: the fit did
+        not converge, see `RenewalFit.converged`; its row is still shown) and ``note``
+        (why a model could not be fitted, or what went wrong). ``attrs`` holds
+        ``x_min`` and ``footing`` (``"full sample"`` or ``"tail"``).
+
+    Warns
+    -----
+    FitWarning
+        One warning naming the models whose fit did not converge.
 
     Notes
     -----
@@ -117,8 +124,9 @@ def compare_models(
         n_mc = check_int("n_mc", n_mc, low=1)
         rng = check_rng(rng)
     rows = []
+    unconverged = []
     for m in models:
-        row = {"model": m, "note": ""}
+        row = {"model": m, "note": "", "converged": False}
         try:
             fit = _fit(x, c, m, threshold, min_tail=min_tail, covariance=False)
         except ValueError as exc:
@@ -128,6 +136,11 @@ def compare_models(
             continue
         row.update(loglik=fit.loglik, k=fit.k, aic=fit.aic, bic=fit.bic, n=fit.n)
         row["n_censored"] = fit.n_censored
+        row["converged"] = fit.converged
+        if fit.warnings:
+            row["note"] = "; ".join(fit.warnings)
+        if not fit.converged:
+            unconverged.append(f"{m} ({fit.warnings[0]})")
         if gof:
             row["gof_pvalue"] = goodness_of_fit(fit, n_mc=n_mc, rng=rng).pvalue
         rows.append(row)
@@ -138,7 +151,14 @@ def compare_models(
     table["delta_bic"] = table["bic"] - table["bic"].min()
     cols = ["loglik", "k", "aic", "bic", "delta_aic", "weight", "delta_bic", "n", "n_censored"]
     cols += ["gof_pvalue"] if gof else []
-    table = table[[*cols, "note"]].sort_values("aic", na_position="last")
+    table = table[[*cols, "converged", "note"]].sort_values("aic", na_position="last")
+    if unconverged:
+        warnings.warn(
+            "compare_models: these fits did not converge (their rows are flagged "
+            f"converged=False): {'; '.join(unconverged)}",
+            FitWarning,
+            stacklevel=2,
+        )
     table.attrs["x_min"] = threshold
     table.attrs["footing"] = "full sample" if threshold is None else "tail"
     return table
@@ -222,6 +242,14 @@ def vuong(intervals, model1, model2, *, censored=None, x_min=None, correction=No
     threshold = _tail_threshold(x, c, [model1, model2], x_min, 50)
     fit1 = _fit(x, c, model1, threshold, covariance=False)
     fit2 = _fit(x, c, model2, threshold, covariance=False)
+    failed = [f"{f.model}: {f.warnings[0]}" for f in (fit1, fit2) if not f.converged]
+    if failed:
+        warnings.warn(
+            f"vuong: fit did not converge ({'; '.join(failed)}); the test compares "
+            "non-maximised likelihoods",
+            FitWarning,
+            stacklevel=2,
+        )
     m = np.concatenate(fit1.pointwise_loglik()) - np.concatenate(fit2.pointwise_loglik())
     n = m.size
     ratio = float(m.sum())
@@ -230,6 +258,13 @@ def vuong(intervals, model1, model2, *, censored=None, x_min=None, correction=No
     note = ""
     if (model1, model2) in _NESTED or (model2, model1) in _NESTED:
         note = "nested models: the normal null of Vuong's statistic needs the larger model"
+    if failed:
+        note = "; ".join([note, *(f"not converged: {f}" for f in failed)]).lstrip("; ")
+    if not np.all(np.isfinite(m)):
+        raise ValueError(
+            f"intervals: some interval has zero likelihood under {model1!r} or {model2!r}; "
+            "Vuong's test needs both fits to give every interval a positive density"
+        )
     if omega <= 1e-12 * max(1.0, abs(m).max()):
         z, p, note = 0.0, 1.0, "the two fits are pointwise identical"
     else:

@@ -36,6 +36,11 @@ from statsmodels.regression.linear_model import OLS
 from statsmodels.tools.tools import add_constant
 
 from ._checks import as_1d_float, check_choice
+from .renewal import FitWarning
+
+# |coefficient| beyond this on log-rate scale means the MLE ran off to infinity
+# (e.g. every count zero at one of two radii: perfect separation)
+_DIVERGED_COEF = 1e3
 
 _MEAN_APPROACH = {"mirror": 4.0 / math.pi**2, "elastic": 4.0 / (3.0 * math.pi)}
 _GL_NODES, _GL_WEIGHTS = np.polynomial.legendre.leggauss(64)
@@ -104,7 +109,9 @@ def kinetic_rate(r, rule="mirror"):
     if bad.any():
         i = int(np.flatnonzero(bad)[0])
         where = "" if scalar else f"[{i}]"
-        raise ValueError(f"r must satisfy 0 < r < 0.5 for two disks, got r{where} = {arr[i]!r}")
+        raise ValueError(
+            f"r must satisfy 0 < r < 0.5 for two disks, got r{where} = {float(arr[i])!r}"
+        )
     a = 1.0 - arr
     rate = (
         4 * np.pi * arr * lens_area(2 * arr, a) * _MEAN_APPROACH[rule] / configuration_volume(arr)
@@ -131,10 +138,19 @@ def _check_frame(df, radius, count, t_window):
     for arr, bad, col, rule in checks:
         if bad.any():
             i = int(np.flatnonzero(bad)[0])
-            raise ValueError(f"df[{col!r}] must be {rule}, got row {i}: {arr[i]!r}")
+            raise ValueError(f"df[{col!r}] must be {rule}, got row {i}: {float(arr[i])!r}")
     if np.unique(r).size < 2:
         raise ValueError(
-            f"df[{radius!r}] must hold at least 2 distinct radii, got {np.unique(r)!r}"
+            f"df[{radius!r}] must hold at least 2 distinct radii, got {np.unique(r).tolist()!r}"
+        )
+    hit = np.unique(r[n > 0])
+    if hit.size < 2:
+        # a log-linear slope needs counts at two radii at least, else it runs off to
+        # +-inf (the counts at the other radii are 0: separation)
+        where = "at no radius" if hit.size == 0 else f"only at radius {float(hit[0])!r}"
+        raise ValueError(
+            f"df[{count!r}] must be non-zero at 2 or more radii for the slope in radius to "
+            f"exist; the counts are non-zero {where}"
         )
     return pd.DataFrame({"radius": r, "count": n, "t_window": t})
 
@@ -156,6 +172,12 @@ class CountRegression:
         The regressor of the two count models.
     rule : str or None
         Collision rule of the kinetic-theory column, if any.
+    converged : bool
+        False when the Poisson or negative-binomial fit did not converge or a
+        coefficient ran off to infinity; the numbers are then not an MLE.
+    warnings : tuple of str
+        Every problem (also unavailable standard errors), each issued as a
+        `FitWarning` by :func:`regress_counts`.
     """
 
     data: pd.DataFrame
@@ -165,11 +187,14 @@ class CountRegression:
     negbin: object
     covariate: str
     rule: str | None
+    converged: bool = True
+    warnings: tuple = ()
 
     def __repr__(self) -> str:
+        flag = "" if self.converged else ", converged=False"
         return (
             f"CountRegression(n={len(self.data)}, radii={len(self.by_radius)}, "
-            f"covariate={self.covariate!r}, alpha={self.alpha:.4g})"
+            f"covariate={self.covariate!r}, alpha={self.alpha:.4g}{flag})"
         )
 
     @property
@@ -223,10 +248,10 @@ class CountRegression:
         r = as_1d_float("radius", radius, allow_empty=False)
         bad = (r <= 0) | (r >= 0.5)
         if bad.any():
-            raise ValueError(f"radius must satisfy 0 < r < 0.5, got {r[bad][0]!r}")
+            raise ValueError(f"radius must satisfy 0 < r < 0.5, got {float(r[bad][0])!r}")
         t = np.broadcast_to(as_1d_float("t_window", t_window, allow_empty=False), r.shape)
         if (t <= 0).any():
-            raise ValueError(f"t_window must be positive, got {t[t <= 0][0]!r}")
+            raise ValueError(f"t_window must be positive, got {float(t[t <= 0][0])!r}")
         g = np.log(r) if self.covariate == "log_radius" else r
         b_ols = np.asarray(self.ols.params)
         b_poi = np.asarray(self.poisson.params)
@@ -256,6 +281,9 @@ class CountRegression:
             "",
             self.by_radius.to_string(**fmt),
         ]
+        if not self.converged:
+            lines.append("NOT CONVERGED: the count models above are not maximum-likelihood fits")
+        lines.extend(f"warning: {w}" for w in self.warnings)
         return "\n".join(lines)
 
 
@@ -279,7 +307,20 @@ def regress_counts(
     Returns
     -------
     CountRegression
-        With ``summary()``, ``predict()``, ``coefficients()``, ``overdispersion()``.
+        With ``summary()``, ``predict()``, ``coefficients()``, ``overdispersion()``,
+        ``converged`` and ``warnings``.
+
+    Raises
+    ------
+    ValueError
+        Bad input naming the column (``df['count']`` ...), fewer than two radii, or
+        every count zero.
+
+    Warns
+    -----
+    FitWarning
+        A count model did not converge, a coefficient diverged, or standard errors are
+        not finite (never a silent NaN).
 
     Notes
     -----
@@ -325,12 +366,59 @@ def regress_counts(
     exog = add_constant(g)
     offset = np.log(data["t_window"].to_numpy())
     y = data["count"].to_numpy()
-    poisson = GLM(y, exog, family=families.Poisson(), offset=offset).fit()
-    with warnings.catch_warnings():
-        # statsmodels warns at alpha -> 0 (equidispersed data); the fit is still usable.
-        warnings.simplefilter("ignore")
+    problems = []
+    with warnings.catch_warnings(record=True) as caught, np.errstate(all="ignore"):
+        # statsmodels' own warnings are judged below and re-issued as one FitWarning
+        warnings.simplefilter("always")
+        poisson = GLM(y, exog, family=families.Poisson(), offset=offset).fit()
+        if not getattr(poisson, "converged", True):
+            problems.append("the Poisson GLM did not converge (IRLS iteration limit)")
         negbin = NegativeBinomial(y, exog, loglike_method="nb2", offset=offset).fit(
             disp=0, maxiter=500, start_params=np.r_[poisson.params, 0.1]
+        )
+        if not negbin.mle_retvals.get("converged", True):
+            problems.append("the negative-binomial fit did not converge")
+        bse = {name: np.asarray(res.bse) for name, res in
+               (("ols", ols), ("poisson", poisson), ("negbin", negbin))}
+    converged = not problems
+    for name, res in (("poisson", poisson), ("negbin", negbin)):
+        coef = np.asarray(res.params)[:2]
+        if not np.all(np.isfinite(coef)) or np.any(np.abs(coef) > _DIVERGED_COEF):
+            problems.append(
+                f"{name} coefficients {coef.tolist()} diverge (no finite MLE: e.g. all "
+                "counts zero at one radius)"
+            )
+            converged = False
+    alpha = float(np.asarray(negbin.params)[-1])
+    if not np.isfinite(alpha):
+        problems.append(f"the negative-binomial dispersion alpha is not finite ({alpha})")
+        converged = False
+    if alpha < 1e-6 and not np.all(np.isfinite(bse["negbin"])):
+        # equidispersed counts: alpha sits on its boundary 0, where the information is
+        # singular; the NB model is then the Poisson one. Noted, not warned: it is the
+        # expected outcome for Poisson data.
+        del bse["negbin"]
+        notes = [f"negative binomial: alpha = {alpha:.3g} is on its boundary 0 (no "
+                 "overdispersion), so its standard errors are undefined; the model reduces "
+                 "to the Poisson fit, use that one's"]
+    else:
+        notes = []
+    bad_se = [name for name, se in bse.items() if not np.all(np.isfinite(se))]
+    if bad_se and len(by_radius) > 2:  # two radii: the OLS line is exact, bse 0/NaN by design
+        problems.append(f"standard errors of the {', '.join(bad_se)} fit are not finite")
+    elif bad_se and bad_se != ["ols"]:
+        problems.append(
+            f"standard errors of the {', '.join(s for s in bad_se if s != 'ols')} fit are "
+            "not finite"
+        )
+    if problems:
+        # keep statsmodels' own words for the record (deduplicated)
+        extra = sorted({str(w.message).splitlines()[0] for w in caught
+                        if "converge" in str(w.message).lower()})
+        problems.extend(f"statsmodels: {m}" for m in extra)
+        status = "" if converged else "did not converge: "
+        warnings.warn(
+            f"regress_counts: {status}{'; '.join(problems)}", FitWarning, stacklevel=2
         )
     return CountRegression(
         data=data,
@@ -340,4 +428,6 @@ def regress_counts(
         negbin=negbin,
         covariate=covariate,
         rule=rule,
+        converged=converged,
+        warnings=tuple(problems + notes),
     )

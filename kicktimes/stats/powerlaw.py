@@ -124,7 +124,8 @@ def fit_powerlaw_tail(complete, censored, *, x_min=None, min_tail=50, max_candid
         j, method = 0, "fixed"
     if not np.isfinite(dist[j]):
         raise ValueError(
-            f"no complete interval at or above x_min={math.exp(lx)!r}; the tail cannot be fitted"
+            f"no complete interval at or above x_min={float(math.exp(lx))!r}; "
+            "the tail cannot be fitted"
         )
     b = float(slope[j])
     tail_ev = events[k:]

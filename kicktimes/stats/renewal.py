@@ -43,6 +43,14 @@ from ._checks import check_choice, check_int, check_intervals, check_real
 from .distributions import fit_hyperexponential, hyperexpon
 from .powerlaw import fit_powerlaw_tail
 
+
+class FitWarning(RuntimeWarning):
+    """A fit that did not converge, overflowed, or has unavailable standard errors.
+
+    The result carries the same news: ``converged`` is False and ``warnings`` says why.
+    """
+
+
 MODELS = ("exponential", "gamma", "weibull", "lognormal", "lomax", "hyperexponential", "powerlaw")
 FULL_SAMPLE_MODELS = MODELS[:-1]
 PARAM_NAMES = {
@@ -64,6 +72,12 @@ _SCIPY_FAMILY = {
 # becomes theta * s**e (mu, a log-time, shifts by log s instead).
 _TIME_POWER = {"rate": -1, "rate1": -1, "rate2": -1, "scale": 1}
 _MIN_COMPLETE = {"exponential": 1, "hyperexponential": 5}
+# In units of the mean observation a sane estimate is far inside these bounds; beyond
+# them the likelihood has no interior maximum (e.g. Lomax on exponential data, whose
+# shape and scale run off to infinity together).
+_DIVERGED = (1e-10, 1e10)
+# messages of scipy/numpy warnings that mean "the optimiser gave up"
+_NOT_CONVERGED = ("converge", "maximum number", "iterations", "precision loss")
 
 
 def frozen_distribution(model: str, theta, x_min: float | None = None):
@@ -87,6 +101,13 @@ def frozen_distribution(model: str, theta, x_min: float | None = None):
 def pointwise_loglik(model, theta, complete, censored, x_min=None):
     """Per-observation log-likelihood terms: ``log f`` (complete), ``log S`` (censored),
     each minus ``log S(x_min)`` for tail fits."""
+    if model == "powerlaw":
+        # closed form in logs: scipy's pareto.logpdf underflows to -inf at x ~ 1e300
+        b, lxm = float(theta[0]) - 1.0, math.log(x_min)
+        with np.errstate(all="ignore"):
+            lx = math.log(b) - lxm - (b + 1.0) * (np.log(complete) - lxm)
+            lc = -b * (np.log(censored) - lxm)
+        return np.asarray(lx, dtype=float), np.asarray(lc, dtype=float)
     dist = frozen_distribution(model, theta, x_min)
     with np.errstate(all="ignore"):
         lx, lc = dist.logpdf(complete), dist.logsf(censored)
@@ -119,17 +140,31 @@ def _from_free(model, free):
     return np.exp(free)
 
 
-def _scipy_fit(model, x, c):
-    """scipy's own (censored) MLE with the location fixed at 0."""
+def _optimizer_trouble(caught) -> list[str]:
+    """The caught warnings that say an optimiser stopped before converging."""
+    return sorted(
+        {
+            str(w.message).splitlines()[0]
+            for w in caught
+            if any(key in str(w.message).lower() for key in _NOT_CONVERGED)
+        }
+    )
+
+
+def _scipy_fit(model, x, c, trouble=None):
+    """scipy's own (censored) MLE with the location fixed at 0; optimiser complaints go
+    to ``trouble`` (a list) instead of the console."""
     data = stats.CensoredData(uncensored=x, right=c) if c.size else x
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
+    with warnings.catch_warnings(record=True) as caught, np.errstate(all="ignore"):
+        warnings.simplefilter("always")
         est = _SCIPY_FAMILY[model].fit(data, floc=0)
+    if trouble is not None:
+        trouble.extend(f"scipy: {m}" for m in _optimizer_trouble(caught))
     shape, scale = float(est[0]), float(est[-1])
     return np.array([math.log(scale), shape]) if model == "lognormal" else np.array([shape, scale])
 
 
-def _direct_fit(model, x, c, x_min, start):
+def _direct_fit(model, x, c, x_min, start, trouble=None):
     """Nelder-Mead on unconstrained coordinates; used for tail fits and as a fallback."""
 
     def nll(free):
@@ -137,12 +172,15 @@ def _direct_fit(model, x, c, x_min, start):
             theta = _from_free(model, free)
             return -_total_loglik(model, theta, x, c, x_min) / (x.size + c.size)
 
-    res = optimize.minimize(
-        nll,
-        _to_free(model, start),
-        method="Nelder-Mead",
-        options={"xatol": 1e-9, "fatol": 1e-12, "maxiter": 4000, "maxfev": 8000},
-    )
+    with np.errstate(all="ignore"):  # inf - inf among simplex values on wild data
+        res = optimize.minimize(
+            nll,
+            _to_free(model, start),
+            method="Nelder-Mead",
+            options={"xatol": 1e-9, "fatol": 1e-12, "maxiter": 4000, "maxfev": 8000},
+        )
+    if trouble is not None and not res.success:
+        trouble.append(f"Nelder-Mead: {res.message}")
     return _from_free(model, res.x)
 
 
@@ -151,10 +189,11 @@ def mle(model, x, c, x_min=None, *, min_tail=50, max_candidates=500):
 
     Returns ``(theta, extra)``; ``extra`` holds the tail bookkeeping of power-law fits.
     """
-    extra: dict = {}
+    extra: dict = {"trouble": []}
+    trouble = extra["trouble"]
     if model == "powerlaw":
         res = fit_powerlaw_tail(x, c, x_min=x_min, min_tail=min_tail, max_candidates=max_candidates)
-        extra = res
+        extra.update(res)
         return np.array([res["alpha"]]), extra
     if x_min is not None:
         # Only the tail is modelled; the rest of the sample is left out.
@@ -169,16 +208,27 @@ def mle(model, x, c, x_min=None, *, min_tail=50, max_candidates=500):
             odds = math.exp(min(math.log(p / (1 - p)) + (lam1 - lam2) * x_min, 700.0))
             return np.array([odds / (1 + odds), lam1, lam2]), extra
         start, _ = mle(model, x, c)
-        return _direct_fit(model, x, c, x_min, start), extra
+        return _direct_fit(model, x, c, x_min, start, trouble), extra
     if model == "exponential":
         return np.array([x.size / (x.sum() + c.sum())]), extra
     if model == "hyperexponential":
         return np.array(fit_hyperexponential(x, c)[:3]), extra
-    theta = _scipy_fit(model, x, c)
-    if not np.isfinite(_total_loglik(model, theta, x, c, None)):
+    scipy_trouble: list[str] = []
+    try:
+        theta = _scipy_fit(model, x, c, scipy_trouble)
+        ok = np.all(np.isfinite(theta)) and np.isfinite(_total_loglik(model, theta, x, c, None))
+    except (ValueError, RuntimeError, FloatingPointError, OverflowError):
+        ok = False  # scipy's solver gave up (e.g. "function value at x=inf is NaN")
+    if not ok or scipy_trouble:
         mean = (x.sum() + c.sum()) / x.size
         start = {"lognormal": [math.log(mean), 1.0]}.get(model, [1.0, mean])
-        theta = _direct_fit(model, x, c, None, np.array(start, dtype=float))
+        direct_trouble: list[str] = []
+        direct = _direct_fit(model, x, c, None, np.array(start, dtype=float), direct_trouble)
+        if not ok or _total_loglik(model, direct, x, c, None) > _total_loglik(
+            model, theta, x, c, None
+        ):
+            theta, scipy_trouble = direct, direct_trouble
+        trouble.extend(scipy_trouble)
     return theta, extra
 
 
@@ -235,6 +285,14 @@ class RenewalFit:
         The data as given (all of it, also for tail fits; see :attr:`sample`).
     scan : dict
         ``min_tail`` and ``max_candidates`` of the power-law threshold scan.
+    converged : bool
+        False when the optimiser gave up or the likelihood or an estimate is not
+        finite; the numbers are then not an MLE. An estimate that runs off to 0 or
+        infinity (the supremum is a limiting case, e.g. Lomax on exponential data)
+        keeps ``converged`` True and is named in ``warnings``.
+    warnings : tuple of str
+        Every problem of the fit (also unavailable standard errors); each was issued
+        as a `FitWarning` by :func:`fit_renewal`.
     """
 
     model: str
@@ -252,6 +310,8 @@ class RenewalFit:
     complete: np.ndarray = field(default=None)
     censored: np.ndarray = field(default=None)
     scan: dict = field(default_factory=dict)
+    converged: bool = True
+    warnings: tuple = ()
 
     @property
     def aic(self) -> float:
@@ -288,9 +348,10 @@ class RenewalFit:
 
     def __repr__(self) -> str:
         shown = ", ".join(f"{k}={v:.6g}" for k, v in self.params.items())
+        flag = "" if self.converged else ", converged=False"
         return (
             f"RenewalFit(model={self.model!r}, {shown}, loglik={self.loglik:.6g}, "
-            f"aic={self.aic:.6g}, n={self.n}, n_censored={self.n_censored})"
+            f"aic={self.aic:.6g}, n={self.n}, n_censored={self.n_censored}{flag})"
         )
 
     def summary(self) -> str:
@@ -314,6 +375,9 @@ class RenewalFit:
         if self.x_min is None:
             mean = float(self.dist.mean())
             lines.append(f"  mean interval {mean:.6g}   (rate {1 / mean:.6g})")
+        if not self.converged:
+            lines.append("  NOT CONVERGED: the numbers above are not a maximum-likelihood fit")
+        lines.extend(f"  warning: {w}" for w in self.warnings)
         return "\n".join(lines)
 
 
@@ -348,7 +412,22 @@ def fit_renewal(intervals, model, *, censored=None, x_min=None, min_tail=50, max
     -------
     RenewalFit
         ``params``, ``stderr``, ``loglik``, ``aic``, ``bic``, ``n``, ``n_censored``,
-        ``dist`` (frozen scipy distribution) and ``summary()``.
+        ``dist`` (frozen scipy distribution), ``converged``, ``warnings`` and
+        ``summary()``.
+
+    Raises
+    ------
+    ValueError
+        Bad input (naming the argument), too few intervals for the model, or
+        degenerate data: all complete intervals equal, which only the exponential
+        model can fit (the others' likelihood grows without bound).
+
+    Warns
+    -----
+    FitWarning
+        The fit did not converge or overflowed (``converged`` is False), an estimate
+        ran off to the edge of the parameter space, or standard errors are
+        unavailable (``warnings`` says which); never a silent NaN or -inf.
 
     Notes
     -----
@@ -378,7 +457,15 @@ def fit_renewal(intervals, model, *, censored=None, x_min=None, min_tail=50, max
     max_candidates = check_int("max_candidates", max_candidates, low=1)
     if x_min is not None:
         x_min = check_real("x_min", x_min, low=0.0)
-    return _fit(x, c, model, x_min, min_tail=min_tail, max_candidates=max_candidates)
+    fit = _fit(x, c, model, x_min, min_tail=min_tail, max_candidates=max_candidates)
+    if fit.warnings:
+        status = "" if fit.converged else "did not converge: "
+        warnings.warn(
+            f"fit_renewal(model={model!r}): {status}{'; '.join(fit.warnings)}",
+            FitWarning,
+            stacklevel=2,
+        )
+    return fit
 
 
 def _fit(x, c, model, x_min, *, min_tail=50, max_candidates=500, covariance=True):
@@ -388,12 +475,23 @@ def _fit(x, c, model, x_min, *, min_tail=50, max_candidates=500, covariance=True
     n_used = x.size if x_min is None else int((x >= x_min).sum())
     if model != "powerlaw" and n_used < need:
         raise ValueError(
-            f"model {model!r} needs at least {need} complete intervals"
+            f"intervals: model {model!r} needs at least {need} complete intervals"
             + ("" if x_min is None else f" at or above x_min={x_min!r}")
             + f", got {n_used}"
         )
-    # Work in units of the mean observation; convert back at the end.
-    unit = float((x.sum() + c.sum()) / (x.size + c.size))
+    used = x if x_min is None else x[x >= x_min]
+    if model != "exponential" and used.size and used.min() == used.max():
+        # a shape parameter would run off to infinity (or sigma to 0): no MLE exists
+        where = "" if x_min is None else f" at or above x_min={x_min!r}"
+        raise ValueError(
+            f"intervals: all {used.size} complete intervals{where} equal "
+            f"{float(used[0])!r}; model {model!r} needs at least two distinct values "
+            "(only 'exponential' fits constant intervals)"
+        )
+    # Work in units of the mean observation; convert back at the end. Summing x / n
+    # rather than x keeps the mean finite for intervals near the float maximum.
+    n_all = x.size + c.size
+    unit = float((x / n_all).sum() + (c / n_all).sum())
     xs, cs = x / unit, c / unit
     xm = None if x_min is None else x_min / unit
     theta, extra = mle(model, xs, cs, xm, min_tail=min_tail, max_candidates=max_candidates)
@@ -415,10 +513,13 @@ def _fit(x, c, model, x_min, *, min_tail=50, max_candidates=500, covariance=True
         cov = np.full((len(theta), len(theta)), np.nan)
     names = PARAM_NAMES[model]
     factor = np.array([unit ** _TIME_POWER.get(name, 0) for name in names], dtype=float)
-    theta_out = theta * factor
+    with np.errstate(over="ignore"):  # an overflow shows as inf and is flagged below
+        theta_out = theta * factor
     if model == "lognormal":
         theta_out[0] = theta[0] + math.log(unit)
-    cov = cov * np.outer(factor, factor)
+    with np.errstate(over="ignore", invalid="ignore"):
+        stderr_values = np.sqrt(np.where(np.diag(cov) >= 0, np.diag(cov), np.nan)) * factor
+        cov = cov * np.outer(factor, factor)
     if xm is None:
         x_min_out = None
     elif x_min is not None:
@@ -427,10 +528,32 @@ def _fit(x, c, model, x_min, *, min_tail=50, max_candidates=500, covariance=True
         x_min_out = float(x[keep_x].min())  # CSN picks a data value: report it exactly
     loglik = _total_loglik(model, theta_out, x[keep_x], c[keep_c], x_min_out)
     params = {n: float(v) for n, v in zip(names, theta_out, strict=True)}
-    stderr = {
-        n: float(math.sqrt(v)) if v >= 0 else math.nan
-        for n, v in zip(names, np.diag(cov), strict=True)
-    }
+    stderr = {n: float(v) for n, v in zip(names, stderr_values, strict=True)}
+    problems = list(dict.fromkeys(extra.get("trouble", [])))
+    converged = not problems
+    scaled = [v for n, v in zip(names, theta, strict=True) if n not in ("mu", "p")]
+    if not np.all(np.isfinite(theta_out)):
+        problems.append("parameters are not finite")
+        converged = False
+    elif any(not _DIVERGED[0] < abs(v) < _DIVERGED[1] for v in scaled):
+        shown = ", ".join(f"{n}={v:.3g}" for n, v in params.items())
+        # the likelihood's supremum lies on the edge of the parameter space (e.g. Lomax
+        # -> exponential): the fitted law is usable, its parameters individually are not
+        problems.append(
+            f"an estimate ran off to 0 or infinity ({shown}): the likelihood has no "
+            "interior maximum for these data (a limiting case of the model fits best)"
+        )
+    if not np.isfinite(loglik):
+        problems.append(f"the log-likelihood is not finite ({loglik})")
+        converged = False
+    if covariance:
+        bad = [n for n, v in stderr.items() if not np.isfinite(v)]
+        if bad:
+            problems.append(
+                f"standard errors of {', '.join(bad)} unavailable: the observed information "
+                "is singular or overflows (an estimate at a boundary, or parameters not "
+                "identified)"
+            )
     if model == "powerlaw":
         params["x_min"], stderr["x_min"] = float(x_min_out), math.nan
     n_tail = int(xt.size)
@@ -450,4 +573,6 @@ def _fit(x, c, model, x_min, *, min_tail=50, max_candidates=500, covariance=True
         complete=x,
         censored=c,
         scan={"min_tail": min_tail, "max_candidates": max_candidates},
+        converged=converged,
+        warnings=tuple(problems),
     )

@@ -1,0 +1,180 @@
+"""Property tests of the public statistics API (hypothesis).
+
+The contract under test, for any input: a call either returns finite, sane numbers (or a
+result that flags its non-convergence), or raises ValueError/TypeError naming the
+argument; it never returns a silent NaN/-inf, never leaks another exception type, and
+finishes within a time limit. Example counts are kept small so the default suite stays
+fast.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+import warnings
+
+import numpy as np
+import pandas as pd
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from kicktimes import stats
+
+SETTINGS = settings(
+    max_examples=20,
+    deadline=None,  # timed by hand: the first call compiles numba kernels
+    suppress_health_check=[HealthCheck.too_slow],
+    derandomize=True,
+    database=None,
+)
+TIME_LIMIT = 20.0  # seconds per call; generous for a shared two-core machine
+
+# positive interval lengths over a wide but finite range, duplicates likely
+lengths = st.one_of(
+    st.floats(min_value=1e-6, max_value=1e6, allow_nan=False, allow_infinity=False),
+    st.sampled_from([1.0, 2.0, 1e-300, 1e300]),
+)
+samples = st.lists(lengths, min_size=0, max_size=60)
+bad_values = st.sampled_from([np.nan, np.inf, -1.0, 0.0, "x", None])
+
+
+def _call(fun, *args, names, **kwargs):
+    """Run ``fun``; return its result, or None if it refused the input properly."""
+    start = time.monotonic()
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", stats.FitWarning)
+            out = fun(*args, **kwargs)
+    except (ValueError, TypeError) as exc:
+        message = str(exc)
+        assert any(name in message for name in names), f"{message!r} names none of {names}"
+        assert "np.float64" not in message
+        out = None
+    assert time.monotonic() - start < TIME_LIMIT
+    return out
+
+
+def _check_fit(fit):
+    assert isinstance(fit.converged, bool)
+    assert isinstance(fit.warnings, tuple)
+    if fit.converged:
+        assert math.isfinite(fit.loglik)
+        assert all(math.isfinite(v) for v in fit.params.values())
+    else:
+        assert fit.warnings, "a fit flagged as not converged must say why"
+    bad_se = [k for k, v in fit.stderr.items() if not math.isfinite(v) and k != "x_min"]
+    if bad_se:
+        assert any("standard errors" in w for w in fit.warnings)
+
+
+@pytest.mark.parametrize("model", stats.MODELS)
+@SETTINGS
+@given(x=samples, c=st.one_of(st.none(), st.lists(lengths, max_size=10)))
+def test_fit_renewal_returns_a_sane_or_flagged_fit_or_refuses(model, x, c):
+    fit = _call(stats.fit_renewal, x, model, censored=c, min_tail=5,
+                names=("intervals", "censored", "min_tail", "x_min"))
+    if fit is not None:
+        _check_fit(fit)
+        assert fit.n + fit.n_excluded >= 1
+
+
+@SETTINGS
+@given(x=samples, bad=bad_values)
+def test_fit_renewal_refuses_a_bad_entry_naming_intervals(x, bad):
+    with pytest.raises((ValueError, TypeError), match="intervals"):
+        stats.fit_renewal([*x, bad], "gamma")
+
+
+@SETTINGS
+@given(value=st.floats(min_value=1e-6, max_value=1e6), n=st.integers(5, 80))
+def test_all_equal_intervals_are_refused_by_every_model_but_the_exponential(value, n):
+    # n >= 5: fewer intervals than a model needs is refused first, for that reason
+    for model in stats.MODELS[1:]:
+        with pytest.raises(ValueError, match="intervals: all .* equal"):
+            stats.fit_renewal(np.full(n, value), model, min_tail=2)
+    fit = stats.fit_renewal(np.full(n, value), "exponential")
+    assert fit.params["rate"] == pytest.approx(1 / value)
+
+
+@settings(SETTINGS, max_examples=5)  # each call fits six models: ~3 s on extreme data
+@given(x=st.lists(lengths, min_size=1, max_size=60))
+def test_compare_models_ranks_finite_rows_and_explains_the_others(x):
+    table = _call(stats.compare_models, x, names=("intervals", "censored"))
+    if table is None:
+        return
+    assert set(table.index) == set(stats.FULL_SAMPLE_MODELS)
+    for model, row in table.iterrows():
+        if np.isfinite(row["aic"]):
+            assert row["weight"] >= 0
+        else:
+            assert row["note"], f"{model}: no AIC and no reason"
+    assert table["converged"].dtype == bool or set(table["converged"]) <= {True, False}
+
+
+event_times = st.lists(
+    st.floats(min_value=0.0, max_value=100.0, allow_nan=False), max_size=40, unique=True
+).map(sorted)
+
+
+@SETTINGS
+@given(t=event_times, window=st.floats(min_value=100.0, max_value=1e4))
+def test_intervals_from_times_partition_the_window(t, window):
+    out = stats.intervals_from_times(t, window, first="keep")
+    assert np.all(out.complete > 0) and np.all(out.censored > 0)
+    total = out.complete.sum() + out.censored.sum()
+    assert total == pytest.approx(window if t else window, rel=1e-9) or not t
+
+
+@SETTINGS
+@given(t=event_times, window=st.one_of(st.floats(min_value=100.0, max_value=1e4), bad_values))
+def test_test_poisson_gives_p_values_in_0_1_or_a_note(t, window):
+    table = _call(stats.test_poisson, t, window, n_mc=19, rng=0, names=("t_window", "times"))
+    if table is None:
+        return
+    for name, row in table.iterrows():
+        if np.isfinite(row["pvalue"]):
+            assert 0 < row["pvalue"] <= 1
+        else:
+            assert row["note"], f"{name}: NaN p-value without a note"
+
+
+@SETTINGS
+@given(seqs=st.lists(event_times, min_size=1, max_size=4))
+def test_test_poisson_ensemble_combines_sane_p_values(seqs):
+    res = _call(stats.test_poisson_ensemble, seqs, 100.0, n_mc=19, n_mc_max=39, rng=0,
+                names=("sequences", "windows"))
+    if res is None:
+        return
+    p = res.combined["pvalue"].to_numpy()
+    assert np.all((p[np.isfinite(p)] >= 0) & (p[np.isfinite(p)] <= 1))
+    assert len(res.per_sequence) == len(seqs)
+
+
+@SETTINGS
+@given(
+    counts=st.lists(st.integers(0, 60), min_size=4, max_size=30),
+    radii=st.lists(st.sampled_from([0.005, 0.01, 0.02, 0.04]), min_size=4, max_size=30),
+    window=st.floats(min_value=1.0, max_value=1e4),
+)
+def test_regress_counts_returns_finite_or_flagged_coefficients_or_refuses(counts, radii, window):
+    n = min(len(counts), len(radii))
+    df = pd.DataFrame({"radius": radii[:n], "count": counts[:n], "t_window": window})
+    reg = _call(stats.regress_counts, df, names=("df[",))
+    if reg is None:
+        return
+    assert isinstance(reg.converged, bool)
+    if reg.converged:
+        coef = reg.coefficients()
+        assert np.all(np.isfinite(coef.loc[["poisson"], "estimate"]))
+        assert np.all(np.isfinite(coef.loc[["negbin"], "estimate"]))
+        se = coef["stderr"].drop(index="ols", level="model")
+        assert np.all(np.isfinite(se)) or reg.warnings
+
+
+@SETTINGS
+@given(r=st.one_of(st.floats(allow_nan=True, allow_infinity=True), bad_values))
+def test_kinetic_rate_is_positive_and_finite_or_refused_naming_r(r):
+    rate = _call(stats.kinetic_rate, r, names=("r",))
+    if rate is not None:
+        assert 0 < r < 0.5 and math.isfinite(rate) and rate > 0
