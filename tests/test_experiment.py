@@ -783,3 +783,8 @@ def test_reproduce_quick_runs_both_quick_families_and_builds_the_report(tmp_path
     for name in ("quick_a", "quick_b"):
         assert load_store(tmp_path / f"store-{name}").experiment == PRESETS[name]
     assert (tmp_path / "report" / "report.html").is_file()
+
+
+def test_a_name_with_a_trailing_newline_is_refused():
+    with pytest.raises(ValueError, match="name"):
+        dataclasses.replace(TINY, name="abc\n")

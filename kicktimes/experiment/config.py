@@ -45,7 +45,7 @@ RR_SAMPLINGS = ("run", "uniform")
 _LATER_FIELDS = {"acf_max_lag": 20, "rr_sampling": "run", "lyapunov_method": "twin"}
 
 _REQUIRED = ("name", "radii", "n_ics", "n_steps", "tau")
-_NAME_RE = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]*$")
+_NAME_RE = re.compile(r"[A-Za-z0-9][A-Za-z0-9_.-]*")  # used with fullmatch: no trailing newline
 
 
 def _real(name, value, *, low=None, high=None, low_open=True, high_open=True):
@@ -209,7 +209,7 @@ class Experiment:
         def put(name, value):
             object.__setattr__(self, name, value)
 
-        if not isinstance(self.name, str) or not _NAME_RE.match(self.name):
+        if not isinstance(self.name, str) or not _NAME_RE.fullmatch(self.name):
             raise ValueError(
                 f"name: must be a non-empty identifier of letters, digits, '_', '.', '-' "
                 f"(it names files), got {self.name!r}"
