@@ -1,6 +1,6 @@
 """Scalar argument checks shared by every layer of kicktimes.
 
-Each message names the argument, the offending value and the valid range (design.md,
+Each message names the argument, the offending value and the valid range (docs/architecture.md,
 "Bad input"). NaN and inf are rejected, never propagated. Layer-specific checks (initial
 conditions, event times, intervals) live beside the code that needs them.
 """

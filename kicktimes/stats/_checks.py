@@ -1,7 +1,7 @@
 """Argument checks for the statistics layer.
 
 Every message names the argument, the offending value and the valid range
-(design.md, "Bad input"); NaN and inf are rejected, never propagated.
+(docs/architecture.md, "Bad input"); NaN and inf are rejected, never propagated.
 """
 
 from __future__ import annotations

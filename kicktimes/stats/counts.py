@@ -17,7 +17,7 @@ r"""Collision counts versus disk radius, and the kinetic-theory rate.
 ``g(r) = log r`` (default; a power law :math:`\Gamma \propto r^{\beta_1}`, which
 contains the kinetic small-r law with :math:`\beta_1 = 1`) or ``g(r) = r``.
 
-:func:`kinetic_rate` is design.md's exact collision rate under the invariant measure.
+:func:`kinetic_rate` is the exact collision rate under the invariant measure.
 """
 
 from __future__ import annotations

@@ -2,7 +2,7 @@ r"""Distributions that scipy.stats lacks: the two-component hyperexponential.
 
 A hyperexponential interval is exponential with rate ``lam1`` with probability ``p``
 and with rate ``lam2`` otherwise. It is what pooling Poisson processes of different
-rates gives (design.md: under the elastic rule angular momentum splits phase space
+rates gives (docs/architecture.md, "Invariant measure and the kinetic rate": under the elastic rule angular momentum splits phase space
 into components with different collision rates), and it is heavier-tailed than any
 single exponential (coefficient of variation >= 1).
 
