@@ -229,7 +229,7 @@ GOOD_IC = [[0.1, 0.2, 0.6, 0.8], [-0.3, -0.1, 0.0, 1.0]]
         (dict(r=float("nan"), t_max=1.0), "r must be finite"),
         (dict(r=0.02, t_max=0.0), "t_max must lie in"),
         (dict(r=0.02, t_max=float("inf")), "t_max must be finite"),
-        (dict(r=0.02, n_steps=0, tau=0.3), "n_steps must be an integer >= 1"),
+        (dict(r=0.02, n_steps=0, tau=0.3), "n_steps must be an integer in \\[1, "),
         (dict(r=0.02, n_steps=10, tau=-0.3), "tau must lie in"),
         (dict(r=0.02, n_steps=10), "tau must be given"),
         (dict(r=0.02, t_max=1.0, rule="sticky"), "rule must be one of"),

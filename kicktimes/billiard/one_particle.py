@@ -23,11 +23,22 @@ import numpy as np
 from numba import njit
 
 from kicktimes.billiard import _checks as chk
-from kicktimes.billiard.geometry import boundary_hit_time, reflect
+from kicktimes.billiard._checks import STALL_EVENTS
+from kicktimes.billiard.geometry import SIN_GRAZE, boundary_hit_time, graze, reflect
 from kicktimes.billiard.runs import BoundaryLog, OneParticleRun
-from kicktimes.billiard.two_particle import _grow
+from kicktimes.billiard.two_particle import (
+    DONE,
+    FULL,
+    OVER_BUDGET,
+    STALLED,
+    _grow_to,
+    raise_for_status,
+)
 
 KICK_ANGLES = {"uniform": 0, "gaussian": 1}
+#: The largest radius of a single disk: the table left to its centre, 1 - r, stays >= 1e-6,
+#: far above the contact tolerance (1e-12).
+R_MAX_ONE = 1.0 - 1e-6
 
 
 @njit(cache=True)
@@ -91,7 +102,18 @@ def process_event_one(st, ev, is_kick, dt, rho, kick_time, angle, kick_mode, uni
     # bias drifts L = x vy - y vx by 6e-12 over 10^6 collisions, 40x more than without.
     vv = vx * vx + vy * vy
     xv = x * vx + y * vy
-    if xv > 0.0:
+    gz = rho * SIN_GRAZE
+    if xv * xv < gz * gz * vv:
+        # Grazing or tangent: slide on (see graze). The Newton step along the flight
+        # below would divide by x.v ~ 0, so project radially.
+        scale = 1.5 - 0.5 * (x * x + y * y) / (rho * rho)
+        x *= scale
+        y *= scale
+        sp = math.sqrt(vv)
+        sin_theta = (x * vy - y * vx) / (rho * sp)
+        vx, vy = graze(x, y, vx, vy, rho, sp)
+        ev[0] = 2.0 * gz / sp
+    elif xv > 0.0:
         # Put the contact back on |x| = rho with a Newton step *along the flight*: a radial
         # projection would rescale L = x vy - y vx and drift sin_theta by 1e-11 over 10^6
         # collisions; moving along v keeps L exact.
@@ -128,13 +150,18 @@ def finish_one_at(st, ev, t_end):
 
 @njit(cache=True)
 def _event_loop_one(st, ev, rho, kicks, angles, kick_mode, unit_speed, t_end, mode, tau, bt, bx,
-                    by, bs, stimes, samples, cnt, next_s):
-    """Logging/sampling loop (see ``_event_loop_two``); ``cnt = [n_kicks, n_b, k]``."""
+                    by, bs, stimes, samples, cnt, next_s, stall_dt):
+    """Logging/sampling loop (see ``_event_loop_two``); ``cnt = [n_kicks, n_b, k, n_stall]``.
+
+    Only boundary collisions count towards a stall: simultaneous kicks are the user's and
+    there are finitely many.
+    """
     n_b = cnt[1]
     k = cnt[2]
+    n_stall = cnt[3]
     ns = stimes.shape[0]
     ns_next = next_s[0]
-    done = False
+    status = FULL
     while True:
         is_kick, dte = next_event_one(st, ev, kicks, cnt)
         while k < ns and ns_next - st[0] < dte:
@@ -145,7 +172,7 @@ def _event_loop_one(st, ev, rho, kicks, angles, kick_mode, unit_speed, t_end, mo
             k += 1
             ns_next = k * tau if mode == 1 else ns_next + tau
         if (mode == 2 and k >= ns) or st[0] + dte > t_end:
-            done = True
+            status = DONE
             break
         if is_kick:
             ik = cnt[0]
@@ -155,6 +182,13 @@ def _event_loop_one(st, ev, rho, kicks, angles, kick_mode, unit_speed, t_end, mo
         else:
             if n_b >= bt.shape[0]:
                 break
+            if dte < stall_dt:
+                n_stall += 1
+                if n_stall >= STALL_EVENTS:
+                    status = STALLED
+                    break
+            else:
+                n_stall = 0
             bs[n_b] = process_event_one(st, ev, False, dte, rho, 0.0, 0.0, kick_mode, unit_speed)
             bt[n_b] = st[0]
             bx[n_b] = st[1]
@@ -168,20 +202,25 @@ def _event_loop_one(st, ev, rho, kicks, angles, kick_mode, unit_speed, t_end, mo
             ns_next = st[0] + tau
     cnt[1] = n_b
     cnt[2] = k
+    cnt[3] = n_stall
     next_s[0] = ns_next
-    return done
+    return status
 
 
 @njit(cache=True)
-def simulate_one_kernel(st, rho, kicks, angles, kick_mode, t_max, mode, n_steps, tau, b_cap):
+def simulate_one_kernel(st, rho, kicks, angles, kick_mode, t_max, mode, n_steps, tau, b_cap,
+                        max_events, stall_dt):
     """Run the kicked one-disk billiard (``mode``: 0 none, 1 uniform, 2 paper sampling).
 
-    ``st`` is ``[t, x, y, vx, vy, clock compensation, squared speed]``.
-    Returns ``(b_time, b_x, b_y, b_sin, sample_times, samples, n_kicks_applied, t_end)``.
+    ``st`` is ``[t, x, y, vx, vy, clock compensation, squared speed]``. Stops early with
+    status `OVER_BUDGET` after ``max_events`` boundary collisions or `STALLED`.
+    Returns ``(b_time, b_x, b_y, b_sin, sample_times, samples, n_kicks_applied, t_end,
+    status)``.
     """
     ev = np.empty(1)
     ev[0] = boundary_hit_time(st[1], st[2], st[3], st[4], rho)
     unit_speed = abs(st[3] * st[3] + st[4] * st[4] - 1.0) < 1e-12
+    b_cap = min(b_cap, max_events + 1)
     bt = np.empty(b_cap)
     bx = np.empty(b_cap)
     by = np.empty(b_cap)
@@ -189,42 +228,80 @@ def simulate_one_kernel(st, rho, kicks, angles, kick_mode, t_max, mode, n_steps,
     ns = n_steps + 1 if mode > 0 else 0
     stimes = np.empty(ns)
     samples = np.empty((ns, 2))
-    cnt = np.zeros(3, dtype=np.int64)
+    cnt = np.zeros(4, dtype=np.int64)
     next_s = np.zeros(1)
     t_end = t_max if mode < 2 else np.inf
-    while not _event_loop_one(st, ev, rho, kicks, angles, kick_mode, unit_speed, t_end, mode, tau,
-                              bt, bx, by, bs, stimes, samples, cnt, next_s):
-        bt = _grow(bt)
-        bx = _grow(bx)
-        by = _grow(by)
-        bs = _grow(bs)
-    if mode == 2:
-        t_end = stimes[ns - 1]
-    finish_one_at(st, ev, t_end)
+    while True:
+        status = _event_loop_one(st, ev, rho, kicks, angles, kick_mode, unit_speed, t_end, mode,
+                                 tau, bt, bx, by, bs, stimes, samples, cnt, next_s, stall_dt)
+        if status != FULL:
+            break
+        room = max_events - cnt[1]
+        if room <= 0:
+            status = OVER_BUDGET
+            break
+        limit = bt.shape[0] + room
+        bt = _grow_to(bt, limit)
+        bx = _grow_to(bx, limit)
+        by = _grow_to(by, limit)
+        bs = _grow_to(bs, limit)
+    if status == DONE:
+        if mode == 2:
+            t_end = stimes[ns - 1]
+        finish_one_at(st, ev, t_end)
     n = cnt[1]
-    return bt[:n], bx[:n], by[:n], bs[:n], stimes, samples, cnt[0], t_end
+    return bt[:n], bx[:n], by[:n], bs[:n], stimes, samples, cnt[0], t_end, status
 
 
 def check_one_particle_state(state, r: float, name: str = "state") -> np.ndarray:
+    """Validate a one-disk state ``(x, y, vx, vy)`` for radius ``r``; a float64 copy."""
+    if r > R_MAX_ONE:
+        raise ValueError(f"r must lie in (0.0, {R_MAX_ONE!r}] for one disk, got {float(r)!r}")
     arr = chk.check_state(name, state, (4,))
     chk.check_inside(name, arr[0], arr[1], 1.0 - r, r, "the disk's")
     if math.hypot(arr[2], arr[3]) == 0.0:
         raise ValueError(f"{name}: the velocity (vx, vy) must be non-zero, got (0, 0)")
+    chk.check_speed(name, arr[2], arr[3], "the disk's", allow_zero=False)
     return arr
 
 
 def check_kick_times(kicks, t_max: float | None, name: str = "kicks") -> np.ndarray:
     """Sorted, finite, non-negative kick times, none beyond ``t_max`` (if known)."""
-    times = np.array(kicks, dtype=np.float64, copy=True).ravel()
+    if isinstance(kicks, str | bytes):
+        raise TypeError(
+            f"{name} must be None, a sequence of kick times or a schedule (e.g. "
+            f"kicktimes.schedules.Poisson(rate)), got the string {kicks!r}"
+        )
+    try:
+        times = np.array(kicks, dtype=np.float64, copy=True).ravel()
+    except (TypeError, ValueError) as exc:
+        raise TypeError(
+            f"{name} must be None, a sequence of kick times or a schedule, got "
+            f"{type(kicks).__name__} ({exc})"
+        ) from None
     if not np.isfinite(times).all():
         raise ValueError(f"{name} must be finite; got NaN or inf")
-    if times.size and times[0] < 0.0:
-        raise ValueError(f"{name} must be >= 0, got {times.min()!r}")
+    if times.size and times.min() < 0.0:
+        raise ValueError(f"{name} must be >= 0, got {float(times.min())!r}")
     if times.size > 1 and (np.diff(times) < 0.0).any():
         raise ValueError(f"{name} must be sorted in increasing order")
     if t_max is not None and times.size and times[-1] > t_max:
-        raise ValueError(f"{name} must lie in [0, t_max={t_max!r}], got a kick at {times[-1]!r}")
+        raise ValueError(
+            f"{name} must lie in [0, t_max={float(t_max)!r}], got a kick at {float(times[-1])!r}"
+        )
     return times
+
+
+def _is_schedule(kicks) -> bool:
+    """A kick schedule: a `Schedule`, or any object with a ``sample`` method that is not
+    array-like (a pandas Series has a ``sample`` method too, but it holds times)."""
+    from kicktimes.schedules import Schedule
+
+    if isinstance(kicks, Schedule):
+        return True
+    if isinstance(kicks, np.ndarray) or hasattr(kicks, "__array__") or hasattr(kicks, "__len__"):
+        return False
+    return callable(getattr(kicks, "sample", None))
 
 
 def draw_kick_angles(n: int, kick_angle: str, sigma: float, rng: np.random.Generator):
@@ -232,6 +309,21 @@ def draw_kick_angles(n: int, kick_angle: str, sigma: float, rng: np.random.Gener
     if kick_angle == "uniform":
         return rng.uniform(0.0, 2.0 * np.pi, size=n)
     return rng.normal(0.0, sigma, size=n)
+
+
+def _check_rng(rng) -> np.random.Generator:
+    """``numpy.random.default_rng(rng)``, with a TypeError naming ``rng`` for bad input."""
+    if isinstance(rng, bool) or not (
+        rng is None or isinstance(rng, int | np.integer | np.random.Generator
+                                  | np.random.BitGenerator | np.random.SeedSequence)
+    ):
+        raise TypeError(
+            "rng must be None, an int seed >= 0, a numpy Generator, BitGenerator or SeedSequence, "
+            f"got {type(rng).__name__}"
+        )
+    if isinstance(rng, int | np.integer) and rng < 0:
+        raise ValueError(f"rng must be an int seed >= 0, got {int(rng)}")
+    return np.random.default_rng(rng)
 
 
 def resolve_kicks(kicks, kick_angles, *, kick_angle, sigma, rng, horizon, t_max):
@@ -244,17 +336,24 @@ def resolve_kicks(kicks, kick_angles, *, kick_angle, sigma, rng, horizon, t_max)
     gen = None
     if kicks is None:
         times = np.empty(0)
-    elif hasattr(kicks, "sample"):
-        gen = np.random.default_rng(rng)
-        times = check_kick_times(kicks.sample(horizon, gen), horizon)
+    elif _is_schedule(kicks):
+        gen = _check_rng(rng)
+        times = check_kick_times(kicks.sample(horizon, gen), horizon, name="kicks.sample()")
     else:
         times = check_kick_times(kicks, t_max)
     if kick_angles is None:
         if not times.size:
             return times, times.copy(), gen
-        gen = gen if gen is not None else np.random.default_rng(rng)
+        gen = gen if gen is not None else _check_rng(rng)
         return times, draw_kick_angles(times.size, kick_angle, sigma, gen), gen
-    angles = np.array(kick_angles, dtype=np.float64, copy=True).ravel()
+    if isinstance(kick_angles, str | bytes):
+        raise TypeError(f"kick_angles must be a sequence of angles, got the string {kick_angles!r}")
+    try:
+        angles = np.array(kick_angles, dtype=np.float64, copy=True).ravel()
+    except (TypeError, ValueError) as exc:
+        raise TypeError(
+            f"kick_angles must be a sequence of angles, got {type(kick_angles).__name__} ({exc})"
+        ) from None
     if angles.shape != times.shape:
         raise ValueError(
             f"kick_angles must have one angle per kick ({times.size}), got {angles.size}"
@@ -266,7 +365,7 @@ def resolve_kicks(kicks, kick_angles, *, kick_angle, sigma, rng, horizon, t_max)
 
 def simulate_one_particle(state, r, *, t_max=None, kicks=None, kick_angle="uniform",
                           kick_angles=None, sigma=1.0, rng=None, sampling="uniform",
-                          n_steps=None, tau=None, seed=None) -> OneParticleRun:
+                          n_steps=None, tau=None, seed=None, max_events=None) -> OneParticleRun:
     """Simulate one disk of radius ``r`` in the unit table, kicked at given times.
 
     Parameters
@@ -296,6 +395,9 @@ def simulate_one_particle(state, r, *, t_max=None, kicks=None, kick_angle="unifo
         Source of the schedule's times (first) and the kick angles (second).
     seed : int, optional
         Recorded in the run's metadata.
+    max_events : int, optional
+        Stop with a ValueError after this many boundary collisions (as in
+        `simulate_two_particle`; kicks do not count).
 
     Returns
     -------
@@ -306,7 +408,10 @@ def simulate_one_particle(state, r, *, t_max=None, kicks=None, kick_angle="unifo
     Notes
     -----
     A kick at the same instant as a boundary collision is applied after the reflection;
-    a kick exactly at the end of the run is applied.
+    a kick exactly at the end of the run is applied. A contact within 1e-4 rad of tangent
+    slides on along the wall (`kicktimes.billiard.geometry.graze`), whether the IC or a
+    kick put the disk there. ``r <= 1 - 1e-6``; the speed must lie in ``[1e-6, 1e6]``;
+    other ranges as in `simulate_two_particle`.
 
     Examples
     --------
@@ -330,11 +435,18 @@ def simulate_one_particle(state, r, *, t_max=None, kicks=None, kick_angle="unifo
     st = np.zeros(7)
     st[1:5] = state
     st[6] = state[2] ** 2 + state[3] ** 2
-    bt, bx, by, bs, stimes, samples, n_applied, t_end = simulate_one_kernel(
-        st, 1.0 - r, times, angles, KICK_ANGLES[kick_angle], 0.0 if mode == 2 else t_max, mode,
+    rho = 1.0 - r
+    speed = math.sqrt(st[6])
+    max_events = chk.event_budget(max_events, horizon=horizon,
+                                  horizon_name="t_max" if mode < 2 else "n_steps * tau",
+                                  speed=speed, rho=rho, n_disks=1)
+    bt, bx, by, bs, stimes, samples, n_applied, t_end, status = simulate_one_kernel(
+        st, rho, times, angles, KICK_ANGLES[kick_angle], 0.0 if mode == 2 else t_max, mode,
         n_steps if n_steps is not None else 0, tau if tau is not None else 0.0,
-        int(3.0 * horizon) + 64,
+        int(2.0 * speed * horizon / rho) + 64, max_events, chk.stall_time(rho, speed),
     )
+    raise_for_status(status, st[0], bt.shape[0], max_events=max_events, name="state",
+                     where=f"disk at ({st[1]:.6g}, {st[2]:.6g}), r={r!r}")
     return OneParticleRun(
         r=r,
         t_max=float(t_end),

@@ -24,10 +24,13 @@ import numpy as np
 from numba import njit
 
 from kicktimes.billiard import _checks as chk
+from kicktimes.billiard._checks import STALL_EVENTS
 from kicktimes.billiard.geometry import (
+    SIN_GRAZE,
     boundary_hit_time,
     collide_elastic,
     collide_mirror,
+    graze,
     pair_hit_time,
     reflect,
 )
@@ -98,7 +101,13 @@ def process_event_two(st, ev, k, rho, sigma, rule):
         else:
             sin_theta = (x * vy - y * vx) / (rho * math.sqrt(vv))
         xv = x * vx + y * vy
-        if xv > 0.0:
+        gz = rho * SIN_GRAZE
+        if xv * xv < gz * gz * vv:
+            # grazing or tangent: reflecting would make no progress; slide on (see graze)
+            sp = 1.0 if rule == 0 else math.sqrt(vv)
+            vx, vy = graze(x, y, vx, vy, rho, sp)
+            ev[k] = 2.0 * gz / sp
+        elif xv > 0.0:
             vx, vy = reflect(vx, vy, x / rho, y / rho)
             # from a point on the circle the next boundary hit is the chord, the exact
             # root of the quadratic with c = 0: t = -2 (x.v') / |v|^2 = 2 (x.v) / |v|^2
@@ -177,22 +186,36 @@ def _grow(a):
 
 
 @njit(cache=True)
+def _grow_to(a, limit):
+    """``a`` copied into a buffer twice as long, but no longer than ``limit`` (> len(a))."""
+    out = np.empty(min(2 * a.shape[0] + 16, limit), dtype=a.dtype)
+    out[: a.shape[0]] = a
+    return out
+
+
+# status codes of the event loops
+DONE, FULL, STALLED, OVER_BUDGET = 0, 1, 2, 3
+
+
+@njit(cache=True)
 def _event_loop_two(st, ev, rho, sigma, rule, t_end, mode, tau, o, pp, bt, bp, bx, by, bs,
-                    stimes, samples, cnt, next_s):
-    """The logging/sampling event loop; returns True when done, False when a buffer is full.
+                    stimes, samples, cnt, next_s, stall_dt):
+    """The logging/sampling event loop; returns `DONE`, `FULL` (a buffer) or `STALLED`.
 
     Growing a buffer reassigns the array, and an array reassigned inside a numba loop
     costs reference counting on every iteration (it halved the speed): so this loop
     only detects a full buffer and returns, and the caller grows it outside.
-    ``cnt = [n_pp, n_b, k]`` and ``next_s[0]`` (the next sample time) carry the loop's
-    position between calls.
+    ``cnt = [n_pp, n_b, k, n_stall]`` and ``next_s[0]`` (the next sample time) carry the
+    loop's position between calls. ``n_stall`` counts consecutive events less than
+    ``stall_dt`` apart; `STALL_EVENTS` of them mean the state makes no progress.
     """
     n_pp = cnt[0]
     n_b = cnt[1]
     k = cnt[2]
+    n_stall = cnt[3]
     ns = stimes.shape[0]
     ns_next = next_s[0]
-    done = False
+    status = FULL
     while True:
         ke, dte = next_event_two(ev)
         # samples strictly before the next event lie on the current free flight
@@ -204,10 +227,18 @@ def _event_loop_two(st, ev, rho, sigma, rule, t_end, mode, tau, o, pp, bt, bp, b
             k += 1
             ns_next = k * tau if mode == 1 else ns_next + tau
         if (mode == 2 and k >= ns) or st[0] + dte > t_end:
-            done = True
+            status = DONE
             break
         if (ke == 2 and n_pp >= pp.shape[0]) or (ke < 2 and n_b >= bt.shape[0]):
             break
+        # one compare per event: cheaper than any bound on the events at one instant
+        if dte < stall_dt:
+            n_stall += 1
+            if n_stall >= STALL_EVENTS:
+                status = STALLED
+                break
+        else:
+            n_stall = 0
         sin_theta = process_event_two(st, ev, ke, rho, sigma, rule)
         if ke == 2:
             pp[n_pp] = st[0]
@@ -229,24 +260,30 @@ def _event_loop_two(st, ev, rho, sigma, rule, t_end, mode, tau, o, pp, bt, bp, b
     cnt[0] = n_pp
     cnt[1] = n_b
     cnt[2] = k
+    cnt[3] = n_stall
     next_s[0] = ns_next
-    return done
+    return status
 
 
 @njit(cache=True)
-def simulate_two_kernel(st, rho, sigma, rule, t_max, mode, n_steps, tau, track, pp_cap, b_cap):
+def simulate_two_kernel(st, rho, sigma, rule, t_max, mode, n_steps, tau, track, pp_cap, b_cap,
+                        max_events, stall_dt):
     """Run the two-disk billiard, logging every event and sampling the tracked disk.
 
     ``st`` is ``[t, x0, y0, vx0, vy0, x1, y1, vx1, vy1, clock compensation, energy]``.
     ``mode``: 0 no samples (run to ``t_max``), 1 uniform samples at ``k tau`` (run to
     ``t_max``), 2 the paper's collision-truncated steps (run until ``n_steps`` are done).
-    Samples are interpolated along the free flight, inside the event loop.
+    Samples are interpolated along the free flight, inside the event loop. The run stops
+    early with status `OVER_BUDGET` after ``max_events`` collisions, or `STALLED` (see
+    `_event_loop_two`); ``st`` then holds the state where it stopped.
 
-    Returns ``(pp_times, b_time, b_part, b_x, b_y, b_sin, sample_times, samples, t_end)``.
+    Returns ``(pp_times, b_time, b_part, b_x, b_y, b_sin, sample_times, samples, t_end,
+    status)``.
     """
     ev = np.empty(3)
     init_events_two(st, ev, rho, sigma)
-    pp = np.empty(pp_cap)
+    pp = np.empty(min(pp_cap, max_events + 1))
+    b_cap = min(b_cap, max_events + 1)
     bt = np.empty(b_cap)
     bp = np.empty(b_cap, dtype=np.int8)
     bx = np.empty(b_cap)
@@ -255,26 +292,54 @@ def simulate_two_kernel(st, rho, sigma, rule, t_max, mode, n_steps, tau, track, 
     ns = n_steps + 1 if mode > 0 else 0
     stimes = np.empty(ns)
     samples = np.empty((ns, 2))
-    cnt = np.zeros(3, dtype=np.int64)
+    cnt = np.zeros(4, dtype=np.int64)
     next_s = np.zeros(1)
     t_end = t_max if mode < 2 else np.inf
-    while not _event_loop_two(st, ev, rho, sigma, rule, t_end, mode, tau, 1 + 4 * track, pp, bt,
-                              bp, bx, by, bs, stimes, samples, cnt, next_s):
+    while True:
+        status = _event_loop_two(st, ev, rho, sigma, rule, t_end, mode, tau, 1 + 4 * track, pp,
+                                 bt, bp, bx, by, bs, stimes, samples, cnt, next_s, stall_dt)
+        if status != FULL:
+            break
+        # the budget is checked only here, when a buffer is full: nothing in the hot loop
+        room = max_events - cnt[0] - cnt[1]
+        if room <= 0:
+            status = OVER_BUDGET
+            break
         if cnt[0] >= pp.shape[0]:
-            pp = _grow(pp)
+            pp = _grow_to(pp, pp.shape[0] + room)
         if cnt[1] >= bt.shape[0]:
-            bt = _grow(bt)
-            bp = _grow(bp)
-            bx = _grow(bx)
-            by = _grow(by)
-            bs = _grow(bs)
-    if mode == 2:
-        t_end = stimes[ns - 1]
-    finish_at(st, ev, t_end)
+            limit = bt.shape[0] + room
+            bt = _grow_to(bt, limit)
+            bp = _grow_to(bp, limit)
+            bx = _grow_to(bx, limit)
+            by = _grow_to(by, limit)
+            bs = _grow_to(bs, limit)
+    if status == DONE:
+        if mode == 2:
+            t_end = stimes[ns - 1]
+        finish_at(st, ev, t_end)
     n_pp = cnt[0]
     n_b = cnt[1]
     # views, not copies: the buffers are at most about twice the size needed
-    return pp[:n_pp], bt[:n_b], bp[:n_b], bx[:n_b], by[:n_b], bs[:n_b], stimes, samples, t_end
+    return (pp[:n_pp], bt[:n_b], bp[:n_b], bx[:n_b], by[:n_b], bs[:n_b], stimes, samples, t_end,
+            status)
+
+
+def raise_for_status(status: int, st_time: float, n_events: int, *, max_events: int,
+                     name: str, where: str) -> None:
+    """Turn a kernel's early stop into a ValueError naming the input (no-op for `DONE`)."""
+    if status == OVER_BUDGET:
+        raise ValueError(
+            f"max_events: the run needed more than max_events={max_events} collisions "
+            f"(stopped at t = {float(st_time)!r}); a disk grazing the wall makes one collision "
+            f"every 2e-4 (1 - r) / |v|; pass a larger max_events or a shorter run"
+        )
+    if status == STALLED:
+        raise ValueError(
+            f"{name}: the run makes no progress: {STALL_EVENTS} consecutive collisions less "
+            f"than 1e-9 (1 - r) / |v| apart at t = {float(st_time)!r} ({n_events} collisions "
+            f"so far; {where}); the state is stuck (e.g. disks jammed against the wall)"
+        )
 
 
 def check_two_particle_ic(ic, r: float, rule: str, name: str = "ic") -> np.ndarray:
@@ -283,11 +348,12 @@ def check_two_particle_ic(ic, r: float, rule: str, name: str = "ic") -> np.ndarr
     rho = 1.0 - r
     for i in range(2):
         chk.check_inside(name, arr[i, 0], arr[i, 1], rho, r, f"disk {i}")
-        speed = math.hypot(arr[i, 2], arr[i, 3])
         if rule == "mirror":
             chk.check_unit_speed(name, arr[i, 2], arr[i, 3], f"disk {i}")
-        elif speed == 0.0 and math.hypot(arr[1 - i, 2], arr[1 - i, 3]) == 0.0:
-            raise ValueError(f"{name}: both disks are at rest; give a non-zero velocity")
+        else:
+            chk.check_speed(name, arr[i, 2], arr[i, 3], f"disk {i}", allow_zero=True)
+    if rule != "mirror" and not arr[:, 2:].any():
+        raise ValueError(f"{name}: both disks are at rest; give a non-zero velocity")
     gap = math.hypot(arr[0, 0] - arr[1, 0], arr[0, 1] - arr[1, 1])
     if gap < 2.0 * r - chk.CONTACT_TOL:
         raise ValueError(
@@ -297,7 +363,7 @@ def check_two_particle_ic(ic, r: float, rule: str, name: str = "ic") -> np.ndarr
 
 
 def simulate_two_particle(ic, r, *, t_max=None, rule="mirror", sampling="uniform", n_steps=None,
-                          tau=None, track=0, seed=None) -> TwoParticleRun:
+                          tau=None, track=0, seed=None, max_events=None) -> TwoParticleRun:
     """Simulate two disks of radius ``r`` in the unit circular table.
 
     Event-driven and exact: the disks move freely between collisions whose times are
@@ -329,6 +395,10 @@ def simulate_two_particle(ic, r, *, t_max=None, rule="mirror", sampling="uniform
         The disk whose centre is sampled.
     seed : int, optional
         Recorded in the run's metadata (the simulation itself is deterministic).
+    max_events : int, optional
+        Stop with a ValueError after this many collisions (``>= 1``). The default is a
+        hundred times the expected number plus 10^6, at most 2e7; a run expected to need
+        more than 5e6 is refused unless ``max_events`` is given.
 
     Returns
     -------
@@ -341,6 +411,18 @@ def simulate_two_particle(ic, r, *, t_max=None, rule="mirror", sampling="uniform
     ``sin_theta = L / (1 - r)`` is the tangential component of the incoming unit
     velocity at a boundary collision (``L = x vy - y vx``); ``s`` is the polar angle of
     the contact point in ``[0, 2 pi)``. Events at exactly ``t_max`` are included.
+
+    A contact within ``GRAZE_ANGLE = 1e-4`` of tangent (an exactly tangent one included)
+    slides on along the wall instead of being reflected: the disk leaves along the
+    whispering-gallery chord of angle ``2e-4`` (`kicktimes.billiard.geometry.graze`).
+    Speeds must be 1 (mirror) or 0 or in ``[1e-6, 1e6]`` (elastic); ``t_max``, ``tau`` and
+    ``n_steps * tau`` at most 1e12, ``n_steps`` at most 1e8.
+
+    Raises
+    ------
+    ValueError
+        For arguments out of range, and when the run exceeds ``max_events`` or stops
+        making progress (``10^4`` consecutive collisions at one instant).
 
     Examples
     --------
@@ -361,14 +443,23 @@ def simulate_two_particle(ic, r, *, t_max=None, rule="mirror", sampling="uniform
     st[1:9] = ic.ravel()
     st[10] = (ic[:, 2:] ** 2).sum()
     horizon = t_max if mode < 2 else n_steps * tau
+    rho = 1.0 - r
+    # the largest speed a disk can reach: all the kinetic energy in one disk
+    speed = 1.0 if rule == "mirror" else math.sqrt(st[10])
+    max_events = chk.event_budget(max_events, horizon=horizon,
+                                  horizon_name="t_max" if mode < 2 else "n_steps * tau",
+                                  speed=speed, rho=rho, n_disks=2)
     # capacities are only a first guess: the kernel grows its buffers when needed
-    b_cap = int(3.0 * horizon) + 64
-    pp_cap = int(20.0 * r * horizon) + 16
-    pp, bt, bp, bx, by, bs, stimes, samples, t_end = simulate_two_kernel(
-        st, 1.0 - r, 2.0 * r, chk.RULES[rule], 0.0 if mode == 2 else t_max, mode,
+    b_cap = int(3.0 * speed * horizon) + 64
+    pp_cap = int(20.0 * r * speed * horizon) + 16
+    pp, bt, bp, bx, by, bs, stimes, samples, t_end, status = simulate_two_kernel(
+        st, rho, 2.0 * r, chk.RULES[rule], 0.0 if mode == 2 else t_max, mode,
         n_steps if n_steps is not None else 0, tau if tau is not None else 0.0, track,
-        pp_cap, b_cap,
+        pp_cap, b_cap, max_events, chk.stall_time(rho, speed),
     )
+    raise_for_status(status, st[0], pp.shape[0] + bt.shape[0], max_events=max_events, name="ic",
+                     where=f"disks at ({st[1]:.6g}, {st[2]:.6g}) and ({st[5]:.6g}, {st[6]:.6g}), "
+                           f"r={r!r}")
     return TwoParticleRun(
         r=r,
         t_max=float(t_end),
