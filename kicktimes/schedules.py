@@ -31,7 +31,7 @@ Conventions shared by every schedule
 
 Schedules compare by value, have a readable ``repr``, serialise with ``to_json()`` /
 :func:`from_json`, and sampled times are stored with :func:`write_kick_times` /
-:func:`read_kick_times` (CSV or Parquet). See docs/schedules.md.
+:func:`read_kick_times` (CSV with a JSON sidecar, or Parquet). See docs/schedules.md.
 """
 
 from __future__ import annotations
@@ -1011,8 +1011,10 @@ def write_kick_times(times, path, *, t_max=None, schedule=None, seed=None, metad
         and moved into place with ``os.replace``: readers never see a partial file.
     t_max, schedule, seed, metadata : keyword-only, optional
         Stored as JSON ``{"format", "kicktimes_version", "n_kicks", "t_max", "seed",
-        "schedule", "metadata"}``: in the Parquet schema metadata (key ``kicktimes``) or
-        in a leading ``# kicktimes metadata: {...}`` line of the CSV.
+        "schedule", "metadata"}``: in the Parquet schema metadata (key ``kicktimes``) or,
+        for a CSV, in the sidecar file ``<path>.json`` (``kicks.csv.json``), so that the
+        CSV itself is plain (one header line ``kick_time``, one time per line) and any CSV
+        reader takes it as it is.
 
     Returns
     -------
@@ -1045,13 +1047,19 @@ def write_kick_times(times, path, *, t_max=None, schedule=None, seed=None, metad
         raise ValueError(f"metadata must be JSON-serialisable without NaN/inf: {exc}") from None
 
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    tmp_meta = None
     try:
         if suffix == ".csv":
             with os.fdopen(fd, "w", newline="") as fh:
-                fh.write(_CSV_MARK + meta_json + "\n")
                 fh.write("kick_time\n")
                 # repr is the shortest string that parses back to the same double
                 fh.writelines(f"{x!r}\n" for x in arr.tolist())
+            fd_meta, tmp_meta = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.",
+                                                 suffix=".json.tmp")
+            with os.fdopen(fd_meta, "w") as fh:
+                fh.write(meta_json + "\n")
+            # sidecar first: a reader that sees the new CSV also sees its metadata
+            os.replace(tmp_meta, _sidecar(path))
         else:
             os.close(fd)
             import pyarrow as pa
@@ -1062,10 +1070,16 @@ def write_kick_times(times, path, *, t_max=None, schedule=None, seed=None, metad
             pq.write_table(table, tmp)
         os.replace(tmp, path)
     except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
+        for name in (tmp, tmp_meta):
+            if name is not None and os.path.exists(name):
+                os.unlink(name)
         raise
     return path
+
+
+def _sidecar(path: Path) -> Path:
+    """The metadata file of a CSV of kick times: ``kicks.csv`` -> ``kicks.csv.json``."""
+    return path.with_name(path.name + ".json")
 
 
 def read_kick_times(path, *, column=None, with_metadata=False):
@@ -1094,12 +1108,18 @@ def read_kick_times(path, *, column=None, with_metadata=False):
 
             skip = 0
             with open(path) as fh:
+                # files written before version 0.2 carry the metadata in a comment line
                 for line in fh:
                     if not line.startswith("#"):
                         break
                     skip += 1
                     if line.startswith(_CSV_MARK):
                         meta = json.loads(line[len(_CSV_MARK) :])
+            sidecar = _sidecar(path)
+            if not meta and sidecar.exists():
+                meta = json.loads(sidecar.read_text())
+                if not isinstance(meta, dict):
+                    raise ValueError(f"{str(sidecar)!r} does not hold a JSON object")
             # read text and let float() parse it: correctly rounded whatever the pandas version
             frame = pd.read_csv(path, skiprows=skip, dtype=str, keep_default_na=False)
             data = {c: frame[c].to_numpy() for c in frame.columns}
@@ -1133,6 +1153,12 @@ def read_kick_times(path, *, column=None, with_metadata=False):
         times = _float_array(values, what, lower="positive", sorted_=True)
     except (TypeError, ValueError) as exc:
         raise ValueError(f"invalid kick-time file: {what}: {exc}") from None
+    n_kicks = meta.get("n_kicks")
+    if n_kicks is not None and n_kicks != times.size:
+        raise ValueError(
+            f"invalid kick-time file {str(path)!r}: its metadata says {n_kicks} kicks, the file "
+            f"holds {times.size} (a stale {_sidecar(path).name}?)"
+        )
     t_max = meta.get("t_max")
     if t_max is not None and times.size and times[-1] > t_max:
         raise ValueError(f"invalid kick-time file {str(path)!r}: times exceed t_max={t_max!r}")
