@@ -21,12 +21,15 @@ from numba import njit
 INF = np.inf
 
 #: The grazing angle delta: a boundary contact whose velocity makes an angle smaller than
-#: this with the wall (|cos theta| < sin delta, exactly tangent included) leaves along the
-#: whispering-gallery chord of angle 2 delta (see `graze`). Under the invariant measure a
-#: contact is this close to tangent with probability 1 - cos(delta) = 5e-9.
+#: delta / 2 with the wall (|cos theta| < sin(delta) / 2, exactly tangent included) leaves
+#: along the whispering-gallery chord of angle 2 delta (see `graze`). The factor 1/2 puts
+#: the contacts of that chord (at angle delta) clearly on the ordinary side, so round-off
+#: cannot make a sliding disk switch between the two treatments. Under the invariant
+#: measure a contact is that close to tangent with probability 1.25e-9.
 GRAZE_ANGLE = 1e-4
 SIN_GRAZE = math.sin(GRAZE_ANGLE)
 COS_GRAZE = math.cos(GRAZE_ANGLE)
+GRAZE_THRESHOLD = 0.5 * SIN_GRAZE
 
 
 @njit(cache=True)

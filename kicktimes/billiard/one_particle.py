@@ -24,7 +24,13 @@ from numba import njit
 
 from kicktimes.billiard import _checks as chk
 from kicktimes.billiard._checks import STALL_EVENTS
-from kicktimes.billiard.geometry import SIN_GRAZE, boundary_hit_time, graze, reflect
+from kicktimes.billiard.geometry import (
+    GRAZE_THRESHOLD,
+    SIN_GRAZE,
+    boundary_hit_time,
+    graze,
+    reflect,
+)
 from kicktimes.billiard.runs import BoundaryLog, OneParticleRun
 from kicktimes.billiard.two_particle import (
     DONE,
@@ -102,7 +108,7 @@ def process_event_one(st, ev, is_kick, dt, rho, kick_time, angle, kick_mode, uni
     # bias drifts L = x vy - y vx by 6e-12 over 10^6 collisions, 40x more than without.
     vv = vx * vx + vy * vy
     xv = x * vx + y * vy
-    gz = rho * SIN_GRAZE
+    gz = rho * GRAZE_THRESHOLD
     if xv * xv < gz * gz * vv:
         # Grazing or tangent: slide on (see graze). The Newton step along the flight
         # below would divide by x.v ~ 0, so project radially.
@@ -112,7 +118,7 @@ def process_event_one(st, ev, is_kick, dt, rho, kick_time, angle, kick_mode, uni
         sp = math.sqrt(vv)
         sin_theta = (x * vy - y * vx) / (rho * sp)
         vx, vy = graze(x, y, vx, vy, rho, sp)
-        ev[0] = 2.0 * gz / sp
+        ev[0] = 2.0 * rho * SIN_GRAZE / sp
     elif xv > 0.0:
         # Put the contact back on |x| = rho with a Newton step *along the flight*: a radial
         # projection would rescale L = x vy - y vx and drift sin_theta by 1e-11 over 10^6
@@ -408,7 +414,7 @@ def simulate_one_particle(state, r, *, t_max=None, kicks=None, kick_angle="unifo
     Notes
     -----
     A kick at the same instant as a boundary collision is applied after the reflection;
-    a kick exactly at the end of the run is applied. A contact within 1e-4 rad of tangent
+    a kick exactly at the end of the run is applied. A contact within 5e-5 rad of tangent
     slides on along the wall (`kicktimes.billiard.geometry.graze`), whether the IC or a
     kick put the disk there. ``r <= 1 - 1e-6``; the speed must lie in ``[1e-6, 1e6]``;
     other ranges as in `simulate_two_particle`.

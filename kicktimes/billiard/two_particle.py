@@ -26,6 +26,7 @@ from numba import njit
 from kicktimes.billiard import _checks as chk
 from kicktimes.billiard._checks import STALL_EVENTS
 from kicktimes.billiard.geometry import (
+    GRAZE_THRESHOLD,
     SIN_GRAZE,
     boundary_hit_time,
     collide_elastic,
@@ -101,12 +102,12 @@ def process_event_two(st, ev, k, rho, sigma, rule):
         else:
             sin_theta = (x * vy - y * vx) / (rho * math.sqrt(vv))
         xv = x * vx + y * vy
-        gz = rho * SIN_GRAZE
+        gz = rho * GRAZE_THRESHOLD
         if xv * xv < gz * gz * vv:
             # grazing or tangent: reflecting would make no progress; slide on (see graze)
             sp = 1.0 if rule == 0 else math.sqrt(vv)
             vx, vy = graze(x, y, vx, vy, rho, sp)
-            ev[k] = 2.0 * gz / sp
+            ev[k] = 2.0 * rho * SIN_GRAZE / sp
         elif xv > 0.0:
             vx, vy = reflect(vx, vy, x / rho, y / rho)
             # from a point on the circle the next boundary hit is the chord, the exact
@@ -412,8 +413,8 @@ def simulate_two_particle(ic, r, *, t_max=None, rule="mirror", sampling="uniform
     velocity at a boundary collision (``L = x vy - y vx``); ``s`` is the polar angle of
     the contact point in ``[0, 2 pi)``. Events at exactly ``t_max`` are included.
 
-    A contact within ``GRAZE_ANGLE = 1e-4`` of tangent (an exactly tangent one included)
-    slides on along the wall instead of being reflected: the disk leaves along the
+    A contact within 5e-5 rad of tangent (an exactly tangent one included) slides on
+    along the wall instead of being reflected: the disk leaves along the
     whispering-gallery chord of angle ``2e-4`` (`kicktimes.billiard.geometry.graze`).
     Speeds must be 1 (mirror) or 0 or in ``[1e-6, 1e6]`` (elastic); ``t_max``, ``tau`` and
     ``n_steps * tau`` at most 1e12, ``n_steps`` at most 1e8.
