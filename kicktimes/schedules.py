@@ -137,17 +137,18 @@ def _float_array(values, name, *, lower, sorted_):
     arr = arr.astype(np.float64) + 0.0  # a copy; + 0.0 turns -0.0 into 0.0 (hash by bytes)
     bad = np.flatnonzero(~np.isfinite(arr))
     if bad.size:
-        raise ValueError(f"{name} must be finite, got {arr[bad[0]]!r} at index {bad[0]}")
+        raise ValueError(f"{name} must be finite, got {float(arr[bad[0]])!r} at index {bad[0]}")
     bad = np.flatnonzero(arr <= 0 if lower == "positive" else arr < 0)
     if bad.size:
         bound = "> 0" if lower == "positive" else ">= 0"
-        raise ValueError(f"{name} must be {bound}, got {arr[bad[0]]!r} at index {bad[0]}")
+        raise ValueError(f"{name} must be {bound}, got {float(arr[bad[0]])!r} at index {bad[0]}")
     if sorted_ and arr.size > 1:
         bad = np.flatnonzero(np.diff(arr) < 0)
         if bad.size:
             i = bad[0]
             raise ValueError(
-                f"{name} must be sorted (non-decreasing), got {arr[i]!r} then {arr[i + 1]!r} "
+                f"{name} must be sorted (non-decreasing), got {float(arr[i])!r} then "
+                f"{float(arr[i + 1])!r} "
                 f"at indices {i}, {i + 1}"
             )
     arr.flags.writeable = False
@@ -164,7 +165,9 @@ def _run_times(run):
     t_max = _check_t_max(run.t_max, "run.t_max")
     times = _float_array(run.pp_times, "run.pp_times", lower="positive", sorted_=True)
     if times.size and times[-1] > t_max:
-        raise ValueError(f"run.pp_times must lie in (0, run.t_max={t_max!r}], got {times[-1]!r}")
+        raise ValueError(
+            f"run.pp_times must lie in (0, run.t_max={t_max!r}], got {float(times[-1])!r}"
+        )
     return times, t_max
 
 
@@ -232,7 +235,7 @@ def _dist_params(dist):
             raise ValueError(f"dist parameter {label} must be a scalar, got {v!r}")
         values.append(_real(v if not isinstance(v, np.ndarray) else v[()], f"dist {label}"))
         if not math.isfinite(values[-1]):
-            raise ValueError(f"dist parameter {label} must be finite, got {values[-1]!r}")
+            raise ValueError(f"dist parameter {label} must be finite, got {float(values[-1])!r}")
     return dist.dist.name, tuple(zip(names, values[:-2], strict=True)), values[-2], values[-1]
 
 
@@ -611,7 +614,7 @@ class Renewal(Schedule):
         if self.stationary and not math.isfinite(self.mean_interval):
             raise ValueError(
                 f"stationary=True needs a finite mean interval, but dist "
-                f"{_dist_repr(self.dist)} has mean {self.mean_interval!r}; the equilibrium "
+                f"{_dist_repr(self.dist)} has mean {float(self.mean_interval)!r}; the equilibrium "
                 "law S(x)/E[X] does not exist (use stationary=False)"
             )
 
@@ -699,7 +702,9 @@ class Replay(Schedule):
         if self.t_max is not None:
             t_max = _check_t_max(self.t_max)
             if times.size and times[-1] > t_max:
-                raise ValueError(f"times must lie in (0, t_max={t_max!r}], got {times[-1]!r}")
+                raise ValueError(
+                    f"times must lie in (0, t_max={t_max!r}], got {float(times[-1])!r}"
+                )
             object.__setattr__(self, "t_max", t_max)
 
     @classmethod
@@ -715,7 +720,7 @@ class Replay(Schedule):
         _check_rng(rng)
         if self.t_max is not None and t_max > self.t_max:
             raise ValueError(
-                f"t_max={t_max!r} exceeds the replayed window (0, {self.t_max!r}]; the "
+                f"t_max={t_max!r} exceeds the replayed window (0, {float(self.t_max)!r}]; the "
                 "kick times after it are unknown"
             )
         out = self.times[: np.searchsorted(self.times, t_max, side="right")].copy()
