@@ -23,7 +23,6 @@ import numpy as np
 from numba import njit
 
 from kicktimes.billiard import _checks as chk
-from kicktimes.billiard._checks import STALL_EVENTS
 from kicktimes.billiard.geometry import (
     GRAZE_THRESHOLD,
     SIN_GRAZE,
@@ -38,6 +37,7 @@ from kicktimes.billiard.two_particle import (
     OVER_BUDGET,
     STALLED,
     _grow_to,
+    _stalled,
     raise_for_status,
 )
 
@@ -108,18 +108,8 @@ def process_event_one(st, ev, is_kick, dt, rho, kick_time, angle, kick_mode, uni
     # bias drifts L = x vy - y vx by 6e-12 over 10^6 collisions, 40x more than without.
     vv = vx * vx + vy * vy
     xv = x * vx + y * vy
-    gz = rho * GRAZE_THRESHOLD
-    if xv * xv < gz * gz * vv:
-        # Grazing or tangent: slide on (see graze). The Newton step along the flight
-        # below would divide by x.v ~ 0, so project radially.
-        scale = 1.5 - 0.5 * (x * x + y * y) / (rho * rho)
-        x *= scale
-        y *= scale
-        sp = math.sqrt(vv)
-        sin_theta = (x * vy - y * vx) / (rho * sp)
-        vx, vy = graze(x, y, vx, vy, rho, sp)
-        ev[0] = 2.0 * rho * SIN_GRAZE / sp
-    elif xv > 0.0:
+    gz = GRAZE_THRESHOLD * rho
+    if xv > 0.0 and xv * xv >= gz * gz * vv:
         # Put the contact back on |x| = rho with a Newton step *along the flight*: a radial
         # projection would rescale L = x vy - y vx and drift sin_theta by 1e-11 over 10^6
         # collisions; moving along v keeps L exact.
@@ -133,6 +123,16 @@ def process_event_one(st, ev, is_kick, dt, rho, kick_time, angle, kick_mode, uni
             sin_theta = (x * vy - y * vx) / (rho * math.sqrt(vv))
         vx, vy = reflect(vx, vy, x / rho, y / rho)
         ev[0] = 2.0 * xv / vv
+    elif xv * xv < gz * gz * vv:
+        # Grazing or tangent: slide on (see graze). The Newton step along the flight
+        # above would divide by x.v ~ 0, so project radially.
+        scale = 1.5 - 0.5 * (x * x + y * y) / (rho * rho)
+        x *= scale
+        y *= scale
+        sp = math.sqrt(vv)
+        sin_theta = (x * vy - y * vx) / (rho * sp)
+        vx, vy = graze(x, y, vx, vy, rho, sp)
+        ev[0] = 2.0 * rho * SIN_GRAZE / sp
     else:
         # a Lyapunov twin moving inward (see process_event_two): no reflection
         scale = 1.5 - 0.5 * (x * x + y * y) / (rho * rho)
@@ -156,15 +156,14 @@ def finish_one_at(st, ev, t_end):
 
 @njit(cache=True)
 def _event_loop_one(st, ev, rho, kicks, angles, kick_mode, unit_speed, t_end, mode, tau, bt, bx,
-                    by, bs, stimes, samples, cnt, next_s, stall_dt):
-    """Logging/sampling loop (see ``_event_loop_two``); ``cnt = [n_kicks, n_b, k, n_stall]``.
+                    by, bs, stimes, samples, cnt, next_s):
+    """Logging/sampling loop (see ``_event_loop_two``); ``cnt = [n_kicks, n_b, k]``.
 
-    Only boundary collisions count towards a stall: simultaneous kicks are the user's and
-    there are finitely many.
+    Only boundary collisions count towards a stall (`_stalled`): simultaneous kicks are
+    the user's and there are finitely many.
     """
     n_b = cnt[1]
     k = cnt[2]
-    n_stall = cnt[3]
     ns = stimes.shape[0]
     ns_next = next_s[0]
     status = FULL
@@ -188,13 +187,6 @@ def _event_loop_one(st, ev, rho, kicks, angles, kick_mode, unit_speed, t_end, mo
         else:
             if n_b >= bt.shape[0]:
                 break
-            if dte < stall_dt:
-                n_stall += 1
-                if n_stall >= STALL_EVENTS:
-                    status = STALLED
-                    break
-            else:
-                n_stall = 0
             bs[n_b] = process_event_one(st, ev, False, dte, rho, 0.0, 0.0, kick_mode, unit_speed)
             bt[n_b] = st[0]
             bx[n_b] = st[1]
@@ -208,7 +200,6 @@ def _event_loop_one(st, ev, rho, kicks, angles, kick_mode, unit_speed, t_end, mo
             ns_next = st[0] + tau
     cnt[1] = n_b
     cnt[2] = k
-    cnt[3] = n_stall
     next_s[0] = ns_next
     return status
 
@@ -234,12 +225,15 @@ def simulate_one_kernel(st, rho, kicks, angles, kick_mode, t_max, mode, n_steps,
     ns = n_steps + 1 if mode > 0 else 0
     stimes = np.empty(ns)
     samples = np.empty((ns, 2))
-    cnt = np.zeros(4, dtype=np.int64)
+    cnt = np.zeros(3, dtype=np.int64)
     next_s = np.zeros(1)
     t_end = t_max if mode < 2 else np.inf
     while True:
         status = _event_loop_one(st, ev, rho, kicks, angles, kick_mode, unit_speed, t_end, mode,
-                                 tau, bt, bx, by, bs, stimes, samples, cnt, next_s, stall_dt)
+                                 tau, bt, bx, by, bs, stimes, samples, cnt, next_s)
+        if _stalled(bt, cnt[1], stall_dt):
+            status = STALLED
+            break
         if status != FULL:
             break
         room = max_events - cnt[1]

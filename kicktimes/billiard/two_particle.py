@@ -98,21 +98,23 @@ def process_event_two(st, ev, k, rho, sigma, rule):
             vx *= sv
             vy *= sv
             vv = 1.0
+            sp = 1.0
             sin_theta = (x * vy - y * vx) / rho
         else:
-            sin_theta = (x * vy - y * vx) / (rho * math.sqrt(vv))
+            sp = math.sqrt(vv)
+            sin_theta = (x * vy - y * vx) / (rho * sp)
         xv = x * vx + y * vy
-        gz = rho * GRAZE_THRESHOLD
-        if xv * xv < gz * gz * vv:
-            # grazing or tangent: reflecting would make no progress; slide on (see graze)
-            sp = 1.0 if rule == 0 else math.sqrt(vv)
-            vx, vy = graze(x, y, vx, vy, rho, sp)
-            ev[k] = 2.0 * rho * SIN_GRAZE / sp
-        elif xv > 0.0:
+        # |x.v| <= rho |v| sin(delta)/2: grazing or tangent (see graze)
+        gz = GRAZE_THRESHOLD * rho * sp
+        if xv > gz:
             vx, vy = reflect(vx, vy, x / rho, y / rho)
             # from a point on the circle the next boundary hit is the chord, the exact
             # root of the quadratic with c = 0: t = -2 (x.v') / |v|^2 = 2 (x.v) / |v|^2
             ev[k] = 2.0 * xv / vv
+        elif xv >= -gz:
+            # reflecting would make no progress (a chord of length ~0): slide on
+            vx, vy = graze(x, y, vx, vy, rho, sp)
+            ev[k] = 2.0 * rho * SIN_GRAZE / sp
         else:
             # Never reflect a disk that is already moving inward (only a perturbed twin of
             # a Lyapunov computation can get here): it would turn it outward, into a
@@ -199,21 +201,30 @@ DONE, FULL, STALLED, OVER_BUDGET = 0, 1, 2, 3
 
 
 @njit(cache=True)
+def _stalled(times, n, stall_dt):
+    """True if the last `STALL_EVENTS` of the ``n`` logged ``times`` are less than
+    ``stall_dt`` apart on average: the run makes no progress (e.g. disks jammed against
+    the wall). Legitimate collisions are at least a grazing chord, ``2e-4 rho / |v|``,
+    apart, five orders more than ``stall_dt``."""
+    if n < STALL_EVENTS:
+        return False
+    return times[n - 1] - times[n - STALL_EVENTS] < STALL_EVENTS * stall_dt
+
+
+@njit(cache=True)
 def _event_loop_two(st, ev, rho, sigma, rule, t_end, mode, tau, o, pp, bt, bp, bx, by, bs,
-                    stimes, samples, cnt, next_s, stall_dt):
-    """The logging/sampling event loop; returns `DONE`, `FULL` (a buffer) or `STALLED`.
+                    stimes, samples, cnt, next_s):
+    """The logging/sampling event loop; returns `DONE` or `FULL` (a buffer is full).
 
     Growing a buffer reassigns the array, and an array reassigned inside a numba loop
     costs reference counting on every iteration (it halved the speed): so this loop
-    only detects a full buffer and returns, and the caller grows it outside.
-    ``cnt = [n_pp, n_b, k, n_stall]`` and ``next_s[0]`` (the next sample time) carry the
-    loop's position between calls. ``n_stall`` counts consecutive events less than
-    ``stall_dt`` apart; `STALL_EVENTS` of them mean the state makes no progress.
+    only detects a full buffer and returns, and the caller grows it outside (and checks
+    the budget and for stalls there, at no cost per event). ``cnt = [n_pp, n_b, k]``
+    and ``next_s[0]`` (the next sample time) carry the loop's position between calls.
     """
     n_pp = cnt[0]
     n_b = cnt[1]
     k = cnt[2]
-    n_stall = cnt[3]
     ns = stimes.shape[0]
     ns_next = next_s[0]
     status = FULL
@@ -232,14 +243,6 @@ def _event_loop_two(st, ev, rho, sigma, rule, t_end, mode, tau, o, pp, bt, bp, b
             break
         if (ke == 2 and n_pp >= pp.shape[0]) or (ke < 2 and n_b >= bt.shape[0]):
             break
-        # one compare per event: cheaper than any bound on the events at one instant
-        if dte < stall_dt:
-            n_stall += 1
-            if n_stall >= STALL_EVENTS:
-                status = STALLED
-                break
-        else:
-            n_stall = 0
         sin_theta = process_event_two(st, ev, ke, rho, sigma, rule)
         if ke == 2:
             pp[n_pp] = st[0]
@@ -261,7 +264,6 @@ def _event_loop_two(st, ev, rho, sigma, rule, t_end, mode, tau, o, pp, bt, bp, b
     cnt[0] = n_pp
     cnt[1] = n_b
     cnt[2] = k
-    cnt[3] = n_stall
     next_s[0] = ns_next
     return status
 
@@ -293,15 +295,19 @@ def simulate_two_kernel(st, rho, sigma, rule, t_max, mode, n_steps, tau, track, 
     ns = n_steps + 1 if mode > 0 else 0
     stimes = np.empty(ns)
     samples = np.empty((ns, 2))
-    cnt = np.zeros(4, dtype=np.int64)
+    cnt = np.zeros(3, dtype=np.int64)
     next_s = np.zeros(1)
     t_end = t_max if mode < 2 else np.inf
     while True:
         status = _event_loop_two(st, ev, rho, sigma, rule, t_end, mode, tau, 1 + 4 * track, pp,
-                                 bt, bp, bx, by, bs, stimes, samples, cnt, next_s, stall_dt)
+                                 bt, bp, bx, by, bs, stimes, samples, cnt, next_s)
+        # budget and stalls are checked only here, when a buffer is full (or at the end):
+        # nothing in the hot loop
+        if _stalled(pp, cnt[0], stall_dt) or _stalled(bt, cnt[1], stall_dt):
+            status = STALLED
+            break
         if status != FULL:
             break
-        # the budget is checked only here, when a buffer is full: nothing in the hot loop
         room = max_events - cnt[0] - cnt[1]
         if room <= 0:
             status = OVER_BUDGET
@@ -337,8 +343,8 @@ def raise_for_status(status: int, st_time: float, n_events: int, *, max_events: 
         )
     if status == STALLED:
         raise ValueError(
-            f"{name}: the run makes no progress: {STALL_EVENTS} consecutive collisions less "
-            f"than 1e-9 (1 - r) / |v| apart at t = {float(st_time)!r} ({n_events} collisions "
+            f"{name}: the run makes no progress: {STALL_EVENTS} collisions in less than "
+            f"{STALL_EVENTS} x 1e-9 (1 - r) / |v| at t = {float(st_time)!r} ({n_events} collisions "
             f"so far; {where}); the state is stuck (e.g. disks jammed against the wall)"
         )
 
