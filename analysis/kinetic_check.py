@@ -1,8 +1,9 @@
 """The exact kinetic-theory check of the simulator, as a table.
 
 With ICs drawn from the invariant measure the mean number of disk-disk collisions in
-[0, T] is Gamma(r) T exactly (docs/architecture.md, "Invariant measure and the kinetic rate"). Prints mean count, its standard error, the
-kinetic expectation and the z-score for both rules at several radii.
+[0, T] is Gamma(r) T exactly (docs/architecture.md, "Invariant measure and the kinetic
+rate"). Prints mean count, its standard error, the kinetic expectation and the z-score
+for both rules at several radii.
 
 Run: python analysis/kinetic_check.py [--n-ics 20000] [--t-max 200]
 """

@@ -23,20 +23,21 @@ def check_real(name: str, value, *, low=None, high=None, low_open=True, high_ope
     bad_low = low is not None and (x <= low if low_open else x < low)
     bad_high = high is not None and (x >= high if high_open else x > high)
     if bad_low or bad_high:
-        lo = "-inf" if low is None else repr(low)
-        hi = "inf" if high is None else repr(high)
+        lo = "-inf" if low is None else repr(float(low))
+        hi = "inf" if high is None else repr(float(high))
         span = f"{'(' if low_open else '['}{lo}, {hi}{')' if high_open else ']'}"
         raise ValueError(f"{name} must lie in {span}, got {x!r}")
     return x
 
 
-def check_int(name: str, value, *, low: int) -> int:
-    """An integer (not a bool) no smaller than ``low``."""
+def check_int(name: str, value, *, low: int, high: int | None = None) -> int:
+    """An integer (not a bool) in ``[low, high]`` (no upper bound if ``high`` is None)."""
     if isinstance(value, bool) or not isinstance(value, Integral | np.integer):
         raise TypeError(f"{name} must be an integer, got {type(value).__name__}")
     n = int(value)
-    if n < low:
-        raise ValueError(f"{name} must be an integer >= {low}, got {n}")
+    if n < low or (high is not None and n > high):
+        span = f">= {low}" if high is None else f"in [{low}, {high}]"
+        raise ValueError(f"{name} must be an integer {span}, got {n}")
     return n
 
 

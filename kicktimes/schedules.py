@@ -31,7 +31,7 @@ Conventions shared by every schedule
 
 Schedules compare by value, have a readable ``repr``, serialise with ``to_json()`` /
 :func:`from_json`, and sampled times are stored with :func:`write_kick_times` /
-:func:`read_kick_times` (CSV or Parquet). See docs/schedules.md.
+:func:`read_kick_times` (CSV with a JSON sidecar, or Parquet). See docs/schedules.md.
 """
 
 from __future__ import annotations
@@ -137,17 +137,18 @@ def _float_array(values, name, *, lower, sorted_):
     arr = arr.astype(np.float64) + 0.0  # a copy; + 0.0 turns -0.0 into 0.0 (hash by bytes)
     bad = np.flatnonzero(~np.isfinite(arr))
     if bad.size:
-        raise ValueError(f"{name} must be finite, got {arr[bad[0]]!r} at index {bad[0]}")
+        raise ValueError(f"{name} must be finite, got {float(arr[bad[0]])!r} at index {bad[0]}")
     bad = np.flatnonzero(arr <= 0 if lower == "positive" else arr < 0)
     if bad.size:
         bound = "> 0" if lower == "positive" else ">= 0"
-        raise ValueError(f"{name} must be {bound}, got {arr[bad[0]]!r} at index {bad[0]}")
+        raise ValueError(f"{name} must be {bound}, got {float(arr[bad[0]])!r} at index {bad[0]}")
     if sorted_ and arr.size > 1:
         bad = np.flatnonzero(np.diff(arr) < 0)
         if bad.size:
             i = bad[0]
             raise ValueError(
-                f"{name} must be sorted (non-decreasing), got {arr[i]!r} then {arr[i + 1]!r} "
+                f"{name} must be sorted (non-decreasing), got {float(arr[i])!r} then "
+                f"{float(arr[i + 1])!r} "
                 f"at indices {i}, {i + 1}"
             )
     arr.flags.writeable = False
@@ -164,7 +165,9 @@ def _run_times(run):
     t_max = _check_t_max(run.t_max, "run.t_max")
     times = _float_array(run.pp_times, "run.pp_times", lower="positive", sorted_=True)
     if times.size and times[-1] > t_max:
-        raise ValueError(f"run.pp_times must lie in (0, run.t_max={t_max!r}], got {times[-1]!r}")
+        raise ValueError(
+            f"run.pp_times must lie in (0, run.t_max={t_max!r}], got {float(times[-1])!r}"
+        )
     return times, t_max
 
 
@@ -232,7 +235,7 @@ def _dist_params(dist):
             raise ValueError(f"dist parameter {label} must be a scalar, got {v!r}")
         values.append(_real(v if not isinstance(v, np.ndarray) else v[()], f"dist {label}"))
         if not math.isfinite(values[-1]):
-            raise ValueError(f"dist parameter {label} must be finite, got {values[-1]!r}")
+            raise ValueError(f"dist parameter {label} must be finite, got {float(values[-1])!r}")
     return dist.dist.name, tuple(zip(names, values[:-2], strict=True)), values[-2], values[-1]
 
 
@@ -611,7 +614,7 @@ class Renewal(Schedule):
         if self.stationary and not math.isfinite(self.mean_interval):
             raise ValueError(
                 f"stationary=True needs a finite mean interval, but dist "
-                f"{_dist_repr(self.dist)} has mean {self.mean_interval!r}; the equilibrium "
+                f"{_dist_repr(self.dist)} has mean {float(self.mean_interval)!r}; the equilibrium "
                 "law S(x)/E[X] does not exist (use stationary=False)"
             )
 
@@ -699,7 +702,9 @@ class Replay(Schedule):
         if self.t_max is not None:
             t_max = _check_t_max(self.t_max)
             if times.size and times[-1] > t_max:
-                raise ValueError(f"times must lie in (0, t_max={t_max!r}], got {times[-1]!r}")
+                raise ValueError(
+                    f"times must lie in (0, t_max={t_max!r}], got {float(times[-1])!r}"
+                )
             object.__setattr__(self, "t_max", t_max)
 
     @classmethod
@@ -715,7 +720,7 @@ class Replay(Schedule):
         _check_rng(rng)
         if self.t_max is not None and t_max > self.t_max:
             raise ValueError(
-                f"t_max={t_max!r} exceeds the replayed window (0, {self.t_max!r}]; the "
+                f"t_max={t_max!r} exceeds the replayed window (0, {float(self.t_max)!r}]; the "
                 "kick times after it are unknown"
             )
         out = self.times[: np.searchsorted(self.times, t_max, side="right")].copy()
@@ -1011,8 +1016,10 @@ def write_kick_times(times, path, *, t_max=None, schedule=None, seed=None, metad
         and moved into place with ``os.replace``: readers never see a partial file.
     t_max, schedule, seed, metadata : keyword-only, optional
         Stored as JSON ``{"format", "kicktimes_version", "n_kicks", "t_max", "seed",
-        "schedule", "metadata"}``: in the Parquet schema metadata (key ``kicktimes``) or
-        in a leading ``# kicktimes metadata: {...}`` line of the CSV.
+        "schedule", "metadata"}``: in the Parquet schema metadata (key ``kicktimes``) or,
+        for a CSV, in the sidecar file ``<path>.json`` (``kicks.csv.json``), so that the
+        CSV itself is plain (one header line ``kick_time``, one time per line) and any CSV
+        reader takes it as it is.
 
     Returns
     -------
@@ -1045,13 +1052,19 @@ def write_kick_times(times, path, *, t_max=None, schedule=None, seed=None, metad
         raise ValueError(f"metadata must be JSON-serialisable without NaN/inf: {exc}") from None
 
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    tmp_meta = None
     try:
         if suffix == ".csv":
             with os.fdopen(fd, "w", newline="") as fh:
-                fh.write(_CSV_MARK + meta_json + "\n")
                 fh.write("kick_time\n")
                 # repr is the shortest string that parses back to the same double
                 fh.writelines(f"{x!r}\n" for x in arr.tolist())
+            fd_meta, tmp_meta = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.",
+                                                 suffix=".json.tmp")
+            with os.fdopen(fd_meta, "w") as fh:
+                fh.write(meta_json + "\n")
+            # sidecar first: a reader that sees the new CSV also sees its metadata
+            os.replace(tmp_meta, _sidecar(path))
         else:
             os.close(fd)
             import pyarrow as pa
@@ -1062,10 +1075,16 @@ def write_kick_times(times, path, *, t_max=None, schedule=None, seed=None, metad
             pq.write_table(table, tmp)
         os.replace(tmp, path)
     except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
+        for name in (tmp, tmp_meta):
+            if name is not None and os.path.exists(name):
+                os.unlink(name)
         raise
     return path
+
+
+def _sidecar(path: Path) -> Path:
+    """The metadata file of a CSV of kick times: ``kicks.csv`` -> ``kicks.csv.json``."""
+    return path.with_name(path.name + ".json")
 
 
 def read_kick_times(path, *, column=None, with_metadata=False):
@@ -1094,12 +1113,18 @@ def read_kick_times(path, *, column=None, with_metadata=False):
 
             skip = 0
             with open(path) as fh:
+                # files written before version 0.2 carry the metadata in a comment line
                 for line in fh:
                     if not line.startswith("#"):
                         break
                     skip += 1
                     if line.startswith(_CSV_MARK):
                         meta = json.loads(line[len(_CSV_MARK) :])
+            sidecar = _sidecar(path)
+            if not meta and sidecar.exists():
+                meta = json.loads(sidecar.read_text())
+                if not isinstance(meta, dict):
+                    raise ValueError(f"{str(sidecar)!r} does not hold a JSON object")
             # read text and let float() parse it: correctly rounded whatever the pandas version
             frame = pd.read_csv(path, skiprows=skip, dtype=str, keep_default_na=False)
             data = {c: frame[c].to_numpy() for c in frame.columns}
@@ -1133,6 +1158,12 @@ def read_kick_times(path, *, column=None, with_metadata=False):
         times = _float_array(values, what, lower="positive", sorted_=True)
     except (TypeError, ValueError) as exc:
         raise ValueError(f"invalid kick-time file: {what}: {exc}") from None
+    n_kicks = meta.get("n_kicks")
+    if n_kicks is not None and n_kicks != times.size:
+        raise ValueError(
+            f"invalid kick-time file {str(path)!r}: its metadata says {n_kicks} kicks, the file "
+            f"holds {times.size} (a stale {_sidecar(path).name}?)"
+        )
     t_max = meta.get("t_max")
     if t_max is not None and times.size and times[-1] > t_max:
         raise ValueError(f"invalid kick-time file {str(path)!r}: times exceed t_max={t_max!r}")

@@ -342,7 +342,7 @@ for rule in RULES:
 # %% [markdown]
 # ## 5. Outliers: sticky and silent ICs
 #
-# Under the mirror rule a small share of the paper's ICs (0.2-0.8 % at these radii) lock into a regular
+# Under the mirror rule a few of the paper's ICs (0.2-0.8 % at these radii) lock into a regular
 # cycle (both disks bouncing almost radially and meeting near the centre every ~2 time units)
 # with collision counts 10–40× the kinetic rate, while a few others circle in step and hardly
 # ever collide. We flag an IC as **sticky** when its count exceeds 5 Γ T and as **silent**

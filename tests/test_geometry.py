@@ -118,3 +118,23 @@ def test_sin_theta_is_the_ccw_tangential_component():
     assert sin_theta_at(0.0, rho, -1.0, 0.0, rho) == pytest.approx(1.0)
     assert sin_theta_at(0.0, rho, 0.0, 1.0, rho) == pytest.approx(0.0)
     assert sin_theta_at(rho, 0.0, 0.6, -0.8, rho) == pytest.approx(-0.8)
+
+
+def test_graze_leaves_the_wall_inward_at_the_grazing_angle_with_the_same_speed_and_sense():
+    from kicktimes.billiard.geometry import GRAZE_ANGLE, graze
+
+    rho = 0.9
+    for phi in np.linspace(0, 2 * np.pi, 7):
+        x, y = rho * math.cos(phi), rho * math.sin(phi)
+        for sense in (1.0, -1.0):
+            speed = 2.5
+            vx, vy = -sense * speed * math.sin(phi), sense * speed * math.cos(phi)  # tangent
+            wx, wy = graze(x, y, vx, vy, rho, speed)
+            assert math.hypot(wx, wy) == pytest.approx(speed, rel=1e-15)
+            # inward at angle GRAZE_ANGLE from the tangent: x.w / (rho |w|) = -sin(delta)
+            assert (x * wx + y * wy) / (rho * speed) == pytest.approx(-math.sin(GRAZE_ANGLE),
+                                                                       rel=1e-9)
+            assert math.copysign(1.0, x * wy - y * wx) == sense
+            # the chord is 2 rho sin(delta) long and ends on the wall
+            t = boundary_hit_time(x, y, wx, wy, rho)
+            assert t * speed == pytest.approx(2 * rho * math.sin(GRAZE_ANGLE), rel=1e-6)

@@ -81,3 +81,62 @@ def test_collision_rate_matches_kinetic_theory_under_the_invariant_measure(rule,
 @pytest.mark.parametrize("r", [0.01, 0.02, 0.05])
 def test_collision_rate_matches_kinetic_theory_with_many_ics(rule, r):
     assert_mean_count_matches_kinetic_theory(rule, r, n=20000, t_max=200.0, seed=7)
+
+
+# ------------------------------------------------------------- every radius, bounded time
+@pytest.mark.parametrize(("method", "rule", "r_max", "digest"), [
+    ("paper", "mirror", 0.03, "b221778024b3b778"),
+    ("paper", "mirror", 0.1, "08695fc9bd669d3e"),
+    ("uniform", "mirror", 0.03, "c6ae7170f08b0360"),
+    ("uniform", "elastic", 0.03, "430e73daf4219840"),
+    ("uniform", "mirror", 0.1, "5d265b106d2b7e6d"),
+    ("uniform", "elastic", 0.1, "68632eb16803941c"),
+])
+def test_the_paper_radii_give_the_same_ensembles_bit_for_bit(method, rule, r_max, digest):
+    # digests of the ensembles drawn before the feasibility fallback existed (commit 2874fcf)
+    import hashlib
+
+    ics = initial_conditions(200, r_max, seed=2026, method=method, rule=rule)
+    assert hashlib.sha256(ics.tobytes()).hexdigest()[:16] == digest
+
+
+@pytest.mark.parametrize("method", ["paper", "uniform"])
+@pytest.mark.parametrize("r_max", [0.34, 0.4, 0.45, 0.49, 0.4999, 0.5 - 1e-9])
+def test_every_radius_up_to_one_half_gives_valid_ics_in_bounded_time(method, r_max):
+    import time
+
+    t0 = time.perf_counter()
+    ics = initial_conditions(20, r_max, seed=1, method=method, rule="elastic")
+    assert time.perf_counter() - t0 < 5.0
+    assert (np.hypot(ics[:, :, 0], ics[:, :, 1]) <= 1 - r_max).all()
+    gap = np.hypot(ics[:, 0, 0] - ics[:, 1, 0], ics[:, 0, 1] - ics[:, 1, 1])
+    assert (gap >= 2 * r_max).all()
+
+
+def test_the_issue_example_returns():
+    ic = initial_conditions(1, 0.4, seed=1)[0]
+    assert np.hypot(ic[0, 0] - ic[1, 0], ic[0, 1] - ic[1, 1]) >= 0.8
+
+
+def test_radii_too_close_to_one_half_are_refused_with_the_reason():
+    with pytest.raises(ValueError, match=r"r_max must lie in .*diametrically opposite"):
+        initial_conditions(1, 0.5 - 1e-12)
+
+
+def test_the_direct_pair_sampler_matches_joint_rejection():
+    # at r_max = 0.45 rejection still works (acceptance ~ 3 %): the direct sampler that takes
+    # over after N_TRY rejections must draw from the same law
+    from scipy.stats import ks_2samp
+
+    from kicktimes.billiard.initial import _uniform_pair
+
+    r = 0.45
+    rng = np.random.default_rng(3)
+    direct = np.array([_uniform_pair(rng, r) for _ in range(400)])  # (400, 2 xy, 2 disks)
+    rej = initial_conditions(400, r, seed=5, method="uniform")
+    d_direct = np.hypot(direct[:, 0, 0], direct[:, 1, 0])
+    d_rej = np.hypot(rej[:, 0, 0], rej[:, 0, 1])
+    assert ks_2samp(d_direct, d_rej).pvalue > 1e-3
+    gap_direct = np.hypot(direct[:, 0, 0] - direct[:, 0, 1], direct[:, 1, 0] - direct[:, 1, 1])
+    gap_rej = np.hypot(rej[:, 0, 0] - rej[:, 1, 0], rej[:, 0, 1] - rej[:, 1, 1])
+    assert ks_2samp(gap_direct, gap_rej).pvalue > 1e-3

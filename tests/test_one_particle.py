@@ -156,3 +156,75 @@ def test_bad_states_raise():
         simulate_one_particle([0.0, 0.0, 0.0, 0.0], 0.02, t_max=1.0)
     with pytest.raises(ValueError, match="shape"):
         simulate_one_particle(np.zeros((2, 4)), 0.02, t_max=1.0)
+
+
+# ------------------------------------------------------------ grazing and bad input
+def test_a_kick_onto_the_wall_tangent_slides_on():
+    # the example: a kick at t = 0 turns the disk on the wall to tangent; it was
+    # reflected again and again at that instant until MemoryError
+    r = 0.05
+    run = simulate_one_particle([0.95, 0, -1, 0], r, t_max=50.0, kicks=[0.0],
+                                kick_angles=[math.pi / 2])
+    assert run.n_kicks == 1
+    assert np.hypot(*run.final_state[:2]) <= 1 - r + 1e-12
+    assert np.hypot(*run.final_state[2:]) == pytest.approx(1.0, abs=1e-12)
+    # sliding: contacts every 2 rho sin(1e-4), the disk goes round at speed 1
+    np.testing.assert_allclose(np.diff(run.boundary.time[:50]), 2 * 0.95 * math.sin(1e-4),
+                               rtol=1e-7)
+    angle = np.unwrap(run.boundary.s.to_numpy())
+    assert (angle[-1] - angle[0]) * 0.95 == pytest.approx(50.0, rel=1e-3)
+
+
+def test_a_tangent_initial_state_gives_sin_theta_one_and_stays_grazing():
+    # at the bottom of the table moving left: clockwise, sin_theta = -1
+    run = simulate_one_particle([0.0, -0.98, -1.0, 0.0], 0.02, t_max=5.0)
+    assert run.boundary.sin_theta.iloc[0] == pytest.approx(-1.0, abs=1e-15)
+    assert (run.boundary.sin_theta < -1 + 1e-8).all()
+
+
+def test_grazing_does_not_touch_ordinary_orbits():
+    # sin_theta = 0.999 (chord angle 0.045, far above 1e-4) keeps its angle exactly
+    s = 0.999
+    run = simulate_one_particle([0.0, 0.0, s, math.sqrt(1 - s * s)], 0.02, t_max=50.0)
+    np.testing.assert_allclose(run.boundary.sin_theta.iloc[1:], run.boundary.sin_theta.iloc[1],
+                               atol=1e-13)
+
+
+def test_kicks_given_as_a_string_raise_a_type_error_naming_kicks():
+    with pytest.raises(TypeError, match="kicks must be None, a sequence of kick times or a "
+                                        "schedule .* got the string 'poisson'"):
+        simulate_one_particle(STATE, 0.02, t_max=10.0, kicks="poisson")
+
+
+def test_a_pandas_series_of_times_is_taken_as_times_not_as_a_schedule():
+    import pandas as pd
+
+    run = simulate_one_particle(STATE, 0.02, t_max=10.0, kicks=pd.Series([1.0, 2.0]), rng=1)
+    assert run.kick_times.tolist() == [1.0, 2.0]
+
+
+def test_messages_show_plain_floats():
+    with pytest.raises(ValueError) as info:
+        simulate_one_particle(STATE, 0.02, t_max=10.0, kicks=np.array([-2.0, 1.0]))
+    assert "got -2.0" in str(info.value) and "np.float64" not in str(info.value)
+
+
+@pytest.mark.parametrize(("kwargs", "match", "exc"), [
+    (dict(state=[0.1, 0.0, 1e156, 0.0]), r"state: the disk's speed must be in \[1e-06", ValueError),
+    (dict(state=[0.1, 0.0, 1e-300, 0.0]), r"state: the disk's speed must be in", ValueError),
+    (dict(r=1 - 1e-9), r"r must lie in \(0.0, 0.999999\] for one disk", ValueError),
+    (dict(t_max=1e300), r"t_max must lie in", ValueError),
+    (dict(rng="seed", kicks=schedules.Poisson(1.0)), r"rng must be None, an int seed", TypeError),
+    (dict(kick_angles="x", kicks=[1.0]), r"kick_angles must be a sequence", TypeError),
+])
+def test_ranges_that_keep_the_arithmetic_finite(kwargs, match, exc):
+    args = dict(state=STATE, r=0.02, t_max=10.0)
+    args.update(kwargs)
+    state, r = args.pop("state"), args.pop("r")
+    with pytest.raises(exc, match=match):
+        simulate_one_particle(state, r, **args)
+
+
+def test_the_one_particle_event_budget():
+    with pytest.raises(ValueError, match="max_events=20 collisions"):
+        simulate_one_particle(STATE, 0.02, t_max=100.0, max_events=20)

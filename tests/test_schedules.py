@@ -459,7 +459,34 @@ def test_kick_times_round_trip_through_files(tmp_path, suffix):
     assert np.array_equal(back, times)
     assert meta["t_max"] == 500.0 and meta["seed"] == 1 and meta["n_kicks"] == times.size
     assert schedules.from_dict(meta["schedule"]) == schedule
-    assert sorted(os.listdir(tmp_path)) == [f"kicks{suffix}"]  # no stray temp file
+    extra = [f"kicks{suffix}.json"] if suffix == ".csv" else []  # the CSV's metadata sidecar
+    assert sorted(os.listdir(tmp_path)) == [f"kicks{suffix}", *extra]  # no stray temp file
+
+
+def test_csv_of_kick_times_is_plain_for_any_reader(tmp_path):
+    import pandas as pd
+
+    path = schedules.write_kick_times([0.1, 2.5], tmp_path / "kicks.csv", t_max=3.0, seed=4)
+    frame = pd.read_csv(path)
+    assert list(frame.columns) == ["kick_time"] and frame["kick_time"].tolist() == [0.1, 2.5]
+    meta = json.loads((tmp_path / "kicks.csv.json").read_text())
+    assert meta["t_max"] == 3.0 and meta["seed"] == 4 and meta["n_kicks"] == 2
+
+
+def test_csv_with_the_old_comment_line_is_still_read(tmp_path):
+    meta = {"format": "kicktimes.kick_times/1", "n_kicks": 2, "t_max": 3.0, "seed": 4}
+    (tmp_path / "old.csv").write_text(
+        "# kicktimes metadata: " + json.dumps(meta) + "\nkick_time\n0.5\n1.5\n"
+    )
+    times, back = schedules.read_kick_times(tmp_path / "old.csv", with_metadata=True)
+    assert times.tolist() == [0.5, 1.5] and back == meta
+
+
+def test_a_stale_sidecar_is_refused(tmp_path):
+    path = schedules.write_kick_times([0.1, 2.5], tmp_path / "kicks.csv")
+    path.write_text("kick_time\n0.5\n")  # rewritten by hand, sidecar not
+    with pytest.raises(ValueError, match="stale"):
+        schedules.read_kick_times(path)
 
 
 @pytest.mark.parametrize("suffix", [".csv", ".parquet"])
@@ -480,7 +507,8 @@ def test_failed_write_leaves_the_old_file_and_no_temp(tmp_path, suffix, monkeypa
         schedules.write_kick_times([3.0, 4.0, 5.0], path)
     monkeypatch.undo()
     assert np.array_equal(schedules.read_kick_times(path), [1.0, 2.0])
-    assert sorted(os.listdir(tmp_path)) == [f"k{suffix}"]
+    extra = [f"k{suffix}.json"] if suffix == ".csv" else []
+    assert sorted(os.listdir(tmp_path)) == [f"k{suffix}", *extra]
 
 
 def test_foreign_and_damaged_time_files(tmp_path):

@@ -229,7 +229,7 @@ GOOD_IC = [[0.1, 0.2, 0.6, 0.8], [-0.3, -0.1, 0.0, 1.0]]
         (dict(r=float("nan"), t_max=1.0), "r must be finite"),
         (dict(r=0.02, t_max=0.0), "t_max must lie in"),
         (dict(r=0.02, t_max=float("inf")), "t_max must be finite"),
-        (dict(r=0.02, n_steps=0, tau=0.3), "n_steps must be an integer >= 1"),
+        (dict(r=0.02, n_steps=0, tau=0.3), "n_steps must be an integer in \\[1, "),
         (dict(r=0.02, n_steps=10, tau=-0.3), "tau must lie in"),
         (dict(r=0.02, n_steps=10), "tau must be given"),
         (dict(r=0.02, t_max=1.0, rule="sticky"), "rule must be one of"),
@@ -267,3 +267,89 @@ def test_elastic_rule_accepts_any_speeds_but_not_both_at_rest():
     np.testing.assert_allclose(run.final_state[:, 2], [-1.3, 0.0], atol=1e-15)
     with pytest.raises(ValueError, match="at rest"):
         simulate_two_particle([[0, 0, 0, 0], [0.5, 0, 0, 0]], 0.02, t_max=2.0, rule="elastic")
+
+
+# ------------------------------------------------------- grazing, budgets and stalls
+def _invariants_hold(run, r):
+    rho = 1.0 - r
+    fs = run.final_state
+    assert (np.hypot(fs[:, 0], fs[:, 1]) <= rho + 1e-12).all()
+    assert np.hypot(*(fs[0, :2] - fs[1, :2])) >= 2 * r - 1e-12
+    if run.samples.size:
+        assert (np.hypot(run.samples[:, 0], run.samples[:, 1]) <= rho + 1e-12).all()
+    t = run.boundary_log.time
+    assert (np.diff(t) >= 0).all() and (t <= run.t_max).all()
+
+
+def test_a_disk_tangent_to_the_wall_slides_on_instead_of_reflecting_forever():
+    # the example: it grew buffers until MemoryError
+    r = 0.05
+    run = simulate_two_particle([[0.95, 0, 0, 1], [0, 0.5, 0, 1]], r, t_max=50.0)
+    _invariants_hold(run, r)
+    np.testing.assert_allclose(np.hypot(run.final_state[:, 2], run.final_state[:, 3]), 1.0,
+                               atol=1e-12)
+    first = run.boundary[run.boundary.particle == 0].iloc[:3]
+    assert first.sin_theta.iloc[0] == 1.0  # the tangent contact, counter-clockwise
+    # then chords of angle 2e-4: one contact every 2 rho sin(1e-4), advancing along the wall
+    np.testing.assert_allclose(np.diff(first.time), 2 * 0.95 * np.sin(1e-4), rtol=1e-9)
+    np.testing.assert_allclose(np.diff(first.s), 2e-4, rtol=1e-6)
+
+
+def test_paper_sampling_of_a_tangent_disk_advances_the_clock():
+    run = simulate_two_particle([[0.95, 0, 0, 1], [0, 0.5, 0, 1]], 0.05, n_steps=2000, tau=0.1,
+                                sampling="paper")
+    assert run.t_max > 0.3  # was 0.0: 2,001 reflections at one instant
+    assert (np.diff(run.sample_times) > 0).all()
+
+
+def test_a_grazing_contact_keeps_the_energy_under_the_elastic_rule():
+    r = 0.05
+    ic = [[0.0, -0.95, 0.6, 0.0], [0.0, 0.3, 0.0, 0.8]]
+    run = simulate_two_particle(ic, r, t_max=30.0, rule="elastic")
+    _invariants_hold(run, r)
+    assert (run.final_state[:, 2:] ** 2).sum() == pytest.approx(1.0, abs=1e-12)
+
+
+def test_the_event_budget_ends_a_run_with_an_error_naming_max_events():
+    ic = initial_conditions(1, 0.05, seed=3)[0]
+    with pytest.raises(ValueError, match=r"max_events=50 collisions"):
+        simulate_two_particle(ic, 0.05, t_max=1000.0, max_events=50)
+    assert simulate_two_particle(ic, 0.05, t_max=10.0, max_events=10**4).n_boundary > 0
+
+
+def test_a_run_too_long_for_the_default_budget_is_refused_up_front():
+    ic = initial_conditions(1, 0.05, seed=3)[0]
+    with pytest.raises(ValueError, match=r"t_max=1000000000.0 needs about .* max_events="):
+        simulate_two_particle(ic, 0.05, t_max=1e9)
+
+
+def test_jammed_disks_end_in_a_clear_error_or_a_valid_run():
+    # r close to 1/2: the disks only fit nearly diametrically opposite
+    r = 0.4999
+    ic = initial_conditions(1, r, seed=2, method="uniform", rule="elastic")[0]
+    try:
+        run = simulate_two_particle(ic, r, t_max=5.0, rule="elastic")
+    except ValueError as exc:
+        assert "max_events" in str(exc) or "no progress" in str(exc)
+    else:
+        _invariants_hold(run, r)
+
+
+@pytest.mark.parametrize(("kwargs", "match"), [
+    (dict(t_max=1e300), r"t_max must lie in \(0.0, 1000000000000.0\], got 1e\+300"),
+    (dict(n_steps=10**9, tau=0.1), r"n_steps must be an integer in \[1, 100000000\]"),
+    (dict(t_max=1e6, tau=1e-6), r"t_max / tau must be <= 100000000 steps"),
+    (dict(n_steps=10**8, tau=1e6), r"n_steps \* tau must be <= 1e\+12"),
+    (dict(t_max=10.0, max_events=0), r"max_events must be an integer >= 1"),
+])
+def test_time_arguments_are_range_checked(kwargs, match):
+    ic = initial_conditions(1, 0.02, seed=1)[0]
+    with pytest.raises(ValueError, match=match):
+        simulate_two_particle(ic, 0.02, **kwargs)
+
+
+@pytest.mark.parametrize("speed", [1e156, 1e-300, 1e7])
+def test_speeds_outside_the_range_are_refused_naming_ic(speed):
+    ic = [[0.1, 0.0, speed, 0.0], [0.0, 0.5, 0.0, 1.0]]
+    with pytest.raises(ValueError, match=r"ic: disk 0 speed must be 0 or in \[1e-06, 1e\+06\]"):
+        simulate_two_particle(ic, 0.02, t_max=1.0, rule="elastic")

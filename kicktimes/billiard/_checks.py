@@ -10,11 +10,26 @@ import numpy as np
 from kicktimes._validation import check_choice, check_int, check_real
 
 __all__ = ["check_choice", "check_int", "check_real", "check_state", "check_inside",
-           "check_unit_speed", "check_sampling", "RULES", "SAMPLINGS", "CONTACT_TOL"]
+           "check_unit_speed", "check_speed", "check_sampling", "event_budget", "stall_time",
+           "RULES", "SAMPLINGS", "CONTACT_TOL", "SPEED_RANGE", "TIME_LIMIT", "N_STEPS_MAX",
+           "MAX_EVENTS_DEFAULT", "STALL_EVENTS"]
 
 RULES = {"mirror": 0, "elastic": 1}
 SAMPLINGS = ("uniform", "paper")
 CONTACT_TOL = 1e-12
+#: Non-zero speeds must lie in this range. The dynamics only depends on speed x time, so
+#: nothing is lost; outside it |v|^2 under- or overflows (|v| >= 1e154 gave NaN event times).
+SPEED_RANGE = (1e-6, 1e6)
+#: Upper limit of t_max, tau and n_steps * tau: keeps the clock's resolution (ulp 1e-4 at
+#: 1e12) far below any event spacing and every count of steps or events finite.
+TIME_LIMIT = 1e12
+#: At most this many sampling steps (24 bytes each: 2.4 GB of samples).
+N_STEPS_MAX = 10**8
+#: Default cap on the number of logged collisions of one run (about 33 bytes each).
+MAX_EVENTS_DEFAULT = 2 * 10**7
+#: This many consecutive events without the clock advancing (see `stall_time`) end a run
+#: with an error: a state the kernel cannot make progress from.
+STALL_EVENTS = 10_000
 
 
 def check_state(name: str, value, shape: tuple[int, ...]) -> np.ndarray:
@@ -44,6 +59,51 @@ def check_unit_speed(name: str, vx: float, vy: float, which: str, tol: float = 1
         )
 
 
+def check_speed(name: str, vx: float, vy: float, which: str, *, allow_zero: bool) -> float:
+    """A speed ``|v|`` in `SPEED_RANGE` (or exactly 0 when ``allow_zero``); returns it."""
+    speed = math.hypot(vx, vy)
+    if speed == 0.0 and allow_zero:
+        return speed
+    lo, hi = SPEED_RANGE
+    if not lo <= speed <= hi:
+        zero = "0 or " if allow_zero else ""
+        raise ValueError(
+            f"{name}: {which} speed must be {zero}in [{lo:g}, {hi:g}], got {float(speed)!r} "
+            "(rescale time instead: the motion depends only on speed x time)"
+        )
+    return speed
+
+
+def stall_time(rho: float, speed: float) -> float:
+    """Events closer than this in time count as "no progress" (1e-9 of the table at ``speed``).
+
+    The shortest legitimate spacing of boundary events is the grazing chord
+    ``2 rho sin(delta) / |v|`` with ``delta = GRAZE_ANGLE`` (1e-4), five orders larger.
+    """
+    return 1e-9 * rho / speed
+
+
+def event_budget(max_events, *, horizon: float, horizon_name: str, speed: float, rho: float,
+                 n_disks: int) -> int:
+    """The maximum number of logged collisions of a run.
+
+    The expected number is ``n_disks |v| T / (pi rho / 2)`` (the mean free path of a
+    disk of radius ``rho`` is ``pi rho / 2``). The default budget is a hundred times that
+    plus 10^6, capped at `MAX_EVENTS_DEFAULT`; a run expected to need more than a quarter
+    of the cap is refused up front, so that it fails at once rather than after minutes.
+    """
+    expected = n_disks * speed * horizon / (0.5 * math.pi * rho)
+    if max_events is None:
+        if expected > MAX_EVENTS_DEFAULT / 4:
+            raise ValueError(
+                f"{horizon_name}={float(horizon)!r} needs about {expected:.3g} collisions, more "
+                f"than the default event budget ({MAX_EVENTS_DEFAULT:.3g}) allows; pass a shorter "
+                f"{horizon_name} or max_events= (about 70 bytes of memory per event)"
+            )
+        return int(min(MAX_EVENTS_DEFAULT, 10**6 + 100.0 * expected))
+    return check_int("max_events", max_events, low=1)
+
+
 def check_sampling(t_max, n_steps, tau, sampling):
     """Resolve the time arguments of a simulator call.
 
@@ -53,11 +113,15 @@ def check_sampling(t_max, n_steps, tau, sampling):
     """
     check_choice("sampling", sampling, SAMPLINGS)
     if tau is not None:
-        tau = check_real("tau", tau, low=0.0)
+        tau = check_real("tau", tau, low=0.0, high=TIME_LIMIT, high_open=False)
     if n_steps is not None:
-        n_steps = check_int("n_steps", n_steps, low=1)
+        n_steps = check_int("n_steps", n_steps, low=1, high=N_STEPS_MAX)
     if t_max is not None:
-        t_max = check_real("t_max", t_max, low=0.0)
+        t_max = check_real("t_max", t_max, low=0.0, high=TIME_LIMIT, high_open=False)
+    if n_steps is not None and tau is not None and n_steps * tau > TIME_LIMIT:
+        raise ValueError(
+            f"n_steps * tau must be <= {TIME_LIMIT:g}, got {n_steps} * {tau!r} = {n_steps * tau!r}"
+        )
 
     if tau is None and n_steps is None:
         if t_max is None:
@@ -77,7 +141,13 @@ def check_sampling(t_max, n_steps, tau, sampling):
     if n_steps is None:
         if t_max is None:
             raise ValueError("give n_steps or t_max together with tau")
-        n_steps = int(math.floor(t_max / tau * (1.0 + 1e-12)))
+        steps = math.floor(t_max / tau * (1.0 + 1e-12))
+        if steps > N_STEPS_MAX:
+            raise ValueError(
+                f"t_max / tau must be <= {N_STEPS_MAX} steps, got {t_max!r} / {tau!r} = "
+                f"{t_max / tau:.6g}; pass a larger tau or a shorter t_max"
+            )
+        n_steps = int(steps)
         if n_steps < 1:
             raise ValueError(f"t_max={t_max!r} is shorter than one step tau={tau!r}")
         return t_max, n_steps, tau, 1

@@ -9,6 +9,7 @@ or across workers: ``initial_conditions(10, r, seed=s)[7]`` equals
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -23,40 +24,147 @@ def ic_generator(seed: int, index: int) -> np.random.Generator:
     return np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(index,)))
 
 
+#: Rejection draws per disk (or pair) before the exact conditional sampler takes over.
+#: At the paper's radii (r_max <= 0.1) a draw is accepted with probability >= 0.7, so the
+#: cap is never reached and the ensembles are bit-for-bit those of the plain rejection.
+N_TRY = 1000
+#: Centres closer than this to the edge of feasibility (where the space left to the other
+#: disk has zero area) are treated as infeasible: the conditional sampler needs some room.
+FEASIBLE_MARGIN = 1e-9
+_GRID = 4097
+#: The largest r_max: 1 - r - (3 r - 1) = 2 - 4 r, the room a first centre has, must
+#: exceed FEASIBLE_MARGIN comfortably.
+R_MAX_IC = 0.5 - 1e-9
+
+
+def _allowed_fraction(d, a, s):
+    """Fraction of the circle ``|p| = d`` at distance ``>= s`` from a centre at distance ``a``.
+
+    ``|p - c|^2 = d^2 + a^2 - 2 d a cos(phi)`` is ``>= s^2`` iff ``cos(phi) <= q`` with
+    ``q = (d^2 + a^2 - s^2) / (2 d a)``: the fraction is ``1 - arccos(q) / pi``.
+    """
+    d = np.asarray(d, dtype=float)
+    if a == 0.0:
+        return (d >= s).astype(float)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        q = (d * d + a * a - s * s) / (2.0 * d * a)
+    q = np.where(d > 0.0, q, -np.inf if a < s else np.inf)
+    return 1.0 - np.arccos(np.clip(q, -1.0, 1.0)) / np.pi
+
+
+def _inverse_cdf(rng, grid, weight):
+    """One draw from the density proportional to ``weight`` (piecewise linear on ``grid``)."""
+    cdf = np.concatenate(([0.0], np.cumsum(0.5 * (weight[1:] + weight[:-1]) * np.diff(grid))))
+    return float(np.interp(rng.uniform(0.0, cdf[-1]), cdf, grid))
+
+
+def _point_away_from(rng, c, s, rho, *, area):
+    """A centre ``p`` with ``|p| <= rho`` and ``|p - c| >= s``, from the conditional law.
+
+    The law is the rejection sampler's, conditioned on acceptance, drawn directly: the
+    distance ``d`` from the table centre has density proportional to ``g(d)`` (the paper's
+    distance uniform on (0, 1)) or ``d g(d)`` (area-uniform), ``g`` the allowed fraction
+    of the circle of radius ``d``; the polar angle is uniform on the allowed arcs.
+    """
+    a = math.hypot(c[0], c[1])
+    phi0 = math.atan2(c[1], c[0])
+    d_lo = max(0.0, s - a)
+    grid = np.linspace(d_lo, rho, _GRID)
+    weight = _allowed_fraction(grid, a, s) * (grid if area else 1.0)
+    for _ in range(100):
+        d = min(_inverse_cdf(rng, grid, weight), rho)
+        # arcs allowed at distance d: |phi - phi0| >= alpha
+        alpha = float(np.pi * (1.0 - _allowed_fraction(d, a, s)))
+        side = 1.0 if rng.uniform() < 0.5 else -1.0
+        phi = phi0 + side * (alpha + rng.uniform() * (np.pi - alpha))
+        x, y = d * math.cos(phi), d * math.sin(phi)
+        if math.hypot(x, y) <= rho and math.hypot(x - c[0], y - c[1]) >= s:
+            return x, y
+    # round-off keeps missing a sliver: the farthest point is always allowed
+    return -rho * math.cos(phi0), -rho * math.sin(phi0)
+
+
 def _paper_ic(rng: np.random.Generator, r_max: float) -> np.ndarray:
     # The paper's procedure: distance from the centre uniform on (0, 1) (not area-uniform),
     # polar angle uniform; redraw a disk while it pokes out of the table or overlaps the
-    # disk already placed, at the family's largest radius.
+    # disk already placed, at the family's largest radius. For r_max > 1/3 the first disk
+    # can leave no room for the second (|c0| <= 3 r_max - 1): it is then drawn again from
+    # its law conditioned on leaving room, instead of redrawing the second disk forever.
     rho = 1.0 - r_max
+    s = 2.0 * r_max
+    a_min = 3.0 * r_max - 1.0 + FEASIBLE_MARGIN
     out = np.empty((2, 4))
     for i in range(2):
-        while True:
+        for _ in range(N_TRY):
             dist = rng.uniform(0.0, 1.0)
             phi = rng.uniform(0.0, 2.0 * np.pi)
             x, y = dist * math.cos(phi), dist * math.sin(phi)
             if dist > rho:
                 continue
-            if i == 1 and math.hypot(x - out[0, 0], y - out[0, 1]) < 2.0 * r_max:
+            if i == 1 and math.hypot(x - out[0, 0], y - out[0, 1]) < s:
                 continue
             break
+        else:
+            if i == 0:  # (1 - rho)^1000: unreachable in practice, but bounded
+                dist = rng.uniform(0.0, rho)
+                x, y = dist, 0.0
+            else:
+                x, y = _point_away_from(rng, out[0, :2], s, rho, area=False)
+        if i == 0 and dist < a_min:
+            dist = rng.uniform(a_min, rho)
+            phi = rng.uniform(0.0, 2.0 * np.pi)
+            x, y = dist * math.cos(phi), dist * math.sin(phi)
         angle = rng.uniform(0.0, 2.0 * np.pi)
         out[i] = (x, y, math.cos(angle), math.sin(angle))
     return out
+
+
+@functools.lru_cache(maxsize=16)
+def _first_centre_density(r_max):
+    """Grid of distances ``a`` of the first centre and the density ``a A(a)`` on it."""
+    rho = 1.0 - r_max
+    s = 2.0 * r_max
+    a_grid = np.linspace(max(0.0, 3.0 * r_max - 1.0 + FEASIBLE_MARGIN), rho, 513)
+    d_grid = np.linspace(0.0, rho, 1025)
+    area = np.array([np.trapezoid(d_grid * _allowed_fraction(d_grid, a, s), d_grid)
+                     for a in a_grid])
+    return a_grid, a_grid * area
+
+
+def _uniform_pair(rng, r_max):
+    """Two centres uniform on the non-overlapping configurations, by the exact marginals.
+
+    The first centre's distance ``a`` from the table centre has density proportional to
+    ``a A(a)``, ``A(a)`` the area left to the second centre; the second is then uniform on
+    that area (`_point_away_from`).
+    """
+    rho = 1.0 - r_max
+    s = 2.0 * r_max
+    a_grid, weight = _first_centre_density(r_max)
+    a = min(_inverse_cdf(rng, a_grid, weight), rho)
+    phi = rng.uniform(0.0, 2.0 * np.pi)
+    c0 = (a * math.cos(phi), a * math.sin(phi))
+    c1 = _point_away_from(rng, c0, s, rho, area=True)
+    return np.array([c0[0], c1[0]]), np.array([c0[1], c1[1]])
 
 
 def _uniform_ic(rng: np.random.Generator, r_max: float, rule: str) -> np.ndarray:
     # The invariant (Liouville) measure: the *pair* of centres uniform on the
     # non-overlapping configurations, by joint rejection (redrawing only the second disk
     # would weight configurations by the free area left to it, which is not uniform).
+    # Near r_max = 0.5 almost every pair overlaps: after N_TRY draws the pair is drawn
+    # from the same law directly.
     rho = 1.0 - r_max
     out = np.empty((2, 4))
-    while True:
+    for _ in range(N_TRY):
         rad = rho * np.sqrt(rng.uniform(size=2))
         phi = rng.uniform(0.0, 2.0 * np.pi, size=2)
         x = rad * np.cos(phi)
         y = rad * np.sin(phi)
         if math.hypot(x[0] - x[1], y[0] - y[1]) >= 2.0 * r_max:
             break
+    else:
+        x, y = _uniform_pair(rng, r_max)
     out[:, 0] = x
     out[:, 1] = y
     if rule == "mirror":
@@ -80,14 +188,15 @@ def initial_conditions(n, r_max, *, seed=0, method="paper", rule="mirror", start
     n : int
         Number of ICs (``>= 1``).
     r_max : float
-        The largest disk radius the ensemble will be used with, ``0 < r_max < 0.5``.
+        The largest disk radius the ensemble will be used with, ``0 < r_max <= 0.5 - 1e-9``.
         ICs are valid (inside the table, no overlap) for every ``r <= r_max``.
     seed : int
         Root seed (``>= 0``). The ensemble is a pure function of ``seed``.
     method : {"paper", "uniform"}
         ``"paper"``: per disk, distance from the centre uniform on (0, 1), polar angle
         and velocity angle uniform on [0, 2 pi), redrawn while it overlaps the boundary or
-        the other disk at ``r_max``; unit speeds. ``"uniform"``: the invariant measure of
+        the other disk at ``r_max``; unit speeds (for ``r_max > 1/3`` the first disk is
+        redrawn while it leaves no room for the second). ``"uniform"``: the invariant measure of
         ``rule`` at ``r = r_max`` (positions uniform on the non-overlapping pairs; unit
         speeds with uniform directions under ``"mirror"``, ``(v1, v2)`` uniform on
         ``|v1|^2 + |v2|^2 = 2`` under ``"elastic"``).
@@ -95,6 +204,13 @@ def initial_conditions(n, r_max, *, seed=0, method="paper", rule="mirror", start
         Only used by ``method="uniform"``.
     start : int
         Index of the first IC: returns ICs ``start .. start + n - 1`` of the ensemble.
+
+    Notes
+    -----
+    Every ``r_max`` in (0, 0.5) works and each IC takes bounded time: after 1000 rejected
+    draws of a disk (or pair) the draw is made from the same conditional law directly
+    (inverse CDF on a 4097-point grid). This never happens for ``r_max <= 0.1``, so those
+    ensembles are exactly the plain rejection sampler's.
 
     Returns
     -------
@@ -111,6 +227,11 @@ def initial_conditions(n, r_max, *, seed=0, method="paper", rule="mirror", start
     """
     n = chk.check_int("n", n, low=1)
     r_max = chk.check_real("r_max", r_max, low=0.0, high=0.5)
+    if r_max > R_MAX_IC:
+        raise ValueError(
+            f"r_max must lie in (0.0, {R_MAX_IC!r}], got {r_max!r}: two disks this large "
+            "only fit diametrically opposite, against the wall, with no room to move"
+        )
     seed = chk.check_int("seed", seed, low=0)
     start = chk.check_int("start", start, low=0)
     chk.check_choice("method", method, METHODS)

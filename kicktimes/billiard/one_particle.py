@@ -23,7 +23,13 @@ import numpy as np
 from numba import njit
 
 from kicktimes.billiard import _checks as chk
-from kicktimes.billiard.geometry import boundary_hit_time, reflect
+from kicktimes.billiard.geometry import (
+    GRAZE_THRESHOLD,
+    SIN_GRAZE,
+    boundary_hit_time,
+    graze,
+    reflect,
+)
 from kicktimes.billiard.runs import BoundaryLog, OneParticleRun
 from kicktimes.billiard.scatter import (
     PARTNER_LAWS,
@@ -31,10 +37,21 @@ from kicktimes.billiard.scatter import (
     scatter_kick,
     twin_meets_partner,
 )
-from kicktimes.billiard.two_particle import _grow
+from kicktimes.billiard.two_particle import (
+    DONE,
+    FULL,
+    OVER_BUDGET,
+    STALLED,
+    _grow_to,
+    _stalled,
+    raise_for_status,
+)
 
 KICK_ANGLES = {"uniform": 0, "gaussian": 1, "scatter": 2}
 SCATTER = KICK_ANGLES["scatter"]
+#: The largest radius of a single disk: the table left to its centre, 1 - r, stays >= 1e-6,
+#: far above the contact tolerance (1e-12).
+R_MAX_ONE = 1.0 - 1e-6
 
 
 @njit(cache=True)
@@ -98,7 +115,8 @@ def process_event_one(st, ev, is_kick, dt, rho, kick_time, angle, kick_mode, uni
     # bias drifts L = x vy - y vx by 6e-12 over 10^6 collisions, 40x more than without.
     vv = vx * vx + vy * vy
     xv = x * vx + y * vy
-    if xv > 0.0:
+    gz = GRAZE_THRESHOLD * rho
+    if xv > 0.0 and xv * xv >= gz * gz * vv:
         # Put the contact back on |x| = rho with a Newton step *along the flight*: a radial
         # projection would rescale L = x vy - y vx and drift sin_theta by 1e-11 over 10^6
         # collisions; moving along v keeps L exact.
@@ -112,6 +130,16 @@ def process_event_one(st, ev, is_kick, dt, rho, kick_time, angle, kick_mode, uni
             sin_theta = (x * vy - y * vx) / (rho * math.sqrt(vv))
         vx, vy = reflect(vx, vy, x / rho, y / rho)
         ev[0] = 2.0 * xv / vv
+    elif xv * xv < gz * gz * vv:
+        # Grazing or tangent: slide on (see graze). The Newton step along the flight
+        # above would divide by x.v ~ 0, so project radially.
+        scale = 1.5 - 0.5 * (x * x + y * y) / (rho * rho)
+        x *= scale
+        y *= scale
+        sp = math.sqrt(vv)
+        sin_theta = (x * vy - y * vx) / (rho * sp)
+        vx, vy = graze(x, y, vx, vy, rho, sp)
+        ev[0] = 2.0 * rho * SIN_GRAZE / sp
     else:
         # a Lyapunov twin moving inward (see process_event_two): no reflection
         scale = 1.5 - 0.5 * (x * x + y * y) / (rho * rho)
@@ -175,13 +203,14 @@ def _event_loop_one(st, ev, rho, kicks, angles, kick_mode, unit_speed, t_end, mo
     """Logging/sampling loop (see ``_event_loop_two``); ``cnt = [n_kicks, n_b, k]``.
 
     Scattering kicks (``kick_mode == 2``) use ``kick_u[i]`` and ``sp`` and log to
-    ``klog[i]`` (see `process_scatter_one`).
+    ``klog[i]`` (see `process_scatter_one`). Only boundary collisions count towards a
+    stall (`_stalled`): simultaneous kicks are the user's and there are finitely many.
     """
     n_b = cnt[1]
     k = cnt[2]
     ns = stimes.shape[0]
     ns_next = next_s[0]
-    done = False
+    status = FULL
     while True:
         is_kick, dte = next_event_one(st, ev, kicks, cnt)
         while k < ns and ns_next - st[0] < dte:
@@ -192,7 +221,7 @@ def _event_loop_one(st, ev, rho, kicks, angles, kick_mode, unit_speed, t_end, mo
             k += 1
             ns_next = k * tau if mode == 1 else ns_next + tau
         if (mode == 2 and k >= ns) or st[0] + dte > t_end:
-            done = True
+            status = DONE
             break
         if is_kick:
             ik = cnt[0]
@@ -220,19 +249,20 @@ def _event_loop_one(st, ev, rho, kicks, angles, kick_mode, unit_speed, t_end, mo
     cnt[1] = n_b
     cnt[2] = k
     next_s[0] = ns_next
-    return done
+    return status
 
 
 @njit(cache=True)
 def simulate_one_kernel(st, rho, kicks, angles, kick_mode, t_max, mode, n_steps, tau, b_cap,
-                        kick_u, sp):
+                        kick_u, sp, max_events, stall_dt):
     """Run the kicked one-disk billiard (``mode``: 0 none, 1 uniform, 2 paper sampling).
 
     ``st`` is ``[t, x, y, vx, vy, clock compensation, squared speed]``. Scattering kicks
     (``kick_mode == 2``) take their random numbers from ``kick_u`` (shape (n_kicks, 2))
-    and their parameters from ``sp`` (see `process_scatter_one`).
+    and their parameters from ``sp`` (see `process_scatter_one`). Stops early with
+    status `OVER_BUDGET` after ``max_events`` boundary collisions or `STALLED`.
     Returns ``(b_time, b_x, b_y, b_sin, sample_times, samples, n_kicks_applied, t_end,
-    kick_log)``; ``kick_log`` has one row per applied scattering kick (else none).
+    kick_log, status)``; ``kick_log`` has one row per applied scattering kick (else none).
     """
     ev = np.empty(1)
     ev[0] = boundary_hit_time(st[1], st[2], st[3], st[4], rho)
@@ -240,6 +270,7 @@ def simulate_one_kernel(st, rho, kicks, angles, kick_mode, t_max, mode, n_steps,
     unit_speed = (abs(st[3] * st[3] + st[4] * st[4] - 1.0) < 1e-12
                   and not (kick_mode == SCATTER and sp[1] != 0.0))
     klog = np.zeros((kicks.shape[0] if kick_mode == SCATTER else 0, 9))
+    b_cap = min(b_cap, max_events + 1)
     bt = np.empty(b_cap)
     bx = np.empty(b_cap)
     by = np.empty(b_cap)
@@ -250,39 +281,82 @@ def simulate_one_kernel(st, rho, kicks, angles, kick_mode, t_max, mode, n_steps,
     cnt = np.zeros(3, dtype=np.int64)
     next_s = np.zeros(1)
     t_end = t_max if mode < 2 else np.inf
-    while not _event_loop_one(st, ev, rho, kicks, angles, kick_mode, unit_speed, t_end, mode, tau,
-                              bt, bx, by, bs, stimes, samples, cnt, next_s, kick_u, sp, klog):
-        bt = _grow(bt)
-        bx = _grow(bx)
-        by = _grow(by)
-        bs = _grow(bs)
-    if mode == 2:
-        t_end = stimes[ns - 1]
-    finish_one_at(st, ev, t_end)
+    while True:
+        status = _event_loop_one(st, ev, rho, kicks, angles, kick_mode, unit_speed, t_end, mode,
+                                 tau, bt, bx, by, bs, stimes, samples, cnt, next_s, kick_u, sp,
+                                 klog)
+        if _stalled(bt, cnt[1], stall_dt):
+            status = STALLED
+            break
+        if status != FULL:
+            break
+        room = max_events - cnt[1]
+        if room <= 0:
+            status = OVER_BUDGET
+            break
+        limit = bt.shape[0] + room
+        bt = _grow_to(bt, limit)
+        bx = _grow_to(bx, limit)
+        by = _grow_to(by, limit)
+        bs = _grow_to(bs, limit)
+    if status == DONE:
+        if mode == 2:
+            t_end = stimes[ns - 1]
+        finish_one_at(st, ev, t_end)
     n = cnt[1]
-    return bt[:n], bx[:n], by[:n], bs[:n], stimes, samples, cnt[0], t_end, klog[: cnt[0]]
+    return (bt[:n], bx[:n], by[:n], bs[:n], stimes, samples, cnt[0], t_end, klog[: cnt[0]],
+            status)
 
 
 def check_one_particle_state(state, r: float, name: str = "state") -> np.ndarray:
+    """Validate a one-disk state ``(x, y, vx, vy)`` for radius ``r``; a float64 copy."""
+    if r > R_MAX_ONE:
+        raise ValueError(f"r must lie in (0.0, {R_MAX_ONE!r}] for one disk, got {float(r)!r}")
     arr = chk.check_state(name, state, (4,))
     chk.check_inside(name, arr[0], arr[1], 1.0 - r, r, "the disk's")
     if math.hypot(arr[2], arr[3]) == 0.0:
         raise ValueError(f"{name}: the velocity (vx, vy) must be non-zero, got (0, 0)")
+    chk.check_speed(name, arr[2], arr[3], "the disk's", allow_zero=False)
     return arr
 
 
 def check_kick_times(kicks, t_max: float | None, name: str = "kicks") -> np.ndarray:
     """Sorted, finite, non-negative kick times, none beyond ``t_max`` (if known)."""
-    times = np.array(kicks, dtype=np.float64, copy=True).ravel()
+    if isinstance(kicks, str | bytes):
+        raise TypeError(
+            f"{name} must be None, a sequence of kick times or a schedule (e.g. "
+            f"kicktimes.schedules.Poisson(rate)), got the string {kicks!r}"
+        )
+    try:
+        times = np.array(kicks, dtype=np.float64, copy=True).ravel()
+    except (TypeError, ValueError) as exc:
+        raise TypeError(
+            f"{name} must be None, a sequence of kick times or a schedule, got "
+            f"{type(kicks).__name__} ({exc})"
+        ) from None
     if not np.isfinite(times).all():
         raise ValueError(f"{name} must be finite; got NaN or inf")
-    if times.size and times[0] < 0.0:
-        raise ValueError(f"{name} must be >= 0, got {times.min()!r}")
+    if times.size and times.min() < 0.0:
+        raise ValueError(f"{name} must be >= 0, got {float(times.min())!r}")
     if times.size > 1 and (np.diff(times) < 0.0).any():
         raise ValueError(f"{name} must be sorted in increasing order")
     if t_max is not None and times.size and times[-1] > t_max:
-        raise ValueError(f"{name} must lie in [0, t_max={t_max!r}], got a kick at {times[-1]!r}")
+        raise ValueError(
+            f"{name} must lie in [0, t_max={float(t_max)!r}], got a kick at {float(times[-1])!r}"
+        )
     return times
+
+
+def _is_schedule(kicks) -> bool:
+    """A kick schedule: a `Schedule`, or any object with a ``sample`` method that is not
+    array-like (a pandas Series has a ``sample`` method too, but it holds times)."""
+    from kicktimes.schedules import Schedule
+
+    if isinstance(kicks, Schedule):
+        return True
+    if isinstance(kicks, np.ndarray) or hasattr(kicks, "__array__") or hasattr(kicks, "__len__"):
+        return False
+    return callable(getattr(kicks, "sample", None))
 
 
 def draw_kick_angles(n: int, kick_angle: str, sigma: float, rng: np.random.Generator):
@@ -298,9 +372,31 @@ def draw_kick_angles(n: int, kick_angle: str, sigma: float, rng: np.random.Gener
     return rng.normal(0.0, sigma, size=n)
 
 
+def _check_rng(rng) -> np.random.Generator:
+    """``numpy.random.default_rng(rng)``, with a TypeError naming ``rng`` for bad input."""
+    if isinstance(rng, bool) or not (
+        rng is None or isinstance(rng, int | np.integer | np.random.Generator
+                                  | np.random.BitGenerator | np.random.SeedSequence)
+    ):
+        raise TypeError(
+            "rng must be None, an int seed >= 0, a numpy Generator, BitGenerator or SeedSequence, "
+            f"got {type(rng).__name__}"
+        )
+    if isinstance(rng, int | np.integer) and rng < 0:
+        raise ValueError(f"rng must be an int seed >= 0, got {int(rng)}")
+    return np.random.default_rng(rng)
+
+
 def _check_kick_angles(kick_angles, times: np.ndarray, kick_angle: str) -> np.ndarray:
-    if kick_angle == "scatter":
+    if isinstance(kick_angles, str | bytes):
+        raise TypeError(f"kick_angles must be a sequence of angles, got the string {kick_angles!r}")
+    try:
         arr = np.array(kick_angles, dtype=np.float64, copy=True, order="C")
+    except (TypeError, ValueError) as exc:
+        raise TypeError(
+            f"kick_angles must be a sequence of angles, got {type(kick_angles).__name__} ({exc})"
+        ) from None
+    if kick_angle == "scatter":
         if arr.shape != (times.size, 2):
             raise ValueError(
                 f"kick_angles of scattering kicks must have shape ({times.size}, 2) (two "
@@ -309,7 +405,7 @@ def _check_kick_angles(kick_angles, times: np.ndarray, kick_angle: str) -> np.nd
         if not np.isfinite(arr).all() or (np.abs(arr) > 1.0).any():
             raise ValueError("kick_angles of scattering kicks must lie in [-1, 1]")
         return arr
-    angles = np.array(kick_angles, dtype=np.float64, copy=True).ravel()
+    angles = arr.ravel()
     if angles.shape != times.shape:
         raise ValueError(
             f"kick_angles must have one angle per kick ({times.size}), got {angles.size}"
@@ -330,16 +426,16 @@ def resolve_kicks(kicks, kick_angles, *, kick_angle, sigma, rng, horizon, t_max)
     gen = None
     if kicks is None:
         times = np.empty(0)
-    elif hasattr(kicks, "sample"):
-        gen = np.random.default_rng(rng)
-        times = check_kick_times(kicks.sample(horizon, gen), horizon)
+    elif _is_schedule(kicks):
+        gen = _check_rng(rng)
+        times = check_kick_times(kicks.sample(horizon, gen), horizon, name="kicks.sample()")
     else:
         times = check_kick_times(kicks, t_max)
     if kick_angles is None:
         if not times.size:
             empty = np.empty((0, 2)) if kick_angle == "scatter" else times.copy()
             return times, empty, gen
-        gen = gen if gen is not None else np.random.default_rng(rng)
+        gen = gen if gen is not None else _check_rng(rng)
         return times, draw_kick_angles(times.size, kick_angle, sigma, gen), gen
     return times, _check_kick_angles(kick_angles, times, kick_angle), gen
 
@@ -381,7 +477,7 @@ def check_scatter_options(state, r, kick_angle, rule, e0, partner):
 def simulate_one_particle(state, r, *, t_max=None, kicks=None, kick_angle="uniform",
                           kick_angles=None, sigma=1.0, rng=None, sampling="uniform",
                           n_steps=None, tau=None, seed=None, rule="mirror", e0=None,
-                          partner="weighted") -> OneParticleRun:
+                          partner="weighted", max_events=None) -> OneParticleRun:
     """Simulate one disk of radius ``r`` in the unit table, kicked at given times.
 
     Parameters
@@ -423,6 +519,9 @@ def simulate_one_particle(state, r, *, t_max=None, kicks=None, kick_angle="unifo
     partner : {"weighted", "uniform"}
         Scattering kicks: the partner's direction, weighted by ``|v - u|`` as at a real
         collision (default) or uniform, independent of ``|v - u|``.
+    max_events : int, optional
+        Stop with a ValueError after this many boundary collisions (as in
+        `simulate_two_particle`; kicks do not count).
 
     Returns
     -------
@@ -434,7 +533,10 @@ def simulate_one_particle(state, r, *, t_max=None, kicks=None, kick_angle="unifo
     -----
     A kick at the same instant as a boundary collision is applied after the reflection;
     a kick exactly at the end of the run is applied. The random numbers are drawn after
-    the schedule's times, from the same generator, whatever the kick law.
+    the schedule's times, from the same generator, whatever the kick law. A contact within
+    5e-5 rad of tangent slides on along the wall (`kicktimes.billiard.geometry.graze`),
+    whether the IC or a kick put the disk there. ``r <= 1 - 1e-6``; the speed must lie in
+    ``[1e-6, 1e6]``; other ranges as in `simulate_two_particle`.
 
     Examples
     --------
@@ -464,12 +566,23 @@ def simulate_one_particle(state, r, *, t_max=None, kicks=None, kick_angle="unifo
     st[1:5] = state
     st[6] = state[2] ** 2 + state[3] ** 2
     scatter = kick_angle == "scatter"
-    bt, bx, by, bs, stimes, samples, n_applied, t_end, klog = simulate_one_kernel(
-        st, 1.0 - r, times, np.zeros(times.size) if scatter else angles,
+    rho = 1.0 - r
+    speed = math.sqrt(st[6])
+    if scatter and sp[1] != 0.0:
+        # elastic scattering can give the disk all of the pair's energy
+        speed = max(speed, math.sqrt(2.0 * sp[2]))
+    max_events = chk.event_budget(max_events, horizon=horizon,
+                                  horizon_name="t_max" if mode < 2 else "n_steps * tau",
+                                  speed=speed, rho=rho, n_disks=1)
+    bt, bx, by, bs, stimes, samples, n_applied, t_end, klog, status = simulate_one_kernel(
+        st, rho, times, np.zeros(times.size) if scatter else angles,
         KICK_ANGLES[kick_angle], 0.0 if mode == 2 else t_max, mode,
         n_steps if n_steps is not None else 0, tau if tau is not None else 0.0,
-        int(3.0 * horizon) + 64, angles if scatter else np.zeros((0, 2)), sp,
+        int(2.0 * speed * horizon / rho) + 64, angles if scatter else np.zeros((0, 2)), sp,
+        max_events, chk.stall_time(rho, speed),
     )
+    raise_for_status(status, st[0], bt.shape[0], max_events=max_events, name="state",
+                     where=f"disk at ({st[1]:.6g}, {st[2]:.6g}), r={r!r}")
     return OneParticleRun(
         r=r,
         t_max=float(t_end),

@@ -24,10 +24,14 @@ import numpy as np
 from numba import njit
 
 from kicktimes.billiard import _checks as chk
+from kicktimes.billiard._checks import STALL_EVENTS
 from kicktimes.billiard.geometry import (
+    GRAZE_THRESHOLD,
+    SIN_GRAZE,
     boundary_hit_time,
     collide_elastic,
     collide_mirror,
+    graze,
     pair_hit_time,
     reflect,
 )
@@ -94,15 +98,23 @@ def process_event_two(st, ev, k, rho, sigma, rule):
             vx *= sv
             vy *= sv
             vv = 1.0
+            sp = 1.0
             sin_theta = (x * vy - y * vx) / rho
         else:
-            sin_theta = (x * vy - y * vx) / (rho * math.sqrt(vv))
+            sp = math.sqrt(vv)
+            sin_theta = (x * vy - y * vx) / (rho * sp)
         xv = x * vx + y * vy
-        if xv > 0.0:
+        # |x.v| <= rho |v| sin(delta)/2: grazing or tangent (see graze)
+        gz = GRAZE_THRESHOLD * rho * sp
+        if xv > gz:
             vx, vy = reflect(vx, vy, x / rho, y / rho)
             # from a point on the circle the next boundary hit is the chord, the exact
             # root of the quadratic with c = 0: t = -2 (x.v') / |v|^2 = 2 (x.v) / |v|^2
             ev[k] = 2.0 * xv / vv
+        elif xv >= -gz:
+            # reflecting would make no progress (a chord of length ~0): slide on
+            vx, vy = graze(x, y, vx, vy, rho, sp)
+            ev[k] = 2.0 * rho * SIN_GRAZE / sp
         else:
             # Never reflect a disk that is already moving inward (only a perturbed twin of
             # a Lyapunov computation can get here): it would turn it outward, into a
@@ -177,30 +189,55 @@ def _grow(a):
 
 
 @njit(cache=True)
-def _grow_rows(a):
-    out = np.empty((2 * a.shape[0] + 16, a.shape[1]), dtype=a.dtype)
+def _grow_to(a, limit):
+    """``a`` copied into a buffer twice as long, but no longer than ``limit`` (> len(a))."""
+    out = np.empty(min(2 * a.shape[0] + 16, limit), dtype=a.dtype)
     out[: a.shape[0]] = a
     return out
 
 
 @njit(cache=True)
+def _grow_rows_to(a, limit):
+    """Rows of ``a`` copied into a buffer twice as long, but no longer than ``limit``."""
+    out = np.empty((min(2 * a.shape[0] + 16, limit), a.shape[1]), dtype=a.dtype)
+    out[: a.shape[0]] = a
+    return out
+
+
+# status codes of the event loops
+DONE, FULL, STALLED, OVER_BUDGET = 0, 1, 2, 3
+
+
+@njit(cache=True)
+def _stalled(times, n, stall_dt):
+    """True if the last `STALL_EVENTS` of the ``n`` logged ``times`` are less than
+    ``stall_dt`` apart on average: the run makes no progress (e.g. disks jammed against
+    the wall). Legitimate collisions are at least a grazing chord, ``2e-4 rho / |v|``,
+    apart, five orders more than ``stall_dt``."""
+    if n < STALL_EVENTS:
+        return False
+    return times[n - 1] - times[n - STALL_EVENTS] < STALL_EVENTS * stall_dt
+
+
+@njit(cache=True)
 def _event_loop_two(st, ev, rho, sigma, rule, t_end, mode, tau, o, pp, bt, bp, bx, by, bs,
                     stimes, samples, cnt, next_s, log_pp, ppl):
-    """The logging/sampling event loop; returns True when done, False when a buffer is full.
+    """The logging/sampling event loop; returns `DONE` or `FULL` (a buffer is full).
 
     Growing a buffer reassigns the array, and an array reassigned inside a numba loop
     costs reference counting on every iteration (it halved the speed): so this loop
-    only detects a full buffer and returns, and the caller grows it outside.
-    ``cnt = [n_pp, n_b, k]`` and ``next_s[0]`` (the next sample time) carry the loop's
-    position between calls. With ``log_pp`` every disk-disk collision also fills a row
-    of ``ppl`` (``runs.PP_LOG_COLUMNS``); only disk-disk events pay for the check.
+    only detects a full buffer and returns, and the caller grows it outside (and checks
+    the budget and for stalls there, at no cost per event). ``cnt = [n_pp, n_b, k]``
+    and ``next_s[0]`` (the next sample time) carry the loop's position between calls.
+    With ``log_pp`` every disk-disk collision also fills a row of ``ppl``
+    (``runs.PP_LOG_COLUMNS``); only disk-disk events pay for the check.
     """
     n_pp = cnt[0]
     n_b = cnt[1]
     k = cnt[2]
     ns = stimes.shape[0]
     ns_next = next_s[0]
-    done = False
+    status = FULL
     while True:
         ke, dte = next_event_two(ev)
         # samples strictly before the next event lie on the current free flight
@@ -212,7 +249,7 @@ def _event_loop_two(st, ev, rho, sigma, rule, t_end, mode, tau, o, pp, bt, bp, b
             k += 1
             ns_next = k * tau if mode == 1 else ns_next + tau
         if (mode == 2 and k >= ns) or st[0] + dte > t_end:
-            done = True
+            status = DONE
             break
         if (ke == 2 and n_pp >= pp.shape[0]) or (ke < 2 and n_b >= bt.shape[0]):
             break
@@ -252,26 +289,29 @@ def _event_loop_two(st, ev, rho, sigma, rule, t_end, mode, tau, o, pp, bt, bp, b
     cnt[1] = n_b
     cnt[2] = k
     next_s[0] = ns_next
-    return done
+    return status
 
 
 @njit(cache=True)
 def simulate_two_kernel(st, rho, sigma, rule, t_max, mode, n_steps, tau, track, pp_cap, b_cap,
-                        log_pp=False):
+                        max_events, stall_dt, log_pp=False):
     """Run the two-disk billiard, logging every event and sampling the tracked disk.
 
     ``st`` is ``[t, x0, y0, vx0, vy0, x1, y1, vx1, vy1, clock compensation, energy]``.
     ``mode``: 0 no samples (run to ``t_max``), 1 uniform samples at ``k tau`` (run to
     ``t_max``), 2 the paper's collision-truncated steps (run until ``n_steps`` are done).
-    Samples are interpolated along the free flight, inside the event loop.
+    Samples are interpolated along the free flight, inside the event loop. The run stops
+    early with status `OVER_BUDGET` after ``max_events`` collisions, or `STALLED` (see
+    `_event_loop_two`); ``st`` then holds the state where it stopped.
 
     Returns ``(pp_times, b_time, b_part, b_x, b_y, b_sin, sample_times, samples, t_end,
-    pp_log)``; ``pp_log`` has a row per disk-disk collision if ``log_pp``, else none.
+    pp_log, status)``; ``pp_log`` has a row per disk-disk collision if ``log_pp``, else none.
     """
     ev = np.empty(3)
     init_events_two(st, ev, rho, sigma)
-    pp = np.empty(pp_cap)
-    ppl = np.empty((pp_cap if log_pp else 0, 12))
+    pp = np.empty(min(pp_cap, max_events + 1))
+    ppl = np.empty((pp.shape[0] if log_pp else 0, 12))
+    b_cap = min(b_cap, max_events + 1)
     bt = np.empty(b_cap)
     bp = np.empty(b_cap, dtype=np.int8)
     bx = np.empty(b_cap)
@@ -283,26 +323,58 @@ def simulate_two_kernel(st, rho, sigma, rule, t_max, mode, n_steps, tau, track, 
     cnt = np.zeros(3, dtype=np.int64)
     next_s = np.zeros(1)
     t_end = t_max if mode < 2 else np.inf
-    while not _event_loop_two(st, ev, rho, sigma, rule, t_end, mode, tau, 1 + 4 * track, pp, bt,
-                              bp, bx, by, bs, stimes, samples, cnt, next_s, log_pp, ppl):
+    while True:
+        status = _event_loop_two(st, ev, rho, sigma, rule, t_end, mode, tau, 1 + 4 * track, pp,
+                                 bt, bp, bx, by, bs, stimes, samples, cnt, next_s, log_pp, ppl)
+        # budget and stalls are checked only here, when a buffer is full (or at the end):
+        # nothing in the hot loop
+        if _stalled(pp, cnt[0], stall_dt) or _stalled(bt, cnt[1], stall_dt):
+            status = STALLED
+            break
+        if status != FULL:
+            break
+        room = max_events - cnt[0] - cnt[1]
+        if room <= 0:
+            status = OVER_BUDGET
+            break
         if cnt[0] >= pp.shape[0]:
-            pp = _grow(pp)
+            limit = pp.shape[0] + room
+            pp = _grow_to(pp, limit)
             if log_pp:
-                ppl = _grow_rows(ppl)
+                ppl = _grow_rows_to(ppl, limit)
         if cnt[1] >= bt.shape[0]:
-            bt = _grow(bt)
-            bp = _grow(bp)
-            bx = _grow(bx)
-            by = _grow(by)
-            bs = _grow(bs)
-    if mode == 2:
-        t_end = stimes[ns - 1]
-    finish_at(st, ev, t_end)
+            limit = bt.shape[0] + room
+            bt = _grow_to(bt, limit)
+            bp = _grow_to(bp, limit)
+            bx = _grow_to(bx, limit)
+            by = _grow_to(by, limit)
+            bs = _grow_to(bs, limit)
+    if status == DONE:
+        if mode == 2:
+            t_end = stimes[ns - 1]
+        finish_at(st, ev, t_end)
     n_pp = cnt[0]
     n_b = cnt[1]
     # views, not copies: the buffers are at most about twice the size needed
     return (pp[:n_pp], bt[:n_b], bp[:n_b], bx[:n_b], by[:n_b], bs[:n_b], stimes, samples, t_end,
-            ppl[: n_pp if log_pp else 0])
+            ppl[: n_pp if log_pp else 0], status)
+
+
+def raise_for_status(status: int, st_time: float, n_events: int, *, max_events: int,
+                     name: str, where: str) -> None:
+    """Turn a kernel's early stop into a ValueError naming the input (no-op for `DONE`)."""
+    if status == OVER_BUDGET:
+        raise ValueError(
+            f"max_events: the run needed more than max_events={max_events} collisions "
+            f"(stopped at t = {float(st_time)!r}); a disk grazing the wall makes one collision "
+            f"every 2e-4 (1 - r) / |v|; pass a larger max_events or a shorter run"
+        )
+    if status == STALLED:
+        raise ValueError(
+            f"{name}: the run makes no progress: {STALL_EVENTS} collisions in less than "
+            f"{STALL_EVENTS} x 1e-9 (1 - r) / |v| at t = {float(st_time)!r} ({n_events} collisions "
+            f"so far; {where}); the state is stuck (e.g. disks jammed against the wall)"
+        )
 
 
 def check_two_particle_ic(ic, r: float, rule: str, name: str = "ic") -> np.ndarray:
@@ -311,11 +383,12 @@ def check_two_particle_ic(ic, r: float, rule: str, name: str = "ic") -> np.ndarr
     rho = 1.0 - r
     for i in range(2):
         chk.check_inside(name, arr[i, 0], arr[i, 1], rho, r, f"disk {i}")
-        speed = math.hypot(arr[i, 2], arr[i, 3])
         if rule == "mirror":
             chk.check_unit_speed(name, arr[i, 2], arr[i, 3], f"disk {i}")
-        elif speed == 0.0 and math.hypot(arr[1 - i, 2], arr[1 - i, 3]) == 0.0:
-            raise ValueError(f"{name}: both disks are at rest; give a non-zero velocity")
+        else:
+            chk.check_speed(name, arr[i, 2], arr[i, 3], f"disk {i}", allow_zero=True)
+    if rule != "mirror" and not arr[:, 2:].any():
+        raise ValueError(f"{name}: both disks are at rest; give a non-zero velocity")
     gap = math.hypot(arr[0, 0] - arr[1, 0], arr[0, 1] - arr[1, 1])
     if gap < 2.0 * r - chk.CONTACT_TOL:
         raise ValueError(
@@ -325,7 +398,8 @@ def check_two_particle_ic(ic, r: float, rule: str, name: str = "ic") -> np.ndarr
 
 
 def simulate_two_particle(ic, r, *, t_max=None, rule="mirror", sampling="uniform", n_steps=None,
-                          tau=None, track=0, seed=None, log_collisions=False) -> TwoParticleRun:
+                          tau=None, track=0, seed=None, max_events=None,
+                          log_collisions=False) -> TwoParticleRun:
     """Simulate two disks of radius ``r`` in the unit circular table.
 
     Event-driven and exact: the disks move freely between collisions whose times are
@@ -357,6 +431,10 @@ def simulate_two_particle(ic, r, *, t_max=None, rule="mirror", sampling="uniform
         The disk whose centre is sampled.
     seed : int, optional
         Recorded in the run's metadata (the simulation itself is deterministic).
+    max_events : int, optional
+        Stop with a ValueError after this many collisions (``>= 1``). The default is a
+        hundred times the expected number plus 10^6, at most 2e7; a run expected to need
+        more than 5e6 is refused unless ``max_events`` is given.
     log_collisions : bool
         Also log every disk-disk collision: contact centres and both velocities before
         and after (``run.pp_log``, ``run.collisions`` with the contact normal).
@@ -373,6 +451,18 @@ def simulate_two_particle(ic, r, *, t_max=None, rule="mirror", sampling="uniform
     velocity at a boundary collision (``L = x vy - y vx``); ``s`` is the polar angle of
     the contact point in ``[0, 2 pi)``. Events at exactly ``t_max`` are included.
 
+    A contact within 5e-5 rad of tangent (an exactly tangent one included) slides on
+    along the wall instead of being reflected: the disk leaves along the
+    whispering-gallery chord of angle ``2e-4`` (`kicktimes.billiard.geometry.graze`).
+    Speeds must be 1 (mirror) or 0 or in ``[1e-6, 1e6]`` (elastic); ``t_max``, ``tau`` and
+    ``n_steps * tau`` at most 1e12, ``n_steps`` at most 1e8.
+
+    Raises
+    ------
+    ValueError
+        For arguments out of range, and when the run exceeds ``max_events`` or stops
+        making progress (``10^4`` consecutive collisions at one instant).
+
     Examples
     --------
     >>> from kicktimes import simulate_two_particle, initial_conditions
@@ -387,21 +477,30 @@ def simulate_two_particle(ic, r, *, t_max=None, rule="mirror", sampling="uniform
     track = chk.check_int("track", track, low=0)
     if track > 1:
         raise ValueError(f"track must be 0 or 1, got {track}")
-    if not isinstance(log_collisions, bool | np.bool_):
-        raise TypeError(f"log_collisions must be a bool, got {type(log_collisions).__name__}")
     ic = check_two_particle_ic(ic, r, rule)
     st = np.zeros(11)
     st[1:9] = ic.ravel()
+    if not isinstance(log_collisions, bool | np.bool_):
+        raise TypeError(f"log_collisions must be a bool, got {type(log_collisions).__name__}")
     st[10] = (ic[:, 2:] ** 2).sum()
     horizon = t_max if mode < 2 else n_steps * tau
+    rho = 1.0 - r
+    # the largest speed a disk can reach: all the kinetic energy in one disk
+    speed = 1.0 if rule == "mirror" else math.sqrt(st[10])
+    max_events = chk.event_budget(max_events, horizon=horizon,
+                                  horizon_name="t_max" if mode < 2 else "n_steps * tau",
+                                  speed=speed, rho=rho, n_disks=2)
     # capacities are only a first guess: the kernel grows its buffers when needed
-    b_cap = int(3.0 * horizon) + 64
-    pp_cap = int(20.0 * r * horizon) + 16
-    pp, bt, bp, bx, by, bs, stimes, samples, t_end, ppl = simulate_two_kernel(
-        st, 1.0 - r, 2.0 * r, chk.RULES[rule], 0.0 if mode == 2 else t_max, mode,
+    b_cap = int(3.0 * speed * horizon) + 64
+    pp_cap = int(20.0 * r * speed * horizon) + 16
+    pp, bt, bp, bx, by, bs, stimes, samples, t_end, ppl, status = simulate_two_kernel(
+        st, rho, 2.0 * r, chk.RULES[rule], 0.0 if mode == 2 else t_max, mode,
         n_steps if n_steps is not None else 0, tau if tau is not None else 0.0, track,
-        pp_cap, b_cap, bool(log_collisions),
+        pp_cap, b_cap, max_events, chk.stall_time(rho, speed), bool(log_collisions),
     )
+    raise_for_status(status, st[0], pp.shape[0] + bt.shape[0], max_events=max_events, name="ic",
+                     where=f"disks at ({st[1]:.6g}, {st[2]:.6g}) and ({st[5]:.6g}, {st[6]:.6g}), "
+                           f"r={r!r}")
     return TwoParticleRun(
         r=r,
         t_max=float(t_end),

@@ -2,9 +2,10 @@ r"""Distributions that scipy.stats lacks: the two-component hyperexponential.
 
 A hyperexponential interval is exponential with rate ``lam1`` with probability ``p``
 and with rate ``lam2`` otherwise. It is what pooling Poisson processes of different
-rates gives (docs/architecture.md, "Invariant measure and the kinetic rate": under the elastic rule angular momentum splits phase space
-into components with different collision rates), and it is heavier-tailed than any
-single exponential (coefficient of variation >= 1).
+rates gives (docs/architecture.md, "Invariant measure and the kinetic rate": under the
+elastic rule angular momentum splits phase space into components with different
+collision rates), and it is heavier-tailed than any single exponential (coefficient of
+variation >= 1).
 
 The instance is named exactly like its ``.name`` (``hyperexpon``) so that a frozen
 distribution serialised as ``frozen.dist.name`` + args + kwds can be resolved by
