@@ -3,7 +3,7 @@
 A schedule is a small immutable *value* that describes a point process on ``(0, t_max]``;
 ``schedule.sample(t_max, rng)`` draws one realisation as a sorted float64 array. The
 schedules are the bridge between the statistics of disk-disk collision times and the
-perturbed one-particle billiard (design.md, "Perturbed one-particle billiard"):
+perturbed one-particle billiard (docs/architecture.md, "Perturbed one-particle billiard"):
 
 ========================  ===============================================================
 ``Poisson(rate)``         homogeneous Poisson process; ``Poisson.from_run(run)`` uses the

@@ -62,7 +62,7 @@ def test_bad_arguments_raise(kwargs, match):
 
 
 def assert_mean_count_matches_kinetic_theory(rule, r, n, t_max, seed):
-    # E[N(T)] = Gamma T exactly for ICs drawn from the invariant measure (design.md)
+    # E[N(T)] = Gamma T exactly for ICs drawn from the invariant measure (docs/architecture.md)
     ics = initial_conditions(n, r, seed=seed, method="uniform", rule=rule)
     counts = np.array([simulate_two_particle(ic, r, t_max=t_max, rule=rule).n_pp for ic in ics])
     expected = kinetic_rate(r, rule=rule) * t_max

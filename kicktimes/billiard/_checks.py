@@ -1,5 +1,5 @@
 """Argument checks shared by the billiard API: every message names the argument,
-the offending value and the valid range (design.md, "Bad input")."""
+the offending value and the valid range (docs/architecture.md, "Bad input")."""
 
 from __future__ import annotations
 

@@ -1,6 +1,6 @@
 """Collision times and reflections in the unit circular table (pure numba kernels).
 
-Conventions (design.md, "The physics, precisely"): the table has radius 1, a disk of
+Conventions (docs/architecture.md, "The physics, precisely"): the table has radius 1, a disk of
 radius ``r`` keeps its centre in ``|x| <= rho`` with ``rho = 1 - r``; two disks touch
 when their centres are ``sigma = 2 r`` apart. Every function takes plain floats and
 returns plain floats or tuples, so numba inlines them into the event loops.
@@ -38,7 +38,7 @@ def boundary_hit_time(x, y, vx, vy, rho):
 
     Solves ``|x + v t| = rho`` for the positive root,
     ``t = (-(x.v) + sqrt((x.v)^2 + |v|^2 (rho^2 - |x|^2))) / |v|^2``.
-    For unit speed this is design.md's ``t = -x.v + sqrt((x.v)^2 - |x|^2 + rho^2)``.
+    For unit speed this is ``t = -x.v + sqrt((x.v)^2 - |x|^2 + rho^2)``.
     Returns ``inf`` for a disk at rest and ``0`` for a centre that round-off has put a
     hair outside the table while it moves outward (it is reflected at once).
     """
@@ -65,7 +65,7 @@ def pair_hit_time(dx, dy, wx, wy, sigma):
     """Time until two centres ``d = x1 - x2`` apart, relative velocity ``w = v1 - v2``, touch.
 
     First contact is the smaller root of ``|d + w t| = sigma`` while approaching
-    (``d.w < 0``), in the cancellation-free form of design.md,
+    (``d.w < 0``), in the cancellation-free form
     ``t = (|d|^2 - sigma^2) / (-(d.w) + sqrt((d.w)^2 - |w|^2 (|d|^2 - sigma^2)))``.
     Returns ``inf`` if the disks separate or miss, ``0`` if round-off has made them
     overlap by a hair while approaching.

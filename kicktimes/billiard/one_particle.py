@@ -1,7 +1,7 @@
 """The randomly perturbed ("kicked") one-disk circular billiard.
 
 One disk of radius ``r`` moves in the unit table; at each kick time its velocity
-direction is changed (design.md, "Perturbed one-particle billiard"). Kicks are events of
+direction is changed (docs/architecture.md, "Perturbed one-particle billiard"). Kicks are events of
 the event loop, applied at their exact times.
 
 Ties: a kick at the same instant as a boundary collision is applied *after* the

@@ -140,7 +140,7 @@ class TwoParticleRun(_Run):
     pp_times : ndarray
         Every disk-disk collision time, increasing, in ``(0, t_max]``.
     boundary : DataFrame
-        Columns ``time, particle, s, sin_theta`` (design.md conventions), time order.
+        Columns ``time, particle, s, sin_theta`` (docs/architecture.md conventions), time order.
     sample_times, samples : ndarray, shapes (n,) and (n, 2)
         Sample times and the tracked disk's centre at them (empty without sampling).
     pp_log : ndarray, shape (n_pp, 12) or (0, 12)

@@ -403,7 +403,7 @@ def simulate_two_particle(ic, r, *, t_max=None, rule="mirror", sampling="uniform
     """Simulate two disks of radius ``r`` in the unit circular table.
 
     Event-driven and exact: the disks move freely between collisions whose times are
-    roots of quadratics (design.md); boundary collisions are specular, disk-disk
+    roots of quadratics (docs/architecture.md); boundary collisions are specular, disk-disk
     collisions follow ``rule``.
 
     Parameters
