@@ -42,8 +42,8 @@ _CELL_PAD = 1.0 + 1e-6
 _MAX_CELLS_PER_AXIS = float(2**26)
 _RADIX_BITS = 11
 
-# Modes of the pair sweep.
-_COUNT, _DEGREE, _FILL = 0, 1, 2
+# Modes of the pair sweep: count the pairs, or also collect them into a buffer.
+_COUNT, _COLLECT = 0, 1
 
 
 # --------------------------------------------------------------------------- kernels
@@ -150,7 +150,8 @@ def _visit_block(xs, ys, perm, a0, a1, b0, b1, same, eps2, w, mode, deg, cursor,
 
     ``same`` marks a block of one cell with itself: then only a < b is examined.
     Counts the unordered pairs with squared distance <= eps2 and ``|i - j| >= w``
-    (``w >= 1``), and in the other modes records them for both orders.
+    (``w >= 1``). In collect mode pair number ``k = cursor[0]`` is also written to
+    ``out_j[2k], out_j[2k + 1]`` while it fits (``cursor[0]`` keeps counting beyond).
     """
     count = 0
     for a in range(a0, a1):
@@ -166,14 +167,12 @@ def _visit_block(xs, ys, perm, a0, a1, b0, b1, same, eps2, w, mode, deg, cursor,
                 if w > 1 and abs(ia - ib) < w:
                     continue
                 count += 1
-                if mode == _DEGREE:
-                    deg[ia] += 1
-                    deg[ib] += 1
-                elif mode == _FILL:
-                    out_j[cursor[ia]] = ib
-                    cursor[ia] += 1
-                    out_j[cursor[ib]] = ia
-                    cursor[ib] += 1
+                if mode == _COLLECT:
+                    k = cursor[0]
+                    if 2 * k + 1 < out_j.shape[0]:
+                        out_j[2 * k] = ia
+                        out_j[2 * k + 1] = ib
+                    cursor[0] = k + 1
     return count
 
 
@@ -237,21 +236,45 @@ def _sweep(xs, ys, perm, cell_start, cell_key, ncx, eps2, w, mode, deg, cursor, 
 
 
 @njit(cache=True)
-def _sort_rows(offsets, out_j):
-    """Sort each row ``out_j[offsets[i]:offsets[i+1]]`` in place (rows are short)."""
-    for i in range(offsets.shape[0] - 1):
-        lo = offsets[i]
-        hi = offsets[i + 1]
-        if hi - lo > 32:
-            out_j[lo:hi] = np.sort(out_j[lo:hi])
-            continue
-        for a in range(lo + 1, hi):  # insertion sort
-            v = out_j[a]
-            b = a - 1
-            while b >= lo and out_j[b] > v:
-                out_j[b + 1] = out_j[b]
-                b -= 1
-            out_j[b + 1] = v
+def _rows_from_pairs(pairs, m, n, diagonal):
+    """Sorted rows of the symmetric matrix of ``m`` unordered pairs (+ the diagonal).
+
+    Two O(N + m) bucket passes instead of a comparison sort: the entries are first
+    bucketed by column, then, visiting the columns in increasing order, appended to their
+    rows, so every row comes out sorted. By symmetry rows and columns have the same
+    lengths, hence the same offsets.
+    """
+    deg = np.zeros(n, np.int64)
+    for k in range(m):
+        deg[pairs[2 * k]] += 1
+        deg[pairs[2 * k + 1]] += 1
+    if diagonal:
+        for i in range(n):
+            deg[i] += 1
+    offsets = np.zeros(n + 1, np.int64)
+    for i in range(n):
+        offsets[i + 1] = offsets[i] + deg[i]
+    by_col = np.empty(offsets[n], np.int64)
+    cursor = offsets[:n].copy()
+    for k in range(m):
+        a = pairs[2 * k]
+        b = pairs[2 * k + 1]
+        by_col[cursor[b]] = a
+        cursor[b] += 1
+        by_col[cursor[a]] = b
+        cursor[a] += 1
+    if diagonal:
+        for i in range(n):
+            by_col[cursor[i]] = i
+            cursor[i] += 1
+    cols = np.empty(offsets[n], np.int64)
+    cursor[:] = offsets[:n]
+    for c in range(n):
+        for e in range(offsets[c], offsets[c + 1]):
+            r = by_col[e]
+            cols[cursor[r]] = c
+            cursor[r] += 1
+    return offsets, cols
 
 
 # ------------------------------------------------------------------------- front end
@@ -454,9 +477,10 @@ def recurrence_pairs(points, eps=1e-3, *, theiler=0):
 
     Notes
     -----
-    Two sweeps of the cell list: the first counts each point's recurrences (the row
-    lengths), the second fills the rows in place, which are then sorted. Memory is
-    O(N + pairs); beware that for large ``eps`` the pair count approaches ``N^2``.
+    One sweep of the cell list collects the pairs (a second one only when they exceed a
+    buffer of a few per point), then two O(N + pairs) bucket passes put them in sorted
+    rows. Memory is O(N + pairs); beware that for large ``eps`` the pair count approaches
+    ``N^2``.
 
     Examples
     --------
@@ -482,20 +506,21 @@ def _pairs_csr(pts: np.ndarray, eps: float, w: int):
     """The recurrence plot as sorted rows: ``cols[offsets[i]:offsets[i+1]]`` are the ``j``.
 
     Both orders of every pair, and the diagonal when ``w == 0``; rows sorted increasingly.
+    One sweep collects the unordered pairs into a buffer sized for a few per point; only
+    when they do not fit (large ``eps``) is the sweep repeated with the exact size.
     """
     n = pts.shape[0]
     xs, ys, perm, cell_start, cell_key, ncx = _cells(pts, eps)
-    deg = np.zeros(n, np.int64) if w > 0 else np.ones(n, np.int64)
-    _sweep(
-        xs, ys, perm, cell_start, cell_key, ncx, eps * eps, max(w, 1), _DEGREE, deg, _EMPTY, _EMPTY
-    )
-    offsets = np.zeros(n + 1, np.int64)
-    np.cumsum(deg, out=offsets[1:])
-    out_j = np.empty(offsets[-1], np.int64)
-    cursor = offsets[:-1].copy()
-    if w == 0:
-        out_j[cursor] = np.arange(n)
-        cursor += 1
-    _sweep(xs, ys, perm, cell_start, cell_key, ncx, eps * eps, max(w, 1), _FILL, deg, cursor, out_j)
-    _sort_rows(offsets, out_j)
-    return offsets, out_j
+    cap = 4 * n + 1024
+    while True:
+        buf = np.empty(2 * cap, np.int64)
+        count = np.zeros(1, np.int64)
+        _sweep(
+            xs, ys, perm, cell_start, cell_key, ncx, eps * eps, max(w, 1), _COLLECT, _EMPTY,
+            count, buf,
+        )
+        m = int(count[0])
+        if m <= cap:
+            break
+        cap = m
+    return _rows_from_pairs(buf, m, n, w == 0)

@@ -71,6 +71,22 @@ def _line_histograms(offsets, cols, n, w):
     return diag, vert
 
 
+@njit(cache=True)
+def _line_sums(hist, l_min):
+    """(number of lines of length >= l_min, entries on them, longest line) of a histogram."""
+    lines = 0
+    on = 0
+    longest = 0
+    for length in range(1, hist.shape[0]):
+        c = hist[length]
+        if c:
+            longest = length
+            if length >= l_min:
+                lines += c
+                on += c * length
+    return lines, on, longest
+
+
 @dataclass(frozen=True)
 class RQAResult:
     """Recurrence quantification measures of one point set (see `rqa` for the definitions).
@@ -217,21 +233,14 @@ def rqa(points, eps=1e-3, *, theiler=1, l_min=2):
     # Python ints from here on: exact counts, correctly rounded ratios
     n_rec = int(cols.shape[0])
     n_adm = n * n if w == 0 else (n - w) * (n - w + 1)
-    lengths = np.arange(n + 1, dtype=np.int64)
-    long_d = lengths >= l_min
-    lines = 2 * int(diag_up[long_d].sum())
-    on_lines = 2 * int((lengths * diag_up)[long_d].sum())
-    nz = np.flatnonzero(diag_up)
-    l_max = int(nz[-1]) if nz.size else 0
+    lines, on_lines, l_max = (int(v) for v in _line_sums(diag_up, l_min))
+    lines, on_lines = 2 * lines, 2 * on_lines  # the mirror image below the diagonal
     if w == 0:  # the main diagonal: one line of length N
         l_max = n
         if n >= l_min:
             lines += 1
             on_lines += n
-    v_lines = int(vert[long_d].sum())
-    on_v_lines = int((lengths * vert)[long_d].sum())
-    nzv = np.flatnonzero(vert)
-    v_max = int(nzv[-1]) if nzv.size else 0
+    v_lines, on_v_lines, v_max = (int(v) for v in _line_sums(vert, l_min))
 
     undefined = {}
     if n_rec == 0:
