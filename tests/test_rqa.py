@@ -61,6 +61,14 @@ def brute_rqa(points: np.ndarray, eps: float, theiler: int, l_min: int) -> dict:
 def assert_matches_brute_force(points, eps, theiler, l_min):
     res = rqa(points, eps, theiler=theiler, l_min=l_min)
     ref = brute_rqa(np.asarray(points, dtype=float), eps, theiler, l_min)
+    # without laminarity only the upper triangle is built: the same diagonal measures
+    half = rqa(points, eps, theiler=theiler, l_min=l_min, laminarity=False)
+    assert half.lam is None and half.tt is None and half.v_max is None
+    full, part = res.to_dict(), half.to_dict()
+    for key in set(full) - {"lam", "tt", "v_max", "undefined"}:
+        np.testing.assert_equal(part[key], full[key], err_msg=key)  # NaN equals NaN here
+    diagonal_reasons = {k: v for k, v in full["undefined"].items() if k not in ("lam", "tt")}
+    assert part["undefined"] == diagonal_reasons
     for key, value in ref.items():
         got = getattr(res, key)
         if isinstance(value, float) and np.isnan(value):
@@ -219,6 +227,7 @@ def test_theiler_window_removes_the_lines_along_the_trajectory():
         ({"theiler": -1}, ValueError, "theiler"),
         ({"eps": 0.0}, ValueError, "eps"),
         ({"eps": np.nan}, ValueError, "eps"),
+        ({"laminarity": 1}, TypeError, "laminarity"),
     ],
 )
 def test_bad_arguments_raise(kwargs, error, match):

