@@ -42,8 +42,9 @@ _CELL_PAD = 1.0 + 1e-6
 _MAX_CELLS_PER_AXIS = float(2**26)
 _RADIX_BITS = 11
 
-# Modes of the pair sweep: count the pairs, or also collect them into a buffer.
-_COUNT, _COLLECT = 0, 1
+# Modes of the pair sweep: count the pairs; also collect them into a buffer; also count
+# the diagonal lines (and the vertical lines) that start at them (see `_visit_block`).
+_COUNT, _COLLECT, _LINES, _LINES_V = 0, 1, 2, 3
 
 
 # --------------------------------------------------------------------------- kernels
@@ -145,15 +146,47 @@ def _build_cells(points, xmin, ymin, inv_h, ncx, n_bits):
 
 
 @njit(cache=True, inline="always")
-def _visit_block(xs, ys, perm, a0, a1, b0, b1, same, eps2, w, mode, deg, cursor, out_j):
+def _recurrent(pts, i, j, eps2):
+    """The recurrence test of the sweep for original indices ``i, j`` (same float values)."""
+    dx = pts[i, 0] - pts[j, 0]
+    dy = pts[i, 1] - pts[j, 1]
+    return dx * dx + dy * dy <= eps2
+
+
+@njit(cache=True)
+def _vertical_line(pts, a, b, eps2, wv, hist_v):
+    """If entry (a, b) (row a, column b) starts a vertical line, add its length to hist_v.
+
+    A line is a maximal run of recurrent admissible entries ``(a + k, b)``; an entry
+    inside the Theiler band ``|i - j| < wv`` is not admissible and ends a run.
+    """
+    n = pts.shape[0]
+    if a > 0 and abs(a - 1 - b) >= wv and _recurrent(pts, a - 1, b, eps2):
+        return
+    length = 1
+    while a + length < n and abs(a + length - b) >= wv and _recurrent(pts, a + length, b, eps2):
+        length += 1
+    hist_v[length] += 1
+
+
+@njit(cache=True, inline="always")
+def _visit_block(
+    xs, ys, perm, a0, a1, b0, b1, same, eps2, w, mode, pts, wv, count, buf, hist_d, hist_v
+):
     """Examine the pairs (a in [a0, a1), b in [b0, b1)) of sorted positions.
 
     ``same`` marks a block of one cell with itself: then only a < b is examined.
     Counts the unordered pairs with squared distance <= eps2 and ``|i - j| >= w``
-    (``w >= 1``). In collect mode pair number ``k = cursor[0]`` is also written to
-    ``out_j[2k], out_j[2k + 1]`` while it fits (``cursor[0]`` keeps counting beyond).
+    (``w >= 1``). In collect mode pair number ``k = count[0]`` is also written to
+    ``buf[2k], buf[2k + 1]`` while it fits (``count[0]`` keeps counting beyond).
+
+    In the line modes a pair ``i < j`` that starts a diagonal line (``(i - 1, j - 1)``
+    not recurrent) walks it, ``(i + k, j + k)``, and adds its length to ``hist_d``: every
+    line of the upper triangle is counted once, at its start, with O(1) work per
+    recurrent pair and no pair stored. `_LINES_V` also counts the vertical lines
+    starting at the entries ``(i, j)`` and ``(j, i)`` (window ``wv``, the true one).
     """
-    count = 0
+    total = 0
     for a in range(a0, a1):
         xa = xs[a]
         ya = ys[a]
@@ -166,18 +199,33 @@ def _visit_block(xs, ys, perm, a0, a1, b0, b1, same, eps2, w, mode, deg, cursor,
                 ib = perm[b]
                 if w > 1 and abs(ia - ib) < w:
                     continue
-                count += 1
+                total += 1
                 if mode == _COLLECT:
-                    k = cursor[0]
-                    if 2 * k + 1 < out_j.shape[0]:
-                        out_j[2 * k] = ia
-                        out_j[2 * k + 1] = ib
-                    cursor[0] = k + 1
-    return count
+                    k = count[0]
+                    if 2 * k + 1 < buf.shape[0]:
+                        buf[2 * k] = ia
+                        buf[2 * k + 1] = ib
+                    count[0] = k + 1
+                elif mode >= _LINES:
+                    i = min(ia, ib)
+                    j = max(ia, ib)
+                    if i == 0 or not _recurrent(pts, i - 1, j - 1, eps2):
+                        length = 1
+                        while j + length < pts.shape[0] and _recurrent(
+                            pts, i + length, j + length, eps2
+                        ):
+                            length += 1
+                        hist_d[length] += 1
+                    if mode == _LINES_V:
+                        _vertical_line(pts, i, j, eps2, wv, hist_v)
+                        _vertical_line(pts, j, i, eps2, wv, hist_v)
+    return total
 
 
 @njit(cache=True)
-def _sweep(xs, ys, perm, cell_start, cell_key, ncx, eps2, w, mode, deg, cursor, out_j):
+def _sweep(
+    xs, ys, perm, cell_start, cell_key, ncx, eps2, w, mode, pts, wv, count, buf, hist_d, hist_v
+):
     """Visit every unordered pair of distinct points in the same or adjacent cells once.
 
     Half stencil: a cell is paired with itself, with ``(cx+1, cy)`` and with the three
@@ -191,7 +239,9 @@ def _sweep(xs, ys, perm, cell_start, cell_key, ncx, eps2, w, mode, deg, cursor, 
         key = cell_key[c]
         s0 = cell_start[c]
         s1 = cell_start[c + 1]
-        total += _visit_block(xs, ys, perm, s0, s1, s0, s1, True, eps2, w, mode, deg, cursor, out_j)
+        total += _visit_block(
+            xs, ys, perm, s0, s1, s0, s1, True, eps2, w, mode, pts, wv, count, buf, hist_d, hist_v
+        )
         if c + 1 < n_cells and cell_key[c + 1] == key + 1:
             total += _visit_block(
                 xs,
@@ -205,9 +255,12 @@ def _sweep(xs, ys, perm, cell_start, cell_key, ncx, eps2, w, mode, deg, cursor, 
                 eps2,
                 w,
                 mode,
-                deg,
-                cursor,
-                out_j,
+                pts,
+                wv,
+                count,
+                buf,
+                hist_d,
+                hist_v,
             )
         lo = key + ncx - 1
         hi = key + ncx + 1
@@ -227,9 +280,12 @@ def _sweep(xs, ys, perm, cell_start, cell_key, ncx, eps2, w, mode, deg, cursor, 
                 eps2,
                 w,
                 mode,
-                deg,
-                cursor,
-                out_j,
+                pts,
+                wv,
+                count,
+                buf,
+                hist_d,
+                hist_v,
             )
             r += 1
     return total
@@ -271,42 +327,6 @@ def _rows_from_pairs(pairs, m, n, diagonal):
     cursor[:] = offsets[:n]
     for c in range(n):
         for e in range(offsets[c], offsets[c + 1]):
-            r = by_col[e]
-            cols[cursor[r]] = c
-            cursor[r] += 1
-    return offsets, cols
-
-
-@njit(cache=True)
-def _upper_rows_from_pairs(pairs, m, n):
-    """Sorted rows of the upper triangle: row ``min(a, b)`` holds ``max(a, b)``.
-
-    Half the entries of `_rows_from_pairs`, for callers that need one triangle only.
-    """
-    row_len = np.zeros(n, np.int64)
-    col_len = np.zeros(n, np.int64)
-    for k in range(m):
-        a = pairs[2 * k]
-        b = pairs[2 * k + 1]
-        row_len[min(a, b)] += 1
-        col_len[max(a, b)] += 1
-    offsets = np.zeros(n + 1, np.int64)
-    col_off = np.zeros(n + 1, np.int64)
-    for i in range(n):
-        offsets[i + 1] = offsets[i] + row_len[i]
-        col_off[i + 1] = col_off[i] + col_len[i]
-    by_col = np.empty(m, np.int64)
-    cursor = col_off[:n].copy()
-    for k in range(m):
-        a = pairs[2 * k]
-        b = pairs[2 * k + 1]
-        hi = max(a, b)
-        by_col[cursor[hi]] = min(a, b)
-        cursor[hi] += 1
-    cols = np.empty(m, np.int64)
-    cursor[:] = offsets[:n]
-    for c in range(n):
-        for e in range(col_off[c], col_off[c + 1]):
             r = by_col[e]
             cols[cursor[r]] = c
             cursor[r] += 1
@@ -382,6 +402,8 @@ def _cells(pts: np.ndarray, eps: float):
 
 
 _EMPTY = np.empty(0, np.int64)
+# pts, wv, count, buf, hist_d, hist_v of a sweep that only counts
+_NO_OUTPUT = (np.empty((0, 2)), 0, _EMPTY, _EMPTY, _EMPTY, _EMPTY)
 
 
 def recurrence_rate(points, eps=1e-3, *, theiler=0):
@@ -463,18 +485,7 @@ def _recurrence_rate_one(pts: np.ndarray, eps: float, w: int) -> float:
     n = pts.shape[0]
     xs, ys, perm, cell_start, cell_key, ncx = _cells(pts, eps)
     pairs = _sweep(
-        xs,
-        ys,
-        perm,
-        cell_start,
-        cell_key,
-        ncx,
-        eps * eps,
-        max(w, 1),
-        _COUNT,
-        _EMPTY,
-        _EMPTY,
-        _EMPTY,
+        xs, ys, perm, cell_start, cell_key, ncx, eps * eps, max(w, 1), _COUNT, *_NO_OUTPUT
     )
     if w == 0:
         # Python ints: N^2 overflows nothing, and the division is correctly rounded
@@ -538,11 +549,10 @@ def recurrence_pairs(points, eps=1e-3, *, theiler=0):
     return out_i, out_j
 
 
-def _pairs_csr(pts: np.ndarray, eps: float, w: int, upper: bool = False):
+def _pairs_csr(pts: np.ndarray, eps: float, w: int):
     """The recurrence plot as sorted rows: ``cols[offsets[i]:offsets[i+1]]`` are the ``j``.
 
     Both orders of every pair, and the diagonal when ``w == 0``; rows sorted increasingly.
-    With ``upper`` only the entries ``j > i`` (never the diagonal).
     One sweep collects the unordered pairs into a buffer sized for a few per point; only
     when they do not fit (large ``eps``) is the sweep repeated with the exact size.
     """
@@ -553,13 +563,66 @@ def _pairs_csr(pts: np.ndarray, eps: float, w: int, upper: bool = False):
         buf = np.empty(2 * cap, np.int64)
         count = np.zeros(1, np.int64)
         _sweep(
-            xs, ys, perm, cell_start, cell_key, ncx, eps * eps, max(w, 1), _COLLECT, _EMPTY,
-            count, buf,
+            xs,
+            ys,
+            perm,
+            cell_start,
+            cell_key,
+            ncx,
+            eps * eps,
+            max(w, 1),
+            _COLLECT,
+            _NO_OUTPUT[0],
+            0,
+            count,
+            buf,
+            _EMPTY,
+            _EMPTY,
         )
         m = int(count[0])
         if m <= cap:
             break
         cap = m
-    if upper:
-        return _upper_rows_from_pairs(buf, m, n)
     return _rows_from_pairs(buf, m, n, w == 0)
+
+
+@njit(cache=True)
+def _diagonal_vertical_lines(pts, eps2, hist_v):
+    """Vertical lines starting on the main diagonal (``w = 0``: entries ``(i, i)``)."""
+    for i in range(pts.shape[0]):
+        _vertical_line(pts, i, i, eps2, 0, hist_v)
+
+
+def _line_histograms(pts: np.ndarray, eps: float, w: int, vertical: bool):
+    """(pairs, diag, vert): recurrent unordered pairs ``i != j`` outside the window, and
+    histograms of line lengths, in one sweep and O(N) memory.
+
+    ``diag[l]`` counts the diagonal lines of length ``l`` in the upper triangle (the main
+    diagonal is left to the caller); ``vert[v]`` the vertical lines of the whole matrix
+    (all zero unless ``vertical``), both over the admissible entries ``|i - j| >= w``.
+    """
+    n = pts.shape[0]
+    xs, ys, perm, cell_start, cell_key, ncx = _cells(pts, eps)
+    diag = np.zeros(n + 1, np.int64)
+    vert = np.zeros(n + 1, np.int64)
+    mode = _LINES_V if vertical else _LINES
+    pairs = _sweep(
+        xs,
+        ys,
+        perm,
+        cell_start,
+        cell_key,
+        ncx,
+        eps * eps,
+        max(w, 1),
+        mode,
+        pts,
+        w,
+        _EMPTY,
+        _EMPTY,
+        diag,
+        vert,
+    )
+    if vertical and w == 0:
+        _diagonal_vertical_lines(pts, eps * eps, vert)
+    return int(pairs), diag, vert

@@ -1,20 +1,21 @@
-"""Recurrence quantification analysis (RQA) without an N x N matrix.
+"""Recurrence quantification analysis (RQA) without an N x N matrix and without the pairs.
 
 The recurrence matrix ``R_ij = Theta(eps - |x_i - x_j|)`` of N planar points is symmetric.
-Its recurrent entries are found by the cell-list pair enumeration of
-`kicktimes.diagnostics.recurrence` and kept as sorted rows (compressed sparse rows, both
-orders of every pair); the line statistics are then read off those rows in one pass:
+Its recurrent pairs are enumerated once by the cell-list sweep of
+`kicktimes.diagnostics.recurrence`, and the line statistics are counted on the fly:
 
 * a **diagonal line** is a maximal run of recurrent entries ``(i + k, j + k)``,
-  ``k = 0..l-1``, along one diagonal ``j - i = d``; the run continues from row ``i`` to
-  row ``i + 1`` when ``j + 1`` is in row ``i + 1`` (a two-pointer merge of the two sorted
-  rows), so each line's length is carried forward and counted where it ends;
-* a **vertical line** is a maximal run of recurrent entries ``(i + k, j)`` in one
-  column; by symmetry column ``j`` equals row ``j``, so these are runs of consecutive
-  column indices within a sorted row.
+  ``k = 0..l-1``, on one diagonal ``j - i = d``. When the sweep meets a pair ``i < j``
+  whose predecessor ``(i - 1, j - 1)`` is not recurrent, the pair starts a line: the
+  line is walked, ``(i + 1, j + 1), (i + 2, j + 2), ...``, testing distances directly,
+  and its length goes into a histogram. Every line is counted once, at its start;
+* a **vertical line** is a maximal run ``(i + k, j)`` in one column, counted the same
+  way from the entries ``(i, j)`` and ``(j, i)`` of each pair.
 
-Memory is O(N) plus two integers per recurrent entry; time O(N + candidate pairs +
-recurrent entries). See `rqa` for the exact conventions, and docs/diagnostics.md.
+The distance test is the sweep's float expression, so the result equals the
+brute-force matrix computation exactly. Memory is O(N) (two histograms; no pair is
+stored); time O(N + candidate pairs + recurrent pairs). See `rqa` and
+docs/diagnostics.md.
 """
 
 from __future__ import annotations
@@ -25,51 +26,14 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 from numba import njit
 
-from kicktimes.diagnostics.recurrence import _as_points, _check_eps, _check_theiler, _pairs_csr
+from kicktimes.diagnostics.recurrence import (
+    _as_points,
+    _check_eps,
+    _check_theiler,
+    _line_histograms,
+)
 
 __all__ = ["RQAResult", "rqa"]
-
-
-@njit(cache=True)
-def _line_histograms(offsets, cols, n, w, vertical):
-    """Histograms of line lengths from the sorted rows of a symmetric recurrence matrix.
-
-    Returns ``(diag, vert)``: ``diag[l]`` counts the diagonal lines of length ``l`` in the
-    upper triangle, on diagonals ``j - i >= max(w, 1)`` (the main diagonal is left to the
-    caller); ``vert[v]`` counts the vertical lines of length ``v`` of the whole matrix
-    (every column, admissible entries only: the rows hold no entry with ``|i - j| < w``,
-    so the Theiler band breaks the runs by itself). ``vertical=False`` skips ``vert``
-    (left zero), and then the rows may hold the upper triangle only.
-    """
-    dmin = max(w, 1)
-    diag = np.zeros(n + 1, np.int64)
-    vert = np.zeros(n + 1, np.int64)
-    # length of the diagonal line ending at each entry, propagated to (i + 1, j + 1)
-    run = np.ones(cols.shape[0], np.int64)
-    for i in range(n):
-        lo = offsets[i]
-        hi = offsets[i + 1]
-        a = lo if vertical else hi
-        while a < hi:  # runs of consecutive columns in row i = vertical lines of column i
-            b = a + 1
-            while b < hi and cols[b] == cols[b - 1] + 1:
-                b += 1
-            vert[b - a] += 1
-            a = b
-        a = lo
-        while a < hi and cols[a] < i + dmin:
-            a += 1
-        p = hi  # start of row i + 1
-        p_hi = offsets[i + 2] if i + 1 < n else hi
-        for e in range(a, hi):
-            target = cols[e] + 1
-            while p < p_hi and cols[p] < target:
-                p += 1
-            if p < p_hi and cols[p] == target:
-                run[p] = run[e] + 1
-            else:
-                diag[run[e]] += 1
-    return diag, vert
 
 
 @njit(cache=True)
@@ -161,8 +125,8 @@ def rqa(points, eps=1e-3, *, theiler=1, l_min=2, laminarity=True):
     l_min : int, default 2
         Minimal length of a diagonal (and of a vertical) line, ``>= 1``.
     laminarity : bool, default True
-        Also compute ``lam``, ``tt``, ``v_max`` (they need both triangles of the matrix;
-        without them about half the memory and 30 % less time; the fields are ``None``).
+        Also compute ``lam``, ``tt``, ``v_max`` (two more distance tests per recurrent
+        pair; with ``False`` the fields are ``None``).
 
     Returns
     -------
@@ -208,8 +172,11 @@ def rqa(points, eps=1e-3, *, theiler=1, l_min=2, laminarity=True):
     recurrent diagonal neighbour; ``DET`` and ``LAM`` are NaN when ``R = 0``, ``L`` and
     ``TT`` when no line reaches ``l_min``; ``l_max`` and ``v_max`` are 0 when ``R = 0``.
 
-    Cost: O(N) memory plus 16 bytes per recurrent entry (the sorted rows and a run
-    length), never an ``N x N`` matrix; time O(N + candidate pairs + recurrent entries).
+    Cost: one sweep of the cell list of `recurrence_rate`; each recurrent pair adds one
+    distance test for its diagonal predecessor (two more for the vertical ones) and each
+    line is walked once. O(N) memory (no pair is stored, never an ``N x N`` matrix);
+    about 1.1x the time of `recurrence_rate` at eps = 1e-3 and 1.3-1.9x at 1e-2 for
+    N = 25 000 (benchmarks/bench_recurrence.py).
 
     References
     ----------
@@ -234,13 +201,10 @@ def rqa(points, eps=1e-3, *, theiler=1, l_min=2, laminarity=True):
     l_min = _check_l_min(l_min)
     if not isinstance(laminarity, bool):
         raise TypeError(f"laminarity: expected True or False, got {laminarity!r}")
-    offsets, cols = _pairs_csr(pts, eps, w, upper=not laminarity)
-    diag_up, vert = _line_histograms(offsets, cols, n, w, laminarity)
+    pairs, diag_up, vert = _line_histograms(pts, eps, w, laminarity)
 
     # Python ints from here on: exact counts, correctly rounded ratios
-    n_rec = int(cols.shape[0])
-    if not laminarity:  # the upper triangle only: mirror it, add the diagonal
-        n_rec = 2 * n_rec + (n if w == 0 else 0)
+    n_rec = 2 * pairs + (n if w == 0 else 0)
     n_adm = n * n if w == 0 else (n - w) * (n - w + 1)
     lines, on_lines, l_max = (int(v) for v in _line_sums(diag_up, l_min))
     lines, on_lines = 2 * lines, 2 * on_lines  # the mirror image below the diagonal
