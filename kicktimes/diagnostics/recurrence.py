@@ -171,7 +171,7 @@ def _vertical_line(pts, a, b, eps2, wv, hist_v):
 
 @njit(cache=True, inline="always")
 def _visit_block(
-    xs, ys, perm, a0, a1, b0, b1, same, eps2, w, mode, pts, wv, count, buf, hist_d, hist_v
+    xs, ys, perm, a0, a1, b0, b1, same, eps2, w, mode, pts, nb, wv, count, buf, hist_d, hist_v
 ):
     """Examine the pairs (a in [a0, a1), b in [b0, b1)) of sorted positions.
 
@@ -183,8 +183,10 @@ def _visit_block(
     In the line modes a pair ``i < j`` that starts a diagonal line (``(i - 1, j - 1)``
     not recurrent) walks it, ``(i + k, j + k)``, and adds its length to ``hist_d``: every
     line of the upper triangle is counted once, at its start, with O(1) work per
-    recurrent pair and no pair stored. `_LINES_V` also counts the vertical lines
-    starting at the entries ``(i, j)`` and ``(j, i)`` (window ``wv``, the true one).
+    recurrent pair and no pair stored. The first two tests read ``nb`` (the time
+    neighbours of each sorted position), the rest of a walk reads ``pts``. `_LINES_V`
+    also counts the vertical lines starting at the entries ``(i, j)`` and ``(j, i)``
+    (window ``wv``, the true one).
     """
     total = 0
     for a in range(a0, a1):
@@ -207,24 +209,32 @@ def _visit_block(
                         buf[2 * k + 1] = ib
                     count[0] = k + 1
                 elif mode >= _LINES:
-                    i = min(ia, ib)
-                    j = max(ia, ib)
-                    if i == 0 or not _recurrent(pts, i - 1, j - 1, eps2):
+                    # predecessor (i - 1, j - 1) and successor (i + 1, j + 1) from the
+                    # neighbours gathered in sorted order: no cache miss for most pairs
+                    px = nb[a, 0] - nb[b, 0]
+                    py = nb[a, 1] - nb[b, 1]
+                    if not (px * px + py * py <= eps2):  # NaN (no predecessor): a start
+                        sx = nb[a, 2] - nb[b, 2]
+                        sy = nb[a, 3] - nb[b, 3]
                         length = 1
-                        while j + length < pts.shape[0] and _recurrent(
-                            pts, i + length, j + length, eps2
-                        ):
-                            length += 1
+                        if sx * sx + sy * sy <= eps2:
+                            i = min(ia, ib)
+                            j = max(ia, ib)
+                            length = 2
+                            while j + length < pts.shape[0] and _recurrent(
+                                pts, i + length, j + length, eps2
+                            ):
+                                length += 1
                         hist_d[length] += 1
                     if mode == _LINES_V:
-                        _vertical_line(pts, i, j, eps2, wv, hist_v)
-                        _vertical_line(pts, j, i, eps2, wv, hist_v)
+                        _vertical_line(pts, ia, ib, eps2, wv, hist_v)
+                        _vertical_line(pts, ib, ia, eps2, wv, hist_v)
     return total
 
 
 @njit(cache=True)
 def _sweep(
-    xs, ys, perm, cell_start, cell_key, ncx, eps2, w, mode, pts, wv, count, buf, hist_d, hist_v
+    xs, ys, perm, cell_start, cell_key, ncx, eps2, w, mode, pts, nb, wv, count, buf, hist_d, hist_v
 ):
     """Visit every unordered pair of distinct points in the same or adjacent cells once.
 
@@ -240,7 +250,24 @@ def _sweep(
         s0 = cell_start[c]
         s1 = cell_start[c + 1]
         total += _visit_block(
-            xs, ys, perm, s0, s1, s0, s1, True, eps2, w, mode, pts, wv, count, buf, hist_d, hist_v
+            xs,
+            ys,
+            perm,
+            s0,
+            s1,
+            s0,
+            s1,
+            True,
+            eps2,
+            w,
+            mode,
+            pts,
+            nb,
+            wv,
+            count,
+            buf,
+            hist_d,
+            hist_v,
         )
         if c + 1 < n_cells and cell_key[c + 1] == key + 1:
             total += _visit_block(
@@ -256,6 +283,7 @@ def _sweep(
                 w,
                 mode,
                 pts,
+                nb,
                 wv,
                 count,
                 buf,
@@ -281,6 +309,7 @@ def _sweep(
                 w,
                 mode,
                 pts,
+                nb,
                 wv,
                 count,
                 buf,
@@ -402,8 +431,8 @@ def _cells(pts: np.ndarray, eps: float):
 
 
 _EMPTY = np.empty(0, np.int64)
-# pts, wv, count, buf, hist_d, hist_v of a sweep that only counts
-_NO_OUTPUT = (np.empty((0, 2)), 0, _EMPTY, _EMPTY, _EMPTY, _EMPTY)
+# pts, nb, wv, count, buf, hist_d, hist_v of a sweep that only counts
+_NO_OUTPUT = (np.empty((0, 2)), np.empty((0, 4)), 0, _EMPTY, _EMPTY, _EMPTY, _EMPTY)
 
 
 def recurrence_rate(points, eps=1e-3, *, theiler=0):
@@ -573,6 +602,7 @@ def _pairs_csr(pts: np.ndarray, eps: float, w: int):
             max(w, 1),
             _COLLECT,
             _NO_OUTPUT[0],
+            _NO_OUTPUT[1],
             0,
             count,
             buf,
@@ -584,6 +614,32 @@ def _pairs_csr(pts: np.ndarray, eps: float, w: int):
             break
         cap = m
     return _rows_from_pairs(buf, m, n, w == 0)
+
+
+@njit(cache=True)
+def _time_neighbours(pts, perm):
+    """Row ``a``: the samples before and after ``perm[a]`` in time, NaN beyond the ends.
+
+    ``(x_prev, y_prev, x_next, y_next)`` in sorted (cell) order, so that the line test of
+    a pair reads them next to the pair's own coordinates.
+    """
+    n = pts.shape[0]
+    nb = np.empty((n, 4))
+    for a in range(n):
+        i = perm[a]
+        if i > 0:
+            nb[a, 0] = pts[i - 1, 0]
+            nb[a, 1] = pts[i - 1, 1]
+        else:
+            nb[a, 0] = np.nan
+            nb[a, 1] = np.nan
+        if i + 1 < n:
+            nb[a, 2] = pts[i + 1, 0]
+            nb[a, 3] = pts[i + 1, 1]
+        else:
+            nb[a, 2] = np.nan
+            nb[a, 3] = np.nan
+    return nb
 
 
 @njit(cache=True)
@@ -606,6 +662,7 @@ def _line_histograms(pts: np.ndarray, eps: float, w: int, vertical: bool):
     diag = np.zeros(n + 1, np.int64)
     vert = np.zeros(n + 1, np.int64)
     mode = _LINES_V if vertical else _LINES
+    nb = _time_neighbours(pts, perm)
     pairs = _sweep(
         xs,
         ys,
@@ -617,6 +674,7 @@ def _line_histograms(pts: np.ndarray, eps: float, w: int, vertical: bool):
         max(w, 1),
         mode,
         pts,
+        nb,
         w,
         _EMPTY,
         _EMPTY,
