@@ -110,13 +110,17 @@ def _radix_argsort(keys, n_bits):
 
 
 @njit(cache=True)
-def _build_cells(points, xmin, ymin, inv_h, ncx, n_bits):
+def _build_cells(points, xmin, ymin, inv_h, ncx, n_bits, neighbours):
     """Sort the points by cell; return sorted coordinates, permutation and cell table.
 
     Cell ``(cx, cy)`` (1-based, so that the neighbour ``cx +- 1`` of a border cell is an
     empty padding column and never aliases the next row) has key ``cy * ncx + cx``.
-    Returns ``xs, ys, perm, cell_start, cell_key`` with the points of cell ``c`` at
+    Returns ``xs, ys, perm, cell_start, cell_key, nb`` with the points of cell ``c`` at
     sorted positions ``cell_start[c] : cell_start[c + 1]`` and original indices ``perm``.
+    With ``neighbours``, row ``a`` of ``nb`` holds the samples before and after
+    ``perm[a]`` in time, ``(x_prev, y_prev, x_next, y_next)`` (NaN beyond the ends), so
+    that the line tests of a pair read them next to the pair's own coordinates; they are
+    gathered in the same loop as the coordinates, where they share its cache lines.
     """
     n = points.shape[0]
     keys = np.empty(n, np.int64)
@@ -127,10 +131,19 @@ def _build_cells(points, xmin, ymin, inv_h, ncx, n_bits):
     perm, skeys = _radix_argsort(keys, n_bits)
     xs = np.empty(n)
     ys = np.empty(n)
+    nb = np.full((n if neighbours else 0, 4), np.nan)
     n_cells = 0
     for a in range(n):
-        xs[a] = points[perm[a], 0]
-        ys[a] = points[perm[a], 1]
+        i = perm[a]
+        xs[a] = points[i, 0]
+        ys[a] = points[i, 1]
+        if neighbours:
+            if i > 0:
+                nb[a, 0] = points[i - 1, 0]
+                nb[a, 1] = points[i - 1, 1]
+            if i + 1 < n:
+                nb[a, 2] = points[i + 1, 0]
+                nb[a, 3] = points[i + 1, 1]
         if a == 0 or skeys[a] != skeys[a - 1]:
             n_cells += 1
     cell_start = np.empty(n_cells + 1, np.int64)
@@ -142,7 +155,7 @@ def _build_cells(points, xmin, ymin, inv_h, ncx, n_bits):
             cell_key[c] = skeys[a]
             c += 1
     cell_start[n_cells] = n
-    return xs, ys, perm, cell_start, cell_key
+    return xs, ys, perm, cell_start, cell_key, nb
 
 
 @njit(cache=True, inline="always")
@@ -413,7 +426,7 @@ def _check_theiler(theiler, n: int) -> int:
     return theiler
 
 
-def _cells(pts: np.ndarray, eps: float):
+def _cells(pts: np.ndarray, eps: float, neighbours: bool = False):
     xmin, xmax, ymin, ymax, finite = _bounding_box(pts)
     if not finite:
         bad = np.flatnonzero(~np.isfinite(pts).all(axis=1))
@@ -427,7 +440,10 @@ def _cells(pts: np.ndarray, eps: float):
     ncx = int(np.floor((xmax - xmin) * inv_h)) + 3  # 1-based columns plus padding
     ncy = int(np.floor((ymax - ymin) * inv_h)) + 3
     n_bits = max(1, int(ncx * ncy - 1).bit_length())
-    return (*_build_cells(pts, xmin, ymin, inv_h, ncx, n_bits), ncx)
+    xs, ys, perm, cell_start, cell_key, nb = _build_cells(
+        pts, xmin, ymin, inv_h, ncx, n_bits, neighbours
+    )
+    return xs, ys, perm, cell_start, cell_key, ncx, nb
 
 
 _EMPTY = np.empty(0, np.int64)
@@ -512,7 +528,7 @@ def recurrence_rate(points, eps=1e-3, *, theiler=0):
 
 def _recurrence_rate_one(pts: np.ndarray, eps: float, w: int) -> float:
     n = pts.shape[0]
-    xs, ys, perm, cell_start, cell_key, ncx = _cells(pts, eps)
+    xs, ys, perm, cell_start, cell_key, ncx, _ = _cells(pts, eps)
     pairs = _sweep(
         xs, ys, perm, cell_start, cell_key, ncx, eps * eps, max(w, 1), _COUNT, *_NO_OUTPUT
     )
@@ -586,7 +602,7 @@ def _pairs_csr(pts: np.ndarray, eps: float, w: int):
     when they do not fit (large ``eps``) is the sweep repeated with the exact size.
     """
     n = pts.shape[0]
-    xs, ys, perm, cell_start, cell_key, ncx = _cells(pts, eps)
+    xs, ys, perm, cell_start, cell_key, ncx, _ = _cells(pts, eps)
     cap = 4 * n + 1024
     while True:
         buf = np.empty(2 * cap, np.int64)
@@ -617,32 +633,6 @@ def _pairs_csr(pts: np.ndarray, eps: float, w: int):
 
 
 @njit(cache=True)
-def _time_neighbours(pts, perm):
-    """Row ``a``: the samples before and after ``perm[a]`` in time, NaN beyond the ends.
-
-    ``(x_prev, y_prev, x_next, y_next)`` in sorted (cell) order, so that the line test of
-    a pair reads them next to the pair's own coordinates.
-    """
-    n = pts.shape[0]
-    nb = np.empty((n, 4))
-    for a in range(n):
-        i = perm[a]
-        if i > 0:
-            nb[a, 0] = pts[i - 1, 0]
-            nb[a, 1] = pts[i - 1, 1]
-        else:
-            nb[a, 0] = np.nan
-            nb[a, 1] = np.nan
-        if i + 1 < n:
-            nb[a, 2] = pts[i + 1, 0]
-            nb[a, 3] = pts[i + 1, 1]
-        else:
-            nb[a, 2] = np.nan
-            nb[a, 3] = np.nan
-    return nb
-
-
-@njit(cache=True)
 def _diagonal_vertical_lines(pts, eps2, hist_v):
     """Vertical lines starting on the main diagonal (``w = 0``: entries ``(i, i)``)."""
     for i in range(pts.shape[0]):
@@ -658,11 +648,10 @@ def _line_histograms(pts: np.ndarray, eps: float, w: int, vertical: bool):
     (all zero unless ``vertical``), both over the admissible entries ``|i - j| >= w``.
     """
     n = pts.shape[0]
-    xs, ys, perm, cell_start, cell_key, ncx = _cells(pts, eps)
+    xs, ys, perm, cell_start, cell_key, ncx, nb = _cells(pts, eps, neighbours=True)
     diag = np.zeros(n + 1, np.int64)
     vert = np.zeros(n + 1, np.int64)
     mode = _LINES_V if vertical else _LINES
-    nb = _time_neighbours(pts, perm)
     pairs = _sweep(
         xs,
         ys,
