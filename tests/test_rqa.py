@@ -151,6 +151,25 @@ def test_property_rqa_equals_the_definition(data, eps, theiler, l_min):
     assert_matches_brute_force(pts, eps, min(theiler, len(pts) - 1), l_min)
 
 
+@pytest.mark.parametrize("laminarity", [True, False])
+def test_several_thresholds_in_one_sweep_equal_one_call_each(laminarity):
+    pts = trajectory(1500, seed=9)
+    eps = [0.01, 0.2, 0.001, 0.05]  # any order; the sweep runs at the largest
+    for w in (0, 1, 3):
+        many = rqa(pts, eps, theiler=w, laminarity=laminarity)
+        assert isinstance(many, tuple) and len(many) == 4
+        for e, res in zip(eps, many, strict=True):
+            one = rqa(pts, e, theiler=w, laminarity=laminarity)
+            assert res.eps == e
+            for key, value in one.to_dict().items():
+                np.testing.assert_equal(res.to_dict()[key], value, err_msg=key)
+    assert rqa(pts, np.array([0.01]))[0].eps == 0.01
+    with pytest.raises(ValueError, match="eps"):
+        rqa(pts, [])
+    with pytest.raises(ValueError, match="eps"):
+        rqa(pts, [0.01, -1.0])
+
+
 def test_rr_is_the_recurrence_rate_with_the_same_theiler_window():
     pts = trajectory(2000, seed=5)
     for w in (0, 1, 4):

@@ -184,7 +184,25 @@ def _vertical_line(pts, a, b, eps2, wv, hist_v):
 
 @njit(cache=True, inline="always")
 def _visit_block(
-    xs, ys, perm, a0, a1, b0, b1, same, eps2, w, mode, pts, nb, wv, count, buf, hist_d, hist_v
+    xs,
+    ys,
+    perm,
+    a0,
+    a1,
+    b0,
+    b1,
+    same,
+    eps2,
+    w,
+    mode,
+    pts,
+    nb,
+    eps2s,
+    wv,
+    count,
+    buf,
+    hist_d,
+    hist_v,
 ):
     """Examine the pairs (a in [a0, a1), b in [b0, b1)) of sorted positions.
 
@@ -193,13 +211,14 @@ def _visit_block(
     (``w >= 1``). In collect mode pair number ``k = count[0]`` is also written to
     ``buf[2k], buf[2k + 1]`` while it fits (``count[0]`` keeps counting beyond).
 
-    In the line modes a pair ``i < j`` that starts a diagonal line (``(i - 1, j - 1)``
-    not recurrent) walks it, ``(i + k, j + k)``, and adds its length to ``hist_d``: every
-    line of the upper triangle is counted once, at its start, with O(1) work per
-    recurrent pair and no pair stored. The first two tests read ``nb`` (the time
-    neighbours of each sorted position), the rest of a walk reads ``pts``. `_LINES_V`
-    also counts the vertical lines starting at the entries ``(i, j)`` and ``(j, i)``
-    (window ``wv``, the true one).
+    In the line modes, for each threshold ``eps2s[k]`` (decreasing; ``eps2s[0] = eps2``)
+    that the pair meets, ``count[k]`` counts it and, if the pair ``i < j`` starts a
+    diagonal line (``(i - 1, j - 1)`` not recurrent), the line ``(i + k, j + k)`` is
+    walked and its length added to ``hist_d[k]``: every line of the upper triangle is
+    counted once, at its start, with O(1) work per recurrent pair and no pair stored. The
+    first two tests read ``nb`` (the time neighbours of each sorted position), the rest
+    of a walk reads ``pts``. `_LINES_V` also counts into ``hist_v[k]`` the vertical lines
+    starting at the entries ``(i, j)`` and ``(j, i)`` (window ``wv``, the true one).
     """
     total = 0
     for a in range(a0, a1):
@@ -222,32 +241,57 @@ def _visit_block(
                         buf[2 * k + 1] = ib
                     count[0] = k + 1
                 elif mode >= _LINES:
-                    # predecessor (i - 1, j - 1) and successor (i + 1, j + 1) from the
-                    # neighbours gathered in sorted order: no cache miss for most pairs
+                    # one pass for several thresholds eps2s (decreasing, eps2s[0] = eps2):
+                    # the predecessor (i - 1, j - 1) and successor (i + 1, j + 1) come from
+                    # the neighbours gathered in sorted order, so most pairs miss no cache
+                    d2 = dx * dx + dy * dy
                     px = nb[a, 0] - nb[b, 0]
                     py = nb[a, 1] - nb[b, 1]
-                    if not (px * px + py * py <= eps2):  # NaN (no predecessor): a start
-                        sx = nb[a, 2] - nb[b, 2]
-                        sy = nb[a, 3] - nb[b, 3]
-                        length = 1
-                        if sx * sx + sy * sy <= eps2:
-                            i = min(ia, ib)
-                            j = max(ia, ib)
-                            length = 2
-                            while j + length < pts.shape[0] and _recurrent(
-                                pts, i + length, j + length, eps2
-                            ):
-                                length += 1
-                        hist_d[length] += 1
-                    if mode == _LINES_V:
-                        _vertical_line(pts, ia, ib, eps2, wv, hist_v)
-                        _vertical_line(pts, ib, ia, eps2, wv, hist_v)
+                    p2 = px * px + py * py  # NaN without a predecessor: never <= e2
+                    sx = nb[a, 2] - nb[b, 2]
+                    sy = nb[a, 3] - nb[b, 3]
+                    s2 = sx * sx + sy * sy
+                    for k in range(eps2s.shape[0]):
+                        e2 = eps2s[k]
+                        if not (d2 <= e2):
+                            break
+                        count[k] += 1
+                        if not (p2 <= e2):  # (i, j) starts a diagonal line: walk it
+                            length = 1
+                            if s2 <= e2:
+                                i = min(ia, ib)
+                                j = max(ia, ib)
+                                length = 2
+                                while j + length < pts.shape[0] and _recurrent(
+                                    pts, i + length, j + length, e2
+                                ):
+                                    length += 1
+                            hist_d[k, length] += 1
+                        if mode == _LINES_V:
+                            _vertical_line(pts, ia, ib, e2, wv, hist_v[k])
+                            _vertical_line(pts, ib, ia, e2, wv, hist_v[k])
     return total
 
 
 @njit(cache=True)
 def _sweep(
-    xs, ys, perm, cell_start, cell_key, ncx, eps2, w, mode, pts, nb, wv, count, buf, hist_d, hist_v
+    xs,
+    ys,
+    perm,
+    cell_start,
+    cell_key,
+    ncx,
+    eps2,
+    w,
+    mode,
+    pts,
+    nb,
+    eps2s,
+    wv,
+    count,
+    buf,
+    hist_d,
+    hist_v,
 ):
     """Visit every unordered pair of distinct points in the same or adjacent cells once.
 
@@ -276,6 +320,7 @@ def _sweep(
             mode,
             pts,
             nb,
+            eps2s,
             wv,
             count,
             buf,
@@ -297,6 +342,7 @@ def _sweep(
                 mode,
                 pts,
                 nb,
+                eps2s,
                 wv,
                 count,
                 buf,
@@ -323,6 +369,7 @@ def _sweep(
                 mode,
                 pts,
                 nb,
+                eps2s,
                 wv,
                 count,
                 buf,
@@ -448,7 +495,16 @@ def _cells(pts: np.ndarray, eps: float, neighbours: bool = False):
 
 _EMPTY = np.empty(0, np.int64)
 # pts, nb, wv, count, buf, hist_d, hist_v of a sweep that only counts
-_NO_OUTPUT = (np.empty((0, 2)), np.empty((0, 4)), 0, _EMPTY, _EMPTY, _EMPTY, _EMPTY)
+_NO_OUTPUT = (
+    np.empty((0, 2)),
+    np.empty((0, 4)),
+    np.empty(0),
+    0,
+    _EMPTY,
+    _EMPTY,
+    np.empty((0, 0), np.int64),
+    np.empty((0, 0), np.int64),
+)
 
 
 def recurrence_rate(points, eps=1e-3, *, theiler=0):
@@ -619,11 +675,12 @@ def _pairs_csr(pts: np.ndarray, eps: float, w: int):
             _COLLECT,
             _NO_OUTPUT[0],
             _NO_OUTPUT[1],
+            _NO_OUTPUT[2],
             0,
             count,
             buf,
-            _EMPTY,
-            _EMPTY,
+            _NO_OUTPUT[6],
+            _NO_OUTPUT[7],
         )
         m = int(count[0])
         if m <= cap:
@@ -639,37 +696,44 @@ def _diagonal_vertical_lines(pts, eps2, hist_v):
         _vertical_line(pts, i, i, eps2, 0, hist_v)
 
 
-def _line_histograms(pts: np.ndarray, eps: float, w: int, vertical: bool):
-    """(pairs, diag, vert): recurrent unordered pairs ``i != j`` outside the window, and
-    histograms of line lengths, in one sweep and O(N) memory.
+def _line_histograms(pts: np.ndarray, eps_list, w: int, vertical: bool):
+    """(pairs, diag, vert) for each threshold of ``eps_list`` (decreasing), in one sweep.
 
-    ``diag[l]`` counts the diagonal lines of length ``l`` in the upper triangle (the main
-    diagonal is left to the caller); ``vert[v]`` the vertical lines of the whole matrix
-    (all zero unless ``vertical``), both over the admissible entries ``|i - j| >= w``.
+    ``pairs[k]``: recurrent unordered pairs ``i != j`` outside the window at
+    ``eps_list[k]``; ``diag[k, l]`` the diagonal lines of length ``l`` in the upper
+    triangle (the main diagonal is left to the caller); ``vert[k, v]`` the vertical lines
+    of the whole matrix (all zero unless ``vertical``), over the admissible entries
+    ``|i - j| >= w``. The cell list is built for the largest threshold, whose candidate
+    pairs contain those of the smaller ones. O(N) memory per threshold.
     """
     n = pts.shape[0]
-    xs, ys, perm, cell_start, cell_key, ncx, nb = _cells(pts, eps, neighbours=True)
-    diag = np.zeros(n + 1, np.int64)
-    vert = np.zeros(n + 1, np.int64)
+    m = len(eps_list)
+    xs, ys, perm, cell_start, cell_key, ncx, nb = _cells(pts, eps_list[0], neighbours=True)
+    eps2s = np.array([e * e for e in eps_list])
+    pairs = np.zeros(m, np.int64)
+    diag = np.zeros((m, n + 1), np.int64)
+    vert = np.zeros((m, n + 1), np.int64)
     mode = _LINES_V if vertical else _LINES
-    pairs = _sweep(
+    _sweep(
         xs,
         ys,
         perm,
         cell_start,
         cell_key,
         ncx,
-        eps * eps,
+        eps2s[0],
         max(w, 1),
         mode,
         pts,
         nb,
+        eps2s,
         w,
-        _EMPTY,
+        pairs,
         _EMPTY,
         diag,
         vert,
     )
     if vertical and w == 0:
-        _diagonal_vertical_lines(pts, eps * eps, vert)
-    return int(pairs), diag, vert
+        for k in range(m):
+            _diagonal_vertical_lines(pts, eps2s[k], vert[k])
+    return pairs, diag, vert

@@ -116,9 +116,10 @@ def rqa(points, eps=1e-3, *, theiler=1, l_min=2, laminarity=True):
     ----------
     points : array_like, shape (N, 2), or a run record
         Sampled planar positions (a run record's ``samples`` are used).
-    eps : float, default 1e-3
+    eps : float or sequence of float, default 1e-3
         Recurrence threshold ``> 0``; ``(i, j)`` is recurrent when
-        ``dx**2 + dy**2 <= eps**2`` in float64 (the test of `recurrence_rate`).
+        ``dx**2 + dy**2 <= eps**2`` in float64 (the test of `recurrence_rate`). A
+        sequence gives one result per threshold, all from one sweep of the points.
     theiler : int, default 1
         Theiler window ``w``, ``0 <= w < N``: the entries with ``|i - j| < w`` are removed
         from the matrix (``w = 1``: the main diagonal only, the usual choice).
@@ -130,7 +131,7 @@ def rqa(points, eps=1e-3, *, theiler=1, l_min=2, laminarity=True):
 
     Returns
     -------
-    RQAResult
+    RQAResult, or tuple of RQAResult (one per threshold, in the given order)
         ``rr, det, l_mean, l_max, n_lines, lam, tt, v_max`` and the counts behind them.
         A measure that is undefined (no recurrence; no line of length ``>= l_min``) is
         NaN and ``result.undefined`` says why.
@@ -197,12 +198,31 @@ def rqa(points, eps=1e-3, *, theiler=1, l_min=2, laminarity=True):
     pts = _as_points(points)
     n = pts.shape[0]
     w = _check_theiler(theiler, n)
-    eps = _check_eps(eps)
     l_min = _check_l_min(l_min)
     if not isinstance(laminarity, bool):
         raise TypeError(f"laminarity: expected True or False, got {laminarity!r}")
-    pairs, diag_up, vert = _line_histograms(pts, eps, w, laminarity)
+    if np.ndim(eps) == 0:
+        eps_list = [_check_eps(eps)]
+    else:
+        eps_arr = np.asarray(eps)
+        if eps_arr.ndim != 1 or eps_arr.size == 0:
+            raise ValueError(
+                f"eps: expected a float or a non-empty 1-D sequence, got shape {eps_arr.shape}"
+            )
+        eps_list = [_check_eps(e.item()) for e in eps_arr]
+    # one sweep at the largest threshold serves them all (decreasing order inside)
+    order = sorted(range(len(eps_list)), key=lambda k: -eps_list[k])
+    pairs, diag, vert = _line_histograms(pts, [eps_list[k] for k in order], w, laminarity)
+    results = [None] * len(eps_list)
+    for row, k in enumerate(order):
+        results[k] = _summarise(
+            eps_list[k], n, w, l_min, int(pairs[row]), diag[row], vert[row] if laminarity else None
+        )
+    return results[0] if np.ndim(eps) == 0 else tuple(results)
 
+
+def _summarise(eps, n, w, l_min, pairs, diag_up, vert) -> RQAResult:
+    """The measures from the pair count and the line histograms of one threshold."""
     # Python ints from here on: exact counts, correctly rounded ratios
     n_rec = 2 * pairs + (n if w == 0 else 0)
     n_adm = n * n if w == 0 else (n - w) * (n - w + 1)
@@ -225,7 +245,7 @@ def rqa(points, eps=1e-3, *, theiler=1, l_min=2, laminarity=True):
     det = ratio("det", on_lines, n_rec, no_pair)
     l_mean = ratio("l_mean", on_lines, lines, f"no diagonal line of length >= l_min = {l_min}")
     lam = tt = v_max = None
-    if laminarity:
+    if vert is not None:
         v_lines, on_v_lines, v_max = (int(v) for v in _line_sums(vert, l_min))
         lam = ratio("lam", on_v_lines, n_rec, no_pair)
         tt = ratio("tt", on_v_lines, v_lines, f"no vertical line of length >= l_min = {l_min}")
