@@ -1,6 +1,6 @@
-"""Benchmark: recurrence rate (cell list, numba) against cKDTree and brute force.
+"""Benchmark: recurrence rate (cell list, numba) against cKDTree and brute force; RQA cost.
 
-Run as ``python benchmarks/bench_recurrence.py [--quick] [--max-n N]``.
+Run as ``python benchmarks/bench_recurrence.py [--quick] [--max-n N] [--rqa-only]``.
 
 Point sets: a billiard-like trajectory (a point particle in the unit disk, straight
 chords sampled every tau = 0.2, direction redrawn at every wall hit, so the chords fill
@@ -13,6 +13,10 @@ References, measured in the same run:
   (N / n_small)^2.
 Then the scaling of our code to N = 10^6 and 10^7 with its extra peak memory (growth
 of the peak resident set during the call, each N in a fresh process).
+
+RQA (``rqa``: the recurrent pairs kept as sorted rows, then the line statistics) against
+``recurrence_rate`` of the same points in the same run, N = 25 000, eps = 1e-3 and 1e-2,
+for both point sets and for a paper-sampled billiard run (the sweep's input).
 """
 
 from __future__ import annotations
@@ -28,7 +32,7 @@ import numpy as np
 from numba import njit
 from scipy.spatial import cKDTree
 
-from kicktimes.diagnostics import recurrence_rate
+from kicktimes.diagnostics import recurrence_rate, rqa
 
 
 @njit(cache=True)
@@ -129,9 +133,46 @@ def child(size, eps):
     print(json.dumps(row))
 
 
+def paper_run_samples(n_steps):
+    """Disk 0's samples of a paper-sampled two-disk run (family A: r = 0.02, tau = 0.2)."""
+    from kicktimes import initial_conditions, simulate_two_particle
+
+    ic = initial_conditions(1, 0.03, seed=1)[0]
+    return simulate_two_particle(ic, 0.02, sampling="paper", n_steps=n_steps, tau=0.2).samples
+
+
+def rqa_table(rep):
+    """rqa (Theiler 1) against recurrence_rate of the same points, same run."""
+    n = 25_000
+    sets = [
+        ("trajectory", kicked_chords(n, 0.2, 1)),
+        ("uniform", uniform_disk(n, 2)),
+        ("paper run", paper_run_samples(n - 1)),
+    ]
+    rqa(uniform_disk(100, 0), 1e-3)  # compile / load the cache outside timings
+    print(f"RQA against the recurrence rate, N = {n}  (min / median of {rep} runs)")
+    header = (
+        f"{'point set':<11} {'eps':>6} {'RR offdiag':>11} {'DET':>6} {'Lmax':>5} "
+        f"{'RR [ms]':>15} {'RQA [ms]':>15} {'RQA / RR':>9}"
+    )
+    print(header)
+    print("-" * len(header))
+    for name, pts in sets:
+        for eps in (1e-3, 1e-2):
+            r_min, r_med, _ = timeit(lambda p=pts, e=eps: recurrence_rate(p, e), rep)
+            q_min, q_med, res = timeit(lambda p=pts, e=eps: rqa(p, e), rep)
+            assert res.rr == recurrence_rate(pts, eps, theiler=1)
+            print(
+                f"{name:<11} {eps:6g} {res.rr:11.3e} {res.det:6.3f} {res.l_max:5d} "
+                f"{r_min * 1e3:7.3f} / {r_med * 1e3:5.3f} {q_min * 1e3:7.3f} / "
+                f"{q_med * 1e3:5.3f} {q_min / r_min:9.1f}"
+            )
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="fewer repeats, N <= 10^6")
+    parser.add_argument("--rqa-only", action="store_true", help="only the RQA table")
     parser.add_argument("--max-n", type=float, default=1e7, help="largest N of the scaling")
     parser.add_argument("--child", type=int, default=0, help=argparse.SUPPRESS)
     parser.add_argument("--eps", type=float, default=1e-3, help="recurrence threshold")
@@ -143,6 +184,9 @@ def main():
     n = 25_000
     n_brute = 5_000
     rep = 5 if args.quick else 30
+    if args.rqa_only:
+        rqa_table(rep)
+        return
 
     recurrence_rate(uniform_disk(100, 0), eps)  # compile / load the cache outside timings
     kicked_chords(10, 0.2, 0)
@@ -175,6 +219,9 @@ def main():
         f"* brute force with numpy at N = {n_brute}, scaled by (N / {n_brute})^2; "
         "cKDTree = build + count_neighbors, KDT count = count_neighbors on a built tree"
     )
+
+    print()
+    rqa_table(rep)
 
     print()
     print(f"Scaling (trajectory, eps = {eps:g}), each N in a fresh process; memory = peak RSS")

@@ -61,6 +61,14 @@ def brute_rqa(points: np.ndarray, eps: float, theiler: int, l_min: int) -> dict:
 def assert_matches_brute_force(points, eps, theiler, l_min):
     res = rqa(points, eps, theiler=theiler, l_min=l_min)
     ref = brute_rqa(np.asarray(points, dtype=float), eps, theiler, l_min)
+    # without laminarity only the upper triangle is built: the same diagonal measures
+    half = rqa(points, eps, theiler=theiler, l_min=l_min, laminarity=False)
+    assert half.lam is None and half.tt is None and half.v_max is None
+    full, part = res.to_dict(), half.to_dict()
+    for key in set(full) - {"lam", "tt", "v_max", "undefined"}:
+        np.testing.assert_equal(part[key], full[key], err_msg=key)  # NaN equals NaN here
+    diagonal_reasons = {k: v for k, v in full["undefined"].items() if k not in ("lam", "tt")}
+    assert part["undefined"] == diagonal_reasons
     for key, value in ref.items():
         got = getattr(res, key)
         if isinstance(value, float) and np.isnan(value):
@@ -143,6 +151,25 @@ def test_property_rqa_equals_the_definition(data, eps, theiler, l_min):
     assert_matches_brute_force(pts, eps, min(theiler, len(pts) - 1), l_min)
 
 
+@pytest.mark.parametrize("laminarity", [True, False])
+def test_several_thresholds_in_one_sweep_equal_one_call_each(laminarity):
+    pts = trajectory(1500, seed=9)
+    eps = [0.01, 0.2, 0.001, 0.05]  # any order; the sweep runs at the largest
+    for w in (0, 1, 3):
+        many = rqa(pts, eps, theiler=w, laminarity=laminarity)
+        assert isinstance(many, tuple) and len(many) == 4
+        for e, res in zip(eps, many, strict=True):
+            one = rqa(pts, e, theiler=w, laminarity=laminarity)
+            assert res.eps == e
+            for key, value in one.to_dict().items():
+                np.testing.assert_equal(res.to_dict()[key], value, err_msg=key)
+    assert rqa(pts, np.array([0.01]))[0].eps == 0.01
+    with pytest.raises(ValueError, match="eps"):
+        rqa(pts, [])
+    with pytest.raises(ValueError, match="eps"):
+        rqa(pts, [0.01, -1.0])
+
+
 def test_rr_is_the_recurrence_rate_with_the_same_theiler_window():
     pts = trajectory(2000, seed=5)
     for w in (0, 1, 4):
@@ -219,6 +246,7 @@ def test_theiler_window_removes_the_lines_along_the_trajectory():
         ({"theiler": -1}, ValueError, "theiler"),
         ({"eps": 0.0}, ValueError, "eps"),
         ({"eps": np.nan}, ValueError, "eps"),
+        ({"laminarity": 1}, TypeError, "laminarity"),
     ],
 )
 def test_bad_arguments_raise(kwargs, error, match):

@@ -42,8 +42,9 @@ _CELL_PAD = 1.0 + 1e-6
 _MAX_CELLS_PER_AXIS = float(2**26)
 _RADIX_BITS = 11
 
-# Modes of the pair sweep.
-_COUNT, _DEGREE, _FILL = 0, 1, 2
+# Modes of the pair sweep: count the pairs; also collect them into a buffer; also count
+# the diagonal lines (and the vertical lines) that start at them (see `_visit_block`).
+_COUNT, _COLLECT, _LINES, _LINES_V = 0, 1, 2, 3
 
 
 # --------------------------------------------------------------------------- kernels
@@ -109,13 +110,17 @@ def _radix_argsort(keys, n_bits):
 
 
 @njit(cache=True)
-def _build_cells(points, xmin, ymin, inv_h, ncx, n_bits):
+def _build_cells(points, xmin, ymin, inv_h, ncx, n_bits, neighbours):
     """Sort the points by cell; return sorted coordinates, permutation and cell table.
 
     Cell ``(cx, cy)`` (1-based, so that the neighbour ``cx +- 1`` of a border cell is an
     empty padding column and never aliases the next row) has key ``cy * ncx + cx``.
-    Returns ``xs, ys, perm, cell_start, cell_key`` with the points of cell ``c`` at
+    Returns ``xs, ys, perm, cell_start, cell_key, nb`` with the points of cell ``c`` at
     sorted positions ``cell_start[c] : cell_start[c + 1]`` and original indices ``perm``.
+    With ``neighbours``, row ``a`` of ``nb`` holds the samples before and after
+    ``perm[a]`` in time, ``(x_prev, y_prev, x_next, y_next)`` (NaN beyond the ends), so
+    that the line tests of a pair read them next to the pair's own coordinates; they are
+    gathered in the same loop as the coordinates, where they share its cache lines.
     """
     n = points.shape[0]
     keys = np.empty(n, np.int64)
@@ -126,10 +131,19 @@ def _build_cells(points, xmin, ymin, inv_h, ncx, n_bits):
     perm, skeys = _radix_argsort(keys, n_bits)
     xs = np.empty(n)
     ys = np.empty(n)
+    nb = np.full((n if neighbours else 0, 4), np.nan)
     n_cells = 0
     for a in range(n):
-        xs[a] = points[perm[a], 0]
-        ys[a] = points[perm[a], 1]
+        i = perm[a]
+        xs[a] = points[i, 0]
+        ys[a] = points[i, 1]
+        if neighbours:
+            if i > 0:
+                nb[a, 0] = points[i - 1, 0]
+                nb[a, 1] = points[i - 1, 1]
+            if i + 1 < n:
+                nb[a, 2] = points[i + 1, 0]
+                nb[a, 3] = points[i + 1, 1]
         if a == 0 or skeys[a] != skeys[a - 1]:
             n_cells += 1
     cell_start = np.empty(n_cells + 1, np.int64)
@@ -141,18 +155,72 @@ def _build_cells(points, xmin, ymin, inv_h, ncx, n_bits):
             cell_key[c] = skeys[a]
             c += 1
     cell_start[n_cells] = n
-    return xs, ys, perm, cell_start, cell_key
+    return xs, ys, perm, cell_start, cell_key, nb
 
 
 @njit(cache=True, inline="always")
-def _visit_block(xs, ys, perm, a0, a1, b0, b1, same, eps2, w, mode, deg, cursor, out_j):
+def _recurrent(pts, i, j, eps2):
+    """The recurrence test of the sweep for original indices ``i, j`` (same float values)."""
+    dx = pts[i, 0] - pts[j, 0]
+    dy = pts[i, 1] - pts[j, 1]
+    return dx * dx + dy * dy <= eps2
+
+
+@njit(cache=True)
+def _vertical_line(pts, a, b, eps2, wv, hist_v):
+    """If entry (a, b) (row a, column b) starts a vertical line, add its length to hist_v.
+
+    A line is a maximal run of recurrent admissible entries ``(a + k, b)``; an entry
+    inside the Theiler band ``|i - j| < wv`` is not admissible and ends a run.
+    """
+    n = pts.shape[0]
+    if a > 0 and abs(a - 1 - b) >= wv and _recurrent(pts, a - 1, b, eps2):
+        return
+    length = 1
+    while a + length < n and abs(a + length - b) >= wv and _recurrent(pts, a + length, b, eps2):
+        length += 1
+    hist_v[length] += 1
+
+
+@njit(cache=True, inline="always")
+def _visit_block(
+    xs,
+    ys,
+    perm,
+    a0,
+    a1,
+    b0,
+    b1,
+    same,
+    eps2,
+    w,
+    mode,
+    pts,
+    nb,
+    eps2s,
+    wv,
+    count,
+    buf,
+    hist_d,
+    hist_v,
+):
     """Examine the pairs (a in [a0, a1), b in [b0, b1)) of sorted positions.
 
     ``same`` marks a block of one cell with itself: then only a < b is examined.
     Counts the unordered pairs with squared distance <= eps2 and ``|i - j| >= w``
-    (``w >= 1``), and in the other modes records them for both orders.
+    (``w >= 1``). In collect mode pair number ``k = count[0]`` is also written to
+    ``buf[2k], buf[2k + 1]`` while it fits (``count[0]`` keeps counting beyond).
+
+    In the line modes, for each threshold ``eps2s[k]`` (decreasing; ``eps2s[0] = eps2``)
+    that the pair meets, ``count[k]`` counts it and, if the pair ``i < j`` starts a
+    diagonal line (``(i - 1, j - 1)`` not recurrent), the line ``(i + k, j + k)`` is
+    walked and its length added to ``hist_d[k]``: every line of the upper triangle is
+    counted once, at its start, with O(1) work per recurrent pair and no pair stored. The
+    first two tests read ``nb`` (the time neighbours of each sorted position), the rest
+    of a walk reads ``pts``. `_LINES_V` also counts into ``hist_v[k]`` the vertical lines
+    starting at the entries ``(i, j)`` and ``(j, i)`` (window ``wv``, the true one).
     """
-    count = 0
+    total = 0
     for a in range(a0, a1):
         xa = xs[a]
         ya = ys[a]
@@ -165,20 +233,66 @@ def _visit_block(xs, ys, perm, a0, a1, b0, b1, same, eps2, w, mode, deg, cursor,
                 ib = perm[b]
                 if w > 1 and abs(ia - ib) < w:
                     continue
-                count += 1
-                if mode == _DEGREE:
-                    deg[ia] += 1
-                    deg[ib] += 1
-                elif mode == _FILL:
-                    out_j[cursor[ia]] = ib
-                    cursor[ia] += 1
-                    out_j[cursor[ib]] = ia
-                    cursor[ib] += 1
-    return count
+                total += 1
+                if mode == _COLLECT:
+                    k = count[0]
+                    if 2 * k + 1 < buf.shape[0]:
+                        buf[2 * k] = ia
+                        buf[2 * k + 1] = ib
+                    count[0] = k + 1
+                elif mode >= _LINES:
+                    # one pass for several thresholds eps2s (decreasing, eps2s[0] = eps2):
+                    # the predecessor (i - 1, j - 1) and successor (i + 1, j + 1) come from
+                    # the neighbours gathered in sorted order, so most pairs miss no cache
+                    d2 = dx * dx + dy * dy
+                    px = nb[a, 0] - nb[b, 0]
+                    py = nb[a, 1] - nb[b, 1]
+                    p2 = px * px + py * py  # NaN without a predecessor: never <= e2
+                    sx = nb[a, 2] - nb[b, 2]
+                    sy = nb[a, 3] - nb[b, 3]
+                    s2 = sx * sx + sy * sy
+                    for k in range(eps2s.shape[0]):
+                        e2 = eps2s[k]
+                        if not (d2 <= e2):
+                            break
+                        count[k] += 1
+                        if not (p2 <= e2):  # (i, j) starts a diagonal line: walk it
+                            length = 1
+                            if s2 <= e2:
+                                i = min(ia, ib)
+                                j = max(ia, ib)
+                                length = 2
+                                while j + length < pts.shape[0] and _recurrent(
+                                    pts, i + length, j + length, e2
+                                ):
+                                    length += 1
+                            hist_d[k, length] += 1
+                        if mode == _LINES_V:
+                            _vertical_line(pts, ia, ib, e2, wv, hist_v[k])
+                            _vertical_line(pts, ib, ia, e2, wv, hist_v[k])
+    return total
 
 
 @njit(cache=True)
-def _sweep(xs, ys, perm, cell_start, cell_key, ncx, eps2, w, mode, deg, cursor, out_j):
+def _sweep(
+    xs,
+    ys,
+    perm,
+    cell_start,
+    cell_key,
+    ncx,
+    eps2,
+    w,
+    mode,
+    pts,
+    nb,
+    eps2s,
+    wv,
+    count,
+    buf,
+    hist_d,
+    hist_v,
+):
     """Visit every unordered pair of distinct points in the same or adjacent cells once.
 
     Half stencil: a cell is paired with itself, with ``(cx+1, cy)`` and with the three
@@ -192,7 +306,27 @@ def _sweep(xs, ys, perm, cell_start, cell_key, ncx, eps2, w, mode, deg, cursor, 
         key = cell_key[c]
         s0 = cell_start[c]
         s1 = cell_start[c + 1]
-        total += _visit_block(xs, ys, perm, s0, s1, s0, s1, True, eps2, w, mode, deg, cursor, out_j)
+        total += _visit_block(
+            xs,
+            ys,
+            perm,
+            s0,
+            s1,
+            s0,
+            s1,
+            True,
+            eps2,
+            w,
+            mode,
+            pts,
+            nb,
+            eps2s,
+            wv,
+            count,
+            buf,
+            hist_d,
+            hist_v,
+        )
         if c + 1 < n_cells and cell_key[c + 1] == key + 1:
             total += _visit_block(
                 xs,
@@ -206,9 +340,14 @@ def _sweep(xs, ys, perm, cell_start, cell_key, ncx, eps2, w, mode, deg, cursor, 
                 eps2,
                 w,
                 mode,
-                deg,
-                cursor,
-                out_j,
+                pts,
+                nb,
+                eps2s,
+                wv,
+                count,
+                buf,
+                hist_d,
+                hist_v,
             )
         lo = key + ncx - 1
         hi = key + ncx + 1
@@ -228,30 +367,59 @@ def _sweep(xs, ys, perm, cell_start, cell_key, ncx, eps2, w, mode, deg, cursor, 
                 eps2,
                 w,
                 mode,
-                deg,
-                cursor,
-                out_j,
+                pts,
+                nb,
+                eps2s,
+                wv,
+                count,
+                buf,
+                hist_d,
+                hist_v,
             )
             r += 1
     return total
 
 
 @njit(cache=True)
-def _sort_rows(offsets, out_j):
-    """Sort each row ``out_j[offsets[i]:offsets[i+1]]`` in place (rows are short)."""
-    for i in range(offsets.shape[0] - 1):
-        lo = offsets[i]
-        hi = offsets[i + 1]
-        if hi - lo > 32:
-            out_j[lo:hi] = np.sort(out_j[lo:hi])
-            continue
-        for a in range(lo + 1, hi):  # insertion sort
-            v = out_j[a]
-            b = a - 1
-            while b >= lo and out_j[b] > v:
-                out_j[b + 1] = out_j[b]
-                b -= 1
-            out_j[b + 1] = v
+def _rows_from_pairs(pairs, m, n, diagonal):
+    """Sorted rows of the symmetric matrix of ``m`` unordered pairs (+ the diagonal).
+
+    Two O(N + m) bucket passes instead of a comparison sort: the entries are first
+    bucketed by column, then, visiting the columns in increasing order, appended to their
+    rows, so every row comes out sorted. By symmetry rows and columns have the same
+    lengths, hence the same offsets.
+    """
+    deg = np.zeros(n, np.int64)
+    for k in range(m):
+        deg[pairs[2 * k]] += 1
+        deg[pairs[2 * k + 1]] += 1
+    if diagonal:
+        for i in range(n):
+            deg[i] += 1
+    offsets = np.zeros(n + 1, np.int64)
+    for i in range(n):
+        offsets[i + 1] = offsets[i] + deg[i]
+    by_col = np.empty(offsets[n], np.int64)
+    cursor = offsets[:n].copy()
+    for k in range(m):
+        a = pairs[2 * k]
+        b = pairs[2 * k + 1]
+        by_col[cursor[b]] = a
+        cursor[b] += 1
+        by_col[cursor[a]] = b
+        cursor[a] += 1
+    if diagonal:
+        for i in range(n):
+            by_col[cursor[i]] = i
+            cursor[i] += 1
+    cols = np.empty(offsets[n], np.int64)
+    cursor[:] = offsets[:n]
+    for c in range(n):
+        for e in range(offsets[c], offsets[c + 1]):
+            r = by_col[e]
+            cols[cursor[r]] = c
+            cursor[r] += 1
+    return offsets, cols
 
 
 # ------------------------------------------------------------------------- front end
@@ -305,7 +473,7 @@ def _check_theiler(theiler, n: int) -> int:
     return theiler
 
 
-def _cells(pts: np.ndarray, eps: float):
+def _cells(pts: np.ndarray, eps: float, neighbours: bool = False):
     xmin, xmax, ymin, ymax, finite = _bounding_box(pts)
     if not finite:
         bad = np.flatnonzero(~np.isfinite(pts).all(axis=1))
@@ -319,10 +487,24 @@ def _cells(pts: np.ndarray, eps: float):
     ncx = int(np.floor((xmax - xmin) * inv_h)) + 3  # 1-based columns plus padding
     ncy = int(np.floor((ymax - ymin) * inv_h)) + 3
     n_bits = max(1, int(ncx * ncy - 1).bit_length())
-    return (*_build_cells(pts, xmin, ymin, inv_h, ncx, n_bits), ncx)
+    xs, ys, perm, cell_start, cell_key, nb = _build_cells(
+        pts, xmin, ymin, inv_h, ncx, n_bits, neighbours
+    )
+    return xs, ys, perm, cell_start, cell_key, ncx, nb
 
 
 _EMPTY = np.empty(0, np.int64)
+# pts, nb, wv, count, buf, hist_d, hist_v of a sweep that only counts
+_NO_OUTPUT = (
+    np.empty((0, 2)),
+    np.empty((0, 4)),
+    np.empty(0),
+    0,
+    _EMPTY,
+    _EMPTY,
+    np.empty((0, 0), np.int64),
+    np.empty((0, 0), np.int64),
+)
 
 
 def recurrence_rate(points, eps=1e-3, *, theiler=0):
@@ -402,20 +584,9 @@ def recurrence_rate(points, eps=1e-3, *, theiler=0):
 
 def _recurrence_rate_one(pts: np.ndarray, eps: float, w: int) -> float:
     n = pts.shape[0]
-    xs, ys, perm, cell_start, cell_key, ncx = _cells(pts, eps)
+    xs, ys, perm, cell_start, cell_key, ncx, _ = _cells(pts, eps)
     pairs = _sweep(
-        xs,
-        ys,
-        perm,
-        cell_start,
-        cell_key,
-        ncx,
-        eps * eps,
-        max(w, 1),
-        _COUNT,
-        _EMPTY,
-        _EMPTY,
-        _EMPTY,
+        xs, ys, perm, cell_start, cell_key, ncx, eps * eps, max(w, 1), _COUNT, *_NO_OUTPUT
     )
     if w == 0:
         # Python ints: N^2 overflows nothing, and the division is correctly rounded
@@ -454,9 +625,10 @@ def recurrence_pairs(points, eps=1e-3, *, theiler=0):
 
     Notes
     -----
-    Two sweeps of the cell list: the first counts each point's recurrences (the row
-    lengths), the second fills the rows in place, which are then sorted. Memory is
-    O(N + pairs); beware that for large ``eps`` the pair count approaches ``N^2``.
+    One sweep of the cell list collects the pairs (a second one only when they exceed a
+    buffer of a few per point), then two O(N + pairs) bucket passes put them in sorted
+    rows. Memory is O(N + pairs); beware that for large ``eps`` the pair count approaches
+    ``N^2``.
 
     Examples
     --------
@@ -482,20 +654,86 @@ def _pairs_csr(pts: np.ndarray, eps: float, w: int):
     """The recurrence plot as sorted rows: ``cols[offsets[i]:offsets[i+1]]`` are the ``j``.
 
     Both orders of every pair, and the diagonal when ``w == 0``; rows sorted increasingly.
+    One sweep collects the unordered pairs into a buffer sized for a few per point; only
+    when they do not fit (large ``eps``) is the sweep repeated with the exact size.
     """
     n = pts.shape[0]
-    xs, ys, perm, cell_start, cell_key, ncx = _cells(pts, eps)
-    deg = np.zeros(n, np.int64) if w > 0 else np.ones(n, np.int64)
+    xs, ys, perm, cell_start, cell_key, ncx, _ = _cells(pts, eps)
+    cap = 4 * n + 1024
+    while True:
+        buf = np.empty(2 * cap, np.int64)
+        count = np.zeros(1, np.int64)
+        _sweep(
+            xs,
+            ys,
+            perm,
+            cell_start,
+            cell_key,
+            ncx,
+            eps * eps,
+            max(w, 1),
+            _COLLECT,
+            _NO_OUTPUT[0],
+            _NO_OUTPUT[1],
+            _NO_OUTPUT[2],
+            0,
+            count,
+            buf,
+            _NO_OUTPUT[6],
+            _NO_OUTPUT[7],
+        )
+        m = int(count[0])
+        if m <= cap:
+            break
+        cap = m
+    return _rows_from_pairs(buf, m, n, w == 0)
+
+
+@njit(cache=True)
+def _diagonal_vertical_lines(pts, eps2, hist_v):
+    """Vertical lines starting on the main diagonal (``w = 0``: entries ``(i, i)``)."""
+    for i in range(pts.shape[0]):
+        _vertical_line(pts, i, i, eps2, 0, hist_v)
+
+
+def _line_histograms(pts: np.ndarray, eps_list, w: int, vertical: bool):
+    """(pairs, diag, vert) for each threshold of ``eps_list`` (decreasing), in one sweep.
+
+    ``pairs[k]``: recurrent unordered pairs ``i != j`` outside the window at
+    ``eps_list[k]``; ``diag[k, l]`` the diagonal lines of length ``l`` in the upper
+    triangle (the main diagonal is left to the caller); ``vert[k, v]`` the vertical lines
+    of the whole matrix (all zero unless ``vertical``), over the admissible entries
+    ``|i - j| >= w``. The cell list is built for the largest threshold, whose candidate
+    pairs contain those of the smaller ones. O(N) memory per threshold.
+    """
+    n = pts.shape[0]
+    m = len(eps_list)
+    xs, ys, perm, cell_start, cell_key, ncx, nb = _cells(pts, eps_list[0], neighbours=True)
+    eps2s = np.array([e * e for e in eps_list])
+    pairs = np.zeros(m, np.int64)
+    diag = np.zeros((m, n + 1), np.int64)
+    vert = np.zeros((m, n + 1), np.int64)
+    mode = _LINES_V if vertical else _LINES
     _sweep(
-        xs, ys, perm, cell_start, cell_key, ncx, eps * eps, max(w, 1), _DEGREE, deg, _EMPTY, _EMPTY
+        xs,
+        ys,
+        perm,
+        cell_start,
+        cell_key,
+        ncx,
+        eps2s[0],
+        max(w, 1),
+        mode,
+        pts,
+        nb,
+        eps2s,
+        w,
+        pairs,
+        _EMPTY,
+        diag,
+        vert,
     )
-    offsets = np.zeros(n + 1, np.int64)
-    np.cumsum(deg, out=offsets[1:])
-    out_j = np.empty(offsets[-1], np.int64)
-    cursor = offsets[:-1].copy()
-    if w == 0:
-        out_j[cursor] = np.arange(n)
-        cursor += 1
-    _sweep(xs, ys, perm, cell_start, cell_key, ncx, eps * eps, max(w, 1), _FILL, deg, cursor, out_j)
-    _sort_rows(offsets, out_j)
-    return offsets, out_j
+    if vertical and w == 0:
+        for k in range(m):
+            _diagonal_vertical_lines(pts, eps2s[k], vert[k])
+    return pairs, diag, vert

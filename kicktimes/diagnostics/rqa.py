@@ -1,20 +1,21 @@
-"""Recurrence quantification analysis (RQA) without an N x N matrix.
+"""Recurrence quantification analysis (RQA) without an N x N matrix and without the pairs.
 
 The recurrence matrix ``R_ij = Theta(eps - |x_i - x_j|)`` of N planar points is symmetric.
-Its recurrent entries are found by the cell-list pair enumeration of
-`kicktimes.diagnostics.recurrence` and kept as sorted rows (compressed sparse rows, both
-orders of every pair); the line statistics are then read off those rows in one pass:
+Its recurrent pairs are enumerated once by the cell-list sweep of
+`kicktimes.diagnostics.recurrence`, and the line statistics are counted on the fly:
 
 * a **diagonal line** is a maximal run of recurrent entries ``(i + k, j + k)``,
-  ``k = 0..l-1``, along one diagonal ``j - i = d``; the run continues from row ``i`` to
-  row ``i + 1`` when ``j + 1`` is in row ``i + 1`` (a two-pointer merge of the two sorted
-  rows), so each line's length is carried forward and counted where it ends;
-* a **vertical line** is a maximal run of recurrent entries ``(i + k, j)`` in one
-  column; by symmetry column ``j`` equals row ``j``, so these are runs of consecutive
-  column indices within a sorted row.
+  ``k = 0..l-1``, on one diagonal ``j - i = d``. When the sweep meets a pair ``i < j``
+  whose predecessor ``(i - 1, j - 1)`` is not recurrent, the pair starts a line: the
+  line is walked, ``(i + 1, j + 1), (i + 2, j + 2), ...``, testing distances directly,
+  and its length goes into a histogram. Every line is counted once, at its start;
+* a **vertical line** is a maximal run ``(i + k, j)`` in one column, counted the same
+  way from the entries ``(i, j)`` and ``(j, i)`` of each pair.
 
-Memory is O(N) plus two integers per recurrent entry; time O(N + candidate pairs +
-recurrent entries). See `rqa` for the exact conventions, and docs/diagnostics.md.
+The distance test is the sweep's float expression, so the result equals the
+brute-force matrix computation exactly. Memory is O(N) (two histograms; no pair is
+stored); time O(N + candidate pairs + recurrent pairs). See `rqa` and
+docs/diagnostics.md.
 """
 
 from __future__ import annotations
@@ -25,50 +26,30 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 from numba import njit
 
-from kicktimes.diagnostics.recurrence import _as_points, _check_eps, _check_theiler, _pairs_csr
+from kicktimes.diagnostics.recurrence import (
+    _as_points,
+    _check_eps,
+    _check_theiler,
+    _line_histograms,
+)
 
 __all__ = ["RQAResult", "rqa"]
 
 
 @njit(cache=True)
-def _line_histograms(offsets, cols, n, w):
-    """Histograms of line lengths from the sorted rows of a symmetric recurrence matrix.
-
-    Returns ``(diag, vert)``: ``diag[l]`` counts the diagonal lines of length ``l`` in the
-    upper triangle, on diagonals ``j - i >= max(w, 1)`` (the main diagonal is left to the
-    caller); ``vert[v]`` counts the vertical lines of length ``v`` of the whole matrix
-    (every column, admissible entries only: the rows hold no entry with ``|i - j| < w``,
-    so the Theiler band breaks the runs by itself).
-    """
-    dmin = max(w, 1)
-    diag = np.zeros(n + 1, np.int64)
-    vert = np.zeros(n + 1, np.int64)
-    # length of the diagonal line ending at each entry, propagated to (i + 1, j + 1)
-    run = np.ones(cols.shape[0], np.int64)
-    for i in range(n):
-        lo = offsets[i]
-        hi = offsets[i + 1]
-        a = lo
-        while a < hi:  # runs of consecutive columns in row i = vertical lines of column i
-            b = a + 1
-            while b < hi and cols[b] == cols[b - 1] + 1:
-                b += 1
-            vert[b - a] += 1
-            a = b
-        a = lo
-        while a < hi and cols[a] < i + dmin:
-            a += 1
-        p = hi  # start of row i + 1
-        p_hi = offsets[i + 2] if i + 1 < n else hi
-        for e in range(a, hi):
-            target = cols[e] + 1
-            while p < p_hi and cols[p] < target:
-                p += 1
-            if p < p_hi and cols[p] == target:
-                run[p] = run[e] + 1
-            else:
-                diag[run[e]] += 1
-    return diag, vert
+def _line_sums(hist, l_min):
+    """(number of lines of length >= l_min, entries on them, longest line) of a histogram."""
+    lines = 0
+    on = 0
+    longest = 0
+    for length in range(1, hist.shape[0]):
+        c = hist[length]
+        if c:
+            longest = length
+            if length >= l_min:
+                lines += c
+                on += c * length
+    return lines, on, longest
 
 
 @dataclass(frozen=True)
@@ -92,8 +73,9 @@ class RQAResult:
     det, l_mean, l_max, n_lines : float, float, int, int
         Determinism, mean and maximal diagonal line length, number of diagonal lines of
         length ``>= l_min``.
-    lam, tt, v_max : float, float, int
-        Laminarity, trapping time and longest vertical line.
+    lam, tt, v_max : float, float, int, or None
+        Laminarity, trapping time and longest vertical line (``None``: not computed,
+        ``laminarity=False``).
     undefined : dict
         ``{field: reason}`` for every field that is NaN (empty when all are defined).
     """
@@ -109,9 +91,9 @@ class RQAResult:
     l_mean: float
     l_max: int
     n_lines: int
-    lam: float
-    tt: float
-    v_max: int
+    lam: float | None
+    tt: float | None
+    v_max: int | None
     undefined: dict = field(default_factory=dict)
 
     def to_dict(self) -> dict:
@@ -127,25 +109,29 @@ def _check_l_min(l_min) -> int:
     return int(l_min)
 
 
-def rqa(points, eps=1e-3, *, theiler=1, l_min=2):
+def rqa(points, eps=1e-3, *, theiler=1, l_min=2, laminarity=True):
     r"""Recurrence quantification analysis: RR, determinism, line lengths, laminarity.
 
     Parameters
     ----------
     points : array_like, shape (N, 2), or a run record
         Sampled planar positions (a run record's ``samples`` are used).
-    eps : float, default 1e-3
+    eps : float or sequence of float, default 1e-3
         Recurrence threshold ``> 0``; ``(i, j)`` is recurrent when
-        ``dx**2 + dy**2 <= eps**2`` in float64 (the test of `recurrence_rate`).
+        ``dx**2 + dy**2 <= eps**2`` in float64 (the test of `recurrence_rate`). A
+        sequence gives one result per threshold, all from one sweep of the points.
     theiler : int, default 1
         Theiler window ``w``, ``0 <= w < N``: the entries with ``|i - j| < w`` are removed
         from the matrix (``w = 1``: the main diagonal only, the usual choice).
     l_min : int, default 2
         Minimal length of a diagonal (and of a vertical) line, ``>= 1``.
+    laminarity : bool, default True
+        Also compute ``lam``, ``tt``, ``v_max`` (two more distance tests per recurrent
+        pair; with ``False`` the fields are ``None``).
 
     Returns
     -------
-    RQAResult
+    RQAResult, or tuple of RQAResult (one per threshold, in the given order)
         ``rr, det, l_mean, l_max, n_lines, lam, tt, v_max`` and the counts behind them.
         A measure that is undefined (no recurrence; no line of length ``>= l_min``) is
         NaN and ``result.undefined`` says why.
@@ -187,8 +173,11 @@ def rqa(points, eps=1e-3, *, theiler=1, l_min=2):
     recurrent diagonal neighbour; ``DET`` and ``LAM`` are NaN when ``R = 0``, ``L`` and
     ``TT`` when no line reaches ``l_min``; ``l_max`` and ``v_max`` are 0 when ``R = 0``.
 
-    Cost: O(N) memory plus 16 bytes per recurrent entry (the sorted rows and a run
-    length), never an ``N x N`` matrix; time O(N + candidate pairs + recurrent entries).
+    Cost: one sweep of the cell list of `recurrence_rate`; each recurrent pair adds one
+    distance test for its diagonal predecessor (two more for the vertical ones) and each
+    line is walked once. O(N) memory (no pair is stored, never an ``N x N`` matrix);
+    about 1.1x the time of `recurrence_rate` at eps = 1e-3 and 1.3-1.9x at 1e-2 for
+    N = 25 000 (benchmarks/bench_recurrence.py).
 
     References
     ----------
@@ -209,48 +198,57 @@ def rqa(points, eps=1e-3, *, theiler=1, l_min=2):
     pts = _as_points(points)
     n = pts.shape[0]
     w = _check_theiler(theiler, n)
-    eps = _check_eps(eps)
     l_min = _check_l_min(l_min)
-    offsets, cols = _pairs_csr(pts, eps, w)
-    diag_up, vert = _line_histograms(offsets, cols, n, w)
+    if not isinstance(laminarity, bool):
+        raise TypeError(f"laminarity: expected True or False, got {laminarity!r}")
+    if np.ndim(eps) == 0:
+        eps_list = [_check_eps(eps)]
+    else:
+        eps_arr = np.asarray(eps)
+        if eps_arr.ndim != 1 or eps_arr.size == 0:
+            raise ValueError(
+                f"eps: expected a float or a non-empty 1-D sequence, got shape {eps_arr.shape}"
+            )
+        eps_list = [_check_eps(e.item()) for e in eps_arr]
+    # one sweep at the largest threshold serves them all (decreasing order inside)
+    order = sorted(range(len(eps_list)), key=lambda k: -eps_list[k])
+    pairs, diag, vert = _line_histograms(pts, [eps_list[k] for k in order], w, laminarity)
+    results = [None] * len(eps_list)
+    for row, k in enumerate(order):
+        results[k] = _summarise(
+            eps_list[k], n, w, l_min, int(pairs[row]), diag[row], vert[row] if laminarity else None
+        )
+    return results[0] if np.ndim(eps) == 0 else tuple(results)
 
+
+def _summarise(eps, n, w, l_min, pairs, diag_up, vert) -> RQAResult:
+    """The measures from the pair count and the line histograms of one threshold."""
     # Python ints from here on: exact counts, correctly rounded ratios
-    n_rec = int(cols.shape[0])
+    n_rec = 2 * pairs + (n if w == 0 else 0)
     n_adm = n * n if w == 0 else (n - w) * (n - w + 1)
-    lengths = np.arange(n + 1, dtype=np.int64)
-    long_d = lengths >= l_min
-    lines = 2 * int(diag_up[long_d].sum())
-    on_lines = 2 * int((lengths * diag_up)[long_d].sum())
-    nz = np.flatnonzero(diag_up)
-    l_max = int(nz[-1]) if nz.size else 0
+    lines, on_lines, l_max = (int(v) for v in _line_sums(diag_up, l_min))
+    lines, on_lines = 2 * lines, 2 * on_lines  # the mirror image below the diagonal
     if w == 0:  # the main diagonal: one line of length N
         l_max = n
         if n >= l_min:
             lines += 1
             on_lines += n
-    v_lines = int(vert[long_d].sum())
-    on_v_lines = int((lengths * vert)[long_d].sum())
-    nzv = np.flatnonzero(vert)
-    v_max = int(nzv[-1]) if nzv.size else 0
-
     undefined = {}
-    if n_rec == 0:
-        reason = f"no recurrent pair at eps = {eps:g} (theiler = {w})"
-        det = lam = np.nan
-        undefined["det"] = undefined["lam"] = reason
-    else:
-        det = on_lines / n_rec
-        lam = on_v_lines / n_rec
-    if lines == 0:
-        l_mean = np.nan
-        undefined["l_mean"] = f"no diagonal line of length >= l_min = {l_min}"
-    else:
-        l_mean = on_lines / lines
-    if v_lines == 0:
-        tt = np.nan
-        undefined["tt"] = f"no vertical line of length >= l_min = {l_min}"
-    else:
-        tt = on_v_lines / v_lines
+    no_pair = f"no recurrent pair at eps = {eps:g} (theiler = {w})"
+
+    def ratio(name, num, den, why):
+        if den == 0:
+            undefined[name] = why
+            return np.nan
+        return num / den
+
+    det = ratio("det", on_lines, n_rec, no_pair)
+    l_mean = ratio("l_mean", on_lines, lines, f"no diagonal line of length >= l_min = {l_min}")
+    lam = tt = v_max = None
+    if vert is not None:
+        v_lines, on_v_lines, v_max = (int(v) for v in _line_sums(vert, l_min))
+        lam = ratio("lam", on_v_lines, n_rec, no_pair)
+        tt = ratio("tt", on_v_lines, v_lines, f"no vertical line of length >= l_min = {l_min}")
     return RQAResult(
         eps=eps,
         theiler=w,

@@ -332,23 +332,25 @@ def recurrence_rows(points: np.ndarray, eps: tuple) -> list[tuple]:
     ``recurrence_rate`` (at ``eps[0]``, the paper's RR with the main diagonal), then for
     each threshold ``e``: ``rr@e`` (the same RR), ``rr_offdiag@e`` (Theiler window 1:
     pairs ``i != j``), ``det@e``, ``l_mean@e``, ``l_max@e`` (Theiler 1, ``l_min = 2``).
-    One `rqa` call per threshold; ``rr@e = (N + R) / N^2`` from its ``R`` recurrent
-    off-diagonal entries is bitwise ``recurrence_rate(points, e)``.
+    One `rqa` call (one sweep) for all thresholds; ``rr@e = (N + R) / N^2`` from its
+    ``R`` recurrent off-diagonal entries is bitwise ``recurrence_rate(points, e)``.
     """
     from kicktimes.diagnostics import rqa
 
     n = int(points.shape[0])
     rows = []
-    for k, e in enumerate(eps):
-        tag = eps_label(e)
-        if n == 1:  # RR = 1 (the diagonal); nothing off the diagonal to compare
-            if k == 0:
-                rows.append(("recurrence_rate", 1.0, ""))
+    if n == 1:  # RR = 1 (the diagonal); nothing off the diagonal to compare
+        rows.append(("recurrence_rate", 1.0, ""))
+        for e in eps:
+            tag = eps_label(e)
             rows.append((f"rr@{tag}", 1.0, ""))
             for name in ("rr_offdiag", "det", "l_mean", "l_max"):
                 rows.append((f"{name}@{tag}", math.nan, "a single sample: no pair i != j"))
-            continue
-        res = rqa(points, e, theiler=1, l_min=2)
+        return rows
+    # one sweep of the points for all thresholds
+    results = rqa(points, list(eps), theiler=1, l_min=2, laminarity=False)
+    for k, (e, res) in enumerate(zip(eps, results, strict=True)):
+        tag = eps_label(e)
         # Python ints: the expression of recurrence_rate(points, e), so bitwise equal
         rr = (n + res.n_recurrent) / (n * n)
         if k == 0:
