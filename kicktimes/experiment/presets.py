@@ -34,9 +34,13 @@ _PAPER = {
     "lag": 1,
     "acf_max_lag": 20,
     "d0": 1.0 / 5000.0,
+    "lyapunov_method": "tangent",
     "lyapunov_variant": "paper",
     "kick_angle": "uniform",
     "sigma": 1.0,
+    # the paper's three systems and, beyond the paper, the scatter-kicked disk
+    # (docs/scatter.md) with Poisson and with actual kick times
+    "systems": ("two_particle", "poisson", "actual", "poisson_scatter", "actual_scatter"),
 }
 
 PRESETS = {
