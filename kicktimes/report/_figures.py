@@ -8,12 +8,20 @@ import pandas as pd
 from matplotlib.figure import Figure
 from matplotlib.ticker import FuncFormatter, NullFormatter
 
-SYSTEMS = ("two_particle", "poisson", "actual")
-SYSTEM_LABELS = {"two_particle": "Two-particle", "poisson": "Poisson", "actual": "Actual"}
+SYSTEMS = ("two_particle", "poisson", "actual", "poisson_scatter", "actual_scatter")
+SYSTEM_LABELS = {
+    "two_particle": "Two-particle",
+    "poisson": "Poisson",
+    "actual": "Actual",
+    "poisson_scatter": "Poisson, scatter",
+    "actual_scatter": "Actual, scatter",
+}
 _SYSTEM_STYLE = {
     "two_particle": {"color": "black", "marker": "o"},
     "poisson": {"color": "tab:orange", "marker": "s"},
     "actual": {"color": "tab:blue", "marker": "^"},
+    "poisson_scatter": {"color": "tab:red", "marker": "v"},
+    "actual_scatter": {"color": "tab:green", "marker": "D"},
 }
 # (title, y-axis label with units) of each diagnostic of the store
 DIAGNOSTIC_LABELS = {
