@@ -131,7 +131,7 @@ def _build_cells(points, xmin, ymin, inv_h, ncx, n_bits, neighbours):
     perm, skeys = _radix_argsort(keys, n_bits)
     xs = np.empty(n)
     ys = np.empty(n)
-    nb = np.full((n if neighbours else 0, 4), np.nan)
+    nb = np.empty((n if neighbours else 0, 4))
     n_cells = 0
     for a in range(n):
         i = perm[a]
@@ -141,9 +141,13 @@ def _build_cells(points, xmin, ymin, inv_h, ncx, n_bits, neighbours):
             if i > 0:
                 nb[a, 0] = points[i - 1, 0]
                 nb[a, 1] = points[i - 1, 1]
+            else:
+                nb[a, 0] = nb[a, 1] = np.nan
             if i + 1 < n:
                 nb[a, 2] = points[i + 1, 0]
                 nb[a, 3] = points[i + 1, 1]
+            else:
+                nb[a, 2] = nb[a, 3] = np.nan
         if a == 0 or skeys[a] != skeys[a - 1]:
             n_cells += 1
     cell_start = np.empty(n_cells + 1, np.int64)
@@ -166,9 +170,19 @@ def _recurrent(pts, i, j, eps2):
     return dx * dx + dy * dy <= eps2
 
 
+@njit(cache=True, inline="always")
+def _add_line(sums, length):
+    """Account a line in ``sums = (l_min, lines >= l_min, entries on them, longest)``."""
+    if length >= sums[0]:
+        sums[1] += 1
+        sums[2] += length
+    if length > sums[3]:
+        sums[3] = length
+
+
 @njit(cache=True)
-def _vertical_line(pts, a, b, eps2, wv, hist_v):
-    """If entry (a, b) (row a, column b) starts a vertical line, add its length to hist_v.
+def _vertical_line(pts, a, b, eps2, wv, sums_v):
+    """If entry (a, b) (row a, column b) starts a vertical line, account it in sums_v.
 
     A line is a maximal run of recurrent admissible entries ``(a + k, b)``; an entry
     inside the Theiler band ``|i - j| < wv`` is not admissible and ends a run.
@@ -179,7 +193,7 @@ def _vertical_line(pts, a, b, eps2, wv, hist_v):
     length = 1
     while a + length < n and abs(a + length - b) >= wv and _recurrent(pts, a + length, b, eps2):
         length += 1
-    hist_v[length] += 1
+    _add_line(sums_v, length)
 
 
 @njit(cache=True, inline="always")
@@ -214,10 +228,10 @@ def _visit_block(
     In the line modes, for each threshold ``eps2s[k]`` (decreasing; ``eps2s[0] = eps2``)
     that the pair meets, ``count[k]`` counts it and, if the pair ``i < j`` starts a
     diagonal line (``(i - 1, j - 1)`` not recurrent), the line ``(i + k, j + k)`` is
-    walked and its length added to ``hist_d[k]``: every line of the upper triangle is
+    walked and accounted in ``hist_d[k]`` (`_add_line`): every line of the upper triangle is
     counted once, at its start, with O(1) work per recurrent pair and no pair stored. The
     first two tests read ``nb`` (the time neighbours of each sorted position), the rest
-    of a walk reads ``pts``. `_LINES_V` also counts into ``hist_v[k]`` the vertical lines
+    of a walk reads ``pts``. `_LINES_V` also accounts in ``hist_v[k]`` the vertical lines
     starting at the entries ``(i, j)`` and ``(j, i)`` (window ``wv``, the true one).
     """
     total = 0
@@ -266,7 +280,7 @@ def _visit_block(
                                     pts, i + length, j + length, e2
                                 ):
                                     length += 1
-                            hist_d[k, length] += 1
+                            _add_line(hist_d[k], length)
                         if mode == _LINES_V:
                             _vertical_line(pts, ia, ib, e2, wv, hist_v[k])
                             _vertical_line(pts, ib, ia, e2, wv, hist_v[k])
@@ -690,29 +704,31 @@ def _pairs_csr(pts: np.ndarray, eps: float, w: int):
 
 
 @njit(cache=True)
-def _diagonal_vertical_lines(pts, eps2, hist_v):
+def _diagonal_vertical_lines(pts, eps2, sums_v):
     """Vertical lines starting on the main diagonal (``w = 0``: entries ``(i, i)``)."""
     for i in range(pts.shape[0]):
-        _vertical_line(pts, i, i, eps2, 0, hist_v)
+        _vertical_line(pts, i, i, eps2, 0, sums_v)
 
 
-def _line_histograms(pts: np.ndarray, eps_list, w: int, vertical: bool):
+def _line_sums(pts: np.ndarray, eps_list, w: int, l_min: int, vertical: bool):
     """(pairs, diag, vert) for each threshold of ``eps_list`` (decreasing), in one sweep.
 
     ``pairs[k]``: recurrent unordered pairs ``i != j`` outside the window at
-    ``eps_list[k]``; ``diag[k, l]`` the diagonal lines of length ``l`` in the upper
-    triangle (the main diagonal is left to the caller); ``vert[k, v]`` the vertical lines
-    of the whole matrix (all zero unless ``vertical``), over the admissible entries
+    ``eps_list[k]``; ``diag[k] = (l_min, lines, entries on them, longest)`` over the
+    diagonal lines of the upper triangle (the main diagonal is left to the caller), where
+    ``lines`` counts those of length ``>= l_min``; ``vert[k]`` the same for the vertical
+    lines of the whole matrix (zeros unless ``vertical``), over the admissible entries
     ``|i - j| >= w``. The cell list is built for the largest threshold, whose candidate
-    pairs contain those of the smaller ones. O(N) memory per threshold.
+    pairs contain those of the smaller ones. O(N) memory (the cells and the time
+    neighbours); no pair and no histogram is stored.
     """
-    n = pts.shape[0]
     m = len(eps_list)
     xs, ys, perm, cell_start, cell_key, ncx, nb = _cells(pts, eps_list[0], neighbours=True)
     eps2s = np.array([e * e for e in eps_list])
     pairs = np.zeros(m, np.int64)
-    diag = np.zeros((m, n + 1), np.int64)
-    vert = np.zeros((m, n + 1), np.int64)
+    diag = np.zeros((m, 4), np.int64)
+    vert = np.zeros((m, 4), np.int64)
+    diag[:, 0] = vert[:, 0] = l_min
     mode = _LINES_V if vertical else _LINES
     _sweep(
         xs,
