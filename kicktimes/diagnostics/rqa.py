@@ -11,11 +11,13 @@ Its recurrent pairs are enumerated once by the cell-list sweep of
   and its length is accounted (lines of length >= l_min, entries on them, longest).
   Every line is counted once, at its start;
 * a **vertical line** is a maximal run ``(i + k, j)`` in one column, counted the same
-  way from the entries ``(i, j)`` and ``(j, i)`` of each pair.
+  way (predecessor test, then a walk) from every recurrent entry of the recurrence
+  plot's rows; only for the laminarity, which therefore costs a second sweep and
+  O(pairs) memory.
 
 The distance test is the sweep's float expression, so the result equals the
-brute-force matrix computation exactly. Memory is O(N) (the cells; no pair is
-stored); time O(N + candidate pairs + recurrent pairs). See `rqa` and
+brute-force matrix computation exactly. Without laminarity memory is O(N) (the cells;
+no pair is stored) and time O(N + candidate pairs + recurrent pairs). See `rqa` and
 docs/diagnostics.md.
 """
 
@@ -110,8 +112,9 @@ def rqa(points, eps=1e-3, *, theiler=1, l_min=2, laminarity=True):
     l_min : int, default 2
         Minimal length of a diagonal (and of a vertical) line, ``>= 1``.
     laminarity : bool, default True
-        Also compute ``lam``, ``tt``, ``v_max`` (two more distance tests per recurrent
-        pair; with ``False`` the fields are ``None``).
+        Also compute ``lam``, ``tt``, ``v_max`` (a second sweep that keeps the recurrent
+        pairs, O(N + pairs) memory, 2-5x the time; with ``False`` the fields are
+        ``None`` and memory stays O(N)).
 
     Returns
     -------
@@ -157,11 +160,13 @@ def rqa(points, eps=1e-3, *, theiler=1, l_min=2, laminarity=True):
     recurrent diagonal neighbour; ``DET`` and ``LAM`` are NaN when ``R = 0``, ``L`` and
     ``TT`` when no line reaches ``l_min``; ``l_max`` and ``v_max`` are 0 when ``R = 0``.
 
-    Cost: one sweep of the cell list of `recurrence_rate`; each recurrent pair adds one
-    distance test for its diagonal predecessor (two more for the vertical ones) and each
-    line is walked once. O(N) memory (no pair is stored, never an ``N x N`` matrix);
-    about 1.1x the time of `recurrence_rate` at eps = 1e-3 and 1.3-1.9x at 1e-2 for
-    N = 25 000 (benchmarks/bench_recurrence.py).
+    Cost: one sweep of the cell list of `recurrence_rate`, for all thresholds at once
+    (at the largest); each recurrent pair adds two distance tests (predecessor and
+    successor, read from the time neighbours gathered in cell order) and each line of
+    length ``>= 2`` is walked once. O(N) memory, never an ``N x N`` matrix nor the pair
+    list; about 1.1x the time of `recurrence_rate` at eps = 1e-3 and 1.6-1.8x at 1e-2
+    for N = 25 000 (``laminarity=False``; benchmarks/bench_recurrence.py). The
+    laminarity adds a sweep that collects the pairs into sorted rows.
 
     References
     ----------
