@@ -8,13 +8,16 @@ Its recurrent pairs are enumerated once by the cell-list sweep of
   ``k = 0..l-1``, on one diagonal ``j - i = d``. When the sweep meets a pair ``i < j``
   whose predecessor ``(i - 1, j - 1)`` is not recurrent, the pair starts a line: the
   line is walked, ``(i + 1, j + 1), (i + 2, j + 2), ...``, testing distances directly,
-  and its length goes into a histogram. Every line is counted once, at its start;
+  and its length is accounted (lines of length >= l_min, entries on them, longest).
+  Every line is counted once, at its start;
 * a **vertical line** is a maximal run ``(i + k, j)`` in one column, counted the same
-  way from the entries ``(i, j)`` and ``(j, i)`` of each pair.
+  way (predecessor test, then a walk) from every recurrent entry of the recurrence
+  plot's rows; only for the laminarity, which therefore costs a second sweep and
+  O(pairs) memory.
 
 The distance test is the sweep's float expression, so the result equals the
-brute-force matrix computation exactly. Memory is O(N) (two histograms; no pair is
-stored); time O(N + candidate pairs + recurrent pairs). See `rqa` and
+brute-force matrix computation exactly. Without laminarity memory is O(N) (the cells;
+no pair is stored) and time O(N + candidate pairs + recurrent pairs). See `rqa` and
 docs/diagnostics.md.
 """
 
@@ -24,32 +27,15 @@ import numbers
 from dataclasses import asdict, dataclass, field
 
 import numpy as np
-from numba import njit
 
 from kicktimes.diagnostics.recurrence import (
     _as_points,
     _check_eps,
     _check_theiler,
-    _line_histograms,
+    _line_sums,
 )
 
 __all__ = ["RQAResult", "rqa"]
-
-
-@njit(cache=True)
-def _line_sums(hist, l_min):
-    """(number of lines of length >= l_min, entries on them, longest line) of a histogram."""
-    lines = 0
-    on = 0
-    longest = 0
-    for length in range(1, hist.shape[0]):
-        c = hist[length]
-        if c:
-            longest = length
-            if length >= l_min:
-                lines += c
-                on += c * length
-    return lines, on, longest
 
 
 @dataclass(frozen=True)
@@ -126,8 +112,9 @@ def rqa(points, eps=1e-3, *, theiler=1, l_min=2, laminarity=True):
     l_min : int, default 2
         Minimal length of a diagonal (and of a vertical) line, ``>= 1``.
     laminarity : bool, default True
-        Also compute ``lam``, ``tt``, ``v_max`` (two more distance tests per recurrent
-        pair; with ``False`` the fields are ``None``).
+        Also compute ``lam``, ``tt``, ``v_max`` (a second sweep that keeps the recurrent
+        pairs, O(N + pairs) memory, 2-5x the time; with ``False`` the fields are
+        ``None`` and memory stays O(N)).
 
     Returns
     -------
@@ -173,11 +160,13 @@ def rqa(points, eps=1e-3, *, theiler=1, l_min=2, laminarity=True):
     recurrent diagonal neighbour; ``DET`` and ``LAM`` are NaN when ``R = 0``, ``L`` and
     ``TT`` when no line reaches ``l_min``; ``l_max`` and ``v_max`` are 0 when ``R = 0``.
 
-    Cost: one sweep of the cell list of `recurrence_rate`; each recurrent pair adds one
-    distance test for its diagonal predecessor (two more for the vertical ones) and each
-    line is walked once. O(N) memory (no pair is stored, never an ``N x N`` matrix);
-    about 1.1x the time of `recurrence_rate` at eps = 1e-3 and 1.3-1.9x at 1e-2 for
-    N = 25 000 (benchmarks/bench_recurrence.py).
+    Cost: one sweep of the cell list of `recurrence_rate`, for all thresholds at once
+    (at the largest); each recurrent pair adds two distance tests (predecessor and
+    successor, read from the time neighbours gathered in cell order) and each line of
+    length ``>= 2`` is walked once. O(N) memory, never an ``N x N`` matrix nor the pair
+    list; about 1.1x the time of `recurrence_rate` at eps = 1e-3 and 1.6-1.8x at 1e-2
+    for N = 25 000 (``laminarity=False``; benchmarks/bench_recurrence.py). The
+    laminarity adds a sweep that collects the pairs into sorted rows.
 
     References
     ----------
@@ -212,7 +201,7 @@ def rqa(points, eps=1e-3, *, theiler=1, l_min=2, laminarity=True):
         eps_list = [_check_eps(e.item()) for e in eps_arr]
     # one sweep at the largest threshold serves them all (decreasing order inside)
     order = sorted(range(len(eps_list)), key=lambda k: -eps_list[k])
-    pairs, diag, vert = _line_histograms(pts, [eps_list[k] for k in order], w, laminarity)
+    pairs, diag, vert = _line_sums(pts, [eps_list[k] for k in order], w, l_min, laminarity)
     results = [None] * len(eps_list)
     for row, k in enumerate(order):
         results[k] = _summarise(
@@ -222,11 +211,11 @@ def rqa(points, eps=1e-3, *, theiler=1, l_min=2, laminarity=True):
 
 
 def _summarise(eps, n, w, l_min, pairs, diag_up, vert) -> RQAResult:
-    """The measures from the pair count and the line histograms of one threshold."""
+    """The measures from the pair count and the line sums of one threshold."""
     # Python ints from here on: exact counts, correctly rounded ratios
     n_rec = 2 * pairs + (n if w == 0 else 0)
     n_adm = n * n if w == 0 else (n - w) * (n - w + 1)
-    lines, on_lines, l_max = (int(v) for v in _line_sums(diag_up, l_min))
+    lines, on_lines, l_max = (int(v) for v in diag_up[1:])
     lines, on_lines = 2 * lines, 2 * on_lines  # the mirror image below the diagonal
     if w == 0:  # the main diagonal: one line of length N
         l_max = n
@@ -246,7 +235,7 @@ def _summarise(eps, n, w, l_min, pairs, diag_up, vert) -> RQAResult:
     l_mean = ratio("l_mean", on_lines, lines, f"no diagonal line of length >= l_min = {l_min}")
     lam = tt = v_max = None
     if vert is not None:
-        v_lines, on_v_lines, v_max = (int(v) for v in _line_sums(vert, l_min))
+        v_lines, on_v_lines, v_max = (int(v) for v in vert[1:])
         lam = ratio("lam", on_v_lines, n_rec, no_pair)
         tt = ratio("tt", on_v_lines, v_lines, f"no vertical line of length >= l_min = {l_min}")
     return RQAResult(
