@@ -6,9 +6,17 @@ diagnostics each, then builds the report (if ``kicktimes.report`` is available),
 prints the wall times with a breakdown by stage (summed over tasks, i.e. worker-seconds,
 from the timings each task records in the store manifest).
 
-Reference measured in the same run: a subset of family A (3 radii x 16 ICs, the full
-25000 steps) with one worker and with all workers, giving the parallel speed-up and the
-per-IC cost of each stage.
+References measured in the same run:
+
+* the bare two-disk simulation of the same ICs (every radius and IC of every family, the
+  experiments' own steps and sampling, no diagnostics, no store, one process): the whole
+  paper's wall time is printed as a multiple of it, with a Markdown row for the README's
+  speed table;
+* a subset of family A (3 radii x 16 ICs, the full 25000 steps) with one worker and with
+  all workers, giving the parallel speed-up and the per-IC cost of each stage.
+
+The report is built twice: from scratch, then again with nothing changed (the cached
+rebuild, which must not recompute anything).
 
 Usage::
 
@@ -55,6 +63,41 @@ def stage_table(store) -> pd.DataFrame:
     rows.append({"stage": "other (ICs, loop)", "worker_s": other, "share": other / total})
     rows.append({"stage": "total (worker-seconds)", "worker_s": total, "share": 1.0})
     return pd.DataFrame(rows)
+
+
+def bare_simulation(names) -> tuple[float, int]:
+    """Seconds to simulate every radius x IC of the experiments ``names`` as two bare
+    disks (the sweep's first step, nothing else), in this process; and the run count."""
+    from kicktimes import initial_conditions, simulate_two_particle
+
+    t0 = time.perf_counter()
+    n = 0
+    for name in names:
+        exp = preset(name)
+        ics = initial_conditions(
+            exp.n_ics, exp.r_max, seed=exp.seed, method=exp.ic_method, rule=exp.rule
+        )
+        for r in exp.radii:
+            for ic in ics:
+                simulate_two_particle(
+                    ic,
+                    r,
+                    rule=exp.rule,
+                    track=0,
+                    seed=exp.seed,
+                    n_steps=exp.n_steps,
+                    tau=exp.tau,
+                    sampling=exp.sampling,
+                )
+                n += 1
+    return time.perf_counter() - t0, n
+
+
+def report_breakdown(timings: pd.DataFrame) -> pd.DataFrame:
+    """Report seconds per stage, summed over the experiments (sections run in workers, so
+    the sum can exceed the wall time)."""
+    t = timings.groupby("stage", sort=False)["seconds"].sum().reset_index()
+    return t.sort_values("seconds", ascending=False, ignore_index=True)
 
 
 def reference(workers: int, root: Path) -> dict:
@@ -143,12 +186,27 @@ def main():
             timings = root / "report" / "report_timings.csv"
             print(f"\nreport (statistics + figures + HTML): wall {report_wall:.1f} s")
             if timings.exists():
-                print(pd.read_csv(timings).to_string(index=False))
-                results["report_stages"] = pd.read_csv(timings).to_dict(orient="records")
+                t = pd.read_csv(timings).fillna("")
+                print(t.to_string(index=False, float_format=lambda x: f"{x:.2f}"))
+                print("\nreport seconds by stage, summed over experiments:")
+                print(report_breakdown(t).to_string(index=False, float_format="{:.2f}".format))
+                results["report_stages"] = t.to_dict(orient="records")
+            t0 = time.perf_counter()
+            build_report(stores, root / "report", workers=args.workers, progress=False)
+            rerun = time.perf_counter() - t0
+            results["report_rerun_s"] = rerun
+            print(f"report rebuilt with nothing changed (cache): wall {rerun:.2f} s")
     results["sweep_wall_s"] = sweep_wall
     results["report_wall_s"] = report_wall
     total = sweep_wall + (report_wall or 0.0)
     results["total_wall_s"] = total
+
+    bare, n_runs = bare_simulation(SCALES[args.scale])
+    results["bare_simulation_s"] = bare
+    print(
+        f"\nreference (same run): bare two-disk simulation of the same {n_runs} radius-IC "
+        f"pairs, one process: {bare:.2f} s; whole paper = {total / bare:.1f}x that"
+    )
 
     print("\nreference (same run): subset of family A, 3 radii x 16 ICs x 25000 steps")
     ref = reference(args.workers, root)
@@ -163,6 +221,16 @@ def main():
         f"{report_wall if report_wall is not None else float('nan'):.1f} s = {total:.1f} s "
         f"({total / 60:.2f} min; target < 10 min, aim < 2 min); "
         f"load average at end {os.getloadavg()[0]:.2f}"
+    )
+    families = " + ".join(SCALES[args.scale])
+    print("\nREADME speed table row:")
+    print(
+        f"| **the whole paper** ({args.scale} scale: {families}, {n_runs} radius-IC pairs x 3 "
+        f"systems x 3 diagnostics) + report, {args.workers} workers "
+        f"| **{total:.0f} s** (sweeps {sweep_wall:.0f} s, report {report_wall or 0:.0f} s; "
+        f"unchanged rerun of the report {results.get('report_rerun_s', float('nan')):.1f} s) "
+        f"| the bare two-disk simulation of the same ICs in one process: {bare:.1f} s, "
+        f"**{total / bare:.0f}x**; 1 -> {args.workers} workers: {w1 / wn:.2f}x |"
     )
     if args.json:
         args.json.write_text(json.dumps(results, indent=1, default=str))

@@ -33,6 +33,7 @@ FIGURES = {
     "fig05_lyapunov_vs_radius",
     "fig06_recurrence_rate_vs_radius",
     "fig07_autocorrelation_vs_radius",
+    "fig07b_autocorrelation_curves",
     "fig08_poisson_rejection_rates",
     "fig09_renewal_model_comparison",
     "fig10_rate_heterogeneity",
@@ -49,6 +50,7 @@ TABLES = {
     "lyapunov_stretching",
     "recurrence_by_radius",
     "autocorrelation_summary",
+    "autocorrelation_curves",
     "sticky_ics",
     "findings",
     "poisson_tests",
@@ -98,11 +100,11 @@ def test_report_html_is_self_contained_with_one_embedded_image_per_figure(built)
     assert "<link" not in page and "<script" not in page  # nothing to fetch
 
 
-def test_every_figure_is_saved_as_png_and_pdf(built):
+def test_every_figure_is_saved_as_png_and_no_pdf_by_default(built):
     _, out, _ = built
     assert {p.stem for p in out.glob("*.png")} == FIGURES
-    for name in FIGURES:
-        assert (out / f"{name}.pdf").read_bytes()[:5] == b"%PDF-"
+    assert not list(out.glob("*.pdf"))
+    assert 'PDF</a>' not in (out / "report.html").read_text(encoding="utf-8")
 
 
 def test_every_table_is_saved_as_csv(built):
@@ -189,7 +191,7 @@ def test_several_stores_give_one_report_with_a_part_per_experiment(built, store_
     assert "Experiment tiny_report</h2>" in page and "Experiment tiny_report_b</h2>" in page
     assert re.search(r"<b>seed</b></td><td>8</td>", page)
     assert (out / "families_autocorrelation_vs_radius.png").is_file()  # paper's top/bottom
-    assert (out / "tiny_report_b_fig07_autocorrelation_vs_radius.pdf").is_file()
+    assert (out / "tiny_report_b_fig07_autocorrelation_vs_radius.png").is_file()
     assert not (out / "tiny_report_b_fig06_recurrence_rate_vs_radius.png").exists()
     # the paper's Fig. 7 layout: family A (the first store) on top and zoomed below
     assert (out / "families_recurrence_rate_vs_radius.png").is_file()
@@ -306,3 +308,84 @@ def test_write_results_gives_pngs_and_a_generated_findings_page(store_path, tmp_
     for name in pngs:
         assert f"]({name})" in text
     assert (tmp_path / "tiny_report_findings.csv").is_file()
+
+
+# ------------------------------------------------------------------ cache
+
+
+def _snapshot(folder):
+    """{name: (mtime_ns, size)} of every file in ``folder``, the cache manifest included."""
+    return {p.name: (p.stat().st_mtime_ns, p.stat().st_size) for p in folder.iterdir()}
+
+
+def test_a_rebuild_with_nothing_changed_writes_nothing_within_3_seconds(built, store_path):
+    import time
+
+    path, out, _ = built
+    before = _snapshot(out)
+    assert ".cache.json" in before
+    t0 = time.perf_counter()
+    again = build_report(store_path, out, progress=False, **OPTIONS, workers=2)
+    assert time.perf_counter() - t0 < 3.0
+    assert again == path
+    assert _snapshot(out) == before
+
+
+def test_a_damaged_output_is_rebuilt_and_no_temporary_file_is_left(built, store_path, tmp_path):
+    import shutil
+
+    out = tmp_path / "copy"
+    shutil.copytree(built[1], out)
+    (out / "poisson_tests.csv").write_text("damaged")
+    (out / "fig04_counts_vs_radius.png").unlink()
+    build_report(store_path, out, progress=False, **OPTIONS, workers=1)
+    pd.testing.assert_frame_equal(
+        pd.read_csv(out / "poisson_tests.csv"), pd.read_csv(built[1] / "poisson_tests.csv")
+    )
+    assert (out / "fig04_counts_vs_radius.png").read_bytes() == (
+        built[1] / "fig04_counts_vs_radius.png"
+    ).read_bytes()  # the same figure, bit for bit
+    assert not [p for p in out.iterdir() if p.name.endswith(".tmp")]
+
+
+def test_pdf_copies_are_written_on_request_and_removed_when_no_longer_asked(
+    built, store_path, tmp_path
+):
+    import shutil
+
+    out = tmp_path / "copy"
+    shutil.copytree(built[1], out)
+    build_report(store_path, out, progress=False, **OPTIONS, workers=1, pdf=True)
+    for name in FIGURES:
+        assert (out / f"{name}.pdf").read_bytes()[:5] == b"%PDF-"
+    assert f'<a href="{sorted(FIGURES)[0]}.pdf">PDF</a>' in (out / "report.html").read_text()
+    build_report(store_path, out, progress=False, **OPTIONS, workers=1)
+    assert not list(out.glob("*.pdf"))
+
+
+def test_a_store_that_gains_a_task_rebuilds_only_its_own_part(store_path, tmp_path):
+    import json
+
+    second = tmp_path / "store_b"
+    run_experiment(SECOND, second, workers=1, progress=False)
+    # take the last task out of store B (entry and files), as if it had not run yet
+    manifest = json.loads((second / "manifest.json").read_text())
+    last = sorted(manifest["tasks"])[-1]
+    for part in ("results", "collisions"):
+        (second / part / f"{last}.parquet").unlink()
+    del manifest["tasks"][last]
+    (second / "manifest.json").write_text(json.dumps(manifest))
+    out = tmp_path / "both"
+    build_report([store_path, second], out, progress=False, **OPTIONS, workers=1)
+    before = _snapshot(out)
+    run_experiment(SECOND, second, workers=1, progress=False)  # resumes: one new task
+    build_report([store_path, second], out, progress=False, **OPTIONS, workers=1)
+    after = _snapshot(out)
+    changed = {name for name in after if after[name] != before.get(name)}
+    assert changed, "the new task must rebuild something"
+    assert all(not n.startswith("tiny_report_") or n.startswith("tiny_report_b_") for n in changed)
+    assert {"tiny_report_b_findings.csv", "report.html", ".cache.json"} <= changed
+    assert "tiny_report_findings.csv" not in changed  # store A's part is reused
+    timings = pd.read_csv(out / "report_timings.csv")
+    reused = timings[timings["stage"] == "reused from the cache"]
+    assert list(reused["experiment"]) == ["tiny_report"]

@@ -1,17 +1,30 @@
-"""Writing the report: figures (PNG + PDF), tables (CSV), and the HTML of the sections."""
+"""Writing the report: figures (PNG, optionally PDF), tables (CSV), and the HTML of the
+sections; every file atomically (:func:`kicktimes.report._cache.atomic_write`)."""
 
 from __future__ import annotations
 
 import base64
 import html
+import io
 import os
+import re
 from pathlib import Path
 
 import pandas as pd
 
 from kicktimes import __version__
+from kicktimes.report._cache import atomic_write
 
-__all__ = ["write_outputs", "store_header", "table_html", "CSS"]
+__all__ = [
+    "write_outputs",
+    "embed_figures",
+    "save_figure",
+    "write_table",
+    "write_text",
+    "store_header",
+    "table_html",
+    "CSS",
+]
 
 #: 4 significant figures in every HTML table (the CSV files keep full precision)
 _FLOAT = "{:.4g}".format
@@ -36,20 +49,62 @@ def table_html(df):
     return f'<div class="table-wrap">{inner}</div>'
 
 
-def write_outputs(sections, out, dpi, prefix=""):
-    """Save figures (PNG + PDF) and tables (CSV); return the HTML of the sections."""
+def save_figure(fig, out, name, dpi, files, *, pdf=False):
+    """Write ``fig`` as ``name.png`` (and ``name.pdf``), atomically; record their SHA-256
+    in ``files``; return the PNG's bytes."""
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=dpi)
+    png = buf.getvalue()
+    files[f"{name}.png"] = atomic_write(out / f"{name}.png", png)
+    if pdf:
+        buf = io.BytesIO()
+        # no creation date: the same figure gives the same bytes (and cache entry)
+        fig.savefig(buf, format="pdf", metadata={"CreationDate": None})
+        files[f"{name}.pdf"] = atomic_write(out / f"{name}.pdf", buf.getvalue())
+    return png
+
+
+def write_table(out, name, df, files):
+    """``df`` as ``name.csv`` (no index), atomically, its SHA-256 recorded in ``files``."""
+    files[f"{name}.csv"] = atomic_write(out / f"{name}.csv", df.to_csv(index=False).encode())
+
+
+def write_text(out, filename, text, files):
+    files[filename] = atomic_write(out / filename, text.encode("utf-8"))
+
+
+#: the page embeds each figure's PNG; the cached HTML fragments name the file instead
+#: (``src="kt-png:NAME.png"``) and :func:`embed_figures` inlines it when the page is written
+_PNG_REF = re.compile(r'src="kt-png:([^"/\\]+\.png)"')
+
+
+def embed_figures(fragment, out):
+    """``fragment`` with every ``kt-png:`` reference replaced by the file's base64 data."""
+
+    def inline(match):
+        data = base64.b64encode((out / match.group(1)).read_bytes()).decode("ascii")
+        return f'src="data:image/png;base64,{data}"'
+
+    return _PNG_REF.sub(inline, fragment)
+
+
+def write_outputs(sections, out, dpi, prefix="", *, pdf=False, files=None):
+    """Save figures (PNG, and PDF if ``pdf``) and tables (CSV), atomically, recording each
+    file's SHA-256 in ``files``; return the HTML of the sections, whose images reference
+    the PNG files (see :func:`embed_figures`)."""
+    files = {} if files is None else files
     body = []
     for sec in sections:
         body.append(f'<h3 id="{prefix}{sec.key}">{html.escape(sec.title)}</h3>')
         for name, fig, caption in sec.figures:
             name = prefix + name
-            fig.savefig(out / f"{name}.png", dpi=dpi)
-            fig.savefig(out / f"{name}.pdf")
-            data = base64.b64encode((out / f"{name}.png").read_bytes()).decode("ascii")
+            save_figure(fig, out, name, dpi, files, pdf=pdf)
+            links = f'<a href="{name}.png">PNG</a>' + (
+                f', <a href="{name}.pdf">PDF</a>' if pdf else ""
+            )
             body.append(
-                f'<figure><img alt="{html.escape(name)}" src="data:image/png;base64,{data}">'
-                f'<figcaption>{html.escape(caption)} Files: <a href="{name}.png">PNG</a>, '
-                f'<a href="{name}.pdf">PDF</a>.</figcaption></figure>'
+                f'<figure><img alt="{html.escape(name)}" src="kt-png:{name}.png">'
+                f"<figcaption>{html.escape(caption)} Files: {links}.</figcaption></figure>"
             )
         for kind, block in sec.blocks:
             if kind == "banner":
@@ -61,7 +116,7 @@ def write_outputs(sections, out, dpi, prefix=""):
                 body.append(f"<p>{html.escape(block)}</p>")
         for name, df, title, show in sec.tables:
             name = prefix + name
-            df.to_csv(out / f"{name}.csv", index=False)
+            write_table(out, name, df, files)
             link = f'<a href="{name}.csv">{name}.csv</a>'
             if show:
                 body.append(f"<h4>{html.escape(title)} ({link})</h4>{table_html(df)}")

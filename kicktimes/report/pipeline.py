@@ -4,6 +4,13 @@ Each section is one module of :mod:`kicktimes.report` holding its computation, f
 text; :data:`STAGES` lists them in page order, so adding a diagnostic means writing one
 module and adding it here (and, for the Findings, to
 :data:`kicktimes.report.findings.EFFECT_MODULES`).
+
+A build is made of parts (one per experiment, the all-experiments figures, the page),
+each cached under a key of what it depends on (:mod:`kicktimes.report._cache`): a rerun
+with nothing changed writes nothing, and a store that gained a task rebuilds that
+experiment's part and the page only. The parts to build run at the same time on the
+process pool (each experiment's statistics, figures and files in one worker), so the
+heavy statistics of both families overlap instead of following each other.
 """
 
 from __future__ import annotations
@@ -12,6 +19,7 @@ import datetime as _dt
 import html
 import os
 import time
+from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 import numpy as np
@@ -32,6 +40,7 @@ from kicktimes.report import (
     summary,
     trajectories,
 )
+from kicktimes.report._cache import ReportCache, content_key, store_key
 from kicktimes.report._common import (
     Context,
     Mapper,
@@ -41,7 +50,15 @@ from kicktimes.report._common import (
     check_int,
 )
 from kicktimes.report._figures import DIAGNOSTIC_LABELS
-from kicktimes.report.html import CSS, store_header, table_html, write_outputs
+from kicktimes.report.html import (
+    CSS,
+    embed_figures,
+    store_header,
+    table_html,
+    write_outputs,
+    write_table,
+    write_text,
+)
 
 __all__ = ["build_report", "analyse", "STAGES"]
 
@@ -74,6 +91,91 @@ def analyse(ctx, *, bar, timings):
         timings.append((ctx.exp.name, stage, time.perf_counter() - t0))
         bar.advance()
     return found, secs, ctx.notes
+
+
+def _read_manifest(path):
+    """A store's manifest (cheap: no part file is read); ValueError if not a store."""
+    from kicktimes.experiment.store import MANIFEST, _read_manifest
+
+    root = Path(path)
+    if not (root / MANIFEST).is_file():
+        raise ValueError(f"path: {os.fspath(root)!r} is not a kicktimes store (no {MANIFEST})")
+    return _read_manifest(root)
+
+
+def _sweep_seconds(manifest):
+    """Per-stage sweep seconds summed over the finished tasks (as ``Store.timings``)."""
+    rows = {tid: e.get("timings", {}) for tid, e in manifest["tasks"].items()}
+    return pd.DataFrame.from_dict(rows, orient="index").sort_index().sum(numeric_only=True)
+
+
+def experiment_part(job, bar=None):
+    """Build one experiment's part: load its store, run every section, write its figures
+    and tables; return what the page needs (HTML fragments, files, timings), JSON-ready.
+
+    Runs in a worker process (``bar`` None) or in this one with a progress bar.
+    """
+    from kicktimes.experiment import load_store
+
+    path, out, prefix, options, render, workers = job
+    out = Path(out)
+    t0 = time.perf_counter()
+    store = load_store(path)
+    name = store.experiment.name
+    timings = [(name, "load store", time.perf_counter() - t0)]
+    pool = Mapper(workers)
+    try:
+        ctx = Context(store, pmap=pool.map, **options)
+        found, secs, notes = analyse(ctx, bar=bar or Progress(False, 0), timings=timings)
+    finally:
+        pool.close()
+    t0 = time.perf_counter()
+    files = {}
+    findings_html = write_outputs(
+        [found], out, render["dpi"], prefix, pdf=render["pdf"], files=files
+    )
+    header, params = store_header(store, notes)
+    write_table(out, f"{prefix}experiment", params, files)
+    write_text(out, f"{prefix}experiment.toml", store.experiment.to_toml(), files)
+    body = write_outputs(secs, out, render["dpi"], prefix, pdf=render["pdf"], files=files)
+    timings.append((name, "write files", time.perf_counter() - t0))
+    items = "".join(f'<li><a href="#{prefix}{s.key}">{html.escape(s.title)}</a></li>' for s in secs)
+    return {
+        "key": content_key("experiment", store_key(path, store.manifest), options, render, prefix),
+        "files": files,
+        "findings_html": findings_html,
+        "findings_toc": f'<li><a href="#{prefix}findings">{html.escape(found.title)}</a></li>',
+        "html": f'<h2 id="{prefix}experiment">Experiment {html.escape(name)}</h2>{header}{body}',
+        "toc": (
+            f'<li><a href="#{prefix}experiment">Experiment {html.escape(name)}</a>'
+            f"<ul>{items}</ul></li>"
+        ),
+        "timings": [list(t) for t in timings],
+    }
+
+
+def families_part(paths, out, render):
+    """The all-experiments figures (:func:`families_section`) as a cache part."""
+    from kicktimes.experiment import load_store
+
+    t0 = time.perf_counter()
+    stores = [load_store(p) for p in paths]
+    families = families_section(stores)
+    files = {}
+    fragment, toc = "", ""
+    if families is not None:
+        fragment = write_outputs(
+            [families], Path(out), render["dpi"], pdf=render["pdf"], files=files
+        )
+        toc = f'<li><a href="#{families.key}">{html.escape(families.title)}</a></li>'
+    keys = [store_key(p, st.manifest) for p, st in zip(paths, stores, strict=True)]
+    return {
+        "key": content_key("families", keys, render),
+        "files": files,
+        "html": fragment,
+        "toc": toc,
+        "timings": [["", "all-experiments figures", time.perf_counter() - t0]],
+    }
 
 
 def families_section(stores):
@@ -134,6 +236,8 @@ def build_report(
     workers=None,
     n_boot=2000,
     tolerance=0.1,
+    pdf=False,
+    force=False,
 ) -> Path:
     r"""Build the report of one or several sweeps: tables, figures, a self-contained page.
 
@@ -165,14 +269,20 @@ def build_report(
     dpi : int, optional
         Resolution of the PNG files.
     workers : int, optional
-        Processes for the Poisson tests (one job per radius) and the renewal fits (one
-        job per sample); default ``os.cpu_count()``; ``1`` computes in this process.
+        Processes (default ``os.cpu_count()``; ``1`` computes everything in this
+        process). With several stores to (re)build, each store's part runs in its own
+        worker, so both families' statistics and figures overlap; with one, its Poisson
+        tests (one job per radius) and renewal fits (one job per sample) use the pool.
         The results do not depend on it.
     n_boot : int, optional
         Bootstrap resamples (over ICs) of the Findings' confidence intervals.
     tolerance : float, optional
         Half-width of the "agrees" band of a ratio's verdict: agrees when the 95 % CI
         lies inside ``[1 - tolerance, 1 + tolerance]`` (see :mod:`kicktimes.report.effects`).
+    pdf : bool, optional
+        Also write a PDF of every figure (the page embeds the PNGs; default False).
+    force : bool, optional
+        Rebuild everything, ignoring the cache ``out_dir/.cache.json``.
 
     Returns
     -------
@@ -184,7 +294,13 @@ def build_report(
     The page opens with the Findings of each store (:mod:`kicktimes.report.findings`):
     one computed statement per question with its effect size, 95 % CI and verdict, a
     banner when the store is below paper scale, then one part per section module.
-    Deterministic: the Monte Carlo streams derive from each experiment's seed
+    Cached: each experiment's part is keyed by its store's content as the manifest records
+    it (per-task SHA-256 entries, experiment hash), the options and the kicktimes version;
+    a rebuild with nothing changed writes nothing and returns at once, a store that
+    changed rebuilds its own part and the page only (:mod:`kicktimes.report._cache`). The
+    cache trusts the store's manifest; ``force=True`` rebuilds from the part files.
+    Every file is written atomically (temporary file, then rename). Deterministic: the
+    Monte Carlo streams derive from each experiment's seed
     (``SeedSequence(seed, spawn_key=(REPORT_DOMAIN, ...))``), the trajectories from its
     IC 0 and the Poisson kicks from the sweep's own ``kick_rng``. Every subsampling is
     listed in the report. Stage timings are written to ``report_timings.csv`` and the
@@ -202,20 +318,7 @@ def build_report(
     >>> build_report(store, tempfile.mkdtemp(), progress=False, workers=1).name
     'report.html'
     """
-    from kicktimes.experiment import load_store
-
-    if isinstance(store_path, str | os.PathLike):
-        paths = [store_path]
-    elif isinstance(store_path, list | tuple) and store_path:
-        paths = list(store_path)
-        for k, p in enumerate(paths):
-            if not isinstance(p, str | os.PathLike):
-                raise TypeError(f"store_path[{k}] must be a path, got {type(p).__name__}")
-    else:
-        raise TypeError(
-            "store_path must be a path or a non-empty list of paths, got "
-            f"{type(store_path).__name__}"
-        )
+    paths = _check_paths(store_path)
     if not isinstance(out_dir, str | os.PathLike):
         raise TypeError(f"out_dir must be a path, got {type(out_dir).__name__}")
     alpha = check_fraction("alpha", alpha)
@@ -227,94 +330,158 @@ def build_report(
     n_boot = check_int("n_boot", n_boot, 100)
     tolerance = check_fraction("tolerance", tolerance)
     workers = check_int("workers", (os.cpu_count() or 1) if workers is None else workers, 1)
-    bar = Progress(progress, 2 + len(STAGES) * len(paths))
-    pool = Mapper(workers)
+    for flag, value in (("pdf", pdf), ("force", force)):
+        if not isinstance(value, bool):
+            raise TypeError(f"{flag} must be True or False, got {type(value).__name__}")
+    if not (progress is None or isinstance(progress, bool) or callable(progress)):
+        raise TypeError(
+            f"progress must be None, a bool or a callable(stage, done, total), got "
+            f"{type(progress).__name__}"
+        )
+
+    t_start = time.perf_counter()
+    manifests = [_read_manifest(p) for p in paths]
+    for p, man in zip(paths, manifests, strict=True):
+        if not man["tasks"]:
+            raise ValueError(f"store_path: {os.fspath(p)!r} holds no finished task yet")
+    names = [str(man["experiment"].get("name")) for man in manifests]
+    if len(set(names)) != len(names):
+        raise ValueError(
+            f"store_path: the stores' experiments must have distinct names, got {names}"
+        )
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    options = dict(
+        alpha=alpha,
+        n_mc=n_mc,
+        max_ics_tests=max_ics_tests,
+        max_ics_model_fits=max_ics_model_fits,
+        max_pooled_intervals=max_pooled_intervals,
+        n_boot=n_boot,
+        tolerance=tolerance,
+    )
+    render = {"dpi": dpi, "pdf": pdf}
+    cache = ReportCache(out, fresh=force)
+    multi = len(paths) > 1
+    prefixes = [f"{n}_" if multi else "" for n in names]
+    part_ids = [f"experiment {n}" + (" (prefixed)" if multi else "") for n in names]
+    store_keys = [store_key(p, m) for p, m in zip(paths, manifests, strict=True)]
+    keys = {
+        pid: content_key("experiment", sk, options, render, prefix)
+        for pid, sk, prefix in zip(part_ids, store_keys, prefixes, strict=True)
+    }
+    if multi:
+        keys["families"] = content_key("families", store_keys, render)
+    parts = {pid: cache.lookup(pid, key) for pid, key in keys.items()}
+    page_key = content_key("page", [keys[pid] for pid in keys])
+    page = out / "report.html"
+    if all(e is not None for e in parts.values()) and cache.lookup("page", page_key):
+        return page  # nothing changed: every file in out_dir is what this build would write
+
+    todo = [k for k, pid in enumerate(part_ids) if parts[pid] is None]
+    families_todo = multi and parts["families"] is None
+    jobs = {part_ids[k]: (paths[k], out, prefixes[k], options, render, workers) for k in todo}
+    parallel = workers > 1 and len(jobs) + families_todo > 1
+    n_steps = 2 + (len(jobs) if parallel else len(STAGES) * len(jobs)) + families_todo
+    bar = Progress(progress, n_steps)
     try:
         bar.step("load store")
-        t0 = time.perf_counter()
-        stores = [load_store(p) for p in paths]
-        for p, st in zip(paths, stores, strict=True):
-            if st.results.empty or st.collisions.empty:
-                raise ValueError(f"store_path: {os.fspath(p)!r} holds no finished task yet")
-        names = [st.experiment.name for st in stores]
-        if len(set(names)) != len(names):
-            raise ValueError(
-                f"store_path: the stores' experiments must have distinct names, got {names}"
-            )
-        out = Path(out_dir)
-        out.mkdir(parents=True, exist_ok=True)
-        timings = [("", "load store", time.perf_counter() - t0)]
+        timings = [("", "check cache", time.perf_counter() - t_start)]
         bar.advance()
-        options = dict(
-            alpha=alpha,
-            n_mc=n_mc,
-            max_ics_tests=max_ics_tests,
-            max_ics_model_fits=max_ics_model_fits,
-            max_pooled_intervals=max_pooled_intervals,
-            n_boot=n_boot,
-            tolerance=tolerance,
-        )
-        analysed = [
-            analyse(Context(st, pmap=pool.map, **options), bar=bar, timings=timings)
-            for st in stores
-        ]
+        if parallel:
+            # one worker per part; each part's statistics then run in its own worker (or
+            # on a small pool of its own when there are more workers than parts)
+            inner = max(1, workers // len(jobs)) if jobs else 1
+            with ProcessPoolExecutor(max_workers=min(workers, len(jobs) or 1)) as ex:
+                futures = {
+                    pid: ex.submit(experiment_part, job[:-1] + (inner,))
+                    for pid, job in jobs.items()
+                }
+                if families_todo:  # in this process meanwhile
+                    bar.step("all-experiments figures")
+                    parts["families"] = families_part(paths, out, render)
+                    bar.advance()
+                for pid, fut in futures.items():
+                    bar.step(f"{pid}: sections (in a worker process)")
+                    parts[pid] = fut.result()
+                    bar.advance()
+        else:
+            for pid, job in jobs.items():
+                parts[pid] = experiment_part(job, bar)
+            if families_todo:
+                bar.step("all-experiments figures")
+                parts["families"] = families_part(paths, out, render)
+                bar.advance()
+        for pid in jobs:
+            timings += [tuple(t) for t in parts[pid]["timings"]]
+        if families_todo:
+            timings += [tuple(t) for t in parts["families"]["timings"]]
+        built = set(jobs) | ({"families"} if families_todo else set())
+        for pid in keys:
+            if pid in built:
+                cache.record(pid, parts[pid])
+
         bar.step("write files")
         t0 = time.perf_counter()
-        multi = len(stores) > 1
-        parts, toc, sweep_rows = [], [], []
-        # Findings first: every store's statements before any detail
-        for st, (findings, _, _) in zip(stores, analysed, strict=True):
-            prefix = f"{st.experiment.name}_" if multi else ""
-            parts.append(write_outputs([findings], out, dpi, prefix))
-            toc.append(f'<li><a href="#{prefix}findings">{html.escape(findings.title)}</a></li>')
-        if multi:
-            families = families_section(stores)
-            if families is not None:
-                parts.append(write_outputs([families], out, dpi))
-                toc.append(f'<li><a href="#{families.key}">{html.escape(families.title)}</a></li>')
-        for st, (_, secs, notes) in zip(stores, analysed, strict=True):
-            name = st.experiment.name
-            prefix = f"{name}_" if multi else ""
-            header, params = store_header(st, notes)
-            params.to_csv(out / f"{prefix}experiment.csv", index=False)
-            (out / f"{prefix}experiment.toml").write_text(st.experiment.to_toml(), encoding="utf-8")
-            sweep = st.timings.sum(numeric_only=True)
-            sweep_rows += [(name, stage, float(v)) for stage, v in sweep.items()]
-            body = write_outputs(secs, out, dpi, prefix)
-            parts.append(
-                f'<h2 id="{prefix}experiment">Experiment {html.escape(name)}</h2>{header}{body}'
-            )
-            items = "".join(
-                f'<li><a href="#{prefix}{s.key}">{html.escape(s.title)}</a></li>' for s in secs
-            )
-            toc.append(
-                f'<li><a href="#{prefix}experiment">Experiment {html.escape(name)}</a>'
-                f"<ul>{items}</ul></li>"
-            )
+        files = {}
+        sweep_rows = [
+            (name, stage, float(v))
+            for name, man in zip(names, manifests, strict=True)
+            for stage, v in _sweep_seconds(man).items()
+        ]
         sweep_t = pd.DataFrame(sweep_rows, columns=["experiment", "stage", "seconds"])
-        sweep_t.to_csv(out / "sweep_timings.csv", index=False)
-        timings.append(("", "write files", time.perf_counter() - t0))
-        bar.advance()
+        write_table(out, "sweep_timings", sweep_t, files)
+        reused = [
+            (n, "reused from the cache", 0.0)
+            for n, pid in zip(names, part_ids, strict=True)
+            if pid not in built
+        ]
+        timings += reused
+        timings.append(("", "write page", time.perf_counter() - t0))
         report_t = pd.DataFrame(timings, columns=["experiment", "stage", "seconds"])
-        report_t.to_csv(out / "report_timings.csv", index=False)
+        write_table(out, "report_timings", report_t, files)
+        ordered = [parts[pid] for pid in part_ids]
+        body = [e["findings_html"] for e in ordered]
+        toc = [e["findings_toc"] for e in ordered]
+        if multi and parts["families"]["html"]:
+            body.append(parts["families"]["html"])
+            toc.append(parts["families"]["toc"])
+        body += [e["html"] for e in ordered]
+        toc += [e["toc"] for e in ordered]
         title = " + ".join(names)
-        page = (
+        text = (
             '<!DOCTYPE html><html lang="en"><head><meta charset="utf-8">'
             f"<title>kicktimes report: {html.escape(title)}</title><style>{CSS}</style>"
             f"</head><body><h1>kicktimes report: {html.escape(title)}</h1>"
             f"<p>Built {_dt.datetime.now(_dt.timezone.utc).isoformat(timespec='seconds')} "
             f"with kicktimes {html.escape(__version__)} from "
-            + ", ".join(html.escape(os.fspath(Path(st.path).resolve())) for st in stores)
-            + f".</p><h2>Contents</h2><ul>{''.join(toc)}</ul>{''.join(parts)}"
-            "<h2>Timings</h2><p>Report stages (seconds, this build):</p>"
+            + ", ".join(html.escape(os.fspath(Path(p).resolve())) for p in paths)
+            + f".</p><h2>Contents</h2><ul>{''.join(toc)}</ul>{embed_figures(''.join(body), out)}"
+            "<h2>Timings</h2><p>Report stages (seconds, this build; parts reused from the "
+            "cache are listed as such):</p>"
             + table_html(report_t)
             + "<p>Sweep stages (seconds, summed over tasks and workers):</p>"
             + table_html(sweep_t)
             + "</body></html>"
         )
-        path = out / "report.html"
-        path.write_text(page, encoding="utf-8")
-        return path
+        write_text(out, "report.html", text, files)
+        cache.record("page", {"key": page_key, "files": files})
+        cache.save()
+        bar.advance()
+        return page
     finally:
-        pool.close()
         bar.close()
+
+
+def _check_paths(store_path):
+    if isinstance(store_path, str | os.PathLike):
+        return [store_path]
+    if isinstance(store_path, list | tuple) and store_path:
+        paths = list(store_path)
+        for k, p in enumerate(paths):
+            if not isinstance(p, str | os.PathLike):
+                raise TypeError(f"store_path[{k}] must be a path, got {type(p).__name__}")
+        return paths
+    raise TypeError(
+        f"store_path must be a path or a non-empty list of paths, got {type(store_path).__name__}"
+    )
