@@ -37,7 +37,7 @@ REASON_TOO_SHORT = "too_short"
 _REASONS = (REASON_OK, REASON_CONSTANT, REASON_TOO_SHORT)
 
 # Default tolerances of the "constant series" test std <= atol + rtol * max|x|. Round-off
-# in a simulated integrable run leaves sin(theta) constant to ~1e-12 (design.md
+# in a simulated integrable run leaves sin(theta) constant to ~1e-12 (docs/simulator.md
 # invariants), while any genuinely varying angle series has a std of order 0.1 rad.
 _RTOL = 1e-9
 _ATOL = 1e-9
@@ -414,7 +414,7 @@ def boundary_angles(run, particle=None):
     r"""Boundary-collision angles ``theta = arcsin(sin_theta)`` of one disk, in time order.
 
     ``sin_theta`` is the tangential component of the incoming unit velocity at each
-    disk-boundary collision (design.md); ``theta`` in ``[-pi/2, pi/2]`` is the series
+    disk-boundary collision (docs/architecture.md); ``theta`` in ``[-pi/2, pi/2]`` is the series
     whose autocorrelation the paper reports.
 
     Parameters
