@@ -273,17 +273,31 @@ def test_the_ftle_finding_is_the_mean_over_radii_of_the_ratio_of_means(built, st
     assert row["estimate"] == pytest.approx(expected, rel=1e-12)
 
 
-def test_old_stores_get_the_off_diagonal_rate_derived_from_the_paper_rr(built, store_path):
+def test_the_stored_off_diagonal_rate_obeys_the_paper_rr_identity(built, store_path):
     res = load_store(store_path).results
     rr = res[(res["diagnostic"] == "recurrence_rate") & (res["system"] == "poisson")]
     n = EXPERIMENT.n_steps + 1
     expected = ((n * rr["value"] - 1) / (n - 1)).groupby(rr["radius"]).mean()
     table = pd.read_csv(built[1] / "recurrence_by_radius.csv")
     off = table[(table["quantity"] == "rr_offdiag@0.001") & (table["system"] == "poisson")]
-    assert np.allclose(off.set_index("radius")["mean"], expected)
+    # the stored off-diagonal rate (Theiler window 1) obeys N RR - 1 = (N - 1) RR_off
+    assert np.allclose(off.set_index("radius")["mean"], expected, rtol=1e-9)
     page = built[0].read_text(encoding="utf-8")
-    assert "derived from the stored RR as (N·RR − 1)/(N − 1) with N = 2501" in page
     assert "collision-truncated steps" in page  # which sampling the RR uses
+
+
+def test_old_stores_get_the_off_diagonal_rate_derived_from_the_paper_rr(store_path):
+    from kicktimes.report.recurrence import recurrence_rows
+
+    res = load_store(store_path).results
+    old = res[~res["diagnostic"].str.contains("@")]  # what a store before the RQA rows held
+    rows, notes = recurrence_rows(old, EXPERIMENT)
+    n = EXPERIMENT.n_steps + 1
+    rr = old[old["diagnostic"] == "recurrence_rate"]["value"].to_numpy()
+    derived = rows[rows["diagnostic"] == "rr_offdiag@0.001"]["value"].to_numpy()
+    assert np.allclose(derived, (n * rr - 1) / (n - 1))
+    assert "derived from the stored RR as (N·RR − 1)/(N − 1) with N = 2501" in notes[0]
+    assert "no recurrence rows" in notes[1]  # the second eps cannot be derived
 
 
 def test_tables_are_rounded_and_scroll_instead_of_stretching_the_page(built):
