@@ -403,13 +403,24 @@ def run_command(experiment, out, workers, scheduler, progress, wait):
     click.echo(store.summary())
 
 
-def _build_report(stores, out, workers=None, progress=None):
+def _build_report(stores, out, workers=None, progress=None, pdf=False, force=False):
     try:
         from kicktimes.report import build_report
     except ImportError as exc:
         raise click.ClickException(f"the report module is not available: {exc}") from None
     target = stores[0] if len(stores) == 1 else list(stores)
-    return build_report(target, out, workers=workers, progress=progress)
+    return build_report(target, out, workers=workers, progress=progress, pdf=pdf, force=force)
+
+
+_pdf_option = click.option(
+    "--pdf", is_flag=True, help="Also write a PDF of every figure (the page embeds PNGs)."
+)
+_force_option = click.option(
+    "--force",
+    is_flag=True,
+    help="Rebuild every part of the report (default: reuse the parts whose stores and "
+    "options did not change, recorded in OUT/.cache.json).",
+)
 
 
 @main.command("report")
@@ -423,16 +434,21 @@ def _build_report(stores, out, workers=None, progress=None):
 )
 @_workers_option
 @_progress_option
-def report_command(stores, out, workers, progress):
+@_pdf_option
+@_force_option
+def report_command(stores, out, workers, progress, pdf, force):
     """Build the report of one or more result STORES into --out.
+
+    A rebuild reuses every part whose store and options are unchanged: with nothing
+    changed it writes nothing.
 
     \b
     Examples:
       kicktimes report stores/quick_a --out report-a
-      kicktimes report stores/family_a stores/family_b --out report
+      kicktimes report stores/family_a stores/family_b --out report --pdf
     """
     with _cli_errors(_RUN_OPTIONS):
-        path = _build_report(stores, out, workers, progress)
+        path = _build_report(stores, out, workers, progress, pdf, force)
     click.echo(f"report written to {path if path is not None else out}")
 
 
@@ -455,7 +471,8 @@ def report_command(stores, out, workers, progress):
 @_scheduler_option
 @_progress_option
 @_wait_option
-def reproduce_command(scale, out, workers, scheduler, progress, wait):
+@_pdf_option
+def reproduce_command(scale, out, workers, scheduler, progress, wait, pdf):
     """Run the paper's two experiment families and build the report.
 
     Reruns resume the stores in --out. The experiments are the built-in presets, the
@@ -476,7 +493,7 @@ def reproduce_command(scale, out, workers, scheduler, progress, wait):
             store = _run_one(exp, path, workers, scheduler, progress, wait)
             click.echo(store.summary())
             stores.append(path)
-        report = _build_report(stores, os.path.join(out, "report"), workers, progress)
+        report = _build_report(stores, os.path.join(out, "report"), workers, progress, pdf)
     click.echo(f"report written to {report if report is not None else os.path.join(out, 'report')}")
 
 
