@@ -152,6 +152,9 @@ def simulate_command(radii, n_ics, t_max, seed, rule, ic_method, out, save_runs)
     # refuses back to the option that caused it
     options = {"r_max": "--radius", "r": "--radius", "n": "--n-ics", "t_max": "--t-max",
                "seed": "--seed", "rule": "--rule", "method": "--ic-method"}
+    from kicktimes._compile import SIMULATE_KERNELS
+
+    _compile_first(None, SIMULATE_KERNELS)
     with _cli_errors(options):
         ics = initial_conditions(n_ics, max(radii), seed=seed, method=ic_method, rule=rule)
         for r in radii:
@@ -344,6 +347,36 @@ def _run_one(experiment, out, workers, scheduler, progress, wait=False):
     return store
 
 
+def _pending(experiment, store_path) -> bool:
+    """True unless ``store_path`` already holds every task of ``experiment`` (by its
+    manifest; the run itself verifies the parts)."""
+    import json
+    import os
+
+    try:
+        with open(os.path.join(store_path, "manifest.json"), encoding="utf-8") as fh:
+            manifest = json.load(fh)
+        done = set(manifest["tasks"])
+        same = manifest["experiment_hash"] == experiment.hash()
+    except (OSError, ValueError, KeyError, TypeError):
+        return True
+    return not same or any(t.id not in done for t in experiment.tasks())
+
+
+def _compile_first(workers, kernels=None):
+    """On a cold numba cache, say so once and compile the sweep's kernels up front, the
+    independent groups in parallel (:mod:`kicktimes._compile`)."""
+    import os
+
+    from kicktimes import _compile
+
+    if kernels is not None:
+        _compile.announce(kernels)
+        return
+    if _compile.announce():
+        _compile.warm_up(workers or os.cpu_count() or 1)
+
+
 _workers_option = click.option(
     "--workers",
     type=click.IntRange(min=1),
@@ -399,6 +432,8 @@ def run_command(experiment, out, workers, scheduler, progress, wait):
     with _cli_errors(_RUN_OPTIONS):
         exp = Experiment.from_toml(experiment)
         click.echo(exp.summary())
+        if scheduler is None and _pending(exp, out):
+            _compile_first(workers)
         store = _run_one(exp, out, workers, scheduler, progress, wait)
     click.echo(store.summary())
 
@@ -486,6 +521,10 @@ def reproduce_command(scale, out, workers, scheduler, progress, wait, pdf):
         raise click.UsageError("--workers sizes the local pool; it cannot go with --scheduler")
     stores = []
     with _cli_errors(_RUN_OPTIONS):
+        if scheduler is None and any(
+            _pending(preset(n), os.path.join(out, f"store-{n}")) for n in SCALES[scale]
+        ):
+            _compile_first(workers)
         for name in SCALES[scale]:
             exp = preset(name)
             path = os.path.join(out, f"store-{name}")
