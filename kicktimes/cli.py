@@ -152,6 +152,9 @@ def simulate_command(radii, n_ics, t_max, seed, rule, ic_method, out, save_runs)
     # refuses back to the option that caused it
     options = {"r_max": "--radius", "r": "--radius", "n": "--n-ics", "t_max": "--t-max",
                "seed": "--seed", "rule": "--rule", "method": "--ic-method"}
+    from kicktimes._compile import SIMULATE_KERNELS
+
+    _compile_first(None, SIMULATE_KERNELS)
     with _cli_errors(options):
         ics = initial_conditions(n_ics, max(radii), seed=seed, method=ic_method, rule=rule)
         for r in radii:
@@ -344,6 +347,36 @@ def _run_one(experiment, out, workers, scheduler, progress, wait=False):
     return store
 
 
+def _pending(experiment, store_path) -> bool:
+    """True unless ``store_path`` already holds every task of ``experiment`` (by its
+    manifest; the run itself verifies the parts)."""
+    import json
+    import os
+
+    try:
+        with open(os.path.join(store_path, "manifest.json"), encoding="utf-8") as fh:
+            manifest = json.load(fh)
+        done = set(manifest["tasks"])
+        same = manifest["experiment_hash"] == experiment.hash()
+    except (OSError, ValueError, KeyError, TypeError):
+        return True
+    return not same or any(t.id not in done for t in experiment.tasks())
+
+
+def _compile_first(workers, kernels=None):
+    """On a cold numba cache, say so once and compile the sweep's kernels up front, the
+    independent groups in parallel (:mod:`kicktimes._compile`)."""
+    import os
+
+    from kicktimes import _compile
+
+    if kernels is not None:
+        _compile.announce(kernels)
+        return
+    if _compile.announce():
+        _compile.warm_up(workers or os.cpu_count() or 1)
+
+
 _workers_option = click.option(
     "--workers",
     type=click.IntRange(min=1),
@@ -399,17 +432,30 @@ def run_command(experiment, out, workers, scheduler, progress, wait):
     with _cli_errors(_RUN_OPTIONS):
         exp = Experiment.from_toml(experiment)
         click.echo(exp.summary())
+        if scheduler is None and _pending(exp, out):
+            _compile_first(workers)
         store = _run_one(exp, out, workers, scheduler, progress, wait)
     click.echo(store.summary())
 
 
-def _build_report(stores, out, workers=None, progress=None):
+def _build_report(stores, out, workers=None, progress=None, pdf=False, force=False):
     try:
         from kicktimes.report import build_report
     except ImportError as exc:
         raise click.ClickException(f"the report module is not available: {exc}") from None
     target = stores[0] if len(stores) == 1 else list(stores)
-    return build_report(target, out, workers=workers, progress=progress)
+    return build_report(target, out, workers=workers, progress=progress, pdf=pdf, force=force)
+
+
+_pdf_option = click.option(
+    "--pdf", is_flag=True, help="Also write a PDF of every figure (the page embeds PNGs)."
+)
+_force_option = click.option(
+    "--force",
+    is_flag=True,
+    help="Rebuild every part of the report (default: reuse the parts whose stores and "
+    "options did not change, recorded in OUT/.cache.json).",
+)
 
 
 @main.command("report")
@@ -423,16 +469,21 @@ def _build_report(stores, out, workers=None, progress=None):
 )
 @_workers_option
 @_progress_option
-def report_command(stores, out, workers, progress):
+@_pdf_option
+@_force_option
+def report_command(stores, out, workers, progress, pdf, force):
     """Build the report of one or more result STORES into --out.
+
+    A rebuild reuses every part whose store and options are unchanged: with nothing
+    changed it writes nothing.
 
     \b
     Examples:
       kicktimes report stores/quick_a --out report-a
-      kicktimes report stores/family_a stores/family_b --out report
+      kicktimes report stores/family_a stores/family_b --out report --pdf
     """
     with _cli_errors(_RUN_OPTIONS):
-        path = _build_report(stores, out, workers, progress)
+        path = _build_report(stores, out, workers, progress, pdf, force)
     click.echo(f"report written to {path if path is not None else out}")
 
 
@@ -455,7 +506,8 @@ def report_command(stores, out, workers, progress):
 @_scheduler_option
 @_progress_option
 @_wait_option
-def reproduce_command(scale, out, workers, scheduler, progress, wait):
+@_pdf_option
+def reproduce_command(scale, out, workers, scheduler, progress, wait, pdf):
     """Run the paper's two experiment families and build the report.
 
     Reruns resume the stores in --out. The experiments are the built-in presets, the
@@ -469,6 +521,10 @@ def reproduce_command(scale, out, workers, scheduler, progress, wait):
         raise click.UsageError("--workers sizes the local pool; it cannot go with --scheduler")
     stores = []
     with _cli_errors(_RUN_OPTIONS):
+        if scheduler is None and any(
+            _pending(preset(n), os.path.join(out, f"store-{n}")) for n in SCALES[scale]
+        ):
+            _compile_first(workers)
         for name in SCALES[scale]:
             exp = preset(name)
             path = os.path.join(out, f"store-{name}")
@@ -476,7 +532,7 @@ def reproduce_command(scale, out, workers, scheduler, progress, wait):
             store = _run_one(exp, path, workers, scheduler, progress, wait)
             click.echo(store.summary())
             stores.append(path)
-        report = _build_report(stores, os.path.join(out, "report"), workers, progress)
+        report = _build_report(stores, os.path.join(out, "report"), workers, progress, pdf)
     click.echo(f"report written to {report if report is not None else os.path.join(out, 'report')}")
 
 

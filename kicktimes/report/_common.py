@@ -7,10 +7,12 @@ import math
 import os
 import sys
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
-import pandas as pd
-from scipy import stats as sps
+
+if TYPE_CHECKING:  # pandas and scipy load with the sections that use them
+    import pandas as pd
 
 #: first spawn-key word of the report's Monte Carlo streams ("rprt"), distinct from the
 #: IC and kick streams of the sweep
@@ -184,6 +186,8 @@ def fmt(x, digits=3):
 def spearman(x, y):
     """Spearman's rho and two-sided p-value (exact permutation for n <= 8), NaN when
     fewer than 3 finite points or a constant variable."""
+    from scipy import stats as sps
+
     x, y = np.asarray(x, float), np.asarray(y, float)
     ok = np.isfinite(x) & np.isfinite(y)
     x, y = x[ok], y[ok]

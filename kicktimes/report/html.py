@@ -10,8 +10,6 @@ import os
 import re
 from pathlib import Path
 
-import pandas as pd
-
 from kicktimes import __version__
 from kicktimes.report._cache import atomic_write
 
@@ -88,10 +86,10 @@ def embed_figures(fragment, out):
     return _PNG_REF.sub(inline, fragment)
 
 
-def write_outputs(sections, out, dpi, prefix="", *, pdf=False, files=None):
+def write_outputs(sections, out, dpi, prefix="", *, pdf=True, files=None, embed=True):
     """Save figures (PNG, and PDF if ``pdf``) and tables (CSV), atomically, recording each
-    file's SHA-256 in ``files``; return the HTML of the sections, whose images reference
-    the PNG files (see :func:`embed_figures`)."""
+    file's SHA-256 in ``files``; return the HTML of the sections, with the PNGs embedded
+    (``embed``) or referenced for :func:`embed_figures` (the report's cached fragments)."""
     files = {} if files is None else files
     body = []
     for sec in sections:
@@ -123,11 +121,14 @@ def write_outputs(sections, out, dpi, prefix="", *, pdf=False, files=None):
             else:
                 body.append(f"<p>{html.escape(title)}: {link} ({len(df)} rows).</p>")
         sec.figures.clear()  # drop the Figure objects: nothing stays alive
-    return "\n".join(body)
+    text = "\n".join(body)
+    return embed_figures(text, out) if embed else text
 
 
 def store_header(store, notes):
     """Metadata of one store and its experiment: (HTML, parameter table)."""
+    import pandas as pd
+
     exp = store.experiment
     man = store.manifest
     meta = [

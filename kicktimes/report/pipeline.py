@@ -22,34 +22,9 @@ import time
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
-import numpy as np
-import pandas as pd
-from matplotlib.figure import Figure
-
 from kicktimes import __version__
-from kicktimes.report import (
-    autocorrelation,
-    counts,
-    findings,
-    heterogeneity,
-    kick_times,
-    lyapunov,
-    poisson,
-    recurrence,
-    renewal,
-    summary,
-    trajectories,
-)
 from kicktimes.report._cache import ReportCache, content_key, store_key
-from kicktimes.report._common import (
-    Context,
-    Mapper,
-    Progress,
-    Section,
-    check_fraction,
-    check_int,
-)
-from kicktimes.report._figures import DIAGNOSTIC_LABELS
+from kicktimes.report._common import Context, Mapper, Progress, check_fraction, check_int
 from kicktimes.report.html import (
     CSS,
     embed_figures,
@@ -60,28 +35,58 @@ from kicktimes.report.html import (
     write_text,
 )
 
-__all__ = ["build_report", "analyse", "STAGES"]
+__all__ = ["build_report", "analyse", "STAGES"]  # noqa: F822 (STAGES: module __getattr__)
 
-#: (stage name, section module) in page order; every module has ``sections(ctx)``
-STAGES = (
-    ("trajectories", trajectories),
-    ("kick times", kick_times),
-    ("counts", counts),
-    ("diagnostic tables", summary),
-    ("Lyapunov exponents", lyapunov),
-    ("recurrence", recurrence),
-    ("autocorrelation", autocorrelation),
-    ("Poisson tests", poisson),
-    ("renewal models", renewal),
-    ("rate heterogeneity", heterogeneity),
-    ("findings", findings),
-)
+
+def _stages():
+    # the section modules (matplotlib, scipy, statsmodels) are imported on first use, so
+    # that a rebuild served from the cache does not pay for them
+    from kicktimes.report import (
+        autocorrelation,
+        counts,
+        findings,
+        heterogeneity,
+        kick_times,
+        lyapunov,
+        poisson,
+        recurrence,
+        renewal,
+        summary,
+        trajectories,
+    )
+
+    return (
+        ("trajectories", trajectories),
+        ("kick times", kick_times),
+        ("counts", counts),
+        ("diagnostic tables", summary),
+        ("Lyapunov exponents", lyapunov),
+        ("recurrence", recurrence),
+        ("autocorrelation", autocorrelation),
+        ("Poisson tests", poisson),
+        ("renewal models", renewal),
+        ("rate heterogeneity", heterogeneity),
+        ("findings", findings),
+    )
+
+
+#: number of section stages per store (:data:`STAGES` without importing the modules)
+N_STAGES = 11
+
+
+def __getattr__(name):
+    # STAGES: (stage name, section module) in page order; every module has sections(ctx)
+    if name == "STAGES":
+        return _stages()
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 def analyse(ctx, *, bar, timings):
     """Every section of one store: ``(findings section, other sections, notes)``."""
+    from kicktimes.report import findings
+
     secs, found = [], None
-    for stage, module in STAGES:
+    for stage, module in _stages():
         bar.step(f"{ctx.exp.name}: {stage}")
         t0 = time.perf_counter()
         if module is findings:
@@ -105,6 +110,8 @@ def _read_manifest(path):
 
 def _sweep_seconds(manifest):
     """Per-stage sweep seconds summed over the finished tasks (as ``Store.timings``)."""
+    import pandas as pd
+
     rows = {tid: e.get("timings", {}) for tid, e in manifest["tasks"].items()}
     return pd.DataFrame.from_dict(rows, orient="index").sort_index().sum(numeric_only=True)
 
@@ -132,12 +139,14 @@ def experiment_part(job, bar=None):
     t0 = time.perf_counter()
     files = {}
     findings_html = write_outputs(
-        [found], out, render["dpi"], prefix, pdf=render["pdf"], files=files
+        [found], out, render["dpi"], prefix, pdf=render["pdf"], files=files, embed=False
     )
     header, params = store_header(store, notes)
     write_table(out, f"{prefix}experiment", params, files)
     write_text(out, f"{prefix}experiment.toml", store.experiment.to_toml(), files)
-    body = write_outputs(secs, out, render["dpi"], prefix, pdf=render["pdf"], files=files)
+    body = write_outputs(
+        secs, out, render["dpi"], prefix, pdf=render["pdf"], files=files, embed=False
+    )
     timings.append((name, "write files", time.perf_counter() - t0))
     items = "".join(f'<li><a href="#{prefix}{s.key}">{html.escape(s.title)}</a></li>' for s in secs)
     return {
@@ -165,7 +174,7 @@ def families_part(paths, out, render):
     fragment, toc = "", ""
     if families is not None:
         fragment = write_outputs(
-            [families], Path(out), render["dpi"], pdf=render["pdf"], files=files
+            [families], Path(out), render["dpi"], pdf=render["pdf"], files=files, embed=False
         )
         toc = f'<li><a href="#{families.key}">{html.escape(families.title)}</a></li>'
     keys = [store_key(p, st.manifest) for p, st in zip(paths, stores, strict=True)]
@@ -182,6 +191,13 @@ def families_section(stores):
     """The paper's layout, one panel per experiment (family A top, B bottom) for the FTLE
     and the autocorrelation; the recurrence rate as the paper's Fig. 7: family A, all radii
     on top and a zoom on its small radii below, with the off-diagonal rate beside."""
+    import numpy as np
+    from matplotlib.figure import Figure
+
+    from kicktimes.report import recurrence, summary
+    from kicktimes.report._common import Section
+    from kicktimes.report._figures import DIAGNOSTIC_LABELS
+
     sec = Section("families", "Diagnostics against radius, all experiments")
     summaries = [summary.diagnostic_summary(st.results, _present(st)) for st in stores]
     for diagnostic in ("lyapunov", "autocorrelation"):
@@ -382,7 +398,7 @@ def build_report(
     families_todo = multi and parts["families"] is None
     jobs = {part_ids[k]: (paths[k], out, prefixes[k], options, render, workers) for k in todo}
     parallel = workers > 1 and len(jobs) + families_todo > 1
-    n_steps = 2 + (len(jobs) if parallel else len(STAGES) * len(jobs)) + families_todo
+    n_steps = 2 + (len(jobs) if parallel else N_STAGES * len(jobs)) + families_todo
     bar = Progress(progress, n_steps)
     try:
         bar.step("load store")
@@ -422,6 +438,8 @@ def build_report(
                 cache.record(pid, parts[pid])
 
         bar.step("write files")
+        import pandas as pd
+
         t0 = time.perf_counter()
         files = {}
         sweep_rows = [

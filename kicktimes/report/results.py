@@ -15,7 +15,6 @@ from pathlib import Path
 
 from kicktimes import __version__
 from kicktimes.report._common import Context, Mapper, Progress, check_int
-from kicktimes.report.findings import rules_text, scale_statement
 
 __all__ = ["write_results"]
 
@@ -53,7 +52,8 @@ def write_results(
     >>> write_results("stores/family_a", "docs/results")  # doctest: +SKIP
     """
     from kicktimes.experiment import load_store
-    from kicktimes.report.pipeline import STAGES, analyse
+    from kicktimes.report.findings import rules_text, scale_statement
+    from kicktimes.report.pipeline import N_STAGES, analyse
 
     paths = [store_paths] if isinstance(store_paths, str | os.PathLike) else list(store_paths)
     if not paths or not all(isinstance(p, str | os.PathLike) for p in paths):
@@ -66,7 +66,7 @@ def write_results(
     out.mkdir(parents=True, exist_ok=True)
     stores = [load_store(p) for p in paths]
     pool = Mapper(workers)
-    bar = Progress(False, len(STAGES) * len(stores))
+    bar = Progress(False, N_STAGES * len(stores))
     lines = [
         "# What the reproduction shows (generated)",
         "",

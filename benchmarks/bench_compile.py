@@ -1,0 +1,144 @@
+"""Compile time of kicktimes' numba kernels, per workload step and per kernel.
+
+Runs the workload twice in fresh subprocesses sharing one empty numba cache directory
+(``NUMBA_CACHE_DIR`` pointing at a new temporary folder): the first run compiles every
+kernel it calls (what a first run after installing costs), the second loads them from the
+cache. Per step, the first-call time of each run; per kernel, the compile time numba
+records (``numba:compile`` events; a kernel compiled inside another one's compilation is
+counted in both, so the per-kernel column is inclusive), with the number of compiled
+signatures (more than one means the callers pass inconsistent dtypes).
+
+Reference measured in the same run: the same steps with a warm cache (the second
+subprocess), i.e. the part of the cold time that is not compilation.
+
+Usage::
+
+    python benchmarks/bench_compile.py            # prints the tables
+    python benchmarks/bench_compile.py --json compile.json
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import time
+
+
+def _steps():
+    """(name, callable) of the workload: what `kicktimes reproduce` compiles."""
+    import numpy as np
+
+    def sweep_task():
+        from kicktimes.experiment import execute_task, preset
+
+        exp = dataclasses.replace(preset("quick_a"), n_ics=1, n_steps=200, block_size=1)
+        execute_task(exp, exp.tasks()[0])
+
+    def report_kernels():
+        # what the report calls beyond the sweep's kernels: the trajectory figures'
+        # re-simulation with a collision log, the RQA of the recurrence plot, the
+        # power-law fit of the renewal comparison
+        from kicktimes import initial_conditions, simulate_two_particle
+        from kicktimes.diagnostics import rqa
+        from kicktimes.stats import compare_models
+
+        ic = initial_conditions(1, 0.02, seed=0)[0]
+        run = simulate_two_particle(ic, 0.02, n_steps=200, tau=0.3, log_collisions=True)
+        rqa(np.column_stack([run.boundary_log.x, run.boundary_log.sin_theta])[:300], 0.05)
+        rng = np.random.default_rng(0)
+        compare_models(rng.exponential(size=200), censored=rng.exponential(size=3))
+
+    return [
+        ("import kicktimes (no compilation expected)", lambda: None),
+        ("sweep task (3 systems x 3 diagnostics)", sweep_task),
+        ("report kernels", report_kernels),
+    ]
+
+
+def child():
+    """One measured run in this (fresh) process; prints JSON."""
+    from numba.core import event
+
+    t0 = time.perf_counter()
+    import kicktimes.diagnostics  # noqa: F401
+    import kicktimes.experiment  # noqa: F401
+
+    steps = {"import": time.perf_counter() - t0}
+    with event.install_recorder("numba:compile") as rec:
+        for name, fn in _steps()[1:]:
+            t0 = time.perf_counter()
+            fn()
+            steps[name] = time.perf_counter() - t0
+    starts, kernels = {}, {}
+    for ts, ev in rec.buffer:
+        disp = ev.data["dispatcher"]
+        name = f"{disp.py_func.__module__}.{disp.py_func.__qualname__}"
+        key = (name, str(ev.data["args"]))
+        if ev.is_start:
+            starts[key] = ts
+        elif key in starts:
+            k = kernels.setdefault(name, {"seconds": 0.0, "signatures": []})
+            k["seconds"] += ts - starts.pop(key)
+            k["signatures"].append(str(ev.data["args"]))
+    print(json.dumps({"steps": steps, "kernels": kernels}))
+
+
+def run_child(cache_dir):
+    env = dict(os.environ, NUMBA_CACHE_DIR=cache_dir)
+    t0 = time.perf_counter()
+    out = subprocess.run(
+        [sys.executable, __file__, "--child"],
+        env=env,
+        capture_output=True,
+        text=True,
+    )
+    if out.returncode:
+        raise SystemExit(f"the measured subprocess failed:\n{out.stderr[-3000:]}")
+    result = json.loads(out.stdout.strip().splitlines()[-1])
+    result["process_wall"] = time.perf_counter() - t0
+    return result
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--child", action="store_true", help=argparse.SUPPRESS)
+    parser.add_argument("--json", default=None, help="also write the numbers here")
+    args = parser.parse_args()
+    if args.child:
+        child()
+        return
+    print(f"{os.cpu_count()} cores, load average {os.getloadavg()[0]:.2f}")
+    with tempfile.TemporaryDirectory(prefix="numba-cache-") as cache:
+        cold = run_child(cache)
+        warm = run_child(cache)
+    print(f"\n{'step':48s} {'cold s':>8s} {'warm s':>8s} {'compile s':>10s}")
+    for name, sec in cold["steps"].items():
+        w = warm["steps"].get(name, float("nan"))
+        print(f"{name:48s} {sec:8.2f} {w:8.2f} {sec - w:10.2f}")
+    total_c, total_w = sum(cold["steps"].values()), sum(warm["steps"].values())
+    print(
+        f"{'total (whole process)':48s} {cold['process_wall']:8.2f} {warm['process_wall']:8.2f}"
+        f" {cold['process_wall'] - warm['process_wall']:10.2f}"
+    )
+    print(f"steps only: cold {total_c:.2f} s = {total_c / total_w:.1f}x the warm run")
+    kernels = sorted(cold["kernels"].items(), key=lambda kv: -kv[1]["seconds"])
+    print(f"\n{'kernel (compile time, inclusive of kernels it calls)':72s} {'s':>6s} {'sigs':>4s}")
+    for name, k in kernels:
+        print(f"{name:72s} {k['seconds']:6.2f} {len(k['signatures']):4d}")
+    several = [(n, k["signatures"]) for n, k in kernels if len(k["signatures"]) > 1]
+    if several:
+        print("\nkernels compiled for more than one signature (inconsistent argument dtypes):")
+        for n, sigs in several:
+            print(f"  {n}: " + " | ".join(sigs))
+    if args.json:
+        with open(args.json, "w") as fh:
+            json.dump({"cold": cold, "warm": warm}, fh, indent=1)
+
+
+if __name__ == "__main__":
+    main()

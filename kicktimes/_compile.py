@@ -1,0 +1,130 @@
+"""First-run compilation of the numba kernels: detect a cold cache, announce it, split it.
+
+numba compiles each ``@njit(cache=True)`` kernel on its first call and stores the machine
+code on disk (next to the source, or under ``NUMBA_CACHE_DIR``); later processes load it
+in milliseconds. On a fresh install the sweep's kernels take tens of seconds to compile
+(``python benchmarks/bench_compile.py`` measures them per kernel), so the command line
+says so once, and compiles the two big independent groups of kernels (the two-disk
+simulation with its diagnostics; the kicked disk with its tangent dynamics) in two
+processes at the same time instead of one after the other in every worker.
+"""
+
+from __future__ import annotations
+
+import sys
+
+__all__ = ["cold_kernels", "announce", "warm_up"]
+
+#: (module, kernel, compile seconds measured by benchmarks/bench_compile.py on the
+#: project's 2-core machine, inclusive of the kernels each one calls)
+SWEEP_KERNELS = (
+    ("kicktimes.billiard.two_particle", "simulate_two_kernel", 15.0),
+    ("kicktimes.billiard.one_particle", "simulate_one_kernel", 6.5),
+    ("kicktimes.diagnostics._tangent", "tangent_two_kernel", 4.0),
+    ("kicktimes.diagnostics._tangent", "tangent_one_kernel", 3.5),
+    ("kicktimes.diagnostics.recurrence", "_sweep", 4.0),
+    ("kicktimes.diagnostics.autocorrelation", "_acf_segments", 2.5),
+)
+SIMULATE_KERNELS = SWEEP_KERNELS[:1]
+
+
+def _is_cold(dispatcher) -> bool | None:
+    """True if ``dispatcher`` has no valid on-disk cache entry, None if unknown."""
+    try:
+        # numba's own index reader: {} when the index is missing or stale (source changed)
+        return not dispatcher._cache._cache_file._load_index()
+    except Exception:  # private numba API: when it changes, say nothing rather than fail
+        return None
+
+
+def cold_kernels(kernels=SWEEP_KERNELS) -> list[tuple[str, str, float]]:
+    """The entries of ``kernels`` whose compiled code is not in numba's cache."""
+    import importlib
+
+    cold = []
+    for module, name, seconds in kernels:
+        try:
+            dispatcher = getattr(importlib.import_module(module), name)
+        except (ImportError, AttributeError):
+            continue
+        if _is_cold(dispatcher):
+            cold.append((module, name, seconds))
+    return cold
+
+
+def announce(kernels=SWEEP_KERNELS, *, stream=None) -> float:
+    """Print "compiling kicktimes' numba kernels (once, about N s)..." to stderr if some
+    of ``kernels`` are not cached; return N (0 when everything is cached)."""
+    cold = cold_kernels(kernels)
+    if not cold:
+        return 0.0
+    seconds = sum(s for *_, s in cold)
+    n = max(5, 5 * round(seconds / 5))
+    print(
+        f"compiling kicktimes' numba kernels (once, about {n} s)...",
+        file=stream or sys.stderr,
+        flush=True,
+    )
+    return float(n)
+
+
+def _warm_two(_):
+    # the two-disk system exactly as a sweep task runs it (simulation, tangent FTLE,
+    # recurrence, autocorrelation), on a tiny run
+    import dataclasses
+
+    from kicktimes.experiment import execute_task, preset
+
+    exp = dataclasses.replace(
+        preset("quick_a"), n_ics=1, n_steps=50, block_size=1, systems=["two_particle"]
+    )
+    execute_task(exp, exp.tasks()[0])
+
+
+def _warm_one(_):
+    # the kicked disk as a sweep task calls it: Poisson kicks, simulation, tangent FTLE
+    import numpy as np
+
+    from kicktimes.billiard.initial import initial_conditions
+    from kicktimes.billiard.one_particle import draw_kick_angles, simulate_one_particle
+    from kicktimes.diagnostics.lyapunov import lyapunov
+    from kicktimes.experiment import preset
+    from kicktimes.experiment.tasks import _kick_law
+
+    exp = preset("quick_a")
+    ic = initial_conditions(1, exp.r_max, seed=0, method=exp.ic_method, rule=exp.rule)[0]
+    steps = {"n_steps": 50, "tau": exp.tau, "sampling": exp.sampling}
+    kick = _kick_law(exp, "poisson", ic)
+    rng = np.random.default_rng(0)
+    times = np.cumsum(rng.exponential(1.0, size=20))
+    angles = draw_kick_angles(times.size, kick["kick_angle"], exp.sigma, rng)
+    r = exp.radii[0]
+    simulate_one_particle(ic[0], r, kicks=times, kick_angles=angles, seed=0, **kick, **steps)
+    lyapunov(
+        ic[0],
+        r,
+        kicks=times,
+        kick_angles=angles,
+        variant=exp.lyapunov_variant,
+        method=exp.lyapunov_method,
+        **kick,
+        **steps,
+    )
+
+
+def warm_up(workers: int) -> None:
+    """Compile the sweep's kernels now, the two groups in two processes at once (when
+    ``workers >= 2``), so that the sweep's workers load them from the cache instead of
+    each compiling all of them in turn. Does nothing when they are cached."""
+    if not cold_kernels():
+        return
+    if workers < 2:
+        _warm_two(None)
+        _warm_one(None)
+        return
+    from concurrent.futures import ProcessPoolExecutor
+
+    with ProcessPoolExecutor(max_workers=2) as pool:
+        futures = [pool.submit(_warm_two, None), pool.submit(_warm_one, None)]
+        for fut in futures:
+            fut.result()
