@@ -44,8 +44,8 @@ from kicktimes.experiment.presets import SCALES
 STAGES = [
     ("simulation_two_particle", "simulation: two-particle runs"),
     ("simulation_one_particle", "simulation: kicked one-particle runs (+ kick draws)"),
-    ("lyapunov_two_particle", "diagnostic: FTLE, two-particle (twins)"),
-    ("lyapunov_kicked", "diagnostic: FTLE, kicked (twins)"),
+    ("lyapunov_two_particle", "diagnostic: FTLE, two-particle"),
+    ("lyapunov_kicked", "diagnostic: FTLE, kicked"),
     ("recurrence_rate", "diagnostic: recurrence rate"),
     ("autocorrelation", "diagnostic: autocorrelation"),
     ("tables", "tidy tables"),
