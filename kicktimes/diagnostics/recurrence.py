@@ -110,44 +110,25 @@ def _radix_argsort(keys, n_bits):
 
 
 @njit(cache=True)
-def _build_cells(points, xmin, ymin, inv_h, ncx, n_bits, neighbours):
-    """Sort the points by cell; return sorted coordinates, permutation and cell table.
-
-    Cell ``(cx, cy)`` (1-based, so that the neighbour ``cx +- 1`` of a border cell is an
-    empty padding column and never aliases the next row) has key ``cy * ncx + cx``.
-    Returns ``xs, ys, perm, cell_start, cell_key, nb`` with the points of cell ``c`` at
-    sorted positions ``cell_start[c] : cell_start[c + 1]`` and original indices ``perm``.
-    With ``neighbours``, row ``a`` of ``nb`` holds the samples before and after
-    ``perm[a]`` in time, ``(x_prev, y_prev, x_next, y_next)`` (NaN beyond the ends), so
-    that the line tests of a pair read them next to the pair's own coordinates; they are
-    gathered in the same loop as the coordinates, where they share its cache lines.
-    """
+def _cell_keys(points, xmin, ymin, inv_h, ncx):
+    """Cell key ``cy * ncx + cx`` of every point (1-based cell coordinates, see
+    `_build_cells`)."""
     n = points.shape[0]
     keys = np.empty(n, np.int64)
     for a in range(n):
         cx = np.int64((points[a, 0] - xmin) * inv_h) + 1
         cy = np.int64((points[a, 1] - ymin) * inv_h) + 1
         keys[a] = cy * ncx + cx
-    perm, skeys = _radix_argsort(keys, n_bits)
-    xs = np.empty(n)
-    ys = np.empty(n)
-    nb = np.empty((n if neighbours else 0, 4))
+    return keys
+
+
+@njit(cache=True)
+def _cell_table(skeys):
+    """``cell_start, cell_key`` of sorted keys: cell ``c`` holds sorted positions
+    ``cell_start[c] : cell_start[c + 1]``."""
+    n = skeys.shape[0]
     n_cells = 0
     for a in range(n):
-        i = perm[a]
-        xs[a] = points[i, 0]
-        ys[a] = points[i, 1]
-        if neighbours:
-            if i > 0:
-                nb[a, 0] = points[i - 1, 0]
-                nb[a, 1] = points[i - 1, 1]
-            else:
-                nb[a, 0] = nb[a, 1] = np.nan
-            if i + 1 < n:
-                nb[a, 2] = points[i + 1, 0]
-                nb[a, 3] = points[i + 1, 1]
-            else:
-                nb[a, 2] = nb[a, 3] = np.nan
         if a == 0 or skeys[a] != skeys[a - 1]:
             n_cells += 1
     cell_start = np.empty(n_cells + 1, np.int64)
@@ -159,7 +140,58 @@ def _build_cells(points, xmin, ymin, inv_h, ncx, n_bits, neighbours):
             cell_key[c] = skeys[a]
             c += 1
     cell_start[n_cells] = n
-    return xs, ys, perm, cell_start, cell_key, nb
+    return cell_start, cell_key
+
+
+@njit(cache=True)
+def _build_cells(points, xmin, ymin, inv_h, ncx, n_bits):
+    """Sort the points by cell; return sorted coordinates, permutation and cell table.
+
+    Cell ``(cx, cy)`` (1-based, so that the neighbour ``cx +- 1`` of a border cell is an
+    empty padding column and never aliases the next row) has key ``cy * ncx + cx``.
+    Returns ``xs, ys, perm, cell_start, cell_key`` with the points of cell ``c`` at
+    sorted positions ``cell_start[c] : cell_start[c + 1]`` and original indices ``perm``.
+    """
+    n = points.shape[0]
+    perm, skeys = _radix_argsort(_cell_keys(points, xmin, ymin, inv_h, ncx), n_bits)
+    xs = np.empty(n)
+    ys = np.empty(n)
+    for a in range(n):
+        i = perm[a]
+        xs[a] = points[i, 0]
+        ys[a] = points[i, 1]
+    cell_start, cell_key = _cell_table(skeys)
+    return xs, ys, perm, cell_start, cell_key
+
+
+@njit(cache=True)
+def _build_cells_lines(points, xmin, ymin, inv_h, ncx, n_bits):
+    """`_build_cells` for the line statistics: one row per sorted position,
+    ``g[a] = (x, y, x_prev, y_prev, x_next, y_next)`` of the sample ``perm[a]`` and its
+    time neighbours (NaN beyond the ends).
+
+    One 48-byte row per point: the candidate test and, for a recurrent pair, the
+    predecessor and successor tests read one cache line per point instead of three arrays.
+    """
+    n = points.shape[0]
+    perm, skeys = _radix_argsort(_cell_keys(points, xmin, ymin, inv_h, ncx), n_bits)
+    g = np.empty((n, 6))
+    for a in range(n):
+        i = perm[a]
+        g[a, 0] = points[i, 0]
+        g[a, 1] = points[i, 1]
+        if i > 0:
+            g[a, 2] = points[i - 1, 0]
+            g[a, 3] = points[i - 1, 1]
+        else:
+            g[a, 2] = g[a, 3] = np.nan
+        if i + 1 < n:
+            g[a, 4] = points[i + 1, 0]
+            g[a, 5] = points[i + 1, 1]
+        else:
+            g[a, 4] = g[a, 5] = np.nan
+    cell_start, cell_key = _cell_table(skeys)
+    return g, perm, cell_start, cell_key
 
 
 @njit(cache=True, inline="always")
@@ -233,54 +265,36 @@ def _visit_block(xs, ys, perm, a0, a1, b0, b1, same, eps2, w, mode, count, buf):
 
 
 @njit(cache=True, inline="always")
-def _visit_block_lines(xs, ys, perm, a0, a1, b0, b1, same, w, pts, nb, eps2s, count, diag):
-    """`_visit_block` that also accounts the lines starting at each recurrent pair.
+def _pair_lines(g, a, b, ia, ib, d2, pts, eps2s, count, diag):
+    """Account the recurrent pair of sorted positions ``a, b`` (original ``ia, ib``, squared
+    distance ``d2``) at every threshold ``eps2s[k]`` (decreasing) that it meets.
 
-    For each threshold ``eps2s[k]`` (decreasing) that the pair meets, ``count[k]``
-    counts it and, if the pair ``i < j`` starts a diagonal line (``(i - 1, j - 1)`` not
-    recurrent), the line ``(i + k, j + k)`` is walked and accounted in ``diag[k]``
-    (`_add_line`): every line of the upper triangle is counted once, at its start, with
-    O(1) work per recurrent pair and no pair stored. The first two tests read ``nb`` (the
-    time neighbours of each sorted position), the rest of a walk reads ``pts``. (The
-    vertical lines are counted by `_vertical_sums`: a call to them in this loop, even
-    never taken, made it twice as slow.)
+    ``count[k]`` counts it and, if the pair ``i < j`` starts a diagonal line
+    (``(i - 1, j - 1)`` not recurrent), the line ``(i + k, j + k)`` is walked and
+    accounted in ``diag[k]`` (`_add_line`): every line of the upper triangle is counted
+    once, at its start, with O(1) work per recurrent pair and no pair stored. The first
+    two tests read the time neighbours in ``g``, the rest of a walk reads ``pts``.
     """
-    eps2 = eps2s[0]
-    for a in range(a0, a1):
-        xa = xs[a]
-        ya = ys[a]
-        ia = perm[a]
-        start = a + 1 if same else b0
-        for b in range(start, b1):
-            dx = xa - xs[b]
-            dy = ya - ys[b]
-            d2 = dx * dx + dy * dy
-            if d2 <= eps2:
-                ib = perm[b]
-                if w > 1 and abs(ia - ib) < w:
-                    continue
-                px = nb[a, 0] - nb[b, 0]
-                py = nb[a, 1] - nb[b, 1]
-                p2 = px * px + py * py  # NaN without a predecessor: never <= e2
-                sx = nb[a, 2] - nb[b, 2]
-                sy = nb[a, 3] - nb[b, 3]
-                s2 = sx * sx + sy * sy
-                for k in range(eps2s.shape[0]):
-                    e2 = eps2s[k]
-                    if not (d2 <= e2):
-                        break
-                    count[k] += 1
-                    if not (p2 <= e2):  # (i, j) starts a diagonal line: walk it
-                        length = 1
-                        if s2 <= e2:
-                            i = min(ia, ib)
-                            j = max(ia, ib)
-                            length = 2
-                            while j + length < pts.shape[0] and _recurrent(
-                                pts, i + length, j + length, e2
-                            ):
-                                length += 1
-                        _add_line(diag, k, length)
+    px = g[a, 2] - g[b, 2]
+    py = g[a, 3] - g[b, 3]
+    p2 = px * px + py * py  # NaN without a predecessor: never <= e2
+    sx = g[a, 4] - g[b, 4]
+    sy = g[a, 5] - g[b, 5]
+    s2 = sx * sx + sy * sy
+    for k in range(eps2s.shape[0]):
+        e2 = eps2s[k]
+        if not (d2 <= e2):
+            break
+        count[k] += 1
+        if not (p2 <= e2):  # (i, j) starts a diagonal line: walk it
+            length = 1
+            if s2 <= e2:
+                i = min(ia, ib)
+                j = max(ia, ib)
+                length = 2
+                while j + length < pts.shape[0] and _recurrent(pts, i + length, j + length, e2):
+                    length += 1
+            _add_line(diag, k, length)
 
 
 @njit(cache=True)
@@ -329,59 +343,64 @@ def _sweep(xs, ys, perm, cell_start, cell_key, ncx, eps2, w, mode, count, buf):
 
 
 @njit(cache=True)
-def _sweep_lines(xs, ys, perm, cell_start, cell_key, ncx, w, pts, nb, eps2s, count, diag):
-    """`_sweep` with `_visit_block_lines`: the same stencil, a separate kernel.
+def _sweep_lines(g, perm, cell_start, cell_key, ncx, w, pts, eps2s, count, diag):
+    """The half-stencil sweep of `_sweep` for the line statistics (`_pair_lines`).
 
+    Same pairs as `_sweep`, visited as two contiguous ranges per point: its own cell's
+    later points plus the next cell of the row (adjacent when sorted), and the three cells
+    of the row above (``key + ncx + (-1, 0, 1)``, also adjacent when sorted). The
+    candidates of a point are first compacted without a branch (``m += d2 <= eps2``):
+    most candidates are not recurrent, and a data-dependent branch per candidate costs
+    more than the test (measured 1.2x on billiard samples, benchmarks/bench_recurrence.py).
     Kept apart from `_sweep` on purpose: one kernel with both bodies made the plain
     counting sweep of `recurrence_rate` 2.5x slower (measured).
     """
     n_cells = cell_key.shape[0]
+    eps2 = eps2s[0]
+    cand = np.empty(g.shape[0], np.int64)
+    dist2 = np.empty(g.shape[0])
     q = 0
     for c in range(n_cells):
         key = cell_key[c]
         s0 = cell_start[c]
         s1 = cell_start[c + 1]
-        _visit_block_lines(xs, ys, perm, s0, s1, s0, s1, True, w, pts, nb, eps2s, count, diag)
+        e1 = s1
         if c + 1 < n_cells and cell_key[c + 1] == key + 1:
-            _visit_block_lines(
-                xs,
-                ys,
-                perm,
-                s0,
-                s1,
-                s1,
-                cell_start[c + 2],
-                False,
-                w,
-                pts,
-                nb,
-                eps2s,
-                count,
-                diag,
-            )
+            e1 = cell_start[c + 2]
         lo = key + ncx - 1
         hi = key + ncx + 1
         while q < n_cells and cell_key[q] < lo:
             q += 1
         r = q
         while r < n_cells and cell_key[r] <= hi:
-            _visit_block_lines(
-                xs,
-                ys,
-                perm,
-                s0,
-                s1,
-                cell_start[r],
-                cell_start[r + 1],
-                False,
-                w,
-                pts,
-                nb,
-                eps2s,
-                count,
-                diag,
-            )
             r += 1
+        u0 = cell_start[q]
+        u1 = cell_start[r]
+        for a in range(s0, s1):
+            xa = g[a, 0]
+            ya = g[a, 1]
+            m = 0
+            for b in range(a + 1, e1):
+                dx = xa - g[b, 0]
+                dy = ya - g[b, 1]
+                d2 = dx * dx + dy * dy
+                cand[m] = b
+                dist2[m] = d2
+                m += d2 <= eps2
+            for b in range(u0, u1):
+                dx = xa - g[b, 0]
+                dy = ya - g[b, 1]
+                d2 = dx * dx + dy * dy
+                cand[m] = b
+                dist2[m] = d2
+                m += d2 <= eps2
+            ia = perm[a]
+            for t in range(m):
+                b = cand[t]
+                ib = perm[b]
+                if w > 1 and abs(ia - ib) < w:
+                    continue
+                _pair_lines(g, a, b, ia, ib, dist2[t], pts, eps2s, count, diag)
 
 
 @njit(cache=True)
@@ -477,7 +496,8 @@ def _check_theiler(theiler, n: int) -> int:
     return theiler
 
 
-def _cells(pts: np.ndarray, eps: float, neighbours: bool = False):
+def _grid(pts: np.ndarray, eps: float):
+    """``xmin, ymin, inv_h, ncx, n_bits`` of the cells of side just above ``eps``."""
     xmin, xmax, ymin, ymax, finite = _bounding_box(pts)
     if not finite:
         bad = np.flatnonzero(~np.isfinite(pts).all(axis=1))
@@ -491,10 +511,13 @@ def _cells(pts: np.ndarray, eps: float, neighbours: bool = False):
     ncx = int(np.floor((xmax - xmin) * inv_h)) + 3  # 1-based columns plus padding
     ncy = int(np.floor((ymax - ymin) * inv_h)) + 3
     n_bits = max(1, int(ncx * ncy - 1).bit_length())
-    xs, ys, perm, cell_start, cell_key, nb = _build_cells(
-        pts, xmin, ymin, inv_h, ncx, n_bits, neighbours
-    )
-    return xs, ys, perm, cell_start, cell_key, ncx, nb
+    return xmin, ymin, inv_h, ncx, n_bits
+
+
+def _cells(pts: np.ndarray, eps: float):
+    xmin, ymin, inv_h, ncx, n_bits = _grid(pts, eps)
+    xs, ys, perm, cell_start, cell_key = _build_cells(pts, xmin, ymin, inv_h, ncx, n_bits)
+    return xs, ys, perm, cell_start, cell_key, ncx
 
 
 _EMPTY = np.empty(0, np.int64)
@@ -577,7 +600,7 @@ def recurrence_rate(points, eps=1e-3, *, theiler=0):
 
 def _recurrence_rate_one(pts: np.ndarray, eps: float, w: int) -> float:
     n = pts.shape[0]
-    xs, ys, perm, cell_start, cell_key, ncx, _ = _cells(pts, eps)
+    xs, ys, perm, cell_start, cell_key, ncx = _cells(pts, eps)
     pairs = _sweep(
         xs, ys, perm, cell_start, cell_key, ncx, eps * eps, max(w, 1), _COUNT, _EMPTY, _EMPTY
     )
@@ -651,7 +674,7 @@ def _pairs_csr(pts: np.ndarray, eps: float, w: int):
     when they do not fit (large ``eps``) is the sweep repeated with the exact size.
     """
     n = pts.shape[0]
-    xs, ys, perm, cell_start, cell_key, ncx, _ = _cells(pts, eps)
+    xs, ys, perm, cell_start, cell_key, ncx = _cells(pts, eps)
     cap = 4 * n + 1024
     while True:
         buf = np.empty(2 * cap, np.int64)
@@ -695,26 +718,14 @@ def _line_sums(pts: np.ndarray, eps_list, w: int, l_min: int, vertical: bool):
     read the recurrence plot's rows (O(N + pairs), a second sweep).
     """
     m = len(eps_list)
-    xs, ys, perm, cell_start, cell_key, ncx, nb = _cells(pts, eps_list[0], neighbours=True)
+    xmin, ymin, inv_h, ncx, n_bits = _grid(pts, eps_list[0])
+    g, perm, cell_start, cell_key = _build_cells_lines(pts, xmin, ymin, inv_h, ncx, n_bits)
     eps2s = np.array([e * e for e in eps_list])
     pairs = np.zeros(m, np.int64)
     diag = np.zeros((m, 4), np.int64)
     vert = np.zeros((m, 4), np.int64)
     diag[:, 0] = vert[:, 0] = l_min
-    _sweep_lines(
-        xs,
-        ys,
-        perm,
-        cell_start,
-        cell_key,
-        ncx,
-        max(w, 1),
-        pts,
-        nb,
-        eps2s,
-        pairs,
-        diag,
-    )
+    _sweep_lines(g, perm, cell_start, cell_key, ncx, max(w, 1), pts, eps2s, pairs, diag)
     if vertical:
         offsets, cols = _pairs_csr(pts, eps_list[0], w)
         _vertical_sums(pts, offsets, cols, eps2s, w, vert)
