@@ -328,18 +328,21 @@ def schedule_command(
 
 
 # --- experiment commands ---
-def _run_one(experiment, out, workers, scheduler, progress, wait=False):
-    """Run or resume one sweep, printing store warnings as plain lines; returns the store."""
+def _run_one(experiment, out, workers, scheduler, progress, wait=False, executor=None):
+    """Run or resume one sweep, printing store warnings as plain lines; returns the store.
+    ``executor``: a pool shared by several sweeps (then ``workers`` is not passed on)."""
     import warnings
 
     from kicktimes.experiment import StoreWarning, run_experiment
 
+    if executor is not None:
+        workers = None
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", StoreWarning)
         try:
             store = run_experiment(
-                experiment, out, workers=workers, scheduler=scheduler, progress=progress,
-                wait=wait,
+                experiment, out, executor=executor, workers=workers, scheduler=scheduler,
+                progress=progress, wait=wait,
             )
         finally:
             for w in caught:
@@ -519,19 +522,30 @@ def reproduce_command(scale, out, workers, scheduler, progress, wait, pdf):
 
     if workers is not None and scheduler is not None:
         raise click.UsageError("--workers sizes the local pool; it cannot go with --scheduler")
+    from contextlib import ExitStack
+
+    from kicktimes.experiment.runner import local_pool
+
     stores = []
-    with _cli_errors(_RUN_OPTIONS):
-        if scheduler is None and any(
+    with _cli_errors(_RUN_OPTIONS), ExitStack() as stack:
+        pending = scheduler is None and any(
             _pending(preset(n), os.path.join(out, f"store-{n}")) for n in SCALES[scale]
-        ):
+        )
+        pool = None
+        if pending:
             _compile_first(workers)
+            if (workers or os.cpu_count() or 1) > 1:
+                # one pool for both families: each worker starts (imports, loads the
+                # compiled kernels) once
+                pool = stack.enter_context(local_pool(workers))
         for name in SCALES[scale]:
             exp = preset(name)
             path = os.path.join(out, f"store-{name}")
             click.echo(exp.summary())
-            store = _run_one(exp, path, workers, scheduler, progress, wait)
+            store = _run_one(exp, path, workers, scheduler, progress, wait, executor=pool)
             click.echo(store.summary())
             stores.append(path)
+        stack.close()  # the sweep workers end before the report starts its own
         report = _build_report(stores, os.path.join(out, "report"), workers, progress, pdf)
     click.echo(f"report written to {report if report is not None else os.path.join(out, 'report')}")
 

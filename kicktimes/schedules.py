@@ -47,8 +47,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-import scipy.stats
-from scipy.stats import rv_continuous, rv_discrete
 
 __all__ = [
     "DEFAULT_MAX_KICKS",
@@ -180,6 +178,8 @@ def _array_repr(arr, noun):
 
 # ------------------------------------------------------------------------ distributions
 def _is_frozen(obj):
+    from scipy.stats import rv_continuous  # scipy.stats only when a law is used
+
     return isinstance(getattr(obj, "dist", None), rv_continuous) and hasattr(obj, "args")
 
 
@@ -205,6 +205,9 @@ def resolve_distribution(name):
     >>> resolve_distribution("gamma")(2.0, scale=0.5).mean()
     np.float64(1.0)
     """
+    import scipy.stats
+    from scipy.stats import rv_continuous
+
     if not isinstance(name, str):
         raise TypeError(f"distribution name must be a str, got {name!r}")
     family = getattr(scipy.stats, name, None)
@@ -240,6 +243,8 @@ def _dist_params(dist):
 
 
 def _check_dist(dist):
+    from scipy.stats import rv_continuous, rv_discrete
+
     if not _is_frozen(dist) and _is_frozen(getattr(dist, "dist", None)):
         x_min = getattr(dist, "x_min", None)
         if x_min is not None:
@@ -306,6 +311,8 @@ def _dist_from_dict(d):
 
 
 def _generic_rvs(family):
+    from scipy.stats import rv_continuous
+
     # rv_continuous falls back to root-finding the CDF (itself a quadrature of the pdf)
     # for every draw when a family defines neither _rvs nor _ppf: far too slow for 1e6.
     cls = type(family)
