@@ -40,6 +40,7 @@ from scipy.special import expit, logit
 from statsmodels.tools.numdiff import approx_hess
 
 from ._checks import check_choice, check_int, check_intervals, check_real
+from ._renewal_mle import FAST_FITS
 from .distributions import fit_hyperexponential, hyperexpon
 from .powerlaw import fit_powerlaw_tail
 
@@ -184,10 +185,13 @@ def _direct_fit(model, x, c, x_min, start, trouble=None):
     return _from_free(model, res.x)
 
 
-def mle(model, x, c, x_min=None, *, min_tail=50, max_candidates=500):
+def mle(model, x, c, x_min=None, *, min_tail=50, max_candidates=500, engine="fast"):
     """Maximum-likelihood parameters of ``model`` (numbers in the units of the data).
 
     Returns ``(theta, extra)``; ``extra`` holds the tail bookkeeping of power-law fits.
+    ``engine="scipy"`` fits gamma, Weibull, lognormal and Lomax with the former
+    ``scipy.stats.<dist>.fit`` path instead of the dedicated optimisers (kept as the
+    reference of the tests and benchmarks).
     """
     extra: dict = {"trouble": []}
     trouble = extra["trouble"]
@@ -207,12 +211,19 @@ def mle(model, x, c, x_min=None, *, min_tail=50, max_candidates=500):
             p, lam1, lam2, _ = fit_hyperexponential(x - x_min, c - x_min)
             odds = math.exp(min(math.log(p / (1 - p)) + (lam1 - lam2) * x_min, 700.0))
             return np.array([odds / (1 + odds), lam1, lam2]), extra
-        start, _ = mle(model, x, c)
+        start, _ = mle(model, x, c, engine=engine)
         return _direct_fit(model, x, c, x_min, start, trouble), extra
     if model == "exponential":
         return np.array([x.size / (x.sum() + c.sum())]), extra
     if model == "hyperexponential":
         return np.array(fit_hyperexponential(x, c)[:3]), extra
+    if engine == "fast":
+        theta, trouble_fast = FAST_FITS[model](x, c)
+        ok = np.all(np.isfinite(theta)) and np.isfinite(_total_loglik(model, theta, x, c, None))
+        if ok and not trouble_fast:
+            return theta, extra
+        # the dedicated optimiser failed: polish (or start afresh) with Nelder-Mead
+        return _fallback(model, x, c, theta if ok else None, trouble_fast, trouble), extra
     scipy_trouble: list[str] = []
     try:
         theta = _scipy_fit(model, x, c, scipy_trouble)
@@ -220,16 +231,23 @@ def mle(model, x, c, x_min=None, *, min_tail=50, max_candidates=500):
     except (ValueError, RuntimeError, FloatingPointError, OverflowError):
         ok = False  # scipy's solver gave up (e.g. "function value at x=inf is NaN")
     if not ok or scipy_trouble:
-        mean = (x.sum() + c.sum()) / x.size
-        start = {"lognormal": [math.log(mean), 1.0]}.get(model, [1.0, mean])
-        direct_trouble: list[str] = []
-        direct = _direct_fit(model, x, c, None, np.array(start, dtype=float), direct_trouble)
-        if not ok or _total_loglik(model, direct, x, c, None) > _total_loglik(
-            model, theta, x, c, None
-        ):
-            theta, scipy_trouble = direct, direct_trouble
-        trouble.extend(scipy_trouble)
+        theta = _fallback(model, x, c, theta if ok else None, scipy_trouble, trouble)
     return theta, extra
+
+
+def _fallback(model, x, c, theta, theta_trouble, trouble):
+    """Nelder-Mead from a default start when the first optimiser failed; the better of
+    the two answers wins, with its own complaints appended to ``trouble``."""
+    mean = (x.sum() + c.sum()) / x.size
+    start = {"lognormal": [math.log(mean), 1.0]}.get(model, [1.0, mean])
+    direct_trouble: list[str] = []
+    direct = _direct_fit(model, x, c, None, np.array(start, dtype=float), direct_trouble)
+    if theta is None or _total_loglik(model, direct, x, c, None) > _total_loglik(
+        model, theta, x, c, None
+    ):
+        theta, theta_trouble = direct, direct_trouble
+    trouble.extend(theta_trouble)
+    return theta
 
 
 def _covariance(model, theta, x, c, x_min, n_tail):
@@ -468,9 +486,9 @@ def fit_renewal(intervals, model, *, censored=None, x_min=None, min_tail=50, max
     return fit
 
 
-def _fit(x, c, model, x_min, *, min_tail=50, max_candidates=500, covariance=True):
+def _fit(x, c, model, x_min, *, min_tail=50, max_candidates=500, covariance=True, engine="fast"):
     """fit_renewal on validated arrays; ``covariance=False`` skips the Hessian
-    (model comparison needs only the likelihood)."""
+    (model comparison needs only the likelihood); ``engine`` as in :func:`mle`."""
     need = _MIN_COMPLETE.get(model, 3)
     n_used = x.size if x_min is None else int((x >= x_min).sum())
     if model != "powerlaw" and n_used < need:
@@ -494,7 +512,9 @@ def _fit(x, c, model, x_min, *, min_tail=50, max_candidates=500, covariance=True
     unit = float((x / n_all).sum() + (c / n_all).sum())
     xs, cs = x / unit, c / unit
     xm = None if x_min is None else x_min / unit
-    theta, extra = mle(model, xs, cs, xm, min_tail=min_tail, max_candidates=max_candidates)
+    theta, extra = mle(
+        model, xs, cs, xm, min_tail=min_tail, max_candidates=max_candidates, engine=engine
+    )
     if model == "powerlaw":
         xm = extra["x_min"]
     # Tail masks: a given x_min applies in the data's units (as RenewalFit.sample
