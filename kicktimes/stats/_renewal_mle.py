@@ -262,11 +262,14 @@ def fit_weibull(x, c):
             hi = min(hi, u)
         # Newton in u: dg/du = k g'(k) = -(1/k + k Var)
         step = g / (1.0 / k + k * var_ly)
-        step = max(min(step, 2.0), -2.0)
-        new = u + step
+        if abs(step) < 1e-13 or g == 0.0:
+            u, converged = u + step, True
+            break
+        new = u + max(min(step, 2.0), -2.0)
         if not lo < new < hi:
+            # Newton left the bracket: bisect (or keep stepping until there is one)
             new = 0.5 * (lo + hi) if math.isfinite(lo + hi) else u + (2.0 if g > 0 else -2.0)
-        if abs(new - u) < 1e-13 or abs(g) * k < 1e-14:
+        if hi - lo < 1e-13:
             u, converged = new, True
             break
         u = new

@@ -218,7 +218,10 @@ def mle(model, x, c, x_min=None, *, min_tail=50, max_candidates=500, engine="fas
     if model == "hyperexponential":
         return np.array(fit_hyperexponential(x, c)[:3]), extra
     if engine == "fast":
-        theta, trouble_fast = FAST_FITS[model](x, c)
+        try:
+            theta, trouble_fast = FAST_FITS[model](x, c)
+        except (ValueError, OverflowError, ZeroDivisionError, FloatingPointError) as exc:
+            theta, trouble_fast = np.full(2, np.nan), [f"{model}: {exc}"]
         ok = np.all(np.isfinite(theta)) and np.isfinite(_total_loglik(model, theta, x, c, None))
         if ok and not trouble_fast:
             return theta, extra
