@@ -41,7 +41,7 @@ from statsmodels.tools.numdiff import approx_hess
 
 from ._checks import check_choice, check_int, check_intervals, check_real
 from ._renewal_mle import FAST_FITS
-from .distributions import fit_hyperexponential, hyperexpon
+from .distributions import _fit_hyperexponential_reference, fit_hyperexponential, hyperexpon
 from .powerlaw import fit_powerlaw_tail
 
 
@@ -72,6 +72,7 @@ _SCIPY_FAMILY = {
 # Exponent e of the time unit in each parameter: measured in units of s, a parameter
 # becomes theta * s**e (mu, a log-time, shifts by log s instead).
 _TIME_POWER = {"rate": -1, "rate1": -1, "rate2": -1, "scale": 1}
+_HYPER_FIT = {"fast": fit_hyperexponential, "scipy": _fit_hyperexponential_reference}
 _MIN_COMPLETE = {"exponential": 1, "hyperexponential": 5}
 # In units of the mean observation a sane estimate is far inside these bounds; beyond
 # them the likelihood has no interior maximum (e.g. Lomax on exponential data, whose
@@ -190,8 +191,9 @@ def mle(model, x, c, x_min=None, *, min_tail=50, max_candidates=500, engine="fas
 
     Returns ``(theta, extra)``; ``extra`` holds the tail bookkeeping of power-law fits.
     ``engine="scipy"`` fits gamma, Weibull, lognormal and Lomax with the former
-    ``scipy.stats.<dist>.fit`` path instead of the dedicated optimisers (kept as the
-    reference of the tests and benchmarks).
+    ``scipy.stats.<dist>.fit`` path instead of the dedicated optimisers, and the
+    hyperexponential with the former EM (kept as the reference of the tests and
+    benchmarks).
     """
     extra: dict = {"trouble": []}
     trouble = extra["trouble"]
@@ -208,7 +210,7 @@ def mle(model, x, c, x_min=None, *, min_tail=50, max_candidates=500, engine="fas
         if model == "hyperexponential":
             # The excess over x_min is again hyperexponential, with the weight of the
             # fast component discounted by exp(-(rate1 - rate2) x_min).
-            p, lam1, lam2, _ = fit_hyperexponential(x - x_min, c - x_min)
+            p, lam1, lam2, _ = _HYPER_FIT[engine](x - x_min, c - x_min)
             odds = math.exp(min(math.log(p / (1 - p)) + (lam1 - lam2) * x_min, 700.0))
             return np.array([odds / (1 + odds), lam1, lam2]), extra
         start, _ = mle(model, x, c, engine=engine)
@@ -216,7 +218,7 @@ def mle(model, x, c, x_min=None, *, min_tail=50, max_candidates=500, engine="fas
     if model == "exponential":
         return np.array([x.size / (x.sum() + c.sum())]), extra
     if model == "hyperexponential":
-        return np.array(fit_hyperexponential(x, c)[:3]), extra
+        return np.array(_HYPER_FIT[engine](x, c)[:3]), extra
     if engine == "fast":
         try:
             theta, trouble_fast = FAST_FITS[model](x, c)
