@@ -221,7 +221,8 @@ def mle(model, x, c, x_min=None, *, min_tail=50, max_candidates=500, engine="fas
         return np.array(_HYPER_FIT[engine](x, c)[:3]), extra
     if engine == "fast":
         try:
-            theta, trouble_fast = FAST_FITS[model](x, c)
+            with np.errstate(all="ignore"):  # wild data: non-finite values are checked below
+                theta, trouble_fast = FAST_FITS[model](x, c)
         except (ValueError, OverflowError, ZeroDivisionError, FloatingPointError) as exc:
             theta, trouble_fast = np.full(2, np.nan), [f"{model}: {exc}"]
         ok = np.all(np.isfinite(theta)) and np.isfinite(_total_loglik(model, theta, x, c, None))
