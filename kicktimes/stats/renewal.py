@@ -40,7 +40,7 @@ from scipy.special import expit, logit
 from statsmodels.tools.numdiff import approx_hess
 
 from ._checks import check_choice, check_int, check_intervals, check_real
-from ._renewal_mle import FAST_FITS
+from ._renewal_mle import CLOSED_FORM_MODELS, FAST_FITS, log_density_and_survival
 from .distributions import _fit_hyperexponential_reference, fit_hyperexponential, hyperexpon
 from .powerlaw import fit_powerlaw_tail
 
@@ -110,13 +110,19 @@ def pointwise_loglik(model, theta, complete, censored, x_min=None):
             lx = math.log(b) - lxm - (b + 1.0) * (np.log(complete) - lxm)
             lc = -b * (np.log(censored) - lxm)
         return np.asarray(lx, dtype=float), np.asarray(lc, dtype=float)
-    dist = frozen_distribution(model, theta, x_min)
     with np.errstate(all="ignore"):
-        lx, lc = dist.logpdf(complete), dist.logsf(censored)
-        if x_min is not None and model != "powerlaw":
-            shift = dist.logsf(x_min)
+        if model in CLOSED_FORM_MODELS:
+            lx, lc = log_density_and_survival(model, theta, complete, censored)
+            shift = (
+                None if x_min is None else log_density_and_survival(model, theta, [], [x_min])[1][0]
+            )
+        else:
+            dist = frozen_distribution(model, theta, x_min)
+            lx, lc = dist.logpdf(complete), dist.logsf(censored)
+            shift = None if x_min is None else dist.logsf(x_min)
+        if shift is not None:
             lx, lc = lx - shift, lc - shift
-    return lx, lc
+    return np.asarray(lx, dtype=float), np.asarray(lc, dtype=float)
 
 
 def _total_loglik(model, theta, x, c, x_min):
