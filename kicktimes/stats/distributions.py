@@ -22,6 +22,8 @@ from scipy import optimize
 from scipy.special import expit, gamma, logit
 from scipy.stats import CensoredData, rv_continuous
 
+from ._renewal_mle import newton
+
 __all__ = ["hyperexpon", "hyperexpon_gen", "fit_hyperexponential"]
 
 
@@ -178,24 +180,33 @@ hyperexpon = hyperexpon_gen(a=0.0, name="hyperexpon", shapes="p, lam1, lam2")
 
 @njit(cache=True)
 def _odds_sums(v, offset, d):
-    """``sum log(1 + r)``, ``sum w`` and ``sum w v`` over ``v`` for the odds
-    ``log r = offset - d v`` and ``w = r / (1 + r)`` (one fused, overflow-free pass)."""
+    """Sums over ``v`` for the odds ``log r = offset - d v`` of component 1, with
+    ``w = r / (1 + r)`` and ``u = w (1 - w)``: ``log(1 + r)``, ``w``, ``w v``, ``u``,
+    ``u v``, ``u v^2`` (one fused, overflow-free pass)."""
     softplus = 0.0
     sum_w = 0.0
     sum_wv = 0.0
+    sum_u = 0.0
+    sum_uv = 0.0
+    sum_uv2 = 0.0
     for i in range(v.size):
         lr = offset - d * v[i]
         e = math.exp(-abs(lr))
         softplus += max(lr, 0.0) + math.log1p(e)
         w = (1.0 if lr >= 0.0 else e) / (1.0 + e)
+        u = e / ((1.0 + e) * (1.0 + e))
         sum_w += w
         sum_wv += w * v[i]
-    return softplus, sum_w, sum_wv
+        sum_u += u
+        sum_uv += u * v[i]
+        sum_uv2 += u * v[i] * v[i]
+    return softplus, sum_w, sum_wv, sum_u, sum_uv, sum_uv2
 
 
 def _mixture_sums(theta, x, c, sum_x, sum_c):
     """Censored log-likelihood at ``theta = (logit p, log lam1, log lam2)`` and the
-    posterior sums EM and the gradient need: ``(ll, sum w, sum w x, sum w_c, sum w_c c)``.
+    posterior sums of :func:`_odds_sums` over the complete (``sx``) and the censored
+    (``sc``) intervals: ``(ll, sx, sc)``.
 
     With ``r`` the odds of component 1 given an observation,
     ``log r = logit p + log(lam1/lam2) - (lam1 - lam2) x`` (complete; no rate ratio for
@@ -205,10 +216,43 @@ def _mixture_sums(theta, x, c, sum_x, sum_c):
     lp, l1, l2 = float(theta[0]), float(theta[1]), float(theta[2])
     d = math.exp(l1) - math.exp(l2)
     log_q = -(max(lp, 0.0) + math.log1p(math.exp(-abs(lp))))  # log(1 - p)
-    spx, w, wx = _odds_sums(x, lp + l1 - l2, d)
-    spc, wc, wcc = _odds_sums(c, lp, d)
-    ll = x.size * (log_q + l2) + c.size * log_q - math.exp(l2) * (sum_x + sum_c) + spx + spc
-    return ll, w, wx, wc, wcc
+    sx = _odds_sums(x, lp + l1 - l2, d)
+    sc = _odds_sums(c, lp, d)
+    ll = x.size * (log_q + l2) + c.size * log_q - math.exp(l2) * (sum_x + sum_c) + sx[0] + sc[0]
+    return ll, sx, sc
+
+
+def _mixture_derivatives(theta, x, c, sum_x, sum_c):
+    """Log-likelihood, gradient and Hessian in ``(logit p, log lam1, log lam2)``.
+
+    Per complete interval ``d log r = (1, 1 - lam1 x, lam2 x - 1)`` and the score is
+    ``(w - p, w (1 - lam1 x), (1 - w)(1 - lam2 x))``; per censored one
+    ``d log r = (1, -lam1 c, lam2 c)`` and the score ``(w - p, -w lam1 c,
+    -(1 - w) lam2 c)``. The Hessian is ``sum u (d log r)(d log r)^T`` plus the
+    curvature of the linear terms (``-p(1-p)`` per observation, ``-w lam1 y`` and
+    ``-(1 - w) lam2 y`` on the rate diagonals).
+    """
+    ll, sx, sc = _mixture_sums(theta, x, c, sum_x, sum_c)
+    _, w, wx, u, ux, ux2 = sx
+    _, wc, wcc, uc, ucc, ucc2 = sc
+    n_obs = x.size + c.size
+    p = float(expit(theta[0]))
+    l1, l2 = math.exp(theta[1]), math.exp(theta[2])
+    grad = np.array(
+        [
+            w + wc - p * n_obs,
+            w - l1 * (wx + wcc),
+            (x.size - w) - l2 * (sum_x - wx + sum_c - wcc),
+        ]
+    )
+    h_aa = u + uc - p * (1.0 - p) * n_obs
+    h_ab = u - l1 * (ux + ucc)
+    h_ag = -u + l2 * (ux + ucc)
+    h_bb = u - 2 * l1 * ux + l1 * l1 * (ux2 + ucc2) - l1 * (wx + wcc)
+    h_bg = -u + (l1 + l2) * ux - l1 * l2 * (ux2 + ucc2)
+    h_gg = u - 2 * l2 * ux + l2 * l2 * (ux2 + ucc2) - l2 * (sum_x - wx + sum_c - wcc)
+    hess = np.array([[h_aa, h_ab, h_ag], [h_ab, h_bb, h_bg], [h_ag, h_bg, h_gg]])
+    return ll, grad, hess
 
 
 def _em_fast(x, c, sum_x, sum_c, p, lam1, lam2, n_iter):
@@ -216,7 +260,7 @@ def _em_fast(x, c, sum_x, sum_c, p, lam1, lam2, n_iter):
     n_obs = x.size + c.size
     for _ in range(n_iter):
         theta = (logit(p), math.log(lam1), math.log(lam2))
-        _, w, wx, wc, wcc = _mixture_sums(theta, x, c, sum_x, sum_c)
+        _, (_, w, wx, *_), (_, wc, wcc, *_) = _mixture_sums(theta, x, c, sum_x, sum_c)
         expo1 = wx + wcc
         expo2 = sum_x + sum_c - expo1
         p = min(max((w + wc) / n_obs, 1e-12), 1 - 1e-12)
@@ -237,7 +281,7 @@ def fit_hyperexponential(complete, censored=None, *, n_em=40, max_polish=500, em
     n_em : int, optional
         EM iterations run from each of four starting points before the polish.
     max_polish : int, optional
-        Iteration cap of the BFGS polish.
+        Iteration cap of the Newton polish.
     em_sample : int or None, optional
         The multi-start EM runs on an evenly strided subsample of about this many
         complete (and proportionally censored) intervals; None uses all of them.
@@ -251,13 +295,15 @@ def fit_hyperexponential(complete, censored=None, *, n_em=40, max_polish=500, em
 
     Notes
     -----
-    EM is monotone but slow near the optimum, a direct quasi-Newton polish with the
-    analytic gradient is fast there but needs a good start: EM from four spread-out
-    starts (rates a few times above and below the exposure rate; on a subsample,
-    since only the basin matters), each end point scored on all the data, then a few
-    EM steps and BFGS on ``(logit p, log lam1, log lam2)`` from the best, on all the
-    data. When the data are close to exponential the maximum is on the boundary
-    (``p -> 0 or 1`` or ``lam1 -> lam2``) and the parameters are not identified.
+    EM is monotone but slow near the optimum, a direct Newton polish with the
+    analytic gradient and Hessian is fast there but needs a good start: EM from four
+    spread-out starts (rates a few times above and below the exposure rate; on an
+    evenly strided subsample, since only the basin matters), each end point scored on
+    all the data, then damped Newton on ``(logit p, log lam1, log lam2)`` from the
+    best, on all the data. The sums over the data (log-likelihood, responsibilities
+    and their moments) come from one fused numba pass. When the data are close to
+    exponential the maximum is on the boundary (``p -> 0 or 1`` or
+    ``lam1 -> lam2``) and the parameters are not identified.
 
     Examples
     --------
@@ -287,34 +333,31 @@ def fit_hyperexponential(complete, censored=None, *, n_em=40, max_polish=500, em
             best = (ll, theta)
     n_obs = x.size + c.size
 
+    cache = {}
+
     def objective(theta):
-        # Keep the weight's logit finite: p within 1e-16 of 0 or 1 is a boundary fit.
-        theta = np.array([np.clip(theta[0], -37.0, 37.0), theta[1], theta[2]])
-        if not np.all(np.abs(theta[1:]) < 700):
-            return np.inf, np.zeros(3)
-        ll, w, wx, wc, wcc = _mixture_sums(theta, x, c, sum_x, sum_c)
+        key = tuple(theta)
+        if key not in cache:
+            cache.clear()
+            cache[key] = _mixture_derivatives(theta, x, c, sum_x, sum_c)
+        ll, grad, _ = cache[key]
         if not np.isfinite(ll):
-            return np.inf, np.zeros(3)
-        p = expit(theta[0])
-        lam1, lam2 = math.exp(theta[1]), math.exp(theta[2])
-        grad = np.array(
-            [
-                w + wc - p * n_obs,
-                w - lam1 * (wx + wcc),
-                (x.size - w) - lam2 * (sum_x - wx + sum_c - wcc),
-            ]
-        )
+            return 1e10, np.zeros(3)
         return -ll / n_obs, -grad / n_obs
 
+    def hessian(theta):
+        objective(theta)
+        return -cache[tuple(theta)][2] / n_obs
+
+    # logit p within +-37: p within 1e-16 of 0 or 1 is a boundary fit
+    bounds = [(-37.0, 37.0), (-700.0, 700.0), (-700.0, 700.0)]
     with np.errstate(all="ignore"):
-        res = optimize.minimize(
-            objective,
-            best[1],
-            jac=True,
-            method="BFGS",
-            options={"maxiter": max_polish, "gtol": 1e-9},
-        )
-    theta = res.x if np.isfinite(res.fun) and -res.fun * n_obs >= best[0] else best[1]
+        theta, _ = newton(objective, best[1], bounds, "hyperexponential", hessian, max_polish)
+        ll_polish = -objective(theta)[0] * n_obs
+    # on the boundary (nearly exponential data) the polish may stop anywhere on a ridge
+    # of equal likelihood: it is kept only if it is at least as good as the EM start
+    if not ll_polish >= best[0]:
+        theta = best[1]
     theta = np.array([np.clip(theta[0], -37.0, 37.0), theta[1], theta[2]])
     p, lam1, lam2 = float(expit(theta[0])), float(np.exp(theta[1])), float(np.exp(theta[2]))
     if lam1 < lam2:
