@@ -43,7 +43,7 @@ _LOG_SQRT_2PI = 0.5 * math.log(2.0 * math.pi)
 _GRAD_OK = 1e-6
 # Lomax: the profile is searched on this grid of log10(eta) (eta = 1/scale in units of
 # the mean observation); heavy tails (shape < 1) put the scale far below the mean.
-_LOMAX_GRID = np.arange(-8.0, 20.01, 0.5)
+_LOMAX_GRID = np.arange(-8.0, 20.01, 1.0)
 # Lomax edge: returned when the supremum is the exponential limit (eta -> 0). Shape and
 # scale are then ~1e12 (beyond the _DIVERGED bounds of renewal.py, so the fit says so),
 # and the log-likelihood differs from the exponential's by ~n * 1e-12.
