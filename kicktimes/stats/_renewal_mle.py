@@ -449,21 +449,22 @@ def log_density_and_survival(model, theta, x, c):
     (:func:`log_gammaincc`) where scipy's underflows to -inf."""
     x = np.asarray(x, dtype=float)
     c = np.asarray(c, dtype=float)
-    t0, t1 = float(theta[0]), float(theta[-1])
+    # numpy scalars: wild parameters give inf/nan (checked by the callers), not errors
+    t0, t1 = np.float64(theta[0]), np.float64(theta[-1])
     if model == "exponential":
-        return math.log(t0) - t0 * x, -t0 * c
+        return np.log(t0) - t0 * x, -t0 * c
     if model == "gamma":
         z = x / t1
-        return xlogy(t0 - 1.0, z) - z - gammaln(t0) - math.log(t1), log_gammaincc(t0, c / t1)
+        return xlogy(t0 - 1.0, z) - z - gammaln(t0) - np.log(t1), log_gammaincc(t0, c / t1)
     if model == "weibull":
         z = x / t1
-        return math.log(t0 / t1) + xlogy(t0 - 1.0, z) - z**t0, -((c / t1) ** t0)
+        return np.log(t0 / t1) + xlogy(t0 - 1.0, z) - z**t0, -((c / t1) ** t0)
     if model == "lognormal":
         lx = np.log(x)
-        lx_pdf = -math.log(t1) - lx - _LOG_SQRT_2PI - 0.5 * ((lx - t0) / t1) ** 2
+        lx_pdf = -np.log(t1) - lx - _LOG_SQRT_2PI - 0.5 * ((lx - t0) / t1) ** 2
         return lx_pdf, log_ndtr(-(np.log(c) - t0) / t1)
     if model == "lomax":
-        return math.log(t0 / t1) - (t0 + 1.0) * np.log1p(x / t1), -t0 * np.log1p(c / t1)
+        return np.log(t0 / t1) - (t0 + 1.0) * np.log1p(x / t1), -t0 * np.log1p(c / t1)
     raise ValueError(f"model {model!r} has no closed form here")
 
 
