@@ -6,6 +6,7 @@ import math
 
 import numpy as np
 import pytest
+import scipy.special
 import scipy.stats
 from scipy import integrate
 
@@ -462,3 +463,68 @@ def test_dedicated_fit_reaches_the_scipy_paths_likelihood(model):
 def test_dedicated_fit_reaches_the_scipy_paths_likelihood_on_many_samples(model):
     for case in comparison_cases(8 * 3 * 3 * 4, seed=100 + FITTED_MODELS.index(model)):
         assert_dedicated_fit_matches_scipy(model, *case)
+
+
+def test_lomax_on_data_less_dispersed_than_exponential_is_the_flagged_exponential_limit():
+    x = np.random.default_rng(30).gamma(1.2, 2.0, 5000)  # coefficient of variation < 1
+    c = np.full(50, 1.0)
+    with pytest.warns(stats.FitWarning, match="ran off"):
+        lomax = stats.fit_renewal(x, "lomax", censored=c)
+    expo = stats.fit_renewal(x, "exponential", censored=c)
+    assert lomax.converged
+    assert lomax.loglik == pytest.approx(expo.loglik, rel=1e-9)
+    assert lomax.params["shape"] / lomax.params["scale"] == pytest.approx(
+        expo.params["rate"], rel=1e-6
+    )
+
+
+def test_lomax_on_heavy_tailed_data_has_an_interior_maximum():
+    law = scipy.stats.lomax(0.8, scale=0.01)  # infinite mean: scale far below the mean
+    x = law.rvs(4000, random_state=np.random.default_rng(31))
+    fit = stats.fit_renewal(x, "lomax")
+    assert not fit.warnings
+    assert abs(fit.params["shape"] - 0.8) < 4 * fit.stderr["shape"]
+    assert abs(fit.params["scale"] - 0.01) < 4 * fit.stderr["scale"]
+
+
+def test_log_upper_incomplete_gamma_is_finite_where_gammaincc_underflows():
+    from kicktimes.stats._renewal_mle import log_gammaincc
+
+    z = np.array([0.5, 50.0, 700.0, 1e4, 1e6])
+    # a = 1: Q(1, z) = exp(-z); a = 0.5: Q = erfc(sqrt z)
+    np.testing.assert_allclose(log_gammaincc(1.0, z), -z, rtol=1e-12)
+    exact = scipy.special.log_ndtr(-np.sqrt(2 * z)) + math.log(2.0)
+    np.testing.assert_allclose(log_gammaincc(0.5, z), exact, rtol=1e-10)
+    # both branches meet where gammaincc leaves the normal range
+    a = 3.7
+    z = np.linspace(600, 700, 201)
+    assert np.all(np.isfinite(log_gammaincc(a, z)))
+    assert np.all(np.diff(log_gammaincc(a, z)) < 0)
+
+
+def test_gamma_survival_terms_far_in_the_tail_keep_the_fit_finite():
+    rng = np.random.default_rng(32)
+    x = rng.gamma(3.0, 1.0, 5000)
+    fit = stats.fit_renewal(x, "gamma", censored=[1500.0])  # S(1500) underflows to 0
+    assert fit.converged and math.isfinite(fit.loglik)
+    assert fit.pointwise_loglik()[1][0] < -745  # exp(-745) is below the smallest double
+    from kicktimes.stats.renewal import _total_loglik
+
+    # a maximum: every nearby parameter pair is less likely
+    for da, ds in [(1, 0), (-1, 0), (0, 1), (0, -1), (1, 1), (-1, -1)]:
+        theta = fit.theta * (1 + 1e-4 * np.array([da, ds]))
+        assert _total_loglik("gamma", theta, x, np.array([1500.0]), None) < fit.loglik
+
+
+def test_a_failed_dedicated_optimiser_falls_back_to_nelder_mead(monkeypatch):
+    from kicktimes.stats import renewal
+
+    x = np.random.default_rng(33).weibull(0.8, 400)
+    good = stats.fit_renewal(x, "weibull")
+    monkeypatch.setitem(
+        renewal.FAST_FITS, "weibull", lambda x, c: (np.array([np.nan, 1.0]), ["broken"])
+    )
+    fallback = stats.fit_renewal(x, "weibull")
+    assert fallback.converged
+    assert fallback.loglik == pytest.approx(good.loglik, rel=1e-9)
+    assert fallback.params["shape"] == pytest.approx(good.params["shape"], rel=1e-4)

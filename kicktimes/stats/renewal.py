@@ -463,10 +463,34 @@ def fit_renewal(intervals, model, *, censored=None, x_min=None, min_tail=50, max
     -----
     Likelihood:
     :math:`\ell = \sum \log f(x_i) + \sum \log S(c_j)` (minus
-    :math:`(n + n_c)\log S(x_{min})` for tail fits). gamma, Weibull, lognormal and
-    Lomax use ``scipy.stats.<dist>.fit`` on :class:`scipy.stats.CensoredData` with
-    ``floc=0``; the exponential and the power law have closed forms; the
-    hyperexponential uses EM plus a quasi-Newton polish. Computations run in units of
+    :math:`(n + n_c)\log S(x_{min})` for tail fits). Each model has a dedicated
+    optimiser, with the complete-data part of the likelihood in sufficient statistics
+    (:math:`n, \sum x, \sum\log x`) and the censored terms over the distinct
+    censored values:
+
+    * exponential: closed form :math:`\hat\lambda = n / (\sum x + \sum c)`;
+    * gamma: uncensored, the profile equation
+      :math:`\log a - \psi(a) = \log\bar x - \overline{\log x}` (Newton);
+      censored, damped Newton on :math:`(\log a, \log s)` with
+      :math:`\log Q(a, c/s)` computed log-safely (continued fraction where
+      ``gammaincc`` underflows);
+    * Weibull: the 1-D profile in the shape, :math:`\lambda^k = \sum y^k / n` over
+      all observations, whose score equation has a unique root (safeguarded Newton);
+    * lognormal: closed form uncensored; censored, damped Newton on
+      :math:`(\mu, \log\sigma)` with ``log_ndtr`` survival terms;
+    * Lomax: the 1-D profile in :math:`\eta = 1/\text{scale}` (the shape is
+      :math:`n / \sum\log(1 + \eta y)`), grid plus bounded Brent;
+      :math:`\eta \to 0` is the exponential limit, returned as a point at
+      :math:`\eta = 10^{-12}` (flagged: the estimates run off to infinity) whose
+      likelihood equals the exponential's;
+    * hyperexponential: multi-start EM on a subsample, then Newton with the analytic
+      Hessian on all the data;
+    * power law: closed form above ``x_min``.
+
+    When a dedicated optimiser fails (no convergence, a non-finite likelihood, a
+    bound of its search box) Nelder-Mead from a default start takes over and the
+    better of the two is kept; tail fits maximise the truncated likelihood by
+    Nelder-Mead from the full-sample fit of the tail. Computations run in units of
     the mean observation, so the parameters are well scaled whatever the time unit.
     Standard errors come from the inverse of the numerical Hessian
     (``statsmodels.tools.numdiff.approx_hess``) of the negative log-likelihood in the
