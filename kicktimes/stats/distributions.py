@@ -203,6 +203,20 @@ def _odds_sums(v, offset, d):
     return softplus, sum_w, sum_wv, sum_u, sum_uv, sum_uv2
 
 
+@njit(cache=True)
+def _responsibility_sums(v, offset, d):
+    """``sum w`` and ``sum w v`` of :func:`_odds_sums`: all an EM step needs."""
+    sum_w = 0.0
+    sum_wv = 0.0
+    for i in range(v.size):
+        lr = offset - d * v[i]
+        e = math.exp(-abs(lr))
+        w = (1.0 if lr >= 0.0 else e) / (1.0 + e)
+        sum_w += w
+        sum_wv += w * v[i]
+    return sum_w, sum_wv
+
+
 def _mixture_sums(theta, x, c, sum_x, sum_c):
     """Censored log-likelihood at ``theta = (logit p, log lam1, log lam2)`` and the
     posterior sums of :func:`_odds_sums` over the complete (``sx``) and the censored
@@ -259,8 +273,9 @@ def _em_fast(x, c, sum_x, sum_c, p, lam1, lam2, n_iter):
     """EM steps as in :func:`_em`, on the posterior sums of :func:`_mixture_sums`."""
     n_obs = x.size + c.size
     for _ in range(n_iter):
-        theta = (logit(p), math.log(lam1), math.log(lam2))
-        _, (_, w, wx, *_), (_, wc, wcc, *_) = _mixture_sums(theta, x, c, sum_x, sum_c)
+        log_odds = math.log(p) - math.log1p(-p)
+        w, wx = _responsibility_sums(x, log_odds + math.log(lam1 / lam2), lam1 - lam2)
+        wc, wcc = _responsibility_sums(c, log_odds, lam1 - lam2)
         expo1 = wx + wcc
         expo2 = sum_x + sum_c - expo1
         p = min(max((w + wc) / n_obs, 1e-12), 1 - 1e-12)
@@ -269,7 +284,7 @@ def _em_fast(x, c, sum_x, sum_c, p, lam1, lam2, n_iter):
     return p, lam1, lam2
 
 
-def fit_hyperexponential(complete, censored=None, *, n_em=40, max_polish=500, em_sample=1000):
+def fit_hyperexponential(complete, censored=None, *, n_em=40, max_polish=500, em_sample=None):
     r"""Maximum-likelihood fit of a hyperexponential to right-censored intervals.
 
     Parameters
@@ -283,8 +298,10 @@ def fit_hyperexponential(complete, censored=None, *, n_em=40, max_polish=500, em
     max_polish : int, optional
         Iteration cap of the Newton polish.
     em_sample : int or None, optional
-        The multi-start EM runs on an evenly strided subsample of about this many
-        complete (and proportionally censored) intervals; None uses all of them.
+        Run the multi-start EM on an evenly strided subsample of about this many
+        complete (and proportionally censored) intervals: faster on large samples, at
+        the risk of missing a small fast component that only all the data reveal
+        (default None: all of them).
 
     Returns
     -------
@@ -297,13 +314,12 @@ def fit_hyperexponential(complete, censored=None, *, n_em=40, max_polish=500, em
     -----
     EM is monotone but slow near the optimum, a direct Newton polish with the
     analytic gradient and Hessian is fast there but needs a good start: EM from four
-    spread-out starts (rates a few times above and below the exposure rate; on an
-    evenly strided subsample, since only the basin matters), each end point scored on
-    all the data, then damped Newton on ``(logit p, log lam1, log lam2)`` from the
-    best, on all the data. The sums over the data (log-likelihood, responsibilities
-    and their moments) come from one fused numba pass. When the data are close to
-    exponential the maximum is on the boundary (``p -> 0 or 1`` or
-    ``lam1 -> lam2``) and the parameters are not identified.
+    spread-out starts (rates a few times above and below the exposure rate), then
+    damped Newton on ``(logit p, log lam1, log lam2)`` from the best. The sums over
+    the data (log-likelihood, responsibilities and their moments) come from fused
+    numba passes. When the data are close to exponential the maximum is on the
+    boundary (``p -> 0 or 1`` or ``lam1 -> lam2``) and the parameters are not
+    identified.
 
     Examples
     --------
