@@ -205,16 +205,37 @@ def _odds_sums(v, offset, d):
 
 @njit(cache=True)
 def _responsibility_sums(v, offset, d):
-    """``sum w`` and ``sum w v`` of :func:`_odds_sums`: all an EM step needs."""
+    """``sum w``, ``sum w v``, ``sum (1 - w) v`` for the odds of :func:`_odds_sums`;
+    ``1 - w`` is formed directly, without cancellation, when ``w`` is near 1."""
     sum_w = 0.0
     sum_wv = 0.0
+    sum_qv = 0.0
     for i in range(v.size):
         lr = offset - d * v[i]
         e = math.exp(-abs(lr))
-        w = (1.0 if lr >= 0.0 else e) / (1.0 + e)
+        if lr >= 0.0:
+            w, q = 1.0 / (1.0 + e), e / (1.0 + e)
+        else:
+            w, q = e / (1.0 + e), 1.0 / (1.0 + e)
         sum_w += w
         sum_wv += w * v[i]
-    return sum_w, sum_wv
+        sum_qv += q * v[i]
+    return sum_w, sum_wv, sum_qv
+
+
+@njit(cache=True)
+def _em_steps(x, c, p, lam1, lam2, n_iter):
+    """``n_iter`` EM steps as in :func:`_em` (each exponential component gets its
+    censored MLE, expected events / expected exposure), compiled as one loop."""
+    n_obs = x.size + c.size
+    for _ in range(n_iter):
+        log_odds = math.log(p) - math.log1p(-p)
+        w, wx, qx = _responsibility_sums(x, log_odds + math.log(lam1 / lam2), lam1 - lam2)
+        wc, wcc, qcc = _responsibility_sums(c, log_odds, lam1 - lam2)
+        p = min(max((w + wc) / n_obs, 1e-12), 1 - 1e-12)
+        lam1 = max(w, 1e-300) / max(wx + wcc, 1e-300)
+        lam2 = max(x.size - w, 1e-300) / max(qx + qcc, 1e-300)
+    return p, lam1, lam2
 
 
 def _mixture_sums(theta, x, c, sum_x, sum_c):
@@ -267,21 +288,6 @@ def _mixture_derivatives(theta, x, c, sum_x, sum_c):
     h_gg = u - 2 * l2 * ux + l2 * l2 * (ux2 + ucc2) - l2 * (sum_x - wx + sum_c - wcc)
     hess = np.array([[h_aa, h_ab, h_ag], [h_ab, h_bb, h_bg], [h_ag, h_bg, h_gg]])
     return ll, grad, hess
-
-
-def _em_fast(x, c, sum_x, sum_c, p, lam1, lam2, n_iter):
-    """EM steps as in :func:`_em`, on the posterior sums of :func:`_mixture_sums`."""
-    n_obs = x.size + c.size
-    for _ in range(n_iter):
-        log_odds = math.log(p) - math.log1p(-p)
-        w, wx = _responsibility_sums(x, log_odds + math.log(lam1 / lam2), lam1 - lam2)
-        wc, wcc = _responsibility_sums(c, log_odds, lam1 - lam2)
-        expo1 = wx + wcc
-        expo2 = sum_x + sum_c - expo1
-        p = min(max((w + wc) / n_obs, 1e-12), 1 - 1e-12)
-        lam1 = max(w, 1e-300) / max(expo1, 1e-300)
-        lam2 = max(x.size - w, 1e-300) / max(expo2, 1e-300)
-    return p, lam1, lam2
 
 
 def fit_hyperexponential(complete, censored=None, *, n_em=40, max_polish=500, em_sample=None):
@@ -338,11 +344,10 @@ def fit_hyperexponential(complete, censored=None, *, n_em=40, max_polish=500, em
     stride = 1 if em_sample is None else max(1, x.size // max(int(em_sample), 1))
     # contiguous copies: one compiled signature of the kernel serves every call
     xs, cs = np.ascontiguousarray(x[::stride]), np.ascontiguousarray(c[::stride])
-    sxs, scs = float(xs.sum()), float(cs.sum())
     starts = [(0.5, 2.0, 0.5), (0.2, 5.0, 0.7), (0.8, 1.5, 0.2), (0.05, 20.0, 0.9)]
     best = None
     for p0, f1, f2 in starts:
-        p, lam1, lam2 = _em_fast(xs, cs, sxs, scs, p0, f1 * rate, f2 * rate, n_em)
+        p, lam1, lam2 = _em_steps(xs, cs, p0, f1 * rate, f2 * rate, n_em)
         theta = np.array([logit(p), np.log(lam1), np.log(lam2)])
         ll = _mixture_sums(theta, x, c, sum_x, sum_c)[0]
         if best is None or ll > best[0]:
