@@ -30,6 +30,7 @@ is comparable only with other tail fits (see :func:`compare_models`).
 
 from __future__ import annotations
 
+import functools
 import math
 import warnings
 from dataclasses import dataclass, field
@@ -41,7 +42,12 @@ from statsmodels.tools.numdiff import approx_hess
 
 from ._checks import check_choice, check_int, check_intervals, check_real
 from ._renewal_mle import CLOSED_FORM_MODELS, FAST_FITS, log_density_and_survival
-from .distributions import _fit_hyperexponential_reference, fit_hyperexponential, hyperexpon
+from .distributions import (
+    _fit_hyperexponential_reference,
+    _log_components,
+    fit_hyperexponential,
+    hyperexpon,
+)
 from .powerlaw import fit_powerlaw_tail
 
 
@@ -116,10 +122,13 @@ def pointwise_loglik(model, theta, complete, censored, x_min=None):
             shift = (
                 None if x_min is None else log_density_and_survival(model, theta, [], [x_min])[1][0]
             )
-        else:
-            dist = frozen_distribution(model, theta, x_min)
-            lx, lc = dist.logpdf(complete), dist.logsf(censored)
-            shift = None if x_min is None else dist.logsf(x_min)
+        elif model == "hyperexponential":
+            p, lam1, lam2 = (float(v) for v in theta)
+            lx = np.logaddexp(*_log_components(complete, p, lam1, lam2, density=True))
+            lc = np.logaddexp(*_log_components(censored, p, lam1, lam2, density=False))
+            shift = None
+            if x_min is not None:
+                shift = np.logaddexp(*_log_components(x_min, p, lam1, lam2, density=False))
         if shift is not None:
             lx, lc = lx - shift, lc - shift
     return np.asarray(lx, dtype=float), np.asarray(lc, dtype=float)
@@ -332,7 +341,6 @@ class RenewalFit:
     k: int
     n: int
     n_censored: int
-    dist: object
     x_min: float | None = None
     x_min_method: str | None = None
     n_excluded: int = 0
@@ -342,6 +350,13 @@ class RenewalFit:
     scan: dict = field(default_factory=dict)
     converged: bool = True
     warnings: tuple = ()
+
+    @functools.cached_property
+    def dist(self):
+        """The fitted interval law, a frozen scipy distribution (the untruncated parent
+        for tail fits). Built on first use: freezing a scipy distribution costs about a
+        millisecond, more than many fits, and model comparison never needs it."""
+        return frozen_distribution(self.model, self.theta, self.x_min)
 
     @property
     def aic(self) -> float:
@@ -621,7 +636,6 @@ def _fit(x, c, model, x_min, *, min_tail=50, max_candidates=500, covariance=True
         k=len(names),
         n=n_tail,
         n_censored=int(ct.size),
-        dist=frozen_distribution(model, theta_out, x_min_out),
         x_min=x_min_out,
         x_min_method=None if x_min_out is None else extra.get("method", "fixed"),
         n_excluded=int(x.size + c.size - xt.size - ct.size),
