@@ -121,35 +121,43 @@ def newton(objective, start, bounds, what, hess=None, max_iter=200):
         return x, [f"{what}: no finite likelihood at the start"]
     converged = False
     for _ in range(max_iter):
-        if np.max(np.abs(g)) < 1e-10:
+        # coordinates held at a bound by a gradient pushing outwards stay fixed
+        free = ~(((x <= lo) & (g > 0)) | ((x >= hi) & (g < 0)))
+        if not free.any() or np.max(np.abs(g[free])) < 1e-10:
             converged = True
             break
         h = hess(x) if hess is not None else _numerical_hessian(objective, x, g)
+        h = h[np.ix_(free, free)]
+        eye = np.eye(h.shape[0])
         shift = 0.0
         scale = max(1e-12, float(np.max(np.abs(np.diag(h)))))
         for _ in range(60):
             try:
-                np.linalg.cholesky(h + shift * np.eye(x.size))
+                np.linalg.cholesky(h + shift * eye)
                 break
             except np.linalg.LinAlgError:
                 shift = max(2.0 * shift, 1e-10 * scale)
-        step = -np.linalg.solve(h + shift * np.eye(x.size), g)
+        step = np.zeros_like(x)
+        step[free] = -np.linalg.solve(h + shift * eye, g[free])
         slope = float(g @ step)
+        if -slope < 1e-15 * max(1.0, abs(f)):
+            # the predicted gain is below rounding: the optimum, if the gradient is small
+            converged = np.max(np.abs(g[free])) < _GRAD_OK
+            break
         t = 1.0
-        while t > 1e-14:
+        for _ in range(40):
             new = np.clip(x + t * step, lo, hi)
             f_new, g_new = objective(new)
-            if f_new <= f + 1e-4 * t * min(slope, 0.0):
+            if f_new <= f + 1e-4 * t * slope:
                 break
             t *= 0.5
         else:
-            # no decrease left: the optimum up to rounding, if the gradient is small
-            converged = np.max(np.abs(g)) < _GRAD_OK
+            converged = np.max(np.abs(g[free])) < _GRAD_OK
             break
         moved = np.max(np.abs(new - x))
         x, f, g = new, f_new, g_new
         if moved < 1e-13:
-            converged = np.max(np.abs(g)) < _GRAD_OK
+            converged = np.max(np.abs(g[free])) < _GRAD_OK
             break
     trouble = []
     if np.any(np.minimum(np.abs(x - lo), np.abs(x - hi)) < 1e-8):
@@ -408,9 +416,17 @@ def fit_lomax(x, c):
     wy = np.concatenate([np.ones(s.n), s.weight])
     if not np.all(np.isfinite(y)) or not (wy @ y) > 0:
         return np.array([np.nan, np.nan]), ["lomax: the data sum is not finite"]
+    etas = np.concatenate([[0.0], 10.0**_LOMAX_GRID])
+    prof = np.full(etas.size, -np.inf)
+    below = 0
     with np.errstate(all="ignore"):
-        etas = np.concatenate([[0.0], 10.0**_LOMAX_GRID])
-        prof = np.array([_lomax_profile(e, s, y, wy) for e in etas])
+        for i, eta in enumerate(etas):
+            prof[i] = _lomax_profile(eta, s, y, wy)
+            # the profile falls (like -log log eta) for eta -> infinity: four decades
+            # below the best so far end the scan
+            below = below + 1 if prof[i] < np.max(prof[:i], initial=-np.inf) else 0
+            if below == 4:
+                break
     if not np.any(np.isfinite(prof)):
         return np.array([np.nan, np.nan]), ["lomax: the profile likelihood is not finite"]
     best = int(np.nanargmax(np.where(np.isfinite(prof), prof, -np.inf)))
