@@ -1,11 +1,16 @@
 """Speed of the statistics layer (kicktimes.stats).
 
-Run: ``python benchmarks/bench_stats.py [--n 100000] [--sequences 1000] [--events 100]``
+Run: ``python benchmarks/bench_stats.py [--n 100000] [--sequences 1000] [--events 100]
+[--part all|fits|compare|poisson]``
 
 1. Fit every renewal model to 10^5 right-censored intervals (with standard errors),
    and the full AIC comparison; reference: scipy's plain, uncensored
    ``expon.fit`` / ``weibull_min.fit`` with ``floc=0`` on the same data, same run.
-2. The Poisson test battery on an ensemble of 1000 sequences of about 100 events;
+2. ``compare_models`` (6 full-sample models, no standard errors) on 50 / 2000 / 10^5
+   exponential intervals with 2 % right-censored ones: the dedicated optimisers
+   against the former scipy path (``scipy.stats.<dist>.fit`` on CensoredData, EM
+   hyperexponential; ``engine="scipy"``), same data, same run.
+3. The Poisson test battery on an ensemble of 1000 sequences of about 100 events;
    reference: a plain loop of ``scipy.stats.kstest`` (uniformity only, one test of
    seven) over the same sequences, same run.
 """
@@ -13,12 +18,17 @@ Run: ``python benchmarks/bench_stats.py [--n 100000] [--sequences 1000] [--event
 from __future__ import annotations
 
 import argparse
+import functools
 import time
+import warnings
+from unittest import mock
 
 import numpy as np
 import scipy.stats
 
 from kicktimes import stats
+from kicktimes.stats import comparison
+from kicktimes.stats.renewal import _fit
 
 
 def timed(fun, repeat=1):
@@ -35,10 +45,23 @@ def main():
     parser.add_argument("--n", type=int, default=100_000, help="intervals to fit")
     parser.add_argument("--sequences", type=int, default=1000, help="ensemble size")
     parser.add_argument("--events", type=float, default=100.0, help="mean events per sequence")
+    parser.add_argument(
+        "--part",
+        choices=("all", "fits", "compare", "poisson"),
+        default="all",
+        help="run only one part",
+    )
     args = parser.parse_args()
     rng = np.random.default_rng(2024)
+    if args.part in ("all", "fits"):
+        bench_fits(args, rng)
+    if args.part in ("all", "compare"):
+        bench_compare(rng)
+    if args.part in ("all", "poisson"):
+        bench_poisson(args, rng)
 
-    # --- 1. renewal fits -------------------------------------------------------------
+
+def bench_fits(args, rng):
     law = scipy.stats.weibull_min(0.7, scale=1.0)
     truth = law.rvs(args.n, random_state=rng)
     cens_time = rng.exponential(8.0, args.n)
@@ -62,7 +85,30 @@ def main():
         f"  compare_models (6 full-sample models, no stderr): {sec:.3f} s; best = {table.index[0]}"
     )
 
-    # --- 2. Poisson ensemble ----------------------------------------------------------
+
+def bench_compare(rng):
+    # Warm up numba (hyperexponential kernel) and scipy once, outside the timings.
+    stats.compare_models(rng.exponential(1.0, 100))
+    print()
+    print("compare_models, 6 models, exponential intervals + 2 % censored: new vs scipy path")
+    print(
+        f"  {'intervals':>10}{'scipy path (s)':>16}{'new (s)':>10}{'speed-up':>10}{'max dll':>10}"
+    )
+    scipy_path = functools.partial(_fit, engine="scipy")
+    for n in (50, 2000, 100_000):
+        xe = rng.exponential(1.0, n)
+        ce = rng.uniform(0.0, 2.0, max(1, n // 50))
+        repeat = 1 if n > 10_000 else 5
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", stats.FitWarning)
+            new_sec, new = timed(lambda x=xe, c=ce: stats.compare_models(x, censored=c), repeat)
+            with mock.patch.object(comparison, "_fit", scipy_path):
+                old_sec, old = timed(lambda x=xe, c=ce: stats.compare_models(x, censored=c), repeat)
+        dll = (new["loglik"] - old.loc[new.index, "loglik"]).abs().max()
+        print(f"  {n:>10}{old_sec:>16.3f}{new_sec:>10.3f}{old_sec / new_sec:>9.1f}x{dll:>10.1e}")
+
+
+def bench_poisson(args, rng):
     t_window = args.events
     seqs = [
         np.sort(rng.uniform(0, t_window, rng.poisson(args.events))) for _ in range(args.sequences)

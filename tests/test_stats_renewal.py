@@ -6,6 +6,7 @@ import math
 
 import numpy as np
 import pytest
+import scipy.special
 import scipy.stats
 from scipy import integrate
 
@@ -383,3 +384,147 @@ def test_bad_model_names_and_options_are_rejected():
         stats.goodness_of_fit("weibull")
     with pytest.raises(TypeError, match="rng"):
         stats.goodness_of_fit(stats.fit_renewal(x, "exponential"), rng="seed")
+
+
+# --- dedicated optimisers against the former scipy path ---------------------------------
+#
+# gamma, Weibull, lognormal and Lomax used to be fitted by scipy.stats.<dist>.fit on
+# CensoredData, the hyperexponential by EM on all the data; mle(engine="scipy") keeps
+# that path. The dedicated optimisers must reach at least the same likelihood.
+
+COMPARISON_LAWS = {
+    "exponential": scipy.stats.expon(),
+    "gamma 0.5": scipy.stats.gamma(0.5),
+    "gamma 3": scipy.stats.gamma(3.0),
+    "weibull 0.7": scipy.stats.weibull_min(0.7),
+    "weibull 1.5": scipy.stats.weibull_min(1.5),
+    "lognormal": scipy.stats.lognorm(1.0),
+    "lomax": scipy.stats.lomax(2.5, scale=1.5),
+    "hyperexponential": stats.hyperexpon(0.3, 5.0, 0.5),
+}
+FITTED_MODELS = ("gamma", "weibull", "lognormal", "lomax", "hyperexponential")
+
+
+def comparison_sample(law, n, censored_fraction, rng):
+    """``n`` draws in a random time unit; a random ``censored_fraction`` of them (at
+    least one if the fraction is positive) is censored at a uniform fraction of itself."""
+    y = COMPARISON_LAWS[law].rvs(n, random_state=rng) * rng.uniform(0.1, 10.0)
+    k = 0 if censored_fraction == 0 else max(1, round(censored_fraction * n))
+    hidden = np.zeros(n, bool)
+    hidden[rng.choice(n, k, replace=False)] = True
+    return y[~hidden], y[hidden] * rng.uniform(size=k)
+
+
+def comparison_cases(n_cases, seed):
+    """Data sets cycling through every law, censoring level (0, 1, 10 %) and size."""
+    rng = np.random.default_rng(seed)
+    laws, fractions, sizes = list(COMPARISON_LAWS), (0.0, 0.01, 0.1), (10, 50, 2000)
+    for i in range(n_cases):
+        law, frac, n = laws[i % 8], fractions[i % 3], sizes[(i // 8) % 3]
+        yield (law, n, frac, *comparison_sample(law, n, frac, rng))
+
+
+def interior(fit, expo):
+    """True when the MLE is an interior point whose parameters are identified."""
+    if any("ran off" in w for w in fit.warnings):
+        return False
+    if fit.model == "hyperexponential":
+        p, lam1, lam2 = fit.theta
+        return 0.01 < p < 0.99 and lam1 > 1.5 * lam2 and fit.loglik > expo.loglik + 5
+    return True
+
+
+def assert_dedicated_fit_matches_scipy(model, law, n, frac, x, c):
+    from kicktimes.stats.renewal import _fit
+
+    case = (model, law, n, frac)
+    new = _fit(x, c, model, None, covariance=False)
+    old = _fit(x, c, model, None, covariance=False, engine="scipy")
+    assert new.converged, (case, new.warnings)
+    assert new.loglik >= old.loglik - 1e-7 * abs(old.loglik), case
+    expo = _fit(x, c, "exponential", None, covariance=False)
+    if model == "lomax" and not interior(new, expo):
+        # the exponential limit, flagged as such, with the exponential's likelihood
+        assert new.loglik == pytest.approx(expo.loglik, rel=1e-9), case
+    if interior(new, expo) and interior(old, expo) and new.loglik - old.loglik < 1e-3:
+        for name, value in new.params.items():
+            tol = 5e-3 * (new.params["sigma"] if name == "mu" else abs(old.params[name]))
+            assert abs(value - old.params[name]) <= tol, (case, name, new.params, old.params)
+
+
+@pytest.mark.parametrize("model", FITTED_MODELS)
+def test_dedicated_fit_reaches_the_scipy_paths_likelihood(model):
+    for case in comparison_cases(36, seed=FITTED_MODELS.index(model)):
+        assert_dedicated_fit_matches_scipy(model, *case)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("model", FITTED_MODELS)
+def test_dedicated_fit_reaches_the_scipy_paths_likelihood_on_many_samples(model):
+    for case in comparison_cases(8 * 3 * 3 * 4, seed=100 + FITTED_MODELS.index(model)):
+        assert_dedicated_fit_matches_scipy(model, *case)
+
+
+def test_lomax_on_data_less_dispersed_than_exponential_is_the_flagged_exponential_limit():
+    x = np.random.default_rng(30).gamma(1.2, 2.0, 5000)  # coefficient of variation < 1
+    c = np.full(50, 1.0)
+    with pytest.warns(stats.FitWarning, match="ran off"):
+        lomax = stats.fit_renewal(x, "lomax", censored=c)
+    expo = stats.fit_renewal(x, "exponential", censored=c)
+    assert lomax.converged
+    assert lomax.loglik == pytest.approx(expo.loglik, rel=1e-9)
+    assert lomax.params["shape"] / lomax.params["scale"] == pytest.approx(
+        expo.params["rate"], rel=1e-6
+    )
+
+
+def test_lomax_on_heavy_tailed_data_has_an_interior_maximum():
+    law = scipy.stats.lomax(0.8, scale=0.01)  # infinite mean: scale far below the mean
+    x = law.rvs(4000, random_state=np.random.default_rng(31))
+    fit = stats.fit_renewal(x, "lomax")
+    assert not fit.warnings
+    assert abs(fit.params["shape"] - 0.8) < 4 * fit.stderr["shape"]
+    assert abs(fit.params["scale"] - 0.01) < 4 * fit.stderr["scale"]
+
+
+def test_log_upper_incomplete_gamma_is_finite_where_gammaincc_underflows():
+    from kicktimes.stats._renewal_mle import log_gammaincc
+
+    z = np.array([0.5, 50.0, 700.0, 1e4, 1e6])
+    # a = 1: Q(1, z) = exp(-z); a = 0.5: Q = erfc(sqrt z)
+    np.testing.assert_allclose(log_gammaincc(1.0, z), -z, rtol=1e-12)
+    exact = scipy.special.log_ndtr(-np.sqrt(2 * z)) + math.log(2.0)
+    np.testing.assert_allclose(log_gammaincc(0.5, z), exact, rtol=1e-10)
+    # both branches meet where gammaincc leaves the normal range
+    a = 3.7
+    z = np.linspace(600, 700, 201)
+    assert np.all(np.isfinite(log_gammaincc(a, z)))
+    assert np.all(np.diff(log_gammaincc(a, z)) < 0)
+
+
+def test_gamma_survival_terms_far_in_the_tail_keep_the_fit_finite():
+    rng = np.random.default_rng(32)
+    x = rng.gamma(3.0, 1.0, 5000)
+    fit = stats.fit_renewal(x, "gamma", censored=[1500.0])  # S(1500) underflows to 0
+    assert fit.converged and math.isfinite(fit.loglik)
+    assert fit.pointwise_loglik()[1][0] < -745  # exp(-745) is below the smallest double
+    from kicktimes.stats.renewal import _total_loglik
+
+    # a maximum: every nearby parameter pair is less likely
+    for da, ds in [(1, 0), (-1, 0), (0, 1), (0, -1), (1, 1), (-1, -1)]:
+        theta = fit.theta * (1 + 1e-4 * np.array([da, ds]))
+        assert _total_loglik("gamma", theta, x, np.array([1500.0]), None) < fit.loglik
+
+
+def test_a_failed_dedicated_optimiser_falls_back_to_nelder_mead(monkeypatch):
+    from kicktimes.stats import renewal
+
+    x = np.random.default_rng(33).weibull(0.8, 400)
+    good = stats.fit_renewal(x, "weibull")
+    monkeypatch.setitem(
+        renewal.FAST_FITS, "weibull", lambda x, c: (np.array([np.nan, 1.0]), ["broken"])
+    )
+    fallback = stats.fit_renewal(x, "weibull")
+    assert fallback.converged
+    assert fallback.loglik == pytest.approx(good.loglik, rel=1e-9)
+    assert fallback.params["shape"] == pytest.approx(good.params["shape"], rel=1e-4)

@@ -30,6 +30,7 @@ is comparable only with other tail fits (see :func:`compare_models`).
 
 from __future__ import annotations
 
+import functools
 import math
 import warnings
 from dataclasses import dataclass, field
@@ -40,7 +41,13 @@ from scipy.special import expit, logit
 from statsmodels.tools.numdiff import approx_hess
 
 from ._checks import check_choice, check_int, check_intervals, check_real
-from .distributions import fit_hyperexponential, hyperexpon
+from ._renewal_mle import CLOSED_FORM_MODELS, FAST_FITS, log_density_and_survival
+from .distributions import (
+    _fit_hyperexponential_reference,
+    _log_components,
+    fit_hyperexponential,
+    hyperexpon,
+)
 from .powerlaw import fit_powerlaw_tail
 
 
@@ -71,6 +78,7 @@ _SCIPY_FAMILY = {
 # Exponent e of the time unit in each parameter: measured in units of s, a parameter
 # becomes theta * s**e (mu, a log-time, shifts by log s instead).
 _TIME_POWER = {"rate": -1, "rate1": -1, "rate2": -1, "scale": 1}
+_HYPER_FIT = {"fast": fit_hyperexponential, "scipy": _fit_hyperexponential_reference}
 _MIN_COMPLETE = {"exponential": 1, "hyperexponential": 5}
 # In units of the mean observation a sane estimate is far inside these bounds; beyond
 # them the likelihood has no interior maximum (e.g. Lomax on exponential data, whose
@@ -108,13 +116,22 @@ def pointwise_loglik(model, theta, complete, censored, x_min=None):
             lx = math.log(b) - lxm - (b + 1.0) * (np.log(complete) - lxm)
             lc = -b * (np.log(censored) - lxm)
         return np.asarray(lx, dtype=float), np.asarray(lc, dtype=float)
-    dist = frozen_distribution(model, theta, x_min)
     with np.errstate(all="ignore"):
-        lx, lc = dist.logpdf(complete), dist.logsf(censored)
-        if x_min is not None and model != "powerlaw":
-            shift = dist.logsf(x_min)
+        if model in CLOSED_FORM_MODELS:
+            lx, lc = log_density_and_survival(model, theta, complete, censored)
+            shift = (
+                None if x_min is None else log_density_and_survival(model, theta, [], [x_min])[1][0]
+            )
+        elif model == "hyperexponential":
+            p, lam1, lam2 = (float(v) for v in theta)
+            lx = np.logaddexp(*_log_components(complete, p, lam1, lam2, density=True))
+            lc = np.logaddexp(*_log_components(censored, p, lam1, lam2, density=False))
+            shift = None
+            if x_min is not None:
+                shift = np.logaddexp(*_log_components(x_min, p, lam1, lam2, density=False))
+        if shift is not None:
             lx, lc = lx - shift, lc - shift
-    return lx, lc
+    return np.asarray(lx, dtype=float), np.asarray(lc, dtype=float)
 
 
 def _total_loglik(model, theta, x, c, x_min):
@@ -184,10 +201,14 @@ def _direct_fit(model, x, c, x_min, start, trouble=None):
     return _from_free(model, res.x)
 
 
-def mle(model, x, c, x_min=None, *, min_tail=50, max_candidates=500):
+def mle(model, x, c, x_min=None, *, min_tail=50, max_candidates=500, engine="fast"):
     """Maximum-likelihood parameters of ``model`` (numbers in the units of the data).
 
     Returns ``(theta, extra)``; ``extra`` holds the tail bookkeeping of power-law fits.
+    ``engine="scipy"`` fits gamma, Weibull, lognormal and Lomax with the former
+    ``scipy.stats.<dist>.fit`` path instead of the dedicated optimisers, and the
+    hyperexponential with the former EM (kept as the reference of the tests and
+    benchmarks).
     """
     extra: dict = {"trouble": []}
     trouble = extra["trouble"]
@@ -204,15 +225,26 @@ def mle(model, x, c, x_min=None, *, min_tail=50, max_candidates=500):
         if model == "hyperexponential":
             # The excess over x_min is again hyperexponential, with the weight of the
             # fast component discounted by exp(-(rate1 - rate2) x_min).
-            p, lam1, lam2, _ = fit_hyperexponential(x - x_min, c - x_min)
+            p, lam1, lam2, _ = _HYPER_FIT[engine](x - x_min, c - x_min)
             odds = math.exp(min(math.log(p / (1 - p)) + (lam1 - lam2) * x_min, 700.0))
             return np.array([odds / (1 + odds), lam1, lam2]), extra
-        start, _ = mle(model, x, c)
+        start, _ = mle(model, x, c, engine=engine)
         return _direct_fit(model, x, c, x_min, start, trouble), extra
     if model == "exponential":
         return np.array([x.size / (x.sum() + c.sum())]), extra
     if model == "hyperexponential":
-        return np.array(fit_hyperexponential(x, c)[:3]), extra
+        return np.array(_HYPER_FIT[engine](x, c)[:3]), extra
+    if engine == "fast":
+        try:
+            with np.errstate(all="ignore"):  # wild data: non-finite values are checked below
+                theta, trouble_fast = FAST_FITS[model](x, c)
+        except (ValueError, OverflowError, ZeroDivisionError, FloatingPointError) as exc:
+            theta, trouble_fast = np.full(2, np.nan), [f"{model}: {exc}"]
+        ok = np.all(np.isfinite(theta)) and np.isfinite(_total_loglik(model, theta, x, c, None))
+        if ok and not trouble_fast:
+            return theta, extra
+        # the dedicated optimiser failed: polish (or start afresh) with Nelder-Mead
+        return _fallback(model, x, c, theta if ok else None, trouble_fast, trouble), extra
     scipy_trouble: list[str] = []
     try:
         theta = _scipy_fit(model, x, c, scipy_trouble)
@@ -220,16 +252,23 @@ def mle(model, x, c, x_min=None, *, min_tail=50, max_candidates=500):
     except (ValueError, RuntimeError, FloatingPointError, OverflowError):
         ok = False  # scipy's solver gave up (e.g. "function value at x=inf is NaN")
     if not ok or scipy_trouble:
-        mean = (x.sum() + c.sum()) / x.size
-        start = {"lognormal": [math.log(mean), 1.0]}.get(model, [1.0, mean])
-        direct_trouble: list[str] = []
-        direct = _direct_fit(model, x, c, None, np.array(start, dtype=float), direct_trouble)
-        if not ok or _total_loglik(model, direct, x, c, None) > _total_loglik(
-            model, theta, x, c, None
-        ):
-            theta, scipy_trouble = direct, direct_trouble
-        trouble.extend(scipy_trouble)
+        theta = _fallback(model, x, c, theta if ok else None, scipy_trouble, trouble)
     return theta, extra
+
+
+def _fallback(model, x, c, theta, theta_trouble, trouble):
+    """Nelder-Mead from a default start when the first optimiser failed; the better of
+    the two answers wins, with its own complaints appended to ``trouble``."""
+    mean = (x.sum() + c.sum()) / x.size
+    start = {"lognormal": [math.log(mean), 1.0]}.get(model, [1.0, mean])
+    direct_trouble: list[str] = []
+    direct = _direct_fit(model, x, c, None, np.array(start, dtype=float), direct_trouble)
+    if theta is None or _total_loglik(model, direct, x, c, None) > _total_loglik(
+        model, theta, x, c, None
+    ):
+        theta, theta_trouble = direct, direct_trouble
+    trouble.extend(theta_trouble)
+    return theta
 
 
 def _covariance(model, theta, x, c, x_min, n_tail):
@@ -302,7 +341,6 @@ class RenewalFit:
     k: int
     n: int
     n_censored: int
-    dist: object
     x_min: float | None = None
     x_min_method: str | None = None
     n_excluded: int = 0
@@ -312,6 +350,13 @@ class RenewalFit:
     scan: dict = field(default_factory=dict)
     converged: bool = True
     warnings: tuple = ()
+
+    @functools.cached_property
+    def dist(self):
+        """The fitted interval law, a frozen scipy distribution (the untruncated parent
+        for tail fits). Built on first use: freezing a scipy distribution costs about a
+        millisecond, more than many fits, and model comparison never needs it."""
+        return frozen_distribution(self.model, self.theta, self.x_min)
 
     @property
     def aic(self) -> float:
@@ -433,10 +478,34 @@ def fit_renewal(intervals, model, *, censored=None, x_min=None, min_tail=50, max
     -----
     Likelihood:
     :math:`\ell = \sum \log f(x_i) + \sum \log S(c_j)` (minus
-    :math:`(n + n_c)\log S(x_{min})` for tail fits). gamma, Weibull, lognormal and
-    Lomax use ``scipy.stats.<dist>.fit`` on :class:`scipy.stats.CensoredData` with
-    ``floc=0``; the exponential and the power law have closed forms; the
-    hyperexponential uses EM plus a quasi-Newton polish. Computations run in units of
+    :math:`(n + n_c)\log S(x_{min})` for tail fits). Each model has a dedicated
+    optimiser, with the complete-data part of the likelihood in sufficient statistics
+    (:math:`n, \sum x, \sum\log x`) and the censored terms over the distinct
+    censored values:
+
+    * exponential: closed form :math:`\hat\lambda = n / (\sum x + \sum c)`;
+    * gamma: uncensored, the profile equation
+      :math:`\log a - \psi(a) = \log\bar x - \overline{\log x}` (Newton);
+      censored, damped Newton on :math:`(\log a, \log s)` with
+      :math:`\log Q(a, c/s)` computed log-safely (continued fraction where
+      ``gammaincc`` underflows);
+    * Weibull: the 1-D profile in the shape, :math:`\lambda^k = \sum y^k / n` over
+      all observations, whose score equation has a unique root (safeguarded Newton);
+    * lognormal: closed form uncensored; censored, damped Newton on
+      :math:`(\mu, \log\sigma)` with ``log_ndtr`` survival terms;
+    * Lomax: the 1-D profile in :math:`\eta = 1/\text{scale}` (the shape is
+      :math:`n / \sum\log(1 + \eta y)`), grid plus bounded Brent;
+      :math:`\eta \to 0` is the exponential limit, returned as a point at
+      :math:`\eta = 10^{-12}` (flagged: the estimates run off to infinity) whose
+      likelihood equals the exponential's;
+    * hyperexponential: multi-start EM on a subsample, then Newton with the analytic
+      Hessian on all the data;
+    * power law: closed form above ``x_min``.
+
+    When a dedicated optimiser fails (no convergence, a non-finite likelihood, a
+    bound of its search box) Nelder-Mead from a default start takes over and the
+    better of the two is kept; tail fits maximise the truncated likelihood by
+    Nelder-Mead from the full-sample fit of the tail. Computations run in units of
     the mean observation, so the parameters are well scaled whatever the time unit.
     Standard errors come from the inverse of the numerical Hessian
     (``statsmodels.tools.numdiff.approx_hess``) of the negative log-likelihood in the
@@ -468,9 +537,9 @@ def fit_renewal(intervals, model, *, censored=None, x_min=None, min_tail=50, max
     return fit
 
 
-def _fit(x, c, model, x_min, *, min_tail=50, max_candidates=500, covariance=True):
+def _fit(x, c, model, x_min, *, min_tail=50, max_candidates=500, covariance=True, engine="fast"):
     """fit_renewal on validated arrays; ``covariance=False`` skips the Hessian
-    (model comparison needs only the likelihood)."""
+    (model comparison needs only the likelihood); ``engine`` as in :func:`mle`."""
     need = _MIN_COMPLETE.get(model, 3)
     n_used = x.size if x_min is None else int((x >= x_min).sum())
     if model != "powerlaw" and n_used < need:
@@ -494,7 +563,9 @@ def _fit(x, c, model, x_min, *, min_tail=50, max_candidates=500, covariance=True
     unit = float((x / n_all).sum() + (c / n_all).sum())
     xs, cs = x / unit, c / unit
     xm = None if x_min is None else x_min / unit
-    theta, extra = mle(model, xs, cs, xm, min_tail=min_tail, max_candidates=max_candidates)
+    theta, extra = mle(
+        model, xs, cs, xm, min_tail=min_tail, max_candidates=max_candidates, engine=engine
+    )
     if model == "powerlaw":
         xm = extra["x_min"]
     # Tail masks: a given x_min applies in the data's units (as RenewalFit.sample
@@ -565,7 +636,6 @@ def _fit(x, c, model, x_min, *, min_tail=50, max_candidates=500, covariance=True
         k=len(names),
         n=n_tail,
         n_censored=int(ct.size),
-        dist=frozen_distribution(model, theta_out, x_min_out),
         x_min=x_min_out,
         x_min_method=None if x_min_out is None else extra.get("method", "fixed"),
         n_excluded=int(x.size + c.size - xt.size - ct.size),
