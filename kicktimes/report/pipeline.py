@@ -24,7 +24,15 @@ from pathlib import Path
 
 from kicktimes import __version__
 from kicktimes.report._cache import ReportCache, content_key, store_key
-from kicktimes.report._common import Context, Mapper, Progress, check_fraction, check_int
+from kicktimes.report._common import (
+    Context,
+    Mapper,
+    Progress,
+    check_fraction,
+    check_int,
+    distinct,
+    report_store,
+)
 from kicktimes.report.html import (
     CSS,
     embed_figures,
@@ -127,7 +135,7 @@ def experiment_part(job, bar=None):
     path, out, prefix, options, render, workers = job
     out = Path(out)
     t0 = time.perf_counter()
-    store = load_store(path)
+    store = report_store(load_store(path))
     name = store.experiment.name
     timings = [(name, "load store", time.perf_counter() - t0)]
     pool = Mapper(workers)
@@ -168,7 +176,7 @@ def families_part(paths, out, render):
     from kicktimes.experiment import load_store
 
     t0 = time.perf_counter()
-    stores = [load_store(p) for p in paths]
+    stores = [report_store(load_store(p)) for p in paths]
     families = families_section(stores)
     files = {}
     fragment, toc = "", ""
@@ -204,7 +212,7 @@ def families_section(stores):
         having = [
             (st, sm)
             for st, sm in zip(stores, summaries, strict=True)
-            if diagnostic in set(sm["diagnostic"])
+            if diagnostic in distinct(sm, "diagnostic")
         ]
         if len(having) < 2:
             continue
@@ -234,7 +242,7 @@ def families_section(stores):
 
 
 def _present(store):
-    have = set(store.results["diagnostic"])
+    have = distinct(store.results, "diagnostic")
     return [d for d in ("lyapunov", "autocorrelation") if d in have] or None
 
 
@@ -405,9 +413,12 @@ def build_report(
         timings = [("", "check cache", time.perf_counter() - t_start)]
         bar.advance()
         if parallel:
-            # one worker per part; each part's statistics then run in its own worker (or
-            # on a small pool of its own when there are more workers than parts)
-            inner = max(1, workers // len(jobs)) if jobs else 1
+            # one worker per part, and each part maps its per-radius jobs (Poisson tests,
+            # renewal fits) over a pool of its own as wide as the machine: the parts are
+            # unequal (family B has 5x the ICs of A), so when the small one is done its
+            # core takes the large one's jobs instead of idling. The pools are forked
+            # (cheap), and the results do not depend on the number of processes.
+            inner = workers
             with ProcessPoolExecutor(max_workers=min(workers, len(jobs) or 1)) as ex:
                 futures = {
                     pid: ex.submit(experiment_part, job[:-1] + (inner,))

@@ -22,6 +22,7 @@ from matplotlib.figure import Figure
 from kicktimes.report._common import (
     REFERENCE,
     Section,
+    distinct,
     eps_values,
     fmt,
     kicked_systems,
@@ -114,9 +115,9 @@ def rr_figure(rows, exp, *, radii=None, title=None):
     """
     if radii is not None:
         rows = rows[rows["radius"].isin(list(radii))]
-    eps = [e for e in eps_values(exp) if f"rr@{e:g}" in set(rows["diagnostic"])]
+    eps = [e for e in eps_values(exp) if f"rr@{e:g}" in distinct(rows, "diagnostic")]
     quantities = [
-        q for q in _QUANTITIES if any(f"{q}@{e:g}" in set(rows["diagnostic"]) for e in eps)
+        q for q in _QUANTITIES if any(f"{q}@{e:g}" in distinct(rows, "diagnostic") for e in eps)
     ]
     fig = Figure(figsize=(4.6 * len(quantities), 3.8 * max(len(eps), 1)), layout="constrained")
     axes = np.atleast_2d(fig.subplots(max(len(eps), 1), len(quantities), squeeze=False))
@@ -126,7 +127,7 @@ def rr_figure(rows, exp, *, radii=None, title=None):
         for j, q in enumerate(quantities):
             ax = axes[i, j]
             name = f"{q}@{e:g}"
-            if summary is None or name not in set(summary["diagnostic"]):
+            if summary is None or name not in distinct(summary, "diagnostic"):
                 ax.text(0.5, 0.5, "not in the store", transform=ax.transAxes, ha="center")
                 ax.set_xlabel(RADIUS_LABEL)
                 ax.set_ylabel(_QUANTITIES[q][1])
@@ -269,7 +270,7 @@ def effects(ctx):
     for ke, e in enumerate(eps_values(ctx.exp)):
         for kq, (q, question) in enumerate((("rr_offdiag", "Off-diagonal RR"), ("det", "DET"))):
             name = f"{q}@{e:g}"
-            if name not in set(rows["diagnostic"]):
+            if name not in distinct(rows, "diagnostic"):
                 continue
             values = wide(rows, name)
             for k, system in enumerate(kicked_systems(rows)):
