@@ -240,6 +240,7 @@ def report_store(store):
     sort orders are unchanged (sorted categories sort as the strings; groupby keeps the
     observed groups only), and so is every table written.
     """
+    import copy
     import dataclasses
 
     import pandas as pd
@@ -249,7 +250,11 @@ def report_store(store):
         return store
     res = res.drop(columns=[c for c in ("note",) if c in res.columns])
     res = res.astype({"system": "category", "diagnostic": "category"})
-    return dataclasses.replace(store, results=res)
+    if dataclasses.is_dataclass(store):
+        return dataclasses.replace(store, results=res)
+    view = copy.copy(store)  # a store-like namespace (tests, notebooks)
+    view.results = res
+    return view
 
 
 def distinct(frame, column):

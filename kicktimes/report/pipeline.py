@@ -106,6 +106,17 @@ def analyse(ctx, *, bar, timings):
     return found, secs, ctx.notes
 
 
+def _preload():
+    """Import the section modules (matplotlib, scipy, statsmodels: ~2 s) and load the
+    compiled KS kernel once in this process, so that the part workers forked from it
+    inherit them instead of each paying for them (only when something is to be built:
+    a rebuild served from the cache stays light)."""
+    from kicktimes.stats.poisson import pomeranz_cdf
+
+    _stages()
+    pomeranz_cdf(10, 0.3)
+
+
 def _read_manifest(path):
     """A store's manifest (cheap: no part file is read); ValueError if not a store."""
     from kicktimes.experiment.store import MANIFEST, _read_manifest
@@ -153,7 +164,14 @@ def experiment_part(job, bar=None):
     write_table(out, f"{prefix}experiment", params, files)
     write_text(out, f"{prefix}experiment.toml", store.experiment.to_toml(), files)
     body = write_outputs(
-        secs, out, render["dpi"], prefix, pdf=render["pdf"], files=files, embed=False
+        secs,
+        out,
+        render["dpi"],
+        prefix,
+        pdf=render["pdf"],
+        files=files,
+        embed=False,
+        workers=workers,
     )
     timings.append((name, "write files", time.perf_counter() - t0))
     items = "".join(f'<li><a href="#{prefix}{s.key}">{html.escape(s.title)}</a></li>' for s in secs)
@@ -171,7 +189,7 @@ def experiment_part(job, bar=None):
     }
 
 
-def families_part(paths, out, render):
+def families_part(paths, out, render, workers=1):
     """The all-experiments figures (:func:`families_section`) as a cache part."""
     from kicktimes.experiment import load_store
 
@@ -182,7 +200,13 @@ def families_part(paths, out, render):
     fragment, toc = "", ""
     if families is not None:
         fragment = write_outputs(
-            [families], Path(out), render["dpi"], pdf=render["pdf"], files=files, embed=False
+            [families],
+            Path(out),
+            render["dpi"],
+            pdf=render["pdf"],
+            files=files,
+            embed=False,
+            workers=workers,
         )
         toc = f'<li><a href="#{families.key}">{html.escape(families.title)}</a></li>'
     keys = [store_key(p, st.manifest) for p, st in zip(paths, stores, strict=True)]
@@ -413,6 +437,7 @@ def build_report(
         timings = [("", "check cache", time.perf_counter() - t_start)]
         bar.advance()
         if parallel:
+            _preload()  # before the pool forks: the workers inherit the imports
             # one worker per part, and each part maps its per-radius jobs (Poisson tests,
             # renewal fits) over a pool of its own as wide as the machine: the parts are
             # unequal (family B has 5x the ICs of A), so when the small one is done its
@@ -426,7 +451,7 @@ def build_report(
                 }
                 if families_todo:  # in this process meanwhile
                     bar.step("all-experiments figures")
-                    parts["families"] = families_part(paths, out, render)
+                    parts["families"] = families_part(paths, out, render, workers)
                     bar.advance()
                 for pid, fut in futures.items():
                     bar.step(f"{pid}: sections (in a worker process)")
@@ -437,7 +462,7 @@ def build_report(
                 parts[pid] = experiment_part(job, bar)
             if families_todo:
                 bar.step("all-experiments figures")
-                parts["families"] = families_part(paths, out, render)
+                parts["families"] = families_part(paths, out, render, workers)
                 bar.advance()
         for pid in jobs:
             timings += [tuple(t) for t in parts[pid]["timings"]]
