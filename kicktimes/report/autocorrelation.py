@@ -231,6 +231,14 @@ def sections(ctx):
     pred = predicted.groupby(["radius", "system"])["value"].mean()
     sticky = ctx.found.get("sticky")
     flags = sticky.set_index(["radius", "ic"])["sticky"] if sticky is not None else None
+    # the decorrelation rows of each (radius, system), grouped once: filtering the whole
+    # table per group and name cost seconds on a paper store
+    decorrelation = {
+        name: dict(
+            list(results[results["diagnostic"] == name].groupby(["radius", "system"])["value"])
+        )
+        for name in ("decorrelation_lag", "tau_int")
+    }
     for (r, system), g in results[results["diagnostic"] == "autocorrelation"].groupby(
         ["radius", "system"]
     ):
@@ -242,12 +250,8 @@ def sections(ctx):
             "predicted_lag1": pred.get((r, system), np.nan),
         }
         for name in ("decorrelation_lag", "tau_int"):
-            v = results[
-                (results["diagnostic"] == name)
-                & (results["radius"] == r)
-                & (results["system"] == system)
-            ]["value"]
-            if len(v):
+            v = decorrelation[name].get((r, system))
+            if v is not None and len(v):
                 entry[f"{name}_mean"] = v.mean()
                 entry[f"{name}_median"] = v.median()
                 entry[f"{name}_n_undefined"] = int(v.isna().sum())
