@@ -66,6 +66,11 @@ class Context:
     max_ics_model_fits: int = 12
     max_pooled_intervals: int = 200_000
     pmap: object = map
+    #: ``pstart(fn, jobs)`` starts ``fn`` over ``jobs`` now and returns a callable giving
+    #: the results later (:meth:`Mapper.start`); None: the sections use ``pmap``
+    pstart: object = None
+    #: results of jobs started ahead of their section (see :func:`start_ahead`)
+    pending: dict = field(default_factory=dict)
     notes: list = field(default_factory=list)
     found: dict = field(default_factory=dict)
 
@@ -126,15 +131,27 @@ class Mapper:
     def __init__(self, workers):
         self.workers, self.pool = workers, None
 
-    def map(self, fn, jobs):
-        jobs = list(jobs)
-        if self.workers == 1 or len(jobs) < 2:
-            return [fn(job) for job in jobs]
+    def _pool(self):
         if self.pool is None:
             from concurrent.futures import ProcessPoolExecutor
 
             self.pool = ProcessPoolExecutor(max_workers=self.workers)
-        return list(self.pool.map(fn, jobs))
+        return self.pool
+
+    def map(self, fn, jobs):
+        jobs = list(jobs)
+        if self.workers == 1 or len(jobs) < 2:
+            return [fn(job) for job in jobs]
+        return list(self._pool().map(fn, jobs))
+
+    def start(self, fn, jobs):
+        """Start ``fn`` over ``jobs`` on the pool now (in this process: when collected);
+        return a callable that waits for the results, in order."""
+        jobs = list(jobs)
+        if self.workers == 1 or len(jobs) < 2:
+            return lambda: [fn(job) for job in jobs]
+        futures = [self._pool().submit(fn, job) for job in jobs]
+        return lambda: [f.result() for f in futures]
 
     def close(self):
         if self.pool is not None:

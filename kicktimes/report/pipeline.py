@@ -94,6 +94,11 @@ def analyse(ctx, *, bar, timings):
     from kicktimes.report import findings
 
     secs, found = [], None
+    for _, module in _stages():
+        # jobs that need only the store (the Poisson tests) start on the pool now and run
+        # while the sections before theirs are computed here
+        if ctx.pstart is not None and hasattr(module, "start"):
+            module.start(ctx)
     for stage, module in _stages():
         bar.step(f"{ctx.exp.name}: {stage}")
         t0 = time.perf_counter()
@@ -151,7 +156,7 @@ def experiment_part(job, bar=None):
     timings = [(name, "load store", time.perf_counter() - t0)]
     pool = Mapper(workers)
     try:
-        ctx = Context(store, pmap=pool.map, **options)
+        ctx = Context(store, pmap=pool.map, pstart=pool.start, **options)
         found, secs, notes = analyse(ctx, bar=bar or Progress(False, 0), timings=timings)
     finally:
         pool.close()
