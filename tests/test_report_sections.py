@@ -308,3 +308,23 @@ def test_figures_render_to_the_same_bytes_on_forked_workers():
     for (png1, pdf1), (png2, pdf2) in zip(serial, forked, strict=True):
         assert pdf1 is None and pdf2.startswith(b"%PDF")
         assert png1 == png2
+
+
+def test_poisson_tests_started_ahead_on_a_pool_equal_the_tests_run_in_place():
+    from kicktimes.report import poisson
+    from kicktimes.report._common import Mapper
+
+    store = synthetic_store(n_ics=6)
+    in_place = Context(store, n_mc=39)
+    expected = poisson.sections(in_place)[0].tables[0][1]
+    pool = Mapper(2)
+    try:
+        ahead = Context(store, n_mc=39, pmap=pool.map, pstart=pool.start)
+        poisson.start(ahead)
+        assert "poisson" in ahead.pending
+        got = poisson.sections(ahead)[0].tables[0][1]
+    finally:
+        pool.close()
+    assert not ahead.pending
+    pd.testing.assert_frame_equal(got, expected)
+    pd.testing.assert_frame_equal(ahead.found["homogeneity"], in_place.found["homogeneity"])
