@@ -10,7 +10,10 @@ each cached under a key of what it depends on (:mod:`kicktimes.report._cache`): 
 with nothing changed writes nothing, and a store that gained a task rebuilds that
 experiment's part and the page only. The parts to build run at the same time on the
 process pool (each experiment's statistics, figures and files in one worker), so the
-heavy statistics of both families overlap instead of following each other.
+heavy statistics of both families overlap instead of following each other; inside a part,
+the per-radius jobs (Poisson tests, started before the first section, and renewal fits)
+and the figure rendering use a pool of their own, so that the larger family's work
+spreads over every core once the smaller one is done.
 """
 
 from __future__ import annotations
@@ -324,9 +327,10 @@ def build_report(
     workers : int, optional
         Processes (default ``os.cpu_count()``; ``1`` computes everything in this
         process). With several stores to (re)build, each store's part runs in its own
-        worker, so both families' statistics and figures overlap; with one, its Poisson
-        tests (one job per radius) and renewal fits (one job per sample) use the pool.
-        The results do not depend on it.
+        worker, so both families' statistics and figures overlap; within a part, its
+        Poisson tests (one job per radius, started before the first section), renewal
+        fits (one job per sample) and figure rendering use ``workers`` processes of
+        their own. The results and files do not depend on it.
     n_boot : int, optional
         Bootstrap resamples (over ICs) of the Findings' confidence intervals.
     tolerance : float, optional
