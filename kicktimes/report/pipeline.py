@@ -458,9 +458,14 @@ def build_report(
                     pid: ex.submit(experiment_part, job[:-1] + (inner,))
                     for pid, job in jobs.items()
                 }
-                if families_todo:  # in this process meanwhile
+                if families_todo:
+                    # a pool job too, queued behind the parts: it runs in the worker of the
+                    # first part done (the smaller family), and renders on processes forked
+                    # from that single-threaded worker, not from this process, whose pool
+                    # threads a fork would copy
+                    fam = ex.submit(families_part, paths, out, render, workers)
                     bar.step("all-experiments figures")
-                    parts["families"] = families_part(paths, out, render, workers)
+                    parts["families"] = fam.result()
                     bar.advance()
                 for pid, fut in futures.items():
                     bar.step(f"{pid}: sections (in a worker process)")
