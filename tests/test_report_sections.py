@@ -253,3 +253,78 @@ def test_sections_of_a_new_store_are_written_as_png_pdf_and_csv(ctx, tmp_path):
         assert (tmp_path / f"{name}.png").is_file() and (tmp_path / f"{name}.pdf").is_file()
     assert (tmp_path / "findings.csv").is_file()
     assert '<p class="banner">' in page and '<ul class="findings">' in page
+
+
+def _tables_as_csv(store):
+    context = Context(store, n_boot=200)
+    secs = []
+    for module in (counts, summary, lyapunov, recurrence, autocorrelation):
+        secs += module.sections(context)
+    secs.append(findings.section(context))
+    return {name: df.to_csv(index=False) for s in secs for name, df, _, _ in s.tables}
+
+
+def test_the_categorical_results_view_writes_the_same_tables():
+    # report_store turns system/diagnostic into categoricals (speed); every table the
+    # sections write must be the same text as from the plain string columns
+    from kicktimes.report._common import report_store
+
+    store = synthetic_store(n_ics=8)
+    view = report_store(store)
+    assert isinstance(view.results["diagnostic"].dtype, pd.CategoricalDtype)
+    assert store.results["diagnostic"].dtype != view.results["diagnostic"].dtype  # a copy
+    plain, fast = _tables_as_csv(store), _tables_as_csv(view)
+    assert plain.keys() == fast.keys() and len(plain) >= 8
+    for name in plain:
+        assert plain[name] == fast[name], name
+
+
+def test_acf_curves_read_the_lag_from_every_acf_row_and_only_those():
+    store = synthetic_store(n_ics=6)
+    res = store.results
+    ref = res[res["diagnostic"].str.match(r"^acf@(\d+)$")]
+    ref = ref.assign(lag=ref["diagnostic"].str.slice(4).astype(int))
+    ref = ref.groupby(["radius", "system", "lag"])["value"].agg(["mean", "median"]).reset_index()
+    from kicktimes.report._common import report_store
+
+    for results in (res, report_store(store).results):
+        got = autocorrelation.acf_curves(results)
+        assert sorted(got["lag"].unique()) == list(range(1, LAGS + 1))
+        np.testing.assert_array_equal(got["mean"], ref["mean"])
+        np.testing.assert_array_equal(got["median"], ref["median"])
+        assert list(got["system"].astype(str)) == list(ref["system"].astype(str))
+
+
+def test_figures_render_to_the_same_bytes_on_forked_workers():
+    from kicktimes.report.html import render_figures
+
+    def figures():
+        context = Context(synthetic_store(n_ics=6), n_boot=100)
+        return [f for s in autocorrelation.sections(context) for _, f, _ in s.figures]
+
+    serial = render_figures(figures(), 40)
+    forked = render_figures(figures(), 40, workers=2, pdf=True)
+    assert len(serial) == len(forked) >= 2
+    for (png1, pdf1), (png2, pdf2) in zip(serial, forked, strict=True):
+        assert pdf1 is None and pdf2.startswith(b"%PDF")
+        assert png1 == png2
+
+
+def test_poisson_tests_started_ahead_on_a_pool_equal_the_tests_run_in_place():
+    from kicktimes.report import poisson
+    from kicktimes.report._common import Mapper
+
+    store = synthetic_store(n_ics=6)
+    in_place = Context(store, n_mc=39)
+    expected = poisson.sections(in_place)[0].tables[0][1]
+    pool = Mapper(2)
+    try:
+        ahead = Context(store, n_mc=39, pmap=pool.map, pstart=pool.start)
+        poisson.start(ahead)
+        assert "poisson" in ahead.pending
+        got = poisson.sections(ahead)[0].tables[0][1]
+    finally:
+        pool.close()
+    assert not ahead.pending
+    pd.testing.assert_frame_equal(got, expected)
+    pd.testing.assert_frame_equal(ahead.found["homogeneity"], in_place.found["homogeneity"])

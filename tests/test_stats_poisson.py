@@ -325,3 +325,21 @@ def test_a_clockwork_sequence_is_rejected_and_degenerate_tests_say_why():
     for name in ("ljung_box", "runs"):  # all intervals exactly equal: undefined
         assert math.isnan(res.loc[name, "pvalue"])
         assert "degenerate" in res.loc[name, "note"]
+
+
+def test_compiled_uniformity_ks_equals_scipy_exact_ks_on_every_branch():
+    # n from 2 to 160 and beyond covers every branch of scipy's exact law (Ruben-Gambino,
+    # Durbin matrix, Pomeranz, Miller, Pelz-Good); the compiled Pomeranz branch may differ
+    # in the last bits of the CDF only (a p-value near 0 is 1 - CDF: absolute error).
+    from kicktimes.stats.poisson import pomeranz_cdf, uniformity_ks
+
+    rng = np.random.default_rng(21)
+    for n in [*range(2, 161, 3), 200, 1000]:
+        u = np.sort(rng.uniform(size=(5, n)) ** rng.uniform(0.6, 1.5, size=(5, 1)), axis=1)
+        d, p = uniformity_ks(u)
+        ref = scipy.stats.ks_1samp(u, scipy.stats.uniform.cdf, axis=-1, method="exact")
+        np.testing.assert_array_equal(d, ref.statistic)
+        np.testing.assert_allclose(p, ref.pvalue, rtol=1e-10, atol=1e-14)
+    # the kernel on its own, inside the Pomeranz region (0.754693 < n x^2 <= 4)
+    for n, x in [(10, 0.3), (50, 0.2), (140, 0.1), (77, 0.15)]:
+        assert abs(pomeranz_cdf(n, x) - scipy.stats.kstwo.cdf(x, n)) < 1e-13

@@ -17,6 +17,7 @@ __all__ = [
     "write_outputs",
     "embed_figures",
     "save_figure",
+    "render_figures",
     "write_table",
     "write_text",
     "store_header",
@@ -47,19 +48,68 @@ def table_html(df):
     return f'<div class="table-wrap">{inner}</div>'
 
 
-def save_figure(fig, out, name, dpi, files, *, pdf=False):
-    """Write ``fig`` as ``name.png`` (and ``name.pdf``), atomically; record their SHA-256
-    in ``files``; return the PNG's bytes."""
+def _render(fig, dpi, pdf):
+    """``(png bytes, pdf bytes or None)`` of one figure."""
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=dpi)
-    png = buf.getvalue()
-    files[f"{name}.png"] = atomic_write(out / f"{name}.png", png)
+    png, pdf_bytes = buf.getvalue(), None
     if pdf:
         buf = io.BytesIO()
         # no creation date: the same figure gives the same bytes (and cache entry)
         fig.savefig(buf, format="pdf", metadata={"CreationDate": None})
-        files[f"{name}.pdf"] = atomic_write(out / f"{name}.pdf", buf.getvalue())
+        pdf_bytes = buf.getvalue()
+    return png, pdf_bytes
+
+
+#: the figures a forked renderer process reads: inherited with the process, never pickled
+_PENDING: list = []
+
+
+def _render_pending(job):
+    k, dpi, pdf = job
+    return _render(_PENDING[k], dpi, pdf)
+
+
+def render_figures(figs, dpi, *, pdf=False, workers=1):
+    """PNG (and PDF) bytes of each figure, ``[(png, pdf or None), ...]`` in order.
+
+    Rendering (layout, drawing, compression) is ~0.3-1 s a figure and a report has ~30:
+    with ``workers > 1`` they are rendered on that many processes forked from this one,
+    which inherit the Figure objects (nothing is pickled) and return the bytes. A figure
+    renders to the same bytes in a forked child as here (each is rendered once, from the
+    same state), so the files do not depend on ``workers``. Without ``fork`` (not Linux),
+    or with fewer than two figures, everything renders here.
+    """
+    global _PENDING
+    import multiprocessing as mp
+
+    figs = list(figs)
+    if workers < 2 or len(figs) < 2 or "fork" not in mp.get_all_start_methods():
+        return [_render(fig, dpi, pdf) for fig in figs]
+    from concurrent.futures import ProcessPoolExecutor
+
+    _PENDING = figs
+    try:
+        with ProcessPoolExecutor(
+            max_workers=min(workers, len(figs)), mp_context=mp.get_context("fork")
+        ) as ex:
+            return list(ex.map(_render_pending, [(k, dpi, pdf) for k in range(len(figs))]))
+    finally:
+        _PENDING = []
+
+
+def _store_rendered(out, name, rendered, files):
+    png, pdf_bytes = rendered
+    files[f"{name}.png"] = atomic_write(out / f"{name}.png", png)
+    if pdf_bytes is not None:
+        files[f"{name}.pdf"] = atomic_write(out / f"{name}.pdf", pdf_bytes)
     return png
+
+
+def save_figure(fig, out, name, dpi, files, *, pdf=False):
+    """Write ``fig`` as ``name.png`` (and ``name.pdf``), atomically; record their SHA-256
+    in ``files``; return the PNG's bytes."""
+    return _store_rendered(out, name, _render(fig, dpi, pdf), files)
 
 
 def write_table(out, name, df, files):
@@ -86,17 +136,25 @@ def embed_figures(fragment, out):
     return _PNG_REF.sub(inline, fragment)
 
 
-def write_outputs(sections, out, dpi, prefix="", *, pdf=True, files=None, embed=True):
+def write_outputs(
+    sections, out, dpi, prefix="", *, pdf=True, files=None, embed=True, workers=1
+):
     """Save figures (PNG, and PDF if ``pdf``) and tables (CSV), atomically, recording each
     file's SHA-256 in ``files``; return the HTML of the sections, with the PNGs embedded
-    (``embed``) or referenced for :func:`embed_figures` (the report's cached fragments)."""
+    (``embed``) or referenced for :func:`embed_figures` (the report's cached fragments).
+    The figures render on ``workers`` processes (:func:`render_figures`)."""
     files = {} if files is None else files
+    rendered = iter(
+        render_figures(
+            [fig for sec in sections for _, fig, _ in sec.figures], dpi, pdf=pdf, workers=workers
+        )
+    )
     body = []
     for sec in sections:
         body.append(f'<h3 id="{prefix}{sec.key}">{html.escape(sec.title)}</h3>')
-        for name, fig, caption in sec.figures:
+        for name, _fig, caption in sec.figures:
             name = prefix + name
-            save_figure(fig, out, name, dpi, files, pdf=pdf)
+            _store_rendered(out, name, next(rendered), files)
             links = f'<a href="{name}.png">PNG</a>' + (
                 f', <a href="{name}.pdf">PDF</a>' if pdf else ""
             )

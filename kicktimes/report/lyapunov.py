@@ -15,7 +15,7 @@ import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 
-from kicktimes.report._common import REFERENCE, Section, fmt, kicked_systems, wide
+from kicktimes.report._common import REFERENCE, Section, distinct, fmt, kicked_systems, wide
 from kicktimes.report._figures import (
     DIAGNOSTIC_LABELS,
     RADIUS_LABEL,
@@ -93,7 +93,7 @@ def stretching_figure(summary, table, *, title=None):
     fig = Figure(figsize=(14.0, 4.4), layout="constrained")
     ax1, ax2, ax3 = fig.subplots(1, 3)
     diagnostic_vs_radius(summary, "lyapunov", ax=ax1, title="(a) FTLE λ", medians=True)
-    systems = [s for s in (REFERENCE, *kicked_systems(table)) if s in set(table["system"])]
+    systems = [s for s in (REFERENCE, *kicked_systems(table)) if s in distinct(table, "system")]
     for k, system in enumerate(systems):
         part = table[table["system"] == system].sort_values("radius")
         style = system_style(system, k)
@@ -139,7 +139,7 @@ def stretching_figure(summary, table, *, title=None):
 def sections(ctx):
     """The FTLE section: figure, stretching table, per-radius ratios."""
     results, exp = ctx.results, ctx.exp
-    if "lyapunov" not in set(results["diagnostic"]):
+    if "lyapunov" not in distinct(results, "diagnostic"):
         return []
     title = DIAGNOSTIC_LABELS["lyapunov"][0]
     if getattr(exp, "lyapunov_variant", "") == "paper":
@@ -192,7 +192,7 @@ def sections(ctx):
 def effects(ctx):
     """FTLE of each kicked system over the two-particle FTLE."""
     results = ctx.results
-    if "lyapunov" not in set(results["diagnostic"]):
+    if "lyapunov" not in distinct(results, "diagnostic"):
         return []
     lam = wide(results, "lyapunov")
     table = stretching_table(results)

@@ -10,7 +10,10 @@ each cached under a key of what it depends on (:mod:`kicktimes.report._cache`): 
 with nothing changed writes nothing, and a store that gained a task rebuilds that
 experiment's part and the page only. The parts to build run at the same time on the
 process pool (each experiment's statistics, figures and files in one worker), so the
-heavy statistics of both families overlap instead of following each other.
+heavy statistics of both families overlap instead of following each other; inside a part,
+the per-radius jobs (Poisson tests, started before the first section, and renewal fits)
+and the figure rendering use a pool of their own, so that the larger family's work
+spreads over every core once the smaller one is done.
 """
 
 from __future__ import annotations
@@ -24,7 +27,15 @@ from pathlib import Path
 
 from kicktimes import __version__
 from kicktimes.report._cache import ReportCache, content_key, store_key
-from kicktimes.report._common import Context, Mapper, Progress, check_fraction, check_int
+from kicktimes.report._common import (
+    Context,
+    Mapper,
+    Progress,
+    check_fraction,
+    check_int,
+    distinct,
+    report_store,
+)
 from kicktimes.report.html import (
     CSS,
     embed_figures,
@@ -86,6 +97,11 @@ def analyse(ctx, *, bar, timings):
     from kicktimes.report import findings
 
     secs, found = [], None
+    for _, module in _stages():
+        # jobs that need only the store (the Poisson tests) start on the pool now and run
+        # while the sections before theirs are computed here
+        if ctx.pstart is not None and hasattr(module, "start"):
+            module.start(ctx)
     for stage, module in _stages():
         bar.step(f"{ctx.exp.name}: {stage}")
         t0 = time.perf_counter()
@@ -96,6 +112,17 @@ def analyse(ctx, *, bar, timings):
         timings.append((ctx.exp.name, stage, time.perf_counter() - t0))
         bar.advance()
     return found, secs, ctx.notes
+
+
+def _preload():
+    """Import the section modules (matplotlib, scipy, statsmodels: ~2 s) and load the
+    compiled KS kernel once in this process, so that the part workers forked from it
+    inherit them instead of each paying for them (only when something is to be built:
+    a rebuild served from the cache stays light)."""
+    from kicktimes.stats.poisson import pomeranz_cdf
+
+    _stages()
+    pomeranz_cdf(10, 0.3)
 
 
 def _read_manifest(path):
@@ -127,12 +154,12 @@ def experiment_part(job, bar=None):
     path, out, prefix, options, render, workers = job
     out = Path(out)
     t0 = time.perf_counter()
-    store = load_store(path)
+    store = report_store(load_store(path))
     name = store.experiment.name
     timings = [(name, "load store", time.perf_counter() - t0)]
     pool = Mapper(workers)
     try:
-        ctx = Context(store, pmap=pool.map, **options)
+        ctx = Context(store, pmap=pool.map, pstart=pool.start, **options)
         found, secs, notes = analyse(ctx, bar=bar or Progress(False, 0), timings=timings)
     finally:
         pool.close()
@@ -145,7 +172,14 @@ def experiment_part(job, bar=None):
     write_table(out, f"{prefix}experiment", params, files)
     write_text(out, f"{prefix}experiment.toml", store.experiment.to_toml(), files)
     body = write_outputs(
-        secs, out, render["dpi"], prefix, pdf=render["pdf"], files=files, embed=False
+        secs,
+        out,
+        render["dpi"],
+        prefix,
+        pdf=render["pdf"],
+        files=files,
+        embed=False,
+        workers=workers,
     )
     timings.append((name, "write files", time.perf_counter() - t0))
     items = "".join(f'<li><a href="#{prefix}{s.key}">{html.escape(s.title)}</a></li>' for s in secs)
@@ -163,18 +197,24 @@ def experiment_part(job, bar=None):
     }
 
 
-def families_part(paths, out, render):
+def families_part(paths, out, render, workers=1):
     """The all-experiments figures (:func:`families_section`) as a cache part."""
     from kicktimes.experiment import load_store
 
     t0 = time.perf_counter()
-    stores = [load_store(p) for p in paths]
+    stores = [report_store(load_store(p)) for p in paths]
     families = families_section(stores)
     files = {}
     fragment, toc = "", ""
     if families is not None:
         fragment = write_outputs(
-            [families], Path(out), render["dpi"], pdf=render["pdf"], files=files, embed=False
+            [families],
+            Path(out),
+            render["dpi"],
+            pdf=render["pdf"],
+            files=files,
+            embed=False,
+            workers=workers,
         )
         toc = f'<li><a href="#{families.key}">{html.escape(families.title)}</a></li>'
     keys = [store_key(p, st.manifest) for p, st in zip(paths, stores, strict=True)]
@@ -204,7 +244,7 @@ def families_section(stores):
         having = [
             (st, sm)
             for st, sm in zip(stores, summaries, strict=True)
-            if diagnostic in set(sm["diagnostic"])
+            if diagnostic in distinct(sm, "diagnostic")
         ]
         if len(having) < 2:
             continue
@@ -234,7 +274,7 @@ def families_section(stores):
 
 
 def _present(store):
-    have = set(store.results["diagnostic"])
+    have = distinct(store.results, "diagnostic")
     return [d for d in ("lyapunov", "autocorrelation") if d in have] or None
 
 
@@ -287,9 +327,10 @@ def build_report(
     workers : int, optional
         Processes (default ``os.cpu_count()``; ``1`` computes everything in this
         process). With several stores to (re)build, each store's part runs in its own
-        worker, so both families' statistics and figures overlap; with one, its Poisson
-        tests (one job per radius) and renewal fits (one job per sample) use the pool.
-        The results do not depend on it.
+        worker, so both families' statistics and figures overlap; within a part, its
+        Poisson tests (one job per radius, started before the first section), renewal
+        fits (one job per sample) and figure rendering use ``workers`` processes of
+        their own. The results and files do not depend on it.
     n_boot : int, optional
         Bootstrap resamples (over ICs) of the Findings' confidence intervals.
     tolerance : float, optional
@@ -405,17 +446,26 @@ def build_report(
         timings = [("", "check cache", time.perf_counter() - t_start)]
         bar.advance()
         if parallel:
-            # one worker per part; each part's statistics then run in its own worker (or
-            # on a small pool of its own when there are more workers than parts)
-            inner = max(1, workers // len(jobs)) if jobs else 1
+            _preload()  # before the pool forks: the workers inherit the imports
+            # one worker per part, and each part maps its per-radius jobs (Poisson tests,
+            # renewal fits) over a pool of its own as wide as the machine: the parts are
+            # unequal (family B has 5x the ICs of A), so when the small one is done its
+            # core takes the large one's jobs instead of idling. The pools are forked
+            # (cheap), and the results do not depend on the number of processes.
+            inner = workers
             with ProcessPoolExecutor(max_workers=min(workers, len(jobs) or 1)) as ex:
                 futures = {
                     pid: ex.submit(experiment_part, job[:-1] + (inner,))
                     for pid, job in jobs.items()
                 }
-                if families_todo:  # in this process meanwhile
+                if families_todo:
+                    # a pool job too, queued behind the parts: it runs in the worker of the
+                    # first part done (the smaller family), and renders on processes forked
+                    # from that single-threaded worker, not from this process, whose pool
+                    # threads a fork would copy
+                    fam = ex.submit(families_part, paths, out, render, workers)
                     bar.step("all-experiments figures")
-                    parts["families"] = families_part(paths, out, render)
+                    parts["families"] = fam.result()
                     bar.advance()
                 for pid, fut in futures.items():
                     bar.step(f"{pid}: sections (in a worker process)")
@@ -426,7 +476,7 @@ def build_report(
                 parts[pid] = experiment_part(job, bar)
             if families_todo:
                 bar.step("all-experiments figures")
-                parts["families"] = families_part(paths, out, render)
+                parts["families"] = families_part(paths, out, render, workers)
                 bar.advance()
         for pid in jobs:
             timings += [tuple(t) for t in parts[pid]["timings"]]

@@ -218,19 +218,33 @@ def _poisson_job(job):
     return rows, hom_row
 
 
-def sections(ctx):
-    """Per-IC Poisson tests at every radius (one job per radius, seeded per radius)."""
+def _jobs(ctx):
     exp, coll = ctx.exp, ctx.store.collisions
-    alpha, n_mc, max_ics_tests = ctx.alpha, ctx.n_mc, ctx.max_ics_tests
     jobs = []
     for ri, (r, part) in enumerate(coll.groupby("radius")):
-        part = subsample(part.sort_values("ic"), max_ics_tests)
+        part = subsample(part.sort_values("ic"), ctx.max_ics_tests)
         seqs = [np.asarray(t, dtype=float) for t in part["pp_times"]]
         # one Monte Carlo stream per radius: identical results for any worker count
         key = (exp.seed, 1, ri)
-        jobs.append((r, seqs, part["t_window"].to_numpy(float), alpha, n_mc, key, exp.rule))
+        jobs.append((r, seqs, part["t_window"].to_numpy(float), ctx.alpha, ctx.n_mc, key, exp.rule))
+    return jobs
+
+
+def start(ctx):
+    """Start the per-radius tests on the pool ahead of the section (they need only the
+    collision times): they run while the sections before this one are computed."""
+    if ctx.pstart is not None:
+        ctx.pending["poisson"] = ctx.pstart(_poisson_job, _jobs(ctx))
+
+
+def sections(ctx):
+    """Per-IC Poisson tests at every radius (one job per radius, seeded per radius)."""
+    coll = ctx.store.collisions
+    alpha, n_mc, max_ics_tests = ctx.alpha, ctx.n_mc, ctx.max_ics_tests
+    started = ctx.pending.pop("poisson", None)
+    results = started() if started is not None else ctx.pmap(_poisson_job, _jobs(ctx))
     rej_rows, hom_rows = [], []
-    for rows, hom_row in ctx.pmap(_poisson_job, jobs):
+    for rows, hom_row in results:
         rej_rows += rows
         hom_rows.append(hom_row)
     rejections = rejection_table(pd.DataFrame(rej_rows))

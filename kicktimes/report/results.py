@@ -14,7 +14,7 @@ import time
 from pathlib import Path
 
 from kicktimes import __version__
-from kicktimes.report._common import Context, Mapper, Progress, check_int
+from kicktimes.report._common import Context, Mapper, Progress, check_int, report_store
 
 __all__ = ["write_results"]
 
@@ -64,7 +64,7 @@ def write_results(
     workers = check_int("workers", workers, 1)
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    stores = [load_store(p) for p in paths]
+    stores = [report_store(load_store(p)) for p in paths]
     pool = Mapper(workers)
     bar = Progress(False, N_STAGES * len(stores))
     lines = [

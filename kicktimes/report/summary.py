@@ -10,7 +10,7 @@ import numpy as np
 import pandas as pd
 from matplotlib.lines import Line2D
 
-from kicktimes.report._common import REFERENCE, Section
+from kicktimes.report._common import REFERENCE, Section, distinct
 from kicktimes.report._figures import (
     _PAPER_BAR,
     _SEM_BAR,
@@ -51,11 +51,11 @@ def diagnostic_summary(results, diagnostic=None) -> pd.DataFrame:
     df = check_frame("results", results, ["radius", "system", "diagnostic", "value"])
     if diagnostic is not None:
         wanted = [diagnostic] if isinstance(diagnostic, str) else list(diagnostic)
-        present = set(df["diagnostic"].unique())
-        missing = [d for d in wanted if d not in present]
+        have = set(df["diagnostic"].unique())
+        missing = [d for d in wanted if d not in have]
         if missing:
             raise ValueError(
-                f"diagnostic {missing[0]!r} is not in results; present: {sorted(present)!r}"
+                f"diagnostic {missing[0]!r} is not in results; present: {sorted(have)!r}"
             )
         df = df[df["diagnostic"].isin(wanted)]
     check_radii("results['radius']", df["radius"])
@@ -111,8 +111,8 @@ def diagnostic_vs_radius(
             raise ValueError(f"diagnostic {diagnostic!r} is not in the summary")
     else:
         summary = diagnostic_summary(results, diagnostic)
-    present = [s for s in SYSTEMS if s in set(summary["system"])]
-    present += sorted(set(summary["system"]) - set(SYSTEMS))
+    present = [s for s in SYSTEMS if s in distinct(summary, "system")]
+    present += sorted(distinct(summary, "system") - set(SYSTEMS))
     if systems is None:
         systems = present
     else:
