@@ -573,7 +573,9 @@ def simulate_two_particle(ic, r, *, t_max=None, rule="mirror", sampling="uniform
     st[1:9] = ic.ravel()
     if not isinstance(log_collisions, bool | np.bool_):
         raise TypeError(f"log_collisions must be a bool, got {type(log_collisions).__name__}")
-    st[10] = (ic[:, 2:] ** 2).sum()
+    vx0, vy0, vx1, vy1 = ic[:, 2:].ravel().tolist()
+    # the initial kinetic energy, summed in this order (numpy's, bits of older runs kept)
+    st[10] = vx0 * vx0 + vy0 * vy0 + vx1 * vx1 + vy1 * vy1
     horizon = t_max if mode < 2 else n_steps * tau
     rho = 1.0 - r
     # the largest speed a disk can reach: all the kinetic energy in one disk
@@ -589,9 +591,10 @@ def simulate_two_particle(ic, r, *, t_max=None, rule="mirror", sampling="uniform
         n_steps if n_steps is not None else 0, tau if tau is not None else 0.0, track,
         pp_cap, b_cap, max_events, chk.stall_time(rho, speed), bool(log_collisions),
     )
-    raise_for_status(status, st[0], pp.shape[0] + bt.shape[0], max_events=max_events, name="ic",
-                     where=f"disks at ({st[1]:.6g}, {st[2]:.6g}) and ({st[5]:.6g}, {st[6]:.6g}), "
-                           f"r={r!r}")
+    if status != DONE:  # (the message is formatted only when it is needed)
+        raise_for_status(status, st[0], pp.shape[0] + bt.shape[0], max_events=max_events,
+                         name="ic", where=f"disks at ({st[1]:.6g}, {st[2]:.6g}) and "
+                                          f"({st[5]:.6g}, {st[6]:.6g}), r={r!r}")
     return TwoParticleRun(
         r=r,
         t_max=float(t_end),
