@@ -30,7 +30,7 @@ import numpy as np
 from numba import njit
 
 from kicktimes.billiard.geometry import boundary_hit_time
-from kicktimes.billiard.one_particle import SCATTER, process_event_one, process_scatter_one
+from kicktimes.billiard.one_particle import SCATTER, kick_one, process_scatter_one, wall_one
 from kicktimes.billiard.scatter import scatter_tangent
 from kicktimes.billiard.two_particle import init_events_two, next_event_two, process_event_two
 
@@ -356,15 +356,14 @@ def tangent_one_kernel(st, rho, kicks, angles, kick_mode, mode, n_steps, tau, U,
                         n_resc += _renormalise(U, log_scale, j)
                 ik += 1
             elif is_kick:
-                process_event_one(st, ev, True, dt, rho, kicks[ik], angles[ik], kick_mode,
-                                  unit_speed)
+                kick_one(st, ev, dt, rho, kicks[ik], angles[ik], kick_mode)
                 for j in range(m):
                     U[j, 2], U[j, 3] = kick_tangent(U[j, 2], U[j, 3], vx, vy, st[3], st[4],
                                                     angles[ik], kick_mode)
                     n_resc += _renormalise(U, log_scale, j)
                 ik += 1
             else:
-                process_event_one(st, ev, False, dt, rho, 0.0, 0.0, kick_mode, unit_speed)
+                wall_one(st, ev, dt, rho, unit_speed)
                 if vx != st[3] or vy != st[4]:
                     for j in range(m):
                         U[j, 0], U[j, 1], U[j, 2], U[j, 3] = wall_tangent(

@@ -32,10 +32,11 @@ from numba import njit
 from kicktimes.billiard.geometry import boundary_hit_time, pair_hit_time
 from kicktimes.billiard.one_particle import (
     SCATTER,
+    kick_one,
     next_event_one,
-    process_event_one,
     process_scatter_one,
     process_twin_scatter_one,
+    wall_one,
 )
 from kicktimes.billiard.two_particle import (
     HASH_MOD,
@@ -321,12 +322,11 @@ def ftle_one_kernel(st0, rho, kicks, angles, kick_mode, mode, n_steps, tau, offs
                 cnt_ref[0] += 1
                 cnt_ref[2] = (cnt_ref[2] * 4 + 4) % HASH_MOD
             elif is_kick:
-                process_event_one(ref, ev_ref, True, dt, rho, kicks[ik], angles[ik], kick_mode,
-                                  False)
+                kick_one(ref, ev_ref, dt, rho, kicks[ik], angles[ik], kick_mode)
                 cnt_ref[0] += 1
                 cnt_ref[2] = (cnt_ref[2] * 4 + 4) % HASH_MOD
             else:
-                process_event_one(ref, ev_ref, False, dt, rho, 0.0, 0.0, kick_mode, False)
+                wall_one(ref, ev_ref, dt, rho, False)
                 cnt_ref[1] += 1
                 cnt_ref[2] = (cnt_ref[2] * 4 + 1) % HASH_MOD
         if status != 0:
@@ -359,12 +359,11 @@ def ftle_one_kernel(st0, rho, kicks, angles, kick_mode, mode, n_steps, tau, offs
                     # a missed partner is a different event sequence: defer, then force
                     cnt_tw[j, 2] = (cnt_tw[j, 2] * 4 + (4 if hit else 2)) % HASH_MOD
                 elif is_kick:
-                    process_event_one(tw[j], ev_tw[j], True, dt, rho, kicks[ik], angles[ik],
-                                      kick_mode, False)
+                    kick_one(tw[j], ev_tw[j], dt, rho, kicks[ik], angles[ik], kick_mode)
                     cnt_tw[j, 0] += 1
                     cnt_tw[j, 2] = (cnt_tw[j, 2] * 4 + 4) % HASH_MOD
                 else:
-                    process_event_one(tw[j], ev_tw[j], False, dt, rho, 0.0, 0.0, kick_mode, False)
+                    wall_one(tw[j], ev_tw[j], dt, rho, False)
                     cnt_tw[j, 1] += 1
                     cnt_tw[j, 2] = (cnt_tw[j, 2] * 4 + 1) % HASH_MOD
             if status != 0:
