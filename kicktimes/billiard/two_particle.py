@@ -200,17 +200,15 @@ def finish_at(st, ev, t_end):
 
 
 @njit(cache=True)
-def _grow(a):
-    out = np.empty(2 * a.shape[0] + 16, dtype=a.dtype)
-    out[: a.shape[0]] = a
-    return out
-
-
-@njit(cache=True)
 def _grow_to(a, limit):
-    """``a`` copied into a buffer twice as long, but no longer than ``limit`` (> len(a))."""
+    """``a`` copied into a buffer twice as long, but no longer than ``limit`` (> len(a)).
+
+    An element loop, not ``out[:n] = a``: numba compiles array-to-slice assignment with
+    its shape-mismatch error message, string formatting included (seconds of compile time).
+    """
     out = np.empty(min(2 * a.shape[0] + 16, limit), dtype=a.dtype)
-    out[: a.shape[0]] = a
+    for i in range(a.shape[0]):
+        out[i] = a[i]
     return out
 
 
@@ -218,7 +216,9 @@ def _grow_to(a, limit):
 def _grow_rows_to(a, limit):
     """Rows of ``a`` copied into a buffer twice as long, but no longer than ``limit``."""
     out = np.empty((min(2 * a.shape[0] + 16, limit), a.shape[1]), dtype=a.dtype)
-    out[: a.shape[0]] = a
+    for i in range(a.shape[0]):
+        for j in range(a.shape[1]):
+            out[i, j] = a[i, j]
     return out
 
 
