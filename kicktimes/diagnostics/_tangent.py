@@ -67,7 +67,7 @@ def wall_tangent(dqx, dqy, dvx, dvy, x, y, vx, vy, wx, wy, rho):
             dvx - dvn * nx - k * (vu * nx + vn * ux), dvy - dvn * ny - k * (vu * ny + vn * uy))
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def pair_tangent(a0, a1, a2, a3, b0, b1, b2, b3, x1, y1, x2, y2, v1x, v1y, v2x, v2y,
                  w1x, w1y, w2x, w2y, rule):
     """Tangent vector across a disk-disk collision (``a``: disk 1, ``b``: disk 2).
@@ -137,7 +137,7 @@ def kick_tangent(dvx, dvy, vx, vy, wx, wy, angle, kick_mode):
     return c * dvx - s * dvy, s * dvx + c * dvy
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _budget(dt, n_ev, n_same, max_events):
     """Event-loop guard: ``(status, n_same)`` after one more event ``dt`` from now."""
     if dt != dt:
@@ -153,7 +153,7 @@ def _budget(dt, n_ev, n_same, max_events):
     return 0, n_same
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _renormalise(U, log_scale, j):
     """Rescale ``U[j]`` to unit norm if it left ``[1/BIG, BIG]``; returns 1 if it did."""
     s = 0.0
