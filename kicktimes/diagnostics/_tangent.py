@@ -139,7 +139,11 @@ def kick_tangent(dvx, dvy, vx, vy, wx, wy, angle, kick_mode):
 
 @njit(cache=True)
 def _budget(dt, n_ev, n_same, max_events):
-    """Event-loop guard: ``(status, n_same)`` after one more event ``dt`` from now."""
+    """Event-loop guard: ``(status, n_same)`` after one more event ``dt`` from now.
+
+    Callers pass ``np.int64(n_same)``: the counter's starting value 0 would otherwise be
+    typed ``Literal[int](0)`` in some loops and compile this function a second time.
+    """
     if dt != dt:
         return 3, n_same
     if dt == 0.0:
@@ -230,7 +234,7 @@ def tangent_two_kernel(st, rho, sigma, rule, mode, n_steps, tau, U, max_events, 
                 n_same = 0
             else:
                 # the rare path: simultaneous events, a NaN time, or the budget used up
-                status, n_same = _budget(dt, n_ev, n_same, max_events)
+                status, n_same = _budget(dt, n_ev, np.int64(n_same), max_events)
                 if status != 0:
                     break
             for j in range(m):
@@ -337,7 +341,7 @@ def tangent_one_kernel(st, rho, kicks, angles, kick_mode, mode, n_steps, tau, U,
                 n_same = 0
             else:
                 # the rare path: simultaneous events, a NaN time, or the budget used up
-                status, n_same = _budget(dt, n_ev, n_same, max_events)
+                status, n_same = _budget(dt, n_ev, np.int64(n_same), max_events)
                 if status != 0:
                     break
             for j in range(m):
