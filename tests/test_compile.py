@@ -92,3 +92,35 @@ def test_simulator_and_ftle_kernels_compile_once_without_error_strings(tmp_path)
     strings = [name for name in sigs if "unicode" in name or "raise_with_shape" in name
                or "ol_str_generic" in name]
     assert strings == []
+
+
+_SWEEP_AFTER_WARM_UP = r"""
+import dataclasses, json
+from numba.core import event
+from kicktimes import _compile
+from kicktimes.experiment import execute_task, preset
+
+_compile._warm_two(None)
+_compile._warm_one(None)
+with event.install_recorder("numba:compile") as rec:
+    for name in ("quick_a", "quick_b"):
+        exp = dataclasses.replace(preset(name), n_ics=1, n_steps=60, block_size=1)
+        execute_task(exp, exp.tasks()[0])
+print(json.dumps(sorted({e.data["dispatcher"].py_func.__module__ for _, e in rec.buffer})))
+"""
+
+
+@pytest.mark.slow
+def test_the_warm_up_groups_compile_every_kernel_a_sweep_task_calls(tmp_path):
+    # the two warm-up groups run in parallel before a sweep; whatever they miss, every
+    # worker of the sweep would compile again
+    import json
+    import os
+    import subprocess
+    import sys
+
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path))
+    out = subprocess.run([sys.executable, "-c", _SWEEP_AFTER_WARM_UP], env=env, check=True,
+                         capture_output=True, text=True)
+    modules = json.loads(out.stdout.strip().splitlines()[-1])
+    assert [m for m in modules if m.startswith("kicktimes")] == []
