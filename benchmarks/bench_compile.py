@@ -11,10 +11,17 @@ signatures (more than one means the callers pass inconsistent dtypes).
 Reference measured in the same run: the same steps with a warm cache (the second
 subprocess), i.e. the part of the cold time that is not compilation.
 
+With ``--reproduce``, also the wall time of ``kicktimes reproduce --scale quick`` with a
+cold cache (a fresh ``NUMBA_CACHE_DIR``) and then a warm one (fresh output folders both
+times). ``--source DIR`` measures the kicktimes source tree in DIR instead (its path goes
+first on ``PYTHONPATH`` of every subprocess), e.g. an export of another branch, so that two
+versions are compared in the same session: ``git archive main | tar -x -C /tmp/main``.
+
 Usage::
 
     python benchmarks/bench_compile.py            # prints the tables
     python benchmarks/bench_compile.py --json compile.json
+    python benchmarks/bench_compile.py --reproduce --source /tmp/main
 """
 
 from __future__ import annotations
@@ -88,8 +95,15 @@ def child():
     print(json.dumps({"steps": steps, "kernels": kernels}))
 
 
-def run_child(cache_dir):
+def _env(cache_dir, source):
     env = dict(os.environ, NUMBA_CACHE_DIR=cache_dir)
+    if source:
+        env["PYTHONPATH"] = os.pathsep.join(p for p in (source, env.get("PYTHONPATH")) if p)
+    return env
+
+
+def run_child(cache_dir, source=None):
+    env = _env(cache_dir, source)
     t0 = time.perf_counter()
     out = subprocess.run(
         [sys.executable, __file__, "--child"],
@@ -104,18 +118,46 @@ def run_child(cache_dir):
     return result
 
 
+def time_reproduce(cache_dir, source=None):
+    """Wall seconds of ``kicktimes reproduce --scale quick`` into a fresh folder."""
+    with tempfile.TemporaryDirectory(prefix="kicktimes-reproduce-") as out:
+        t0 = time.perf_counter()
+        proc = subprocess.run(
+            [sys.executable, "-m", "kicktimes", "reproduce", "--scale", "quick", "--out", out,
+             "--no-progress"],
+            env=_env(cache_dir, source), capture_output=True, text=True,
+        )
+        seconds = time.perf_counter() - t0
+    if proc.returncode:
+        raise SystemExit(f"kicktimes reproduce failed:\n{proc.stderr[-3000:]}")
+    return seconds
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--child", action="store_true", help=argparse.SUPPRESS)
     parser.add_argument("--json", default=None, help="also write the numbers here")
+    parser.add_argument("--reproduce", action="store_true",
+                        help="also time `kicktimes reproduce --scale quick`, cold and warm")
+    parser.add_argument("--source", default=None,
+                        help="measure the kicktimes source tree in this folder")
     args = parser.parse_args()
     if args.child:
         child()
         return
-    print(f"{os.cpu_count()} cores, load average {os.getloadavg()[0]:.2f}")
+    source = os.path.abspath(args.source) if args.source else None
+    print(f"{os.cpu_count()} cores, load average {os.getloadavg()[0]:.2f}"
+          + (f"; source {source}" if source else ""))
+    reproduce = {}
+    if args.reproduce:
+        with tempfile.TemporaryDirectory(prefix="numba-cache-") as cache:
+            reproduce["cold"] = time_reproduce(cache, source)
+            reproduce["warm"] = time_reproduce(cache, source)
+        print(f"kicktimes reproduce --scale quick: cold cache {reproduce['cold']:.1f} s, "
+              f"warm cache {reproduce['warm']:.1f} s")
     with tempfile.TemporaryDirectory(prefix="numba-cache-") as cache:
-        cold = run_child(cache)
-        warm = run_child(cache)
+        cold = run_child(cache, source)
+        warm = run_child(cache, source)
     print(f"\n{'step':48s} {'cold s':>8s} {'warm s':>8s} {'compile s':>10s}")
     for name, sec in cold["steps"].items():
         w = warm["steps"].get(name, float("nan"))
@@ -137,7 +179,7 @@ def main():
             print(f"  {n}: " + " | ".join(sigs))
     if args.json:
         with open(args.json, "w") as fh:
-            json.dump({"cold": cold, "warm": warm}, fh, indent=1)
+            json.dump({"cold": cold, "warm": warm, "reproduce": reproduce}, fh, indent=1)
 
 
 if __name__ == "__main__":

@@ -15,7 +15,10 @@ import numpy as np
 
 def check_real(name: str, value, *, low=None, high=None, low_open=True, high_open=True) -> float:
     """A finite real number inside the given (open by default) interval."""
-    if isinstance(value, bool) or not isinstance(value, Real | np.floating | np.integer):
+    # (exact float and int first: the ABC check costs more than the rest of a simulator call's
+    # argument checks together)
+    if not (type(value) is float or type(value) is int) and (
+            isinstance(value, bool) or not isinstance(value, Real | np.floating | np.integer)):
         raise TypeError(f"{name} must be a real number, got {type(value).__name__}")
     x = float(value)
     if not math.isfinite(x):
@@ -32,7 +35,8 @@ def check_real(name: str, value, *, low=None, high=None, low_open=True, high_ope
 
 def check_int(name: str, value, *, low: int, high: int | None = None) -> int:
     """An integer (not a bool) in ``[low, high]`` (no upper bound if ``high`` is None)."""
-    if isinstance(value, bool) or not isinstance(value, Integral | np.integer):
+    if type(value) is not int and (
+            isinstance(value, bool) or not isinstance(value, Integral | np.integer)):
         raise TypeError(f"{name} must be an integer, got {type(value).__name__}")
     n = int(value)
     if n < low or (high is not None and n > high):

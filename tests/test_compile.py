@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import io
 
+import pytest
+
 from kicktimes import _compile
 
 
@@ -35,3 +37,93 @@ def test_the_cache_probe_reads_numbas_index_of_a_real_kernel():
     from kicktimes.billiard.two_particle import simulate_two_kernel
 
     assert _compile._is_cold(simulate_two_kernel) in (True, False)
+
+
+_RECORD_COMPILES = r"""
+import json
+from numba.core import event
+from kicktimes import initial_conditions, schedules, simulate_one_particle, simulate_two_particle
+from kicktimes.diagnostics import lyapunov
+
+ic = initial_conditions(1, 0.02, seed=0)[0]
+with event.install_recorder("numba:compile") as rec:
+    for rule in ("mirror", "elastic"):
+        for sampling in ("uniform", "paper"):
+            simulate_two_particle(ic, 0.02, rule=rule, sampling=sampling, n_steps=20, tau=0.3)
+    simulate_two_particle(ic, 0.02, t_max=5.0, log_collisions=True)
+    for law in ("uniform", "gaussian", "scatter"):
+        run = simulate_one_particle(ic[0], 0.02, n_steps=20, tau=0.3, kick_angle=law,
+                                    kicks=schedules.Poisson(0.5), rng=0)
+        lyapunov(run)
+        lyapunov(run, method="twin")
+    lyapunov(ic, 0.02, n_steps=20, tau=0.3)
+    lyapunov(ic, 0.02, n_steps=20, tau=0.3, method="twin")
+sigs = {}
+for _, ev in rec.buffer:
+    if ev.is_start:
+        f = ev.data["dispatcher"].py_func
+        sigs.setdefault(f"{f.__module__}.{f.__qualname__}", []).append(str(ev.data["args"]))
+print(json.dumps(sigs))
+"""
+
+
+@pytest.mark.slow
+def test_simulator_and_ftle_kernels_compile_once_without_error_strings(tmp_path):
+    # A cold cache compiles everything the simulators and the FTLE call (~30 s). Each
+    # kernel must compile one signature (literal int/bool arguments would add more), and
+    # none may pull in numba's string formatting (error messages of slice assignments
+    # or of raise with formatted text cost seconds of compilation).
+    import json
+    import os
+    import subprocess
+    import sys
+
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path))
+    out = subprocess.run([sys.executable, "-c", _RECORD_COMPILES], env=env, check=True,
+                         capture_output=True, text=True)
+    sigs = json.loads(out.stdout.strip().splitlines()[-1])
+    ours = {name: s for name, s in sigs.items() if name.startswith("kicktimes.")}
+    assert "kicktimes.billiard.two_particle.simulate_two_kernel" in ours
+    # the buffer growth is generic over the dtype: the int8 particle column and the floats
+    several = {name: s for name, s in ours.items()
+               if len(s) > 1 and name != "kicktimes.billiard.two_particle._grow_to"}
+    assert several == {}
+    assert len(ours["kicktimes.billiard.two_particle._grow_to"]) <= 2
+    strings = [name for name in sigs if "unicode" in name or "raise_with_shape" in name
+               or "ol_str_generic" in name]
+    assert strings == []
+
+
+_SWEEP_AFTER_WARM_UP = r"""
+import dataclasses, json
+from numba.core import event
+from kicktimes import _compile
+from kicktimes.experiment import execute_task, preset
+
+_compile._warm_two(None)
+_compile._warm_one(None)
+with event.install_recorder("numba:compile") as rec:
+    for name in ("quick_a", "quick_b"):
+        exp = dataclasses.replace(preset(name), n_ics=1, n_steps=60, block_size=1)
+        execute_task(exp, exp.tasks()[0])
+print(json.dumps([sorted({e.data["dispatcher"].py_func.__module__ for _, e in rec.buffer}),
+                  _compile.cold_kernels()]))
+"""
+
+
+@pytest.mark.slow
+def test_the_warm_up_groups_compile_every_kernel_a_sweep_task_calls(tmp_path):
+    # the two warm-up groups run in parallel before a sweep; whatever they miss, every
+    # worker of the sweep would compile again
+    import json
+    import os
+    import subprocess
+    import sys
+
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path))
+    out = subprocess.run([sys.executable, "-c", _SWEEP_AFTER_WARM_UP], env=env, check=True,
+                         capture_output=True, text=True)
+    modules, still_cold = json.loads(out.stdout.strip().splitlines()[-1])
+    assert [m for m in modules if m.startswith("kicktimes")] == []
+    # and the cache probe agrees: nothing is announced as cold on the next run
+    assert still_cold == []

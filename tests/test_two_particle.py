@@ -353,3 +353,19 @@ def test_speeds_outside_the_range_are_refused_naming_ic(speed):
     ic = [[0.1, 0.0, speed, 0.0], [0.0, 0.5, 0.0, 1.0]]
     with pytest.raises(ValueError, match=r"ic: disk 0 speed must be 0 or in \[1e-06, 1e\+06\]"):
         simulate_two_particle(ic, 0.02, t_max=1.0, rule="elastic")
+
+
+def test_simulators_reproduce_the_golden_outputs_bit_for_bit():
+    # tests/data/kernels_golden.npz holds every output array of 66 varied runs (both rules,
+    # all samplings, radii 0.005-0.3, uniform/gaussian/scatter kicks) recorded before the
+    # kernels were optimised; a speed-up must not change a single bit of them
+    import importlib.util
+    from pathlib import Path
+
+    data = Path(__file__).parent / "data"
+    spec = importlib.util.spec_from_file_location("kernel_cases", data / "kernel_cases.py")
+    cases = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(cases)
+    ref = cases.load(data / "kernels_golden.npz")
+    assert len(ref) == 762
+    assert cases.differences(ref, cases.outputs(small=True)) == []

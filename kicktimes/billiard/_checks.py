@@ -37,7 +37,8 @@ def check_state(name: str, value, shape: tuple[int, ...]) -> np.ndarray:
     arr = np.array(value, dtype=np.float64, copy=True, order="C")
     if arr.shape != shape:
         raise ValueError(f"{name} must have shape {shape} (rows x, y, vx, vy), got {arr.shape}")
-    if not np.isfinite(arr).all():
+    # (math.isfinite on the few floats of a state: a third of the cost of np.isfinite().all())
+    if not all(map(math.isfinite, arr.ravel().tolist())):
         raise ValueError(f"{name} must be finite, got NaN or inf in {arr.tolist()}")
     return arr
 

@@ -94,23 +94,13 @@ def next_event_one(st, ev, kicks, cnt):
 
 
 @njit(cache=True)
-def process_event_one(st, ev, is_kick, dt, rho, kick_time, angle, kick_mode, unit_speed):
-    """Fly ``dt`` and apply a kick (at ``kick_time``) or a boundary collision.
+def wall_event_one(x, y, vx, vy, rho, unit_speed):
+    """Boundary collision of the disk at ``(x, y)`` on ``|x| = rho`` (up to round-off).
 
-    Returns the incoming ``sin_theta`` of a boundary collision (0 for a kick).
+    Returns ``(x, y, vx, vy, t_next, sin_theta)``: the contact put back on the circle, the
+    outgoing velocity, the time to the next boundary collision and the incoming
+    ``sin_theta``. Plain floats, so that the event loop keeps the state in registers.
     """
-    drift_one(st, ev, dt)
-    if is_kick:
-        # the kick times are the user's: put the clock exactly on them
-        st[0] = kick_time
-        st[5] = 0.0
-        apply_kick(st, angle, kick_mode)
-        ev[0] = boundary_hit_time(st[1], st[2], st[3], st[4], rho)
-        return 0.0
-    x = st[1]
-    y = st[2]
-    vx = st[3]
-    vy = st[4]
     # No Newton step on the speed here (unlike the two-disk mirror kernel): its rounding
     # bias drifts L = x vy - y vx by 6e-12 over 10^6 collisions, 40x more than without.
     vv = vx * vx + vy * vy
@@ -129,7 +119,7 @@ def process_event_one(st, ev, is_kick, dt, rho, kick_time, angle, kick_mode, uni
         else:
             sin_theta = (x * vy - y * vx) / (rho * math.sqrt(vv))
         vx, vy = reflect(vx, vy, x / rho, y / rho)
-        ev[0] = 2.0 * xv / vv
+        t_next = 2.0 * xv / vv
     elif xv * xv < gz * gz * vv:
         # Grazing or tangent: slide on (see graze). The Newton step along the flight
         # above would divide by x.v ~ 0, so project radially.
@@ -139,19 +129,40 @@ def process_event_one(st, ev, is_kick, dt, rho, kick_time, angle, kick_mode, uni
         sp = math.sqrt(vv)
         sin_theta = (x * vy - y * vx) / (rho * sp)
         vx, vy = graze(x, y, vx, vy, rho, sp)
-        ev[0] = 2.0 * rho * SIN_GRAZE / sp
+        t_next = 2.0 * rho * SIN_GRAZE / sp
     else:
-        # a Lyapunov twin moving inward (see process_event_two): no reflection
+        # a Lyapunov twin moving inward (see two_particle.wall_event): no reflection
         scale = 1.5 - 0.5 * (x * x + y * y) / (rho * rho)
         x *= scale
         y *= scale
         sin_theta = (x * vy - y * vx) / (rho * math.sqrt(vv))
-        ev[0] = boundary_hit_time(x, y, vx, vy, rho)
+        t_next = boundary_hit_time(x, y, vx, vy, rho)
+    return x, y, vx, vy, t_next, sin_theta
+
+
+@njit(cache=True)
+def wall_one(st, ev, dt, rho, unit_speed):
+    """Fly ``dt`` and apply a boundary collision; returns the incoming ``sin_theta``."""
+    drift_one(st, ev, dt)
+    x, y, vx, vy, t_next, sin_theta = wall_event_one(st[1], st[2], st[3], st[4], rho,
+                                                     unit_speed)
     st[1] = x
     st[2] = y
     st[3] = vx
     st[4] = vy
+    ev[0] = t_next
     return sin_theta
+
+
+@njit(cache=True)
+def kick_one(st, ev, dt, rho, kick_time, angle, kick_mode):
+    """Fly ``dt`` to ``kick_time`` and apply a kick of ``angle`` (see `apply_kick`)."""
+    drift_one(st, ev, dt)
+    # the kick times are the user's: put the clock exactly on them
+    st[0] = kick_time
+    st[5] = 0.0
+    apply_kick(st, angle, kick_mode)
+    ev[0] = boundary_hit_time(st[1], st[2], st[3], st[4], rho)
 
 
 @njit(cache=True)
@@ -202,50 +213,99 @@ def _event_loop_one(st, ev, rho, kicks, angles, kick_mode, unit_speed, t_end, mo
                     by, bs, stimes, samples, cnt, next_s, kick_u, sp, klog):
     """Logging/sampling loop (see ``_event_loop_two``); ``cnt = [n_kicks, n_b, k]``.
 
-    Scattering kicks (``kick_mode == 2``) use ``kick_u[i]`` and ``sp`` and log to
-    ``klog[i]`` (see `process_scatter_one`). Only boundary collisions count towards a
-    stall (`_stalled`): simultaneous kicks are the user's and there are finitely many.
+    The state lives in local variables between kicks (boundary collisions, the frequent
+    events, touch no array but the output); a kick writes it back to ``st``, applies the
+    kick there and reloads it. Scattering kicks (``kick_mode == 2``) use ``kick_u[i]`` and
+    ``sp`` and log to ``klog[i]`` (see `process_scatter_one`). Only boundary collisions
+    count towards a stall (`_stalled`): simultaneous kicks are the user's and there are
+    finitely many.
     """
+    t = st[0]
+    x = st[1]
+    y = st[2]
+    vx = st[3]
+    vy = st[4]
+    comp = st[5]
+    tb = ev[0]
+    ik = cnt[0]
     n_b = cnt[1]
     k = cnt[2]
+    nk = kicks.shape[0]
     ns = stimes.shape[0]
+    b_cap = bt.shape[0]
     ns_next = next_s[0]
     status = FULL
     while True:
-        is_kick, dte = next_event_one(st, ev, kicks, cnt)
-        while k < ns and ns_next - st[0] < dte:
-            ds = ns_next - st[0]
+        # the next event; a tie goes to the boundary
+        is_kick = False
+        dte = tb
+        if ik < nk:
+            dk = kicks[ik] - t
+            if dk < dte:
+                is_kick = True
+                dte = dk
+        while k < ns and ns_next - t < dte:
+            ds = ns_next - t
             stimes[k] = ns_next
-            samples[k, 0] = st[1] + st[3] * ds
-            samples[k, 1] = st[2] + st[4] * ds
+            samples[k, 0] = x + vx * ds
+            samples[k, 1] = y + vy * ds
             k += 1
             ns_next = k * tau if mode == 1 else ns_next + tau
-        if (mode == 2 and k >= ns) or st[0] + dte > t_end:
+        if (mode == 2 and k >= ns) or t + dte > t_end:
             status = DONE
             break
         if is_kick:
-            ik = cnt[0]
+            st[0] = t
+            st[1] = x
+            st[2] = y
+            st[3] = vx
+            st[4] = vy
+            st[5] = comp
+            ev[0] = tb
             if kick_mode == SCATTER:
                 process_scatter_one(st, ev, dte, rho, kicks[ik], kick_u[ik, 0], kick_u[ik, 1],
                                     sp, klog[ik])
             else:
-                process_event_one(st, ev, True, dte, rho, kicks[ik], angles[ik], kick_mode,
-                                  unit_speed)
-            cnt[0] += 1
+                kick_one(st, ev, dte, rho, kicks[ik], angles[ik], kick_mode)
+            t = st[0]
+            x = st[1]
+            y = st[2]
+            vx = st[3]
+            vy = st[4]
+            comp = st[5]
+            tb = ev[0]
+            ik += 1
         else:
-            if n_b >= bt.shape[0]:
+            if n_b >= b_cap:
                 break
-            bs[n_b] = process_event_one(st, ev, False, dte, rho, 0.0, 0.0, kick_mode, unit_speed)
-            bt[n_b] = st[0]
-            bx[n_b] = st[1]
-            by[n_b] = st[2]
+            # free flight (drift_one): relative event time, Kahan clock
+            x += vx * dte
+            y += vy * dte
+            tb -= dte
+            yk = dte - comp
+            tn = t + yk
+            comp = (tn - t) - yk
+            t = tn
+            x, y, vx, vy, tb, sin_theta = wall_event_one(x, y, vx, vy, rho, unit_speed)
+            bs[n_b] = sin_theta
+            bt[n_b] = t
+            bx[n_b] = x
+            by[n_b] = y
             n_b += 1
         if mode == 2 and k < ns:
-            stimes[k] = st[0]
-            samples[k, 0] = st[1]
-            samples[k, 1] = st[2]
+            stimes[k] = t
+            samples[k, 0] = x
+            samples[k, 1] = y
             k += 1
-            ns_next = st[0] + tau
+            ns_next = t + tau
+    st[0] = t
+    st[1] = x
+    st[2] = y
+    st[3] = vx
+    st[4] = vy
+    st[5] = comp
+    ev[0] = tb
+    cnt[0] = ik
     cnt[1] = n_b
     cnt[2] = k
     next_s[0] = ns_next

@@ -30,7 +30,7 @@ import numpy as np
 from numba import njit
 
 from kicktimes.billiard.geometry import boundary_hit_time
-from kicktimes.billiard.one_particle import SCATTER, process_event_one, process_scatter_one
+from kicktimes.billiard.one_particle import SCATTER, kick_one, process_scatter_one, wall_one
 from kicktimes.billiard.scatter import scatter_tangent
 from kicktimes.billiard.two_particle import init_events_two, next_event_two, process_event_two
 
@@ -67,7 +67,7 @@ def wall_tangent(dqx, dqy, dvx, dvy, x, y, vx, vy, wx, wy, rho):
             dvx - dvn * nx - k * (vu * nx + vn * ux), dvy - dvn * ny - k * (vu * ny + vn * uy))
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def pair_tangent(a0, a1, a2, a3, b0, b1, b2, b3, x1, y1, x2, y2, v1x, v1y, v2x, v2y,
                  w1x, w1y, w2x, w2y, rule):
     """Tangent vector across a disk-disk collision (``a``: disk 1, ``b``: disk 2).
@@ -137,9 +137,13 @@ def kick_tangent(dvx, dvy, vx, vy, wx, wy, angle, kick_mode):
     return c * dvx - s * dvy, s * dvx + c * dvy
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _budget(dt, n_ev, n_same, max_events):
-    """Event-loop guard: ``(status, n_same)`` after one more event ``dt`` from now."""
+    """Event-loop guard: ``(status, n_same)`` after one more event ``dt`` from now.
+
+    Callers pass ``np.int64(n_same)``: the counter's starting value 0 would otherwise be
+    typed ``Literal[int](0)`` in some loops and compile this function a second time.
+    """
     if dt != dt:
         return 3, n_same
     if dt == 0.0:
@@ -153,7 +157,7 @@ def _budget(dt, n_ev, n_same, max_events):
     return 0, n_same
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _renormalise(U, log_scale, j):
     """Rescale ``U[j]`` to unit norm if it left ``[1/BIG, BIG]``; returns 1 if it did."""
     s = 0.0
@@ -230,7 +234,7 @@ def tangent_two_kernel(st, rho, sigma, rule, mode, n_steps, tau, U, max_events, 
                 n_same = 0
             else:
                 # the rare path: simultaneous events, a NaN time, or the budget used up
-                status, n_same = _budget(dt, n_ev, n_same, max_events)
+                status, n_same = _budget(dt, n_ev, np.int64(n_same), max_events)
                 if status != 0:
                     break
             for j in range(m):
@@ -337,7 +341,7 @@ def tangent_one_kernel(st, rho, kicks, angles, kick_mode, mode, n_steps, tau, U,
                 n_same = 0
             else:
                 # the rare path: simultaneous events, a NaN time, or the budget used up
-                status, n_same = _budget(dt, n_ev, n_same, max_events)
+                status, n_same = _budget(dt, n_ev, np.int64(n_same), max_events)
                 if status != 0:
                     break
             for j in range(m):
@@ -356,15 +360,14 @@ def tangent_one_kernel(st, rho, kicks, angles, kick_mode, mode, n_steps, tau, U,
                         n_resc += _renormalise(U, log_scale, j)
                 ik += 1
             elif is_kick:
-                process_event_one(st, ev, True, dt, rho, kicks[ik], angles[ik], kick_mode,
-                                  unit_speed)
+                kick_one(st, ev, dt, rho, kicks[ik], angles[ik], kick_mode)
                 for j in range(m):
                     U[j, 2], U[j, 3] = kick_tangent(U[j, 2], U[j, 3], vx, vy, st[3], st[4],
                                                     angles[ik], kick_mode)
                     n_resc += _renormalise(U, log_scale, j)
                 ik += 1
             else:
-                process_event_one(st, ev, False, dt, rho, 0.0, 0.0, kick_mode, unit_speed)
+                wall_one(st, ev, dt, rho, unit_speed)
                 if vx != st[3] or vy != st[4]:
                     for j in range(m):
                         U[j, 0], U[j, 1], U[j, 2], U[j, 3] = wall_tangent(

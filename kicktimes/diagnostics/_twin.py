@@ -32,10 +32,11 @@ from numba import njit
 from kicktimes.billiard.geometry import boundary_hit_time, pair_hit_time
 from kicktimes.billiard.one_particle import (
     SCATTER,
+    kick_one,
     next_event_one,
-    process_event_one,
     process_scatter_one,
     process_twin_scatter_one,
+    wall_one,
 )
 from kicktimes.billiard.two_particle import (
     HASH_MOD,
@@ -107,7 +108,10 @@ def ftle_two_kernel(st0, rho, sigma, rule, mode, n_steps, tau, track, offsets, m
     cnt_tw = np.zeros((m, 5), dtype=np.int64)
     o = 1 + 4 * track
     for j in range(m):
-        tw[j] = st0
+        # element copy, not tw[j] = st0: numba compiles row assignment with a formatted
+        # shape-mismatch message (seconds of compile time)
+        for c in range(st0.shape[0]):
+            tw[j, c] = st0[c]
         tw[j, o] += offsets[j, 0]
         tw[j, o + 1] += offsets[j, 1]
         init_events_two(tw[j], ev_tw[j], rho, sigma)
@@ -139,7 +143,7 @@ def ftle_two_kernel(st0, rho, sigma, rule, mode, n_steps, tau, track, offsets, m
             if dt > 0.0 and n_ev <= max_events:
                 n_same = 0
             else:
-                status, n_same = _budget(dt, n_ev, n_same, max_events)
+                status, n_same = _budget(dt, n_ev, np.int64(n_same), max_events)
                 if status != 0:
                     break
             process_event_two(ref, ev_ref, ke, rho, sigma, rule)
@@ -173,7 +177,7 @@ def ftle_two_kernel(st0, rho, sigma, rule, mode, n_steps, tau, track, offsets, m
                 if dt > 0.0 and n_ev <= max_events:
                     n_same = 0
                 else:
-                    status, n_same = _budget(dt, n_ev, n_same, max_events)
+                    status, n_same = _budget(dt, n_ev, np.int64(n_same), max_events)
                     if status != 0:
                         break
                 process_event_two(tw[j], ev_tw[j], ke, rho, sigma, rule)
@@ -260,6 +264,9 @@ def ftle_one_kernel(st0, rho, kicks, angles, kick_mode, mode, n_steps, tau, offs
     scatter = kick_mode == SCATTER
     unit_speed = (abs(st0[3] * st0[3] + st0[4] * st0[4] - 1.0) < 1e-12
                   and not (scatter and sp[1] != 0.0))
+    # the reference and the twins reflect with the general-speed formula (np.bool_: a bool
+    # variable, not the literal False, so that wall_one compiles one signature)
+    no_shortcut = np.bool_(False)
     # the partner of each scattering kick: centre and velocity at the kick time
     partners = np.zeros((nk if scatter else 0, 4))
     row = np.empty(9)
@@ -271,7 +278,10 @@ def ftle_one_kernel(st0, rho, kicks, angles, kick_mode, mode, n_steps, tau, offs
     ev_tw = np.empty((m, 1))
     cnt_tw = np.zeros((m, 3), dtype=np.int64)
     for j in range(m):
-        tw[j] = st0
+        # element copy, not tw[j] = st0: numba compiles row assignment with a formatted
+        # shape-mismatch message (seconds of compile time)
+        for c in range(st0.shape[0]):
+            tw[j, c] = st0[c]
         tw[j, 1] += offsets[j, 0]
         tw[j, 2] += offsets[j, 1]
         ev_tw[j, 0] = boundary_hit_time(tw[j, 1], tw[j, 2], tw[j, 3], tw[j, 4], rho)
@@ -307,7 +317,7 @@ def ftle_one_kernel(st0, rho, kicks, angles, kick_mode, mode, n_steps, tau, offs
             if dt > 0.0 and n_ev <= max_events:
                 n_same = 0
             else:
-                status, n_same = _budget(dt, n_ev, n_same, max_events)
+                status, n_same = _budget(dt, n_ev, np.int64(n_same), max_events)
                 if status != 0:
                     break
             if is_kick and scatter:
@@ -321,12 +331,11 @@ def ftle_one_kernel(st0, rho, kicks, angles, kick_mode, mode, n_steps, tau, offs
                 cnt_ref[0] += 1
                 cnt_ref[2] = (cnt_ref[2] * 4 + 4) % HASH_MOD
             elif is_kick:
-                process_event_one(ref, ev_ref, True, dt, rho, kicks[ik], angles[ik], kick_mode,
-                                  False)
+                kick_one(ref, ev_ref, dt, rho, kicks[ik], angles[ik], kick_mode)
                 cnt_ref[0] += 1
                 cnt_ref[2] = (cnt_ref[2] * 4 + 4) % HASH_MOD
             else:
-                process_event_one(ref, ev_ref, False, dt, rho, 0.0, 0.0, kick_mode, False)
+                wall_one(ref, ev_ref, dt, rho, no_shortcut)
                 cnt_ref[1] += 1
                 cnt_ref[2] = (cnt_ref[2] * 4 + 1) % HASH_MOD
         if status != 0:
@@ -349,7 +358,7 @@ def ftle_one_kernel(st0, rho, kicks, angles, kick_mode, mode, n_steps, tau, offs
                 if dt > 0.0 and n_ev <= max_events:
                     n_same = 0
                 else:
-                    status, n_same = _budget(dt, n_ev, n_same, max_events)
+                    status, n_same = _budget(dt, n_ev, np.int64(n_same), max_events)
                     if status != 0:
                         break
                 if is_kick and scatter:
@@ -359,12 +368,11 @@ def ftle_one_kernel(st0, rho, kicks, angles, kick_mode, mode, n_steps, tau, offs
                     # a missed partner is a different event sequence: defer, then force
                     cnt_tw[j, 2] = (cnt_tw[j, 2] * 4 + (4 if hit else 2)) % HASH_MOD
                 elif is_kick:
-                    process_event_one(tw[j], ev_tw[j], True, dt, rho, kicks[ik], angles[ik],
-                                      kick_mode, False)
+                    kick_one(tw[j], ev_tw[j], dt, rho, kicks[ik], angles[ik], kick_mode)
                     cnt_tw[j, 0] += 1
                     cnt_tw[j, 2] = (cnt_tw[j, 2] * 4 + 4) % HASH_MOD
                 else:
-                    process_event_one(tw[j], ev_tw[j], False, dt, rho, 0.0, 0.0, kick_mode, False)
+                    wall_one(tw[j], ev_tw[j], dt, rho, no_shortcut)
                     cnt_tw[j, 1] += 1
                     cnt_tw[j, 2] = (cnt_tw[j, 2] * 4 + 1) % HASH_MOD
             if status != 0:

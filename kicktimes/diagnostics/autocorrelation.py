@@ -189,13 +189,16 @@ def _acf_curve(values, max_lag, rtol, atol, out, code):
         out[:] = np.nan
         code[:] = 2
         return
-    mean, f, scale = _prepare(values, 0, n)
+    # an int64 zero, not the literal 0: numba would compile the callees a second time
+    # for the type Literal[int](0) (they are also called with int64 bounds)
+    lo = np.int64(0)
+    mean, f, scale = _prepare(values, lo, n)
     for lag in range(1, max_lag + 1):
         if n <= lag:
             out[lag - 1] = np.nan
             code[lag - 1] = 2
             continue
-        den, num = _centred_sums(values, 0, n, lag, mean, f)
+        den, num = _centred_sums(values, lo, n, lag, mean, f)
         if _is_constant(den, n, f, scale, rtol, atol):
             out[lag - 1] = np.nan
             code[lag - 1] = 1
