@@ -436,7 +436,8 @@ def _rows_from_pairs(pairs, m, n, diagonal):
             by_col[cursor[i]] = i
             cursor[i] += 1
     cols = np.empty(offsets[n], np.int64)
-    cursor[:] = offsets[:n]
+    for i in range(n):  # element copy: a slice assignment compiles numba's error strings
+        cursor[i] = offsets[i]
     for c in range(n):
         for e in range(offsets[c], offsets[c + 1]):
             r = by_col[e]
