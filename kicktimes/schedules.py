@@ -559,8 +559,14 @@ class Poisson(Schedule):
         if self.rate == 0:
             return np.empty(0)
         rate = self.rate
+
+        def draw(n):
+            # a subnormal rate overflows to inf: an interval beyond any window, no kick
+            with np.errstate(over="ignore"):
+                return rng.standard_exponential(n) / rate
+
         return _renewal_times(
-            lambda n: rng.standard_exponential(n) / rate,
+            draw,
             t_max,
             mean=1.0 / rate,
             max_kicks=max_kicks,

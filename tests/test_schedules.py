@@ -648,3 +648,13 @@ def test_cli_reports_bad_input(tmp_path, args, message):
     assert result.exit_code == 2
     assert message in result.output
     assert not os.path.exists(out)
+
+
+def test_poisson_with_a_subnormal_rate_has_no_kick_and_no_overflow_warning():
+    # found by the property test: 1 / rate overflows to inf, an interval beyond any window
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        times = Poisson(1e-310).sample(1e6, np.random.default_rng(0))
+    assert times.size == 0 and times.dtype == np.float64
