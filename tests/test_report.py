@@ -403,3 +403,31 @@ def test_a_store_that_gains_a_task_rebuilds_only_its_own_part(store_path, tmp_pa
     timings = pd.read_csv(out / "report_timings.csv")
     reused = timings[timings["stage"] == "reused from the cache"]
     assert list(reused["experiment"]) == ["tiny_report"]
+
+
+def test_one_draw_png_is_byte_identical_to_savefig():
+    # the report draws each figure once (layout and rendering in one Agg draw) instead of
+    # savefig's two draws; the bytes must be those savefig writes
+    import io
+
+    from matplotlib.figure import Figure
+
+    from kicktimes.report.html import _png
+
+    def figure():
+        fig = Figure(figsize=(7.0, 3.5), layout="constrained")
+        axes = fig.subplots(1, 2)
+        x = np.linspace(0.0, 1.0, 50)
+        for k, ax in enumerate(axes):
+            ax.plot(x, np.sin(7 * x + k), marker="o", label="data")
+            ax.set_xlabel("time (time units)")
+            ax.set_title(f"panel {k}: $\\lambda = {k}$")
+        fig.legend(*axes[0].get_legend_handles_labels(), loc="outside lower center")
+        fig.suptitle("a constrained layout with a legend outside")
+        return fig
+
+    buf = io.BytesIO()
+    figure().savefig(buf, format="png", dpi=150)
+    fig = figure()
+    assert _png(fig, 150) == buf.getvalue()
+    assert fig.dpi == 100  # the figure's own dpi is restored

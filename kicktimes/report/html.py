@@ -48,11 +48,34 @@ def table_html(df):
     return f'<div class="table-wrap">{inner}</div>'
 
 
+def _png(fig, dpi):
+    """PNG bytes of ``fig`` at ``dpi``: the bytes of ``fig.savefig(format="png", dpi=dpi)``
+    from one draw instead of two.
+
+    With a layout engine, ``savefig`` draws the figure twice (a draw with rendering
+    disabled that runs the constrained layout, then the real one); an Agg canvas draw runs
+    the layout and renders in one pass, and `matplotlib.image.imsave` encodes the buffer
+    exactly as ``savefig`` does (same metadata and compression), so the files are
+    byte-identical (tested) for about 20 % less time (benchmarks/bench_report.py).
+    """
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.image import imsave
+
+    old_dpi = fig.dpi
+    fig.set_dpi(dpi)
+    try:
+        canvas = FigureCanvasAgg(fig)
+        canvas.draw()
+        buf = io.BytesIO()
+        imsave(buf, canvas.buffer_rgba(), format="png", origin="upper", dpi=dpi)
+    finally:
+        fig.set_dpi(old_dpi)
+    return buf.getvalue()
+
+
 def _render(fig, dpi, pdf):
     """``(png bytes, pdf bytes or None)`` of one figure."""
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=dpi)
-    png, pdf_bytes = buf.getvalue(), None
+    png, pdf_bytes = _png(fig, dpi), None
     if pdf:
         buf = io.BytesIO()
         # no creation date: the same figure gives the same bytes (and cache entry)
