@@ -170,6 +170,34 @@ def rqa_table(rep):
                 f"{lam_min / r_min:6.1f}"
             )
     print("RQA = rqa(laminarity=False), as in the sweep; +LAM = rqa() with laminarity")
+    grid_table(sets, rep)
+
+
+def grid_table(sets, rep):
+    """The sweep's call, rqa(points, [1e-3, 1e-2]), on the dense grid it takes against the
+    radix-sorted occupied cells (the former path, forced), same points, same run."""
+    from kicktimes.diagnostics import recurrence
+
+    print()
+    print(f"The sweep's rqa(points, [1e-3, 1e-2]): dense grid against sorted occupied cells "
+          f"(min / median of {rep} runs)")
+    header = f"{'point set':<11} {'sorted cells [ms]':>18} {'dense grid [ms]':>16} {'speed-up':>9}"
+    print(header)
+    print("-" * len(header))
+    saved = recurrence._DENSE_CELLS_PER_POINT, recurrence._DENSE_CELLS_MIN
+    for name, pts in sets:
+        def call(p=pts):
+            return rqa(p, [1e-3, 1e-2], laminarity=False)
+
+        d_min, d_med, dense = timeit(call, rep)
+        recurrence._DENSE_CELLS_PER_POINT, recurrence._DENSE_CELLS_MIN = 0, 0
+        try:
+            s_min, s_med, sparse = timeit(call, rep)
+        finally:
+            recurrence._DENSE_CELLS_PER_POINT, recurrence._DENSE_CELLS_MIN = saved
+        assert dense == sparse
+        print(f"{name:<11} {s_min * 1e3:8.3f} / {s_med * 1e3:7.3f} {d_min * 1e3:7.3f} / "
+              f"{d_med * 1e3:6.3f} {s_min / d_min:9.2f}")
 
 
 def main():

@@ -124,6 +124,40 @@ POINT_SETS = {
 # ------------------------------------------------------------------ exactness
 
 
+@pytest.mark.parametrize("eps", [1e-2, 0.05])
+@pytest.mark.parametrize("name", ["paper_samples", *sorted(POINT_SETS)])
+def test_dense_and_sparse_cell_grids_give_the_same_line_statistics(name, eps, monkeypatch):
+    # rqa sweeps a dense grid (an offset per cell) when it has few cells per point and the
+    # radix-sorted occupied cells otherwise; both must give the very same counts
+    from kicktimes.diagnostics import recurrence
+
+    if name == "paper_samples":
+        from kicktimes import initial_conditions, simulate_two_particle
+
+        ic = initial_conditions(1, 0.02, seed=4, method="paper")[0]
+        pts = simulate_two_particle(ic, 0.01, n_steps=3000, tau=0.3, sampling="paper").samples
+    else:
+        pts = POINT_SETS[name]
+    eps_list = [eps, eps / 3]
+    monkeypatch.setattr(recurrence, "_DENSE_CELLS_MIN", 2**62)
+    dense = rqa(pts, eps_list, theiler=1, laminarity=False)
+    monkeypatch.setattr(recurrence, "_DENSE_CELLS_PER_POINT", 0)
+    monkeypatch.setattr(recurrence, "_DENSE_CELLS_MIN", 0)
+    sparse = rqa(pts, eps_list, theiler=1, laminarity=False)
+    assert dense == sparse
+    assert dense[0].n_recurrent > 0  # there is something to count
+
+
+def test_the_sweep_threshold_takes_the_dense_grid_for_billiard_samples():
+    from kicktimes.diagnostics import recurrence
+
+    pts = POINT_SETS["trajectory"]
+    *_, ncx, ncy, _ = recurrence._grid(pts, 1e-2)
+    assert ncx * ncy <= recurrence._DENSE_CELLS_PER_POINT * len(pts) + recurrence._DENSE_CELLS_MIN
+    *_, ncx, ncy, _ = recurrence._grid(np.tile(pts, (80, 1)), 1e-3)  # 28 000 points
+    assert ncx * ncy > recurrence._DENSE_CELLS_PER_POINT * 28_000 + recurrence._DENSE_CELLS_MIN
+
+
 @pytest.mark.parametrize("name", sorted(POINT_SETS))
 @pytest.mark.parametrize("eps", [0.01, 0.05, 0.2])
 @pytest.mark.parametrize("theiler", [0, 1, 5])

@@ -166,7 +166,8 @@ def rqa(points, eps=1e-3, *, theiler=1, l_min=2, laminarity=True):
     a point are compacted without branches before the recurrent ones are accounted)
     and each line of length ``>= 2`` is walked once. O(N) memory, never an ``N x N``
     matrix nor the pair list; about 1.2x the time of `recurrence_rate` at eps = 1e-3
-    and 1.2-1.5x at 1e-2 for N = 25 000 (``laminarity=False``; benchmarks/bench_recurrence.py). The
+    and 1.0-1.2x at 1e-2 for N = 25 000 (``laminarity=False``; at 1e-2 the cells are a
+    dense grid, see `kicktimes.diagnostics.recurrence`; benchmarks/bench_recurrence.py). The
     laminarity adds a sweep that collects the pairs into sorted rows.
 
     References
