@@ -156,8 +156,10 @@ def _pass_loop_two(st, ev, rho, sigma, rule, t_end, mode, tau, track, pp, bt, bp
                 fin[6] = y1 + vy1 * dt
                 fin[7] = vx1
                 fin[8] = vy1
-                # _actual_times: continued only if the sampled window ends before t_continue
+                # _actual_times: continued only if the sampled window ends before t_continue;
+                # its budget counts every event from t = 0, as a run to t_continue's does
                 cont_on = mode == 2 and not t_end >= t_continue
+                n_b_cont = n_b
         if tan_on:
             # tangent_two_kernel: the step ends before the next event
             while not t + dte <= tk:
