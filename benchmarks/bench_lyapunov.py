@@ -6,7 +6,17 @@ paper-procedure ICs. References, timed in the same run on the same trajectories:
 kicks at each IC's own collision rate (for the kicked FTLE, on the very runs it computes).
 Each trajectory's calls are timed back to back, each the best of ``--repeat``.
 
+``--one-pass``: the sweep's physics per IC on the paper's workload (family_b, r = 0.01,
+15000 collision-truncated steps of 0.3, variant "paper", all five systems): the separate
+calls the sweep made before the one pass (simulation, then the FTLE re-simulating it, then
+the two-disk run again to the horizon for the actual kick times; per kicked system a
+simulation and an FTLE), against the one pass (`lyapunov_pass` and
+``lyapunov(..., return_run=True)``), in the same run, interleaved per IC. Both compute the
+same numbers (checked). Also timed: the whole sweep task of one IC (`execute_task`, with
+the recurrence and autocorrelation diagnostics, which the one pass does not change).
+
 Run: python benchmarks/bench_lyapunov.py [--n-ics 100] [--repeat 3]
+     python benchmarks/bench_lyapunov.py --one-pass [--n-ics 20] [--repeat 3]
 """
 
 import argparse
@@ -35,11 +45,88 @@ def interleaved_min(calls, n, repeat):
     return totals
 
 
+def one_pass(n_ics, repeat):
+    """Per IC: the sweep's simulations and FTLEs as separate calls vs one pass."""
+    import numpy as np
+
+    from kicktimes.billiard.one_particle import draw_kick_angles
+    from kicktimes.diagnostics.lyapunov import lyapunov_pass
+    from kicktimes.experiment import Task, execute_task, kick_rng, preset
+    from kicktimes.experiment.tasks import _actual_times, _kick_law
+
+    exp = preset("family_b")
+    r = 0.01
+    ri = exp.radii.index(r)
+    ics = initial_conditions(n_ics, exp.r_max, seed=exp.seed, method=exp.ic_method,
+                             rule=exp.rule)
+    steps = {"n_steps": exp.n_steps, "tau": exp.tau, "sampling": exp.sampling}
+    var = exp.lyapunov_variant
+    kicked = [s for s in exp.systems if s != "two_particle"]
+
+    def kicks(i, system, two, actual):
+        rng = kick_rng(exp.seed, i, r, system)
+        kick = _kick_law(exp, system, ics[i])
+        if system.startswith("poisson"):
+            times = schedules.Poisson(two.n_pp / two.t_max).sample(exp.horizon, rng)
+        else:
+            times = actual
+        return times, draw_kick_angles(times.size, kick["kick_angle"], exp.sigma, rng), kick
+
+    def separate(i):
+        ic = ics[i]
+        two = simulate_two_particle(ic, r, rule=exp.rule, track=0, seed=exp.seed, **steps)
+        out = [lyapunov(ic, r, rule=exp.rule, track=0, variant=var, **steps).lam]
+        actual = _actual_times(exp, ic, r, two)
+        for system in kicked:
+            times, angles, kick = kicks(i, system, two, actual)
+            one = simulate_one_particle(ic[0], r, kicks=times, kick_angles=angles,
+                                        seed=exp.seed, **kick, **steps)
+            out += [one.n_boundary, lyapunov(ic[0], r, kicks=times, kick_angles=angles,
+                                             variant=var, **kick, **steps).lam]
+        return out + [two.n_pp, actual.size]
+
+    def together(i):
+        ic = ics[i]
+        res, two, actual = lyapunov_pass(ic, r, rule=exp.rule, track=0, variant=var,
+                                         t_continue=exp.horizon, **steps)
+        out = [res.lam]
+        for system in kicked:
+            times, angles, kick = kicks(i, system, two, np.array(actual, dtype=np.float64))
+            res, one = lyapunov(ic[0], r, kicks=times, kick_angles=angles, variant=var,
+                                return_run=True, **kick, **steps)
+            out += [one.n_boundary, res.lam]
+        return out + [two.n_pp, actual.size]
+
+    def task(i):
+        execute_task(exp, Task(ri, r, i, i + 1))
+
+    for i in range(n_ics):
+        # (repr: bitwise for floats, NaN equal to NaN)
+        assert repr(separate(i)) == repr(together(i)), f"IC {i}: the one pass differs"
+    task(0)  # compile / load the sweep's remaining kernels
+    calls = {"separate calls (before)": separate, "one pass (now)": together,
+             "sweep task of one IC (now, + RR, ACF)": task}
+    totals = interleaved_min(calls, n_ics, repeat)
+    ref = totals["separate calls (before)"]
+    print(f"workload: family_b, r={r}, {exp.n_steps} paper steps of tau={exp.tau}, variant "
+          f"{var!r}, {len(exp.systems)} systems, {n_ics} ICs, best of {repeat} per IC, "
+          f"interleaved; {os.cpu_count()} cores (one used); same numbers checked")
+    print(f"{'what':40s} {'ms/IC':>8s} {'ratio to separate calls':>25s}")
+    for name, t in totals.items():
+        print(f"{name:40s} {t * 1e3 / n_ics:8.2f} {t / ref:25.3f}")
+
+
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("--n-ics", type=int, default=100)
+    ap.add_argument("--n-ics", type=int, default=None, help="default 100 (20 with --one-pass)")
     ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--one-pass", action="store_true",
+                    help="the sweep's per-IC physics: separate calls vs one pass")
     args = ap.parse_args()
+    if args.one_pass:
+        one_pass(args.n_ics or 20, args.repeat)
+        return
+    args.n_ics = args.n_ics or 100
     r, tau, n_steps = 0.01, 0.3, 15000
     ics = initial_conditions(args.n_ics, r, seed=2026, method="paper")
 

@@ -57,11 +57,13 @@ def experiment(name: str, content: str):
         exp = dataclasses.replace(exp, **PAPER_CONTENT)
     return exp
 
+# with the tangent FTLE (the presets) each trajectory is simulated once, together with its
+# FTLE (one pass): that time is under lyapunov_*; simulation_* is what runs without it
 STAGES = [
-    ("simulation_two_particle", "simulation: two-particle runs"),
-    ("simulation_one_particle", "simulation: kicked one-particle runs (+ kick draws)"),
-    ("lyapunov_two_particle", "diagnostic: FTLE, two-particle"),
-    ("lyapunov_kicked", "diagnostic: FTLE, kicked"),
+    ("simulation_two_particle", "simulation: two-particle runs (without the FTLE)"),
+    ("simulation_one_particle", "kick draws (+ kicked runs without the FTLE)"),
+    ("lyapunov_two_particle", "simulation + FTLE, two-particle (one pass)"),
+    ("lyapunov_kicked", "simulation + FTLE, kicked (one pass)"),
     ("recurrence_rate", "diagnostic: recurrence rate"),
     ("autocorrelation", "diagnostic: autocorrelation"),
     ("tables", "tidy tables"),

@@ -5,9 +5,9 @@ code on disk (next to the source, or under ``NUMBA_CACHE_DIR``); later processes
 in milliseconds. On a fresh install the sweep's kernels take tens of seconds to compile
 (``python benchmarks/bench_compile.py`` measures them per kernel), so the command line
 says so once, and compiles two independent groups of kernels of about the same cost (the
-two-disk simulation with its tangent FTLE and autocorrelation; the kicked disk with its
-tangent FTLE, and the recurrence kernels) in two processes at the same time instead of one
-after the other in every worker.
+two-disk one-pass kernel, simulation and tangent FTLE in one event loop, with the
+autocorrelation; the kicked disk's one-pass kernel and the recurrence kernels) in two
+processes at the same time instead of one after the other in every worker.
 """
 
 from __future__ import annotations
@@ -20,15 +20,16 @@ __all__ = ["cold_kernels", "announce", "warm_up"]
 #: project's 2-core machine, inclusive of the kernels each one calls; the recurrence entry,
 #: the kernel of the sweep's `rqa` call (not `_sweep`, which only `recurrence_rate` calls:
 #: it stayed "cold" after every sweep), stands for all its kernels)
+#: A sweep with the tangent FTLE (every preset) runs each trajectory once, through the
+#: one-pass kernels (kicktimes.diagnostics._tangent_run); the separate simulation and
+#: tangent kernels are compiled on first use by the calls that need them.
 SWEEP_KERNELS = (
-    ("kicktimes.billiard.two_particle", "simulate_two_kernel", 4.5),
-    ("kicktimes.billiard.one_particle", "simulate_one_kernel", 4.5),
-    ("kicktimes.diagnostics._tangent", "tangent_two_kernel", 3.0),
-    ("kicktimes.diagnostics._tangent", "tangent_one_kernel", 2.0),
+    ("kicktimes.diagnostics._tangent_run", "simulate_tangent_two_kernel", 5.5),
+    ("kicktimes.diagnostics._tangent_run", "simulate_tangent_one_kernel", 5.0),
     ("kicktimes.diagnostics.recurrence", "_sweep_lines", 4.0),
     ("kicktimes.diagnostics.autocorrelation", "_acf_segments", 1.5),
 )
-SIMULATE_KERNELS = SWEEP_KERNELS[:1]
+SIMULATE_KERNELS = (("kicktimes.billiard.two_particle", "simulate_two_kernel", 4.5),)
 
 
 def _is_cold(dispatcher) -> bool | None:
@@ -72,10 +73,9 @@ def announce(kernels=SWEEP_KERNELS, *, stream=None) -> float:
 
 
 def _warm_two(_):
-    # the two-disk system exactly as a sweep task runs it (simulation, tangent FTLE,
-    # autocorrelation), on a tiny run; the recurrence kernels are left to _warm_one,
-    # which balances the two groups (about 9 s and 13 s on the project's machine; the
-    # recurrence kernels alone take about 8 s)
+    # the two-disk system exactly as a sweep task runs it (one pass: simulation and
+    # tangent FTLE; autocorrelation), on a tiny run; the recurrence kernels are left to
+    # _warm_one, which balances the two groups
     import dataclasses
 
     from kicktimes.experiment import execute_task, preset
@@ -88,12 +88,13 @@ def _warm_two(_):
 
 
 def _warm_one(_):
-    # the kicked disk as a sweep task calls it: Poisson kicks, simulation, tangent FTLE;
-    # then the sweep's recurrence rows (the same call as a task's) on its samples
+    # the kicked disk as a sweep task calls it: Poisson kicks, one pass (simulation and
+    # tangent FTLE); then the sweep's recurrence rows (the same call as a task's) on its
+    # samples
     import numpy as np
 
     from kicktimes.billiard.initial import initial_conditions
-    from kicktimes.billiard.one_particle import draw_kick_angles, simulate_one_particle
+    from kicktimes.billiard.one_particle import draw_kick_angles
     from kicktimes.diagnostics.lyapunov import lyapunov
     from kicktimes.experiment import preset
     from kicktimes.experiment.tasks import _kick_law, recurrence_rows
@@ -106,18 +107,8 @@ def _warm_one(_):
     times = np.cumsum(rng.exponential(1.0, size=20))
     angles = draw_kick_angles(times.size, kick["kick_angle"], exp.sigma, rng)
     r = exp.radii[0]
-    run = simulate_one_particle(ic[0], r, kicks=times, kick_angles=angles, seed=0, **kick,
-                                **steps)
-    lyapunov(
-        ic[0],
-        r,
-        kicks=times,
-        kick_angles=angles,
-        variant=exp.lyapunov_variant,
-        method=exp.lyapunov_method,
-        **kick,
-        **steps,
-    )
+    _, run = lyapunov(ic[0], r, kicks=times, kick_angles=angles, variant=exp.lyapunov_variant,
+                      method=exp.lyapunov_method, return_run=True, **kick, **steps)
     recurrence_rows(run.samples, exp.eps)
 
 

@@ -332,6 +332,50 @@ def test_actual_kicks_cover_the_whole_paper_sampled_one_particle_run():
     np.testing.assert_array_equal(times[: two.n_pp], two.pp_times)
 
 
+def test_sweep_results_are_bitwise_those_of_separate_simulation_and_ftle_runs():
+    # tests/data/sweep_golden.parquet: the tables of small experiments (paper setup of both
+    # families with all five systems and diagnostics, uniform sampling, elastic rule with
+    # gaussian kicks) computed before the one-pass sweep, with a separate simulation, FTLE
+    # and actual-time continuation per trajectory; one pass must not change a bit
+    import importlib.util
+
+    data = REPO / "tests" / "data"
+    spec = importlib.util.spec_from_file_location("sweep_cases", data / "sweep_cases.py")
+    cases = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(cases)
+    ref = cases.load(data / "sweep_golden.parquet")
+    assert len(ref[0]) == 5028 and len(ref[1]) == 24
+    assert set(ref[0]["system"]) == {"two_particle", "poisson", "actual", "poisson_scatter",
+                                     "actual_scatter"}
+    assert cases.differences(ref, cases.tables()) == []
+
+
+def test_one_pass_continues_the_two_disk_run_to_the_horizon_for_the_actual_kicks():
+    from kicktimes import initial_conditions, simulate_two_particle
+    from kicktimes.diagnostics.lyapunov import lyapunov_pass
+
+    exp = dataclasses.replace(TINY, n_steps=2000)
+    ic = initial_conditions(1, 0.03, seed=3)[0]
+    two = simulate_two_particle(ic, 0.03, sampling="paper", n_steps=2000, tau=0.3)
+    _, run, times = lyapunov_pass(ic, 0.03, sampling="paper", n_steps=2000, tau=0.3,
+                                  t_continue=exp.horizon)
+    np.testing.assert_array_equal(run.pp_times, two.pp_times)
+    assert run.t_max == two.t_max < exp.horizon
+    np.testing.assert_array_equal(times, _actual_times(exp, ic, 0.03, two))
+    assert times.size > two.n_pp
+
+
+def test_the_one_pass_sweep_keeps_its_stage_timings_under_the_ftle_keys():
+    from kicktimes.experiment import execute_task
+
+    out = execute_task(TINY, TINY.tasks()[0])
+    # simulation + FTLE of every trajectory is timed as one stage; no separate simulation
+    assert out.timings["lyapunov_two_particle"] > 0 and out.timings["lyapunov_kicked"] > 0
+    assert "simulation_two_particle" not in out.timings
+    plain = dataclasses.replace(TINY, diagnostics=["recurrence_rate"])
+    assert "simulation_two_particle" in execute_task(plain, plain.tasks()[0]).timings
+
+
 def test_kick_streams_differ_by_ic_radius_and_system_and_ignore_the_radius_list():
     draws = {
         key: kick_rng(7, *key).random()

@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from kicktimes import initial_conditions, simulate_one_particle, simulate_two_particle
+from kicktimes import initial_conditions, schedules, simulate_one_particle, simulate_two_particle
 from kicktimes.diagnostics import lyapunov
 from kicktimes.diagnostics._tangent import MAX_SAME_INSTANT, tangent_two_kernel
 from kicktimes.diagnostics._twin import ftle_two_kernel
@@ -178,3 +178,168 @@ def test_sweeps_pass_the_lyapunov_method_through():
     assert values["twin"] == lyapunov(ic, 0.02, n_steps=300, tau=0.3, method="twin").lam
     with pytest.raises(ValueError, match="lyapunov_method"):
         Experiment(name="m", radii=[0.02], n_ics=1, n_steps=3, tau=0.3, lyapunov_method="qr")
+
+
+# ------------------------------------------------ one pass: the run and the FTLE together
+def assert_runs_bitwise_equal(a, b):
+    """Same class, every field equal to the bit (arrays: dtype, shape and bytes)."""
+    import dataclasses
+
+    assert type(a) is type(b)
+    for f in dataclasses.fields(a):
+        x, y = getattr(a, f.name), getattr(b, f.name)
+        if f.name == "boundary_log":
+            for u, v in zip(x, y, strict=True):
+                assert u.dtype == v.dtype and u.tobytes() == v.tobytes(), f.name
+        elif isinstance(x, np.ndarray):
+            assert (x.dtype, x.shape) == (y.dtype, y.shape) and x.tobytes() == y.tobytes(), f.name
+        else:
+            assert x == y or (x != x and y != y), (f.name, x, y)
+
+
+def assert_results_bitwise_equal(a, b):
+    import dataclasses
+
+    for f in dataclasses.fields(a):
+        x, y = getattr(a, f.name), getattr(b, f.name)
+        assert x == y or (x != x and y != y), (f.name, x, y)
+
+
+@pytest.mark.parametrize("r", [0.005, 0.02, 0.1])
+@pytest.mark.parametrize("rule", ["mirror", "elastic"])
+@pytest.mark.parametrize("sampling", ["uniform", "paper"])
+@pytest.mark.parametrize("variant", ["norm", "paper"])
+def test_one_pass_gives_the_two_disk_run_and_exponent_of_separate_calls(r, rule, sampling,
+                                                                        variant):
+    for k, ic in enumerate(initial_conditions(2, r, seed=11, rule=rule)):
+        kw = dict(n_steps=800, tau=0.3, sampling=sampling, rule=rule, track=k)
+        res, run = lyapunov(ic, r, variant=variant, return_run=True, **kw)
+        assert_results_bitwise_equal(res, lyapunov(ic, r, variant=variant, **kw))
+        assert_runs_bitwise_equal(run, simulate_two_particle(ic, r, **kw))
+        assert res.n_perturbations == run.n_pp and (run.n_pp > 0 or r < 0.01)
+
+
+@pytest.mark.parametrize("r", [0.005, 0.02, 0.1])
+@pytest.mark.parametrize(("kick_angle", "extra"), [("uniform", {}), ("gaussian", {"sigma": 0.4}),
+                                                   ("scatter", {"rule": "mirror"}),
+                                                   ("scatter", {"rule": "elastic"})])
+@pytest.mark.parametrize("sampling", ["uniform", "paper"])
+@pytest.mark.parametrize("variant", ["norm", "paper"])
+def test_one_pass_gives_the_kicked_run_and_exponent_of_separate_calls(r, kick_angle, extra,
+                                                                      sampling, variant):
+    state = initial_conditions(1, r, seed=12)[0, 0]
+    kw = dict(n_steps=800, tau=0.3, sampling=sampling, kick_angle=kick_angle, **extra)
+    # drawn from a schedule with rng (the same draws both ways), and given explicitly with
+    # kicks beyond the run's end (paper sampling: applied only while the run lasts)
+    res, run = lyapunov(state, r, kicks=schedules.Poisson(0.2), rng=3, variant=variant,
+                        return_run=True, **kw)
+    assert_results_bitwise_equal(res, lyapunov(state, r, kicks=schedules.Poisson(0.2), rng=3,
+                                               variant=variant, **kw))
+    assert_runs_bitwise_equal(run, simulate_one_particle(state, r, kicks=schedules.Poisson(0.2),
+                                                         rng=3, **kw))
+    assert run.n_kicks > 0 and res.n_perturbations == run.n_kicks
+    if sampling == "paper":
+        late = 0.3 * 800 + 1.0
+        kicks = np.r_[run.kick_times, late]
+        angles = np.concatenate([run.kick_angles, run.kick_angles[:1]])
+        res, run2 = lyapunov(state, r, kicks=kicks, kick_angles=angles, variant=variant,
+                             return_run=True, **kw)
+        assert_runs_bitwise_equal(run2, simulate_one_particle(state, r, kicks=kicks,
+                                                              kick_angles=angles, **kw))
+        assert_runs_bitwise_equal(run2, run)
+
+
+def test_one_pass_accepts_runs_and_refuses_the_twin_method(ics):
+    run = simulate_one_particle(ics[0, 0], 0.03, n_steps=500, tau=0.2, kicks=[5.0, 9.0], rng=2)
+    res, again = lyapunov(run, return_run=True)
+    assert res == lyapunov(run)
+    assert_runs_bitwise_equal(again, run)
+    with pytest.raises(ValueError, match="return_run=True needs method='tangent'"):
+        lyapunov(ics[0], 0.03, n_steps=10, tau=0.2, method="twin", return_run=True)
+    with pytest.raises(TypeError, match="return_run must be a bool"):
+        lyapunov(ics[0], 0.03, n_steps=10, tau=0.2, return_run="yes")
+
+
+def test_an_ftle_error_in_one_pass_is_the_error_of_the_separate_call(ics):
+    # simultaneous kicks stop the tangent half (as lyapunov() would), not silently
+    kicks = np.full(MAX_SAME_INSTANT + 5, 3.0)
+    simulate_one_particle(ics[0, 0], 0.03, n_steps=100, tau=0.2, kicks=kicks, rng=0)
+    with pytest.raises(RuntimeError, match="consecutive events at the same instant"):
+        lyapunov(ics[0, 0], 0.03, n_steps=100, tau=0.2, kicks=kicks, rng=0, return_run=True)
+
+
+@pytest.mark.parametrize("r", [0.005, 0.03])
+@pytest.mark.parametrize("rule", ["mirror", "elastic"])
+def test_the_continued_pass_has_the_collision_times_of_a_fresh_run_to_the_horizon(r, rule):
+    from kicktimes.diagnostics.lyapunov import lyapunov_pass
+
+    horizon = 1500 * 0.3
+    for ic in initial_conditions(3, r, seed=13, rule=rule):
+        kw = dict(n_steps=1500, tau=0.3, rule=rule)
+        res, run, times = lyapunov_pass(ic, r, sampling="paper", variant="paper",
+                                        t_continue=horizon, **kw)
+        assert_runs_bitwise_equal(run, simulate_two_particle(ic, r, sampling="paper", **kw))
+        assert res == lyapunov(ic, r, sampling="paper", variant="paper", **kw)
+        fresh = simulate_two_particle(ic, r, t_max=horizon, rule=rule)
+        assert run.t_max < horizon and times.tobytes() == fresh.pp_times.tobytes()
+        # nothing to continue: a window that reaches t_continue, or uniform sampling
+        _, _, same = lyapunov_pass(ic, r, sampling="paper", t_continue=run.t_max, **kw)
+        assert same.tobytes() == run.pp_times.tobytes()
+        _, uni, same = lyapunov_pass(ic, r, t_continue=2 * horizon, **kw)
+        assert same.tobytes() == uni.pp_times.tobytes()
+
+
+_RECORD_ONE_PASS_COMPILES = r"""
+import json
+import numpy as np
+from numba.core import event
+from kicktimes import initial_conditions, schedules
+from kicktimes.diagnostics import lyapunov
+from kicktimes.diagnostics.lyapunov import lyapunov_pass
+
+ic = initial_conditions(1, 0.02, seed=0)[0]
+with event.install_recorder("numba:compile") as rec:
+    for rule in ("mirror", "elastic"):
+        for sampling in ("uniform", "paper"):
+            for variant in ("norm", "paper"):
+                lyapunov(ic, 0.02, rule=rule, sampling=sampling, variant=variant, n_steps=20,
+                         tau=0.3, return_run=True)
+        lyapunov_pass(ic, 0.02, rule=rule, sampling="paper", n_steps=20, tau=0.3,
+                      t_continue=30.0)
+    for law in ("uniform", "gaussian", "scatter"):
+        for sampling in ("uniform", "paper"):
+            lyapunov(ic[0], 0.02, n_steps=20, tau=0.3, kick_angle=law, sampling=sampling,
+                     kicks=schedules.Poisson(0.5), rng=0, return_run=True)
+        lyapunov(ic[0], 0.02, n_steps=20, tau=0.3, kick_angle=law, kicks=np.empty(0),
+                 return_run=True)
+sigs = {}
+for _, ev in rec.buffer:
+    if ev.is_start:
+        f = ev.data["dispatcher"].py_func
+        sigs.setdefault(f"{f.__module__}.{f.__qualname__}", []).append(str(ev.data["args"]))
+print(json.dumps(sigs))
+"""
+
+
+@pytest.mark.slow
+def test_one_pass_kernels_compile_once_without_error_strings(tmp_path):
+    # as tests/test_compile.py checks for the simulators: one signature per kernel whatever
+    # the rule, sampling, variant or kick law, and no numba string formatting
+    import json
+    import os
+    import subprocess
+    import sys
+
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path))
+    out = subprocess.run([sys.executable, "-c", _RECORD_ONE_PASS_COMPILES], env=env, check=True,
+                         capture_output=True, text=True)
+    sigs = json.loads(out.stdout.strip().splitlines()[-1])
+    ours = {name: s for name, s in sigs.items() if name.startswith("kicktimes.")}
+    assert "kicktimes.diagnostics._tangent_run.simulate_tangent_two_kernel" in ours
+    assert "kicktimes.diagnostics._tangent_run.simulate_tangent_one_kernel" in ours
+    several = {name: s for name, s in ours.items()
+               if len(s) > 1 and name != "kicktimes.billiard.two_particle._grow_to"}
+    assert several == {}
+    strings = [name for name in sigs if "unicode" in name or "raise_with_shape" in name
+               or "ol_str_generic" in name]
+    assert strings == []

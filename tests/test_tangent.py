@@ -318,3 +318,59 @@ def test_elastic_spectrum_comes_in_pairs_summing_to_zero(ics20):
     spec = lyapunov_spectrum(ics20[0], R_AGREE, t_max=2000.0, rule="elastic").exponents
     np.testing.assert_allclose(spec + spec[::-1], 0.0, atol=1e-3)
     assert spec[1] > 10 * abs(spec[2])  # two positive exponents, well above the zeros
+
+
+# ------------------------------------------ one pass: simulation and tangent vectors together
+def _two_args(ic, r, *, mode, n_steps, tau, max_events=None, rule="mirror"):
+    from kicktimes.billiard.two_particle import kernel_args
+
+    return kernel_args(np.asarray(ic, dtype=float), r, rule, mode,
+                       n_steps * tau if mode == 1 else None, n_steps, tau, 0, max_events)
+
+
+@pytest.mark.parametrize("mode", [1, 2])
+def test_one_pass_kernel_carries_every_tangent_vector_as_the_tangent_kernel(mode):
+    from kicktimes.billiard.two_particle import simulate_two_kernel
+    from kicktimes.diagnostics._tangent_run import simulate_tangent_two_kernel
+
+    ic = initial_conditions(1, R, seed=21, rule="elastic")[0]
+    args = _two_args(ic, R, mode=mode, n_steps=600, tau=0.3, rule="elastic")
+    U, U_ref = np.eye(8), np.eye(8)
+    out = simulate_tangent_two_kernel(*(a.copy() if isinstance(a, np.ndarray) else a
+                                        for a in args), U, 10**6, 0.0)
+    ref = tangent_two_kernel(two_state(ic), RHO, SIG, 1, mode, 600, 0.3, U_ref, 10**6, 0)
+    assert U.tobytes() == U_ref.tobytes()
+    np.testing.assert_array_equal(out[11], ref[0])
+    assert out[12:16] == (ref[1], ref[2], ref[3], ref[4])
+    sim = simulate_two_kernel(*args, False)
+    assert out[0].tobytes() == sim[0].tobytes() and out[1] == sim[0].size
+    assert out[7].tobytes() == sim[6].tobytes() and out[8].tobytes() == sim[7].tobytes()
+    assert out[9] == sim[8] and out[10] == sim[10] == 0
+
+
+def test_an_exhausted_tangent_budget_stops_only_the_tangent_half():
+    from kicktimes.billiard.two_particle import simulate_two_kernel
+    from kicktimes.diagnostics._tangent_run import simulate_tangent_two_kernel
+
+    ic = initial_conditions(1, R, seed=22)[0]
+    args = _two_args(ic, R, mode=2, n_steps=500, tau=0.3)
+    out = simulate_tangent_two_kernel(*(a.copy() if isinstance(a, np.ndarray) else a
+                                        for a in args), np.eye(8)[[0]], 50, 0.0)
+    sim = simulate_two_kernel(*args, False)
+    assert out[15] == 1 and out[10] == 0  # the FTLE's budget error; the run completes
+    assert out[0].tobytes() == sim[0].tobytes() and out[8].tobytes() == sim[7].tobytes()
+
+
+def test_the_continuation_has_the_event_budget_of_a_run_to_t_continue():
+    from kicktimes import simulate_two_particle
+    from kicktimes.diagnostics._tangent_run import simulate_tangent_two_kernel
+
+    ic = initial_conditions(1, R, seed=23)[0]
+    run = simulate_two_particle(ic, R, sampling="paper", n_steps=500, tau=0.3)
+    budget = run.n_pp + run.n_boundary + 5  # enough for the run, not for its continuation
+    with pytest.raises(ValueError, match="max_events"):
+        simulate_two_particle(ic, R, t_max=150.0, max_events=budget)
+    args = _two_args(ic, R, mode=2, n_steps=500, tau=0.3, max_events=budget)
+    out = simulate_tangent_two_kernel(*args, np.eye(8)[[0]], 10**6, 150.0)
+    assert out[10] == 0 and out[16] == 3  # run DONE, continuation OVER_BUDGET
+    assert out[1] == run.n_pp and out[0].size + run.n_boundary <= budget + 1

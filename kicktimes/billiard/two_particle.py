@@ -583,6 +583,20 @@ def simulate_two_particle(ic, r, *, t_max=None, rule="mirror", sampling="uniform
     ic = check_two_particle_ic(ic, r, rule)
     if not isinstance(log_collisions, bool | np.bool_):
         raise TypeError(f"log_collisions must be a bool, got {type(log_collisions).__name__}")
+    args = kernel_args(ic, r, rule, mode, t_max, n_steps, tau, track, max_events)
+    out = simulate_two_kernel(*args, bool(log_collisions))
+    return two_particle_run(out, args, r=r, rule=rule, sampling=sampling, tau=tau,
+                            n_steps=n_steps, ic=ic, track=track, seed=seed, name="ic")
+
+
+def kernel_args(ic, r, rule, mode, t_max, n_steps, tau, track, max_events) -> tuple:
+    """`simulate_two_kernel`'s arguments (all but ``log_pp``) for validated inputs.
+
+    ``ic``, ``r``, ``rule``, ``track`` validated, ``(t_max, n_steps, tau, mode)`` from
+    `check_sampling`, ``max_events`` as given (``None``: the default budget). Shared with
+    the one-pass FTLE (`kicktimes.diagnostics.lyapunov`), which must run the very same
+    simulation.
+    """
     x0, y0, vx0, vy0, x1, y1, vx1, vy1 = ic.ravel().tolist()
     # the initial kinetic energy, summed in this order (numpy's, bits of older runs kept)
     e0 = vx0 * vx0 + vy0 * vy0 + vx1 * vx1 + vy1 * vy1
@@ -597,14 +611,20 @@ def simulate_two_particle(ic, r, *, t_max=None, rule="mirror", sampling="uniform
     # capacities are only a first guess: the kernel grows its buffers when needed
     b_cap = int(3.0 * speed * horizon) + 64
     pp_cap = int(20.0 * r * speed * horizon) + 16
-    pp, bt, bp, bx, by, bs, stimes, samples, t_end, ppl, status = simulate_two_kernel(
-        st, rho, 2.0 * r, chk.RULES[rule], 0.0 if mode == 2 else t_max, mode,
-        n_steps if n_steps is not None else 0, tau if tau is not None else 0.0, track,
-        pp_cap, b_cap, max_events, chk.stall_time(rho, speed), bool(log_collisions),
-    )
+    return (st, rho, 2.0 * r, chk.RULES[rule], 0.0 if mode == 2 else t_max, mode,
+            n_steps if n_steps is not None else 0, tau if tau is not None else 0.0, track,
+            pp_cap, b_cap, max_events, chk.stall_time(rho, speed))
+
+
+def two_particle_run(out, args, *, r, rule, sampling, tau, n_steps, ic, track, seed,
+                     name) -> TwoParticleRun:
+    """The `TwoParticleRun` of `simulate_two_kernel`'s output ``out`` for ``args``
+    (`kernel_args`); raises the ValueError of an early stop, naming the argument ``name``."""
+    pp, bt, bp, bx, by, bs, stimes, samples, t_end, ppl, status = out
+    st, mode, max_events = args[0], args[5], args[11]
     if status != DONE:  # (the message is formatted only when it is needed)
         raise_for_status(status, st[0], pp.shape[0] + bt.shape[0], max_events=max_events,
-                         name="ic", where=f"disks at ({st[1]:.6g}, {st[2]:.6g}) and "
+                         name=name, where=f"disks at ({st[1]:.6g}, {st[2]:.6g}) and "
                                           f"({st[5]:.6g}, {st[6]:.6g}), r={r!r}")
     return TwoParticleRun(
         r=r,

@@ -29,9 +29,19 @@ from kicktimes.billiard.one_particle import (
     check_scatter_options,
     resolve_kicks,
 )
-from kicktimes.billiard.runs import OneParticleRun, TwoParticleRun
-from kicktimes.billiard.two_particle import check_two_particle_ic
+from kicktimes.billiard.runs import BoundaryLog, OneParticleRun, TwoParticleRun
+from kicktimes.billiard.two_particle import (
+    DONE,
+    check_two_particle_ic,
+    kernel_args,
+    raise_for_status,
+    two_particle_run,
+)
 from kicktimes.diagnostics._tangent import MAX_SAME_INSTANT, tangent_one_kernel, tangent_two_kernel
+from kicktimes.diagnostics._tangent_run import (
+    simulate_tangent_one_kernel,
+    simulate_tangent_two_kernel,
+)
 from kicktimes.diagnostics._twin import ftle_one_kernel, ftle_two_kernel
 
 VARIANTS = ("norm", "paper")
@@ -195,7 +205,7 @@ def _start_vectors(variant: str, size: int, offset: int) -> np.ndarray:
 def lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rule="mirror",
              track=0, kicks=None, kick_angles=None, kick_angle="uniform", sigma=1.0, rng=None,
              method="tangent", variant="norm", d0=None, max_defer=10, e0=None,
-             partner="weighted") -> LyapunovResult:
+             partner="weighted", return_run=False):
     """Finite-time Lyapunov exponent of a two-disk or a kicked one-disk billiard.
 
     Parameters
@@ -234,10 +244,17 @@ def lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rule
         (default the paper's 1/5000). Must be ``None`` for ``method="tangent"``.
     max_defer : int
         Twin only: consecutive deferred renormalisations after which one is forced.
+    return_run : bool
+        Also return the simulated run: ``(result, run)``, where ``run`` is the
+        `TwoParticleRun` / `OneParticleRun` that `simulate_two_particle` /
+        `simulate_one_particle` return for the same arguments (every field bitwise
+        equal, ``seed=None``), from the same single pass of the event loop that carries
+        the tangent vectors (no second simulation). Tangent method only: with
+        ``method="twin"`` it raises a ValueError.
 
     Returns
     -------
-    LyapunovResult
+    LyapunovResult, or ``(LyapunovResult, run)`` with ``return_run=True``
 
     Notes
     -----
@@ -255,7 +272,9 @@ def lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rule
     per collision, ``lam_per_perturbation``, is larger by about ``ln(1/r)``).
 
     The reference trajectory is bitwise the one `simulate_two_particle` /
-    `simulate_one_particle` compute with the same arguments.
+    `simulate_one_particle` compute with the same arguments; with ``return_run=True`` one
+    event loop (`kicktimes.diagnostics._tangent_run`) produces both, each bitwise what
+    its own call gives (the result, that of ``lyapunov`` without ``return_run``).
 
     Examples
     --------
@@ -268,7 +287,46 @@ def lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rule
     >>> twin = lyapunov(ic, 0.03, n_steps=2000, tau=0.2, method="twin", d0=1e-8)
     >>> bool(abs(twin.lam - res.lam) < 0.02 * res.lam)
     True
+
+    One pass for the exponent and the run (its samples, boundary log, collision times):
+
+    >>> from kicktimes import simulate_two_particle
+    >>> res2, run = lyapunov(ic, 0.03, n_steps=2000, tau=0.2, return_run=True)
+    >>> res2 == res
+    True
+    >>> same = simulate_two_particle(ic, 0.03, n_steps=2000, tau=0.2)
+    >>> bool((run.pp_times == same.pp_times).all() and (run.samples == same.samples).all())
+    True
     """
+    if not isinstance(return_run, bool | np.bool_):
+        raise TypeError(f"return_run must be a bool, got {type(return_run).__name__}")
+    res, run, _ = _lyapunov(
+        system, r, n_steps=n_steps, tau=tau, sampling=sampling, rule=rule, track=track,
+        kicks=kicks, kick_angles=kick_angles, kick_angle=kick_angle, sigma=sigma, rng=rng,
+        method=method, variant=variant, d0=d0, max_defer=max_defer, e0=e0, partner=partner,
+        return_run=bool(return_run), t_continue=0.0,
+    )
+    return (res, run) if return_run else res
+
+
+def lyapunov_pass(system, r=None, *, t_continue=0.0, **options):
+    """`lyapunov` with ``return_run=True``, and the two-disk run continued: for the sweep.
+
+    Returns ``(result, run, pp_times)``. With two disks, ``sampling="paper"`` and a run
+    that ends before ``t_continue``, the event loop goes on (no samples, no tangent work)
+    to ``t_continue`` and ``pp_times`` holds the disk-disk times up to it, bitwise those
+    of ``simulate_two_particle(ic, r, t_max=t_continue, rule=rule).pp_times``; otherwise
+    ``pp_times`` is ``run.pp_times`` (``None`` for one disk).
+    """
+    t_continue = chk.check_real("t_continue", t_continue, low=0.0, low_open=False)
+    return _lyapunov(system, r, return_run=True, t_continue=t_continue, **options)
+
+
+def _lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rule="mirror",
+              track=0, kicks=None, kick_angles=None, kick_angle="uniform", sigma=1.0, rng=None,
+              method="tangent", variant="norm", d0=None, max_defer=10, e0=None,
+              partner="weighted", return_run=False, t_continue=0.0):
+    """`lyapunov`'s body: ``(result, run or None, pp_times or None)``."""
     if isinstance(system, TwoParticleRun | OneParticleRun):
         run = system
         if run.sampling is None:
@@ -288,6 +346,10 @@ def lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rule
             system = run.ic
     chk.check_choice("method", method, METHODS)
     chk.check_choice("variant", variant, VARIANTS)
+    if return_run and method != "tangent":
+        raise ValueError("return_run=True needs method='tangent' (the one-pass kernels carry "
+                         "tangent vectors; for the twin method call simulate_two_particle / "
+                         f"simulate_one_particle and lyapunov separately), got method={method!r}")
     if method == "twin":
         d0 = D0_DEFAULT if d0 is None else chk.check_real(
             "d0", d0, low=D0_RANGE[0], high=D0_RANGE[1], low_open=False, high_open=False)
@@ -317,12 +379,15 @@ def lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rule
         st = np.zeros(11)
         st[1:9] = ic.ravel()
         st[10] = (ic[:, 2:] ** 2).sum()
+        if return_run:
+            return _pass_two(ic, r, rule, sampling, mode, n_steps, tau, track, variant,
+                             max_events, t_continue)
         if method == "tangent":
             U = _start_vectors(variant, 8, 4 * track)
             out = tangent_two_kernel(st, rho, sig, chk.RULES[rule], mode, n_steps, tau, U,
                                      max_events, 0)
             return _tangent_result(out, U, (4 * track, 4 * track + 1), variant, horizon,
-                                   max_events)
+                                   max_events), None, None
         o = track
 
         def ok(dx, dy):
@@ -333,14 +398,14 @@ def lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rule
         offsets, measure = _twin_offsets(variant, d0, ok)
         out = ftle_two_kernel(st, rho, sig, chk.RULES[rule], mode, n_steps, tau, track, offsets,
                               measure, d0, max_defer, max_events)
-        return _twin_result(out, variant, d0, horizon, max_events)
+        return _twin_result(out, variant, d0, horizon, max_events), None, None
     if arr.shape != (4,):
         raise ValueError(f"system must have shape (2, 4) or (4,), got {arr.shape}")
     r = chk.check_real("r", r, low=0.0, high=1.0)
     chk.check_choice("kick_angle", kick_angle, KICK_ANGLES)
     sigma = chk.check_real("sigma", sigma, low=0.0)
     state = check_one_particle_state(arr, r, name="system")
-    sp, _, _, _ = check_scatter_options(state, r, kick_angle, rule, e0, partner)
+    sp, rule, e0, partner = check_scatter_options(state, r, kick_angle, rule, e0, partner)
     times, angles, _ = resolve_kicks(kicks, kick_angles, kick_angle=kick_angle, sigma=sigma,
                                      rng=rng, horizon=horizon,
                                      t_max=horizon if mode == 1 else None)
@@ -355,15 +420,92 @@ def lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rule
         kick_u = np.zeros((0, 2))
     if method == "tangent":
         U = _start_vectors(variant, 4, 0)
+        if return_run:
+            return _pass_one(st, state, r, times, angles, kick_u, sp, mode, n_steps, tau, U,
+                             variant, max_events, sampling=sampling, kick_angle=kick_angle,
+                             sigma=sigma, rule=rule, e0=e0, partner=partner)
         out = tangent_one_kernel(st, rho, times, angles, KICK_ANGLES[kick_angle], mode, n_steps,
                                  tau, U, max_events, kick_u, sp)
-        return _tangent_result(out, U, (0, 1), variant, horizon, max_events)
+        return _tangent_result(out, U, (0, 1), variant, horizon, max_events), None, None
     offsets, measure = _twin_offsets(
         variant, d0, lambda dx, dy: math.hypot(state[0] + dx, state[1] + dy) <= rho
     )
     out = ftle_one_kernel(st, rho, times, angles, KICK_ANGLES[kick_angle], mode, n_steps, tau,
                           offsets, measure, d0, max_defer, max_events, kick_u, sp)
-    return _twin_result(out, variant, d0, horizon, max_events)
+    return _twin_result(out, variant, d0, horizon, max_events), None, None
+
+
+def _pass_two(ic, r, rule, sampling, mode, n_steps, tau, track, variant, max_ev_tan,
+              t_continue):
+    """The two-disk run and its tangent FTLE from one pass (`simulate_tangent_two_kernel`)."""
+    args = kernel_args(ic, r, rule, mode, n_steps * tau if mode == 1 else None, n_steps, tau,
+                       track, None)
+    U = _start_vectors(variant, 8, 4 * track)
+    (pp, n_pp_run, bt, bp, bx, by, bs, stimes, samples, t_end, status, log_scale, n_resc,
+     n_pert, t_tan, status_tan, status_cont) = simulate_tangent_two_kernel(
+        *args, U, max_ev_tan, t_continue if mode == 2 else 0.0)
+    # errors in the order of separate calls: the simulation's, the FTLE's, the continuation's
+    out = (pp[:n_pp_run], bt, bp, bx, by, bs, stimes, samples, t_end, np.empty((0, 12)), status)
+    run = two_particle_run(out, args, r=r, rule=rule, sampling=sampling, tau=tau,
+                           n_steps=n_steps, ic=ic, track=track, seed=None, name="system")
+    horizon = n_steps * tau
+    res = _tangent_result((log_scale, n_resc, n_pert, t_tan, status_tan), U,
+                          (4 * track, 4 * track + 1), variant, horizon, max_ev_tan)
+    if status_cont != DONE:
+        raise_for_status(status_cont, t_continue, pp.shape[0], max_events=args[11],
+                         name="system", where=f"continuing the run to t = {t_continue!r}")
+    return res, run, pp
+
+
+def _pass_one(st, state, r, times, angles, kick_u, sp, mode, n_steps, tau, U, variant,
+              max_ev_tan, *, sampling, kick_angle, sigma, rule, e0, partner):
+    """The kicked run and its tangent FTLE from one pass (`simulate_tangent_one_kernel`).
+
+    The simulation's setup is `simulate_one_particle`'s (its speed bound, event budget,
+    buffer size and stall time); tests/test_lyapunov.py checks that the two agree.
+    """
+    scatter = kick_angle == "scatter"
+    rho = 1.0 - r
+    horizon = n_steps * tau
+    speed = math.sqrt(st[6])
+    if scatter and sp[1] != 0.0:
+        # elastic scattering can give the disk all of the pair's energy
+        speed = max(speed, math.sqrt(2.0 * sp[2]))
+    max_events = chk.event_budget(None, horizon=horizon,
+                                  horizon_name="t_max" if mode < 2 else "n_steps * tau",
+                                  speed=speed, rho=rho, n_disks=1)
+    (bt, bx, by, bs, stimes, samples, n_applied, t_end, klog, status, log_scale, n_resc,
+     n_kicks, t_tan, status_tan) = simulate_tangent_one_kernel(
+        st, rho, times, angles, KICK_ANGLES[kick_angle], horizon if mode == 1 else 0.0, mode,
+        n_steps, tau, int(2.0 * speed * horizon / rho) + 64, kick_u, sp, max_events,
+        chk.stall_time(rho, speed), U, max_ev_tan)
+    raise_for_status(status, st[0], bt.shape[0], max_events=max_events, name="system",
+                     where=f"disk at ({st[1]:.6g}, {st[2]:.6g}), r={r!r}")
+    applied = kick_u if scatter else angles
+    run = OneParticleRun(
+        r=r,
+        t_max=float(t_end),
+        sampling=sampling,
+        tau=tau,
+        n_steps=n_steps,
+        ic=state,
+        final_state=st[1:5].copy(),
+        boundary_log=BoundaryLog(bt, np.zeros(bt.shape[0], dtype=np.int8), bx, by, bs),
+        sample_times=stimes,
+        samples=samples,
+        seed=None,
+        kick_angle=kick_angle,
+        sigma=sigma if kick_angle == "gaussian" else None,
+        kick_times=times[:n_applied],
+        kick_angles=applied[:n_applied],
+        rule=rule,
+        e0=e0,
+        partner=partner,
+        kick_log_array=klog,
+    )
+    res = _tangent_result((log_scale, n_resc, n_kicks, t_tan, status_tan), U, (0, 1), variant,
+                          horizon, max_ev_tan)
+    return res, run, None
 
 
 @dataclass(frozen=True)

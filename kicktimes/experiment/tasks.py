@@ -201,6 +201,12 @@ def _lyapunov():
     return lyapunov
 
 
+def _lyapunov_pass():
+    from kicktimes.diagnostics.lyapunov import lyapunov_pass
+
+    return lyapunov_pass
+
+
 def _run_ic(exp: Experiment, r: float, ic_index: int, ic: np.ndarray, rows, coll, timer):
     from kicktimes.billiard.one_particle import draw_kick_angles, simulate_one_particle
     from kicktimes.billiard.two_particle import simulate_two_particle
@@ -244,8 +250,23 @@ def _run_ic(exp: Experiment, r: float, ic_index: int, ic: np.ndarray, rows, coll
             add(system, "lyapunov_n_renorm", res.n_renorm)
             add(system, "lyapunov_n_forced", res.n_forced)
 
-    with timer("simulation_two_particle"):
-        two = simulate_two_particle(ic, r, rule=exp.rule, track=0, seed=exp.seed, **steps)
+    # One pass per trajectory: with the tangent FTLE among the diagnostics, one event loop
+    # gives each run and its exponent (and, for the actual-time systems, the two-disk
+    # collision times beyond the sampled window), bitwise what separate calls give; its
+    # time is recorded under "lyapunov_*" (simulation + FTLE)
+    one_pass = "lyapunov" in diags and exp.lyapunov_method == "tangent"
+    horizon = exp.horizon
+    continued = None
+    two_pass = one_pass and "two_particle" in exp.systems
+    if two_pass:
+        with timer("lyapunov_two_particle"):
+            res_two, two, continued = _lyapunov_pass()(
+                ic, r, rule=exp.rule, track=0, variant=exp.lyapunov_variant, method="tangent",
+                t_continue=horizon if exp.sampling == "paper" else 0.0, **steps,
+            )
+    else:
+        with timer("simulation_two_particle"):
+            two = simulate_two_particle(ic, r, rule=exp.rule, track=0, seed=exp.seed, **steps)
     n_b0 = int(np.count_nonzero(two.boundary_log.particle == 0))
     coll.append((r, ic_index, two.t_max, two.n_pp, np.array(two.pp_times, dtype=np.float64)))
     if "two_particle" in exp.systems:
@@ -255,13 +276,12 @@ def _run_ic(exp: Experiment, r: float, ic_index: int, ic: np.ndarray, rows, coll
         diagnose(
             "two_particle",
             two,
-            lambda: _lyapunov()(
+            (lambda: res_two) if two_pass else lambda: _lyapunov()(
                 ic, r, rule=exp.rule, track=0, variant=exp.lyapunov_variant, **ftle_method,
                 **steps,
             ),
         )
 
-    horizon = exp.horizon
     actual_times = None
     for system in ("poisson", "actual", "poisson_scatter", "actual_scatter"):
         if system not in exp.systems:
@@ -270,42 +290,39 @@ def _run_ic(exp: Experiment, r: float, ic_index: int, ic: np.ndarray, rows, coll
         rng = kick_rng(exp.seed, ic_index, r, system)
         if system.startswith("actual"):
             if actual_times is None:
-                with timer("simulation_two_particle"):
-                    actual_times = _actual_times(exp, ic, r, two)
+                if continued is not None:
+                    # the one pass went on to the horizon (_actual_times' continuation)
+                    actual_times = np.array(continued, dtype=np.float64)
+                else:
+                    with timer("simulation_two_particle"):
+                        actual_times = _actual_times(exp, ic, r, two)
             kick_times = actual_times
         with timer("simulation_one_particle"):
             if system.startswith("poisson"):
                 rate = two.n_pp / two.t_max
                 kick_times = Poisson(rate).sample(horizon, rng)
             kick_angles = draw_kick_angles(kick_times.size, kick["kick_angle"], exp.sigma, rng)
-            one = simulate_one_particle(
-                ic[0],
-                r,
-                kicks=kick_times,
-                kick_angles=kick_angles,
-                seed=exp.seed,
-                **kick,
-                **steps,
-            )
+        one_kw = {"kicks": kick_times, "kick_angles": kick_angles, **kick, **steps}
+        if one_pass:
+            with timer("lyapunov_kicked"):
+                res_one, one = _lyapunov()(ic[0], r, variant=exp.lyapunov_variant,
+                                           method="tangent", return_run=True, **one_kw)
+
+            def ftle(res_one=res_one):
+                return res_one
+        else:
+            with timer("simulation_one_particle"):
+                one = simulate_one_particle(ic[0], r, seed=exp.seed, **one_kw)
+
+            def ftle(one_kw=one_kw):
+                return _lyapunov()(ic[0], r, variant=exp.lyapunov_variant, **ftle_method,
+                                   **one_kw)
         add(system, "t_max", one.t_max)
         if system.startswith("poisson"):
             add(system, "kick_rate", rate)
         add(system, "n_kicks", one.n_kicks)
         add(system, "n_boundary", one.n_boundary)
-        diagnose(
-            system,
-            one,
-            lambda kick_times=kick_times, kick_angles=kick_angles, kick=kick: _lyapunov()(
-                ic[0],
-                r,
-                kicks=kick_times,
-                kick_angles=kick_angles,
-                variant=exp.lyapunov_variant,
-                **ftle_method,
-                **kick,
-                **steps,
-            ),
-        )
+        diagnose(system, one, ftle)
 
 
 def _kick_law(exp: Experiment, system: str, ic: np.ndarray) -> dict:
