@@ -366,9 +366,10 @@ def _pending(experiment, store_path) -> bool:
     return not same or any(t.id not in done for t in experiment.tasks())
 
 
-def _compile_first(workers, kernels=None):
-    """On a cold numba cache, say so once and compile the sweep's kernels up front, the
-    independent groups in parallel (:mod:`kicktimes._compile`)."""
+def _compile_first(workers, kernels=None, *, report=False):
+    """On a cold numba cache, say so once and compile the sweep's kernels (and the
+    report's, with ``report``) up front, the independent groups in parallel
+    (:mod:`kicktimes._compile`)."""
     import os
 
     from kicktimes import _compile
@@ -376,8 +377,9 @@ def _compile_first(workers, kernels=None):
     if kernels is not None:
         _compile.announce(kernels)
         return
-    if _compile.announce():
-        _compile.warm_up(workers or os.cpu_count() or 1)
+    wanted = _compile.SWEEP_KERNELS + (_compile.REPORT_KERNELS if report else ())
+    if _compile.announce(wanted):
+        _compile.warm_up(workers or os.cpu_count() or 1, report=report)
 
 
 _workers_option = click.option(
@@ -533,7 +535,7 @@ def reproduce_command(scale, out, workers, scheduler, progress, wait, pdf):
         )
         pool = None
         if pending:
-            _compile_first(workers)
+            _compile_first(workers, report=True)
             if (workers or os.cpu_count() or 1) > 1:
                 # one pool for both families: each worker starts (imports, loads the
                 # compiled kernels) once

@@ -127,3 +127,39 @@ def test_the_warm_up_groups_compile_every_kernel_a_sweep_task_calls(tmp_path):
     assert [m for m in modules if m.startswith("kicktimes")] == []
     # and the cache probe agrees: nothing is announced as cold on the next run
     assert still_cold == []
+
+
+_REPORT_AFTER_WARM_UP = r"""
+import dataclasses, json, sys
+from numba.core import event
+from kicktimes import _compile
+from kicktimes.experiment import preset, run_experiment
+from kicktimes.report import build_report
+
+_compile._warm_group_two(True)
+_compile._warm_group_one(True)
+exp = dataclasses.replace(preset("quick_b"), n_ics=4, n_steps=300, block_size=2,
+                          radii=[0.01, 0.02])
+run_experiment(exp, sys.argv[1] + "/store", workers=1)
+with event.install_recorder("numba:compile") as rec:
+    build_report(sys.argv[1] + "/store", sys.argv[1] + "/report", workers=1)
+print(json.dumps([sorted({e.data["dispatcher"].py_func.__module__ for _, e in rec.buffer}),
+                  _compile.cold_kernels(_compile.SWEEP_KERNELS + _compile.REPORT_KERNELS)]))
+"""
+
+
+@pytest.mark.slow
+def test_the_reproduce_warm_up_also_compiles_every_kernel_the_report_calls(tmp_path):
+    # `kicktimes reproduce` warms the report's kernels with the sweep's, in the same two
+    # parallel groups; whatever they miss, the report's workers compile on the first run
+    import json
+    import os
+    import subprocess
+    import sys
+
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache"))
+    out = subprocess.run([sys.executable, "-c", _REPORT_AFTER_WARM_UP, str(tmp_path)], env=env,
+                         check=True, capture_output=True, text=True)
+    modules, still_cold = json.loads(out.stdout.strip().splitlines()[-1])
+    assert [m for m in modules if m.startswith("kicktimes")] == []
+    assert still_cold == []
