@@ -82,6 +82,12 @@ class _Real(click.ParamType):
 @click.version_option(__version__, prog_name="kicktimes")
 def main():
     """kicktimes: collision-time processes in circular billiards."""
+    # the command owns its process: freed arrays are kept for reuse instead of being
+    # returned to the system and faulted in again by the next kernel call (the sweep's and
+    # the report's forked workers inherit the setting; see kicktimes._memory)
+    from kicktimes._memory import keep_freed_memory
+
+    keep_freed_memory()
 
 
 # --- simulate command -------------------------------------------------------------------

@@ -10,6 +10,7 @@ import threading
 import time
 from concurrent.futures import FIRST_COMPLETED, Executor, ProcessPoolExecutor, wait
 
+from kicktimes._memory import keep_freed_memory
 from kicktimes.experiment.config import Experiment
 from kicktimes.experiment.store import Store, StoreWriter, load_store
 from kicktimes.experiment.tasks import execute_task
@@ -69,6 +70,13 @@ def _exit_with_parent(parent_pid: int, poll: float = 1.0) -> None:
     threading.Thread(target=watch, name="kicktimes-parent-watch", daemon=True).start()
 
 
+def _worker_init(parent_pid: int) -> None:
+    """Initializer of the local pool's workers: end with the driver
+    (`_exit_with_parent`), keep freed memory for reuse (`keep_freed_memory`)."""
+    _exit_with_parent(parent_pid)
+    keep_freed_memory()
+
+
 def _dask_executor(scheduler: str):
     try:
         from distributed import Client
@@ -91,7 +99,7 @@ def local_pool(workers: int | None = None) -> ProcessPoolExecutor:
     """
     return ProcessPoolExecutor(
         max_workers=workers or os.cpu_count(),
-        initializer=_exit_with_parent,
+        initializer=_worker_init,
         initargs=(os.getpid(),),
     )
 

@@ -11,6 +11,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from kicktimes._memory import keep_freed_memory
+
 if TYPE_CHECKING:  # pandas and scipy load with the sections that use them
     import pandas as pd
 
@@ -135,7 +137,9 @@ class Mapper:
         if self.pool is None:
             from concurrent.futures import ProcessPoolExecutor
 
-            self.pool = ProcessPoolExecutor(max_workers=self.workers)
+            self.pool = ProcessPoolExecutor(
+                max_workers=self.workers, initializer=keep_freed_memory
+            )
         return self.pool
 
     def map(self, fn, jobs):

@@ -11,6 +11,7 @@ import re
 from pathlib import Path
 
 from kicktimes import __version__
+from kicktimes._memory import keep_freed_memory
 from kicktimes.report._cache import atomic_write
 
 __all__ = [
@@ -114,7 +115,8 @@ def render_figures(figs, dpi, *, pdf=False, workers=1):
     _PENDING = figs
     try:
         with ProcessPoolExecutor(
-            max_workers=min(workers, len(figs)), mp_context=mp.get_context("fork")
+            max_workers=min(workers, len(figs)), mp_context=mp.get_context("fork"),
+            initializer=keep_freed_memory,
         ) as ex:
             return list(ex.map(_render_pending, [(k, dpi, pdf) for k in range(len(figs))]))
     finally:

@@ -26,6 +26,7 @@ from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 from kicktimes import __version__
+from kicktimes._memory import keep_freed_memory
 from kicktimes.report._cache import ReportCache, content_key, store_key
 from kicktimes.report._common import (
     Context,
@@ -453,7 +454,9 @@ def build_report(
             # core takes the large one's jobs instead of idling. The pools are forked
             # (cheap), and the results do not depend on the number of processes.
             inner = workers
-            with ProcessPoolExecutor(max_workers=min(workers, len(jobs) or 1)) as ex:
+            with ProcessPoolExecutor(
+                max_workers=min(workers, len(jobs) or 1), initializer=keep_freed_memory
+            ) as ex:
                 futures = {
                     pid: ex.submit(experiment_part, job[:-1] + (inner,))
                     for pid, job in jobs.items()
