@@ -626,23 +626,46 @@ def simulate_one_particle(state, r, *, t_max=None, kicks=None, kick_angle="unifo
     st[1:5] = state
     st[6] = state[2] ** 2 + state[3] ** 2
     scatter = kick_angle == "scatter"
+    rho, max_events, b_cap, stall_dt = kernel_limits(st, r, sp, scatter, horizon, mode,
+                                                     max_events)
+    out = simulate_one_kernel(
+        st, rho, times, np.zeros(times.size) if scatter else angles,
+        KICK_ANGLES[kick_angle], 0.0 if mode == 2 else t_max, mode,
+        n_steps if n_steps is not None else 0, tau if tau is not None else 0.0,
+        b_cap, angles if scatter else np.zeros((0, 2)), sp, max_events, stall_dt,
+    )
+    raise_for_status(out[9], st[0], out[0].shape[0], max_events=max_events, name="state",
+                     where=f"disk at ({st[1]:.6g}, {st[2]:.6g}), r={r!r}")
+    return one_particle_run(st, r, state, out[:9], sampling=sampling, mode=mode, tau=tau,
+                            n_steps=n_steps, seed=seed, kick_angle=kick_angle, sigma=sigma,
+                            times=times, applied=angles, rule=rule, e0=e0, partner=partner)
+
+
+def kernel_limits(st, r, sp, scatter, horizon, mode, max_events=None):
+    """``(rho, max_events, b_cap, stall_dt)`` of a kicked run from the state ``st``.
+
+    The event budget (`event_budget` at the largest speed the disk can reach: elastic
+    scattering can give it all of the pair's energy), the initial size of the boundary
+    log and the stall time, shared by `simulate_one_particle` and the one pass of
+    `kicktimes.diagnostics.lyapunov` so that both set up the very same run.
+    """
     rho = 1.0 - r
     speed = math.sqrt(st[6])
     if scatter and sp[1] != 0.0:
-        # elastic scattering can give the disk all of the pair's energy
         speed = max(speed, math.sqrt(2.0 * sp[2]))
     max_events = chk.event_budget(max_events, horizon=horizon,
                                   horizon_name="t_max" if mode < 2 else "n_steps * tau",
                                   speed=speed, rho=rho, n_disks=1)
-    bt, bx, by, bs, stimes, samples, n_applied, t_end, klog, status = simulate_one_kernel(
-        st, rho, times, np.zeros(times.size) if scatter else angles,
-        KICK_ANGLES[kick_angle], 0.0 if mode == 2 else t_max, mode,
-        n_steps if n_steps is not None else 0, tau if tau is not None else 0.0,
-        int(2.0 * speed * horizon / rho) + 64, angles if scatter else np.zeros((0, 2)), sp,
-        max_events, chk.stall_time(rho, speed),
-    )
-    raise_for_status(status, st[0], bt.shape[0], max_events=max_events, name="state",
-                     where=f"disk at ({st[1]:.6g}, {st[2]:.6g}), r={r!r}")
+    return rho, max_events, int(2.0 * speed * horizon / rho) + 64, chk.stall_time(rho, speed)
+
+
+def one_particle_run(st, r, state, out, *, sampling, mode, tau, n_steps, seed, kick_angle,
+                     sigma, times, applied, rule, e0, partner) -> OneParticleRun:
+    """The `OneParticleRun` of a finished kicked run: ``out`` is the kernel's
+    ``(b_time, b_x, b_y, b_sin, sample_times, samples, n_kicks_applied, t_end,
+    kick_log)``, ``st`` its final state, ``applied`` the kick angles (or, for scattering
+    kicks, their random numbers) of which the first ``n_kicks_applied`` were used."""
+    bt, bx, by, bs, stimes, samples, n_applied, t_end, klog = out
     return OneParticleRun(
         r=r,
         t_max=float(t_end),
@@ -658,7 +681,7 @@ def simulate_one_particle(state, r, *, t_max=None, kicks=None, kick_angle="unifo
         kick_angle=kick_angle,
         sigma=sigma if kick_angle == "gaussian" else None,
         kick_times=times[:n_applied],
-        kick_angles=angles[:n_applied],
+        kick_angles=applied[:n_applied],
         rule=rule,
         e0=e0,
         partner=partner,

@@ -27,9 +27,11 @@ from kicktimes.billiard.one_particle import (
     KICK_ANGLES,
     check_one_particle_state,
     check_scatter_options,
+    kernel_limits,
+    one_particle_run,
     resolve_kicks,
 )
-from kicktimes.billiard.runs import BoundaryLog, OneParticleRun, TwoParticleRun
+from kicktimes.billiard.runs import OneParticleRun, TwoParticleRun
 from kicktimes.billiard.two_particle import (
     DONE,
     check_two_particle_ic,
@@ -461,50 +463,22 @@ def _pass_one(st, state, r, times, angles, kick_u, sp, mode, n_steps, tau, U, va
               max_ev_tan, *, sampling, kick_angle, sigma, rule, e0, partner):
     """The kicked run and its tangent FTLE from one pass (`simulate_tangent_one_kernel`).
 
-    The simulation's setup is `simulate_one_particle`'s (its speed bound, event budget,
-    buffer size and stall time); tests/test_lyapunov.py checks that the two agree.
+    The simulation is set up and recorded by `simulate_one_particle`'s own helpers
+    (`kernel_limits`, `one_particle_run`), so the run is the very one it returns.
     """
     scatter = kick_angle == "scatter"
-    rho = 1.0 - r
     horizon = n_steps * tau
-    speed = math.sqrt(st[6])
-    if scatter and sp[1] != 0.0:
-        # elastic scattering can give the disk all of the pair's energy
-        speed = max(speed, math.sqrt(2.0 * sp[2]))
-    max_events = chk.event_budget(None, horizon=horizon,
-                                  horizon_name="t_max" if mode < 2 else "n_steps * tau",
-                                  speed=speed, rho=rho, n_disks=1)
-    (bt, bx, by, bs, stimes, samples, n_applied, t_end, klog, status, log_scale, n_resc,
-     n_kicks, t_tan, status_tan) = simulate_tangent_one_kernel(
+    rho, max_events, b_cap, stall_dt = kernel_limits(st, r, sp, scatter, horizon, mode)
+    out = simulate_tangent_one_kernel(
         st, rho, times, angles, KICK_ANGLES[kick_angle], horizon if mode == 1 else 0.0, mode,
-        n_steps, tau, int(2.0 * speed * horizon / rho) + 64, kick_u, sp, max_events,
-        chk.stall_time(rho, speed), U, max_ev_tan)
-    raise_for_status(status, st[0], bt.shape[0], max_events=max_events, name="system",
+        n_steps, tau, b_cap, kick_u, sp, max_events, stall_dt, U, max_ev_tan)
+    raise_for_status(out[9], st[0], out[0].shape[0], max_events=max_events, name="system",
                      where=f"disk at ({st[1]:.6g}, {st[2]:.6g}), r={r!r}")
-    applied = kick_u if scatter else angles
-    run = OneParticleRun(
-        r=r,
-        t_max=float(t_end),
-        sampling=sampling,
-        tau=tau,
-        n_steps=n_steps,
-        ic=state,
-        final_state=st[1:5].copy(),
-        boundary_log=BoundaryLog(bt, np.zeros(bt.shape[0], dtype=np.int8), bx, by, bs),
-        sample_times=stimes,
-        samples=samples,
-        seed=None,
-        kick_angle=kick_angle,
-        sigma=sigma if kick_angle == "gaussian" else None,
-        kick_times=times[:n_applied],
-        kick_angles=applied[:n_applied],
-        rule=rule,
-        e0=e0,
-        partner=partner,
-        kick_log_array=klog,
-    )
-    res = _tangent_result((log_scale, n_resc, n_kicks, t_tan, status_tan), U, (0, 1), variant,
-                          horizon, max_ev_tan)
+    run = one_particle_run(st, r, state, out[:9], sampling=sampling, mode=mode, tau=tau,
+                           n_steps=n_steps, seed=None, kick_angle=kick_angle, sigma=sigma,
+                           times=times, applied=kick_u if scatter else angles, rule=rule,
+                           e0=e0, partner=partner)
+    res = _tangent_result(out[10:], U, (0, 1), variant, horizon, max_ev_tan)
     return res, run, None
 
 
