@@ -50,7 +50,7 @@ _DENSE_CELLS_PER_POINT = 8
 _DENSE_CELLS_MIN = 2**16
 
 # Modes of the pair sweep: count the pairs, or also collect them into a buffer.
-# (The line statistics of `rqa` have their own kernel, `_sweep_lines`.)
+# (The line statistics of `rqa` have their own kernels, `_sweep_lines` and `_sweep_lines_dense`.)
 _COUNT, _COLLECT = 0, 1
 
 
