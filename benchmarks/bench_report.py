@@ -11,6 +11,9 @@ Run: ``python benchmarks/bench_report.py [--stores A B] [--skip-renewal] [--sequ
    ``workers=2``, same run: wall and CPU seconds (this process and its children), and the
    report's stage table of the parallel build. ``--skip-renewal`` leaves out the renewal
    model fits (their own benchmark is ``bench_stats.py``).
+3. Figure rendering: the same builds (``workers=1``) with ``savefig`` (two draws per
+   figure: a layout pass, then the real one) and with the report's one Agg draw,
+   alternating, rendering seconds summed per build; the PNG bytes are compared.
 
 Wall times depend on what else runs on the machine: the load average is printed, and the
 CPU seconds are the figure to compare between runs on a busy machine.
@@ -120,6 +123,53 @@ def bench_build(paths, out_root, skip_renewal):
     )
 
 
+def bench_render(paths, out_root, rounds=2):
+    """The report's figures drawn by ``savefig`` (two draws: a layout pass, then the real
+    one) against one Agg draw (`kicktimes.report.html._png`): builds of the same stores
+    with ``workers=1``, alternating, summing each build's rendering time; the PNG bytes
+    of the two methods are compared."""
+    import io
+
+    from kicktimes.report import build_report, html
+
+    one_draw = html._png
+
+    def savefig(fig, dpi):
+        buf = io.BytesIO()
+        fig.savefig(buf, format="png", dpi=dpi)
+        return buf.getvalue()
+
+    seconds = {"savefig": [], "one draw": []}
+    pngs = {}
+    try:
+        for k in range(rounds):
+            for name, fun in (("savefig", savefig), ("one draw", one_draw)):
+                spent, out = [0.0], []
+
+                def timed(fig, dpi, fun=fun, spent=spent, out=out):
+                    t0 = time.perf_counter()
+                    png = fun(fig, dpi)
+                    spent[0] += time.perf_counter() - t0
+                    out.append(png)
+                    return png
+
+                html._png = timed
+                build_report(paths, out_root / f"render-{k}", force=True, workers=1)
+                seconds[name].append(spent[0])
+                pngs[name] = out
+    finally:
+        html._png = one_draw
+    n = len(pngs["one draw"])
+    same = pngs["savefig"] == pngs["one draw"]
+    print()
+    print(f"figure rendering: {n} figures, builds with workers=1, {rounds} alternating rounds")
+    for name, values in seconds.items():
+        print(f"  {name:<10} " + "  ".join(f"{v:6.2f} s" for v in values))
+    best = {name: min(values) for name, values in seconds.items()}
+    print(f"  savefig / one draw (best of each): {best['savefig'] / best['one draw']:.2f}x;"
+          f" PNG bytes identical: {same}")
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--stores", nargs="+", type=Path, default=None, help="stores to report")
@@ -131,6 +181,7 @@ def main():
         tmp = Path(tmp)
         paths = args.stores if args.stores else small_stores(tmp)
         bench_build(paths, tmp, args.skip_renewal)
+        bench_render(paths, tmp)
 
 
 if __name__ == "__main__":
