@@ -57,7 +57,7 @@ def _exit_with_parent(parent_pid: int, poll: float = 1.0) -> None:
         except ProcessLookupError:
             return False
         except PermissionError:
-            pass  # it exists
+            return True  # it exists, under another user
         return True
 
     def watch():
