@@ -14,6 +14,11 @@ registers and the Lyapunov twin runs can reuse the same functions):
 * ``cnt = [n_pp, n_boundary, n_boundary_0, n_boundary_1, seq_hash]`` — event counters
   and an order-sensitive hash of the event sequence (used to tell whether a reference
   and a twin trajectory have processed the same collisions).
+
+The kernels are compiled with ``error_model="numpy"`` (no zero test before each division;
+see `kicktimes.billiard.geometry`): every divisor is a non-zero radius, a contact distance
+``2 r``, a speed of a disk at a wall, or the initial energy, which the input checks make
+positive.
 """
 
 from __future__ import annotations
@@ -40,7 +45,7 @@ from kicktimes.billiard.runs import BoundaryLog, TwoParticleRun
 HASH_MOD = 2305843009213693951  # 2**61 - 1, keeps seq_hash * 8 inside int64
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def init_events_two(st, ev, rho, sigma):
     """Fill ``ev`` with the times from now to the next events of the state ``st``."""
     ev[0] = boundary_hit_time(st[1], st[2], st[3], st[4], rho)
@@ -48,7 +53,7 @@ def init_events_two(st, ev, rho, sigma):
     ev[2] = pair_hit_time(st[1] - st[5], st[2] - st[6], st[3] - st[7], st[4] - st[8], sigma)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def drift_two(st, ev, dt):
     """Free flight of both disks for ``dt``; the clock is summed with Kahan compensation.
 
@@ -69,7 +74,7 @@ def drift_two(st, ev, dt):
 
 
 # inlined (numba IR): as a call, every event spilled the loop's state around it (2% of a run)
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def wall_event(x, y, vx, vy, rho, rule):
     """Boundary collision of a disk at ``(x, y)`` on ``|x| = rho`` (up to the flight's round-off).
 
@@ -116,7 +121,7 @@ def wall_event(x, y, vx, vy, rho, rule):
     return x, y, vx, vy, t_next, sin_theta
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def pair_event(x0, y0, vx0, vy0, x1, y1, vx1, vy1, rule):
     """Velocities ``(vx0, vy0, vx1, vy1)`` after a disk-disk collision of disks in contact."""
     dx = x0 - x1
@@ -132,7 +137,7 @@ def pair_event(x0, y0, vx0, vy0, x1, y1, vx1, vy1, rule):
     return collide_elastic(vx0, vy0, vx1, vy1, nx, ny)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def anchor_energy(vx0, vy0, vx1, vy1, e0):
     """The four velocity components rescaled to kinetic energy ``e0`` (one Newton step).
 
@@ -144,7 +149,7 @@ def anchor_energy(vx0, vy0, vx1, vy1, e0):
     return vx0 * f, vy0 * f, vx1 * f, vy1 * f
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def process_event_two(st, ev, k, rho, sigma, rule):
     """Fly both disks to event ``k`` and apply it; returns the incoming ``sin_theta``.
 
@@ -178,7 +183,7 @@ def process_event_two(st, ev, k, rho, sigma, rule):
     return sin_theta
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def next_event_two(ev):
     """Index (0, 1: boundary of that disk; 2: disk-disk) and time to the next event."""
     k = 0
@@ -192,7 +197,7 @@ def next_event_two(ev):
     return k, dt
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def finish_at(st, ev, t_end):
     """Fly to ``t_end`` (no event before it) and set the clock to exactly ``t_end``."""
     drift_two(st, ev, t_end - st[0])
@@ -200,7 +205,7 @@ def finish_at(st, ev, t_end):
     st[9] = 0.0
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _grow_to(a, limit):
     """``a`` copied into a buffer twice as long, but no longer than ``limit`` (> len(a)).
 
@@ -213,7 +218,7 @@ def _grow_to(a, limit):
     return out
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _grow_rows_to(a, limit):
     """Rows of ``a`` copied into a buffer twice as long, but no longer than ``limit``."""
     out = np.empty((min(2 * a.shape[0] + 16, limit), a.shape[1]), dtype=a.dtype)
@@ -227,7 +232,7 @@ def _grow_rows_to(a, limit):
 DONE, FULL, STALLED, OVER_BUDGET = 0, 1, 2, 3
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _stalled(times, n, stall_dt):
     """True if the last `STALL_EVENTS` of the ``n`` logged ``times`` are less than
     ``stall_dt`` apart on average: the run makes no progress (e.g. disks jammed against
@@ -238,7 +243,7 @@ def _stalled(times, n, stall_dt):
     return times[n - 1] - times[n - STALL_EVENTS] < STALL_EVENTS * stall_dt
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _event_loop_two(st, ev, rho, sigma, rule, t_end, mode, tau, track, pp, bt, bp, bx, by, bs,
                     stimes, samples, cnt, next_s, log_pp, ppl):
     """The logging/sampling event loop; returns `DONE` or `FULL` (a buffer is full).
@@ -391,7 +396,7 @@ def _event_loop_two(st, ev, rho, sigma, rule, t_end, mode, tau, track, pp, bt, b
     return status
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def simulate_two_kernel(st, rho, sigma, rule, t_max, mode, n_steps, tau, track, pp_cap, b_cap,
                         max_events, stall_dt, log_pp=False):
     """Run the two-disk billiard, logging every event and sampling the tracked disk.
