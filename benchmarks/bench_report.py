@@ -170,6 +170,32 @@ def bench_render(paths, out_root, rounds=2):
           f" PNG bytes identical: {same}")
 
 
+def bench_inner(paths, out_root, rounds=3):
+    """Nested pools (each part's own pools as wide as the machine) against
+    `pipeline._inner_workers`, ``workers=2``, alternating."""
+    from kicktimes.report import build_report, pipeline
+
+    rule = pipeline._inner_workers
+    chosen = rule(2, [pipeline._read_manifest(p) for p in paths])
+    runs = {"inner pools": [], "rule": []}
+    try:
+        for k in range(rounds):
+            for name in runs:
+                pipeline._inner_workers = (lambda w, m: w) if name == "inner pools" else rule
+                c0, t0 = cpu_seconds(), time.perf_counter()
+                build_report(paths, out_root / f"inner-{k}", force=True, workers=2,
+                             progress=False)
+                runs[name].append((time.perf_counter() - t0, cpu_seconds() - c0))
+    finally:
+        pipeline._inner_workers = rule
+    print()
+    print(f"pools inside the parts, workers=2, {rounds} alternating rounds "
+          f"(the rule gives inner = {chosen} for these stores)")
+    for name, values in runs.items():
+        print(f"  {name:<12} wall " + "  ".join(f"{w:6.2f}" for w, _ in values)
+              + "   CPU " + "  ".join(f"{c:6.2f}" for _, c in values))
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--stores", nargs="+", type=Path, default=None, help="stores to report")
@@ -182,6 +208,7 @@ def main():
         paths = args.stores if args.stores else small_stores(tmp)
         bench_build(paths, tmp, args.skip_renewal)
         bench_render(paths, tmp)
+        bench_inner(paths, tmp)
 
 
 if __name__ == "__main__":

@@ -431,3 +431,17 @@ def test_one_draw_png_is_byte_identical_to_savefig():
     fig = figure()
     assert _png(fig, 150) == buf.getvalue()
     assert fig.dpi == 100  # the figure's own dpi is restored
+
+
+def test_parts_of_about_equal_size_get_no_pools_of_their_own():
+    from kicktimes.report.pipeline import _inner_workers
+
+    def manifest(n_radii, n_ics, n_steps):
+        return {"experiment": {"radii": [0.01] * n_radii, "n_ics": n_ics, "n_steps": n_steps}}
+
+    quick = [manifest(4, 20, 2000), manifest(4, 20, 2000)]
+    paper = [manifest(12, 200, 25000), manifest(10, 1000, 15000)]
+    assert _inner_workers(2, quick) == 1  # one part per core: nested pools only add forks
+    assert _inner_workers(2, paper) == 2  # unequal: the small part's core helps the large
+    assert _inner_workers(4, quick) == 4  # more cores than parts
+    assert _inner_workers(2, quick[:1]) == 2  # one part to rebuild

@@ -126,6 +126,27 @@ def _preload():
     pomeranz_cdf(10, 0.3)
 
 
+def _inner_workers(workers, manifests):
+    """Processes of each part's own pools when the parts run in parallel.
+
+    As wide as the machine when the parts are unequal (the paper's family B has 2.5x the
+    samples of A): when the small part is done, its core takes the large one's jobs
+    instead of idling. When the parts are about equal (within 2x) and at least as many as
+    the workers, every core already has a part, and the pools would only add processes
+    (16 for the quick report instead of 2), each fork of a part worker costing CPU
+    (copy-on-write of its heap): the quick report took 15.4 CPU-s and 9.7 s without them
+    against 17.2 CPU-s and 10.5 s with them (means of 4 alternating builds on 2 cores;
+    benchmarks/bench_report.py, section 4). The results do not depend on it.
+    """
+    work = [
+        len(m["experiment"]["radii"]) * m["experiment"]["n_ics"] * m["experiment"]["n_steps"]
+        for m in manifests
+    ]
+    if len(work) >= workers and max(work) <= 2 * min(work):
+        return 1
+    return workers
+
+
 def _read_manifest(path):
     """A store's manifest (cheap: no part file is read); ValueError if not a store."""
     from kicktimes.experiment.store import MANIFEST, _read_manifest
@@ -448,12 +469,9 @@ def build_report(
         bar.advance()
         if parallel:
             _preload()  # before the pool forks: the workers inherit the imports
-            # one worker per part, and each part maps its per-radius jobs (Poisson tests,
-            # renewal fits) over a pool of its own as wide as the machine: the parts are
-            # unequal (family B has 5x the ICs of A), so when the small one is done its
-            # core takes the large one's jobs instead of idling. The pools are forked
-            # (cheap), and the results do not depend on the number of processes.
-            inner = workers
+            # one worker per part; each part maps its per-radius jobs (Poisson tests,
+            # renewal fits) and renders its figures on pools of its own
+            inner = _inner_workers(workers, [manifests[k] for k in todo])
             with ProcessPoolExecutor(
                 max_workers=min(workers, len(jobs) or 1), initializer=keep_freed_memory
             ) as ex:
@@ -466,7 +484,7 @@ def build_report(
                     # first part done (the smaller family), and renders on processes forked
                     # from that single-threaded worker, not from this process, whose pool
                     # threads a fork would copy
-                    fam = ex.submit(families_part, paths, out, render, workers)
+                    fam = ex.submit(families_part, paths, out, render, inner)
                     bar.step("all-experiments figures")
                     parts["families"] = fam.result()
                     bar.advance()
