@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import sys
 
-__all__ = ["cold_kernels", "announce", "warm_up"]
+__all__ = ["cold_kernels", "announce", "warm_up", "warm_report"]
 
 #: (module, kernel, compile seconds measured by benchmarks/bench_compile.py on the
 #: project's 2-core machine, inclusive of the kernels each one calls; the recurrence entry,
@@ -66,13 +66,16 @@ def cold_kernels(kernels=SWEEP_KERNELS) -> list[tuple[str, str, float]]:
     return cold
 
 
-def announce(kernels=SWEEP_KERNELS, *, stream=None) -> float:
+def announce(kernels=SWEEP_KERNELS, *, stream=None, extra_seconds=0.0) -> float:
     """Print "compiling kicktimes' numba kernels (once, about N s)..." to stderr if some
-    of ``kernels`` are not cached; return N (0 when everything is cached)."""
+    of ``kernels`` are not cached; return N (0 when everything is cached). ``extra_seconds``
+    is added to the estimate: kernels compiled elsewhere at the same time (the report's,
+    in `kicktimes reproduce`'s report process), whose modules are too costly to import
+    here just to probe them."""
     cold = cold_kernels(kernels)
     if not cold:
         return 0.0
-    seconds = sum(s for *_, s in cold)
+    seconds = sum(s for *_, s in cold) + extra_seconds
     n = max(5, 5 * round(seconds / 5))
     print(
         f"compiling kicktimes' numba kernels (once, about {n} s)...",
@@ -143,6 +146,14 @@ def _warm_report_one(_):
     rng = np.random.default_rng(0)
     recurrence_pairs(rng.uniform(-1.0, 1.0, (60, 2)), 1e-3)
     compare_models(rng.exponential(size=60), censored=rng.exponential(size=2))
+
+
+def warm_report() -> None:
+    """Load (or compile, on a cold cache) the report's kernels in this process: what
+    `kicktimes reproduce`'s report process does while the sweeps run, so that the report's
+    workers, forked from it, inherit them."""
+    _warm_report_two(None)
+    _warm_report_one(None)
 
 
 def _warm_group_two(report):

@@ -120,3 +120,35 @@ def test_python_dash_m_runs_the_cli():
                          text=True, check=True)
     for command in ("simulate", "schedule", "run", "report", "reproduce"):
         assert command in out.stdout
+
+
+def test_the_report_process_builds_the_report_the_driver_sends(tmp_path):
+    # `reproduce` forks it before the sweeps: it imports the report's modules meanwhile
+    from kicktimes.cli import _ReportProcess
+    from kicktimes.experiment import run_experiment
+
+    exp = Experiment(name="tiny_rp", radii=[0.02], n_ics=2, n_steps=200, tau=0.3,
+                     diagnostics=["recurrence_rate"])
+    run_experiment(exp, tmp_path / "store", workers=1, progress=False)
+    process = _ReportProcess()
+    try:
+        path = process.build([str(tmp_path / "store")], str(tmp_path / "report"), 1, False,
+                             False)
+    finally:
+        process.close()
+    assert path == tmp_path / "report" / "report.html" and path.is_file()
+    assert process._proc.exitcode == 0
+
+
+def test_the_report_process_hands_its_errors_to_the_driver(tmp_path):
+    from kicktimes.cli import _ReportProcess
+
+    process = _ReportProcess()
+    try:
+        with pytest.raises(ValueError, match="is not a kicktimes store"):
+            process.build([str(tmp_path)], str(tmp_path / "report"), 1, False, False)
+    finally:
+        process.close()
+    idle = _ReportProcess()
+    idle.close()  # no job: it ends when the driver closes the pipe
+    assert idle._proc.exitcode == 0

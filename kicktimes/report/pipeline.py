@@ -484,7 +484,7 @@ def build_report(
                     # first part done (the smaller family), and renders on processes forked
                     # from that single-threaded worker, not from this process, whose pool
                     # threads a fork would copy
-                    fam = ex.submit(families_part, paths, out, render, inner)
+                    fam = ex.submit(families_part, paths, out, render, workers)
                     bar.step("all-experiments figures")
                     parts["families"] = fam.result()
                     bar.advance()
