@@ -7,7 +7,9 @@ in milliseconds. On a fresh install the sweep's kernels take tens of seconds to 
 says so once, and compiles two independent groups of kernels of about the same cost (the
 two-disk one-pass kernel, simulation and tangent FTLE in one event loop, with the
 autocorrelation; the kicked disk's one-pass kernel and the recurrence kernels) in two
-processes at the same time instead of one after the other in every worker.
+processes at the same time instead of one after the other in every worker. ``kicktimes
+reproduce`` leaves the report's kernels to its report process (`warm_report`), which
+compiles them at the same time, while the sweep's groups compile.
 """
 
 from __future__ import annotations
@@ -30,10 +32,11 @@ SWEEP_KERNELS = (
     ("kicktimes.diagnostics.autocorrelation", "_acf_segments", 1.5),
 )
 SIMULATE_KERNELS = (("kicktimes.billiard.two_particle", "simulate_two_kernel", 4.5),)
-#: What the report compiles beyond the sweep's kernels (``kicktimes reproduce`` warms both
-#: before its sweeps): the trajectory figures' re-simulation with a collision log, the
-#: recurrence plot's pair sweep (sorted cells, pairs collected), the
-#: hyperexponential EM of the renewal fits, the exact KS law of the Poisson tests.
+#: What the report compiles beyond the sweep's kernels (``kicktimes reproduce``'s report
+#: process warms them while the sweep's compile or run): the trajectory figures'
+#: re-simulation with a collision log, the recurrence plot's pair sweep (sorted cells, pairs
+#: collected), the hyperexponential EM of the renewal fits, the exact KS law of the Poisson
+#: tests.
 REPORT_KERNELS = (
     ("kicktimes.billiard.two_particle", "simulate_two_kernel", 2.0),
     ("kicktimes.diagnostics.recurrence", "_sweep", 1.0),
