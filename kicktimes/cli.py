@@ -469,6 +469,8 @@ def _build_report(stores, out, workers=None, progress=None, pdf=False, force=Fal
 def _report_server(conn, driver_end):
     """Body of `_ReportProcess`: import the report's modules, then build the one report
     the driver sends and send back ``("ok", path)`` or ``("error", exception)``."""
+    import pickle
+
     driver_end.close()  # the fork's copy: else closing the driver's would never reach us
     from kicktimes import _compile
     from kicktimes.report import pipeline
@@ -483,7 +485,14 @@ def _report_server(conn, driver_end):
         result = ("ok", _build_report(*job))
     except BaseException as exc:  # noqa: BLE001  (handed to the driver, which raises it)
         result = ("error", exc)
-    conn.send(result)
+    try:
+        try:
+            conn.send(result)
+        except (TypeError, AttributeError, pickle.PicklingError):  # an unpicklable error
+            exc = result[1]
+            conn.send(("error", RuntimeError(f"{type(exc).__name__}: {exc}")))
+    except OSError:  # the driver is gone (e.g. interrupted): nobody to tell
+        pass
 
 
 class _ReportProcess:

@@ -152,3 +152,21 @@ def test_the_report_process_hands_its_errors_to_the_driver(tmp_path):
     idle = _ReportProcess()
     idle.close()  # no job: it ends when the driver closes the pipe
     assert idle._proc.exitcode == 0
+
+
+def test_an_unpicklable_error_of_the_report_process_still_reaches_the_driver(monkeypatch):
+    from kicktimes import cli
+
+    class LocalError(Exception):  # a local class: pickle cannot name it
+        pass
+
+    def fail(*job):
+        raise LocalError("the figures could not be drawn")
+
+    monkeypatch.setattr(cli, "_build_report", fail)  # the forked process inherits it
+    process = cli._ReportProcess()
+    try:
+        with pytest.raises(RuntimeError, match="LocalError: the figures could not be drawn"):
+            process.build("job")
+    finally:
+        process.close()

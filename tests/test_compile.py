@@ -136,8 +136,10 @@ from kicktimes import _compile
 from kicktimes.experiment import preset, run_experiment
 from kicktimes.report import build_report
 
-_compile._warm_group_two(True)
-_compile._warm_group_one(True)
+# what `kicktimes reproduce` runs: the sweep's two groups, and the report process's warm-up
+_compile._warm_group_two(False)
+_compile._warm_group_one(False)
+_compile.warm_report()
 exp = dataclasses.replace(preset("quick_b"), n_ics=4, n_steps=300, block_size=2,
                           radii=[0.01, 0.02])
 run_experiment(exp, sys.argv[1] + "/store", workers=1)
@@ -150,8 +152,8 @@ print(json.dumps([sorted({e.data["dispatcher"].py_func.__module__ for _, e in re
 
 @pytest.mark.slow
 def test_the_reproduce_warm_up_also_compiles_every_kernel_the_report_calls(tmp_path):
-    # `kicktimes reproduce` warms the report's kernels with the sweep's, in the same two
-    # parallel groups; whatever they miss, the report's workers compile on the first run
+    # `kicktimes reproduce`'s report process warms the report's kernels while the sweep's
+    # compile; whatever they miss, the report's workers compile on the first run
     import json
     import os
     import subprocess
