@@ -503,8 +503,8 @@ class _ReportProcess:
     cache and runs the sweeps, on the core the driver's imports leave idle; the report
     starts at once when the sweeps end, and its workers, forked from this process,
     inherit all of it. Forked before the driver starts any thread or pool. The quick
-    ``reproduce`` took 9.9 s against 10.9 s without it (means of 4 alternating runs on 2
-    cores, with the report's pool rule of this release).
+    ``reproduce`` took 9.8 s against 10.9 s without it (means of 6 alternating runs on 2
+    cores, both with the report's pool rule of this release).
     """
 
     def __init__(self):
