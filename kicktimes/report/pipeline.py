@@ -135,8 +135,9 @@ def _inner_workers(workers, manifests):
     the workers, every core already has a part, and the pools would only add processes
     (16 for the quick report instead of 2), each fork of a part worker costing CPU
     (copy-on-write of its heap): the quick report took 15.4 CPU-s and 9.7 s without them
-    against 17.2 CPU-s and 10.5 s with them (means of 4 alternating builds on 2 cores;
-    benchmarks/bench_report.py, section 4). The results do not depend on it.
+    against 17.2 CPU-s and 10.5 s with them (means of 4 alternating ``kicktimes report
+    --force`` builds on 2 cores; benchmarks/bench_report.py, section 4, alternates the two
+    rules in one process). The results do not depend on it.
     """
     work = [
         len(m["experiment"]["radii"]) * m["experiment"]["n_ics"] * m["experiment"]["n_steps"]
