@@ -39,31 +39,24 @@ def test_the_cache_probe_reads_numbas_index_of_a_real_kernel():
     assert _compile._is_cold(simulate_two_kernel) in (True, False)
 
 
-_RECORD_COMPILES = r"""
-import json
-from numba.core import event
+_SETUP = """
 from kicktimes import initial_conditions, schedules, simulate_one_particle, simulate_two_particle
 from kicktimes.diagnostics import lyapunov
 
 ic = initial_conditions(1, 0.02, seed=0)[0]
-with event.install_recorder("numba:compile") as rec:
-    for rule in ("mirror", "elastic"):
-        for sampling in ("uniform", "paper"):
-            simulate_two_particle(ic, 0.02, rule=rule, sampling=sampling, n_steps=20, tau=0.3)
-    simulate_two_particle(ic, 0.02, t_max=5.0, log_collisions=True)
-    for law in ("uniform", "gaussian", "scatter"):
-        run = simulate_one_particle(ic[0], 0.02, n_steps=20, tau=0.3, kick_angle=law,
-                                    kicks=schedules.Poisson(0.5), rng=0)
-        lyapunov(run)
-        lyapunov(run, method="twin")
-    lyapunov(ic, 0.02, n_steps=20, tau=0.3)
-    lyapunov(ic, 0.02, n_steps=20, tau=0.3, method="twin")
-sigs = {}
-for _, ev in rec.buffer:
-    if ev.is_start:
-        f = ev.data["dispatcher"].py_func
-        sigs.setdefault(f"{f.__module__}.{f.__qualname__}", []).append(str(ev.data["args"]))
-print(json.dumps(sigs))
+"""
+_CALLS = """
+for rule in ("mirror", "elastic"):
+    for sampling in ("uniform", "paper"):
+        simulate_two_particle(ic, 0.02, rule=rule, sampling=sampling, n_steps=20, tau=0.3)
+simulate_two_particle(ic, 0.02, t_max=5.0, log_collisions=True)
+for law in ("uniform", "gaussian", "scatter"):
+    run = simulate_one_particle(ic[0], 0.02, n_steps=20, tau=0.3, kick_angle=law,
+                                kicks=schedules.Poisson(0.5), rng=0)
+    lyapunov(run)
+    lyapunov(run, method="twin")
+lyapunov(ic, 0.02, n_steps=20, tau=0.3)
+lyapunov(ic, 0.02, n_steps=20, tau=0.3, method="twin")
 """
 
 
@@ -73,15 +66,9 @@ def test_simulator_and_ftle_kernels_compile_once_without_error_strings(tmp_path)
     # kernel must compile one signature (literal int/bool arguments would add more), and
     # none may pull in numba's string formatting (error messages of slice assignments
     # or of raise with formatted text cost seconds of compilation).
-    import json
-    import os
-    import subprocess
-    import sys
+    from _compile_record import compiled_signatures, string_formatting
 
-    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path))
-    out = subprocess.run([sys.executable, "-c", _RECORD_COMPILES], env=env, check=True,
-                         capture_output=True, text=True)
-    sigs = json.loads(out.stdout.strip().splitlines()[-1])
+    sigs = compiled_signatures(_SETUP, _CALLS, tmp_path)
     ours = {name: s for name, s in sigs.items() if name.startswith("kicktimes.")}
     assert "kicktimes.billiard.two_particle.simulate_two_kernel" in ours
     # the buffer growth is generic over the dtype: the int8 particle column and the floats
@@ -89,8 +76,7 @@ def test_simulator_and_ftle_kernels_compile_once_without_error_strings(tmp_path)
                if len(s) > 1 and name != "kicktimes.billiard.two_particle._grow_to"}
     assert several == {}
     assert len(ours["kicktimes.billiard.two_particle._grow_to"]) <= 2
-    strings = [name for name in sigs if "unicode" in name or "raise_with_shape" in name
-               or "ol_str_generic" in name]
+    strings = string_formatting(sigs)
     assert strings == []
 
 

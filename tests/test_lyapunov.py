@@ -289,35 +289,28 @@ def test_the_continued_pass_has_the_collision_times_of_a_fresh_run_to_the_horizo
         assert same.tobytes() == uni.pp_times.tobytes()
 
 
-_RECORD_ONE_PASS_COMPILES = r"""
-import json
+_ONE_PASS_SETUP = """
 import numpy as np
-from numba.core import event
 from kicktimes import initial_conditions, schedules
 from kicktimes.diagnostics import lyapunov
 from kicktimes.diagnostics.lyapunov import lyapunov_pass
 
 ic = initial_conditions(1, 0.02, seed=0)[0]
-with event.install_recorder("numba:compile") as rec:
-    for rule in ("mirror", "elastic"):
-        for sampling in ("uniform", "paper"):
-            for variant in ("norm", "paper"):
-                lyapunov(ic, 0.02, rule=rule, sampling=sampling, variant=variant, n_steps=20,
-                         tau=0.3, return_run=True)
-        lyapunov_pass(ic, 0.02, rule=rule, sampling="paper", n_steps=20, tau=0.3,
-                      t_continue=30.0)
-    for law in ("uniform", "gaussian", "scatter"):
-        for sampling in ("uniform", "paper"):
-            lyapunov(ic[0], 0.02, n_steps=20, tau=0.3, kick_angle=law, sampling=sampling,
-                     kicks=schedules.Poisson(0.5), rng=0, return_run=True)
-        lyapunov(ic[0], 0.02, n_steps=20, tau=0.3, kick_angle=law, kicks=np.empty(0),
-                 return_run=True)
-sigs = {}
-for _, ev in rec.buffer:
-    if ev.is_start:
-        f = ev.data["dispatcher"].py_func
-        sigs.setdefault(f"{f.__module__}.{f.__qualname__}", []).append(str(ev.data["args"]))
-print(json.dumps(sigs))
+"""
+_ONE_PASS_CALLS = """
+for rule in ("mirror", "elastic"):
+    for sampling in ("uniform", "paper"):
+        for variant in ("norm", "paper"):
+            lyapunov(ic, 0.02, rule=rule, sampling=sampling, variant=variant, n_steps=20,
+                     tau=0.3, return_run=True)
+    lyapunov_pass(ic, 0.02, rule=rule, sampling="paper", n_steps=20, tau=0.3,
+                  t_continue=30.0)
+for law in ("uniform", "gaussian", "scatter"):
+    for sampling in ("uniform", "paper"):
+        lyapunov(ic[0], 0.02, n_steps=20, tau=0.3, kick_angle=law, sampling=sampling,
+                 kicks=schedules.Poisson(0.5), rng=0, return_run=True)
+    lyapunov(ic[0], 0.02, n_steps=20, tau=0.3, kick_angle=law, kicks=np.empty(0),
+             return_run=True)
 """
 
 
@@ -325,21 +318,14 @@ print(json.dumps(sigs))
 def test_one_pass_kernels_compile_once_without_error_strings(tmp_path):
     # as tests/test_compile.py checks for the simulators: one signature per kernel whatever
     # the rule, sampling, variant or kick law, and no numba string formatting
-    import json
-    import os
-    import subprocess
-    import sys
+    from _compile_record import compiled_signatures, string_formatting
 
-    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path))
-    out = subprocess.run([sys.executable, "-c", _RECORD_ONE_PASS_COMPILES], env=env, check=True,
-                         capture_output=True, text=True)
-    sigs = json.loads(out.stdout.strip().splitlines()[-1])
+    sigs = compiled_signatures(_ONE_PASS_SETUP, _ONE_PASS_CALLS, tmp_path)
     ours = {name: s for name, s in sigs.items() if name.startswith("kicktimes.")}
     assert "kicktimes.diagnostics._tangent_run.simulate_tangent_two_kernel" in ours
     assert "kicktimes.diagnostics._tangent_run.simulate_tangent_one_kernel" in ours
     several = {name: s for name, s in ours.items()
                if len(s) > 1 and name != "kicktimes.billiard.two_particle._grow_to"}
     assert several == {}
-    strings = [name for name in sigs if "unicode" in name or "raise_with_shape" in name
-               or "ol_str_generic" in name]
+    strings = string_formatting(sigs)
     assert strings == []
