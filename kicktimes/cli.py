@@ -386,14 +386,11 @@ def _compile_first(workers, kernels=None, *, report=False, report_process=False)
     if kernels is not None:
         _compile.announce(kernels)
         return
-    if report and report_process:
-        extra = sum(s for *_, s in _compile.REPORT_KERNELS)
-        if _compile.announce(_compile.SWEEP_KERNELS, extra_seconds=extra):
-            _compile.warm_up(workers or os.cpu_count() or 1)
-        return
-    wanted = _compile.SWEEP_KERNELS + (_compile.REPORT_KERNELS if report else ())
-    if _compile.announce(wanted):
-        _compile.warm_up(workers or os.cpu_count() or 1, report=report)
+    here = report and not report_process
+    elsewhere = sum(s for *_, s in _compile.REPORT_KERNELS) if report and report_process else 0
+    wanted = _compile.SWEEP_KERNELS + (_compile.REPORT_KERNELS if here else ())
+    if _compile.announce(wanted, extra_seconds=elsewhere):
+        _compile.warm_up(workers or os.cpu_count() or 1, report=here)
 
 
 _workers_option = click.option(
