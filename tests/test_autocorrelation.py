@@ -8,6 +8,8 @@ import warnings
 import numpy as np
 import pandas as pd
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as hs
 from numpy.testing import assert_allclose, assert_array_equal
 from statsmodels.tsa.stattools import acf
 
@@ -326,6 +328,27 @@ def test_real_run_records_work():
     assert_array_equal(boundary_angles(run), boundary_angles(df, particle=1))
 
 
+@pytest.mark.parametrize("seed", range(6))
+def test_one_pass_selection_gives_what_masking_and_sorting_give(seed):
+    # run records take a one-pass kernel (float64 columns, int8 disks); anything else,
+    # and any record it finds unsorted, takes the general path: both must agree
+    rng = np.random.default_rng(seed)
+    n = int(rng.integers(1, 400))
+    times = np.round(rng.uniform(0.0, 20.0, n), 1)  # ties
+    if seed % 2 == 0:
+        times = np.sort(times)
+    df = pd.DataFrame({"time": times, "particle": rng.integers(0, 2, n).astype(np.int8),
+                       "s": np.zeros(n), "sin_theta": rng.uniform(-1.0, 1.0, n)})
+    for particle in (0, 1):
+        chosen = df[df["particle"] == particle]
+        expected = np.arcsin(chosen["sin_theta"].to_numpy()[
+            np.argsort(chosen["time"].to_numpy(), kind="stable")])
+        got = boundary_angles(_RawRun(df, track=particle))
+        assert_array_equal(got, expected)
+        wide = df.astype({"particle": np.int64})  # not the kernel's dtype: general path
+        assert_array_equal(boundary_angles(wide, particle=particle), expected)
+
+
 def test_round_off_beyond_one_is_clipped_but_real_violations_raise():
     df = pd.DataFrame({"time": [0.0, 1.0], "s": [0.0, 1.0], "sin_theta": [1.0 + 1e-15, -1.0]})
     assert_array_equal(boundary_angles(df), [np.pi / 2, -np.pi / 2])
@@ -394,6 +417,31 @@ def test_curve_is_bitwise_the_lag_by_lag_autocorrelation():
     curve = autocorrelation_function(x, 25)
     assert curve.shape == (25,)
     assert_array_equal(curve, [autocorrelation(x, lag) for lag in range(1, 26)])
+
+
+@settings(max_examples=150, deadline=None)
+@given(
+    n=hs.integers(1, 120),
+    max_lag=hs.integers(1, 40),
+    scale_exp=hs.integers(-200, 200),
+    kind=hs.sampled_from(["noise", "walk", "nearly_constant", "constant"]),
+    seed=hs.integers(0, 2**32 - 1),
+)
+def test_curve_is_bitwise_lag_by_lag_for_any_series(n, max_lag, scale_exp, kind, seed):
+    # the curve shares the sums of squares of all lags (a prefix of blocks); every value
+    # and every NaN must still be exactly what autocorrelation gives lag by lag
+    rng = np.random.default_rng(seed)
+    x = rng.normal(size=n)
+    if kind == "walk":
+        x = np.cumsum(x)
+    elif kind == "nearly_constant":
+        x = 0.3 + 1e-13 * x
+    elif kind == "constant":
+        x = np.full(n, 0.3)
+    x = x * 2.0**scale_exp
+    curve, _ = autocorrelation_function(x, max_lag, return_reason=True)
+    expected = [autocorrelation(x, lag, return_reason=True)[0] for lag in range(1, max_lag + 1)]
+    assert_array_equal(curve.view(np.int64), np.array(expected).view(np.int64))
 
 
 def test_curve_equals_statsmodels_acf():

@@ -269,6 +269,32 @@ def test_recurrence_and_acf_rows_are_the_library_diagnostics_of_the_run():
     assert "acf@6" not in got.index
 
 
+@pytest.mark.parametrize(
+    ("theta", "lag", "max_lag"),
+    [
+        (np.sin(np.arange(300.0)), 1, 20),
+        (np.sin(np.arange(300.0)), 3, 2),  # R_lag beyond the curve: its own call
+        (np.full(40, 0.2), 1, 5),  # constant: NaN with the reason
+        (np.array([0.1, -0.4, 0.3]), 2, 6),  # short: NaN beyond N - 1
+        (np.array([0.5]), 1, 3),
+    ],
+)
+def test_acf_rows_take_r_lag_from_the_curve_exactly(theta, lag, max_lag):
+    # the rows compute one curve and read R_lag off it: value and note must be what
+    # the public functions give
+    from kicktimes.diagnostics import autocorrelation, autocorrelation_function
+    from kicktimes.experiment.tasks import autocorrelation_rows
+
+    rows = {name: (value, note) for name, value, note in
+            autocorrelation_rows(theta, lag, max_lag)}
+    value, reason = autocorrelation(theta, lag, return_reason=True)
+    np.testing.assert_equal(rows["autocorrelation"], (value, reason or ""))
+    curve, reason = autocorrelation_function(theta, max_lag, return_reason=True)
+    for k in range(max_lag):
+        note = (reason or "") if np.isnan(curve[k]) else ""
+        np.testing.assert_equal(rows[f"acf@{k + 1}"], (curve[k], note))
+
+
 def test_uniform_rr_sampling_uses_a_uniform_rerun_of_the_same_trajectory():
     from kicktimes import initial_conditions, simulate_two_particle
     from kicktimes.diagnostics import recurrence_rate

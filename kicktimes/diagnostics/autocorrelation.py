@@ -181,30 +181,67 @@ def _acf_segments(values, offsets, lag, rtol, atol, out, code):
 def _acf_curve(values, max_lag, rtol, atol, out, code):
     """R_1..R_max_lag of one series into ``out[0..max_lag-1]``, codes as `_acf_segments`.
 
-    The mean is computed once; each lag then calls the very kernel of `_acf_segments`, so
-    ``out[l - 1]`` is bitwise ``autocorrelation(values, l)``.
+    ``out[l - 1]`` is bitwise ``autocorrelation(values, l)``, i.e. what `_centred_sums`
+    gives at lag ``l`` (a property test), in less time: at 20 lags and N of about 2400, the
+    public call is 1.3-1.7x faster than with the previous kernel, which ran those sums
+    lag by lag (benchmarks/bench_autocorrelation.py):
+
+    * the centred, scaled values ``a_i = f x_i - mean`` are computed once, by the same
+      expression, instead of twice per lag;
+    * the sum of squares of lag ``l`` is four blocked accumulators over the first
+      ``4 ((N - l) // 4)`` values, then the rest added to the first one in order. The
+      blocks are a prefix shared by every lag, so they are advanced once, from the
+      largest lag (fewest blocks) down, and each lag adds only its tail (at most
+      ``l + 3`` values).
     """
     n = values.shape[0]
     if n < 2:
         out[:] = np.nan
         code[:] = 2
         return
-    # an int64 zero, not the literal 0: numba would compile the callees a second time
-    # for the type Literal[int](0) (they are also called with int64 bounds)
+    # an int64 zero, not the literal 0: numba would compile the callee a second time
+    # for the type Literal[int](0) (it is also called with int64 bounds)
     lo = np.int64(0)
     mean, f, scale = _prepare(values, lo, n)
-    for lag in range(1, max_lag + 1):
-        if n <= lag:
-            out[lag - 1] = np.nan
-            code[lag - 1] = 2
-            continue
-        den, num = _centred_sums(values, lo, n, lag, mean, f)
+    a = np.empty(n)
+    for i in range(n):
+        a[i] = values[i] * f - mean
+    top = min(max_lag, n - 1)
+    for lag in range(top + 1, max_lag + 1):  # no pair that far apart
+        out[lag - 1] = np.nan
+        code[lag - 1] = 2
+    d0 = d1 = d2 = d3 = 0.0
+    blocks = 0
+    for lag in range(top, 0, -1):
+        m = n - lag  # products exist for i < m
+        while blocks < m // 4:
+            i = 4 * blocks
+            d0 += a[i] * a[i]
+            d1 += a[i + 1] * a[i + 1]
+            d2 += a[i + 2] * a[i + 2]
+            d3 += a[i + 3] * a[i + 3]
+            blocks += 1
+        t0 = d0
+        for i in range(4 * blocks, n):
+            t0 += a[i] * a[i]
+        den = (t0 + d1) + (d2 + d3)
         if _is_constant(den, n, f, scale, rtol, atol):
             out[lag - 1] = np.nan
             code[lag - 1] = 1
-        else:
-            out[lag - 1] = num / den
-            code[lag - 1] = 0
+            continue
+        c0 = c1 = c2 = c3 = 0.0
+        i = 0
+        while i + 3 < m:
+            c0 += a[i] * a[i + lag]
+            c1 += a[i + 1] * a[i + 1 + lag]
+            c2 += a[i + 2] * a[i + 2 + lag]
+            c3 += a[i + 3] * a[i + 3 + lag]
+            i += 4
+        while i < m:
+            c0 += a[i] * a[i + lag]
+            i += 1
+        out[lag - 1] = ((c0 + c1) + (c2 + c3)) / den
+        code[lag - 1] = 0
 
 
 # ------------------------------------------------------------------------- validation
@@ -456,6 +493,7 @@ def boundary_angles(run, particle=None):
     [0.0, 1.5708]
     """
     time, sin_theta, particles, track = _boundary_columns(run)
+    fast = _fast_columns(time, sin_theta, particles)
     if particles is None:
         if particle is not None and not _is_int(particle, 0):
             raise ValueError(
@@ -467,6 +505,15 @@ def boundary_angles(run, particle=None):
             particle = track if track is not None else 0
         if not (_is_int(particle, 0) or _is_int(particle, 1)):
             raise ValueError(f"particle: must be 0 or 1 (the disk to analyse), got {particle!r}")
+    if fast:
+        # one pass selects the disk's values and checks them; anything unusual (unsorted
+        # times, a bad value) takes the general path below, which sorts or says what is wrong
+        which = -1 if particles is None else int(particle)
+        chosen, ok = _select_checked(time, sin_theta, _NO_PARTICLE if which < 0 else particles,
+                                     which, 1.0 + _SIN_SLACK)
+        if ok:
+            return np.arcsin(np.clip(chosen, -1.0, 1.0))
+    if particles is not None:
         mask = particles == int(particle)
         sin_theta = sin_theta[mask]
         time = time[mask] if time is not None else None
@@ -482,6 +529,49 @@ def boundary_angles(run, particle=None):
         raise ValueError(f"sin_theta: must lie in [-1, 1]; element {k} is {sin_theta[k]!r}")
     # clip only the round-off excess; arcsin writes a fresh array, the record is untouched
     return np.arcsin(np.clip(sin_theta, -1.0, 1.0))
+
+
+_NO_PARTICLE = np.empty(0, np.int8)
+
+
+def _fast_columns(time, sin_theta, particles) -> bool:
+    """Whether `_select_checked` takes these columns: a run record's own arrays (float64
+    times and values, int8 disk labels), so that one compiled signature serves."""
+    return (
+        isinstance(time, np.ndarray)
+        and isinstance(sin_theta, np.ndarray)
+        and time.dtype == np.float64
+        and sin_theta.dtype == np.float64
+        and time.shape == sin_theta.shape
+        and time.ndim == 1
+        and (particles is None or (particles.dtype == np.int8 and particles.shape == time.shape))
+    )
+
+
+@njit(cache=True)
+def _select_checked(time, sin_theta, particles, which, bound):
+    """``(sin_theta of disk `which` in record order, ok)`` in one pass (``which < 0``:
+    every row). ``ok`` is False when the chosen times are not non-decreasing (or NaN) or
+    a value is not within ``[-bound, bound]`` (or not finite): the caller then takes the
+    general path. Replaces two boolean-mask gathers and four checks (42 -> 12 us
+    for a 5000-row two-disk log; with the one-curve rows the sweep's autocorrelation stage
+    is 1.7x faster, benchmarks/bench_autocorrelation.py)."""
+    n = sin_theta.shape[0]
+    out = np.empty(n)
+    k = 0
+    ok = True
+    last = -np.inf
+    for i in range(n):
+        if which >= 0 and particles[i] != which:
+            continue
+        t = time[i]
+        v = sin_theta[i]
+        if not (t >= last and abs(v) <= bound):
+            ok = False
+        last = t
+        out[k] = v
+        k += 1
+    return out[:k], ok
 
 
 def _is_int(value, target: int) -> bool:

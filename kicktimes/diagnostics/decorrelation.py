@@ -120,24 +120,8 @@ def autocorrelation_function(series, max_lag=20, *, rtol=_RTOL, atol=_ATOL, retu
     max_lag = _check_max_lag(max_lag)
     rtol = _check_tol("rtol", rtol)
     atol = _check_tol("atol", atol)
-    out = np.empty(max_lag)
-    code = np.empty(max_lag, np.int8)
-    _acf_curve(x, max_lag, rtol, atol, out, code)
-    n = x.size
-    reason = None
-    if (code == 1).any():
-        reason = (
-            f"constant series (N = {n}): the variance is zero to within the tolerance, so "
-            f"R_l is undefined at every lag"
-        )
-    elif (code == 2).any():
-        if n < 2:
-            reason = f"series too short: N = {n} < 2, so R_l is undefined at every lag"
-        else:
-            reason = (
-                f"series too short: N = {n} gives R_l only for l < N; lags {n}..{max_lag} "
-                "are NaN"
-            )
+    out, code = _curve(x, max_lag, rtol, atol)
+    reason = _curve_reason(code, x.size, max_lag)
     if return_reason:
         return out, reason
     if reason is not None:
@@ -145,6 +129,32 @@ def autocorrelation_function(series, max_lag=20, *, rtol=_RTOL, atol=_ATOL, retu
             f"autocorrelation_function has NaN: {reason}", UndefinedDiagnosticWarning, stacklevel=2
         )
     return out
+
+
+def _curve(x: np.ndarray, max_lag: int, rtol: float = _RTOL, atol: float = _ATOL):
+    """``(acf, code)`` of a checked series: the values of `autocorrelation_function` and
+    the kernel's code per lag (0 defined, 1 constant series, 2 no pair that far apart)."""
+    out = np.empty(max_lag)
+    code = np.empty(max_lag, np.int8)
+    _acf_curve(x, max_lag, rtol, atol, out, code)
+    return out, code
+
+
+def _curve_reason(code: np.ndarray, n: int, max_lag: int) -> str | None:
+    """Why some of a curve is NaN (None when every lag is defined)."""
+    if (code == 1).any():
+        return (
+            f"constant series (N = {n}): the variance is zero to within the tolerance, so "
+            f"R_l is undefined at every lag"
+        )
+    if (code == 2).any():
+        if n < 2:
+            return f"series too short: N = {n} < 2, so R_l is undefined at every lag"
+        return (
+            f"series too short: N = {n} gives R_l only for l < N; lags {n}..{max_lag} "
+            "are NaN"
+        )
+    return None
 
 
 def decorrelation_lag(acf, threshold=INV_E, *, return_reason=False):

@@ -390,15 +390,24 @@ def autocorrelation_rows(theta: np.ndarray, lag: int, max_lag: int) -> list[tupl
     """
     from kicktimes.diagnostics import (
         autocorrelation,
-        autocorrelation_function,
         decorrelation_lag,
         integrated_autocorrelation_time,
     )
+    from kicktimes.diagnostics.autocorrelation import _as_series, _reason_text
+    from kicktimes.diagnostics.decorrelation import _check_max_lag, _curve, _curve_reason
 
-    value, reason = autocorrelation(theta, lag, return_reason=True)
+    theta = _as_series(theta, "theta")
+    n = theta.size
+    # one curve: R_lag is its entry lag - 1, bitwise autocorrelation(theta, lag)
+    acf, code = _curve(theta, _check_max_lag(max_lag))
+    if 1 <= lag <= max_lag:
+        value = float(acf[lag - 1])
+        reason = _reason_text(int(code[lag - 1]), n, lag) if code[lag - 1] else None
+    else:
+        value, reason = autocorrelation(theta, lag, return_reason=True)
     rows = [("autocorrelation", value, reason or "")]
-    acf, reason = autocorrelation_function(theta, max_lag, return_reason=True)
-    for k, value in enumerate(acf):
+    reason = _curve_reason(code, n, max_lag)
+    for k, value in enumerate(acf.tolist()):
         rows.append((f"acf@{k + 1}", value, (reason or "") if math.isnan(value) else ""))
     value, reason = decorrelation_lag(acf, return_reason=True)
     rows.append(("decorrelation_lag", value, reason or ""))
