@@ -6,14 +6,16 @@ Input: the boundary logs of paper-sampled two-disk runs (family B: r = 0.016, 15
 collision-truncated steps of tau = 0.3, about 2 400 boundary collisions of the tracked
 disk), the stage a sweep task times as "autocorrelation".
 
-1. The curve ``autocorrelation_function(theta, 20)``; references in the same run: the
-   previous kernel (one compiled call; per lag, the blocked sums of `autocorrelation`
-   from the series: centring again and the sum of squares again), which the curve
+1. The curve's kernel (what ``autocorrelation_function(theta, 20)`` calls after its
+   input checks); references in the same run: the previous kernel (one compiled call;
+   per lag, the blocked sums of `autocorrelation` from the series: centring again and
+   the sum of squares again), which the curve
    equals bitwise (checked here), and ``statsmodels``' ``acf`` (``fft=False``,
    ``adjusted=False``; equal to 1e-12).
 2. The whole stage, ``autocorrelation_rows(boundary_angles(run, 0), 1, 20)``; reference:
    the stage as it was (angles selected by boolean masks and checked by four numpy
    passes, ``R_1`` by its own call, the curve by the previous kernel), same rows.
+3. ``boundary_angles(run, 0)`` of the two-disk log alone against the masked selection.
 
 Times are the best of ``--repeat`` rounds of 100 calls per run, in microseconds per call.
 """
@@ -36,6 +38,7 @@ from kicktimes.diagnostics import (
     integrated_autocorrelation_time,
 )
 from kicktimes.diagnostics.autocorrelation import _centred_sums, _is_constant, _prepare
+from kicktimes.diagnostics.decorrelation import _curve
 from kicktimes.experiment.tasks import autocorrelation_rows
 
 
@@ -112,11 +115,11 @@ def main():
     sizes = [theta.size for theta in thetas]
     print(f"{len(runs)} runs, {min(sizes)}-{max(sizes)} boundary angles of the tracked disk")
 
-    curve_us = per_call_us(lambda t: autocorrelation_function(t, 20), thetas, args.repeat)
+    curve_us = per_call_us(lambda t: _curve(t, 20), thetas, args.repeat)
     lags_us = per_call_us(lambda t: previous_curve(t, 20), thetas, args.repeat)
     sm_us = per_call_us(lambda t: acf(t, nlags=20, fft=False), thetas, args.repeat)
-    print("1. the curve R_1..R_20 (us per series)")
-    print(f"   autocorrelation_function: {curve_us:7.1f}")
+    print("1. the curve R_1..R_20, kernels (us per series)")
+    print(f"   this release:             {curve_us:7.1f}")
     print(f"   previous kernel:          {lags_us:7.1f}  -> {lags_us / curve_us:.2f}x")
     print(f"   statsmodels acf:          {sm_us:7.1f}  -> {sm_us / curve_us:.2f}x")
 
@@ -130,6 +133,14 @@ def main():
     print("2. the sweep's stage: angles + rows (us per run)")
     print(f"   one curve, one-pass angles: {stage_us:7.1f}")
     print(f"   as it was (reference):      {ref_us:7.1f}  -> {ref_us / stage_us:.2f}x")
+    for run in runs:
+        assert np.array_equal(boundary_angles(run, 0), masked_angles(run))
+    angles_us = per_call_us(lambda r: boundary_angles(r, 0), runs, args.repeat)
+    masked_us = per_call_us(masked_angles, runs, args.repeat)
+    n_log = [run.boundary_log.time.size for run in runs]
+    print(f"3. boundary angles of a {min(n_log)}-{max(n_log)} row two-disk log (us per run)")
+    print(f"   one-pass selection:         {angles_us:7.1f}")
+    print(f"   boolean masks (reference):  {masked_us:7.1f}  -> {masked_us / angles_us:.2f}x")
 
 
 if __name__ == "__main__":
