@@ -29,8 +29,8 @@ SWEEP_KERNELS = (
     ("kicktimes.diagnostics._tangent_run", "simulate_tangent_two_kernel", 5.5),
     ("kicktimes.diagnostics._tangent_run", "simulate_tangent_one_kernel", 5.0),
     ("kicktimes.diagnostics.recurrence", "_sweep_lines_dense", 1.5),
-    ("kicktimes.diagnostics.autocorrelation", "_acf_curve", 1.5),
-    ("kicktimes.diagnostics.autocorrelation", "_select_checked", 0.5),
+    ("kicktimes.diagnostics.autocorrelation", "_acf_curve", 1.3),
+    ("kicktimes.diagnostics.autocorrelation", "_select_checked", 0.2),
 )
 SIMULATE_KERNELS = (("kicktimes.billiard.two_particle", "simulate_two_kernel", 4.5),)
 #: What the report compiles beyond the sweep's kernels (``kicktimes reproduce``'s report
