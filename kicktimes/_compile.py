@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import sys
 
-__all__ = ["cold_kernels", "announce", "warm_up", "warm_report"]
+__all__ = ["cold_kernels", "announce", "warm_up", "warm_sweep", "warm_report"]
 
 #: (module, kernel, compile seconds measured by benchmarks/bench_compile.py on the
 #: project's 2-core machine, inclusive of the kernels each one calls; the recurrence entry,
@@ -150,6 +150,19 @@ def _warm_report_one(_):
     rng = np.random.default_rng(0)
     recurrence_pairs(rng.uniform(-1.0, 1.0, (60, 2)), 1e-3)
     compare_models(rng.exponential(size=60), censored=rng.exponential(size=2))
+
+
+def warm_sweep() -> None:
+    """Load (or compile, on a cold cache) the sweep's kernels in this process, by running a
+    tiny task of each kind (the one-pass kernels, the autocorrelation and the recurrence
+    rows, with the sweep's own argument types).
+
+    The command line does it before it forks the local pool: the workers inherit the
+    loaded kernels instead of each loading them on its first task (about 0.8 s a process;
+    ``benchmarks/bench_startup.py``, section 1, measures both ways in the same run).
+    """
+    _warm_two(None)
+    _warm_one(None)
 
 
 def warm_report() -> None:

@@ -83,11 +83,41 @@ class _Real(click.ParamType):
 def main():
     """kicktimes: collision-time processes in circular billiards."""
     # the command owns its process: freed arrays are kept for reuse instead of being
-    # returned to the system and faulted in again by the next kernel call (the sweep's and
-    # the report's forked workers inherit the setting; see kicktimes._memory)
-    from kicktimes._memory import keep_freed_memory
+    # returned to the system and faulted in again by the next kernel call, and the cyclic
+    # garbage collector runs less often until the command ends (the sweep's and the
+    # report's forked workers inherit both; see kicktimes._memory)
+    from kicktimes._memory import fewer_collections, keep_freed_memory
 
     keep_freed_memory()
+    ctx = click.get_current_context()
+    ctx.with_resource(fewer_collections())
+    ctx.with_resource(_one_blas_thread())
+
+
+#: BLAS thread counts read when the library loads: OpenBLAS (numpy's and scipy's wheels), MKL
+_BLAS_THREADS = ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
+
+
+@contextlib.contextmanager
+def _one_blas_thread():
+    """One BLAS thread in each of the command's processes, unless the user set a number.
+
+    The command already runs one process per core; OpenBLAS would add a thread per core
+    to each, which, woken for the report's small products, spin on the cores the other
+    processes need (the quick report on 2 cores: 1.04x less CPU time with one thread,
+    same files; ``benchmarks/bench_startup.py``, section 3). Set before numpy loads
+    (``kicktimes.cli`` does not import it; tested), inherited by the forked processes,
+    restored when the command ends.
+    """
+    import os
+
+    added = [var for var in _BLAS_THREADS if var not in os.environ]
+    os.environ.update(dict.fromkeys(added, "1"))
+    try:
+        yield
+    finally:
+        for var in added:
+            os.environ.pop(var, None)
 
 
 # --- simulate command -------------------------------------------------------------------
@@ -375,10 +405,11 @@ def _pending(experiment, store_path) -> bool:
 def _compile_first(workers, kernels=None, *, report=False, report_process=False):
     """On a cold numba cache, say so once and compile the sweep's kernels (and the
     report's, with ``report``) up front, the independent groups in parallel
-    (:mod:`kicktimes._compile`). With ``report_process`` the report's kernels are left to
-    the report process (`_ReportProcess`), which compiles them while the sweeps run; the
-    estimate includes them, and their modules (scipy.stats, statsmodels: about 1 s) are
-    not imported here."""
+    (:mod:`kicktimes._compile`); then, for a pool of several workers, load the sweep's
+    kernels in this process, which the workers fork from. With ``report_process`` the
+    report's kernels are left to the report process (`_ReportProcess`), which compiles
+    them while the sweeps run; the estimate includes them, and their modules (scipy.stats,
+    statsmodels: about 1 s) are not imported here."""
     import os
 
     from kicktimes import _compile
@@ -389,8 +420,12 @@ def _compile_first(workers, kernels=None, *, report=False, report_process=False)
     here = report and not report_process
     elsewhere = sum(s for *_, s in _compile.REPORT_KERNELS) if report and report_process else 0
     wanted = _compile.SWEEP_KERNELS + (_compile.REPORT_KERNELS if here else ())
+    n_workers = workers or os.cpu_count() or 1
     if _compile.announce(wanted, extra_seconds=elsewhere):
-        _compile.warm_up(workers or os.cpu_count() or 1, report=here)
+        _compile.warm_up(n_workers, report=here)
+    if n_workers > 1:
+        # load them here, once: the pool's workers, forked from this process, inherit them
+        _compile.warm_sweep()
 
 
 _workers_option = click.option(

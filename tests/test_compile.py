@@ -151,3 +151,31 @@ def test_the_reproduce_warm_up_also_compiles_every_kernel_the_report_calls(tmp_p
     modules, still_cold = json.loads(out.stdout.strip().splitlines()[-1])
     assert [m for m in modules if m.startswith("kicktimes")] == []
     assert still_cold == []
+
+
+_LOADED_AFTER_WARM_SWEEP = r"""
+import importlib, json
+from kicktimes import _compile
+
+def loaded():
+    return {name: bool(getattr(importlib.import_module(module), name).overloads)
+            for module, name, _ in _compile.SWEEP_KERNELS}
+
+before = loaded()
+_compile.warm_sweep()
+print(json.dumps([before, loaded()]))
+"""
+
+
+def test_warm_sweep_loads_every_kernel_of_the_sweep_into_this_process():
+    # what the command line runs before it forks the pool: the workers inherit the loaded
+    # kernels (on a cold cache this compiles them, about 15 s)
+    import json
+    import subprocess
+    import sys
+
+    out = subprocess.run([sys.executable, "-c", _LOADED_AFTER_WARM_SWEEP], check=True,
+                         capture_output=True, text=True).stdout
+    before, after = json.loads(out)
+    assert not any(before.values())
+    assert all(after.values()), after

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import base64
+import gc
 import re
 
 import numpy as np
@@ -79,18 +80,25 @@ def store_path(tmp_path_factory):
 def built(store_path, tmp_path_factory):
     out = tmp_path_factory.mktemp("report")
     stages = []
+    thresholds = {"before": gc.get_threshold(), "during": set()}
+
+    def progress(stage, done, total):
+        stages.append((stage, done, total))
+        thresholds["during"].add(gc.get_threshold())
+
     path = build_report(
         store_path,
         out,
-        progress=lambda stage, done, total: stages.append((stage, done, total)),
+        progress=progress,
         **OPTIONS,
         workers=2,  # the multi-store build below uses 1: results must agree
     )
-    return path, out, stages
+    thresholds["after"] = gc.get_threshold()
+    return path, out, stages, thresholds
 
 
 def test_report_html_is_self_contained_with_one_embedded_image_per_figure(built):
-    path, out, _ = built
+    path, out, *_ = built
     page = path.read_text(encoding="utf-8")
     images = re.findall(r'<img[^>]*src="([^"]+)"', page)
     assert len(images) == len(FIGURES)
@@ -101,21 +109,21 @@ def test_report_html_is_self_contained_with_one_embedded_image_per_figure(built)
 
 
 def test_every_figure_is_saved_as_png_and_no_pdf_by_default(built):
-    _, out, _ = built
+    _, out, *_ = built
     assert {p.stem for p in out.glob("*.png")} == FIGURES
     assert not list(out.glob("*.pdf"))
     assert 'PDF</a>' not in (out / "report.html").read_text(encoding="utf-8")
 
 
 def test_every_table_is_saved_as_csv(built):
-    _, out, _ = built
+    _, out, *_ = built
     assert {p.stem for p in out.glob("*.csv")} == TABLES
     page = (out / "report.html").read_text(encoding="utf-8")
     assert page.count('<table class="dataframe">') >= 8
 
 
 def test_report_records_experiment_seed_rule_version_and_store(built, store_path):
-    path, out, _ = built
+    path, out, *_ = built
     page = path.read_text(encoding="utf-8")
     for text in ("tiny_report", EXPERIMENT.hash(), "mirror", __version__, str(store_path)):
         assert text in page
@@ -124,7 +132,7 @@ def test_report_records_experiment_seed_rule_version_and_store(built, store_path
 
 
 def test_numbers_come_from_the_store(built, store_path):
-    _, out, _ = built
+    _, out, *_ = built
     store = load_store(store_path)
     counts = pd.read_csv(out / "counts_by_radius.csv").set_index("radius")
     expected = store.collisions.groupby("radius")["n_pp"].mean()
@@ -161,6 +169,15 @@ def test_progress_callable_sees_every_stage_in_order(built):
     stages = built[2]
     assert [done for _, done, _ in stages] == list(range(len(stages)))
     assert stages[0][0] == "load store" and stages[-1][0] == "write files"
+
+
+def test_the_build_runs_with_fewer_garbage_collections_and_restores_the_setting(built):
+    from kicktimes._memory import _GC_THRESHOLDS
+
+    thresholds = built[3]
+    raised = tuple(max(a, b) for a, b in zip(_GC_THRESHOLDS, thresholds["before"], strict=True))
+    assert thresholds["during"] == {raised}
+    assert thresholds["after"] == thresholds["before"]
 
 
 def test_no_figure_is_left_open(built):
@@ -335,7 +352,7 @@ def _snapshot(folder):
 def test_a_rebuild_with_nothing_changed_writes_nothing_within_3_seconds(built, store_path):
     import time
 
-    path, out, _ = built
+    path, out, *_ = built
     before = _snapshot(out)
     assert ".cache.json" in before
     t0 = time.perf_counter()

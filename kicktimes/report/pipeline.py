@@ -23,10 +23,11 @@ import html
 import os
 import time
 from concurrent.futures import ProcessPoolExecutor
+from contextlib import closing
 from pathlib import Path
 
 from kicktimes import __version__
-from kicktimes._memory import keep_freed_memory
+from kicktimes._memory import fewer_collections, keep_freed_memory
 from kicktimes.report._cache import ReportCache, content_key, store_key
 from kicktimes.report._common import (
     Context,
@@ -464,7 +465,8 @@ def build_report(
     parallel = workers > 1 and len(jobs) + families_todo > 1
     n_steps = 2 + (len(jobs) if parallel else N_STAGES * len(jobs)) + families_todo
     bar = Progress(progress, n_steps)
-    try:
+    # the collector runs less often while the report allocates (kicktimes._memory)
+    with closing(bar), fewer_collections():
         bar.step("load store")
         timings = [("", "check cache", time.perf_counter() - t_start)]
         bar.advance()
@@ -559,8 +561,6 @@ def build_report(
         cache.save()
         bar.advance()
         return page
-    finally:
-        bar.close()
 
 
 def _check_paths(store_path):

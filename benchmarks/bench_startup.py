@@ -1,0 +1,197 @@
+"""What the command line does around its process pools, each against the alternative.
+
+1. **Sweep kernels loaded before the fork.** The quick sweeps (``quick_a`` then
+   ``quick_b``) on one local pool of 2 workers, with the sweep's kernels loaded in the
+   parent before the pool forks (`kicktimes._compile.warm_sweep`, what ``kicktimes run``
+   and ``reproduce`` do) against without it (each worker loads them on its first task).
+   Each variant runs in a fresh subprocess, alternating, ``--rounds`` times: wall time,
+   CPU seconds (the subprocess and its children) and the tasks' own seconds summed over
+   the workers (the stores' timings).
+2. **Garbage collection during the report.** ``build_report`` of the quick stores
+   (``workers=2``, ``force=True``) under `kicktimes._memory.fewer_collections` against
+   CPython's default thresholds (700, 10, 10), each in a fresh subprocess, alternating:
+   seconds spent in the collector in every process (``gc.callbacks``), wall time, CPU
+   seconds and the largest resident set of any process; the CSV tables and PNG files of
+   the two builds are compared byte for byte.
+3. **One BLAS thread per process.** The same build (under `fewer_collections`) with
+   ``OPENBLAS_NUM_THREADS=1``, what the command line sets before numpy loads, against
+   OpenBLAS's default (one thread per core in every process), alternating: wall time and
+   CPU seconds; the files are compared byte for byte.
+
+Wall times depend on what else runs on the machine; the CPU and collector seconds are the
+figures to compare on a busy one.
+
+Usage::
+
+    python benchmarks/bench_startup.py [--rounds 3]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+#: what the command line sets (kicktimes.cli._BLAS_THREADS)
+_BLAS_VARS = ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
+
+_SWEEP_CHILD = """
+import json, os, resource, sys, time
+from kicktimes._memory import keep_freed_memory
+from kicktimes.experiment import preset, run_experiment
+from kicktimes.experiment.runner import local_pool
+keep_freed_memory()
+root, preload = sys.argv[1], sys.argv[2] == "1"
+t0 = time.perf_counter()
+if preload:
+    from kicktimes import _compile
+    _compile.warm_sweep()
+work = 0.0
+with local_pool(2) as pool:
+    for name in ("quick_a", "quick_b"):
+        store = run_experiment(preset(name), os.path.join(root, name), executor=pool,
+                               progress=False)
+        work += float(store.timings["total"].sum())
+wall = time.perf_counter() - t0
+use = [resource.getrusage(w) for w in (resource.RUSAGE_SELF, resource.RUSAGE_CHILDREN)]
+print(json.dumps({"wall": wall, "cpu": sum(u.ru_utime + u.ru_stime for u in use),
+                  "work": work}))
+"""
+
+_REPORT_CHILD = """
+import gc, json, os, resource, sys, time
+relaxed = sys.argv[3] == "1"
+log = sys.argv[4]
+state = {}
+def timed(phase, info):
+    if phase == "start":
+        state["t"] = time.thread_time()
+    else:
+        with open(log, "a") as fh:
+            fh.write(f"{time.thread_time() - state['t']:.6f}\\n")
+gc.callbacks.append(timed)
+from kicktimes import _memory
+from kicktimes.report import build_report
+if not relaxed:
+    _memory._GC_THRESHOLDS = gc.get_threshold()  # the context keeps CPython's defaults
+t0 = time.perf_counter()
+build_report(sys.argv[1].split(","), sys.argv[2], workers=2, force=True, progress=False)
+wall = time.perf_counter() - t0
+use = [resource.getrusage(w) for w in (resource.RUSAGE_SELF, resource.RUSAGE_CHILDREN)]
+print(json.dumps({"wall": wall, "cpu": sum(u.ru_utime + u.ru_stime for u in use),
+                  "rss_mb": max(u.ru_maxrss for u in use) / 1024}))
+"""
+
+
+def _child(code, *args, env=None):
+    out = subprocess.run([sys.executable, "-c", code, *map(str, args)], check=True,
+                         capture_output=True, text=True, env=env).stdout
+    return json.loads(out.strip().splitlines()[-1])
+
+
+def _mean(rows, key):
+    return sum(r[key] for r in rows) / len(rows)
+
+
+def bench_preload(root: Path, rounds: int):
+    runs = {False: [], True: []}
+    for k in range(rounds):
+        for preload in (False, True):
+            runs[preload].append(_child(_SWEEP_CHILD, root / f"sweep-{k}-{int(preload)}",
+                                        int(preload)))
+    print(f"1. quick sweeps (quick_a + quick_b) on a pool of 2 workers, {rounds} alternating "
+          f"rounds, load average {os.getloadavg()[0]:.1f}")
+    print(f"   {'':34}{'wall (s)':>10}{'CPU (s)':>10}{'task s':>10}")
+    for preload, label in ((False, "each worker loads (reference)"),
+                           (True, "loaded before the fork")):
+        for r in runs[preload]:
+            print(f"   {label:34}{r['wall']:>10.2f}{r['cpu']:>10.2f}{r['work']:>10.2f}")
+    ref, new = runs[False], runs[True]
+    print(f"   means: wall {_mean(ref, 'wall'):.2f} -> {_mean(new, 'wall'):.2f} s "
+          f"({_mean(ref, 'wall') / _mean(new, 'wall'):.2f}x), CPU {_mean(ref, 'cpu'):.2f} -> "
+          f"{_mean(new, 'cpu'):.2f} s, task seconds {_mean(ref, 'work'):.2f} -> "
+          f"{_mean(new, 'work'):.2f}")
+    return [root / f"sweep-0-1/{n}" for n in ("quick_a", "quick_b")]
+
+
+def _files(folder: Path):
+    return {f.name: f.read_bytes() for f in sorted(folder.iterdir())
+            if f.suffix in (".csv", ".png") and "timings" not in f.name}
+
+
+def bench_gc(stores, root: Path, rounds: int):
+    runs = {False: [], True: []}
+    outputs = {}
+    for k in range(rounds):
+        for relaxed in (False, True):
+            out = root / f"report-{k}-{int(relaxed)}"
+            log = root / f"gc-{k}-{int(relaxed)}.txt"
+            log.write_text("")
+            r = _child(_REPORT_CHILD, ",".join(map(str, stores)), out, int(relaxed), log)
+            times = [float(x) for x in log.read_text().split()]
+            r.update(gc=sum(times), n_gc=len(times))
+            runs[relaxed].append(r)
+            outputs[relaxed] = _files(out)
+    print()
+    print(f"2. build_report of the quick stores (workers=2, force=True), {rounds} alternating "
+          f"rounds, load average {os.getloadavg()[0]:.1f}")
+    print(f"   {'':34}{'GC (s)':>8}{'passes':>8}{'wall (s)':>10}{'CPU (s)':>10}{'RSS MB':>8}")
+    for relaxed, label in ((False, "CPython's thresholds (reference)"),
+                           (True, "fewer_collections")):
+        for r in runs[relaxed]:
+            print(f"   {label:34}{r['gc']:>8.2f}{r['n_gc']:>8d}{r['wall']:>10.2f}"
+                  f"{r['cpu']:>10.2f}{r['rss_mb']:>8.0f}")
+    ref, new = runs[False], runs[True]
+    print(f"   means: collector {_mean(ref, 'gc'):.2f} -> {_mean(new, 'gc'):.2f} s, CPU "
+          f"{_mean(ref, 'cpu'):.2f} -> {_mean(new, 'cpu'):.2f} s "
+          f"({_mean(ref, 'cpu') / _mean(new, 'cpu'):.2f}x), wall {_mean(ref, 'wall'):.2f} -> "
+          f"{_mean(new, 'wall'):.2f} s")
+    same = outputs[False] == outputs[True]
+    print(f"   {len(outputs[True])} CSV and PNG files byte-identical between the two: {same}")
+
+
+def bench_blas(stores, root: Path, rounds: int):
+    base = {k: v for k, v in os.environ.items() if k not in _BLAS_VARS}
+    runs = {False: [], True: []}
+    outputs = {}
+    for k in range(rounds):
+        for single in (False, True):
+            out = root / f"blas-{k}-{int(single)}"
+            env = dict(base, **dict.fromkeys(_BLAS_VARS, "1")) if single else base
+            r = _child(_REPORT_CHILD, ",".join(map(str, stores)), out, 1, os.devnull,
+                       env=env)
+            runs[single].append(r)
+            outputs[single] = _files(out)
+    print()
+    print(f"3. the same build, {rounds} alternating rounds, load average "
+          f"{os.getloadavg()[0]:.1f}")
+    print(f"   {'':34}{'wall (s)':>10}{'CPU (s)':>10}")
+    for single, label in ((False, "OpenBLAS's threads (reference)"),
+                          (True, "OPENBLAS_NUM_THREADS=1")):
+        for r in runs[single]:
+            print(f"   {label:34}{r['wall']:>10.2f}{r['cpu']:>10.2f}")
+    ref, new = runs[False], runs[True]
+    print(f"   means: CPU {_mean(ref, 'cpu'):.2f} -> {_mean(new, 'cpu'):.2f} s "
+          f"({_mean(ref, 'cpu') / _mean(new, 'cpu'):.2f}x), wall {_mean(ref, 'wall'):.2f} -> "
+          f"{_mean(new, 'wall'):.2f} s ({_mean(ref, 'wall') / _mean(new, 'wall'):.2f}x)")
+    same = outputs[False] == outputs[True]
+    print(f"   {len(outputs[True])} CSV and PNG files byte-identical between the two: {same}")
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--rounds", type=int, default=3, help="alternating rounds")
+    args = parser.parse_args()
+    with tempfile.TemporaryDirectory() as tmp:
+        root = Path(tmp)
+        stores = bench_preload(root, args.rounds)
+        bench_gc(stores, root, args.rounds)
+        bench_blas(stores, root, args.rounds)
+
+
+if __name__ == "__main__":
+    main()
