@@ -12,11 +12,14 @@
    CPython's default thresholds (700, 10, 10), each in a fresh subprocess, alternating:
    seconds spent in the collector in every process (``gc.callbacks``), wall time, CPU
    seconds and the largest resident set of any process; the CSV tables and PNG files of
-   the two builds are compared byte for byte.
-3. **One BLAS thread per process.** The same build (under `fewer_collections`) with
-   ``OPENBLAS_NUM_THREADS=1``, what the command line sets before numpy loads, against
-   OpenBLAS's default (one thread per core in every process), alternating: wall time and
-   CPU seconds; the files are compared byte for byte.
+   the two builds are compared byte for byte. ``--stores`` builds those stores instead
+   (sections 2 and 3), e.g. the paper's.
+3. **One BLAS thread.** The same build (under `fewer_collections`) with BLAS limited to
+   one thread (`kicktimes.report.pipeline._one_blas_thread`, threadpoolctl) against
+   OpenBLAS's default (a thread per core in every process), alternating: wall time and
+   CPU seconds; the files are compared byte for byte (on the paper's stores the pooled
+   renewal fits' log-likelihoods differ in their last bits: the thread count splits their
+   sums).
 
 Wall times depend on what else runs on the machine; the CPU and collector seconds are the
 figures to compare on a busy one.
@@ -24,6 +27,7 @@ figures to compare on a busy one.
 Usage::
 
     python benchmarks/bench_startup.py [--rounds 3]
+    python benchmarks/bench_startup.py --rounds 1 --stores STORE_A STORE_B  # e.g. the paper's
 """
 
 from __future__ import annotations
@@ -35,9 +39,6 @@ import subprocess
 import sys
 import tempfile
 from pathlib import Path
-
-#: what the command line sets (kicktimes.cli._BLAS_THREADS)
-_BLAS_VARS = ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
 
 _SWEEP_CHILD = """
 import json, os, resource, sys, time
@@ -66,6 +67,7 @@ _REPORT_CHILD = """
 import gc, json, os, resource, sys, time
 relaxed = sys.argv[3] == "1"
 log = sys.argv[4]
+one_blas_thread = sys.argv[5] == "1"
 state = {}
 def timed(phase, info):
     if phase == "start":
@@ -78,6 +80,10 @@ from kicktimes import _memory
 from kicktimes.report import build_report
 if not relaxed:
     _memory._GC_THRESHOLDS = gc.get_threshold()  # the context keeps CPython's defaults
+if not one_blas_thread:
+    import contextlib
+    from kicktimes.report import pipeline
+    pipeline._one_blas_thread = contextlib.nullcontext  # OpenBLAS's default threads
 t0 = time.perf_counter()
 build_report(sys.argv[1].split(","), sys.argv[2], workers=2, force=True, progress=False)
 wall = time.perf_counter() - t0
@@ -87,9 +93,9 @@ print(json.dumps({"wall": wall, "cpu": sum(u.ru_utime + u.ru_stime for u in use)
 """
 
 
-def _child(code, *args, env=None):
+def _child(code, *args):
     out = subprocess.run([sys.executable, "-c", code, *map(str, args)], check=True,
-                         capture_output=True, text=True, env=env).stdout
+                         capture_output=True, text=True).stdout
     return json.loads(out.strip().splitlines()[-1])
 
 
@@ -131,14 +137,14 @@ def bench_gc(stores, root: Path, rounds: int):
             out = root / f"report-{k}-{int(relaxed)}"
             log = root / f"gc-{k}-{int(relaxed)}.txt"
             log.write_text("")
-            r = _child(_REPORT_CHILD, ",".join(map(str, stores)), out, int(relaxed), log)
+            r = _child(_REPORT_CHILD, ",".join(map(str, stores)), out, int(relaxed), log, 1)
             times = [float(x) for x in log.read_text().split()]
             r.update(gc=sum(times), n_gc=len(times))
             runs[relaxed].append(r)
             outputs[relaxed] = _files(out)
     print()
-    print(f"2. build_report of the quick stores (workers=2, force=True), {rounds} alternating "
-          f"rounds, load average {os.getloadavg()[0]:.1f}")
+    print(f"2. build_report of {', '.join(p.name for p in stores)} (workers=2, force=True), "
+          f"{rounds} alternating rounds, load average {os.getloadavg()[0]:.1f}")
     print(f"   {'':34}{'GC (s)':>8}{'passes':>8}{'wall (s)':>10}{'CPU (s)':>10}{'RSS MB':>8}")
     for relaxed, label in ((False, "CPython's thresholds (reference)"),
                            (True, "fewer_collections")):
@@ -155,15 +161,13 @@ def bench_gc(stores, root: Path, rounds: int):
 
 
 def bench_blas(stores, root: Path, rounds: int):
-    base = {k: v for k, v in os.environ.items() if k not in _BLAS_VARS}
     runs = {False: [], True: []}
     outputs = {}
     for k in range(rounds):
         for single in (False, True):
             out = root / f"blas-{k}-{int(single)}"
-            env = dict(base, **dict.fromkeys(_BLAS_VARS, "1")) if single else base
             r = _child(_REPORT_CHILD, ",".join(map(str, stores)), out, 1, os.devnull,
-                       env=env)
+                       int(single))
             runs[single].append(r)
             outputs[single] = _files(out)
     print()
@@ -171,24 +175,29 @@ def bench_blas(stores, root: Path, rounds: int):
           f"{os.getloadavg()[0]:.1f}")
     print(f"   {'':34}{'wall (s)':>10}{'CPU (s)':>10}")
     for single, label in ((False, "OpenBLAS's threads (reference)"),
-                          (True, "OPENBLAS_NUM_THREADS=1")):
+                          (True, "one BLAS thread")):
         for r in runs[single]:
             print(f"   {label:34}{r['wall']:>10.2f}{r['cpu']:>10.2f}")
     ref, new = runs[False], runs[True]
     print(f"   means: CPU {_mean(ref, 'cpu'):.2f} -> {_mean(new, 'cpu'):.2f} s "
           f"({_mean(ref, 'cpu') / _mean(new, 'cpu'):.2f}x), wall {_mean(ref, 'wall'):.2f} -> "
           f"{_mean(new, 'wall'):.2f} s ({_mean(ref, 'wall') / _mean(new, 'wall'):.2f}x)")
-    same = outputs[False] == outputs[True]
-    print(f"   {len(outputs[True])} CSV and PNG files byte-identical between the two: {same}")
+    differ = sorted(k for k in outputs[True] if outputs[True][k] != outputs[False].get(k))
+    print(f"   files that differ between the two: {len(differ)} of {len(outputs[True])}"
+          + (f" ({', '.join(differ)})" if differ else ""))
 
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--rounds", type=int, default=3, help="alternating rounds")
+    parser.add_argument("--stores", nargs="+", type=Path, default=None,
+                        help="stores to report in sections 2 and 3 (default: the quick ones)")
     args = parser.parse_args()
     with tempfile.TemporaryDirectory() as tmp:
         root = Path(tmp)
         stores = bench_preload(root, args.rounds)
+        if args.stores:
+            stores = [p.resolve() for p in args.stores]
         bench_gc(stores, root, args.rounds)
         bench_blas(stores, root, args.rounds)
 

@@ -89,35 +89,7 @@ def main():
     from kicktimes._memory import fewer_collections, keep_freed_memory
 
     keep_freed_memory()
-    ctx = click.get_current_context()
-    ctx.with_resource(fewer_collections())
-    ctx.with_resource(_one_blas_thread())
-
-
-#: BLAS thread counts read when the library loads: OpenBLAS (numpy's and scipy's wheels), MKL
-_BLAS_THREADS = ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
-
-
-@contextlib.contextmanager
-def _one_blas_thread():
-    """One BLAS thread in each of the command's processes, unless the user set a number.
-
-    The command already runs one process per core; OpenBLAS would add a thread per core
-    to each, which, woken for the report's small products, spin on the cores the other
-    processes need (the quick report on 2 cores: 1.04x less CPU time with one thread,
-    same files; ``benchmarks/bench_startup.py``, section 3). Set before numpy loads
-    (``kicktimes.cli`` does not import it; tested), inherited by the forked processes,
-    restored when the command ends.
-    """
-    import os
-
-    added = [var for var in _BLAS_THREADS if var not in os.environ]
-    os.environ.update(dict.fromkeys(added, "1"))
-    try:
-        yield
-    finally:
-        for var in added:
-            os.environ.pop(var, None)
+    click.get_current_context().with_resource(fewer_collections())
 
 
 # --- simulate command -------------------------------------------------------------------

@@ -9,6 +9,7 @@ import re
 import numpy as np
 import pandas as pd
 import pytest
+from threadpoolctl import threadpool_info
 
 from kicktimes import __version__
 from kicktimes.experiment import Experiment, load_store, run_experiment
@@ -80,11 +81,13 @@ def store_path(tmp_path_factory):
 def built(store_path, tmp_path_factory):
     out = tmp_path_factory.mktemp("report")
     stages = []
-    thresholds = {"before": gc.get_threshold(), "during": set()}
+    thresholds = {"before": gc.get_threshold(), "during": set(), "blas": set()}
 
     def progress(stage, done, total):
         stages.append((stage, done, total))
         thresholds["during"].add(gc.get_threshold())
+        thresholds["blas"] |= {i["num_threads"] for i in threadpool_info()
+                               if i["user_api"] == "blas"}
 
     path = build_report(
         store_path,
@@ -178,6 +181,33 @@ def test_the_build_runs_with_fewer_garbage_collections_and_restores_the_setting(
     raised = tuple(max(a, b) for a, b in zip(_GC_THRESHOLDS, thresholds["before"], strict=True))
     assert thresholds["during"] == {raised}
     assert thresholds["after"] == thresholds["before"]
+
+
+def test_the_build_runs_blas_on_one_thread(built):
+    assert built[3]["blas"] == {1}
+
+
+def _blas_threads_in_a_forked_process():
+    import multiprocessing as mp
+
+    with mp.get_context("fork").Pool(1) as pool:
+        return pool.apply(_blas_threads)
+
+
+def _blas_threads():
+    return sorted({i["num_threads"] for i in threadpool_info() if i["user_api"] == "blas"})
+
+
+def test_one_blas_thread_reaches_the_forked_workers_and_is_lifted_after():
+    import numpy  # noqa: F401  (its BLAS is loaded: the limit applies to loaded libraries)
+
+    from kicktimes.report.pipeline import _one_blas_thread
+
+    before = _blas_threads()
+    with _one_blas_thread():
+        assert _blas_threads() == [1]
+        assert _blas_threads_in_a_forked_process() == [1]
+    assert _blas_threads() == before
 
 
 def test_no_figure_is_left_open(built):

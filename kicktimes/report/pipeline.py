@@ -23,7 +23,7 @@ import html
 import os
 import time
 from concurrent.futures import ProcessPoolExecutor
-from contextlib import closing
+from contextlib import closing, contextmanager
 from pathlib import Path
 
 from kicktimes import __version__
@@ -125,6 +125,28 @@ def _preload():
 
     _stages()
     pomeranz_cdf(10, 0.3)
+
+
+@contextmanager
+def _one_blas_thread():
+    """BLAS on one thread while the report is built (and in the processes it forks).
+
+    A report runs one process per core already. With OpenBLAS's default of a thread per
+    core, the threads woken for its small products spin on the cores the other processes
+    need, and the long sums (the pooled renewal fits' log-likelihoods) are split by thread
+    count, so their last bits depended on the machine: on the paper's stores, 3 of 67
+    files (the pooled fits' log-likelihoods, AIC and weights, 1 ulp of two Findings
+    CIs) differed between 2 threads and 1. On one thread the files do not depend on the
+    core count, and the paper report took 1.06x less CPU time
+    (``benchmarks/bench_startup.py``, section 3). The limit applies to the BLAS libraries
+    loaded when it is set, so the section modules (numpy's and scipy's BLAS) are imported
+    first; the previous limits are restored on exit.
+    """
+    from threadpoolctl import threadpool_limits
+
+    _stages()
+    with threadpool_limits(limits=1, user_api="blas"):
+        yield
 
 
 def _inner_workers(workers, manifests):
@@ -466,7 +488,7 @@ def build_report(
     n_steps = 2 + (len(jobs) if parallel else N_STAGES * len(jobs)) + families_todo
     bar = Progress(progress, n_steps)
     # the collector runs less often while the report allocates (kicktimes._memory)
-    with closing(bar), fewer_collections():
+    with closing(bar), fewer_collections(), _one_blas_thread():
         bar.step("load store")
         timings = [("", "check cache", time.perf_counter() - t_start)]
         bar.advance()
