@@ -132,15 +132,14 @@ def _one_blas_thread():
     """BLAS on one thread while the report is built (and in the processes it forks).
 
     A report runs one process per core already. With OpenBLAS's default of a thread per
-    core, the threads woken for its small products spin on the cores the other processes
-    need, and the long sums (the pooled renewal fits' log-likelihoods) are split by thread
+    core, its long sums (the pooled renewal fits' log-likelihoods) are split by thread
     count, so their last bits depended on the machine: on the paper's stores, 3 of 67
-    files (the pooled fits' log-likelihoods, AIC and weights, 1 ulp of two Findings
-    CIs) differed between 2 threads and 1. On one thread the files do not depend on the
-    core count, and the paper report took 1.06x less CPU time
-    (``benchmarks/bench_startup.py``, section 3). The limit applies to the BLAS libraries
-    loaded when it is set, so the section modules (numpy's and scipy's BLAS) are imported
-    first; the previous limits are restored on exit.
+    files (the pooled fits' log-likelihoods, AIC and weights, 1 ulp of two Findings CIs)
+    differed between 2 threads and 1. On one thread the files do not depend on the core
+    count, at no measurable cost (CPU time 1.01x less on the quick and on the paper's
+    stores; ``benchmarks/bench_startup.py``, section 3). The limit applies to the BLAS
+    libraries loaded when it is set, so the section modules (numpy's and scipy's BLAS)
+    are imported first; the previous limits are restored on exit.
     """
     from threadpoolctl import threadpool_limits
 
