@@ -404,7 +404,9 @@ def build_report(
     Every file is written atomically (temporary file, then rename). Deterministic: the
     Monte Carlo streams derive from each experiment's seed
     (``SeedSequence(seed, spawn_key=(REPORT_DOMAIN, ...))``), the trajectories from its
-    IC 0 and the Poisson kicks from the sweep's own ``kick_rng``. Every subsampling is
+    IC 0 and the Poisson kicks from the sweep's own ``kick_rng``; BLAS runs on one thread
+    during the build (the previous limit is restored afterwards), so the files do not
+    depend on the machine's number of cores either. Every subsampling is
     listed in the report. Stage timings are written to ``report_timings.csv`` and the
     sweep's (summed over tasks) to ``sweep_timings.csv``.
 
