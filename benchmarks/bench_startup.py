@@ -103,24 +103,41 @@ def _mean(rows, key):
     return sum(r[key] for r in rows) / len(rows)
 
 
-def bench_preload(root: Path, rounds: int):
+def _alternate(rounds, run):
+    """``{False: [...], True: [...]}`` of ``run(k, flag)``, the reference (False) first in
+    each of ``rounds`` rounds."""
     runs = {False: [], True: []}
     for k in range(rounds):
-        for preload in (False, True):
-            runs[preload].append(_child(_SWEEP_CHILD, root / f"sweep-{k}-{int(preload)}",
-                                        int(preload)))
-    print(f"1. quick sweeps (quick_a + quick_b) on a pool of 2 workers, {rounds} alternating "
-          f"rounds, load average {os.getloadavg()[0]:.1f}")
-    print(f"   {'':34}{'wall (s)':>10}{'CPU (s)':>10}{'task s':>10}")
-    for preload, label in ((False, "each worker loads (reference)"),
-                           (True, "loaded before the fork")):
-        for r in runs[preload]:
-            print(f"   {label:34}{r['wall']:>10.2f}{r['cpu']:>10.2f}{r['work']:>10.2f}")
+        for flag in (False, True):
+            runs[flag].append(run(k, flag))
+    return runs
+
+
+def _report(title, runs, labels, columns, means):
+    """Print the section: one row per run (``columns``: key, header, width, format) and the
+    means of ``means`` (keys) as reference -> new, with their ratio."""
+    print(title)
+    print(f"   {'':34}" + "".join(f"{head:>{width}}" for _, head, width, _ in columns))
+    for flag, label in zip((False, True), labels, strict=True):
+        for r in runs[flag]:
+            print(f"   {label:34}"
+                  + "".join(f"{r[key]:>{width}{fmt}}" for key, _, width, fmt in columns))
     ref, new = runs[False], runs[True]
-    print(f"   means: wall {_mean(ref, 'wall'):.2f} -> {_mean(new, 'wall'):.2f} s "
-          f"({_mean(ref, 'wall') / _mean(new, 'wall'):.2f}x), CPU {_mean(ref, 'cpu'):.2f} -> "
-          f"{_mean(new, 'cpu'):.2f} s, task seconds {_mean(ref, 'work'):.2f} -> "
-          f"{_mean(new, 'work'):.2f}")
+    print("   means: " + ", ".join(
+        f"{key} {_mean(ref, key):.2f} -> {_mean(new, key):.2f} "
+        f"({_mean(ref, key) / _mean(new, key):.2f}x)" for key in means))
+
+
+_TIMES = [("wall", "wall (s)", 10, ".2f"), ("cpu", "CPU (s)", 10, ".2f")]
+
+
+def bench_preload(root: Path, rounds: int):
+    runs = _alternate(rounds, lambda k, preload: _child(
+        _SWEEP_CHILD, root / f"sweep-{k}-{int(preload)}", int(preload)))
+    _report(f"1. quick sweeps (quick_a + quick_b) on a pool of 2 workers, {rounds} alternating "
+            f"rounds, load average {os.getloadavg()[0]:.1f}", runs,
+            ("each worker loads (reference)", "loaded before the fork"),
+            [*_TIMES, ("work", "task s", 10, ".2f")], ("wall", "cpu", "work"))
     return [root / f"sweep-0-1/{n}" for n in ("quick_a", "quick_b")]
 
 
@@ -129,62 +146,47 @@ def _files(folder: Path):
             if f.suffix in (".csv", ".png") and "timings" not in f.name}
 
 
+def _build(stores, out: Path, relaxed: bool, one_blas_thread: bool, log=None):
+    """One `_REPORT_CHILD` build; with ``log``, the collector's passes and seconds too."""
+    if log is not None:
+        log.write_text("")
+    r = _child(_REPORT_CHILD, ",".join(map(str, stores)), out, int(relaxed),
+               log if log is not None else os.devnull, int(one_blas_thread))
+    if log is not None:
+        times = [float(x) for x in log.read_text().split()]
+        r.update(gc=sum(times), n_gc=len(times))
+    r["files"] = _files(out)
+    return r
+
+
+def _differing(runs):
+    new, ref = runs[True][-1]["files"], runs[False][-1]["files"]
+    differ = sorted(k for k in new if new[k] != ref.get(k))
+    print(f"   files that differ between the two: {len(differ)} of {len(new)}"
+          + (f" ({', '.join(differ)})" if differ else ""))
+
+
 def bench_gc(stores, root: Path, rounds: int):
-    runs = {False: [], True: []}
-    outputs = {}
-    for k in range(rounds):
-        for relaxed in (False, True):
-            out = root / f"report-{k}-{int(relaxed)}"
-            log = root / f"gc-{k}-{int(relaxed)}.txt"
-            log.write_text("")
-            r = _child(_REPORT_CHILD, ",".join(map(str, stores)), out, int(relaxed), log, 1)
-            times = [float(x) for x in log.read_text().split()]
-            r.update(gc=sum(times), n_gc=len(times))
-            runs[relaxed].append(r)
-            outputs[relaxed] = _files(out)
+    runs = _alternate(rounds, lambda k, relaxed: _build(
+        stores, root / f"report-{k}-{int(relaxed)}", relaxed, True,
+        log=root / f"gc-{k}-{int(relaxed)}.txt"))
     print()
-    print(f"2. build_report of {', '.join(p.name for p in stores)} (workers=2, force=True), "
-          f"{rounds} alternating rounds, load average {os.getloadavg()[0]:.1f}")
-    print(f"   {'':34}{'GC (s)':>8}{'passes':>8}{'wall (s)':>10}{'CPU (s)':>10}{'RSS MB':>8}")
-    for relaxed, label in ((False, "CPython's thresholds (reference)"),
-                           (True, "fewer_collections")):
-        for r in runs[relaxed]:
-            print(f"   {label:34}{r['gc']:>8.2f}{r['n_gc']:>8d}{r['wall']:>10.2f}"
-                  f"{r['cpu']:>10.2f}{r['rss_mb']:>8.0f}")
-    ref, new = runs[False], runs[True]
-    print(f"   means: collector {_mean(ref, 'gc'):.2f} -> {_mean(new, 'gc'):.2f} s, CPU "
-          f"{_mean(ref, 'cpu'):.2f} -> {_mean(new, 'cpu'):.2f} s "
-          f"({_mean(ref, 'cpu') / _mean(new, 'cpu'):.2f}x), wall {_mean(ref, 'wall'):.2f} -> "
-          f"{_mean(new, 'wall'):.2f} s")
-    same = outputs[False] == outputs[True]
-    print(f"   {len(outputs[True])} CSV and PNG files byte-identical between the two: {same}")
+    _report(f"2. build_report of {', '.join(p.name for p in stores)} (workers=2, force=True), "
+            f"{rounds} alternating rounds, load average {os.getloadavg()[0]:.1f}", runs,
+            ("CPython's thresholds (reference)", "fewer_collections"),
+            [("gc", "GC (s)", 8, ".2f"), ("n_gc", "passes", 8, "d"), *_TIMES,
+             ("rss_mb", "RSS MB", 8, ".0f")], ("gc", "cpu", "wall"))
+    _differing(runs)
 
 
 def bench_blas(stores, root: Path, rounds: int):
-    runs = {False: [], True: []}
-    outputs = {}
-    for k in range(rounds):
-        for single in (False, True):
-            out = root / f"blas-{k}-{int(single)}"
-            r = _child(_REPORT_CHILD, ",".join(map(str, stores)), out, 1, os.devnull,
-                       int(single))
-            runs[single].append(r)
-            outputs[single] = _files(out)
+    runs = _alternate(rounds, lambda k, single: _build(
+        stores, root / f"blas-{k}-{int(single)}", True, single))
     print()
-    print(f"3. the same build, {rounds} alternating rounds, load average "
-          f"{os.getloadavg()[0]:.1f}")
-    print(f"   {'':34}{'wall (s)':>10}{'CPU (s)':>10}")
-    for single, label in ((False, "OpenBLAS's threads (reference)"),
-                          (True, "one BLAS thread")):
-        for r in runs[single]:
-            print(f"   {label:34}{r['wall']:>10.2f}{r['cpu']:>10.2f}")
-    ref, new = runs[False], runs[True]
-    print(f"   means: CPU {_mean(ref, 'cpu'):.2f} -> {_mean(new, 'cpu'):.2f} s "
-          f"({_mean(ref, 'cpu') / _mean(new, 'cpu'):.2f}x), wall {_mean(ref, 'wall'):.2f} -> "
-          f"{_mean(new, 'wall'):.2f} s ({_mean(ref, 'wall') / _mean(new, 'wall'):.2f}x)")
-    differ = sorted(k for k in outputs[True] if outputs[True][k] != outputs[False].get(k))
-    print(f"   files that differ between the two: {len(differ)} of {len(outputs[True])}"
-          + (f" ({', '.join(differ)})" if differ else ""))
+    _report(f"3. the same build, {rounds} alternating rounds, load average "
+            f"{os.getloadavg()[0]:.1f}", runs,
+            ("OpenBLAS's threads (reference)", "one BLAS thread"), _TIMES, ("cpu", "wall"))
+    _differing(runs)
 
 
 def main():
