@@ -16,7 +16,10 @@ of the peak resident set during the call, each N in a fresh process).
 
 RQA (``rqa``: the recurrent pairs kept as sorted rows, then the line statistics) against
 ``recurrence_rate`` of the same points in the same run, N = 25 000, eps = 1e-3 and 1e-2,
-for both point sets and for a paper-sampled billiard run (the sweep's input).
+for both point sets and for a paper-sampled billiard run (the sweep's input); the sweep's
+call on its dense grid against the sorted occupied cells; and its line kernels against
+the former ones (a loop per point over its recurrent pairs, every line walked; copied
+here as the reference).
 """
 
 from __future__ import annotations
@@ -33,6 +36,7 @@ from numba import njit
 from scipy.spatial import cKDTree
 
 from kicktimes.diagnostics import recurrence_rate, rqa
+from kicktimes.diagnostics.recurrence import _add_line, _cell_keys, _recurrent
 
 
 @njit(cache=True)
@@ -171,6 +175,7 @@ def rqa_table(rep):
             )
     print("RQA = rqa(laminarity=False), as in the sweep; +LAM = rqa() with laminarity")
     grid_table(sets, rep)
+    batch_table(sets, rep)
 
 
 def grid_table(sets, rep):
@@ -198,6 +203,142 @@ def grid_table(sets, rep):
         assert dense == sparse
         print(f"{name:<11} {s_min * 1e3:8.3f} / {s_med * 1e3:7.3f} {d_min * 1e3:7.3f} / "
               f"{d_med * 1e3:6.3f} {s_min / d_min:9.2f}")
+
+
+# ----------------------------------------------------------------- the former line sweep
+# The reference of `batch_table`: the dense-grid build and line sweep as they were before
+# the recurrent pairs were accounted in batches (commit 356782d): a copy of the grid
+# (``fill``), and a loop per point over its recurrent candidates with a walk of every line.
+
+
+@njit(cache=True)
+def _former_dense_cells_lines(points, xmin, ymin, inv_h, ncx, n_cells):
+    n = points.shape[0]
+    keys = _cell_keys(points, xmin, ymin, inv_h, ncx)
+    start = np.zeros(n_cells + 1, np.int64)
+    for a in range(n):
+        start[keys[a] + 1] += 1
+    for c in range(n_cells):
+        start[c + 1] += start[c]
+    fill = start[:n_cells].copy()
+    g = np.empty((n, 6))
+    perm = np.empty(n, np.int64)
+    skey = np.empty(n, np.int64)
+    for i in range(n):
+        k = keys[i]
+        a = fill[k]
+        fill[k] = a + 1
+        perm[a] = i
+        skey[a] = k
+        g[a, 0] = points[i, 0]
+        g[a, 1] = points[i, 1]
+        if i > 0:
+            g[a, 2] = points[i - 1, 0]
+            g[a, 3] = points[i - 1, 1]
+        else:
+            g[a, 2] = g[a, 3] = np.nan
+        if i + 1 < n:
+            g[a, 4] = points[i + 1, 0]
+            g[a, 5] = points[i + 1, 1]
+        else:
+            g[a, 4] = g[a, 5] = np.nan
+    return g, perm, skey, start
+
+
+@njit(cache=True)
+def _former_sweep_lines_dense(g, perm, skey, start, ncx, w, pts, eps2s, count, diag):
+    n = g.shape[0]
+    eps2 = eps2s[0]
+    cand = np.empty(n, np.int64)
+    dist2 = np.empty(n)
+    for a in range(n):
+        key = skey[a]
+        xa = g[a, 0]
+        ya = g[a, 1]
+        m = 0
+        for b in range(a + 1, start[key + 2]):
+            dx = xa - g[b, 0]
+            dy = ya - g[b, 1]
+            d2 = dx * dx + dy * dy
+            cand[m] = b
+            dist2[m] = d2
+            m += d2 <= eps2
+        for b in range(start[key + ncx - 1], start[key + ncx + 2]):
+            dx = xa - g[b, 0]
+            dy = ya - g[b, 1]
+            d2 = dx * dx + dy * dy
+            cand[m] = b
+            dist2[m] = d2
+            m += d2 <= eps2
+        ia = perm[a]
+        for t in range(m):
+            b = cand[t]
+            ib = perm[b]
+            if w > 1 and abs(ia - ib) < w:
+                continue
+            px = g[a, 2] - g[b, 2]
+            py = g[a, 3] - g[b, 3]
+            p2 = px * px + py * py
+            sx = g[a, 4] - g[b, 4]
+            sy = g[a, 5] - g[b, 5]
+            s2 = sx * sx + sy * sy
+            d2 = dist2[t]
+            for k in range(eps2s.shape[0]):
+                e2 = eps2s[k]
+                if not (d2 <= e2):
+                    break
+                count[k] += 1
+                if not (p2 <= e2):
+                    length = 1
+                    if s2 <= e2:
+                        i = min(ia, ib)
+                        j = max(ia, ib)
+                        length = 2
+                        while j + length < n and _recurrent(pts, i + length, j + length, e2):
+                            length += 1
+                    _add_line(diag, k, length)
+
+
+def _line_kernels(pts, build, sweep):
+    """The sweep's call at [1e-2, 1e-3] (Theiler 1, l_min 2) through the given kernels."""
+    from kicktimes.diagnostics import recurrence
+
+    xmin, ymin, inv_h, ncx, ncy, _ = recurrence._grid(pts, 1e-2)
+    eps2s = np.array([1e-2 * 1e-2, 1e-3 * 1e-3])
+    count = np.zeros(2, np.int64)
+    diag = np.zeros((2, 4), np.int64)
+    diag[:, 0] = 2
+    g, perm, skey, start = build(pts, xmin, ymin, inv_h, ncx, ncx * ncy)
+    sweep(g, perm, skey, start, ncx, 1, pts, eps2s, count, diag)
+    return count, diag
+
+
+def batch_table(sets, rep):
+    """The sweep's dense-grid kernels (build + line sweep at [1e-2, 1e-3]) against the
+    former ones (per-point accounting, every line walked), same points, same run,
+    alternating; the counts must be equal."""
+    from kicktimes.diagnostics import recurrence
+
+    new = (recurrence._dense_cells_lines, recurrence._sweep_lines_dense)
+    old = (_former_dense_cells_lines, _former_sweep_lines_dense)
+    print()
+    print(f"The sweep's line kernels at [1e-2, 1e-3] (build + sweep): batched accounting "
+          f"against the former per-point loop (min / median of {rep} alternating runs)")
+    header = f"{'point set':<11} {'former [ms]':>16} {'batched [ms]':>16} {'speed-up':>9}"
+    print(header)
+    print("-" * len(header))
+    for name, pts in sets:
+        a = _line_kernels(pts, *new)
+        b = _line_kernels(pts, *old)
+        assert all(np.array_equal(x, y) for x, y in zip(a, b, strict=True)), name
+        t_new, t_old = [], []
+        for _ in range(rep):
+            t_old.append(timeit(lambda p=pts: _line_kernels(p, *old), 1)[0])
+            t_new.append(timeit(lambda p=pts: _line_kernels(p, *new), 1)[0])
+        o_min, n_min = min(t_old), min(t_new)
+        print(f"{name:<11} {o_min * 1e3:7.3f} / {statistics.median(t_old) * 1e3:6.3f} "
+              f"{n_min * 1e3:7.3f} / {statistics.median(t_new) * 1e3:6.3f} "
+              f"{o_min / n_min:9.2f}")
 
 
 def main():

@@ -166,6 +166,46 @@ def test_rqa_equals_the_definition_on_the_full_matrix(name, eps, theiler, l_min)
     assert_matches_brute_force(POINT_SETS[name], eps, theiler, l_min)
 
 
+@pytest.mark.parametrize("l_min", [1, 2, 3, 4])
+@pytest.mark.parametrize("theiler", [0, 1, 5])
+def test_many_batches_of_pairs_equal_the_definition(theiler, l_min):
+    # the sweep accounts the recurrent pairs in batches of about _BATCH, the largest
+    # threshold without a walk unless a line can beat the longest (l_min <= 2); here the
+    # pairs fill several batches and the lines have many lengths
+    from kicktimes.diagnostics import recurrence
+
+    pts = trajectory(900, seed=3, tau=0.02)
+    eps = [0.15, 0.05]
+    res = rqa(pts, eps, theiler=theiler, l_min=l_min, laminarity=False)
+    assert res[0].n_recurrent / 2 > 6 * recurrence._BATCH
+    for e, got in zip(eps, res, strict=True):
+        ref = brute_rqa(pts, e, theiler, l_min)
+        for key in ("n_recurrent", "rr", "det", "l_mean", "l_max", "n_lines"):
+            assert getattr(got, key) == ref[key], (e, key, getattr(got, key), ref[key])
+
+
+@pytest.mark.parametrize("grid", ["dense", "sparse"])
+def test_a_point_with_more_candidates_than_the_buffer(grid, monkeypatch):
+    # 4500 samples within 1e-6 of each other: every pair recurs, each point has thousands
+    # of candidates (more than the sweep's buffer of 2 * _BATCH pairs); the upper triangle
+    # holds one line of length N - d on each diagonal d >= 1
+    from kicktimes.diagnostics import recurrence
+
+    n = 4500
+    pts = 0.3 + 1e-7 * np.random.default_rng(5).uniform(size=(n, 2))
+    if grid == "sparse":
+        monkeypatch.setattr(recurrence, "_DENSE_CELLS_PER_POINT", 0)
+        monkeypatch.setattr(recurrence, "_DENSE_CELLS_MIN", 0)
+    assert n > 2 * recurrence._BATCH
+    for l_min in (1, 2, 3):
+        res = rqa(pts, 1e-3, theiler=1, l_min=l_min, laminarity=False)
+        assert res.n_recurrent == n * (n - 1)
+        assert res.n_lines == 2 * (n - l_min)  # diagonals d = 1 .. n - l_min, both sides
+        on_lines = 2 * sum(n - d for d in range(1, n - l_min + 1))
+        assert res.det == on_lines / (n * (n - 1))
+        assert res.l_max == n - 1
+
+
 @settings(max_examples=150, deadline=None)
 @given(
     data=st.lists(

@@ -215,21 +215,25 @@ def _dense_cells_lines(points, xmin, ymin, inv_h, ncx, n_cells):
     """
     n = points.shape[0]
     keys = _cell_keys(points, xmin, ymin, inv_h, ncx)
-    start = np.zeros(n_cells + 1, np.int64)
-    for a in range(n):
-        start[keys[a] + 1] += 1
-    for c in range(n_cells):
-        start[c + 1] += start[c]
-    fill = start[:n_cells].copy()
-    g = np.empty((n, 6))
+    # counts shifted by two, so that after the prefix sum start[k + 1] is the first slot
+    # of cell k and the placing pass leaves start[k] = first position of cell k (no copy)
+    start = np.zeros(n_cells + 2, np.int64)
+    for i in range(n):
+        start[keys[i] + 2] += 1
+    for c in range(1, n_cells + 2):
+        start[c] += start[c - 1]
     perm = np.empty(n, np.int64)
     skey = np.empty(n, np.int64)
     for i in range(n):
         k = keys[i]
-        a = fill[k]
-        fill[k] = a + 1
+        a = start[k + 1]
+        start[k + 1] = a + 1
         perm[a] = i
         skey[a] = k
+    # then the rows in sorted order: sequential writes, reads of three adjacent samples
+    g = np.empty((n, 6))
+    for a in range(n):
+        i = perm[a]
         g[a, 0] = points[i, 0]
         g[a, 1] = points[i, 1]
         if i > 0:
@@ -242,7 +246,7 @@ def _dense_cells_lines(points, xmin, ymin, inv_h, ncx, n_cells):
             g[a, 5] = points[i + 1, 1]
         else:
             g[a, 4] = g[a, 5] = np.nan
-    return g, perm, skey, start
+    return g, perm, skey, start[: n_cells + 1]
 
 
 @njit(cache=True, inline="always")
@@ -316,23 +320,29 @@ def _visit_block(xs, ys, perm, a0, a1, b0, b1, same, eps2, w, mode, count, buf):
 
 
 @njit(cache=True, inline="always")
-def _pair_lines(g, a, b, ia, ib, d2, pts, eps2s, count, diag):
-    """Account the recurrent pair of sorted positions ``a, b`` (original ``ia, ib``, squared
-    distance ``d2``) at every threshold ``eps2s[k]`` (decreasing) that it meets.
+def _walk(pts, ia, ib, e2):
+    """Length of the diagonal line that starts at the recurrent pair ``ia, ib`` whose
+    successor is recurrent too (so at least 2)."""
+    i = min(ia, ib)
+    j = max(ia, ib)
+    length = 2
+    while j + length < pts.shape[0] and _recurrent(pts, i + length, j + length, e2):
+        length += 1
+    return length
+
+
+@njit(cache=True, inline="always")
+def _pair_lines(k0, d2, p2, s2, ia, ib, pts, eps2s, count, diag):
+    """Account a recurrent pair (original ``ia, ib``, squared distance ``d2``, squared
+    distances ``p2`` of its predecessor and ``s2`` of its successor pair) at every
+    threshold ``eps2s[k]``, ``k >= k0`` (decreasing), that it meets.
 
     ``count[k]`` counts it and, if the pair ``i < j`` starts a diagonal line
     (``(i - 1, j - 1)`` not recurrent), the line ``(i + k, j + k)`` is walked and
     accounted in ``diag[k]`` (`_add_line`): every line of the upper triangle is counted
-    once, at its start, with O(1) work per recurrent pair and no pair stored. The first
-    two tests read the time neighbours in ``g``, the rest of a walk reads ``pts``.
+    once, at its start, with O(1) work per recurrent pair and no pair stored.
     """
-    px = g[a, 2] - g[b, 2]
-    py = g[a, 3] - g[b, 3]
-    p2 = px * px + py * py  # NaN without a predecessor: never <= e2
-    sx = g[a, 4] - g[b, 4]
-    sy = g[a, 5] - g[b, 5]
-    s2 = sx * sx + sy * sy
-    for k in range(eps2s.shape[0]):
+    for k in range(k0, eps2s.shape[0]):
         e2 = eps2s[k]
         if not (d2 <= e2):
             break
@@ -340,12 +350,97 @@ def _pair_lines(g, a, b, ia, ib, d2, pts, eps2s, count, diag):
         if not (p2 <= e2):  # (i, j) starts a diagonal line: walk it
             length = 1
             if s2 <= e2:
-                i = min(ia, ib)
-                j = max(ia, ib)
-                length = 2
-                while j + length < pts.shape[0] and _recurrent(pts, i + length, j + length, e2):
-                    length += 1
+                length = _walk(pts, ia, ib, e2)
             _add_line(diag, k, length)
+
+
+# Recurrent pairs are gathered over many points into a buffer until it holds this many
+# pairs, then accounted in one loop (`_account_pairs`): a loop per point over its few pairs costs
+# a mispredicted exit per point, and that was the sweep's largest cost (measured 1.7x on
+# billiard samples at eps = 1e-2, benchmarks/bench_recurrence.py).
+_BATCH = 2048
+# Fields of the accumulator of the first (largest) threshold, see `_account_pairs`.
+_PAIRS, _STARTS2, _ON2, _SINGLE, _LONGEST = 0, 1, 2, 3, 4
+
+
+@njit(cache=True)
+def _account_pairs(g, perm, pts, pa, pb, pd2, m, w, eps2s, count, diag, acc):
+    """Account ``m`` pairs of sorted positions ``pa[t], pb[t]``, recurrent at the largest
+    threshold (squared distances ``pd2[t] <= eps2s[0]``), at every threshold.
+
+    With ``l_min <= 2`` (``diag[0, 0]``) the first threshold needs no walk but to find the
+    longest line, and is accounted without a branch in ``acc``: pairs, starts of lines of
+    length >= 2 (``(i - 1, j - 1)`` not recurrent, ``(i + 1, j + 1)`` recurrent), entries
+    with a recurrent predecessor or successor (the entries of those lines), isolated
+    entries (lines of length 1) and the longest line (`_finish_lines` adds them to
+    ``count[0], diag[0]``). A line is walked only if it can beat the longest so far,
+    which the single test of ``(i + longest, j + longest)`` decides. The other thresholds,
+    and every threshold for ``l_min > 2``, go through `_pair_lines`.
+    """
+    n = pts.shape[0]
+    e20 = eps2s[0]
+    e21 = eps2s[1] if eps2s.shape[0] > 1 else -1.0
+    fast = diag[0, 0] <= 2
+    pairs = acc[_PAIRS]
+    starts2 = acc[_STARTS2]
+    on2 = acc[_ON2]
+    single = acc[_SINGLE]
+    longest = acc[_LONGEST]
+    for t in range(m):
+        a = pa[t]
+        b = pb[t]
+        ia = perm[a]
+        ib = perm[b]
+        if w > 1 and abs(ia - ib) < w:
+            continue
+        px = g[a, 2] - g[b, 2]
+        py = g[a, 3] - g[b, 3]
+        p2 = px * px + py * py  # NaN without a predecessor: never <= e2
+        sx = g[a, 4] - g[b, 4]
+        sy = g[a, 5] - g[b, 5]
+        s2 = sx * sx + sy * sy
+        d2 = pd2[t]
+        if not fast:
+            _pair_lines(0, d2, p2, s2, ia, ib, pts, eps2s, count, diag)
+            continue
+        pred = p2 <= e20
+        succ = s2 <= e20
+        pairs += 1
+        on2 += pred | succ
+        single += not (pred | succ)
+        start2 = (not pred) & succ
+        starts2 += start2
+        if start2:
+            # a line longer than `longest` contains (i + longest, j + longest)
+            i = min(ia, ib)
+            j = max(ia, ib)
+            if j + longest < n and _recurrent(pts, i + longest, j + longest, e20):
+                longest = max(longest, _walk(pts, ia, ib, e20))
+        if d2 <= e21:
+            _pair_lines(1, d2, p2, s2, ia, ib, pts, eps2s, count, diag)
+    acc[_PAIRS] = pairs
+    acc[_STARTS2] = starts2
+    acc[_ON2] = on2
+    acc[_SINGLE] = single
+    acc[_LONGEST] = longest
+
+
+@njit(cache=True)
+def _finish_lines(acc, count, diag):
+    """Add the first threshold's accumulator of `_account_pairs` (``l_min <= 2``) to
+    ``count[0]`` and ``diag[0]``."""
+    if diag[0, 0] > 2:
+        return
+    single = acc[_SINGLE]
+    count[0] += acc[_PAIRS]
+    if diag[0, 0] <= 1:  # isolated entries are lines too
+        diag[0, 1] += acc[_STARTS2] + single
+        diag[0, 2] += acc[_ON2] + single
+    else:
+        diag[0, 1] += acc[_STARTS2]
+        diag[0, 2] += acc[_ON2]
+    longest = max(acc[_LONGEST], 1 if single > 0 else 0)
+    diag[0, 3] = max(diag[0, 3], longest)
 
 
 @njit(cache=True)
@@ -394,22 +489,39 @@ def _sweep(xs, ys, perm, cell_start, cell_key, ncx, eps2, w, mode, count, buf):
 
 
 @njit(cache=True)
+def _most_in_a_cell(start):
+    """The largest ``start[c + 1] - start[c]``: the most points in one cell."""
+    most = 0
+    for c in range(start.shape[0] - 1):
+        most = max(most, start[c + 1] - start[c])
+    return most
+
+
+@njit(cache=True)
 def _sweep_lines(g, perm, cell_start, cell_key, ncx, w, pts, eps2s, count, diag):
-    """The half-stencil sweep of `_sweep` for the line statistics (`_pair_lines`).
+    """The half-stencil sweep of `_sweep` for the line statistics (`_account_pairs`).
 
     Same pairs as `_sweep`, visited as two contiguous ranges per point: its own cell's
     later points plus the next cell of the row (adjacent when sorted), and the three cells
     of the row above (``key + ncx + (-1, 0, 1)``, also adjacent when sorted). The
-    candidates of a point are first compacted without a branch (``m += d2 <= eps2``):
-    most candidates are not recurrent, and a data-dependent branch per candidate costs
-    more than the test (measured 1.2x on billiard samples, benchmarks/bench_recurrence.py).
+    candidates are compacted without a branch (``m += d2 <= eps2``): most candidates are
+    not recurrent, and a data-dependent branch per candidate costs more than the test
+    (measured 1.2x on billiard samples, benchmarks/bench_recurrence.py). The recurrent
+    ones gather over many points into a buffer, accounted in one loop once it holds
+    ``_BATCH`` pairs, so it needs room for ``_BATCH`` plus one point's candidates (five
+    cells' worth: O(1) memory for bounded cell occupancy, and it stays in cache).
     Kept apart from `_sweep` on purpose: one kernel with both bodies made the plain
     counting sweep of `recurrence_rate` 2.5x slower (measured).
     """
     n_cells = cell_key.shape[0]
     eps2 = eps2s[0]
-    cand = np.empty(g.shape[0], np.int64)
-    dist2 = np.empty(g.shape[0])
+    # a point's candidates lie in 5 cells; the buffer never holds more than _BATCH + those
+    cap = _BATCH + 5 * _most_in_a_cell(cell_start)
+    pa = np.empty(cap, np.int64)
+    pb = np.empty(cap, np.int64)
+    pd2 = np.empty(cap)
+    acc = np.zeros(5, np.int64)
+    m = 0
     q = 0
     for c in range(n_cells):
         key = cell_key[c]
@@ -430,28 +542,27 @@ def _sweep_lines(g, perm, cell_start, cell_key, ncx, w, pts, eps2s, count, diag)
         for a in range(s0, s1):
             xa = g[a, 0]
             ya = g[a, 1]
-            m = 0
             for b in range(a + 1, e1):
                 dx = xa - g[b, 0]
                 dy = ya - g[b, 1]
                 d2 = dx * dx + dy * dy
-                cand[m] = b
-                dist2[m] = d2
+                pa[m] = a
+                pb[m] = b
+                pd2[m] = d2
                 m += d2 <= eps2
             for b in range(u0, u1):
                 dx = xa - g[b, 0]
                 dy = ya - g[b, 1]
                 d2 = dx * dx + dy * dy
-                cand[m] = b
-                dist2[m] = d2
+                pa[m] = a
+                pb[m] = b
+                pd2[m] = d2
                 m += d2 <= eps2
-            ia = perm[a]
-            for t in range(m):
-                b = cand[t]
-                ib = perm[b]
-                if w > 1 and abs(ia - ib) < w:
-                    continue
-                _pair_lines(g, a, b, ia, ib, dist2[t], pts, eps2s, count, diag)
+            if m >= _BATCH:
+                _account_pairs(g, perm, pts, pa, pb, pd2, m, w, eps2s, count, diag, acc)
+                m = 0
+    _account_pairs(g, perm, pts, pa, pb, pd2, m, w, eps2s, count, diag, acc)
+    _finish_lines(acc, count, diag)
 
 
 @njit(cache=True)
@@ -469,34 +580,41 @@ def _sweep_lines_dense(g, perm, skey, start, ncx, w, pts, eps2s, count, diag):
     """
     n = g.shape[0]
     eps2 = eps2s[0]
-    cand = np.empty(n, np.int64)
-    dist2 = np.empty(n)
+    # a point's candidates lie in 5 cells; the buffer never holds more than _BATCH + those
+    cap = _BATCH + 5 * _most_in_a_cell(start)
+    pa = np.empty(cap, np.int64)
+    pb = np.empty(cap, np.int64)
+    pd2 = np.empty(cap)
+    acc = np.zeros(5, np.int64)
+    m = 0
     for a in range(n):
         key = skey[a]
+        e1 = start[key + 2]
+        u0 = start[key + ncx - 1]
+        u1 = start[key + ncx + 2]
         xa = g[a, 0]
         ya = g[a, 1]
-        m = 0
-        for b in range(a + 1, start[key + 2]):
+        for b in range(a + 1, e1):
             dx = xa - g[b, 0]
             dy = ya - g[b, 1]
             d2 = dx * dx + dy * dy
-            cand[m] = b
-            dist2[m] = d2
+            pa[m] = a
+            pb[m] = b
+            pd2[m] = d2
             m += d2 <= eps2
-        for b in range(start[key + ncx - 1], start[key + ncx + 2]):
+        for b in range(u0, u1):
             dx = xa - g[b, 0]
             dy = ya - g[b, 1]
             d2 = dx * dx + dy * dy
-            cand[m] = b
-            dist2[m] = d2
+            pa[m] = a
+            pb[m] = b
+            pd2[m] = d2
             m += d2 <= eps2
-        ia = perm[a]
-        for t in range(m):
-            b = cand[t]
-            ib = perm[b]
-            if w > 1 and abs(ia - ib) < w:
-                continue
-            _pair_lines(g, a, b, ia, ib, dist2[t], pts, eps2s, count, diag)
+        if m >= _BATCH:
+            _account_pairs(g, perm, pts, pa, pb, pd2, m, w, eps2s, count, diag, acc)
+            m = 0
+    _account_pairs(g, perm, pts, pa, pb, pd2, m, w, eps2s, count, diag, acc)
+    _finish_lines(acc, count, diag)
 
 
 @njit(cache=True)
