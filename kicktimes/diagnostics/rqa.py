@@ -9,7 +9,10 @@ Its recurrent pairs are enumerated once by the cell-list sweep of
   whose predecessor ``(i - 1, j - 1)`` is not recurrent, the pair starts a line: the
   line is walked, ``(i + 1, j + 1), (i + 2, j + 2), ...``, testing distances directly,
   and its length is accounted (lines of length >= l_min, entries on them, longest).
-  Every line is counted once, at its start;
+  Every line is counted once, at its start. For ``l_min <= 2`` the counts need no walk
+  (a line of length >= 2 starts at a pair with a recurrent successor; its entries are
+  the pairs with a recurrent predecessor or successor), and only a line that may be
+  the longest is walked;
 * a **vertical line** is a maximal run ``(i + k, j)`` in one column, counted the same
   way (predecessor test, then a walk) from every recurrent entry of the recurrence
   plot's rows; only for the laminarity, which therefore costs a second sweep and
@@ -162,12 +165,14 @@ def rqa(points, eps=1e-3, *, theiler=1, l_min=2, laminarity=True):
 
     Cost: one sweep of the cell list of `recurrence_rate`, for all thresholds at once
     (at the largest); each recurrent pair adds two distance tests (predecessor and
-    successor, read from the time neighbours gathered in cell order; the candidates of
-    a point are compacted without branches before the recurrent ones are accounted)
-    and each line of length ``>= 2`` is walked once. O(N) memory, never an ``N x N``
-    matrix nor the pair list; about 1.2x the time of `recurrence_rate` at eps = 1e-3
-    and 1.0-1.2x at 1e-2 for N = 25 000 (``laminarity=False``; at 1e-2 the cells are a
-    dense grid, see `kicktimes.diagnostics.recurrence`; benchmarks/bench_recurrence.py). The
+    successor, read from the time neighbours gathered in cell order). The recurrent pairs
+    gather over many points in a buffer and are accounted in one loop; at the largest
+    threshold with ``l_min <= 2`` the line counts are sums of those two tests, and a line
+    is walked only when it can be longer than the longest so far. O(N) memory, never an
+    ``N x N`` matrix nor the pair list; 0.8-1.2x the time of `recurrence_rate` for
+    N = 25 000 (``laminarity=False``; at 1e-2 the cells are a dense grid, see
+    `kicktimes.diagnostics.recurrence`; benchmarks/bench_recurrence.py, which also times
+    the line kernels against the former per-point accounting: 1.30-1.38x). The
     laminarity adds a sweep that collects the pairs into sorted rows.
 
     References
