@@ -319,7 +319,7 @@ def _visit_block(xs, ys, perm, a0, a1, b0, b1, same, eps2, w, mode, count, buf):
     return total
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _walk(pts, ia, ib, e2):
     """Length of the diagonal line that starts at the recurrent pair ``ia, ib`` whose
     successor is recurrent too (so at least 2)."""
@@ -331,7 +331,7 @@ def _walk(pts, ia, ib, e2):
     return length
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _pair_lines(k0, d2, p2, s2, ia, ib, pts, eps2s, count, diag):
     """Account a recurrent pair (original ``ia, ib``, squared distance ``d2``, squared
     distances ``p2`` of its predecessor and ``s2`` of its successor pair) at every
@@ -381,6 +381,10 @@ def _account_pairs(g, perm, pts, pa, pb, pd2, m, w, eps2s, count, diag, acc):
     e20 = eps2s[0]
     e21 = eps2s[1] if eps2s.shape[0] > 1 else -1.0
     fast = diag[0, 0] <= 2
+    # the thresholds `_pair_lines` accounts from: all, or those after the first (int64
+    # variables: literal arguments would compile it once per value)
+    k_all = np.int64(0)
+    k_rest = np.int64(1)
     pairs = acc[_PAIRS]
     starts2 = acc[_STARTS2]
     on2 = acc[_ON2]
@@ -401,7 +405,7 @@ def _account_pairs(g, perm, pts, pa, pb, pd2, m, w, eps2s, count, diag, acc):
         s2 = sx * sx + sy * sy
         d2 = pd2[t]
         if not fast:
-            _pair_lines(0, d2, p2, s2, ia, ib, pts, eps2s, count, diag)
+            _pair_lines(k_all, d2, p2, s2, ia, ib, pts, eps2s, count, diag)
             continue
         pred = p2 <= e20
         succ = s2 <= e20
@@ -417,7 +421,7 @@ def _account_pairs(g, perm, pts, pa, pb, pd2, m, w, eps2s, count, diag, acc):
             if j + longest < n and _recurrent(pts, i + longest, j + longest, e20):
                 longest = max(longest, _walk(pts, ia, ib, e20))
         if d2 <= e21:
-            _pair_lines(1, d2, p2, s2, ia, ib, pts, eps2s, count, diag)
+            _pair_lines(k_rest, d2, p2, s2, ia, ib, pts, eps2s, count, diag)
     acc[_PAIRS] = pairs
     acc[_STARTS2] = starts2
     acc[_ON2] = on2
@@ -521,7 +525,9 @@ def _sweep_lines(g, perm, cell_start, cell_key, ncx, w, pts, eps2s, count, diag)
     pb = np.empty(cap, np.int64)
     pd2 = np.empty(cap)
     acc = np.zeros(5, np.int64)
-    m = 0
+    # an int64 from the start: with m = 0 numba's type inference first sees a literal 0
+    # and compiles `_account_pairs` for it too (a second signature, twice the compile)
+    m = np.int64(0)
     q = 0
     for c in range(n_cells):
         key = cell_key[c]
@@ -586,7 +592,9 @@ def _sweep_lines_dense(g, perm, skey, start, ncx, w, pts, eps2s, count, diag):
     pb = np.empty(cap, np.int64)
     pd2 = np.empty(cap)
     acc = np.zeros(5, np.int64)
-    m = 0
+    # an int64 from the start: with m = 0 numba's type inference first sees a literal 0
+    # and compiles `_account_pairs` for it too (a second signature, twice the compile)
+    m = np.int64(0)
     for a in range(n):
         key = skey[a]
         e1 = start[key + 2]
