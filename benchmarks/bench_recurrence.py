@@ -12,7 +12,8 @@ References, measured in the same run:
 * brute force with numpy (row blocks of the distance matrix) at a smaller N, scaled by
   (N / n_small)^2.
 Then the scaling of our code to N = 10^6 and 10^7 with its extra peak memory (growth
-of the peak resident set during the call, each N in a fresh process).
+of the peak resident set during the call, each N in a fresh process), and the same for
+``rqa`` with its defaults (laminarity included) at N = 10^5 and 10^6.
 
 RQA (``rqa``: the recurrent pairs kept as sorted rows, then the line statistics) against
 ``recurrence_rate`` of the same points in the same run, N = 25 000, eps = 1e-3 and 1e-2,
@@ -103,6 +104,53 @@ def scaling_row(size, eps):
         text=True,
     )
     return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+def rqa_scaling_row(size, eps):
+    """`rqa` (laminarity included) of one N in a fresh process (see --child-rqa)."""
+    out = subprocess.run(
+        [sys.executable, __file__, "--child-rqa", str(size), "--eps", repr(eps)],
+        check=True,
+        capture_output=True,
+        text=True,
+    )
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+def child_rqa(size, eps):
+    """`rqa(points, eps)` with its defaults (laminarity included) on the chords: the time
+    (min of a first call and 2 more) and the peak RSS the first call added."""
+    rqa(uniform_disk(300, 0), eps)  # load the kernels of this grid outside the timing
+    pts = kicked_chords(size, 0.2, 3)
+    with open("/proc/self/clear_refs", "w") as fh:
+        fh.write("5")
+    before = _status_kb("VmRSS")
+    t0 = time.perf_counter()
+    res = rqa(pts, eps)
+    dt = time.perf_counter() - t0
+    extra = (_status_kb("VmHWM") - before) * 1024
+    dt = min(dt, timeit(lambda: rqa(pts, eps), 2)[0])
+    print(json.dumps({"n": size, "pairs": res.n_recurrent // 2, "lam": res.lam,
+                      "time": dt, "extra_bytes": extra}))
+
+
+def rqa_scaling(sizes):
+    """rqa() with laminarity at large N, each N and eps in a fresh process."""
+    print()
+    print("rqa(points, eps) with its defaults (laminarity included), chords, each N in a fresh")
+    print("process: time (min of 3) and peak RSS added by the call")
+    header = (
+        f"{'N':>10} {'eps':>6} {'pairs':>11} {'LAM':>7} {'time [s]':>9} {'mem [MB]':>9} "
+        f"{'B/point':>8}"
+    )
+    print(header)
+    print("-" * len(header))
+    for size in sizes:
+        for eps in (1e-3, 1e-2):
+            row = rqa_scaling_row(size, eps)
+            mem = row["extra_bytes"]
+            print(f"{size:>10} {eps:6g} {row['pairs']:>11} {row['lam']:7.4f} {row['time']:9.3f} "
+                  f"{mem / 2**20:9.1f} {mem / size:8.1f}")
 
 
 def _status_kb(field):
@@ -347,17 +395,22 @@ def main():
     parser.add_argument("--rqa-only", action="store_true", help="only the RQA table")
     parser.add_argument("--max-n", type=float, default=1e7, help="largest N of the scaling")
     parser.add_argument("--child", type=int, default=0, help=argparse.SUPPRESS)
+    parser.add_argument("--child-rqa", type=int, default=0, help=argparse.SUPPRESS)
     parser.add_argument("--eps", type=float, default=1e-3, help="recurrence threshold")
     args = parser.parse_args()
     eps = args.eps
     if args.child:
         child(args.child, eps)
         return
+    if args.child_rqa:
+        child_rqa(args.child_rqa, eps)
+        return
     n = 25_000
     n_brute = 5_000
     rep = 5 if args.quick else 30
     if args.rqa_only:
         rqa_table(rep)
+        rqa_scaling([10**5, 10**6])
         return
 
     recurrence_rate(uniform_disk(100, 0), eps)  # compile / load the cache outside timings
@@ -416,6 +469,7 @@ def main():
             f"{size:>10} {row['rr']:11.4e} {dt:9.4f} {dt / size * 1e9:9.1f} "
             f"{mem / 2**20:9.1f} {mem / size:8.1f} {kdt}"
         )
+    rqa_scaling([10**5, 10**6])
 
 
 if __name__ == "__main__":

@@ -170,18 +170,19 @@ def test_rqa_equals_the_definition_on_the_full_matrix(name, eps, theiler, l_min)
 @pytest.mark.parametrize("theiler", [0, 1, 5])
 def test_many_batches_of_pairs_equal_the_definition(theiler, l_min):
     # the sweep accounts the recurrent pairs in batches of about _BATCH, the largest
-    # threshold without a walk unless a line can beat the longest (l_min <= 2); here the
-    # pairs fill several batches and the lines have many lengths
+    # threshold without a walk unless a line can beat the longest (l_min <= 2), and the
+    # vertical lines through both entries of each pair; here the pairs fill several
+    # batches and the lines have many lengths
     from kicktimes.diagnostics import recurrence
 
     pts = trajectory(900, seed=3, tau=0.02)
     eps = [0.15, 0.05]
-    res = rqa(pts, eps, theiler=theiler, l_min=l_min, laminarity=False)
+    res = rqa(pts, eps, theiler=theiler, l_min=l_min)
     assert res[0].n_recurrent / 2 > 6 * recurrence._BATCH
     for e, got in zip(eps, res, strict=True):
         ref = brute_rqa(pts, e, theiler, l_min)
-        for key in ("n_recurrent", "rr", "det", "l_mean", "l_max", "n_lines"):
-            assert getattr(got, key) == ref[key], (e, key, getattr(got, key), ref[key])
+        for key, value in ref.items():
+            assert getattr(got, key) == value, (e, key, getattr(got, key), value)
 
 
 @pytest.mark.parametrize("grid", ["dense", "sparse"])
@@ -198,12 +199,18 @@ def test_a_point_with_more_candidates_than_the_buffer(grid, monkeypatch):
         monkeypatch.setattr(recurrence, "_DENSE_CELLS_MIN", 0)
     assert n > 2 * recurrence._BATCH
     for l_min in (1, 2, 3):
-        res = rqa(pts, 1e-3, theiler=1, l_min=l_min, laminarity=False)
+        res = rqa(pts, 1e-3, theiler=1, l_min=l_min)
         assert res.n_recurrent == n * (n - 1)
         assert res.n_lines == 2 * (n - l_min)  # diagonals d = 1 .. n - l_min, both sides
         on_lines = 2 * sum(n - d for d in range(1, n - l_min + 1))
         assert res.det == on_lines / (n * (n - 1))
         assert res.l_max == n - 1
+        # column j: rows 0 .. j-1 and j+1 .. n-1, the diagonal entry (Theiler 1) cuts it
+        runs = [v for j in range(n) for v in (j, n - 1 - j) if v >= l_min]
+        assert res.lam == sum(runs) / (n * (n - 1)) and res.v_max == n - 1
+        assert res.tt == sum(runs) / len(runs)
+    res0 = rqa(pts, 1e-3, theiler=0)  # with the diagonal: every column is one run of n
+    assert (res0.lam, res0.tt, res0.v_max) == (1.0, n, n)
 
 
 @settings(max_examples=150, deadline=None)

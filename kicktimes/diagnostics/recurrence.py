@@ -493,6 +493,74 @@ def _sweep(xs, ys, perm, cell_start, cell_key, ncx, eps2, w, mode, count, buf):
 
 
 @njit(cache=True)
+def _vertical_entry(pts, r, c, p2, s2, e2, wv, vert, k):
+    """Account entry ``(r, c)`` (row, column) in ``vert[k]`` if it starts a vertical line.
+
+    ``p2`` and ``s2`` are the squared distances of ``(r - 1, c)`` and ``(r + 1, c)`` (NaN
+    beyond the ends); an entry of the Theiler band ``|i - j| < wv`` is not admissible and
+    ends a run. The tests are those of `_vertical_line`, on the same float values.
+    """
+    if abs(r - 1 - c) >= wv and p2 <= e2:
+        return  # the run started above
+    length = 1
+    if abs(r + 1 - c) >= wv and s2 <= e2:
+        length = 2
+        n = pts.shape[0]
+        while r + length < n and abs(r + length - c) >= wv and _recurrent(pts, r + length, c, e2):
+            length += 1
+    _add_line(vert, k, length)
+
+
+@njit(cache=True)
+def _account_vertical(g, perm, pts, pa, pb, pd2, m, w, wv, eps2s, vert):
+    """The vertical lines through both entries ``(i, j)`` and ``(j, i)`` of ``m`` pairs of
+    sorted positions ``pa[t], pb[t]`` (recurrent at the largest threshold), at every
+    threshold they meet; ``wv`` is the Theiler window of the matrix (0: the main diagonal
+    is admissible, see `_diagonal_vertical`). Both entries' neighbours in their column,
+    ``(i +- 1, j)`` and ``(j +- 1, i)``, are read from the time neighbours in ``g``."""
+    for t in range(m):
+        a = pa[t]
+        b = pb[t]
+        ia = perm[a]
+        ib = perm[b]
+        if w > 1 and abs(ia - ib) < w:
+            continue
+        d2 = pd2[t]
+        xa = g[a, 0]
+        ya = g[a, 1]
+        xb = g[b, 0]
+        yb = g[b, 1]
+        # column ib: rows ia - 1 and ia + 1; column ia: rows ib - 1 and ib + 1
+        dx = g[a, 2] - xb
+        dy = g[a, 3] - yb
+        pa2 = dx * dx + dy * dy
+        dx = g[a, 4] - xb
+        dy = g[a, 5] - yb
+        sa2 = dx * dx + dy * dy
+        dx = g[b, 2] - xa
+        dy = g[b, 3] - ya
+        pb2 = dx * dx + dy * dy
+        dx = g[b, 4] - xa
+        dy = g[b, 5] - ya
+        sb2 = dx * dx + dy * dy
+        for k in range(eps2s.shape[0]):
+            e2 = eps2s[k]
+            if not (d2 <= e2):
+                break
+            _vertical_entry(pts, ia, ib, pa2, sa2, e2, wv, vert, k)
+            _vertical_entry(pts, ib, ia, pb2, sb2, e2, wv, vert, k)
+
+
+@njit(cache=True)
+def _diagonal_vertical(pts, eps2s, vert):
+    """The vertical lines through the main diagonal's entries ``(j, j)`` (Theiler window
+    0), at every threshold: the sweep visits the pairs ``i != j`` only."""
+    for j in range(pts.shape[0]):
+        for k in range(eps2s.shape[0]):
+            _vertical_line(pts, j, j, eps2s[k], 0, vert, k)
+
+
+@njit(cache=True)
 def _most_in_a_cell(start):
     """The largest ``start[c + 1] - start[c]``: the most points in one cell."""
     most = 0
@@ -502,7 +570,7 @@ def _most_in_a_cell(start):
 
 
 @njit(cache=True)
-def _sweep_lines(g, perm, cell_start, cell_key, ncx, w, pts, eps2s, count, diag):
+def _sweep_lines(g, perm, cell_start, cell_key, ncx, w, pts, eps2s, count, diag, wv, vert):
     """The half-stencil sweep of `_sweep` for the line statistics (`_account_pairs`).
 
     Same pairs as `_sweep`, visited as two contiguous ranges per point: its own cell's
@@ -525,6 +593,7 @@ def _sweep_lines(g, perm, cell_start, cell_key, ncx, w, pts, eps2s, count, diag)
     pb = np.empty(cap, np.int64)
     pd2 = np.empty(cap)
     acc = np.zeros(5, np.int64)
+    vertical = vert.shape[0] > 0  # laminarity: a row of vert per threshold
     # an int64 from the start: with m = 0 numba's type inference first sees a literal 0
     # and compiles `_account_pairs` for it too (a second signature, twice the compile)
     m = np.int64(0)
@@ -566,13 +635,17 @@ def _sweep_lines(g, perm, cell_start, cell_key, ncx, w, pts, eps2s, count, diag)
                 m += d2 <= eps2
             if m >= _BATCH:
                 _account_pairs(g, perm, pts, pa, pb, pd2, m, w, eps2s, count, diag, acc)
+                if vertical:
+                    _account_vertical(g, perm, pts, pa, pb, pd2, m, w, wv, eps2s, vert)
                 m = 0
     _account_pairs(g, perm, pts, pa, pb, pd2, m, w, eps2s, count, diag, acc)
+    if vertical:
+        _account_vertical(g, perm, pts, pa, pb, pd2, m, w, wv, eps2s, vert)
     _finish_lines(acc, count, diag)
 
 
 @njit(cache=True)
-def _sweep_lines_dense(g, perm, skey, start, ncx, w, pts, eps2s, count, diag):
+def _sweep_lines_dense(g, perm, skey, start, ncx, w, pts, eps2s, count, diag, wv, vert):
     """`_sweep_lines` on the dense grid of `_dense_cells_lines`: the same candidates in the
     same order, hence the same counts.
 
@@ -592,6 +665,7 @@ def _sweep_lines_dense(g, perm, skey, start, ncx, w, pts, eps2s, count, diag):
     pb = np.empty(cap, np.int64)
     pd2 = np.empty(cap)
     acc = np.zeros(5, np.int64)
+    vertical = vert.shape[0] > 0  # laminarity: a row of vert per threshold
     # an int64 from the start: with m = 0 numba's type inference first sees a literal 0
     # and compiles `_account_pairs` for it too (a second signature, twice the compile)
     m = np.int64(0)
@@ -620,8 +694,12 @@ def _sweep_lines_dense(g, perm, skey, start, ncx, w, pts, eps2s, count, diag):
             m += d2 <= eps2
         if m >= _BATCH:
             _account_pairs(g, perm, pts, pa, pb, pd2, m, w, eps2s, count, diag, acc)
+            if vertical:
+                _account_vertical(g, perm, pts, pa, pb, pd2, m, w, wv, eps2s, vert)
             m = 0
     _account_pairs(g, perm, pts, pa, pb, pd2, m, w, eps2s, count, diag, acc)
+    if vertical:
+        _account_vertical(g, perm, pts, pa, pb, pd2, m, w, wv, eps2s, vert)
     _finish_lines(acc, count, diag)
 
 
@@ -911,23 +989,6 @@ def _pairs_csr(pts: np.ndarray, eps: float, w: int):
     return _rows_from_pairs(buf, m, n, w == 0)
 
 
-@njit(cache=True)
-def _vertical_sums(pts, offsets, cols, eps2s, wv, sums_v):
-    """Account the vertical lines at each threshold from the recurrence plot's rows.
-
-    ``cols[offsets[i]:offsets[i+1]]`` are the columns ``j`` recurrent with row ``i`` at
-    the largest threshold (both orders, the diagonal when ``wv = 0``); every entry that
-    also recurs at ``eps2s[k]`` and starts a vertical line adds it to ``sums_v[k]``.
-    """
-    for i in range(offsets.shape[0] - 1):
-        for e in range(offsets[i], offsets[i + 1]):
-            j = cols[e]
-            for k in range(eps2s.shape[0]):
-                if not _recurrent(pts, i, j, eps2s[k]):
-                    break
-                _vertical_line(pts, i, j, eps2s[k], wv, sums_v, k)
-
-
 def _line_sums(pts: np.ndarray, eps_list, w: int, l_min: int, vertical: bool):
     """(pairs, diag, vert) for each threshold of ``eps_list`` (decreasing), in one sweep.
 
@@ -938,23 +999,29 @@ def _line_sums(pts: np.ndarray, eps_list, w: int, l_min: int, vertical: bool):
     lines of the whole matrix (zeros unless ``vertical``), over the admissible entries
     ``|i - j| >= w``. The cell list is built for the largest threshold, whose candidate
     pairs contain those of the smaller ones. O(N) memory (the cells and the time
-    neighbours); no pair and no histogram is stored, except for the vertical lines, which
-    read the recurrence plot's rows (O(N + pairs), a second sweep).
+    neighbours); no pair and no histogram is stored. The vertical lines are accounted in
+    the same sweep, at both entries of each pair (`_account_vertical`), plus the
+    diagonal's entries when ``w = 0`` (`_diagonal_vertical`).
     """
     m = len(eps_list)
     xmin, ymin, inv_h, ncx, ncy, n_bits = _grid(pts, eps_list[0])
     eps2s = np.array([e * e for e in eps_list])
     pairs = np.zeros(m, np.int64)
     diag = np.zeros((m, 4), np.int64)
-    vert = np.zeros((m, 4), np.int64)
+    vert = np.zeros((m if vertical else 0, 4), np.int64)
     diag[:, 0] = vert[:, 0] = l_min
     if ncx * ncy <= _DENSE_CELLS_PER_POINT * pts.shape[0] + _DENSE_CELLS_MIN:
         g, perm, skey, start = _dense_cells_lines(pts, xmin, ymin, inv_h, ncx, ncx * ncy)
-        _sweep_lines_dense(g, perm, skey, start, ncx, max(w, 1), pts, eps2s, pairs, diag)
+        _sweep_lines_dense(
+            g, perm, skey, start, ncx, max(w, 1), pts, eps2s, pairs, diag, w, vert
+        )
     else:
         g, perm, cell_start, cell_key = _build_cells_lines(pts, xmin, ymin, inv_h, ncx, n_bits)
-        _sweep_lines(g, perm, cell_start, cell_key, ncx, max(w, 1), pts, eps2s, pairs, diag)
-    if vertical:
-        offsets, cols = _pairs_csr(pts, eps_list[0], w)
-        _vertical_sums(pts, offsets, cols, eps2s, w, vert)
+        _sweep_lines(
+            g, perm, cell_start, cell_key, ncx, max(w, 1), pts, eps2s, pairs, diag, w, vert
+        )
+    if vertical and w == 0:
+        _diagonal_vertical(pts, eps2s, vert)
+    if not vertical:
+        vert = np.zeros((m, 4), np.int64)
     return pairs, diag, vert
