@@ -347,8 +347,10 @@ def _former_sweep_lines_dense(g, perm, skey, start, ncx, w, pts, eps2s, count, d
                     _add_line(diag, k, length)
 
 
-def _line_kernels(pts, build, sweep):
-    """The sweep's call at [1e-2, 1e-3] (Theiler 1, l_min 2) through the given kernels."""
+def _line_kernels(pts, build, sweep, *extra):
+    """The sweep's call at [1e-2, 1e-3] (Theiler 1, l_min 2, no laminarity) through the
+    given kernels (``extra``: the current sweep's Theiler window and empty laminarity
+    sums)."""
     from kicktimes.diagnostics import recurrence
 
     xmin, ymin, inv_h, ncx, ncy, _ = recurrence._grid(pts, 1e-2)
@@ -357,7 +359,7 @@ def _line_kernels(pts, build, sweep):
     diag = np.zeros((2, 4), np.int64)
     diag[:, 0] = 2
     g, perm, skey, start = build(pts, xmin, ymin, inv_h, ncx, ncx * ncy)
-    sweep(g, perm, skey, start, ncx, 1, pts, eps2s, count, diag)
+    sweep(g, perm, skey, start, ncx, 1, pts, eps2s, count, diag, *extra)
     return count, diag
 
 
@@ -367,7 +369,8 @@ def batch_table(sets, rep):
     alternating; the counts must be equal."""
     from kicktimes.diagnostics import recurrence
 
-    new = (recurrence._dense_cells_lines, recurrence._sweep_lines_dense)
+    no_lam = np.zeros((0, 4), np.int64)
+    new = (recurrence._dense_cells_lines, recurrence._sweep_lines_dense, 1, no_lam)
     old = (_former_dense_cells_lines, _former_sweep_lines_dense)
     print()
     print(f"The sweep's line kernels at [1e-2, 1e-3] (build + sweep): batched accounting "
