@@ -28,7 +28,7 @@ __all__ = ["cold_kernels", "announce", "warm_up", "warm_sweep", "warm_report"]
 SWEEP_KERNELS = (
     ("kicktimes.diagnostics._tangent_run", "simulate_tangent_two_kernel", 5.5),
     ("kicktimes.diagnostics._tangent_run", "simulate_tangent_one_kernel", 5.0),
-    ("kicktimes.diagnostics.recurrence", "_sweep_lines_dense", 1.8),
+    ("kicktimes.diagnostics.recurrence", "_sweep_lines_dense", 3.0),
     ("kicktimes.diagnostics.autocorrelation", "_acf_curve", 1.3),
     ("kicktimes.diagnostics.autocorrelation", "_select_checked", 0.2),
 )
