@@ -492,3 +492,38 @@ def test_parts_of_about_equal_size_get_no_pools_of_their_own():
     assert _inner_workers(2, paper) == 2  # unequal: the small part's core helps the large
     assert _inner_workers(4, quick) == 4  # more cores than parts
     assert _inner_workers(2, quick[:1]) == 2  # one part to rebuild
+
+
+def test_the_report_reads_a_store_as_report_store_of_load_store(store_path, tmp_path):
+    # load_report_store reads system/diagnostic as Parquet dictionaries and skips note:
+    # the very frames of report_store(load_store(path)), categories and codes included,
+    # for a whole store and for an unfinished one; a damaged part is still refused
+    import json
+    import shutil
+
+    from kicktimes.experiment.store import _part_path
+    from kicktimes.report._common import load_report_store, report_store
+
+    def same(path):
+        ref, got = report_store(load_store(path)), load_report_store(path)
+        pd.testing.assert_frame_equal(got.results, ref.results, check_exact=True)
+        pd.testing.assert_frame_equal(got.collisions, ref.collisions, check_exact=True)
+        for column in ("system", "diagnostic"):
+            cats = list(got.results[column].cat.categories)
+            assert cats == sorted(cats) == list(ref.results[column].cat.categories)
+        assert got.missing_tasks == ref.missing_tasks and got.manifest == ref.manifest
+        return got
+
+    full = same(store_path)
+    assert not full.missing_tasks and "note" not in full.results.columns
+    partial = tmp_path / "partial"
+    shutil.copytree(store_path, partial)
+    manifest = json.loads((partial / "manifest.json").read_text())
+    dropped = sorted(manifest["tasks"])[0]
+    del manifest["tasks"][dropped]
+    (partial / "manifest.json").write_text(json.dumps(manifest))
+    assert same(partial).missing_tasks == [dropped]
+    part = _part_path(partial, "results", sorted(manifest["tasks"])[0])  # a task still read
+    part.write_bytes(part.read_bytes()[:-10])
+    with pytest.raises(ValueError, match="damaged store"):
+        load_report_store(partial)

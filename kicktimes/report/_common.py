@@ -278,6 +278,18 @@ def report_store(store):
     return view
 
 
+def load_report_store(path):
+    """``report_store(load_store(path))``, read straight into that form: the results
+    without ``note``, ``system`` and ``diagnostic`` read from Parquet as dictionaries
+    (categoricals, then their categories sorted), never as 2 million strings. The same
+    frames (a test compares them); a paper store loads 4-6x faster.
+    """
+    from kicktimes.experiment.store import _load
+
+    columns = ["radius", "ic", "system", "diagnostic", "value"]
+    return _load(path, result_columns=columns, categories=("system", "diagnostic"))
+
+
 def distinct(frame, column):
     """The distinct values of ``frame[column]`` as a set (fast on categoricals: only the
     observed values, not the categories)."""

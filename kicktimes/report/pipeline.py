@@ -36,7 +36,7 @@ from kicktimes.report._common import (
     check_fraction,
     check_int,
     distinct,
-    report_store,
+    load_report_store,
 )
 from kicktimes.report.html import (
     CSS,
@@ -194,12 +194,10 @@ def experiment_part(job, bar=None):
 
     Runs in a worker process (``bar`` None) or in this one with a progress bar.
     """
-    from kicktimes.experiment import load_store
-
     path, out, prefix, options, render, workers = job
     out = Path(out)
     t0 = time.perf_counter()
-    store = report_store(load_store(path))
+    store = load_report_store(path)
     name = store.experiment.name
     timings = [(name, "load store", time.perf_counter() - t0)]
     pool = Mapper(workers)
@@ -244,10 +242,8 @@ def experiment_part(job, bar=None):
 
 def families_part(paths, out, render, workers=1):
     """The all-experiments figures (:func:`families_section`) as a cache part."""
-    from kicktimes.experiment import load_store
-
     t0 = time.perf_counter()
-    stores = [report_store(load_store(p)) for p in paths]
+    stores = [load_report_store(p) for p in paths]
     families = families_section(stores)
     files = {}
     fragment, toc = "", ""

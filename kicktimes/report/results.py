@@ -14,7 +14,13 @@ import time
 from pathlib import Path
 
 from kicktimes import __version__
-from kicktimes.report._common import Context, Mapper, Progress, check_int, report_store
+from kicktimes.report._common import (
+    Context,
+    Mapper,
+    Progress,
+    check_int,
+    load_report_store,
+)
 
 __all__ = ["write_results"]
 
@@ -51,7 +57,6 @@ def write_results(
     >>> from kicktimes.report import write_results
     >>> write_results("stores/family_a", "docs/results")  # doctest: +SKIP
     """
-    from kicktimes.experiment import load_store
     from kicktimes.report.findings import rules_text, scale_statement
     from kicktimes.report.pipeline import N_STAGES, analyse
 
@@ -64,7 +69,7 @@ def write_results(
     workers = check_int("workers", workers, 1)
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    stores = [report_store(load_store(p)) for p in paths]
+    stores = [load_report_store(p) for p in paths]
     pool = Mapper(workers)
     bar = Progress(False, N_STAGES * len(stores))
     lines = [
