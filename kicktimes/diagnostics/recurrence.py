@@ -355,9 +355,10 @@ def _pair_lines(k0, d2, p2, s2, ia, ib, pts, eps2s, count, diag):
 
 
 # Recurrent pairs are gathered over many points into a buffer until it holds this many
-# pairs, then accounted in one loop (`_account_pairs`): a loop per point over its few pairs costs
-# a mispredicted exit per point, and that was the sweep's largest cost (measured 1.7x on
-# billiard samples at eps = 1e-2, benchmarks/bench_recurrence.py).
+# pairs, then accounted in one loop (`_account_pairs`): a loop per point over its two or
+# three pairs cost a mispredicted exit per point, the sweep's largest cost (with the
+# branch-free counts below, the build and sweep take 1/1.30-1/1.38 of the former per-point
+# kernels' time, benchmarks/bench_recurrence.py).
 _BATCH = 2048
 # Fields of the accumulator of the first (largest) threshold, see `_account_pairs`.
 _PAIRS, _STARTS2, _ON2, _SINGLE, _LONGEST = 0, 1, 2, 3, 4
