@@ -1,6 +1,7 @@
 """Speed of the report (kicktimes.report): its exact KS kernel and the whole build.
 
-Run: ``python benchmarks/bench_report.py [--stores A B] [--skip-renewal] [--sequences 2000]``
+Run: ``python benchmarks/bench_report.py [--stores A B] [--skip-renewal] [--sequences 2000]
+[--load-only]``
 
 1. Exact two-sided KS p-values of the Poisson tests' uniformity test on an ensemble of
    sequences of 5..140 events (the range where scipy's law runs the Pomeranz recursion in
@@ -14,6 +15,11 @@ Run: ``python benchmarks/bench_report.py [--stores A B] [--skip-renewal] [--sequ
 3. Figure rendering: the same builds (``workers=1``) with ``savefig`` (two draws per
    figure: a layout pass, then the real one) and with the report's one Agg draw,
    alternating, rendering seconds summed per build; the PNG bytes are compared.
+4. Pools inside the parts against the report's rule, alternating.
+5. Reading a store as the report does, ``load_report_store`` (``system``/``diagnostic``
+   read as Parquet dictionaries, no ``note``), against the former
+   ``report_store(load_store(path))`` (Arrow strings, converted afterwards), alternating,
+   the frames checked equal first. ``--load-only`` runs this section only.
 
 Wall times depend on what else runs on the machine: the load average is printed, and the
 CPU seconds are the figure to compare between runs on a busy machine.
@@ -196,12 +202,45 @@ def bench_inner(paths, out_root, rounds=3):
               + "   CPU " + "  ".join(f"{c:6.2f}" for _, c in values))
 
 
+def bench_load(paths, rounds=7):
+    """`load_report_store` against ``report_store(load_store(path))``, alternating."""
+    import pandas as pd
+
+    from kicktimes.experiment import load_store
+    from kicktimes.report._common import load_report_store, report_store
+
+    def former(path):
+        return report_store(load_store(path))
+
+    print()
+    print(f"reading a store as the report does, {rounds} alternating rounds (min / median, s)")
+    for path in paths:
+        a, b = former(path), load_report_store(path)  # also warms the imports
+        pd.testing.assert_frame_equal(a.results, b.results, check_exact=True)
+        pd.testing.assert_frame_equal(a.collisions, b.collisions, check_exact=True)
+        times = {"former": [], "load_report_store": []}
+        for _ in range(rounds):
+            for name, fn in (("former", former), ("load_report_store", load_report_store)):
+                t0 = time.perf_counter()
+                fn(path)
+                times[name].append(time.perf_counter() - t0)
+        old, new = (np.array(times[k]) for k in times)
+        print(f"  {Path(path).name:<24} {len(b.results):>9} rows: former "
+              f"{old.min():6.3f} / {np.median(old):6.3f}, load_report_store "
+              f"{new.min():6.3f} / {np.median(new):6.3f}  ({old.min() / new.min():.2f}x)")
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--stores", nargs="+", type=Path, default=None, help="stores to report")
     parser.add_argument("--skip-renewal", action="store_true", help="leave out renewal fits")
     parser.add_argument("--sequences", type=int, default=2000, help="KS benchmark sequences")
+    parser.add_argument("--load-only", action="store_true", help="only section 5 (store loading)")
     args = parser.parse_args()
+    if args.load_only:
+        with tempfile.TemporaryDirectory() as tmp:
+            bench_load(args.stores if args.stores else small_stores(Path(tmp)))
+        return
     bench_ks(args.sequences, np.random.default_rng(2024))
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
@@ -209,6 +248,7 @@ def main():
         bench_build(paths, tmp, args.skip_renewal)
         bench_render(paths, tmp)
         bench_inner(paths, tmp)
+        bench_load(paths)
 
 
 if __name__ == "__main__":
