@@ -571,6 +571,15 @@ def _most_in_a_cell(start):
 
 
 @njit(cache=True)
+def _flush(g, perm, pts, pa, pb, pd2, m, w, wv, eps2s, count, diag, acc, vert):
+    """Account the buffer's ``m`` pairs: the diagonal lines (`_account_pairs`) and, when
+    ``vert`` has a row per threshold (laminarity), the vertical ones (`_account_vertical`)."""
+    _account_pairs(g, perm, pts, pa, pb, pd2, m, w, eps2s, count, diag, acc)
+    if vert.shape[0] > 0:
+        _account_vertical(g, perm, pts, pa, pb, pd2, m, w, wv, eps2s, vert)
+
+
+@njit(cache=True)
 def _sweep_lines(g, perm, cell_start, cell_key, ncx, w, pts, eps2s, count, diag, wv, vert):
     """The half-stencil sweep of `_sweep` for the line statistics (`_account_pairs`).
 
@@ -589,14 +598,14 @@ def _sweep_lines(g, perm, cell_start, cell_key, ncx, w, pts, eps2s, count, diag,
     n_cells = cell_key.shape[0]
     eps2 = eps2s[0]
     # a point's candidates lie in 5 cells; the buffer never holds more than _BATCH + those
+    # (allocated here: from a helper returning them, the sweep measured about 5 % slower)
     cap = _BATCH + 5 * _most_in_a_cell(cell_start)
     pa = np.empty(cap, np.int64)
     pb = np.empty(cap, np.int64)
     pd2 = np.empty(cap)
     acc = np.zeros(5, np.int64)
-    vertical = vert.shape[0] > 0  # laminarity: a row of vert per threshold
     # an int64 from the start: with m = 0 numba's type inference first sees a literal 0
-    # and compiles `_account_pairs` for it too (a second signature, twice the compile)
+    # and compiles `_flush` for it too (a second signature, twice the compile)
     m = np.int64(0)
     q = 0
     for c in range(n_cells):
@@ -635,13 +644,9 @@ def _sweep_lines(g, perm, cell_start, cell_key, ncx, w, pts, eps2s, count, diag,
                 pd2[m] = d2
                 m += d2 <= eps2
             if m >= _BATCH:
-                _account_pairs(g, perm, pts, pa, pb, pd2, m, w, eps2s, count, diag, acc)
-                if vertical:
-                    _account_vertical(g, perm, pts, pa, pb, pd2, m, w, wv, eps2s, vert)
+                _flush(g, perm, pts, pa, pb, pd2, m, w, wv, eps2s, count, diag, acc, vert)
                 m = 0
-    _account_pairs(g, perm, pts, pa, pb, pd2, m, w, eps2s, count, diag, acc)
-    if vertical:
-        _account_vertical(g, perm, pts, pa, pb, pd2, m, w, wv, eps2s, vert)
+    _flush(g, perm, pts, pa, pb, pd2, m, w, wv, eps2s, count, diag, acc, vert)
     _finish_lines(acc, count, diag)
 
 
@@ -661,14 +666,14 @@ def _sweep_lines_dense(g, perm, skey, start, ncx, w, pts, eps2s, count, diag, wv
     n = g.shape[0]
     eps2 = eps2s[0]
     # a point's candidates lie in 5 cells; the buffer never holds more than _BATCH + those
+    # (allocated here: from a helper returning them, the sweep measured about 5 % slower)
     cap = _BATCH + 5 * _most_in_a_cell(start)
     pa = np.empty(cap, np.int64)
     pb = np.empty(cap, np.int64)
     pd2 = np.empty(cap)
     acc = np.zeros(5, np.int64)
-    vertical = vert.shape[0] > 0  # laminarity: a row of vert per threshold
     # an int64 from the start: with m = 0 numba's type inference first sees a literal 0
-    # and compiles `_account_pairs` for it too (a second signature, twice the compile)
+    # and compiles `_flush` for it too (a second signature, twice the compile)
     m = np.int64(0)
     for a in range(n):
         key = skey[a]
@@ -694,13 +699,9 @@ def _sweep_lines_dense(g, perm, skey, start, ncx, w, pts, eps2s, count, diag, wv
             pd2[m] = d2
             m += d2 <= eps2
         if m >= _BATCH:
-            _account_pairs(g, perm, pts, pa, pb, pd2, m, w, eps2s, count, diag, acc)
-            if vertical:
-                _account_vertical(g, perm, pts, pa, pb, pd2, m, w, wv, eps2s, vert)
+            _flush(g, perm, pts, pa, pb, pd2, m, w, wv, eps2s, count, diag, acc, vert)
             m = 0
-    _account_pairs(g, perm, pts, pa, pb, pd2, m, w, eps2s, count, diag, acc)
-    if vertical:
-        _account_vertical(g, perm, pts, pa, pb, pd2, m, w, wv, eps2s, vert)
+    _flush(g, perm, pts, pa, pb, pd2, m, w, wv, eps2s, count, diag, acc, vert)
     _finish_lines(acc, count, diag)
 
 
