@@ -95,10 +95,11 @@ def brute_count(pts, eps, block=1024):
     return total
 
 
-def scaling_row(size, eps):
-    """Time and extra peak memory of one N, measured in a fresh process (see --child)."""
+def scaling_row(size, eps, flag="--child"):
+    """Time and extra peak memory of one N, measured in a fresh process (``flag``:
+    ``--child`` for `recurrence_rate`, ``--child-rqa`` for `rqa`)."""
     out = subprocess.run(
-        [sys.executable, __file__, "--child", str(size), "--eps", repr(eps)],
+        [sys.executable, __file__, flag, str(size), "--eps", repr(eps)],
         check=True,
         capture_output=True,
         text=True,
@@ -106,15 +107,17 @@ def scaling_row(size, eps):
     return json.loads(out.stdout.strip().splitlines()[-1])
 
 
-def rqa_scaling_row(size, eps):
-    """`rqa` (laminarity included) of one N in a fresh process (see --child-rqa)."""
-    out = subprocess.run(
-        [sys.executable, __file__, "--child-rqa", str(size), "--eps", repr(eps)],
-        check=True,
-        capture_output=True,
-        text=True,
-    )
-    return json.loads(out.stdout.strip().splitlines()[-1])
+def first_call(fn):
+    """``(result, seconds, extra peak bytes)`` of ``fn()``: the kernel's peak-RSS mark
+    (VmHWM) is reset to the current RSS just before the call (``/proc/self/clear_refs``),
+    so its growth is the extra peak memory of the call."""
+    with open("/proc/self/clear_refs", "w") as fh:
+        fh.write("5")
+    before = _status_kb("VmRSS")
+    t0 = time.perf_counter()
+    out = fn()
+    dt = time.perf_counter() - t0
+    return out, dt, (_status_kb("VmHWM") - before) * 1024
 
 
 def child_rqa(size, eps):
@@ -122,13 +125,7 @@ def child_rqa(size, eps):
     (min of a first call and 2 more) and the peak RSS the first call added."""
     rqa(uniform_disk(300, 0), eps)  # load the kernels of this grid outside the timing
     pts = kicked_chords(size, 0.2, 3)
-    with open("/proc/self/clear_refs", "w") as fh:
-        fh.write("5")
-    before = _status_kb("VmRSS")
-    t0 = time.perf_counter()
-    res = rqa(pts, eps)
-    dt = time.perf_counter() - t0
-    extra = (_status_kb("VmHWM") - before) * 1024
+    res, dt, extra = first_call(lambda: rqa(pts, eps))
     dt = min(dt, timeit(lambda: rqa(pts, eps), 2)[0])
     print(json.dumps({"n": size, "pairs": res.n_recurrent // 2, "lam": res.lam,
                       "time": dt, "extra_bytes": extra}))
@@ -147,7 +144,7 @@ def rqa_scaling(sizes):
     print("-" * len(header))
     for size in sizes:
         for eps in (1e-3, 1e-2):
-            row = rqa_scaling_row(size, eps)
+            row = scaling_row(size, eps, "--child-rqa")
             mem = row["extra_bytes"]
             print(f"{size:>10} {eps:6g} {row['pairs']:>11} {row['lam']:7.4f} {row['time']:9.3f} "
                   f"{mem / 2**20:9.1f} {mem / size:8.1f}")
@@ -162,20 +159,11 @@ def _status_kb(field):
 
 
 def child(size, eps):
-    """Generate the points, then report RR, its time, and the peak RSS it added.
-
-    The kernel's peak-RSS mark (VmHWM) is reset to the current RSS just before the call
-    (``/proc/self/clear_refs``), so its growth is the extra peak memory of the call.
-    """
+    """Generate the points, then report RR, its time, and the peak RSS it added
+    (`first_call`)."""
     recurrence_rate(uniform_disk(100, 0), eps)
     pts = kicked_chords(size, 0.2, 3)
-    with open("/proc/self/clear_refs", "w") as fh:
-        fh.write("5")
-    before = _status_kb("VmRSS")
-    t0 = time.perf_counter()
-    rr = recurrence_rate(pts, eps)
-    dt = time.perf_counter() - t0
-    extra = (_status_kb("VmHWM") - before) * 1024
+    rr, dt, extra = first_call(lambda: recurrence_rate(pts, eps))
     row = {"n": size, "rr": rr, "time": dt, "extra_bytes": extra}
     if size <= 10**6:
         row["time"] = min(dt, timeit(lambda: recurrence_rate(pts, eps), 5)[0])
