@@ -271,22 +271,6 @@ def _add_line(sums, k, length):
         sums[k, 3] = length
 
 
-@njit(cache=True)
-def _vertical_line(pts, a, b, eps2, wv, sums_v, k):
-    """If entry (a, b) (row a, column b) starts a vertical line, account it in sums_v[k].
-
-    A line is a maximal run of recurrent admissible entries ``(a + k, b)``; an entry
-    inside the Theiler band ``|i - j| < wv`` is not admissible and ends a run.
-    """
-    n = pts.shape[0]
-    if a > 0 and abs(a - 1 - b) >= wv and _recurrent(pts, a - 1, b, eps2):
-        return
-    length = 1
-    while a + length < n and abs(a + length - b) >= wv and _recurrent(pts, a + length, b, eps2):
-        length += 1
-    _add_line(sums_v, k, length)
-
-
 @njit(cache=True, inline="always")
 def _visit_block(xs, ys, perm, a0, a1, b0, b1, same, eps2, w, mode, count, buf):
     """Examine the pairs (a in [a0, a1), b in [b0, b1)) of sorted positions.
@@ -499,7 +483,7 @@ def _vertical_entry(pts, r, c, p2, s2, e2, wv, vert, k):
 
     ``p2`` and ``s2`` are the squared distances of ``(r - 1, c)`` and ``(r + 1, c)`` (NaN
     beyond the ends); an entry of the Theiler band ``|i - j| < wv`` is not admissible and
-    ends a run. The tests are those of `_vertical_line`, on the same float values.
+    ends a run. The tests are `_recurrent`'s, on the same float values.
     """
     if abs(r - 1 - c) >= wv and p2 <= e2:
         return  # the run started above
@@ -556,9 +540,19 @@ def _account_vertical(g, perm, pts, pa, pb, pd2, m, w, wv, eps2s, vert):
 def _diagonal_vertical(pts, eps2s, vert):
     """The vertical lines through the main diagonal's entries ``(j, j)`` (Theiler window
     0), at every threshold: the sweep visits the pairs ``i != j`` only."""
-    for j in range(pts.shape[0]):
+    n = pts.shape[0]
+    for j in range(n):
+        p2 = s2 = np.nan  # no row above the first, none below the last
+        if j > 0:
+            dx = pts[j - 1, 0] - pts[j, 0]
+            dy = pts[j - 1, 1] - pts[j, 1]
+            p2 = dx * dx + dy * dy
+        if j + 1 < n:
+            dx = pts[j + 1, 0] - pts[j, 0]
+            dy = pts[j + 1, 1] - pts[j, 1]
+            s2 = dx * dx + dy * dy
         for k in range(eps2s.shape[0]):
-            _vertical_line(pts, j, j, eps2s[k], 0, vert, k)
+            _vertical_entry(pts, j, j, p2, s2, eps2s[k], 0, vert, k)
 
 
 @njit(cache=True)
