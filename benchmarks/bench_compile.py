@@ -49,16 +49,18 @@ def _steps():
     def report_kernels():
         # what the report calls beyond the sweep's kernels: the trajectory figures'
         # re-simulation with a collision log, the RQA of the recurrence plot, the
-        # power-law fit of the renewal comparison
+        # power-law fit of the renewal comparison, the Poisson tests (exact KS law,
+        # Ljung-Box Q)
         from kicktimes import initial_conditions, simulate_two_particle
         from kicktimes.diagnostics import rqa
-        from kicktimes.stats import compare_models
+        from kicktimes.stats import compare_models, test_poisson
 
         ic = initial_conditions(1, 0.02, seed=0)[0]
         run = simulate_two_particle(ic, 0.02, n_steps=200, tau=0.3, log_collisions=True)
         rqa(np.column_stack([run.boundary_log.x, run.boundary_log.sin_theta])[:300], 0.05)
         rng = np.random.default_rng(0)
         compare_models(rng.exponential(size=200), censored=rng.exponential(size=3))
+        test_poisson(np.sort(rng.uniform(0.0, 60.0, 60)), 60.0, n_mc=99, rng=rng)
 
     return [
         ("import kicktimes (no compilation expected)", lambda: None),

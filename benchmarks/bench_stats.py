@@ -15,7 +15,9 @@ Run: ``python benchmarks/bench_stats.py [--n 100000] [--sequences 1000] [--event
    seven) over the same sequences, same run. Then where the tests should run: 200 of
    the sequences as one ensemble (what the report does per radius: equal event counts
    share a Monte Carlo null) against one `test_poisson` per sequence (what a sweep task
-   would do, each IC with its own null and stream), n_mc = 199, same run.
+   would do, each IC with its own null and stream), n_mc = 199, same run. Last, the
+   Ljung-Box statistic of the Monte Carlo nulls: the compiled kernel against the numpy
+   expression it replaced (checked bitwise equal), alternating.
 """
 
 from __future__ import annotations
@@ -30,7 +32,7 @@ import numpy as np
 import scipy.stats
 
 from kicktimes import stats
-from kicktimes.stats import comparison
+from kicktimes.stats import comparison, iid_tests
 from kicktimes.stats.renewal import _fit
 
 
@@ -145,6 +147,38 @@ def bench_poisson(args, rng):
         f"    one test per sequence (in sweep tasks)       {loop_sec:8.3f} s   "
         f"x{loop_sec / ens_sec:.1f}"
     )
+    bench_ljung_box(rng)
+
+
+def _ljung_box_numpy(x, lags):
+    # the former vectorised expression of kicktimes.stats.iid_tests.ljung_box
+    m = x.shape[-1]
+    d = x - x.mean(axis=-1, keepdims=True)
+    denom = (d * d).sum(axis=-1)
+    denom = np.where(denom > 0, denom, np.nan)
+    q = np.zeros(x.shape[:-1])
+    for k in range(1, lags + 1):
+        rho = (d[..., k:] * d[..., :-k]).sum(axis=-1) / denom
+        q += rho * rho / (m - k)
+    return m * (m + 2) * q
+
+
+def bench_ljung_box(rng, rounds=7):
+    """The Ljung-Box Monte Carlo null's statistic (199 rows of m Exp(1) intervals, 10
+    lags): the compiled kernel against the numpy expression it replaced, checked bitwise
+    equal, alternating, min of ``rounds``."""
+    print("  Ljung-Box Q of a Monte Carlo null (199 rows, 10 lags), min of "
+          f"{rounds} alternating rounds:")
+    print(f"  {'m':>8}{'numpy ms':>10}{'kernel ms':>11}{'ratio':>8}")
+    for m in (30, 60, 120, 250, 1000):
+        x = rng.standard_exponential((199, m))
+        if not np.array_equal(iid_tests.ljung_box(x, 10), _ljung_box_numpy(x, 10)):
+            raise AssertionError(f"ljung_box differs from the numpy expression at m = {m}")
+        old = new = np.inf
+        for _ in range(rounds):
+            old = min(old, timed(functools.partial(_ljung_box_numpy, x, 10), repeat=5)[0])
+            new = min(new, timed(functools.partial(iid_tests.ljung_box, x, 10), repeat=5)[0])
+        print(f"  {m:>8}{old * 1e3:>10.3f}{new * 1e3:>11.3f}{old / new:>7.2f}x")
 
 
 if __name__ == "__main__":

@@ -36,13 +36,14 @@ SIMULATE_KERNELS = (("kicktimes.billiard.two_particle", "simulate_two_kernel", 4
 #: What the report compiles beyond the sweep's kernels (``kicktimes reproduce``'s report
 #: process warms them while the sweep's compile or run): the trajectory figures'
 #: re-simulation with a collision log, the recurrence plot's pair sweep (sorted cells, pairs
-#: collected), the hyperexponential EM of the renewal fits, the exact KS law of the Poisson
-#: tests.
+#: collected), the hyperexponential EM of the renewal fits, the exact KS law and the
+#: Ljung-Box statistic of the Poisson tests.
 REPORT_KERNELS = (
     ("kicktimes.billiard.two_particle", "simulate_two_kernel", 2.0),
     ("kicktimes.diagnostics.recurrence", "_sweep", 1.0),
     ("kicktimes.stats.distributions", "_em_steps", 0.5),
     ("kicktimes.stats.poisson", "pomeranz_cdf", 0.5),
+    ("kicktimes.stats.iid_tests", "_ljung_box_rows", 1.9),
 )
 
 
@@ -131,13 +132,17 @@ def _warm_one(_):
 
 def _warm_report_two(_):
     # the trajectory figures' two-disk run with a collision log; the Poisson tests' exact
-    # KS law (its compiled branch: n <= 140 events, 0.75 < n D^2 <= 4)
+    # KS law (its compiled branch: n <= 140 events, 0.75 < n D^2 <= 4) and Ljung-Box Q
+    import numpy as np
+
     from kicktimes import initial_conditions, simulate_two_particle
+    from kicktimes.stats.iid_tests import ljung_box
     from kicktimes.stats.poisson import pomeranz_cdf
 
     ic = initial_conditions(1, 0.02, seed=0)[0]
     simulate_two_particle(ic, 0.02, n_steps=50, tau=0.3, log_collisions=True)
     pomeranz_cdf(12, 0.3)
+    ljung_box(np.arange(12.0), 2)
 
 
 def _warm_report_one(_):
