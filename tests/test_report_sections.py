@@ -132,6 +132,27 @@ def test_paired_ratio_covers_the_true_ratio_and_is_seeded():
     assert list(a[0]["n_pairs"]) == [200, 200]
 
 
+def test_paired_ratio_shares_its_resamples_between_calls():
+    # the Findings draw the bootstrap once per store: a second ratio over as many ICs
+    # reuses the first call's resamples, and gets the CI a fresh draw from the same stream
+    # would give it
+    idx = pd.MultiIndex.from_product([[0.01, 0.02], range(50)], names=["radius", "ic"])
+    rng = np.random.default_rng(4)
+    y = pd.Series(rng.lognormal(0, 0.5, idx.size), index=idx)
+    x, z = 0.5 * y * rng.lognormal(0, 0.2, idx.size), y * rng.lognormal(0, 0.4, idx.size)
+    shared = {}
+    paired_ratio(x, y, rng=np.random.default_rng(9), n_boot=300, resamples=shared)
+    assert list(shared) == [(50, 300)] and shared[(50, 300)].sum(axis=1).tolist() == [50] * 300
+    # the stream is no longer read: any generator gives the shared resamples' CI
+    second = paired_ratio(z, y, rng=np.random.default_rng(123), n_boot=300, resamples=shared)
+    alone = paired_ratio(z, y, rng=np.random.default_rng(9), n_boot=300)
+    assert second[1] == alone[1]
+    pd.testing.assert_frame_equal(second[0], alone[0])
+    # another number of ICs or of resamples draws (and keeps) its own
+    paired_ratio(x, y, rng=np.random.default_rng(9), n_boot=100, resamples=shared)
+    assert sorted(shared) == [(50, 100), (50, 300)]
+
+
 def test_paired_ratio_skips_pairs_with_a_missing_value():
     idx = pd.MultiIndex.from_product([[0.01], range(4)], names=["radius", "ic"])
     x = pd.Series([1.0, 2.0, np.nan, 4.0], index=idx)

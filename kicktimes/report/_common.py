@@ -73,6 +73,9 @@ class Context:
     pstart: object = None
     #: results of jobs started ahead of their section (see :func:`start_ahead`)
     pending: dict = field(default_factory=dict)
+    #: the bootstrap resamples of the ICs shared by every ratio of the Findings
+    #: (`kicktimes.report.effects.paired_ratio`'s ``resamples``, drawn from ``boot_rng()``)
+    resamples: dict = field(default_factory=dict)
     notes: list = field(default_factory=list)
     found: dict = field(default_factory=dict)
 
@@ -86,6 +89,10 @@ class Context:
 
     def rng(self, *key):
         return seeded_rng(self.exp.seed, *key)
+
+    def boot_rng(self):
+        """The stream of the Findings' shared bootstrap resamples (``resamples``)."""
+        return self.rng(3)
 
 
 class Progress:

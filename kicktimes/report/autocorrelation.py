@@ -291,16 +291,20 @@ def effects(ctx):
     one_minus = 1.0 - r1
     pred = wide(predicted_lag1(results), "predicted_lag1")
     out = []
-    for k, system in enumerate(kicked_systems(results)):
+    for system in kicked_systems(results):
         if system not in one_minus.columns or REFERENCE not in one_minus.columns:
             continue
         _, tot = paired_ratio(
-            one_minus[system], one_minus[REFERENCE], rng=ctx.rng(3, 9, k), n_boot=ctx.n_boot
+            one_minus[system],
+            one_minus[REFERENCE],
+            rng=ctx.boot_rng(),
+            n_boot=ctx.n_boot,
+            resamples=ctx.resamples,
         )
         detail = ""
         if system in pred.columns and REFERENCE in pred.columns:
             _, ptot = paired_ratio(
-                1 - pred[system], 1 - pred[REFERENCE], rng=ctx.rng(3, 10, k), n_boot=0
+                1 - pred[system], 1 - pred[REFERENCE], rng=ctx.boot_rng(), n_boot=0
             )
             detail = (
                 f"the built-in prediction (perturbations per boundary collision, kicked / "

@@ -243,8 +243,9 @@ def effects(ctx):
     per_r, tot = paired_ratio(
         coll["n_pp"].astype(float),
         pd.Series(expected, index=coll.index),
-        rng=ctx.rng(3, 20),
+        rng=ctx.boot_rng(),
         n_boot=ctx.n_boot,
+        resamples=ctx.resamples,
     )
     sticky = ctx.found.get("sticky")
     n_sticky = int(sticky["sticky"].sum()) if sticky is not None else 0

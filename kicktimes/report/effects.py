@@ -138,7 +138,7 @@ def _matrix(frame, column, radii, ics):
     return frame[column].unstack("ic").reindex(index=radii, columns=ics).to_numpy(float)
 
 
-def paired_ratio(numerator, denominator, *, rng, n_boot=2000, level=0.95):
+def paired_ratio(numerator, denominator, *, rng, n_boot=2000, level=0.95, resamples=None):
     r"""Ratio of ensemble means per radius and averaged over radii, with bootstrap CIs.
 
     Parameters
@@ -151,6 +151,12 @@ def paired_ratio(numerator, denominator, *, rng, n_boot=2000, level=0.95):
         Bootstrap resamples of the IC indices.
     level : float
         Confidence level of the percentile intervals.
+    resamples : dict, optional
+        Bootstrap draws shared between calls. The resample counts of ``n`` ICs are drawn
+        from ``rng`` by the first call and kept here under ``(n, n_boot)``; later calls
+        with as many ICs reuse them, so that every ratio's CI comes from the same
+        resampled ICs (one joint bootstrap of the ICs), drawn once: the multinomial draw
+        is most of a call's time (about 0.1 s for 2000 resamples of 1000 ICs).
 
     Returns
     -------
@@ -181,7 +187,11 @@ def paired_ratio(numerator, denominator, *, rng, n_boot=2000, level=0.95):
     ok = np.isfinite(x) & np.isfinite(y)
     x, y = np.where(ok, x, 0.0), np.where(ok, y, 0.0)
     n = ics.size
-    counts = rng.multinomial(n, np.full(n, 1.0 / n), size=n_boot).astype(float)
+    counts = None if resamples is None else resamples.get((n, n_boot))
+    if counts is None:
+        counts = rng.multinomial(n, np.full(n, 1.0 / n), size=n_boot).astype(float)
+        if resamples is not None:
+            resamples[(n, n_boot)] = counts
     with np.errstate(invalid="ignore", divide="ignore"):
         point = x.sum(axis=1) / y.sum(axis=1)
         boot = (counts @ x.T) / (counts @ y.T)  # (n_boot, n_radii)

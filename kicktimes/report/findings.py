@@ -52,7 +52,7 @@ def rules_text(ctx):
         + SHARE_RULE.format(level=0.5).replace("0.5", "the level")
         + ". Ratios average the per-radius ratios of ensemble means; their CIs come from "
         f"{ctx.n_boot} bootstrap resamples of the IC indices (seeded from the experiment's "
-        "seed, one resample applied to all systems and radii). "
+        "seed; the same resamples for every ratio, each applied to all systems and radii). "
         f"'{BUILT_IN}' marks agreement the kicked system has by construction (kick rate = "
         "collision rate): it is not a confirmation."
     )

@@ -197,11 +197,15 @@ def effects(ctx):
     lam = wide(results, "lyapunov")
     table = stretching_table(results)
     out = []
-    for k, system in enumerate(kicked_systems(results)):
+    for system in kicked_systems(results):
         if system not in lam.columns or REFERENCE not in lam.columns:
             continue
         per_r, tot = paired_ratio(
-            lam[system], lam[REFERENCE], rng=ctx.rng(3, 0, k), n_boot=ctx.n_boot
+            lam[system],
+            lam[REFERENCE],
+            rng=ctx.boot_rng(),
+            n_boot=ctx.n_boot,
+            resamples=ctx.resamples,
         )
         ref = table[table["system"] == REFERENCE].set_index("radius")
         kick = table[table["system"] == system].set_index("radius")

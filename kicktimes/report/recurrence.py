@@ -275,20 +275,21 @@ def effects(ctx):
     if rows is None:
         rows, _ = recurrence_rows(ctx.results, ctx.exp)
     out = []
-    for ke, e in enumerate(eps_values(ctx.exp)):
-        for kq, (q, question) in enumerate((("rr_offdiag", "Off-diagonal RR"), ("det", "DET"))):
+    for e in eps_values(ctx.exp):
+        for q, question in (("rr_offdiag", "Off-diagonal RR"), ("det", "DET")):
             name = f"{q}@{e:g}"
             if name not in distinct(rows, "diagnostic"):
                 continue
             values = wide(rows, name)
-            for k, system in enumerate(kicked_systems(rows)):
+            for system in kicked_systems(rows):
                 if system not in values.columns or REFERENCE not in values.columns:
                     continue
                 per_r, tot = paired_ratio(
                     values[system],
                     values[REFERENCE],
-                    rng=ctx.rng(3, 1 + ke, 10 * kq + k),
+                    rng=ctx.boot_rng(),
                     n_boot=ctx.n_boot,
+                    resamples=ctx.resamples,
                 )
                 med = values.groupby(level="radius").median()
                 out.append(
