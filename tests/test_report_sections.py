@@ -151,6 +151,8 @@ def test_paired_ratio_shares_its_resamples_between_calls():
     # another number of ICs or of resamples draws (and keeps) its own
     paired_ratio(x, y, rng=np.random.default_rng(9), n_boot=100, resamples=shared)
     assert sorted(shared) == [(50, 100), (50, 300)]
+    with pytest.raises(TypeError, match="resamples must be None or a dict"):
+        paired_ratio(x, y, rng=np.random.default_rng(9), resamples=[])
 
 
 def test_paired_ratio_skips_pairs_with_a_missing_value():

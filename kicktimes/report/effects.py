@@ -180,6 +180,8 @@ def paired_ratio(numerator, denominator, *, rng, n_boot=2000, level=0.95, resamp
     >>> round(overall["ratio"], 12), round(overall["ci_high"], 12)
     (0.5, 0.5)
     """
+    if resamples is not None and not isinstance(resamples, dict):
+        raise TypeError(f"resamples must be None or a dict, got {type(resamples).__name__}")
     frame = pd.concat({"x": numerator, "y": denominator}, axis=1)
     radii = np.sort(frame.index.get_level_values("radius").unique().to_numpy())
     ics = np.sort(frame.index.get_level_values("ic").unique().to_numpy())
