@@ -47,15 +47,12 @@ from kicktimes.experiment import execute_task, preset, run_experiment
 from kicktimes.experiment.presets import SCALES
 from kicktimes.experiment.runner import local_pool
 
-PAPER_CONTENT = {"systems": ("two_particle", "poisson", "actual"), "eps": (1e-3,), "acf_max_lag": 1}
-
 
 def experiment(name: str, content: str):
-    """Preset ``name``, reduced to the paper's own content for ``content == "paper"``."""
-    exp = preset(name)
-    if content == "paper":
-        exp = dataclasses.replace(exp, **PAPER_CONTENT)
-    return exp
+    """Preset ``name``, reduced to the paper's own content for ``content == "paper"``
+    (`kicktimes.experiment.presets.PAPER_CONTENT`, what ``kicktimes reproduce --content
+    paper`` runs)."""
+    return preset(name, content=content)
 
 # with the tangent FTLE (the presets) each trajectory is simulated once, together with its
 # FTLE (one pass): that time is under lyapunov_*; simulation_* is what runs without it

@@ -591,6 +591,16 @@ def report_command(stores, out, workers, progress, pdf, force):
     help="quick: small versions of both families; paper: the paper's full scale.",
 )
 @click.option(
+    "--content",
+    type=click.Choice(["full", "paper"]),
+    default="full",
+    show_default=True,
+    help="full: the presets (the paper's systems and diagnostics plus the scatter-kicked "
+    "systems, RQA at two thresholds, ACF curves); paper: the paper's own content only "
+    "(3 systems, RR at eps = 0.001, R_1), under half the sweep's work, into "
+    "store-<name>-paper and report-paper/.",
+)
+@click.option(
     "--out",
     "out",
     type=click.Path(file_okay=False),
@@ -602,11 +612,12 @@ def report_command(stores, out, workers, progress, pdf, force):
 @_progress_option
 @_wait_option
 @_pdf_option
-def reproduce_command(scale, out, workers, scheduler, progress, wait, pdf):
+def reproduce_command(scale, content, out, workers, scheduler, progress, wait, pdf):
     """Run the paper's two experiment families and build the report.
 
     Reruns resume the stores in --out. The experiments are the built-in presets, the
-    same as analysis/<name>.toml.
+    same as analysis/<name>.toml (with --content paper, reduced to the paper's own
+    systems and diagnostics: kicktimes.experiment.presets.PAPER_CONTENT).
     """
     import os
 
@@ -620,8 +631,12 @@ def reproduce_command(scale, out, workers, scheduler, progress, wait, pdf):
 
     stores = []
     with _cli_errors(_RUN_OPTIONS), ExitStack() as stack:
+        # the paper's content goes to its own stores and report: both contents can share --out
+        suffix = "-paper" if content == "paper" else ""
+        exps = [preset(n, content) for n in SCALES[scale]]
+        paths = [os.path.join(out, f"store-{n}{suffix}") for n in SCALES[scale]]
         pending = scheduler is None and any(
-            _pending(preset(n), os.path.join(out, f"store-{n}")) for n in SCALES[scale]
+            _pending(e, p) for e, p in zip(exps, paths, strict=True)
         )
         pool = None
         n_workers = workers or os.cpu_count() or 1
@@ -635,18 +650,17 @@ def reproduce_command(scale, out, workers, scheduler, progress, wait, pdf):
                 # one pool for both families: each worker starts (imports, loads the
                 # compiled kernels) once
                 pool = stack.enter_context(local_pool(workers))
-        for name in SCALES[scale]:
-            exp = preset(name)
-            path = os.path.join(out, f"store-{name}")
+        for exp, path in zip(exps, paths, strict=True):
             click.echo(exp.summary())
             store = _run_one(exp, path, workers, scheduler, progress, wait, executor=pool)
             click.echo(store.summary())
             stores.append(path)
         if pool is not None:
             pool.shutdown()  # the sweep workers end before the report starts its own
-        job = (stores, os.path.join(out, "report"), workers, progress, pdf)
+        report_dir = os.path.join(out, f"report{suffix}")
+        job = (stores, report_dir, workers, progress, pdf)
         report = report_process.build(*job) if report_process else _build_report(*job)
-    click.echo(f"report written to {report if report is not None else os.path.join(out, 'report')}")
+    click.echo(f"report written to {report if report is not None else report_dir}")
 
 
 # --- end experiment commands ---

@@ -98,6 +98,92 @@ def test_analysis_files_are_the_builtin_presets_with_the_papers_parameters():
         assert exp.eps == (1e-3, 1e-2) and exp.rr_sampling == "run" and exp.acf_max_lag == 20
 
 
+def test_the_papers_content_drops_only_the_extensions():
+    from kicktimes.experiment import preset
+
+    for name, full in PRESETS.items():
+        assert preset(name) is full and preset(name, content="full") is full
+        paper = preset(name, content="paper")
+        assert paper.systems == ("two_particle", "poisson", "actual")
+        assert paper.eps == (1e-3,) and paper.acf_max_lag == 1
+        kept = {f.name for f in dataclasses.fields(Experiment)} - {
+            "systems", "eps", "acf_max_lag", "description"
+        }
+        assert all(getattr(paper, k) == getattr(full, k) for k in kept)
+        assert paper.hash() != full.hash()
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "error", "match"),
+    [
+        ({"name": "family_c"}, ValueError, "name: unknown preset"),
+        ({"name": 3}, TypeError, "name: expected a str"),
+        ({"name": "family_a", "content": "extended"}, ValueError, "content: expected one of"),
+        ({"name": "family_a", "content": None}, TypeError, "content: expected a str"),
+    ],
+)
+def test_preset_refuses_unknown_names_and_contents(kwargs, error, match):
+    from kicktimes.experiment import preset
+
+    with pytest.raises(error, match=match):
+        preset(**kwargs)
+
+
+def test_the_papers_rows_are_bitwise_the_same_in_both_contents():
+    # the shared rows (every system, IC and radius) must not depend on the content: the
+    # paper's quantities come from the same runs, kick draws and kernels
+    full = dataclasses.replace(TINY, systems=PRESETS["family_a"].systems, n_ics=2, block_size=2)
+    from kicktimes.experiment.presets import PAPER_CONTENT
+
+    paper = dataclasses.replace(full, **PAPER_CONTENT)
+    task = full.tasks()[0]
+    rows_full, coll_full = run_task(full, task)
+    rows_paper, coll_paper = run_task(paper, task)
+    pd.testing.assert_frame_equal(coll_full, coll_paper)
+    key = ["radius", "ic", "system", "diagnostic"]
+    # the ACF curve's summaries (decorrelation lag, tau_int) depend on its length
+    curve = {"decorrelation_lag", "tau_int"}
+    shared = rows_paper[~rows_paper["diagnostic"].isin(curve)]
+    both = shared.merge(rows_full, on=key, suffixes=("_paper", "_full"), validate="1:1")
+    assert len(both) == len(shared) > 50
+    assert set(both["system"]) == {"two_particle", "poisson", "actual"}
+    assert {"recurrence_rate", "autocorrelation", "lyapunov", "n_pp"} <= set(both["diagnostic"])
+    same = (both["value_paper"] == both["value_full"]) | (
+        both["value_paper"].isna() & both["value_full"].isna()
+    )
+    assert same.all(), both[~same]
+    assert (both["note_paper"] == both["note_full"]).all()
+
+
+def test_reproduce_content_paper_writes_its_own_stores_and_report(tmp_path, monkeypatch):
+    from click.testing import CliRunner
+
+    from kicktimes.cli import main
+    from kicktimes.experiment import presets
+
+    # the quick presets, shrunk: the command's wiring is under test, not the science
+    for name in ("quick_a", "quick_b"):
+        monkeypatch.setitem(
+            presets.PRESETS,
+            name,
+            dataclasses.replace(presets.PRESETS[name], radii=[0.02], n_ics=2, n_steps=120),
+        )
+    result = CliRunner().invoke(
+        main,
+        ["reproduce", "--content", "paper", "--out", str(tmp_path), "--workers", "1",
+         "--no-progress"],
+    )
+    assert result.exit_code == 0, result.output
+    for name in ("quick_a", "quick_b"):
+        store = load_store(tmp_path / f"store-{name}-paper")
+        assert store.experiment == presets.preset(name, content="paper")
+        assert set(store.results["system"]) == {"two_particle", "poisson", "actual"}
+    assert (tmp_path / "report-paper" / "report.html").is_file()
+    assert not (tmp_path / "report").exists()
+    assert not (tmp_path / "store-quick_a").exists()
+    assert f"report written to {tmp_path / 'report-paper'}" in result.output
+
+
 @pytest.mark.parametrize(
     ("change", "match"),
     [
