@@ -422,6 +422,11 @@ def test_pdf_copies_are_written_on_request_and_removed_when_no_longer_asked(
     assert f'<a href="{sorted(FIGURES)[0]}.pdf">PDF</a>' in (out / "report.html").read_text()
     build_report(store_path, out, progress=False, **OPTIONS, workers=1)
     assert not list(out.glob("*.pdf"))
+    # a forced rebuild reuses nothing, but still removes what it no longer writes
+    build_report(store_path, out, progress=False, **OPTIONS, workers=1, pdf=True)
+    assert list(out.glob("*.pdf"))
+    build_report(store_path, out, progress=False, **OPTIONS, workers=1, force=True)
+    assert not list(out.glob("*.pdf"))
 
 
 def test_a_store_that_gains_a_task_rebuilds_only_its_own_part(store_path, tmp_path):

@@ -234,6 +234,25 @@ def test_acf_curves_figure_draws_each_radius_with_the_prediction(ctx):
     assert (table["decorrelation_lag_n_undefined"] == 16).all()
 
 
+
+def test_a_store_with_r1_only_has_no_curve_decorrelation_or_tau_int():
+    # acf_max_lag = 1 (`reproduce --content paper`): one lag is no curve, and the
+    # decorrelation lag and tau_int read off it would be meaningless
+    store = synthetic_store(n_ics=6)
+    res = store.results
+    keep = ~res["diagnostic"].str.match(r"^acf@([2-9]|\d\d+)$")
+    store.results = res[keep].reset_index(drop=True)
+    assert set(autocorrelation.acf_curves(store.results)["lag"]) == {1}
+    (sec,) = autocorrelation.sections(Context(store, n_boot=100))
+    assert [name for name, _, _ in sec.figures] == ["fig07_autocorrelation_vs_radius"]
+    assert any("stops at lag 1" in t for t in sec.paragraphs)
+    assert not any(t.startswith("Decorrelation") for t in sec.paragraphs)
+    tables = {name: df for name, df, _, _ in sec.tables}
+    assert set(tables) == {"autocorrelation_summary"}
+    table = tables["autocorrelation_summary"]
+    assert not any(c.startswith(("decorrelation_lag", "tau_int")) for c in table.columns)
+    assert np.allclose(table["R1_mean"], table["predicted_lag1"])
+
 def test_stretching_per_perturbation_is_mean_lambda_over_the_pooled_rate(ctx):
     table = lyapunov.stretching_table(ctx.results)
     res = ctx.results

@@ -82,13 +82,13 @@ def store_key(path, manifest: dict) -> str:
 
 class ReportCache:
     """The parts recorded in ``out_dir/.cache.json`` (empty if absent, damaged or of
-    another layout; ``fresh=True`` ignores it)."""
+    another layout). ``fresh=True`` reuses none of them, but still knows their files, so
+    that a rebuild deletes the files a part no longer writes."""
 
     def __init__(self, out: Path, *, fresh: bool = False):
         self.path = Path(out) / CACHE_FILE
         self.parts: dict[str, dict] = {}
-        if fresh:
-            return
+        self.fresh = fresh
         try:
             record = json.loads(self.path.read_text(encoding="utf-8"))
         except (OSError, UnicodeDecodeError, json.JSONDecodeError):
@@ -108,7 +108,7 @@ class ReportCache:
         """The recorded entry of ``part`` if it was built with ``key`` and every file it
         wrote is still there with the same SHA-256; else None."""
         entry = self.parts.get(part)
-        if entry is None or entry.get("key") != key:
+        if self.fresh or entry is None or entry.get("key") != key:
             return None
         folder = self.path.parent
         for name, sha in entry["files"].items():

@@ -212,10 +212,23 @@ def sections(ctx):
         ),
     )
     curves = acf_curves(results)
-    if curves.empty:
+    # a curve needs two lags: with R_1 alone (acf_max_lag = 1, e.g. `reproduce --content
+    # paper`) there is no curve to draw, and the decorrelation lag and tau_int, read off
+    # the curve, say nothing (tau_int would be 1/2 + R_1, the lag undefined)
+    one_lag = not curves.empty and int(curves["lag"].max()) < 2
+    if curves.empty or one_lag:
         sec.text(
-            "The store has no autocorrelation curve (rows acf@l): only the lag-"
-            f"{lag} value is shown; rerun the sweep for R_l over lags and decorrelation times."
+            (
+                "The store's autocorrelation curve stops at lag 1 (acf_max_lag = 1): only "
+                f"the lag-{lag} value is shown, without the curve, the decorrelation lag and "
+                "τ_int; run with acf_max_lag >= 2 for them."
+            )
+            if one_lag
+            else (
+                "The store has no autocorrelation curve (rows acf@l): only the lag-"
+                f"{lag} value is shown; rerun the sweep for R_l over lags and decorrelation "
+                "times."
+            )
         )
     else:
         sec.figure(
@@ -237,7 +250,7 @@ def sections(ctx):
         name: dict(
             list(results[results["diagnostic"] == name].groupby(["radius", "system"])["value"])
         )
-        for name in ("decorrelation_lag", "tau_int")
+        for name in (() if one_lag else ("decorrelation_lag", "tau_int"))
     }
     for (r, system), g in results[results["diagnostic"] == "autocorrelation"].groupby(
         ["radius", "system"]
@@ -249,7 +262,7 @@ def sections(ctx):
             f"R{lag}_median": g["value"].median(),
             "predicted_lag1": pred.get((r, system), np.nan),
         }
-        for name in ("decorrelation_lag", "tau_int"):
+        for name in decorrelation:
             v = decorrelation[name].get((r, system))
             if v is not None and len(v):
                 entry[f"{name}_mean"] = v.mean()
