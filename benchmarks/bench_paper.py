@@ -47,13 +47,6 @@ from kicktimes.experiment import execute_task, preset, run_experiment
 from kicktimes.experiment.presets import SCALES
 from kicktimes.experiment.runner import local_pool
 
-
-def experiment(name: str, content: str):
-    """Preset ``name``, reduced to the paper's own content for ``content == "paper"``
-    (`kicktimes.experiment.presets.PAPER_CONTENT`, what ``kicktimes reproduce --content
-    paper`` runs)."""
-    return preset(name, content=content)
-
 # with the tangent FTLE (the presets) each trajectory is simulated once, together with its
 # FTLE (one pass): that time is under lyapunov_*; simulation_* is what runs without it
 STAGES = [
@@ -176,7 +169,8 @@ def main():
     # one pool for both families, as `kicktimes reproduce` does (its start-up is timed)
     pool = local_pool(args.workers) if args.workers > 1 else None
     for name in SCALES[args.scale]:
-        exp = experiment(name, args.content)
+        # --content paper: PAPER_CONTENT, what `kicktimes reproduce --content paper` runs
+        exp = preset(name, content=args.content)
         path = root / f"store-{name}"
         t0 = time.perf_counter()
         store = run_experiment(

@@ -132,9 +132,9 @@ def test_preset_refuses_unknown_names_and_contents(kwargs, error, match):
 def test_the_papers_rows_are_bitwise_the_same_in_both_contents():
     # the shared rows (every system, IC and radius) must not depend on the content: the
     # paper's quantities come from the same runs, kick draws and kernels
-    full = dataclasses.replace(TINY, systems=PRESETS["family_a"].systems, n_ics=2, block_size=2)
     from kicktimes.experiment.presets import PAPER_CONTENT
 
+    full = dataclasses.replace(TINY, systems=PRESETS["family_a"].systems, n_ics=2, block_size=2)
     paper = dataclasses.replace(full, **PAPER_CONTENT)
     task = full.tasks()[0]
     rows_full, coll_full = run_task(full, task)

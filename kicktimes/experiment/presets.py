@@ -126,9 +126,10 @@ def preset(name: str, content: str = "full") -> Experiment:
         ``"full"``: kicktimes' presets, the paper's systems and diagnostics plus the
         scatter-kicked systems, the RQA at eps = 1e-3 and 1e-2 and the ACF curve to lag 20.
         ``"paper"``: the paper's own content only (`PAPER_CONTENT`: three systems, the
-        recurrence rate at eps = 1e-3, ``R_1``), about half the work; the rest of the
-        experiment (radii, ICs, steps, seed, FTLE) is the same, so every row both contents
-        have is bitwise the same.
+        recurrence rate at eps = 1e-3, ``R_1``), about half the sweep's work; the rest of
+        the experiment (radii, ICs, steps, seed, FTLE) is the same, so the rows both
+        contents have are bitwise the same, except ``decorrelation_lag`` and ``tau_int``,
+        which are read off the ACF curve and depend on its length.
 
     Examples
     --------
