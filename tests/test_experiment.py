@@ -444,22 +444,23 @@ def test_actual_kicks_cover_the_whole_paper_sampled_one_particle_run():
     np.testing.assert_array_equal(times[: two.n_pp], two.pp_times)
 
 
+@pytest.mark.reproducibility
 def test_sweep_results_are_bitwise_those_of_separate_simulation_and_ftle_runs():
-    # tests/data/sweep_golden.parquet: the tables of small experiments (paper setup of both
-    # families with all five systems and diagnostics, uniform sampling, elastic rule with
-    # gaussian kicks) computed before the one-pass sweep, with a separate simulation, FTLE
-    # and actual-time continuation per trajectory; one pass must not change a bit
+    # small experiments (paper setup of both families with all five systems and
+    # diagnostics, uniform sampling, elastic rule with gaussian kicks): the one-pass sweep
+    # and separate simulation, FTLE and actual-time continuation calls per trajectory,
+    # both computed here, must agree in every bit
     import importlib.util
 
     data = REPO / "tests" / "data"
     spec = importlib.util.spec_from_file_location("sweep_cases", data / "sweep_cases.py")
     cases = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(cases)
-    ref = cases.load(data / "sweep_golden.parquet")
-    assert len(ref[0]) == 5028 and len(ref[1]) == 24
-    assert set(ref[0]["system"]) == {"two_particle", "poisson", "actual", "poisson_scatter",
-                                     "actual_scatter"}
-    assert cases.differences(ref, cases.tables()) == []
+    separate = cases.tables(one_pass=False)
+    assert len(separate[0]) == 5028 and len(separate[1]) == 24
+    assert set(separate[0]["system"]) == {"two_particle", "poisson", "actual",
+                                          "poisson_scatter", "actual_scatter"}
+    assert cases.differences(separate, cases.tables()) == []
 
 
 def test_one_pass_continues_the_two_disk_run_to_the_horizon_for_the_actual_kicks():
@@ -514,6 +515,7 @@ def test_run_task_rejects_a_task_of_another_experiment():
 # -------------------------------------------------------------------------- executors
 
 
+@pytest.mark.reproducibility
 def test_results_are_identical_for_one_or_two_processes_and_threads(reference, tmp_path):
     two = run_quiet(TINY, tmp_path / "two", workers=2)
     assert_same_store(reference, two)
@@ -522,6 +524,7 @@ def test_results_are_identical_for_one_or_two_processes_and_threads(reference, t
     assert_same_store(reference, threads)
 
 
+@pytest.mark.reproducibility
 def test_results_are_identical_on_a_dask_local_cluster(reference, tmp_path):
     distributed = pytest.importorskip("distributed")
     with warnings.catch_warnings():
@@ -536,6 +539,7 @@ def test_results_are_identical_on_a_dask_local_cluster(reference, tmp_path):
     assert_same_store(reference, via_address)
 
 
+@pytest.mark.reproducibility
 def test_results_do_not_depend_on_the_block_size(reference, tmp_path):
     other = run_quiet(dataclasses.replace(TINY, block_size=3), tmp_path / "b3", workers=1)
     assert_same_store(reference, other)

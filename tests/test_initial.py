@@ -18,6 +18,7 @@ def test_ics_are_valid_at_r_max_and_have_unit_speeds(method):
     np.testing.assert_allclose(np.hypot(ics[:, :, 2], ics[:, :, 3]), 1.0, atol=1e-15)
 
 
+@pytest.mark.reproducibility
 def test_ic_i_does_not_depend_on_chunking():
     whole = initial_conditions(40, 0.02, seed=9)
     parts = np.concatenate([initial_conditions(n, 0.02, seed=9, start=s)
@@ -85,15 +86,20 @@ def test_collision_rate_matches_kinetic_theory_with_many_ics(rule, r):
 
 # ------------------------------------------------------------- every radius, bounded time
 @pytest.mark.parametrize(("method", "rule", "r_max", "digest"), [
-    ("paper", "mirror", 0.03, "b221778024b3b778"),
+    ("paper", "mirror", 0.03, "ec87380d32a32b43"),
     ("paper", "mirror", 0.1, "08695fc9bd669d3e"),
-    ("uniform", "mirror", 0.03, "c6ae7170f08b0360"),
-    ("uniform", "elastic", 0.03, "430e73daf4219840"),
-    ("uniform", "mirror", 0.1, "5d265b106d2b7e6d"),
-    ("uniform", "elastic", 0.1, "68632eb16803941c"),
+    ("uniform", "mirror", 0.03, "ba581fe5561252f7"),
+    ("uniform", "elastic", 0.03, "467dda53eb02182c"),
+    ("uniform", "mirror", 0.1, "ec4b485c1e1dd0e6"),
+    ("uniform", "elastic", 0.1, "e769906015cfdbf6"),
 ])
+@pytest.mark.reproducibility
 def test_the_paper_radii_give_the_same_ensembles_bit_for_bit(method, rule, r_max, digest):
-    # digests of the ensembles drawn before the feasibility fallback existed (commit 2874fcf)
+    # The ensembles are CPU-independent (correctly rounded cos/sin, no BLAS): these digests
+    # hold on every x86-64 CPU, under any BLAS kernel, numpy SIMD level and glibc libm
+    # variant (CI runs this file again under foreign ones). The paper-method r = 0.1
+    # digest is the one of commit 2874fcf: there the C library's cos/sin happened to be
+    # correctly rounded on every draw.
     import hashlib
 
     ics = initial_conditions(200, r_max, seed=2026, method=method, rule=rule)
@@ -140,3 +146,63 @@ def test_the_direct_pair_sampler_matches_joint_rejection():
     gap_direct = np.hypot(direct[:, 0, 0] - direct[:, 0, 1], direct[:, 1, 0] - direct[:, 1, 1])
     gap_rej = np.hypot(rej[:, 0, 0] - rej[:, 1, 0], rej[:, 0, 1] - rej[:, 1, 1])
     assert ks_2samp(gap_direct, gap_rej).pvalue > 1e-3
+
+
+# ------------------------------------------------------------- CPU-independent ICs
+# arguments on which the C library's cos or sin (glibc's FMA variant) is not correctly
+# rounded, with the correctly rounded values (mpmath at 250 bits), as float64 hex
+CORRECTLY_ROUNDED = [
+    ("0x1.41673e33c2b0ap+2", "0x1.37edd01bb9f17p-2", "-0x1.e7aabf12f23d8p-1"),
+    ("0x1.42f7771305f6bp+2", "0x1.4fa89b09ec2ffp-2", "-0x1.e3b6474a5ca90p-1"),
+    ("0x1.feee68f7c0ea6p+1", "-0x1.51e3985af43b7p-1", "-0x1.80acd89c66856p-1"),
+    ("0x1.2567b8275ddd6p+2", "-0x1.054b286dd3291p-3", "-0x1.fbd0d626308f8p-1"),
+    ("0x1.46128524b88e0p-1", "0x1.9ba18ee6d10cdp-1", "0x1.30791ae826e53p-1"),
+    ("0x1.216720f3cb3ecp+2", "-0x1.83ba2a976ba2bp-3", "-0x1.f6bd9f6f5a6c3p-1"),
+]
+
+
+@pytest.mark.reproducibility
+@pytest.mark.parametrize(("x", "cos_x", "sin_x"), CORRECTLY_ROUNDED)
+def test_ic_trigonometry_is_correctly_rounded_where_the_c_library_is_not(x, cos_x, sin_x):
+    from kicktimes.billiard._crmath import cos_sin
+
+    assert cos_sin(float.fromhex(x)) == (float.fromhex(cos_x), float.fromhex(sin_x))
+
+
+@pytest.mark.reproducibility
+def test_ic_trigonometry_is_within_one_ulp_of_the_c_library_and_exact_at_special_angles():
+    import math
+
+    from kicktimes.billiard._crmath import cos_sin
+
+    x = np.random.default_rng(3).uniform(-2 * np.pi, 2 * np.pi, 3000)
+    cs = np.array([cos_sin(v) for v in x])
+    assert np.all(np.abs(cs[:, 0] - np.cos(x)) <= np.spacing(np.abs(np.cos(x))))
+    assert np.all(np.abs(cs[:, 1] - np.sin(x)) <= np.spacing(np.abs(np.sin(x))))
+    assert cos_sin(0.0) == (1.0, 0.0)
+    # cos of the float64 nearest pi/2 is 6.123233995736766e-17 (exact value rounded)
+    assert cos_sin(math.pi / 2) == (6.123233995736766e-17, 1.0)
+    assert cos_sin(math.pi) == (-1.0, 1.2246467991473532e-16)
+    with pytest.raises(ValueError, match="x must be finite"):
+        cos_sin(float("nan"))
+
+
+@pytest.mark.reproducibility
+@pytest.mark.parametrize(("method", "rule"), [("paper", "mirror"), ("uniform", "mirror"),
+                                              ("uniform", "elastic")])
+def test_ics_use_no_blas_and_no_c_library_trigonometry(monkeypatch, method, rule):
+    # the operations that round differently on different CPUs are not reachable from the
+    # IC samplers at the paper's radii (the feasibility fallback above r_max = 1/3 is
+    # documented as the exception)
+    import math
+
+    def refuse(*args, **kwargs):
+        raise AssertionError("a CPU-dependent operation was called")
+
+    for name in ("norm", "multi_dot", "solve"):
+        monkeypatch.setattr(np.linalg, name, refuse)
+    for mod, names in ((np, ("cos", "sin", "dot", "arctan2")), (math, ("cos", "sin", "atan2"))):
+        for name in names:
+            monkeypatch.setattr(mod, name, refuse)
+    ics = initial_conditions(50, 0.1, seed=4, method=method, rule=rule)
+    assert np.isfinite(ics).all()

@@ -183,6 +183,7 @@ def test_the_build_runs_with_fewer_garbage_collections_and_restores_the_setting(
     assert thresholds["after"] == thresholds["before"]
 
 
+@pytest.mark.reproducibility
 def test_the_build_runs_blas_on_one_thread(built):
     assert built[3]["blas"] == {1}
 

@@ -337,6 +337,7 @@ def test_acf_curves_read_the_lag_from_every_acf_row_and_only_those():
         assert list(got["system"].astype(str)) == list(ref["system"].astype(str))
 
 
+@pytest.mark.reproducibility
 def test_figures_render_to_the_same_bytes_on_forked_workers():
     from kicktimes.report.html import render_figures
 

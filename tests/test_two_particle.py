@@ -355,6 +355,7 @@ def test_speeds_outside_the_range_are_refused_naming_ic(speed):
         simulate_two_particle(ic, 0.02, t_max=1.0, rule="elastic")
 
 
+@pytest.mark.reproducibility
 def test_simulators_reproduce_the_golden_outputs_bit_for_bit():
     # tests/data/kernels_golden.npz holds every output array of 66 varied runs (both rules,
     # all samplings, radii 0.005-0.3, uniform/gaussian/scatter kicks) recorded before the

@@ -24,6 +24,8 @@ import math
 import numpy as np
 from numba import njit
 
+from kicktimes.billiard._crmath import cos_sin
+
 INF = np.inf
 
 #: The grazing angle delta: a boundary contact whose velocity makes an angle smaller than
@@ -33,8 +35,7 @@ INF = np.inf
 #: cannot make a sliding disk switch between the two treatments. Under the invariant
 #: measure a contact is that close to tangent with probability 1.25e-9.
 GRAZE_ANGLE = 1e-4
-SIN_GRAZE = math.sin(GRAZE_ANGLE)
-COS_GRAZE = math.cos(GRAZE_ANGLE)
+COS_GRAZE, SIN_GRAZE = cos_sin(GRAZE_ANGLE)  # correctly rounded: the same on every CPU
 GRAZE_THRESHOLD = 0.5 * SIN_GRAZE
 
 

@@ -15,6 +15,7 @@ import math
 import numpy as np
 
 from kicktimes.billiard import _checks as chk
+from kicktimes.billiard._crmath import cos_sin
 
 METHODS = ("paper", "uniform")
 
@@ -77,11 +78,13 @@ def _point_away_from(rng, c, s, rho, *, area):
         alpha = float(np.pi * (1.0 - _allowed_fraction(d, a, s)))
         side = 1.0 if rng.uniform() < 0.5 else -1.0
         phi = phi0 + side * (alpha + rng.uniform() * (np.pi - alpha))
-        x, y = d * math.cos(phi), d * math.sin(phi)
+        c_phi, s_phi = cos_sin(phi)
+        x, y = d * c_phi, d * s_phi
         if math.hypot(x, y) <= rho and math.hypot(x - c[0], y - c[1]) >= s:
             return x, y
     # round-off keeps missing a sliver: the farthest point is always allowed
-    return -rho * math.cos(phi0), -rho * math.sin(phi0)
+    c_phi0, s_phi0 = cos_sin(phi0)
+    return -rho * c_phi0, -rho * s_phi0
 
 
 def _paper_ic(rng: np.random.Generator, r_max: float) -> np.ndarray:
@@ -98,7 +101,8 @@ def _paper_ic(rng: np.random.Generator, r_max: float) -> np.ndarray:
         for _ in range(N_TRY):
             dist = rng.uniform(0.0, 1.0)
             phi = rng.uniform(0.0, 2.0 * np.pi)
-            x, y = dist * math.cos(phi), dist * math.sin(phi)
+            c_phi, s_phi = cos_sin(phi)
+            x, y = dist * c_phi, dist * s_phi
             if dist > rho:
                 continue
             if i == 1 and math.hypot(x - out[0, 0], y - out[0, 1]) < s:
@@ -113,9 +117,10 @@ def _paper_ic(rng: np.random.Generator, r_max: float) -> np.ndarray:
         if i == 0 and dist < a_min:
             dist = rng.uniform(a_min, rho)
             phi = rng.uniform(0.0, 2.0 * np.pi)
-            x, y = dist * math.cos(phi), dist * math.sin(phi)
+            c_phi, s_phi = cos_sin(phi)
+            x, y = dist * c_phi, dist * s_phi
         angle = rng.uniform(0.0, 2.0 * np.pi)
-        out[i] = (x, y, math.cos(angle), math.sin(angle))
+        out[i] = (x, y, *cos_sin(angle))
     return out
 
 
@@ -143,7 +148,8 @@ def _uniform_pair(rng, r_max):
     a_grid, weight = _first_centre_density(r_max)
     a = min(_inverse_cdf(rng, a_grid, weight), rho)
     phi = rng.uniform(0.0, 2.0 * np.pi)
-    c0 = (a * math.cos(phi), a * math.sin(phi))
+    c_phi, s_phi = cos_sin(phi)
+    c0 = (a * c_phi, a * s_phi)
     c1 = _point_away_from(rng, c0, s, rho, area=True)
     return np.array([c0[0], c1[0]]), np.array([c0[1], c1[1]])
 
@@ -159,8 +165,9 @@ def _uniform_ic(rng: np.random.Generator, r_max: float, rule: str) -> np.ndarray
     for _ in range(N_TRY):
         rad = rho * np.sqrt(rng.uniform(size=2))
         phi = rng.uniform(0.0, 2.0 * np.pi, size=2)
-        x = rad * np.cos(phi)
-        y = rad * np.sin(phi)
+        (c0, s0), (c1, s1) = cos_sin(phi[0]), cos_sin(phi[1])
+        x = rad * np.array([c0, c1])
+        y = rad * np.array([s0, s1])
         if math.hypot(x[0] - x[1], y[0] - y[1]) >= 2.0 * r_max:
             break
     else:
@@ -169,12 +176,14 @@ def _uniform_ic(rng: np.random.Generator, r_max: float, rule: str) -> np.ndarray
     out[:, 1] = y
     if rule == "mirror":
         angle = rng.uniform(0.0, 2.0 * np.pi, size=2)
-        out[:, 2] = np.cos(angle)
-        out[:, 3] = np.sin(angle)
+        out[0, 2:] = cos_sin(angle[0])
+        out[1, 2:] = cos_sin(angle[1])
     else:
         # (v1, v2) uniform on the sphere |v1|^2 + |v2|^2 = 2 in R^4
+        # the norm by elementwise IEEE operations in a fixed order (np.linalg.norm calls
+        # BLAS, whose kernels round differently on different CPUs)
         g = rng.standard_normal(4)
-        g *= math.sqrt(2.0) / np.linalg.norm(g)
+        g *= math.sqrt(2.0) / math.sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2] + g[3] * g[3])
         out[0, 2:] = g[:2]
         out[1, 2:] = g[2:]
     return out

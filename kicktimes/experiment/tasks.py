@@ -164,8 +164,14 @@ def run_task(experiment: Experiment, task: Task) -> tuple[pd.DataFrame, pd.DataF
     return out.results, out.collisions
 
 
-def execute_task(experiment: Experiment, task: Task) -> TaskOutput:
-    """`run_task` plus the per-stage timings, as a `TaskOutput` (what workers return)."""
+def execute_task(experiment: Experiment, task: Task, *, one_pass: bool = True) -> TaskOutput:
+    """`run_task` plus the per-stage timings, as a `TaskOutput` (what workers return).
+
+    ``one_pass=False`` computes every trajectory by separate calls (a simulation, then
+    its FTLE, then the two-disk continuation for the actual-time kicks) instead of one
+    event loop per trajectory: the same tables bit for bit (tested), several times slower;
+    it exists as the reference the one-pass sweep is checked against.
+    """
     from kicktimes.billiard.initial import initial_conditions
 
     _check_task(experiment, task)
@@ -182,7 +188,8 @@ def execute_task(experiment: Experiment, task: Task) -> TaskOutput:
     rows: list[tuple] = []
     coll: list[tuple] = []
     for k in range(task.n_ics):
-        _run_ic(experiment, task.radius, task.ic_start + k, ics[k], rows, coll, timer)
+        _run_ic(experiment, task.radius, task.ic_start + k, ics[k], rows, coll, timer,
+                one_pass=one_pass)
     with timer("tables"):
         results = pd.DataFrame(rows, columns=list(RESULT_COLUMNS))
         results = results.astype({"radius": "float64", "ic": "int64", "value": "float64"})
@@ -207,7 +214,8 @@ def _lyapunov_pass():
     return lyapunov_pass
 
 
-def _run_ic(exp: Experiment, r: float, ic_index: int, ic: np.ndarray, rows, coll, timer):
+def _run_ic(exp: Experiment, r: float, ic_index: int, ic: np.ndarray, rows, coll, timer, *,
+            one_pass: bool = True):
     from kicktimes.billiard.one_particle import draw_kick_angles, simulate_one_particle
     from kicktimes.billiard.two_particle import simulate_two_particle
     from kicktimes.diagnostics import boundary_angles
@@ -254,7 +262,7 @@ def _run_ic(exp: Experiment, r: float, ic_index: int, ic: np.ndarray, rows, coll
     # gives each run and its exponent (and, for the actual-time systems, the two-disk
     # collision times beyond the sampled window), bitwise what separate calls give; its
     # time is recorded under "lyapunov_*" (simulation + FTLE)
-    one_pass = "lyapunov" in diags and exp.lyapunov_method == "tangent"
+    one_pass = one_pass and "lyapunov" in diags and exp.lyapunov_method == "tangent"
     horizon = exp.horizon
     continued = None
     two_pass = one_pass and "two_particle" in exp.systems

@@ -1,21 +1,16 @@
-"""Golden sweep results: small experiments whose tidy tables must not change by a bit.
+"""Sweep cases: small experiments whose tables the one-pass sweep must not change by a bit.
 
-The one-pass sweep (simulation, FTLE and the actual-time continuation from one event
-loop per trajectory) was introduced without changing any result; ``sweep_golden.parquet``
-holds the ``results`` and ``collisions`` tables of the experiments below computed by the
-code before it (separate simulation, FTLE and continuation runs), and the test compares
-every value bit for bit.
-
-Usage (from the repository root, with ``PYTHONPATH=$PWD``)::
-
-    python tests/data/sweep_cases.py dump tests/data/sweep_golden.parquet
-    python tests/data/sweep_cases.py check tests/data/sweep_golden.parquet
+The one-pass sweep computes simulation, FTLE and the actual-time continuation from one
+event loop per trajectory. ``tables(one_pass=False)`` computes the same experiments by
+separate calls (a simulation, its FTLE, the continuation), and the test compares the two
+in one process: a bitwise property of one machine, so no file made on another machine is
+involved (chaotic trajectories are not bitwise across CPUs; docs/architecture.md,
+*Reproducibility*).
 """
 
 from __future__ import annotations
 
 import dataclasses
-import sys
 
 import numpy as np
 import pandas as pd
@@ -42,43 +37,18 @@ def experiments():
     ]
 
 
-def tables() -> tuple[pd.DataFrame, pd.DataFrame]:
+def tables(one_pass: bool = True) -> tuple[pd.DataFrame, pd.DataFrame]:
     """The results and collisions of every experiment, with a column ``experiment``."""
-    from kicktimes.experiment import run_task
+    from kicktimes.experiment.tasks import execute_task
 
     results, collisions = [], []
     for exp in experiments():
         for task in exp.tasks():
-            res, col = run_task(exp, task)
+            out = execute_task(exp, task, one_pass=one_pass)
+            res, col = out.results, out.collisions
             results.append(res.assign(experiment=exp.name))
             collisions.append(col.assign(experiment=exp.name))
     return pd.concat(results, ignore_index=True), pd.concat(collisions, ignore_index=True)
-
-
-def save(path) -> None:
-    """One parquet file: the results rows, then one row per IC with its collision times
-    (``diagnostic == "pp_times"``, the times in ``pp_times``)."""
-    res, col = tables()
-    col = col.assign(system="two_particle", diagnostic="pp_times", value=col["t_window"],
-                     note="")
-    both = pd.concat([res.assign(pp_times=[np.empty(0)] * len(res)),
-                      col[list(res.columns) + ["pp_times"]]], ignore_index=True)
-    both.to_parquet(path, compression="zstd")
-
-
-def load(path) -> tuple[pd.DataFrame, pd.DataFrame]:
-    """The ``(results, collisions)`` written by `save`, as `tables` returns them."""
-    both = pd.read_parquet(path)
-    is_col = both["diagnostic"] == "pp_times"
-    res = both[~is_col].drop(columns="pp_times").reset_index(drop=True)
-    col = both[is_col].reset_index(drop=True)
-    col = pd.DataFrame({
-        "radius": col["radius"], "ic": col["ic"], "t_window": col["value"],
-        "n_pp": col["pp_times"].map(len).astype("int64"),
-        "pp_times": [np.asarray(p, dtype=np.float64) for p in col["pp_times"]],
-        "experiment": col["experiment"],
-    })
-    return res, col
 
 
 def differences(ref, new) -> list[str]:
@@ -98,18 +68,3 @@ def differences(ref, new) -> list[str]:
         if a.tobytes() != np.asarray(b, dtype=np.float64).tobytes():
             bad.append(f"collisions row {i}: pp_times differ")
     return bad
-
-
-def main(argv):
-    action, path = argv[0], argv[1]
-    if action == "dump":
-        save(path)
-        print(f"written to {path}")
-        return 0
-    bad = differences(load(path), tables())
-    print("identical" if not bad else "\n".join(bad))
-    return 1 if bad else 0
-
-
-if __name__ == "__main__":
-    sys.exit(main(sys.argv[1:]))
