@@ -95,7 +95,8 @@ def test_analysis_files_are_the_builtin_presets_with_the_papers_parameters():
     for exp in (a, b):
         assert exp.sampling == "paper" and exp.ic_method == "paper"
         assert exp.d0 == 1 / 5000 and exp.lyapunov_variant == "paper"
-        assert exp.eps == (1e-3, 1e-2) and exp.rr_sampling == "run" and exp.acf_max_lag == 20
+        assert exp.eps == (1e-3, 1e-2) and exp.rr_sampling == "run+uniform"
+        assert exp.acf_max_lag == 20
 
 
 def test_the_papers_content_drops_only_the_extensions():
@@ -105,9 +106,9 @@ def test_the_papers_content_drops_only_the_extensions():
         assert preset(name) is full and preset(name, content="full") is full
         paper = preset(name, content="paper")
         assert paper.systems == ("two_particle", "poisson", "actual")
-        assert paper.eps == (1e-3,) and paper.acf_max_lag == 1
+        assert paper.eps == (1e-3,) and paper.acf_max_lag == 1 and paper.rr_sampling == "run"
         kept = {f.name for f in dataclasses.fields(Experiment)} - {
-            "systems", "eps", "acf_max_lag", "description"
+            "systems", "eps", "acf_max_lag", "rr_sampling", "description"
         }
         assert all(getattr(paper, k) == getattr(full, k) for k in kept)
         assert paper.hash() != full.hash()
@@ -457,7 +458,7 @@ def test_sweep_results_are_bitwise_those_of_separate_simulation_and_ftle_runs():
     cases = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(cases)
     separate = cases.tables(one_pass=False)
-    assert len(separate[0]) == 5028 and len(separate[1]) == 24
+    assert len(separate[0]) == 6228 and len(separate[1]) == 24  # with the uniform_ rows
     assert set(separate[0]["system"]) == {"two_particle", "poisson", "actual",
                                           "poisson_scatter", "actual_scatter"}
     assert cases.differences(separate, cases.tables()) == []
@@ -943,6 +944,44 @@ def test_reproduce_quick_runs_both_quick_families_and_builds_the_report(tmp_path
     for name in ("quick_a", "quick_b"):
         assert load_store(tmp_path / f"store-{name}").experiment == PRESETS[name]
     assert (tmp_path / "report" / "report.html").is_file()
+    # the findings tables: every comparison under its controls, robust flags consistent
+    from kicktimes.report.controls import COLUMNS
+
+    for name in ("quick_a", "quick_b"):
+        table = pd.read_csv(tmp_path / "report" / name / "findings.csv")
+        assert tuple(table.columns) == COLUMNS
+        assert set(table["family"]) == {name}
+        assert {"ftle", "rr_offdiag@0.001", "rr_offdiag@0.01", "det@0.01", "one_minus_r1",
+                "counts"} <= set(table["diagnostic"])
+        comparisons = table[table["diagnostic"] != "counts"]
+        for _, part in comparisons.groupby(["diagnostic", "system"]):
+            controls = set(part["control"])
+            assert {"primary", "paired_median", "sticky_excluded"} <= controls
+            assert part["robust"].nunique() == 1
+            assert bool(part["robust"].iloc[0]) == (part["verdict"].nunique() == 1)
+        recurrence = comparisons[comparisons["diagnostic"].str.startswith(("rr_", "det"))]
+        assert (recurrence.groupby(["diagnostic", "system"])["control"]
+                .apply(lambda c: "uniform_sampling" in set(c)).all())
+
+
+def test_the_uniform_control_rows_are_those_of_a_uniform_rr_sampling_run():
+    from kicktimes.experiment import run_task
+
+    both = dataclasses.replace(TINY, n_ics=2, block_size=2, n_steps=300,
+                               rr_sampling="run+uniform", eps=(1e-3, 1e-2))
+    run = dataclasses.replace(both, rr_sampling="run")
+    uniform = dataclasses.replace(both, rr_sampling="uniform")
+    task = both.tasks()[0]
+    res_both, _ = run_task(both, task)
+    res_run, _ = run_task(run, task)
+    res_uniform, _ = run_task(uniform, task)
+    prefixed = res_both["diagnostic"].str.startswith("uniform_")
+    pd.testing.assert_frame_equal(res_both[~prefixed].reset_index(drop=True), res_run)
+    mine = res_both[prefixed].assign(
+        diagnostic=res_both.loc[prefixed, "diagnostic"].str.removeprefix("uniform_"))
+    theirs = res_uniform[res_uniform["diagnostic"].isin(set(mine["diagnostic"]))]
+    assert len(mine) == len(theirs) > 0
+    pd.testing.assert_frame_equal(mine.reset_index(drop=True), theirs.reset_index(drop=True))
 
 
 def test_a_name_with_a_trailing_newline_is_refused():

@@ -41,6 +41,8 @@ FIGURES = {
     "fig10_rate_heterogeneity",
 }
 TABLES = {
+    "findings_statements",
+    "findings_overview",
     "poincare_runs",
     "kick_times_fit",
     "counts_by_radius",
@@ -292,7 +294,7 @@ def test_the_page_opens_with_the_findings_and_a_below_paper_scale_banner(built):
 
 
 def test_every_finding_has_an_effect_a_confidence_interval_and_a_ruled_verdict(built):
-    table = pd.read_csv(built[1] / "findings.csv")
+    table = pd.read_csv(built[1] / "findings_statements.csv")
     questions = set(table["question"])
     assert {"FTLE", "Lag-1 ACF of boundary angles", "Off-diagonal RR (ε = 0.001)"} <= questions
     assert "Collision counts against kinetic theory" in questions
@@ -316,7 +318,7 @@ def test_the_ftle_finding_is_the_mean_over_radii_of_the_ratio_of_means(built, st
     )
     ratio = lam.groupby(level="radius").sum()
     expected = (ratio["poisson"] / ratio["two_particle"]).mean()
-    table = pd.read_csv(built[1] / "findings.csv")
+    table = pd.read_csv(built[1] / "findings_statements.csv")
     row = table[(table["question"] == "FTLE") & (table["system"] == "poisson")].iloc[0]
     assert row["estimate"] == pytest.approx(expected, rel=1e-12)
 
@@ -363,7 +365,7 @@ def test_write_results_gives_pngs_and_a_generated_findings_page(store_path, tmp_
     path = write_results(store_path, tmp_path, dpi=40, n_mc=19, max_ics_model_fits=1)
     text = path.read_text(encoding="utf-8")
     assert text.startswith("# What the reproduction shows (generated)")
-    assert "**Below paper scale**" in text and "### Findings" in text
+    assert "**Below paper scale**" in text and "## The answers" in text and "### All statements" in text
     assert "FTLE, Poisson vs two-particle: ratio of mean λ" in text
     pngs = {p.name for p in tmp_path.glob("*.png")}
     assert "tiny_report_fig05_lyapunov_vs_radius.png" in pngs

@@ -36,7 +36,7 @@ RULES = ("mirror", "elastic")
 LYAPUNOV_VARIANTS = ("norm", "paper")
 LYAPUNOV_METHODS = ("tangent", "twin")
 KICK_ANGLES = ("uniform", "gaussian")
-RR_SAMPLINGS = ("run", "uniform")
+RR_SAMPLINGS = ("run", "uniform", "run+uniform")
 
 #: Fields added after the first store layout, with the value that reproduces the earlier
 #: results: `Experiment.hash` leaves a field out while it has that value (and writes a
@@ -141,7 +141,9 @@ class Experiment:
         ``sampling="paper"`` the paper's collision-truncated steps); ``"uniform"``: samples
         at ``k tau`` over the run's duration, from a uniformly sampled re-run of the same
         trajectory with the same kicks (identical to ``"run"`` when
-        ``sampling="uniform"``).
+        ``sampling="uniform"``); ``"run+uniform"``: both, the uniform rows prefixed
+        ``uniform_`` (``uniform_rr_offdiag@e``, ``uniform_det@e``, ...): the
+        uniform-sampling control of the recurrence findings.
     lag : int
         Autocorrelation lag ``>= 1`` of the ``autocorrelation`` row.
     acf_max_lag : int

@@ -32,7 +32,9 @@ _PAPER = {
     "sampling": "paper",
     "rule": "mirror",
     "eps": (1e-3, 1e-2),
-    "rr_sampling": "run",
+    # the recurrence rows on the paper's samples and, as the control of the recurrence
+    # findings, on uniform-time samples of the same trajectories (uniform_* rows)
+    "rr_sampling": "run+uniform",
     "lag": 1,
     "acf_max_lag": 20,
     "d0": 1.0 / 5000.0,
@@ -110,6 +112,8 @@ PAPER_CONTENT = {
     "eps": (1e-3,),
     # the lag-1 autocorrelation R_1 only (no ACF curve)
     "acf_max_lag": 1,
+    # the recurrence rate on the paper's samples only (no uniform-sampling control)
+    "rr_sampling": "run",
 }
 #: The contents a preset comes in (``preset(name, content=...)``).
 CONTENTS = ("full", "paper")

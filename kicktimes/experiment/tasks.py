@@ -242,6 +242,14 @@ def _run_ic(exp: Experiment, r: float, ic_index: int, ic: np.ndarray, rows, coll
             with timer("recurrence_rate"):
                 for diagnostic, value, note in recurrence_rows(points, exp.eps):
                     add(system, diagnostic, value, note)
+            if exp.rr_sampling == "run+uniform":
+                # the uniform-sampling control: the same trajectory sampled at k tau
+                with timer("recurrence_resampling"):
+                    points = _uniform_samples(exp, system, ic, r, run)
+                with timer("recurrence_rate"):
+                    for diagnostic, value, note in recurrence_rows(points, exp.eps):
+                        if "@" in diagnostic:
+                            add(system, UNIFORM_PREFIX + diagnostic, value, note)
         if "autocorrelation" in diags:
             with timer("autocorrelation"):
                 theta = boundary_angles(run, 0 if system == "two_particle" else None)
@@ -344,6 +352,11 @@ def _kick_law(exp: Experiment, system: str, ic: np.ndarray) -> dict:
         return {"kick_angle": exp.kick_angle, "sigma": exp.sigma}
     e0 = 0.5 * float((ic[:, 2:] ** 2).sum()) if exp.rule == "elastic" else None
     return {"kick_angle": "scatter", "sigma": exp.sigma, "rule": exp.rule, "e0": e0}
+
+
+#: prefix of the recurrence rows computed on uniform-time samples when
+#: ``rr_sampling = "run+uniform"`` (e.g. ``uniform_rr_offdiag@0.001``)
+UNIFORM_PREFIX = "uniform_"
 
 
 def eps_label(eps: float) -> str:

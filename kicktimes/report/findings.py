@@ -14,6 +14,7 @@ import pandas as pd
 
 from kicktimes.report import autocorrelation, counts, lyapunov, poisson, recurrence, renewal
 from kicktimes.report._common import PAPER_SCALE, Section, is_paper_scale
+from kicktimes.report.controls import answers, controls_table, overview_table, poisson_share
 from kicktimes.report.effects import BUILT_IN, RATIO_RULE, SHARE_RULE
 
 __all__ = ["collect", "scale_statement", "section", "EFFECT_MODULES"]
@@ -72,6 +73,18 @@ def section(ctx):
         )
     else:
         sec.text(f"Scale: {scale}.")
+    controls = controls_table(
+        ctx.results, ctx.store.collisions, family=ctx.exp.name, eps=ctx.exp.eps,
+        rule=ctx.exp.rule, rng=ctx.boot_rng(), n_boot=ctx.n_boot, resamples=ctx.resamples,
+    )
+    ctx.found["controls"] = controls
+    for sentence in answers(controls, {ctx.exp.name: poisson_share(effects)}):
+        sec.text(sentence.replace("**", ""))
+    sec.table("findings", controls, "Findings under their controls (ratio to the two-disk "
+              "value, 95 % CI, verdict, robust to every control)", show=False)
+    sec.table("findings_overview", overview_table(controls), "Overview: ✓ robust to every "
+              "control; ✗ depends on the named control")
+    sec.text("All statements, under the primary setting:")
     sec.bullets(e.statement() + (f" ({e.detail}.)" if e.detail else "") for e in effects)
     sec.text(rules_text(ctx))
     table = pd.DataFrame(
@@ -91,6 +104,6 @@ def section(ctx):
             for e in effects
         ]
     )
-    sec.table("findings", table, "Findings (effect, 95 % CI, verdict)", show=False)
+    sec.table("findings_statements", table, "Findings (effect, 95 % CI, verdict)", show=False)
     ctx.found["effects"] = effects
     return sec

@@ -57,6 +57,7 @@ def write_results(
     >>> from kicktimes.report import write_results
     >>> write_results("stores/family_a", "docs/results")  # doctest: +SKIP
     """
+    from kicktimes.report.controls import first_screen, poisson_share
     from kicktimes.report.findings import rules_text, scale_statement
     from kicktimes.report.pipeline import N_STAGES, analyse
 
@@ -82,6 +83,8 @@ def write_results(
         + ". Every number below is computed from the stores; nothing is typed.",
         "",
     ]
+    head = len(lines)
+    controls, shares = [], {}
     try:
         for st in stores:
             t0 = time.perf_counter()
@@ -104,7 +107,9 @@ def write_results(
                 ]
             else:
                 lines += [f"Scale: {scale}.", ""]
-            lines += ["### Findings", ""]
+            controls.append(ctx.found["controls"])
+            shares[name] = poisson_share(ctx.found["effects"])
+            lines += ["### All statements (primary setting)", ""]
             for e in ctx.found["effects"]:
                 lines.append(
                     "- " + _md_escape(e.statement() + (f" ({e.detail}.)" if e.detail else ""))
@@ -141,6 +146,15 @@ def write_results(
                     lines += [_md_escape(caption), "", f"![{fname}]({fname}.png)", ""]
     finally:
         pool.close()
+    import pandas as pd
+
+    table = pd.concat(controls, ignore_index=True)
+    screen = ["## The answers", ""] + first_screen(table, shares) + [
+        "Every row under every control: " + ", ".join(
+            f"[{st.experiment.name}_findings.csv]({st.experiment.name}_findings.csv)"
+            for st in stores) + ". Below: per family, the scale, every statement under the "
+        "primary setting, and the figures.", ""]
+    lines[head:head] = screen
     path = out / "README.md"
     path.write_text("\n".join(lines), encoding="utf-8")
     return path

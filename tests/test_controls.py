@@ -1,0 +1,85 @@
+"""The findings' controls: estimators on data with known answers, verdicts and robustness."""
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from kicktimes.report.controls import (
+    COLUMNS,
+    answers,
+    band_verdict,
+    controls_table,
+    overview_table,
+    paired_median,
+)
+
+
+def _frame(values_by_system, radii, n_ics):
+    idx = pd.MultiIndex.from_product([radii, range(n_ics)], names=["radius", "ic"])
+    rows = []
+    for system, diag_values in values_by_system.items():
+        for diagnostic, values in diag_values.items():
+            for (r, i), v in zip(idx, values, strict=True):
+                rows.append((r, i, system, diagnostic, float(v), ""))
+    return pd.DataFrame(rows, columns=["radius", "ic", "system", "diagnostic", "value", "note"])
+
+
+@pytest.mark.parametrize(("low", "high", "verdict"), [
+    (0.95, 1.05, "within 10 %"), (0.9, 1.1, "within 10 %"), (0.3, 0.4, "differs"),
+    (1.2, 1.5, "differs"), (0.85, 1.0, "inconclusive"), (np.nan, 1.0, "inconclusive"),
+])
+def test_the_band_verdict(low, high, verdict):
+    assert band_verdict(low, high) == verdict
+
+
+def test_the_paired_median_ignores_a_few_extreme_runs_and_covers_the_true_ratio():
+    rng = np.random.default_rng(5)
+    idx = pd.MultiIndex.from_product([[0.01, 0.02, 0.03], range(200)], names=["radius", "ic"])
+    y = pd.Series(rng.lognormal(0.0, 0.3, idx.size), index=idx)
+    x = 0.93 * y * rng.lognormal(0.0, 0.05, idx.size)
+    x.iloc[[0, 250, 500]] *= 1e3  # three sticky runs
+    med = paired_median(x, y, rng=np.random.default_rng(1), n_boot=400)
+    assert med["ci_low"] < 0.93 < med["ci_high"]
+    assert med["ci_high"] - med["ci_low"] < 0.02
+    assert med["n_pairs"] == idx.size
+
+
+def test_sticky_runs_are_left_out_and_a_control_that_flips_the_verdict_is_named():
+    # a kicked system at 0.93 of the two-disk value, except three ICs whose two-disk run
+    # is sticky (collides 10x the kinetic rate) and whose ratio is 2: the ratio of means
+    # moves, the median and the sticky-free ratio do not
+    from kicktimes.stats import kinetic_rate
+
+    radii, n = [0.01, 0.02], 60
+    rng = np.random.default_rng(2)
+    two = rng.uniform(1.0, 1.2, len(radii) * n)
+    kicked = 0.93 * two
+    sticky_ics = [0, 1, 2]
+    for r_i in range(len(radii)):
+        for i in sticky_ics:
+            two[r_i * n + i] = 0.05
+            kicked[r_i * n + i] = 30.0
+    results = _frame({"two_particle": {"lyapunov": two}, "poisson_scatter": {"lyapunov": kicked}},
+                     radii, n)
+    t = 1000.0
+    coll = pd.DataFrame([(r, i, t, int(round(kinetic_rate(r) * t * (10 if i in sticky_ics
+                                                                     else 1))))
+                         for r in radii for i in range(n)],
+                        columns=["radius", "ic", "t_window", "n_pp"])
+    table = controls_table(results, coll, family="f", eps=(), rng=np.random.default_rng(0),
+                           n_boot=400)
+    assert tuple(table.columns) == COLUMNS
+    ftle = table[table["diagnostic"] == "ftle"].set_index("control")
+    assert ftle.loc["primary", "estimate"] > 1.3
+    assert ftle.loc["sticky_excluded", "estimate"] == pytest.approx(0.93)
+    assert ftle.loc["paired_median", "estimate"] == pytest.approx(0.93)
+    assert ftle.loc["sticky_excluded", "verdict"] == "within 10 %"
+    assert not ftle["robust"].any()
+    cell = overview_table(table).loc[0, "Poisson, scatter"]
+    assert "✗ depends on paired_median" in cell
+    counts = table[table["diagnostic"] == "counts"].set_index("control")
+    assert counts.loc["sticky_excluded", "estimate"] == pytest.approx(1.0, abs=0.01)
+    assert "3 sticky" not in counts.loc["primary", "detail"]
+    assert counts.loc["sticky_excluded", "detail"].startswith("6 sticky")
+    text = " ".join(answers(table))
+    assert "Does any kick?" in text and "depends on" in text
