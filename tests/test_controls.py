@@ -7,7 +7,6 @@ import pytest
 from kicktimes.report.controls import (
     COLUMNS,
     answers,
-    band_verdict,
     controls_table,
     overview_table,
     paired_median,
@@ -29,7 +28,9 @@ def _frame(values_by_system, radii, n_ics):
     (1.2, 1.5, "differs"), (0.85, 1.0, "inconclusive"), (np.nan, 1.0, "inconclusive"),
 ])
 def test_the_band_verdict(low, high, verdict):
-    assert band_verdict(low, high) == verdict
+    from kicktimes.stats import ratio_verdict
+
+    assert ratio_verdict(low, high) == verdict
 
 
 def test_the_paired_median_ignores_a_few_extreme_runs_and_covers_the_true_ratio():

@@ -105,11 +105,11 @@ def _effect(ctx, question, system):
 
 
 def test_ratio_verdict_follows_the_printed_rule():
-    assert ratio_verdict(0.91, 1.09) == "agrees"
+    assert ratio_verdict(0.91, 1.09) == "within 10 %"
     assert ratio_verdict(0.2, 0.89) == "differs" and ratio_verdict(1.11, 3.0) == "differs"
     assert ratio_verdict(0.85, 1.05) == "inconclusive"
     assert ratio_verdict(np.nan, 1.0) == "inconclusive"
-    assert ratio_verdict(0.75, 1.2, tolerance=0.25) == "agrees"
+    assert ratio_verdict(0.75, 1.2, tolerance=0.25) == "within 25 %"
 
 
 def test_share_verdict_and_clopper_pearson():
@@ -184,12 +184,12 @@ def test_recurrence_findings_at_every_eps_off_diagonal_and_det(ctx):
         off = _effect(ctx, f"Off-diagonal RR (ε = {eps})", "poisson")
         assert off.estimate == pytest.approx(1.5, rel=1e-9) and off.verdict == "differs"
         det = _effect(ctx, f"DET (ε = {eps})", "actual")
-        assert det.estimate == pytest.approx(1.0) and det.verdict == "agrees"
+        assert det.estimate == pytest.approx(1.0) and det.verdict == "within 10 %"
 
 
 def test_acf_finding_is_marked_built_in(ctx):
     e = _effect(ctx, "Lag-1 ACF of boundary angles", "actual")
-    assert e.verdict.startswith("agrees") and "built in" in e.verdict
+    assert e.verdict.startswith("within 10 %") and "built in" in e.verdict
     assert "built-in prediction" in e.detail
 
 

@@ -31,7 +31,7 @@ from kicktimes.report._figures import (
     system_label,
     system_style,
 )
-from kicktimes.report.effects import BUILT_IN, RATIO_RULE, Effect, paired_ratio, ratio_verdict
+from kicktimes.report.effects import BUILT_IN, Effect, paired_ratio, ratio_rule, ratio_verdict
 from kicktimes.report.summary import diagnostic_summary, diagnostic_vs_radius
 
 __all__ = ["predicted_lag1", "acf_curves", "acf_figure", "sections", "effects"]
@@ -334,10 +334,10 @@ def effects(ctx):
                 ci_high=tot["ci_high"],
                 verdict=(
                     f"{verdict} ({BUILT_IN}: kick rate = collision rate)"
-                    if verdict == "agrees"
+                    if verdict.startswith("within")
                     else f"{verdict} (an agreement would be {BUILT_IN}: kick rate = collision rate)"
                 ),
-                rule=RATIO_RULE.format(t=ctx.tolerance),
+                rule=ratio_rule(ctx.tolerance),
                 method=f"paired bootstrap over {tot['n_ics']} ICs",
                 detail=detail,
             )

@@ -26,9 +26,9 @@ changes it. The controls:
 Every interval is a percentile bootstrap clustered on ICs: one resample draws IC indices
 with replacement and applies them at every radius and to every system (the same IC is
 the same initial condition everywhere), so the correlation of one IC across radii and
-systems is kept. Verdicts use one band (:data:`BAND_RULE`): *within 10 %* when the whole
-95 % interval lies in [0.9, 1.1], *differs* when it lies entirely outside, *inconclusive*
-otherwise.
+systems is kept. Verdicts use one band (:func:`kicktimes.stats.ratio_verdict`): *within 10 %*
+when the whole 95 % interval lies in [0.9, 1.1], *differs* when it lies entirely outside,
+*inconclusive* otherwise.
 """
 
 from __future__ import annotations
@@ -41,12 +41,11 @@ import pandas as pd
 
 from kicktimes.report._common import REFERENCE, kicked_systems, wide
 from kicktimes.report.effects import paired_ratio
+from kicktimes.stats import ratio_rule, ratio_verdict
 
 __all__ = [
-    "BAND_RULE",
     "COLUMNS",
     "CONTROLS",
-    "band_verdict",
     "controls_table",
     "diagnostics_of",
     "paired_median",
@@ -61,12 +60,6 @@ WITHIN = "within 10 %"
 DIFFERS = "differs"
 INCONCLUSIVE = "inconclusive"
 #: how an interval becomes a verdict
-BAND_RULE = (
-    "within 10 %: the whole 95 % CI of the ratio lies in [0.9, 1.1] (the kicked system "
-    "reproduces the two-disk value to 10 %, the band being the precision the paper's "
-    "comparison by eye can claim); differs: the CI lies entirely outside [0.9, 1.1]; "
-    "inconclusive: the CI straddles a band edge"
-)
 _QUESTIONS = {
     "ftle": "FTLE",
     "rr_offdiag": "off-diagonal recurrence rate",
@@ -74,21 +67,6 @@ _QUESTIONS = {
     "one_minus_r1": "decorrelation 1 − R₁ of boundary angles",
     "counts": "collision counts / kinetic theory Γ(r)T",
 }
-
-
-def band_verdict(low, high, tolerance=0.1):
-    """``within 10 %``, ``differs`` or ``inconclusive`` for a ratio's CI (:data:`BAND_RULE`).
-
-    >>> band_verdict(0.95, 1.04), band_verdict(0.3, 0.4), band_verdict(0.85, 1.0)
-    ('within 10 %', 'differs', 'inconclusive')
-    """
-    if not (np.isfinite(low) and np.isfinite(high)):
-        return INCONCLUSIVE
-    if low >= 1 - tolerance and high <= 1 + tolerance:
-        return WITHIN
-    if high < 1 - tolerance or low > 1 + tolerance:
-        return DIFFERS
-    return INCONCLUSIVE
 
 
 def paired_median(numerator, denominator, *, rng, n_boot=1000, level=0.95):
@@ -190,7 +168,7 @@ def _row(family, diagnostic, system, control, est, low, high, n_pairs, detail):
         "estimate": est,
         "ci_low": low,
         "ci_high": high,
-        "verdict": band_verdict(low, high),
+        "verdict": ratio_verdict(low, high),
         "robust": False,
         "n_pairs": int(n_pairs),
         "detail": detail,
@@ -441,7 +419,7 @@ def first_screen(table: pd.DataFrame, shares: dict) -> list[str]:
     for sentence in answers(table, {k: v for k, v in shares.items() if v is not None}):
         lines += [sentence, ""]
     lines += ["Ratio of each kicked system to the two-disk value, averaged over radii [95 % "
-              "CI, bootstrap clustered on ICs]; ✓: the verdict (" + BAND_RULE.split(";")[0]
+              "CI, bootstrap clustered on ICs]; ✓: the verdict (" + ratio_rule(0.1).split(";")[0]
               + "; differs; inconclusive) is the same under every control (paired median, "
               "sticky runs excluded, uniform-time sampling for recurrence); ✗: it is not, and "
               "the control that changes it is named with its number.", ""]

@@ -235,7 +235,7 @@ def sections(ctx):
 def effects(ctx):
     """Observed disk-disk collision counts over the kinetic-theory counts Γ(r)·T."""
     from kicktimes import stats
-    from kicktimes.report.effects import RATIO_RULE, Effect, paired_ratio, ratio_verdict
+    from kicktimes.report.effects import Effect, paired_ratio, ratio_rule, ratio_verdict
 
     coll = ctx.store.collisions.set_index(["radius", "ic"])
     r = coll.index.get_level_values("radius").to_numpy(float)
@@ -258,7 +258,7 @@ def effects(ctx):
             ci_low=tot["ci_low"],
             ci_high=tot["ci_high"],
             verdict=ratio_verdict(tot["ci_low"], tot["ci_high"], ctx.tolerance),
-            rule=RATIO_RULE.format(t=ctx.tolerance),
+            rule=ratio_rule(ctx.tolerance),
             method=f"bootstrap over {tot['n_ics']} ICs",
             detail=(
                 f"per-radius ratio {per_r['ratio'].min():.3g} to {per_r['ratio'].max():.3g}; "

@@ -2,7 +2,7 @@ r"""Effect sizes with 95 % confidence intervals and the verdict rules of the Fin
 
 Every comparison of the report is a ratio (a kicked system over the two-particle system,
 or an observed rate over the kinetic rate) with a 95 % confidence interval, and every
-verdict follows one printed rule (:data:`RATIO_RULE`, :data:`SHARE_RULE`), so no verdict
+verdict follows one printed rule (:func:`ratio_rule`, :data:`SHARE_RULE`), so no verdict
 is typed by hand.
 
 The bootstrap resamples initial conditions: the same IC index is the same initial
@@ -19,9 +19,11 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
+from kicktimes.stats import ratio_rule, ratio_verdict
+
 __all__ = [
     "Effect",
-    "RATIO_RULE",
+    "ratio_rule",
     "SHARE_RULE",
     "BUILT_IN",
     "ratio_verdict",
@@ -30,11 +32,6 @@ __all__ = [
     "clopper_pearson",
 ]
 
-#: how a ratio's verdict is decided, with ``{t}`` the tolerance
-RATIO_RULE = (
-    "agrees: the 95 % CI of the ratio lies inside [1 − {t:g}, 1 + {t:g}]; differs: the CI "
-    "lies entirely outside that band; inconclusive otherwise"
-)
 #: how a share's verdict is decided against a reference level ``{level}``
 SHARE_RULE = (
     "above: the 95 % CI of the share lies above {level:g}; below: it lies below {level:g}; "
@@ -94,21 +91,6 @@ class Effect:
 
 def _g(x):
     return "n/a" if not np.isfinite(x) else f"{x:.3g}"
-
-
-def ratio_verdict(low, high, tolerance=0.1):
-    """``agrees``/``differs``/``inconclusive`` for a ratio's CI (:data:`RATIO_RULE`).
-
-    >>> ratio_verdict(0.95, 1.04), ratio_verdict(0.3, 0.4), ratio_verdict(0.85, 1.0)
-    ('agrees', 'differs', 'inconclusive')
-    """
-    if not (np.isfinite(low) and np.isfinite(high)):
-        return "inconclusive"
-    if low >= 1 - tolerance and high <= 1 + tolerance:
-        return "agrees"
-    if high < 1 - tolerance or low > 1 + tolerance:
-        return "differs"
-    return "inconclusive"
 
 
 def share_verdict(low, high, level):

@@ -15,7 +15,7 @@ import pandas as pd
 from kicktimes.report import autocorrelation, counts, lyapunov, poisson, recurrence, renewal
 from kicktimes.report._common import PAPER_SCALE, Section, is_paper_scale
 from kicktimes.report.controls import answers, controls_table, overview_table, poisson_share
-from kicktimes.report.effects import BUILT_IN, RATIO_RULE, SHARE_RULE
+from kicktimes.report.effects import BUILT_IN, SHARE_RULE, ratio_rule
 
 __all__ = ["collect", "scale_statement", "section", "EFFECT_MODULES"]
 
@@ -48,7 +48,7 @@ def scale_statement(store):
 def rules_text(ctx):
     return (
         "Verdict rules. Ratios (kicked / two-particle, observed / kinetic): "
-        + RATIO_RULE.format(t=ctx.tolerance)
+        + ratio_rule(ctx.tolerance)
         + ". Shares (of rejections against α, of fitted ICs against 1/2): "
         + SHARE_RULE.format(level=0.5).replace("0.5", "the level")
         + ". Ratios average the per-radius ratios of ensemble means; their CIs come from "

@@ -22,7 +22,7 @@ from kicktimes.report._figures import (
     system_label,
     system_style,
 )
-from kicktimes.report.effects import RATIO_RULE, Effect, paired_ratio, ratio_verdict
+from kicktimes.report.effects import Effect, paired_ratio, ratio_rule, ratio_verdict
 from kicktimes.report.summary import diagnostic_summary, diagnostic_vs_radius
 
 __all__ = ["stretching_table", "stretching_figure", "sections", "effects"]
@@ -227,7 +227,7 @@ def effects(ctx):
                 ci_low=tot["ci_low"],
                 ci_high=tot["ci_high"],
                 verdict=ratio_verdict(tot["ci_low"], tot["ci_high"], ctx.tolerance),
-                rule=RATIO_RULE.format(t=ctx.tolerance),
+                rule=ratio_rule(ctx.tolerance),
                 method=f"paired bootstrap over {tot['n_ics']} ICs",
                 detail=detail,
             )

@@ -379,7 +379,7 @@ def build_report(
     n_boot : int, optional
         Bootstrap resamples (over ICs) of the Findings' confidence intervals.
     tolerance : float, optional
-        Half-width of the "agrees" band of a ratio's verdict: agrees when the 95 % CI
+        Half-width of the band of a ratio's verdict: "within 10 %" when the 95 % CI
         lies inside ``[1 - tolerance, 1 + tolerance]`` (see :mod:`kicktimes.report.effects`).
     pdf : bool, optional
         Also write a PDF of every figure (the page embeds the PNGs; default False).

@@ -29,7 +29,7 @@ from kicktimes.report._common import (
     wide,
 )
 from kicktimes.report._figures import RADIUS_LABEL, plain_ticks, shared_legend
-from kicktimes.report.effects import RATIO_RULE, Effect, paired_ratio, ratio_verdict
+from kicktimes.report.effects import Effect, paired_ratio, ratio_rule, ratio_verdict
 from kicktimes.report.summary import diagnostic_summary, diagnostic_vs_radius
 
 __all__ = ["recurrence_rows", "sampling_statement", "rr_figure", "sections", "effects"]
@@ -301,7 +301,7 @@ def effects(ctx):
                         ci_low=tot["ci_low"],
                         ci_high=tot["ci_high"],
                         verdict=ratio_verdict(tot["ci_low"], tot["ci_high"], ctx.tolerance),
-                        rule=RATIO_RULE.format(t=ctx.tolerance),
+                        rule=ratio_rule(ctx.tolerance),
                         method=f"paired bootstrap over {tot['n_ics']} ICs",
                         detail=(
                             f"per-radius ratio {fmt(per_r['ratio'].min())} to "

@@ -13,6 +13,8 @@ It takes event times and observation windows only (no billiard knowledge):
 See ``docs/statistics.md`` for the conventions.
 """
 
+from kicktimes.stats._findings import ratio_rule, ratio_verdict
+
 from .analyze import Analysis, analyze
 from .comparison import VuongResult, compare_models, vuong
 from .counts import CountRegression, kinetic_rate, regress_counts
@@ -53,4 +55,6 @@ __all__ = [
     "PoissonEnsembleResult",
     "CountRegression",
     "FitWarning",
+    "ratio_verdict",
+    "ratio_rule",
 ]

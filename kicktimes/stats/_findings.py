@@ -13,7 +13,44 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import stats as sps
 
-__all__ = ["Finding", "findings"]
+__all__ = ["Finding", "findings", "ratio_verdict", "ratio_rule"]
+
+def ratio_rule(tolerance=0.1) -> str:
+    """The printed rule of :func:`ratio_verdict` for a band of half-width ``tolerance``.
+
+    >>> ratio_rule(0.1)[:58]
+    'within 10 %: the whole 95 % CI of the ratio lies in [0.9, '
+    """
+    p, lo, hi = f"{100 * tolerance:g}", f"{1 - tolerance:g}", f"{1 + tolerance:g}"
+    return (
+        f"within {p} %: the whole 95 % CI of the ratio lies in [{lo}, {hi}] (the two values "
+        f"agree to {p} %; a CI inside the band may still exclude 1, which then measures a "
+        f"real difference smaller than the band); differs: the CI lies entirely outside "
+        f"[{lo}, {hi}]; inconclusive: the CI straddles a band edge"
+    )
+
+
+def ratio_verdict(low, high, tolerance=0.1):
+    """``"within 10 %"``, ``"differs"`` or ``"inconclusive"`` for a ratio's 95 % CI.
+
+    The verdict of every ratio kicktimes states (:func:`ratio_rule` prints it): *within* when the
+    whole interval lies in ``[1 - tolerance, 1 + tolerance]``, *differs* when it lies
+    entirely outside, *inconclusive* otherwise (and when an endpoint is not finite).
+
+    Examples
+    --------
+    >>> ratio_verdict(0.95, 1.04), ratio_verdict(0.3, 0.4), ratio_verdict(0.85, 1.0)
+    ('within 10 %', 'differs', 'inconclusive')
+    >>> ratio_verdict(0.8, 1.2, tolerance=0.25)
+    'within 25 %'
+    """
+    if not (np.isfinite(low) and np.isfinite(high)):
+        return "inconclusive"
+    if low >= 1 - tolerance and high <= 1 + tolerance:
+        return f"within {100 * tolerance:g} %"
+    if high < 1 - tolerance or low > 1 + tolerance:
+        return "differs"
+    return "inconclusive"
 
 
 @dataclass(frozen=True)
@@ -185,25 +222,16 @@ def _reference(res):
     ref = res.reference
     if ref is None or ref.empty:
         return None
-    rule = (
-        "agrees: the 95 % CI of observed / reference rate lies inside [0.9, 1.1]; differs: "
-        "the CI excludes [0.9, 1.1] entirely; inconclusive otherwise."
-    )
+    rule = "Observed / reference rate: " + ratio_rule(0.1) + "."
     verdicts, parts = [], []
     for r in ref.itertuples():
-        if r.ci_low >= 0.9 and r.ci_high <= 1.1:
-            v = "agrees"
-        elif r.ci_high < 0.9 or r.ci_low > 1.1:
-            v = "differs"
-        else:
-            v = "inconclusive"
-        verdicts.append(v)
+        verdicts.append(ratio_verdict(r.ci_low, r.ci_high))
         label = "" if res.group is None else f"{res.group} = {_v(r.group)}: "
         parts.append(f"{label}{r.ratio:.3f} [{r.ci_low:.3f}, {r.ci_high:.3f}]")
     verdict = (
         verdicts[0]
         if len(set(verdicts)) == 1
-        else (f"{verdicts.count('agrees')}/{len(verdicts)} groups agree")
+        else (f"{verdicts.count('within 10 %')}/{len(verdicts)} groups within 10 %")
     )
     text = (
         f"Observed / reference rate ({res.reference_column}) with 95 % CI: "
