@@ -84,3 +84,39 @@ def test_sticky_runs_are_left_out_and_a_control_that_flips_the_verdict_is_named(
     assert counts.loc["sticky_excluded", "detail"].startswith("6 sticky")
     text = " ".join(answers(table))
     assert "Does any kick?" in text and "depends on" in text
+
+
+# ------------------------------------------------------------- pooled shares, calibrated
+def test_a_share_pooled_over_radii_gets_an_interval_clustered_on_ics():
+    # every IC rejects at all 12 radii or at none: 12 x 200 runs are 200 independent
+    # units, and the clustered interval is as wide as a binomial interval over 200
+    from kicktimes.report.effects import clopper_pearson
+    from kicktimes.report.poisson import clustered_share
+
+    rng = np.random.default_rng(3)
+    rejects = rng.uniform(size=200) < 0.3
+    df = pd.DataFrame({"radius": np.repeat(np.arange(12) / 1000 + 0.008, 200),
+                       "ic": np.tile(np.arange(200), 12),
+                       "p": np.tile(np.where(rejects, 0.0, 1.0), 12)})
+    low, high = clustered_share(df, "p", 0.05, rng=np.random.default_rng(0))
+    naive = clopper_pearson(int(rejects.sum()) * 12, 2400)
+    wide = clopper_pearson(int(rejects.sum()), 200)
+    assert high - low > 2.5 * (naive[1] - naive[0])
+    assert high - low == pytest.approx(wide[1] - wide[0], rel=0.25)
+
+
+def test_the_fixed_interval_poisson_test_has_its_size_on_poisson_times():
+    from kicktimes.report.poisson import FIXED_EVENTS, _poisson_job
+
+    rng = np.random.default_rng(8)
+    seqs, windows = [], []
+    for _ in range(1500):
+        t = np.cumsum(rng.exponential(1.0, 80))
+        window = float(rng.uniform(35.0, 80.0))
+        seqs.append(t[t <= window])
+        windows.append(window)
+    job = (0.01, seqs, np.array(windows), 0.05, 19, (1, 1, 0), "mirror", np.arange(1500))
+    _, _, per_ic = _poisson_job(job)
+    fixed = per_ic["p_fixed"].dropna()
+    assert len(fixed) == sum(s.size >= FIXED_EVENTS for s in seqs) > 1000
+    assert abs((fixed < 0.05).mean() - 0.05) < 0.02

@@ -24,7 +24,7 @@ from kicktimes.report._figures import (
     finite,
     new_axes,
 )
-from kicktimes.report.effects import SHARE_RULE, Effect, clopper_pearson, share_verdict
+from kicktimes.report.effects import SHARE_RULE, Effect, share_verdict
 from kicktimes.stats.poisson import _NULL
 
 __all__ = [
@@ -39,6 +39,10 @@ __all__ = [
 #: the test of the Findings: given n, the times of a homogeneous Poisson process are
 #: uniform on the window (exact, conditional KS); the others are listed beside it
 HEADLINE_TEST = "uniformity_ks"
+#: the headline test is also run on the first FIXED_EVENTS collisions of every run (the
+#: first FIXED_EVENTS - 1 times, uniform on (0, t_FIXED_EVENTS) under Poisson), so that
+#: rejection rates at different radii compare the same number of intervals (equal power)
+FIXED_EVENTS = 30
 
 
 def binomial_ci(k, n, level=0.95):
@@ -179,11 +183,22 @@ def subsample(part, limit):
 def _poisson_job(job):
     """Poisson tests and rate homogeneity of one radius (runs in a worker process)."""
     from kicktimes import stats
+    from kicktimes.stats.poisson import uniformity_ks
 
-    r, seqs, windows, alpha, n_mc, seed_key, rule = job
+    r, seqs, windows, alpha, n_mc, seed_key, rule, ics = job
     ens = stats.test_poisson_ensemble(
         seqs, windows, alpha=alpha, n_mc=n_mc, rng=seeded_rng(*seed_key)
     )
+    # per IC: the headline test's p-value, and the same test on the first FIXED_EVENTS
+    # collisions only (NaN for runs with fewer)
+    p_fixed = np.full(len(seqs), np.nan)
+    long = [k for k, t in enumerate(seqs) if t.size >= FIXED_EVENTS]
+    if long:
+        u = np.array([seqs[k][: FIXED_EVENTS - 1] / seqs[k][FIXED_EVENTS - 1] for k in long])
+        p_fixed[long] = uniformity_ks(u)[1]
+    per_ic = pd.DataFrame({"radius": r, "ic": ics,
+                           "p": ens.per_sequence[f"p_{HEADLINE_TEST}"].to_numpy(float),
+                           "p_fixed": p_fixed})
     rows = []
     for test in stats.TESTS:
         p = ens.per_sequence[f"p_{test}"].to_numpy()
@@ -215,7 +230,7 @@ def _poisson_job(job):
         "lr_pvalue": hom.loc["likelihood_ratio", "pvalue"],
         "n_flagged_fdr": int(ens.reject["rate"].sum()),
     }
-    return rows, hom_row
+    return rows, hom_row, per_ic
 
 
 def _jobs(ctx):
@@ -226,7 +241,8 @@ def _jobs(ctx):
         seqs = [np.asarray(t, dtype=float) for t in part["pp_times"]]
         # one Monte Carlo stream per radius: identical results for any worker count
         key = (exp.seed, 1, ri)
-        jobs.append((r, seqs, part["t_window"].to_numpy(float), ctx.alpha, ctx.n_mc, key, exp.rule))
+        jobs.append((r, seqs, part["t_window"].to_numpy(float), ctx.alpha, ctx.n_mc, key, exp.rule,
+                     part["ic"].to_numpy()))
     return jobs
 
 
@@ -243,11 +259,22 @@ def sections(ctx):
     alpha, n_mc, max_ics_tests = ctx.alpha, ctx.n_mc, ctx.max_ics_tests
     started = ctx.pending.pop("poisson", None)
     results = started() if started is not None else ctx.pmap(_poisson_job, _jobs(ctx))
-    rej_rows, hom_rows = [], []
-    for rows, hom_row in results:
+    rej_rows, hom_rows, per_ic = [], [], []
+    for rows, hom_row, ic_rows in results:
         rej_rows += rows
         hom_rows.append(hom_row)
+        per_ic.append(ic_rows)
     rejections = rejection_table(pd.DataFrame(rej_rows))
+    per_ic = pd.concat(per_ic, ignore_index=True)
+    fixed = per_ic.groupby("radius").agg(
+        n_tested_fixed=("p_fixed", lambda p: int(np.isfinite(p).sum())),
+        n_reject_fixed=("p_fixed", lambda p: int((p < alpha).sum())),
+    )
+    with np.errstate(invalid="ignore", divide="ignore"):
+        fixed["rate_fixed"] = fixed["n_reject_fixed"] / fixed["n_tested_fixed"]
+    headline = rejections["test"] == HEADLINE_TEST
+    for col in fixed.columns:
+        rejections.loc[headline, col] = rejections.loc[headline, "radius"].map(fixed[col])
     homogeneity = pd.DataFrame(hom_rows)
     if max_ics_tests is not None and coll.groupby("radius")["ic"].nunique().max() > max_ics_tests:
         ctx.notes.append(
@@ -283,10 +310,52 @@ def sections(ctx):
         f"{int((rejections['combined_pvalue'] < alpha).sum())} of them. Tests with too few "
         "events in an IC are not run on it (n_tested counts the ICs tested)."
     )
-    sec.table("poisson_tests", rejections, "Rejections per radius and test")
+    t = rejections[headline].sort_values("radius")
+    sec.text(
+        f"At a fixed number of intervals ({HEADLINE_TEST} on the first {FIXED_EVENTS} "
+        "collisions of every run that has them, so every radius has the same power): "
+        + ", ".join(f"{pct(v)} at r = {r:g} ({int(n)} runs)" for r, v, n in
+                    zip(t["radius"], t["rate_fixed"], t["n_tested_fixed"], strict=True))
+        + "."
+    )
+    sec.table("poisson_tests", rejections, "Rejections per radius and test (the headline test "
+              f"also at a fixed {FIXED_EVENTS} collisions: *_fixed)")
     ctx.found["rejections"] = rejections
+    ctx.found["poisson_per_ic"] = per_ic
     ctx.found["homogeneity"] = homogeneity
     return [sec]
+
+
+def clustered_share(per_ic, column, alpha, *, rng, n_boot=2000, level=0.95):
+    """95 % CI of the share of runs with ``per_ic[column] < alpha``, by a bootstrap
+    clustered on ICs.
+
+    The runs of one IC at different radii start from the same initial condition, so they
+    are not independent: one resample draws IC indices with replacement and takes all
+    their runs; the share is ``rejections / runs tested`` of the resample (percentile CI).
+
+    Examples
+    --------
+    >>> import numpy as np, pandas as pd
+    >>> df = pd.DataFrame({"radius": np.repeat([0.01, 0.02], 50), "ic": np.tile(range(50), 2),
+    ...                    "p": np.tile(np.r_[np.zeros(10), np.ones(40)], 2)})
+    >>> low, high = clustered_share(df, "p", 0.05, rng=np.random.default_rng(0))
+    >>> bool(low < 0.2 < high)
+    True
+    """
+    table = per_ic.pivot_table(index="ic", columns="radius", values=column, dropna=False)
+    p = table.to_numpy(float)
+    tested = np.isfinite(p).sum(axis=1).astype(float)
+    rejected = (np.where(np.isfinite(p), p, 1.0) < alpha).sum(axis=1).astype(float)
+    if tested.sum() == 0:
+        return math.nan, math.nan
+    n = tested.size
+    counts = rng.multinomial(n, np.full(n, 1.0 / n), size=n_boot).astype(float)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        boot = (counts @ rejected) / (counts @ tested)
+    boot = boot[np.isfinite(boot)]
+    a = (1 - level) / 2 * 100
+    return float(np.percentile(boot, a)), float(np.percentile(boot, 100 - a))
 
 
 def effects(ctx):
@@ -298,8 +367,13 @@ def effects(ctx):
     if HEADLINE_TEST not in totals.index or totals.loc[HEADLINE_TEST, "n_tested"] == 0:
         return []
     k, n = (int(v) for v in totals.loc[HEADLINE_TEST])
-    low, high = clopper_pearson(k, n)
+    per_ic = ctx.found["poisson_per_ic"]
+    low, high = clustered_share(per_ic, "p", ctx.alpha, rng=ctx.rng(4), n_boot=ctx.n_boot)
     verdict = share_verdict(low, high, ctx.alpha)
+    n_fixed = max(1, int(np.isfinite(per_ic["p_fixed"]).sum()))
+    fixed_share = float((per_ic["p_fixed"] < ctx.alpha).sum()) / n_fixed
+    f_low, f_high = clustered_share(per_ic, "p_fixed", ctx.alpha, rng=ctx.rng(5),
+                                    n_boot=ctx.n_boot)
     words = {
         "above": "Poisson rejected (more rejections than α)",
         "below": "fewer rejections than α (conservative test)",
@@ -324,11 +398,15 @@ def effects(ctx):
             ci_high=high,
             verdict=words,
             rule=SHARE_RULE.format(level=ctx.alpha) + " (level: α, the share under Poisson)",
-            method=f"Clopper-Pearson, {n} runs",
+            method=(f"bootstrap clustered on {per_ic['ic'].nunique()} ICs ({n} runs at "
+                    f"{per_ic['radius'].nunique()} radii)"),
             detail=(
                 f"{pct(by_r['rate'].iloc[0])} at r = {by_r['radius'].iloc[0]:g}, "
-                f"{pct(by_r['rate'].iloc[-1])} at r = {by_r['radius'].iloc[-1]:g}; other "
-                f"tests (pooled): {others}"
+                f"{pct(by_r['rate'].iloc[-1])} at r = {by_r['radius'].iloc[-1]:g}; at a fixed "
+                f"{FIXED_EVENTS} collisions per run {pct(fixed_share)} [{pct(f_low)}, "
+                f"{pct(f_high)}] ({pct(by_r['rate_fixed'].iloc[0])} at r = "
+                f"{by_r['radius'].iloc[0]:g}, {pct(by_r['rate_fixed'].iloc[-1])} at r = "
+                f"{by_r['radius'].iloc[-1]:g}); other tests (pooled): {others}"
             ),
         )
     ]
