@@ -7,7 +7,7 @@ import pytest
 from kicktimes.report.controls import (
     COLUMNS,
     answers,
-    controls_table,
+    compute_controls,
     overview_table,
     paired_median,
 )
@@ -67,8 +67,13 @@ def test_sticky_runs_are_left_out_and_a_control_that_flips_the_verdict_is_named(
                                                                      else 1))))
                          for r in radii for i in range(n)],
                         columns=["radius", "ic", "t_window", "n_pp"])
-    table = controls_table(results, coll, family="f", eps=(), rng=np.random.default_rng(0),
-                           n_boot=400)
+    computed = compute_controls(results, coll, family="f", eps=(),
+                                rng=np.random.default_rng(0), n_boot=400)
+    table = computed.table
+    curve = computed.curves.query("diagnostic == 'ftle' and control == 'sticky_excluded'")
+    assert list(curve["radius"]) == radii
+    assert np.allclose(curve["ratio"], 0.93)
+    assert (curve["ci_low"] <= curve["ratio"]).all() and (curve["ratio"] <= curve["ci_high"]).all()
     assert tuple(table.columns) == COLUMNS
     ftle = table[table["diagnostic"] == "ftle"].set_index("control")
     assert ftle.loc["primary", "estimate"] > 1.3

@@ -28,6 +28,7 @@ EXPERIMENT = Experiment(
     description="report test",
 )
 FIGURES = {
+    "fig00_ratios_vs_radius",
     "fig01_poincare_sections",
     "fig02_recurrence_plot",
     "fig03_kick_times_vs_collision_times",

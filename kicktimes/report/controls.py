@@ -35,6 +35,7 @@ from __future__ import annotations
 
 import math
 import warnings
+from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
@@ -46,7 +47,9 @@ from kicktimes.stats import ratio_rule, ratio_verdict
 __all__ = [
     "COLUMNS",
     "CONTROLS",
-    "controls_table",
+    "Controls",
+    "compute_controls",
+    "ratio_curves_figure",
     "diagnostics_of",
     "paired_median",
 ]
@@ -87,7 +90,8 @@ def paired_median(numerator, denominator, *, rng, n_boot=1000, level=0.95):
     Returns
     -------
     dict
-        ``ratio, ci_low, ci_high, n_pairs, per_radius`` (a Series of per-radius medians).
+        ``ratio, ci_low, ci_high, n_pairs`` and ``per_radius``, a DataFrame ``radius,
+        n_pairs, ratio, ci_low, ci_high`` (per-radius medians and their intervals).
 
     Examples
     --------
@@ -110,24 +114,31 @@ def paired_median(numerator, denominator, *, rng, n_boot=1000, level=0.95):
     usable = np.isfinite(per_radius.to_numpy())
     n_pairs = int(np.isfinite(values).sum())
     if not usable.any():
+        curve = pd.DataFrame({"radius": table.index.to_numpy(float), "n_pairs": 0,
+                              "ratio": np.nan, "ci_low": np.nan, "ci_high": np.nan})
         return {"ratio": math.nan, "ci_low": math.nan, "ci_high": math.nan, "n_pairs": n_pairs,
-                "per_radius": per_radius}
-    values = values[usable]
+                "per_radius": curve}
     n = values.shape[1]
-    boot = np.empty(n_boot)
+    boot_r = np.empty((n_boot, values.shape[0]))
     idx = rng.integers(0, n, size=(n_boot, n))
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)  # a resample without a finite pair
         for b in range(n_boot):
-            boot[b] = np.nanmean(np.nanmedian(values[:, idx[b]], axis=1))
+            boot_r[b] = np.nanmedian(values[:, idx[b]], axis=1)
+        boot = np.nanmean(boot_r[:, usable], axis=1)
+        a = (1 - level) / 2 * 100
+        low_r = np.nanpercentile(boot_r, a, axis=0)
+        high_r = np.nanpercentile(boot_r, 100 - a, axis=0)
     boot = boot[np.isfinite(boot)]
-    a = (1 - level) / 2 * 100
+    curve = pd.DataFrame({"radius": table.index.to_numpy(float),
+                          "n_pairs": np.isfinite(values).sum(axis=1),
+                          "ratio": per_radius.to_numpy(), "ci_low": low_r, "ci_high": high_r})
     return {
         "ratio": float(per_radius[usable].mean()),
         "ci_low": float(np.percentile(boot, a)) if boot.size else math.nan,
         "ci_high": float(np.percentile(boot, 100 - a)) if boot.size else math.nan,
         "n_pairs": n_pairs,
-        "per_radius": per_radius,
+        "per_radius": curve,
     }
 
 
@@ -176,38 +187,59 @@ def _row(family, diagnostic, system, control, est, low, high, n_pairs, detail):
 
 
 def _ratio_rows(family, diagnostic, system, x, y, sticky, *, x_uniform, y_uniform, rng,
-                n_boot, resamples):
-    """The rows of one (diagnostic, system): every control that applies."""
+                n_boot, resamples, curves):
+    """The rows of one (diagnostic, system): every control that applies; the per-radius
+    ratios and CIs of each go to ``curves``."""
     rows = []
+
+    def add(control, per_r, tot, n_pairs, detail):
+        rows.append(_row(family, diagnostic, system, control, tot["ratio"], tot["ci_low"],
+                         tot["ci_high"], n_pairs, detail))
+        curves.append(per_r.assign(family=family, diagnostic=diagnostic, system=system,
+                                   control=control))
+
     per_r, tot = paired_ratio(x, y, rng=rng, n_boot=n_boot, resamples=resamples)
-    rows.append(_row(family, diagnostic, system, "primary", tot["ratio"], tot["ci_low"],
-                     tot["ci_high"], per_r["n_pairs"].sum(),
-                     "ratio of means per radius, averaged over radii; per radius "
-                     + ", ".join(f"{r:g}: {v:.3g}" for r, v in zip(per_r["radius"],
-                                                                   per_r["ratio"], strict=True))))
+    add("primary", per_r, tot, per_r["n_pairs"].sum(),
+        "ratio of means per radius, averaged over radii; per radius "
+        + ", ".join(f"{r:g}: {v:.3g}" for r, v in zip(per_r["radius"], per_r["ratio"],
+                                                      strict=True)))
     med = paired_median(x, y, rng=rng, n_boot=max(200, n_boot // 2))
-    rows.append(_row(family, diagnostic, system, "paired_median", med["ratio"], med["ci_low"],
-                     med["ci_high"], med["n_pairs"],
-                     "median of per-IC ratios per radius, averaged over radii"))
+    add("paired_median", med["per_radius"], med, med["n_pairs"],
+        "median of per-IC ratios per radius, averaged over radii")
     keep = ~sticky.reindex(x.index, fill_value=False).to_numpy(bool)
-    n_out = int((~keep).sum())
     per_r, tot = paired_ratio(x[keep], y[keep], rng=rng, n_boot=n_boot, resamples=None)
-    rows.append(_row(family, diagnostic, system, "sticky_excluded", tot["ratio"], tot["ci_low"],
-                     tot["ci_high"], per_r["n_pairs"].sum(),
-                     f"{n_out} sticky (radius, IC) runs left out"))
+    add("sticky_excluded", per_r, tot, per_r["n_pairs"].sum(),
+        f"{int((~keep).sum())} sticky (radius, IC) runs left out")
     if x_uniform is not None:
         per_r, tot = paired_ratio(x_uniform, y_uniform, rng=rng, n_boot=n_boot,
                                   resamples=resamples)
-        rows.append(_row(family, diagnostic, system, "uniform_sampling", tot["ratio"],
-                         tot["ci_low"], tot["ci_high"], per_r["n_pairs"].sum(),
-                         "samples at uniform times k τ of the same trajectories"))
+        add("uniform_sampling", per_r, tot, per_r["n_pairs"].sum(),
+            "samples at uniform times k τ of the same trajectories")
     return rows
 
 
-def controls_table(results, collisions, *, family, eps, rule="mirror", rng, n_boot=2000,
-                   resamples=None) -> pd.DataFrame:
-    """The findings table: every comparison diagnostic of every kicked system under every
-    control, with the verdict and whether it is robust.
+@dataclass(frozen=True)
+class Controls:
+    """Every comparison of one store under its controls.
+
+    Attributes
+    ----------
+    table : pandas.DataFrame
+        The findings table, columns :data:`COLUMNS`: one row per (diagnostic, system,
+        control), averaged over radii.
+    curves : pandas.DataFrame
+        The same per radius: ``family, diagnostic, system, control, radius, n_pairs,
+        ratio, ci_low, ci_high`` (the headline figure's curves).
+    """
+
+    table: pd.DataFrame
+    curves: pd.DataFrame
+
+
+def compute_controls(results, collisions, *, family, eps, rule="mirror", rng, n_boot=2000,
+                     resamples=None) -> Controls:
+    """Every comparison diagnostic of every kicked system under every control, with the
+    verdict and whether it is robust, averaged over radii and per radius.
 
     Parameters
     ----------
@@ -228,14 +260,15 @@ def controls_table(results, collisions, *, family, eps, rule="mirror", rng, n_bo
 
     Returns
     -------
-    pandas.DataFrame
-        Columns :data:`COLUMNS`. ``robust`` is True on every row of a (family,
-        diagnostic, system) exactly when all its controls give the same verdict.
+    Controls
+        ``table`` (columns :data:`COLUMNS`; ``robust`` is True on every row of a (family,
+        diagnostic, system) exactly when all its controls give the same verdict) and
+        ``curves`` (per radius).
     """
     from kicktimes.report.counts import sticky_ics
 
     sticky = sticky_ics(collisions, rule).set_index(["radius", "ic"])["sticky"]
-    rows = []
+    rows, curves = [], []
     systems = kicked_systems(results)
     for diagnostic, row, uniform in diagnostics_of(results, eps):
         transform = (lambda t: 1.0 - t) if diagnostic == "one_minus_r1" else None
@@ -250,16 +283,20 @@ def controls_table(results, collisions, *, family, eps, rule="mirror", rng, n_bo
                 family, diagnostic, system, table[system], table[REFERENCE], sticky,
                 x_uniform=None if table_u is None else table_u[system],
                 y_uniform=None if table_u is None else table_u[REFERENCE],
-                rng=rng, n_boot=n_boot, resamples=resamples,
+                rng=rng, n_boot=n_boot, resamples=resamples, curves=curves,
             )
     rows += _count_rows(family, collisions, sticky, rule, rng=rng, n_boot=n_boot,
                         resamples=resamples)
     out = pd.DataFrame(rows, columns=list(COLUMNS))
-    if out.empty:
-        return out
-    same = out.groupby(["family", "diagnostic", "system"])["verdict"].transform("nunique") == 1
-    out["robust"] = same.to_numpy(bool)
-    return out
+    if not out.empty:
+        same = out.groupby(["family", "diagnostic", "system"])["verdict"].transform(
+            "nunique") == 1
+        out["robust"] = same.to_numpy(bool)
+    curve_cols = ["family", "diagnostic", "system", "control", "radius", "n_pairs", "ratio",
+                  "ci_low", "ci_high"]
+    curves = (pd.concat(curves, ignore_index=True)[curve_cols] if curves
+              else pd.DataFrame(columns=curve_cols))
+    return Controls(out, curves)
 
 
 def _count_rows(family, collisions, sticky, rule, *, rng, n_boot, resamples):
@@ -425,3 +462,84 @@ def first_screen(table: pd.DataFrame, shares: dict) -> list[str]:
               "the control that changes it is named with its number.", ""]
     lines += markdown_table(overview_table(table))
     return lines + [""]
+
+
+_PANELS = (
+    ("ftle", "FTLE λ"),
+    ("rr_offdiag@0.001", "off-diagonal RR, ε = 10⁻³\n(uniform-time samples)"),
+    ("rr_offdiag@0.01", "off-diagonal RR, ε = 10⁻²\n(uniform-time samples)"),
+    ("det@0.01", "DET, ε = 10⁻²\n(uniform-time samples)"),
+    ("one_minus_r1", "1 − R₁\n(lag-1 decorrelation)"),
+)
+_FAMILY_LINES = ("-", "--", ":", "-.")
+# y ticks of the ratio panels, by how many decades the panel spans (labels never overlap)
+_LOG_TICKS = (
+    (4.0, (0.2, 0.3, 0.5, 0.7, 0.9, 1.0, 1.1, 1.5, 2.0, 3.0)),
+    (20.0, (0.1, 0.2, 0.3, 0.5, 0.7, 1.0, 1.5, 2.0, 3.0, 5.0, 10.0)),
+    (math.inf, (0.01, 0.02, 0.05, 0.1, 0.2, 0.5, 1.0, 2.0, 5.0, 10.0, 20.0, 50.0)),
+)
+
+
+def ratio_curves_figure(curves: pd.DataFrame):
+    """The headline figure: the ratio of each kicked system to the two-disk value against
+    r, one panel per diagnostic, with 95 % CIs (bootstrap clustered on ICs) and the ±10 %
+    band; families by line style. The recurrence panels show the uniform-time control:
+    on the paper's collision-truncated samples their ratios are inflated by where the
+    samples fall (the findings table has both).
+
+    Parameters
+    ----------
+    curves : pandas.DataFrame
+        ``Controls.curves`` of one or more stores (concatenated).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    from matplotlib.figure import Figure
+    from matplotlib.lines import Line2D
+    from matplotlib.ticker import FixedLocator, FuncFormatter, NullLocator
+
+    from kicktimes.report._figures import RADIUS_LABEL, system_label, system_style
+
+    panels = [(d, t) for d, t in _PANELS if d in set(curves["diagnostic"])]
+    fig = Figure(figsize=(3.3 * max(len(panels), 1), 4.2), layout="constrained")
+    axes = fig.subplots(1, max(len(panels), 1), squeeze=False)[0]
+    families = list(dict.fromkeys(curves["family"]))
+    systems = [s for s in _SHORT if s in set(curves["system"])]
+    for ax, (diagnostic, title) in zip(axes, panels, strict=False):
+        ax.axhspan(0.9, 1.1, color="0.85", zorder=0)
+        ax.axhline(1.0, color="0.5", linewidth=0.8, zorder=0)
+        part = curves[curves["diagnostic"] == diagnostic]
+        recurrence = diagnostic.startswith(("rr_", "det"))
+        controls = ["uniform_sampling"] if recurrence else ["primary"]
+        for k, system in enumerate(systems):
+            style = system_style(system, k)
+            for f, fam in enumerate(families):
+                for control in controls:
+                    c = part[(part["system"] == system) & (part["family"] == fam)
+                             & (part["control"] == control)].sort_values("radius")
+                    if c.empty:
+                        continue
+                    err = np.vstack([c["ratio"] - c["ci_low"], c["ci_high"] - c["ratio"]])
+                    ax.errorbar(c["radius"], c["ratio"], yerr=np.clip(err, 0, None),
+                                color=style["color"], marker=style["marker"], markersize=3.5,
+                                linestyle=_FAMILY_LINES[f % 4], linewidth=1.0, capsize=1.5)
+        ax.set_yscale("log")
+        ax.set_title(title, fontsize="medium")
+        ax.set_xlabel(RADIUS_LABEL)
+        lo, hi = ax.get_ylim()
+        choice = next(t for span, t in _LOG_TICKS if hi / lo <= span)
+        ticks = [t for t in choice if lo <= t <= hi]
+        ax.yaxis.set_major_locator(FixedLocator(ticks))
+        ax.yaxis.set_minor_locator(NullLocator())
+        ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+    axes[0].set_ylabel("kicked / two-disk (ratio of means)")
+    handles = [Line2D([], [], color=system_style(s, k)["color"], marker=system_style(s, k)[
+        "marker"], linestyle="-", label=system_label(s)) for k, s in enumerate(systems)]
+    handles += [Line2D([], [], color="k", linestyle=_FAMILY_LINES[f % 4], label=fam)
+                for f, fam in enumerate(families)]
+    handles += [Line2D([], [], color="0.85", linewidth=6, label="±10 % band")]
+    fig.legend(handles=handles, loc="outside lower center", ncol=min(len(handles), 6),
+               fontsize="small")
+    return fig
