@@ -151,6 +151,10 @@ def write_results(
 
     table = pd.concat(controls, ignore_index=True)
     screen = ["## The answers", ""] + first_screen(table, shares) + [
+        "The mechanism behind these numbers (stretching per perturbation against ln(1/r) "
+        "down to r = 0.002, decorrelation per perturbation, the collision rate's relaxation, "
+        "the sticky orbits, the cost per unit time): [science.md](science.md), written by "
+        "`python analysis/science.py`.", "",
         "Every row under every control: " + ", ".join(
             f"[{st.experiment.name}_findings.csv]({st.experiment.name}_findings.csv)"
             for st in stores) + ". Below: per family, the scale, every statement under the "
