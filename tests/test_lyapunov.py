@@ -1,15 +1,16 @@
 """Finite-time Lyapunov exponents: the public API, both methods, validation."""
 
 import math
+import warnings
 
 import numpy as np
 import pytest
 
 from kicktimes import initial_conditions, schedules, simulate_one_particle, simulate_two_particle
-from kicktimes.diagnostics import lyapunov
+from kicktimes.diagnostics import UndefinedDiagnosticWarning, lyapunov
 from kicktimes.diagnostics._tangent import MAX_SAME_INSTANT, tangent_two_kernel
 from kicktimes.diagnostics._twin import ftle_two_kernel
-from kicktimes.diagnostics.lyapunov import _check_status
+from kicktimes.diagnostics.lyapunov import _check_status, lyapunov_spectrum
 
 
 @pytest.fixture(scope="module")
@@ -134,6 +135,69 @@ def test_a_pile_of_simultaneous_events_is_an_error_not_a_hang(ics, method):
     # a few simultaneous kicks are fine
     assert np.isfinite(lyapunov(ics[0, 0], 0.03, n_steps=100, tau=0.2, kicks=kicks[:50],
                                 method=method).lam)
+
+
+# Degenerate two-disk states where the exponent is undefined; each gave lam = -inf (the
+# tracked disk's position deviation vanished exactly) or a ZeroDivisionError, silently.
+HEAD_ON = [[-0.05, 0.0, 1.0, 0.0], [0.05, 0.0, -1.0, 0.0]]  # touching, colliding head-on at t = 0
+HEAD_ON_TINY = [[-1e-12, 0.0, 1.0, 0.0], [1e-12, 0.0, -1.0, 0.0]]  # the same with r = 1e-12
+ONTO_A_DISK_AT_REST = [[0.0, 0.0, 1.0, 0.0], [0.1, 0.0, 0.0, 0.0]]  # elastic: disk 0 stops
+ON_THE_WALL = [[0.95, 0.0, 0.0, 1.0], [0.0, 0.5, 0.0, 1.0]]  # disk 0 tangent to the wall
+
+
+@pytest.mark.parametrize(
+    ("ic", "r", "kwargs", "reason"),
+    [
+        (HEAD_ON, 0.05, {}, "position deviation of disk 0 is exactly 0"),
+        (HEAD_ON, 0.05, {"n_steps": 1}, "position deviation of disk 0 is exactly 0"),
+        (HEAD_ON_TINY, 1e-12, {}, "position deviation of disk 0 is exactly 0"),
+        (ONTO_A_DISK_AT_REST, 0.05, {"rule": "elastic"}, "position deviation of disk 0 is exa"),
+        (ON_THE_WALL, 0.05, {}, "tangent vector is not finite"),
+        (ON_THE_WALL, 0.05, {"sampling": "paper"}, "tangent vector is not finite"),
+        (ON_THE_WALL, 0.05, {"variant": "paper"}, "tangent vector is not finite"),
+    ],
+)
+def test_an_undefined_tangent_exponent_is_nan_with_a_reason_and_a_warning(ic, r, kwargs, reason):
+    kwargs = {"n_steps": 100, "tau": 0.3, **kwargs}
+    with pytest.warns(UndefinedDiagnosticWarning, match=f"lyapunov: lam is NaN: .*{reason}"):
+        res = lyapunov(ic, r, **kwargs)
+    assert math.isnan(res.lam) and reason in res.reason
+    assert math.isnan(res.lam_per_perturbation)
+    # one pass with the run: the same result
+    with pytest.warns(UndefinedDiagnosticWarning):
+        res2, _ = lyapunov(ic, r, return_run=True, **kwargs)
+    assert_results_bitwise_equal(res2, res)
+
+
+def test_a_vanished_part_of_the_paper_variant_is_named():
+    with pytest.warns(UndefinedDiagnosticWarning, match=r"\|dx\| of disk 0 is exactly 0"):
+        res = lyapunov(HEAD_ON, 0.05, n_steps=100, tau=0.3, variant="paper")
+    assert math.isnan(res.lam_x) and math.isfinite(res.lam_y) and math.isnan(res.lam)
+
+
+def test_a_horizon_that_covers_no_time_gives_nan_with_a_reason():
+    # one paper step, ended by the collision at t = 0
+    with pytest.warns(UndefinedDiagnosticWarning, match="covers no time"):
+        res = lyapunov(HEAD_ON, 0.05, n_steps=1, tau=0.3, sampling="paper")
+    assert math.isnan(res.lam) and res.total_time == 0.0 and "covers no time" in res.reason
+    with pytest.warns(UndefinedDiagnosticWarning, match="twin was never renormalised"):
+        res = lyapunov(HEAD_ON, 0.05, n_steps=1, tau=0.3, method="twin")
+    assert math.isnan(res.lam) and "never renormalised" in res.reason
+
+
+def test_defined_exponents_have_no_reason_and_no_warning(ics):
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        for method in ("tangent", "twin"):
+            for variant in ("norm", "paper"):
+                res = lyapunov(ics[1], 0.03, n_steps=500, tau=0.2, method=method, variant=variant)
+                assert math.isfinite(res.lam) and res.reason is None
+
+
+def test_the_spectrum_refuses_a_contact_tangent_to_the_wall():
+    # the linearised reflection divides by v.n = 0 (was a ZeroDivisionError from the kernel)
+    with pytest.raises(ValueError, match="ic: the linearised dynamics is singular"):
+        lyapunov_spectrum(ON_THE_WALL, 0.05, t_max=10.0)
 
 
 def test_every_event_loop_has_a_budget(ics):

@@ -318,6 +318,29 @@ def test_bad_points_raise_value_error(points, match):
         recurrence_pairs(points, 1e-3)
 
 
+@pytest.mark.parametrize(
+    "points",
+    [
+        np.array([[1e308, 0.0], [-1e308, 0.5]]),  # x - xmin overflows to inf
+        np.array([[0.0, -1e308], [0.5, 1e308]]),
+        np.array([[0.0, 0.0], [1e200, 0.0]]),  # finite spread, but dx**2 overflows
+    ],
+)
+def test_points_spreading_beyond_the_float_range_raise_value_error(points):
+    # the cell grid took (xmax - xmin) * (1 / inf) = NaN cells ("cannot convert float NaN
+    # to integer"), or the distance test dx**2 + dy**2 <= eps**2 overflowed
+    match = r"points: the coordinates must span at most 1e\+150 in x and in y"
+    for fun in (recurrence_rate, recurrence_pairs):
+        with pytest.raises(ValueError, match=match):
+            fun(points, 1e-3)
+
+
+def test_points_spreading_up_to_the_bound_are_counted_exactly():
+    pts = np.array([[0.0, 0.0], [1e-4, 0.0], [1e150, 0.0], [1e150, 1e-4], [0.0, 1e150]])
+    assert recurrence_rate(pts, 1e-3) == (5 + 2 * 2) / 25
+    assert recurrence_rate(pts, 1e300) == 1.0  # eps**2 = inf: every (finite) d**2 is below
+
+
 def test_non_numeric_points_raise_type_error():
     with pytest.raises(TypeError, match="points"):
         recurrence_rate(np.array([["a", "b"]]), 1e-3)

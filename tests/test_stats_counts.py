@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import warnings
 
 import numpy as np
 import pandas as pd
@@ -189,6 +190,38 @@ def test_linear_covariate_option_changes_the_count_models():
     reg = stats.regress_counts(df, covariate="radius")
     assert ("poisson", "radius") in reg.coefficients().index
     assert "kinetic" not in reg.predict(0.01).columns
+
+
+def test_two_rows_give_estimates_with_a_warning_naming_the_missing_degrees_of_freedom():
+    # as statsmodels: no residual degrees of freedom -> NaN standard errors, and a warning
+    df = pd.DataFrame({"radius": [0.01, 0.02], "count": [172, 315], "t_window": 100.0})
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        reg = stats.regress_counts(df)
+    messages = [str(w.message) for w in caught]
+    assert [w.category for w in caught] == [stats.FitWarning], messages  # no numpy warnings
+    assert "no residual degrees of freedom" in messages[0]
+    assert "at least 3 radii" in messages[0]
+    assert any("no residual degrees of freedom" in w for w in reg.warnings)
+    coef = reg.coefficients()
+    assert np.isfinite(coef["estimate"]).all()
+    # the Poisson GLM's errors need no residual degrees of freedom (its scale is fixed)
+    assert np.isfinite(coef.loc["poisson", "stderr"]).all()
+    assert not np.isfinite(coef.loc["ols", "stderr"]).any()
+    assert np.isnan(coef.loc["negbin", "stderr"]).all()
+    assert math.isnan(reg.overdispersion()["pearson_dispersion"])  # was inf
+    assert reg.converged
+
+
+def test_two_radii_with_more_rows_warn_about_the_exact_ols_line_only():
+    rng = np.random.default_rng(9)
+    r = np.repeat([0.01, 0.02], 2)
+    df = pd.DataFrame({"radius": r, "count": rng.poisson(r * 16000), "t_window": 100.0})
+    with pytest.warns(stats.FitWarning, match="the OLS line through 2 radii is exact"):
+        reg = stats.regress_counts(df)
+    problem = next(w for w in reg.warnings if "degrees of freedom" in w)
+    assert "Poisson" not in problem and "negative binomial" not in problem
+    assert np.isfinite(reg.overdispersion()["pearson_dispersion"])
 
 
 @pytest.mark.parametrize(

@@ -250,6 +250,96 @@ def test_compare_models_with_the_power_law_compares_on_the_tail():
     assert table.loc["powerlaw", "delta_aic"] <= 2
 
 
+def _weights_of_the_fitted_models(table):
+    """The Akaike weights sum to 1 over the rows with a finite AIC; the others (failed
+    fits) have NaN AIC and weight and a note saying why."""
+    fitted = np.isfinite(table["aic"])
+    assert fitted.any()
+    assert table.loc[fitted, "weight"].sum() == pytest.approx(1.0, abs=1e-12)
+    assert (table.loc[fitted, "weight"] >= 0).all()
+    assert table.loc[~fitted, "weight"].isna().all()
+    assert table.loc[~fitted, "delta_aic"].isna().all()
+    assert (table.loc[~fitted, "note"] != "").all()
+    return table.loc[fitted, "weight"]
+
+
+@pytest.mark.parametrize("n", [80, 200])
+def test_tail_comparison_weights_sum_to_one_over_the_fitted_models(n):
+    x = np.random.default_rng(n).exponential(1.0, n) + 0.01
+    table = stats.compare_models(x, x_min=1.0)
+    assert set(table.index) == set(stats.MODELS)
+    _weights_of_the_fitted_models(table)
+
+
+def test_comparison_of_tiny_intervals_is_that_of_the_rescaled_ones():
+    x = np.array([1e-12, 2e-12, 5e-12, 1e-11])
+    table = stats.compare_models(x)
+    w = _weights_of_the_fitted_models(table)
+    assert "needs at least 5 complete intervals" in table.loc["hyperexponential", "note"]
+    for scale in (1e12, 1e288):  # the same data in units 1e-12 and 1e-300
+        other = _weights_of_the_fitted_models(stats.compare_models(x * scale))
+        np.testing.assert_allclose(other.sort_index(), w.sort_index(), rtol=1e-6)
+
+
+def test_weights_do_not_depend_on_the_time_unit_even_near_the_float_range():
+    # in units of 1e-300 the Lomax fit's scale (1e12 data means: the exponential limit)
+    # overflows; its likelihood is that of the scaled fit, so it keeps its weight
+    x = np.random.default_rng(3).exponential(1.0, 80) + 0.01
+    ref = stats.compare_models(x, x_min=1.0)["weight"].sort_index()
+    with pytest.warns(stats.FitWarning, match="lomax"):
+        big = stats.compare_models(x * 1e300, x_min=1e300)
+    np.testing.assert_allclose(big["weight"].sort_index(), ref, rtol=1e-6, atol=1e-12)
+
+
+@pytest.mark.parametrize("tiny", [5e-324, 1e-310, 2e-308])
+def test_subnormal_intervals_are_refused_naming_the_floor(tiny):
+    # they raised ZeroDivisionError / OverflowError: their mean, the unit of every fit,
+    # underflowed, and the rate 1 / mean overflowed
+    x = [tiny, 2 * tiny, 4 * tiny, 10 * tiny]
+    match = r"intervals must lie in \[2.2250738585072014e-308, inf\)"
+    with pytest.raises(ValueError, match=match):
+        stats.compare_models(x)
+    with pytest.raises(ValueError, match=match):
+        stats.fit_renewal(x, "hyperexponential")
+    with pytest.raises(ValueError, match="censored must be 0 or lie in"):
+        stats.fit_renewal([1.0, 2.0, 3.0], "gamma", censored=[tiny])
+    # the smallest normal float is accepted
+    fit = stats.fit_renewal(np.array([1.0, 2.0, 5.0, 10.0]) * 2.3e-308, "exponential")
+    assert np.isfinite(fit.loglik) and np.isfinite(fit.params["rate"])
+
+
+def test_x_min_at_or_above_the_largest_interval_is_refused():
+    x = np.random.default_rng(4).exponential(1.0, 80)
+    for x_min in (1e300, float(x.max())):
+        with pytest.raises(ValueError, match=r"x_min must lie below the largest complete"):
+            stats.compare_models(x, x_min=x_min)
+        with pytest.raises(ValueError, match=r"x_min must lie below the largest complete"):
+            stats.vuong(x, "exponential", "gamma", x_min=x_min)
+
+
+def test_x_min_that_underflows_in_units_of_the_mean_is_refused():
+    # intervals spanning 300 decades: x_min / mean underflowed to 0 ("math domain error")
+    x = np.r_[np.geomspace(1e-200, 1e-190, 20), np.geomspace(1e150, 1e160, 20)]
+    with pytest.raises(ValueError, match="x_min must be at least 2.2250738585072014e-308 times"):
+        stats.fit_renewal(x, "powerlaw", x_min=1e-199)
+
+
+def test_a_tail_without_excess_over_x_min_is_refused_not_divided_by():
+    # four intervals at x_min and one an ulp above: in the fit's units (the mean) the tail's
+    # excess over x_min rounds to 0 (the hyperexponential's start divided by it)
+    x = np.r_[np.random.default_rng(7).exponential(1.0, 80), [1e300] * 4, 1e300 * (1 + 2.2e-16)]
+    for model in ("exponential", "hyperexponential", "powerlaw"):
+        with pytest.raises(ValueError, match=r"intervals: .* x_min=1e\+300 exceed it by nothing"):
+            stats.fit_renewal(x, model, x_min=1e300)
+    with pytest.raises(ValueError, match="intervals: none of the models could be fitted"):
+        stats.compare_models(x, x_min=1e300, models=["exponential", "hyperexponential"])
+
+
+def test_a_comparison_where_no_model_can_be_fitted_is_refused_with_the_reasons():
+    with pytest.raises(ValueError, match="hyperexponential: .*needs at least 5"):
+        stats.compare_models([1.0, 2.0, 3.0], models=["hyperexponential"])
+
+
 def _aic_recovery(model, n_rep, rng):
     law = TRUE_LAWS[model][0]
     hits = 0

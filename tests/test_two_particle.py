@@ -1,6 +1,7 @@
 """The two-disk simulator: invariants, records, sampling, determinism and bad input."""
 
 import math
+import warnings
 
 import numpy as np
 import pytest
@@ -300,6 +301,34 @@ def test_paper_sampling_of_a_tangent_disk_advances_the_clock():
                                 sampling="paper")
     assert run.t_max > 0.3  # was 0.0: 2,001 reflections at one instant
     assert (np.diff(run.sample_times) > 0).all()
+
+
+# disk 1 touches the wall and disk 0, both moving tangentially: under the mirror rule disk 1
+# bounces between them at t = 0 (a pinch), and every paper step ends at one of those events
+PINCHED = [[0.85, 0.0, 0.0, 1.0], [0.95, 0.0, 0.0, 1.0]]
+
+
+def test_a_paper_run_that_covers_no_time_warns_why():
+    match = r"ic: the paper-sampled run covers no time \(t_max = 0.0\): all n_steps = 5 steps"
+    with pytest.warns(RuntimeWarning, match=match):
+        run = simulate_two_particle(PINCHED, 0.05, n_steps=5, tau=0.3, sampling="paper")
+    assert run.t_max == 0.0 and (run.sample_times == 0.0).all()
+    # the same state is stuck for good: enough steps end in the stall error
+    with pytest.raises(ValueError, match="ic: the run makes no progress"):
+        simulate_two_particle(PINCHED, 0.05, n_steps=100_000, tau=0.3, sampling="paper")
+
+
+def test_paper_runs_that_cover_time_do_not_warn():
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        # the elastic pinch resolves after three events at t = 0 and then moves on
+        run = simulate_two_particle(PINCHED, 0.05, n_steps=5, tau=0.3, sampling="paper",
+                                    rule="elastic")
+        assert run.t_max > 0.0
+        # disks touching head-on collide at t = 0, and the steps after it cover time
+        run = simulate_two_particle([[-0.05, 0.0, 1.0, 0.0], [0.05, 0.0, -1.0, 0.0]], 0.05,
+                                    n_steps=1, tau=0.3, sampling="paper")
+        assert run.t_max == 0.3
 
 
 def test_a_grazing_contact_keeps_the_energy_under_the_elastic_rule():

@@ -24,6 +24,7 @@ positive.
 from __future__ import annotations
 
 import math
+import warnings
 
 import numpy as np
 from numba import njit
@@ -571,6 +572,13 @@ def simulate_two_particle(ic, r, *, t_max=None, rule="mirror", sampling="uniform
         For arguments out of range, and when the run exceeds ``max_events`` or stops
         making progress (``10^4`` consecutive collisions at one instant).
 
+    Warns
+    -----
+    RuntimeWarning
+        A ``sampling="paper"`` run that covers no time (``t_max = 0``): every one of its
+        ``n_steps`` steps ended at a collision at ``t = 0`` (disks starting in contact with
+        each other or the wall, e.g. pinched between them).
+
     Examples
     --------
     >>> from kicktimes import simulate_two_particle, initial_conditions
@@ -631,6 +639,17 @@ def two_particle_run(out, args, *, r, rule, sampling, tau, n_steps, ic, track, s
         raise_for_status(status, st[0], pp.shape[0] + bt.shape[0], max_events=max_events,
                          name=name, where=f"disks at ({st[1]:.6g}, {st[2]:.6g}) and "
                                           f"({st[5]:.6g}, {st[6]:.6g}), r={r!r}")
+    if mode == 2 and t_end == 0.0:
+        # every paper step was cut short by a collision at t = 0 (fewer than the STALL_EVENTS
+        # a stuck state needs to end in the stall error)
+        warnings.warn(
+            f"{name}: the paper-sampled run covers no time (t_max = 0.0): all n_steps = "
+            f"{n_steps} steps ended at collisions at t = 0 ({pp.shape[0]} disk-disk, "
+            f"{bt.shape[0]} boundary), the disks starting in contact with each other or the "
+            "wall; more steps may resolve the contacts (a state that stays stuck ends in an "
+            f"error after {STALL_EVENTS} collisions), or start the disks apart",
+            RuntimeWarning, stacklevel=3,
+        )
     return TwoParticleRun(
         r=r,
         t_max=float(t_end),

@@ -53,10 +53,17 @@ def wall_tangent(dqx, dqy, dvx, dvy, x, y, vx, vy, wx, wy, rho):
 
     ``dq' = dq + (v - w) dtau``, ``dv' = R dv - (2/rho) [(v.u) n + (v.n) u]``,
     ``R = I - 2 n n^T``.
+
+    At a contact exactly tangent to the wall (``v.n = 0``, a disk sliding on it: the
+    `kicktimes.billiard.geometry.graze` event) the contact time's variation is infinite:
+    the linearised dynamics is singular there, and the result is NaN (the Python layer
+    reports an undefined exponent instead of dividing by zero).
     """
     nx = x / rho
     ny = y / rho
     vn = vx * nx + vy * ny
+    if vn == 0.0:
+        return math.nan, math.nan, math.nan, math.nan
     dtau = -(nx * dqx + ny * dqy) / vn
     ux = dqx + vx * dtau
     uy = dqy + vy * dtau

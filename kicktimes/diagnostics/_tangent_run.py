@@ -28,6 +28,9 @@ Status codes: the simulation's as in `kicktimes.billiard.two_particle` (`DONE`, 
 budget, 2 stuck at one instant, 3 non-finite time); a simulation error stops the loop at
 once (the simulation would have raised first), a tangent error only stops the tangent
 half (the simulation's errors take precedence, as when the two ran one after the other).
+A contact exactly tangent to the wall, where the linearised dynamics is singular, makes
+`wall_tangent` return NaN (it raised ZeroDivisionError): the tangent half carries the NaN
+to its end, where `kicktimes.diagnostics.lyapunov` reports the exponent as undefined.
 """
 
 from __future__ import annotations

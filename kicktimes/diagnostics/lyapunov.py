@@ -18,6 +18,7 @@ separately for the paper's variant).
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -45,6 +46,7 @@ from kicktimes.diagnostics._tangent_run import (
     simulate_tangent_two_kernel,
 )
 from kicktimes.diagnostics._twin import ftle_one_kernel, ftle_two_kernel
+from kicktimes.diagnostics.autocorrelation import UndefinedDiagnosticWarning
 
 VARIANTS = ("norm", "paper")
 METHODS = ("tangent", "twin")
@@ -64,9 +66,9 @@ class LyapunovResult:
     ----------
     lam : float
         The exponent (per unit time): the 2-norm exponent, or ``max(lam_x, lam_y)`` for
-        the paper's variant.
+        the paper's variant; ``nan`` when it is undefined (or a part is), see ``reason``.
     lam_x, lam_y : float
-        The paper variant's parts (``nan`` for ``variant="norm"``).
+        The paper variant's parts (``nan`` for ``variant="norm"``, or when undefined).
     n_renorm : int
         Renormalisations (twin: one per sample and twin; tangent: rescalings of a tangent
         vector whose norm left ``[1e-100, 1e100]``).
@@ -85,6 +87,14 @@ class LyapunovResult:
     lam_per_perturbation : float
         ``lam * total_time / n_perturbations``: the stretching per perturbation in nats
         (``nan`` without perturbations).
+    reason : str or None
+        Why ``lam`` is ``nan`` (None when it is defined): the horizon covers no time
+        (paper steps all ended at collisions at ``t = 0``); the measured deviation is
+        exactly 0 at the end (a degenerate collision, e.g. head-on, or one that stops the
+        tracked disk, moved the whole perturbation to the other disk: a growth factor 0,
+        ``log 0 = -inf``); the tangent vector is not finite (a contact exactly tangent to
+        the wall, where the linearised dynamics is singular); or the twin was never
+        renormalised. `lyapunov` issues it as an `UndefinedDiagnosticWarning`.
     """
 
     lam: float
@@ -99,6 +109,7 @@ class LyapunovResult:
     method: str = "tangent"
     n_perturbations: int = 0
     lam_per_perturbation: float = math.nan
+    reason: str | None = None
 
 
 def _twin_offsets(variant: str, d0: float, ok) -> tuple[np.ndarray, np.ndarray]:
@@ -153,24 +164,41 @@ def _per_perturbation(lam, t, n):
     return lam * t / n if n > 0 else math.nan
 
 
+def _warn_undefined(res: LyapunovResult) -> None:
+    """Issue ``res.reason`` (an undefined exponent) as an `UndefinedDiagnosticWarning`."""
+    if res.reason is not None:
+        warnings.warn(f"lyapunov: lam is NaN: {res.reason}", UndefinedDiagnosticWarning,
+                      stacklevel=3)
+
+
+_PARTS = {"norm": ("the position deviation",), "paper": ("|dx|", "|dy|")}
+
+
 def _twin_result(out, variant, d0, horizon, max_events) -> LyapunovResult:
     log_sum, n_renorm, n_forced, n_deferred, t_last, n_pert, status = out
     _check_status(status, horizon, max_events)
     with np.errstate(invalid="ignore", divide="ignore"):
         lams = np.where(t_last > 0, log_sum / t_last, np.nan)
     lam, lam_x, lam_y = _combine(lams, variant)
+    reasons = [
+        f"the twin was never renormalised (it measures {part}): at every sample it had met "
+        "other collisions than the reference (renormalisation deferred) or its separation "
+        "was 0, so no growth was measured"
+        for part, t in zip(_PARTS[variant], t_last, strict=True) if not t > 0
+    ]
     j = int(np.argmax(t_last))
     t, n = float(t_last[j]), int(n_pert[j])
     return LyapunovResult(
         lam=lam, lam_x=lam_x, lam_y=lam_y, n_renorm=int(n_renorm.sum()),
         n_forced=int(n_forced.sum()), n_deferred=int(n_deferred.sum()), total_time=t, d0=d0,
         variant=variant, method="twin", n_perturbations=n,
-        lam_per_perturbation=_per_perturbation(lam, t, n),
+        lam_per_perturbation=_per_perturbation(lam, t, n), reason="; ".join(reasons) or None,
     )
 
 
-def _tangent_result(out, U, cols, variant, horizon, max_events) -> LyapunovResult:
-    """``cols``: the (x, y) columns of the tracked disk's position deviation in ``U``."""
+def _tangent_result(out, U, cols, variant, horizon, max_events, who) -> LyapunovResult:
+    """``cols``: the (x, y) columns of the tracked disk's position deviation in ``U``;
+    ``who`` names that disk in the reason of an undefined exponent."""
     log_scale, n_resc, n_pert, t_end, status = out
     _check_status(status, horizon, max_events)
     ix, iy = cols
@@ -179,18 +207,38 @@ def _tangent_result(out, U, cols, variant, horizon, max_events) -> LyapunovResul
     else:
         meas = [abs(U[0, ix]), abs(U[1, iy])]
     lams = []
+    nonfinite, vanished = [], []
     for j, d in enumerate(meas):
-        if t_end > 0.0 and d > 0.0:
+        if t_end > 0.0 and math.isfinite(d) and d > 0.0:
             lams.append((log_scale[j] + math.log(d)) / t_end)
         else:
-            # d = 0 has probability zero; t_end = 0 only for a zero-length paper step
-            lams.append(-math.inf if t_end > 0.0 else math.nan)
+            lams.append(math.nan)
+            (vanished if d == 0.0 else nonfinite).append(_PARTS[variant][j])
+    reasons = []
+    if not t_end > 0.0:
+        # only a paper step cut short by a collision at t = 0 has zero length
+        reasons.append("the horizon covers no time (total_time = 0): every paper step ended "
+                       "at a collision at t = 0")
+    elif nonfinite:
+        # the only source of NaN: wall_tangent at a contact with v.n = 0
+        reasons.append(
+            f"the tangent vector is not finite ({' and '.join(nonfinite)} of {who}): a contact "
+            "exactly tangent to the wall (v.n = 0, e.g. a disk starting on the wall with a "
+            "tangential velocity) makes the linearised dynamics singular")
+    if t_end > 0.0 and vanished:
+        how = ("a degenerate collision (head-on, or one that leaves the disk at rest) moved "
+               "the whole perturbation to the other disk" if who.startswith("disk")
+               else "an event of the trajectory annihilated the perturbation")
+        reasons.append(
+            f"{' and '.join(vanished)} of {who} {'is' if len(vanished) == 1 else 'are'} "
+            f"exactly 0 at T = {float(t_end):.6g} (a growth factor 0, log 0 = -inf): {how}")
     lam, lam_x, lam_y = _combine(lams, variant)
     n = int(n_pert)
     return LyapunovResult(
         lam=lam, lam_x=lam_x, lam_y=lam_y, n_renorm=int(n_resc), n_forced=0, n_deferred=0,
         total_time=float(t_end), d0=None, variant=variant, method="tangent", n_perturbations=n,
         lam_per_perturbation=_per_perturbation(lam, float(t_end), n),
+        reason="; ".join(reasons) or None,
     )
 
 
@@ -258,6 +306,17 @@ def lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rule
     -------
     LyapunovResult, or ``(LyapunovResult, run)`` with ``return_run=True``
 
+    Warns
+    -----
+    UndefinedDiagnosticWarning
+        ``lam`` is undefined (NaN) for this input, with the reason (also in
+        ``result.reason``): the horizon covers no time (every paper step ended at a
+        collision at ``t = 0``); the measured deviation is exactly 0 at the end (a
+        degenerate collision, e.g. head-on or one that stops the tracked disk, moved the
+        whole perturbation to the other disk; it was reported as ``-inf``); a contact
+        exactly tangent to the wall (the linearised dynamics is singular there; it raised
+        ZeroDivisionError); or a twin that was never renormalised.
+
     Notes
     -----
     ``lambda = log(|dq(T)| / |dq(0)|) / T`` for the tracked disk's position deviation
@@ -308,6 +367,7 @@ def lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rule
         method=method, variant=variant, d0=d0, max_defer=max_defer, e0=e0, partner=partner,
         return_run=bool(return_run), t_continue=0.0,
     )
+    _warn_undefined(res)
     return (res, run) if return_run else res
 
 
@@ -318,10 +378,13 @@ def lyapunov_pass(system, r=None, *, t_continue=0.0, **options):
     that ends before ``t_continue``, the event loop goes on (no samples, no tangent work)
     to ``t_continue`` and ``pp_times`` holds the disk-disk times up to it, bitwise those
     of ``simulate_two_particle(ic, r, t_max=t_continue, rule=rule).pp_times``; otherwise
-    ``pp_times`` is ``run.pp_times`` (``None`` for one disk).
+    ``pp_times`` is ``run.pp_times`` (``None`` for one disk). Warns as `lyapunov` when
+    the exponent is undefined.
     """
     t_continue = chk.check_real("t_continue", t_continue, low=0.0, low_open=False)
-    return _lyapunov(system, r, return_run=True, t_continue=t_continue, **options)
+    out = _lyapunov(system, r, return_run=True, t_continue=t_continue, **options)
+    _warn_undefined(out[0])
+    return out
 
 
 def _lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rule="mirror",
@@ -389,7 +452,7 @@ def _lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rul
             out = tangent_two_kernel(st, rho, sig, chk.RULES[rule], mode, n_steps, tau, U,
                                      max_events, 0)
             return _tangent_result(out, U, (4 * track, 4 * track + 1), variant, horizon,
-                                   max_events), None, None
+                                   max_events, f"disk {track}"), None, None
         o = track
 
         def ok(dx, dy):
@@ -428,7 +491,7 @@ def _lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rul
                              sigma=sigma, rule=rule, e0=e0, partner=partner)
         out = tangent_one_kernel(st, rho, times, angles, KICK_ANGLES[kick_angle], mode, n_steps,
                                  tau, U, max_events, kick_u, sp)
-        return _tangent_result(out, U, (0, 1), variant, horizon, max_events), None, None
+        return _tangent_result(out, U, (0, 1), variant, horizon, max_events, "the disk"), None, None
     offsets, measure = _twin_offsets(
         variant, d0, lambda dx, dy: math.hypot(state[0] + dx, state[1] + dy) <= rho
     )
@@ -452,7 +515,8 @@ def _pass_two(ic, r, rule, sampling, mode, n_steps, tau, track, variant, max_ev_
                            n_steps=n_steps, ic=ic, track=track, seed=None, name="system")
     horizon = n_steps * tau
     res = _tangent_result((log_scale, n_resc, n_pert, t_tan, status_tan), U,
-                          (4 * track, 4 * track + 1), variant, horizon, max_ev_tan)
+                          (4 * track, 4 * track + 1), variant, horizon, max_ev_tan,
+                          f"disk {track}")
     if status_cont != DONE:
         raise_for_status(status_cont, t_continue, pp.shape[0], max_events=args[11],
                          name="system", where=f"continuing the run to t = {t_continue!r}")
@@ -478,7 +542,7 @@ def _pass_one(st, state, r, times, angles, kick_u, sp, mode, n_steps, tau, U, va
                            n_steps=n_steps, seed=None, kick_angle=kick_angle, sigma=sigma,
                            times=times, applied=kick_u if scatter else angles, rule=rule,
                            e0=e0, partner=partner)
-    res = _tangent_result(out[10:], U, (0, 1), variant, horizon, max_ev_tan)
+    res = _tangent_result(out[10:], U, (0, 1), variant, horizon, max_ev_tan, "the disk")
     return res, run, None
 
 
@@ -520,6 +584,12 @@ def lyapunov_spectrum(ic, r, *, t_max, rule="mirror", every=1.0) -> LyapunovSpec
     -------
     LyapunovSpectrum
 
+    Raises
+    ------
+    ValueError
+        Bad input (naming it), and a trajectory with a contact exactly tangent to the
+        wall, where the linearised dynamics is singular (naming ``ic``).
+
     Notes
     -----
     Benettin's QR method on exact tangent vectors: ``U <- Q`` after each interval and
@@ -549,5 +619,11 @@ def lyapunov_spectrum(ic, r, *, t_max, rule="mirror", every=1.0) -> LyapunovSpec
     U = np.eye(8)
     out = tangent_two_kernel(st, 1.0 - r, 2.0 * r, chk.RULES[rule], 1, 1, t_max, U, max_events, n)
     _check_status(out[4], t_max, max_events)
+    if not np.isfinite(out[0]).all():
+        raise ValueError(
+            "ic: the linearised dynamics is singular along this trajectory (a contact exactly "
+            "tangent to the wall, v.n = 0, e.g. a disk starting on the wall with a tangential "
+            "velocity): the Lyapunov spectrum is undefined"
+        )
     return LyapunovSpectrum(exponents=np.sort(out[0] / t_max)[::-1], total_time=t_max,
                             n_orthonormalisations=n, rule=rule)

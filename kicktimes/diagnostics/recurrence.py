@@ -41,6 +41,10 @@ _CELL_PAD = 1.0 + 1e-6
 # At most 2^26 cells per axis: keys stay below 2^53 and round-off stays far below 1 cell.
 # Only reached for eps < 3e-8 * extent, where the coarser cells cost nothing in practice.
 _MAX_CELLS_PER_AXIS = float(2**26)
+# The coordinates must span at most this in x and in y: the distance test dx*dx + dy*dy
+# then cannot overflow (2 * 1e300 < 1.8e308), and neither can the extent of the cell grid
+# (beyond the float range it was inf, and the cell count (xmax - xmin) / inf NaN).
+_MAX_SPREAD = 1e150
 _RADIX_BITS = 11
 # The line sweep of `rqa` uses a dense grid (an offset per cell, occupied or not) when it
 # has at most this many cells per point (plus a floor that small point sets may use):
@@ -804,6 +808,12 @@ def _grid(pts: np.ndarray, eps: float):
             f"({bad.size} non-finite rows)"
         )
     extent = max(xmax - xmin, ymax - ymin)
+    if not extent <= _MAX_SPREAD:
+        raise ValueError(
+            f"points: the coordinates must span at most {_MAX_SPREAD:g} in x and in y (so that "
+            f"dx**2 + dy**2 cannot overflow), got x in [{float(xmin)!r}, {float(xmax)!r}] and "
+            f"y in [{float(ymin)!r}, {float(ymax)!r}]"
+        )
     h = max(eps * _CELL_PAD, extent / _MAX_CELLS_PER_AXIS)
     inv_h = 1.0 / h
     ncx = int(np.floor((xmax - xmin) * inv_h)) + 3  # 1-based columns plus padding
@@ -855,7 +865,8 @@ def recurrence_rate(points, eps=1e-3, *, theiler=0):
     Raises
     ------
     ValueError
-        Points not of shape (N, 2), empty or non-finite; ``eps`` not positive and finite;
+        Points not of shape (N, 2), empty or non-finite, or spanning more than 1e150 in x
+        or y (``dx**2 + dy**2`` would overflow); ``eps`` not positive and finite;
         ``theiler`` negative or ``>= N``.
     TypeError
         Non-numeric points, eps or theiler.

@@ -44,13 +44,20 @@ def as_1d_float(name: str, value, *, allow_empty: bool = True) -> np.ndarray:
     return arr
 
 
-def check_intervals(name: str, value, *, allow_zero: bool = False, allow_empty=True):
-    """Finite interval lengths, positive (or non-negative with ``allow_zero``)."""
+def check_intervals(name: str, value, *, allow_zero: bool = False, allow_empty=True,
+                    floor: float = 0.0):
+    """Finite interval lengths, positive (or non-negative with ``allow_zero``); with a
+    ``floor``, the positive ones at least ``floor``."""
     arr = as_1d_float(name, value, allow_empty=allow_empty)
     bad = arr < 0 if allow_zero else arr <= 0
+    if floor > 0.0:
+        bad |= (arr > 0) & (arr < floor)
     if bad.any():
-        rng = "[0, inf)" if allow_zero else "(0, inf)"
-        raise ValueError(f"{name} must lie in {rng}, got {name}{_show(arr, bad)}")
+        if floor > 0.0:
+            rng = f"{'be 0 or ' if allow_zero else ''}lie in [{floor!r}, inf)"
+        else:
+            rng = f"lie in {'[0, inf)' if allow_zero else '(0, inf)'}"
+        raise ValueError(f"{name} must {rng}, got {name}{_show(arr, bad)}")
     return arr
 
 

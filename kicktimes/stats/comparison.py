@@ -52,7 +52,13 @@ def _check_models(models, x_min):
 def _tail_threshold(x, c, models, x_min, min_tail):
     """The common ``x_min`` of a tail comparison, or None for a full-sample one."""
     if x_min is not None:
-        return check_real("x_min", x_min, low=0.0)
+        x_min = check_real("x_min", x_min, low=0.0)
+        if not x_min < x.max():
+            raise ValueError(
+                f"x_min must lie below the largest complete interval, in (0.0, "
+                f"{float(x.max())!r}), got {x_min!r}: no complete interval would exceed it"
+            )
+        return x_min
     if "powerlaw" in models:
         return _fit(x, c, "powerlaw", None, min_tail=min_tail, covariance=False).x_min
     return None
@@ -73,9 +79,9 @@ def compare_models(
         Models to compare (default: every full-sample model, i.e. ``MODELS``
         without ``"powerlaw"``; with ``x_min`` given, all of ``MODELS``).
     x_min : float, optional
-        Compare on the tail ``x >= x_min`` (see the module notes). If
-        ``"powerlaw"`` is among ``models`` and ``x_min`` is None, the power law's
-        CSN threshold is used for every model.
+        Compare on the tail ``x >= x_min`` (see the module notes); it must lie below the
+        largest complete interval. If ``"powerlaw"`` is among ``models`` and ``x_min``
+        is None, the power law's CSN threshold is used for every model.
     gof : bool, optional
         Add a ``gof_pvalue`` column from :func:`goodness_of_fit` with ``n_mc``
         Monte Carlo samples (this refits each model ``n_mc`` times).
@@ -91,20 +97,35 @@ def compare_models(
         ``bic``, ``delta_aic``, ``weight`` (Akaike weight), ``delta_bic``, ``n``,
         ``n_censored``, ``gof_pvalue`` (if asked), ``converged`` (False: the fit did
         not converge, see `RenewalFit.converged`; its row is still shown) and ``note``
-        (why a model could not be fitted, or what went wrong). ``attrs`` holds
-        ``x_min`` and ``footing`` (``"full sample"`` or ``"tail"``).
+        (why a model could not be fitted, or what went wrong). The models with a finite
+        AIC are compared: their weights sum to 1. A model that could not be fitted (too
+        few intervals, degenerate data, a likelihood that is not finite) is left out of
+        the comparison: NaN ``aic``, ``bic``, deltas and ``weight``, and its ``note``
+        says why. ``attrs`` holds ``x_min`` and ``footing`` (``"full sample"`` or
+        ``"tail"``).
+
+    Raises
+    ------
+    ValueError
+        Bad input (naming the argument: e.g. subnormal interval lengths, an ``x_min``
+        not below the largest complete interval), or no model could be fitted (the
+        message gives each model's reason).
 
     Warns
     -----
     FitWarning
-        One warning naming the models whose fit did not converge.
+        One warning naming the models whose fit did not converge (their rows still
+        take part in the comparison when their AIC is finite).
 
     Notes
     -----
     :math:`\mathrm{AIC} = 2k - 2\ell`, :math:`\mathrm{BIC} = k\log N - 2\ell` (N the
     number of complete plus censored intervals used), Akaike weights
     :math:`w_m = e^{-\Delta_m/2} / \sum_j e^{-\Delta_j/2}` with
-    :math:`\Delta_m = \mathrm{AIC}_m - \min \mathrm{AIC}`.
+    :math:`\Delta_m = \mathrm{AIC}_m - \min \mathrm{AIC}`, over the fitted models.
+    Every fit runs in units of the mean interval, so the table does not depend on the
+    time unit (a parameter that overflows in the data's units keeps the likelihood of
+    the scaled fit).
 
     Examples
     --------
@@ -145,6 +166,13 @@ def compare_models(
             row["gof_pvalue"] = goodness_of_fit(fit, n_mc=n_mc, rng=rng).pvalue
         rows.append(row)
     table = pd.DataFrame(rows).set_index("model")
+    # Compared are the fits with a finite AIC; a failed one (refused, or a likelihood that
+    # is not finite) has NaN AIC, BIC, deltas and weight, and its note says why.
+    fitted = np.isfinite(table["aic"].to_numpy(float))
+    if not fitted.any():
+        reasons = "; ".join(f"{m}: {note}" for m, note in table["note"].items())
+        raise ValueError(f"intervals: none of the models could be fitted ({reasons})")
+    table.loc[~fitted, ["aic", "bic"]] = np.nan
     table["delta_aic"] = table["aic"] - table["aic"].min()
     rel = np.exp(-0.5 * table["delta_aic"])
     table["weight"] = rel / rel.sum()
@@ -196,8 +224,8 @@ def vuong(intervals, model1, model2, *, censored=None, x_min=None, correction=No
     censored : array_like, optional
         Right-censored intervals (they contribute :math:`\log S(c)`).
     x_min : float, optional
-        Compare on the tail ``x >= x_min``; forced (CSN threshold) when either
-        model is ``"powerlaw"``.
+        Compare on the tail ``x >= x_min`` (below the largest complete interval); forced
+        (CSN threshold) when either model is ``"powerlaw"``.
     correction : {None, "aic", "bic"}, optional
         Penalise the log-likelihood ratio for the difference in parameter counts:
         ``LR - (k1 - k2)`` or ``LR - (k1 - k2) log(N) / 2``.

@@ -227,12 +227,17 @@ class CountRegression:
         """Pearson dispersion of the Poisson fit and the LR test of ``alpha = 0``.
 
         The null ``alpha = 0`` is on the boundary, so the LR statistic is a 50:50
-        mixture of 0 and chi-square(1): p = chi2.sf(LR, 1) / 2.
+        mixture of 0 and chi-square(1): p = chi2.sf(LR, 1) / 2. The Pearson dispersion
+        (chi-square over the residual degrees of freedom) is NaN for 2 rows, which leave
+        none (`regress_counts` warns).
         """
         lr = max(0.0, 2 * (self.negbin.llf - self.poisson.llf))
+        # no residual degrees of freedom (2 rows): undefined, see `warnings`
+        df_resid = float(self.poisson.df_resid)
+        pearson = float(self.poisson.pearson_chi2 / df_resid) if df_resid > 0 else math.nan
         return pd.Series(
             {
-                "pearson_dispersion": float(self.poisson.pearson_chi2 / self.poisson.df_resid),
+                "pearson_dispersion": pearson,
                 "lr_statistic": lr,
                 "lr_pvalue": 0.5 * stats.chi2.sf(lr, 1) if lr > 0 else 1.0,
                 "alpha": self.alpha,
@@ -320,7 +325,12 @@ def regress_counts(
     -----
     FitWarning
         A count model did not converge, a coefficient diverged, or standard errors are
-        not finite (never a silent NaN).
+        not finite (never a silent NaN). In particular, as statsmodels does, when a model
+        has no residual degrees of freedom: the OLS line through 2 radii is exact (its
+        standard errors are inf/NaN), and 2 rows leave the Poisson GLM none (its Pearson
+        dispersion is NaN) and do not identify the negative binomial's 3 parameters (its
+        standard errors are NaN); the estimates are still returned. Every standard error
+        exists from 3 radii on.
 
     Notes
     -----
@@ -381,6 +391,21 @@ def regress_counts(
         bse = {name: np.asarray(res.bse) for name, res in
                (("ols", ols), ("poisson", poisson), ("negbin", negbin))}
     converged = not problems
+    # Residual degrees of freedom: the OLS line has one point per radius and 2 coefficients,
+    # the Poisson GLM one per row and 2, the negative binomial 3 (alpha too). Without any,
+    # statsmodels gives NaN (or inf) standard errors; say so here, once and explicitly.
+    no_df = []
+    if len(by_radius) <= 2:
+        no_df.append("the OLS line through 2 radii is exact (its standard errors are inf/NaN)")
+        del bse["ols"]
+    if len(data) <= 2:
+        no_df.append("2 rows leave the Poisson GLM none (its Pearson dispersion is NaN; its "
+                     "standard errors need none) and do not identify the negative binomial's "
+                     "3 parameters (2 coefficients and alpha: its standard errors are NaN)")
+        del bse["negbin"]
+    if no_df:
+        problems.append(f"no residual degrees of freedom: {'; '.join(no_df)}; the estimates "
+                        "are returned, and at least 3 radii give every standard error")
     for name, res in (("poisson", poisson), ("negbin", negbin)):
         coef = np.asarray(res.params)[:2]
         if not np.all(np.isfinite(coef)) or np.any(np.abs(coef) > _DIVERGED_COEF):
@@ -393,7 +418,7 @@ def regress_counts(
     if not np.isfinite(alpha):
         problems.append(f"the negative-binomial dispersion alpha is not finite ({alpha})")
         converged = False
-    if alpha < 1e-6 and not np.all(np.isfinite(bse["negbin"])):
+    if "negbin" in bse and alpha < 1e-6 and not np.all(np.isfinite(bse["negbin"])):
         # equidispersed counts: alpha sits on its boundary 0, where the information is
         # singular; the NB model is then the Poisson one. Noted, not warned: it is the
         # expected outcome for Poisson data.
@@ -403,14 +428,10 @@ def regress_counts(
                  "to the Poisson fit, use that one's"]
     else:
         notes = []
+    # (the fits without residual degrees of freedom are explained above)
     bad_se = [name for name, se in bse.items() if not np.all(np.isfinite(se))]
-    if bad_se and len(by_radius) > 2:  # two radii: the OLS line is exact, bse 0/NaN by design
+    if bad_se:
         problems.append(f"standard errors of the {', '.join(bad_se)} fit are not finite")
-    elif bad_se and bad_se != ["ols"]:
-        problems.append(
-            f"standard errors of the {', '.join(s for s in bad_se if s != 'ols')} fit are "
-            "not finite"
-        )
     if problems:
         # keep statsmodels' own words for the record (deduplicated)
         extra = sorted({str(w.message).splitlines()[0] for w in caught

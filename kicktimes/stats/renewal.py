@@ -86,6 +86,10 @@ _MIN_COMPLETE = {"exponential": 1, "hyperexponential": 5}
 _DIVERGED = (1e-10, 1e10)
 # messages of scipy/numpy warnings that mean "the optimiser gave up"
 _NOT_CONVERGED = ("converge", "maximum number", "iterations", "precision loss")
+#: Smallest supported interval length, the smallest normal float. Fits run in units of the
+#: mean interval; for subnormal lengths that mean underflows (to 0 for 5e-324) and a rate,
+#: its reciprocal, overflows.
+INTERVAL_FLOOR = float(np.finfo(float).tiny)
 
 
 def frozen_distribution(model: str, theta, x_min: float | None = None):
@@ -427,9 +431,11 @@ class RenewalFit:
 
 
 def check_sample(intervals, censored):
-    """Validated ``(complete, censored)`` arrays."""
-    x = check_intervals("intervals", intervals, allow_empty=False)
-    c = np.empty(0) if censored is None else check_intervals("censored", censored, allow_zero=True)
+    """Validated ``(complete, censored)`` arrays: lengths at least `INTERVAL_FLOOR`
+    (censored ones may be 0)."""
+    x = check_intervals("intervals", intervals, allow_empty=False, floor=INTERVAL_FLOOR)
+    c = (np.empty(0) if censored is None
+         else check_intervals("censored", censored, allow_zero=True, floor=INTERVAL_FLOOR))
     return x, c
 
 
@@ -439,12 +445,14 @@ def fit_renewal(intervals, model, *, censored=None, x_min=None, min_tail=50, max
     Parameters
     ----------
     intervals : array_like
-        Complete inter-event intervals, positive and finite.
+        Complete inter-event intervals, finite and at least ``2.2250738585072014e-308``
+        (the smallest normal float; change the time unit for smaller lengths).
     model : str
         One of ``MODELS``: ``"exponential"``, ``"gamma"``, ``"weibull"``,
         ``"lognormal"``, ``"lomax"``, ``"hyperexponential"``, ``"powerlaw"``.
     censored : array_like, optional
-        Right-censored intervals (e.g. ``T - t_last``): the interval exceeds the value.
+        Right-censored intervals (e.g. ``T - t_last``): the interval exceeds the value;
+        0 or at least ``2.2250738585072014e-308``.
     x_min : float, optional
         Fit only the tail ``x >= x_min``, conditionally on exceeding ``x_min``
         (left-truncated likelihood). For ``"powerlaw"``, ``None`` chooses ``x_min``
@@ -463,9 +471,11 @@ def fit_renewal(intervals, model, *, censored=None, x_min=None, min_tail=50, max
     Raises
     ------
     ValueError
-        Bad input (naming the argument), too few intervals for the model, or
-        degenerate data: all complete intervals equal, which only the exponential
-        model can fit (the others' likelihood grows without bound).
+        Bad input (naming the argument; subnormal interval lengths included), too few
+        intervals for the model, or degenerate data: all complete intervals equal, which
+        only the exponential model can fit (the others' likelihood grows without bound),
+        or, for the exponential, hyperexponential and power-law tails, no interval that
+        exceeds a given ``x_min`` (in the fit's units: the mean interval).
 
     Warns
     -----
@@ -558,11 +568,31 @@ def _fit(x, c, model, x_min, *, min_tail=50, max_candidates=500, covariance=True
             "(only 'exponential' fits constant intervals)"
         )
     # Work in units of the mean observation; convert back at the end. Summing x / n
-    # rather than x keeps the mean finite for intervals near the float maximum.
+    # rather than x keeps the mean finite for intervals near the float maximum; a unit of
+    # at least INTERVAL_FLOOR keeps its reciprocal (rates) finite (a mean below it takes
+    # many censored zeros: complete intervals are at least INTERVAL_FLOOR).
     n_all = x.size + c.size
-    unit = float((x / n_all).sum() + (c / n_all).sum())
+    unit = max(float((x / n_all).sum() + (c / n_all).sum()), INTERVAL_FLOOR)
     xs, cs = x / unit, c / unit
     xm = None if x_min is None else x_min / unit
+    if xm is not None and model == "powerlaw" and xm < INTERVAL_FLOOR:
+        # the power law takes log(x_min) in these units: a "math domain error" once x_min
+        # underflowed to 0 (intervals spanning more than the float range)
+        raise ValueError(
+            f"x_min must be at least {INTERVAL_FLOOR!r} times the mean interval {unit!r} "
+            f"for the power law (the fits run in units of the mean), got {x_min!r}"
+        )
+    if xm is not None and model in ("exponential", "hyperexponential", "powerlaw"):
+        # these fit the excess over x_min (the power law its logarithm); with none the
+        # rate is infinite (1 / 0: a ZeroDivisionError in the hyperexponential's start)
+        tail_x, tail_c = xs[xs >= xm], cs[cs >= xm]
+        if not (tail_x - xm).sum() + (tail_c - xm).sum() > 0.0:
+            raise ValueError(
+                f"intervals: the {tail_x.size} complete and {tail_c.size} censored intervals "
+                f"at or above x_min={x_min!r} exceed it by nothing (to float precision in "
+                f"units of the mean interval, {unit!r}); model {model!r} fits the excess "
+                "over x_min and needs some"
+            )
     theta, extra = mle(
         model, xs, cs, xm, min_tail=min_tail, max_candidates=max_candidates, engine=engine
     )
@@ -598,6 +628,11 @@ def _fit(x, c, model, x_min, *, min_tail=50, max_candidates=500, covariance=True
     else:
         x_min_out = float(x[keep_x].min())  # CSN picks a data value: report it exactly
     loglik = _total_loglik(model, theta_out, x[keep_x], c[keep_c], x_min_out)
+    if not np.isfinite(loglik):
+        # parameters that overflow in the data's units (e.g. a Lomax scale of 1e12 means
+        # of 1e300, the exponential limit) but not in the fit's: the scaled likelihood,
+        # whose density terms differ from the data's by the Jacobian log(unit) each
+        loglik = _total_loglik(model, theta, xt, ct, xm) - xt.size * math.log(unit)
     params = {n: float(v) for n, v in zip(names, theta_out, strict=True)}
     stderr = {n: float(v) for n, v in zip(names, stderr_values, strict=True)}
     problems = list(dict.fromkeys(extra.get("trouble", [])))
