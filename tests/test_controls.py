@@ -125,3 +125,19 @@ def test_the_fixed_interval_poisson_test_has_its_size_on_poisson_times():
     fixed = per_ic["p_fixed"].dropna()
     assert len(fixed) == sum(s.size >= FIXED_EVENTS for s in seqs) > 1000
     assert abs((fixed < 0.05).mean() - 0.05) < 0.02
+
+
+def test_the_bca_interval_shifts_with_skew_and_keeps_the_estimate_inside():
+    from kicktimes.report.effects import paired_ratio
+
+    rng = np.random.default_rng(4)
+    idx = pd.MultiIndex.from_product([[0.01, 0.02], range(150)], names=["radius", "ic"])
+    y = pd.Series(rng.lognormal(0.0, 1.2, idx.size), index=idx)
+    x = pd.Series(0.9 * rng.lognormal(0.0, 1.2, idx.size), index=idx)
+    _, pct = paired_ratio(x, y, rng=np.random.default_rng(1), n_boot=1000)
+    _, bca = paired_ratio(x, y, rng=np.random.default_rng(1), n_boot=1000, interval="bca")
+    assert bca["ratio"] == pct["ratio"]
+    assert bca["ci_low"] < bca["ratio"] < bca["ci_high"]
+    assert (bca["ci_low"], bca["ci_high"]) != (pct["ci_low"], pct["ci_high"])
+    with pytest.raises(ValueError, match="interval must be"):
+        paired_ratio(x, y, rng=np.random.default_rng(1), n_boot=100, interval="studentized")
