@@ -10,11 +10,14 @@ killed and replaced when it overruns ``--timeout``; its address space is capped 
 =================  ===========================================================
 ok                 returned; every number in the result is finite and runs
                    satisfy their invariants (inside the table, times in order)
-clear-error        ValueError/TypeError whose message names an argument
+clear-error        ValueError/TypeError whose message names an argument (or a
+                   MemoryError whose message starts with the argument's name)
 unclear-error      ValueError/TypeError that names no argument (or shows
                    ``np.float64(...)``)
 other-exception    any other exception
-non-finite         returned NaN/inf somewhere in the result
+explained-nan      returned NaN/inf with a stated reason (a warning, or the result's
+                   ``reason``/``undefined``/``warnings``/``note``): a defined result
+non-finite         returned NaN/inf somewhere in the result, silently
 invalid            returned a run that breaks an invariant
 timeout            still running after ``--timeout`` seconds (worker killed)
 memory             MemoryError, or the worker died (address-space limit)
@@ -40,7 +43,8 @@ import time
 
 import numpy as np
 
-OUTCOMES = ("ok", "clear-error", "unclear-error", "other-exception", "non-finite", "invalid",
+OUTCOMES = ("ok", "clear-error", "unclear-error", "other-exception", "explained-nan",
+            "non-finite", "invalid",
             "timeout", "memory")
 NAN, INF = math.nan, math.inf
 
@@ -353,8 +357,18 @@ def _numbers(obj, depth=0):
         return
     fields = getattr(obj, "__dataclass_fields__", None)
     if fields:
+        documented = _DOCUMENTED_NAN.get(type(obj).__name__, lambda _: ())(obj)
         for name in fields:
-            yield from _numbers(getattr(obj, name, None), depth + 1)
+            if name not in documented:
+                yield from _numbers(getattr(obj, name, None), depth + 1)
+
+
+#: fields documented as NaN where they do not apply (not a silent NaN): the paper
+#: variant's parts of a 2-norm FTLE, the stretching per perturbation of a run without any
+_DOCUMENTED_NAN = {
+    "LyapunovResult": lambda res: (("lam_x", "lam_y") if res.variant == "norm" else ())
+    + (("lam_per_perturbation",) if res.n_perturbations == 0 else ()),
+}
 
 
 def _run_invariants(run):
@@ -383,10 +397,13 @@ def classify(target, args, kw):
     import warnings
 
     try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
             result = _run_call(target, args, kw)
     except MemoryError as exc:
+        # a MemoryError that names the argument asking for too much is a clear answer
+        if str(exc).split(":")[0] in set(kw) | {"n", "n_mc", "t_max", "n_steps"}:
+            return "clear-error", f"MemoryError: {exc}"[:300]
         return "memory", f"MemoryError: {exc}"[:300]
     except (ValueError, TypeError) as exc:
         msg = str(exc)
@@ -402,12 +419,31 @@ def classify(target, args, kw):
         return "other-exception", f"{type(exc).__name__}: {exc}"[:300]
     for arr in _numbers(result):
         if arr.dtype.kind == "f" and not np.isfinite(arr).all():
+            reason = _stated_reason(result, caught)
+            if reason:
+                return "explained-nan", f"{type(result).__name__} holds NaN/inf: {reason}"[:300]
             return "non-finite", f"{type(result).__name__} holds NaN/inf"
     if hasattr(result, "boundary_log"):
         bad = _run_invariants(result)
         if bad:
             return "invalid", bad
     return "ok", type(result).__name__
+
+
+def _stated_reason(result, caught):
+    """Why a result holds NaN/inf, if the library said so: a warning it issued, or a
+    reason carried by the result (``reason``, ``undefined``, ``warnings``, a ``note``
+    column); empty when the NaN is silent."""
+    if caught:
+        return f"{caught[0].category.__name__}: {caught[0].message}"
+    for name in ("reason", "undefined", "warnings"):
+        value = getattr(result, name, None)
+        if value:
+            return f"{name}: {value}"
+    note = getattr(result, "get", lambda *_: None)("note")
+    if note is not None and note.astype(str).str.len().gt(0).any():
+        return "note column"
+    return ""
 
 
 # ------------------------------------------------------------------------- workers

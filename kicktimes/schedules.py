@@ -1043,7 +1043,7 @@ def write_kick_times(times, path, *, t_max=None, schedule=None, seed=None, metad
     if t_max is not None:
         t_max = _check_t_max(t_max)
         if arr.size and arr[-1] > t_max:
-            raise ValueError(f"times must lie in (0, t_max={t_max!r}], got {arr[-1]!r}")
+            raise ValueError(f"times must lie in (0, t_max={t_max!r}], got {float(arr[-1])!r}")
     if schedule is not None and not isinstance(schedule, Schedule):
         raise TypeError(f"schedule must be a kicktimes Schedule, got {type(schedule).__name__}")
     if seed is not None and (isinstance(seed, bool) or not isinstance(seed, numbers.Integral)):

@@ -206,3 +206,18 @@ def test_ics_use_no_blas_and_no_c_library_trigonometry(monkeypatch, method, rule
             monkeypatch.setattr(mod, name, refuse)
     ics = initial_conditions(50, 0.1, seed=4, method=method, rule=rule)
     assert np.isfinite(ics).all()
+
+
+def test_an_ensemble_too_large_for_memory_names_n_and_the_way_out(monkeypatch):
+    import kicktimes.billiard.initial as initial
+
+    real_empty = np.empty
+
+    def refuse(shape, *args, **kwargs):
+        if shape == (10**9, 2, 4):
+            raise MemoryError("Unable to allocate")
+        return real_empty(shape, *args, **kwargs)
+
+    monkeypatch.setattr(initial.np, "empty", refuse)
+    with pytest.raises(MemoryError, match=r"^n: 1000000000 ICs need 59.6 GiB.*start="):
+        initial_conditions(10**9, 0.01)

@@ -102,6 +102,8 @@ def test_bad_options_are_rejected():
         stats.intervals_from_times(t, T, first="censor")
     with pytest.raises(ValueError, match="n_mc"):
         stats.test_poisson(t, T, n_mc=5)
+    with pytest.raises(ValueError, match=r"n_mc must be an integer in \[19, 10000000\]"):
+        stats.test_poisson(t, T, n_mc=10**9)  # a null held whole in memory: 7.5 GiB
     with pytest.raises(ValueError, match="lags"):
         stats.test_poisson(t, T, lags=0)
     with pytest.raises(TypeError, match="rng"):

@@ -245,7 +245,13 @@ def initial_conditions(n, r_max, *, seed=0, method="paper", rule="mirror", start
     start = chk.check_int("start", start, low=0)
     chk.check_choice("method", method, METHODS)
     chk.check_choice("rule", rule, chk.RULES)
-    out = np.empty((n, 2, 4))
+    try:
+        out = np.empty((n, 2, 4))
+    except MemoryError:
+        raise MemoryError(
+            f"n: {n} ICs need {n * 64 / 2**30:.3g} GiB, more than this machine can allocate; "
+            "draw them in blocks with start= (IC i does not depend on the block)"
+        ) from None
     for k in range(n):
         rng = ic_generator(seed, start + k)
         out[k] = _paper_ic(rng, r_max) if method == "paper" else _uniform_ic(rng, r_max, rule)

@@ -277,7 +277,7 @@ def _as_series(series, name: str = "series") -> np.ndarray:
     arr = np.ascontiguousarray(arr, dtype=np.float64)
     if not np.isfinite(arr).all():
         k = int(np.flatnonzero(~np.isfinite(arr))[0])
-        raise ValueError(f"{name}: must be finite; element {k} is {arr[k]!r}")
+        raise ValueError(f"{name}: must be finite; element {k} is {float(arr[k])!r}")
     return arr
 
 
@@ -423,7 +423,7 @@ def autocorrelation_many(series, lag=1, *, rtol=_RTOL, atol=_ATOL):
         if not np.isfinite(arr).all():
             row, col = np.argwhere(~np.isfinite(arr))[0]
             raise ValueError(
-                f"series: must be finite; row {row}, element {col} is {arr[row, col]!r}"
+                f"series: must be finite; row {row}, element {col} is {float(arr[row, col])!r}"
             )
         values = arr.ravel()
         lengths = np.full(arr.shape[0], arr.shape[1], np.int64)

@@ -432,8 +432,13 @@ def _refine(groups, pval, refine, rng):
                 pval[g.members, j] = g.pvalue(name)
 
 
+#: The largest Monte Carlo null: 10^7 simulated sequences already pin a p-value to 3e-4
+#: relative (binomial), and a null is held in memory whole.
+N_MC_MAX = 10**7
+
+
 def _check_options(n_mc, lags, n_bins):
-    n_mc = check_int("n_mc", n_mc, low=19)
+    n_mc = check_int("n_mc", n_mc, low=19, high=N_MC_MAX)
     if lags is not None:
         lags = check_int("lags", lags, low=1)
     if n_bins is not None:
@@ -452,7 +457,7 @@ def test_poisson(times, t_window, *, n_mc=999, lags=None, n_bins=None, randomize
         Observation window ``T``.
     n_mc : int, optional
         Monte Carlo samples of the conditional nulls (p-value resolution
-        ``1/(n_mc + 1)``).
+        ``1/(n_mc + 1)``), from 19 to ``N_MC_MAX`` = 10^7.
     lags : int, optional
         Ljung-Box lags (default ``min(10, (n - 1) // 5)``).
     n_bins : int, optional
