@@ -120,7 +120,7 @@ def test_the_fixed_interval_poisson_test_has_its_size_on_poisson_times():
         window = float(rng.uniform(35.0, 80.0))
         seqs.append(t[t <= window])
         windows.append(window)
-    job = (0.01, seqs, np.array(windows), 0.05, 19, (1, 1, 0), "mirror", np.arange(1500))
+    job = (0.01, seqs, np.array(windows), 0.05, 19, (1, 1, 0), "mirror", np.arange(1500), None)
     _, _, per_ic = _poisson_job(job)
     fixed = per_ic["p_fixed"].dropna()
     assert len(fixed) == sum(s.size >= FIXED_EVENTS for s in seqs) > 1000
@@ -141,3 +141,24 @@ def test_the_bca_interval_shifts_with_skew_and_keeps_the_estimate_inside():
     assert (bca["ci_low"], bca["ci_high"]) != (pct["ci_low"], pct["ci_high"])
     with pytest.raises(ValueError, match="interval must be"):
         paired_ratio(x, y, rng=np.random.default_rng(1), n_boot=100, interval="studentized")
+
+
+def test_the_poisson_tests_control_on_the_sweeps_own_kicks_sits_at_alpha():
+    # two-disk-like times (clustered) and the control on the Poisson kicks of the same runs
+    from kicktimes.report.poisson import _poisson_job
+
+    rng = np.random.default_rng(9)
+    seqs, windows = [], []
+    for _ in range(400):
+        window = 2000.0
+        t = np.cumsum(rng.exponential(1.0, 80) * rng.choice([0.2, 3.0], 80))
+        seqs.append(t[t <= window])
+        windows.append(window)
+    job = (0.02, seqs, np.array(windows), 0.05, 39, (1, 1, 0), "mirror", np.arange(400),
+           (5, 3000.0))
+    rows, _, _ = _poisson_job(job)
+    table = pd.DataFrame(rows).set_index("test")
+    rate = table["n_reject"] / table["n_tested"]
+    control = table["control_n_reject"] / table["control_n_tested"]
+    assert rate["exponential_ks"] > 0.5  # the clustered times are rejected
+    assert (control < 0.12).all() and control.mean() == pytest.approx(0.05, abs=0.03)

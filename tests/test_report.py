@@ -241,7 +241,8 @@ def test_several_stores_give_one_report_with_a_part_per_experiment(built, store_
     page = path.read_text(encoding="utf-8")
     assert "Experiment tiny_report</h2>" in page and "Experiment tiny_report_b</h2>" in page
     assert re.search(r"<b>seed</b></td><td>8</td>", page)
-    assert (out / "families_autocorrelation_vs_radius.png").is_file()  # paper's top/bottom
+    # the families' FTLE and ACF are in each family's fig05/fig07 and in fig00: no copies
+    assert not (out / "families_autocorrelation_vs_radius.png").exists()
     assert (out / "tiny_report_b_fig07_autocorrelation_vs_radius.png").is_file()
     assert not (out / "tiny_report_b_fig06_recurrence_rate_vs_radius.png").exists()
     # the paper's Fig. 7 layout: family A (the first store) on top and zoomed below

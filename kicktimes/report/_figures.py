@@ -44,6 +44,16 @@ _PAPER_BAR = {"linewidth": 5.0, "alpha": 0.3}
 _SEM_BAR = {"linewidth": 1.0, "capsize": 3.0}
 
 
+def radius_axis(ax):
+    """Label ``ax``'s x axis as the disk radius, with at most 6 plain ticks (0.01, 0.015):
+    radii in steps of 0.002 otherwise give ten 5-digit labels that run together."""
+    from matplotlib.ticker import MaxNLocator
+
+    ax.set_xlabel(RADIUS_LABEL)
+    ax.xaxis.set_major_locator(MaxNLocator(nbins=5, steps=[1, 2, 2.5, 5, 10]))
+    ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:.3g}"))
+
+
 def system_label(system):
     return SYSTEM_LABELS.get(system, system.replace("_", " "))
 

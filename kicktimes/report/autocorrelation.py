@@ -25,14 +25,14 @@ from matplotlib.lines import Line2D
 
 from kicktimes.report._common import REFERENCE, Section, distinct, fmt, kicked_systems, wide
 from kicktimes.report._figures import (
-    DIAGNOSTIC_LABELS,
+    _SEM_BAR,
     dodge,
-    shared_legend,
+    radius_axis,
     system_label,
     system_style,
 )
 from kicktimes.report.effects import BUILT_IN, Effect, paired_ratio, ratio_rule, ratio_verdict
-from kicktimes.report.summary import diagnostic_summary, diagnostic_vs_radius
+from kicktimes.report.summary import diagnostic_summary
 
 __all__ = ["predicted_lag1", "acf_curves", "acf_figure", "sections", "effects"]
 
@@ -95,6 +95,8 @@ def acf_figure(curves, predicted, *, max_panels=6):
     -------
     matplotlib.figure.Figure
     """
+    from matplotlib.ticker import MaxNLocator
+
     radii = np.sort(curves["radius"].unique())
     if radii.size > max_panels:
         radii = radii[np.unique(np.linspace(0, radii.size - 1, max_panels).round().astype(int))]
@@ -135,9 +137,12 @@ def acf_figure(curves, predicted, *, max_panels=6):
                     markersize=7,
                     color=style["color"],
                 )
-        ax.axhline(np.exp(-1), color="grey", linestyle=":", linewidth=0.8)
+        lowest = curves.loc[curves["radius"] == r, "mean"].min()
+        if lowest < np.exp(-1):  # the 1/e level only where a curve reaches it
+            ax.axhline(np.exp(-1), color="grey", linestyle=":", linewidth=0.8)
         ax.set_title(f"r = {r:g}")
         ax.set_xlabel("lag l (boundary collisions)")
+        ax.xaxis.set_major_locator(MaxNLocator(integer=True))
     for ax in axes[radii.size :]:
         ax.set_visible(False)
     for ax in axes[::ncol]:
@@ -147,45 +152,63 @@ def acf_figure(curves, predicted, *, max_panels=6):
         Line2D([], [], color="grey", marker="o", markerfacecolor="none", linestyle="none"),
         Line2D([], [], color="grey", linestyle=":"),
     ]
-    labels += ["built-in prediction 1 − n_pert/n_boundary", "1/e"]
+    labels += ["built-in prediction 1 − n_pert/n_boundary", "1/e (where reached)"]
     fig.legend(handles, labels, loc="outside lower center", ncol=len(labels), fontsize="small")
     return fig
 
 
 def _lag1_figure(summary, predicted, lag):
-    fig = diagnostic_vs_radius(
-        summary,
-        "autocorrelation",
-        medians=True,
-        title=DIAGNOSTIC_LABELS["autocorrelation"][0] + f" (lag {lag})",
-    )
-    fig.set_size_inches(7.4, 5.4)
-    ax = fig.axes[0]
-    if lag == 1 and not predicted.empty:
-        pred = predicted.groupby(["radius", "system"])["value"].mean()
-        systems = list(dict.fromkeys(summary["system"]))
-        order = [s for s in (REFERENCE, *kicked_systems(summary)) if s in systems]
-        radii = summary["radius"].to_numpy()
-        for k, system in enumerate(order):
-            p = (
-                pred.xs(system, level="system")
-                if system in pred.index.get_level_values(1)
-                else None
-            )
-            if p is None:
-                continue
-            style = system_style(system, k)
-            ax.plot(
-                p.index.to_numpy() + dodge(radii, k, len(order)) + dodge(radii, 0.5, 1),
-                p.to_numpy(),
-                linestyle="none",
-                marker=style["marker"],
-                markerfacecolor="none",
-                markersize=8,
-                color=style["color"],
-                label=f"{system_label(system)}: built-in 1 − n_pert/n_boundary",
-            )
-    shared_legend(fig, [ax], ncol=2)
+    """(a) the decorrelation per boundary collision 1 − R_lag against r, log axis, with the
+    built-in prediction 1 − n_pert/n_boundary (open markers) at lag 1; (b) each kicked
+    system's 1 − R_lag over the two-disk value, with the ±10 % band. Plotting R_lag itself
+    on [0.91, 0.98] would hide the difference in 1 − R_lag that the comparison is about."""
+    from matplotlib.ticker import FuncFormatter, LogLocator
+
+    summary = summary[summary["diagnostic"] == "autocorrelation"]
+    systems = list(dict.fromkeys(summary["system"]))
+    order = [s for s in (REFERENCE, *kicked_systems(summary)) if s in systems]
+    fig = Figure(figsize=(11.0, 4.6), layout="constrained")
+    ax, ax_ratio = fig.subplots(1, 2)
+    radii = summary["radius"].to_numpy()
+    pred = (predicted.groupby(["radius", "system"])["value"].mean()
+            if lag == 1 and not predicted.empty else None)
+    ref = summary[summary["system"] == REFERENCE].set_index("radius")
+    for k, system in enumerate(order):
+        part = summary[summary["system"] == system].sort_values("radius")
+        style = system_style(system, k)
+        x = part["radius"].to_numpy() + dodge(radii, k, len(order))
+        ax.errorbar(x, 1.0 - part["mean"].to_numpy(), yerr=part["sem"].to_numpy(),
+                    color=style["color"], marker=style["marker"], markersize=5,
+                    label=system_label(system), **_SEM_BAR)
+        if pred is not None and system in pred.index.get_level_values(1):
+            p = pred.xs(system, level="system")
+            ax.plot(p.index.to_numpy() + dodge(radii, k, len(order)), 1.0 - p.to_numpy(),
+                    linestyle="none", marker=style["marker"], markerfacecolor="none",
+                    markersize=8, color=style["color"])
+        if system != REFERENCE and not ref.empty:
+            two = ref["mean"].reindex(part["radius"]).to_numpy()
+            ax_ratio.plot(part["radius"], (1.0 - part["mean"].to_numpy()) / (1.0 - two),
+                          color=style["color"], marker=style["marker"], markersize=5)
+    ax.set_yscale("log")
+    ax.yaxis.set_major_locator(LogLocator(subs=(1.0, 2.0, 5.0)))
+    ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+    ax.yaxis.set_minor_formatter(FuncFormatter(lambda v, _: ""))
+    radius_axis(ax)
+    ax.set_ylabel(f"1 − R_{lag} of θ (decorrelation per boundary collision)")
+    ax.set_title(f"(a) 1 − R_{lag}: mean ± s.e.m. over ICs; open: built-in 1 − n_pert/n_boundary"
+                 if pred is not None else f"(a) 1 − R_{lag}: mean ± s.e.m. over ICs",
+                 fontsize="medium")
+    ax_ratio.axhspan(0.9, 1.1, color="0.88", zorder=0)
+    ax_ratio.axhline(1.0, color="0.5", linewidth=0.8, zorder=0)
+    radius_axis(ax_ratio)
+    ax_ratio.set_ylabel(f"(1 − R_{lag}) kicked / (1 − R_{lag}) two-disk")
+    ax_ratio.set_title("(b) ratio to the two-disk value (grey: ±10 %)", fontsize="medium")
+    handles, labels = ax.get_legend_handles_labels()
+    if pred is not None:
+        handles.append(Line2D([], [], color="grey", marker="o", markerfacecolor="none",
+                              linestyle="none"))
+        labels.append("built-in prediction")
+    fig.legend(handles, labels, loc="outside lower center", ncol=len(labels), fontsize="small")
     return fig
 
 
@@ -201,15 +224,17 @@ def sections(ctx):
     sec.figure(
         "fig07_autocorrelation_vs_radius",
         _lag1_figure(summary, predicted, lag),
-        f"Lag-{lag} autocorrelation of disk 0's boundary angles against radius: mean over ICs "
-        "(filled, with the paper's ± std/10 and ± s.e.m. bars) and median (open, dotted)"
+        f"(a) The decorrelation per boundary collision 1 − R_{lag} of disk 0's boundary "
+        "angles against radius (log axis): mean ± s.e.m. over ICs"
         + (
-            "; large open markers: the built-in prediction 1 − n_pert/n_boundary (disk-disk "
+            "; open markers: the built-in prediction 1 − n_pert/n_boundary (disk-disk "
             "collisions or kicks per boundary collision), which the kick rate = collision "
-            "rate construction makes agree."
+            "rate construction makes about equal"
             if lag == 1
-            else "."
-        ),
+            else ""
+        )
+        + f". (b) Each kicked system's 1 − R_{lag} over the two-disk value, with the ±10 % "
+        "band.",
     )
     curves = acf_curves(results)
     # a curve needs two lags: with R_1 alone (acf_max_lag = 1, e.g. `reproduce --content

@@ -500,7 +500,7 @@ def ratio_curves_figure(curves: pd.DataFrame):
     from matplotlib.lines import Line2D
     from matplotlib.ticker import FixedLocator, FuncFormatter, NullLocator
 
-    from kicktimes.report._figures import RADIUS_LABEL, system_label, system_style
+    from kicktimes.report._figures import radius_axis, system_label, system_style
 
     panels = [(d, t) for d, t in _PANELS if d in set(curves["diagnostic"])]
     fig = Figure(figsize=(3.3 * max(len(panels), 1), 4.2), layout="constrained")
@@ -527,7 +527,7 @@ def ratio_curves_figure(curves: pd.DataFrame):
                                 linestyle=_FAMILY_LINES[f % 4], linewidth=1.0, capsize=1.5)
         ax.set_yscale("log")
         ax.set_title(title, fontsize="medium")
-        ax.set_xlabel(RADIUS_LABEL)
+        radius_axis(ax)
         lo, hi = ax.get_ylim()
         choice = next(t for span, t in _LOG_TICKS if hi / lo <= span)
         ticks = [t for t in choice if lo <= t <= hi]

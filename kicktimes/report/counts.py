@@ -10,7 +10,13 @@ import numpy as np
 import pandas as pd
 
 from kicktimes.report._common import Section, fmt_p
-from kicktimes.report._figures import RADIUS_LABEL, check_frame, check_radii, finite, new_axes
+from kicktimes.report._figures import (
+    check_frame,
+    check_radii,
+    finite,
+    new_axes,
+    radius_axis,
+)
 
 __all__ = ["counts_by_radius", "counts_vs_radius", "sticky_ics", "STICKY_FACTOR", "sections"]
 
@@ -148,7 +154,7 @@ def counts_vs_radius(collisions, regression=None, *, rule="mirror", ax=None):
     ax.plot(
         grid, kinetic, color="grey", linestyle=":", label=f"kinetic theory Γ(r)·T ({kinetic_rule})"
     )
-    ax.set_xlabel(RADIUS_LABEL)
+    radius_axis(ax)
     ax.set_ylabel("disk-disk collisions per run (count)")
     ax.set_title("Mean number of disk-disk collisions")
     ax.legend(fontsize="small")

@@ -10,7 +10,7 @@ import pandas as pd
 from matplotlib.figure import Figure
 
 from kicktimes.report._common import Section, fmt
-from kicktimes.report._figures import RADIUS_LABEL, check_frame, plain_log_ticks
+from kicktimes.report._figures import check_frame, plain_log_ticks, radius_axis
 from kicktimes.report.counts import counts_by_radius
 
 __all__ = ["rate_heterogeneity", "sections"]
@@ -108,7 +108,7 @@ def rate_heterogeneity(collisions, *, homogeneity=None, rule="mirror", max_point
             label=f"kinetic theory Γ(r) ({rule})",
         )
     ax1.set_yscale("log")
-    ax1.set_xlabel(RADIUS_LABEL)
+    radius_axis(ax1)
     ax1.set_ylabel("disk-disk collision rate (1 / time unit)")
     ax1.set_title("(a) rates of the individual ICs")
     ax1.legend(fontsize="x-small")
@@ -134,25 +134,28 @@ def rate_heterogeneity(collisions, *, homogeneity=None, rule="mirror", max_point
             raise TypeError(f"homogeneity must be a DataFrame, got {type(hom).__name__}")
         if "radius" in hom.columns:
             hom = hom.set_index("radius")
-        column = "pvalue_mc" if "pvalue_mc" in hom.columns else "pvalue"
-        if column not in hom.columns:
+        if "pvalue" not in hom.columns and "pvalue_mc" not in hom.columns:
             raise ValueError("homogeneity must have a column 'pvalue' or 'pvalue_mc'")
+        # the Monte Carlo p-value is exact but floored at 1/(n_mc + 1): where it sits at its
+        # floor (every radius of a paper store) the labels would all read that floor, so
+        # the asymptotic chi-square p-value is shown, which can be as small as it is
+        column = "pvalue" if "pvalue" in hom.columns else "pvalue_mc"
         p = hom[column].reindex(dispersion.index)
         # the p-values go on a second x axis on top, one per radius: never over a marker
         top = ax2.secondary_xaxis("top")
         top.set_xticks(
             dispersion.index.to_numpy(),
-            ["p<1e-300" if v == 0 else ("" if not np.isfinite(v) else f"{v:.2g}") for v in p],
+            ["p<1e-300" if v == 0 else ("" if not np.isfinite(v) else f"{v:.1g}") for v in p],
             rotation=90,
             fontsize="x-small",
         )
         top.set_xlabel(
             "p of a common rate ("
-            + ("Monte Carlo" if column == "pvalue_mc" else "asymptotic")
+            + ("Monte Carlo" if column == "pvalue_mc" else "Pearson χ², asymptotic")
             + ")",
             fontsize="small",
         )
-    ax2.set_xlabel(RADIUS_LABEL)
+    radius_axis(ax2)
     ax2.set_ylabel("index of dispersion of counts across ICs")
     ax2.set_title("(b) over-dispersion")
     ax2.legend(fontsize="x-small")
@@ -173,7 +176,8 @@ def sections(ctx):
         rate_heterogeneity(ctx.store.collisions, homogeneity=het, rule=exp.rule),
         "(a) Disk-disk collision rate n_pp / t_window of every IC, the pooled and median rates "
         f"and the kinetic rate ({exp.rule}); (b) index of dispersion of the counts across ICs; "
-        "on top, the Monte Carlo p-value of the Pearson test of a common rate (given the total).",
+        "on top, the asymptotic p-value of the Pearson χ² test of a common rate (given the "
+        "total); the Monte Carlo p-value, exact but floored at 1/(n_mc + 1), is in the text.",
     )
     sec.text(
         f"A common rate across ICs is rejected at α = {alpha:g} at "

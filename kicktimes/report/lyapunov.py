@@ -18,7 +18,7 @@ from matplotlib.figure import Figure
 from kicktimes.report._common import REFERENCE, Section, distinct, fmt, kicked_systems, wide
 from kicktimes.report._figures import (
     DIAGNOSTIC_LABELS,
-    RADIUS_LABEL,
+    radius_axis,
     system_label,
     system_style,
 )
@@ -104,7 +104,7 @@ def stretching_figure(summary, table, *, title=None):
             color=style["color"],
             label=system_label(system),
         )
-    ax2.set_xlabel(RADIUS_LABEL)
+    radius_axis(ax2)
     ax2.set_ylabel("λ / Γ (nats per perturbation)")
     ax2.set_title("(b) stretching per perturbation")
     ax2.set_ylim(bottom=0)

@@ -35,7 +35,6 @@ from kicktimes.report._common import (
     Progress,
     check_fraction,
     check_int,
-    distinct,
     load_report_store,
 )
 from kicktimes.report.html import (
@@ -273,54 +272,18 @@ def families_part(paths, out, render, workers=1):
 
 
 def families_section(stores):
-    """The paper's layout, one panel per experiment (family A top, B bottom) for the FTLE
-    and the autocorrelation; the recurrence rate as the paper's Fig. 7: family A, all radii
-    on top and a zoom on its small radii below, with the off-diagonal rate beside."""
-    import numpy as np
-    from matplotlib.figure import Figure
-
-    from kicktimes.report import recurrence, summary
+    """The recurrence rate in the paper's Fig. 7 layout: family A, all radii on top and a
+    zoom on its small radii below, with the off-diagonal rate beside. (The FTLE and the
+    autocorrelation of every family are in each family's fig05 and fig07, and their ratios
+    to the two-disk values, both families together, in the Findings' fig00.)"""
+    from kicktimes.report import recurrence
     from kicktimes.report._common import Section
-    from kicktimes.report._figures import DIAGNOSTIC_LABELS
 
     sec = Section("families", "Diagnostics against radius, all experiments")
-    summaries = [summary.diagnostic_summary(st.results, _present(st)) for st in stores]
-    for diagnostic in ("lyapunov", "autocorrelation"):
-        having = [
-            (st, sm)
-            for st, sm in zip(stores, summaries, strict=True)
-            if diagnostic in distinct(sm, "diagnostic")
-        ]
-        if len(having) < 2:
-            continue
-        fig = Figure(figsize=(6.4, 4.0 * len(having)), layout="constrained")
-        axes = np.atleast_1d(fig.subplots(len(having), 1))
-        for ax, (st, sm) in zip(axes, having, strict=True):
-            exp = st.experiment
-            summary.diagnostic_vs_radius(
-                sm,
-                diagnostic,
-                ax=ax,
-                medians=True,
-                title=f"{exp.name}: {exp.n_ics} ICs, {exp.n_steps} steps of τ = {exp.tau:g}",
-            )
-        name = DIAGNOSTIC_LABELS[diagnostic][0]
-        sec.figure(
-            f"families_{diagnostic}_vs_radius",
-            fig,
-            f"{name} against radius, one panel per experiment (the paper's top and bottom "
-            "plots); thick pale bars ± std/10 (the paper's), thin capped bars ± std/√n_valid, "
-            "open markers the medians.",
-        )
     rr = recurrence.family_figure(stores)
     if rr is not None:
         sec.figure("families_recurrence_rate_vs_radius", *rr)
     return sec if sec.figures else None
-
-
-def _present(store):
-    have = distinct(store.results, "diagnostic")
-    return [d for d in ("lyapunov", "autocorrelation") if d in have] or None
 
 
 def build_report(

@@ -13,16 +13,17 @@ import math
 import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
+from matplotlib.lines import Line2D
 
 from kicktimes.report._common import Section, fmt_rho, pct, seeded_rng, spearman
 from kicktimes.report._figures import (
-    RADIUS_LABEL,
     check_alpha,
     check_frame,
     check_radii,
     dodge,
     finite,
     new_axes,
+    radius_axis,
 )
 from kicktimes.report.effects import SHARE_RULE, Effect, share_verdict
 from kicktimes.stats.poisson import _NULL
@@ -39,6 +40,16 @@ __all__ = [
 #: the test of the Findings: given n, the times of a homogeneous Poisson process are
 #: uniform on the window (exact, conditional KS); the others are listed beside it
 HEADLINE_TEST = "uniformity_ks"
+#: what each test checks, as panel titles
+TEST_TITLES = {
+    "uniformity_ks": "uniform times given N (KS)",
+    "laplace_trend": "no rate trend (Laplace)",
+    "exponential_ks": "exponential intervals (KS)",
+    "exponential_ad": "exponential intervals (AD)",
+    "ljung_box": "uncorrelated intervals (Ljung-Box)",
+    "runs": "runs above/below the median",
+    "dispersion": "count dispersion",
+}
 #: the headline test is also run on the first FIXED_EVENTS collisions of every run (the
 #: first FIXED_EVENTS - 1 times, uniform on (0, t_FIXED_EVENTS) under Poisson), so that
 #: rejection rates at different radii compare the same number of intervals (equal power)
@@ -74,6 +85,10 @@ def rejection_table(rejections, *, level=0.95) -> pd.DataFrame:
     with np.errstate(invalid="ignore", divide="ignore"):
         out["rate"] = np.where(n > 0, k / np.where(n > 0, n, 1), np.nan)
     out["ci_low"], out["ci_high"] = binomial_ci(k, n, level)
+    if {"control_n_tested", "control_n_reject"} <= set(df.columns):
+        nc, kc = df["control_n_tested"].to_numpy(float), df["control_n_reject"].to_numpy(float)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            out["control_rate"] = np.where(nc > 0, kc / np.where(nc > 0, nc, 1), np.nan)
     return out
 
 
@@ -130,21 +145,30 @@ def poisson_rejection_rates(rejections, *, alpha=0.05, ncols=4, ax=None):
             linewidth=1,
             color="C0",
         )
+        if "control_rate" in part.columns and part["control_rate"].notna().any():
+            ax.plot(part["radius"], part["control_rate"], color="grey", marker="s",
+                    markersize=3, linewidth=0.8, label="control: the sweep's Poisson kicks")
         ax.axhline(alpha, color="black", linestyle=":", linewidth=0.8)
-        ax.set_title(test.replace("_", " "), fontsize="medium")
+        ax.set_title(TEST_TITLES.get(test, test.replace("_", " ")), fontsize="medium")
         ax.set_ylim(0.0, 1.0)
         if k % ncols == 0:
             ax.set_ylabel(f"share rejected at α = {alpha:g}")
         if k >= len(tests) - ncols:
-            ax.set_xlabel(RADIUS_LABEL)
+            radius_axis(ax)
             ax.tick_params(axis="x", labelbottom=True)
     for ax in axes[len(tests) :]:
         ax.set_visible(False)
-    fig.suptitle(
-        f"Poisson tests of the disk-disk collision times, per IC (dotted: α = {alpha:g}, "
-        "the share expected if every IC were Poisson)",
-        fontsize="medium",
-    )
+    handles = [Line2D([], [], color="C0", marker="o", markersize=4,
+                      label="disk-disk collision times (± 95 % CI)")]
+    if "control_rate" in table.columns and table["control_rate"].notna().any():
+        handles.append(Line2D([], [], color="grey", marker="s", markersize=3,
+                              label="control: the same tests on the sweep's Poisson kick times"))
+    handles.append(Line2D([], [], color="black", linestyle=":",
+                          label=f"α = {alpha:g}, the share if every IC were Poisson"))
+    fig.legend(handles=handles, loc="outside lower center", ncol=len(handles),
+               fontsize="small")
+    fig.suptitle("Poisson tests of the disk-disk collision times, per IC: share of runs "
+                 "rejected", fontsize="medium")
     return fig
 
 
@@ -169,7 +193,7 @@ def _overlaid(table, tests, alpha, ax):
         )
     ax.axhline(alpha, color="black", linestyle=":", label=f"α = {alpha:g} (all ICs Poisson)")
     ax.set_ylim(0.0, 1.0)
-    ax.set_xlabel(RADIUS_LABEL)
+    radius_axis(ax)
     ax.set_ylabel(f"share of ICs rejected at α = {alpha:g}")
     ax.legend(fontsize="x-small", ncol=2)
     return fig
@@ -183,12 +207,28 @@ def subsample(part, limit):
 def _poisson_job(job):
     """Poisson tests and rate homogeneity of one radius (runs in a worker process)."""
     from kicktimes import stats
+    from kicktimes.experiment import kick_rng
+    from kicktimes.schedules import Poisson
     from kicktimes.stats.poisson import uniformity_ks
 
-    r, seqs, windows, alpha, n_mc, seed_key, rule, ics = job
+    r, seqs, windows, alpha, n_mc, seed_key, rule, ics, control = job
     ens = stats.test_poisson_ensemble(
         seqs, windows, alpha=alpha, n_mc=n_mc, rng=seeded_rng(*seed_key)
     )
+    # the control: the same tests on the sweep's own Poisson kick times of each IC (rate
+    # n_pp / t_window, the "poisson" system's stream), cut at the same window; Poisson by
+    # construction, so every test should reject about alpha of them
+    ctrl_seqs = []
+    if control is not None:
+        exp_seed, horizon = control
+        for ic, t, w in zip(ics, seqs, windows, strict=True):
+            if t.size == 0:
+                ctrl_seqs.append(np.empty(0))
+                continue
+            kicks = Poisson(t.size / w).sample(horizon, kick_rng(exp_seed, int(ic), r, "poisson"))
+            ctrl_seqs.append(kicks[kicks <= w])
+        ctrl = stats.test_poisson_ensemble(ctrl_seqs, windows, alpha=alpha, n_mc=n_mc,
+                                           rng=seeded_rng(*seed_key, 9))
     # per IC: the headline test's p-value, and the same test on the first FIXED_EVENTS
     # collisions only (NaN for runs with fewer)
     p_fixed = np.full(len(seqs), np.nan)
@@ -204,16 +244,20 @@ def _poisson_job(job):
         p = ens.per_sequence[f"p_{test}"].to_numpy()
         ok = np.isfinite(p)
         comb = ens.combined.loc[test]
-        rows.append(
-            {
-                "radius": r,
-                "test": test,
-                "n_tested": int(ok.sum()),
-                "n_reject": int((p[ok] < alpha).sum()),
-                "n_reject_fdr": int(comb["n_reject_fdr"]),
-                "combined_pvalue": float(comb["pvalue"]),
-            }
-        )
+        row = {
+            "radius": r,
+            "test": test,
+            "n_tested": int(ok.sum()),
+            "n_reject": int((p[ok] < alpha).sum()),
+            "n_reject_fdr": int(comb["n_reject_fdr"]),
+            "combined_pvalue": float(comb["pvalue"]),
+        }
+        if ctrl_seqs:
+            pc = ctrl.per_sequence[f"p_{test}"].to_numpy()
+            okc = np.isfinite(pc)
+            row["control_n_tested"] = int(okc.sum())
+            row["control_n_reject"] = int((pc[okc] < alpha).sum())
+        rows.append(row)
     hom = ens.rate_homogeneity
     counts = np.array([t.size for t in seqs], dtype=float)
     hom_row = {
@@ -241,8 +285,10 @@ def _jobs(ctx):
         seqs = [np.asarray(t, dtype=float) for t in part["pp_times"]]
         # one Monte Carlo stream per radius: identical results for any worker count
         key = (exp.seed, 1, ri)
+        # (event times from elsewhere, `kicktimes analyze`, have no kick schedules)
+        control = ((exp.seed, exp.horizon) if "poisson" in getattr(exp, "systems", ()) else None)
         jobs.append((r, seqs, part["t_window"].to_numpy(float), ctx.alpha, ctx.n_mc, key, exp.rule,
-                     part["ic"].to_numpy()))
+                     part["ic"].to_numpy(), control))
     return jobs
 
 
@@ -310,6 +356,16 @@ def sections(ctx):
         f"{int((rejections['combined_pvalue'] < alpha).sum())} of them. Tests with too few "
         "events in an IC are not run on it (n_tested counts the ICs tested)."
     )
+    if "control_rate" in rejections.columns:
+        c = rejections.groupby("test", sort=False)[["control_n_reject", "control_n_tested"]].sum()
+        sec.text(
+            "Control: the same tests on the sweep's own Poisson kick times of each run (rate "
+            "n_pp / t_window, cut at the same window; Poisson by construction) reject "
+            + "; ".join(f"{TEST_TITLES.get(t, t)} "
+                        f"{pct(row.control_n_reject / row.control_n_tested)}"
+                        for t, row in c.iterrows() if row.control_n_tested > 0)
+            + f" of them, against the nominal {pct(alpha)}."
+        )
     t = rejections[headline].sort_values("radius")
     sec.text(
         f"At a fixed number of intervals ({HEADLINE_TEST} on the first {FIXED_EVENTS} "

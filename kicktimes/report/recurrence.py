@@ -28,7 +28,7 @@ from kicktimes.report._common import (
     kicked_systems,
     wide,
 )
-from kicktimes.report._figures import RADIUS_LABEL, plain_ticks, shared_legend
+from kicktimes.report._figures import plain_ticks, radius_axis, shared_legend
 from kicktimes.report.effects import Effect, paired_ratio, ratio_rule, ratio_verdict
 from kicktimes.report.summary import diagnostic_summary, diagnostic_vs_radius
 
@@ -129,7 +129,7 @@ def rr_figure(rows, exp, *, radii=None, title=None):
             name = f"{q}@{e:g}"
             if summary is None or name not in distinct(summary, "diagnostic"):
                 ax.text(0.5, 0.5, "not in the store", transform=ax.transAxes, ha="center")
-                ax.set_xlabel(RADIUS_LABEL)
+                radius_axis(ax)
                 ax.set_ylabel(_QUANTITIES[q][1])
                 continue
             diagnostic_vs_radius(

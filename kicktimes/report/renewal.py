@@ -14,7 +14,7 @@ from matplotlib.figure import Figure
 from matplotlib.patches import Patch
 
 from kicktimes.report._common import Section, pct
-from kicktimes.report._figures import RADIUS_LABEL, check_frame, check_radii, finite
+from kicktimes.report._figures import check_frame, check_radii, finite, radius_axis
 from kicktimes.report.effects import SHARE_RULE, Effect, clopper_pearson, share_verdict
 from kicktimes.report.poisson import binomial_ci, subsample
 
@@ -84,7 +84,7 @@ def model_comparison(per_ic, pooled, *, models=None):
                 va="center",
             )
     ax1.set_ylim(0, 1.08)
-    ax1.set_xlabel(RADIUS_LABEL)
+    radius_axis(ax1)
     ax1.set_ylabel("share of ICs where the model is AIC-best")
     ax1.set_title("(a) per IC (number of ICs on top)")
     for m in models:
@@ -111,8 +111,13 @@ def model_comparison(per_ic, pooled, *, models=None):
     ax2.set_yscale("symlog", linthresh=1.0)
     # ΔAIC >= 0: no negative band below the best model
     top = float(np.nanmax(delta)) if delta.size and np.isfinite(delta).any() else 10.0
-    ax2.set_ylim(0.0, max(20.0, 2.0 * top))
-    ax2.set_xlabel(RADIUS_LABEL)
+    # below 0 a little: the best model of each radius (ΔAIC = 0) sits on a visible line
+    # above the axis, not on it
+    ax2.set_ylim(-0.8, max(20.0, 2.0 * top))
+    ax2.axhline(0.0, color="grey", linewidth=0.8, zorder=0)
+    ax2.annotate("ΔAIC = 0: the best model", (0.01, 0.0), xycoords=("axes fraction", "data"),
+                 fontsize="x-small", color="grey", va="bottom")
+    radius_axis(ax2)
     ax2.set_ylabel("ΔAIC = AIC − min AIC (pooled intervals)")
     ax2.set_title("(b) intervals pooled over ICs")
     # one legend for both panels, outside the axes: it never covers data

@@ -15,13 +15,13 @@ from kicktimes.report._figures import (
     _PAPER_BAR,
     _SEM_BAR,
     DIAGNOSTIC_LABELS,
-    RADIUS_LABEL,
     SYSTEMS,
     check_frame,
     check_radii,
     dodge,
     finite,
     new_axes,
+    radius_axis,
     system_label,
     system_style,
 )
@@ -156,6 +156,7 @@ def diagnostic_vs_radius(
                 markersize=5,
                 color=style["color"],
             )
+    _robust_ylim(ax, summary[summary["system"].isin(systems)], medians)
     handles, labels = ax.get_legend_handles_labels()
     handles += [
         Line2D([], [], color="grey", **_PAPER_BAR),
@@ -169,10 +170,41 @@ def diagnostic_vs_radius(
         labels.append("median over ICs")
     ax.legend(handles, labels, fontsize="x-small")
     name, default_ylabel = DIAGNOSTIC_LABELS.get(diagnostic, (diagnostic, diagnostic))
-    ax.set_xlabel(RADIUS_LABEL)
+    radius_axis(ax)
     ax.set_ylabel(ylabel if ylabel is not None else default_ylabel)
     ax.set_title(title if title is not None else name)
     return fig
+
+
+def _robust_ylim(ax, summary, medians):
+    """Keep a single extreme (radius, system) mean from setting the y-range.
+
+    The limits cover every mean ± paper bar and median within 3 interquartile ranges of
+    the values' quartiles; a mean beyond is drawn at the edge with its value written
+    beside it (an arrow marks the clipped point), so one sticky run cannot flatten the
+    other curves.
+    """
+    lo = summary["mean"] - summary["paper_err"]
+    hi = summary["mean"] + summary["paper_err"]
+    vals = np.concatenate([lo, hi] + ([summary["median"]] if medians else []))
+    vals = vals[np.isfinite(vals)]
+    if vals.size < 4:
+        return
+    q1, q3 = np.percentile(vals, [25, 75])
+    iqr = q3 - q1
+    top = min(vals.max(), q3 + 3 * iqr)
+    bottom = max(vals.min(), q1 - 3 * iqr)
+    if top >= vals.max() and bottom <= vals.min():
+        return
+    pad = 0.06 * (top - bottom if top > bottom else abs(top) or 1.0)
+    ax.set_ylim(bottom - pad, top + pad)
+    for row in summary.itertuples():
+        if row.mean > top + pad or row.mean < bottom - pad:
+            edge = top + pad if row.mean > top else bottom - pad
+            ax.annotate(f"{row.mean:.3g}", (row.radius, edge), xytext=(0, -12 if row.mean > top
+                                                                        else 12),
+                        textcoords="offset points", ha="center", fontsize="x-small",
+                        arrowprops={"arrowstyle": "->", "color": "grey"})
 
 
 def comparison_table(summary):

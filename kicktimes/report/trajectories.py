@@ -176,7 +176,8 @@ def _as_pairs(data, eps, n_points):
 
 
 def recurrence_plot(
-    data, *, eps=1e-3, n_points=None, tau=None, ax=None, max_markers=300_000, bins=600, title=None
+    data, *, eps=1e-3, n_points=None, tau=None, ax=None, max_markers=300_000, bins=600,
+    title=None, zoom=None,
 ):
     r"""Recurrence plot from the list of recurrent index pairs (never an N x N matrix).
 
@@ -198,6 +199,9 @@ def recurrence_plot(
         Up to this many pairs are drawn as dots; beyond, the pairs are binned on a
         ``bins x bins`` grid (memory O(bins²), not O(N²)) and shown as counts.
     title : str, optional
+    zoom : int, optional
+        Also draw the first ``zoom`` samples enlarged in an inset (where the diagonal lines
+        that DET counts are visible; at full scale the main diagonal hides them).
 
     Returns
     -------
@@ -253,11 +257,40 @@ def recurrence_plot(
     ax.set_xlim(0, n * scale)
     ax.set_ylim(0, n * scale)
     ax.set_aspect("equal")
+    if zoom and n > 2 * zoom:
+        # at full scale the main diagonal hides the short diagonal lines DET counts: the
+        # first `zoom` samples, enlarged
+        inset = ax.inset_axes([0.56, 0.04, 0.42, 0.42])
+        sel = (i < zoom) & (j < zoom)
+        inset.plot(i[sel] * scale, j[sel] * scale, linestyle="none", marker="s",
+                   markersize=1.2, markeredgewidth=0, color="black", rasterized=True)
+        inset.set_xlim(0, zoom * scale)
+        inset.set_ylim(0, zoom * scale)
+        inset.set_aspect("equal")
+        inset.tick_params(labelsize="xx-small")
+        inset.set_title(f"first {zoom} samples", fontsize="x-small")
+        ax.indicate_inset_zoom(inset, edgecolor="tab:red")
     ax.set_xlabel(f"{unit} $i$")
     ax.set_ylabel(f"{unit} $j$")
     rate = i.size / float(n) ** 2
     ax.set_title(title if title is not None else f"N = {n}, {i.size} pairs, RR = {rate:.3g}")
     return fig
+
+
+def _sweep_poisson_run(exp, ic, r, two):
+    """The sweep's Poisson-kicked run of IC 0 at ``r``: its kick times and angles from the
+    ``kick_rng(seed, 0, r, "poisson")`` stream, as the sweep draws them."""
+    from kicktimes.billiard.one_particle import draw_kick_angles, simulate_one_particle
+    from kicktimes.experiment import kick_rng
+    from kicktimes.schedules import Poisson
+
+    rng = kick_rng(exp.seed, 0, r, "poisson")
+    rate = two.n_pp / two.t_max if two.t_max > 0 else 0.0
+    times = Poisson(rate).sample(exp.horizon, rng) if rate > 0 else np.empty(0)
+    angles = draw_kick_angles(times.size, exp.kick_angle, exp.sigma, rng)
+    return simulate_one_particle(ic[0], r, kicks=times, kick_angles=angles,
+                                 kick_angle=exp.kick_angle, sigma=exp.sigma,
+                                 n_steps=exp.n_steps, tau=exp.tau, sampling=exp.sampling)
 
 
 def sections(ctx):
@@ -301,13 +334,28 @@ def sections(ctx):
             }
         )
     table = pd.DataFrame(rows)
+    kicked = {r: _sweep_poisson_run(exp, ic, r, run) for r, run in runs.items()}
+    fig = Figure(figsize=(11.0, 3.2 * len(radii)), layout="constrained")
+    axes = np.atleast_2d(fig.subplots(len(radii), 2, sharex=True, sharey=True, squeeze=False))
+    for k, r in enumerate(radii):
+        poincare_section(runs[r], 0, ax=axes[k, 0],
+                         title=f"({chr(ord('a') + 2 * k)}) two disks, disk 0, r = {r:g}")
+        poincare_section(kicked[r], 0, ax=axes[k, 1], color="tab:orange",
+                         title=f"({chr(ord('b') + 2 * k)}) one disk, Poisson kicks, r = {r:g}")
+        if k < len(radii) - 1:
+            for ax in axes[k]:
+                ax.set_xlabel("")
+        axes[k, 1].set_ylabel("")
     sec.figure(
         "fig01_poincare_sections",
-        poincare_panels(list(runs.values())),
+        fig,
         f"Poincaré sections (s, sin θ) of disk 0 of IC 0 (drawn at r_max = {exp.r_max:g} with "
         f"seed {exp.seed}, {exp.ic_method} method), at r = "
         + " and ".join(f"{r:g}" for r in radii)
-        + f"; {exp.n_steps} {exp.sampling}-sampled steps of τ = {exp.tau:g}.",
+        + f"; {exp.n_steps} {exp.sampling}-sampled steps of τ = {exp.tau:g}. Left: the two-disk "
+        "billiard; right: the same disk kicked at the sweep's own Poisson times and angles "
+        "(rate n_pp / t_window of the left run). Horizontal segments are regular motion "
+        "between perturbations.",
     )
     parts = [
         f"r = {row.radius:g}: {row.n_boundary_disk0} boundary collisions of disk 0 and "
@@ -346,9 +394,11 @@ def sections(ctx):
             n_points=n,
             tau=exp.tau if exp.sampling == "uniform" else None,
             title=f"r = {r_rr:g}, ε = {eps:g}: N = {n}, RR = {rr:.4g}",
+            zoom=min(400, n // 4),
         ),
         f"Recurrence plot of disk 0's sampled centre, IC 0, r = {r_rr:g}, ε = {eps:g} "
-        "(L2 norm), drawn from the list of recurrent pairs (no N x N matrix).",
+        "(L2 norm), drawn from the list of recurrent pairs (no N x N matrix); inset: the "
+        "first samples enlarged, where the short diagonal lines that DET counts show.",
     )
     off = (i.size - n) / (n * (n - 1.0))
     text = (
