@@ -165,6 +165,7 @@ def _lag1_figure(summary, predicted, lag):
     from matplotlib.ticker import FuncFormatter, LogLocator
 
     summary = summary[summary["diagnostic"] == "autocorrelation"]
+    r_l = "R₁" if lag == 1 else f"R_{lag}"
     systems = list(dict.fromkeys(summary["system"]))
     order = [s for s in (REFERENCE, *kicked_systems(summary)) if s in systems]
     fig = Figure(figsize=(11.0, 4.6), layout="constrained")
@@ -190,18 +191,18 @@ def _lag1_figure(summary, predicted, lag):
             ax_ratio.plot(part["radius"], (1.0 - part["mean"].to_numpy()) / (1.0 - two),
                           color=style["color"], marker=style["marker"], markersize=5)
     ax.set_yscale("log")
-    ax.yaxis.set_major_locator(LogLocator(subs=(1.0, 2.0, 5.0)))
+    ax.yaxis.set_major_locator(LogLocator(subs=(1.0, 2.0, 3.0, 5.0, 7.0)))
     ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
     ax.yaxis.set_minor_formatter(FuncFormatter(lambda v, _: ""))
     radius_axis(ax)
-    ax.set_ylabel(f"1 − R_{lag} of θ (decorrelation per boundary collision)")
-    ax.set_title(f"(a) 1 − R_{lag}: mean ± s.e.m. over ICs; open: built-in 1 − n_pert/n_boundary"
-                 if pred is not None else f"(a) 1 − R_{lag}: mean ± s.e.m. over ICs",
+    ax.set_ylabel(f"1 − {r_l} of θ (decorrelation per boundary collision)")
+    ax.set_title(f"(a) 1 − {r_l}: mean ± s.e.m. over ICs; open: built-in 1 − n_pert/n_boundary"
+                 if pred is not None else f"(a) 1 − {r_l}: mean ± s.e.m. over ICs",
                  fontsize="medium")
     ax_ratio.axhspan(0.9, 1.1, color="0.88", zorder=0)
     ax_ratio.axhline(1.0, color="0.5", linewidth=0.8, zorder=0)
     radius_axis(ax_ratio)
-    ax_ratio.set_ylabel(f"(1 − R_{lag}) kicked / (1 − R_{lag}) two-disk")
+    ax_ratio.set_ylabel(f"(1 − {r_l}) kicked / (1 − {r_l}) two-disk")
     ax_ratio.set_title("(b) ratio to the two-disk value (grey: ±10 %)", fontsize="medium")
     handles, labels = ax.get_legend_handles_labels()
     if pred is not None:

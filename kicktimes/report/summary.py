@@ -200,11 +200,15 @@ def _robust_ylim(ax, summary, medians):
     ax.set_ylim(bottom - pad, top + pad)
     for row in summary.itertuples():
         if row.mean > top + pad or row.mean < bottom - pad:
-            edge = top + pad if row.mean > top else bottom - pad
-            ax.annotate(f"{row.mean:.3g}", (row.radius, edge), xytext=(0, -12 if row.mean > top
-                                                                        else 12),
-                        textcoords="offset points", ha="center", fontsize="x-small",
-                        arrowprops={"arrowstyle": "->", "color": "grey"})
+            # in axes coordinates: the note stays at the edge if a caller moves the limits
+            above = row.mean > top
+            ax.annotate(f"{row.mean:.3g} ↑" if above else f"{row.mean:.3g} ↓",
+                        (row.radius, 0.985 if above else 0.015),
+                        xycoords=("data", "axes fraction"), xytext=(4, 0),
+                        textcoords="offset points", ha="left", va="top" if above else "bottom",
+                        fontsize="x-small", color="dimgrey",
+                        bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none",
+                              "alpha": 0.85})
 
 
 def comparison_table(summary):

@@ -200,8 +200,10 @@ def recurrence_plot(
         ``bins x bins`` grid (memory O(bins²), not O(N²)) and shown as counts.
     title : str, optional
     zoom : int, optional
-        Also draw the first ``zoom`` samples enlarged in an inset (where the diagonal lines
-        that DET counts are visible; at full scale the main diagonal hides them).
+        Also draw, enlarged in an inset, the ``zoom`` x ``zoom`` block of sample indices on
+        the main diagonal that holds the most recurrent pairs off it, where the short lines
+        parallel to the diagonal that DET counts are visible (at full scale the main
+        diagonal hides them).
 
     Returns
     -------
@@ -257,18 +259,23 @@ def recurrence_plot(
     ax.set_xlim(0, n * scale)
     ax.set_ylim(0, n * scale)
     ax.set_aspect("equal")
-    if zoom and n > 2 * zoom:
-        # at full scale the main diagonal hides the short diagonal lines DET counts: the
-        # first `zoom` samples, enlarged
+    off = i < j  # one triangle, off the main diagonal
+    if zoom and n > 2 * zoom and off.any():
+        # at full scale the main diagonal hides the short lines parallel to it that DET
+        # counts: the zoom x zoom block on the diagonal holding the most pairs off it
+        blocks = np.bincount(i[off] // zoom, weights=(j[off] // zoom == i[off] // zoom))
+        i0 = j0 = int(np.argmax(blocks)) * zoom
         inset = ax.inset_axes([0.56, 0.04, 0.42, 0.42])
-        sel = (i < zoom) & (j < zoom)
+        sel = (i >= i0) & (i < i0 + zoom) & (j >= j0) & (j < j0 + zoom)
         inset.plot(i[sel] * scale, j[sel] * scale, linestyle="none", marker="s",
-                   markersize=1.2, markeredgewidth=0, color="black", rasterized=True)
-        inset.set_xlim(0, zoom * scale)
-        inset.set_ylim(0, zoom * scale)
+                   markersize=max(1.5, 120.0 / zoom), markeredgewidth=0, color="black",
+                   rasterized=True)
+        inset.set_xlim(i0 * scale, (i0 + zoom) * scale)
+        inset.set_ylim(j0 * scale, (j0 + zoom) * scale)
         inset.set_aspect("equal")
         inset.tick_params(labelsize="xx-small")
-        inset.set_title(f"first {zoom} samples", fontsize="x-small")
+        inset.set_xlabel(f"{int(sel.sum())} pairs in {zoom} x {zoom} samples",
+                         fontsize="xx-small", labelpad=1)
         ax.indicate_inset_zoom(inset, edgecolor="tab:red")
     ax.set_xlabel(f"{unit} $i$")
     ax.set_ylabel(f"{unit} $j$")
@@ -394,11 +401,12 @@ def sections(ctx):
             n_points=n,
             tau=exp.tau if exp.sampling == "uniform" else None,
             title=f"r = {r_rr:g}, ε = {eps:g}: N = {n}, RR = {rr:.4g}",
-            zoom=min(400, n // 4),
+            zoom=min(40, n // 4),
         ),
         f"Recurrence plot of disk 0's sampled centre, IC 0, r = {r_rr:g}, ε = {eps:g} "
         "(L2 norm), drawn from the list of recurrent pairs (no N x N matrix); inset: the "
-        "first samples enlarged, where the short diagonal lines that DET counts show.",
+        "stretch of the diagonal with the most recurrent pairs beside it, enlarged, where "
+        "the short lines parallel to the diagonal that DET counts show.",
     )
     off = (i.size - n) / (n * (n - 1.0))
     text = (
