@@ -44,7 +44,7 @@ from pathlib import Path
 import pandas as pd
 
 from kicktimes.experiment import execute_task, preset, run_experiment
-from kicktimes.experiment.presets import SCALES
+from kicktimes.experiment.presets import SCALES, scale_presets
 from kicktimes.experiment.runner import local_pool
 
 # with the tangent FTLE (the presets) each trajectory is simulated once, together with its
@@ -168,7 +168,7 @@ def main():
     t_all = time.perf_counter()
     # one pool for both families, as `kicktimes reproduce` does (its start-up is timed)
     pool = local_pool(args.workers) if args.workers > 1 else None
-    for name in SCALES[args.scale]:
+    for name in scale_presets(args.scale, args.content):
         # --content paper: PAPER_CONTENT, what `kicktimes reproduce --content paper` runs
         exp = preset(name, content=args.content)
         path = root / f"store-{name}"
@@ -224,7 +224,7 @@ def main():
     total = sweep_wall + (report_wall or 0.0)
     results["total_wall_s"] = total
 
-    bare, n_runs = bare_simulation(SCALES[args.scale])
+    bare, n_runs = bare_simulation(scale_presets(args.scale, args.content))
     results["bare_simulation_s"] = bare
     print(
         f"\nreference (same run): bare two-disk simulation of the same {n_runs} radius-IC "
@@ -245,7 +245,7 @@ def main():
         f"({total / 60:.2f} min; target < 10 min, aim < 2 min); "
         f"load average at end {os.getloadavg()[0]:.2f}"
     )
-    families = " + ".join(SCALES[args.scale])
+    families = " + ".join(scale_presets(args.scale, args.content))
     print("\nREADME speed table row:")
     print(
         f"| **the whole paper** ({args.scale} scale, {args.content} content: {families}, "

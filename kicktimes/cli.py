@@ -621,7 +621,7 @@ def reproduce_command(scale, content, out, workers, scheduler, progress, wait, p
     """
     import os
 
-    from kicktimes.experiment.presets import SCALES, preset
+    from kicktimes.experiment.presets import preset, scale_presets
 
     if workers is not None and scheduler is not None:
         raise click.UsageError("--workers sizes the local pool; it cannot go with --scheduler")
@@ -633,8 +633,9 @@ def reproduce_command(scale, content, out, workers, scheduler, progress, wait, p
     with _cli_errors(_RUN_OPTIONS), ExitStack() as stack:
         # the paper's content goes to its own stores and report: both contents can share --out
         suffix = "-paper" if content == "paper" else ""
-        exps = [preset(n, content) for n in SCALES[scale]]
-        paths = [os.path.join(out, f"store-{n}{suffix}") for n in SCALES[scale]]
+        names = scale_presets(scale, content)
+        exps = [preset(n, content) for n in names]
+        paths = [os.path.join(out, f"store-{exp.name}{suffix}") for exp in exps]
         pending = scheduler is None and any(
             _pending(e, p) for e, p in zip(exps, paths, strict=True)
         )

@@ -162,3 +162,27 @@ def test_the_poisson_tests_control_on_the_sweeps_own_kicks_sits_at_alpha():
     control = table["control_n_reject"] / table["control_n_tested"]
     assert rate["exponential_ks"] > 0.5  # the clustered times are rejected
     assert (control < 0.12).all() and control.mean() == pytest.approx(0.05, abs=0.03)
+
+
+def test_a_control_experiment_becomes_rows_of_its_familys_table():
+    from kicktimes.report.controls import merge_control_families
+
+    def table(family, verdict, controls=("primary", "paired_median")):
+        return pd.DataFrame([
+            {"family": family, "question": "FTLE", "diagnostic": "ftle", "system": "poisson",
+             "control": c, "estimate": 0.3, "ci_low": 0.29, "ci_high": 0.31,
+             "verdict": verdict, "robust": True, "n_pairs": 10, "detail": "d"}
+            for c in controls])
+
+    merged = merge_control_families([table("family_a", "differs"),
+                                     table("family_a-elastic", "within 10 %"),
+                                     table("family_b", "differs")])
+    assert set(merged) == {"family_a", "family_b"}
+    a = merged["family_a"]
+    assert list(a["control"]) == ["primary", "paired_median", "elastic"]
+    assert not a["robust"].any()  # the elastic rule changes the verdict
+    assert a.loc[2, "detail"].startswith("from the experiment family_a-elastic")
+    assert merged["family_b"]["robust"].all()
+    # a control whose family is not there stays a family of its own
+    alone = merge_control_families([table("family_c-elastic", "differs")])
+    assert set(alone) == {"family_c-elastic"}

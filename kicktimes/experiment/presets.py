@@ -19,7 +19,8 @@ import dataclasses
 
 from kicktimes.experiment.config import Experiment
 
-__all__ = ["CONTENTS", "PAPER_CONTENT", "PRESETS", "SCALES", "preset"]
+__all__ = ["CONTENTS", "CONTROL_PRESETS", "PAPER_CONTENT", "PRESETS", "SCALES", "preset",
+           "scale_presets"]
 
 
 def _radii(start_mm: int, stop_mm: int) -> list[float]:
@@ -76,6 +77,40 @@ PRESETS = {
         ),
         **_PAPER,
     ),
+    # the controls of family A's findings that other experiments provide: initial
+    # conditions from the invariant measure instead of the paper's procedure, and the
+    # elastic collision rule (with its invariant-measure ICs). The name
+    # "<family>-<control>" makes their ratios rows of family A's findings table under
+    # that control (kicktimes.report.controls.merge_control_families).
+    "family_a_invariant": Experiment(
+        name="family_a-invariant_ics",
+        radii=_radii(8, 30),
+        n_ics=200,
+        n_steps=25000,
+        tau=0.2,
+        seed=1,
+        block_size=25,
+        description=(
+            "Control of family A: the same experiment with initial conditions drawn from the "
+            "invariant measure (positions uniform on the non-overlapping pairs, uniform "
+            "directions) instead of the paper's procedure."
+        ),
+        **{**_PAPER, "ic_method": "uniform"},
+    ),
+    "family_a_elastic": Experiment(
+        name="family_a-elastic",
+        radii=_radii(8, 30),
+        n_ics=200,
+        n_steps=25000,
+        tau=0.2,
+        seed=1,
+        block_size=25,
+        description=(
+            "Control of family A: the same experiment under the elastic collision rule "
+            "(energy exchanged between the disks), invariant-measure initial conditions."
+        ),
+        **{**_PAPER, "ic_method": "uniform", "rule": "elastic"},
+    ),
     "quick_a": Experiment(
         name="quick_a",
         radii=[0.008, 0.014, 0.02, 0.03],
@@ -100,8 +135,24 @@ PRESETS = {
     ),
 }
 
-#: The experiments ``kicktimes reproduce --scale`` runs.
-SCALES = {"paper": ("family_a", "family_b"), "quick": ("quick_a", "quick_b")}
+#: The experiments ``kicktimes reproduce --scale`` runs (with ``--content paper``, the
+#: paper's own content, the control experiments of `CONTROL_PRESETS` are left out).
+SCALES = {
+    "paper": ("family_a", "family_b", "family_a_invariant", "family_a_elastic"),
+    "quick": ("quick_a", "quick_b"),
+}
+#: Presets that are controls of another family's findings (named "<family>-<control>").
+CONTROL_PRESETS = ("family_a_invariant", "family_a_elastic")
+
+
+def scale_presets(scale: str, content: str = "full") -> tuple:
+    """The preset names ``kicktimes reproduce --scale <scale> --content <content>`` runs.
+
+    >>> scale_presets("paper", "paper")
+    ('family_a', 'family_b')
+    """
+    names = SCALES[scale]
+    return tuple(n for n in names if n not in CONTROL_PRESETS) if content == "paper" else names
 
 #: What ``content="paper"`` keeps of a preset: the paper's own systems and diagnostics.
 PAPER_CONTENT = {

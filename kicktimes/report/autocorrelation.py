@@ -190,10 +190,12 @@ def _lag1_figure(summary, predicted, lag):
             two = ref["mean"].reindex(part["radius"]).to_numpy()
             ax_ratio.plot(part["radius"], (1.0 - part["mean"].to_numpy()) / (1.0 - two),
                           color=style["color"], marker=style["marker"], markersize=5)
-    ax.set_yscale("log")
-    ax.yaxis.set_major_locator(LogLocator(subs=(1.0, 2.0, 3.0, 5.0, 7.0)))
-    ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
-    ax.yaxis.set_minor_formatter(FuncFormatter(lambda v, _: ""))
+    decorrelation = 1.0 - summary["mean"].to_numpy(float)
+    if np.any(np.isfinite(decorrelation) & (decorrelation > 0)):  # else a linear axis
+        ax.set_yscale("log")
+        ax.yaxis.set_major_locator(LogLocator(subs=(1.0, 2.0, 3.0, 5.0, 7.0)))
+        ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+        ax.yaxis.set_minor_formatter(FuncFormatter(lambda v, _: ""))
     radius_axis(ax)
     ax.set_ylabel(f"1 − {r_l} of θ (decorrelation per boundary collision)")
     ax.set_title(f"(a) 1 − {r_l}: mean ± s.e.m. over ICs; open: built-in 1 − n_pert/n_boundary"

@@ -42,7 +42,7 @@ import pandas as pd
 
 from kicktimes.report._common import REFERENCE, kicked_systems, wide
 from kicktimes.report.effects import paired_ratio
-from kicktimes.stats import ratio_rule, ratio_verdict
+from kicktimes.stats import ratio_verdict
 
 __all__ = [
     "COLUMNS",
@@ -332,6 +332,13 @@ PAPER_CLAIMS = {
     "det": "not studied",
     "one_minus_r1": "similar R₁ (Fig. 8)",
 }
+_CONTROL_WORDS = {
+    "paired_median": "paired median",
+    "sticky_excluded": "sticky runs excluded",
+    "uniform_sampling": "uniform-time samples for recurrence",
+    "invariant_ics": "invariant-measure ICs",
+    "elastic": "the elastic rule",
+}
 _SHORT = {"poisson": "Poisson", "actual": "actual", "poisson_scatter": "Poisson, scatter",
           "actual_scatter": "actual, scatter"}
 
@@ -456,10 +463,13 @@ def first_screen(table: pd.DataFrame, shares: dict) -> list[str]:
     for sentence in answers(table, {k: v for k, v in shares.items() if v is not None}):
         lines += [sentence, ""]
     lines += ["Ratio of each kicked system to the two-disk value, averaged over radii [95 % "
-              "CI, bootstrap clustered on ICs]; ✓: the verdict (" + ratio_rule(0.1).split(";")[0]
-              + "; differs; inconclusive) is the same under every control (paired median, "
-              "sticky runs excluded, uniform-time sampling for recurrence); ✗: it is not, and "
-              "the control that changes it is named with its number.", ""]
+              "CI, bootstrap clustered on ICs]; ✓: the verdict (within 10 %: the whole CI lies in "
+              "[0.9, 1.1]; differs: it lies entirely outside; inconclusive: it straddles an "
+              "edge) is the same under every control ("
+              + ", ".join(_CONTROL_WORDS.get(c, c) for c in dict.fromkeys(table["control"])
+                          if c != "primary")
+              + "); ✗: it is not, and the control that changes it is named with its "
+              "number.", ""]
     lines += markdown_table(overview_table(table))
     return lines + [""]
 
@@ -543,3 +553,47 @@ def ratio_curves_figure(curves: pd.DataFrame):
     fig.legend(handles=handles, loc="outside lower center", ncol=min(len(handles), 6),
                fontsize="small")
     return fig
+
+
+def merge_control_families(tables):
+    """Fold the findings of control experiments into their family's table.
+
+    An experiment named ``"<family>-<control>"`` (the presets ``family_a_invariant`` and
+    ``family_a_elastic``: invariant-measure ICs, the elastic rule) is a control of
+    ``<family>``: the primary rows of its table become rows of ``<family>``'s table with
+    ``control = "<control>"``, and ``robust`` is recomputed over every control.
+
+    Parameters
+    ----------
+    tables : sequence of pandas.DataFrame
+        Findings tables (:data:`COLUMNS`), one per experiment.
+
+    Returns
+    -------
+    dict
+        ``{family: table}`` of the experiments that are not controls of another present
+        one (a control whose family is absent stays a family of its own).
+    """
+    tables = [t for t in tables if not t.empty]
+    names = {t["family"].iloc[0] for t in tables}
+    out = {}
+    extra = {}
+    for t in tables:
+        name = t["family"].iloc[0]
+        family, _, control = name.partition("-")
+        if control and family in names:
+            rows = t[t["control"] == "primary"].assign(
+                family=family, control=control,
+                detail=lambda d, n=name: f"from the experiment {n}: " + d["detail"])
+            extra.setdefault(family, []).append(rows)
+        else:
+            out[name] = t
+    for family, parts in extra.items():
+        merged = pd.concat([out[family], *parts], ignore_index=True)
+        keys = ["family", "diagnostic", "system"]
+        merged["robust"] = (merged.groupby(keys)["verdict"].transform("nunique") == 1).to_numpy()
+        pair = list(zip(merged["diagnostic"], merged["system"], strict=True))
+        first = {p: k for k, p in reversed(list(enumerate(pair)))}
+        rank = np.array([first[p] for p in pair])
+        out[family] = merged.iloc[np.argsort(rank, kind="stable")].reset_index(drop=True)
+    return out

@@ -57,7 +57,12 @@ def write_results(
     >>> from kicktimes.report import write_results
     >>> write_results("stores/family_a", "docs/results")  # doctest: +SKIP
     """
-    from kicktimes.report.controls import first_screen, poisson_share, ratio_curves_figure
+    from kicktimes.report.controls import (
+        first_screen,
+        merge_control_families,
+        poisson_share,
+        ratio_curves_figure,
+    )
     from kicktimes.report.findings import rules_text, scale_statement
     from kicktimes.report.pipeline import N_STAGES, analyse
 
@@ -149,7 +154,12 @@ def write_results(
         pool.close()
     import pandas as pd
 
-    table = pd.concat(controls, ignore_index=True)
+    # control experiments ("<family>-<control>") become rows of their family's table
+    merged = merge_control_families(controls)
+    for family, t in merged.items():
+        t.to_csv(out / f"{family}_findings.csv", index=False)
+    table = pd.concat(list(merged.values()), ignore_index=True)
+    shares = {k: v for k, v in shares.items() if k in merged}
     screen = ["## The answers", ""] + first_screen(table, shares) + [
         "The mechanism behind these numbers (stretching per perturbation against ln(1/r) "
         "down to r = 0.002, decorrelation per perturbation, the collision rate's relaxation, "
@@ -159,7 +169,8 @@ def write_results(
             f"[{st.experiment.name}_findings.csv]({st.experiment.name}_findings.csv)"
             for st in stores) + ". Below: per family, the scale, every statement under the "
         "primary setting, and the figures.", ""]
-    figure = ratio_curves_figure(pd.concat(curves, ignore_index=True))
+    curves = pd.concat(curves, ignore_index=True)
+    figure = ratio_curves_figure(curves[curves["family"].isin(list(merged))])
     figure.savefig(out / "headline_ratios_vs_radius.png", dpi=dpi)
     screen[-1:-1] = ["![headline](headline_ratios_vs_radius.png)", "",
                      "**The ratio to the two-disk value against r**, per diagnostic, with 95 % "
