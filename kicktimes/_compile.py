@@ -31,6 +31,10 @@ SWEEP_KERNELS = (
     ("kicktimes.diagnostics.recurrence", "_sweep_lines_dense", 3.0),
     ("kicktimes.diagnostics.autocorrelation", "_acf_curve", 1.3),
     ("kicktimes.diagnostics.autocorrelation", "_select_checked", 0.2),
+    # the uniform-time re-runs of the recurrence control (rr_sampling = "run+uniform", the
+    # full presets); seconds timed cold on the project's machine, 2026-11-25
+    ("kicktimes.billiard.two_particle", "simulate_two_kernel", 2.6),
+    ("kicktimes.billiard.one_particle", "simulate_one_kernel", 2.8),
 )
 SIMULATE_KERNELS = (("kicktimes.billiard.two_particle", "simulate_two_kernel", 4.5),)
 #: What the report compiles beyond the sweep's kernels (``kicktimes reproduce``'s report
@@ -103,6 +107,16 @@ def _warm_two(_):
     exp = dataclasses.replace(exp, n_ics=1, n_steps=50, block_size=1, systems=["two_particle"],
                               diagnostics=diagnostics)
     execute_task(exp, exp.tasks()[0])
+    # the recurrence control's uniform-time re-run, as a task makes it
+    from kicktimes.billiard.initial import initial_conditions
+    from kicktimes.billiard.two_particle import simulate_two_particle
+    from kicktimes.experiment.tasks import _uniform_samples
+
+    ic = initial_conditions(1, exp.r_max, seed=0, method=exp.ic_method, rule=exp.rule)[0]
+    r = exp.radii[0]
+    two = simulate_two_particle(ic, r, rule=exp.rule, track=0, n_steps=50, tau=exp.tau,
+                                sampling=exp.sampling)
+    _uniform_samples(exp, "two_particle", ic, r, two)
 
 
 def _warm_one(_):
@@ -115,7 +129,7 @@ def _warm_one(_):
     from kicktimes.billiard.one_particle import draw_kick_angles
     from kicktimes.diagnostics.lyapunov import lyapunov
     from kicktimes.experiment import preset
-    from kicktimes.experiment.tasks import _kick_law, recurrence_rows
+    from kicktimes.experiment.tasks import _kick_law, _uniform_samples, recurrence_rows
 
     exp = preset("quick_a")
     ic = initial_conditions(1, exp.r_max, seed=0, method=exp.ic_method, rule=exp.rule)[0]
@@ -128,6 +142,8 @@ def _warm_one(_):
     _, run = lyapunov(ic[0], r, kicks=times, kick_angles=angles, variant=exp.lyapunov_variant,
                       method=exp.lyapunov_method, return_run=True, **kick, **steps)
     recurrence_rows(run.samples, exp.eps)
+    # the recurrence control's uniform-time re-run of the kicked disk
+    _uniform_samples(exp, "poisson", ic, r, run)
 
 
 def _warm_report_two(_):

@@ -44,6 +44,7 @@ FIGURES = {
 TABLES = {
     "findings_statements",
     "findings_overview",
+    "findings_by_radius",
     "poincare_runs",
     "kick_times_fit",
     "counts_by_radius",

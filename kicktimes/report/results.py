@@ -158,6 +158,9 @@ def write_results(
     merged = merge_control_families(controls)
     for family, t in merged.items():
         t.to_csv(out / f"{family}_findings.csv", index=False)
+    for c in curves:
+        if not c.empty:
+            c.to_csv(out / f"{c['family'].iloc[0]}_findings_by_radius.csv", index=False)
     table = pd.concat(list(merged.values()), ignore_index=True)
     shares = {k: v for k, v in shares.items() if k in merged}
     screen = ["## The answers", ""] + first_screen(table, shares) + [
@@ -167,8 +170,11 @@ def write_results(
         "`python analysis/science.py`.", "",
         "Every row under every control: " + ", ".join(
             f"[{st.experiment.name}_findings.csv]({st.experiment.name}_findings.csv)"
-            for st in stores) + ". Below: per family, the scale, every statement under the "
-        "primary setting, and the figures.", ""]
+            for st in stores) + "; per radius: " + ", ".join(
+            f"[{st.experiment.name}_findings_by_radius.csv]"
+            f"({st.experiment.name}_findings_by_radius.csv)" for st in stores)
+        + ". Below: per family, the scale, every statement under the primary setting, and "
+        "the figures.", ""]
     curves = pd.concat(curves, ignore_index=True)
     figure = ratio_curves_figure(curves[curves["family"].isin(list(merged))])
     figure.savefig(out / "headline_ratios_vs_radius.png", dpi=dpi)
