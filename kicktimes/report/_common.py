@@ -28,8 +28,12 @@ PAPER_SCALE = {"n_ics": 200, "n_steps": 15000}
 class Section:
     """One part of the report: title, computed text, figures and tables."""
 
-    def __init__(self, key, title):
+    def __init__(self, key, title, *, answers_first=False):
         self.key, self.title = key, title
+        #: the page shows this section's text up to its `fold` (or its first list), then
+        #: its shown tables, then its figures, then the rest (a section that opens with its
+        #: answers); otherwise figures, text, tables
+        self.answers_first = answers_first
         self.blocks: list[tuple[str, object]] = []  # ("p" | "banner", str), ("ul", [str])
         self.figures: list[tuple[str, object, str]] = []  # (name, Figure, caption)
         self.tables: list[tuple[str, pd.DataFrame, str, bool]] = []  # (name, df, title, html)
@@ -46,6 +50,10 @@ class Section:
 
     def bullets(self, items):
         self.blocks.append(("ul", list(items)))
+
+    def fold(self):
+        """Where an ``answers_first`` section's opening text ends."""
+        self.blocks.append(("fold", None))
 
     def figure(self, name, fig, caption):
         self.figures.append((name, fig, caption))

@@ -69,7 +69,7 @@ def section(ctx):
     """The Findings section of one store, and its effects as a table."""
     effects = collect(ctx)
     paper, scale = scale_statement(ctx.store)
-    sec = Section("findings", f"Findings: {ctx.exp.name}")
+    sec = Section("findings", f"Findings: {ctx.exp.name}", answers_first=True)
     if not paper:
         sec.banner(
             f"Below paper scale: {scale}. The paper's smaller family has {PAPER_SCALE['n_ics']} "
@@ -101,6 +101,7 @@ def section(ctx):
         "uniform-time samples (on the paper's samples the kicked systems' ratios are inflated "
         "by where the samples fall: see the table).",
     )
+    sec.fold()
     sec.text("All statements, under the primary setting:")
     sec.bullets(e.statement() + (f" ({e.detail}.)" if e.detail else "") for e in effects)
     sec.text(rules_text(ctx))

@@ -161,6 +161,17 @@ def embed_figures(fragment, out):
     return _PNG_REF.sub(inline, fragment)
 
 
+def _block_html(kind, block):
+    if kind == "fold":
+        return ""
+    if kind == "banner":
+        return f'<p class="banner">{html.escape(block)}</p>'
+    if kind == "ul":
+        items = "".join(f"<li>{html.escape(item)}</li>" for item in block)
+        return f'<ul class="findings">{items}</ul>'
+    return f"<p>{html.escape(block)}</p>"
+
+
 def write_outputs(
     sections, out, dpi, prefix="", *, pdf=True, files=None, embed=True, workers=1
 ):
@@ -177,32 +188,34 @@ def write_outputs(
     body = []
     for sec in sections:
         body.append(f'<h3 id="{prefix}{sec.key}">{html.escape(sec.title)}</h3>')
+        figures = []
         for name, _fig, caption in sec.figures:
             name = prefix + name
             _store_rendered(out, name, next(rendered), files)
             links = f'<a href="{name}.png">PNG</a>' + (
                 f', <a href="{name}.pdf">PDF</a>' if pdf else ""
             )
-            body.append(
+            figures.append(
                 f'<figure><img alt="{html.escape(name)}" src="kt-png:{name}.png">'
                 f"<figcaption>{html.escape(caption)} Files: {links}.</figcaption></figure>"
             )
-        for kind, block in sec.blocks:
-            if kind == "banner":
-                body.append(f'<p class="banner">{html.escape(block)}</p>')
-            elif kind == "ul":
-                items = "".join(f"<li>{html.escape(item)}</li>" for item in block)
-                body.append(f'<ul class="findings">{items}</ul>')
-            else:
-                body.append(f"<p>{html.escape(block)}</p>")
+        blocks = [_block_html(kind, block) for kind, block in sec.blocks]
+        shown, listed = [], []
         for name, df, title, show in sec.tables:
             name = prefix + name
             write_table(out, name, df, files)
             link = f'<a href="{name}.csv">{name}.csv</a>'
             if show:
-                body.append(f"<h4>{html.escape(title)} ({link})</h4>{table_html(df)}")
+                shown.append(f"<h4>{html.escape(title)} ({link})</h4>{table_html(df)}")
             else:
-                body.append(f"<p>{html.escape(title)}: {link} ({len(df)} rows).</p>")
+                listed.append(f"<p>{html.escape(title)}: {link} ({len(df)} rows).</p>")
+        if sec.answers_first:
+            kinds = [kind for kind, _ in sec.blocks]
+            fold = next((k for k, kind in enumerate(kinds) if kind in ("fold", "ul")),
+                        len(kinds))
+            body += blocks[:fold] + shown + figures + blocks[fold:] + listed
+        else:
+            body += figures + blocks + shown + listed
         sec.figures.clear()  # drop the Figure objects: nothing stays alive
     text = "\n".join(body)
     return embed_figures(text, out) if embed else text
