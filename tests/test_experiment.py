@@ -948,7 +948,7 @@ def test_reproduce_quick_runs_both_quick_families_and_builds_the_report(tmp_path
     from kicktimes.report.controls import COLUMNS
 
     for name in ("quick_a", "quick_b"):
-        table = pd.read_csv(tmp_path / "report" / name / "findings.csv")
+        table = pd.read_csv(tmp_path / "report" / f"{name}_findings.csv")
         assert tuple(table.columns) == COLUMNS
         assert set(table["family"]) == {name}
         assert {"ftle", "rr_offdiag@0.001", "rr_offdiag@0.01", "det@0.01", "one_minus_r1",

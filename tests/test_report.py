@@ -539,3 +539,15 @@ def test_the_report_reads_a_store_as_report_store_of_load_store(store_path, tmp_
     part.write_bytes(part.read_bytes()[:-10])
     with pytest.raises(ValueError, match="damaged store"):
         load_report_store(partial)
+
+
+def test_the_findings_table_has_every_control_and_consistent_robust_flags(built):
+    from kicktimes.report.controls import COLUMNS
+
+    table = pd.read_csv(built[1] / "findings.csv")
+    assert tuple(table.columns) == COLUMNS
+    assert {"primary", "paired_median", "sticky_excluded"} <= set(table["control"])
+    for _, part in table.groupby(["family", "diagnostic", "system"]):
+        assert part["robust"].nunique() == 1
+        assert bool(part["robust"].iloc[0]) == (part["verdict"].nunique() == 1)
+    assert set(table["verdict"]) <= {"within 10 %", "differs", "inconclusive"}
