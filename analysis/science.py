@@ -161,6 +161,51 @@ def stretching_figure(fits, per_radius, path):
     fig.savefig(path, dpi=110)
 
 
+# ------------------------------------------------------------------ 2. independent twins
+def independent_angle_twin(r, *, n_ics=8, n_steps=3000, tau=0.2, d0=2e-4, seed=3):
+    """Benettin twins of the Poisson-kicked disk that draw *independent* kick angles.
+
+    Reference and twin share the kick times (rate Gamma(r)) but not the new directions;
+    every tau the phase-space separation d of (x, y, vx, vy) is measured, ln(d / d0)
+    accumulated and the twin put back at distance d0 along the separation (Benettin).
+    Returns the mean lambda over ICs, the kick rate and the bootstrap CI (kicktimes' own
+    twins share the angles: common random numbers).
+    """
+    rate = kinetic_rate(r)
+    ics = initial_conditions(n_ics, r, seed=seed)
+    lams = []
+    for k, ic in enumerate(ics):
+        rng = np.random.default_rng([seed, k])
+        horizon = n_steps * tau
+        kicks = schedules.Poisson(rate).sample(horizon, rng)
+        ang_a = rng.uniform(0.0, 2.0 * np.pi, kicks.size)
+        ang_b = rng.uniform(0.0, 2.0 * np.pi, kicks.size)
+        a = np.array(ic[0], dtype=float)
+        b = a.copy()
+        b[0] += d0
+        total = 0.0
+        for step in range(n_steps):
+            t0 = step * tau
+            sel = (kicks > t0) & (kicks <= t0 + tau)
+            ks = kicks[sel] - t0
+            a = simulate_one_particle(a, r, t_max=tau, kicks=ks, kick_angles=ang_a[sel]
+                                      ).final_state.ravel()[:4]
+            b = simulate_one_particle(b, r, t_max=tau, kicks=ks, kick_angles=ang_b[sel]
+                                      ).final_state.ravel()[:4]
+            diff = b - a
+            d = float(np.sqrt(diff @ diff))
+            total += math.log(d / d0)
+            b = a + diff * (d0 / d)
+            # a twin pushed outside the table by the rescaling is put back on the reference
+            if math.hypot(b[0], b[1]) > 1.0 - r:
+                b = a.copy()
+                b[0] += d0 if a[0] < 0 else -d0
+        lams.append(total / (n_steps * tau))
+    boot_rng = np.random.default_rng(1)
+    boot = [np.mean(boot_rng.choice(lams, len(lams))) for _ in range(N_BOOT)]
+    return float(np.mean(lams)), rate, _ci(boot)
+
+
 # ------------------------------------------------------------------ 3. decorrelation
 def _pairs(times, theta, events):
     """For consecutive wall hits (k, k+1): theta_k, theta_{k+1}, perturbations between."""
@@ -320,19 +365,33 @@ def main(argv=None):
         "", "![stretching](science_stretching.png)", "",
     ]
     tau, d0 = exp.tau, exp.d0
-    s_two_small = per_radius[(per_radius["system"] == "two_particle")].sort_values("radius")
+    s_two = per_radius[(per_radius["system"] == "two_particle")].set_index("radius")
+    twin_rows = []
+    for r_twin in (0.008, 0.02):
+        lam, rate, (lo, hi) = independent_angle_twin(r_twin, tau=tau, d0=d0)
+        twin_rows.append({"radius": r_twin, "lambda": lam, "ci_low": lo, "ci_high": hi,
+                          "kick_rate": rate, "per_kick": lam / rate,
+                          "two_disk_per_collision": float(
+                              s_two["stretch_per_perturbation"].reindex([r_twin]).iloc[0])})
+    twins = pd.DataFrame(twin_rows)
+    twins.to_csv(out / "science_independent_twins.csv", index=False)
     lines += [
         "## 2. Twins with independent kick angles", "",
-        "If a twin draws its own kick angles, every kick separates it from the reference by "
-        "O(τ) within a step, and renormalising to d0 each time gives about ln(τ/d0) nats per "
-        f"kick: λ ≈ Γ ln(τ/d0) = {math.log(tau / d0):.2f} Γ at the paper's τ = {tau:g}, "
-        f"d0 = {d0:g} (derived, not simulated). The two-disk stretching per collision measured "
-        f"above is {s_two_small['stretch_per_perturbation'].iloc[-1]:.2f} nats at r = "
-        f"{s_two_small['radius'].iloc[-1]:g} and "
-        f"{s_two_small['stretch_per_perturbation'].iloc[0]:.2f} at r = "
-        f"{s_two_small['radius'].iloc[0]:g}: of the same size, which may explain the paper's "
-        "reported FTLE agreement if its twins did not share kicks (kicktimes' twins share "
-        "them: common random numbers).", "",
+        "A twin that draws its own kick angles is thrown O(1) away from the reference at "
+        "every kick. A first estimate, O(τ) of position separation renormalised to d0 every "
+        f"τ, gives λ ≈ Γ ln(τ/d0) = {math.log(tau / d0):.2f} Γ at the paper's τ = {tau:g}, "
+        f"d0 = {d0:g}. Simulated (Benettin on (x, y, vx, vy), 8 paper ICs, 3000 steps of τ, "
+        "Poisson kicks at Γ(r); `science_independent_twins.csv`): "
+        + "; ".join(f"r = {row.radius:g}: λ = "
+                    f"{_fmt(row['lambda'], row.ci_low, row.ci_high)}, {row.per_kick:.2f} nats "
+                    f"per kick, against {row.two_disk_per_collision:.2f} per collision for "
+                    "the two disks" for _, row in twins.iterrows())
+        + ", i.e. "
+        + " and ".join(f"{row.per_kick / row.two_disk_per_collision:.1f}× the two-disk λ at "
+                       f"r = {row.radius:g}" for _, row in twins.iterrows())
+        + ". Twins that do not share their kicks measure the kick's O(1) randomisation of "
+        "the direction, not a stretching, and overshoot the two-disk exponent rather than "
+        "match it; kicktimes' twins share the kicks (common random numbers).", "",
     ]
 
     # 3. decorrelation
