@@ -18,24 +18,23 @@ Run: python benchmarks/bench_cost_per_time.py [--t-max 20000] [--n-ics 5] [--csv
 """
 
 import argparse
+import os
+import sys
 import time
 
-import numpy as np
 import pandas as pd
 
 from kicktimes import initial_conditions, schedules, simulate_one_particle, simulate_two_particle
 from kicktimes.stats import kinetic_rate
 
+sys.path.insert(0, os.path.dirname(__file__))
+from _timing import best_time  # noqa: E402
+
 RADII = (0.001, 0.002, 0.005, 0.01, 0.03)
 
 
 def cpu(fn, repeat):
-    best = np.inf
-    for _ in range(repeat):
-        t0 = time.process_time()
-        fn()
-        best = min(best, time.process_time() - t0)
-    return best
+    return best_time(fn, repeat, clock=time.process_time)
 
 
 def measure(t_max=20000.0, n_ics=5, repeat=3, radii=RADII) -> pd.DataFrame:

@@ -11,13 +11,17 @@ Run: ``python benchmarks/bench_schedules.py``
 
 from __future__ import annotations
 
+import os
 import pickle
-import time
+import sys
 
 import numpy as np
 import scipy.stats as st
 
 from kicktimes import schedules
+
+sys.path.insert(0, os.path.dirname(__file__))
+import _timing  # noqa: E402
 
 N_KICKS = 10**6
 N_LOOP = 10**4
@@ -32,12 +36,7 @@ class _Hyperexp(st.rv_continuous):
 
 
 def best_time(func, repeats=REPEATS):
-    best = np.inf
-    for _ in range(repeats):
-        start = time.perf_counter()
-        func()
-        best = min(best, time.perf_counter() - start)
-    return best
+    return _timing.best_time(func, repeats)
 
 
 def python_loop(draw_one, n, rng):

@@ -77,40 +77,6 @@ PRESETS = {
         ),
         **_PAPER,
     ),
-    # the controls of family A's findings that other experiments provide: initial
-    # conditions from the invariant measure instead of the paper's procedure, and the
-    # elastic collision rule (with its invariant-measure ICs). The name
-    # "<family>-<control>" makes their ratios rows of family A's findings table under
-    # that control (kicktimes.report.controls.merge_control_families).
-    "family_a_invariant": Experiment(
-        name="family_a-invariant_ics",
-        radii=_radii(8, 30),
-        n_ics=200,
-        n_steps=25000,
-        tau=0.2,
-        seed=1,
-        block_size=25,
-        description=(
-            "Control of family A: the same experiment with initial conditions drawn from the "
-            "invariant measure (positions uniform on the non-overlapping pairs, uniform "
-            "directions) instead of the paper's procedure."
-        ),
-        **{**_PAPER, "ic_method": "uniform"},
-    ),
-    "family_a_elastic": Experiment(
-        name="family_a-elastic",
-        radii=_radii(8, 30),
-        n_ics=200,
-        n_steps=25000,
-        tau=0.2,
-        seed=1,
-        block_size=25,
-        description=(
-            "Control of family A: the same experiment under the elastic collision rule "
-            "(energy exchanged between the disks), invariant-measure initial conditions."
-        ),
-        **{**_PAPER, "ic_method": "uniform", "rule": "elastic"},
-    ),
     "quick_a": Experiment(
         name="quick_a",
         radii=[0.008, 0.014, 0.02, 0.03],
@@ -134,6 +100,33 @@ PRESETS = {
         **_PAPER,
     ),
 }
+
+
+
+def _control(base: Experiment, control: str, label: str, what: str, **changes) -> Experiment:
+    """``base`` again with ``changes``, named ``"<base>-<control>"``: a control of its
+    findings (`kicktimes.report.controls.merge_control_families` folds its ratios into
+    ``base``'s findings table under ``control``)."""
+    return dataclasses.replace(base, name=f"{base.name}-{control}",
+                               description=f"Control of {label}: the same experiment {what}.",
+                               **changes)
+
+
+# the controls of family A's findings that other experiments provide: initial conditions
+# from the invariant measure instead of the paper's procedure, and the elastic collision
+# rule (with its invariant-measure ICs)
+PRESETS["family_a_invariant"] = _control(
+    PRESETS["family_a"], "invariant_ics", "family A",
+    "with initial conditions drawn from the invariant measure (positions uniform on the "
+    "non-overlapping pairs, uniform directions) instead of the paper's procedure",
+    ic_method="uniform",
+)
+PRESETS["family_a_elastic"] = _control(
+    PRESETS["family_a"], "elastic", "family A",
+    "under the elastic collision rule (energy exchanged between the disks), "
+    "invariant-measure initial conditions",
+    ic_method="uniform", rule="elastic",
+)
 
 #: The experiments ``kicktimes reproduce --scale`` runs (with ``--content paper``, the
 #: paper's own content, the control experiments of `CONTROL_PRESETS` are left out).
