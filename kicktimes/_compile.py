@@ -110,13 +110,13 @@ def _warm_two(_):
     # the recurrence control's uniform-time re-run, as a task makes it
     from kicktimes.billiard.initial import initial_conditions
     from kicktimes.billiard.two_particle import simulate_two_particle
-    from kicktimes.experiment.tasks import _uniform_samples
+    from kicktimes.experiment.tasks import uniform_samples
 
     ic = initial_conditions(1, exp.r_max, seed=0, method=exp.ic_method, rule=exp.rule)[0]
     r = exp.radii[0]
     two = simulate_two_particle(ic, r, rule=exp.rule, track=0, n_steps=50, tau=exp.tau,
                                 sampling=exp.sampling)
-    _uniform_samples(exp, "two_particle", ic, r, two)
+    uniform_samples(exp, "two_particle", ic, r, two)
 
 
 def _warm_one(_):
@@ -129,12 +129,12 @@ def _warm_one(_):
     from kicktimes.billiard.one_particle import draw_kick_angles
     from kicktimes.diagnostics.lyapunov import lyapunov
     from kicktimes.experiment import preset
-    from kicktimes.experiment.tasks import _kick_law, _uniform_samples, recurrence_rows
+    from kicktimes.experiment.tasks import kick_law, recurrence_rows, uniform_samples
 
     exp = preset("quick_a")
     ic = initial_conditions(1, exp.r_max, seed=0, method=exp.ic_method, rule=exp.rule)[0]
     steps = {"n_steps": 50, "tau": exp.tau, "sampling": exp.sampling}
-    kick = _kick_law(exp, "poisson", ic)
+    kick = kick_law(exp, "poisson", ic)
     rng = np.random.default_rng(0)
     times = np.cumsum(rng.exponential(1.0, size=20))
     angles = draw_kick_angles(times.size, kick["kick_angle"], exp.sigma, rng)
@@ -143,7 +143,7 @@ def _warm_one(_):
                       method=exp.lyapunov_method, return_run=True, **kick, **steps)
     recurrence_rows(run.samples, exp.eps)
     # the recurrence control's uniform-time re-run of the kicked disk
-    _uniform_samples(exp, "poisson", ic, r, run)
+    uniform_samples(exp, "poisson", ic, r, run)
 
 
 def _warm_report_two(_):

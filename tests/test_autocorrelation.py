@@ -551,3 +551,25 @@ def test_integrated_time_with_an_undefined_lag_first_is_nan_with_reason():
 def test_decay_summaries_reject_bad_input(call, error, match):
     with pytest.raises(error, match=match):
         call()
+
+
+def test_acf_curve_is_autocorrelation_lag_by_lag_with_its_reasons():
+    from kicktimes.diagnostics import (
+        UndefinedDiagnosticWarning,
+        acf_curve,
+        autocorrelation,
+        autocorrelation_function,
+    )
+
+    x = np.random.default_rng(4).normal(size=12)
+    curve = acf_curve(x, 15)
+    with pytest.warns(UndefinedDiagnosticWarning):  # the function warns; the curve does not
+        np.testing.assert_array_equal(curve.acf, autocorrelation_function(x, 15))
+    for lag in range(1, 16):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", UndefinedDiagnosticWarning)
+            value, reason = autocorrelation(x, lag, return_reason=True)
+        assert np.array_equal(curve.acf[lag - 1], value, equal_nan=True)
+        assert curve.lag_reasons[lag - 1] == reason
+    assert "series too short" in curve.reason
+    assert acf_curve(np.ones(5), 2).reason.startswith("constant series")

@@ -385,7 +385,7 @@ def test_acf_rows_take_r_lag_from_the_curve_exactly(theta, lag, max_lag):
 def test_uniform_rr_sampling_uses_a_uniform_rerun_of_the_same_trajectory():
     from kicktimes import initial_conditions, simulate_two_particle
     from kicktimes.diagnostics import recurrence_rate
-    from kicktimes.experiment.tasks import _uniform_samples
+    from kicktimes.experiment.tasks import uniform_samples
 
     exp = dataclasses.replace(TINY, diagnostics=["recurrence_rate"], n_ics=2)
     uni = dataclasses.replace(exp, rr_sampling="uniform")
@@ -405,7 +405,7 @@ def test_uniform_rr_sampling_uses_a_uniform_rerun_of_the_same_trajectory():
 
     kicked = simulate_one_particle(ic[0], 0.01, kicks=np.array([3.0, 50.0, 77.7]),
                                    sampling="paper", n_steps=400, tau=0.3, rng=5)
-    pts = _uniform_samples(uni, "poisson", ic, 0.01, kicked)
+    pts = uniform_samples(uni, "poisson", ic, 0.01, kicked)
     assert len(pts) == int(np.floor(kicked.t_max / 0.3 * (1 + 1e-12))) + 1
     same_times = np.isin(kicked.sample_times, np.arange(len(pts)) * 0.3)
     assert same_times.any()
@@ -413,7 +413,7 @@ def test_uniform_rr_sampling_uses_a_uniform_rerun_of_the_same_trajectory():
     np.testing.assert_allclose(kicked.samples[same_times], pts[idx], atol=1e-9)
     # with uniform sampling there is nothing to re-run
     flat = dataclasses.replace(uni, sampling="uniform")
-    assert _uniform_samples(flat, "poisson", ic, 0.01, kicked) is kicked.samples
+    assert uniform_samples(flat, "poisson", ic, 0.01, kicked) is kicked.samples
 
 
 def test_poisson_rate_and_window_come_from_the_same_ics_two_particle_run(reference):

@@ -17,6 +17,8 @@ from kicktimes.diagnostics.autocorrelation import (
     boundary_angles,
 )
 from kicktimes.diagnostics.decorrelation import (
+    AcfCurve,
+    acf_curve,
     autocorrelation_function,
     decorrelation_lag,
     integrated_autocorrelation_time,
@@ -31,10 +33,12 @@ from kicktimes.diagnostics.recurrence import recurrence_pairs, recurrence_rate
 from kicktimes.diagnostics.rqa import RQAResult, rqa
 
 __all__ = [
+    "AcfCurve",
     "LyapunovResult",
     "LyapunovSpectrum",
     "RQAResult",
     "UndefinedDiagnosticWarning",
+    "acf_curve",
     "autocorrelation",
     "autocorrelation_function",
     "autocorrelation_many",

@@ -13,6 +13,7 @@ from __future__ import annotations
 import math
 import numbers
 import warnings
+from typing import NamedTuple
 
 import numpy as np
 
@@ -28,7 +29,13 @@ from kicktimes.diagnostics.autocorrelation import (
 #: The default decorrelation threshold 1/e (an exponential decay's time constant).
 INV_E = math.exp(-1.0)
 
-__all__ = ["autocorrelation_function", "decorrelation_lag", "integrated_autocorrelation_time"]
+__all__ = [
+    "AcfCurve",
+    "acf_curve",
+    "autocorrelation_function",
+    "decorrelation_lag",
+    "integrated_autocorrelation_time",
+]
 
 
 def _check_max_lag(max_lag) -> int:
@@ -141,6 +148,57 @@ def _curve(x: np.ndarray, max_lag: int, rtol: float = _RTOL, atol: float = _ATOL
     code = np.empty(max_lag, np.int8)
     _acf_curve(x, max_lag, rtol, atol, out, code)
     return out, code
+
+
+class AcfCurve(NamedTuple):
+    """The autocorrelation curve of one series and why any of it is undefined.
+
+    Attributes
+    ----------
+    acf : ndarray, shape (max_lag,)
+        ``R_1 .. R_max_lag``, bitwise `autocorrelation_function`'s values.
+    lag_reasons : tuple of (str or None)
+        Per lag, why ``R_l`` is NaN (None where it is defined); the text of
+        ``autocorrelation(series, l, return_reason=True)``.
+    reason : str or None
+        Why some of the curve is NaN (None when every lag is defined).
+    """
+
+    acf: np.ndarray
+    lag_reasons: tuple
+    reason: str | None
+
+
+def acf_curve(series, max_lag=20, *, name="series") -> AcfCurve:
+    """``R_1 .. R_max_lag`` of one series in one pass, with the reasons of its NaN values.
+
+    The same numbers as `autocorrelation_function` (and, lag by lag, as
+    :func:`~kicktimes.diagnostics.autocorrelation`), without warnings: the reasons come
+    back with the values, for callers that store them beside the numbers (the sweep's
+    rows).
+
+    Parameters
+    ----------
+    series : array_like, shape (N,)
+        Finite values.
+    max_lag : int
+        The last lag, ``>= 1``.
+    name : str
+        The argument's name in error messages.
+
+    Examples
+    --------
+    >>> curve = acf_curve([1.0, 2.0, 1.0, 2.0], 4)
+    >>> curve.acf[:2].round(3).tolist(), curve.lag_reasons[3] is not None
+    ([-0.75, 0.5], True)
+    """
+    from kicktimes.diagnostics.autocorrelation import _as_series, _reason_text
+
+    x = _as_series(series, name)
+    acf, code = _curve(x, _check_max_lag(max_lag))
+    reasons = tuple(_reason_text(int(c), x.size, k + 1) if c else None
+                    for k, c in enumerate(code.tolist()))
+    return AcfCurve(acf, reasons, _curve_reason(code, x.size, acf.size))
 
 
 def _curve_reason(code: np.ndarray, n: int, max_lag: int) -> str | None:

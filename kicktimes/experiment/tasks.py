@@ -36,9 +36,11 @@ __all__ = [
     "Task",
     "TaskOutput",
     "execute_task",
+    "kick_law",
     "kick_rng",
     "make_tasks",
     "run_task",
+    "uniform_samples",
 ]
 
 RESULT_COLUMNS = ("radius", "ic", "system", "diagnostic", "value", "note")
@@ -238,14 +240,14 @@ def _run_ic(exp: Experiment, r: float, ic_index: int, ic: np.ndarray, rows, coll
             points = run.samples
             if exp.rr_sampling == "uniform":
                 with timer("recurrence_resampling"):
-                    points = _uniform_samples(exp, system, ic, r, run)
+                    points = uniform_samples(exp, system, ic, r, run)
             with timer("recurrence_rate"):
                 for diagnostic, value, note in recurrence_rows(points, exp.eps):
                     add(system, diagnostic, value, note)
             if exp.rr_sampling == "run+uniform":
                 # the uniform-sampling control: the same trajectory sampled at k tau
                 with timer("recurrence_resampling"):
-                    points = _uniform_samples(exp, system, ic, r, run)
+                    points = uniform_samples(exp, system, ic, r, run)
                 with timer("recurrence_rate"):
                     for diagnostic, value, note in recurrence_rows(points, exp.eps):
                         if "@" in diagnostic:
@@ -302,7 +304,7 @@ def _run_ic(exp: Experiment, r: float, ic_index: int, ic: np.ndarray, rows, coll
     for system in ("poisson", "actual", "poisson_scatter", "actual_scatter"):
         if system not in exp.systems:
             continue
-        kick = _kick_law(exp, system, ic)
+        kick = kick_law(exp, system, ic)
         rng = kick_rng(exp.seed, ic_index, r, system)
         if system.startswith("actual"):
             if actual_times is None:
@@ -341,7 +343,7 @@ def _run_ic(exp: Experiment, r: float, ic_index: int, ic: np.ndarray, rows, coll
         diagnose(system, one, ftle)
 
 
-def _kick_law(exp: Experiment, system: str, ic: np.ndarray) -> dict:
+def kick_law(exp: Experiment, system: str, ic: np.ndarray) -> dict:
     """Keyword arguments of the kicks of a one-particle ``system``.
 
     The paper's systems use ``exp.kick_angle``; the ``*_scatter`` systems collide with a
@@ -410,26 +412,21 @@ def autocorrelation_rows(theta: np.ndarray, lag: int, max_lag: int) -> list[tupl
     ``R_l <= 0`` up to ``max_lag``). NaN values carry the reason.
     """
     from kicktimes.diagnostics import (
+        acf_curve,
         autocorrelation,
         decorrelation_lag,
         integrated_autocorrelation_time,
     )
-    from kicktimes.diagnostics.autocorrelation import _as_series, _reason_text
-    from kicktimes.diagnostics.decorrelation import _check_max_lag, _curve, _curve_reason
 
-    theta = _as_series(theta, "theta")
-    n = theta.size
     # one curve: R_lag is its entry lag - 1, bitwise autocorrelation(theta, lag)
-    acf, code = _curve(theta, _check_max_lag(max_lag))
+    acf, lag_reasons, curve_reason = acf_curve(theta, max_lag, name="theta")
     if 1 <= lag <= max_lag:
-        value = float(acf[lag - 1])
-        reason = _reason_text(int(code[lag - 1]), n, lag) if code[lag - 1] else None
+        value, reason = float(acf[lag - 1]), lag_reasons[lag - 1]
     else:
         value, reason = autocorrelation(theta, lag, return_reason=True)
     rows = [("autocorrelation", value, reason or "")]
-    reason = _curve_reason(code, n, max_lag)
     for k, value in enumerate(acf.tolist()):
-        rows.append((f"acf@{k + 1}", value, (reason or "") if math.isnan(value) else ""))
+        rows.append((f"acf@{k + 1}", value, (curve_reason or "") if math.isnan(value) else ""))
     value, reason = decorrelation_lag(acf, return_reason=True)
     rows.append(("decorrelation_lag", value, reason or ""))
     value, reason = integrated_autocorrelation_time(acf, return_reason=True)
@@ -437,7 +434,7 @@ def autocorrelation_rows(theta: np.ndarray, lag: int, max_lag: int) -> list[tupl
     return rows
 
 
-def _uniform_samples(exp: Experiment, system: str, ic: np.ndarray, r: float, run) -> np.ndarray:
+def uniform_samples(exp: Experiment, system: str, ic: np.ndarray, r: float, run) -> np.ndarray:
     """Samples at ``k tau``, ``k = 0..floor(t_max / tau)``, of the trajectory of ``run``.
 
     The same trajectory (same IC and, for a kicked system, the very kick times and angles
@@ -465,7 +462,7 @@ def _uniform_samples(exp: Experiment, system: str, ic: np.ndarray, r: float, run
             kicks=run.kick_times,
             kick_angles=run.kick_angles,
             sampling="uniform",
-            **_kick_law(exp, system, ic),
+            **kick_law(exp, system, ic),
         )
     return again.samples
 

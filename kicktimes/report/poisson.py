@@ -26,7 +26,7 @@ from kicktimes.report._figures import (
     radius_axis,
 )
 from kicktimes.report.effects import SHARE_RULE, Effect, share_verdict
-from kicktimes.stats.poisson import _NULL
+from kicktimes.stats.poisson import TEST_NULLS
 
 __all__ = [
     "binomial_ci",
@@ -334,7 +334,7 @@ def sections(ctx):
         f"Share of ICs whose disk-disk collision times reject a homogeneous Poisson process at "
         f"α = {alpha:g}, one panel per test, per radius, with 95% Clopper-Pearson intervals. Each "
         "test conditions on the IC's own number of collisions; nulls: "
-        + "; ".join(f"{t} {_NULL[t]}" for t in rejections["test"].unique() if t in _NULL)
+        + "; ".join(f"{t} {TEST_NULLS[t]}" for t in rejections["test"].unique() if t in TEST_NULLS)
         + f" (Monte Carlo with n_mc = {n_mc}).",
     )
     lines = []

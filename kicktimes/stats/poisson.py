@@ -36,7 +36,8 @@ TESTS = (
     "runs",
     "dispersion",
 )
-_NULL = {
+#: how each test's null distribution is computed (the report's captions say it)
+TEST_NULLS = {
     "uniformity_ks": "exact KS (given n)",
     "laplace_trend": "asymptotic normal",
     "exponential_ks": "Monte Carlo (given n)",
@@ -515,7 +516,7 @@ def test_poisson(times, t_window, *, n_mc=999, lags=None, n_bins=None, randomize
         {
             "statistic": stat[0],
             "pvalue": pval[0],
-            "null": [_NULL[name] for name in TESTS],
+            "null": [TEST_NULLS[name] for name in TESTS],
             "note": [notes[0].get(name, "") for name in TESTS],
         },
         index=pd.Index(TESTS, name="test"),
