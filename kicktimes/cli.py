@@ -153,7 +153,7 @@ def simulate_command(radii, n_ics, t_max, seed, rule, ic_method, out, save_runs)
     from tqdm.auto import tqdm
 
     from kicktimes import initial_conditions, simulate_two_particle
-    from kicktimes.experiment.store import _atomic_write
+    from kicktimes.fileio import atomic_write
     from kicktimes.stats import kinetic_rate
 
     # the options are range-checked by click; this maps anything the library still
@@ -200,7 +200,7 @@ def simulate_command(radii, n_ics, t_max, seed, rule, ic_method, out, save_runs)
     table = table.replace_schema_metadata({b"kicktimes": json.dumps(meta).encode()})
     path = os.path.join(out, "collisions.parquet")
     with _cli_errors():
-        _atomic_write(path, lambda tmp: pq.write_table(table, tmp))
+        atomic_write(path, lambda tmp: pq.write_table(table, tmp))
     df = pd.DataFrame({"radius": table["radius"].to_numpy(), "n_pp": table["n_pp"].to_numpy()})
     summary = df.groupby("radius").n_pp.agg(["mean", "std", "count"])
     summary["sem"] = summary["std"] / np.sqrt(summary["count"])
@@ -361,17 +361,9 @@ def _run_one(experiment, out, workers, scheduler, progress, wait=False, executor
 def _pending(experiment, store_path) -> bool:
     """True unless ``store_path`` already holds every task of ``experiment`` (by its
     manifest; the run itself verifies the parts)."""
-    import json
-    import os
+    from kicktimes.experiment.store import pending_tasks
 
-    try:
-        with open(os.path.join(store_path, "manifest.json"), encoding="utf-8") as fh:
-            manifest = json.load(fh)
-        done = set(manifest["tasks"])
-        same = manifest["experiment_hash"] == experiment.hash()
-    except (OSError, ValueError, KeyError, TypeError):
-        return True
-    return not same or any(t.id not in done for t in experiment.tasks())
+    return bool(pending_tasks(experiment, store_path))
 
 
 def _compile_first(workers, kernels=None, *, report=False, report_process=False):

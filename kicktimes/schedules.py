@@ -42,7 +42,6 @@ import json
 import math
 import numbers
 import os
-import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -1064,34 +1063,26 @@ def write_kick_times(times, path, *, t_max=None, schedule=None, seed=None, metad
     except (TypeError, ValueError) as exc:
         raise ValueError(f"metadata must be JSON-serialisable without NaN/inf: {exc}") from None
 
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    tmp_meta = None
-    try:
-        if suffix == ".csv":
-            with os.fdopen(fd, "w", newline="") as fh:
+    from kicktimes.fileio import atomic_write
+
+    if suffix == ".csv":
+
+        def write_csv(tmp):
+            with open(tmp, "w", newline="") as fh:
                 fh.write("kick_time\n")
                 # repr is the shortest string that parses back to the same double
                 fh.writelines(f"{x!r}\n" for x in arr.tolist())
-            fd_meta, tmp_meta = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.",
-                                                 suffix=".json.tmp")
-            with os.fdopen(fd_meta, "w") as fh:
-                fh.write(meta_json + "\n")
-            # sidecar first: a reader that sees the new CSV also sees its metadata
-            os.replace(tmp_meta, _sidecar(path))
-        else:
-            os.close(fd)
-            import pyarrow as pa
-            import pyarrow.parquet as pq
 
-            table = pa.table({"kick_time": pa.array(arr, type=pa.float64())})
-            table = table.replace_schema_metadata({"kicktimes": meta_json})
-            pq.write_table(table, tmp)
-        os.replace(tmp, path)
-    except BaseException:
-        for name in (tmp, tmp_meta):
-            if name is not None and os.path.exists(name):
-                os.unlink(name)
-        raise
+        # sidecar first: a reader that sees the new CSV also sees its metadata
+        atomic_write(_sidecar(path), lambda tmp: Path(tmp).write_text(meta_json + "\n"))
+        atomic_write(path, write_csv)
+    else:
+        import pyarrow as pa
+        import pyarrow.parquet as pq
+
+        table = pa.table({"kick_time": pa.array(arr, type=pa.float64())})
+        table = table.replace_schema_metadata({"kicktimes": meta_json})
+        atomic_write(path, lambda tmp: pq.write_table(table, tmp))
     return path
 
 

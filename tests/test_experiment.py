@@ -987,3 +987,21 @@ def test_the_uniform_control_rows_are_those_of_a_uniform_rr_sampling_run():
 def test_a_name_with_a_trailing_newline_is_refused():
     with pytest.raises(ValueError, match="name"):
         dataclasses.replace(TINY, name="abc\n")
+
+
+def test_the_store_seams_read_the_manifest_and_the_pending_tasks(reference, tmp_path):
+    from kicktimes.experiment import pending_tasks, read_manifest
+
+    manifest = read_manifest(reference.path)
+    assert manifest["experiment_hash"] == TINY.hash() and len(manifest["tasks"]) == len(
+        TINY.tasks())
+    assert pending_tasks(TINY, reference.path) == []
+    assert pending_tasks(TINY, tmp_path / "nothing") == TINY.tasks()
+    other = dataclasses.replace(TINY, seed=99)
+    assert pending_tasks(other, reference.path) == other.tasks()
+    with pytest.raises(ValueError, match="is not a kicktimes store"):
+        read_manifest(tmp_path)
+    few = load_store(reference.path, result_columns=["radius", "ic", "system", "value"],
+                     categories=("system",))
+    assert list(few.results.columns) == ["radius", "ic", "system", "value"]
+    assert few.results["system"].dtype == "category"

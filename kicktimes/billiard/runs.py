@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import json
 import os
-import tempfile
 from dataclasses import dataclass, field, fields
 from functools import cached_property
 from typing import ClassVar, NamedTuple
@@ -23,6 +22,7 @@ import numpy as np
 import pandas as pd
 
 from kicktimes import __version__
+from kicktimes.fileio import atomic_write
 
 TWO_PI = 2.0 * np.pi
 
@@ -117,7 +117,7 @@ class _Run:
         }
         meta = {b"kicktimes": json.dumps(self.meta).encode()}
         table = pa.table(columns).replace_schema_metadata(meta)
-        _atomic_write(path, lambda tmp: pq.write_table(table, tmp))
+        atomic_write(path, lambda tmp: pq.write_table(table, tmp))
 
     def __repr__(self) -> str:
         params = ", ".join(f"{k}={v!r}" for k, v in self.meta.items() if k != "kind")
@@ -311,19 +311,3 @@ def read_run(path: str | os.PathLike) -> TwoParticleRun | OneParticleRun:
         kwargs["kick_angles"] = kwargs["kick_angles"].reshape(-1, 2)
     known = {f.name for f in fields(cls)}
     return cls(**{k: v for k, v in kwargs.items() if k in known})
-
-
-def _atomic_write(path: str | os.PathLike, write) -> None:
-    """Call ``write(tmp_path)`` then move the file into place; never leave a partial file."""
-    path = os.fspath(path)
-    folder = os.path.dirname(os.path.abspath(path))
-    os.makedirs(folder, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=folder, prefix=".tmp-", suffix=".parquet")
-    os.close(fd)
-    try:
-        write(tmp)
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.remove(tmp)
-        raise

@@ -21,7 +21,14 @@ Examples
 from kicktimes.experiment.config import DIAGNOSTICS, SYSTEMS, Experiment
 from kicktimes.experiment.presets import PRESETS, preset
 from kicktimes.experiment.runner import run_experiment
-from kicktimes.experiment.store import Store, StoreLockedError, StoreWarning, load_store
+from kicktimes.experiment.store import (
+    Store,
+    StoreLockedError,
+    StoreWarning,
+    load_store,
+    pending_tasks,
+    read_manifest,
+)
 from kicktimes.experiment.tasks import (
     COLLISION_COLUMNS,
     RESULT_COLUMNS,
@@ -48,6 +55,8 @@ __all__ = [
     "execute_task",
     "kick_rng",
     "load_store",
+    "pending_tasks",
+    "read_manifest",
     "make_tasks",
     "preset",
     "run_experiment",

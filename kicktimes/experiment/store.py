@@ -25,11 +25,9 @@ from __future__ import annotations
 
 import datetime as _dt
 import errno
-import hashlib
 import json
 import os
 import socket
-import tempfile
 import time
 import warnings
 from dataclasses import dataclass
@@ -40,14 +38,21 @@ import pandas as pd
 from kicktimes import __version__
 from kicktimes.experiment.config import Experiment
 from kicktimes.experiment.tasks import COLLISION_COLUMNS, RESULT_COLUMNS, Task, TaskOutput
+from kicktimes.fileio import TMP_PREFIX, atomic_write, file_sha256
 
-__all__ = ["Store", "StoreLockedError", "StoreWarning", "load_store"]
+__all__ = [
+    "Store",
+    "StoreLockedError",
+    "StoreWarning",
+    "load_store",
+    "pending_tasks",
+    "read_manifest",
+]
 
 MANIFEST = "manifest.json"
 LOCK = ".lock"
 LAYOUT_VERSION = 1
 PARTS = ("results", "collisions")
-_TMP_PREFIX = ".tmp-"
 _META_KEY = b"kicktimes"
 # errors that mean "this store cannot be written here" rather than a bug
 _READ_ONLY_ERRNOS = {errno.EACCES, errno.EPERM, errno.EROFS}
@@ -63,51 +68,6 @@ class StoreLockedError(RuntimeError):
 
 def _now() -> str:
     return _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")
-
-
-def _sha256(path: str | os.PathLike) -> str:
-    h = hashlib.sha256()
-    with open(path, "rb") as fh:
-        for chunk in iter(lambda: fh.read(1 << 20), b""):
-            h.update(chunk)
-    return h.hexdigest()
-
-
-def _umask() -> int:
-    """The process umask, read without changing it where the OS allows (Linux)."""
-    try:
-        with open("/proc/self/status", encoding="ascii") as fh:
-            for line in fh:
-                if line.startswith("Umask:"):
-                    return int(line.split()[1], 8)
-    except (OSError, ValueError):
-        pass
-    # os.umask can only be read by setting it; put it straight back
-    mask = os.umask(0o022)
-    os.umask(mask)
-    return mask
-
-
-def _atomic_write(path: Path, write) -> None:
-    """``write(tmp)`` into a temp file beside ``path``, fsync, then ``os.replace``.
-
-    ``mkstemp`` creates the file 0600; it is given ``0666 & ~umask`` before the move,
-    the mode ``open(path, "w")`` would have produced.
-    """
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=_TMP_PREFIX, suffix=path.suffix)
-    os.close(fd)
-    try:
-        write(tmp)
-        with open(tmp, "rb+") as fh:
-            os.fsync(fh.fileno())
-            os.chmod(tmp, 0o666 & ~_umask())
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.remove(tmp)
-        raise
 
 
 def _schemas():
@@ -244,7 +204,7 @@ def _release_lock(fd: int | None) -> None:
 
 def _only_leftovers(root: Path) -> bool:
     """True if the folder holds nothing but a lock and temporary files (an aborted start)."""
-    return all(p.name == LOCK or p.name.startswith(_TMP_PREFIX) for p in root.iterdir())
+    return all(p.name == LOCK or p.name.startswith(TMP_PREFIX) for p in root.iterdir())
 
 
 class StoreWriter:
@@ -347,7 +307,7 @@ class StoreWriter:
         for folder in (self.root, *(self.root / p for p in PARTS)):
             if not folder.is_dir():
                 continue
-            for tmp in folder.glob(f"{_TMP_PREFIX}*"):
+            for tmp in folder.glob(f"{TMP_PREFIX}*"):
                 # we hold the lock, so no other writer owns this file: it is a leftover
                 self._need_write(f"remove the leftover temporary file {tmp.name}")
                 self._report(f"removing leftover temporary file {tmp.name} of an interrupted run")
@@ -431,10 +391,10 @@ class StoreWriter:
             schema = schemas[part].with_metadata(meta)
             table = pa.Table.from_pandas(df, schema=schema, preserve_index=False)
             path = _part_path(self.root, part, task.id)
-            _atomic_write(path, lambda tmp, table=table: pq.write_table(table, tmp))
+            atomic_write(path, lambda tmp, table=table: pq.write_table(table, tmp))
             prefix = "" if part == "results" else "collisions_"
             entry[f"{prefix}file"] = f"{part}/{path.name}"
-            entry[f"{prefix}sha256"] = _sha256(path)
+            entry[f"{prefix}sha256"] = file_sha256(path)
             entry[f"{prefix}rows"] = table.num_rows
         entry["timings"] = {k: round(v, 6) for k, v in output.timings.items()}
         entry["finished"] = _now()
@@ -450,7 +410,7 @@ class StoreWriter:
             with open(tmp, "w", encoding="utf-8") as fh:
                 fh.write(text)
 
-        _atomic_write(self.root / MANIFEST, write)
+        atomic_write(self.root / MANIFEST, write)
 
 
 _MANIFEST_TYPES = {
@@ -521,7 +481,7 @@ def _check_entry(root: Path, task_id: str, entry, exp_hash: str) -> str | None:
             return f"part {rel} is a symbolic link; a store's parts must be regular files"
         if not path.is_file():
             return f"part {rel} is missing"
-        if _sha256(path) != sha:
+        if file_sha256(path) != sha:
             return f"part {rel} is damaged (SHA-256 does not match the manifest)"
         try:
             meta = _read_part_meta(path)
@@ -589,7 +549,39 @@ class Store:
         )
 
 
-def load_store(path: str | os.PathLike, *, verify: bool = True) -> Store:
+def read_manifest(path: str | os.PathLike) -> dict:
+    """A store's manifest, checked (layout, structure), without reading any part file.
+
+    Raises
+    ------
+    ValueError
+        ``path`` is not a store, or its manifest is unreadable or malformed.
+    """
+    root = Path(path)
+    if not (root / MANIFEST).is_file():
+        raise ValueError(f"path: {os.fspath(root)!r} is not a kicktimes store (no {MANIFEST})")
+    return _read_manifest(root)
+
+
+def pending_tasks(experiment: Experiment, path: str | os.PathLike) -> list[Task]:
+    """The tasks of ``experiment`` that the store at ``path`` does not list as finished.
+
+    Every task when ``path`` holds no store, an unreadable one, or one of another
+    experiment (a run would refuse or recompute it). Reads the manifest only: the run
+    itself verifies the parts.
+    """
+    try:
+        manifest = read_manifest(path)
+    except ValueError:
+        return list(experiment.tasks())
+    if manifest.get("experiment_hash") != experiment.hash():
+        return list(experiment.tasks())
+    done = set(manifest.get("tasks") or {})
+    return [t for t in experiment.tasks() if t.id not in done]
+
+
+def load_store(path: str | os.PathLike, *, verify: bool = True, result_columns=None,
+               categories=()) -> Store:
     """Load a result store written by `run_experiment`.
 
     Parameters
@@ -598,6 +590,11 @@ def load_store(path: str | os.PathLike, *, verify: bool = True) -> Store:
         The store directory.
     verify : bool, default True
         Check every listed part's SHA-256 and metadata before reading.
+    result_columns : sequence of str, optional
+        Read only these columns of the results (all by default).
+    categories : sequence of str
+        String columns of the results to read as categoricals with sorted categories (as
+        ``astype("category")`` would give, without materialising the strings).
 
     Returns
     -------
@@ -611,7 +608,7 @@ def load_store(path: str | os.PathLike, *, verify: bool = True) -> Store:
         Not a store, unreadable manifest, or a damaged, missing or foreign part file (the
         message names it; rerunning the experiment on the store recomputes it).
     """
-    return _load(path, verify=verify)
+    return _load(path, verify=verify, result_columns=result_columns, categories=categories)
 
 
 def _load(path, *, verify=True, result_columns=None, categories=()) -> Store:
@@ -625,9 +622,7 @@ def _load(path, *, verify=True, result_columns=None, categories=()) -> Store:
     import pyarrow.parquet as pq
 
     root = Path(path)
-    if not (root / MANIFEST).is_file():
-        raise ValueError(f"path: {os.fspath(root)!r} is not a kicktimes store (no {MANIFEST})")
-    manifest = _read_manifest(root)
+    manifest = read_manifest(root)
     try:
         experiment = Experiment.from_record(manifest["experiment"])
     except (TypeError, ValueError, KeyError, IndexError, AttributeError) as exc:

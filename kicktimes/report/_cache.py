@@ -24,6 +24,7 @@ import os
 from pathlib import Path
 
 from kicktimes import __version__
+from kicktimes.fileio import atomic_write_bytes, file_sha256
 
 #: name of the cache manifest in the report folder
 CACHE_FILE = ".cache.json"
@@ -36,28 +37,16 @@ def sha256_bytes(data: bytes) -> str:
 
 
 def _sha256_file(path: Path) -> str | None:
-    h = hashlib.sha256()
+    """The file's SHA-256, or None when it cannot be read."""
     try:
-        with open(path, "rb") as fh:
-            for block in iter(lambda: fh.read(1 << 20), b""):
-                h.update(block)
+        return file_sha256(path)
     except OSError:
         return None
-    return h.hexdigest()
 
 
 def atomic_write(path: Path, data: bytes) -> str:
-    """Write ``data`` to ``path`` through a temporary file and a rename; its SHA-256."""
-    path = Path(path)
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    try:
-        with open(tmp, "wb") as fh:
-            fh.write(data)
-        os.replace(tmp, path)
-    except BaseException:
-        tmp.unlink(missing_ok=True)
-        raise
-    return sha256_bytes(data)
+    """Write ``data`` to ``path`` whole or not at all (`kicktimes.fileio`); its SHA-256."""
+    return atomic_write_bytes(path, data)
 
 
 def content_key(*parts) -> str:

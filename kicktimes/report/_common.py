@@ -300,10 +300,10 @@ def load_report_store(path):
     frames (a test compares them); the paper's stores load 1.32x faster
     (``python benchmarks/bench_report.py --load-only --stores ...``).
     """
-    from kicktimes.experiment.store import _load
+    from kicktimes.experiment import load_store
 
     columns = ["radius", "ic", "system", "diagnostic", "value"]
-    return _load(path, result_columns=columns, categories=("system", "diagnostic"))
+    return load_store(path, result_columns=columns, categories=("system", "diagnostic"))
 
 
 def distinct(frame, column):

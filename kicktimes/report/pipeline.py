@@ -173,16 +173,6 @@ def _inner_workers(workers, manifests):
     return workers
 
 
-def _read_manifest(path):
-    """A store's manifest (cheap: no part file is read); ValueError if not a store."""
-    from kicktimes.experiment.store import MANIFEST, _read_manifest
-
-    root = Path(path)
-    if not (root / MANIFEST).is_file():
-        raise ValueError(f"path: {os.fspath(root)!r} is not a kicktimes store (no {MANIFEST})")
-    return _read_manifest(root)
-
-
 def _sweep_seconds(manifest):
     """Per-stage sweep seconds summed over the finished tasks (as ``Store.timings``)."""
     import pandas as pd
@@ -407,7 +397,9 @@ def build_report(
         )
 
     t_start = time.perf_counter()
-    manifests = [_read_manifest(p) for p in paths]
+    from kicktimes.experiment.store import read_manifest
+
+    manifests = [read_manifest(p) for p in paths]
     for p, man in zip(paths, manifests, strict=True):
         if not man["tasks"]:
             raise ValueError(f"store_path: {os.fspath(p)!r} holds no finished task yet")
