@@ -659,4 +659,6 @@ def reproduce_command(scale, content, out, workers, scheduler, progress, wait, p
 # --- end experiment commands ---
 
 
-from kicktimes import _cli_analyze  # noqa: E402, F401  (registers "kicktimes analyze")
+from kicktimes._cli_analyze import analyze_command  # noqa: E402
+
+main.add_command(analyze_command)

@@ -260,7 +260,7 @@ class Experiment:
 
     def tasks(self):
         """All tasks of the sweep (radius-major, then IC block); see `kicktimes.experiment.Task`."""
-        from kicktimes.experiment.tasks import make_tasks
+        from kicktimes.experiment.plan import make_tasks
 
         return make_tasks(self)
 

@@ -29,6 +29,7 @@ import numpy as np
 import pandas as pd
 
 from kicktimes.experiment.config import Experiment
+from kicktimes.experiment.plan import Task, make_tasks
 
 __all__ = [
     "COLLISION_COLUMNS",
@@ -51,34 +52,6 @@ COLLISION_COLUMNS = ("radius", "ic", "t_window", "n_pp", "pp_times")
 KICK_DOMAIN = 0x6B69636B  # "kick"
 SYSTEM_CODES = {"two_particle": 0, "poisson": 1, "actual": 2, "poisson_scatter": 3,
                 "actual_scatter": 4}
-
-
-@dataclass(frozen=True)
-class Task:
-    """One unit of work: radius ``radii[radius_index]`` and ICs ``ic_start .. ic_stop - 1``."""
-
-    radius_index: int
-    radius: float
-    ic_start: int
-    ic_stop: int
-
-    @property
-    def id(self) -> str:
-        """Stable name, e.g. ``"r003-ic000050-000100"`` (used for part files)."""
-        return f"r{self.radius_index:03d}-ic{self.ic_start:06d}-{self.ic_stop:06d}"
-
-    @property
-    def n_ics(self) -> int:
-        return self.ic_stop - self.ic_start
-
-
-def make_tasks(experiment: Experiment) -> list[Task]:
-    """Every task of ``experiment``, radius-major then by IC block."""
-    out = []
-    for ri, r in enumerate(experiment.radii):
-        for start in range(0, experiment.n_ics, experiment.block_size):
-            out.append(Task(ri, r, start, min(start + experiment.block_size, experiment.n_ics)))
-    return out
 
 
 def _radius_key(radius: float) -> int:
