@@ -15,7 +15,6 @@ from kicktimes.report._figures import (
     SYSTEMS,
     TIME_UNIT,
 )
-from kicktimes.report._figures import check_alpha as _check_alpha
 from kicktimes.report.counts import counts_by_radius, counts_vs_radius
 from kicktimes.report.heterogeneity import rate_heterogeneity
 from kicktimes.report.kick_times import TimesFit, kick_times_vs_collision_times, kth_time_fit
@@ -45,5 +44,4 @@ __all__ = [
     "rate_heterogeneity",
     "recurrence_plot",
     "rejection_table",
-    "_check_alpha",
 ]

@@ -5,9 +5,9 @@ process places them as ``n`` IID uniform points, so every test below has an exac
 null given ``n`` (the tests are *conditional on n*):
 
 * on the scaled times ``u_i = t_i / T`` (uniform order statistics): conditional
-  uniformity (KS, exact null), Laplace's trend statistic (asymptotically normal),
-  the index of dispersion of counts in equal sub-windows (multinomial null by
-  Monte Carlo);
+  uniformity (KS, exact null: `kicktimes.stats.poisson.uniformity_ks`), Laplace's trend
+  statistic (asymptotically normal), the index of dispersion of counts in equal
+  sub-windows (multinomial null by Monte Carlo);
 * on the ``m = n - 1`` inner intervals ``t_{k+1} - t_k`` (the first time, a forward
   recurrence time, and the censored ``T - t_n`` are left out): the inner spacings of
   uniform order statistics are a Dirichlet vector, i.e. IID exponentials divided by
@@ -32,12 +32,6 @@ from scipy.special import gammaln
 
 # Largest block of random numbers simulated at once (memory bound for long sequences).
 _BLOCK = 2_000_000
-
-
-def uniformity_ks(u):
-    """KS distance of each row of sorted uniforms from U(0, 1) and its exact p-value."""
-    res = stats.ks_1samp(u, stats.uniform.cdf, axis=-1, method="exact")
-    return np.asarray(res.statistic, dtype=float), np.asarray(res.pvalue, dtype=float)
 
 
 def laplace_trend(u):
