@@ -179,9 +179,8 @@ def warm_sweep() -> None:
     rows, with the sweep's own argument types).
 
     The command line does it before it forks the local pool: the workers inherit the
-    loaded kernels instead of each loading them on its first task. The quick sweeps on 2
-    workers: 0.58 task seconds instead of 1.56, 1.99 CPU seconds instead of 2.64 with
-    this load included (``benchmarks/bench_startup.py``, section 1, same run).
+    loaded kernels instead of each loading them on its first task
+    (``benchmarks/bench_startup.py``, section 1; docs/benchmarks.md).
     """
     _warm_two(None)
     _warm_one(None)

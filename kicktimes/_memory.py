@@ -23,9 +23,8 @@ def keep_freed_memory() -> bool:
     with ``mmap`` and returns them to the system on ``free``, so the next call's arrays
     are new pages again, and each first touch of a page is a page fault (a costly exit on
     a virtual machine). Serving blocks below 32 MB from the heap and trimming it only
-    above 256 MB of free memory removes nearly all of them (648 000 -> 300 page faults on
-    24 family-A tasks) and makes family-A tasks 1.5x and family-B tasks 1.14x faster
-    (benchmarks/bench_memory.py, same run). A worker keeps at most that much freed
+    above 256 MB of free memory removes nearly all of them and makes the sweep's tasks
+    faster (benchmarks/bench_memory.py; docs/benchmarks.md). A worker keeps at most that much freed
     memory. Returns whether it applied (glibc only; elsewhere nothing changes).
     """
     if not sys.platform.startswith("linux"):
@@ -56,9 +55,8 @@ def fewer_collections():
     collections that found little: 1.7 of the quick report's 14 CPU seconds, 2.3 s of
     the paper report's. Collecting the youngest generation every 100 000 allocations and
     the middle one every 20 of those keeps the same collector, with every reference
-    cycle still freed, at a quarter of the cost: 0.45 s and 0.48 s, the quick report
-    1.09x less CPU time, the same files, no larger peak memory
-    (``benchmarks/bench_startup.py``, section 2, both ways in the same run). The previous
+    cycle still freed, at a fraction of the cost, with the same files and no larger peak
+    memory (``benchmarks/bench_startup.py``, section 2; docs/benchmarks.md). The previous
     thresholds are restored on exit (never lowered: the larger of each pair applies);
     processes forked inside the block inherit the setting.
     """

@@ -498,9 +498,8 @@ class _ReportProcess:
     (on a cold cache: compiles) the report's kernels while the driver checks the numba
     cache and runs the sweeps, on the core the driver's imports leave idle; the report
     starts at once when the sweeps end, and its workers, forked from this process,
-    inherit all of it. Forked before the driver starts any thread or pool. The quick
-    ``reproduce`` took 9.8 s against 10.9 s without it (means of 6 alternating runs on 2
-    cores, both with the report's pool rule of this release).
+    inherit all of it. Forked before the driver starts any thread or pool (measured:
+    docs/benchmarks.md, "Measurements behind design choices").
     """
 
     def __init__(self):

@@ -13,8 +13,9 @@ formula subtracts two nearly equal numbers and can return a spurious tiny root.
 Every division here has a divisor that cannot be zero (a speed tested non-zero, a root
 ``-b + sqrt(D)`` with ``b < 0``, the table radius), so these functions and the two-disk event
 loop are compiled with ``error_model="numpy"``: numba then drops the zero test it puts
-before each division under its default error model, which made the two-disk kernel 6%
-slower (benchmarks/bench_simulators.py --c-only). The results are the same to the bit.
+before each division under its default error model, which made the two-disk kernel
+slower (benchmarks/bench_simulators.py --c-only; docs/benchmarks.md). The results are
+the same to the bit.
 """
 
 from __future__ import annotations

@@ -62,8 +62,8 @@ class UndefinedDiagnosticWarning(RuntimeWarning):
 def _centred_sums(values, lo, hi, lag, mean, f):
     """(sum d_i^2, sum_{i < n-lag} d_i d_{i+lag}) with d_i = f x_i - mean, over [lo, hi).
 
-    Four independent accumulators: they break the add-latency chain (about 4x faster)
-    and, as a side effect, sum in a slightly more accurate blocked order.
+    Four independent accumulators: they break the add-latency chain and, as a side
+    effect, sum in a slightly more accurate blocked order.
     """
     d0 = d1 = d2 = d3 = 0.0
     c0 = c1 = c2 = c3 = 0.0
@@ -182,9 +182,8 @@ def _acf_curve(values, max_lag, rtol, atol, out, code):
     """R_1..R_max_lag of one series into ``out[0..max_lag-1]``, codes as `_acf_segments`.
 
     ``out[l - 1]`` is bitwise ``autocorrelation(values, l)``, i.e. what `_centred_sums`
-    gives at lag ``l`` (a property test), in about half the time of the previous kernel,
-    which ran those sums lag by lag (24 against 45 us at 20 lags and N of about 2400,
-    benchmarks/bench_autocorrelation.py):
+    gives at lag ``l`` (a property test), faster than running those sums lag by lag
+    (benchmarks/bench_autocorrelation.py; docs/benchmarks.md):
 
     * the centred, scaled values ``a_i = f x_i - mean`` are computed once, by the same
       expression, instead of twice per lag;
@@ -553,9 +552,8 @@ def _select_checked(time, sin_theta, particles, which, bound):
     """``(sin_theta of disk `which` in record order, ok)`` in one pass (``which < 0``:
     every row). ``ok`` is False when the chosen times are not non-decreasing (or NaN) or
     a value is not within ``[-bound, bound]`` (or not finite): the caller then takes the
-    general path. Replaces two boolean-mask gathers and four checks (12 against 39 us
-    for a 5000-row two-disk log; with the one-curve rows the sweep's autocorrelation stage
-    is 1.8x faster, benchmarks/bench_autocorrelation.py)."""
+    general path. Replaces two boolean-mask gathers and four checks
+    (benchmarks/bench_autocorrelation.py; docs/benchmarks.md)."""
     n = sin_theta.shape[0]
     out = np.empty(n)
     k = 0

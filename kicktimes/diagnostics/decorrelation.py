@@ -110,11 +110,10 @@ def autocorrelation_function(series, max_lag=20, *, rtol=_RTOL, atol=_ATOL, retu
     Notes
     -----
     The centred series once, then one pass per lag for the lagged products: O(N L) with
-    four independent accumulators (about 1 us per lag for N = 2400,
-    benchmarks/bench_autocorrelation.py). Each lag's sum of squares keeps the blocking of
-    `autocorrelation` (so the values are bitwise equal) but shares its blocks with the
-    other lags. The series is scaled by an exact power of two, so neither huge nor tiny
-    values overflow.
+    four independent accumulators (benchmarks/bench_autocorrelation.py). Each lag's sum of
+    squares keeps the blocking of `autocorrelation` (so the values are bitwise equal) but
+    shares its blocks with the other lags. The series is scaled by an exact power of two,
+    so neither huge nor tiny values overflow.
 
     Examples
     --------

@@ -344,9 +344,8 @@ def _pair_lines(k0, d2, p2, s2, ia, ib, pts, eps2s, count, diag):
 
 # Recurrent pairs are gathered over many points into a buffer until it holds this many
 # pairs, then accounted in one loop (`_account_pairs`): a loop per point over its two or
-# three pairs cost a mispredicted exit per point, the sweep's largest cost (with the
-# branch-free counts below, the build and sweep take 1/1.30-1/1.38 of the former per-point
-# kernels' time, benchmarks/bench_recurrence.py).
+# three pairs cost a mispredicted exit per point, the sweep's largest cost
+# (benchmarks/bench_recurrence.py; docs/benchmarks.md).
 _BATCH = 2048
 # Fields of the accumulator of the first (largest) threshold, see `_account_pairs`.
 _PAIRS, _STARTS2, _ON2, _SINGLE, _LONGEST = 0, 1, 2, 3, 4
@@ -586,7 +585,7 @@ def _sweep_lines(g, perm, cell_start, cell_key, ncx, w, pts, eps2s, count, diag,
     of the row above (``key + ncx + (-1, 0, 1)``, also adjacent when sorted). The
     candidates are compacted without a branch (``m += d2 <= eps2``): most candidates are
     not recurrent, and a data-dependent branch per candidate costs more than the test
-    (measured 1.2x on billiard samples, benchmarks/bench_recurrence.py). The recurrent
+    (benchmarks/bench_recurrence.py). The recurrent
     ones gather over many points into a buffer, accounted in one loop once it holds
     ``_BATCH`` pairs, so it needs room for ``_BATCH`` plus one point's candidates (five
     cells' worth: O(1) memory for bounded cell occupancy, and it stays in cache).
@@ -656,10 +655,9 @@ def _sweep_lines_dense(g, perm, skey, start, ncx, w, pts, eps2s, count, diag, wv
     The point at sorted position ``a`` (cell key ``k``) meets the later points of its cell
     and the next cell's, ``a + 1 .. start[k + 2]``, and the three cells of the row above,
     ``start[k + ncx - 1] .. start[k + ncx + 2]``: two contiguous ranges read off ``start``,
-    with no per-cell bookkeeping (about 10 % faster on billiard samples at eps = 1e-2,
-    benchmarks/bench_recurrence.py). The per-point body is written out as in
-    `_sweep_lines` on purpose: sharing it through an inlined helper made both sweeps about
-    20 % slower (measured against this version, alternating, same session).
+    with no per-cell bookkeeping (benchmarks/bench_recurrence.py). The per-point body is
+    written out as in `_sweep_lines` on purpose: sharing it through an inlined helper made
+    both sweeps slower (docs/benchmarks.md).
     """
     n = g.shape[0]
     eps2 = eps2s[0]

@@ -168,10 +168,10 @@ def rqa(points, eps=1e-3, *, theiler=1, l_min=2, laminarity=True):
     gather over many points in a buffer and are accounted in one loop; at the largest
     threshold with ``l_min <= 2`` the line counts are sums of those two tests, and a line
     is walked only when it can be longer than the longest so far. O(N) memory, never an
-    ``N x N`` matrix nor the pair list; 0.7-1.2x the time of `recurrence_rate` for
-    N = 25 000 (``laminarity=False``; at 1e-2 the cells are a dense grid, see
-    `kicktimes.diagnostics.recurrence`; benchmarks/bench_recurrence.py, which also times
-    the line kernels against the former per-point accounting: 1.30-1.38x). The
+    ``N x N`` matrix nor the pair list; about the time of `recurrence_rate`
+    (``laminarity=False``; at 1e-2 the cells are a dense grid, see
+    `kicktimes.diagnostics.recurrence`; benchmarks/bench_recurrence.py and
+    docs/benchmarks.md). The
     laminarity adds, per recurrent pair, the column tests of both its entries, read from
     the same time neighbours; for the matrix's diagonal (``theiler = 0``) one pass over
     the points.

@@ -297,8 +297,8 @@ def load_report_store(path):
     """``report_store(load_store(path))``, read straight into that form: the results
     without ``note``, ``system`` and ``diagnostic`` read from Parquet as dictionaries
     (categoricals, then their categories sorted), never as 2 million strings. The same
-    frames (a test compares them); the paper's stores load 1.32x faster
-    (``python benchmarks/bench_report.py --load-only --stores ...``).
+    frames (a test compares them), read faster
+    (``python benchmarks/bench_report.py --load-only --stores ...``; docs/benchmarks.md).
     """
     from kicktimes.experiment import load_store
 

@@ -57,7 +57,7 @@ def _png(fig, dpi):
     disabled that runs the constrained layout, then the real one); an Agg canvas draw runs
     the layout and renders in one pass, and `matplotlib.image.imsave` encodes the buffer
     exactly as ``savefig`` does (same metadata and compression), so the files are
-    byte-identical (tested) for about 20 % less time (benchmarks/bench_report.py).
+    byte-identical (tested) in less time (benchmarks/bench_report.py; docs/benchmarks.md).
     """
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.image import imsave

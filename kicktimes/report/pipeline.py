@@ -139,8 +139,8 @@ def _one_blas_thread():
     count, so their last bits depended on the machine: on the paper's stores, 3 of 67
     files (the pooled fits' log-likelihoods, AIC and weights, 1 ulp of two Findings CIs)
     differed between 2 threads and 1. On one thread the files do not depend on the core
-    count, at no measurable cost (CPU time 1.01x less on the quick and on the paper's
-    stores; ``benchmarks/bench_startup.py``, section 3). The limit applies to the BLAS
+    count, at no measurable cost (``benchmarks/bench_startup.py``, section 3;
+    docs/benchmarks.md). The limit applies to the BLAS
     libraries loaded when it is set, so the section modules (numpy's and scipy's BLAS)
     are imported first; the previous limits are restored on exit.
     """
@@ -159,10 +159,9 @@ def _inner_workers(workers, manifests):
     instead of idling. When the parts are about equal (within 2x) and at least as many as
     the workers, every core already has a part, and the pools would only add processes
     (16 for the quick report instead of 2), each fork of a part worker costing CPU
-    (copy-on-write of its heap): the quick report took 15.4 CPU-s and 9.7 s without them
-    against 17.2 CPU-s and 10.5 s with them (means of 4 alternating ``kicktimes report
-    --force`` builds on 2 cores; benchmarks/bench_report.py, section 4, alternates the two
-    rules in one process). The results do not depend on it.
+    (copy-on-write of its heap), which made the quick report slower
+    (benchmarks/bench_report.py, section 4; docs/benchmarks.md). The results do not
+    depend on it.
     """
     work = [
         len(m["experiment"]["radii"]) * m["experiment"]["n_ics"] * m["experiment"]["n_steps"]

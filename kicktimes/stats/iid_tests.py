@@ -75,8 +75,7 @@ def ljung_box(x, lags):
 
     One compiled pass per row (`_ljung_box_rows`), bitwise what the numpy expression
     ``(d[..., k:] * d[..., :-k]).sum(axis=-1)`` per lag gave (the same pairwise sums), and
-    1.2-1.6x faster than it on Monte Carlo nulls of 30-250 intervals
-    (``python benchmarks/bench_stats.py --part poisson``, last table).
+    faster (``python benchmarks/bench_stats.py --part poisson``; docs/benchmarks.md).
     """
     x = np.asarray(x, dtype=float)
     m = x.shape[-1]

@@ -147,8 +147,8 @@ def intervals_from_times(times, t_window, *, first="drop") -> Intervals:
 
 # ------------------------------------------------------------------ exact KS p-value
 # scipy's exact two-sided KS law (``kstwo.sf``, Simard & L'Ecuyer 2011) runs the Pomeranz
-# recursion in Python, ~2-3 ms per sequence: at paper scale (10^4 sequences) that was most
-# of the Poisson tests. The same recursion as a numba kernel; every other branch of the
+# recursion in Python, which at paper scale (10^4 sequences) was most of the Poisson tests
+# (docs/benchmarks.md). The same recursion as a numba kernel; every other branch of the
 # dispatch stays scipy's own. The sums of the convolutions run in index order (numpy's may
 # use a blocked dot), so p-values can differ from scipy's in the last bits only.
 
