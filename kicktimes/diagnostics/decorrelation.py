@@ -169,7 +169,7 @@ class AcfCurve(NamedTuple):
 
 
 def acf_curve(series, max_lag=20, *, name="series") -> AcfCurve:
-    """``R_1 .. R_max_lag`` of one series in one pass, with the reasons of its NaN values.
+    """The autocorrelations ``R_1`` to ``R_max_lag`` of one series in one pass, with reasons.
 
     The same numbers as `autocorrelation_function` (and, lag by lag, as
     :func:`~kicktimes.diagnostics.autocorrelation`), without warnings: the reasons come

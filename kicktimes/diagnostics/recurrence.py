@@ -919,7 +919,7 @@ def _recurrence_rate_one(pts: np.ndarray, eps: float, w: int) -> float:
 
 
 def recurrence_pairs(points, eps=1e-3, *, theiler=0):
-    r"""The recurrence plot as index pairs: every ``(i, j)`` with ``|x_i - x_j| <= eps``.
+    r"""The recurrence plot as index pairs: every ``(i, j)`` of samples within ``eps``.
 
     Returns the nonzero entries of the recurrence matrix
     ``R_ij = Theta(eps - |x_i - x_j|)`` (both orders, main diagonal included unless a
