@@ -52,7 +52,7 @@ def one_pass(n_ics, repeat):
     from kicktimes.billiard.one_particle import draw_kick_angles
     from kicktimes.diagnostics.lyapunov import lyapunov_pass
     from kicktimes.experiment import Task, execute_task, kick_rng, preset
-    from kicktimes.experiment.tasks import _actual_times, _kick_law
+    from kicktimes.experiment.tasks import _actual_times, kick_law
 
     exp = preset("family_b")
     r = 0.01
@@ -65,7 +65,7 @@ def one_pass(n_ics, repeat):
 
     def kicks(i, system, two, actual):
         rng = kick_rng(exp.seed, i, r, system)
-        kick = _kick_law(exp, system, ics[i])
+        kick = kick_law(exp, system, ics[i])
         if system.startswith("poisson"):
             times = schedules.Poisson(two.n_pp / two.t_max).sample(exp.horizon, rng)
         else:
