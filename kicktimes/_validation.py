@@ -50,3 +50,29 @@ def check_choice(name: str, value, choices) -> str:
     if not isinstance(value, str) or value not in choices:
         raise ValueError(f"{name} must be one of {sorted(choices)!r}, got {value!r}")
     return value
+
+
+def check_rng(rng, name: str = "rng") -> np.random.Generator:
+    """``numpy.random.default_rng(rng)`` for the inputs kicktimes accepts, else an error.
+
+    Accepted: None (fresh entropy), an integer seed >= 0 (not a bool), a
+    `numpy.random.Generator` (used as is), a `numpy.random.BitGenerator` or a
+    `numpy.random.SeedSequence`. TypeError for anything else, ValueError for a negative
+    seed; both name ``name``.
+
+    >>> bool(check_rng(3).integers(10) == check_rng(np.random.default_rng(3)).integers(10))
+    True
+    """
+    if isinstance(rng, bool | np.bool_) or not (
+        rng is None or isinstance(rng, Integral | np.integer | np.random.Generator
+                                  | np.random.BitGenerator | np.random.SeedSequence)
+    ):
+        raise TypeError(
+            f"{name} must be None, an int seed >= 0, a numpy Generator, BitGenerator or "
+            f"SeedSequence, got {type(rng).__name__}"
+        )
+    if isinstance(rng, Integral | np.integer):
+        if int(rng) < 0:
+            raise ValueError(f"{name} must be an int seed >= 0, got {int(rng)}")
+        rng = int(rng)
+    return np.random.default_rng(rng)

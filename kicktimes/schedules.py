@@ -47,6 +47,8 @@ from pathlib import Path
 
 import numpy as np
 
+from kicktimes._validation import check_rng
+
 __all__ = [
     "DEFAULT_MAX_KICKS",
     "Bootstrap",
@@ -99,21 +101,6 @@ def _check_bool(value, name):
     if not isinstance(value, (bool, np.bool_)):
         raise TypeError(f"{name} must be True or False, got {value!r}")
     return bool(value)
-
-
-def _check_rng(rng):
-    if rng is None or isinstance(
-        rng, (np.random.Generator, np.random.BitGenerator, np.random.SeedSequence)
-    ):
-        return np.random.default_rng(rng)
-    if isinstance(rng, numbers.Integral) and not isinstance(rng, (bool, np.bool_)):
-        if rng < 0:
-            raise ValueError(f"rng seed must be >= 0, got {rng}")
-        return np.random.default_rng(int(rng))
-    raise TypeError(
-        "rng must be a numpy.random.Generator, an int seed >= 0, a SeedSequence or None, "
-        f"got {rng!r} ({type(rng).__name__})"
-    )
 
 
 def _check_max_kicks(max_kicks):
@@ -554,7 +541,7 @@ class Poisson(Schedule):
         """Kick times of a Poisson process on ``(0, t_max]``, sorted float64."""
         t_max = _check_t_max(t_max)
         max_kicks = _check_max_kicks(max_kicks)
-        rng = _check_rng(rng)
+        rng = check_rng(rng)
         if self.rate == 0:
             return np.empty(0)
         rate = self.rate
@@ -648,7 +635,7 @@ class Renewal(Schedule):
         """Kick times of the renewal process on ``(0, t_max]``, sorted float64."""
         t_max = _check_t_max(t_max)
         max_kicks = _check_max_kicks(max_kicks)
-        rng = _check_rng(rng)
+        rng = check_rng(rng)
         draw = self._cached("draw", lambda: _interval_sampler(self.dist))
         first = None
         if self.stationary:
@@ -729,7 +716,7 @@ class Replay(Schedule):
         """The stored times in ``(0, t_max]`` (a copy); ``rng`` is validated and ignored."""
         t_max = _check_t_max(t_max)
         max_kicks = _check_max_kicks(max_kicks)
-        _check_rng(rng)
+        check_rng(rng)
         if self.t_max is not None and t_max > self.t_max:
             raise ValueError(
                 f"t_max={t_max!r} exceeds the replayed window (0, {float(self.t_max)!r}]; the "
@@ -829,7 +816,7 @@ class Bootstrap(Schedule):
         """Kick times with resampled intervals on ``(0, t_max]``, sorted float64."""
         t_max = _check_t_max(t_max)
         max_kicks = _check_max_kicks(max_kicks)
-        rng = _check_rng(rng)
+        rng = check_rng(rng)
         x = self.intervals
         first = None
         if self.stationary:

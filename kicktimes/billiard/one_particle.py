@@ -22,6 +22,7 @@ import math
 import numpy as np
 from numba import njit
 
+from kicktimes._validation import check_rng
 from kicktimes.billiard import _checks as chk
 from kicktimes.billiard.geometry import (
     GRAZE_THRESHOLD,
@@ -432,21 +433,6 @@ def draw_kick_angles(n: int, kick_angle: str, sigma: float, rng: np.random.Gener
     return rng.normal(0.0, sigma, size=n)
 
 
-def _check_rng(rng) -> np.random.Generator:
-    """``numpy.random.default_rng(rng)``, with a TypeError naming ``rng`` for bad input."""
-    if isinstance(rng, bool) or not (
-        rng is None or isinstance(rng, int | np.integer | np.random.Generator
-                                  | np.random.BitGenerator | np.random.SeedSequence)
-    ):
-        raise TypeError(
-            "rng must be None, an int seed >= 0, a numpy Generator, BitGenerator or SeedSequence, "
-            f"got {type(rng).__name__}"
-        )
-    if isinstance(rng, int | np.integer) and rng < 0:
-        raise ValueError(f"rng must be an int seed >= 0, got {int(rng)}")
-    return np.random.default_rng(rng)
-
-
 def _check_kick_angles(kick_angles, times: np.ndarray, kick_angle: str) -> np.ndarray:
     if isinstance(kick_angles, str | bytes):
         raise TypeError(f"kick_angles must be a sequence of angles, got the string {kick_angles!r}")
@@ -487,7 +473,7 @@ def resolve_kicks(kicks, kick_angles, *, kick_angle, sigma, rng, horizon, t_max)
     if kicks is None:
         times = np.empty(0)
     elif _is_schedule(kicks):
-        gen = _check_rng(rng)
+        gen = check_rng(rng)
         times = check_kick_times(kicks.sample(horizon, gen), horizon, name="kicks.sample()")
     else:
         times = check_kick_times(kicks, t_max)
@@ -495,7 +481,7 @@ def resolve_kicks(kicks, kick_angles, *, kick_angle, sigma, rng, horizon, t_max)
         if not times.size:
             empty = np.empty((0, 2)) if kick_angle == "scatter" else times.copy()
             return times, empty, gen
-        gen = gen if gen is not None else _check_rng(rng)
+        gen = gen if gen is not None else check_rng(rng)
         return times, draw_kick_angles(times.size, kick_angle, sigma, gen), gen
     return times, _check_kick_angles(kick_angles, times, kick_angle), gen
 

@@ -6,11 +6,9 @@ Every message names the argument, the offending value and the valid range
 
 from __future__ import annotations
 
-from numbers import Integral
-
 import numpy as np
 
-from kicktimes._validation import check_choice, check_int, check_real
+from kicktimes._validation import check_choice, check_int, check_real, check_rng
 
 __all__ = [
     "as_1d_float", "check_choice", "check_int", "check_intervals", "check_real", "check_rng",
@@ -82,14 +80,3 @@ def check_times(name: str, value, t_window: float) -> np.ndarray:
     return arr
 
 
-def check_rng(rng) -> np.random.Generator:
-    """A numpy Generator from a Generator, an integer seed, a SeedSequence or None."""
-    if rng is None or isinstance(rng, np.random.Generator | np.random.SeedSequence):
-        return np.random.default_rng(rng)
-    if isinstance(rng, Integral | np.integer) and not isinstance(rng, bool):
-        if int(rng) < 0:
-            raise ValueError(f"rng seed must be a non-negative integer, got {rng!r}")
-        return np.random.default_rng(int(rng))
-    raise TypeError(
-        f"rng must be None, an integer seed or a numpy.random.Generator, got {type(rng).__name__}"
-    )
