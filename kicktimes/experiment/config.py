@@ -18,11 +18,11 @@ from __future__ import annotations
 
 import hashlib
 import json
-import math
-import numbers
 import os
 import re
 from dataclasses import asdict, dataclass, field, fields
+
+from kicktimes._validation import check_choice, check_int, check_real
 
 __all__ = ["DEFAULT_SYSTEMS", "DIAGNOSTICS", "SYSTEMS", "Experiment"]
 
@@ -45,36 +45,8 @@ RR_SAMPLINGS = ("run", "uniform", "run+uniform")
 _LATER_FIELDS = {"acf_max_lag": 20, "rr_sampling": "run", "lyapunov_method": "twin"}
 
 _REQUIRED = ("name", "radii", "n_ics", "n_steps", "tau")
+
 _NAME_RE = re.compile(r"[A-Za-z0-9][A-Za-z0-9_.-]*")  # used with fullmatch: no trailing newline
-
-
-def _real(name, value, *, low=None, high=None, low_open=True, high_open=True):
-    if isinstance(value, bool) or not isinstance(value, numbers.Real):
-        raise TypeError(f"{name}: expected a real number, got {value!r}")
-    value = float(value)
-    if not math.isfinite(value):
-        raise ValueError(f"{name}: must be finite, got {value!r}")
-    if low is not None and (value <= low if low_open else value < low):
-        bound = f"> {low}" if low_open else f">= {low}"
-        raise ValueError(f"{name}: must be {bound}, got {value!r}")
-    if high is not None and (value >= high if high_open else value > high):
-        bound = f"< {high}" if high_open else f"<= {high}"
-        raise ValueError(f"{name}: must be {bound}, got {value!r}")
-    return value
-
-
-def _int(name, value, *, low):
-    if isinstance(value, bool) or not isinstance(value, numbers.Integral):
-        raise TypeError(f"{name}: expected an integer, got {value!r}")
-    if value < low:
-        raise ValueError(f"{name}: must be >= {low}, got {value!r}")
-    return int(value)
-
-
-def _choice(name, value, choices):
-    if not isinstance(value, str) or value not in choices:
-        raise ValueError(f"{name}: must be one of {', '.join(map(repr, choices))}; got {value!r}")
-    return value
 
 
 def _eps_tuple(value):
@@ -82,8 +54,8 @@ def _eps_tuple(value):
     if isinstance(value, (str, bytes)):
         raise TypeError(f"eps: expected a float or a list of floats, got {value!r}")
     if not hasattr(value, "__iter__"):
-        return (_real("eps", value, low=0.0),)
-    items = [_real(f"eps[{k}]", e, low=0.0) for k, e in enumerate(value)]
+        return (check_real("eps", value, low=0.0),)
+    items = [check_real(f"eps[{k}]", e, low=0.0) for k, e in enumerate(value)]
     if not items:
         raise ValueError("eps: must contain at least one recurrence threshold, got []")
     if len(set(items)) != len(items):
@@ -98,7 +70,7 @@ def _subset(name, value, choices):
     if not items:
         raise ValueError(f"{name}: must name at least one of {list(choices)}, got []")
     for item in items:
-        _choice(f"{name} entry", item, choices)
+        check_choice(f"{name} entry", item, choices)
     if len(set(items)) != len(items):
         raise ValueError(f"{name}: duplicate entries in {items}")
     # canonical order, so that the same set always hashes the same
@@ -219,31 +191,31 @@ class Experiment:
         radii = self.radii
         if isinstance(radii, (str, bytes)) or not hasattr(radii, "__iter__"):
             raise TypeError(f"radii: expected a list of radii, got {radii!r}")
-        radii = [_real(f"radii[{k}]", r, low=0.0, high=0.5) for k, r in enumerate(radii)]
+        radii = [check_real(f"radii[{k}]", r, low=0.0, high=0.5) for k, r in enumerate(radii)]
         if not radii:
             raise ValueError("radii: must contain at least one radius, got []")
         if len(set(radii)) != len(radii):
             raise ValueError(f"radii: must be distinct, got {radii}")
         put("radii", tuple(sorted(radii)))
-        put("n_ics", _int("n_ics", self.n_ics, low=1))
-        put("n_steps", _int("n_steps", self.n_steps, low=1))
-        put("tau", _real("tau", self.tau, low=0.0))
-        _choice("ic_method", self.ic_method, IC_METHODS)
-        put("seed", _int("seed", self.seed, low=0))
-        _choice("sampling", self.sampling, SAMPLINGS)
-        _choice("rule", self.rule, RULES)
+        put("n_ics", check_int("n_ics", self.n_ics, low=1))
+        put("n_steps", check_int("n_steps", self.n_steps, low=1))
+        put("tau", check_real("tau", self.tau, low=0.0))
+        check_choice("ic_method", self.ic_method, IC_METHODS)
+        put("seed", check_int("seed", self.seed, low=0))
+        check_choice("sampling", self.sampling, SAMPLINGS)
+        check_choice("rule", self.rule, RULES)
         put("eps", _eps_tuple(self.eps))
-        _choice("rr_sampling", self.rr_sampling, RR_SAMPLINGS)
-        put("lag", _int("lag", self.lag, low=1))
-        put("acf_max_lag", _int("acf_max_lag", self.acf_max_lag, low=1))
-        put("d0", _real("d0", self.d0, low=1e-10, high=1e-2, low_open=False, high_open=False))
-        _choice("lyapunov_variant", self.lyapunov_variant, LYAPUNOV_VARIANTS)
-        _choice("lyapunov_method", self.lyapunov_method, LYAPUNOV_METHODS)
-        _choice("kick_angle", self.kick_angle, KICK_ANGLES)
-        put("sigma", _real("sigma", self.sigma, low=0.0))
+        check_choice("rr_sampling", self.rr_sampling, RR_SAMPLINGS)
+        put("lag", check_int("lag", self.lag, low=1))
+        put("acf_max_lag", check_int("acf_max_lag", self.acf_max_lag, low=1))
+        put("d0", check_real("d0", self.d0, low=1e-10, high=1e-2, low_open=False, high_open=False))
+        check_choice("lyapunov_variant", self.lyapunov_variant, LYAPUNOV_VARIANTS)
+        check_choice("lyapunov_method", self.lyapunov_method, LYAPUNOV_METHODS)
+        check_choice("kick_angle", self.kick_angle, KICK_ANGLES)
+        put("sigma", check_real("sigma", self.sigma, low=0.0))
         put("systems", _subset("systems", self.systems, SYSTEMS))
         put("diagnostics", _subset("diagnostics", self.diagnostics, DIAGNOSTICS))
-        put("block_size", _int("block_size", self.block_size, low=1))
+        put("block_size", check_int("block_size", self.block_size, low=1))
         if not isinstance(self.description, str):
             raise TypeError(f"description: expected a string, got {self.description!r}")
 
