@@ -19,6 +19,7 @@ from hypothesis import strategies as hs
 from kicktimes import schedules
 from kicktimes.cli import main
 from kicktimes.schedules import Bootstrap, Poisson, Renewal, Replay
+from kicktimes.schedules._distributions import _equilibrium_sampler
 
 
 def run_like(pp_times, t_max):
@@ -163,7 +164,7 @@ def test_ordinary_renewal_first_interval_has_the_interval_mean():
 @pytest.mark.parametrize("method", ["auto", "pinv", "quad"])
 def test_equilibrium_sampler_follows_the_equilibrium_cdf(method):
     dist = st.gamma(2.0, scale=0.5)
-    draw = schedules._equilibrium_sampler(dist, 1.0, method=method)
+    draw = _equilibrium_sampler(dist, 1.0, method=method)
     rng = np.random.default_rng(4)
     n = 150 if method == "quad" else 5000
     sample = np.array([draw(rng) for _ in range(n)])
@@ -185,7 +186,7 @@ def test_equilibrium_sampler_follows_the_equilibrium_cdf(method):
     ids=["lomax", "expon", "weibull-c1", "pareto"],
 )
 def test_closed_form_equilibrium_laws(dist, equilibrium):
-    draw = schedules._equilibrium_sampler(dist, float(dist.mean()))
+    draw = _equilibrium_sampler(dist, float(dist.mean()))
     rng = np.random.default_rng(9)
     sample = np.array([draw(rng) for _ in range(4000)])
     assert st.kstest(sample, equilibrium.cdf).pvalue > 0.01
@@ -195,7 +196,7 @@ def test_hyperexponential_equilibrium_reweights_components_by_their_means():
     hyperexpon = pytest.importorskip("kicktimes.stats.distributions").hyperexpon
     dist = hyperexpon(0.4, 5.0, 0.5, scale=2.0)
     w = (0.4 / 5.0) / (0.4 / 5.0 + 0.6 / 0.5)  # p_i / lam_i, renormalised
-    draw = schedules._equilibrium_sampler(dist, float(dist.mean()))
+    draw = _equilibrium_sampler(dist, float(dist.mean()))
     rng = np.random.default_rng(9)
     sample = np.array([draw(rng) for _ in range(4000)])
     assert st.kstest(sample, hyperexpon(w, 5.0, 0.5, scale=2.0).cdf).pvalue > 0.01
@@ -205,8 +206,8 @@ def test_hyperexponential_equilibrium_reweights_components_by_their_means():
 def test_lognormal_equilibrium_matches_generic_inversion():
     dist = st.lognorm(0.8, scale=1.5)
     rng = np.random.default_rng(2)
-    closed = schedules._equilibrium_sampler(dist, float(dist.mean()))
-    pinv = schedules._equilibrium_sampler(dist, float(dist.mean()), method="pinv")
+    closed = _equilibrium_sampler(dist, float(dist.mean()))
+    pinv = _equilibrium_sampler(dist, float(dist.mean()), method="pinv")
     a = np.array([closed(rng) for _ in range(4000)])
     b = np.array([pinv(rng) for _ in range(4000)])
     assert st.ks_2samp(a, b).pvalue > 0.01
@@ -502,7 +503,7 @@ def test_failed_write_leaves_the_old_file_and_no_temp(tmp_path, suffix, monkeypa
     def broken_replace(src, dst):
         raise OSError("disk full")
 
-    monkeypatch.setattr(schedules.os, "replace", broken_replace)
+    monkeypatch.setattr(os, "replace", broken_replace)
     with pytest.raises(OSError, match="disk full"):
         schedules.write_kick_times([3.0, 4.0, 5.0], path)
     monkeypatch.undo()
