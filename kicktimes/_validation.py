@@ -17,8 +17,11 @@ def check_real(name: str, value, *, low=None, high=None, low_open=True, high_ope
     """A finite real number inside the given (open by default) interval."""
     # (exact float and int first: the ABC check costs more than the rest of a simulator call's
     # argument checks together)
+    if isinstance(value, np.ndarray) and value.ndim == 0 and value.dtype.kind in "iuf":
+        value = value.item()  # a 0-d numeric array is its number
     if not (type(value) is float or type(value) is int) and (
-            isinstance(value, bool) or not isinstance(value, Real | np.floating | np.integer)):
+            isinstance(value, bool | np.bool_)
+            or not isinstance(value, Real | np.floating | np.integer)):
         raise TypeError(f"{name} must be a real number, got {type(value).__name__}")
     x = float(value)
     if not math.isfinite(x):

@@ -636,7 +636,7 @@ def test_cli_renewal_bootstrap_replay_and_json(tmp_path):
 @pytest.mark.parametrize(
     "args, message",
     [
-        (["poisson", "-p", "rate=-1"], "rate must be finite and >= 0"),
+        (["poisson", "-p", "rate=-1"], "rate must lie in [0.0, inf)"),
         (["poisson", "-p", "rate"], "NAME=VALUE"),
         (["renewal", "-p", "a=2"], "needs dist"),
         (["renewal", "--dist", "norm"], "support"),

@@ -7,7 +7,7 @@ import math
 
 import numpy as np
 
-from kicktimes.schedules._validate import _real
+from kicktimes._validation import check_real
 
 
 # ------------------------------------------------------------------------ distributions
@@ -70,9 +70,8 @@ def _dist_params(dist):
     for label, v in zip([*names, "loc", "scale"], [*shapes, loc, scale], strict=True):
         if np.ndim(v) != 0:
             raise ValueError(f"dist parameter {label} must be a scalar, got {v!r}")
-        values.append(_real(v if not isinstance(v, np.ndarray) else v[()], f"dist {label}"))
-        if not math.isfinite(values[-1]):
-            raise ValueError(f"dist parameter {label} must be finite, got {float(values[-1])!r}")
+        values.append(check_real(f"dist parameter {label}",
+                                 v if not isinstance(v, np.ndarray) else v[()]))
     return dist.dist.name, tuple(zip(names, values[:-2], strict=True)), values[-2], values[-1]
 
 

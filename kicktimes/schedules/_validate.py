@@ -2,10 +2,9 @@
 
 from __future__ import annotations
 
-import math
-import numbers
-
 import numpy as np
+
+from kicktimes._validation import check_int, check_real
 
 DEFAULT_MAX_KICKS = 10**8
 _FORMAT_VERSION = 1
@@ -15,28 +14,13 @@ _TINY = float(np.nextafter(0.0, 1.0))  # "0+": a kick time that underflowed to 0
 
 
 # --------------------------------------------------------------------------- validation
-def _real(value, name):
-    if isinstance(value, (bool, np.bool_)) or not (
-        isinstance(value, numbers.Real) or (isinstance(value, np.ndarray) and value.ndim == 0)
-    ):
-        raise TypeError(f"{name} must be a real number, got {value!r} ({type(value).__name__})")
-    if isinstance(value, np.ndarray) and not np.issubdtype(value.dtype, np.number):
-        raise TypeError(f"{name} must be a real number, got {value!r}")
-    return float(value)
-
-
 def _check_t_max(t_max, name="t_max"):
-    value = _real(t_max, name)
-    if not (math.isfinite(value) and value > 0):
-        raise ValueError(f"{name} must be finite and > 0, got {value!r}")
-    return value
+    return check_real(name, t_max, low=0.0)
 
 
 def _check_rate(rate):
-    value = _real(rate, "rate")
-    if not (math.isfinite(value) and value >= 0):
-        raise ValueError(f"rate must be finite and >= 0 (0 means no kicks), got {value!r}")
-    return value
+    """A rate >= 0 (0 means no kicks)."""
+    return check_real("rate", rate, low=0.0, low_open=False)
 
 
 def _check_bool(value, name):
@@ -46,11 +30,7 @@ def _check_bool(value, name):
 
 
 def _check_max_kicks(max_kicks):
-    if isinstance(max_kicks, (bool, np.bool_)) or not isinstance(max_kicks, numbers.Integral):
-        raise TypeError(f"max_kicks must be an int >= 1, got {max_kicks!r}")
-    if max_kicks < 1:
-        raise ValueError(f"max_kicks must be an int >= 1, got {max_kicks}")
-    return int(max_kicks)
+    return check_int("max_kicks", max_kicks, low=1)
 
 
 def _float_array(values, name, *, lower, sorted_):
