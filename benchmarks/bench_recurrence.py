@@ -37,7 +37,7 @@ from numba import njit
 from scipy.spatial import cKDTree
 
 from kicktimes.diagnostics import recurrence_rate, rqa
-from kicktimes.diagnostics.recurrence import _add_line, _cell_keys, _recurrent
+from kicktimes.diagnostics._recurrence_kernels import _add_line, _cell_keys, _recurrent
 
 
 @njit(cache=True)
@@ -355,10 +355,11 @@ def batch_table(sets, rep):
     """The sweep's dense-grid kernels (build + line sweep at [1e-2, 1e-3]) against the
     former ones (per-point accounting, every line walked), same points, same run,
     alternating; the counts must be equal."""
-    from kicktimes.diagnostics import recurrence
+
+    from kicktimes.diagnostics import _recurrence_kernels as kernels
 
     no_lam = np.zeros((0, 4), np.int64)
-    new = (recurrence._dense_cells_lines, recurrence._sweep_lines_dense, 1, no_lam)
+    new = (kernels._dense_cells_lines, kernels._sweep_lines_dense, 1, no_lam)
     old = (_former_dense_cells_lines, _former_sweep_lines_dense)
     print()
     print(f"The sweep's line kernels at [1e-2, 1e-3] (build + sweep): batched accounting "

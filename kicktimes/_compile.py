@@ -28,7 +28,7 @@ __all__ = ["cold_kernels", "announce", "warm_up", "warm_sweep", "warm_report"]
 SWEEP_KERNELS = (
     ("kicktimes.diagnostics._tangent_run", "simulate_tangent_two_kernel", 5.5),
     ("kicktimes.diagnostics._tangent_run", "simulate_tangent_one_kernel", 5.0),
-    ("kicktimes.diagnostics.recurrence", "_sweep_lines_dense", 3.0),
+    ("kicktimes.diagnostics._recurrence_kernels", "_sweep_lines_dense", 3.0),
     ("kicktimes.diagnostics.autocorrelation", "_acf_curve", 1.3),
     ("kicktimes.diagnostics.autocorrelation", "_select_checked", 0.2),
     # the uniform-time re-runs of the recurrence control (rr_sampling = "run+uniform", the
@@ -44,7 +44,7 @@ SIMULATE_KERNELS = (("kicktimes.billiard.two_particle", "simulate_two_kernel", 4
 #: Ljung-Box statistic of the Poisson tests.
 REPORT_KERNELS = (
     ("kicktimes.billiard.two_particle", "simulate_two_kernel", 2.0),
-    ("kicktimes.diagnostics.recurrence", "_sweep", 1.0),
+    ("kicktimes.diagnostics._recurrence_kernels", "_sweep", 1.0),
     ("kicktimes.stats.distributions", "_em_steps", 0.5),
     ("kicktimes.stats.poisson", "pomeranz_cdf", 0.5),
     ("kicktimes.stats.iid_tests", "_ljung_box_rows", 1.9),

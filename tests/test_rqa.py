@@ -11,7 +11,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from kicktimes.diagnostics import RQAResult, recurrence_rate, rqa
+from kicktimes.diagnostics import RQAResult, _recurrence_kernels, recurrence_rate, rqa
 
 # ------------------------------------------------------------------ reference
 
@@ -173,12 +173,11 @@ def test_many_batches_of_pairs_equal_the_definition(theiler, l_min):
     # threshold without a walk unless a line can beat the longest (l_min <= 2), and the
     # vertical lines through both entries of each pair; here the pairs fill several
     # batches and the lines have many lengths
-    from kicktimes.diagnostics import recurrence
 
     pts = trajectory(900, seed=3, tau=0.02)
     eps = [0.15, 0.05]
     res = rqa(pts, eps, theiler=theiler, l_min=l_min)
-    assert res[0].n_recurrent / 2 > 6 * recurrence._BATCH
+    assert res[0].n_recurrent / 2 > 6 * _recurrence_kernels._BATCH
     for e, got in zip(eps, res, strict=True):
         ref = brute_rqa(pts, e, theiler, l_min)
         for key, value in ref.items():
@@ -197,7 +196,7 @@ def test_a_point_with_more_candidates_than_the_buffer(grid, monkeypatch):
     if grid == "sparse":
         monkeypatch.setattr(recurrence, "_DENSE_CELLS_PER_POINT", 0)
         monkeypatch.setattr(recurrence, "_DENSE_CELLS_MIN", 0)
-    assert n > 2 * recurrence._BATCH
+    assert n > 2 * _recurrence_kernels._BATCH
     for l_min in (1, 2, 3):
         res = rqa(pts, 1e-3, theiler=1, l_min=l_min)
         assert res.n_recurrent == n * (n - 1)
