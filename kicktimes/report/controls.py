@@ -410,12 +410,18 @@ def answers(table: pd.DataFrame, poisson_share=None) -> list[str]:
                     + ("No. " if reject else "Not rejected everywhere. ")
                     + "; ".join(parts) + " (under Poisson times the share would be α).")
     ftle = table[(table["diagnostic"] == "ftle")]
-    paper = []
-    for fam in dict.fromkeys(ftle["family"]):
-        for system in ("poisson", "actual"):
-            rows = ftle[(ftle["family"] == fam) & (ftle["system"] == system)]
-            if not rows.empty:
-                paper.append(f"{fam}, {_SHORT[system]} kicks: {_stated(rows)}")
+
+    def statements(systems):
+        """"<family>, <system> kicks: <verdict>" for each family and system present."""
+        out = []
+        for fam in dict.fromkeys(ftle["family"]):
+            for system in systems:
+                rows = ftle[(ftle["family"] == fam) & (ftle["system"] == system)]
+                if not rows.empty:
+                    out.append(f"{fam}, {_SHORT[system]} kicks: {_stated(rows)}")
+        return out
+
+    paper = statements(("poisson", "actual"))
     if paper:
         mine = ftle[ftle["system"].isin(["poisson", "actual"])]
         verdicts = set(mine["verdict"])
@@ -425,12 +431,7 @@ def answers(table: pd.DataFrame, poisson_share=None) -> list[str]:
         out.append("**Does the paper's kicked disk reproduce the two-disk chaos?** "
                    f"{lead}: its FTLE is {primary.min():.2f}–{primary.max():.2f} of the "
                    "two-disk one. " + "; ".join(paper) + ".")
-    other = []
-    for fam in dict.fromkeys(ftle["family"]):
-        for system in ("poisson_scatter", "actual_scatter"):
-            rows = ftle[(ftle["family"] == fam) & (ftle["system"] == system)]
-            if not rows.empty:
-                other.append(f"{fam}, {_SHORT[system]} kicks: {_stated(rows)}")
+    other = statements(("poisson_scatter", "actual_scatter"))
     if other:
         out.append("**Does any kick?** The scatter kick (a collision with a virtual partner) "
                    "comes closest; FTLE ratio " + "; ".join(other) + ".")
