@@ -8,7 +8,8 @@ import pyarrow.parquet as pq
 import pytest
 from click.testing import CliRunner
 
-from kicktimes.cli import _plain, main
+from kicktimes.cli import main
+from kicktimes.cli._group import _plain
 from kicktimes.experiment import Experiment
 
 
@@ -124,7 +125,7 @@ def test_python_dash_m_runs_the_cli():
 
 def test_the_report_process_builds_the_report_the_driver_sends(tmp_path):
     # `reproduce` forks it before the sweeps: it imports the report's modules meanwhile
-    from kicktimes.cli import _ReportProcess
+    from kicktimes.cli.experiment import _ReportProcess
     from kicktimes.experiment import run_experiment
 
     exp = Experiment(name="tiny_rp", radii=[0.02], n_ics=2, n_steps=200, tau=0.3,
@@ -141,7 +142,7 @@ def test_the_report_process_builds_the_report_the_driver_sends(tmp_path):
 
 
 def test_the_report_process_hands_its_errors_to_the_driver(tmp_path):
-    from kicktimes.cli import _ReportProcess
+    from kicktimes.cli.experiment import _ReportProcess
 
     process = _ReportProcess()
     try:
@@ -155,7 +156,7 @@ def test_the_report_process_hands_its_errors_to_the_driver(tmp_path):
 
 
 def test_an_unpicklable_error_of_the_report_process_still_reaches_the_driver(monkeypatch):
-    from kicktimes import cli
+    from kicktimes.cli import experiment as cli
 
     class LocalError(Exception):  # a local class: pickle cannot name it
         pass
@@ -196,7 +197,7 @@ def test_the_sweep_kernels_are_loaded_before_a_pool_forks(monkeypatch, workers, 
     import os
 
     from kicktimes import _compile
-    from kicktimes.cli import _compile_first
+    from kicktimes.cli._group import _compile_first
 
     calls = []
     monkeypatch.setattr(_compile, "announce", lambda *a, **k: 0.0)

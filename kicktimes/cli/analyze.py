@@ -1,7 +1,6 @@
 """``kicktimes analyze``: the statistics of collision times from any source (a CLI command).
 
-Registered on the ``kicktimes`` group by :mod:`kicktimes.cli` (``main.add_command``); this
-module does not import the group, so the two form no import circle.
+Registered on the ``kicktimes`` group by :mod:`kicktimes.cli`.
 """
 
 from __future__ import annotations
