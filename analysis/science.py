@@ -143,7 +143,7 @@ def stretching(results, n_boot=N_BOOT, seed=0):
 def stretching_figure(fits, per_radius, path):
     from matplotlib.figure import Figure
 
-    from kicktimes.report._figures import system_label, system_style
+    from kicktimes.report.figures import system_label, system_style
 
     fig = Figure(figsize=(6.0, 4.2), layout="constrained")
     ax = fig.subplots()

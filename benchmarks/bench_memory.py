@@ -1,6 +1,6 @@
-"""Sweep tasks with and without the workers' allocator setting (kicktimes._memory).
+"""Sweep tasks with and without the workers' allocator setting (kicktimes.memory).
 
-The local pool's workers call `kicktimes._memory.keep_freed_memory` (glibc ``mallopt``:
+The local pool's workers call `kicktimes.memory.keep_freed_memory` (glibc ``mallopt``:
 blocks below 32 MB from the heap, trim above 256 MB free) so that the arrays each kernel
 call returns reuse freed memory instead of being ``mmap``-ed afresh and faulted in again.
 This benchmark runs the same sweep tasks on two-worker pools, with the setting (the

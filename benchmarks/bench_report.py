@@ -207,7 +207,7 @@ def bench_load(paths, rounds=7):
     import pandas as pd
 
     from kicktimes.experiment import load_store
-    from kicktimes.report._common import load_report_store, report_store
+    from kicktimes.report.common import load_report_store, report_store
 
     def former(path):
         return report_store(load_store(path))

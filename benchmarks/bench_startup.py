@@ -2,13 +2,13 @@
 
 1. **Sweep kernels loaded before the fork.** The quick sweeps (``quick_a`` then
    ``quick_b``) on one local pool of 2 workers, with the sweep's kernels loaded in the
-   parent before the pool forks (`kicktimes._compile.warm_sweep`, what ``kicktimes run``
+   parent before the pool forks (`kicktimes.compilation.warm_sweep`, what ``kicktimes run``
    and ``reproduce`` do) against without it (each worker loads them on its first task).
    Each variant runs in a fresh subprocess, alternating, ``--rounds`` times: wall time,
    CPU seconds (the subprocess and its children) and the tasks' own seconds summed over
    the workers (the stores' timings).
 2. **Garbage collection during the report.** ``build_report`` of the quick stores
-   (``workers=2``, ``force=True``) under `kicktimes._memory.fewer_collections` against
+   (``workers=2``, ``force=True``) under `kicktimes.memory.fewer_collections` against
    CPython's default thresholds (700, 10, 10), each in a fresh subprocess, alternating:
    seconds spent in the collector in every process (``gc.callbacks``), wall time, CPU
    seconds and the largest resident set of any process; the CSV tables and PNG files of
@@ -42,14 +42,14 @@ from pathlib import Path
 
 _SWEEP_CHILD = """
 import json, os, resource, sys, time
-from kicktimes._memory import keep_freed_memory
+from kicktimes.memory import keep_freed_memory
 from kicktimes.experiment import preset, run_experiment
 from kicktimes.experiment.runner import local_pool
 keep_freed_memory()
 root, preload = sys.argv[1], sys.argv[2] == "1"
 t0 = time.perf_counter()
 if preload:
-    from kicktimes import _compile
+    from kicktimes import compilation as _compile
     _compile.warm_sweep()
 work = 0.0
 with local_pool(2) as pool:

@@ -42,7 +42,7 @@ import numpy as np
 import pandas as pd
 
 from kicktimes import stats
-from kicktimes._analyze_report import write_analysis
+from kicktimes.report.analyze_page import write_analysis
 
 SMALL = os.environ.get("KICKTIMES_NOTEBOOK_SIZE", "small") != "full"
 N_PER_GROUP = 6 if SMALL else 40

@@ -178,7 +178,7 @@ def test_every_command_runs_with_fewer_garbage_collections():
 
     import click
 
-    from kicktimes._memory import _GC_THRESHOLDS
+    from kicktimes.memory import _GC_THRESHOLDS
 
     before = gc.get_threshold()
     seen = []
@@ -196,7 +196,7 @@ def test_every_command_runs_with_fewer_garbage_collections():
 def test_the_sweep_kernels_are_loaded_before_a_pool_forks(monkeypatch, workers, loads):
     import os
 
-    from kicktimes import _compile
+    from kicktimes import compilation as _compile
     from kicktimes.cli._group import _compile_first
 
     calls = []

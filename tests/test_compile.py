@@ -1,4 +1,4 @@
-"""Specification of the first-run compilation notice (kicktimes._compile)."""
+"""Specification of the first-run compilation notice (kicktimes.compilation)."""
 
 from __future__ import annotations
 
@@ -6,7 +6,7 @@ import io
 
 import pytest
 
-from kicktimes import _compile
+from kicktimes import compilation as _compile
 
 
 def test_a_cold_cache_is_announced_once_with_an_estimate(monkeypatch):
@@ -83,7 +83,7 @@ def test_simulator_and_ftle_kernels_compile_once_without_error_strings(tmp_path)
 _SWEEP_AFTER_WARM_UP = r"""
 import dataclasses, json
 from numba.core import event
-from kicktimes import _compile
+from kicktimes import compilation as _compile
 from kicktimes.experiment import execute_task, preset
 
 _compile._warm_two(None)
@@ -118,7 +118,7 @@ def test_the_warm_up_groups_compile_every_kernel_a_sweep_task_calls(tmp_path):
 _REPORT_AFTER_WARM_UP = r"""
 import dataclasses, json, sys
 from numba.core import event
-from kicktimes import _compile
+from kicktimes import compilation as _compile
 from kicktimes.experiment import preset, run_experiment
 from kicktimes.report import build_report
 
@@ -155,7 +155,7 @@ def test_the_reproduce_warm_up_also_compiles_every_kernel_the_report_calls(tmp_p
 
 _LOADED_AFTER_WARM_SWEEP = r"""
 import importlib, json
-from kicktimes import _compile
+from kicktimes import compilation as _compile
 
 def loaded():
     return {name: bool(getattr(importlib.import_module(module), name).overloads)

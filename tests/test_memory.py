@@ -1,4 +1,4 @@
-"""kicktimes._memory: kicktimes' own worker processes keep freed memory for reuse; the
+"""kicktimes.memory: kicktimes' own worker processes keep freed memory for reuse; the
 command line and the report run the garbage collector less often."""
 
 from __future__ import annotations
@@ -10,11 +10,11 @@ import weakref
 
 import pytest
 
-from kicktimes._memory import _GC_THRESHOLDS, fewer_collections
+from kicktimes.memory import _GC_THRESHOLDS, fewer_collections
 
 _FAULTS = r"""
 import dataclasses, resource
-from kicktimes._memory import keep_freed_memory
+from kicktimes.memory import keep_freed_memory
 from kicktimes.experiment import execute_task, preset
 
 exp = dataclasses.replace(preset("family_a"), radii=[0.02], n_ics=4, block_size=4)

@@ -179,7 +179,7 @@ def test_progress_callable_sees_every_stage_in_order(built):
 
 
 def test_the_build_runs_with_fewer_garbage_collections_and_restores_the_setting(built):
-    from kicktimes._memory import _GC_THRESHOLDS
+    from kicktimes.memory import _GC_THRESHOLDS
 
     thresholds = built[3]
     raised = tuple(max(a, b) for a, b in zip(_GC_THRESHOLDS, thresholds["before"], strict=True))
@@ -514,7 +514,7 @@ def test_the_report_reads_a_store_as_report_store_of_load_store(store_path, tmp_
     import shutil
 
     from kicktimes.experiment.store import _part_path
-    from kicktimes.report._common import load_report_store, report_store
+    from kicktimes.report.common import load_report_store, report_store
 
     def same(path):
         ref, got = report_store(load_store(path)), load_report_store(path)

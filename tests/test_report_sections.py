@@ -12,7 +12,7 @@ import pytest
 
 from kicktimes import stats
 from kicktimes.report import autocorrelation, counts, findings, lyapunov, recurrence, summary
-from kicktimes.report._common import Context
+from kicktimes.report.common import Context
 from kicktimes.report.effects import (
     clopper_pearson,
     paired_ratio,
@@ -309,7 +309,7 @@ def _tables_as_csv(store):
 def test_the_categorical_results_view_writes_the_same_tables():
     # report_store turns system/diagnostic into categoricals (speed); every table the
     # sections write must be the same text as from the plain string columns
-    from kicktimes.report._common import report_store
+    from kicktimes.report.common import report_store
 
     store = synthetic_store(n_ics=8)
     view = report_store(store)
@@ -327,7 +327,7 @@ def test_acf_curves_read_the_lag_from_every_acf_row_and_only_those():
     ref = res[res["diagnostic"].str.match(r"^acf@(\d+)$")]
     ref = ref.assign(lag=ref["diagnostic"].str.slice(4).astype(int))
     ref = ref.groupby(["radius", "system", "lag"])["value"].agg(["mean", "median"]).reset_index()
-    from kicktimes.report._common import report_store
+    from kicktimes.report.common import report_store
 
     for results in (res, report_store(store).results):
         got = autocorrelation.acf_curves(results)
@@ -355,7 +355,7 @@ def test_figures_render_to_the_same_bytes_on_forked_workers():
 
 def test_poisson_tests_started_ahead_on_a_pool_equal_the_tests_run_in_place():
     from kicktimes.report import poisson
-    from kicktimes.report._common import Mapper
+    from kicktimes.report.common import Mapper
 
     store = synthetic_store(n_ics=6)
     in_place = Context(store, n_mc=39)

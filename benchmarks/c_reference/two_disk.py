@@ -16,7 +16,7 @@ import tempfile
 
 import numpy as np
 
-from kicktimes.billiard import _checks as chk
+from kicktimes.billiard import checks as chk
 from kicktimes.billiard import geometry
 
 HERE = os.path.dirname(os.path.abspath(__file__))

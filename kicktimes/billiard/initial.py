@@ -14,7 +14,7 @@ import math
 
 import numpy as np
 
-from kicktimes.billiard import _checks as chk
+from kicktimes.billiard import checks as chk
 from kicktimes.billiard._crmath import cos_sin
 
 METHODS = ("paper", "uniform")

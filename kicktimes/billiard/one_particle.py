@@ -23,7 +23,7 @@ import numpy as np
 from numba import njit
 
 from kicktimes._validation import check_rng
-from kicktimes.billiard import _checks as chk
+from kicktimes.billiard import checks as chk
 from kicktimes.billiard.geometry import (
     GRAZE_THRESHOLD,
     SIN_GRAZE,

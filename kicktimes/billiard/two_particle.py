@@ -29,8 +29,8 @@ import warnings
 import numpy as np
 from numba import njit
 
-from kicktimes.billiard import _checks as chk
-from kicktimes.billiard._checks import STALL_EVENTS
+from kicktimes.billiard import checks as chk
+from kicktimes.billiard.checks import STALL_EVENTS
 from kicktimes.billiard.geometry import (
     GRAZE_THRESHOLD,
     SIN_GRAZE,

@@ -82,8 +82,8 @@ def main():
     # the command owns its process: freed arrays are kept for reuse instead of being
     # returned to the system and faulted in again by the next kernel call, and the cyclic
     # garbage collector runs less often until the command ends (the sweep's and the
-    # report's forked workers inherit both; see kicktimes._memory)
-    from kicktimes._memory import fewer_collections, keep_freed_memory
+    # report's forked workers inherit both; see kicktimes.memory)
+    from kicktimes.memory import fewer_collections, keep_freed_memory
 
     keep_freed_memory()
     click.get_current_context().with_resource(fewer_collections())
@@ -92,14 +92,14 @@ def main():
 def _compile_first(workers, kernels=None, *, report=False, report_process=False):
     """On a cold numba cache, say so once and compile the sweep's kernels (and the
     report's, with ``report``) up front, the independent groups in parallel
-    (:mod:`kicktimes._compile`); then, for a pool of several workers, load the sweep's
+    (:mod:`kicktimes.compilation`); then, for a pool of several workers, load the sweep's
     kernels in this process, which the workers fork from. With ``report_process`` the
     report's kernels are left to the report process (`_ReportProcess`), which compiles
     them while the sweeps run; the estimate includes them, and their modules (scipy.stats,
     statsmodels: about 1 s) are not imported here."""
     import os
 
-    from kicktimes import _compile
+    from kicktimes import compilation as _compile
 
     if kernels is not None:
         _compile.announce(kernels)

@@ -93,7 +93,7 @@ def analyze_command(
       kicktimes analyze events.csv --windows sequences.csv --group density \\
           --reference kinetic_rate --out report
     """
-    from kicktimes._analyze_report import write_analysis
+    from kicktimes.report.analyze_page import write_analysis
     from kicktimes.stats import analyze
 
     try:

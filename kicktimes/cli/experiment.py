@@ -114,7 +114,7 @@ def _report_server(conn, driver_end):
     import pickle
 
     driver_end.close()  # the fork's copy: else closing the driver's would never reach us
-    from kicktimes import _compile
+    from kicktimes import compilation as _compile
     from kicktimes.report import pipeline
 
     pipeline._stages()

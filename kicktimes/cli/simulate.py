@@ -76,7 +76,7 @@ def simulate_command(radii, n_ics, t_max, seed, rule, ic_method, out, save_runs)
     # refuses back to the option that caused it
     options = {"r_max": "--radius", "r": "--radius", "n": "--n-ics", "t_max": "--t-max",
                "seed": "--seed", "rule": "--rule", "method": "--ic-method"}
-    from kicktimes._compile import SIMULATE_KERNELS
+    from kicktimes.compilation import SIMULATE_KERNELS
 
     _compile_first(None, SIMULATE_KERNELS)
     with _cli_errors(options):

@@ -23,7 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from kicktimes.billiard import _checks as chk
+from kicktimes.billiard import checks as chk
 from kicktimes.billiard.one_particle import (
     KICK_ANGLES,
     check_one_particle_state,

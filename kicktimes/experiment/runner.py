@@ -10,10 +10,10 @@ import threading
 import time
 from concurrent.futures import FIRST_COMPLETED, Executor, ProcessPoolExecutor, wait
 
-from kicktimes._memory import keep_freed_memory
 from kicktimes.experiment.config import Experiment
 from kicktimes.experiment.store import Store, StoreWriter, load_store
 from kicktimes.experiment.tasks import execute_task
+from kicktimes.memory import keep_freed_memory
 
 __all__ = ["run_experiment"]
 

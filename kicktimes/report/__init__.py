@@ -25,7 +25,7 @@ One module per section, each holding its computation, figure and text:
 
 from __future__ import annotations
 
-from kicktimes.report._common import REPORT_DOMAIN
+from kicktimes.report.common import REPORT_DOMAIN
 from kicktimes.report.pipeline import build_report
 from kicktimes.report.results import write_results
 

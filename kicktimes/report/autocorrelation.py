@@ -23,15 +23,15 @@ import pandas as pd
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
-from kicktimes.report._common import REFERENCE, Section, distinct, fmt, kicked_systems, wide
-from kicktimes.report._figures import (
+from kicktimes.report.common import REFERENCE, Section, distinct, fmt, kicked_systems, wide
+from kicktimes.report.effects import BUILT_IN, Effect, paired_ratio, ratio_rule, ratio_verdict
+from kicktimes.report.figures import (
     _SEM_BAR,
     dodge,
     radius_axis,
     system_label,
     system_style,
 )
-from kicktimes.report.effects import BUILT_IN, Effect, paired_ratio, ratio_rule, ratio_verdict
 from kicktimes.report.summary import diagnostic_summary
 
 __all__ = ["predicted_lag1", "acf_curves", "acf_figure", "sections", "effects"]

@@ -40,7 +40,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from kicktimes.report._common import REFERENCE, kicked_systems, wide
+from kicktimes.report.common import REFERENCE, kicked_systems, wide
 from kicktimes.report.effects import paired_ratio
 from kicktimes.stats import ratio_verdict
 
@@ -511,7 +511,7 @@ def ratio_curves_figure(curves: pd.DataFrame):
     from matplotlib.lines import Line2D
     from matplotlib.ticker import FixedLocator, FuncFormatter, NullLocator
 
-    from kicktimes.report._figures import radius_axis, system_label, system_style
+    from kicktimes.report.figures import radius_axis, system_label, system_style
 
     panels = [(d, t) for d, t in _PANELS if d in set(curves["diagnostic"])]
     fig = Figure(figsize=(3.3 * max(len(panels), 1), 4.2), layout="constrained")

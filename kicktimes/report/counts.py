@@ -9,8 +9,8 @@ import warnings
 import numpy as np
 import pandas as pd
 
-from kicktimes.report._common import Section, fmt_p
-from kicktimes.report._figures import (
+from kicktimes.report.common import Section, fmt_p
+from kicktimes.report.figures import (
     check_frame,
     check_radii,
     finite,

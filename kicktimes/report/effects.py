@@ -78,7 +78,7 @@ class Effect:
 
     def statement(self) -> str:
         """One sentence: question, effect, CI and verdict."""
-        from kicktimes.report._figures import system_label
+        from kicktimes.report.figures import system_label
 
         who = f", {system_label(self.system)} vs two-particle" if self.system else ""
         ci = (

@@ -13,7 +13,7 @@ from __future__ import annotations
 import pandas as pd
 
 from kicktimes.report import autocorrelation, counts, lyapunov, poisson, recurrence, renewal
-from kicktimes.report._common import PAPER_SCALE, Section, is_paper_scale
+from kicktimes.report.common import PAPER_SCALE, Section, is_paper_scale
 from kicktimes.report.controls import (
     answers,
     compute_controls,

@@ -9,9 +9,9 @@ import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 
-from kicktimes.report._common import Section, fmt
-from kicktimes.report._figures import check_frame, plain_log_ticks, radius_axis
+from kicktimes.report.common import Section, fmt
 from kicktimes.report.counts import counts_by_radius
+from kicktimes.report.figures import check_frame, plain_log_ticks, radius_axis
 
 __all__ = ["rate_heterogeneity", "sections"]
 

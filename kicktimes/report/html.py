@@ -11,7 +11,7 @@ import re
 from pathlib import Path
 
 from kicktimes import __version__
-from kicktimes._memory import keep_freed_memory
+from kicktimes.memory import keep_freed_memory
 from kicktimes.report._cache import atomic_write
 
 __all__ = [

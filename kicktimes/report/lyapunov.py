@@ -15,14 +15,14 @@ import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 
-from kicktimes.report._common import REFERENCE, Section, distinct, fmt, kicked_systems, wide
-from kicktimes.report._figures import (
+from kicktimes.report.common import REFERENCE, Section, distinct, fmt, kicked_systems, wide
+from kicktimes.report.effects import Effect, paired_ratio, ratio_rule, ratio_verdict
+from kicktimes.report.figures import (
     DIAGNOSTIC_LABELS,
     radius_axis,
     system_label,
     system_style,
 )
-from kicktimes.report.effects import Effect, paired_ratio, ratio_rule, ratio_verdict
 from kicktimes.report.summary import diagnostic_summary, diagnostic_vs_radius
 
 __all__ = ["stretching_table", "stretching_figure", "sections", "effects"]

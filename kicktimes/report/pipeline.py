@@ -27,9 +27,9 @@ from contextlib import closing, contextmanager
 from pathlib import Path
 
 from kicktimes import __version__
-from kicktimes._memory import fewer_collections, keep_freed_memory
+from kicktimes.memory import fewer_collections, keep_freed_memory
 from kicktimes.report._cache import ReportCache, content_key, store_key
-from kicktimes.report._common import (
+from kicktimes.report.common import (
     Context,
     Mapper,
     Progress,
@@ -266,7 +266,7 @@ def families_section(stores):
     autocorrelation of every family are in each family's fig05 and fig07, and their ratios
     to the two-disk values, both families together, in the Findings' fig00.)"""
     from kicktimes.report import recurrence
-    from kicktimes.report._common import Section
+    from kicktimes.report.common import Section
 
     sec = Section("families", "Diagnostics against radius, all experiments")
     rr = recurrence.family_figure(stores)
@@ -442,7 +442,7 @@ def build_report(
     parallel = workers > 1 and len(jobs) + families_todo > 1
     n_steps = 2 + (len(jobs) if parallel else N_STAGES * len(jobs)) + families_todo
     bar = Progress(progress, n_steps)
-    # the collector runs less often while the report allocates (kicktimes._memory)
+    # the collector runs less often while the report allocates (kicktimes.memory)
     with closing(bar), fewer_collections(), _one_blas_thread():
         bar.step("load store")
         timings = [("", "check cache", time.perf_counter() - t_start)]

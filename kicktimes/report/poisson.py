@@ -15,8 +15,9 @@ import pandas as pd
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
-from kicktimes.report._common import Section, fmt_rho, pct, seeded_rng, spearman
-from kicktimes.report._figures import (
+from kicktimes.report.common import Section, fmt_rho, pct, seeded_rng, spearman
+from kicktimes.report.effects import SHARE_RULE, Effect, share_verdict
+from kicktimes.report.figures import (
     check_alpha,
     check_frame,
     check_radii,
@@ -25,7 +26,6 @@ from kicktimes.report._figures import (
     new_axes,
     radius_axis,
 )
-from kicktimes.report.effects import SHARE_RULE, Effect, share_verdict
 from kicktimes.stats.poisson import TEST_NULLS
 
 __all__ = [

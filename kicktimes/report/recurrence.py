@@ -19,7 +19,7 @@ import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 
-from kicktimes.report._common import (
+from kicktimes.report.common import (
     REFERENCE,
     Section,
     distinct,
@@ -28,8 +28,8 @@ from kicktimes.report._common import (
     kicked_systems,
     wide,
 )
-from kicktimes.report._figures import plain_ticks, radius_axis, shared_legend
 from kicktimes.report.effects import Effect, paired_ratio, ratio_rule, ratio_verdict
+from kicktimes.report.figures import plain_ticks, radius_axis, shared_legend
 from kicktimes.report.summary import diagnostic_summary, diagnostic_vs_radius
 
 __all__ = ["recurrence_rows", "sampling_statement", "rr_figure", "sections", "effects"]

@@ -13,9 +13,9 @@ import pandas as pd
 from matplotlib.figure import Figure
 from matplotlib.patches import Patch
 
-from kicktimes.report._common import Section, pct
-from kicktimes.report._figures import check_frame, check_radii, finite, radius_axis
+from kicktimes.report.common import Section, pct
 from kicktimes.report.effects import SHARE_RULE, Effect, clopper_pearson, share_verdict
+from kicktimes.report.figures import check_frame, check_radii, finite, radius_axis
 from kicktimes.report.poisson import binomial_ci, subsample
 
 __all__ = ["model_comparison", "sections", "effects"]

@@ -14,7 +14,7 @@ import time
 from pathlib import Path
 
 from kicktimes import __version__
-from kicktimes.report._common import (
+from kicktimes.report.common import (
     Context,
     Mapper,
     Progress,

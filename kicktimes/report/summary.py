@@ -10,8 +10,8 @@ import numpy as np
 import pandas as pd
 from matplotlib.lines import Line2D
 
-from kicktimes.report._common import REFERENCE, Section, distinct
-from kicktimes.report._figures import (
+from kicktimes.report.common import REFERENCE, Section, distinct
+from kicktimes.report.figures import (
     _PAPER_BAR,
     _SEM_BAR,
     DIAGNOSTIC_LABELS,

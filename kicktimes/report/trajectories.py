@@ -15,8 +15,8 @@ import pandas as pd
 from matplotlib.colors import LogNorm
 from matplotlib.figure import Figure
 
-from kicktimes.report._common import REFERENCE, Section, eps_values, nearest, pct
-from kicktimes.report._figures import TIME_UNIT, check_frame, finite, new_axes
+from kicktimes.report.common import REFERENCE, Section, eps_values, nearest, pct
+from kicktimes.report.figures import TIME_UNIT, check_frame, finite, new_axes
 
 __all__ = ["poincare_section", "poincare_panels", "recurrence_plot", "sections"]
 

@@ -124,11 +124,16 @@ class Analysis:
             out["reference_rate"] = self.reference
         return out
 
-    def summary(self) -> str:
-        """The findings, one line each."""
+    def findings(self) -> list:
+        """One computed statement per question (`kicktimes.stats._findings.Finding`: the
+        question, the verdict, the statement with its numbers, and the rule)."""
         from ._findings import findings
 
-        return "\n".join(f"- {f.question}: {f.statement}" for f in findings(self))
+        return findings(self)
+
+    def summary(self) -> str:
+        """The findings, one line each."""
+        return "\n".join(f"- {f.question}: {f.statement}" for f in self.findings())
 
 
 def analyze(

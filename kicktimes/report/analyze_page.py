@@ -31,8 +31,8 @@ def _report_api():
     from types import SimpleNamespace
 
     from kicktimes.report import heterogeneity, poisson, renewal
-    from kicktimes.report._common import Section
-    from kicktimes.report._figures import RADIUS_LABEL
+    from kicktimes.report.common import Section
+    from kicktimes.report.figures import RADIUS_LABEL
     from kicktimes.report.html import CSS, write_outputs
 
     figures = SimpleNamespace(
@@ -97,9 +97,7 @@ def _sections(res, Section, plots):
         return out
 
     # ---- findings first
-    from kicktimes.stats._findings import findings
-
-    fs = findings(res)
+    fs = res.findings()
     sec = Section("findings", "Findings")
     sec.bullets(f"{f.question} — {f.verdict}. {f.statement} (Rule: {f.rule})" for f in fs)
     table = pd.DataFrame([f.__dict__ for f in fs])

@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from kicktimes._memory import keep_freed_memory
+from kicktimes.memory import keep_freed_memory
 
 if TYPE_CHECKING:  # pandas and scipy load with the sections that use them
     import pandas as pd
@@ -248,7 +248,7 @@ def fmt_rho(rho, p):
 
 def kicked_systems(results):
     """Every system of the store except the reference, in a stable order."""
-    from kicktimes.report._figures import SYSTEMS
+    from kicktimes.report.figures import SYSTEMS
 
     present = set(results["system"].unique())
     known = [s for s in SYSTEMS if s in present and s != REFERENCE]
