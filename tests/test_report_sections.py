@@ -96,7 +96,7 @@ def ctx():
 
 
 def _effect(ctx, question, system):
-    matches = [e for e in ctx.found["effects"] if e.question == question and e.system == system]
+    matches = [e for e in ctx.found.effects if e.question == question and e.system == system]
     assert len(matches) == 1, (question, system)
     return matches[0]
 
@@ -168,7 +168,7 @@ def test_paired_ratio_skips_pairs_with_a_missing_value():
 
 
 def test_findings_compare_every_kicked_system_including_new_ones(ctx):
-    systems = {e.system for e in ctx.found["effects"] if e.system}
+    systems = {e.system for e in ctx.found.effects if e.system}
     assert systems == {"poisson", "actual", "poisson_scatter"}
 
 
@@ -370,4 +370,4 @@ def test_poisson_tests_started_ahead_on_a_pool_equal_the_tests_run_in_place():
         pool.close()
     assert not ahead.pending
     pd.testing.assert_frame_equal(got, expected)
-    pd.testing.assert_frame_equal(ahead.found["homogeneity"], in_place.found["homogeneity"])
+    pd.testing.assert_frame_equal(ahead.found.homogeneity, in_place.found.homogeneity)

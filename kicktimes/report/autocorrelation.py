@@ -270,7 +270,7 @@ def sections(ctx):
         sec.table("autocorrelation_curves", curves, "R_l per lag", show=False)
     rows = []
     pred = predicted.groupby(["radius", "system"])["value"].mean()
-    sticky = ctx.found.get("sticky")
+    sticky = ctx.found.sticky
     flags = sticky.set_index(["radius", "ic"])["sticky"] if sticky is not None else None
     # the decorrelation rows of each (radius, system), grouped once: filtering the whole
     # table per group and name cost seconds on a paper store

@@ -63,6 +63,27 @@ class Section:
 
 
 @dataclass
+class Found:
+    """What the sections compute for later sections and for the Findings, typed.
+
+    Each attribute is set by the section named beside it and read after it (the page's
+    stage order, `kicktimes.report.pipeline`); None until then.
+    """
+
+    summary: object = None  # summary: the diagnostics' summary table
+    count_regression: object = None  # counts: the regressions of counts on the radius
+    sticky: object = None  # counts: per (radius, IC) rate and the sticky flag
+    recurrence_rows: object = None  # recurrence: the rows behind the RR figures
+    rejections: object = None  # poisson: rejections per radius and test
+    homogeneity: object = None  # poisson: rate-homogeneity tests per radius
+    poisson_per_ic: object = None  # poisson: per-IC p-values of the headline test
+    renewal_best: object = None  # renewal: the AIC-best model of every fitted IC
+    renewal_pooled: object = None  # renewal: the comparison of pooled intervals
+    effects: list = field(default_factory=list)  # findings: the statements
+    controls: object = None  # findings: `kicktimes.report.controls.Controls`
+
+
+@dataclass
 class Context:
     """What every section of one store sees: the store, the options, the pool and the
     place where sections leave results for later ones (``found``) and subsampling notes."""
@@ -85,7 +106,7 @@ class Context:
     #: (`kicktimes.report.effects.paired_ratio`'s ``resamples``, drawn from ``boot_rng()``)
     resamples: dict = field(default_factory=dict)
     notes: list = field(default_factory=list)
-    found: dict = field(default_factory=dict)
+    found: Found = field(default_factory=Found)
 
     @property
     def exp(self):

@@ -173,7 +173,7 @@ def sections(ctx):
     table["rate_over_kinetic"] = table["pooled_rate"] / table["kinetic_rate"]
     table["dispersion_index"] = grouped["n_pp"].var(ddof=1) / grouped["n_pp"].mean()
     sticky = sticky_ics(coll, exp.rule)
-    ctx.found["sticky"] = sticky
+    ctx.found.sticky = sticky
     table["n_sticky"] = sticky.groupby("radius")["sticky"].sum().astype(int)
     sec = Section("counts", "Number of disk-disk collisions against radius")
     sec.table("counts_by_radius", table.reset_index(), "Counts per radius")
@@ -234,7 +234,7 @@ def sections(ctx):
         od.to_frame("value").reset_index(names="quantity"),
         "Over-dispersion",
     )
-    ctx.found["count_regression"] = reg
+    ctx.found.count_regression = reg
     return [sec]
 
 
@@ -253,7 +253,7 @@ def effects(ctx):
         n_boot=ctx.n_boot,
         resamples=ctx.resamples,
     )
-    sticky = ctx.found.get("sticky")
+    sticky = ctx.found.sticky
     n_sticky = int(sticky["sticky"].sum()) if sticky is not None else 0
     return [
         Effect(

@@ -84,7 +84,7 @@ def section(ctx):
         rule=ctx.exp.rule, rng=ctx.boot_rng(), n_boot=ctx.n_boot, resamples=ctx.resamples,
     )
     controls = computed.table
-    ctx.found["controls"] = computed
+    ctx.found.controls = computed
     for sentence in answers(controls, {ctx.exp.name: poisson_share(effects)}):
         sec.text(sentence.replace("**", ""))
     sec.table("findings", controls, "Findings under their controls (ratio to the two-disk "
@@ -123,5 +123,5 @@ def section(ctx):
         ]
     )
     sec.table("findings_statements", table, "Findings (effect, 95 % CI, verdict)", show=False)
-    ctx.found["effects"] = effects
+    ctx.found.effects = effects
     return sec

@@ -166,7 +166,7 @@ def rate_heterogeneity(collisions, *, homogeneity=None, rule="mirror", max_point
 def sections(ctx):
     """Rate heterogeneity, from the homogeneity tests the Poisson section ran."""
     exp = ctx.exp
-    het = ctx.found.get("homogeneity")
+    het = ctx.found.homogeneity
     if het is None or het.empty:
         return []
     alpha, n_mc = ctx.alpha, ctx.n_mc

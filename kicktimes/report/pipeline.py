@@ -82,8 +82,9 @@ def _stages():
     )
 
 
-#: number of section stages per store (:data:`STAGES` without importing the modules)
-N_STAGES = 11
+def n_stages() -> int:
+    """The number of section stages per store (the length of the stage list)."""
+    return len(_stages())
 
 
 def __getattr__(name):
@@ -440,7 +441,7 @@ def build_report(
     families_todo = multi and parts["families"] is None
     jobs = {part_ids[k]: (paths[k], out, prefixes[k], options, render, workers) for k in todo}
     parallel = workers > 1 and len(jobs) + families_todo > 1
-    n_steps = 2 + (len(jobs) if parallel else N_STAGES * len(jobs)) + families_todo
+    n_steps = 2 + (len(jobs) if parallel else n_stages() * len(jobs)) + families_todo
     bar = Progress(progress, n_steps)
     # the collector runs less often while the report allocates (kicktimes.memory)
     with closing(bar), fewer_collections(), _one_blas_thread():

@@ -376,9 +376,9 @@ def sections(ctx):
     )
     sec.table("poisson_tests", rejections, "Rejections per radius and test (the headline test "
               f"also at a fixed {FIXED_EVENTS} collisions: *_fixed)")
-    ctx.found["rejections"] = rejections
-    ctx.found["poisson_per_ic"] = per_ic
-    ctx.found["homogeneity"] = homogeneity
+    ctx.found.rejections = rejections
+    ctx.found.poisson_per_ic = per_ic
+    ctx.found.homogeneity = homogeneity
     return [sec]
 
 
@@ -416,14 +416,14 @@ def clustered_share(per_ic, column, alpha, *, rng, n_boot=2000, level=0.95):
 
 def effects(ctx):
     """Share of (IC, radius) runs whose collision times reject a Poisson process."""
-    rej = ctx.found.get("rejections")
+    rej = ctx.found.rejections
     if rej is None or rej.empty:
         return []
     totals = rej.groupby("test", sort=False)[["n_reject", "n_tested"]].sum()
     if HEADLINE_TEST not in totals.index or totals.loc[HEADLINE_TEST, "n_tested"] == 0:
         return []
     k, n = (int(v) for v in totals.loc[HEADLINE_TEST])
-    per_ic = ctx.found["poisson_per_ic"]
+    per_ic = ctx.found.poisson_per_ic
     low, high = clustered_share(per_ic, "p", ctx.alpha, rng=ctx.rng(4), n_boot=ctx.n_boot)
     verdict = share_verdict(low, high, ctx.alpha)
     n_fixed = max(1, int(np.isfinite(per_ic["p_fixed"]).sum()))

@@ -193,7 +193,7 @@ def sections(ctx):
     """The recurrence section: RR beside the off-diagonal rate and DET at every ε."""
     exp = ctx.exp
     rows, notes = recurrence_rows(ctx.results, exp)
-    ctx.found["recurrence_rows"] = rows
+    ctx.found.recurrence_rows = rows
     if rows.empty:
         return []
     sec = Section("recurrence_rate", "Recurrence rate, off-diagonal rate and DET against radius")
@@ -208,7 +208,7 @@ def sections(ctx):
     sec.text(sampling_statement(exp))
     for note in notes:
         sec.text(note)
-    table = _sticky_table(rows, ctx.found.get("sticky"))
+    table = _sticky_table(rows, ctx.found.sticky)
     n = n_samples(exp)
     for e in eps_values(exp):
         rr = table[(table["quantity"] == f"rr@{e:g}") & (table["system"] == REFERENCE)]
@@ -271,7 +271,7 @@ def family_figure(stores):
 
 def effects(ctx):
     """Off-diagonal RR and DET of each kicked system over the two-particle values."""
-    rows = ctx.found.get("recurrence_rows")
+    rows = ctx.found.recurrence_rows
     if rows is None:
         rows, _ = recurrence_rows(ctx.results, ctx.exp)
     out = []

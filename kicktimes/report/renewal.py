@@ -267,14 +267,14 @@ def sections(ctx):
     sec.table("renewal_pooled", pooled, "Pooled intervals: model comparison")
     sec.table("renewal_per_ic", per_ic, "Per IC: every model", show=False)
     sec.table("renewal_best_per_ic", best, "Per IC: best model", show=False)
-    ctx.found["renewal_best"] = best
-    ctx.found["renewal_pooled"] = pooled
+    ctx.found.renewal_best = best
+    ctx.found.renewal_pooled = pooled
     return [sec]
 
 
 def effects(ctx):
     """Share of fitted ICs whose AIC-best renewal model is the exponential."""
-    best = ctx.found.get("renewal_best")
+    best = ctx.found.renewal_best
     if best is None:
         return []
     fitted = best[best["best_model"].notna()]
@@ -296,7 +296,7 @@ def effects(ctx):
     }[share_verdict(low, high, level)]
     others = fitted["best_model"].value_counts()
     detail = ", ".join(f"{m} {c}" for m, c in others.items())
-    pooled = ctx.found.get("renewal_pooled")
+    pooled = ctx.found.renewal_pooled
     if pooled is not None and not pooled.empty:
         winners = pooled.loc[pooled.groupby("radius")["aic"].idxmin(), "model"].value_counts()
         detail += "; pooled over ICs (a mixture of rates): " + ", ".join(

@@ -64,7 +64,7 @@ def write_results(
         ratio_curves_figure,
     )
     from kicktimes.report.findings import rules_text, scale_statement
-    from kicktimes.report.pipeline import N_STAGES, analyse
+    from kicktimes.report.pipeline import analyse, n_stages
 
     paths = [store_paths] if isinstance(store_paths, str | os.PathLike) else list(store_paths)
     if not paths or not all(isinstance(p, str | os.PathLike) for p in paths):
@@ -77,7 +77,7 @@ def write_results(
     out.mkdir(parents=True, exist_ok=True)
     stores = [load_report_store(p) for p in paths]
     pool = Mapper(workers)
-    bar = Progress(False, N_STAGES * len(stores))
+    bar = Progress(False, n_stages() * len(stores))
     lines = [
         "# What the reproduction shows (generated)",
         "",
@@ -112,11 +112,11 @@ def write_results(
                 ]
             else:
                 lines += [f"Scale: {scale}.", ""]
-            controls.append(ctx.found["controls"].table)
-            curves.append(ctx.found["controls"].curves)
-            shares[name] = poisson_share(ctx.found["effects"])
+            controls.append(ctx.found.controls.table)
+            curves.append(ctx.found.controls.curves)
+            shares[name] = poisson_share(ctx.found.effects)
             lines += ["### All statements (primary setting)", ""]
-            for e in ctx.found["effects"]:
+            for e in ctx.found.effects:
                 lines.append(
                     "- " + _md_escape(e.statement() + (f" ({e.detail}.)" if e.detail else ""))
                 )

@@ -252,7 +252,7 @@ def sections(ctx):
     diag = results[~results["diagnostic"].isin(["t_max", "kick_rate"])]
     summary = diagnostic_summary(diag)
     comparison = comparison_table(summary)
-    ctx.found["summary"] = summary
+    ctx.found.summary = summary
     sec = Section("diagnostic_tables", "Diagnostic summaries (all diagnostics)")
     sec.text(
         "Per radius, system and diagnostic: number of ICs n, number of finite values n_valid "
