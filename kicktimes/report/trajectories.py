@@ -274,8 +274,8 @@ def recurrence_plot(
         inset.set_ylim(j0 * scale, (j0 + zoom) * scale)
         inset.set_aspect("equal")
         inset.tick_params(labelsize="xx-small")
-        inset.set_xlabel(f"{int(sel.sum())} pairs in {zoom} x {zoom} samples",
-                         fontsize="xx-small", labelpad=1)
+        inset.text(0.03, 0.97, f"{int(sel.sum())} pairs in {zoom} x {zoom} samples",
+                   transform=inset.transAxes, fontsize="xx-small", va="top")
         ax.indicate_inset_zoom(inset, edgecolor="tab:red")
     ax.set_xlabel(f"{unit} $i$")
     ax.set_ylabel(f"{unit} $j$")
