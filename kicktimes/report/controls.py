@@ -164,11 +164,6 @@ def diagnostics_of(results, eps):
     return out
 
 
-def _per_ic(results, row, transform=None):
-    table = wide(results, row)
-    return table if transform is None else transform(table)
-
-
 def _row(family, diagnostic, system, control, est, low, high, n_pairs, detail):
     return {
         "family": family,
@@ -271,9 +266,10 @@ def compute_controls(results, collisions, *, family, eps, rule="mirror", rng, n_
     rows, curves = [], []
     systems = kicked_systems(results)
     for diagnostic, row, uniform in diagnostics_of(results, eps):
-        transform = (lambda t: 1.0 - t) if diagnostic == "one_minus_r1" else None
-        table = _per_ic(results, row, transform)
-        table_u = _per_ic(results, uniform) if uniform else None
+        table = wide(results, row)
+        if diagnostic == "one_minus_r1":
+            table = 1.0 - table
+        table_u = wide(results, uniform) if uniform else None
         if REFERENCE not in table.columns:
             continue
         for system in systems:
