@@ -33,9 +33,9 @@ import pandas as pd
 from numba import njit
 
 from kicktimes import initial_conditions, simulate_one_particle, simulate_two_particle
-from kicktimes.billiard.two_particle import init_events_two, next_event_two, process_event_two
+from kicktimes.billiard.kernels import two
+from kicktimes.billiard.kernels.tangent import pair_tangent, renormalise, wall_tangent
 from kicktimes.diagnostics import autocorrelation_function, boundary_angles, lyapunov, rqa
-from kicktimes.diagnostics._tangent import _renormalise, pair_tangent, wall_tangent
 from kicktimes.experiment.presets import preset
 from kicktimes.schedules import Poisson
 
@@ -46,13 +46,13 @@ def fresh_partner_tangent(st, rho, sigma, n_steps, tau, U):
     before each disk-disk collision. Returns ``(log_scale, t_end)``."""
     m = U.shape[0]
     ev = np.empty(3)
-    init_events_two(st, ev, rho, sigma)
+    two.init_events(st, ev, rho, sigma)
     log_scale = np.zeros(m)
     t_prev = 0.0
     for _ in range(n_steps):
         tk = min(t_prev + tau, st[0] + min(ev[0], min(ev[1], ev[2])))
         while True:
-            ke, dt = next_event_two(ev)
+            ke, dt = two.next_event(two.load(st, ev))
             if not st[0] + dt <= tk:
                 break
             for j in range(m):
@@ -61,7 +61,7 @@ def fresh_partner_tangent(st, rho, sigma, n_steps, tau, U):
                 U[j, 4] += U[j, 6] * dt
                 U[j, 5] += U[j, 7] * dt
             v0x, v0y, v1x, v1y = st[3], st[4], st[7], st[8]
-            process_event_two(st, ev, ke, rho, sigma, 0)
+            two.process_event(st, ev, ke, rho, sigma, 0)
             if ke == 2:
                 for j in range(m):
                     for i in range(4, 8):
@@ -71,7 +71,7 @@ def fresh_partner_tangent(st, rho, sigma, n_steps, tau, U):
                                              U[j, 5], U[j, 6], U[j, 7], st[1], st[2], st[5],
                                              st[6], v0x, v0y, v1x, v1y, st[3], st[4], st[7],
                                              st[8], 0)
-                    _renormalise(U, log_scale, j)
+                    renormalise(U, log_scale, j)
             else:
                 o = 1 + 4 * ke
                 vx = v0x if ke == 0 else v1x
@@ -81,7 +81,7 @@ def fresh_partner_tangent(st, rho, sigma, n_steps, tau, U):
                         (U[j, o - 1], U[j, o], U[j, o + 1], U[j, o + 2]) = wall_tangent(
                             U[j, o - 1], U[j, o], U[j, o + 1], U[j, o + 2], st[o], st[o + 1],
                             vx, vy, st[o + 2], st[o + 3], rho)
-                        _renormalise(U, log_scale, j)
+                        renormalise(U, log_scale, j)
         t_prev = tk
     dt = t_prev - st[0]
     for j in range(m):

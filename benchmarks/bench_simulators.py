@@ -66,7 +66,7 @@ def check_c_matches(c_ref, r, tau, n_steps):
 def compare_with_c(ics, r, tau, n_steps, repeat=15):
     """CPU seconds of (simulate_two_particle, the bare kernel, the C loop) over ``ics``,
     minima of ``repeat`` interleaved rounds; None if no C compiler."""
-    from kicktimes.billiard.two_particle import simulate_two_kernel
+    from kicktimes.billiard.kernels.drive_two import simulate_two_kernel
 
     c_ref, why = load_c_reference()
     if c_ref is None:

@@ -23,27 +23,27 @@ __all__ = ["cold_kernels", "announce", "warm_up", "warm_sweep", "warm_report"]
 #: the kernel of the sweep's `rqa` call (not `_sweep`, which only `recurrence_rate` calls:
 #: it stayed "cold" after every sweep), stands for all its kernels)
 #: A sweep with the tangent FTLE (every preset) runs each trajectory once, through the
-#: one-pass kernels (kicktimes.diagnostics._tangent_run); the separate simulation and
+#: one-pass kernels (kicktimes.billiard.kernels.drive_two, .drive_one); the separate simulation and
 #: tangent kernels are compiled on first use by the calls that need them.
 SWEEP_KERNELS = (
-    ("kicktimes.diagnostics._tangent_run", "simulate_tangent_two_kernel", 5.5),
-    ("kicktimes.diagnostics._tangent_run", "simulate_tangent_one_kernel", 5.0),
+    ("kicktimes.billiard.kernels.drive_two", "simulate_tangent_two_kernel", 5.5),
+    ("kicktimes.billiard.kernels.drive_one", "simulate_tangent_one_kernel", 5.0),
     ("kicktimes.diagnostics._recurrence_kernels", "_sweep_lines_dense", 3.0),
     ("kicktimes.diagnostics.autocorrelation", "_acf_curve", 1.3),
     ("kicktimes.diagnostics.autocorrelation", "_select_checked", 0.2),
     # the uniform-time re-runs of the recurrence control (rr_sampling = "run+uniform", the
     # full presets); seconds timed cold on the project's machine, 2026-11-25
-    ("kicktimes.billiard.two_particle", "simulate_two_kernel", 2.6),
-    ("kicktimes.billiard.one_particle", "simulate_one_kernel", 2.8),
+    ("kicktimes.billiard.kernels.drive_two", "simulate_two_kernel", 2.6),
+    ("kicktimes.billiard.kernels.drive_one", "simulate_one_kernel", 2.8),
 )
-SIMULATE_KERNELS = (("kicktimes.billiard.two_particle", "simulate_two_kernel", 4.5),)
+SIMULATE_KERNELS = (("kicktimes.billiard.kernels.drive_two", "simulate_two_kernel", 4.5),)
 #: What the report compiles beyond the sweep's kernels (``kicktimes reproduce``'s report
 #: process warms them while the sweep's compile or run): the trajectory figures'
 #: re-simulation with a collision log, the recurrence plot's pair sweep (sorted cells, pairs
 #: collected), the hyperexponential EM of the renewal fits, the exact KS law and the
 #: Ljung-Box statistic of the Poisson tests.
 REPORT_KERNELS = (
-    ("kicktimes.billiard.two_particle", "simulate_two_kernel", 2.0),
+    ("kicktimes.billiard.kernels.drive_two", "simulate_two_kernel", 2.0),
     ("kicktimes.diagnostics._recurrence_kernels", "_sweep", 1.0),
     ("kicktimes.stats.distributions", "_em_steps", 0.5),
     ("kicktimes.stats.poisson", "pomeranz_cdf", 0.5),

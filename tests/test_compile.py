@@ -34,7 +34,7 @@ def test_unknown_cache_state_says_nothing(monkeypatch):
 
 
 def test_the_cache_probe_reads_numbas_index_of_a_real_kernel():
-    from kicktimes.billiard.two_particle import simulate_two_kernel
+    from kicktimes.billiard.kernels.drive_two import simulate_two_kernel
 
     assert _compile._is_cold(simulate_two_kernel) in (True, False)
 
@@ -70,12 +70,12 @@ def test_simulator_and_ftle_kernels_compile_once_without_error_strings(tmp_path)
 
     sigs = compiled_signatures(_SETUP, _CALLS, tmp_path)
     ours = {name: s for name, s in sigs.items() if name.startswith("kicktimes.")}
-    assert "kicktimes.billiard.two_particle.simulate_two_kernel" in ours
+    assert "kicktimes.billiard.kernels.drive_two.simulate_two_kernel" in ours
     # the buffer growth is generic over the dtype: the int8 particle column and the floats
     several = {name: s for name, s in ours.items()
-               if len(s) > 1 and name != "kicktimes.billiard.two_particle._grow_to"}
+               if len(s) > 1 and name != "kicktimes.billiard.kernels.observe.grow_to"}
     assert several == {}
-    assert len(ours["kicktimes.billiard.two_particle._grow_to"]) <= 2
+    assert len(ours["kicktimes.billiard.kernels.observe.grow_to"]) <= 2
     strings = string_formatting(sigs)
     assert strings == []
 

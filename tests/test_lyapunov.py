@@ -7,9 +7,10 @@ import numpy as np
 import pytest
 
 from kicktimes import initial_conditions, schedules, simulate_one_particle, simulate_two_particle
+from kicktimes.billiard.kernels.drive_two import tangent_two_kernel
+from kicktimes.billiard.kernels.tangent import MAX_SAME_INSTANT
+from kicktimes.billiard.kernels.twins import ftle_two_kernel
 from kicktimes.diagnostics import UndefinedDiagnosticWarning, lyapunov
-from kicktimes.diagnostics._tangent import MAX_SAME_INSTANT, tangent_two_kernel
-from kicktimes.diagnostics._twin import ftle_two_kernel
 from kicktimes.diagnostics.lyapunov import _check_status, lyapunov_spectrum
 
 
@@ -386,10 +387,10 @@ def test_one_pass_kernels_compile_once_without_error_strings(tmp_path):
 
     sigs = compiled_signatures(_ONE_PASS_SETUP, _ONE_PASS_CALLS, tmp_path)
     ours = {name: s for name, s in sigs.items() if name.startswith("kicktimes.")}
-    assert "kicktimes.diagnostics._tangent_run.simulate_tangent_two_kernel" in ours
-    assert "kicktimes.diagnostics._tangent_run.simulate_tangent_one_kernel" in ours
+    assert "kicktimes.billiard.kernels.drive_two.simulate_tangent_two_kernel" in ours
+    assert "kicktimes.billiard.kernels.drive_one.simulate_tangent_one_kernel" in ours
     several = {name: s for name, s in ours.items()
-               if len(s) > 1 and name != "kicktimes.billiard.two_particle._grow_to"}
+               if len(s) > 1 and name != "kicktimes.billiard.kernels.observe.grow_to"}
     assert several == {}
     strings = string_formatting(sigs)
     assert strings == []

@@ -7,10 +7,11 @@ import pytest
 
 from kicktimes import initial_conditions, schedules
 from kicktimes.billiard.geometry import boundary_hit_time
-from kicktimes.billiard.two_particle import init_events_two, next_event_two, process_event_two
+from kicktimes.billiard.kernels import two
+from kicktimes.billiard.kernels.drive_one import tangent_one_kernel
+from kicktimes.billiard.kernels.drive_two import tangent_two_kernel
+from kicktimes.billiard.kernels.twins import ftle_one_kernel
 from kicktimes.diagnostics import lyapunov
-from kicktimes.diagnostics._tangent import tangent_one_kernel, tangent_two_kernel
-from kicktimes.diagnostics._twin import ftle_one_kernel
 from kicktimes.diagnostics.lyapunov import lyapunov_spectrum
 
 R = 0.05
@@ -39,10 +40,10 @@ def first_events_two(st0, rule):
     """(kind of the first event, its time, time of the second event)."""
     st = st0.copy()
     ev = np.empty(3)
-    init_events_two(st, ev, RHO, SIG)
-    k1, t1 = next_event_two(ev)
-    process_event_two(st, ev, k1, RHO, SIG, rule)
-    _, dt2 = next_event_two(ev)
+    two.init_events(st, ev, RHO, SIG)
+    k1, t1 = two.next_event(two.load(st, ev))
+    two.process_event(st, ev, k1, RHO, SIG, rule)
+    _, dt2 = two.next_event(two.load(st, ev))
     return k1, t1, t1 + dt2
 
 
@@ -330,8 +331,10 @@ def _two_args(ic, r, *, mode, n_steps, tau, max_events=None, rule="mirror"):
 
 @pytest.mark.parametrize("mode", [1, 2])
 def test_one_pass_kernel_carries_every_tangent_vector_as_the_tangent_kernel(mode):
-    from kicktimes.billiard.two_particle import simulate_two_kernel
-    from kicktimes.diagnostics._tangent_run import simulate_tangent_two_kernel
+    from kicktimes.billiard.kernels.drive_two import (
+        simulate_tangent_two_kernel,
+        simulate_two_kernel,
+    )
 
     ic = initial_conditions(1, R, seed=21, rule="elastic")[0]
     args = _two_args(ic, R, mode=mode, n_steps=600, tau=0.3, rule="elastic")
@@ -349,8 +352,10 @@ def test_one_pass_kernel_carries_every_tangent_vector_as_the_tangent_kernel(mode
 
 
 def test_an_exhausted_tangent_budget_stops_only_the_tangent_half():
-    from kicktimes.billiard.two_particle import simulate_two_kernel
-    from kicktimes.diagnostics._tangent_run import simulate_tangent_two_kernel
+    from kicktimes.billiard.kernels.drive_two import (
+        simulate_tangent_two_kernel,
+        simulate_two_kernel,
+    )
 
     ic = initial_conditions(1, R, seed=22)[0]
     args = _two_args(ic, R, mode=2, n_steps=500, tau=0.3)
@@ -363,7 +368,7 @@ def test_an_exhausted_tangent_budget_stops_only_the_tangent_half():
 
 def test_the_continuation_has_the_event_budget_of_a_run_to_t_continue():
     from kicktimes import simulate_two_particle
-    from kicktimes.diagnostics._tangent_run import simulate_tangent_two_kernel
+    from kicktimes.billiard.kernels.drive_two import simulate_tangent_two_kernel
 
     ic = initial_conditions(1, R, seed=23)[0]
     run = simulate_two_particle(ic, R, sampling="paper", n_steps=500, tau=0.3)

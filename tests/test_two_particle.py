@@ -8,7 +8,7 @@ import pytest
 from numba import njit
 
 from kicktimes import initial_conditions, read_run, simulate_two_particle
-from kicktimes.billiard.two_particle import init_events_two, next_event_two, process_event_two
+from kicktimes.billiard.kernels import two
 
 
 @njit  # not cached: numba's cache does not see changes in the kernels it calls
@@ -20,7 +20,7 @@ def _invariant_violations(st, r, rule, n_events):
     rho = 1.0 - r
     sigma = 2.0 * r
     ev = np.empty(3)
-    init_events_two(st, ev, rho, sigma)
+    two.init_events(st, ev, rho, sigma)
     e0 = st[3] ** 2 + st[4] ** 2 + st[7] ** 2 + st[8] ** 2
     outside = 0.0
     overlap = 0.0
@@ -28,8 +28,8 @@ def _invariant_violations(st, r, rule, n_events):
     energy_err = 0.0
     n_pp = 0
     for _ in range(n_events):
-        k, _ = next_event_two(ev)
-        process_event_two(st, ev, k, rho, sigma, rule)
+        k, _ = two.next_event(two.load(st, ev))
+        two.process_event(st, ev, k, rho, sigma, rule)
         n_pp += k == 2
         for i in range(2):
             o = 1 + 4 * i

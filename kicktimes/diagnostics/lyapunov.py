@@ -5,9 +5,9 @@ Two methods (docs/lyapunov.md has the derivations):
 * ``method="tangent"`` (default): the linearised dynamics, exact. A tangent vector
   ``(dq, dv)`` starts along ``x`` of the tracked disk and is carried through free flights,
   wall reflections, disk-disk collisions and kicks by the exact linearised event maps
-  (`kicktimes.diagnostics._tangent`). No ``d0``, no round-off floor, no deferrals.
+  (`kicktimes.billiard.kernels.tangent`). No ``d0``, no round-off floor, no deferrals.
 * ``method="twin"``: Benettin's twin trajectory at distance ``d0``, renormalised at the
-  sample times (`kicktimes.diagnostics._twin`); kept for fidelity to the paper, which used
+  sample times (`kicktimes.billiard.kernels.twins`); kept for fidelity to the paper, which used
   it. For small enough ``d0`` it converges to the tangent result.
 
 Both measure the same quantity: the growth rate of the tracked disk's position
@@ -24,6 +24,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from kicktimes.billiard import checks as chk
+from kicktimes.billiard.kernels.drive_one import simulate_tangent_one_kernel, tangent_one_kernel
+from kicktimes.billiard.kernels.drive_two import simulate_tangent_two_kernel, tangent_two_kernel
+from kicktimes.billiard.kernels.tangent import MAX_SAME_INSTANT
+from kicktimes.billiard.kernels.twins import ftle_one_kernel, ftle_two_kernel
 from kicktimes.billiard.one_particle import (
     KICK_ANGLES,
     check_one_particle_state,
@@ -40,12 +44,6 @@ from kicktimes.billiard.two_particle import (
     raise_for_status,
     two_particle_run,
 )
-from kicktimes.diagnostics._tangent import MAX_SAME_INSTANT, tangent_one_kernel, tangent_two_kernel
-from kicktimes.diagnostics._tangent_run import (
-    simulate_tangent_one_kernel,
-    simulate_tangent_two_kernel,
-)
-from kicktimes.diagnostics._twin import ftle_one_kernel, ftle_two_kernel
 from kicktimes.diagnostics.autocorrelation import UndefinedDiagnosticWarning
 
 VARIANTS = ("norm", "paper")
@@ -334,8 +332,8 @@ def lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rule
 
     The reference trajectory is bitwise the one `simulate_two_particle` /
     `simulate_one_particle` compute with the same arguments; with ``return_run=True`` one
-    event loop (`kicktimes.diagnostics._tangent_run`) produces both, each bitwise what
-    its own call gives (the result, that of ``lyapunov`` without ``return_run``).
+    event loop (`kicktimes.billiard.kernels.drive_two`, `.drive_one`) produces both, each
+    bitwise what its own call gives (the result, that of ``lyapunov`` without ``return_run``).
 
     Examples
     --------

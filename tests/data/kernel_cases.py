@@ -9,6 +9,10 @@ Usage (from the repository root, with ``PYTHONPATH=$PWD``)::
     python tests/data/kernel_cases.py dump /tmp/kern_ref.npz          # record
     python tests/data/kernel_cases.py check /tmp/kern_ref.npz         # compare (exit 1 if not)
     python tests/data/kernel_cases.py dump tests/data/kernels_golden.npz --small
+
+``--lyapunov`` adds the FTLE kernels (tangent, twin, one pass with its continuation,
+spectrum) on the same kinds of runs: a same-machine reference for a change to the event
+loops (not stored: their chaotic outputs are bitwise only on one machine).
 """
 
 from __future__ import annotations
@@ -69,6 +73,50 @@ def outputs(small: bool = False) -> dict[str, np.ndarray]:
     return out
 
 
+def lyapunov_outputs(small: bool = False) -> dict[str, np.ndarray]:
+    """Every number the FTLE kernels return, keyed ``case/field``."""
+    from kicktimes import initial_conditions, schedules
+    from kicktimes.diagnostics import lyapunov, lyapunov_spectrum
+    from kicktimes.diagnostics.lyapunov import lyapunov_pass
+
+    n = 60 if small else 1500
+    out = {}
+
+    def put(name, res):
+        for key, val in res.__dict__.items():
+            if isinstance(val, int | float | np.ndarray) and not isinstance(val, bool):
+                out[f"{name}/{key}"] = np.asarray(val)
+
+    for name, ic, r, kw in _two_cases(small):
+        if "t_max" in kw:
+            continue
+        kw = {k: v for k, v in kw.items() if k != "log_collisions"}
+        for method, variant in (("tangent", "norm"), ("tangent", "paper"), ("twin", "paper")):
+            extra = {"d0": 1e-8} if method == "twin" else {}
+            put(f"{name}/{method}_{variant}",
+                lyapunov(ic, r, method=method, variant=variant, **extra, **kw))
+        if kw.get("sampling") == "paper":
+            res, run, pp = lyapunov_pass(ic, r, t_continue=0.5 * n, **kw)
+            put(f"{name}/pass", res)
+            out.update(_fields(f"{name}/pass_run", run, ("pp_times",)))
+            out[f"{name}/pass_pp"] = np.asarray(pp)
+    for name, state, r, kw in _one_cases(small):
+        if "t_max" in kw:
+            continue
+        for method in ("tangent", "twin"):
+            extra = {"d0": 1e-8} if method == "twin" else {}
+            put(f"{name}/{method}", lyapunov(state, r, method=method, **extra, **kw))
+        res, run = lyapunov(state, r, return_run=True, **kw)
+        put(f"{name}/pass", res)
+        out.update(_fields(f"{name}/pass_run", run, ("kick_times", "kick_log_array")))
+    for i, rule in enumerate(("mirror", "elastic")):
+        r = 0.05
+        ic = initial_conditions(1, r, seed=300 + i, method="uniform", rule=rule)[0]
+        put(f"spectrum_{rule}", lyapunov_spectrum(ic, r, t_max=0.1 * n, rule=rule))
+    del schedules
+    return out
+
+
 def _fields(name, run, extra):
     d = {f"{name}/{k}": np.asarray(v) for k, v in run.boundary_log._asdict().items()}
     d[f"{name}/sample_times"] = run.sample_times
@@ -120,14 +168,21 @@ def load(path) -> dict[str, np.ndarray]:
 def main(argv):
     action, path = argv[0], argv[1]
     small = "--small" in argv
-    if action == "dump":
+
+    def everything(small):
         out = outputs(small)
+        if "--lyapunov" in argv:
+            out.update(lyapunov_outputs(small))
+        return out
+
+    if action == "dump":
+        out = everything(small)
         save(path, out)
         print(f"{len(out)} arrays written to {path}")
         return 0
     ref = load(path)
     small = small or "golden" in path
-    bad = differences(ref, outputs(small))
+    bad = differences(ref, everything(small))
     print(f"{len(ref)} arrays compared: {len(bad)} differ" + (": " + ", ".join(bad[:20])
                                                                if bad else ""))
     return 1 if bad else 0

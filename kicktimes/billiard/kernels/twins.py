@@ -1,4 +1,4 @@
-"""Benettin's twin-trajectory FTLE kernels (``lyapunov(..., method="twin")``).
+"""The twin driver: Benettin's twin-trajectory FTLE (``lyapunov(..., method="twin")``).
 
 A twin starts ``d0`` away from the reference in the tracked disk's position. At every
 sample time ``t_k`` the separation ``d_k`` of the tracked disk's centres is measured,
@@ -17,6 +17,13 @@ counts and an order-sensitive hash). After ``max_defer`` consecutive deferrals i
 
 Kicked twins share the reference's kick times and angles (common random numbers).
 
+The reference and every twin advance through the event steps of
+`kicktimes.billiard.kernels.two` and `.one` in their array form (`two.process_event`,
+`one.process_wall`, `one.kick_step`, ...), so they compute the bits the simulators do.
+The per-sample work (event selection, counters, renormalisation) is written out in each
+kernel, on scalars and 2-D arrays indexed in place: a helper taking arrays, called per
+sample and twin, costs numba's reference counting on every call (measured: 2-5x slower).
+
 Every event loop has a budget: the kernels return a status (0 ok, 1 event budget
 exhausted, 2 too many events at one instant, 3 a non-finite event time) for the Python
 layer to turn into an error naming the input.
@@ -30,21 +37,12 @@ import numpy as np
 from numba import njit
 
 from kicktimes.billiard.geometry import boundary_hit_time, pair_hit_time
-from kicktimes.billiard.one_particle import (
-    SCATTER,
-    kick_one,
-    next_event_one,
-    process_scatter_one,
-    process_twin_scatter_one,
-    wall_one,
-)
-from kicktimes.billiard.two_particle import (
-    HASH_MOD,
-    init_events_two,
-    next_event_two,
-    process_event_two,
-)
-from kicktimes.diagnostics._tangent import _budget
+from kicktimes.billiard.kernels import one, two
+from kicktimes.billiard.kernels.tangent import event_guard
+
+__all__ = ["HASH_MOD", "ftle_one_kernel", "ftle_two_kernel"]
+
+HASH_MOD = 2305843009213693951  # 2**61 - 1, keeps seq_hash * 8 inside int64
 
 
 @njit(cache=True)
@@ -101,7 +99,7 @@ def ftle_two_kernel(st0, rho, sigma, rule, mode, n_steps, tau, track, offsets, m
     nst = st0.shape[0]
     ref = st0.copy()
     ev_ref = np.empty(3)
-    init_events_two(ref, ev_ref, rho, sigma)
+    two.init_events(ref, ev_ref, rho, sigma)
     cnt_ref = np.zeros(5, dtype=np.int64)
     tw = np.empty((m, nst))
     ev_tw = np.empty((m, 3))
@@ -114,7 +112,7 @@ def ftle_two_kernel(st0, rho, sigma, rule, mode, n_steps, tau, track, offsets, m
             tw[j, c] = st0[c]
         tw[j, o] += offsets[j, 0]
         tw[j, o + 1] += offsets[j, 1]
-        init_events_two(tw[j], ev_tw[j], rho, sigma)
+        two.init_events(tw[j], ev_tw[j], rho, sigma)
     log_sum = np.zeros(m)
     n_renorm = np.zeros(m, dtype=np.int64)
     n_forced = np.zeros(m, dtype=np.int64)
@@ -135,7 +133,7 @@ def ftle_two_kernel(st0, rho, sigma, rule, mode, n_steps, tau, track, offsets, m
             tk = min(t_prev + tau, ref[0] + min(ev_ref[0], min(ev_ref[1], ev_ref[2])))
         # the reference: every event at time <= tk, no flight on (positions interpolated)
         while True:
-            ke, dt = next_event_two(ev_ref)
+            ke, dt = two.next_event(two.load(ref, ev_ref))
             if not ref[0] + dt <= tk:
                 status = 3 if dt != dt else 0
                 break
@@ -143,10 +141,10 @@ def ftle_two_kernel(st0, rho, sigma, rule, mode, n_steps, tau, track, offsets, m
             if dt > 0.0 and n_ev <= max_events:
                 n_same = 0
             else:
-                status, n_same = _budget(dt, n_ev, np.int64(n_same), max_events)
+                status, n_same = event_guard(dt, n_ev, np.int64(n_same), max_events)
                 if status != 0:
                     break
-            process_event_two(ref, ev_ref, ke, rho, sigma, rule)
+            two.process_event(ref, ev_ref, ke, rho, sigma, rule)
             if ke == 2:
                 cnt_ref[0] += 1
             else:
@@ -177,10 +175,10 @@ def ftle_two_kernel(st0, rho, sigma, rule, mode, n_steps, tau, track, offsets, m
                 if dt > 0.0 and n_ev <= max_events:
                     n_same = 0
                 else:
-                    status, n_same = _budget(dt, n_ev, np.int64(n_same), max_events)
+                    status, n_same = event_guard(dt, n_ev, np.int64(n_same), max_events)
                     if status != 0:
                         break
-                process_event_two(tw[j], ev_tw[j], ke, rho, sigma, rule)
+                two.process_event(tw[j], ev_tw[j], ke, rho, sigma, rule)
                 if ke == 2:
                     cnt_tw[j, 0] += 1
                 else:
@@ -256,12 +254,13 @@ def ftle_one_kernel(st0, rho, kicks, angles, kick_mode, mode, n_steps, tau, offs
     Twins share the kick times and angles (common random numbers). Returns as
     `ftle_two_kernel`, ``n_pert`` counting the kicks applied. Scattering kicks
     (``kick_mode == 2``, numbers ``kick_u``, parameters ``sp`` as in
-    `process_scatter_one`): the reference draws the partner, placed in contact with it,
-    and every twin meets that same partner at its own contact time, or misses it.
+    `kicktimes.billiard.kernels.one.scatter_step`): the reference draws the partner, placed
+    in contact with it, and every twin meets that same partner at its own contact time, or
+    misses it.
     """
     m = offsets.shape[0]
     nk = kicks.shape[0]
-    scatter = kick_mode == SCATTER
+    scatter = kick_mode == one.SCATTER
     unit_speed = (abs(st0[3] * st0[3] + st0[4] * st0[4] - 1.0) < 1e-12
                   and not (scatter and sp[1] != 0.0))
     # the reference and the twins reflect with the general-speed formula (np.bool_: a bool
@@ -301,7 +300,7 @@ def ftle_one_kernel(st0, rho, kicks, angles, kick_mode, mode, n_steps, tau, offs
         if mode == 1:
             tk = k * tau
         else:
-            _, dtn = next_event_one(ref, ev_ref, kicks, cnt_ref)
+            _, dtn = one.next_event(one.load(ref, ev_ref), kicks, cnt_ref[0])
             tk = min(t_prev + tau, ref[0] + dtn)
         while True:
             ik = cnt_ref[0]
@@ -317,11 +316,11 @@ def ftle_one_kernel(st0, rho, kicks, angles, kick_mode, mode, n_steps, tau, offs
             if dt > 0.0 and n_ev <= max_events:
                 n_same = 0
             else:
-                status, n_same = _budget(dt, n_ev, np.int64(n_same), max_events)
+                status, n_same = event_guard(dt, n_ev, np.int64(n_same), max_events)
                 if status != 0:
                     break
             if is_kick and scatter:
-                process_scatter_one(ref, ev_ref, dt, rho, kicks[ik], kick_u[ik, 0],
+                one.scatter_step(ref, ev_ref, dt, rho, kicks[ik], kick_u[ik, 0],
                                     kick_u[ik, 1], sp, row)
                 # the kick does not move the centre: the partner touches it along n
                 partners[ik, 0] = ref[1] + sp[0] * row[4]
@@ -331,11 +330,11 @@ def ftle_one_kernel(st0, rho, kicks, angles, kick_mode, mode, n_steps, tau, offs
                 cnt_ref[0] += 1
                 cnt_ref[2] = (cnt_ref[2] * 4 + 4) % HASH_MOD
             elif is_kick:
-                kick_one(ref, ev_ref, dt, rho, kicks[ik], angles[ik], kick_mode)
+                one.kick_step(ref, ev_ref, dt, rho, kicks[ik], angles[ik], kick_mode)
                 cnt_ref[0] += 1
                 cnt_ref[2] = (cnt_ref[2] * 4 + 4) % HASH_MOD
             else:
-                wall_one(ref, ev_ref, dt, rho, no_shortcut)
+                one.process_wall(ref, ev_ref, dt, rho, no_shortcut)
                 cnt_ref[1] += 1
                 cnt_ref[2] = (cnt_ref[2] * 4 + 1) % HASH_MOD
         if status != 0:
@@ -358,21 +357,21 @@ def ftle_one_kernel(st0, rho, kicks, angles, kick_mode, mode, n_steps, tau, offs
                 if dt > 0.0 and n_ev <= max_events:
                     n_same = 0
                 else:
-                    status, n_same = _budget(dt, n_ev, np.int64(n_same), max_events)
+                    status, n_same = event_guard(dt, n_ev, np.int64(n_same), max_events)
                     if status != 0:
                         break
                 if is_kick and scatter:
-                    hit = process_twin_scatter_one(tw[j], ev_tw[j], dt, rho, kicks[ik],
+                    hit = one.twin_scatter_step(tw[j], ev_tw[j], dt, rho, kicks[ik],
                                                    partners[ik], sp)
                     cnt_tw[j, 0] += 1
                     # a missed partner is a different event sequence: defer, then force
                     cnt_tw[j, 2] = (cnt_tw[j, 2] * 4 + (4 if hit else 2)) % HASH_MOD
                 elif is_kick:
-                    kick_one(tw[j], ev_tw[j], dt, rho, kicks[ik], angles[ik], kick_mode)
+                    one.kick_step(tw[j], ev_tw[j], dt, rho, kicks[ik], angles[ik], kick_mode)
                     cnt_tw[j, 0] += 1
                     cnt_tw[j, 2] = (cnt_tw[j, 2] * 4 + 4) % HASH_MOD
                 else:
-                    wall_one(tw[j], ev_tw[j], dt, rho, no_shortcut)
+                    one.process_wall(tw[j], ev_tw[j], dt, rho, no_shortcut)
                     cnt_tw[j, 1] += 1
                     cnt_tw[j, 2] = (cnt_tw[j, 2] * 4 + 1) % HASH_MOD
             if status != 0:

@@ -1,0 +1,414 @@
+"""The two-disk driver: one event loop, with the observers a caller switches on.
+
+`drive` runs the event step of `kicktimes.billiard.kernels.two` and composes around it:
+
+* the **simulation** (``cnt[SIM_ON]``): samples of the tracked disk on the free flights
+  (`kicktimes.billiard.kernels.observe`), the boundary log, the disk-disk times and,
+  with ``log_pp``, their collision log, up to the run's end (``t_max``, or ``n_steps``
+  collision-truncated steps);
+* the **tangent vectors** (``tan``, or ``None``): the linearised event maps of
+  `kicktimes.billiard.kernels.tangent` after each event, over the tangent's own steps
+  (its step ends ``min(t_prev + tau, t + dt_next)`` can differ from the sample times in
+  the last bit), with Gram-Schmidt at ``n_orth`` times for the spectrum;
+* the **continuation** (``cont``, or ``None``): after a paper-sampled window that ends
+  before ``t_continue``, the disk-disk times on to it (a fresh run to ``t_max =
+  t_continue`` logs the same).
+
+An observer passed as ``None`` is compiled out (numba prunes the branches on an argument
+that is ``None``), so the simulation alone runs the loop it always had. All observers see
+one event sequence; each stops recording at its own end and the loop runs until the
+longest is done. Three entry points: `simulate_two_kernel`, `simulate_tangent_two_kernel`
+(the one pass of a sweep) and `tangent_two_kernel` (the FTLE and the spectrum alone).
+
+Status codes: the simulation's `DONE`, `STALLED`, `OVER_BUDGET`
+(`kicktimes.billiard.kernels.observe`); the tangent half's as `tangent.event_guard`'s
+(0 ok, 1 budget, 2 stuck at one instant, 3 non-finite time). A simulation error stops the
+loop at once; a tangent error only stops the tangent half. A contact exactly tangent to
+the wall makes `wall_tangent` return NaN: the tangent half carries it to its end, where
+`kicktimes.diagnostics.lyapunov` reports the exponent as undefined.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from kicktimes.billiard.kernels import two
+from kicktimes.billiard.kernels.observe import (
+    DONE,
+    FULL,
+    OVER_BUDGET,
+    STALLED,
+    grow_rows_to,
+    grow_to,
+    sample_at_event,
+    sample_flight,
+    stalled,
+)
+from kicktimes.billiard.kernels.tangent import (
+    close_step,
+    end_step,
+    guard,
+    pair_tangent,
+    renormalise,
+    step_end,
+    tangent_flight,
+    wall_tangent,
+)
+
+__all__ = ["drive", "simulate_tangent_two_kernel", "simulate_two_kernel", "tangent_two_kernel"]
+
+# the int64 carry array ``cnt`` of the loop (its position between calls)
+N_PP, N_B, K, SIM_ON, N_PP_RUN, CONT_ON, N_B_CONT, CONT_STATUS = range(8)
+# ... and the tangent half's: ``tgi`` (int64) and ``tgf`` (float64)
+TAN_ON, I_LOOP, N_LOOP, N_EV, N_SAME, N_RESC, N_PERT, TAN_STATUS = range(8)
+TK, T_PREV = range(2)
+
+
+@njit(cache=True, error_model="numpy")
+def drive(st, ev, phys, t_end, mode, tau, track, logs, stimes, samples, cnt, next_s, fin, tan,
+          cont):
+    """Run the event loop from ``st``/``ev``; returns `DONE`, or `FULL` when a log is full.
+
+    ``phys = (rho, sigma, rule)``; ``logs = (pp, bt, bp, bx, by, bs, ppl, log_pp)``;
+    ``stimes``, ``samples`` the sample buffers; ``cnt``, ``next_s`` (the next sample time)
+    and ``fin`` (the simulation's final state ``[t_end, x0, .., vy1]``) carry the loop's
+    position between calls. ``tan = (U, log_scale, tgi, tgf, max_events, n_orth,
+    n_steps)`` or ``None``; ``cont = (t_continue, max_events)`` or ``None``.
+
+    The state lives in a tuple of locals for the whole loop (numba keeps it in registers;
+    kept in arrays, every event stored and reloaded it, since numba cannot prove that the
+    output buffers do not alias it). `FULL` returns before anything of the event is
+    counted: the caller grows the buffer and calls again.
+    """
+    rho, sigma, rule = phys
+    pp, bt, bp, bx, by, bs, ppl, log_pp = logs
+    e0 = st[10]
+    s = two.load(st, ev)
+    n_pp = cnt[N_PP]
+    n_b = cnt[N_B]
+    k = cnt[K]
+    # an observer passed as None is compiled out: the simulation alone is always on
+    sim_on = True
+    tan_on = False
+    cont_on = False
+    if cont is not None:
+        sim_on = cnt[SIM_ON] != 0
+        cont_on = cnt[CONT_ON] != 0
+    n_b_cont = cnt[N_B_CONT]
+    if tan is not None:
+        sim_on = cnt[SIM_ON] != 0
+        tan_on = tan[2][TAN_ON] != 0
+        U, log_scale, tgi, tgf, max_ev_tan, n_orth, n_steps = tan
+        m = U.shape[0]
+        i_loop = tgi[I_LOOP]
+        n_loop = tgi[N_LOOP]
+        n_ev = tgi[N_EV]
+        n_same = tgi[N_SAME]
+        n_resc = tgi[N_RESC]
+        n_pert = tgi[N_PERT]
+        tk = tgf[TK]
+        t_prev = tgf[T_PREV]
+    ns = stimes.shape[0]
+    pp_cap = pp.shape[0]
+    b_cap = bt.shape[0]
+    ns_next = next_s[0]
+    status = FULL
+    while True:
+        ke, dte = two.next_event(s)
+        t = s[two.S_T]
+        if sim_on:
+            x, y, vx, vy = two.disk(s, track)
+            k, ns_next = sample_flight(stimes, samples, k, ns_next, t, dte, x, y, vx, vy, mode,
+                                       tau)
+            if (mode == 2 and k >= ns) or t + dte > t_end:
+                sim_on = False
+                cnt[N_PP_RUN] = n_pp
+                if mode == 2:
+                    t_end = stimes[ns - 1]
+                f = two.fly(s, t_end)
+                fin[0] = t_end
+                fin[1], fin[2], fin[3], fin[4] = two.disk(f, 0)
+                fin[5], fin[6], fin[7], fin[8] = two.disk(f, 1)
+                if cont is not None:
+                    # continued only if the sampled window ends before t_continue; its
+                    # budget counts every event from t = 0, as a run to t_continue's does
+                    cont_on = mode == 2 and not t_end >= cont[0]
+                    n_b_cont = n_b
+        if tan is not None and tan_on:
+            while not t + dte <= tk:
+                code, last, tk, t_prev, i_loop = close_step(t, dte, tk, t_prev, i_loop, n_loop,
+                                                            mode, n_steps, tau)
+                if (last and code == 0) or n_orth > 0:
+                    end_step(U, log_scale, t_prev - t, last, n_orth)
+                if last:
+                    tgi[TAN_STATUS] = code
+                    tan_on = False
+                    break
+        if cont is not None and cont_on:
+            # the run to t_continue stops at the first event after it
+            if t + dte > cont[0]:
+                cont_on = False
+            elif n_pp + n_b_cont >= cont[1]:
+                cnt[CONT_STATUS] = OVER_BUDGET
+                cont_on = False
+        if not (sim_on or tan_on or cont_on):
+            status = DONE
+            break
+        # a full buffer: return before anything of this event is counted
+        if ke == two.PAIR:
+            if (sim_on or cont_on) and n_pp >= pp_cap:
+                break
+            if sim_on and log_pp:
+                ppl[n_pp, 4] = s[two.S_VX0]
+                ppl[n_pp, 5] = s[two.S_VY0]
+                ppl[n_pp, 6] = s[two.S_VX1]
+                ppl[n_pp, 7] = s[two.S_VY1]
+        elif sim_on and n_b >= b_cap:
+            break
+        if tan is not None and tan_on:
+            code, n_ev, n_same = guard(dte, n_ev, n_same, max_ev_tan)
+            if code != 0:
+                tgi[TAN_STATUS] = code
+                tan_on = False
+            else:
+                tangent_flight(U, dte)
+        before = s
+        s, sin_theta = two.step(s, ke, dte, rho, sigma, rule, e0)
+        t = s[two.S_T]
+        if ke == two.PAIR:
+            if tan is not None and tan_on:
+                n_pert += 1
+                for j in range(m):
+                    (U[j, 0], U[j, 1], U[j, 2], U[j, 3], U[j, 4], U[j, 5], U[j, 6],
+                     U[j, 7]) = pair_tangent(
+                        U[j, 0], U[j, 1], U[j, 2], U[j, 3], U[j, 4], U[j, 5], U[j, 6], U[j, 7],
+                        s[two.S_X0], s[two.S_Y0], s[two.S_X1], s[two.S_Y1],
+                        before[two.S_VX0], before[two.S_VY0], before[two.S_VX1],
+                        before[two.S_VY1], s[two.S_VX0], s[two.S_VY0], s[two.S_VX1],
+                        s[two.S_VY1], rule)
+                    n_resc += renormalise(U, log_scale, j)
+            if sim_on or cont_on:
+                pp[n_pp] = t
+                if sim_on and log_pp:
+                    ppl[n_pp, 0] = s[two.S_X0]
+                    ppl[n_pp, 1] = s[two.S_Y0]
+                    ppl[n_pp, 2] = s[two.S_X1]
+                    ppl[n_pp, 3] = s[two.S_Y1]
+                    ppl[n_pp, 8] = s[two.S_VX0]
+                    ppl[n_pp, 9] = s[two.S_VY0]
+                    ppl[n_pp, 10] = s[two.S_VX1]
+                    ppl[n_pp, 11] = s[two.S_VY1]
+                n_pp += 1
+        else:
+            x, y, wx, wy = two.disk(s, ke)
+            if tan is not None and tan_on:
+                _, _, vx, vy = two.disk(before, ke)
+                if vx != wx or vy != wy:
+                    # (a disk already moving inward is not reflected: identity map)
+                    c = 4 * ke
+                    for j in range(m):
+                        (U[j, c], U[j, c + 1], U[j, c + 2], U[j, c + 3]) = wall_tangent(
+                            U[j, c], U[j, c + 1], U[j, c + 2], U[j, c + 3], x, y, vx, vy, wx,
+                            wy, rho)
+            if sim_on:
+                bt[n_b] = t
+                bp[n_b] = ke
+                bx[n_b] = x
+                by[n_b] = y
+                bs[n_b] = sin_theta
+                n_b += 1
+            elif cont is not None and cont_on:
+                n_b_cont += 1
+        if sim_on and mode == 2 and k < ns:
+            # the paper's step is cut short by this collision: sample at it
+            x, y, _, _ = two.disk(s, track)
+            k, ns_next = sample_at_event(stimes, samples, k, t, x, y, tau)
+    two.store(st, ev, s)
+    cnt[N_PP] = n_pp
+    cnt[N_B] = n_b
+    cnt[K] = k
+    cnt[SIM_ON] = 1 if sim_on else 0
+    cnt[CONT_ON] = 1 if cont_on else 0
+    cnt[N_B_CONT] = n_b_cont
+    next_s[0] = ns_next
+    if tan is not None:
+        tgi[TAN_ON] = 1 if tan_on else 0
+        tgi[I_LOOP] = i_loop
+        tgi[N_EV] = n_ev
+        tgi[N_SAME] = n_same
+        tgi[N_RESC] = n_resc
+        tgi[N_PERT] = n_pert
+        tgf[TK] = tk
+        tgf[T_PREV] = t_prev
+    return status
+
+
+@njit(cache=True)
+def tangent_state(U, mode, n_steps, tau, max_events, n_orth):
+    """The tangent half of `drive`: ``(U, log_scale, tgi, tgf, max_events, n_orth,
+    n_steps)``; the first step's end is set by `_run` from the initial state."""
+    tgi = np.zeros(8, dtype=np.int64)
+    tgi[TAN_ON] = 1
+    tgi[N_LOOP] = max(1, n_orth) if mode == 1 else n_steps
+    return (U, np.zeros(U.shape[0]), tgi, np.zeros(2), max_events, n_orth, n_steps)
+
+
+@njit(cache=True, error_model="numpy")
+def _run(st, rho, sigma, rule, t_max, mode, n_steps, tau, track, pp_cap, b_cap, max_events,
+         stall_dt, log_pp, sim, tan, cont):
+    """Allocate the logs, run `drive` to its end, growing them when full.
+
+    ``sim``: record the simulation; ``tan`` (`tangent_state`, or ``None``): carry tangent
+    vectors; ``cont``: the continuation (see `drive`).
+    Returns ``(logs, stimes, samples, cnt, fin, tan, status)``.
+    """
+    ev = np.empty(3)
+    two.init_events(st, ev, rho, sigma)
+    pp = np.empty(min(pp_cap, max_events + 1) if sim else 0)
+    ppl = np.empty((pp.shape[0] if log_pp else 0, 12))
+    b_cap = min(b_cap, max_events + 1) if sim else 0
+    bt = np.empty(b_cap)
+    bp = np.empty(b_cap, dtype=np.int8)
+    bx = np.empty(b_cap)
+    by = np.empty(b_cap)
+    bs = np.empty(b_cap)
+    ns = n_steps + 1 if mode > 0 and sim else 0
+    stimes = np.empty(ns)
+    samples = np.empty((ns, 2))
+    cnt = np.zeros(8, dtype=np.int64)
+    cnt[SIM_ON] = 1 if sim else 0
+    next_s = np.zeros(1)
+    fin = np.empty(9)
+    if tan is not None:
+        _, dt = two.next_event(two.load(st, ev))
+        tan[3][TK] = step_end(0, tan[2][N_LOOP], mode, n_steps, tau, 0.0, st[0] + dt)
+    t_end = t_max if mode < 2 else np.inf
+    phys = (rho, sigma, rule)
+    status = DONE
+    while True:
+        logs = (pp, bt, bp, bx, by, bs, ppl, log_pp)
+        loop = drive(st, ev, phys, t_end, mode, tau, track, logs, stimes, samples, cnt, next_s,
+                     fin, tan, cont)
+        if cnt[SIM_ON] != 0:
+            # budget and stalls are checked only here, when a log is full: nothing in the
+            # hot loop
+            if stalled(pp, cnt[N_PP], stall_dt) or stalled(bt, cnt[N_B], stall_dt):
+                status = STALLED
+                break
+            room = max_events - cnt[N_PP] - cnt[N_B]
+            if room <= 0:
+                status = OVER_BUDGET
+                break
+            if cnt[N_PP] >= pp.shape[0]:
+                limit = pp.shape[0] + room
+                pp = grow_to(pp, limit)
+                if log_pp:
+                    ppl = grow_rows_to(ppl, limit)
+            if cnt[N_B] >= bt.shape[0]:
+                limit = bt.shape[0] + room
+                bt = grow_to(bt, limit)
+                bp = grow_to(bp, limit)
+                bx = grow_to(bx, limit)
+                by = grow_to(by, limit)
+                bs = grow_to(bs, limit)
+        elif loop == FULL:
+            # the continuation's times (its budget is checked in the loop)
+            pp = grow_to(pp, pp.shape[0] + max_events + 1)
+        else:
+            break
+    n_pp_run = cnt[N_PP_RUN] if status == DONE else cnt[N_PP]
+    # the last stall test, on the run's own logs
+    if status == DONE and (stalled(pp, n_pp_run, stall_dt) or stalled(bt, cnt[N_B], stall_dt)):
+        status = STALLED
+    if sim and status == DONE:
+        for i in range(9):
+            st[i] = fin[i]
+        st[9] = 0.0
+    logs = (pp, bt, bp, bx, by, bs, ppl, log_pp)
+    return logs, stimes, samples, cnt, fin, tan, status
+
+
+@njit(cache=True, error_model="numpy")
+def simulate_two_kernel(st, rho, sigma, rule, t_max, mode, n_steps, tau, track, pp_cap, b_cap,
+                        max_events, stall_dt, log_pp=False):
+    """Run the two-disk billiard, logging every event and sampling the tracked disk.
+
+    ``st`` is ``[t, x0, y0, vx0, vy0, x1, y1, vx1, vy1, clock compensation, energy]``.
+    ``mode``: 0 no samples (run to ``t_max``), 1 uniform samples at ``k tau`` (run to
+    ``t_max``), 2 the paper's collision-truncated steps (run until ``n_steps`` are done).
+    Samples are interpolated along the free flight, inside the event loop. The run stops
+    early with status `OVER_BUDGET` after ``max_events`` collisions, or `STALLED` (see
+    `kicktimes.billiard.kernels.observe.stalled`); ``st`` then holds the state where it
+    stopped.
+
+    Returns ``(pp_times, b_time, b_part, b_x, b_y, b_sin, sample_times, samples, t_end,
+    pp_log, status)``; ``pp_log`` has a row per disk-disk collision if ``log_pp``, else none.
+    """
+    logs, stimes, samples, cnt, fin, _, status = _run(
+        st, rho, sigma, rule, t_max, mode, n_steps, tau, track, pp_cap, b_cap, max_events,
+        stall_dt, log_pp, True, None, None)
+    pp, bt, bp, bx, by, bs, ppl, _ = logs
+    n_pp = cnt[N_PP]
+    n_b = cnt[N_B]
+    t_end = fin[0] if status == DONE else (t_max if mode < 2 else np.inf)
+    # views, not copies: the buffers are at most about twice the size needed
+    return (pp[:n_pp], bt[:n_b], bp[:n_b], bx[:n_b], by[:n_b], bs[:n_b], stimes, samples, t_end,
+            ppl[: n_pp if log_pp else 0], status)
+
+
+@njit(cache=True, error_model="numpy")
+def simulate_tangent_two_kernel(st, rho, sigma, rule, t_max, mode, n_steps, tau, track, pp_cap,
+                                b_cap, max_events, stall_dt, U, max_ev_tan, t_continue):
+    """`simulate_two_kernel` (without the collision log) and `tangent_two_kernel` in one pass.
+
+    The simulation's arguments are `simulate_two_kernel`'s, ``U`` (m, 8) and
+    ``max_ev_tan`` are `tangent_two_kernel`'s (``n_orth = 0``; ``mode`` 1 or 2, the
+    tangent vectors run over the same ``n_steps`` and ``tau``). ``t_continue``: with
+    ``mode == 2``, continue to it when the sampled window ends before it (``0``: never).
+    ``st`` ends as `simulate_two_kernel` leaves it; ``U`` as `tangent_two_kernel` does.
+
+    Returns ``(pp_times, n_pp_run, b_time, b_part, b_x, b_y, b_sin, sample_times, samples,
+    t_end, status, log_scale, n_rescaled, n_pp_tangent, t_end_tangent, status_tangent,
+    status_continuation)``: ``pp_times[:n_pp_run]`` are the run's disk-disk times,
+    ``pp_times`` with the continuation's after them.
+    """
+    logs, stimes, samples, cnt, fin, tan, status = _run(
+        st, rho, sigma, rule, t_max, mode, n_steps, tau, track, pp_cap, b_cap, max_events,
+        stall_dt, False, True, tangent_state(U, mode, n_steps, tau, max_ev_tan, 0),
+        (t_continue, max_events))
+    pp, bt, bp, bx, by, bs, _, _ = logs
+    _, log_scale, tgi, tgf, _, _, _ = tan
+    n_pp_run = cnt[N_PP_RUN] if status == DONE else cnt[N_PP]
+    n_b = cnt[N_B]
+    t_end = fin[0] if status == DONE else (t_max if mode < 2 else np.inf)
+    return (pp[: cnt[N_PP]], n_pp_run, bt[:n_b], bp[:n_b], bx[:n_b], by[:n_b], bs[:n_b], stimes,
+            samples, t_end, status, log_scale, tgi[N_RESC], tgi[N_PERT], tgf[T_PREV],
+            tgi[TAN_STATUS], cnt[CONT_STATUS])
+
+
+@njit(cache=True, error_model="numpy")
+def tangent_two_kernel(st, rho, sigma, rule, mode, n_steps, tau, U, max_events, n_orth):
+    """Carry the tangent vectors ``U`` (m, 8) along the two-disk trajectory from ``st``.
+
+    ``mode`` 1: up to ``n_steps * tau``; mode 2: through ``n_steps`` of the paper's
+    collision-truncated steps (``t_k = min(t_{k-1} + tau, next event)``). Events at
+    times ``<= t_end`` are applied, then everything flies on to ``t_end``. ``U`` and ``st``
+    are updated in place; ``U[j]`` is rescaled now and then and ``log_scale[j]`` collects
+    the logarithms of the factors taken out. With ``n_orth > 0`` (mode 1 only) the rows are
+    re-orthonormalised by Gram-Schmidt at ``n_orth`` equally spaced times, the last at
+    ``t_end`` (for the spectrum: then ``log_scale[j]`` sums ``log |R_jj|``).
+
+    Returns ``(log_scale, n_rescaled, n_pp, t_end, status)``.
+    """
+    tan = tangent_state(U, mode, n_steps, tau, max_events, n_orth)
+    _run(st, rho, sigma, rule, 0.0, mode, n_steps, tau, 0, 0, 0, max_events, 0.0, False, False,
+         tan, None)
+    _, log_scale, tgi, tgf, _, _, _ = tan
+    # the state flies on to the end, as the vectors did
+    dt = tgf[T_PREV] - st[0]
+    for o in (1, 5):
+        st[o] += st[o + 2] * dt
+        st[o + 1] += st[o + 3] * dt
+    st[0] = tgf[T_PREV]
+    return log_scale, tgi[N_RESC], tgi[N_PERT], tgf[T_PREV], tgi[TAN_STATUS]

@@ -1,0 +1,86 @@
+"""What the drivers record around the event step: samples, growing logs, stalls, status.
+
+The observers of a run, shared by the two-disk and the kicked-disk drivers:
+
+* sampling (`sample_flight`, `sample_at_event`): the tracked disk's centre at the sample
+  times that fall on the current free flight (interpolated, before the event), and, under
+  the paper's collision-truncated steps, at the event itself;
+* logs that grow (`grow_to`, `grow_rows_to`): a driver's loop only *detects* a full
+  buffer and returns `FULL`; its caller grows the buffer outside the loop (an array
+  reassigned inside a numba loop costs reference counting on every iteration) and checks
+  there, at no cost per event, the event budget and for stalls (`stalled`);
+* the status codes of a run: `DONE`, `FULL`, `STALLED`, `OVER_BUDGET`.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from kicktimes.billiard.checks import STALL_EVENTS
+
+__all__ = ["DONE", "FULL", "OVER_BUDGET", "STALLED", "grow_to", "grow_rows_to",
+           "sample_at_event", "sample_flight", "stalled"]
+
+# status codes of the event loops
+DONE, FULL, STALLED, OVER_BUDGET = 0, 1, 2, 3
+
+
+@njit(cache=True, error_model="numpy")
+def grow_to(a, limit):
+    """``a`` copied into a buffer twice as long, but no longer than ``limit`` (> len(a)).
+
+    An element loop, not ``out[:n] = a``: numba compiles array-to-slice assignment with
+    its shape-mismatch error message, string formatting included (seconds of compile time).
+    """
+    out = np.empty(min(2 * a.shape[0] + 16, limit), dtype=a.dtype)
+    for i in range(a.shape[0]):
+        out[i] = a[i]
+    return out
+
+
+@njit(cache=True, error_model="numpy")
+def grow_rows_to(a, limit):
+    """Rows of ``a`` copied into a buffer twice as long, but no longer than ``limit``."""
+    out = np.empty((min(2 * a.shape[0] + 16, limit), a.shape[1]), dtype=a.dtype)
+    for i in range(a.shape[0]):
+        for j in range(a.shape[1]):
+            out[i, j] = a[i, j]
+    return out
+
+
+@njit(cache=True, error_model="numpy")
+def stalled(times, n, stall_dt):
+    """True if the last `STALL_EVENTS` of the ``n`` logged ``times`` are less than
+    ``stall_dt`` apart on average: the run makes no progress (e.g. disks jammed against
+    the wall). Legitimate collisions are at least a grazing chord, ``2e-4 rho / |v|``,
+    apart, five orders more than ``stall_dt``."""
+    if n < STALL_EVENTS:
+        return False
+    return times[n - 1] - times[n - STALL_EVENTS] < STALL_EVENTS * stall_dt
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def sample_flight(stimes, samples, k, next_time, t, dt, x, y, vx, vy, mode, tau):
+    """Record the samples strictly before the next event, ``dt`` from now, on the free
+    flight from ``(x, y)`` at time ``t``; returns ``(k, next_time)``, the next sample's
+    index and time. ``mode`` 1: samples at ``k tau``; 2: the paper's steps of ``tau``."""
+    ns = stimes.shape[0]
+    while k < ns and next_time - t < dt:
+        ds = next_time - t
+        stimes[k] = next_time
+        samples[k, 0] = x + vx * ds
+        samples[k, 1] = y + vy * ds
+        k += 1
+        next_time = k * tau if mode == 1 else next_time + tau
+    return k, next_time
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def sample_at_event(stimes, samples, k, t, x, y, tau):
+    """The paper's step cut short by the event at ``t``: a sample there; returns
+    ``(k, next_time)``."""
+    stimes[k] = t
+    samples[k, 0] = x
+    samples[k, 1] = y
+    return k + 1, t + tau

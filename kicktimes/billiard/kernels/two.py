@@ -1,0 +1,259 @@
+"""The event step of the two-disk billiard: find the next event, advance, resolve.
+
+This module is the only place where two disks in the table move and collide. Every
+driver (`kicktimes.billiard.kernels.drive_two`: the simulation with its samples and logs,
+the tangent vectors, the one pass of both; `kicktimes.billiard.kernels.twins`: Benettin's
+twin trajectories) applies events through `step` (state in registers) or its array form
+`process_event` (state in ``st``/``ev``), so they compute the same bits.
+
+The state is a tuple of 13 floats (numba keeps it in registers; `S_*` name the fields)::
+
+    s = (t, comp, x0, y0, vx0, vy0, x1, y1, vx1, vy1, tb0, tb1, tpp)
+
+``t`` the clock and ``comp`` its Kahan compensation; the centres and velocities of disk 0
+and disk 1; ``tb0``, ``tb1``, ``tpp`` the times *from now* to the next boundary collision
+of each disk and to the next disk-disk collision (``inf`` if none). Event times are kept
+relative to the clock: absolute times lose digits as it grows (at ``t ~ 1e6`` their
+spacing is ``1e-10``, enough to make disks overlap).
+
+The array form: ``st = [t, x0, y0, vx0, vy0, x1, y1, vx1, vy1, comp, e0]`` (``e0`` the
+initial kinetic energy, the anchor of the elastic rule) and ``ev = [tb0, tb1, tpp]``.
+
+An event is ``k`` = 0 or 1 (boundary collision of that disk) or 2 (disk-disk). The
+arithmetic (docs/architecture.md, "The physics, precisely"):
+
+* boundary (`wall_event`): the contact is put back on ``|x| = rho`` (one Newton step of
+  ``1/sqrt``), the velocity reflected (or slid on, at a grazing contact,
+  `kicktimes.billiard.geometry.graze`) and the next boundary time is the chord
+  ``2 (x.v) / |v|^2``;
+* disk-disk (`pair_event`): the rule's velocity map along the contact normal, then both
+  boundary times afresh;
+* after either, the elastic rule's velocities are anchored to ``e0`` (`anchor_energy`)
+  and the disk-disk time is recomputed (both events change the relative motion).
+
+Compiled with ``error_model="numpy"`` (no zero test before each division; see
+`kicktimes.billiard.geometry`): every divisor is a non-zero radius, a contact distance
+``2 r``, a speed of a disk at a wall, or the initial energy, which the input checks make
+positive.
+"""
+
+from __future__ import annotations
+
+import math
+
+from numba import njit
+
+from kicktimes.billiard.geometry import (
+    GRAZE_THRESHOLD,
+    SIN_GRAZE,
+    boundary_hit_time,
+    collide_elastic,
+    collide_mirror,
+    graze,
+    pair_hit_time,
+    reflect,
+)
+
+__all__ = ["PAIR", "advance", "anchor_energy", "disk", "init_events", "load", "next_event",
+           "pair_event", "process_event", "resolve", "step", "store", "wall_event"]
+
+#: fields of the state tuple
+(S_T, S_COMP, S_X0, S_Y0, S_VX0, S_VY0, S_X1, S_Y1, S_VX1, S_VY1, S_TB0, S_TB1,
+ S_TPP) = range(13)
+#: the event code of a disk-disk collision (0 and 1 are the boundary of that disk)
+PAIR = 2
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def wall_event(x, y, vx, vy, rho, rule):
+    """Boundary collision of a disk at ``(x, y)`` on ``|x| = rho`` (up to the flight's round-off).
+
+    Returns ``(x, y, vx, vy, t_next, sin_theta)``: the contact put back on the circle, the
+    outgoing velocity, the time from now to the disk's next boundary collision and the
+    incoming ``sin_theta``.
+    """
+    # The contact lies on |x| = rho: remove the flight's round-off with one Newton
+    # step of 1/sqrt (|x|^2 = rho^2 (1 + e), e ~ 1e-16, so the error is O(e^2)).
+    scale = 1.5 - 0.5 * (x * x + y * y) / (rho * rho)
+    x *= scale
+    y *= scale
+    vv = vx * vx + vy * vy
+    if rule == 0:
+        # The mirror rule keeps unit speeds: skip the square root, and stop the
+        # round-off of 10^6 reflections from drifting the speed (one Newton step).
+        sv = 1.5 - 0.5 * vv
+        vx *= sv
+        vy *= sv
+        vv = 1.0
+        sp = 1.0
+        sin_theta = (x * vy - y * vx) / rho
+    else:
+        sp = math.sqrt(vv)
+        sin_theta = (x * vy - y * vx) / (rho * sp)
+    xv = x * vx + y * vy
+    # |x.v| <= rho |v| sin(delta)/2: grazing or tangent (see graze)
+    gz = GRAZE_THRESHOLD * rho * sp
+    if xv > gz:
+        vx, vy = reflect(vx, vy, x / rho, y / rho)
+        # from a point on the circle the next boundary hit is the chord, the exact
+        # root of the quadratic with c = 0: t = -2 (x.v') / |v|^2 = 2 (x.v) / |v|^2
+        t_next = 2.0 * xv / vv
+    elif xv >= -gz:
+        # reflecting would make no progress (a chord of length ~0): slide on
+        vx, vy = graze(x, y, vx, vy, rho, sp)
+        t_next = 2.0 * rho * SIN_GRAZE / sp
+    else:
+        # Never reflect a disk that is already moving inward (only a perturbed twin of
+        # a Lyapunov computation can get here): it would turn it outward, into a
+        # negative chord time.
+        t_next = boundary_hit_time(x, y, vx, vy, rho)
+    return x, y, vx, vy, t_next, sin_theta
+
+
+@njit(cache=True, error_model="numpy")
+def pair_event(x0, y0, vx0, vy0, x1, y1, vx1, vy1, rule):
+    """Velocities ``(vx0, vy0, vx1, vy1)`` after a disk-disk collision of disks in contact."""
+    dx = x0 - x1
+    dy = y0 - y1
+    dd = math.sqrt(dx * dx + dy * dy)
+    nx = dx / dd
+    ny = dy / dd
+    if rule == 0:
+        a, b, c, d = collide_mirror(vx0, vy0, vx1, vy1, nx, ny)
+        s1 = 1.5 - 0.5 * (a * a + b * b)
+        s2 = 1.5 - 0.5 * (c * c + d * d)
+        return a * s1, b * s1, c * s2, d * s2
+    return collide_elastic(vx0, vy0, vx1, vy1, nx, ny)
+
+
+@njit(cache=True, error_model="numpy")
+def anchor_energy(vx0, vy0, vx1, vy1, e0):
+    """The four velocity components rescaled to kinetic energy ``e0`` (one Newton step).
+
+    Correcting each event relative to the previous one would let the rounding bias of
+    10^6 events accumulate to 1e-10; anchoring to the initial value does not.
+    """
+    e = vx0 * vx0 + vy0 * vy0 + vx1 * vx1 + vy1 * vy1
+    f = 1.5 - 0.5 * e / e0
+    return vx0 * f, vy0 * f, vx1 * f, vy1 * f
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def next_event(s):
+    """``(k, dt)``: the next event (0, 1: boundary of that disk; 2: disk-disk) and its
+    time from now; a tie goes to the lower code."""
+    k = 0
+    dt = s[S_TB0]
+    if s[S_TB1] < dt:
+        k = 1
+        dt = s[S_TB1]
+    if s[S_TPP] < dt:
+        k = PAIR
+        dt = s[S_TPP]
+    return k, dt
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def advance(s, dt):
+    """Free flight of both disks for ``dt``; the clock is summed with Kahan compensation."""
+    t, comp, x0, y0, vx0, vy0, x1, y1, vx1, vy1, tb0, tb1, tpp = s
+    x0 += vx0 * dt
+    y0 += vy0 * dt
+    x1 += vx1 * dt
+    y1 += vy1 * dt
+    tb0 -= dt
+    tb1 -= dt
+    tpp -= dt
+    yk = dt - comp
+    tn = t + yk
+    comp = (tn - t) - yk
+    return (tn, comp, x0, y0, vx0, vy0, x1, y1, vx1, vy1, tb0, tb1, tpp)
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def resolve(s, k, rho, sigma, rule, e0):
+    """Apply event ``k`` to disks in contact; returns ``(s, sin_theta)`` (the incoming
+    ``sin_theta`` of a boundary collision, 0 for a disk-disk collision)."""
+    t, comp, x0, y0, vx0, vy0, x1, y1, vx1, vy1, tb0, tb1, tpp = s
+    sin_theta = 0.0
+    if k < PAIR:
+        # one call site for both disks: half the code of two
+        if k == 0:
+            x, y, vx, vy = x0, y0, vx0, vy0
+        else:
+            x, y, vx, vy = x1, y1, vx1, vy1
+        x, y, vx, vy, tb, sin_theta = wall_event(x, y, vx, vy, rho, rule)
+        if k == 0:
+            x0, y0, vx0, vy0, tb0 = x, y, vx, vy, tb
+        else:
+            x1, y1, vx1, vy1, tb1 = x, y, vx, vy, tb
+    else:
+        vx0, vy0, vx1, vy1 = pair_event(x0, y0, vx0, vy0, x1, y1, vx1, vy1, rule)
+        tb0 = boundary_hit_time(x0, y0, vx0, vy0, rho)
+        tb1 = boundary_hit_time(x1, y1, vx1, vy1, rho)
+    if rule != 0:
+        vx0, vy0, vx1, vy1 = anchor_energy(vx0, vy0, vx1, vy1, e0)
+    # both kinds of event change the pair's relative motion
+    tpp = pair_hit_time(x0 - x1, y0 - y1, vx0 - vx1, vy0 - vy1, sigma)
+    return (t, comp, x0, y0, vx0, vy0, x1, y1, vx1, vy1, tb0, tb1, tpp), sin_theta
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def step(s, k, dt, rho, sigma, rule, e0):
+    """Fly ``dt`` to event ``k`` and apply it: `advance` then `resolve`."""
+    return resolve(advance(s, dt), k, rho, sigma, rule, e0)
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def disk(s, i):
+    """``(x, y, vx, vy)`` of disk ``i`` in the state tuple ``s`` (a select, not an index:
+    an index that varies from event to event would compile to a jump table)."""
+    if i == 0:
+        return s[S_X0], s[S_Y0], s[S_VX0], s[S_VY0]
+    return s[S_X1], s[S_Y1], s[S_VX1], s[S_VY1]
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def init_events(st, ev, rho, sigma):
+    """Fill ``ev`` with the times from now to the next events of the state ``st``."""
+    ev[0] = boundary_hit_time(st[1], st[2], st[3], st[4], rho)
+    ev[1] = boundary_hit_time(st[5], st[6], st[7], st[8], rho)
+    ev[2] = pair_hit_time(st[1] - st[5], st[2] - st[6], st[3] - st[7], st[4] - st[8], sigma)
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def load(st, ev):
+    """The state tuple of the arrays ``st``, ``ev``."""
+    return (st[0], st[9], st[1], st[2], st[3], st[4], st[5], st[6], st[7], st[8], ev[0], ev[1],
+            ev[2])
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def store(st, ev, s):
+    """Write the state tuple ``s`` back to the arrays ``st``, ``ev``."""
+    st[0] = s[S_T]
+    st[9] = s[S_COMP]
+    st[1], st[2], st[3], st[4] = disk(s, 0)
+    st[5], st[6], st[7], st[8] = disk(s, 1)
+    ev[0] = s[S_TB0]
+    ev[1] = s[S_TB1]
+    ev[2] = s[S_TPP]
+
+
+@njit(cache=True, error_model="numpy")
+def process_event(st, ev, k, rho, sigma, rule):
+    """`step` on the arrays ``st``, ``ev``: fly to event ``k`` and apply it; returns the
+    incoming ``sin_theta``. For the drivers that keep many trajectories (the twins)."""
+    s, sin_theta = step(load(st, ev), k, ev[k], rho, sigma, rule, st[10])
+    store(st, ev, s)
+    return sin_theta
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def fly(s, t_end):
+    """The state flown freely to the time ``t_end`` (no event before it), clock exactly
+    ``t_end`` and its compensation reset."""
+    t, comp, x0, y0, vx0, vy0, x1, y1, vx1, vy1, tb0, tb1, tpp = s
+    dt = t_end - t
+    return (t_end, 0.0, x0 + vx0 * dt, y0 + vy0 * dt, vx0, vy0, x1 + vx1 * dt, y1 + vy1 * dt,
+            vx1, vy1, tb0 - dt, tb1 - dt, tpp - dt)
