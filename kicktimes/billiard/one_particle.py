@@ -21,7 +21,7 @@ from kicktimes._validation import check_rng
 from kicktimes.billiard import checks as chk
 from kicktimes.billiard.kernels.drive_one import simulate_one_kernel
 from kicktimes.billiard.kernels.one import KICK_ANGLES
-from kicktimes.billiard.runs import BoundaryLog, OneParticleRun
+from kicktimes.billiard.runs import BoundaryLog, OneParticleRun, sampling_fields
 from kicktimes.billiard.scatter import PARTNER_LAWS, draw_scatter_uniforms
 from kicktimes.billiard.two_particle import raise_for_status
 
@@ -315,16 +315,11 @@ def one_particle_run(st, r, state, out, *, sampling, mode, tau, n_steps, seed, k
     bt, bx, by, bs, stimes, samples, n_applied, t_end, klog = out
     return OneParticleRun(
         r=r,
-        t_max=float(t_end),
-        sampling=sampling if mode > 0 else None,
-        tau=tau,
-        n_steps=n_steps,
         ic=state,
         final_state=st[1:5].copy(),
         boundary_log=BoundaryLog(bt, np.zeros(bt.shape[0], dtype=np.int8), bx, by, bs),
-        sample_times=stimes,
-        samples=samples,
         seed=seed,
+        **sampling_fields(t_end, mode, sampling, tau, n_steps, stimes, samples),
         kick_angle=kick_angle,
         sigma=sigma if kick_angle == "gaussian" else None,
         kick_times=times[:n_applied],

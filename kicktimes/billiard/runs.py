@@ -53,6 +53,13 @@ def _arclength(x: np.ndarray, y: np.ndarray) -> np.ndarray:
     return s
 
 
+def sampling_fields(t_end, mode, sampling, tau, n_steps, sample_times, samples) -> dict:
+    """A run's fields that describe its horizon and samples, from a kernel's output (``mode``
+    0: no samples, then ``sampling`` is recorded as ``None``)."""
+    return {"t_max": float(t_end), "sampling": sampling if mode > 0 else None, "tau": tau,
+            "n_steps": n_steps, "sample_times": sample_times, "samples": samples}
+
+
 @dataclass(frozen=True, repr=False)
 class _Run:
     r: float

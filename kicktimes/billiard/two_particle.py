@@ -20,7 +20,7 @@ from kicktimes.billiard import checks as chk
 from kicktimes.billiard.checks import STALL_EVENTS
 from kicktimes.billiard.kernels.drive_two import simulate_two_kernel
 from kicktimes.billiard.kernels.observe import DONE, OVER_BUDGET, STALLED
-from kicktimes.billiard.runs import BoundaryLog, TwoParticleRun
+from kicktimes.billiard.runs import BoundaryLog, TwoParticleRun, sampling_fields
 
 
 def raise_for_status(status: int, st_time: float, n_events: int, *, max_events: int,
@@ -210,18 +210,13 @@ def two_particle_run(out, args, *, r, rule, sampling, tau, n_steps, ic, track, s
         )
     return TwoParticleRun(
         r=r,
-        t_max=float(t_end),
-        sampling=sampling if mode > 0 else None,
-        tau=tau,
-        n_steps=n_steps,
         ic=ic,
         final_state=st[1:9].reshape(2, 4).copy(),
         boundary_log=BoundaryLog(bt, bp, bx, by, bs),
-        sample_times=stimes,
-        samples=samples,
         seed=seed,
         rule=rule,
         track=track,
         pp_times=pp,
         pp_log=ppl,
+        **sampling_fields(t_end, mode, sampling, tau, n_steps, stimes, samples),
     )

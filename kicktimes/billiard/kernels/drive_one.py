@@ -19,41 +19,21 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from kicktimes.billiard.kernels import observe as ob
 from kicktimes.billiard.kernels import one
-from kicktimes.billiard.kernels.observe import (
-    DONE,
-    FULL,
-    OVER_BUDGET,
-    STALLED,
-    grow_to,
-    sample_at_event,
-    sample_flight,
-    stalled,
-)
-from kicktimes.billiard.kernels.tangent import (
-    close_step,
-    end_step,
-    guard,
-    kick_tangent,
-    renormalise,
-    step_end,
-    tangent_flight,
-    wall_tangent,
-)
+from kicktimes.billiard.kernels import tangent as tg
 from kicktimes.billiard.scatter import scatter_tangent
 
 __all__ = ["drive", "simulate_one_kernel", "simulate_tangent_one_kernel", "tangent_one_kernel"]
 
 # the int64 carry array ``cnt`` of the loop, and the tangent half's ``tgi`` and ``tgf``
 N_KICKS, N_B, K, SIM_ON, N_KICKS_RUN = range(5)
-TAN_ON, I_LOOP, N_LOOP, N_EV, N_SAME, N_RESC, N_PERT, TAN_STATUS = range(8)
-TK, T_PREV = range(2)
 
 
 @njit(cache=True)
 def drive(st, ev, rho, kicks, angles, kick_mode, kick_u, sp, unit_speed, t_end, mode, tau, logs,
           stimes, samples, cnt, next_s, fin, tan):
-    """Run the event loop from ``st``/``ev``; returns `DONE`, or `FULL` when the boundary
+    """Run the event loop from ``st``/``ev``; returns `ob.DONE`, or `ob.FULL` when the boundary
     log is full (see `kicktimes.billiard.kernels.drive_two.drive`).
 
     Kicks at ``kicks`` (sorted) with ``angles``; scattering kicks (``kick_mode ==
@@ -71,27 +51,21 @@ def drive(st, ev, rho, kicks, angles, kick_mode, kick_u, sp, unit_speed, t_end, 
         tan_on = False
     else:
         sim_on = cnt[SIM_ON] != 0
-        tan_on = tan[2][TAN_ON] != 0
+        tan_on = tan[2][tg.TAN_ON] != 0
         U, log_scale, tgi, tgf, max_ev_tan, n_orth, n_steps = tan
         m = U.shape[0]
-        i_loop = tgi[I_LOOP]
-        n_loop = tgi[N_LOOP]
-        n_ev = tgi[N_EV]
-        n_same = tgi[N_SAME]
-        n_resc = tgi[N_RESC]
-        n_pert = tgi[N_PERT]
-        tk = tgf[TK]
-        t_prev = tgf[T_PREV]
+        i_loop, n_loop, n_ev, n_same, n_resc, n_pert, tk, t_prev, tan_code = tg.load_carry(
+            tgi, tgf)
     scatter = kick_mode == one.SCATTER
     ns = stimes.shape[0]
     b_cap = bt.shape[0]
     ns_next = next_s[0]
-    status = FULL
+    status = ob.FULL
     while True:
         is_kick, dte = one.next_event(s, kicks, ik)
         t = s[one.S_T]
         if sim_on:
-            k, ns_next = sample_flight(stimes, samples, k, ns_next, t, dte, s[one.S_X],
+            k, ns_next = ob.sample_flight(stimes, samples, k, ns_next, t, dte, s[one.S_X],
                                        s[one.S_Y], s[one.S_VX], s[one.S_VY], mode, tau)
             if (mode == 2 and k >= ns) or t + dte > t_end:
                 sim_on = False
@@ -104,28 +78,24 @@ def drive(st, ev, rho, kicks, angles, kick_mode, kick_u, sp, unit_speed, t_end, 
                 fin[2] = f[one.S_Y]
                 fin[3] = f[one.S_VX]
                 fin[4] = f[one.S_VY]
-        if tan is not None and tan_on:
-            while not t + dte <= tk:
-                code, last, tk, t_prev, i_loop = close_step(t, dte, tk, t_prev, i_loop, n_loop,
-                                                            mode, n_steps, tau)
-                if (last and code == 0) or n_orth > 0:
-                    end_step(U, log_scale, t_prev - t, last, n_orth)
-                if last:
-                    tgi[TAN_STATUS] = code
-                    tan_on = False
-                    break
+        if tan is not None:
+            # the tangent vectors' step ends before the next event
+            while tan_on and not t + dte <= tk:
+                tan_code, last, tk, t_prev, i_loop = tg.close_step(t, dte, tk, t_prev, i_loop,
+                                                                   n_loop, mode, n_steps, tau)
+                if (last and tan_code == 0) or n_orth > 0:
+                    tg.end_step(U, log_scale, t_prev - t, last, n_orth)
+                tan_on = not last
         if not (sim_on or tan_on):
-            status = DONE
+            status = ob.DONE
             break
         if not is_kick and sim_on and n_b >= b_cap:
             break
         if tan is not None and tan_on:
-            code, n_ev, n_same = guard(dte, n_ev, n_same, max_ev_tan)
-            if code != 0:
-                tgi[TAN_STATUS] = code
-                tan_on = False
-            else:
-                tangent_flight(U, dte)
+            tan_code, n_ev, n_same = tg.guard(dte, n_ev, n_same, max_ev_tan)
+            tan_on = tan_code == 0
+            if tan_on:
+                tg.tangent_flight(U, dte)
         ux = s[one.S_VX]
         uy = s[one.S_VY]
         if is_kick:
@@ -145,18 +115,18 @@ def drive(st, ev, rho, kicks, angles, kick_mode, kick_u, sp, unit_speed, t_end, 
                             U[j, 0], U[j, 1], U[j, 2], U[j, 3] = scatter_tangent(
                                 ux, uy, row[6], row[7], row[4], row[5], sp[0], int(sp[1]),
                                 U[j, 0], U[j, 1], U[j, 2], U[j, 3])
-                            n_resc += renormalise(U, log_scale, j)
+                            n_resc += tg.renormalise(U, log_scale, j)
                 else:
                     for j in range(m):
-                        U[j, 2], U[j, 3] = kick_tangent(U[j, 2], U[j, 3], ux, uy, s[one.S_VX],
+                        U[j, 2], U[j, 3] = tg.kick_tangent(U[j, 2], U[j, 3], ux, uy, s[one.S_VX],
                                                         s[one.S_VY], angles[ik], kick_mode)
-                        n_resc += renormalise(U, log_scale, j)
+                        n_resc += tg.renormalise(U, log_scale, j)
             ik += 1
         else:
             s, sin_theta = one.wall_step(s, dte, rho, unit_speed)
             if tan is not None and tan_on and (ux != s[one.S_VX] or uy != s[one.S_VY]):
                 for j in range(m):
-                    U[j, 0], U[j, 1], U[j, 2], U[j, 3] = wall_tangent(
+                    U[j, 0], U[j, 1], U[j, 2], U[j, 3] = tg.wall_tangent(
                         U[j, 0], U[j, 1], U[j, 2], U[j, 3], s[one.S_X], s[one.S_Y], ux, uy,
                         s[one.S_VX], s[one.S_VY], rho)
             if sim_on:
@@ -166,7 +136,7 @@ def drive(st, ev, rho, kicks, angles, kick_mode, kick_u, sp, unit_speed, t_end, 
                 by[n_b] = s[one.S_Y]
                 n_b += 1
         if sim_on and mode == 2 and k < ns:
-            k, ns_next = sample_at_event(stimes, samples, k, s[one.S_T], s[one.S_X], s[one.S_Y],
+            k, ns_next = ob.sample_at_event(stimes, samples, k, s[one.S_T], s[one.S_X], s[one.S_Y],
                                          tau)
     one.store(st, ev, s)
     cnt[N_KICKS] = ik
@@ -175,25 +145,9 @@ def drive(st, ev, rho, kicks, angles, kick_mode, kick_u, sp, unit_speed, t_end, 
     cnt[SIM_ON] = 1 if sim_on else 0
     next_s[0] = ns_next
     if tan is not None:
-        tgi[TAN_ON] = 1 if tan_on else 0
-        tgi[I_LOOP] = i_loop
-        tgi[N_EV] = n_ev
-        tgi[N_SAME] = n_same
-        tgi[N_RESC] = n_resc
-        tgi[N_PERT] = n_pert
-        tgf[TK] = tk
-        tgf[T_PREV] = t_prev
+        tg.store_carry(tgi, tgf, tan_on, i_loop, n_ev, n_same, n_resc, n_pert, tk, t_prev,
+                       tan_code)
     return status
-
-
-@njit(cache=True)
-def tangent_state(U, mode, n_steps, tau, max_events, n_orth):
-    """The tangent half of `drive`: ``(U, log_scale, tgi, tgf, max_events, n_orth,
-    n_steps)``; the first step's end is set by `_run` from the initial state."""
-    tgi = np.zeros(8, dtype=np.int64)
-    tgi[TAN_ON] = 1
-    tgi[N_LOOP] = max(1, n_orth) if mode == 1 else n_steps
-    return (U, np.zeros(U.shape[0]), tgi, np.zeros(2), max_events, n_orth, n_steps)
 
 
 @njit(cache=True)
@@ -207,44 +161,33 @@ def _run(st, rho, kicks, angles, kick_mode, t_max, mode, n_steps, tau, b_cap, ki
     ev[0] = one.boundary_hit_time(st[1], st[2], st[3], st[4], rho)
     unit_speed = one.unit_speed_of(st, kick_mode, sp)
     klog = np.zeros((kicks.shape[0] if kick_mode == one.SCATTER else 0, 9))
-    b_cap = min(b_cap, max_events + 1) if sim else 0
-    bt = np.empty(b_cap)
-    bx = np.empty(b_cap)
-    by = np.empty(b_cap)
-    bs = np.empty(b_cap)
-    ns = n_steps + 1 if mode > 0 and sim else 0
-    stimes = np.empty(ns)
-    samples = np.empty((ns, 2))
+    bt, bx, by, bs = ob.new_boundary_log(min(b_cap, max_events + 1) if sim else 0)
+    stimes, samples = ob.new_samples(n_steps + 1 if mode > 0 and sim else 0)
     cnt = np.zeros(5, dtype=np.int64)
     cnt[SIM_ON] = 1 if sim else 0
     next_s = np.zeros(1)
     fin = np.empty(5)
     if tan is not None:
-        _, dt = one.next_event(one.load(st, ev), kicks, 0)
-        tan[3][TK] = step_end(0, tan[2][N_LOOP], mode, n_steps, tau, 0.0, st[0] + dt)
+        tg.start(tan, mode, n_steps, tau, st[0] + one.next_event(one.load(st, ev), kicks, 0)[1])
     t_end = t_max if mode < 2 else np.inf
-    status = DONE
+    status = ob.DONE
     while True:
         loop = drive(st, ev, rho, kicks, angles, kick_mode, kick_u, sp, unit_speed, t_end, mode,
                      tau, (bt, bx, by, bs, klog), stimes, samples, cnt, next_s, fin, tan)
-        if loop == DONE:
+        if loop == ob.DONE:
             break
         # a full boundary log
-        if stalled(bt, cnt[N_B], stall_dt):
-            status = STALLED
+        if ob.stalled(bt, cnt[N_B], stall_dt):
+            status = ob.STALLED
             break
         room = max_events - cnt[N_B]
         if room <= 0:
-            status = OVER_BUDGET
+            status = ob.OVER_BUDGET
             break
-        limit = bt.shape[0] + room
-        bt = grow_to(bt, limit)
-        bx = grow_to(bx, limit)
-        by = grow_to(by, limit)
-        bs = grow_to(bs, limit)
-    if status == DONE and stalled(bt, cnt[N_B], stall_dt):
-        status = STALLED
-    if sim and status == DONE:
+        bt, bx, by, bs = ob.grow_boundary_log(bt, bx, by, bs, bt.shape[0] + room)
+    if status == ob.DONE and ob.stalled(bt, cnt[N_B], stall_dt):
+        status = ob.STALLED
+    if sim and status == ob.DONE:
         for i in range(5):
             st[i] = fin[i]
         st[5] = 0.0
@@ -259,8 +202,8 @@ def simulate_one_kernel(st, rho, kicks, angles, kick_mode, t_max, mode, n_steps,
     ``st`` is ``[t, x, y, vx, vy, clock compensation, squared speed]``. Scattering kicks
     (``kick_mode == 2``) take their random numbers from ``kick_u`` (shape (n_kicks, 2))
     and their parameters from ``sp`` (see `kicktimes.billiard.kernels.one.scatter_step`).
-    Stops early with status `OVER_BUDGET` after ``max_events`` boundary collisions or
-    `STALLED`. Returns ``(b_time, b_x, b_y, b_sin, sample_times, samples,
+    Stops early with status `ob.OVER_BUDGET` after ``max_events`` boundary collisions or
+    `ob.STALLED`. Returns ``(b_time, b_x, b_y, b_sin, sample_times, samples,
     n_kicks_applied, t_end, kick_log, status)``; ``kick_log`` has one row per applied
     scattering kick (else none).
     """
@@ -269,8 +212,8 @@ def simulate_one_kernel(st, rho, kicks, angles, kick_mode, t_max, mode, n_steps,
         max_events, stall_dt, True, None)
     bt, bx, by, bs, klog = logs
     n = cnt[N_B]
-    n_applied = cnt[N_KICKS_RUN] if status == DONE else cnt[N_KICKS]
-    t_end = fin[0] if status == DONE else (t_max if mode < 2 else np.inf)
+    n_applied = cnt[N_KICKS_RUN] if status == ob.DONE else cnt[N_KICKS]
+    t_end = fin[0] if status == ob.DONE else (t_max if mode < 2 else np.inf)
     return (bt[:n], bx[:n], by[:n], bs[:n], stimes, samples, n_applied, t_end, klog[:n_applied],
             status)
 
@@ -287,14 +230,14 @@ def simulate_tangent_one_kernel(st, rho, kicks, angles, kick_mode, t_max, mode, 
     logs, stimes, samples, cnt, fin, tan, status = _run(
         st, rho, kicks, angles, kick_mode, t_max, mode, n_steps, tau, b_cap, kick_u, sp,
         max_events, stall_dt, True,
-        tangent_state(U, mode, n_steps, tau, max_ev_tan, 0))
+        tg.tangent_state(U, mode, n_steps, tau, max_ev_tan, np.int64(0)))
     bt, bx, by, bs, klog = logs
     _, log_scale, tgi, tgf, _, _, _ = tan
     n = cnt[N_B]
-    n_applied = cnt[N_KICKS_RUN] if status == DONE else cnt[N_KICKS]
-    t_end = fin[0] if status == DONE else (t_max if mode < 2 else np.inf)
+    n_applied = cnt[N_KICKS_RUN] if status == ob.DONE else cnt[N_KICKS]
+    t_end = fin[0] if status == ob.DONE else (t_max if mode < 2 else np.inf)
     return (bt[:n], bx[:n], by[:n], bs[:n], stimes, samples, n_applied, t_end, klog[:n_applied],
-            status, log_scale, tgi[N_RESC], tgi[N_PERT], tgf[T_PREV], tgi[TAN_STATUS])
+            status, log_scale, tgi[tg.N_RESC], tgi[tg.N_PERT], tgf[tg.T_PREV], tgi[tg.TAN_STATUS])
 
 
 @njit(cache=True)
@@ -303,7 +246,7 @@ def tangent_one_kernel(st, rho, kicks, angles, kick_mode, mode, n_steps, tau, U,
     """Carry the tangent vectors ``U`` (m, 4) along the kicked one-disk trajectory.
 
     As `kicktimes.billiard.kernels.drive_two.tangent_two_kernel`; kicks at ``kicks``
-    (sorted times) with ``angles`` are applied with `kick_tangent` (a tie with a boundary
+    (sorted times) with ``angles`` are applied with `tg.kick_tangent` (a tie with a boundary
     collision goes to the boundary first). Scattering kicks (``kick_mode == 2``, numbers
     ``kick_u``, parameters ``sp``) are linearised by
     `kicktimes.billiard.scatter.scatter_tangent`: a disk-disk collision with a partner
@@ -311,13 +254,13 @@ def tangent_one_kernel(st, rho, kicks, angles, kick_mode, mode, n_steps, tau, U,
 
     Returns ``(log_scale, n_rescaled, n_kicks, t_end, status)``.
     """
-    tan = tangent_state(U, mode, n_steps, tau, max_events, 0)
+    tan = tg.tangent_state(U, mode, n_steps, tau, max_events, np.int64(0))
     _run(st, rho, kicks, angles, kick_mode, 0.0, mode, n_steps, tau, 0, kick_u, sp, max_events,
          0.0, False, tan)
     _, log_scale, tgi, tgf, _, _, _ = tan
     # the state flies on to the end, as the vectors did
-    dt = tgf[T_PREV] - st[0]
+    dt = tgf[tg.T_PREV] - st[0]
     st[1] += st[3] * dt
     st[2] += st[4] * dt
-    st[0] = tgf[T_PREV]
-    return log_scale, tgi[N_RESC], tgi[N_PERT], tgf[T_PREV], tgi[TAN_STATUS]
+    st[0] = tgf[tg.T_PREV]
+    return log_scale, tgi[tg.N_RESC], tgi[tg.N_PERT], tgf[tg.T_PREV], tgi[tg.TAN_STATUS]

@@ -33,42 +33,21 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from kicktimes.billiard.kernels import observe as ob
+from kicktimes.billiard.kernels import tangent as tg
 from kicktimes.billiard.kernels import two
-from kicktimes.billiard.kernels.observe import (
-    DONE,
-    FULL,
-    OVER_BUDGET,
-    STALLED,
-    grow_rows_to,
-    grow_to,
-    sample_at_event,
-    sample_flight,
-    stalled,
-)
-from kicktimes.billiard.kernels.tangent import (
-    close_step,
-    end_step,
-    guard,
-    pair_tangent,
-    renormalise,
-    step_end,
-    tangent_flight,
-    wall_tangent,
-)
 
 __all__ = ["drive", "simulate_tangent_two_kernel", "simulate_two_kernel", "tangent_two_kernel"]
 
 # the int64 carry array ``cnt`` of the loop (its position between calls)
 N_PP, N_B, K, SIM_ON, N_PP_RUN, CONT_ON, N_B_CONT, CONT_STATUS = range(8)
 # ... and the tangent half's: ``tgi`` (int64) and ``tgf`` (float64)
-TAN_ON, I_LOOP, N_LOOP, N_EV, N_SAME, N_RESC, N_PERT, TAN_STATUS = range(8)
-TK, T_PREV = range(2)
 
 
 @njit(cache=True, error_model="numpy")
 def drive(st, ev, phys, t_end, mode, tau, track, logs, stimes, samples, cnt, next_s, fin, tan,
           cont):
-    """Run the event loop from ``st``/``ev``; returns `DONE`, or `FULL` when a log is full.
+    """Run the event loop from ``st``/``ev``; returns `ob.DONE`, or `ob.FULL` when a log is full.
 
     ``phys = (rho, sigma, rule)``; ``logs = (pp, bt, bp, bx, by, bs, ppl, log_pp)``;
     ``stimes``, ``samples`` the sample buffers; ``cnt``, ``next_s`` (the next sample time)
@@ -78,7 +57,7 @@ def drive(st, ev, phys, t_end, mode, tau, track, logs, stimes, samples, cnt, nex
 
     The state lives in a tuple of locals for the whole loop (numba keeps it in registers;
     kept in arrays, every event stored and reloaded it, since numba cannot prove that the
-    output buffers do not alias it). `FULL` returns before anything of the event is
+    output buffers do not alias it). `ob.FULL` returns before anything of the event is
     counted: the caller grows the buffer and calls again.
     """
     rho, sigma, rule = phys
@@ -98,28 +77,22 @@ def drive(st, ev, phys, t_end, mode, tau, track, logs, stimes, samples, cnt, nex
     n_b_cont = cnt[N_B_CONT]
     if tan is not None:
         sim_on = cnt[SIM_ON] != 0
-        tan_on = tan[2][TAN_ON] != 0
+        tan_on = tan[2][tg.TAN_ON] != 0
         U, log_scale, tgi, tgf, max_ev_tan, n_orth, n_steps = tan
         m = U.shape[0]
-        i_loop = tgi[I_LOOP]
-        n_loop = tgi[N_LOOP]
-        n_ev = tgi[N_EV]
-        n_same = tgi[N_SAME]
-        n_resc = tgi[N_RESC]
-        n_pert = tgi[N_PERT]
-        tk = tgf[TK]
-        t_prev = tgf[T_PREV]
+        i_loop, n_loop, n_ev, n_same, n_resc, n_pert, tk, t_prev, tan_code = tg.load_carry(
+            tgi, tgf)
     ns = stimes.shape[0]
     pp_cap = pp.shape[0]
     b_cap = bt.shape[0]
     ns_next = next_s[0]
-    status = FULL
+    status = ob.FULL
     while True:
         ke, dte = two.next_event(s)
         t = s[two.S_T]
         if sim_on:
             x, y, vx, vy = two.disk(s, track)
-            k, ns_next = sample_flight(stimes, samples, k, ns_next, t, dte, x, y, vx, vy, mode,
+            k, ns_next = ob.sample_flight(stimes, samples, k, ns_next, t, dte, x, y, vx, vy, mode,
                                        tau)
             if (mode == 2 and k >= ns) or t + dte > t_end:
                 sim_on = False
@@ -135,25 +108,23 @@ def drive(st, ev, phys, t_end, mode, tau, track, logs, stimes, samples, cnt, nex
                     # budget counts every event from t = 0, as a run to t_continue's does
                     cont_on = mode == 2 and not t_end >= cont[0]
                     n_b_cont = n_b
-        if tan is not None and tan_on:
-            while not t + dte <= tk:
-                code, last, tk, t_prev, i_loop = close_step(t, dte, tk, t_prev, i_loop, n_loop,
-                                                            mode, n_steps, tau)
-                if (last and code == 0) or n_orth > 0:
-                    end_step(U, log_scale, t_prev - t, last, n_orth)
-                if last:
-                    tgi[TAN_STATUS] = code
-                    tan_on = False
-                    break
+        if tan is not None:
+            # the tangent vectors' step ends before the next event
+            while tan_on and not t + dte <= tk:
+                tan_code, last, tk, t_prev, i_loop = tg.close_step(t, dte, tk, t_prev, i_loop,
+                                                                   n_loop, mode, n_steps, tau)
+                if (last and tan_code == 0) or n_orth > 0:
+                    tg.end_step(U, log_scale, t_prev - t, last, n_orth)
+                tan_on = not last
         if cont is not None and cont_on:
             # the run to t_continue stops at the first event after it
             if t + dte > cont[0]:
                 cont_on = False
             elif n_pp + n_b_cont >= cont[1]:
-                cnt[CONT_STATUS] = OVER_BUDGET
+                cnt[CONT_STATUS] = ob.OVER_BUDGET
                 cont_on = False
         if not (sim_on or tan_on or cont_on):
-            status = DONE
+            status = ob.DONE
             break
         # a full buffer: return before anything of this event is counted
         if ke == two.PAIR:
@@ -167,12 +138,10 @@ def drive(st, ev, phys, t_end, mode, tau, track, logs, stimes, samples, cnt, nex
         elif sim_on and n_b >= b_cap:
             break
         if tan is not None and tan_on:
-            code, n_ev, n_same = guard(dte, n_ev, n_same, max_ev_tan)
-            if code != 0:
-                tgi[TAN_STATUS] = code
-                tan_on = False
-            else:
-                tangent_flight(U, dte)
+            tan_code, n_ev, n_same = tg.guard(dte, n_ev, n_same, max_ev_tan)
+            tan_on = tan_code == 0
+            if tan_on:
+                tg.tangent_flight(U, dte)
         before = s
         s, sin_theta = two.step(s, ke, dte, rho, sigma, rule, e0)
         t = s[two.S_T]
@@ -181,13 +150,13 @@ def drive(st, ev, phys, t_end, mode, tau, track, logs, stimes, samples, cnt, nex
                 n_pert += 1
                 for j in range(m):
                     (U[j, 0], U[j, 1], U[j, 2], U[j, 3], U[j, 4], U[j, 5], U[j, 6],
-                     U[j, 7]) = pair_tangent(
+                     U[j, 7]) = tg.pair_tangent(
                         U[j, 0], U[j, 1], U[j, 2], U[j, 3], U[j, 4], U[j, 5], U[j, 6], U[j, 7],
                         s[two.S_X0], s[two.S_Y0], s[two.S_X1], s[two.S_Y1],
                         before[two.S_VX0], before[two.S_VY0], before[two.S_VX1],
                         before[two.S_VY1], s[two.S_VX0], s[two.S_VY0], s[two.S_VX1],
                         s[two.S_VY1], rule)
-                    n_resc += renormalise(U, log_scale, j)
+                    n_resc += tg.renormalise(U, log_scale, j)
             if sim_on or cont_on:
                 pp[n_pp] = t
                 if sim_on and log_pp:
@@ -208,7 +177,7 @@ def drive(st, ev, phys, t_end, mode, tau, track, logs, stimes, samples, cnt, nex
                     # (a disk already moving inward is not reflected: identity map)
                     c = 4 * ke
                     for j in range(m):
-                        (U[j, c], U[j, c + 1], U[j, c + 2], U[j, c + 3]) = wall_tangent(
+                        (U[j, c], U[j, c + 1], U[j, c + 2], U[j, c + 3]) = tg.wall_tangent(
                             U[j, c], U[j, c + 1], U[j, c + 2], U[j, c + 3], x, y, vx, vy, wx,
                             wy, rho)
             if sim_on:
@@ -223,7 +192,7 @@ def drive(st, ev, phys, t_end, mode, tau, track, logs, stimes, samples, cnt, nex
         if sim_on and mode == 2 and k < ns:
             # the paper's step is cut short by this collision: sample at it
             x, y, _, _ = two.disk(s, track)
-            k, ns_next = sample_at_event(stimes, samples, k, t, x, y, tau)
+            k, ns_next = ob.sample_at_event(stimes, samples, k, t, x, y, tau)
     two.store(st, ev, s)
     cnt[N_PP] = n_pp
     cnt[N_B] = n_b
@@ -233,25 +202,9 @@ def drive(st, ev, phys, t_end, mode, tau, track, logs, stimes, samples, cnt, nex
     cnt[N_B_CONT] = n_b_cont
     next_s[0] = ns_next
     if tan is not None:
-        tgi[TAN_ON] = 1 if tan_on else 0
-        tgi[I_LOOP] = i_loop
-        tgi[N_EV] = n_ev
-        tgi[N_SAME] = n_same
-        tgi[N_RESC] = n_resc
-        tgi[N_PERT] = n_pert
-        tgf[TK] = tk
-        tgf[T_PREV] = t_prev
+        tg.store_carry(tgi, tgf, tan_on, i_loop, n_ev, n_same, n_resc, n_pert, tk, t_prev,
+                       tan_code)
     return status
-
-
-@njit(cache=True)
-def tangent_state(U, mode, n_steps, tau, max_events, n_orth):
-    """The tangent half of `drive`: ``(U, log_scale, tgi, tgf, max_events, n_orth,
-    n_steps)``; the first step's end is set by `_run` from the initial state."""
-    tgi = np.zeros(8, dtype=np.int64)
-    tgi[TAN_ON] = 1
-    tgi[N_LOOP] = max(1, n_orth) if mode == 1 else n_steps
-    return (U, np.zeros(U.shape[0]), tgi, np.zeros(2), max_events, n_orth, n_steps)
 
 
 @njit(cache=True, error_model="numpy")
@@ -259,7 +212,7 @@ def _run(st, rho, sigma, rule, t_max, mode, n_steps, tau, track, pp_cap, b_cap, 
          stall_dt, log_pp, sim, tan, cont):
     """Allocate the logs, run `drive` to its end, growing them when full.
 
-    ``sim``: record the simulation; ``tan`` (`tangent_state`, or ``None``): carry tangent
+    ``sim``: record the simulation; ``tan`` (`tg.tangent_state`, or ``None``): carry tangent
     vectors; ``cont``: the continuation (see `drive`).
     Returns ``(logs, stimes, samples, cnt, fin, tan, status)``.
     """
@@ -267,25 +220,18 @@ def _run(st, rho, sigma, rule, t_max, mode, n_steps, tau, track, pp_cap, b_cap, 
     two.init_events(st, ev, rho, sigma)
     pp = np.empty(min(pp_cap, max_events + 1) if sim else 0)
     ppl = np.empty((pp.shape[0] if log_pp else 0, 12))
-    b_cap = min(b_cap, max_events + 1) if sim else 0
-    bt = np.empty(b_cap)
-    bp = np.empty(b_cap, dtype=np.int8)
-    bx = np.empty(b_cap)
-    by = np.empty(b_cap)
-    bs = np.empty(b_cap)
-    ns = n_steps + 1 if mode > 0 and sim else 0
-    stimes = np.empty(ns)
-    samples = np.empty((ns, 2))
+    bt, bx, by, bs = ob.new_boundary_log(min(b_cap, max_events + 1) if sim else 0)
+    bp = np.empty(bt.shape[0], dtype=np.int8)
+    stimes, samples = ob.new_samples(n_steps + 1 if mode > 0 and sim else 0)
     cnt = np.zeros(8, dtype=np.int64)
     cnt[SIM_ON] = 1 if sim else 0
     next_s = np.zeros(1)
     fin = np.empty(9)
     if tan is not None:
-        _, dt = two.next_event(two.load(st, ev))
-        tan[3][TK] = step_end(0, tan[2][N_LOOP], mode, n_steps, tau, 0.0, st[0] + dt)
+        tg.start(tan, mode, n_steps, tau, st[0] + two.next_event(two.load(st, ev))[1])
     t_end = t_max if mode < 2 else np.inf
     phys = (rho, sigma, rule)
-    status = DONE
+    status = ob.DONE
     while True:
         logs = (pp, bt, bp, bx, by, bs, ppl, log_pp)
         loop = drive(st, ev, phys, t_end, mode, tau, track, logs, stimes, samples, cnt, next_s,
@@ -293,35 +239,33 @@ def _run(st, rho, sigma, rule, t_max, mode, n_steps, tau, track, pp_cap, b_cap, 
         if cnt[SIM_ON] != 0:
             # budget and stalls are checked only here, when a log is full: nothing in the
             # hot loop
-            if stalled(pp, cnt[N_PP], stall_dt) or stalled(bt, cnt[N_B], stall_dt):
-                status = STALLED
+            if ob.stalled(pp, cnt[N_PP], stall_dt) or ob.stalled(bt, cnt[N_B], stall_dt):
+                status = ob.STALLED
                 break
             room = max_events - cnt[N_PP] - cnt[N_B]
             if room <= 0:
-                status = OVER_BUDGET
+                status = ob.OVER_BUDGET
                 break
             if cnt[N_PP] >= pp.shape[0]:
                 limit = pp.shape[0] + room
-                pp = grow_to(pp, limit)
+                pp = ob.grow_to(pp, limit)
                 if log_pp:
-                    ppl = grow_rows_to(ppl, limit)
+                    ppl = ob.grow_rows_to(ppl, limit)
             if cnt[N_B] >= bt.shape[0]:
                 limit = bt.shape[0] + room
-                bt = grow_to(bt, limit)
-                bp = grow_to(bp, limit)
-                bx = grow_to(bx, limit)
-                by = grow_to(by, limit)
-                bs = grow_to(bs, limit)
-        elif loop == FULL:
+                bp = ob.grow_to(bp, limit)
+                bt, bx, by, bs = ob.grow_boundary_log(bt, bx, by, bs, limit)
+        elif loop == ob.FULL:
             # the continuation's times (its budget is checked in the loop)
-            pp = grow_to(pp, pp.shape[0] + max_events + 1)
+            pp = ob.grow_to(pp, pp.shape[0] + max_events + 1)
         else:
             break
-    n_pp_run = cnt[N_PP_RUN] if status == DONE else cnt[N_PP]
+    n_pp_run = cnt[N_PP_RUN] if status == ob.DONE else cnt[N_PP]
     # the last stall test, on the run's own logs
-    if status == DONE and (stalled(pp, n_pp_run, stall_dt) or stalled(bt, cnt[N_B], stall_dt)):
-        status = STALLED
-    if sim and status == DONE:
+    if status == ob.DONE and (ob.stalled(pp, n_pp_run, stall_dt)
+                              or ob.stalled(bt, cnt[N_B], stall_dt)):
+        status = ob.STALLED
+    if sim and status == ob.DONE:
         for i in range(9):
             st[i] = fin[i]
         st[9] = 0.0
@@ -338,7 +282,7 @@ def simulate_two_kernel(st, rho, sigma, rule, t_max, mode, n_steps, tau, track, 
     ``mode``: 0 no samples (run to ``t_max``), 1 uniform samples at ``k tau`` (run to
     ``t_max``), 2 the paper's collision-truncated steps (run until ``n_steps`` are done).
     Samples are interpolated along the free flight, inside the event loop. The run stops
-    early with status `OVER_BUDGET` after ``max_events`` collisions, or `STALLED` (see
+    early with status `ob.OVER_BUDGET` after ``max_events`` collisions, or `ob.STALLED` (see
     `kicktimes.billiard.kernels.observe.stalled`); ``st`` then holds the state where it
     stopped.
 
@@ -351,7 +295,7 @@ def simulate_two_kernel(st, rho, sigma, rule, t_max, mode, n_steps, tau, track, 
     pp, bt, bp, bx, by, bs, ppl, _ = logs
     n_pp = cnt[N_PP]
     n_b = cnt[N_B]
-    t_end = fin[0] if status == DONE else (t_max if mode < 2 else np.inf)
+    t_end = fin[0] if status == ob.DONE else (t_max if mode < 2 else np.inf)
     # views, not copies: the buffers are at most about twice the size needed
     return (pp[:n_pp], bt[:n_b], bp[:n_b], bx[:n_b], by[:n_b], bs[:n_b], stimes, samples, t_end,
             ppl[: n_pp if log_pp else 0], status)
@@ -375,16 +319,16 @@ def simulate_tangent_two_kernel(st, rho, sigma, rule, t_max, mode, n_steps, tau,
     """
     logs, stimes, samples, cnt, fin, tan, status = _run(
         st, rho, sigma, rule, t_max, mode, n_steps, tau, track, pp_cap, b_cap, max_events,
-        stall_dt, False, True, tangent_state(U, mode, n_steps, tau, max_ev_tan, 0),
+        stall_dt, False, True, tg.tangent_state(U, mode, n_steps, tau, max_ev_tan, np.int64(0)),
         (t_continue, max_events))
     pp, bt, bp, bx, by, bs, _, _ = logs
     _, log_scale, tgi, tgf, _, _, _ = tan
-    n_pp_run = cnt[N_PP_RUN] if status == DONE else cnt[N_PP]
+    n_pp_run = cnt[N_PP_RUN] if status == ob.DONE else cnt[N_PP]
     n_b = cnt[N_B]
-    t_end = fin[0] if status == DONE else (t_max if mode < 2 else np.inf)
+    t_end = fin[0] if status == ob.DONE else (t_max if mode < 2 else np.inf)
     return (pp[: cnt[N_PP]], n_pp_run, bt[:n_b], bp[:n_b], bx[:n_b], by[:n_b], bs[:n_b], stimes,
-            samples, t_end, status, log_scale, tgi[N_RESC], tgi[N_PERT], tgf[T_PREV],
-            tgi[TAN_STATUS], cnt[CONT_STATUS])
+            samples, t_end, status, log_scale, tgi[tg.N_RESC], tgi[tg.N_PERT], tgf[tg.T_PREV],
+            tgi[tg.TAN_STATUS], cnt[CONT_STATUS])
 
 
 @njit(cache=True, error_model="numpy")
@@ -401,14 +345,14 @@ def tangent_two_kernel(st, rho, sigma, rule, mode, n_steps, tau, U, max_events, 
 
     Returns ``(log_scale, n_rescaled, n_pp, t_end, status)``.
     """
-    tan = tangent_state(U, mode, n_steps, tau, max_events, n_orth)
+    tan = tg.tangent_state(U, mode, n_steps, tau, max_events, n_orth)
     _run(st, rho, sigma, rule, 0.0, mode, n_steps, tau, 0, 0, 0, max_events, 0.0, False, False,
          tan, None)
     _, log_scale, tgi, tgf, _, _, _ = tan
     # the state flies on to the end, as the vectors did
-    dt = tgf[T_PREV] - st[0]
+    dt = tgf[tg.T_PREV] - st[0]
     for o in (1, 5):
         st[o] += st[o + 2] * dt
         st[o + 1] += st[o + 3] * dt
-    st[0] = tgf[T_PREV]
-    return log_scale, tgi[N_RESC], tgi[N_PERT], tgf[T_PREV], tgi[TAN_STATUS]
+    st[0] = tgf[tg.T_PREV]
+    return log_scale, tgi[tg.N_RESC], tgi[tg.N_PERT], tgf[tg.T_PREV], tgi[tg.TAN_STATUS]

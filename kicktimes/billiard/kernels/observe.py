@@ -19,8 +19,9 @@ from numba import njit
 
 from kicktimes.billiard.checks import STALL_EVENTS
 
-__all__ = ["DONE", "FULL", "OVER_BUDGET", "STALLED", "grow_to", "grow_rows_to",
-           "sample_at_event", "sample_flight", "stalled"]
+__all__ = ["DONE", "FULL", "OVER_BUDGET", "STALLED", "grow_boundary_log", "grow_rows_to",
+           "grow_to", "new_boundary_log", "new_samples", "sample_at_event", "sample_flight",
+           "stalled"]
 
 # status codes of the event loops
 DONE, FULL, STALLED, OVER_BUDGET = 0, 1, 2, 3
@@ -47,6 +48,24 @@ def grow_rows_to(a, limit):
         for j in range(a.shape[1]):
             out[i, j] = a[i, j]
     return out
+
+
+@njit(cache=True, error_model="numpy")
+def new_boundary_log(cap):
+    """Buffers ``(time, x, y, sin_theta)`` of a boundary log for ``cap`` collisions."""
+    return np.empty(cap), np.empty(cap), np.empty(cap), np.empty(cap)
+
+
+@njit(cache=True, error_model="numpy")
+def grow_boundary_log(bt, bx, by, bs, limit):
+    """The boundary log's buffers grown (`grow_to`)."""
+    return grow_to(bt, limit), grow_to(bx, limit), grow_to(by, limit), grow_to(bs, limit)
+
+
+@njit(cache=True, error_model="numpy")
+def new_samples(n):
+    """Buffers ``(sample_times, samples)`` for ``n`` samples of a centre."""
+    return np.empty(n), np.empty((n, 2))
 
 
 @njit(cache=True, error_model="numpy")

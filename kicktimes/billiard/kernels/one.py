@@ -33,8 +33,8 @@ from kicktimes.billiard.geometry import (
 from kicktimes.billiard.scatter import scatter_kick, twin_meets_partner
 
 __all__ = ["KICK_ANGLES", "SCATTER", "advance", "apply_kick", "fly", "kick_step", "load",
-           "next_event", "process_wall", "scatter_step", "store", "twin_scatter_step",
-           "unit_speed_of", "wall_event", "wall_step"]
+           "next_event", "process_wall", "process_wall_at", "scatter_step", "store",
+           "twin_scatter_step", "unit_speed_of", "wall_event", "wall_step"]
 
 #: kick laws and their codes in the kernels
 KICK_ANGLES = {"uniform": 0, "gaussian": 1, "scatter": 2}
@@ -152,6 +152,21 @@ def process_wall(st, ev, dt, rho, unit_speed):
     """`wall_step` on the arrays ``st``, ``ev``; returns the incoming ``sin_theta``."""
     s, sin_theta = wall_step(load(st, ev), dt, rho, unit_speed)
     store(st, ev, s)
+    return sin_theta
+
+
+@njit(cache=True)
+def process_wall_at(traj, ev, j, dt, rho, unit_speed):
+    """`process_wall` on row ``j`` of the 2-D arrays ``traj``, ``ev`` (the twins' form)."""
+    s = (traj[j, 0], traj[j, 5], traj[j, 1], traj[j, 2], traj[j, 3], traj[j, 4], ev[j, 0])
+    s, sin_theta = wall_step(s, dt, rho, unit_speed)
+    traj[j, 0] = s[S_T]
+    traj[j, 5] = s[S_COMP]
+    traj[j, 1] = s[S_X]
+    traj[j, 2] = s[S_Y]
+    traj[j, 3] = s[S_VX]
+    traj[j, 4] = s[S_VY]
+    ev[j, 0] = s[S_TB]
     return sin_theta
 
 

@@ -32,8 +32,13 @@ import numpy as np
 from numba import njit
 
 __all__ = ["BIG", "MAX_SAME_INSTANT", "close_step", "end_step", "event_guard", "gram_schmidt",
-           "guard", "kick_tangent", "pair_tangent", "renormalise", "step_end", "tangent_flight",
-           "wall_tangent"]
+           "guard", "kick_tangent", "load_carry", "pair_tangent", "renormalise", "start",
+           "step_end", "store_carry", "tangent_flight", "tangent_state", "wall_tangent"]
+
+#: the tangent half of a driver carries its position between calls in ``tgi`` (int64) and
+#: ``tgf`` (float64), at these indices
+TAN_ON, I_LOOP, N_LOOP, N_EV, N_SAME, N_RESC, N_PERT, TAN_STATUS = range(8)
+TK, T_PREV = range(2)
 
 MAX_SAME_INSTANT = 1000
 # Keep tangent norms inside [1/BIG, BIG]: far from overflow, and rescaling is rare (a
@@ -210,6 +215,46 @@ def tangent_flight(U, dt):
         if U.shape[1] == 8:
             U[j, 4] += U[j, 6] * dt
             U[j, 5] += U[j, 7] * dt
+
+
+@njit(cache=True)
+def tangent_state(U, mode, n_steps, tau, max_events, n_orth):
+    """The tangent half of a driver (`kicktimes.billiard.kernels.drive_two.drive`):
+    ``(U, log_scale, tgi, tgf, max_events, n_orth, n_steps)`` at the start; the driver sets
+    the first step's end from the initial state."""
+    tgi = np.zeros(8, dtype=np.int64)
+    tgi[TAN_ON] = 1
+    tgi[N_LOOP] = max(1, n_orth) if mode == 1 else n_steps
+    return (U, np.zeros(U.shape[0]), tgi, np.zeros(2), max_events, n_orth, n_steps)
+
+
+@njit(cache=True)
+def start(tan, mode, n_steps, tau, t_next_event):
+    """Set the end of the tangent half's first step, the next event being at
+    ``t_next_event``."""
+    tan[3][TK] = step_end(0, tan[2][N_LOOP], mode, n_steps, tau, 0.0, t_next_event)
+
+
+@njit(cache=True, inline="always")
+def load_carry(tgi, tgf):
+    """The tangent half's position between driver calls: ``(i_loop, n_loop, n_ev, n_same,
+    n_resc, n_pert, tk, t_prev, status)``."""
+    return (tgi[I_LOOP], tgi[N_LOOP], tgi[N_EV], tgi[N_SAME], tgi[N_RESC], tgi[N_PERT], tgf[TK],
+            tgf[T_PREV], tgi[TAN_STATUS])
+
+
+@njit(cache=True, inline="always")
+def store_carry(tgi, tgf, tan_on, i_loop, n_ev, n_same, n_resc, n_pert, tk, t_prev, status):
+    """Write the tangent half's position back (see `load_carry`)."""
+    tgi[TAN_STATUS] = status
+    tgi[TAN_ON] = 1 if tan_on else 0
+    tgi[I_LOOP] = i_loop
+    tgi[N_EV] = n_ev
+    tgi[N_SAME] = n_same
+    tgi[N_RESC] = n_resc
+    tgi[N_PERT] = n_pert
+    tgf[TK] = tk
+    tgf[T_PREV] = t_prev
 
 
 @njit(cache=True, inline="always")

@@ -18,8 +18,8 @@ counts and an order-sensitive hash). After ``max_defer`` consecutive deferrals i
 Kicked twins share the reference's kick times and angles (common random numbers).
 
 The reference and every twin advance through the event steps of
-`kicktimes.billiard.kernels.two` and `.one` in their array form (`two.process_event`,
-`one.process_wall`, `one.kick_step`, ...), so they compute the bits the simulators do.
+`kicktimes.billiard.kernels.two` and `.one` in their array form (`two.process_event_at`,
+`one.process_wall_at`, `one.kick_step`, ...), so they compute the bits the simulators do.
 The per-sample work (event selection, counters, renormalisation) is written out in each
 kernel, on scalars and 2-D arrays indexed in place: a helper taking arrays, called per
 sample and twin, costs numba's reference counting on every call (measured: 2-5x slower).
@@ -36,9 +36,9 @@ import math
 import numpy as np
 from numba import njit
 
-from kicktimes.billiard.geometry import boundary_hit_time, pair_hit_time
+from kicktimes.billiard.geometry import boundary_hit_time
 from kicktimes.billiard.kernels import one, two
-from kicktimes.billiard.kernels.tangent import event_guard
+from kicktimes.billiard.kernels.tangent import guard
 
 __all__ = ["HASH_MOD", "ftle_one_kernel", "ftle_two_kernel"]
 
@@ -81,38 +81,57 @@ def _separation(dx, dy, measure):
     return abs(dy)
 
 
-# The per-sample loops below are written out rather than calling a helper per sample: a
-# numba call with array arguments costs ~50 ns, as much as the rest of a sample's work,
-# and there are 25 000 samples per run. Array-taking kernels are called only per event.
+# The per-sample work below is written out rather than calling a helper per sample: a numba
+# call with array arguments (or an inlined helper taking arrays) costs about as much as the
+# rest of a sample's work, and there are 25 000 samples per run. Array-taking kernels are
+# called only per event.
 
 
 @njit(cache=True)
-def ftle_two_kernel(st0, rho, sigma, rule, mode, n_steps, tau, track, offsets, measure, d0,
-                    max_defer, max_events):
-    """Benettin FTLE for the two-disk billiard with ``len(offsets)`` twins.
+def _ftle(st0, rho, mode, n_steps, tau, track, offsets, measure, d0, max_defer, max_events, pair,
+          kick):
+    """Benettin FTLE of either system: ``pair = (sigma, rule)`` for two disks (``kick`` is
+    ``None``), ``kick = (kicks, angles, kick_mode, kick_u, sp)`` for the kicked disk
+    (``pair`` is ``None``); the other system's code is compiled out.
 
-    Returns ``(log_sum, n_renorm, n_forced, n_deferred, t_last, n_pert, status)``; the
-    first five per twin, ``n_pert[j]`` the reference's disk-disk collisions up to
-    ``t_last[j]``.
+    Row 0 of the trajectory arrays is the reference, rows ``1..m`` the twins: each sample
+    first advances the reference (no flight on: its positions at ``t_k`` are interpolated),
+    then each twin, flown on to ``t_k``, measured against it and renormalised.
     """
     m = offsets.shape[0]
     nst = st0.shape[0]
-    ref = st0.copy()
-    ev_ref = np.empty(3)
-    two.init_events(ref, ev_ref, rho, sigma)
-    cnt_ref = np.zeros(5, dtype=np.int64)
-    tw = np.empty((m, nst))
-    ev_tw = np.empty((m, 3))
-    cnt_tw = np.zeros((m, 5), dtype=np.int64)
+    two_disks = kick is None
+    n_disks = 2 if two_disks else 1
     o = 1 + 4 * track
-    for j in range(m):
-        # element copy, not tw[j] = st0: numba compiles row assignment with a formatted
+    traj = np.empty((m + 1, nst))
+    for j in range(m + 1):
+        # element copy, not traj[j] = st0: numba compiles row assignment with a formatted
         # shape-mismatch message (seconds of compile time)
-        for c in range(st0.shape[0]):
-            tw[j, c] = st0[c]
-        tw[j, o] += offsets[j, 0]
-        tw[j, o + 1] += offsets[j, 1]
-        two.init_events(tw[j], ev_tw[j], rho, sigma)
+        for c in range(nst):
+            traj[j, c] = st0[c]
+        if j > 0:
+            traj[j, o] += offsets[j - 1, 0]
+            traj[j, o + 1] += offsets[j - 1, 1]
+    # per trajectory: event times, and the event counts and hash of the sequence
+    if pair is not None:
+        sigma, rule = pair
+        unit_speed = rule == 0
+        ev = np.empty((m + 1, 3))
+        cnt = np.zeros((m + 1, 5), dtype=np.int64)
+        for j in range(m + 1):
+            two.init_events(traj[j], ev[j], rho, sigma)
+    if kick is not None:
+        kicks, angles, kick_mode, kick_u, sp = kick
+        nk = kicks.shape[0]
+        unit_speed = one.unit_speed_of(st0, kick_mode, sp)
+        # the partner of each scattering kick: centre and velocity at the kick time
+        partners = np.zeros((nk if kick_mode == one.SCATTER else 0, 4))
+        row = np.empty(9)
+        ev = np.empty((m + 1, 1))
+        cnt = np.zeros((m + 1, 3), dtype=np.int64)
+        for j in range(m + 1):
+            ev[j, 0] = boundary_hit_time(traj[j, 1], traj[j, 2], traj[j, 3], traj[j, 4], rho)
+    ref = traj[0]
     log_sum = np.zeros(m)
     n_renorm = np.zeros(m, dtype=np.int64)
     n_forced = np.zeros(m, dtype=np.int64)
@@ -127,123 +146,158 @@ def ftle_two_kernel(st0, rho, sigma, rule, mode, n_steps, tau, track, offsets, m
     n_same = 0
     status = 0
     for k in range(1, n_steps + 1):
+        # (each system's code sits under a test of its own argument against None, which
+        # numba resolves at compile time: the other system's code is not compiled)
         if mode == 1:
             tk = k * tau
         else:
-            tk = min(t_prev + tau, ref[0] + min(ev_ref[0], min(ev_ref[1], ev_ref[2])))
-        # the reference: every event at time <= tk, no flight on (positions interpolated)
-        while True:
-            ke, dt = two.next_event(two.load(ref, ev_ref))
-            if not ref[0] + dt <= tk:
-                status = 3 if dt != dt else 0
-                break
-            n_ev += 1
-            if dt > 0.0 and n_ev <= max_events:
-                n_same = 0
-            else:
-                status, n_same = event_guard(dt, n_ev, np.int64(n_same), max_events)
-                if status != 0:
-                    break
-            two.process_event(ref, ev_ref, ke, rho, sigma, rule)
-            if ke == 2:
-                cnt_ref[0] += 1
-            else:
-                cnt_ref[1] += 1
-                cnt_ref[2 + ke] += 1
-            cnt_ref[4] = (cnt_ref[4] * 4 + ke + 1) % HASH_MOD
-        if status != 0:
-            break
-        ds = tk - ref[0]
-        for i in range(2):
-            q = 1 + 4 * i
-            pos[2 * i] = ref[q] + ref[q + 2] * ds
-            pos[2 * i + 1] = ref[q + 1] + ref[q + 3] * ds
-        for j in range(m):
+            if pair is not None:
+                dtn = min(ev[0, 0], min(ev[0, 1], ev[0, 2]))
+            if kick is not None:
+                # (as one.next_event, on the rows in place: a row view per event costs
+                # reference counting)
+                dtn = ev[0, 0]
+                if cnt[0, 0] < nk and kicks[cnt[0, 0]] - ref[0] < dtn:
+                    dtn = kicks[cnt[0, 0]] - ref[0]
+            tk = min(t_prev + tau, ref[0] + dtn)
+        for j in range(m + 1):
+            # every event of trajectory j at a time <= tk
             while True:
-                ke = 0
-                dt = ev_tw[j, 0]
-                if ev_tw[j, 1] < dt:
-                    ke = 1
-                    dt = ev_tw[j, 1]
-                if ev_tw[j, 2] < dt:
-                    ke = 2
-                    dt = ev_tw[j, 2]
-                if not tw[j, 0] + dt <= tk:
+                if pair is not None:
+                    ke = 0
+                    dt = ev[j, 0]
+                    if ev[j, 1] < dt:
+                        ke = 1
+                        dt = ev[j, 1]
+                    if ev[j, 2] < dt:
+                        ke = 2
+                        dt = ev[j, 2]
+                if kick is not None:
+                    ik = cnt[j, 0]
+                    is_kick = False
+                    dt = ev[j, 0]
+                    if ik < nk and kicks[ik] - traj[j, 0] < dt:
+                        is_kick = True
+                        dt = kicks[ik] - traj[j, 0]
+                if not traj[j, 0] + dt <= tk:
                     status = 3 if dt != dt else 0
                     break
-                n_ev += 1
-                if dt > 0.0 and n_ev <= max_events:
-                    n_same = 0
-                else:
-                    status, n_same = event_guard(dt, n_ev, np.int64(n_same), max_events)
-                    if status != 0:
-                        break
-                two.process_event(tw[j], ev_tw[j], ke, rho, sigma, rule)
-                if ke == 2:
-                    cnt_tw[j, 0] += 1
-                else:
-                    cnt_tw[j, 1] += 1
-                    cnt_tw[j, 2 + ke] += 1
-                cnt_tw[j, 4] = (cnt_tw[j, 4] * 4 + ke + 1) % HASH_MOD
+                status, n_ev, n_same = guard(dt, n_ev, n_same, max_events)
+                if status != 0:
+                    break
+                if pair is not None:
+                    two.process_event_at(traj, ev, j, ke, rho, sigma, rule)
+                    if ke == 2:
+                        cnt[j, 0] += 1
+                    else:
+                        cnt[j, 1] += 1
+                        cnt[j, 2 + ke] += 1
+                    cnt[j, 4] = (cnt[j, 4] * 4 + ke + 1) % HASH_MOD
+                if kick is not None and not is_kick:
+                    # reference and twins reflect with the general-speed formula
+                    one.process_wall_at(traj, ev, j, dt, rho, np.bool_(False))
+                    cnt[j, 1] += 1
+                    cnt[j, 2] = (cnt[j, 2] * 4 + 1) % HASH_MOD
+                if kick is not None and is_kick:
+                    hit = True
+                    if kick_mode != one.SCATTER:
+                        one.kick_step(traj[j], ev[j], dt, rho, kicks[ik], angles[ik], kick_mode)
+                    elif j == 0:
+                        one.scatter_step(traj[j], ev[j], dt, rho, kicks[ik], kick_u[ik, 0],
+                                         kick_u[ik, 1], sp, row)
+                        # the kick does not move the centre: the partner touches it along n
+                        partners[ik, 0] = ref[1] + sp[0] * row[4]
+                        partners[ik, 1] = ref[2] + sp[0] * row[5]
+                        partners[ik, 2] = row[6]
+                        partners[ik, 3] = row[7]
+                    else:
+                        # a missed partner is a different event sequence: defer, then force
+                        hit = one.twin_scatter_step(traj[j], ev[j], dt, rho, kicks[ik],
+                                                    partners[ik], sp)
+                    cnt[j, 0] += 1
+                    cnt[j, 2] = (cnt[j, 2] * 4 + (4 if hit else 2)) % HASH_MOD
             if status != 0:
                 break
+            if j == 0:
+                # the reference's centres at tk
+                ds = tk - ref[0]
+                for i in range(n_disks):
+                    q = 1 + 4 * i
+                    pos[2 * i] = ref[q] + ref[q + 2] * ds
+                    pos[2 * i + 1] = ref[q + 1] + ref[q + 3] * ds
+                continue
             # fly the twin on to tk
-            dt = tk - tw[j, 0]
-            tw[j, 1] += tw[j, 3] * dt
-            tw[j, 2] += tw[j, 4] * dt
-            tw[j, 5] += tw[j, 7] * dt
-            tw[j, 6] += tw[j, 8] * dt
-            ev_tw[j, 0] -= dt
-            ev_tw[j, 1] -= dt
-            ev_tw[j, 2] -= dt
-            tw[j, 0] = tk
-            tw[j, 9] = 0.0
-            d = _separation(tw[j, o] - pos[2 * track], tw[j, o + 1] - pos[2 * track + 1],
-                            measure[j])
+            dt = tk - traj[j, 0]
+            for i in range(n_disks):
+                q = 1 + 4 * i
+                traj[j, q] += traj[j, q + 2] * dt
+                traj[j, q + 1] += traj[j, q + 3] * dt
+            for c in range(ev.shape[1]):
+                ev[j, c] -= dt
+            traj[j, 0] = tk
+            traj[j, nst - 2] = 0.0  # the clock's compensation
+            d = _separation(traj[j, o] - pos[2 * track], traj[j, o + 1] - pos[2 * track + 1],
+                            measure[j - 1])
+            i = j - 1
             same = True
-            for c in range(5):
-                if cnt_tw[j, c] != cnt_ref[c]:
+            for c in range(cnt.shape[1]):
+                if cnt[j, c] != cnt[0, c]:
                     same = False
-            if d > 0.0 and (same or n_defer_now[j] >= max_defer):
-                if not same:
-                    n_forced[j] += 1
-                    for c in range(5):
-                        cnt_tw[j, c] = cnt_ref[c]
-                log_sum[j] += math.log(d / m_plus[j])
-                n_renorm[j] += 1
-                t_last[j] = tk
-                n_pert[j] = cnt_ref[0]
-                n_defer_now[j] = 0
-                big = d
-                for i in range(2):
-                    q = 1 + 4 * i
-                    ex = tw[j, q] - pos[2 * i]
-                    ey = tw[j, q + 1] - pos[2 * i + 1]
-                    big = max(big, math.sqrt(ex * ex + ey * ey))
-                f = d0 / big
-                m_plus[j] = d * f
-                for i in range(2):
-                    q = 1 + 4 * i
-                    a, b, c2, d2 = _rescaled(tw[j, q], tw[j, q + 1], tw[j, q + 2], tw[j, q + 3],
-                                             pos[2 * i], pos[2 * i + 1], ref[q + 2], ref[q + 3],
-                                             f, rule == 0)
-                    tw[j, q] = a
-                    tw[j, q + 1] = b
-                    tw[j, q + 2] = c2
-                    tw[j, q + 3] = d2
-                tw[j, 10] = (tw[j, 3] * tw[j, 3] + tw[j, 4] * tw[j, 4] + tw[j, 7] * tw[j, 7]
-                             + tw[j, 8] * tw[j, 8])
-                ev_tw[j, 0] = boundary_hit_time(tw[j, 1], tw[j, 2], tw[j, 3], tw[j, 4], rho)
-                ev_tw[j, 1] = boundary_hit_time(tw[j, 5], tw[j, 6], tw[j, 7], tw[j, 8], rho)
-                ev_tw[j, 2] = pair_hit_time(tw[j, 1] - tw[j, 5], tw[j, 2] - tw[j, 6],
-                                            tw[j, 3] - tw[j, 7], tw[j, 4] - tw[j, 8], sigma)
-            else:
-                n_defer_now[j] += 1
-                n_deferred[j] += 1
+            if not (d > 0.0 and (same or n_defer_now[i] >= max_defer)):
+                n_defer_now[i] += 1
+                n_deferred[i] += 1
+                continue
+            if not same:
+                n_forced[i] += 1
+                for c in range(cnt.shape[1]):
+                    cnt[j, c] = cnt[0, c]
+            log_sum[i] += math.log(d / m_plus[i])
+            n_renorm[i] += 1
+            t_last[i] = tk
+            n_pert[i] = cnt[0, 0]
+            n_defer_now[i] = 0
+            # scale the whole difference by f, no component beyond d0
+            big = d
+            for i2 in range(n_disks):
+                q = 1 + 4 * i2
+                ex = traj[j, q] - pos[2 * i2]
+                ey = traj[j, q + 1] - pos[2 * i2 + 1]
+                big = max(big, math.sqrt(ex * ex + ey * ey))
+            f = d0 / big
+            m_plus[i] = d * f
+            for i2 in range(n_disks):
+                q = 1 + 4 * i2
+                a, b, c2, d2 = _rescaled(traj[j, q], traj[j, q + 1], traj[j, q + 2],
+                                         traj[j, q + 3], pos[2 * i2], pos[2 * i2 + 1],
+                                         ref[q + 2], ref[q + 3], f, unit_speed)
+                traj[j, q] = a
+                traj[j, q + 1] = b
+                traj[j, q + 2] = c2
+                traj[j, q + 3] = d2
+            if pair is not None:
+                traj[j, 10] = (traj[j, 3] * traj[j, 3] + traj[j, 4] * traj[j, 4]
+                               + traj[j, 7] * traj[j, 7] + traj[j, 8] * traj[j, 8])
+                two.init_events(traj[j], ev[j], rho, sigma)
+            if kick is not None:
+                ev[j, 0] = boundary_hit_time(traj[j, 1], traj[j, 2], traj[j, 3], traj[j, 4],
+                                             rho)
         t_prev = tk
         if status != 0:
             break
     return log_sum, n_renorm, n_forced, n_deferred, t_last, n_pert, status
+
+
+@njit(cache=True)
+def ftle_two_kernel(st0, rho, sigma, rule, mode, n_steps, tau, track, offsets, measure, d0,
+                    max_defer, max_events):
+    """Benettin FTLE for the two-disk billiard with ``len(offsets)`` twins.
+
+    Returns ``(log_sum, n_renorm, n_forced, n_deferred, t_last, n_pert, status)``; the
+    first five per twin, ``n_pert[j]`` the reference's disk-disk collisions up to
+    ``t_last[j]``.
+    """
+    return _ftle(st0, rho, mode, n_steps, tau, track, offsets, measure, d0, max_defer,
+                 max_events, (sigma, rule), None)
 
 
 @njit(cache=True)
@@ -258,160 +312,5 @@ def ftle_one_kernel(st0, rho, kicks, angles, kick_mode, mode, n_steps, tau, offs
     in contact with it, and every twin meets that same partner at its own contact time, or
     misses it.
     """
-    m = offsets.shape[0]
-    nk = kicks.shape[0]
-    scatter = kick_mode == one.SCATTER
-    unit_speed = (abs(st0[3] * st0[3] + st0[4] * st0[4] - 1.0) < 1e-12
-                  and not (scatter and sp[1] != 0.0))
-    # the reference and the twins reflect with the general-speed formula (np.bool_: a bool
-    # variable, not the literal False, so that wall_one compiles one signature)
-    no_shortcut = np.bool_(False)
-    # the partner of each scattering kick: centre and velocity at the kick time
-    partners = np.zeros((nk if scatter else 0, 4))
-    row = np.empty(9)
-    ref = st0.copy()
-    ev_ref = np.empty(1)
-    ev_ref[0] = boundary_hit_time(ref[1], ref[2], ref[3], ref[4], rho)
-    cnt_ref = np.zeros(3, dtype=np.int64)
-    tw = np.empty((m, st0.shape[0]))
-    ev_tw = np.empty((m, 1))
-    cnt_tw = np.zeros((m, 3), dtype=np.int64)
-    for j in range(m):
-        # element copy, not tw[j] = st0: numba compiles row assignment with a formatted
-        # shape-mismatch message (seconds of compile time)
-        for c in range(st0.shape[0]):
-            tw[j, c] = st0[c]
-        tw[j, 1] += offsets[j, 0]
-        tw[j, 2] += offsets[j, 1]
-        ev_tw[j, 0] = boundary_hit_time(tw[j, 1], tw[j, 2], tw[j, 3], tw[j, 4], rho)
-    log_sum = np.zeros(m)
-    n_renorm = np.zeros(m, dtype=np.int64)
-    n_forced = np.zeros(m, dtype=np.int64)
-    n_deferred = np.zeros(m, dtype=np.int64)
-    n_defer_now = np.zeros(m, dtype=np.int64)
-    t_last = np.zeros(m)
-    m_plus = np.full(m, d0)
-    n_pert = np.zeros(m, dtype=np.int64)
-    t_prev = 0.0
-    n_ev = 0
-    n_same = 0
-    status = 0
-    for k in range(1, n_steps + 1):
-        if mode == 1:
-            tk = k * tau
-        else:
-            _, dtn = one.next_event(one.load(ref, ev_ref), kicks, cnt_ref[0])
-            tk = min(t_prev + tau, ref[0] + dtn)
-        while True:
-            ik = cnt_ref[0]
-            is_kick = False
-            dt = ev_ref[0]
-            if ik < nk and kicks[ik] - ref[0] < dt:
-                is_kick = True
-                dt = kicks[ik] - ref[0]
-            if not ref[0] + dt <= tk:
-                status = 3 if dt != dt else 0
-                break
-            n_ev += 1
-            if dt > 0.0 and n_ev <= max_events:
-                n_same = 0
-            else:
-                status, n_same = event_guard(dt, n_ev, np.int64(n_same), max_events)
-                if status != 0:
-                    break
-            if is_kick and scatter:
-                one.scatter_step(ref, ev_ref, dt, rho, kicks[ik], kick_u[ik, 0],
-                                    kick_u[ik, 1], sp, row)
-                # the kick does not move the centre: the partner touches it along n
-                partners[ik, 0] = ref[1] + sp[0] * row[4]
-                partners[ik, 1] = ref[2] + sp[0] * row[5]
-                partners[ik, 2] = row[6]
-                partners[ik, 3] = row[7]
-                cnt_ref[0] += 1
-                cnt_ref[2] = (cnt_ref[2] * 4 + 4) % HASH_MOD
-            elif is_kick:
-                one.kick_step(ref, ev_ref, dt, rho, kicks[ik], angles[ik], kick_mode)
-                cnt_ref[0] += 1
-                cnt_ref[2] = (cnt_ref[2] * 4 + 4) % HASH_MOD
-            else:
-                one.process_wall(ref, ev_ref, dt, rho, no_shortcut)
-                cnt_ref[1] += 1
-                cnt_ref[2] = (cnt_ref[2] * 4 + 1) % HASH_MOD
-        if status != 0:
-            break
-        ds = tk - ref[0]
-        px = ref[1] + ref[3] * ds
-        py = ref[2] + ref[4] * ds
-        for j in range(m):
-            while True:
-                ik = cnt_tw[j, 0]
-                is_kick = False
-                dt = ev_tw[j, 0]
-                if ik < nk and kicks[ik] - tw[j, 0] < dt:
-                    is_kick = True
-                    dt = kicks[ik] - tw[j, 0]
-                if not tw[j, 0] + dt <= tk:
-                    status = 3 if dt != dt else 0
-                    break
-                n_ev += 1
-                if dt > 0.0 and n_ev <= max_events:
-                    n_same = 0
-                else:
-                    status, n_same = event_guard(dt, n_ev, np.int64(n_same), max_events)
-                    if status != 0:
-                        break
-                if is_kick and scatter:
-                    hit = one.twin_scatter_step(tw[j], ev_tw[j], dt, rho, kicks[ik],
-                                                   partners[ik], sp)
-                    cnt_tw[j, 0] += 1
-                    # a missed partner is a different event sequence: defer, then force
-                    cnt_tw[j, 2] = (cnt_tw[j, 2] * 4 + (4 if hit else 2)) % HASH_MOD
-                elif is_kick:
-                    one.kick_step(tw[j], ev_tw[j], dt, rho, kicks[ik], angles[ik], kick_mode)
-                    cnt_tw[j, 0] += 1
-                    cnt_tw[j, 2] = (cnt_tw[j, 2] * 4 + 4) % HASH_MOD
-                else:
-                    one.process_wall(tw[j], ev_tw[j], dt, rho, no_shortcut)
-                    cnt_tw[j, 1] += 1
-                    cnt_tw[j, 2] = (cnt_tw[j, 2] * 4 + 1) % HASH_MOD
-            if status != 0:
-                break
-            dt = tk - tw[j, 0]
-            tw[j, 1] += tw[j, 3] * dt
-            tw[j, 2] += tw[j, 4] * dt
-            ev_tw[j, 0] -= dt
-            tw[j, 0] = tk
-            tw[j, 5] = 0.0
-            d = _separation(tw[j, 1] - px, tw[j, 2] - py, measure[j])
-            same = (cnt_tw[j, 0] == cnt_ref[0] and cnt_tw[j, 1] == cnt_ref[1]
-                    and cnt_tw[j, 2] == cnt_ref[2])
-            if d > 0.0 and (same or n_defer_now[j] >= max_defer):
-                if not same:
-                    n_forced[j] += 1
-                    for c in range(3):
-                        cnt_tw[j, c] = cnt_ref[c]
-                log_sum[j] += math.log(d / m_plus[j])
-                n_renorm[j] += 1
-                t_last[j] = tk
-                n_pert[j] = cnt_ref[0]
-                n_defer_now[j] = 0
-                ex = tw[j, 1] - px
-                ey = tw[j, 2] - py
-                f = d0 / max(d, math.sqrt(ex * ex + ey * ey))
-                m_plus[j] = d * f
-                a, b, c2, d2 = _rescaled(tw[j, 1], tw[j, 2], tw[j, 3], tw[j, 4], px, py, ref[3],
-                                         ref[4], f, unit_speed)
-                tw[j, 1] = a
-                tw[j, 2] = b
-                tw[j, 3] = c2
-                tw[j, 4] = d2
-                ev_tw[j, 0] = boundary_hit_time(a, b, c2, d2, rho)
-            else:
-                n_defer_now[j] += 1
-                n_deferred[j] += 1
-        t_prev = tk
-        if status != 0:
-            break
-    return log_sum, n_renorm, n_forced, n_deferred, t_last, n_pert, status
-
-
+    return _ftle(st0, rho, mode, n_steps, tau, 0, offsets, measure, d0, max_defer, max_events,
+                 None, (kicks, angles, kick_mode, kick_u, sp))

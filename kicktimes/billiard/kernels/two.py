@@ -55,7 +55,8 @@ from kicktimes.billiard.geometry import (
 )
 
 __all__ = ["PAIR", "advance", "anchor_energy", "disk", "init_events", "load", "next_event",
-           "pair_event", "process_event", "resolve", "step", "store", "wall_event"]
+           "pair_event", "process_event", "process_event_at", "resolve", "step", "store",
+           "wall_event"]
 
 #: fields of the state tuple
 (S_T, S_COMP, S_X0, S_Y0, S_VX0, S_VY0, S_X1, S_Y1, S_VX1, S_VY1, S_TB0, S_TB1,
@@ -246,6 +247,23 @@ def process_event(st, ev, k, rho, sigma, rule):
     incoming ``sin_theta``. For the drivers that keep many trajectories (the twins)."""
     s, sin_theta = step(load(st, ev), k, ev[k], rho, sigma, rule, st[10])
     store(st, ev, s)
+    return sin_theta
+
+
+@njit(cache=True, error_model="numpy")
+def process_event_at(traj, ev, j, k, rho, sigma, rule):
+    """`process_event` on row ``j`` of the 2-D arrays ``traj``, ``ev`` (the twins' form:
+    a row view per event would cost reference counting on every event)."""
+    s = (traj[j, 0], traj[j, 9], traj[j, 1], traj[j, 2], traj[j, 3], traj[j, 4], traj[j, 5],
+         traj[j, 6], traj[j, 7], traj[j, 8], ev[j, 0], ev[j, 1], ev[j, 2])
+    s, sin_theta = step(s, k, ev[j, k], rho, sigma, rule, traj[j, 10])
+    traj[j, 0] = s[S_T]
+    traj[j, 9] = s[S_COMP]
+    traj[j, 1], traj[j, 2], traj[j, 3], traj[j, 4] = disk(s, 0)
+    traj[j, 5], traj[j, 6], traj[j, 7], traj[j, 8] = disk(s, 1)
+    ev[j, 0] = s[S_TB0]
+    ev[j, 1] = s[S_TB1]
+    ev[j, 2] = s[S_TPP]
     return sin_theta
 
 
