@@ -8,6 +8,7 @@ the statistics on known processes, the CLI outputs, and an outside simulator end
 from __future__ import annotations
 
 import math
+import warnings
 
 import numpy as np
 import pandas as pd
@@ -16,8 +17,8 @@ from click.testing import CliRunner
 
 from kicktimes import stats
 from kicktimes.cli import main
-from kicktimes.stats._findings import findings
 from kicktimes.stats._table import event_table
+from kicktimes.stats.findings import findings
 
 
 def _poisson_rows(rates, t_end=100.0, seed=0, start=0.0):
@@ -308,3 +309,59 @@ def test_outside_hard_disk_simulator_matches_kinetic_theory(tmp_path):
     assert b["ci_low"] < 1.0 < b["ci_high"] or abs(b["estimate"] - 1) < 0.03
     d = reg.loc[("density", "poisson", "slope"), "estimate"]
     assert 0.95 < d < 1.2  # rate ∝ n at low density, g(σ) adds a little
+
+
+# ------------------------------------------------------------ edge cases and the page
+
+
+def test_a_group_of_one_sequence_has_no_dispersion_index_and_no_warning():
+    df = _poisson_rows([1.0, 2.0, 2.0])  # density 1.0: a single sequence
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        res = stats.analyze(df, window=(0, 100), group="density", rng=0, max_fits_per_group=0)
+    het = res.heterogeneity.set_index("group")
+    assert het.loc[1.0, "n_sequences"] == 1 and np.isnan(het.loc[1.0, "dispersion_index"])
+    assert np.isfinite(het.loc[2.0, "dispersion_index"])
+
+
+def test_the_poisson_finding_of_sequences_without_events_is_inconclusive():
+    df = pd.DataFrame({"sequence": ["a", "b"], "time": [None, None]})
+    res = stats.analyze(df, window=(0, 10), rng=0)
+    verdicts = {f.question: f.verdict for f in findings(res)}
+    assert verdicts["Poisson?"] == "inconclusive"
+
+
+def test_a_tie_between_pooled_renewal_models_goes_to_the_first_group():
+    import dataclasses
+
+    res = stats.analyze(_poisson_rows([1.0, 2.0]), window=(0, 100), group="density", rng=0,
+                        max_fits_per_group=0)
+    pooled = pd.DataFrame({"group": [1.0, 1.0, 2.0, 2.0],
+                           "model": ["weibull", "gamma", "gamma", "weibull"],
+                           "aic": [1.0, 5.0, 1.0, 5.0], "delta_aic": [0.0, 4.0, 0.0, 4.0],
+                           "n": 50})
+    (renewal,) = [f for f in findings(dataclasses.replace(res, renewal_pooled=pooled))
+                  if f.question == "Which renewal model?"]
+    assert renewal.verdict == "weibull (pooled, 1/2 groups)"
+
+
+def test_the_page_draws_the_figures_against_the_group_values_and_names(tmp_path):
+    from kicktimes.report.analyze_page import write_analysis
+    from kicktimes.report.poisson import poisson_rejection_rates
+
+    df = _poisson_rows([1.0, 1.0, 2.0, 2.0, 4.0, 4.0], seed=2)
+    df["density"] *= 100.0  # far outside the disk radii
+    res = stats.analyze(df, window=(0, 100), group="density", rng=0, max_fits_per_group=1)
+    fig = poisson_rejection_rates(res.poisson, alpha=res.alpha, x="group", xlabel="density")
+    ax = [a for a in fig.axes if a.get_visible()][-1]
+    assert ax.get_xlabel() == "density"
+    np.testing.assert_array_equal(ax.containers[0].lines[0].get_xdata(), [100.0, 200.0, 400.0])
+    page = write_analysis(res, tmp_path / "grouped", dpi=30).read_text()
+    assert page.count("<img") == 3 and "<h2>Contents</h2>" in page
+    # without a group every sequence is in the one group "all", drawn as a labelled tick
+    ungrouped = stats.analyze(df, window=(0, 100), rng=0, max_fits_per_group=1)
+    fig = poisson_rejection_rates(ungrouped.poisson, x="group", xlabel="group")
+    ax = [a for a in fig.axes if a.get_visible()][-1]
+    fig.canvas.draw()
+    assert [t.get_text() for t in ax.get_xticklabels()] == ["all"]
+    assert write_analysis(ungrouped, tmp_path / "all", dpi=30).is_file()

@@ -445,6 +445,39 @@ def test_rate_heterogeneity_draws_zero_rate_ics_at_the_floor_and_p_values():
         plots.rate_heterogeneity(coll, homogeneity=hom.rename(columns={"pvalue": "p"}))
 
 
+def test_statistics_figures_draw_against_any_numeric_column_at_its_values():
+    density = {r: 1000 * r for r in RADII}  # far outside the radius range (0, 0.5)
+    rej = _rejection_rows().assign(density=lambda d: d["radius"].map(density))
+    fig = plots.poisson_rejection_rates(rej.drop(columns="radius"), x="density",
+                                        xlabel="density (1 / area)")
+    ax = [a for a in fig.axes if a.get_visible()][-1]
+    assert ax.get_xlabel() == "density (1 / area)"
+    np.testing.assert_allclose(ax.containers[0].lines[0].get_xdata().astype(float),
+                               sorted(density.values()))
+    coll = make_collisions(n_ics=10).assign(density=lambda d: d["radius"].map(density))
+    fig = plots.rate_heterogeneity(coll.drop(columns="radius"), x="density", rule=None)
+    assert [a.get_xlabel() for a in fig.axes] == ["density", "density"]
+    np.testing.assert_allclose(fig.axes[1].get_lines()[0].get_xdata(), sorted(density.values()))
+    with pytest.raises(ValueError, match="rule needs x='radius'"):
+        plots.rate_heterogeneity(coll, x="density")
+    with pytest.raises(ValueError, match=r"pooled\['radius'\] must satisfy 0 < r < 0.5"):
+        plots.model_comparison(pd.DataFrame({"radius": [], "best_model": []}),
+                               pd.DataFrame({"radius": [2.0], "model": ["gamma"],
+                                             "delta_aic": [0.0]}))
+
+
+def test_statistics_figures_draw_a_column_of_labels_at_labelled_positions():
+    per = pd.DataFrame({"site": ["north", "south", "north"], "best_model": ["gamma"] * 3})
+    pooled = pd.DataFrame({"site": ["south", "north"], "model": "gamma", "delta_aic": 0.0})
+    fig = plots.model_comparison(per, pooled, x="site", xlabel="site")
+    ax1, ax2 = fig.axes
+    assert [round(b.get_x() + b.get_width() / 2, 9) for b in ax1.patches] == [0.0, 1.0]
+    assert list(ax2.get_lines()[0].get_xdata()) == [0.0, 1.0]
+    for ax in (ax1, ax2):
+        assert list(ax.xaxis.get_major_formatter().seq) == ["north", "south"]
+        assert ax.get_xlabel() == "site"
+
+
 def test_plotting_draws_into_a_given_axes():
     fig = Figure()
     ax = fig.add_subplot()

@@ -371,3 +371,51 @@ def test_poisson_tests_started_ahead_on_a_pool_equal_the_tests_run_in_place():
     assert not ahead.pending
     pd.testing.assert_frame_equal(got, expected)
     pd.testing.assert_frame_equal(ahead.found.homogeneity, in_place.found.homogeneity)
+
+
+def test_one_ic_per_radius_has_no_dispersion_index_and_no_warning():
+    # the report's rate-homogeneity rows are kicktimes.stats.poisson_group's: a radius with
+    # a single IC has no variance of its counts
+    import warnings
+
+    from kicktimes.report import heterogeneity, poisson
+
+    context = Context(synthetic_store(n_ics=1), n_mc=39)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        poisson.sections(context)
+    het = context.found.homogeneity
+    assert (het["n_ics"] == 1).all() and het["dispersion_index"].isna().all()
+    (sec,) = heterogeneity.sections(context)
+    assert sec.figures and "rate_homogeneity" in [name for name, *_ in sec.tables]
+
+
+def test_the_report_findings_are_stats_findings_with_an_effect_size(ctx):
+    from kicktimes.report.findings import STATEMENT_COLUMNS
+    from kicktimes.stats.findings import findings_table
+
+    e = _effect(ctx, "FTLE", "poisson")
+    assert isinstance(e, stats.Finding)
+    assert e.statement.startswith("FTLE, Poisson vs two-particle: ratio of mean λ")
+    assert e.sentence() == f"{e.statement} ({e.detail}.)"
+    table = findings_table(ctx.found.effects, columns=STATEMENT_COLUMNS)
+    assert list(table.columns) == list(STATEMENT_COLUMNS)
+    assert len(table) == len(ctx.found.effects) and table["estimate"].notna().all()
+
+
+def test_one_writer_writes_the_page_of_the_report_and_of_kicktimes_analyze(tmp_path):
+    from kicktimes.report.html import CSS, toc_item, write_page
+
+    files = {}
+    toc = [toc_item("s", "S & T", [toc_item("u", "U")]), toc_item("v", "V")]
+    path = write_page(tmp_path, "a <b> page", sources="x.csv", toc=toc,
+                      body="<h3 id='s'>S</h3>", appendix="<p>end</p>", files=files)
+    text = path.read_text(encoding="utf-8")
+    assert path == tmp_path / "report.html" and set(files) == {"report.html"}
+    assert text.startswith("<!DOCTYPE html>") and f"<style>{CSS}</style>" in text
+    assert "<title>a &lt;b&gt; page</title>" in text and "<h1>a &lt;b&gt; page</h1>" in text
+    assert " from x.csv.</p><h2>Contents</h2>" in text
+    assert ('<ul><li><a href="#s">S &amp; T</a><ul><li><a href="#u">U</a></li></ul></li>'
+            '<li><a href="#v">V</a></li></ul>') in text
+    assert text.endswith("<h3 id='s'>S</h3><p>end</p></body></html>")
+    assert not list(tmp_path.glob("*.tmp*"))  # written atomically

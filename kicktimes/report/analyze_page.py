@@ -1,110 +1,39 @@
-"""The pages of ``kicktimes analyze``: findings first, then the report's own sections.
+"""The page of ``kicktimes analyze``: findings first, then the report's own sections.
 
 :func:`write_analysis` turns an :class:`kicktimes.stats.Analysis` into ``report.html``
-(self-contained), ``findings.md``, one PNG + PDF per figure and one CSV per table. The
-figures are the sweep report's (Poisson rejection rates, renewal-model comparison, rate
-heterogeneity); where they draw against the disk radius, the sequences' group takes its
-place: groups are mapped affinely into the radius range the figures accept and the x
-axis is relabelled with the group's own values and name, so the geometry is that of the
-group values (see :func:`_as_radius`).
+(self-contained, written by :func:`kicktimes.report.html.write_page` as the sweep report
+is), ``findings.md``, one PNG + PDF per figure and one CSV per table. The figures are the
+sweep report's (Poisson rejection rates, renewal-model comparison, rate heterogeneity),
+drawn against the sequences' group where the report draws against the disk radius (their
+``x`` and ``xlabel`` arguments): numeric groups at their values, the single group
+``"all"`` of an analysis without ``group`` as one labelled position.
 """
 
 from __future__ import annotations
 
-import datetime as _dt
 import html
 import os
 import warnings
 from pathlib import Path
 
-import numpy as np
-import pandas as pd
-from matplotlib.ticker import FixedFormatter, FixedLocator, FuncFormatter
-
-from kicktimes import __version__
+from kicktimes.report.common import Section
+from kicktimes.report.heterogeneity import rate_heterogeneity
+from kicktimes.report.html import toc_item, write_outputs, write_page, write_table, write_text
+from kicktimes.report.poisson import poisson_rejection_rates
+from kicktimes.report.renewal import model_comparison
+from kicktimes.stats.findings import findings_table
 
 __all__ = ["write_analysis"]
 
 
-def _report_api():
-    """The report's section record, figure functions and HTML writer."""
-    from types import SimpleNamespace
-
-    from kicktimes.report import heterogeneity, poisson, renewal
-    from kicktimes.report.common import Section
-    from kicktimes.report.figures import RADIUS_LABEL
-    from kicktimes.report.html import CSS, write_outputs
-
-    figures = SimpleNamespace(
-        RADIUS_LABEL=RADIUS_LABEL,
-        poisson_rejection_rates=poisson.poisson_rejection_rates,
-        model_comparison=renewal.model_comparison,
-        rate_heterogeneity=heterogeneity.rate_heterogeneity,
-    )
-    return Section, figures, write_outputs, CSS
-
-
-def _as_radius(groups):
-    """Map group values into (0, 0.5) for the radius-axis figures; return the map and a
-    function that relabels an Axes' x axis with the group values.
-
-    Numeric groups: ``x' = a + c x`` (spacing kept, ticks show ``x``); others: evenly
-    spaced positions with the labels as fixed ticks.
-    """
-    values = list(dict.fromkeys(groups))
-    try:
-        x = np.asarray(values, dtype=float)
-        numeric = bool(np.isfinite(x).all())
-    except (TypeError, ValueError):
-        numeric = False
-    if numeric and x.size > 1 and np.ptp(x) > 0:
-        c = 0.4 / np.ptp(x)
-        a = 0.05 - c * x.min()
-        mapping = {v: a + c * float(v) for v in values}
-
-        def relabel(ax, name):
-            ax.xaxis.set_major_formatter(FuncFormatter(lambda u, _: f"{(u - a) / c:.4g}"))
-            ax.set_xlabel(name)
-
-    else:
-        pos = np.linspace(0.1, 0.4, len(values)) if len(values) > 1 else np.array([0.25])
-        mapping = dict(zip(values, pos.tolist(), strict=True))
-
-        def relabel(ax, name):
-            ax.xaxis.set_major_locator(FixedLocator(pos))
-            ax.xaxis.set_major_formatter(FixedFormatter([str(v) for v in values]))
-            ax.set_xlabel(name)
-
-    return mapping, relabel
-
-
-def _relabel_figure(fig, relabel, name, radius_label):
-    for ax in fig.axes:
-        label = ax.get_xlabel()
-        if label in (radius_label, ""):
-            relabel(ax, name if label else "")
-
-
-def _sections(res, Section, plots):
-    secs = []
-    group_name = res.group or "group"
-    mapping, relabel = _as_radius(res.sequences["group"])
-    radius_label = getattr(plots, "RADIUS_LABEL", "")
-
-    def radius(df):
-        out = df.copy()
-        out["radius"] = out["group"].map(mapping)
-        return out
-
-    # ---- findings first
-    fs = res.findings()
+def _findings_section(fs):
     sec = Section("findings", "Findings")
     sec.bullets(f"{f.question} — {f.verdict}. {f.statement} (Rule: {f.rule})" for f in fs)
-    table = pd.DataFrame([f.__dict__ for f in fs])
-    sec.table("findings", table, "Findings", show=False)
-    secs.append(sec)
+    sec.table("findings", findings_table(fs), "Findings", show=False)
+    return sec
 
-    # ---- data
+
+def _data_section(res):
     sec = Section("data", "The sequences")
     seq = res.tables()["sequences"]
     sec.text(
@@ -118,33 +47,30 @@ def _sections(res, Section, plots):
         sec.table(
             "skipped", res.skipped, "Skipped sequences and steps", show=len(res.skipped) <= 40
         )
-    secs.append(sec)
+    return sec
 
-    # ---- Poisson tests
+
+def _poisson_section(res, axis):
     sec = Section("poisson_tests", "Poisson tests of the event times, per sequence")
-    rej = radius(res.poisson)
-    if (rej["n_tested"] > 0).any():
-        fig = plots.poisson_rejection_rates(rej, alpha=res.alpha)
-        _relabel_figure(fig, relabel, group_name, radius_label)
+    if (res.poisson["n_tested"] > 0).any():
         sec.figure(
             "poisson_rejection_rates",
-            fig,
+            poisson_rejection_rates(res.poisson, alpha=res.alpha, **axis),
             f"Share of sequences rejecting a homogeneous Poisson process at α = {res.alpha:g}, "
-            f"per test and {group_name}, with 95 % Clopper-Pearson intervals (each test "
+            f"per test and {axis['xlabel']}, with 95 % Clopper-Pearson intervals (each test "
             f"conditional on the sequence's own count; Monte Carlo nulls, n_mc = {res.n_mc}).",
         )
     sec.table("poisson_tests", res.poisson, "Rejections per group and test")
-    secs.append(sec)
+    return sec
 
-    # ---- renewal models
+
+def _renewal_section(res, axis):
     sec = Section("renewal", "Renewal-model comparison of the intervals")
-    per = radius(res.sequences.dropna(subset=["best_model"])[["group", "best_model"]])
-    pooled = radius(res.renewal_pooled)
-    if len(per) or len(pooled):
+    per = res.sequences.dropna(subset=["best_model"])[["group", "best_model"]]
+    if len(per) or len(res.renewal_pooled):
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            fig = plots.model_comparison(per, pooled)
-        _relabel_figure(fig, relabel, group_name, radius_label)
+            fig = model_comparison(per, res.renewal_pooled, **axis)
         sec.figure(
             "renewal_model_comparison",
             fig,
@@ -153,29 +79,27 @@ def _sections(res, Section, plots):
         )
     sec.table("renewal_pooled", res.renewal_pooled, "Pooled intervals: model comparison")
     sec.table("renewal_per_sequence", res.renewal_per_sequence, "Per sequence", show=False)
-    secs.append(sec)
+    return sec
 
-    # ---- heterogeneity
+
+def _heterogeneity_section(res, axis):
     sec = Section("heterogeneity", "Rate heterogeneity across sequences")
-    coll = radius(res.sequences[["group", "n_events", "t_window"]]).rename(
-        columns={"n_events": "n_pp"}
-    )
-    hom = radius(res.heterogeneity)
-    fig = plots.rate_heterogeneity(coll, homogeneity=hom, rule=None)
-    _relabel_figure(fig, relabel, group_name, radius_label)
+    counts = res.sequences[["group", "n_events", "t_window"]].rename(columns={"n_events": "n_pp"})
     sec.figure(
         "rate_heterogeneity",
-        fig,
+        rate_heterogeneity(counts, homogeneity=res.heterogeneity, rule=None, **axis),
         "(a) Event rate n / t_window of every sequence with the pooled and median rates per "
-        f"{group_name}; (b) index of dispersion of the counts across the sequences of a group, "
-        "annotated with the p-value of the Pearson test of a common rate (given the total).",
+        f"{axis['xlabel']}; (b) index of dispersion of the counts across the sequences of a "
+        "group, annotated with the p-value of the Pearson test of a common rate (given the "
+        "total).",
     )
     sec.table("rate_homogeneity", res.heterogeneity, "Rate homogeneity per group")
     if res.reference is not None:
         sec.table("reference_rate", res.reference, f"Observed / {res.reference_column}")
-    secs.append(sec)
+    return sec
 
-    # ---- counts
+
+def _counts_section(res):
     sec = Section("counts", "Counts against the covariates")
     sec.text(
         "One covariate at a time: Poisson GLM and negative binomial (NB2) of the counts with "
@@ -184,8 +108,7 @@ def _sections(res, Section, plots):
     )
     sec.table("count_regressions", res.regressions, "Coefficients (95 % intervals)")
     sec.table("count_overdispersion", res.overdispersion, "Over-dispersion")
-    secs.append(sec)
-    return secs, fs
+    return sec
 
 
 def write_analysis(res, out_dir, *, dpi=150, sources=None, windows=None) -> Path:
@@ -207,29 +130,37 @@ def write_analysis(res, out_dir, *, dpi=150, sources=None, windows=None) -> Path
     pathlib.Path
         ``out_dir / "report.html"``.
     """
-    Section, plots, write_outputs, css = _report_api()
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    secs, fs = _sections(res, Section, plots)
+    fs = res.findings()
+    # the figures' x axis: the group, named as the analysis names it
+    axis = {"x": "group", "xlabel": res.group or "group"}
+    secs = [
+        _findings_section(fs),
+        _data_section(res),
+        _poisson_section(res, axis),
+        _renewal_section(res, axis),
+        _heterogeneity_section(res, axis),
+        _counts_section(res),
+    ]
+    files = {}
+    in_sections = {name for sec in secs for name, *_ in sec.tables}
     for name, df in res.tables().items():
-        df.to_csv(out / f"{name}.csv", index=False)
+        if name not in in_sections:
+            write_table(out, name, df, files)
     md = ["# Findings", ""]
     md += [f"- **{f.question}** {f.verdict}. {f.statement} _Rule: {f.rule}_" for f in fs]
-    (out / "findings.md").write_text("\n".join(md) + "\n", encoding="utf-8")
-    body = write_outputs(secs, out, dpi)
+    write_text(out, "findings.md", "\n".join(md) + "\n", files)
+    body = write_outputs(secs, out, dpi, files=files)
     inputs = ", ".join(html.escape(os.fspath(s)) for s in (sources or [])) or "a DataFrame"
     if windows is not None:
         inputs += f"; windows from {html.escape(os.fspath(windows))}"
-    toc = "".join(f'<li><a href="#{s.key}">{html.escape(s.title)}</a></li>' for s in secs)
-    page = (
-        '<!DOCTYPE html><html lang="en"><head><meta charset="utf-8">'
-        f"<title>kicktimes analyze</title><style>{css}</style></head><body>"
-        f"<h1>kicktimes analyze</h1><p>Built "
-        f"{_dt.datetime.now(_dt.timezone.utc).isoformat(timespec='seconds')} with kicktimes "
-        f"{html.escape(__version__)} from {inputs}: {len(res.sequences)} sequences, "
-        f"{int(res.sequences['n_events'].sum())} events, α = {res.alpha:g}, "
-        f"n_mc = {res.n_mc}.</p><h2>Contents</h2><ul>{toc}</ul>{body}</body></html>"
+    return write_page(
+        out,
+        "kicktimes analyze",
+        sources=f"{inputs}: {len(res.sequences)} sequences, "
+        f"{int(res.sequences['n_events'].sum())} events, α = {res.alpha:g}, n_mc = {res.n_mc}",
+        toc=[toc_item(s.key, s.title) for s in secs],
+        body=body,
+        files=files,
     )
-    path = out / "report.html"
-    path.write_text(page, encoding="utf-8")
-    return path

@@ -24,7 +24,7 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
 from kicktimes.report.common import REFERENCE, Section, distinct, fmt, kicked_systems, wide
-from kicktimes.report.effects import BUILT_IN, Effect, paired_ratio, ratio_rule, ratio_verdict
+from kicktimes.report.effects import BUILT_IN, Effect, paired_ratio, ratio_verdict, store_ratio
 from kicktimes.report.figures import (
     _SEM_BAR,
     dodge,
@@ -335,13 +335,7 @@ def effects(ctx):
     for system in kicked_systems(results):
         if system not in one_minus.columns or REFERENCE not in one_minus.columns:
             continue
-        _, tot = paired_ratio(
-            one_minus[system],
-            one_minus[REFERENCE],
-            rng=ctx.boot_rng(),
-            n_boot=ctx.n_boot,
-            resamples=ctx.resamples,
-        )
+        _, tot = store_ratio(ctx, one_minus[system], one_minus[REFERENCE])
         detail = ""
         if system in pred.columns and REFERENCE in pred.columns:
             _, ptot = paired_ratio(
@@ -353,20 +347,17 @@ def effects(ctx):
             )
         verdict = ratio_verdict(tot["ci_low"], tot["ci_high"], ctx.tolerance)
         out.append(
-            Effect(
-                question="Lag-1 ACF of boundary angles",
-                system=system,
-                quantity="ratio of 1 − R_1 (kicked / two-particle, averaged over radii)",
-                estimate=tot["ratio"],
-                ci_low=tot["ci_low"],
-                ci_high=tot["ci_high"],
+            Effect.of_ratio(
+                "Lag-1 ACF of boundary angles",
+                system,
+                "ratio of 1 − R_1 (kicked / two-particle, averaged over radii)",
+                tot,
+                tolerance=ctx.tolerance,
                 verdict=(
                     f"{verdict} ({BUILT_IN}: kick rate = collision rate)"
                     if verdict.startswith("within")
                     else f"{verdict} (an agreement would be {BUILT_IN}: kick rate = collision rate)"
                 ),
-                rule=ratio_rule(ctx.tolerance),
-                method=f"paired bootstrap over {tot['n_ics']} ICs",
                 detail=detail,
             )
         )

@@ -65,19 +65,20 @@ def sticky_ics(collisions, rule="mirror", *, factor=STICKY_FACTOR) -> pd.DataFra
 # ------------------------------------------------------------- counts vs radius
 
 
-def counts_by_radius(collisions) -> pd.DataFrame:
+def counts_by_radius(collisions, *, x="radius") -> pd.DataFrame:
     """Per radius: ``n_ics``, ``mean_count``, ``std_count``, ``sem``, ``mean_t_window``.
 
-    ``collisions`` has one row per (radius, IC) with ``radius``, ``n_pp``, ``t_window``.
+    ``collisions`` has one row per (radius, IC) with ``radius``, ``n_pp``, ``t_window``;
+    with ``x``, per value of that numeric column instead of the radius.
     """
-    df = check_frame("collisions", collisions, ["radius", "n_pp", "t_window"])
-    check_radii("collisions['radius']", df["radius"])
+    df = check_frame("collisions", collisions, [x, "n_pp", "t_window"])
+    (check_radii if x == "radius" else finite)(f"collisions[{x!r}]", df[x])
     n_pp = finite("collisions['n_pp']", df["n_pp"])
     if (n_pp < 0).any():
         raise ValueError("collisions['n_pp'] must be non-negative")
     if (finite("collisions['t_window']", df["t_window"]) <= 0).any():
         raise ValueError("collisions['t_window'] must be positive")
-    g = df.groupby("radius")
+    g = df.groupby(x)
     out = pd.DataFrame(
         {
             "n_ics": g.size(),
@@ -241,30 +242,22 @@ def sections(ctx):
 def effects(ctx):
     """Observed disk-disk collision counts over the kinetic-theory counts Γ(r)·T."""
     from kicktimes import stats
-    from kicktimes.report.effects import Effect, paired_ratio, ratio_rule, ratio_verdict
+    from kicktimes.report.effects import Effect, store_ratio
 
     coll = ctx.store.collisions.set_index(["radius", "ic"])
     r = coll.index.get_level_values("radius").to_numpy(float)
     expected = stats.kinetic_rate(r, ctx.exp.rule) * coll["t_window"].to_numpy(float)
-    per_r, tot = paired_ratio(
-        coll["n_pp"].astype(float),
-        pd.Series(expected, index=coll.index),
-        rng=ctx.boot_rng(),
-        n_boot=ctx.n_boot,
-        resamples=ctx.resamples,
-    )
+    expected = pd.Series(expected, index=coll.index)
+    per_r, tot = store_ratio(ctx, coll["n_pp"].astype(float), expected)
     sticky = ctx.found.sticky
     n_sticky = int(sticky["sticky"].sum()) if sticky is not None else 0
     return [
-        Effect(
-            question="Collision counts against kinetic theory",
-            system="",
-            quantity=f"ratio ΣN / Σ Γ(r)T ({ctx.exp.rule} rule, averaged over radii)",
-            estimate=tot["ratio"],
-            ci_low=tot["ci_low"],
-            ci_high=tot["ci_high"],
-            verdict=ratio_verdict(tot["ci_low"], tot["ci_high"], ctx.tolerance),
-            rule=ratio_rule(ctx.tolerance),
+        Effect.of_ratio(
+            "Collision counts against kinetic theory",
+            "",
+            f"ratio ΣN / Σ Γ(r)T ({ctx.exp.rule} rule, averaged over radii)",
+            tot,
+            tolerance=ctx.tolerance,
             method=f"bootstrap over {tot['n_ics']} ICs",
             detail=(
                 f"per-radius ratio {per_r['ratio'].min():.3g} to {per_r['ratio'].max():.3g}; "

@@ -3,7 +3,9 @@ r"""Effect sizes with 95 % confidence intervals and the verdict rules of the Fin
 Every comparison of the report is a ratio (a kicked system over the two-particle system,
 or an observed rate over the kinetic rate) with a 95 % confidence interval, and every
 verdict follows one printed rule (:func:`ratio_rule`, :data:`SHARE_RULE`), so no verdict
-is typed by hand.
+is typed by hand. The record and the rules are those of every page kicktimes writes
+(:mod:`kicktimes.stats.findings`; ``kicktimes analyze`` states its findings with them):
+an :class:`Effect` is a :class:`kicktimes.stats.Finding` with the compared system.
 
 The bootstrap resamples initial conditions: the same IC index is the same initial
 condition in every system and at every radius (the paper's design), so one resample of IC
@@ -14,12 +16,20 @@ from __future__ import annotations
 
 import math
 import warnings
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 import pandas as pd
 
-from kicktimes.stats import ratio_rule, ratio_verdict
+from kicktimes.stats.findings import (
+    SHARE_RULE,
+    Finding,
+    clopper_pearson,
+    effect_statement,
+    ratio_rule,
+    ratio_verdict,
+    share_verdict,
+)
 
 __all__ = [
     "Effect",
@@ -29,21 +39,19 @@ __all__ = [
     "ratio_verdict",
     "share_verdict",
     "paired_ratio",
+    "store_ratio",
     "clopper_pearson",
 ]
 
-#: how a share's verdict is decided against a reference level ``{level}``
-SHARE_RULE = (
-    "above: the 95 % CI of the share lies above {level:g}; below: it lies below {level:g}; "
-    "inconclusive: it contains {level:g}"
-)
 #: appended to a verdict whose agreement is guaranteed by how the kicked system is built
 BUILT_IN = "built in"
 
 
 @dataclass(frozen=True)
-class Effect:
-    """One finding: an effect size, its 95 % CI, how the CI was computed and the verdict.
+class Effect(Finding):
+    """A finding of the report (:class:`kicktimes.stats.Finding`): an effect size, its
+    95 % CI, how the CI was computed and the verdict, for one kicked ``system`` against
+    the two-particle one (or for the store, ``system=""``).
 
     Attributes
     ----------
@@ -63,57 +71,41 @@ class Effect:
         How the interval was computed.
     detail : str
         The supporting numbers (per radius, medians, predictions).
+    statement : str
+        One sentence, derived from the rest: question, effect, CI and verdict.
     """
 
-    question: str
-    system: str
-    quantity: str
-    estimate: float
-    ci_low: float
-    ci_high: float
-    verdict: str
-    rule: str
-    method: str
-    detail: str = ""
+    statement: str = field(init=False, default="")
+    system: str = ""
 
-    def statement(self) -> str:
-        """One sentence: question, effect, CI and verdict."""
+    def __post_init__(self):
         from kicktimes.report.figures import system_label
 
         who = f", {system_label(self.system)} vs two-particle" if self.system else ""
-        ci = (
-            f" (95 % CI {_g(self.ci_low)} to {_g(self.ci_high)}, {self.method})"
-            if np.isfinite(self.ci_low)
-            else ""
+        text = effect_statement(self.question + who, self.quantity, self.estimate, self.ci_low,
+                                self.ci_high, self.method, self.verdict)
+        object.__setattr__(self, "statement", text)
+
+    @classmethod
+    def of_ratio(cls, question, system, quantity, overall, *, tolerance, detail="", method=None,
+                 verdict=None):
+        """The Effect of a ratio and its bootstrap CI, ``overall`` as :func:`paired_ratio`
+        returns it: the verdict of :func:`ratio_verdict` (unless ``verdict`` is given) under
+        the printed :func:`ratio_rule`, the method "paired bootstrap over N ICs" (unless
+        ``method`` is given)."""
+        low, high = overall["ci_low"], overall["ci_high"]
+        return cls(
+            question=question,
+            system=system,
+            quantity=quantity,
+            estimate=overall["ratio"],
+            ci_low=low,
+            ci_high=high,
+            verdict=verdict or ratio_verdict(low, high, tolerance),
+            rule=ratio_rule(tolerance),
+            method=method or f"paired bootstrap over {overall['n_ics']} ICs",
+            detail=detail,
         )
-        return f"{self.question}{who}: {self.quantity} {_g(self.estimate)}{ci}: {self.verdict}."
-
-
-def _g(x):
-    return "n/a" if not np.isfinite(x) else f"{x:.3g}"
-
-
-def share_verdict(low, high, level):
-    """``above``/``below``/``inconclusive`` for a share's CI against ``level``."""
-    if not (np.isfinite(low) and np.isfinite(high)):
-        return "inconclusive"
-    if low > level:
-        return "above"
-    if high < level:
-        return "below"
-    return "inconclusive"
-
-
-def clopper_pearson(k, n, level=0.95):
-    """Exact binomial interval of ``k`` successes in ``n`` trials (NaN when n = 0)."""
-    from scipy import stats as sps
-
-    if n <= 0:
-        return math.nan, math.nan
-    a = 1 - level
-    low = 0.0 if k == 0 else float(sps.beta.ppf(a / 2, k, n - k + 1))
-    high = 1.0 if k == n else float(sps.beta.ppf(1 - a / 2, k + 1, n - k))
-    return low, high
 
 
 def _matrix(frame, column, radii, ics):
@@ -229,6 +221,14 @@ def paired_ratio(numerator, denominator, *, rng, n_boot=2000, level=0.95, resamp
         "n_radii": int(usable.sum()),
     }
     return per_radius, overall
+
+
+def store_ratio(ctx, numerator, denominator):
+    """:func:`paired_ratio` under the store's bootstrap: the Findings' stream
+    (``ctx.boot_rng()``), ``ctx.n_boot`` resamples, shared by every ratio of the store
+    (``ctx.resamples``)."""
+    return paired_ratio(numerator, denominator, rng=ctx.boot_rng(), n_boot=ctx.n_boot,
+                        resamples=ctx.resamples)
 
 
 def _bca_levels(boot, estimate, x, y, level):

@@ -3,6 +3,8 @@ constrained-layout Figure factory (never pyplot)."""
 
 from __future__ import annotations
 
+from dataclasses import dataclass, replace
+
 import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
@@ -47,11 +49,86 @@ _SEM_BAR = {"linewidth": 1.0, "capsize": 3.0}
 def radius_axis(ax):
     """Label ``ax``'s x axis as the disk radius, with at most 6 plain ticks (0.01, 0.015):
     radii in steps of 0.002 otherwise give ten 5-digit labels that run together."""
-    from matplotlib.ticker import MaxNLocator
+    XAxis().draw(ax)
 
-    ax.set_xlabel(RADIUS_LABEL)
-    ax.xaxis.set_major_locator(MaxNLocator(nbins=5, steps=[1, 2, 2.5, 5, 10]))
-    ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:.3g}"))
+
+@dataclass(frozen=True)
+class XAxis:
+    """What a figure draws along x: a column of its tables and the axis label.
+
+    The report's figures draw against the disk radius (the default); ``kicktimes analyze``
+    draws the same figures against the sequences' group. A numeric column is drawn at its
+    values; a column of labels (the analysis' single group ``"all"``) at 0, 1, ... in
+    order of first appearance, with the labels as ticks (``labels``, set by
+    :meth:`positions`).
+
+    Examples
+    --------
+    >>> import pandas as pd
+    >>> axis = XAxis("density", "particles per unit area")
+    >>> axis.positions(t=pd.DataFrame({"density": [0.2, 0.1]}))[0]["density"].tolist()
+    [0.2, 0.1]
+    >>> t, axis = XAxis("group", "group").positions(t=pd.DataFrame({"group": ["all"]}))
+    >>> t["group"].tolist(), axis.labels
+    ([0.0], ('all',))
+    """
+
+    column: str = "radius"
+    label: str = RADIUS_LABEL
+    labels: tuple | None = None
+
+    def positions(self, **frames):
+        """Check the column in every frame, given by name (radii: 0 < r < 0.5; other
+        numbers: finite), and return ``(*frames, axis)``: the frames with the column as
+        float positions, in the order given; a column of labels becomes 0, 1, ... (shared
+        by the frames) and the returned axis carries the labels."""
+        for name, frame in frames.items():
+            check_frame(name, frame, [self.column], allow_empty=True)
+        values = {name: frame[self.column] for name, frame in frames.items()}
+        if all(v.empty or pd.api.types.is_numeric_dtype(v) for v in values.values()):
+            check = check_radii if self.column == "radius" else finite
+            for name, v in values.items():
+                check(f"{name}[{self.column!r}]", v)
+            return (*frames.values(), self)
+        labels = tuple(dict.fromkeys(str(v) for column in values.values() for v in column))
+        where = {label: float(k) for k, label in enumerate(labels)}
+        mapped = [
+            frame.assign(**{self.column: [where[str(v)] for v in frame[self.column]]})
+            for frame in frames.values()
+        ]
+        return (*mapped, replace(self, labels=labels))
+
+    @staticmethod
+    def step(values, single):
+        """The smallest gap between the distinct ``values`` (``single`` for one value)."""
+        u = np.unique(np.asarray(values, float))
+        return float(np.min(np.diff(u))) if u.size > 1 else single
+
+    def draw(self, ax):
+        """Label the x axis; at most 6 plain ticks for numbers, the labels for text."""
+        from matplotlib.ticker import FixedFormatter, FixedLocator, MaxNLocator
+
+        ax.set_xlabel(self.label)
+        if self.labels is not None:
+            ax.xaxis.set_major_locator(FixedLocator(np.arange(len(self.labels), dtype=float)))
+            ax.xaxis.set_major_formatter(FixedFormatter(list(self.labels)))
+            return
+        ax.xaxis.set_major_locator(MaxNLocator(nbins=5, steps=[1, 2, 2.5, 5, 10]))
+        # radii: 3 significant digits (0.0125); any other value as a plain number
+        digits = ".3g" if self.column == "radius" else "g"
+        ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:{digits}}"))
+
+
+def x_axis(x="radius", xlabel=None):
+    """The :class:`XAxis` of a figure's ``x`` and ``xlabel`` arguments (``xlabel`` None:
+    the radius label for ``"radius"``, the column's name otherwise)."""
+    if not isinstance(x, str) or not x:
+        raise TypeError(f"x must be a column name, got {x!r}")
+    if xlabel is None:
+        xlabel = RADIUS_LABEL if x == "radius" else x
+    if not isinstance(xlabel, str):
+        raise TypeError(f"xlabel must be a string, got {type(xlabel).__name__}")
+    return XAxis(x, xlabel)
 
 
 def system_label(system):

@@ -10,8 +10,6 @@ this module only gathers them, states the rules and the scale.
 
 from __future__ import annotations
 
-import pandas as pd
-
 from kicktimes.report import autocorrelation, counts, lyapunov, poisson, recurrence, renewal
 from kicktimes.report.common import PAPER_SCALE, Section, is_paper_scale
 from kicktimes.report.controls import (
@@ -22,11 +20,15 @@ from kicktimes.report.controls import (
     ratio_curves_figure,
 )
 from kicktimes.report.effects import BUILT_IN, SHARE_RULE, ratio_rule
+from kicktimes.stats.findings import findings_table
 
-__all__ = ["collect", "scale_statement", "section", "EFFECT_MODULES"]
+__all__ = ["collect", "scale_statement", "section", "EFFECT_MODULES", "STATEMENT_COLUMNS"]
 
 #: the modules whose ``effects(ctx)`` make the Findings, in the order of the questions
 EFFECT_MODULES = (poisson, renewal, counts, lyapunov, recurrence, autocorrelation)
+#: the columns of ``findings_statements.csv``: one row per `Effect`
+STATEMENT_COLUMNS = ("question", "system", "quantity", "estimate", "ci_low", "ci_high",
+                     "verdict", "method", "rule", "detail")
 
 
 def collect(ctx):
@@ -103,25 +105,9 @@ def section(ctx):
     )
     sec.fold()
     sec.text("All statements, under the primary setting:")
-    sec.bullets(e.statement() + (f" ({e.detail}.)" if e.detail else "") for e in effects)
+    sec.bullets(e.sentence() for e in effects)
     sec.text(rules_text(ctx))
-    table = pd.DataFrame(
-        [
-            {
-                "question": e.question,
-                "system": e.system,
-                "quantity": e.quantity,
-                "estimate": e.estimate,
-                "ci_low": e.ci_low,
-                "ci_high": e.ci_high,
-                "verdict": e.verdict,
-                "method": e.method,
-                "rule": e.rule,
-                "detail": e.detail,
-            }
-            for e in effects
-        ]
-    )
+    table = findings_table(effects, columns=STATEMENT_COLUMNS)
     sec.table("findings_statements", table, "Findings (effect, 95 % CI, verdict)", show=False)
     ctx.found.effects = effects
     return sec

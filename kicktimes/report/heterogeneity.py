@@ -11,12 +11,13 @@ from matplotlib.figure import Figure
 
 from kicktimes.report.common import Section, fmt
 from kicktimes.report.counts import counts_by_radius
-from kicktimes.report.figures import check_frame, plain_log_ticks, radius_axis
+from kicktimes.report.figures import check_frame, plain_log_ticks, x_axis
 
 __all__ = ["rate_heterogeneity", "sections"]
 
 
-def rate_heterogeneity(collisions, *, homogeneity=None, rule="mirror", max_points=4000):
+def rate_heterogeneity(collisions, *, homogeneity=None, rule="mirror", max_points=4000,
+                       x="radius", xlabel=None):
     r"""Collision rates across ICs: per-IC rates and their dispersion, per radius.
 
     Parameters
@@ -29,10 +30,14 @@ def rate_heterogeneity(collisions, *, homogeneity=None, rule="mirror", max_point
         rate (the Pearson dispersion test of
         :func:`kicktimes.stats.test_poisson_ensemble`); printed on top of panel (b).
     rule : {"mirror", "elastic"} or None
-        Rule of the kinetic-theory rate (None: no kinetic curve).
+        Rule of the kinetic-theory rate (None: no kinetic curve; a rule needs
+        ``x="radius"``).
     max_points : int
         At most this many per-IC points are drawn per radius (every k-th IC in index
         order; the summaries use all).
+    x, xlabel : str, optional
+        The column of both tables drawn along x and its axis label (default: the disk
+        radius; e.g. the group of `kicktimes analyze`; labels are drawn at 0, 1, ...).
 
     Returns
     -------
@@ -44,8 +49,24 @@ def rate_heterogeneity(collisions, *, homogeneity=None, rule="mirror", max_point
     """
     from kicktimes import stats
 
-    df = check_frame("collisions", collisions, ["radius", "n_pp", "t_window"])
-    table = counts_by_radius(df)
+    axis = x_axis(x, xlabel)
+    df = check_frame("collisions", collisions, [x, "n_pp", "t_window"])
+    if rule is not None and x != "radius":
+        raise ValueError(f"rule needs x='radius' (the kinetic rate is one of the radius), got "
+                         f"x={x!r}; pass rule=None")
+    hom = homogeneity
+    if hom is not None:
+        if not isinstance(hom, pd.DataFrame):
+            raise TypeError(f"homogeneity must be a DataFrame, got {type(hom).__name__}")
+        if x not in hom.columns:
+            hom = hom.rename_axis(x).reset_index()
+        if "pvalue" not in hom.columns and "pvalue_mc" not in hom.columns:
+            raise ValueError("homogeneity must have a column 'pvalue' or 'pvalue_mc'")
+        df, hom, axis = axis.positions(collisions=df, homogeneity=hom)
+        hom = hom.set_index(x)
+    else:
+        df, axis = axis.positions(collisions=df)
+    table = counts_by_radius(df, x=x)
     if isinstance(max_points, bool) or not isinstance(max_points, int) or max_points < 1:
         raise ValueError(f"max_points must be a positive integer, got {max_points!r}")
     rate = df["n_pp"].to_numpy(float) / df["t_window"].to_numpy(float)
@@ -54,17 +75,17 @@ def rate_heterogeneity(collisions, *, homogeneity=None, rule="mirror", max_point
     fig = Figure(figsize=(11.0, 4.4), layout="constrained")
     ax1, ax2 = fig.subplots(1, 2)
     radii = table.index.to_numpy()
-    jitter = 0.25 * (np.min(np.diff(radii)) if radii.size > 1 else 0.004)
+    jitter = 0.25 * axis.step(radii, single=0.004)
     rng = np.random.default_rng(0)  # jitter only: the figure is reproducible
     zero_labelled = False
     for k, r in enumerate(radii):
-        sel = np.flatnonzero(df["radius"].to_numpy() == r)
+        sel = np.flatnonzero(df[x].to_numpy() == r)
         sel = sel[:: max(1, math.ceil(sel.size / max_points))]
         y = rate[sel]
-        x = r + rng.uniform(-jitter, jitter, sel.size)
+        xs = r + rng.uniform(-jitter, jitter, sel.size)
         lab = "per-IC rate" if k == 0 else None
         ax1.plot(
-            x[y > 0],
+            xs[y > 0],
             y[y > 0],
             linestyle="none",
             marker=".",
@@ -76,7 +97,7 @@ def rate_heterogeneity(collisions, *, homogeneity=None, rule="mirror", max_point
         )
         if (y == 0).any():
             ax1.plot(
-                x[y == 0],
+                xs[y == 0],
                 np.full((y == 0).sum(), floor),
                 linestyle="none",
                 marker="v",
@@ -85,9 +106,9 @@ def rate_heterogeneity(collisions, *, homogeneity=None, rule="mirror", max_point
                 label=None if zero_labelled else "IC without collisions (at the floor)",
             )
             zero_labelled = True
-    grouped = df.groupby("radius")
+    grouped = df.groupby(x)
     pooled = grouped["n_pp"].sum() / grouped["t_window"].sum()
-    median = pd.Series(rate, index=df.index).groupby(df["radius"]).median()
+    median = pd.Series(rate, index=df.index).groupby(df[x]).median()
     ax1.plot(pooled.index, pooled.to_numpy(), marker="o", color="black", label="pooled ΣN/ΣT")
     ax1.plot(
         median.index,
@@ -108,7 +129,7 @@ def rate_heterogeneity(collisions, *, homogeneity=None, rule="mirror", max_point
             label=f"kinetic theory Γ(r) ({rule})",
         )
     ax1.set_yscale("log")
-    radius_axis(ax1)
+    axis.draw(ax1)
     ax1.set_ylabel("disk-disk collision rate (1 / time unit)")
     ax1.set_title("(a) rates of the individual ICs")
     ax1.legend(fontsize="x-small")
@@ -128,14 +149,7 @@ def rate_heterogeneity(collisions, *, homogeneity=None, rule="mirror", max_point
     hi = float(max(shown.max(), 1.0)) if shown.size else 1.0
     ax2.set_ylim(lo / 1.5, hi * 1.5)
     plain_log_ticks(ax2.yaxis)
-    if homogeneity is not None:
-        hom = homogeneity
-        if not isinstance(hom, pd.DataFrame):
-            raise TypeError(f"homogeneity must be a DataFrame, got {type(hom).__name__}")
-        if "radius" in hom.columns:
-            hom = hom.set_index("radius")
-        if "pvalue" not in hom.columns and "pvalue_mc" not in hom.columns:
-            raise ValueError("homogeneity must have a column 'pvalue' or 'pvalue_mc'")
+    if hom is not None:
         # the Monte Carlo p-value is exact but floored at 1/(n_mc + 1): where it sits at its
         # floor (every radius of a paper store) the labels would all read that floor, so
         # the asymptotic chi-square p-value is shown, which can be as small as it is
@@ -155,7 +169,7 @@ def rate_heterogeneity(collisions, *, homogeneity=None, rule="mirror", max_point
             + ")",
             fontsize="small",
         )
-    radius_axis(ax2)
+    axis.draw(ax2)
     ax2.set_ylabel("index of dispersion of counts across ICs")
     ax2.set_title("(b) over-dispersion")
     ax2.legend(fontsize="x-small")

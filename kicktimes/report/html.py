@@ -1,9 +1,13 @@
-"""Writing the report: figures (PNG, optionally PDF), tables (CSV), and the HTML of the
-sections; every file atomically (:func:`kicktimes.report._cache.atomic_write`)."""
+"""Writing the pages: figures (PNG, optionally PDF), tables (CSV), the HTML of the
+sections and the page around them (:func:`write_page`: the sweep report of
+:func:`kicktimes.report.build_report` and the page of ``kicktimes analyze``,
+:func:`kicktimes.report.analyze_page.write_analysis`); every file atomically
+(:func:`kicktimes.report._cache.atomic_write`)."""
 
 from __future__ import annotations
 
 import base64
+import datetime as _dt
 import html
 import io
 import os
@@ -15,6 +19,8 @@ from kicktimes.memory import keep_freed_memory
 from kicktimes.report._cache import atomic_write
 
 __all__ = [
+    "write_page",
+    "toc_item",
     "write_outputs",
     "embed_figures",
     "save_figure",
@@ -143,6 +149,7 @@ def write_table(out, name, df, files):
 
 
 def write_text(out, filename, text, files):
+    """``text`` as ``filename`` (UTF-8), atomically, its SHA-256 recorded in ``files``."""
     files[filename] = atomic_write(out / filename, text.encode("utf-8"))
 
 
@@ -261,3 +268,48 @@ def store_header(store, notes):
         parts.append(f'<div class="note"><b>Subsampling (deterministic):</b><ul>{items}</ul></div>')
     parts.append("<h3>Parameters</h3>" + table_html(params))
     return "\n".join(parts), params
+
+
+def toc_item(anchor, title, children=()):
+    """One entry of a page's contents: a link to ``#anchor`` titled ``title``, with the
+    entries ``children`` (HTML ``<li>`` items) nested below it."""
+    nested = f"<ul>{''.join(children)}</ul>" if children else ""
+    return f'<li><a href="#{anchor}">{html.escape(title)}</a>{nested}</li>'
+
+
+def write_page(out, title, *, sources, toc, body, appendix="", files=None) -> Path:
+    """Write the self-contained page ``out/report.html``, atomically.
+
+    Parameters
+    ----------
+    out : pathlib.Path
+        The output folder.
+    title : str
+        The page's title and heading.
+    sources : str
+        HTML (escaped by the caller) completing "Built <time> with kicktimes <version>
+        from ...": what the page was computed from.
+    toc : sequence of str
+        The contents, ``<li>`` items (:func:`toc_item`).
+    body : str
+        The sections' HTML (:func:`write_outputs`), figures embedded.
+    appendix : str, optional
+        HTML after the sections (the report's timings).
+    files : dict, optional
+        Records the page's SHA-256 (as :func:`write_table`).
+
+    Returns
+    -------
+    pathlib.Path
+        ``out / "report.html"``.
+    """
+    built = _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")
+    text = (
+        '<!DOCTYPE html><html lang="en"><head><meta charset="utf-8">'
+        f"<title>{html.escape(title)}</title><style>{CSS}</style></head><body>"
+        f"<h1>{html.escape(title)}</h1><p>Built {built} with kicktimes "
+        f"{html.escape(__version__)} from {sources}.</p><h2>Contents</h2><ul>{''.join(toc)}</ul>"
+        f"{body}{appendix}</body></html>"
+    )
+    write_text(out, "report.html", text, {} if files is None else files)
+    return out / "report.html"

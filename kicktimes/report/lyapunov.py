@@ -16,7 +16,7 @@ import pandas as pd
 from matplotlib.figure import Figure
 
 from kicktimes.report.common import REFERENCE, Section, distinct, fmt, kicked_systems, wide
-from kicktimes.report.effects import Effect, paired_ratio, ratio_rule, ratio_verdict
+from kicktimes.report.effects import Effect, store_ratio
 from kicktimes.report.figures import (
     DIAGNOSTIC_LABELS,
     radius_axis,
@@ -200,13 +200,7 @@ def effects(ctx):
     for system in kicked_systems(results):
         if system not in lam.columns or REFERENCE not in lam.columns:
             continue
-        per_r, tot = paired_ratio(
-            lam[system],
-            lam[REFERENCE],
-            rng=ctx.boot_rng(),
-            n_boot=ctx.n_boot,
-            resamples=ctx.resamples,
-        )
+        per_r, tot = store_ratio(ctx, lam[system], lam[REFERENCE])
         ref = table[table["system"] == REFERENCE].set_index("radius")
         kick = table[table["system"] == system].set_index("radius")
         detail = f"per-radius ratio {fmt(per_r['ratio'].min())} to {fmt(per_r['ratio'].max())}"
@@ -219,16 +213,12 @@ def effects(ctx):
                 f"(ln(1/r) = {fmt(np.log(1 / r0))})"
             )
         out.append(
-            Effect(
-                question="FTLE",
-                system=system,
-                quantity="ratio of mean λ (kicked / two-particle, averaged over radii)",
-                estimate=tot["ratio"],
-                ci_low=tot["ci_low"],
-                ci_high=tot["ci_high"],
-                verdict=ratio_verdict(tot["ci_low"], tot["ci_high"], ctx.tolerance),
-                rule=ratio_rule(ctx.tolerance),
-                method=f"paired bootstrap over {tot['n_ics']} ICs",
+            Effect.of_ratio(
+                "FTLE",
+                system,
+                "ratio of mean λ (kicked / two-particle, averaged over radii)",
+                tot,
+                tolerance=ctx.tolerance,
                 detail=detail,
             )
         )

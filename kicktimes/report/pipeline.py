@@ -18,15 +18,14 @@ spreads over every core once the smaller one is done.
 
 from __future__ import annotations
 
-import datetime as _dt
 import html
 import os
 import time
 from concurrent.futures import ProcessPoolExecutor
 from contextlib import closing, contextmanager
+from dataclasses import dataclass
 from pathlib import Path
 
-from kicktimes import __version__
 from kicktimes.memory import fewer_collections, keep_freed_memory
 from kicktimes.report._cache import ReportCache, content_key, store_key
 from kicktimes.report.common import (
@@ -38,11 +37,12 @@ from kicktimes.report.common import (
     load_report_store,
 )
 from kicktimes.report.html import (
-    CSS,
     embed_figures,
     store_header,
     table_html,
+    toc_item,
     write_outputs,
+    write_page,
     write_table,
     write_text,
 )
@@ -218,16 +218,16 @@ def experiment_part(job, bar=None):
         workers=workers,
     )
     timings.append((name, "write files", time.perf_counter() - t0))
-    items = "".join(f'<li><a href="#{prefix}{s.key}">{html.escape(s.title)}</a></li>' for s in secs)
     return {
         "key": content_key("experiment", store_key(path, store.manifest), options, render, prefix),
         "files": files,
         "findings_html": findings_html,
-        "findings_toc": f'<li><a href="#{prefix}findings">{html.escape(found.title)}</a></li>',
+        "findings_toc": toc_item(f"{prefix}findings", found.title),
         "html": f'<h2 id="{prefix}experiment">Experiment {html.escape(name)}</h2>{header}{body}',
-        "toc": (
-            f'<li><a href="#{prefix}experiment">Experiment {html.escape(name)}</a>'
-            f"<ul>{items}</ul></li>"
+        "toc": toc_item(
+            f"{prefix}experiment",
+            f"Experiment {name}",
+            [toc_item(f"{prefix}{s.key}", s.title) for s in secs],
         ),
         "timings": [list(t) for t in timings],
     }
@@ -250,7 +250,7 @@ def families_part(paths, out, render, workers=1):
             embed=False,
             workers=workers,
         )
-        toc = f'<li><a href="#{families.key}">{html.escape(families.title)}</a></li>'
+        toc = toc_item(families.key, families.title)
     keys = [store_key(p, st.manifest) for p, st in zip(paths, stores, strict=True)]
     return {
         "key": content_key("families", keys, render),
@@ -376,16 +376,68 @@ def build_report(
     'report.html'
     """
     paths = _check_paths(store_path)
+    options, render, workers = _check_options(
+        out_dir,
+        progress=progress,
+        alpha=alpha,
+        n_mc=n_mc,
+        max_ics_tests=max_ics_tests,
+        max_ics_model_fits=max_ics_model_fits,
+        max_pooled_intervals=max_pooled_intervals,
+        dpi=dpi,
+        workers=workers,
+        n_boot=n_boot,
+        tolerance=tolerance,
+        pdf=pdf,
+        force=force,
+    )
+    t_start = time.perf_counter()
+    plan = _plan(paths, Path(out_dir), options, render, force=force)
+    if plan.up_to_date():
+        return plan.out / "report.html"  # nothing changed: every file is what it would write
+    # the parts to (re)build: one job per store, and the all-experiments figures
+    jobs = {
+        pid: (path, plan.out, prefix, options, render, workers)
+        for pid, path, prefix in zip(plan.part_ids, paths, plan.prefixes, strict=True)
+        if plan.parts[pid] is None
+    }
+    families_todo = plan.multi and plan.parts["families"] is None
+    parallel = workers > 1 and len(jobs) + families_todo > 1
+    n_steps = 2 + (len(jobs) if parallel else n_stages() * len(jobs)) + families_todo
+    bar = Progress(progress, n_steps)
+    # the collector runs less often while the report allocates (kicktimes.memory)
+    with closing(bar), fewer_collections(), _one_blas_thread():
+        bar.step("load store")
+        timings = [("", "check cache", time.perf_counter() - t_start)]
+        bar.advance()
+        build = _build_parallel if parallel else _build_serial
+        build(plan, jobs, families_todo, workers=workers, render=render, bar=bar)
+        built = [*jobs, *(["families"] if families_todo else [])]
+        for pid in built:
+            timings += [tuple(t) for t in plan.parts[pid]["timings"]]
+            plan.cache.record(pid, plan.parts[pid])
+        bar.step("write files")
+        page = _write_page(plan, timings, built)
+        bar.advance()
+        return page
+
+
+def _check_options(out_dir, *, progress, alpha, n_mc, max_ics_tests, max_ics_model_fits,
+                   max_pooled_intervals, dpi, workers, n_boot, tolerance, pdf, force):
+    """The checked arguments of :func:`build_report` as ``(options, render, workers)``:
+    ``options`` the sections' (as `Context` takes them), ``render`` the figures'."""
     if not isinstance(out_dir, str | os.PathLike):
         raise TypeError(f"out_dir must be a path, got {type(out_dir).__name__}")
-    alpha = check_fraction("alpha", alpha)
-    n_mc = check_int("n_mc", n_mc, 19)
-    max_ics_tests = check_int("max_ics_tests", max_ics_tests, 2, allow_none=True)
-    max_ics_model_fits = check_int("max_ics_model_fits", max_ics_model_fits, 1)
-    max_pooled_intervals = check_int("max_pooled_intervals", max_pooled_intervals, 100)
-    dpi = check_int("dpi", dpi, 30)
-    n_boot = check_int("n_boot", n_boot, 100)
-    tolerance = check_fraction("tolerance", tolerance)
+    options = {
+        "alpha": check_fraction("alpha", alpha),
+        "n_mc": check_int("n_mc", n_mc, 19),
+        "max_ics_tests": check_int("max_ics_tests", max_ics_tests, 2, allow_none=True),
+        "max_ics_model_fits": check_int("max_ics_model_fits", max_ics_model_fits, 1),
+        "max_pooled_intervals": check_int("max_pooled_intervals", max_pooled_intervals, 100),
+        "n_boot": check_int("n_boot", n_boot, 100),
+        "tolerance": check_fraction("tolerance", tolerance),
+    }
+    render = {"dpi": check_int("dpi", dpi, 30), "pdf": pdf}
     workers = check_int("workers", (os.cpu_count() or 1) if workers is None else workers, 1)
     for flag, value in (("pdf", pdf), ("force", force)):
         if not isinstance(value, bool):
@@ -395,8 +447,38 @@ def build_report(
             f"progress must be None, a bool or a callable(stage, done, total), got "
             f"{type(progress).__name__}"
         )
+    return options, render, workers
 
-    t_start = time.perf_counter()
+
+@dataclass
+class _Plan:
+    """What a build writes: one part per store (and the all-experiments figures with
+    several), each with its cache key, and the cached parts (None: to build)."""
+
+    paths: list
+    out: Path
+    names: list  # the stores' experiment names
+    manifests: list
+    part_ids: list  # "experiment <name>", one per store
+    prefixes: list  # the file-name prefix of each store's files ("<name>_" with several)
+    keys: dict  # part id (and "families") -> cache key
+    parts: dict  # part id -> the part, from the cache or built; None until built
+    page_key: str
+    cache: ReportCache
+
+    @property
+    def multi(self):
+        return len(self.paths) > 1
+
+    def up_to_date(self):
+        """Every part and the page are in the cache under their keys."""
+        return all(e is not None for e in self.parts.values()) and bool(
+            self.cache.lookup("page", self.page_key)
+        )
+
+
+def _plan(paths, out, options, render, *, force):
+    """Read the stores' manifests, check them, and look every part up in the cache."""
     from kicktimes.experiment.store import read_manifest
 
     manifests = [read_manifest(p) for p in paths]
@@ -408,18 +490,7 @@ def build_report(
         raise ValueError(
             f"store_path: the stores' experiments must have distinct names, got {names}"
         )
-    out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    options = dict(
-        alpha=alpha,
-        n_mc=n_mc,
-        max_ics_tests=max_ics_tests,
-        max_ics_model_fits=max_ics_model_fits,
-        max_pooled_intervals=max_pooled_intervals,
-        n_boot=n_boot,
-        tolerance=tolerance,
-    )
-    render = {"dpi": dpi, "pdf": pdf}
     cache = ReportCache(out, fresh=force)
     multi = len(paths) > 1
     prefixes = [f"{n}_" if multi else "" for n in names]
@@ -431,114 +502,103 @@ def build_report(
     }
     if multi:
         keys["families"] = content_key("families", store_keys, render)
-    parts = {pid: cache.lookup(pid, key) for pid, key in keys.items()}
-    page_key = content_key("page", [keys[pid] for pid in keys])
-    page = out / "report.html"
-    if all(e is not None for e in parts.values()) and cache.lookup("page", page_key):
-        return page  # nothing changed: every file in out_dir is what this build would write
+    return _Plan(
+        paths=paths,
+        out=out,
+        names=names,
+        manifests=manifests,
+        part_ids=part_ids,
+        prefixes=prefixes,
+        keys=keys,
+        parts={pid: cache.lookup(pid, key) for pid, key in keys.items()},
+        page_key=content_key("page", list(keys.values())),
+        cache=cache,
+    )
 
-    todo = [k for k, pid in enumerate(part_ids) if parts[pid] is None]
-    families_todo = multi and parts["families"] is None
-    jobs = {part_ids[k]: (paths[k], out, prefixes[k], options, render, workers) for k in todo}
-    parallel = workers > 1 and len(jobs) + families_todo > 1
-    n_steps = 2 + (len(jobs) if parallel else n_stages() * len(jobs)) + families_todo
-    bar = Progress(progress, n_steps)
-    # the collector runs less often while the report allocates (kicktimes.memory)
-    with closing(bar), fewer_collections(), _one_blas_thread():
-        bar.step("load store")
-        timings = [("", "check cache", time.perf_counter() - t_start)]
+
+def _build_serial(plan, jobs, families_todo, *, workers, render, bar):
+    """Build the parts in this process, one after the other (each with its own pools)."""
+    for pid, job in jobs.items():
+        plan.parts[pid] = experiment_part(job, bar)
+    if families_todo:
+        bar.step("all-experiments figures")
+        plan.parts["families"] = families_part(plan.paths, plan.out, render, workers)
         bar.advance()
-        if parallel:
-            _preload()  # before the pool forks: the workers inherit the imports
-            # one worker per part; each part maps its per-radius jobs (Poisson tests,
-            # renewal fits) and renders its figures on pools of its own
-            inner = _inner_workers(workers, [manifests[k] for k in todo])
-            with ProcessPoolExecutor(
-                max_workers=min(workers, len(jobs) or 1), initializer=keep_freed_memory
-            ) as ex:
-                futures = {
-                    pid: ex.submit(experiment_part, job[:-1] + (inner,))
-                    for pid, job in jobs.items()
-                }
-                if families_todo:
-                    # a pool job too, queued behind the parts: it runs in the worker of the
-                    # first part done (the smaller family), and renders on processes forked
-                    # from that single-threaded worker, not from this process, whose pool
-                    # threads a fork would copy
-                    fam = ex.submit(families_part, paths, out, render, workers)
-                    bar.step("all-experiments figures")
-                    parts["families"] = fam.result()
-                    bar.advance()
-                for pid, fut in futures.items():
-                    bar.step(f"{pid}: sections (in a worker process)")
-                    parts[pid] = fut.result()
-                    bar.advance()
-        else:
-            for pid, job in jobs.items():
-                parts[pid] = experiment_part(job, bar)
-            if families_todo:
-                bar.step("all-experiments figures")
-                parts["families"] = families_part(paths, out, render, workers)
-                bar.advance()
-        for pid in jobs:
-            timings += [tuple(t) for t in parts[pid]["timings"]]
+
+
+def _build_parallel(plan, jobs, families_todo, *, workers, render, bar):
+    """Build the parts at the same time, one worker process per part; each part maps its
+    per-radius jobs (Poisson tests, renewal fits) and renders its figures on pools of its
+    own (:func:`_inner_workers` processes)."""
+    _preload()  # before the pool forks: the workers inherit the imports
+    inner = _inner_workers(workers, [plan.manifests[plan.part_ids.index(pid)] for pid in jobs])
+    with ProcessPoolExecutor(
+        max_workers=min(workers, len(jobs) or 1), initializer=keep_freed_memory
+    ) as ex:
+        futures = {
+            pid: ex.submit(experiment_part, job[:-1] + (inner,)) for pid, job in jobs.items()
+        }
         if families_todo:
-            timings += [tuple(t) for t in parts["families"]["timings"]]
-        built = set(jobs) | ({"families"} if families_todo else set())
-        for pid in keys:
-            if pid in built:
-                cache.record(pid, parts[pid])
+            # a pool job too, queued behind the parts: it runs in the worker of the first
+            # part done (the smaller family), and renders on processes forked from that
+            # single-threaded worker, not from this process, whose pool threads a fork
+            # would copy
+            fam = ex.submit(families_part, plan.paths, plan.out, render, workers)
+            bar.step("all-experiments figures")
+            plan.parts["families"] = fam.result()
+            bar.advance()
+        for pid, fut in futures.items():
+            bar.step(f"{pid}: sections (in a worker process)")
+            plan.parts[pid] = fut.result()
+            bar.advance()
 
-        bar.step("write files")
-        import pandas as pd
 
-        t0 = time.perf_counter()
-        files = {}
-        sweep_rows = [
-            (name, stage, float(v))
-            for name, man in zip(names, manifests, strict=True)
-            for stage, v in _sweep_seconds(man).items()
-        ]
-        sweep_t = pd.DataFrame(sweep_rows, columns=["experiment", "stage", "seconds"])
-        write_table(out, "sweep_timings", sweep_t, files)
-        reused = [
-            (n, "reused from the cache", 0.0)
-            for n, pid in zip(names, part_ids, strict=True)
-            if pid not in built
-        ]
-        timings += reused
-        timings.append(("", "write page", time.perf_counter() - t0))
-        report_t = pd.DataFrame(timings, columns=["experiment", "stage", "seconds"])
-        write_table(out, "report_timings", report_t, files)
-        ordered = [parts[pid] for pid in part_ids]
-        body = [e["findings_html"] for e in ordered]
-        toc = [e["findings_toc"] for e in ordered]
-        if multi and parts["families"]["html"]:
-            body.append(parts["families"]["html"])
-            toc.append(parts["families"]["toc"])
-        body += [e["html"] for e in ordered]
-        toc += [e["toc"] for e in ordered]
-        title = " + ".join(names)
-        text = (
-            '<!DOCTYPE html><html lang="en"><head><meta charset="utf-8">'
-            f"<title>kicktimes report: {html.escape(title)}</title><style>{CSS}</style>"
-            f"</head><body><h1>kicktimes report: {html.escape(title)}</h1>"
-            f"<p>Built {_dt.datetime.now(_dt.timezone.utc).isoformat(timespec='seconds')} "
-            f"with kicktimes {html.escape(__version__)} from "
-            + ", ".join(html.escape(os.fspath(Path(p).resolve())) for p in paths)
-            + f".</p><h2>Contents</h2><ul>{''.join(toc)}</ul>{embed_figures(''.join(body), out)}"
-            "<h2>Timings</h2><p>Report stages (seconds, this build; parts reused from the "
-            "cache are listed as such):</p>"
-            + table_html(report_t)
-            + "<p>Sweep stages (seconds, summed over tasks and workers):</p>"
-            + table_html(sweep_t)
-            + "</body></html>"
-        )
-        write_text(out, "report.html", text, files)
-        cache.record("page", {"key": page_key, "files": files})
-        cache.save()
-        bar.advance()
-        return page
+def _write_page(plan, timings, built):
+    """Write the timing tables and the page from the parts; record the page in the cache
+    and save it. Returns the page's path."""
+    import pandas as pd
+
+    t0 = time.perf_counter()
+    out, files = plan.out, {}
+    sweep_rows = [
+        (name, stage, float(v))
+        for name, man in zip(plan.names, plan.manifests, strict=True)
+        for stage, v in _sweep_seconds(man).items()
+    ]
+    sweep_t = pd.DataFrame(sweep_rows, columns=["experiment", "stage", "seconds"])
+    write_table(out, "sweep_timings", sweep_t, files)
+    timings = timings + [
+        (n, "reused from the cache", 0.0)
+        for n, pid in zip(plan.names, plan.part_ids, strict=True)
+        if pid not in built
+    ]
+    timings.append(("", "write page", time.perf_counter() - t0))
+    report_t = pd.DataFrame(timings, columns=["experiment", "stage", "seconds"])
+    write_table(out, "report_timings", report_t, files)
+    ordered = [plan.parts[pid] for pid in plan.part_ids]
+    body = [e["findings_html"] for e in ordered]
+    toc = [e["findings_toc"] for e in ordered]
+    if plan.multi and plan.parts["families"]["html"]:
+        body.append(plan.parts["families"]["html"])
+        toc.append(plan.parts["families"]["toc"])
+    body += [e["html"] for e in ordered]
+    toc += [e["toc"] for e in ordered]
+    page = write_page(
+        out,
+        "kicktimes report: " + " + ".join(plan.names),
+        sources=", ".join(html.escape(os.fspath(Path(p).resolve())) for p in plan.paths),
+        toc=toc,
+        body=embed_figures("".join(body), out),
+        appendix="<h2>Timings</h2><p>Report stages (seconds, this build; parts reused from "
+        "the cache are listed as such):</p>"
+        + table_html(report_t)
+        + "<p>Sweep stages (seconds, summed over tasks and workers):</p>"
+        + table_html(sweep_t),
+        files=files,
+    )
+    plan.cache.record("page", {"key": plan.page_key, "files": files})
+    plan.cache.save()
+    return page
 
 
 def _check_paths(store_path):

@@ -20,11 +20,10 @@ from kicktimes.report.effects import SHARE_RULE, Effect, share_verdict
 from kicktimes.report.figures import (
     check_alpha,
     check_frame,
-    check_radii,
     dodge,
     finite,
     new_axes,
-    radius_axis,
+    x_axis,
 )
 from kicktimes.stats.poisson import TEST_NULLS
 
@@ -71,12 +70,13 @@ def binomial_ci(k, n, level=0.95):
     return low, high
 
 
-def rejection_table(rejections, *, level=0.95) -> pd.DataFrame:
+def rejection_table(rejections, *, level=0.95, x="radius") -> pd.DataFrame:
     """Add ``rate`` and Clopper-Pearson ``ci_low``/``ci_high`` to counts of rejections.
 
-    ``rejections`` has columns ``radius, test, n_tested, n_reject``.
+    ``rejections`` has columns ``<x>, test, n_tested, n_reject`` (``x``: the radius, or the
+    column of the figure's x axis).
     """
-    df = check_frame("rejections", rejections, ["radius", "test", "n_tested", "n_reject"])
+    df = check_frame("rejections", rejections, [x, "test", "n_tested", "n_reject"])
     n = finite("rejections['n_tested']", df["n_tested"])
     k = finite("rejections['n_reject']", df["n_reject"])
     if ((k < 0) | (k > n)).any():
@@ -92,7 +92,8 @@ def rejection_table(rejections, *, level=0.95) -> pd.DataFrame:
     return out
 
 
-def poisson_rejection_rates(rejections, *, alpha=0.05, ncols=4, ax=None):
+def poisson_rejection_rates(rejections, *, alpha=0.05, ncols=4, ax=None, x="radius",
+                            xlabel=None):
     """Rejection rate of each Poisson test per radius, one panel per test (small multiples).
 
     Parameters
@@ -107,46 +108,39 @@ def poisson_rejection_rates(rejections, *, alpha=0.05, ncols=4, ax=None):
     ncols : int
         Panels per row.
     ax : matplotlib Axes, optional
-        Draw every test into this one Axes instead (overlaid, slightly shifted along r,
+        Draw every test into this one Axes instead (overlaid, slightly shifted along x,
         with a legend): a compact form for a grid of such plots.
+    x, xlabel : str, optional
+        The column drawn along x and its axis label (default: the disk radius; e.g. the
+        group of `kicktimes analyze`; a column of labels is drawn at 0, 1, ...).
 
     Returns
     -------
     matplotlib.figure.Figure
-        One panel per test, shared axes, rate ± 95 % Clopper-Pearson interval at each radius.
+        One panel per test, shared axes, rate ± 95 % Clopper-Pearson interval at each x.
     """
     alpha = check_alpha(alpha)
+    axis = x_axis(x, xlabel)
     if isinstance(rejections, pd.DataFrame) and {"rate", "ci_low", "ci_high"} <= set(
         rejections.columns
     ):
-        table = check_frame("rejections", rejections, ["radius", "test", "rate"])
+        table = check_frame("rejections", rejections, [x, "test", "rate"])
     else:
-        table = rejection_table(rejections)
-    check_radii("rejections['radius']", table["radius"])
+        table = rejection_table(rejections, x=x)
+    table, axis = axis.positions(rejections=table)
     tests = list(dict.fromkeys(table["test"]))
     if ax is not None:
-        return _overlaid(table, tests, alpha, ax)
+        return _overlaid(table, tests, alpha, ax, axis)
     ncols = min(ncols, len(tests))
     nrows = math.ceil(len(tests) / ncols)
     fig = Figure(figsize=(3.3 * ncols, 2.9 * nrows), layout="constrained")
     axes = np.atleast_1d(fig.subplots(nrows, ncols, sharex=True, sharey=True, squeeze=False))
     axes = axes.ravel()
     for k, (ax, test) in enumerate(zip(axes, tests, strict=False)):
-        part = table[table["test"] == test].sort_values("radius")
-        rate = part["rate"].to_numpy()
-        err = np.vstack([rate - part["ci_low"].to_numpy(), part["ci_high"].to_numpy() - rate])
-        ax.errorbar(
-            part["radius"],
-            rate,
-            yerr=err,
-            marker="o",
-            markersize=4,
-            capsize=2,
-            linewidth=1,
-            color="C0",
-        )
+        part = table[table["test"] == test].sort_values(x)
+        _rate_bars(ax, part[x], part, color="C0")
         if "control_rate" in part.columns and part["control_rate"].notna().any():
-            ax.plot(part["radius"], part["control_rate"], color="grey", marker="s",
+            ax.plot(part[x], part["control_rate"], color="grey", marker="s",
                     markersize=3, linewidth=0.8, label="control: the sweep's Poisson kicks")
         ax.axhline(alpha, color="black", linestyle=":", linewidth=0.8)
         ax.set_title(TEST_TITLES.get(test, test.replace("_", " ")), fontsize="medium")
@@ -154,7 +148,7 @@ def poisson_rejection_rates(rejections, *, alpha=0.05, ncols=4, ax=None):
         if k % ncols == 0:
             ax.set_ylabel(f"share rejected at α = {alpha:g}")
         if k >= len(tests) - ncols:
-            radius_axis(ax)
+            axis.draw(ax)
             ax.tick_params(axis="x", labelbottom=True)
     for ax in axes[len(tests) :]:
         ax.set_visible(False)
@@ -172,28 +166,23 @@ def poisson_rejection_rates(rejections, *, alpha=0.05, ncols=4, ax=None):
     return fig
 
 
-def _overlaid(table, tests, alpha, ax):
+def _rate_bars(ax, x, part, **style):
+    """The rejection rates of ``part`` at ``x`` with their 95 % intervals."""
+    rate = part["rate"].to_numpy()
+    err = np.vstack([rate - part["ci_low"].to_numpy(), part["ci_high"].to_numpy() - rate])
+    ax.errorbar(x, rate, yerr=err, marker="o", markersize=4, capsize=2, linewidth=1, **style)
+
+
+def _overlaid(table, tests, alpha, ax, axis):
     fig, ax = new_axes(ax, (6.4, 4.4))
-    radii = table["radius"].to_numpy()
+    xs = table[axis.column].to_numpy()
     for k, test in enumerate(tests):
-        part = table[table["test"] == test].sort_values("radius")
-        x = part["radius"].to_numpy() + dodge(radii, k, len(tests))
-        rate = part["rate"].to_numpy()
-        err = np.vstack([rate - part["ci_low"].to_numpy(), part["ci_high"].to_numpy() - rate])
-        ax.errorbar(
-            x,
-            rate,
-            yerr=err,
-            marker="o",
-            markersize=4,
-            capsize=2,
-            linewidth=1,
-            label=test.replace("_", " "),
-            color=f"C{k}",
-        )
+        part = table[table["test"] == test].sort_values(axis.column)
+        shifted = part[axis.column].to_numpy() + dodge(xs, k, len(tests))
+        _rate_bars(ax, shifted, part, label=test.replace("_", " "), color=f"C{k}")
     ax.axhline(alpha, color="black", linestyle=":", label=f"α = {alpha:g} (all ICs Poisson)")
     ax.set_ylim(0.0, 1.0)
-    radius_axis(ax)
+    axis.draw(ax)
     ax.set_ylabel(f"share of ICs rejected at α = {alpha:g}")
     ax.legend(fontsize="x-small", ncol=2)
     return fig
@@ -204,31 +193,46 @@ def subsample(part, limit):
     return part[part["ic"].isin(ics[:limit])] if limit is not None and ics.size > limit else part
 
 
-def _poisson_job(job):
-    """Poisson tests and rate homogeneity of one radius (runs in a worker process)."""
-    from kicktimes import stats
+def _control_times(seqs, windows, ics, r, control):
+    """The sweep's own Poisson kick times of each IC (rate n_pp / t_window, the "poisson"
+    system's stream), cut at the same window: Poisson by construction."""
     from kicktimes.experiment import kick_rng
     from kicktimes.schedules import Poisson
+
+    exp_seed, horizon = control
+    out = []
+    for ic, t, w in zip(ics, seqs, windows, strict=True):
+        if t.size == 0:
+            out.append(np.empty(0))
+            continue
+        kicks = Poisson(t.size / w).sample(horizon, kick_rng(exp_seed, int(ic), r, "poisson"))
+        out.append(kicks[kicks <= w])
+    return out
+
+
+#: the columns of the rate-homogeneity table, in order (`kicktimes.stats.PoissonGroup`'s
+#: ``homogeneity`` with ``n_sequences`` named ``n_ics`` and the kinetic rate beside)
+_HOMOGENEITY = ("dispersion_index", "pearson_statistic", "df", "pvalue", "pvalue_mc",
+                "lr_pvalue", "n_flagged_fdr")
+
+
+def _poisson_job(job):
+    """Poisson tests and rate homogeneity of one radius (runs in a worker process): the
+    group tables of `kicktimes.stats.poisson_group`, with group = radius."""
+    from kicktimes import stats
     from kicktimes.stats.poisson import uniformity_ks
 
     r, seqs, windows, alpha, n_mc, seed_key, rule, ics, control = job
-    ens = stats.test_poisson_ensemble(
-        seqs, windows, alpha=alpha, n_mc=n_mc, rng=seeded_rng(*seed_key)
-    )
-    # the control: the same tests on the sweep's own Poisson kick times of each IC (rate
-    # n_pp / t_window, the "poisson" system's stream), cut at the same window; Poisson by
-    # construction, so every test should reject about alpha of them
-    ctrl_seqs = []
+    group = stats.poisson_group(seqs, windows, alpha=alpha, n_mc=n_mc, rng=seeded_rng(*seed_key))
+    rows = group.rejections.drop(columns="rate")
+    rows.insert(0, "radius", r)
     if control is not None:
-        exp_seed, horizon = control
-        for ic, t, w in zip(ics, seqs, windows, strict=True):
-            if t.size == 0:
-                ctrl_seqs.append(np.empty(0))
-                continue
-            kicks = Poisson(t.size / w).sample(horizon, kick_rng(exp_seed, int(ic), r, "poisson"))
-            ctrl_seqs.append(kicks[kicks <= w])
-        ctrl = stats.test_poisson_ensemble(ctrl_seqs, windows, alpha=alpha, n_mc=n_mc,
-                                           rng=seeded_rng(*seed_key, 9))
+        # the control: the same tests on the sweep's own Poisson kick times of each IC;
+        # every test should reject about alpha of them
+        ctrl = stats.poisson_group(_control_times(seqs, windows, ics, r, control), windows,
+                                   alpha=alpha, n_mc=n_mc, rng=seeded_rng(*seed_key, 9))
+        rows["control_n_tested"] = ctrl.rejections["n_tested"]
+        rows["control_n_reject"] = ctrl.rejections["n_reject"]
     # per IC: the headline test's p-value, and the same test on the first FIXED_EVENTS
     # collisions only (NaN for runs with fewer)
     p_fixed = np.full(len(seqs), np.nan)
@@ -237,44 +241,18 @@ def _poisson_job(job):
         u = np.array([seqs[k][: FIXED_EVENTS - 1] / seqs[k][FIXED_EVENTS - 1] for k in long])
         p_fixed[long] = uniformity_ks(u)[1]
     per_ic = pd.DataFrame({"radius": r, "ic": ics,
-                           "p": ens.per_sequence[f"p_{HEADLINE_TEST}"].to_numpy(float),
+                           "p": group.ensemble.per_sequence[f"p_{HEADLINE_TEST}"].to_numpy(float),
                            "p_fixed": p_fixed})
-    rows = []
-    for test in stats.TESTS:
-        p = ens.per_sequence[f"p_{test}"].to_numpy()
-        ok = np.isfinite(p)
-        comb = ens.combined.loc[test]
-        row = {
-            "radius": r,
-            "test": test,
-            "n_tested": int(ok.sum()),
-            "n_reject": int((p[ok] < alpha).sum()),
-            "n_reject_fdr": int(comb["n_reject_fdr"]),
-            "combined_pvalue": float(comb["pvalue"]),
-        }
-        if ctrl_seqs:
-            pc = ctrl.per_sequence[f"p_{test}"].to_numpy()
-            okc = np.isfinite(pc)
-            row["control_n_tested"] = int(okc.sum())
-            row["control_n_reject"] = int((pc[okc] < alpha).sum())
-        rows.append(row)
-    hom = ens.rate_homogeneity
-    counts = np.array([t.size for t in seqs], dtype=float)
+    hom = group.homogeneity
     hom_row = {
         "radius": r,
-        "n_ics": len(seqs),
-        "pooled_rate": counts.sum() / windows.sum(),
-        "median_rate": float(np.median(counts / windows)),
+        "n_ics": hom["n_sequences"],
+        "pooled_rate": hom["pooled_rate"],
+        "median_rate": hom["median_rate"],
         "kinetic_rate": float(stats.kinetic_rate(r, rule)),
-        "dispersion_index": counts.var(ddof=1) / counts.mean() if counts.mean() > 0 else math.nan,
-        "pearson_statistic": hom.loc["pearson", "statistic"],
-        "df": hom.loc["pearson", "df"],
-        "pvalue": hom.loc["pearson", "pvalue"],
-        "pvalue_mc": hom.loc["pearson", "pvalue_mc"],
-        "lr_pvalue": hom.loc["likelihood_ratio", "pvalue"],
-        "n_flagged_fdr": int(ens.reject["rate"].sum()),
+        **{name: hom[name] for name in _HOMOGENEITY},
     }
-    return rows, hom_row, per_ic
+    return rows.to_dict("records"), hom_row, per_ic
 
 
 def _jobs(ctx):

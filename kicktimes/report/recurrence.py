@@ -28,7 +28,7 @@ from kicktimes.report.common import (
     kicked_systems,
     wide,
 )
-from kicktimes.report.effects import Effect, paired_ratio, ratio_rule, ratio_verdict
+from kicktimes.report.effects import Effect, store_ratio
 from kicktimes.report.figures import plain_ticks, radius_axis, shared_legend
 from kicktimes.report.summary import diagnostic_summary, diagnostic_vs_radius
 
@@ -284,25 +284,15 @@ def effects(ctx):
             for system in kicked_systems(rows):
                 if system not in values.columns or REFERENCE not in values.columns:
                     continue
-                per_r, tot = paired_ratio(
-                    values[system],
-                    values[REFERENCE],
-                    rng=ctx.boot_rng(),
-                    n_boot=ctx.n_boot,
-                    resamples=ctx.resamples,
-                )
+                per_r, tot = store_ratio(ctx, values[system], values[REFERENCE])
                 med = values.groupby(level="radius").median()
                 out.append(
-                    Effect(
-                        question=f"{question} (ε = {e:g})",
-                        system=system,
-                        quantity="ratio of means (kicked / two-particle, averaged over radii)",
-                        estimate=tot["ratio"],
-                        ci_low=tot["ci_low"],
-                        ci_high=tot["ci_high"],
-                        verdict=ratio_verdict(tot["ci_low"], tot["ci_high"], ctx.tolerance),
-                        rule=ratio_rule(ctx.tolerance),
-                        method=f"paired bootstrap over {tot['n_ics']} ICs",
+                    Effect.of_ratio(
+                        f"{question} (ε = {e:g})",
+                        system,
+                        "ratio of means (kicked / two-particle, averaged over radii)",
+                        tot,
+                        tolerance=ctx.tolerance,
                         detail=(
                             f"per-radius ratio {fmt(per_r['ratio'].min())} to "
                             f"{fmt(per_r['ratio'].max())}; ratio of per-radius medians "

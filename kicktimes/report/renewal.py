@@ -15,15 +15,14 @@ from matplotlib.patches import Patch
 
 from kicktimes.report.common import Section, pct
 from kicktimes.report.effects import SHARE_RULE, Effect, clopper_pearson, share_verdict
-from kicktimes.report.figures import check_frame, check_radii, finite, radius_axis
+from kicktimes.report.figures import check_frame, finite, x_axis
 from kicktimes.report.poisson import binomial_ci, subsample
+from kicktimes.stats.analyze import MIN_INTERVALS
 
 __all__ = ["model_comparison", "sections", "effects"]
 
-_MIN_INTERVALS_PER_IC = 10
 
-
-def model_comparison(per_ic, pooled, *, models=None):
+def model_comparison(per_ic, pooled, *, models=None, x="radius", xlabel=None):
     r"""Renewal-model comparison per radius: per IC (AIC-best shares) and pooled (ΔAIC).
 
     Parameters
@@ -36,6 +35,9 @@ def model_comparison(per_ic, pooled, *, models=None):
         intervals pooled over ICs at that radius.
     models : sequence of str, optional
         Models and their order (default: those present).
+    x, xlabel : str, optional
+        The column of both tables drawn along x and its axis label (default: the disk
+        radius; e.g. the group of `kicktimes analyze`; labels are drawn at 0, 1, ...).
 
     One of the two tables may be empty (e.g. no IC has enough intervals for a fit of
     its own): its panel then says so.
@@ -47,12 +49,12 @@ def model_comparison(per_ic, pooled, *, models=None):
         number of ICs on top; (b) pooled ΔAIC per model on a symmetric-log axis, with
         the usual ΔAIC = 2 and 10 guides.
     """
-    per_ic = check_frame("per_ic", per_ic, ["radius", "best_model"], allow_empty=True)
-    pooled = check_frame("pooled", pooled, ["radius", "model", "delta_aic"], allow_empty=True)
+    axis = x_axis(x, xlabel)
+    per_ic = check_frame("per_ic", per_ic, [x, "best_model"], allow_empty=True)
+    pooled = check_frame("pooled", pooled, [x, "model", "delta_aic"], allow_empty=True)
     if per_ic.empty and pooled.empty:
         raise ValueError("per_ic and pooled must not both be empty")
-    check_radii("per_ic['radius']", per_ic["radius"])
-    check_radii("pooled['radius']", pooled["radius"])
+    per_ic, pooled, axis = axis.positions(per_ic=per_ic, pooled=pooled)
     delta = finite("pooled['delta_aic']", pooled["delta_aic"], allow_nan=True)
     if (delta < 0).any():
         raise ValueError("pooled['delta_aic'] must be non-negative (AIC - min AIC)")
@@ -61,18 +63,18 @@ def model_comparison(per_ic, pooled, *, models=None):
     colour = {m: f"C{k}" for k, m in enumerate(models)}
     fig = Figure(figsize=(11.0, 4.4), layout="constrained")
     ax1, ax2 = fig.subplots(1, 2)
-    counts = pd.crosstab(per_ic["radius"], per_ic["best_model"]).reindex(
+    counts = pd.crosstab(per_ic[x], per_ic["best_model"]).reindex(
         columns=models, fill_value=0
     )
     share = counts.div(counts.sum(axis=1), axis=0)
     r = share.index.to_numpy()
-    width = 0.8 * (np.min(np.diff(r)) if r.size > 1 else 0.01)
+    width = 0.8 * axis.step(r, single=0.01)
     bottom = np.zeros(r.size)
     for m in models:
         ax1.bar(r, share[m].to_numpy(), width=width, bottom=bottom, color=colour[m], label=m)
         bottom += share[m].to_numpy()
-    for x, n in zip(r, counts.sum(axis=1), strict=True):
-        ax1.text(x, 1.01, str(int(n)), ha="center", va="bottom", fontsize="x-small")
+    for at, n in zip(r, counts.sum(axis=1), strict=True):
+        ax1.text(at, 1.01, str(int(n)), ha="center", va="bottom", fontsize="x-small")
     for ax, empty in ((ax1, per_ic.empty), (ax2, pooled.empty)):
         if empty:
             ax.text(
@@ -84,14 +86,14 @@ def model_comparison(per_ic, pooled, *, models=None):
                 va="center",
             )
     ax1.set_ylim(0, 1.08)
-    radius_axis(ax1)
+    axis.draw(ax1)
     ax1.set_ylabel("share of ICs where the model is AIC-best")
     ax1.set_title("(a) per IC (number of ICs on top)")
     for m in models:
-        part = pooled[pooled["model"] == m].sort_values("radius")
+        part = pooled[pooled["model"] == m].sort_values(x)
         if len(part):
             ax2.plot(
-                part["radius"],
+                part[x],
                 part["delta_aic"],
                 marker="o",
                 markersize=4,
@@ -117,7 +119,7 @@ def model_comparison(per_ic, pooled, *, models=None):
     ax2.axhline(0.0, color="grey", linewidth=0.8, zorder=0)
     ax2.annotate("ΔAIC = 0: the best model", (0.01, 0.0), xycoords=("axes fraction", "data"),
                  fontsize="x-small", color="grey", va="bottom")
-    radius_axis(ax2)
+    axis.draw(ax2)
     ax2.set_ylabel("ΔAIC = AIC − min AIC (pooled intervals)")
     ax2.set_title("(b) intervals pooled over ICs")
     # one legend for both panels, outside the axes: it never covers data
@@ -148,24 +150,25 @@ def sections(ctx):
     for r, part in coll.groupby("radius"):
         part = part.sort_values("ic")
         # pooled: whole ICs in index order until the interval budget is used
-        sizes = np.maximum(part["n_pp"].to_numpy() - 1, 0)
-        used = part[np.cumsum(sizes) - sizes < max_pooled_intervals]
-        iv = stats.intervals_from_times(
-            [np.asarray(t, float) for t in used["pp_times"]], used["t_window"].to_numpy(float)
+        n_used, iv = stats.pooled_intervals(
+            [np.asarray(t, float) for t in part["pp_times"]],
+            part["t_window"].to_numpy(float),
+            part["n_pp"].to_numpy(),
+            max_intervals=max_pooled_intervals,
         )
-        if iv.complete.size >= _MIN_INTERVALS_PER_IC:
+        if iv.complete.size >= MIN_INTERVALS:
             jobs.append((iv.complete, iv.censored))
-            meta.append(("pooled", {"radius": r, "n_ics_used": len(used)}))
-        if len(used) < len(part):
+            meta.append(("pooled", {"radius": r, "n_ics_used": n_used}))
+        if n_used < len(part):
             notes.append(
-                f"Pooled renewal fits at r = {r:g}: the first {len(used)} of {len(part)} "
+                f"Pooled renewal fits at r = {r:g}: the first {n_used} of {len(part)} "
                 f"ICs (≈{max_pooled_intervals} intervals)."
             )
         for row in subsample(part, max_ics_model_fits).itertuples():
             iv = stats.intervals_from_times(np.asarray(row.pp_times, float), row.t_window)
             base = {"radius": r, "ic": int(row.ic), "n_intervals": int(iv.complete.size)}
-            if iv.complete.size < _MIN_INTERVALS_PER_IC:
-                note = f"fewer than {_MIN_INTERVALS_PER_IC} intervals"
+            if iv.complete.size < MIN_INTERVALS:
+                note = f"fewer than {MIN_INTERVALS} intervals"
                 best_rows.append({**base, "best_model": None, "note": note})
             else:
                 jobs.append((iv.complete, iv.censored))
@@ -227,7 +230,7 @@ def sections(ctx):
         share_long["n_best"], share_long["n_ics_fitted"]
     )
     if fitted.empty and pooled.empty:
-        sec.text(f"No sample has {_MIN_INTERVALS_PER_IC} or more intervals: no renewal fit.")
+        sec.text(f"No sample has {MIN_INTERVALS} or more intervals: no renewal fit.")
     else:
         sec.figure(
             "fig09_renewal_model_comparison",
@@ -237,7 +240,7 @@ def sections(ctx):
         )
     if fitted.empty:
         sec.text(
-            f"No IC among those fitted per radius has {_MIN_INTERVALS_PER_IC} or more "
+            f"No IC among those fitted per radius has {MIN_INTERVALS} or more "
             "intervals: no per-IC comparison."
         )
     else:
@@ -248,7 +251,7 @@ def sections(ctx):
             f"Per IC, the exponential (Poisson) model is AIC-best for {pct(exp_share.mean())} "
             f"of the fitted ICs on average over radii (from {pct(exp_share.min())} to "
             f"{pct(exp_share.max())}); {len(best) - len(fitted)} ICs had fewer than "
-            f"{_MIN_INTERVALS_PER_IC} intervals and were not fitted."
+            f"{MIN_INTERVALS} intervals and were not fitted."
         )
     if not pooled.empty:
         best_pooled = pooled.loc[pooled.groupby("radius")["aic"].idxmin()]

@@ -118,7 +118,7 @@ def write_results(
             lines += ["### All statements (primary setting)", ""]
             for e in ctx.found.effects:
                 lines.append(
-                    "- " + _md_escape(e.statement() + (f" ({e.detail}.)" if e.detail else ""))
+                    "- " + _md_escape(e.sentence())
                 )
             lines += ["", _md_escape(rules_text(ctx)), ""]
             if notes:

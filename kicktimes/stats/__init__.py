@@ -6,21 +6,23 @@ It takes event times and observation windows only (no billiard knowledge):
   (:func:`fit_renewal`, :func:`compare_models`, :func:`vuong`,
   :func:`goodness_of_fit`; models in ``MODELS``);
 * Poisson / IID tests of one sequence and of an ensemble
-  (:func:`intervals_from_times`, :func:`test_poisson`, :func:`test_poisson_ensemble`);
+  (:func:`intervals_from_times`, :func:`test_poisson`, :func:`test_poisson_ensemble`), and
+  the tables of one group of sequences (:func:`poisson_group`, :func:`pooled_intervals`,
+  shared by :func:`analyze` and the sweep report);
 * collision counts versus radius and the kinetic-theory rate
   (:func:`regress_counts`, :func:`kinetic_rate`).
 
 See ``docs/statistics.md`` for the conventions.
 """
 
-from kicktimes.stats._findings import ratio_rule, ratio_verdict
-
 from .analyze import Analysis, analyze
 from .comparison import VuongResult, compare_models, vuong
 from .counts import CountRegression, kinetic_rate, regress_counts
 from .distributions import hyperexpon
 from .ensemble import PoissonEnsembleResult, test_poisson_ensemble
+from .findings import Finding, ratio_rule, ratio_verdict
 from .gof import GofResult, goodness_of_fit
+from .groups import PoissonGroup, poisson_group, pooled_intervals
 from .poisson import TESTS, Intervals, intervals_from_times, test_poisson
 from .renewal import (
     FULL_SAMPLE_MODELS,
@@ -45,6 +47,8 @@ __all__ = [
     "intervals_from_times",
     "test_poisson",
     "test_poisson_ensemble",
+    "poisson_group",
+    "pooled_intervals",
     "regress_counts",
     "kinetic_rate",
     "hyperexpon",
@@ -53,8 +57,10 @@ __all__ = [
     "GofResult",
     "Intervals",
     "PoissonEnsembleResult",
+    "PoissonGroup",
     "CountRegression",
     "FitWarning",
+    "Finding",
     "ratio_verdict",
     "ratio_rule",
 ]

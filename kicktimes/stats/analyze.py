@@ -15,7 +15,9 @@ own runs:
   OLS line of the rate; :func:`regress_counts`) on every numeric covariate.
 
 A *group* plays the part the disk radius plays in a sweep: sequences observed under the
-same conditions, pooled together. Without ``group`` all sequences form one group.
+same conditions, pooled together. Without ``group`` all sequences form one group. The
+per-group tables come from :func:`~kicktimes.stats.poisson_group` and
+:func:`~kicktimes.stats.pooled_intervals`, which the sweep report runs per radius.
 Sequences without events count in the rates, the heterogeneity tests and the
 regressions (a zero count is an observation); the tests and fits that need events skip
 them, and ``Analysis.skipped`` says which and why.
@@ -35,7 +37,7 @@ from ._checks import check_int, check_real, check_rng
 from ._table import EventTable, event_table
 from .comparison import compare_models
 from .counts import regress_counts
-from .ensemble import test_poisson_ensemble
+from .groups import poisson_group, pooled_intervals
 from .poisson import TESTS, intervals_from_times
 
 __all__ = ["Analysis", "analyze"]
@@ -125,9 +127,9 @@ class Analysis:
         return out
 
     def findings(self) -> list:
-        """One computed statement per question (`kicktimes.stats._findings.Finding`: the
+        """One computed statement per question (:class:`kicktimes.stats.Finding`: the
         question, the verdict, the statement with its numbers, and the rule)."""
-        from ._findings import findings
+        from .findings import findings
 
         return findings(self)
 
@@ -304,48 +306,16 @@ def analyze(
 
 
 def _poisson(part, g, *, alpha, n_mc, rng):
-    times = list(part["times"])
-    win = part["t_window"].to_numpy(float)
-    counts = part["n_events"].to_numpy(float)
-    ens = test_poisson_ensemble(times, win, alpha=alpha, n_mc=n_mc, rng=rng)
-    rows = []
-    for test in TESTS:
-        p = ens.per_sequence[f"p_{test}"].to_numpy()
-        ok = np.isfinite(p)
-        comb = ens.combined.loc[test]
-        n_tested = int(ok.sum())
-        rows.append(
-            {
-                "group": g,
-                "test": test,
-                "n_tested": n_tested,
-                "n_reject": int((p[ok] < alpha).sum()),
-                "n_reject_fdr": int(comb["n_reject_fdr"]),
-                "rate": (p[ok] < alpha).mean() if n_tested else math.nan,
-                "combined_pvalue": float(comb["pvalue"]),
-            }
-        )
-    hom = ens.rate_homogeneity
-    mean = counts.mean()
-    hom_row = {
-        "group": g,
-        "n_sequences": len(part),
-        "n_empty": int((counts == 0).sum()),
-        "pooled_rate": counts.sum() / win.sum(),
-        "median_rate": float(np.median(counts / win)),
-        "dispersion_index": counts.var(ddof=1) / mean if mean > 0 and counts.size > 1 else math.nan,
-        "pearson_statistic": hom.loc["pearson", "statistic"],
-        "df": hom.loc["pearson", "df"],
-        "pvalue": hom.loc["pearson", "pvalue"],
-        "pvalue_mc": hom.loc["pearson", "pvalue_mc"],
-        "lr_pvalue": hom.loc["likelihood_ratio", "pvalue"],
-        "n_flagged_fdr": int(ens.reject["rate"].sum()),
-    }
+    res = poisson_group(
+        list(part["times"]), part["t_window"].to_numpy(float), alpha=alpha, n_mc=n_mc, rng=rng
+    )
+    rows = [{"group": g, **row} for row in res.rejections.to_dict("records")]
+    ens = res.ensemble
     pcols = [f"p_{t}" for t in TESTS] + ["p_rate"]
     pvals = ens.per_sequence[pcols].reset_index(drop=True)
     pvals.insert(0, "sequence", part["sequence"].to_numpy())
     pvals["reject_any_fdr"] = ens.reject[list(TESTS)].any(axis=1).to_numpy()
-    return rows, hom_row, pvals
+    return rows, {"group": g, **res.homogeneity}, pvals
 
 
 # ----------------------------------------------------------------- renewal models
@@ -374,13 +344,16 @@ def _compare(complete, censored):
 def _renewal(part, g, *, max_fits, max_pooled):
     per, pooled, skipped = [], [], []
     cols = _RENEWAL_COLS[3:]
-    sizes = np.maximum(part["n_events"].to_numpy() - 1, 0)
-    used = part[np.cumsum(sizes) - sizes < max_pooled]
-    iv = intervals_from_times(list(used["times"]), used["t_window"].to_numpy(float))
+    n_used, iv = pooled_intervals(
+        list(part["times"]),
+        part["t_window"].to_numpy(float),
+        part["n_events"].to_numpy(),
+        max_intervals=max_pooled,
+    )
     if iv.complete.size >= MIN_INTERVALS:
         for model, t in _compare(iv.complete, iv.censored).iterrows():
             pooled.append({"group": g, "model": model, **{c: t[c] for c in cols}})
-    for s in part.loc[~part.index.isin(used.index), "sequence"]:
+    for s in part["sequence"].iloc[n_used:]:
         skipped.append((s, "pooled renewal fit", f"over the budget of {max_pooled} intervals"))
     n_fitted = 0
     for row in part.itertuples():
@@ -515,20 +488,11 @@ def _back_transform(res, cov, model, g, shift, scale):
             "covariate": cov,
             "g": g,
             "model": model,
-            "term": "intercept",
-            "estimate": b0,
-            "stderr": se0,
-            "ci_low": b0 - q * se0,
-            "ci_high": b0 + q * se0,
-        },
-        {
-            "covariate": cov,
-            "g": g,
-            "model": model,
-            "term": "slope",
-            "estimate": b1,
-            "stderr": se1,
-            "ci_low": b1 - q * se1,
-            "ci_high": b1 + q * se1,
-        },
+            "term": term,
+            "estimate": est,
+            "stderr": err,
+            "ci_low": est - q * err,
+            "ci_high": est + q * err,
+        }
+        for term, est, err in (("intercept", b0, se0), ("slope", b1, se1))
     ]

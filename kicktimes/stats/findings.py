@@ -1,4 +1,11 @@
-r"""Findings of an :class:`~kicktimes.stats.analyze.Analysis`: one computed statement per question.
+r"""Findings: one computed statement per question, with the rule that reached its verdict.
+
+The record (:class:`Finding`), the verdict rules (:func:`ratio_verdict`, :func:`ratio_rule`,
+:func:`share_verdict`, :data:`SHARE_RULE`) and the exact binomial interval
+(:func:`clopper_pearson`) are shared by every page kicktimes writes: the findings of an
+:class:`~kicktimes.stats.analyze.Analysis` (:func:`findings`, ``kicktimes analyze``) and
+the sweep report's (:mod:`kicktimes.report.findings`, whose effects are Findings with an
+effect size and the compared system, under the report's controls).
 
 Every statement is built from the result's tables (never typed), carries its effect size
 with a 95 % interval where one exists, and a verdict reached by a rule that is printed
@@ -11,9 +18,28 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+import pandas as pd
 from scipy import stats as sps
 
-__all__ = ["Finding", "findings", "ratio_verdict", "ratio_rule"]
+__all__ = [
+    "Finding",
+    "findings",
+    "findings_table",
+    "ratio_verdict",
+    "ratio_rule",
+    "share_verdict",
+    "SHARE_RULE",
+    "clopper_pearson",
+    "effect_statement",
+    "format_p",
+]
+
+#: how a share's verdict is decided against a reference level ``{level}``
+SHARE_RULE = (
+    "above: the 95 % CI of the share lies above {level:g}; below: it lies below {level:g}; "
+    "inconclusive: it contains {level:g}"
+)
+
 
 def ratio_rule(tolerance=0.1) -> str:
     """The printed rule of :func:`ratio_verdict` for a band of half-width ``tolerance``.
@@ -53,14 +79,105 @@ def ratio_verdict(low, high, tolerance=0.1):
     return "inconclusive"
 
 
+def share_verdict(low, high, level):
+    """``"above"``, ``"below"`` or ``"inconclusive"`` for a share's CI against ``level``
+    (:data:`SHARE_RULE`; inconclusive when an endpoint is not finite).
+
+    Examples
+    --------
+    >>> share_verdict(0.1, 0.3, 0.05), share_verdict(0.0, 0.02, 0.05), share_verdict(0.0, 0.1, 0.05)
+    ('above', 'below', 'inconclusive')
+    """
+    if not (np.isfinite(low) and np.isfinite(high)):
+        return "inconclusive"
+    if low > level:
+        return "above"
+    if high < level:
+        return "below"
+    return "inconclusive"
+
+
+def clopper_pearson(k, n, level=0.95):
+    r"""Exact (Clopper-Pearson) interval of a binomial share: ``k`` successes in ``n``.
+
+    Notes
+    -----
+    With :math:`a = 1 - \text{level}`: the bounds are the :math:`a/2` quantile of
+    :math:`\text{Beta}(k, n - k + 1)` (0 when k = 0) and the :math:`1 - a/2` quantile of
+    :math:`\text{Beta}(k + 1, n - k)` (1 when k = n); NaN when n = 0. Clopper & Pearson,
+    Biometrika 26, 404 (1934).
+
+    Examples
+    --------
+    >>> [round(v, 4) for v in clopper_pearson(3, 10)]
+    [0.0667, 0.6525]
+    >>> clopper_pearson(0, 10)[0], clopper_pearson(10, 10)[1]
+    (0.0, 1.0)
+    """
+    if n <= 0:
+        return math.nan, math.nan
+    a = 1 - level
+    low = 0.0 if k == 0 else float(sps.beta.ppf(a / 2, k, n - k + 1))
+    high = 1.0 if k == n else float(sps.beta.ppf(1 - a / 2, k + 1, n - k))
+    return low, high
+
+
 @dataclass(frozen=True)
 class Finding:
-    """One answered question: ``question``, ``verdict``, ``statement`` and the ``rule``."""
+    """One answered question: ``question``, ``verdict``, ``statement`` and the ``rule``.
+
+    A finding that is one effect size (a share, a ratio) also carries it: ``quantity``
+    (what ``estimate`` is), ``estimate`` with its 95 % interval ``ci_low``, ``ci_high``,
+    the ``method`` of the interval and the supporting numbers in ``detail``; the others
+    leave them empty (NaN, ``""``) and give their numbers in the statement.
+    """
 
     question: str
     verdict: str
     statement: str
     rule: str
+    quantity: str = ""
+    estimate: float = math.nan
+    ci_low: float = math.nan
+    ci_high: float = math.nan
+    method: str = ""
+    detail: str = ""
+
+    def sentence(self) -> str:
+        """The statement, with the supporting numbers (``detail``) in parentheses."""
+        return self.statement + (f" ({self.detail}.)" if self.detail else "")
+
+
+def _g(x):
+    return "n/a" if not np.isfinite(x) else f"{x:.3g}"
+
+
+def effect_statement(subject, quantity, estimate, ci_low, ci_high, method, verdict) -> str:
+    """The sentence of an effect size: ``"<subject>: <quantity> <estimate> (95 % CI <low>
+    to <high>, <method>): <verdict>."`` (no interval when it is not finite).
+
+    >>> effect_statement("FTLE", "ratio", 0.331, 0.3, 0.36, "bootstrap", "differs")
+    'FTLE: ratio 0.331 (95 % CI 0.3 to 0.36, bootstrap): differs.'
+    """
+    ci = f" (95 % CI {_g(ci_low)} to {_g(ci_high)}, {method})" if np.isfinite(ci_low) else ""
+    return f"{subject}: {quantity} {_g(estimate)}{ci}: {verdict}."
+
+
+def findings_table(items, *, columns=("question", "verdict", "statement", "rule")) -> pd.DataFrame:
+    """The findings as a table, one row per finding, with the given attributes as columns.
+
+    >>> table = findings_table([Finding("Data", "—", "3 sequences.", "all counted")])
+    >>> table.columns.tolist(), table.loc[0, "statement"]
+    (['question', 'verdict', 'statement', 'rule'], '3 sequences.')
+    """
+    return pd.DataFrame([{c: getattr(f, c) for c in columns} for f in items], columns=list(columns))
+
+
+def format_p(p):
+    """A p-value for the text: 3 significant digits, ``"< 1e-300"`` for 0, ``"n/a"``."""
+    if not np.isfinite(p):
+        return "n/a"
+    return "< 1e-300" if p == 0 else f"{p:.3g}"
 
 
 def _v(value):
@@ -68,20 +185,6 @@ def _v(value):
     if isinstance(value, int | float | np.integer | np.floating):
         return f"{float(value):.4g}"
     return str(value)
-
-
-def _p(p):
-    if not np.isfinite(p):
-        return "n/a"
-    return "< 1e-300" if p == 0 else f"{p:.3g}"
-
-
-def _clopper_pearson(k, n):
-    if n == 0:
-        return math.nan, math.nan
-    lo = sps.beta.ppf(0.025, k, n - k + 1) if k > 0 else 0.0
-    hi = sps.beta.ppf(0.975, k + 1, n - k) if k < n else 1.0
-    return float(lo), float(hi)
 
 
 def _input(res):
@@ -108,24 +211,24 @@ def _poisson(res):
     bad = tested[tested["combined_pvalue"] < cut].sort_values("combined_pvalue")
     s = res.sequences
     has_events = s["n_events"] > 0
-    k = int(s.loc[has_events, "reject_any_fdr"].sum())
-    n = int(has_events.sum())
-    lo, hi = _clopper_pearson(k, n)
-    share = f"{k}/{n} sequences ({100 * k / n:.0f} %, 95 % CI {100 * lo:.0f}-{100 * hi:.0f} %)"
     if n_cells == 0:
         return Finding("Poisson?", "inconclusive", "No sequence has enough events for a test.", "—")
+    k = int(s.loc[has_events, "reject_any_fdr"].sum())
+    n = int(has_events.sum())
+    lo, hi = clopper_pearson(k, n)
+    share = f"{k}/{n} sequences ({100 * k / n:.0f} %, 95 % CI {100 * lo:.0f}-{100 * hi:.0f} %)"
     if bad.empty:
         verdict = "consistent with Poisson"
         text = (
             f"No test rejects over the ensemble: the smallest Fisher-combined p-value is "
-            f"{_p(tested['combined_pvalue'].min())} ({n_cells} test x group cells); "
+            f"{format_p(tested['combined_pvalue'].min())} ({n_cells} test x group cells); "
             f"{share} are rejected by some test after FDR."
         )
     else:
         verdict = "not Poisson"
         items = [
             f"{r.test} ({'' if res.group is None else f'{res.group} = {_v(r.group)}: '}"
-            f"p = {_p(r.combined_pvalue)}, {r.n_reject_fdr}/{r.n_tested} sequences after FDR)"
+            f"p = {format_p(r.combined_pvalue)}, {r.n_reject_fdr}/{r.n_tested} sequences after FDR)"
             for r in bad.head(4).itertuples()
         ]
         text = (
@@ -166,12 +269,13 @@ def _renewal(res):
             f"exponential ΔAIC = {d_e:.4g}, {int(best['n'])} intervals)"
         )
         verdicts.append(best["model"])
-    top = max(set(verdicts), key=verdicts.count)
+    # the most frequent best model; a tie goes to the one of the first group
+    top = max(dict.fromkeys(verdicts), key=verdicts.count)
     per = res.sequences["best_model"].dropna()
     text = "Pooled per group: " + "; ".join(parts) + "."
     if len(per):
         k = int((per == "exponential").sum())
-        lo, hi = _clopper_pearson(k, len(per))
+        lo, hi = clopper_pearson(k, len(per))
         counts = per.value_counts()
         text += (
             f" Per sequence ({len(per)} fitted): "
@@ -268,7 +372,7 @@ def _regressions(res):
             f"{what} (95 % CI; {label}; Poisson GLM: {po['estimate']:.4g} "
             f"[{po['ci_low']:.4g}, {po['ci_high']:.4g}]); Poisson Pearson dispersion "
             f"{od['pearson_dispersion']:.3g}, NB alpha = {od['alpha']:.3g} (LR p = "
-            f"{_p(od['lr_pvalue'])})."
+            f"{format_p(od['lr_pvalue'])})."
         )
         rule = (
             "increases / decreases when the 95 % CI of the slope (negative binomial, or "
