@@ -62,7 +62,7 @@ def drive(st, ev, rho, kicks, angles, kick_mode, kick_u, sp, unit_speed, t_end, 
     ns_next = next_s[0]
     status = ob.FULL
     while True:
-        is_kick, dte = one.next_event(s, kicks, ik)
+        is_kick, dte = one.next_event(s, one.next_kick(kicks, ik))
         t = s[one.S_T]
         if sim_on:
             k, ns_next = ob.sample_flight(stimes, samples, k, ns_next, t, dte, s[one.S_X],
@@ -80,12 +80,20 @@ def drive(st, ev, rho, kicks, angles, kick_mode, kick_u, sp, unit_speed, t_end, 
                 fin[4] = f[one.S_VY]
         if tan is not None:
             # the tangent vectors' step ends before the next event
+            # (the kicked disk's tangent vectors have one step in mode 1: no Gram-Schmidt,
+            # and a later step ends at min(t_prev + tau, next event))
             while tan_on and not t + dte <= tk:
-                tan_code, last, tk, t_prev, i_loop = tg.close_step(t, dte, tk, t_prev, i_loop,
-                                                                   n_loop, mode, n_steps, tau)
-                if (last and tan_code == 0) or n_orth > 0:
-                    tg.end_step(U, log_scale, t_prev - t, last, n_orth)
-                tan_on = not last
+                if dte != dte:
+                    tan_code = 3
+                    tan_on = False
+                    break
+                t_prev = tk
+                i_loop += 1
+                if i_loop == n_loop:
+                    tg.end_step(U, log_scale, t_prev - t, 0)
+                    tan_on = False
+                    break
+                tk = min(t_prev + tau, t + dte)
         if not (sim_on or tan_on):
             status = ob.DONE
             break
@@ -104,23 +112,23 @@ def drive(st, ev, rho, kicks, angles, kick_mode, kick_u, sp, unit_speed, t_end, 
                 row = klog[ik]
                 one.scatter_step(st, ev, dte, rho, kicks[ik], kick_u[ik, 0], kick_u[ik, 1], sp,
                                  row)
+                # (a partner missed by round-off leaves the disk and the vectors unchanged)
+                if tan is not None and tan_on and (row[4] != 0.0 or row[5] != 0.0):
+                    for j in range(m):
+                        U[j, 0], U[j, 1], U[j, 2], U[j, 3] = scatter_tangent(
+                            ux, uy, row[6], row[7], row[4], row[5], sp[0], int(sp[1]), U[j, 0],
+                            U[j, 1], U[j, 2], U[j, 3])
+                        n_resc += tg.renormalise(U, log_scale, j)
             else:
                 one.kick_step(st, ev, dte, rho, kicks[ik], angles[ik], kick_mode)
+                if tan is not None and tan_on:
+                    for j in range(m):
+                        U[j, 2], U[j, 3] = tg.kick_tangent(U[j, 2], U[j, 3], ux, uy, st[3], st[4],
+                                                           angles[ik], kick_mode)
+                        n_resc += tg.renormalise(U, log_scale, j)
             s = one.load(st, ev)
             if tan is not None and tan_on:
                 n_pert += 1
-                if scatter:
-                    if row[4] != 0.0 or row[5] != 0.0:
-                        for j in range(m):
-                            U[j, 0], U[j, 1], U[j, 2], U[j, 3] = scatter_tangent(
-                                ux, uy, row[6], row[7], row[4], row[5], sp[0], int(sp[1]),
-                                U[j, 0], U[j, 1], U[j, 2], U[j, 3])
-                            n_resc += tg.renormalise(U, log_scale, j)
-                else:
-                    for j in range(m):
-                        U[j, 2], U[j, 3] = tg.kick_tangent(U[j, 2], U[j, 3], ux, uy, s[one.S_VX],
-                                                        s[one.S_VY], angles[ik], kick_mode)
-                        n_resc += tg.renormalise(U, log_scale, j)
             ik += 1
         else:
             s, sin_theta = one.wall_step(s, dte, rho, unit_speed)
@@ -168,7 +176,8 @@ def _run(st, rho, kicks, angles, kick_mode, t_max, mode, n_steps, tau, b_cap, ki
     next_s = np.zeros(1)
     fin = np.empty(5)
     if tan is not None:
-        tg.start(tan, mode, n_steps, tau, st[0] + one.next_event(one.load(st, ev), kicks, 0)[1])
+        tg.start(tan, mode, n_steps, tau,
+                 st[0] + one.next_event(one.load(st, ev), one.next_kick(kicks, 0))[1])
     t_end = t_max if mode < 2 else np.inf
     status = ob.DONE
     while True:

@@ -111,11 +111,19 @@ def drive(st, ev, phys, t_end, mode, tau, track, logs, stimes, samples, cnt, nex
         if tan is not None:
             # the tangent vectors' step ends before the next event
             while tan_on and not t + dte <= tk:
-                tan_code, last, tk, t_prev, i_loop = tg.close_step(t, dte, tk, t_prev, i_loop,
-                                                                   n_loop, mode, n_steps, tau)
-                if (last and tan_code == 0) or n_orth > 0:
-                    tg.end_step(U, log_scale, t_prev - t, last, n_orth)
-                tan_on = not last
+                if dte != dte:
+                    tan_code = 3
+                    tan_on = False
+                    break
+                t_prev = tk
+                i_loop += 1
+                if i_loop == n_loop:
+                    tg.end_step(U, log_scale, t_prev - t, n_orth)
+                    tan_on = False
+                    break
+                if n_orth > 0:
+                    tg.gram_schmidt(U, log_scale)
+                tk = tg.step_end(i_loop, n_loop, mode, n_steps, tau, t_prev, t + dte)
         if cont is not None and cont_on:
             # the run to t_continue stops at the first event after it
             if t + dte > cont[0]:

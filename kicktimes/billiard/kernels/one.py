@@ -33,7 +33,7 @@ from kicktimes.billiard.geometry import (
 from kicktimes.billiard.scatter import scatter_kick, twin_meets_partner
 
 __all__ = ["KICK_ANGLES", "SCATTER", "advance", "apply_kick", "fly", "kick_step", "load",
-           "next_event", "process_wall", "process_wall_at", "scatter_step", "store",
+           "next_event", "next_kick", "process_wall", "process_wall_at", "scatter_step", "store",
            "twin_scatter_step", "unit_speed_of", "wall_event", "wall_step"]
 
 #: kick laws and their codes in the kernels
@@ -68,15 +68,20 @@ def apply_kick(st, angle, kick_mode):
 
 
 @njit(cache=True, inline="always")
-def next_event(s, kicks, ik):
-    """``(is_kick, dt)``: whether the next event is kick ``ik`` and its time from now; a
-    tie goes to the boundary."""
-    dt = s[S_TB]
-    if ik < kicks.shape[0]:
-        dk = kicks[ik] - s[S_T]
-        if dk < dt:
-            return True, dk
-    return False, dt
+def next_kick(kicks, ik):
+    """The time of kick ``ik`` (``inf`` when all are applied)."""
+    return kicks[ik] if ik < kicks.shape[0] else math.inf
+
+
+@njit(cache=True, inline="always")
+def next_event(s, t_kick):
+    """``(is_kick, dt)``: whether the next event is the kick at ``t_kick`` (`next_kick`) and
+    its time from now; a tie goes to the boundary. Scalars only: a helper taking the kick
+    array, called per event, would cost reference counting on every event."""
+    dk = t_kick - s[S_T]
+    if dk < s[S_TB]:
+        return True, dk
+    return False, s[S_TB]
 
 
 @njit(cache=True)

@@ -31,7 +31,7 @@ import math
 import numpy as np
 from numba import njit
 
-__all__ = ["BIG", "MAX_SAME_INSTANT", "close_step", "end_step", "event_guard", "gram_schmidt",
+__all__ = ["BIG", "MAX_SAME_INSTANT", "end_step", "event_guard", "gram_schmidt",
            "guard", "kick_tangent", "load_carry", "pair_tangent", "renormalise", "start",
            "step_end", "store_carry", "tangent_flight", "tangent_state", "wall_tangent"]
 
@@ -271,31 +271,16 @@ def step_end(i_loop, n_loop, mode, n_steps, tau, t_prev, t_next_event):
     return min(t_prev + tau, t_next_event)
 
 
-@njit(cache=True, inline="always")
-def close_step(t, dt, tk, t_prev, i_loop, n_loop, mode, n_steps, tau):
-    """The tangent vectors' step ending at ``tk`` is over: the next event comes ``dt``
-    after the last one, at ``t``, beyond ``tk``.
-
-    Returns ``(status, last, tk, t_prev, i_loop)`` with the next step's end; ``last`` when
-    that was the last step (or the next event time is NaN, status 3). Scalars only: called
-    in the event loop, where a helper taking arrays would cost reference counting on every
-    event; the array work of a step end is `end_step`'s.
-    """
-    if dt != dt:
-        return 3, True, tk, t_prev, i_loop
-    t_prev = tk
-    i_loop += 1
-    if i_loop == n_loop:
-        return 0, True, tk, t_prev, i_loop
-    return 0, False, step_end(i_loop, n_loop, mode, n_steps, tau, t_prev, t + dt), t_prev, i_loop
-
-
 @njit(cache=True)
-def end_step(U, log_scale, dt, last, n_orth):
-    """The array work at the end of a tangent step: after the last, the vectors fly ``dt``
-    on to it; with ``n_orth > 0`` the rows are re-orthonormalised (`gram_schmidt`)."""
-    if last:
-        tangent_flight(U, dt)
+def end_step(U, log_scale, dt, n_orth):
+    """The end of the tangent vectors' last step, ``dt`` after the last event: they fly on
+    to it, and with ``n_orth > 0`` are orthonormalised a last time (`gram_schmidt`).
+
+    The step ends themselves are crossed in the drivers' event loops, written out there:
+    a helper for them, inlined or called at every sample, measured 5-20 % slower
+    (benchmarks/bench_kernels.py).
+    """
+    tangent_flight(U, dt)
     if n_orth > 0:
         gram_schmidt(U, log_scale)
 
