@@ -14,6 +14,7 @@ to the load of a shared machine drifting between runs. Each figure is CPU second
 (``time.process_time``), the minimum over ``--repeat`` rounds.
 
 Run: python benchmarks/bench_kernels.py [--baseline HEAD~3] [--n-ics 20] [--repeat 30]
+     python benchmarks/bench_kernels.py --only "pass one scatter" "ftle two twin"
 """
 
 from __future__ import annotations
@@ -87,9 +88,11 @@ def baseline_package(rev: str) -> str:
     return "kt_baseline"
 
 
-def compare(rev: str, n_ics: int, repeat: int) -> None:
+def compare(rev: str, n_ics: int, repeat: int, only=None) -> None:
     new = workloads("kicktimes", n_ics)
     old = workloads(baseline_package(rev), n_ics)
+    if only:
+        new = {name: fn for name, fn in new.items() if name in only}
     print(f"{n_ics} ICs, r = 0.01, tau = 0.3, 15 000 steps; CPU ms, min of {repeat} rounds, "
           f"baseline {rev} and working tree interleaved in one process")
     print(f"{'driver':22s} {'baseline':>9s} {'now':>9s} {'now / base':>10s}")
@@ -110,8 +113,9 @@ def main() -> None:
     ap.add_argument("--baseline", default="HEAD", help="the commit to compare against")
     ap.add_argument("--n-ics", type=int, default=20)
     ap.add_argument("--repeat", type=int, default=30)
+    ap.add_argument("--only", nargs="+", metavar="DRIVER", help="time only these drivers")
     args = ap.parse_args()
-    compare(args.baseline, args.n_ics, args.repeat)
+    compare(args.baseline, args.n_ics, args.repeat, args.only)
 
 
 if __name__ == "__main__":

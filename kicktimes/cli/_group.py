@@ -16,6 +16,11 @@ from kicktimes import __version__
 _NUMPY_REPR = re.compile(r"\bnp\.(?:float|int|uint|bool_?)\d*\((.*?)\)")
 
 
+def option(*param_decls, **attrs):
+    """`click.option` that shows its default in ``--help`` (every kicktimes option does)."""
+    return click.option(*param_decls, show_default=True, **attrs)
+
+
 def _plain(message: str, options: dict | None = None) -> str:
     """``message`` with numpy scalar reprs unwrapped and a leading library argument name
     replaced by its command-line option (``t_max must ...`` -> ``--t-max must ...``)."""

@@ -7,29 +7,17 @@ from __future__ import annotations
 
 import click
 
+from kicktimes.cli._group import option
+
 
 @click.command("analyze")
 @click.argument("files", nargs=-1, required=True, type=click.Path(exists=True, dir_okay=False))
-@click.option(
-    "--out",
-    "out",
-    type=click.Path(file_okay=False),
-    required=True,
-    help="Output folder: report.html, findings.md, figures (PNG/PDF), tables (CSV).",
-)
-@click.option(
-    "--windows",
-    type=click.Path(exists=True, dir_okay=False),
-    default=None,
-    help="CSV/Parquet table with one row per sequence: id, start, end (and covariates).",
-)
-@click.option(
-    "--window",
-    type=(float, float),
-    default=None,
-    metavar="T_START T_END",
-    help="One observation window for every sequence.",
-)
+@click.option("--out", "out", type=click.Path(file_okay=False), required=True,
+              help="Output folder: report.html, findings.md, figures (PNG/PDF), tables (CSV).")
+@click.option("--windows", type=click.Path(exists=True, dir_okay=False), default=None,
+              help="CSV/Parquet table with one row per sequence: id, start, end (and covariates).")
+@click.option("--window", type=(float, float), default=None, metavar="T_START T_END",
+              help="One observation window for every sequence.")
 @click.option("--sequence-col", default="sequence", show_default=True, help="Sequence-id column.")
 @click.option("--time-col", default="time", show_default=True, help="Event-time column.")
 @click.option("--start-col", default="t_start", show_default=True, help="Window-start column.")
@@ -42,26 +30,13 @@ import click
     "further column of the windows table and constant columns of the event table).",
 )
 @click.option("--group", default=None, help="Covariate whose values group the sequences.")
-@click.option(
-    "--reference",
-    default=None,
-    help="Covariate holding each sequence's expected rate (e.g. a kinetic-theory rate).",
-)
+@click.option("--reference", default=None,
+              help="Covariate holding each sequence's expected rate (e.g. a kinetic-theory rate).")
 @click.option("--alpha", type=float, default=0.05, show_default=True, help="Test and FDR level.")
-@click.option(
-    "--n-mc",
-    type=click.IntRange(min=19),
-    default=199,
-    show_default=True,
-    help="Monte Carlo samples of the conditional nulls.",
-)
-@click.option(
-    "--max-fits-per-group",
-    type=click.IntRange(min=0),
-    default=12,
-    show_default=True,
-    help="Sequences per group with their own renewal-model comparison.",
-)
+@option("--n-mc", type=click.IntRange(min=19), default=199,
+        help="Monte Carlo samples of the conditional nulls.")
+@option("--max-fits-per-group", type=click.IntRange(min=0), default=12,
+        help="Sequences per group with their own renewal-model comparison.")
 @click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True, help="Seed.")
 @click.option("--dpi", type=click.IntRange(min=30), default=150, show_default=True)
 def analyze_command(

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import click
 
-from kicktimes.cli._group import _cli_errors, _compile_first
+from kicktimes.cli._group import _cli_errors, _compile_first, option
 
 
 # --- experiment commands ---
@@ -67,13 +67,8 @@ _RUN_OPTIONS = {"store": "--out", "workers": "--workers", "scheduler": "--schedu
 
 @click.command("run")
 @click.argument("experiment", type=click.Path(exists=True, dir_okay=False))
-@click.option(
-    "--out",
-    "out",
-    type=click.Path(file_okay=False),
-    required=True,
-    help="Store directory (created; rerunning resumes it).",
-)
+@click.option("--out", "out", type=click.Path(file_okay=False), required=True,
+              help="Store directory (created; rerunning resumes it).")
 @_workers_option
 @_scheduler_option
 @_progress_option
@@ -192,13 +187,8 @@ _force_option = click.option(
 
 @click.command("report")
 @click.argument("stores", nargs=-1, required=True, type=click.Path(exists=True, file_okay=False))
-@click.option(
-    "--out",
-    "out",
-    type=click.Path(file_okay=False),
-    required=True,
-    help="Report directory (HTML page, figures, tables).",
-)
+@click.option("--out", "out", type=click.Path(file_okay=False), required=True,
+              help="Report directory (HTML page, figures, tables).")
 @_workers_option
 @_progress_option
 @_pdf_option
@@ -220,13 +210,8 @@ def report_command(stores, out, workers, progress, pdf, force):
 
 
 @click.command("reproduce")
-@click.option(
-    "--scale",
-    type=click.Choice(["quick", "paper"]),
-    default="quick",
-    show_default=True,
-    help="quick: small versions of both families; paper: the paper's full scale.",
-)
+@option("--scale", type=click.Choice(["quick", "paper"]), default="quick",
+        help="quick: small versions of both families; paper: the paper's full scale.")
 @click.option(
     "--content",
     type=click.Choice(["full", "paper"]),
@@ -237,13 +222,8 @@ def report_command(stores, out, workers, progress, pdf, force):
     "(3 systems, RR at eps = 0.001, R_1), under half the sweep's work, into "
     "store-<name>-paper and report-paper/.",
 )
-@click.option(
-    "--out",
-    "out",
-    type=click.Path(file_okay=False),
-    required=True,
-    help="Directory for the stores (store-<name>) and the report (report/).",
-)
+@click.option("--out", "out", type=click.Path(file_okay=False), required=True,
+              help="Directory for the stores (store-<name>) and the report (report/).")
 @_workers_option
 @_scheduler_option
 @_progress_option

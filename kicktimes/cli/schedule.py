@@ -45,18 +45,11 @@ _SCHEDULE_OPTIONS = {"t_max": "--t-max", "seed": "--seed", "window": "--window",
     default=False,
     help="Renewal/bootstrap: first interval from the equilibrium law (stationary from t=0).",
 )
-@click.option(
-    "--input",
-    "input_path",
-    type=click.Path(exists=True, dir_okay=False),
-    help="bootstrap/replay: CSV/Parquet file of event times; json: a schedule JSON file.",
-)
-@click.option(
-    "--window",
-    type=_Real(0.0),
-    default=None,
-    help="replay: observation window of the input times (sampling beyond it is an error).",
-)
+@click.option("--input", "input_path", type=click.Path(exists=True, dir_okay=False),
+              help="bootstrap/replay: CSV/Parquet file of event times; json: a schedule JSON file.")
+@click.option("--window", type=_Real(0.0), default=None,
+              help="replay: observation window of the input times (sampling beyond it is an "
+              "error).")
 @click.option("--t-max", "t_max", type=_Real(0.0), required=True, help="Horizon: kicks in (0, T].")
 @click.option(
     "--seed",
@@ -64,13 +57,8 @@ _SCHEDULE_OPTIONS = {"t_max": "--t-max", "seed": "--seed", "window": "--window",
     default=None,
     help="Integer seed (default: fresh entropy, printed and stored so the run can be redone).",
 )
-@click.option(
-    "--output",
-    "-o",
-    type=click.Path(dir_okay=False),
-    required=True,
-    help="Output file, .csv or .parquet (one column kick_time, metadata inside).",
-)
+@click.option("--output", "-o", type=click.Path(dir_okay=False), required=True,
+              help="Output file, .csv or .parquet (one column kick_time, metadata inside).")
 @click.option("--print-json", is_flag=True, help="Also print the schedule's JSON.")
 def schedule_command(
     model, params, dist, stationary, input_path, window, t_max, seed, output, print_json

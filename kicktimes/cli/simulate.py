@@ -5,51 +5,23 @@ from __future__ import annotations
 import click
 
 from kicktimes import __version__
-from kicktimes.cli._group import _cli_errors, _compile_first, _Real
+from kicktimes.cli._group import _cli_errors, _compile_first, _Real, option
 
 
 # --- simulate command -------------------------------------------------------------------
 @click.command("simulate")
-@click.option(
-    "--radius",
-    "-r",
-    "radii",
-    type=_Real(0.0, 0.5),
-    multiple=True,
-    default=(0.01, 0.02),
-    show_default=True,
-    help="Disk radius (repeat for several), 0 < r < 0.5.",
-)
-@click.option(
-    "--n-ics",
-    type=click.IntRange(min=1),
-    default=100,
-    show_default=True,
-    help="Number of initial conditions (drawn once, at the largest radius).",
-)
-@click.option(
-    "--t-max", type=_Real(0.0), default=1000.0, show_default=True, help="Run time per IC."
-)
-@click.option(
-    "--seed", type=click.IntRange(min=0), default=0, show_default=True, help="Ensemble seed."
-)
-@click.option(
-    "--rule",
-    type=click.Choice(["mirror", "elastic"]),
-    default="mirror",
-    show_default=True,
-    help="Disk-disk collision rule.",
-)
-@click.option(
-    "--ic-method",
-    type=click.Choice(["paper", "uniform"]),
-    default="paper",
-    show_default=True,
-    help="'paper' procedure or the invariant measure.",
-)
-@click.option(
-    "--out", "out", type=click.Path(file_okay=False), required=True, help="Output folder (created)."
-)
+@option("--radius", "-r", "radii", type=_Real(0.0, 0.5), multiple=True, default=(0.01, 0.02),
+        help="Disk radius (repeat for several), 0 < r < 0.5.")
+@option("--n-ics", type=click.IntRange(min=1), default=100,
+        help="Number of initial conditions (drawn once, at the largest radius).")
+@option("--t-max", type=_Real(0.0), default=1000.0, help="Run time per IC.")
+@option("--seed", type=click.IntRange(min=0), default=0, help="Ensemble seed.")
+@option("--rule", type=click.Choice(["mirror", "elastic"]), default="mirror",
+        help="Disk-disk collision rule.")
+@option("--ic-method", type=click.Choice(["paper", "uniform"]), default="paper",
+        help="'paper' procedure or the invariant measure.")
+@click.option("--out", "out", type=click.Path(file_okay=False), required=True,
+              help="Output folder (created).")
 @click.option("--save-runs", is_flag=True, help="Also write every run (boundary log) to OUT/runs/.")
 def simulate_command(radii, n_ics, t_max, seed, rule, ic_method, out, save_runs):
     """Simulate two-disk billiards and log every disk-disk collision.

@@ -23,13 +23,7 @@ import math
 
 from numba import njit
 
-from kicktimes.billiard.geometry import (
-    GRAZE_THRESHOLD,
-    SIN_GRAZE,
-    boundary_hit_time,
-    graze,
-    reflect,
-)
+from kicktimes.billiard import geometry as geo
 from kicktimes.billiard.scatter import scatter_kick, twin_meets_partner
 
 __all__ = ["KICK_ANGLES", "SCATTER", "advance", "apply_kick", "fly", "kick_step", "load",
@@ -96,7 +90,7 @@ def wall_event(x, y, vx, vy, rho, unit_speed):
     # bias drifts L = x vy - y vx by 6e-12 over 10^6 collisions, 40x more than without.
     vv = vx * vx + vy * vy
     xv = x * vx + y * vy
-    gz = GRAZE_THRESHOLD * rho
+    gz = geo.GRAZE_THRESHOLD * rho
     if xv > 0.0 and xv * xv >= gz * gz * vv:
         # Put the contact back on |x| = rho with a Newton step *along the flight*: a radial
         # projection would rescale L = x vy - y vx and drift sin_theta by 1e-11 over 10^6
@@ -109,25 +103,25 @@ def wall_event(x, y, vx, vy, rho, unit_speed):
             sin_theta = (x * vy - y * vx) / rho
         else:
             sin_theta = (x * vy - y * vx) / (rho * math.sqrt(vv))
-        vx, vy = reflect(vx, vy, x / rho, y / rho)
+        vx, vy = geo.reflect(vx, vy, x / rho, y / rho)
         t_next = 2.0 * xv / vv
     elif xv * xv < gz * gz * vv:
-        # Grazing or tangent: slide on (see graze). The Newton step along the flight
+        # Grazing or tangent: slide on (see geometry.graze). The Newton step along the flight
         # above would divide by x.v ~ 0, so project radially.
         scale = 1.5 - 0.5 * (x * x + y * y) / (rho * rho)
         x *= scale
         y *= scale
         sp = math.sqrt(vv)
         sin_theta = (x * vy - y * vx) / (rho * sp)
-        vx, vy = graze(x, y, vx, vy, rho, sp)
-        t_next = 2.0 * rho * SIN_GRAZE / sp
+        vx, vy = geo.graze(x, y, vx, vy, rho, sp)
+        t_next = 2.0 * rho * geo.SIN_GRAZE / sp
     else:
         # a Lyapunov twin moving inward (see kernels.two.wall_event): no reflection
         scale = 1.5 - 0.5 * (x * x + y * y) / (rho * rho)
         x *= scale
         y *= scale
         sin_theta = (x * vy - y * vx) / (rho * math.sqrt(vv))
-        t_next = boundary_hit_time(x, y, vx, vy, rho)
+        t_next = geo.boundary_hit_time(x, y, vx, vy, rho)
     return x, y, vx, vy, t_next, sin_theta
 
 
@@ -146,7 +140,7 @@ def advance(s, dt):
 
 @njit(cache=True, inline="always")
 def wall_step(s, dt, rho, unit_speed):
-    """Fly ``dt`` to the wall and reflect: ``(s, sin_theta)``."""
+    """Fly ``dt`` to the wall and geo.reflect: ``(s, sin_theta)``."""
     t, comp, x, y, vx, vy, tb = advance(s, dt)
     x, y, vx, vy, tb, sin_theta = wall_event(x, y, vx, vy, rho, unit_speed)
     return (t, comp, x, y, vx, vy, tb), sin_theta
@@ -206,7 +200,7 @@ def kick_step(st, ev, dt, rho, kick_time, angle, kick_mode):
     """Fly ``dt`` to ``kick_time`` and apply a kick of ``angle`` (see `apply_kick`)."""
     _to_kick(st, ev, dt, kick_time)
     apply_kick(st, angle, kick_mode)
-    ev[0] = boundary_hit_time(st[1], st[2], st[3], st[4], rho)
+    ev[0] = geo.boundary_hit_time(st[1], st[2], st[3], st[4], rho)
 
 
 @njit(cache=True)
@@ -218,7 +212,7 @@ def scatter_step(st, ev, dt, rho, kick_time, a, b, sp, out):
     """
     _to_kick(st, ev, dt, kick_time)
     scatter_kick(st, a, b, sp[0], rho, int(sp[1]), sp[2], int(sp[3]), out)
-    ev[0] = boundary_hit_time(st[1], st[2], st[3], st[4], rho)
+    ev[0] = geo.boundary_hit_time(st[1], st[2], st[3], st[4], rho)
 
 
 @njit(cache=True)
@@ -237,7 +231,7 @@ def twin_scatter_step(st, ev, dt, rho, kick_time, partner, sp):
     st[3] = vx
     st[4] = vy
     st[6] = vx * vx + vy * vy
-    ev[0] = boundary_hit_time(x, y, vx, vy, rho)
+    ev[0] = geo.boundary_hit_time(x, y, vx, vy, rho)
     return hit
 
 
