@@ -19,6 +19,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from kicktimes.billiard import geometry as geo
 from kicktimes.billiard.kernels import observe as ob
 from kicktimes.billiard.kernels import one
 from kicktimes.billiard.kernels import tangent as tg
@@ -166,7 +167,7 @@ def _run(st, rho, kicks, angles, kick_mode, t_max, mode, n_steps, tau, b_cap, ki
     Returns ``(logs, stimes, samples, cnt, fin, tan, status)``.
     """
     ev = np.empty(1)
-    ev[0] = one.boundary_hit_time(st[1], st[2], st[3], st[4], rho)
+    ev[0] = geo.boundary_hit_time(st[1], st[2], st[3], st[4], rho)
     unit_speed = one.unit_speed_of(st, kick_mode, sp)
     klog = np.zeros((kicks.shape[0] if kick_mode == one.SCATTER else 0, 9))
     bt, bx, by, bs = ob.new_boundary_log(min(b_cap, max_events + 1) if sim else 0)
