@@ -122,17 +122,33 @@ def _check_kick_angles(kick_angles, times: np.ndarray, kick_angle: str) -> np.nd
     return angles
 
 
-def resolve_kicks(kicks, kick_angles, *, kick_angle, sigma, rng, horizon, t_max):
-    """Kick times and angles of a run, and the generator used (``None`` if none was).
+def resolve_kicks(kicks, kick_angles, *, kick_angle, sigma, rng, horizon, t_max, r=None):
+    """Kick times and angles of a run, the generator used (``None`` if none was) and the
+    kinetic-kick arguments of the kernels (``None`` but for a `KineticRate`).
 
     ``kicks`` is ``None``, an array of times (checked against ``t_max`` when it is not
-    ``None``) or a schedule sampled on ``(0, horizon]`` with ``rng``. ``kick_angles`` is
-    given (one per kick; shape ``(n, 2)`` for scattering kicks) or drawn from the same
-    generator, after the times.
+    ``None``), a schedule sampled on ``(0, horizon]`` with ``rng``, or a
+    `kicktimes.schedules.KineticRate`: then ``times`` is a buffer the event loop fills, and
+    the standard exponential numbers of the intervals are drawn from ``rng`` first, for a
+    run of ``horizon`` (`KineticRate.capacity`). ``kick_angles`` is given (one per kick;
+    shape ``(n, 2)`` for scattering kicks) or drawn from the same generator, after the
+    times (or numbers).
     """
+    from kicktimes.schedules import KineticRate
+
     gen = None
+    kinetic = None
     if kicks is None:
         times = np.empty(0)
+    elif isinstance(kicks, KineticRate):
+        if kick_angles is not None:
+            raise ValueError("kick_angles: kinetic kicks draw their angles with their times; "
+                             "to replay a kinetic run pass kicks=run.kick_times and "
+                             "kick_angles=run.kick_angles")
+        gen = check_rng(rng)
+        n = kicks.capacity(horizon)
+        kinetic = (gen.standard_exponential(n), *kicks.kernel_table(r))
+        times = np.full(n, np.inf)
     elif _is_schedule(kicks):
         gen = check_rng(rng)
         times = check_kick_times(kicks.sample(horizon, gen), horizon, name="kicks.sample()")
@@ -141,10 +157,31 @@ def resolve_kicks(kicks, kick_angles, *, kick_angle, sigma, rng, horizon, t_max)
     if kick_angles is None:
         if not times.size:
             empty = np.empty((0, 2)) if kick_angle == "scatter" else times.copy()
-            return times, empty, gen
+            return times, empty, gen, kinetic
         gen = gen if gen is not None else check_rng(rng)
-        return times, draw_kick_angles(times.size, kick_angle, sigma, gen), gen
-    return times, _check_kick_angles(kick_angles, times, kick_angle), gen
+        return times, draw_kick_angles(times.size, kick_angle, sigma, gen), gen, kinetic
+    return times, _check_kick_angles(kick_angles, times, kick_angle), gen, kinetic
+
+
+def check_kinetic(kinetic, state, kick_angle, rule) -> None:
+    """Kinetic kicks need unit speed for the whole run (the rate is tabulated for it)."""
+    if kinetic is None:
+        return
+    if abs(math.hypot(state[2], state[3]) - 1.0) > 1e-12:
+        raise ValueError("kicks: kinetic kicks are tabulated for unit speed; the disk's speed "
+                         f"is {math.hypot(state[2], state[3])!r}")
+    if kick_angle == "scatter" and rule != "mirror":
+        raise ValueError(f"rule={rule!r}: kinetic kicks need unit speeds, i.e. scattering "
+                         "kicks under rule='mirror'")
+
+
+def check_kinetic_capacity(kinetic, n_applied: int) -> None:
+    """The run used every kinetic number drawn (probability < 1e-15): an error, since the
+    loop could not draw a further kick."""
+    if kinetic is not None and n_applied >= kinetic[0].size:
+        raise RuntimeError(f"kicks: the run applied all {n_applied} kinetic kicks drawn for "
+                           "its horizon (KineticRate.capacity); this should not happen, "
+                           "please report it")
 
 
 def check_scatter_options(state, r, kick_angle, rule, e0, partner):
@@ -200,7 +237,10 @@ def simulate_one_particle(state, r, *, t_max=None, kicks=None, kick_angle="unifo
     kicks : array_like or schedule, optional
         Kick times (sorted, in ``[0, t_max]``), or a schedule object with a
         ``sample(t_max, rng)`` method (see `kicktimes.schedules`), sampled here with
-        ``rng``. ``None``: no kicks (the integrable billiard).
+        ``rng``, or a `kicktimes.schedules.KineticRate`: kinetic kicks, whose rate after
+        each kick is the kinetic collision rate of the disk's angular momentum (unit
+        speed; the run's ``kick_times`` are then the times it drew). ``None``: no kicks
+        (the integrable billiard).
     kick_angle : {"uniform", "gaussian", "scatter"}
         ``"uniform"``: a kick replaces the direction by an angle uniform on [0, 2 pi)
         (the paper's choice). ``"gaussian"``: a kick rotates it by ``N(0, sigma^2)``.
@@ -266,9 +306,10 @@ def simulate_one_particle(state, r, *, t_max=None, kicks=None, kick_angle="unifo
     state = check_one_particle_state(state, r)
     sp, rule, e0, partner = check_scatter_options(state, r, kick_angle, rule, e0, partner)
     horizon = t_max if mode < 2 else n_steps * tau  # paper steps are at most tau long
-    times, angles, _ = resolve_kicks(kicks, kick_angles, kick_angle=kick_angle, sigma=sigma,
-                                     rng=rng, horizon=horizon,
-                                     t_max=t_max if mode < 2 else None)
+    times, angles, _, kinetic = resolve_kicks(kicks, kick_angles, kick_angle=kick_angle,
+                                              sigma=sigma, rng=rng, horizon=horizon,
+                                              t_max=t_max if mode < 2 else None, r=r)
+    check_kinetic(kinetic, state, kick_angle, rule)
     st = np.zeros(7)
     st[1:5] = state
     st[6] = state[2] ** 2 + state[3] ** 2
@@ -279,10 +320,11 @@ def simulate_one_particle(state, r, *, t_max=None, kicks=None, kick_angle="unifo
         st, rho, times, np.zeros(times.size) if scatter else angles,
         KICK_ANGLES[kick_angle], 0.0 if mode == 2 else t_max, mode,
         n_steps if n_steps is not None else 0, tau if tau is not None else 0.0,
-        b_cap, angles if scatter else np.zeros((0, 2)), sp, max_events, stall_dt,
+        b_cap, angles if scatter else np.zeros((0, 2)), sp, max_events, stall_dt, kinetic,
     )
     raise_for_status(out[9], st[0], out[0].shape[0], max_events=max_events, name="state",
                      where=f"disk at ({st[1]:.6g}, {st[2]:.6g}), r={r!r}")
+    check_kinetic_capacity(kinetic, out[6])
     return one_particle_run(st, r, state, out[:9], sampling=sampling, mode=mode, tau=tau,
                             n_steps=n_steps, seed=seed, kick_angle=kick_angle, sigma=sigma,
                             times=times, applied=angles, rule=rule, e0=e0, partner=partner)

@@ -30,6 +30,8 @@ from kicktimes.billiard.kernels.tangent import MAX_SAME_INSTANT
 from kicktimes.billiard.kernels.twins import ftle_one_kernel, ftle_two_kernel
 from kicktimes.billiard.one_particle import (
     KICK_ANGLES,
+    check_kinetic,
+    check_kinetic_capacity,
     check_one_particle_state,
     check_scatter_options,
     kernel_limits,
@@ -469,9 +471,10 @@ def _lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rul
     sigma = chk.check_real("sigma", sigma, low=0.0)
     state = check_one_particle_state(arr, r, name="system")
     sp, rule, e0, partner = check_scatter_options(state, r, kick_angle, rule, e0, partner)
-    times, angles, _ = resolve_kicks(kicks, kick_angles, kick_angle=kick_angle, sigma=sigma,
-                                     rng=rng, horizon=horizon,
-                                     t_max=horizon if mode == 1 else None)
+    times, angles, _, kinetic = resolve_kicks(kicks, kick_angles, kick_angle=kick_angle,
+                                              sigma=sigma, rng=rng, horizon=horizon,
+                                              t_max=horizon if mode == 1 else None, r=r)
+    check_kinetic(kinetic, state, kick_angle, rule)
     rho = 1.0 - r
     st = np.zeros(7)
     st[1:5] = state
@@ -486,15 +489,17 @@ def _lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rul
         if return_run:
             return _pass_one(st, state, r, times, angles, kick_u, sp, mode, n_steps, tau, U,
                              variant, max_events, sampling=sampling, kick_angle=kick_angle,
-                             sigma=sigma, rule=rule, e0=e0, partner=partner)
+                             sigma=sigma, rule=rule, e0=e0, partner=partner, kinetic=kinetic)
         out = tangent_one_kernel(st, rho, times, angles, KICK_ANGLES[kick_angle], mode, n_steps,
-                                 tau, U, max_events, kick_u, sp)
+                                 tau, U, max_events, kick_u, sp, kinetic)
+        check_kinetic_capacity(kinetic, out[2])
         return _tangent_result(out, U, (0, 1), variant, horizon, max_events, "the disk"), None, None
     offsets, measure = _twin_offsets(
         variant, d0, lambda dx, dy: math.hypot(state[0] + dx, state[1] + dy) <= rho
     )
     out = ftle_one_kernel(st, rho, times, angles, KICK_ANGLES[kick_angle], mode, n_steps, tau,
-                          offsets, measure, d0, max_defer, max_events, kick_u, sp)
+                          offsets, measure, d0, max_defer, max_events, kick_u, sp, kinetic)
+    check_kinetic_capacity(kinetic, int(np.searchsorted(times, np.inf)))
     return _twin_result(out, variant, d0, horizon, max_events), None, None
 
 
@@ -522,7 +527,7 @@ def _pass_two(ic, r, rule, sampling, mode, n_steps, tau, track, variant, max_ev_
 
 
 def _pass_one(st, state, r, times, angles, kick_u, sp, mode, n_steps, tau, U, variant,
-              max_ev_tan, *, sampling, kick_angle, sigma, rule, e0, partner):
+              max_ev_tan, *, sampling, kick_angle, sigma, rule, e0, partner, kinetic=None):
     """The kicked run and its tangent FTLE from one pass (`simulate_tangent_one_kernel`).
 
     The simulation is set up and recorded by `simulate_one_particle`'s own helpers
@@ -533,9 +538,10 @@ def _pass_one(st, state, r, times, angles, kick_u, sp, mode, n_steps, tau, U, va
     rho, max_events, b_cap, stall_dt = kernel_limits(st, r, sp, scatter, horizon, mode)
     out = simulate_tangent_one_kernel(
         st, rho, times, angles, KICK_ANGLES[kick_angle], horizon if mode == 1 else 0.0, mode,
-        n_steps, tau, b_cap, kick_u, sp, max_events, stall_dt, U, max_ev_tan)
+        n_steps, tau, b_cap, kick_u, sp, max_events, stall_dt, U, max_ev_tan, kinetic)
     raise_for_status(out[9], st[0], out[0].shape[0], max_events=max_events, name="system",
                      where=f"disk at ({st[1]:.6g}, {st[2]:.6g}), r={r!r}")
+    check_kinetic_capacity(kinetic, out[6])
     run = one_particle_run(st, r, state, out[:9], sampling=sampling, mode=mode, tau=tau,
                            n_steps=n_steps, seed=None, kick_angle=kick_angle, sigma=sigma,
                            times=times, applied=kick_u if scatter else angles, rule=rule,

@@ -26,7 +26,8 @@ from kicktimes._validation import check_choice, check_int, check_real
 
 __all__ = ["DEFAULT_SYSTEMS", "DIAGNOSTICS", "SYSTEMS", "Experiment"]
 
-SYSTEMS = ("two_particle", "poisson", "actual", "poisson_scatter", "actual_scatter")
+SYSTEMS = ("two_particle", "poisson", "actual", "poisson_scatter", "actual_scatter",
+           "poisson_kinetic")
 #: The paper's systems, run when an experiment names none (scattering kicks are opt-in)
 DEFAULT_SYSTEMS = ("two_particle", "poisson", "actual")
 DIAGNOSTICS = ("lyapunov", "recurrence_rate", "autocorrelation")
@@ -133,11 +134,13 @@ class Experiment:
         deviation of the gaussian rotation (unused for ``"uniform"``).
     systems : sequence of str
         Subset of ``("two_particle", "poisson", "actual", "poisson_scatter",
-        "actual_scatter")`` whose diagnostics are stored (default the first three, the
-        paper's). The two-particle run is always simulated (its collision times are
-        stored and drive the others). The ``*_scatter`` systems are kicked at the same
-        kinds of times but by scattering kicks (a collision with a virtual partner under
-        ``rule``, docs/scatter.md) instead of ``kick_angle``.
+        "actual_scatter", "poisson_kinetic")`` whose diagnostics are stored (default the
+        first three, the paper's). The two-particle run is always simulated (its collision
+        times are stored and drive the others). The ``*_scatter`` systems are kicked at the
+        same kinds of times but by scattering kicks (a collision with a virtual partner under
+        ``rule``, docs/scatter.md) instead of ``kick_angle``. ``"poisson_kinetic"``: scattering
+        kicks at the kinetic rate of the disk's own angular momentum, redrawn after every
+        kick (`kicktimes.schedules.KineticRate`; the mirror rule only).
     diagnostics : sequence of str
         Subset of ``("lyapunov", "recurrence_rate", "autocorrelation")``.
     block_size : int
@@ -214,6 +217,9 @@ class Experiment:
         check_choice("kick_angle", self.kick_angle, KICK_ANGLES)
         put("sigma", check_real("sigma", self.sigma, low=0.0))
         put("systems", _subset("systems", self.systems, SYSTEMS))
+        if "poisson_kinetic" in self.systems and self.rule != "mirror":
+            raise ValueError("systems: 'poisson_kinetic' needs rule='mirror' (the kinetic rate "
+                             f"is tabulated for unit speeds), got rule={self.rule!r}")
         put("diagnostics", _subset("diagnostics", self.diagnostics, DIAGNOSTICS))
         put("block_size", check_int("block_size", self.block_size, low=1))
         if not isinstance(self.description, str):

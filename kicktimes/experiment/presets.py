@@ -44,8 +44,9 @@ _PAPER = {
     "kick_angle": "uniform",
     "sigma": 1.0,
     # the paper's three systems and, beyond the paper, the scatter-kicked disk
-    # (docs/scatter.md) with Poisson and with actual kick times
-    "systems": ("two_particle", "poisson", "actual", "poisson_scatter", "actual_scatter"),
+    # (docs/scatter.md) with Poisson, actual and kinetic-rate kick times (docs/mechanism.md)
+    "systems": ("two_particle", "poisson", "actual", "poisson_scatter", "actual_scatter",
+                "poisson_kinetic"),
 }
 
 PRESETS = {
@@ -126,6 +127,8 @@ PRESETS["family_a_elastic"] = _control(
     "under the elastic collision rule (energy exchanged between the disks), "
     "invariant-measure initial conditions",
     ic_method="uniform", rule="elastic",
+    # (the kinetic-rate kicks are tabulated for the mirror rule's unit speeds)
+    systems=tuple(s for s in PRESETS["family_a"].systems if s != "poisson_kinetic"),
 )
 
 #: The experiments ``kicktimes reproduce --scale`` runs (with ``--content paper``, the
@@ -183,7 +186,7 @@ def preset(name: str, content: str = "full") -> Experiment:
     --------
     >>> from kicktimes.experiment import preset
     >>> preset("family_b").systems
-    ('two_particle', 'poisson', 'actual', 'poisson_scatter', 'actual_scatter')
+    ('two_particle', 'poisson', 'actual', 'poisson_scatter', 'actual_scatter', 'poisson_kinetic')
     >>> exp = preset("family_b", content="paper")
     >>> exp.systems, exp.eps, exp.acf_max_lag
     (('two_particle', 'poisson', 'actual'), (0.001,), 1)

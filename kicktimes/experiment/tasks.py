@@ -19,6 +19,7 @@ run and its Lyapunov twins (common random numbers).
 
 from __future__ import annotations
 
+import functools
 import math
 import struct
 import time
@@ -51,7 +52,7 @@ COLLISION_COLUMNS = ("radius", "ic", "t_window", "n_pp", "pp_times")
 #: families of streams can never coincide (their keys differ in length and content).
 KICK_DOMAIN = 0x6B69636B  # "kick"
 SYSTEM_CODES = {"two_particle": 0, "poisson": 1, "actual": 2, "poisson_scatter": 3,
-                "actual_scatter": 4}
+                "actual_scatter": 4, "poisson_kinetic": 5}
 
 
 def _radius_key(radius: float) -> int:
@@ -191,7 +192,7 @@ def _lyapunov_pass():
 
 def _run_ic(exp: Experiment, r: float, ic_index: int, ic: np.ndarray, rows, coll, timer, *,
             one_pass: bool = True):
-    from kicktimes.billiard.one_particle import draw_kick_angles, simulate_one_particle
+    from kicktimes.billiard.one_particle import draw_kick_angles
     from kicktimes.billiard.two_particle import simulate_two_particle
     from kicktimes.diagnostics import boundary_angles
     from kicktimes.schedules import Poisson
@@ -274,11 +275,16 @@ def _run_ic(exp: Experiment, r: float, ic_index: int, ic: np.ndarray, rows, coll
         )
 
     actual_times = None
-    for system in ("poisson", "actual", "poisson_scatter", "actual_scatter"):
+    for system in ("poisson", "actual", "poisson_scatter", "actual_scatter", "poisson_kinetic"):
         if system not in exp.systems:
             continue
         kick = kick_law(exp, system, ic)
         rng = kick_rng(exp.seed, ic_index, r, system)
+        if system == "poisson_kinetic":
+            # the event loop draws the kick times (and their scattering numbers) from rng
+            one_kw = {"kicks": kinetic_rate_table(r), "rng": rng, **kick, **steps}
+            _kicked(system, one_kw, one_pass, exp, ic, r, timer, add, diagnose)
+            continue
         if system.startswith("actual"):
             if actual_times is None:
                 if continued is not None:
@@ -294,26 +300,50 @@ def _run_ic(exp: Experiment, r: float, ic_index: int, ic: np.ndarray, rows, coll
                 kick_times = Poisson(rate).sample(horizon, rng)
             kick_angles = draw_kick_angles(kick_times.size, kick["kick_angle"], exp.sigma, rng)
         one_kw = {"kicks": kick_times, "kick_angles": kick_angles, **kick, **steps}
-        if one_pass:
-            with timer("lyapunov_kicked"):
-                res_one, one = _lyapunov()(ic[0], r, variant=exp.lyapunov_variant,
-                                           method="tangent", return_run=True, **one_kw)
+        extra = (("kick_rate", rate),) if system.startswith("poisson") else ()
+        _kicked(system, one_kw, one_pass, exp, ic, r, timer, add, diagnose, extra)
 
-            def ftle(res_one=res_one):
-                return res_one
-        else:
-            with timer("simulation_one_particle"):
-                one = simulate_one_particle(ic[0], r, seed=exp.seed, **one_kw)
 
-            def ftle(one_kw=one_kw):
-                return _lyapunov()(ic[0], r, variant=exp.lyapunov_variant, **ftle_method,
-                                   **one_kw)
-        add(system, "t_max", one.t_max)
-        if system.startswith("poisson"):
-            add(system, "kick_rate", rate)
-        add(system, "n_kicks", one.n_kicks)
-        add(system, "n_boundary", one.n_boundary)
-        diagnose(system, one, ftle)
+def _kicked(system, one_kw, one_pass, exp, ic, r, timer, add, diagnose, extra=()):
+    """Run the kicked ``system`` with the kicks ``one_kw`` (and its FTLE, in one pass or
+    not), store its counts (``extra`` rows after ``t_max``) and diagnose it."""
+    from kicktimes.billiard.one_particle import simulate_one_particle
+
+    ftle_method = {"method": exp.lyapunov_method}
+    if exp.lyapunov_method == "twin":
+        ftle_method["d0"] = exp.d0
+    if one_pass:
+        with timer("lyapunov_kicked"):
+            res_one, one = _lyapunov()(ic[0], r, variant=exp.lyapunov_variant, method="tangent",
+                                       return_run=True, **one_kw)
+
+        def ftle(res_one=res_one):
+            return res_one
+    else:
+        with timer("simulation_one_particle"):
+            one = simulate_one_particle(ic[0], r, seed=exp.seed, **one_kw)
+
+        def ftle():
+            kw = one_kw
+            if "rng" in kw:
+                # kinetic kicks are drawn by the run: the FTLE replays the ones it applied
+                kw = {**one_kw, "kicks": one.kick_times, "kick_angles": one.kick_angles}
+                del kw["rng"]
+            return _lyapunov()(ic[0], r, variant=exp.lyapunov_variant, **ftle_method, **kw)
+    add(system, "t_max", one.t_max)
+    for name, value in extra:
+        add(system, name, value)
+    add(system, "n_kicks", one.n_kicks)
+    add(system, "n_boundary", one.n_boundary)
+    diagnose(system, one, ftle)
+
+
+@functools.lru_cache(maxsize=16)
+def kinetic_rate_table(r: float):
+    """The `KineticRate` of radius ``r`` (tabulated once per process and radius)."""
+    from kicktimes.schedules import KineticRate
+
+    return KineticRate(r)
 
 
 def kick_law(exp: Experiment, system: str, ic: np.ndarray) -> dict:
@@ -323,6 +353,8 @@ def kick_law(exp: Experiment, system: str, ic: np.ndarray) -> dict:
     virtual partner under the experiment's rule, with the two-disk IC's kinetic energy
     (elastic rule).
     """
+    if system == "poisson_kinetic":
+        return {"kick_angle": "scatter", "sigma": exp.sigma, "rule": "mirror"}
     if not system.endswith("_scatter"):
         return {"kick_angle": exp.kick_angle, "sigma": exp.sigma}
     e0 = 0.5 * float((ic[:, 2:] ** 2).sum()) if exp.rule == "elastic" else None

@@ -336,7 +336,7 @@ _CONTROL_WORDS = {
     "elastic": "the elastic rule",
 }
 _SHORT = {"poisson": "Poisson", "actual": "actual", "poisson_scatter": "Poisson, scatter",
-          "actual_scatter": "actual, scatter"}
+          "actual_scatter": "actual, scatter", "poisson_kinetic": "kinetic rate, scatter"}
 
 
 def _ci(row):
@@ -427,10 +427,11 @@ def answers(table: pd.DataFrame, poisson_share=None) -> list[str]:
         out.append("**Does the paper's kicked disk reproduce the two-disk chaos?** "
                    f"{lead}: its FTLE is {primary.min():.2f}–{primary.max():.2f} of the "
                    "two-disk one. " + "; ".join(paper) + ".")
-    other = statements(("poisson_scatter", "actual_scatter"))
+    other = statements(("poisson_scatter", "actual_scatter", "poisson_kinetic"))
     if other:
-        out.append("**Does any kick?** The scatter kick (a collision with a virtual partner) "
-                   "comes closest; FTLE ratio " + "; ".join(other) + ".")
+        out.append("**Does any kick?** The scatter kick (a collision with a virtual partner, "
+                   "at Poisson, actual or kinetic-rate times) comes closest; FTLE ratio "
+                   + "; ".join(other) + ".")
     return out
 
 

@@ -10,13 +10,15 @@ import pandas as pd
 from matplotlib.figure import Figure
 from matplotlib.ticker import FuncFormatter, NullFormatter
 
-SYSTEMS = ("two_particle", "poisson", "actual", "poisson_scatter", "actual_scatter")
+SYSTEMS = ("two_particle", "poisson", "actual", "poisson_scatter", "actual_scatter",
+           "poisson_kinetic")
 SYSTEM_LABELS = {
     "two_particle": "Two-particle",
     "poisson": "Poisson",
     "actual": "Actual",
     "poisson_scatter": "Poisson, scatter",
     "actual_scatter": "Actual, scatter",
+    "poisson_kinetic": "Kinetic rate, scatter",
 }
 _SYSTEM_STYLE = {
     "two_particle": {"color": "black", "marker": "o"},
@@ -24,6 +26,7 @@ _SYSTEM_STYLE = {
     "actual": {"color": "tab:blue", "marker": "^"},
     "poisson_scatter": {"color": "tab:red", "marker": "v"},
     "actual_scatter": {"color": "tab:green", "marker": "D"},
+    "poisson_kinetic": {"color": "tab:purple", "marker": "P"},
 }
 # (title, y-axis label with units) of each diagnostic of the store
 DIAGNOSTIC_LABELS = {

@@ -15,6 +15,10 @@ perturbed one-particle billiard (docs/architecture.md, "Perturbed one-particle b
 ``Bootstrap(intervals)``  IID resampling of observed intervals, ``Bootstrap.from_run(run)``
 ========================  ===============================================================
 
+``KineticRate(r)`` is the state-dependent kick law: not a schedule, since each interval
+depends on the kicked disk's angular momentum after the previous kick; the event loop
+draws its times (docs/mechanism.md).
+
 Conventions shared by every schedule
 ------------------------------------
 * ``sample(t_max, rng=None)`` returns kick times ``0 < t_1 <= t_2 <= ... <= t_max``.
@@ -47,12 +51,14 @@ from kicktimes.schedules._base import (
 )
 from kicktimes.schedules._distributions import resolve_distribution
 from kicktimes.schedules._io import read_kick_times, write_kick_times
+from kicktimes.schedules._kinetic import KineticRate
 from kicktimes.schedules._specs import from_spec
 from kicktimes.schedules._validate import DEFAULT_MAX_KICKS
 
 __all__ = [
     "DEFAULT_MAX_KICKS",
     "Bootstrap",
+    "KineticRate",
     "Poisson",
     "Renewal",
     "Replay",

@@ -10,7 +10,8 @@ It takes event times and observation windows only (no billiard knowledge):
   the tables of one group of sequences (:func:`poisson_group`, :func:`pooled_intervals`,
   shared by :func:`analyze` and the sweep report);
 * collision counts versus radius and the kinetic-theory rate
-  (:func:`regress_counts`, :func:`kinetic_rate`).
+  (:func:`regress_counts`, :func:`kinetic_rate`), and the rate conditioned on the two
+  angular momenta (:func:`conditional_kinetic_rate`, :func:`mean_kinetic_rate`).
 
 See ``docs/statistics.md`` for the conventions.
 """
@@ -23,6 +24,7 @@ from .ensemble import PoissonEnsembleResult, test_poisson_ensemble
 from .findings import Finding, ratio_rule, ratio_verdict
 from .gof import GofResult, goodness_of_fit
 from .groups import PoissonGroup, poisson_group, pooled_intervals
+from .kinetic import conditional_kinetic_rate, mean_kinetic_rate
 from .poisson import TESTS, Intervals, intervals_from_times, test_poisson
 from .renewal import (
     FULL_SAMPLE_MODELS,
@@ -51,6 +53,8 @@ __all__ = [
     "pooled_intervals",
     "regress_counts",
     "kinetic_rate",
+    "conditional_kinetic_rate",
+    "mean_kinetic_rate",
     "hyperexpon",
     "RenewalFit",
     "VuongResult",

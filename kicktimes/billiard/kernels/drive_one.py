@@ -33,7 +33,7 @@ N_KICKS, N_B, K, SIM_ON, N_KICKS_RUN = range(5)
 
 @njit(cache=True)
 def drive(st, ev, rho, kicks, angles, kick_mode, kick_u, sp, unit_speed, t_end, mode, tau, logs,
-          stimes, samples, cnt, next_s, fin, tan):
+          stimes, samples, cnt, next_s, fin, tan, kinetic):
     """Run the event loop from ``st``/``ev``; returns `ob.DONE`, or `ob.FULL` when the boundary
     log is full (see `kicktimes.billiard.kernels.drive_two.drive`).
 
@@ -41,6 +41,9 @@ def drive(st, ev, rho, kicks, angles, kick_mode, kick_u, sp, unit_speed, t_end, 
     one.SCATTER``) take ``kick_u[i]`` and ``sp`` and log to ``klog[i]``.
     ``logs = (bt, bx, by, bs, klog)``; ``fin = [t_end, x, y, vx, vy]``, the run's final
     state; ``tan = (U, log_scale, tgi, tgf, max_events, n_orth, n_steps)`` or ``None``.
+    ``kinetic = (e, rates, l_first, dl)`` or ``None``: kinetic kicks, whose times the loop
+    writes into ``kicks`` as it goes: after kick ``i`` the next comes
+    `one.kinetic_delay` later, with the number ``e[i + 1]``.
     """
     bt, bx, by, bs, klog = logs
     s = one.load(st, ev)
@@ -58,6 +61,7 @@ def drive(st, ev, rho, kicks, angles, kick_mode, kick_u, sp, unit_speed, t_end, 
         i_loop, n_loop, n_ev, n_same, n_resc, n_pert, tk, t_prev, tan_code = tg.load_carry(
             tgi, tgf)
     scatter = kick_mode == one.SCATTER
+    nk = kicks.shape[0]
     ns = stimes.shape[0]
     b_cap = bt.shape[0]
     ns_next = next_s[0]
@@ -130,6 +134,9 @@ def drive(st, ev, rho, kicks, angles, kick_mode, kick_u, sp, unit_speed, t_end, 
             s = one.load(st, ev)
             if tan is not None and tan_on:
                 n_pert += 1
+            if kinetic is not None and ik + 1 < nk:
+                kicks[ik + 1] = kicks[ik] + one.kinetic_delay(st, kinetic[0][ik + 1], kinetic[1],
+                                                              kinetic[2], kinetic[3])
             ik += 1
         else:
             s, sin_theta = one.wall_step(s, dte, rho, unit_speed)
@@ -161,13 +168,19 @@ def drive(st, ev, rho, kicks, angles, kick_mode, kick_u, sp, unit_speed, t_end, 
 
 @njit(cache=True)
 def _run(st, rho, kicks, angles, kick_mode, t_max, mode, n_steps, tau, b_cap, kick_u, sp,
-         max_events, stall_dt, sim, tan):
+         max_events, stall_dt, sim, tan, kinetic):
     """Allocate the logs, run `drive` to its end, growing the boundary log when full.
+
+    With ``kinetic`` (see `drive`) the first kick's time is set here, from the initial
+    state; ``kicks`` must then be a writable buffer, one entry per number in ``e``.
 
     Returns ``(logs, stimes, samples, cnt, fin, tan, status)``.
     """
     ev = np.empty(1)
     ev[0] = geo.boundary_hit_time(st[1], st[2], st[3], st[4], rho)
+    if kinetic is not None and kicks.shape[0] > 0:
+        kicks[0] = st[0] + one.kinetic_delay(st, kinetic[0][0], kinetic[1], kinetic[2],
+                                             kinetic[3])
     unit_speed = one.unit_speed_of(st, kick_mode, sp)
     klog = np.zeros((kicks.shape[0] if kick_mode == one.SCATTER else 0, 9))
     bt, bx, by, bs = ob.new_boundary_log(min(b_cap, max_events + 1) if sim else 0)
@@ -183,7 +196,8 @@ def _run(st, rho, kicks, angles, kick_mode, t_max, mode, n_steps, tau, b_cap, ki
     status = ob.DONE
     while True:
         loop = drive(st, ev, rho, kicks, angles, kick_mode, kick_u, sp, unit_speed, t_end, mode,
-                     tau, (bt, bx, by, bs, klog), stimes, samples, cnt, next_s, fin, tan)
+                     tau, (bt, bx, by, bs, klog), stimes, samples, cnt, next_s, fin, tan,
+                     kinetic)
         if loop == ob.DONE:
             break
         # a full boundary log
@@ -206,7 +220,7 @@ def _run(st, rho, kicks, angles, kick_mode, t_max, mode, n_steps, tau, b_cap, ki
 
 @njit(cache=True)
 def simulate_one_kernel(st, rho, kicks, angles, kick_mode, t_max, mode, n_steps, tau, b_cap,
-                        kick_u, sp, max_events, stall_dt):
+                        kick_u, sp, max_events, stall_dt, kinetic=None):
     """Run the kicked one-disk billiard (``mode``: 0 none, 1 uniform, 2 paper sampling).
 
     ``st`` is ``[t, x, y, vx, vy, clock compensation, squared speed]``. Scattering kicks
@@ -215,11 +229,12 @@ def simulate_one_kernel(st, rho, kicks, angles, kick_mode, t_max, mode, n_steps,
     Stops early with status `ob.OVER_BUDGET` after ``max_events`` boundary collisions or
     `ob.STALLED`. Returns ``(b_time, b_x, b_y, b_sin, sample_times, samples,
     n_kicks_applied, t_end, kick_log, status)``; ``kick_log`` has one row per applied
-    scattering kick (else none).
+    scattering kick (else none). ``kinetic``: kinetic kicks (see `drive`), whose times the
+    run writes into ``kicks``.
     """
     logs, stimes, samples, cnt, fin, _, status = _run(
         st, rho, kicks, angles, kick_mode, t_max, mode, n_steps, tau, b_cap, kick_u, sp,
-        max_events, stall_dt, True, None)
+        max_events, stall_dt, True, None, kinetic)
     bt, bx, by, bs, klog = logs
     n = cnt[N_B]
     n_applied = cnt[N_KICKS_RUN] if status == ob.DONE else cnt[N_KICKS]
@@ -230,7 +245,8 @@ def simulate_one_kernel(st, rho, kicks, angles, kick_mode, t_max, mode, n_steps,
 
 @njit(cache=True)
 def simulate_tangent_one_kernel(st, rho, kicks, angles, kick_mode, t_max, mode, n_steps, tau,
-                                b_cap, kick_u, sp, max_events, stall_dt, U, max_ev_tan):
+                                b_cap, kick_u, sp, max_events, stall_dt, U, max_ev_tan,
+                                kinetic=None):
     """`simulate_one_kernel` and `tangent_one_kernel` in one pass.
 
     Arguments as theirs (``mode`` 1 or 2). Returns ``(b_time, b_x, b_y, b_sin,
@@ -240,7 +256,7 @@ def simulate_tangent_one_kernel(st, rho, kicks, angles, kick_mode, t_max, mode, 
     logs, stimes, samples, cnt, fin, tan, status = _run(
         st, rho, kicks, angles, kick_mode, t_max, mode, n_steps, tau, b_cap, kick_u, sp,
         max_events, stall_dt, True,
-        tg.tangent_state(U, mode, n_steps, tau, max_ev_tan, np.int64(0)))
+        tg.tangent_state(U, mode, n_steps, tau, max_ev_tan, np.int64(0)), kinetic)
     bt, bx, by, bs, klog = logs
     _, log_scale, tgi, tgf, _, _, _ = tan
     n = cnt[N_B]
@@ -252,7 +268,7 @@ def simulate_tangent_one_kernel(st, rho, kicks, angles, kick_mode, t_max, mode, 
 
 @njit(cache=True)
 def tangent_one_kernel(st, rho, kicks, angles, kick_mode, mode, n_steps, tau, U, max_events,
-                       kick_u, sp):
+                       kick_u, sp, kinetic=None):
     """Carry the tangent vectors ``U`` (m, 4) along the kicked one-disk trajectory.
 
     As `kicktimes.billiard.kernels.drive_two.tangent_two_kernel`; kicks at ``kicks``
@@ -266,7 +282,7 @@ def tangent_one_kernel(st, rho, kicks, angles, kick_mode, mode, n_steps, tau, U,
     """
     tan = tg.tangent_state(U, mode, n_steps, tau, max_events, np.int64(0))
     _run(st, rho, kicks, angles, kick_mode, 0.0, mode, n_steps, tau, 0, kick_u, sp, max_events,
-         0.0, False, tan)
+         0.0, False, tan, kinetic)
     _, log_scale, tgi, tgf, _, _, _ = tan
     # the state flies on to the end, as the vectors did
     dt = tgf[tg.T_PREV] - st[0]

@@ -26,9 +26,9 @@ from numba import njit
 from kicktimes.billiard import geometry as geo
 from kicktimes.billiard.scatter import scatter_kick, twin_meets_partner
 
-__all__ = ["KICK_ANGLES", "SCATTER", "advance", "apply_kick", "fly", "kick_step", "load",
-           "next_event", "next_kick", "process_wall", "process_wall_at", "scatter_step", "store",
-           "twin_scatter_step", "unit_speed_of", "wall_event", "wall_step"]
+__all__ = ["KICK_ANGLES", "SCATTER", "advance", "apply_kick", "fly", "kick_step", "kinetic_delay",
+           "load", "next_event", "next_kick", "process_wall", "process_wall_at", "scatter_step",
+           "store", "twin_scatter_step", "unit_speed_of", "wall_event", "wall_step"]
 
 #: kick laws and their codes in the kernels
 KICK_ANGLES = {"uniform": 0, "gaussian": 1, "scatter": 2}
@@ -43,6 +43,20 @@ def unit_speed_of(st, kick_mode, sp):
     scattering kick can change it (the boundary collision then skips a square root)."""
     return (abs(st[3] * st[3] + st[4] * st[4] - 1.0) < 1e-12
             and not (kick_mode == SCATTER and sp[1] != 0.0))
+
+
+@njit(cache=True)
+def kinetic_delay(st, e, rates, l_first, dl):
+    """The delay ``e / rate(L)`` of the next kick at the rate of the disk's own angular
+    momentum ``L = x vy - y vx`` (kinetic kicks): ``e`` a standard exponential number,
+    ``rate`` interpolated linearly in ``rates`` on the grid ``l_first + i dl`` (clamped to
+    its ends). Between kicks ``L`` is conserved (wall reflections keep it), so the delay
+    is drawn once, right after a kick, from the state the kick left."""
+    ell = st[1] * st[4] - st[2] * st[3]
+    f = (ell - l_first) / dl
+    i = min(max(int(math.floor(f)), 0), rates.shape[0] - 2)
+    w = min(max(f - i, 0.0), 1.0)
+    return e / (rates[i] * (1.0 - w) + rates[i + 1] * w)
 
 
 @njit(cache=True)

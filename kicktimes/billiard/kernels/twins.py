@@ -89,10 +89,13 @@ def _separation(dx, dy, measure):
 
 @njit(cache=True)
 def _ftle(st0, rho, mode, n_steps, tau, track, offsets, measure, d0, max_defer, max_events, pair,
-          kick):
+          kick, kinetic):
     """Benettin FTLE of either system: ``pair = (sigma, rule)`` for two disks (``kick`` is
     ``None``), ``kick = (kicks, angles, kick_mode, kick_u, sp)`` for the kicked disk
-    (``pair`` is ``None``); the other system's code is compiled out.
+    (``pair`` is ``None``); the other system's code is compiled out. ``kinetic`` (or
+    ``None``): kinetic kicks, whose times the reference writes into ``kicks`` as it applies
+    them (`kicktimes.billiard.kernels.drive_one.drive`); the twins, which lag the reference
+    within a sample, find them written.
 
     Row 0 of the trajectory arrays is the reference, rows ``1..m`` the twins: each sample
     first advances the reference (no flight on: its positions at ``t_k`` are interpolated),
@@ -131,6 +134,9 @@ def _ftle(st0, rho, mode, n_steps, tau, track, offsets, measure, d0, max_defer, 
         cnt = np.zeros((m + 1, 3), dtype=np.int64)
         for j in range(m + 1):
             ev[j, 0] = boundary_hit_time(traj[j, 1], traj[j, 2], traj[j, 3], traj[j, 4], rho)
+        if kinetic is not None and nk > 0:
+            kicks[0] = st0[0] + one.kinetic_delay(st0, kinetic[0][0], kinetic[1], kinetic[2],
+                                                  kinetic[3])
     ref = traj[0]
     log_sum = np.zeros(m)
     n_renorm = np.zeros(m, dtype=np.int64)
@@ -214,6 +220,9 @@ def _ftle(st0, rho, mode, n_steps, tau, track, offsets, measure, d0, max_defer, 
                         # a missed partner is a different event sequence: defer, then force
                         hit = one.twin_scatter_step(traj[j], ev[j], dt, rho, kicks[ik],
                                                     partners[ik], sp)
+                    if kinetic is not None and j == 0 and ik + 1 < nk:
+                        kicks[ik + 1] = kicks[ik] + one.kinetic_delay(
+                            ref, kinetic[0][ik + 1], kinetic[1], kinetic[2], kinetic[3])
                     cnt[j, 0] += 1
                     cnt[j, 2] = (cnt[j, 2] * 4 + (4 if hit else 2)) % HASH_MOD
             if status != 0:
@@ -297,12 +306,12 @@ def ftle_two_kernel(st0, rho, sigma, rule, mode, n_steps, tau, track, offsets, m
     ``t_last[j]``.
     """
     return _ftle(st0, rho, mode, n_steps, tau, track, offsets, measure, d0, max_defer,
-                 max_events, (sigma, rule), None)
+                 max_events, (sigma, rule), None, None)
 
 
 @njit(cache=True)
 def ftle_one_kernel(st0, rho, kicks, angles, kick_mode, mode, n_steps, tau, offsets, measure, d0,
-                    max_defer, max_events, kick_u, sp):
+                    max_defer, max_events, kick_u, sp, kinetic=None):
     """Benettin FTLE for the kicked one-disk billiard.
 
     Twins share the kick times and angles (common random numbers). Returns as
@@ -310,7 +319,7 @@ def ftle_one_kernel(st0, rho, kicks, angles, kick_mode, mode, n_steps, tau, offs
     (``kick_mode == 2``, numbers ``kick_u``, parameters ``sp`` as in
     `kicktimes.billiard.kernels.one.scatter_step`): the reference draws the partner, placed
     in contact with it, and every twin meets that same partner at its own contact time, or
-    misses it.
+    misses it. ``kinetic``: kinetic kicks (see `_ftle`).
     """
     return _ftle(st0, rho, mode, n_steps, tau, 0, offsets, measure, d0, max_defer, max_events,
-                 None, (kicks, angles, kick_mode, kick_u, sp))
+                 None, (kicks, angles, kick_mode, kick_u, sp), kinetic)
