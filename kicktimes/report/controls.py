@@ -472,7 +472,8 @@ def first_screen(table: pd.DataFrame, shares: dict) -> list[str]:
     return lines + [""]
 
 
-_PANELS = (
+#: the headline figure's panels: (diagnostic, title)
+PANELS = (
     ("ftle", "FTLE λ"),
     ("rr_offdiag@0.001", "off-diagonal RR, ε = 10⁻³\n(uniform-time samples)"),
     ("rr_offdiag@0.01", "off-diagonal RR, ε = 10⁻²\n(uniform-time samples)"),
@@ -486,6 +487,18 @@ _LOG_TICKS = (
     (20.0, (0.1, 0.2, 0.3, 0.5, 0.7, 1.0, 1.5, 2.0, 3.0, 5.0, 10.0)),
     (math.inf, (0.01, 0.02, 0.05, 0.1, 0.2, 0.5, 1.0, 2.0, 5.0, 10.0, 20.0, 50.0)),
 )
+
+
+def log_ratio_axis(ax):
+    """A log y axis for ratios with plain tick labels that never overlap."""
+    from matplotlib.ticker import FixedLocator, FuncFormatter, NullLocator
+
+    ax.set_yscale("log")
+    lo, hi = ax.get_ylim()
+    choice = next(t for span, t in _LOG_TICKS if hi / lo <= span)
+    ax.yaxis.set_major_locator(FixedLocator([t for t in choice if lo <= t <= hi]))
+    ax.yaxis.set_minor_locator(NullLocator())
+    ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
 
 
 def ratio_curves_figure(curves: pd.DataFrame):
@@ -506,11 +519,10 @@ def ratio_curves_figure(curves: pd.DataFrame):
     """
     from matplotlib.figure import Figure
     from matplotlib.lines import Line2D
-    from matplotlib.ticker import FixedLocator, FuncFormatter, NullLocator
 
     from kicktimes.report.figures import radius_axis, system_label, system_style
 
-    panels = [(d, t) for d, t in _PANELS if d in set(curves["diagnostic"])]
+    panels = [(d, t) for d, t in PANELS if d in set(curves["diagnostic"])]
     fig = Figure(figsize=(3.3 * max(len(panels), 1), 4.2), layout="constrained")
     axes = fig.subplots(1, max(len(panels), 1), squeeze=False)[0]
     families = list(dict.fromkeys(curves["family"]))
@@ -533,15 +545,9 @@ def ratio_curves_figure(curves: pd.DataFrame):
                     ax.errorbar(c["radius"], c["ratio"], yerr=np.clip(err, 0, None),
                                 color=style["color"], marker=style["marker"], markersize=3.5,
                                 linestyle=_FAMILY_LINES[f % 4], linewidth=1.0, capsize=1.5)
-        ax.set_yscale("log")
         ax.set_title(title, fontsize="medium")
         radius_axis(ax)
-        lo, hi = ax.get_ylim()
-        choice = next(t for span, t in _LOG_TICKS if hi / lo <= span)
-        ticks = [t for t in choice if lo <= t <= hi]
-        ax.yaxis.set_major_locator(FixedLocator(ticks))
-        ax.yaxis.set_minor_locator(NullLocator())
-        ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+        log_ratio_axis(ax)
     axes[0].set_ylabel("kicked / two-disk (ratio of means)")
     handles = [Line2D([], [], color=system_style(s, k)["color"], marker=system_style(s, k)[
         "marker"], linestyle="-", label=system_label(s)) for k, s in enumerate(systems)]

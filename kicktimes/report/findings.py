@@ -19,6 +19,7 @@ from kicktimes.report.controls import (
     poisson_share,
     ratio_curves_figure,
 )
+from kicktimes.report.decomposition import gap_decomposition, gap_figure
 from kicktimes.report.effects import BUILT_IN, SHARE_RULE, ratio_rule
 from kicktimes.stats.findings import findings_table
 
@@ -103,6 +104,23 @@ def section(ctx):
         "uniform-time samples (on the paper's samples the kicked systems' ratios are inflated "
         "by where the samples fall: see the table).",
     )
+    gaps = gap_decomposition(
+        ctx.results, ctx.store.collisions, family=ctx.exp.name, eps=ctx.exp.eps,
+        rule=ctx.exp.rule, rng=ctx.boot_rng(), n_boot=min(ctx.n_boot, 1000),
+    )
+    if not gaps.empty:
+        sec.table("gap_decomposition", gaps, "How much of the paper's kicked-versus-two-disk "
+                  "gap |log ratio| each ingredient closes: the scatter kick (deflection law), "
+                  "then the kinetic rate (state-dependent timing), and what is left (partner "
+                  "memory, re-collisions); ratios and shares under every control, 95 % CI",
+                  show=False)
+        sec.figure(
+            "fig00b_gap_decomposition", gap_figure(gaps),
+            "Each ingredient of the kicks against the two-disk value: the paper's kick "
+            "(uniform direction, Poisson times), a collision with a virtual partner, and the "
+            "same collisions at the kinetic rate of the disk's own angular momentum (95 % CI, "
+            "bootstrap clustered on ICs; recurrence on uniform-time samples).",
+        )
     sec.fold()
     sec.text("All statements, under the primary setting:")
     sec.bullets(e.sentence() for e in effects)
