@@ -7,7 +7,9 @@ autocorrelation of the boundary-collision angles (`autocorrelation`,
 (`autocorrelation_function`, `decorrelation_lag`, `integrated_autocorrelation_time`)
 and finite-time Lyapunov exponents (`lyapunov`: exact tangent vectors by default, or
 Benettin twins; `lyapunov_spectrum`: all exponents of the two-disk billiard); see
-docs/diagnostics.md.
+docs/diagnostics.md. The collision mechanism of two-disk runs (angular momenta, impact
+parameters and wall hits per collision, re-collisions, predicted rates) is in
+`kicktimes.diagnostics.mechanism`; see docs/mechanism.md.
 """
 
 from kicktimes.diagnostics.autocorrelation import (
@@ -29,6 +31,15 @@ from kicktimes.diagnostics.lyapunov import (
     lyapunov,
     lyapunov_spectrum,
 )
+from kicktimes.diagnostics.mechanism import (
+    RecollisionShare,
+    collision_table,
+    collision_tables,
+    initial_angular_momenta,
+    poisson_recollision_share,
+    predicted_rates,
+    recollision_share,
+)
 from kicktimes.diagnostics.recurrence import recurrence_pairs, recurrence_rate
 from kicktimes.diagnostics.rqa import RQAResult, rqa
 
@@ -37,16 +48,23 @@ __all__ = [
     "LyapunovResult",
     "LyapunovSpectrum",
     "RQAResult",
+    "RecollisionShare",
     "UndefinedDiagnosticWarning",
     "acf_curve",
     "autocorrelation",
     "autocorrelation_function",
     "autocorrelation_many",
     "boundary_angles",
+    "collision_table",
+    "collision_tables",
     "decorrelation_lag",
+    "initial_angular_momenta",
     "integrated_autocorrelation_time",
     "lyapunov",
     "lyapunov_spectrum",
+    "poisson_recollision_share",
+    "predicted_rates",
+    "recollision_share",
     "recurrence_pairs",
     "recurrence_rate",
     "rqa",

@@ -81,6 +81,7 @@ class Found:
     renewal_pooled: object = None  # renewal: the comparison of pooled intervals
     effects: list = field(default_factory=list)  # findings: the statements
     controls: object = None  # findings: `kicktimes.report.controls.Controls`
+    gaps: object = None  # findings: the gap decomposition (`report.decomposition`)
 
 
 @dataclass

@@ -108,6 +108,7 @@ def section(ctx):
         ctx.results, ctx.store.collisions, family=ctx.exp.name, eps=ctx.exp.eps,
         rule=ctx.exp.rule, rng=ctx.boot_rng(), n_boot=min(ctx.n_boot, 1000),
     )
+    ctx.found.gaps = gaps
     if not gaps.empty:
         sec.table("gap_decomposition", gaps, "How much of the paper's kicked-versus-two-disk "
                   "gap |log ratio| each ingredient closes: the scatter kick (deflection law), "

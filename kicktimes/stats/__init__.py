@@ -11,7 +11,10 @@ It takes event times and observation windows only (no billiard knowledge):
   shared by :func:`analyze` and the sweep report);
 * collision counts versus radius and the kinetic-theory rate
   (:func:`regress_counts`, :func:`kinetic_rate`), and the rate conditioned on the two
-  angular momenta (:func:`conditional_kinetic_rate`, :func:`mean_kinetic_rate`).
+  angular momenta (:func:`conditional_kinetic_rate`, :func:`mean_kinetic_rate`);
+* the hazard of intervals against the time since the last event and the rate-mixture
+  (Cox) processes that explain a falling one (:func:`interval_hazard`,
+  :func:`rate_mixture`, :func:`simulate_cox_times`).
 
 See ``docs/statistics.md`` for the conventions.
 """
@@ -24,7 +27,9 @@ from .ensemble import PoissonEnsembleResult, test_poisson_ensemble
 from .findings import Finding, ratio_rule, ratio_verdict
 from .gof import GofResult, goodness_of_fit
 from .groups import PoissonGroup, poisson_group, pooled_intervals
+from .hazard import HazardTable, interval_hazard
 from .kinetic import conditional_kinetic_rate, mean_kinetic_rate
+from .mixture import RateMixture, rate_mixture, simulate_cox_times
 from .poisson import TESTS, Intervals, intervals_from_times, test_poisson
 from .renewal import (
     FULL_SAMPLE_MODELS,
@@ -67,4 +72,9 @@ __all__ = [
     "Finding",
     "ratio_verdict",
     "ratio_rule",
+    "interval_hazard",
+    "HazardTable",
+    "rate_mixture",
+    "RateMixture",
+    "simulate_cox_times",
 ]
