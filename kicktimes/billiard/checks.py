@@ -9,7 +9,7 @@ import numpy as np
 
 from kicktimes._validation import check_choice, check_int, check_real
 
-__all__ = ["check_choice", "check_int", "check_real", "check_state", "check_inside",
+__all__ = ["check_choice", "check_holes", "check_int", "check_real", "check_state", "check_inside",
            "check_unit_speed", "check_speed", "check_sampling", "event_budget", "stall_time",
            "RULES", "SAMPLINGS", "CONTACT_TOL", "SPEED_RANGE", "TIME_LIMIT", "N_STEPS_MAX",
            "MAX_EVENTS_DEFAULT", "STALL_EVENTS"]
@@ -160,3 +160,23 @@ def check_sampling(t_max, n_steps, tau, sampling):
             "pass t_max >= n_steps * tau or omit it"
         )
     return t_max, n_steps, tau, 1
+
+
+def check_holes(holes):
+    """Holes in the table's wall as a float64 array of rows ``(centre angle, half-width)``,
+    or ``None``; half-widths in ``(0, pi)``, angles finite."""
+    if holes is None:
+        return None
+    try:
+        arcs = np.array(holes, dtype=np.float64, copy=True, ndmin=2)
+    except (TypeError, ValueError) as exc:
+        raise TypeError(f"holes must be rows (centre angle, half-width), got "
+                        f"{type(holes).__name__} ({exc})") from None
+    if arcs.ndim != 2 or arcs.shape[1] != 2 or arcs.shape[0] == 0:
+        raise ValueError(f"holes must have shape (n, 2), rows (centre angle, half-width), "
+                         f"got shape {arcs.shape}")
+    if not np.isfinite(arcs).all():
+        raise ValueError("holes must be finite; got NaN or inf")
+    if ((arcs[:, 1] <= 0.0) | (arcs[:, 1] >= np.pi)).any():
+        raise ValueError(f"holes: each half-width must lie in (0, pi), got {arcs[:, 1].tolist()}")
+    return arcs

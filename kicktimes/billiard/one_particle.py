@@ -221,7 +221,7 @@ def check_scatter_options(state, r, kick_angle, rule, e0, partner):
 def simulate_one_particle(state, r, *, t_max=None, kicks=None, kick_angle="uniform",
                           kick_angles=None, sigma=1.0, rng=None, sampling="uniform",
                           n_steps=None, tau=None, seed=None, rule="mirror", e0=None,
-                          partner="weighted", max_events=None) -> OneParticleRun:
+                          partner="weighted", max_events=None, holes=None) -> OneParticleRun:
     """Simulate one disk of radius ``r`` in the unit table, kicked at given times.
 
     Parameters
@@ -269,6 +269,10 @@ def simulate_one_particle(state, r, *, t_max=None, kicks=None, kick_angle="unifo
     max_events : int, optional
         Stop with a ValueError after this many boundary collisions (as in
         `simulate_two_particle`; kicks do not count).
+    holes : array_like, shape (n, 2), optional
+        Holes in the table's wall, rows ``(centre angle, half-width)`` in radians: the
+        disk escapes at a wall contact in a hole and the run ends there
+        (``run.escape_time``; ``inf`` if it did not escape by the end).
 
     Returns
     -------
@@ -310,6 +314,7 @@ def simulate_one_particle(state, r, *, t_max=None, kicks=None, kick_angle="unifo
                                               sigma=sigma, rng=rng, horizon=horizon,
                                               t_max=t_max if mode < 2 else None, r=r)
     check_kinetic(kinetic, state, kick_angle, rule)
+    arcs = chk.check_holes(holes)
     st = np.zeros(7)
     st[1:5] = state
     st[6] = state[2] ** 2 + state[3] ** 2
@@ -320,14 +325,15 @@ def simulate_one_particle(state, r, *, t_max=None, kicks=None, kick_angle="unifo
         st, rho, times, np.zeros(times.size) if scatter else angles,
         KICK_ANGLES[kick_angle], 0.0 if mode == 2 else t_max, mode,
         n_steps if n_steps is not None else 0, tau if tau is not None else 0.0,
-        b_cap, angles if scatter else np.zeros((0, 2)), sp, max_events, stall_dt, kinetic,
+        b_cap, angles if scatter else np.zeros((0, 2)), sp, max_events, stall_dt, kinetic, arcs,
     )
     raise_for_status(out[9], st[0], out[0].shape[0], max_events=max_events, name="state",
                      where=f"disk at ({st[1]:.6g}, {st[2]:.6g}), r={r!r}")
     check_kinetic_capacity(kinetic, out[6])
     return one_particle_run(st, r, state, out[:9], sampling=sampling, mode=mode, tau=tau,
                             n_steps=n_steps, seed=seed, kick_angle=kick_angle, sigma=sigma,
-                            times=times, applied=angles, rule=rule, e0=e0, partner=partner)
+                            times=times, applied=angles, rule=rule, e0=e0, partner=partner,
+                            escape_time=float(out[10][0]))
 
 
 def kernel_limits(st, r, sp, scatter, horizon, mode, max_events=None):
@@ -349,7 +355,8 @@ def kernel_limits(st, r, sp, scatter, horizon, mode, max_events=None):
 
 
 def one_particle_run(st, r, state, out, *, sampling, mode, tau, n_steps, seed, kick_angle,
-                     sigma, times, applied, rule, e0, partner) -> OneParticleRun:
+                     sigma, times, applied, rule, e0, partner,
+                     escape_time=math.inf) -> OneParticleRun:
     """The `OneParticleRun` of a finished kicked run: ``out`` is the kernel's
     ``(b_time, b_x, b_y, b_sin, sample_times, samples, n_kicks_applied, t_end,
     kick_log)``, ``st`` its final state, ``applied`` the kick angles (or, for scattering
@@ -370,4 +377,6 @@ def one_particle_run(st, r, state, out, *, sampling, mode, tau, n_steps, seed, k
         e0=e0,
         partner=partner,
         kick_log_array=klog,
+        escape_time=escape_time,
+        escaped=0 if math.isfinite(escape_time) else -1,
     )

@@ -13,6 +13,7 @@ written atomically: a temporary file in the same folder, then ``os.replace``.
 from __future__ import annotations
 
 import json
+import math
 import os
 from dataclasses import dataclass, field, fields
 from functools import cached_property
@@ -74,6 +75,11 @@ class _Run:
     samples: np.ndarray
     seed: int | None = None
     version: str = field(default=__version__)
+    #: the time a disk escaped through a hole of the table (``inf``: it did not, or the
+    #: table has none); the run ends there
+    escape_time: float = math.inf
+    #: the disk that escaped (0 or 1; -1: none)
+    escaped: int = -1
 
     kind: ClassVar[str] = "run"
     _array_fields: ClassVar[tuple[str, ...]] = ()
@@ -101,6 +107,9 @@ class _Run:
         for name in self._scalar_fields:
             value = getattr(self, name)
             out[name] = value.item() if isinstance(value, np.generic) else value
+        if self.escaped >= 0:
+            out["escape_time"] = float(self.escape_time)
+            out["escaped"] = int(self.escaped)
         return out
 
     def _arrays(self) -> dict[str, np.ndarray]:

@@ -66,7 +66,7 @@ def check_two_particle_ic(ic, r: float, rule: str, name: str = "ic") -> np.ndarr
 
 def simulate_two_particle(ic, r, *, t_max=None, rule="mirror", sampling="uniform", n_steps=None,
                           tau=None, track=0, seed=None, max_events=None,
-                          log_collisions=False) -> TwoParticleRun:
+                          log_collisions=False, holes=None) -> TwoParticleRun:
     """Simulate two disks of radius ``r`` in the unit circular table.
 
     Event-driven and exact: the disks move freely between collisions whose times are
@@ -105,6 +105,11 @@ def simulate_two_particle(ic, r, *, t_max=None, rule="mirror", sampling="uniform
     log_collisions : bool
         Also log every disk-disk collision: contact centres and both velocities before
         and after (``run.pp_log``, ``run.collisions`` with the contact normal).
+    holes : array_like, shape (n, 2), optional
+        Holes in the table's wall: rows ``(centre angle, half-width)`` in radians. A disk
+        whose wall contact lies in a hole escapes there: the run ends at that time
+        (``run.escape_time``, ``run.escaped`` the disk; ``inf`` and -1 if none escaped by
+        the end), and its samples stop there.
 
     Returns
     -------
@@ -154,8 +159,9 @@ def simulate_two_particle(ic, r, *, t_max=None, rule="mirror", sampling="uniform
     ic = check_two_particle_ic(ic, r, rule)
     if not isinstance(log_collisions, bool | np.bool_):
         raise TypeError(f"log_collisions must be a bool, got {type(log_collisions).__name__}")
+    arcs = chk.check_holes(holes)
     args = kernel_args(ic, r, rule, mode, t_max, n_steps, tau, track, max_events)
-    out = simulate_two_kernel(*args, bool(log_collisions))
+    out = simulate_two_kernel(*args, bool(log_collisions), arcs)
     return two_particle_run(out, args, r=r, rule=rule, sampling=sampling, tau=tau,
                             n_steps=n_steps, ic=ic, track=track, seed=seed, name="ic")
 
@@ -191,13 +197,14 @@ def two_particle_run(out, args, *, r, rule, sampling, tau, n_steps, ic, track, s
                      name) -> TwoParticleRun:
     """The `TwoParticleRun` of `simulate_two_kernel`'s output ``out`` for ``args``
     (`kernel_args`); raises the ValueError of an early stop, naming the argument ``name``."""
-    pp, bt, bp, bx, by, bs, stimes, samples, t_end, ppl, status = out
+    pp, bt, bp, bx, by, bs, stimes, samples, t_end, ppl, status = out[:11]
+    escape = out[11] if len(out) > 11 else (math.inf, -1.0)
     st, mode, max_events = args[0], args[5], args[11]
     if status != DONE:  # (the message is formatted only when it is needed)
         raise_for_status(status, st[0], pp.shape[0] + bt.shape[0], max_events=max_events,
                          name=name, where=f"disks at ({st[1]:.6g}, {st[2]:.6g}) and "
                                           f"({st[5]:.6g}, {st[6]:.6g}), r={r!r}")
-    if mode == 2 and t_end == 0.0:
+    if mode == 2 and t_end == 0.0 and escape[1] < 0:
         # every paper step was cut short by a collision at t = 0 (fewer than the STALL_EVENTS
         # a stuck state needs to end in the stall error)
         warnings.warn(
@@ -218,5 +225,7 @@ def two_particle_run(out, args, *, r, rule, sampling, tau, n_steps, ic, track, s
         track=track,
         pp_times=pp,
         pp_log=ppl,
+        escape_time=float(escape[0]),
+        escaped=int(escape[1]),
         **sampling_fields(t_end, mode, sampling, tau, n_steps, stimes, samples),
     )

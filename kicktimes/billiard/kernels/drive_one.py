@@ -33,7 +33,7 @@ N_KICKS, N_B, K, SIM_ON, N_KICKS_RUN = range(5)
 
 @njit(cache=True)
 def drive(st, ev, rho, kicks, angles, kick_mode, kick_u, sp, unit_speed, t_end, mode, tau, logs,
-          stimes, samples, cnt, next_s, fin, tan, kinetic):
+          stimes, samples, cnt, next_s, fin, tan, kinetic, holes):
     """Run the event loop from ``st``/``ev``; returns `ob.DONE`, or `ob.FULL` when the boundary
     log is full (see `kicktimes.billiard.kernels.drive_two.drive`).
 
@@ -43,7 +43,8 @@ def drive(st, ev, rho, kicks, angles, kick_mode, kick_u, sp, unit_speed, t_end, 
     state; ``tan = (U, log_scale, tgi, tgf, max_events, n_orth, n_steps)`` or ``None``.
     ``kinetic = (e, rates, l_first, dl)`` or ``None``: kinetic kicks, whose times the loop
     writes into ``kicks`` as it goes: after kick ``i`` the next comes
-    `one.kinetic_delay` later, with the number ``e[i + 1]``.
+    `one.kinetic_delay` later, with the number ``e[i + 1]``. ``holes = (arcs, escape)`` or
+    ``None``: the table's holes, as in `kicktimes.billiard.kernels.drive_two.drive`.
     """
     bt, bx, by, bs, klog = logs
     s = one.load(st, ev)
@@ -78,6 +79,21 @@ def drive(st, ev, rho, kicks, angles, kick_mode, kick_u, sp, unit_speed, t_end, 
                 if mode == 2:
                     t_end = stimes[ns - 1]
                 f = one.fly(s, t_end)
+                fin[0] = t_end
+                fin[1] = f[one.S_X]
+                fin[2] = f[one.S_Y]
+                fin[3] = f[one.S_VX]
+                fin[4] = f[one.S_VY]
+            elif (holes is not None and not is_kick
+                  and ob.in_hole(s[one.S_X] + s[one.S_VX] * dte, s[one.S_Y] + s[one.S_VY] * dte,
+                                 holes[0])):
+                # the disk escapes at this wall contact: the run ends there
+                sim_on = False
+                cnt[N_KICKS_RUN] = ik
+                f = one.advance(s, dte)
+                t_end = f[one.S_T]
+                holes[1][0] = t_end
+                holes[1][1] = 0.0
                 fin[0] = t_end
                 fin[1] = f[one.S_X]
                 fin[2] = f[one.S_Y]
@@ -168,7 +184,7 @@ def drive(st, ev, rho, kicks, angles, kick_mode, kick_u, sp, unit_speed, t_end, 
 
 @njit(cache=True)
 def _run(st, rho, kicks, angles, kick_mode, t_max, mode, n_steps, tau, b_cap, kick_u, sp,
-         max_events, stall_dt, sim, tan, kinetic):
+         max_events, stall_dt, sim, tan, kinetic, holes):
     """Allocate the logs, run `drive` to its end, growing the boundary log when full.
 
     With ``kinetic`` (see `drive`) the first kick's time is set here, from the initial
@@ -197,7 +213,7 @@ def _run(st, rho, kicks, angles, kick_mode, t_max, mode, n_steps, tau, b_cap, ki
     while True:
         loop = drive(st, ev, rho, kicks, angles, kick_mode, kick_u, sp, unit_speed, t_end, mode,
                      tau, (bt, bx, by, bs, klog), stimes, samples, cnt, next_s, fin, tan,
-                     kinetic)
+                     kinetic, holes)
         if loop == ob.DONE:
             break
         # a full boundary log
@@ -220,7 +236,7 @@ def _run(st, rho, kicks, angles, kick_mode, t_max, mode, n_steps, tau, b_cap, ki
 
 @njit(cache=True)
 def simulate_one_kernel(st, rho, kicks, angles, kick_mode, t_max, mode, n_steps, tau, b_cap,
-                        kick_u, sp, max_events, stall_dt, kinetic=None):
+                        kick_u, sp, max_events, stall_dt, kinetic=None, holes=None):
     """Run the kicked one-disk billiard (``mode``: 0 none, 1 uniform, 2 paper sampling).
 
     ``st`` is ``[t, x, y, vx, vy, clock compensation, squared speed]``. Scattering kicks
@@ -230,17 +246,27 @@ def simulate_one_kernel(st, rho, kicks, angles, kick_mode, t_max, mode, n_steps,
     `ob.STALLED`. Returns ``(b_time, b_x, b_y, b_sin, sample_times, samples,
     n_kicks_applied, t_end, kick_log, status)``; ``kick_log`` has one row per applied
     scattering kick (else none). ``kinetic``: kinetic kicks (see `drive`), whose times the
-    run writes into ``kicks``.
+    run writes into ``kicks``. ``holes``: the table's holes (rows ``[centre angle,
+    half-width]``, or ``None``); then an 11th item ``escape = [t, 0]`` (``[inf, -1]``: no
+    escape), and the run ends at the escape.
     """
-    logs, stimes, samples, cnt, fin, _, status = _run(
-        st, rho, kicks, angles, kick_mode, t_max, mode, n_steps, tau, b_cap, kick_u, sp,
-        max_events, stall_dt, True, None, kinetic)
+    escape = np.array([np.inf, -1.0])
+    # (two calls, not a conditional argument: numba compiles the holes out when absent)
+    if holes is None:
+        logs, stimes, samples, cnt, fin, _, status = _run(
+            st, rho, kicks, angles, kick_mode, t_max, mode, n_steps, tau, b_cap, kick_u, sp,
+            max_events, stall_dt, True, None, kinetic, None)
+    else:
+        logs, stimes, samples, cnt, fin, _, status = _run(
+            st, rho, kicks, angles, kick_mode, t_max, mode, n_steps, tau, b_cap, kick_u, sp,
+            max_events, stall_dt, True, None, kinetic, (holes, escape))
     bt, bx, by, bs, klog = logs
     n = cnt[N_B]
     n_applied = cnt[N_KICKS_RUN] if status == ob.DONE else cnt[N_KICKS]
     t_end = fin[0] if status == ob.DONE else (t_max if mode < 2 else np.inf)
-    return (bt[:n], bx[:n], by[:n], bs[:n], stimes, samples, n_applied, t_end, klog[:n_applied],
-            status)
+    k = cnt[K] if escape[1] >= 0.0 else stimes.shape[0]
+    return (bt[:n], bx[:n], by[:n], bs[:n], stimes[:k], samples[:k], n_applied, t_end,
+            klog[:n_applied], status, escape)
 
 
 @njit(cache=True)
@@ -256,7 +282,7 @@ def simulate_tangent_one_kernel(st, rho, kicks, angles, kick_mode, t_max, mode, 
     logs, stimes, samples, cnt, fin, tan, status = _run(
         st, rho, kicks, angles, kick_mode, t_max, mode, n_steps, tau, b_cap, kick_u, sp,
         max_events, stall_dt, True,
-        tg.tangent_state(U, mode, n_steps, tau, max_ev_tan, np.int64(0)), kinetic)
+        tg.tangent_state(U, mode, n_steps, tau, max_ev_tan, np.int64(0)), kinetic, None)
     bt, bx, by, bs, klog = logs
     _, log_scale, tgi, tgf, _, _, _ = tan
     n = cnt[N_B]
@@ -282,7 +308,7 @@ def tangent_one_kernel(st, rho, kicks, angles, kick_mode, mode, n_steps, tau, U,
     """
     tan = tg.tangent_state(U, mode, n_steps, tau, max_events, np.int64(0))
     _run(st, rho, kicks, angles, kick_mode, 0.0, mode, n_steps, tau, 0, kick_u, sp, max_events,
-         0.0, False, tan, kinetic)
+         0.0, False, tan, kinetic, None)
     _, log_scale, tgi, tgf, _, _, _ = tan
     # the state flies on to the end, as the vectors did
     dt = tgf[tg.T_PREV] - st[0]

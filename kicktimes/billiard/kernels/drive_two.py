@@ -46,7 +46,7 @@ N_PP, N_B, K, SIM_ON, N_PP_RUN, CONT_ON, N_B_CONT, CONT_STATUS = range(8)
 
 @njit(cache=True, error_model="numpy")
 def drive(st, ev, phys, t_end, mode, tau, track, logs, stimes, samples, cnt, next_s, fin, tan,
-          cont):
+          cont, holes):
     """Run the event loop from ``st``/``ev``; returns `ob.DONE`, or `ob.FULL` when a log is full.
 
     ``phys = (rho, sigma, rule)``; ``logs = (pp, bt, bp, bx, by, bs, ppl, log_pp)``;
@@ -54,6 +54,10 @@ def drive(st, ev, phys, t_end, mode, tau, track, logs, stimes, samples, cnt, nex
     and ``fin`` (the simulation's final state ``[t_end, x0, .., vy1]``) carry the loop's
     position between calls. ``tan = (U, log_scale, tgi, tgf, max_events, n_orth,
     n_steps)`` or ``None``; ``cont = (t_continue, max_events)`` or ``None``.
+    ``holes = (arcs, escape)`` or ``None``: the table's holes (`observe.in_hole`); a disk
+    whose wall contact lies in one escapes there and the simulation ends, its time and
+    disk written to ``escape = [t, disk]`` (the simulation alone: no tangent, no
+    continuation).
 
     The state lives in a tuple of locals for the whole loop (numba keeps it in registers;
     kept in arrays, every event stored and reloaded it, since numba cannot prove that the
@@ -108,6 +112,19 @@ def drive(st, ev, phys, t_end, mode, tau, track, logs, stimes, samples, cnt, nex
                     # budget counts every event from t = 0, as a run to t_continue's does
                     cont_on = mode == 2 and not t_end >= cont[0]
                     n_b_cont = n_b
+            elif holes is not None and ke != two.PAIR:
+                x, y, vx, vy = two.disk(s, ke)
+                if ob.in_hole(x + vx * dte, y + vy * dte, holes[0]):
+                    # the disk escapes at this wall contact: the run ends there
+                    sim_on = False
+                    cnt[N_PP_RUN] = n_pp
+                    f = two.advance(s, dte)
+                    t_end = f[two.S_T]
+                    holes[1][0] = t_end
+                    holes[1][1] = ke
+                    fin[0] = t_end
+                    fin[1], fin[2], fin[3], fin[4] = two.disk(f, 0)
+                    fin[5], fin[6], fin[7], fin[8] = two.disk(f, 1)
         if tan is not None:
             # the tangent vectors' step ends before the next event
             while tan_on and not t + dte <= tk:
@@ -217,7 +234,7 @@ def drive(st, ev, phys, t_end, mode, tau, track, logs, stimes, samples, cnt, nex
 
 @njit(cache=True, error_model="numpy")
 def _run(st, rho, sigma, rule, t_max, mode, n_steps, tau, track, pp_cap, b_cap, max_events,
-         stall_dt, log_pp, sim, tan, cont):
+         stall_dt, log_pp, sim, tan, cont, holes):
     """Allocate the logs, run `drive` to its end, growing them when full.
 
     ``sim``: record the simulation; ``tan`` (`tg.tangent_state`, or ``None``): carry tangent
@@ -243,7 +260,7 @@ def _run(st, rho, sigma, rule, t_max, mode, n_steps, tau, track, pp_cap, b_cap, 
     while True:
         logs = (pp, bt, bp, bx, by, bs, ppl, log_pp)
         loop = drive(st, ev, phys, t_end, mode, tau, track, logs, stimes, samples, cnt, next_s,
-                     fin, tan, cont)
+                     fin, tan, cont, holes)
         if cnt[SIM_ON] != 0:
             # budget and stalls are checked only here, when a log is full: nothing in the
             # hot loop
@@ -283,7 +300,7 @@ def _run(st, rho, sigma, rule, t_max, mode, n_steps, tau, track, pp_cap, b_cap, 
 
 @njit(cache=True, error_model="numpy")
 def simulate_two_kernel(st, rho, sigma, rule, t_max, mode, n_steps, tau, track, pp_cap, b_cap,
-                        max_events, stall_dt, log_pp=False):
+                        max_events, stall_dt, log_pp=False, holes=None):
     """Run the two-disk billiard, logging every event and sampling the tracked disk.
 
     ``st`` is ``[t, x0, y0, vx0, vy0, x1, y1, vx1, vy1, clock compensation, energy]``.
@@ -295,18 +312,29 @@ def simulate_two_kernel(st, rho, sigma, rule, t_max, mode, n_steps, tau, track, 
     stopped.
 
     Returns ``(pp_times, b_time, b_part, b_x, b_y, b_sin, sample_times, samples, t_end,
-    pp_log, status)``; ``pp_log`` has a row per disk-disk collision if ``log_pp``, else none.
+    pp_log, status, escape)``; ``pp_log`` has a row per disk-disk collision if ``log_pp``,
+    else none. ``holes`` (an array of rows ``[centre angle, half-width]``, or ``None``):
+    the table's holes; ``escape = [t, disk]`` of the first escape (``[inf, -1]``: none),
+    where the run then ends (its samples stop there).
     """
-    logs, stimes, samples, cnt, fin, _, status = _run(
-        st, rho, sigma, rule, t_max, mode, n_steps, tau, track, pp_cap, b_cap, max_events,
-        stall_dt, log_pp, True, None, None)
+    escape = np.array([np.inf, -1.0])
+    # (two calls, not a conditional argument: numba compiles the holes out when absent)
+    if holes is None:
+        logs, stimes, samples, cnt, fin, _, status = _run(
+            st, rho, sigma, rule, t_max, mode, n_steps, tau, track, pp_cap, b_cap, max_events,
+            stall_dt, log_pp, True, None, None, None)
+    else:
+        logs, stimes, samples, cnt, fin, _, status = _run(
+            st, rho, sigma, rule, t_max, mode, n_steps, tau, track, pp_cap, b_cap, max_events,
+            stall_dt, log_pp, True, None, None, (holes, escape))
     pp, bt, bp, bx, by, bs, ppl, _ = logs
     n_pp = cnt[N_PP]
     n_b = cnt[N_B]
     t_end = fin[0] if status == ob.DONE else (t_max if mode < 2 else np.inf)
     # views, not copies: the buffers are at most about twice the size needed
-    return (pp[:n_pp], bt[:n_b], bp[:n_b], bx[:n_b], by[:n_b], bs[:n_b], stimes, samples, t_end,
-            ppl[: n_pp if log_pp else 0], status)
+    k = cnt[K] if escape[1] >= 0.0 else stimes.shape[0]
+    return (pp[:n_pp], bt[:n_b], bp[:n_b], bx[:n_b], by[:n_b], bs[:n_b], stimes[:k], samples[:k],
+            t_end, ppl[: n_pp if log_pp else 0], status, escape)
 
 
 @njit(cache=True, error_model="numpy")
@@ -328,7 +356,7 @@ def simulate_tangent_two_kernel(st, rho, sigma, rule, t_max, mode, n_steps, tau,
     logs, stimes, samples, cnt, fin, tan, status = _run(
         st, rho, sigma, rule, t_max, mode, n_steps, tau, track, pp_cap, b_cap, max_events,
         stall_dt, False, True, tg.tangent_state(U, mode, n_steps, tau, max_ev_tan, np.int64(0)),
-        (t_continue, max_events))
+        (t_continue, max_events), None)
     pp, bt, bp, bx, by, bs, _, _ = logs
     _, log_scale, tgi, tgf, _, _, _ = tan
     n_pp_run = cnt[N_PP_RUN] if status == ob.DONE else cnt[N_PP]
@@ -355,7 +383,7 @@ def tangent_two_kernel(st, rho, sigma, rule, mode, n_steps, tau, U, max_events, 
     """
     tan = tg.tangent_state(U, mode, n_steps, tau, max_events, n_orth)
     _run(st, rho, sigma, rule, 0.0, mode, n_steps, tau, 0, 0, 0, max_events, 0.0, False, False,
-         tan, None)
+         tan, None, None)
     _, log_scale, tgi, tgf, _, _, _ = tan
     # the state flies on to the end, as the vectors did
     dt = tgf[tg.T_PREV] - st[0]

@@ -14,14 +14,16 @@ The observers of a run, shared by the two-disk and the kicked-disk drivers:
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numba import njit
 
 from kicktimes.billiard.checks import STALL_EVENTS
 
 __all__ = ["DONE", "FULL", "OVER_BUDGET", "STALLED", "grow_boundary_log", "grow_rows_to",
-           "grow_to", "new_boundary_log", "new_samples", "sample_at_event", "sample_flight",
-           "stalled"]
+           "grow_to", "in_hole", "new_boundary_log", "new_samples", "sample_at_event",
+           "sample_flight", "stalled"]
 
 # status codes of the event loops
 DONE, FULL, STALLED, OVER_BUDGET = 0, 1, 2, 3
@@ -77,6 +79,20 @@ def stalled(times, n, stall_dt):
     if n < STALL_EVENTS:
         return False
     return times[n - 1] - times[n - STALL_EVENTS] < STALL_EVENTS * stall_dt
+
+
+@njit(cache=True, error_model="numpy")
+def in_hole(x, y, arcs):
+    """True if a wall contact of the centre ``(x, y)`` lies in one of the holes ``arcs``
+    (rows ``[centre angle, half-width]``, radians): the contact point's polar angle is
+    within a half-width of a hole's centre (angles compared on the circle)."""
+    s = math.atan2(y, x)
+    for i in range(arcs.shape[0]):
+        d = s - arcs[i, 0]
+        d -= 2.0 * math.pi * math.floor(d / (2.0 * math.pi) + 0.5)
+        if abs(d) <= arcs[i, 1]:
+            return True
+    return False
 
 
 @njit(cache=True, inline="always", error_model="numpy")
