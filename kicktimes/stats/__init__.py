@@ -29,6 +29,7 @@ from .gof import GofResult, goodness_of_fit
 from .groups import PoissonGroup, poisson_group, pooled_intervals
 from .hazard import HazardTable, interval_hazard
 from .kinetic import conditional_kinetic_rate, mean_kinetic_rate
+from .survival import EscapeTail, escape_survival, fit_escape_tail
 from .mixture import RateMixture, rate_mixture, simulate_cox_times
 from .poisson import TESTS, Intervals, intervals_from_times, test_poisson
 from .renewal import (
@@ -60,6 +61,9 @@ __all__ = [
     "kinetic_rate",
     "conditional_kinetic_rate",
     "mean_kinetic_rate",
+    "escape_survival",
+    "fit_escape_tail",
+    "EscapeTail",
     "hyperexpon",
     "RenewalFit",
     "VuongResult",
