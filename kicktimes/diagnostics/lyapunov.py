@@ -255,7 +255,7 @@ def _start_vectors(variant: str, size: int, offset: int) -> np.ndarray:
 def lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rule="mirror",
              track=0, kicks=None, kick_angles=None, kick_angle="uniform", sigma=1.0, rng=None,
              method="tangent", variant="norm", d0=None, max_defer=10, e0=None,
-             partner="weighted", return_run=False):
+             partner="weighted", return_run=False, holes=None):
     """Finite-time Lyapunov exponent of a two-disk or a kicked one-disk billiard.
 
     Parameters
@@ -301,6 +301,9 @@ def lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rule
         equal, ``seed=None``), from the same single pass of the event loop that carries
         the tangent vectors (no second simulation). Tangent method only: with
         ``method="twin"`` it raises a ValueError.
+    holes : array_like, shape (n, 2), optional
+        Holes in the table's wall (as in `simulate_two_particle`): the exponent is
+        measured up to the escape (``total_time`` the escape time), tangent method only.
 
     Returns
     -------
@@ -365,7 +368,7 @@ def lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rule
         system, r, n_steps=n_steps, tau=tau, sampling=sampling, rule=rule, track=track,
         kicks=kicks, kick_angles=kick_angles, kick_angle=kick_angle, sigma=sigma, rng=rng,
         method=method, variant=variant, d0=d0, max_defer=max_defer, e0=e0, partner=partner,
-        return_run=bool(return_run), t_continue=0.0,
+        return_run=bool(return_run), t_continue=0.0, holes=holes,
     )
     _warn_undefined(res)
     return (res, run) if return_run else res
@@ -390,8 +393,16 @@ def lyapunov_pass(system, r=None, *, t_continue=0.0, **options):
 def _lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rule="mirror",
               track=0, kicks=None, kick_angles=None, kick_angle="uniform", sigma=1.0, rng=None,
               method="tangent", variant="norm", d0=None, max_defer=10, e0=None,
-              partner="weighted", return_run=False, t_continue=0.0):
+              partner="weighted", return_run=False, t_continue=0.0, holes=None):
     """`lyapunov`'s body: ``(result, run or None, pp_times or None)``."""
+    arcs = chk.check_holes(holes)
+    if arcs is not None:
+        if method != "tangent":
+            raise ValueError(f"holes: the FTLE up to an escape needs method='tangent', got "
+                             f"method={method!r}")
+        if t_continue:
+            raise ValueError("holes: a run with holes ends at its escape; it cannot be "
+                             "continued (t_continue)")
     if isinstance(system, TwoParticleRun | OneParticleRun):
         run = system
         if run.sampling is None:
@@ -444,9 +455,10 @@ def _lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rul
         st = np.zeros(11)
         st[1:9] = ic.ravel()
         st[10] = (ic[:, 2:] ** 2).sum()
-        if return_run:
-            return _pass_two(ic, r, rule, sampling, mode, n_steps, tau, track, variant,
-                             max_events, t_continue)
+        if return_run or arcs is not None:
+            res, run, pp = _pass_two(ic, r, rule, sampling, mode, n_steps, tau, track, variant,
+                                     max_events, t_continue, arcs)
+            return (res, run, pp) if return_run else (res, None, None)
         if method == "tangent":
             U = _start_vectors(variant, 8, 4 * track)
             out = tangent_two_kernel(st, rho, sig, chk.RULES[rule], mode, n_steps, tau, U,
@@ -486,10 +498,12 @@ def _lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rul
         kick_u = np.zeros((0, 2))
     if method == "tangent":
         U = _start_vectors(variant, 4, 0)
-        if return_run:
-            return _pass_one(st, state, r, times, angles, kick_u, sp, mode, n_steps, tau, U,
-                             variant, max_events, sampling=sampling, kick_angle=kick_angle,
-                             sigma=sigma, rule=rule, e0=e0, partner=partner, kinetic=kinetic)
+        if return_run or arcs is not None:
+            res, run, _ = _pass_one(st, state, r, times, angles, kick_u, sp, mode, n_steps, tau,
+                                    U, variant, max_events, sampling=sampling,
+                                    kick_angle=kick_angle, sigma=sigma, rule=rule, e0=e0,
+                                    partner=partner, kinetic=kinetic, holes=arcs)
+            return res, (run if return_run else None), None
         out = tangent_one_kernel(st, rho, times, angles, KICK_ANGLES[kick_angle], mode, n_steps,
                                  tau, U, max_events, kick_u, sp, kinetic)
         check_kinetic_capacity(kinetic, out[2])
@@ -504,16 +518,17 @@ def _lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rul
 
 
 def _pass_two(ic, r, rule, sampling, mode, n_steps, tau, track, variant, max_ev_tan,
-              t_continue):
+              t_continue, holes=None):
     """The two-disk run and its tangent FTLE from one pass (`simulate_tangent_two_kernel`)."""
     args = kernel_args(ic, r, rule, mode, n_steps * tau if mode == 1 else None, n_steps, tau,
                        track, None)
     U = _start_vectors(variant, 8, 4 * track)
     (pp, n_pp_run, bt, bp, bx, by, bs, stimes, samples, t_end, status, log_scale, n_resc,
-     n_pert, t_tan, status_tan, status_cont) = simulate_tangent_two_kernel(
-        *args, U, max_ev_tan, t_continue if mode == 2 else 0.0)
+     n_pert, t_tan, status_tan, status_cont, escape) = simulate_tangent_two_kernel(
+        *args, U, max_ev_tan, t_continue if mode == 2 else 0.0, holes)
     # errors in the order of separate calls: the simulation's, the FTLE's, the continuation's
-    out = (pp[:n_pp_run], bt, bp, bx, by, bs, stimes, samples, t_end, np.empty((0, 12)), status)
+    out = (pp[:n_pp_run], bt, bp, bx, by, bs, stimes, samples, t_end, np.empty((0, 12)), status,
+           escape)
     run = two_particle_run(out, args, r=r, rule=rule, sampling=sampling, tau=tau,
                            n_steps=n_steps, ic=ic, track=track, seed=None, name="system")
     horizon = n_steps * tau
@@ -527,7 +542,8 @@ def _pass_two(ic, r, rule, sampling, mode, n_steps, tau, track, variant, max_ev_
 
 
 def _pass_one(st, state, r, times, angles, kick_u, sp, mode, n_steps, tau, U, variant,
-              max_ev_tan, *, sampling, kick_angle, sigma, rule, e0, partner, kinetic=None):
+              max_ev_tan, *, sampling, kick_angle, sigma, rule, e0, partner, kinetic=None,
+              holes=None):
     """The kicked run and its tangent FTLE from one pass (`simulate_tangent_one_kernel`).
 
     The simulation is set up and recorded by `simulate_one_particle`'s own helpers
@@ -538,15 +554,15 @@ def _pass_one(st, state, r, times, angles, kick_u, sp, mode, n_steps, tau, U, va
     rho, max_events, b_cap, stall_dt = kernel_limits(st, r, sp, scatter, horizon, mode)
     out = simulate_tangent_one_kernel(
         st, rho, times, angles, KICK_ANGLES[kick_angle], horizon if mode == 1 else 0.0, mode,
-        n_steps, tau, b_cap, kick_u, sp, max_events, stall_dt, U, max_ev_tan, kinetic)
+        n_steps, tau, b_cap, kick_u, sp, max_events, stall_dt, U, max_ev_tan, kinetic, holes)
     raise_for_status(out[9], st[0], out[0].shape[0], max_events=max_events, name="system",
                      where=f"disk at ({st[1]:.6g}, {st[2]:.6g}), r={r!r}")
     check_kinetic_capacity(kinetic, out[6])
     run = one_particle_run(st, r, state, out[:9], sampling=sampling, mode=mode, tau=tau,
                            n_steps=n_steps, seed=None, kick_angle=kick_angle, sigma=sigma,
                            times=times, applied=kick_u if scatter else angles, rule=rule,
-                           e0=e0, partner=partner)
-    res = _tangent_result(out[10:], U, (0, 1), variant, horizon, max_ev_tan, "the disk")
+                           e0=e0, partner=partner, escape_time=float(out[15][0]))
+    res = _tangent_result(out[10:15], U, (0, 1), variant, horizon, max_ev_tan, "the disk")
     return res, run, None
 
 

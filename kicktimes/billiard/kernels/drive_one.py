@@ -99,6 +99,11 @@ def drive(st, ev, rho, kicks, angles, kick_mode, kick_u, sp, unit_speed, t_end, 
                 fin[2] = f[one.S_Y]
                 fin[3] = f[one.S_VX]
                 fin[4] = f[one.S_VY]
+                if tan is not None and tan_on:
+                    # the tangent vectors end with the run: the FTLE up to the escape
+                    tg.end_step(U, log_scale, t_end - t, n_orth)
+                    t_prev = t_end
+                    tan_on = False
         if tan is not None:
             # the tangent vectors' step ends before the next event
             # (the kicked disk's tangent vectors have one step in mode 1: no Gram-Schmidt,
@@ -272,24 +277,32 @@ def simulate_one_kernel(st, rho, kicks, angles, kick_mode, t_max, mode, n_steps,
 @njit(cache=True)
 def simulate_tangent_one_kernel(st, rho, kicks, angles, kick_mode, t_max, mode, n_steps, tau,
                                 b_cap, kick_u, sp, max_events, stall_dt, U, max_ev_tan,
-                                kinetic=None):
+                                kinetic=None, holes=None):
     """`simulate_one_kernel` and `tangent_one_kernel` in one pass.
 
     Arguments as theirs (``mode`` 1 or 2). Returns ``(b_time, b_x, b_y, b_sin,
     sample_times, samples, n_kicks_applied, t_end, kick_log, status, log_scale, n_rescaled,
     n_kicks_tangent, t_end_tangent, status_tangent)``.
     """
-    logs, stimes, samples, cnt, fin, tan, status = _run(
-        st, rho, kicks, angles, kick_mode, t_max, mode, n_steps, tau, b_cap, kick_u, sp,
-        max_events, stall_dt, True,
-        tg.tangent_state(U, mode, n_steps, tau, max_ev_tan, np.int64(0)), kinetic, None)
+    tan = tg.tangent_state(U, mode, n_steps, tau, max_ev_tan, np.int64(0))
+    escape = np.array([np.inf, -1.0])
+    if holes is None:
+        logs, stimes, samples, cnt, fin, tan, status = _run(
+            st, rho, kicks, angles, kick_mode, t_max, mode, n_steps, tau, b_cap, kick_u, sp,
+            max_events, stall_dt, True, tan, kinetic, None)
+    else:
+        logs, stimes, samples, cnt, fin, tan, status = _run(
+            st, rho, kicks, angles, kick_mode, t_max, mode, n_steps, tau, b_cap, kick_u, sp,
+            max_events, stall_dt, True, tan, kinetic, (holes, escape))
     bt, bx, by, bs, klog = logs
     _, log_scale, tgi, tgf, _, _, _ = tan
     n = cnt[N_B]
     n_applied = cnt[N_KICKS_RUN] if status == ob.DONE else cnt[N_KICKS]
     t_end = fin[0] if status == ob.DONE else (t_max if mode < 2 else np.inf)
-    return (bt[:n], bx[:n], by[:n], bs[:n], stimes, samples, n_applied, t_end, klog[:n_applied],
-            status, log_scale, tgi[tg.N_RESC], tgi[tg.N_PERT], tgf[tg.T_PREV], tgi[tg.TAN_STATUS])
+    k = cnt[K] if escape[1] >= 0.0 else stimes.shape[0]
+    return (bt[:n], bx[:n], by[:n], bs[:n], stimes[:k], samples[:k], n_applied, t_end,
+            klog[:n_applied], status, log_scale, tgi[tg.N_RESC], tgi[tg.N_PERT], tgf[tg.T_PREV],
+            tgi[tg.TAN_STATUS], escape)
 
 
 @njit(cache=True)

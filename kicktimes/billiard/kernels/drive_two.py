@@ -125,6 +125,11 @@ def drive(st, ev, phys, t_end, mode, tau, track, logs, stimes, samples, cnt, nex
                     fin[0] = t_end
                     fin[1], fin[2], fin[3], fin[4] = two.disk(f, 0)
                     fin[5], fin[6], fin[7], fin[8] = two.disk(f, 1)
+                    if tan is not None and tan_on:
+                        # the tangent vectors end with the run: the FTLE up to the escape
+                        tg.end_step(U, log_scale, t_end - t, n_orth)
+                        t_prev = t_end
+                        tan_on = False
         if tan is not None:
             # the tangent vectors' step ends before the next event
             while tan_on and not t + dte <= tk:
@@ -339,7 +344,8 @@ def simulate_two_kernel(st, rho, sigma, rule, t_max, mode, n_steps, tau, track, 
 
 @njit(cache=True, error_model="numpy")
 def simulate_tangent_two_kernel(st, rho, sigma, rule, t_max, mode, n_steps, tau, track, pp_cap,
-                                b_cap, max_events, stall_dt, U, max_ev_tan, t_continue):
+                                b_cap, max_events, stall_dt, U, max_ev_tan, t_continue,
+                                holes=None):
     """`simulate_two_kernel` (without the collision log) and `tangent_two_kernel` in one pass.
 
     The simulation's arguments are `simulate_two_kernel`'s, ``U`` (m, 8) and
@@ -353,18 +359,25 @@ def simulate_tangent_two_kernel(st, rho, sigma, rule, t_max, mode, n_steps, tau,
     status_continuation)``: ``pp_times[:n_pp_run]`` are the run's disk-disk times,
     ``pp_times`` with the continuation's after them.
     """
-    logs, stimes, samples, cnt, fin, tan, status = _run(
-        st, rho, sigma, rule, t_max, mode, n_steps, tau, track, pp_cap, b_cap, max_events,
-        stall_dt, False, True, tg.tangent_state(U, mode, n_steps, tau, max_ev_tan, np.int64(0)),
-        (t_continue, max_events), None)
+    tan = tg.tangent_state(U, mode, n_steps, tau, max_ev_tan, np.int64(0))
+    escape = np.array([np.inf, -1.0])
+    if holes is None:
+        logs, stimes, samples, cnt, fin, tan, status = _run(
+            st, rho, sigma, rule, t_max, mode, n_steps, tau, track, pp_cap, b_cap, max_events,
+            stall_dt, False, True, tan, (t_continue, max_events), None)
+    else:
+        logs, stimes, samples, cnt, fin, tan, status = _run(
+            st, rho, sigma, rule, t_max, mode, n_steps, tau, track, pp_cap, b_cap, max_events,
+            stall_dt, False, True, tan, None, (holes, escape))
     pp, bt, bp, bx, by, bs, _, _ = logs
     _, log_scale, tgi, tgf, _, _, _ = tan
     n_pp_run = cnt[N_PP_RUN] if status == ob.DONE else cnt[N_PP]
     n_b = cnt[N_B]
     t_end = fin[0] if status == ob.DONE else (t_max if mode < 2 else np.inf)
-    return (pp[: cnt[N_PP]], n_pp_run, bt[:n_b], bp[:n_b], bx[:n_b], by[:n_b], bs[:n_b], stimes,
-            samples, t_end, status, log_scale, tgi[tg.N_RESC], tgi[tg.N_PERT], tgf[tg.T_PREV],
-            tgi[tg.TAN_STATUS], cnt[CONT_STATUS])
+    k = cnt[K] if escape[1] >= 0.0 else stimes.shape[0]
+    return (pp[: cnt[N_PP]], n_pp_run, bt[:n_b], bp[:n_b], bx[:n_b], by[:n_b], bs[:n_b],
+            stimes[:k], samples[:k], t_end, status, log_scale, tgi[tg.N_RESC], tgi[tg.N_PERT],
+            tgf[tg.T_PREV], tgi[tg.TAN_STATUS], cnt[CONT_STATUS], escape)
 
 
 @njit(cache=True, error_model="numpy")
