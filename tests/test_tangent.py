@@ -16,6 +16,7 @@ from kicktimes.diagnostics.lyapunov import lyapunov_spectrum
 
 R = 0.05
 RHO, SIG = 1.0 - R, 2.0 * R
+RHO2 = (RHO, RHO)  # the two-disk kernels take the table left to each disk
 
 
 # ---------------------------------------------------------------- helpers: the event maps
@@ -31,7 +32,7 @@ def flow_two(st0, t_end, rule, U=None):
     """State (and tangent vectors) at ``t_end`` through the kernel actually used."""
     st = st0.copy()
     U = np.zeros((1, 8)) if U is None else U.copy()
-    out = tangent_two_kernel(st, RHO, SIG, rule, 1, 1, t_end, U, 10**6, 0)
+    out = tangent_two_kernel(st, RHO2, SIG, rule, 1, 1, t_end, U, 10**6, 0)
     assert out[4] == 0
     return st, U, out
 
@@ -40,9 +41,9 @@ def first_events_two(st0, rule):
     """(kind of the first event, its time, time of the second event)."""
     st = st0.copy()
     ev = np.empty(3)
-    two.init_events(st, ev, RHO, SIG)
+    two.init_events(st, ev, RHO2, SIG)
     k1, t1 = two.next_event(two.load(st, ev))
-    two.process_event(st, ev, k1, RHO, SIG, rule)
+    two.process_event(st, ev, k1, RHO2, SIG, rule)
     _, dt2 = two.next_event(two.load(st, ev))
     return k1, t1, t1 + dt2
 
@@ -341,7 +342,7 @@ def test_one_pass_kernel_carries_every_tangent_vector_as_the_tangent_kernel(mode
     U, U_ref = np.eye(8), np.eye(8)
     out = simulate_tangent_two_kernel(*(a.copy() if isinstance(a, np.ndarray) else a
                                         for a in args), U, 10**6, 0.0)
-    ref = tangent_two_kernel(two_state(ic), RHO, SIG, 1, mode, 600, 0.3, U_ref, 10**6, 0)
+    ref = tangent_two_kernel(two_state(ic), RHO2, SIG, 1, mode, 600, 0.3, U_ref, 10**6, 0)
     assert U.tobytes() == U_ref.tobytes()
     np.testing.assert_array_equal(out[11], ref[0])
     assert out[12:16] == (ref[1], ref[2], ref[3], ref[4])

@@ -9,7 +9,8 @@ import numpy as np
 
 from kicktimes._validation import check_choice, check_int, check_real
 
-__all__ = ["check_choice", "check_holes", "check_int", "check_real", "check_state", "check_inside",
+__all__ = ["check_choice", "check_holes", "check_radii", "check_int", "check_real",
+           "check_state", "check_inside",
            "check_unit_speed", "check_speed", "check_sampling", "event_budget", "stall_time",
            "RULES", "SAMPLINGS", "CONTACT_TOL", "SPEED_RANGE", "TIME_LIMIT", "N_STEPS_MAX",
            "MAX_EVENTS_DEFAULT", "STALL_EVENTS"]
@@ -180,3 +181,17 @@ def check_holes(holes):
     if ((arcs[:, 1] <= 0.0) | (arcs[:, 1] >= np.pi)).any():
         raise ValueError(f"holes: each half-width must lie in (0, pi), got {arcs[:, 1].tolist()}")
     return arcs
+
+
+def check_radii(r):
+    """The two disks' radii ``(r0, r1)`` from ``r``: one radius for equal disks, or a pair
+    for unequal ones, each in ``(0, 0.5)``. Returns ``(r0, r1, r)`` with ``r`` a float for
+    equal disks (given as one number) and the tuple otherwise."""
+    if isinstance(r, tuple | list | np.ndarray) and np.ndim(r) == 1:
+        if len(r) != 2:
+            raise ValueError(f"r must be one radius or a pair (r0, r1), got {len(r)} values")
+        r0 = check_real("r[0]", r[0], low=0.0, high=0.5)
+        r1 = check_real("r[1]", r[1], low=0.0, high=0.5)
+        return r0, r1, (r0, r1)
+    r = check_real("r", r, low=0.0, high=0.5)
+    return r, r, r

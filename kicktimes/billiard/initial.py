@@ -154,13 +154,19 @@ def _uniform_pair(rng, r_max):
     return np.array([c0[0], c1[0]]), np.array([c0[1], c1[1]])
 
 
-def _uniform_ic(rng: np.random.Generator, r_max: float, rule: str) -> np.ndarray:
+def _uniform_ic(rng: np.random.Generator, r_max, rule: str) -> np.ndarray:
     # The invariant (Liouville) measure: the *pair* of centres uniform on the
     # non-overlapping configurations, by joint rejection (redrawing only the second disk
     # would weight configurations by the free area left to it, which is not uniform).
     # Near r_max = 0.5 almost every pair overlaps: after N_TRY draws the pair is drawn
-    # from the same law directly.
-    rho = 1.0 - r_max
+    # from the same law directly. Unequal disks (r_max = (r0, r1)): each centre in its own
+    # disk of radius 1 - r_i, contact at r0 + r1 (rejection only: both radii < 1/3).
+    if isinstance(r_max, tuple):
+        rho = np.array([1.0 - r_max[0], 1.0 - r_max[1]])
+        sigma = r_max[0] + r_max[1]
+    else:
+        rho = 1.0 - r_max
+        sigma = 2.0 * r_max
     out = np.empty((2, 4))
     for _ in range(N_TRY):
         rad = rho * np.sqrt(rng.uniform(size=2))
@@ -168,9 +174,11 @@ def _uniform_ic(rng: np.random.Generator, r_max: float, rule: str) -> np.ndarray
         (c0, s0), (c1, s1) = cos_sin(phi[0]), cos_sin(phi[1])
         x = rad * np.array([c0, c1])
         y = rad * np.array([s0, s1])
-        if math.hypot(x[0] - x[1], y[0] - y[1]) >= 2.0 * r_max:
+        if math.hypot(x[0] - x[1], y[0] - y[1]) >= sigma:
             break
     else:
+        if isinstance(r_max, tuple):
+            raise RuntimeError(f"r_max={r_max!r}: no non-overlapping pair in {N_TRY} draws")
         x, y = _uniform_pair(rng, r_max)
     out[:, 0] = x
     out[:, 1] = y
@@ -196,9 +204,11 @@ def initial_conditions(n, r_max, *, seed=0, method="paper", rule="mirror", start
     ----------
     n : int
         Number of ICs (``>= 1``).
-    r_max : float
+    r_max : float or (float, float)
         The largest disk radius the ensemble will be used with, ``0 < r_max <= 0.5 - 1e-9``.
-        ICs are valid (inside the table, no overlap) for every ``r <= r_max``.
+        ICs are valid (inside the table, no overlap) for every ``r <= r_max``. A tuple
+        ``(r0, r1)`` (with ``method="uniform"``, each at most 1/3): the invariant measure of
+        two disks of those radii.
     seed : int
         Root seed (``>= 0``). The ensemble is a pure function of ``seed``.
     method : {"paper", "uniform"}
@@ -235,8 +245,16 @@ def initial_conditions(n, r_max, *, seed=0, method="paper", rule="mirror", start
     True
     """
     n = chk.check_int("n", n, low=1)
-    r_max = chk.check_real("r_max", r_max, low=0.0, high=0.5)
-    if r_max > R_MAX_IC:
+    if isinstance(r_max, tuple):
+        # unequal disks: the invariant measure of the pair of radii
+        r0, r1, r_max = chk.check_radii(r_max)
+        if method != "uniform" or max(r0, r1) > 1.0 / 3.0:
+            raise ValueError("r_max: a pair of radii (r0, r1) needs method='uniform' and both "
+                             "radii at most 1/3; for the paper's procedure draw at "
+                             "max(r0, r1), which is valid for both disks")
+    else:
+        r_max = chk.check_real("r_max", r_max, low=0.0, high=0.5)
+    if not isinstance(r_max, tuple) and r_max > R_MAX_IC:
         raise ValueError(
             f"r_max must lie in (0.0, {R_MAX_IC!r}], got {r_max!r}: two disks this large "
             "only fit diametrically opposite, against the wall, with no room to move"

@@ -40,15 +40,16 @@ def raise_for_status(status: int, st_time: float, n_events: int, *, max_events: 
         )
 
 
-def check_two_particle_ic(ic, r: float, rule: str, name: str = "ic") -> np.ndarray:
-    """Validate a two-disk initial condition; returns a float64 (2, 4) copy."""
+def check_two_particle_ic(ic, r, rule: str, name: str = "ic") -> np.ndarray:
+    """Validate a two-disk initial condition for radius ``r`` (or radii ``(r0, r1)``);
+    returns a float64 (2, 4) copy."""
     arr = chk.check_state(name, ic, (2, 4))
-    rho = 1.0 - r
+    radii = tuple(r) if isinstance(r, tuple) else (r, r)
     # plain floats: the checks run on every simulator call, and numpy scalars cost ~10x
     rows = arr.tolist()
     for i, (x, y, vx, vy) in enumerate(rows):
         which = "disk 0" if i == 0 else "disk 1"
-        chk.check_inside(name, x, y, rho, r, which)
+        chk.check_inside(name, x, y, 1.0 - radii[i], radii[i], which)
         if rule == "mirror":
             chk.check_unit_speed(name, vx, vy, which)
         else:
@@ -57,9 +58,10 @@ def check_two_particle_ic(ic, r: float, rule: str, name: str = "ic") -> np.ndarr
     if rule != "mirror" and not (vx0 or vy0 or vx1 or vy1):
         raise ValueError(f"{name}: both disks are at rest; give a non-zero velocity")
     gap = math.hypot(x0 - x1, y0 - y1)
-    if gap < 2.0 * r - chk.CONTACT_TOL:
+    sigma = radii[0] + radii[1] if isinstance(r, tuple) else 2.0 * r
+    if gap < sigma - chk.CONTACT_TOL:
         raise ValueError(
-            f"{name}: the disks overlap (centre distance {gap:.15g} < 2 r = {2 * r:.15g})"
+            f"{name}: the disks overlap (centre distance {gap:.15g} < r0 + r1 = {sigma:.15g})"
         )
     return arr
 
@@ -78,8 +80,9 @@ def simulate_two_particle(ic, r, *, t_max=None, rule="mirror", sampling="uniform
     ic : array_like, shape (2, 4)
         Rows ``(x, y, vx, vy)`` of disk 0 and disk 1. Centres must lie in the table
         (``|x| <= 1 - r``) without overlap; speeds must be 1 under the mirror rule.
-    r : float
-        Disk radius, ``0 < r < 0.5``.
+    r : float or (float, float)
+        Disk radius, ``0 < r < 0.5``; or the two disks' radii ``(r0, r1)`` (unequal
+        disks: disk ``i`` keeps its centre in ``|x| <= 1 - r_i``, contact at ``r0 + r1``).
     t_max : float, optional
         End time. With ``n_steps`` and ``tau`` (uniform sampling) it defaults to
         ``n_steps * tau``; it must not be given with ``sampling="paper"``.
@@ -150,7 +153,7 @@ def simulate_two_particle(ic, r, *, t_max=None, rule="mirror", sampling="uniform
     >>> bool((run.pp_times > 0).all() and (run.pp_times <= 200.0).all())
     True
     """
-    r = chk.check_real("r", r, low=0.0, high=0.5)
+    _, _, r = chk.check_radii(r)
     chk.check_choice("rule", rule, chk.RULES)
     t_max, n_steps, tau, mode = chk.check_sampling(t_max, n_steps, tau, sampling)
     track = chk.check_int("track", track, low=0)
@@ -179,7 +182,8 @@ def kernel_args(ic, r, rule, mode, t_max, n_steps, tau, track, max_events) -> tu
     e0 = vx0 * vx0 + vy0 * vy0 + vx1 * vx1 + vy1 * vy1
     st = np.array([0.0, x0, y0, vx0, vy0, x1, y1, vx1, vy1, 0.0, e0])
     horizon = t_max if mode < 2 else n_steps * tau
-    rho = 1.0 - r
+    r0, r1 = r if isinstance(r, tuple) else (r, r)
+    rho = min(1.0 - r0, 1.0 - r1)
     # the largest speed a disk can reach: all the kinetic energy in one disk
     speed = 1.0 if rule == "mirror" else math.sqrt(e0)
     max_events = chk.event_budget(max_events, horizon=horizon,
@@ -187,10 +191,11 @@ def kernel_args(ic, r, rule, mode, t_max, n_steps, tau, track, max_events) -> tu
                                   speed=speed, rho=rho, n_disks=2)
     # capacities are only a first guess: the kernel grows its buffers when needed
     b_cap = int(3.0 * speed * horizon) + 64
-    pp_cap = int(20.0 * r * speed * horizon) + 16
-    return (st, rho, 2.0 * r, chk.RULES[rule], 0.0 if mode == 2 else t_max, mode,
-            n_steps if n_steps is not None else 0, tau if tau is not None else 0.0, track,
-            pp_cap, b_cap, max_events, chk.stall_time(rho, speed))
+    pp_cap = int(10.0 * (r0 + r1) * speed * horizon) + 16
+    sigma = r0 + r1 if isinstance(r, tuple) else 2.0 * r
+    return (st, (1.0 - r0, 1.0 - r1), sigma, chk.RULES[rule], 0.0 if mode == 2 else t_max,
+            mode, n_steps if n_steps is not None else 0, tau if tau is not None else 0.0,
+            track, pp_cap, b_cap, max_events, chk.stall_time(rho, speed))
 
 
 def two_particle_run(out, args, *, r, rule, sampling, tau, n_steps, ic, track, seed,

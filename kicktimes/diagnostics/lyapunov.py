@@ -443,7 +443,7 @@ def _lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rul
     max_events = int(EVENTS_PER_TIME * horizon) + 10**6
     arr = np.asarray(system, dtype=np.float64)
     if arr.shape == (2, 4):
-        r = chk.check_real("r", r, low=0.0, high=0.5)
+        r0, r1, r = chk.check_radii(r)
         chk.check_choice("rule", rule, chk.RULES)
         track = chk.check_int("track", track, low=0)
         if track > 1:
@@ -451,7 +451,7 @@ def _lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rul
         if kicks is not None:
             raise ValueError("kicks apply to a one-disk state (shape (4,)), not to two disks")
         ic = check_two_particle_ic(arr, r, rule, name="system")
-        rho, sig = 1.0 - r, 2.0 * r
+        rho, sig = (1.0 - r0, 1.0 - r1), (r0 + r1 if isinstance(r, tuple) else 2.0 * r)
         st = np.zeros(11)
         st[1:9] = ic.ravel()
         st[10] = (ic[:, 2:] ** 2).sum()
@@ -470,7 +470,7 @@ def _lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rul
         def ok(dx, dy):
             x, y = ic[o, 0] + dx, ic[o, 1] + dy
             other = ic[1 - o]
-            return math.hypot(x, y) <= rho and math.hypot(x - other[0], y - other[1]) >= sig
+            return math.hypot(x, y) <= rho[o] and math.hypot(x - other[0], y - other[1]) >= sig
 
         offsets, measure = _twin_offsets(variant, d0, ok)
         out = ftle_two_kernel(st, rho, sig, chk.RULES[rule], mode, n_steps, tau, track, offsets,
@@ -626,7 +626,7 @@ def lyapunov_spectrum(ic, r, *, t_max, rule="mirror", every=1.0) -> LyapunovSpec
     >>> bool(abs(spec.exponents.sum()) < 1e-6)
     True
     """
-    r = chk.check_real("r", r, low=0.0, high=0.5)
+    r0, r1, r = chk.check_radii(r)
     chk.check_choice("rule", rule, chk.RULES)
     t_max = chk.check_real("t_max", t_max, low=0.0, high=MAX_HORIZON, high_open=False)
     every = chk.check_real("every", every, low=0.0)
@@ -637,7 +637,9 @@ def lyapunov_spectrum(ic, r, *, t_max, rule="mirror", every=1.0) -> LyapunovSpec
     n = max(1, int(math.ceil(t_max / every)))
     max_events = int(EVENTS_PER_TIME * t_max) + 10**6
     U = np.eye(8)
-    out = tangent_two_kernel(st, 1.0 - r, 2.0 * r, chk.RULES[rule], 1, 1, t_max, U, max_events, n)
+    sigma = r0 + r1 if isinstance(r, tuple) else 2.0 * r
+    out = tangent_two_kernel(st, (1.0 - r0, 1.0 - r1), sigma, chk.RULES[rule], 1, 1, t_max, U,
+                             max_events, n)
     _check_status(out[4], t_max, max_events)
     if not np.isfinite(out[0]).all():
         raise ValueError(

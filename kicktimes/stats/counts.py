@@ -56,6 +56,38 @@ def lens_area(d, a):
     return 2 * a**2 * np.arccos(ratio) - 0.5 * d * np.sqrt(np.maximum(4 * a**2 - d**2, 0.0))
 
 
+def lens_area_two(d, a, b):
+    r"""Area of the overlap of two disks of radii ``a`` and ``b`` whose centres are ``d``
+    apart: :math:`a^2 \arccos\frac{d^2 + a^2 - b^2}{2da} + b^2 \arccos\frac{d^2 + b^2 -
+    a^2}{2db} - \frac12\sqrt{(-d+a+b)(d+a-b)(d-a+b)(d+a+b)}` for :math:`|a-b| < d < a+b`,
+    :math:`\pi \min(a, b)^2` for :math:`d \le |a - b|` (one disk inside the other)."""
+    d = np.asarray(d, dtype=float)
+    inside = d <= abs(a - b)
+    dd = np.where(inside, abs(a - b) + 1.0, d)  # (a placeholder where one disk is inside)
+    ca = np.clip((dd * dd + a * a - b * b) / (2 * dd * a), -1.0, 1.0)
+    cb = np.clip((dd * dd + b * b - a * a) / (2 * dd * b), -1.0, 1.0)
+    k = np.maximum((-dd + a + b) * (dd + a - b) * (dd - a + b) * (dd + a + b), 0.0)
+    area = a * a * np.arccos(ca) + b * b * np.arccos(cb) - 0.5 * np.sqrt(k)
+    return np.where(inside, np.pi * min(a, b) ** 2, np.where(d >= a + b, 0.0, area))
+
+
+def _kinetic_rate_unequal(r0, r1, rule):
+    """`kinetic_rate` of two disks of radii ``r0``, ``r1`` (equal masses)."""
+    a, b, sigma = 1.0 - r0, 1.0 - r1, r0 + r1
+    # the configurations with the centres closer than sigma, excluded: the 2-D integral of
+    # L over the distance (smooth on [0, sigma]; a kink at |a - b| < sigma is split off)
+    edges = sorted({0.0, min(abs(a - b), sigma), sigma})
+    excluded = 0.0
+    for lo, hi in zip(edges[:-1], edges[1:], strict=True):
+        if hi > lo:
+            rho = lo + (hi - lo) * 0.5 * (1.0 + _GL_NODES)
+            excluded += 0.5 * (hi - lo) * float(
+                (2 * np.pi * rho * lens_area_two(rho, a, b) * _GL_WEIGHTS).sum())
+    volume = (np.pi * a * a) * (np.pi * b * b) - excluded
+    contact = 2 * np.pi * sigma * float(lens_area_two(sigma, a, b))
+    return contact * _MEAN_APPROACH[rule] / volume
+
+
 def configuration_volume(r):
     r"""Volume of the two-disk configuration space,
     :math:`|Q| = (\pi a^2)^2 - \int_0^{2r} 2\pi\rho L(\rho)\,d\rho` with ``a = 1 - r``
@@ -73,8 +105,9 @@ def kinetic_rate(r, rule="mirror"):
 
     Parameters
     ----------
-    r : float or array_like
-        Disk radius, ``0 < r < 0.5``.
+    r : float or array_like or tuple
+        Disk radius, ``0 < r < 0.5`` (an array: one rate per radius); a *tuple*
+        ``(r0, r1)``: two disks of different radii (equal masses), one rate.
     rule : {"mirror", "elastic"}
         Collision rule, which fixes the velocity measure.
 
@@ -92,7 +125,12 @@ def kinetic_rate(r, rule="mirror"):
     uniform directions) and :math:`4/(3\pi)` for the elastic rule
     (:math:`|v_1|^2 + |v_2|^2 = 2`, uniform on that sphere). For small r the mirror
     rate tends to :math:`16 r / (\pi^2 a^2)`. Because the measure is invariant,
-    :math:`E[N(T)] = \Gamma T` exactly when ICs are drawn from it.
+    :math:`E[N(T)] = \Gamma T` exactly when ICs are drawn from it. Unequal disks, radii
+    :math:`r_0, r_1` (centres in :math:`|x_i| \le a_i = 1 - r_i`, contact at
+    :math:`\sigma = r_0 + r_1`): :math:`\Gamma = 2\pi\sigma\, L(\sigma; a_0, a_1)\,
+    E[(w\cdot n)^-] / |Q|` with :math:`L(d; a_0, a_1)` the overlap of disks of radii
+    :math:`a_0, a_1` at distance :math:`d` (`lens_area_two`) and :math:`|Q| = \pi^2 a_0^2
+    a_1^2 - \int_0^\sigma 2\pi d\, L(d; a_0, a_1)\,dd`.
 
     Examples
     --------
@@ -101,6 +139,14 @@ def kinetic_rate(r, rule="mirror"):
     0.01633
     """
     check_choice("rule", rule, tuple(_MEAN_APPROACH))
+    if isinstance(r, tuple):
+        # two disks of different radii
+        if len(r) != 2:
+            raise ValueError(f"r: a tuple gives the two disks' radii (r0, r1), got {r!r}")
+        radii = as_1d_float("r", np.asarray(r, dtype=float), allow_empty=False)
+        if ((radii <= 0) | (radii >= 0.5)).any():
+            raise ValueError(f"r: each radius must satisfy 0 < r < 0.5, got {r!r}")
+        return _kinetic_rate_unequal(float(radii[0]), float(radii[1]), rule)
     scalar = np.ndim(r) == 0
     if isinstance(r, str | bytes):
         raise TypeError(f"r must be a number or an array of numbers, got {type(r).__name__}")

@@ -49,7 +49,8 @@ def drive(st, ev, phys, t_end, mode, tau, track, logs, stimes, samples, cnt, nex
           cont, holes):
     """Run the event loop from ``st``/``ev``; returns `ob.DONE`, or `ob.FULL` when a log is full.
 
-    ``phys = (rho, sigma, rule)``; ``logs = (pp, bt, bp, bx, by, bs, ppl, log_pp)``;
+    ``phys = (rho, sigma, rule)`` with ``rho = (rho0, rho1)``, one per disk;
+    ``logs = (pp, bt, bp, bx, by, bs, ppl, log_pp)``;
     ``stimes``, ``samples`` the sample buffers; ``cnt``, ``next_s`` (the next sample time)
     and ``fin`` (the simulation's final state ``[t_end, x0, .., vy1]``) carry the loop's
     position between calls. ``tan = (U, log_scale, tgi, tgf, max_events, n_orth,
@@ -209,7 +210,7 @@ def drive(st, ev, phys, t_end, mode, tau, track, logs, stimes, samples, cnt, nex
                     for j in range(m):
                         (U[j, c], U[j, c + 1], U[j, c + 2], U[j, c + 3]) = tg.wall_tangent(
                             U[j, c], U[j, c + 1], U[j, c + 2], U[j, c + 3], x, y, vx, vy, wx,
-                            wy, rho)
+                            wy, rho[0] if ke == 0 else rho[1])
             if sim_on:
                 bt[n_b] = t
                 bp[n_b] = ke

@@ -19,6 +19,10 @@ spacing is ``1e-10``, enough to make disks overlap).
 The array form: ``st = [t, x0, y0, vx0, vy0, x1, y1, vx1, vy1, comp, e0]`` (``e0`` the
 initial kinetic energy, the anchor of the elastic rule) and ``ev = [tb0, tb1, tpp]``.
 
+The disks may differ in size: ``rho = (rho0, rho1) = (1 - r0, 1 - r1)``, the table left
+to each centre, and ``sigma = r0 + r1``, the contact distance (equal disks: ``rho0 = rho1``,
+``sigma = 2 r``, the same arithmetic bit for bit).
+
 An event is ``k`` = 0 or 1 (boundary collision of that disk) or 2 (disk-disk). The
 arithmetic (docs/architecture.md, "The physics, precisely"):
 
@@ -174,7 +178,8 @@ def advance(s, dt):
 @njit(cache=True, inline="always", error_model="numpy")
 def resolve(s, k, rho, sigma, rule, e0):
     """Apply event ``k`` to disks in contact; returns ``(s, sin_theta)`` (the incoming
-    ``sin_theta`` of a boundary collision, 0 for a disk-disk collision)."""
+    ``sin_theta`` of a boundary collision, 0 for a disk-disk collision). ``rho = (rho0,
+    rho1)``: the table left to each disk's centre, ``1 - r_i``; ``sigma = r0 + r1``."""
     t, comp, x0, y0, vx0, vy0, x1, y1, vx1, vy1, tb0, tb1, tpp = s
     sin_theta = 0.0
     if k < PAIR:
@@ -183,15 +188,16 @@ def resolve(s, k, rho, sigma, rule, e0):
             x, y, vx, vy = x0, y0, vx0, vy0
         else:
             x, y, vx, vy = x1, y1, vx1, vy1
-        x, y, vx, vy, tb, sin_theta = wall_event(x, y, vx, vy, rho, rule)
+        x, y, vx, vy, tb, sin_theta = wall_event(x, y, vx, vy, rho[0] if k == 0 else rho[1],
+                                                  rule)
         if k == 0:
             x0, y0, vx0, vy0, tb0 = x, y, vx, vy, tb
         else:
             x1, y1, vx1, vy1, tb1 = x, y, vx, vy, tb
     else:
         vx0, vy0, vx1, vy1 = pair_event(x0, y0, vx0, vy0, x1, y1, vx1, vy1, rule)
-        tb0 = boundary_hit_time(x0, y0, vx0, vy0, rho)
-        tb1 = boundary_hit_time(x1, y1, vx1, vy1, rho)
+        tb0 = boundary_hit_time(x0, y0, vx0, vy0, rho[0])
+        tb1 = boundary_hit_time(x1, y1, vx1, vy1, rho[1])
     if rule != 0:
         vx0, vy0, vx1, vy1 = anchor_energy(vx0, vy0, vx1, vy1, e0)
     # both kinds of event change the pair's relative motion
@@ -216,9 +222,10 @@ def disk(s, i):
 
 @njit(cache=True, inline="always", error_model="numpy")
 def init_events(st, ev, rho, sigma):
-    """Fill ``ev`` with the times from now to the next events of the state ``st``."""
-    ev[0] = boundary_hit_time(st[1], st[2], st[3], st[4], rho)
-    ev[1] = boundary_hit_time(st[5], st[6], st[7], st[8], rho)
+    """Fill ``ev`` with the times from now to the next events of the state ``st``
+    (``rho = (rho0, rho1)``, ``sigma = r0 + r1``)."""
+    ev[0] = boundary_hit_time(st[1], st[2], st[3], st[4], rho[0])
+    ev[1] = boundary_hit_time(st[5], st[6], st[7], st[8], rho[1])
     ev[2] = pair_hit_time(st[1] - st[5], st[2] - st[6], st[3] - st[7], st[4] - st[8], sigma)
 
 
