@@ -46,7 +46,7 @@ def fresh_partner_tangent(st, rho, sigma, n_steps, tau, U):
     before each disk-disk collision. Returns ``(log_scale, t_end)``."""
     m = U.shape[0]
     ev = np.empty(3)
-    two.init_events(st, ev, (rho, rho), sigma)
+    two.init_events(st, ev, (rho, rho, 1.0, 1.0), sigma)
     log_scale = np.zeros(m)
     t_prev = 0.0
     for _ in range(n_steps):
@@ -61,7 +61,7 @@ def fresh_partner_tangent(st, rho, sigma, n_steps, tau, U):
                 U[j, 4] += U[j, 6] * dt
                 U[j, 5] += U[j, 7] * dt
             v0x, v0y, v1x, v1y = st[3], st[4], st[7], st[8]
-            two.process_event(st, ev, ke, (rho, rho), sigma, 0)
+            two.process_event(st, ev, ke, (rho, rho, 1.0, 1.0), sigma, 0)
             if ke == 2:
                 for j in range(m):
                     for i in range(4, 8):

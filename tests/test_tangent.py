@@ -16,7 +16,7 @@ from kicktimes.diagnostics.lyapunov import lyapunov_spectrum
 
 R = 0.05
 RHO, SIG = 1.0 - R, 2.0 * R
-RHO2 = (RHO, RHO)  # the two-disk kernels take the table left to each disk
+RHO2 = (RHO, RHO, 1.0, 1.0)  # the two-disk kernels' table (kernels.two.table)
 
 
 # ---------------------------------------------------------------- helpers: the event maps

@@ -20,7 +20,7 @@ def _invariant_violations(st, r, rule, n_events):
     rho = 1.0 - r
     sigma = 2.0 * r
     ev = np.empty(3)
-    two.init_events(st, ev, (rho, rho), sigma)
+    two.init_events(st, ev, (rho, rho, 1.0, 1.0), sigma)
     e0 = st[3] ** 2 + st[4] ** 2 + st[7] ** 2 + st[8] ** 2
     outside = 0.0
     overlap = 0.0
@@ -29,7 +29,7 @@ def _invariant_violations(st, r, rule, n_events):
     n_pp = 0
     for _ in range(n_events):
         k, _ = two.next_event(two.load(st, ev))
-        two.process_event(st, ev, k, (rho, rho), sigma, rule)
+        two.process_event(st, ev, k, (rho, rho, 1.0, 1.0), sigma, rule)
         n_pp += k == 2
         for i in range(2):
             o = 1 + 4 * i

@@ -70,3 +70,48 @@ def test_bad_radii_are_refused(r, match):
     ic = initial_conditions(1, 0.03, seed=1)[0]
     with pytest.raises(ValueError, match=match):
         simulate_two_particle(ic, r, t_max=10.0)
+
+
+MASSES = (1.0, 3.0)
+
+
+def test_collisions_with_masses_conserve_momentum_and_energy():
+    ic = initial_conditions(1, 0.03, seed=2, method="uniform", rule="elastic")[0]
+    run = simulate_two_particle(ic, 0.03, t_max=3000.0, rule="elastic", masses=MASSES,
+                                log_collisions=True)
+    log, (m0, m1) = run.pp_log, MASSES
+    before = m0 * log[:, 4:6] + m1 * log[:, 6:8]
+    after = m0 * log[:, 8:10] + m1 * log[:, 10:12]
+    energy = m0 * (log[:, 8:10] ** 2).sum(1) + m1 * (log[:, 10:12] ** 2).sum(1)
+    assert run.n_pp > 100 and np.abs(after - before).max() < 1e-13
+    start = m0 * (ic[0, 2:] ** 2).sum() + m1 * (ic[1, 2:] ** 2).sum()
+    assert np.abs(energy - start).max() < 1e-12
+    assert run.masses == (0.5, 1.5)  # normalised to (m0 + m1) / 2 = 1
+
+
+def test_the_mean_count_with_masses_is_the_kinetic_count_with_masses():
+    ics = initial_conditions(2000, RADII, seed=5, method="uniform", rule="elastic",
+                             masses=MASSES)
+    t_max = 1000.0
+    counts = np.array([simulate_two_particle(ic, RADII, t_max=t_max, rule="elastic",
+                                             masses=MASSES).n_pp for ic in ics])
+    gamma = kinetic_rate(RADII, "elastic", masses=MASSES)
+    z = (counts.mean() - gamma * t_max) / (counts.std(ddof=1) / np.sqrt(counts.size))
+    assert abs(z) < 3.5 and gamma > kinetic_rate(RADII, "elastic")
+
+
+def test_the_tangent_ftle_with_masses_agrees_with_a_small_twin():
+    ic = initial_conditions(1, 0.03, seed=2, method="uniform", rule="elastic")[0]
+    kw = {"n_steps": 3000, "tau": 0.3, "rule": "elastic", "masses": MASSES}
+    tangent = lyapunov(ic, RADII, **kw)
+    twin = lyapunov(ic, RADII, method="twin", d0=1e-9, **kw)
+    assert tangent.lam > 0 and twin.lam == pytest.approx(tangent.lam, rel=1e-3)
+
+
+@pytest.mark.parametrize("masses, rule, match", [
+    ((1.0, 2.0), "mirror", "rule='elastic'"), ((1.0, 0.0), "elastic", r"masses\[1\]"),
+    ((1.0,), "elastic", "pair")])
+def test_bad_masses_are_refused(masses, rule, match):
+    ic = initial_conditions(1, 0.03, seed=2, method="uniform", rule=rule)[0]
+    with pytest.raises(ValueError, match=match):
+        simulate_two_particle(ic, 0.03, t_max=10.0, rule=rule, masses=masses)

@@ -9,7 +9,7 @@ import numpy as np
 
 from kicktimes._validation import check_choice, check_int, check_real
 
-__all__ = ["check_choice", "check_holes", "check_radii", "check_int", "check_real",
+__all__ = ["check_choice", "check_holes", "check_masses", "check_radii", "check_int", "check_real",
            "check_state", "check_inside",
            "check_unit_speed", "check_speed", "check_sampling", "event_budget", "stall_time",
            "RULES", "SAMPLINGS", "CONTACT_TOL", "SPEED_RANGE", "TIME_LIMIT", "N_STEPS_MAX",
@@ -195,3 +195,18 @@ def check_radii(r):
         return r0, r1, (r0, r1)
     r = check_real("r", r, low=0.0, high=0.5)
     return r, r, r
+
+
+def check_masses(masses, rule):
+    """The disks' masses ``(m0, m1)`` (positive, finite), or ``None`` (equal masses); only
+    the elastic rule has masses (the mirror rule keeps each speed)."""
+    if masses is None:
+        return None
+    if rule != "elastic":
+        raise ValueError(f"masses apply to rule='elastic' (the mirror rule keeps each disk's "
+                         f"speed), got rule={rule!r}")
+    if isinstance(masses, str | bytes) or np.ndim(masses) != 1 or len(masses) != 2:
+        raise ValueError(f"masses must be a pair (m0, m1), got {masses!r}")
+    m0 = check_real("masses[0]", masses[0], low=0.0)
+    m1 = check_real("masses[1]", masses[1], low=0.0)
+    return (m0, m1)

@@ -154,7 +154,7 @@ def _uniform_pair(rng, r_max):
     return np.array([c0[0], c1[0]]), np.array([c0[1], c1[1]])
 
 
-def _uniform_ic(rng: np.random.Generator, r_max, rule: str) -> np.ndarray:
+def _uniform_ic(rng: np.random.Generator, r_max, rule: str, masses=None) -> np.ndarray:
     # The invariant (Liouville) measure: the *pair* of centres uniform on the
     # non-overlapping configurations, by joint rejection (redrawing only the second disk
     # would weight configurations by the free area left to it, which is not uniform).
@@ -192,12 +192,19 @@ def _uniform_ic(rng: np.random.Generator, r_max, rule: str) -> np.ndarray:
         # BLAS, whose kernels round differently on different CPUs)
         g = rng.standard_normal(4)
         g *= math.sqrt(2.0) / math.sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2] + g[3] * g[3])
+        if masses is not None:
+            # uniform on the ellipsoid m0 |v0|^2 + m1 |v1|^2 = 2, masses normalised to
+            # (m0 + m1) / 2 = 1: v_i = u_i / sqrt(m_i), u uniform on the sphere
+            total = masses[0] + masses[1]
+            g[:2] /= math.sqrt(2.0 * masses[0] / total)
+            g[2:] /= math.sqrt(2.0 * masses[1] / total)
         out[0, 2:] = g[:2]
         out[1, 2:] = g[2:]
     return out
 
 
-def initial_conditions(n, r_max, *, seed=0, method="paper", rule="mirror", start=0) -> np.ndarray:
+def initial_conditions(n, r_max, *, seed=0, method="paper", rule="mirror", start=0,
+                       masses=None) -> np.ndarray:
     """Draw an ensemble of two-disk initial conditions.
 
     Parameters
@@ -223,6 +230,9 @@ def initial_conditions(n, r_max, *, seed=0, method="paper", rule="mirror", start
         Only used by ``method="uniform"``.
     start : int
         Index of the first IC: returns ICs ``start .. start + n - 1`` of the ensemble.
+    masses : (float, float), optional
+        ``method="uniform"``, ``rule="elastic"``: the disks' masses; velocities uniform on
+        ``m0 |v0|^2 + m1 |v1|^2 = 2`` with the masses normalised to ``(m0 + m1) / 2 = 1``.
 
     Notes
     -----
@@ -263,6 +273,9 @@ def initial_conditions(n, r_max, *, seed=0, method="paper", rule="mirror", start
     start = chk.check_int("start", start, low=0)
     chk.check_choice("method", method, METHODS)
     chk.check_choice("rule", rule, chk.RULES)
+    masses = chk.check_masses(masses, rule)
+    if masses is not None and method != "uniform":
+        raise ValueError("masses: the paper's procedure has unit speeds; draw method='uniform'")
     try:
         out = np.empty((n, 2, 4))
     except MemoryError:
@@ -272,5 +285,6 @@ def initial_conditions(n, r_max, *, seed=0, method="paper", rule="mirror", start
         ) from None
     for k in range(n):
         rng = ic_generator(seed, start + k)
-        out[k] = _paper_ic(rng, r_max) if method == "paper" else _uniform_ic(rng, r_max, rule)
+        out[k] = (_paper_ic(rng, r_max) if method == "paper"
+                  else _uniform_ic(rng, r_max, rule, masses))
     return out

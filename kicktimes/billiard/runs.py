@@ -169,6 +169,8 @@ class TwoParticleRun(_Run):
     track: int = 0
     pp_times: np.ndarray = field(default_factory=lambda: np.empty(0))
     pp_log: np.ndarray = field(default_factory=lambda: np.empty((0, 12)))
+    #: the elastic rule's masses, normalised to ``(m0, m1) * 2 / (m0 + m1)`` (None: equal)
+    masses: tuple | None = None
 
     kind = "two_particle"
     _array_fields = ("pp_times", "pp_log")

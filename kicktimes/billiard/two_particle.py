@@ -18,6 +18,7 @@ import numpy as np
 
 from kicktimes.billiard import checks as chk
 from kicktimes.billiard.checks import STALL_EVENTS
+from kicktimes.billiard.kernels import two
 from kicktimes.billiard.kernels.drive_two import simulate_two_kernel
 from kicktimes.billiard.kernels.observe import DONE, OVER_BUDGET, STALLED
 from kicktimes.billiard.runs import BoundaryLog, TwoParticleRun, sampling_fields
@@ -68,7 +69,7 @@ def check_two_particle_ic(ic, r, rule: str, name: str = "ic") -> np.ndarray:
 
 def simulate_two_particle(ic, r, *, t_max=None, rule="mirror", sampling="uniform", n_steps=None,
                           tau=None, track=0, seed=None, max_events=None,
-                          log_collisions=False, holes=None) -> TwoParticleRun:
+                          log_collisions=False, holes=None, masses=None) -> TwoParticleRun:
     """Simulate two disks of radius ``r`` in the unit circular table.
 
     Event-driven and exact: the disks move freely between collisions whose times are
@@ -108,6 +109,9 @@ def simulate_two_particle(ic, r, *, t_max=None, rule="mirror", sampling="uniform
     log_collisions : bool
         Also log every disk-disk collision: contact centres and both velocities before
         and after (``run.pp_log``, ``run.collisions`` with the contact normal).
+    masses : (float, float), optional
+        The disks' masses under the elastic rule (default equal): a collision exchanges
+        momentum, ``v0' = v0 - 2 m1/(m0 + m1) (w.n) n``, ``v1' = v1 + 2 m0/(m0 + m1) (w.n) n``.
     holes : array_like, shape (n, 2), optional
         Holes in the table's wall: rows ``(centre angle, half-width)`` in radians. A disk
         whose wall contact lies in a hole escapes there: the run ends at that time
@@ -159,17 +163,18 @@ def simulate_two_particle(ic, r, *, t_max=None, rule="mirror", sampling="uniform
     track = chk.check_int("track", track, low=0)
     if track > 1:
         raise ValueError(f"track must be 0 or 1, got {track}")
+    masses = chk.check_masses(masses, rule)
     ic = check_two_particle_ic(ic, r, rule)
     if not isinstance(log_collisions, bool | np.bool_):
         raise TypeError(f"log_collisions must be a bool, got {type(log_collisions).__name__}")
     arcs = chk.check_holes(holes)
-    args = kernel_args(ic, r, rule, mode, t_max, n_steps, tau, track, max_events)
+    args = kernel_args(ic, r, rule, mode, t_max, n_steps, tau, track, max_events, masses)
     out = simulate_two_kernel(*args, bool(log_collisions), arcs)
     return two_particle_run(out, args, r=r, rule=rule, sampling=sampling, tau=tau,
                             n_steps=n_steps, ic=ic, track=track, seed=seed, name="ic")
 
 
-def kernel_args(ic, r, rule, mode, t_max, n_steps, tau, track, max_events) -> tuple:
+def kernel_args(ic, r, rule, mode, t_max, n_steps, tau, track, max_events, masses=None) -> tuple:
     """`simulate_two_kernel`'s arguments (all but ``log_pp``) for validated inputs.
 
     ``ic``, ``r``, ``rule``, ``track`` validated, ``(t_max, n_steps, tau, mode)`` from
@@ -178,14 +183,19 @@ def kernel_args(ic, r, rule, mode, t_max, n_steps, tau, track, max_events) -> tu
     simulation.
     """
     x0, y0, vx0, vy0, x1, y1, vx1, vy1 = ic.ravel().tolist()
-    # the initial kinetic energy, summed in this order (numpy's, bits of older runs kept)
-    e0 = vx0 * vx0 + vy0 * vy0 + vx1 * vx1 + vy1 * vy1
+    r0, r1 = r if isinstance(r, tuple) else (r, r)
+    table = two.table(1.0 - r0, 1.0 - r1, *(masses if masses is not None else (1.0, 1.0)))
+    # the initial kinetic energy, summed in this order (numpy's, bits of older runs kept);
+    # with masses, k1 |v0|^2 + k0 |v1|^2, as the kernels' anchor computes it
+    if masses is None:
+        e0 = vx0 * vx0 + vy0 * vy0 + vx1 * vx1 + vy1 * vy1
+    else:
+        e0 = table[3] * (vx0 * vx0 + vy0 * vy0) + table[2] * (vx1 * vx1 + vy1 * vy1)
     st = np.array([0.0, x0, y0, vx0, vy0, x1, y1, vx1, vy1, 0.0, e0])
     horizon = t_max if mode < 2 else n_steps * tau
-    r0, r1 = r if isinstance(r, tuple) else (r, r)
     rho = min(1.0 - r0, 1.0 - r1)
     # the largest speed a disk can reach: all the kinetic energy in one disk
-    speed = 1.0 if rule == "mirror" else math.sqrt(e0)
+    speed = 1.0 if rule == "mirror" else math.sqrt(e0 / min(table[2], table[3]))
     max_events = chk.event_budget(max_events, horizon=horizon,
                                   horizon_name="t_max" if mode < 2 else "n_steps * tau",
                                   speed=speed, rho=rho, n_disks=2)
@@ -193,7 +203,7 @@ def kernel_args(ic, r, rule, mode, t_max, n_steps, tau, track, max_events) -> tu
     b_cap = int(3.0 * speed * horizon) + 64
     pp_cap = int(10.0 * (r0 + r1) * speed * horizon) + 16
     sigma = r0 + r1 if isinstance(r, tuple) else 2.0 * r
-    return (st, (1.0 - r0, 1.0 - r1), sigma, chk.RULES[rule], 0.0 if mode == 2 else t_max,
+    return (st, table, sigma, chk.RULES[rule], 0.0 if mode == 2 else t_max,
             mode, n_steps if n_steps is not None else 0, tau if tau is not None else 0.0,
             track, pp_cap, b_cap, max_events, chk.stall_time(rho, speed))
 
@@ -232,5 +242,6 @@ def two_particle_run(out, args, *, r, rule, sampling, tau, n_steps, ic, track, s
         pp_log=ppl,
         escape_time=float(escape[0]),
         escaped=int(escape[1]),
+        masses=None if args[1][2] == 1.0 == args[1][3] else (args[1][3], args[1][2]),
         **sampling_fields(t_end, mode, sampling, tau, n_steps, stimes, samples),
     )

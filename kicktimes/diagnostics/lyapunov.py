@@ -255,7 +255,7 @@ def _start_vectors(variant: str, size: int, offset: int) -> np.ndarray:
 def lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rule="mirror",
              track=0, kicks=None, kick_angles=None, kick_angle="uniform", sigma=1.0, rng=None,
              method="tangent", variant="norm", d0=None, max_defer=10, e0=None,
-             partner="weighted", return_run=False, holes=None):
+             partner="weighted", return_run=False, holes=None, masses=None):
     """Finite-time Lyapunov exponent of a two-disk or a kicked one-disk billiard.
 
     Parameters
@@ -301,6 +301,8 @@ def lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rule
         equal, ``seed=None``), from the same single pass of the event loop that carries
         the tangent vectors (no second simulation). Tangent method only: with
         ``method="twin"`` it raises a ValueError.
+    masses : (float, float), optional
+        Two disks, elastic rule: their masses (as in `simulate_two_particle`).
     holes : array_like, shape (n, 2), optional
         Holes in the table's wall (as in `simulate_two_particle`): the exponent is
         measured up to the escape (``total_time`` the escape time), tangent method only.
@@ -368,7 +370,7 @@ def lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rule
         system, r, n_steps=n_steps, tau=tau, sampling=sampling, rule=rule, track=track,
         kicks=kicks, kick_angles=kick_angles, kick_angle=kick_angle, sigma=sigma, rng=rng,
         method=method, variant=variant, d0=d0, max_defer=max_defer, e0=e0, partner=partner,
-        return_run=bool(return_run), t_continue=0.0, holes=holes,
+        return_run=bool(return_run), t_continue=0.0, holes=holes, masses=masses,
     )
     _warn_undefined(res)
     return (res, run) if return_run else res
@@ -393,7 +395,8 @@ def lyapunov_pass(system, r=None, *, t_continue=0.0, **options):
 def _lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rule="mirror",
               track=0, kicks=None, kick_angles=None, kick_angle="uniform", sigma=1.0, rng=None,
               method="tangent", variant="norm", d0=None, max_defer=10, e0=None,
-              partner="weighted", return_run=False, t_continue=0.0, holes=None):
+              partner="weighted", return_run=False, t_continue=0.0, holes=None,
+              masses=None):
     """`lyapunov`'s body: ``(result, run or None, pp_times or None)``."""
     arcs = chk.check_holes(holes)
     if arcs is not None:
@@ -451,13 +454,13 @@ def _lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rul
         if kicks is not None:
             raise ValueError("kicks apply to a one-disk state (shape (4,)), not to two disks")
         ic = check_two_particle_ic(arr, r, rule, name="system")
-        rho, sig = (1.0 - r0, 1.0 - r1), (r0 + r1 if isinstance(r, tuple) else 2.0 * r)
-        st = np.zeros(11)
-        st[1:9] = ic.ravel()
-        st[10] = (ic[:, 2:] ** 2).sum()
+        masses = chk.check_masses(masses, rule)
+        # the kernels' table and state, as the simulator sets them up
+        args = kernel_args(ic, r, rule, 1, 1.0, 1, 1.0, 0, None, masses)
+        rho, sig, st = args[1], args[2], args[0]
         if return_run or arcs is not None:
             res, run, pp = _pass_two(ic, r, rule, sampling, mode, n_steps, tau, track, variant,
-                                     max_events, t_continue, arcs)
+                                     max_events, t_continue, arcs, masses)
             return (res, run, pp) if return_run else (res, None, None)
         if method == "tangent":
             U = _start_vectors(variant, 8, 4 * track)
@@ -518,10 +521,10 @@ def _lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rul
 
 
 def _pass_two(ic, r, rule, sampling, mode, n_steps, tau, track, variant, max_ev_tan,
-              t_continue, holes=None):
+              t_continue, holes=None, masses=None):
     """The two-disk run and its tangent FTLE from one pass (`simulate_tangent_two_kernel`)."""
     args = kernel_args(ic, r, rule, mode, n_steps * tau if mode == 1 else None, n_steps, tau,
-                       track, None)
+                       track, None, masses)
     U = _start_vectors(variant, 8, 4 * track)
     (pp, n_pp_run, bt, bp, bx, by, bs, stimes, samples, t_end, status, log_scale, n_resc,
      n_pert, t_tan, status_tan, status_cont, escape) = simulate_tangent_two_kernel(
@@ -638,8 +641,8 @@ def lyapunov_spectrum(ic, r, *, t_max, rule="mirror", every=1.0) -> LyapunovSpec
     max_events = int(EVENTS_PER_TIME * t_max) + 10**6
     U = np.eye(8)
     sigma = r0 + r1 if isinstance(r, tuple) else 2.0 * r
-    out = tangent_two_kernel(st, (1.0 - r0, 1.0 - r1), sigma, chk.RULES[rule], 1, 1, t_max, U,
-                             max_events, n)
+    out = tangent_two_kernel(st, kernel_args(ic, r, rule, 1, 1.0, 1, 1.0, 0, None)[1], sigma,
+                             chk.RULES[rule], 1, 1, t_max, U, max_events, n)
     _check_status(out[4], t_max, max_events)
     if not np.isfinite(out[0]).all():
         raise ValueError(

@@ -100,7 +100,7 @@ def configuration_volume(r):
     return (np.pi * a**2) ** 2 - excluded
 
 
-def kinetic_rate(r, rule="mirror"):
+def kinetic_rate(r, rule="mirror", *, masses=None):
     r"""Disk-disk collision rate of two disks of radius ``r`` under the invariant measure.
 
     Parameters
@@ -110,6 +110,10 @@ def kinetic_rate(r, rule="mirror"):
         ``(r0, r1)``: two disks of different radii (equal masses), one rate.
     rule : {"mirror", "elastic"}
         Collision rule, which fixes the velocity measure.
+    masses : (float, float), optional
+        Elastic rule: the disks' masses, normalised to ``(m0 + m1) / 2 = 1`` (velocities
+        uniform on ``m0 |v0|^2 + m1 |v1|^2 = 2``, as
+        ``initial_conditions(..., masses=...)`` draws them); default equal.
 
     Returns
     -------
@@ -139,6 +143,18 @@ def kinetic_rate(r, rule="mirror"):
     0.01633
     """
     check_choice("rule", rule, tuple(_MEAN_APPROACH))
+    factor = 1.0
+    if masses is not None:
+        if rule != "elastic":
+            raise ValueError(f"masses apply to rule='elastic', got rule={rule!r}")
+        m = as_1d_float("masses", np.asarray(masses, dtype=float), allow_empty=False)
+        if m.size != 2 or (m <= 0).any():
+            raise ValueError(f"masses must be a pair of positive masses, got {masses!r}")
+        m = 2.0 * m / m.sum()
+        # the projection of (sqrt(m0) v0, sqrt(m1) v1), uniform on a 3-sphere of radius
+        # sqrt 2, on two directions is uniform on a disk: E[(w.n)^-] scales with
+        # sqrt((1/m0 + 1/m1) / 2)
+        factor = math.sqrt((1.0 / m[0] + 1.0 / m[1]) / 2.0)
     if isinstance(r, tuple):
         # two disks of different radii
         if len(r) != 2:
@@ -146,7 +162,7 @@ def kinetic_rate(r, rule="mirror"):
         radii = as_1d_float("r", np.asarray(r, dtype=float), allow_empty=False)
         if ((radii <= 0) | (radii >= 0.5)).any():
             raise ValueError(f"r: each radius must satisfy 0 < r < 0.5, got {r!r}")
-        return _kinetic_rate_unequal(float(radii[0]), float(radii[1]), rule)
+        return factor * _kinetic_rate_unequal(float(radii[0]), float(radii[1]), rule)
     scalar = np.ndim(r) == 0
     if isinstance(r, str | bytes):
         raise TypeError(f"r must be a number or an array of numbers, got {type(r).__name__}")
@@ -162,6 +178,7 @@ def kinetic_rate(r, rule="mirror"):
     rate = (
         4 * np.pi * arr * lens_area(2 * arr, a) * _MEAN_APPROACH[rule] / configuration_volume(arr)
     )
+    rate = rate * factor if masses is not None else rate
     return float(rate[0]) if scalar else rate.reshape(np.shape(r))
 
 

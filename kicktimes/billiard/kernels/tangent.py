@@ -82,7 +82,7 @@ def wall_tangent(dqx, dqy, dvx, dvy, x, y, vx, vy, wx, wy, rho):
 
 @njit(cache=True)
 def pair_tangent(a0, a1, a2, a3, b0, b1, b2, b3, x1, y1, x2, y2, v1x, v1y, v2x, v2y,
-                 w1x, w1y, w2x, w2y, rule):
+                 w1x, w1y, w2x, w2y, rule, k0=1.0, k1=1.0):
     """Tangent vector across a disk-disk collision (``a``: disk 1, ``b``: disk 2).
 
     ``a = (dx, dy, dvx, dvy)`` of disk 1, ``b`` of disk 2; ``(x_i, y_i)`` the centres at
@@ -95,7 +95,8 @@ def pair_tangent(a0, a1, a2, a3, b0, b1, b2, b3, x1, y1, x2, y2, v1x, v1y, v2x, 
       ``dv_i' = R dv_i - 2 [(v_i.m) n + (v_i.n) m]``;
     * elastic (``v_1' = v1 - (g.n) n``, ``v_2' = v2 + (g.n) n``):
       ``dv_1' = dv_1 - c n - (g.n) m``, ``dv_2' = dv_2 + c n + (g.n) m`` with
-      ``c = (dv_1 - dv_2).n + g.m``.
+      ``c = (dv_1 - dv_2).n + g.m``; with masses (``v_1' = v1 - k0 (g.n) n``,
+      ``v_2' = v2 + k1 (g.n) n``) the two corrections carry ``k0`` and ``k1``.
     """
     ex = x1 - x2
     ey = y1 - y2
@@ -123,12 +124,18 @@ def pair_tangent(a0, a1, a2, a3, b0, b1, b2, b3, x1, y1, x2, y2, v1x, v1y, v2x, 
         db = 2.0 * (b2 * nx + b3 * ny)
         pb2 = b2 - db * nx - 2.0 * (v2m * nx + v2n * mx)
         pb3 = b3 - db * ny - 2.0 * (v2m * ny + v2n * my)
-    else:
+    elif k0 == 1.0 and k1 == 1.0:
         c = (a2 - b2) * nx + (a3 - b3) * ny + gx * mx + gy * my
         pa2 = a2 - c * nx - gn * mx
         pa3 = a3 - c * ny - gn * my
         pb2 = b2 + c * nx + gn * mx
         pb3 = b3 + c * ny + gn * my
+    else:
+        c = (a2 - b2) * nx + (a3 - b3) * ny + gx * mx + gy * my
+        pa2 = a2 - k0 * (c * nx + gn * mx)
+        pa3 = a3 - k0 * (c * ny + gn * my)
+        pb2 = b2 + k1 * (c * nx + gn * mx)
+        pb3 = b3 + k1 * (c * ny + gn * my)
     return qa0, qa1, pa2, pa3, qb0, qb1, pb2, pb3
 
 

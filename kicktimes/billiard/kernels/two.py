@@ -19,8 +19,9 @@ spacing is ``1e-10``, enough to make disks overlap).
 The array form: ``st = [t, x0, y0, vx0, vy0, x1, y1, vx1, vy1, comp, e0]`` (``e0`` the
 initial kinetic energy, the anchor of the elastic rule) and ``ev = [tb0, tb1, tpp]``.
 
-The disks may differ in size: ``rho = (rho0, rho1) = (1 - r0, 1 - r1)``, the table left
-to each centre, and ``sigma = r0 + r1``, the contact distance (equal disks: ``rho0 = rho1``,
+The disks may differ in size and mass: ``rho = (rho0, rho1, k0, k1)`` (`table`), the room
+left to each centre ``1 - r_i`` and the elastic rule's momentum-exchange factors, and
+``sigma = r0 + r1``, the contact distance (equal disks: ``rho0 = rho1``, ``k0 = k1 = 1``,
 ``sigma = 2 r``, the same arithmetic bit for bit).
 
 An event is ``k`` = 0 or 1 (boundary collision of that disk) or 2 (disk-disk). The
@@ -58,7 +59,7 @@ from kicktimes.billiard.geometry import (
     reflect,
 )
 
-__all__ = ["PAIR", "advance", "anchor_energy", "disk", "init_events", "load", "next_event",
+__all__ = ["PAIR", "table", "advance", "anchor_energy", "disk", "init_events", "load", "next_event",
            "pair_event", "process_event", "process_event_at", "resolve", "step", "store",
            "wall_event"]
 
@@ -115,9 +116,20 @@ def wall_event(x, y, vx, vy, rho, rule):
     return x, y, vx, vy, t_next, sin_theta
 
 
+def table(rho0, rho1, m0=1.0, m1=1.0) -> tuple:
+    """The disks' table ``(rho0, rho1, k0, k1)`` the kernels take as ``rho``: the room
+    left to each centre and the elastic rule's momentum-exchange factors
+    ``k0 = 2 m1 / (m0 + m1)``, ``k1 = 2 m0 / (m0 + m1)`` (1 and 1 for equal masses)."""
+    m0, m1 = float(m0), float(m1)
+    return (float(rho0), float(rho1), 2.0 * m1 / (m0 + m1), 2.0 * m0 / (m0 + m1))
+
+
 @njit(cache=True, error_model="numpy")
-def pair_event(x0, y0, vx0, vy0, x1, y1, vx1, vy1, rule):
-    """Velocities ``(vx0, vy0, vx1, vy1)`` after a disk-disk collision of disks in contact."""
+def pair_event(x0, y0, vx0, vy0, x1, y1, vx1, vy1, rule, k0=1.0, k1=1.0):
+    """Velocities ``(vx0, vy0, vx1, vy1)`` after a disk-disk collision of disks in contact.
+
+    The elastic rule with masses: ``v0' = v0 - k0 (w.n) n``, ``v1' = v1 + k1 (w.n) n``
+    (``k0 = 2 m1 / (m0 + m1)``, ``k1 = 2 m0 / (m0 + m1)``; `table`)."""
     dx = x0 - x1
     dy = y0 - y1
     dd = math.sqrt(dx * dx + dy * dy)
@@ -128,17 +140,24 @@ def pair_event(x0, y0, vx0, vy0, x1, y1, vx1, vy1, rule):
         s1 = 1.5 - 0.5 * (a * a + b * b)
         s2 = 1.5 - 0.5 * (c * c + d * d)
         return a * s1, b * s1, c * s2, d * s2
-    return collide_elastic(vx0, vy0, vx1, vy1, nx, ny)
+    if k0 == 1.0 and k1 == 1.0:
+        return collide_elastic(vx0, vy0, vx1, vy1, nx, ny)
+    p = (vx0 - vx1) * nx + (vy0 - vy1) * ny
+    return vx0 - k0 * p * nx, vy0 - k0 * p * ny, vx1 + k1 * p * nx, vy1 + k1 * p * ny
 
 
 @njit(cache=True, error_model="numpy")
-def anchor_energy(vx0, vy0, vx1, vy1, e0):
+def anchor_energy(vx0, vy0, vx1, vy1, e0, k0=1.0, k1=1.0):
     """The four velocity components rescaled to kinetic energy ``e0`` (one Newton step).
 
     Correcting each event relative to the previous one would let the rounding bias of
-    10^6 events accumulate to 1e-10; anchoring to the initial value does not.
+    10^6 events accumulate to 1e-10; anchoring to the initial value does not. With masses
+    the energy is ``k1 |v0|^2 + k0 |v1|^2`` (proportional to ``m0 |v0|^2 + m1 |v1|^2``).
     """
-    e = vx0 * vx0 + vy0 * vy0 + vx1 * vx1 + vy1 * vy1
+    if k0 == 1.0 and k1 == 1.0:
+        e = vx0 * vx0 + vy0 * vy0 + vx1 * vx1 + vy1 * vy1
+    else:
+        e = k1 * (vx0 * vx0 + vy0 * vy0) + k0 * (vx1 * vx1 + vy1 * vy1)
     f = 1.5 - 0.5 * e / e0
     return vx0 * f, vy0 * f, vx1 * f, vy1 * f
 
@@ -179,7 +198,8 @@ def advance(s, dt):
 def resolve(s, k, rho, sigma, rule, e0):
     """Apply event ``k`` to disks in contact; returns ``(s, sin_theta)`` (the incoming
     ``sin_theta`` of a boundary collision, 0 for a disk-disk collision). ``rho = (rho0,
-    rho1)``: the table left to each disk's centre, ``1 - r_i``; ``sigma = r0 + r1``."""
+    rho1, k0, k1)`` (`table`): the room left to each disk's centre, ``1 - r_i``, and the
+    elastic rule's mass factors; ``sigma = r0 + r1``."""
     t, comp, x0, y0, vx0, vy0, x1, y1, vx1, vy1, tb0, tb1, tpp = s
     sin_theta = 0.0
     if k < PAIR:
@@ -195,11 +215,12 @@ def resolve(s, k, rho, sigma, rule, e0):
         else:
             x1, y1, vx1, vy1, tb1 = x, y, vx, vy, tb
     else:
-        vx0, vy0, vx1, vy1 = pair_event(x0, y0, vx0, vy0, x1, y1, vx1, vy1, rule)
+        vx0, vy0, vx1, vy1 = pair_event(x0, y0, vx0, vy0, x1, y1, vx1, vy1, rule, rho[2],
+                                         rho[3])
         tb0 = boundary_hit_time(x0, y0, vx0, vy0, rho[0])
         tb1 = boundary_hit_time(x1, y1, vx1, vy1, rho[1])
     if rule != 0:
-        vx0, vy0, vx1, vy1 = anchor_energy(vx0, vy0, vx1, vy1, e0)
+        vx0, vy0, vx1, vy1 = anchor_energy(vx0, vy0, vx1, vy1, e0, rho[2], rho[3])
     # both kinds of event change the pair's relative motion
     tpp = pair_hit_time(x0 - x1, y0 - y1, vx0 - vx1, vy0 - vy1, sigma)
     return (t, comp, x0, y0, vx0, vy0, x1, y1, vx1, vy1, tb0, tb1, tpp), sin_theta
