@@ -205,9 +205,10 @@ def test_every_event_loop_has_a_budget(ics):
     st = np.zeros(11)
     st[1:9] = ics[0].ravel()
     st[10] = 2.0
-    out = tangent_two_kernel(st.copy(), (0.97, 0.97, 1.0, 1.0), 0.06, 0, 1, 1000, 0.2, np.eye(8)[[0]], 50, 0)
+    table = (0.97, 0.97, 1.0, 1.0)  # kernels.two.table(0.97, 0.97)
+    out = tangent_two_kernel(st.copy(), table, 0.06, 0, 1, 1000, 0.2, np.eye(8)[[0]], 50, 0)
     assert out[4] == 1
-    out = ftle_two_kernel(st, (0.97, 0.97, 1.0, 1.0), 0.06, 0, 1, 1000, 0.2, 0, np.array([[1e-8, 0.0]]),
+    out = ftle_two_kernel(st, table, 0.06, 0, 1, 1000, 0.2, 0, np.array([[1e-8, 0.0]]),
                           np.array([0]), 1e-8, 10, 50)
     assert out[6] == 1
     with pytest.raises(RuntimeError, match="budget of 50 events"):
