@@ -84,8 +84,8 @@ def compare_with_c(ics, r, tau, n_steps, repeat=15):
     def kernel():
         # the kernel on the wrapper's arguments: what the Python layer costs on top
         for i in range(n_ics):
-            simulate_two_kernel(st0[i].copy(), (rho, rho, 1.0, 1.0), sigma, rule, t_max, mode, n_steps,
-                                tau, 0,
+            simulate_two_kernel(st0[i].copy(), (rho, rho, 1.0, 1.0), sigma, rule, t_max, mode,
+                                n_steps, tau, 0,
                                 int(pp_cap[i]), int(b_cap[i]), int(max_events[i]),
                                 float(stall_dt[i]), False)
 
