@@ -448,7 +448,7 @@ def test_actual_kicks_cover_the_whole_paper_sampled_one_particle_run():
 @pytest.mark.reproducibility
 def test_sweep_results_are_bitwise_those_of_separate_simulation_and_ftle_runs():
     # small experiments (paper setup of both families with every system and diagnostic,
-    # uniform sampling, elastic rule with gaussian kicks): the one-pass sweep
+    # uniform sampling, elastic rule with gaussian kicks, MMPP kicks): the one-pass sweep
     # and separate simulation, FTLE and actual-time continuation calls per trajectory,
     # both computed here, must agree in every bit
     import importlib.util
@@ -458,10 +458,10 @@ def test_sweep_results_are_bitwise_those_of_separate_simulation_and_ftle_runs():
     cases = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(cases)
     separate = cases.tables(one_pass=False)
-    assert len(separate[0]) == 7152 and len(separate[1]) == 24  # with the uniform_ rows
+    assert len(separate[0]) == 8130 and len(separate[1]) == 30  # with the uniform_ rows
     assert set(separate[0]["system"]) == {"two_particle", "poisson", "actual",
                                           "poisson_scatter", "actual_scatter",
-                                          "poisson_kinetic"}
+                                          "poisson_kinetic", "mmpp"}
     assert cases.differences(separate, cases.tables()) == []
 
 

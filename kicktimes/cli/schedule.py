@@ -23,13 +23,31 @@ def _parse_schedule_params(params):
     return parsed
 
 
+def _fitted_mmpp(input_path, params, stationary, window):
+    """A two-state MMPP fitted to the times of ``input_path`` on ``(0, window]`` (the file's
+    ``t_max`` metadata by default), started in its stationary law."""
+    from kicktimes import schedules
+    from kicktimes.stats import fit_mmpp
+
+    if params or stationary:
+        raise click.UsageError("mmpp with --input is fitted to the times: it takes no --param "
+                               "and starts stationary (no --stationary)")
+    times, meta = schedules.read_kick_times(input_path, with_metadata=True)
+    window = window if window is not None else meta.get("t_max")
+    if window is None:
+        raise click.UsageError("mmpp with --input needs --window, the observation window of "
+                               "the input times (the file has no t_max metadata)")
+    return schedules.MMPP.from_fit(fit_mmpp(times, float(window), n_states=2, rng=0))
+
+
 _SCHEDULE_OPTIONS = {"t_max": "--t-max", "seed": "--seed", "window": "--window",
                      "times": "--input", "dist": "--dist", "path": "--output"}
 
 
 @click.command("schedule")
 @click.argument(
-    "model", type=click.Choice(["poisson", "renewal", "bootstrap", "replay", "json"], False)
+    "model",
+    type=click.Choice(["poisson", "renewal", "bootstrap", "replay", "mmpp", "json"], False),
 )
 @click.option(
     "--param",
@@ -37,19 +55,23 @@ _SCHEDULE_OPTIONS = {"t_max": "--t-max", "seed": "--seed", "window": "--window",
     "params",
     multiple=True,
     metavar="NAME=VALUE",
-    help="Model parameter, repeatable: rate=R (poisson); shape names, loc, scale (renewal).",
+    help="Model parameter, repeatable: rate=R (poisson); shape names, loc, scale (renewal); "
+    "rate0, rate1, ... (kick rate of each hidden state), q01, q10, ... (switching rate from "
+    "state i to j) and optionally p0, p1, ... (initial probabilities) (mmpp).",
 )
 @click.option("--dist", help="Interval distribution for renewal: a scipy.stats name, e.g. gamma.")
 @click.option(
     "--stationary/--no-stationary",
     default=False,
-    help="Renewal/bootstrap: first interval from the equilibrium law (stationary from t=0).",
+    help="Renewal/bootstrap: first interval from the equilibrium law (stationary from t=0). "
+    "mmpp starts in the stationary law unless p0, p1, ... are given.",
 )
 @click.option("--input", "input_path", type=click.Path(exists=True, dir_okay=False),
-              help="bootstrap/replay: CSV/Parquet file of event times; json: a schedule JSON file.")
+              help="bootstrap/replay: CSV/Parquet file of event times; mmpp: event times to "
+              "fit a two-state MMPP to (then sampled from the fit); json: a schedule JSON file.")
 @click.option("--window", type=_Real(0.0), default=None,
-              help="replay: observation window of the input times (sampling beyond it is an "
-              "error).")
+              help="replay, mmpp with --input: observation window of the input times "
+              "(default: the file's t_max metadata; replay: sampling beyond it is an error).")
 @click.option("--t-max", "t_max", type=_Real(0.0), required=True, help="Horizon: kicks in (0, T].")
 @click.option(
     "--seed",
@@ -71,7 +93,15 @@ def schedule_command(
       kicktimes schedule renewal --dist gamma -p a=2 -p scale=0.5 --stationary \\
           --t-max 1000 --seed 1 -o kicks.csv
       kicktimes schedule bootstrap --input pp_times.csv --t-max 1000 --seed 2 -o boot.csv
+      kicktimes schedule mmpp -p rate0=0.5 -p rate1=4 -p q01=0.1 -p q10=0.4 \\
+          --t-max 1000 --seed 4 -o clustered.csv
+      kicktimes schedule mmpp --input pp_times.csv --window 5000 --t-max 1000 -o fitted.csv
       kicktimes schedule json --input schedule.json --t-max 1000 --seed 3 -o kicks.csv
+
+    mmpp with --input fits a two-state Markov-modulated Poisson process to the input
+    times (maximum likelihood, kicktimes.stats.fit_mmpp, fit seed 0) and samples kicks
+    from the fit, started in its stationary law; --print-json shows the fitted rates and
+    generator.
     """
     import numpy as np
 
@@ -83,6 +113,8 @@ def schedule_command(
                 raise click.UsageError("model json takes only --input SCHEDULE.json")
             with open(input_path) as fh:
                 schedule = schedules.from_json(fh.read())
+        elif model == "mmpp" and input_path is not None:
+            schedule = _fitted_mmpp(input_path, params, stationary, window)
         else:
             schedule = schedules.from_spec(
                 model,

@@ -27,7 +27,7 @@ from kicktimes._validation import check_choice, check_int, check_real
 __all__ = ["DEFAULT_SYSTEMS", "DIAGNOSTICS", "SYSTEMS", "Experiment"]
 
 SYSTEMS = ("two_particle", "poisson", "actual", "poisson_scatter", "actual_scatter",
-           "poisson_kinetic")
+           "poisson_kinetic", "mmpp")
 #: The paper's systems, run when an experiment names none (scattering kicks are opt-in)
 DEFAULT_SYSTEMS = ("two_particle", "poisson", "actual")
 DIAGNOSTICS = ("lyapunov", "recurrence_rate", "autocorrelation")
@@ -134,13 +134,16 @@ class Experiment:
         deviation of the gaussian rotation (unused for ``"uniform"``).
     systems : sequence of str
         Subset of ``("two_particle", "poisson", "actual", "poisson_scatter",
-        "actual_scatter", "poisson_kinetic")`` whose diagnostics are stored (default the
+        "actual_scatter", "poisson_kinetic", "mmpp")`` whose diagnostics are stored (default the
         first three, the paper's). The two-particle run is always simulated (its collision
         times are stored and drive the others). The ``*_scatter`` systems are kicked at the
         same kinds of times but by scattering kicks (a collision with a virtual partner under
         ``rule``, docs/scatter.md) instead of ``kick_angle``. ``"poisson_kinetic"``: scattering
         kicks at the kinetic rate of the disk's own angular momentum, redrawn after every
-        kick (`kicktimes.schedules.KineticRate`; the mirror rule only).
+        kick (`kicktimes.schedules.KineticRate`; the mirror rule only). ``"mmpp"``: the
+        kicks of ``kick_angle`` at the times of a two-state Markov-modulated Poisson
+        process fitted to the IC's own collision times (`kicktimes.stats.fit_mmpp`;
+        Poisson at the IC's rate when the run has too few collisions for a fit).
     diagnostics : sequence of str
         Subset of ``("lyapunov", "recurrence_rate", "autocorrelation")``.
     block_size : int

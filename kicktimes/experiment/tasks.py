@@ -8,7 +8,9 @@
    ``n_pp / t_max`` of that IC's two-particle run (the paper's per-IC estimate);
 3. the actual-time one-particle billiard, kicked at that run's disk-disk collision times;
 4. optionally (``poisson_scatter``, ``actual_scatter``) the same two kinds of kick times
-   with scattering kicks, a collision with a virtual partner (docs/scatter.md).
+   with scattering kicks, a collision with a virtual partner (docs/scatter.md);
+5. optionally (``mmpp``) the kicks of the Poisson system at the times of a two-state
+   Markov-modulated Poisson process fitted to that IC's collision times (`mmpp_kicks`).
 
 Every random number of (IC, radius, system) comes from its own
 ``SeedSequence(seed, spawn_key=(KICK_DOMAIN, ic, radius bits, system code))``, so the
@@ -41,6 +43,7 @@ __all__ = [
     "kick_law",
     "kick_rng",
     "make_tasks",
+    "mmpp_kicks",
     "run_task",
     "uniform_samples",
 ]
@@ -52,7 +55,13 @@ COLLISION_COLUMNS = ("radius", "ic", "t_window", "n_pp", "pp_times")
 #: families of streams can never coincide (their keys differ in length and content).
 KICK_DOMAIN = 0x6B69636B  # "kick"
 SYSTEM_CODES = {"two_particle": 0, "poisson": 1, "actual": 2, "poisson_scatter": 3,
-                "actual_scatter": 4, "poisson_kinetic": 5}
+                "actual_scatter": 4, "poisson_kinetic": 5, "mmpp": 6}
+#: the fewest disk-disk collisions for an IC's own MMPP-2 fit (4 parameters); fewer, or a
+#: fit that fails, and the ``mmpp`` system is kicked at Poisson times of the IC's rate
+MIN_MMPP_EVENTS = 50
+#: the rows of the ``mmpp`` system that describe its fit (NaN, with the reason, without one)
+MMPP_ROWS = ("mmpp_rate_low", "mmpp_rate_high", "mmpp_switch_low", "mmpp_switch_high",
+             "mmpp_delta_aic")
 
 
 def _radius_key(radius: float) -> int:
@@ -275,7 +284,8 @@ def _run_ic(exp: Experiment, r: float, ic_index: int, ic: np.ndarray, rows, coll
         )
 
     actual_times = None
-    for system in ("poisson", "actual", "poisson_scatter", "actual_scatter", "poisson_kinetic"):
+    for system in ("poisson", "actual", "poisson_scatter", "actual_scatter", "poisson_kinetic",
+                   "mmpp"):
         if system not in exp.systems:
             continue
         kick = kick_law(exp, system, ic)
@@ -294,19 +304,26 @@ def _run_ic(exp: Experiment, r: float, ic_index: int, ic: np.ndarray, rows, coll
                     with timer("simulation_two_particle"):
                         actual_times = _actual_times(exp, ic, r, two)
             kick_times = actual_times
+        extra = ()
+        if system == "mmpp":
+            with timer("mmpp_fit"):
+                schedule, extra = mmpp_kicks(two.pp_times, two.t_max, rng)
         with timer("simulation_one_particle"):
             if system.startswith("poisson"):
                 rate = two.n_pp / two.t_max
                 kick_times = Poisson(rate).sample(horizon, rng)
+                extra = (("kick_rate", rate),)
+            elif system == "mmpp":
+                kick_times = schedule.sample(horizon, rng)
             kick_angles = draw_kick_angles(kick_times.size, kick["kick_angle"], exp.sigma, rng)
         one_kw = {"kicks": kick_times, "kick_angles": kick_angles, **kick, **steps}
-        extra = (("kick_rate", rate),) if system.startswith("poisson") else ()
         _kicked(system, one_kw, one_pass, exp, ic, r, timer, add, diagnose, extra)
 
 
 def _kicked(system, one_kw, one_pass, exp, ic, r, timer, add, diagnose, extra=()):
     """Run the kicked ``system`` with the kicks ``one_kw`` (and its FTLE, in one pass or
-    not), store its counts (``extra`` rows after ``t_max``) and diagnose it."""
+    not), store its counts (``extra`` rows ``(name, value[, note])`` after ``t_max``) and
+    diagnose it."""
     from kicktimes.billiard.one_particle import simulate_one_particle
 
     ftle_method = {"method": exp.lyapunov_method}
@@ -331,11 +348,69 @@ def _kicked(system, one_kw, one_pass, exp, ic, r, timer, add, diagnose, extra=()
                 del kw["rng"]
             return _lyapunov()(ic[0], r, variant=exp.lyapunov_variant, **ftle_method, **kw)
     add(system, "t_max", one.t_max)
-    for name, value in extra:
-        add(system, name, value)
+    for name, value, *note in extra:
+        add(system, name, value, *note)
     add(system, "n_kicks", one.n_kicks)
     add(system, "n_boundary", one.n_boundary)
     diagnose(system, one, ftle)
+
+
+def mmpp_kicks(pp_times, t_window: float, rng: np.random.Generator) -> tuple:
+    """The kick schedule of the ``mmpp`` system of one IC, and its rows.
+
+    A two-state MMPP fitted to the IC's disk-disk collision times on ``(0, t_window]``
+    (`kicktimes.stats.fit_mmpp`, its starts drawn from a child of ``rng``), started in its
+    stationary law (`kicktimes.schedules.MMPP.from_fit`): kicks at the IC's own mean rate,
+    clustered as its collisions are. With fewer than `MIN_MMPP_EVENTS` collisions, or a fit
+    that fails, Poisson kicks at the IC's rate ``n_pp / t_window`` (the ``poisson`` system's
+    law, from this system's stream), and every row's note says so.
+
+    Returns
+    -------
+    schedule : kicktimes.schedules.MMPP or Poisson
+    rows : tuple of (name, value, note)
+        ``kick_rate`` (the schedule's stationary rate), then `MMPP_ROWS`: the low and
+        high rate, the rates of leaving the low and the high state (1 / mean sojourn) and
+        ``AIC(MMPP-2) - AIC(Poisson)`` on the window likelihood (negative: the
+        clustering is supported); NaN with the fallback's reason without a fit.
+    """
+    import warnings
+
+    from kicktimes.schedules import MMPP, Poisson
+
+    times = np.asarray(pp_times, dtype=np.float64)
+    n = times.size
+    rate = n / t_window
+    reason = ""
+    if n < MIN_MMPP_EVENTS:
+        reason = f"{n} collisions, fewer than {MIN_MMPP_EVENTS} for an MMPP-2 fit"
+    else:
+        from kicktimes.stats import FitWarning, fit_mmpp
+
+        try:
+            with warnings.catch_warnings():
+                # a degenerate fit (a state without events, equal rates) is still defined:
+                # it is used, and its warnings go to the rows' note
+                warnings.simplefilter("ignore", FitWarning)
+                fit = fit_mmpp(times, t_window, n_states=2, rng=rng.spawn(1)[0])
+            schedule = MMPP.from_fit(fit)
+            if not (math.isfinite(fit.loglik) and math.isfinite(schedule.stationary_rate)):
+                raise ValueError(f"a non-finite fit (loglik {fit.loglik!r})")
+        except (ValueError, FloatingPointError, np.linalg.LinAlgError) as exc:
+            reason = f"the MMPP-2 fit failed ({exc})"
+    if reason:
+        note = f"Poisson kicks at the IC's rate: {reason}"
+        return Poisson(rate), (("kick_rate", rate, note),
+                               *((name, math.nan, note) for name in MMPP_ROWS))
+    # the Poisson model (MMPP-1) on the same window likelihood: n log(n / T) - n
+    loglik_poisson = n * math.log(rate) - n
+    delta_aic = fit.aic - (2.0 - 2.0 * loglik_poisson)
+    note = "; ".join(fit.warnings)
+    q = fit.generator
+    rows = (("kick_rate", schedule.stationary_rate), ("mmpp_rate_low", fit.rates[0]),
+            ("mmpp_rate_high", fit.rates[-1]), ("mmpp_switch_low", -q[0, 0]),
+            ("mmpp_switch_high", -q[-1, -1]), ("mmpp_delta_aic", delta_aic))
+    return schedule, tuple((name, float(value), note) for name, value in rows)
 
 
 @functools.lru_cache(maxsize=16)

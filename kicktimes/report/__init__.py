@@ -5,12 +5,12 @@ figure redrawn.
 (:func:`kicktimes.experiment.load_store`) and writes into ``out_dir`` a self-contained
 ``report.html`` (figures as base64 PNG, tables as HTML), a PNG and a PDF per figure and a
 CSV per table. The page opens with the *Findings*: one statement per question (Poisson?
-which renewal model? counts against kinetic theory? each kicked system against the
-two-particle system for the FTLE, the off-diagonal recurrence rate, DET and the
-autocorrelation), each with its effect size, 95 % confidence interval and a verdict from a
-printed rule (:mod:`kicktimes.report.effects`), and a banner when the store is below
-paper scale. :func:`write_results` writes the figures and a Markdown findings page (for
-``docs/results/``).
+which renewal model? which model with an MMPP? counts against kinetic theory? each
+kicked system against the two-particle system for the FTLE, the off-diagonal recurrence
+rate, DET and the autocorrelation), each with its effect size, 95 % confidence interval
+and a verdict from a printed rule (:mod:`kicktimes.report.effects`), and a banner when the
+store is below paper scale. :func:`write_results` writes the figures and a Markdown
+findings page (for ``docs/results/``).
 
 One module per section, each holding its computation, figure and text:
 :mod:`~kicktimes.report.trajectories` (Poincaré sections, recurrence plot),
@@ -18,7 +18,8 @@ One module per section, each holding its computation, figure and text:
 :mod:`~kicktimes.report.summary` (generic summaries and the diagnostic-vs-radius figure),
 :mod:`~kicktimes.report.lyapunov`, :mod:`~kicktimes.report.recurrence`,
 :mod:`~kicktimes.report.autocorrelation`, :mod:`~kicktimes.report.poisson`,
-:mod:`~kicktimes.report.renewal`, :mod:`~kicktimes.report.heterogeneity`,
+:mod:`~kicktimes.report.renewal`, :mod:`~kicktimes.report.mmpp` (the Markov-modulated
+Poisson model against Poisson and the renewal models), :mod:`~kicktimes.report.heterogeneity`,
 :mod:`~kicktimes.report.findings`; :mod:`~kicktimes.report.html` writes the page and
 :mod:`~kicktimes.report.pipeline` runs them. See docs/report.md.
 """

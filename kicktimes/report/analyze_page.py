@@ -6,7 +6,9 @@ is), ``findings.md``, one PNG + PDF per figure and one CSV per table. The figure
 sweep report's (Poisson rejection rates, renewal-model comparison, rate heterogeneity),
 drawn against the sequences' group where the report draws against the disk radius (their
 ``x`` and ``xlabel`` arguments): numeric groups at their values, the single group
-``"all"`` of an analysis without ``group`` as one labelled position.
+``"all"`` of an analysis without ``group`` as one labelled position. With an MMPP table
+(`kicktimes.report.mmpp_analysis.analyze_mmpp`, ``kicktimes analyze --mmpp``) the page
+adds the finding "Clustered (MMPP-2)?" and the section of the MMPP-2 fits.
 """
 
 from __future__ import annotations
@@ -99,6 +101,42 @@ def _heterogeneity_section(res, axis):
     return sec
 
 
+def _mmpp_section(res, table, axis):
+    from kicktimes.report.mmpp import MIN_EVENTS, mmpp_comparison
+
+    sec = Section("mmpp", "Clustered events: a Markov-modulated Poisson model (MMPP-2)")
+    sec.text(
+        "A two-state Markov-modulated Poisson process: a hidden Markov chain switches the "
+        "event rate between a low and a high value, so events cluster and successive "
+        "intervals are correlated (no renewal model allows that). Per sequence with "
+        f"{MIN_EVENTS} or more events: the likelihood-ratio test of the MMPP-2 against "
+        "Poisson, calibrated by a parametric bootstrap (kicktimes.stats.mmpp_lr_test; the "
+        "χ² reference fails where the two rates coincide), and the MMPP-2's AIC on the "
+        "renewal fits' likelihood (the events after the first, given it), set against the "
+        "sequence's Poisson and renewal AICs. Rates and switching rates are the "
+        "full-likelihood fit's (stationary start)."
+    )
+    ok = table.dropna(subset=["mmpp_aic"])
+    if len(ok):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            fig = mmpp_comparison(ok, alpha=res.alpha, **axis)
+        sec.figure(
+            "mmpp_comparison",
+            fig,
+            f"(a) Per {axis['xlabel']}: share of tested sequences whose AIC-best model "
+            "(Poisson, renewal models, MMPP-2) is the MMPP-2, where the MMPP-2 beats Poisson "
+            f"by AIC, and where the bootstrap LR test rejects Poisson at α = {res.alpha:g}, "
+            "with 95 % Clopper-Pearson intervals. (b) Fitted low and high rates over the "
+            "sequence's rate n/T; (c) mean time in each state (1/q) in mean intervals T/n; "
+            "medians and quartiles over the sequences where the MMPP-2 beats Poisson.",
+        )
+    else:
+        sec.text(f"No sequence has {MIN_EVENTS} or more events: no MMPP-2 fit.")
+    sec.table("mmpp_per_sequence", table, "MMPP-2 per sequence", show=len(table) <= 40)
+    return sec
+
+
 def _counts_section(res):
     sec = Section("counts", "Counts against the covariates")
     sec.text(
@@ -111,7 +149,7 @@ def _counts_section(res):
     return sec
 
 
-def write_analysis(res, out_dir, *, dpi=150, sources=None, windows=None) -> Path:
+def write_analysis(res, out_dir, *, dpi=150, sources=None, windows=None, mmpp=None) -> Path:
     """Write the report of an analysis: HTML, findings.md, figures and CSV tables.
 
     Parameters
@@ -124,6 +162,9 @@ def write_analysis(res, out_dir, *, dpi=150, sources=None, windows=None) -> Path
         Resolution of the PNG files.
     sources, windows : optional
         The input files, named in the page header.
+    mmpp : pandas.DataFrame, optional
+        `kicktimes.report.mmpp_analysis.analyze_mmpp` of ``res``: adds its finding and
+        section.
 
     Returns
     -------
@@ -133,6 +174,10 @@ def write_analysis(res, out_dir, *, dpi=150, sources=None, windows=None) -> Path
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     fs = res.findings()
+    if mmpp is not None:
+        from kicktimes.report.mmpp_analysis import mmpp_finding
+
+        fs.insert(3, mmpp_finding(res, mmpp))  # after "Which renewal model?"
     # the figures' x axis: the group, named as the analysis names it
     axis = {"x": "group", "xlabel": res.group or "group"}
     secs = [
@@ -140,6 +185,7 @@ def write_analysis(res, out_dir, *, dpi=150, sources=None, windows=None) -> Path
         _data_section(res),
         _poisson_section(res, axis),
         _renewal_section(res, axis),
+        *([_mmpp_section(res, mmpp, axis)] if mmpp is not None else []),
         _heterogeneity_section(res, axis),
         _counts_section(res),
     ]

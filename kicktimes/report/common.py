@@ -79,6 +79,7 @@ class Found:
     poisson_per_ic: object = None  # poisson: per-IC p-values of the headline test
     renewal_best: object = None  # renewal: the AIC-best model of every fitted IC
     renewal_pooled: object = None  # renewal: the comparison of pooled intervals
+    mmpp: object = None  # mmpp: the MMPP-2 against Poisson and renewal, per fitted IC
     effects: list = field(default_factory=list)  # findings: the statements
     controls: object = None  # findings: `kicktimes.report.controls.Controls`
     gaps: object = None  # findings: the gap decomposition (`report.decomposition`)

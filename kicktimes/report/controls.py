@@ -336,7 +336,8 @@ _CONTROL_WORDS = {
     "elastic": "the elastic rule",
 }
 _SHORT = {"poisson": "Poisson", "actual": "actual", "poisson_scatter": "Poisson, scatter",
-          "actual_scatter": "actual, scatter", "poisson_kinetic": "kinetic rate, scatter"}
+          "actual_scatter": "actual, scatter", "poisson_kinetic": "kinetic rate, scatter",
+          "mmpp": "MMPP"}
 
 
 def _ci(row):
@@ -390,8 +391,9 @@ def _stated(rows):
 
 
 def answers(table: pd.DataFrame, poisson_share=None) -> list[str]:
-    """The three sentences that open the results: Poisson? Does the paper's kicked disk
-    reproduce the two-disk chaos (FTLE)? Does any kick?
+    """The sentences that open the results: Poisson? Does the paper's kicked disk
+    reproduce the two-disk chaos (FTLE)? Does any kick? And, with the ``mmpp`` system,
+    does clustering in the kick times bring the kicked disk closer?
 
     ``poisson_share``: ``{family: (share, ci_low, ci_high, alpha)}`` of runs whose collision
     times reject uniformity (the Poisson test), or None.
@@ -432,6 +434,17 @@ def answers(table: pd.DataFrame, poisson_share=None) -> list[str]:
         out.append("**Does any kick?** The scatter kick (a collision with a virtual partner, "
                    "at Poisson, actual or kinetic-rate times) comes closest; FTLE ratio "
                    + "; ".join(other) + ".")
+    clustered = statements(("mmpp",))
+    if clustered:
+        primary = ftle[ftle["control"] == "primary"].set_index(["family", "system"])["estimate"]
+        pairs = [f"{fam}: {primary[fam, 'mmpp']:.2f} against {primary[fam, 'poisson']:.2f}"
+                 for fam in dict.fromkeys(ftle["family"])
+                 if (fam, "mmpp") in primary.index and (fam, "poisson") in primary.index]
+        out.append("**Does clustering in the kick times bring the kicked disk closer?** "
+                   "MMPP kicks (a two-state Markov-modulated Poisson process fitted to each "
+                   "IC's collision times) against Poisson kicks at the same mean rate, FTLE "
+                   "ratio to the two-disk value" + (f" ({'; '.join(pairs)})" if pairs else "")
+                   + ": " + "; ".join(clustered) + ".")
     return out
 
 

@@ -1,7 +1,8 @@
 r"""The Findings: one computed statement per question, with its effect size, 95 % CI and
 verdict, opening the report (and ``docs/results/``).
 
-Questions, in order: are the collision times Poisson; which renewal model; do the counts
+Questions, in order: are the collision times Poisson; which renewal model; which model
+with a Markov-modulated Poisson process (clustered collisions); do the counts
 follow kinetic theory; and, for every kicked system against the two-particle system, the
 FTLE, the off-diagonal recurrence rate and DET at each ε, and the lag-1 autocorrelation
 (whose agreement is built in). Each section module provides its own ``effects(ctx)``;
@@ -10,7 +11,15 @@ this module only gathers them, states the rules and the scale.
 
 from __future__ import annotations
 
-from kicktimes.report import autocorrelation, counts, lyapunov, poisson, recurrence, renewal
+from kicktimes.report import (
+    autocorrelation,
+    counts,
+    lyapunov,
+    mmpp,
+    poisson,
+    recurrence,
+    renewal,
+)
 from kicktimes.report.common import PAPER_SCALE, Section, is_paper_scale
 from kicktimes.report.controls import (
     answers,
@@ -26,7 +35,7 @@ from kicktimes.stats.findings import findings_table
 __all__ = ["collect", "scale_statement", "section", "EFFECT_MODULES", "STATEMENT_COLUMNS"]
 
 #: the modules whose ``effects(ctx)`` make the Findings, in the order of the questions
-EFFECT_MODULES = (poisson, renewal, counts, lyapunov, recurrence, autocorrelation)
+EFFECT_MODULES = (poisson, renewal, mmpp, counts, lyapunov, recurrence, autocorrelation)
 #: the columns of ``findings_statements.csv``: one row per `Effect`
 STATEMENT_COLUMNS = ("question", "system", "quantity", "estimate", "ci_low", "ci_high",
                      "verdict", "method", "rule", "detail")

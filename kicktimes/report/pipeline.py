@@ -60,6 +60,7 @@ def _stages():
         heterogeneity,
         kick_times,
         lyapunov,
+        mmpp,
         poisson,
         recurrence,
         renewal,
@@ -77,6 +78,7 @@ def _stages():
         ("autocorrelation", autocorrelation),
         ("Poisson tests", poisson),
         ("renewal models", renewal),
+        ("MMPP", mmpp),
         ("rate heterogeneity", heterogeneity),
         ("findings", findings),
     )

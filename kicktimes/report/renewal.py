@@ -188,8 +188,12 @@ def sections(ctx):
             continue
         if kind == "null":
             best_rows[-1]["null_best_model"] = table.index[0]
+            best_rows[-1]["null_best_aic"] = float(table["aic"].min())
             continue
-        best_rows.append({**base, "best_model": table.index[0], "note": ""})
+        # the best AIC, on the conditional footing of kicktimes.stats.compare_point_processes:
+        # the MMPP section (report/mmpp.py) sets the MMPP-2 against it
+        best_rows.append({**base, "best_model": table.index[0], "best_aic": float(
+            table["aic"].min()), "note": ""})
         for model, t in table.iterrows():
             per_rows.append(
                 {
@@ -283,20 +287,15 @@ def effects(ctx):
     fitted = best[best["best_model"].notna()]
     if fitted.empty:
         return []
-    from kicktimes.report.poisson import clustered_share
-
-    k, n = int((fitted["best_model"] == "exponential").sum()), len(fitted)
-    # the level: the share a Poisson process would give with the same numbers of
-    # collisions, windows and models (one simulated Poisson twin per fitted IC)
-    level = float((fitted["null_best_model"] == "exponential").mean())
-    lvl_low, lvl_high = clopper_pearson(int((fitted["null_best_model"] == "exponential").sum()), n)
-    flags = fitted.assign(p=np.where(fitted["best_model"] == "exponential", 0.0, 1.0))
-    low, high = clustered_share(flags, "p", 0.5, rng=ctx.rng(7), n_boot=ctx.n_boot)
+    share = calibrated_share(ctx, fitted, fitted["best_model"] == "exponential",
+                             fitted["null_best_model"] == "exponential", rng=ctx.rng(7),
+                             under="under Poisson times")
     verdict = {
         "above": "the exponential is AIC-best more often than under Poisson",
         "below": "the exponential is AIC-best less often than Poisson times would make it",
         "inconclusive": "as often as under Poisson: no evidence against it from AIC",
-    }[share_verdict(low, high, level)]
+    }[share.pop("verdict")]
+    level = share.pop("level")
     others = fitted["best_model"].value_counts()
     detail = ", ".join(f"{m} {c}" for m, c in others.items())
     pooled = ctx.found.renewal_pooled
@@ -310,16 +309,37 @@ def effects(ctx):
             question="Which renewal model?",
             system="",
             quantity="share of fitted ICs whose AIC-best model is the exponential",
-            estimate=k / n,
-            ci_low=low,
-            ci_high=high,
             verdict=verdict,
-            rule=SHARE_RULE.format(level=level) + (
-                f" (level: the share under Poisson times with the same numbers of collisions "
-                f"and windows, by simulation: {level:.3g} [{lvl_low:.3g}, {lvl_high:.3g}])"
-            ),
-            method=f"bootstrap clustered on {fitted['ic'].nunique()} ICs ({n} fits)",
             detail=(f"under Poisson times {pct(level)} of the same fits pick the exponential; "
                     "AIC-best counts: " + detail),
+            **share,
         )
     ]
+
+
+def calibrated_share(ctx, fitted, hit, null_hit, *, rng, under, what="fits") -> dict:
+    """A share of fitted ICs against its level on their Poisson twins, as `Effect` fields.
+
+    ``hit`` / ``null_hit``: booleans per row of ``fitted`` (one row per fitted (radius,
+    IC)), on the data and on the IC's Poisson twin (the same numbers of collisions and
+    windows, fitted the same way: the level a Poisson process would give). Returns
+    ``estimate``, ``ci_low``, ``ci_high`` (bootstrap clustered on ICs), ``rule``,
+    ``method``, and ``level`` and the ``verdict`` key of `share_verdict` for the caller
+    to word.
+    """
+    from kicktimes.report.poisson import clustered_share
+
+    hit, null_hit = np.asarray(hit, bool), np.asarray(null_hit, bool)
+    n = len(fitted)
+    level = float(null_hit.mean())
+    lvl_low, lvl_high = clopper_pearson(int(null_hit.sum()), n)
+    flags = fitted.assign(p=np.where(hit, 0.0, 1.0))
+    low, high = clustered_share(flags, "p", 0.5, rng=rng, n_boot=ctx.n_boot)
+    return {
+        "estimate": int(hit.sum()) / n, "ci_low": low, "ci_high": high,
+        "rule": SHARE_RULE.format(level=level) + (
+            f" (level: the share {under} with the same numbers of collisions and windows, by "
+            f"simulation: {level:.3g} [{lvl_low:.3g}, {lvl_high:.3g}])"),
+        "method": f"bootstrap clustered on {fitted['ic'].nunique()} ICs ({n} {what})",
+        "level": level, "verdict": share_verdict(low, high, level),
+    }

@@ -249,7 +249,11 @@ def comparison_table(summary):
 def sections(ctx):
     """The summary and comparison tables of every diagnostic of the store (CSV only)."""
     results = ctx.results
-    diag = results[~results["diagnostic"].isin(["t_max", "kick_rate"])]
+    # the run's length, its kick rate and the mmpp system's fitted parameters describe the
+    # run: not diagnostics to compare with the two-disk system
+    names = pd.Series(results["diagnostic"].astype(str))
+    drop = names.isin(["t_max", "kick_rate"]) | names.str.startswith("mmpp_")
+    diag = results[~drop.to_numpy()]
     summary = diagnostic_summary(diag)
     comparison = comparison_table(summary)
     ctx.found.summary = summary

@@ -13,6 +13,9 @@ perturbed one-particle billiard (docs/architecture.md, "Perturbed one-particle b
                           the first interval from the equilibrium distribution
 ``Replay(times)``         the actual disk-disk collision times, ``Replay.from_run(run)``
 ``Bootstrap(intervals)``  IID resampling of observed intervals, ``Bootstrap.from_run(run)``
+``MMPP(rates, generator)`` Markov-modulated Poisson: a hidden Markov chain switches the
+                          rate; ``MMPP.from_fit(fit)`` of a ``kicktimes.stats.fit_mmpp``
+                          result, stationary from ``t = 0`` by default
 ========================  ===============================================================
 
 ``KineticRate(r)`` is the state-dependent kick law: not a schedule, since each interval
@@ -52,6 +55,7 @@ from kicktimes.schedules._base import (
 from kicktimes.schedules._distributions import resolve_distribution
 from kicktimes.schedules._io import read_kick_times, write_kick_times
 from kicktimes.schedules._kinetic import KineticRate
+from kicktimes.schedules._mmpp import MMPP
 from kicktimes.schedules._specs import from_spec
 from kicktimes.schedules._validate import DEFAULT_MAX_KICKS
 
@@ -59,6 +63,7 @@ __all__ = [
     "DEFAULT_MAX_KICKS",
     "Bootstrap",
     "KineticRate",
+    "MMPP",
     "Poisson",
     "Renewal",
     "Replay",

@@ -483,6 +483,12 @@ class Bootstrap(Schedule):
 _TYPES = {cls._type: cls for cls in (Poisson, Renewal, Replay, Bootstrap)}
 
 
+def _register(cls):
+    """Add a schedule class defined in another module (``MMPP``) to the JSON registry."""
+    _TYPES[cls._type] = cls
+    return cls
+
+
 # --------------------------------------------------------------------------------- JSON
 def _loads(s):
     if not isinstance(s, (str, bytes, bytearray)):

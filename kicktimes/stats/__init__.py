@@ -14,7 +14,12 @@ It takes event times and observation windows only (no billiard knowledge):
   angular momenta (:func:`conditional_kinetic_rate`, :func:`mean_kinetic_rate`);
 * the hazard of intervals against the time since the last event and the rate-mixture
   (Cox) processes that explain a falling one (:func:`interval_hazard`,
-  :func:`rate_mixture`, :func:`simulate_cox_times`).
+  :func:`rate_mixture`, :func:`simulate_cox_times`);
+* Markov-modulated Poisson processes over censored windows: the EM fit and simulation
+  (:func:`fit_mmpp`, :func:`simulate_mmpp`), the comparison with Poisson and renewal
+  models on one likelihood (:func:`compare_point_processes`), the bootstrap
+  likelihood-ratio test against Poisson (:func:`mmpp_lr_test`) and time-rescaling
+  residuals (:func:`mmpp_residuals`).
 
 See ``docs/statistics.md`` for the conventions.
 """
@@ -29,8 +34,10 @@ from .gof import GofResult, goodness_of_fit
 from .groups import PoissonGroup, poisson_group, pooled_intervals
 from .hazard import HazardTable, interval_hazard
 from .kinetic import conditional_kinetic_rate, mean_kinetic_rate
-from .survival import EscapeTail, escape_survival, fit_escape_tail
 from .mixture import RateMixture, rate_mixture, simulate_cox_times
+from .mmpp import MMPPFit, fit_mmpp
+from .mmpp_choice import MMPPLRTest, compare_point_processes, mmpp_lr_test
+from .mmpp_simulation import simulate_mmpp
 from .poisson import TESTS, Intervals, intervals_from_times, test_poisson
 from .renewal import (
     FULL_SAMPLE_MODELS,
@@ -40,6 +47,8 @@ from .renewal import (
     RenewalFit,
     fit_renewal,
 )
+from .rescaling import RescaledTimes, mmpp_residuals
+from .survival import EscapeTail, escape_survival, fit_escape_tail
 
 __all__ = [
     "MODELS",
@@ -81,4 +90,12 @@ __all__ = [
     "rate_mixture",
     "RateMixture",
     "simulate_cox_times",
+    "fit_mmpp",
+    "MMPPFit",
+    "simulate_mmpp",
+    "compare_point_processes",
+    "mmpp_lr_test",
+    "MMPPLRTest",
+    "mmpp_residuals",
+    "RescaledTimes",
 ]

@@ -18,8 +18,9 @@ import pandas as pd
 
 def experiments():
     """Small experiments: the paper's setup (paper sampling and variant, every system and
-    diagnostic) for both quick families, uniform sampling with the norm variant, and the
-    elastic rule with gaussian kicks (without the kinetic-rate kicks, mirror rule only)."""
+    diagnostic) for both quick families, uniform sampling with the norm variant, the
+    elastic rule with gaussian kicks (without the kinetic-rate kicks, mirror rule only),
+    and the MMPP kicks at radii large enough for the IC's own fit (50+ collisions)."""
     from kicktimes.experiment import preset
 
     def small(family, **kw):
@@ -34,6 +35,9 @@ def experiments():
               lyapunov_variant="norm"),
         small("quick_b", name="elastic", n_steps=600, rule="elastic", kick_angle="gaussian",
               sigma=0.5, systems=[s for s in preset("quick_b").systems if s != "poisson_kinetic"]),
+        dataclasses.replace(preset("quick_a"), name="mmpp", radii=[0.1, 0.2], n_ics=3,
+                            block_size=3, n_steps=1500, systems=["two_particle", "poisson",
+                                                                 "mmpp"]),
     ]
 
 

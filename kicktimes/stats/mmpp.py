@@ -1,0 +1,408 @@
+r"""Markov-modulated Poisson processes (MMPP): maximum-likelihood fit by EM over many
+censored windows, the fitted model, and simulation.
+
+A hidden continuous-time Markov chain on ``n`` states with generator ``Q`` switches the
+rate of a Poisson process between ``rates[0] < ... < rates[n-1]``. Observed are event
+times ``0 < t_1 < ... < t_N <= T`` in each window ``[0, T]``; each window starts from the
+stationary law ``pi`` of ``Q`` (``initial="stationary"``, default) or from one
+distribution common to all windows, estimated (``initial="free"``). With
+``D = Q - diag(rates)``, ``x_k = t_k - t_{k-1}`` (``t_0 = 0``) the exact likelihood of a
+window, the right end censored, is
+
+.. math::
+
+    L = \alpha\, e^{D x_1} \Lambda\, e^{D x_2} \Lambda \cdots e^{D x_N} \Lambda\,
+        e^{D (T - t_N)} \mathbf 1, \qquad \Lambda = \mathrm{diag}(\text{rates}),
+
+the last factor being the probability of no event from the last event to the window's
+end. The model, the likelihood, the EM and its checks: ``docs/mmpp.md``.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from dataclasses import dataclass
+
+import numpy as np
+
+from . import _mmpp_em as em
+from ._checks import as_1d_float, check_choice, check_int, check_real, check_rng, check_times
+from .mmpp_simulation import simulate_mmpp
+from .poisson import _is_ensemble
+from .renewal import FitWarning
+
+INITIAL = ("stationary", "free")
+MAX_STATES = 4
+# Multi-start: every start runs _SCREEN_ITER EM iterations (to a relative tolerance of
+# _SCREEN_TOL) on about _SCREEN_INTERVALS intervals (whole windows drawn at random, all of
+# them for smaller data); the _FINALISTS best continue on all the data.
+_SCREEN_INTERVALS, _SCREEN_ITER, _SCREEN_TOL, _FINALISTS = 20_000, 25, 1e-6, 2
+
+
+def check_windows(times, t_max):
+    """Validated ``(list of event-time arrays, array of window lengths)``: one window (a
+    1-D array) or a list of windows, ``t_max`` one length or one per window."""
+    if isinstance(times, np.ndarray) and times.dtype != object and times.ndim != 1:
+        raise TypeError(f"times must be a 1-D array (one window) or a list of 1-D arrays "
+                        f"(one per window), got an array of shape {times.shape}")
+    several = _is_ensemble(times)
+    seqs = list(times) if several else [times]
+    if np.ndim(t_max) == 0:
+        lengths = np.full(len(seqs), check_real("t_max", t_max, low=0.0))
+    else:
+        lengths = np.array([check_real(f"t_max[{i}]", v, low=0.0) for i, v in enumerate(t_max)])
+        if lengths.size != len(seqs):
+            raise ValueError(f"t_max must be a number or hold one length per window "
+                             f"({len(seqs)}), got {lengths.size}")
+    out = []
+    for i, (seq, length) in enumerate(zip(seqs, lengths, strict=True)):
+        name = f"times[{i}]" if several else "times"
+        t = as_1d_float(name, seq)
+        outside = (t < 0) | (t > length)
+        if outside.any():
+            j = int(np.flatnonzero(outside)[0])
+            raise ValueError(f"{name} must lie in [0, t_max] = [0, {float(length)!r}], got "
+                             f"{name}[{j}] = {float(t[j])!r}")
+        out.append(check_times(name, t, float(length)))
+    return out, lengths
+
+
+@dataclass(frozen=True, repr=False)
+class MMPPFit:
+    r"""A fitted Markov-modulated Poisson process (result of :func:`fit_mmpp`).
+
+    Attributes
+    ----------
+    rates : ndarray, shape (n,)
+        Event rate in each state, ascending (per unit of time of the data).
+    generator : ndarray, shape (n, n)
+        The hidden chain's generator ``Q``: ``Q[i, j]`` (``i != j``) is the switching
+        rate from state ``i`` to ``j``; rows sum to 0.
+    stationary : ndarray, shape (n,)
+        The stationary law ``pi`` of ``Q``.
+    initial : ndarray, shape (n,)
+        The state law at each window's start (``stationary`` unless
+        ``initial_method == "free"``).
+    loglik : float
+        Exact log-likelihood of all windows (censored ends included).
+    rates_se, generator_se : ndarray
+        Standard errors from the observed information (central differences of the exact
+        score, Fisher's identity), by the delta method; the diagonal of
+        ``generator_se`` is that of ``-sum_j q_ij``. NaN when the information is
+        singular. A free start is held fixed in them.
+    covariance : ndarray
+        Covariance of ``(rates, off-diagonal q_ij in row order)``.
+    converged, n_iter, n_starts, warnings :
+        EM health: converged within ``max_iter`` E-steps (``n_iter`` of the kept run,
+        its screening included) from the best of ``n_starts`` starts; ``warnings`` lists
+        degenerate fits (a state without events, states not distinguished, a switching
+        rate at its floor or cap) and numerical trouble.
+    """
+
+    rates: np.ndarray
+    generator: np.ndarray
+    stationary: np.ndarray
+    initial: np.ndarray
+    initial_method: str
+    loglik: float
+    n_windows: int
+    n_events: int
+    total_time: float
+    converged: bool
+    n_iter: int
+    n_starts: int
+    rates_se: np.ndarray
+    generator_se: np.ndarray
+    covariance: np.ndarray
+    warnings: tuple = ()
+
+    @property
+    def n_states(self) -> int:
+        return int(self.rates.size)
+
+    @property
+    def n_params(self) -> int:
+        """Free parameters: ``n`` rates, ``n (n - 1)`` switching rates, and ``n - 1``
+        for a free start."""
+        n = self.n_states
+        return n * n + (n - 1 if self.initial_method == "free" else 0)
+
+    @property
+    def aic(self) -> float:
+        """``2 k - 2 loglik``."""
+        return 2 * self.n_params - 2 * self.loglik
+
+    @property
+    def bic(self) -> float:
+        """``k log(n_events) - 2 loglik``."""
+        return self.n_params * math.log(max(self.n_events, 1)) - 2 * self.loglik
+
+    @property
+    def stationary_rate(self) -> float:
+        """Mean event rate of the stationary process, ``stationary @ rates``."""
+        return float(self.stationary @ self.rates)
+
+    @property
+    def mean_sojourns(self) -> np.ndarray:
+        """Mean time the chain stays in each state, ``-1 / Q[i, i]``."""
+        with np.errstate(divide="ignore"):
+            return -1.0 / np.diag(self.generator)
+
+    @property
+    def params(self) -> dict:
+        """``{"rate[i]": ..., "q[i,j]": ...}`` (the free parameters)."""
+        return _keyed(self.rates, self.generator)
+
+    @property
+    def stderr(self) -> dict:
+        """Standard errors keyed as :attr:`params`."""
+        return _keyed(self.rates_se, self.generator_se)
+
+    def __repr__(self) -> str:
+        flag = "" if self.converged else ", converged=False"
+        rates = np.array2string(self.rates, precision=4)
+        return (f"MMPPFit(n_states={self.n_states}, rates={rates}, loglik={self.loglik:.6g}, "
+                f"aic={self.aic:.6g}, n_windows={self.n_windows}, "
+                f"n_events={self.n_events}{flag})")
+
+    def summary(self) -> str:
+        """A readable table of the fit."""
+        n = self.n_states
+        start = ("stationary start" if self.initial_method == "stationary"
+                 else "free start, " + ", ".join(f"{v:.3g}" for v in self.initial))
+        lines = [f"MMPP fit: {n} state{'s' if n > 1 else ''} (exact censored likelihood, "
+                 f"EM; {start})",
+                 f"  windows: {self.n_windows}, events: {self.n_events}, total time "
+                 f"{self.total_time:.6g}; each window's right end censored",
+                 f"  log-likelihood {self.loglik:.6g}   AIC {self.aic:.6g}   BIC {self.bic:.6g}"
+                 f"   (k = {self.n_params})",
+                 f"  {'parameter':<10} {'estimate':>14} {'std. err.':>14}"]
+        se = self.stderr
+        lines += [f"  {k:<10} {v:>14.6g} {se[k]:>14.6g}" for k, v in self.params.items()]
+        lines.append("  stationary law " + ", ".join(f"{v:.4g}" for v in self.stationary)
+                     + f"   stationary rate {self.stationary_rate:.6g}")
+        if n > 1:
+            lines.append("  mean sojourns " + ", ".join(f"{v:.4g}" for v in self.mean_sojourns))
+            lines.append(f"  EM: {self.n_iter} iterations, best of {self.n_starts} starts")
+        if not self.converged:
+            lines.append("  NOT CONVERGED: the numbers above are not a maximum-likelihood fit")
+        lines.extend(f"  warning: {w}" for w in self.warnings)
+        return "\n".join(lines)
+
+    def simulate(self, t_max, rng=None, *, n_windows=1, stationary=True):
+        """Event times of the fitted process: see :func:`simulate_mmpp`. Each window
+        starts from :attr:`stationary` (``stationary=True``) or from :attr:`initial`."""
+        return simulate_mmpp(self.rates, self.generator, t_max, n_windows=n_windows,
+                             initial=self.stationary if stationary else self.initial, rng=rng)
+
+    def loglik_of(self, times, t_max) -> float:
+        """Exact log-likelihood of other windows (e.g. held-out data) under the fit."""
+        seqs, lengths = check_windows(times, t_max)
+        data = em.Windows.of(seqs, lengths)
+        st = em.estep(self.rates * data.unit, self.generator * data.unit, self.initial, data)
+        return st.loglik - data.n_events.sum() * math.log(data.unit)
+
+
+def _keyed(rates, generator) -> dict:
+    n = rates.size
+    out = {f"rate[{i}]": float(v) for i, v in enumerate(rates)}
+    out.update({f"q[{i},{j}]": float(generator[i, j])
+                for i in range(n) for j in range(n) if i != j})
+    return out
+
+
+def fit_mmpp(times, t_max, *, n_states=2, n_starts=8, rng=None, max_iter=1000, tol=1e-9,
+             initial="stationary"):
+    r"""Fit a Markov-modulated Poisson process to event times in censored windows.
+
+    Parameters
+    ----------
+    times : array_like or list of array_like
+        Event times of one window (a 1-D array) or of several (a list of 1-D arrays),
+        strictly increasing, in ``[0, t_max]`` of their window.
+    t_max : float or sequence of float
+        Window lengths (> 0): one for all, or one per window. Every window starts at 0;
+        its right end is censored (the likelihood includes the probability of no event
+        from the last event to ``t_max``).
+    n_states : int, optional
+        Number of hidden states, 1 to 4 (1 is the homogeneous Poisson process).
+    n_starts : int, optional
+        EM starts (>= 1): two from quantiles of local event rates, the others random;
+        the best log-likelihood is kept (see Notes).
+    rng : Generator or int, optional
+        Randomness of the random starts and of the screening subsample.
+    max_iter : int, optional
+        Most E-steps of the kept run (>= 1).
+    tol : float, optional
+        Stop when the log-likelihood changes by at most ``tol * |loglik|`` in an
+        iteration, in (0, 1).
+    initial : {"stationary", "free"}, optional
+        Each window starts from the stationary law of the chain (default: windows cut
+        from a stationary process) or from one estimated distribution.
+
+    Returns
+    -------
+    MMPPFit
+
+    Raises
+    ------
+    ValueError, TypeError
+        Bad input, naming the argument and its valid range; fewer events than
+        parameters.
+
+    Warns
+    -----
+    FitWarning
+        EM did not converge, a degenerate fit (a state without events, two states with
+        nearly equal rates, a chain that switches less than once in all the data, a
+        switching rate at its floor or cap: the likelihood has no interior maximum and
+        a smaller model fits as well), or standard errors unavailable; the result is
+        defined and ``warnings`` says which.
+
+    Notes
+    -----
+    EM for MMPPs (Rydén 1996): the E-step runs scaled forward and backward recursions
+    over the intervals of every window and, from the eigendecomposition of
+    :math:`D = Q - \Lambda`, integrates exactly the expected time in each state
+    :math:`T_i` and transitions :math:`M_{ij}` within each interval, the expected events
+    in each state :math:`N_i` and the state at each window's start :math:`s_i`. The
+    M-step sets :math:`\lambda_i = N_i / T_i`, and :math:`q_{ij} = M_{ij} / T_i` for a
+    free start; with the stationary start it maximises
+    :math:`\sum_{i \ne j} (M_{ij}\log q_{ij} - T_i q_{ij}) + \sum_k s_k \log \pi_k(Q)` by
+    Newton's method. SQUAREM (Varadhan & Roland 2008) accelerates the iterations,
+    keeping them monotone. Each start first runs 25 iterations on a random subsample of
+    whole windows (about 20 000 intervals; all of them for smaller data), the two best
+    then run on all the data. Standard errors: the observed information, by central
+    differences of the exact score (Fisher's identity: the gradient of the expected
+    complete-data log-likelihood at the fit). Computations run in a time unit in which
+    the mean event rate is 1. Details: ``docs/mmpp.md``.
+
+    References
+    ----------
+    T. Rydén, "An EM algorithm for estimation in Markov-modulated Poisson processes",
+    Comput. Stat. Data Anal. 21 (1996) 431-447.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from kicktimes import stats
+    >>> Q = np.array([[-0.1, 0.1], [0.3, -0.3]])
+    >>> times = stats.simulate_mmpp([0.5, 5.0], Q, 60.0, n_windows=300, rng=1)
+    >>> fit = stats.fit_mmpp(times, 60.0, rng=2)
+    >>> np.round(fit.rates, 1)
+    array([0.5, 5. ])
+    """
+    n = check_int("n_states", n_states, low=1, high=MAX_STATES)
+    n_starts = check_int("n_starts", n_starts, low=1)
+    max_iter = check_int("max_iter", max_iter, low=1)
+    tol = check_real("tol", tol, low=0.0, high=1.0)
+    check_choice("initial", initial, INITIAL)
+    rng = check_rng(rng)
+    seqs, lengths = check_windows(times, t_max)
+    data = em.Windows.of(seqs, lengths)
+    fit = _fit(data, n, n_starts=n_starts, rng=rng, max_iter=max_iter, tol=tol,
+               initial=initial)
+    if fit.warnings:
+        status = "" if fit.converged else "did not converge: "
+        warnings.warn(f"fit_mmpp(n_states={n}): {status}{'; '.join(fit.warnings)}",
+                      FitWarning, stacklevel=2)
+    return fit
+
+
+def _fit(data, n, *, n_starts=8, rng=None, max_iter=1000, tol=1e-9, initial="stationary",
+         covariance=True):
+    """fit_mmpp on a validated :class:`~._mmpp_em.Windows`; no warning is issued."""
+    rng = check_rng(rng)
+    k = n * n + (n - 1 if initial == "free" else 0)
+    n_events = int(data.n_events.sum())
+    if n_events < max(k, 1):
+        raise ValueError(f"times: a {n}-state MMPP has {k} parameters and needs at least as "
+                         f"many events, got {n_events}")
+    if n == 1:
+        return _poisson(data, covariance)
+    points = em.starting_points(data, n, n_starts, rng)
+    screen = data
+    if data.x.size > _SCREEN_INTERVALS and data.n_windows >= 4:
+        size = max(2, math.ceil(data.n_windows * _SCREEN_INTERVALS / data.x.size))
+        screen = data.subset(np.sort(rng.choice(data.n_windows, size=size, replace=False)))
+    runs = [em.run_em(r, q, screen, initial=initial, max_iter=min(_SCREEN_ITER, max_iter),
+                      tol=max(tol, _SCREEN_TOL)) for r, q in points]
+    runs.sort(key=lambda run: run.loglik if np.isfinite(run.loglik) else -np.inf, reverse=True)
+    finals = []
+    for run in runs[:_FINALISTS]:
+        rest = max(1, max_iter - run.n_iter)
+        final = em.run_em(run.rates, run.Q, data, initial=initial, max_iter=rest, tol=tol,
+                          alpha=run.alpha if initial == "free" else None)
+        final.n_iter += run.n_iter
+        finals.append(final)
+    best = max(finals, key=lambda run: run.loglik if np.isfinite(run.loglik) else -np.inf)
+    return _result(best, data, initial, n_starts=len(points), covariance=covariance)
+
+
+def _poisson(data, covariance):
+    n_events = int(data.n_events.sum())
+    time = data.total_time * data.unit
+    rate = n_events / time
+    loglik = n_events * math.log(rate) - rate * time
+    se = rate / math.sqrt(n_events) if covariance else math.nan
+    return MMPPFit(np.array([rate]), np.zeros((1, 1)), np.ones(1), np.ones(1), "stationary",
+                   float(loglik), data.n_windows, n_events, time, True, 0, 1, np.array([se]),
+                   np.zeros((1, 1)), np.array([[se * se]]))
+
+
+def _result(run, data, initial, *, n_starts, covariance):
+    n = run.rates.size
+    order = np.argsort(run.rates, kind="stable")
+    rates, Q = run.rates[order], run.Q[np.ix_(order, order)]
+    alpha = run.alpha[order]
+    st = run.stats
+    events, pi = st.events[order], em.stationary_law(Q)
+    problems = [] if run.converged else [f"EM stopped after max_iter = {run.n_iter} E-steps"]
+    off = ~np.eye(n, dtype=bool)
+    for i in range(n):
+        if events[i] < 1.0 or pi[i] < 1e-6:
+            problems.append(f"state {i} holds {events[i]:.3g} expected events and stationary "
+                            f"probability {pi[i]:.3g}: a state with (almost) no events")
+    close = np.flatnonzero(np.diff(rates) <= 0.01 * rates[1:])
+    problems += [f"states {i} and {i + 1} have rates within 1 % ({rates[i]:.4g}, "
+                 f"{rates[i + 1]:.4g}): the states are not distinguished" for i in close]
+    switches = float(st.transitions.sum())
+    if switches < 1.0:
+        problems.append(f"the hidden chain switches {switches:.3g} times (expected) in all the "
+                        "windows: the fit is a mixture of Poisson windows, not a switching "
+                        "process, and the switching rates are not identified")
+    if np.any(Q[off] <= 1.01 * em.Q_FLOOR) or np.any(Q[off] >= 0.99 * em.Q_CAP):
+        problems.append("a switching rate ran to its floor or cap (in units of the mean event "
+                        "rate: 1e-10, 1e6): the chain hardly switches, or switches much "
+                        "faster than events occur")
+    k = n + n * (n - 1)
+    cov = np.full((k, k), np.nan)
+    if covariance:
+        info = em.information(rates, Q, alpha, data, initial)
+        try:
+            cov_log = np.linalg.inv(info)
+            ok = np.all(np.isfinite(cov_log)) and np.all(np.diag(cov_log) > 0)
+        except np.linalg.LinAlgError:
+            ok = False
+        if ok:
+            theta = np.concatenate([rates, Q[off]])
+            cov = cov_log * np.outer(theta, theta)
+        else:
+            problems.append("standard errors unavailable: the observed information is "
+                            "singular or not positive definite (an estimate at a boundary, "
+                            "or parameters not identified)")
+    u = data.unit
+    cov = cov / u**2
+    se = np.sqrt(np.where(np.diag(cov) >= 0, np.diag(cov), np.nan))
+    q_se = np.zeros((n, n))
+    q_se[off] = se[n:]
+    for i in range(n):
+        # q_ii = -sum_j q_ij: the variance of the sum over row i's entries
+        row = n + i * (n - 1) + np.arange(n - 1)
+        q_se[i, i] = math.sqrt(cov[np.ix_(row, row)].sum()) if np.isfinite(se[row]).all() \
+            else math.nan
+    return MMPPFit(rates / u, Q / u, pi, alpha, initial,
+                   float(st.loglik - data.n_events.sum() * math.log(u)), data.n_windows,
+                   int(data.n_events.sum()), data.total_time * u, bool(run.converged),
+                   int(run.n_iter), n_starts, se[:n], q_se, cov, tuple(problems))
