@@ -351,7 +351,7 @@ def test_lr_test_rejects_mmpp_data_and_not_poisson_data(mmpp_data):
 
 @pytest.mark.slow
 def test_lr_test_has_its_nominal_size_on_poisson_data():
-    # measured: 5.2 % of 500 data sets at 5 % (docs/mmpp.md)
+    # measured: 5.4 % of 500 data sets at 5 % (docs/mmpp.md)
     rng = np.random.default_rng(21)
     pvalues = []
     with warnings.catch_warnings():

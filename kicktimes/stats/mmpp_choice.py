@@ -18,7 +18,7 @@ event and the window's end,
 which for a renewal process is :math:`\sum \log f(x) + \sum \log S(c)` and for an MMPP
 the full window likelihood divided by the density of its first event,
 :math:`p(t_1) = \pi e^{D t_1} \lambda`. Each model is maximised on it: the renewal fits
-as they are, the MMPP from its full-likelihood fit by BFGS on the exact gradient (two
+as they are, the MMPP from its full-likelihood fit by L-BFGS-B on the exact gradient (two
 forward-backward passes: Fisher's identity on all windows minus on the first events).
 """
 
