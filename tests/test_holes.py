@@ -3,6 +3,7 @@
 import math
 
 import numpy as np
+import pandas as pd
 import pytest
 
 from kicktimes import initial_conditions, simulate_one_particle, simulate_two_particle
@@ -98,3 +99,34 @@ def test_the_ftle_is_measured_up_to_the_escape():
     assert two.total_time == run2.t_max <= 1200.0
     with pytest.raises(ValueError, match="method='tangent'"):
         lyapunov(ic, R, n_steps=100, tau=0.3, holes=HOLES, method="twin")
+
+
+def test_sweeps_store_escape_times_and_one_pass_equals_separate_runs():
+    import dataclasses
+
+    from kicktimes.experiment import preset
+    from kicktimes.experiment.tasks import execute_task
+
+    exp = dataclasses.replace(preset("quick_a"), name="holes", radii=(0.02, 0.03), n_ics=3,
+                              block_size=3, n_steps=1500, holes=[(0.0, 0.15)])
+    assert exp.hash() != preset("quick_a").hash()
+    tables = []
+    for one_pass in (True, False):
+        tables.append(pd.concat([execute_task(exp, t, one_pass=one_pass).results
+                                 for t in exp.tasks()], ignore_index=True))
+    pd.testing.assert_frame_equal(tables[0], tables[1], check_exact=True)
+    esc = tables[0][tables[0]["diagnostic"] == "escape_time"]
+    assert set(esc["system"]) == set(exp.systems)
+    escaped = np.isfinite(esc["value"])
+    assert escaped.any() and (esc.loc[~escaped, "note"] != "").all()
+    t_max = tables[0][tables[0]["diagnostic"] == "t_max"].set_index(["radius", "ic", "system"])
+    done = esc[escaped].set_index(["radius", "ic", "system"])["value"]
+    assert (t_max.loc[done.index, "value"] == done).all()
+
+
+def test_an_experiment_with_holes_needs_the_tangent_ftle():
+    from kicktimes.experiment import Experiment
+
+    with pytest.raises(ValueError, match="lyapunov_method='tangent'"):
+        Experiment(name="h", radii=[0.02], n_ics=2, n_steps=100, tau=0.3, holes=[(0.0, 0.1)],
+                   lyapunov_method="twin")

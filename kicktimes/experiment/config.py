@@ -43,7 +43,8 @@ RR_SAMPLINGS = ("run", "uniform", "run+uniform")
 #: results: `Experiment.hash` leaves a field out while it has that value (and writes a
 #: single ``eps`` as a float, as before), so stores written before the field existed keep
 #: their hash and still load. Their results simply lack the rows added since.
-_LATER_FIELDS = {"acf_max_lag": 20, "rr_sampling": "run", "lyapunov_method": "twin"}
+_LATER_FIELDS = {"acf_max_lag": 20, "rr_sampling": "run", "lyapunov_method": "twin",
+                 "holes": []}
 
 _REQUIRED = ("name", "radii", "n_ics", "n_steps", "tau")
 
@@ -148,6 +149,12 @@ class Experiment:
         Subset of ``("lyapunov", "recurrence_rate", "autocorrelation")``.
     block_size : int
         Initial conditions per task (``>= 1``); a task is one radius times one block.
+    holes : sequence of (float, float)
+        Holes in the table's wall, rows ``(centre angle, half-width)`` in radians (default
+        none): every run ends when a disk escapes (docs/escape.md), its ``escape_time``
+        row is stored (``inf``: none by the end), and the disk kicked at actual times gets
+        the two-disk run's collision times up to its end (no continuation). Needs
+        ``lyapunov_method = "tangent"``.
     description : str
         Free text for the report.
 
@@ -184,6 +191,7 @@ class Experiment:
     diagnostics: tuple = DIAGNOSTICS
     block_size: int = 25
     description: str = field(default="")
+    holes: tuple = ()
 
     def __post_init__(self):
         def put(name, value):
@@ -225,6 +233,15 @@ class Experiment:
                              f"is tabulated for unit speeds), got rule={self.rule!r}")
         put("diagnostics", _subset("diagnostics", self.diagnostics, DIAGNOSTICS))
         put("block_size", check_int("block_size", self.block_size, low=1))
+        if self.holes is None or (hasattr(self.holes, "__len__") and len(self.holes) == 0):
+            put("holes", ())
+        else:
+            from kicktimes.billiard.checks import check_holes
+
+            put("holes", tuple(tuple(row) for row in check_holes(self.holes).tolist()))
+            if "lyapunov" in self.diagnostics and self.lyapunov_method != "tangent":
+                raise ValueError("holes: the FTLE up to an escape needs lyapunov_method="
+                                 f"'tangent', got {self.lyapunov_method!r}")
         if not isinstance(self.description, str):
             raise TypeError(f"description: expected a string, got {self.description!r}")
 
@@ -251,6 +268,7 @@ class Experiment:
         out = asdict(self)
         for key in ("radii", "eps", "systems", "diagnostics"):
             out[key] = list(out[key])
+        out["holes"] = [list(row) for row in out["holes"]]
         return out
 
     @classmethod

@@ -207,6 +207,8 @@ def _run_ic(exp: Experiment, r: float, ic_index: int, ic: np.ndarray, rows, coll
     from kicktimes.schedules import Poisson
 
     steps = {"n_steps": exp.n_steps, "tau": exp.tau, "sampling": exp.sampling}
+    # holes in the wall: every run (and its FTLE) ends at its escape
+    holes = {"holes": np.array(exp.holes)} if exp.holes else {}
     ftle_method = {"method": exp.lyapunov_method}
     if exp.lyapunov_method == "twin":
         ftle_method["d0"] = exp.d0
@@ -259,7 +261,14 @@ def _run_ic(exp: Experiment, r: float, ic_index: int, ic: np.ndarray, rows, coll
     horizon = exp.horizon
     continued = None
     two_pass = one_pass and "two_particle" in exp.systems
-    if two_pass:
+    if two_pass and holes:
+        # the run ends at its escape: no continuation to the horizon
+        with timer("lyapunov_two_particle"):
+            res_two, two = _lyapunov()(ic, r, rule=exp.rule, track=0, method="tangent",
+                                       variant=exp.lyapunov_variant, return_run=True, **holes,
+                                       **steps)
+        continued = two.pp_times
+    elif two_pass:
         with timer("lyapunov_two_particle"):
             res_two, two, continued = _lyapunov_pass()(
                 ic, r, rule=exp.rule, track=0, variant=exp.lyapunov_variant, method="tangent",
@@ -267,19 +276,25 @@ def _run_ic(exp: Experiment, r: float, ic_index: int, ic: np.ndarray, rows, coll
             )
     else:
         with timer("simulation_two_particle"):
-            two = simulate_two_particle(ic, r, rule=exp.rule, track=0, seed=exp.seed, **steps)
+            two = simulate_two_particle(ic, r, rule=exp.rule, track=0, seed=exp.seed, **holes,
+                                        **steps)
+        if holes:
+            continued = two.pp_times
     n_b0 = int(np.count_nonzero(two.boundary_log.particle == 0))
     coll.append((r, ic_index, two.t_max, two.n_pp, np.array(two.pp_times, dtype=np.float64)))
     if "two_particle" in exp.systems:
         add("two_particle", "t_max", two.t_max)
         add("two_particle", "n_pp", two.n_pp)
         add("two_particle", "n_boundary", n_b0)
+        if holes:
+            add("two_particle", "escape_time", two.escape_time,
+                "" if two.escaped >= 0 else "no escape by the end of the run")
         diagnose(
             "two_particle",
             two,
             (lambda: res_two) if two_pass else lambda: _lyapunov()(
                 ic, r, rule=exp.rule, track=0, variant=exp.lyapunov_variant, **ftle_method,
-                **steps,
+                **holes, **steps,
             ),
         )
 
@@ -292,7 +307,7 @@ def _run_ic(exp: Experiment, r: float, ic_index: int, ic: np.ndarray, rows, coll
         rng = kick_rng(exp.seed, ic_index, r, system)
         if system == "poisson_kinetic":
             # the event loop draws the kick times (and their scattering numbers) from rng
-            one_kw = {"kicks": kinetic_rate_table(r), "rng": rng, **kick, **steps}
+            one_kw = {"kicks": kinetic_rate_table(r), "rng": rng, **kick, **holes, **steps}
             _kicked(system, one_kw, one_pass, exp, ic, r, timer, add, diagnose)
             continue
         if system.startswith("actual"):
@@ -316,7 +331,7 @@ def _run_ic(exp: Experiment, r: float, ic_index: int, ic: np.ndarray, rows, coll
             elif system == "mmpp":
                 kick_times = schedule.sample(horizon, rng)
             kick_angles = draw_kick_angles(kick_times.size, kick["kick_angle"], exp.sigma, rng)
-        one_kw = {"kicks": kick_times, "kick_angles": kick_angles, **kick, **steps}
+        one_kw = {"kicks": kick_times, "kick_angles": kick_angles, **kick, **holes, **steps}
         _kicked(system, one_kw, one_pass, exp, ic, r, timer, add, diagnose, extra)
 
 
@@ -348,6 +363,9 @@ def _kicked(system, one_kw, one_pass, exp, ic, r, timer, add, diagnose, extra=()
                 del kw["rng"]
             return _lyapunov()(ic[0], r, variant=exp.lyapunov_variant, **ftle_method, **kw)
     add(system, "t_max", one.t_max)
+    if "holes" in one_kw:
+        add(system, "escape_time", one.escape_time,
+            "" if one.escaped >= 0 else "no escape by the end of the run")
     for name, value, *note in extra:
         add(system, name, value, *note)
     add(system, "n_kicks", one.n_kicks)
