@@ -76,7 +76,8 @@ def test_simulator_and_ftle_kernels_compile_once_without_error_strings(tmp_path)
     # tangent vectors alone; the twins once per system), which is how an argument passed as
     # None is compiled out
     drivers = {f"kicktimes.billiard.kernels.{m}.{f}" for m in ("drive_two", "drive_one")
-               for f in ("drive", "_run")} | {"kicktimes.billiard.kernels.twins._ftle"}
+               for f in ("drive", "_run")} | {"kicktimes.billiard.kernels.twins._ftle",
+                                              "kicktimes.billiard.kernels.drive_one._simulate"}
     several = {name: s for name, s in ours.items()
                if len(s) > (3 if name in drivers else 1)
                and name != "kicktimes.billiard.kernels.observe.grow_to"}

@@ -392,7 +392,8 @@ def test_one_pass_kernels_compile_once_without_error_strings(tmp_path):
     assert "kicktimes.billiard.kernels.drive_one.simulate_tangent_one_kernel" in ours
     # one signature per set of observers (see tests/test_compile.py)
     drivers = {f"kicktimes.billiard.kernels.{m}.{f}" for m in ("drive_two", "drive_one")
-               for f in ("drive", "_run")} | {"kicktimes.billiard.kernels.twins._ftle"}
+               for f in ("drive", "_run")} | {"kicktimes.billiard.kernels.twins._ftle",
+                                              "kicktimes.billiard.kernels.drive_one._simulate"}
     several = {name: s for name, s in ours.items()
                if len(s) > (3 if name in drivers else 1)
                and name != "kicktimes.billiard.kernels.observe.grow_to"}

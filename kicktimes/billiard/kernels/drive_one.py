@@ -255,23 +255,32 @@ def simulate_one_kernel(st, rho, kicks, angles, kick_mode, t_max, mode, n_steps,
     half-width]``, or ``None``); then an 11th item ``escape = [t, 0]`` (``[inf, -1]``: no
     escape), and the run ends at the escape.
     """
+    return _simulate(st, rho, kicks, angles, kick_mode, t_max, mode, n_steps, tau, b_cap, kick_u,
+                     sp, max_events, stall_dt, None, kinetic, holes)[0]
+
+
+@njit(cache=True)
+def _simulate(st, rho, kicks, angles, kick_mode, t_max, mode, n_steps, tau, b_cap, kick_u, sp,
+              max_events, stall_dt, tan, kinetic, holes):
+    """`_run` with the simulation on, and its output as `simulate_one_kernel` returns it;
+    also the tangent half (``tan``, or ``None``)."""
     escape = np.array([np.inf, -1.0])
     # (two calls, not a conditional argument: numba compiles the holes out when absent)
     if holes is None:
-        logs, stimes, samples, cnt, fin, _, status = _run(
+        logs, stimes, samples, cnt, fin, tan, status = _run(
             st, rho, kicks, angles, kick_mode, t_max, mode, n_steps, tau, b_cap, kick_u, sp,
-            max_events, stall_dt, True, None, kinetic, None)
+            max_events, stall_dt, True, tan, kinetic, None)
     else:
-        logs, stimes, samples, cnt, fin, _, status = _run(
+        logs, stimes, samples, cnt, fin, tan, status = _run(
             st, rho, kicks, angles, kick_mode, t_max, mode, n_steps, tau, b_cap, kick_u, sp,
-            max_events, stall_dt, True, None, kinetic, (holes, escape))
+            max_events, stall_dt, True, tan, kinetic, (holes, escape))
     bt, bx, by, bs, klog = logs
     n = cnt[N_B]
     n_applied = cnt[N_KICKS_RUN] if status == ob.DONE else cnt[N_KICKS]
     t_end = fin[0] if status == ob.DONE else (t_max if mode < 2 else np.inf)
     k = cnt[K] if escape[1] >= 0.0 else stimes.shape[0]
     return (bt[:n], bx[:n], by[:n], bs[:n], stimes[:k], samples[:k], n_applied, t_end,
-            klog[:n_applied], status, escape)
+            klog[:n_applied], status, escape), tan
 
 
 @njit(cache=True)
@@ -284,25 +293,14 @@ def simulate_tangent_one_kernel(st, rho, kicks, angles, kick_mode, t_max, mode, 
     sample_times, samples, n_kicks_applied, t_end, kick_log, status, log_scale, n_rescaled,
     n_kicks_tangent, t_end_tangent, status_tangent)``.
     """
-    tan = tg.tangent_state(U, mode, n_steps, tau, max_ev_tan, np.int64(0))
-    escape = np.array([np.inf, -1.0])
-    if holes is None:
-        logs, stimes, samples, cnt, fin, tan, status = _run(
-            st, rho, kicks, angles, kick_mode, t_max, mode, n_steps, tau, b_cap, kick_u, sp,
-            max_events, stall_dt, True, tan, kinetic, None)
-    else:
-        logs, stimes, samples, cnt, fin, tan, status = _run(
-            st, rho, kicks, angles, kick_mode, t_max, mode, n_steps, tau, b_cap, kick_u, sp,
-            max_events, stall_dt, True, tan, kinetic, (holes, escape))
-    bt, bx, by, bs, klog = logs
+    out, tan = _simulate(st, rho, kicks, angles, kick_mode, t_max, mode, n_steps, tau, b_cap,
+                         kick_u, sp, max_events, stall_dt,
+                         tg.tangent_state(U, mode, n_steps, tau, max_ev_tan, np.int64(0)),
+                         kinetic, holes)
     _, log_scale, tgi, tgf, _, _, _ = tan
-    n = cnt[N_B]
-    n_applied = cnt[N_KICKS_RUN] if status == ob.DONE else cnt[N_KICKS]
-    t_end = fin[0] if status == ob.DONE else (t_max if mode < 2 else np.inf)
-    k = cnt[K] if escape[1] >= 0.0 else stimes.shape[0]
-    return (bt[:n], bx[:n], by[:n], bs[:n], stimes[:k], samples[:k], n_applied, t_end,
-            klog[:n_applied], status, log_scale, tgi[tg.N_RESC], tgi[tg.N_PERT], tgf[tg.T_PREV],
-            tgi[tg.TAN_STATUS], escape)
+    return (out[0], out[1], out[2], out[3], out[4], out[5], out[6], out[7], out[8], out[9],
+            log_scale, tgi[tg.N_RESC], tgi[tg.N_PERT], tgf[tg.T_PREV], tgi[tg.TAN_STATUS],
+            out[10])
 
 
 @njit(cache=True)
