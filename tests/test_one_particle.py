@@ -228,3 +228,11 @@ def test_ranges_that_keep_the_arithmetic_finite(kwargs, match, exc):
 def test_the_one_particle_event_budget():
     with pytest.raises(ValueError, match="max_events=20 collisions"):
         simulate_one_particle(STATE, 0.02, t_max=100.0, max_events=20)
+
+
+def test_a_paper_run_cut_short_at_t0_by_every_kick_warns_that_it_covers_no_time():
+    # found by the property tests: both paper steps end at the kicks at t = 0
+    with pytest.warns(RuntimeWarning, match="covers no time"):
+        run = simulate_one_particle([0.0, 0.0, 1.0, 0.0], 0.5, sampling="paper", n_steps=1,
+                                    tau=1.0, kicks=[0.0, 0.0], rng=0)
+    assert run.t_max == 0.0 and run.n_kicks == 2

@@ -10,6 +10,7 @@ outward velocities, huge and tiny speeds and times, NaN, wrong types.
 from __future__ import annotations
 
 import math
+import warnings
 
 import numpy as np
 import pytest
@@ -19,7 +20,9 @@ from hypothesis import strategies as hs
 from kicktimes import initial_conditions, schedules, simulate_one_particle, simulate_two_particle
 
 # numba kernels compile (or load) on first use: that must not count against the deadline
-SETTINGS = settings(max_examples=40, deadline=4000,
+# derandomize: the same examples on every run and machine (a CI that fails at random is no
+# test); the search is still broad, and a failure is reproducible
+SETTINGS = settings(max_examples=40, deadline=4000, derandomize=True,
                     suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])
 
 WEIRD_FLOATS = hs.sampled_from([0.0, -0.0, -1.0, math.nan, math.inf, -math.inf, 1e-300, 1e300,
@@ -78,7 +81,8 @@ def _check_run(run, r):
     t = run.boundary_log.time
     assert np.isfinite(t).all() and np.isfinite(run.boundary_log.sin_theta).all()
     assert (np.diff(t) >= 0).all()
-    assert math.isfinite(run.t_max) and run.t_max > 0
+    # (a paper-sampled run may cover no time: every step cut short at t = 0, with a warning)
+    assert math.isfinite(run.t_max) and (run.t_max > 0 or run.sampling == "paper")
     if t.size:
         assert t[0] >= 0 and t[-1] <= run.t_max * (1 + 1e-12)
     assert (np.abs(run.boundary_log.sin_theta) <= 1 + 1e-9).all()
@@ -162,7 +166,9 @@ def test_simulate_one_particle_returns_sane_runs_or_names_the_argument(data, r, 
             # turn a disk on the wall exactly tangent (the example)
             kwargs["kick_angles"] = [math.atan2(state[1], state[0]) + math.pi / 2]
     try:
-        run = simulate_one_particle(state, r, **kwargs)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)  # a paper run covering no time
+            run = simulate_one_particle(state, r, **kwargs)
     except (ValueError, TypeError) as exc:
         _names_an_argument(exc, ["state", "r", "t_max", "n_steps", "tau", "kicks", "max_events"])
         return
@@ -192,7 +198,7 @@ def test_schedules_sample_sorted_times_in_the_window_or_name_the_argument(kind, 
     assert times.size == 0 or (times[0] > 0 and times[-1] <= t_max)
 
 
-@settings(max_examples=15, deadline=4000)
+@settings(max_examples=15, deadline=4000, derandomize=True)
 @given(seed=hs.integers(0, 1000), particle=hs.sampled_from([None, 0, 1]))
 def test_run_objects_give_finite_angles_and_a_consistent_boundary_table(seed, particle):
     ic = initial_conditions(1, 0.05, seed=seed)[0]

@@ -14,6 +14,7 @@ outcome a deterministic function of the kick times and angles.
 from __future__ import annotations
 
 import math
+import warnings
 
 import numpy as np
 
@@ -330,6 +331,14 @@ def simulate_one_particle(state, r, *, t_max=None, kicks=None, kick_angle="unifo
     raise_for_status(out[9], st[0], out[0].shape[0], max_events=max_events, name="state",
                      where=f"disk at ({st[1]:.6g}, {st[2]:.6g}), r={r!r}")
     check_kinetic_capacity(kinetic, out[6])
+    if mode == 2 and out[7] == 0.0:
+        # every paper step was cut short at t = 0 (kicks at 0, or the disk on the wall)
+        warnings.warn(
+            f"state: the paper-sampled run covers no time (t_max = 0.0): all n_steps = "
+            f"{n_steps} steps ended at events at t = 0 ({out[6]} kicks, {out[0].shape[0]} "
+            "boundary collisions); more steps, or kicks after t = 0, give it a duration",
+            RuntimeWarning, stacklevel=2,
+        )
     return one_particle_run(st, r, state, out[:9], sampling=sampling, mode=mode, tau=tau,
                             n_steps=n_steps, seed=seed, kick_angle=kick_angle, sigma=sigma,
                             times=times, applied=angles, rule=rule, e0=e0, partner=partner,
