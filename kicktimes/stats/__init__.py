@@ -48,7 +48,7 @@ from .renewal import (
     fit_renewal,
 )
 from .rescaling import RescaledTimes, mmpp_residuals
-from .survival import EscapeTail, escape_survival, fit_escape_tail
+from .survival import EscapeTail, circle_escape_constant, escape_survival, fit_escape_tail
 
 __all__ = [
     "MODELS",
@@ -70,6 +70,7 @@ __all__ = [
     "kinetic_rate",
     "conditional_kinetic_rate",
     "mean_kinetic_rate",
+    "circle_escape_constant",
     "escape_survival",
     "fit_escape_tail",
     "EscapeTail",

@@ -20,7 +20,7 @@ import pandas as pd
 
 from ._checks import check_real
 
-__all__ = ["EscapeTail", "escape_survival", "fit_escape_tail"]
+__all__ = ["EscapeTail", "circle_escape_constant", "escape_survival", "fit_escape_tail"]
 
 
 def _censored(escape_times, t_max):
@@ -170,3 +170,68 @@ def fit_escape_tail(escape_times, t_max, *, t_min) -> EscapeTail:
                       alpha_ci=rate_ci(log_exposure), aic_exponential=aic_e,
                       aic_algebraic=aic_a,
                       best="exponential" if aic_e <= aic_a else "algebraic")
+
+
+def circle_escape_constant(half_width, *, radius=1.0, speed=1.0) -> float:
+    r"""The constant :math:`C` of the circle's algebraic escape, :math:`S(t) \sim C/t`.
+
+    A point particle in a circle of radius :math:`R` at speed :math:`v`, started from the
+    Liouville measure of the flow (position uniform in the disk, direction uniform), with
+    one hole: the arc of half-width :math:`h` (radians) of the wall. Following Bunimovich
+    & Dettmann's argument, write :math:`\omega \in (0, 2\pi)` for the angle the bounce
+    point advances per chord, of length :math:`2R\sin(\omega/2)`; the flow measure gives
+    :math:`\omega` the density :math:`\sin^2(\omega/2)/\pi`. At long times only
+    :math:`\omega` near :math:`2\pi p/q` survive: the :math:`q` bounce points drift by
+    :math:`\delta = \omega - 2\pi p/q` per chord and stay out of the hole for
+    :math:`N` chords on a fraction :math:`(2\pi/q - 2h - N|\delta|)_+ \, q/2\pi` of the
+    first bounce points. Integrating over :math:`\delta` with :math:`N = t v / (2R\sin(\pi
+    p/q))` and summing over :math:`p/q` in lowest terms,
+
+    .. math::
+
+        C = \frac{4R}{\pi^2 v} \sum_{2 \le q < \pi/h} q \left(\frac{\pi}{q} - h\right)^2
+            \sum_{\substack{1 \le p < q \\ \gcd(p, q) = 1}} \sin^3\frac{\pi p}{q} .
+
+    The sum is finite: orbits whose :math:`q` bounce points are closer than the hole's
+    width all escape.
+
+    For a disk of radius :math:`r` in the unit table, whose contact point lies at the
+    angle of its centre, pass ``radius=1 - r``. With a distribution of speeds,
+    :math:`S(t) \sim C(v{=}1)\, E[1/v]/t`.
+
+    Parameters
+    ----------
+    half_width : float
+        The hole's half-width in radians, in (0, π).
+    radius, speed : float
+        The circle the centre moves on, and the speed (both > 0).
+
+    Returns
+    -------
+    float
+        :math:`C`, in units of time.
+
+    References
+    ----------
+    L. A. Bunimovich and C. P. Dettmann, "Open circular billiards and the Riemann
+    hypothesis", Phys. Rev. Lett. 94, 100201 (2005).
+
+    Examples
+    --------
+    >>> from kicktimes.stats import circle_escape_constant
+    >>> round(circle_escape_constant(0.25), 4)
+    3.99
+    >>> round(circle_escape_constant(0.05, radius=0.99), 3)   # a disk of radius 0.01
+    21.333
+    """
+    h = check_real("half_width", half_width, low=0.0, high=math.pi)
+    radius = check_real("radius", radius, low=0.0)
+    speed = check_real("speed", speed, low=0.0)
+    total = 0.0
+    q = 2
+    while math.pi / q > h:
+        p = np.arange(1, q)
+        coprime = p[np.gcd(p, q) == 1]
+        total += q * (math.pi / q - h) ** 2 * float(np.sum(np.sin(math.pi * coprime / q) ** 3))
+        q += 1
+    return 4.0 * radius * total / (math.pi ** 2 * speed)
