@@ -178,3 +178,38 @@ def test_kinetic_rate_is_positive_and_finite_or_refused_naming_r(r):
     rate = _call(stats.kinetic_rate, r, names=("r",))
     if rate is not None:
         assert 0 < r < 0.5 and math.isfinite(rate) and rate > 0
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.lists(st.lists(st.one_of(st.floats(allow_nan=True, allow_infinity=True, width=64),
+                                    st.sampled_from([0.0, -0.0, 1.0, -1.0])),
+                         min_size=0, max_size=9), min_size=1, max_size=5).filter(
+    lambda rows: len({len(r) for r in rows}) == 1))
+def test_nanmedian_equals_numpys_bit_for_bit(rows):
+    import warnings
+
+    from kicktimes.stats import nanmedian
+
+    a = np.array(rows, dtype=float)
+    got = nanmedian(a, axis=1)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        ref = np.nanmedian(a, axis=1) if a.shape[1] else np.full(a.shape[0], np.nan)
+    assert np.array_equal(np.isnan(got), np.isnan(ref))
+    finite = ~np.isnan(ref)
+    assert got[finite].tobytes() == ref[finite].tobytes()
+
+
+def test_nanmedian_equals_numpys_on_long_rows_and_blocks():
+    from kicktimes.stats import nanmedian
+
+    rng = np.random.default_rng(3)
+    a = rng.standard_normal((4, 3, 801))
+    a[rng.random(a.shape) < 0.2] = np.nan
+    a[0, 0] = np.nan  # a row without a number
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        ref = np.nanmedian(a, axis=2)
+        ref1 = np.nanmedian(a, axis=1)
+    assert nanmedian(a, axis=2).tobytes() == ref.tobytes()
+    assert nanmedian(a, axis=1).tobytes() == ref1.tobytes()

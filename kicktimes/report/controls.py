@@ -42,7 +42,7 @@ import pandas as pd
 
 from kicktimes.report.common import REFERENCE, kicked_systems, wide
 from kicktimes.report.effects import paired_ratio
-from kicktimes.stats import ratio_verdict
+from kicktimes.stats import nanmedian, ratio_verdict
 
 __all__ = [
     "COLUMNS",
@@ -110,7 +110,7 @@ def paired_median(numerator, denominator, *, rng, n_boot=1000, level=0.95):
     values = table.to_numpy(float)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)  # a radius without a finite pair
-        per_radius = pd.Series(np.nanmedian(values, axis=1), index=table.index, dtype=float)
+        per_radius = pd.Series(nanmedian(values, axis=1), index=table.index, dtype=float)
     usable = np.isfinite(per_radius.to_numpy())
     n_pairs = int(np.isfinite(values).sum())
     if not usable.any():
@@ -124,7 +124,7 @@ def paired_median(numerator, denominator, *, rng, n_boot=1000, level=0.95):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)  # a resample without a finite pair
         for b in range(n_boot):
-            boot_r[b] = np.nanmedian(values[:, idx[b]], axis=1)
+            boot_r[b] = nanmedian(values[:, idx[b]], axis=1)
         boot = np.nanmean(boot_r[:, usable], axis=1)
         a = (1 - level) / 2 * 100
         low_r = np.nanpercentile(boot_r, a, axis=0)

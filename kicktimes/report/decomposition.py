@@ -37,6 +37,7 @@ import pandas as pd
 
 from kicktimes.report.common import REFERENCE, wide
 from kicktimes.report.controls import diagnostics_of
+from kicktimes.stats import nanmedian
 
 __all__ = ["LADDER", "STEPS", "gap_decomposition", "gap_figure", "gap_summary"]
 
@@ -83,7 +84,11 @@ def _ratio_medians(x, y, idx):
     with np.errstate(invalid="ignore", divide="ignore"), warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)  # a radius without pairs
         q = x / y
-        return np.nanmean(np.nanmedian(q[:, idx], axis=2), axis=0)
+        # resamples in blocks: q[:, idx] holds radii x B x N values at once otherwise
+        block = max(1, 2_000_000 // max(q.size, 1))
+        medians = np.concatenate([nanmedian(q[:, idx[b:b + block]], axis=2)
+                                  for b in range(0, idx.shape[0], block)], axis=1)
+        return np.nanmean(medians, axis=0)
 
 
 def _shares(rho):

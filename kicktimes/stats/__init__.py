@@ -48,6 +48,7 @@ from .renewal import (
     fit_renewal,
 )
 from .rescaling import RescaledTimes, mmpp_residuals
+from .robust import nanmedian
 from .survival import EscapeTail, circle_escape_constant, escape_survival, fit_escape_tail
 
 __all__ = [
@@ -72,6 +73,7 @@ __all__ = [
     "mean_kinetic_rate",
     "circle_escape_constant",
     "escape_survival",
+    "nanmedian",
     "fit_escape_tail",
     "EscapeTail",
     "hyperexpon",
