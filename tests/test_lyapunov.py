@@ -400,3 +400,33 @@ def test_one_pass_kernels_compile_once_without_error_strings(tmp_path):
     assert several == {}
     strings = string_formatting(sigs)
     assert strings == []
+
+
+@pytest.mark.parametrize("rule", ["mirror", "elastic"])
+def test_the_one_pass_records_the_uniform_samples_of_a_uniform_rerun(rule):
+    """lyapunov_pass(uniform=True): the samples at k tau from the paper run's own event loop
+    are bitwise those of the trajectory re-simulated with uniform sampling to its end."""
+    from kicktimes import schedules, simulate_one_particle, simulate_two_particle
+    from kicktimes.diagnostics.lyapunov import lyapunov_pass
+
+    steps = {"sampling": "paper", "n_steps": 1500, "tau": 0.3}
+    for i, ic in enumerate(initial_conditions(6, 0.03, seed=17, rule=rule)):
+        res, run, _, u = lyapunov_pass(ic, 0.02, rule=rule, t_continue=450.0, uniform=True,
+                                       **steps)
+        again = simulate_two_particle(ic, 0.02, t_max=run.t_max, tau=0.3, rule=rule)
+        assert u.tobytes() == again.samples.tobytes()
+        assert res == lyapunov_pass(ic, 0.02, rule=rule, t_continue=450.0, **steps)[0]
+        for law in ("uniform", "scatter"):
+            kicks = schedules.Poisson(0.05).sample(450.0, np.random.default_rng(i))
+            _, one, _, u1 = lyapunov_pass(ic[0], 0.02, kicks=kicks, kick_angle=law,
+                                          rng=np.random.default_rng(i), uniform=True, **steps)
+            again = simulate_one_particle(ic[0], 0.02, t_max=one.t_max, tau=0.3,
+                                          kicks=one.kick_times, kick_angles=one.kick_angles,
+                                          kick_angle=law)
+            assert u1.tobytes() == again.samples.tobytes()
+    # no uniform samples to record: uniform sampling, or holes (the run ends at an escape)
+    ic = initial_conditions(1, 0.03, seed=18)[0]
+    assert lyapunov_pass(ic, 0.02, n_steps=100, tau=0.3, uniform=True)[3] is None
+    assert lyapunov_pass(ic, 0.02, holes=[(0.0, 0.1)], uniform=True, **steps)[3] is None
+    with pytest.raises(TypeError, match="uniform"):
+        lyapunov_pass(ic, 0.02, uniform="yes", **steps)

@@ -376,7 +376,7 @@ def lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rule
     return (res, run) if return_run else res
 
 
-def lyapunov_pass(system, r=None, *, t_continue=0.0, **options):
+def lyapunov_pass(system, r=None, *, t_continue=0.0, uniform=False, **options):
     """`lyapunov` with ``return_run=True``, and the two-disk run continued: for the sweep.
 
     Returns ``(result, run, pp_times)``. With two disks, ``sampling="paper"`` and a run
@@ -385,19 +385,32 @@ def lyapunov_pass(system, r=None, *, t_continue=0.0, **options):
     of ``simulate_two_particle(ic, r, t_max=t_continue, rule=rule).pp_times``; otherwise
     ``pp_times`` is ``run.pp_times`` (``None`` for one disk). Warns as `lyapunov` when
     the exponent is undefined.
+
+    ``uniform=True`` adds a fourth item: with ``sampling="paper"`` and no holes, the
+    tracked disk's centre at ``k tau``, ``k = 0 .. floor(run.t_max / tau)``, recorded by
+    the same event loop, bitwise the samples of the same trajectory re-simulated with
+    uniform sampling to ``t_max = run.t_max`` (for a kicked disk, with the kicks it
+    applied); otherwise ``None``.
     """
     t_continue = chk.check_real("t_continue", t_continue, low=0.0, low_open=False)
-    out = _lyapunov(system, r, return_run=True, t_continue=t_continue, **options)
+    if not isinstance(uniform, bool | np.bool_):
+        raise TypeError(f"uniform must be a bool, got {type(uniform).__name__}")
+    sink = [] if uniform else None
+    out = _lyapunov(system, r, return_run=True, t_continue=t_continue, uniform_out=sink,
+                    **options)
     _warn_undefined(out[0])
-    return out
+    if not uniform:
+        return out
+    return (*out, sink[0] if sink else None)
 
 
 def _lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rule="mirror",
               track=0, kicks=None, kick_angles=None, kick_angle="uniform", sigma=1.0, rng=None,
               method="tangent", variant="norm", d0=None, max_defer=10, e0=None,
               partner="weighted", return_run=False, t_continue=0.0, holes=None,
-              masses=None):
-    """`lyapunov`'s body: ``(result, run or None, pp_times or None)``."""
+              masses=None, uniform_out=None):
+    """`lyapunov`'s body: ``(result, run or None, pp_times or None)``; a list
+    ``uniform_out`` receives the one pass's uniform samples (see `lyapunov_pass`)."""
     arcs = chk.check_holes(holes)
     if arcs is not None:
         if method != "tangent":
@@ -460,7 +473,7 @@ def _lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rul
         rho, sig, st = args[1], args[2], args[0]
         if return_run or arcs is not None:
             res, run, pp = _pass_two(ic, r, rule, sampling, mode, n_steps, tau, track, variant,
-                                     max_events, t_continue, arcs, masses)
+                                     max_events, t_continue, arcs, masses, uniform_out)
             return (res, run, pp) if return_run else (res, None, None)
         if method == "tangent":
             U = _start_vectors(variant, 8, 4 * track)
@@ -505,7 +518,8 @@ def _lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rul
             res, run, _ = _pass_one(st, state, r, times, angles, kick_u, sp, mode, n_steps, tau,
                                     U, variant, max_events, sampling=sampling,
                                     kick_angle=kick_angle, sigma=sigma, rule=rule, e0=e0,
-                                    partner=partner, kinetic=kinetic, holes=arcs)
+                                    partner=partner, kinetic=kinetic, holes=arcs,
+                                    uniform_out=uniform_out)
             return res, (run if return_run else None), None
         out = tangent_one_kernel(st, rho, times, angles, KICK_ANGLES[kick_angle], mode, n_steps,
                                  tau, U, max_events, kick_u, sp, kinetic)
@@ -521,14 +535,16 @@ def _lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rul
 
 
 def _pass_two(ic, r, rule, sampling, mode, n_steps, tau, track, variant, max_ev_tan,
-              t_continue, holes=None, masses=None):
-    """The two-disk run and its tangent FTLE from one pass (`simulate_tangent_two_kernel`)."""
+              t_continue, holes=None, masses=None, uniform_out=None):
+    """The two-disk run and its tangent FTLE from one pass (`simulate_tangent_two_kernel`);
+    its uniform samples appended to the list ``uniform_out`` (see `_uniform_samples`)."""
     args = kernel_args(ic, r, rule, mode, n_steps * tau if mode == 1 else None, n_steps, tau,
                        track, None, masses)
     U = _start_vectors(variant, 8, 4 * track)
     (pp, n_pp_run, bt, bp, bx, by, bs, stimes, samples, t_end, status, log_scale, n_resc,
-     n_pert, t_tan, status_tan, status_cont, escape) = simulate_tangent_two_kernel(
-        *args, U, max_ev_tan, t_continue if mode == 2 else 0.0, holes)
+     n_pert, t_tan, status_tan, status_cont, escape, u_times, u_samples) = (
+        simulate_tangent_two_kernel(*args, U, max_ev_tan, t_continue if mode == 2 else 0.0,
+                                    holes, uniform_out is not None and mode == 2))
     # errors in the order of separate calls: the simulation's, the FTLE's, the continuation's
     out = (pp[:n_pp_run], bt, bp, bx, by, bs, stimes, samples, t_end, np.empty((0, 12)), status,
            escape)
@@ -541,12 +557,27 @@ def _pass_two(ic, r, rule, sampling, mode, n_steps, tau, track, variant, max_ev_
     if status_cont != DONE:
         raise_for_status(status_cont, t_continue, pp.shape[0], max_events=args[11],
                          name="system", where=f"continuing the run to t = {t_continue!r}")
+    _uniform_samples(uniform_out, run, tau, holes, u_samples)
     return res, run, pp
+
+
+def _uniform_samples(sink, run, tau, holes, samples):
+    """Append to ``sink`` (a list, or ``None``: nothing) the uniform samples of a paper run
+    recorded by its one pass, or ``None`` where the pass has none (uniform sampling,
+    holes). A run shorter than one step has the start as its only uniform sample."""
+    if sink is None:
+        return
+    if run.sampling != "paper" or holes is not None:
+        sink.append(None)
+    elif not run.t_max >= tau:
+        sink.append(run.samples[:1])
+    else:
+        sink.append(samples)
 
 
 def _pass_one(st, state, r, times, angles, kick_u, sp, mode, n_steps, tau, U, variant,
               max_ev_tan, *, sampling, kick_angle, sigma, rule, e0, partner, kinetic=None,
-              holes=None):
+              holes=None, uniform_out=None):
     """The kicked run and its tangent FTLE from one pass (`simulate_tangent_one_kernel`).
 
     The simulation is set up and recorded by `simulate_one_particle`'s own helpers
@@ -557,7 +588,8 @@ def _pass_one(st, state, r, times, angles, kick_u, sp, mode, n_steps, tau, U, va
     rho, max_events, b_cap, stall_dt = kernel_limits(st, r, sp, scatter, horizon, mode)
     out = simulate_tangent_one_kernel(
         st, rho, times, angles, KICK_ANGLES[kick_angle], horizon if mode == 1 else 0.0, mode,
-        n_steps, tau, b_cap, kick_u, sp, max_events, stall_dt, U, max_ev_tan, kinetic, holes)
+        n_steps, tau, b_cap, kick_u, sp, max_events, stall_dt, U, max_ev_tan, kinetic, holes,
+        uniform_out is not None and mode == 2)
     raise_for_status(out[9], st[0], out[0].shape[0], max_events=max_events, name="system",
                      where=f"disk at ({st[1]:.6g}, {st[2]:.6g}), r={r!r}")
     check_kinetic_capacity(kinetic, out[6])
@@ -566,6 +598,7 @@ def _pass_one(st, state, r, times, angles, kick_u, sp, mode, n_steps, tau, U, va
                            times=times, applied=kick_u if scatter else angles, rule=rule,
                            e0=e0, partner=partner, escape_time=float(out[15][0]))
     res = _tangent_result(out[10:15], U, (0, 1), variant, horizon, max_ev_tan, "the disk")
+    _uniform_samples(uniform_out, run, tau, holes, out[17])
     return res, run, None
 
 

@@ -33,7 +33,7 @@ N_KICKS, N_B, K, SIM_ON, N_KICKS_RUN = range(5)
 
 @njit(cache=True)
 def drive(st, ev, rho, kicks, angles, kick_mode, kick_u, sp, unit_speed, t_end, mode, tau, logs,
-          stimes, samples, cnt, next_s, fin, tan, kinetic, holes):
+          stimes, samples, cnt, next_s, fin, tan, kinetic, holes, uni=None):
     """Run the event loop from ``st``/``ev``; returns `ob.DONE`, or `ob.FULL` when the boundary
     log is full (see `kicktimes.billiard.kernels.drive_two.drive`).
 
@@ -44,7 +44,8 @@ def drive(st, ev, rho, kicks, angles, kick_mode, kick_u, sp, unit_speed, t_end, 
     ``kinetic = (e, rates, l_first, dl)`` or ``None``: kinetic kicks, whose times the loop
     writes into ``kicks`` as it goes: after kick ``i`` the next comes
     `one.kinetic_delay` later, with the number ``e[i + 1]``. ``holes = (arcs, escape)`` or
-    ``None``: the table's holes, as in `kicktimes.billiard.kernels.drive_two.drive`.
+    ``None``: the table's holes, and ``uni`` (or ``None``) the uniform samples of a
+    paper-sampled run, both as in `kicktimes.billiard.kernels.drive_two.drive`.
     """
     bt, bx, by, bs, klog = logs
     s = one.load(st, ev)
@@ -61,6 +62,12 @@ def drive(st, ev, rho, kicks, angles, kick_mode, kick_u, sp, unit_speed, t_end, 
         m = U.shape[0]
         i_loop, n_loop, n_ev, n_same, n_resc, n_pert, tk, t_prev, tan_code = tg.load_carry(
             tgi, tgf)
+    uni_on = False
+    if uni is not None:
+        u_times, u_samples, u_cnt = uni
+        ku = u_cnt[0]
+        uni_on = u_cnt[1] != 0
+        u_limit = u_cnt[2]
     scatter = kick_mode == one.SCATTER
     nk = kicks.shape[0]
     ns = stimes.shape[0]
@@ -104,6 +111,18 @@ def drive(st, ev, rho, kicks, angles, kick_mode, kick_u, sp, unit_speed, t_end, 
                     tg.end_step(U, log_scale, t_end - t, n_orth)
                     t_prev = t_end
                     tan_on = False
+        if uni is not None and uni_on:
+            # the uniform samples of the same flight (see drive_two.drive)
+            if sim_on:
+                ku = ob.sample_uniform(u_times, u_samples, ku, u_times.shape[0], t, dte,
+                                       s[one.S_X], s[one.S_Y], s[one.S_VX], s[one.S_VY], tau)
+            else:
+                if u_limit < 0:
+                    u_limit = ob.uniform_limit(fin[0], tau, u_times.shape[0])
+                ku = ob.sample_uniform(u_times, u_samples, ku, u_limit, t, dte, s[one.S_X],
+                                       s[one.S_Y], s[one.S_VX], s[one.S_VY], tau)
+                if t + dte > fin[0]:
+                    uni_on = False
         if tan is not None:
             # the tangent vectors' step ends before the next event
             # (the kicked disk's tangent vectors have one step in mode 1: no Gram-Schmidt,
@@ -120,7 +139,7 @@ def drive(st, ev, rho, kicks, angles, kick_mode, kick_u, sp, unit_speed, t_end, 
                     tan_on = False
                     break
                 tk = min(t_prev + tau, t + dte)
-        if not (sim_on or tan_on):
+        if not (sim_on or tan_on or uni_on):
             status = ob.DONE
             break
         if not is_kick and sim_on and n_b >= b_cap:
@@ -181,6 +200,10 @@ def drive(st, ev, rho, kicks, angles, kick_mode, kick_u, sp, unit_speed, t_end, 
     cnt[K] = k
     cnt[SIM_ON] = 1 if sim_on else 0
     next_s[0] = ns_next
+    if uni is not None:
+        u_cnt[0] = ku
+        u_cnt[1] = 1 if uni_on else 0
+        u_cnt[2] = u_limit
     if tan is not None:
         tg.store_carry(tgi, tgf, tan_on, i_loop, n_ev, n_same, n_resc, n_pert, tk, t_prev,
                        tan_code)
@@ -189,7 +212,7 @@ def drive(st, ev, rho, kicks, angles, kick_mode, kick_u, sp, unit_speed, t_end, 
 
 @njit(cache=True)
 def _run(st, rho, kicks, angles, kick_mode, t_max, mode, n_steps, tau, b_cap, kick_u, sp,
-         max_events, stall_dt, sim, tan, kinetic, holes):
+         max_events, stall_dt, sim, tan, kinetic, holes, uni=None):
     """Allocate the logs, run `drive` to its end, growing the boundary log when full.
 
     With ``kinetic`` (see `drive`) the first kick's time is set here, from the initial
@@ -218,7 +241,7 @@ def _run(st, rho, kicks, angles, kick_mode, t_max, mode, n_steps, tau, b_cap, ki
     while True:
         loop = drive(st, ev, rho, kicks, angles, kick_mode, kick_u, sp, unit_speed, t_end, mode,
                      tau, (bt, bx, by, bs, klog), stimes, samples, cnt, next_s, fin, tan,
-                     kinetic, holes)
+                     kinetic, holes, uni)
         if loop == ob.DONE:
             break
         # a full boundary log
@@ -261,15 +284,15 @@ def simulate_one_kernel(st, rho, kicks, angles, kick_mode, t_max, mode, n_steps,
 
 @njit(cache=True)
 def _simulate(st, rho, kicks, angles, kick_mode, t_max, mode, n_steps, tau, b_cap, kick_u, sp,
-              max_events, stall_dt, tan, kinetic, holes):
+              max_events, stall_dt, tan, kinetic, holes, uni=None):
     """`_run` with the simulation on, and its output as `simulate_one_kernel` returns it;
-    also the tangent half (``tan``, or ``None``)."""
+    also the tangent half (``tan``, or ``None``); ``uni``: see `drive` (not with holes)."""
     escape = np.array([np.inf, -1.0])
     # (two calls, not a conditional argument: numba compiles the holes out when absent)
     if holes is None:
         logs, stimes, samples, cnt, fin, tan, status = _run(
             st, rho, kicks, angles, kick_mode, t_max, mode, n_steps, tau, b_cap, kick_u, sp,
-            max_events, stall_dt, True, tan, kinetic, None)
+            max_events, stall_dt, True, tan, kinetic, None, uni)
     else:
         logs, stimes, samples, cnt, fin, tan, status = _run(
             st, rho, kicks, angles, kick_mode, t_max, mode, n_steps, tau, b_cap, kick_u, sp,
@@ -286,21 +309,29 @@ def _simulate(st, rho, kicks, angles, kick_mode, t_max, mode, n_steps, tau, b_ca
 @njit(cache=True)
 def simulate_tangent_one_kernel(st, rho, kicks, angles, kick_mode, t_max, mode, n_steps, tau,
                                 b_cap, kick_u, sp, max_events, stall_dt, U, max_ev_tan,
-                                kinetic=None, holes=None):
+                                kinetic=None, holes=None, uniform=False):
     """`simulate_one_kernel` and `tangent_one_kernel` in one pass.
 
-    Arguments as theirs (``mode`` 1 or 2). Returns ``(b_time, b_x, b_y, b_sin,
-    sample_times, samples, n_kicks_applied, t_end, kick_log, status, log_scale, n_rescaled,
-    n_kicks_tangent, t_end_tangent, status_tangent)``.
+    Arguments as theirs (``mode`` 1 or 2); ``uniform`` (``mode == 2``, no holes): also the
+    run's uniform samples at ``k tau`` over its duration, bitwise those of a uniform run
+    with the kicks it applied. Returns ``(b_time, b_x, b_y, b_sin, sample_times, samples,
+    n_kicks_applied, t_end, kick_log, status, log_scale, n_rescaled, n_kicks_tangent,
+    t_end_tangent, status_tangent, escape, uniform_times, uniform_samples)``.
     """
+    on = uniform and mode == 2 and holes is None
+    u_times, u_samples = ob.new_samples(n_steps + 2 if on else 0)
+    u_cnt = np.zeros(3, dtype=np.int64)
+    u_cnt[1] = 1 if on else 0
+    u_cnt[2] = -1
     out, tan = _simulate(st, rho, kicks, angles, kick_mode, t_max, mode, n_steps, tau, b_cap,
                          kick_u, sp, max_events, stall_dt,
                          tg.tangent_state(U, mode, n_steps, tau, max_ev_tan, np.int64(0)),
-                         kinetic, holes)
+                         kinetic, holes, (u_times, u_samples, u_cnt))
     _, log_scale, tgi, tgf, _, _, _ = tan
+    ku = u_cnt[0]
     return (out[0], out[1], out[2], out[3], out[4], out[5], out[6], out[7], out[8], out[9],
             log_scale, tgi[tg.N_RESC], tgi[tg.N_PERT], tgf[tg.T_PREV], tgi[tg.TAN_STATUS],
-            out[10])
+            out[10], u_times[:ku], u_samples[:ku])
 
 
 @njit(cache=True)

@@ -46,7 +46,7 @@ N_PP, N_B, K, SIM_ON, N_PP_RUN, CONT_ON, N_B_CONT, CONT_STATUS = range(8)
 
 @njit(cache=True, error_model="numpy")
 def drive(st, ev, phys, t_end, mode, tau, track, logs, stimes, samples, cnt, next_s, fin, tan,
-          cont, holes):
+          cont, holes, uni=None):
     """Run the event loop from ``st``/``ev``; returns `ob.DONE`, or `ob.FULL` when a log is full.
 
     ``phys = (rho, sigma, rule)`` with ``rho = (rho0, rho1)``, one per disk;
@@ -59,6 +59,10 @@ def drive(st, ev, phys, t_end, mode, tau, track, logs, stimes, samples, cnt, nex
     whose wall contact lies in one escapes there and the simulation ends, its time and
     disk written to ``escape = [t, disk]`` (the simulation alone: no tangent, no
     continuation).
+    ``uni = (u_times, u_samples, u_cnt)`` or ``None``: the uniform samples of a
+    paper-sampled run (`observe.sample_uniform`) at ``k tau`` over the run's duration
+    ``T``, recorded in this loop as a uniform run to ``t_max = T`` records them; ``u_cnt =
+    [k, on, limit]`` (``limit`` -1 until ``T`` is known).
 
     The state lives in a tuple of locals for the whole loop (numba keeps it in registers;
     kept in arrays, every event stored and reloaded it, since numba cannot prove that the
@@ -87,6 +91,12 @@ def drive(st, ev, phys, t_end, mode, tau, track, logs, stimes, samples, cnt, nex
         m = U.shape[0]
         i_loop, n_loop, n_ev, n_same, n_resc, n_pert, tk, t_prev, tan_code = tg.load_carry(
             tgi, tgf)
+    uni_on = False
+    if uni is not None:
+        u_times, u_samples, u_cnt = uni
+        ku = u_cnt[0]
+        uni_on = u_cnt[1] != 0
+        u_limit = u_cnt[2]
     ns = stimes.shape[0]
     pp_cap = pp.shape[0]
     b_cap = bt.shape[0]
@@ -131,6 +141,20 @@ def drive(st, ev, phys, t_end, mode, tau, track, logs, stimes, samples, cnt, nex
                         tg.end_step(U, log_scale, t_end - t, n_orth)
                         t_prev = t_end
                         tan_on = False
+        if uni is not None and uni_on:
+            # the uniform samples of the same flight; once the run has ended at T = fin[0],
+            # up to floor(T / tau) steps, and no flight beyond the one a run to T ends in
+            x, y, vx, vy = two.disk(s, track)
+            if sim_on:
+                ku = ob.sample_uniform(u_times, u_samples, ku, u_times.shape[0], t, dte, x, y,
+                                       vx, vy, tau)
+            else:
+                if u_limit < 0:
+                    u_limit = ob.uniform_limit(fin[0], tau, u_times.shape[0])
+                ku = ob.sample_uniform(u_times, u_samples, ku, u_limit, t, dte, x, y, vx, vy,
+                                       tau)
+                if t + dte > fin[0]:
+                    uni_on = False
         if tan is not None:
             # the tangent vectors' step ends before the next event
             while tan_on and not t + dte <= tk:
@@ -154,7 +178,7 @@ def drive(st, ev, phys, t_end, mode, tau, track, logs, stimes, samples, cnt, nex
             elif n_pp + n_b_cont >= cont[1]:
                 cnt[CONT_STATUS] = ob.OVER_BUDGET
                 cont_on = False
-        if not (sim_on or tan_on or cont_on):
+        if not (sim_on or tan_on or cont_on or uni_on):
             status = ob.DONE
             break
         # a full buffer: return before anything of this event is counted
@@ -232,6 +256,10 @@ def drive(st, ev, phys, t_end, mode, tau, track, logs, stimes, samples, cnt, nex
     cnt[CONT_ON] = 1 if cont_on else 0
     cnt[N_B_CONT] = n_b_cont
     next_s[0] = ns_next
+    if uni is not None:
+        u_cnt[0] = ku
+        u_cnt[1] = 1 if uni_on else 0
+        u_cnt[2] = u_limit
     if tan is not None:
         tg.store_carry(tgi, tgf, tan_on, i_loop, n_ev, n_same, n_resc, n_pert, tk, t_prev,
                        tan_code)
@@ -240,11 +268,11 @@ def drive(st, ev, phys, t_end, mode, tau, track, logs, stimes, samples, cnt, nex
 
 @njit(cache=True, error_model="numpy")
 def _run(st, rho, sigma, rule, t_max, mode, n_steps, tau, track, pp_cap, b_cap, max_events,
-         stall_dt, log_pp, sim, tan, cont, holes):
+         stall_dt, log_pp, sim, tan, cont, holes, uni=None):
     """Allocate the logs, run `drive` to its end, growing them when full.
 
     ``sim``: record the simulation; ``tan`` (`tg.tangent_state`, or ``None``): carry tangent
-    vectors; ``cont``: the continuation (see `drive`).
+    vectors; ``cont``: the continuation; ``uni``: the uniform samples (see `drive`).
     Returns ``(logs, stimes, samples, cnt, fin, tan, status)``.
     """
     ev = np.empty(3)
@@ -266,7 +294,7 @@ def _run(st, rho, sigma, rule, t_max, mode, n_steps, tau, track, pp_cap, b_cap, 
     while True:
         logs = (pp, bt, bp, bx, by, bs, ppl, log_pp)
         loop = drive(st, ev, phys, t_end, mode, tau, track, logs, stimes, samples, cnt, next_s,
-                     fin, tan, cont, holes)
+                     fin, tan, cont, holes, uni)
         if cnt[SIM_ON] != 0:
             # budget and stalls are checked only here, when a log is full: nothing in the
             # hot loop
@@ -346,26 +374,35 @@ def simulate_two_kernel(st, rho, sigma, rule, t_max, mode, n_steps, tau, track, 
 @njit(cache=True, error_model="numpy")
 def simulate_tangent_two_kernel(st, rho, sigma, rule, t_max, mode, n_steps, tau, track, pp_cap,
                                 b_cap, max_events, stall_dt, U, max_ev_tan, t_continue,
-                                holes=None):
+                                holes=None, uniform=False):
     """`simulate_two_kernel` (without the collision log) and `tangent_two_kernel` in one pass.
 
     The simulation's arguments are `simulate_two_kernel`'s, ``U`` (m, 8) and
     ``max_ev_tan`` are `tangent_two_kernel`'s (``n_orth = 0``; ``mode`` 1 or 2, the
     tangent vectors run over the same ``n_steps`` and ``tau``). ``t_continue``: with
     ``mode == 2``, continue to it when the sampled window ends before it (``0``: never).
+    ``uniform`` (``mode == 2``, no holes): also the run's uniform samples, at ``k tau``
+    over its duration, bitwise those of a uniform run to the same end.
     ``st`` ends as `simulate_two_kernel` leaves it; ``U`` as `tangent_two_kernel` does.
 
     Returns ``(pp_times, n_pp_run, b_time, b_part, b_x, b_y, b_sin, sample_times, samples,
     t_end, status, log_scale, n_rescaled, n_pp_tangent, t_end_tangent, status_tangent,
-    status_continuation)``: ``pp_times[:n_pp_run]`` are the run's disk-disk times,
-    ``pp_times`` with the continuation's after them.
+    status_continuation, escape, uniform_times, uniform_samples)``: ``pp_times[:n_pp_run]``
+    are the run's disk-disk times, ``pp_times`` with the continuation's after them; the
+    uniform samples are empty unless ``uniform``.
     """
     tan = tg.tangent_state(U, mode, n_steps, tau, max_ev_tan, np.int64(0))
     escape = np.array([np.inf, -1.0])
+    on = uniform and mode == 2 and holes is None
+    u_times, u_samples = ob.new_samples(n_steps + 2 if on else 0)
+    u_cnt = np.zeros(3, dtype=np.int64)
+    u_cnt[1] = 1 if on else 0
+    u_cnt[2] = -1
     if holes is None:
         logs, stimes, samples, cnt, fin, tan, status = _run(
             st, rho, sigma, rule, t_max, mode, n_steps, tau, track, pp_cap, b_cap, max_events,
-            stall_dt, False, True, tan, (t_continue, max_events), None)
+            stall_dt, False, True, tan, (t_continue, max_events), None,
+            (u_times, u_samples, u_cnt))
     else:
         logs, stimes, samples, cnt, fin, tan, status = _run(
             st, rho, sigma, rule, t_max, mode, n_steps, tau, track, pp_cap, b_cap, max_events,
@@ -376,9 +413,11 @@ def simulate_tangent_two_kernel(st, rho, sigma, rule, t_max, mode, n_steps, tau,
     n_b = cnt[N_B]
     t_end = fin[0] if status == ob.DONE else (t_max if mode < 2 else np.inf)
     k = cnt[K] if escape[1] >= 0.0 else stimes.shape[0]
+    ku = u_cnt[0]
     return (pp[: cnt[N_PP]], n_pp_run, bt[:n_b], bp[:n_b], bx[:n_b], by[:n_b], bs[:n_b],
             stimes[:k], samples[:k], t_end, status, log_scale, tgi[tg.N_RESC], tgi[tg.N_PERT],
-            tgf[tg.T_PREV], tgi[tg.TAN_STATUS], cnt[CONT_STATUS], escape)
+            tgf[tg.T_PREV], tgi[tg.TAN_STATUS], cnt[CONT_STATUS], escape, u_times[:ku],
+            u_samples[:ku])
 
 
 @njit(cache=True, error_model="numpy")

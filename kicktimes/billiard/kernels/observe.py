@@ -4,7 +4,9 @@ The observers of a run, shared by the two-disk and the kicked-disk drivers:
 
 * sampling (`sample_flight`, `sample_at_event`): the tracked disk's centre at the sample
   times that fall on the current free flight (interpolated, before the event), and, under
-  the paper's collision-truncated steps, at the event itself;
+  the paper's collision-truncated steps, at the event itself; `sample_uniform` samples
+  the same flights at ``k tau`` too (a paper-sampled run's uniform samples, in the same
+  loop);
 * logs that grow (`grow_to`, `grow_rows_to`): a driver's loop only *detects* a full
   buffer and returns `FULL`; its caller grows the buffer outside the loop (an array
   reassigned inside a numba loop costs reference counting on every iteration) and checks
@@ -23,7 +25,7 @@ from kicktimes.billiard.checks import STALL_EVENTS
 
 __all__ = ["DONE", "FULL", "OVER_BUDGET", "STALLED", "grow_boundary_log", "grow_rows_to",
            "grow_to", "in_hole", "new_boundary_log", "new_samples", "sample_at_event",
-           "sample_flight", "stalled"]
+           "sample_flight", "sample_uniform", "stalled", "uniform_limit"]
 
 # status codes of the event loops
 DONE, FULL, STALLED, OVER_BUDGET = 0, 1, 2, 3
@@ -109,6 +111,31 @@ def sample_flight(stimes, samples, k, next_time, t, dt, x, y, vx, vy, mode, tau)
         k += 1
         next_time = k * tau if mode == 1 else next_time + tau
     return k, next_time
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def sample_uniform(stimes, samples, k, limit, t, dt, x, y, vx, vy, tau):
+    """`sample_flight` at ``k tau`` (its mode 1) with the samples capped at ``limit``;
+    returns ``k``. A second sampler of the same flights: the uniform samples of a
+    paper-sampled run, which a uniform run over the same time records bit for bit (the same
+    sample times ``k tau``, the same interpolation)."""
+    next_time = k * tau
+    while k < limit and next_time - t < dt:
+        ds = next_time - t
+        stimes[k] = next_time
+        samples[k, 0] = x + vx * ds
+        samples[k, 1] = y + vy * ds
+        k += 1
+        next_time = k * tau
+    return k
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def uniform_limit(t_end, tau, cap):
+    """How many uniform samples a run to ``t_end`` has: ``k tau`` for ``k = 0 ..
+    floor(t_end / tau (1 + 1e-12))``, as `kicktimes.billiard.checks.check_sampling` counts
+    the steps of ``t_max = t_end`` (at most ``cap``)."""
+    return min(np.int64(math.floor(t_end / tau * (1.0 + 1e-12))) + 1, cap)
 
 
 @njit(cache=True, inline="always", error_model="numpy")
