@@ -307,6 +307,20 @@ def escape_answer(comparison) -> str:
     otherwise "It depends on the radius", "... on the kicked system" or "... on the radius
     and the kicked system" (whichever splits the verdicts cleanly), with the numbers of
     the cases that differ. Comparisons that could not be made ("n/a") are named.
+
+    Examples
+    --------
+    >>> import numpy as np, pandas as pd
+    >>> rng = np.random.default_rng(0)
+    >>> rows = [(0.02, ic, system, name, value)
+    ...         for system in ("two_particle", "poisson")
+    ...         for ic, t in enumerate(rng.exponential(40.0, 500))
+    ...         for name, value in (("escape_time", t), ("t_max", t), ("escaped_disk", 0.0))
+    ...         if name != "escaped_disk" or system == "two_particle"]
+    >>> results = pd.DataFrame(rows, columns=["radius", "ic", "system", "diagnostic", "value"])
+    >>> table = escape_table(escape_runs(results), t_min=10.0)
+    >>> escape_answer(escape_comparison(table))[:55]
+    'Does the kicked disk escape like the two disks? Yes: at'
     """
     check_frame("comparison", comparison, ["radius", "system", "verdict", "reason"],
                 allow_empty=True)
