@@ -152,7 +152,8 @@ class Experiment:
     holes : sequence of (float, float)
         Holes in the table's wall, rows ``(centre angle, half-width)`` in radians (default
         none): every run ends when a disk escapes (docs/escape.md), its ``escape_time``
-        row is stored (``inf``: none by the end), and the disk kicked at actual times gets
+        row is stored (``inf``: none by the end) and, for the two-disk run, its
+        ``escaped_disk`` row (0, 1, or -1 for none), and the disk kicked at actual times gets
         the two-disk run's collision times up to its end (no continuation). Needs
         ``lyapunov_method = "tangent"``.
     description : str

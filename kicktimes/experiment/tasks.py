@@ -287,8 +287,11 @@ def _run_ic(exp: Experiment, r: float, ic_index: int, ic: np.ndarray, rows, coll
         add("two_particle", "n_pp", two.n_pp)
         add("two_particle", "n_boundary", n_b0)
         if holes:
-            add("two_particle", "escape_time", two.escape_time,
-                "" if two.escaped >= 0 else "no escape by the end of the run")
+            none = "" if two.escaped >= 0 else "no escape by the end of the run"
+            add("two_particle", "escape_time", two.escape_time, none)
+            # which disk left (the run's `escaped`: 0, 1, or -1 for none): the kicked
+            # systems follow disk 0, so disk 1's escape censors disk 0's (report/escape.py)
+            add("two_particle", "escaped_disk", two.escaped, none)
         diagnose(
             "two_particle",
             two,

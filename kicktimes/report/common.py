@@ -98,6 +98,9 @@ class Context:
     max_ics_tests: int | None = None
     max_ics_model_fits: int = 12
     max_pooled_intervals: int = 200_000
+    #: where the escape section's tail fits start (None: `report.escape.T_MIN_FRACTION` of
+    #: the horizon)
+    escape_t_min: float | None = None
     pmap: object = map
     #: ``pstart(fn, jobs)`` starts ``fn`` over ``jobs`` now and returns a callable giving
     #: the results later (:meth:`Mapper.start`); None: the sections use ``pmap``

@@ -19,6 +19,7 @@ spreads over every core once the smaller one is done.
 from __future__ import annotations
 
 import html
+import math
 import os
 import time
 from concurrent.futures import ProcessPoolExecutor
@@ -56,6 +57,7 @@ def _stages():
     from kicktimes.report import (
         autocorrelation,
         counts,
+        escape,
         findings,
         heterogeneity,
         kick_times,
@@ -80,6 +82,7 @@ def _stages():
         ("renewal models", renewal),
         ("MMPP", mmpp),
         ("rate heterogeneity", heterogeneity),
+        ("escape", escape),
         ("findings", findings),
     )
 
@@ -292,6 +295,7 @@ def build_report(
     workers=None,
     n_boot=2000,
     tolerance=0.1,
+    escape_t_min=None,
     pdf=False,
     force=False,
 ) -> Path:
@@ -336,6 +340,10 @@ def build_report(
     tolerance : float, optional
         Half-width of the band of a ratio's verdict: "within 10 %" when the 95 % CI
         lies inside ``[1 - tolerance, 1 + tolerance]`` (see :mod:`kicktimes.report.effects`).
+    escape_t_min : float, optional
+        Where the escape section's tail fits start, in time units (stores of experiments
+        with holes; default: 1/20 of the experiment's horizon ``n_steps * tau``; see
+        :mod:`kicktimes.report.escape`).
     pdf : bool, optional
         Also write a PDF of every figure (the page embeds the PNGs; default False).
     force : bool, optional
@@ -390,6 +398,7 @@ def build_report(
         workers=workers,
         n_boot=n_boot,
         tolerance=tolerance,
+        escape_t_min=escape_t_min,
         pdf=pdf,
         force=force,
     )
@@ -425,7 +434,8 @@ def build_report(
 
 
 def _check_options(out_dir, *, progress, alpha, n_mc, max_ics_tests, max_ics_model_fits,
-                   max_pooled_intervals, dpi, workers, n_boot, tolerance, pdf, force):
+                   max_pooled_intervals, dpi, workers, n_boot, tolerance, escape_t_min, pdf,
+                   force):
     """The checked arguments of :func:`build_report` as ``(options, render, workers)``:
     ``options`` the sections' (as `Context` takes them), ``render`` the figures'."""
     if not isinstance(out_dir, str | os.PathLike):
@@ -438,6 +448,7 @@ def _check_options(out_dir, *, progress, alpha, n_mc, max_ics_tests, max_ics_mod
         "max_pooled_intervals": check_int("max_pooled_intervals", max_pooled_intervals, 100),
         "n_boot": check_int("n_boot", n_boot, 100),
         "tolerance": check_fraction("tolerance", tolerance),
+        "escape_t_min": _check_t_min(escape_t_min),
     }
     render = {"dpi": check_int("dpi", dpi, 30), "pdf": pdf}
     workers = check_int("workers", (os.cpu_count() or 1) if workers is None else workers, 1)
@@ -450,6 +461,16 @@ def _check_options(out_dir, *, progress, alpha, n_mc, max_ics_tests, max_ics_mod
             f"{type(progress).__name__}"
         )
     return options, render, workers
+
+
+def _check_t_min(value):
+    if value is None:
+        return None
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        raise TypeError(f"escape_t_min must be a number or None, got {type(value).__name__}")
+    if not (math.isfinite(value) and value > 0):
+        raise ValueError(f"escape_t_min must be positive and finite, got {float(value)}")
+    return float(value)
 
 
 @dataclass

@@ -11,6 +11,7 @@ import pandas as pd
 from matplotlib.lines import Line2D
 
 from kicktimes.report.common import REFERENCE, Section, distinct
+from kicktimes.report.escape import ESCAPE_ROWS
 from kicktimes.report.figures import (
     _PAPER_BAR,
     _SEM_BAR,
@@ -250,9 +251,11 @@ def sections(ctx):
     """The summary and comparison tables of every diagnostic of the store (CSV only)."""
     results = ctx.results
     # the run's length, its kick rate and the mmpp system's fitted parameters describe the
-    # run: not diagnostics to compare with the two-disk system
+    # run: not diagnostics to compare with the two-disk system; the escape rows (inf when
+    # nothing escaped) are the escape section's, with their censoring
     names = pd.Series(results["diagnostic"].astype(str))
-    drop = names.isin(["t_max", "kick_rate"]) | names.str.startswith("mmpp_")
+    drop = (names.isin(["t_max", "kick_rate", *ESCAPE_ROWS])
+            | names.str.startswith("mmpp_"))
     diag = results[~drop.to_numpy()]
     summary = diagnostic_summary(diag)
     comparison = comparison_table(summary)
