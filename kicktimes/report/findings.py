@@ -94,6 +94,7 @@ def section(ctx):
     computed = compute_controls(
         ctx.results, ctx.store.collisions, family=ctx.exp.name, eps=ctx.exp.eps,
         rule=ctx.exp.rule, rng=ctx.boot_rng(), n_boot=ctx.n_boot, resamples=ctx.resamples,
+        kinetic=ctx.exp.kinetic_rate,
     )
     controls = computed.table
     ctx.found.controls = computed
@@ -116,6 +117,7 @@ def section(ctx):
     gaps = gap_decomposition(
         ctx.results, ctx.store.collisions, family=ctx.exp.name, eps=ctx.exp.eps,
         rule=ctx.exp.rule, rng=ctx.boot_rng(), n_boot=min(ctx.n_boot, 1000),
+        kinetic=ctx.exp.kinetic_rate,
     )
     ctx.found.gaps = gaps
     if not gaps.empty:
