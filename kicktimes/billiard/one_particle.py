@@ -341,6 +341,15 @@ def simulate_one_particle(state, r, *, t_max=None, kicks=None, kick_angle="unifo
     ...                             kick_angle="scatter", rng=1)
     >>> hit.kick_log.shape[0] == hit.n_kicks
     True
+
+    A partner of another radius (and, under the elastic rule, mass), e.g. the other disk
+    of an unequal pair (docs/unequal.md):
+
+    >>> big = simulate_one_particle(state, 0.02, t_max=100.0, kicks=schedules.Poisson(0.1),
+    ...                             kick_angle="scatter", rule="elastic", partner_radius=0.05,
+    ...                             partner_mass=3.0, rng=1)
+    >>> big.partner_radius, big.partner_mass
+    (0.05, 3.0)
     """
     r = chk.check_real("r", r, low=0.0, high=1.0)
     chk.check_choice("kick_angle", kick_angle, KICK_ANGLES)
