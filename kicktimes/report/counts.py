@@ -18,7 +18,8 @@ from kicktimes.report.figures import (
     radius_axis,
 )
 
-__all__ = ["counts_by_radius", "counts_vs_radius", "kinetic_rate_of", "sticky_ics",
+__all__ = ["counts_by_radius", "counts_vs_radius", "experiment_kinetic", "kinetic_rate_of",
+           "sticky_ics",
            "STICKY_FACTOR", "sections"]
 
 #: an IC is "sticky" when its disk-disk collision rate exceeds this multiple of the
@@ -35,6 +36,14 @@ def kinetic_rate_of(radius, rule="mirror", kinetic=None):
     from kicktimes import stats
 
     return stats.kinetic_rate(radius, rule)
+
+
+def experiment_kinetic(exp):
+    """The kinetic rate of an experiment's disks as a function of the radius
+    (``Experiment.kinetic_rate``: the pair's for unequal disks), or ``None`` for an object
+    without one (the event times of `kicktimes analyze`, a duck-typed experiment): then the
+    equal disks' rate under its rule."""
+    return getattr(exp, "kinetic_rate", None)
 
 
 def sticky_ics(collisions, rule="mirror", *, factor=STICKY_FACTOR,
@@ -189,10 +198,11 @@ def sections(ctx):
     table = counts_by_radius(coll)
     grouped = coll.groupby("radius")
     table["pooled_rate"] = grouped["n_pp"].sum() / grouped["t_window"].sum()
-    table["kinetic_rate"] = exp.kinetic_rate(table.index.to_numpy())
+    kinetic = experiment_kinetic(exp)
+    table["kinetic_rate"] = kinetic_rate_of(table.index.to_numpy(), exp.rule, kinetic)
     table["rate_over_kinetic"] = table["pooled_rate"] / table["kinetic_rate"]
     table["dispersion_index"] = grouped["n_pp"].var(ddof=1) / grouped["n_pp"].mean()
-    sticky = sticky_ics(coll, exp.rule, kinetic=exp.kinetic_rate)
+    sticky = sticky_ics(coll, exp.rule, kinetic=kinetic)
     ctx.found.sticky = sticky
     table["n_sticky"] = sticky.groupby("radius")["sticky"].sum().astype(int)
     sec = Section("counts", "Number of disk-disk collisions against radius")
@@ -224,7 +234,7 @@ def sections(ctx):
         od = reg.overdispersion()
     sec.figure(
         "fig04_counts_vs_radius",
-        counts_vs_radius(coll, reg, rule=exp.rule, kinetic=exp.kinetic_rate),
+        counts_vs_radius(coll, reg, rule=exp.rule, kinetic=kinetic),
         "Mean number of disk-disk collisions per run against radius (± s.e.m. over ICs) with "
         "the paper's least-squares line, Poisson and negative-binomial regressions and the "
         f"kinetic-theory count Γ(r)·T ({exp.rule} rule), curves at the mean window T(r).",
@@ -264,7 +274,8 @@ def effects(ctx):
 
     coll = ctx.store.collisions.set_index(["radius", "ic"])
     r = coll.index.get_level_values("radius").to_numpy(float)
-    expected = ctx.exp.kinetic_rate(r) * coll["t_window"].to_numpy(float)
+    expected = (kinetic_rate_of(r, ctx.exp.rule, experiment_kinetic(ctx.exp))
+                * coll["t_window"].to_numpy(float))
     expected = pd.Series(expected, index=coll.index)
     per_r, tot = store_ratio(ctx, coll["n_pp"].astype(float), expected)
     sticky = ctx.found.sticky

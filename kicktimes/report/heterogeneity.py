@@ -10,7 +10,7 @@ import pandas as pd
 from matplotlib.figure import Figure
 
 from kicktimes.report.common import Section, fmt
-from kicktimes.report.counts import counts_by_radius, kinetic_rate_of
+from kicktimes.report.counts import counts_by_radius, experiment_kinetic, kinetic_rate_of
 from kicktimes.report.figures import check_frame, plain_log_ticks, x_axis
 
 __all__ = ["rate_heterogeneity", "sections"]
@@ -193,7 +193,7 @@ def sections(ctx):
     sec.figure(
         "fig10_rate_heterogeneity",
         rate_heterogeneity(ctx.store.collisions, homogeneity=het, rule=exp.rule,
-                           kinetic=exp.kinetic_rate),
+                           kinetic=experiment_kinetic(exp)),
         "(a) Disk-disk collision rate n_pp / t_window of every IC, the pooled and median rates "
         f"and the kinetic rate ({exp.rule}); (b) index of dispersion of the counts across ICs; "
         "on top, the asymptotic p-value of the Pearson χ² test of a common rate (given the "

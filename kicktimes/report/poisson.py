@@ -16,7 +16,7 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
 from kicktimes.report.common import Section, fmt_rho, pct, seeded_rng, spearman
-from kicktimes.report.counts import kinetic_rate_of
+from kicktimes.report.counts import experiment_kinetic, kinetic_rate_of
 from kicktimes.report.effects import SHARE_RULE, Effect, share_verdict
 from kicktimes.report.figures import (
     check_alpha,
@@ -267,7 +267,7 @@ def _jobs(ctx):
         # (event times from elsewhere, `kicktimes analyze`, have no kick schedules)
         control = ((exp.seed, exp.horizon) if "poisson" in getattr(exp, "systems", ()) else None)
         jobs.append((r, seqs, part["t_window"].to_numpy(float), ctx.alpha, ctx.n_mc, key,
-                     float(kinetic_rate_of(r, exp.rule, getattr(exp, "kinetic_rate", None))),
+                     float(kinetic_rate_of(r, exp.rule, experiment_kinetic(exp))),
                      part["ic"].to_numpy(), control))
     return jobs
 
