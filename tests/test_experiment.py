@@ -251,10 +251,10 @@ def test_a_single_eps_is_accepted_and_kept_as_a_tuple():
 
 def legacy_record(exp: Experiment) -> dict:
     """The record of a store written before eps lists, acf_max_lag, rr_sampling,
-    lyapunov_method and holes."""
+    lyapunov_method, holes and unequal disks (partner_ratio, partner_mass)."""
     record = exp.to_dict()
     del record["acf_max_lag"], record["rr_sampling"], record["lyapunov_method"]
-    del record["holes"]
+    del record["holes"], record["partner_ratio"], record["partner_mass"]
     record["eps"] = record["eps"][0]
     return record
 

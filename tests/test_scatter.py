@@ -63,7 +63,7 @@ def test_normal_angle_to_the_relative_velocity_has_density_cos_phi():
     rng = np.random.default_rng(2)
     phis = []
     for a, b in rng.uniform(-1, 1, (20000, 2)):
-        ux, uy, nx, ny = draw_partner(0.6, 0.8, a, b, 0, 0.0, 0)
+        ux, uy, nx, ny = draw_partner(0.6, 0.8, a, b, 0, 0.0, 0, 1.0, 1.0)
         wx, wy = 0.6 - ux, 0.8 - uy
         phis.append(math.atan2(wx * ny - wy * nx, wx * nx + wy * ny))
         assert math.hypot(ux, uy) == pytest.approx(1.0)
@@ -72,7 +72,7 @@ def test_normal_angle_to_the_relative_velocity_has_density_cos_phi():
 
 
 def test_elastic_partner_has_the_energy_left_by_the_disk():
-    ux, uy, _, _ = draw_partner(0.3, 0.4, 0.2, 0.1, 1, 1.0, 0)
+    ux, uy, _, _ = draw_partner(0.3, 0.4, 0.2, 0.1, 1, 1.0, 0, 1.0, 1.0)
     assert 0.25 + ux * ux + uy * uy == pytest.approx(2.0)
 
 
@@ -114,7 +114,7 @@ def test_collision_log_is_a_contact_and_the_rule_applied_to_its_normal(law_sampl
     np.testing.assert_allclose(gap, 2 * R_LAW, rtol=0, atol=1e-12)
     for row in c.itertuples():
         after = collide_with_partner(row.vx0, row.vy0, row.vx1, row.vy1, row.nx, row.ny,
-                                     0 if rule == "mirror" else 1)
+                                     0 if rule == "mirror" else 1, 1.0)
         np.testing.assert_allclose(after, (row.vx0_post, row.vy0_post), atol=1e-9)
         # approaching before: (v0 - v1).n > 0 with n from disk 0 towards disk 1
         assert (row.vx0 - row.vx1) * row.nx + (row.vy0 - row.vy1) * row.ny > 0
@@ -150,41 +150,50 @@ def test_state_blind_uniform_kicks_do_not_reproduce_the_collision_law(law_sample
 # --- the twin's kick map and its linearisation -------------------------------------------
 
 
-def _reference_collision(rule, a=0.4, b=-0.3):
+#: (contact distance r0 + r1, normalised masses m0, m1): equal disks, and a partner of
+#: another radius and three times the mass
+PAIRS = [(0.04, 1.0, 1.0), (0.07, 0.5, 1.5)]
+
+
+def _reference_collision(rule, a=0.4, b=-0.3, pair=PAIRS[0]):
     x, y, vx, vy = 0.1, -0.2, 0.6, 0.8
     e0 = 1.0
+    sigma, m0, m1 = pair
     if rule == 1:
         vx, vy = 0.9, 0.3
-    ux, uy, nx, ny = draw_partner(vx, vy, a, b, rule, e0, 0)
-    sigma = 0.04
+    ux, uy, nx, ny = draw_partner(vx, vy, a, b, rule, e0, 0, m0, m1)
     return (x, y, vx, vy), (x + sigma * nx, y + sigma * ny, ux, uy), (nx, ny), sigma
 
 
+@pytest.mark.parametrize("pair", PAIRS)
 @pytest.mark.parametrize("rule", [0, 1])
-def test_the_reference_meets_its_partner_at_the_kick_time(rule):
-    (x, y, vx, vy), (px, py, ux, uy), (nx, ny), sigma = _reference_collision(rule)
-    x2, y2, vx2, vy2, hit = twin_meets_partner(x, y, vx, vy, px, py, ux, uy, sigma, rule)
+def test_the_reference_meets_its_partner_at_the_kick_time(rule, pair):
+    (x, y, vx, vy), (px, py, ux, uy), (nx, ny), sigma = _reference_collision(rule, pair=pair)
+    k0 = pair[2]
+    x2, y2, vx2, vy2, hit = twin_meets_partner(x, y, vx, vy, px, py, ux, uy, sigma, rule, k0)
     assert hit
-    expected = collide_with_partner(vx, vy, ux, uy, nx, ny, rule)
+    expected = collide_with_partner(vx, vy, ux, uy, nx, ny, rule, k0)
     np.testing.assert_allclose((vx2, vy2), expected, atol=1e-12)
     np.testing.assert_allclose((x2, y2), (x, y), atol=1e-12)
 
 
+@pytest.mark.parametrize("pair", PAIRS)
 @pytest.mark.parametrize("rule", [0, 1])
 @pytest.mark.parametrize("ab", [(0.4, -0.3), (-0.9, 0.8), (0.05, 0.0)])
-def test_tangent_map_is_the_jacobian_of_the_twin_kick_map(rule, ab):
-    z, (px, py, ux, uy), (nx, ny), sigma = _reference_collision(rule, *ab)
+def test_tangent_map_is_the_jacobian_of_the_twin_kick_map(rule, ab, pair):
+    z, (px, py, ux, uy), (nx, ny), sigma = _reference_collision(rule, *ab, pair=pair)
+    k0 = pair[2]
     h = 1e-6
     jac_fd = np.empty((4, 4))
     jac = np.empty((4, 4))
     for i in range(4):
         e = np.zeros(4)
         e[i] = h
-        plus = twin_meets_partner(*(np.array(z) + e), px, py, ux, uy, sigma, rule)
-        minus = twin_meets_partner(*(np.array(z) - e), px, py, ux, uy, sigma, rule)
+        plus = twin_meets_partner(*(np.array(z) + e), px, py, ux, uy, sigma, rule, k0)
+        minus = twin_meets_partner(*(np.array(z) - e), px, py, ux, uy, sigma, rule, k0)
         assert plus[4] and minus[4]
         jac_fd[:, i] = (np.array(plus[:4]) - np.array(minus[:4])) / (2 * h)
-        jac[:, i] = scatter_tangent(z[2], z[3], ux, uy, nx, ny, sigma, rule, *(e / h))
+        jac[:, i] = scatter_tangent(z[2], z[3], ux, uy, nx, ny, sigma, rule, k0, *(e / h))
     scale = np.abs(jac).max()
     assert np.abs(jac - jac_fd).max() <= 1e-6 * scale
 
@@ -194,7 +203,7 @@ def test_a_twin_off_the_partner_line_misses_it():
     # move the twin sideways by more than the contact diameter
     wx, wy = vx - ux, vy - uy
     k = 3 * sigma / math.hypot(wx, wy)
-    out = twin_meets_partner(x - wy * k, y + wx * k, vx, vy, px, py, ux, uy, sigma, 0)
+    out = twin_meets_partner(x - wy * k, y + wx * k, vx, vy, px, py, ux, uy, sigma, 0, 1.0)
     assert not out[4]
     assert out[2:4] == (vx, vy)
 

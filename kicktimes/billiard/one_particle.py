@@ -185,23 +185,43 @@ def check_kinetic_capacity(kinetic, n_applied: int) -> None:
                            "please report it")
 
 
-def check_scatter_options(state, r, kick_angle, rule, e0, partner):
-    """Validate the scattering-kick options; returns ``(sp, rule, e0, partner)``.
+def check_scatter_options(state, r, kick_angle, rule, e0, partner, partner_radius=None,
+                          partner_mass=None):
+    """Validate the scattering-kick options; returns ``(sp, options)``.
 
-    ``sp = [2 r, rule code, e0, partner-law code]`` for the kernels. Raises ValueError
-    for options that only make sense with ``kick_angle="scatter"``.
+    ``sp = [r + r1, rule code, e0, partner-law code, 1 - r1, m0, m1]`` for the kernels
+    (`kicktimes.billiard.kernels.one.SCATTER_PARAMS`): ``r1`` the partner's radius
+    (``partner_radius``, default ``r``) and the masses normalised to ``(m0 + m1) / 2 = 1``
+    from ``partner_mass = m1 / m0`` (default 1). ``options`` are the run's record
+    ``{"rule", "e0", "partner", "partner_radius", "partner_mass"}`` (``None`` where they do
+    not apply or keep their default). Raises ValueError for options that only make sense
+    with ``kick_angle="scatter"``, or that the rule does not have.
     """
     chk.check_choice("rule", rule, chk.RULES)
     chk.check_choice("partner", partner, PARTNER_LAWS)
     if kick_angle != "scatter":
-        if rule != "mirror" or e0 is not None or partner != "weighted":
+        if (rule != "mirror" or e0 is not None or partner != "weighted"
+                or partner_radius is not None or partner_mass is not None):
             raise ValueError(
-                f"rule, e0 and partner describe scattering kicks; they need "
-                f"kick_angle='scatter', got kick_angle={kick_angle!r}"
+                f"rule, e0, partner, partner_radius and partner_mass describe scattering "
+                f"kicks; they need kick_angle='scatter', got kick_angle={kick_angle!r}"
             )
-        return np.zeros(4), None, None, None
+        return np.zeros(7), dict.fromkeys(SCATTER_OPTIONS)
     if not r < 0.5:
         raise ValueError(f"r must be < 0.5 for scattering kicks (two disks), got {r!r}")
+    r1 = r
+    if partner_radius is not None:
+        r1 = partner_radius = chk.check_real("partner_radius", partner_radius, low=0.0,
+                                             high=0.5)
+    m0 = m1 = 1.0
+    if partner_mass is not None:
+        if rule != "elastic":
+            raise ValueError(f"partner_mass applies to rule='elastic' (the mirror rule keeps "
+                             f"the disk's speed whatever the masses), got rule={rule!r}")
+        partner_mass = chk.check_real("partner_mass", partner_mass, low=0.0)
+        # normalised to (m0 + m1) / 2 = 1, as the two-disk system's masses
+        m0 = 2.0 / (1.0 + partner_mass)
+        m1 = 2.0 * partner_mass / (1.0 + partner_mass)
     v2 = float(state[2] ** 2 + state[3] ** 2)
     if rule == "mirror":
         if e0 is not None:
@@ -209,20 +229,27 @@ def check_scatter_options(state, r, kick_angle, rule, e0, partner):
         e0_val = 0.0
     else:
         e0_val = 1.0 if e0 is None else chk.check_real("e0", e0, low=0.0)
-        if v2 > 2.0 * e0_val * (1.0 + 1e-12):
+        if m0 * v2 > 2.0 * e0_val * (1.0 + 1e-12):
             raise ValueError(
                 f"e0={e0_val!r}: the pair's kinetic energy must be at least the disk's, "
-                f"|v|^2 / 2 = {v2 / 2.0!r}"
+                f"m0 |v|^2 / 2 = {m0 * v2 / 2.0!r} (masses normalised to (m0 + m1) / 2 = 1)"
             )
         e0 = e0_val
-    sp = np.array([2.0 * r, chk.RULES[rule], e0_val, PARTNER_LAWS[partner]], dtype=np.float64)
-    return sp, rule, e0, partner
+    sp = np.array([r + r1, chk.RULES[rule], e0_val, PARTNER_LAWS[partner], 1.0 - r1, m0, m1],
+                  dtype=np.float64)
+    return sp, {"rule": rule, "e0": e0, "partner": partner, "partner_radius": partner_radius,
+                "partner_mass": partner_mass}
+
+
+#: the scattering kicks' options a `OneParticleRun` records (`check_scatter_options`)
+SCATTER_OPTIONS = ("rule", "e0", "partner", "partner_radius", "partner_mass")
 
 
 def simulate_one_particle(state, r, *, t_max=None, kicks=None, kick_angle="uniform",
                           kick_angles=None, sigma=1.0, rng=None, sampling="uniform",
                           n_steps=None, tau=None, seed=None, rule="mirror", e0=None,
-                          partner="weighted", max_events=None, holes=None) -> OneParticleRun:
+                          partner="weighted", partner_radius=None, partner_mass=None,
+                          max_events=None, holes=None) -> OneParticleRun:
     """Simulate one disk of radius ``r`` in the unit table, kicked at given times.
 
     Parameters
@@ -245,8 +272,9 @@ def simulate_one_particle(state, r, *, t_max=None, kicks=None, kick_angle="unifo
     kick_angle : {"uniform", "gaussian", "scatter"}
         ``"uniform"``: a kick replaces the direction by an angle uniform on [0, 2 pi)
         (the paper's choice). ``"gaussian"``: a kick rotates it by ``N(0, sigma^2)``.
-        ``"scatter"``: a kick is a collision with a virtual partner disk of radius ``r``
-        drawn from the two-disk collision statistics (docs/scatter.md).
+        ``"scatter"``: a kick is a collision with a virtual partner disk (radius
+        ``partner_radius``, default ``r``) drawn from the two-disk collision statistics
+        (docs/scatter.md).
     kick_angles : array_like, optional
         Explicit angles, one per kick (new directions for ``"uniform"``, rotations for
         ``"gaussian"``, shape (n, 2) uniforms on (-1, 1) for ``"scatter"``), e.g.
@@ -260,13 +288,23 @@ def simulate_one_particle(state, r, *, t_max=None, kicks=None, kick_angle="unifo
         Recorded in the run's metadata.
     rule : {"mirror", "elastic"}
         Scattering kicks: the collision rule with the partner. The mirror partner has the
-        disk's speed; the elastic partner has speed ``sqrt(2 e0 - |v|^2)``.
+        disk's speed; the elastic partner has speed ``sqrt((2 e0 - m0 |v|^2) / m1)``.
     e0 : float, optional
         Scattering kicks with ``rule="elastic"``: the pair's kinetic energy
-        ``(|v|^2 + |u|^2) / 2`` (default 1, the two-disk invariant measure's).
+        ``(m0 |v|^2 + m1 |u|^2) / 2`` with the masses normalised to ``(m0 + m1) / 2 = 1``
+        (default 1, the two-disk invariant measure's).
     partner : {"weighted", "uniform"}
         Scattering kicks: the partner's direction, weighted by ``|v - u|`` as at a real
         collision (default) or uniform, independent of ``|v - u|``.
+    partner_radius : float, optional
+        Scattering kicks: the partner's radius ``r1``, ``0 < r1 < 0.5`` (default ``r``,
+        the disk's own). The partner touches the disk at the distance ``r + r1``; the
+        kick log's ``outside`` flags a partner centre beyond its room ``1 - r1``.
+    partner_mass : float, optional
+        Scattering kicks with ``rule="elastic"``: the partner's mass in units of the
+        disk's, ``m1 / m0 > 0`` (default 1). The disk leaves with
+        ``v' = v - 2 m1 / (m0 + m1) ((v - u).n) n`` (momentum and energy of the pair
+        kept, docs/unequal.md).
     max_events : int, optional
         Stop with a ValueError after this many boundary collisions (as in
         `simulate_two_particle`; kicks do not count).
@@ -303,13 +341,24 @@ def simulate_one_particle(state, r, *, t_max=None, kicks=None, kick_angle="unifo
     ...                             kick_angle="scatter", rng=1)
     >>> hit.kick_log.shape[0] == hit.n_kicks
     True
+
+    A partner of another radius (and, under the elastic rule, mass), e.g. the other disk
+    of an unequal pair (docs/unequal.md):
+
+    >>> big = simulate_one_particle(state, 0.02, t_max=100.0, kicks=schedules.Poisson(0.1),
+    ...                             kick_angle="scatter", rule="elastic", partner_radius=0.05,
+    ...                             partner_mass=3.0, rng=1)
+    >>> big.partner_radius, big.partner_mass
+    (0.05, 3.0)
     """
     r = chk.check_real("r", r, low=0.0, high=1.0)
     chk.check_choice("kick_angle", kick_angle, KICK_ANGLES)
     sigma = chk.check_real("sigma", sigma, low=0.0)
     t_max, n_steps, tau, mode = chk.check_sampling(t_max, n_steps, tau, sampling)
     state = check_one_particle_state(state, r)
-    sp, rule, e0, partner = check_scatter_options(state, r, kick_angle, rule, e0, partner)
+    sp, options = check_scatter_options(state, r, kick_angle, rule, e0, partner,
+                                        partner_radius, partner_mass)
+    rule = options["rule"]
     horizon = t_max if mode < 2 else n_steps * tau  # paper steps are at most tau long
     times, angles, _, kinetic = resolve_kicks(kicks, kick_angles, kick_angle=kick_angle,
                                               sigma=sigma, rng=rng, horizon=horizon,
@@ -341,8 +390,8 @@ def simulate_one_particle(state, r, *, t_max=None, kicks=None, kick_angle="unifo
         )
     return one_particle_run(st, r, state, out[:9], sampling=sampling, mode=mode, tau=tau,
                             n_steps=n_steps, seed=seed, kick_angle=kick_angle, sigma=sigma,
-                            times=times, applied=angles, rule=rule, e0=e0, partner=partner,
-                            escape_time=float(out[10][0]))
+                            times=times, applied=angles, escape_time=float(out[10][0]),
+                            **options)
 
 
 def kernel_limits(st, r, sp, scatter, horizon, mode, max_events=None):
@@ -356,7 +405,7 @@ def kernel_limits(st, r, sp, scatter, horizon, mode, max_events=None):
     rho = 1.0 - r
     speed = math.sqrt(st[6])
     if scatter and sp[1] != 0.0:
-        speed = max(speed, math.sqrt(2.0 * sp[2]))
+        speed = max(speed, math.sqrt(2.0 * sp[2] / sp[5]))
     max_events = chk.event_budget(max_events, horizon=horizon,
                                   horizon_name="t_max" if mode < 2 else "n_steps * tau",
                                   speed=speed, rho=rho, n_disks=1)
@@ -364,8 +413,8 @@ def kernel_limits(st, r, sp, scatter, horizon, mode, max_events=None):
 
 
 def one_particle_run(st, r, state, out, *, sampling, mode, tau, n_steps, seed, kick_angle,
-                     sigma, times, applied, rule, e0, partner,
-                     escape_time=math.inf) -> OneParticleRun:
+                     sigma, times, applied, rule, e0, partner, partner_radius=None,
+                     partner_mass=None, escape_time=math.inf) -> OneParticleRun:
     """The `OneParticleRun` of a finished kicked run: ``out`` is the kernel's
     ``(b_time, b_x, b_y, b_sin, sample_times, samples, n_kicks_applied, t_end,
     kick_log)``, ``st`` its final state, ``applied`` the kick angles (or, for scattering
@@ -385,6 +434,8 @@ def one_particle_run(st, r, state, out, *, sampling, mode, tau, n_steps, seed, k
         rule=rule,
         e0=e0,
         partner=partner,
+        partner_radius=partner_radius,
+        partner_mass=partner_mass,
         kick_log_array=klog,
         escape_time=escape_time,
         escaped=0 if math.isfinite(escape_time) else -1,

@@ -86,6 +86,8 @@ class _Run:
     #: 2-D array fields and their column count (stored flat in Parquet)
     _array_columns: ClassVar[dict[str, int]] = {}
     _scalar_fields: ClassVar[tuple[str, ...]] = ()
+    #: scalar fields recorded only when not None (added later: older records lack them)
+    _optional_fields: ClassVar[tuple[str, ...]] = ()
 
     @property
     def n_boundary(self) -> int:
@@ -106,6 +108,8 @@ class _Run:
         out = {"kind": self.kind}
         for name in self._scalar_fields:
             value = getattr(self, name)
+            if value is None and name in self._optional_fields:
+                continue
             out[name] = value.item() if isinstance(value, np.generic) else value
         if self.escaped >= 0:
             out["escape_time"] = float(self.escape_time)
@@ -238,6 +242,10 @@ class OneParticleRun(_Run):
     rule, e0, partner : str, float, str or None
         Scattering kicks only: the collision rule, the pair's kinetic energy (elastic)
         and the partner law (docs/scatter.md).
+    partner_radius, partner_mass : float or None
+        Scattering kicks with a partner of another radius / mass ratio ``m1 / m0``
+        (docs/unequal.md); ``None``: the disk's own radius, equal masses (and left out
+        of ``meta``, so that runs without them keep their records).
     kick_log : DataFrame
         Scattering kicks only: per kick the time, the velocity before and after, the
         contact normal ``n``, the partner's velocity ``u`` and whether the partner's
@@ -255,13 +263,16 @@ class OneParticleRun(_Run):
     rule: str | None = None
     e0: float | None = None
     partner: str | None = None
+    partner_radius: float | None = None
+    partner_mass: float | None = None
     kick_log_array: np.ndarray = field(default_factory=lambda: np.empty((0, 9)))
 
     kind = "one_particle"
     _array_fields = ("kick_times", "kick_angles", "kick_log_array")
     _array_columns = {"kick_log_array": 9}
     _scalar_fields = ("r", "t_max", "sampling", "tau", "n_steps", "kick_angle", "sigma", "seed",
-                      "version", "rule", "e0", "partner")
+                      "version", "rule", "e0", "partner", "partner_radius", "partner_mass")
+    _optional_fields = ("partner_radius", "partner_mass")
 
     @cached_property
     def kick_log(self) -> pd.DataFrame:

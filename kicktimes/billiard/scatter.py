@@ -1,25 +1,32 @@
 """Scattering kicks: a kick that *is* a disk-disk collision with a virtual partner.
 
-At a kick the disk (centre ``x``, velocity ``v``) collides with a partner disk of the same
-radius drawn from the two-disk system's own collision statistics (docs/scatter.md):
+At a kick the disk (centre ``x``, velocity ``v``, radius ``r0``) collides with a partner
+disk of radius ``r1`` (default ``r0``) drawn from the two-disk system's own collision
+statistics (docs/scatter.md, docs/unequal.md):
 
 * the partner's velocity ``u`` is at angle ``D`` from ``v``. Its speed is ``|v|`` under the
-  mirror rule and ``sqrt(2 e0 - |v|^2)`` under the elastic rule (the pair then has the
-  two-disk system's kinetic energy ``e0``). The ``"weighted"`` partner law gives ``D`` the
-  density ``p(D) ~ |v - u(D)|`` on ``(-pi, pi)``, the flux weight of the collision kernel;
-  ``"uniform"`` draws ``D`` uniformly (the issue's literal wording);
+  mirror rule and ``sqrt((2 e0 - m0 |v|^2) / m1)`` under the elastic rule (the pair then
+  has the two-disk system's kinetic energy ``e0``; masses normalised to
+  ``(m0 + m1) / 2 = 1``, so equal masses are ``m0 = m1 = 1``). The ``"weighted"`` partner
+  law gives ``D`` the density ``p(D) ~ |v - u(D)|`` on ``(-pi, pi)``, the flux weight of
+  the collision kernel; ``"uniform"`` draws ``D`` uniformly (the issue's literal wording);
 * the contact normal ``n`` (from the disk's centre towards the partner's) makes the angle
   ``phi = arcsin(b)`` with ``w = v - u``, ``b`` uniform on ``(-1, 1)``, i.e. density
-  ``cos(phi) / 2`` on ``(-pi/2, pi/2)``: the kernel ``(w.n)^+`` of kinetic theory;
+  ``cos(phi) / 2`` on ``(-pi/2, pi/2)``: the kernel ``(w.n)^+`` of kinetic theory (it does
+  not depend on the radii: they only set the contact distance);
 * the collision follows the rule (``"mirror"``: ``v' = v - 2 (v.n) n``; ``"elastic"``:
-  ``v' = v - (w.n) n``). The partner sits at ``x + 2 r n`` with velocity ``u``, which is
-  all a Lyapunov twin needs to meet the same partner.
+  ``v' = v - k0 (w.n) n`` with ``k0 = 2 m1 / (m0 + m1) = m1``, and the partner would leave
+  with ``u' = u + m0 (w.n) n``: momentum ``m0 v + m1 u`` and energy kept). The partner
+  sits at ``x + sigma n``, ``sigma = r0 + r1``, with velocity ``u``, which is all a
+  Lyapunov twin needs to meet the same partner.
 
 Each kick consumes two numbers ``(a, b)`` uniform on ``(-1, 1)``, drawn outside the kernels
 (`draw_scatter_uniforms`), so that reference, twins and tangent vectors see the same
 partner and runs are reproducible.
 
-All kernels take and return plain floats (numba inlines them into the event loops).
+All kernels take and return plain floats (numba inlines them into the event loops). With
+the defaults (``r1 = r0``, ``m0 = m1 = 1``) every factor is exactly 1.0 or the old
+operand, so the arithmetic is bitwise that of the equal-disk kicks.
 """
 
 from __future__ import annotations
@@ -105,30 +112,33 @@ def partner_angle(a, sv, su, law):
 
 
 @njit(cache=True)
-def collide_with_partner(vx, vy, ux, uy, nx, ny, rule):
+def collide_with_partner(vx, vy, ux, uy, nx, ny, rule, k0):
     """The disk's velocity after meeting a partner with velocity ``u`` along normal ``n``.
 
-    ``rule`` 0 (mirror): ``v' = v - 2 (v.n) n``; 1 (elastic): ``v' = v - ((v - u).n) n``.
+    ``rule`` 0 (mirror): ``v' = v - 2 (v.n) n``; 1 (elastic):
+    ``v' = v - k0 ((v - u).n) n`` with ``k0 = 2 m1 / (m0 + m1)`` (1 for equal masses).
     """
     if rule == 0:
         p = 2.0 * (vx * nx + vy * ny)
     else:
-        p = (vx - ux) * nx + (vy - uy) * ny
+        p = k0 * ((vx - ux) * nx + (vy - uy) * ny)
     return vx - p * nx, vy - p * ny
 
 
 @njit(cache=True)
-def draw_partner(vx, vy, a, b, rule, e0, law):
+def draw_partner(vx, vy, a, b, rule, e0, law, m0, m1):
     """Partner velocity ``u`` and contact normal ``n`` of one kick, from ``(a, b)``.
 
-    Returns ``(ux, uy, nx, ny)``; ``n`` is ``(0, 0)`` if ``w = v - u`` vanishes (no
-    collision: ``u = v`` exactly, an event of probability zero).
+    Elastic rule: the partner's speed is ``sqrt((2 e0 - m0 |v|^2) / m1)`` (masses
+    normalised to ``(m0 + m1) / 2 = 1``; ``m0 = m1 = 1`` for equal masses). Returns
+    ``(ux, uy, nx, ny)``; ``n`` is ``(0, 0)`` if ``w = v - u`` vanishes (no collision:
+    ``u = v`` exactly, an event of probability zero).
     """
     sv = math.sqrt(vx * vx + vy * vy)
     if rule == 0:
         su = sv
     else:
-        su = math.sqrt(max(2.0 * e0 - sv * sv, 0.0))
+        su = math.sqrt(max((2.0 * e0 - m0 * sv * sv) / m1, 0.0))
     d = partner_angle(a, sv, su, law)
     if sv > 0.0:
         cx = vx / sv
@@ -156,7 +166,7 @@ def draw_partner(vx, vy, a, b, rule, e0, law):
 
 
 @njit(cache=True)
-def twin_meets_partner(x, y, vx, vy, px, py, ux, uy, sigma, rule):
+def twin_meets_partner(x, y, vx, vy, px, py, ux, uy, sigma, rule, k0):
     """A twin at ``(x, v)`` meets the partner at ``p`` (velocity ``u``) at the kick time.
 
     The kick is a map of the state at the kick time: the twin's straight relative line
@@ -166,6 +176,8 @@ def twin_meets_partner(x, y, vx, vy, px, py, ux, uy, sigma, rule):
     collides there with ``n = -d(s1) / sigma`` and is carried back to the kick time,
     ``x' = x + (v - v') s1``. For the reference ``s1 = 0``. Returns
     ``(x', y', vx', vy', hit)``; ``hit`` is False (state unchanged) if the line misses.
+    ``sigma = r0 + r1`` is the contact distance, ``k0`` the elastic mass factor
+    (`collide_with_partner`).
     """
     dx = x - px
     dy = y - py
@@ -184,12 +196,12 @@ def twin_meets_partner(x, y, vx, vy, px, py, ux, uy, sigma, rule):
     ny /= nn
     if wx * nx + wy * ny <= 0.0:
         return x, y, vx, vy, False  # tangent line from outside: a graze, not a collision
-    vx2, vy2 = collide_with_partner(vx, vy, ux, uy, nx, ny, rule)
+    vx2, vy2 = collide_with_partner(vx, vy, ux, uy, nx, ny, rule, k0)
     return x + (vx - vx2) * s1, y + (vy - vy2) * s1, vx2, vy2, True
 
 
 @njit(cache=True)
-def scatter_tangent(vx, vy, ux, uy, nx, ny, sigma, rule, dx, dy, dvx, dvy):
+def scatter_tangent(vx, vy, ux, uy, nx, ny, sigma, rule, k0, dx, dy, dvx, dvy):
     """Linearised scattering kick: the tangent vector ``(dx, dv)`` through the collision.
 
     The partner's deviation is zero. With ``w = v - u`` and ``n`` the reference normal,
@@ -198,9 +210,10 @@ def scatter_tangent(vx, vy, ux, uy, nx, ny, sigma, rule, dx, dy, dvx, dvy):
 
     * ``dx' = dx + (v - v') dt``
     * mirror: ``dv' = dv - 2 (n.dv) n - 2 [(v.dn) n + (v.n) dn]``
-    * elastic: ``dv' = dv - (n.dv) n - [(w.dn) n + (w.n) dn]``
+    * elastic: ``dv' = dv - k0 (n.dv) n - k0 [(w.dn) n + (w.n) dn]``, ``k0 = 2 m1 / (m0 + m1)``
 
-    (the Dellago-Posch-Hoover collision map for a partner without deviation). Returns
+    (the Dellago-Posch-Hoover collision map for a partner without deviation; ``sigma =
+    r0 + r1`` the contact distance). Returns
     ``(dx', dy', dvx', dvy')``.
     """
     wx = vx - ux
@@ -209,13 +222,13 @@ def scatter_tangent(vx, vy, ux, uy, nx, ny, sigma, rule, dx, dy, dvx, dvy):
     dt = -(dx * nx + dy * ny) / wn
     dnx = -(dx + wx * dt) / sigma
     dny = -(dy + wy * dt) / sigma
-    vx2, vy2 = collide_with_partner(vx, vy, ux, uy, nx, ny, rule)
+    vx2, vy2 = collide_with_partner(vx, vy, ux, uy, nx, ny, rule, k0)
     if rule == 0:
         g = 2.0
         an = vx * nx + vy * ny
         adn = vx * dnx + vy * dny
     else:
-        g = 1.0
+        g = k0
         an = wn
         adn = wx * dnx + wy * dny
     ndv = nx * dvx + ny * dvy
@@ -225,16 +238,18 @@ def scatter_tangent(vx, vy, ux, uy, nx, ny, sigma, rule, dx, dy, dvx, dvy):
 
 
 @njit(cache=True)
-def scatter_kick(st, a, b, sigma, rho, rule, e0, law, out):
+def scatter_kick(st, a, b, sigma, rho1, rule, e0, law, m0, m1, out):
     """Apply a scattering kick to the one-disk state ``st = [t, x, y, vx, vy, c, v2]``.
 
+    ``sigma = r0 + r1`` is the contact distance, ``rho1 = 1 - r1`` the partner's room,
+    ``m0, m1`` the normalised masses (`draw_partner`; the elastic factor is ``k0 = m1``).
     Fills ``out`` (length 9, the `KICK_LOG_COLUMNS`): pre- and post-kick velocity,
     normal, partner velocity, and 1.0 if the partner's centre ``x + sigma n`` lies outside
-    the table (``|x + sigma n| > rho``: a virtual partner, allowed; docs/scatter.md).
+    its room (``|x + sigma n| > rho1``: a virtual partner, allowed; docs/scatter.md).
     """
     vx = st[3]
     vy = st[4]
-    ux, uy, nx, ny = draw_partner(vx, vy, a, b, rule, e0, law)
+    ux, uy, nx, ny = draw_partner(vx, vy, a, b, rule, e0, law, m0, m1)
     out[0] = vx
     out[1] = vy
     out[4] = nx
@@ -243,9 +258,10 @@ def scatter_kick(st, a, b, sigma, rho, rule, e0, law, out):
     out[7] = uy
     px = st[1] + sigma * nx
     py = st[2] + sigma * ny
-    out[8] = 1.0 if px * px + py * py > rho * rho else 0.0
+    out[8] = 1.0 if px * px + py * py > rho1 * rho1 else 0.0
     if nx != 0.0 or ny != 0.0:
-        vx, vy = collide_with_partner(vx, vy, ux, uy, nx, ny, rule)
+        # normalised masses: k0 = 2 m1 / (m0 + m1) = m1
+        vx, vy = collide_with_partner(vx, vy, ux, uy, nx, ny, rule, m1)
     st[3] = vx
     st[4] = vy
     st[6] = vx * vx + vy * vy

@@ -255,7 +255,8 @@ def _start_vectors(variant: str, size: int, offset: int) -> np.ndarray:
 def lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rule="mirror",
              track=0, kicks=None, kick_angles=None, kick_angle="uniform", sigma=1.0, rng=None,
              method="tangent", variant="norm", d0=None, max_defer=10, e0=None,
-             partner="weighted", return_run=False, holes=None, masses=None):
+             partner="weighted", partner_radius=None, partner_mass=None, return_run=False,
+             holes=None, masses=None):
     """Finite-time Lyapunov exponent of a two-disk or a kicked one-disk billiard.
 
     Parameters
@@ -273,14 +274,15 @@ def lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rule
         Two-disk collision rule and the disk whose position deviation is measured. For a
         one-disk state with ``kick_angle="scatter"``, ``rule`` is the rule of the
         collision with the virtual partner.
-    kicks, kick_angles, kick_angle, sigma, rng, e0, partner
+    kicks, kick_angles, kick_angle, sigma, rng, e0, partner, partner_radius, partner_mass
         One-disk kicks, as in `simulate_one_particle` (``sigma`` finite, ``> 0``). Kick
         times and angles are given data, the same for every perturbed trajectory (common
         random numbers): a kick is linearised at fixed time and angle. A scattering kick
         (``kick_angle="scatter"``) is a collision with a virtual partner placed in
-        contact with the reference: the tangent vector goes through the linearised
-        collision with a partner of zero deviation; a twin meets the same partner at its
-        own contact time, or misses it (docs/scatter.md).
+        contact with the reference (at the distance ``r + partner_radius``): the tangent
+        vector goes through the linearised collision with a partner of zero deviation; a
+        twin meets the same partner at its own contact time, or misses it
+        (docs/scatter.md).
     method : {"tangent", "twin"}
         ``"tangent"``: exact propagation of tangent vectors. ``"twin"``: Benettin's twin at
         distance ``d0`` (the paper's method; converges to the tangent value as ``d0 -> 0``
@@ -370,6 +372,7 @@ def lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rule
         system, r, n_steps=n_steps, tau=tau, sampling=sampling, rule=rule, track=track,
         kicks=kicks, kick_angles=kick_angles, kick_angle=kick_angle, sigma=sigma, rng=rng,
         method=method, variant=variant, d0=d0, max_defer=max_defer, e0=e0, partner=partner,
+        partner_radius=partner_radius, partner_mass=partner_mass,
         return_run=bool(return_run), t_continue=0.0, holes=holes, masses=masses,
     )
     _warn_undefined(res)
@@ -407,8 +410,8 @@ def lyapunov_pass(system, r=None, *, t_continue=0.0, uniform=False, **options):
 def _lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rule="mirror",
               track=0, kicks=None, kick_angles=None, kick_angle="uniform", sigma=1.0, rng=None,
               method="tangent", variant="norm", d0=None, max_defer=10, e0=None,
-              partner="weighted", return_run=False, t_continue=0.0, holes=None,
-              masses=None, uniform_out=None):
+              partner="weighted", partner_radius=None, partner_mass=None, return_run=False,
+              t_continue=0.0, holes=None, masses=None, uniform_out=None):
     """`lyapunov`'s body: ``(result, run or None, pp_times or None)``; a list
     ``uniform_out`` receives the one pass's uniform samples (see `lyapunov_pass`)."""
     arcs = chk.check_holes(holes)
@@ -435,6 +438,7 @@ def _lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rul
             sigma = run.sigma if run.sigma is not None else 1.0
             if kick_angle == "scatter":
                 rule, e0, partner = run.rule, run.e0, run.partner
+                partner_radius, partner_mass = run.partner_radius, run.partner_mass
             system = run.ic
     chk.check_choice("method", method, METHODS)
     chk.check_choice("variant", variant, VARIANTS)
@@ -498,7 +502,9 @@ def _lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rul
     chk.check_choice("kick_angle", kick_angle, KICK_ANGLES)
     sigma = chk.check_real("sigma", sigma, low=0.0)
     state = check_one_particle_state(arr, r, name="system")
-    sp, rule, e0, partner = check_scatter_options(state, r, kick_angle, rule, e0, partner)
+    sp, options = check_scatter_options(state, r, kick_angle, rule, e0, partner,
+                                        partner_radius, partner_mass)
+    rule = options["rule"]
     times, angles, _, kinetic = resolve_kicks(kicks, kick_angles, kick_angle=kick_angle,
                                               sigma=sigma, rng=rng, horizon=horizon,
                                               t_max=horizon if mode == 1 else None, r=r)
@@ -517,9 +523,8 @@ def _lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rul
         if return_run or arcs is not None:
             res, run, _ = _pass_one(st, state, r, times, angles, kick_u, sp, mode, n_steps, tau,
                                     U, variant, max_events, sampling=sampling,
-                                    kick_angle=kick_angle, sigma=sigma, rule=rule, e0=e0,
-                                    partner=partner, kinetic=kinetic, holes=arcs,
-                                    uniform_out=uniform_out)
+                                    kick_angle=kick_angle, sigma=sigma, options=options,
+                                    kinetic=kinetic, holes=arcs, uniform_out=uniform_out)
             return res, (run if return_run else None), None
         out = tangent_one_kernel(st, rho, times, angles, KICK_ANGLES[kick_angle], mode, n_steps,
                                  tau, U, max_events, kick_u, sp, kinetic)
@@ -576,7 +581,7 @@ def _uniform_samples(sink, run, tau, holes, samples):
 
 
 def _pass_one(st, state, r, times, angles, kick_u, sp, mode, n_steps, tau, U, variant,
-              max_ev_tan, *, sampling, kick_angle, sigma, rule, e0, partner, kinetic=None,
+              max_ev_tan, *, sampling, kick_angle, sigma, options, kinetic=None,
               holes=None, uniform_out=None):
     """The kicked run and its tangent FTLE from one pass (`simulate_tangent_one_kernel`).
 
@@ -595,8 +600,8 @@ def _pass_one(st, state, r, times, angles, kick_u, sp, mode, n_steps, tau, U, va
     check_kinetic_capacity(kinetic, out[6])
     run = one_particle_run(st, r, state, out[:9], sampling=sampling, mode=mode, tau=tau,
                            n_steps=n_steps, seed=None, kick_angle=kick_angle, sigma=sigma,
-                           times=times, applied=kick_u if scatter else angles, rule=rule,
-                           e0=e0, partner=partner, escape_time=float(out[15][0]))
+                           times=times, applied=kick_u if scatter else angles,
+                           escape_time=float(out[15][0]), **options)
     res = _tangent_result(out[10:15], U, (0, 1), variant, horizon, max_ev_tan, "the disk")
     _uniform_samples(uniform_out, run, tau, holes, out[17])
     return res, run, None

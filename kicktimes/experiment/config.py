@@ -44,7 +44,7 @@ RR_SAMPLINGS = ("run", "uniform", "run+uniform")
 #: single ``eps`` as a float, as before), so stores written before the field existed keep
 #: their hash and still load. Their results simply lack the rows added since.
 _LATER_FIELDS = {"acf_max_lag": 20, "rr_sampling": "run", "lyapunov_method": "twin",
-                 "holes": []}
+                 "holes": [], "partner_ratio": 1.0, "partner_mass": 1.0}
 
 _REQUIRED = ("name", "radii", "n_ics", "n_steps", "tau")
 
@@ -156,6 +156,22 @@ class Experiment:
         ``escaped_disk`` row (0, 1, or -1 for none), and the disk kicked at actual times gets
         the two-disk run's collision times up to its end (no continuation). Needs
         ``lyapunov_method = "tangent"``.
+    partner_ratio : float
+        Unequal disks (docs/unequal.md, "In sweeps"): disk 1 has the radius
+        ``partner_ratio * r`` for the sweep radius ``r`` of disk 0 (default 1, equal
+        disks). Disk 0 is the disk the one-disk systems simulate and kick, so a ratio
+        ``> 1`` studies the small disk of the pair and a ratio ``< 1`` the large one. The
+        two-disk system runs with ``r = (r, partner_ratio * r)``, the scattering kicks meet
+        a partner of radius ``partner_ratio * r``, the actual-time kicks are disk 0's
+        collisions with disk 1, and the report's kinetic rate is the pair's
+        (`kicktimes.stats.kinetic_rate`). Disk 1 of the largest radius must fit:
+        ``partner_ratio * max(radii) < 0.5`` (at most 1/3 for each disk with
+        ``ic_method = "uniform"``). Not with ``"poisson_kinetic"`` (its rate table,
+        `kicktimes.schedules.KineticRate`, is for equal disks).
+    partner_mass : float
+        Disk 1's mass in units of disk 0's, ``m1 / m0 > 0`` (default 1). Only the elastic
+        rule has masses (``rule = "elastic"``), and only the invariant ICs draw their
+        speeds (``ic_method = "uniform"``).
     description : str
         Free text for the report.
 
@@ -193,6 +209,8 @@ class Experiment:
     block_size: int = 25
     description: str = field(default="")
     holes: tuple = ()
+    partner_ratio: float = 1.0
+    partner_mass: float = 1.0
 
     def __post_init__(self):
         def put(name, value):
@@ -245,12 +263,89 @@ class Experiment:
                                  f"'tangent', got {self.lyapunov_method!r}")
         if not isinstance(self.description, str):
             raise TypeError(f"description: expected a string, got {self.description!r}")
+        self._check_partner(put)
+
+    def _check_partner(self, put):
+        """Validate ``partner_ratio`` and ``partner_mass`` against the radii, rule and ICs."""
+        ratio = check_real("partner_ratio", self.partner_ratio, low=0.0)
+        mass = check_real("partner_mass", self.partner_mass, low=0.0)
+        put("partner_ratio", ratio)
+        put("partner_mass", mass)
+        if mass != 1.0 and self.rule != "elastic":
+            raise ValueError(f"partner_mass: masses apply to rule='elastic' (the mirror rule "
+                             f"keeps each disk's speed), got partner_mass={mass!r} with "
+                             f"rule={self.rule!r}")
+        if mass != 1.0 and self.ic_method != "uniform":
+            raise ValueError(f"partner_mass: the paper's ICs have unit speeds; masses need "
+                             f"ic_method='uniform', got partner_mass={mass!r} with "
+                             f"ic_method={self.ic_method!r}")
+        if ratio == 1.0:
+            return
+        r1 = ratio * self.r_max
+        limit = 1.0 / 3.0 if self.ic_method == "uniform" else 0.5 - 1e-9
+        if not r1 <= limit:
+            raise ValueError(
+                f"partner_ratio: disk 1 at the largest radius has radius {ratio!r} * "
+                f"{self.r_max!r} = {r1!r}; partner_ratio * max(radii) must be at most "
+                f"{limit:.6g} (ic_method={self.ic_method!r}), i.e. partner_ratio <= "
+                f"{limit / self.r_max:.6g}"
+            )
+        if self.ic_method == "uniform" and self.r_max > limit:
+            raise ValueError(f"partner_ratio: unequal disks' invariant ICs need every radius "
+                             f"at most 1/3, got max(radii) = {self.r_max!r}")
+        if "poisson_kinetic" in self.systems:
+            raise ValueError(f"partner_ratio={ratio!r}: the 'poisson_kinetic' system tabulates "
+                             "the kinetic rate of equal disks (KineticRate); leave it out of "
+                             "systems or use partner_ratio = 1")
 
     # ------------------------------------------------------------------ derived
     @property
     def r_max(self) -> float:
         """The largest radius: the ICs are drawn (and valid) at it."""
         return self.radii[-1]
+
+    def radius_pair(self, r: float):
+        """The two-disk ``r`` argument at sweep radius ``r``: ``r`` itself for equal disks,
+        ``(r, partner_ratio * r)`` otherwise."""
+        return r if self.partner_ratio == 1.0 else (r, self.partner_ratio * r)
+
+    @property
+    def masses(self):
+        """The two-disk ``masses`` argument: ``None`` (equal) or ``(1.0, partner_mass)``."""
+        return None if self.partner_mass == 1.0 else (1.0, self.partner_mass)
+
+    @property
+    def ic_radius(self):
+        """The ``r_max`` the ICs are drawn at, valid for the pair at every radius.
+
+        Equal disks: ``r_max``. Unequal disks, paper ICs: the larger disk at ``r_max``,
+        ``max(1, partner_ratio) * r_max`` (both disks drawn that large fit at every
+        radius); invariant ICs: the pair ``(r_max, partner_ratio * r_max)``, whose
+        configurations stay valid for every smaller pair of the same ratio.
+        """
+        if self.partner_ratio == 1.0:
+            return self.r_max
+        if self.ic_method == "paper":
+            return max(1.0, self.partner_ratio) * self.r_max
+        return (self.r_max, self.partner_ratio * self.r_max)
+
+    def ic_radius_label(self) -> str:
+        """`ic_radius` as text: ``0.02``, or ``(0.02, 0.04)`` for a pair."""
+        r = self.ic_radius
+        return f"({r[0]:g}, {r[1]:g})" if isinstance(r, tuple) else f"{r:g}"
+
+    def kinetic_rate(self, radius):
+        """The pair's kinetic collision rate at sweep radius (or radii) ``radius``
+        (`kicktimes.stats.kinetic_rate` of ``radius_pair``, ``rule`` and ``masses``)."""
+        import numpy as np
+
+        from kicktimes.stats import kinetic_rate
+
+        if self.partner_ratio == 1.0 and self.masses is None:
+            return kinetic_rate(radius, self.rule)
+        rates = [kinetic_rate(self.radius_pair(float(r)), self.rule, masses=self.masses)
+                 for r in np.ravel(radius)]
+        return np.reshape(rates, np.shape(radius)) if np.ndim(radius) else rates[0]
 
     @property
     def horizon(self) -> float:
@@ -359,15 +454,24 @@ class Experiment:
             f"Experiment {self.name!r} (hash {self.hash()})\n"
             f"  radii ({len(self.radii)}): {radii}\n"
             f"  {self.n_ics} ICs ({self.ic_method}, seed {self.seed}, drawn at r_max = "
-            f"{self.r_max:g}); {self.n_steps} steps of tau = {self.tau:g} ({self.sampling} "
-            f"sampling); rule {self.rule}\n"
+            f"{self.ic_radius_label()}); {self.n_steps} steps of tau = {self.tau:g} "
+            f"({self.sampling} sampling); rule {self.rule}\n"
             f"  systems: {', '.join(self.systems)}; diagnostics: {', '.join(self.diagnostics)}"
             f" (eps = {', '.join(f'{e:g}' for e in self.eps)} on {self.rr_sampling} samples, "
             f"lag = {self.lag}, ACF to lag {self.acf_max_lag}; Lyapunov {self.lyapunov_method}"
             f"{f' d0 = {self.d0:g}' if self.lyapunov_method == 'twin' else ''}, variant "
             f"{self.lyapunov_variant}; kicks {self.kick_angle})\n"
             f"  {n_tasks} tasks of up to {self.block_size} ICs"
+            + (f"\n  {self.partner_line()}" if self.partner_line() else "")
         )
+
+    def partner_line(self) -> str:
+        """One line on disk 1 when it differs from disk 0 (empty for equal disks)."""
+        if self.partner_ratio == 1.0 and self.partner_mass == 1.0:
+            return ""
+        mass = f", mass {self.partner_mass:g} m0" if self.partner_mass != 1.0 else ""
+        return (f"unequal disks: disk 1 has radius {self.partner_ratio:g} r{mass}; disk 0 "
+                f"(radius r) is the disk kicked alone")
 
 
 def _toml_value(value) -> str:

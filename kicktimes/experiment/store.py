@@ -539,6 +539,7 @@ class Store:
             f"{self.manifest['experiment_hash']}), kicktimes {self.manifest['kicktimes_version']}"
             f"\n  {done}/{n} tasks finished; {len(self.results)} result rows, "
             f"{len(self.collisions)} collision rows"
+            + (f"\n  {self.experiment.partner_line()}" if self.experiment.partner_line() else "")
         )
 
     def __repr__(self) -> str:

@@ -12,6 +12,11 @@
 5. optionally (``mmpp``) the kicks of the Poisson system at the times of a two-state
    Markov-modulated Poisson process fitted to that IC's collision times (`mmpp_kicks`).
 
+With ``partner_ratio`` or ``partner_mass`` (unequal disks, docs/unequal.md) the
+two-particle run is that of disk 0 (radius ``r``, the one the one-disk systems kick) and
+disk 1 (``Experiment.radius_pair``, ``Experiment.masses``), its collision times are disk
+0's with disk 1, and the scattering kicks meet a partner of disk 1's radius and mass.
+
 Every random number of (IC, radius, system) comes from its own
 ``SeedSequence(seed, spawn_key=(KICK_DOMAIN, ic, radius bits, system code))``, so the
 results do not depend on the block size, the worker count or the executor, nor on which
@@ -164,11 +169,12 @@ def execute_task(experiment: Experiment, task: Task, *, one_pass: bool = True) -
     t0 = time.perf_counter()
     ics = initial_conditions(
         task.n_ics,
-        experiment.r_max,
+        experiment.ic_radius,
         seed=experiment.seed,
         method=experiment.ic_method,
         rule=experiment.rule,
         start=task.ic_start,
+        masses=experiment.masses,
     )
     rows: list[tuple] = []
     coll: list[tuple] = []
@@ -209,6 +215,8 @@ def _run_ic(exp: Experiment, r: float, ic_index: int, ic: np.ndarray, rows, coll
     steps = {"n_steps": exp.n_steps, "tau": exp.tau, "sampling": exp.sampling}
     # holes in the wall: every run (and its FTLE) ends at its escape
     holes = {"holes": np.array(exp.holes)} if exp.holes else {}
+    # the two-disk system: disk 0 of radius r, disk 1 of the partner's radius and mass
+    pair, two_kw = exp.radius_pair(r), _two_disk_kw(exp)
     ftle_method = {"method": exp.lyapunov_method}
     if exp.lyapunov_method == "twin":
         ftle_method["d0"] = exp.d0
@@ -264,19 +272,19 @@ def _run_ic(exp: Experiment, r: float, ic_index: int, ic: np.ndarray, rows, coll
     if two_pass and holes:
         # the run ends at its escape: no continuation to the horizon
         with timer("lyapunov_two_particle"):
-            res_two, two = _lyapunov()(ic, r, rule=exp.rule, track=0, method="tangent",
+            res_two, two = _lyapunov()(ic, pair, track=0, method="tangent",
                                        variant=exp.lyapunov_variant, return_run=True, **holes,
-                                       **steps)
+                                       **two_kw, **steps)
         continued = two.pp_times
     elif two_pass:
         with timer("lyapunov_two_particle"):
             res_two, two, continued = _lyapunov_pass()(
-                ic, r, rule=exp.rule, track=0, variant=exp.lyapunov_variant, method="tangent",
-                t_continue=horizon if exp.sampling == "paper" else 0.0, **steps,
+                ic, pair, track=0, variant=exp.lyapunov_variant, method="tangent",
+                t_continue=horizon if exp.sampling == "paper" else 0.0, **two_kw, **steps,
             )
     else:
         with timer("simulation_two_particle"):
-            two = simulate_two_particle(ic, r, rule=exp.rule, track=0, seed=exp.seed, **holes,
+            two = simulate_two_particle(ic, pair, track=0, seed=exp.seed, **holes, **two_kw,
                                         **steps)
         if holes:
             continued = two.pp_times
@@ -296,8 +304,8 @@ def _run_ic(exp: Experiment, r: float, ic_index: int, ic: np.ndarray, rows, coll
             "two_particle",
             two,
             (lambda: res_two) if two_pass else lambda: _lyapunov()(
-                ic, r, rule=exp.rule, track=0, variant=exp.lyapunov_variant, **ftle_method,
-                **holes, **steps,
+                ic, pair, track=0, variant=exp.lyapunov_variant, **ftle_method,
+                **holes, **two_kw, **steps,
             ),
         )
 
@@ -306,7 +314,7 @@ def _run_ic(exp: Experiment, r: float, ic_index: int, ic: np.ndarray, rows, coll
                    "mmpp"):
         if system not in exp.systems:
             continue
-        kick = kick_law(exp, system, ic)
+        kick = kick_law(exp, system, ic, r)
         rng = kick_rng(exp.seed, ic_index, r, system)
         if system == "poisson_kinetic":
             # the event loop draws the kick times (and their scattering numbers) from rng
@@ -442,19 +450,37 @@ def kinetic_rate_table(r: float):
     return KineticRate(r)
 
 
-def kick_law(exp: Experiment, system: str, ic: np.ndarray) -> dict:
-    """Keyword arguments of the kicks of a one-particle ``system``.
+def _two_disk_kw(exp: Experiment) -> dict:
+    """The two-disk runs' ``rule`` (and ``masses``, for a partner of another mass)."""
+    return {"rule": exp.rule, **({"masses": exp.masses} if exp.masses else {})}
+
+
+def kick_law(exp: Experiment, system: str, ic: np.ndarray, r: float | None = None) -> dict:
+    """Keyword arguments of the kicks of a one-particle ``system`` at sweep radius ``r``.
 
     The paper's systems use ``exp.kick_angle``; the ``*_scatter`` systems collide with a
     virtual partner under the experiment's rule, with the two-disk IC's kinetic energy
-    (elastic rule).
+    (elastic rule; with masses normalised to ``(m0 + m1) / 2 = 1``,
+    ``e0 = (m0 |v0|^2 + m1 |v1|^2) / 2``) and, for unequal disks, disk 1's radius
+    ``partner_ratio * r`` (``r`` is then required) and mass.
     """
     if system == "poisson_kinetic":
         return {"kick_angle": "scatter", "sigma": exp.sigma, "rule": "mirror"}
     if not system.endswith("_scatter"):
         return {"kick_angle": exp.kick_angle, "sigma": exp.sigma}
-    e0 = 0.5 * float((ic[:, 2:] ** 2).sum()) if exp.rule == "elastic" else None
-    return {"kick_angle": "scatter", "sigma": exp.sigma, "rule": exp.rule, "e0": e0}
+    partner = {}
+    if exp.partner_ratio != 1.0:
+        if r is None:
+            raise ValueError("r: the scattering kicks of unequal disks need the sweep radius")
+        partner["partner_radius"] = exp.partner_ratio * r
+    if exp.masses is None:
+        e0 = 0.5 * float((ic[:, 2:] ** 2).sum()) if exp.rule == "elastic" else None
+    else:
+        partner["partner_mass"] = exp.partner_mass
+        m0, m1 = 2.0 / (1.0 + exp.partner_mass), 2.0 * exp.partner_mass / (1.0 + exp.partner_mass)
+        e0 = 0.5 * float(m0 * (ic[0, 2:] ** 2).sum() + m1 * (ic[1, 2:] ** 2).sum())
+    return {"kick_angle": "scatter", "sigma": exp.sigma, "rule": exp.rule, "e0": e0,
+            **partner}
 
 
 #: prefix of the recurrence rows computed on uniform-time samples when
@@ -550,7 +576,8 @@ def uniform_samples(exp: Experiment, system: str, ic: np.ndarray, r: float, run)
         from kicktimes.billiard.two_particle import simulate_two_particle
 
         again = simulate_two_particle(
-            ic, r, t_max=run.t_max, tau=exp.tau, rule=exp.rule, track=0, sampling="uniform"
+            ic, exp.radius_pair(r), t_max=run.t_max, tau=exp.tau, track=0, sampling="uniform",
+            **_two_disk_kw(exp),
         )
     else:
         from kicktimes.billiard.one_particle import simulate_one_particle
@@ -563,7 +590,7 @@ def uniform_samples(exp: Experiment, system: str, ic: np.ndarray, r: float, run)
             kicks=run.kick_times,
             kick_angles=run.kick_angles,
             sampling="uniform",
-            **kick_law(exp, system, ic),
+            **kick_law(exp, system, ic, r),
         )
     return again.samples
 
@@ -583,7 +610,8 @@ def _actual_times(exp: Experiment, ic: np.ndarray, r: float, two) -> np.ndarray:
 
     if two.t_max >= exp.horizon:
         return np.array(two.pp_times, dtype=np.float64)
-    longer = simulate_two_particle(ic, r, t_max=exp.horizon, rule=exp.rule)
+    longer = simulate_two_particle(ic, exp.radius_pair(r), t_max=exp.horizon,
+                                   **_two_disk_kw(exp))
     times = np.array(longer.pp_times, dtype=np.float64)
     # the event sequence does not depend on sampling: the continuation must start with
     # exactly the collisions of the sampled run

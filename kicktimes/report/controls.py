@@ -232,7 +232,7 @@ class Controls:
 
 
 def compute_controls(results, collisions, *, family, eps, rule="mirror", rng, n_boot=2000,
-                     resamples=None) -> Controls:
+                     resamples=None, kinetic=None) -> Controls:
     """Every comparison diagnostic of every kicked system under every control, with the
     verdict and whether it is robust, averaged over radii and per radius.
 
@@ -252,6 +252,10 @@ def compute_controls(results, collisions, *, family, eps, rule="mirror", rng, n_
         Bootstrap resamples of the ICs.
     resamples : dict, optional
         Shared bootstrap draws (`paired_ratio`).
+    kinetic : callable, optional
+        The kinetic rate as a function of the radius (array in, array out), e.g.
+        ``Experiment.kinetic_rate`` for unequal disks; default
+        ``kicktimes.stats.kinetic_rate(r, rule)`` (equal disks).
 
     Returns
     -------
@@ -262,7 +266,7 @@ def compute_controls(results, collisions, *, family, eps, rule="mirror", rng, n_
     """
     from kicktimes.report.counts import sticky_ics
 
-    sticky = sticky_ics(collisions, rule).set_index(["radius", "ic"])["sticky"]
+    sticky = sticky_ics(collisions, rule, kinetic=kinetic).set_index(["radius", "ic"])["sticky"]
     rows, curves = [], []
     systems = kicked_systems(results)
     for diagnostic, row, uniform in diagnostics_of(results, eps):
@@ -281,7 +285,7 @@ def compute_controls(results, collisions, *, family, eps, rule="mirror", rng, n_
                 y_uniform=None if table_u is None else table_u[REFERENCE],
                 rng=rng, n_boot=n_boot, resamples=resamples, curves=curves,
             )
-    rows += _count_rows(family, collisions, sticky, rule, rng=rng, n_boot=n_boot,
+    rows += _count_rows(family, collisions, sticky, rule, kinetic, rng=rng, n_boot=n_boot,
                         resamples=resamples)
     out = pd.DataFrame(rows, columns=list(COLUMNS))
     if not out.empty:
@@ -295,12 +299,12 @@ def compute_controls(results, collisions, *, family, eps, rule="mirror", rng, n_
     return Controls(out, curves)
 
 
-def _count_rows(family, collisions, sticky, rule, *, rng, n_boot, resamples):
+def _count_rows(family, collisions, sticky, rule, kinetic, *, rng, n_boot, resamples):
     """Observed disk-disk collisions over the kinetic count Γ(r) T, under the controls."""
-    from kicktimes.stats import kinetic_rate
+    from kicktimes.report.counts import kinetic_rate_of
 
     coll = collisions.set_index(["radius", "ic"])
-    gamma = np.array([kinetic_rate(float(r), rule=rule) for r in
+    gamma = np.array([kinetic_rate_of(float(r), rule, kinetic) for r in
                       coll.index.get_level_values("radius")])
     observed = coll["n_pp"].astype(float)
     expected = pd.Series(gamma * coll["t_window"].to_numpy(float), index=coll.index)

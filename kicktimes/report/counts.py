@@ -18,14 +18,36 @@ from kicktimes.report.figures import (
     radius_axis,
 )
 
-__all__ = ["counts_by_radius", "counts_vs_radius", "sticky_ics", "STICKY_FACTOR", "sections"]
+__all__ = ["counts_by_radius", "counts_vs_radius", "experiment_kinetic", "kinetic_rate_of",
+           "sticky_ics",
+           "STICKY_FACTOR", "sections"]
 
 #: an IC is "sticky" when its disk-disk collision rate exceeds this multiple of the
 #: kinetic rate (the disks stay close together for long stretches)
 STICKY_FACTOR = 5.0
 
 
-def sticky_ics(collisions, rule="mirror", *, factor=STICKY_FACTOR) -> pd.DataFrame:
+def kinetic_rate_of(radius, rule="mirror", kinetic=None):
+    """The kinetic rate at ``radius``: ``kinetic(radius)`` if given (e.g.
+    ``Experiment.kinetic_rate``, the pair's rate for unequal disks), else that of two equal
+    disks under ``rule`` (`kicktimes.stats.kinetic_rate`)."""
+    if kinetic is not None:
+        return kinetic(radius)
+    from kicktimes import stats
+
+    return stats.kinetic_rate(radius, rule)
+
+
+def experiment_kinetic(exp):
+    """The kinetic rate of an experiment's disks as a function of the radius
+    (``Experiment.kinetic_rate``: the pair's for unequal disks), or ``None`` for an object
+    without one (the event times of `kicktimes analyze`, a duck-typed experiment): then the
+    equal disks' rate under its rule."""
+    return getattr(exp, "kinetic_rate", None)
+
+
+def sticky_ics(collisions, rule="mirror", *, factor=STICKY_FACTOR,
+               kinetic=None) -> pd.DataFrame:
     """Per (radius, IC): collision rate, kinetic rate and whether the IC is sticky.
 
     Parameters
@@ -36,6 +58,10 @@ def sticky_ics(collisions, rule="mirror", *, factor=STICKY_FACTOR) -> pd.DataFra
         Rule of the kinetic rate :func:`kicktimes.stats.kinetic_rate`.
     factor : float
         Threshold: sticky when ``n_pp / t_window > factor * kinetic_rate(r, rule)``.
+    kinetic : callable, optional
+        The kinetic rate as a function of the radius (array in, array out), e.g.
+        ``Experiment.kinetic_rate`` for unequal disks; default
+        ``kicktimes.stats.kinetic_rate(r, rule)`` (equal disks).
 
     Returns
     -------
@@ -51,12 +77,10 @@ def sticky_ics(collisions, rule="mirror", *, factor=STICKY_FACTOR) -> pd.DataFra
     >>> sticky_ics(df)["sticky"].tolist()
     [False, True]
     """
-    from kicktimes import stats
-
     df = check_frame("collisions", collisions, ["radius", "ic", "n_pp", "t_window"])
     out = df[["radius", "ic"]].copy()
     out["rate"] = df["n_pp"].to_numpy(float) / df["t_window"].to_numpy(float)
-    out["kinetic_rate"] = stats.kinetic_rate(df["radius"].to_numpy(float), rule)
+    out["kinetic_rate"] = kinetic_rate_of(df["radius"].to_numpy(float), rule, kinetic)
     out["rate_over_kinetic"] = out["rate"] / out["kinetic_rate"]
     out["sticky"] = out["rate_over_kinetic"] > factor
     return out.reset_index(drop=True)
@@ -91,7 +115,7 @@ def counts_by_radius(collisions, *, x="radius") -> pd.DataFrame:
     return out
 
 
-def counts_vs_radius(collisions, regression=None, *, rule="mirror", ax=None):
+def counts_vs_radius(collisions, regression=None, *, rule="mirror", ax=None, kinetic=None):
     r"""Mean number of disk-disk collisions against radius, with the fitted curves.
 
     Parameters
@@ -106,6 +130,10 @@ def counts_vs_radius(collisions, regression=None, *, rule="mirror", ax=None):
         Collision rule of the kinetic-theory curve (the regression's rule wins when it
         has one).
     ax : matplotlib Axes, optional
+    kinetic : callable, optional
+        The kinetic rate as a function of the radius (array in, array out), e.g.
+        ``Experiment.kinetic_rate`` for unequal disks; default
+        ``kicktimes.stats.kinetic_rate(r, rule)`` (equal disks).
 
     Returns
     -------
@@ -131,7 +159,7 @@ def counts_vs_radius(collisions, regression=None, *, rule="mirror", ax=None):
     t_grid = np.interp(grid, r, table["mean_t_window"].to_numpy())
     pred = regression.predict(grid, t_window=t_grid)
     kinetic_rule = regression.rule or rule
-    kinetic = stats.kinetic_rate(grid, kinetic_rule) * t_grid
+    kinetic = kinetic_rate_of(grid, kinetic_rule, kinetic) * t_grid
     fig, ax = new_axes(ax, (6.0, 4.4))
     ax.errorbar(
         r,
@@ -170,10 +198,11 @@ def sections(ctx):
     table = counts_by_radius(coll)
     grouped = coll.groupby("radius")
     table["pooled_rate"] = grouped["n_pp"].sum() / grouped["t_window"].sum()
-    table["kinetic_rate"] = stats.kinetic_rate(table.index.to_numpy(), exp.rule)
+    kinetic = experiment_kinetic(exp)
+    table["kinetic_rate"] = kinetic_rate_of(table.index.to_numpy(), exp.rule, kinetic)
     table["rate_over_kinetic"] = table["pooled_rate"] / table["kinetic_rate"]
     table["dispersion_index"] = grouped["n_pp"].var(ddof=1) / grouped["n_pp"].mean()
-    sticky = sticky_ics(coll, exp.rule)
+    sticky = sticky_ics(coll, exp.rule, kinetic=kinetic)
     ctx.found.sticky = sticky
     table["n_sticky"] = sticky.groupby("radius")["sticky"].sum().astype(int)
     sec = Section("counts", "Number of disk-disk collisions against radius")
@@ -205,7 +234,7 @@ def sections(ctx):
         od = reg.overdispersion()
     sec.figure(
         "fig04_counts_vs_radius",
-        counts_vs_radius(coll, reg, rule=exp.rule),
+        counts_vs_radius(coll, reg, rule=exp.rule, kinetic=kinetic),
         "Mean number of disk-disk collisions per run against radius (± s.e.m. over ICs) with "
         "the paper's least-squares line, Poisson and negative-binomial regressions and the "
         f"kinetic-theory count Γ(r)·T ({exp.rule} rule), curves at the mean window T(r).",
@@ -241,12 +270,12 @@ def sections(ctx):
 
 def effects(ctx):
     """Observed disk-disk collision counts over the kinetic-theory counts Γ(r)·T."""
-    from kicktimes import stats
     from kicktimes.report.effects import Effect, store_ratio
 
     coll = ctx.store.collisions.set_index(["radius", "ic"])
     r = coll.index.get_level_values("radius").to_numpy(float)
-    expected = stats.kinetic_rate(r, ctx.exp.rule) * coll["t_window"].to_numpy(float)
+    expected = (kinetic_rate_of(r, ctx.exp.rule, experiment_kinetic(ctx.exp))
+                * coll["t_window"].to_numpy(float))
     expected = pd.Series(expected, index=coll.index)
     per_r, tot = store_ratio(ctx, coll["n_pp"].astype(float), expected)
     sticky = ctx.found.sticky

@@ -99,7 +99,7 @@ def _shares(rho):
 
 
 def gap_decomposition(results, collisions, *, family, eps, rule="mirror", rng, n_boot=1000,
-                      level=0.95) -> pd.DataFrame:
+                      level=0.95, kinetic=None) -> pd.DataFrame:
     """The gap decomposition of every comparison diagnostic under every control.
 
     Parameters
@@ -151,7 +151,7 @@ def gap_decomposition(results, collisions, *, family, eps, rule="mirror", rng, n
     if not set(LADDER) | {REFERENCE} <= present:
         return pd.DataFrame(columns=["family", "diagnostic", "control", "quantity", "estimate",
                                      "ci_low", "ci_high"])
-    sticky = sticky_ics(collisions, rule).set_index(["radius", "ic"])["sticky"]
+    sticky = sticky_ics(collisions, rule, kinetic=kinetic).set_index(["radius", "ic"])["sticky"]
     alpha = (1.0 - level) / 2.0
     rows = []
     for diagnostic, row, uniform in diagnostics_of(results, eps):

@@ -28,6 +28,7 @@ from kicktimes.report.controls import (
     poisson_share,
     ratio_curves_figure,
 )
+from kicktimes.report.counts import experiment_kinetic
 from kicktimes.report.decomposition import gap_decomposition, gap_figure
 from kicktimes.report.effects import BUILT_IN, SHARE_RULE, ratio_rule
 from kicktimes.stats.findings import findings_table
@@ -94,6 +95,7 @@ def section(ctx):
     computed = compute_controls(
         ctx.results, ctx.store.collisions, family=ctx.exp.name, eps=ctx.exp.eps,
         rule=ctx.exp.rule, rng=ctx.boot_rng(), n_boot=ctx.n_boot, resamples=ctx.resamples,
+        kinetic=experiment_kinetic(ctx.exp),
     )
     controls = computed.table
     ctx.found.controls = computed
@@ -116,6 +118,7 @@ def section(ctx):
     gaps = gap_decomposition(
         ctx.results, ctx.store.collisions, family=ctx.exp.name, eps=ctx.exp.eps,
         rule=ctx.exp.rule, rng=ctx.boot_rng(), n_boot=min(ctx.n_boot, 1000),
+        kinetic=experiment_kinetic(ctx.exp),
     )
     ctx.found.gaps = gaps
     if not gaps.empty:

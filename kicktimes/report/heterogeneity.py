@@ -10,14 +10,14 @@ import pandas as pd
 from matplotlib.figure import Figure
 
 from kicktimes.report.common import Section, fmt
-from kicktimes.report.counts import counts_by_radius
+from kicktimes.report.counts import counts_by_radius, experiment_kinetic, kinetic_rate_of
 from kicktimes.report.figures import check_frame, plain_log_ticks, x_axis
 
 __all__ = ["rate_heterogeneity", "sections"]
 
 
 def rate_heterogeneity(collisions, *, homogeneity=None, rule="mirror", max_points=4000,
-                       x="radius", xlabel=None):
+                       x="radius", xlabel=None, kinetic=None):
     r"""Collision rates across ICs: per-IC rates and their dispersion, per radius.
 
     Parameters
@@ -46,8 +46,13 @@ def rate_heterogeneity(collisions, *, homogeneity=None, rule="mirror", max_point
         bottom edge as ▽), the pooled rate :math:`\sum N / \sum T`, the median and the
         kinetic rate; (b) the index of dispersion of the counts, variance / mean
         (1 for a common Poisson rate and equal windows), with the p-values.
+
+    Other Parameters
+    ----------------
+    kinetic : callable, optional
+        The kinetic rate as a function of the radius (e.g. ``Experiment.kinetic_rate``
+        for unequal disks); default that of equal disks under ``rule``.
     """
-    from kicktimes import stats
 
     axis = x_axis(x, xlabel)
     df = check_frame("collisions", collisions, [x, "n_pp", "t_window"])
@@ -123,7 +128,7 @@ def rate_heterogeneity(collisions, *, homogeneity=None, rule="mirror", max_point
     if rule is not None:  # None: sequences from elsewhere (kicktimes analyze), no Γ(r)
         ax1.plot(
             grid,
-            stats.kinetic_rate(grid, rule),
+            kinetic_rate_of(grid, rule, kinetic),
             color="grey",
             linestyle=":",
             label=f"kinetic theory Γ(r) ({rule})",
@@ -187,7 +192,8 @@ def sections(ctx):
     sec = Section("heterogeneity", "Rate heterogeneity across ICs")
     sec.figure(
         "fig10_rate_heterogeneity",
-        rate_heterogeneity(ctx.store.collisions, homogeneity=het, rule=exp.rule),
+        rate_heterogeneity(ctx.store.collisions, homogeneity=het, rule=exp.rule,
+                           kinetic=experiment_kinetic(exp)),
         "(a) Disk-disk collision rate n_pp / t_window of every IC, the pooled and median rates "
         f"and the kinetic rate ({exp.rule}); (b) index of dispersion of the counts across ICs; "
         "on top, the asymptotic p-value of the Pearson χ² test of a common rate (given the "

@@ -234,12 +234,16 @@ def store_header(store, notes):
 
     exp = store.experiment
     man = store.manifest
+    # unequal disks (docs/unequal.md): the partner, and the pair the ICs are drawn at
+    partner = exp.partner_line() if hasattr(exp, "partner_line") else ""
+    ic_at = exp.ic_radius_label() if hasattr(exp, "ic_radius_label") else f"{exp.r_max:g}"
     meta = [
         ("experiment", f"{exp.name} (hash {man.get('experiment_hash', exp.hash())})"),
         ("description", exp.description or "—"),
         ("seed", str(exp.seed)),
         ("rule", exp.rule),
-        ("IC method", f"{exp.ic_method}, {exp.n_ics} ICs drawn at r_max = {exp.r_max:g}"),
+        *([("disks", partner)] if partner else []),
+        ("IC method", f"{exp.ic_method}, {exp.n_ics} ICs drawn at r_max = {ic_at}"),
         ("steps", f"{exp.n_steps} steps of τ = {exp.tau:g} ({exp.sampling} sampling)"),
         ("kicktimes version (store)", str(man.get("kicktimes_version", "unknown"))),
         ("kicktimes version (report)", __version__),

@@ -16,6 +16,7 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
 from kicktimes.report.common import Section, fmt_rho, pct, seeded_rng, spearman
+from kicktimes.report.counts import experiment_kinetic, kinetic_rate_of
 from kicktimes.report.effects import SHARE_RULE, Effect, share_verdict
 from kicktimes.report.figures import (
     check_alpha,
@@ -222,7 +223,7 @@ def _poisson_job(job):
     from kicktimes import stats
     from kicktimes.stats.poisson import uniformity_ks
 
-    r, seqs, windows, alpha, n_mc, seed_key, rule, ics, control = job
+    r, seqs, windows, alpha, n_mc, seed_key, kinetic_rate, ics, control = job
     group = stats.poisson_group(seqs, windows, alpha=alpha, n_mc=n_mc, rng=seeded_rng(*seed_key))
     rows = group.rejections.drop(columns="rate")
     rows.insert(0, "radius", r)
@@ -249,7 +250,7 @@ def _poisson_job(job):
         "n_ics": hom["n_sequences"],
         "pooled_rate": hom["pooled_rate"],
         "median_rate": hom["median_rate"],
-        "kinetic_rate": float(stats.kinetic_rate(r, rule)),
+        "kinetic_rate": kinetic_rate,
         **{name: hom[name] for name in _HOMOGENEITY},
     }
     return rows.to_dict("records"), hom_row, per_ic
@@ -265,7 +266,8 @@ def _jobs(ctx):
         key = (exp.seed, 1, ri)
         # (event times from elsewhere, `kicktimes analyze`, have no kick schedules)
         control = ((exp.seed, exp.horizon) if "poisson" in getattr(exp, "systems", ()) else None)
-        jobs.append((r, seqs, part["t_window"].to_numpy(float), ctx.alpha, ctx.n_mc, key, exp.rule,
+        jobs.append((r, seqs, part["t_window"].to_numpy(float), ctx.alpha, ctx.n_mc, key,
+                     float(kinetic_rate_of(r, exp.rule, experiment_kinetic(exp))),
                      part["ic"].to_numpy(), control))
     return jobs
 

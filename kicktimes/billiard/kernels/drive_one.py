@@ -161,8 +161,8 @@ def drive(st, ev, rho, kicks, angles, kick_mode, kick_u, sp, unit_speed, t_end, 
                 if tan is not None and tan_on and (row[4] != 0.0 or row[5] != 0.0):
                     for j in range(m):
                         U[j, 0], U[j, 1], U[j, 2], U[j, 3] = scatter_tangent(
-                            ux, uy, row[6], row[7], row[4], row[5], sp[0], int(sp[1]), U[j, 0],
-                            U[j, 1], U[j, 2], U[j, 3])
+                            ux, uy, row[6], row[7], row[4], row[5], sp[0], int(sp[1]), sp[6],
+                            U[j, 0], U[j, 1], U[j, 2], U[j, 3])
                         n_resc += tg.renormalise(U, log_scale, j)
             else:
                 one.kick_step(st, ev, dte, rho, kicks[ik], angles[ik], kick_mode)

@@ -26,13 +26,15 @@ from numba import njit
 from kicktimes.billiard import geometry as geo
 from kicktimes.billiard.scatter import scatter_kick, twin_meets_partner
 
-__all__ = ["KICK_ANGLES", "SCATTER", "advance", "apply_kick", "fly", "kick_step", "kinetic_delay",
-           "load", "next_event", "next_kick", "process_wall", "process_wall_at", "scatter_step",
-           "store", "twin_scatter_step", "unit_speed_of", "wall_event", "wall_step"]
+__all__ = ["KICK_ANGLES", "SCATTER", "SCATTER_PARAMS", "advance", "apply_kick", "fly", "kick_step",
+           "kinetic_delay", "load", "next_event", "next_kick", "process_wall", "process_wall_at",
+           "scatter_step", "store", "twin_scatter_step", "unit_speed_of", "wall_event", "wall_step"]
 
 #: kick laws and their codes in the kernels
 KICK_ANGLES = {"uniform": 0, "gaussian": 1, "scatter": 2}
 SCATTER = KICK_ANGLES["scatter"]
+#: the scattering kicks' parameter array ``sp`` (`scatter_step`), field by field
+SCATTER_PARAMS = ("sigma", "rule", "e0", "law", "rho1", "m0", "m1")
 #: fields of the state tuple
 S_T, S_COMP, S_X, S_Y, S_VX, S_VY, S_TB = range(7)
 
@@ -221,11 +223,12 @@ def kick_step(st, ev, dt, rho, kick_time, angle, kick_mode):
 def scatter_step(st, ev, dt, rho, kick_time, a, b, sp, out):
     """Fly ``dt`` to ``kick_time`` and apply a scattering kick (kicktimes.billiard.scatter).
 
-    ``sp = [sigma = 2 r, rule code, e0, partner law code]``; ``out`` receives the kick's
-    log row (``runs.KICK_LOG_COLUMNS``).
+    ``sp = [sigma = r0 + r1, rule code, e0, partner law code, rho1 = 1 - r1, m0, m1]``
+    (`SCATTER_PARAMS`; the partner's radius ``r1`` and the normalised masses, ``m0 = m1 =
+    1`` for equal ones); ``out`` receives the kick's log row (``runs.KICK_LOG_COLUMNS``).
     """
     _to_kick(st, ev, dt, kick_time)
-    scatter_kick(st, a, b, sp[0], rho, int(sp[1]), sp[2], int(sp[3]), out)
+    scatter_kick(st, a, b, sp[0], sp[4], int(sp[1]), sp[2], int(sp[3]), sp[5], sp[6], out)
     ev[0] = geo.boundary_hit_time(st[1], st[2], st[3], st[4], rho)
 
 
@@ -239,7 +242,7 @@ def twin_scatter_step(st, ev, dt, rho, kick_time, partner, sp):
     """
     _to_kick(st, ev, dt, kick_time)
     x, y, vx, vy, hit = twin_meets_partner(st[1], st[2], st[3], st[4], partner[0], partner[1],
-                                           partner[2], partner[3], sp[0], int(sp[1]))
+                                           partner[2], partner[3], sp[0], int(sp[1]), sp[6])
     st[1] = x
     st[2] = y
     st[3] = vx
