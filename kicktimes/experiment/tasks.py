@@ -228,19 +228,24 @@ def _run_ic(exp: Experiment, r: float, ic_index: int, ic: np.ndarray, rows, coll
             note = f"{diagnostic} is not finite ({value!r})"
         rows.append((r, ic_index, system, diagnostic, value, note))
 
-    def diagnose(system, run, ftle):
+    def resampled(system, run, uniform):
+        # the uniform samples recorded by the run's one pass, or a re-simulation
+        if uniform is not None:
+            return uniform
+        with timer("recurrence_resampling"):
+            return uniform_samples(exp, system, ic, r, run)
+
+    def diagnose(system, run, ftle, uniform=None):
         if "recurrence_rate" in diags:
             points = run.samples
             if exp.rr_sampling == "uniform":
-                with timer("recurrence_resampling"):
-                    points = uniform_samples(exp, system, ic, r, run)
+                points = resampled(system, run, uniform)
             with timer("recurrence_rate"):
                 for diagnostic, value, note in recurrence_rows(points, exp.eps):
                     add(system, diagnostic, value, note)
             if exp.rr_sampling == "run+uniform":
                 # the uniform-sampling control: the same trajectory sampled at k tau
-                with timer("recurrence_resampling"):
-                    points = uniform_samples(exp, system, ic, r, run)
+                points = resampled(system, run, uniform)
                 with timer("recurrence_rate"):
                     for diagnostic, value, note in recurrence_rows(points, exp.eps):
                         if "@" in diagnostic:
@@ -266,6 +271,12 @@ def _run_ic(exp: Experiment, r: float, ic_index: int, ic: np.ndarray, rows, coll
     # collision times beyond the sampled window), bitwise what separate calls give; its
     # time is recorded under "lyapunov_*" (simulation + FTLE)
     one_pass = one_pass and "lyapunov" in diags and exp.lyapunov_method == "tangent"
+    # the one passes also record the uniform samples of a paper run (lyapunov_pass), which
+    # the recurrence control would otherwise get by simulating the trajectory again
+    uniform_kw = {"uniform": True} if (
+        one_pass and not holes and exp.sampling == "paper" and "recurrence_rate" in diags
+        and exp.rr_sampling in ("uniform", "run+uniform")) else {}
+    two_uniform = None
     horizon = exp.horizon
     continued = None
     two_pass = one_pass and "two_particle" in exp.systems
@@ -278,10 +289,12 @@ def _run_ic(exp: Experiment, r: float, ic_index: int, ic: np.ndarray, rows, coll
         continued = two.pp_times
     elif two_pass:
         with timer("lyapunov_two_particle"):
-            res_two, two, continued = _lyapunov_pass()(
+            res_two, two, continued, *more = _lyapunov_pass()(
                 ic, pair, track=0, variant=exp.lyapunov_variant, method="tangent",
                 t_continue=horizon if exp.sampling == "paper" else 0.0, **two_kw, **steps,
+                **uniform_kw,
             )
+        two_uniform = more[0] if more else None
     else:
         with timer("simulation_two_particle"):
             two = simulate_two_particle(ic, pair, track=0, seed=exp.seed, **holes, **two_kw,
@@ -307,6 +320,7 @@ def _run_ic(exp: Experiment, r: float, ic_index: int, ic: np.ndarray, rows, coll
                 ic, pair, track=0, variant=exp.lyapunov_variant, **ftle_method,
                 **holes, **two_kw, **steps,
             ),
+            two_uniform,
         )
 
     actual_times = None
@@ -319,7 +333,8 @@ def _run_ic(exp: Experiment, r: float, ic_index: int, ic: np.ndarray, rows, coll
         if system == "poisson_kinetic":
             # the event loop draws the kick times (and their scattering numbers) from rng
             one_kw = {"kicks": kinetic_rate_table(r), "rng": rng, **kick, **holes, **steps}
-            _kicked(system, one_kw, one_pass, exp, ic, r, timer, add, diagnose)
+            _kicked(system, one_kw, one_pass, exp, ic, r, timer, add, diagnose,
+                    uniform_kw=uniform_kw)
             continue
         if system.startswith("actual"):
             if actual_times is None:
@@ -343,22 +358,28 @@ def _run_ic(exp: Experiment, r: float, ic_index: int, ic: np.ndarray, rows, coll
                 kick_times = schedule.sample(horizon, rng)
             kick_angles = draw_kick_angles(kick_times.size, kick["kick_angle"], exp.sigma, rng)
         one_kw = {"kicks": kick_times, "kick_angles": kick_angles, **kick, **holes, **steps}
-        _kicked(system, one_kw, one_pass, exp, ic, r, timer, add, diagnose, extra)
+        _kicked(system, one_kw, one_pass, exp, ic, r, timer, add, diagnose, extra,
+                uniform_kw=uniform_kw)
 
 
-def _kicked(system, one_kw, one_pass, exp, ic, r, timer, add, diagnose, extra=()):
+def _kicked(system, one_kw, one_pass, exp, ic, r, timer, add, diagnose, extra=(), *,
+            uniform_kw=None):
     """Run the kicked ``system`` with the kicks ``one_kw`` (and its FTLE, in one pass or
     not), store its counts (``extra`` rows ``(name, value[, note])`` after ``t_max``) and
-    diagnose it."""
+    diagnose it. ``uniform_kw`` (``{"uniform": True}`` or empty): the one pass also
+    records the run's uniform samples (`lyapunov_pass`)."""
     from kicktimes.billiard.one_particle import simulate_one_particle
 
     ftle_method = {"method": exp.lyapunov_method}
     if exp.lyapunov_method == "twin":
         ftle_method["d0"] = exp.d0
+    uniform = None
     if one_pass:
         with timer("lyapunov_kicked"):
-            res_one, one = _lyapunov()(ic[0], r, variant=exp.lyapunov_variant, method="tangent",
-                                       return_run=True, **one_kw)
+            res_one, one, _, *more = _lyapunov_pass()(
+                ic[0], r, variant=exp.lyapunov_variant, method="tangent", **one_kw,
+                **(uniform_kw or {}))
+        uniform = more[0] if more else None
 
         def ftle(res_one=res_one):
             return res_one
@@ -381,7 +402,7 @@ def _kicked(system, one_kw, one_pass, exp, ic, r, timer, add, diagnose, extra=()
         add(system, name, value, *note)
     add(system, "n_kicks", one.n_kicks)
     add(system, "n_boundary", one.n_boundary)
-    diagnose(system, one, ftle)
+    diagnose(system, one, ftle, uniform)
 
 
 def mmpp_kicks(pp_times, t_window: float, rng: np.random.Generator) -> tuple:
