@@ -371,3 +371,70 @@ def test_compiled_uniformity_ks_equals_scipy_exact_ks_on_every_branch():
     # the kernel on its own, inside the Pomeranz region (0.754693 < n x^2 <= 4)
     for n, x in [(10, 0.3), (50, 0.2), (140, 0.1), (77, 0.15)]:
         assert abs(pomeranz_cdf(n, x) - scipy.stats.kstwo.cdf(x, n)) < 1e-13
+
+
+# ------------------------------------------------------------------ shared Monte Carlo nulls
+
+
+@pytest.mark.parametrize("test", ["exponential_ks", "exponential_ad", "ljung_box", "dispersion"])
+def test_null_bank_is_a_function_of_its_key(test):
+    # the first `size` values do not depend on how the null grew nor on other keys
+    kw = {"lags": 3, "n_bins": 4}
+    grown = stats.MonteCarloNulls(5)
+    grown.sample(test, 31, 0, **kw)
+    grown.sample("exponential_ks", 17, 50)  # another key in between
+    a = grown.sample(test, 31, 99, **kw).copy()
+    b = grown.sample(test, 31, 250, **kw)
+    fresh = stats.MonteCarloNulls(5).sample(test, 31, 250, **kw)
+    np.testing.assert_array_equal(b[:99], a)
+    np.testing.assert_array_equal(b, fresh)
+    # the key's own stream, drawn in one go
+    key = (stats.poisson.MC_TESTS.index(test), 31, 3 if test == "ljung_box" else 0,
+           4 if test == "dispersion" else 2)
+    stream = np.random.default_rng(
+        np.random.SeedSequence(5, spawn_key=(stats.poisson._NULL_DOMAIN, *key)))
+    np.testing.assert_array_equal(
+        fresh, iid_tests.simulate_null(test, 31, 250, stream, **kw))
+    assert not b.flags.writeable
+    other_seed = stats.MonteCarloNulls(6).sample(test, 31, 250, **kw)
+    assert not np.array_equal(other_seed, fresh)
+
+
+def test_null_bank_makes_groups_independent_of_the_grouping():
+    # with the nulls from one bank (and no refinement, no randomised ties) a sequence's
+    # Monte Carlo p-values do not depend on which other sequences share its call
+    rng = np.random.default_rng(3)
+    seqs = poisson_sequences(40, 0.4, rng)
+    kw = {"n_mc": 99, "n_mc_max": 99, "randomize": False, "rng": 1}
+    whole = stats.test_poisson_ensemble(seqs, T, nulls=stats.MonteCarloNulls(8), **kw)
+    bank = stats.MonteCarloNulls(8)
+    halves = pd.concat([
+        stats.test_poisson_ensemble(seqs[:25], T, nulls=bank, **kw).per_sequence,
+        stats.test_poisson_ensemble(seqs[25:], T, nulls=bank, **kw).per_sequence,
+    ], ignore_index=True)
+    for test in ("exponential_ks", "exponential_ad", "ljung_box", "dispersion"):
+        np.testing.assert_array_equal(halves[f"p_{test}"].to_numpy(),
+                                      whole.per_sequence[f"p_{test}"].to_numpy())
+
+
+def test_null_bank_tests_keep_their_size():
+    # shared nulls make p-values of equal n dependent, not invalid: under Poisson every
+    # Monte Carlo test rejects about alpha of the sequences (500 sequences, binomial
+    # 99.9 % band around 0.05 is about [0.024, 0.083])
+    rng = np.random.default_rng(11)
+    seqs = poisson_sequences(500, 0.5, rng)
+    res = stats.test_poisson_ensemble(seqs, T, n_mc=199, rng=2, nulls=stats.MonteCarloNulls(4))
+    for test in ("exponential_ks", "exponential_ad", "ljung_box", "dispersion"):
+        share = float((res.per_sequence[f"p_{test}"] < 0.05).mean())
+        assert 0.02 <= share <= 0.09, (test, share)
+
+
+def test_null_bank_bad_input():
+    with pytest.raises(TypeError, match="nulls"):
+        stats.test_poisson_ensemble([np.array([1.0, 2.0, 3.0])], 5.0, nulls=3)
+    with pytest.raises(ValueError, match="seed"):
+        stats.MonteCarloNulls(-1)
+    with pytest.raises(ValueError, match="test"):
+        stats.MonteCarloNulls(1).sample("runs", 20, 10)
+    with pytest.raises(ValueError, match="n_events"):
+        stats.MonteCarloNulls(1).sample("exponential_ks", 0, 10)

@@ -50,6 +50,7 @@ __all__ = [
     "make_tasks",
     "mmpp_kicks",
     "run_task",
+    "task_initial_conditions",
     "uniform_samples",
 ]
 
@@ -162,20 +163,10 @@ def execute_task(experiment: Experiment, task: Task, *, one_pass: bool = True) -
     event loop per trajectory: the same tables bit for bit (tested), several times slower;
     it exists as the reference the one-pass sweep is checked against.
     """
-    from kicktimes.billiard.initial import initial_conditions
-
     _check_task(experiment, task)
     timer = _Timer()
     t0 = time.perf_counter()
-    ics = initial_conditions(
-        task.n_ics,
-        experiment.ic_radius,
-        seed=experiment.seed,
-        method=experiment.ic_method,
-        rule=experiment.rule,
-        start=task.ic_start,
-        masses=experiment.masses,
-    )
+    ics = task_initial_conditions(experiment, task)
     rows: list[tuple] = []
     coll: list[tuple] = []
     for k in range(task.n_ics):
@@ -190,6 +181,29 @@ def execute_task(experiment: Experiment, task: Task, *, one_pass: bool = True) -
         )
     timer.seconds["total"] = time.perf_counter() - t0
     return TaskOutput(task, results, collisions, timer.seconds)
+
+
+def task_initial_conditions(experiment: Experiment, task: Task) -> np.ndarray:
+    """The initial conditions of ``task``'s ICs, shape ``(n_ics, 2, 4)``, read-only.
+
+    Every radius of an experiment starts from the same ICs (drawn at ``ic_radius``), so a
+    worker that runs a block of ICs at several radii draws them once: the draws are kept
+    per process (`_cached_ics`; about 0.16 ms per IC with the correctly rounded
+    ``cos_sin``, 12 radii share them in family A).
+    """
+    masses = None if experiment.masses is None else tuple(experiment.masses)
+    return _cached_ics(task.n_ics, experiment.ic_radius, experiment.seed, experiment.ic_method,
+                       experiment.rule, task.ic_start, masses)
+
+
+@functools.lru_cache(maxsize=64)
+def _cached_ics(n_ics, ic_radius, seed, method, rule, start, masses):
+    from kicktimes.billiard.initial import initial_conditions
+
+    ics = initial_conditions(n_ics, ic_radius, seed=seed, method=method, rule=rule,
+                             start=start, masses=masses)
+    ics.flags.writeable = False  # shared by every radius: nothing may change it
+    return ics
 
 
 def _lyapunov():

@@ -3,11 +3,13 @@ rate heterogeneity across ICs.
 
 Per radius, :func:`kicktimes.stats.test_poisson_ensemble` tests every IC's collision times
 (each test conditional on the IC's own number of collisions) and the hypothesis of a common
-rate across ICs (Pearson χ² given the total, with an exact Monte Carlo p-value).
+rate across ICs (Pearson χ² given the total, with an exact Monte Carlo p-value). The Monte
+Carlo nulls of equal ``n`` are shared by every radius (`null_bank`).
 """
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -35,6 +37,7 @@ __all__ = [
     "sections",
     "effects",
     "HEADLINE_TEST",
+    "null_bank",
 ]
 
 #: the test of the Findings: given n, the times of a homogeneous Poisson process are
@@ -217,6 +220,21 @@ _HOMOGENEITY = ("dispersion_index", "pearson_statistic", "df", "pvalue", "pvalue
                 "lr_pvalue", "n_flagged_fdr")
 
 
+@functools.lru_cache(maxsize=4)
+def null_bank(seed: int):
+    """This process's `kicktimes.stats.MonteCarloNulls` of the experiments seeded ``seed``.
+
+    The conditional nulls depend on ``n`` only, so every radius, its Poisson control and
+    the other experiments with this seed (a family and its controls) share them: about
+    4x fewer null draws than a stream per radius (266 distinct ``n`` in family B against
+    1123 (radius, ``n``) groups). A null's values depend on the seed and its key only,
+    so the tables do not depend on which process or job drew it first.
+    """
+    from kicktimes import stats
+
+    return stats.MonteCarloNulls(seed)
+
+
 def _poisson_job(job):
     """Poisson tests and rate homogeneity of one radius (runs in a worker process): the
     group tables of `kicktimes.stats.poisson_group`, with group = radius."""
@@ -224,14 +242,17 @@ def _poisson_job(job):
     from kicktimes.stats.poisson import uniformity_ks
 
     r, seqs, windows, alpha, n_mc, seed_key, kinetic_rate, ics, control = job
-    group = stats.poisson_group(seqs, windows, alpha=alpha, n_mc=n_mc, rng=seeded_rng(*seed_key))
+    nulls = null_bank(seed_key[0])
+    group = stats.poisson_group(seqs, windows, alpha=alpha, n_mc=n_mc, rng=seeded_rng(*seed_key),
+                                nulls=nulls)
     rows = group.rejections.drop(columns="rate")
     rows.insert(0, "radius", r)
     if control is not None:
         # the control: the same tests on the sweep's own Poisson kick times of each IC;
         # every test should reject about alpha of them
         ctrl = stats.poisson_group(_control_times(seqs, windows, ics, r, control), windows,
-                                   alpha=alpha, n_mc=n_mc, rng=seeded_rng(*seed_key, 9))
+                                   alpha=alpha, n_mc=n_mc, rng=seeded_rng(*seed_key, 9),
+                                   nulls=nulls)
         rows["control_n_tested"] = ctrl.rejections["n_tested"]
         rows["control_n_reject"] = ctrl.rejections["n_reject"]
     # per IC: the headline test's p-value, and the same test on the first FIXED_EVENTS
@@ -262,7 +283,8 @@ def _jobs(ctx):
     for ri, (r, part) in enumerate(coll.groupby("radius")):
         part = subsample(part.sort_values("ic"), ctx.max_ics_tests)
         seqs = [np.asarray(t, dtype=float) for t in part["pp_times"]]
-        # one Monte Carlo stream per radius: identical results for any worker count
+        # one Monte Carlo stream per radius (its ties and rate test; the nulls come from
+        # the seed's shared bank): identical results for any worker count
         key = (exp.seed, 1, ri)
         # (event times from elsewhere, `kicktimes analyze`, have no kick schedules)
         control = ((exp.seed, exp.horizon) if "poisson" in getattr(exp, "systems", ()) else None)

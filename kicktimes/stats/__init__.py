@@ -6,7 +6,8 @@ It takes event times and observation windows only (no billiard knowledge):
   (:func:`fit_renewal`, :func:`compare_models`, :func:`vuong`,
   :func:`goodness_of_fit`; models in ``MODELS``);
 * Poisson / IID tests of one sequence and of an ensemble
-  (:func:`intervals_from_times`, :func:`test_poisson`, :func:`test_poisson_ensemble`), and
+  (:func:`intervals_from_times`, :func:`test_poisson`, :func:`test_poisson_ensemble`, the
+  shared Monte Carlo nulls :class:`MonteCarloNulls`), and
   the tables of one group of sequences (:func:`poisson_group`, :func:`pooled_intervals`,
   shared by :func:`analyze` and the sweep report);
 * collision counts versus radius and the kinetic-theory rate
@@ -38,7 +39,7 @@ from .mixture import RateMixture, rate_mixture, simulate_cox_times
 from .mmpp import MMPPFit, fit_mmpp
 from .mmpp_choice import MMPPLRTest, compare_point_processes, mmpp_lr_test
 from .mmpp_simulation import simulate_mmpp
-from .poisson import TESTS, Intervals, intervals_from_times, test_poisson
+from .poisson import TESTS, Intervals, MonteCarloNulls, intervals_from_times, test_poisson
 from .renewal import (
     FULL_SAMPLE_MODELS,
     MODELS,
@@ -65,6 +66,7 @@ __all__ = [
     "intervals_from_times",
     "test_poisson",
     "test_poisson_ensemble",
+    "MonteCarloNulls",
     "poisson_group",
     "pooled_intervals",
     "regress_counts",

@@ -38,7 +38,7 @@ from ._table import EventTable, event_table
 from .comparison import compare_models
 from .counts import regress_counts
 from .groups import poisson_group, pooled_intervals
-from .poisson import TESTS, intervals_from_times
+from .poisson import TESTS, MonteCarloNulls, intervals_from_times
 
 __all__ = ["Analysis", "analyze"]
 
@@ -181,7 +181,8 @@ def analyze(
     max_pooled_intervals : int, optional
         Interval budget of a group's pooled fits (whole sequences in order).
     rng : Generator or int, optional
-        Seed of the Monte Carlo nulls (one child stream per group).
+        Seed of the Monte Carlo: one child stream per group, and the nulls of equal n
+        shared by the groups (`MonteCarloNulls`).
 
     Returns
     -------
@@ -246,10 +247,13 @@ def analyze(
     ]
     groups = list(pd.unique(seqs["group"]))
     streams = rng.spawn(len(groups))
+    # the groups share the Monte Carlo nulls of equal n (the conditional nulls depend on
+    # n only), as the radii of a sweep report do
+    nulls = MonteCarloNulls(int(rng.integers(2**63 - 1)))
     rej_rows, hom_rows, per_rows, pooled_rows, seq_p = [], [], [], [], []
     for g, stream in zip(groups, streams, strict=True):
         part = seqs[seqs["group"] == g]
-        rows, hom, pvals = _poisson(part, g, alpha=alpha, n_mc=n_mc, rng=stream)
+        rows, hom, pvals = _poisson(part, g, alpha=alpha, n_mc=n_mc, rng=stream, nulls=nulls)
         rej_rows += rows
         hom_rows.append(hom)
         seq_p.append(pvals)
@@ -305,10 +309,9 @@ def analyze(
 # ------------------------------------------------------------------ Poisson tests
 
 
-def _poisson(part, g, *, alpha, n_mc, rng):
-    res = poisson_group(
-        list(part["times"]), part["t_window"].to_numpy(float), alpha=alpha, n_mc=n_mc, rng=rng
-    )
+def _poisson(part, g, *, alpha, n_mc, rng, nulls):
+    res = poisson_group(list(part["times"]), part["t_window"].to_numpy(float), alpha=alpha,
+                        n_mc=n_mc, rng=rng, nulls=nulls)
     rows = [{"group": g, **row} for row in res.rejections.to_dict("records")]
     ens = res.ensemble
     pcols = [f"p_{t}" for t in TESTS] + ["p_rate"]

@@ -25,7 +25,15 @@ from scipy import stats
 from statsmodels.stats.multitest import multipletests
 
 from ._checks import check_choice, check_int, check_real, check_rng, check_times
-from .poisson import COMBINE_METHODS, FDR_METHODS, TESTS, _check_options, _run_tests, _windows
+from .poisson import (
+    COMBINE_METHODS,
+    FDR_METHODS,
+    TESTS,
+    _check_options,
+    _run_tests,
+    _windows,
+    check_nulls,
+)
 
 
 @dataclass(frozen=True, repr=False)
@@ -136,6 +144,7 @@ def test_poisson_ensemble(
     n_bins=None,
     randomize=True,
     rng=None,
+    nulls=None,
 ):
     r"""Poisson tests on every sequence of an ensemble, combined and FDR-screened.
 
@@ -159,6 +168,11 @@ def test_poisson_ensemble(
         Cap of the adaptive Monte Carlo refinement (see Notes).
     rng : Generator or int, optional
         Source of randomness.
+    nulls : MonteCarloNulls, optional
+        Take the Monte Carlo nulls of the per-sequence tests from this bank, shared with
+        every other call given it (the groups of a report share the nulls of equal
+        ``n``), instead of drawing them from ``rng``; ``rng`` still draws the tie-breaking
+        uniforms and the rate test's null.
 
     Returns
     -------
@@ -228,6 +242,7 @@ def test_poisson_ensemble(
         rng=rng,
         randomize=randomize,
         refine=(alpha, fdr, n_mc_max),
+        nulls=check_nulls(nulls),
     )
     counts = np.array([s.size for s in seqs])
     homogeneity, p_rate = _rate_tests(counts, ws, n_mc, rng)

@@ -56,7 +56,7 @@ class PoissonGroup:
         )
 
 
-def poisson_group(times, windows, *, alpha=0.05, n_mc=199, rng=None) -> PoissonGroup:
+def poisson_group(times, windows, *, alpha=0.05, n_mc=199, rng=None, nulls=None) -> PoissonGroup:
     r"""Poisson tests of every sequence of one group and the test of a common rate.
 
     Parameters
@@ -70,7 +70,10 @@ def poisson_group(times, windows, *, alpha=0.05, n_mc=199, rng=None) -> PoissonG
     n_mc : int, optional
         Monte Carlo samples of the conditional nulls.
     rng : Generator or int, optional
-        The stream of the Monte Carlo nulls (give each group its own).
+        The stream of the Monte Carlo (give each group its own).
+    nulls : MonteCarloNulls, optional
+        Take the per-sequence tests' nulls from this bank, shared by the groups given it
+        (`test_poisson_ensemble`).
 
     Returns
     -------
@@ -98,7 +101,7 @@ def poisson_group(times, windows, *, alpha=0.05, n_mc=199, rng=None) -> PoissonG
     >>> stats.poisson_group([seqs[0]], 50.0, n_mc=99, rng=1).homogeneity["dispersion_index"]
     nan
     """
-    ens = test_poisson_ensemble(times, windows, alpha=alpha, n_mc=n_mc, rng=rng)
+    ens = test_poisson_ensemble(times, windows, alpha=alpha, n_mc=n_mc, rng=rng, nulls=nulls)
     rows = []
     for test in TESTS:
         p = ens.per_sequence[f"p_{test}"].to_numpy()

@@ -283,6 +283,75 @@ def _default_bins(n):
 
 
 MC_TESTS = ("exponential_ks", "exponential_ad", "ljung_box", "dispersion")
+#: first spawn-key word of the null streams of `MonteCarloNulls` ("null")
+_NULL_DOMAIN = 0x6E756C6C
+
+
+class MonteCarloNulls:
+    r"""Monte Carlo nulls of the conditional Poisson tests, drawn once and shared.
+
+    The null of a Monte Carlo test given ``n`` events depends on ``(test, n, lags,
+    n_bins)`` only, not on the sequence, its window or its group. A bank gives each such
+    key its own stream, ``SeedSequence(seed, spawn_key=(key...))``, and the key's null
+    is the sequence of statistics drawn from that stream in order: its first ``size``
+    values are the same whoever asks first, however the request grew (the refinement
+    doubles nulls) and in whichever process. So every call given a bank with the same
+    ``seed`` (the radii of a report, the groups of `kicktimes analyze`, the controls)
+    shares the nulls of equal ``n``, and the results do not depend on the order of the
+    calls, the grouping or the worker count.
+
+    Parameters
+    ----------
+    seed : int
+        Seed of every key's stream (``>= 0``).
+
+    Examples
+    --------
+    >>> from kicktimes import stats
+    >>> bank = stats.MonteCarloNulls(7)
+    >>> first = bank.sample("exponential_ks", 40, 199).copy()
+    >>> longer = bank.sample("exponential_ks", 40, 399)      # extended, not redrawn
+    >>> bool((longer[:199] == first).all())
+    True
+    >>> bool((stats.MonteCarloNulls(7).sample("exponential_ks", 40, 399) == longer).all())
+    True
+    """
+
+    def __init__(self, seed: int):
+        self.seed = check_int("seed", seed, low=0)
+        self._streams: dict = {}
+        self._values: dict = {}
+
+    def __repr__(self) -> str:
+        return f"MonteCarloNulls(seed={self.seed}, keys={len(self._values)})"
+
+    def sample(self, test: str, n_events: int, size: int, *, lags: int = 0,
+               n_bins: int = 2) -> np.ndarray:
+        """The first ``size`` null statistics of ``test`` given ``n_events`` (read-only).
+
+        ``lags`` (Ljung-Box) and ``n_bins`` (dispersion) are part of the key of the tests
+        that use them and ignored by the others.
+        """
+        check_choice("test", test, MC_TESTS)
+        n_events = check_int("n_events", n_events, low=1)
+        size = check_int("size", size, low=0)
+        lags = check_int("lags", lags, low=0) if test == "ljung_box" else 0
+        n_bins = check_int("n_bins", n_bins, low=2) if test == "dispersion" else 2
+        key = (MC_TESTS.index(test), n_events, lags, n_bins)
+        have = self._values.get(key)
+        if have is None or have.size < size:
+            stream = self._streams.get(key)
+            if stream is None:
+                stream = np.random.default_rng(
+                    np.random.SeedSequence(self.seed, spawn_key=(_NULL_DOMAIN, *key)))
+                self._streams[key] = stream
+            done = 0 if have is None else have.size
+            more = iid.simulate_null(test, n_events, size - done, stream, lags=lags,
+                                     n_bins=n_bins)
+            have = more if have is None else np.concatenate([have, more])
+            have.flags.writeable = False
+            self._values[key] = have
+        return have[:size]
 
 
 @dataclass
@@ -298,6 +367,7 @@ class _Group:
     null: dict = field(default_factory=dict)
     draws: dict = field(default_factory=dict)
     exact: dict = field(default_factory=dict)
+    nulls: MonteCarloNulls | None = None
 
     def pvalue(self, name):
         if name in ("exponential_ks", "exponential_ad", "ljung_box"):
@@ -315,12 +385,19 @@ class _Group:
         )
 
     def extend(self, name, size, rng):
+        if self.nulls is not None:
+            self.null[name] = self._shared(name, self.null[name].size + size)
+            return
         more = iid.simulate_null(name, self.n, size, rng, lags=self.lags, n_bins=self.n_bins)
         self.null[name] = np.concatenate([self.null[name], more])
 
+    def _shared(self, name, size):
+        return self.nulls.sample(name, self.n, size, lags=self.lags, n_bins=self.n_bins)
 
-def _make_group(times, t_window, members, *, lags, n_bins, n_mc, rng, randomize):
-    """Statistics, exact p-values and Monte Carlo nulls of ``k`` sequences with ``n`` events."""
+
+def _make_group(times, t_window, members, *, lags, n_bins, n_mc, rng, randomize, nulls=None):
+    """Statistics, exact p-values and Monte Carlo nulls of ``k`` sequences with ``n`` events
+    (from ``rng``, or from the bank ``nulls``)."""
     k, n = times.shape
     m = n - 1
     h = _default_lags(m) if lags is None else lags
@@ -334,7 +411,7 @@ def _make_group(times, t_window, members, *, lags, n_bins, n_mc, rng, randomize)
             notes[name] = f"needs at least lags + 5 = {h + 5} intervals, got {m}"
         elif name == "dispersion" and n < 2 * bins:
             notes[name] = f"needs at least 2 events per sub-window ({2 * bins}), got {n}"
-    g = _Group(members=members, n=n, lags=h, n_bins=bins, notes=notes)
+    g = _Group(members=members, n=n, lags=h, n_bins=bins, notes=notes, nulls=nulls)
     u = times / t_window[:, None]
     x = np.diff(times, axis=1)
     funs = {
@@ -346,7 +423,8 @@ def _make_group(times, t_window, members, *, lags, n_bins, n_mc, rng, randomize)
     for name in MC_TESTS:
         if name not in notes:
             g.stat[name] = funs[name]()
-            g.null[name] = iid.simulate_null(name, n, n_mc, rng, lags=h, n_bins=bins)
+            g.null[name] = (iid.simulate_null(name, n, n_mc, rng, lags=h, n_bins=bins)
+                            if nulls is None else g._shared(name, n_mc))
     if "runs" not in notes:
         g.stat["runs"], g.stat["runs_n1"] = iid.runs_count(x)
     for name in ("dispersion", "runs"):
@@ -358,11 +436,12 @@ def _make_group(times, t_window, members, *, lags, n_bins, n_mc, rng, randomize)
     return g
 
 
-def _run_tests(seqs, ws, *, lags, n_bins, n_mc, rng, randomize, refine=None):
+def _run_tests(seqs, ws, *, lags, n_bins, n_mc, rng, randomize, refine=None, nulls=None):
     """Per-sequence statistics, p-values and notes.
 
     Sequences are grouped by their number of events so that each ``n`` gets one
-    Monte Carlo null. With ``refine = (alpha, fdr_method, n_mc_max)`` the nulls of
+    Monte Carlo null (drawn from ``rng``, or taken from the bank ``nulls``, a
+    `MonteCarloNulls`). With ``refine = (alpha, fdr_method, n_mc_max)`` the nulls of
     groups holding a sequence whose p-value is at the Monte Carlo floor but above the
     running FDR cut-off are extended (doubling, up to ``n_mc_max`` samples), so that a
     strong signal in a large ensemble is not lost to Monte Carlo resolution.
@@ -390,6 +469,7 @@ def _run_tests(seqs, ws, *, lags, n_bins, n_mc, rng, randomize, refine=None):
             n_mc=n_mc,
             rng=rng,
             randomize=randomize,
+            nulls=nulls,
         )
         groups.append(g)
         for i in members:
@@ -438,6 +518,13 @@ def _refine(groups, pval, refine, rng):
 N_MC_MAX = 10**7
 
 
+def check_nulls(nulls):
+    """``nulls``: None or a `MonteCarloNulls`."""
+    if nulls is not None and not isinstance(nulls, MonteCarloNulls):
+        raise TypeError(f"nulls: expected a MonteCarloNulls or None, got {type(nulls).__name__}")
+    return nulls
+
+
 def _check_options(n_mc, lags, n_bins):
     n_mc = check_int("n_mc", n_mc, low=19, high=N_MC_MAX)
     if lags is not None:
@@ -447,7 +534,8 @@ def _check_options(n_mc, lags, n_bins):
     return n_mc, lags, n_bins
 
 
-def test_poisson(times, t_window, *, n_mc=999, lags=None, n_bins=None, randomize=True, rng=None):
+def test_poisson(times, t_window, *, n_mc=999, lags=None, n_bins=None, randomize=True, rng=None,
+                 nulls=None):
     r"""Test whether one event sequence is a homogeneous Poisson process.
 
     Parameters
@@ -470,6 +558,9 @@ def test_poisson(times, t_window, *, n_mc=999, lags=None, n_bins=None, randomize
         p-values.
     rng : Generator or int, optional
         Source of randomness for the Monte Carlo.
+    nulls : MonteCarloNulls, optional
+        Take the Monte Carlo nulls from this bank (shared with every call given it)
+        instead of drawing them from ``rng``; ``rng`` still breaks the ties.
 
     Returns
     -------
@@ -511,6 +602,7 @@ def test_poisson(times, t_window, *, n_mc=999, lags=None, n_bins=None, randomize
         n_mc=n_mc,
         rng=rng,
         randomize=randomize,
+        nulls=check_nulls(nulls),
     )
     table = pd.DataFrame(
         {
