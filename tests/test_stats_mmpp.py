@@ -7,6 +7,7 @@ import math
 import warnings
 
 import numpy as np
+import pandas as pd
 import pytest
 import scipy.stats
 from scipy import linalg
@@ -285,6 +286,26 @@ def test_comparison_is_on_the_renewal_fits_footing(mmpp_data):
     assert table.loc["poisson", "loglik"] == pytest.approx(expo.loglik, rel=1e-12)
     assert table.loc["mmpp2", "k"] == 4
     assert table["weight"].sum() == pytest.approx(1.0)
+
+
+def test_comparison_returns_the_fit_it_compared(mmpp_data):
+    # the fit behind the mmpp2 row is fit_mmpp's with the same starts (bitwise, without
+    # standard errors), so its parameters need no second fit
+    table, fits = stats.compare_point_processes(mmpp_data[:60], T, models=[], rng=3,
+                                                return_fits=True)
+    alone = stats.fit_mmpp(mmpp_data[:60], T, rng=3)
+    assert set(fits) == {"mmpp2"}
+    np.testing.assert_array_equal(fits["mmpp2"].rates, alone.rates)
+    np.testing.assert_array_equal(fits["mmpp2"].generator, alone.generator)
+    assert fits["mmpp2"].loglik == alone.loglik
+    same = stats.compare_point_processes(mmpp_data[:60], T, models=[], rng=3)
+    pd.testing.assert_frame_equal(table, same)
+    # a model that cannot be fitted has a row but no fit
+    few = [np.array([1.0, 2.0, 4.0])]
+    with pytest.warns(stats.FitWarning, match="mmpp3"):
+        table, fits = stats.compare_point_processes(few, 10.0, models=[], n_states=(3,),
+                                                    rng=1, return_fits=True)
+    assert fits == {} and np.isnan(table.loc["mmpp3", "loglik"])
 
 
 def test_the_mmpp_conditional_likelihood_reduces_to_poisson_with_equal_rates():

@@ -7,8 +7,9 @@ Markov chain switch the collision rate. Per fitted IC (those of the renewal sect
 at least `MIN_EVENTS` collisions) it is set against Poisson and every renewal model on one
 likelihood, that of the events after the window's first given it
 (`kicktimes.stats.compare_point_processes`, the renewal fits' own footing): the renewal
-section's AICs and the MMPP-2's conditional AIC. Its full-likelihood fit
-(`kicktimes.stats.fit_mmpp`) gives the rates and switching rates. AIC is not calibrated
+section's AICs and the MMPP-2's conditional AIC. The full-likelihood fit that comparison
+starts from (`kicktimes.stats.fit_mmpp`'s, returned with ``return_fits``) gives the rates and
+switching rates: one fit per IC, not two. AIC is not calibrated
 for an MMPP against Poisson (the switching rates are not identified when the rates are
 equal), so the level of every share is the share on the IC's Poisson twin, the renewal
 section's: as many uniform times in the same window, fitted the same way.
@@ -49,7 +50,8 @@ def fit_job(job):
     ``poisson_aic`` on the conditional footing of `kicktimes.stats.compare_point_processes`
     (NaN and ``note`` when the fit fails) and, with ``with_params``, the full-likelihood
     fit's ``rate_low``, ``rate_high``, ``switch_low``, ``switch_high`` (rates of leaving
-    the low and the high state), ``stationary_rate`` and its warnings in ``note``.
+    the low and the high state), ``stationary_rate`` and its warnings in ``note``: the
+    fit the comparison itself made (``return_fits``), not a second one.
     """
     from kicktimes import stats
 
@@ -59,15 +61,16 @@ def fit_job(job):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # degenerate fits are named in their notes
         try:
-            table = stats.compare_point_processes(times, window, models=[], n_states=(2,),
-                                                  n_starts=N_STARTS, rng=rng)
+            table, fits = stats.compare_point_processes(
+                times, window, models=[], n_states=(2,), n_starts=N_STARTS, rng=rng,
+                return_fits=True)
         except ValueError as exc:
             return {**out, "note": str(exc)}
         out["mmpp_aic"] = float(table.loc["mmpp2", "aic"])
         out["poisson_aic"] = float(table.loc["poisson", "aic"])
         out["note"] = str(table.loc["mmpp2", "note"])
-        if with_params:
-            fit = stats.fit_mmpp(times, window, n_states=2, n_starts=N_STARTS, rng=rng)
+        if with_params and "mmpp2" in fits:
+            fit = fits["mmpp2"]
             q = fit.generator
             out.update(rate_low=float(fit.rates[0]), rate_high=float(fit.rates[1]),
                        switch_low=float(-q[0, 0]), switch_high=float(-q[1, 1]),

@@ -81,7 +81,7 @@ def _conditional_fit(fit: MMPPFit, data):
 
 
 def compare_point_processes(times, t_max, *, models=None, n_states=(2,), n_starts=8,
-                            rng=None):
+                            rng=None, return_fits=False):
     r"""Rank Poisson, renewal and MMPP models of event times in windows by AIC, on one
     likelihood.
 
@@ -100,6 +100,10 @@ def compare_point_processes(times, t_max, *, models=None, n_states=(2,), n_start
         EM starts of each MMPP fit.
     rng : Generator or int, optional
         Randomness of the MMPP starts.
+    return_fits : bool, optional
+        Also return the MMPP fits behind the rows (their full-likelihood fits, as
+        :func:`fit_mmpp` gives them but without standard errors), so that their
+        parameters need no second fit.
 
     Returns
     -------
@@ -110,6 +114,8 @@ def compare_point_processes(times, t_max, *, models=None, n_states=(2,), n_start
         ``converged`` and ``note``. ``attrs``: ``footing``, ``n_windows`` (with at least
         one event), ``n`` (events after each window's first, plus one censored end per
         window: the BIC's sample size).
+    fits : dict of MMPPFit
+        With ``return_fits``: ``{"mmpp<n>": fit}`` for every MMPP that could be fitted.
 
     Notes
     -----
@@ -156,6 +162,7 @@ def compare_point_processes(times, t_max, *, models=None, n_states=(2,), n_start
                      "family": "poisson" if model == "exponential" else "renewal",
                      "loglik": row["loglik"], "k": row["k"], "converged": row["converged"],
                      "note": row["note"]})
+    fits = {}
     for k in sizes:
         row = {"model": f"mmpp{k}", "family": "mmpp", "k": k * k}
         try:
@@ -163,6 +170,7 @@ def compare_point_processes(times, t_max, *, models=None, n_states=(2,), n_start
         except ValueError as exc:
             rows.append({**row, "loglik": np.nan, "converged": False, "note": str(exc)})
             continue
+        fits[row["model"]] = fit
         loglik, ok = _conditional_fit(fit, data)
         rows.append({**row, "loglik": loglik, "converged": fit.converged and ok,
                      "note": "; ".join(fit.warnings)})
@@ -181,7 +189,7 @@ def compare_point_processes(times, t_max, *, models=None, n_states=(2,), n_start
                       f"converged=False): {', '.join(bad)}", FitWarning, stacklevel=2)
     out.attrs.update(footing="conditional on each window's first event",
                      n_windows=int((data.n_events > 0).sum()), n=int(n_obs))
-    return out
+    return (out, fits) if return_fits else out
 
 
 @dataclass(frozen=True)
