@@ -213,3 +213,53 @@ def test_nanmedian_equals_numpys_on_long_rows_and_blocks():
         ref1 = np.nanmedian(a, axis=1)
     assert nanmedian(a, axis=2).tobytes() == ref.tobytes()
     assert nanmedian(a, axis=1).tobytes() == ref1.tobytes()
+
+
+@settings(max_examples=200, deadline=None)
+@given(
+    rows=st.integers(1, 4),
+    cols=st.integers(1, 12),
+    data=st.data(),
+)
+def test_bootstrap_nanmedians_equal_the_medians_of_the_resamples(rows, cols, data):
+    # every resample's nanmedian, bit for bit (values without -0.0, the documented
+    # exception; repeated values, NaN, inf and whole-NaN rows included)
+    from kicktimes.stats import bootstrap_nanmedians, nanmedian
+
+    element = st.one_of(st.sampled_from([np.nan, np.inf, -np.inf, 0.0, 1.0, 2.5]),
+                        st.floats(-1e6, 1e6).filter(lambda v: v != 0.0))
+    a = np.array(data.draw(st.lists(st.lists(element, min_size=cols, max_size=cols),
+                                    min_size=rows, max_size=rows)), dtype=float)
+    idx = np.array(data.draw(st.lists(st.lists(st.integers(0, cols - 1), min_size=1,
+                                               max_size=15), min_size=1, max_size=6)
+                             .filter(lambda v: len({len(r) for r in v}) == 1)))
+    got = bootstrap_nanmedians(a, idx)
+    ref = np.array([nanmedian(a[:, idx[b]], axis=1) for b in range(idx.shape[0])])
+    assert got.shape == (idx.shape[0], rows)
+    assert np.array_equal(np.isnan(got), np.isnan(ref))
+    assert got[~np.isnan(ref)].tobytes() == ref[~np.isnan(ref)].tobytes()
+
+
+def test_bootstrap_nanmedians_on_a_report_sized_bootstrap():
+    from kicktimes.stats import bootstrap_nanmedians, nanmedian
+
+    rng = np.random.default_rng(5)
+    a = rng.lognormal(size=(10, 300))
+    a[rng.random(a.shape) < 0.1] = np.nan
+    a[3] = np.nan  # a radius without a pair
+    idx = rng.integers(0, 300, size=(200, 300))
+    got = bootstrap_nanmedians(a, idx)
+    ref = np.array([nanmedian(a[:, idx[b]], axis=1) for b in range(200)])
+    assert got.tobytes() == ref.tobytes()
+    assert got.flags.c_contiguous
+
+
+def test_bootstrap_nanmedians_bad_input():
+    from kicktimes.stats import bootstrap_nanmedians
+
+    with pytest.raises(ValueError, match="values"):
+        bootstrap_nanmedians(np.zeros(3), np.zeros((1, 3), int))
+    with pytest.raises(ValueError, match="idx"):
+        bootstrap_nanmedians(np.zeros((2, 3)), np.zeros((1, 3)))
+    with pytest.raises(ValueError, match=r"idx: column indices must lie in \[0, 3\)"):
+        bootstrap_nanmedians(np.zeros((2, 3)), np.array([[0, 3]]))

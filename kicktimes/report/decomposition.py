@@ -37,7 +37,7 @@ import pandas as pd
 
 from kicktimes.report.common import REFERENCE, wide
 from kicktimes.report.controls import diagnostics_of
-from kicktimes.stats import nanmedian
+from kicktimes.stats import bootstrap_nanmedians
 
 __all__ = ["LADDER", "STEPS", "gap_decomposition", "gap_figure", "gap_summary"]
 
@@ -84,10 +84,8 @@ def _ratio_medians(x, y, idx):
     with np.errstate(invalid="ignore", divide="ignore"), warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)  # a radius without pairs
         q = x / y
-        # resamples in blocks: q[:, idx] holds radii x B x N values at once otherwise
-        block = max(1, 2_000_000 // max(q.size, 1))
-        medians = np.concatenate([nanmedian(q[:, idx[b:b + block]], axis=2)
-                                  for b in range(0, idx.shape[0], block)], axis=1)
+        # radii x B, C-ordered as the reduction over radii expects (its summation order)
+        medians = np.ascontiguousarray(bootstrap_nanmedians(q, idx).T)
         return np.nanmean(medians, axis=0)
 
 

@@ -49,7 +49,7 @@ from .renewal import (
     fit_renewal,
 )
 from .rescaling import RescaledTimes, mmpp_residuals
-from .robust import nanmedian
+from .robust import bootstrap_nanmedians, nanmedian
 from .survival import EscapeTail, circle_escape_constant, escape_survival, fit_escape_tail
 
 __all__ = [
@@ -76,6 +76,7 @@ __all__ = [
     "circle_escape_constant",
     "escape_survival",
     "nanmedian",
+    "bootstrap_nanmedians",
     "fit_escape_tail",
     "EscapeTail",
     "hyperexpon",
