@@ -241,7 +241,8 @@ def sections(ctx):
         "calibrated for an MMPP against Poisson, so each share has as its level the share on "
         "the IC's Poisson twin (the renewal section's: as many uniform times in the same "
         "window, fitted the same way). The rates and switching rates are those of the "
-        "full-likelihood fit (kicktimes.stats.fit_mmpp, stationary start)."
+        "full-likelihood fit behind the comparison (kicktimes.stats.fit_mmpp's with the same "
+        "4 starts, stationary start): a good local optimum, not always the global one."
     )
     if best is None or "best_aic" not in best:
         sec.text("No renewal comparison per IC: no MMPP fit.")
