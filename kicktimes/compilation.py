@@ -4,10 +4,11 @@ numba compiles each ``@njit(cache=True)`` kernel on its first call and stores th
 code on disk (next to the source, or under ``NUMBA_CACHE_DIR``); later processes load it
 in milliseconds. On a fresh install the sweep's kernels take tens of seconds to compile
 (``python benchmarks/bench_compile.py`` measures them per kernel), so the command line
-says so once, and compiles two independent groups of kernels of about the same cost (the
-two-disk one-pass kernel, simulation and tangent FTLE in one event loop, with the
-autocorrelation; the kicked disk's one-pass kernel and the recurrence kernels) in two
-processes at the same time instead of one after the other in every worker. ``kicktimes
+says so once, and compiles two groups of kernels in two processes at the same time instead
+of one after the other in every worker: a tiny task of the two-disk system (its one-pass
+kernel: simulation, tangent FTLE and uniform samples in one event loop; the recurrence and
+the autocorrelation), and one of every kicked system (the kicked disk's one-pass kernel for
+each kind of kick, the kinetic rate table, the recurrence again). ``kicktimes
 reproduce`` leaves the report's kernels to its report process (`warm_report`), which
 compiles them at the same time, while the sweep's groups compile.
 """
@@ -31,23 +32,24 @@ SWEEP_KERNELS = (
     ("kicktimes.diagnostics._recurrence_kernels", "_sweep_lines_dense", 3.0),
     ("kicktimes.diagnostics.autocorrelation", "_acf_curve", 1.3),
     ("kicktimes.diagnostics.autocorrelation", "_select_checked", 0.2),
-    # the uniform-time re-runs of the recurrence control (rr_sampling = "run+uniform", the
-    # full presets); seconds timed cold on the project's machine, 2026-11-25
-    ("kicktimes.billiard.kernels.drive_two", "simulate_two_kernel", 2.6),
-    ("kicktimes.billiard.kernels.drive_one", "simulate_one_kernel", 2.8),
+    # the kinetic-rate kicks' table of the rate against the angular momentum
+    ("kicktimes.stats._kinetic_quadrature", "invariant_partner_rates", 2.0),
 )
 SIMULATE_KERNELS = (("kicktimes.billiard.kernels.drive_two", "simulate_two_kernel", 4.5),)
 #: What the report compiles beyond the sweep's kernels (``kicktimes reproduce``'s report
 #: process warms them while the sweep's compile or run): the trajectory figures'
-#: re-simulation with a collision log, the recurrence plot's pair sweep (sorted cells, pairs
-#: collected), the hyperexponential EM of the renewal fits, the exact KS law and the
-#: Ljung-Box statistic of the Poisson tests.
+#: re-simulations (two disks with a collision log, the kicked disk plainly), the
+#: recurrence plot's pair sweep (sorted cells, pairs collected), the hyperexponential EM of
+#: the renewal fits, the exact KS law and the Ljung-Box statistic of the Poisson tests, the
+#: Findings' bootstrap medians.
 REPORT_KERNELS = (
     ("kicktimes.billiard.kernels.drive_two", "simulate_two_kernel", 2.0),
+    ("kicktimes.billiard.kernels.drive_one", "simulate_one_kernel", 2.8),
     ("kicktimes.diagnostics._recurrence_kernels", "_sweep", 1.0),
     ("kicktimes.stats.distributions", "_em_steps", 0.5),
     ("kicktimes.stats.poisson", "pomeranz_cdf", 0.5),
     ("kicktimes.stats.iid_tests", "_ljung_box_rows", 1.9),
+    ("kicktimes.stats.robust", "_bootstrap_nanmedians", 0.5),
 )
 
 
@@ -94,83 +96,67 @@ def announce(kernels=SWEEP_KERNELS, *, stream=None, extra_seconds=0.0) -> float:
     return float(n)
 
 
-def _warm_two(_):
-    # the two-disk system exactly as a sweep task runs it (one pass: simulation and
-    # tangent FTLE; autocorrelation), on a tiny run; the recurrence kernels are left to
-    # _warm_one, which balances the two groups
+def _warm_task(systems, diagnostics=None) -> None:
+    """One tiny task of the quick preset with these ``systems`` (and ``diagnostics``): the
+    very calls, argument types and observers (the one pass's uniform samples) of a
+    sweep's task."""
     import dataclasses
 
     from kicktimes.experiment import execute_task, preset
 
     exp = preset("quick_a")
-    diagnostics = tuple(d for d in exp.diagnostics if d != "recurrence_rate")
-    exp = dataclasses.replace(exp, n_ics=1, n_steps=50, block_size=1, systems=["two_particle"],
-                              diagnostics=diagnostics)
+    exp = dataclasses.replace(exp, n_ics=1, n_steps=50, block_size=1, systems=systems,
+                              diagnostics=diagnostics or exp.diagnostics)
     execute_task(exp, exp.tasks()[0])
-    # the recurrence control's uniform-time re-run, as a task makes it
-    from kicktimes.billiard.initial import initial_conditions
-    from kicktimes.billiard.two_particle import simulate_two_particle
-    from kicktimes.experiment.tasks import uniform_samples
 
-    ic = initial_conditions(1, exp.r_max, seed=0, method=exp.ic_method, rule=exp.rule)[0]
-    r = exp.radii[0]
-    two = simulate_two_particle(ic, r, rule=exp.rule, track=0, n_steps=50, tau=exp.tau,
-                                sampling=exp.sampling)
-    uniform_samples(exp, "two_particle", ic, r, two)
+
+def _warm_two(_):
+    # the two-disk system exactly as a sweep task runs it: its one pass (simulation,
+    # tangent FTLE and the uniform samples of the recurrence control), the recurrence rows
+    # and the autocorrelation
+    _warm_task(("two_particle",))
 
 
 def _warm_one(_):
-    # the kicked disk as a sweep task calls it: Poisson kicks, one pass (simulation and
-    # tangent FTLE); then the sweep's recurrence rows (the same call as a task's) on its
-    # samples
-    import numpy as np
-
-    from kicktimes.billiard.initial import initial_conditions
-    from kicktimes.billiard.one_particle import draw_kick_angles
-    from kicktimes.diagnostics.lyapunov import lyapunov
-    from kicktimes.experiment import preset
-    from kicktimes.experiment.tasks import kick_law, recurrence_rows, uniform_samples
-
-    exp = preset("quick_a")
-    ic = initial_conditions(1, exp.r_max, seed=0, method=exp.ic_method, rule=exp.rule)[0]
-    steps = {"n_steps": 50, "tau": exp.tau, "sampling": exp.sampling}
-    kick = kick_law(exp, "poisson", ic)
-    rng = np.random.default_rng(0)
-    times = np.cumsum(rng.exponential(1.0, size=20))
-    angles = draw_kick_angles(times.size, kick["kick_angle"], exp.sigma, rng)
-    r = exp.radii[0]
-    _, run = lyapunov(ic[0], r, kicks=times, kick_angles=angles, variant=exp.lyapunov_variant,
-                      method=exp.lyapunov_method, return_run=True, **kick, **steps)
-    recurrence_rows(run.samples, exp.eps)
-    # the recurrence control's uniform-time re-run of the kicked disk
-    uniform_samples(exp, "poisson", ic, r, run)
+    # the kicked disk as a sweep task runs it, every kind of kick (Poisson and actual
+    # times, uniform and scattering kicks, kinetic-rate kicks with their rate table), one
+    # pass each, with the recurrence rows (compiled here too: the groups run at once); the
+    # two-disk run that sets their rates is a plain simulation here
+    _warm_task(("poisson", "actual", "poisson_scatter", "actual_scatter", "poisson_kinetic"),
+               ("lyapunov", "recurrence_rate"))
 
 
 def _warm_report_two(_):
-    # the trajectory figures' two-disk run with a collision log; the Poisson tests' exact
-    # KS law (its compiled branch: n <= 140 events, 0.75 < n D^2 <= 4) and Ljung-Box Q
+    # the trajectory figures' two-disk run with a collision log and their kicked run (a
+    # plain simulation: no FTLE, no observers); the Poisson tests' exact KS law (its
+    # compiled branch: n <= 140 events, 0.75 < n D^2 <= 4) and Ljung-Box Q
     import numpy as np
 
-    from kicktimes import initial_conditions, simulate_two_particle
+    from kicktimes import initial_conditions, simulate_one_particle, simulate_two_particle
     from kicktimes.stats.iid_tests import ljung_box
     from kicktimes.stats.poisson import pomeranz_cdf
 
     ic = initial_conditions(1, 0.02, seed=0)[0]
     simulate_two_particle(ic, 0.02, n_steps=50, tau=0.3, log_collisions=True)
+    simulate_one_particle(ic[0], 0.02, kicks=np.array([0.5, 1.0]), kick_angles=np.zeros(2),
+                          kick_angle="uniform", sigma=1.0, n_steps=50, tau=0.3,
+                          sampling="paper")
     pomeranz_cdf(12, 0.3)
     ljung_box(np.arange(12.0), 2)
 
 
 def _warm_report_one(_):
-    # the recurrence plot's pairs (sorted cells); the renewal fits' EM
+    # the recurrence plot's pairs (sorted cells); the renewal fits' EM; the findings'
+    # bootstrap medians
     import numpy as np
 
     from kicktimes.diagnostics import recurrence_pairs
-    from kicktimes.stats import compare_models
+    from kicktimes.stats import bootstrap_nanmedians, compare_models
 
     rng = np.random.default_rng(0)
     recurrence_pairs(rng.uniform(-1.0, 1.0, (60, 2)), 1e-3)
     compare_models(rng.exponential(size=60), censored=rng.exponential(size=2))
+    bootstrap_nanmedians(rng.uniform(size=(2, 5)), rng.integers(0, 5, size=(3, 5)))
 
 
 def warm_sweep() -> None:

@@ -102,7 +102,9 @@ def bootstrap_nanmedians(values, idx):
     >>> np.array_equal(bootstrap_nanmedians(values, idx)[1], nanmedian(values[:, idx[1]]))
     True
     """
-    values = np.ascontiguousarray(values, dtype=np.float64)
+    # C-ordered and writable: a read-only array (pandas' to_numpy) would compile the
+    # kernel a second time
+    values = np.require(values, dtype=np.float64, requirements=["C", "W"])
     idx = np.asarray(idx)
     if values.ndim != 2:
         raise ValueError(f"values: expected a 2-D array (rows x columns), got shape "

@@ -135,7 +135,9 @@ def drive(st, ev, rho, kicks, angles, kick_mode, kick_u, sp, unit_speed, t_end, 
                 t_prev = tk
                 i_loop += 1
                 if i_loop == n_loop:
-                    tg.end_step(U, log_scale, t_prev - t, 0)
+                    # no Gram-Schmidt (an int64, not a literal 0: a literal would
+                    # compile end_step a second time)
+                    tg.end_step(U, log_scale, t_prev - t, np.int64(0))
                     tan_on = False
                     break
                 tk = min(t_prev + tau, t + dte)
