@@ -16,7 +16,9 @@ Issue 32's yardstick. Per round, for each ``--content``:
 The ratio of each command is its wall time over the C loop's time measured in the same
 round. After each command the stage table is read back from what it wrote: sweep
 worker-seconds by stage (the stores' manifests) and report seconds by stage
-(``report/report_timings.csv``).
+(``report/report_timings.csv``). With ``--source``, each round then checks that the two
+trees' stores are bitwise equal (results and collision times) and lists the report files
+whose bytes differ.
 
 Run it on an idle machine::
 
@@ -36,6 +38,7 @@ import tempfile
 import time
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "c_reference"))
@@ -98,6 +101,41 @@ def stage_table(out: Path) -> pd.Series:
     return pd.Series(sums, dtype=float)
 
 
+def store_differences(a: Path, b: Path) -> list[str]:
+    """The stores of run ``a`` that are not bitwise those of run ``b``: their results
+    (every column; values compared as bytes) and collision times."""
+    diffs = []
+    names = sorted(p.name for p in a.glob("store-*"))
+    if names != sorted(p.name for p in b.glob("store-*")):
+        return [f"different stores: {names}"]
+    for name in names:
+        sa, sb = load_store(a / name, verify=False), load_store(b / name, verify=False)
+        ra, rb = sa.results.reset_index(drop=True), sb.results.reset_index(drop=True)
+        ca, cb = sa.collisions.reset_index(drop=True), sb.collisions.reset_index(drop=True)
+        values_same = ra["value"].to_numpy().tobytes() == rb["value"].to_numpy().tobytes()
+        same = (ra.equals(rb) and values_same
+                and ca.drop(columns="pp_times").equals(cb.drop(columns="pp_times"))
+                and len(ca) == len(cb)
+                and all(np.asarray(x).tobytes() == np.asarray(y).tobytes()
+                        for x, y in zip(ca["pp_times"], cb["pp_times"], strict=True)))
+        if not same:
+            diffs.append(name)
+    return diffs
+
+
+def report_differences(a: Path, b: Path) -> list[str]:
+    """The report files (CSV, PNG) of run ``a`` whose bytes differ from run ``b``'s
+    (timings left out)."""
+    out = []
+    for f in sorted((a / "report").rglob("*")):
+        if f.suffix not in (".csv", ".png") or "timings" in f.name:
+            continue
+        g = b / "report" / f.relative_to(a / "report")
+        if not g.exists() or f.read_bytes() != g.read_bytes():
+            out.append(f.name)
+    return out
+
+
 def warm(source: Path | None, root: Path, workers: int) -> None:
     """A quick run per tree first: its numba cache is then warm, as a user's is."""
     run_command(source, "quick", "full", root / "warm", workers, root / "warm.log")
@@ -139,8 +177,18 @@ def main(argv=None):
                 stages[(content, label, rnd)] = stage_table(out)
                 print(f"round {rnd}, {content:5s}, {label:9s}: {wall:7.1f} s, C loop "
                       f"{c_sec:5.2f} s ({n} trajectories): {wall / c_sec:5.1f}x", flush=True)
-                if args.out is None:
-                    shutil.rmtree(out, ignore_errors=True)
+            runs = [root / f"{label.replace(' ', '_')}-{content}-{rnd}" for label, _ in trees]
+            if len(runs) == 2:
+                # no change to any result: the stores of the two trees, bitwise
+                stores = store_differences(*runs)
+                files = report_differences(*runs)
+                print(f"round {rnd}, {content:5s}: stores bitwise equal: "
+                      f"{'yes' if not stores else 'NO, ' + ', '.join(stores)}; report files "
+                      f"that differ: {len(files)}{' (' + ', '.join(files) + ')' if files else ''}",
+                      flush=True)
+            if args.out is None:
+                for run in runs:
+                    shutil.rmtree(run, ignore_errors=True)
     table = pd.DataFrame(rows)
     print("\n" + table.to_markdown(index=False, floatfmt=".2f"))
     stage_frame = pd.DataFrame(stages).fillna(0.0)
