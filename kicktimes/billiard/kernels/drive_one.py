@@ -64,10 +64,7 @@ def drive(st, ev, rho, kicks, angles, kick_mode, kick_u, sp, unit_speed, t_end, 
             tgi, tgf)
     uni_on = False
     if uni is not None:
-        u_times, u_samples, u_cnt = uni
-        ku = u_cnt[0]
-        uni_on = u_cnt[1] != 0
-        u_limit = u_cnt[2]
+        u_times, u_samples, ku, uni_on, u_limit = ob.load_uniform(uni)
     scatter = kick_mode == one.SCATTER
     nk = kicks.shape[0]
     ns = stimes.shape[0]
@@ -203,9 +200,7 @@ def drive(st, ev, rho, kicks, angles, kick_mode, kick_u, sp, unit_speed, t_end, 
     cnt[SIM_ON] = 1 if sim_on else 0
     next_s[0] = ns_next
     if uni is not None:
-        u_cnt[0] = ku
-        u_cnt[1] = 1 if uni_on else 0
-        u_cnt[2] = u_limit
+        ob.store_uniform(uni, ku, uni_on, u_limit)
     if tan is not None:
         tg.store_carry(tgi, tgf, tan_on, i_loop, n_ev, n_same, n_resc, n_pert, tk, t_prev,
                        tan_code)

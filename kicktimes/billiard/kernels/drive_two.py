@@ -93,10 +93,7 @@ def drive(st, ev, phys, t_end, mode, tau, track, logs, stimes, samples, cnt, nex
             tgi, tgf)
     uni_on = False
     if uni is not None:
-        u_times, u_samples, u_cnt = uni
-        ku = u_cnt[0]
-        uni_on = u_cnt[1] != 0
-        u_limit = u_cnt[2]
+        u_times, u_samples, ku, uni_on, u_limit = ob.load_uniform(uni)
     ns = stimes.shape[0]
     pp_cap = pp.shape[0]
     b_cap = bt.shape[0]
@@ -257,9 +254,7 @@ def drive(st, ev, phys, t_end, mode, tau, track, logs, stimes, samples, cnt, nex
     cnt[N_B_CONT] = n_b_cont
     next_s[0] = ns_next
     if uni is not None:
-        u_cnt[0] = ku
-        u_cnt[1] = 1 if uni_on else 0
-        u_cnt[2] = u_limit
+        ob.store_uniform(uni, ku, uni_on, u_limit)
     if tan is not None:
         tg.store_carry(tgi, tgf, tan_on, i_loop, n_ev, n_same, n_resc, n_pert, tk, t_prev,
                        tan_code)

@@ -25,7 +25,8 @@ from kicktimes.billiard.checks import STALL_EVENTS
 
 __all__ = ["DONE", "FULL", "OVER_BUDGET", "STALLED", "grow_boundary_log", "grow_rows_to",
            "grow_to", "in_hole", "new_boundary_log", "new_samples", "sample_at_event",
-           "sample_flight", "sample_uniform", "stalled", "uniform_limit"]
+           "load_uniform", "sample_flight", "sample_uniform", "stalled", "store_uniform",
+           "uniform_limit"]
 
 # status codes of the event loops
 DONE, FULL, STALLED, OVER_BUDGET = 0, 1, 2, 3
@@ -97,13 +98,31 @@ def in_hole(x, y, arcs):
     return False
 
 
+@njit(cache=True, inline="always")
+def load_uniform(uni):
+    """The uniform observer's arrays and state, as the drivers carry them:
+    ``(u_times, u_samples, ku, uni_on, u_limit)`` from ``uni = (times, samples, counters)``
+    with counters ``(next index, on, limit)``."""
+    u_times, u_samples, u_cnt = uni
+    return u_times, u_samples, u_cnt[0], u_cnt[1] != 0, u_cnt[2]
+
+
+@njit(cache=True, inline="always")
+def store_uniform(uni, ku, uni_on, u_limit):
+    """Write the uniform observer's state back between driver calls (see `load_uniform`)."""
+    u_cnt = uni[2]
+    u_cnt[0] = ku
+    u_cnt[1] = 1 if uni_on else 0
+    u_cnt[2] = u_limit
+
+
 @njit(cache=True, inline="always", error_model="numpy")
-def sample_flight(stimes, samples, k, next_time, t, dt, x, y, vx, vy, mode, tau):
-    """Record the samples strictly before the next event, ``dt`` from now, on the free
-    flight from ``(x, y)`` at time ``t``; returns ``(k, next_time)``, the next sample's
-    index and time. ``mode`` 1: samples at ``k tau``; 2: the paper's steps of ``tau``."""
-    ns = stimes.shape[0]
-    while k < ns and next_time - t < dt:
+def _sample_steps(stimes, samples, k, limit, next_time, t, dt, x, y, vx, vy, mode, tau):
+    """The one sampler of free flights: record the samples strictly before the next
+    event, ``dt`` from now, on the flight from ``(x, y)`` at time ``t``, from sample ``k``
+    at ``next_time`` and below ``limit``; returns ``(k, next_time)``. ``mode`` 1: samples
+    at ``k tau``; 2: the paper's steps of ``tau``."""
+    while k < limit and next_time - t < dt:
         ds = next_time - t
         stimes[k] = next_time
         samples[k, 0] = x + vx * ds
@@ -114,20 +133,21 @@ def sample_flight(stimes, samples, k, next_time, t, dt, x, y, vx, vy, mode, tau)
 
 
 @njit(cache=True, inline="always", error_model="numpy")
+def sample_flight(stimes, samples, k, next_time, t, dt, x, y, vx, vy, mode, tau):
+    """Record the samples strictly before the next event, ``dt`` from now, on the free
+    flight from ``(x, y)`` at time ``t``; returns ``(k, next_time)``, the next sample's
+    index and time. ``mode`` 1: samples at ``k tau``; 2: the paper's steps of ``tau``."""
+    return _sample_steps(stimes, samples, k, stimes.shape[0], next_time, t, dt, x, y, vx, vy,
+                         mode, tau)
+
+
+@njit(cache=True, inline="always", error_model="numpy")
 def sample_uniform(stimes, samples, k, limit, t, dt, x, y, vx, vy, tau):
     """`sample_flight` at ``k tau`` (its mode 1) with the samples capped at ``limit``;
     returns ``k``. A second sampler of the same flights: the uniform samples of a
     paper-sampled run, which a uniform run over the same time records bit for bit (the same
     sample times ``k tau``, the same interpolation)."""
-    next_time = k * tau
-    while k < limit and next_time - t < dt:
-        ds = next_time - t
-        stimes[k] = next_time
-        samples[k, 0] = x + vx * ds
-        samples[k, 1] = y + vy * ds
-        k += 1
-        next_time = k * tau
-    return k
+    return _sample_steps(stimes, samples, k, limit, k * tau, t, dt, x, y, vx, vy, 1, tau)[0]
 
 
 @njit(cache=True, inline="always", error_model="numpy")
