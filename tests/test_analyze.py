@@ -163,8 +163,12 @@ def test_poisson_sequences_are_consistent_with_poisson_and_rate_scales_linearly(
     assert slope["g"] == "log" and slope["ci_low"] < 1.0 < slope["ci_high"]
     assert (res.reference["ci_low"] < 1).all() and (res.reference["ci_high"] > 1).all()
     verdicts = {f.question: f.verdict for f in findings(res)}
-    assert verdicts["Poisson?"] == "consistent with Poisson"
-    assert verdicts["One rate for all sequences?"] == "consistent with one rate per group"
+    assert verdicts["Poisson?"] == "; ".join(
+        f"density = {d}: consistent with Poisson" for d in (1, 2, 4)
+    )
+    assert verdicts["One rate for all sequences?"] == "; ".join(
+        f"density = {d}: consistent with one rate" for d in (1, 2, 4)
+    )
 
 
 def test_regular_sequences_are_not_poisson():
@@ -214,9 +218,10 @@ def test_covariate_regression_recovers_a_linear_log_rate_on_any_scale():
     assert reg.loc[("poisson", "intercept"), "estimate"] == pytest.approx(0.5, abs=0.1)
 
 
-def test_group_and_reference_must_be_covariates():
+def test_group_must_be_a_column_and_reference_a_covariate():
     df = _poisson_rows([1.0])
-    with pytest.raises(ValueError, match="group must be one of the covariates"):
+    with pytest.raises(ValueError,
+                       match=r"group must name a per-sequence column, one of \['density'\]"):
         stats.analyze(df, window=(0, 100), group="nope")
     with pytest.raises(ValueError, match="reference must be one of the covariates"):
         stats.analyze(df, window=(0, 100), reference="nope")
@@ -270,11 +275,132 @@ def test_cli_bad_input_is_one_error_line(tmp_path):
         main,
         ["analyze", str(tmp_path / "e.csv"), "--window", "0", "5", "--out", str(tmp_path / "o")],
     )
-    assert result.exit_code == 1
-    assert result.output.strip().splitlines() == [
+    assert result.exit_code == 2  # bad input is bad usage, as in every command
+    assert result.output.strip().splitlines()[-1] == (
         "Error: e.csv, row 1 (line 3): unsorted times in sequence 'a': 1.0 is earlier than the "
         "time of row 0 (2.0); times must increase strictly within a sequence"
-    ]
+    )
+    assert not (tmp_path / "o").exists()
+
+
+def _poisson_and_clustered(n_per_kind=12, window=200.0, seed=0):
+    """Events of ``n_per_kind`` Poisson sequences and as many clustered ones (Neyman-Scott:
+    clusters of about 6 events within 0.5 time units), with a text column ``kind``."""
+    rng = np.random.default_rng(seed)
+    rows, wins = [], []
+    for k in range(2 * n_per_kind):
+        kind = "poisson" if k < n_per_kind else "clustered"
+        if kind == "poisson":
+            t = np.sort(rng.uniform(0, window, rng.poisson(100)))
+        else:
+            centres = rng.uniform(0, window, rng.poisson(15))
+            t = np.concatenate([c + rng.exponential(0.5, rng.poisson(6)) for c in centres])
+            t = np.sort(t[t < window])
+        rows += [(f"s{k}", x) for x in t]
+        wins.append((f"s{k}", 0.0, window, kind))
+    return (pd.DataFrame(rows, columns=["sequence", "time"]),
+            pd.DataFrame(wins, columns=["sequence", "t_start", "t_end", "kind"]))
+
+
+def test_a_text_group_gets_one_verdict_per_group_in_order_of_appearance(tmp_path):
+    events, windows = _poisson_and_clustered()
+    events.to_csv(tmp_path / "events.csv", index=False)
+    windows.to_csv(tmp_path / "sequences.csv", index=False)
+    result = CliRunner().invoke(main, [
+        "analyze", str(tmp_path / "events.csv"), "--windows", str(tmp_path / "sequences.csv"),
+        "--group", "kind", "--max-fits-per-group", "2", "--n-mc", "99",
+        "--out", str(tmp_path / "out")])
+    assert result.exit_code == 0, result.output
+    lines = result.output.splitlines()
+    poisson = next(line for line in lines if line.startswith("- Poisson?"))
+    assert poisson == ("- Poisson? kind = poisson: consistent with Poisson; "
+                       "kind = clustered: not Poisson.")
+    statement = lines[lines.index(poisson) + 1]
+    assert "kind = poisson: consistent with Poisson: none of 7 tests rejects" in statement
+    assert "...." not in statement and "; ..." not in statement
+    page = (tmp_path / "out" / "report.html").read_text()
+    # no billiard words on the page of outside data
+    for word in ("disk", " IC", "ICs", "radius", "radii"):
+        assert word not in page, word
+    seqs = pd.read_csv(tmp_path / "out" / "sequences.csv")
+    assert list(pd.unique(seqs["group"])) == ["poisson", "clustered"]
+
+
+def test_text_groups_are_categories_drawn_without_joining_lines():
+    from kicktimes.report.poisson import poisson_rejection_rates
+
+    events, windows = _poisson_and_clustered(n_per_kind=4)
+    res = stats.analyze(events, windows=windows, group="kind", rng=0, max_fits_per_group=0,
+                        n_mc=99)
+    assert res.events.labels == ("kind",) and "kind" not in res.events.covariates
+    fig = poisson_rejection_rates(res.poisson, x="group", xlabel="kind")
+    ax = [a for a in fig.axes if a.get_visible()][-1]
+    assert [t.get_text() for t in ax.get_xticklabels()] == ["poisson", "clustered"]
+    line = ax.containers[0].lines[0]
+    assert line.get_linestyle() == "None"
+    legend = " ".join(t.get_text() for t in fig.legends[0].get_texts())
+    assert "event times" in legend and "IC" not in legend and "disk" not in legend
+
+
+def test_a_numeric_group_with_few_values_is_ticked_at_its_values():
+    from kicktimes.report.figures import XAxis
+
+    t = pd.DataFrame({"clustered": [0, 1, 0]})
+    (_, axis) = XAxis("clustered", "clustered").positions(t=t)
+    assert axis.values == (0.0, 1.0) and axis.line == "-"
+
+
+@pytest.mark.parametrize(
+    "name, content, message",
+    [
+        ("empty.csv", "", "empty.csv: the file is empty"),
+        ("header.csv", "sequence,time\n", "header.csv: no rows (only a header)"),
+        ("prose.parquet", "This is prose, not Parquet.\n",
+         "prose.parquet: not a readable Parquet file"),
+        ("latin.csv", b"sequence,time\n\x80\xff,1\n", "latin.csv: not a text (UTF-8 CSV) file"),
+    ],
+)
+def test_bad_files_get_one_line_naming_the_file_and_nothing_is_written(
+        tmp_path, name, content, message):
+    path = tmp_path / name
+    path.write_bytes(content if isinstance(content, bytes) else content.encode())
+    result = CliRunner().invoke(
+        main, ["analyze", str(path), "--window", "0", "5", "--out", str(tmp_path / "o")])
+    assert result.exit_code == 2
+    errors = [line for line in result.output.splitlines() if line.startswith("Error")]
+    assert len(errors) == 1 and errors[0].startswith(f"Error: {message}"), result.output
+    assert not (tmp_path / "o").exists()
+
+
+def test_a_header_only_event_file_with_windows_names_the_file(tmp_path):
+    (tmp_path / "events.csv").write_text("sequence,time\n")
+    (tmp_path / "w.csv").write_text("sequence,t_start,t_end\na,0,10\nb,0,10\n")
+    result = CliRunner().invoke(main, [
+        "analyze", str(tmp_path / "events.csv"), "--windows", str(tmp_path / "w.csv"),
+        "--out", str(tmp_path / "o")])
+    assert result.exit_code == 2
+    assert result.output.splitlines()[-1] == (
+        "Error: events.csv: no event in any of the 2 sequences: nothing to analyse")
+    assert not (tmp_path / "o").exists()
+
+
+@pytest.mark.parametrize(
+    "args, message",
+    [
+        ([], "give columns 't_start' and 't_end', a --windows table, or --window T_START T_END"),
+        (["--window", "0", "5", "--time-col", "t"],
+         "no column 't' (the event table); the columns are ['sequence', 'time'] (name the "
+         "column with --time-col)"),
+        (["--window", "0", "5", "--group", "nope"],
+         "--group must name a per-sequence column, one of [], got 'nope'"),
+    ],
+)
+def test_cli_messages_name_the_options(tmp_path, args, message):
+    (tmp_path / "e.csv").write_text("sequence,time\na,1.0\n")
+    result = CliRunner().invoke(
+        main, ["analyze", str(tmp_path / "e.csv"), *args, "--out", str(tmp_path / "o")])
+    assert result.exit_code == 2
+    assert message in result.output.splitlines()[-1], result.output
 
 
 # ------------------------------------------------------------ an outside simulator
@@ -324,11 +450,19 @@ def test_a_group_of_one_sequence_has_no_dispersion_index_and_no_warning():
     assert np.isfinite(het.loc[2.0, "dispersion_index"])
 
 
-def test_the_poisson_finding_of_sequences_without_events_is_inconclusive():
+def test_sequences_without_any_event_are_nothing_to_analyse():
     df = pd.DataFrame({"sequence": ["a", "b"], "time": [None, None]})
-    res = stats.analyze(df, window=(0, 10), rng=0)
-    verdicts = {f.question: f.verdict for f in findings(res)}
-    assert verdicts["Poisson?"] == "inconclusive"
+    with pytest.raises(ValueError, match="no event in any of the 2 sequences"):
+        stats.analyze(df, window=(0, 10), rng=0)
+
+
+def test_the_poisson_finding_of_a_group_without_testable_sequences_says_so():
+    df = pd.DataFrame({"sequence": ["a", "b"] + ["c"] * 6,
+                       "time": [None, None, 1.0, 2.5, 3.0, 4.5, 7.0, 9.0],
+                       "kind": ["x", "x"] + ["y"] * 6})
+    res = stats.analyze(df, window=(0, 10), group="kind", rng=0)
+    verdict = {f.question: f.verdict for f in findings(res)}["Poisson?"]
+    assert verdict.startswith("kind = x: untested")
 
 
 def test_a_tie_between_pooled_renewal_models_goes_to_the_first_group():
@@ -342,7 +476,7 @@ def test_a_tie_between_pooled_renewal_models_goes_to_the_first_group():
                            "n": 50})
     (renewal,) = [f for f in findings(dataclasses.replace(res, renewal_pooled=pooled))
                   if f.question == "Which renewal model?"]
-    assert renewal.verdict == "weibull (pooled, 1/2 groups)"
+    assert renewal.verdict == "density = 1: weibull (clear); density = 2: gamma (clear)"
 
 
 def test_the_page_draws_the_figures_against_the_group_values_and_names(tmp_path):
@@ -357,7 +491,9 @@ def test_the_page_draws_the_figures_against_the_group_values_and_names(tmp_path)
     assert ax.get_xlabel() == "density"
     np.testing.assert_array_equal(ax.containers[0].lines[0].get_xdata(), [100.0, 200.0, 400.0])
     page = write_analysis(res, tmp_path / "grouped", dpi=30).read_text()
-    assert page.count("<img") == 3 and "<h2>Contents</h2>" in page
+    assert page.count("<img") == 3 and '<details class="contents">' in page
+    # the answers come first, the collapsed contents after them
+    assert page.index('id="findings"') < page.index('<details class="contents">')
     # without a group every sequence is in the one group "all", drawn as a labelled tick
     ungrouped = stats.analyze(df, window=(0, 100), rng=0, max_fits_per_group=1)
     fig = poisson_rejection_rates(ungrouped.poisson, x="group", xlabel="group")

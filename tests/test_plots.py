@@ -428,7 +428,7 @@ def test_rate_heterogeneity_draws_zero_rate_ics_at_the_floor_and_p_values():
     assert_labelled(fig)
     ax1, ax2 = fig.axes
     labels = [t.get_text() for t in ax1.get_legend().get_texts()]
-    assert any("without collisions" in lab for lab in labels)
+    assert any("without disk-disk collisions" in lab for lab in labels)
     # p-values on a second x axis on top (never over a marker), one per radius
     (top,) = ax2.child_axes
     assert [t.get_text() for t in top.get_xticklabels()] == ["p<1e-300", "0.01", "0.2", "0.5"]

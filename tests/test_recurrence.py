@@ -166,6 +166,19 @@ def test_theiler_normalisation_counts_admissible_pairs_only():
     assert recurrence_rate(pts, 0.1, theiler=2) == 1.0  # (0, 2) and (2, 0) only
 
 
+@pytest.mark.parametrize("eps", [5e-324, 1e-320, 1e-200, 1.4e-154])
+def test_a_threshold_whose_square_is_subnormal_is_refused_by_name(eps):
+    with pytest.raises(ValueError, match=r"eps: must be at least 1\.492e-154"):
+        recurrence_rate(np.zeros((3, 2)), eps=eps)
+
+
+def test_the_smallest_threshold_counts_exactly():
+    from kicktimes.diagnostics.recurrence import EPS_MIN
+
+    pts = np.array([[0.0, 0.0], [EPS_MIN, 0.0], [0.0, 3 * EPS_MIN]])
+    assert recurrence_rate(pts, eps=EPS_MIN) == 5 / 9
+
+
 def test_points_exactly_eps_apart_are_recurrent():
     # 0.25 and its squares are exact in binary: the tie |x_i - x_j| = eps counts
     pts = np.array([[0.0, 0.0], [0.25, 0.0], [0.25, 0.25], [0.75, 0.25]])

@@ -292,7 +292,10 @@ def test_the_page_opens_with_the_findings_and_a_below_paper_scale_banner(built):
     page = built[0].read_text(encoding="utf-8")
     findings = page.index('id="findings"')
     assert findings < page.index('id="poincare"')
-    assert '<p class="banner">Below paper scale: tiny_report: 6 ICs' in page
+    assert '<p class="banner">A pipeline check, not an answer: tiny_report: 6 ICs' in page
+    # the answers first, then the collapsed contents; the stores named relative to the page
+    assert findings < page.index('<details class="contents">')
+    assert str(built[1].parent) not in page.split('id="findings"')[0]
     assert "Verdict rules." in page and "the whole 95 % CI of the ratio lies in [0.9, 1.1]" in page
 
 

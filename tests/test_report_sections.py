@@ -278,8 +278,10 @@ def test_findings_section_states_the_rules_and_the_scale(ctx):
     kinds = [kind for kind, _ in sec.blocks]
     assert kinds[0] == "banner" and "ul" in kinds
     banner = sec.blocks[0][1]
-    assert "16 ICs" in banner and "smoke test" in banner
+    assert "16 ICs" in banner and "pipeline check" in banner and "docs/results" in banner
     assert any("Verdict rules" in p for p in sec.paragraphs)
+    # below paper scale no answer ("No.") stands under the banner
+    assert not any(p.startswith("Are the collision times Poisson?") for p in sec.paragraphs)
 
 
 def test_sections_of_a_new_store_are_written_as_png_pdf_and_csv(ctx, tmp_path):
@@ -408,13 +410,15 @@ def test_one_writer_writes_the_page_of_the_report_and_of_kicktimes_analyze(tmp_p
 
     files = {}
     toc = [toc_item("s", "S & T", [toc_item("u", "U")]), toc_item("v", "V")]
-    path = write_page(tmp_path, "a <b> page", sources="x.csv", toc=toc,
+    path = write_page(tmp_path, "a <b> page", sources="x.csv", toc=toc, lead="<p>answers</p>",
                       body="<h3 id='s'>S</h3>", appendix="<p>end</p>", files=files)
     text = path.read_text(encoding="utf-8")
     assert path == tmp_path / "report.html" and set(files) == {"report.html"}
     assert text.startswith("<!DOCTYPE html>") and f"<style>{CSS}</style>" in text
     assert "<title>a &lt;b&gt; page</title>" in text and "<h1>a &lt;b&gt; page</h1>" in text
-    assert " from x.csv.</p><h2>Contents</h2>" in text
+    # the answers first, then the contents, collapsed (3 sections)
+    assert (' from x.csv.</p><p>answers</p><details class="contents"><summary>Contents '
+            "(3 sections)</summary>") in text
     assert ('<ul><li><a href="#s">S &amp; T</a><ul><li><a href="#u">U</a></li></ul></li>'
             '<li><a href="#v">V</a></li></ul>') in text
     assert text.endswith("<h3 id='s'>S</h3><p>end</p></body></html>")

@@ -5,9 +5,53 @@ Registered on the ``kicktimes`` group by :mod:`kicktimes.cli`.
 
 from __future__ import annotations
 
+import re
+
 import click
 
-from kicktimes.cli._group import option
+from kicktimes.cli._group import _plain, option
+
+#: library argument names as the command's options, at the start of a message
+_OPTIONS = {
+    "windows": "--windows",
+    "window": "--window",
+    "group": "--group",
+    "reference": "--reference",
+    "covariates": "--covariate",
+    "labels": "--group",
+    "alpha": "--alpha",
+    "n_mc": "--n-mc",
+    "max_fits_per_group": "--max-fits-per-group",
+}
+#: phrases of the library's messages that name its arguments, as the command's options
+_PHRASES = (
+    (r"window=\(t_start, t_end\)", "--window T_START T_END"),
+    (r"a windows table", "a --windows table"),
+    (r"as a table \(windows\) or as window", "as --windows or as --window"),
+    (r"covariates: no table", "--covariate: no table"),
+)
+#: the option that chooses each column, for a missing column
+_COLUMN_OPTIONS = (
+    ("time", "--time-col"),
+    ("sequence", "--sequence-col"),
+    ("t_start", "--start-col"),
+    ("t_end", "--end-col"),
+)
+
+
+def _cli_message(message: str, columns: dict) -> str:
+    """A library message in the command's words: options instead of argument names, and
+    for a missing column the option that names it."""
+    message = _plain(message, _OPTIONS)
+    for pattern, replacement in _PHRASES:
+        message = re.sub(pattern, replacement, message)
+    missing = re.search(r"no column '([^']*)'", message)
+    if missing:
+        for key, opt in _COLUMN_OPTIONS:
+            if columns[key] == missing.group(1):
+                message += f" (name the column with {opt})"
+                break
+    return message
 
 
 @click.command("analyze")
@@ -115,7 +159,10 @@ def analyze_command(
         path = write_analysis(res, out, dpi=dpi, sources=list(files), windows=windows,
                               mmpp=table)
     except (ValueError, TypeError) as exc:
-        raise click.ClickException(str(exc)) from None
+        # bad input is bad usage: exit status 2 with the usage line, as every command
+        columns = {"time": time_col, "sequence": sequence_col, "t_start": start_col,
+                   "t_end": end_col}
+        raise click.UsageError(_cli_message(str(exc), columns)) from None
     except OSError as exc:
         raise click.ClickException(f"{exc.strerror or exc}: {exc.filename or out}") from None
     click.echo(res.summary())
@@ -123,5 +170,5 @@ def analyze_command(
         from kicktimes.report.mmpp_analysis import mmpp_finding
 
         f = mmpp_finding(res, table)
-        click.echo(f"- {f.question}: {f.statement}")
+        click.echo(f"- {f.question} {f.verdict}.\n  {f.statement}")
     click.echo(f"report written to {path}")

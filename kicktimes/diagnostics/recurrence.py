@@ -91,6 +91,10 @@ def _as_points(points) -> np.ndarray:
     return np.ascontiguousarray(arr, dtype=np.float64)
 
 
+#: the smallest threshold whose square is a normal float64 (pairs compare squared lengths)
+EPS_MIN = float(np.sqrt(np.finfo(np.float64).tiny))
+
+
 def _check_eps(eps) -> float:
     if isinstance(eps, np.ndarray) and eps.ndim == 0:
         eps = eps.item()
@@ -99,6 +103,11 @@ def _check_eps(eps) -> float:
     eps = float(eps)
     if not (np.isfinite(eps) and eps > 0.0):
         raise ValueError(f"eps: must be positive and finite (0 < eps < inf), got {eps!r}")
+    if eps < EPS_MIN:
+        raise ValueError(
+            f"eps: must be at least {EPS_MIN:.4g}, so that eps**2 is a normal float64 (pairs "
+            f"compare squared distances), got {eps!r}"
+        )
     return eps
 
 
@@ -185,7 +194,8 @@ def recurrence_rate(points, eps=1e-3, *, theiler=0):
     ------
     ValueError
         Points not of shape (N, 2), empty or non-finite, or spanning more than 1e150 in x
-        or y (``dx**2 + dy**2`` would overflow); ``eps`` not positive and finite;
+        or y (``dx**2 + dy**2`` would overflow); ``eps`` not positive and finite, or
+        below ``EPS_MIN`` = 1.49e-154 (``eps**2`` subnormal);
         ``theiler`` negative or ``>= N``.
     TypeError
         Non-numeric points, eps or theiler.

@@ -197,16 +197,22 @@ def write_analysis(res, out_dir, *, dpi=150, sources=None, windows=None, mmpp=No
     md = ["# Findings", ""]
     md += [f"- **{f.question}** {f.verdict}. {f.statement} _Rule: {f.rule}_" for f in fs]
     write_text(out, "findings.md", "\n".join(md) + "\n", files)
-    body = write_outputs(secs, out, dpi, files=files)
-    inputs = ", ".join(html.escape(os.fspath(s)) for s in (sources or [])) or "a DataFrame"
+    lead = write_outputs(secs[:1], out, dpi, files=files)
+    body = write_outputs(secs[1:], out, dpi, files=files)
+
+    def shown(path):
+        return html.escape(os.path.relpath(Path(path).resolve(), out.resolve()))
+
+    inputs = ", ".join(shown(s) for s in (sources or [])) or "a DataFrame"
     if windows is not None:
-        inputs += f"; windows from {html.escape(os.fspath(windows))}"
+        inputs += f"; windows from {shown(windows)}"
     return write_page(
         out,
         "kicktimes analyze",
         sources=f"{inputs}: {len(res.sequences)} sequences, "
         f"{int(res.sequences['n_events'].sum())} events, α = {res.alpha:g}, n_mc = {res.n_mc}",
         toc=[toc_item(s.key, s.title) for s in secs],
+        lead=lead,
         body=body,
         files=files,
     )

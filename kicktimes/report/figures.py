@@ -58,14 +58,38 @@ def radius_axis(ax):
 
 
 @dataclass(frozen=True)
+class Nouns:
+    """The words a figure uses for what it shows: its event times, one event, one
+    sequence of them, and several sequences.
+
+    A figure drawn against the disk radius shows kicktimes' own runs (``SWEEP_NOUNS``:
+    disk-disk collision times, ICs); drawn against any other column it shows event times
+    from elsewhere (``EVENT_NOUNS``: events, sequences), the page of ``kicktimes
+    analyze``, which must not speak of disks.
+    """
+
+    events: str
+    event: str
+    one: str
+    many: str
+
+
+SWEEP_NOUNS = Nouns("disk-disk collision times", "disk-disk collision", "IC", "ICs")
+EVENT_NOUNS = Nouns("event times", "event", "sequence", "sequences")
+
+
+@dataclass(frozen=True)
 class XAxis:
     """What a figure draws along x: a column of its tables and the axis label.
 
     The report's figures draw against the disk radius (the default); ``kicktimes analyze``
     draws the same figures against the sequences' group. A numeric column is drawn at its
-    values; a column of labels (the analysis' single group ``"all"``) at 0, 1, ... in
-    order of first appearance, with the labels as ticks (``labels``, set by
-    :meth:`positions`).
+    values (a column other than the radius with at most `MAX_VALUE_TICKS` distinct values
+    gets a tick at each value and none between); a column of labels (text groups, the
+    analysis' single group ``"all"``) at 0, 1, ... in order of first appearance, with the
+    labels as ticks (``labels``, set by :meth:`positions`): categories, so figures draw
+    their points without joining lines (:attr:`line`). The figure's words follow the
+    column (:attr:`nouns`).
 
     Examples
     --------
@@ -74,13 +98,30 @@ class XAxis:
     >>> axis.positions(t=pd.DataFrame({"density": [0.2, 0.1]}))[0]["density"].tolist()
     [0.2, 0.1]
     >>> t, axis = XAxis("group", "group").positions(t=pd.DataFrame({"group": ["all"]}))
-    >>> t["group"].tolist(), axis.labels
-    ([0.0], ('all',))
+    >>> t["group"].tolist(), axis.labels, axis.line
+    ([0.0], ('all',), 'none')
+    >>> XAxis().nouns.many, XAxis("group").nouns.many
+    ('ICs', 'sequences')
     """
 
     column: str = "radius"
     label: str = RADIUS_LABEL
     labels: tuple | None = None
+    values: tuple | None = None
+
+    #: a numeric column other than the radius with this many distinct values or fewer
+    #: is ticked at its values
+    MAX_VALUE_TICKS = 8
+
+    @property
+    def nouns(self) -> Nouns:
+        """The figure's words: kicktimes' runs along the radius, events elsewhere."""
+        return SWEEP_NOUNS if self.column == "radius" else EVENT_NOUNS
+
+    @property
+    def line(self) -> str:
+        """The linestyle joining points along x: none between categories."""
+        return "none" if self.labels is not None else "-"
 
     def positions(self, **frames):
         """Check the column in every frame, given by name (radii: 0 < r < 0.5; other
@@ -90,10 +131,18 @@ class XAxis:
         for name, frame in frames.items():
             check_frame(name, frame, [self.column], allow_empty=True)
         values = {name: frame[self.column] for name, frame in frames.items()}
-        if all(v.empty or pd.api.types.is_numeric_dtype(v) for v in values.values()):
+        if all(
+            v.empty or (pd.api.types.is_numeric_dtype(v) and not pd.api.types.is_bool_dtype(v))
+            for v in values.values()
+        ):
             check = check_radii if self.column == "radius" else finite
             for name, v in values.items():
                 check(f"{name}[{self.column!r}]", v)
+            distinct = np.unique(
+                np.concatenate([np.asarray(v, float) for v in values.values()] or [[]])
+            )
+            if self.column != "radius" and 0 < distinct.size <= self.MAX_VALUE_TICKS:
+                return (*frames.values(), replace(self, values=tuple(distinct.tolist())))
             return (*frames.values(), self)
         labels = tuple(dict.fromkeys(str(v) for column in values.values() for v in column))
         where = {label: float(k) for k, label in enumerate(labels)}
@@ -110,13 +159,19 @@ class XAxis:
         return float(np.min(np.diff(u))) if u.size > 1 else single
 
     def draw(self, ax):
-        """Label the x axis; at most 6 plain ticks for numbers, the labels for text."""
+        """Label the x axis; at most 6 plain ticks for numbers (a tick at each value of a
+        column with few values), the labels for text, with a margin of half a step."""
         from matplotlib.ticker import FixedFormatter, FixedLocator, MaxNLocator
 
         ax.set_xlabel(self.label)
         if self.labels is not None:
             ax.xaxis.set_major_locator(FixedLocator(np.arange(len(self.labels), dtype=float)))
             ax.xaxis.set_major_formatter(FixedFormatter(list(self.labels)))
+            ax.set_xlim(-0.5, len(self.labels) - 0.5)
+            return
+        if self.values is not None:
+            ax.xaxis.set_major_locator(FixedLocator(np.asarray(self.values, float)))
+            ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
             return
         ax.xaxis.set_major_locator(MaxNLocator(nbins=5, steps=[1, 2, 2.5, 5, 10]))
         # radii: 3 significant digits (0.0125); any other value as a plain number

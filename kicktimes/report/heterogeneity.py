@@ -82,13 +82,14 @@ def rate_heterogeneity(collisions, *, homogeneity=None, rule="mirror", max_point
     radii = table.index.to_numpy()
     jitter = 0.25 * axis.step(radii, single=0.004)
     rng = np.random.default_rng(0)  # jitter only: the figure is reproducible
+    nouns = axis.nouns
     zero_labelled = False
     for k, r in enumerate(radii):
         sel = np.flatnonzero(df[x].to_numpy() == r)
         sel = sel[:: max(1, math.ceil(sel.size / max_points))]
         y = rate[sel]
         xs = r + rng.uniform(-jitter, jitter, sel.size)
-        lab = "per-IC rate" if k == 0 else None
+        lab = f"per-{nouns.one} rate" if k == 0 else None
         ax1.plot(
             xs[y > 0],
             y[y > 0],
@@ -108,13 +109,15 @@ def rate_heterogeneity(collisions, *, homogeneity=None, rule="mirror", max_point
                 marker="v",
                 markersize=3,
                 color="tab:red",
-                label=None if zero_labelled else "IC without collisions (at the floor)",
+                label=None if zero_labelled
+                else f"{nouns.one} without {nouns.event}s (at the floor)",
             )
             zero_labelled = True
     grouped = df.groupby(x)
     pooled = grouped["n_pp"].sum() / grouped["t_window"].sum()
     median = pd.Series(rate, index=df.index).groupby(df[x]).median()
-    ax1.plot(pooled.index, pooled.to_numpy(), marker="o", color="black", label="pooled ΣN/ΣT")
+    ax1.plot(pooled.index, pooled.to_numpy(), marker="o", color="black", linestyle=axis.line,
+             label="pooled ΣN/ΣT")
     ax1.plot(
         median.index,
         median.to_numpy(),
@@ -122,7 +125,7 @@ def rate_heterogeneity(collisions, *, homogeneity=None, rule="mirror", max_point
         markersize=12,
         linestyle="none",
         color="tab:green",
-        label="median over ICs",
+        label=f"median over {nouns.many}",
     )
     grid = np.linspace(radii.min(), radii.max(), 100) if radii.size > 1 else radii
     if rule is not None:  # None: sequences from elsewhere (kicktimes analyze), no Γ(r)
@@ -135,8 +138,8 @@ def rate_heterogeneity(collisions, *, homogeneity=None, rule="mirror", max_point
         )
     ax1.set_yscale("log")
     axis.draw(ax1)
-    ax1.set_ylabel("disk-disk collision rate (1 / time unit)")
-    ax1.set_title("(a) rates of the individual ICs")
+    ax1.set_ylabel(f"{nouns.event} rate (1 / time unit)")
+    ax1.set_title(f"(a) rates of the individual {nouns.many}")
     ax1.legend(fontsize="x-small")
     dispersion = grouped["n_pp"].var(ddof=1) / grouped["n_pp"].mean()
     ax2.plot(
@@ -144,6 +147,7 @@ def rate_heterogeneity(collisions, *, homogeneity=None, rule="mirror", max_point
         dispersion.to_numpy(),
         marker="o",
         color="black",
+        linestyle=axis.line,
         label="variance / mean of counts",
     )
     ax2.axhline(1.0, color="grey", linestyle=":", label="Poisson, common rate")
@@ -175,7 +179,7 @@ def rate_heterogeneity(collisions, *, homogeneity=None, rule="mirror", max_point
             fontsize="small",
         )
     axis.draw(ax2)
-    ax2.set_ylabel("index of dispersion of counts across ICs")
+    ax2.set_ylabel(f"index of dispersion of counts across {nouns.many}")
     ax2.set_title("(b) over-dispersion")
     ax2.legend(fontsize="x-small")
     plain_log_ticks(ax1.yaxis)

@@ -45,6 +45,9 @@ figure{margin:1em 0}figure img{max-width:100%}figcaption{font-size:.9em;color:#4
 .banner{background:#ffe3e3;border:1px solid #d66;padding:.6em;font-weight:bold}
 .table-wrap{overflow-x:auto;max-width:100%;max-height:32em;overflow-y:auto}
 ul.findings li{margin:.3em 0}
+details.contents{margin:1.5em 0;border:1px solid #ccc;padding:.3em .8em}
+details.contents summary{cursor:pointer;font-weight:bold}
+p.built{font-size:.85em;color:#555}
 """
 
 
@@ -281,8 +284,11 @@ def toc_item(anchor, title, children=()):
     return f'<li><a href="#{anchor}">{html.escape(title)}</a>{nested}</li>'
 
 
-def write_page(out, title, *, sources, toc, body, appendix="", files=None) -> Path:
+def write_page(out, title, *, sources, toc, body, lead="", appendix="", files=None) -> Path:
     """Write the self-contained page ``out/report.html``, atomically.
+
+    The page opens with its answers: the title, one line saying what it was built from,
+    then ``lead`` (the findings), then the contents, collapsed, then the rest.
 
     Parameters
     ----------
@@ -292,11 +298,13 @@ def write_page(out, title, *, sources, toc, body, appendix="", files=None) -> Pa
         The page's title and heading.
     sources : str
         HTML (escaped by the caller) completing "Built <time> with kicktimes <version>
-        from ...": what the page was computed from.
+        from ...": what the page was computed from (paths relative to ``out``, short).
     toc : sequence of str
         The contents, ``<li>`` items (:func:`toc_item`).
     body : str
         The sections' HTML (:func:`write_outputs`), figures embedded.
+    lead : str, optional
+        HTML shown before the contents: the answers.
     appendix : str, optional
         HTML after the sections (the report's timings).
     files : dict, optional
@@ -308,11 +316,14 @@ def write_page(out, title, *, sources, toc, body, appendix="", files=None) -> Pa
         ``out / "report.html"``.
     """
     built = _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")
+    n_items = sum(item.count("<li>") for item in toc)
     text = (
         '<!DOCTYPE html><html lang="en"><head><meta charset="utf-8">'
         f"<title>{html.escape(title)}</title><style>{CSS}</style></head><body>"
-        f"<h1>{html.escape(title)}</h1><p>Built {built} with kicktimes "
-        f"{html.escape(__version__)} from {sources}.</p><h2>Contents</h2><ul>{''.join(toc)}</ul>"
+        f"<h1>{html.escape(title)}</h1><p class=\"built\">Built {built} with kicktimes "
+        f"{html.escape(__version__)} from {sources}.</p>{lead}"
+        f'<details class="contents"><summary>Contents ({n_items} sections)</summary>'
+        f"<ul>{''.join(toc)}</ul></details>"
         f"{body}{appendix}</body></html>"
     )
     write_text(out, "report.html", text, {} if files is None else files)

@@ -149,11 +149,12 @@ def mmpp_comparison(per_ic, *, x="radius", xlabel=None, alpha=None):
         y = shares[f"share_{name}"].to_numpy(float)
         err = np.vstack([y - shares[f"{name}_low"], shares[f"{name}_high"] - y])
         ax1.errorbar(at + shift, y, yerr=np.clip(err, 0, None), color=colour, marker=marker,
-                     linestyle="-", capsize=2, label=f"{label} (data)")
+                     linestyle=axis.line, capsize=2, label=f"{label} (data)")
         if f"share_null_{name}" in shares:
             y0 = shares[f"share_null_{name}"].to_numpy(float)
             ax1.plot(at + shift, y0, color=colour, marker=marker, markerfacecolor="white",
-                     linestyle=":", label=f"{label} (Poisson twins: the level)")
+                     linestyle=":" if axis.labels is None else "none",
+                     label=f"{label} (Poisson twins: the level)")
     ax1.set_ylim(-0.02, 1.02)
     ax1.set_ylabel("share of fitted sequences")
     ax1.set_title("(a) MMPP-2 against Poisson and renewal (AIC)")
@@ -178,7 +179,8 @@ def mmpp_comparison(per_ic, *, x="radius", xlabel=None, alpha=None):
             pos, q1, med, q3 = np.array(rows).T
             state = "low" if k == 0 else "high"
             ax.errorbar(pos + (k - 0.5) * dx, med, yerr=[med - q1, q3 - med], color=colour,
-                        marker="o", capsize=2, label=f"{state}-rate state")
+                        marker="o", capsize=2, linestyle=axis.line,
+                        label=f"{state}-rate state")
             bounds.append((q1.min(), q3.max()))
         if clustered.empty:
             ax.text(0.5, 0.5, "no sequence where the MMPP-2 beats Poisson",

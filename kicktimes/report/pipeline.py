@@ -599,8 +599,9 @@ def _write_page(plan, timings, built):
     report_t = pd.DataFrame(timings, columns=["experiment", "stage", "seconds"])
     write_table(out, "report_timings", report_t, files)
     ordered = [plan.parts[pid] for pid in plan.part_ids]
-    body = [e["findings_html"] for e in ordered]
+    lead = embed_figures("".join(e["findings_html"] for e in ordered), out)
     toc = [e["findings_toc"] for e in ordered]
+    body = []
     if plan.multi and plan.parts["families"]["html"]:
         body.append(plan.parts["families"]["html"])
         toc.append(plan.parts["families"]["toc"])
@@ -609,8 +610,12 @@ def _write_page(plan, timings, built):
     page = write_page(
         out,
         "kicktimes report: " + " + ".join(plan.names),
-        sources=", ".join(html.escape(os.fspath(Path(p).resolve())) for p in plan.paths),
+        sources=", ".join(
+            html.escape(os.path.relpath(Path(p).resolve(), Path(out).resolve()))
+            for p in plan.paths
+        ),
         toc=toc,
+        lead=lead,
         body=embed_figures("".join(body), out),
         appendix="<h2>Timings</h2><p>Report stages (seconds, this build; parts reused from "
         "the cache are listed as such):</p>"

@@ -142,10 +142,12 @@ def poisson_rejection_rates(rejections, *, alpha=0.05, ncols=4, ax=None, x="radi
     axes = axes.ravel()
     for k, (ax, test) in enumerate(zip(axes, tests, strict=False)):
         part = table[table["test"] == test].sort_values(x)
-        _rate_bars(ax, part[x], part, color="C0")
+        _rate_bars(ax, part[x], part, color="C0",
+                   linestyle=axis.line)
         if "control_rate" in part.columns and part["control_rate"].notna().any():
             ax.plot(part[x], part["control_rate"], color="grey", marker="s",
-                    markersize=3, linewidth=0.8, label="control: the sweep's Poisson kicks")
+                    markersize=3, linewidth=0.8, linestyle=axis.line,
+                    label="control: the sweep's Poisson kicks")
         ax.axhline(alpha, color="black", linestyle=":", linewidth=0.8)
         ax.set_title(TEST_TITLES.get(test, test.replace("_", " ")), fontsize="medium")
         ax.set_ylim(0.0, 1.0)
@@ -156,17 +158,18 @@ def poisson_rejection_rates(rejections, *, alpha=0.05, ncols=4, ax=None, x="radi
             ax.tick_params(axis="x", labelbottom=True)
     for ax in axes[len(tests) :]:
         ax.set_visible(False)
-    handles = [Line2D([], [], color="C0", marker="o", markersize=4,
-                      label="disk-disk collision times (± 95 % CI)")]
+    nouns = axis.nouns
+    handles = [Line2D([], [], color="C0", marker="o", markersize=4, linestyle=axis.line,
+                      label=f"{nouns.events} (± 95 % CI)")]
     if "control_rate" in table.columns and table["control_rate"].notna().any():
         handles.append(Line2D([], [], color="grey", marker="s", markersize=3,
                               label="control: the same tests on the sweep's Poisson kick times"))
     handles.append(Line2D([], [], color="black", linestyle=":",
-                          label=f"α = {alpha:g}, the share if every IC were Poisson"))
+                          label=f"α = {alpha:g}, the share if every {nouns.one} were Poisson"))
     fig.legend(handles=handles, loc="outside lower center", ncol=len(handles),
                fontsize="small")
-    fig.suptitle("Poisson tests of the disk-disk collision times, per IC: share of runs "
-                 "rejected", fontsize="medium")
+    fig.suptitle(f"Poisson tests of the {nouns.events}, per {nouns.one}: share of "
+                 f"{nouns.many} rejected", fontsize="medium")
     return fig
 
 
@@ -183,11 +186,13 @@ def _overlaid(table, tests, alpha, ax, axis):
     for k, test in enumerate(tests):
         part = table[table["test"] == test].sort_values(axis.column)
         shifted = part[axis.column].to_numpy() + dodge(xs, k, len(tests))
-        _rate_bars(ax, shifted, part, label=test.replace("_", " "), color=f"C{k}")
-    ax.axhline(alpha, color="black", linestyle=":", label=f"α = {alpha:g} (all ICs Poisson)")
+        _rate_bars(ax, shifted, part, label=test.replace("_", " "), color=f"C{k}",
+                   linestyle=axis.line)
+    ax.axhline(alpha, color="black", linestyle=":",
+               label=f"α = {alpha:g} (all {axis.nouns.many} Poisson)")
     ax.set_ylim(0.0, 1.0)
     axis.draw(ax)
-    ax.set_ylabel(f"share of ICs rejected at α = {alpha:g}")
+    ax.set_ylabel(f"share of {axis.nouns.many} rejected at α = {alpha:g}")
     ax.legend(fontsize="x-small", ncol=2)
     return fig
 

@@ -253,13 +253,17 @@ def family_figure(stores):
                 f"{q}@{e:g}",
                 ax=axes[i, j],
                 medians=True,
-                title=f"{exp.name}, {where}: {_QUANTITIES[q][0]}",
+                title=f"{_QUANTITIES[q][0]}\n{where}",
                 ylabel=_QUANTITIES[q][1],
             )
             plain_ticks(axes[i, j].yaxis)
             if q == "rr":
                 axes[i, j].set_ylim(0.0, 1.05 * axes[i, j].get_ylim()[1])
                 axes[i, j].axhline(1.0 / n_samples(exp), color="grey", linestyle="--", lw=0.8)
+    for ax in axes.ravel():
+        ax.title.set_fontsize("medium")
+    fig.suptitle(f"{exp.name}: recurrence rates at ε = {e:g} (the paper's Fig. 7 layout)",
+                 fontsize="medium")
     shared_legend(fig, axes.ravel())
     return fig, (
         f"Recurrence rates of {exp.name} at ε = {e:g} in the paper's Fig. 7 layout: top all "

@@ -87,8 +87,9 @@ def model_comparison(per_ic, pooled, *, models=None, x="radius", xlabel=None):
             )
     ax1.set_ylim(0, 1.08)
     axis.draw(ax1)
-    ax1.set_ylabel("share of ICs where the model is AIC-best")
-    ax1.set_title("(a) per IC (number of ICs on top)")
+    nouns = axis.nouns
+    ax1.set_ylabel(f"share of {nouns.many} where the model is AIC-best")
+    ax1.set_title(f"(a) per {nouns.one} (number of {nouns.many} on top)")
     for m in models:
         part = pooled[pooled["model"] == m].sort_values(x)
         if len(part):
@@ -97,6 +98,7 @@ def model_comparison(per_ic, pooled, *, models=None, x="radius", xlabel=None):
                 part["delta_aic"],
                 marker="o",
                 markersize=4,
+                linestyle=axis.line,
                 color=colour[m],
                 label=m,
             )
@@ -121,7 +123,7 @@ def model_comparison(per_ic, pooled, *, models=None, x="radius", xlabel=None):
                  fontsize="x-small", color="grey", va="bottom")
     axis.draw(ax2)
     ax2.set_ylabel("ΔAIC = AIC − min AIC (pooled intervals)")
-    ax2.set_title("(b) intervals pooled over ICs")
+    ax2.set_title(f"(b) intervals pooled over {nouns.many}")
     # one legend for both panels, outside the axes: it never covers data
     handles = [Patch(color=colour[m], label=m) for m in models]
     fig.legend(handles=handles, loc="outside lower center", ncol=len(models), fontsize="small")

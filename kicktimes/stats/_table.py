@@ -9,7 +9,9 @@ event: a sequence id and an event time. Each sequence also needs its observation
   and any covariates; it may list sequences that have no events at all), or
 * one window for every sequence, given as an option.
 
-Covariates (radius, density, temperature, ...) are per-sequence columns of either table.
+Covariates (radius, density, temperature, ...) are per-sequence numeric columns of either
+table; labels (a material, a condition: ``kind = poisson``) are per-sequence text columns,
+which can group the sequences but are never regressed on.
 
 Every defect is a one-line :class:`ValueError` (or :class:`TypeError`) that names the
 source, the column and the row: unsorted or duplicate times within a sequence, times
@@ -22,6 +24,7 @@ kept (they count: a zero is an observation) and listed, never dropped silently.
 from __future__ import annotations
 
 import os
+import re
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -44,13 +47,32 @@ def read_table(path) -> pd.DataFrame:
     if not p.is_file():
         raise ValueError(f"{os.fspath(p)!r}: no such file")
     suffix = p.suffix.lower()
+    name = p.name  # as every message about the table's content names it
+    if suffix not in (".csv", ".parquet", ".pq"):
+        raise ValueError(f"{os.fspath(p)}: the file must end in .csv or .parquet")
+    if p.stat().st_size == 0:
+        raise ValueError(f"{name}: the file is empty (expected a header and one row per event)")
     if suffix == ".csv":
-        # strings first, so that a non-numeric value can be named (not silently NaN)
-        df = pd.read_csv(p, dtype=str, keep_default_na=False, na_values=[""])
-    elif suffix in (".parquet", ".pq"):
-        df = pd.read_parquet(p)
+        try:
+            # strings first, so that a non-numeric value can be named (not silently NaN)
+            df = pd.read_csv(p, dtype=str, keep_default_na=False, na_values=[""])
+        except pd.errors.EmptyDataError:
+            raise ValueError(f"{name}: the file has no header (no columns)") from None
+        except pd.errors.ParserError as exc:
+            detail = str(exc).strip().splitlines()[-1]
+            raise ValueError(f"{name}: not a readable CSV table ({detail})") from None
+        except UnicodeDecodeError:
+            raise ValueError(f"{name}: not a text (UTF-8 CSV) file") from None
     else:
-        raise ValueError(f"{os.fspath(p)!r}: the file must end in .csv or .parquet")
+        import pyarrow as pa
+
+        try:
+            df = pd.read_parquet(p)
+        except (pa.ArrowException, OSError) as exc:
+            detail = str(exc).strip().splitlines()[0]
+            detail = re.sub(r"^Could not open Parquet input source '.*?': ", "", detail)
+            detail = detail.split(". ")[0].rstrip(".")
+            raise ValueError(f"{name}: not a readable Parquet file ({detail})") from None
     df.attrs.update(source=p.name, csv=suffix == ".csv")
     return df
 
@@ -132,17 +154,21 @@ class EventTable:
         increasing, in ``[0, t_window]``) and one column per covariate.
     covariates : tuple of str
         The covariate columns (numeric, constant within each sequence).
+    labels : tuple of str
+        The label columns (text, constant within each sequence), e.g. a condition that
+        groups the sequences.
     """
 
     sequences: pd.DataFrame
     covariates: tuple
+    labels: tuple = ()
 
     def __repr__(self) -> str:
         n = len(self.sequences)
         return (
             f"EventTable(n_sequences={n}, n_events={int(self.sequences['n_events'].sum())}, "
             f"empty={int((self.sequences['n_events'] == 0).sum())}, "
-            f"covariates={list(self.covariates)!r})"
+            f"covariates={list(self.covariates)!r}, labels={list(self.labels)!r})"
         )
 
     @property
@@ -178,6 +204,7 @@ def event_table(
     start="t_start",
     end="t_end",
     covariates=None,
+    labels=None,
 ) -> EventTable:
     r"""Check a tidy table of event times and collect its sequences.
 
@@ -197,9 +224,14 @@ def event_table(
     sequence, time, start, end : str, optional
         Column names.
     covariates : list of str, optional
-        Per-sequence numeric columns to keep (default: every further column of the
-        windows table, and those further columns of the event table that are numeric
+        Per-sequence numeric columns to keep (default: every further numeric column of
+        the windows table, and those further columns of the event table that are numeric
         and constant within every sequence).
+    labels : list of str, optional
+        Per-sequence columns to keep as text (compared as strings; constant within each
+        sequence). Default: with ``covariates`` None, every further column that is not
+        numeric and is constant within every sequence; otherwise none. A column named
+        here is a label even if it holds numbers.
 
     Returns
     -------
@@ -248,6 +280,9 @@ def event_table(
             raise ValueError(f"covariates must not name a reserved column, got {clash[0]!r}")
 
     # ---- events: ids, times, per-sequence window / covariate columns
+    if all(len(df) == 0 for df in frames) and (win is None or len(win) == 0):
+        names = ", ".join(df.attrs.get("source", "events") for df in frames)
+        raise ValueError(f"{names}: no rows (only a header): no sequence to analyse")
     ids_all, times_all, seq_frames = [], [], []
     owner: dict[str, str] = {}
     for df in frames:
@@ -337,6 +372,25 @@ def event_table(
         wanted = []
         for df in sources:
             wanted += [c for c in df.columns if c not in taken and c not in wanted]
+    label_values: dict[str, pd.Series] = {}
+    if labels is not None:
+        if isinstance(labels, str):
+            labels = [labels]
+        labels = list(labels)
+        _check_names(**{f"labels[{k}]": c for k, c in enumerate(labels)})
+        wanted = [c for c in wanted if c not in labels]
+    for col in labels or []:
+        found = False
+        for df in sources:
+            if col not in df.columns:
+                continue
+            found = True
+            ids = wid if df is win else _ids(df, sequence)
+            series = _text_per_sequence(df, ids, col)
+            prev = label_values.get(col)
+            label_values[col] = series if prev is None else prev.combine_first(series)
+        if not found:
+            raise ValueError(f"labels: no table has a column {col!r}")
     for col in wanted:
         found = False
         for df in sources:
@@ -345,7 +399,16 @@ def event_table(
             found = True
             ids = wid if df is win else _ids(df, sequence)
             if auto and pd.to_numeric(df[col], errors="coerce").isna().all():
-                break  # a text label (e.g. a material name): kept out of the regressions
+                # a text label (e.g. a material name): kept as a label, out of the
+                # regressions; an event-level text column (not constant) is dropped
+                try:
+                    series = _text_per_sequence(df, ids, col)
+                except ValueError:
+                    label_values.pop(col, None)
+                    break
+                prev = label_values.get(col)
+                label_values[col] = series if prev is None else prev.combine_first(series)
+                continue
             try:
                 values = _numeric(df, col, allow_missing=False)
                 series = _per_sequence(df, ids, values, col)
@@ -368,6 +431,21 @@ def event_table(
         if col in _RESERVED:
             raise ValueError(f"covariate column {col!r} clashes with a reserved column name")
 
+    for col, series in list(label_values.items()):
+        lacking = [s for s in order if s not in series.index]
+        if lacking and labels is None:
+            del label_values[col]
+        elif lacking:
+            raise ValueError(f"label {col!r} has no value for sequence {lacking[0]!r}")
+        if col in _RESERVED or col in cov_values:
+            raise ValueError(f"label column {col!r} clashes with a reserved column name")
+
+    if not any(t.size for t in per_seq.values()):
+        names = ", ".join(df.attrs.get("source", "events") for df, _ in seq_frames)
+        raise ValueError(
+            f"{names}: no event in any of the {len(order)} sequences: nothing to analyse"
+        )
+
     seqs = pd.DataFrame({"sequence": order})
     seqs["t_start"] = t0.reindex(order).to_numpy()
     seqs["t_end"] = t1.reindex(order).to_numpy()
@@ -377,7 +455,30 @@ def event_table(
     seqs["rate"] = seqs["n_events"] / seqs["t_window"]
     for col, series in cov_values.items():
         seqs[col] = series.reindex(order).to_numpy()
-    return EventTable(sequences=seqs, covariates=tuple(cov_values))
+    for col, series in label_values.items():
+        seqs[col] = series.reindex(order).to_numpy(dtype=object)
+    return EventTable(sequences=seqs, covariates=tuple(cov_values), labels=tuple(label_values))
+
+
+def _text_per_sequence(df, ids, col):
+    """Column ``col`` as text, one value per sequence; a missing value, or a value that
+    changes within a sequence, raises naming the row."""
+    raw = df[col]
+    missing = raw.isna().to_numpy()
+    if missing.any():
+        i = int(np.flatnonzero(missing)[0])
+        raise ValueError(f"{_where(df, i)}: column {col!r} has a missing value")
+    values = raw.astype(str).to_numpy(dtype=object)
+    first = pd.Series(values).groupby(ids, sort=False).transform("first").to_numpy()
+    changed = first != values
+    if changed.any():
+        i = int(np.flatnonzero(changed)[0])
+        raise ValueError(
+            f"{_where(df, i)}: column {col!r} must be constant within sequence {str(ids[i])!r}, "
+            f"got {values[i]!r} after {first[i]!r}"
+        )
+    out = pd.Series(values, index=ids)
+    return out[~out.index.duplicated()]
 
 
 def _check_order(df, ids, t):

@@ -134,8 +134,13 @@ class Analysis:
         return findings(self)
 
     def summary(self) -> str:
-        """The findings, one line each."""
-        return "\n".join(f"- {f.question}: {f.statement}" for f in self.findings())
+        """The findings: the question and its verdict (one per group), then the
+        statement with its numbers."""
+        return "\n".join(
+            f"- {f.question}{' ' if f.question.endswith('?') else ': '}{f.verdict}.\n"
+            f"  {f.statement}"
+            for f in self.findings()
+        )
 
 
 def analyze(
@@ -165,8 +170,10 @@ def analyze(
         contract: ``windows``, ``window``, ``sequence``, ``time``, ``start``, ``end`` and
         ``covariates`` are passed to it).
     group : str, optional
-        A covariate whose values group the sequences (pooled fits, one Poisson ensemble
-        and one rate-homogeneity test per group). Default: one group, ``"all"``.
+        A per-sequence column whose values group the sequences (pooled fits, one Poisson
+        ensemble and one rate-homogeneity test per group): a numeric covariate, or a
+        text label (``kind = "poisson"``), whose groups keep their order of first
+        appearance. Default: one group, ``"all"``.
     reference : str, optional
         A covariate holding each sequence's expected rate (e.g. a kinetic-theory rate):
         ``Analysis.reference`` then compares the observed rate with it per group.
@@ -212,6 +219,7 @@ def analyze(
     2    1.0
     Name: estimate, dtype: float64
     """
+    named = [covariates] if isinstance(covariates, str) else covariates
     tab = (
         events
         if isinstance(events, EventTable)
@@ -224,6 +232,10 @@ def analyze(
             start=start,
             end=end,
             covariates=covariates,
+            # a group outside the named covariates is kept as a label (text)
+            labels=[group]
+            if isinstance(group, str) and named is not None and group not in named
+            else None,
         )
     )
     alpha = check_real("alpha", alpha, low=0.0, high=1.0)
@@ -234,9 +246,10 @@ def analyze(
     rng = check_rng(rng)
     seqs = tab.sequences.copy()
     if group is not None:
-        if group not in tab.covariates:
+        if group not in tab.covariates + tab.labels:
             raise ValueError(
-                f"group must be one of the covariates {list(tab.covariates)!r}, got {group!r}"
+                f"group must name a per-sequence column, one of "
+                f"{list(tab.covariates + tab.labels)!r}, got {group!r}"
             )
         seqs.insert(1, "group", seqs[group])
     else:

@@ -187,6 +187,19 @@ def _v(value):
     return str(value)
 
 
+def _label(res, g):
+    """``"<group> = <value>: "`` for a statement about one group ('' without groups)."""
+    return "" if res.group is None else f"{res.group} = {_v(g)}: "
+
+
+def _by_group(res, verdicts: dict) -> str:
+    """One verdict per group, never cut: ``"kind = a: v1; kind = b: v2"``; the verdict
+    alone without groups."""
+    if res.group is None:
+        return next(iter(verdicts.values()))
+    return "; ".join(f"{_label(res, g)}{v}" for g, v in verdicts.items())
+
+
 def _input(res):
     s = res.sequences
     n_empty = int((s["n_events"] == 0).sum())
@@ -199,8 +212,14 @@ def _input(res):
         "events (counted in the rates and regressions, skipped by the tests and fits)"
     )
     covs = list(res.events.covariates)
-    text += f"; covariates: {', '.join(covs) if covs else 'none'}."
-    return Finding("Data", "—", text, "Every sequence of the input is counted.")
+    text += f"; covariates: {', '.join(covs) if covs else 'none'}"
+    labels = list(getattr(res.events, "labels", ()))
+    text += f"; labels: {', '.join(labels)}." if labels else "."
+    verdict = (
+        f"{len(s)} sequences, {int(s['n_events'].sum())} events"
+        + (f", {groups} groups by {res.group}" if res.group else "")
+    )
+    return Finding("Data", verdict, text, "Every sequence of the input is counted.")
 
 
 def _poisson(res):
@@ -208,40 +227,45 @@ def _poisson(res):
     tested = pt[pt["n_tested"] > 0]
     n_cells = len(tested)
     cut = res.alpha / max(n_cells, 1)
-    bad = tested[tested["combined_pvalue"] < cut].sort_values("combined_pvalue")
-    s = res.sequences
-    has_events = s["n_events"] > 0
-    if n_cells == 0:
-        return Finding("Poisson?", "inconclusive", "No sequence has enough events for a test.", "—")
-    k = int(s.loc[has_events, "reject_any_fdr"].sum())
-    n = int(has_events.sum())
-    lo, hi = clopper_pearson(k, n)
-    share = f"{k}/{n} sequences ({100 * k / n:.0f} %, 95 % CI {100 * lo:.0f}-{100 * hi:.0f} %)"
-    if bad.empty:
-        verdict = "consistent with Poisson"
-        text = (
-            f"No test rejects over the ensemble: the smallest Fisher-combined p-value is "
-            f"{format_p(tested['combined_pvalue'].min())} ({n_cells} test x group cells); "
-            f"{share} are rejected by some test after FDR."
-        )
-    else:
-        verdict = "not Poisson"
-        items = [
-            f"{r.test} ({'' if res.group is None else f'{res.group} = {_v(r.group)}: '}"
-            f"p = {format_p(r.combined_pvalue)}, {r.n_reject_fdr}/{r.n_tested} sequences after FDR)"
-            for r in bad.head(4).itertuples()
-        ]
-        text = (
-            f"{len(bad)} of {n_cells} test x group cells reject a homogeneous Poisson process: "
-            + "; ".join(items)
-            + ("; ..." if len(bad) > 4 else "")
-            + f". Rejected by some test after FDR: {share}."
-        )
     rule = (
-        f"not Poisson when some test's Fisher-combined p-value over a group's sequences is "
-        f"below alpha / (tests x groups) = {cut:.3g} (Bonferroni); consistent otherwise."
+        f"a group is not Poisson when some test's Fisher-combined p-value over its sequences "
+        f"is below alpha / (tests x groups) = {cut:.3g} (Bonferroni), and consistent with "
+        "Poisson otherwise; a sequence is rejected when some test rejects it after "
+        "Benjamini-Hochberg FDR within its group."
     )
-    return Finding("Poisson?", verdict, text, rule)
+    if n_cells == 0:
+        return Finding("Poisson?", "inconclusive", "No sequence has enough events for a test.",
+                       rule)
+    s = res.sequences
+    verdicts, parts = {}, []
+    for g in pd.unique(s["group"]):
+        cells = tested[tested["group"] == g]
+        mine = s[(s["group"] == g) & (s["n_events"] > 0)]
+        k, n = int(mine["reject_any_fdr"].sum()), len(mine)
+        if cells.empty or n == 0:
+            verdicts[g] = "untested (no sequence with enough events)"
+            parts.append(f"{_label(res, g)}no sequence has enough events for a test")
+            continue
+        lo, hi = clopper_pearson(k, n)
+        share = (f"{k}/{n} sequences rejected by some test after FDR ({100 * k / n:.0f} %, "
+                 f"95 % CI {100 * lo:.0f}-{100 * hi:.0f} %)")
+        bad = cells[cells["combined_pvalue"] < cut].sort_values("combined_pvalue")
+        if bad.empty:
+            verdicts[g] = "consistent with Poisson"
+            parts.append(
+                f"{_label(res, g)}consistent with Poisson: none of {len(cells)} tests rejects "
+                f"(smallest combined p = {format_p(cells['combined_pvalue'].min())}); {share}"
+            )
+        else:
+            verdicts[g] = "not Poisson"
+            worst = ", ".join(
+                f"{r.test} p = {format_p(r.combined_pvalue)}" for r in bad.itertuples()
+            )
+            parts.append(
+                f"{_label(res, g)}not Poisson: {len(bad)} of {len(cells)} tests reject "
+                f"({worst}); {share}"
+            )
+    return Finding("Poisson?", _by_group(res, verdicts), "; ".join(parts) + ".", rule)
 
 
 def _renewal(res):
@@ -254,25 +278,22 @@ def _renewal(res):
         return Finding(
             "Which renewal model?", "inconclusive", "No group has enough intervals for a fit.", rule
         )
-    parts, verdicts = [], []
+    parts, verdicts = [], {}
     for g, t in pooled.groupby("group", sort=False):
         t = t.dropna(subset=["aic"]).sort_values("aic")
         best, runner = t.iloc[0], t.iloc[1] if len(t) > 1 else None
         gap = runner["delta_aic"] if runner is not None else math.inf
         strength = "decisive" if gap > 10 else ("weak" if gap < 2 else "clear")
         d_exp = t.loc[t["model"] == "exponential", "delta_aic"]
-        label = "" if res.group is None else f"{res.group} = {_v(g)}: "
         second = runner["model"] if runner is not None else "—"
         d_e = float(d_exp.iloc[0]) if len(d_exp) else math.nan
         parts.append(
-            f"{label}{best['model']} ({strength}; runner-up {second} ΔAIC = {gap:.3g}; "
+            f"{_label(res, g)}{best['model']} ({strength}; runner-up {second} ΔAIC = {gap:.3g}; "
             f"exponential ΔAIC = {d_e:.4g}, {int(best['n'])} intervals)"
         )
-        verdicts.append(best["model"])
-    # the most frequent best model; a tie goes to the one of the first group
-    top = max(dict.fromkeys(verdicts), key=verdicts.count)
+        verdicts[g] = f"{best['model']} ({strength})"
     per = res.sequences["best_model"].dropna()
-    text = "Pooled per group: " + "; ".join(parts) + "."
+    text = "Pooled intervals per group: " + "; ".join(parts) + "."
     if len(per):
         k = int((per == "exponential").sum())
         lo, hi = clopper_pearson(k, len(per))
@@ -287,12 +308,7 @@ def _renewal(res):
         " A pooled sample mixes sequences with different rates, which alone makes it "
         "heavier-tailed than exponential: read it with the rate heterogeneity."
     )
-    return Finding(
-        "Which renewal model?",
-        f"{top} (pooled, {verdicts.count(top)}/{len(verdicts)} groups)",
-        text,
-        rule,
-    )
+    return Finding("Which renewal model?", _by_group(res, verdicts), text, rule)
 
 
 def _heterogeneity(res):
@@ -300,8 +316,8 @@ def _heterogeneity(res):
     ok = het[het["n_sequences"] > 1]
     cut = res.alpha / max(len(ok), 1)
     rule = (
-        f"heterogeneous when the exact (Monte Carlo) Pearson p-value of a common rate is "
-        f"below alpha / groups = {cut:.3g} in some group."
+        f"heterogeneous when the exact (Monte Carlo) Pearson p-value of a common rate within "
+        f"a group is below alpha / groups = {cut:.3g}; one rate otherwise."
     )
     if ok.empty:
         return Finding(
@@ -310,16 +326,21 @@ def _heterogeneity(res):
             "Every group has a single sequence.",
             rule,
         )
-    rejected = ok[ok["pvalue_mc"] < cut]
-    verdict = "heterogeneous" if len(rejected) else "consistent with one rate per group"
+    verdicts, parts = {}, []
+    for r in ok.itertuples():
+        verdicts[r.group] = "heterogeneous" if r.pvalue_mc < cut else "consistent with one rate"
+        parts.append(
+            f"{_label(res, r.group)}{verdicts[r.group]} (p = {format_p(r.pvalue_mc)}, index of "
+            f"dispersion {r.dispersion_index:.3g}, {int(r.n_flagged_fdr)} sequences with a rate "
+            "incompatible with the group's after FDR)"
+        )
     text = (
-        f"A common rate is rejected in {len(rejected)}/{len(ok)} groups (Pearson χ², exact "
-        f"p-value at resolution 1/{res.n_mc + 1}); index of dispersion of the counts "
-        f"{ok['dispersion_index'].min():.3g} to {ok['dispersion_index'].max():.3g} (1 for a "
-        f"common Poisson rate); {int(ok['n_flagged_fdr'].sum())} sequences have a rate "
-        "incompatible with their group's after FDR."
+        "A common rate per group (Pearson χ², exact p-value at resolution "
+        f"1/{res.n_mc + 1}; an index of dispersion of 1 for a common Poisson rate): "
+        + "; ".join(parts)
+        + "."
     )
-    return Finding("One rate for all sequences?", verdict, text, rule)
+    return Finding("One rate for all sequences?", _by_group(res, verdicts), text, rule)
 
 
 def _reference(res):
@@ -363,11 +384,11 @@ def _regressions(res):
         else:
             what = f"log rate = a + b {cov}: b = {main['estimate']:.4g} [{lo:.4g}, {hi:.4g}]"
         if lo > 0:
-            verdict = "increases"
+            verdict = f"the rate increases with {cov}"
         elif hi < 0:
-            verdict = "decreases"
+            verdict = f"the rate decreases with {cov}"
         else:
-            verdict = "no detectable trend"
+            verdict = f"no detectable trend of the rate with {cov}"
         text = (
             f"{what} (95 % CI; {label}; Poisson GLM: {po['estimate']:.4g} "
             f"[{po['ci_low']:.4g}, {po['ci_high']:.4g}]); Poisson Pearson dispersion "
@@ -378,7 +399,7 @@ def _regressions(res):
             "increases / decreases when the 95 % CI of the slope (negative binomial, or "
             "Poisson when the NB fit has alpha = 0) excludes 0."
         )
-        out.append(Finding(f"Counts against {cov}?", f"rate {verdict} with {cov}", text, rule))
+        out.append(Finding(f"Counts against {cov}?", verdict, text, rule))
     return out
 
 
