@@ -28,6 +28,10 @@ def main(argv=None):
     parser.add_argument(
         "--fits", type=int, default=12, help="ICs per radius with their own renewal fits (12)"
     )
+    parser.add_argument(
+        "--readme", default=None,
+        help="also replace the block between <!-- results:begin --> and <!-- results:end --> "
+        "of this file (the repository's README.md) by the page's first screen")
     args = parser.parse_args(argv)
     from kicktimes.report import write_results
 
@@ -45,6 +49,11 @@ def main(argv=None):
     except (ValueError, TypeError) as exc:
         parser.exit(2, f"error: {exc}\n")
     print(f"{path} written in {time.perf_counter() - t0:.0f} s")
+    if args.readme:
+        from kicktimes.report.results import copy_first_screen
+
+        copy_first_screen(path, args.readme)
+        print(f"{args.readme}: its results block replaced")
     return 0
 
 

@@ -122,7 +122,8 @@ def _warm_one(_):
     # times, uniform and scattering kicks, kinetic-rate kicks with their rate table), one
     # pass each, with the recurrence rows (compiled here too: the groups run at once); the
     # two-disk run that sets their rates is a plain simulation here
-    _warm_task(("poisson", "actual", "poisson_scatter", "actual_scatter", "poisson_kinetic"),
+    _warm_task(("poisson", "actual", "poisson_scatter", "actual_scatter", "poisson_kinetic",
+                "uniform_kinetic"),
                ("lyapunov", "recurrence_rate"))
 
 

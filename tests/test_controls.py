@@ -24,8 +24,8 @@ def _frame(values_by_system, radii, n_ics):
 
 
 @pytest.mark.parametrize(("low", "high", "verdict"), [
-    (0.95, 1.05, "within 10 %"), (0.9, 1.1, "within 10 %"), (0.3, 0.4, "differs"),
-    (1.2, 1.5, "differs"), (0.85, 1.0, "inconclusive"), (np.nan, 1.0, "inconclusive"),
+    (0.95, 1.05, "within 10 %"), (0.9, 1.1, "within 10 %"), (0.3, 0.4, "lower"),
+    (1.2, 1.5, "higher"), (0.85, 1.0, "inconclusive"), (np.nan, 1.0, "inconclusive"),
 ])
 def test_the_band_verdict(low, high, verdict):
     from kicktimes.stats import ratio_verdict
@@ -80,15 +80,14 @@ def test_sticky_runs_are_left_out_and_a_control_that_flips_the_verdict_is_named(
     assert ftle.loc["sticky_excluded", "estimate"] == pytest.approx(0.93)
     assert ftle.loc["paired_median", "estimate"] == pytest.approx(0.93)
     assert ftle.loc["sticky_excluded", "verdict"] == "within 10 %"
-    assert not ftle["robust"].any()
+    assert not ftle["robust"].any() and (ftle["depends_on"] == "paired_median").all()
     cell = overview_table(table).loc[0, "Poisson, scatter"]
-    assert "✗ depends on paired_median" in cell
+    assert cell.startswith("depends on paired_median: 2.36 [")
     counts = table[table["diagnostic"] == "counts"].set_index("control")
     assert counts.loc["sticky_excluded", "estimate"] == pytest.approx(1.0, abs=0.01)
     assert "3 sticky" not in counts.loc["primary", "detail"]
     assert counts.loc["sticky_excluded", "detail"].startswith("6 sticky")
-    text = " ".join(answers(table))
-    assert "Does any kick?" in text and "depends on" in text
+    assert answers(table) == []  # neither the paper's kicked disk nor a Poisson question
 
 
 # ------------------------------------------------------------- pooled shares, calibrated
@@ -174,15 +173,145 @@ def test_a_control_experiment_becomes_rows_of_its_familys_table():
              "verdict": verdict, "robust": True, "n_pairs": 10, "detail": "d"}
             for c in controls])
 
-    merged = merge_control_families([table("family_a", "differs"),
+    merged = merge_control_families([table("family_a", "lower"),
                                      table("family_a-elastic", "within 10 %"),
-                                     table("family_b", "differs")])
+                                     table("family_b", "lower")])
     assert set(merged) == {"family_a", "family_b"}
     a = merged["family_a"]
     assert list(a["control"]) == ["primary", "paired_median", "elastic"]
     assert not a["robust"].any()  # the elastic rule changes the verdict
+    assert (a["depends_on"] == "elastic").all()
     assert a.loc[2, "detail"].startswith("from the experiment family_a-elastic")
     assert merged["family_b"]["robust"].all()
     # a control whose family is not there stays a family of its own
-    alone = merge_control_families([table("family_c-elastic", "differs")])
+    alone = merge_control_families([table("family_c-elastic", "lower")])
     assert set(alone) == {"family_c-elastic"}
+
+
+def _rows(spec, question="FTLE", diagnostic="ftle", system="poisson"):
+    from kicktimes.stats import ratio_verdict
+
+    return pd.DataFrame([
+        {"family": fam, "question": question, "diagnostic": diagnostic, "system": system,
+         "control": c, "estimate": (lo + hi) / 2, "ci_low": lo, "ci_high": hi,
+         "verdict": ratio_verdict(lo, hi), "robust": False, "depends_on": "", "n_pairs": 10,
+         "detail": ""} for fam, c, lo, hi in spec])
+
+
+def test_a_verdict_that_changes_direction_is_never_robust():
+    """Both 'higher' and 'lower' used to read 'differs' and pass as robust: 1.88 on the
+    paper's samples against 0.774 on uniform-time ones is a change of sign, not a finding."""
+    from kicktimes.report.controls import overview_table, with_robustness
+
+    table = with_robustness(_rows([("family_b", "primary", 0.76, 0.79),
+                                   ("family_b", "paper_sampling", 1.85, 1.90)],
+                                  diagnostic="det@0.01"))
+    assert not table["robust"].any() and set(table["depends_on"]) == {"paper_sampling"}
+    # two inconclusive verdicts on opposite sides of 1: the same word, not the same finding
+    table = with_robustness(_rows([("f", "primary", 1.08, 1.16), ("f", "uniform", 0.89, 0.95)],
+                                  diagnostic="rr_offdiag@0.01"))
+    assert set(table["verdict"]) == {"inconclusive"} and not table["robust"].any()
+    cell = overview_table(table).iloc[0]["Poisson"]
+    assert cell == "depends on uniform: 1.12 [1.08, 1.16] vs 0.920 [0.890, 0.950]"
+
+
+def test_a_robust_cell_gives_its_verdict_and_the_range_over_every_control_and_family():
+    from kicktimes.report.controls import screen_cell, with_robustness
+
+    table = with_robustness(_rows([("family_a", "primary", 0.32, 0.33),
+                                   ("family_a", "elastic", 0.40, 0.42),
+                                   ("family_b", "primary", 0.31, 0.33)]))
+    assert table["robust"].all()
+    assert screen_cell(table) == "✓ lower: 0.32–0.41"
+
+
+def test_the_poisson_question_is_a_row_per_test_with_the_rule_as_a_control():
+    from kicktimes.report.controls import (
+        POISSON_QUESTION,
+        first_screen,
+        merge_control_families,
+        poisson_rows,
+    )
+
+    rej = pd.DataFrame({"radius": [0.01, 0.02] * 2,
+                        "test": ["uniformity_ks"] * 2 + ["ljung_box"] * 2,
+                        "n_tested": [200, 200, 1000, 1000], "n_reject": [80, 76, 52, 48]})
+    per_ic = pd.DataFrame({"radius": np.repeat([0.01, 0.02], 200), "ic": np.tile(range(200), 2),
+                           "p": np.r_[np.zeros(80), np.ones(120), np.zeros(76), np.ones(124)],
+                           "p_fixed": np.nan})
+    mirror = pd.DataFrame(poisson_rows("family_a", rej, per_ic, alpha=0.05,
+                                       rng=np.random.default_rng(0), n_boot=300))
+    assert list(mirror["diagnostic"]) == ["reject@uniformity_ks", "reject@ljung_box"]
+    assert mirror.loc[0, "estimate"] == pytest.approx(156 / 400)
+    assert mirror.loc[0, "verdict"] == "above nominal" and mirror.loc[1, "verdict"] == "nominal"
+    rej_e = rej.assign(n_reject=[28, 24, 50, 45])
+    per_ic_e = per_ic.assign(p=np.r_[np.zeros(28), np.ones(172), np.zeros(24), np.ones(176)])
+    elastic = pd.DataFrame(poisson_rows("family_a-elastic", rej_e, per_ic_e, alpha=0.05,
+                                        rng=np.random.default_rng(0), n_boot=300))
+    table = merge_control_families([mirror, elastic])["family_a"]
+    assert (table["question"] == POISSON_QUESTION).all()
+    assert set(table["control"]) == {"primary", "elastic"}
+    head = table[table["diagnostic"] == "reject@uniformity_ks"]
+    assert head["robust"].all()  # above nominal under both rules
+    assert table[table["diagnostic"] == "reject@ljung_box"]["robust"].all()  # nominal twice
+    text = first_screen(table)[0]
+    assert text.startswith("Under the paper's mirror rule the two-disk collision times are not "
+                           "Poisson (39.0 %")
+    assert "under the elastic rule fewer runs reject (13.0 %" in text and "disjoint" in text
+
+
+def test_the_first_screen_is_at_most_three_sentences_and_a_table_of_at_most_8_columns():
+    from kicktimes.report.controls import first_screen, with_robustness
+
+    spec = []
+    for system in ("poisson", "actual", "poisson_scatter", "actual_scatter", "poisson_kinetic",
+                   "uniform_kinetic"):
+        for fam in ("family_a", "family_b"):
+            for c in ("primary", "paired_median", "sticky_excluded", "invariant_ics",
+                      "elastic", "elastic+invariant_ics"):
+                spec.append((fam, c, system))
+    rows = pd.concat([_rows([(f, c, 0.3, 0.33)], system=s) for f, c, s in spec],
+                     ignore_index=True)
+    lines = first_screen(with_robustness(rows))
+    prose = lines[0]
+    assert len(prose) <= 1200 and prose.count(". ") <= 2
+    header = lines[2]
+    assert header.count("|") - 1 <= 8
+
+
+def test_every_family_has_the_rule_by_ic_design_as_control_experiments():
+    from kicktimes.experiment.presets import CONTROL_ICS_B, CONTROL_PRESETS, PRESETS, SCALES
+
+    names = {PRESETS[k].name for k in CONTROL_PRESETS}
+    assert names == {f"{fam}-{c}" for fam in ("family_a", "family_b")
+                     for c in ("invariant_ics", "elastic", "elastic+invariant_ics")}
+    assert set(CONTROL_PRESETS) <= set(SCALES["paper"])
+    for key in CONTROL_PRESETS:
+        exp = PRESETS[key]
+        family = PRESETS[exp.name.split("-")[0]]
+        control = exp.name.split("-", 1)[1]
+        assert exp.rule == ("elastic" if "elastic" in control else "mirror")
+        assert exp.ic_method == ("uniform" if "invariant_ics" in control else "paper")
+        assert exp.n_ics == (CONTROL_ICS_B if family.name == "family_b" else family.n_ics) >= 200
+        assert (exp.radii, exp.n_steps, exp.tau) == (family.radii, family.n_steps, family.tau)
+        kicked = set(family.systems) - {"poisson_kinetic", "uniform_kinetic"}
+        assert set(exp.systems) == (kicked if exp.rule == "elastic" else set(family.systems))
+
+
+def test_the_readme_block_is_replaced_by_the_generated_first_screen(tmp_path):
+    from kicktimes.report.results import BEGIN, END, copy_first_screen
+
+    page = tmp_path / "docs" / "results" / "README.md"
+    page.parent.mkdir(parents=True)
+    page.write_text("# t\n\nGenerated 2026 by kicktimes from `a`.\n\n## The answers\n\nOne. "
+                    "Two.\n\n![h](h.png)\n\n## Next\n\nrest\n")
+    readme = tmp_path / "README.md"
+    readme.write_text(f"intro\n\n{BEGIN}\nold\n{END}\n\ntail\n")
+    copy_first_screen(page, readme)
+    text = readme.read_text()
+    assert "old" not in text and text.startswith("intro") and text.endswith("tail\n")
+    assert "Generated 2026 by kicktimes" in text and "![h](docs/results/h.png)" in text
+    assert "rest" not in text
+    (tmp_path / "plain.md").write_text("no block\n")
+    with pytest.raises(ValueError, match="no block"):
+        copy_first_screen(page, tmp_path / "plain.md")

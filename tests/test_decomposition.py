@@ -1,10 +1,21 @@
-"""The gap decomposition: shares of the kicked-versus-two-disk gap each kick ingredient closes."""
+"""The gap decomposition: Shapley shares of the kicked-versus-two-disk gap that each kick
+ingredient (deflection law, timing) closes, over the 2 x 2 factorial of kicked systems."""
+
+import itertools
 
 import numpy as np
 import pandas as pd
 import pytest
 
-from kicktimes.report.decomposition import LADDER, STEPS, gap_decomposition, gap_figure
+from kicktimes.report.decomposition import (
+    FACTORIAL,
+    NO_GAP,
+    STEPS,
+    gap_decomposition,
+    gap_figure,
+    gap_summary,
+    shapley_shares,
+)
 
 
 def _store(values, n_ics=30, radii=(0.01, 0.02), noise=0.0, seed=0):
@@ -24,45 +35,77 @@ def _store(values, n_ics=30, radii=(0.01, 0.02), noise=0.0, seed=0):
     return res, col
 
 
-def test_shares_of_a_known_ladder_and_they_sum_to_one():
-    res, col = _store({"two_particle": 1.0, "poisson": 0.25, "poisson_scatter": 0.5,
-                       "poisson_kinetic": 0.8})
+FOUR = {"two_particle": 1.0, "poisson": 0.25, "poisson_scatter": 0.5, "uniform_kinetic": 0.4,
+        "poisson_kinetic": 0.8}
+
+
+def test_shapley_shares_average_both_orders_and_sum_to_one():
+    res, col = _store(FOUR)
     tab = gap_decomposition(res, col, family="f", eps=(), rng=np.random.default_rng(1),
                             n_boot=100)
     prim = tab[(tab["control"] == "primary") & (tab["diagnostic"] == "ftle")]
     est = prim.set_index("quantity")["estimate"]
     assert est["ratio poisson"] == pytest.approx(0.25)
-    g = np.abs(np.log([0.25, 0.5, 0.8]))
-    assert est[STEPS[0]] == pytest.approx((g[0] - g[1]) / g[0])
-    assert est[STEPS[1]] == pytest.approx((g[1] - g[2]) / g[0])
-    assert est[STEPS[2]] == pytest.approx(g[2] / g[0])
+    g = dict(zip(FACTORIAL, np.abs(np.log([0.25, 0.5, 0.4, 0.8])), strict=True))
+    up, sp, uk, sk = (g[s] for s in FACTORIAL)
+    # deflection first, then timing; and timing first, then deflection: the average
+    order_1 = ((up - sp), (sp - sk))
+    order_2 = ((uk - sk), (up - uk))
+    assert est[STEPS[0]] == pytest.approx(0.5 * (order_1[0] + order_2[0]) / up)
+    assert est[STEPS[1]] == pytest.approx(0.5 * (order_1[1] + order_2[1]) / up)
+    assert est[STEPS[2]] == pytest.approx(sk / up)
     assert est[list(STEPS)].sum() == pytest.approx(1.0)
     assert set(tab["control"]) == {"primary", "paired_median", "sticky_excluded"}
     assert set(tab["diagnostic"]) == {"ftle", "one_minus_r1"}
 
 
+@pytest.mark.parametrize("rho", list(itertools.product([0.3, 0.6, 0.95], repeat=4)))
+def test_shapley_shares_do_not_depend_on_which_ingredient_is_named_first(rho):
+    """Swapping the two ingredients swaps their shares and keeps the remainder."""
+    up, sp, uk, sk = rho
+    a = shapley_shares(np.array([up, sp, uk, sk]))
+    b = shapley_shares(np.array([up, uk, sp, sk]))  # timing <-> deflection
+    np.testing.assert_allclose(a[[1, 0, 2]], b, rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(a.sum(), 1.0)
+
+
+def test_a_gap_inside_the_band_is_not_decomposed():
+    res, col = _store({"two_particle": 1.0, "poisson": 0.97, "poisson_scatter": 0.99,
+                       "uniform_kinetic": 0.98, "poisson_kinetic": 1.0}, noise=0.01)
+    tab = gap_decomposition(res, col, family="f", eps=(), rng=np.random.default_rng(0),
+                            n_boot=100)
+    shares = tab[tab["quantity"].isin(STEPS)]
+    assert shares["estimate"].isna().all() and (shares["note"] == NO_GAP).all()
+    summary = gap_summary(tab)
+    assert (summary[STEPS[0]] == NO_GAP).all()
+    fig = gap_figure(tab)
+    assert any("no gap" in t.get_text() for ax in fig.axes for t in ax.texts)
+
+
 def test_intervals_cover_the_estimate_and_widen_with_noise():
-    quiet = gap_decomposition(*_store({"two_particle": 1.0, "poisson": 0.3,
-                                       "poisson_scatter": 0.9, "poisson_kinetic": 0.9},
-                                      noise=0.05), family="f", eps=(),
+    values = {"two_particle": 1.0, "poisson": 0.3, "poisson_scatter": 0.9,
+              "uniform_kinetic": 0.3, "poisson_kinetic": 0.9}
+    quiet = gap_decomposition(*_store(values, noise=0.05), family="f", eps=(),
                               rng=np.random.default_rng(2), n_boot=300)
-    loud = gap_decomposition(*_store({"two_particle": 1.0, "poisson": 0.3,
-                                      "poisson_scatter": 0.9, "poisson_kinetic": 0.9},
-                                     noise=0.4), family="f", eps=(),
+    loud = gap_decomposition(*_store(values, noise=0.4), family="f", eps=(),
                              rng=np.random.default_rng(2), n_boot=300)
     key = (quiet["control"] == "primary") & (quiet["quantity"] == STEPS[0])
     q, lo = quiet[key].iloc[0], loud[key.to_numpy()].iloc[0]
     assert q["ci_low"] <= q["estimate"] <= q["ci_high"]
     assert (lo["ci_high"] - lo["ci_low"]) > (q["ci_high"] - q["ci_low"])
+    # a share is robust only when no control's CI straddles 0
+    summary = gap_summary(quiet).set_index("diagnostic")
+    assert summary.loc["ftle", f"{STEPS[0]} robust"] == "✓"
+    assert summary.loc["ftle", f"{STEPS[1]} robust"].startswith("✗")
 
 
-def test_without_the_ladders_systems_the_table_is_empty_and_the_figure_draws():
-    res, col = _store({"two_particle": 1.0, "poisson": 0.5})
-    assert gap_decomposition(res, col, family="f", eps=(), rng=np.random.default_rng(0),
-                             n_boot=10).empty
+def test_without_the_factorials_systems_the_table_is_empty_and_the_figure_draws():
     res, col = _store({"two_particle": 1.0, "poisson": 0.5, "poisson_scatter": 0.9,
                        "poisson_kinetic": 1.0})
+    assert gap_decomposition(res, col, family="f", eps=(), rng=np.random.default_rng(0),
+                             n_boot=10).empty
+    res, col = _store(FOUR)
     tab = gap_decomposition(res, col, family="f", eps=(), rng=np.random.default_rng(0),
                             n_boot=50)
     fig = gap_figure(tab)
-    assert len(fig.axes) == 2 and len(LADDER) == 3
+    assert len(fig.axes) == 2

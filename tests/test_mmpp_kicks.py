@@ -365,11 +365,11 @@ def test_the_answers_ask_whether_clustered_kicks_bring_the_disk_closer():
         for control in ("primary", "paired_median"):
             rows.append({"family": "f", "question": "FTLE", "diagnostic": "ftle",
                          "system": system, "control": control, "estimate": est,
-                         "ci_low": est - 0.01, "ci_high": est + 0.01, "verdict": "differs",
-                         "robust": True, "n_pairs": 10, "detail": ""})
+                         "ci_low": est - 0.01, "ci_high": est + 0.01, "verdict": "lower",
+                         "robust": True, "depends_on": "", "n_pairs": 10, "detail": ""})
     text = " ".join(answers(pd.DataFrame(rows, columns=list(COLUMNS))))
     assert "Does clustering in the kick times bring the kicked disk closer?" in text
-    assert "f: 0.30 against 0.32" in text and "MMPP kicks: differs" in text
+    assert "f: 0.30 against 0.32" in text and "MMPP kicks: ✓ lower: 0.3" in text
 
 
 def test_analyze_offers_the_mmpp_for_outside_data(tmp_path):

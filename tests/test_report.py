@@ -310,7 +310,7 @@ def test_every_finding_has_an_effect_a_confidence_interval_and_a_ruled_verdict(b
     assert (ratios.loc[ok, "ci_low"] <= ratios.loc[ok, "estimate"]).all()
     assert (ratios.loc[ok, "estimate"] <= ratios.loc[ok, "ci_high"]).all()
     for row in table.itertuples():
-        assert row.verdict.split(" ")[0] in {"within", "differs", "inconclusive"} or any(
+        assert row.verdict.split(" ")[0] in {"within", "higher", "lower", "inconclusive"} or any(
             w in row.verdict for w in ("Poisson", "model", "majority", "exponential")
         )
     acf = table[table["question"].str.startswith("Lag-1 ACF")]
@@ -550,7 +550,12 @@ def test_the_findings_table_has_every_control_and_consistent_robust_flags(built)
     table = pd.read_csv(built[1] / "findings.csv")
     assert tuple(table.columns) == COLUMNS
     assert {"primary", "paired_median", "sticky_excluded"} <= set(table["control"])
-    for _, part in table.groupby(["family", "diagnostic", "system"]):
+    ratios = table[table["question"] != "Poisson collision times?"]
+    for _, part in ratios.groupby(["family", "diagnostic", "system"]):
         assert part["robust"].nunique() == 1
-        assert bool(part["robust"].iloc[0]) == (part["verdict"].nunique() == 1)
-    assert set(table["verdict"]) <= {"within 10 %", "differs", "inconclusive"}
+        flips = (part["ci_low"] > 1).any() and (part["ci_high"] < 1).any()
+        assert bool(part["robust"].iloc[0]) == (part["verdict"].nunique() == 1 and not flips)
+    assert set(ratios["verdict"]) <= {"within 10 %", "higher", "lower", "inconclusive"}
+    shares = table[table["question"] == "Poisson collision times?"]
+    assert set(shares["verdict"]) <= {"nominal", "above nominal", "below nominal",
+                                      "inconclusive"}

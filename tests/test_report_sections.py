@@ -106,7 +106,7 @@ def _effect(ctx, question, system):
 
 def test_ratio_verdict_follows_the_printed_rule():
     assert ratio_verdict(0.91, 1.09) == "within 10 %"
-    assert ratio_verdict(0.2, 0.89) == "differs" and ratio_verdict(1.11, 3.0) == "differs"
+    assert ratio_verdict(0.2, 0.89) == "lower" and ratio_verdict(1.11, 3.0) == "higher"
     assert ratio_verdict(0.85, 1.05) == "inconclusive"
     assert ratio_verdict(np.nan, 1.0) == "inconclusive"
     assert ratio_verdict(0.75, 1.2, tolerance=0.25) == "within 25 %"
@@ -172,17 +172,17 @@ def test_findings_compare_every_kicked_system_including_new_ones(ctx):
     assert systems == {"poisson", "actual", "poisson_scatter"}
 
 
-def test_ftle_finding_recovers_the_built_in_third_and_says_differs(ctx):
+def test_ftle_finding_recovers_the_built_in_third_and_says_lower(ctx):
     e = _effect(ctx, "FTLE", "poisson")
     assert e.estimate == pytest.approx(1 / 3, rel=1e-9)
-    assert e.verdict == "differs"
+    assert e.verdict == "lower"
     assert "stretching per perturbation" in e.detail
 
 
 def test_recurrence_findings_at_every_eps_off_diagonal_and_det(ctx):
     for eps in ("0.001", "0.01"):
         off = _effect(ctx, f"Off-diagonal RR (ε = {eps})", "poisson")
-        assert off.estimate == pytest.approx(1.5, rel=1e-9) and off.verdict == "differs"
+        assert off.estimate == pytest.approx(1.5, rel=1e-9) and off.verdict == "higher"
         det = _effect(ctx, f"DET (ε = {eps})", "actual")
         assert det.estimate == pytest.approx(1.0) and det.verdict == "within 10 %"
 

@@ -27,7 +27,10 @@ from kicktimes._validation import check_choice, check_int, check_real
 __all__ = ["DEFAULT_SYSTEMS", "DIAGNOSTICS", "SYSTEMS", "Experiment"]
 
 SYSTEMS = ("two_particle", "poisson", "actual", "poisson_scatter", "actual_scatter",
-           "poisson_kinetic", "mmpp")
+           "poisson_kinetic", "mmpp", "uniform_kinetic")
+#: the systems kicked at the kinetic rate of the disk's own angular momentum (unit speeds:
+#: the mirror rule and equal disks only)
+KINETIC_SYSTEMS = ("poisson_kinetic", "uniform_kinetic")
 #: The paper's systems, run when an experiment names none (scattering kicks are opt-in)
 DEFAULT_SYSTEMS = ("two_particle", "poisson", "actual")
 DIAGNOSTICS = ("lyapunov", "recurrence_rate", "autocorrelation")
@@ -48,7 +51,7 @@ _LATER_FIELDS = {"acf_max_lag": 20, "rr_sampling": "run", "lyapunov_method": "tw
 
 _REQUIRED = ("name", "radii", "n_ics", "n_steps", "tau")
 
-_NAME_RE = re.compile(r"[A-Za-z0-9][A-Za-z0-9_.-]*")  # used with fullmatch: no trailing newline
+_NAME_RE = re.compile(r"[A-Za-z0-9][A-Za-z0-9_.+-]*")  # used with fullmatch: no trailing newline
 
 
 def _eps_tuple(value):
@@ -135,13 +138,17 @@ class Experiment:
         deviation of the gaussian rotation (unused for ``"uniform"``).
     systems : sequence of str
         Subset of ``("two_particle", "poisson", "actual", "poisson_scatter",
-        "actual_scatter", "poisson_kinetic", "mmpp")`` whose diagnostics are stored (default the
+        "actual_scatter", "poisson_kinetic", "mmpp", "uniform_kinetic")`` whose diagnostics are
+        stored (default the
         first three, the paper's). The two-particle run is always simulated (its collision
         times are stored and drive the others). The ``*_scatter`` systems are kicked at the
         same kinds of times but by scattering kicks (a collision with a virtual partner under
         ``rule``, docs/scatter.md) instead of ``kick_angle``. ``"poisson_kinetic"``: scattering
         kicks at the kinetic rate of the disk's own angular momentum, redrawn after every
-        kick (`kicktimes.schedules.KineticRate`; the mirror rule only). ``"mmpp"``: the
+        kick (`kicktimes.schedules.KineticRate`; the mirror rule only);
+        ``"uniform_kinetic"``: the kicks of ``kick_angle`` at that kinetic rate (with
+        ``poisson``, ``poisson_scatter`` and ``poisson_kinetic`` the 2 x 2 factorial of
+        deflection law and timing, `kicktimes.report.decomposition`). ``"mmpp"``: the
         kicks of ``kick_angle`` at the times of a two-state Markov-modulated Poisson
         process fitted to the IC's own collision times (`kicktimes.stats.fit_mmpp`;
         Poisson at the IC's rate when the run has too few collisions for a fit).
@@ -218,7 +225,7 @@ class Experiment:
 
         if not isinstance(self.name, str) or not _NAME_RE.fullmatch(self.name):
             raise ValueError(
-                f"name: must be a non-empty identifier of letters, digits, '_', '.', '-' "
+                f"name: must be a non-empty identifier of letters, digits, '_', '.', '+', '-' "
                 f"(it names files), got {self.name!r}"
             )
         radii = self.radii
@@ -247,9 +254,10 @@ class Experiment:
         check_choice("kick_angle", self.kick_angle, KICK_ANGLES)
         put("sigma", check_real("sigma", self.sigma, low=0.0))
         put("systems", _subset("systems", self.systems, SYSTEMS))
-        if "poisson_kinetic" in self.systems and self.rule != "mirror":
-            raise ValueError("systems: 'poisson_kinetic' needs rule='mirror' (the kinetic rate "
-                             f"is tabulated for unit speeds), got rule={self.rule!r}")
+        for system in KINETIC_SYSTEMS:
+            if system in self.systems and self.rule != "mirror":
+                raise ValueError(f"systems: {system!r} needs rule='mirror' (the kinetic rate "
+                                 f"is tabulated for unit speeds), got rule={self.rule!r}")
         put("diagnostics", _subset("diagnostics", self.diagnostics, DIAGNOSTICS))
         put("block_size", check_int("block_size", self.block_size, low=1))
         if self.holes is None or (hasattr(self.holes, "__len__") and len(self.holes) == 0):
@@ -293,8 +301,9 @@ class Experiment:
         if self.ic_method == "uniform" and self.r_max > limit:
             raise ValueError(f"partner_ratio: unequal disks' invariant ICs need every radius "
                              f"at most 1/3, got max(radii) = {self.r_max!r}")
-        if "poisson_kinetic" in self.systems:
-            raise ValueError(f"partner_ratio={ratio!r}: the 'poisson_kinetic' system tabulates "
+        kinetic = [s for s in KINETIC_SYSTEMS if s in self.systems]
+        if kinetic:
+            raise ValueError(f"partner_ratio={ratio!r}: the {kinetic[0]!r} system tabulates "
                              "the kinetic rate of equal disks (KineticRate); leave it out of "
                              "systems or use partner_ratio = 1")
 

@@ -19,8 +19,8 @@ import dataclasses
 
 from kicktimes.experiment.config import Experiment
 
-__all__ = ["CONTENTS", "CONTROL_PRESETS", "PAPER_CONTENT", "PRESETS", "SCALES", "preset",
-           "scale_presets"]
+__all__ = ["CONTENTS", "CONTROL_ICS_B", "CONTROL_PRESETS", "PAPER_CONTENT", "PRESETS", "SCALES",
+           "preset", "scale_presets"]
 
 
 def _radii(start_mm: int, stop_mm: int) -> list[float]:
@@ -45,8 +45,10 @@ _PAPER = {
     "sigma": 1.0,
     # the paper's three systems and, beyond the paper, the scatter-kicked disk
     # (docs/scatter.md) with Poisson, actual and kinetic-rate kick times (docs/mechanism.md)
+    # and uniform kicks at that kinetic rate (the fourth cell of the deflection x timing
+    # factorial, kicktimes.report.decomposition)
     "systems": ("two_particle", "poisson", "actual", "poisson_scatter", "actual_scatter",
-                "poisson_kinetic"),
+                "poisson_kinetic", "uniform_kinetic"),
 }
 
 PRESETS = {
@@ -113,32 +115,49 @@ def _control(base: Experiment, control: str, label: str, what: str, **changes) -
                                **changes)
 
 
-# the controls of family A's findings that other experiments provide: initial conditions
-# from the invariant measure instead of the paper's procedure, and the elastic collision
-# rule (with its invariant-measure ICs)
-PRESETS["family_a_invariant"] = _control(
-    PRESETS["family_a"], "invariant_ics", "family A",
-    "with initial conditions drawn from the invariant measure (positions uniform on the "
-    "non-overlapping pairs, uniform directions) instead of the paper's procedure",
-    ic_method="uniform",
-)
-PRESETS["family_a_elastic"] = _control(
-    PRESETS["family_a"], "elastic", "family A",
-    "under the elastic collision rule (energy exchanged between the disks), "
-    "invariant-measure initial conditions",
-    ic_method="uniform", rule="elastic",
-    # (the kinetic-rate kicks are tabulated for the mirror rule's unit speeds)
-    systems=tuple(s for s in PRESETS["family_a"].systems if s != "poisson_kinetic"),
-)
+#: ICs of each of family B's control experiments: a stated subset (the first 300 of the
+#: control's own draw) keeps the added cost of the controls bounded; their intervals come
+#: from these ICs alone
+CONTROL_ICS_B = 300
+_WITHOUT_KINETIC = tuple(s for s in PRESETS["family_a"].systems
+                         if s not in ("poisson_kinetic", "uniform_kinetic"))
 
+#: The controls of a family's findings that other experiments provide: the 2 x 2 design
+#: collision rule (mirror, elastic) x IC measure (the paper's procedure, the invariant
+#: measure). (control name, what changes, the settings)
+_DESIGN = (
+    ("invariant_ics",
+     "with initial conditions drawn from the invariant measure (positions uniform on the "
+     "non-overlapping pairs, uniform directions) instead of the paper's procedure",
+     {"ic_method": "uniform"}),
+    ("elastic",
+     "under the elastic collision rule (energy exchanged between the disks), from the "
+     "paper's initial conditions (unit speeds at the start)",
+     # the kinetic-rate kicks are tabulated for the mirror rule's unit speeds
+     {"rule": "elastic", "systems": _WITHOUT_KINETIC}),
+    ("elastic+invariant_ics",
+     "under the elastic collision rule, with initial conditions drawn from the invariant "
+     "measure (positions as for invariant_ics, velocities uniform on the energy shell)",
+     {"rule": "elastic", "ic_method": "uniform", "systems": _WITHOUT_KINETIC}),
+)
+_KEYS = {"invariant_ics": "invariant", "elastic": "elastic",
+         "elastic+invariant_ics": "elastic_invariant"}
+for _family, _label, _extra in (("family_a", "family A", {}),
+                                ("family_b", "family B", {"n_ics": CONTROL_ICS_B})):
+    for _name, _what, _changes in _DESIGN:
+        _subset = (f" (the first {CONTROL_ICS_B} ICs of its own draw)" if _extra else "")
+        PRESETS[f"{_family}_{_KEYS[_name]}"] = _control(
+            PRESETS[_family], _name, _label, _what + _subset, **_changes, **_extra)
+
+#: Presets that are controls of another family's findings (named "<family>-<control>").
+CONTROL_PRESETS = tuple(f"{family}_{key}" for family in ("family_a", "family_b")
+                        for key in _KEYS.values())
 #: The experiments ``kicktimes reproduce --scale`` runs (with ``--content paper``, the
 #: paper's own content, the control experiments of `CONTROL_PRESETS` are left out).
 SCALES = {
-    "paper": ("family_a", "family_b", "family_a_invariant", "family_a_elastic"),
+    "paper": ("family_a", "family_b", *CONTROL_PRESETS),
     "quick": ("quick_a", "quick_b"),
 }
-#: Presets that are controls of another family's findings (named "<family>-<control>").
-CONTROL_PRESETS = ("family_a_invariant", "family_a_elastic")
 
 
 def scale_presets(scale: str, content: str = "full") -> tuple:

@@ -61,7 +61,8 @@ COLLISION_COLUMNS = ("radius", "ic", "t_window", "n_pp", "pp_times")
 #: families of streams can never coincide (their keys differ in length and content).
 KICK_DOMAIN = 0x6B69636B  # "kick"
 SYSTEM_CODES = {"two_particle": 0, "poisson": 1, "actual": 2, "poisson_scatter": 3,
-                "actual_scatter": 4, "poisson_kinetic": 5, "mmpp": 6}
+                "actual_scatter": 4, "poisson_kinetic": 5, "mmpp": 6,
+                "uniform_kinetic": 7}
 #: the fewest disk-disk collisions for an IC's own MMPP-2 fit (4 parameters); fewer, or a
 #: fit that fails, and the ``mmpp`` system is kicked at Poisson times of the IC's rate
 MIN_MMPP_EVENTS = 50
@@ -339,12 +340,12 @@ def _run_ic(exp: Experiment, r: float, ic_index: int, ic: np.ndarray, rows, coll
 
     actual_times = None
     for system in ("poisson", "actual", "poisson_scatter", "actual_scatter", "poisson_kinetic",
-                   "mmpp"):
+                   "uniform_kinetic", "mmpp"):
         if system not in exp.systems:
             continue
         kick = kick_law(exp, system, ic, r)
         rng = kick_rng(exp.seed, ic_index, r, system)
-        if system == "poisson_kinetic":
+        if system in ("poisson_kinetic", "uniform_kinetic"):
             # the event loop draws the kick times (and their scattering numbers) from rng
             one_kw = {"kicks": kinetic_rate_table(r), "rng": rng, **kick, **holes, **steps}
             _kicked(system, one_kw, one_pass, exp, ic, r, timer, add, diagnose,
@@ -501,6 +502,8 @@ def kick_law(exp: Experiment, system: str, ic: np.ndarray, r: float | None = Non
     """
     if system == "poisson_kinetic":
         return {"kick_angle": "scatter", "sigma": exp.sigma, "rule": "mirror"}
+    if system == "uniform_kinetic":
+        return {"kick_angle": exp.kick_angle, "sigma": exp.sigma}
     if not system.endswith("_scatter"):
         return {"kick_angle": exp.kick_angle, "sigma": exp.sigma}
     partner = {}

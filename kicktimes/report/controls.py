@@ -17,18 +17,32 @@ changes it. The controls:
     two-disk run collides faster than :data:`~kicktimes.report.counts.STICKY_FACTOR`
     times the kinetic rate :math:`\Gamma(r)` (regular orbits in which the disks bounce
     almost radially and meet near the centre).
-``uniform_sampling``
-    Recurrence diagnostics only: the same trajectories sampled at uniform times
-    :math:`k\tau` (the store's ``uniform_`` rows, ``rr_sampling = "run+uniform"``) instead
-    of the paper's collision-truncated steps, whose samples sit on the rim at every wall
-    hit and differ in number between the systems.
+``uniform_sampling`` / ``paper_sampling``
+    Recurrence diagnostics only: the primary row of a recurrence diagnostic (RR, DET) is
+    computed on the same trajectories sampled at uniform times :math:`k\tau` (the store's
+    ``uniform_`` rows, ``rr_sampling = "run+uniform"``; its detail says so), and the
+    paper's collision-truncated steps, whose samples sit on the rim at every wall hit and
+    differ in number between the systems, are the control ``paper_sampling``. Its
+    ``uniform_sampling`` row repeats the primary value under its own name, so that every
+    recurrence diagnostic lists the uniform-time samples explicitly.
+``invariant_ics``, ``elastic``, ``elastic+invariant_ics``
+    Other experiments (`merge_control_families`): the 2 x 2 design collision rule (the
+    paper's mirror rule, the elastic rule) x initial conditions (the paper's procedure, the
+    invariant measure); their primary rows join the family's table under these names.
 
 Every interval is a percentile bootstrap clustered on ICs: one resample draws IC indices
 with replacement and applies them at every radius and to every system (the same IC is
 the same initial condition everywhere), so the correlation of one IC across radii and
 systems is kept. Verdicts use one band (:func:`kicktimes.stats.ratio_verdict`): *within 10 %*
-when the whole 95 % interval lies in [0.9, 1.1], *differs* when it lies entirely outside,
-*inconclusive* otherwise.
+when the whole 95 % interval lies in [0.9, 1.1], *higher* / *lower* when it lies entirely
+above / below it, *inconclusive* otherwise. A comparison is *robust*
+(:func:`kicktimes.stats.robust_verdict`) only when every control gives the same verdict and
+no control's interval lies above 1 while another's lies below 1; otherwise it *depends on*
+the first control that breaks it (the ``depends_on`` column).
+
+The Poisson question is in the same table (:func:`poisson_rows`): per test, the share of
+runs whose two-disk collision times reject it, with the verdict of
+:func:`kicktimes.stats.rejection_verdict`, under the same rule x IC design.
 """
 
 from __future__ import annotations
@@ -42,7 +56,14 @@ import pandas as pd
 
 from kicktimes.report.common import REFERENCE, kicked_systems, wide
 from kicktimes.report.effects import paired_ratio
-from kicktimes.stats import bootstrap_nanmedians, nanmedian, ratio_verdict
+from kicktimes.stats import (
+    bootstrap_nanmedians,
+    format_interval,
+    nanmedian,
+    ratio_verdict,
+    rejection_verdict,
+    robust_verdict,
+)
 
 __all__ = [
     "COLUMNS",
@@ -52,16 +73,22 @@ __all__ = [
     "ratio_curves_figure",
     "diagnostics_of",
     "paired_median",
+    "poisson_rows",
+    "with_robustness",
 ]
 
-#: the controls, in the order of the table
-CONTROLS = ("primary", "paired_median", "sticky_excluded", "uniform_sampling")
+#: the controls, in the order of the table (then the other experiments' controls)
+CONTROLS = ("primary", "paired_median", "sticky_excluded", "uniform_sampling",
+            "paper_sampling")
 #: the columns of the findings table
 COLUMNS = ("family", "question", "diagnostic", "system", "control", "estimate", "ci_low",
-           "ci_high", "verdict", "robust", "n_pairs", "detail")
+           "ci_high", "verdict", "robust", "depends_on", "n_pairs", "detail")
 WITHIN = "within 10 %"
-DIFFERS = "differs"
+HIGHER = "higher"
+LOWER = "lower"
 INCONCLUSIVE = "inconclusive"
+#: the question of the Poisson rows
+POISSON_QUESTION = "Poisson collision times?"
 #: how an interval becomes a verdict
 _QUESTIONS = {
     "ftle": "FTLE",
@@ -175,6 +202,7 @@ def _row(family, diagnostic, system, control, est, low, high, n_pairs, detail):
         "ci_high": high,
         "verdict": ratio_verdict(low, high),
         "robust": False,
+        "depends_on": "",
         "n_pairs": int(n_pairs),
         "detail": detail,
     }
@@ -192,23 +220,32 @@ def _ratio_rows(family, diagnostic, system, x, y, sticky, *, x_uniform, y_unifor
         curves.append(per_r.assign(family=family, diagnostic=diagnostic, system=system,
                                    control=control))
 
+    # recurrence: the uniform-time samples are the primary setting, the paper's
+    # collision-truncated samples a control
+    paper_x, paper_y = x, y
+    samples = ""
+    if x_uniform is not None:
+        x, y = x_uniform, y_uniform
+        samples = "uniform-time samples k τ; "
     per_r, tot = paired_ratio(x, y, rng=rng, n_boot=n_boot, resamples=resamples)
-    add("primary", per_r, tot, per_r["n_pairs"].sum(),
-        "ratio of means per radius, averaged over radii; per radius "
-        + ", ".join(f"{r:g}: {v:.3g}" for r, v in zip(per_r["radius"], per_r["ratio"],
-                                                      strict=True)))
+    primary_detail = (samples + "ratio of means per radius, averaged over radii; per radius "
+                      + ", ".join(f"{r:g}: {v:.3g}" for r, v in zip(per_r["radius"],
+                                                                    per_r["ratio"], strict=True)))
+    add("primary", per_r, tot, per_r["n_pairs"].sum(), primary_detail)
     med = paired_median(x, y, rng=rng, n_boot=max(200, n_boot // 2))
     add("paired_median", med["per_radius"], med, med["n_pairs"],
-        "median of per-IC ratios per radius, averaged over radii")
+        samples + "median of per-IC ratios per radius, averaged over radii")
     keep = ~sticky.reindex(x.index, fill_value=False).to_numpy(bool)
     per_r, tot = paired_ratio(x[keep], y[keep], rng=rng, n_boot=n_boot, resamples=None)
     add("sticky_excluded", per_r, tot, per_r["n_pairs"].sum(),
-        f"{int((~keep).sum())} sticky (radius, IC) runs left out")
+        samples + f"{int((~keep).sum())} sticky (radius, IC) runs left out")
     if x_uniform is not None:
-        per_r, tot = paired_ratio(x_uniform, y_uniform, rng=rng, n_boot=n_boot,
+        rows.append({**rows[0], "control": "uniform_sampling",
+                     "detail": "the primary row: samples at uniform times k τ"})
+        per_r, tot = paired_ratio(paper_x, paper_y, rng=rng, n_boot=n_boot,
                                   resamples=resamples)
-        add("uniform_sampling", per_r, tot, per_r["n_pairs"].sum(),
-            "samples at uniform times k τ of the same trajectories")
+        add("paper_sampling", per_r, tot, per_r["n_pairs"].sum(),
+            "the paper's collision-truncated samples of the same trajectories")
     return rows
 
 
@@ -286,16 +323,50 @@ def compute_controls(results, collisions, *, family, eps, rule="mirror", rng, n_
             )
     rows += _count_rows(family, collisions, sticky, rule, kinetic, rng=rng, n_boot=n_boot,
                         resamples=resamples)
-    out = pd.DataFrame(rows, columns=list(COLUMNS))
-    if not out.empty:
-        same = out.groupby(["family", "diagnostic", "system"])["verdict"].transform(
-            "nunique") == 1
-        out["robust"] = same.to_numpy(bool)
+    out = with_robustness(pd.DataFrame(rows, columns=list(COLUMNS)))
     curve_cols = ["family", "diagnostic", "system", "control", "radius", "n_pairs", "ratio",
                   "ci_low", "ci_high"]
     curves = (pd.concat(curves, ignore_index=True)[curve_cols] if curves
               else pd.DataFrame(columns=curve_cols))
     return Controls(out, curves)
+
+
+def with_robustness(table: pd.DataFrame) -> pd.DataFrame:
+    """``table`` with ``robust`` and ``depends_on`` set per (family, diagnostic, system):
+    robust when every control gives the same verdict and, for ratios, no control's CI lies
+    above 1 while another's lies below 1 (:func:`kicktimes.stats.robust_verdict`; the
+    Poisson rows compare shares, so only their verdicts count). ``depends_on`` names the
+    first control (in table order) whose verdict differs from the primary's or whose CI
+    lies on the other side of 1."""
+    out = table.copy()
+    if out.empty:
+        return out
+    robust = np.zeros(len(out), bool)
+    depends = np.array([""] * len(out), dtype=object)
+    for _, g in out.groupby(["family", "diagnostic", "system"], sort=False):
+        share = (g["question"] == POISSON_QUESTION).all()
+        ok, _ = robust_verdict(list(g["verdict"]), g["ci_low"], g["ci_high"],
+                               level=np.inf if share else 1.0)
+        pos = out.index.get_indexer(g.index)
+        robust[pos] = ok
+        if ok:
+            continue
+        first = g.iloc[0]
+        side = 1 if first["ci_low"] > 1 else -1 if first["ci_high"] < 1 else 0
+        for _, r in g.iloc[1:].iterrows():
+            other = 1 if r["ci_low"] > 1 else -1 if r["ci_high"] < 1 else 0
+            flips = not share and side * other < 0
+            if r["verdict"] != first["verdict"] or flips:
+                depends[pos] = r["control"]
+                break
+        else:  # the primary agrees with each; two other controls lie on opposite sides of 1
+            sides = [1 if r["ci_low"] > 1 else -1 if r["ci_high"] < 1 else 0
+                     for _, r in g.iterrows()]
+            ref = next(v for v in sides if v)
+            depends[pos] = g["control"].iloc[sides.index(-ref)]
+    out["robust"] = robust
+    out["depends_on"] = depends
+    return out
 
 
 def _count_rows(family, collisions, sticky, rule, kinetic, *, rng, n_boot, resamples):
@@ -324,6 +395,70 @@ def _count_rows(family, collisions, sticky, rule, kinetic, *, rng, n_boot, resam
     return rows
 
 
+def poisson_rows(family, rejections, per_ic, *, alpha, rng, n_boot=2000):
+    """The Poisson question as rows of the findings table: per test of the battery, the
+    share of (radius, IC) runs whose two-disk collision times reject it at ``alpha``.
+
+    Rows ``diagnostic = "reject@<test>"`` pool the runs of every radius with a
+    Clopper-Pearson interval; the headline test's rows (`poisson.HEADLINE_TEST`, on the
+    whole window and ``"@first<n>"`` on the first `poisson.FIXED_EVENTS` collisions of
+    every run that has them, the same power at every radius) have a bootstrap interval
+    clustered on ICs instead (the runs of one IC at different radii share its initial
+    condition). The verdict is :func:`kicktimes.stats.rejection_verdict`'s: *nominal*,
+    *above nominal*, *below nominal* or *inconclusive*.
+
+    Parameters
+    ----------
+    family : str
+        The experiment's name.
+    rejections : pandas.DataFrame
+        The Poisson section's table (``radius, test, n_tested, n_reject``).
+    per_ic : pandas.DataFrame
+        The headline test's p-values per run (``radius, ic, p, p_fixed``).
+    alpha : float
+        The tests' level.
+    rng : numpy.random.Generator
+        The clustered bootstrap's stream.
+    n_boot : int
+        Its resamples.
+    """
+    from kicktimes.report.poisson import FIXED_EVENTS, HEADLINE_TEST, clustered_share
+    from kicktimes.stats.findings import clopper_pearson
+
+    rows = []
+
+    def add(diagnostic, k, n, low, high, detail):
+        share = k / n if n else math.nan
+        rows.append({
+            "family": family, "question": POISSON_QUESTION, "diagnostic": diagnostic,
+            "system": REFERENCE, "control": "primary", "estimate": share, "ci_low": low,
+            "ci_high": high, "verdict": rejection_verdict(low, high, alpha), "robust": False,
+            "depends_on": "", "n_pairs": int(n), "detail": detail})
+
+    totals = rejections.groupby("test", sort=False)[["n_reject", "n_tested"]].sum()
+    for test, (k, n) in totals.iterrows():
+        if n == 0:
+            continue
+        if test == HEADLINE_TEST and per_ic is not None:
+            low, high = clustered_share(per_ic, "p", alpha, rng=rng, n_boot=n_boot)
+            how = "95 % CI from a bootstrap clustered on ICs"
+        else:
+            low, high = clopper_pearson(int(k), int(n))
+            how = "Clopper-Pearson 95 % CI (runs of one IC at different radii counted apart)"
+        add(f"reject@{test}", int(k), int(n), low, high,
+            f"share of runs rejecting {test} at α = {alpha:g}, every radius, whole window; "
+            + how)
+    if per_ic is not None and np.isfinite(per_ic["p_fixed"]).any():
+        p = per_ic["p_fixed"].to_numpy(float)
+        ok = np.isfinite(p)
+        low, high = clustered_share(per_ic, "p_fixed", alpha, rng=rng, n_boot=n_boot)
+        add(f"reject@{HEADLINE_TEST}@first{FIXED_EVENTS}", int((p[ok] < alpha).sum()),
+            int(ok.sum()), low, high,
+            f"{HEADLINE_TEST} on the first {FIXED_EVENTS} collisions of every run that has "
+            "them (the same power at every radius); 95 % CI from a bootstrap clustered on ICs")
+    return rows
+
+
 #: what the paper says of each diagnostic (Ranković & Porter 2013), beside the table's rows
 PAPER_CLAIMS = {
     "ftle": "“very similar” λ (Fig. 6)",
@@ -334,121 +469,189 @@ PAPER_CLAIMS = {
 _CONTROL_WORDS = {
     "paired_median": "paired median",
     "sticky_excluded": "sticky runs excluded",
-    "uniform_sampling": "uniform-time samples for recurrence",
+    "uniform_sampling": "uniform-time samples",
+    "paper_sampling": "the paper's samples",
     "invariant_ics": "invariant-measure ICs",
     "elastic": "the elastic rule",
+    "elastic+invariant_ics": "the elastic rule with invariant-measure ICs",
 }
 _SHORT = {"poisson": "Poisson", "actual": "actual", "poisson_scatter": "Poisson, scatter",
           "actual_scatter": "actual, scatter", "poisson_kinetic": "kinetic rate, scatter",
-          "mmpp": "MMPP"}
+          "uniform_kinetic": "kinetic rate, uniform", "mmpp": "MMPP"}
+#: the rows of the first screen's table, in order: (diagnostic, label)
+SCREEN_ROWS = (
+    ("ftle", "FTLE λ"),
+    ("rr_offdiag@0.01", "off-diagonal RR, ε = 10⁻² (uniform-time samples)"),
+    ("det@0.01", "DET, ε = 10⁻² (uniform-time samples)"),
+    ("rr_offdiag@0.001", "off-diagonal RR, ε = 10⁻³ (uniform-time samples)"),
+    ("one_minus_r1", "1 − R₁ (lag-1 decorrelation)"),
+)
+_FAMILY_SHORT = {"family_a": "A", "family_b": "B"}
 
 
 def _ci(row):
-    return f"{row.estimate:.2f} [{row.ci_low:.2f}, {row.ci_high:.2f}]"
+    return format_interval(row.estimate, row.ci_low, row.ci_high)
 
 
-def _verdict_text(rows):
-    """``(text, robust)`` of one (family, diagnostic, system): the primary ratio and CI,
-    with "depends on <control>" and its number where a control changes the verdict."""
-    rows = rows.set_index("control")
-    primary = rows.loc["primary"]
-    if bool(primary.robust):
-        return f"{_ci(primary)} ✓", True
-    other = [c for c in rows.index if rows.loc[c, "verdict"] != primary.verdict]
-    c = other[0]
-    return (f"{_ci(primary)} ✗ depends on {c}: {_ci(rows.loc[c])}"), False
+def _fam(family):
+    return _FAMILY_SHORT.get(family, family)
+
+
+def screen_cell(rows: pd.DataFrame) -> str:
+    """One cell of the first screen: a comparison over every control and family.
+
+    ``"✓ lower: 0.301–0.338"`` (the verdict word and the range of the estimate over every
+    control and family) when it is robust in every family with one verdict; otherwise
+    ``"depends on <control>: <primary> vs <control's value>"`` (the family named when there
+    are several), or ``"depends on the family"`` with both primaries.
+    """
+    families = list(dict.fromkeys(rows["family"]))
+    primary = rows[rows["control"] == "primary"].set_index("family")
+    lo, hi = rows["estimate"].min(), rows["estimate"].max()
+    missing = ""
+    if rows["system"].iloc[0] in ("poisson_kinetic", "uniform_kinetic"):
+        missing = " (mirror rule only)"
+    for fam in families:
+        mine = rows[rows["family"] == fam]
+        if not mine["robust"].all():
+            control = mine["depends_on"].iloc[0]
+            other = mine[mine["control"] == control].iloc[0]
+            where = f"{_fam(fam)}: " if len(families) > 1 else ""
+            return (f"depends on {control}: {where}{_ci(primary.loc[fam])} vs "
+                    f"{_ci(other)}{missing}")
+    verdicts = set(primary["verdict"])
+    if len(verdicts) > 1:
+        return ("depends on the family: " + "; ".join(
+            f"{_fam(f)} {_ci(primary.loc[f])}" for f in families) + missing)
+    if (rows["ci_low"] > 1).any() and (rows["ci_high"] < 1).any():
+        return ("depends on the family: " + "; ".join(
+            f"{_fam(f)} {_ci(primary.loc[f])}" for f in families) + missing)
+    return f"✓ {verdicts.pop()}: {lo:.3g}–{hi:.3g}{missing}"
 
 
 def overview_table(table: pd.DataFrame) -> pd.DataFrame:
-    """One screen: diagnostics as rows, kicked systems as columns; each cell the primary
-    ratio to the two-disk value [95 % CI] per family, ✓ when the verdict is robust to every
-    control and ✗ with the control that changes it otherwise; the paper's claim beside."""
-    comp = table[table["system"] != REFERENCE]
-    families = list(dict.fromkeys(comp["family"]))
+    """The first screen's table: diagnostics as rows (`SCREEN_ROWS`), kick laws as columns,
+    each cell :func:`screen_cell` over every control and family; the paper's claim beside."""
+    comp = table[(table["system"] != REFERENCE) & (table["question"] != POISSON_QUESTION)]
     systems = [s for s in _SHORT if s in set(comp["system"])]
     out = []
-    for diagnostic in dict.fromkeys(comp["diagnostic"]):
-        line = {"diagnostic": diagnostic}
+    rows_wanted = [r for r in SCREEN_ROWS if r[0] in set(comp["diagnostic"])]
+    for diagnostic, label in rows_wanted:
+        line = {"diagnostic": label}
         for system in systems:
-            cells = []
-            for fam in families:
-                rows = comp[(comp["family"] == fam) & (comp["diagnostic"] == diagnostic)
-                            & (comp["system"] == system)]
-                if not rows.empty:
-                    text, _ = _verdict_text(rows)
-                    cells.append(f"{fam}: {text}" if len(families) > 1 else text)
-            line[_SHORT[system]] = "<br>".join(cells)
-        line["paper"] = PAPER_CLAIMS.get(diagnostic.split("@")[0], "")
+            rows = comp[(comp["diagnostic"] == diagnostic) & (comp["system"] == system)]
+            line[_SHORT[system]] = screen_cell(rows) if not rows.empty else ""
+        line["the paper"] = PAPER_CLAIMS.get(diagnostic.split("@")[0], "")
         out.append(line)
     return pd.DataFrame(out)
 
 
-def _stated(rows):
-    """A robust verdict as a finding, or "depends on" with both numbers."""
-    text, robust = _verdict_text(rows)
-    primary = rows.set_index("control").loc["primary"]
-    if robust:
-        return f"{primary.verdict} ({_ci(primary)} of the two-disk value, under every control)"
-    return f"{primary.verdict} under the primary setting ({text.split(' ✗ ')[0]}), but it " \
-        + text.split(" ✗ ")[1]
+def _pct(row):
+    return (f"{100 * row.estimate:.1f} % [{100 * row.ci_low:.1f}, {100 * row.ci_high:.1f}]")
+
+
+def poisson_answer(table: pd.DataFrame, alpha=0.05) -> str:
+    """The first screen's sentence on the Poisson question, with the collision rule as a
+    factor: the headline test's rejection share under the mirror and the elastic rule (the
+    paper's ICs) per family, whether the intervals are disjoint, and which tests reject at
+    their nominal rate under the elastic rule in every family."""
+    from kicktimes.report.poisson import HEADLINE_TEST, TEST_TITLES
+
+    rows = table[table["question"] == POISSON_QUESTION]
+    head = rows[rows["diagnostic"] == f"reject@{HEADLINE_TEST}"]
+    if head.empty:
+        return ""
+    families = list(dict.fromkeys(head["family"]))
+
+    def cell(fam, control):
+        r = head[(head["family"] == fam) & (head["control"] == control)]
+        return r.iloc[0] if len(r) else None
+
+    mirror = [(f, cell(f, "primary")) for f in families]
+    mirror = [(f, r) for f, r in mirror if r is not None]
+    above = all(r.verdict == "above nominal" for _, r in mirror)
+    text = ("Under the paper's mirror rule the two-disk collision times are "
+            + ("not Poisson" if above else "not shown to differ from Poisson") + " ("
+            + ", ".join(f"{_pct(r)} ({_fam(f)})" for f, r in mirror)
+            + f" of runs reject uniform times at α = {alpha:g}, against {100 * alpha:g} % for a "
+            "Poisson process)")
+    elastic = [(f, cell(f, "elastic"), cell(f, "primary")) for f in families]
+    elastic = [(f, e, m) for f, e, m in elastic if e is not None and m is not None]
+    if elastic:
+        disjoint = all(e.ci_high < m.ci_low for _, e, m in elastic)
+        shares = ", ".join(f"{_pct(e)} ({_fam(f)})" for f, e, _ in elastic)
+        text += (f"; under the elastic rule fewer runs reject ({shares}; intervals disjoint)"
+                 if disjoint else f"; under the elastic rule {shares} of runs reject")
+        nominal = []
+        for test in dict.fromkeys(rows["diagnostic"]):
+            cells = rows[(rows["diagnostic"] == test) & (rows["control"] == "elastic")]
+            if len(cells) == len(elastic) and (cells["verdict"] == "nominal").all():
+                name = test.split("@")[1]
+                nominal.append(TEST_TITLES.get(name, name).split(" (")[0])
+        if nominal:
+            text += " and the tests of " + ", ".join(nominal) + " reject at their nominal rate"
+    return text + "."
+
+
+def ftle_answer(table: pd.DataFrame) -> str:
+    """The first screen's sentence on the FTLE of the paper's kicked disk (Poisson and
+    actual kicks): its verdict over every control and family, or what it depends on."""
+    ftle = table[(table["diagnostic"] == "ftle") & table["system"].isin(["poisson", "actual"])]
+    if ftle.empty:
+        return ""
+    robust = ftle["robust"].all()
+    verdicts = set(ftle["verdict"])
+    lo, hi = ftle["estimate"].min(), ftle["estimate"].max()
+    n_controls = ftle["control"].nunique()
+    if robust and verdicts == {LOWER}:
+        return ("The paper's kicked disk does not reproduce the two-disk chaos: its FTLE is "
+                f"{lo:.3g}–{hi:.3g} of the two-disk value, lower under all {n_controls} "
+                "controls in every family.")
+    if robust and verdicts == {WITHIN}:
+        return ("The paper's kicked disk reproduces the two-disk FTLE within 10 % "
+                f"({lo:.3g}–{hi:.3g}) under all {n_controls} controls.")
+    cells = [screen_cell(ftle[ftle["system"] == s]) for s in ("poisson", "actual")]
+    return (f"The paper's kicked disk's FTLE, Poisson kicks: {cells[0]}; actual kicks: "
+            f"{cells[1]}.")
+
+
+def first_screen(table: pd.DataFrame, shares=None) -> list[str]:
+    """The Markdown lines that open a results page: at most three sentences (the Poisson
+    question with the collision rule, the paper's kicked disk, how to read the table),
+    then the table (:func:`overview_table`). ``shares`` is accepted for compatibility and
+    unused: the Poisson numbers come from the table's rows."""
+    controls = [c for c in dict.fromkeys(table["control"]) if c != "primary"]
+    sentences = [poisson_answer(table), ftle_answer(table),
+                 "Below, each cell is the kicked/two-disk ratio's range over every control ("
+                 + ", ".join(_CONTROL_WORDS.get(c, c) for c in controls)
+                 + ") and both families: ✓ with its verdict when all agree in verdict and "
+                 "direction, else the control it depends on, with both numbers."]
+    lines = [" ".join(s for s in sentences if s), ""]
+    lines += markdown_table(overview_table(table))
+    return lines + [""]
+
+
+def mmpp_answer(table: pd.DataFrame) -> str:
+    """With the ``mmpp`` system: does clustering in the kick times bring the kicked disk
+    closer? Its FTLE ratio against the Poisson kicks' (primary, per family), and its cell."""
+    ftle = table[table["diagnostic"] == "ftle"]
+    if "mmpp" not in set(ftle["system"]):
+        return ""
+    primary = ftle[ftle["control"] == "primary"].set_index(["family", "system"])["estimate"]
+    pairs = [f"{fam}: {primary[fam, 'mmpp']:.2f} against {primary[fam, 'poisson']:.2f}"
+             for fam in dict.fromkeys(ftle["family"])
+             if (fam, "mmpp") in primary.index and (fam, "poisson") in primary.index]
+    return ("Does clustering in the kick times bring the kicked disk closer? MMPP kicks (a "
+            "two-state Markov-modulated Poisson process fitted to each IC's collision times) "
+            "against Poisson kicks at the same mean rate, FTLE ratio to the two-disk value"
+            + (f" ({'; '.join(pairs)})" if pairs else "") + ": MMPP kicks: "
+            + screen_cell(ftle[ftle["system"] == "mmpp"]) + ".")
 
 
 def answers(table: pd.DataFrame, poisson_share=None) -> list[str]:
-    """The sentences that open the results: Poisson? Does the paper's kicked disk
-    reproduce the two-disk chaos (FTLE)? Does any kick? And, with the ``mmpp`` system,
-    does clustering in the kick times bring the kicked disk closer?
-
-    ``poisson_share``: ``{family: (share, ci_low, ci_high, alpha)}`` of runs whose collision
-    times reject uniformity (the Poisson test), or None.
-    """
-    out = []
-    poisson_share = {k: v for k, v in (poisson_share or {}).items() if v is not None}
-    if poisson_share:
-        parts = [f"{fam}: {s:.0%} of runs [{lo:.0%}, {hi:.0%}] reject it at α = {a:g}"
-                 for fam, (s, lo, hi, a) in poisson_share.items()]
-        reject = all(lo > a for (_, lo, _, a) in poisson_share.values())
-        out.append("**Are the collision times Poisson?** "
-                    + ("No. " if reject else "Not rejected everywhere. ")
-                    + "; ".join(parts) + " (under Poisson times the share would be α).")
-    ftle = table[(table["diagnostic"] == "ftle")]
-
-    def statements(systems):
-        """"<family>, <system> kicks: <verdict>" for each family and system present."""
-        out = []
-        for fam in dict.fromkeys(ftle["family"]):
-            for system in systems:
-                rows = ftle[(ftle["family"] == fam) & (ftle["system"] == system)]
-                if not rows.empty:
-                    out.append(f"{fam}, {_SHORT[system]} kicks: {_stated(rows)}")
-        return out
-
-    paper = statements(("poisson", "actual"))
-    if paper:
-        mine = ftle[ftle["system"].isin(["poisson", "actual"])]
-        verdicts = set(mine["verdict"])
-        primary = mine[mine["control"] == "primary"]["estimate"]
-        lead = ("Yes" if verdicts == {WITHIN} else "No" if verdicts == {DIFFERS}
-                else "Not under every control")
-        out.append("**Does the paper's kicked disk reproduce the two-disk chaos?** "
-                   f"{lead}: its FTLE is {primary.min():.2f}–{primary.max():.2f} of the "
-                   "two-disk one. " + "; ".join(paper) + ".")
-    other = statements(("poisson_scatter", "actual_scatter", "poisson_kinetic"))
-    if other:
-        out.append("**Does any kick?** The scatter kick (a collision with a virtual partner, "
-                   "at Poisson, actual or kinetic-rate times) comes closest; FTLE ratio "
-                   + "; ".join(other) + ".")
-    clustered = statements(("mmpp",))
-    if clustered:
-        primary = ftle[ftle["control"] == "primary"].set_index(["family", "system"])["estimate"]
-        pairs = [f"{fam}: {primary[fam, 'mmpp']:.2f} against {primary[fam, 'poisson']:.2f}"
-                 for fam in dict.fromkeys(ftle["family"])
-                 if (fam, "mmpp") in primary.index and (fam, "poisson") in primary.index]
-        out.append("**Does clustering in the kick times bring the kicked disk closer?** "
-                   "MMPP kicks (a two-state Markov-modulated Poisson process fitted to each "
-                   "IC's collision times) against Poisson kicks at the same mean rate, FTLE "
-                   "ratio to the two-disk value" + (f" ({'; '.join(pairs)})" if pairs else "")
-                   + ": " + "; ".join(clustered) + ".")
-    return out
+    """The answers that open a report's findings: the Poisson question, the paper's kicked
+    disk, and (with the ``mmpp`` system) clustered kicks."""
+    return [s for s in (poisson_answer(table), ftle_answer(table), mmpp_answer(table)) if s]
 
 
 def markdown_table(frame: pd.DataFrame) -> list[str]:
@@ -471,23 +674,6 @@ def poisson_share(effects) -> tuple | None:
     return None
 
 
-def first_screen(table: pd.DataFrame, shares: dict) -> list[str]:
-    """The Markdown lines that open a results page: the three answers, then the table."""
-    lines = []
-    for sentence in answers(table, {k: v for k, v in shares.items() if v is not None}):
-        lines += [sentence, ""]
-    lines += ["Ratio of each kicked system to the two-disk value, averaged over radii [95 % "
-              "CI, bootstrap clustered on ICs]; ✓: the verdict (within 10 %: the whole CI lies in "
-              "[0.9, 1.1]; differs: it lies entirely outside; inconclusive: it straddles an "
-              "edge) is the same under every control ("
-              + ", ".join(_CONTROL_WORDS.get(c, c) for c in dict.fromkeys(table["control"])
-                          if c != "primary")
-              + "); ✗: it is not, and the control that changes it is named with its "
-              "number.", ""]
-    lines += markdown_table(overview_table(table))
-    return lines + [""]
-
-
 #: the headline figure's panels: (diagnostic, title)
 PANELS = (
     ("ftle", "FTLE λ"),
@@ -496,13 +682,14 @@ PANELS = (
     ("det@0.01", "DET, ε = 10⁻²\n(uniform-time samples)"),
     ("one_minus_r1", "1 − R₁\n(lag-1 decorrelation)"),
 )
-_FAMILY_LINES = ("-", "--", ":", "-.")
 # y ticks of the ratio panels, by how many decades the panel spans (labels never overlap)
 _LOG_TICKS = (
     (4.0, (0.2, 0.3, 0.5, 0.7, 0.9, 1.0, 1.1, 1.5, 2.0, 3.0)),
     (20.0, (0.1, 0.2, 0.3, 0.5, 0.7, 1.0, 1.5, 2.0, 3.0, 5.0, 10.0)),
     (math.inf, (0.01, 0.02, 0.05, 0.1, 0.2, 0.5, 1.0, 2.0, 5.0, 10.0, 20.0, 50.0)),
 )
+#: the statistic of the headline figure: robust to the few sticky runs
+HEADLINE_CONTROL = "paired_median"
 
 
 def log_ratio_axis(ax):
@@ -517,17 +704,20 @@ def log_ratio_axis(ax):
     ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
 
 
-def ratio_curves_figure(curves: pd.DataFrame):
+def ratio_curves_figure(curves: pd.DataFrame, control=HEADLINE_CONTROL):
     """The headline figure: the ratio of each kicked system to the two-disk value against
-    r, one panel per diagnostic, with 95 % CIs (bootstrap clustered on ICs) and the ±10 %
-    band; families by line style. The recurrence panels show the uniform-time control:
-    on the paper's collision-truncated samples their ratios are inflated by where the
-    samples fall (the findings table has both).
+    r, one line per kick law, one panel per diagnostic (columns) and family (rows), with
+    95 % CIs (bootstrap clustered on ICs) and the ±10 % band. Every panel shares one log y
+    scale, so the band has the same height everywhere. The statistic is ``control``'s
+    (default the paired median of per-IC ratios, which a few sticky runs cannot move); the
+    recurrence panels use uniform-time samples (the primary setting of recurrence).
 
     Parameters
     ----------
     curves : pandas.DataFrame
         ``Controls.curves`` of one or more stores (concatenated).
+    control : str
+        Which control's per-radius curves to draw.
 
     Returns
     -------
@@ -538,39 +728,43 @@ def ratio_curves_figure(curves: pd.DataFrame):
 
     from kicktimes.report.figures import radius_axis, system_label, system_style
 
+    curves = curves[curves["control"] == control]
     panels = [(d, t) for d, t in PANELS if d in set(curves["diagnostic"])]
-    fig = Figure(figsize=(3.3 * max(len(panels), 1), 4.2), layout="constrained")
-    axes = fig.subplots(1, max(len(panels), 1), squeeze=False)[0]
     families = list(dict.fromkeys(curves["family"]))
     systems = [s for s in _SHORT if s in set(curves["system"])]
-    for ax, (diagnostic, title) in zip(axes, panels, strict=False):
-        ax.axhspan(0.9, 1.1, color="0.85", zorder=0)
-        ax.axhline(1.0, color="0.5", linewidth=0.8, zorder=0)
-        part = curves[curves["diagnostic"] == diagnostic]
-        recurrence = diagnostic.startswith(("rr_", "det"))
-        controls = ["uniform_sampling"] if recurrence else ["primary"]
-        for k, system in enumerate(systems):
-            style = system_style(system, k)
-            for f, fam in enumerate(families):
-                for control in controls:
-                    c = part[(part["system"] == system) & (part["family"] == fam)
-                             & (part["control"] == control)].sort_values("radius")
-                    if c.empty:
-                        continue
-                    err = np.vstack([c["ratio"] - c["ci_low"], c["ci_high"] - c["ratio"]])
-                    ax.errorbar(c["radius"], c["ratio"], yerr=np.clip(err, 0, None),
-                                color=style["color"], marker=style["marker"], markersize=3.5,
-                                linestyle=_FAMILY_LINES[f % 4], linewidth=1.0, capsize=1.5)
-        ax.set_title(title, fontsize="medium")
-        radius_axis(ax)
-        log_ratio_axis(ax)
-    axes[0].set_ylabel("kicked / two-disk (ratio of means)")
+    ncol, nrow = max(len(panels), 1), max(len(families), 1)
+    fig = Figure(figsize=(3.0 * ncol, 2.9 * nrow + 0.9), layout="constrained")
+    axes = fig.subplots(nrow, ncol, squeeze=False, sharey=True, sharex="row")
+    shown = curves[curves["diagnostic"].isin([d for d, _ in panels])]
+    values = shown[["ratio", "ci_low", "ci_high"]].to_numpy(float)
+    values = values[np.isfinite(values) & (values > 0)]
+    lo = min(0.8, float(values.min()) / 1.1) if values.size else 0.5
+    hi = max(1.25, float(values.max()) * 1.1) if values.size else 2.0
+    for f, fam in enumerate(families):
+        for j, (diagnostic, title) in enumerate(panels):
+            ax = axes[f, j]
+            ax.axhspan(0.9, 1.1, color="0.85", zorder=0)
+            ax.axhline(1.0, color="0.5", linewidth=0.8, zorder=0)
+            part = curves[(curves["diagnostic"] == diagnostic) & (curves["family"] == fam)]
+            for k, system in enumerate(systems):
+                c = part[part["system"] == system].sort_values("radius")
+                if c.empty:
+                    continue
+                style = system_style(system, k)
+                err = np.vstack([c["ratio"] - c["ci_low"], c["ci_high"] - c["ratio"]])
+                ax.errorbar(c["radius"], c["ratio"], yerr=np.clip(err, 0, None),
+                            color=style["color"], marker=style["marker"], markersize=3,
+                            linewidth=1.0, capsize=1.5)
+            ax.set_title(f"{fam}: {title}" if j == 0 or f == 0 else title, fontsize="small")
+            radius_axis(ax)
+            ax.set_ylim(lo, hi)
+            log_ratio_axis(ax)
+        axes[f, 0].set_ylabel(f"{fam}\nkicked / two-disk\n(median of per-IC ratios)",
+                              fontsize="small")
     handles = [Line2D([], [], color=system_style(s, k)["color"], marker=system_style(s, k)[
         "marker"], linestyle="-", label=system_label(s)) for k, s in enumerate(systems)]
-    handles += [Line2D([], [], color="k", linestyle=_FAMILY_LINES[f % 4], label=fam)
-                for f, fam in enumerate(families)]
     handles += [Line2D([], [], color="0.85", linewidth=6, label="±10 % band")]
-    fig.legend(handles=handles, loc="outside lower center", ncol=min(len(handles), 6),
+    fig.legend(handles=handles, loc="outside lower center", ncol=min(len(handles), 4),
                fontsize="small")
     return fig
 
@@ -578,10 +772,12 @@ def ratio_curves_figure(curves: pd.DataFrame):
 def merge_control_families(tables):
     """Fold the findings of control experiments into their family's table.
 
-    An experiment named ``"<family>-<control>"`` (the presets ``family_a_invariant`` and
-    ``family_a_elastic``: invariant-measure ICs, the elastic rule) is a control of
-    ``<family>``: the primary rows of its table become rows of ``<family>``'s table with
-    ``control = "<control>"``, and ``robust`` is recomputed over every control.
+    An experiment named ``"<family>-<control>"`` (the presets of
+    `kicktimes.experiment.presets.CONTROL_PRESETS`: ``invariant_ics``, ``elastic``,
+    ``elastic+invariant_ics``) is a control of ``<family>``: the primary rows of its table
+    (ratios and the Poisson question) become rows of ``<family>``'s table with
+    ``control = "<control>"``, and ``robust`` and ``depends_on`` are recomputed over every
+    control (:func:`with_robustness`).
 
     Parameters
     ----------
@@ -610,10 +806,9 @@ def merge_control_families(tables):
             out[name] = t
     for family, parts in extra.items():
         merged = pd.concat([out[family], *parts], ignore_index=True)
-        keys = ["family", "diagnostic", "system"]
-        merged["robust"] = (merged.groupby(keys)["verdict"].transform("nunique") == 1).to_numpy()
         pair = list(zip(merged["diagnostic"], merged["system"], strict=True))
         first = {p: k for k, p in reversed(list(enumerate(pair)))}
         rank = np.array([first[p] for p in pair])
-        out[family] = merged.iloc[np.argsort(rank, kind="stable")].reset_index(drop=True)
+        merged = merged.iloc[np.argsort(rank, kind="stable")].reset_index(drop=True)
+        out[family] = with_robustness(merged)
     return out

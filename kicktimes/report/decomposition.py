@@ -1,31 +1,36 @@
 r"""How much of the kicked-versus-two-disk gap each ingredient of the kicks closes.
 
-The kicked disk approaches the two-disk system in three steps, each adding one
-ingredient of a real disk-disk collision:
+Two ingredients of a real disk-disk collision, each switched on or off, give a 2 x 2
+factorial of kicked systems:
 
-1. ``poisson``: a uniform new direction at Poisson times (the paper's kicked disk);
-2. ``poisson_scatter``: a collision with a virtual partner, at the same kind of times
-   (the *deflection law*);
-3. ``poisson_kinetic``: the same collisions at the kinetic rate of the disk's own
-   angular momentum, redrawn after every kick (the *state-dependent timing*);
+==================  ====================  ==============================
+deflection \ time   Poisson times         kinetic rate of the disk's L
+==================  ====================  ==============================
+uniform direction   ``poisson`` (paper)   ``uniform_kinetic``
+scatter kick        ``poisson_scatter``   ``poisson_kinetic``
+==================  ====================  ==============================
 
-and what no kick law has is the rest: the partner's memory (its angular momentum is
-correlated with the disk's, and the pair can meet again soon after a glancing
-collision). For a diagnostic with kicked / two-disk ratio :math:`\rho_s`, the gap of
-system ``s`` is :math:`g_s = |\log \rho_s|`, and the shares of the paper's gap
-:math:`g_{\rm poisson}` closed by each step are
+For a diagnostic with kicked / two-disk ratio :math:`\rho_s`, the gap of system ``s`` is
+:math:`g_s = |\log \rho_s|`. The gap the two ingredients close together,
+:math:`g_{UP} - g_{SK}`, is split by Shapley values (the average of the two orders in
+which the ingredients can be added, so no order is privileged):
 
 .. math::
 
-    \frac{g_{\rm poisson} - g_{\rm scatter}}{g_{\rm poisson}}, \qquad
-    \frac{g_{\rm scatter} - g_{\rm kinetic}}{g_{\rm poisson}}, \qquad
-    \frac{g_{\rm kinetic}}{g_{\rm poisson}} \ \text{(left)},
+    \phi_{\rm deflection} = \tfrac12\big[(g_{UP} - g_{SP}) + (g_{UK} - g_{SK})\big], \qquad
+    \phi_{\rm timing} = \tfrac12\big[(g_{UP} - g_{UK}) + (g_{SP} - g_{SK})\big],
 
-which sum to one; a negative share is a step that widens the gap. Every quantity is
-computed under the findings' controls (`kicktimes.report.controls`), with a percentile
-bootstrap clustered on ICs: one resample draws IC indices and applies them to every
-system and radius, so the three ratios (and their differences) come from the same
-resampled ICs.
+and the shares of the paper's gap :math:`g_{UP}` are :math:`\phi_{\rm deflection}/g_{UP}`,
+:math:`\phi_{\rm timing}/g_{UP}` and the remainder :math:`g_{SK}/g_{UP}` (partner memory,
+re-collisions: what no kick law has; *not measured*, only left over). They sum to one; a
+negative share is an ingredient that widens the gap. The shares are computed only where
+the paper's gap exists: where the CI of :math:`\rho_{UP}` lies entirely outside the
+±10 % band under that control; elsewhere the row says "no gap to decompose" (a gap
+inside its own noise is not decomposed). Every quantity is computed under the findings'
+controls (`kicktimes.report.controls`; the recurrence diagnostics on uniform-time samples,
+the paper's samples as the control ``paper_sampling``), with a percentile bootstrap
+clustered on ICs: one resample draws IC indices and applies them to every system and
+radius, so the four ratios and their differences come from the same resampled ICs.
 """
 
 from __future__ import annotations
@@ -39,16 +44,17 @@ from kicktimes.report.common import REFERENCE, wide
 from kicktimes.report.controls import diagnostics_of
 from kicktimes.stats import bootstrap_nanmedians
 
-__all__ = ["LADDER", "STEPS", "gap_decomposition", "gap_figure", "gap_summary"]
+__all__ = ["FACTORIAL", "NO_GAP", "STEPS", "gap_decomposition", "gap_figure", "gap_summary"]
 
-#: the kicked systems in the order each adds an ingredient
-LADDER = ("poisson", "poisson_scatter", "poisson_kinetic")
-#: the step each share measures, in the table's order
-STEPS = ("deflection law (uniform kick -> scatter kick)",
-         "state-dependent timing (Poisson -> kinetic rate)",
-         "left: partner memory and re-collisions")
-_LABELS = {"poisson": "uniform kick, Poisson times", "poisson_scatter": "+ scatter kick",
-           "poisson_kinetic": "+ kinetic rate"}
+#: the factorial's systems: (uniform, Poisson), (scatter, Poisson), (uniform, kinetic),
+#: (scatter, kinetic)
+FACTORIAL = ("poisson", "poisson_scatter", "uniform_kinetic", "poisson_kinetic")
+#: the shares, in the table's order
+STEPS = ("deflection law (Shapley)", "state-dependent timing (Shapley)",
+         "remainder (partner memory, re-collisions; not measured)")
+#: what a share's row says where the paper's gap lies inside the ±10 % band
+NO_GAP = "no gap to decompose"
+_BAND = (0.9, 1.1)
 
 
 def _arrays(table, systems, keep):
@@ -89,22 +95,35 @@ def _ratio_medians(x, y, idx):
         return np.nanmean(medians, axis=0)
 
 
-def _shares(rho):
-    """The gaps ``|log rho|`` of the ladder and the three shares (columns: resamples)."""
+def shapley_shares(rho):
+    r"""The Shapley shares of the paper's gap from the factorial's four ratios.
+
+    ``rho``: array of shape (4, ...) in the order of `FACTORIAL`. Returns an array (3, ...):
+    deflection, timing and remainder, each over :math:`g_{UP} = |\log \rho_{UP}|`.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> rho = np.array([0.25, 0.5, 0.25, 0.5])  # only the deflection law matters
+    >>> shapley_shares(rho).round(3).tolist()
+    [0.5, 0.0, 0.5]
+    """
     with np.errstate(invalid="ignore", divide="ignore"):
-        g = np.abs(np.log(rho))
-        return g, np.stack([(g[0] - g[1]) / g[0], (g[1] - g[2]) / g[0], g[2] / g[0]])
+        g_up, g_sp, g_uk, g_sk = np.abs(np.log(np.asarray(rho, float)))
+        deflection = 0.5 * ((g_up - g_sp) + (g_uk - g_sk))
+        timing = 0.5 * ((g_up - g_uk) + (g_sp - g_sk))
+        return np.stack([deflection / g_up, timing / g_up, g_sk / g_up])
 
 
 def gap_decomposition(results, collisions, *, family, eps, rule="mirror", rng, n_boot=1000,
                       level=0.95, kinetic=None) -> pd.DataFrame:
-    """The gap decomposition of every comparison diagnostic under every control.
+    """The Shapley decomposition of every comparison diagnostic's gap under every control.
 
     Parameters
     ----------
     results, collisions : pandas.DataFrame
-        A store's tables (`kicktimes.experiment.load_store`), with the systems of `LADDER`
-        and ``two_particle``.
+        A store's tables (`kicktimes.experiment.load_store`), with the systems of
+        `FACTORIAL` and ``two_particle``.
     family : str
         The experiment's name.
     eps : sequence of float
@@ -122,53 +141,48 @@ def gap_decomposition(results, collisions, *, family, eps, rule="mirror", rng, n
     -------
     pandas.DataFrame
         One row per (diagnostic, control, quantity): ``family, diagnostic, control,
-        quantity, estimate, ci_low, ci_high``. Quantities: ``ratio <system>`` for the
-        ladder, then the three `STEPS` shares. Empty without the ladder's systems.
+        quantity, estimate, ci_low, ci_high, note``. Quantities: ``ratio <system>`` for the
+        factorial, then the three `STEPS` shares (NaN with ``note = NO_GAP`` where the
+        paper's ratio lies inside its band). Empty without the factorial's systems.
 
     Examples
     --------
     >>> import numpy as np, pandas as pd
     >>> rows = [(0.01, i, s, "lyapunov", v) for i in range(8) for s, v in
     ...         (("two_particle", 1.0), ("poisson", 0.25), ("poisson_scatter", 0.5),
-    ...          ("poisson_kinetic", 0.5))]
+    ...          ("uniform_kinetic", 0.25), ("poisson_kinetic", 0.5))]
     >>> res = pd.DataFrame(rows, columns=["radius", "ic", "system", "diagnostic", "value"])
     >>> col = pd.DataFrame({"radius": [0.01] * 8, "ic": range(8), "t_window": [1e3] * 8,
     ...                     "n_pp": [16] * 8})
     >>> tab = gap_decomposition(res, col, family="demo", eps=(), rng=np.random.default_rng(0),
     ...                         n_boot=50)
-    >>> tab[tab["control"] == "primary"].set_index("quantity")["estimate"].round(2).iloc[3:]
-    quantity
-    deflection law (uniform kick -> scatter kick)       0.5
-    state-dependent timing (Poisson -> kinetic rate)    0.0
-    left: partner memory and re-collisions              0.5
-    Name: estimate, dtype: float64
+    >>> tab[tab["control"] == "primary"]["estimate"].round(2).tolist()[4:]
+    [0.5, 0.0, 0.5]
     """
     from kicktimes.report.counts import sticky_ics
 
+    columns = ["family", "diagnostic", "control", "quantity", "estimate", "ci_low", "ci_high",
+               "note"]
     present = set(results["system"].unique())
-    if not set(LADDER) | {REFERENCE} <= present:
-        return pd.DataFrame(columns=["family", "diagnostic", "control", "quantity", "estimate",
-                                     "ci_low", "ci_high"])
+    if not set(FACTORIAL) | {REFERENCE} <= present:
+        return pd.DataFrame(columns=columns)
     sticky = sticky_ics(collisions, rule, kinetic=kinetic).set_index(["radius", "ic"])["sticky"]
     alpha = (1.0 - level) / 2.0
     rows = []
     for diagnostic, row, uniform in diagnostics_of(results, eps):
-        tables = {"primary": wide(results, row)}
+        # recurrence: uniform-time samples are the primary setting (as in the findings)
+        main = wide(results, uniform if uniform is not None else row)
+        settings = [("primary", "mean", main), ("paired_median", "median", main),
+                    ("sticky_excluded", "mean", main)]
         if uniform is not None:
-            tables["uniform_sampling"] = wide(results, uniform)
+            settings.append(("paper_sampling", "mean", wide(results, row)))
         n_ic = None
-        for control, name, table in (
-            ("primary", "mean", tables["primary"]),
-            ("paired_median", "median", tables["primary"]),
-            ("sticky_excluded", "mean", tables["primary"]),
-            *((("uniform_sampling", "mean", tables["uniform_sampling"]),)
-              if uniform is not None else ()),
-        ):
+        for control, name, table in settings:
             if diagnostic == "one_minus_r1":
                 table = 1.0 - table
             keep = (~sticky if control == "sticky_excluded"
                     else pd.Series(True, index=sticky.index))
-            xs, y, _ = _arrays(table, LADDER, keep)
+            xs, y, _ = _arrays(table, FACTORIAL, keep)
             if n_ic is None:
                 n_ic = y.shape[1]
                 idx = rng.integers(0, n_ic, size=(n_boot, n_ic))
@@ -182,93 +196,110 @@ def gap_decomposition(results, collisions, *, family, eps, rule="mirror", rng, n
                 every = np.arange(n_ic)[None, :]
                 point = np.array([_ratio_medians(x, y, every)[0] for x in xs])
                 boot = np.stack([_ratio_medians(x, y, idx) for x in xs])
-            _, shares = _shares(point[:, None])
-            _, boot_shares = _shares(boot)
-            estimates = [*point, *shares[:, 0]]
+            shares = shapley_shares(point[:, None])[:, 0]
+            boot_shares = shapley_shares(boot)
+            finite = boot[0][np.isfinite(boot[0])]
+            lo0, hi0 = (np.quantile(finite, [alpha, 1.0 - alpha]) if finite.size
+                        else (np.nan, np.nan))
+            gap = bool(hi0 < _BAND[0] or lo0 > _BAND[1])
+            names = [f"ratio {s}" for s in FACTORIAL] + list(STEPS)
+            estimates = [*point, *shares]
             draws = [*boot, *boot_shares]
-            names = [f"ratio {s}" for s in LADDER] + list(STEPS)
-            for quantity, est, dist in zip(names, estimates, draws, strict=True):
+            for k, (quantity, est, dist) in enumerate(zip(names, estimates, draws, strict=True)):
+                note = ""
+                if k >= len(FACTORIAL) and not gap:
+                    rows.append((family, diagnostic, control, quantity, np.nan, np.nan, np.nan,
+                                 NO_GAP))
+                    continue
                 dist = dist[np.isfinite(dist)]
                 lo, hi = (np.quantile(dist, [alpha, 1.0 - alpha]) if dist.size
                           else (np.nan, np.nan))
                 rows.append((family, diagnostic, control, quantity, float(est), float(lo),
-                             float(hi)))
-    return pd.DataFrame(rows, columns=["family", "diagnostic", "control", "quantity",
-                                       "estimate", "ci_low", "ci_high"])
+                             float(hi), note))
+    return pd.DataFrame(rows, columns=columns)
 
 
 def gap_figure(table: pd.DataFrame):
-    """The ladder's ratios per diagnostic, one panel each (uniform-time samples for the
-    recurrence diagnostics, the primary setting otherwise), with 95 % CIs (bootstrap
-    clustered on ICs) and the ±10 % band; families side by side."""
+    """The Shapley shares of the paper's gap, one panel per diagnostic with a gap (primary
+    setting: uniform-time samples for recurrence), with their 95 % CIs (bootstrap clustered
+    on ICs), families side by side; a panel without a gap says so. One y scale for all."""
     from matplotlib.figure import Figure
     from matplotlib.lines import Line2D
 
-    from kicktimes.report.controls import PANELS, log_ratio_axis
-    from kicktimes.report.figures import system_label, system_style
+    from kicktimes.report.controls import PANELS
 
-    panels = [(d, t) for d, t in PANELS if d in set(table["diagnostic"])
-              and np.isfinite(table.loc[table["diagnostic"] == d, "estimate"]).any()]
+    panels = [(d, t) for d, t in PANELS if d in set(table["diagnostic"])]
     families = list(dict.fromkeys(table["family"]))
-    fig = Figure(figsize=(3.0 * max(len(panels), 1), 3.9), layout="constrained")
-    axes = fig.subplots(1, max(len(panels), 1), squeeze=False)[0]
+    fig = Figure(figsize=(2.9 * max(len(panels), 1), 3.9), layout="constrained")
+    axes = fig.subplots(1, max(len(panels), 1), squeeze=False, sharey=True)[0]
+    colours = ("tab:red", "tab:purple", "0.45")
+    short = ("deflection", "timing", "remainder")
     for ax, (diagnostic, title) in zip(axes, panels, strict=False):
-        ax.axhspan(0.9, 1.1, color="0.85", zorder=0)
-        ax.axhline(1.0, color="0.5", linewidth=0.8, zorder=0)
-        part = table[table["diagnostic"] == diagnostic]
-        control = ("uniform_sampling" if (part["control"] == "uniform_sampling").any()
-                   else "primary")
+        ax.axhline(0.0, color="0.5", linewidth=0.8, zorder=0)
+        ax.axhline(1.0, color="0.8", linewidth=0.8, linestyle=":", zorder=0)
+        part = table[(table["diagnostic"] == diagnostic) & (table["control"] == "primary")]
+        drawn = False
         for f, family in enumerate(families):
-            rows = part[(part["control"] == control) & (part["family"] == family)]
-            rows = rows.set_index("quantity")
-            for i, system in enumerate(LADDER):
-                est, lo, hi = rows.loc[f"ratio {system}", ["estimate", "ci_low", "ci_high"]]
-                if not np.isfinite(est):
+            rows = part[part["family"] == family].set_index("quantity")
+            for i, step in enumerate(STEPS):
+                if step not in rows.index or not np.isfinite(rows.loc[step, "estimate"]):
                     continue
-                # (a percentile interval need not contain the point estimate)
+                est, lo, hi = rows.loc[step, ["estimate", "ci_low", "ci_high"]]
                 err = [[max(est - lo, 0.0)], [max(hi - est, 0.0)]]
-                style = system_style(system)
-                ax.errorbar([i + 0.18 * (f - (len(families) - 1) / 2)], [est], yerr=err,
-                            fmt=style["marker"], color=style["color"], capsize=2.5, ms=6,
-                            mfc="white" if f else style["color"])
-        ax.set_xticks(range(len(LADDER)), [_LABELS[s] for s in LADDER], rotation=25,
-                      ha="right", fontsize="small")
-        ax.set_xlim(-0.5, len(LADDER) - 0.5)
+                ax.errorbar([i + 0.2 * (f - (len(families) - 1) / 2)], [est], yerr=err,
+                            fmt="os"[f % 2], color=colours[i], capsize=2.5, ms=5,
+                            mfc="white" if f else colours[i])
+                drawn = True
+        if not drawn:
+            ax.text(0.5, 0.5, "no gap to decompose:\nthe paper's kick is within\nthe ±10 % "
+                    "band or its CI\nstraddles an edge", transform=ax.transAxes,
+                    ha="center", va="center", fontsize="small", color="0.3")
+        ax.set_xticks(range(len(STEPS)), short, fontsize="small")
+        ax.set_xlim(-0.5, len(STEPS) - 0.5)
         ax.set_title(title, fontsize="medium")
-        log_ratio_axis(ax)
-    axes[0].set_ylabel("kicked / two-disk (ratio of means)")
-    handles = [Line2D([], [], color=system_style(s)["color"], marker=system_style(s)["marker"],
-                      linestyle="none", label=system_label(s)) for s in LADDER]
-    if len(families) > 1:
-        handles += [Line2D([], [], color="k", marker="o", mfc="white" if f else "k",
-                           linestyle="none", label=fam) for f, fam in enumerate(families)]
-    handles += [Line2D([], [], color="0.85", linewidth=6, label="±10 % band")]
-    fig.legend(handles=handles, loc="outside lower center", ncol=len(handles),
+    axes[0].set_ylabel("share of the paper's gap |log(kicked / two-disk)|")
+    handles = [Line2D([], [], color="k", marker="os"[f % 2], mfc="white" if f else "k",
+                      linestyle="none", label=fam) for f, fam in enumerate(families)]
+    fig.legend(handles=handles, loc="outside lower center", ncol=max(len(handles), 1),
                fontsize="small")
+    fig.suptitle("Shapley shares of the paper's kicked-disk gap closed by the deflection law "
+                 "and the timing (95 % CI); the remainder is not measured", fontsize="medium")
     return fig
 
 
 def gap_summary(table: pd.DataFrame) -> pd.DataFrame:
-    """One row per (family, diagnostic): the three shares under the headline setting
-    (uniform-time samples for recurrence, the primary ratio otherwise) with their 95 % CIs,
-    and whether each share keeps its sign (or its CI's side of 0) under every control.
+    """One row per (family, diagnostic): the three shares under the primary setting with
+    their 95 % CIs (or `NO_GAP`), and whether each is robust: every control has a gap, and
+    every control's CI lies on the same side of 0, none straddling it.
 
-    Returns columns ``family, diagnostic, setting`` and per step ``<step>`` (``"0.62
-    [0.41, 0.80]"``) and ``<step> robust`` (True when the intervals of every control lie on
-    the same side of 0 as the headline's, or all contain 0).
+    Returns columns ``family, diagnostic`` and per step ``<step>`` (``"0.62 [0.41, 0.80]"``)
+    and ``<step> robust`` (``"✓"``, or ``"✗ <control>"`` naming the first control that breaks
+    it).
     """
+    from kicktimes.stats import format_interval
+
     rows = []
     for (family, diagnostic), part in table.groupby(["family", "diagnostic"], sort=False):
-        setting = ("uniform_sampling" if (part["control"] == "uniform_sampling").any()
-                   else "primary")
-        head = part[part["control"] == setting].set_index("quantity")
-        row = {"family": family, "diagnostic": diagnostic, "setting": setting}
+        head = part[part["control"] == "primary"].set_index("quantity")
+        row = {"family": family, "diagnostic": diagnostic}
         for step in STEPS:
             est, lo, hi = head.loc[step, ["estimate", "ci_low", "ci_high"]]
-            row[step] = f"{est:.2f} [{lo:.2f}, {hi:.2f}]" if np.isfinite(est) else "n/a"
-            sides = set()
+            row[step] = (format_interval(est, lo, hi, edges=(0.0,)) if np.isfinite(est)
+                         else NO_GAP)
+            verdict = "✓"
+            sides = []
             for _, r in part[part["quantity"] == step].iterrows():
-                sides.add(1 if r["ci_low"] > 0 else -1 if r["ci_high"] < 0 else 0)
-            row[f"{step} robust"] = len(sides) == 1
+                side = 1 if r["ci_low"] > 0 else -1 if r["ci_high"] < 0 else 0
+                if not np.isfinite(r["estimate"]):
+                    verdict = f"✗ {r['control']} (no gap)"
+                    break
+                if side == 0:
+                    verdict = f"✗ {r['control']}: CI contains 0"
+                    break
+                if sides and side != sides[0]:
+                    verdict = f"✗ {r['control']}: other sign"
+                    break
+                sides.append(side)
+            row[f"{step} robust"] = verdict if np.isfinite(est) else "—"
         rows.append(row)
     return pd.DataFrame(rows)

@@ -11,7 +11,7 @@ from matplotlib.figure import Figure
 from matplotlib.ticker import FuncFormatter, NullFormatter
 
 SYSTEMS = ("two_particle", "poisson", "actual", "poisson_scatter", "actual_scatter",
-           "poisson_kinetic", "mmpp")
+           "poisson_kinetic", "uniform_kinetic", "mmpp")
 SYSTEM_LABELS = {
     "two_particle": "Two-particle",
     "poisson": "Poisson",
@@ -19,6 +19,7 @@ SYSTEM_LABELS = {
     "poisson_scatter": "Poisson, scatter",
     "actual_scatter": "Actual, scatter",
     "poisson_kinetic": "Kinetic rate, scatter",
+    "uniform_kinetic": "Kinetic rate, uniform",
     "mmpp": "MMPP (clustered times)",
 }
 _SYSTEM_STYLE = {
@@ -28,6 +29,7 @@ _SYSTEM_STYLE = {
     "poisson_scatter": {"color": "tab:red", "marker": "v"},
     "actual_scatter": {"color": "tab:green", "marker": "D"},
     "poisson_kinetic": {"color": "tab:purple", "marker": "P"},
+    "uniform_kinetic": {"color": "tab:olive", "marker": "*"},
     "mmpp": {"color": "tab:brown", "marker": "X"},
 }
 # (title, y-axis label with units) of each diagnostic of the store

@@ -11,6 +11,8 @@ this module only gathers them, states the rules and the scale.
 
 from __future__ import annotations
 
+import pandas as pd
+
 from kicktimes.report import (
     autocorrelation,
     counts,
@@ -99,6 +101,16 @@ def section(ctx):
         rule=ctx.exp.rule, rng=ctx.boot_rng(), n_boot=ctx.n_boot, resamples=ctx.resamples,
         kinetic=experiment_kinetic(ctx.exp),
     )
+    if ctx.found.rejections is not None and not ctx.found.rejections.empty:
+        # the Poisson question joins the findings table, under the same controls
+        from kicktimes.report.controls import COLUMNS, Controls, poisson_rows, with_robustness
+
+        extra = pd.DataFrame(poisson_rows(ctx.exp.name, ctx.found.rejections,
+                                          ctx.found.poisson_per_ic, alpha=ctx.alpha,
+                                          rng=ctx.boot_rng(), n_boot=ctx.n_boot),
+                             columns=list(COLUMNS))
+        computed = Controls(with_robustness(pd.concat([computed.table, extra],
+                                                      ignore_index=True)), computed.curves)
     controls = computed.table
     ctx.found.controls = computed
     if paper:  # below paper scale the verdicts answer nothing (the banner says so)

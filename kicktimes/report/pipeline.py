@@ -99,17 +99,28 @@ def __getattr__(name):
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
-def analyse(ctx, *, bar, timings):
-    """Every section of one store: ``(findings section, other sections, notes)``."""
+#: the stages a control experiment needs (`write_results`): its findings table's rows come
+#: from the store and from the Poisson tests
+CONTROL_STAGES = ("Poisson tests", "findings")
+
+
+def analyse(ctx, *, bar, timings, only=None):
+    """Every section of one store: ``(findings section, other sections, notes)``.
+
+    ``only``: the names of the stages to run (e.g. `CONTROL_STAGES`); the others are
+    skipped (still counted on ``bar``)."""
     from kicktimes.report import findings
 
     secs, found = [], None
-    for _, module in _stages():
+    stages = [(n, m) for n, m in _stages() if only is None or n in only]
+    for _ in range(len(_stages()) - len(stages)):
+        bar.advance()
+    for _, module in stages:
         # jobs that need only the store (the Poisson tests) start on the pool now and run
         # while the sections before theirs are computed here
         if ctx.pstart is not None and hasattr(module, "start"):
             module.start(ctx)
-    for stage, module in _stages():
+    for stage, module in stages:
         bar.step(f"{ctx.exp.name}: {stage}")
         t0 = time.perf_counter()
         if module is findings:

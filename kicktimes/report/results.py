@@ -10,8 +10,11 @@ from __future__ import annotations
 
 import datetime as _dt
 import os
+import re
 import time
 from pathlib import Path
+
+import pandas as pd
 
 from kicktimes import __version__
 from kicktimes.report.common import (
@@ -22,11 +25,94 @@ from kicktimes.report.common import (
     load_report_store,
 )
 
-__all__ = ["write_results"]
+__all__ = ["copy_first_screen", "counts_section", "poisson_section", "write_results"]
+
+BEGIN, END = "<!-- results:begin -->", "<!-- results:end -->"
 
 
 def _md_escape(text):
     return text.replace("|", "\\|").replace("\n", " ")
+
+
+def poisson_section(table):
+    """The Markdown of the Poisson question under the rule x IC design: one row per test
+    (and the headline test on the first collisions), one column per (family, control)."""
+    from kicktimes.report.controls import POISSON_QUESTION, markdown_table
+    from kicktimes.stats import format_interval, rejection_rule
+
+    rows = table[table["question"] == POISSON_QUESTION]
+    if rows.empty:
+        return []
+    cells = {}
+    for r in rows.itertuples():
+        cell = format_interval(100 * r.estimate, 100 * r.ci_low, 100 * r.ci_high,
+                               edges=(2.5, 5.0, 7.5))
+        cells.setdefault(r.diagnostic, {})[f"{_short(r.family)}, {r.control}"] = (
+            f"{cell} % {r.verdict}")
+    frame = pd.DataFrame.from_dict(cells, orient="index").rename_axis("test").reset_index()
+    frame["test"] = frame["test"].str.replace("reject@", "", regex=False)
+    robust = rows.groupby("diagnostic", sort=False)["robust"].all()
+    return [
+        "## Are the collision times Poisson? The collision rule as a factor", "",
+        "Share of (radius, IC) runs whose two-disk collision times reject each test at "
+        "α = 0.05, under the 2 × 2 design collision rule (primary: the paper's mirror rule; "
+        "elastic) × initial conditions (the paper's; invariant_ics: the invariant measure), "
+        "with 95 % CIs (the headline uniformity test: bootstrap clustered on ICs; the others: "
+        "Clopper-Pearson). Verdict: " + rejection_rule(0.05) + ". Robust over the design: "
+        + ", ".join(f"{d.replace('reject@', '')} {'✓' if ok else '✗'}"
+                    for d, ok in robust.items()) + ".", "",
+        *markdown_table(frame), ""]
+
+
+def counts_section(table):
+    """The Markdown of the collision counts against kinetic theory under every control."""
+    from kicktimes.report.controls import markdown_table
+    from kicktimes.stats import format_interval
+
+    rows = table[table["diagnostic"] == "counts"]
+    if rows.empty:
+        return []
+    frame = pd.DataFrame({
+        "family": rows["family"].map(_short), "control": rows["control"],
+        "ΣN / ΣΓ(r)T": [format_interval(r.estimate, r.ci_low, r.ci_high)
+                        for r in rows.itertuples()],
+        "verdict": rows["verdict"]})
+    return ["## Do the collision counts follow kinetic theory?", "",
+            "Observed two-disk collisions over the kinetic-theory count Γ(r)T (the rule's own "
+            "Γ), per family and control, 95 % CI (bootstrap clustered on ICs). The paper's "
+            "ICs are not drawn from the invariant measure, so their ratio need not be 1.", "",
+            *markdown_table(frame), ""]
+
+
+def copy_first_screen(page, target):
+    """Replace the block between `BEGIN` and `END` of ``target`` (the repository's README)
+    by the first screen of the generated ``page`` (its "Generated ..." line, the answers,
+    the table and the figure, with links made relative to ``target``), atomically.
+
+    Raises ``ValueError`` when ``target`` has no such block.
+    """
+    from kicktimes.fileio import atomic_write_bytes
+
+    page, target = Path(page), Path(target)
+    lines = page.read_text(encoding="utf-8").splitlines()
+    generated = next(line for line in lines if line.startswith("Generated "))
+    start = lines.index("## The answers") + 1
+    stop = next(k for k in range(start, len(lines)) if lines[k].startswith("## "))
+    rel = os.path.relpath(page.parent, target.parent)
+    body = [generated, ""] + lines[start:stop]
+    body = [re.sub(r"\]\((?!https?:)([^)]+)\)", lambda m: f"]({rel}/{m.group(1)})", line)
+            for line in body]
+    text = target.read_text(encoding="utf-8")
+    if BEGIN not in text or END not in text:
+        raise ValueError(f"{target}: no block between {BEGIN} and {END}")
+    head, rest = text.split(BEGIN, 1)
+    _, tail = rest.split(END, 1)
+    new = head + BEGIN + "\n" + "\n".join(body).strip() + "\n" + END + tail
+    atomic_write_bytes(target, new.encode("utf-8"))
+
+
+def _short(family):
+    return {"family_a": "A", "family_b": "B"}.get(family, family)
 
 
 def write_results(
@@ -60,11 +146,11 @@ def write_results(
     from kicktimes.report.controls import (
         first_screen,
         merge_control_families,
-        poisson_share,
         ratio_curves_figure,
     )
     from kicktimes.report.findings import rules_text, scale_statement
-    from kicktimes.report.pipeline import analyse, n_stages
+    from kicktimes.report.pipeline import CONTROL_STAGES, analyse, n_stages
+    from kicktimes.stats import ratio_rule
 
     paths = [store_paths] if isinstance(store_paths, str | os.PathLike) else list(store_paths)
     if not paths or not all(isinstance(p, str | os.PathLike) for p in paths):
@@ -89,7 +175,8 @@ def write_results(
         "",
     ]
     head = len(lines)
-    controls, curves, shares, gaps = [], [], {}, []
+    controls, curves, gaps, control_lines = [], [], [], []
+    names = {st.experiment.name for st in stores}
     try:
         for st in stores:
             t0 = time.perf_counter()
@@ -100,14 +187,28 @@ def write_results(
                 max_ics_model_fits=check_int("max_ics_model_fits", max_ics_model_fits, 1),
                 pmap=pool.map,
             )
-            findings, secs, notes = analyse(ctx, bar=bar, timings=[])
             name = st.experiment.name
+            family, _, control = name.partition("-")
+            is_control = bool(control) and family in names
+            # a control experiment contributes rows to its family's table: its Poisson
+            # tests and findings are all it needs
+            findings, secs, notes = analyse(ctx, bar=bar, timings=[],
+                                            only=CONTROL_STAGES if is_control else None)
             paper, scale = scale_statement(st)
+            if is_control:
+                controls.append(ctx.found.controls.table)
+                curves.append(ctx.found.controls.curves)
+                findings.tables[0][1].to_csv(out / f"{name}_findings.csv", index=False)
+                control_lines += [f"- `{name}`: {scale}; its primary rows are the control "
+                                  f"`{control}` of {family}'s findings "
+                                  f"([{name}_findings.csv]({name}_findings.csv), built in "
+                                  f"{time.perf_counter() - t0:.0f} s).", ""]
+                continue
             lines += [f"## {name}", ""]
             if not paper:
                 lines += [
-                    f"> **Below paper scale** ({scale}): a smoke test; the verdicts are not "
-                    "evidence.",
+                    f"> **Below paper scale** ({scale}): a pipeline check; its verdicts answer "
+                    "nothing.",
                     "",
                 ]
             else:
@@ -116,7 +217,6 @@ def write_results(
             curves.append(ctx.found.controls.curves)
             if ctx.found.gaps is not None and not ctx.found.gaps.empty:
                 gaps.append(ctx.found.gaps)
-            shares[name] = poisson_share(ctx.found.effects)
             lines += ["### All statements (primary setting)", ""]
             for e in ctx.found.effects:
                 lines.append(
@@ -146,7 +246,8 @@ def write_results(
         if len(stores) > 1:
             from kicktimes.report.pipeline import families_section
 
-            families = families_section(stores)
+            families = families_section([st for st in stores
+                                         if "-" not in st.experiment.name])
             if families is not None:
                 lines += ["## All experiments, the paper's layout", ""]
                 for fname, fig, caption in families.figures:
@@ -156,7 +257,8 @@ def write_results(
         pool.close()
     import pandas as pd
 
-    from kicktimes.report.decomposition import STEPS
+    from kicktimes.report.controls import markdown_table
+    from kicktimes.report.decomposition import STEPS, gap_figure, gap_summary
 
     # control experiments ("<family>-<control>") become rows of their family's table
     merged = merge_control_families(controls)
@@ -166,50 +268,50 @@ def write_results(
         if not c.empty:
             c.to_csv(out / f"{c['family'].iloc[0]}_findings_by_radius.csv", index=False)
     table = pd.concat(list(merged.values()), ignore_index=True)
-    shares = {k: v for k, v in shares.items() if k in merged}
-    screen = ["## The answers", ""] + first_screen(table, shares) + [
-        "The mechanism behind these numbers (stretching per perturbation against ln(1/r) "
-        "down to r = 0.002, decorrelation per perturbation, the collision rate's relaxation, "
-        "the sticky orbits, the cost per unit time): [science.md](science.md), written by "
-        "`python analysis/science.py`.", "",
-        "Every row under every control: " + ", ".join(
-            f"[{st.experiment.name}_findings.csv]({st.experiment.name}_findings.csv)"
-            for st in stores) + "; per radius: " + ", ".join(
-            f"[{st.experiment.name}_findings_by_radius.csv]"
-            f"({st.experiment.name}_findings_by_radius.csv)" for st in stores)
-        + ". Below: per family, the scale, every statement under the primary setting, and "
-        "the figures.", ""]
+    screen = ["## The answers", ""] + first_screen(table)
     curves = pd.concat(curves, ignore_index=True)
     figure = ratio_curves_figure(curves[curves["family"].isin(list(merged))])
     figure.savefig(out / "headline_ratios_vs_radius.png", dpi=dpi)
-    screen[-1:-1] = ["![headline](headline_ratios_vs_radius.png)", "",
-                     "**The ratio to the two-disk value against r**, per diagnostic, with 95 % "
-                     "CIs (bootstrap clustered on ICs) and the ±10 % band (grey); the "
-                     "recurrence panels on uniform-time samples (on the paper's samples the "
-                     "kicked systems' ratios are inflated: see the table).", ""]
+    screen += [
+        "![headline](headline_ratios_vs_radius.png)", "",
+        "**The ratio to the two-disk value against r**, one line per kick law, per diagnostic "
+        "and family: the median of per-IC ratios (robust to the few sticky runs), 95 % CIs "
+        "from a bootstrap clustered on ICs, one log scale for every panel with the ±10 % "
+        "band (grey); recurrence on uniform-time samples.", "",
+        "Verdicts (`kicktimes.stats.ratio_verdict`): " + ratio_rule(0.1) + ". Every row "
+        "under every control: " + ", ".join(f"[{f}_findings.csv]({f}_findings.csv)"
+                                            for f in merged) + ".", ""]
+    screen += poisson_section(table)
     if gaps:
-        from kicktimes.report.controls import markdown_table
-        from kicktimes.report.decomposition import gap_figure, gap_summary
-
         gaps = pd.concat(gaps, ignore_index=True)
         gaps = gaps[gaps["family"].isin(list(merged))]
         gaps.to_csv(out / "gap_decomposition.csv", index=False)
         gap_figure(gaps).savefig(out / "gap_decomposition.png", dpi=dpi)
         summary = gap_summary(gaps)
-        shown = summary[["family", "diagnostic", "setting", *STEPS]]
-        screen[-1:-1] = [
-            "**Which ingredient of a collision closes the gap?** The share of the paper's "
-            "kicked-disk gap |log(kicked / two-disk)| closed by the scatter kick (deflection "
-            "law), then by the kinetic rate of the disk's own angular momentum "
-            "(state-dependent timing), and left to partner memory and re-collisions (95 % CI, "
-            "one bootstrap clustered on ICs for the three systems; a share is *robust* when "
-            "every control puts its interval on the same side of 0: "
-            + "; ".join(f"{r['family']} {r['diagnostic']}: "
-                        + ", ".join(("✓" if r[f"{s} robust"] else "✗") for s in STEPS)
-                        for _, r in summary.iterrows()) + "):", "",
+        shown = summary[["family", "diagnostic"]].copy()
+        for step in STEPS:
+            shown[step] = summary[step] + " " + summary[f"{step} robust"]
+        screen += [
+            "## Which ingredient of a collision closes the gap?", "",
+            "The 2 × 2 factorial of kicks, deflection law (uniform / scatter kick) × timing "
+            "(Poisson / the kinetic rate of the disk's own angular momentum), and the Shapley "
+            "shares (both orders averaged) of the paper's gap |log(kicked / two-disk)| closed "
+            "by each ingredient, with 95 % CIs from one bootstrap clustered on ICs; the "
+            "remainder is what no kick law has (partner memory, re-collisions) and is not "
+            "measured. A gap whose CI touches the ±10 % band is not decomposed. ✓: every "
+            "control (paired median, sticky runs excluded, the paper's samples for "
+            "recurrence) puts the share's CI on the same side of 0 and none straddles 0; ✗ "
+            "names the control that does not.", "",
             *markdown_table(shown), "",
             "![gap decomposition](gap_decomposition.png)", "",
             "Every control: [gap_decomposition.csv](gap_decomposition.csv).", ""]
+    screen += counts_section(table)
+    if control_lines:
+        screen += ["## The control experiments", ""] + control_lines
+    screen += [
+        "The mechanism behind these numbers: [science.md](science.md), written by "
+        "`python analysis/science.py`. Below: per family, the scale, every statement under "
+        "the primary setting, and the figures.", ""]
     lines[head:head] = screen
     path = out / "README.md"
     path.write_text("\n".join(lines), encoding="utf-8")

@@ -30,7 +30,15 @@ from .comparison import VuongResult, compare_models, vuong
 from .counts import CountRegression, kinetic_rate, regress_counts
 from .distributions import hyperexpon
 from .ensemble import PoissonEnsembleResult, test_poisson_ensemble
-from .findings import Finding, ratio_rule, ratio_verdict
+from .findings import (
+    Finding,
+    format_interval,
+    ratio_rule,
+    ratio_verdict,
+    rejection_rule,
+    rejection_verdict,
+    robust_verdict,
+)
 from .gof import GofResult, goodness_of_fit
 from .groups import PoissonGroup, poisson_group, pooled_intervals
 from .hazard import HazardTable, interval_hazard
@@ -90,6 +98,10 @@ __all__ = [
     "FitWarning",
     "Finding",
     "ratio_verdict",
+    "robust_verdict",
+    "format_interval",
+    "rejection_verdict",
+    "rejection_rule",
     "ratio_rule",
     "interval_hazard",
     "HazardTable",

@@ -27,6 +27,10 @@ __all__ = [
     "findings_table",
     "ratio_verdict",
     "ratio_rule",
+    "robust_verdict",
+    "format_interval",
+    "rejection_verdict",
+    "rejection_rule",
     "share_verdict",
     "SHARE_RULE",
     "clopper_pearson",
@@ -50,33 +54,132 @@ def ratio_rule(tolerance=0.1) -> str:
     p, lo, hi = f"{100 * tolerance:g}", f"{1 - tolerance:g}", f"{1 + tolerance:g}"
     return (
         f"within {p} %: the whole 95 % CI of the ratio lies in [{lo}, {hi}] (the two values "
-        f"agree to {p} %; a CI inside the band may still exclude 1, which then measures a "
-        f"real difference smaller than the band); differs: the CI lies entirely outside "
-        f"[{lo}, {hi}]; inconclusive: the CI straddles a band edge"
+        f"agree to {p} %, an equivalence test with a margin stated in advance; a CI inside "
+        f"the band may still exclude 1, which then measures a real difference smaller than "
+        f"the band); higher: the CI lies entirely above {hi}; lower: it lies entirely below "
+        f"{lo}; inconclusive: the CI straddles a band edge. Robust: every control gives the "
+        f"same verdict and no control's CI lies above 1 while another's lies below 1"
     )
 
 
 def ratio_verdict(low, high, tolerance=0.1):
-    """``"within 10 %"``, ``"differs"`` or ``"inconclusive"`` for a ratio's 95 % CI.
+    """``"within 10 %"``, ``"higher"``, ``"lower"`` or ``"inconclusive"`` for a ratio's 95 % CI.
 
-    The verdict of every ratio kicktimes states (:func:`ratio_rule` prints it): *within* when the
-    whole interval lies in ``[1 - tolerance, 1 + tolerance]``, *differs* when it lies
-    entirely outside, *inconclusive* otherwise (and when an endpoint is not finite).
+    The verdict of every ratio kicktimes states (:func:`ratio_rule` prints it): *within* when
+    the whole interval lies in ``[1 - tolerance, 1 + tolerance]`` (an equivalence test),
+    *higher* when it lies entirely above ``1 + tolerance``, *lower* when it lies entirely
+    below ``1 - tolerance``, *inconclusive* otherwise (and when an endpoint is not finite).
+    Decide on unrounded values; print with :func:`format_interval`.
 
     Examples
     --------
-    >>> ratio_verdict(0.95, 1.04), ratio_verdict(0.3, 0.4), ratio_verdict(0.85, 1.0)
-    ('within 10 %', 'differs', 'inconclusive')
-    >>> ratio_verdict(0.8, 1.2, tolerance=0.25)
-    'within 25 %'
+    >>> ratio_verdict(0.95, 1.04), ratio_verdict(0.3, 0.4), ratio_verdict(1.2, 1.9)
+    ('within 10 %', 'lower', 'higher')
+    >>> ratio_verdict(0.85, 1.0), ratio_verdict(0.8, 1.2, tolerance=0.25)
+    ('inconclusive', 'within 25 %')
     """
     if not (np.isfinite(low) and np.isfinite(high)):
         return "inconclusive"
     if low >= 1 - tolerance and high <= 1 + tolerance:
         return f"within {100 * tolerance:g} %"
-    if high < 1 - tolerance or low > 1 + tolerance:
-        return "differs"
+    if high < 1 - tolerance:
+        return "lower"
+    if low > 1 + tolerance:
+        return "higher"
     return "inconclusive"
+
+
+def robust_verdict(verdicts, lows, highs, level=1.0):
+    """Whether a comparison keeps its verdict and its direction under every control.
+
+    ``(robust, reason)``: robust when every control gives the same verdict **and** no
+    control's CI lies entirely above ``level`` while another's lies entirely below it (a
+    change of direction is never robust, even when both sides "differ"). ``reason`` names
+    what breaks it: ``""``, ``"verdict"`` or ``"direction"``.
+
+    Examples
+    --------
+    >>> robust_verdict(["lower", "lower"], [0.3, 0.31], [0.33, 0.35])
+    (True, '')
+    >>> robust_verdict(["higher", "lower"], [1.85, 0.75], [1.9, 0.8])
+    (False, 'direction')
+    >>> robust_verdict(["inconclusive", "inconclusive"], [1.08, 0.89], [1.16, 0.95])
+    (False, 'direction')
+    >>> robust_verdict(["within 10 %", "inconclusive"], [0.95, 0.85], [1.05, 1.0])
+    (False, 'verdict')
+    """
+    lows, highs = np.asarray(lows, float), np.asarray(highs, float)
+    if (lows > level).any() and (highs < level).any():
+        return False, "direction"
+    if len(set(verdicts)) > 1:
+        return False, "verdict"
+    return True, ""
+
+
+def format_interval(estimate, low, high, *, edges=(0.9, 1.0, 1.1), digits=3):
+    """``"0.886 [0.883, 0.892]"``: three significant digits, more where rounding would move
+    an endpoint across one of ``edges`` (the band and 1) or merge distinct endpoints, so
+    that the printed interval shows the verdict it was given.
+
+    Examples
+    --------
+    >>> format_interval(0.913, 0.89996, 0.927)
+    '0.91300 [0.89996, 0.92700]'
+    >>> format_interval(0.889, 0.886, 0.892)
+    '0.889 [0.886, 0.892]'
+    >>> format_interval(0.32, 0.3219, 0.3273)
+    '0.320 [0.322, 0.327]'
+    """
+    def side(x, e):
+        return int(x > e) - int(x < e)
+
+    def text(x, d):
+        return f"{x:#.{d}g}".rstrip(".") if np.isfinite(x) else "n/a"
+
+    estimate, low, high = float(estimate), float(low), float(high)
+    for d in range(digits, 8):
+        lo, hi = (float(text(v, d)) if np.isfinite(v) else v for v in (low, high))
+        ok = all(side(lo, e) == side(low, e) and side(hi, e) == side(high, e) for e in edges)
+        if ok and (lo < hi or not low < high):
+            break
+    return f"{text(estimate, d)} [{text(low, d)}, {text(high, d)}]"
+
+
+def rejection_verdict(low, high, alpha, margin=0.5):
+    """The verdict on a share of runs that reject a test at level ``alpha``.
+
+    ``"nominal"`` when the 95 % CI lies in ``[alpha (1 - margin), alpha (1 + margin)]`` (an
+    equivalence test: the runs reject as often as a process that satisfies the null);
+    ``"above nominal"`` when it lies entirely above that band (the null fails in more runs
+    than the test's size allows); ``"below nominal"`` when entirely below; ``"inconclusive"``
+    otherwise.
+
+    Examples
+    --------
+    >>> rejection_verdict(0.37, 0.41, 0.05), rejection_verdict(0.037, 0.054, 0.05)
+    ('above nominal', 'nominal')
+    >>> rejection_verdict(0.03, 0.09, 0.05)
+    'inconclusive'
+    """
+    if not (np.isfinite(low) and np.isfinite(high)):
+        return "inconclusive"
+    lo_band, hi_band = alpha * (1 - margin), alpha * (1 + margin)
+    if low >= lo_band and high <= hi_band:
+        return "nominal"
+    if low > hi_band:
+        return "above nominal"
+    if high < lo_band:
+        return "below nominal"
+    return "inconclusive"
+
+
+def rejection_rule(alpha=0.05, margin=0.5) -> str:
+    """The printed rule of :func:`rejection_verdict`."""
+    lo, hi = alpha * (1 - margin), alpha * (1 + margin)
+    return (f"nominal: the 95 % CI of the share of runs rejected at α = {alpha:g} lies in "
+            f"[{lo:g}, {hi:g}] (the share a process satisfying the null gives, within "
+            f"{100 * margin:g} % of α); above / below nominal: it lies entirely above / below "
+            "that band; inconclusive otherwise")
 
 
 def share_verdict(low, high, level):
@@ -356,7 +459,8 @@ def _reference(res):
     verdict = (
         verdicts[0]
         if len(set(verdicts)) == 1
-        else (f"{verdicts.count('within 10 %')}/{len(verdicts)} groups within 10 %")
+        else "; ".join(f"{_label(res, r.group)}{v}" for r, v in zip(ref.itertuples(), verdicts,
+                                                                      strict=True))
     )
     text = (
         f"Observed / reference rate ({res.reference_column}) with 95 % CI: "

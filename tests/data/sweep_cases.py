@@ -34,7 +34,8 @@ def experiments():
         small("quick_a", name="uniform", n_steps=600, sampling="uniform",
               lyapunov_variant="norm"),
         small("quick_b", name="elastic", n_steps=600, rule="elastic", kick_angle="gaussian",
-              sigma=0.5, systems=[s for s in preset("quick_b").systems if s != "poisson_kinetic"]),
+              sigma=0.5, systems=[s for s in preset("quick_b").systems
+                                  if s not in ("poisson_kinetic", "uniform_kinetic")]),
         dataclasses.replace(preset("quick_a"), name="mmpp", radii=[0.1, 0.2], n_ics=3,
                             block_size=3, n_steps=1500, systems=["two_particle", "poisson",
                                                                  "mmpp"]),

@@ -1,0 +1,72 @@
+"""The committed results (docs/results) say no more than their numbers.
+
+The findings tables that ``python analysis/make_results.py`` writes are checked as a
+referee would: every verdict agrees with its own interval (the rules of
+:mod:`kicktimes.stats`), no comparison flagged robust changes direction between controls,
+the Poisson question is there under the collision rule x IC design, and the first screen
+of the page is short.
+"""
+
+from pathlib import Path
+
+import pandas as pd
+import pytest
+
+from kicktimes.stats import ratio_verdict, rejection_verdict
+
+RESULTS = Path(__file__).resolve().parents[1] / "docs" / "results"
+TABLES = sorted(RESULTS.glob("*_findings.csv"))
+FAMILIES = [t for t in TABLES if "-" not in t.name]
+
+
+def _table(path):
+    return pd.read_csv(path, keep_default_na=False, na_values=[""])
+
+
+@pytest.mark.parametrize("path", TABLES, ids=[t.name for t in TABLES])
+def test_every_verdict_is_the_one_its_interval_gives(path):
+    table = _table(path)
+    poisson = table["question"] == "Poisson collision times?"
+    for row in table[~poisson].itertuples():
+        assert row.verdict == ratio_verdict(row.ci_low, row.ci_high), row
+    for row in table[poisson].itertuples():
+        assert row.verdict == rejection_verdict(row.ci_low, row.ci_high, 0.05), row
+
+
+@pytest.mark.parametrize("path", TABLES, ids=[t.name for t in TABLES])
+def test_no_comparison_flagged_robust_changes_direction(path):
+    table = _table(path)
+    ratios = table[table["question"] != "Poisson collision times?"]
+    for key, group in ratios.groupby(["family", "diagnostic", "system"]):
+        if group["robust"].astype(str).str.lower().eq("true").all():
+            assert not ((group["ci_low"] > 1).any() and (group["ci_high"] < 1).any()), key
+            assert group["verdict"].nunique() == 1, key
+
+
+@pytest.mark.parametrize("path", FAMILIES, ids=[t.name for t in FAMILIES])
+def test_every_kicked_system_is_under_every_control(path):
+    table = _table(path)
+    needed = {"primary", "paired_median", "sticky_excluded", "invariant_ics", "elastic",
+              "elastic+invariant_ics"}
+    for diagnostic in ("ftle", "rr_offdiag@0.01"):
+        part = table[table["diagnostic"] == diagnostic]
+        for system, rows in part.groupby("system"):
+            want = set(needed)
+            if system in ("poisson_kinetic", "uniform_kinetic"):
+                want -= {"elastic", "elastic+invariant_ics"}  # mirror rule only
+            if diagnostic.startswith("rr"):
+                want |= {"uniform_sampling", "paper_sampling"}
+            assert want <= set(rows["control"]), (diagnostic, system)
+    poisson = table[table["question"] == "Poisson collision times?"]
+    assert {"primary", "invariant_ics", "elastic", "elastic+invariant_ics"} <= set(
+        poisson["control"])
+
+
+def test_the_first_screen_is_short_and_generated():
+    text = (RESULTS / "README.md").read_text(encoding="utf-8")
+    assert "\nGenerated " in text
+    screen = text.split("## The answers", 1)[1].lstrip("\n")
+    prose = screen.split("\n|", 1)[0]
+    assert len(prose) <= 1200, len(prose)
+    header = screen.split("\n|", 1)[1].split("\n", 1)[0]
+    assert header.count("|") - 1 <= 8
