@@ -182,7 +182,7 @@ def test_recurrence_plot_inset_shows_diagonal_lines_away_from_the_main_diagonal(
     assert y0 > x1  # not the main diagonal
     red = [ln for ln in inset.get_lines() if ln.get_color() == "tab:red"]
     assert len(red) == 1 and len(red[0].get_xdata()) == 6
-    assert "6 of 6 pairs on lines" in inset.get_title()
+    assert any("6 of 6 pairs on lines" in t.get_text() for t in inset.texts)
 
 
 @pytest.mark.parametrize(

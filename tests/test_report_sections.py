@@ -244,8 +244,18 @@ def test_recurrence_figure_counts_the_means_above_the_axis():
     fig = recurrence.rr_figure(rows, store.experiment)
     (ax,) = [ax for ax in fig.axes if ax.get_title().startswith("off-diagonal RR (pairs i ≠ j)"
                                                                  ", ε = 0.001")]
-    assert "1 mean(s) above the axis (r = 0.014" in ax.get_title()
+    assert "1 mean(s) above the axis (r = 0.014: 1)" in ax.get_title()
     assert ax.get_ylim()[0] == 0 and ax.get_ylim()[1] < 1.0
+    # a mean a little above the rest, from 0 no outlier, is drawn inside the axis
+    near = res["value"].where(~far, 2 * res.loc[far, "value"].max())
+    store.results = res.assign(value=near)
+    rows, _ = recurrence.recurrence_rows(store.results, store.experiment)
+    fig = recurrence.rr_figure(rows, store.experiment)
+    (ax,) = [ax for ax in fig.axes if ax.get_title().startswith("off-diagonal RR (pairs i ≠ j)"
+                                                                 ", ε = 0.001")]
+    assert "above the axis" not in ax.get_title()
+    assert ax.get_ylim()[1] > 2 * res.loc[far, "value"].max()
+    assert not [t for t in ax.texts if t.get_text().endswith("↑")]
 
 
 def test_family_figure_has_one_row_per_store_with_uniform_samples_where_present():

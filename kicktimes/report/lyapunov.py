@@ -95,7 +95,7 @@ def stretching_figure(summary, table, *, title=None):
         and error bars of (a) and (b), one for the differences of (c)), so no legend
         covers a point.
     """
-    fig = Figure(figsize=(14.0, 4.4), layout="constrained")
+    fig = Figure(figsize=(14.0, 5.6), layout="constrained")  # room for the legends below
     ax1, ax2, ax3 = fig.subplots(1, 3)
     diagnostic_vs_radius(summary, "lyapunov", ax=ax1, title="(a) FTLE λ", medians=True)
     systems = [s for s in (REFERENCE, *kicked_systems(table)) if s in distinct(table, "system")]
@@ -133,7 +133,7 @@ def stretching_figure(summary, table, *, title=None):
         ax3.set_xlim(0.9 * grid.min(), 1.05 * grid.max())
     # ln(1/r) is a pure number; the identity line reads it as nats per collision
     ax3.set_xlabel("ln(1/r), r the disk radius in table radii (dimensionless)")
-    ax3.set_ylabel("excess stretching per perturbation (nats)")
+    ax3.set_ylabel("excess λ/Γ (nats per perturbation)")
     ax3.set_title("(c) excess of a collision over a kick")
     # legends outside the axes: inside, (a)'s legend hid two-disk points at r = 0.012-0.016
     handles, labels = ax1.get_legend_handles_labels()

@@ -108,6 +108,12 @@ def sampling_statement(exp):
             f"The recurrence rates use samples at k·τ (τ = {exp.tau:g}) over each run's "
             "horizon, from a uniformly sampled re-run of the same trajectory with the same kicks."
         )
+    uniform = (
+        f" The rows uniform_* (rr_sampling = 'run+uniform') use samples at k·τ (τ = "
+        f"{exp.tau:g}) over each run's horizon, from a uniformly sampled re-run of the same "
+        "trajectory with the same kicks."
+        if rr_sampling == "run+uniform" else ""
+    )
     what = (
         "the paper's collision-truncated steps (a step ends early at every collision, so "
         "samples cluster at collisions and many off-diagonal recurrences at small ε are pairs "
@@ -117,7 +123,7 @@ def sampling_statement(exp):
     )
     return (
         f"The recurrence rates use the run's own {n_samples(exp)} samples (initial point and "
-        f"{exp.n_steps} steps): {what}."
+        f"{exp.n_steps} steps): {what}." + uniform
     )
 
 
@@ -140,7 +146,26 @@ def _sampling_words(prefix):
 def _panel(ax, summary, name, title, ylabel, n):
     """One quantity against radius: mean ± bars per system (no medians: with seven
     systems they would double the series), the axis from 0, and the number and radii of
-    the means above the axis written in the title."""
+    the means above the axis written in the title.
+
+    Parameters
+    ----------
+    ax : matplotlib Axes
+    summary : pandas.DataFrame
+        :func:`~kicktimes.report.summary.diagnostic_summary` output.
+    name : str
+        The row name drawn, e.g. ``"uniform_rr_offdiag@0.001"``.
+    title, ylabel : str
+    n : int
+        Samples per run (the 1/N guide of the paper's RR).
+
+    Notes
+    -----
+    The y range from 0 covers every mean unless the largest is more than 2.5 times the
+    top of :func:`~kicktimes.report.summary.diagnostic_vs_radius`'s robust range; then
+    the means above are written at the top edge and counted, with radius and value, in
+    the title.
+    """
     q = name.split("@")[0].removeprefix(UNIFORM)
     part = summary[summary["diagnostic"] == name]
     diagnostic_vs_radius(part, name, ax=ax, medians=False, title=title, ylabel=ylabel)
@@ -152,12 +177,23 @@ def _panel(ax, summary, name, title, ylabel, n):
         ax.axhline(1.0 / n, color="grey", linestyle="--", linewidth=0.8)
         ax.text(0.02, 0.45, f"dashed: 1/N = {1.0 / n:.3g}, the main diagonal alone",
                 transform=ax.transAxes, fontsize="x-small", color="grey")
-    ax.set_ylim(0.0, top)  # every rate and DET from 0
+    # every rate and DET from 0; from 0, a mean a little above the robust range is no
+    # outlier: show every mean unless the largest is far (> 2.5x) above the range's top
+    # (a long bar may still leave the axis)
+    full = float(np.nanmax(part["mean"].to_numpy(float)))
+    if np.isfinite(full) and full <= 2.5 * top:
+        top = max(top, 1.08 * full)
+        for note in [t for t in ax.texts if t.get_text().endswith(("↑", "↓"))]:
+            note.remove()  # the clipping notes of diagnostic_vs_radius: nothing is clipped
+    ax.set_ylim(0.0, top)
     above = part[part["mean"] > top]
     if len(above):
-        where = ", ".join(f"{r:g}" for r in sorted(above["radius"].unique()))
-        ax.set_title(f"{title}\n{len(above)} mean(s) above the axis (r = {where}; "
-                     "values at the top edge)", fontsize="small")
+        above = above.sort_values(["radius", "mean"])
+        where = "; ".join(f"r = {row.radius:g}: {row.mean:.3g}"
+                          for row in above.head(4).itertuples())
+        more = f"; {len(above) - 4} more" if len(above) > 4 else ""
+        ax.set_title(f"{title}\n{len(above)} mean(s) above the axis ({where}{more})",
+                     fontsize="small")
 
 
 def rr_figure(rows, exp, *, radii=None, title=None):

@@ -81,6 +81,9 @@ def model_comparison(per_ic, pooled, *, models=None, x="radius", xlabel=None):
         ax1.bar(at, y, width=bar, color=colour[m], label=m,
                 yerr=np.vstack([y - low, high - y]),
                 error_kw={"elinewidth": 0.9, "capsize": 2.0, "ecolor": "black"})
+        # a share of 0 has no bar: a dash in the model's colour says which interval it is
+        ax1.plot(at, y, linestyle="none", marker="_", markersize=6, markeredgewidth=2,
+                 color=colour[m])
     for at, n in zip(r, total, strict=True):
         ax1.text(at, 1.02, f"n = {int(n)}", ha="center", va="bottom", fontsize="x-small")
     for ax, empty in ((ax1, per_ic.empty), (ax2, pooled.empty)):

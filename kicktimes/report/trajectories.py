@@ -329,8 +329,11 @@ def _line_inset(ax, i, j, n, zoom, scale):
     inset.set_aspect("equal")
     inset.tick_params(labelsize="xx-small")
     n_line = int((sel & lines).sum())
-    inset.set_title(f"{zoom} x {zoom} samples: {n_line} of {int(sel.sum())} pairs on lines "
-                    "of length ≥ 2 (red)", fontsize="xx-small")
+    # inside the inset, on white: above it the text would cross the main plot's dots
+    inset.text(0.03, 0.97, f"{zoom} x {zoom} samples:\n{n_line} of {int(sel.sum())} pairs on "
+               "lines\nof length ≥ 2 (red)", transform=inset.transAxes, fontsize="xx-small",
+               va="top", bbox={"boxstyle": "round,pad=0.2", "fc": "white", "ec": "none",
+                               "alpha": 0.85})
     ax.indicate_inset_zoom(inset, edgecolor="tab:red")
 
 
