@@ -413,6 +413,16 @@ def test_model_comparison_shares_add_up_to_one():
     assert [seg[0][1] for seg in segments] == pytest.approx(low)
     assert [seg[1][1] for seg in segments] == pytest.approx(high)
     assert {t.get_text() for t in ax1.texts} >= {"n = 3", "n = 2"}
+
+
+def test_model_comparison_states_a_common_n_once_for_many_radii():
+    radii = np.repeat([0.008, 0.01, 0.012, 0.014, 0.016, 0.018], 12)
+    per_ic = pd.DataFrame({"radius": radii, "best_model": ["gamma", "exponential"] * 36})
+    pooled = pd.DataFrame({"radius": [0.01], "model": ["gamma"], "delta_aic": [0.0]})
+    ax1 = plots.model_comparison(per_ic, pooled).axes[0]
+    assert "n = 12 ICs fitted at every radius" in ax1.get_title()
+    assert not [t for t in ax1.texts if t.get_text().startswith("n = ")]
+    assert all(c.errorbar is not None for c in ax1.containers if hasattr(c, "errorbar"))
     with pytest.raises(ValueError, match="non-negative"):
         plots.model_comparison(per_ic, pooled.assign(delta_aic=-1.0))
 

@@ -47,7 +47,8 @@ def model_comparison(per_ic, pooled, *, models=None, x="radius", xlabel=None):
     matplotlib.figure.Figure
         (a) one bar per model and radius: the share of ICs for which the model is
         AIC-best, with its Clopper-Pearson 95 % interval (:func:`binomial_ci`), and the
-        number n of ICs fitted on top of each group; (b) pooled ΔAIC per model on a
+        number n of ICs fitted on top of each group (in the title instead when more than
+        four groups all have the same n); (b) pooled ΔAIC per model on a
         symmetric-log axis, with the usual ΔAIC = 2 and 10 guides.
     """
     axis = x_axis(x, xlabel)
@@ -62,8 +63,11 @@ def model_comparison(per_ic, pooled, *, models=None, x="radius", xlabel=None):
     if models is None:
         models = list(dict.fromkeys([*pooled["model"], *per_ic["best_model"]]))
     colour = {m: f"C{k}" for k, m in enumerate(models)}
-    fig = Figure(figsize=(11.0, 4.4), layout="constrained")
-    ax1, ax2 = fig.subplots(1, 2)
+    # panel (a) holds one bar per model and x value: wider with many x values
+    n_x = max(per_ic[x].nunique(), 1)
+    wide_a = min(2.0, max(1.0, n_x * max(len(models), 1) / 24))
+    fig = Figure(figsize=(5.5 * (1 + wide_a), 4.6), layout="constrained")
+    ax1, ax2 = fig.subplots(1, 2, width_ratios=[wide_a, 1])
     counts = pd.crosstab(per_ic[x], per_ic["best_model"]).reindex(
         columns=models, fill_value=0
     )
@@ -84,8 +88,12 @@ def model_comparison(per_ic, pooled, *, models=None, x="radius", xlabel=None):
         # a share of 0 has no bar: a dash in the model's colour says which interval it is
         ax1.plot(at, y, linestyle="none", marker="_", markersize=6, markeredgewidth=2,
                  color=colour[m])
+    # n on top of each group, or once in the title when every one of many groups has the
+    # same n (twelve "n = 12" run into each other)
+    same_n = r.size > 4 and total.nunique() == 1
     for at, n in zip(r, total, strict=True):
-        ax1.text(at, 1.02, f"n = {int(n)}", ha="center", va="bottom", fontsize="x-small")
+        if not same_n:
+            ax1.text(at, 1.02, f"n = {int(n)}", ha="center", va="bottom", fontsize="x-small")
     for ax, empty in ((ax1, per_ic.empty), (ax2, pooled.empty)):
         if empty:
             ax.text(
@@ -98,10 +106,15 @@ def model_comparison(per_ic, pooled, *, models=None, x="radius", xlabel=None):
             )
     ax1.set_ylim(0, 1.12)
     axis.draw(ax1)
+    if x == "radius" and 4 < r.size <= 20:  # a tick under every group of bars
+        ax1.set_xticks(r, [f"{v:g}" for v in r], fontsize="small")
     nouns = axis.nouns
     ax1.set_ylabel(f"share of {nouns.many} where the model is AIC-best")
-    ax1.set_title(f"(a) per {nouns.one}: share ± Clopper-Pearson 95 %\n"
-                  f"(n = number of {nouns.many} fitted, on top)", fontsize="medium")
+    where = (f"n = {int(total.iloc[0])} {nouns.many} fitted at every "
+             + ("radius" if x == "radius" else (xlabel or x))
+             if same_n else f"n = number of {nouns.many} fitted, on top")
+    ax1.set_title(f"(a) per {nouns.one}: share ± Clopper-Pearson 95 %\n({where})",
+                  fontsize="medium")
     for m in models:
         part = pooled[pooled["model"] == m].sort_values(x)
         if len(part):
