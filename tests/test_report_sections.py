@@ -525,3 +525,21 @@ def test_one_writer_writes_the_page_of_the_report_and_of_kicktimes_analyze(tmp_p
             '<li><a href="#v">V</a></li></ul>') in text
     assert text.endswith("<h3 id='s'>S</h3><p>end</p></body></html>")
     assert not list(tmp_path.glob("*.tmp*"))  # written atomically
+
+
+def test_recurrence_plot_section_names_the_system_and_eps_and_zooms_on_lines():
+    from kicktimes.experiment import Experiment
+    from kicktimes.report import trajectories
+
+    exp = Experiment(name="tiny", radii=[0.014, 0.02], n_ics=1, n_steps=600, tau=0.3,
+                     eps=[0.05])
+    results = pd.DataFrame({"radius": [], "ic": [], "system": [], "diagnostic": [],
+                            "value": []})
+    store = SimpleNamespace(experiment=exp, results=results)
+    (sec,) = [s for s in trajectories.sections(Context(store)) if s.key == "recurrence_plot"]
+    name, fig, caption = sec.figures[0]
+    title = fig.axes[0].get_title()
+    assert "two-disk billiard" in title and "ε = 0.05" in title and "r = 0.02" in title
+    assert "length ≥ 2" in caption
+    (inset,) = fig.axes[0].child_axes
+    assert any("pairs on lines" in t.get_text() for t in inset.texts)
