@@ -421,8 +421,6 @@ def sections(ctx):
                     + ", ".join(f"{r:g}" for r in g["radius"])
                     for sys_, g in crossing.groupby("system")) + "." if len(crossing) else "")
             )
-            sec.table("autocorrelation_crossings", cross,
-                      "Crossings of each kicked R_l curve with the two-disk one", show=False)
         sec.table("autocorrelation_curves", curves, "R_l per lag", show=False)
     rows = []
     pred = predicted.groupby(["radius", "system"])["value"].mean()
