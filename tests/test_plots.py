@@ -522,6 +522,9 @@ def test_rate_heterogeneity_draws_the_dispersion_without_the_sticky_runs():
     fig = plots.rate_heterogeneity(coll, sticky=flags)
     (without,) = [ln for ln in fig.axes[1].get_lines() if ln.get_gid() == "sticky_excluded"]
     assert "1 sticky IC" in without.get_label()
+    fig = plots.rate_heterogeneity(coll, sticky=np.zeros(len(coll), bool))
+    (without,) = [ln for ln in fig.axes[1].get_lines() if ln.get_gid() == "sticky_excluded"]
+    assert "(none: the same curve)" in without.get_label()
     fig = plots.rate_heterogeneity(coll, sticky=None)
     assert not [ln for ln in fig.axes[1].get_lines() if ln.get_gid() == "sticky_excluded"]
     with pytest.raises(ValueError, match="one flag per row"):

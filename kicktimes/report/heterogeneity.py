@@ -188,7 +188,8 @@ def rate_heterogeneity(collisions, *, homogeneity=None, rule="mirror", max_point
             markerfacecolor="none",
             color="tab:orange",
             linestyle="--" if axis.line != "none" else "none",
-            label=f"without the {int(flag.sum())} sticky {nouns.many}",
+            label=(f"without the {int(flag.sum())} sticky {nouns.many}" if flag.any()
+                   else f"without sticky {nouns.many} (none: the same curve)"),
             gid="sticky_excluded",
         )
         for at, k in n_out.items():
