@@ -12,6 +12,7 @@ import pytest
 from matplotlib.figure import Figure
 
 from kicktimes import initial_conditions, plots, simulate_two_particle, stats
+from kicktimes.report.trajectories import line_pairs
 
 # ------------------------------------------------------------------ synthetic data
 # Tables with exactly the store's columns (docs: contracts / docs/experiments.md).
@@ -157,6 +158,31 @@ def test_recurrence_plot_never_builds_an_n_by_n_array():
     finally:
         tracemalloc.stop()
     assert peak < 200e6
+
+
+def test_line_pairs_are_the_pairs_on_diagonal_lines_off_the_main_diagonal():
+    # a line (2, 7), (3, 8), (4, 9); an isolated pair (0, 5); the main diagonal
+    i = np.array([0, 2, 3, 4, 0, 1, 2, 3, 4])
+    j = np.array([5, 7, 8, 9, 0, 1, 2, 3, 4])
+    on = line_pairs(i, j, 10)
+    assert on.tolist() == [False, True, True, True, False, False, False, False, False]
+
+
+def test_recurrence_plot_inset_shows_diagonal_lines_away_from_the_main_diagonal():
+    n = 400
+    diag = np.arange(n)
+    line = np.arange(300, 306)  # a line of length 6 at j = i - 250, far off the diagonal
+    i = np.concatenate([diag, line - 250, line, [10, 380]])
+    j = np.concatenate([diag, line, line - 250, [200, 20]])
+    fig = plots.recurrence_plot((i, j), n_points=n, zoom=40)
+    (inset,) = fig.axes[0].child_axes
+    x0, x1 = inset.get_xlim()
+    y0, y1 = inset.get_ylim()
+    assert x0 <= 50 and x1 >= 56 and y0 <= 300 and y1 >= 306  # the line, whole
+    assert y0 > x1  # not the main diagonal
+    red = [ln for ln in inset.get_lines() if ln.get_color() == "tab:red"]
+    assert len(red) == 1 and len(red[0].get_xdata()) == 6
+    assert any("6 of 6 pairs on lines" in t.get_text() for t in inset.texts)
 
 
 @pytest.mark.parametrize(
@@ -374,10 +400,29 @@ def test_model_comparison_shares_add_up_to_one():
     assert_labelled(fig)
     ax1 = fig.axes[0]
     tops = {}
-    for bar in ax1.patches:
-        x = round(bar.get_x() + bar.get_width() / 2, 6)
+    for bar in ax1.patches:  # one bar per model beside the others, grouped at the radius
+        x = min((0.01, 0.02), key=lambda r: abs(r - (bar.get_x() + bar.get_width() / 2)))
         tops[x] = tops.get(x, 0) + bar.get_height()
-    assert all(v == pytest.approx(1.0) for v in tops.values())
+    assert tops == {0.01: pytest.approx(1.0), 0.02: pytest.approx(1.0)}
+    # every share has its Clopper-Pearson 95 % interval, and n is written per radius
+    bars = [c for c in ax1.containers if hasattr(c, "errorbar")]
+    assert len(bars) == 3 and all(c.errorbar is not None for c in bars)
+    gamma = next(c for c in bars if c.get_label() == "gamma")
+    segments = gamma.errorbar.lines[2][0].get_segments()
+    low, high = plots.binomial_ci([2, 1], [3, 2])
+    assert [seg[0][1] for seg in segments] == pytest.approx(low)
+    assert [seg[1][1] for seg in segments] == pytest.approx(high)
+    assert {t.get_text() for t in ax1.texts} >= {"n = 3", "n = 2"}
+
+
+def test_model_comparison_states_a_common_n_once_for_many_radii():
+    radii = np.repeat([0.008, 0.01, 0.012, 0.014, 0.016, 0.018], 12)
+    per_ic = pd.DataFrame({"radius": radii, "best_model": ["gamma", "exponential"] * 36})
+    pooled = pd.DataFrame({"radius": [0.01], "model": ["gamma"], "delta_aic": [0.0]})
+    ax1 = plots.model_comparison(per_ic, pooled).axes[0]
+    assert "n = 12 ICs fitted at every radius" in ax1.get_title()
+    assert not [t for t in ax1.texts if t.get_text().startswith("n = ")]
+    assert all(c.errorbar is not None for c in ax1.containers if hasattr(c, "errorbar"))
     with pytest.raises(ValueError, match="non-negative"):
         plots.model_comparison(per_ic, pooled.assign(delta_aic=-1.0))
 
@@ -431,18 +476,59 @@ def test_rate_heterogeneity_draws_zero_rate_ics_at_the_floor_and_p_values():
     assert any("without disk-disk collisions" in lab for lab in labels)
     # p-values on a second x axis on top (never over a marker), one per radius
     (top,) = ax2.child_axes
-    assert [t.get_text() for t in top.get_xticklabels()] == ["p<1e-300", "0.01", "0.2", "0.5"]
+    assert [t.get_text() for t in top.get_xticklabels()] == [
+        "p < 10⁻³⁰⁰", "p = 0.01", "p = 0.2", "p = 0.5"]
     assert "asymptotic" in top.get_xlabel()
     # with the Monte Carlo p-value beside (floored at 1/(n_mc + 1)) the labels stay the
     # asymptotic ones, which are not floored; with the Monte Carlo one alone, that one
     mc = hom.assign(pvalue_mc=[0.005, 0.02, 0.3, 0.6])
     (top,) = plots.rate_heterogeneity(coll, homogeneity=mc).axes[1].child_axes
-    assert "asymptotic" in top.get_xlabel() and top.get_xticklabels()[0].get_text() == "p<1e-300"
+    assert "asymptotic" in top.get_xlabel()
+    assert top.get_xticklabels()[0].get_text() == "p < 10⁻³⁰⁰"
     only_mc = mc.drop(columns="pvalue")
     (top,) = plots.rate_heterogeneity(coll, homogeneity=only_mc).axes[1].child_axes
-    assert "Monte Carlo" in top.get_xlabel() and top.get_xticklabels()[0].get_text() == "0.005"
+    assert "Monte Carlo" in top.get_xlabel()
+    assert top.get_xticklabels()[0].get_text() == "p = 0.005"
     with pytest.raises(ValueError, match="pvalue"):
         plots.rate_heterogeneity(coll, homogeneity=hom.rename(columns={"pvalue": "p"}))
+
+
+def test_rate_heterogeneity_writes_tiny_p_values_as_powers_of_ten():
+    coll = make_collisions(n_ics=20)
+    hom = pd.DataFrame({"radius": list(RADII), "pvalue": [3e-12, 2e-4, 0.04, np.nan]})
+    (top,) = plots.rate_heterogeneity(coll, homogeneity=hom).axes[1].child_axes
+    assert [t.get_text() for t in top.get_xticklabels()] == [
+        "p < 10⁻¹¹", "p < 10⁻³", "p = 0.04", ""]
+
+
+def test_rate_heterogeneity_draws_the_dispersion_without_the_sticky_runs():
+    coll = make_collisions(n_ics=40, rate_spread=0.0)
+    sticky = coll.index[(coll["radius"] == 0.012) & (coll["ic"] < 2)]
+    coll.loc[sticky, "n_pp"] = int(20 * float(stats.kinetic_rate(0.012)) * 2000.0)
+    fig = plots.rate_heterogeneity(coll)
+    ax2 = fig.axes[1]
+    (every,) = [ln for ln in ax2.get_lines() if ln.get_label().endswith("all ICs")]
+    (without,) = [ln for ln in ax2.get_lines() if ln.get_gid() == "sticky_excluded"]
+    assert "2 sticky ICs" in without.get_label()
+    at = list(RADII).index(0.012)
+    # two sticky runs blow the dispersion up; without them a common Poisson rate is back
+    assert every.get_ydata()[at] > 50 and without.get_ydata()[at] < 3
+    np.testing.assert_allclose(np.delete(every.get_ydata(), at),
+                               np.delete(without.get_ydata(), at))
+    assert [t.get_text() for t in ax2.texts] == ["−2"]
+    # flags given by hand, or none
+    flags = np.zeros(len(coll), bool)
+    flags[sticky[:1]] = True
+    fig = plots.rate_heterogeneity(coll, sticky=flags)
+    (without,) = [ln for ln in fig.axes[1].get_lines() if ln.get_gid() == "sticky_excluded"]
+    assert "1 sticky IC" in without.get_label()
+    fig = plots.rate_heterogeneity(coll, sticky=np.zeros(len(coll), bool))
+    (without,) = [ln for ln in fig.axes[1].get_lines() if ln.get_gid() == "sticky_excluded"]
+    assert "(none: the same curve)" in without.get_label()
+    fig = plots.rate_heterogeneity(coll, sticky=None)
+    assert not [ln for ln in fig.axes[1].get_lines() if ln.get_gid() == "sticky_excluded"]
+    with pytest.raises(ValueError, match="one flag per row"):
+        plots.rate_heterogeneity(coll, sticky=flags[:3])
 
 
 def test_statistics_figures_draw_against_any_numeric_column_at_its_values():

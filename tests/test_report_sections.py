@@ -19,6 +19,7 @@ from kicktimes.report.effects import (
     ratio_verdict,
     share_verdict,
 )
+from kicktimes.report.figures import system_label
 
 RADII = (0.008, 0.014, 0.02)
 EPS = (0.001, 0.01)
@@ -206,6 +207,72 @@ def test_recurrence_figure_has_a_row_per_eps_and_rr_offdiag_det_columns(ctx):
     assert "1/N" in caption and "collision-truncated" in caption
 
 
+def _with_uniform(store):
+    res = store.results
+    rec = res[res["diagnostic"].str.match(r"^(rr|rr_offdiag|det)@")]
+    uni = rec.assign(diagnostic="uniform_" + rec["diagnostic"].astype(str),
+                     value=rec["value"] * 2)
+    store.results = pd.concat([res, uni], ignore_index=True)
+    return store
+
+
+def test_recurrence_figure_puts_the_uniform_samples_first_and_the_run_as_control():
+    store = _with_uniform(synthetic_store(n_ics=6))
+    rows, _ = recurrence.recurrence_rows(store.results, store.experiment)
+    assert "uniform_rr_offdiag@0.001" in set(rows["diagnostic"])
+    fig = recurrence.rr_figure(rows, store.experiment)
+    axes = [ax for ax in fig.axes if ax.get_visible()]
+    assert len(axes) == len(EPS) * 5
+    titles = [ax.get_title() for ax in axes[:5]]
+    assert "uniform-time samples" in titles[0] and titles[0].startswith("off-diagonal")
+    assert "uniform-time samples" in titles[1] and titles[1].startswith("DET")
+    assert all("control" in t for t in titles[2:])
+    for ax in axes:
+        assert ax.get_ylim()[0] == 0  # every axis from 0
+        # one series per system (mean with bars): no more than the systems
+        assert len(ax.containers) == 2 * len(SYSTEMS)
+        assert not [ln for ln in ax.get_lines() if ln.get_linestyle() == ":"]
+
+
+def test_recurrence_figure_counts_the_means_above_the_axis():
+    store = synthetic_store(n_ics=6)
+    res = store.results
+    far = (res["radius"] == 0.014) & (res["system"] == "actual") & (
+        res["diagnostic"] == "rr_offdiag@0.001")
+    store.results = res.assign(value=np.where(far, 1.0, res["value"]))
+    rows, _ = recurrence.recurrence_rows(store.results, store.experiment)
+    fig = recurrence.rr_figure(rows, store.experiment)
+    (ax,) = [ax for ax in fig.axes if ax.get_title().startswith("off-diagonal RR (pairs i ≠ j)"
+                                                                 ", ε = 0.001")]
+    assert "1 mean(s) above the axis (r = 0.014: 1)" in ax.get_title()
+    assert ax.get_ylim()[0] == 0 and ax.get_ylim()[1] < 1.0
+    # a mean a little above the rest, from 0 no outlier, is drawn inside the axis
+    near = res["value"].where(~far, 2 * res.loc[far, "value"].max())
+    store.results = res.assign(value=near)
+    rows, _ = recurrence.recurrence_rows(store.results, store.experiment)
+    fig = recurrence.rr_figure(rows, store.experiment)
+    (ax,) = [ax for ax in fig.axes if ax.get_title().startswith("off-diagonal RR (pairs i ≠ j)"
+                                                                 ", ε = 0.001")]
+    assert "above the axis" not in ax.get_title()
+    assert ax.get_ylim()[1] > 2 * res.loc[far, "value"].max()
+    assert not [t for t in ax.texts if t.get_text().endswith("↑")]
+
+
+def test_family_figure_has_one_row_per_store_with_uniform_samples_where_present():
+    a = _with_uniform(synthetic_store(n_ics=6))
+    b = synthetic_store(n_ics=6, seed=1)
+    b.experiment = SimpleNamespace(**{**vars(b.experiment), "name": "family_b"})
+    a.experiment.name = "family_a"
+    fig, caption = recurrence.family_figure([a, b])
+    grid = np.array(fig.axes).reshape(2, 3)
+    assert [ax.get_title().split(":")[0] for ax in grid[:, 0]] == ["family_a", "family_b"]
+    assert "uniform-time samples" in grid[0, 0].get_title()
+    assert grid[0, 0].containers and not grid[1, 0].containers  # b has no uniform rows
+    assert any("not in the store" in t.get_text() for t in grid[1, 0].texts)
+    assert all(ax.containers for ax in grid[:, 1:].ravel())
+    assert "family_a" in caption and "family_b" in caption
+
+
 def test_recurrence_table_gives_medians_and_flags_the_sticky_ic(ctx):
     (sec,) = ctx.sections["recurrence"]
     table = {name: df for name, df, _, _ in sec.tables}["recurrence_by_radius"]
@@ -228,11 +295,40 @@ def test_acf_curves_figure_draws_each_radius_with_the_prediction(ctx):
     assert names == ["fig07_autocorrelation_vs_radius", "fig07b_autocorrelation_curves"]
     fig = sec.figures[1][1]
     axes = [ax for ax in fig.axes if ax.get_visible()]
-    assert [ax.get_title() for ax in axes] == [f"r = {r:g}" for r in RADII]
+    titles = [ax.get_title() for ax in axes]
+    # per radius the curves, and below them each kicked system's difference to two disks
+    assert titles == [f"r = {r:g}" for r in RADII] + [
+        f"r = {r:g}: kicked − two-disk" for r in RADII]
+    assert "95 %" in sec.figures[1][2] and "95 %" in sec.figures[0][2]
     table = {name: df for name, df, _, _ in sec.tables}["autocorrelation_summary"]
     assert np.allclose(table["R1_mean"], table["predicted_lag1"])
     assert (table["decorrelation_lag_n_undefined"] == 16).all()
 
+
+
+def test_acf_intervals_are_95_percent_t_intervals_and_crossings_are_found():
+    curves = pd.DataFrame({
+        "radius": 0.01, "system": ["two_particle"] * 3 + ["poisson"] * 3, "lag": [1, 2, 3] * 2,
+        "mean": [0.9, 0.8, 0.7, 0.85, 0.8, 0.75], "sem": 0.01, "count": 10,
+    })
+    half = autocorrelation.half_width95(curves["sem"], curves["count"])
+    assert half == pytest.approx(0.01 * 2.2621571627, rel=1e-9)  # t_{0.975, 9}
+    diff = autocorrelation.acf_differences(curves)
+    assert diff["difference"].tolist() == pytest.approx([-0.05, 0.0, 0.05])
+    assert diff["ci95"].to_numpy() == pytest.approx(np.hypot(0.01, 0.01) * 2.2621571627)
+    (row,) = autocorrelation.crossings(diff).itertuples()
+    assert row.crosses and row.clear and row.sign_lag1 == -1 and row.first_lag_other_sign == 3
+
+
+def test_lag1_figure_draws_95_percent_intervals(ctx):
+    (sec,) = ctx.sections["autocorrelation"]
+    ax, ax_ratio = sec.figures[0][1].axes
+    part = summary.diagnostic_summary(ctx.results, "autocorrelation")
+    two = part[part["system"] == "two_particle"].sort_values("radius")
+    bars = ax.containers[0].lines[2][0].get_segments()
+    half = [(seg[1][1] - seg[0][1]) / 2 for seg in bars]
+    assert half == pytest.approx(autocorrelation.half_width95(two["sem"], two["n_valid"]))
+    assert all(c.lines[2] for c in ax_ratio.containers)  # the ratios have intervals too
 
 
 def test_a_store_with_r1_only_has_no_curve_decorrelation_or_tau_int():
@@ -270,7 +366,13 @@ def test_lyapunov_figure_shows_lambda_stretching_and_the_ln_inverse_r_relation(c
     fig = sec.figures[0][1]
     assert len(fig.axes) == 3
     assert "ln(1/r)" in fig.axes[2].get_xlabel()
+    assert "nats" not in fig.axes[2].get_xlabel()  # ln(1/r) is a pure number
     assert "nats" in fig.axes[1].get_ylabel()
+    # no legend inside the axes (it hid two-disk points); the legends are the figure's
+    assert all(ax.get_legend() is None for ax in fig.axes)
+    assert len(fig.legends) == 2
+    texts = [t.get_text() for t in fig.legends[0].get_texts()]
+    assert system_label("two_particle") in texts and "median over ICs" in texts
 
 
 def test_findings_section_states_the_rules_and_the_scale(ctx):
@@ -423,3 +525,21 @@ def test_one_writer_writes_the_page_of_the_report_and_of_kicktimes_analyze(tmp_p
             '<li><a href="#v">V</a></li></ul>') in text
     assert text.endswith("<h3 id='s'>S</h3><p>end</p></body></html>")
     assert not list(tmp_path.glob("*.tmp*"))  # written atomically
+
+
+def test_recurrence_plot_section_names_the_system_and_eps_and_zooms_on_lines():
+    from kicktimes.experiment import Experiment
+    from kicktimes.report import trajectories
+
+    exp = Experiment(name="tiny", radii=[0.014, 0.02], n_ics=1, n_steps=600, tau=0.3,
+                     eps=[0.05])
+    results = pd.DataFrame({"radius": [], "ic": [], "system": [], "diagnostic": [],
+                            "value": []})
+    store = SimpleNamespace(experiment=exp, results=results)
+    (sec,) = [s for s in trajectories.sections(Context(store)) if s.key == "recurrence_plot"]
+    name, fig, caption = sec.figures[0]
+    title = fig.axes[0].get_title()
+    assert "two-disk billiard" in title and "ε = 0.05" in title and "r = 0.02" in title
+    assert "length ≥ 2" in caption
+    (inset,) = fig.axes[0].child_axes
+    assert any("pairs on lines" in t.get_text() for t in inset.texts)

@@ -34,7 +34,8 @@ from kicktimes.report.figures import (
 )
 from kicktimes.report.summary import diagnostic_summary
 
-__all__ = ["predicted_lag1", "acf_curves", "acf_figure", "sections", "effects"]
+__all__ = ["predicted_lag1", "acf_curves", "acf_differences", "crossings", "acf_figure",
+           "half_width95", "sections", "effects"]
 
 _ACF = re.compile(r"^acf@(\d+)$")
 
@@ -66,8 +67,43 @@ def predicted_lag1(results) -> pd.DataFrame:
     return pd.concat(out, ignore_index=True)
 
 
+def half_width95(sem, n):
+    """Half-width of the 95 % t interval of a mean, ``t_{0.975, n-1} · sem`` (NaN where
+    n < 2).
+
+    Parameters
+    ----------
+    sem : array_like
+        Standard errors over ICs.
+    n : array_like
+        Numbers of ICs behind them.
+
+    Returns
+    -------
+    numpy.ndarray
+    """
+    from scipy.stats import t
+
+    n = np.asarray(n, dtype=float)
+    with np.errstate(invalid="ignore"):
+        q = np.where(n >= 2, t.ppf(0.975, np.maximum(n - 1, 1)), np.nan)
+    return q * np.asarray(sem, dtype=float)
+
+
 def acf_curves(results) -> pd.DataFrame:
-    """Mean, s.e.m. and median of R_l per radius, system and lag from the ``acf@l`` rows."""
+    """Mean, s.e.m., 95 % interval and median of R_l per radius, system and lag.
+
+    Parameters
+    ----------
+    results : pandas.DataFrame
+        Tidy results with the ``acf@l`` rows.
+
+    Returns
+    -------
+    pandas.DataFrame
+        ``radius, system, lag, mean, median, std, count, sem, ci95``: ``ci95`` the
+        half-width of the 95 % t interval of the mean over ICs (:func:`half_width95`).
+    """
     # the lag of each distinct diagnostic name, then per row through the category codes:
     # a regex per row took ~10 s on a paper store's million acf@l rows
     diag = results["diagnostic"]
@@ -79,21 +115,105 @@ def acf_curves(results) -> pd.DataFrame:
     keep = np.isfinite(lag)
     part = results[keep]
     if part.empty:
-        return pd.DataFrame(columns=["radius", "system", "lag", "mean", "sem", "median"])
+        return pd.DataFrame(columns=["radius", "system", "lag", "mean", "sem", "median",
+                                     "ci95"])
     part = part.assign(lag=lag[keep].astype(int))
     g = part.groupby(["radius", "system", "lag"])["value"]
     out = g.agg(["mean", "median", "std", "count"]).reset_index()
     out["sem"] = out["std"] / np.sqrt(out["count"].where(out["count"] > 0))
+    out["ci95"] = half_width95(out["sem"], out["count"])
     return out
 
 
+def acf_differences(curves) -> pd.DataFrame:
+    """Each kicked system's R_l minus the two-particle R_l, per radius and lag.
+
+    Parameters
+    ----------
+    curves : pandas.DataFrame
+        :func:`acf_curves` output.
+
+    Returns
+    -------
+    pandas.DataFrame
+        ``radius, system, lag, difference, ci95``: the difference of the means and the
+        half-width of its 95 % interval, ``t · √(sem² + sem₂²)`` (Welch-like, the ICs
+        of the two systems taken as independent samples; the smaller count sets the
+        degrees of freedom). A difference that changes sign over the lags is a crossing.
+    """
+    ref = curves[curves["system"] == REFERENCE].set_index(["radius", "lag"])
+    out = []
+    for system in kicked_systems(curves):
+        part = curves[curves["system"] == system].set_index(["radius", "lag"])
+        two = ref.reindex(part.index)
+        se = np.hypot(part["sem"], two["sem"])
+        n = np.minimum(part["count"], two["count"])
+        out.append(pd.DataFrame({
+            "system": system,
+            "difference": part["mean"] - two["mean"],
+            "ci95": half_width95(se, n),
+        }, index=part.index).reset_index())
+    if not out:
+        return pd.DataFrame(columns=["radius", "lag", "system", "difference", "ci95"])
+    return pd.concat(out, ignore_index=True)
+
+
+def crossings(differences) -> pd.DataFrame:
+    """Per radius and kicked system, whether its R_l curve crosses the two-particle one.
+
+    Parameters
+    ----------
+    differences : pandas.DataFrame
+        :func:`acf_differences` output.
+
+    Returns
+    -------
+    pandas.DataFrame
+        ``radius, system, sign_lag1, crosses, first_lag_other_sign, clear``: the sign of
+        the lag-1 difference, whether a later lag has the other sign, the first such lag,
+        and whether the crossing is clear (the 95 % intervals exclude 0 on both sides).
+    """
+    rows = []
+    for (r, system), g in differences.groupby(["radius", "system"]):
+        g = g.sort_values("lag")
+        d, h = g["difference"].to_numpy(float), g["ci95"].to_numpy(float)
+        if d.size == 0 or not np.isfinite(d[0]) or d[0] == 0:
+            continue
+        first = np.sign(d[0])
+        other = np.flatnonzero(np.sign(d) == -first)
+        sure = (np.abs(d) > np.nan_to_num(h, nan=np.inf))
+        rows.append({
+            "radius": r,
+            "system": system,
+            "sign_lag1": int(first),
+            "crosses": bool(other.size),
+            "first_lag_other_sign": int(g["lag"].iloc[other[0]]) if other.size else np.nan,
+            "clear": bool(other.size and sure[0] and sure[other].any()),
+        })
+    return pd.DataFrame(rows, columns=["radius", "system", "sign_lag1", "crosses",
+                                       "first_lag_other_sign", "clear"])
+
+
 def acf_figure(curves, predicted, *, max_panels=6):
-    """R_l against l, one panel per radius (up to ``max_panels``, evenly chosen), per
-    system mean ± s.e.m. band, with the built-in lag-1 prediction as an open marker at l = 1.
+    """R_l against l per radius, and each kicked system's difference to the two-disk curve.
+
+    Parameters
+    ----------
+    curves : pandas.DataFrame
+        :func:`acf_curves` output.
+    predicted : pandas.DataFrame
+        :func:`predicted_lag1` output (the built-in lag-1 prediction).
+    max_panels : int
+        At most this many radii (evenly chosen).
 
     Returns
     -------
     matplotlib.figure.Figure
+        Per radius two panels, one above the other: (top, titled ``r = ...``) R_l per
+        system, mean with its 95 % interval over ICs as a band, the built-in lag-1
+        prediction as an open marker at l = 1; (below, titled ``r = ...: kicked −
+        two-disk``) each kicked system's R_l minus the two-disk R_l with its 95 % interval
+        and the zero line, where the curves cross the difference changes sign.
     """
     from matplotlib.ticker import MaxNLocator
 
@@ -101,59 +221,61 @@ def acf_figure(curves, predicted, *, max_panels=6):
     if radii.size > max_panels:
         radii = radii[np.unique(np.linspace(0, radii.size - 1, max_panels).round().astype(int))]
     ncol = min(3, radii.size)
-    nrow = int(np.ceil(radii.size / ncol))
-    fig = Figure(figsize=(4.4 * ncol, 3.4 * nrow), layout="constrained")
-    axes = np.atleast_1d(fig.subplots(nrow, ncol, squeeze=False, sharey=True)).ravel()
+    nblock = int(np.ceil(radii.size / ncol))
+    fig = Figure(figsize=(4.4 * ncol, 5.6 * nblock), layout="constrained")
+    grid = fig.subplots(2 * nblock, ncol, squeeze=False,
+                        gridspec_kw={"height_ratios": [3, 2] * nblock})
+    top_axes = grid[0::2].ravel()
+    diff_axes = grid[1::2].ravel()
     pred = predicted.groupby(["radius", "system"])["value"].mean()
     systems = [s for s in (REFERENCE, *kicked_systems(curves)) if s in distinct(curves, "system")]
-    for ax, r in zip(axes, radii, strict=False):
+    diffs = acf_differences(curves)
+    if "ci95" not in curves.columns:
+        curves = curves.assign(ci95=half_width95(curves["sem"], curves["count"]))
+    for ax, dax, r in zip(top_axes, diff_axes, radii, strict=False):
         for k, system in enumerate(systems):
             c = curves[(curves["radius"] == r) & (curves["system"] == system)].sort_values("lag")
             style = system_style(system, k)
-            ax.plot(
-                c["lag"],
-                c["mean"],
-                color=style["color"],
-                marker=style["marker"],
-                markersize=3,
-                label=system_label(system),
-            )
-            ax.fill_between(
-                c["lag"],
-                c["mean"] - c["sem"],
-                c["mean"] + c["sem"],
-                color=style["color"],
-                alpha=0.2,
-                linewidth=0,
-            )
+            ax.plot(c["lag"], c["mean"], color=style["color"], marker=style["marker"],
+                    markersize=3, label=system_label(system))
+            ax.fill_between(c["lag"], c["mean"] - c["ci95"], c["mean"] + c["ci95"],
+                            color=style["color"], alpha=0.2, linewidth=0)
             if (r, system) in pred.index:
                 # beside lag 1, shifted so it does not hide the measured value
-                ax.plot(
-                    [1 - 0.25 + 0.25 * k],
-                    [pred[(r, system)]],
-                    linestyle="none",
-                    marker=style["marker"],
-                    markerfacecolor="none",
-                    markersize=7,
-                    color=style["color"],
-                )
+                ax.plot([1 - 0.25 + 0.25 * k], [pred[(r, system)]], linestyle="none",
+                        marker=style["marker"], markerfacecolor="none", markersize=7,
+                        color=style["color"])
+            if system == REFERENCE:
+                continue
+            d = diffs[(diffs["radius"] == r) & (diffs["system"] == system)].sort_values("lag")
+            dax.plot(d["lag"], d["difference"], color=style["color"], marker=style["marker"],
+                     markersize=3)
+            dax.fill_between(d["lag"], d["difference"] - d["ci95"],
+                             d["difference"] + d["ci95"], color=style["color"], alpha=0.2,
+                             linewidth=0)
         lowest = curves.loc[curves["radius"] == r, "mean"].min()
         if lowest < np.exp(-1):  # the 1/e level only where a curve reaches it
             ax.axhline(np.exp(-1), color="grey", linestyle=":", linewidth=0.8)
+        dax.axhline(0.0, color="black", linewidth=0.8)
         ax.set_title(f"r = {r:g}")
-        ax.set_xlabel("lag l (boundary collisions)")
-        ax.xaxis.set_major_locator(MaxNLocator(integer=True))
-    for ax in axes[radii.size :]:
-        ax.set_visible(False)
-    for ax in axes[::ncol]:
+        dax.set_title(f"r = {r:g}: kicked − two-disk", fontsize="small")
         ax.set_ylabel(r"$R_l$ of $\theta$ (dimensionless)")
-    handles, labels = axes[0].get_legend_handles_labels()
+        dax.set_ylabel(r"$\Delta R_l$ (dimensionless)")
+        dax.set_xlabel("lag l (boundary collisions)")
+        for a in (ax, dax):
+            a.xaxis.set_major_locator(MaxNLocator(integer=True))
+    for a in (*top_axes[radii.size:], *diff_axes[radii.size:]):
+        a.set_visible(False)
+    handles, labels = top_axes[0].get_legend_handles_labels()
     handles += [
+        Line2D([], [], color="grey", linewidth=6, alpha=0.3),
         Line2D([], [], color="grey", marker="o", markerfacecolor="none", linestyle="none"),
         Line2D([], [], color="grey", linestyle=":"),
     ]
-    labels += ["built-in prediction 1 − n_pert/n_boundary", "1/e (where reached)"]
-    fig.legend(handles, labels, loc="outside lower center", ncol=len(labels), fontsize="small")
+    labels += ["95 % interval of the mean over ICs",
+               "built-in prediction 1 − n_pert/n_boundary", "1/e (where reached)"]
+    fig.legend(handles, labels, loc="outside lower center", ncol=min(5, len(labels)),
+               fontsize="small")
     return fig
 
 
@@ -178,7 +300,8 @@ def _lag1_figure(summary, predicted, lag):
         part = summary[summary["system"] == system].sort_values("radius")
         style = system_style(system, k)
         x = part["radius"].to_numpy() + dodge(radii, k, len(order))
-        ax.errorbar(x, 1.0 - part["mean"].to_numpy(), yerr=part["sem"].to_numpy(),
+        half = half_width95(part["sem"], part["n_valid"])
+        ax.errorbar(x, 1.0 - part["mean"].to_numpy(), yerr=half,
                     color=style["color"], marker=style["marker"], markersize=5,
                     label=system_label(system), **_SEM_BAR)
         if pred is not None and system in pred.index.get_level_values(1):
@@ -187,9 +310,17 @@ def _lag1_figure(summary, predicted, lag):
                     linestyle="none", marker=style["marker"], markerfacecolor="none",
                     markersize=8, color=style["color"])
         if system != REFERENCE and not ref.empty:
-            two = ref["mean"].reindex(part["radius"]).to_numpy()
-            ax_ratio.plot(part["radius"], (1.0 - part["mean"].to_numpy()) / (1.0 - two),
-                          color=style["color"], marker=style["marker"], markersize=5)
+            two = 1.0 - ref["mean"].reindex(part["radius"]).to_numpy()
+            two_se = ref["sem"].reindex(part["radius"]).to_numpy()
+            own = 1.0 - part["mean"].to_numpy()
+            ratio = own / two
+            # delta method: the relative errors of the two means add in quadrature
+            se = np.abs(ratio) * np.hypot(part["sem"].to_numpy() / own, two_se / two)
+            n = np.minimum(part["n_valid"].to_numpy(),
+                           ref["n_valid"].reindex(part["radius"]).to_numpy())
+            ax_ratio.errorbar(part["radius"].to_numpy() + dodge(radii, k, len(order)), ratio,
+                              yerr=half_width95(se, n), color=style["color"],
+                              marker=style["marker"], markersize=5, **_SEM_BAR)
     decorrelation = 1.0 - summary["mean"].to_numpy(float)
     if np.any(np.isfinite(decorrelation) & (decorrelation > 0)):  # else a linear axis
         ax.set_yscale("log")
@@ -198,14 +329,16 @@ def _lag1_figure(summary, predicted, lag):
         ax.yaxis.set_minor_formatter(FuncFormatter(lambda v, _: ""))
     radius_axis(ax)
     ax.set_ylabel(f"1 − {r_l} of θ (decorrelation per boundary collision)")
-    ax.set_title(f"(a) 1 − {r_l}: mean ± s.e.m. over ICs; open: built-in 1 − n_pert/n_boundary"
-                 if pred is not None else f"(a) 1 − {r_l}: mean ± s.e.m. over ICs",
+    ax.set_title(f"(a) 1 − {r_l}: mean, 95 % interval over ICs\nopen: built-in "
+                 "1 − n_pert/n_boundary"
+                 if pred is not None else f"(a) 1 − {r_l}: mean, 95 % interval over ICs",
                  fontsize="medium")
     ax_ratio.axhspan(0.9, 1.1, color="0.88", zorder=0)
     ax_ratio.axhline(1.0, color="0.5", linewidth=0.8, zorder=0)
     radius_axis(ax_ratio)
     ax_ratio.set_ylabel(f"(1 − {r_l}) kicked / (1 − {r_l}) two-disk")
-    ax_ratio.set_title("(b) ratio to the two-disk value (grey: ±10 %)", fontsize="medium")
+    ax_ratio.set_title("(b) ratio to the two-disk value, 95 % interval (delta method)\n"
+                       "grey: ±10 %", fontsize="medium")
     handles, labels = ax.get_legend_handles_labels()
     if pred is not None:
         handles.append(Line2D([], [], color="grey", marker="o", markerfacecolor="none",
@@ -228,7 +361,7 @@ def sections(ctx):
         "fig07_autocorrelation_vs_radius",
         _lag1_figure(summary, predicted, lag),
         f"(a) The decorrelation per boundary collision 1 − R_{lag} of disk 0's boundary "
-        "angles against radius (log axis): mean ± s.e.m. over ICs"
+        "angles against radius (log axis): mean over ICs with its 95 % t interval"
         + (
             "; open markers: the built-in prediction 1 − n_pert/n_boundary (disk-disk "
             "collisions or kicks per boundary collision), which the kick rate = collision "
@@ -236,8 +369,9 @@ def sections(ctx):
             if lag == 1
             else ""
         )
-        + f". (b) Each kicked system's 1 − R_{lag} over the two-disk value, with the ±10 % "
-        "band.",
+        + f". (b) Each kicked system's 1 − R_{lag} over the two-disk value, with its 95 % "
+        "interval (delta method, ICs of the two systems taken as independent) and the ±10 % "
+        "band. Lag 1 alone can mislead: the curves R_l cross at larger lags (fig07b).",
     )
     curves = acf_curves(results)
     # a curve needs two lags: with R_1 alone (acf_max_lag = 1, e.g. `reproduce --content
@@ -263,10 +397,30 @@ def sections(ctx):
             "fig07b_autocorrelation_curves",
             acf_figure(curves, predicted),
             "R_l of the boundary angles over lags l = 1.."
-            f"{int(curves['lag'].max())} per radius and system (mean ± s.e.m. band), with the "
-            "built-in lag-1 prediction 1 − n_pert/n_boundary (open markers at l ≈ 1) and 1/e "
-            "(the decorrelation threshold).",
+            f"{int(curves['lag'].max())} per radius and system (mean over ICs, band: 95 % t "
+            "interval), with the built-in lag-1 prediction 1 − n_pert/n_boundary (open "
+            "markers at l ≈ 1) and 1/e (the decorrelation threshold); below each radius, "
+            "each kicked system's R_l minus the two-disk R_l with its 95 % interval: where "
+            "the curves cross, the difference changes sign.",
         )
+        cross = crossings(acf_differences(curves))
+        if not cross.empty:
+            crossing = cross[cross["crosses"]]
+            clear = int(crossing["clear"].sum())
+            sec.text(
+                f"Crossings of the R_l curves: {len(crossing)} of {len(cross)} (radius, "
+                "kicked system) pairs change the sign of the mean R_l − R_l(two-disk) between "
+                f"lag 1 and lag {int(curves['lag'].max())}; {clear} of them clearly (95 % "
+                "intervals excluding 0 at lag 1 and at a lag of the other sign)"
+                + ("; at those the ranking at lag 1 reverses at larger lags, so lag 1 alone "
+                   "misleads there." if clear else
+                   ": every crossing is within the intervals, none shows that the ranking at "
+                   "lag 1 reverses.")
+                + (" Crossing, by system: " + ", ".join(
+                    f"{system_label(sys_)} at r = "
+                    + ", ".join(f"{r:g}" for r in g["radius"])
+                    for sys_, g in crossing.groupby("system")) + "." if len(crossing) else "")
+            )
         sec.table("autocorrelation_curves", curves, "R_l per lag", show=False)
     rows = []
     pred = predicted.groupby(["radius", "system"])["value"].mean()

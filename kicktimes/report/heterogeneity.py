@@ -16,8 +16,21 @@ from kicktimes.report.figures import check_frame, plain_log_ticks, x_axis
 __all__ = ["rate_heterogeneity", "sections"]
 
 
+def _p_label(p):
+    """A p-value as a tick label: ``"p < 10⁻³⁰⁰"`` where the asymptotic χ² p-value
+    underflowed to 0, ``"p < 10⁻ᵏ"`` below 10⁻³, else ``"p = "`` and 1 significant figure."""
+    if not np.isfinite(p):
+        return ""
+    if p <= 0:
+        return "p < 10⁻³⁰⁰"
+    if p < 1e-3:
+        sup = str.maketrans("-0123456789", "⁻⁰¹²³⁴⁵⁶⁷⁸⁹")
+        return "p < 10" + str(int(math.floor(math.log10(p))) + 1).translate(sup)
+    return f"p = {p:.1g}"
+
+
 def rate_heterogeneity(collisions, *, homogeneity=None, rule="mirror", max_points=4000,
-                       x="radius", xlabel=None, kinetic=None):
+                       x="radius", xlabel=None, kinetic=None, sticky="auto"):
     r"""Collision rates across ICs: per-IC rates and their dispersion, per radius.
 
     Parameters
@@ -52,6 +65,18 @@ def rate_heterogeneity(collisions, *, homogeneity=None, rule="mirror", max_point
     kinetic : callable, optional
         The kinetic rate as a function of the radius (e.g. ``Experiment.kinetic_rate``
         for unequal disks); default that of equal disks under ``rule``.
+    sticky : "auto", array_like of bool or None
+        Which rows of ``collisions`` are sticky runs (a disk pair trapped in repeated
+        collisions), left out of the second dispersion curve of panel (b). ``"auto"``
+        (default): :func:`kicktimes.report.counts.sticky_ics` under ``rule`` when
+        ``rule`` is given, ``x="radius"`` and the table has an ``ic`` column, else none;
+        None: no sticky-excluded curve.
+
+    Notes
+    -----
+    A few sticky ICs drive the index of dispersion at a radius to 100 or more; the curve
+    without them shows the dispersion of the rest. Tick labels of p-values below 10⁻³
+    read ``p < 10⁻ᵏ``, and an asymptotic p-value that underflows to 0 reads ``p ≈ 0``.
     """
 
     axis = x_axis(x, xlabel)
@@ -148,12 +173,36 @@ def rate_heterogeneity(collisions, *, homogeneity=None, rule="mirror", max_point
         marker="o",
         color="black",
         linestyle=axis.line,
-        label="variance / mean of counts",
+        label=f"variance / mean of counts, all {nouns.many}",
     )
+    flag = _sticky_flags(df, sticky, rule, x, kinetic)
+    curves = [dispersion]
+    if flag is not None:
+        rest = df[~flag].groupby(x)["n_pp"]
+        without = (rest.var(ddof=1) / rest.mean()).reindex(dispersion.index)
+        n_out = pd.Series(flag, index=df.index).groupby(df[x]).sum()
+        ax2.plot(
+            without.index.to_numpy(),
+            without.to_numpy(),
+            marker="s",
+            markerfacecolor="none",
+            color="tab:orange",
+            linestyle="--" if axis.line != "none" else "none",
+            label=(f"without the {int(flag.sum())} sticky {nouns.many}" if flag.any()
+                   else f"without sticky {nouns.many} (none: the same curve)"),
+            gid="sticky_excluded",
+        )
+        for at, k in n_out.items():
+            if k:
+                ax2.annotate(f"−{int(k)}", (at, without.get(at, np.nan)), xytext=(0, -9),
+                             textcoords="offset points", ha="center", fontsize="xx-small",
+                             color="tab:orange")
+        curves.append(without)
     ax2.axhline(1.0, color="grey", linestyle=":", label="Poisson, common rate")
     ax2.set_yscale("log")
     # log axis: only positive, finite dispersions set the range (0 when all counts agree)
-    shown = dispersion[np.isfinite(dispersion) & (dispersion > 0)].to_numpy()
+    shown = pd.concat(curves).to_numpy(float)
+    shown = shown[np.isfinite(shown) & (shown > 0)]
     lo = float(min(shown.min(), 1.0)) if shown.size else 1.0
     hi = float(max(shown.max(), 1.0)) if shown.size else 1.0
     ax2.set_ylim(lo / 1.5, hi * 1.5)
@@ -168,7 +217,7 @@ def rate_heterogeneity(collisions, *, homogeneity=None, rule="mirror", max_point
         top = ax2.secondary_xaxis("top")
         top.set_xticks(
             dispersion.index.to_numpy(),
-            ["p<1e-300" if v == 0 else ("" if not np.isfinite(v) else f"{v:.1g}") for v in p],
+            [_p_label(v) for v in p],
             rotation=90,
             fontsize="x-small",
         )
@@ -186,6 +235,24 @@ def rate_heterogeneity(collisions, *, homogeneity=None, rule="mirror", max_point
     return fig
 
 
+def _sticky_flags(df, sticky, rule, x, kinetic):
+    """Per row of ``df``, whether it is a sticky run (None: no sticky-excluded curve)."""
+    if sticky is None:
+        return None
+    if isinstance(sticky, str):
+        if sticky != "auto":
+            raise ValueError(f"sticky must be 'auto', None or booleans, got {sticky!r}")
+        if rule is None or x != "radius" or "ic" not in df.columns:
+            return None
+        from kicktimes.report.counts import sticky_ics
+
+        return sticky_ics(df, rule, kinetic=kinetic)["sticky"].to_numpy(bool)
+    flag = np.asarray(sticky, dtype=bool)
+    if flag.shape != (len(df),):
+        raise ValueError(f"sticky must have one flag per row ({len(df)}), got {flag.shape}")
+    return flag
+
+
 def sections(ctx):
     """Rate heterogeneity, from the homogeneity tests the Poisson section ran."""
     exp = ctx.exp
@@ -199,7 +266,9 @@ def sections(ctx):
         rate_heterogeneity(ctx.store.collisions, homogeneity=het, rule=exp.rule,
                            kinetic=experiment_kinetic(exp)),
         "(a) Disk-disk collision rate n_pp / t_window of every IC, the pooled and median rates "
-        f"and the kinetic rate ({exp.rule}); (b) index of dispersion of the counts across ICs; "
+        f"and the kinetic rate ({exp.rule}); (b) index of dispersion of the counts across ICs, "
+        "of all ICs (black) and without the sticky runs (orange, collision rate above 5 times "
+        "the kinetic rate; −k: the runs left out at that radius); "
         "on top, the asymptotic p-value of the Pearson χ² test of a common rate (given the "
         "total); the Monte Carlo p-value, exact but floored at 1/(n_mc + 1), is in the text.",
     )

@@ -85,12 +85,17 @@ def stretching_figure(summary, table, *, title=None):
         :func:`~kicktimes.report.summary.diagnostic_summary` of the ``lyapunov`` rows.
     table : pandas.DataFrame
         :func:`stretching_table`.
+    title : str, optional
+        Figure title.
 
     Returns
     -------
     matplotlib.figure.Figure
+        Three panels; every legend is outside the axes, below them (one for the systems
+        and error bars of (a) and (b), one for the differences of (c)), so no legend
+        covers a point.
     """
-    fig = Figure(figsize=(14.0, 4.4), layout="constrained")
+    fig = Figure(figsize=(14.0, 5.6), layout="constrained")  # room for the legends below
     ax1, ax2, ax3 = fig.subplots(1, 3)
     diagnostic_vs_radius(summary, "lyapunov", ax=ax1, title="(a) FTLE λ", medians=True)
     systems = [s for s in (REFERENCE, *kicked_systems(table)) if s in distinct(table, "system")]
@@ -108,7 +113,6 @@ def stretching_figure(summary, table, *, title=None):
     ax2.set_ylabel("λ / Γ (nats per perturbation)")
     ax2.set_title("(b) stretching per perturbation")
     ax2.set_ylim(bottom=0)
-    ax2.legend(fontsize="x-small")
     ref = table[table["system"] == REFERENCE].set_index("radius")
     grid = np.sort(ref["ln_inv_r"].to_numpy())
     for k, system in enumerate(systems[1:], start=1):
@@ -127,10 +131,26 @@ def stretching_figure(summary, table, *, title=None):
         span = np.array([0.0, grid.max() * 1.05])
         ax3.plot(span, span, color="grey", linestyle=":", label="ln(1/r) (identity)")
         ax3.set_xlim(0.9 * grid.min(), 1.05 * grid.max())
-    ax3.set_xlabel("ln(1/r) (nats)")
-    ax3.set_ylabel("excess stretching per perturbation (nats)")
+    # ln(1/r) is a pure number; the identity line reads it as nats per collision
+    ax3.set_xlabel("ln(1/r), r the disk radius in table radii (dimensionless)")
+    ax3.set_ylabel("excess λ/Γ (nats per perturbation)")
     ax3.set_title("(c) excess of a collision over a kick")
-    ax3.legend(fontsize="x-small")
+    # legends outside the axes: inside, (a)'s legend hid two-disk points at r = 0.012-0.016
+    handles, labels = ax1.get_legend_handles_labels()
+    legend = ax1.get_legend()
+    if legend is not None:  # (a)'s proxy entries (error bars, medians) follow the systems
+        texts = [t.get_text() for t in legend.get_texts()]
+        extra = [(h, t) for h, t in zip(legend.legend_handles, texts, strict=True)
+                 if t not in labels]
+        handles += [h for h, _ in extra]
+        labels += [t for _, t in extra]
+        legend.remove()
+    fig.legend(handles, labels, loc="outside lower left", ncol=4, fontsize="small",
+               title="(a), (b)", title_fontsize="small")
+    h3, l3 = ax3.get_legend_handles_labels()
+    if h3:
+        fig.legend(h3, l3, loc="outside lower right", ncol=1, fontsize="small",
+                   title="(c)", title_fontsize="small")
     if title:
         fig.suptitle(title)
     return fig

@@ -7,7 +7,11 @@ distinguishes the systems; every figure and table here shows the off-diagonal ra
 it, at each threshold of the experiment, and DET (the share of off-diagonal recurrences on
 diagonal lines of length ≥ 2) where the store has it.
 
-Store rows (per eps ``e`` formatted ``f"{e:g}"``): ``rr@e``, ``rr_offdiag@e``, ``det@e``.
+Store rows (per eps ``e`` formatted ``f"{e:g}"``): ``rr@e``, ``rr_offdiag@e``, ``det@e``,
+and with ``rr_sampling = "run+uniform"`` the same from uniform-time samples,
+``uniform_rr@e``, ``uniform_rr_offdiag@e``, ``uniform_det@e``: the figures draw those
+first (uniform samples do not cluster at collisions) and the run's own samples as the
+control.
 Old stores have only ``recurrence_rate`` at one ε; the off-diagonal rate is then derived
 as :math:`(N\,RR - 1)/(N - 1)` with N = ``n_steps`` + 1 samples (the run's own samples),
 and DET is missing.
@@ -32,7 +36,11 @@ from kicktimes.report.effects import Effect, store_ratio
 from kicktimes.report.figures import plain_ticks, radius_axis, shared_legend
 from kicktimes.report.summary import diagnostic_summary, diagnostic_vs_radius
 
-__all__ = ["recurrence_rows", "sampling_statement", "rr_figure", "sections", "effects"]
+__all__ = ["recurrence_rows", "sampling_statement", "rr_figure", "family_figure", "sections",
+           "effects"]
+
+#: prefix of the rows computed from uniform-time samples (``rr_sampling = "run+uniform"``)
+UNIFORM = "uniform_"
 
 _QUANTITIES = {
     "rr": ("paper's RR (all pairs, diagonal included)", "RR (fraction of pairs)"),
@@ -49,14 +57,30 @@ def n_samples(exp):
 def recurrence_rows(results, exp):
     """Tidy rows ``rr@e``, ``rr_offdiag@e``, ``det@e`` for every ε of the experiment.
 
-    Returns ``(rows, notes)``: rows as in the store (``diagnostic`` = ``"rr@0.001"``...),
-    taken from the store where present, else derived from ``recurrence_rate`` (old
-    stores, first ε only), and the notes saying what was derived or is missing.
+    Parameters
+    ----------
+    results : pandas.DataFrame
+        The store's tidy results.
+    exp : Experiment
+        For ε and N.
+
+    Returns
+    -------
+    rows : pandas.DataFrame
+        Rows as in the store (``diagnostic`` = ``"rr@0.001"``...), taken from the store
+        where present, else derived from ``recurrence_rate`` (old stores, first ε only);
+        with them the uniform-time rows ``uniform_rr@e``, ``uniform_rr_offdiag@e``,
+        ``uniform_det@e`` where the store has them.
+    notes : list of str
+        What was derived or is missing.
     """
     have = set(results["diagnostic"].unique())
     out, notes = [], []
     for k, e in enumerate(eps_values(exp)):
         tag = f"{e:g}"
+        uniform = [f"{UNIFORM}{q}@{tag}" for q in _QUANTITIES]
+        if any(u in have for u in uniform):
+            out.append(results[results["diagnostic"].isin(uniform)])
         if f"rr@{tag}" in have:
             out.append(results[results["diagnostic"].isin([f"{q}@{tag}" for q in _QUANTITIES])])
             continue
@@ -84,6 +108,12 @@ def sampling_statement(exp):
             f"The recurrence rates use samples at k·τ (τ = {exp.tau:g}) over each run's "
             "horizon, from a uniformly sampled re-run of the same trajectory with the same kicks."
         )
+    uniform = (
+        f" The rows uniform_* (rr_sampling = 'run+uniform') use samples at k·τ (τ = "
+        f"{exp.tau:g}) over each run's horizon, from a uniformly sampled re-run of the same "
+        "trajectory with the same kicks."
+        if rr_sampling == "run+uniform" else ""
+    )
     what = (
         "the paper's collision-truncated steps (a step ends early at every collision, so "
         "samples cluster at collisions and many off-diagonal recurrences at small ε are pairs "
@@ -93,12 +123,83 @@ def sampling_statement(exp):
     )
     return (
         f"The recurrence rates use the run's own {n_samples(exp)} samples (initial point and "
-        f"{exp.n_steps} steps): {what}."
+        f"{exp.n_steps} steps): {what}." + uniform
     )
 
 
+def _columns(rows, eps):
+    """The panels' ``(prefix, quantity)`` pairs, the uniform-time ones first: the
+    uniform-time off-diagonal RR and DET (the panels that matter), then the run's own
+    samples (the control): the paper's RR, off-diagonal RR and DET."""
+    have = distinct(rows, "diagnostic")
+    out = []
+    for prefix, quantities in ((UNIFORM, ("rr_offdiag", "det")), ("", tuple(_QUANTITIES))):
+        out += [(prefix, q) for q in quantities
+                if any(f"{prefix}{q}@{e:g}" in have for e in eps)]
+    return out
+
+
+def _sampling_words(prefix):
+    return "uniform-time samples" if prefix == UNIFORM else "run's own samples"
+
+
+def _panel(ax, summary, name, title, ylabel, n):
+    """One quantity against radius: mean ± bars per system (no medians: with seven
+    systems they would double the series), the axis from 0, and the number and radii of
+    the means above the axis written in the title.
+
+    Parameters
+    ----------
+    ax : matplotlib Axes
+    summary : pandas.DataFrame
+        :func:`~kicktimes.report.summary.diagnostic_summary` output.
+    name : str
+        The row name drawn, e.g. ``"uniform_rr_offdiag@0.001"``.
+    title, ylabel : str
+    n : int
+        Samples per run (the 1/N guide of the paper's RR).
+
+    Notes
+    -----
+    The y range from 0 covers every mean unless the largest is more than 2.5 times the
+    top of :func:`~kicktimes.report.summary.diagnostic_vs_radius`'s robust range; then
+    the means above are written at the top edge and counted, with radius and value, in
+    the title.
+    """
+    q = name.split("@")[0].removeprefix(UNIFORM)
+    part = summary[summary["diagnostic"] == name]
+    diagnostic_vs_radius(part, name, ax=ax, medians=False, title=title, ylabel=ylabel)
+    plain_ticks(ax.yaxis)
+    top = ax.get_ylim()[1]
+    if q == "rr":
+        # the paper's RR is mostly the diagonal 1/N, and the axis shows it
+        top = max(top, 1.05 / n)
+        ax.axhline(1.0 / n, color="grey", linestyle="--", linewidth=0.8)
+        ax.text(0.02, 0.45, f"dashed: 1/N = {1.0 / n:.3g}, the main diagonal alone",
+                transform=ax.transAxes, fontsize="x-small", color="grey")
+    # every rate and DET from 0; from 0, a mean a little above the robust range is no
+    # outlier: show every mean unless the largest is far (> 2.5x) above the range's top
+    # (a long bar may still leave the axis)
+    full = float(np.nanmax(part["mean"].to_numpy(float)))
+    if np.isfinite(full) and full <= 2.5 * top:
+        top = max(top, 1.08 * full)
+        for note in [t for t in ax.texts if t.get_text().endswith(("↑", "↓"))]:
+            note.remove()  # the clipping notes of diagnostic_vs_radius: nothing is clipped
+    ax.set_ylim(0.0, top)
+    above = part[part["mean"] > top]
+    if len(above):
+        above = above.sort_values(["radius", "mean"])
+        where = "; ".join(f"r = {row.radius:g}: {row.mean:.3g}"
+                          for row in above.head(4).itertuples())
+        more = f"; {len(above) - 4} more" if len(above) > 4 else ""
+        ax.set_title(f"{title}\n{len(above)} mean(s) above the axis ({where}{more})",
+                     fontsize="small")
+
+
 def rr_figure(rows, exp, *, radii=None, title=None):
-    """Small multiples: one row per ε, columns paper's RR / off-diagonal RR / DET.
+    """Small multiples: one row per ε; columns the uniform-time off-diagonal RR and DET
+    (where the store has them), then the run's own samples: paper's RR, off-diagonal RR,
+    DET.
 
     Parameters
     ----------
@@ -108,51 +209,43 @@ def rr_figure(rows, exp, *, radii=None, title=None):
         For N (the 1/N guide of the main diagonal) and ε.
     radii : sequence of float, optional
         Only these radii (a zoom, as the paper's bottom panel).
+    title : str, optional
+        Figure title.
 
     Returns
     -------
     matplotlib.figure.Figure
+        Per panel the mean over ICs of each system with its two error bars (no medians:
+        they are in the section's table), one series per system; the y axis starts at 0,
+        and a mean above the axis is written at the top edge and counted, with its radius,
+        in the panel's title. One legend below the panels.
     """
     if radii is not None:
         rows = rows[rows["radius"].isin(list(radii))]
-    eps = [e for e in eps_values(exp) if f"rr@{e:g}" in distinct(rows, "diagnostic")]
-    quantities = [
-        q for q in _QUANTITIES if any(f"{q}@{e:g}" in distinct(rows, "diagnostic") for e in eps)
-    ]
-    fig = Figure(figsize=(4.6 * len(quantities), 3.8 * max(len(eps), 1)), layout="constrained")
-    axes = np.atleast_2d(fig.subplots(max(len(eps), 1), len(quantities), squeeze=False))
+    eps = [e for e in eps_values(exp)
+           if any(f"{p}rr@{e:g}" in distinct(rows, "diagnostic") for p in ("", UNIFORM))
+           or f"{UNIFORM}rr_offdiag@{e:g}" in distinct(rows, "diagnostic")]
+    columns = _columns(rows, eps)
+    fig = Figure(figsize=(4.4 * max(len(columns), 1), 3.9 * max(len(eps), 1)),
+                 layout="constrained")
+    axes = np.atleast_2d(fig.subplots(max(len(eps), 1), max(len(columns), 1), squeeze=False))
     summary = diagnostic_summary(rows) if len(rows) else None
     n = n_samples(exp)
     for i, e in enumerate(eps):
-        for j, q in enumerate(quantities):
+        for j, (prefix, q) in enumerate(columns):
             ax = axes[i, j]
-            name = f"{q}@{e:g}"
+            name = f"{prefix}{q}@{e:g}"
             if summary is None or name not in distinct(summary, "diagnostic"):
                 ax.text(0.5, 0.5, "not in the store", transform=ax.transAxes, ha="center")
                 radius_axis(ax)
                 ax.set_ylabel(_QUANTITIES[q][1])
                 continue
-            diagnostic_vs_radius(
-                summary,
-                name,
-                ax=ax,
-                medians=True,
-                title=f"{_QUANTITIES[q][0]}, ε = {e:g}",
-                ylabel=_QUANTITIES[q][1],
-            )
-            plain_ticks(ax.yaxis)
-            if q == "rr":
-                # from 0: the paper's RR is mostly the diagonal 1/N, and the axis shows it
-                ax.set_ylim(0.0, 1.05 * ax.get_ylim()[1])
-                ax.axhline(1.0 / n, color="grey", linestyle="--", linewidth=0.8)
-                ax.text(
-                    0.02,
-                    0.45,
-                    f"dashed: 1/N = {1.0 / n:.3g}, the main diagonal alone",
-                    transform=ax.transAxes,
-                    fontsize="x-small",
-                    color="grey",
-                )
+            role = "" if prefix == UNIFORM or not columns[0][0] else " (control)"
+            _panel(ax, summary, name,
+                   f"{_QUANTITIES[q][0]}, ε = {e:g}\n{_sampling_words(prefix)}{role}",
+                   _QUANTITIES[q][1], n)
+    for ax in axes.ravel():
+        ax.title.set_fontsize("small")
     shared_legend(fig, axes.ravel())
     if title:
         fig.suptitle(title)
@@ -200,10 +293,16 @@ def sections(ctx):
     sec.figure(
         "fig06_recurrence_rate_vs_radius",
         rr_figure(rows, exp),
-        "Per threshold ε (rows): the paper's recurrence rate (all pairs, axis from 0; "
-        "dashed: 1/N, the main diagonal alone), the off-diagonal rate (pairs i ≠ j) and DET, "
-        "per system: mean over ICs (filled; thick pale bars ± std/10 as in the paper, thin capped "
-        "bars ± s.e.m.) and median (open, dotted). " + sampling_statement(exp),
+        "Per threshold ε (rows): "
+        + ("the off-diagonal rate (pairs i ≠ j) and DET from uniform-time samples (the "
+           "comparison that matters: they do not cluster at collisions), then, as the "
+           "control, from the run's own samples: "
+           if any(c[0] == UNIFORM for c in _columns(rows, eps_values(exp))) else "")
+        + "the paper's recurrence rate (all pairs; dashed: 1/N, the main diagonal alone), "
+        "the off-diagonal rate and DET, per system: mean over ICs (thick pale bars ± std/10 "
+        "as in the paper, thin capped bars ± s.e.m.; medians in the table). Every axis "
+        "starts at 0; a mean above the axis is written at the top edge and counted, with its "
+        "radius, in the panel's title. " + sampling_statement(exp),
     )
     sec.text(sampling_statement(exp))
     for note in notes:
@@ -230,46 +329,67 @@ def sections(ctx):
 
 
 def family_figure(stores):
-    """The paper's Fig. 7 layout from the first store (family A): top all radii, bottom a
-    zoom on its smaller half of the radii; paper's RR and off-diagonal RR at the first ε."""
-    store = stores[0]
-    exp = store.experiment
-    rows, _ = recurrence_rows(store.results, exp)
-    e = eps_values(exp)[0]
-    rows = rows[rows["diagnostic"].isin([f"rr@{e:g}", f"rr_offdiag@{e:g}"])]
-    if rows.empty:
+    """Recurrence rates of every family (store), one row per store, at its first ε.
+
+    Parameters
+    ----------
+    stores : sequence of Store
+        The families' stores (each with ``experiment`` and ``results``).
+
+    Returns
+    -------
+    (matplotlib.figure.Figure, str) or None
+        The figure and its caption, None when no store has recurrence rows. Row k is
+        store k; its columns: the off-diagonal RR from uniform-time samples (where any
+        store has them; "not in the store" where this one has not), then from the run's
+        own samples the off-diagonal RR and the paper's RR (diagonal included, dashed
+        1/N). Every axis starts at 0.
+    """
+    found = []
+    for store in stores:
+        exp = store.experiment
+        rows, _ = recurrence_rows(store.results, exp)
+        e = eps_values(exp)[0]
+        names = [f"{p}{q}@{e:g}" for p, q in ((UNIFORM, "rr_offdiag"), ("", "rr_offdiag"),
+                                              ("", "rr"))]
+        rows = rows[rows["diagnostic"].isin(names)]
+        if not rows.empty:
+            found.append((exp, e, rows))
+    if not found:
         return None
-    radii = np.sort(rows["radius"].unique())
-    small = radii[: max(2, (radii.size + 1) // 2)]
-    summary = diagnostic_summary(rows)
-    fig = Figure(figsize=(10.0, 7.6), layout="constrained")
-    axes = fig.subplots(2, 2)
-    for i, sel in enumerate((radii, small)):
-        part = summary[summary["radius"].isin(sel)]
-        for j, q in enumerate(("rr", "rr_offdiag")):
-            where = "all radii" if i == 0 else f"zoom: r ≤ {sel.max():g}"
-            diagnostic_vs_radius(
-                part,
-                f"{q}@{e:g}",
-                ax=axes[i, j],
-                medians=True,
-                title=f"{_QUANTITIES[q][0]}\n{where}",
-                ylabel=_QUANTITIES[q][1],
-            )
-            plain_ticks(axes[i, j].yaxis)
-            if q == "rr":
-                axes[i, j].set_ylim(0.0, 1.05 * axes[i, j].get_ylim()[1])
-                axes[i, j].axhline(1.0 / n_samples(exp), color="grey", linestyle="--", lw=0.8)
+    uniform = any(f"{UNIFORM}rr_offdiag@{e:g}" in distinct(rows, "diagnostic")
+                  for _, e, rows in found)
+    columns = ([(UNIFORM, "rr_offdiag")] if uniform else []) + [("", "rr_offdiag"), ("", "rr")]
+    fig = Figure(figsize=(4.6 * len(columns), 3.9 * len(found)), layout="constrained")
+    axes = np.atleast_2d(fig.subplots(len(found), len(columns), squeeze=False))
+    for i, (exp, e, rows) in enumerate(found):
+        summary = diagnostic_summary(rows)
+        for j, (prefix, q) in enumerate(columns):
+            ax = axes[i, j]
+            name = f"{prefix}{q}@{e:g}"
+            title = f"{exp.name}: {_QUANTITIES[q][0]}, ε = {e:g}\n{_sampling_words(prefix)}"
+            if name not in distinct(summary, "diagnostic"):
+                ax.text(0.5, 0.5, "not in the store", transform=ax.transAxes, ha="center")
+                radius_axis(ax)
+                ax.set_ylabel(_QUANTITIES[q][1])
+                ax.set_title(title)
+                continue
+            _panel(ax, summary, name, title, _QUANTITIES[q][1], n_samples(exp))
     for ax in axes.ravel():
-        ax.title.set_fontsize("medium")
-    fig.suptitle(f"{exp.name}: recurrence rates at ε = {e:g} (the paper's Fig. 7 layout)",
+        ax.title.set_fontsize("small")
+    fig.suptitle("Recurrence rates of every family (one row per family) against radius",
                  fontsize="medium")
     shared_legend(fig, axes.ravel())
+    names = ", ".join(exp.name for exp, _, _ in found)
     return fig, (
-        f"Recurrence rates of {exp.name} at ε = {e:g} in the paper's Fig. 7 layout: top all "
-        f"radii, bottom a zoom on r ≤ {small.max():g}; left the paper's RR (diagonal "
-        "included, axis from 0, dashed: 1/N), right the off-diagonal rate. "
-        + sampling_statement(exp)
+        f"Recurrence rates of every family ({names}; one row each) at its first ε, mean over "
+        "ICs per system (thick pale bars ± std/10, thin capped bars ± s.e.m.): "
+        + ("left, the off-diagonal rate from uniform-time samples where the store has them; "
+           "then " if uniform else "")
+        + "the off-diagonal rate and the paper's RR (diagonal included, dashed: 1/N) from "
+        "the run's own samples, the paper's layout. Every axis starts at 0; means above the "
+        "axis are counted in the panel titles. "
+        + " ".join(f"{exp.name}: {sampling_statement(exp)}" for exp, _, _ in found)
     )
 
 

@@ -45,9 +45,11 @@ def model_comparison(per_ic, pooled, *, models=None, x="radius", xlabel=None):
     Returns
     -------
     matplotlib.figure.Figure
-        (a) stacked bars of the share of ICs for which each model is AIC-best, with the
-        number of ICs on top; (b) pooled ΔAIC per model on a symmetric-log axis, with
-        the usual ΔAIC = 2 and 10 guides.
+        (a) one bar per model and radius: the share of ICs for which the model is
+        AIC-best, with its Clopper-Pearson 95 % interval (:func:`binomial_ci`), and the
+        number n of ICs fitted on top of each group (in the title instead when more than
+        four groups all have the same n); (b) pooled ΔAIC per model on a
+        symmetric-log axis, with the usual ΔAIC = 2 and 10 guides.
     """
     axis = x_axis(x, xlabel)
     per_ic = check_frame("per_ic", per_ic, [x, "best_model"], allow_empty=True)
@@ -61,20 +63,37 @@ def model_comparison(per_ic, pooled, *, models=None, x="radius", xlabel=None):
     if models is None:
         models = list(dict.fromkeys([*pooled["model"], *per_ic["best_model"]]))
     colour = {m: f"C{k}" for k, m in enumerate(models)}
-    fig = Figure(figsize=(11.0, 4.4), layout="constrained")
-    ax1, ax2 = fig.subplots(1, 2)
+    # panel (a) holds one bar per model and x value: wider with many x values
+    n_x = max(per_ic[x].nunique(), 1)
+    wide_a = min(2.0, max(1.0, n_x * max(len(models), 1) / 24))
+    fig = Figure(figsize=(5.5 * (1 + wide_a), 4.6), layout="constrained")
+    ax1, ax2 = fig.subplots(1, 2, width_ratios=[wide_a, 1])
     counts = pd.crosstab(per_ic[x], per_ic["best_model"]).reindex(
         columns=models, fill_value=0
     )
-    share = counts.div(counts.sum(axis=1), axis=0)
+    total = counts.sum(axis=1)
+    share = counts.div(total, axis=0)
     r = share.index.to_numpy()
+    # one bar per model beside the others (not stacked: a stacked share has no interval
+    # of its own), each with its Clopper-Pearson 95 % interval
     width = 0.8 * axis.step(r, single=0.01)
-    bottom = np.zeros(r.size)
-    for m in models:
-        ax1.bar(r, share[m].to_numpy(), width=width, bottom=bottom, color=colour[m], label=m)
-        bottom += share[m].to_numpy()
-    for at, n in zip(r, counts.sum(axis=1), strict=True):
-        ax1.text(at, 1.01, str(int(n)), ha="center", va="bottom", fontsize="x-small")
+    bar = width / max(len(models), 1)
+    for k, m in enumerate(models):
+        at = r + (k - (len(models) - 1) / 2) * bar
+        low, high = binomial_ci(counts[m].to_numpy(), total.to_numpy())
+        y = share[m].to_numpy()
+        ax1.bar(at, y, width=bar, color=colour[m], label=m,
+                yerr=np.vstack([y - low, high - y]),
+                error_kw={"elinewidth": 0.9, "capsize": 2.0, "ecolor": "black"})
+        # a share of 0 has no bar: a dash in the model's colour says which interval it is
+        ax1.plot(at, y, linestyle="none", marker="_", markersize=6, markeredgewidth=2,
+                 color=colour[m])
+    # n on top of each group, or once in the title when every one of many groups has the
+    # same n (twelve "n = 12" run into each other)
+    same_n = r.size > 4 and total.nunique() == 1
+    for at, n in zip(r, total, strict=True):
+        if not same_n:
+            ax1.text(at, 1.02, f"n = {int(n)}", ha="center", va="bottom", fontsize="x-small")
     for ax, empty in ((ax1, per_ic.empty), (ax2, pooled.empty)):
         if empty:
             ax.text(
@@ -85,11 +104,17 @@ def model_comparison(per_ic, pooled, *, models=None, x="radius", xlabel=None):
                 ha="center",
                 va="center",
             )
-    ax1.set_ylim(0, 1.08)
+    ax1.set_ylim(0, 1.12)
     axis.draw(ax1)
+    if x == "radius" and 4 < r.size <= 20:  # a tick under every group of bars
+        ax1.set_xticks(r, [f"{v:g}" for v in r], fontsize="small")
     nouns = axis.nouns
     ax1.set_ylabel(f"share of {nouns.many} where the model is AIC-best")
-    ax1.set_title(f"(a) per {nouns.one} (number of {nouns.many} on top)")
+    where = (f"n = {int(total.iloc[0])} {nouns.many} fitted at every "
+             + ("radius" if x == "radius" else (xlabel or x))
+             if same_n else f"n = number of {nouns.many} fitted, on top")
+    ax1.set_title(f"(a) per {nouns.one}: share ± Clopper-Pearson 95 %\n({where})",
+                  fontsize="medium")
     for m in models:
         part = pooled[pooled["model"] == m].sort_values(x)
         if len(part):
@@ -241,7 +266,9 @@ def sections(ctx):
         sec.figure(
             "fig09_renewal_model_comparison",
             model_comparison(fitted, pooled, models=list(stats.FULL_SAMPLE_MODELS)),
-            "(a) Per IC: share of ICs for which each renewal model has the lowest AIC; (b) "
+            "(a) Per IC: share of ICs for which each renewal model has the lowest AIC, with "
+            "Clopper-Pearson 95 % intervals (n, the ICs fitted at that radius, on top: at most "
+            f"{ctx.max_ics_model_fits} per radius, so the intervals are wide); (b) "
             "intervals pooled over ICs: ΔAIC of each model (0 = best; 2 and 10 guides).",
         )
     if fitted.empty:

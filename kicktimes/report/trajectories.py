@@ -18,7 +18,7 @@ from matplotlib.figure import Figure
 from kicktimes.report.common import REFERENCE, Section, eps_values, nearest, pct
 from kicktimes.report.figures import TIME_UNIT, check_frame, finite, new_axes
 
-__all__ = ["poincare_section", "poincare_panels", "recurrence_plot", "sections"]
+__all__ = ["poincare_section", "poincare_panels", "recurrence_plot", "line_pairs", "sections"]
 
 _POINCARE_RADII = (0.02, 0.014)
 
@@ -200,10 +200,11 @@ def recurrence_plot(
         ``bins x bins`` grid (memory O(bins²), not O(N²)) and shown as counts.
     title : str, optional
     zoom : int, optional
-        Also draw, enlarged in an inset, the ``zoom`` x ``zoom`` block of sample indices on
-        the main diagonal that holds the most recurrent pairs off it, where the short lines
-        parallel to the diagonal that DET counts are visible (at full scale the main
-        diagonal hides them).
+        Also draw, enlarged in an inset, a ``zoom`` x ``zoom`` window of sample indices
+        centred on the densest cluster of diagonal lines of length ≥ 2 (pairs
+        ``(i, j)`` and ``(i + 1, j + 1)`` both recurrent, ``i ≠ j``: what DET counts), away
+        from the main diagonal where there are any (at full scale the main diagonal and
+        the dots hide them); the pairs on such lines are red, the others black.
 
     Returns
     -------
@@ -259,29 +260,81 @@ def recurrence_plot(
     ax.set_xlim(0, n * scale)
     ax.set_ylim(0, n * scale)
     ax.set_aspect("equal")
-    off = i < j  # one triangle, off the main diagonal
-    if zoom and n > 2 * zoom and off.any():
-        # at full scale the main diagonal hides the short lines parallel to it that DET
-        # counts: the zoom x zoom block on the diagonal holding the most pairs off it
-        blocks = np.bincount(i[off] // zoom, weights=(j[off] // zoom == i[off] // zoom))
-        i0 = j0 = int(np.argmax(blocks)) * zoom
-        inset = ax.inset_axes([0.56, 0.04, 0.42, 0.42])
-        sel = (i >= i0) & (i < i0 + zoom) & (j >= j0) & (j < j0 + zoom)
-        inset.plot(i[sel] * scale, j[sel] * scale, linestyle="none", marker="s",
-                   markersize=max(1.5, 120.0 / zoom), markeredgewidth=0, color="black",
-                   rasterized=True)
-        inset.set_xlim(i0 * scale, (i0 + zoom) * scale)
-        inset.set_ylim(j0 * scale, (j0 + zoom) * scale)
-        inset.set_aspect("equal")
-        inset.tick_params(labelsize="xx-small")
-        inset.text(0.03, 0.97, f"{int(sel.sum())} pairs in {zoom} x {zoom} samples",
-                   transform=inset.transAxes, fontsize="xx-small", va="top")
-        ax.indicate_inset_zoom(inset, edgecolor="tab:red")
+    if zoom and n > 2 * zoom:
+        _line_inset(ax, i, j, n, zoom, scale)
     ax.set_xlabel(f"{unit} $i$")
     ax.set_ylabel(f"{unit} $j$")
     rate = i.size / float(n) ** 2
     ax.set_title(title if title is not None else f"N = {n}, {i.size} pairs, RR = {rate:.3g}")
     return fig
+
+
+def line_pairs(i, j, n):
+    """Which pairs lie on a diagonal line of length ≥ 2 off the main diagonal.
+
+    Parameters
+    ----------
+    i, j : numpy.ndarray of int
+        Recurrent index pairs.
+    n : int
+        Number of samples.
+
+    Returns
+    -------
+    numpy.ndarray of bool
+        True where ``i ≠ j`` and ``(i - 1, j - 1)`` or ``(i + 1, j + 1)`` is also a pair
+        (the diagonal structures DET counts with ``l_min = 2``).
+    """
+    i = np.asarray(i, dtype=np.int64)
+    j = np.asarray(j, dtype=np.int64)
+    if i.size == 0:
+        return np.zeros(0, dtype=bool)
+    key = i * n + j
+    order = np.sort(key)
+
+    def has(k):
+        at = np.searchsorted(order, k).clip(0, order.size - 1)
+        return order[at] == k
+
+    nxt = (i + 1 < n) & (j + 1 < n) & has(key + n + 1)
+    prv = (i > 0) & (j > 0) & has(key - n - 1)
+    return (i != j) & (nxt | prv)
+
+
+def _line_inset(ax, i, j, n, zoom, scale):
+    """The inset of :func:`recurrence_plot`: a ``zoom`` window on diagonal lines."""
+    lines = line_pairs(i, j, n)
+    on = lines & (i < j)  # one triangle
+    if not on.any():
+        ax.text(0.98, 0.02, "no diagonal line of length ≥ 2 off the main diagonal",
+                transform=ax.transAxes, ha="right", va="bottom", fontsize="x-small")
+        return
+    far = on & (j - i >= zoom)  # away from the main diagonal, where there are any
+    pick = far if far.any() else on
+    bi, bj = i[pick] // zoom, j[pick] // zoom
+    cells = bi * (n // zoom + 1) + bj
+    best = np.bincount(cells).argmax()
+    inside = cells == best
+    ci, cj = (int(np.median(a[pick][inside])) for a in (i, j))
+    i0 = int(np.clip(ci - zoom // 2, 0, n - zoom))
+    j0 = int(np.clip(cj - zoom // 2, 0, n - zoom))
+    inset = ax.inset_axes([0.56, 0.04, 0.42, 0.42])
+    sel = (i >= i0) & (i < i0 + zoom) & (j >= j0) & (j < j0 + zoom)
+    size = max(1.5, 120.0 / zoom)
+    for mask, colour in ((sel & ~lines, "black"), (sel & lines, "tab:red")):
+        inset.plot(i[mask] * scale, j[mask] * scale, linestyle="none", marker="s",
+                   markersize=size, markeredgewidth=0, color=colour, rasterized=True)
+    inset.set_xlim(i0 * scale, (i0 + zoom) * scale)
+    inset.set_ylim(j0 * scale, (j0 + zoom) * scale)
+    inset.set_aspect("equal")
+    inset.tick_params(labelsize="xx-small")
+    n_line = int((sel & lines).sum())
+    # inside the inset, on white: above it the text would cross the main plot's dots
+    inset.text(0.03, 0.97, f"{zoom} x {zoom} samples:\n{n_line} of {int(sel.sum())} pairs on "
+               "lines\nof length ≥ 2 (red)", transform=inset.transAxes, fontsize="xx-small",
+               va="top", bbox={"boxstyle": "round,pad=0.2", "fc": "white", "ec": "none",
+                               "alpha": 0.85})
+    ax.indicate_inset_zoom(inset, edgecolor="tab:red")
 
 
 def _sweep_poisson_run(exp, ic, r, two):
@@ -400,13 +453,15 @@ def sections(ctx):
             (i, j),
             n_points=n,
             tau=exp.tau if exp.sampling == "uniform" else None,
-            title=f"r = {r_rr:g}, ε = {eps:g}: N = {n}, RR = {rr:.4g}",
+            title=(f"two-disk billiard, disk 0 of IC 0 ({exp.sampling} sampling)\n"
+                   f"r = {r_rr:g}, ε = {eps:g}: N = {n}, RR = {rr:.4g}"),
             zoom=min(40, n // 4),
         ),
-        f"Recurrence plot of disk 0's sampled centre, IC 0, r = {r_rr:g}, ε = {eps:g} "
-        "(L2 norm), drawn from the list of recurrent pairs (no N x N matrix); inset: the "
-        "stretch of the diagonal with the most recurrent pairs beside it, enlarged, where "
-        "the short lines parallel to the diagonal that DET counts show.",
+        f"Recurrence plot of disk 0's sampled centre in the two-disk billiard, IC 0, "
+        f"r = {r_rr:g}, ε = {eps:g} (L2 norm), drawn from the list of recurrent pairs (no "
+        "N x N matrix); inset: the window of samples with the most pairs on diagonal lines "
+        "of length ≥ 2 off the main diagonal (red; what DET counts), away from the main "
+        "diagonal where there are such lines, enlarged.",
     )
     off = (i.size - n) / (n * (n - 1.0))
     text = (
