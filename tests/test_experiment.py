@@ -460,10 +460,10 @@ def test_sweep_results_are_bitwise_those_of_separate_simulation_and_ftle_runs():
     cases = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(cases)
     separate = cases.tables(one_pass=False)
-    assert len(separate[0]) == 8130 and len(separate[1]) == 30  # with the uniform_ rows
+    assert len(separate[0]) == 9054 and len(separate[1]) == 30  # with the uniform_ rows
     assert set(separate[0]["system"]) == {"two_particle", "poisson", "actual",
                                           "poisson_scatter", "actual_scatter",
-                                          "poisson_kinetic", "mmpp"}
+                                          "poisson_kinetic", "uniform_kinetic", "mmpp"}
     assert cases.differences(separate, cases.tables()) == []
 
 
