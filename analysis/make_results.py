@@ -32,8 +32,21 @@ def main(argv=None):
         "--readme", default=None,
         help="also replace the block between <!-- results:begin --> and <!-- results:end --> "
         "of this file (the repository's README.md) by the page's first screen")
+    parser.add_argument(
+        "--screen-only", action="store_true",
+        help="only rewrite the first screen of OUT/README.md from the findings tables beside "
+        "it (no store is read; the stores argument is ignored)")
     args = parser.parse_args(argv)
     from kicktimes.report import write_results
+
+    if args.screen_only:
+        from kicktimes.report.results import copy_first_screen, refresh_first_screen
+
+        path = refresh_first_screen(args.out)
+        print(f"{path}: first screen rewritten")
+        if args.readme:
+            copy_first_screen(path, args.readme)
+        return 0
 
     t0 = time.perf_counter()
     try:

@@ -212,7 +212,13 @@ def test_a_verdict_that_changes_direction_is_never_robust():
                                   diagnostic="rr_offdiag@0.01"))
     assert set(table["verdict"]) == {"inconclusive"} and not table["robust"].any()
     cell = overview_table(table).iloc[0]["Poisson"]
-    assert cell == "depends on uniform: 1.12 [1.08, 1.16] vs 0.920 [0.890, 0.950]"
+    assert cell == "↕ depends on uniform: 1.12 [1.08, 1.16] vs 0.920 [0.890, 0.950]"
+    # the control named is the one that reverses the direction, not a milder one
+    table = with_robustness(_rows([("f", "primary", 0.763, 0.823),
+                                   ("f", "paired_median", 0.870, 0.922),
+                                   ("f", "elastic", 1.33, 1.52)], diagnostic="det@0.01"))
+    assert set(table["depends_on"]) == {"elastic"}
+    assert overview_table(table).iloc[0]["Poisson"].startswith("↕ depends on elastic: 0.793")
 
 
 def test_a_robust_cell_gives_its_verdict_and_the_range_over_every_control_and_family():
@@ -315,3 +321,17 @@ def test_the_readme_block_is_replaced_by_the_generated_first_screen(tmp_path):
     (tmp_path / "plain.md").write_text("no block\n")
     with pytest.raises(ValueError, match="no block"):
         copy_first_screen(page, tmp_path / "plain.md")
+
+
+def test_the_first_screen_is_rewritten_from_the_findings_tables_alone(tmp_path):
+    from kicktimes.report.results import refresh_first_screen
+
+    table = _rows([("family_a", "primary", 0.30, 0.33), ("family_a", "elastic", 0.31, 0.34)])
+    table.to_csv(tmp_path / "family_a_findings.csv", index=False)
+    table.to_csv(tmp_path / "family_a-elastic_findings.csv", index=False)  # ignored
+    (tmp_path / "README.md").write_text(
+        "# t\n\nGenerated 2026 from `a`.\n\n## The answers\n\nold words\n\n| old |\n\n"
+        "![headline](h.png)\n\n## Next\n")
+    text = refresh_first_screen(tmp_path).read_text()
+    assert "old words" not in text and "| FTLE λ | ✓ lower: 0.315–0.325 |" in text
+    assert "first screen was rewritten" in text and text.index("## Next") > text.index("![h")

@@ -349,24 +349,38 @@ def with_robustness(table: pd.DataFrame) -> pd.DataFrame:
                                level=np.inf if share else 1.0)
         pos = out.index.get_indexer(g.index)
         robust[pos] = ok
-        if ok:
-            continue
-        first = g.iloc[0]
-        side = 1 if first["ci_low"] > 1 else -1 if first["ci_high"] < 1 else 0
-        for _, r in g.iloc[1:].iterrows():
-            other = 1 if r["ci_low"] > 1 else -1 if r["ci_high"] < 1 else 0
-            flips = not share and side * other < 0
-            if r["verdict"] != first["verdict"] or flips:
-                depends[pos] = r["control"]
-                break
-        else:  # the primary agrees with each; two other controls lie on opposite sides of 1
-            sides = [1 if r["ci_low"] > 1 else -1 if r["ci_high"] < 1 else 0
-                     for _, r in g.iterrows()]
-            ref = next(v for v in sides if v)
-            depends[pos] = g["control"].iloc[sides.index(-ref)]
+        if not ok:
+            depends[pos] = _deciding_control(g, share)
     out["robust"] = robust
     out["depends_on"] = depends
     return out
+
+
+def _deciding_control(g: pd.DataFrame, share: bool) -> str:
+    """The control a non-robust comparison depends on, most telling first: one whose CI
+    lies on the other side of 1 from the primary's (from another control's, when the
+    primary's straddles 1), else the one with another verdict whose estimate lies
+    farthest from the primary's (on a log scale)."""
+    def side(r):
+        return 1 if r["ci_low"] > 1 else -1 if r["ci_high"] < 1 else 0
+
+    first = g.iloc[0]
+    others = g.iloc[1:]
+    if not share:
+        sides = [side(r) for _, r in g.iterrows()]
+        ref = sides[0] or next((v for v in sides if v), 0)
+        flipped = [r for (_, r), v in zip(g.iterrows(), sides, strict=True) if v == -ref and v]
+        if ref and flipped:
+            far = max(flipped, key=lambda r: abs(math.log(r["estimate"] / first["estimate"]))
+                      if r["estimate"] > 0 and first["estimate"] > 0 else 0.0)
+            return str(far["control"])
+    changed = others[others["verdict"] != first["verdict"]]
+    if changed.empty:
+        changed = others
+    with np.errstate(divide="ignore", invalid="ignore"):
+        dist = np.abs(np.log(changed["estimate"].to_numpy(float) / first["estimate"]))
+    dist = np.where(np.isfinite(dist), dist, -1.0)
+    return str(changed["control"].iloc[int(np.argmax(dist))])
 
 
 def _count_rows(family, collisions, sticky, rule, kinetic, *, rng, n_boot, resamples):
@@ -487,6 +501,11 @@ SCREEN_ROWS = (
     ("one_minus_r1", "1 − R₁ (lag-1 decorrelation)"),
 )
 _FAMILY_SHORT = {"family_a": "A", "family_b": "B"}
+#: the Poisson battery's tests, as the first screen names them
+_TEST_NAMES = {"uniformity_ks": "uniformity (KS)", "laplace_trend": "Laplace trend",
+               "exponential_ks": "exponential-interval (KS)",
+               "exponential_ad": "exponential-interval (AD)", "ljung_box": "Ljung–Box",
+               "runs": "runs", "dispersion": "dispersion"}
 
 
 def _ci(row):
@@ -517,7 +536,9 @@ def screen_cell(rows: pd.DataFrame) -> str:
             control = mine["depends_on"].iloc[0]
             other = mine[mine["control"] == control].iloc[0]
             where = f"{_fam(fam)}: " if len(families) > 1 else ""
-            return (f"depends on {control}: {where}{_ci(primary.loc[fam])} vs "
+            flips = (mine["ci_low"] > 1).any() and (mine["ci_high"] < 1).any()
+            mark = "↕ " if flips else ""
+            return (f"{mark}depends on {control}: {where}{_ci(primary.loc[fam])} vs "
                     f"{_ci(other)}{missing}")
     verdicts = set(primary["verdict"])
     if len(verdicts) > 1:
@@ -555,7 +576,7 @@ def poisson_answer(table: pd.DataFrame, alpha=0.05) -> str:
     factor: the headline test's rejection share under the mirror and the elastic rule (the
     paper's ICs) per family, whether the intervals are disjoint, and which tests reject at
     their nominal rate under the elastic rule in every family."""
-    from kicktimes.report.poisson import HEADLINE_TEST, TEST_TITLES
+    from kicktimes.report.poisson import HEADLINE_TEST
 
     rows = table[table["question"] == POISSON_QUESTION]
     head = rows[rows["diagnostic"] == f"reject@{HEADLINE_TEST}"]
@@ -580,16 +601,22 @@ def poisson_answer(table: pd.DataFrame, alpha=0.05) -> str:
     if elastic:
         disjoint = all(e.ci_high < m.ci_low for _, e, m in elastic)
         shares = ", ".join(f"{_pct(e)} ({_fam(f)})" for f, e, _ in elastic)
+        still = all(e.verdict == "above nominal" for _, e, _ in elastic)
         text += (f"; under the elastic rule fewer runs reject ({shares}; intervals disjoint)"
                  if disjoint else f"; under the elastic rule {shares} of runs reject")
+        if still:
+            text += f", still more than the nominal {100 * alpha:g} %, so not Poisson either"
         nominal = []
         for test in dict.fromkeys(rows["diagnostic"]):
             cells = rows[(rows["diagnostic"] == test) & (rows["control"] == "elastic")]
             if len(cells) == len(elastic) and (cells["verdict"] == "nominal").all():
                 name = test.split("@")[1]
-                nominal.append(TEST_TITLES.get(name, name).split(" (")[0])
+                nominal.append(_TEST_NAMES.get(name, name))
         if nominal:
-            text += " and the tests of " + ", ".join(nominal) + " reject at their nominal rate"
+            names = (", ".join(nominal[:-1]) + " and " + nominal[-1] if len(nominal) > 1
+                     else nominal[0])
+            text += (f", and the {names} test{'s' if len(nominal) > 1 else ''} reject"
+                     f"{'' if len(nominal) > 1 else 's'} at the nominal rate")
     return text + "."
 
 
@@ -624,8 +651,10 @@ def first_screen(table: pd.DataFrame, shares=None) -> list[str]:
     sentences = [poisson_answer(table), ftle_answer(table),
                  "Below, each cell is the kicked/two-disk ratio's range over every control ("
                  + ", ".join(_CONTROL_WORDS.get(c, c) for c in controls)
-                 + ") and both families: ✓ with its verdict when all agree in verdict and "
-                 "direction, else the control it depends on, with both numbers."]
+                 + "; the kinetic-rate kicks under the mirror rule only) and both families: ✓ "
+                 "with its verdict when all agree in verdict and direction, else the control "
+                 "that changes it most, with both numbers (↕: the ratio lies above 1 under one "
+                 "control and below 1 under another)."]
     lines = [" ".join(s for s in sentences if s), ""]
     lines += markdown_table(overview_table(table))
     return lines + [""]

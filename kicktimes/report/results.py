@@ -17,6 +17,7 @@ from pathlib import Path
 import pandas as pd
 
 from kicktimes import __version__
+from kicktimes.fileio import atomic_write_bytes
 from kicktimes.report.common import (
     Context,
     Mapper,
@@ -25,7 +26,8 @@ from kicktimes.report.common import (
     load_report_store,
 )
 
-__all__ = ["copy_first_screen", "counts_section", "poisson_section", "write_results"]
+__all__ = ["copy_first_screen", "counts_section", "poisson_section", "refresh_first_screen",
+           "write_results"]
 
 BEGIN, END = "<!-- results:begin -->", "<!-- results:end -->"
 
@@ -91,8 +93,6 @@ def copy_first_screen(page, target):
 
     Raises ``ValueError`` when ``target`` has no such block.
     """
-    from kicktimes.fileio import atomic_write_bytes
-
     page, target = Path(page), Path(target)
     lines = page.read_text(encoding="utf-8").splitlines()
     generated = next(line for line in lines if line.startswith("Generated "))
@@ -109,6 +109,42 @@ def copy_first_screen(page, target):
     _, tail = rest.split(END, 1)
     new = head + BEGIN + "\n" + "\n".join(body).strip() + "\n" + END + tail
     atomic_write_bytes(target, new.encode("utf-8"))
+
+
+def refresh_first_screen(out_dir) -> Path:
+    """Rewrite the answers and the table of ``out_dir/README.md`` from the findings tables
+    beside it (``<family>_findings.csv``, the merged ones that `write_results` wrote),
+    without recomputing anything else; the "Generated" line says so. Returns the page.
+
+    For a change of the first screen's wording: the numbers are the tables' own.
+    """
+    from kicktimes.report.controls import first_screen
+
+    out = Path(out_dir)
+    page = out / "README.md"
+    tables = [pd.read_csv(p, keep_default_na=False, na_values=[""])
+              for p in sorted(out.glob("*_findings.csv")) if "-" not in p.name]
+    if not tables:
+        raise ValueError(f"{out}: no <family>_findings.csv to build the first screen from")
+    from kicktimes.report.controls import with_robustness
+
+    table = pd.concat(tables, ignore_index=True)
+    table["depends_on"] = table["depends_on"].astype(object).where(table["depends_on"].notna(),
+                                                                    "")
+    table = with_robustness(table)
+    for family, part in table.groupby("family", sort=False):  # the derived columns, again
+        part.to_csv(out / f"{family}_findings.csv", index=False)
+    lines = page.read_text(encoding="utf-8").splitlines()
+    start = lines.index("## The answers") + 2
+    stop = next(k for k in range(start, len(lines)) if lines[k].startswith("![headline]"))
+    lines[start:stop] = first_screen(table)
+    now = _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")
+    k = next(i for i, line in enumerate(lines) if line.startswith("Generated "))
+    lines[k] = (lines[k].split(" The first screen was rewritten")[0]
+                + f" The first screen was rewritten {now} from the findings tables "
+                "(`make_results.py --screen-only`).")
+    atomic_write_bytes(page, ("\n".join(lines) + "\n").encode("utf-8"))
+    return page
 
 
 def _short(family):

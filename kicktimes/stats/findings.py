@@ -259,9 +259,16 @@ def effect_statement(subject, quantity, estimate, ci_low, ci_high, method, verdi
     """The sentence of an effect size: ``"<subject>: <quantity> <estimate> (95 % CI <low>
     to <high>, <method>): <verdict>."`` (no interval when it is not finite).
 
-    >>> effect_statement("FTLE", "ratio", 0.331, 0.3, 0.36, "bootstrap", "differs")
-    'FTLE: ratio 0.331 (95 % CI 0.3 to 0.36, bootstrap): differs.'
+    >>> effect_statement("FTLE", "ratio", 0.331, 0.3, 0.36, "bootstrap", "lower")
+    'FTLE: ratio 0.331 (95 % CI 0.300 to 0.360, bootstrap): lower.'
+    >>> effect_statement("RR", "ratio", 1.12, 1.1009, 1.13, "bootstrap", "higher")
+    'RR: ratio 1.120 (95 % CI 1.101 to 1.130, bootstrap): higher.'
     """
+    if np.isfinite(ci_low) and np.isfinite(ci_high):
+        # enough digits that the printed interval shows its verdict (format_interval)
+        est, interval = format_interval(estimate, ci_low, ci_high).split(" ", 1)
+        lo, hi = interval.strip("[]").split(", ")
+        return f"{subject}: {quantity} {est} (95 % CI {lo} to {hi}, {method}): {verdict}."
     ci = f" (95 % CI {_g(ci_low)} to {_g(ci_high)}, {method})" if np.isfinite(ci_low) else ""
     return f"{subject}: {quantity} {_g(estimate)}{ci}: {verdict}."
 
