@@ -387,7 +387,8 @@ def test_analyze_offers_the_mmpp_for_outside_data(tmp_path):
             "--n-mc", "19", "--out", str(out)]
     result = CliRunner().invoke(main, args)
     assert result.exit_code == 0, result.output
-    assert "- Clustered (MMPP-2)?: Parametric-bootstrap LR test" in result.output
+    assert "- Clustered (MMPP-2)? " in result.output
+    assert "\n  Parametric-bootstrap LR test" in result.output
     table = pd.read_csv(out / "mmpp_per_sequence.csv")
     assert len(table) == 3 and table["lr_pvalue"].between(0.025, 1).all()
     assert table.loc[table["sequence"] != "s0.01-2", "mmpp_best"].all()
