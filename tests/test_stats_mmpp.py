@@ -14,8 +14,8 @@ from scipy import linalg
 from statsmodels.tools.numdiff import approx_hess
 
 from kicktimes import stats
-from kicktimes.stats import _mmpp_em as em
-from kicktimes.stats import _mmpp_estep
+from kicktimes.stats.mmpp import _em as em
+from kicktimes.stats.mmpp import _estep
 
 RATES = np.array([0.5, 5.0])
 Q = np.array([[-0.1, 0.1], [0.3, -0.3]])
@@ -98,7 +98,7 @@ def test_a_nearly_defective_generator_falls_back_to_the_reference(monkeypatch):
     data = em.Windows.of(times, np.full(3, 10.0))
     args = (RATES3 * data.unit, Q3 * data.unit, em.stationary_law(Q3), data)
     fast = em.estep(*args)
-    monkeypatch.setattr(_mmpp_estep, "_COND_MAX", 0.0)
+    monkeypatch.setattr(_estep, "_COND_MAX", 0.0)
     assert em.spectral(Q3, RATES3) is None
     assert em.estep(*args).loglik == pytest.approx(fast.loglik, rel=1e-12)
 
@@ -309,7 +309,7 @@ def test_comparison_returns_the_fit_it_compared(mmpp_data):
 
 
 def test_the_mmpp_conditional_likelihood_reduces_to_poisson_with_equal_rates():
-    from kicktimes.stats.mmpp_choice import _conditional_loglik
+    from kicktimes.stats.mmpp.choice import _conditional_loglik
 
     times = poisson_windows(6, 1.0, 20.0, np.random.default_rng(4))
     data = em.Windows.of(times, np.full(6, 20.0))

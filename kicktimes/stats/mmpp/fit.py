@@ -26,11 +26,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import _mmpp_em as em
-from ._checks import as_1d_float, check_choice, check_int, check_real, check_rng, check_times
-from .mmpp_simulation import simulate_mmpp
-from .poisson import _is_ensemble
-from .renewal import FitWarning
+from .._checks import as_1d_float, check_choice, check_int, check_real, check_rng, check_times
+from ..poisson import _is_ensemble
+from ..renewal import FitWarning
+from . import _em as em
+from .simulation import simulate_mmpp
 
 INITIAL = ("stationary", "free")
 MAX_STATES = 4
@@ -312,7 +312,7 @@ def fit_mmpp(times, t_max, *, n_states=2, n_starts=8, rng=None, max_iter=1000, t
 
 def _fit(data, n, *, n_starts=8, rng=None, max_iter=1000, tol=1e-9, initial="stationary",
          covariance=True):
-    """fit_mmpp on a validated :class:`~._mmpp_em.Windows`; no warning is issued."""
+    """fit_mmpp on a validated :class:`~._em.Windows`; no warning is issued."""
     rng = check_rng(rng)
     k = n * n + (n - 1 if initial == "free" else 0)
     n_events = int(data.n_events.sum())

@@ -32,12 +32,12 @@ import numpy as np
 import pandas as pd
 from scipy import optimize
 
-from . import _mmpp_em as em
-from ._checks import check_choice, check_int, check_rng
-from .comparison import compare_models
-from .mmpp import MAX_STATES, MMPPFit, _fit, check_windows
-from .poisson import intervals_from_times
-from .renewal import FULL_SAMPLE_MODELS, FitWarning
+from .._checks import check_choice, check_int, check_rng
+from ..comparison import compare_models
+from ..poisson import intervals_from_times
+from ..renewal import FULL_SAMPLE_MODELS, FitWarning
+from . import _em as em
+from .fit import MAX_STATES, MMPPFit, _fit, check_windows
 
 
 def _conditional_loglik(rates, Q, data, first):

@@ -1,7 +1,7 @@
 r"""The EM of the Markov-modulated Poisson process (Rydén 1996): M-step, score,
 the accelerated iterations, starting points and the observed information.
 
-The E-step and the data layout are in :mod:`._mmpp_estep` (names re-exported here).
+The E-step and the data layout are in :mod:`._estep` (names re-exported here).
 
 * :func:`mstep` maximises the expected complete-data log-likelihood: rates ``N_i/T_i``;
   the generator in closed form ``M_ij / T_i`` for a free start, and by Newton's method
@@ -22,7 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from ._mmpp_estep import (  # noqa: F401 - the E-step's names, used as em.<name>
+from ._estep import (  # noqa: F401 - the E-step's names, used as em.<name>
     Q_CAP,
     Q_FLOOR,
     RATE_FLOOR,
