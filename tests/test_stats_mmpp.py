@@ -3,6 +3,7 @@ bootstrap LR test and time-rescaling residuals (kicktimes.stats, issue 30)."""
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import warnings
 
@@ -186,9 +187,11 @@ def test_results_do_not_depend_on_the_time_unit(mmpp_data, mmpp_fit):
 def test_summary_repr_and_counts(mmpp_fit):
     text = mmpp_fit.summary()
     for piece in ("MMPP fit: 2 states", "rate[1]", "q[0,1]", "stationary law", "AIC",
-                  "right end censored", "best of 8 starts"):
+                  "right end censored", "12 starts run to convergence",
+                  "reached the best log-likelihood"):
         assert piece in text
     assert "n_states=2" in repr(mmpp_fit)
+    assert f"best_of_starts={mmpp_fit.n_best}/12" in repr(mmpp_fit)
     assert mmpp_fit.n_params == 4 and mmpp_fit.n_windows == 300
     assert mmpp_fit.aic == pytest.approx(8 - 2 * mmpp_fit.loglik)
     assert list(mmpp_fit.params) == ["rate[0]", "rate[1]", "q[0,1]", "q[1,0]"]
@@ -225,6 +228,75 @@ def test_degenerate_fits_warn_and_stay_defined():
         fit = stats.fit_mmpp(times, 10.0, rng=3)
     assert fit.warnings and np.all(np.isfinite(fit.rates)) and np.isfinite(fit.loglik)
     assert np.all(np.isfinite(fit.generator))
+
+
+# --- the search: starts that reach the optimum (issue 39) ---------------------------------
+
+
+@pytest.fixture(scope="module")
+def run_22():
+    """The issue's reproducer: two-disk collision times whose MMPP-2 optimum has a burst
+    state (gaps of 0.022, 0.026 and 0.031 against a mean gap of 27.6)."""
+    from kicktimes import initial_conditions, simulate_two_particle
+
+    ic = initial_conditions(60, 0.02, seed=5)[22]
+    return simulate_two_particle(ic, 0.02, t_max=3000.0).pp_times
+
+
+def test_the_issue_reproducer_reaches_its_burst_optimum_for_every_seed(run_22):
+    issue = dict(rates=np.array([0.034502, 25.317517]),
+                 generator=np.array([[-7.524331e-4, 7.524331e-4], [12.70239, -12.70239]]))
+    fits = []
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", stats.FitWarning)
+        for seed in range(4):
+            fits.append(stats.fit_mmpp(run_22, 3000.0, rng=seed))
+    assert fits[0].loglik_of(run_22, 3000.0) == pytest.approx(fits[0].loglik, abs=1e-9)
+    for fit in fits:
+        assert fit.loglik == pytest.approx(-456.637, abs=1e-3)
+        assert fit.rates[1] > 20.0 and fit.n_best >= 2
+    # the issue's parameters, scored by the same likelihood
+    at_issue = dataclasses.replace(fits[0], **issue, initial=em.stationary_law(
+        issue["generator"]))
+    assert at_issue.loglik_of(run_22, 3000.0) == pytest.approx(-456.637, abs=1e-3)
+
+
+def test_the_fit_reports_how_many_starts_reached_the_best(mmpp_fit, run_22):
+    for fit in (mmpp_fit, stats.fit_mmpp(run_22, 3000.0, n_starts=6, rng=1)):
+        lls = np.array(fit.start_logliks)
+        assert len(lls) == fit.n_starts and lls.max() == pytest.approx(fit.loglik, abs=1e-9)
+        assert fit.n_best == int(np.sum(lls >= fit.loglik - 1e-6 * abs(fit.loglik)))
+        assert 1 <= fit.n_best <= fit.n_starts
+    assert mmpp_fit.n_best >= 6  # a well-identified MMPP: most starts agree
+
+
+def test_a_fit_is_never_below_the_poisson_fit_and_warns_of_equal_rates_only_as_the_best():
+    rng = np.random.default_rng(30)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", stats.FitWarning)
+        for d in range(6):
+            times = np.sort(rng.uniform(0.0, 150.0, rng.poisson(150.0)))
+            two = stats.fit_mmpp(times, 150.0, rng=d, n_starts=6)
+            one = stats.fit_mmpp(times, 150.0, n_states=1)
+            assert two.loglik >= one.loglik - 1e-9 * abs(one.loglik)
+            if any("within 1 %" in w for w in two.warnings):
+                assert max(two.start_logliks) <= two.loglik + 1e-9 * abs(two.loglik)
+
+
+def test_the_compiled_em_run_equals_the_python_loop(run_22):
+    data = em.Windows.of([run_22], np.array([3000.0]))
+    rng = np.random.default_rng(4)
+    for initial in ("stationary", "free"):
+        for _ in range(3):
+            rates = np.sort(10.0 ** rng.uniform(-1, 2, 2))
+            q = 10.0 ** rng.uniform(-3, 1, 2)
+            gen = np.array([[-q[0], q[0]], [q[1], -q[1]]])
+            fast = em.run_em(rates, gen, data, initial=initial, max_iter=300, tol=1e-9)
+            slow = em.run_em(rates, gen, data, initial=initial, max_iter=300, tol=1e-9,
+                             compiled=False)
+            assert fast.n_iter == slow.n_iter
+            assert fast.loglik >= slow.loglik - 1e-9 * abs(slow.loglik)
+            np.testing.assert_allclose(fast.rates, slow.rates, rtol=1e-6)
 
 
 @pytest.mark.parametrize("kwargs, error, match", [

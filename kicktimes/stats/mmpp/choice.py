@@ -80,7 +80,7 @@ def _conditional_fit(fit: MMPPFit, data):
     return -best - shift, bool(res.success) or best < start
 
 
-def compare_point_processes(times, t_max, *, models=None, n_states=(2,), n_starts=8,
+def compare_point_processes(times, t_max, *, models=None, n_states=(2,), n_starts=12,
                             rng=None, return_fits=False):
     r"""Rank Poisson, renewal and MMPP models of event times in windows by AIC, on one
     likelihood.
@@ -207,7 +207,7 @@ class MMPPLRTest:
     mmpp: MMPPFit = field(repr=False)
 
 
-def mmpp_lr_test(times, t_max, *, n_states=2, n_boot=99, n_starts=8, rng=None):
+def mmpp_lr_test(times, t_max, *, n_states=2, n_boot=99, n_starts=12, rng=None):
     r"""Is an MMPP needed? The likelihood-ratio test against the homogeneous Poisson
     process, calibrated by a parametric bootstrap given the number of events.
 
