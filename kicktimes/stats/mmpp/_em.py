@@ -22,7 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._em_kernels import em_run_reversible, generator_step
+from ._em_kernels import em_run_reversible, generator_step, hopeless
 from ._em_kernels import generator_of as _generator_of
 from ._em_kernels import objective as _objective
 from ._estep import (  # noqa: F401 - the E-step's names, used as em.<name>
@@ -114,7 +114,7 @@ def _unpack(phi, n, initial):
 
 
 def run_em(rates, Q, data: Windows, *, initial, max_iter, tol, alpha=None,
-           compiled=True) -> EMRun:
+           compiled=True, floor=-math.inf) -> EMRun:
     r"""Baum-Welch iterations from ``(rates, Q)``, accelerated by SQUAREM, until an EM
     step changes the log-likelihood by at most ``tol * |loglik|`` or ``max_iter``
     E-steps were made; the result holds the last E-step's parameters with their exact
@@ -130,6 +130,10 @@ def run_em(rates, Q, data: Windows, *, initial, max_iter, tol, alpha=None,
     likelihood is flat (states nearly alike, a rate or switching rate running to 0);
     SQUAREM cuts those runs several-fold and leaves quick ones as they were.
 
+    With a ``floor`` (the best log-likelihood of other starts) a run stops early, not
+    converged, when it is :func:`._em_kernels.hopeless`: below the floor by more than ten
+    times its last gain per E-step for all the E-steps left.
+
     Two states (a reversible chain) run as one compiled loop
     (:func:`._em_kernels.em_run_reversible`, the same steps); ``compiled=False`` runs this
     Python loop instead (the reference of the tests).
@@ -141,7 +145,7 @@ def run_em(rates, Q, data: Windows, *, initial, max_iter, tol, alpha=None,
         # every two-state chain is reversible: the whole run in one compiled loop
         out = em_run_reversible(np.array(rates, dtype=float), np.array(Q, dtype=float),
                                 np.array(alpha, dtype=float), data.x, data.start,
-                                initial == "free", int(max_iter), float(tol))
+                                initial == "free", int(max_iter), float(tol), float(floor))
         stats = EStats(float(out[3]), out[8], out[9], out[4], out[5], out[6], out[7])
         return EMRun(out[0], out[1], out[2], stats, int(out[10]), bool(out[11]))
     theta = (rates, Q, alpha)
@@ -157,6 +161,7 @@ def run_em(rates, Q, data: Windows, *, initial, max_iter, tol, alpha=None,
         return abs(new.loglik - old.loglik) <= tol * abs(new.loglik)
 
     while used < max_iter:
+        cycle_loglik, cycle_used = st.loglik, used
         theta1, st1 = em_step(theta, st)
         used += 1
         if done(st, st1) or used >= max_iter:
@@ -173,6 +178,9 @@ def run_em(rates, Q, data: Windows, *, initial, max_iter, tol, alpha=None,
         if step >= -1.0:
             if free < -1.0:  # EM's own point was the bounded step: allow longer ones
                 step_max *= 4.0
+            if hopeless(st.loglik, floor, (st.loglik - cycle_loglik) / (used - cycle_used),
+                        used, max_iter):
+                break
             continue
         for _ in range(2):  # the extrapolation, then once halfway back towards EM's point
             if used >= max_iter:
@@ -187,6 +195,9 @@ def run_em(rates, Q, data: Windows, *, initial, max_iter, tol, alpha=None,
                 break
             step_max = max(1.0, step_max / 4.0)
             step = 0.5 * (step - 1.0)
+        if hopeless(st.loglik, floor, (st.loglik - cycle_loglik) / (used - cycle_used), used,
+                    max_iter):
+            break
     return EMRun(*theta, st, used, False)
 
 

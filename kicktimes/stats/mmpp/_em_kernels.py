@@ -224,10 +224,25 @@ def _unpack(phi, n, free):
 
 
 @njit(cache=True)
-def em_run_reversible(rates, Q, alpha, x, start, free, max_iter, tol):
+def hopeless(loglik, floor, gain, used, max_iter):
+    """Whether a run at ``loglik``, gaining ``gain`` per E-step over its last cycle, stays
+    below ``floor`` (the best log-likelihood of the starts before it) even if it kept
+    ten times that gain for all its remaining E-steps: EM's gains shrink as it converges,
+    so it cannot end above the best. Checked after ``ABANDON_AFTER`` E-steps (a start
+    near a saddle gains little at first)."""
+    return used >= ABANDON_AFTER and floor - loglik > 10.0 * max(gain, 0.0) * (max_iter - used)
+
+
+#: the fewest E-steps of a start before :func:`hopeless` may stop it
+ABANDON_AFTER = 30
+
+
+@njit(cache=True)
+def em_run_reversible(rates, Q, alpha, x, start, free, max_iter, tol, floor=-np.inf):
     """``_em.run_em`` compiled, for a reversible chain: Baum-Welch iterations with SQUAREM
     (scheme S3, the same steps, bounds and acceptance rule) until an EM step changes the
-    log-likelihood by at most ``tol * |loglik|`` or ``max_iter`` E-steps were made.
+    log-likelihood by at most ``tol * |loglik|``, ``max_iter`` E-steps were made, or the
+    run is :func:`hopeless` against ``floor``.
 
     Returns ``(rates, Q, alpha, loglik, time, transitions, events, init, ll, ll_first,
     n_iter, converged)``, the statistics of the last E-step at the returned parameters.
@@ -240,6 +255,7 @@ def em_run_reversible(rates, Q, alpha, x, start, free, max_iter, tol):
     used = 1
     step_max = 1.0
     while used < max_iter:
+        cycle_loglik, cycle_used = st[0], used
         rates1, Q1, alpha1 = _mstep(rates, Q, st[1], st[2], st[3], st[4], free)
         st1 = _estep_reversible(rates1, Q1, alpha1, x, start, bt, e, r)
         used += 1
@@ -263,6 +279,9 @@ def em_run_reversible(rates, Q, alpha, x, start, free, max_iter, tol):
         if step >= -1.0:
             if step_free < -1.0:  # EM's own point was the bounded step: allow longer ones
                 step_max *= 4.0
+            if hopeless(st[0], floor, (st[0] - cycle_loglik) / (used - cycle_used), used,
+                        max_iter):
+                break
             continue
         for _ in range(2):  # the extrapolation, then once halfway back towards EM's point
             if used >= max_iter:
@@ -277,4 +296,7 @@ def em_run_reversible(rates, Q, alpha, x, start, free, max_iter, tol):
                 break
             step_max = max(1.0, step_max / 4.0)
             step = 0.5 * (step - 1.0)
+        if hopeless(st[0], floor, (st[0] - cycle_loglik) / (used - cycle_used), used,
+                    max_iter):
+            break
     return (rates, Q, alpha) + st + (used, False)

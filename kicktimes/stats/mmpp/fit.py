@@ -349,8 +349,13 @@ def _fit(data, n, *, n_starts=12, rng=None, max_iter=1000, tol=1e-9, initial="st
     if data.x.size > _SEARCH_INTERVALS and data.n_windows >= 4:
         size = max(2, math.ceil(data.n_windows * _SEARCH_INTERVALS / data.x.size))
         search = data.subset(np.sort(rng.choice(data.n_windows, size=size, replace=False)))
-    runs = [em.run_em(r, q, search, initial=initial, max_iter=max_iter, tol=tol)
-            for r, q, _ in points]
+    runs, floor = [], -math.inf
+    for r, q, _ in points:
+        # a start that cannot catch up with the best so far stops early (_em.run_em)
+        runs.append(em.run_em(r, q, search, initial=initial, max_iter=max_iter, tol=tol,
+                              floor=floor))
+        if np.isfinite(runs[-1].loglik):
+            floor = max(floor, runs[-1].loglik)
     lls = np.array([run.loglik if np.isfinite(run.loglik) else -np.inf for run in runs])
     top = lls.max()
     n_best = int(np.sum(lls >= top - BEST_RTOL * abs(top)))
