@@ -220,7 +220,9 @@ def mmpp_lr_test(times, t_max, *, n_states=2, n_boot=99, n_starts=12, rng=None):
     n_boot : int, optional
         Bootstrap samples (>= 1); the p-value's resolution is ``1 / (n_boot + 1)``.
     n_starts : int, optional
-        EM starts of every MMPP fit (the data's and each sample's alike).
+        EM starts of every MMPP fit, the data's and each sample's alike: the search of
+        :func:`fit_mmpp` (every start run to convergence), so that the statistic of the
+        data and its null distribution come from the same maximisation.
     rng : Generator or int, optional
 
     Returns

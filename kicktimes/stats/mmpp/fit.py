@@ -39,6 +39,8 @@ MAX_STATES = 4
 #: subset of whole windows of about that size: every start runs to convergence there, and
 #: the _FINALISTS best distinct optima continue on all the data
 _SEARCH_INTERVALS, _FINALISTS = 20_000, 2
+#: E-steps of every start in the search's first pass (see _search)
+_FIRST_PASS = 100
 #: a start "reached the best" log-likelihood when it ended within this much of it,
 #: relative (the EM stops at a relative change of ``tol = 1e-9`` per iteration, which
 #: leaves converged starts up to about 1e-7 relative apart)
@@ -349,13 +351,7 @@ def _fit(data, n, *, n_starts=12, rng=None, max_iter=1000, tol=1e-9, initial="st
     if data.x.size > _SEARCH_INTERVALS and data.n_windows >= 4:
         size = max(2, math.ceil(data.n_windows * _SEARCH_INTERVALS / data.x.size))
         search = data.subset(np.sort(rng.choice(data.n_windows, size=size, replace=False)))
-    runs, floor = [], -math.inf
-    for r, q, _ in points:
-        # a start that cannot catch up with the best so far stops early (_em.run_em)
-        runs.append(em.run_em(r, q, search, initial=initial, max_iter=max_iter, tol=tol,
-                              floor=floor))
-        if np.isfinite(runs[-1].loglik):
-            floor = max(floor, runs[-1].loglik)
+    runs = _search(points, search, initial=initial, max_iter=max_iter, tol=tol)
     lls = np.array([run.loglik if np.isfinite(run.loglik) else -np.inf for run in runs])
     top = lls.max()
     n_best = int(np.sum(lls >= top - BEST_RTOL * abs(top)))
@@ -387,6 +383,34 @@ def _fit(data, n, *, n_starts=12, rng=None, max_iter=1000, tol=1e-9, initial="st
         best = em.EMRun(rates, Q, alpha, em.estep(rates, Q, alpha, data), 1, True)
     return _result(best, data, initial, n_starts=len(points), covariance=covariance,
                    n_best=n_best, start_logliks=start_logliks)
+
+
+def _search(points, data, *, initial, max_iter, tol):
+    """Run every start to convergence, in two passes: each start first for up to
+    ``_FIRST_PASS`` E-steps, then those not converged from where they stopped, the best
+    first. A start that cannot catch up with the best so far stops early
+    (:func:`._em.run_em`'s ``floor``), and the first pass gives the floor early, so that
+    the starts crawling along a flat ridge below the best are stopped before they took
+    ``max_iter`` E-steps."""
+    runs, floor = [], -math.inf
+    for r, q, _ in points:
+        run = em.run_em(r, q, data, initial=initial, max_iter=min(_FIRST_PASS, max_iter),
+                        tol=tol, floor=floor)
+        runs.append(run)
+        if run.converged and np.isfinite(run.loglik):
+            floor = max(floor, run.loglik)
+    pending = [i for i, run in enumerate(runs) if not run.converged and run.n_iter < max_iter
+               and np.isfinite(run.loglik)]
+    for i in sorted(pending, key=lambda i: -runs[i].loglik):
+        run = runs[i]
+        more = em.run_em(run.rates, run.Q, data, initial=initial, tol=tol, floor=floor,
+                         max_iter=max_iter - run.n_iter,
+                         alpha=run.alpha if initial == "free" else None)
+        more.n_iter += run.n_iter
+        runs[i] = more
+        if np.isfinite(more.loglik):
+            floor = max(floor, more.loglik)
+    return runs
 
 
 def _poisson(data, covariance):
