@@ -69,6 +69,9 @@ def main(argv=None):
                     continue
             rows.append({"design": design, "k": k, "n_events": times.size,
                          "statistic": res.statistic, "pvalue": res.pvalue})
+            if (k + 1) % 50 == 0:
+                print(f"  {design}: {k + 1} of {count}, {time.perf_counter() - start:.0f} s",
+                      flush=True)
         print(f"{design}: {count} tests in {time.perf_counter() - start:.0f} s", flush=True)
         pd.DataFrame(rows).to_csv(out / "lr_pvalues.csv", index=False)
     df = pd.DataFrame(rows)

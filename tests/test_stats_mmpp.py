@@ -445,18 +445,31 @@ def test_lr_test_rejects_mmpp_data_and_not_poisson_data(mmpp_data):
     assert null.statistic == pytest.approx(2 * (null.mmpp.loglik - null.poisson.loglik), abs=1e-9)
 
 
-@pytest.mark.slow
-def test_lr_test_has_its_nominal_size_on_poisson_data():
-    # measured: 5.4 % of 500 data sets at 5 % (docs/mmpp.md)
-    rng = np.random.default_rng(21)
+def lr_pvalues(n_datasets, events, n_boot, seed, n_starts=12):
+    """p-values of the LR test on single Poisson windows."""
+    rng = np.random.default_rng(seed)
     pvalues = []
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", stats.FitWarning)
-        for d in range(100):
-            times = poisson_windows(20, 1.0, 50.0, rng)
-            pvalues.append(stats.mmpp_lr_test(times, 50.0, n_boot=19, n_starts=4,
+        for d in range(n_datasets):
+            times = np.sort(rng.uniform(0.0, events, rng.poisson(events)))
+            pvalues.append(stats.mmpp_lr_test(times, events, n_boot=n_boot, n_starts=n_starts,
                                               rng=d).pvalue)
-    assert np.mean(np.array(pvalues) <= 0.05) <= 0.05 + 3 * math.sqrt(0.05 * 0.95 / 100)
+    return np.array(pvalues)
+
+
+def test_lr_test_keeps_its_level_on_poisson_windows():
+    # a fast check: 20 windows of ~40 events, 9 samples each (p = 0.1 is exact at 10
+    # draws), 6 starts; at most 5 rejections at 10 % (1 % chance at the nominal level)
+    assert np.sum(lr_pvalues(20, 40.0, 9, seed=40, n_starts=6) <= 0.1) <= 5
+
+
+@pytest.mark.slow
+def test_lr_test_has_its_nominal_size_on_poisson_data():
+    # docs/mmpp.md: 300 windows of ~150 events with 19 samples each (analysis/mmpp_lr_size.py)
+    p = lr_pvalues(100, 150.0, 19, seed=21)
+    assert np.mean(p <= 0.05) <= 0.05 + 3 * math.sqrt(0.05 * 0.95 / 100)
+    assert np.mean(p <= 0.10) <= 0.10 + 3 * math.sqrt(0.10 * 0.90 / 100)
 
 
 # --- time-rescaling residuals -------------------------------------------------------------

@@ -22,7 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._em_kernels import em_run_reversible, generator_step, hopeless
+from ._em_kernels import em_run_reversible, generator_step, hopeless, value_grad
 from ._em_kernels import generator_of as _generator_of
 from ._em_kernels import objective as _objective
 from ._estep import (  # noqa: F401 - the E-step's names, used as em.<name>
@@ -55,7 +55,7 @@ def mstep(st: EStats, rates, Q, alpha, initial):
         old = np.log(np.clip(Q[off], Q_FLOOR, Q_CAP))
         # start Newton from the better of the old point (which guarantees an ascent)
         # and the closed form that ignores the stationary start
-        u0 = max((closed, old), key=lambda v: _objective(v, M, T, s, n)[0])
+        u0 = max((closed, old), key=lambda v: value_grad(v, M, T, s, n)[0])
         u = generator_step(u0, M, T, s, n, lo, hi)
         new_alpha = None
     new_Q = _generator_of(np.ascontiguousarray(u, dtype=float), n)

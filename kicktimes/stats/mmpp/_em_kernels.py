@@ -69,23 +69,63 @@ def objective(u, M, T, s, n):
 
 
 @njit(cache=True)
+def objective_two(u, M, T, s):
+    r""":func:`objective` of a two-state chain in closed form, with its Hessian: with
+    :math:`a = q_{01}, b = q_{10}`, :math:`\pi = (b, a) / (a + b)`, so
+    :math:`f = (M_{01} + s_1) u_0 - T_0 a + (M_{10} + s_0) u_1 - T_1 b - S \log(a + b)`,
+    :math:`S = s_0 + s_1`: a concave function of ``u = log(a, b)`` (log-sum-exp is
+    convex), whose maximum Newton's method finds in a few steps."""
+    a, b = math.exp(u[0]), math.exp(u[1])
+    S = s[0] + s[1]
+    ab = a + b
+    value = (M[0, 1] * u[0] - T[0] * a + M[1, 0] * u[1] - T[1] * b
+             + S * (-math.log(ab)))
+    if s[0] > 0.0:
+        value += s[0] * u[1]
+    if s[1] > 0.0:
+        value += s[1] * u[0]
+    grad = np.empty(2)
+    grad[0] = M[0, 1] + s[1] - T[0] * a - S * a / ab
+    grad[1] = M[1, 0] + s[0] - T[1] * b - S * b / ab
+    c = S * a * b / (ab * ab)
+    H = np.empty((2, 2))
+    H[0, 0] = -T[0] * a - c
+    H[1, 1] = -T[1] * b - c
+    H[0, 1] = c
+    H[1, 0] = c
+    return value, grad, H
+
+
+@njit(cache=True)
+def value_grad(u, M, T, s, n):
+    if n == 2:
+        f, g, _ = objective_two(u, M, T, s)
+        return f, g
+    return objective(u, M, T, s, n)
+
+
+@njit(cache=True)
 def generator_step(u, M, T, s, n, lo, hi, max_iter=50):
-    """Maximise :func:`objective` from ``u`` by damped Newton (Hessian by differences of
-    the gradient, Levenberg shift, Armijo backtracking) inside ``[lo, hi]``; never
-    returns a point worse than ``u``."""
-    f, g = objective(u, M, T, s, n)
+    """Maximise :func:`objective` from ``u`` by damped Newton (Hessian in closed form for
+    two states, :func:`objective_two`, else by differences of the gradient; Levenberg
+    shift, Armijo backtracking) inside ``[lo, hi]``; never returns a point worse than
+    ``u``."""
+    f, g = value_grad(u, M, T, s, n)
     p = u.size
     for _ in range(max_iter):
         scale = 1.0 + np.abs(M).max() + np.abs(s).max()
         if np.abs(g).max() <= 1e-10 * scale:
             break
-        H = np.empty((p, p))
-        for j in range(p):
-            h = 1e-6 * max(1.0, abs(u[j]))
-            v = u.copy()
-            v[j] += h
-            H[:, j] = (objective(v, M, T, s, n)[1] - g) / h
-        H = 0.5 * (H + H.T)
+        if n == 2:
+            H = objective_two(u, M, T, s)[2]
+        else:
+            H = np.empty((p, p))
+            for j in range(p):
+                h = 1e-6 * max(1.0, abs(u[j]))
+                v = u.copy()
+                v[j] += h
+                H[:, j] = (objective(v, M, T, s, n)[1] - g) / h
+            H = 0.5 * (H + H.T)
         # Levenberg: shift -H until it is safely positive definite
         low = np.linalg.eigvalsh(-H)[0]
         shift = max(0.0, 1e-8 * (1.0 + np.abs(H).max()) - low)
@@ -94,7 +134,7 @@ def generator_step(u, M, T, s, n, lo, hi, max_iter=50):
         improved = False
         for _b in range(40):
             v = np.minimum(np.maximum(u + t * step, lo), hi)
-            fv, gv = objective(v, M, T, s, n)
+            fv, gv = value_grad(v, M, T, s, n)
             if np.isfinite(fv) and fv >= f + 1e-4 * t * (g @ step) - 1e-12 * abs(f):
                 improved = fv > f
                 u, f, g = v, fv, gv
@@ -187,7 +227,7 @@ def _mstep(rates, Q, time, trans, events, init, free):
         new_Q = generator_of(closed, n)
         return new_rates, new_Q, init / init.sum()
     u0 = closed
-    if objective(old, trans, time, init, n)[0] > objective(closed, trans, time, init, n)[0]:
+    if value_grad(old, trans, time, init, n)[0] > value_grad(closed, trans, time, init, n)[0]:
         u0 = old
     u = generator_step(u0, trans, time, init, n, lo, hi)
     new_Q = generator_of(u, n)
