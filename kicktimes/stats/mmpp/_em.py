@@ -22,7 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._em_kernels import em_run_reversible, generator_step, hopeless, value_grad
+from ._em_kernels import em_run_reversible, estep_reversible, generator_step, hopeless, value_grad
 from ._em_kernels import generator_of as _generator_of
 from ._em_kernels import objective as _objective
 from ._estep import (  # noqa: F401 - the E-step's names, used as em.<name>
@@ -31,11 +31,26 @@ from ._estep import (  # noqa: F401 - the E-step's names, used as em.<name>
     RATE_FLOOR,
     EStats,
     Windows,
-    estep,
     estep_reference,
     spectral,
     stationary_law,
 )
+from ._estep import estep as _estep_any
+
+
+def estep(rates, Q, alpha, data: Windows, *, log_surv=False) -> EStats:
+    """:func:`._estep.estep`; for two states (a reversible chain) without ``log_surv``
+    the compiled :func:`._em_kernels.estep_reversible`, the same kernel without the
+    Python work around it."""
+    if rates.size != 2 or log_surv:
+        return _estep_any(rates, Q, alpha, data, log_surv=log_surv)
+    bt, e, r = data.work(np.float64, 2)
+    out = estep_reversible(np.ascontiguousarray(rates, dtype=float),
+                           np.ascontiguousarray(Q, dtype=float),
+                           np.ascontiguousarray(alpha, dtype=float), data.x, data.start,
+                           bt, e, r)
+    return EStats(float(out[0]), out[5], out[6], out[1], out[2], out[3], out[4])
+
 
 # --------------------------------------------------------------------------- M-step
 

@@ -172,7 +172,7 @@ def _decompose_reversible(Q, rates):
 
 
 @njit(cache=True)
-def _estep_reversible(rates, Q, alpha, x, start, bt, e, r):
+def estep_reversible(rates, Q, alpha, x, start, bt, e, r):
     """One E-step (``_estep.estep`` for a reversible ``Q``): ``(loglik, time, transitions,
     events, init, ll, ll_first)``."""
     n = rates.size
@@ -291,19 +291,19 @@ def em_run_reversible(rates, Q, alpha, x, start, free, max_iter, tol, floor=-np.
     bt = np.empty((x.size, n))
     e = np.empty((x.size, n))
     r = np.empty((x.size, n))
-    st = _estep_reversible(rates, Q, alpha, x, start, bt, e, r)
+    st = estep_reversible(rates, Q, alpha, x, start, bt, e, r)
     used = 1
     step_max = 1.0
     while used < max_iter:
         cycle_loglik, cycle_used = st[0], used
         rates1, Q1, alpha1 = _mstep(rates, Q, st[1], st[2], st[3], st[4], free)
-        st1 = _estep_reversible(rates1, Q1, alpha1, x, start, bt, e, r)
+        st1 = estep_reversible(rates1, Q1, alpha1, x, start, bt, e, r)
         used += 1
         done = abs(st1[0] - st[0]) <= tol * abs(st1[0])
         if done or used >= max_iter:
             return (rates1, Q1, alpha1) + st1 + (used, done)
         rates2, Q2, alpha2 = _mstep(rates1, Q1, st1[1], st1[2], st1[3], st1[4], free)
-        st2 = _estep_reversible(rates2, Q2, alpha2, x, start, bt, e, r)
+        st2 = estep_reversible(rates2, Q2, alpha2, x, start, bt, e, r)
         used += 1
         done = abs(st2[0] - st1[0]) <= tol * abs(st2[0])
         if done or used >= max_iter:
@@ -327,7 +327,7 @@ def em_run_reversible(rates, Q, alpha, x, start, free, max_iter, tol, floor=-np.
             if used >= max_iter:
                 break
             tr_rates, tr_Q, tr_alpha = _unpack(phi0 - 2 * step * rr + step * step * v, n, free)
-            st_trial = _estep_reversible(tr_rates, tr_Q, tr_alpha, x, start, bt, e, r)
+            st_trial = estep_reversible(tr_rates, tr_Q, tr_alpha, x, start, bt, e, r)
             used += 1
             if np.isfinite(st_trial[0]) and st_trial[0] > st2[0]:
                 rates, Q, alpha, st = tr_rates, tr_Q, tr_alpha, st_trial

@@ -14,6 +14,9 @@ mean event rate 1):
   ``(e - c) / d`` and is left at rate ``c / d``, the background has the other events'
   rate ``(N - e + c) / (T - d)`` and is left at rate ``c / (T - d)``. Thresholds just
   above the 1st, 2nd, 4th, ... shortest gap and at fractions of the mean gap;
+* ``"quiet"``: a nearly silent state from the longest gaps: the gaps above ``tau`` are
+  rests in a state of rate 0.02, left after the mean long gap; the active state holds
+  every event (the optimum of some collision sequences has a state of rate 0);
 * ``"local"``: quantiles of local event rates (blocks of up to 8 gaps) with slow
   switching, every 20 and every 100 events (the starts before issue 39);
 * ``"fast"`` and ``"slow"``: the switching limits, rates 0.3 and 3 times the mean
@@ -22,9 +25,10 @@ mean event rate 1):
 * ``"random"``: rates and switching rates drawn log-uniformly (rates in
   ``[0.05, 200]``, switching rates in ``[1e-3, 30]``), the remaining starts.
 
-For more than two states the burst state is the top one and the lower states take
-quantiles of the local rates. The order of :func:`starting_points` is the order of
-priority when ``n_starts`` is smaller than the number of structured starts.
+For more than two states the burst state is the top one (the quiet state the bottom
+one) and the other states take quantiles of the local rates. The order of
+:func:`structured_starts` is the order of priority: :func:`starting_points` takes the
+first ``n_starts - n_starts // 6`` and adds ``n_starts // 6`` random ones.
 
 The Poisson fit is nested, not a start: an MMPP whose rates are equal has exactly its
 likelihood, whatever ``Q``, and the EM cannot leave that point (the states are not told
