@@ -1,8 +1,8 @@
 """How much the report's MMPP-2 comparison depends on its number of EM starts.
 
 The report's MMPP section (`kicktimes.report.mmpp`) fits every eligible IC's collision
-times with `kicktimes.stats.compare_point_processes` and 4 EM starts
-(`kicktimes.report.mmpp.N_STARTS`). This script refits the same ICs, with the report's
+times with `kicktimes.stats.compare_point_processes` and `kicktimes.report.mmpp.N_STARTS`
+EM starts (4 until issue 39, now 12). This script refits the same ICs, with the report's
 own seeds, at several numbers of starts and prints, per number of starts, the share of
 ICs where the MMPP-2 beats Poisson by AIC, and how many ICs' MMPP-2 AIC is worse than
 with the most starts (by more than 0.01). Two independent fits with the same number of
@@ -14,9 +14,10 @@ fitted ICs in ``<family>_mmpp_per_ic.csv``)::
 
     python analysis/mmpp_starts.py paper/store-family_b paper/report/family_b_mmpp_per_ic.csv
 
-Measured on 2026-11-26 (family B, 106 fitted ICs): shares 0.642, 0.660 and 0.670 with 4,
-8 and 16 starts; 18 ICs worse than with 16 starts by more than 0.01 in AIC (up to 30);
-the two 4-start fits differ by more than 1e-6 in log-likelihood in 25 ICs (docs/report.md).
+Measured on 2026-11-26 with the search before issue 39 (family B, 106 fitted ICs):
+shares 0.642, 0.660 and 0.670 with 4, 8 and 16 starts; 18 ICs worse than with 16 starts
+by more than 0.01 in AIC (up to 30); the two 4-start fits differ by more than 1e-6 in
+log-likelihood in 25 ICs (docs/report.md).
 """
 
 from __future__ import annotations

@@ -7,7 +7,7 @@ Data: an MMPP-2 (rates 0.5 and 5, switching rates 0.1 and 0.3, stationary rate 1
 ``--windows`` windows of length ``--events / 1.625`` (about ``--events`` events each).
 
 1. One E-step over all the windows: the compiled forward-backward pass
-   (``kicktimes.stats._mmpp_estep.estep``) against the plain NumPy/scipy implementation of
+   (``kicktimes.stats.mmpp._estep.estep``) against the plain NumPy/scipy implementation of
    the same recursions (``estep_reference``: one ``scipy.linalg.expm`` of the 2n x 2n Van
    Loan block matrix per interval), timed on the first ``--subset`` windows and scaled
    to all of them by their number of intervals; the two are checked equal.
@@ -27,7 +27,7 @@ from unittest import mock
 import numpy as np
 
 from kicktimes import stats
-from kicktimes.stats import _mmpp_em as em
+from kicktimes.stats.mmpp import _em as em
 
 sys.path.insert(0, os.path.dirname(__file__))
 from _timing import best_time  # noqa: E402

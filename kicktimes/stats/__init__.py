@@ -44,9 +44,14 @@ from .groups import PoissonGroup, poisson_group, pooled_intervals
 from .hazard import HazardTable, interval_hazard
 from .kinetic import conditional_kinetic_rate, mean_kinetic_rate
 from .mixture import RateMixture, rate_mixture, simulate_cox_times
-from .mmpp import MMPPFit, fit_mmpp
-from .mmpp_choice import MMPPLRTest, compare_point_processes, mmpp_lr_test
-from .mmpp_simulation import simulate_mmpp
+from .mmpp import (
+    MMPPFit,
+    MMPPLRTest,
+    compare_point_processes,
+    fit_mmpp,
+    mmpp_lr_test,
+    simulate_mmpp,
+)
 from .poisson import TESTS, Intervals, MonteCarloNulls, intervals_from_times, test_poisson
 from .renewal import (
     FULL_SAMPLE_MODELS,

@@ -22,9 +22,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import _mmpp_em as em
 from .ensemble import test_poisson_ensemble
-from .mmpp import MMPPFit, check_windows
+from .mmpp import _em as em
+from .mmpp.fit import MMPPFit, check_windows
 
 
 @dataclass(frozen=True, repr=False)

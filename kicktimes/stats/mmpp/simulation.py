@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._checks import check_choice, check_int, check_real, check_rng
-from ._mmpp_em import stationary_law
-from ._mmpp_kernels import simulate_window
+from .._checks import check_choice, check_int, check_real, check_rng
+from ._em import stationary_law
+from ._kernels import simulate_window
 
 # uniforms are drawn in blocks of this size, whatever the horizon, so that with one seed
 # a shorter window's events are a prefix of a longer one's

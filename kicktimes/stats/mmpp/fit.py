@@ -26,18 +26,25 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import _mmpp_em as em
-from ._checks import as_1d_float, check_choice, check_int, check_real, check_rng, check_times
-from .mmpp_simulation import simulate_mmpp
-from .poisson import _is_ensemble
-from .renewal import FitWarning
+from .._checks import as_1d_float, check_choice, check_int, check_real, check_rng, check_times
+from ..poisson import _is_ensemble
+from ..renewal import FitWarning
+from . import _em as em
+from ._starts import starting_points
+from .simulation import simulate_mmpp
 
 INITIAL = ("stationary", "free")
 MAX_STATES = 4
-# Multi-start: every start runs _SCREEN_ITER EM iterations (to a relative tolerance of
-# _SCREEN_TOL) on about _SCREEN_INTERVALS intervals (whole windows drawn at random, all of
-# them for smaller data); the _FINALISTS best continue on all the data.
-_SCREEN_INTERVALS, _SCREEN_ITER, _SCREEN_TOL, _FINALISTS = 20_000, 25, 1e-6, 2
+#: Data over _SEARCH_INTERVALS intervals (in 4 windows or more) are searched on a random
+#: subset of whole windows of about that size: every start runs to convergence there, and
+#: the _FINALISTS best distinct optima continue on all the data
+_SEARCH_INTERVALS, _FINALISTS = 20_000, 2
+#: E-steps of every start in the search's first pass (see _search)
+_FIRST_PASS = 100
+#: a start "reached the best" log-likelihood when it ended within this much of it,
+#: relative (the EM stops at a relative change of ``tol = 1e-9`` per iteration, which
+#: leaves converged starts up to about 1e-7 relative apart)
+BEST_RTOL = 1e-6
 
 
 def check_windows(times, t_max):
@@ -94,10 +101,15 @@ class MMPPFit:
     covariance : ndarray
         Covariance of ``(rates, off-diagonal q_ij in row order)``.
     converged, n_iter, n_starts, warnings :
-        EM health: converged within ``max_iter`` E-steps (``n_iter`` of the kept run,
-        its screening included) from the best of ``n_starts`` starts; ``warnings`` lists
+        EM health: the kept run converged within ``max_iter`` E-steps (``n_iter``), the
+        best of ``n_starts`` starts each run to convergence; ``warnings`` lists
         degenerate fits (a state without events, states not distinguished, a switching
         rate at its floor or cap) and numerical trouble.
+    n_best, start_logliks :
+        The convergence report: how many of the starts ended at the best
+        log-likelihood (within ``BEST_RTOL = 1e-6`` relative), and the log-likelihood
+        each start ended at (in the order of the starts; -inf for a failed one). A
+        best reached by one start only is fragile: more starts may find a better one.
     """
 
     rates: np.ndarray
@@ -116,6 +128,8 @@ class MMPPFit:
     generator_se: np.ndarray
     covariance: np.ndarray
     warnings: tuple = ()
+    n_best: int = 1
+    start_logliks: tuple = ()
 
     @property
     def n_states(self) -> int:
@@ -162,9 +176,10 @@ class MMPPFit:
     def __repr__(self) -> str:
         flag = "" if self.converged else ", converged=False"
         rates = np.array2string(self.rates, precision=4)
+        best = f", best_of_starts={self.n_best}/{self.n_starts}" if self.n_states > 1 else ""
         return (f"MMPPFit(n_states={self.n_states}, rates={rates}, loglik={self.loglik:.6g}, "
                 f"aic={self.aic:.6g}, n_windows={self.n_windows}, "
-                f"n_events={self.n_events}{flag})")
+                f"n_events={self.n_events}{best}{flag})")
 
     def summary(self) -> str:
         """A readable table of the fit."""
@@ -184,7 +199,10 @@ class MMPPFit:
                      + f"   stationary rate {self.stationary_rate:.6g}")
         if n > 1:
             lines.append("  mean sojourns " + ", ".join(f"{v:.4g}" for v in self.mean_sojourns))
-            lines.append(f"  EM: {self.n_iter} iterations, best of {self.n_starts} starts")
+            lines.append(f"  EM: {self.n_starts} starts run to convergence; {self.n_best} "
+                         f"reached the best log-likelihood (within {BEST_RTOL:g} relative)"
+                         f"{' - a fragile optimum' if self.n_best < 2 else ''}; the kept "
+                         f"run took {self.n_iter} iterations")
         if not self.converged:
             lines.append("  NOT CONVERGED: the numbers above are not a maximum-likelihood fit")
         lines.extend(f"  warning: {w}" for w in self.warnings)
@@ -212,7 +230,7 @@ def _keyed(rates, generator) -> dict:
     return out
 
 
-def fit_mmpp(times, t_max, *, n_states=2, n_starts=8, rng=None, max_iter=1000, tol=1e-9,
+def fit_mmpp(times, t_max, *, n_states=2, n_starts=12, rng=None, max_iter=1000, tol=1e-9,
              initial="stationary"):
     r"""Fit a Markov-modulated Poisson process to event times in censored windows.
 
@@ -228,12 +246,15 @@ def fit_mmpp(times, t_max, *, n_states=2, n_starts=8, rng=None, max_iter=1000, t
     n_states : int, optional
         Number of hidden states, 1 to 4 (1 is the homogeneous Poisson process).
     n_starts : int, optional
-        EM starts (>= 1): two from quantiles of local event rates, the others random;
-        the best log-likelihood is kept (see Notes).
+        EM starts (>= 1), each run to convergence; the best log-likelihood is kept.
+        The structured starts built from the data come first (bursts from the shortest
+        gaps, quiet spells from the longest, local event
+        rates, the fast- and slow-switching limits), then ``n_starts // 6`` random ones
+        (see Notes).
     rng : Generator or int, optional
-        Randomness of the random starts and of the screening subsample.
+        Randomness of the random starts.
     max_iter : int, optional
-        Most E-steps of the kept run (>= 1).
+        Most E-steps of each start's run (>= 1).
     tol : float, optional
         Stop when the log-likelihood changes by at most ``tol * |loglik|`` in an
         iteration, in (0, 1).
@@ -271,9 +292,13 @@ def fit_mmpp(times, t_max, *, n_states=2, n_starts=8, rng=None, max_iter=1000, t
     free start; with the stationary start it maximises
     :math:`\sum_{i \ne j} (M_{ij}\log q_{ij} - T_i q_{ij}) + \sum_k s_k \log \pi_k(Q)` by
     Newton's method. SQUAREM (Varadhan & Roland 2008) accelerates the iterations,
-    keeping them monotone. Each start first runs 25 iterations on a random subsample of
-    whole windows (about 20 000 intervals; all of them for smaller data), the two best
-    then run on all the data. Standard errors: the observed information, by central
+    keeping them monotone. The likelihood has several local maxima; on clustered event
+    times the global one often has a burst state (a rate far above the mean, entered a
+    few times) or a quiet one, which starts near the local event rates never reach. So
+    the starts are built for every regime (``kicktimes.stats.mmpp._starts``) and all are
+    run to convergence; ``n_best`` counts those that reached the best, and a fit is
+    never below the Poisson fit it nests (equal rates). Standard errors: the observed
+    information, by central
     differences of the exact score (Fisher's identity: the gradient of the expected
     complete-data log-likelihood at the fit). Computations run in a time unit in which
     the mean event rate is 1. Details: ``docs/mmpp.md``.
@@ -310,9 +335,9 @@ def fit_mmpp(times, t_max, *, n_states=2, n_starts=8, rng=None, max_iter=1000, t
     return fit
 
 
-def _fit(data, n, *, n_starts=8, rng=None, max_iter=1000, tol=1e-9, initial="stationary",
+def _fit(data, n, *, n_starts=12, rng=None, max_iter=1000, tol=1e-9, initial="stationary",
          covariance=True):
-    """fit_mmpp on a validated :class:`~._mmpp_em.Windows`; no warning is issued."""
+    """fit_mmpp on a validated :class:`~._em.Windows`; no warning is issued."""
     rng = check_rng(rng)
     k = n * n + (n - 1 if initial == "free" else 0)
     n_events = int(data.n_events.sum())
@@ -321,23 +346,71 @@ def _fit(data, n, *, n_starts=8, rng=None, max_iter=1000, tol=1e-9, initial="sta
                          f"many events, got {n_events}")
     if n == 1:
         return _poisson(data, covariance)
-    points = em.starting_points(data, n, n_starts, rng)
-    screen = data
-    if data.x.size > _SCREEN_INTERVALS and data.n_windows >= 4:
-        size = max(2, math.ceil(data.n_windows * _SCREEN_INTERVALS / data.x.size))
-        screen = data.subset(np.sort(rng.choice(data.n_windows, size=size, replace=False)))
-    runs = [em.run_em(r, q, screen, initial=initial, max_iter=min(_SCREEN_ITER, max_iter),
-                      tol=max(tol, _SCREEN_TOL)) for r, q in points]
-    runs.sort(key=lambda run: run.loglik if np.isfinite(run.loglik) else -np.inf, reverse=True)
-    finals = []
-    for run in runs[:_FINALISTS]:
-        rest = max(1, max_iter - run.n_iter)
-        final = em.run_em(run.rates, run.Q, data, initial=initial, max_iter=rest, tol=tol,
-                          alpha=run.alpha if initial == "free" else None)
-        final.n_iter += run.n_iter
-        finals.append(final)
-    best = max(finals, key=lambda run: run.loglik if np.isfinite(run.loglik) else -np.inf)
-    return _result(best, data, initial, n_starts=len(points), covariance=covariance)
+    points = starting_points(data, n, n_starts, rng)
+    search = data
+    if data.x.size > _SEARCH_INTERVALS and data.n_windows >= 4:
+        size = max(2, math.ceil(data.n_windows * _SEARCH_INTERVALS / data.x.size))
+        search = data.subset(np.sort(rng.choice(data.n_windows, size=size, replace=False)))
+    runs = _search(points, search, initial=initial, max_iter=max_iter, tol=tol)
+    lls = np.array([run.loglik if np.isfinite(run.loglik) else -np.inf for run in runs])
+    top = lls.max()
+    n_best = int(np.sum(lls >= top - BEST_RTOL * abs(top)))
+    shift = search.n_events.sum() * math.log(search.unit)
+    start_logliks = tuple(float(v - shift) for v in lls)
+    if search is data:
+        best = runs[int(np.argmax(lls))]
+    else:
+        finals, seen = [], []
+        for i in np.argsort(-lls, kind="stable"):
+            if len(finals) == _FINALISTS or not np.isfinite(lls[i]):
+                break
+            if any(abs(lls[i] - v) <= BEST_RTOL * abs(v) for v in seen):
+                continue  # the same optimum as a finalist
+            seen.append(lls[i])
+            run = runs[i]
+            final = em.run_em(run.rates, run.Q, data, initial=initial, max_iter=max_iter,
+                              tol=tol, alpha=run.alpha if initial == "free" else None)
+            final.n_iter += run.n_iter
+            finals.append(final)
+        best = max(finals, key=lambda run: run.loglik if np.isfinite(run.loglik) else -np.inf)
+    # the Poisson fit is nested (equal rates): no MMPP fit may end below it
+    rate = n_events / data.total_time
+    loglik_poisson = n_events * math.log(rate) - rate * data.total_time
+    if not best.loglik >= loglik_poisson - 1e-12 * abs(loglik_poisson):
+        rates = np.full(n, rate)
+        Q = np.full((n, n), rate / max(n - 1, 1)) - np.eye(n) * rate * n / max(n - 1, 1)
+        alpha = em.stationary_law(Q)
+        best = em.EMRun(rates, Q, alpha, em.estep(rates, Q, alpha, data), 1, True)
+    return _result(best, data, initial, n_starts=len(points), covariance=covariance,
+                   n_best=n_best, start_logliks=start_logliks)
+
+
+def _search(points, data, *, initial, max_iter, tol):
+    """Run every start to convergence, in two passes: each start first for up to
+    ``_FIRST_PASS`` E-steps, then those not converged from where they stopped, the best
+    first. A start that cannot catch up with the best so far stops early
+    (:func:`._em.run_em`'s ``floor``), and the first pass gives the floor early, so that
+    the starts crawling along a flat ridge below the best are stopped before they took
+    ``max_iter`` E-steps."""
+    runs, floor = [], -math.inf
+    for r, q, _ in points:
+        run = em.run_em(r, q, data, initial=initial, max_iter=min(_FIRST_PASS, max_iter),
+                        tol=tol, floor=floor)
+        runs.append(run)
+        if run.converged and np.isfinite(run.loglik):
+            floor = max(floor, run.loglik)
+    pending = [i for i, run in enumerate(runs) if not run.converged and run.n_iter < max_iter
+               and np.isfinite(run.loglik)]
+    for i in sorted(pending, key=lambda i: -runs[i].loglik):
+        run = runs[i]
+        more = em.run_em(run.rates, run.Q, data, initial=initial, tol=tol, floor=floor,
+                         max_iter=max_iter - run.n_iter,
+                         alpha=run.alpha if initial == "free" else None)
+        more.n_iter += run.n_iter
+        runs[i] = more
+        if np.isfinite(more.loglik):
+            floor = max(floor, more.loglik)
+    return runs
 
 
 def _poisson(data, covariance):
@@ -351,7 +424,7 @@ def _poisson(data, covariance):
                    np.zeros((1, 1)), np.array([[se * se]]))
 
 
-def _result(run, data, initial, *, n_starts, covariance):
+def _result(run, data, initial, *, n_starts, covariance, n_best=1, start_logliks=()):
     n = run.rates.size
     order = np.argsort(run.rates, kind="stable")
     rates, Q = run.rates[order], run.Q[np.ix_(order, order)]
@@ -365,8 +438,10 @@ def _result(run, data, initial, *, n_starts, covariance):
             problems.append(f"state {i} holds {events[i]:.3g} expected events and stationary "
                             f"probability {pi[i]:.3g}: a state with (almost) no events")
     close = np.flatnonzero(np.diff(rates) <= 0.01 * rates[1:])
+    # the best of all starts: no start found distinct rates with a higher likelihood
     problems += [f"states {i} and {i + 1} have rates within 1 % ({rates[i]:.4g}, "
-                 f"{rates[i + 1]:.4g}): the states are not distinguished" for i in close]
+                 f"{rates[i + 1]:.4g}) and no start found distinct rates with a higher "
+                 f"log-likelihood: the states are not distinguished" for i in close]
     switches = float(st.transitions.sum())
     if switches < 1.0:
         problems.append(f"the hidden chain switches {switches:.3g} times (expected) in all the "
@@ -405,4 +480,5 @@ def _result(run, data, initial, *, n_starts, covariance):
     return MMPPFit(rates / u, Q / u, pi, alpha, initial,
                    float(st.loglik - data.n_events.sum() * math.log(u)), data.n_windows,
                    int(data.n_events.sum()), data.total_time * u, bool(run.converged),
-                   int(run.n_iter), n_starts, se[:n], q_se, cov, tuple(problems))
+                   int(run.n_iter), n_starts, se[:n], q_se, cov, tuple(problems),
+                   n_best=n_best, start_logliks=start_logliks)

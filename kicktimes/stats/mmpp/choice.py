@@ -32,12 +32,12 @@ import numpy as np
 import pandas as pd
 from scipy import optimize
 
-from . import _mmpp_em as em
-from ._checks import check_choice, check_int, check_rng
-from .comparison import compare_models
-from .mmpp import MAX_STATES, MMPPFit, _fit, check_windows
-from .poisson import intervals_from_times
-from .renewal import FULL_SAMPLE_MODELS, FitWarning
+from .._checks import check_choice, check_int, check_rng
+from ..comparison import compare_models
+from ..poisson import intervals_from_times
+from ..renewal import FULL_SAMPLE_MODELS, FitWarning
+from . import _em as em
+from .fit import MAX_STATES, MMPPFit, _fit, check_windows
 
 
 def _conditional_loglik(rates, Q, data, first):
@@ -80,7 +80,7 @@ def _conditional_fit(fit: MMPPFit, data):
     return -best - shift, bool(res.success) or best < start
 
 
-def compare_point_processes(times, t_max, *, models=None, n_states=(2,), n_starts=8,
+def compare_point_processes(times, t_max, *, models=None, n_states=(2,), n_starts=12,
                             rng=None, return_fits=False):
     r"""Rank Poisson, renewal and MMPP models of event times in windows by AIC, on one
     likelihood.
@@ -207,7 +207,7 @@ class MMPPLRTest:
     mmpp: MMPPFit = field(repr=False)
 
 
-def mmpp_lr_test(times, t_max, *, n_states=2, n_boot=99, n_starts=8, rng=None):
+def mmpp_lr_test(times, t_max, *, n_states=2, n_boot=99, n_starts=12, rng=None):
     r"""Is an MMPP needed? The likelihood-ratio test against the homogeneous Poisson
     process, calibrated by a parametric bootstrap given the number of events.
 
@@ -220,7 +220,9 @@ def mmpp_lr_test(times, t_max, *, n_states=2, n_boot=99, n_starts=8, rng=None):
     n_boot : int, optional
         Bootstrap samples (>= 1); the p-value's resolution is ``1 / (n_boot + 1)``.
     n_starts : int, optional
-        EM starts of every MMPP fit (the data's and each sample's alike).
+        EM starts of every MMPP fit, the data's and each sample's alike: the search of
+        :func:`fit_mmpp` (every start run to convergence), so that the statistic of the
+        data and its null distribution come from the same maximisation.
     rng : Generator or int, optional
 
     Returns

@@ -25,7 +25,7 @@ import numpy as np
 from numba import njit
 from scipy import linalg
 
-from ._mmpp_kernels import forward_backward
+from ._kernels import forward_backward
 
 #: Floors and caps of the generator's off-diagonal entries and of the rates, in the fit's
 #: unit (mean event rate 1): they keep the chain irreducible and every state reachable,
@@ -147,7 +147,7 @@ def spectral(Q, rates):
 
 
 def estep(rates, Q, alpha, data: Windows, *, log_surv=False) -> EStats:
-    """One forward-backward pass over all windows (compiled; see ``_mmpp_kernels``)."""
+    """One forward-backward pass over all windows (compiled; see ``_kernels``)."""
     n = rates.size
     dec = spectral(Q, rates)
     if dec is None:

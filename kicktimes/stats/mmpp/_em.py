@@ -1,16 +1,17 @@
 r"""The EM of the Markov-modulated Poisson process (Rydén 1996): M-step, score,
 the accelerated iterations, starting points and the observed information.
 
-The E-step and the data layout are in :mod:`._mmpp_estep` (names re-exported here).
+The E-step and the data layout are in :mod:`._estep` (names re-exported here).
 
 * :func:`mstep` maximises the expected complete-data log-likelihood: rates ``N_i/T_i``;
   the generator in closed form ``M_ij / T_i`` for a free start, and by Newton's method
-  (:func:`_generator_step`, compiled) when the start is the stationary law of ``Q``,
+  (:func:`._em_kernels.generator_step`, compiled) when the start is the stationary law of ``Q``,
   whose ``sum_k s_k log pi_k(Q)`` term has no closed form.
 * :func:`score` is the exact gradient of the observed log-likelihood by Fisher's
   identity (the gradient of the expected complete-data log-likelihood at the E-step's
   parameters).
-* :func:`run_em` iterates E- and M-steps with SQUAREM; :func:`starting_points` and
+* :func:`run_em` iterates E- and M-steps with SQUAREM (for two states one compiled loop,
+  :mod:`._em_kernels`); :func:`starting_points` and
   :func:`information` serve the fit.
 """
 
@@ -20,102 +21,38 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit
 
-from ._mmpp_estep import (  # noqa: F401 - the E-step's names, used as em.<name>
+from ._em_kernels import em_run_reversible, estep_reversible, generator_step, hopeless, value_grad
+from ._em_kernels import generator_of as _generator_of
+from ._em_kernels import objective as _objective
+from ._estep import (  # noqa: F401 - the E-step's names, used as em.<name>
     Q_CAP,
     Q_FLOOR,
     RATE_FLOOR,
     EStats,
     Windows,
-    estep,
     estep_reference,
     spectral,
     stationary_law,
 )
+from ._estep import estep as _estep_any
+
+
+def estep(rates, Q, alpha, data: Windows, *, log_surv=False) -> EStats:
+    """:func:`._estep.estep`; for two states (a reversible chain) without ``log_surv``
+    the compiled :func:`._em_kernels.estep_reversible`, the same kernel without the
+    Python work around it."""
+    if rates.size != 2 or log_surv:
+        return _estep_any(rates, Q, alpha, data, log_surv=log_surv)
+    bt, e, r = data.work(np.float64, 2)
+    out = estep_reversible(np.ascontiguousarray(rates, dtype=float),
+                           np.ascontiguousarray(Q, dtype=float),
+                           np.ascontiguousarray(alpha, dtype=float), data.x, data.start,
+                           bt, e, r)
+    return EStats(float(out[0]), out[5], out[6], out[1], out[2], out[3], out[4])
+
 
 # --------------------------------------------------------------------------- M-step
-
-@njit(cache=True)
-def _generator_of(u, n):
-    Q = np.zeros((n, n))
-    k = 0
-    for i in range(n):
-        for j in range(n):
-            if i != j:
-                Q[i, j] = math.exp(u[k])
-                Q[i, i] -= Q[i, j]
-                k += 1
-    return Q
-
-
-@njit(cache=True)
-def _objective(u, M, T, s, n):
-    r"""The generator's part of the expected complete-data log-likelihood,
-    :math:`\sum_{i \ne j} (M_{ij} \log q_{ij} - T_i q_{ij}) + \sum_k s_k \log\pi_k(Q)`,
-    and its gradient in ``u = log q``: with :math:`Z = (Q - 1\pi)^{-1}` and
-    :math:`v = Z (s / \pi)`,
-    :math:`\partial_{q_{ij}} \sum_k s_k \log \pi_k = -\pi_i (v_j - v_i)`."""
-    Q = _generator_of(u, n)
-    pi = stationary_law(Q)
-    value = 0.0
-    for k in range(n):
-        if s[k] > 0.0:
-            value += s[k] * math.log(max(pi[k], 1e-300))
-    A = Q.copy()
-    for i in range(n):
-        for j in range(n):
-            A[i, j] -= pi[j]
-    Z = np.linalg.inv(A)
-    v = Z @ (s / np.maximum(pi, 1e-300))
-    grad = np.empty(u.size)
-    k = 0
-    for i in range(n):
-        for j in range(n):
-            if i != j:
-                q = Q[i, j]
-                value += M[i, j] * u[k] - T[i] * q
-                grad[k] = M[i, j] - T[i] * q - q * pi[i] * (v[j] - v[i])
-                k += 1
-    return value, grad
-
-
-@njit(cache=True)
-def _generator_step(u, M, T, s, n, lo, hi, max_iter=50):
-    """Maximise :func:`_objective` from ``u`` by damped Newton (Hessian by differences of
-    the gradient, Levenberg shift, Armijo backtracking) inside ``[lo, hi]``; never
-    returns a point worse than ``u``."""
-    f, g = _objective(u, M, T, s, n)
-    p = u.size
-    for _ in range(max_iter):
-        scale = 1.0 + np.abs(M).max() + np.abs(s).max()
-        if np.abs(g).max() <= 1e-10 * scale:
-            break
-        H = np.empty((p, p))
-        for j in range(p):
-            h = 1e-6 * max(1.0, abs(u[j]))
-            v = u.copy()
-            v[j] += h
-            H[:, j] = (_objective(v, M, T, s, n)[1] - g) / h
-        H = 0.5 * (H + H.T)
-        # Levenberg: shift -H until it is safely positive definite
-        low = np.linalg.eigvalsh(-H)[0]
-        shift = max(0.0, 1e-8 * (1.0 + np.abs(H).max()) - low)
-        step = np.linalg.solve(-H + shift * np.eye(p), g)
-        t = 1.0
-        improved = False
-        for _b in range(40):
-            v = np.minimum(np.maximum(u + t * step, lo), hi)
-            fv, gv = _objective(v, M, T, s, n)
-            if np.isfinite(fv) and fv >= f + 1e-4 * t * (g @ step) - 1e-12 * abs(f):
-                improved = fv > f
-                u, f, g = v, fv, gv
-                break
-            t *= 0.5
-        if not improved:
-            break
-    return u
-
 
 def mstep(st: EStats, rates, Q, alpha, initial):
     """Maximiser of the expected complete-data log-likelihood: ``(rates, Q, alpha)``."""
@@ -133,8 +70,8 @@ def mstep(st: EStats, rates, Q, alpha, initial):
         old = np.log(np.clip(Q[off], Q_FLOOR, Q_CAP))
         # start Newton from the better of the old point (which guarantees an ascent)
         # and the closed form that ignores the stationary start
-        u0 = max((closed, old), key=lambda v: _objective(v, M, T, s, n)[0])
-        u = _generator_step(u0, M, T, s, n, lo, hi)
+        u0 = max((closed, old), key=lambda v: value_grad(v, M, T, s, n)[0])
+        u = generator_step(u0, M, T, s, n, lo, hi)
         new_alpha = None
     new_Q = _generator_of(np.ascontiguousarray(u, dtype=float), n)
     if new_alpha is None:
@@ -191,7 +128,8 @@ def _unpack(phi, n, initial):
     return rates, Q, stationary_law(Q)
 
 
-def run_em(rates, Q, data: Windows, *, initial, max_iter, tol, alpha=None) -> EMRun:
+def run_em(rates, Q, data: Windows, *, initial, max_iter, tol, alpha=None,
+           compiled=True, floor=-math.inf) -> EMRun:
     r"""Baum-Welch iterations from ``(rates, Q)``, accelerated by SQUAREM, until an EM
     step changes the log-likelihood by at most ``tol * |loglik|`` or ``max_iter``
     E-steps were made; the result holds the last E-step's parameters with their exact
@@ -206,10 +144,25 @@ def run_em(rates, Q, data: Windows, *, initial, max_iter, tol, alpha=None) -> EM
     retry halfway back), so the iterations stay monotone. EM crawls where the
     likelihood is flat (states nearly alike, a rate or switching rate running to 0);
     SQUAREM cuts those runs several-fold and leaves quick ones as they were.
+
+    With a ``floor`` (the best log-likelihood of other starts) a run stops early, not
+    converged, when it is :func:`._em_kernels.hopeless`: below the floor by more than ten
+    times its last gain per E-step for all the E-steps left.
+
+    Two states (a reversible chain) run as one compiled loop
+    (:func:`._em_kernels.em_run_reversible`, the same steps); ``compiled=False`` runs this
+    Python loop instead (the reference of the tests).
     """
     n = rates.size
     if alpha is None:
         alpha = stationary_law(Q)
+    if n == 2 and compiled:
+        # every two-state chain is reversible: the whole run in one compiled loop
+        out = em_run_reversible(np.array(rates, dtype=float), np.array(Q, dtype=float),
+                                np.array(alpha, dtype=float), data.x, data.start,
+                                initial == "free", int(max_iter), float(tol), float(floor))
+        stats = EStats(float(out[3]), out[8], out[9], out[4], out[5], out[6], out[7])
+        return EMRun(out[0], out[1], out[2], stats, int(out[10]), bool(out[11]))
     theta = (rates, Q, alpha)
     st = estep(*theta, data)
     used = 1
@@ -223,6 +176,7 @@ def run_em(rates, Q, data: Windows, *, initial, max_iter, tol, alpha=None) -> EM
         return abs(new.loglik - old.loglik) <= tol * abs(new.loglik)
 
     while used < max_iter:
+        cycle_loglik, cycle_used = st.loglik, used
         theta1, st1 = em_step(theta, st)
         used += 1
         if done(st, st1) or used >= max_iter:
@@ -239,6 +193,9 @@ def run_em(rates, Q, data: Windows, *, initial, max_iter, tol, alpha=None) -> EM
         if step >= -1.0:
             if free < -1.0:  # EM's own point was the bounded step: allow longer ones
                 step_max *= 4.0
+            if hopeless(st.loglik, floor, (st.loglik - cycle_loglik) / (used - cycle_used),
+                        used, max_iter):
+                break
             continue
         for _ in range(2):  # the extrapolation, then once halfway back towards EM's point
             if used >= max_iter:
@@ -253,6 +210,9 @@ def run_em(rates, Q, data: Windows, *, initial, max_iter, tol, alpha=None) -> EM
                 break
             step_max = max(1.0, step_max / 4.0)
             step = 0.5 * (step - 1.0)
+        if hopeless(st.loglik, floor, (st.loglik - cycle_loglik) / (used - cycle_used), used,
+                    max_iter):
+            break
     return EMRun(*theta, st, used, False)
 
 
