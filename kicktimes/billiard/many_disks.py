@@ -145,10 +145,12 @@ def expected_collisions(radii: np.ndarray, speed: float, t_max: float) -> tuple[
 
 def engine_run(state, radii, rule_code, t_max, *, masses=None, arcs=None, walls_sel=None,
                sample=None, tau=None, contacts=False, max_events=None, log=True,
-               cap_hint=1024):
+               cap_hint=1024, debug=False):
     """Run the engine on a validated state; returns a dict of its raw outputs in the
     caller's disk numbering. ``log=False`` keeps no collision log (the log buffer is
-    reused: the initial-state growth runs only need the final state)."""
+    reused: the initial-state growth runs only need the final state). ``debug=True``
+    checks every disk for overlaps and the table's wall after every event (O(n) per event,
+    `kd.check_state`): ``out["debug"] = [largest overlap, largest distance outside, checks]``."""
     n = state.shape[0]
     m, w = cells.grid(n, float(radii.max()))
     perm, eng = kd.new_engine(state, radii, m, w)
@@ -164,8 +166,8 @@ def engine_run(state, radii, rule_code, t_max, *, masses=None, arcs=None, walls_
     # then gets empty arrays: no holes, no disk selected, no samples): two compilations
     # of a minute each instead of one per combination.
     full = (masses is not None or arcs is not None or walls_sel is not None
-            or sample is not None or contacts)
-    walls = samp = con = None
+            or sample is not None or contacts or debug)
+    walls = samp = con = dbg = None
     if full:
         if mass is None:
             mass = np.ones(n)
@@ -184,6 +186,7 @@ def engine_run(state, radii, rule_code, t_max, *, masses=None, arcs=None, walls_
         else:
             samp = (1.0, np.zeros(0, dtype=np.int64), np.empty((0, 0, 2)))
         con = (np.empty(cap), np.empty(cap))
+        dbg = np.array([-np.inf, -np.inf, 0.0, 1.0 if debug else 0.0])
     speed = float(np.hypot(state[:, 2], state[:, 3]).max())
     if masses is not None:
         e = float(np.sum(masses * (state[:, 2] ** 2 + state[:, 3] ** 2)))
@@ -194,7 +197,7 @@ def engine_run(state, radii, rule_code, t_max, *, masses=None, arcs=None, walls_
     while True:
         status = kd.drive(fs, iv, head, m, w, qt, qi, ht, qh, qs, qw, rule_code, mass,
                           float(t_max), budget, stall_dt, clock, cnt, pp_t, pp_i, pp_j, esc,
-                          arcs, walls, samp, con)
+                          arcs, walls, samp, con, dbg)
         if status != FULL:
             break
         if cnt[kd.N_PP] >= pp_t.shape[0]:
@@ -230,6 +233,8 @@ def engine_run(state, radii, rule_code, t_max, *, masses=None, arcs=None, walls_
     if sample is not None and tau is not None:
         out["samples"] = samp[2]
         out["sample_times"] = np.arange(samp[2].shape[0]) * float(tau)
+    if debug:
+        out["debug"] = dbg[:3].copy()
     if contacts:
         out["contacts"] = (con[0][:n_pp].copy(), con[1][:n_pp].copy())
     return out

@@ -242,9 +242,38 @@ def rebase(fs, iv, qt, qi, ht, qh, qs, qw, now):
     cal.build(qt, qi, ht, qh, qs, qw, qt)
 
 
+@njit(cache=True, error_model="numpy")
+def check_state(fs, iv, head, m, now, dbg):
+    """Debug observer: the largest overlap of two disks and the largest distance of a
+    centre outside its room ``1 - r``, at ``now`` (all disks flown there), into
+    ``dbg[0]``, ``dbg[1]`` (maxima over the calls); ``dbg[2]`` counts the calls."""
+    for i in range(fs.shape[0]):
+        if iv[i, CELL] < 0:
+            continue
+        dt = now - fs[i, T]
+        x = fs[i, X] + fs[i, VX] * dt
+        y = fs[i, Y] + fs[i, VY] * dt
+        dbg[1] = max(dbg[1], np.sqrt(x * x + y * y) - (1.0 - fs[i, RAD]))
+        c = iv[i, CELL]
+        cx = c % m
+        cy = c // m
+        for gy in range(max(cy - 1, 0), min(cy + 2, m)):
+            for gx in range(max(cx - 1, 0), min(cx + 2, m)):
+                k = head[gx + m * gy]
+                while k >= 0:
+                    if k > i:
+                        dk = now - fs[k, T]
+                        dx = x - (fs[k, X] + fs[k, VX] * dk)
+                        dy = y - (fs[k, Y] + fs[k, VY] * dk)
+                        ov = fs[i, RAD] + fs[k, RAD] - np.sqrt(dx * dx + dy * dy)
+                        dbg[0] = max(dbg[0], ov)
+                    k = iv[k, NEXT]
+    dbg[2] += 1.0
+
+
 @njit(cache=True, error_model="numpy", _nrt=False)
 def drive(fs, iv, head, m, w, qt, qi, ht, qh, qs, qw, rule, mass, t_end, max_events,
-          stall_dt, clock, cnt, pp_t, pp_i, pp_j, esc, arcs, walls, samp, contacts):
+          stall_dt, clock, cnt, pp_t, pp_i, pp_j, esc, arcs, walls, samp, contacts, dbg):
     """Run the event loop until ``t_end`` (absolute; events at ``t_end`` included).
 
     Returns a status of `kicktimes.billiard.kernels.observe`: ``DONE``, ``FULL`` (a log is
@@ -255,7 +284,8 @@ def drive(fs, iv, head, m, w, qt, qi, ht, qh, qs, qw, rule, mass, t_end, max_eve
     escape time of disk ``i`` (``inf``). Observers (``None``: compiled out): ``arcs`` the
     holes; ``walls = (bt, bd, bx, by, bs, sel)`` the contacts of the disks with
     ``sel[i]``; ``samp = (tau, sdisks, spos)``: positions of ``sdisks`` at ``k tau`` into
-    ``spos[k]``; ``contacts = (cx, cy)`` the contact points of the disk-disk log.
+    ``spos[k]``; ``contacts = (cx, cy)`` the contact points of the disk-disk log;
+    ``dbg`` (debug mode if ``dbg[3] != 0``): `check_state` after every event.
     """
     cap = pp_t.shape[0]
     t_loc = t_end - clock[OFFSET]
@@ -290,6 +320,9 @@ def drive(fs, iv, head, m, w, qt, qi, ht, qh, qs, qw, rule, mass, t_end, max_eve
             clock[T_CHECK] -= now
             t_loc = t_end - clock[OFFSET]
             continue
+        if dbg is not None:
+            if dbg[3] != 0.0:
+                check_state(fs, iv, head, m, te, dbg)
         kind = iv[i, KIND]
         # a stall: STALL_EVENTS events in less than STALL_EVENTS * stall_dt
         cnt[N_CHECK] += 1
