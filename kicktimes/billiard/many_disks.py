@@ -194,6 +194,7 @@ def engine_run(state, radii, rule_code, t_max, *, masses=None, arcs=None, walls_
     stall_dt = 1e-9 * (1.0 - float(radii.max())) / (speed * n)
     budget = np.iinfo(np.int64).max if max_events is None else int(max_events)
     fs, iv, head, qt, qi, ht, qh, qs, qw = eng
+    dropped = 0  # collisions of a reused log buffer (log=False)
     while True:
         status = kd.drive(fs, iv, head, m, w, qt, qi, ht, qh, qs, qw, rule_code, mass,
                           float(t_max), budget, stall_dt, clock, cnt, pp_t, pp_i, pp_j, esc,
@@ -204,6 +205,7 @@ def engine_run(state, radii, rule_code, t_max, *, masses=None, arcs=None, walls_
             if not log:
                 cnt[kd.N_PP] = 0
                 budget -= pp_t.shape[0]
+                dropped += pp_t.shape[0]
             else:
                 new = min(2 * pp_t.shape[0], 2**31 - 1)
                 pp_t, pp_i, pp_j = (np.resize(pp_t, new), np.resize(pp_i, new),
@@ -221,7 +223,8 @@ def engine_run(state, radii, rule_code, t_max, *, masses=None, arcs=None, walls_
     out = {"status": int(status), "final_state": final, "clock_time": float(clock[0]),
            "pp_times": pp_t[:n_pp].copy(), "pp_i": np.minimum(a, b).astype(np.int32),
            "pp_j": np.maximum(a, b).astype(np.int32), "n_wall": int(cnt[kd.N_WALL]),
-           "n_pp_total": n_pp, "crossings": int(cnt[kd.N_CROSS]), "stale": int(cnt[kd.N_STALE]),
+           "n_pp_total": n_pp + dropped, "crossings": int(cnt[kd.N_CROSS]),
+           "stale": int(cnt[kd.N_STALE]),
            "cells_per_side": m, "buckets": int(qs[3])}
     esc_user = np.empty(n)
     esc_user[perm] = esc
