@@ -382,3 +382,23 @@ def test_bad_input_names_the_argument():
         kt.initial_state(100, None, packing=0.95)
     with pytest.raises(ValueError, match="n_disks"):
         kt.initial_state(0, 0.1)
+
+
+# --- the command line ------------------------------------------------------------------------
+def test_the_command_line_writes_the_log_and_prints_enskogs_frequency(tmp_path):
+    import pyarrow.parquet as pq
+    from click.testing import CliRunner
+
+    from kicktimes.cli import main
+
+    out = tmp_path / "d"
+    result = CliRunner().invoke(main, ["simulate", "--disks", "500", "--packing", "0.2",
+                                       "--t-max", "1", "--out", str(out)])
+    assert result.exit_code == 0, result.output
+    assert "Enskog-Henderson" in result.output
+    table = pq.read_table(out / "disks.parquet")
+    assert table.column_names == ["time", "i", "j"] and table.num_rows > 1000
+    assert b"kicktimes" in table.schema.metadata
+    bad = CliRunner().invoke(main, ["simulate", "--disks", "500", "--packing", "0.8",
+                                    "--out", str(out)])
+    assert bad.exit_code != 0 and "--packing must lie in (0.0, 0.7]" in bad.output
