@@ -21,7 +21,7 @@ from kicktimes.stats.enskog import PACKING_MAX, contact_value
 
 __all__ = ["check_disks", "engine_run", "expected_collisions", "simulate_disks"]
 
-#: most disks a run takes (int32 indices; 250 bytes each)
+#: most disks a run takes (int32 indices; about 180 bytes each)
 N_DISKS_MAX = 10**7
 #: bytes of the log per disk-disk collision (time, i, j)
 LOG_BYTES = 16
@@ -293,7 +293,7 @@ def simulate_disks(state, r, *, t_max, rule="mirror", masses=None, holes=None, s
     Exact and event-driven (docs/disks.md): collision times are roots of quadratics,
     disks carry their own clocks and move only when an event touches them. The wall and
     the rules are those of `simulate_two_particle`, and two disks agree with it event by
-    event. Memory: about 250 bytes per disk plus 16 per logged collision.
+    event. Memory: about 180 bytes per disk plus 16 per logged collision.
 
     Examples
     --------

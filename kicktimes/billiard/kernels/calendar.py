@@ -17,8 +17,8 @@ prediction) stay in the calendar and are recognised when they come to the top, b
 per-disk event counters of the engine (`kicktimes.billiard.kernels.disks`): lazy
 invalidation, without a search.
 
-The arrays (`new_calendar`; memory O(n): 56 bytes per disk and 8 per bucket, ``nb <= 2 n +
-64``):
+The arrays (`new_calendar`; memory O(n): 36 bytes per disk and 4 per bucket, ``nb`` the
+power of two at or above ``max(64, 2 n)``):
 
 * ``qt[i]`` the event time of disk ``i``; ``qi[i] = (where, next, prev, heap slot,
   disk at heap slot i)``, where ``where`` is `IN_HEAP`, `OVERFLOW`, `NEVER` or the

@@ -418,8 +418,9 @@ def new_engine(state: np.ndarray, radii: np.ndarray, m: int, w: float) -> tuple:
     a validated ``state`` (n, 4), set up at time 0 (`setup`), its disk ``k`` the caller's
     disk ``perm[k]`` (`cells.spatial_order`: neighbours share cache lines).
 
-    Memory: 64 + 64 bytes per disk here, 56 in the calendar, 8 per cell (at most ``4 n``
-    cells) and per bucket (at most ``2 n + 64``): under 250 bytes per disk."""
+    Memory: 64 + 32 bytes per disk here, 36 in the calendar, 4 per cell (at most about
+    ``4 n`` cells) and per bucket (``2 n`` rounded up to a power of two): 153-161 bytes per
+    disk at 10^4 disks (docs/disks.md)."""
     n = state.shape[0]
     perm = cells.spatial_order(state[:, 0], state[:, 1], m, w)
     fs = np.zeros((n, 8))
