@@ -123,10 +123,12 @@ def _simulate_disks(n_disks, packing, t_max, seed, rule, out):
     import os
 
     from kicktimes import initial_state, simulate_disks
+    from kicktimes.compilation import DISKS_KERNELS
     from kicktimes.stats import enskog_frequency
 
     if n_disks is None or packing is None:
         raise click.UsageError("--disks and --packing go together: give both")
+    _compile_first(None, DISKS_KERNELS)
     options = {"n_disks": "--disks", "packing": "--packing", "r": "--packing",
                "t_max": "--t-max", "seed": "--seed", "rule": "--rule", "state": "--packing"}
     with _cli_errors(options):
