@@ -7,6 +7,7 @@ collisions, and randomly kicked one-disk billiards driven by those times
 The main entry points::
 
     from kicktimes import simulate_two_particle, simulate_one_particle, initial_conditions
+    from kicktimes import simulate_disks, initial_state   # N disks (docs/disks.md)
     from kicktimes import schedules, stats, diagnostics
 
 Subpackages are imported lazily, so ``import kicktimes`` stays cheap.
@@ -25,6 +26,9 @@ _LAZY_ATTRS = {
     "TwoParticleRun": ("kicktimes.billiard.runs", "TwoParticleRun"),
     "OneParticleRun": ("kicktimes.billiard.runs", "OneParticleRun"),
     "read_run": ("kicktimes.billiard.runs", "read_run"),
+    "simulate_disks": ("kicktimes.billiard.many_disks", "simulate_disks"),
+    "initial_state": ("kicktimes.billiard.disk_states", "initial_state"),
+    "DisksRun": ("kicktimes.billiard.disks_run", "DisksRun"),
 }
 _LAZY_MODULES = {"billiard", "schedules", "stats", "diagnostics", "experiment", "plots", "report"}
 

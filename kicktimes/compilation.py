@@ -36,6 +36,9 @@ SWEEP_KERNELS = (
     ("kicktimes.stats._kinetic_quadrature", "invariant_partner_rates", 2.0),
 )
 SIMULATE_KERNELS = (("kicktimes.billiard.kernels.drive_two", "simulate_two_kernel", 4.5),)
+#: ``kicktimes simulate --disks``: the N-disk engine's loop, its variant without observers
+#: (inlined helpers: 70 s to 180 s on the 2-core machine at a load of 10, 2026-11-26)
+DISKS_KERNELS = (("kicktimes.billiard.kernels.disks", "drive", 60.0),)
 #: What the report compiles beyond the sweep's kernels (``kicktimes reproduce``'s report
 #: process warms them while the sweep's compile or run): the trajectory figures'
 #: re-simulations (two disks with a collision log, the kicked disk plainly), the

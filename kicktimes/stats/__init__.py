@@ -30,6 +30,7 @@ from .comparison import VuongResult, compare_models, vuong
 from .counts import CountRegression, kinetic_rate, regress_counts
 from .distributions import hyperexpon
 from .ensemble import PoissonEnsembleResult, test_poisson_ensemble
+from .enskog import contact_value, enskog_frequency
 from .findings import (
     Finding,
     format_interval,
@@ -84,6 +85,8 @@ __all__ = [
     "pooled_intervals",
     "regress_counts",
     "kinetic_rate",
+    "enskog_frequency",
+    "contact_value",
     "conditional_kinetic_rate",
     "mean_kinetic_rate",
     "circle_escape_constant",

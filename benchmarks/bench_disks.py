@@ -1,0 +1,180 @@
+"""Speed of the N-disk engine (issue 40): disk-disk collisions per second on one core.
+
+For N = 10^2, 10^3, 10^4 disks at packings 0.1, 0.3, 0.5 (mirror rule, every event
+processed, the collision log on): `kicktimes.simulate_disks` as a user calls it (argument
+checks, engine set-up, log), about ``--collisions`` collisions per run, CPU seconds
+(``time.process_time``: the machine is shared), the best of ``--repeats``. The cost per
+collision at 10^4 disks is compared with that at 10^2 (the target: at most 1.5x).
+
+Same-output baselines, where they finish:
+
+* python-billiards (``billiards``, GPL, the optional ``outside`` extra; imported, never
+  copied): its ``Billiard`` keeps an O(N^2) table of pair times. It has no concave wall, so
+  the table's wall is an ``Obstacle`` subclass here (`ConcaveCircle`). Elastic rule, the
+  same initial state; its first collisions must equal the engine's (pairs, times to 1e-6)
+  before it is timed.
+* the brute-force reference of the tests (``tests/_disks_reference.py``: all pairs at every
+  event, NumPy), mirror rule, same state and output.
+
+Also the robustness run of the issue: ``--robust 1e8`` collisions at packing 0.6 (N = 1000),
+checked for overlaps and disks outside at the end.
+
+Run: python benchmarks/bench_disks.py [--quick] [--robust 1e8]
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import sys
+import time
+
+import numpy as np
+
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "tests"))
+import _disks_reference as ref  # noqa: E402
+
+import kicktimes as kt  # noqa: E402
+from kicktimes.stats import enskog_frequency  # noqa: E402
+
+
+def cpu_best(func, repeats):
+    best, out = math.inf, None
+    for _ in range(repeats):
+        t0 = time.process_time()
+        out = func()
+        best = min(best, time.process_time() - t0)
+    return best, out
+
+
+def engine_rate(n, phi, collisions, repeats, rule="mirror"):
+    """``(collisions per CPU second, run)`` of simulate_disks at ``n``, ``phi``."""
+    r = math.sqrt(phi / n)
+    state = kt.initial_state(n, r, seed=1, rule=rule)
+    t_max = collisions / (0.5 * n * enskog_frequency(r, n))
+    kt.simulate_disks(state, r, t_max=t_max / 100, rule=rule)  # compiled, warm
+    sec, run = cpu_best(lambda: kt.simulate_disks(state, r, t_max=t_max, rule=rule), repeats)
+    return run.n_pp / sec, run, state, r
+
+
+class ConcaveCircle:
+    """The unit table's wall as a python-billiards obstacle: a disk of radius ``r`` inside
+    ``|x| <= 1`` hits it when its centre reaches ``1 - r``, and is reflected."""
+
+    def calc_toi(self, pos, vel, radius):
+        rho = 1.0 - radius
+        b = pos[0] * vel[0] + pos[1] * vel[1]
+        vv = vel[0] * vel[0] + vel[1] * vel[1]
+        if vv == 0.0:
+            return math.inf
+        c = rho * rho - pos[0] * pos[0] - pos[1] * pos[1]
+        disc = max(b * b + vv * c, 0.0)
+        t = c / (b + math.sqrt(disc)) if b > 0.0 else (-b + math.sqrt(disc)) / vv
+        return max(t, 0.0)
+
+    def collide(self, pos, vel, radius):
+        n = pos / math.hypot(pos[0], pos[1])
+        return vel - 2.0 * (vel @ n) * n
+
+
+def billiards_rate(state, r, n_events):
+    """``(collisions per CPU second, log)`` of python-billiards, or ``(None, why)``."""
+    try:
+        import billiards
+        from billiards.obstacles import Obstacle
+    except ImportError:
+        return None, "billiards not installed (pip install kicktimes[outside])"
+    wall = type("Wall", (ConcaveCircle, Obstacle), {})()
+    # its set-up fills the O(N^2) table of pair times: timed apart from the run
+    sim = billiards.Billiard(obstacles=[wall])
+    for row in state:
+        sim.add_ball(row[:2], row[2:], radius=r, mass=1.0)
+    # run until n_events disk-disk collisions: step the horizon
+    t0 = time.process_time()
+    log, t = [], 0.0
+    step = n_events / (0.5 * len(state) * enskog_frequency(r, len(state), rule="elastic")) / 8
+    while len(log) < n_events:
+        t += step
+        log += [c for c in sim.evolve(t) if isinstance(c[2], int | np.integer)]
+    sec = time.process_time() - t0
+    return len(log) / sec, np.array([(c[0], c[1], c[2]) for c in log], dtype=float)
+
+
+def agree(log_a, times_b, i_b, j_b, k):
+    """The first ``k`` collisions are the same pairs at times within 1e-6."""
+    k = min(k, len(log_a), len(times_b))
+    same = (log_a[:k, 1] == i_b[:k]).all() and (log_a[:k, 2] == j_b[:k]).all()
+    return bool(same and np.abs(log_a[:k, 0] - times_b[:k]).max() < 1e-6), k
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--quick", action="store_true", help="fewer collisions per run")
+    ap.add_argument("--collisions", type=float, default=3e6)
+    ap.add_argument("--repeats", type=int, default=3)
+    ap.add_argument("--robust", type=float, default=0.0,
+                    help="also run this many collisions at packing 0.6, N = 1000")
+    args = ap.parse_args(argv)
+    collisions = 3e5 if args.quick else args.collisions
+    rows = {}
+    print(f"kicktimes {kt.__version__}, {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}, "
+          f"CPU seconds, best of {args.repeats}, ~{collisions:.2g} collisions per run")
+    print(f"{'N':>6} {'packing':>7} {'coll/s':>10} {'ns/coll':>8} {'billiards':>10} "
+          f"{'brute':>10}")
+    for phi in (0.1, 0.3, 0.5):
+        for n in (100, 1000, 10000):
+            rate, run, state, r = engine_rate(n, phi, collisions, args.repeats)
+            rows[n, phi] = rate
+            bil = brute = "-"
+            if n == 100:
+                # python-billiards: elastic rule, the same state, same output first
+                es = kt.initial_state(n, r, seed=1, rule="elastic")
+                ours = kt.simulate_disks(es, r, t_max=200 / (0.5 * n * enskog_frequency(
+                    r, n, rule="elastic")), rule="elastic")
+                b_rate, b_log = billiards_rate(es, r, 1000 if not args.quick else 300)
+                if b_rate is not None:
+                    ok, k = agree(b_log, ours.pp_times, ours.pp_i, ours.pp_j, 20)
+                    e_rate, *_ = engine_rate(n, phi, collisions, 1, rule="elastic")
+                    bil = f"{e_rate / b_rate:.0f}x" + ("" if ok else "(!)")
+                    print(f"  python-billiards N={n} phi={phi}: {b_rate:.3g} coll/s, first {k} "
+                          f"collisions {'agree' if ok else 'DIFFER'}; engine elastic "
+                          f"{e_rate:.3g} coll/s")
+                else:
+                    print(f"  python-billiards skipped: {b_log}")
+            if n <= 1000:
+                k = 300 if n == 100 else 40
+                t0 = time.process_time()
+                log, _ = ref.simulate(state, r, run.t_max, n_pp=k)
+                b_rate = len(log) / (time.process_time() - t0)
+                ok, kk = agree(log, run.pp_times, run.pp_i, run.pp_j, 20)
+                brute = f"{rate / b_rate:.0f}x" + ("" if ok else "(!)")
+            print(f"{n:>6} {phi:>7} {rate:>10.3g} {1e9 / rate:>8.0f} {bil:>10} {brute:>10}",
+                  flush=True)
+    for phi in (0.1, 0.3, 0.5):
+        print(f"cost per collision N=1e4 / N=1e2 at packing {phi}: "
+              f"{rows[100, phi] / rows[10000, phi]:.2f}")
+    print(f"target: >= 1.0e6 coll/s at N=1000, packing 0.3: {rows[1000, 0.3]:.3g}")
+    if args.robust:
+        n, phi = 1000, 0.6
+        from scipy.spatial import cKDTree
+
+        from kicktimes.billiard.many_disks import engine_run
+
+        r = math.sqrt(phi / n)
+        state = kt.initial_state(n, r, seed=7)
+        t_max = args.robust / (0.5 * n * enskog_frequency(r, n))
+        t0 = time.process_time()
+        out = engine_run(state, np.full(n, r), 0, t_max, log=False)
+        sec = time.process_time() - t0
+        end = out["final_state"]
+        pairs = cKDTree(end[:, :2]).query_pairs(2 * r * (1 - 1e-10))
+        outside = (np.hypot(end[:, 0], end[:, 1]) > 1 - r + 1e-12).sum()
+        total = out["n_pp_total"]
+        print(f"robustness: packing 0.6, N=1000, t_max={t_max:.4g}: status {out['status']}, "
+              f"{total:.4g} disk-disk collisions in {sec:.0f} s ({total / sec:.3g}/s), "
+              f"overlapping pairs at the end {len(pairs)}, disks outside {outside}")
+
+
+if __name__ == "__main__":
+    main()

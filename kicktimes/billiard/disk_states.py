@@ -1,0 +1,233 @@
+"""Initial states of N disks in the unit table: `initial_state`.
+
+Positions: random sequential addition (RSA) up to packing `RSA_PACKING`; denser states
+are grown from there with the engine itself (Lubachevsky-Stillinger growth in steps: the
+disks move, then each grows by half the room it has, `grow_step`); finally the disks are
+relaxed by the dynamics (`RELAX_COLLISIONS` collisions per disk), whose invariant measure
+is uniform over the non-overlapping configurations. Velocities are drawn last.
+docs/disks.md, "Initial states".
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from kicktimes._validation import check_int, check_real, check_rng
+from kicktimes.billiard import checks as chk
+from kicktimes.billiard.many_disks import check_radii_of, engine_run
+from kicktimes.stats.enskog import PACKING_MAX, contact_value
+
+__all__ = ["initial_state", "grow_step"]
+
+#: RSA places disks directly up to this packing (its jamming limit is 0.547)
+RSA_PACKING = 0.35
+#: densest state `initial_state` grows
+PACKING_LIMIT = 0.7
+#: collisions per disk of the relaxation run, and of each growth step
+RELAX_COLLISIONS = 20.0
+GROW_COLLISIONS = 2.0
+#: at most this many growth steps
+GROW_STEPS = 2000
+
+
+@njit(cache=True, error_model="numpy")
+def _rsa(radii, order, u, xy, m, w, head, nxt, k0, j0):
+    """Place disks ``order[k0:]`` one by one at candidates ``u[j]`` (uniform in [0, 1)^2,
+    mapped to the square) inside the table and clear of the disks placed; returns
+    ``(k, j)``: disks placed so far and candidates used (more candidates are needed if
+    ``j == len(u)``)."""
+    k = k0
+    j = j0
+    n = order.shape[0]
+    r_max = radii[order[0]]
+    while k < n and j < u.shape[0]:
+        i = order[k]
+        x = 2.0 * u[j, 0] - 1.0
+        y = 2.0 * u[j, 1] - 1.0
+        j += 1
+        rho = 1.0 - radii[i]
+        if x * x + y * y > rho * rho:
+            continue
+        cx = min(int((x + 1.0) / w), m - 1)
+        cy = min(int((y + 1.0) / w), m - 1)
+        reach = int(math.ceil((radii[i] + r_max) / w))
+        ok = True
+        for gy in range(max(cy - reach, 0), min(cy + reach + 1, m)):
+            for gx in range(max(cx - reach, 0), min(cx + reach + 1, m)):
+                q = head[gx + m * gy]
+                while q >= 0:
+                    dx = x - xy[q, 0]
+                    dy = y - xy[q, 1]
+                    s = radii[i] + radii[q]
+                    if dx * dx + dy * dy < s * s:
+                        ok = False
+                        break
+                    q = nxt[q]
+                if not ok:
+                    break
+            if not ok:
+                break
+        if not ok:
+            continue
+        xy[i, 0] = x
+        xy[i, 1] = y
+        c = cx + m * cy
+        nxt[i] = head[c]
+        head[c] = i
+        k += 1
+    return k, j
+
+
+def _rsa_positions(radii: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+    """Centres by random sequential addition, largest disks first."""
+    n = radii.shape[0]
+    order = np.argsort(-radii, kind="stable")
+    m = max(1, min(int(2.0 / (2.0 * radii.max())), int(math.ceil(2.0 * math.sqrt(n)))))
+    w = 2.0 / m
+    head = np.full(m * m, -1, dtype=np.int64)
+    nxt = np.full(n, -1, dtype=np.int64)
+    xy = np.zeros((n, 2))
+    k = 0
+    tries = 0
+    while k < n:
+        u = rng.random((max(4 * (n - k), 256), 2))
+        k, _ = _rsa(radii, order, u, xy, m, w, head, nxt, k, 0)
+        tries += u.shape[0]
+        if tries > 1000 * n + 10**6:  # pragma: no cover - RSA_PACKING is far from jamming
+            raise RuntimeError("random sequential addition did not place the disks")
+    return xy
+
+
+def grow_step(xy: np.ndarray, radii: np.ndarray, target: np.ndarray) -> np.ndarray:
+    """Radii grown by half the room each disk has (capped at ``target``): disk ``i`` may
+    reach ``min(1 - |x_i|, min_j (d_ij - r_j))``; if both disks of a pair take half their
+    room they still do not overlap."""
+    from scipy.spatial import cKDTree
+
+    room = 1.0 - np.hypot(xy[:, 0], xy[:, 1]) - radii
+    pairs = cKDTree(xy).query_pairs(2.0 * float(target.max()), output_type="ndarray")
+    if pairs.size:
+        a, b = pairs[:, 0], pairs[:, 1]
+        gap = np.hypot(xy[a, 0] - xy[b, 0], xy[a, 1] - xy[b, 1]) - radii[a] - radii[b]
+        np.minimum.at(room, a, gap)
+        np.minimum.at(room, b, gap)
+    # (a margin of 1e-9 of the room: the contact tests of the engine take touching disks)
+    return np.minimum(target, radii + 0.5 * np.maximum(room, 0.0) * (1.0 - 1e-9))
+
+
+def _unit_velocities(n: int, rng: np.random.Generator) -> np.ndarray:
+    theta = rng.uniform(0.0, 2.0 * np.pi, n)
+    return np.column_stack([np.cos(theta), np.sin(theta)])
+
+
+def _relax(xy, radii, t, rng):
+    """Positions after the mirror dynamics has run for ``t`` from unit velocities."""
+    state = np.column_stack([xy, _unit_velocities(radii.shape[0], rng)])
+    out = engine_run(state, radii, chk.RULES["mirror"], t, log=False)
+    return out["final_state"][:, :2]
+
+
+def _collision_time(radii: np.ndarray, per_disk: float) -> float:
+    """The time in which each disk collides about ``per_disk`` times (Enskog, unit speeds)."""
+    n = radii.shape[0]
+    phi = float(np.sum(radii ** 2))
+    r = math.sqrt(phi / n)
+    nu = (n / math.pi) * 4.0 * r * float(contact_value(phi)) * 4.0 / math.pi
+    return per_disk / max(nu, 1e-12) if n > 1 else per_disk
+
+
+def initial_state(n_disks, r, *, seed=0, rule="mirror", masses=None, packing=None) -> np.ndarray:
+    """A state of ``n_disks`` non-overlapping disks in the unit table, for `simulate_disks`.
+
+    Parameters
+    ----------
+    n_disks : int
+        Number of disks (``>= 1``).
+    r : float or array_like or None
+        The disks' radius, or one radius per disk (each in ``(0, 1)``); with ``packing``,
+        relative radii (``None``: equal disks).
+    seed : int or numpy.random.Generator
+        The random stream (`kicktimes._validation.check_rng`).
+    rule : {"mirror", "elastic"}
+        The velocities: unit speeds with uniform directions (``"mirror"``), or uniform on
+        the energy shell ``sum_i m_i |v_i|^2 = n_disks`` (``"elastic"``).
+    masses : array_like, optional
+        The masses of the energy shell (elastic rule; default 1).
+    packing : float, optional
+        The area fraction ``sum r_i^2`` (the table has area pi, a disk pi r^2), at most 0.7:
+        the radii ``r`` are scaled to it.
+
+    Returns
+    -------
+    ndarray, shape (n_disks, 4)
+        Rows ``(x, y, vx, vy)``.
+
+    Notes
+    -----
+    Positions are placed by random sequential addition up to packing 0.35; a denser
+    state grows from there with the engine (each step: two collisions per disk of the
+    mirror dynamics, then every disk grows by half the room it has, up to its radius).
+    Then the dynamics runs for 20 collisions per disk, so that positions come close to
+    the invariant measure, uniform over non-overlapping configurations (RSA alone is
+    not: it favours gaps near the disks placed first). docs/disks.md, "Initial states".
+
+    Examples
+    --------
+    >>> import numpy as np, kicktimes as kt
+    >>> s = kt.initial_state(100, None, packing=0.3, seed=2)
+    >>> s.shape, bool(np.allclose(np.hypot(s[:, 2], s[:, 3]), 1.0))
+    ((100, 4), True)
+    """
+    n = check_int("n_disks", n_disks, low=1, high=10**7)
+    rng = check_rng(seed, "seed")
+    chk.check_choice("rule", rule, chk.RULES)
+    if packing is not None:
+        packing = check_real("packing", packing, low=0.0)
+        if packing >= PACKING_MAX:
+            raise ValueError(f"packing must lie in (0.0, {PACKING_LIMIT}]: a packing of "
+                             f"{packing!r} cannot exist (the densest is pi/sqrt(12) = "
+                             f"{PACKING_MAX:.6g})")
+        rel = np.ones(n) if r is None else check_radii_of(r, n)
+        radii = rel * math.sqrt(packing / float(np.sum(rel ** 2)))
+        if radii.max() >= 1.0:
+            raise ValueError(f"packing={packing!r} makes a radius of {radii.max():.6g}, not "
+                             f"below 1")
+    else:
+        if r is None:
+            raise ValueError("give r (a radius, or one per disk) or packing")
+        radii = check_radii_of(r, n)
+    phi = float(np.sum(radii ** 2))
+    if phi > PACKING_LIMIT:
+        raise ValueError(f"packing must lie in (0.0, {PACKING_LIMIT}], got {phi:.6g}: denser "
+                         f"states are not grown (hard disks freeze above about 0.70)")
+    if masses is not None:
+        if rule != "elastic":
+            raise ValueError(f"masses apply to rule='elastic', got rule={rule!r}")
+        masses = np.array(masses, dtype=np.float64)
+        if masses.ndim == 0:
+            masses = np.full(n, float(masses))
+        if masses.shape != (n,) or not (np.isfinite(masses) & (masses > 0.0)).all():
+            raise ValueError(f"masses must be {n} positive finite numbers (one per disk)")
+    start = min(1.0, math.sqrt(RSA_PACKING / phi))
+    cur = radii * start
+    xy = _rsa_positions(cur, rng)
+    steps = 0
+    while n > 1 and (cur < radii).any():
+        xy = _relax(xy, cur, _collision_time(cur, GROW_COLLISIONS), rng)
+        cur = grow_step(xy, cur, radii)
+        steps += 1
+        if steps > GROW_STEPS:
+            raise RuntimeError(f"initial_state: the disks did not grow to packing {phi:.4g} "
+                               f"in {GROW_STEPS} steps (reached {float(np.sum(cur ** 2)):.4g})")
+    if n > 1:
+        xy = _relax(xy, radii, _collision_time(radii, RELAX_COLLISIONS), rng)
+    if rule == "mirror":
+        v = _unit_velocities(n, rng)
+    else:
+        m = np.ones(n) if masses is None else masses
+        v = rng.standard_normal((n, 2)) / np.sqrt(m)[:, None]
+        v *= math.sqrt(n / float(np.sum(m * (v[:, 0] ** 2 + v[:, 1] ** 2))))
+    return np.column_stack([xy, v])
