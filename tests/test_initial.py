@@ -111,9 +111,11 @@ def test_the_paper_radii_give_the_same_ensembles_bit_for_bit(method, rule, r_max
 def test_every_radius_up_to_one_half_gives_valid_ics_in_bounded_time(method, r_max):
     import time
 
-    t0 = time.perf_counter()
+    # a bound against a hang, not a benchmark: 2-5 s on a 2-core machine, more when it is
+    # shared (CPU time, so other processes do not count)
+    t0 = time.process_time()
     ics = initial_conditions(20, r_max, seed=1, method=method, rule="elastic")
-    assert time.perf_counter() - t0 < 5.0
+    assert time.process_time() - t0 < 15.0
     assert (np.hypot(ics[:, :, 0], ics[:, :, 1]) <= 1 - r_max).all()
     gap = np.hypot(ics[:, 0, 0] - ics[:, 1, 0], ics[:, 0, 1] - ics[:, 1, 1])
     assert (gap >= 2 * r_max).all()
