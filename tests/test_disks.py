@@ -6,10 +6,12 @@ import os
 import sys
 
 import numpy as np
+import pandas as pd
 import pytest
 
 import kicktimes as kt
 from kicktimes import initial_conditions, simulate_two_particle
+from kicktimes.billiard import many_disks as md
 from kicktimes.billiard.kernels import calendar as cal
 from kicktimes.billiard.kernels import cells
 from kicktimes.billiard.many_disks import engine_run
@@ -246,6 +248,31 @@ def test_disks_escape_through_holes_and_the_rest_go_on():
     assert (run.pp_times > esc[out[0]]).sum() > 10
     assert run.walls is not None and set(run.walls.disk) <= {0, 1}
     assert run.samples.shape == (61, 2, 2)
+
+
+@pytest.mark.parametrize("observers", [False, True])
+def test_renumbering_the_disks_in_space_changes_no_event(monkeypatch, observers):
+    # the engine renumbers its disks by cell as they diffuse (kd.relabel, from 2048 disks
+    # on); renumbering after every collision must leave every output as it was, bitwise
+    n, r = 60, 0.04
+    state = kt.initial_state(n, r, seed=8)
+    kw = dict(holes=[(0.0, 0.1)], sample=[0, 5, 17], tau=0.5, log_walls=True) if observers \
+        else {}
+
+    def run(sweeps, min_disks):
+        monkeypatch.setattr(md, "REORDER_SWEEPS", sweeps)
+        monkeypatch.setattr(md, "REORDER_MIN_DISKS", min_disks)
+        return kt.simulate_disks(state, r, t_max=20.0, **kw)
+
+    plain, renumbered = run(10, 10**9), run(1 / n, 0)
+    assert plain.n_pp > 500
+    pd.testing.assert_frame_equal(plain.collisions, renumbered.collisions)
+    np.testing.assert_array_equal(plain.final_state, renumbered.final_state)
+    if observers:
+        assert np.isfinite(plain.escape_times).sum() > 5
+        np.testing.assert_array_equal(plain.escape_times, renumbered.escape_times)
+        pd.testing.assert_frame_equal(plain.walls, renumbered.walls)
+        np.testing.assert_array_equal(plain.samples, renumbered.samples)
 
 
 def test_samples_are_the_positions_at_k_tau():

@@ -25,6 +25,10 @@ __all__ = ["check_disks", "engine_run", "expected_collisions", "simulate_disks"]
 N_DISKS_MAX = 10**7
 #: bytes of the log per disk-disk collision (time, i, j)
 LOG_BYTES = 16
+#: the engine renumbers its disks in space (`kd.relabel`) every this many disk-disk
+#: collisions per disk, from this many disks on (fewer fit in the core's cache anyway)
+REORDER_SWEEPS = 10
+REORDER_MIN_DISKS = 2048
 
 
 def _memory_bytes() -> float:
@@ -156,9 +160,11 @@ def engine_run(state, radii, rule_code, t_max, *, masses=None, arcs=None, walls_
     perm, eng = kd.new_engine(state, radii, m, w)
     inv = np.empty(n, dtype=np.int64)
     inv[perm] = np.arange(n)
+    ident = perm.astype(np.int32)  # engine disk k is the caller's ident[k]
+    reorder_every = max(1, int(REORDER_SWEEPS * n)) if n >= REORDER_MIN_DISKS else 0
     mass = None if masses is None else np.ascontiguousarray(masses[perm])
     clock = np.zeros(3)
-    cnt = np.zeros(8, dtype=np.int64)
+    cnt = np.zeros(9, dtype=np.int64)
     cap = int(min(max(cap_hint, 64), 2**31 - 1)) if log else 4096
     pp_t, pp_i, pp_j = np.empty(cap), np.empty(cap, np.int32), np.empty(cap, np.int32)
     esc = np.full(n, np.inf)
@@ -198,7 +204,18 @@ def engine_run(state, radii, rule_code, t_max, *, masses=None, arcs=None, walls_
     while True:
         status = kd.drive(fs, iv, head, m, w, qt, qi, ht, qh, qs, qw, rule_code, mass,
                           float(t_max), budget, stall_dt, clock, cnt, pp_t, pp_i, pp_j, esc,
-                          arcs, walls, samp, con, dbg)
+                          ident, reorder_every, arcs, walls, samp, con, dbg)
+        if status == kd.REORDER:
+            order = cells.cell_order(iv[:, kd.CELL], m)
+            new_of = kd.relabel(fs, iv, head, m, qt, qi, ht, qh, qs, qw, order)
+            ident = ident[order]
+            if mass is not None:
+                mass = mass[order]
+            if walls is not None:
+                walls = walls[:5] + (walls[5][order],)
+            if samp is not None:
+                samp = (samp[0], new_of[samp[1]].astype(np.int64), samp[2])
+            continue
         if status != FULL:
             break
         if cnt[kd.N_PP] >= pp_t.shape[0]:
@@ -218,20 +235,17 @@ def engine_run(state, radii, rule_code, t_max, *, masses=None, arcs=None, walls_
     n_pp = int(cnt[kd.N_PP])
     fin = kd.final_state(fs, iv, clock, float(t_max))
     final = np.empty_like(fin)
-    final[perm] = fin
-    a, b = perm[pp_i[:n_pp]], perm[pp_j[:n_pp]]
+    final[ident] = fin
     out = {"status": int(status), "final_state": final, "clock_time": float(clock[0]),
-           "pp_times": pp_t[:n_pp].copy(), "pp_i": np.minimum(a, b).astype(np.int32),
-           "pp_j": np.maximum(a, b).astype(np.int32), "n_wall": int(cnt[kd.N_WALL]),
+           "pp_times": pp_t[:n_pp].copy(), "pp_i": pp_i[:n_pp].copy(),
+           "pp_j": pp_j[:n_pp].copy(), "n_wall": int(cnt[kd.N_WALL]),
            "n_pp_total": n_pp + dropped, "crossings": int(cnt[kd.N_CROSS]),
            "stale": int(cnt[kd.N_STALE]),
            "cells_per_side": m, "buckets": int(qs[3])}
-    esc_user = np.empty(n)
-    esc_user[perm] = esc
-    out["escape_times"] = esc_user
+    out["escape_times"] = esc
     if walls_sel is not None:
         q = int(cnt[kd.N_WLOG])
-        out["wall_log"] = (walls[0][:q].copy(), perm[walls[1][:q]].astype(np.int32),
+        out["wall_log"] = (walls[0][:q].copy(), walls[1][:q].copy(),
                            walls[2][:q].copy(), walls[3][:q].copy(), walls[4][:q].copy())
     if sample is not None and tau is not None:
         out["samples"] = samp[2]

@@ -20,7 +20,7 @@ import math
 import numpy as np
 from numba import njit
 
-__all__ = ["cell_of", "crossing", "grid", "insert", "remove", "spatial_order"]
+__all__ = ["cell_of", "cell_order", "crossing", "grid", "insert", "remove", "spatial_order"]
 
 INF = np.inf
 
@@ -103,12 +103,20 @@ def crossing(x, y, vx, vy, c, m, w):
     return dt, cn
 
 
+def cell_order(c: np.ndarray, m: int) -> np.ndarray:
+    """A permutation of the disks in cells ``c`` (-1: none, last) that puts neighbours next
+    to each other in memory: by cell, the cells in boustrophedon order (rows of cells,
+    every other one reversed). The engine numbers its disks so, and renumbers them so as
+    they diffuse (`kicktimes.billiard.kernels.disks.relabel`): at 10^4 disks the rows of
+    neighbours then share cache lines."""
+    c = np.asarray(c, dtype=np.int64)
+    cx, cy = c % m, c // m
+    key = np.where(c >= 0, cy * m + np.where(cy % 2 == 0, cx, m - 1 - cx), m * m)
+    return np.argsort(key, kind="stable")
+
+
 def spatial_order(x: np.ndarray, y: np.ndarray, m: int, w: float) -> np.ndarray:
-    """A permutation of the disks that puts neighbours next to each other in memory: by
-    cell, the cells in boustrophedon order (rows of cells, every other one reversed).
-    The engine numbers its disks so: at 10^4 disks the rows of neighbours then share cache
-    lines."""
+    """`cell_order` of the disks at centres ``(x, y)``."""
     cx = np.clip(((x + 1.0) / w).astype(np.int64), 0, m - 1)
     cy = np.clip(((y + 1.0) / w).astype(np.int64), 0, m - 1)
-    key = cy * m + np.where(cy % 2 == 0, cx, m - 1 - cx)
-    return np.argsort(key, kind="stable")
+    return cell_order(cx + m * cy, m)

@@ -50,7 +50,7 @@ from kicktimes.billiard.kernels import cells
 from kicktimes.billiard.kernels import observe as ob
 from kicktimes.billiard.kernels.two import anchor_energy, pair_event, wall_event
 
-__all__ = ["CROSS", "NONE", "WALL", "drive", "final_state", "setup"]
+__all__ = ["CROSS", "NONE", "REORDER", "WALL", "drive", "final_state", "relabel", "setup"]
 
 #: columns of the disk table ``fs``
 X, Y, VX, VY, T, TW, TP, RAD = range(8)
@@ -60,7 +60,10 @@ KIND, STAMP, COUNT, KIND_P, STAMP_P, CELL, NEXT, PREV = range(8)
 WALL, CROSS, NONE = -1, -2, -3
 #: fields of ``clock`` (float64) and ``cnt`` (int64), the loop's position between calls
 OFFSET, COMP, T_CHECK = range(3)
-N_PP, N_WALL, N_CROSS, N_STALE, N_WLOG, K_SAMPLE, N_ESC, N_CHECK = range(8)
+N_PP, N_WALL, N_CROSS, N_STALE, N_WLOG, K_SAMPLE, N_ESC, N_CHECK, N_SINCE = range(9)
+#: the engine's own status (beside `kicktimes.billiard.kernels.observe`'s): ``reorder_every``
+#: collisions since the last renumbering; the caller renumbers (`relabel`) and resumes
+REORDER = 4
 #: local clocks are shifted back to 0 once they pass this (ulp(32) = 7e-15)
 REBASE = 32.0
 #: a stall: this many events with the clock advancing less than ``stall_dt`` in all
@@ -271,17 +274,21 @@ def check_state(fs, iv, head, m, now, dbg):
     dbg[2] += 1.0
 
 
-@njit(cache=True, error_model="numpy", _nrt=False)
+@njit(cache=True, inline="always", error_model="numpy")
 def drive(fs, iv, head, m, w, qt, qi, ht, qh, qs, qw, rule, mass, t_end, max_events,
-          stall_dt, clock, cnt, pp_t, pp_i, pp_j, esc, arcs, walls, samp, contacts, dbg):
+          stall_dt, clock, cnt, pp_t, pp_i, pp_j, esc, ident, reorder_every, arcs, walls, samp,
+          contacts, dbg):
     """Run the event loop until ``t_end`` (absolute; events at ``t_end`` included).
 
     Returns a status of `kicktimes.billiard.kernels.observe`: ``DONE``, ``FULL`` (a log is
     full: grow it and call again, the loop resumes where it stopped), ``OVER_BUDGET``
     (``max_events`` collisions, disk-disk and wall) or ``STALLED``.
 
-    ``pp_t, pp_i, pp_j``: the disk-disk log (absolute time, ``i < j``); ``esc[i]`` the
-    escape time of disk ``i`` (``inf``). Observers (``None``: compiled out): ``arcs`` the
+    ``pp_t, pp_i, pp_j``: the disk-disk log (absolute time, ``i < j``) and ``esc[i]`` the
+    escape time of disk ``i`` (``inf``), both in the caller's numbering: engine disk ``k`` is
+    the caller's ``ident[k]``. Every ``reorder_every`` disk-disk collisions (0: never) the
+    loop returns `REORDER`, for the caller to renumber the disks in space (`relabel`).
+    Observers (``None``: compiled out): ``arcs`` the
     holes; ``walls = (bt, bd, bx, by, bs, sel)`` the contacts of the disks with
     ``sel[i]``; ``samp = (tau, sdisks, spos)``: positions of ``sdisks`` at ``k tau`` into
     ``spos[k]``; ``contacts = (cx, cy)`` the contact points of the disk-disk log;
@@ -345,8 +352,8 @@ def drive(fs, iv, head, m, w, qt, qi, ht, qh, qs, qw, rule, mass, t_end, max_eve
                 return ob.OVER_BUDGET
             collide(i, j, te, fs, rule, mass)
             pp_t[n] = clock[OFFSET] + te
-            pp_i[n] = min(i, j)
-            pp_j[n] = max(i, j)
+            pp_i[n] = min(ident[i], ident[j])
+            pp_j[n] = max(ident[i], ident[j])
             if contacts is not None:
                 contacts[0][n] = 0.5 * (fs[i, X] + fs[j, X])
                 contacts[1][n] = 0.5 * (fs[i, Y] + fs[j, Y])
@@ -355,6 +362,11 @@ def drive(fs, iv, head, m, w, qt, qi, ht, qh, qs, qw, rule, mass, t_end, max_eve
             iv[j, COUNT] += 1
             predict(i, te, fs, iv, head, m, w, qt, qi, ht, qh, qs, qw)
             predict(j, te, fs, iv, head, m, w, qt, qi, ht, qh, qs, qw)
+            if reorder_every > 0:
+                cnt[N_SINCE] += 1
+                if cnt[N_SINCE] >= reorder_every:
+                    cnt[N_SINCE] = 0
+                    return REORDER
         elif kind == WALL:
             if walls is not None:
                 if walls[5][i] and cnt[N_WLOG] >= walls[0].shape[0]:
@@ -367,7 +379,7 @@ def drive(fs, iv, head, m, w, qt, qi, ht, qh, qs, qw, rule, mass, t_end, max_eve
             if arcs is not None:
                 if ob.in_hole(x, y, arcs):
                     # the disk leaves the table: out of its cell, never scheduled again
-                    esc[i] = clock[OFFSET] + te
+                    esc[ident[i]] = clock[OFFSET] + te
                     cells.remove(head, iv, NEXT, PREV, i, iv[i, CELL])
                     iv[i, CELL] = -1
                     iv[i, KIND] = NONE
@@ -380,7 +392,7 @@ def drive(fs, iv, head, m, w, qt, qi, ht, qh, qs, qw, rule, mass, t_end, max_eve
                 if walls[5][i]:
                     q = cnt[N_WLOG]
                     walls[0][q] = clock[OFFSET] + te
-                    walls[1][q] = i
+                    walls[1][q] = ident[i]
                     walls[2][q] = x
                     walls[3][q] = y
                     walls[4][q] = sin_theta
@@ -396,6 +408,45 @@ def drive(fs, iv, head, m, w, qt, qi, ht, qh, qs, qw, rule, mass, t_end, max_eve
             cross(i, te, iv[i, STAMP], fs, iv, head, m, w, qt, qi, ht, qh, qs, qw)
         else:
             return ob.DONE
+
+
+@njit(cache=True, error_model="numpy")
+def relabel(fs, iv, head, m, qt, qi, ht, qh, qs, qw, order):
+    """Renumber the disks: the disk numbered ``order[k]`` becomes disk ``k``. Returns the
+    new number of each old disk.
+
+    A pure relabelling between two events: the rows of ``fs`` and ``iv`` move with their
+    disks (each keeps its clock, position and scheduled event; a partner's index in the
+    event table is renamed), the cell lists and the calendar are rebuilt from the moved
+    rows. Nothing is predicted again, so the run goes on with the same events, bitwise, up
+    to the order of exactly simultaneous ones. The disks drift apart as they diffuse; at
+    10^4 disks, renumbering them in space every few collisions per disk keeps a collision's
+    neighbours in nearby cache lines (benchmarks/bench_disks.py)."""
+    n = fs.shape[0]
+    new_of = np.empty(n, dtype=np.int32)
+    for k in range(n):
+        new_of[order[k]] = k
+    fs_old = fs.copy()
+    iv_old = iv.copy()
+    times = np.empty(n)
+    for k in range(n):
+        o = order[k]
+        for c in range(fs.shape[1]):
+            fs[k, c] = fs_old[o, c]
+        for c in range(iv.shape[1]):
+            iv[k, c] = iv_old[o, c]
+        if iv[k, KIND] >= 0:
+            iv[k, KIND] = new_of[iv[k, KIND]]
+        if iv[k, KIND_P] >= 0:
+            iv[k, KIND_P] = new_of[iv[k, KIND_P]]
+        times[k] = qt[o]
+    for c in range(head.shape[0]):
+        head[c] = -1
+    for k in range(n - 1, -1, -1):
+        if iv[k, CELL] >= 0:
+            cells.insert(head, iv, NEXT, PREV, k, iv[k, CELL])
+    cal.build(qt, qi, ht, qh, qs, qw, times)
+    return new_of
 
 
 @njit(cache=True, error_model="numpy")
