@@ -62,10 +62,19 @@ def _steps():
         compare_models(rng.exponential(size=200), censored=rng.exponential(size=3))
         test_poisson(np.sort(rng.uniform(0.0, 60.0, 60)), 60.0, n_mc=99, rng=rng)
 
+    def disks(**observers):
+        # the N-disk engine's two compiled loops: no observers, and all of them
+        from kicktimes import initial_state, simulate_disks
+
+        state = initial_state(20, 0.05, seed=0)
+        return lambda: simulate_disks(state, 0.05, t_max=1.0, **observers)
+
     return [
         ("import kicktimes (no compilation expected)", lambda: None),
         ("sweep task (3 systems x 3 diagnostics)", sweep_task),
         ("report kernels", report_kernels),
+        ("N-disk engine, no observers", disks()),
+        ("N-disk engine, all observers", disks(holes=[(0.0, 0.1)], tau=0.5, log_walls=True)),
     ]
 
 

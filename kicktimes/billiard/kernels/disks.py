@@ -50,14 +50,15 @@ from kicktimes.billiard.kernels import cells
 from kicktimes.billiard.kernels import observe as ob
 from kicktimes.billiard.kernels.two import anchor_energy, pair_event, wall_event
 
-__all__ = ["CROSS", "NONE", "REORDER", "WALL", "drive", "final_state", "relabel", "setup"]
+__all__ = ["CROSS", "NONE", "PREDICT", "REORDER", "WALL", "drive", "final_state", "relabel",
+           "setup"]
 
 #: columns of the disk table ``fs``
 X, Y, VX, VY, T, TW, TP, RAD = range(8)
 #: columns of the event table ``iv``
 KIND, STAMP, COUNT, KIND_P, STAMP_P, CELL, NEXT, PREV = range(8)
-#: event kinds other than a partner's index
-WALL, CROSS, NONE = -1, -2, -3
+#: event kinds other than a partner's index (`PREDICT`: the disk's first prediction is due)
+WALL, CROSS, NONE, PREDICT = -1, -2, -3, -4
 #: fields of ``clock`` (float64) and ``cnt`` (int64), the loop's position between calls
 OFFSET, COMP, T_CHECK = range(3)
 N_PP, N_WALL, N_CROSS, N_STALE, N_WLOG, K_SAMPLE, N_ESC, N_CHECK, N_SINCE = range(9)
@@ -119,52 +120,60 @@ def schedule(i, x, y, vx, vy, now, best, kind, stamp, fs, iv, m, w, qt, qi, ht, 
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def predict(i, now, fs, iv, head, m, w, qt, qi, ht, qh, qs, qw):
-    """Schedule disk ``i``'s earliest event from ``now``: its wall contact, its next cell
-    crossing, or a contact with a disk of the 3 x 3 cells around it (extrapolated to
-    ``now``); the disk is first brought to ``now``."""
+def rescan(i, now, gx0, gx1, gy0, gy1, best, kind, stamp, fs, iv, head, m, w, qt, qi, ht, qh,
+           qs, qw):
+    """Bring disk ``i`` to ``now``, look for an earlier contact than ``(best, kind, stamp)``
+    in cells ``gx0..gx1 x gy0..gy1`` and schedule its earliest event (`scan`, `schedule`).
+
+    The one place the scan is compiled into the event loop: numba inlines it once, not
+    once per kind of event (with four copies the loop took 95-155 s to compile, with one
+    20-30 s, and runs 3 % slower: benchmarks/bench_compile.py)."""
     x, y = bring(fs, i, now)
     vx = fs[i, VX]
     vy = fs[i, VY]
-    c = iv[i, CELL]
-    cx = c % m
-    cy = c // m
-    best, kind, stamp = scan(i, x, y, vx, vy, now, max(cx - 1, 0), min(cx + 1, m - 1),
-                             max(cy - 1, 0), min(cy + 1, m - 1), fs, iv, head, m,
-                             np.inf, NONE, 0)
+    best, kind, stamp = scan(i, x, y, vx, vy, now, gx0, gx1, gy0, gy1, fs, iv, head, m, best,
+                             kind, stamp)
     schedule(i, x, y, vx, vy, now, best, kind, stamp, fs, iv, m, w, qt, qi, ht, qh, qs, qw)
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def cross(i, now, c, fs, iv, head, m, w, qt, qi, ht, qh, qs, qw):
-    """Disk ``i`` enters cell ``c`` at ``now``: only the row of three cells that became
-    neighbours is scanned; the earliest contact kept from before still holds for the
-    others (a partner that has moved since is a stale event, found when it comes due)."""
+def neighbourhood(c, m):
+    """``(gx0, gx1, gy0, gy1)``: the block of 3 x 3 cells around cell ``c`` in the grid."""
+    cx = c % m
+    cy = c // m
+    return max(cx - 1, 0), min(cx + 1, m - 1), max(cy - 1, 0), min(cy + 1, m - 1)
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def enter_cell(i, c, fs, iv, head, m):
+    """Disk ``i`` enters cell ``c``: moved to its list. Returns the row of three cells that
+    became neighbours (``gx0 > gx1``: none, beyond the grid) and the earliest contact kept
+    from before, which still holds for the others (a partner that has moved since is a
+    stale event, found when it comes due): ``(gx0, gx1, gy0, gy1, best, kind, stamp)``."""
     cells.remove(head, iv, NEXT, PREV, i, iv[i, CELL])
     d = c - iv[i, CELL]
     iv[i, CELL] = c
     cells.insert(head, iv, NEXT, PREV, i, c)
-    x, y = bring(fs, i, now)
-    vx = fs[i, VX]
-    vy = fs[i, VY]
-    cx = c % m
-    cy = c // m
-    best = fs[i, TP]
-    kind = iv[i, KIND_P]
-    stamp = iv[i, STAMP_P]
+    gx0, gx1, gy0, gy1 = neighbourhood(c, m)
     if d == 1 or d == -1:
-        gx = cx + d
-        if 0 <= gx < m:
-            best, kind, stamp = scan(i, x, y, vx, vy, now, gx, gx, max(cy - 1, 0),
-                                     min(cy + 1, m - 1), fs, iv, head, m, best, kind,
-                                     stamp)
+        gx0 = gx1 = c % m + d
+        if gx0 < 0 or gx0 >= m:
+            gx0, gx1 = 1, 0
     else:
-        gy = cy + (1 if d > 0 else -1)
-        if 0 <= gy < m:
-            best, kind, stamp = scan(i, x, y, vx, vy, now, max(cx - 1, 0),
-                                     min(cx + 1, m - 1), gy, gy, fs, iv, head, m, best,
-                                     kind, stamp)
-    schedule(i, x, y, vx, vy, now, best, kind, stamp, fs, iv, m, w, qt, qi, ht, qh, qs, qw)
+        gy0 = gy1 = c // m + (1 if d > 0 else -1)
+        if gy0 < 0 or gy0 >= m:
+            gx0, gx1 = 1, 0
+    return gx0, gx1, gy0, gy1, fs[i, TP], iv[i, KIND_P], iv[i, STAMP_P]
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def predict(i, now, fs, iv, head, m, w, qt, qi, ht, qh, qs, qw):
+    """Schedule disk ``i``'s earliest event from ``now``: its wall contact, its next cell
+    crossing, or a contact with a disk of the 3 x 3 cells around it (extrapolated to
+    ``now``); the disk is first brought to ``now``."""
+    gx0, gx1, gy0, gy1 = neighbourhood(iv[i, CELL], m)
+    rescan(i, now, gx0, gx1, gy0, gy1, np.inf, NONE, 0, fs, iv, head, m, w, qt, qi, ht, qh, qs,
+           qw)
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -211,22 +220,22 @@ def collide(i, j, now, fs, rule, mass):
 
 @njit(cache=True, error_model="numpy")
 def setup(fs, iv, head, m, w, qt, qi, ht, qh, qs, qw):
-    """Fill the cells, the wall times and the calendar for the disks of ``fs`` at local
-    time 0 (their clocks set to 0)."""
+    """Fill the cells and the wall times for the disks of ``fs`` at local time 0 (their
+    clocks set to 0), and file each disk's first prediction as a `PREDICT` event at time 0:
+    `drive` makes it (the scan is compiled once, in the loop)."""
     n = fs.shape[0]
     for c in range(head.shape[0]):
         head[c] = -1
-    cal.build(qt, qi, ht, qh, qs, qw, np.full(n, np.inf))
     for i in range(n):
         fs[i, T] = 0.0
         fs[i, TW] = boundary_hit_time(fs[i, X], fs[i, Y], fs[i, VX], fs[i, VY], 1.0 - fs[i, RAD])
+        fs[i, TP] = np.inf
         iv[i, COUNT] = 0
-        iv[i, KIND] = NONE
+        iv[i, KIND] = PREDICT
         c = cells.cell_of(fs[i, X], fs[i, Y], m, w)
         iv[i, CELL] = c
         cells.insert(head, iv, NEXT, PREV, i, c)
-    for i in range(n):
-        predict(i, 0.0, fs, iv, head, m, w, qt, qi, ht, qh, qs, qw)
+    cal.build(qt, qi, ht, qh, qs, qw, np.zeros(n))
 
 
 @njit(cache=True, error_model="numpy")
@@ -274,7 +283,7 @@ def check_state(fs, iv, head, m, now, dbg):
     dbg[2] += 1.0
 
 
-@njit(cache=True, inline="always", error_model="numpy")
+@njit(cache=True, error_model="numpy", _nrt=False)
 def drive(fs, iv, head, m, w, qt, qi, ht, qh, qs, qw, rule, mass, t_end, max_events,
           stall_dt, clock, cnt, pp_t, pp_i, pp_j, esc, ident, reorder_every, arcs, walls, samp,
           contacts, dbg):
@@ -331,42 +340,41 @@ def drive(fs, iv, head, m, w, qt, qi, ht, qh, qs, qw, rule, mass, t_end, max_eve
             if dbg[3] != 0.0:
                 check_state(fs, iv, head, m, te, dbg)
         kind = iv[i, KIND]
-        # a stall: STALL_EVENTS events in less than STALL_EVENTS * stall_dt
-        cnt[N_CHECK] += 1
-        if cnt[N_CHECK] >= STALL_EVENTS:
-            if te - clock[T_CHECK] < STALL_EVENTS * stall_dt:
-                return ob.STALLED
-            clock[T_CHECK] = te
-            cnt[N_CHECK] = 0
+        if kind != PREDICT:
+            # a stall: STALL_EVENTS events in less than STALL_EVENTS * stall_dt
+            cnt[N_CHECK] += 1
+            if cnt[N_CHECK] >= STALL_EVENTS:
+                if te - clock[T_CHECK] < STALL_EVENTS * stall_dt:
+                    return ob.STALLED
+                clock[T_CHECK] = te
+                cnt[N_CHECK] = 0
+        # the disks to predict afresh after the event: ``pa`` (and ``pb``), as entering a
+        # cell if ``enter``
+        pa = i
+        pb = -1
+        enter = False
         if kind >= 0:
             j = kind
             if iv[j, COUNT] != iv[i, STAMP]:
                 # the partner has moved since the prediction
                 cnt[N_STALE] += 1
-                predict(i, te, fs, iv, head, m, w, qt, qi, ht, qh, qs, qw)
-                continue
-            n = cnt[N_PP]
-            if n >= cap:
-                return ob.FULL
-            if n + cnt[N_WALL] >= max_events:
-                return ob.OVER_BUDGET
-            collide(i, j, te, fs, rule, mass)
-            pp_t[n] = clock[OFFSET] + te
-            pp_i[n] = min(ident[i], ident[j])
-            pp_j[n] = max(ident[i], ident[j])
-            if contacts is not None:
-                contacts[0][n] = 0.5 * (fs[i, X] + fs[j, X])
-                contacts[1][n] = 0.5 * (fs[i, Y] + fs[j, Y])
-            cnt[N_PP] = n + 1
-            iv[i, COUNT] += 1
-            iv[j, COUNT] += 1
-            predict(i, te, fs, iv, head, m, w, qt, qi, ht, qh, qs, qw)
-            predict(j, te, fs, iv, head, m, w, qt, qi, ht, qh, qs, qw)
-            if reorder_every > 0:
-                cnt[N_SINCE] += 1
-                if cnt[N_SINCE] >= reorder_every:
-                    cnt[N_SINCE] = 0
-                    return REORDER
+            else:
+                n = cnt[N_PP]
+                if n >= cap:
+                    return ob.FULL
+                if n + cnt[N_WALL] >= max_events:
+                    return ob.OVER_BUDGET
+                collide(i, j, te, fs, rule, mass)
+                pp_t[n] = clock[OFFSET] + te
+                pp_i[n] = min(ident[i], ident[j])
+                pp_j[n] = max(ident[i], ident[j])
+                if contacts is not None:
+                    contacts[0][n] = 0.5 * (fs[i, X] + fs[j, X])
+                    contacts[1][n] = 0.5 * (fs[i, Y] + fs[j, Y])
+                cnt[N_PP] = n + 1
+                iv[i, COUNT] += 1
+                iv[j, COUNT] += 1
+                pb = j
         elif kind == WALL:
             if walls is not None:
                 if walls[5][i] and cnt[N_WLOG] >= walls[0].shape[0]:
@@ -402,12 +410,27 @@ def drive(fs, iv, head, m, w, qt, qi, ht, qh, qs, qw, rule, mass, t_end, max_eve
             fs[i, VX] = vx
             fs[i, VY] = vy
             fs[i, TW] = te + tn
-            predict(i, te, fs, iv, head, m, w, qt, qi, ht, qh, qs, qw)
         elif kind == CROSS:
             cnt[N_CROSS] += 1
-            cross(i, te, iv[i, STAMP], fs, iv, head, m, w, qt, qi, ht, qh, qs, qw)
-        else:
+            enter = True
+        elif kind != PREDICT:
             return ob.DONE
+        for k in range(1 if pb < 0 else 2):
+            d = pa if k == 0 else pb
+            if enter:
+                gx0, gx1, gy0, gy1, best, bk, bs = enter_cell(d, iv[d, STAMP], fs, iv, head, m)
+            else:
+                gx0, gx1, gy0, gy1 = neighbourhood(iv[d, CELL], m)
+                best = np.inf
+                bk = NONE
+                bs = 0
+            rescan(d, te, gx0, gx1, gy0, gy1, best, bk, bs, fs, iv, head, m, w, qt, qi, ht,
+                   qh, qs, qw)
+        if pb >= 0 and reorder_every > 0:
+            cnt[N_SINCE] += 1
+            if cnt[N_SINCE] >= reorder_every:
+                cnt[N_SINCE] = 0
+                return REORDER
 
 
 @njit(cache=True, error_model="numpy")
@@ -481,6 +504,11 @@ def new_engine(state: np.ndarray, radii: np.ndarray, m: int, w: float) -> tuple:
     head = np.empty(m * m, dtype=np.int32)
     q = cal.new_calendar(n, 1.0)
     setup(fs, iv, head, m, w, *q)
+    # the first predictions, made by the loop up to (not including) the first event at 0
+    no_log = np.empty(0, dtype=np.int32)
+    drive(fs, iv, head, m, w, *q, 0, None, 0.0, 0, 0.0, np.zeros(3), np.zeros(9, np.int64),
+          np.empty(0), no_log, no_log, np.empty(n), np.arange(n, dtype=np.int32), 0, None,
+          None, None, None, None)
     # buckets about two event spacings wide: a disk's next event is about mean(qt) away
     qt = q[0]
     finite = qt[np.isfinite(qt)]
