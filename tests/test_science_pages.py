@@ -1,0 +1,70 @@
+"""The generated science pages (docs/results/*.md) say only what their tables show.
+
+Each page starts with its "Generated ..." line, names no machine path, and the numbers a
+reader sees are the ones in the CSV beside it, with the verdict their interval gives.
+"""
+
+import re
+from pathlib import Path
+
+import pandas as pd
+import pytest
+
+from kicktimes.stats import format_interval, ratio_verdict
+
+RESULTS = Path(__file__).resolve().parents[1] / "docs" / "results"
+PAGES = ["README.md", "science.md", "mechanism.md", "escape.md", "unequal.md", "scatter.md"]
+MACHINE_PATH = re.compile(r"(/tmp/|/work/|/home/|/Users/|/root/|[A-Za-z]:\\\\)")
+
+
+def _page(name):
+    path = RESULTS / name
+    if not path.is_file():
+        pytest.skip(f"{name} is not generated yet")
+    return path.read_text(encoding="utf-8")
+
+
+@pytest.mark.parametrize("name", PAGES)
+def test_every_page_starts_with_its_generated_line_and_names_no_machine_path(name):
+    text = _page(name)
+    lines = [line for line in text.splitlines() if line.strip()]
+    assert lines[0].startswith("# ")
+    assert lines[1].startswith("Generated "), lines[1][:80]
+    assert " by kicktimes " in lines[1] and " from " in lines[1]
+    assert not MACHINE_PATH.search(text), MACHINE_PATH.search(text).group(0)
+
+
+def _cells(text, first_column):
+    """The row of the page's markdown table whose first cell is ``first_column``."""
+    for line in text.splitlines():
+        cells = [c.strip() for c in line.strip().strip("|").split("|")]
+        if cells and cells[0] == first_column:
+            return cells
+    raise AssertionError(f"no table row {first_column!r}")
+
+
+def test_the_science_page_s_ratio_per_radius_is_its_csv_with_its_verdict():
+    text = _page("science.md")
+    table = pd.read_csv(RESULTS / "science_stretching.csv")
+    kicked = table[table["system"] != "two_particle"]
+    for row in kicked.itertuples():
+        assert row.verdict == ratio_verdict(row.ratio_ci_low, row.ratio_ci_high)
+    for r, g in kicked.groupby("radius"):
+        cells = _cells(text, f"{r:g}")
+        for k, system in enumerate(("poisson", "poisson_scatter")):
+            row = g[g["system"] == system].iloc[0]
+            want = (f"{format_interval(row.ratio, row.ratio_ci_low, row.ratio_ci_high)}, "
+                    f"{row.verdict}")
+            assert cells[1 + k] == want
+
+
+def test_the_science_page_extrapolates_nothing_and_quotes_predictions_with_measurements():
+    text = _page("science.md")
+    assert "10⁻⁶" not in text and "r → 0" not in text
+    compare = pd.read_csv(RESULTS / "science_decorrelation_prediction.csv")
+    for row in compare.itertuples():
+        assert row.quotient_verdict == ratio_verdict(row.quotient_ci_low, row.quotient_ci_high)
+        measured = format_interval(row.measured, row.measured_ci_low, row.measured_ci_high)
+        predicted = format_interval(row.predicted, row.predicted_ci_low, row.predicted_ci_high)
+        line = next(x for x in text.splitlines() if predicted in x and measured in x)
+        assert row.quotient_verdict in line
