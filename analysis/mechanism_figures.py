@@ -23,7 +23,9 @@ from kicktimes import stats  # noqa: E402
 TWIN_LABELS = {"poisson": "Poisson\n(pooled rate)",
                "mixed_poisson": "mixed Poisson\nΓ(L initial)",
                "cox_iid": "Cox, iid\npost-collision L",
-               "cox_sequence": "Cox, run's own\nL sequence", "observed": "observed"}
+               "cox_sequence": "Cox, run's own\nL sequence",
+               "cox_markov_oos": "rate chain fitted\non the other half",
+               "observed": "observed"}
 
 
 def _groups(results):
