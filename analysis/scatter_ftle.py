@@ -284,12 +284,12 @@ def write_page(df, page, command):
         counts = main[main["ratio"] == label]["verdict"].value_counts()
         changed = (both.pivot(index="radius", columns="ics", values="verdict")
                    .nunique(axis=1) > 1).sum()
-        lines.append(f"- {label}: " + ", ".join(f"{v} at {k} radii" for v, k in
-                                                 zip(counts.index, counts.to_numpy(),
-                                                     strict=True))
+        lines.append(f"- {label}: " + ", ".join(
+            f"{v} at {k} radi{'us' if k == 1 else 'i'}"
+            for v, k in zip(counts.index, counts.to_numpy(), strict=True))
                      + f" (range {main[main['ratio'] == label]['estimate'].min():.3f}–"
                      f"{main[main['ratio'] == label]['estimate'].max():.3f}); the sticky ICs "
-                     f"change the verdict at {changed} radii.")
+                     f"change the verdict at {changed} of {main['radius'].nunique()} radii.")
     fresh = main[main["ratio"] == labels[3]]["estimate"]
     gap = main[main["ratio"] == labels[0]]["estimate"]
     lines += ["", "**What the zeroed partner tangent measures.** The fourth column runs the "

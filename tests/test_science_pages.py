@@ -68,3 +68,28 @@ def test_the_science_page_extrapolates_nothing_and_quotes_predictions_with_measu
         predicted = format_interval(row.predicted, row.predicted_ci_low, row.predicted_ci_high)
         line = next(x for x in text.splitlines() if predicted in x and measured in x)
         assert row.quotient_verdict in line
+
+
+def test_the_unequal_page_gives_every_ratio_the_verdict_of_its_interval():
+    text = _page("unequal.md")
+    table = pd.read_csv(RESULTS / "size_ratio" / "size_ratio.csv")
+    for row in table.itertuples():
+        cells = _cells(text, f"{row.size_ratio:g}")
+        want = (f"{format_interval(row.ftle_partner_ratio_disk0, row.ftle_partner_low_disk0, row.ftle_partner_high_disk0)}, "  # noqa: E501
+                f"{ratio_verdict(row.ftle_partner_low_disk0, row.ftle_partner_high_disk0)}")
+        assert cells[4] == want
+    assert "within 10 % … at every ratio" not in text
+
+
+def test_the_scatter_page_is_its_csv_and_no_longer_decomposes_the_gap():
+    text = _page("scatter.md")
+    table = pd.read_csv(RESULTS / "scatter_ratios.csv")
+    for row in table.itertuples():
+        assert row.verdict == ratio_verdict(row.ci_low, row.ci_high)
+    main = table[table["ics"] == "without sticky ICs"]
+    for r, g in main.groupby("radius"):
+        cells = _cells(text, f"{r:g}")
+        first = g.iloc[0]
+        assert cells[1] == (f"{format_interval(first.estimate, first.ci_low, first.ci_high)}, "
+                            f"{first.verdict}")
+    assert "almost all" not in text.lower()
