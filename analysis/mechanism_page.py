@@ -58,14 +58,38 @@ def _get(tab, method, r, quantity):
 
 
 def _iv(row, edges=()):
-    if not math.isfinite(row["ci_low"]):
+    if not math.isfinite(row["estimate"]):
+        return "n/a"
+    if not (math.isfinite(row["ci_low"]) and math.isfinite(row["ci_high"])):
         return f"{row['estimate']:.3g}"
     return format_interval(row["estimate"], row["ci_low"], row["ci_high"], edges=edges)
 
 
 def _hazard_cell(row):
     """A hazard over its reference rate (1), with the ratio verdict against it."""
+    if not math.isfinite(row["estimate"]):
+        return "no interval ends there"
     return f"{_iv(row, (0.9, 1.0, 1.1))}, {ratio_verdict(row['ci_low'], row['ci_high'], MARGIN)}"
+
+
+#: the observed row of each explained quantity and the Poisson value it is measured from
+OBSERVED = {"uniformity_ks": ("observed_reject_uniformity_ks", 0.05),
+            "exponential_ad": ("observed_reject_exponential_ad", 0.05),
+            "dispersion_index_nonsticky": ("observed_dispersion_index_nonsticky", 1.0)}
+
+
+def _excess(tab, m, r, test):
+    """Whether the observed value's 95 % interval lies above the Poisson value (an excess
+    to explain; a gap inside its own noise is not decomposed)."""
+    name, base = OBSERVED[test]
+    row = _get(tab, m, r, name)
+    return bool(row["ci_low"] > base)
+
+
+def _explained_cell(tab, m, r, test, model):
+    if not _excess(tab, m, r, test):
+        return "no excess to explain"
+    return _iv(_get(tab, m, r, f"explained_{test}_by_{model}"))
 
 
 def _above_chance(share, chance):
@@ -76,7 +100,8 @@ def _above_chance(share, chance):
     return "not distinguished from chance (intervals overlap)"
 
 
-def rule_section(tab):
+def rule_section(tab, figures):
+    """The section of one rule; ``figures`` is its folder relative to the page."""
     rule = tab["rule"].iloc[0]
     run = tab[tab["method"] == "run"].set_index("quantity")["estimate"]
     groups = [g for g in GROUPS if ((tab["method"] == g[0]) & (tab["radius"] == g[1])).any()]
@@ -113,6 +138,11 @@ def rule_section(tab):
              line("rescaled t in [1, 5)", lambda m, r: _hazard_cell(
                  g(m, r, "rescaled_hazard_1_5"))),
              line("rescaled t > 5", lambda m, r: _hazard_cell(g(m, r, "rescaled_hazard_late"))),
+             "", f"![hazard]({figures}/mechanism_hazard.png)", "",
+             f"![rescaled hazard]({figures}/mechanism_hazard_normalised.png)", "",
+             "**The hazard** (top, raw time) and **the hazard after removing the rate "
+             "differences** (bottom: green, intervals in units of the run's own mean interval; "
+             "blue, intervals times Γ of the state they start in), 95 % intervals.",
              "", "**Re-collisions** (at most one wall hit of each disk since the previous "
              "collision; sticky runs left out; bootstrap over runs) against randomly placed "
              "events at each run's rate (\"above chance\": the two 95 % intervals are "
@@ -126,7 +156,9 @@ def rule_section(tab):
              "", "**The Poisson battery** (share of runs rejected at α = 0.05, "
              "Clopper–Pearson; dispersion index of the counts, bootstrap over ICs) and the "
              "share of its excess over a Poisson process that each twin model reproduces, "
-             "(twin − Poisson) / (observed − Poisson), bootstrap over ICs:", "", head, sep,
+             "(twin − Poisson) / (observed − Poisson), bootstrap over ICs; given only where "
+             "the observed value's interval lies above the Poisson value (0.05, or 1 for the "
+             "dispersion index), otherwise \"no excess to explain\":", "", head, sep,
              line("uniformity KS, observed", lambda m, r: _iv(
                  g(m, r, "observed_reject_uniformity_ks"))),
              line("exponential AD, observed", lambda m, r: _iv(
@@ -136,19 +168,27 @@ def rule_section(tab):
     for model, label in MODELS:
         for test, tlabel in TESTS:
             lines.append(line(f"explained, {tlabel}: {label}", lambda m, r, test=test,
-                              model=model: _iv(g(m, r, f"explained_{test}_by_{model}"))))
-    lines += ["", _carry(tab, groups, rule), ""]
+                              model=model: _explained_cell(tab, m, r, test, model)))
+    lines += ["", f"![battery]({figures}/mechanism_battery.png)", "",
+              "**The Poisson battery on the twins** (bars: the twins' 95 % range over the "
+              "ensembles; observed: Clopper–Pearson).", "", _carry(tab, groups, rule), ""]
     return lines
 
 
 def _carry(tab, groups, rule):
     """What carries the non-Poisson statistics under this rule: sentences from the rows."""
-    def rng(q):
-        v = [_get(tab, m, r, q)["estimate"] for m, r in groups]
-        return f"{min(v):.2f}–{max(v):.2f}"
+    def rng(q, test=None):
+        v = [_get(tab, m, r, q)["estimate"] for m, r in groups
+             if test is None or _excess(tab, m, r, test)]
+        v = [x for x in v if math.isfinite(x)]
+        if not v:
+            return "n/a (no group with an excess to explain)" if test else "n/a"
+        n = f" ({len(v)} of {len(groups)} groups with an excess)" if test else ""
+        return (f"{v[0]:.2f}" if len(v) == 1 else f"{min(v):.2f}–{max(v):.2f}") + n
 
     late = [_get(tab, m, r, "rescaled_hazard_late") for m, r in groups]
-    late_v = {ratio_verdict(x["ci_low"], x["ci_high"], MARGIN) for x in late}
+    late_v = {ratio_verdict(x["ci_low"], x["ci_high"], MARGIN) for x in late
+              if math.isfinite(x["estimate"])} or {"no interval ends there"}
     first = [_get(tab, m, r, "hazard_nonsticky_first_bin_over_rate") for m, r in groups]
     first_v = {ratio_verdict(x["ci_low"], x["ci_high"], MARGIN) for x in first}
     return (f"Read from the rows above ({rule} rule): in the first half time unit after a "
@@ -156,12 +196,13 @@ def _carry(tab, groups, rule):
             f"(verdicts: {', '.join(sorted(first_v))}); at rescaled t > 5 the Γ-rescaled "
             f"hazard is {rng('rescaled_hazard_late')} (verdicts: {', '.join(sorted(late_v))}). "
             "The Cox twins that replay each run's own states reproduce "
-            f"{rng('explained_uniformity_ks_by_cox_sequence')} of the excess uniformity-KS "
-            f"rejections and {rng('explained_exponential_ad_by_cox_sequence')} of the excess "
-            "exponential-AD rejections (an in-sample upper bound); the rate chain fitted on "
-            "the other half of the ICs reproduces "
-            f"{rng('explained_uniformity_ks_by_cox_markov_oos')} and "
-            f"{rng('explained_exponential_ad_by_cox_markov_oos')}.")
+            f"{rng('explained_uniformity_ks_by_cox_sequence', 'uniformity_ks')} of the excess "
+            "uniformity-KS rejections and "
+            f"{rng('explained_exponential_ad_by_cox_sequence', 'exponential_ad')} of the "
+            "excess exponential-AD rejections (an in-sample upper bound); the rate chain "
+            "fitted on the other half of the ICs reproduces "
+            f"{rng('explained_uniformity_ks_by_cox_markov_oos', 'uniformity_ks')} and "
+            f"{rng('explained_exponential_ad_by_cox_markov_oos', 'exponential_ad')}.")
 
 
 def _rel(folder, page):
@@ -183,8 +224,8 @@ def main(argv=None):
               "(0.01, 0.02) × two IC families (the paper's, the invariant measure), the same "
               "ICs at both radii. Verdicts of a hazard against the rate it should equal: "
               f"{ratio_rule(MARGIN)}.", ""]
-    for tab in tabs:
-        lines += rule_section(tab)
+    for tab, folder in zip(tabs, args.folders, strict=True):
+        lines += rule_section(tab, _rel(folder, args.out))
     Path(args.out).write_text("\n".join(lines), encoding="utf-8")
     print(f"{args.out} written")
 

@@ -93,3 +93,48 @@ def test_the_scatter_page_is_its_csv_and_no_longer_decomposes_the_gap():
         assert cells[1] == (f"{format_interval(first.estimate, first.ci_low, first.ci_high)}, "
                             f"{first.verdict}")
     assert "almost all" not in text.lower()
+
+
+def _numbers(folder):
+    path = RESULTS / "mechanism" / folder / "mechanism_numbers.csv"
+    if not path.is_file():
+        pytest.skip(f"{path.name} of {folder or 'mirror'} is not generated yet")
+    return pd.read_csv(path)
+
+
+@pytest.mark.parametrize("folder", ["", "elastic"])
+def test_the_mechanism_page_reads_the_late_hazard_from_its_table(folder):
+    text = _page("mechanism.md")
+    tab = _numbers(folder)
+    rule = tab["rule"].iloc[0]
+    section = text.split(f"## The {rule} rule")[1].split("\n## ")[0]
+    cells = _cells(section, "rescaled t > 5")
+    groups = [("paper", 0.01), ("paper", 0.02), ("uniform", 0.01), ("uniform", 0.02)]
+    for k, (method, r) in enumerate(groups):
+        row = tab[(tab["method"] == method) & (tab["radius"] == r)
+                  & (tab["quantity"] == "rescaled_hazard_late")].iloc[0]
+        verdict = ratio_verdict(row["ci_low"], row["ci_high"])
+        assert cells[1 + k].endswith(verdict), (cells[1 + k], verdict)
+    assert "explains about half to two-thirds" not in text
+
+
+def test_the_escape_page_answers_with_an_equivalence_test_and_its_controls():
+    text = _page("escape.md")
+    ratios = pd.read_csv(RESULTS / "escape" / "escape_ratios.csv")
+    for row in ratios.itertuples():
+        assert row.verdict == ratio_verdict(row.ci_low, row.ci_high)
+        assert format_interval(row.ratio, row.ci_low, row.ci_high) in text
+    assert set(ratios.loc[ratios["negative_control"], "system"]) == {"poisson_small_hole",
+                                                                      "bursty"}
+    assert "Yes, at every radius" not in text
+
+
+def test_the_mmpp_page_s_residual_verdicts_are_their_intervals():
+    from kicktimes.stats import rejection_verdict
+
+    _page("mmpp.md")
+    resid = pd.read_csv(RESULTS / "mmpp" / "mmpp_billiard_residuals.csv")
+    for row in resid.itertuples():
+        assert row.verdict == rejection_verdict(row.ci_low, row.ci_high, 0.05)
+    dip = pd.read_csv(RESULTS / "mmpp" / "mmpp_billiard_dip.csv")
+    assert (dip["mmpp"] >= 1.0 - 1e-9).all()   # an MMPP has no refractory dip
