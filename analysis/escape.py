@@ -308,7 +308,8 @@ def figure(curves):
             if km.empty:
                 continue
             ax.step(km["time"], km["survival"], where="post", color=styles[system]["color"],
-                    label=LABELS[system])
+                    label=LABELS[system],
+                    linestyle="--" if system == "poisson_scatter" else "-")
             ax.fill_between(km["time"], km["ci_low"], km["ci_high"], step="post",
                             color=styles[system]["color"], alpha=0.15, linewidth=0)
         tt = np.geomspace(50.0, 3000.0, 20)
