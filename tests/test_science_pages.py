@@ -138,3 +138,26 @@ def test_the_mmpp_page_s_residual_verdicts_are_their_intervals():
         assert row.verdict == rejection_verdict(row.ci_low, row.ci_high, 0.05)
     dip = pd.read_csv(RESULTS / "mmpp" / "mmpp_billiard_dip.csv")
     assert (dip["mmpp"] >= 1.0 - 1e-9).all()   # an MMPP has no refractory dip
+
+
+def test_one_command_rebuilds_every_generated_science_page():
+    import importlib.util
+    import sys
+
+    analysis = RESULTS.parents[1] / "analysis"
+    sys.path.insert(0, str(analysis))
+    try:
+        spec = importlib.util.spec_from_file_location("make_science",
+                                                      analysis / "make_science.py")
+        module = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(module)
+    finally:
+        sys.path.remove(str(analysis))
+    steps = module.steps("paper", "paper/science", 1, reuse=False)
+    names = [name for name, _ in steps]
+    for page in PAGES[1:]:
+        assert page in names or any(page.split(".")[0] in n for n in names), page
+    for _, argv in steps:
+        assert Path(argv[1]).is_file(), argv[1]
+    readme = (RESULTS.parents[1] / "README.md").read_text(encoding="utf-8")
+    assert "python analysis/make_science.py" in readme
