@@ -665,7 +665,8 @@ def main(argv=None):
         ["the stores " + ", ".join(f"`{n}`" for n in names)]
         + [f"the FTLE sweep `{exp.name}` (run here)",
            "the findings tables of " + ", ".join(f"`{f}`" for f in families.values()),
-           "the direct simulations of sections 2–3"])
+           "the direct simulations of sections 2–3"
+           + (" (read from the work folder's cache of an earlier run)" if args.reuse else "")])
     lines += ["Intervals are 95 % bootstrap intervals over ICs unless said otherwise. "
               f"Verdicts of ratios: {ratio_rule(MARGIN)}.", ""]
 
