@@ -661,7 +661,8 @@ def main(argv=None):
     families = {"mirror": "family_a", "elastic": "family_a-elastic"}
     lines = header(
         "The mechanism, computed", COMMAND + " " + " ".join(
-            f"paper/store-{n}" for n in names) + " --out docs/results --work paper/science",
+            f"paper/store-{n}" for n in names) + " --out docs/results --work paper/science"
+        + (" --reuse" if args.reuse else "") + (" --skip-cost" if args.skip_cost else ""),
         ["the stores " + ", ".join(f"`{n}`" for n in names)]
         + [f"the FTLE sweep `{exp.name}` (run here)",
            "the findings tables of " + ", ".join(f"`{f}`" for f in families.values()),
@@ -737,7 +738,9 @@ def main(argv=None):
     cost = pd.read_csv(out / "science_cost.csv")
     lines += ["## 6. Cost: is the kicked disk much cheaper?", "",
               "CPU time per unit of simulated time (`benchmarks/bench_cost_per_time.py`, min "
-              "of 3 interleaved repeats, 5 ICs, T = 50 000; `science_cost.csv`): the two-disk "
+              "of 3 interleaved repeats, 5 ICs, T = 50 000; `science_cost.csv`"
+              + ("; measured by an earlier run of this script" if args.skip_cost else "")
+              + "): the two-disk "
               f"run costs {cost['two_over_kicked'].min():.1f}–{cost['two_over_kicked'].max():.1f}"
               f"× the kicked run at r = {cost['radius'].min():g}–{cost['radius'].max():g}. Both "
               "need a simulated time ∝ 1/r to see a given number of perturbations (Γ(r) ∝ r), "
