@@ -111,7 +111,7 @@ def _verdicts(results, t_min=10.0):
 def test_the_same_exponential_escape_is_like_the_two_disks():
     # "like" is an equivalence test: the ratio's interval within 10 %, which needs many runs
     rng = np.random.default_rng(1)
-    law = {s: rng.exponential(40.0, 20000) for s in ("two_particle", "poisson", "actual")}
+    law = {s: rng.exponential(40.0, 6000) for s in ("two_particle", "poisson", "actual")}
     comparison, answer = _verdicts(_results({0.02: law}))
     assert (comparison["verdict"] == "like").all()
     assert ((comparison["ratio_low"] >= 0.9) & (comparison["ratio_high"] <= 1.1)).all()
@@ -132,7 +132,7 @@ def test_an_algebraic_tail_against_an_exponential_one_is_not_like():
 
 def test_an_answer_that_differs_across_radii_says_so_with_the_numbers():
     rng = np.random.default_rng(3)
-    same = {s: rng.exponential(40.0, 20000) for s in ("two_particle", "poisson")}
+    same = {s: rng.exponential(40.0, 6000) for s in ("two_particle", "poisson")}
     faster = {"two_particle": rng.exponential(40.0, 800), "poisson": rng.exponential(15.0, 800)}
     comparison, answer = _verdicts(_results({0.01: same, 0.03: faster}))
     assert list(comparison["verdict"]) == ["like", "not like"]
