@@ -227,7 +227,9 @@ def summary(tabs):
              "|---|" + "---|" * len(rules)]
     for label, fn in rows:
         lines.append(f"| {label} | " + " | ".join(fn(t) for t in tabs) + " |")
-    return lines + [""]
+    return lines + ["", "An explained share above 1 means the twins depart from Poisson more "
+                    "often than the runs do (the model overshoots); below 0, less often than "
+                    "a Poisson process.", ""]
 
 
 def _carry(tab, groups, rule):
