@@ -42,7 +42,13 @@ from kicktimes.diagnostics import mechanism
 RADII = (0.01, 0.02)
 METHODS = ("paper", "uniform")
 BATTERY = ("uniformity_ks", "exponential_ks", "exponential_ad", "dispersion")
-TWINS = ("poisson", "mixed_poisson", "cox_iid", "cox_sequence")
+TWINS = ("poisson", "mixed_poisson", "cox_iid", "cox_sequence", "cox_markov_oos")
+#: the models whose explained share is reported; cox_markov_oos is out of sample
+EXPLAINERS = ("mixed_poisson", "cox_iid", "cox_sequence", "cox_markov_oos")
+#: rescaled time beyond which the Gamma-rescaled hazard is read as one bin
+LATE_RESCALED = 5.0
+#: states drawn per out-of-sample twin (its path is recycled if a run needs more)
+CHAIN_STATES = 600
 STICKY_FACTOR = 5.0
 #: intervals shorter than this hold the wall round trips (the hazard's peak)
 RETURN_TIME = 4.0
@@ -56,18 +62,19 @@ HAZARD_EDGES = np.array([0, 0.5, 1, 1.5, 2, 2.5, 3, 4, 6, 10, 16, 25, 40, 63, 10
 
 # ------------------------------------------------------------------ simulation
 def _simulate(task):
-    ic, r, t_max = task
-    return simulate_two_particle(ic, r, t_max=t_max, log_collisions=True)
+    ic, r, t_max, rule = task
+    return simulate_two_particle(ic, r, t_max=t_max, rule=rule, log_collisions=True)
 
 
-def simulate(n_ics, t_max, workers, seed):
+def simulate(n_ics, t_max, workers, seed, rule="mirror"):
     """{(method, r): (ics, runs)} with the same ICs at both radii (drawn at the larger)."""
     out = {}
     with ProcessPoolExecutor(workers) as pool:
         for method in METHODS:
-            ics = initial_conditions(n_ics, max(RADII), seed=seed, method=method)
+            ics = initial_conditions(n_ics, max(RADII), seed=seed, method=method, rule=rule)
             for r in RADII:
-                runs = list(pool.map(_simulate, [(ic, r, t_max) for ic in ics], chunksize=10))
+                runs = list(pool.map(_simulate, [(ic, r, t_max, rule) for ic in ics],
+                                     chunksize=10))
                 out[method, r] = (ics, runs)
     return out
 
@@ -76,10 +83,51 @@ def has_rate() -> bool:
     return hasattr(stats, "conditional_kinetic_rate")
 
 
-def rate(r, L0, L1):
-    """Gamma(r; L0, L1), vectorised (`kicktimes.stats.conditional_kinetic_rate`)."""
-    return np.asarray(stats.conditional_kinetic_rate(r, np.asarray(L0, float),
-                                                     np.asarray(L1, float)), float)
+def rate(r, L0, L1, speed0=None, speed1=None):
+    """Gamma(r; L0, L1), vectorised (`kicktimes.stats.conditional_kinetic_rate`); with the
+    speeds, the elastic rule's rate conditioned on them as well."""
+    L0, L1 = np.asarray(L0, float), np.asarray(L1, float)
+    if speed0 is None:
+        return np.asarray(stats.conditional_kinetic_rate(r, L0, L1), float)
+    return np.asarray(stats.conditional_kinetic_rate(
+        r, L0, L1, rule="elastic", speed1=np.asarray(speed0, float),
+        speed2=np.asarray(speed1, float)), float)
+
+
+def fit_rate_chain(first, post_by_run, n_bins=10):
+    """A first-order Markov chain of the post-collision rate, fitted on training runs.
+
+    The pairs (rate of the state before, rate of the state after) of consecutive
+    collisions of each run (the first "before" is the IC's predicted rate) are binned by
+    the rate before at its deciles; the chain's step from a rate in bin k draws the next
+    rate uniformly from the training pairs' "after" values in bin k. Returns
+    ``(edges, pool, counts)``.
+    """
+    prev = np.concatenate([np.r_[g, p[:-1]] for g, p in zip(first, post_by_run, strict=True)
+                           if p.size])
+    nxt = np.concatenate([p for p in post_by_run if p.size])
+    edges = np.unique(np.quantile(prev, np.linspace(0, 1, n_bins + 1)[1:-1]))
+    b = np.digitize(prev, edges)
+    counts = np.bincount(b, minlength=edges.size + 1)
+    pool = np.full((edges.size + 1, max(int(counts.max()), 1)), np.nan)
+    for k in range(edges.size + 1):
+        pool[k, :counts[k]] = nxt[b == k] if counts[k] else np.nan
+        if not counts[k]:                      # an empty bin steps like the whole sample
+            pool[k, :min(nxt.size, pool.shape[1])] = nxt[:pool.shape[1]]
+            counts[k] = min(nxt.size, pool.shape[1])
+    return edges, pool, counts
+
+
+def draw_rate_chains(chain, start, n_states, rng):
+    """Paths (len(start), n_states + 1) of the chain, each from its start rate."""
+    edges, pool, counts = chain
+    out = np.empty((len(start), n_states + 1))
+    out[:, 0] = cur = np.asarray(start, float)
+    for k in range(n_states):
+        b = np.digitize(cur, edges)
+        cur = pool[b, (rng.random(cur.size) * counts[b]).astype(int)]
+        out[:, k + 1] = cur
+    return out
 
 
 # ------------------------------------------------------------------ helpers
@@ -115,7 +163,7 @@ def _sup_distance(t, sf_emp, sf_model):
 
 
 # ------------------------------------------------------------------ analysis of one group
-def analyse(key, ics, runs, *, n_twins, rng):
+def analyse(key, ics, runs, *, n_twins, rng, rule="mirror"):
     method, r = key
     rows, data = [], {}
     t_max = runs[0].t_max
@@ -227,9 +275,9 @@ def analyse(key, ics, runs, *, n_twins, rng):
     if not has_rate():
         return rows, data
     # 4. predicted rates
-    L_ic = mechanism.initial_angular_momenta(ics)
-    pred = rate(r, L_ic[:, 0], L_ic[:, 1])
-    post = rate(r, tab["L0_post"], tab["L1_post"])
+    pred = np.asarray(mechanism.predicted_rates(ics, r, rule=rule), float)
+    speeds = (tab["speed0_post"], tab["speed1_post"]) if rule == "elastic" else ()
+    post = rate(r, tab["L0_post"], tab["L1_post"], *speeds)
     tab["rate_post"] = post
     # memory of the state from one collision to the next
     log_rate = np.log(post)
@@ -297,9 +345,24 @@ def analyse(key, ics, runs, *, n_twins, rng):
     _peak_row(rows, key, "rescaled_hazard_peak", haz_u, scale=1.0)
     _row(rows, key, "rescaled_hazard_rate", haz_u.rate, note="1 if the rate is right on average")
     _row(rows, key, "rescaled_hazard_flat_lr_pvalue", haz_u.pvalue)
+    # the long-time end of the same figure, read as one bin: Gamma t > LATE_RESCALED
+    late = stats.interval_hazard(u[done], u[~done], edges=[0.0, LATE_RESCALED,
+                                                          max(float(u.max()), 2 * LATE_RESCALED)])
+    lt = late.table.iloc[1]
+    _row(rows, key, "rescaled_hazard_late", lt["hazard"], lt["ci_low"], lt["ci_high"],
+         note=f"Gamma-rescaled hazard over rescaled t > {LATE_RESCALED:g} "
+         f"({int(lt['events'])} intervals end there); 1 if the phase-averaged rate held")
+    for lo_t, hi_t in ((0.2, 1.0), (1.0, LATE_RESCALED)):
+        mid = stats.interval_hazard(u[done], u[~done], edges=[0.0, lo_t, hi_t,
+                                                             max(float(u.max()), 2 * hi_t)])
+        mt = mid.table.iloc[1]
+        _row(rows, key, f"rescaled_hazard_{lo_t:g}_{hi_t:g}", mt["hazard"], mt["ci_low"],
+             mt["ci_high"], note=f"Gamma-rescaled hazard over rescaled t in [{lo_t:g}, {hi_t:g})")
 
     # Cox twins through the same battery
     twins = _twins(runs, tab, pred, post, t_max, n_twins, rng)
+    _row(rows, key, "oos_chain_states", CHAIN_STATES,
+         note="cox_markov_oos: rate chain fitted on the other half of the ICs (even / odd)")
     data["twins"] = twins
     for name, res in twins.items():
         for test in BATTERY:
@@ -343,7 +406,14 @@ def _twins(runs, tab, pred, post, t_max, n_twins, rng):
     by_run = [post[tab["run"].to_numpy() == i] for i in range(len(runs))]
     pooled = np.array([run.n_pp for run in runs]).sum() / (len(runs) * t_max)
     out = {name: [] for name in TWINS}
+    # out of sample: each half of the ICs gets the chain fitted on the other half
+    half = np.arange(len(runs)) % 2
+    chains = {h: fit_rate_chain(pred[half != h], [by_run[i] for i in np.flatnonzero(half != h)])
+              for h in (0, 1)}
     for _ in range(n_twins):
+        paths = np.empty((len(runs), CHAIN_STATES + 1))
+        for h in (0, 1):
+            paths[half == h] = draw_rate_chains(chains[h], pred[half == h], CHAIN_STATES, rng)
         draws = {
             "poisson": [stats.simulate_cox_times([pooled], t_max, rng=rng) for _ in runs],
             "mixed_poisson": [stats.simulate_cox_times([g], t_max, rng=rng) for g in pred],
@@ -351,6 +421,7 @@ def _twins(runs, tab, pred, post, t_max, n_twins, rng):
                         for _ in runs],
             "cox_sequence": [stats.simulate_cox_times(np.concatenate([[g], p]), t_max, rng=rng)
                              for g, p in zip(pred, by_run, strict=True)],
+            "cox_markov_oos": [stats.simulate_cox_times(path, t_max, rng=rng) for path in paths],
         }
         for name, seqs in draws.items():
             out[name].append(_battery(seqs, t_max, rng))
@@ -377,7 +448,7 @@ def _explained(rows, key, what, obs, twins, rng, *, subset=None, suffix=""):
         return (_dispersion(obs["counts"][p]) if what == "dispersion_index"
                 else obs["reject"][what].to_numpy()[p].mean())
 
-    for name in ("mixed_poisson", "cox_iid", "cox_sequence"):
+    for name in EXPLAINERS:
         def ratio(p, name=name):
             with np.errstate(divide="ignore", invalid="ignore"):
                 return (stat(name, p) - base) / (observed(p) - base)
@@ -432,11 +503,13 @@ def main(argv=None):
     ap.add_argument("--twins", type=int, default=20, help="twin ensembles per model (20)")
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--seed", type=int, default=29)
+    ap.add_argument("--rule", choices=("mirror", "elastic"), default="mirror",
+                    help="collision rule; elastic: rates conditioned on the speeds too")
     args = ap.parse_args(argv)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
-    groups = simulate(args.n_ics, args.t_max, args.workers, args.seed)
+    groups = simulate(args.n_ics, args.t_max, args.workers, args.seed, args.rule)
     print(f"simulated {sum(len(v[1]) for v in groups.values())} runs in "
           f"{time.perf_counter() - t0:.0f} s", flush=True)
     if not has_rate():
@@ -444,7 +517,8 @@ def main(argv=None):
     rng = np.random.default_rng(args.seed)
     rows, results = [], {}
     for key, (ics, runs) in groups.items():
-        part, results[key] = analyse(key, ics, runs, n_twins=args.twins, rng=rng)
+        part, results[key] = analyse(key, ics, runs, n_twins=args.twins, rng=rng,
+                                     rule=args.rule)
         rows += part
         print(f"analysed {key} at {time.perf_counter() - t0:.0f} s", flush=True)
     if has_rate():
@@ -471,7 +545,11 @@ def main(argv=None):
                 _row(rows, ("pooled", r), f"cell_rate_rim_{name}", emp[i, j] / gamma,
                      note=f"corner cell (signs of L0, L1), over the kinetic rate; predicted "
                      f"{pred[i, j] / gamma:.3g}; {int(events[i, j])} collisions")
+    for name, value in (("n_ics", args.n_ics), ("t_max", args.t_max), ("twins", args.twins),
+                        ("seed", args.seed)):
+        _row(rows, ("run", math.nan), name, value, note=f"rule {args.rule}")
     table = pd.DataFrame(rows)
+    table.insert(0, "rule", args.rule)
     table.to_csv(out / "mechanism_numbers.csv", index=False, float_format="%.6g")
     cells = {r: state_rates(results, r) for r in RADII} if has_rate() else None
     write_figures(results, out, cells=cells, rate=rate)

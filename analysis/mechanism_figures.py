@@ -20,10 +20,12 @@ import pandas as pd  # noqa: E402
 
 from kicktimes import stats  # noqa: E402
 
-TWIN_LABELS = {"poisson": "Poisson\n(pooled rate)",
-               "mixed_poisson": "mixed Poisson\nΓ(L initial)",
-               "cox_iid": "Cox, iid\npost-collision L",
-               "cox_sequence": "Cox, run's own\nL sequence", "observed": "observed"}
+TWIN_LABELS = {"poisson": "Poisson\n(pooled\nrate)",
+               "mixed_poisson": "mixed\nPoisson\nΓ(initial)",
+               "cox_iid": "Cox, iid\npost-\ncollision",
+               "cox_sequence": "Cox, run's\nown states\n(in sample)",
+               "cox_markov_oos": "rate chain,\nother half\n(out of\nsample)",
+               "observed": "observed"}
 
 
 def _groups(results):
@@ -91,11 +93,12 @@ def fig_hazard_normalised(results):
                       label="time in units of the run's own mean interval")
         if "hazard_rescaled" in d:
             _hazard_steps(ax, d["hazard_rescaled"], color="C0",
-                          label="time rescaled by Γ(L after the last collision)")
+                          label="time rescaled by Γ(state after the last collision)")
         ax.axhline(1.0, color="grey", ls="--", label="Poisson")
         _log_log(ax, "rescaled time since the last collision (dimensionless)",
                  "hazard / mean rate")
-    return _panels(results, draw, "Hazard after removing the rate differences")
+    return _panels(results, draw, "Hazard after removing the rate differences (one y scale)",
+                   sharey=True)
 
 
 def fig_recollisions(results):
@@ -162,7 +165,7 @@ def fig_survival(results):
 
 
 def fig_battery(results):
-    fig, axes = plt.subplots(1, 3, figsize=(15, 4.8))
+    fig, axes = plt.subplots(1, 3, figsize=(15, 5.2))
     twins = tuple(next(iter(results.values()))["twins"])
     names = (*twins, "observed")
     width = 0.8 / len(results)

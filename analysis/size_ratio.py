@@ -16,9 +16,11 @@ ratio, 200 ICs from the pair's invariant measure (mirror rule), run for 10 000 s
   ``ftle_own_*``). Both use the same kick times and scattering numbers (common random
   numbers), so they differ only in the contact distance ``r_d + r_partner``.
 
-Writes ``size_ratio.csv`` and ``size_ratio.png`` into ``--out``.
+Writes ``size_ratio.csv`` and ``size_ratio.png`` into ``--out`` and the page
+``unequal.md`` beside it: every ratio with its `kicktimes.stats.ratio_verdict` (10 %).
 
 Run: python analysis/size_ratio.py [--n-ics 200] [--out docs/results/size_ratio]
+     python analysis/size_ratio.py --page-only   (the page from the CSV, nothing simulated)
 """
 
 from __future__ import annotations
@@ -54,9 +56,17 @@ def main(argv=None):
     ap.add_argument("--tau", type=float, default=0.3)
     ap.add_argument("--seed", type=int, default=5)
     ap.add_argument("--out", default="docs/results/size_ratio")
+    ap.add_argument("--page-only", action="store_true",
+                    help="write unequal.md from OUT/size_ratio.csv without simulating")
     args = ap.parse_args(argv)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
+    command = ("python analysis/size_ratio.py --page-only" if args.page_only else
+               f"python analysis/size_ratio.py --n-ics {args.n_ics} --n-steps {args.n_steps}")
+    if args.page_only:
+        write_page(pd.read_csv(out / "size_ratio.csv"), out.parent / "unequal.md", command,
+                   args)
+        return
     rng = np.random.default_rng(args.seed)
     t0 = time.perf_counter()
     rows = []
@@ -104,6 +114,54 @@ def main(argv=None):
     table.to_csv(out / "size_ratio.csv", index=False)
     figure(table).savefig(out / "size_ratio.png", dpi=110)
     print(table.round(4).to_string())
+    write_page(table, out.parent / "unequal.md", command, args)
+
+
+def write_page(table, page, command, args):
+    """docs/results/unequal.md: the size-ratio table with a verdict beside every ratio."""
+    from generated import MARGIN, header
+
+    from kicktimes.stats import format_interval, ratio_rule, ratio_verdict
+
+    lines = header("Unequal disks: the size ratio", command,
+                   ["the direct simulations of `analysis/size_ratio.py` (`size_ratio.csv`; "
+                    "no store)"])
+    lines += [f"Definitions and methods: [../unequal.md](../unequal.md). Disk 0 keeps "
+              f"r0 = {R0:g}; {args.n_ics} invariant ICs per ratio, {args.n_steps} steps of "
+              f"{args.tau:g}, mirror rule; the kicked disk gets scattering kicks at Poisson "
+              "times at its IC's own collision rate. Ratios of means with 95 % bootstrap "
+              f"intervals over ICs; verdicts: {ratio_rule(MARGIN)}.", "",
+              "| r1 / r0 | rate / Γ(r0, r1) | KS rejections | dispersion | small disk, "
+              "partner r1 | own-size partner | large disk, partner r0 | own-size partner |",
+              "|---|---|---|---|---|---|---|---|"]
+    cols = [("ftle_partner_ratio_disk0", "ftle_partner_low_disk0", "ftle_partner_high_disk0"),
+            ("ftle_own_ratio_disk0", "ftle_own_low_disk0", "ftle_own_high_disk0"),
+            ("ftle_partner_ratio_disk1", "ftle_partner_low_disk1", "ftle_partner_high_disk1"),
+            ("ftle_own_ratio_disk1", "ftle_own_low_disk1", "ftle_own_high_disk1")]
+
+    def cell(row, c):
+        return (f"{format_interval(row[c[0]], row[c[1]], row[c[2]])}, "
+                f"{ratio_verdict(row[c[1]], row[c[2]], MARGIN)}")
+
+    for _, row in table.iterrows():
+        rate = cell(row, ("rate_ratio", "rate_low", "rate_high"))
+        lines.append(f"| {row['size_ratio']:g} | {rate}"
+                     f" | {100 * row['ks_reject_share']:.0f} % | {row['dispersion_index']:.1f} | "
+                     + " | ".join(cell(row, c) for c in cols) + " |")
+    lines.append("")
+    for c, name in ((("rate_ratio", "rate_low", "rate_high"), "collision rate / kinetic rate"),
+                    (cols[0], "small disk, partner of the other disk's size"),
+                    (cols[2], "large disk, partner of the other disk's size")):
+        v = [ratio_verdict(lo, hi, MARGIN) for lo, hi in zip(table[c[1]], table[c[2]],
+                                                             strict=True)]
+        counts = pd.Series(v).value_counts()
+        odd = [f"ratio {x:g}: {vv}" for x, vv in zip(table["size_ratio"], v, strict=True)
+               if vv != counts.index[0]]
+        lines.append(f"- {name}: {counts.index[0]} at {counts.iloc[0]} of {len(v)} ratios"
+                     + (f" (not at {', '.join(odd)})" if odd else "") + ".")
+    lines += ["", "![size ratio](size_ratio/size_ratio.png)", ""]
+    Path(page).write_text("\n".join(lines), encoding="utf-8")
+    print(f"{page} written")
 
 
 def figure(table):

@@ -191,3 +191,27 @@ def test_predicted_rates_average_to_the_kinetic_rate_over_invariant_ics():
     rates = mechanism.predicted_rates(ics, r)
     se = rates.std() / np.sqrt(rates.size)
     assert abs(rates.mean() - stats.kinetic_rate(r)) < 3 * se + 0.05 * stats.kinetic_rate(r)
+
+
+def test_the_elastic_rule_s_speeds_change_at_collisions_and_keep_the_energy():
+    ic = initial_conditions(1, 0.03, seed=4)[0]
+    run = simulate_two_particle(ic, 0.03, t_max=1500.0, rule="elastic", log_collisions=True)
+    tab = mechanism.collision_table(run)
+    energy = tab["speed0_post"] ** 2 + tab["speed1_post"] ** 2
+    np.testing.assert_allclose(energy, (ic[:, 2:] ** 2).sum(), rtol=1e-9)
+    assert tab["speed0_post"].std() > 0.05
+    mirror = mechanism.collision_table(simulate_two_particle(ic, 0.03, t_max=300.0,
+                                                             log_collisions=True))
+    np.testing.assert_allclose(mirror[["speed0_post", "speed1_post"]], 1.0, rtol=1e-12)
+
+
+@needs_conditional_rate
+def test_predicted_rates_under_the_elastic_rule_condition_on_the_speeds():
+    ic = initial_conditions(1, 0.02, seed=2, method="uniform", rule="elastic")
+    slow, fast = ic.copy(), ic.copy()
+    slow[0, :, 2:] *= 0.5
+    fast[0, :, 2:] *= 2.0
+    rates = [float(np.squeeze(mechanism.predicted_rates(x, 0.02, rule="elastic")))
+             for x in (slow, ic, fast)]
+    assert rates[0] < rates[1] < rates[2]
+    np.testing.assert_allclose(rates[2] / rates[1], 2.0, rtol=1e-9)

@@ -63,7 +63,7 @@ def test_a_sweep_with_holes_gets_the_escape_section_figure_and_tables(report):
     assert np.allclose(tails["t_min"], exp.horizon / 20)
     comparison = pd.read_csv(out / "escape_comparison.csv")
     assert len(comparison) == len(exp.radii) * (len(exp.systems) - 1)
-    assert set(comparison["verdict"]) <= {"like", "not like", "n/a"}
+    assert set(comparison["verdict"]) <= {"like", "not like", "inconclusive", "n/a"}
     # the figure's own curves: survival decreasing in [0, 1] within each (radius, system)
     curves = pd.read_csv(out / "escape_survival.csv")
     for _, g in curves.groupby(["radius", "system"]):
@@ -109,10 +109,12 @@ def _verdicts(results, t_min=10.0):
 
 
 def test_the_same_exponential_escape_is_like_the_two_disks():
+    # "like" is an equivalence test: the ratio's interval within 10 %, which needs many runs
     rng = np.random.default_rng(1)
-    law = {s: rng.exponential(40.0, 800) for s in ("two_particle", "poisson", "actual")}
+    law = {s: rng.exponential(40.0, 6000) for s in ("two_particle", "poisson", "actual")}
     comparison, answer = _verdicts(_results({0.02: law}))
     assert (comparison["verdict"] == "like").all()
+    assert ((comparison["ratio_low"] >= 0.9) & (comparison["ratio_high"] <= 1.1)).all()
     assert (comparison["compared"] == "rate").all()
     assert answer.startswith("Does the kicked disk escape like the two disks? Yes")
 
@@ -130,12 +132,22 @@ def test_an_algebraic_tail_against_an_exponential_one_is_not_like():
 
 def test_an_answer_that_differs_across_radii_says_so_with_the_numbers():
     rng = np.random.default_rng(3)
-    same = {s: rng.exponential(40.0, 800) for s in ("two_particle", "poisson")}
+    same = {s: rng.exponential(40.0, 6000) for s in ("two_particle", "poisson")}
     faster = {"two_particle": rng.exponential(40.0, 800), "poisson": rng.exponential(15.0, 800)}
     comparison, answer = _verdicts(_results({0.01: same, 0.03: faster}))
     assert list(comparison["verdict"]) == ["like", "not like"]
     assert "It depends on the radius: like at r = 0.01" in answer
     assert "r = 0.03, Poisson: γ = " in answer  # the differing case, with its numbers
+
+
+def test_overlapping_intervals_alone_are_not_agreement():
+    # few runs: the intervals overlap, but the ratio's interval reaches past the 10 % band
+    rng = np.random.default_rng(5)
+    law = {s: rng.exponential(40.0, 300) for s in ("two_particle", "poisson")}
+    comparison, answer = _verdicts(_results({0.02: law}))
+    row = comparison.iloc[0]
+    assert row["ci_overlap"] and row["verdict"] == "inconclusive"
+    assert "Undecided" in answer
 
 
 def test_a_store_that_does_not_say_which_disk_left_is_not_compared():

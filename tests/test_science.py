@@ -1,24 +1,29 @@
 """analysis/science.py: the mechanism statements' estimators on data with known answers."""
 
 import importlib.util
+import sys
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 import pytest
 
+from kicktimes.stats import ratio_verdict
+
 REPO = Path(__file__).resolve().parents[1]
 
 
 @pytest.fixture(scope="module")
 def science():
+    if str(REPO / "analysis") not in sys.path:   # the scripts import their helper `generated`
+        sys.path.insert(0, str(REPO / "analysis"))
     spec = importlib.util.spec_from_file_location("science", REPO / "analysis" / "science.py")
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     return module
 
 
-def test_the_stretching_fit_recovers_known_slopes_and_their_ratio(science):
+def test_the_stretching_per_radius_gives_the_ratio_its_verdict_and_its_trend(science):
     # per-IC FTLE built so that lambda / rate = a + b ln(1/r) exactly (rate 0.1 everywhere)
     radii = [0.002, 0.005, 0.01, 0.03]
     coef = {"two_particle": (-2.5, 2.0), "poisson": (-1.8, 0.9), "poisson_scatter": (-2.8, 2.0)}
@@ -32,22 +37,66 @@ def test_the_stretching_fit_recovers_known_slopes_and_their_ratio(science):
                 rows += [(r, ic, system, "lyapunov", 0.1 * s), (r, ic, system, "t_max", 1000.0),
                          (r, ic, system, n_name, 100.0)]
     results = pd.DataFrame(rows, columns=["radius", "ic", "system", "diagnostic", "value"])
-    fits, per_radius = science.stretching(results, n_boot=200)
+    per_radius, fits, trend = science.stretching(results, n_boot=200)
     f = fits.set_index("system")
     assert f.loc["poisson", "slope"] == pytest.approx(0.9, rel=0.05)
-    assert f.loc["two_particle", "slope"] == pytest.approx(2.0, rel=0.05)
+    assert f.loc["two_particle", "intercept"] == pytest.approx(-2.5, abs=0.3)
     assert f.loc["poisson", "slope_ci_low"] < 0.9 < f.loc["poisson", "slope_ci_high"]
-    assert f.loc["poisson", "slope_ratio"] == pytest.approx(0.45, rel=0.07)
+    kicked = per_radius[per_radius["system"] == "poisson"].set_index("radius")
+    x = np.log(1 / kicked.index.to_numpy())
+    np.testing.assert_allclose(kicked["ratio"], (-1.8 + 0.9 * x) / (-2.5 + 2.0 * x), rtol=0.05)
+    for row in per_radius.dropna(subset=["ratio"]).itertuples():
+        assert row.ci_low <= row.stretch_per_perturbation <= row.ci_high
+        assert row.verdict == ratio_verdict(row.ratio_ci_low, row.ratio_ci_high)
+    t = trend.set_index(["system", "quantity"])
+    assert t.loc[("poisson", "ratio"), "verdict"] == "rises"      # 0.30 -> 0.38
+    assert t.loc[("poisson", "abs_log_ratio"), "verdict"] == "falls"
     assert len(per_radius) == 3 * len(radii)
 
 
+def test_the_prediction_is_set_beside_the_store_s_measurement(science, tmp_path):
+    by_radius = pd.DataFrame({
+        "family": "fam", "diagnostic": "one_minus_r1", "system": ["poisson", "poisson_scatter"],
+        "control": "primary", "radius": 0.01, "n_pairs": 200, "ratio": [0.77, 0.99],
+        "ci_low": [0.72, 0.96], "ci_high": [0.82, 1.02]})
+    by_radius.to_csv(tmp_path / "fam_findings_by_radius.csv", index=False)
+    preds = pd.DataFrame({"rule": "mirror", "radius": 0.01,
+                          "system": ["poisson", "poisson_scatter"],
+                          "predicted": [0.88, 1.0], "predicted_ci_low": [0.86, 0.98],
+                          "predicted_ci_high": [0.90, 1.02]})
+    out = science.prediction_against_measurement(preds, tmp_path, {"mirror": "fam"}).set_index(
+        "system")
+    assert out.loc["poisson", "measured_over_predicted"] == pytest.approx(0.77 / 0.88)
+    assert out.loc["poisson", "quotient_verdict"] == "inconclusive"   # 0.875 straddles 0.9
+    assert out.loc["poisson_scatter", "quotient_verdict"] == "within 10 %"
+    assert out.loc["poisson", "measured_verdict"] == "lower"
+    with pytest.raises(ValueError, match="findings_dir"):
+        science.prediction_against_measurement(preds, tmp_path, {"mirror": "missing"})
+
+
+def test_a_law_comes_closest_only_when_its_distance_interval_is_clear(science, tmp_path):
+    rows = [("poisson", 0.32, 0.31, 0.33), ("actual", 0.30, 0.29, 0.31),
+            ("poisson_scatter", 0.97, 0.93, 1.02), ("actual_scatter", 0.92, 0.89, 0.96)]
+    table = pd.DataFrame([{"family": "fam", "diagnostic": "ftle", "system": s,
+                           "control": "primary", "estimate": e, "ci_low": lo, "ci_high": hi,
+                           "verdict": ratio_verdict(lo, hi)} for s, e, lo, hi in rows])
+    table.to_csv(tmp_path / "fam_findings.csv", index=False)
+    out = science.closest_kick_law(tmp_path, ["fam"], diagnostics=("ftle",)).set_index("system")
+    assert out["closest"].to_dict() == {"poisson": False, "actual": False,
+                                        "poisson_scatter": True, "actual_scatter": True}
+
+
 def test_one_perturbation_decorrelates_and_none_keeps_the_angle(science):
-    table, by_angle = science.decorrelation(radii=(0.03,), n_ics=3, t_max=3000.0, n_boot=50)
+    table, by_angle, predicted = science.decorrelation(radii=(0.03,), n_ics=3, t_max=3000.0,
+                                                       n_boot=50)
     corr = table.set_index("perturbation")["correlation"]
     assert corr["no perturbation"] == pytest.approx(1.0)  # the wall conserves the angle
     assert abs(corr["uniform kick"]) < 0.2  # a uniform kick draws a new direction
     assert corr["disk-disk collision"] < 0.5
     assert set(by_angle["perturbation"]) == set(corr.index)
+    pred = predicted.set_index("system")["predicted"]
+    assert pred["poisson"] == pytest.approx((1 - corr["uniform kick"])
+                                            / (1 - corr["disk-disk collision"]))
 
 
 def test_twins_with_independent_kick_angles_separate_by_order_one_at_every_kick(science):
@@ -58,3 +107,49 @@ def test_twins_with_independent_kick_angles_separate_by_order_one_at_every_kick(
     lam, rate, (low, high) = science.independent_angle_twin(0.05, n_ics=2, n_steps=400)
     assert low <= lam <= high
     assert lam / rate > math.log(1 / 2e-4) - 1.0
+
+
+def _script(name):
+    if str(REPO / "analysis") not in sys.path:
+        sys.path.insert(0, str(REPO / "analysis"))
+    spec = importlib.util.spec_from_file_location(name, REPO / "analysis" / f"{name}.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_the_out_of_sample_rate_chain_keeps_the_order_of_its_training_states():
+    mech = _script("mechanism")
+    # training runs alternate a slow and a fast state: the chain must alternate too
+    first = np.array([1.0, 1.0, 1.0])
+    post = [np.tile([10.0, 1.0], 20) for _ in first]
+    chain = mech.fit_rate_chain(first, post, n_bins=4)
+    paths = mech.draw_rate_chains(chain, np.array([1.0, 10.0]), 50, np.random.default_rng(0))
+    assert paths.shape == (2, 51)
+    np.testing.assert_array_equal(paths[:, 0], [1.0, 10.0])
+    np.testing.assert_array_equal(paths[0, 1::2], 10.0)
+    np.testing.assert_array_equal(paths[0, 2::2], 1.0)
+
+
+def test_the_escape_tail_rate_is_events_over_time_at_risk_beyond_t_min():
+    escape = _script("escape")
+    rng = np.random.default_rng(1)
+    t = rng.exponential(100.0, 20000)
+    horizon = np.full(t.size, 3000.0)
+    t[t > 3000.0] = np.inf
+    picks = np.arange(t.size)[None, :]
+    one = escape.tail_rates(t, horizon, 50.0, picks)[0]
+    assert one == pytest.approx(0.01, rel=0.03)
+    assert escape.tail_rates(t, horizon, 50.0, picks, disks=2)[0] == pytest.approx(one / 2)
+
+
+def test_an_mmpp_has_no_refractory_dip():
+    from types import SimpleNamespace
+
+    mm = _script("mmpp_billiard")
+    same = SimpleNamespace(rates=[0.5, 0.5], stationary=[0.5, 0.5],
+                           generator=[[-0.1, 0.1], [0.1, -0.1]])
+    assert mm.mmpp_dip(same) == pytest.approx(1.0, rel=1e-6)
+    bursty = SimpleNamespace(rates=[0.05, 2.0], stationary=[0.9, 0.1],
+                             generator=[[-0.01, 0.01], [0.09, -0.09]])
+    assert mm.mmpp_dip(bursty) > 1.0

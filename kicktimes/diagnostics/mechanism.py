@@ -44,6 +44,7 @@ __all__ = [
 COLLISION_COLUMNS = (
     "time", "interval", "next_interval", "next_censored", "L0_pre", "L1_pre", "L0_post",
     "L1_post", "impact", "impact_ratio", "contact_radius", "wall_hits0", "wall_hits1",
+    "speed0_post", "speed1_post",
 )
 
 
@@ -117,7 +118,10 @@ def collision_table(run) -> pd.DataFrame:
           ``impact_ratio`` :math:`= b / 2r \in [0, 1]` (0 head-on, 1 grazing);
         * ``contact_radius``: distance of the pair's midpoint from the table's centre;
         * ``wall_hits0, wall_hits1``: boundary collisions of each disk since the previous
-          disk-disk collision (since time 0 for the first).
+          disk-disk collision (since time 0 for the first);
+        * ``speed0_post, speed1_post``: each disk's speed just after (1 under the mirror
+          rule; the elastic rule exchanges the normal components, so the speeds change and
+          the rate after a collision depends on them as well as on the angular momenta).
 
     Notes
     -----
@@ -160,6 +164,8 @@ def collision_table(run) -> pd.DataFrame:
         "contact_radius": np.hypot(c["x0"] + c["x1"], c["y0"] + c["y1"]) / 2.0,
         "wall_hits0": hits[:n, 0],
         "wall_hits1": hits[:n, 1],
+        "speed0_post": np.hypot(c["vx0_post"], c["vy0_post"]),
+        "speed1_post": np.hypot(c["vx1_post"], c["vy1_post"]),
     })
     return table
 
@@ -359,7 +365,8 @@ def predicted_rates(ics, r, *, rule="mirror") -> np.ndarray:
     r : float
         Disk radius.
     rule : {"mirror", "elastic"}, optional
-        Collision rule (passed on).
+        Collision rule (passed on; under ``"elastic"`` the rate is conditioned on the
+        ICs' speeds as well).
 
     Returns
     -------
@@ -379,4 +386,8 @@ def predicted_rates(ics, r, *, rule="mirror") -> np.ndarray:
     from kicktimes import stats
 
     L = initial_angular_momenta(ics)
-    return stats.conditional_kinetic_rate(r, L[..., 0], L[..., 1], rule=rule)
+    if rule != "elastic":
+        return stats.conditional_kinetic_rate(r, L[..., 0], L[..., 1], rule=rule)
+    speed = np.hypot(np.asarray(ics)[..., 2], np.asarray(ics)[..., 3])
+    return stats.conditional_kinetic_rate(r, L[..., 0], L[..., 1], rule=rule,
+                                          speed1=speed[..., 0], speed2=speed[..., 1])

@@ -21,11 +21,14 @@ is the one whose AIC is lower by more than `AIC_MARGIN`, "undecided" otherwise.
 
 **Verdict** per (radius, kicked system), against the two-disk system at that radius:
 "not like" when one tail is decidedly exponential and the other decidedly algebraic;
-otherwise the 95 % intervals of the shared law's parameter (α when at least one tail is
-algebraic and none exponential, γ otherwise) are compared: "like" when they overlap,
-"not like" when they do not. Overlapping intervals are a lenient criterion (two estimates
-whose intervals just touch differ at about the 0.6 % level); disjoint intervals are a
-clear difference. The section's first line combines the verdicts (:func:`escape_answer`).
+otherwise an equivalence test on the ratio of the shared law's parameter (α when at least
+one tail is algebraic and none exponential, γ otherwise), kicked / two disks. Its 95 %
+interval combines the two exact intervals, each read as normal on the log scale
+(:math:`\sigma = \ln(hi / lo) / (2 \cdot 1.96)`, added in quadrature); the verdict is
+`kicktimes.stats.ratio_verdict` with the margin `MARGIN` (10 %), fixed in advance: "like"
+when the whole interval lies within it, "not like" when it lies entirely outside
+(lower or higher), "inconclusive" otherwise. Overlapping intervals are never taken as
+agreement. The section's first line combines the verdicts (:func:`escape_answer`).
 """
 
 from __future__ import annotations
@@ -65,6 +68,8 @@ ESCAPE_ROWS = ("escape_time", "escaped_disk")
 #: default ``t_min`` of the tail fits: this fraction of the experiment's horizon n_steps·tau
 T_MIN_FRACTION = 1 / 20
 #: AIC difference beyond which a tail law is decided (one parameter each)
+#: equivalence margin of the escape-rate ratio, fixed in advance
+MARGIN = 0.1
 AIC_MARGIN = 2.0
 _RUN_COLUMNS = ["radius", "ic", "system", "time", "horizon", "other_disk", "followed"]
 
@@ -242,9 +247,12 @@ def escape_comparison(table) -> pd.DataFrame:
     pandas.DataFrame
         ``radius, system, tail_law, tail_law_two_particle, compared`` (``rate`` or
         ``alpha``), ``estimate, low, high`` and the same of the two-disk system
-        (``..._two_particle``), ``ci_overlap`` and ``verdict``: ``like``, ``not like`` or
-        ``n/a`` with its ``reason`` (the module's rules).
+        (``..._two_particle``), ``ci_overlap``, the ``ratio`` kicked / two disks with
+        ``ratio_low``, ``ratio_high``, and ``verdict``: ``like``, ``not like``,
+        ``inconclusive`` or ``n/a`` with its ``reason`` (the module's rules).
     """
+    from kicktimes.stats import format_interval, ratio_verdict
+
     check_frame("table", table, ["radius", "system", "followed", "tail_law", "rate",
                                  "rate_low", "rate_high", "alpha", "alpha_low",
                                  "alpha_high"], allow_empty=True)
@@ -264,6 +272,7 @@ def escape_comparison(table) -> pd.DataFrame:
                             f"high{suffix}": src[f"{compared}_high"]})
             overlap = bool(out["low"] <= out["high_two_particle"]
                            and out["low_two_particle"] <= out["high"])
+            ratio, ratio_low, ratio_high = _ratio(out)
             if ref["followed"] != "disk 0":
                 verdict, reason = "n/a", ("the store does not record which disk left the "
                                           "two-disk table")
@@ -273,13 +282,31 @@ def escape_comparison(table) -> pd.DataFrame:
                 verdict, reason = "not like", "one tail is exponential, the other algebraic"
             else:
                 name = "γ" if compared == "rate" else "α"
-                verdict = "like" if overlap else "not like"
-                reason = f"95 % CIs of {name} {'overlap' if overlap else 'are disjoint'}"
-            rows.append({**out, "ci_overlap": overlap, "verdict": verdict, "reason": reason})
+                rv = ratio_verdict(ratio_low, ratio_high, MARGIN)
+                verdict = {"lower": "not like", "higher": "not like",
+                           "inconclusive": "inconclusive"}.get(rv, "like")
+                reason = (f"ratio of {name} {format_interval(ratio, ratio_low, ratio_high)}: "
+                          f"{rv}")
+            rows.append({**out, "ci_overlap": overlap, "ratio": ratio, "ratio_low": ratio_low,
+                         "ratio_high": ratio_high, "verdict": verdict, "reason": reason})
     columns = ["radius", "system", "tail_law", "tail_law_two_particle", "compared",
                "estimate", "low", "high", "estimate_two_particle", "low_two_particle",
-               "high_two_particle", "ci_overlap", "verdict", "reason"]
+               "high_two_particle", "ci_overlap", "ratio", "ratio_low", "ratio_high",
+               "verdict", "reason"]
     return pd.DataFrame(rows, columns=columns)
+
+
+def _ratio(out):
+    """Kicked / two-disk ratio of the compared parameter with its 95 % interval (the two
+    exact intervals combined on the log scale); NaNs when an interval is missing."""
+    ends = (out["low"], out["high"], out["low_two_particle"], out["high_two_particle"])
+    est, ref = out["estimate"], out["estimate_two_particle"]
+    if not all(np.isfinite(v) and v > 0 for v in (*ends, est, ref)):
+        return math.nan, math.nan, math.nan
+    sd = math.hypot(math.log(out["high"] / out["low"]),
+                    math.log(out["high_two_particle"] / out["low_two_particle"])) / (2 * 1.96)
+    ratio = est / ref
+    return ratio, ratio * math.exp(-1.96 * sd), ratio * math.exp(1.96 * sd)
 
 
 def _case(row):
@@ -290,7 +317,7 @@ def _case(row):
     else:
         numbers = (f"{name} = {fmt(row.estimate)} [{fmt(row.low)}, {fmt(row.high)}] against "
                    f"{fmt(row.estimate_two_particle)} [{fmt(row.low_two_particle)}, "
-                   f"{fmt(row.high_two_particle)}]")
+                   f"{fmt(row.high_two_particle)}], {row.reason}")
     return f"r = {row.radius:g}, {system_label(row.system)}: {numbers}"
 
 
@@ -303,10 +330,12 @@ def _cases(rows, limit=6):
 def escape_answer(comparison) -> str:
     """The computed one-line answer to "does the kicked disk escape like the two disks?".
 
-    "Yes" when every (radius, kicked system) compared is "like", "No" when none is, and
-    otherwise "It depends on the radius", "... on the kicked system" or "... on the radius
-    and the kicked system" (whichever splits the verdicts cleanly), with the numbers of
-    the cases that differ. Comparisons that could not be made ("n/a") are named.
+    "Yes" when every (radius, kicked system) compared is "like" (the equivalence test),
+    "No" when every one is "not like", "Undecided" when none is either (every ratio's
+    interval straddles an edge of the band), and otherwise "It depends on the radius",
+    "... on the kicked system" or "... on the radius and the kicked system" (whichever
+    splits the verdicts cleanly), with the numbers of the cases that differ.
+    Comparisons that could not be made ("n/a") are named.
 
     Examples
     --------
@@ -314,7 +343,7 @@ def escape_answer(comparison) -> str:
     >>> rng = np.random.default_rng(0)
     >>> rows = [(0.02, ic, system, name, value)
     ...         for system in ("two_particle", "poisson")
-    ...         for ic, t in enumerate(rng.exponential(40.0, 500))
+    ...         for ic, t in enumerate(rng.exponential(40.0, 20000))
     ...         for name, value in (("escape_time", t), ("t_max", t), ("escaped_disk", 0.0))
     ...         if name != "escaped_disk" or system == "two_particle"]
     >>> results = pd.DataFrame(rows, columns=["radius", "ic", "system", "diagnostic", "value"])
@@ -333,13 +362,18 @@ def escape_answer(comparison) -> str:
         reasons = sorted(set(comparison["reason"]))
         return question + "Not computed: " + "; ".join(reasons) + "."
     like = made["verdict"] == "like"
+    unlike = made["verdict"] == "not like"
     where = f"{made['radius'].nunique()} radii × {made['system'].nunique()} kicked systems"
     if like.all():
         answer = (f"Yes: at every radius every kicked system's escape tail matches the two "
-                  f"disks' (same tail law, overlapping 95 % intervals; {where}).")
-    elif not like.any():
+                  f"disks' (same tail law, the ratio's 95 % interval within {100 * MARGIN:g} "
+                  f"%; {where}).")
+    elif unlike.all():
         answer = ("No: no kicked system escapes like the two disks at any radius ("
                   + _cases(made) + ").")
+    elif not (like.any() or unlike.any()):
+        answer = (f"Undecided: every ratio's 95 % interval straddles an edge of the "
+                  f"±{100 * MARGIN:g} % band (" + _cases(made) + ").")
     else:
         by_radius = (made.groupby("radius")["verdict"].nunique() == 1).all()
         by_system = (made.groupby("system")["verdict"].nunique() == 1).all()
@@ -351,7 +385,7 @@ def escape_answer(comparison) -> str:
             on = f"the kicked system: like for {', '.join(system_label(s) for s in yes)}"
         else:
             on = f"the radius and the kicked system: like in {int(like.sum())} of {len(made)}"
-        answer = f"It depends on {on}; not like for {_cases(made[~like])}."
+        answer = f"It depends on {on}; not like or inconclusive for {_cases(made[~like])}."
     if {"tail_law", "tail_law_two_particle"} <= set(made.columns):
         weak = made[like & ((made["tail_law"] == "undecided")
                             | (made["tail_law_two_particle"] == "undecided"))]

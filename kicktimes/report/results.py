@@ -345,9 +345,12 @@ def write_results(
     if control_lines:
         screen += ["## The control experiments", ""] + control_lines
     screen += [
-        "The mechanism behind these numbers: [science.md](science.md), written by "
-        "`python analysis/science.py`. Below: per family, the scale, every statement under "
-        "the primary setting, and the figures.", ""]
+        "The mechanism behind these numbers: [science.md](science.md), "
+        "[mechanism.md](mechanism.md); escape through a hole: [escape.md](escape.md); "
+        "unequal disks: [unequal.md](unequal.md); scatter kicks: [scatter.md](scatter.md); "
+        "MMPP fits to the collision times: [mmpp.md](mmpp.md); all written by "
+        "`python analysis/make_science.py`. Below: per family, the scale, every statement "
+        "under the primary setting, and the figures.", ""]
     lines[head:head] = screen
     path = out / "README.md"
     path.write_text("\n".join(lines), encoding="utf-8")

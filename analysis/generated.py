@@ -1,0 +1,67 @@
+"""The header and the verdict phrases shared by the generated science pages.
+
+Every page under ``docs/results/`` that states results starts with one line, ::
+
+    Generated <UTC time> by kicktimes <version> (`<command>`) from <stores by name>.
+
+(the model is ``docs/results/README.md``), and every comparative word in it comes from
+a verdict of :mod:`kicktimes.stats` (``ratio_verdict``, ``share_verdict``), never typed.
+"""
+
+from __future__ import annotations
+
+import datetime as _dt
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+
+from kicktimes import __version__
+from kicktimes.stats import format_interval, ratio_verdict
+
+#: the equivalence margin of every ratio on these pages, stated before any was computed
+MARGIN = 0.1
+
+
+def store_name(path) -> str:
+    """The experiment name of a store (its manifest's ``experiment.name``), never its path."""
+    manifest = Path(path) / "manifest.json"
+    if not manifest.is_file():
+        raise ValueError(f"stores: {path} is not a kicktimes store (no manifest.json)")
+    return json.loads(manifest.read_text(encoding="utf-8"))["experiment"]["name"]
+
+
+def header(title, command, sources) -> list[str]:
+    """The page's title and "Generated ..." line; ``sources`` are names, not paths."""
+    now = _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")
+    return [f"# {title} (generated)", "",
+            f"Generated {now} by kicktimes {__version__} (`{command}`) from "
+            + ", ".join(sources) + ". Every number below is computed; nothing is typed.", ""]
+
+
+def ci(values, level=0.95):
+    """Percentile interval of the finite ``values`` (NaNs when there are none)."""
+    v = np.asarray(values, float)
+    v = v[np.isfinite(v)]
+    if not v.size:
+        return math.nan, math.nan
+    a = (1 - level) / 2 * 100
+    return float(np.percentile(v, a)), float(np.percentile(v, 100 - a))
+
+
+def ratio_text(estimate, low, high, tolerance=MARGIN) -> str:
+    """``"0.771 [0.721, 0.825], lower"``: the interval and its `ratio_verdict`."""
+    return (f"{format_interval(estimate, low, high)}, "
+            f"{ratio_verdict(low, high, tolerance)}")
+
+
+def trend_verdict(low, high) -> str:
+    """``"rises"``, ``"falls"`` or ``"no trend detected"`` for a slope's 95 % CI against 0."""
+    if not (np.isfinite(low) and np.isfinite(high)):
+        return "no trend detected"
+    if low > 0:
+        return "rises"
+    if high < 0:
+        return "falls"
+    return "no trend detected"

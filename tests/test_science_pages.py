@@ -1,0 +1,163 @@
+"""The generated science pages (docs/results/*.md) say only what their tables show.
+
+Each page starts with its "Generated ..." line, names no machine path, and the numbers a
+reader sees are the ones in the CSV beside it, with the verdict their interval gives.
+"""
+
+import re
+from pathlib import Path
+
+import pandas as pd
+import pytest
+
+from kicktimes.stats import format_interval, ratio_verdict
+
+RESULTS = Path(__file__).resolve().parents[1] / "docs" / "results"
+PAGES = ["README.md", "science.md", "mechanism.md", "escape.md", "unequal.md", "scatter.md"]
+MACHINE_PATH = re.compile(r"(/tmp/|/work/|/home/|/Users/|/root/|[A-Za-z]:\\\\)")
+
+
+def _page(name):
+    path = RESULTS / name
+    if not path.is_file():
+        pytest.skip(f"{name} is not generated yet")
+    return path.read_text(encoding="utf-8")
+
+
+@pytest.mark.parametrize("name", PAGES)
+def test_every_page_starts_with_its_generated_line_and_names_no_machine_path(name):
+    text = _page(name)
+    lines = [line for line in text.splitlines() if line.strip()]
+    assert lines[0].startswith("# ")
+    assert lines[1].startswith("Generated "), lines[1][:80]
+    assert " by kicktimes " in lines[1] and " from " in lines[1]
+    assert not MACHINE_PATH.search(text), MACHINE_PATH.search(text).group(0)
+
+
+def _cells(text, first_column):
+    """The row of the page's markdown table whose first cell is ``first_column``."""
+    for line in text.splitlines():
+        cells = [c.strip() for c in line.strip().strip("|").split("|")]
+        if cells and cells[0] == first_column:
+            return cells
+    raise AssertionError(f"no table row {first_column!r}")
+
+
+def test_the_science_page_s_ratio_per_radius_is_its_csv_with_its_verdict():
+    text = _page("science.md")
+    table = pd.read_csv(RESULTS / "science_stretching.csv")
+    kicked = table[table["system"] != "two_particle"]
+    for row in kicked.itertuples():
+        assert row.verdict == ratio_verdict(row.ratio_ci_low, row.ratio_ci_high)
+    for r, g in kicked.groupby("radius"):
+        cells = _cells(text, f"{r:g}")
+        for k, system in enumerate(("poisson", "poisson_scatter")):
+            row = g[g["system"] == system].iloc[0]
+            want = (f"{format_interval(row.ratio, row.ratio_ci_low, row.ratio_ci_high)}, "
+                    f"{row.verdict}")
+            assert cells[1 + k] == want
+
+
+def test_the_science_page_extrapolates_nothing_and_quotes_predictions_with_measurements():
+    text = _page("science.md")
+    assert "10⁻⁶" not in text and "r → 0" not in text
+    compare = pd.read_csv(RESULTS / "science_decorrelation_prediction.csv")
+    for row in compare.itertuples():
+        assert row.quotient_verdict == ratio_verdict(row.quotient_ci_low, row.quotient_ci_high)
+        measured = format_interval(row.measured, row.measured_ci_low, row.measured_ci_high)
+        predicted = format_interval(row.predicted, row.predicted_ci_low, row.predicted_ci_high)
+        line = next(x for x in text.splitlines() if predicted in x and measured in x)
+        assert row.quotient_verdict in line
+
+
+def test_the_unequal_page_gives_every_ratio_the_verdict_of_its_interval():
+    text = _page("unequal.md")
+    table = pd.read_csv(RESULTS / "size_ratio" / "size_ratio.csv")
+    for row in table.itertuples():
+        cells = _cells(text, f"{row.size_ratio:g}")
+        want = (f"{format_interval(row.ftle_partner_ratio_disk0, row.ftle_partner_low_disk0, row.ftle_partner_high_disk0)}, "  # noqa: E501
+                f"{ratio_verdict(row.ftle_partner_low_disk0, row.ftle_partner_high_disk0)}")
+        assert cells[4] == want
+    assert "within 10 % … at every ratio" not in text
+
+
+def test_the_scatter_page_is_its_csv_and_no_longer_decomposes_the_gap():
+    text = _page("scatter.md")
+    table = pd.read_csv(RESULTS / "scatter_ratios.csv")
+    for row in table.itertuples():
+        assert row.verdict == ratio_verdict(row.ci_low, row.ci_high)
+    main = table[table["ics"] == "without sticky ICs"]
+    for r, g in main.groupby("radius"):
+        cells = _cells(text, f"{r:g}")
+        first = g.iloc[0]
+        assert cells[1] == (f"{format_interval(first.estimate, first.ci_low, first.ci_high)}, "
+                            f"{first.verdict}")
+    assert "almost all" not in text.lower()
+
+
+def _numbers(folder):
+    path = RESULTS / "mechanism" / folder / "mechanism_numbers.csv"
+    if not path.is_file():
+        pytest.skip(f"{path.name} of {folder or 'mirror'} is not generated yet")
+    return pd.read_csv(path)
+
+
+@pytest.mark.parametrize("folder", ["", "elastic"])
+def test_the_mechanism_page_reads_the_late_hazard_from_its_table(folder):
+    text = _page("mechanism.md")
+    tab = _numbers(folder)
+    rule = tab["rule"].iloc[0]
+    section = text.split(f"## The {rule} rule")[1].split("\n## ")[0]
+    cells = _cells(section, "rescaled t > 5")
+    groups = [("paper", 0.01), ("paper", 0.02), ("uniform", 0.01), ("uniform", 0.02)]
+    for k, (method, r) in enumerate(groups):
+        row = tab[(tab["method"] == method) & (tab["radius"] == r)
+                  & (tab["quantity"] == "rescaled_hazard_late")].iloc[0]
+        verdict = ratio_verdict(row["ci_low"], row["ci_high"])
+        assert cells[1 + k].endswith(verdict), (cells[1 + k], verdict)
+    assert "explains about half to two-thirds" not in text
+
+
+def test_the_escape_page_answers_with_an_equivalence_test_and_its_controls():
+    text = _page("escape.md")
+    ratios = pd.read_csv(RESULTS / "escape" / "escape_ratios.csv")
+    for row in ratios.itertuples():
+        assert row.verdict == ratio_verdict(row.ci_low, row.ci_high)
+        assert format_interval(row.ratio, row.ci_low, row.ci_high) in text
+    assert set(ratios.loc[ratios["negative_control"], "system"]) == {"poisson_small_hole",
+                                                                      "bursty"}
+    assert "Yes, at every radius" not in text
+
+
+def test_the_mmpp_page_s_residual_verdicts_are_their_intervals():
+    from kicktimes.stats import rejection_verdict
+
+    _page("mmpp.md")
+    resid = pd.read_csv(RESULTS / "mmpp" / "mmpp_billiard_residuals.csv")
+    for row in resid.itertuples():
+        assert row.verdict == rejection_verdict(row.ci_low, row.ci_high, 0.05)
+    dip = pd.read_csv(RESULTS / "mmpp" / "mmpp_billiard_dip.csv")
+    assert (dip["mmpp"] >= 1.0 - 1e-9).all()   # an MMPP has no refractory dip
+
+
+def test_one_command_rebuilds_every_generated_science_page():
+    import importlib.util
+    import sys
+
+    analysis = RESULTS.parents[1] / "analysis"
+    sys.path.insert(0, str(analysis))
+    try:
+        spec = importlib.util.spec_from_file_location("make_science",
+                                                      analysis / "make_science.py")
+        module = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(module)
+    finally:
+        sys.path.remove(str(analysis))
+    steps = module.steps("paper", "paper/science", 1, reuse=False)
+    names = [name for name, _ in steps]
+    for page in PAGES[1:]:
+        assert page in names or any(page.split(".")[0] in n for n in names), page
+    for _, argv in steps:
+        assert Path(argv[1]).is_file(), argv[1]
+    readme = (RESULTS.parents[1] / "README.md").read_text(encoding="utf-8")
+    assert "python analysis/make_science.py" in readme
