@@ -394,15 +394,22 @@ def family_figure(stores):
 
 
 def effects(ctx):
-    """Off-diagonal RR and DET of each kicked system over the two-particle values."""
+    """Off-diagonal RR and DET of each kicked system over the two-particle values, on the
+    findings tables' primary samples (uniform-time where the store has them)."""
     rows = ctx.found.recurrence_rows
     if rows is None:
         rows, _ = recurrence_rows(ctx.results, ctx.exp)
     out = []
+    have = set(distinct(rows, "diagnostic"))
     for e in eps_values(ctx.exp):
         for q, question in (("rr_offdiag", "Off-diagonal RR"), ("det", "DET")):
+            # the primary setting of the findings tables (controls.py): uniform-time
+            # samples where the store has them, else the paper's samples
             name = f"{q}@{e:g}"
-            if name not in distinct(rows, "diagnostic"):
+            samples = "the paper's samples"
+            if UNIFORM + name in have:
+                name, samples = UNIFORM + name, "uniform-time samples"
+            if name not in have:
                 continue
             values = wide(rows, name)
             for system in kicked_systems(rows):
@@ -414,7 +421,8 @@ def effects(ctx):
                     Effect.of_ratio(
                         f"{question} (ε = {e:g})",
                         system,
-                        "ratio of means (kicked / two-particle, averaged over radii)",
+                        f"ratio of means on {samples} (kicked / two-particle, averaged "
+                        "over radii)",
                         tot,
                         tolerance=ctx.tolerance,
                         detail=(
