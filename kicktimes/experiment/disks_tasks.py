@@ -1,0 +1,138 @@
+"""Tasks of a `DisksExperiment`: one N times one block of runs of the N-disk engine.
+
+Each run ``k`` at N:
+
+1. draws its state (`kicktimes.initial_state`, equal disks of radius
+   `DisksExperiment.radius`), its tagged disks (`DisksExperiment.tagged_per_run` of them,
+   without replacement) and nothing else from ``SeedSequence(seed, spawn_key=(N, k))``;
+2. runs `kicktimes.simulate_disks` for `DisksExperiment.t_max`; under the elastic rule
+   with the tagged disks' positions sampled every ``tau = 1 / (samples_per_collision nu)``
+   and their wall hits logged, from which each interval's speed is read
+   (`interval_speeds`);
+3. returns one results row per run quantity (``collision_frequency``, ``t_max``,
+   ``n_pp``, ``energy`` the mean ``|v|^2`` at the end, ``speed_known`` the share of the
+   tagged intervals whose speed was read) and one collisions row per tagged disk (its
+   collision times and, elastic, its speeds).
+
+The engine is called through its public API in one of its two compiled configurations:
+no observers (mirror) or all of them (elastic).
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import pandas as pd
+
+from kicktimes.experiment.disks import DisksExperiment, DisksTask
+
+__all__ = ["DISKS_COLLISION_COLUMNS", "DISKS_RESULT_COLUMNS", "execute_disks_task",
+           "interval_speeds", "run_disks"]
+
+DISKS_RESULT_COLUMNS = ("n_disks", "radius", "ic", "system", "diagnostic", "value", "note")
+DISKS_COLLISION_COLUMNS = ("n_disks", "radius", "ic", "disk", "t_window", "n_pp", "pp_times",
+                           "speeds")
+
+
+def interval_speeds(pp_times, wall_times, sample_times, positions) -> np.ndarray:
+    """The speed a disk flew each interval between its disk-disk collisions at.
+
+    Parameters
+    ----------
+    pp_times : array_like
+        The disk's collision times with other disks, increasing.
+    wall_times : array_like
+        Its wall hits (the speed does not change there, the direction does).
+    sample_times, positions : array_like, shapes (n,) and (n, 2)
+        Its positions sampled at equally spaced times.
+
+    Returns
+    -------
+    ndarray, shape (len(pp_times) + 1,)
+        Entry ``j`` is the speed between collision ``j - 1`` and collision ``j`` (entry 0:
+        before the first collision, the last: after the last one). A straight flight
+        between two consecutive samples with no event (collision or wall hit) between them
+        gives the speed exactly, ``|x(s_{k+1}) - x(s_k)| / (s_{k+1} - s_k)``; an interval
+        without such a pair of samples (shorter than about two sampling steps) gets NaN.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> s = np.arange(6) * 0.1
+    >>> x = np.c_[np.where(s < 0.25, 2.0 * s, 0.5 + 0.5 * (s - 0.25)), 0.0 * s]
+    >>> interval_speeds([0.25], [], s, x).round(12).tolist()
+    [2.0, 0.5]
+    """
+    pp = np.asarray(pp_times, float)
+    events = np.sort(np.concatenate([pp, np.asarray(wall_times, float)]))
+    s = np.asarray(sample_times, float)
+    pos = np.asarray(positions, float)
+    crossed = np.searchsorted(events, s, side="right")
+    clean = crossed[1:] == crossed[:-1]
+    step = np.diff(s)
+    speed = np.hypot(pos[1:, 0] - pos[:-1, 0], pos[1:, 1] - pos[:-1, 1]) / step
+    ok = clean & np.isfinite(speed)
+    which = np.searchsorted(pp, s[:-1], side="right")[ok]
+    total = np.bincount(which, weights=speed[ok], minlength=pp.size + 1)
+    count = np.bincount(which, minlength=pp.size + 1)
+    out = np.full(pp.size + 1, np.nan)
+    np.divide(total, count, out=out, where=count > 0)
+    return out
+
+
+def run_disks(experiment: DisksExperiment, n_disks: int, k: int):
+    """Run ``k`` at ``n_disks``: ``(run, tagged, speeds)``, ``speeds`` a list of arrays
+    (`interval_speeds`, one per tagged disk; ``None`` under the mirror rule, all speeds 1)."""
+    from kicktimes import initial_state, simulate_disks
+
+    rng = np.random.default_rng(np.random.SeedSequence(experiment.seed, spawn_key=(n_disks, k)))
+    r = experiment.radius(n_disks)
+    state = initial_state(n_disks, r, seed=rng, rule=experiment.rule)
+    tagged = np.sort(rng.choice(n_disks, experiment.tagged_per_run(n_disks), replace=False))
+    t_max = experiment.t_max(n_disks)
+    if experiment.rule == "mirror":
+        return simulate_disks(state, r, t_max=t_max, rule="mirror"), tagged, None
+    tau = 1.0 / (experiment.samples_per_collision * experiment.reference_frequency(n_disks))
+    run = simulate_disks(state, r, t_max=t_max, rule="elastic", sample=tagged, tau=tau,
+                         log_walls=True)
+    walls = run.walls
+    speeds = [interval_speeds(run.collision_times(int(d)),
+                              walls["time"].to_numpy()[walls["disk"].to_numpy() == d],
+                              run.sample_times, run.samples[:, m])
+              for m, d in enumerate(tagged)]
+    return run, tagged, speeds
+
+
+def execute_disks_task(experiment: DisksExperiment, task: DisksTask):
+    """Run every run of ``task`` and return its tables (a `TaskOutput`)."""
+    from kicktimes.experiment.tasks import TaskOutput
+
+    if not isinstance(experiment, DisksExperiment):
+        raise TypeError(f"experiment: expected a DisksExperiment, got "
+                        f"{type(experiment).__name__}")
+    if task not in experiment.tasks():
+        raise ValueError(f"task: {task!r} is not a task of experiment {experiment.name!r}")
+    n, r = task.n_disks, task.radius
+    results, collisions = [], []
+    t0 = time.perf_counter()
+    for k in range(task.ic_start, task.ic_stop):
+        run, tagged, speeds = run_disks(experiment, n, k)
+        v = run.final_state[:, 2:]
+        known = (np.nan if speeds is None
+                 else float(np.mean(np.concatenate([np.isfinite(s) for s in speeds]))))
+        for name, value in (("collision_frequency", run.collision_frequency),
+                            ("t_max", run.t_max), ("n_pp", run.n_pp),
+                            ("energy", float(np.mean(np.sum(v * v, axis=1)))),
+                            ("speed_known", known)):
+            results.append((n, r, k, "disks", name, float(value), ""))
+        for m, d in enumerate(tagged):
+            times = run.collision_times(int(d))
+            sp = np.empty(0) if speeds is None else speeds[m]
+            collisions.append((n, r, k, int(d), run.t_max, int(times.size), times, sp))
+    return TaskOutput(
+        task=task,
+        results=pd.DataFrame(results, columns=list(DISKS_RESULT_COLUMNS)),
+        collisions=pd.DataFrame(collisions, columns=list(DISKS_COLLISION_COLUMNS)),
+        timings={"simulate": time.perf_counter() - t0},
+    )
