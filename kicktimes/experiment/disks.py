@@ -276,12 +276,12 @@ class DisksExperiment:
 
 
 def _preset(name, rule, description, **geometry):
-    return DisksExperiment(name=name, n_disks=N_SWEEP, rule=rule, seed=42,
+    return DisksExperiment(name=name, n_disks=N_SWEEP, rule=rule, seed=42, n_tagged=4000,
                            description=description, **geometry)
 
 
 #: the issue's sweep: N = 2 .. 1000 at packings 0.02 and 0.2 and at the radius of packing
-#: 0.02 at N = 1000, under both rules; about 1000 tagged disks per N, 30 collisions each
+#: 0.02 at N = 1000, under both rules; about 4000 tagged disks per N, 30 collisions each
 DISKS_PRESETS = {
     f"disks-{geo}-{rule}": _preset(
         f"disks-{geo}-{rule}", rule,
