@@ -126,6 +126,16 @@ def test_interval_speeds_leave_an_interval_without_a_clean_pair_of_samples_unkno
     assert out[0] == pytest.approx(1.0) and np.isnan(out[1]) and out[2] == pytest.approx(1.0)
 
 
+def test_interval_speeds_read_a_flight_between_two_wall_hits():
+    # a disk bouncing between x = -1 and x = 1 at speed 4, sampled too rarely to see it
+    walls = np.array([0.5, 1.0, 1.5])
+    at_walls = np.array([[1.0, 0.0], [-1.0, 0.0], [1.0, 0.0]])
+    s = np.array([0.0, 2.0])
+    x = np.array([[-1.0, 0.0], [-1.0, 0.0]])
+    assert np.isnan(interval_speeds([], walls, s, x)[0])
+    assert interval_speeds([], walls, s, x, at_walls)[0] == pytest.approx(4.0)
+
+
 def _synthetic_store(exp, sequences, speeds, t_window):
     """A store of ``exp`` holding the given tagged sequences, 10 per run."""
     n = exp.n_disks[0]

@@ -7,8 +7,8 @@ Each run ``k`` at N:
    without replacement) and nothing else from ``SeedSequence(seed, spawn_key=(N, k))``;
 2. runs `kicktimes.simulate_disks` for `DisksExperiment.t_max`; under the elastic rule
    with the tagged disks' positions sampled every ``tau = 1 / (samples_per_collision nu)``
-   and their wall hits logged, from which each interval's speed is read
-   (`interval_speeds`);
+   and their wall hits logged (the centre's position at each), from which each interval's
+   speed is read (`interval_speeds`);
 3. returns one results row per run quantity (``collision_frequency``, ``t_max``,
    ``n_pp``, ``energy`` the mean ``|v|^2`` at the end, ``speed_known`` the share of the
    tagged intervals whose speed was read) and one collisions row per tagged disk (its
@@ -35,7 +35,7 @@ DISKS_COLLISION_COLUMNS = ("n_disks", "radius", "ic", "disk", "t_window", "n_pp"
                            "speeds")
 
 
-def interval_speeds(pp_times, wall_times, sample_times, positions) -> np.ndarray:
+def interval_speeds(pp_times, wall_times, sample_times, positions, wall_positions=None):
     """The speed a disk flew each interval between its disk-disk collisions at.
 
     Parameters
@@ -43,18 +43,20 @@ def interval_speeds(pp_times, wall_times, sample_times, positions) -> np.ndarray
     pp_times : array_like
         The disk's collision times with other disks, increasing.
     wall_times : array_like
-        Its wall hits (the speed does not change there, the direction does).
+        Its wall hits, increasing (the speed does not change there, the direction does).
     sample_times, positions : array_like, shapes (n,) and (n, 2)
-        Its positions sampled at equally spaced times.
+        Its positions sampled at increasing times.
+    wall_positions : array_like, shape (len(wall_times), 2), optional
+        Its centre at each wall hit: more observed positions.
 
     Returns
     -------
     ndarray, shape (len(pp_times) + 1,)
         Entry ``j`` is the speed between collision ``j - 1`` and collision ``j`` (entry 0:
-        before the first collision, the last: after the last one). A straight flight
-        between two consecutive samples with no event (collision or wall hit) between them
-        gives the speed exactly, ``|x(s_{k+1}) - x(s_k)| / (s_{k+1} - s_k)``; an interval
-        without such a pair of samples (shorter than about two sampling steps) gets NaN.
+        before the first collision, the last: after the last one). Two consecutive observed
+        positions (samples and, if given, wall hits) with no event (collision or wall hit)
+        strictly between them lie on one straight flight, which gives the speed exactly,
+        ``|x(s_b) - x(s_a)| / (s_b - s_a)``; an interval without such a pair gets NaN.
 
     Examples
     --------
@@ -65,14 +67,23 @@ def interval_speeds(pp_times, wall_times, sample_times, positions) -> np.ndarray
     [2.0, 0.5]
     """
     pp = np.asarray(pp_times, float)
-    events = np.sort(np.concatenate([pp, np.asarray(wall_times, float)]))
+    walls = np.asarray(wall_times, float)
+    events = np.sort(np.concatenate([pp, walls]))
     s = np.asarray(sample_times, float)
-    pos = np.asarray(positions, float)
-    crossed = np.searchsorted(events, s, side="right")
-    clean = crossed[1:] == crossed[:-1]
+    pos = np.asarray(positions, float).reshape(-1, 2)
+    if wall_positions is not None:
+        s = np.concatenate([s, walls])
+        pos = np.concatenate([pos, np.asarray(wall_positions, float).reshape(-1, 2)])
+        order = np.argsort(s, kind="stable")
+        s, pos = s[order], pos[order]
+    # events strictly between consecutive observations: a wall hit that is itself an
+    # observation ends one straight flight and starts the next
+    inside = (np.searchsorted(events, s[1:], side="left")
+              - np.searchsorted(events, s[:-1], side="right"))
     step = np.diff(s)
-    speed = np.hypot(pos[1:, 0] - pos[:-1, 0], pos[1:, 1] - pos[:-1, 1]) / step
-    ok = clean & np.isfinite(speed)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        speed = np.hypot(pos[1:, 0] - pos[:-1, 0], pos[1:, 1] - pos[:-1, 1]) / step
+    ok = (inside == 0) & (step > 0) & np.isfinite(speed)
     which = np.searchsorted(pp, s[:-1], side="right")[ok]
     total = np.bincount(which, weights=speed[ok], minlength=pp.size + 1)
     count = np.bincount(which, minlength=pp.size + 1)
@@ -96,11 +107,13 @@ def run_disks(experiment: DisksExperiment, n_disks: int, k: int):
     tau = 1.0 / (experiment.samples_per_collision * experiment.reference_frequency(n_disks))
     run = simulate_disks(state, r, t_max=t_max, rule="elastic", sample=tagged, tau=tau,
                          log_walls=True)
-    walls = run.walls
-    speeds = [interval_speeds(run.collision_times(int(d)),
-                              walls["time"].to_numpy()[walls["disk"].to_numpy() == d],
-                              run.sample_times, run.samples[:, m])
-              for m, d in enumerate(tagged)]
+    w_time, w_disk, w_x, w_y, _ = run.wall_log
+    speeds = []
+    for m, d in enumerate(tagged):
+        mine = w_disk == d
+        speeds.append(interval_speeds(run.collision_times(int(d)), w_time[mine],
+                                      run.sample_times, run.samples[:, m],
+                                      np.c_[w_x[mine], w_y[mine]]))
     return run, tagged, speeds
 
 
