@@ -204,8 +204,60 @@ def test_rates_agree_with_enskog_and_two_disks_with_the_kinetic_rate(reference):
 
 
 def test_the_presets_cover_the_issue_sweep():
+    sweeps = [e for e in DISKS_PRESETS.values() if not e.kicked_runs]
     assert {e.n_disks for e in DISKS_PRESETS.values()} == {(2, 3, 4, 6, 10, 30, 100, 300, 1000)}
-    assert {(e.rule, e.packing, e.r) for e in DISKS_PRESETS.values()} == {
+    assert {(e.rule, e.packing, e.r) for e in sweeps} == {
         (rule, p, r) for rule in ("mirror", "elastic")
         for p, r in ((0.02, None), (0.2, None), (None, 0.0045))}
-    assert all(e.collisions >= 30 and e.n_tagged >= 1000 for e in DISKS_PRESETS.values())
+    assert all(e.collisions >= 30 and e.n_tagged >= 1000 for e in sweeps)
+    # the kicked comparison's fields leave the hash of a sweep without it unchanged
+    plain = dataclasses.replace(TINY, kicked_time=60.0)
+    assert plain.hash() == TINY.hash() != dataclasses.replace(TINY, kicked_runs=1).hash()
+    with pytest.raises(ValueError, match="kicked_runs"):
+        dataclasses.replace(TINY, rule="elastic", kicked_runs=1)
+
+
+def test_the_page_is_written_from_its_tables_and_names_stores_not_paths(reference, tmp_path):
+    from kicktimes.report.disks_page import write_disks_page
+
+    page = write_disks_page([reference.path], tmp_path / "results", n_boot=199, n_mc=49,
+                            dpi=40)
+    text = page.read_text()
+    assert text.startswith("# From two disks to a gas (generated)\n\nGenerated ")
+    assert "`tiny-gas`" in text and str(reference.path) not in text
+    table = pd.read_csv(tmp_path / "results" / "disks.csv")
+    two = table.set_index("n_disks").loc[2]
+    shown = kt.stats.format_interval(two["rate_enskog"], two["rate_enskog_low"],
+                                     two["rate_enskog_high"])
+    assert f"{shown} {two['rate_enskog_verdict']}" in text
+    for png in ("disks_rejection_vs_n.png", "disks_hazard_vs_n.png",
+                "disks_rate_dispersion_vs_n.png"):
+        assert (tmp_path / "results" / png).stat().st_size > 1000
+
+
+def test_the_twin_ftle_of_two_disks_is_the_two_disk_tangent_ftle():
+    from kicktimes.diagnostics import disks_lyapunov, lyapunov
+
+    ratios = []
+    for seed in range(3):
+        state = kt.initial_state(2, 0.1, seed=seed)
+        twin = disks_lyapunov(state, 0.1, t_max=400.0, segment=2.0, rng=seed).exponent
+        tangent = lyapunov(state, 0.1, n_steps=200, tau=2.0).lam
+        ratios.append(twin / tangent)
+    # the same exponent, measured in two norms over a finite time
+    assert np.mean(ratios) == pytest.approx(1.0, abs=0.1)
+
+
+def test_the_kicked_comparison_gives_ratios_with_verdicts(tmp_path):
+    from kicktimes.report.disks import kicked_table
+
+    exp = dataclasses.replace(TINY, name="tiny-kicked", kicked_runs=3, kicked_time=20.0)
+    store = run_quiet(exp, tmp_path / "k", workers=1)
+    tab = kicked_table(store, n_boot=99)
+    assert set(tab["n_disks"]) == {2, 5}
+    assert {"poisson/gas", "actual/gas", "gas/two_particle"} <= set(tab["system"])
+    ftle = tab[(tab["system"] == "poisson/gas") & (tab["diagnostic"] == "ftle")]
+    # the kicked disk's FTLE is a fraction of the gas's (uniform kicks erase the deviation
+    # of the direction; the gas's exponent is the whole gas's)
+    assert (ftle["ratio"] < 1.0).all() and ftle["verdict"].isin(
+        ["lower", "inconclusive"]).all()

@@ -39,6 +39,8 @@ RULES = ("mirror", "elastic")
 N_SWEEP = (2, 3, 4, 6, 10, 30, 100, 300, 1000)
 #: the largest packing `kicktimes.initial_state` builds
 PACKING_MAX = 0.7
+#: fields added after the first stores, with the value that leaves those stores' hash
+_LATER_FIELDS = {"kicked_runs": 0, "kicked_time": 60.0}
 
 
 @dataclass(frozen=True)
@@ -112,6 +114,14 @@ class DisksExperiment:
         ``max(1, block_sequences // tagged_per_run(N))`` runs.
     description : str
         Free text for the page.
+    kicked_runs : int
+        The first ``kicked_runs`` runs of each N (``>= 0``; at most `n_runs`) also compare
+        the gas with a kicked single disk (the paper's question for a gas,
+        `kicktimes.experiment.disks_tasks.kicked_rows`): another state of the same N is
+        run for ``kicked_time`` mean free times (``> 0``), and the first disk's FTLE,
+        boundary-angle autocorrelation and recurrence rate are compared with those of one
+        disk from its state kicked at its own collision rate (Poisson) and at its
+        collision times (actual). Mirror rule only.
     """
 
     name: str
@@ -128,6 +138,8 @@ class DisksExperiment:
     seed: int = 0
     block_sequences: int = 250
     description: str = field(default="")
+    kicked_runs: int = 0
+    kicked_time: float = 60.0
 
     #: what a store's record says this is (`Experiment` records have no ``kind``)
     kind = "disks"
@@ -178,6 +190,15 @@ class DisksExperiment:
         put("block_sequences", check_int("block_sequences", self.block_sequences, low=1))
         if not isinstance(self.description, str):
             raise TypeError(f"description: expected a string, got {self.description!r}")
+        put("kicked_runs", check_int("kicked_runs", self.kicked_runs, low=0))
+        put("kicked_time", check_real("kicked_time", self.kicked_time, low=0.0))
+        if self.kicked_runs and self.rule != "mirror":
+            raise ValueError(f"kicked_runs: the kicked disk keeps its speed, so the comparison "
+                             f"needs rule='mirror', got rule={self.rule!r}")
+        if self.kicked_runs > min(self.n_runs(n) for n in self.n_disks):
+            raise ValueError(f"kicked_runs must be at most the runs of every N, "
+                             f"{min(self.n_runs(n) for n in self.n_disks)}, got "
+                             f"{self.kicked_runs}")
 
     # ------------------------------------------------------------------ derived
     def radius(self, n_disks: int) -> float:
@@ -255,9 +276,14 @@ class DisksExperiment:
     from_dict = from_record
 
     def hash(self) -> str:
-        """Stable identity: the first 16 hex digits of SHA-256 of the canonical JSON."""
-        text = json.dumps(self.to_dict(), sort_keys=True, separators=(",", ":"),
-                          allow_nan=False)
+        """Stable identity: the first 16 hex digits of SHA-256 of the canonical JSON (the
+        kicked comparison's fields left out while it is off, as before they existed)."""
+        record = self.to_dict()
+        if not self.kicked_runs:
+            for key, default in _LATER_FIELDS.items():
+                if record[key] == default:
+                    del record[key]
+        text = json.dumps(record, sort_keys=True, separators=(",", ":"), allow_nan=False)
         return hashlib.sha256(text.encode()).hexdigest()[:16]
 
     def partner_line(self) -> str:
@@ -293,6 +319,15 @@ DISKS_PRESETS = {
     )
     for rule in RULES
 }
+
+
+#: the kicked single disk against the tagged disk of the gas (packing 0.02, mirror rule):
+#: 8 runs per N of 60 mean free times each
+DISKS_PRESETS["disks-kicked-phi0.02-mirror"] = DisksExperiment(
+    name="disks-kicked-phi0.02-mirror", n_disks=N_SWEEP, packing=0.02, rule="mirror", seed=43,
+    n_tagged=8, min_runs=8, kicked_runs=8, kicked_time=60.0,
+    description="The kicked single disk against the tagged disk of N = 2 .. 1000 disks at "
+                "packing 0.02, mirror rule: FTLE, boundary-angle ACF, recurrence.")
 
 
 def disks_preset(name: str) -> DisksExperiment:

@@ -27,8 +27,8 @@ import pandas as pd
 
 from kicktimes.experiment.disks import DisksExperiment, DisksTask
 
-__all__ = ["DISKS_COLLISION_COLUMNS", "DISKS_RESULT_COLUMNS", "execute_disks_task",
-           "interval_speeds", "run_disks"]
+__all__ = ["DISKS_COLLISION_COLUMNS", "DISKS_RESULT_COLUMNS", "KICKED_EPS",
+           "execute_disks_task", "interval_speeds", "kicked_rows", "run_disks"]
 
 DISKS_RESULT_COLUMNS = ("n_disks", "radius", "ic", "system", "diagnostic", "value", "note")
 DISKS_COLLISION_COLUMNS = ("n_disks", "radius", "ic", "disk", "t_window", "n_pp", "pp_times",
@@ -95,7 +95,7 @@ def interval_speeds(pp_times, wall_times, sample_times, positions, wall_position
 def run_disks(experiment: DisksExperiment, n_disks: int, k: int):
     """Run ``k`` at ``n_disks``: ``(run, tagged, speeds)``, ``speeds`` a list of arrays
     (`interval_speeds`, one per tagged disk; ``None`` under the mirror rule, all speeds 1)."""
-    from kicktimes import initial_state, simulate_disks
+    from kicktimes.billiard import initial_state, simulate_disks
 
     rng = np.random.default_rng(np.random.SeedSequence(experiment.seed, spawn_key=(n_disks, k)))
     r = experiment.radius(n_disks)
@@ -115,6 +115,71 @@ def run_disks(experiment: DisksExperiment, n_disks: int, k: int):
                                       run.sample_times, run.samples[:, m],
                                       np.c_[w_x[mine], w_y[mine]]))
     return run, tagged, speeds
+
+
+#: the recurrence threshold of the kicked comparison (positions sampled every 0.1 mean
+#: free times; the runs are short, so a threshold coarser than the paper's 1e-3)
+KICKED_EPS = 0.05
+
+
+def kicked_rows(experiment: DisksExperiment, n_disks: int, k: int) -> list:
+    """The kicked comparison of run ``k`` at ``n_disks`` (`DisksExperiment.kicked_runs`).
+
+    A state of its own (``SeedSequence(seed, spawn_key=(N, k, 1))``) runs for
+    ``T = kicked_time / nu`` with disk 0 sampled every ``0.1 / nu`` and its wall hits
+    logged. Rows ``(system, diagnostic, value)``, systems ``"gas"`` (disk 0 in the gas;
+    its FTLE is the whole gas's, `kicktimes.diagnostics.gas_lyapunov.disks_lyapunov`),
+    ``"poisson"`` and ``"actual"`` (one disk from disk 0's state, kicked with uniform new
+    directions at disk 0's own rate ``n / T`` or at its collision times; FTLE from tangent
+    vectors, `kicktimes.diagnostics.lyapunov`) and, at N = 2, ``"two_particle"`` (the
+    two-disk FTLE of the same state, `lyapunov`). Diagnostics: ``ftle``, ``acf@1`` (the
+    boundary angles' lag-1 autocorrelation, `kicktimes.diagnostics.autocorrelation`),
+    ``rr`` (the recurrence rate of the sampled positions at ``KICKED_EPS``) and, for the
+    gas, ``rate`` (disk 0's collisions per unit time).
+    """
+    import warnings
+
+    from kicktimes.billiard import initial_state, simulate_disks, simulate_one_particle
+    from kicktimes.diagnostics import (
+        autocorrelation,
+        boundary_angles,
+        disks_lyapunov,
+        lyapunov,
+        recurrence_rate,
+    )
+    from kicktimes.schedules import Poisson, Replay
+
+    rng = np.random.default_rng(np.random.SeedSequence(experiment.seed,
+                                                       spawn_key=(n_disks, k, 1)))
+    r = experiment.radius(n_disks)
+    state = initial_state(n_disks, r, seed=rng, rule="mirror")
+    nu = experiment.reference_frequency(n_disks)
+    tau = 0.1 / nu
+    n_steps = int(round(experiment.kicked_time / 0.1))
+    t_max = n_steps * tau
+    gas = simulate_disks(state, r, t_max=t_max, rule="mirror", sample=[0], tau=tau,
+                         log_walls=True)
+    times = gas.collision_times(0)
+    rows = []
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # an ACF of too few wall hits is NaN, with a reason
+        theta = np.arcsin(np.clip(gas.walls["sin_theta"].to_numpy()[
+            gas.walls["disk"].to_numpy() == 0], -1.0, 1.0))
+        ftle = disks_lyapunov(state, r, t_max=t_max, segment=1.0 / nu, rng=rng).exponent
+        rows += [("gas", "ftle", ftle), ("gas", "acf@1", autocorrelation(theta, 1)),
+                 ("gas", "rr", recurrence_rate(gas.samples[:, 0], KICKED_EPS)),
+                 ("gas", "rate", times.size / t_max)]
+        for system, kicks in (("poisson", Poisson(times.size / t_max)),
+                              ("actual", Replay(times, t_max=t_max))):
+            one = simulate_one_particle(state[0], r, t_max=t_max, kicks=kicks,
+                                        rng=rng, tau=tau)
+            rows += [(system, "ftle", lyapunov(one).lam),
+                     (system, "acf@1", autocorrelation(boundary_angles(one), 1)),
+                     (system, "rr", recurrence_rate(one.samples[:, :2], KICKED_EPS))]
+        if n_disks == 2:
+            rows.append(("two_particle", "ftle",
+                         lyapunov(state, r, n_steps=n_steps, tau=tau, rule="mirror").lam))
+    return [(s, d, float(v)) for s, d, v in rows]
 
 
 def execute_disks_task(experiment: DisksExperiment, task: DisksTask):
@@ -139,6 +204,9 @@ def execute_disks_task(experiment: DisksExperiment, task: DisksTask):
                             ("energy", float(np.mean(np.sum(v * v, axis=1)))),
                             ("speed_known", known)):
             results.append((n, r, k, "disks", name, float(value), ""))
+        if k < experiment.kicked_runs:
+            for system, name, value in kicked_rows(experiment, n, k):
+                results.append((n, r, k, system, name, value, ""))
         for m, d in enumerate(tagged):
             times = run.collision_times(int(d))
             sp = np.empty(0) if speeds is None else speeds[m]

@@ -11,7 +11,9 @@ From the stores of `kicktimes.experiment.DisksExperiment` sweeps, one row per (s
 * the index of dispersion of the tagged disks' counts in a common window of ``K`` mean
   intervals, ``D = s^2 / mean`` (1 for Poisson counts of one rate);
 * the hazard of the intervals against the time since the last collision, in units of the
-  mean interval (`kicktimes.stats.interval_hazard`), and a gamma renewal fit's shape
+  mean interval (`kicktimes.stats.interval_hazard`): its first bin over the constant rate
+  (``hazard_first``, the refractory dip) and its highest later bin (``hazard_peak`` at
+  ``hazard_peak_t``, the return peak), and a gamma renewal fit's shape
   (`kicktimes.stats.fit_renewal`; 1 for exponential intervals);
 * under the elastic rule the same battery and dispersion after the speed-conditioned
   rescaling: time runs at ``nu(v) / nu_bar`` (`kicktimes.stats.speed_rate_factor`) while
@@ -46,10 +48,11 @@ from kicktimes.stats import (
 )
 from kicktimes.stats.findings import clopper_pearson
 
-__all__ = ["HAZARD_EDGES", "disks_hazard", "disks_table", "rescale_by_speed"]
+__all__ = ["HAZARD_EDGES", "KICKED_DIAGNOSTICS", "disks_hazard", "disks_table", "kicked_table",
+           "rescale_by_speed"]
 
 #: bins of the hazard, in units of the mean interval
-HAZARD_EDGES = (0.0, 0.05, 0.1, 0.2, 0.3, 0.5, 0.75, 1.0, 1.5, 2.0, 3.0, 5.0)
+HAZARD_EDGES = (0.0, 0.01, 0.02, 0.05, 0.1, 0.2, 0.3, 0.5, 0.75, 1.0, 1.5, 2.0, 3.0, 5.0)
 #: the speed-conditioned rescaling's temperature: the energy shell sum |v|^2 = N
 KT = 0.5
 
@@ -198,10 +201,16 @@ def _row(exp, n, res, col, *, alpha, n_boot, n_mc, rng):
           if plain.times else [])
     if len(iv) > 10:
         haz = interval_hazard(iv, edges=HAZARD_EDGES)
-        first = haz.table.iloc[0]
-        row["hazard_first"] = float(first["hazard"] / haz.rate)
-        row["hazard_first_low"] = float(first["ci_low"] / haz.rate)
-        row["hazard_first_high"] = float(first["ci_high"] / haz.rate)
+        tab = haz.table[haz.table["exposure"] > 0]
+        # the refractory dip: the first bin; the return peak: the highest later bin
+        peak = tab.iloc[1:]["hazard"].idxmax() if len(tab) > 1 else tab.index[0]
+        for name, b in (("hazard_first", tab.index[0]), ("hazard_peak", peak)):
+            row[name] = float(tab.loc[b, "hazard"] / haz.rate)
+            row[f"{name}_low"] = float(tab.loc[b, "ci_low"] / haz.rate)
+            row[f"{name}_high"] = float(tab.loc[b, "ci_high"] / haz.rate)
+            row[f"{name}_verdict"] = ratio_verdict(row[f"{name}_low"], row[f"{name}_high"])
+        row["hazard_peak_t"] = float(tab.loc[peak, "t_mid"])
+        row["hazard_flat_pvalue"] = haz.pvalue
         fit = fit_renewal(iv, "gamma")
         shape, se = fit.params["shape"], fit.stderr["shape"]
         row["gamma_shape"] = float(shape)
@@ -290,3 +299,42 @@ def disks_hazard(store, *, edges=HAZARD_EDGES) -> pd.DataFrame:
         tab["flat_pvalue"] = haz.pvalue
         out.append(tab)
     return pd.concat(out, ignore_index=True) if out else pd.DataFrame()
+
+
+#: the kicked comparison's diagnostics and the systems compared with the gas
+KICKED_DIAGNOSTICS = ("ftle", "acf@1", "rr")
+KICKED_SYSTEMS = ("poisson", "actual")
+
+
+def kicked_table(store, *, n_boot=999, seed=0) -> pd.DataFrame:
+    """The kicked single disk against the gas (`DisksExperiment.kicked_runs`): one row per
+    (N, kicked system, diagnostic), the ratio kicked / gas of the means over runs with a
+    percentile bootstrap clustered on runs and its `kicktimes.stats.ratio_verdict`; at
+    N = 2 also the gas's FTLE (twin, `disks_lyapunov`) over the two-disk FTLE of the same
+    states (tangent, `kicktimes.diagnostics.lyapunov`), system ``"gas/two_particle"``.
+    Empty when the store has no kicked rows."""
+    res = store.results
+    res = res[res["system"] != "disks"]
+    rows = []
+    for n, g in res.groupby("n_disks", sort=True):
+        wide = g.pivot_table(index="ic", columns=["system", "diagnostic"], values="value")
+        runs = wide.index.size
+        rng = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(int(n), 7)))
+        weights = rng.multinomial(runs, np.full(runs, 1.0 / runs), size=n_boot) / runs
+        pairs = [(s, d, "gas") for s in KICKED_SYSTEMS for d in KICKED_DIAGNOSTICS]
+        if ("two_particle", "ftle") in wide:
+            pairs.append(("gas", "ftle", "two_particle"))
+        for system, diag, ref in pairs:
+            num, den = wide[(system, diag)].to_numpy(), wide[(ref, diag)].to_numpy()
+            ok = np.isfinite(num) & np.isfinite(den)
+            w = weights[:, ok]
+            with np.errstate(divide="ignore", invalid="ignore"):
+                boot = (w @ num[ok]) / (w @ den[ok])
+                ratio = num[ok].mean() / den[ok].mean() if ok.any() else math.nan
+            lo, hi = _ci(boot)
+            rows.append({"experiment": store.experiment.name, "n_disks": int(n),
+                         "system": f"{system}/{ref}", "diagnostic": diag,
+                         "reference": float(np.mean(den[ok])) if ok.any() else math.nan,
+                         "ratio": ratio, "ratio_low": lo, "ratio_high": hi,
+                         "verdict": ratio_verdict(lo, hi), "n_runs": int(ok.sum())})
+    return pd.DataFrame(rows)
