@@ -235,17 +235,18 @@ def test_the_page_is_written_from_its_tables_and_names_stores_not_paths(referenc
         assert (tmp_path / "results" / png).stat().st_size > 1000
 
 
-def test_the_twin_ftle_of_two_disks_is_the_two_disk_tangent_ftle():
+def test_the_twin_ftle_of_two_disks_is_the_two_disk_tangent_ftle_on_average():
     from kicktimes.diagnostics import disks_lyapunov, lyapunov
 
-    ratios = []
-    for seed in range(3):
+    twin, tangent = [], []
+    for seed in range(12):
         state = kt.initial_state(2, 0.1, seed=seed)
-        twin = disks_lyapunov(state, 0.1, t_max=400.0, segment=2.0, rng=seed).exponent
-        tangent = lyapunov(state, 0.1, n_steps=200, tau=2.0).lam
-        ratios.append(twin / tangent)
-    # the same exponent, measured in two norms over a finite time
-    assert np.mean(ratios) == pytest.approx(1.0, abs=0.1)
+        twin.append(disks_lyapunov(state, 0.1, t_max=600.0, segment=2.0, rng=seed).exponent)
+        tangent.append(lyapunov(state, 0.1, n_steps=300, tau=2.0).lam)
+    # each restart of the engine moves the reference by round-off, which the chaos
+    # amplifies: after about 100 time units the two follow different trajectories, so only
+    # ensemble means compare (measured: 0.990 of the tangent mean)
+    assert np.mean(twin) / np.mean(tangent) == pytest.approx(1.0, abs=0.1)
 
 
 def test_the_kicked_comparison_gives_ratios_with_verdicts(tmp_path):

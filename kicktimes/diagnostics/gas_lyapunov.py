@@ -95,7 +95,12 @@ def disks_lyapunov(state, r, *, t_max, segment, rule="mirror", d0=1e-9, rng=None
     \Delta t)`. For a dilute hard-disk gas kinetic theory gives :math:`\lambda \propto \nu
     \ln(1/\tilde n)` (van Zon, van Beijeren & Dellago, Phys. Rev. Lett. 80, 2035 (1998)).
     A twin whose collision sequence departs from the reference's (a grazing collision
-    missed) shows as one large ``log(d_k / d0)``; keep ``d0`` small.
+    missed) shows as one large ``log(d_k / d0)``; keep ``d0`` small. Each restart moves the
+    reference by round-off, which the chaos amplifies: after some ``37 / lambda`` the
+    reference is another trajectory than one uninterrupted run's, so the exponent of one
+    state compares with another method's only on average over states (two disks: the mean
+    of 12 states is 0.99 of `kicktimes.diagnostics.lyapunov`'s tangent mean,
+    ``tests/test_disks_gas.py``).
 
     Examples
     --------

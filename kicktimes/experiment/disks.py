@@ -322,10 +322,10 @@ DISKS_PRESETS = {
 
 
 #: the kicked single disk against the tagged disk of the gas (packing 0.02, mirror rule):
-#: 8 runs per N of 60 mean free times each
+#: 16 runs per N of 200 mean free times each
 DISKS_PRESETS["disks-kicked-phi0.02-mirror"] = DisksExperiment(
     name="disks-kicked-phi0.02-mirror", n_disks=N_SWEEP, packing=0.02, rule="mirror", seed=43,
-    n_tagged=8, min_runs=8, kicked_runs=8, kicked_time=60.0,
+    n_tagged=16, min_runs=16, kicked_runs=16, kicked_time=200.0,
     description="The kicked single disk against the tagged disk of N = 2 .. 1000 disks at "
                 "packing 0.02, mirror rule: FTLE, boundary-angle ACF, recurrence.")
 

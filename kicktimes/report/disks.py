@@ -320,7 +320,7 @@ def kicked_table(store, *, n_boot=999, seed=0) -> pd.DataFrame:
         wide = g.pivot_table(index="ic", columns=["system", "diagnostic"], values="value")
         runs = wide.index.size
         rng = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(int(n), 7)))
-        weights = rng.multinomial(runs, np.full(runs, 1.0 / runs), size=n_boot) / runs
+        weights = rng.multinomial(runs, np.full(runs, 1.0 / runs), size=n_boot).astype(float)
         pairs = [(s, d, "gas") for s in KICKED_SYSTEMS for d in KICKED_DIAGNOSTICS]
         if ("two_particle", "ftle") in wide:
             pairs.append(("gas", "ftle", "two_particle"))
@@ -332,9 +332,11 @@ def kicked_table(store, *, n_boot=999, seed=0) -> pd.DataFrame:
                 boot = (w @ num[ok]) / (w @ den[ok])
                 ratio = num[ok].mean() / den[ok].mean() if ok.any() else math.nan
             lo, hi = _ci(boot)
+            ref_lo, ref_hi = _ci(w @ den[ok] / w.sum(axis=1))
             rows.append({"experiment": store.experiment.name, "n_disks": int(n),
                          "system": f"{system}/{ref}", "diagnostic": diag,
                          "reference": float(np.mean(den[ok])) if ok.any() else math.nan,
+                         "reference_low": ref_lo, "reference_high": ref_hi,
                          "ratio": ratio, "ratio_low": lo, "ratio_high": hi,
                          "verdict": ratio_verdict(lo, hi), "n_runs": int(ok.sum())})
     return pd.DataFrame(rows)
