@@ -20,6 +20,7 @@ import pandas as pd
 
 from kicktimes import __version__
 from kicktimes.report.disks import HAZARD_EDGES, disks_hazard, disks_table, kicked_table
+from kicktimes.report.figures import plain_log_ticks
 from kicktimes.stats import format_interval, ratio_rule, rejection_rule
 
 __all__ = ["hazard_figure", "rates_figure", "rejection_figure", "reproduce_disks",
@@ -98,7 +99,7 @@ def hazard_figure(hazard, table, n_shown=SHOWN_N):
     exp_of = table.drop_duplicates(["rule", "geometry"]).set_index(["rule", "geometry"])
     fig, axes = plt.subplots(len(rules), len(geos), figsize=(4.2 * len(geos), 6.4),
                              sharex=True, sharey=True, squeeze=False)
-    colors = dict(zip(n_shown, ("C3", "C1", "C2", "C0", "C4"), strict=True))
+    colors = {n: f"C{(3, 1, 2, 0, 4, 5, 6, 7, 8, 9)[k % 10]}" for k, n in enumerate(n_shown)}
     for i, rule in enumerate(rules):
         for j, geo in enumerate(geos):
             ax = axes[i, j]
@@ -121,6 +122,8 @@ def hazard_figure(hazard, table, n_shown=SHOWN_N):
             ax.set_xscale("log")
             ax.set_ylim(0.05, 20)
             ax.set_xlim(X_MIN, HAZARD_EDGES[-1])
+            plain_log_ticks(ax.xaxis)
+            plain_log_ticks(ax.yaxis)
             ax.set_title(f"{rule}, {geo}", fontsize=9)
             if i == len(rules) - 1:
                 ax.set_xlabel("time since the last collision / mean interval")
@@ -155,6 +158,7 @@ def rates_figure(table):
                         label=f"{geo}, {rule}")
         ax.set_xscale("log")
         ax.set_yscale("log")
+        plain_log_ticks(ax.yaxis)
         ax.set_xlabel("number of disks N")
         ax.set_ylabel(label)
     axes[0, 0].legend(fontsize=7, ncol=1)
