@@ -34,10 +34,10 @@
 # Every conclusion is printed from the computed table through the verdict rules of
 # `kicktimes.stats`.
 #
-# **Size.** `KICKTIMES_NOTEBOOK_SIZE`: `"small"` (default; CI; N = 2, 10, 100 with 120
-# tagged disks each, under a minute once the engine is compiled) or `"full"` (the
-# presets of docs/results/disks.md at packing 0.2: N = 2 .. 1000, about 1000 tagged disks
-# per N; a few minutes).
+# **Size.** `KICKTIMES_NOTEBOOK_SIZE`: `"small"` (default; CI; N = 2, 10, 100 with 60
+# tagged disks each (at least 4 runs), seconds once the engine is compiled) or `"full"`
+# (the presets of docs/results/disks.md at packing 0.2: N = 2 .. 1000, about 4000 tagged
+# disks per N; a few minutes).
 
 # %%
 import os
@@ -60,7 +60,7 @@ if SIZE not in ("small", "full"):
 t_start = time.perf_counter()
 if SIZE == "small":
     experiments = [DisksExperiment(name=f"gas-{rule}", n_disks=(2, 10, 100), packing=0.2,
-                                   rule=rule, n_tagged=120, min_runs=4, seed=1)
+                                   rule=rule, n_tagged=60, min_runs=4, seed=1)
                    for rule in ("mirror", "elastic")]
 else:
     experiments = [DISKS_PRESETS["disks-phi0.2-mirror"], DISKS_PRESETS["disks-phi0.2-elastic"]]

@@ -309,9 +309,11 @@ KICKED_SYSTEMS = ("poisson", "actual")
 def kicked_table(store, *, n_boot=999, seed=0) -> pd.DataFrame:
     """The kicked single disk against the gas (`DisksExperiment.kicked_runs`): one row per
     (N, kicked system, diagnostic), the ratio kicked / gas of the means over runs with a
-    percentile bootstrap clustered on runs and its `kicktimes.stats.ratio_verdict`; at
-    N = 2 also the gas's FTLE (twin, `disks_lyapunov`) over the two-disk FTLE of the same
-    states (tangent, `kicktimes.diagnostics.lyapunov`), system ``"gas/two_particle"``.
+    percentile bootstrap clustered on runs and its `kicktimes.stats.ratio_verdict`; the
+    gas's FTLE over its disk's collision rate (system ``"gas/gas"``, diagnostic
+    ``"ftle/rate"``: the exponent per collision); at N = 2 also the gas's FTLE (twin,
+    `disks_lyapunov`) over the two-disk FTLE of the same states (tangent,
+    `kicktimes.diagnostics.lyapunov`), system ``"gas/two_particle"``.
     Empty when the store has no kicked rows."""
     res = store.results
     res = res[res["system"] != "disks"]
@@ -321,11 +323,13 @@ def kicked_table(store, *, n_boot=999, seed=0) -> pd.DataFrame:
         runs = wide.index.size
         rng = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(int(n), 7)))
         weights = rng.multinomial(runs, np.full(runs, 1.0 / runs), size=n_boot).astype(float)
-        pairs = [(s, d, "gas") for s in KICKED_SYSTEMS for d in KICKED_DIAGNOSTICS]
+        # (system, diagnostic, reference system, reference diagnostic)
+        pairs = [(s, d, "gas", d) for s in KICKED_SYSTEMS for d in KICKED_DIAGNOSTICS]
+        pairs.append(("gas", "ftle", "gas", "rate"))  # lambda / nu: per collision of a disk
         if ("two_particle", "ftle") in wide:
-            pairs.append(("gas", "ftle", "two_particle"))
-        for system, diag, ref in pairs:
-            num, den = wide[(system, diag)].to_numpy(), wide[(ref, diag)].to_numpy()
+            pairs.append(("gas", "ftle", "two_particle", "ftle"))
+        for system, diag, ref, ref_diag in pairs:
+            num, den = wide[(system, diag)].to_numpy(), wide[(ref, ref_diag)].to_numpy()
             ok = np.isfinite(num) & np.isfinite(den)
             w = weights[:, ok]
             with np.errstate(divide="ignore", invalid="ignore"):
@@ -334,7 +338,8 @@ def kicked_table(store, *, n_boot=999, seed=0) -> pd.DataFrame:
             lo, hi = _ci(boot)
             ref_lo, ref_hi = _ci(w @ den[ok] / w.sum(axis=1))
             rows.append({"experiment": store.experiment.name, "n_disks": int(n),
-                         "system": f"{system}/{ref}", "diagnostic": diag,
+                         "system": f"{system}/{ref}",
+                         "diagnostic": diag if ref_diag == diag else f"{diag}/{ref_diag}",
                          "reference": float(np.mean(den[ok])) if ok.any() else math.nan,
                          "reference_low": ref_lo, "reference_high": ref_hi,
                          "ratio": ratio, "ratio_low": lo, "ratio_high": hi,
