@@ -480,8 +480,8 @@ def write_disks_page(store_paths, out_dir, *, command="python analysis/make_disk
     lines += [
         "Columns: r the disk radius; tagged (short): tagged disks per rule (mirror / "
         f"elastic) and, in brackets, those with fewer than {k + 1} collisions in their run, "
-        f"left out of the tests (two disks whose conserved state keeps them apart, or a "
-        f"slow disk); rate: 2 n_pp / (N t) over all disks; rejected: uniform times (KS) at "
+        f"left out of the tests (two disks whose conserved state makes them collide "
+        f"rarely, or a slow disk); rate: 2 n_pp / (N t) over all disks; rejected: uniform times (KS) at "
         f"α = {ALPHA:g}; D: the variance over the mean of the tagged disks' collision counts "
         f"in a common window of K mean intervals (in the rescaled clock for the rescaled "
         f"column). Every test of the battery ({', '.join(TESTS)}), the gamma renewal "
