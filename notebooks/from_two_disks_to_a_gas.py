@@ -50,7 +50,7 @@ from IPython.display import display
 
 from kicktimes.experiment import DISKS_PRESETS, DisksExperiment, run_experiment
 from kicktimes.report.disks import disks_hazard, disks_table
-from kicktimes.report.disks_page import hazard_figure, rates_figure, rejection_figure
+from kicktimes.report.disks_figures import hazard_figure, rates_figure, rejection_figure
 from kicktimes.stats import format_interval
 
 # %matplotlib inline
