@@ -262,3 +262,22 @@ def test_the_kicked_comparison_gives_ratios_with_verdicts(tmp_path):
     # of the direction; the gas's exponent is the whole gas's)
     assert (ftle["ratio"] < 1.0).all() and ftle["verdict"].isin(
         ["lower", "inconclusive"]).all()
+
+
+def test_the_n2_row_is_checked_against_the_two_disk_simulator(reference, tmp_path):
+    from kicktimes.experiment import Experiment
+    from kicktimes.report.disks import two_disk_check
+
+    r = TINY.radius(2)
+    two = run_quiet(Experiment(name="tiny-two", radii=[r], n_ics=12, n_steps=200, tau=0.5,
+                               ic_method="uniform", systems=("two_particle",),
+                               diagnostics=("autocorrelation",)), tmp_path / "two",
+                    workers=1)
+    check = two_disk_check(reference, two, n_boot=99, n_mc=49)
+    assert check["engine_n"] == (reference.collisions["n_disks"] == 2).sum()
+    assert 0 < check["two_disk_n"] <= 12
+    assert 0.0 <= check["engine_low"] <= check["engine"] <= check["engine_high"] <= 1.0
+    assert check["ratio_verdict"] in ("within 10 %", "higher", "lower", "inconclusive")
+    with pytest.raises(ValueError, match="two_store"):
+        two_disk_check(dataclasses.replace(reference, experiment=dataclasses.replace(
+            TINY, packing=0.2)), two)

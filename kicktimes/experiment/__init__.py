@@ -19,7 +19,12 @@ Examples
 """
 
 from kicktimes.experiment.config import DIAGNOSTICS, SYSTEMS, Experiment
-from kicktimes.experiment.disks import DISKS_PRESETS, DisksExperiment, disks_preset
+from kicktimes.experiment.disks import (
+    DISKS_PRESETS,
+    DISKS_REFERENCES,
+    DisksExperiment,
+    disks_preset,
+)
 from kicktimes.experiment.disks_tasks import execute_disks_task
 from kicktimes.experiment.presets import PRESETS, preset
 from kicktimes.experiment.runner import run_experiment
@@ -46,6 +51,7 @@ __all__ = [
     "COLLISION_COLUMNS",
     "DIAGNOSTICS",
     "DISKS_PRESETS",
+    "DISKS_REFERENCES",
     "DisksExperiment",
     "PRESETS",
     "RESULT_COLUMNS",

@@ -32,7 +32,7 @@ from dataclasses import asdict, dataclass, field, fields
 
 from kicktimes._validation import check_choice, check_int, check_real
 
-__all__ = ["DISKS_PRESETS", "DisksExperiment", "DisksTask", "disks_preset"]
+__all__ = ["DISKS_PRESETS", "DISKS_REFERENCES", "DisksExperiment", "DisksTask", "disks_preset"]
 
 RULES = ("mirror", "elastic")
 #: the number of disks a packing preset sweeps (issue 42)
@@ -330,7 +330,30 @@ DISKS_PRESETS["disks-kicked-phi0.02-mirror"] = DisksExperiment(
                 "packing 0.02, mirror rule: FTLE, boundary-angle ACF, recurrence.")
 
 
+def _two_disk_reference(rule):
+    from kicktimes.experiment.config import Experiment
+
+    base = DISKS_PRESETS[f"disks-phi0.02-{rule}"]
+    r = base.radius(2)
+    horizon = base.t_max(2)
+    return Experiment(
+        name=f"disks-two-phi0.02-{rule}", radii=[r], n_ics=base.n_tagged,
+        n_steps=int(math.ceil(horizon / 0.5)), tau=0.5, ic_method="uniform", seed=44,
+        rule=rule, systems=("two_particle",), diagnostics=("autocorrelation",),
+        block_size=500,
+        description=f"The two-disk simulator at the radius of N = 2 at packing 0.02 "
+                    f"(r = {r:g}), invariant-measure ICs, {rule} rule, as long as the "
+                    f"disks sweep's N = 2 runs: the reference of its N = 2 row.")
+
+
+#: the two-disk simulator's own sweep at the N = 2 radius of packing 0.02 (an `Experiment`
+#: of one radius, invariant-measure ICs, as many ICs as tagged disks): the N = 2 row of the
+#: disks sweep against the two-disk results
+DISKS_REFERENCES = {f"disks-two-phi0.02-{rule}": _two_disk_reference(rule) for rule in RULES}
+
+
 def disks_preset(name: str) -> DisksExperiment:
-    """The built-in disks experiment ``name`` (one of `DISKS_PRESETS`)."""
-    check_choice("name", name, sorted(DISKS_PRESETS))
-    return DISKS_PRESETS[name]
+    """The built-in disks experiment ``name``: one of `DISKS_PRESETS`, or of the two-disk
+    references `DISKS_REFERENCES` (`Experiment` objects)."""
+    check_choice("name", name, sorted(DISKS_PRESETS) + sorted(DISKS_REFERENCES))
+    return DISKS_PRESETS.get(name) or DISKS_REFERENCES[name]

@@ -49,6 +49,7 @@ from kicktimes.stats import (
 from kicktimes.stats.findings import clopper_pearson
 
 __all__ = ["HAZARD_EDGES", "KICKED_DIAGNOSTICS", "disks_hazard", "disks_table", "kicked_table",
+           "two_disk_check",
            "rescale_by_speed"]
 
 #: bins of the hazard, in units of the mean interval
@@ -345,3 +346,70 @@ def kicked_table(store, *, n_boot=999, seed=0) -> pd.DataFrame:
                          "ratio": ratio, "ratio_low": lo, "ratio_high": hi,
                          "verdict": ratio_verdict(lo, hi), "n_runs": int(ok.sum())})
     return pd.DataFrame(rows)
+
+
+def _first_k(pp_times, k):
+    """The first ``k`` collision times of each sequence that has ``k + 1``, and the time of
+    collision ``k + 1`` (the window)."""
+    times, windows = [], []
+    for t in pp_times:
+        t = np.asarray(t, float)
+        if t.size > k:
+            times.append(t[:k])
+            windows.append(float(t[k]))
+    return times, windows
+
+
+def _share_replicates(times, windows, *, alpha, n_mc, n_boot, rng):
+    """The share of sequences rejecting uniform times at ``alpha`` and its bootstrap
+    replicates (sequences resampled: each is its own cluster)."""
+    group = poisson_group(times, windows, alpha=alpha, n_mc=n_mc, rng=rng)
+    p = group.ensemble.per_sequence["p_uniformity_ks"].to_numpy()
+    rej = (p[np.isfinite(p)] < alpha).astype(float)
+    idx = rng.integers(0, rej.size, size=(n_boot, rej.size))
+    return float(rej.mean()), rej[idx].mean(axis=1), int(rej.size)
+
+
+def two_disk_check(disks_store, two_store, *, alpha=0.05, n_boot=999, n_mc=199, seed=0):
+    """The N = 2 row of a disks sweep against the two-disk simulator's own sweep.
+
+    Parameters
+    ----------
+    disks_store : Store
+        A `DisksExperiment` store with N = 2 (one tagged disk per run).
+    two_store : Store
+        An `Experiment` store of the two-disk simulator at the same radius and rule
+        (`kicktimes.experiment.DISKS_REFERENCES`).
+
+    Returns
+    -------
+    dict
+        ``engine`` and ``two_disk``: the share of runs whose first K collision times
+        (``K = collisions`` of the disks sweep, window to collision K + 1) reject uniform
+        times at ``alpha``, with its percentile bootstrap CI and its count; ``ratio``:
+        engine over two-disk, CI from the ratio of independent replicates, and its
+        `kicktimes.stats.ratio_verdict`; ``radius``, ``rule``, the stores' names.
+    """
+    exp, two = disks_store.experiment, two_store.experiment
+    k = exp.collisions
+    r = exp.radius(2)
+    if two.radii != (r,) or two.rule != exp.rule:
+        raise ValueError(f"two_store: expected a two-disk sweep at r = {r!r} under the "
+                         f"{exp.rule} rule, got radii {list(two.radii)} under {two.rule}")
+    rng = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(2, 11)))
+    col = disks_store.collisions
+    engine = _share_replicates(*_first_k(col[col["n_disks"] == 2]["pp_times"], k),
+                               alpha=alpha, n_mc=n_mc, n_boot=n_boot, rng=rng)
+    ref = _share_replicates(*_first_k(two_store.collisions["pp_times"], k), alpha=alpha,
+                            n_mc=n_mc, n_boot=n_boot, rng=rng)
+    out = {"engine_store": exp.name, "two_disk_store": two.name, "radius": r,
+           "rule": exp.rule, "collisions": k}
+    for name, (share, boot, n) in (("engine", engine), ("two_disk", ref)):
+        lo, hi = _ci(boot)
+        out.update({f"{name}": share, f"{name}_low": lo, f"{name}_high": hi,
+                    f"{name}_n": n, f"{name}_verdict": rejection_verdict(lo, hi, alpha)})
+    with np.errstate(divide="ignore", invalid="ignore"):
+        out["ratio"] = engine[0] / ref[0] if ref[0] > 0 else math.nan
+        out["ratio_low"], out["ratio_high"] = _ci(engine[1] / ref[1])
+    out["ratio_verdict"] = ratio_verdict(out["ratio_low"], out["ratio_high"])
+    return out
