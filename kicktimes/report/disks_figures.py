@@ -107,8 +107,11 @@ def hazard_figure(hazard, table, n_shown=SHOWN_N):
                 ax.set_xlabel("time since the last collision / mean interval")
             if j == 0:
                 ax.set_ylabel("hazard / constant rate")
-    axes[0, 0].legend(fontsize=8, loc="upper right")
-    fig.tight_layout()
+    # one legend above the panels: inside, it would hide a curve in some panel
+    handles, labels = axes[0, 0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="upper center", ncol=len(labels), fontsize=9,
+               frameon=False)
+    fig.tight_layout(rect=(0, 0, 1, 0.95))
     return fig
 
 
