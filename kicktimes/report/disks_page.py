@@ -462,6 +462,11 @@ def write_disks_page(store_paths, out_dir, *, command="python analysis/make_disk
               "two-disk simulator at its own radius (packing 0.02 only), not with the "
               "rejection shares of docs/results/README.md, which are for other radii "
               "(0.008–0.030) and, but for its `@first30` rows, whole runs.",
+              "- No controls: every verdict here is the primary design's (one K, one seed, "
+              "at most 250 tagged disks per run, equilibrated engine states); none is checked "
+              "under another (`robust_verdict`), so none is called robust.",
+              "- The renewal fits are reduced to a gamma shape per row (disks.csv, "
+              "`gamma_shape`); no model comparison (`compare_models`) is made.",
               "- One fixed K; the tests' power grows with K, so 'nominal' here means "
               f"'indistinguishable from Poisson with {k} collisions per disk'.", ""]
     page = out / "disks.md"
