@@ -210,6 +210,13 @@ def report_command(stores, out, workers, progress, pdf, force):
 
 
 @click.command("reproduce")
+@click.option("--study", type=click.Choice(["paper", "disks"]), default="paper",
+              show_default=True,
+              help="paper: the paper's two families and their report; disks: the tagged disk "
+              "among N = 2..1000 disks (issue 42), its stores and docs/results-style page "
+              "disks.md (into --results, default OUT/results-disks).")
+@click.option("--results", "results", type=click.Path(file_okay=False), default=None,
+              help="--study disks: folder of the page disks.md (default OUT/results-disks).")
 @option("--scale", type=click.Choice(["quick", "paper"]), default="quick",
         help="quick: small versions of both families; paper: the paper's full scale.")
 @click.option(
@@ -229,14 +236,30 @@ def report_command(stores, out, workers, progress, pdf, force):
 @_progress_option
 @_wait_option
 @_pdf_option
-def reproduce_command(scale, content, out, workers, scheduler, progress, wait, pdf):
+def reproduce_command(study, results, scale, content, out, workers, scheduler, progress, wait,
+                      pdf):
     """Run the paper's experiment families (and, at paper scale, their controls) and report.
 
     Reruns resume the stores in --out. The experiments are the built-in presets, the
     same as analysis/<name>.toml (with --content paper, reduced to the paper's own
-    systems and diagnostics: kicktimes.experiment.presets.PAPER_CONTENT).
+    systems and diagnostics: kicktimes.experiment.presets.PAPER_CONTENT). With
+    --study disks: the disks presets (kicktimes.experiment.DISKS_PRESETS) and the page
+    disks.md (docs/results/disks.md is built with --results docs/results).
     """
     import os
+
+    if study == "disks":
+        from kicktimes.report.disks_page import reproduce_disks
+
+        if workers is not None and scheduler is not None:
+            raise click.UsageError("--workers sizes the local pool; it cannot go with "
+                                   "--scheduler")
+        with _cli_errors(_RUN_OPTIONS):
+            page = reproduce_disks(out, results_dir=results, workers=workers or 1,
+                                   scheduler=scheduler, progress=progress,
+                                   command="kicktimes reproduce --study disks")
+        click.echo(f"page written to {page}")
+        return
 
     from kicktimes.experiment.presets import preset, scale_presets
 

@@ -6,7 +6,8 @@ autocorrelation of the boundary-collision angles (`autocorrelation`,
 `autocorrelation_many`, `boundary_angles`), its curve over lags and decay
 (`autocorrelation_function`, `decorrelation_lag`, `integrated_autocorrelation_time`)
 and finite-time Lyapunov exponents (`lyapunov`: exact tangent vectors by default, or
-Benettin twins; `lyapunov_spectrum`: all exponents of the two-disk billiard); see
+Benettin twins; `lyapunov_spectrum`: all exponents of the two-disk billiard;
+`disks_lyapunov`: the largest exponent of N disks from a Benettin twin); see
 docs/diagnostics.md. The collision mechanism of two-disk runs (angular momenta, impact
 parameters and wall hits per collision, re-collisions, predicted rates) is in
 `kicktimes.diagnostics.mechanism`; see docs/mechanism.md.
@@ -25,6 +26,7 @@ from kicktimes.diagnostics.decorrelation import (
     decorrelation_lag,
     integrated_autocorrelation_time,
 )
+from kicktimes.diagnostics.gas_lyapunov import DisksLyapunov, disks_lyapunov
 from kicktimes.diagnostics.lyapunov import (
     LyapunovResult,
     LyapunovSpectrum,
@@ -45,12 +47,14 @@ from kicktimes.diagnostics.rqa import RQAResult, rqa
 
 __all__ = [
     "AcfCurve",
+    "DisksLyapunov",
     "LyapunovResult",
     "LyapunovSpectrum",
     "RQAResult",
     "RecollisionShare",
     "UndefinedDiagnosticWarning",
     "acf_curve",
+    "disks_lyapunov",
     "autocorrelation",
     "autocorrelation_function",
     "autocorrelation_many",

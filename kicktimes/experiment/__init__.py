@@ -19,6 +19,13 @@ Examples
 """
 
 from kicktimes.experiment.config import DIAGNOSTICS, SYSTEMS, Experiment
+from kicktimes.experiment.disks import (
+    DISKS_PRESETS,
+    DISKS_REFERENCES,
+    DisksExperiment,
+    disks_preset,
+)
+from kicktimes.experiment.disks_tasks import execute_disks_task
 from kicktimes.experiment.presets import PRESETS, preset
 from kicktimes.experiment.runner import run_experiment
 from kicktimes.experiment.store import (
@@ -43,6 +50,9 @@ from kicktimes.experiment.tasks import (
 __all__ = [
     "COLLISION_COLUMNS",
     "DIAGNOSTICS",
+    "DISKS_PRESETS",
+    "DISKS_REFERENCES",
+    "DisksExperiment",
     "PRESETS",
     "RESULT_COLUMNS",
     "SYSTEMS",
@@ -52,6 +62,8 @@ __all__ = [
     "StoreWarning",
     "Task",
     "TaskOutput",
+    "disks_preset",
+    "execute_disks_task",
     "execute_task",
     "kick_rng",
     "load_store",

@@ -11,6 +11,8 @@ import time
 from concurrent.futures import FIRST_COMPLETED, Executor, ProcessPoolExecutor, wait
 
 from kicktimes.experiment.config import Experiment
+from kicktimes.experiment.disks import DisksExperiment
+from kicktimes.experiment.disks_tasks import execute_disks_task
 from kicktimes.experiment.store import Store, StoreWriter, load_store
 from kicktimes.experiment.tasks import execute_task
 from kicktimes.memory import keep_freed_memory
@@ -118,8 +120,9 @@ def run_experiment(
 
     Parameters
     ----------
-    experiment : Experiment or path-like
-        The sweep, or the path of its TOML file.
+    experiment : Experiment, DisksExperiment or path-like
+        The sweep (over radii, or over the number of disks N: `DisksExperiment`), or the
+        path of an `Experiment`'s TOML file.
     store : path-like
         Store directory (created if needed). If it already holds this experiment the run
         resumes: finished tasks whose parts are intact are skipped, damaged or foreign
@@ -179,9 +182,10 @@ def run_experiment(
     """
     if isinstance(experiment, (str, os.PathLike)):
         experiment = Experiment.from_toml(experiment)
-    if not isinstance(experiment, Experiment):
+    if not isinstance(experiment, Experiment | DisksExperiment):
         raise TypeError(
-            f"experiment: expected an Experiment or a TOML path, got {type(experiment).__name__}"
+            f"experiment: expected an Experiment, a DisksExperiment or a TOML path, got "
+            f"{type(experiment).__name__}"
         )
     if not isinstance(store, (str, os.PathLike)):
         raise TypeError(f"store: expected a directory path, got {type(store).__name__}")
@@ -213,6 +217,7 @@ def _run_pending(writer, pending, executor, workers, scheduler, show):
     from tqdm import tqdm
 
     experiment = writer.experiment
+    execute = execute_disks_task if isinstance(experiment, DisksExperiment) else execute_task
     total = len(writer.all_tasks)
     bar = tqdm(
         total=total,
@@ -227,14 +232,14 @@ def _run_pending(writer, pending, executor, workers, scheduler, show):
     try:
         if executor is None and scheduler is None and (workers or os.cpu_count() or 1) == 1:
             for task in pending:
-                writer.write(execute_task(experiment, task))
+                writer.write(execute(experiment, task))
                 bar.update()
             return
         if scheduler is not None:
             client, executor = _dask_executor(scheduler)
         elif executor is None:
             own_pool = executor = local_pool(workers)
-        futures = {executor.submit(execute_task, experiment, task): task for task in pending}
+        futures = {executor.submit(execute, experiment, task): task for task in pending}
         not_done = set(futures)
         try:
             while not_done:

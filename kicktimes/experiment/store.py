@@ -37,6 +37,8 @@ import pandas as pd
 
 from kicktimes import __version__
 from kicktimes.experiment.config import Experiment
+from kicktimes.experiment.disks import DisksExperiment
+from kicktimes.experiment.disks_tasks import DISKS_COLLISION_COLUMNS, DISKS_RESULT_COLUMNS
 from kicktimes.experiment.tasks import COLLISION_COLUMNS, RESULT_COLUMNS, Task, TaskOutput
 from kicktimes.fileio import TMP_PREFIX, atomic_write, file_sha256
 
@@ -70,9 +72,13 @@ def _now() -> str:
     return _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")
 
 
-def _schemas():
+def _schemas(experiment=None):
+    """The part files' schemas: a radius sweep's, or a disks sweep's (``n_disks`` first;
+    one collisions row per tagged disk, with its ``disk`` and its interval ``speeds``)."""
     import pyarrow as pa
 
+    if isinstance(experiment, DisksExperiment):
+        return _disks_schemas()
     results = pa.schema(
         [
             ("radius", pa.float64()),
@@ -93,6 +99,26 @@ def _schemas():
         ]
     )
     return {"results": results, "collisions": collisions}
+
+
+def _disks_schemas():
+    import pyarrow as pa
+
+    head = [("n_disks", pa.int64()), ("radius", pa.float64()), ("ic", pa.int64())]
+    results = pa.schema(head + [("system", pa.string()), ("diagnostic", pa.string()),
+                                ("value", pa.float64()), ("note", pa.string())])
+    collisions = pa.schema(head + [("disk", pa.int64()), ("t_window", pa.float64()),
+                                   ("n_pp", pa.int64()), ("pp_times", pa.list_(pa.float64())),
+                                   ("speeds", pa.list_(pa.float64()))])
+    return {"results": results, "collisions": collisions}
+
+
+def _experiment_from_record(record):
+    """The experiment a store's record describes: a `DisksExperiment` (``kind = "disks"``)
+    or an `Experiment`."""
+    if isinstance(record, dict) and record.get("kind") == DisksExperiment.kind:
+        return DisksExperiment.from_record(record)
+    return Experiment.from_record(record)
 
 
 def _part_meta(experiment: Experiment, task: Task, part: str) -> dict:
@@ -385,7 +411,7 @@ class StoreWriter:
             "ic_start": task.ic_start,
             "ic_stop": task.ic_stop,
         }
-        schemas = _schemas()
+        schemas = _schemas(self.experiment)
         for part, df in (("results", output.results), ("collisions", output.collisions)):
             meta = {_META_KEY: json.dumps(_part_meta(self.experiment, task, part)).encode()}
             schema = schemas[part].with_metadata(meta)
@@ -625,7 +651,7 @@ def _load(path, *, verify=True, result_columns=None, categories=()) -> Store:
     root = Path(path)
     manifest = read_manifest(root)
     try:
-        experiment = Experiment.from_record(manifest["experiment"])
+        experiment = _experiment_from_record(manifest["experiment"])
     except (TypeError, ValueError, KeyError, IndexError, AttributeError) as exc:
         raise ValueError(
             f"damaged store {os.fspath(root)!r}: bad experiment record ({exc})"
@@ -638,7 +664,9 @@ def _load(path, *, verify=True, result_columns=None, categories=()) -> Store:
     entries = manifest["tasks"]
     order = [t.id for t in experiment.tasks()]
     finished = [tid for tid in order if tid in entries]
-    schemas = _schemas()
+    schemas = _schemas(experiment)
+    disks = isinstance(experiment, DisksExperiment)
+    keys = ["n_disks", "ic"] if disks else ["radius", "ic"]
     tables = {part: [] for part in PARTS}
     for tid in finished:
         entry = entries[tid]
@@ -671,13 +699,15 @@ def _load(path, *, verify=True, result_columns=None, categories=()) -> Store:
         if tables[part]:
             frames[part] = pa.concat_tables(tables[part]).to_pandas()
         else:
-            columns = RESULT_COLUMNS if part == "results" else COLLISION_COLUMNS
+            columns = ((DISKS_RESULT_COLUMNS if part == "results" else DISKS_COLLISION_COLUMNS)
+                       if disks else
+                       (RESULT_COLUMNS if part == "results" else COLLISION_COLUMNS))
             if part == "results" and result_columns:
                 columns = result_columns
             frames[part] = schemas[part].empty_table().to_pandas()[list(columns)]
-    frames["collisions"] = frames["collisions"].sort_values(["radius", "ic"], kind="stable")
+    frames["collisions"] = frames["collisions"].sort_values(keys, kind="stable")
     frames["collisions"] = frames["collisions"].reset_index(drop=True)
-    frames["results"] = frames["results"].sort_values(["radius", "ic"], kind="stable")
+    frames["results"] = frames["results"].sort_values(keys, kind="stable")
     frames["results"] = frames["results"].reset_index(drop=True)
     for column in categories:
         values = frames["results"][column]

@@ -30,7 +30,7 @@ from .comparison import VuongResult, compare_models, vuong
 from .counts import CountRegression, kinetic_rate, regress_counts
 from .distributions import hyperexpon
 from .ensemble import PoissonEnsembleResult, test_poisson_ensemble
-from .enskog import contact_value, enskog_frequency
+from .enskog import contact_value, enskog_frequency, speed_rate_factor
 from .findings import (
     Finding,
     format_interval,
@@ -86,6 +86,7 @@ __all__ = [
     "regress_counts",
     "kinetic_rate",
     "enskog_frequency",
+    "speed_rate_factor",
     "contact_value",
     "conditional_kinetic_rate",
     "mean_kinetic_rate",

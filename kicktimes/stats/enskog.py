@@ -12,7 +12,7 @@ import numpy as np
 
 from kicktimes._validation import check_choice, check_int, check_real
 
-__all__ = ["contact_value", "enskog_frequency"]
+__all__ = ["contact_value", "enskog_frequency", "speed_rate_factor"]
 
 #: the densest packing of disks, pi / sqrt(12)
 PACKING_MAX = math.pi / math.sqrt(12.0)
@@ -85,3 +85,55 @@ def enskog_frequency(r, n_disks, *, rule="mirror", area=math.pi, kT=0.5):
                          f"{PACKING_MAX:.6g}")
     w = 4.0 / math.pi if rule == "mirror" else math.sqrt(math.pi * kT)
     return float(n * 4.0 * r * contact_value(phi) * w)
+
+
+def speed_rate_factor(speed, *, kT=0.5):
+    r"""How much faster a disk of speed ``speed`` collides than the average disk of a
+    Maxwellian gas at temperature ``kT``: :math:`\nu(v) / \bar\nu`.
+
+    Parameters
+    ----------
+    speed : array_like
+        Speeds ``>= 0`` (NaN passes through).
+    kT : float
+        Temperature (unit masses), ``> 0``; 0.5 on the energy shell ``sum |v|^2 = N``.
+
+    Returns
+    -------
+    ndarray
+        :math:`\langle |v - w| \rangle_w / \langle |w_1 - w_2| \rangle`, with :math:`w`
+        Maxwellian: in Enskog's frequency (`enskog_frequency`) a disk of speed :math:`v`
+        sweeps partners at the mean relative speed :math:`\langle |v - w| \rangle`, so
+        :math:`\nu(v) = n\,2\sigma\,g(\sigma) \langle |v - w| \rangle` and the density
+        and contact value cancel in the ratio.
+
+    Notes
+    -----
+    :math:`|v - w|` is Rice-distributed with scale :math:`\sqrt{kT}`; its mean is
+    :math:`\sqrt{\pi kT / 2}\, L_{1/2}(-v^2 / 2kT)`, and with :math:`y = v^2 / 4kT`,
+    :math:`L_{1/2}(-2y) = e^{y}[(1 + 2y) I_0(y) + 2y I_1(y)]`. Over :math:`\langle |w_1 -
+    w_2| \rangle = \sqrt{\pi kT}`:
+
+    .. math:: \nu(v) / \bar\nu = [(1 + 2y)\, e^{-y} I_0(y) + 2y\, e^{-y} I_1(y)] / \sqrt 2,
+
+    :math:`1/\sqrt 2` at rest, :math:`\to v / \sqrt{\pi kT}` for fast disks, 1 on
+    average over the Maxwellian. This is the tagged particle's speed-dependent rate of
+    Visco, van Wijland & Trizac, Phys. Rev. E 77, 041117 (2008), in two dimensions.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> speed_rate_factor([0.0, 1.0]).round(4).tolist()
+    [0.7071, 1.0228]
+    >>> v = np.random.default_rng(0).normal(0.0, 0.5 ** 0.5, (200000, 2))
+    >>> round(float(speed_rate_factor(np.hypot(v[:, 0], v[:, 1])).mean()), 2)
+    1.0
+    """
+    from scipy.special import i0e, i1e
+
+    kT = check_real("kT", kT, low=0.0)
+    v = np.asarray(speed, dtype=float)
+    if np.any(v < 0):
+        raise ValueError(f"speed must be >= 0, got {float(v[v < 0].ravel()[0])!r}")
+    y = v * v / (4.0 * kT)
+    return ((1.0 + 2.0 * y) * i0e(y) + 2.0 * y * i1e(y)) / math.sqrt(2.0)

@@ -1,0 +1,359 @@
+"""The ``disks`` experiment: a tagged disk's collision times in a gas of N disks, over N.
+
+A `DisksExperiment` sweeps the number of disks ``n_disks`` at a fixed packing (or a fixed
+radius) under one collision rule. For each N it simulates independent runs of the N-disk
+engine (`kicktimes.simulate_disks`) from `kicktimes.initial_state`, and records the
+collision times of a few *tagged* disks per run, each up to at least ``collisions + 1``
+collisions (the Poisson battery is read at a fixed number of collisions per tagged disk,
+docs/disks_gas.md). Under the elastic rule it also records the speed each tagged disk
+flew each interval at (`kicktimes.experiment.disks_tasks`), for the speed-conditioned
+(Cox) rescaling of Visco, van Wijland & Trizac, Phys. Rev. E 77, 041117 (2008).
+
+It is stored, resumed and run on a local pool or a Dask cluster exactly like an
+`Experiment` (`run_experiment`, `load_store`): a task is one N times one block of runs,
+and run ``k`` at N draws every random number from ``SeedSequence(seed, spawn_key=(N, k))``,
+so the results depend neither on the executor nor on the block size.
+
+Examples
+--------
+>>> exp = DisksExperiment(name="gas", n_disks=[10, 2], packing=0.1, n_tagged=20)
+>>> exp.n_disks, exp.tagged_per_run(2), exp.tagged_per_run(10), exp.n_runs(10)
+((2, 10), 1, 10, 8)
+>>> DisksExperiment.from_record(exp.to_dict()) == exp
+True
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+from dataclasses import asdict, dataclass, field, fields
+
+from kicktimes._validation import check_choice, check_int, check_real
+
+__all__ = ["DISKS_PRESETS", "DISKS_REFERENCES", "DisksExperiment", "DisksTask", "disks_preset"]
+
+RULES = ("mirror", "elastic")
+#: the number of disks a packing preset sweeps (issue 42)
+N_SWEEP = (2, 3, 4, 6, 10, 30, 100, 300, 1000)
+#: the largest packing `kicktimes.initial_state` builds
+PACKING_MAX = 0.7
+#: fields added after the first stores, with the value that leaves those stores' hash
+_LATER_FIELDS = {"kicked_runs": 0, "kicked_time": 60.0}
+
+
+@dataclass(frozen=True)
+class DisksTask:
+    """One unit of work: ``n_disks`` (the ``n_index``-th of the sweep), runs ``ic_start ..
+    ic_stop - 1``. ``radius`` is the disks' radius at that N; ``radius_index`` is
+    ``n_index`` (the store's manifest records both)."""
+
+    n_index: int
+    n_disks: int
+    radius: float
+    ic_start: int
+    ic_stop: int
+
+    @property
+    def radius_index(self) -> int:
+        return self.n_index
+
+    @property
+    def id(self) -> str:
+        """Stable name, e.g. ``"n0030-ic000008-000016"`` (used for part files)."""
+        return f"n{self.n_disks:04d}-ic{self.ic_start:06d}-{self.ic_stop:06d}"
+
+    @property
+    def n_ics(self) -> int:
+        return self.ic_stop - self.ic_start
+
+
+@dataclass(frozen=True)
+class DisksExperiment:
+    """A sweep over the number of disks N of the tagged-disk collision-time process.
+
+    Parameters
+    ----------
+    name : str
+        Identifier (letters, digits, ``_ . -``), used in store and page names.
+    n_disks : sequence of int
+        Numbers of disks ``>= 2``, distinct; stored sorted increasingly.
+    packing : float, optional
+        Area fraction ``N r^2`` in ``(0, 0.7]``, the same for every N (``r = sqrt(packing /
+        N)``). Give exactly one of ``packing`` and ``r``.
+    r : float, optional
+        One disk radius for every N (``N r^2 <= 0.7`` at the largest N).
+    rule : {"mirror", "elastic"}
+        Disk-disk collision rule. Elastic runs start on the energy shell ``sum |v|^2 = N``
+        (``kT = 1/2``) and record the tagged disks' speeds.
+    n_tagged : int
+        Tagged disks per N (``>= 1``), summed over runs: each run tags
+        `tagged_per_run` disks and N gets `n_runs` runs.
+    collisions : int
+        The fixed number of collisions per tagged disk the tests read (``>= 5``; the
+        issue's 30).
+    max_tagged_per_run : int
+        At most this many tagged disks per run (``>= 1``): more runs, less correlation
+        between the tagged sequences, fewer position samples in memory.
+    min_runs : int
+        At least this many runs per N (``>= 2``): the confidence intervals are bootstraps
+        clustered on runs.
+    t_factor : float
+        Each run lasts ``t_factor (collisions + 1) / nu`` (``>= 1``), ``nu`` the Enskog
+        frequency (`kicktimes.stats.enskog_frequency`), or the two-disk kinetic rate when it
+        is lower (few disks); a tagged disk with fewer than ``collisions + 1`` collisions by
+        then is recorded and counted, not tested.
+    samples_per_collision : int
+        Elastic rule: position samples per mean free time (``>= 2``), from which each
+        interval's speed is read (`kicktimes.experiment.disks_tasks.interval_speeds`).
+    seed : int
+        Root seed (``>= 0``).
+    block_sequences : int
+        Tagged sequences per task, about (``>= 1``): a task is one N times
+        ``max(1, block_sequences // tagged_per_run(N))`` runs.
+    description : str
+        Free text for the page.
+    kicked_runs : int
+        The first ``kicked_runs`` runs of each N (``>= 0``; at most `n_runs`) also compare
+        the gas with a kicked single disk (the paper's question for a gas,
+        `kicktimes.experiment.disks_tasks.kicked_rows`): another state of the same N is
+        run for ``kicked_time`` mean free times (``> 0``), and the first disk's FTLE,
+        boundary-angle autocorrelation and recurrence rate are compared with those of one
+        disk from its state kicked at its own collision rate (Poisson) and at its
+        collision times (actual). Mirror rule only.
+    """
+
+    name: str
+    n_disks: tuple
+    packing: float | None = None
+    r: float | None = None
+    rule: str = "mirror"
+    n_tagged: int = 1000
+    collisions: int = 30
+    max_tagged_per_run: int = 250
+    min_runs: int = 8
+    t_factor: float = 3.0
+    samples_per_collision: int = 40
+    seed: int = 0
+    block_sequences: int = 250
+    description: str = field(default="")
+    kicked_runs: int = 0
+    kicked_time: float = 60.0
+
+    #: what a store's record says this is (`Experiment` records have no ``kind``)
+    kind = "disks"
+
+    def __post_init__(self):
+        def put(name, value):
+            object.__setattr__(self, name, value)
+
+        from kicktimes.experiment.config import _NAME_RE
+
+        if not isinstance(self.name, str) or not _NAME_RE.fullmatch(self.name):
+            raise ValueError(f"name: must be a non-empty identifier of letters, digits, '_', "
+                             f"'.', '+', '-' (it names files), got {self.name!r}")
+        ns = self.n_disks
+        if isinstance(ns, (str, bytes)) or not hasattr(ns, "__iter__"):
+            raise TypeError(f"n_disks: expected a list of disk numbers, got {ns!r}")
+        ns = [check_int(f"n_disks[{k}]", n, low=2, high=100_000) for k, n in enumerate(ns)]
+        if not ns:
+            raise ValueError("n_disks: must contain at least one number of disks, got []")
+        if len(set(ns)) != len(ns):
+            raise ValueError(f"n_disks: must be distinct, got {ns}")
+        put("n_disks", tuple(sorted(ns)))
+        if (self.packing is None) == (self.r is None):
+            raise ValueError(f"packing, r: give exactly one of them, got packing={self.packing!r}"
+                             f", r={self.r!r}")
+        if self.packing is not None:
+            put("packing", check_real("packing", self.packing, low=0.0, high=PACKING_MAX,
+                                      high_open=False))
+        else:
+            r = check_real("r", self.r, low=0.0, high=0.5)
+            phi = self.n_disks[-1] * r * r
+            if phi > PACKING_MAX:
+                raise ValueError(f"r: {self.n_disks[-1]} disks of radius {r!r} have packing "
+                                 f"{phi:.6g}; N r^2 must be at most {PACKING_MAX} at the "
+                                 f"largest N, i.e. r <= {math.sqrt(PACKING_MAX / ns[-1]):.6g}")
+            put("r", r)
+        check_choice("rule", self.rule, RULES)
+        put("n_tagged", check_int("n_tagged", self.n_tagged, low=1))
+        put("collisions", check_int("collisions", self.collisions, low=5))
+        put("max_tagged_per_run", check_int("max_tagged_per_run", self.max_tagged_per_run,
+                                            low=1))
+        put("min_runs", check_int("min_runs", self.min_runs, low=2))
+        put("t_factor", check_real("t_factor", self.t_factor, low=1.0, low_open=False,
+                                   high=100.0, high_open=False))
+        put("samples_per_collision", check_int("samples_per_collision",
+                                               self.samples_per_collision, low=2))
+        put("seed", check_int("seed", self.seed, low=0))
+        put("block_sequences", check_int("block_sequences", self.block_sequences, low=1))
+        if not isinstance(self.description, str):
+            raise TypeError(f"description: expected a string, got {self.description!r}")
+        put("kicked_runs", check_int("kicked_runs", self.kicked_runs, low=0))
+        put("kicked_time", check_real("kicked_time", self.kicked_time, low=0.0))
+        if self.kicked_runs and self.rule != "mirror":
+            raise ValueError(f"kicked_runs: the kicked disk keeps its speed, so the comparison "
+                             f"needs rule='mirror', got rule={self.rule!r}")
+        if self.kicked_runs > min(self.n_runs(n) for n in self.n_disks):
+            raise ValueError(f"kicked_runs must be at most the runs of every N, "
+                             f"{min(self.n_runs(n) for n in self.n_disks)}, got "
+                             f"{self.kicked_runs}")
+
+    # ------------------------------------------------------------------ derived
+    def radius(self, n_disks: int) -> float:
+        """The disks' radius at ``n_disks``: ``sqrt(packing / N)`` or the fixed ``r``."""
+        return math.sqrt(self.packing / n_disks) if self.packing is not None else self.r
+
+    def packing_at(self, n_disks: int) -> float:
+        """The area fraction ``N r^2`` at ``n_disks``."""
+        return n_disks * self.radius(n_disks) ** 2
+
+    def tagged_per_run(self, n_disks: int) -> int:
+        """Tagged disks per run: one for two disks (their sequences are the same), else
+        ``min(N, max_tagged_per_run, n_tagged)``."""
+        return 1 if n_disks == 2 else min(n_disks, self.max_tagged_per_run, self.n_tagged)
+
+    def n_runs(self, n_disks: int) -> int:
+        """Runs at ``n_disks``: enough for ``n_tagged`` sequences, at least ``min_runs``."""
+        return max(self.min_runs, -(-self.n_tagged // self.tagged_per_run(n_disks)))
+
+    def reference_frequency(self, n_disks: int) -> float:
+        """The collision frequency a run's length is set by: Enskog's
+        (`kicktimes.stats.enskog_frequency`, ``kT = 1/2``), or the two-disk kinetic rate
+        (`kicktimes.stats.kinetic_rate`) of the same radius when lower."""
+        from kicktimes.stats import enskog_frequency, kinetic_rate
+
+        r = self.radius(n_disks)
+        nu = enskog_frequency(r, n_disks, rule=self.rule)
+        if r < 1.0 / 3.0:
+            # two disks of radius r collide at the rate Gamma(r); a few disks nearly so
+            nu = min(nu, float(kinetic_rate(r, self.rule)) * (n_disks - 1))
+        return nu
+
+    def t_max(self, n_disks: int) -> float:
+        """Duration of each run at ``n_disks``: ``t_factor (collisions + 1) / nu``."""
+        return self.t_factor * (self.collisions + 1) / self.reference_frequency(n_disks)
+
+    def tasks(self) -> list[DisksTask]:
+        """All tasks of the sweep (N-major, then blocks of runs)."""
+        out = []
+        for k, n in enumerate(self.n_disks):
+            runs = self.n_runs(n)
+            block = max(1, self.block_sequences // self.tagged_per_run(n))
+            for start in range(0, runs, block):
+                out.append(DisksTask(k, n, self.radius(n), start, min(start + block, runs)))
+        return out
+
+    @property
+    def geometry_label(self) -> str:
+        """``packing 0.02`` or ``r = 0.0045``."""
+        return f"packing {self.packing:g}" if self.packing is not None else f"r = {self.r:g}"
+
+    # -------------------------------------------------------------- conversions
+    def to_dict(self) -> dict:
+        """JSON-ready dict of every field, with ``kind = "disks"``."""
+        out = asdict(self)
+        out["n_disks"] = list(out["n_disks"])
+        out["kind"] = self.kind
+        return out
+
+    @classmethod
+    def from_record(cls, d) -> DisksExperiment:
+        """The experiment of `to_dict` output (a store's record); unknown keys are refused."""
+        if not isinstance(d, dict):
+            raise TypeError(f"expected a dict of experiment fields, got {type(d).__name__}")
+        d = dict(d)
+        if d.pop("kind", cls.kind) != cls.kind:
+            raise ValueError(f"kind: a disks experiment's record has kind {cls.kind!r}")
+        known = [f.name for f in fields(cls)]
+        unknown = sorted(set(d) - set(known))
+        if unknown:
+            raise ValueError(f"unknown experiment key(s) {unknown}; valid keys are "
+                             f"{', '.join(known)}")
+        return cls(**d)
+
+    from_dict = from_record
+
+    def hash(self) -> str:
+        """Stable identity: the first 16 hex digits of SHA-256 of the canonical JSON (the
+        kicked comparison's fields left out while it is off, as before they existed)."""
+        record = self.to_dict()
+        if not self.kicked_runs:
+            for key, default in _LATER_FIELDS.items():
+                if record[key] == default:
+                    del record[key]
+        text = json.dumps(record, sort_keys=True, separators=(",", ":"), allow_nan=False)
+        return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+    def partner_line(self) -> str:
+        """Empty: the disks are equal (`Store.summary` asks every experiment)."""
+        return ""
+
+    def summary(self) -> str:
+        """A few lines describing the sweep."""
+        ns = ", ".join(str(n) for n in self.n_disks)
+        runs = sum(self.n_runs(n) for n in self.n_disks)
+        return (f"Disks experiment {self.name!r} (hash {self.hash()})\n"
+                f"  N ({len(self.n_disks)}): {ns}; {self.geometry_label}; rule {self.rule}\n"
+                f"  about {self.n_tagged} tagged disks per N ({runs} runs in all), "
+                f"{self.collisions} collisions each; seed {self.seed}\n"
+                f"  {len(self.tasks())} tasks")
+
+
+def _preset(name, rule, description, **geometry):
+    return DisksExperiment(name=name, n_disks=N_SWEEP, rule=rule, seed=42, n_tagged=4000,
+                           description=description, **geometry)
+
+
+#: the issue's sweep: N = 2 .. 1000 at packings 0.02 and 0.2 and at the radius of packing
+#: 0.02 at N = 1000, under both rules; about 4000 tagged disks per N, 30 collisions each
+DISKS_PRESETS = {
+    f"disks-{geo}-{rule}": _preset(
+        f"disks-{geo}-{rule}", rule,
+        f"The tagged disk among N = 2 .. 1000 disks at {text}, {rule} rule.", **kw)
+    for geo, text, kw in (
+        ("phi0.02", "packing 0.02", {"packing": 0.02}),
+        ("phi0.2", "packing 0.2", {"packing": 0.2}),
+        ("r0.0045", "the fixed radius 0.0045 (packing 0.02 at N = 1000)", {"r": 0.0045}),
+    )
+    for rule in RULES
+}
+
+
+#: the kicked single disk against the tagged disk of the gas (packing 0.02, mirror rule):
+#: 16 runs per N of 200 mean free times each
+DISKS_PRESETS["disks-kicked-phi0.02-mirror"] = DisksExperiment(
+    name="disks-kicked-phi0.02-mirror", n_disks=N_SWEEP, packing=0.02, rule="mirror", seed=43,
+    n_tagged=16, min_runs=16, kicked_runs=16, kicked_time=200.0,
+    description="The kicked single disk against the tagged disk of N = 2 .. 1000 disks at "
+                "packing 0.02, mirror rule: FTLE, boundary-angle ACF, recurrence.")
+
+
+def _two_disk_reference(rule):
+    from kicktimes.experiment.config import Experiment
+
+    base = DISKS_PRESETS[f"disks-phi0.02-{rule}"]
+    r = base.radius(2)
+    horizon = base.t_max(2)
+    return Experiment(
+        name=f"disks-two-phi0.02-{rule}", radii=[r], n_ics=base.n_tagged,
+        n_steps=int(math.ceil(horizon / 0.5)), tau=0.5, ic_method="uniform", seed=44,
+        rule=rule, systems=("two_particle",), diagnostics=("autocorrelation",),
+        block_size=500,
+        description=f"The two-disk simulator at the radius of N = 2 at packing 0.02 "
+                    f"(r = {r:g}), invariant-measure ICs, {rule} rule, as long as the "
+                    f"disks sweep's N = 2 runs: the reference of its N = 2 row.")
+
+
+#: the two-disk simulator's own sweep at the N = 2 radius of packing 0.02 (an `Experiment`
+#: of one radius, invariant-measure ICs, as many ICs as tagged disks): the N = 2 row of the
+#: disks sweep against the two-disk results
+DISKS_REFERENCES = {f"disks-two-phi0.02-{rule}": _two_disk_reference(rule) for rule in RULES}
+
+
+def disks_preset(name: str) -> DisksExperiment:
+    """The built-in disks experiment ``name``: one of `DISKS_PRESETS`, or of the two-disk
+    references `DISKS_REFERENCES` (`Experiment` objects)."""
+    check_choice("name", name, sorted(DISKS_PRESETS) + sorted(DISKS_REFERENCES))
+    return DISKS_PRESETS.get(name) or DISKS_REFERENCES[name]

@@ -1,0 +1,127 @@
+# ---
+# jupyter:
+#   jupytext:
+#     formats: ipynb,py:percent
+#     text_representation:
+#       extension: .py
+#       format_name: percent
+#       format_version: '1.3'
+#       jupytext_version: 1.19.6
+#   kernelspec:
+#     display_name: Python 3 (ipykernel)
+#     language: python
+#     name: python3
+# ---
+
+# %% [markdown]
+# # From two disks to a gas
+#
+# Two hard disks in a circular table collide at times that are far from Poisson under the
+# paper's mirror rule: the disks' conserved state sets a rate that every collision resets,
+# and a disk returns after a round trip to the wall. In a dilute gas, molecular chaos makes
+# a tagged disk's collisions uncorrelated, yet its rate still depends on its speed
+# (Visco, van Wijland & Trizac 2008). This notebook follows a tagged disk from N = 2 disks
+# to a gas with the N-disk engine (`kicktimes.simulate_disks`):
+#
+# 1. a `DisksExperiment` sweep over N at a fixed packing, under both rules, into a store;
+# 2. the collision frequency against Enskog–Henderson kinetic theory;
+# 3. the Poisson battery on each tagged disk's first K collisions, and the index of
+#    dispersion of their counts;
+# 4. the hazard of the next collision against the time since the last one;
+# 5. under the elastic rule, the speed-conditioned rescaling: how much of the non-Poisson
+#    statistics the speed carries.
+#
+# Every conclusion is printed from the computed table through the verdict rules of
+# `kicktimes.stats`.
+#
+# **Size.** `KICKTIMES_NOTEBOOK_SIZE`: `"small"` (default; CI; N = 2, 10, 100 with 60
+# tagged disks each (at least 4 runs), seconds once the engine is compiled) or `"full"`
+# (the presets of docs/results/disks.md at packing 0.2: N = 2 .. 1000, about 4000 tagged
+# disks per N; a few minutes).
+
+# %%
+import os
+import tempfile
+import time
+
+import matplotlib.pyplot as plt
+import pandas as pd
+from IPython.display import display
+
+from kicktimes.experiment import DISKS_PRESETS, DisksExperiment, run_experiment
+from kicktimes.report.disks import disks_hazard, disks_table
+from kicktimes.report.disks_figures import hazard_figure, rates_figure, rejection_figure
+from kicktimes.stats import format_interval
+
+# %matplotlib inline
+SIZE = os.environ.get("KICKTIMES_NOTEBOOK_SIZE", "small")
+if SIZE not in ("small", "full"):
+    raise ValueError(f"KICKTIMES_NOTEBOOK_SIZE must be 'small' or 'full', got {SIZE!r}")
+t_start = time.perf_counter()
+if SIZE == "small":
+    experiments = [DisksExperiment(name=f"gas-{rule}", n_disks=(2, 10, 100), packing=0.2,
+                                   rule=rule, n_tagged=60, min_runs=4, seed=1)
+                   for rule in ("mirror", "elastic")]
+else:
+    experiments = [DISKS_PRESETS["disks-phi0.2-mirror"], DISKS_PRESETS["disks-phi0.2-elastic"]]
+for exp in experiments:
+    print(exp.summary())
+
+# %% [markdown]
+# ## 1. The sweeps
+#
+# Each N gets independent runs from equilibrated states (`kicktimes.initial_state`); a few
+# disks of each run are tagged and their collision times stored, with, under the elastic
+# rule, the speed of each interval (read from position samples). The store resumes like
+# every kicktimes sweep.
+
+# %%
+folder = tempfile.mkdtemp()
+stores = [run_experiment(exp, os.path.join(folder, exp.name), workers=1, progress=False)
+          for exp in experiments]
+stores[0].collisions.head()
+
+# %% [markdown]
+# ## 2.–5. The table: one row per (rule, N)
+
+# %%
+table = pd.concat([disks_table(st, n_boot=499, n_mc=199) for st in stores], ignore_index=True)
+hazard = pd.concat([disks_hazard(st) for st in stores], ignore_index=True)
+cols = ["rule", "n_disks", "rate_enskog", "rate_enskog_verdict", "reject_uniformity_ks",
+        "reject_uniformity_ks_verdict", "dispersion", "dispersion_verdict", "hazard_first"]
+display(table[cols].round(3))
+
+# %%
+fig = rates_figure(table)
+plt.show()
+
+# %%
+fig = rejection_figure(table)
+plt.show()
+
+# %%
+fig = hazard_figure(hazard, table, n_shown=tuple(n for n in (2, 3, 10, 100, 1000)
+                                                 if n in set(table["n_disks"])))
+plt.show()
+
+# %% [markdown]
+# ## What the numbers say
+
+# %%
+lines = []
+for row in table.itertuples(index=False):
+    r = row._asdict()
+    text = (f"{r['rule']}, N = {r['n_disks']}: rate/Enskog "
+            f"{format_interval(r['rate_enskog'], r['rate_enskog_low'], r['rate_enskog_high'])}"
+            f" ({r['rate_enskog_verdict']}); uniform-times rejections "
+            f"{100 * r['reject_uniformity_ks']:.1f} % [{100 * r['reject_uniformity_ks_low']:.1f},"
+            f" {100 * r['reject_uniformity_ks_high']:.1f}] ({r['reject_uniformity_ks_verdict']});"
+            f" D = {format_interval(r['dispersion'], r['dispersion_low'], r['dispersion_high'])}"
+            f" ({r['dispersion_verdict']})")
+    if r["rule"] == "elastic":
+        d_r = format_interval(r["rescaled_dispersion"], r["rescaled_dispersion_low"],
+                              r["rescaled_dispersion_high"])
+        text += f"; speed-rescaled D = {d_r} ({r['rescaled_dispersion_verdict']})"
+    lines.append(text)
+print("\n".join(lines))
+print(f"\nnotebook computed in {time.perf_counter() - t_start:.1f} s")
