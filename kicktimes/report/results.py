@@ -349,8 +349,9 @@ def write_results(
         "[mechanism.md](mechanism.md); escape through a hole: [escape.md](escape.md); "
         "unequal disks: [unequal.md](unequal.md); scatter kicks: [scatter.md](scatter.md); "
         "MMPP fits to the collision times: [mmpp.md](mmpp.md); all written by "
-        "`python analysis/make_science.py`. Below: per family, the scale, every statement "
-        "under the primary setting, and the figures.", ""]
+        "`python analysis/make_science.py`. From two disks to a gas (N = 2 to 1000 disks): "
+        "[disks.md](disks.md), written by `python analysis/make_disks.py`. Below: per "
+        "family, the scale, every statement under the primary setting, and the figures.", ""]
     lines[head:head] = screen
     path = out / "README.md"
     path.write_text("\n".join(lines), encoding="utf-8")
