@@ -555,9 +555,11 @@ def _stretching_lines(exp, per_radius, fits, trend):
     lines += ["", f"What happens below r = {lo_r:g} is not measured here. "
               "[scatter.md](scatter.md) gives the same quantity (mean FTLE of the scatter-kicked "
               "disk over the mean two-disk FTLE, ratio of means over ICs) at family A's radii "
-              "from another sample: its first 40 paper ICs drawn with seed 1 and its own kick "
-              "draws, against the 100 ICs drawn with seed 11 here; where the two pages' "
-              "intervals differ at a shared radius, that is the difference of the samples.", "",
+              "from another sample: its first 40 paper ICs drawn with seed 1, its own kick "
+              "draws and its sticky orbits (FTLE below a quarter of the radius's median) left "
+              "out, against the 100 ICs drawn with seed 11 here, all kept; where the two "
+              "pages' intervals differ at a shared radius, that is the difference of the "
+              "samples, not of the definition.", "",
               "![stretching](science_stretching.png)", "",
               "**Left:** stretching per perturbation against ln(1/r) (top axis: r), 95 % "
               "intervals over ICs. **Right:** the kicked / two-disk ratio per radius with its "
