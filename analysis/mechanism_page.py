@@ -22,6 +22,7 @@ from pathlib import Path
 
 import pandas as pd
 from generated import MARGIN, header
+from mechanism_figures import NORMALISED_YLIM
 
 from kicktimes.stats import format_interval, ratio_rule, ratio_verdict
 
@@ -144,9 +145,14 @@ def rule_section(tab, figures):
              line("rescaled t > 5", lambda m, r: _hazard_cell(g(m, r, "rescaled_hazard_late"))),
              "", f"![hazard]({figures}/mechanism_hazard.png)", "",
              f"![rescaled hazard]({figures}/mechanism_hazard_normalised.png)", "",
-             "**The hazard** (top, raw time) and **the hazard after removing the rate "
-             "differences** (bottom: green, intervals in units of the run's own mean interval; "
-             "blue, intervals times Γ of the state they start in), 95 % intervals.",
+             "**The hazard** (top, raw time, one y scale over the four panels; open black: "
+             "all runs, red: sticky runs left out; the hyperexponential fit and the mixture "
+             "over post-collision L are smooth laws that miss the data below t ≈ 10, the "
+             "refractory dip and the wall round-trip peak, and follow them only beyond) and "
+             "**the hazard after removing the rate differences** (bottom, the same y range "
+             f"{NORMALISED_YLIM[0]:g}–{NORMALISED_YLIM[1]:g} under both rules: green, "
+             "intervals in units of the run's own mean interval; blue, intervals times Γ of "
+             "the state they start in), 95 % intervals.",
              "", "**Re-collisions** (at most one wall hit of each disk since the previous "
              "collision; sticky runs left out; bootstrap over runs) against randomly placed "
              "events at each run's rate (\"above chance\": the two 95 % intervals are "
