@@ -36,7 +36,7 @@ def steps(paper, work, workers, reuse):
     py = [sys.executable]
     science = [*py, str(HERE / "science.py"), str(Path(paper) / "store-family_a"),
                str(Path(paper) / "store-family_b"), "--out", "docs/results", "--work", work,
-               "--workers", str(workers)] + (["--reuse", "--skip-cost"] if reuse else [])
+               "--workers", str(workers)] + (["--reuse"] if reuse else [])
     return [
         ("science.md", science),
         ("mechanism, mirror", [*py, str(HERE / "mechanism.py"), "--rule", "mirror",

@@ -55,12 +55,17 @@ def _panels(results, fn, title, *, sharey=False, figsize=(10, 7.5)):
     return fig
 
 
-def _hazard_steps(ax, haz, *, scale=1.0, label, color):
+#: one y-range for the rescaled hazard under every rule (mirror and elastic figures alike)
+NORMALISED_YLIM = (1e-3, 10.0)
+
+
+def _hazard_steps(ax, haz, *, scale=1.0, label, color, hollow=False, zorder=2):
     tab = haz.table
     mid = tab["t_mid"].to_numpy()
     ax.errorbar(mid, tab["hazard"] / scale, yerr=[(tab["hazard"] - tab["ci_low"]) / scale,
-                (tab["ci_high"] - tab["hazard"]) / scale], fmt="o", ms=4, color=color,
-                capsize=2, label=label)
+                (tab["ci_high"] - tab["hazard"]) / scale], fmt="o", ms=7 if hollow else 4,
+                color=color, capsize=2, label=label, zorder=zorder,
+                mfc="none" if hollow else color)
 
 
 def _log_log(ax, xlabel, ylabel):
@@ -74,8 +79,9 @@ def _log_log(ax, xlabel, ylabel):
 def fig_hazard(results):
     def draw(ax, key, d):
         haz = d["hazard"]
-        _hazard_steps(ax, haz, label="two disks, all runs (95 % CI)", color="k")
         _hazard_steps(ax, d["hazard_nonsticky"], label="sticky runs left out", color="C3")
+        _hazard_steps(ax, haz, label="two disks, all runs (95 % CI, open)", color="k",
+                      hollow=True, zorder=3)
         ax.axhline(haz.rate, color="grey", ls="--", label="Poisson (flat, same rate)")
         t = np.geomspace(0.1, haz.table["t_high"].iloc[-1], 300)
         if "hyper" in d:
@@ -84,7 +90,7 @@ def fig_hazard(results):
             ax.plot(t, d["mixture"].hazard(t), color="C0", label="mixture over post-collision L")
         _log_log(ax, "time since the last collision (table radii / speed)",
                  "hazard (collisions per unit time)")
-    return _panels(results, draw, "Hazard of the next collision")
+    return _panels(results, draw, "Hazard of the next collision (one y scale)", sharey=True)
 
 
 def fig_hazard_normalised(results):
@@ -97,6 +103,7 @@ def fig_hazard_normalised(results):
         ax.axhline(1.0, color="grey", ls="--", label="Poisson")
         _log_log(ax, "rescaled time since the last collision (dimensionless)",
                  "hazard / mean rate")
+        ax.set_ylim(*NORMALISED_YLIM)
     return _panels(results, draw, "Hazard after removing the rate differences (one y scale)",
                    sharey=True)
 
@@ -179,8 +186,12 @@ def fig_battery(results):
         for ax, (what, _) in zip(axes, panels, strict=True):
             if what == "dispersion_index":
                 vals = [[_dispersion(b["counts"][calm]) for b in d["twins"][n]] for n in twins]
-                obs = _dispersion(d["observed"]["counts"][calm])
-                obs_ci = (math.nan, math.nan)
+                counts = np.asarray(d["observed"]["counts"][calm], float)
+                obs = _dispersion(counts)
+                picks = np.random.default_rng(0).integers(0, counts.size,
+                                                          (1000, counts.size))
+                obs_ci = tuple(np.percentile([_dispersion(counts[p]) for p in picks],
+                                             [2.5, 97.5]))
             else:
                 vals = [[b["reject"][what].mean() for b in d["twins"][n]] for n in twins]
                 obs = d["observed"]["reject"][what].mean()
@@ -192,11 +203,13 @@ def fig_battery(results):
             ax.bar(x, mean, width, yerr=err, capsize=2, label=label)
     for ax, (what, ylabel) in zip(axes, panels, strict=True):
         ax.axhline(1.0 if what == "dispersion_index" else 0.05, color="grey", ls="--", lw=1)
+        if what == "dispersion_index":
+            ax.set_yscale("log")       # the twins reach tens, the observed lie at a few
         ax.set_xticks(np.arange(len(names)), [TWIN_LABELS[n] for n in names], fontsize=7)
         ax.set_ylabel(ylabel, fontsize=9)
     axes[0].legend(fontsize=7)
     fig.suptitle("The Poisson battery on twins of the runs (bars: twins' 95 % range over "
-                 "ensembles; observed: Clopper-Pearson)")
+                 "ensembles; observed: Clopper-Pearson, dispersion: bootstrap over ICs)")
     fig.tight_layout()
     return fig
 

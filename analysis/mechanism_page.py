@@ -22,6 +22,7 @@ from pathlib import Path
 
 import pandas as pd
 from generated import MARGIN, header
+from mechanism_figures import NORMALISED_YLIM
 
 from kicktimes.stats import format_interval, ratio_rule, ratio_verdict
 
@@ -118,7 +119,11 @@ def rule_section(tab, figures):
              "collisions per group: " + ", ".join(
                  f"{int(g(m, r, 'n_collisions')['estimate'])}" for m, r in groups) + ".", "",
              "**Hazard of the next collision** (sticky runs left out; over the group's pooled "
-             "rate, 95 % Garwood intervals; verdicts against 1 by `ratio_verdict`):", "",
+             "rate, 95 % Garwood intervals, which treat every interval as independent and "
+             "leave out the differences between runs; verdicts against 1 by "
+             "`ratio_verdict`. The first row at r = 0.02, paper ICs, is the refractory dip of "
+             "[mmpp.md](mmpp.md): the same ICs, the same `kicktimes.stats.interval_hazard`; "
+             "that page gives a bootstrap interval over runs beside it):", "",
              head, sep,
              line("in [0, 0.5) after a collision",
                   lambda m, r: _hazard_cell(g(m, r, "hazard_nonsticky_first_bin_over_rate"))),
@@ -140,9 +145,14 @@ def rule_section(tab, figures):
              line("rescaled t > 5", lambda m, r: _hazard_cell(g(m, r, "rescaled_hazard_late"))),
              "", f"![hazard]({figures}/mechanism_hazard.png)", "",
              f"![rescaled hazard]({figures}/mechanism_hazard_normalised.png)", "",
-             "**The hazard** (top, raw time) and **the hazard after removing the rate "
-             "differences** (bottom: green, intervals in units of the run's own mean interval; "
-             "blue, intervals times Γ of the state they start in), 95 % intervals.",
+             "**The hazard** (top, raw time, one y scale over the four panels; open black: "
+             "all runs, red: sticky runs left out; the hyperexponential fit and the mixture "
+             "over post-collision L are smooth laws that miss the data below t ≈ 10, the "
+             "refractory dip and the wall round-trip peak, and follow them only beyond) and "
+             "**the hazard after removing the rate differences** (bottom, the same y range "
+             f"{NORMALISED_YLIM[0]:g}–{NORMALISED_YLIM[1]:g} under both rules: green, "
+             "intervals in units of the run's own mean interval; blue, intervals times Γ of "
+             "the state they start in), 95 % intervals.",
              "", "**Re-collisions** (at most one wall hit of each disk since the previous "
              "collision; sticky runs left out; bootstrap over runs) against randomly placed "
              "events at each run's rate (\"above chance\": the two 95 % intervals are "
@@ -188,14 +198,22 @@ def _count(tab, quantity, verdict):
     return f"{k} of {len(groups)}"
 
 
+def _share_sides(rows):
+    """How many explained shares' 95 % intervals lie below 1, contain 1, lie above 1."""
+    below = sum(x["ci_high"] < 1 for x in rows)
+    above = sum(x["ci_low"] > 1 for x in rows)
+    return f"CI below 1 in {below}, containing 1 in {len(rows) - below - above}, above 1 in {above}"
+
+
 def _explained_range(tab, test, model):
     groups = [g for g in _groups_of(tab) if _excess(tab, *g, test)]
-    v = [_get(tab, m, r, f"explained_{test}_by_{model}")["estimate"] for m, r in groups]
-    v = [x for x in v if math.isfinite(x)]
-    if not v:
+    rows = [_get(tab, m, r, f"explained_{test}_by_{model}") for m, r in groups]
+    rows = [x for x in rows if math.isfinite(x["estimate"])]
+    if not rows:
         return "no group with an excess"
+    v = [x["estimate"] for x in rows]
     span = f"{v[0]:.2f}" if len(v) == 1 else f"{min(v):.2f}–{max(v):.2f}"
-    return f"{span} ({len(v)} groups)"
+    return f"{span} ({len(v)} groups; {_share_sides(rows)})"
 
 
 def summary(tabs):
@@ -227,20 +245,24 @@ def summary(tabs):
              "|---|" + "---|" * len(rules)]
     for label, fn in rows:
         lines.append(f"| {label} | " + " | ".join(fn(t) for t in tabs) + " |")
-    return lines + ["", "An explained share above 1 means the twins depart from Poisson more "
-                    "often than the runs do (the model overshoots); below 0, less often than "
-                    "a Poisson process.", ""]
+    return lines + ["", "A share is read as falling short of the excess only where its 95 % "
+                    "interval lies below 1, and as overshooting it (the twins departing from "
+                    "Poisson more often than the runs) only where the interval lies above 1; "
+                    "an interval containing 1 does not tell either. In sample and out of "
+                    "sample are two estimates side by side; neither bounds the other.", ""]
 
 
 def _carry(tab, groups, rule):
     """What carries the non-Poisson statistics under this rule: sentences from the rows."""
     def rng(q, test=None):
-        v = [_get(tab, m, r, q)["estimate"] for m, r in groups
-             if test is None or _excess(tab, m, r, test)]
-        v = [x for x in v if math.isfinite(x)]
+        rows = [_get(tab, m, r, q) for m, r in groups
+                if test is None or _excess(tab, m, r, test)]
+        rows = [x for x in rows if math.isfinite(x["estimate"])]
+        v = [x["estimate"] for x in rows]
         if not v:
             return "n/a (no group with an excess to explain)" if test else "n/a"
-        n = f" ({len(v)} of {len(groups)} groups with an excess)" if test else ""
+        n = (f" ({len(v)} of {len(groups)} groups with an excess; {_share_sides(rows)})"
+             if test else "")
         return (f"{v[0]:.2f}" if len(v) == 1 else f"{min(v):.2f}–{max(v):.2f}") + n
 
     late = [_get(tab, m, r, "rescaled_hazard_late") for m, r in groups]
@@ -256,10 +278,11 @@ def _carry(tab, groups, rule):
             f"{rng('explained_uniformity_ks_by_cox_sequence', 'uniformity_ks')} of the excess "
             "uniformity-KS rejections and "
             f"{rng('explained_exponential_ad_by_cox_sequence', 'exponential_ad')} of the "
-            "excess exponential-AD rejections (an in-sample upper bound); the rate chain "
+            "excess exponential-AD rejections (in sample); the rate chain "
             "fitted on the other half of the ICs reproduces "
             f"{rng('explained_uniformity_ks_by_cox_markov_oos', 'uniformity_ks')} and "
-            f"{rng('explained_exponential_ad_by_cox_markov_oos', 'exponential_ad')}.")
+            f"{rng('explained_exponential_ad_by_cox_markov_oos', 'exponential_ad')} (out "
+            "of sample); each share's interval is in the table above.")
 
 
 def _rel(folder, page):

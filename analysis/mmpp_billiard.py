@@ -52,7 +52,7 @@ N_MC = 199
 
 def simulate(rule, n_ics, r, t_max, seed):
     """Collision times of ``n_ics`` paper ICs under ``rule``; the sticky runs flagged."""
-    ics = initial_conditions(n_ics, r, seed=seed, method="paper")
+    ics = initial_conditions(n_ics, r, seed=seed, method="paper", rule=rule)
     times = [np.asarray(simulate_two_particle(ic, r, t_max=t_max, rule=rule).pp_times, float)
              for ic in ics]
     sticky = np.array([t.size / t_max > STICKY_FACTOR * stats.kinetic_rate(r) for t in times])
@@ -107,7 +107,7 @@ def analyse(rule, times, sticky, t_max, per_run, seed):
                    "n_events": two.n_events, "rate_low": two.rates[0],
                    "rate_high": two.rates[-1], "share_high": two.stationary[-1],
                    "mean_stay_high": two.mean_sojourns[-1],
-                   "mean_stay_low": two.mean_sojourns[0],
+                   "mean_stay_low": two.mean_sojourns[0], "t_max": t_max,
                    "aic_poisson_minus_mmpp": fits[1].aic - two.aic,
                    **{f"aic_{law}_minus_mmpp": aic - two.aic for law, aic in renewal.items()},
                    "n_best_starts": two.n_best, "n_starts": two.n_starts})
@@ -132,12 +132,22 @@ def analyse(rule, times, sticky, t_max, per_run, seed):
         max(complete.max(), censored.max()))])
     first = haz.table.iloc[0]
     model = mmpp_dip(two)
+    boot_rng = np.random.default_rng(seed)
+    boot = []
+    for _ in range(1000):
+        pick = [calm[i] for i in boot_rng.integers(0, len(calm), len(calm))]
+        c, z = _intervals(pick, t_max)
+        h = stats.interval_hazard(c, z, edges=[0.0, DIP, float(max(c.max(), z.max()))])
+        boot.append(h.table["hazard"].iloc[0] / h.rate)
+    b_lo, b_hi = np.percentile(boot, [2.5, 97.5])
     dip.append({"rule": rule, "observed": first["hazard"] / haz.rate,
                 "ci_low": first["ci_low"] / haz.rate, "ci_high": first["ci_high"] / haz.rate,
+                "boot_low": b_lo, "boot_high": b_hi,
                 "mmpp": model, "poisson": 1.0,
-                "verdict": ("below the MMPP's" if first["ci_high"] / haz.rate < model else
-                            "above the MMPP's" if first["ci_low"] / haz.rate > model else
-                            "not distinguished from the MMPP's")})
+                "mean_stay_max": float(max(two.mean_sojourns)), "t_max": t_max,
+                "verdict": ("below the MMPP's" if max(first["ci_high"] / haz.rate, b_hi) < model
+                            else "above the MMPP's" if min(first["ci_low"] / haz.rate, b_lo) > model
+                            else "not distinguished from the MMPP's")})
     return pooled, resid, dip
 
 
@@ -179,6 +189,9 @@ def write_page(pooled, resid, dip, args, seconds):
               "on every window. The Cox twins of the post-collision states, the other model "
               "of the clustering, are on [mechanism.md](mechanism.md).", "",
               "| rule | fit | " + " | ".join(TESTS) + " |", "|---|---|" + "---|" * len(TESTS)]
+    n_w = int(resid["n_windows"].min())
+    k5 = round(0.05 * n_w)
+    cp_lo, cp_hi = clopper_pearson(k5, n_w)
     for (rule, fit, k), g in resid.groupby(["rule", "fit", "states"], sort=False):
         g = g.set_index("test")
         model = "Poisson" if k == 1 else "MMPP-2"
@@ -186,13 +199,41 @@ def write_page(pooled, resid, dip, args, seconds):
         lines.append(f"| {rule} | {label} | " + " | ".join(
             f"{100 * g.loc[t, 'share']:.1f} % [{100 * g.loc[t, 'ci_low']:.1f}, "
             f"{100 * g.loc[t, 'ci_high']:.1f}] {g.loc[t, 'verdict']}" for t in TESTS) + " |")
+    lines += ["", f"No verdict above can be nominal at this number of windows: even exactly "
+              f"{k5} rejections of {n_w} ({100 * k5 / n_w:.1f} %) have the Clopper–Pearson "
+              f"interval [{100 * cp_lo:.2f}, {100 * cp_hi:.2f}] %, which does not lie inside "
+              "[2.5, 7.5] %; the test has no power to confirm the nominal size here, and "
+              "\"inconclusive\" includes fits that hold.", ""]
     lines += ["", f"**The refractory dip**: the hazard of the next collision in [0, {DIP:g}) "
-              "after a collision over the pooled rate, observed (Garwood interval) against the "
-              "fitted MMPP-2's (exact) and a Poisson process's (1) (`mmpp_billiard_dip.csv`):", ""]
+              "after a collision over the pooled rate, observed (Garwood interval, which treats "
+              "every interval as independent, and a 95 % bootstrap interval over runs) against "
+              "the fitted MMPP-2's (exact) and a Poisson process's (1) "
+              "(`mmpp_billiard_dip.csv`). The ICs are those of mechanism.py's paper-IC groups "
+              f"(seed {args.seed}, drawn at r = {args.radius:g} under each rule) and the hazard is "
+              "the same `kicktimes.stats.interval_hazard` of the intervals after a collision, "
+              "sticky runs left out, so at r = 0.02 the observed value is the one on "
+              "[mechanism.md](mechanism.md). Another IC draw of the same size can move the "
+              "dip by more than the Garwood interval (it ignores the differences between "
+              "runs); the bootstrap over runs includes them.", ""]
     for d in dip.itertuples():
         observed = format_interval(d.observed, d.ci_low, d.ci_high, edges=(d.mmpp,))
-        lines.append(f"- {d.rule} rule: observed {observed}, the MMPP's {d.mmpp:.3f}: "
+        burst = (f"the MMPP-2 predicts a hazard above the rate (a burst right after a "
+                 f"collision, {d.mmpp:.3f}) where " if d.mmpp > 1 else
+                 f"the MMPP-2 predicts {d.mmpp:.3f}; ")
+        deficit = ("the data show a deficit (the observed interval lies below 1)"
+                   if max(d.ci_high, d.boot_high) < 1 else
+                   "the observed interval is not below 1")
+        lines.append(f"- {d.rule} rule: observed {observed} (bootstrap over runs "
+                     f"[{d.boot_low:.3f}, {d.boot_high:.3f}]); {burst}{deficit}: "
                      f"{d.verdict}.")
+    for p in pooled.itertuples():
+        if max(p.mean_stay_high, p.mean_stay_low) > p.t_max:
+            lines.append(f"- {p.rule} rule: the longer mean stay in a state "
+                         f"({max(p.mean_stay_high, p.mean_stay_low):.0f}, high / low "
+                         f"{p.mean_stay_high:.0f} / {p.mean_stay_low:.0f}) exceeds t_max = "
+                         f"{p.t_max:g}, so a run mostly stays in one state: the two "
+                         "\"states\" are then differences between runs, not clustering in "
+                         "time.")
     lines += ["", f"Built in {seconds:.0f} s.", ""]
     return lines
 
@@ -203,7 +244,8 @@ def main(argv=None):
     ap.add_argument("--radius", type=float, default=0.02)
     ap.add_argument("--t-max", type=float, default=2000.0)
     ap.add_argument("--per-run", type=int, default=200)
-    ap.add_argument("--seed", type=int, default=41)
+    ap.add_argument("--seed", type=int, default=29,
+                    help="IC seed; 29 draws the paper-IC groups of mechanism.py at r = 0.02")
     ap.add_argument("--out", default="docs/results/mmpp")
     args = ap.parse_args(argv)
     out = Path(args.out)

@@ -269,7 +269,14 @@ def write_page(df, page, command):
               "ICs with 95 % bootstrap intervals over ICs (`scatter_ratios.csv`); verdicts: "
               f"{ratio_rule(0.1)}. Sticky two-disk orbits (exponent below a quarter of the "
               f"radius's median): {int(sticky.sum())} (radius, IC) runs, left out in the "
-              "table; the control with them is in the CSV.", ""]
+              "table; the control with them is in the CSV. The scatter-kick / two-disk "
+              "ratio of [science.md](science.md), section 1, is the same quantity (mean FTLE "
+              "of the kicked disk over the mean two-disk FTLE, ratio of means over ICs) on "
+              "another sample: 100 paper ICs drawn with seed 11 (the FTLE sweep "
+              "`stretching_small_r`), its own kick draws, all ICs kept; here the first "
+              f"{df['ic'].nunique()} paper ICs drawn with seed 1, sticky orbits left out. At a "
+              "radius both pages measure, their intervals differ by the sample and the "
+              "sticky orbits, not by the definition.", ""]
     main = tab[tab["ics"] == "without sticky ICs"]
     labels = [label for _, _, label in RATIOS]
     lines += ["| r | " + " | ".join(labels) + " |", "|---|" + "---|" * len(labels)]

@@ -161,3 +161,72 @@ def test_one_command_rebuilds_every_generated_science_page():
         assert Path(argv[1]).is_file(), argv[1]
     readme = (RESULTS.parents[1] / "README.md").read_text(encoding="utf-8")
     assert "python analysis/make_science.py" in readme
+
+
+def test_the_science_page_claims_a_direction_only_where_both_trend_measures_agree():
+    text = _page("science.md")
+    trend = pd.read_csv(RESULTS / "science_stretching_trend.csv").set_index(["system",
+                                                                            "quantity"])
+    assert "holds in direction" not in text and "Named: *radial orbits*" not in text
+    assert "## 6. Cost" not in text
+    bullets = text.split("The paper's expectation")[1].split("What happens below")[0]
+    for system, name in (("poisson", "uniform kick"), ("poisson_scatter", "scatter kick")):
+        line = next(x for x in bullets.splitlines() if x.startswith(f"- {name}:"))
+        ratio, dist = (trend.loc[(system, q), "verdict"] for q in ("ratio", "abs_log_ratio"))
+        if "no trend detected" in (ratio, dist) and ratio != dist:
+            assert "no direction is claimed" in line
+        else:
+            assert "no direction is claimed" not in line
+
+
+def test_the_science_page_puts_the_twin_estimate_beside_its_measurement():
+    text = _page("science.md")
+    twins = pd.read_csv(RESULTS / "science_independent_twins.csv")
+    for row in twins.itertuples():
+        want = format_interval(row.over_predicted, row.over_predicted_ci_low,
+                               row.over_predicted_ci_high)
+        line = next(x for x in text.splitlines() if x.startswith(f"- r = {row.radius:g}:"))
+        assert f"measured / predicted {want}, " + ratio_verdict(
+            row.over_predicted_ci_low, row.over_predicted_ci_high) in line
+
+
+def test_the_mmpp_page_s_dip_is_the_mechanism_page_s_at_the_same_ics():
+    dip = pd.read_csv(RESULTS / "mmpp" / "mmpp_billiard_dip.csv").set_index("rule")
+    mech = pd.read_csv(RESULTS / "mechanism" / "mechanism_numbers.csv")
+    row = mech[(mech["method"] == "paper") & (mech["radius"] == 0.02)
+               & (mech["quantity"] == "hazard_nonsticky_first_bin_over_rate")].iloc[0]
+    assert abs(dip.loc["mirror", "observed"] - row["estimate"]) < 1e-4 * row["estimate"]
+    text = _page("mmpp.md")
+    assert "No verdict above can be nominal" in text
+
+
+def test_the_mechanism_page_reads_no_share_as_a_bound_or_an_overshoot_inside_noise():
+    text = _page("mechanism.md")
+    assert "upper bound" not in text and "(the model overshoots)" not in text
+    assert "an interval containing 1 does not tell either" in text
+
+
+def test_the_escape_page_sets_every_rate_beside_the_hole_s_ergodic_rate():
+    import math
+
+    text = _page("escape.md")
+    tails = pd.read_csv(RESULTS / "escape" / "escape_tails.csv").set_index(["radius", "system"])
+    block = text.split("**The hole alone.**")[1].split("**Ratio of escape rates")[0]
+    for r in (0.005, 0.01, 0.02, 0.03):
+        erg = 0.1 / (math.pi ** 2 * (1 - r))          # 2h / (pi^2 (1 - r)), h = 0.05
+        cells = _cells(block, f"{r:g}")
+        assert cells[1] == f"{erg:.5f}"
+        row = tails.loc[(r, "poisson")]
+        lo, hi = row["rate_boot_low"] / erg, row["rate_boot_high"] / erg
+        assert cells[4] == f"{format_interval(row['rate'] / erg, lo, hi)}, {ratio_verdict(lo, hi)}"
+
+
+def test_the_unequal_page_names_the_ftle_and_gives_ks_and_dispersion_intervals():
+    text = _page("unequal.md")
+    assert "finite-time Lyapunov exponent" in text
+    table = pd.read_csv(RESULTS / "size_ratio" / "size_ratio.csv")
+    for row in table.itertuples():
+        cells = _cells(text, f"{row.size_ratio:g}")
+        assert re.fullmatch(r"[\d.]+ % \[[\d.]+, [\d.]+\]", cells[2])
+        assert cells[3] == format_interval(row.dispersion_index, row.disp_low, row.disp_high,
+                                           edges=(1.0,))
