@@ -336,8 +336,10 @@ def effects(ctx):
                              under="on Poisson twins",
                              what=f"fits with >= {MIN_EVENTS} collisions")
     verdict = {
-        "above": "the MMPP-2 is AIC-best more often than on Poisson times: the collisions "
-                 "cluster beyond what a renewal model describes",
+        "above": "the MMPP-2 is AIC-best more often than on Poisson times: the intervals are "
+                 "not independent, and an MMPP-2 fits them better by AIC than any renewal "
+                 "model (though no MMPP can make the refractory dip after a collision: "
+                 "mmpp.md)",
         "below": "the MMPP-2 is AIC-best less often than on Poisson times",
         "inconclusive": "as often as on Poisson times: no evidence for clustering from AIC",
     }[share.pop("verdict")]
