@@ -296,7 +296,7 @@ def main(argv=None):
     ap.add_argument("--out", default="docs/results/mechanism.md")
     args = ap.parse_args(argv)
     tabs = [load(f) for f in args.folders]
-    lines = header("Why the collisions cluster: the mechanism, computed", COMMAND,
+    lines = header("Why the collision times are not Poisson: the mechanism, computed", COMMAND,
                    [f"the direct simulations of `analysis/mechanism.py` under the "
                     f"{t['rule'].iloc[0]} rule ([table]({_rel(f, args.out)}/mechanism_numbers.csv))"
                     for t, f in zip(tabs, args.folders, strict=True)])
