@@ -310,9 +310,11 @@ KICKED_SYSTEMS = ("poisson", "actual")
 def kicked_table(store, *, n_boot=999, seed=0) -> pd.DataFrame:
     """The kicked single disk against the gas (`DisksExperiment.kicked_runs`): one row per
     (N, kicked system, diagnostic), the ratio kicked / gas of the means over runs with a
-    percentile bootstrap clustered on runs and its `kicktimes.stats.ratio_verdict`; the
+    percentile bootstrap clustered on runs and its `kicktimes.stats.ratio_verdict`, the
+    means of both (``value``, ``reference``) with the same bootstrap's intervals; the
     gas's FTLE over its disk's collision rate (system ``"gas/gas"``, diagnostic
-    ``"ftle/rate"``: the exponent per collision); at N = 2 also the gas's FTLE (twin,
+    ``"ftle/rate"``: the exponent per collision) and the kicked disks' FTLE over the same rate
+    (``"poisson/gas"``, ``"actual/gas"``, ``"ftle/rate"``); at N = 2 also the gas's FTLE (twin,
     `disks_lyapunov`) over the two-disk FTLE of the same states (tangent,
     `kicktimes.diagnostics.lyapunov`), system ``"gas/two_particle"``.
     Empty when the store has no kicked rows."""
@@ -327,6 +329,8 @@ def kicked_table(store, *, n_boot=999, seed=0) -> pd.DataFrame:
         # (system, diagnostic, reference system, reference diagnostic)
         pairs = [(s, d, "gas", d) for s in KICKED_SYSTEMS for d in KICKED_DIAGNOSTICS]
         pairs.append(("gas", "ftle", "gas", "rate"))  # lambda / nu: per collision of a disk
+        # the kicked disks' own exponents per collision of the gas's disk (their kick rate)
+        pairs += [(s, "ftle", "gas", "rate") for s in KICKED_SYSTEMS]
         if ("two_particle", "ftle") in wide:
             pairs.append(("gas", "ftle", "two_particle", "ftle"))
         for system, diag, ref, ref_diag in pairs:
@@ -338,11 +342,14 @@ def kicked_table(store, *, n_boot=999, seed=0) -> pd.DataFrame:
                 ratio = num[ok].mean() / den[ok].mean() if ok.any() else math.nan
             lo, hi = _ci(boot)
             ref_lo, ref_hi = _ci(w @ den[ok] / w.sum(axis=1))
+            val_lo, val_hi = _ci(w @ num[ok] / w.sum(axis=1))
             rows.append({"experiment": store.experiment.name, "n_disks": int(n),
                          "system": f"{system}/{ref}",
                          "diagnostic": diag if ref_diag == diag else f"{diag}/{ref_diag}",
                          "reference": float(np.mean(den[ok])) if ok.any() else math.nan,
                          "reference_low": ref_lo, "reference_high": ref_hi,
+                         "value": float(np.mean(num[ok])) if ok.any() else math.nan,
+                         "value_low": val_lo, "value_high": val_hi,
                          "ratio": ratio, "ratio_low": lo, "ratio_high": hi,
                          "verdict": ratio_verdict(lo, hi), "n_runs": int(ok.sum())})
     return pd.DataFrame(rows)
