@@ -339,3 +339,18 @@ def test_the_poisson_answer_uses_d_and_the_hazard_not_only_the_share():
     assert (tot["d"], tot["h"], tot["s"], tot["sn"], tot["rows"]) == (2, 2, 2, 2, 2)
     lines, tot = _answers(rows(0.95, 0.4))
     assert "neither D's interval nor the hazard's flatness excludes Poisson" in lines[0]
+
+
+def test_the_hazard_bootstrap_over_runs_reproduces_the_pooled_hazard_with_unit_weights(reference):
+    from kicktimes.report.disks import HAZARD_EDGES, _hazard_replicates, _Sequences
+
+    col = reference.collisions[reference.collisions["n_disks"] == 5]
+    seqs = _Sequences(col, TINY.collisions, 1e9, rescale=False)
+    runs = np.unique(seqs.run)
+    iv = np.concatenate([np.diff(np.append(t, w)) for t, w in zip(seqs.times, seqs.windows,
+                                                                  strict=True)])
+    scale = 1.0 / iv.mean()
+    haz = kt.stats.interval_hazard(iv * scale, edges=HAZARD_EDGES)
+    one = _hazard_replicates(seqs, runs, np.ones((1, runs.size)), scale)[0]
+    ok = haz.table["exposure"].to_numpy() > 0
+    np.testing.assert_allclose(one[ok], (haz.table["hazard"] / haz.rate).to_numpy()[ok])

@@ -552,12 +552,12 @@ def write_disks_page(store_paths, out_dir, *, command="python analysis/make_disk
         "disk here): " + rejection_rule(ALPHA)
         + ". Ratios and D (`stats.ratio_verdict`): " + ratio_rule(0.1).split(". Robust")[0]
         + ". 95 % intervals: percentile bootstrap clustered on runs (999 replicates; for a "
-        "share, the wider of that and Clopper–Pearson) for the shares, D, the rates and the "
-        "speed share; the hazard's bins (first bin, highest later bin, the figure's bands) "
-        "are Garwood intervals on the pooled intervals of all tagged disks, taken as "
-        "independent: they ignore the correlation between the intervals of one disk and of "
-        "the disks of one run, so they are narrower than a bootstrap over runs would be, "
-        "and so is the hazard flatness test's p-value too small by an unknown factor; the gamma "
+        "share, the wider of that and Clopper–Pearson) for the shares, D, the rates, the "
+        "speed share and the hazard's first and highest later bins (disks.csv); the hazard "
+        "figure's bands and disks_hazard.csv are Garwood intervals on the pooled intervals "
+        "of all tagged disks, taken as independent: they ignore the correlation between the "
+        "intervals of one disk and of the disks of one run, and so does the hazard "
+        "flatness test, whose p-value may be too small by an unknown factor; the gamma "
         "shape's interval (disks.csv) is ±1.96 standard errors of its maximum-likelihood fit "
         "on the pooled intervals, taken as independent in the same way, and a gamma shape "
         "called within 10 % may still exclude 1.", "",
