@@ -262,6 +262,11 @@ def test_the_kicked_comparison_gives_ratios_with_verdicts(tmp_path):
     # of the direction; the gas's exponent is the whole gas's)
     assert (ftle["ratio"] < 1.0).all() and ftle["verdict"].isin(
         ["lower", "inconclusive"]).all()
+    # the kicked disk's own FTLE, with its interval, and per collision beside the gas's
+    assert (ftle["value_low"] <= ftle["value"]).all()
+    assert (ftle["value"] <= ftle["value_high"]).all()
+    per = tab[tab["diagnostic"] == "ftle/rate"]
+    assert {"gas/gas", "poisson/gas", "actual/gas"} <= set(per["system"])
 
 
 def test_the_n2_row_is_checked_against_the_two_disk_simulator(reference, tmp_path):
@@ -281,3 +286,71 @@ def test_the_n2_row_is_checked_against_the_two_disk_simulator(reference, tmp_pat
     with pytest.raises(ValueError, match="two_store"):
         two_disk_check(dataclasses.replace(reference, experiment=dataclasses.replace(
             TINY, packing=0.2)), two)
+
+
+def _row(**kw):
+    return pd.Series(kw)
+
+
+@pytest.mark.parametrize(("low", "high", "reading"), [
+    (-0.2, 0.1, "no share detected"), (0.6, 1.2, "consistent with all"),
+    (-0.7, -0.04, "negative"), (-5.0, 8.0, "undetermined"), (0.2, 0.4, "part of it")])
+def test_each_speed_share_is_given_its_reading(low, high, reading):
+    from kicktimes.report.disks_page import _share
+
+    text = _share(_row(speed_share=(low + high) / 2, speed_share_low=low,
+                       speed_share_high=high))
+    assert text.endswith(reading) or reading in text
+
+
+def test_no_kicked_ftle_ratio_where_the_kicked_disk_is_not_chaotic_or_the_gas_near_zero():
+    from kicktimes.report.disks_page import _kicked_cell
+
+    base = dict(reference=1.0, reference_low=0.9, reference_high=1.1, ratio=-0.01,
+                ratio_low=-0.02, ratio_high=-0.005, verdict="lower", value=-0.01,
+                value_low=-0.02, value_high=-0.005)
+    assert _kicked_cell(_row(**base), "ftle") == "— (kicked FTLE ≤ 0)"
+    near = dict(base, reference=-0.1, reference_low=-0.19, reference_high=-0.01,
+                ratio=-0.07, ratio_low=-1.45, ratio_high=1.91)
+    assert _kicked_cell(_row(**near), "acf@1").startswith("— (gas near 0")
+    fine = dict(base, ratio=0.5, ratio_low=0.4, ratio_high=0.6, value=0.5, value_low=0.4,
+                value_high=0.6)
+    assert _kicked_cell(_row(**fine), "ftle") == "0.500 [0.400, 0.600] lower"
+
+
+def test_the_poisson_answer_uses_d_and_the_hazard_not_only_the_share():
+    from kicktimes.report.disks_page import _answers
+
+    def rows(d_low, p):
+        out = []
+        for n, (dl, pv) in zip((2, 30, 1000), ((5.0, 0.0), (d_low, p), (d_low, p)),
+                               strict=True):
+            r = {"geometry": "g", "rule": "mirror", "n_disks": n, "hazard_flat_pvalue": pv,
+                 "dispersion": dl + 0.05, "dispersion_low": dl, "dispersion_high": dl + 0.1,
+                 "dispersion_verdict": "inconclusive"}
+            for key in ("reject_uniformity_ks", "reject_exponential_ad"):
+                r.update({key: 0.06, f"{key}_low": 0.055, f"{key}_high": 0.066,
+                          f"{key}_verdict": "nominal"})
+            out.append(r)
+        return pd.DataFrame(out)
+
+    lines, tot = _answers(rows(1.03, 1e-9))
+    assert "still not Poisson at N = 1000 by D and the hazard" in lines[0]
+    assert (tot["d"], tot["h"], tot["s"], tot["sn"], tot["rows"]) == (2, 2, 2, 2, 2)
+    lines, tot = _answers(rows(0.95, 0.4))
+    assert "neither D's interval nor the hazard's flatness excludes Poisson" in lines[0]
+
+
+def test_the_hazard_bootstrap_over_runs_reproduces_the_pooled_hazard_with_unit_weights(reference):
+    from kicktimes.report.disks import HAZARD_EDGES, _hazard_replicates, _Sequences
+
+    col = reference.collisions[reference.collisions["n_disks"] == 5]
+    seqs = _Sequences(col, TINY.collisions, 1e9, rescale=False)
+    runs = np.unique(seqs.run)
+    iv = np.concatenate([np.diff(np.append(t, w)) for t, w in zip(seqs.times, seqs.windows,
+                                                                  strict=True)])
+    scale = 1.0 / iv.mean()
+    haz = kt.stats.interval_hazard(iv * scale, edges=HAZARD_EDGES)
+    one = _hazard_replicates(seqs, runs, np.ones((1, runs.size)), scale)[0]
+    ok = haz.table["exposure"].to_numpy() > 0
+    np.testing.assert_allclose(one[ok], (haz.table["hazard"] / haz.rate).to_numpy()[ok])

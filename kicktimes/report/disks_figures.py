@@ -9,6 +9,7 @@ against N), from `kicktimes.report.disks.disks_table` and `disks_hazard`.
 from __future__ import annotations
 
 import numpy as np
+from matplotlib.ticker import FuncFormatter
 
 from kicktimes.report.disks import HAZARD_EDGES
 from kicktimes.report.figures import plain_log_ticks
@@ -22,6 +23,8 @@ TEST_NAMES = {"uniformity_ks": "uniform times (KS)", "exponential_ad": "exponent
 SHOWN_N = (2, 3, 10, 100, 1000)
 #: where the hazard figure's log time axis starts (its first bin is [0, 0.01))
 X_MIN = 0.003
+#: the hazard figure's zoomed rows show these N and more
+ZOOM_MIN_N = 10
 
 
 def geometries_of(table):
@@ -29,85 +32,55 @@ def geometries_of(table):
     return list(dict.fromkeys(table["geometry"]))
 
 
+def _n_ticks(ax, ns):
+    ax.set_xscale("log")
+    ax.set_xticks(list(ns))
+    ax.set_xticks([], minor=True)
+    ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+
+
 def rejection_figure(table, tests=(HEADLINE, "exponential_ad")):
     """The share of tagged disks whose first K collision times reject each test at
-    alpha = 0.05, against N: one column per geometry, one row per test; mirror, elastic and
-    elastic after the speed rescaling; 95 % CIs; the nominal band shaded."""
+    alpha = 0.05, against N: one column per geometry, one row per test, log y axis (the
+    nominal band stays readable next to the N = 2 shares); mirror, elastic and elastic after
+    the speed rescaling, dodged and with different markers; 95 % CIs; the nominal band
+    shaded."""
     import matplotlib.pyplot as plt
 
     geos = geometries_of(table)
-    fig, axes = plt.subplots(len(tests), len(geos), figsize=(4.2 * len(geos), 3.3 * len(tests)),
+    ns = sorted(set(table["n_disks"]))
+    fig, axes = plt.subplots(len(tests), len(geos), figsize=(4.4 * len(geos), 3.6 * len(tests)),
                              sharex=True, sharey=True, squeeze=False)
-    styles = (("mirror", "", "mirror", "C0", "o"), ("elastic", "", "elastic", "C3", "s"),
-              ("elastic", "rescaled_", "elastic, speed-rescaled", "C2", "^"))
+    styles = (("mirror", "", "mirror", "C0", "o", "C0"),
+              ("elastic", "", "elastic", "C3", "s", "C3"),
+              ("elastic", "rescaled_", "elastic, speed-rescaled", "C2", "^", "none"))
     for i, test in enumerate(tests):
         for j, geo in enumerate(geos):
             ax = axes[i, j]
             ax.axhspan(100 * ALPHA * 0.5, 100 * ALPHA * 1.5, color="0.88", zorder=0)
             ax.axhline(100 * ALPHA, color="0.5", lw=0.8, zorder=0)
-            for k, (rule, prefix, label, color, marker) in enumerate(styles):
+            for k, (rule, prefix, label, color, marker, face) in enumerate(styles):
                 d = table[(table["geometry"] == geo) & (table["rule"] == rule)]
                 key = f"{prefix}reject_{test}"
                 if d.empty or key not in d:
                     continue
-                x = d["n_disks"].to_numpy() * (1.0 + 0.06 * (k - 1))
+                x = d["n_disks"].to_numpy() * (1.0 + 0.12 * (k - 1))
                 y = 100 * d[key].to_numpy()
                 err = np.abs(100 * d[[f"{key}_low", f"{key}_high"]].to_numpy().T - y)
-                ax.errorbar(x, y, yerr=err, color=color, marker=marker, ms=4, lw=1,
-                            capsize=2, label=label)
-            ax.set_xscale("log")
+                ax.errorbar(x, y, yerr=err, color=color, marker=marker, ms=4.5, lw=1,
+                            capsize=2, label=label, mfc=face)
+            _n_ticks(ax, ns)
+            ax.set_yscale("log")
+            ax.set_ylim(0.5, 100)
+            ax.set_yticks([1, 2.5, 5, 7.5, 10, 20, 50, 100])
+            ax.set_yticks([], minor=True)
+            ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
             ax.set_title(f"{geo}: {TEST_NAMES.get(test, test)}", fontsize=9)
             if i == len(tests) - 1:
                 ax.set_xlabel("number of disks N")
+                ax.tick_params(axis="x", labelsize=7)
             if j == 0:
-                ax.set_ylabel("tagged disks rejected (%)")
-    axes[0, 0].legend(fontsize=8, loc="upper right")
-    fig.tight_layout()
-    return fig
-
-
-def hazard_figure(hazard, table, n_shown=SHOWN_N):
-    """The hazard of the tagged disk's next collision against the time since its last one,
-    both in units of the mean interval, over the constant rate (1 for Poisson): one panel
-    per (rule, geometry), one line per N, 95 % bands; one log y scale for all panels."""
-    import matplotlib.pyplot as plt
-
-    geos = geometries_of(table)
-    rules = ("mirror", "elastic")
-    exp_of = table.drop_duplicates(["rule", "geometry"]).set_index(["rule", "geometry"])
-    fig, axes = plt.subplots(len(rules), len(geos), figsize=(4.2 * len(geos), 6.4),
-                             sharex=True, sharey=True, squeeze=False)
-    colors = {n: f"C{(3, 1, 2, 0, 4, 5, 6, 7, 8, 9)[k % 10]}" for k, n in enumerate(n_shown)}
-    for i, rule in enumerate(rules):
-        for j, geo in enumerate(geos):
-            ax = axes[i, j]
-            ax.axhline(1.0, color="0.5", lw=0.8)
-            if (rule, geo) not in exp_of.index:
-                continue
-            name = exp_of.loc[(rule, geo), "experiment"]
-            for n in n_shown:
-                d = hazard[(hazard["experiment"] == name) & (hazard["n_disks"] == n)]
-                if d.empty:
-                    continue
-                # log time axis: the first bin, [0, 0.01), is drawn from X_MIN
-                x = np.r_[np.maximum(d["t_low"].to_numpy(), X_MIN), d["t_high"].to_numpy()[-1]]
-                y = np.r_[d["hazard"].to_numpy(), d["hazard"].to_numpy()[-1]]
-                ax.step(x, y, where="post", color=colors[n], lw=1.2, label=f"N = {n}")
-                ax.fill_between(x, np.r_[d["ci_low"], d["ci_low"].iloc[-1]],
-                                np.r_[d["ci_high"], d["ci_high"].iloc[-1]], step="post",
-                                color=colors[n], alpha=0.15, lw=0)
-            ax.set_yscale("log")
-            ax.set_xscale("log")
-            ax.set_ylim(0.05, 20)
-            ax.set_xlim(X_MIN, HAZARD_EDGES[-1])
-            plain_log_ticks(ax.xaxis)
-            plain_log_ticks(ax.yaxis)
-            ax.set_title(f"{rule}, {geo}", fontsize=9)
-            if i == len(rules) - 1:
-                ax.set_xlabel("time since the last collision / mean interval")
-            if j == 0:
-                ax.set_ylabel("hazard / constant rate")
-    # one legend above the panels: inside, it would hide a curve in some panel
+                ax.set_ylabel("tagged disks rejected (%, log)")
     handles, labels = axes[0, 0].get_legend_handles_labels()
     fig.legend(handles, labels, loc="upper center", ncol=len(labels), fontsize=9,
                frameon=False)
@@ -115,33 +88,115 @@ def hazard_figure(hazard, table, n_shown=SHOWN_N):
     return fig
 
 
-def rates_figure(table):
-    """Against N: the collision frequency over Enskog's, the index of dispersion of the
-    tagged disks' counts in K mean intervals, and the hazard of a collision within 0.01
-    mean intervals of the last over the constant rate (the refractory dip); 95 % CIs,
-    the ±10 % band shaded, one line per (geometry, rule)."""
+def hazard_figure(hazard, table, n_shown=SHOWN_N):
+    """The hazard of the tagged disk's next collision against the time since its last one,
+    both in units of the mean interval, over the constant rate (1 for Poisson): per rule a
+    row over the whole range (log y) and a row zoomed near 1 for N >= ZOOM_MIN_N (linear y,
+    ±10 % shaded); one
+    column per geometry, one line per N (distinct colours and markers at the bins'
+    middles), 95 % bands."""
     import matplotlib.pyplot as plt
 
-    panels = (("rate_enskog", "collision frequency / Enskog"),
-              ("dispersion", "index of dispersion D"),
-              ("hazard_first", "hazard in [0, 0.01) mean intervals / rate"))
-    fig, axes = plt.subplots(1, len(panels), figsize=(14, 3.8), squeeze=False)
-    for ax, (key, label) in zip(axes[0], panels, strict=True):
+    geos = geometries_of(table)
+    rules = ("mirror", "elastic")
+    exp_of = table.drop_duplicates(["rule", "geometry"]).set_index(["rule", "geometry"])
+    fig, axes = plt.subplots(2 * len(rules), len(geos), figsize=(4.4 * len(geos), 11.5),
+                             sharex=True, squeeze=False)
+    palette = ("C3", "C1", "C2", "C0", "k", "C4", "C5", "C6", "C7", "C8")
+    marks = ("o", "s", "^", "D", "v", "P", "X", "<", ">", "*")
+    colors = {n: palette[k % 10] for k, n in enumerate(n_shown)}
+    markers = {n: marks[k % 10] for k, n in enumerate(n_shown)}
+    for i, rule in enumerate(rules):
+        for zoom in (False, True):
+            for j, geo in enumerate(geos):
+                ax = axes[2 * i + zoom, j]
+                if zoom:
+                    ax.axhspan(0.9, 1.1, color="0.9", zorder=0)
+                ax.axhline(1.0, color="0.5", lw=0.8)
+                if (rule, geo) not in exp_of.index:
+                    continue
+                name = exp_of.loc[(rule, geo), "experiment"]
+                for n in n_shown:
+                    d = hazard[(hazard["experiment"] == name) & (hazard["n_disks"] == n)]
+                    if d.empty or (zoom and n < ZOOM_MIN_N):
+                        continue
+                    # log time axis: the first bin, [0, 0.01), is drawn from X_MIN
+                    lo_t = np.maximum(d["t_low"].to_numpy(), X_MIN)
+                    x = np.r_[lo_t, d["t_high"].to_numpy()[-1]]
+                    y = np.r_[d["hazard"].to_numpy(), d["hazard"].to_numpy()[-1]]
+                    ax.step(x, y, where="post", color=colors[n], lw=1.1)
+                    ax.plot(np.sqrt(lo_t * d["t_high"].to_numpy()), d["hazard"], ls="none",
+                            marker=markers[n], ms=3.5, color=colors[n], label=f"N = {n}")
+                    ax.fill_between(x, np.r_[d["ci_low"], d["ci_low"].iloc[-1]],
+                                    np.r_[d["ci_high"], d["ci_high"].iloc[-1]], step="post",
+                                    color=colors[n], alpha=0.15, lw=0)
+                ax.set_xscale("log")
+                ax.set_xlim(X_MIN, HAZARD_EDGES[-1])
+                plain_log_ticks(ax.xaxis)
+                if zoom:
+                    ax.set_ylim(0.75, 1.3)
+                    ax.set_title(f"{rule}, {geo}: N ≥ {ZOOM_MIN_N}, zoomed near 1", fontsize=9)
+                else:
+                    ax.set_yscale("log")
+                    ax.set_ylim(0.05, 20)
+                    plain_log_ticks(ax.yaxis)
+                    ax.set_title(f"{rule}, {geo}", fontsize=9)
+                if 2 * i + zoom == 2 * len(rules) - 1:
+                    ax.set_xlabel("time since the last collision / mean interval")
+                if j == 0:
+                    ax.set_ylabel("hazard / constant rate")
+    handles, labels = axes[0, 0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="upper center", ncol=len(labels), fontsize=9,
+               frameon=False)
+    fig.tight_layout(rect=(0, 0, 1, 0.965))
+    return fig
+
+
+def rates_figure(table):
+    """Against N: the collision frequency over Enskog's (at N = 2 also over the two-disk
+    kinetic rate, stars: Enskog is not the reference for two disks), the index of
+    dispersion of the tagged disks' counts in K mean intervals (log y), and the hazard of a
+    collision within 0.01 mean intervals of the last over the constant rate (the refractory
+    dip); 95 % CIs, the ±10 % band shaded, one line per (geometry, rule), panel titles, one
+    legend below the panels."""
+    import matplotlib.pyplot as plt
+
+    panels = (("rate_enskog", "collision frequency / Enskog", "collision rate / Enskog",
+               False),
+              ("dispersion", "index of dispersion D (log)", "index of dispersion", True),
+              ("hazard_first", "hazard in [0, 0.01) mean intervals / rate",
+               "refractory dip: first hazard bin", False))
+    ns = sorted(set(table["n_disks"]))
+    fig, axes = plt.subplots(1, len(panels), figsize=(14, 4.6), squeeze=False)
+    for ax, (key, label, title, log) in zip(axes[0], panels, strict=True):
         ax.axhspan(0.9, 1.1, color="0.88", zorder=0)
         ax.axhline(1.0, color="0.5", lw=0.8, zorder=0)
         for k, ((_, geo, rule), d) in enumerate(table.groupby(
                 ["experiment", "geometry", "rule"], sort=False)):
-            x = d["n_disks"].to_numpy() * (1.0 + 0.04 * (k - 2.5))
+            shift = 1.0 + 0.04 * (k - 2.5)
+            x = d["n_disks"].to_numpy() * shift
             y = d[key].to_numpy()
             err = np.abs(d[[f"{key}_low", f"{key}_high"]].to_numpy().T - y)
             ax.errorbar(x, y, yerr=err, marker="os"[rule == "elastic"], ms=3.5, lw=1,
                         capsize=2, color=f"C{k // 2}", ls="-" if rule == "mirror" else "--",
                         label=f"{geo}, {rule}")
-        ax.set_xscale("log")
-        ax.set_yscale("log")
-        plain_log_ticks(ax.yaxis)
+            if key == "rate_enskog" and "rate_two_disk" in d:
+                two = d[(d["n_disks"] == 2) & d["rate_two_disk"].notna()]
+                if not two.empty:
+                    ax.plot(two["n_disks"] * shift, two["rate_two_disk"], ls="none",
+                            marker="*", ms=8, color=f"C{k // 2}",
+                            label="N = 2 over the two-disk rate Γ(r)" if k == 0 else None)
+        _n_ticks(ax, ns)
+        ax.tick_params(axis="x", labelsize=7)
+        if log:
+            ax.set_yscale("log")
+            ax.set_yticks([0.8, 1, 1.5, 2, 3, 5, 8])
+            ax.set_yticks([], minor=True)
+            ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+        ax.set_title(title, fontsize=10)
         ax.set_xlabel("number of disks N")
         ax.set_ylabel(label)
-    axes[0, 0].legend(fontsize=7, ncol=1)
-    fig.tight_layout()
+    handles, labels = axes[0, 0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="lower center", ncol=4, fontsize=8, frameon=False)
+    fig.tight_layout(rect=(0, 0.1, 1, 1))
     return fig
