@@ -19,8 +19,7 @@ MACHINE_PATH = re.compile(r"(/tmp/|/work/|/home/|/Users/|/root/|[A-Za-z]:\\\\)")
 
 def _page(name):
     path = RESULTS / name
-    if not path.is_file():
-        pytest.skip(f"{name} is not generated yet")
+    assert path.is_file(), f"{name} is missing: rebuild it with analysis/make_science.py"
     return path.read_text(encoding="utf-8")
 
 
@@ -97,8 +96,8 @@ def test_the_scatter_page_is_its_csv_and_no_longer_decomposes_the_gap():
 
 def _numbers(folder):
     path = RESULTS / "mechanism" / folder / "mechanism_numbers.csv"
-    if not path.is_file():
-        pytest.skip(f"{path.name} of {folder or 'mirror'} is not generated yet")
+    assert path.is_file(), (f"{path.name} of {folder or 'mirror'} is missing: rebuild it with "
+                            "analysis/mechanism.py")
     return pd.read_csv(path)
 
 
