@@ -22,7 +22,7 @@ Writes ``OUT/disks_ftle_check.csv`` (columns ``check, n_disks, rule, packing, n_
 estimate, lo, hi, margin, verdict``) and ``OUT/disks_ftle_check_runs.csv`` (every state's
 two exponents).
 
-Run: python analysis/disks_ftle_check.py --out docs/results [--ics 24] [--workers 1]
+Run: python analysis/disks_ftle_check.py --out docs/results [--ics 32] [--workers 1]
      [--scale 1.0] [--max-disks 1000]
 """
 
@@ -43,8 +43,8 @@ MARGINS = {"tangent/twin": 0.02, "engine/two-disk": 0.05}
 # per N: (t_max, segment) at scale 1; the twin's segment keeps d0 e^(lambda segment) far
 # below r (lambda segment about 2-3) and the collisions per segment few enough that a
 # grazing one missed by the twin is rare
-TWIN_RUNS = {2: (3000.0, 2.0), 10: (400.0, 0.5), 100: (40.0, 0.1), 1000: (8.0, 0.04)}
-TWO_DISK_RUN = (10000.0, 10.0)
+TWIN_RUNS = {2: (4000.0, 5.0), 10: (400.0, 0.5), 100: (40.0, 0.1), 1000: (8.0, 0.04)}
+TWO_DISK_RUN = (20000.0, 10.0)
 COLUMNS = ["check", "n_disks", "rule", "packing", "n_ics", "t_max", "estimate", "lo", "hi",
            "margin", "verdict"]
 
@@ -109,7 +109,7 @@ def summarise(runs: pd.DataFrame) -> pd.DataFrame:
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--out", required=True, help="folder of disks_ftle_check.csv")
-    parser.add_argument("--ics", type=int, default=24, help="states per (check, N, rule)")
+    parser.add_argument("--ics", type=int, default=32, help="states per (check, N, rule)")
     parser.add_argument("--workers", type=int, default=1)
     parser.add_argument("--scale", type=float, default=1.0, help="times every t_max")
     parser.add_argument("--max-disks", type=int, default=1000, help="largest N checked")

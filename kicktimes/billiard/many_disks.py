@@ -229,7 +229,7 @@ def engine_run(state, radii, rule_code, t_max, *, masses=None, arcs=None, walls_
                 walls = walls[:5] + (walls[5][order],)
             if samp is not None:
                 samp = (samp[0], new_of[samp[1]].astype(np.int64), samp[2])
-            if tan is not None:
+            if tangent is not None:
                 tan = (tan[0][order], tan[1])
             continue
         if status == DONE and tangent is not None:
