@@ -24,6 +24,7 @@ two exponents).
 
 Run: python analysis/disks_ftle_check.py --out docs/results [--ics 32] [--workers 1]
      [--scale 1.0] [--max-disks 1000]
+     python analysis/disks_ftle_check.py --out docs/results --from-runs   (statistics only)
 """
 
 from __future__ import annotations
@@ -95,7 +96,7 @@ def summarise(runs: pd.DataFrame) -> pd.DataFrame:
         margin = MARGINS[check]
         rows.append({
             "check": check, "n_disks": int(n), "rule": rule,
-            "packing": PACKING if check == "tangent/twin" else 2 * TWO_DISK_R ** 2,
+            "packing": PACKING if check == "tangent/twin" else round(2 * TWO_DISK_R ** 2, 12),
             "n_ics": len(g), "t_max": float(g["t_max"].iloc[0]),
             "estimate": overall["ratio"], "lo": overall["ci_low"], "hi": overall["ci_high"],
             "margin": margin,
@@ -113,27 +114,32 @@ def main(argv=None):
     parser.add_argument("--workers", type=int, default=1)
     parser.add_argument("--scale", type=float, default=1.0, help="times every t_max")
     parser.add_argument("--max-disks", type=int, default=1000, help="largest N checked")
+    parser.add_argument("--from-runs", action="store_true",
+                        help="only the statistics, from OUT/disks_ftle_check_runs.csv")
     args = parser.parse_args(argv)
     if args.ics < 2 or args.workers < 1 or not args.scale > 0:
         parser.error("--ics must be >= 2, --workers >= 1, --scale > 0")
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    todo = tasks(args.ics, args.scale, args.max_disks)
     t0 = time.perf_counter()
-    if args.workers == 1:
-        done = [pair(t) for t in todo]
+    if args.from_runs:
+        runs = pd.read_csv(out / "disks_ftle_check_runs.csv")
     else:
-        with ProcessPoolExecutor(args.workers) as pool:
-            done = list(pool.map(pair, todo, chunksize=1))
-    runs = pd.DataFrame(done, columns=["check", "n_disks", "rule", "seed", "t_max", "numerator",
-                                       "denominator"])
-    runs = runs.sort_values(["check", "n_disks", "rule", "seed"], ignore_index=True)
-    runs.to_csv(out / "disks_ftle_check_runs.csv", index=False)
+        todo = tasks(args.ics, args.scale, args.max_disks)
+        if args.workers == 1:
+            done = [pair(t) for t in todo]
+        else:
+            with ProcessPoolExecutor(args.workers) as pool:
+                done = list(pool.map(pair, todo, chunksize=1))
+        runs = pd.DataFrame(done, columns=["check", "n_disks", "rule", "seed", "t_max",
+                                           "numerator", "denominator"])
+        runs = runs.sort_values(["check", "n_disks", "rule", "seed"], ignore_index=True)
+        runs.to_csv(out / "disks_ftle_check_runs.csv", index=False)
     table = summarise(runs)
     table.to_csv(out / "disks_ftle_check.csv", index=False)
     with pd.option_context("display.width", 140, "display.max_columns", 20):
         print(table.to_string(index=False))
-    print(f"{len(todo)} states in {time.perf_counter() - t0:.0f} s")
+    print(f"{len(runs)} states in {time.perf_counter() - t0:.0f} s")
 
 
 if __name__ == "__main__":
