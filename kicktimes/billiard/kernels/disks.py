@@ -54,7 +54,7 @@ from kicktimes.billiard.kernels.tangent import BIG, pair_tangent, wall_tangent
 from kicktimes.billiard.kernels.two import anchor_energy, pair_event, wall_event
 
 __all__ = ["CROSS", "NONE", "PREDICT", "REORDER", "WALL", "drive", "final_state", "relabel",
-           "setup", "tangent_at"]
+           "setup", "tangent_at", "tangent_back"]
 
 #: columns of the disk table ``fs``
 X, Y, VX, VY, T, TW, TP, RAD = range(8)
