@@ -135,6 +135,19 @@ def test_the_tangent_observer_changes_no_event(rule):
         assert plain["n_wall"] == other["n_wall"]
 
 
+def test_an_escaped_disk_takes_its_deviation_with_it():
+    # holes: the observer zeroes the row of a disk that leaves the table; the others go on
+    n, r = 30, 0.05
+    state, radii, _ = md.check_disks(kt.initial_state(n, r, seed=10), r, "mirror")
+    arcs = np.array([[0.0, 0.3]])
+    out = md.engine_run(state, radii, 0, 20.0, arcs=arcs, tangent=direction(state, "mirror", 5),
+                        segment=5.0, on_segment=lambda *_: None)
+    gone = np.isfinite(out["escape_times"])
+    assert 3 <= gone.sum() < n
+    assert (out["tangent"][gone] == 0.0).all()
+    assert np.isfinite(out["tangent"]).all() and (out["tangent"][~gone] != 0.0).any(axis=1).all()
+
+
 def test_renumbering_the_disks_changes_no_exponent(monkeypatch):
     # kd.relabel moves the tangent rows with the disks: renumbering after every collision
     # gives the same exponent, bitwise (t = 40: a rebasing too)
