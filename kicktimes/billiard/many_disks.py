@@ -19,7 +19,8 @@ from kicktimes.billiard.kernels import disks as kd
 from kicktimes.billiard.kernels.observe import DONE, FULL, OVER_BUDGET, STALLED
 from kicktimes.stats.enskog import PACKING_MAX, contact_value
 
-__all__ = ["check_disks", "engine_run", "expected_collisions", "simulate_disks"]
+__all__ = ["check_disks", "engine_run", "expected_collisions", "raise_for_status",
+           "simulate_disks"]
 
 #: most disks a run takes (int32 indices; about 180 bytes each)
 N_DISKS_MAX = 10**7
@@ -149,12 +150,19 @@ def expected_collisions(radii: np.ndarray, speed: float, t_max: float) -> tuple[
 
 def engine_run(state, radii, rule_code, t_max, *, masses=None, arcs=None, walls_sel=None,
                sample=None, tau=None, contacts=False, max_events=None, log=True,
-               cap_hint=1024, debug=False):
+               cap_hint=1024, debug=False, tangent=None, segment=None, on_segment=None):
     """Run the engine on a validated state; returns a dict of its raw outputs in the
     caller's disk numbering. ``log=False`` keeps no collision log (the log buffer is
     reused: the initial-state growth runs only need the final state). ``debug=True``
     checks every disk for overlaps and the table's wall after every event (O(n) per event,
-    `kd.check_state`): ``out["debug"] = [largest overlap, largest distance outside, checks]``."""
+    `kd.check_state`): ``out["debug"] = [largest overlap, largest distance outside, checks]``.
+
+    ``tangent`` (n, 4): a tangent vector ``(dx, dy, dvx, dvy)`` per disk at time 0, carried
+    by the engine's tangent observer; the run stops at every multiple of ``segment`` (and
+    at ``t_max``) and calls ``on_segment(u, v, lg)`` with the vector flown to that time
+    (``u``, caller's numbering, changed in place and carried on from there), the disks'
+    velocities ``v`` and ``lg`` the log of the engine's own rescalings since the last stop
+    (`kd.shrink_tangent`). ``out["tangent"]``: the vector at ``t_max``."""
     n = state.shape[0]
     m, w = cells.grid(n, float(radii.max()))
     perm, eng = kd.new_engine(state, radii, m, w)
@@ -172,8 +180,8 @@ def engine_run(state, radii, rule_code, t_max, *, masses=None, arcs=None, walls_
     # then gets empty arrays: no holes, no disk selected, no samples): two compilations
     # of a minute each instead of one per combination.
     full = (masses is not None or arcs is not None or walls_sel is not None
-            or sample is not None or contacts or debug)
-    walls = samp = con = dbg = None
+            or sample is not None or contacts or debug or tangent is not None)
+    walls = samp = con = tan = dbg = None
     if full:
         if mass is None:
             mass = np.ones(n)
@@ -192,6 +200,8 @@ def engine_run(state, radii, rule_code, t_max, *, masses=None, arcs=None, walls_
         else:
             samp = (1.0, np.zeros(0, dtype=np.int64), np.empty((0, 0, 2)))
         con = (np.empty(cap), np.empty(cap))
+        u = np.empty((0, 4)) if tangent is None else np.array(tangent, dtype=np.float64)[perm]
+        tan = (u, np.zeros(1))
         dbg = np.array([-np.inf, -np.inf, 0.0, 1.0 if debug else 0.0])
     speed = float(np.hypot(state[:, 2], state[:, 3]).max())
     if masses is not None:
@@ -201,10 +211,14 @@ def engine_run(state, radii, rule_code, t_max, *, masses=None, arcs=None, walls_
     budget = np.iinfo(np.int64).max if max_events is None else int(max_events)
     fs, iv, head, qt, qi, ht, qh, qs, qw = eng
     dropped = 0  # collisions of a reused log buffer (log=False)
+    # the stops of the tangent's segments (the last at t_max)
+    n_stop = 1 if tangent is None else max(1, int(math.floor(t_max / segment * (1 + 1e-12))))
+    k_stop = 1
     while True:
+        t_stop = float(t_max) if k_stop == n_stop else k_stop * segment
         status = kd.drive(fs, iv, head, m, w, qt, qi, ht, qh, qs, qw, rule_code, mass,
-                          float(t_max), budget, stall_dt, clock, cnt, pp_t, pp_i, pp_j, esc,
-                          ident, reorder_every, arcs, walls, samp, con, dbg)
+                          t_stop, budget, stall_dt, clock, cnt, pp_t, pp_i, pp_j, esc,
+                          ident, reorder_every, arcs, walls, samp, con, tan, dbg)
         if status == kd.REORDER:
             order = cells.cell_order(iv[:, kd.CELL], m)
             new_of = kd.relabel(fs, iv, head, m, qt, qi, ht, qh, qs, qw, order)
@@ -215,7 +229,21 @@ def engine_run(state, radii, rule_code, t_max, *, masses=None, arcs=None, walls_
                 walls = walls[:5] + (walls[5][order],)
             if samp is not None:
                 samp = (samp[0], new_of[samp[1]].astype(np.int64), samp[2])
+            if tangent is not None:
+                tan = (tan[0][order], tan[1])
             continue
+        if status == DONE and tangent is not None:
+            common, dt = kd.tangent_at(tan[0], fs, clock, t_stop)
+            at_stop = np.empty_like(common)
+            at_stop[ident] = common
+            v = np.empty((n, 2))
+            v[ident] = fs[:, kd.VX:kd.VY + 1]
+            on_segment(at_stop, v, float(tan[1][0]))
+            tan[1][0] = 0.0
+            kd.tangent_back(tan[0], at_stop[ident], dt)
+            if k_stop < n_stop:
+                k_stop += 1
+                continue
         if status != FULL:
             break
         if cnt[kd.N_PP] >= pp_t.shape[0]:
@@ -254,7 +282,21 @@ def engine_run(state, radii, rule_code, t_max, *, masses=None, arcs=None, walls_
         out["debug"] = dbg[:3].copy()
     if contacts:
         out["contacts"] = (con[0][:n_pp].copy(), con[1][:n_pp].copy())
+    if tangent is not None and status == DONE:
+        out["tangent"] = at_stop
     return out
+
+
+def raise_for_status(out: dict, budget: int) -> None:
+    """A ValueError naming the argument for a run of `engine_run` that did not finish."""
+    if out["status"] == OVER_BUDGET:
+        raise ValueError(f"max_events: the run needed more than max_events={budget} collisions "
+                         f"(stopped at t = {out['clock_time']:.6g}); pass a larger max_events "
+                         f"or a shorter t_max")
+    if out["status"] == STALLED:
+        raise ValueError(f"state: the run makes no progress at t = {out['clock_time']:.6g} "
+                         f"(disks jammed: {kd.STALL_EVENTS} events in no time)")
+    assert out["status"] == DONE
 
 
 def simulate_disks(state, r, *, t_max, rule="mirror", masses=None, holes=None, sample=None,
@@ -362,14 +404,7 @@ def simulate_disks(state, r, *, t_max, rule="mirror", masses=None, holes=None, s
     out = engine_run(state, radii, chk.RULES[rule], t_max, masses=masses, arcs=arcs,
                      walls_sel=sample if log_walls else None, sample=sample, tau=tau,
                      max_events=budget, cap_hint=int(1.2 * e_pp) + 1024)
-    if out["status"] == OVER_BUDGET:
-        raise ValueError(f"max_events: the run needed more than max_events={budget} collisions "
-                         f"(stopped at t = {out['clock_time']:.6g}); pass a larger max_events "
-                         f"or a shorter t_max")
-    if out["status"] == STALLED:
-        raise ValueError(f"state: the run makes no progress at t = {out['clock_time']:.6g} "
-                         f"(disks jammed: {kd.STALL_EVENTS} events in no time)")
-    assert out["status"] == DONE
+    raise_for_status(out, budget)
     return DisksRun(
         radii=radii, rule=rule, t_max=t_max, state=state, final_state=out["final_state"],
         pp_times=out["pp_times"], pp_i=out["pp_i"], pp_j=out["pp_j"],

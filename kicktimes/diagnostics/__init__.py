@@ -7,7 +7,7 @@ autocorrelation of the boundary-collision angles (`autocorrelation`,
 (`autocorrelation_function`, `decorrelation_lag`, `integrated_autocorrelation_time`)
 and finite-time Lyapunov exponents (`lyapunov`: exact tangent vectors by default, or
 Benettin twins; `lyapunov_spectrum`: all exponents of the two-disk billiard;
-`disks_lyapunov`: the largest exponent of N disks from a Benettin twin); see
+`disks_lyapunov`: the largest exponent of N disks from tangent vectors or a twin); see
 docs/diagnostics.md. The collision mechanism of two-disk runs (angular momenta, impact
 parameters and wall hits per collision, re-collisions, predicted rates) is in
 `kicktimes.diagnostics.mechanism`; see docs/mechanism.md.

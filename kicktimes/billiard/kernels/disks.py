@@ -36,7 +36,9 @@ helper call, more than the helper (measured: 45 ns against 5 ns for six arrays).
 Optional observers, compiled out when passed as ``None`` (as in `drive_two`): ``arcs``
 (holes in the wall), ``walls`` (the wall-contact log of selected disks), ``samp``
 (positions of selected disks every ``tau``), ``contacts`` (the contact point of every
-disk-disk collision).
+disk-disk collision), ``tan`` (a tangent vector, one row ``(dx, dy, dvx, dvy)`` per disk,
+in the same delayed form as the disk table: carried by the linearised event maps of
+`kicktimes.billiard.kernels.tangent`, for the largest Lyapunov exponent).
 """
 
 from __future__ import annotations
@@ -48,10 +50,11 @@ from kicktimes.billiard.geometry import boundary_hit_time, pair_hit_time
 from kicktimes.billiard.kernels import calendar as cal
 from kicktimes.billiard.kernels import cells
 from kicktimes.billiard.kernels import observe as ob
+from kicktimes.billiard.kernels.tangent import BIG, pair_tangent, wall_tangent
 from kicktimes.billiard.kernels.two import anchor_energy, pair_event, wall_event
 
 __all__ = ["CROSS", "NONE", "PREDICT", "REORDER", "WALL", "drive", "final_state", "relabel",
-           "setup"]
+           "setup", "tangent_at", "tangent_back"]
 
 #: columns of the disk table ``fs``
 X, Y, VX, VY, T, TW, TP, RAD = range(8)
@@ -121,14 +124,14 @@ def schedule(i, x, y, vx, vy, now, best, kind, stamp, fs, iv, m, w, qt, qi, ht, 
 
 @njit(cache=True, inline="always", error_model="numpy")
 def rescan(i, now, gx0, gx1, gy0, gy1, best, kind, stamp, fs, iv, head, m, w, qt, qi, ht, qh,
-           qs, qw):
+           qs, qw, tan):
     """Bring disk ``i`` to ``now``, look for an earlier contact than ``(best, kind, stamp)``
     in cells ``gx0..gx1 x gy0..gy1`` and schedule its earliest event (`scan`, `schedule`).
 
     The one place the scan is compiled into the event loop: numba inlines it once, not
     once per kind of event (with four copies the loop took 95-155 s to compile, with one
     20-30 s, and runs 3 % slower: benchmarks/bench_compile.py)."""
-    x, y = bring(fs, i, now)
+    x, y = bring(fs, i, now, tan)
     vx = fs[i, VX]
     vy = fs[i, VY]
     best, kind, stamp = scan(i, x, y, vx, vy, now, gx0, gx1, gy0, gy1, fs, iv, head, m, best,
@@ -173,28 +176,35 @@ def predict(i, now, fs, iv, head, m, w, qt, qi, ht, qh, qs, qw):
     ``now``); the disk is first brought to ``now``."""
     gx0, gx1, gy0, gy1 = neighbourhood(iv[i, CELL], m)
     rescan(i, now, gx0, gx1, gy0, gy1, np.inf, NONE, 0, fs, iv, head, m, w, qt, qi, ht, qh, qs,
-           qw)
+           qw, None)
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def bring(fs, i, now):
-    """``(x, y)`` of disk ``i`` flown to ``now`` (stored, its clock set to ``now``)."""
+def bring(fs, i, now, tan):
+    """``(x, y)`` of disk ``i`` flown to ``now`` (stored, its clock set to ``now``); its row
+    of the tangent observer ``tan`` (if any) flown with it, ``dq += dv dt``."""
     dt = now - fs[i, T]
     x = fs[i, X] + fs[i, VX] * dt
     y = fs[i, Y] + fs[i, VY] * dt
     fs[i, X] = x
     fs[i, Y] = y
     fs[i, T] = now
+    if tan is not None:
+        u = tan[0]
+        if u.shape[0] > 0:
+            u[i, 0] += u[i, 2] * dt
+            u[i, 1] += u[i, 3] * dt
     return x, y
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def collide(i, j, now, fs, rule, mass):
-    """The disk-disk collision of ``i`` and ``j`` at ``now`` (both brought there): the
-    rule's velocity map, the elastic rule's energy anchored to the pair's energy before,
-    both wall times afresh."""
-    xi, yi = bring(fs, i, now)
-    xj, yj = bring(fs, j, now)
+def collide(i, j, now, fs, rule, mass, tan):
+    """The disk-disk collision of ``i`` and ``j`` at ``now`` (both brought there, with their
+    tangent rows): the rule's velocity map, the elastic rule's energy anchored to the pair's
+    energy before, both wall times afresh. Returns the mass factors ``(ki, kj)`` of the
+    velocity map (1 for equal masses)."""
+    xi, yi = bring(fs, i, now, tan)
+    xj, yj = bring(fs, j, now, tan)
     ai, bi, aj, bj = fs[i, VX], fs[i, VY], fs[j, VX], fs[j, VY]
     ki = 1.0
     kj = 1.0
@@ -216,6 +226,62 @@ def collide(i, j, now, fs, rule, mass):
     fs[j, VY] = bj2
     fs[i, TW] = now + boundary_hit_time(xi, yi, ai2, bi2, 1.0 - fs[i, RAD])
     fs[j, TW] = now + boundary_hit_time(xj, yj, aj2, bj2, 1.0 - fs[j, RAD])
+    return ki, kj
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def pair_tangent_rows(u, lg, i, j, fs, ai, bi, aj, bj, rule, ki, kj):
+    """The tangent rows of ``i`` and ``j`` across their collision (`tangent.pair_tangent`;
+    both disks and rows at the contact, ``(ai, bi)``, ``(aj, bj)`` the incoming velocities),
+    and all rows rescaled by ``1/BIG`` (``log BIG`` into ``lg[0]``) once the squared norm
+    of one passes ``BIG`` (1e100): the vector grows at disk-disk collisions (walls only
+    shear it), so this check keeps it finite however long the caller's segments are."""
+    (u[i, 0], u[i, 1], u[i, 2], u[i, 3], u[j, 0], u[j, 1], u[j, 2], u[j, 3]) = pair_tangent(
+        u[i, 0], u[i, 1], u[i, 2], u[i, 3], u[j, 0], u[j, 1], u[j, 2], u[j, 3],
+        fs[i, X], fs[i, Y], fs[j, X], fs[j, Y], ai, bi, aj, bj,
+        fs[i, VX], fs[i, VY], fs[j, VX], fs[j, VY], rule, ki, kj)
+    si = u[i, 0] * u[i, 0] + u[i, 1] * u[i, 1] + u[i, 2] * u[i, 2] + u[i, 3] * u[i, 3]
+    sj = u[j, 0] * u[j, 0] + u[j, 1] * u[j, 1] + u[j, 2] * u[j, 2] + u[j, 3] * u[j, 3]
+    if si > BIG or sj > BIG:
+        shrink_tangent(u, lg)
+
+
+@njit(cache=True, error_model="numpy")
+def shrink_tangent(u, lg):
+    """All tangent rows times ``1/BIG``, ``log BIG`` added to ``lg[0]`` (the dynamics is
+    linear: rows at different clocks scale alike)."""
+    for k in range(u.shape[0]):
+        for c in range(4):
+            u[k, c] /= BIG
+    lg[0] += np.log(BIG)
+
+
+@njit(cache=True, error_model="numpy")
+def fly_tangent(u, fs, iv, now):
+    """Every live disk's tangent row flown to ``now`` (``dq += dv (now - t_k)``), as
+    `rebase` flies the disks."""
+    for k in range(u.shape[0]):
+        if iv[k, CELL] >= 0:
+            dt = now - fs[k, T]
+            u[k, 0] += u[k, 2] * dt
+            u[k, 1] += u[k, 3] * dt
+
+
+def tangent_at(u, fs, clock, t_end):
+    """The tangent vector at the common time ``t_end`` (absolute): a copy of the rows ``u``
+    (the engine's numbering, each at its disk's own clock) flown there; and the flight
+    times, for putting the rows back (`tangent_back`)."""
+    dt = (t_end - clock[OFFSET]) - fs[:, T]
+    out = u.copy()
+    out[:, :2] += out[:, 2:] * dt[:, None]
+    return out, dt
+
+
+def tangent_back(u, common, dt):
+    """Write the common-time rows ``common`` back into ``u`` at the disks' own clocks (flown
+    back by ``dt``, from `tangent_at`)."""
+    u[:, 2:] = common[:, 2:]
+    u[:, :2] = common[:, :2] - common[:, 2:] * dt[:, None]
 
 
 @njit(cache=True, error_model="numpy")
@@ -286,7 +352,7 @@ def check_state(fs, iv, head, m, now, dbg):
 @njit(cache=True, error_model="numpy", _nrt=False)
 def drive(fs, iv, head, m, w, qt, qi, ht, qh, qs, qw, rule, mass, t_end, max_events,
           stall_dt, clock, cnt, pp_t, pp_i, pp_j, esc, ident, reorder_every, arcs, walls, samp,
-          contacts, dbg):
+          contacts, tan, dbg):
     """Run the event loop until ``t_end`` (absolute; events at ``t_end`` included).
 
     Returns a status of `kicktimes.billiard.kernels.observe`: ``DONE``, ``FULL`` (a log is
@@ -301,6 +367,10 @@ def drive(fs, iv, head, m, w, qt, qi, ht, qh, qs, qw, rule, mass, t_end, max_eve
     holes; ``walls = (bt, bd, bx, by, bs, sel)`` the contacts of the disks with
     ``sel[i]``; ``samp = (tau, sdisks, spos)``: positions of ``sdisks`` at ``k tau`` into
     ``spos[k]``; ``contacts = (cx, cy)`` the contact points of the disk-disk log;
+    ``tan = (u, lg)`` a tangent vector, ``u[k] = (dx, dy, dvx, dvy)`` of disk ``k`` at its
+    own clock ``fs[k, T]`` (flown with it by `bring`, through collisions by
+    `tangent.pair_tangent`, wall contacts by `tangent.wall_tangent`, zeroed at an escape;
+    ``u`` of shape (0, 4): off), ``lg[0]`` the log of its rescalings;
     ``dbg`` (debug mode if ``dbg[3] != 0``): `check_state` after every event.
     """
     cap = pp_t.shape[0]
@@ -328,6 +398,8 @@ def drive(fs, iv, head, m, w, qt, qi, ht, qh, qs, qw, rule, mass, t_end, max_eve
         if te > REBASE:
             # no event before te: every disk can fly there, and te becomes 0
             now = te
+            if tan is not None:
+                fly_tangent(tan[0], fs, iv, now)
             rebase(fs, iv, qt, qi, ht, qh, qs, qw, now)
             yk = now - clock[COMP]
             tn = clock[OFFSET] + yk
@@ -364,7 +436,12 @@ def drive(fs, iv, head, m, w, qt, qi, ht, qh, qs, qw, rule, mass, t_end, max_eve
                     return ob.FULL
                 if n + cnt[N_WALL] >= max_events:
                     return ob.OVER_BUDGET
-                collide(i, j, te, fs, rule, mass)
+                ai, bi, aj, bj = fs[i, VX], fs[i, VY], fs[j, VX], fs[j, VY]
+                ki, kj = collide(i, j, te, fs, rule, mass, tan)
+                if tan is not None:
+                    if tan[0].shape[0] > 0:
+                        pair_tangent_rows(tan[0], tan[1], i, j, fs, ai, bi, aj, bj, rule, ki,
+                                          kj)
                 pp_t[n] = clock[OFFSET] + te
                 pp_i[n] = min(ident[i], ident[j])
                 pp_j[n] = max(ident[i], ident[j])
@@ -381,7 +458,7 @@ def drive(fs, iv, head, m, w, qt, qi, ht, qh, qs, qw, rule, mass, t_end, max_eve
                     return ob.FULL
             if cnt[N_PP] + cnt[N_WALL] >= max_events:
                 return ob.OVER_BUDGET
-            x, y = bring(fs, i, te)
+            x, y = bring(fs, i, te, tan)
             iv[i, COUNT] += 1
             cnt[N_WALL] += 1
             if arcs is not None:
@@ -393,9 +470,25 @@ def drive(fs, iv, head, m, w, qt, qi, ht, qh, qs, qw, rule, mass, t_end, max_eve
                     iv[i, KIND] = NONE
                     cnt[N_ESC] += 1
                     cal.update(qt, qi, ht, qh, qs, qw, i, np.inf)
+                    if tan is not None:
+                        if tan[0].shape[0] > 0:
+                            # the disk leaves the phase space: its deviation with it
+                            for c in range(4):
+                                tan[0][i, c] = 0.0
                     continue
             x, y, vx, vy, tn, sin_theta = wall_event(x, y, fs[i, VX], fs[i, VY],
                                                      1.0 - fs[i, RAD], rule)
+            if tan is not None:
+                u = tan[0]
+                if u.shape[0] > 0:
+                    ai = fs[i, VX]
+                    bi = fs[i, VY]
+                    # a reflection (or a grazing slide, where the map is singular); a disk
+                    # already moving inward is not reflected: the identity (as drive_two)
+                    if x * ai + y * bi >= 0.0:
+                        u[i, 0], u[i, 1], u[i, 2], u[i, 3] = wall_tangent(
+                            u[i, 0], u[i, 1], u[i, 2], u[i, 3], x, y, ai, bi, vx, vy,
+                            1.0 - fs[i, RAD])
             if walls is not None:
                 if walls[5][i]:
                     q = cnt[N_WLOG]
@@ -425,7 +518,7 @@ def drive(fs, iv, head, m, w, qt, qi, ht, qh, qs, qw, rule, mass, t_end, max_eve
                 bk = NONE
                 bs = 0
             rescan(d, te, gx0, gx1, gy0, gy1, best, bk, bs, fs, iv, head, m, w, qt, qi, ht,
-                   qh, qs, qw)
+                   qh, qs, qw, tan)
         if pb >= 0 and reorder_every > 0:
             cnt[N_SINCE] += 1
             if cnt[N_SINCE] >= reorder_every:
@@ -508,7 +601,7 @@ def new_engine(state: np.ndarray, radii: np.ndarray, m: int, w: float) -> tuple:
     no_log = np.empty(0, dtype=np.int32)
     drive(fs, iv, head, m, w, *q, 0, None, 0.0, 0, 0.0, np.zeros(3), np.zeros(9, np.int64),
           np.empty(0), no_log, no_log, np.empty(n), np.arange(n, dtype=np.int32), 0, None,
-          None, None, None, None)
+          None, None, None, None, None)
     # buckets about two event spacings wide: a disk's next event is about mean(qt) away
     qt = q[0]
     finite = qt[np.isfinite(qt)]
