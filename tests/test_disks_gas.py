@@ -304,7 +304,7 @@ def test_each_speed_share_is_given_its_reading(low, high, reading):
 
 
 def test_no_kicked_ftle_ratio_where_the_kicked_disk_is_not_chaotic_or_the_gas_near_zero():
-    from kicktimes.report.disks_page import _kicked_cell
+    from kicktimes.report.disks_kicked import _kicked_cell
 
     base = dict(reference=1.0, reference_low=0.9, reference_high=1.1, ratio=-0.01,
                 ratio_low=-0.02, ratio_high=-0.005, verdict="lower", value=-0.01,
