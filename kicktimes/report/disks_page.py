@@ -1,8 +1,11 @@
 """docs/results/disks.md: from two disks to a gas, written from the disks stores.
 
 `write_disks_page` reads the stores of the `kicktimes.experiment.DISKS_PRESETS` sweeps,
-computes their tables (`kicktimes.report.disks`), writes them as CSV beside the page,
-draws the figures (`kicktimes.report.disks_figures`) and writes the page:
+their controls (`DISKS_CONTROLS`) and the two-disk references, computes their tables
+(`kicktimes.report.disks`; the findings under their controls,
+`kicktimes.report.disks_controls`; the renewal models, `kicktimes.report.disks_renewal`;
+the kicked comparison's sections, `kicktimes.report.disks_kicked`), writes them as CSV
+beside the page, draws the figures (`kicktimes.report.disks_figures`) and writes the page:
 the answers first, each from the table through the verdict rules of `kicktimes.stats`,
 then one table per geometry with a row per N. `reproduce_disks` runs (or resumes) the
 sweeps first: ``kicktimes reproduce --study disks`` and ``analysis/make_disks.py``.
@@ -663,13 +666,20 @@ def reproduce_disks(out, *, results_dir=None, names=None, workers=1, scheduler=N
     results_dir : path-like, optional
         Where the page goes (default ``out/results-disks``).
     names : sequence of str, optional
-        Presets (default every one of `kicktimes.experiment.DISKS_PRESETS`).
+        Presets (default every one of `kicktimes.experiment.DISKS_PRESETS`, their controls
+        `DISKS_CONTROLS` and the two-disk references `DISKS_REFERENCES`).
     workers, scheduler, progress :
         As in `kicktimes.experiment.run_experiment`.
     """
-    from kicktimes.experiment import DISKS_PRESETS, DISKS_REFERENCES, disks_preset, run_experiment
+    from kicktimes.experiment import (
+        DISKS_CONTROLS,
+        DISKS_PRESETS,
+        DISKS_REFERENCES,
+        disks_preset,
+        run_experiment,
+    )
 
-    names = list(names or [*DISKS_PRESETS, *DISKS_REFERENCES])
+    names = list(names or [*DISKS_PRESETS, *DISKS_CONTROLS, *DISKS_REFERENCES])
     paths, cost = [], []
     for name in names:
         path = os.path.join(out, f"store-{name}")
