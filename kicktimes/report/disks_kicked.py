@@ -125,12 +125,14 @@ def kicked_answer(kicked, exp) -> list:
             f"{exp.rule}; below, \"Does a kicked disk reproduce a gas?\") The FTLE per "
             f"collision of the disk (λ / ν, ν the gas disk's collision rate), the kicked "
             f"disks' own beside the gas's: {'; '.join(side(n) for n in (ns[0], ns[-1]))}. "
-            f"The Poisson-kicked FTLE's interval is at or below 0 at N = "
-            f"{', '.join(str(n) for n in kicked_not_chaotic(kicked)) or 'no N'} (not chaotic; "
-            "no ratio stated)"
-            + (f", the scatter-kicked one's at N = "
-               f"{', '.join(str(n) for n in kicked_not_chaotic(kicked, 'scatter')) or 'no N'}"
-               if "scatter" in systems else "")
+            "The Poisson-kicked FTLE's interval is at or below 0 at "
+            + (f"N = {', '.join(str(n) for n in kicked_not_chaotic(kicked))}"
+               if kicked_not_chaotic(kicked) else "no N")
+            + " (not chaotic; no ratio stated)"
+            + ((", the scatter-kicked one's at N = " + ", ".join(
+                str(n) for n in kicked_not_chaotic(kicked, "scatter"))
+                if kicked_not_chaotic(kicked, "scatter") else
+                ", the scatter-kicked one's at no N") if "scatter" in systems else "")
             + ". The gas's reference is the whole gas's largest exponent, which per collision "
             f"grows with N, so a kicked/gas FTLE ratio is not a like-for-like comparison."
             f"{check} Every kicked disk ({names}) is within 10 % of the gas's recurrence "

@@ -236,8 +236,9 @@ def _short_answers(table, tot, kicked, long=None):
     if bad:
         lines += [f"The single disk kicked with uniform new directions has its own FTLE's 95 % "
                   f"interval at or below 0 at N = {', '.join(str(n) for n in bad)}: it is not "
-                  "chaotic there, and no kicked/gas FTLE ratio is stated for it. "
-                  + scatter_answer(kicked), ""]
+                  "chaotic there, and no kicked/gas FTLE ratio is stated for it.", ""]
+    if not kicked.empty and scatter_answer(kicked):
+        lines += [scatter_answer(kicked), ""]
     if long.empty:
         lines += ["No controls were run: every verdict is the primary design's (one K, one "
                   "seed), none is called robust."]
