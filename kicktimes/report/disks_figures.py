@@ -218,8 +218,8 @@ def controls_figure(long, *, n_min=10, names=None):
     """The findings under their controls against N (``N >= n_min``): one row per geometry x
     rule, one column per finding of `CONTROL_PANELS`, the controls dodged sideways with
     their own colours and markers, 95 % CIs, the finding's band shaded (±10 % for the
-    ratios, the nominal band for the share), a hollow marker where the finding is not
-    robust (`kicktimes.report.disks_controls.controls_findings`, its ``robust``)."""
+    ratios, the nominal band for the share), one y scale per column, a hollow marker where
+    the finding is not robust (`kicktimes.report.disks_controls.controls_findings`, its ``robust``)."""
     import matplotlib.pyplot as plt
 
     d = long[long["n_disks"] >= n_min]
@@ -228,7 +228,7 @@ def controls_figure(long, *, n_min=10, names=None):
     ns = sorted(set(d["n_disks"]))
     fig, axes = plt.subplots(len(families), len(CONTROL_PANELS),
                              figsize=(4.3 * len(CONTROL_PANELS), 2.3 * len(families) + 0.8),
-                             sharex=True, squeeze=False)
+                             sharex=True, sharey="col", squeeze=False)
     for i, fam in enumerate(families):
         for j, (finding, label, band, scale) in enumerate(CONTROL_PANELS):
             ax = axes[i, j]
@@ -262,6 +262,8 @@ def controls_figure(long, *, n_min=10, names=None):
             if lab not in labels:
                 handles.append(h)
                 labels.append(lab)
+    handles.append(axes[0, 0].plot([], [], ls="none", marker="o", mfc="white", color="0.3")[0])
+    labels.append("hollow: not robust at that N")
     fig.legend(handles, labels, loc="upper center", ncol=len(labels), fontsize=8.5,
                frameon=False)
     fig.tight_layout(rect=(0, 0, 1, 1 - 0.5 / (2.3 * len(families) + 0.8)))

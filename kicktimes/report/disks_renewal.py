@@ -98,6 +98,10 @@ def renewal_models(store, *, models=RENEWAL_MODELS) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
+def _ns(ns):
+    return f"N = {', '.join(str(n) for n in ns)}" if ns else "no N"
+
+
 def _delta(x):
     return "—" if not np.isfinite(x) else f"{x:.3g}"
 
@@ -127,9 +131,8 @@ def renewal_lines(models: pd.DataFrame) -> list:
             f"- {fam}, {rule}: at N = {int(big['n_disks'])} the best is {big['best']} "
             f"(the next, {big['second']}, ΔAIC {_delta(big['delta_aic_second'])}; the "
             f"exponential ΔAIC {_delta(big['delta_aic_exponential'])}); the exponential is "
-            f"the best at N = {', '.join(str(n) for n in exp_best) or 'no N'}; the ranking "
-            f"is not stable over the halves at N = "
-            f"{', '.join(str(n) for n in unstable) or 'no N'}.")
+            f"the best at {_ns(exp_best)}; the ranking is not stable over the halves at "
+            f"{_ns(unstable)}.")
     fams = list(dict.fromkeys(zip(models["geometry"], models["rule"], strict=True)))
     lines += ["", "| N | " + " | ".join(f"{g}, {r}" for g, r in fams) + " |",
               "|---|" + "---|" * len(fams)]
