@@ -425,7 +425,8 @@ def _left_out(table, long, kicked_stores, k, ftle_checked):
                    "seed); none is checked under another (`robust_verdict`), so none is called "
                    "robust.")
     else:
-        low = table[(table["packing"] == table["packing"].min())].iloc[-1]
+        big = table[table["n_disks"] == table["n_disks"].max()]
+        low = big.loc[big["packing"].idxmin()]
         out.append(
             f"- Controls not run: another cap on the tagged disks per run (at most 250 here; "
             f"the intervals are clustered on runs), starts away from equilibrium, another α, "
