@@ -219,10 +219,13 @@ def controls_figure(long, *, n_min=10, names=None):
     rule, one column per finding of `CONTROL_PANELS`, the controls dodged sideways with
     their own colours and markers, 95 % CIs, the finding's band shaded (±10 % for the
     ratios, the nominal band for the share), one y scale per column, a hollow marker where
-    the finding is not robust (`kicktimes.report.disks_controls.controls_findings`, its ``robust``)."""
+    the finding is not robust (`kicktimes.report.disks_controls.controls_findings`, its
+    ``robust``)."""
     import matplotlib.pyplot as plt
 
     d = long[long["n_disks"] >= n_min]
+    if d.empty:
+        raise ValueError(f"long: no finding at N >= n_min = {n_min}")
     families = list(dict.fromkeys(d["family"]))
     controls = [c for c in CONTROL_STYLES if c in set(d["control"])]
     ns = sorted(set(d["n_disks"]))

@@ -56,6 +56,9 @@ from kicktimes.stats.findings import share_verdict
 
 __all__ = ["reproduce_disks", "write_disks_page"]
 
+#: the controls figure shows N from here on (where the page's "becomes Poisson" is decided)
+CONTROLS_MIN_N = 10
+
 
 def _pct(row, key):
     """``"39.1 [37.2, 41.0] % above nominal"`` from the row's share and its CI."""
@@ -536,8 +539,10 @@ def write_disks_page(store_paths, out_dir, *, command="python analysis/make_disk
     figures = {"disks_rejection_vs_n.png": rejection_figure(table),
                "disks_hazard_vs_n.png": hazard_figure(hazard, table),
                "disks_rate_dispersion_vs_n.png": rates_figure(table)}
-    if not long.empty:
-        figures["disks_controls_vs_n.png"] = controls_figure(long, names=CONTROL_NAMES)
+    with_controls_figure = not long.empty and (long["n_disks"] >= CONTROLS_MIN_N).any()
+    if with_controls_figure:
+        figures["disks_controls_vs_n.png"] = controls_figure(long, n_min=CONTROLS_MIN_N,
+                                                             names=CONTROL_NAMES)
     for name, fig in figures.items():
         fig.savefig(out / name, dpi=dpi)
         plt.close(fig)
@@ -638,11 +643,11 @@ def write_disks_page(store_paths, out_dir, *, command="python analysis/make_disk
         "reference there: stars, the rate over Γ(r)).", "",
     ]
     lines += [*controls_lines(long)]
-    if not long.empty:
+    if with_controls_figure:
         lines += [
             "![controls](disks_controls_vs_n.png)", "",
-            "**The findings under their controls against N** (N ≥ 10): per geometry and rule "
-            "(rows) the index of dispersion D, the share of tagged disks rejecting uniform "
+            f"**The findings under their controls against N** (N ≥ {CONTROLS_MIN_N}): per "
+            "geometry and rule (rows) the index of dispersion D, the share of tagged disks rejecting uniform "
             "times and the first hazard bin over the constant rate (columns), under each "
             "control (colours and markers, dodged sideways); 95 % CIs; grey: ±10 % (the "
             f"nominal band [{100 * ALPHA * 0.5:g}, {100 * ALPHA * 1.5:g}] % for the share); "
