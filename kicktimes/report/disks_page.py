@@ -649,8 +649,9 @@ def write_disks_page(store_paths, out_dir, *, command="python analysis/make_disk
             f"**The findings under their controls against N** (N ≥ {CONTROLS_MIN_N}): per "
             "geometry and rule (rows) the index of dispersion D, the share of tagged disks "
             "rejecting uniform times and the first hazard bin over the constant rate "
-            "(columns), under each control (colours and markers, dodged sideways); 95 % CIs; grey: ±10 % (the "
-            f"nominal band [{100 * ALPHA * 0.5:g}, {100 * ALPHA * 1.5:g}] % for the share); "
+            "(columns), under each control (colours and markers, dodged sideways); 95 % "
+            f"CIs; grey: ±10 % (the nominal band [{100 * ALPHA * 0.5:g}, "
+            f"{100 * ALPHA * 1.5:g}] % for the share); "
             "hollow markers: the finding is not robust at that N (it depends on a control).",
             ""]
     lines += renewal_lines(renewal)
