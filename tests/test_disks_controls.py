@@ -236,7 +236,9 @@ def test_the_page_gives_every_finding_under_its_controls(tiny, tmp_path):
         page = write_disks_page([tiny.path, control.path], tmp_path / "results", n_boot=99,
                                 n_mc=19, dpi=30)
     text = page.read_text()
-    long = pd.read_csv(tmp_path / "results" / "disks_controls_findings.csv")
+    long = pd.read_csv(tmp_path / "results" / "disks_controls.csv")
+    # not a sweep report's findings table (tests/test_results_pages.py reads *_findings.csv)
+    assert not list((tmp_path / "results").glob("*_findings.csv"))
     assert set(long["control"]) == {"primary", "seed", "bulk"}
     assert "## Under the controls" in text and "No controls were run" not in text
     assert "## Which renewal model?" in text

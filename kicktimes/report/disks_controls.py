@@ -1,4 +1,9 @@
-"""The disks page's findings under their controls: docs/results/disks_controls_findings.csv.
+"""The disks page's findings under their controls: docs/results/disks_controls.csv.
+
+(Not named ``*_findings.csv``: those are the sweep report's tables, one schema with a
+``question`` column, that tests/test_results_pages.py reads; this table has the columns
+``claims_lint`` reads, ``family, diagnostic, system, control, estimate, ci_low, ci_high,
+verdict, robust``, and its verdicts are of three kinds.)
 
 Every finding of a row (geometry x rule x N) of `kicktimes.report.disks.disks_table` is
 computed under the primary design and under each control:
@@ -205,7 +210,7 @@ def controls_lines(long, *, n_min=30) -> list:
         "cell says on which control it depends, with the numbers under the primary and under "
         "that control. The hazard's flatness has a p-value, no interval: its verdict is "
         "whether p < 0.05. Every control's number is in "
-        "[disks_controls_findings.csv](disks_controls_findings.csv).", "",
+        "[disks_controls.csv](disks_controls.csv).", "",
         f"Over the {n_all} findings of the rows at N ≥ {n_min} ({len(set(big['family']))} "
         f"geometry × rule, {len(set(big['diagnostic']))} findings): {n_rob} robust, "
         f"{n_all - n_rob} depend on a control ("

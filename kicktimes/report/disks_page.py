@@ -510,7 +510,7 @@ def write_disks_page(store_paths, out_dir, *, command="python analysis/make_disk
         by_control["bulk"] = tables(stores, within=BULK_WITHIN)
     long = controls_findings(by_control) if len(by_control) > 1 else pd.DataFrame()
     if not long.empty:
-        long.to_csv(out / "disks_controls_findings.csv", index=False)
+        long.to_csv(out / "disks_controls.csv", index=False)
     renewal = pd.concat([renewal_models(st) for st in stores], ignore_index=True)
     renewal.to_csv(out / "disks_renewal.csv", index=False)
     hazard = pd.concat([disks_hazard(st) for st in stores], ignore_index=True)
