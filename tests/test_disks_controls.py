@@ -247,3 +247,12 @@ def test_the_page_gives_every_finding_under_its_controls(tiny, tmp_path):
     # every finding's cell is "robust: <verdict>" or "depends on <control>: <numbers>"
     for _, g in long.groupby(["family", "n_disks", "diagnostic"]):
         assert robust_text(g) in text
+
+
+def test_the_bulk_control_refuses_a_store_whose_seeds_now_tag_other_disks(tiny):
+    from kicktimes.report.disks import bulk_rows
+
+    other = dataclasses.replace(tiny, collisions=tiny.collisions.assign(
+        disk=tiny.collisions["disk"] + 1000))
+    with pytest.raises(ValueError, match="rerun the store"):
+        bulk_rows(other, 0.5)

@@ -265,12 +265,19 @@ def bulk_rows(store, within):
     keep = np.zeros(len(col), bool)
     pos = {key: m for m, key in enumerate(zip(col["n_disks"], col["ic"], col["disk"],
                                               strict=True))}
+    found = 0
     for n, k in sorted(set(zip(col["n_disks"], col["ic"], strict=True))):
         tagged, radii = tagged_start_radii(store.experiment, int(n), int(k))
         for d, rad in zip(tagged, radii, strict=True):
             m = pos.get((n, k, int(d)))
             if m is not None:
                 keep[m] = rad <= within
+                found += 1
+    if found != len(col):
+        # the redrawn states tag other disks than the store's runs did: the code that draws
+        # a run's state has changed since the store was written
+        raise ValueError(f"store: {len(col) - found} of its {len(col)} tagged disks are not "
+                         f"the ones its runs' seeds tag now; rerun the store")
     return keep
 
 
