@@ -4,7 +4,8 @@
 
     python analysis/make_disks.py --stores stores-disks --out docs/results
 
-runs (or resumes) every preset of ``kicktimes.experiment.DISKS_PRESETS`` into
+runs (or resumes) every preset of ``kicktimes.experiment.DISKS_PRESETS``, their controls
+``DISKS_CONTROLS`` and the two-disk references ``DISKS_REFERENCES`` into
 ``STORES/store-<name>`` on one worker, then writes ``OUT/disks.md``, its CSV tables and
 figures (:func:`kicktimes.report.disks_page.reproduce_disks`). The same as
 ``kicktimes reproduce --study disks --out STORES --results OUT``.

@@ -20,9 +20,11 @@ Examples
 
 from kicktimes.experiment.config import DIAGNOSTICS, SYSTEMS, Experiment
 from kicktimes.experiment.disks import (
+    DISKS_CONTROLS,
     DISKS_PRESETS,
     DISKS_REFERENCES,
     DisksExperiment,
+    disks_control,
     disks_preset,
 )
 from kicktimes.experiment.disks_tasks import execute_disks_task
@@ -50,6 +52,7 @@ from kicktimes.experiment.tasks import (
 __all__ = [
     "COLLISION_COLUMNS",
     "DIAGNOSTICS",
+    "DISKS_CONTROLS",
     "DISKS_PRESETS",
     "DISKS_REFERENCES",
     "DisksExperiment",
@@ -62,6 +65,7 @@ __all__ = [
     "StoreWarning",
     "Task",
     "TaskOutput",
+    "disks_control",
     "disks_preset",
     "execute_disks_task",
     "execute_task",

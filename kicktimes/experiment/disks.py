@@ -25,6 +25,7 @@ True
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import json
 import math
@@ -32,15 +33,23 @@ from dataclasses import asdict, dataclass, field, fields
 
 from kicktimes._validation import check_choice, check_int, check_real
 
-__all__ = ["DISKS_PRESETS", "DISKS_REFERENCES", "DisksExperiment", "DisksTask", "disks_preset"]
+__all__ = ["DISKS_CONTROLS", "DISKS_PRESETS", "DISKS_REFERENCES", "DisksExperiment", "DisksTask",
+           "KICKED_SYSTEMS", "disks_control", "disks_preset"]
 
 RULES = ("mirror", "elastic")
 #: the number of disks a packing preset sweeps (issue 42)
 N_SWEEP = (2, 3, 4, 6, 10, 30, 100, 300, 1000)
 #: the largest packing `kicktimes.initial_state` builds
 PACKING_MAX = 0.7
-#: fields added after the first stores, with the value that leaves those stores' hash
+#: fields added after the first stores, with the value that leaves those stores' hash: the
+#: kicked comparison's (left out of the hash while it is off) and later ones (left out of the
+#: hash whenever they are at this value)
 _LATER_FIELDS = {"kicked_runs": 0, "kicked_time": 60.0}
+_LATER_OPTIONAL = {"kicked_systems": ("poisson", "actual")}
+#: the kicked single disk's systems: uniform new directions at Poisson times of the gas
+#: disk's rate (poisson) or at its collision times (actual); scattering kicks off a virtual
+#: partner from the collision kernel at Poisson times of that rate (scatter)
+KICKED_SYSTEMS = ("poisson", "actual", "scatter")
 
 
 @dataclass(frozen=True)
@@ -122,6 +131,11 @@ class DisksExperiment:
         boundary-angle autocorrelation and recurrence rate are compared with those of one
         disk from its state kicked at its own collision rate (Poisson) and at its
         collision times (actual). Mirror rule only.
+    kicked_systems : tuple of str
+        The kicked systems of that comparison, from `KICKED_SYSTEMS` (default ``("poisson",
+        "actual")``; ``"scatter"``: kicks at Poisson times of the disk's rate, each a
+        collision with a virtual partner drawn from the collision kernel,
+        `kicktimes.billiard.scatter`).
     """
 
     name: str
@@ -140,6 +154,7 @@ class DisksExperiment:
     description: str = field(default="")
     kicked_runs: int = 0
     kicked_time: float = 60.0
+    kicked_systems: tuple = ("poisson", "actual")
 
     #: what a store's record says this is (`Experiment` records have no ``kind``)
     kind = "disks"
@@ -192,6 +207,16 @@ class DisksExperiment:
             raise TypeError(f"description: expected a string, got {self.description!r}")
         put("kicked_runs", check_int("kicked_runs", self.kicked_runs, low=0))
         put("kicked_time", check_real("kicked_time", self.kicked_time, low=0.0))
+        systems = self.kicked_systems
+        if isinstance(systems, (str, bytes)) or not hasattr(systems, "__iter__"):
+            raise TypeError(f"kicked_systems: expected a list of systems, got {systems!r}")
+        systems = tuple(systems)
+        for s in systems:
+            check_choice("kicked_systems", s, KICKED_SYSTEMS)
+        if not systems or len(set(systems)) != len(systems):
+            raise ValueError(f"kicked_systems: give distinct systems of {KICKED_SYSTEMS}, got "
+                             f"{list(systems)}")
+        put("kicked_systems", systems)
         if self.kicked_runs and self.rule != "mirror":
             raise ValueError(f"kicked_runs: the kicked disk keeps its speed, so the comparison "
                              f"needs rule='mirror', got rule={self.rule!r}")
@@ -255,6 +280,7 @@ class DisksExperiment:
         """JSON-ready dict of every field, with ``kind = "disks"``."""
         out = asdict(self)
         out["n_disks"] = list(out["n_disks"])
+        out["kicked_systems"] = list(out["kicked_systems"])
         out["kind"] = self.kind
         return out
 
@@ -277,12 +303,16 @@ class DisksExperiment:
 
     def hash(self) -> str:
         """Stable identity: the first 16 hex digits of SHA-256 of the canonical JSON (the
-        kicked comparison's fields left out while it is off, as before they existed)."""
+        kicked comparison's fields left out while it is off, later fields while they have
+        their first value, as before they existed)."""
         record = self.to_dict()
         if not self.kicked_runs:
             for key, default in _LATER_FIELDS.items():
                 if record[key] == default:
                     del record[key]
+        for key, default in _LATER_OPTIONAL.items():
+            if tuple(record[key]) == default:
+                del record[key]
         text = json.dumps(record, sort_keys=True, separators=(",", ":"), allow_nan=False)
         return hashlib.sha256(text.encode()).hexdigest()[:16]
 
@@ -325,22 +355,48 @@ DISKS_PRESETS = {
 #: 16 runs per N of 200 mean free times each
 DISKS_PRESETS["disks-kicked-phi0.02-mirror"] = DisksExperiment(
     name="disks-kicked-phi0.02-mirror", n_disks=N_SWEEP, packing=0.02, rule="mirror", seed=43,
-    n_tagged=16, min_runs=16, kicked_runs=16, kicked_time=200.0,
-    description="The kicked single disk against the tagged disk of N = 2 .. 1000 disks at "
-                "packing 0.02, mirror rule: FTLE, boundary-angle ACF, recurrence.")
+    n_tagged=16, min_runs=16, kicked_runs=16, kicked_time=200.0, kicked_systems=KICKED_SYSTEMS,
+    description="The kicked single disk (uniform kicks at Poisson and at the actual times, "
+                "scattering kicks from the collision kernel at Poisson times) against the "
+                "tagged disk of N = 2 .. 1000 disks at packing 0.02, mirror rule: FTLE, "
+                "boundary-angle ACF, recurrence.")
+
+#: the controls of every sweep, named ``<sweep>-<control>``: an independent replicate
+#: (``seed``: another root seed, the same design) and another number of collisions per tagged
+#: disk (``k60``: K = 60, another seed too; the tests' power grows with K)
+_CONTROL_FIELDS = {"seed": {"seed": 1042}, "k60": {"collisions": 60, "seed": 2042}}
+DISKS_CONTROLS = {
+    f"{name}-{control}": dataclasses.replace(
+        exp, name=f"{name}-{control}", **change,
+        description=f"{exp.description} Control {control!r} of {name}: "
+                    + ", ".join(f"{k} = {v}" for k, v in change.items()) + ".")
+    for name, exp in DISKS_PRESETS.items() if not exp.kicked_runs
+    for control, change in _CONTROL_FIELDS.items()
+}
+
+#: the elastic N = 2 validation with the power its 10 % margin needs (issue 42): 30000
+#: two-disk runs of the engine (one tagged disk each) against as many of the two-disk
+#: simulator (`DISKS_REFERENCES`); the sample size from the share's binomial variance
+DISKS_N2_RUNS = 30000
+DISKS_PRESETS["disks-n2-phi0.02-elastic"] = DisksExperiment(
+    name="disks-n2-phi0.02-elastic", n_disks=(2,), packing=0.02, rule="elastic", seed=45,
+    n_tagged=DISKS_N2_RUNS, block_sequences=2500,
+    description="Two disks in the N-disk engine at packing 0.02 (r = 0.1), elastic rule, "
+                f"{DISKS_N2_RUNS} runs: the powered validation against the two-disk "
+                "simulator.")
 
 
-def _two_disk_reference(rule):
+def _two_disk_reference(rule, *, name=None, n_ics=None, seed=44):
     from kicktimes.experiment.config import Experiment
 
     base = DISKS_PRESETS[f"disks-phi0.02-{rule}"]
     r = base.radius(2)
     horizon = base.t_max(2)
     return Experiment(
-        name=f"disks-two-phi0.02-{rule}", radii=[r], n_ics=base.n_tagged,
-        n_steps=int(math.ceil(horizon / 0.5)), tau=0.5, ic_method="uniform", seed=44,
+        name=name or f"disks-two-phi0.02-{rule}", radii=[r], n_ics=n_ics or base.n_tagged,
+        n_steps=int(math.ceil(horizon / 0.5)), tau=0.5, ic_method="uniform", seed=seed,
         rule=rule, systems=("two_particle",), diagnostics=("autocorrelation",),
-        block_size=500,
+        block_size=500 if n_ics is None else 2500,
         description=f"The two-disk simulator at the radius of N = 2 at packing 0.02 "
                     f"(r = {r:g}), invariant-measure ICs, {rule} rule, as long as the "
                     f"disks sweep's N = 2 runs: the reference of its N = 2 row.")
@@ -350,10 +406,24 @@ def _two_disk_reference(rule):
 #: of one radius, invariant-measure ICs, as many ICs as tagged disks): the N = 2 row of the
 #: disks sweep against the two-disk results
 DISKS_REFERENCES = {f"disks-two-phi0.02-{rule}": _two_disk_reference(rule) for rule in RULES}
+DISKS_REFERENCES["disks-two-n2-phi0.02-elastic"] = _two_disk_reference(
+    "elastic", name="disks-two-n2-phi0.02-elastic", n_ics=DISKS_N2_RUNS, seed=46)
+
+
+def disks_control(name: str):
+    """``(sweep, control)`` of a control preset's name (`DISKS_CONTROLS`), else ``None``.
+
+    >>> disks_control("disks-phi0.2-elastic-k60"), disks_control("disks-phi0.2-elastic")
+    (('disks-phi0.2-elastic', 'k60'), None)
+    """
+    head, _, control = name.rpartition("-")
+    return (head, control) if control in _CONTROL_FIELDS and head else None
 
 
 def disks_preset(name: str) -> DisksExperiment:
-    """The built-in disks experiment ``name``: one of `DISKS_PRESETS`, or of the two-disk
-    references `DISKS_REFERENCES` (`Experiment` objects)."""
-    check_choice("name", name, sorted(DISKS_PRESETS) + sorted(DISKS_REFERENCES))
-    return DISKS_PRESETS.get(name) or DISKS_REFERENCES[name]
+    """The built-in disks experiment ``name``: one of `DISKS_PRESETS`, of their controls
+    `DISKS_CONTROLS`, or of the two-disk references `DISKS_REFERENCES` (`Experiment`
+    objects)."""
+    check_choice("name", name, sorted(DISKS_PRESETS) + sorted(DISKS_CONTROLS)
+                 + sorted(DISKS_REFERENCES))
+    return DISKS_PRESETS.get(name) or DISKS_CONTROLS.get(name) or DISKS_REFERENCES[name]

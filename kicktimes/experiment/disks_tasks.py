@@ -28,7 +28,8 @@ import pandas as pd
 from kicktimes.experiment.disks import DisksExperiment, DisksTask
 
 __all__ = ["DISKS_COLLISION_COLUMNS", "DISKS_RESULT_COLUMNS", "KICKED_EPS",
-           "execute_disks_task", "interval_speeds", "kicked_rows", "run_disks"]
+           "execute_disks_task", "interval_speeds", "kicked_rows", "run_disks",
+           "tagged_start_radii"]
 
 DISKS_RESULT_COLUMNS = ("n_disks", "radius", "ic", "system", "diagnostic", "value", "note")
 DISKS_COLLISION_COLUMNS = ("n_disks", "radius", "ic", "disk", "t_window", "n_pp", "pp_times",
@@ -92,15 +93,31 @@ def interval_speeds(pp_times, wall_times, sample_times, positions, wall_position
     return out
 
 
+def _start(experiment: DisksExperiment, n_disks: int, k: int):
+    """Run ``k``'s generator, initial state and tagged disks (its first draws)."""
+    from kicktimes.billiard import initial_state
+
+    rng = np.random.default_rng(np.random.SeedSequence(experiment.seed, spawn_key=(n_disks, k)))
+    state = initial_state(n_disks, experiment.radius(n_disks), seed=rng, rule=experiment.rule)
+    tagged = np.sort(rng.choice(n_disks, experiment.tagged_per_run(n_disks), replace=False))
+    return rng, state, tagged
+
+
+def tagged_start_radii(experiment: DisksExperiment, n_disks: int, k: int):
+    """The tagged disks of run ``k`` at ``n_disks`` and their centres' distances from the
+    table's centre at ``t = 0``: ``(tagged, radii)``, redrawn from the run's seed (no
+    simulation), e.g. to keep the disks that start in the bulk, away from the wall."""
+    _, state, tagged = _start(experiment, n_disks, k)
+    return tagged, np.hypot(state[tagged, 0], state[tagged, 1])
+
+
 def run_disks(experiment: DisksExperiment, n_disks: int, k: int):
     """Run ``k`` at ``n_disks``: ``(run, tagged, speeds)``, ``speeds`` a list of arrays
     (`interval_speeds`, one per tagged disk; ``None`` under the mirror rule, all speeds 1)."""
-    from kicktimes.billiard import initial_state, simulate_disks
+    from kicktimes.billiard import simulate_disks
 
-    rng = np.random.default_rng(np.random.SeedSequence(experiment.seed, spawn_key=(n_disks, k)))
+    rng, state, tagged = _start(experiment, n_disks, k)
     r = experiment.radius(n_disks)
-    state = initial_state(n_disks, r, seed=rng, rule=experiment.rule)
-    tagged = np.sort(rng.choice(n_disks, experiment.tagged_per_run(n_disks), replace=False))
     t_max = experiment.t_max(n_disks)
     if experiment.rule == "mirror":
         return simulate_disks(state, r, t_max=t_max, rule="mirror"), tagged, None
@@ -131,7 +148,10 @@ def kicked_rows(experiment: DisksExperiment, n_disks: int, k: int) -> list:
     its FTLE is the whole gas's, `kicktimes.diagnostics.gas_lyapunov.disks_lyapunov`),
     ``"poisson"`` and ``"actual"`` (one disk from disk 0's state, kicked with uniform new
     directions at disk 0's own rate ``n / T`` or at its collision times; FTLE from tangent
-    vectors, `kicktimes.diagnostics.lyapunov`) and, at N = 2, ``"two_particle"`` (the
+    vectors, `kicktimes.diagnostics.lyapunov`), ``"scatter"`` (kicked at that rate, each
+    kick a mirror collision with a virtual partner of radius ``r`` from the collision
+    kernel, ``kick_angle="scatter"``, ``partner="weighted"``), those of
+    `DisksExperiment.kicked_systems`, and, at N = 2, ``"two_particle"`` (the
     two-disk FTLE of the same state, `lyapunov`). Diagnostics: ``ftle``, ``acf@1`` (the
     boundary angles' lag-1 autocorrelation, `kicktimes.diagnostics.autocorrelation`),
     ``rr`` (the recurrence rate of the sampled positions at ``KICKED_EPS``) and, for the
@@ -169,10 +189,16 @@ def kicked_rows(experiment: DisksExperiment, n_disks: int, k: int) -> list:
         rows += [("gas", "ftle", ftle), ("gas", "acf@1", autocorrelation(theta, 1)),
                  ("gas", "rr", recurrence_rate(gas.samples[:, 0], KICKED_EPS)),
                  ("gas", "rate", times.size / t_max)]
-        for system, kicks in (("poisson", Poisson(times.size / t_max)),
-                              ("actual", Replay(times, t_max=t_max))):
-            one = simulate_one_particle(state[0], r, t_max=t_max, kicks=kicks,
-                                        rng=rng, tau=tau)
+        schedules = {"poisson": Poisson(times.size / t_max),
+                     "actual": Replay(times, t_max=t_max),
+                     "scatter": Poisson(times.size / t_max)}
+        for system in experiment.kicked_systems:
+            # scatter: each kick a mirror collision with a partner of the gas's radius drawn
+            # from the collision kernel (flux-weighted direction, (w.n)+ normal)
+            kind = ({"kick_angle": "scatter", "rule": "mirror", "partner": "weighted",
+                     "partner_radius": r} if system == "scatter" else {})
+            one = simulate_one_particle(state[0], r, t_max=t_max, kicks=schedules[system],
+                                        rng=rng, tau=tau, **kind)
             rows += [(system, "ftle", lyapunov(one).lam),
                      (system, "acf@1", autocorrelation(boundary_angles(one), 1)),
                      (system, "rr", recurrence_rate(one.samples[:, :2], KICKED_EPS))]

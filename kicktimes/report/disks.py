@@ -44,13 +44,13 @@ from kicktimes.stats import (
     poisson_group,
     ratio_verdict,
     rejection_verdict,
+    share_ratio_sample_size,
     speed_rate_factor,
 )
 from kicktimes.stats.findings import clopper_pearson
 
-__all__ = ["HAZARD_EDGES", "KICKED_DIAGNOSTICS", "disks_hazard", "disks_table", "kicked_table",
-           "two_disk_check",
-           "rescale_by_speed"]
+__all__ = ["HAZARD_EDGES", "KICKED_DIAGNOSTICS", "bulk_rows", "disks_hazard", "disks_table",
+           "kicked_table", "rescale_by_speed", "two_disk_check"]
 
 #: bins of the hazard, in units of the mean interval
 HAZARD_EDGES = (0.0, 0.01, 0.02, 0.05, 0.1, 0.2, 0.3, 0.5, 0.75, 1.0, 1.5, 2.0, 3.0, 5.0)
@@ -255,7 +255,34 @@ def _row(exp, n, res, col, *, alpha, n_boot, n_mc, rng):
     return row
 
 
-def disks_table(store, *, alpha=0.05, n_boot=999, n_mc=199, seed=0) -> pd.DataFrame:
+def bulk_rows(store, within):
+    """Which collision rows of a disks store are tagged disks whose centre starts at most
+    ``within`` from the table's centre (`kicktimes.experiment.disks_tasks.tagged_start_radii`,
+    redrawn from each run's seed): a boolean array aligned with ``store.collisions``."""
+    from kicktimes.experiment.disks_tasks import tagged_start_radii
+
+    col = store.collisions
+    keep = np.zeros(len(col), bool)
+    pos = {key: m for m, key in enumerate(zip(col["n_disks"], col["ic"], col["disk"],
+                                              strict=True))}
+    found = 0
+    for n, k in sorted(set(zip(col["n_disks"], col["ic"], strict=True))):
+        tagged, radii = tagged_start_radii(store.experiment, int(n), int(k))
+        for d, rad in zip(tagged, radii, strict=True):
+            m = pos.get((n, k, int(d)))
+            if m is not None:
+                keep[m] = rad <= within
+                found += 1
+    if found != len(col):
+        # the redrawn states tag other disks than the store's runs did: the code that draws
+        # a run's state has changed since the store was written
+        raise ValueError(f"store: {len(col) - found} of its {len(col)} tagged disks are not "
+                         f"the ones its runs' seeds tag now; rerun the store")
+    return keep
+
+
+def disks_table(store, *, alpha=0.05, n_boot=999, n_mc=199, seed=0,
+                within=None) -> pd.DataFrame:
     """One row per N of a disks store (see the module's docstring for the columns).
 
     Parameters
@@ -270,6 +297,10 @@ def disks_table(store, *, alpha=0.05, n_boot=999, n_mc=199, seed=0) -> pd.DataFr
         Monte Carlo samples of the conditional nulls (`kicktimes.stats.poisson_group`).
     seed : int
         The bootstrap's and the Monte Carlo's stream (one per N, from ``(seed, N)``).
+    within : float, optional
+        Keep only the tagged disks whose centre starts at most ``within`` from the table's
+        centre (`bulk_rows`): the tagged disks of the bulk, away from the wall. The runs'
+        quantities (the collision rate) are those of all disks.
     """
     from kicktimes.experiment import DisksExperiment
 
@@ -281,10 +312,13 @@ def disks_table(store, *, alpha=0.05, n_boot=999, n_mc=199, seed=0) -> pd.DataFr
         raise ValueError(f"alpha must lie in (0, 1), got {alpha!r}")
     if n_boot < 99:
         raise ValueError(f"n_boot must be >= 99, got {n_boot!r}")
+    collisions = store.collisions
+    if within is not None:
+        collisions = collisions[bulk_rows(store, within)]
     rows = []
     for n in exp.n_disks:
         res = store.results[store.results["n_disks"] == n]
-        col = store.collisions[store.collisions["n_disks"] == n]
+        col = collisions[collisions["n_disks"] == n]
         if res.empty:
             continue
         rng = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(n,)))
@@ -324,7 +358,7 @@ def disks_hazard(store, *, edges=HAZARD_EDGES) -> pd.DataFrame:
 
 #: the kicked comparison's diagnostics and the systems compared with the gas
 KICKED_DIAGNOSTICS = ("ftle", "acf@1", "rr")
-KICKED_SYSTEMS = ("poisson", "actual")
+KICKED_SYSTEMS = ("poisson", "actual", "scatter")
 
 
 def kicked_table(store, *, n_boot=999, seed=0) -> pd.DataFrame:
@@ -347,10 +381,11 @@ def kicked_table(store, *, n_boot=999, seed=0) -> pd.DataFrame:
         rng = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(int(n), 7)))
         weights = rng.multinomial(runs, np.full(runs, 1.0 / runs), size=n_boot).astype(float)
         # (system, diagnostic, reference system, reference diagnostic)
-        pairs = [(s, d, "gas", d) for s in KICKED_SYSTEMS for d in KICKED_DIAGNOSTICS]
+        systems = [s for s in KICKED_SYSTEMS if (s, "ftle") in wide]
+        pairs = [(s, d, "gas", d) for s in systems for d in KICKED_DIAGNOSTICS]
         pairs.append(("gas", "ftle", "gas", "rate"))  # lambda / nu: per collision of a disk
         # the kicked disks' own exponents per collision of the gas's disk (their kick rate)
-        pairs += [(s, "ftle", "gas", "rate") for s in KICKED_SYSTEMS]
+        pairs += [(s, "ftle", "gas", "rate") for s in systems]
         if ("two_particle", "ftle") in wide:
             pairs.append(("gas", "ftle", "two_particle", "ftle"))
         for system, diag, ref, ref_diag in pairs:
@@ -393,8 +428,15 @@ def _share_replicates(times, windows, *, alpha, n_mc, n_boot, rng):
     group = poisson_group(times, windows, alpha=alpha, n_mc=n_mc, rng=rng)
     p = group.ensemble.per_sequence["p_uniformity_ks"].to_numpy()
     rej = (p[np.isfinite(p)] < alpha).astype(float)
-    idx = rng.integers(0, rej.size, size=(n_boot, rej.size))
-    return float(rej.mean()), rej[idx].mean(axis=1), int(rej.size)
+    return float(rej.mean()), _boot_means(rej, n_boot, rng), int(rej.size)
+
+
+def _boot_means(x, n_boot, rng, chunk=100):
+    """Percentile-bootstrap replicates of the mean of ``x`` (each value its own cluster),
+    drawn ``chunk`` replicates at a time (the same stream as all at once)."""
+    out = [x[rng.integers(0, x.size, size=(min(chunk, n_boot - m), x.size))].mean(axis=1)
+           for m in range(0, n_boot, chunk)]
+    return np.concatenate(out)
 
 
 def two_disk_check(disks_store, two_store, *, alpha=0.05, n_boot=999, n_mc=199, seed=0):
@@ -415,7 +457,11 @@ def two_disk_check(disks_store, two_store, *, alpha=0.05, n_boot=999, n_mc=199, 
         (``K = collisions`` of the disks sweep, window to collision K + 1) reject uniform
         times at ``alpha``, with its percentile bootstrap CI and its count; ``ratio``:
         engine over two-disk, CI from the ratio of independent replicates, and its
-        `kicktimes.stats.ratio_verdict`; ``radius``, ``rule``, the stores' names.
+        `kicktimes.stats.ratio_verdict`; ``rate_ratio`` (``_low``, ``_high``, ``_verdict``):
+        the same for the mean collision rate per run (``n_pp / t_window``), a statistic
+        with more power; ``n_needed``: the runs per arm the share ratio needs to be called
+        within 10 % with probability 0.8 at the two-disk share
+        (`kicktimes.stats.share_ratio_sample_size`); ``radius``, ``rule``, the stores' names.
     """
     exp, two = disks_store.experiment, two_store.experiment
     k = exp.collisions
@@ -439,4 +485,12 @@ def two_disk_check(disks_store, two_store, *, alpha=0.05, n_boot=999, n_mc=199, 
         out["ratio"] = engine[0] / ref[0] if ref[0] > 0 else math.nan
         out["ratio_low"], out["ratio_high"] = _ci(engine[1] / ref[1])
     out["ratio_verdict"] = ratio_verdict(out["ratio_low"], out["ratio_high"])
+    out["n_needed"] = (share_ratio_sample_size(ref[0]) if 0 < ref[0] < 1 else math.nan)
+    rates = []
+    for c in (col[col["n_disks"] == 2], two_store.collisions):
+        rate = c["n_pp"].to_numpy(float) / c["t_window"].to_numpy(float)
+        rates.append((rate.mean(), _boot_means(rate, n_boot, rng)))
+    out["rate_ratio"] = rates[0][0] / rates[1][0]
+    out["rate_ratio_low"], out["rate_ratio_high"] = _ci(rates[0][1] / rates[1][1])
+    out["rate_ratio_verdict"] = ratio_verdict(out["rate_ratio_low"], out["rate_ratio_high"])
     return out

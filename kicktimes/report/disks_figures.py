@@ -3,7 +3,9 @@
 `rejection_figure` (the Poisson battery's rejection shares against N), `hazard_figure` (the
 hazard of the next collision against the time since the last, per N) and `rates_figure`
 (collision frequency over Enskog's, index of dispersion and the hazard's first bin
-against N), from `kicktimes.report.disks.disks_table` and `disks_hazard`.
+against N), from `kicktimes.report.disks.disks_table` and `disks_hazard`; `controls_figure`
+(the findings under their controls against N, from
+`kicktimes.report.disks_controls.controls_findings`).
 """
 
 from __future__ import annotations
@@ -14,7 +16,8 @@ from matplotlib.ticker import FuncFormatter
 from kicktimes.report.disks import HAZARD_EDGES
 from kicktimes.report.figures import plain_log_ticks
 
-__all__ = ["geometries_of", "hazard_figure", "rates_figure", "rejection_figure"]
+__all__ = ["controls_figure", "geometries_of", "hazard_figure", "rates_figure",
+           "rejection_figure"]
 
 ALPHA = 0.05
 HEADLINE = "uniformity_ks"
@@ -199,4 +202,72 @@ def rates_figure(table):
     handles, labels = axes[0, 0].get_legend_handles_labels()
     fig.legend(handles, labels, loc="lower center", ncol=4, fontsize=8, frameon=False)
     fig.tight_layout(rect=(0, 0.1, 1, 1))
+    return fig
+
+
+#: the controls figure's findings: (the controls table's diagnostic, y label, band, scale)
+CONTROL_PANELS = (("count dispersion D", "index of dispersion D", (0.9, 1.1), 1.0),
+                  ("uniform-times rejection share", "uniform times rejected (%)",
+                   (100 * ALPHA * 0.5, 100 * ALPHA * 1.5), 100.0),
+                  ("hazard first bin", "first hazard bin / rate", (0.9, 1.1), 1.0))
+CONTROL_STYLES = {"primary": ("k", "o"), "seed": ("C0", "s"), "k60": ("C3", "^"),
+                  "bulk": ("C2", "D")}
+
+
+def controls_figure(long, *, n_min=10, names=None):
+    """The findings under their controls against N (``N >= n_min``): one row per geometry x
+    rule, one column per finding of `CONTROL_PANELS`, the controls dodged sideways with
+    their own colours and markers, 95 % CIs, the finding's band shaded (±10 % for the
+    ratios, the nominal band for the share), one y scale per column, a hollow marker where
+    the finding is not robust (`kicktimes.report.disks_controls.controls_findings`, its
+    ``robust``)."""
+    import matplotlib.pyplot as plt
+
+    d = long[long["n_disks"] >= n_min]
+    if d.empty:
+        raise ValueError(f"long: no finding at N >= n_min = {n_min}")
+    families = list(dict.fromkeys(d["family"]))
+    controls = [c for c in CONTROL_STYLES if c in set(d["control"])]
+    ns = sorted(set(d["n_disks"]))
+    fig, axes = plt.subplots(len(families), len(CONTROL_PANELS),
+                             figsize=(4.3 * len(CONTROL_PANELS), 2.3 * len(families) + 0.8),
+                             sharex=True, sharey="col", squeeze=False)
+    for i, fam in enumerate(families):
+        for j, (finding, label, band, scale) in enumerate(CONTROL_PANELS):
+            ax = axes[i, j]
+            ax.axhspan(*band, color="0.88", zorder=0)
+            ax.axhline(1.0 if scale == 1.0 else 100 * ALPHA, color="0.5", lw=0.8, zorder=0)
+            for k, control in enumerate(controls):
+                g = d[(d["family"] == fam) & (d["diagnostic"] == finding)
+                      & (d["control"] == control)]
+                if g.empty:
+                    continue
+                color, marker = CONTROL_STYLES[control]
+                x = g["n_disks"].to_numpy() * (1.0 + 0.09 * (k - (len(controls) - 1) / 2))
+                y = scale * g["estimate"].to_numpy()
+                err = np.abs(scale * g[["ci_low", "ci_high"]].to_numpy().T - y)
+                ax.errorbar(x, y, yerr=err, color=color, marker="none", ls="none", lw=1,
+                            capsize=2)
+                for rob in (True, False):
+                    m = g["robust"].to_numpy() == rob
+                    ax.plot(x[m], y[m], ls="none", marker=marker, ms=4.5, color=color,
+                            mfc=color if rob else "white",
+                            label=(names or {}).get(control, control) if rob else None)
+            _n_ticks(ax, ns)
+            ax.tick_params(axis="x", labelsize=7)
+            ax.set_title(f"{fam}: {finding}", fontsize=8.5)
+            ax.set_ylabel(label, fontsize=8)
+            if i == len(families) - 1:
+                ax.set_xlabel("number of disks N")
+    handles, labels = [], []
+    for ax in axes.ravel():
+        for h, lab in zip(*ax.get_legend_handles_labels(), strict=True):
+            if lab not in labels:
+                handles.append(h)
+                labels.append(lab)
+    handles.append(axes[0, 0].plot([], [], ls="none", marker="o", mfc="white", color="0.3")[0])
+    labels.append("hollow: not robust at that N")
+    fig.legend(handles, labels, loc="upper center", ncol=len(labels), fontsize=8.5,
+               frameon=False)
+    fig.tight_layout(rect=(0, 0, 1, 1 - 0.5 / (2.3 * len(families) + 0.8)))
     return fig

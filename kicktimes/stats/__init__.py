@@ -39,6 +39,7 @@ from .findings import (
     rejection_rule,
     rejection_verdict,
     robust_verdict,
+    share_ratio_sample_size,
 )
 from .gof import GofResult, goodness_of_fit
 from .groups import PoissonGroup, poisson_group, pooled_intervals
@@ -108,6 +109,7 @@ __all__ = [
     "Finding",
     "ratio_verdict",
     "robust_verdict",
+    "share_ratio_sample_size",
     "format_interval",
     "rejection_verdict",
     "rejection_rule",

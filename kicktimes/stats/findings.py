@@ -34,6 +34,7 @@ __all__ = [
     "share_verdict",
     "SHARE_RULE",
     "clopper_pearson",
+    "share_ratio_sample_size",
     "effect_statement",
     "format_p",
 ]
@@ -198,6 +199,35 @@ def share_verdict(low, high, level):
     if high < level:
         return "below"
     return "inconclusive"
+
+
+def share_ratio_sample_size(share, tolerance=0.1, power=0.8, level=0.95):
+    """Runs per arm for the ratio of two equal shares to be called within ``tolerance``.
+
+    The sample size at which the ratio of two independent shares, both equal to ``share``
+    (true ratio 1), gets its ``level`` interval inside ``[1 - tolerance, 1 + tolerance]``
+    (:func:`ratio_verdict`'s equivalence test) with probability at least ``power``, on the
+    log scale (the delta method): ``SE(log ratio)^2 = 2 (1 - p) / (n p)`` and
+    ``n = 2 (1 - p) / p * ((z_level + z_power) / log(1 + tolerance))^2`` with
+    ``z_level`` the two-sided quantile and ``z_power = Phi^-1((1 + power) / 2)`` (the
+    estimate may fall on either side), the band taken as symmetric at its narrower side
+    ``log(1 + tolerance)``; the wider lower side ``-log(1 - tolerance)`` makes the power a
+    little higher (0.85 for 0.8 at a 10 % tolerance).
+
+    Examples
+    --------
+    >>> share_ratio_sample_size(0.08)
+    26604
+    >>> share_ratio_sample_size(0.35) < share_ratio_sample_size(0.08)
+    True
+    """
+    from scipy.stats import norm
+
+    p = float(share)
+    if not 0 < p < 1:
+        raise ValueError(f"share must lie in (0, 1), got {share!r}")
+    z = norm.ppf(0.5 + level / 2) + norm.ppf(0.5 + power / 2)
+    return int(math.ceil(2 * (1 - p) / p * (z / math.log1p(tolerance)) ** 2))
 
 
 def clopper_pearson(k, n, level=0.95):

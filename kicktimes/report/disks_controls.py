@@ -1,0 +1,227 @@
+"""The disks page's findings under their controls: docs/results/disks_controls.csv.
+
+(Not named ``*_findings.csv``: those are the sweep report's tables, one schema with a
+``question`` column, that tests/test_results_pages.py reads; this table has the columns
+``claims_lint`` reads, ``family, diagnostic, system, control, estimate, ci_low, ci_high,
+verdict, robust``, and its verdicts are of three kinds.)
+
+Every finding of a row (geometry x rule x N) of `kicktimes.report.disks.disks_table` is
+computed under the primary design and under each control:
+
+* ``seed``: an independent replicate, the same sweep from another root seed (the store
+  ``<sweep>-seed``, `kicktimes.experiment.DISKS_CONTROLS`);
+* ``k60``: the tests read at K = 60 collisions per tagged disk instead of 30 (the store
+  ``<sweep>-k60``, another seed too): the tests' power grows with K, so this control can
+  turn "nominal" into "above nominal";
+* ``bulk``: the primary store's tagged disks that start in the bulk, their centre within
+  `BULK_WITHIN` of the table's centre (`kicktimes.report.disks.disks_table`'s ``within``):
+  the wall changes a disk's surroundings, so a wall effect would show as a difference.
+  The collision rate is a quantity of all disks of a run, so ``bulk`` is not a control of
+  rate / Enskog.
+
+A finding is **robust** (`kicktimes.stats.robust_verdict`) when every control gives the
+primary's verdict and no control's interval lies above the finding's level while another's
+lies below it; otherwise it *depends on* the controls whose verdict differs (or, for a
+change of direction alone, whose interval lies on the other side of the level).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pandas as pd
+
+from kicktimes.stats import format_interval, robust_verdict
+
+__all__ = ["BULK_WITHIN", "CONTROL_NAMES", "FINDINGS", "controls_findings", "controls_lines",
+           "robust_text"]
+
+#: the bulk control keeps the tagged disks starting within this distance of the centre
+#: (a quarter of the table's area)
+BULK_WITHIN = 0.5
+#: the controls, in the page's order, and how the page names them
+CONTROL_NAMES = {"primary": "primary (K = 30, seed 42)", "seed": "replicate (seed 1042)",
+                 "k60": "K = 60", "bulk": f"bulk tagged disks (start |x| ≤ {BULK_WITHIN:g})"}
+#: finding -> (column of disks_table, level of its direction, kind of verdict); the names
+#: are the CSV's ``diagnostic``
+FINDINGS = {
+    "count dispersion D": ("dispersion", 1.0, "ratio"),
+    "uniform-times rejection share": ("reject_uniformity_ks", 0.05, "share"),
+    "hazard flatness": ("hazard_flat_pvalue", 0.05, "p"),
+    "hazard first bin": ("hazard_first", 1.0, "ratio"),
+    "rate / Enskog": ("rate_enskog", 1.0, "ratio"),
+}
+#: the controls that do not apply to a finding
+NOT_A_CONTROL = {("rate / Enskog", "bulk")}
+
+
+def _p_verdict(p, alpha):
+    if not np.isfinite(p):
+        return "undetermined"
+    return "flatness rejected" if p < alpha else "flatness not rejected"
+
+
+def controls_findings(tables: dict) -> pd.DataFrame:
+    """The long table of every finding under every control.
+
+    Parameters
+    ----------
+    tables : dict
+        Control name (``"primary"`` and any of `CONTROL_NAMES`) -> a `disks_table` of the
+        sweeps under that control (rows ``geometry, rule, n_disks``).
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per geometry x rule x N x finding x control: ``family`` (``"<geometry>,
+        <rule>"``), ``geometry``, ``rule``, ``n_disks``, ``system`` (``"N=<n>"``),
+        ``diagnostic`` (the finding), ``control``, ``estimate``, ``ci_low``, ``ci_high``
+        (NaN for the hazard's flatness, a p-value), ``verdict``, and over the group's
+        controls ``robust`` (`kicktimes.stats.robust_verdict`), ``reason`` and
+        ``depends_on`` (the controls that break it, ``;``-separated).
+
+    Examples
+    --------
+    >>> import pandas as pd
+    >>> row = dict(geometry="packing 0.02", rule="mirror", n_disks=30, dispersion=1.2,
+    ...            dispersion_low=1.15, dispersion_high=1.25, dispersion_verdict="higher")
+    >>> other = dict(row, dispersion=1.05, dispersion_low=0.97, dispersion_high=1.09,
+    ...              dispersion_verdict="within 10 %")
+    >>> t = controls_findings({"primary": pd.DataFrame([row]), "k60": pd.DataFrame([other])})
+    >>> t[["control", "verdict", "robust", "depends_on"]].values.tolist()
+    [['primary', 'higher', False, 'k60'], ['k60', 'within 10 %', False, 'k60']]
+    """
+    if "primary" not in tables:
+        raise ValueError(f"tables: needs the 'primary' table, got {sorted(tables)}")
+    rows = []
+    for control, table in tables.items():
+        for _, r in table.iterrows():
+            for finding, (key, level, kind) in FINDINGS.items():
+                if key not in r or (finding, control) in NOT_A_CONTROL:
+                    continue
+                if kind == "p":
+                    est, lo, hi = float(r[key]), math.nan, math.nan
+                    verdict = _p_verdict(est, level)
+                else:
+                    est, lo, hi = float(r[key]), float(r[f"{key}_low"]), float(r[f"{key}_high"])
+                    verdict = r[f"{key}_verdict"]
+                if not np.isfinite(est):
+                    continue
+                rows.append({"family": f"{r['geometry']}, {r['rule']}",
+                             "geometry": r["geometry"], "rule": r["rule"],
+                             "n_disks": int(r["n_disks"]), "system": f"N={int(r['n_disks'])}",
+                             "diagnostic": finding, "control": control, "estimate": est,
+                             "ci_low": lo, "ci_high": hi, "verdict": verdict, "level": level})
+    out = pd.DataFrame(rows)
+    if out.empty:
+        return out
+    order = {c: m for m, c in enumerate(tables)}
+    out["_order"] = out["control"].map(order)
+    out = out.sort_values(["family", "n_disks", "diagnostic", "_order"], kind="stable")
+    robust, reason, depends = {}, {}, {}
+    for key, g in out.groupby(["family", "n_disks", "diagnostic"], sort=False):
+        ok, why = robust_verdict(g["verdict"].tolist(), g["ci_low"], g["ci_high"],
+                                 level=float(g["level"].iloc[0]))
+        robust[key], reason[key] = ok, why
+        depends[key] = ";".join(_breaking(g)) if not ok else ""
+    keys = list(zip(out["family"], out["n_disks"], out["diagnostic"], strict=True))
+    out["robust"] = [robust[k] for k in keys]
+    out["reason"] = [reason[k] for k in keys]
+    out["depends_on"] = [depends[k] for k in keys]
+    # restore the caller's order of geometries and rules
+    fam = {f: m for m, f in enumerate(dict.fromkeys(
+        f"{g}, {r}" for t in tables.values() for g, r in zip(t["geometry"], t["rule"],
+                                                              strict=True)))}
+    out["_fam"] = out["family"].map(fam)
+    out = out.sort_values(["_fam", "n_disks", "diagnostic", "_order"], kind="stable")
+    return out.drop(columns=["_order", "_fam", "level"]).reset_index(drop=True)
+
+
+def _breaking(g):
+    """The controls that break a group's robustness: those whose verdict is not the
+    primary's, else (a change of direction alone) those on the other side of the level
+    from the primary, else every control on the side opposite to the majority."""
+    prim = g[g["control"] == "primary"].iloc[0]
+    others = g[g["control"] != "primary"]
+    diff = others[others["verdict"] != prim["verdict"]]["control"].tolist()
+    if diff:
+        return diff
+    level = {"uniform-times rejection share": 0.05}.get(prim["diagnostic"], 1.0)
+    above, below = g["ci_low"] > level, g["ci_high"] < level
+    side = "above" if above[prim.name] else "below" if below[prim.name] else None
+    flip = below if side == "above" else above if side == "below" else None
+    if flip is None:
+        return [c for c in g[above | below]["control"] if c != "primary"]
+    return g[flip]["control"].tolist()
+
+
+def _number(row):
+    if not np.isfinite(row["ci_low"]):
+        return f"p = {row['estimate']:.2g}"
+    if row["diagnostic"] == "uniform-times rejection share":
+        text = format_interval(100 * row["estimate"], 100 * row["ci_low"],
+                               100 * row["ci_high"], edges=(2.5, 5.0, 7.5))
+        return f"{text} %"
+    return format_interval(row["estimate"], row["ci_low"], row["ci_high"])
+
+
+def robust_text(group) -> str:
+    """``"robust: higher"`` or ``"depends on k60: 1.08 [1.03, 1.13] inconclusive (primary),
+    1.21 [1.15, 1.27] higher (k60)"`` for the rows of one finding (one per control)."""
+    prim = group[group["control"] == "primary"].iloc[0]
+    if bool(prim["robust"]):
+        return f"robust: {prim['verdict']}"
+    on = [c for c in str(prim["depends_on"]).split(";") if c]
+    shown = group[group["control"].isin(["primary", *on])]
+    nums = ", ".join(f"{_number(r)} {r['verdict']} ({r['control']})"
+                     for _, r in shown.iterrows())
+    return f"depends on {', '.join(on) or 'the direction'}: {nums}"
+
+
+def _cell(long, family, n, finding):
+    g = long[(long["family"] == family) & (long["n_disks"] == n)
+             & (long["diagnostic"] == finding)]
+    return robust_text(g) if not g.empty else "—"
+
+
+def controls_lines(long, *, n_min=30) -> list:
+    """The page's section on the controls: the counts, then one table per geometry x rule
+    (rows N, a column per finding)."""
+    if long.empty:
+        return []
+    prim = long[long["control"] == "primary"]
+    controls = [c for c in CONTROL_NAMES if c in set(long["control"])]
+    big = prim[prim["n_disks"] >= n_min]
+    n_rob, n_all = int(big["robust"].sum()), len(big)
+    by = {c: int(big["depends_on"].str.split(";").apply(lambda s, c=c: c in s).sum())
+          for c in controls if c != "primary"}
+    every = int(prim["robust"].sum())
+    lines = [
+        "## Under the controls", "",
+        "Every finding is computed under the primary design and under each control: "
+        + "; ".join(f"**{c}**: {CONTROL_NAMES[c]}" for c in controls)
+        + " (the replicate and K = 60 are sweeps of their own, `<sweep>-seed` and "
+        "`<sweep>-k60`; the bulk control keeps the primary's tagged disks whose centre starts "
+        "in the inner quarter of the table's area; the collision rate is of all disks, so "
+        "bulk is no control of it). A finding is robust (`stats.robust_verdict`) when every "
+        "control gives the primary's verdict and no interval lies above the finding's level "
+        "(1 for the ratios, 5 % for the share) while another's lies below it; otherwise the "
+        "cell says on which control it depends, with the numbers under the primary and under "
+        "that control. The hazard's flatness has a p-value, no interval: its verdict is "
+        "whether p < 0.05. Every control's number is in "
+        "[disks_controls.csv](disks_controls.csv).", "",
+        f"Over the {n_all} findings of the rows at N ≥ {n_min} ({len(set(big['family']))} "
+        f"geometry × rule, {len(set(big['diagnostic']))} findings): {n_rob} robust, "
+        f"{n_all - n_rob} depend on a control ("
+        + ", ".join(f"{c}: {v}" for c, v in by.items())
+        + f"); over every N: {every} of {len(prim)} robust.", ""]
+    findings = [f for f in FINDINGS if f in set(long["diagnostic"])]
+    for family in dict.fromkeys(long["family"]):
+        lines += [f"**{family}**", "", "| N | " + " | ".join(findings) + " |",
+                  "|---|" + "---|" * len(findings)]
+        for n in sorted(set(long[long["family"] == family]["n_disks"])):
+            lines.append(f"| {n} | " + " | ".join(_cell(long, family, n, f)
+                                                    for f in findings) + " |")
+        lines.append("")
+    return lines

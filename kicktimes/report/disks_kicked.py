@@ -1,0 +1,269 @@
+"""docs/results/disks.md: the kicked single disk against the gas, and the gas's FTLE checks.
+
+The page's sections on the paper's question for a gas (`kicktimes.report.disks.kicked_table`:
+one disk of the gas against one disk kicked with uniform new directions at Poisson times of
+its rate or at its collision times, or scattered off virtual partners from the collision
+kernel at Poisson times) and on the checks of the gas's FTLE
+(``disks_ftle_check.csv``, written beside the page by `kicktimes.diagnostics.gas_lyapunov`'s
+checks, rendered when it exists).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pandas as pd
+
+from kicktimes.stats import format_interval, ratio_verdict
+
+__all__ = ["FTLE_CHECK_COLUMNS", "KICKED_NAMES", "ftle_check_lines", "kicked_answer",
+           "kicked_ftle_cells", "kicked_not_chaotic", "kicked_section", "scatter_answer"]
+
+KICKED_NAMES = {"ftle": "FTLE λ", "acf@1": "boundary-angle ACF R₁", "rr": "recurrence rate"}
+#: the kicked systems the tables show, in order, with their page names
+SYSTEM_NAMES = {"poisson": "Poisson-kicked", "actual": "actual-kicked",
+                "scatter": "scatter-kicked"}
+#: the columns of disks_ftle_check.csv
+FTLE_CHECK_COLUMNS = ("check", "n_disks", "rule", "packing", "n_ics", "t_max", "estimate",
+                      "lo", "hi", "margin", "verdict")
+
+
+def _systems(kicked):
+    return [s for s in SYSTEM_NAMES if (kicked["system"] == f"{s}/gas").any()]
+
+
+def kicked_not_chaotic(kicked, system="poisson"):
+    """The N at which a kicked disk's own FTLE has its interval at or below 0."""
+    if kicked.empty or "value_high" not in kicked:
+        return []
+    f = kicked[(kicked["system"] == f"{system}/gas") & (kicked["diagnostic"] == "ftle")]
+    return [int(n) for n in f[f["value_high"] <= 0.0]["n_disks"]]
+
+
+def _ratio_of(row):
+    return f"{format_interval(row['ratio'], row['ratio_low'], row['ratio_high'])} {row['verdict']}"
+
+
+def _kicked_cell(row, diag):
+    """A kicked/gas ratio, or "—" where no ratio is meaningful: the gas's mean is
+    indistinguishable from 0, the ratio's interval contains 0 (the gas's value too near 0
+    for its noise), or (FTLE) the kicked disk's own exponent has its interval at or below 0."""
+    gas = format_interval(row["reference"], row["reference_low"], row["reference_high"],
+                          edges=(0.0,))
+    if row["reference_low"] <= 0.0 <= row["reference_high"]:
+        return f"— (gas: {gas})"
+    if row["ratio_low"] <= 0.0 <= row["ratio_high"]:
+        return f"— (gas near 0: {gas})"
+    if diag == "ftle" and "value_low" in row and row["value_low"] <= 0.0:
+        return "— (kicked FTLE ≤ 0)"
+    return _ratio_of(row)
+
+
+def _per_collision(row):
+    return format_interval(row["ratio"], row["ratio_low"], row["ratio_high"], edges=(0.0,))
+
+
+def _ftle(row):
+    return format_interval(row["value"], row["value_low"], row["value_high"], edges=(0.0,))
+
+
+def _twin_check(k):
+    """The N = 2 check twin (gas) against tangent (two-disk) FTLE, at the issue's 2 %."""
+    row = k.loc[(2, "gas/two_particle", "ftle")]
+    v2 = ratio_verdict(row["ratio_low"], row["ratio_high"], tolerance=0.02)
+    return (f"at N = 2 the gas's FTLE (`disks_lyapunov`) over the two-disk FTLE of the same "
+            f"states (tangent vectors, `lyapunov`) is "
+            f"{format_interval(row['ratio'], row['ratio_low'], row['ratio_high'])} "
+            f"({int(row['n_runs'])} states): {v2} at the issue's 2 % margin "
+            f"(`ratio_verdict`, tolerance 0.02), "
+            + ("passed" if v2 == "within 2 %" else "not passed")
+            + ("; its interval excludes 1" if not row["ratio_low"] <= 1.0 <= row["ratio_high"]
+               else ""))
+
+
+def scatter_answer(kicked) -> str:
+    """The first screen's sentence on the scatter-kicked disk's FTLE over the gas's."""
+    if "scatter" not in _systems(kicked):
+        return ""
+    k = kicked.set_index(["n_disks", "system", "diagnostic"])
+    ns = sorted(set(kicked["n_disks"]))
+    cells = [f"N = {n}: {_kicked_cell(k.loc[(n, 'scatter/gas', 'ftle')], 'ftle')}"
+             for n in ns]
+    bad = kicked_not_chaotic(kicked, "scatter")
+    return ("The single disk scattered off virtual partners from the collision kernel, at "
+            "Poisson times of the gas disk's rate, has a positive FTLE "
+            + (f"at every N but {', '.join(map(str, bad))}" if bad else "at every N")
+            + "; its FTLE over the gas's (the whole gas's largest exponent, not a "
+            "like-for-like reference): " + "; ".join(cells) + ".")
+
+
+def kicked_answer(kicked, exp) -> list:
+    """The answers' paragraph on the kicked comparison."""
+    k = kicked.set_index(["n_disks", "system", "diagnostic"])
+    ns = sorted(set(kicked["n_disks"]))
+    systems = _systems(kicked)
+
+    def side(n):
+        return (f"N = {n}: Poisson-kicked {_per_collision(k.loc[(n, 'poisson/gas', 'ftle/rate')])}"
+                + (f", scatter-kicked "
+                   f"{_per_collision(k.loc[(n, 'scatter/gas', 'ftle/rate')])}"
+                   if "scatter" in systems else "")
+                + f", gas {_per_collision(k.loc[(n, 'gas/gas', 'ftle/rate')])}")
+
+    check = (f" Check: {_twin_check(k)}." if (2, "gas/two_particle", "ftle") in k.index
+             else "")
+
+    def within(diag):
+        ok = [n for n in ns if all(
+            (n, f"{sy}/gas", diag) in k.index
+            and k.loc[(n, f"{sy}/gas", diag), "verdict"] == "within 10 %"
+            for sy in systems)]
+        return ", ".join(str(n) for n in ok) or "no N"
+
+    names = ", ".join(SYSTEM_NAMES[s] for s in systems)
+    return [f"**Does a kicked disk reproduce a gas better than a partner?** ({exp.geometry_label}, "
+            f"{exp.rule}; below, \"Does a kicked disk reproduce a gas?\") The FTLE per "
+            f"collision of the disk (λ / ν, ν the gas disk's collision rate), the kicked "
+            f"disks' own beside the gas's: {'; '.join(side(n) for n in (ns[0], ns[-1]))}. "
+            "The Poisson-kicked FTLE's interval is at or below 0 at "
+            + (f"N = {', '.join(str(n) for n in kicked_not_chaotic(kicked))}"
+               if kicked_not_chaotic(kicked) else "no N")
+            + " (not chaotic; no ratio stated)"
+            + ((", the scatter-kicked one's at N = " + ", ".join(
+                str(n) for n in kicked_not_chaotic(kicked, "scatter"))
+                if kicked_not_chaotic(kicked, "scatter") else
+                ", the scatter-kicked one's at no N") if "scatter" in systems else "")
+            + ". The gas's reference is the whole gas's largest exponent, which per collision "
+            f"grows with N, so a kicked/gas FTLE ratio is not a like-for-like comparison."
+            f"{check} Every kicked disk ({names}) is within 10 % of the gas's recurrence "
+            f"rate at N = {within('rr')}, and of its boundary-angle ACF R₁ at N = "
+            f"{within('acf@1')}.", ""]
+
+
+def _ftle_table(kicked, systems):
+    k = kicked.set_index(["n_disks", "system", "diagnostic"])
+    head = (["N", "gas FTLE λ"] + [f"FTLE λ, {SYSTEM_NAMES[s]}" for s in systems]
+            + ["per collision λ / ν: gas"] + [SYSTEM_NAMES[s] for s in systems]
+            + [f"FTLE λ, {SYSTEM_NAMES[s]} / gas" for s in systems])
+    out = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    for n in sorted(set(kicked["n_disks"])):
+        g = k.loc[(n, "poisson/gas", "ftle")]
+        cells = ([str(n), format_interval(g["reference"], g["reference_low"],
+                                          g["reference_high"], edges=(0.0,))]
+                 + [_ftle(k.loc[(n, f"{s}/gas", "ftle")]) for s in systems]
+                 + [_per_collision(k.loc[(n, "gas/gas", "ftle/rate")])]
+                 + [_per_collision(k.loc[(n, f"{s}/gas", "ftle/rate")]) for s in systems]
+                 + [_kicked_cell(k.loc[(n, f"{s}/gas", "ftle")], "ftle") for s in systems])
+        out.append("| " + " | ".join(cells) + " |")
+    return out
+
+
+def _other_table(kicked, systems):
+    k = kicked.set_index(["n_disks", "system", "diagnostic"])
+    head = ["N"] + [f"{KICKED_NAMES[d]}, {SYSTEM_NAMES[s]} / gas" for d in ("acf@1", "rr")
+                    for s in systems]
+    out = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    for n in sorted(set(kicked["n_disks"])):
+        cells = [str(n)] + [_kicked_cell(k.loc[(n, f"{s}/gas", d)], d)
+                            for d in ("acf@1", "rr") for s in systems]
+        out.append("| " + " | ".join(cells) + " |")
+    return out
+
+
+def kicked_ftle_cells(kicked, n) -> list:
+    """The geometry table's kicked cells at ``n``: the Poisson-kicked disk's FTLE per
+    collision over the gas's, and the scatter-kicked/gas FTLE ratio (if it was run)."""
+    k = kicked.set_index(["n_disks", "system", "diagnostic"])
+    out = [f"{_per_collision(k.loc[(n, 'poisson/gas', 'ftle/rate')])} / "
+           f"{_per_collision(k.loc[(n, 'gas/gas', 'ftle/rate')])}"]
+    if "scatter" in _systems(kicked):
+        out.append(_kicked_cell(k.loc[(n, "scatter/gas", "ftle")], "ftle"))
+    return out
+
+
+def kicked_section(kicked, exp) -> list:
+    """The section "Does a kicked disk reproduce a gas?"."""
+    systems = _systems(kicked)
+    k = kicked.set_index(["n_disks", "system", "diagnostic"])
+    scatter = (
+        " The scatter-kicked disk (system scatter) is kicked at Poisson times of the same "
+        "rate, each kick a mirror collision with a virtual partner of the gas's radius "
+        "(`kick_angle=\"scatter\"`, `partner=\"weighted\"`, `rule=\"mirror\"`; "
+        "docs/scatter.md): the partner's direction at angle D from the disk's with density "
+        "∝ |v − u| ∝ |sin(D/2)|, the contact normal at angle φ from v − u with density "
+        "cos φ / 2. In a mirror gas every disk has unit speed and, at equilibrium, a uniform "
+        "direction, so a collision's pre-collision pair (v, u, n) has density ∝ (w·n)⁺ "
+        "(kinetic theory, molecular chaos): the scatter kick draws the gas's collision "
+        "kernel, as `kicktimes.billiard.scatter` documents. What it leaves out: correlations "
+        "between successive partners (recollisions, the dense gas's ring events), the "
+        "density's variation near the wall (Enskog's contact factor sets the gas's rate, "
+        "which the kicks take from the gas disk, not the kernel's shape), and it allows a "
+        "virtual partner beyond the wall." if "scatter" in systems else "")
+    return [
+        "## Does a kicked disk reproduce a gas?", "",
+        f"The paper's question for a gas ({exp.geometry_label}, {exp.rule} rule; store "
+        f"`{exp.name}`): one disk of a gas, followed for {exp.kicked_time:g} mean free "
+        f"times in {exp.kicked_runs} states per N, against one disk from its initial state "
+        "kicked with uniform new directions at its own collision rate (poisson) or at its "
+        f"collision times (actual).{scatter} The gas's FTLE is the whole gas's largest "
+        "exponent (`disks_lyapunov`, renormalised every mean free time); the kicked disk's "
+        "from tangent vectors; the ACF is of the disk's boundary angles θ (lag 1), the "
+        "recurrence rate of its positions sampled every 0.1 mean free times at ε = 0.05; "
+        "λ / ν is an FTLE over the gas disk's collision rate (at fixed packing the reduced "
+        "density ñ = n σ² is the same for every N; the comparison with the kinetic theory "
+        "of the largest exponent, van Zon, van Beijeren & Dellago 1998, is not made here). "
+        "Ratios of the means over states, 95 % percentile bootstrap over states, "
+        "`ratio_verdict` (within 10 %); —: no ratio is stated where the gas's mean is "
+        "indistinguishable from 0, where the ratio's interval contains 0 (the gas's value "
+        "too near 0 for its noise), or, for the FTLE, where the kicked disk's own exponent "
+        "has its interval at or below 0 (not chaotic). The gas's FTLE is the whole gas's "
+        "largest exponent, whose value per collision grows with N: a kicked/gas FTLE ratio "
+        "is not a like-for-like comparison (a single disk's exponent against an N-disk "
+        "system's). An ACF needs enough wall hits: at large N the disk seldom reaches the "
+        "wall in this time, and states without a value are left out "
+        "([disks_kicked.csv](disks_kicked.csv), column n_runs).", "",
+        f"Check: {_twin_check(k)}." if (2, "gas/two_particle", "ftle") in k.index else "",
+        "", "**FTLE**", "", *_ftle_table(kicked, systems), "",
+        "**Boundary-angle ACF and recurrence**", "", *_other_table(kicked, systems), ""]
+
+
+def ftle_check_lines(path) -> list:
+    """The section on the gas's FTLE checks from ``disks_ftle_check.csv`` (columns
+    `FTLE_CHECK_COLUMNS`), each verdict recomputed (`kicktimes.stats.ratio_verdict` at the
+    row's margin; the file's own word shown beside it where it differs); one line saying it
+    is absent if ``path`` does not exist.
+
+    Examples
+    --------
+    >>> ftle_check_lines("/nonexistent/disks_ftle_check.csv")[-2].startswith("Not run")
+    True
+    """
+    title = ["## The gas's FTLE: tangent vectors against a twin, and N = 2 against the "
+             "two-disk simulator", ""]
+    path = Path(path)
+    if not path.exists():
+        return title + [f"Not run here: no {path.name} beside the page (the checks of "
+                        "`kicktimes.diagnostics.gas_lyapunov` write it).", ""]
+    tab = pd.read_csv(path)
+    missing = [c for c in FTLE_CHECK_COLUMNS if c not in tab.columns]
+    if missing:
+        raise ValueError(f"{path.name}: missing columns {missing}")
+    out = title + [
+        f"From [{path.name}]({path.name}): each check's ratio (tangent over twin FTLE of the "
+        "same gas states; the engine's N = 2 FTLE over the two-disk simulator's) with its "
+        "95 % interval, and its verdict at the check's margin, stated in advance "
+        "(`stats.ratio_verdict` with that tolerance: within when the whole interval lies "
+        "in [1 − margin, 1 + margin]).", "",
+        "| check | N | rule | packing | states | t_max | ratio | margin | verdict |",
+        "|---|---|---|---|---|---|---|---|---|"]
+    for _, r in tab.iterrows():
+        m = float(r["margin"])
+        verdict = ratio_verdict(r["lo"], r["hi"], tolerance=m)
+        if str(r["verdict"]) != verdict:
+            # the page's verdict is the rule's; the file's other wording is shown beside it
+            verdict += f" (the file: {r['verdict']})"
+        out.append(f"| {r['check']} | {int(r['n_disks'])} | {r['rule']} | {r['packing']:g} | "
+                   f"{int(r['n_ics'])} | {r['t_max']:g} | "
+                   f"{format_interval(r['estimate'], r['lo'], r['hi'], edges=(1 - m, 1, 1 + m))}"
+                   f" | {m:g} | {verdict} |")
+    return out + [""]

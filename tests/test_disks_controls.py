@@ -1,0 +1,258 @@
+"""The disks page's controls, renewal models, scatter-kicked system and FTLE-check section
+(issue 42, "left out" closed): the verdict logic on synthetic numbers, the wording of a
+robust finding and of one that depends on a control, and the sections written from tables.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import warnings
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from kicktimes.experiment import (
+    DISKS_CONTROLS,
+    DISKS_PRESETS,
+    DisksExperiment,
+    disks_control,
+    run_experiment,
+)
+from kicktimes.report.disks_controls import controls_findings, controls_lines, robust_text
+from kicktimes.stats import share_ratio_sample_size
+
+TINY = DisksExperiment(name="tiny-gas", n_disks=[2, 5], packing=0.1, n_tagged=6, min_runs=3,
+                       collisions=5, block_sequences=2, seed=3)
+
+
+def run_quiet(exp, path):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return run_experiment(exp, path, progress=False, workers=1)
+
+
+def _table(n=1000, d=(1.2, 1.15, 1.25, "higher"), share=(0.06, 0.05, 0.07, "nominal"),
+           p=1e-5, first=(0.92, 0.86, 0.98, "inconclusive"), rate=(1.01, 1.0, 1.02,
+                                                                   "within 10 %")):
+    row = {"geometry": "packing 0.02", "rule": "mirror", "n_disks": n,
+           "hazard_flat_pvalue": p}
+    for key, (est, lo, hi, v) in (("dispersion", d), ("reject_uniformity_ks", share),
+                                  ("hazard_first", first), ("rate_enskog", rate)):
+        row.update({key: est, f"{key}_low": lo, f"{key}_high": hi, f"{key}_verdict": v})
+    return pd.DataFrame([row])
+
+
+def _group(long, finding):
+    return long[long["diagnostic"] == finding]
+
+
+def test_a_finding_with_the_same_verdict_under_every_control_is_robust():
+    long = controls_findings({"primary": _table(), "seed": _table(),
+                              "k60": _table(d=(1.3, 1.2, 1.4, "higher"))})
+    g = _group(long, "count dispersion D")
+    assert g["robust"].all() and list(g["control"]) == ["primary", "seed", "k60"]
+    assert robust_text(g) == "robust: higher"
+
+
+def test_a_finding_whose_verdict_changes_depends_on_that_control_with_both_numbers():
+    long = controls_findings({"primary": _table(), "seed": _table(),
+                              "k60": _table(share=(0.11, 0.09, 0.13, "above nominal"))})
+    g = _group(long, "uniform-times rejection share")
+    assert not g["robust"].any() and set(g["depends_on"]) == {"k60"}
+    text = robust_text(g)
+    assert text.startswith("depends on k60: ")
+    assert "6.00 [5.00, 7.00] % nominal (primary)" in text
+    assert "11.0 [9.00, 13.0] % above nominal (k60)" in text
+    assert "(seed)" not in text  # the controls that agree are not listed
+
+
+def test_a_change_of_direction_alone_is_not_robust():
+    # both inconclusive, one interval above 1 and the other below it
+    long = controls_findings({"primary": _table(first=(1.08, 1.02, 1.14, "inconclusive")),
+                              "bulk": _table(first=(0.93, 0.88, 0.98, "inconclusive"))})
+    g = _group(long, "hazard first bin")
+    assert not g["robust"].any() and set(g["reason"]) == {"direction"}
+    assert robust_text(g).startswith("depends on bulk: 1.08 [1.02, 1.14] inconclusive (primary)")
+
+
+def test_the_hazard_flatness_verdict_is_its_p_value_and_bulk_is_no_control_of_the_rate():
+    long = controls_findings({"primary": _table(p=1e-5), "bulk": _table(p=0.3)})
+    g = _group(long, "hazard flatness")
+    assert list(g["verdict"]) == ["flatness rejected", "flatness not rejected"]
+    assert g["ci_low"].isna().all()
+    assert "p = 1e-05 flatness rejected (primary)" in robust_text(g)
+    assert list(_group(long, "rate / Enskog")["control"]) == ["primary"]
+
+
+def test_the_controls_section_counts_robust_and_dependent_findings():
+    long = controls_findings({"primary": _table(), "k60": _table(
+        share=(0.11, 0.09, 0.13, "above nominal"))})
+    text = "\n".join(controls_lines(long))
+    assert "## Under the controls" in text
+    assert "Over the 5 findings of the rows at N ≥ 30" in text
+    assert "4 robust, 1 depend on a control (k60: 1)" in text
+    assert "| 1000 | robust: higher | depends on k60:" in text
+
+
+def test_the_controls_table_is_lint_clean(tmp_path):
+    long = controls_findings({"primary": _table(), "seed": _table(d=(1.05, 0.95, 1.09,
+                                                                     "within 10 %"))})
+    d = long[long["diagnostic"] == "count dispersion D"]
+    assert set(d["verdict"]) == {"higher", "within 10 %"} and not d["robust"].any()
+    assert {"family", "diagnostic", "system", "control", "estimate", "ci_low", "ci_high",
+            "verdict", "robust"} <= set(long.columns)
+
+
+def test_the_controls_are_presets_of_their_own_that_keep_the_sweeps_hashes():
+    assert disks_control("disks-phi0.2-mirror-k60") == ("disks-phi0.2-mirror", "k60")
+    assert disks_control("disks-phi0.2-mirror") is None
+    sweeps = {n for n, e in DISKS_PRESETS.items() if not e.kicked_runs and len(e.n_disks) > 1}
+    assert {disks_control(n)[0] for n in DISKS_CONTROLS} == sweeps
+    for name, exp in DISKS_CONTROLS.items():
+        base = DISKS_PRESETS[disks_control(name)[0]]
+        changed = {f.name for f in dataclasses.fields(exp)
+                   if getattr(exp, f.name) != getattr(base, f.name)}
+        assert changed <= {"name", "seed", "collisions", "description"}
+        assert exp.seed != base.seed
+    # the kicked systems' field leaves the hash of a store without it unchanged
+    assert dataclasses.replace(TINY, kicked_systems=("poisson", "actual")).hash() == TINY.hash()
+    k = dataclasses.replace(TINY, kicked_runs=1)
+    assert dataclasses.replace(k, kicked_systems=("poisson", "actual", "scatter")).hash() \
+        != k.hash()
+    with pytest.raises(ValueError, match="kicked_systems"):
+        dataclasses.replace(TINY, kicked_systems=("poisson", "poisson"))
+
+
+def test_the_sample_size_of_a_share_ratio_gives_its_power():
+    p, n = 0.08, share_ratio_sample_size(0.08)
+    rng = np.random.default_rng(0)
+    a, b = rng.binomial(n, p, size=4000) / n, rng.binomial(n, p, size=4000) / n
+    se = np.sqrt((1 - a) / (n * a) + (1 - b) / (n * b))
+    lo, hi = np.exp(np.log(a / b) - 1.96 * se), np.exp(np.log(a / b) + 1.96 * se)
+    power = np.mean((lo >= 0.9) & (hi <= 1.1))
+    # at least the power asked for (the band's lower side is the wider)
+    assert 0.8 <= power <= 0.88
+    assert share_ratio_sample_size(0.3) < n < share_ratio_sample_size(0.02)
+    with pytest.raises(ValueError, match="share"):
+        share_ratio_sample_size(0.0)
+
+
+@pytest.fixture(scope="module")
+def tiny(tmp_path_factory):
+    return run_quiet(TINY, tmp_path_factory.mktemp("tiny"))
+
+
+def test_the_bulk_control_keeps_the_tagged_disks_that_start_near_the_centre(tiny):
+    from kicktimes.experiment.disks_tasks import tagged_start_radii
+    from kicktimes.report.disks import bulk_rows, disks_table
+
+    keep = bulk_rows(tiny, 0.5)
+    col = tiny.collisions
+    for m, row in enumerate(col.itertuples(index=False)):
+        tagged, radii = tagged_start_radii(tiny.experiment, row.n_disks, row.ic)
+        assert keep[m] == (radii[list(tagged).index(row.disk)] <= 0.5)
+    assert 0 < keep.sum() < len(col)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        bulk = disks_table(tiny, n_boot=99, n_mc=19, within=0.5)
+    assert (bulk["n_tagged"].sum()) == keep.sum()
+
+
+def test_renewal_models_rank_gamma_intervals_gamma_and_check_the_halves():
+    from types import SimpleNamespace
+
+    from kicktimes.report.disks_renewal import renewal_lines, renewal_models
+
+    rng = np.random.default_rng(2)
+    exp = DisksExperiment(name="x", n_disks=[10], packing=0.1, collisions=20)
+    col = pd.DataFrame({"n_disks": 10, "ic": np.arange(600) % 12,
+                        "pp_times": [np.cumsum(rng.gamma(3.0, size=25)) for _ in range(600)]})
+    t = renewal_models(SimpleNamespace(experiment=exp, collisions=col))
+    row = t.iloc[0]
+    assert row["best"] == "gamma" and row["n_intervals"] == 600 * 20
+    assert row["delta_aic_exponential"] > 100 and row["stable"]
+    text = "\n".join(renewal_lines(t))
+    assert "not independent" in text and "| 10 | gamma; exponential ΔAIC" in text
+
+
+def test_the_scatter_kicked_system_is_compared_with_the_gas(tmp_path):
+    from kicktimes.report.disks import kicked_table
+    from kicktimes.report.disks_kicked import kicked_ftle_cells, kicked_section
+
+    exp = dataclasses.replace(TINY, name="tiny-scatter", kicked_runs=3, kicked_time=20.0,
+                              kicked_systems=("poisson", "actual", "scatter"))
+    store = run_quiet(exp, tmp_path / "k")
+    rows = store.results[store.results["system"] == "scatter"]
+    assert set(rows["diagnostic"]) == {"ftle", "acf@1", "rr"}
+    assert len(rows) == 3 * 3 * 2  # diagnostics x runs x N
+    tab = kicked_table(store, n_boot=99)
+    sc = tab[(tab["system"] == "scatter/gas") & (tab["diagnostic"] == "ftle")]
+    assert len(sc) == 2 and sc["verdict"].notna().all()
+    # a scattered disk keeps the deviation of its direction: its FTLE is positive
+    assert (sc["value"] > 0).all()
+    assert len(kicked_ftle_cells(tab, 5)) == 2
+    text = "\n".join(kicked_section(tab, exp))
+    assert "FTLE λ, scatter-kicked / gas" in text and "collision kernel" in text
+
+
+def test_the_ftle_check_section_is_rendered_from_its_table_or_skipped(tmp_path):
+    from kicktimes.report.disks_kicked import ftle_check_lines
+
+    path = tmp_path / "disks_ftle_check.csv"
+    lines = ftle_check_lines(path)
+    assert lines[0].startswith("## The gas's FTLE: tangent vectors against a twin")
+    assert lines[2].startswith("Not run here: no disks_ftle_check.csv")
+    pd.DataFrame([
+        {"check": "tangent/twin", "n_disks": 100, "rule": "mirror", "packing": 0.02,
+         "n_ics": 8, "t_max": 50.0, "estimate": 1.003, "lo": 0.991, "hi": 1.012,
+         "margin": 0.02, "verdict": "within 2 %"},
+        {"check": "engine/two-disk", "n_disks": 2, "rule": "mirror", "packing": 0.02,
+         "n_ics": 16, "t_max": 200.0, "estimate": 1.06, "lo": 1.01, "hi": 1.11,
+         "margin": 0.05, "verdict": "inconclusive"},
+        {"check": "tangent/twin", "n_disks": 2, "rule": "mirror", "packing": 0.02,
+         "n_ics": 8, "t_max": 50.0, "estimate": 1.0, "lo": 0.97, "hi": 1.03,
+         "margin": 0.02, "verdict": "pass"},
+    ]).to_csv(path, index=False)
+    text = "\n".join(ftle_check_lines(path))
+    assert "| tangent/twin | 100 | mirror | 0.02 | 8 | 50 | 1.00 [0.991, 1.01] | 0.02 | " \
+           "within 2 % |" in text
+    assert "| engine/two-disk | 2 | mirror | 0.02 | 16 | 200 | 1.06 [1.01, 1.11] | 0.05 | " \
+           "inconclusive |" in text
+    # the page's verdict is the rule's, the file's other word beside it
+    assert "| inconclusive (the file: pass) |" in text
+    pd.DataFrame([{"check": "x"}]).to_csv(path, index=False)
+    with pytest.raises(ValueError, match="missing columns"):
+        ftle_check_lines(path)
+
+
+def test_the_page_gives_every_finding_under_its_controls(tiny, tmp_path):
+    from kicktimes.report.disks_page import write_disks_page
+
+    control = run_quiet(dataclasses.replace(TINY, name="tiny-gas-seed", seed=4),
+                        tmp_path / "seed")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        page = write_disks_page([tiny.path, control.path], tmp_path / "results", n_boot=99,
+                                n_mc=19, dpi=30)
+    text = page.read_text()
+    long = pd.read_csv(tmp_path / "results" / "disks_controls.csv")
+    # not a sweep report's findings table (tests/test_results_pages.py reads *_findings.csv)
+    assert not list((tmp_path / "results").glob("*_findings.csv"))
+    assert set(long["control"]) == {"primary", "seed", "bulk"}
+    assert "## Under the controls" in text and "No controls were run" not in text
+    assert "## Which renewal model?" in text
+    assert (tmp_path / "results" / "disks_renewal.csv").exists()
+    assert "Not run here: no disks_ftle_check.csv" in text
+    # every finding's cell is "robust: <verdict>" or "depends on <control>: <numbers>"
+    for _, g in long.groupby(["family", "n_disks", "diagnostic"]):
+        assert robust_text(g) in text
+
+
+def test_the_bulk_control_refuses_a_store_whose_seeds_now_tag_other_disks(tiny):
+    from kicktimes.report.disks import bulk_rows
+
+    other = dataclasses.replace(tiny, collisions=tiny.collisions.assign(
+        disk=tiny.collisions["disk"] + 1000))
+    with pytest.raises(ValueError, match="rerun the store"):
+        bulk_rows(other, 0.5)
