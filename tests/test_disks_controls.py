@@ -124,6 +124,22 @@ def test_the_controls_are_presets_of_their_own_that_keep_the_sweeps_hashes():
         dataclasses.replace(TINY, kicked_systems=("poisson", "poisson"))
 
 
+def test_the_gas_ftle_method_is_in_the_hash_only_when_the_kicked_comparison_uses_it():
+    # without the kicked comparison the method is unused: no hash changes
+    assert dataclasses.replace(TINY, gas_ftle="twin").hash() == TINY.hash()
+    k = dataclasses.replace(TINY, kicked_runs=1)
+    twin = dataclasses.replace(k, gas_ftle="twin")
+    assert k.gas_ftle == "tangent" and k.hash() != twin.hash()
+    # a record from before the field (a twin's store) reads back as the twin, same hash
+    old = twin.to_dict()
+    del old["gas_ftle"]
+    back = type(TINY).from_record(old)
+    assert back.gas_ftle == "twin" and back.hash() == twin.hash()
+    assert type(TINY).from_record(k.to_dict()) == k
+    with pytest.raises(ValueError, match="gas_ftle"):
+        dataclasses.replace(k, gas_ftle="benettin")
+
+
 def test_the_sample_size_of_a_share_ratio_gives_its_power():
     p, n = 0.08, share_ratio_sample_size(0.08)
     rng = np.random.default_rng(0)

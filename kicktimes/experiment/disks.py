@@ -46,6 +46,10 @@ PACKING_MAX = 0.7
 #: hash whenever they are at this value)
 _LATER_FIELDS = {"kicked_runs": 0, "kicked_time": 60.0}
 _LATER_OPTIONAL = {"kicked_systems": ("poisson", "actual")}
+#: the gas's FTLE in the kicked comparison: ``"tangent"`` (tangent vectors in the engine,
+#: the default since they exist) or ``"twin"`` (a Benettin twin, what the stores written
+#: before carry: a record without the field is read as ``"twin"`` and keeps its hash)
+GAS_FTLE_METHODS = ("tangent", "twin")
 #: the kicked single disk's systems: uniform new directions at Poisson times of the gas
 #: disk's rate (poisson) or at its collision times (actual); scattering kicks off a virtual
 #: partner from the collision kernel at Poisson times of that rate (scatter)
@@ -136,6 +140,11 @@ class DisksExperiment:
         "actual")``; ``"scatter"``: kicks at Poisson times of the disk's rate, each a
         collision with a virtual partner drawn from the collision kernel,
         `kicktimes.billiard.scatter`).
+    gas_ftle : {"tangent", "twin"}
+        How that comparison measures the gas's largest Lyapunov exponent
+        (`kicktimes.diagnostics.gas_lyapunov.disks_lyapunov`'s ``method``): tangent vectors
+        carried by the engine (default) or a Benettin twin. Stores written before the field
+        existed used the twin and are read so.
     """
 
     name: str
@@ -155,6 +164,7 @@ class DisksExperiment:
     kicked_runs: int = 0
     kicked_time: float = 60.0
     kicked_systems: tuple = ("poisson", "actual")
+    gas_ftle: str = "tangent"
 
     #: what a store's record says this is (`Experiment` records have no ``kind``)
     kind = "disks"
@@ -217,6 +227,7 @@ class DisksExperiment:
             raise ValueError(f"kicked_systems: give distinct systems of {KICKED_SYSTEMS}, got "
                              f"{list(systems)}")
         put("kicked_systems", systems)
+        check_choice("gas_ftle", self.gas_ftle, GAS_FTLE_METHODS)
         if self.kicked_runs and self.rule != "mirror":
             raise ValueError(f"kicked_runs: the kicked disk keeps its speed, so the comparison "
                              f"needs rule='mirror', got rule={self.rule!r}")
@@ -290,6 +301,7 @@ class DisksExperiment:
         if not isinstance(d, dict):
             raise TypeError(f"expected a dict of experiment fields, got {type(d).__name__}")
         d = dict(d)
+        d.setdefault("gas_ftle", "twin")  # a record from before the field: a twin's FTLE
         if d.pop("kind", cls.kind) != cls.kind:
             raise ValueError(f"kind: a disks experiment's record has kind {cls.kind!r}")
         known = [f.name for f in fields(cls)]
@@ -313,6 +325,10 @@ class DisksExperiment:
         for key, default in _LATER_OPTIONAL.items():
             if tuple(record[key]) == default:
                 del record[key]
+        if not self.kicked_runs or self.gas_ftle == "twin":
+            # the field is unused without the kicked comparison, and "twin" is what the
+            # records written before it existed mean
+            del record["gas_ftle"]
         text = json.dumps(record, sort_keys=True, separators=(",", ":"), allow_nan=False)
         return hashlib.sha256(text.encode()).hexdigest()[:16]
 

@@ -145,7 +145,8 @@ def kicked_rows(experiment: DisksExperiment, n_disks: int, k: int) -> list:
     A state of its own (``SeedSequence(seed, spawn_key=(N, k, 1))``) runs for
     ``T = kicked_time / nu`` with disk 0 sampled every ``0.1 / nu`` and its wall hits
     logged. Rows ``(system, diagnostic, value)``, systems ``"gas"`` (disk 0 in the gas;
-    its FTLE is the whole gas's, `kicktimes.diagnostics.gas_lyapunov.disks_lyapunov`),
+    its FTLE is the whole gas's, `kicktimes.diagnostics.gas_lyapunov.disks_lyapunov` with
+    ``method=experiment.gas_ftle``),
     ``"poisson"`` and ``"actual"`` (one disk from disk 0's state, kicked with uniform new
     directions at disk 0's own rate ``n / T`` or at its collision times; FTLE from tangent
     vectors, `kicktimes.diagnostics.lyapunov`), ``"scatter"`` (kicked at that rate, each
@@ -185,7 +186,8 @@ def kicked_rows(experiment: DisksExperiment, n_disks: int, k: int) -> list:
         warnings.simplefilter("ignore")  # an ACF of too few wall hits is NaN, with a reason
         theta = np.arcsin(np.clip(gas.walls["sin_theta"].to_numpy()[
             gas.walls["disk"].to_numpy() == 0], -1.0, 1.0))
-        ftle = disks_lyapunov(state, r, t_max=t_max, segment=1.0 / nu, rng=rng).exponent
+        ftle = disks_lyapunov(state, r, t_max=t_max, segment=1.0 / nu, rng=rng,
+                              method=experiment.gas_ftle).exponent
         rows += [("gas", "ftle", ftle), ("gas", "acf@1", autocorrelation(theta, 1)),
                  ("gas", "rr", recurrence_rate(gas.samples[:, 0], KICKED_EPS)),
                  ("gas", "rate", times.size / t_max)]

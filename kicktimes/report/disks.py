@@ -368,9 +368,9 @@ def kicked_table(store, *, n_boot=999, seed=0) -> pd.DataFrame:
     means of both (``value``, ``reference``) with the same bootstrap's intervals; the
     gas's FTLE over its disk's collision rate (system ``"gas/gas"``, diagnostic
     ``"ftle/rate"``: the exponent per collision) and the kicked disks' FTLE over the same rate
-    (``"poisson/gas"``, ``"actual/gas"``, ``"ftle/rate"``); at N = 2 also the gas's FTLE (twin,
-    `disks_lyapunov`) over the two-disk FTLE of the same states (tangent,
-    `kicktimes.diagnostics.lyapunov`), system ``"gas/two_particle"``.
+    (``"poisson/gas"``, ``"actual/gas"``, ``"ftle/rate"``); at N = 2 also the gas's FTLE
+    (`disks_lyapunov`, the store's ``gas_ftle`` method) over the two-disk FTLE of the same
+    states (tangent, `kicktimes.diagnostics.lyapunov`), system ``"gas/two_particle"``.
     Empty when the store has no kicked rows."""
     res = store.results
     res = res[res["system"] != "disks"]
