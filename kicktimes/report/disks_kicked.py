@@ -14,6 +14,7 @@ from pathlib import Path
 
 import pandas as pd
 
+from kicktimes.experiment.disks_tasks import KICKED_THEILER
 from kicktimes.stats import format_interval, ratio_verdict
 
 __all__ = ["FTLE_CHECK_COLUMNS", "KICKED_NAMES", "ftle_check_lines", "kicked_answer",
@@ -101,14 +102,14 @@ def scatter_answer(kicked) -> str:
         return ""
     k = kicked.set_index(["n_disks", "system", "diagnostic"])
     ns = sorted(set(kicked["n_disks"]))
-    cells = [f"N = {n}: {_kicked_cell(k.loc[(n, 'scatter/gas', 'ftle')], 'ftle')}"
-             for n in ns]
+    cells = [f"N = {n}: " + format_interval(*k.loc[(n, "scatter/gas", "ftle")][
+        ["ratio", "ratio_low", "ratio_high"]]) for n in ns]
     bad = kicked_not_chaotic(kicked, "scatter")
     return ("The single disk scattered off virtual partners from the collision kernel, at "
             "Poisson times of the gas disk's rate, has a positive FTLE "
             + (f"at every N but {', '.join(map(str, bad))}" if bad else "at every N")
             + "; its FTLE over the gas's (the whole gas's largest exponent, not a "
-            "like-for-like reference): " + "; ".join(cells) + ".")
+            "like-for-like reference, so no verdict is read): " + "; ".join(cells) + ".")
 
 
 def kicked_answer(kicked, exp) -> list:
@@ -223,7 +224,10 @@ def kicked_section(kicked, exp) -> list:
         f"exponent (`disks_lyapunov`, {_method(exp)}, renormalised every mean free time); "
         "the kicked disk's "
         "from tangent vectors; the ACF is of the disk's boundary angles θ (lag 1), the "
-        "recurrence rate of its positions sampled every 0.1 mean free times at ε = 0.05; "
+        "recurrence rate of its positions sampled every 0.1 mean free times at ε = 0.05, "
+        f"pairs less than {KICKED_THEILER / 10:g} mean free times apart left out (a "
+        f"Theiler window of {KICKED_THEILER} samples: the diagonal and one flight's "
+        "successive samples would make every system's rate alike); "
         "λ / ν is an FTLE over the gas disk's collision rate (at fixed packing the reduced "
         "density ñ = n σ² is the same for every N; the comparison with the kinetic theory "
         "of the largest exponent, van Zon, van Beijeren & Dellago 1998, is not made here). "
@@ -281,4 +285,59 @@ def ftle_check_lines(path) -> list:
                    f"{int(r['n_ics'])} | {r['t_max']:g} | "
                    f"{format_interval(r['estimate'], r['lo'], r['hi'], edges=(1 - m, 1, 1 + m))}"
                    f" | {m:g} | {verdict} |")
+    return out + [""]
+
+
+def density_lines(table_path, fit_path) -> list:
+    """The section on the gas's FTLE against density (the kinetic-theory form
+    ``λ/ν = a + b ln(1/ñ)``) from ``disks_lyapunov_density.csv`` and its ``_fit.csv``
+    (`analysis/disks_lyapunov_density.py`); each local slope's verdict recomputed
+    (`kicktimes.stats.ratio_verdict` at the file's margin); one line if a file is absent.
+
+    Examples
+    --------
+    >>> density_lines("/nonexistent/a.csv", "/nonexistent/b.csv")[-2].startswith("Not run")
+    True
+    """
+    title = ["## The gas's FTLE against density: the kinetic-theory form", ""]
+    table_path, fit_path = Path(table_path), Path(fit_path)
+    if not (table_path.exists() and fit_path.exists()):
+        return title + [f"Not run here: no {table_path.name} and {fit_path.name} beside the "
+                        "page (`python analysis/disks_lyapunov_density.py` writes them).", ""]
+    tab, fits = pd.read_csv(table_path), pd.read_csv(fit_path)
+    out = title + [
+        "Kinetic theory gives a dilute gas's largest exponent per collision as linear in the "
+        "logarithm of the reduced density, λ/ν = a + b ln(1/ñ), ñ = nσ² = 4φ/π in the unit "
+        "table (van Zon, van Beijeren & Dellago, Phys. Rev. Lett. 80, 2035 (1998), with "
+        "corrections of order ñ and a slow growth with N). Measured with tangent vectors "
+        "(`disks_lyapunov`, mirror rule), ν each run's own collision rate per disk; 95 % "
+        f"bootstrap over states ([{table_path.name}]({table_path.name}), "
+        f"[{fit_path.name}]({fit_path.name})). The prefactors a and b of the theory are not "
+        "computed here: only the form is tested, by the curvature c of a quadratic fit and "
+        "by each local slope over b, within the margin stated before the run.", "",
+        "| N | packing φ | ñ | ln(1/ñ) | states | λ / ν |", "|---|---|---|---|---|---|"]
+    for _, r in tab.iterrows():
+        out.append(f"| {int(r['n_disks'])} | {r['packing']:g} | {r['reduced_density']:.3g} | "
+                   f"{r['ln_inv_density']:.3g} | {int(r['n_states'])} | "
+                   f"{format_interval(r['lam_per_coll'], r['lo'], r['hi'])} |")
+    out.append("")
+    for _, f in fits.iterrows():
+        m = float(f["margin"])
+        local = [(float(e), float(lo), float(hi)) for e, lo, hi in zip(
+            str(f["local_over_b"]).split(";"), str(f["local_lo"]).split(";"),
+            str(f["local_hi"]).split(";"), strict=True)]
+        verdicts = [ratio_verdict(lo, hi, tolerance=m) for _, lo, hi in local]
+        curved = not f["c_lo"] <= 0.0 <= f["c_hi"]
+        reading = ("curvature detected: λ/ν is not linear in ln(1/ñ) over this range"
+                   if curved else "no curvature detected and every local slope within "
+                   f"{m * 100:g} % of b: the form holds over this range"
+                   if all(v.startswith("within") for v in verdicts) else "inconclusive")
+        out.append(
+            f"- N = {int(f['n_disks'])}, fitted at φ ≤ {f['fit_max_packing']:g}: "
+            f"a = {format_interval(f['a'], f['a_lo'], f['a_hi'])}, "
+            f"b = {format_interval(f['b'], f['b_lo'], f['b_hi'])}, curvature "
+            f"c = {format_interval(f['c'], f['c_lo'], f['c_hi'], edges=(0.0,))}; local "
+            "slopes over b, from dilute to dense: " + "; ".join(
+                f"{format_interval(e, lo, hi, edges=(1 - m, 1, 1 + m))} {v}"
+                for (e, lo, hi), v in zip(local, verdicts, strict=True)) + f". {reading}.")
     return out + [""]
