@@ -19,7 +19,8 @@ Same-output baselines, where they finish:
 Also the robustness run of the issue: ``--robust 1e8`` collisions at packing 0.6 (N = 1000),
 checked for overlaps and disks outside at the end.
 
-Run: python benchmarks/bench_disks.py [--quick] [--packings 0.1 0.3 0.5] [--robust 1e8]
+Run: python benchmarks/bench_disks.py [--quick] [--packings 0.1 0.3 0.5] [--rounds 5]
+[--robust 1e8]
 """
 
 from __future__ import annotations
@@ -114,6 +115,9 @@ def main(argv=None):
     ap.add_argument("--collisions", type=float, default=3e6)
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--packings", type=float, nargs="+", default=[0.1, 0.3, 0.5])
+    ap.add_argument("--rounds", type=int, default=0,
+                    help="also measure the cost ratio N=1e4 / N=1e2 in this many alternated "
+                         "rounds (one run of each per round): median and range")
     ap.add_argument("--robust", type=float, default=0.0,
                     help="also run this many collisions at packing 0.6, N = 1000")
     args = ap.parse_args(argv)
@@ -157,6 +161,14 @@ def main(argv=None):
               f"{rows[100, phi] / rows[10000, phi]:.2f}")
     if (1000, 0.3) in rows:
         print(f"target: >= 1.0e6 coll/s at N=1000, packing 0.3: {rows[1000, 0.3]:.3g}")
+    for phi in args.packings if args.rounds else ():
+        # the two sizes run one after the other in each round, so that a change of the
+        # machine's load (other processes in the shared L3) falls on both alike
+        ratios = [engine_rate(100, phi, collisions, 1)[0] / engine_rate(10000, phi, collisions,
+                                                                          1)[0]
+                  for _ in range(args.rounds)]
+        print(f"cost ratio N=1e4 / N=1e2 at packing {phi}, {args.rounds} alternated rounds: "
+              f"median {np.median(ratios):.2f}, range {min(ratios):.2f}-{max(ratios):.2f}")
     if args.robust:
         n, phi = 1000, 0.6
         from scipy.spatial import cKDTree

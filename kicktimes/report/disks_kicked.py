@@ -152,7 +152,10 @@ def kicked_answer(kicked, exp) -> list:
             f"grows with N, so a kicked/gas FTLE ratio is not a like-for-like comparison."
             f"{check} Every kicked disk ({names}) is within 10 % of the gas's recurrence "
             f"rate at N = {within('rr')}, and of its boundary-angle ACF R₁ at N = "
-            f"{within('acf@1')}.", ""]
+            f"{within('acf@1')}. The recurrence rate is weak evidence: for positions drawn "
+            "independently and uniformly over the table it is about ε² (the share of the "
+            "table within ε of a point), whatever the dynamics, so a rate near the gas's "
+            "says that both cover the table alike, not that they move alike.", ""]
 
 
 def _ftle_table(kicked, systems):
@@ -328,8 +331,8 @@ def density_lines(table_path, fit_path) -> list:
             str(f["local_hi"]).split(";"), strict=True)]
         verdicts = [ratio_verdict(lo, hi, tolerance=m) for _, lo, hi in local]
         curved = not f["c_lo"] <= 0.0 <= f["c_hi"]
-        reading = ("curvature detected: λ/ν is not linear in ln(1/ñ) over this range"
-                   if curved else "no curvature detected and every local slope within "
+        reading = ("Curvature detected: λ/ν is not linear in ln(1/ñ) over this range"
+                   if curved else "No curvature detected and every local slope within "
                    f"{m * 100:g} % of b: the form holds over this range"
                    if all(v.startswith("within") for v in verdicts) else "inconclusive")
         out.append(
