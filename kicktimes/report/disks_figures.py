@@ -187,8 +187,11 @@ def rates_figure(table):
                 two = d[(d["n_disks"] == 2) & d["rate_two_disk"].notna()]
                 if not two.empty:
                     ax.plot(two["n_disks"] * shift, two["rate_two_disk"], ls="none",
-                            marker="*", ms=8, color=f"C{k // 2}",
-                            label="N = 2 over the two-disk rate Γ(r)" if k == 0 else None)
+                            marker="*", ms=8, color=f"C{k // 2}", mec="k", mew=0.5)
+                    if k == 0:
+                        # the legend's star in black: the stars take their family's colour
+                        ax.plot([], [], ls="none", marker="*", ms=8, color="k",
+                                label="N = 2 over the two-disk rate Γ(r) (colour: family)")
         _n_ticks(ax, ns)
         ax.tick_params(axis="x", labelsize=7)
         if log:
