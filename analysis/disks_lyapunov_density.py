@@ -90,6 +90,7 @@ def _fit(x, y):
 def summarise(runs: pd.DataFrame, *, n_boot=2000, seed=0, fit_max_packing=FIT_MAX_PACKING):
     """The per-packing table and the per-N fit table (see the module docstring), the fit
     over the packings up to ``fit_max_packing``."""
+    from kicktimes.report.disks_kicked import density_form_reading
     from kicktimes.stats import ratio_verdict
 
     rng = np.random.default_rng(seed)
@@ -117,11 +118,7 @@ def summarise(runs: pd.DataFrame, *, n_boot=2000, seed=0, fit_max_packing=FIT_MA
         ci = {k: np.percentile([f[k] for f in bs], [2.5, 97.5], axis=0) for k in range(4)}
         local_verdicts = [ratio_verdict(ci[3][0][i], ci[3][1][i], tolerance=SLOPE_MARGIN)
                           for i in range(int(dilute.sum()) - 1)]
-        curvature = not (ci[2][0] <= 0.0 <= ci[2][1])
-        within = all(v.startswith("within") for v in local_verdicts)
-        reading = ("curvature detected: the form does not hold over this range" if curvature
-                   else "no curvature detected, every local slope within 10 % of b: the form "
-                   "holds over this range" if within else "inconclusive")
+        reading = density_form_reading(ci[2][0], ci[2][1], local_verdicts, SLOPE_MARGIN)
         fits.append({"n_disks": n_disks, "fit_max_packing": fit_max_packing,
                      "a": est[0], "a_lo": ci[0][0], "a_hi": ci[0][1],
                      "b": est[1], "b_lo": ci[1][0], "b_hi": ci[1][1], "c": est[2],

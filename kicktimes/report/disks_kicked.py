@@ -291,6 +291,25 @@ def ftle_check_lines(path) -> list:
     return out + [""]
 
 
+def density_form_reading(c_low, c_high, local_verdicts, margin) -> str:
+    """The reading of the kinetic-theory form from the curvature ``c``'s interval and the
+    local slopes' `ratio_verdict` words: curvature detected (``c``'s interval excludes 0),
+    the form holds (no curvature and every local slope within ``margin`` of ``b``), or
+    inconclusive.
+
+    Examples
+    --------
+    >>> density_form_reading(0.1, 0.3, ["within 10 %"], 0.1)[:18]
+    'curvature detected'
+    """
+    if not c_low <= 0.0 <= c_high:
+        return "curvature detected: λ/ν is not linear in ln(1/ñ) over this range"
+    if all(v.startswith("within") for v in local_verdicts):
+        return (f"no curvature detected and every local slope within {margin * 100:g} % of "
+                "b: the form holds over this range")
+    return "inconclusive"
+
+
 def density_lines(table_path, fit_path) -> list:
     """The section on the gas's FTLE against density (the kinetic-theory form
     ``λ/ν = a + b ln(1/ñ)``) from ``disks_lyapunov_density.csv`` and its ``_fit.csv``
@@ -330,11 +349,8 @@ def density_lines(table_path, fit_path) -> list:
             str(f["local_over_b"]).split(";"), str(f["local_lo"]).split(";"),
             str(f["local_hi"]).split(";"), strict=True)]
         verdicts = [ratio_verdict(lo, hi, tolerance=m) for _, lo, hi in local]
-        curved = not f["c_lo"] <= 0.0 <= f["c_hi"]
-        reading = ("Curvature detected: λ/ν is not linear in ln(1/ñ) over this range"
-                   if curved else "No curvature detected and every local slope within "
-                   f"{m * 100:g} % of b: the form holds over this range"
-                   if all(v.startswith("within") for v in verdicts) else "inconclusive")
+        reading = density_form_reading(f["c_lo"], f["c_hi"], verdicts, m)
+        reading = reading[0].upper() + reading[1:]
         out.append(
             f"- N = {int(f['n_disks'])}, fitted at φ ≤ {f['fit_max_packing']:g}: "
             f"a = {format_interval(f['a'], f['a_lo'], f['a_hi'])}, "

@@ -74,15 +74,18 @@ def _ratio(row, key, verdict=True):
     return f"{text} {row[f'{key}_verdict']}" if verdict else text
 
 
+def _holds_from(ns, ok):
+    """The smallest N of ``ns`` (increasing) from which ``ok`` holds at every larger N, or
+    None."""
+    ok = np.asarray(ok, dtype=bool)
+    return next((int(ns[m]) for m in range(len(ns)) if ok[m:].all()), None)
+
+
 def _first_nominal(d, keys):
     """The smallest N from which every larger N's verdict on every key is "nominal", or
     None."""
-    ok = d[[f"{k}_verdict" for k in keys]].eq("nominal").all(axis=1).to_numpy()
-    ns = d["n_disks"].to_numpy()
-    for m in range(len(ns)):
-        if ok[m:].all():
-            return int(ns[m])
-    return None
+    return _holds_from(d["n_disks"].to_numpy(),
+                       d[[f"{k}_verdict" for k in keys]].eq("nominal").all(axis=1))
 
 
 def _p(p):
@@ -222,9 +225,7 @@ def _answers(table, long=None, n_min=30):
 
 
 def _from_on(g, key, verdict):
-    ok = g[f"{key}_verdict"].eq(verdict).to_numpy()
-    ns = g["n_disks"].to_numpy()
-    return next((int(ns[m]) for m in range(len(ns)) if ok[m:].all()), None)
+    return _holds_from(g["n_disks"].to_numpy(), g[f"{key}_verdict"].eq(verdict))
 
 
 #: the controls table's name of the collision rate over Enskog's
@@ -238,9 +239,8 @@ def _robust_from(long, finding, verdict):
     froms = []
     for _, g in prim.groupby("family", sort=False):
         g = g.sort_values("n_disks")
-        ok = (g["robust"].astype(bool) & g["verdict"].eq(verdict)).to_numpy()
-        ns = g["n_disks"].to_numpy()
-        froms.append(next((int(ns[m]) for m in range(len(ns)) if ok[m:].all()), None))
+        froms.append(_holds_from(g["n_disks"].to_numpy(),
+                                 g["robust"].astype(bool) & g["verdict"].eq(verdict)))
     return max(froms) if froms and all(froms) else None
 
 
