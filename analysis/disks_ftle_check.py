@@ -88,7 +88,8 @@ def summarise(runs: pd.DataFrame) -> pd.DataFrame:
     from kicktimes.stats import ratio_verdict
 
     rows = []
-    for (check, n, rule), g in runs.groupby(["check", "n_disks", "rule"], sort=False):
+    for (check, n, rule), g in runs.groupby(["check", "n_disks", "rule"], sort=False,
+                                            observed=True):
         idx = pd.MultiIndex.from_product([[0.0], g["seed"].to_numpy()], names=["radius", "ic"])
         _, overall = paired_ratio(pd.Series(g["numerator"].to_numpy(), index=idx),
                                   pd.Series(g["denominator"].to_numpy(), index=idx),

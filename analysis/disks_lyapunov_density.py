@@ -95,7 +95,7 @@ def summarise(runs: pd.DataFrame, *, n_boot=2000, seed=0, fit_max_packing=FIT_MA
 
     rng = np.random.default_rng(seed)
     rows, fits = [], []
-    for n_disks, g in runs.groupby("n_disks", sort=True):
+    for n_disks, g in runs.groupby("n_disks", sort=True, observed=True):
         packings = sorted(g["packing"].unique())
         x = np.array([math.log(1.0 / reduced_density(p)) for p in packings])
         per = [g.loc[g["packing"] == p, "lam_per_coll"].to_numpy() for p in packings]

@@ -278,11 +278,12 @@ def write_page(table, ratios, constant, args, command, seconds):
               "perturbations apart.", "",
               "**Ratio of escape rates, kicked / two disks** (`escape_ratios.csv`):", "",
               "| r | uniform kicks | scatter kicks |", "|---|---|---|"]
-    for r, g in ratios.groupby("radius"):
+    for r, g in ratios.groupby("radius", observed=True):
         lines.append(f"| {r:g} | " + " | ".join(_robust(g[g["system"] == s])
                                                 for s in ("poisson", "poisson_scatter")) + " |")
     both = {sy: sum(all(g[(g["system"] == sy)]["verdict"] == "within 10 %")
-                    for _, g in ratios.groupby("radius")) for sy in ("poisson", "poisson_scatter")}
+                    for _, g in ratios.groupby("radius", observed=True))
+               for sy in ("poisson", "poisson_scatter")}
     lines += ["", "Within 10 % under both estimators: " + ", ".join(
         f"{LABELS[sy]} at {n} of {ratios['radius'].nunique()} radii" for sy, n in both.items())
         + "."]
@@ -292,7 +293,7 @@ def write_page(table, ratios, constant, args, command, seconds):
               f"stationary gamma renewal process of shape {BURSTY_SHAPE:g} (coefficient of "
               f"variation {1 / math.sqrt(BURSTY_SHAPE):.1f}, against 1 for Poisson):", "",
               "| r | half-width hole | bursty kick times |", "|---|---|---|"]
-    for r, g in ratios.groupby("radius"):
+    for r, g in ratios.groupby("radius", observed=True):
         lines.append(f"| {r:g} | " + " | ".join(_robust(g[g["system"] == s])
                                                 for s in CONTROLS) + " |")
     for s in CONTROLS:
@@ -319,7 +320,7 @@ def write_page(table, ratios, constant, args, command, seconds):
               "", "| r | C | " + " | ".join(f"t = {t:g}" for t in constant["t"].unique())
               + f" | local α, t = {constant['t'].min():g}–{constant['t'].max():g} |",
               "|---|---|" + "---|" * (constant["t"].nunique() + 1)]
-    for r, g in constant.groupby("radius"):
+    for r, g in constant.groupby("radius", observed=True):
         c = g["C_predicted"].iloc[0]
         g = g.sort_values("t")
         a, b = g.iloc[0], g.iloc[-1]

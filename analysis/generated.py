@@ -34,7 +34,7 @@ def store_name(path) -> str:
 
 def header(title, command, sources) -> list[str]:
     """The page's title and "Generated ..." line; ``sources`` are names, not paths."""
-    now = _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")
+    now = _dt.datetime.now(_dt.UTC).isoformat(timespec="seconds")
     return [f"# {title} (generated)", "",
             f"Generated {now} by kicktimes {__version__} (`{command}`) from "
             + ", ".join(sources) + ". Every number below is computed; nothing is typed.", ""]

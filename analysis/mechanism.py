@@ -240,7 +240,7 @@ def analyse(key, ics, runs, *, n_twins, rng, rule="mirror"):
     _row(rows, key, "recollision_share_poisson_null_nonsticky", null_ns.share, null_ns.ci_low,
          null_ns.ci_high)
     # the collision *before* a re-collision: was it glancing?
-    before = tab.groupby("run")["impact_ratio"].shift(1).to_numpy()
+    before = tab.groupby("run", observed=True)["impact_ratio"].shift(1).to_numpy()
     tab["impact_ratio_before"] = before
     others = ~again & tab["interval"].notna().to_numpy()
     for name, mask in (("recollisions", again & calm), ("others", others & calm)):
@@ -250,7 +250,7 @@ def analyse(key, ics, runs, *, n_twins, rng, rule="mirror"):
              note="impact of the previous collision; sticky runs left out")
     # the angular momenta the previous collision left: radial orbits return through the centre
     spin = np.maximum(np.abs(tab["L0_post"]), np.abs(tab["L1_post"]))
-    spin_before = spin.groupby(tab["run"]).shift(1).to_numpy()
+    spin_before = spin.groupby(tab["run"], observed=True).shift(1).to_numpy()
     for name, mask in (("recollisions", again & calm), ("others", others & calm)):
         _row(rows, key, f"max_abs_L_before_median_{name}", np.median(spin_before[mask]),
              note="max |L| left by the previous collision; sticky runs left out")
@@ -281,7 +281,7 @@ def analyse(key, ics, runs, *, n_twins, rng, rule="mirror"):
     tab["rate_post"] = post
     # memory of the state from one collision to the next
     log_rate = np.log(post)
-    prev = pd.Series(log_rate).groupby(tab["run"].to_numpy()).shift(1).to_numpy()
+    prev = pd.Series(log_rate).groupby(tab["run"].to_numpy(), observed=True).shift(1).to_numpy()
     ok = np.isfinite(prev)
     _row(rows, key, "lag1_corr_log_rate_post", np.corrcoef(log_rate[ok], prev[ok])[0, 1],
          note="consecutive post-collision states of a run")

@@ -192,7 +192,7 @@ def write_page(pooled, resid, dip, args, seconds):
     n_w = int(resid["n_windows"].min())
     k5 = round(0.05 * n_w)
     cp_lo, cp_hi = clopper_pearson(k5, n_w)
-    for (rule, fit, k), g in resid.groupby(["rule", "fit", "states"], sort=False):
+    for (rule, fit, k), g in resid.groupby(["rule", "fit", "states"], sort=False, observed=True):
         g = g.set_index("test")
         model = "Poisson" if k == 1 else "MMPP-2"
         label = f"{fit}, {model} ({int(g['n_windows'].iloc[0])} windows)"

@@ -109,7 +109,8 @@ def shortfall_table(ref, fits_by_tag):
     """Per tag: fits within 0.01 of the optimum, shortfalls above 0.01 and 1, worst."""
     best = ref.set_index("set")["reference"]
     for fits in fits_by_tag.values():
-        best = np.maximum(best, fits.groupby("set")["loglik"].max().reindex(best.index))
+        best = np.maximum(
+            best, fits.groupby("set", observed=True)["loglik"].max().reindex(best.index))
     rows, detail = [], []
     for tag, fits in fits_by_tag.items():
         gap = best.reindex(fits["set"]).to_numpy() - fits["loglik"].to_numpy()

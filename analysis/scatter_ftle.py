@@ -187,13 +187,13 @@ def summarise(df):
     print(df.loc[df.sticky, ["radius", "ic", "rate", "two", "scatter"]].to_string(index=False))
     cols = ["two", "two_fresh", "uniform", "scatter", "scatter_unw", "scatter_actual"]
     for label, part in (("all ICs", df), ("without sticky ICs", df[~df.sticky])):
-        g = part.groupby("radius")
+        g = part.groupby("radius", observed=True)
         tab = g[cols].mean()
         tab["n"] = g.size()
         ratio = part["scatter"] / part["two"]
         tab["scatter/two"] = tab["scatter"] / tab["two"]
         tab["+-"] = np.sqrt(g["scatter"].var() / g.size()) / tab["two"]
-        tab["median ratio"] = ratio.groupby(part["radius"]).median()
+        tab["median ratio"] = ratio.groupby(part["radius"], observed=True).median()
         tab["uniform/two"] = tab["uniform"] / tab["two"]
         tab["unw/two"] = tab["scatter_unw"] / tab["two"]
         tab["actual/two"] = tab["scatter_actual"] / tab["two"]
@@ -205,7 +205,7 @@ def summarise(df):
     part = df[~df.sticky]
     names = [f"{n}_{k}" for n in ("two", "uniform", "scatter")
              for k in ("rr_offdiag", "det", "acf1", "acf5")]
-    shape = part.groupby("radius")[names].mean()
+    shape = part.groupby("radius", observed=True)[names].mean()
     for name in ("two", "uniform", "scatter"):
         shape[f"{name}_rr_offdiag"] *= 1e4
     print("\nwithout sticky ICs; rr_offdiag (eps = 0.001, Theiler 1) in units of 1e-4")
@@ -223,7 +223,7 @@ RATIOS = (("scatter", "two", "scatter kicks / two disks"),
 def _sticky(df):
     """A two-disk orbit is sticky when its exponent is below a quarter of its radius's
     median (a near-periodic head-on orbit with a collision rate ~10x the typical one)."""
-    return df["two"] < 0.25 * df.groupby("radius")["two"].transform("median")
+    return df["two"] < 0.25 * df.groupby("radius", observed=True)["two"].transform("median")
 
 
 def ratio_table(df, n_boot=1000, seed=0):
@@ -238,7 +238,7 @@ def ratio_table(df, n_boot=1000, seed=0):
     sticky = _sticky(df)
     rows = []
     for ics, part in (("without sticky ICs", df[~sticky]), ("all ICs", df)):
-        for r, g in part.groupby("radius"):
+        for r, g in part.groupby("radius", observed=True):
             picks = np.vstack([np.arange(len(g)), rng.integers(0, len(g), (n_boot, len(g)))])
             for num, den, label in RATIOS:
                 q = g[num].to_numpy()[picks].mean(1) / g[den].to_numpy()[picks].mean(1)
@@ -280,7 +280,7 @@ def write_page(df, page, command):
     main = tab[tab["ics"] == "without sticky ICs"]
     labels = [label for _, _, label in RATIOS]
     lines += ["| r | " + " | ".join(labels) + " |", "|---|" + "---|" * len(labels)]
-    for r, g in main.groupby("radius"):
+    for r, g in main.groupby("radius", observed=True):
         g = g.set_index("ratio")
         lines.append(f"| {r:g} | " + " | ".join(
             f"{format_interval(g.loc[x, 'estimate'], g.loc[x, 'ci_low'], g.loc[x, 'ci_high'])}"

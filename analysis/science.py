@@ -161,7 +161,7 @@ def stretching_figure(per_radius, path):
 
     fig = Figure(figsize=(10.0, 4.2), layout="constrained")
     ax, bx = fig.subplots(1, 2)
-    for k, (system, g) in enumerate(per_radius.groupby("system", sort=False)):
+    for k, (system, g) in enumerate(per_radius.groupby("system", sort=False, observed=True)):
         st = system_style(system, k)
         err = [g["stretch_per_perturbation"] - g["ci_low"], g["ci_high"]
                - g["stretch_per_perturbation"]]
@@ -400,7 +400,7 @@ def rate_relaxation(store, n_windows=10, n_boot=N_BOOT, seed=0):
     rows, whole = [], []
     rng = np.random.default_rng(seed)
     boot_sum, est_sum, n_r = np.zeros((n_boot, n_windows)), np.zeros(n_windows), 0
-    for r, part in coll.groupby("radius"):
+    for r, part in coll.groupby("radius", observed=True):
         t_end = float(part["t_window"].min())
         edges = np.linspace(0.0, t_end, n_windows + 1)
         per_ic = np.array([np.histogram(np.asarray(times, float), bins=edges)[0]
@@ -604,7 +604,7 @@ def _decorrelation_lines(dec, compare, closest):
              "Correlation of the boundary angle θ at the wall hit before and the wall hit "
              "after exactly one perturbation (40 paper ICs, T = 20 000 per run; kicked runs "
              "at their two-disk run's collision rate; `science_decorrelation.csv`):", ""]
-    for (rule, r), g in dec.groupby(["rule", "radius"], sort=False):
+    for (rule, r), g in dec.groupby(["rule", "radius"], sort=False, observed=True):
         lines.append(f"- {rule} rule, r = {r:g}: " + "; ".join(
             f"{row.perturbation} {_fmt(row.correlation, row.ci_low, row.ci_high)} "
             f"({row.n_pairs} pairs)" for row in g.itertuples()) + ".")
@@ -635,7 +635,7 @@ def _decorrelation_lines(dec, compare, closest):
               "primary; distance from 1: |ln ratio|, its interval the image of the ratio's; "
               "the closest group is the law with the lowest upper distance and every law whose "
               "distance interval reaches below it; `science_closest.csv`):", ""]
-    for (family, diag), g in closest.groupby(["family", "diagnostic"], sort=False):
+    for (family, diag), g in closest.groupby(["family", "diagnostic"], sort=False, observed=True):
         best, rest = g[g["closest"]], g[~g["closest"]]
 
         def cells(part):
@@ -668,7 +668,7 @@ def _store_lines(whole, windows, sticky):
              "equal windows of the shortest run, averaged over radii, with a 95 % bootstrap "
              "interval over ICs and its `ratio_verdict` (`science_rate_windows.csv`; per "
              "radius: `science_rate_relaxation.csv`):", ""]
-    for fam, g in whole.groupby("family", sort=False):
+    for fam, g in whole.groupby("family", sort=False, observed=True):
         w = windows[windows["family"] == fam].set_index("window")
         counts = g["verdict"].value_counts()
         wv = w["verdict"].value_counts()

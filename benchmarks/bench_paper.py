@@ -104,7 +104,7 @@ def bare_simulation(names) -> tuple[float, int]:
 def report_breakdown(timings: pd.DataFrame) -> pd.DataFrame:
     """Report seconds per stage, summed over the experiments (sections run in workers, so
     the sum can exceed the wall time)."""
-    t = timings.groupby("stage", sort=False)["seconds"].sum().reset_index()
+    t = timings.groupby("stage", sort=False, observed=True)["seconds"].sum().reset_index()
     return t.sort_values("seconds", ascending=False, ignore_index=True)
 
 

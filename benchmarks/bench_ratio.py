@@ -96,7 +96,7 @@ def stage_table(out: Path) -> pd.Series:
             sums[f"sweep: {stage}"] = sums.get(f"sweep: {stage}", 0.0) + float(sec)
     for report in out.glob("report*/report_timings.csv"):
         t = pd.read_csv(report)
-        for stage, sec in t.groupby("stage")["seconds"].sum().items():
+        for stage, sec in t.groupby("stage", observed=True)["seconds"].sum().items():
             sums[f"report: {stage}"] = sums.get(f"report: {stage}", 0.0) + float(sec)
     return pd.Series(sums, dtype=float)
 

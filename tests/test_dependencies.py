@@ -17,15 +17,11 @@ from __future__ import annotations
 import ast
 import re
 import sys
+import tomllib
 from importlib.metadata import packages_distributions
 from pathlib import Path
 
 import pytest
-
-if sys.version_info >= (3, 11):
-    import tomllib
-else:  # pragma: no cover - Python 3.10
-    import tomli as tomllib
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -79,7 +75,7 @@ def _undeclared(folder: str, allowed: set[str]) -> list[str]:
     """Imports under ``folder`` from no distribution in ``allowed``.
 
     A module that is not installed passes only if a distribution of its name is declared
-    somewhere (``tomli`` on Python >= 3.11, the ``outside`` extra's ``billiards``, which
+    somewhere (the ``outside`` extra's ``billiards``, which
     the notebooks import only when present)."""
     distributions = packages_distributions()
     anywhere = set().union(*_declared().values())

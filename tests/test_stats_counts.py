@@ -193,7 +193,7 @@ def test_linear_covariate_option_changes_the_count_models():
 
 
 def test_two_rows_give_estimates_with_a_warning_naming_the_missing_degrees_of_freedom():
-    # as statsmodels: no residual degrees of freedom -> NaN standard errors, and a warning
+    # kicktimes decides: no residual degrees of freedom -> NaN standard errors, and a warning
     df = pd.DataFrame({"radius": [0.01, 0.02], "count": [172, 315], "t_window": 100.0})
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
@@ -207,10 +207,82 @@ def test_two_rows_give_estimates_with_a_warning_naming_the_missing_degrees_of_fr
     assert np.isfinite(coef["estimate"]).all()
     # the Poisson GLM's errors need no residual degrees of freedom (its scale is fixed)
     assert np.isfinite(coef.loc["poisson", "stderr"]).all()
-    assert not np.isfinite(coef.loc["ols", "stderr"]).any()
+    assert np.isnan(coef.loc["ols", "stderr"]).all()
     assert np.isnan(coef.loc["negbin", "stderr"]).all()
     assert math.isnan(reg.overdispersion()["pearson_dispersion"])  # was inf
+    # two rows: the Poisson line passes through both points, so the NB MLE is on alpha = 0
+    # and is the Poisson fit, exactly (no optimiser, nothing a BLAS kernel could change)
+    assert reg.negbin is None and reg.alpha == 0.0
+    np.testing.assert_array_equal(reg.params("negbin")[:2], reg.params("poisson"))
     assert reg.converged
+
+
+def test_one_radius_is_refused_naming_the_radius_and_the_remedy():
+    df = pd.DataFrame({"radius": [0.01] * 4, "count": [172, 160, 133, 157], "t_window": 100.0})
+    with pytest.raises(ValueError, match=r"takes one value \(0\.01\): no slope to estimate; "
+                       "give at least two radii"):
+        stats.regress_counts(df)
+
+
+def test_three_rows_leave_the_negative_binomial_no_degrees_of_freedom_and_say_so():
+    df = pd.DataFrame({"radius": [0.01, 0.02, 0.03], "count": [150, 340, 470],
+                       "t_window": 100.0})
+    with pytest.warns(stats.FitWarning, match="3 rows leave the negative binomial"):
+        reg = stats.regress_counts(df)
+    coef = reg.coefficients()
+    assert np.isnan(coef.loc["negbin", "stderr"]).all()
+    assert np.isfinite(coef.loc["ols", "stderr"]).all()  # 3 radii: one degree of freedom
+    assert np.isfinite(coef.loc["poisson", "stderr"]).all()
+
+
+def test_standard_errors_near_a_singularity_do_not_depend_on_what_statsmodels_returns(
+        monkeypatch):
+    """A BLAS kernel may turn a singular Hessian into finite numbers or NaN: kicktimes'
+    answer must be the same either way (issue 47)."""
+    from statsmodels.discrete.discrete_model import NegativeBinomialResults
+    from statsmodels.regression.linear_model import RegressionResults
+
+    df = pd.DataFrame({"radius": [0.01, 0.02, 0.03], "count": [150, 340, 470],
+                       "t_window": 100.0})
+    two = df.iloc[:2]
+    answers = []
+    for fake in (None, 0.25, np.nan):
+        with monkeypatch.context() as m:
+            if fake is not None:
+                def cov(self, *args, _v=fake, **kwargs):
+                    k = len(np.asarray(self.params))
+                    return np.full((k, k), _v) + np.eye(k)
+                m.setattr(NegativeBinomialResults, "cov_params", cov)
+                m.setattr(RegressionResults, "cov_params", cov)
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                answers.append([stats.regress_counts(d).coefficients() for d in (df, two)])
+    (three, two_rows) = answers[0]
+    assert np.isnan(three.loc["negbin", "stderr"]).all()
+    assert np.isnan(two_rows.loc[["ols", "negbin"], "stderr"]).all()
+    for other_three, other_two in answers[1:]:
+        # what kicktimes decides is undefined stays so, whatever statsmodels returned
+        pd.testing.assert_frame_equal(other_three.loc[["negbin"]], three.loc[["negbin"]])
+        pd.testing.assert_frame_equal(other_two.loc[["ols", "negbin"]],
+                                      two_rows.loc[["ols", "negbin"]])
+
+
+def test_equidispersed_data_put_the_negative_binomial_on_its_boundary_with_a_note():
+    # under-dispersed counts (binomial): the score in alpha at 0 is negative
+    rng = np.random.default_rng(12)
+    r = np.repeat([0.01, 0.02, 0.03], 40)
+    df = pd.DataFrame({"radius": r, "count": rng.binomial(400, r * 5), "t_window": 100.0})
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # a boundary is expected, not a problem
+        reg = stats.regress_counts(df)
+    coef = reg.coefficients()
+    assert reg.negbin is None and reg.alpha == 0.0
+    np.testing.assert_array_equal(coef.loc["negbin", "stderr"].to_numpy()[:2],
+                                  coef.loc["poisson", "stderr"].to_numpy())
+    assert math.isnan(coef.loc[("negbin", "alpha"), "stderr"])
+    assert any("boundary 0" in w for w in reg.warnings)
+    assert reg.overdispersion()["lr_pvalue"] == 1.0
+    assert reg.aic["negbin"] == pytest.approx(reg.aic["poisson"] + 2.0)
 
 
 def test_two_radii_with_more_rows_warn_about_the_exact_ols_line_only():
@@ -233,7 +305,7 @@ def test_two_radii_with_more_rows_warn_about_the_exact_ols_line_only():
         (pd.DataFrame({"radius": [0.01, 0.6], "count": [1, 2], "t_window": 1.0}), "radius"),
         (pd.DataFrame({"radius": [0.01, 0.02], "count": [1, 2], "t_window": 0.0}), "t_window"),
         (pd.DataFrame({"radius": [0.01, np.nan], "count": [1, 2], "t_window": 1.0}), "radius"),
-        (pd.DataFrame({"radius": [0.01, 0.01], "count": [1, 2], "t_window": 1.0}), "2 distinct"),
+        (pd.DataFrame({"radius": [0.01, 0.01], "count": [1, 2], "t_window": 1.0}), "two radii"),
     ],
 )
 def test_regress_counts_rejects_bad_frames(frame, match):

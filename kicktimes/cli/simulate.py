@@ -104,7 +104,7 @@ def simulate_command(radii, n_ics, t_max, seed, rule, ic_method, out, save_runs,
     with _cli_errors():
         atomic_write(path, lambda tmp: pq.write_table(table, tmp))
     df = pd.DataFrame({"radius": table["radius"].to_numpy(), "n_pp": table["n_pp"].to_numpy()})
-    summary = df.groupby("radius").n_pp.agg(["mean", "std", "count"])
+    summary = df.groupby("radius", observed=True).n_pp.agg(["mean", "std", "count"])
     summary["sem"] = summary["std"] / np.sqrt(summary["count"])
     summary["kinetic"] = [kinetic_rate(r, rule=rule) * t_max for r in summary.index]
     click.echo(f"{n_ics} ICs ({ic_method}), rule={rule}, t_max={t_max:g}, seed={seed}")

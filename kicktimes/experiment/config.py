@@ -499,8 +499,6 @@ def _toml_value(value) -> str:
 
 
 def _tomllib():
-    try:
-        import tomllib
-    except ModuleNotFoundError:  # Python 3.10
-        import tomli as tomllib
+    import tomllib
+
     return tomllib

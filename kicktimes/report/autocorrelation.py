@@ -118,7 +118,7 @@ def acf_curves(results) -> pd.DataFrame:
         return pd.DataFrame(columns=["radius", "system", "lag", "mean", "sem", "median",
                                      "ci95"])
     part = part.assign(lag=lag[keep].astype(int))
-    g = part.groupby(["radius", "system", "lag"])["value"]
+    g = part.groupby(["radius", "system", "lag"], observed=True)["value"]
     out = g.agg(["mean", "median", "std", "count"]).reset_index()
     out["sem"] = out["std"] / np.sqrt(out["count"].where(out["count"] > 0))
     out["ci95"] = half_width95(out["sem"], out["count"])
@@ -174,7 +174,7 @@ def crossings(differences) -> pd.DataFrame:
         and whether the crossing is clear (the 95 % intervals exclude 0 on both sides).
     """
     rows = []
-    for (r, system), g in differences.groupby(["radius", "system"]):
+    for (r, system), g in differences.groupby(["radius", "system"], observed=True):
         g = g.sort_values("lag")
         d, h = g["difference"].to_numpy(float), g["ci95"].to_numpy(float)
         if d.size == 0 or not np.isfinite(d[0]) or d[0] == 0:
@@ -227,7 +227,7 @@ def acf_figure(curves, predicted, *, max_panels=6):
                         gridspec_kw={"height_ratios": [3, 2] * nblock})
     top_axes = grid[0::2].ravel()
     diff_axes = grid[1::2].ravel()
-    pred = predicted.groupby(["radius", "system"])["value"].mean()
+    pred = predicted.groupby(["radius", "system"], observed=True)["value"].mean()
     systems = [s for s in (REFERENCE, *kicked_systems(curves)) if s in distinct(curves, "system")]
     diffs = acf_differences(curves)
     if "ci95" not in curves.columns:
@@ -293,7 +293,7 @@ def _lag1_figure(summary, predicted, lag):
     fig = Figure(figsize=(11.0, 4.6), layout="constrained")
     ax, ax_ratio = fig.subplots(1, 2)
     radii = summary["radius"].to_numpy()
-    pred = (predicted.groupby(["radius", "system"])["value"].mean()
+    pred = (predicted.groupby(["radius", "system"], observed=True)["value"].mean()
             if lag == 1 and not predicted.empty else None)
     ref = summary[summary["system"] == REFERENCE].set_index("radius")
     for k, system in enumerate(order):
@@ -419,23 +419,25 @@ def sections(ctx):
                 + (" Crossing, by system: " + ", ".join(
                     f"{system_label(sys_)} at r = "
                     + ", ".join(f"{r:g}" for r in g["radius"])
-                    for sys_, g in crossing.groupby("system")) + "." if len(crossing) else "")
+                    for sys_, g in crossing.groupby("system", observed=True))
+            + "." if len(crossing) else "")
             )
         sec.table("autocorrelation_curves", curves, "R_l per lag", show=False)
     rows = []
-    pred = predicted.groupby(["radius", "system"])["value"].mean()
+    pred = predicted.groupby(["radius", "system"], observed=True)["value"].mean()
     sticky = ctx.found.sticky
     flags = sticky.set_index(["radius", "ic"])["sticky"] if sticky is not None else None
     # the decorrelation rows of each (radius, system), grouped once: filtering the whole
     # table per group and name cost seconds on a paper store
     decorrelation = {
         name: dict(
-            list(results[results["diagnostic"] == name].groupby(["radius", "system"])["value"])
+            list(results[results["diagnostic"] == name].groupby(["radius", "system"],
+                                                               observed=True)["value"])
         )
         for name in (() if one_lag else ("decorrelation_lag", "tau_int"))
     }
     for (r, system), g in results[results["diagnostic"] == "autocorrelation"].groupby(
-        ["radius", "system"]
+        ["radius", "system"], observed=True
     ):
         entry = {
             "radius": r,

@@ -341,4 +341,5 @@ def distinct(frame, column):
 def wide(results, diagnostic):
     """``value`` of one diagnostic as a (radius, ic) x system table."""
     part = results[results["diagnostic"] == diagnostic]
-    return part.pivot_table(index=["radius", "ic"], columns="system", values="value", dropna=False)
+    return part.pivot_table(index=["radius", "ic"], columns="system", values="value", dropna=False,
+                            observed=True)

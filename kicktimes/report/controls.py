@@ -343,7 +343,7 @@ def with_robustness(table: pd.DataFrame) -> pd.DataFrame:
         return out
     robust = np.zeros(len(out), bool)
     depends = np.array([""] * len(out), dtype=object)
-    for _, g in out.groupby(["family", "diagnostic", "system"], sort=False):
+    for _, g in out.groupby(["family", "diagnostic", "system"], sort=False, observed=True):
         share = (g["question"] == POISSON_QUESTION).all()
         ok, _ = robust_verdict(list(g["verdict"]), g["ci_low"], g["ci_high"],
                                level=np.inf if share else 1.0)
@@ -449,7 +449,7 @@ def poisson_rows(family, rejections, per_ic, *, alpha, rng, n_boot=2000):
             "ci_high": high, "verdict": rejection_verdict(low, high, alpha), "robust": False,
             "depends_on": "", "n_pairs": int(n), "detail": detail})
 
-    totals = rejections.groupby("test", sort=False)[["n_reject", "n_tested"]].sum()
+    totals = rejections.groupby("test", sort=False, observed=True)[["n_reject", "n_tested"]].sum()
     for test, (k, n) in totals.iterrows():
         if n == 0:
             continue

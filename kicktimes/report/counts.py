@@ -102,7 +102,7 @@ def counts_by_radius(collisions, *, x="radius") -> pd.DataFrame:
         raise ValueError("collisions['n_pp'] must be non-negative")
     if (finite("collisions['t_window']", df["t_window"]) <= 0).any():
         raise ValueError("collisions['t_window'] must be positive")
-    g = df.groupby(x)
+    g = df.groupby(x, observed=True)
     out = pd.DataFrame(
         {
             "n_ics": g.size(),
@@ -196,7 +196,7 @@ def sections(ctx):
 
     exp, coll = ctx.exp, ctx.store.collisions
     table = counts_by_radius(coll)
-    grouped = coll.groupby("radius")
+    grouped = coll.groupby("radius", observed=True)
     table["pooled_rate"] = grouped["n_pp"].sum() / grouped["t_window"].sum()
     kinetic = experiment_kinetic(exp)
     table["kinetic_rate"] = kinetic_rate_of(table.index.to_numpy(), exp.rule, kinetic)
@@ -204,7 +204,7 @@ def sections(ctx):
     table["dispersion_index"] = grouped["n_pp"].var(ddof=1) / grouped["n_pp"].mean()
     sticky = sticky_ics(coll, exp.rule, kinetic=kinetic)
     ctx.found.sticky = sticky
-    table["n_sticky"] = sticky.groupby("radius")["sticky"].sum().astype(int)
+    table["n_sticky"] = sticky.groupby("radius", observed=True)["sticky"].sum().astype(int)
     sec = Section("counts", "Number of disk-disk collisions against radius")
     sec.table("counts_by_radius", table.reset_index(), "Counts per radius")
     sec.table("sticky_ics", sticky[sticky["sticky"]], "Sticky ICs", show=False)
@@ -246,8 +246,8 @@ def sections(ctx):
         + ("over-dispersed" if od["lr_pvalue"] < 0.05 else "not significantly over-dispersed")
         + f" across ICs: Poisson Pearson dispersion {od['pearson_dispersion']:.3g}, "
         f"negative-binomial α = {od['alpha']:.3g} (LR test of α = 0: p = "
-        f"{fmt_p(od['lr_pvalue'])}); AIC Poisson {reg.poisson.aic:.6g} vs negative binomial "
-        f"{reg.negbin.aic:.6g}. The negative-binomial exponent of r is {b1['estimate']:.3f} "
+        f"{fmt_p(od['lr_pvalue'])}); AIC Poisson {reg.aic['poisson']:.6g} vs negative binomial "
+        f"{reg.aic['negbin']:.6g}. The negative-binomial exponent of r is {b1['estimate']:.3f} "
         f"(95% CI {b1['ci_low']:.3f} to {b1['ci_high']:.3f}; kinetic theory: about 1). The "
         f"pooled rate is {table['rate_over_kinetic'].min():.3g} to "
         f"{table['rate_over_kinetic'].max():.3g} times the kinetic-theory rate "

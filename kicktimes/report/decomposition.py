@@ -279,7 +279,8 @@ def gap_summary(table: pd.DataFrame) -> pd.DataFrame:
     from kicktimes.stats import format_interval
 
     rows = []
-    for (family, diagnostic), part in table.groupby(["family", "diagnostic"], sort=False):
+    for (family, diagnostic), part in table.groupby(["family", "diagnostic"], sort=False,
+                                                    observed=True):
         head = part[part["control"] == "primary"].set_index("quantity")
         row = {"family": family, "diagnostic": diagnostic}
         for step in STEPS:

@@ -375,8 +375,9 @@ def kicked_table(store, *, n_boot=999, seed=0) -> pd.DataFrame:
     res = store.results
     res = res[res["system"] != "disks"]
     rows = []
-    for n, g in res.groupby("n_disks", sort=True):
-        wide = g.pivot_table(index="ic", columns=["system", "diagnostic"], values="value")
+    for n, g in res.groupby("n_disks", sort=True, observed=True):
+        wide = g.pivot_table(index="ic", columns=["system", "diagnostic"], values="value",
+                              observed=True)
         runs = wide.index.size
         rng = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(int(n), 7)))
         weights = rng.multinomial(runs, np.full(runs, 1.0 / runs), size=n_boot).astype(float)

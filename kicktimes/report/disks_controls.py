@@ -120,7 +120,7 @@ def controls_findings(tables: dict) -> pd.DataFrame:
     out["_order"] = out["control"].map(order)
     out = out.sort_values(["family", "n_disks", "diagnostic", "_order"], kind="stable")
     robust, reason, depends = {}, {}, {}
-    for key, g in out.groupby(["family", "n_disks", "diagnostic"], sort=False):
+    for key, g in out.groupby(["family", "n_disks", "diagnostic"], sort=False, observed=True):
         ok, why = robust_verdict(g["verdict"].tolist(), g["ci_low"], g["ci_high"],
                                  level=float(g["level"].iloc[0]))
         robust[key], reason[key] = ok, why

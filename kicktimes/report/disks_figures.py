@@ -175,7 +175,7 @@ def rates_figure(table):
         ax.axhspan(0.9, 1.1, color="0.88", zorder=0)
         ax.axhline(1.0, color="0.5", lw=0.8, zorder=0)
         for k, ((_, geo, rule), d) in enumerate(table.groupby(
-                ["experiment", "geometry", "rule"], sort=False)):
+                ["experiment", "geometry", "rule"], sort=False, observed=True)):
             shift = 1.0 + 0.04 * (k - 2.5)
             x = d["n_disks"].to_numpy() * shift
             y = d[key].to_numpy()

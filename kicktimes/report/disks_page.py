@@ -124,7 +124,7 @@ def _summary_table(table, long=None):
             "D, speed-rescaled", "hazard flatness p", "share nominal from N on",
             "under the controls (seed, K = 60, bulk)"]
     out = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
-    for (geo, rule), g in table.groupby(["geometry", "rule"], sort=False):
+    for (geo, rule), g in table.groupby(["geometry", "rule"], sort=False, observed=True):
         big = g.iloc[-1]
         first = _first_nominal(g, [f"reject_{HEADLINE}"])
         out.append("| " + " | ".join([
@@ -155,7 +155,7 @@ def _answers(table, long=None, n_min=30):
     long = pd.DataFrame() if long is None else long
     lines = []
     tot = {"d": 0, "h": 0, "s": 0, "sn": 0, "rows": 0}
-    for (geo, rule), g in table.groupby(["geometry", "rule"], sort=False):
+    for (geo, rule), g in table.groupby(["geometry", "rule"], sort=False, observed=True):
         lo, hi = g.iloc[0], g.iloc[-1]
         big = g[g["n_disks"] >= n_min]
         d_above = [r for _, r in big.iterrows() if _above(r, "dispersion", 1.0) == "above"]
@@ -237,7 +237,7 @@ def _robust_from(long, finding, verdict):
     controls with the primary ``verdict`` at every larger N (None: no such N)."""
     prim = long[(long["control"] == "primary") & (long["diagnostic"] == finding)]
     froms = []
-    for _, g in prim.groupby("family", sort=False):
+    for _, g in prim.groupby("family", sort=False, observed=True):
         g = g.sort_values("n_disks")
         froms.append(_holds_from(g["n_disks"].to_numpy(),
                                  g["robust"].astype(bool) & g["verdict"].eq(verdict)))
@@ -248,11 +248,11 @@ def _short_answers(table, tot, kicked, long=None):
     """The first screen's sentences under its table."""
     long = pd.DataFrame() if long is None else long
     el = table[table["rule"] == "elastic"]
-    big = el.groupby("geometry", sort=False).tail(1)
+    big = el.groupby("geometry", sort=False, observed=True).tail(1)
     resc = "; ".join(f"{r['geometry']}: {_ratio(r, 'rescaled_dispersion')}"
                      for _, r in big.iterrows())
     froms = [_from_on(g, "rate_enskog", "within 10 %")
-             for _, g in table.groupby(["geometry", "rule"], sort=False)]
+             for _, g in table.groupby(["geometry", "rule"], sort=False, observed=True)]
     rate = (f"from N = {max(froms)} on at every geometry and rule" if all(froms)
             else "not from one N on at every geometry and rule")
     if not long.empty:
@@ -293,7 +293,7 @@ def _short_answers(table, tot, kicked, long=None):
 
 def _hazard_answers(table):
     lines = []
-    for (geo, rule), g in table.groupby(["geometry", "rule"], sort=False):
+    for (geo, rule), g in table.groupby(["geometry", "rule"], sort=False, observed=True):
         lo, hi = g.iloc[0], g.iloc[-1]
         side = _above(hi, "hazard_first", 1.0)
         gap = abs(1.0 - hi["hazard_first"])
@@ -356,7 +356,7 @@ def _speed_answers(table):
 
 def _rate_answers(table):
     lines = []
-    for (geo, rule), g in table.groupby(["geometry", "rule"], sort=False):
+    for (geo, rule), g in table.groupby(["geometry", "rule"], sort=False, observed=True):
         within = g[g["rate_enskog_verdict"] == "within 10 %"]["n_disks"].tolist()
         two = g[g["n_disks"] == 2]
         two_text = (f"; N = 2 against the two-disk kinetic rate Γ(r) "
@@ -583,7 +583,7 @@ def write_disks_page(store_paths, out_dir, *, command="python analysis/make_disk
         plt.close(fig)
     exp0 = stores[0].experiment
     names = ", ".join(f"`{st.experiment.name}`" for st in every)
-    now = _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")
+    now = _dt.datetime.now(_dt.UTC).isoformat(timespec="seconds")
     k = exp0.collisions
     poisson_lines, poisson_tot = _answers(table, long)
     lines = [

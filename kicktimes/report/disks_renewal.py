@@ -123,7 +123,7 @@ def renewal_lines(models: pd.DataFrame) -> list:
         "check that does not rest on that count, the two best models are refitted on the odd "
         "and the even runs (independent gases): *stable* when both halves pick the same "
         "model.", ""]
-    for (fam, rule), g in models.groupby(["geometry", "rule"], sort=False):
+    for (fam, rule), g in models.groupby(["geometry", "rule"], sort=False, observed=True):
         exp_best = g[g["best"] == "exponential"]["n_disks"].tolist()
         unstable = g[~g["stable"]]["n_disks"].tolist()
         big = g.iloc[-1]

@@ -130,7 +130,7 @@ def escape_curves(runs) -> pd.DataFrame:
 
     check_frame("runs", runs, ["radius", "system", "time", "horizon"])
     parts = []
-    for (r, system), g in runs.groupby(["radius", "system"], sort=True):
+    for (r, system), g in runs.groupby(["radius", "system"], sort=True, observed=True):
         horizon = g["horizon"].to_numpy(float)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", RuntimeWarning)  # log of S = 0 or 1 in the bands
@@ -193,7 +193,7 @@ def escape_table(runs, *, t_min, curves=None) -> pd.DataFrame:
         raise ValueError(f"t_min must be positive and finite, got {float(t_min)}")
     curves = escape_curves(runs) if curves is None else curves
     rows = []
-    for (r, system), g in runs.groupby(["radius", "system"], sort=True):
+    for (r, system), g in runs.groupby(["radius", "system"], sort=True, observed=True):
         time, horizon = g["time"].to_numpy(float), g["horizon"].to_numpy(float)
         km = curves[(curves["radius"] == r) & (curves["system"] == system)]
         row = {"radius": r, "system": system, "followed": g["followed"].iloc[0],
@@ -257,7 +257,7 @@ def escape_comparison(table) -> pd.DataFrame:
                                  "rate_low", "rate_high", "alpha", "alpha_low",
                                  "alpha_high"], allow_empty=True)
     rows = []
-    for r, g in table.groupby("radius", sort=True):
+    for r, g in table.groupby("radius", sort=True, observed=True):
         ref = g[g["system"] == REFERENCE]
         if ref.empty:
             continue
@@ -375,8 +375,8 @@ def escape_answer(comparison) -> str:
         answer = (f"Undecided: every ratio's 95 % interval straddles an edge of the "
                   f"±{100 * MARGIN:g} % band (" + _cases(made) + ").")
     else:
-        by_radius = (made.groupby("radius")["verdict"].nunique() == 1).all()
-        by_system = (made.groupby("system")["verdict"].nunique() == 1).all()
+        by_radius = (made.groupby("radius", observed=True)["verdict"].nunique() == 1).all()
+        by_system = (made.groupby("system", observed=True)["verdict"].nunique() == 1).all()
         if by_radius and not by_system:
             yes = sorted(made.loc[like, "radius"].unique())
             on = f"the radius: like at r = {', '.join(f'{r:g}' for r in yes)}"

@@ -56,7 +56,7 @@ def scale_statement(store):
     """``(is_paper_scale, sentence)`` describing the store's size."""
     exp = store.experiment
     coll = store.collisions
-    per_ic = coll.groupby("radius")["n_pp"].mean()
+    per_ic = coll.groupby("radius", observed=True)["n_pp"].mean()
     r0 = float(per_ic.index.min())
     text = (
         f"{exp.name}: {exp.n_ics} ICs × {len(exp.radii)} radii, {exp.n_steps} steps of "

@@ -138,9 +138,9 @@ def rate_heterogeneity(collisions, *, homogeneity=None, rule="mirror", max_point
                 else f"{nouns.one} without {nouns.event}s (at the floor)",
             )
             zero_labelled = True
-    grouped = df.groupby(x)
+    grouped = df.groupby(x, observed=True)
     pooled = grouped["n_pp"].sum() / grouped["t_window"].sum()
-    median = pd.Series(rate, index=df.index).groupby(df[x]).median()
+    median = pd.Series(rate, index=df.index).groupby(df[x], observed=True).median()
     ax1.plot(pooled.index, pooled.to_numpy(), marker="o", color="black", linestyle=axis.line,
              label="pooled ΣN/ΣT")
     ax1.plot(
@@ -178,9 +178,9 @@ def rate_heterogeneity(collisions, *, homogeneity=None, rule="mirror", max_point
     flag = _sticky_flags(df, sticky, rule, x, kinetic)
     curves = [dispersion]
     if flag is not None:
-        rest = df[~flag].groupby(x)["n_pp"]
+        rest = df[~flag].groupby(x, observed=True)["n_pp"]
         without = (rest.var(ddof=1) / rest.mean()).reindex(dispersion.index)
-        n_out = pd.Series(flag, index=df.index).groupby(df[x]).sum()
+        n_out = pd.Series(flag, index=df.index).groupby(df[x], observed=True).sum()
         ax2.plot(
             without.index.to_numpy(),
             without.to_numpy(),

@@ -315,7 +315,7 @@ def write_page(out, title, *, sources, toc, body, lead="", appendix="", files=No
     pathlib.Path
         ``out / "report.html"``.
     """
-    built = _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")
+    built = _dt.datetime.now(_dt.UTC).isoformat(timespec="seconds")
     n_items = sum(item.count("<li>") for item in toc)
     text = (
         '<!DOCTYPE html><html lang="en"><head><meta charset="utf-8">'

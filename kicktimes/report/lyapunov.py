@@ -57,9 +57,9 @@ def stretching_table(results) -> pd.DataFrame:
         stored = results[
             (results["diagnostic"] == "lyapunov_per_perturbation") & (results["system"] == system)
         ]
-        stored = stored.groupby("radius")["value"].median()
+        stored = stored.groupby("radius", observed=True)["value"].median()
         frame = pd.concat({"lam": lam, "t": t, "n": n}, axis=1).dropna()
-        for r, g in frame.groupby(level="radius"):
+        for r, g in frame.groupby(level="radius", observed=True):
             rate = g["n"].sum() / g["t"].sum()
             rows.append(
                 {

@@ -86,7 +86,7 @@ def _share_rows(per_ic, x):
     """Per ``x``: how often the MMPP-2 is AIC-best (of all models) and beats Poisson, on the
     data and on the twins, with Clopper-Pearson intervals."""
     rows = []
-    for at, part in per_ic.groupby(x, sort=True):
+    for at, part in per_ic.groupby(x, sort=True, observed=True):
         row = {x: at, "n_fitted": len(part)}
         for name, column in (("best", "mmpp_best"), ("beats_poisson", "mmpp_beats_poisson"),
                              ("null_best", "null_mmpp_best"),
@@ -173,7 +173,7 @@ def mmpp_comparison(per_ic, *, x="radius", xlabel=None, alpha=None):
         for k, (column, colour) in enumerate(zip(columns, ("tab:cyan", "tab:red"),
                                                  strict=True)):
             rows = []
-            for pos, part in clustered.groupby(x, sort=True):
+            for pos, part in clustered.groupby(x, sort=True, observed=True):
                 v = value(part, column).to_numpy(float)
                 v = v[np.isfinite(v) & (v > 0)]
                 if v.size:

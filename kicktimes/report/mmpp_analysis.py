@@ -85,10 +85,11 @@ def analyze_mmpp(res, *, n_boot=99, max_fits_per_group=12, rng=None) -> pd.DataF
         max_fits_per_group = check_int("max_fits_per_group", max_fits_per_group, low=0)
     rng = check_rng(rng)
     renewal = res.renewal_per_sequence.dropna(subset=["aic"])
-    best = renewal.loc[renewal.groupby("sequence")["aic"].idxmin()].set_index("sequence")
+    best = renewal.loc[renewal.groupby("sequence", observed=True)["aic"].idxmin()]
+    best = best.set_index("sequence")
     seqs = res.sequences[res.sequences["n_events"] >= MIN_EVENTS]
     rows = []
-    for g, part in seqs.groupby("group", sort=False):
+    for g, part in seqs.groupby("group", sort=False, observed=True):
         if max_fits_per_group is not None:
             part = part.iloc[:max_fits_per_group]
         for row, stream in zip(part.itertuples(), rng.spawn(len(part)), strict=True):

@@ -285,7 +285,7 @@ def _poisson_job(job):
 def _jobs(ctx):
     exp, coll = ctx.exp, ctx.store.collisions
     jobs = []
-    for ri, (r, part) in enumerate(coll.groupby("radius")):
+    for ri, (r, part) in enumerate(coll.groupby("radius", observed=True)):
         part = subsample(part.sort_values("ic"), ctx.max_ics_tests)
         seqs = [np.asarray(t, dtype=float) for t in part["pp_times"]]
         # one Monte Carlo stream per radius (its ties and rate test; the nulls come from
@@ -319,7 +319,7 @@ def sections(ctx):
         per_ic.append(ic_rows)
     rejections = rejection_table(pd.DataFrame(rej_rows))
     per_ic = pd.concat(per_ic, ignore_index=True)
-    fixed = per_ic.groupby("radius").agg(
+    fixed = per_ic.groupby("radius", observed=True).agg(
         n_tested_fixed=("p_fixed", lambda p: int(np.isfinite(p).sum())),
         n_reject_fixed=("p_fixed", lambda p: int((p < alpha).sum())),
     )
@@ -329,7 +329,8 @@ def sections(ctx):
     for col in fixed.columns:
         rejections.loc[headline, col] = rejections.loc[headline, "radius"].map(fixed[col])
     homogeneity = pd.DataFrame(hom_rows)
-    if max_ics_tests is not None and coll.groupby("radius")["ic"].nunique().max() > max_ics_tests:
+    most_ics = coll.groupby("radius", observed=True)["ic"].nunique().max()
+    if max_ics_tests is not None and most_ics > max_ics_tests:
         ctx.notes.append(
             f"Poisson tests and rate homogeneity: the first {max_ics_tests} ICs (by index) "
             "per radius."
@@ -345,7 +346,7 @@ def sections(ctx):
         + f" (Monte Carlo with n_mc = {n_mc}).",
     )
     lines = []
-    for test, t in rejections.groupby("test", sort=False):
+    for test, t in rejections.groupby("test", sort=False, observed=True):
         t = t.sort_values("radius")
         rho, p = spearman(t["radius"], t["rate"])
         lines.append(
@@ -364,7 +365,8 @@ def sections(ctx):
         "events in an IC are not run on it (n_tested counts the ICs tested)."
     )
     if "control_rate" in rejections.columns:
-        c = rejections.groupby("test", sort=False)[["control_n_reject", "control_n_tested"]].sum()
+        c = rejections.groupby("test", sort=False, observed=True)[
+            ["control_n_reject", "control_n_tested"]].sum()
         sec.text(
             "Control: the same tests on the sweep's own Poisson kick times of each run (rate "
             "n_pp / t_window, cut at the same window; Poisson by construction) reject "
@@ -406,7 +408,8 @@ def clustered_share(per_ic, column, alpha, *, rng, n_boot=2000, level=0.95):
     >>> bool(low < 0.2 < high)
     True
     """
-    table = per_ic.pivot_table(index="ic", columns="radius", values=column, dropna=False)
+    table = per_ic.pivot_table(index="ic", columns="radius", values=column, dropna=False,
+                                observed=True)
     p = table.to_numpy(float)
     tested = np.isfinite(p).sum(axis=1).astype(float)
     rejected = (np.where(np.isfinite(p), p, 1.0) < alpha).sum(axis=1).astype(float)
@@ -426,7 +429,7 @@ def effects(ctx):
     rej = ctx.found.rejections
     if rej is None or rej.empty:
         return []
-    totals = rej.groupby("test", sort=False)[["n_reject", "n_tested"]].sum()
+    totals = rej.groupby("test", sort=False, observed=True)[["n_reject", "n_tested"]].sum()
     if HEADLINE_TEST not in totals.index or totals.loc[HEADLINE_TEST, "n_tested"] == 0:
         return []
     k, n = (int(v) for v in totals.loc[HEADLINE_TEST])

@@ -416,7 +416,7 @@ def effects(ctx):
                 if system not in values.columns or REFERENCE not in values.columns:
                     continue
                 per_r, tot = store_ratio(ctx, values[system], values[REFERENCE])
-                med = values.groupby(level="radius").median()
+                med = values.groupby(level="radius", observed=True).median()
                 out.append(
                     Effect.of_ratio(
                         f"{question} (ε = {e:g})",

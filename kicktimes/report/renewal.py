@@ -174,7 +174,7 @@ def sections(ctx):
     notes, pmap = ctx.notes, ctx.pmap
     per_rows, pooled_rows, best_rows = [], [], []
     jobs, meta = [], []
-    for r, part in coll.groupby("radius"):
+    for r, part in coll.groupby("radius", observed=True):
         part = part.sort_values("ic")
         # pooled: whole ICs in index order until the interval budget is used
         n_used, iv = stats.pooled_intervals(
@@ -232,7 +232,7 @@ def sections(ctx):
                     "note": t["note"],
                 }
             )
-    n_per_radius = coll.groupby("radius")["ic"].nunique()
+    n_per_radius = coll.groupby("radius", observed=True)["ic"].nunique()
     if (n_per_radius > max_ics_model_fits).any():
         notes.append(
             f"Per-IC renewal-model comparison: the first {max_ics_model_fits} ICs (by "
@@ -277,7 +277,7 @@ def sections(ctx):
             "intervals: no per-IC comparison."
         )
     else:
-        exp_share = fitted.groupby("radius")["best_model"].apply(
+        exp_share = fitted.groupby("radius", observed=True)["best_model"].apply(
             lambda b: (b == "exponential").mean()
         )
         sec.text(
@@ -287,7 +287,7 @@ def sections(ctx):
             f"{MIN_INTERVALS} intervals and were not fitted."
         )
     if not pooled.empty:
-        best_pooled = pooled.loc[pooled.groupby("radius")["aic"].idxmin()]
+        best_pooled = pooled.loc[pooled.groupby("radius", observed=True)["aic"].idxmin()]
         best_pooled = best_pooled.set_index("radius")["model"]
         d_exp = pooled[pooled["model"] == "exponential"].set_index("radius")["delta_aic"]
         top = best_pooled.value_counts()
@@ -329,7 +329,8 @@ def effects(ctx):
     detail = ", ".join(f"{m} {c}" for m, c in others.items())
     pooled = ctx.found.renewal_pooled
     if pooled is not None and not pooled.empty:
-        winners = pooled.loc[pooled.groupby("radius")["aic"].idxmin(), "model"].value_counts()
+        best = pooled.groupby("radius", observed=True)["aic"].idxmin()
+        winners = pooled.loc[best, "model"].value_counts()
         detail += "; pooled over ICs (a mixture of rates): " + ", ".join(
             f"{m} best at {c} radii" for m, c in winners.items()
         )

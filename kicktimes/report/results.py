@@ -53,7 +53,7 @@ def poisson_section(table):
             f"{cell} % {r.verdict}")
     frame = pd.DataFrame.from_dict(cells, orient="index").rename_axis("test").reset_index()
     frame["test"] = frame["test"].str.replace("reject@", "", regex=False)
-    robust = rows.groupby("diagnostic", sort=False)["robust"].all()
+    robust = rows.groupby("diagnostic", sort=False, observed=True)["robust"].all()
     return [
         "## Are the collision times Poisson? The collision rule as a factor", "",
         "Share of (radius, IC) runs whose two-disk collision times reject each test at "
@@ -132,13 +132,14 @@ def refresh_first_screen(out_dir) -> Path:
     table["depends_on"] = table["depends_on"].astype(object).where(table["depends_on"].notna(),
                                                                     "")
     table = with_robustness(table)
-    for family, part in table.groupby("family", sort=False):  # the derived columns, again
+    # the derived columns, again
+    for family, part in table.groupby("family", sort=False, observed=True):
         part.to_csv(out / f"{family}_findings.csv", index=False)
     lines = page.read_text(encoding="utf-8").splitlines()
     start = lines.index("## The answers") + 2
     stop = next(k for k in range(start, len(lines)) if lines[k].startswith("![headline]"))
     lines[start:stop] = first_screen(table)
-    now = _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")
+    now = _dt.datetime.now(_dt.UTC).isoformat(timespec="seconds")
     k = next(i for i, line in enumerate(lines) if line.startswith("Generated "))
     lines[k] = (lines[k].split(" The first screen was rewritten")[0]
                 + f" The first screen was rewritten {now} from the findings tables "
@@ -203,7 +204,7 @@ def write_results(
     lines = [
         "# What the reproduction shows (generated)",
         "",
-        f"Generated {_dt.datetime.now(_dt.timezone.utc).isoformat(timespec='seconds')} by "
+        f"Generated {_dt.datetime.now(_dt.UTC).isoformat(timespec='seconds')} by "
         f"kicktimes {__version__} (`kicktimes.report.write_results`, "
         "`python analysis/make_results.py`) from the stores "
         + ", ".join(f"`{st.experiment.name}`" for st in stores)

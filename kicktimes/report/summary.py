@@ -62,7 +62,7 @@ def diagnostic_summary(results, diagnostic=None) -> pd.DataFrame:
     check_radii("results['radius']", df["radius"])
     values = finite("results['value']", df["value"], allow_nan=True)
     df = df.assign(value=values, valid=np.isfinite(values))
-    g = df.groupby(["radius", "system", "diagnostic"], sort=True)
+    g = df.groupby(["radius", "system", "diagnostic"], sort=True, observed=True)
     out = g.agg(
         n=("value", "size"),
         n_valid=("valid", "sum"),

@@ -129,7 +129,7 @@ def _ids(df, col):
 
 def _per_sequence(df, ids, values, col):
     """One value per sequence id; a value that changes within a sequence raises."""
-    first = pd.Series(values).groupby(ids, sort=False).transform("first").to_numpy()
+    first = pd.Series(values).groupby(ids, sort=False, observed=True).transform("first").to_numpy()
     same = (first == values) | (np.isnan(first) & np.isnan(values))
     if not same.all():
         i = int(np.flatnonzero(~same)[0])
@@ -358,7 +358,7 @@ def event_table(
                 f"{_where(df, i)}: column {time!r} = {float(t[i])!r} lies outside the window "
                 f"[{float(lo[i])!r}, {float(hi[i])!r}] of sequence {str(ids[i])!r}"
             )
-        for s, idx in pd.Series(np.arange(ids.size)).groupby(ids, sort=False):
+        for s, idx in pd.Series(np.arange(ids.size)).groupby(ids, sort=False, observed=True):
             vals = t[idx.to_numpy()]
             per_seq[s] = vals[~np.isnan(vals)] - t0[s]
 
@@ -469,7 +469,7 @@ def _text_per_sequence(df, ids, col):
         i = int(np.flatnonzero(missing)[0])
         raise ValueError(f"{_where(df, i)}: column {col!r} has a missing value")
     values = raw.astype(str).to_numpy(dtype=object)
-    first = pd.Series(values).groupby(ids, sort=False).transform("first").to_numpy()
+    first = pd.Series(values).groupby(ids, sort=False, observed=True).transform("first").to_numpy()
     changed = first != values
     if changed.any():
         i = int(np.flatnonzero(changed)[0])
@@ -486,8 +486,8 @@ def _check_order(df, ids, t):
     ok = ~np.isnan(t)
     rows = np.flatnonzero(ok)
     frame = pd.DataFrame({"id": ids[rows], "t": t[rows], "row": rows})
-    prev_t = frame.groupby("id", sort=False)["t"].shift()
-    prev_row = frame.groupby("id", sort=False)["row"].shift()
+    prev_t = frame.groupby("id", sort=False, observed=True)["t"].shift()
+    prev_row = frame.groupby("id", sort=False, observed=True)["row"].shift()
     for kind, bad in (("duplicate", frame["t"] == prev_t), ("unsorted", frame["t"] < prev_t)):
         if bad.any():
             k = int(np.flatnonzero(bad.to_numpy())[0])

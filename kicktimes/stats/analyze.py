@@ -405,7 +405,7 @@ def _reference(seqs, col):
     when no event was seen. Sequences are taken as independent.
     """
     rows = []
-    for g, part in seqs.groupby("group", sort=False):
+    for g, part in seqs.groupby("group", sort=False, observed=True):
         n = part["n_events"].to_numpy(float)
         e = (part[col] * part["t_window"]).to_numpy(float)
         total, expected = n.sum(), e.sum()
@@ -465,12 +465,11 @@ def _regressions(tab, seqs):
             warnings.simplefilter("ignore")  # OLS through 2 points: no residual variance
             reg = regress_counts(df, covariate="log_radius" if log else "radius")
         for model in ("ols", "poisson", "negbin"):
-            res = getattr(reg, model)
             linear = model == "ols" or not log
             shift = a if linear else math.log(c)
             scale = c if linear else 1.0
             rows += _back_transform(
-                res, cov, model, "log" if log and not linear else "linear", shift, scale
+                reg, cov, model, "log" if log and not linear else "linear", shift, scale
             )
         od = reg.overdispersion()
         od_rows.append({"covariate": cov, **od.to_dict()})
@@ -479,22 +478,17 @@ def _regressions(tab, seqs):
     return pd.DataFrame(rows, columns=cols), pd.DataFrame(od_rows, columns=od_cols), skipped
 
 
-def _back_transform(res, cov, model, g, shift, scale):
-    """Intercept and slope of ``eta = b0 + b1 u`` with ``u = shift + scale * v`` on ``v``."""
-    b = np.asarray(res.params, float)[:2]
-    with warnings.catch_warnings(), np.errstate(all="ignore"):
-        warnings.simplefilter("ignore")
-        try:
-            v = np.asarray(res.cov_params(), float)[:2, :2]
-        except ValueError:  # a singular Hessian: no standard errors
-            v = np.full((2, 2), np.nan)
-        # a line through two points has no residual degrees of freedom: no errors either
-        v[~np.isfinite(v)] = np.nan
-        se = np.sqrt(np.diag(v))
-        if model == "ols":
-            q = float(sps.t.ppf(0.975, res.df_resid)) if res.df_resid > 0 else math.nan
-        else:
-            q = float(sps.norm.ppf(0.975))  # Wald intervals, as statsmodels' conf_int
+def _back_transform(reg, cov, model, g, shift, scale):
+    """Intercept and slope of ``eta = b0 + b1 u`` with ``u = shift + scale * v`` on ``v``,
+    with the standard errors `regress_counts` decided (NaN where undefined)."""
+    b = reg.params(model)[:2]
+    v = reg.cov_params(model)[:2, :2]
+    se = np.sqrt(np.diag(v))
+    if model == "ols":
+        df_resid = len(reg.by_radius) - 2
+        q = float(sps.t.ppf(0.975, df_resid)) if df_resid > 0 else math.nan
+    else:
+        q = float(sps.norm.ppf(0.975))  # Wald intervals, as statsmodels' conf_int
     b0 = b[0] + b[1] * shift
     var0 = v[0, 0] + 2 * shift * v[0, 1] + shift**2 * v[1, 1]
     se0 = math.sqrt(var0) if var0 >= 0 else math.nan

@@ -204,7 +204,8 @@ def _check_frame(df, radius, count, t_window):
             raise ValueError(f"df[{col!r}] must be {rule}, got row {i}: {float(arr[i])!r}")
     if np.unique(r).size < 2:
         raise ValueError(
-            f"df[{radius!r}] must hold at least 2 distinct radii, got {np.unique(r).tolist()!r}"
+            f"df[{radius!r}] takes one value ({float(r[0])!r}): no slope to estimate; give "
+            "at least two radii"
         )
     hit = np.unique(r[n > 0])
     if hit.size < 2:
@@ -222,6 +223,10 @@ def _check_frame(df, radius, count, t_window):
 class CountRegression:
     """Result of :func:`regress_counts`: the three fits and their comparison.
 
+    Every standard error, interval and log-likelihood here is decided by kicktimes from
+    the data's shape (see :func:`regress_counts`, Notes), never by what a BLAS kernel or a
+    statsmodels version happens to return near a singular matrix.
+
     Attributes
     ----------
     data : DataFrame
@@ -229,8 +234,19 @@ class CountRegression:
     by_radius : DataFrame
         Per radius: ``n_ics``, ``total_count``, ``exposure``, ``rate`` (pooled),
         ``mean_count``, ``var_count``, ``dispersion_index`` (variance / mean).
-    ols, poisson, negbin : statsmodels results
-        The OLS line of rate on radius, the Poisson GLM and the NB2 model.
+    estimates : DataFrame
+        The table :meth:`coefficients` returns.
+    covariances : dict of str to ndarray
+        ``"ols"``, ``"poisson"``, ``"negbin"``: the covariance of each model's parameters
+        as kicktimes decided it (all NaN where undefined).
+    loglik : dict of str to float
+        Maximised log-likelihoods of ``"poisson"`` and ``"negbin"``.
+    ols, poisson : statsmodels results
+        The OLS line of rate on radius and the Poisson GLM, for everything else
+        statsmodels offers (``rsquared``, residuals ...).
+    negbin : statsmodels results or None
+        The NB2 fit; None when the maximum-likelihood estimate is on the boundary
+        ``alpha = 0``, where the model is the Poisson one and no optimiser is run.
     covariate : {"log_radius", "radius"}
         The regressor of the two count models.
     rule : str or None
@@ -239,12 +255,15 @@ class CountRegression:
         False when the Poisson or negative-binomial fit did not converge or a
         coefficient ran off to infinity; the numbers are then not an MLE.
     warnings : tuple of str
-        Every problem (also unavailable standard errors), each issued as a
-        `FitWarning` by :func:`regress_counts`.
+        Every problem (issued as a `FitWarning` by :func:`regress_counts`) and every
+        note on an undefined quantity (a NaN is never left unexplained).
     """
 
     data: pd.DataFrame
     by_radius: pd.DataFrame
+    estimates: pd.DataFrame
+    covariances: dict
+    loglik: dict
     ols: object
     poisson: object
     negbin: object
@@ -263,28 +282,32 @@ class CountRegression:
     @property
     def alpha(self) -> float:
         """Negative-binomial dispersion ``alpha`` (``Var N = mu + alpha mu^2``)."""
-        return float(np.asarray(self.negbin.params)[-1])
+        return float(self.estimates.loc[("negbin", "alpha"), "estimate"])
+
+    @property
+    def aic(self) -> dict:
+        """AIC of the Poisson (2 parameters) and negative-binomial (3) models."""
+        return {"poisson": 4.0 - 2.0 * self.loglik["poisson"],
+                "negbin": 6.0 - 2.0 * self.loglik["negbin"]}
+
+    def params(self, model) -> np.ndarray:
+        """Estimates of ``model`` (``"ols"``, ``"poisson"`` or ``"negbin"``), in order."""
+        check_choice("model", model, _MODELS)
+        return self.estimates.loc[model, "estimate"].to_numpy()
+
+    def cov_params(self, model) -> np.ndarray:
+        """Covariance of the estimates of ``model``; all NaN where kicktimes decided the
+        standard errors are undefined (the reason is in ``warnings``)."""
+        check_choice("model", model, _MODELS)
+        return self.covariances[model].copy()
 
     def coefficients(self) -> pd.DataFrame:
-        """Estimates, standard errors and 95% intervals of every model's parameters."""
-        rows = []
-        names = {"ols": ["intercept", "radius"], "poisson": ["intercept", self.covariate]}
-        names["negbin"] = [*names["poisson"], "alpha"]
-        for model in ("ols", "poisson", "negbin"):
-            res = getattr(self, model)
-            ci = np.asarray(res.conf_int())
-            for i, term in enumerate(names[model]):
-                rows.append(
-                    {
-                        "model": model,
-                        "term": term,
-                        "estimate": float(np.asarray(res.params)[i]),
-                        "stderr": float(np.asarray(res.bse)[i]),
-                        "ci_low": float(ci[i, 0]),
-                        "ci_high": float(ci[i, 1]),
-                    }
-                )
-        return pd.DataFrame(rows).set_index(["model", "term"])
+        """Estimates, standard errors and 95% intervals of every model's parameters.
+
+        The OLS interval uses Student's t on the line's residual degrees of freedom, the
+        count models' are Wald intervals (as statsmodels' ``conf_int``).
+        """
+        return self.estimates.copy()
 
     def overdispersion(self) -> pd.Series:
         """Pearson dispersion of the Poisson fit and the LR test of ``alpha = 0``.
@@ -294,9 +317,8 @@ class CountRegression:
         (chi-square over the residual degrees of freedom) is NaN for 2 rows, which leave
         none (`regress_counts` warns).
         """
-        lr = max(0.0, 2 * (self.negbin.llf - self.poisson.llf))
-        # no residual degrees of freedom (2 rows): undefined, see `warnings`
-        df_resid = float(self.poisson.df_resid)
+        lr = max(0.0, 2 * (self.loglik["negbin"] - self.loglik["poisson"]))
+        df_resid = len(self.data) - 2
         pearson = float(self.poisson.pearson_chi2 / df_resid) if df_resid > 0 else math.nan
         return pd.Series(
             {
@@ -321,9 +343,7 @@ class CountRegression:
         if (t <= 0).any():
             raise ValueError(f"t_window must be positive, got {float(t[t <= 0][0])!r}")
         g = np.log(r) if self.covariate == "log_radius" else r
-        b_ols = np.asarray(self.ols.params)
-        b_poi = np.asarray(self.poisson.params)
-        b_nb = np.asarray(self.negbin.params)[:2]
+        b_ols, b_poi, b_nb = (self.params(m)[:2] for m in _MODELS)
         out = pd.DataFrame({"radius": r, "t_window": t})
         out["ols"] = (b_ols[0] + b_ols[1] * r) * t
         out["poisson"] = np.exp(b_poi[0] + b_poi[1] * g) * t
@@ -336,6 +356,7 @@ class CountRegression:
         """Coefficient tables, overdispersion and the per-radius table as text."""
         fmt = {"float_format": lambda v: f"{v:.5g}"}
         od = self.overdispersion()
+        aic = self.aic
         lines = [
             f"Collision counts vs radius: {len(self.data)} ICs at {len(self.by_radius)} radii",
             "OLS line: pooled rate = intercept + slope * r (the paper's line, per unit time);",
@@ -345,7 +366,7 @@ class CountRegression:
             f"Poisson Pearson dispersion {od['pearson_dispersion']:.4g}; NB alpha = "
             f"{od['alpha']:.4g}, LR test of alpha = 0: {od['lr_statistic']:.4g} "
             f"(p = {od['lr_pvalue']:.3g})",
-            f"AIC: Poisson {self.poisson.aic:.6g}, negative binomial {self.negbin.aic:.6g}",
+            f"AIC: Poisson {aic['poisson']:.6g}, negative binomial {aic['negbin']:.6g}",
             "",
             self.by_radius.to_string(**fmt),
         ]
@@ -353,6 +374,29 @@ class CountRegression:
             lines.append("NOT CONVERGED: the count models above are not maximum-likelihood fits")
         lines.extend(f"warning: {w}" for w in self.warnings)
         return "\n".join(lines)
+
+
+_MODELS = ("ols", "poisson", "negbin")
+
+
+def _coefficient_rows(model, names, params, cov, quantile):
+    """Rows of the coefficient table: estimate, standard error and the interval
+    ``estimate +- quantile * stderr`` (NaN where the covariance is)."""
+    se = np.sqrt(np.diag(cov))
+    return [
+        {"model": model, "term": term, "estimate": float(b), "stderr": float(s),
+         "ci_low": float(b - quantile * s), "ci_high": float(b + quantile * s)}
+        for term, b, s in zip(names, params, se, strict=True)
+    ]
+
+
+def _nb2_boundary_score(y, mu):
+    r"""The score of the NB2 log-likelihood in ``alpha`` at ``alpha = 0`` and the Poisson
+    MLE, :math:`\tfrac12\sum_i [(y_i - \mu_i)^2 - y_i]` (Cameron & Trivedi 1990). The
+    score in the coefficients is zero there, so when this one is <= 0 the point
+    ``(beta_Poisson, 0)`` meets the Karush-Kuhn-Tucker conditions of ``alpha >= 0``: the
+    negative-binomial MLE is on the boundary and equals the Poisson fit."""
+    return 0.5 * float(np.sum((y - mu) ** 2 - y))
 
 
 def regress_counts(
@@ -376,24 +420,21 @@ def regress_counts(
     -------
     CountRegression
         With ``summary()``, ``predict()``, ``coefficients()``, ``overdispersion()``,
-        ``converged`` and ``warnings``.
+        ``cov_params()``, ``aic``, ``converged`` and ``warnings``.
 
     Raises
     ------
     ValueError
-        Bad input naming the column (``df['count']`` ...), fewer than two radii, or
-        every count zero.
+        Bad input naming the column (``df['count']`` ...); one radius only (there is no
+        slope to estimate: give at least two radii); counts non-zero at fewer than two
+        radii (the slope runs off to infinity).
 
     Warns
     -----
     FitWarning
-        A count model did not converge, a coefficient diverged, or standard errors are
-        not finite (never a silent NaN). In particular, as statsmodels does, when a model
-        has no residual degrees of freedom: the OLS line through 2 radii is exact (its
-        standard errors are inf/NaN), and 2 rows leave the Poisson GLM none (its Pearson
-        dispersion is NaN) and do not identify the negative binomial's 3 parameters (its
-        standard errors are NaN); the estimates are still returned. Every standard error
-        exists from 3 radii on.
+        A count model did not converge, a coefficient diverged, or a model has no
+        residual degrees of freedom (its standard errors are then NaN, named in the
+        warning; the estimates are still returned). Never a silent NaN.
 
     Notes
     -----
@@ -401,6 +442,28 @@ def regress_counts(
     binomial: ``NegativeBinomial(count, [1, g(r)], loglike_method="nb2",
     offset=log t)``, which estimates :math:`\alpha` by maximum likelihood (the GLM
     family would hold it fixed).
+
+    Which standard errors exist is decided here from the data's shape, so that no result
+    depends on how a BLAS kernel or a statsmodels version treats a singular matrix:
+
+    * the OLS line (one point per radius, 2 coefficients) has ``k - 2`` residual degrees
+      of freedom over ``k`` radii: through 2 radii it is exact and its standard errors
+      are NaN;
+    * the Poisson model's scale is fixed at 1, so its standard errors (the inverse Fisher
+      information, full rank from two radii on) need no residual degrees of freedom; its
+      Pearson dispersion does, and is NaN for 2 rows;
+    * the negative binomial has 3 parameters: ``n <= 3`` rows leave it no residual
+      degrees of freedom and its standard errors are NaN. When the score in
+      :math:`\alpha` at :math:`\alpha = 0` is <= 0 the MLE is on that boundary and
+      equals the Poisson fit (no optimiser is run): the coefficients' standard errors are
+      then the Poisson ones (the NB2 information is block-diagonal at
+      :math:`\alpha = 0`) and :math:`\alpha`'s is NaN (a Wald interval is not valid on a
+      boundary; use the LR test of :meth:`CountRegression.overdispersion`).
+
+    References
+    ----------
+    Cameron, A. C. & Trivedi, P. K. (1990). Regression-based tests for overdispersion in
+    the Poisson model. *J. Econometrics* 46, 347-364.
 
     Examples
     --------
@@ -417,7 +480,7 @@ def regress_counts(
     if rule is not None:
         check_choice("rule", rule, tuple(_MEAN_APPROACH))
     data = _check_frame(df, radius, count, t_window)
-    grouped = data.groupby("radius")
+    grouped = data.groupby("radius", observed=True)
     by_radius = pd.DataFrame(
         {
             "n_ics": grouped.size(),
@@ -430,7 +493,6 @@ def regress_counts(
     by_radius.insert(3, "rate", by_radius["total_count"] / by_radius["exposure"])
     with np.errstate(divide="ignore", invalid="ignore"):
         by_radius["dispersion_index"] = by_radius["var_count"] / by_radius["mean_count"]
-    ols = OLS(by_radius["rate"].to_numpy(), add_constant(by_radius.index.to_numpy())).fit()
     g = (
         np.log(data["radius"].to_numpy())
         if covariate == "log_radius"
@@ -439,60 +501,70 @@ def regress_counts(
     exog = add_constant(g)
     offset = np.log(data["t_window"].to_numpy())
     y = data["count"].to_numpy()
-    problems = []
+    n_rows, n_radii = len(data), len(by_radius)
+    problems, notes, no_df = [], [], []
+    nan2, nan3 = np.full((2, 2), np.nan), np.full((3, 3), np.nan)
     with warnings.catch_warnings(record=True) as caught, np.errstate(all="ignore"):
         # statsmodels' own warnings are judged below and re-issued as one FitWarning
         warnings.simplefilter("always")
+        ols = OLS(by_radius["rate"].to_numpy(), add_constant(by_radius.index.to_numpy())).fit()
+        if n_radii > 2:
+            cov = {"ols": np.asarray(ols.cov_params(), float)}
+        else:
+            cov = {"ols": nan2}
+            no_df.append("the OLS line through 2 radii is exact (its standard errors are NaN)")
         poisson = GLM(y, exog, family=families.Poisson(), offset=offset).fit()
         if not getattr(poisson, "converged", True):
             problems.append("the Poisson GLM did not converge (IRLS iteration limit)")
-        negbin = NegativeBinomial(y, exog, loglike_method="nb2", offset=offset).fit(
-            disp=0, maxiter=500, start_params=np.r_[poisson.params, 0.1]
-        )
-        if not negbin.mle_retvals.get("converged", True):
-            problems.append("the negative-binomial fit did not converge")
-        bse = {name: np.asarray(res.bse) for name, res in
-               (("ols", ols), ("poisson", poisson), ("negbin", negbin))}
+        cov["poisson"] = np.asarray(poisson.cov_params(), float)
+        loglik = {"poisson": float(poisson.llf)}
+        if _nb2_boundary_score(y, np.asarray(poisson.mu, float)) <= 0:
+            negbin = None
+            nb_params = np.r_[np.asarray(poisson.params, float), 0.0]
+            loglik["negbin"] = loglik["poisson"]
+            cov["negbin"] = nan3.copy()
+            cov["negbin"][:2, :2] = cov["poisson"]
+            if n_rows > 3:
+                notes.append(
+                    "negative binomial: the maximum-likelihood alpha is on its boundary 0 "
+                    "(no overdispersion: the score in alpha at 0 is <= 0), so the model is "
+                    "the Poisson fit; alpha has no standard error there (use the LR test)")
+        else:
+            negbin = NegativeBinomial(y, exog, loglike_method="nb2", offset=offset).fit(
+                disp=0, maxiter=500, start_params=np.r_[poisson.params, 0.1]
+            )
+            if not negbin.mle_retvals.get("converged", True):
+                problems.append("the negative-binomial fit did not converge")
+            nb_params = np.asarray(negbin.params, float)
+            loglik["negbin"] = float(negbin.llf)
+            cov["negbin"] = np.asarray(negbin.cov_params(), float)
     converged = not problems
-    # Residual degrees of freedom: the OLS line has one point per radius and 2 coefficients,
-    # the Poisson GLM one per row and 2, the negative binomial 3 (alpha too). Without any,
-    # statsmodels gives NaN (or inf) standard errors; say so here, once and explicitly.
-    no_df = []
-    if len(by_radius) <= 2:
-        no_df.append("the OLS line through 2 radii is exact (its standard errors are inf/NaN)")
-        del bse["ols"]
-    if len(data) <= 2:
+    if n_rows <= 2:
         no_df.append("2 rows leave the Poisson GLM none (its Pearson dispersion is NaN; its "
-                     "standard errors need none) and do not identify the negative binomial's "
-                     "3 parameters (2 coefficients and alpha: its standard errors are NaN)")
-        del bse["negbin"]
+                     "standard errors need none)")
+    if n_rows <= 3:
+        no_df.append(f"{n_rows} rows leave the negative binomial's 3 parameters (2 "
+                     "coefficients and alpha) none (its standard errors are NaN)")
+        cov["negbin"] = nan3
     if no_df:
         problems.append(f"no residual degrees of freedom: {'; '.join(no_df)}; the estimates "
-                        "are returned, and at least 3 radii give every standard error")
-    for name, res in (("poisson", poisson), ("negbin", negbin)):
-        coef = np.asarray(res.params)[:2]
+                        "are returned, and at least 3 radii and 4 rows give every standard "
+                        "error")
+    for name, coef in (("poisson", np.asarray(poisson.params)), ("negbin", nb_params[:2])):
         if not np.all(np.isfinite(coef)) or np.any(np.abs(coef) > _DIVERGED_COEF):
             problems.append(
                 f"{name} coefficients {coef.tolist()} diverge (no finite MLE: e.g. all "
                 "counts zero at one radius)"
             )
             converged = False
-    alpha = float(np.asarray(negbin.params)[-1])
+    alpha = float(nb_params[-1])
     if not np.isfinite(alpha):
         problems.append(f"the negative-binomial dispersion alpha is not finite ({alpha})")
         converged = False
-    if "negbin" in bse and alpha < 1e-6 and not np.all(np.isfinite(bse["negbin"])):
-        # equidispersed counts: alpha sits on its boundary 0, where the information is
-        # singular; the NB model is then the Poisson one. Noted, not warned: it is the
-        # expected outcome for Poisson data.
-        del bse["negbin"]
-        notes = [f"negative binomial: alpha = {alpha:.3g} is on its boundary 0 (no "
-                 "overdispersion), so its standard errors are undefined; the model reduces "
-                 "to the Poisson fit, use that one's"]
-    else:
-        notes = []
-    # (the fits without residual degrees of freedom are explained above)
-    bad_se = [name for name, se in bse.items() if not np.all(np.isfinite(se))]
+    # what is left non-finite was not decided above: a numerical failure, said so
+    decided_nan = {"ols": n_radii <= 2, "poisson": False, "negbin": n_rows <= 3}
+    bad_se = [name for name in _MODELS if not decided_nan[name]
+              and not np.all(np.isfinite(np.diag(cov[name])[: 2 if negbin is None else 3]))]
     if bad_se:
         problems.append(f"standard errors of the {', '.join(bad_se)} fit are not finite")
     if problems:
@@ -504,9 +576,20 @@ def regress_counts(
         warnings.warn(
             f"regress_counts: {status}{'; '.join(problems)}", FitWarning, stacklevel=2
         )
+    z = float(stats.norm.ppf(0.975))
+    t_q = float(stats.t.ppf(0.975, n_radii - 2)) if n_radii > 2 else math.nan
+    rows = _coefficient_rows("ols", ["intercept", "radius"], np.asarray(ols.params, float),
+                             cov["ols"], t_q)
+    rows += _coefficient_rows("poisson", ["intercept", covariate],
+                              np.asarray(poisson.params, float), cov["poisson"], z)
+    rows += _coefficient_rows("negbin", ["intercept", covariate, "alpha"], nb_params,
+                              cov["negbin"], z)
     return CountRegression(
         data=data,
         by_radius=by_radius,
+        estimates=pd.DataFrame(rows).set_index(["model", "term"]),
+        covariances=cov,
+        loglik=loglik,
         ols=ols,
         poisson=poisson,
         negbin=negbin,

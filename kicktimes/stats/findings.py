@@ -419,7 +419,7 @@ def _renewal(res):
             "Which renewal model?", "inconclusive", "No group has enough intervals for a fit.", rule
         )
     parts, verdicts = [], {}
-    for g, t in pooled.groupby("group", sort=False):
+    for g, t in pooled.groupby("group", sort=False, observed=True):
         t = t.dropna(subset=["aic"]).sort_values("aic")
         best, runner = t.iloc[0], t.iloc[1] if len(t) > 1 else None
         gap = runner["delta_aic"] if runner is not None else math.inf
@@ -510,7 +510,7 @@ def _reference(res):
 def _regressions(res):
     reg = res.regressions
     out = []
-    for cov, t in reg.groupby("covariate", sort=False):
+    for cov, t in reg.groupby("covariate", sort=False, observed=True):
         nb = t[(t["model"] == "negbin") & (t["term"] == "slope")].iloc[0]
         po = t[(t["model"] == "poisson") & (t["term"] == "slope")].iloc[0]
         main, label = nb, "negative binomial"
