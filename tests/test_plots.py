@@ -467,7 +467,8 @@ def test_model_comparison_says_so_when_no_ic_could_be_fitted():
 
 def test_rate_heterogeneity_draws_zero_rate_ics_at_the_floor_and_p_values():
     coll = make_collisions(n_ics=20)
-    coll.loc[0, ["n_pp", "pp_times"]] = [0, np.array([])]
+    coll.at[0, "n_pp"] = 0
+    coll.at[0, "pp_times"] = np.array([])
     hom = pd.DataFrame({"radius": list(RADII), "pvalue": [0.0, 0.01, 0.2, 0.5]})
     fig = plots.rate_heterogeneity(coll, homogeneity=hom)
     assert_labelled(fig)

