@@ -1,6 +1,6 @@
 """A pytest plugin for ``benchmarks/bench_suite.py``: every numba compilation of a test
-run, with its exclusive and inclusive seconds, one JSON file per process in
-``$KICKTIMES_COMPILE_LOG`` (a folder).
+run, with its exclusive and inclusive seconds and the test that caused it, one JSON file
+per process in ``$KICKTIMES_COMPILE_LOG`` (a folder).
 
 numba emits a ``numba:compile`` event only when it really compiles (not when it loads a
 signature from its cache), so on a warm cache the log is empty.
@@ -17,11 +17,11 @@ from numba.core import event
 
 
 class _CompileLog(event.Listener):
-    """(kernel, signature, exclusive s, inclusive s) of each compilation; a kernel compiled
-    while another compiles is subtracted from the outer one's exclusive time."""
+    """(kernel, signature, exclusive s, inclusive s, test) of each compilation; a kernel
+    compiled while another compiles is subtracted from the outer one's exclusive time."""
 
     def __init__(self):
-        self.stack, self.rows = [], []
+        self.stack, self.rows, self.test = [], [], ""
 
     def on_start(self, ev):
         self.stack.append([time.perf_counter(), 0.0])
@@ -33,7 +33,7 @@ class _CompileLog(event.Listener):
             self.stack[-1][1] += seconds
         func = ev.data["dispatcher"].py_func
         self.rows.append((f"{func.__module__}.{func.__qualname__}", str(ev.data["args"]),
-                          seconds - inner, seconds))
+                          seconds - inner, seconds, self.test))
 
 
 _LOG = _CompileLog()
@@ -41,6 +41,10 @@ _LOG = _CompileLog()
 
 def pytest_configure(config):
     event.register("numba:compile", _LOG)
+
+
+def pytest_runtest_setup(item):
+    _LOG.test = item.nodeid
 
 
 def pytest_sessionfinish(session):

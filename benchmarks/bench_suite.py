@@ -59,7 +59,7 @@ def compile_table(log):
     """Per kernel: signatures, processes that compiled each, exclusive seconds summed."""
     rows = []
     for path in sorted(Path(log).glob("*.json")):
-        for kernel, sig, exclusive, _ in json.loads(path.read_text()):
+        for kernel, sig, exclusive, *_ in json.loads(path.read_text()):
             rows.append((path.stem, kernel, sig, exclusive))
     per = collections.defaultdict(lambda: {"seconds": 0.0, "sigs": set(), "compiles": 0})
     for _, kernel, sig, exclusive in rows:
@@ -73,11 +73,22 @@ def compile_table(log):
     return table, sum(r["seconds"] for r in table), twice
 
 
+def compile_by_test(log):
+    """Per test: the compile seconds it caused (exclusive, summed) and the kernels."""
+    per = collections.defaultdict(lambda: [0.0, set()])
+    for path in sorted(Path(log).glob("*.json")):
+        for kernel, _, exclusive, _, test in json.loads(path.read_text()):
+            per[test][0] += exclusive
+            per[test][1].add(kernel.rsplit(".", 2)[-2] + "." + kernel.rsplit(".", 1)[-1])
+    return sorted(((t, s, sorted(k)) for t, (s, k) in per.items()), key=lambda r: -r[1])
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--workers", default="auto", help="pytest-xdist -n (auto)")
     parser.add_argument("--only", choices=["cold", "warm", "both"], default="both")
     parser.add_argument("--json", help="write the measurements here")
+    parser.add_argument("--keep-log", help="copy the cold run's compile log to this folder")
     parser.add_argument("extra", nargs="*", help="pytest arguments (after --)")
     args = parser.parse_args(argv)
     results = {}
@@ -91,6 +102,11 @@ def main(argv=None):
             log.mkdir()
             res = run_suite(cache, log, args.workers, args.extra)
             res["kernels"], res["compile_s"], res["duplicate_compilations"] = compile_table(log)
+            res["by_test"] = compile_by_test(log)
+            if name == "cold" and args.keep_log:
+                import shutil
+
+                shutil.copytree(log, args.keep_log, dirs_exist_ok=True)
             results[name] = res
             print(f"{name}: {res['wall_s']:.0f} s wall ({res['summary']}); numba compiled "
                   f"{res['compile_s']:.0f} s in the pytest processes (exclusive, summed over "
@@ -102,6 +118,9 @@ def main(argv=None):
         for row in results["cold"]["kernels"][:25]:
             print(f"{row['kernel']} | {row['seconds']:.1f} | {row['signatures']} | "
                   f"{row['compilations']}")
+        print("\ntests that compiled the most (exclusive s, kernels):")
+        for test, seconds, kernels in results["cold"]["by_test"][:20]:
+            print(f"{seconds:6.1f}  {test}  {', '.join(kernels[:6])}")
     if len(results) == 2:
         cold, warm = results["cold"]["wall_s"], results["warm"]["wall_s"]
         print(f"\ncold {cold:.0f} s = warm {warm:.0f} s + {cold - warm:.0f} s of compiling "

@@ -91,8 +91,8 @@ def section(ctx):
             f"({PAPER_SCALE['n_ics']} ICs, {PAPER_SCALE['n_steps']}+ steps). The tables and "
             "figures below show that every stage runs; their verdicts are too noisy to read. "
             "The answers at the paper's scale are in docs/results/README.md of the kicktimes "
-            "repository, and `kicktimes reproduce --scale paper` computes them (about 2-3 "
-            "minutes on 2 cores)."
+            "repository, and `kicktimes reproduce --scale paper` computes them (about 13 "
+            "minutes on 2 cores: 788 s measured on 2026-11-28, docs/benchmarks.md)."
         )
     else:
         sec.text(f"Scale: {scale}.")

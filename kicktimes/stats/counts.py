@@ -36,6 +36,7 @@ from statsmodels.regression.linear_model import OLS
 from statsmodels.tools.tools import add_constant
 
 from ._checks import as_1d_float, check_choice
+from ._information import inverse_information
 from .renewal import FitWarning
 
 # |coefficient| beyond this on log-rate scale means the MLE ran off to infinity
@@ -516,7 +517,7 @@ def regress_counts(
         poisson = GLM(y, exog, family=families.Poisson(), offset=offset).fit()
         if not getattr(poisson, "converged", True):
             problems.append("the Poisson GLM did not converge (IRLS iteration limit)")
-        cov["poisson"] = np.asarray(poisson.cov_params(), float)
+        cov["poisson"] = inverse_information(-poisson.model.hessian(poisson.params))[0]
         loglik = {"poisson": float(poisson.llf)}
         if _nb2_boundary_score(y, np.asarray(poisson.mu, float)) <= 0:
             negbin = None
@@ -537,7 +538,8 @@ def regress_counts(
                 problems.append("the negative-binomial fit did not converge")
             nb_params = np.asarray(negbin.params, float)
             loglik["negbin"] = float(negbin.llf)
-            cov["negbin"] = np.asarray(negbin.cov_params(), float)
+            # the observed information at the MLE, inverted under kicktimes' own rule
+            cov["negbin"] = inverse_information(-negbin.model.hessian(nb_params))[0]
     converged = not problems
     if n_rows <= 2:
         no_df.append("2 rows leave the Poisson GLM none (its Pearson dispersion is NaN; its "

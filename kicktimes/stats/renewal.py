@@ -41,6 +41,7 @@ from scipy.special import expit, logit
 from statsmodels.tools.numdiff import approx_hess
 
 from ._checks import check_choice, check_int, check_intervals, check_real
+from ._information import inverse_information
 from ._renewal_mle import CLOSED_FORM_MODELS, FAST_FITS, log_density_and_survival
 from .distributions import (
     _fit_hyperexponential_reference,
@@ -277,7 +278,6 @@ def _fallback(model, x, c, theta, theta_trouble, trouble):
 
 def _covariance(model, theta, x, c, x_min, n_tail):
     """Inverse observed information in the natural parameters (NaN if singular)."""
-    k = len(theta)
     if model == "exponential" and x_min is None:
         return np.array([[theta[0] ** 2 / x.size]])
     if model == "powerlaw":
@@ -293,13 +293,9 @@ def _covariance(model, theta, x, c, x_min, n_tail):
     with np.errstate(all="ignore"), warnings.catch_warnings():
         warnings.simplefilter("ignore")
         hess = approx_hess(np.asarray(theta, dtype=float), nll)
-    if not np.all(np.isfinite(hess)):
-        return np.full((k, k), np.nan)
-    try:
-        np.linalg.cholesky(hess)
-    except np.linalg.LinAlgError:
-        return np.full((k, k), np.nan)
-    return np.linalg.inv(hess)
+    # identified or not is decided on the unit-diagonal information, not by whether a
+    # BLAS kernel's Cholesky happens to succeed near a singularity
+    return inverse_information(hess)[0]
 
 
 @dataclass(frozen=True, eq=False, repr=False)

@@ -27,6 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._checks import as_1d_float, check_choice, check_int, check_real, check_rng, check_times
+from .._information import inverse_information
 from ..poisson import _is_ensemble
 from ..renewal import FitWarning
 from . import _em as em
@@ -455,11 +456,9 @@ def _result(run, data, initial, *, n_starts, covariance, n_best=1, start_logliks
     cov = np.full((k, k), np.nan)
     if covariance:
         info = em.information(rates, Q, alpha, data, initial)
-        try:
-            cov_log = np.linalg.inv(info)
-            ok = np.all(np.isfinite(cov_log)) and np.all(np.diag(cov_log) > 0)
-        except np.linalg.LinAlgError:
-            ok = False
+        # identifiability decided on the unit-diagonal information (not by whether a BLAS
+        # kernel's inverse of a near-singular matrix happens to come out finite)
+        cov_log, ok = inverse_information(info)
         if ok:
             theta = np.concatenate([rates, Q[off]])
             cov = cov_log * np.outer(theta, theta)
