@@ -395,8 +395,9 @@ def _nb2_boundary_score(y, mu):
     r"""The score of the NB2 log-likelihood in ``alpha`` at ``alpha = 0`` and the Poisson
     MLE, :math:`\tfrac12\sum_i [(y_i - \mu_i)^2 - y_i]` (Cameron & Trivedi 1990). The
     score in the coefficients is zero there, so when this one is <= 0 the point
-    ``(beta_Poisson, 0)`` meets the Karush-Kuhn-Tucker conditions of ``alpha >= 0``: the
-    negative-binomial MLE is on the boundary and equals the Poisson fit."""
+    ``(beta_Poisson, 0)`` meets the Karush-Kuhn-Tucker conditions of ``alpha >= 0``, and
+    `regress_counts` takes it as the negative-binomial fit (the Poisson one) instead of
+    running an optimiser towards the boundary."""
     return 0.5 * float(np.sum((y - mu) ** 2 - y))
 
 
@@ -455,8 +456,9 @@ def regress_counts(
       Pearson dispersion does, and is NaN for 2 rows;
     * the negative binomial has 3 parameters: ``n <= 3`` rows leave it no residual
       degrees of freedom and its standard errors are NaN. When the score in
-      :math:`\alpha` at :math:`\alpha = 0` is <= 0 the MLE is on that boundary and
-      equals the Poisson fit (no optimiser is run): the coefficients' standard errors are
+      :math:`\alpha` at :math:`\alpha = 0` is <= 0 (the Karush-Kuhn-Tucker condition of
+      :math:`\alpha \ge 0` there) the fit is taken on that boundary, where it equals the
+      Poisson fit (no optimiser is run): the coefficients' standard errors are
       then the Poisson ones (the NB2 information is block-diagonal at
       :math:`\alpha = 0`) and :math:`\alpha`'s is NaN (a Wald interval is not valid on a
       boundary; use the LR test of :meth:`CountRegression.overdispersion`).
