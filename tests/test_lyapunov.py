@@ -209,7 +209,7 @@ def test_every_event_loop_has_a_budget(ics):
     out = tangent_two_kernel(st.copy(), table, 0.06, 0, 1, 1000, 0.2, np.eye(8)[[0]], 50, 0)
     assert out[4] == 1
     out = ftle_two_kernel(st, table, 0.06, 0, 1, 1000, 0.2, 0, np.array([[1e-8, 0.0]]),
-                          np.array([0]), 1e-8, 10, 50)
+                          np.array([0]), 1e-8, 10, 50, True)
     assert out[6] == 1
     with pytest.raises(RuntimeError, match="budget of 50 events"):
         _check_status(1, 200.0, 50)
@@ -430,3 +430,59 @@ def test_the_one_pass_records_the_uniform_samples_of_a_uniform_rerun(rule):
     assert lyapunov_pass(ic, 0.02, holes=[(0.0, 0.1)], uniform=True, **steps)[3] is None
     with pytest.raises(TypeError, match="uniform"):
         lyapunov_pass(ic, 0.02, uniform="yes", **steps)
+
+
+# --- eq. (4) of Rankovic & Porter read literally (renormalize=False) -------------------------
+
+
+def _literal_eq4(reference, twin_x, twin_y, d0, tau):
+    """``max`` over x and y of ``1/(n tau) sum_k log(|q_twin(k tau) - q(k tau)| / d0)``,
+    from three separately simulated runs' samples (k = 1..n)."""
+    lams = [np.log(np.abs(tw.samples[1:, c] - reference.samples[1:, c]) / d0).sum()
+            / (tau * (reference.samples.shape[0] - 1)) for tw, c in ((twin_x, 0), (twin_y, 1))]
+    return max(lams), lams
+
+
+def test_the_literal_eq4_is_the_sum_of_log_raw_separations_of_two_trajectories():
+    r, tau, n, d0 = 0.05, 0.2, 100, 1 / 5000
+    ic = initial_conditions(1, r, seed=11)[0]
+    reference = simulate_two_particle(ic, r, n_steps=n, tau=tau)
+    twins = []
+    for c in (0, 1):  # the paper's twins: the tracked disk moved by +d0 along x, along y
+        moved = ic.copy()
+        moved[0, c] += d0
+        twins.append(simulate_two_particle(moved, r, n_steps=n, tau=tau))
+    want, (want_x, want_y) = _literal_eq4(reference, *twins, d0, tau)
+    got = lyapunov(reference, method="twin", variant="paper", d0=d0, renormalize=False)
+    assert not got.renormalized and got.n_renorm == 0
+    np.testing.assert_allclose([got.lam, got.lam_x, got.lam_y], [want, want_x, want_y],
+                               rtol=1e-7)
+    # the separations saturated: the literal sum is far from Benettin's exponent
+    benettin = lyapunov(reference, method="twin", variant="paper", d0=d0)
+    assert got.lam > 3 * benettin.lam > 0
+
+
+def test_the_literal_eq4_of_a_kicked_run_shares_its_kicks():
+    r, tau, n, d0 = 0.02, 0.2, 150, 1 / 5000
+    state = initial_conditions(1, r, seed=5)[0][0]
+    kicks = schedules.Poisson(rate=0.2).sample(n * tau, rng=np.random.default_rng(3))
+    angles = np.random.default_rng(4).uniform(0, 2 * np.pi, kicks.size)
+    common = dict(kicks=kicks, kick_angles=angles, kick_angle="uniform", n_steps=n, tau=tau)
+    reference = simulate_one_particle(state, r, **common)
+    twins = []
+    for c in (0, 1):
+        moved = state.copy()
+        moved[c] += d0
+        twins.append(simulate_one_particle(moved, r, **common))
+    want, parts = _literal_eq4(reference, *twins, d0, tau)
+    got = lyapunov(reference, method="twin", variant="paper", d0=d0, renormalize=False)
+    assert kicks.size > 5 and got.n_perturbations == kicks.size
+    np.testing.assert_allclose([got.lam, got.lam_x, got.lam_y], [want, *parts], rtol=1e-7)
+
+
+def test_renormalize_false_needs_the_twin_method_and_a_bool(ics):
+    ic = ics[0]
+    with pytest.raises(ValueError, match="method='twin'"):
+        lyapunov(ic, 0.03, n_steps=10, tau=0.2, renormalize=False)
+    with pytest.raises(TypeError, match="renormalize must be a bool"):
+        lyapunov(ic, 0.03, n_steps=10, tau=0.2, method="twin", renormalize="no")

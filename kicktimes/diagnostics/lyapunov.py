@@ -95,6 +95,10 @@ class LyapunovResult:
         ``log 0 = -inf``); the tangent vector is not finite (a contact exactly tangent to
         the wall, where the linearised dynamics is singular); or the twin was never
         renormalised. `lyapunov` issues it as an `UndefinedDiagnosticWarning`.
+    renormalized : bool
+        False for a twin that was never renormalised (``renormalize=False``: eq. (4) of
+        Ranković & Porter read literally; ``lam`` is then that sum, not an exponent, and
+        ``n_renorm``, ``n_forced`` and ``n_deferred`` are 0).
     """
 
     lam: float
@@ -110,6 +114,7 @@ class LyapunovResult:
     n_perturbations: int = 0
     lam_per_perturbation: float = math.nan
     reason: str | None = None
+    renormalized: bool = True
 
 
 def _twin_offsets(variant: str, d0: float, ok) -> tuple[np.ndarray, np.ndarray]:
@@ -174,9 +179,29 @@ def _warn_undefined(res: LyapunovResult) -> None:
 _PARTS = {"norm": ("the position deviation",), "paper": ("|dx|", "|dy|")}
 
 
-def _twin_result(out, variant, d0, horizon, max_events) -> LyapunovResult:
+def _twin_result(out, variant, d0, horizon, max_events, renormalize=True,
+                 tau=None) -> LyapunovResult:
     log_sum, n_renorm, n_forced, n_deferred, t_last, n_pert, status = out
     _check_status(status, horizon, max_events)
+    if not renormalize:
+        # eq. (4) as printed: the sum over the n samples divided by n tau
+        with np.errstate(invalid="ignore", divide="ignore"):
+            lams = np.where((n_renorm > 0) & np.isfinite(log_sum),
+                            log_sum / (n_renorm * tau), np.nan)
+        lam, lam_x, lam_y = _combine(lams, variant)
+        reasons = [f"the twin measuring {part} "
+                   + ("was at distance exactly 0 from the reference at a sample (log 0)"
+                      if n > 0 else "was measured at no sample (the horizon covers no time)")
+                   for part, n, v in zip(_PARTS[variant], n_renorm, lams, strict=True)
+                   if not np.isfinite(v)]
+        j = int(np.argmax(t_last))
+        t, n = float(t_last[j]), int(n_pert[j])
+        return LyapunovResult(
+            lam=lam, lam_x=lam_x, lam_y=lam_y, n_renorm=0, n_forced=0, n_deferred=0,
+            total_time=t, d0=d0, variant=variant, method="twin", n_perturbations=n,
+            lam_per_perturbation=_per_perturbation(lam, t, n), reason="; ".join(reasons) or None,
+            renormalized=False,
+        )
     with np.errstate(invalid="ignore", divide="ignore"):
         lams = np.where(t_last > 0, log_sum / t_last, np.nan)
     lam, lam_x, lam_y = _combine(lams, variant)
@@ -256,7 +281,7 @@ def lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rule
              track=0, kicks=None, kick_angles=None, kick_angle="uniform", sigma=1.0, rng=None,
              method="tangent", variant="norm", d0=None, max_defer=10, e0=None,
              partner="weighted", partner_radius=None, partner_mass=None, return_run=False,
-             holes=None, masses=None):
+             holes=None, masses=None, renormalize=True):
     """Finite-time Lyapunov exponent of a two-disk or a kicked one-disk billiard.
 
     Parameters
@@ -296,6 +321,16 @@ def lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rule
         (default the paper's 1/5000). Must be ``None`` for ``method="tangent"``.
     max_defer : int
         Twin only: consecutive deferred renormalisations after which one is forced.
+    renormalize : bool
+        Twin only. ``True`` (default): Benettin's algorithm, the twin renormalised to
+        ``d0`` at every sample. ``False``: eq. (4) of Ranković & Porter (2013) read
+        literally, "λ_max(n) = 1/(τn) Σ_{k=1}^{n} log(‖δd(kτ)‖/‖δd(0)‖)": the twin is never
+        renormalised and the sum runs over the logs of its raw separations ``d_k`` from
+        the reference at the ``n`` samples, ``lam = Σ_k log(d_k / d0) / (n tau)`` (``n
+        tau`` as printed, also for ``sampling="paper"``, whose steps are shorter). Once
+        the twin's separation saturates at the table's size this does not tend to 0 with
+        ``n``: it is not an exponent, and docs/lyapunov.md compares the two readings. A
+        kicked twin shares the run's kick times and angles.
     return_run : bool
         Also return the simulated run: ``(result, run)``, where ``run`` is the
         `TwoParticleRun` / `OneParticleRun` that `simulate_two_particle` /
@@ -374,6 +409,7 @@ def lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rule
         method=method, variant=variant, d0=d0, max_defer=max_defer, e0=e0, partner=partner,
         partner_radius=partner_radius, partner_mass=partner_mass,
         return_run=bool(return_run), t_continue=0.0, holes=holes, masses=masses,
+        renormalize=renormalize,
     )
     _warn_undefined(res)
     return (res, run) if return_run else res
@@ -411,9 +447,15 @@ def _lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rul
               track=0, kicks=None, kick_angles=None, kick_angle="uniform", sigma=1.0, rng=None,
               method="tangent", variant="norm", d0=None, max_defer=10, e0=None,
               partner="weighted", partner_radius=None, partner_mass=None, return_run=False,
-              t_continue=0.0, holes=None, masses=None, uniform_out=None):
+              t_continue=0.0, holes=None, masses=None, uniform_out=None, renormalize=True):
     """`lyapunov`'s body: ``(result, run or None, pp_times or None)``; a list
     ``uniform_out`` receives the one pass's uniform samples (see `lyapunov_pass`)."""
+    if not isinstance(renormalize, bool | np.bool_):
+        raise TypeError(f"renormalize must be a bool, got {type(renormalize).__name__}")
+    renormalize = bool(renormalize)
+    if not renormalize and method != "twin":
+        raise ValueError("renormalize=False (eq. (4) read literally) applies to method='twin' "
+                         f"only, got method={method!r}")
     arcs = chk.check_holes(holes)
     if arcs is not None:
         if method != "tangent":
@@ -494,8 +536,8 @@ def _lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rul
 
         offsets, measure = _twin_offsets(variant, d0, ok)
         out = ftle_two_kernel(st, rho, sig, chk.RULES[rule], mode, n_steps, tau, track, offsets,
-                              measure, d0, max_defer, max_events)
-        return _twin_result(out, variant, d0, horizon, max_events), None, None
+                              measure, d0, max_defer, max_events, renormalize)
+        return _twin_result(out, variant, d0, horizon, max_events, renormalize, tau), None, None
     if arr.shape != (4,):
         raise ValueError(f"system must have shape (2, 4) or (4,), got {arr.shape}")
     r = chk.check_real("r", r, low=0.0, high=1.0)
@@ -534,9 +576,10 @@ def _lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rul
         variant, d0, lambda dx, dy: math.hypot(state[0] + dx, state[1] + dy) <= rho
     )
     out = ftle_one_kernel(st, rho, times, angles, KICK_ANGLES[kick_angle], mode, n_steps, tau,
-                          offsets, measure, d0, max_defer, max_events, kick_u, sp, kinetic)
+                          offsets, measure, d0, max_defer, max_events, kick_u, sp, kinetic,
+                          renormalize)
     check_kinetic_capacity(kinetic, int(np.searchsorted(times, np.inf)))
-    return _twin_result(out, variant, d0, horizon, max_events), None, None
+    return _twin_result(out, variant, d0, horizon, max_events, renormalize, tau), None, None
 
 
 def _pass_two(ic, r, rule, sampling, mode, n_steps, tau, track, variant, max_ev_tan,

@@ -89,7 +89,7 @@ def _separation(dx, dy, measure):
 
 @njit(cache=True)
 def _ftle(st0, rho, mode, n_steps, tau, track, offsets, measure, d0, max_defer, max_events, pair,
-          kick, kinetic):
+          kick, kinetic, renorm):
     """Benettin FTLE of either system: ``pair = (sigma, rule)`` for two disks (``kick`` is
     ``None``), ``kick = (kicks, angles, kick_mode, kick_u, sp)`` for the kicked disk
     (``pair`` is ``None``); the other system's code is compiled out. ``kinetic`` (or
@@ -100,6 +100,9 @@ def _ftle(st0, rho, mode, n_steps, tau, track, offsets, measure, d0, max_defer, 
     Row 0 of the trajectory arrays is the reference, rows ``1..m`` the twins: each sample
     first advances the reference (no flight on: its positions at ``t_k`` are interpolated),
     then each twin, flown on to ``t_k``, measured against it and renormalised.
+    ``renorm=False``: the twins are never renormalised (eq. (4) of Ranković & Porter read
+    literally): ``log_sum`` sums ``log(d_k / d0)`` over every sample ``k``, ``n_renorm``
+    counts the samples, and a separation of exactly 0 makes the sum ``-inf``.
     """
     m = offsets.shape[0]
     nst = st0.shape[0]
@@ -248,6 +251,13 @@ def _ftle(st0, rho, mode, n_steps, tau, track, offsets, measure, d0, max_defer, 
             d = _separation(traj[j, o] - pos[2 * track], traj[j, o + 1] - pos[2 * track + 1],
                             measure[j - 1])
             i = j - 1
+            if not renorm:
+                # the raw separation at this sample; the twin flies on unchanged
+                log_sum[i] += math.log(d / d0) if d > 0.0 else -math.inf
+                n_renorm[i] += 1
+                t_last[i] = tk
+                n_pert[i] = cnt[0, 0]
+                continue
             same = True
             for c in range(cnt.shape[1]):
                 if cnt[j, c] != cnt[0, c]:
@@ -303,20 +313,21 @@ def _ftle(st0, rho, mode, n_steps, tau, track, offsets, measure, d0, max_defer, 
 
 @njit(cache=True)
 def ftle_two_kernel(st0, rho, sigma, rule, mode, n_steps, tau, track, offsets, measure, d0,
-                    max_defer, max_events):
-    """Benettin FTLE for the two-disk billiard with ``len(offsets)`` twins.
+                    max_defer, max_events, renorm):
+    """Benettin FTLE for the two-disk billiard with ``len(offsets)`` twins (``renorm``:
+    renormalise them, or measure the raw separations, see `_ftle`).
 
     Returns ``(log_sum, n_renorm, n_forced, n_deferred, t_last, n_pert, status)``; the
     first five per twin, ``n_pert[j]`` the reference's disk-disk collisions up to
     ``t_last[j]``.
     """
     return _ftle(st0, rho, mode, n_steps, tau, track, offsets, measure, d0, max_defer,
-                 max_events, (sigma, rule), None, None)
+                 max_events, (sigma, rule), None, None, renorm)
 
 
 @njit(cache=True)
 def ftle_one_kernel(st0, rho, kicks, angles, kick_mode, mode, n_steps, tau, offsets, measure, d0,
-                    max_defer, max_events, kick_u, sp, kinetic=None):
+                    max_defer, max_events, kick_u, sp, kinetic, renorm):
     """Benettin FTLE for the kicked one-disk billiard.
 
     Twins share the kick times and angles (common random numbers). Returns as
@@ -324,7 +335,8 @@ def ftle_one_kernel(st0, rho, kicks, angles, kick_mode, mode, n_steps, tau, offs
     (``kick_mode == 2``, numbers ``kick_u``, parameters ``sp`` as in
     `kicktimes.billiard.kernels.one.scatter_step`): the reference draws the partner, placed
     in contact with it, and every twin meets that same partner at its own contact time, or
-    misses it. ``kinetic``: kinetic kicks (see `_ftle`).
+    misses it. ``kinetic``: kinetic kicks or ``None`` (see `_ftle`); ``renorm``: as in
+    `ftle_two_kernel`.
     """
     return _ftle(st0, rho, mode, n_steps, tau, 0, offsets, measure, d0, max_defer, max_events,
-                 None, (kicks, angles, kick_mode, kick_u, sp), kinetic)
+                 None, (kicks, angles, kick_mode, kick_u, sp), kinetic, renorm)
