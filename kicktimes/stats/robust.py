@@ -24,7 +24,10 @@ def nanmedian(a, axis=-1):
     median is the middle one for odd :math:`n` and :math:`(s_{(n/2-1)} + s_{(n/2)})/2`
     for even :math:`n`, with the very operations of `numpy.median` (a sum from 0.0, so
     even the sign of a zero median agrees). A row without a number
-    gives NaN (and no warning).
+    gives NaN (and no warning). One exception: for an odd count, numpy's small-array path
+    (fewer than 600 values along ``axis``) averages the middle value with itself,
+    :math:`(m + m)/2`, which overflows to ``inf`` when :math:`|m| \ge 2^{1023}`; here the
+    median is :math:`m`, as `numpy.median` gives.
 
     Parameters
     ----------
@@ -55,10 +58,11 @@ def nanmedian(a, axis=-1):
     s_hi = np.take_along_axis(s, hi, axis=-1)[..., 0]
     # numpy's mean of the middle values sums from 0.0: (0 + a) + b, which differs from
     # a + b only in the sign of a zero
+    first = 0.0 + s_lo
+    out = first.copy()
+    pairs = n % 2 == 0  # (only these rows average: no overflow warning from the odd ones)
     with np.errstate(invalid="ignore"):
-        first = 0.0 + s_lo
-        even = (first + s_hi) / 2.0
-    out = np.where(n % 2 == 1, first, even)
+        out[pairs] = (first[pairs] + s_hi[pairs]) / 2.0
     # a fresh C-ordered array, as numpy's: reductions over it then sum in the same order
     return np.ascontiguousarray(np.where(n == 0, np.nan, out))
 
