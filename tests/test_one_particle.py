@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from kicktimes import read_run, schedules, simulate_one_particle
+from kicktimes import initial_conditions, read_run, schedules, simulate_one_particle
 
 STATE = np.array([0.12, -0.31, 0.6, 0.8])
 
@@ -236,3 +236,41 @@ def test_a_paper_run_cut_short_at_t0_by_every_kick_warns_that_it_covers_no_time(
         run = simulate_one_particle([0.0, 0.0, 1.0, 0.0], 0.5, sampling="paper", n_steps=1,
                                     tau=1.0, kicks=[0.0, 0.0], rng=0)
     assert run.t_max == 0.0 and run.n_kicks == 2
+
+
+# --- the paper's N(0, 1) kick angles, both readings ---------------------------------------
+
+
+@pytest.mark.parametrize(("kick_angle", "direction"), [
+    ("normal", lambda old, a: a),          # the new direction is the angle drawn
+    ("gaussian", lambda old, a: old + a),  # the direction is rotated by it
+])
+def test_the_two_readings_of_normal_kick_angles(kick_angle, direction):
+    old, a = math.pi / 2, 0.7
+    state = np.array([0.0, 0.0, math.cos(old), math.sin(old)])
+    run = simulate_one_particle(state, 0.02, t_max=0.02, kicks=np.array([0.01]),
+                               kick_angle=kick_angle, kick_angles=[a])
+    want = direction(old, a)
+    np.testing.assert_allclose(run.final_state[2:], [math.cos(want), math.sin(want)],
+                               atol=1e-15)
+    assert run.sigma == 1.0 and run.kick_angle == kick_angle
+
+
+def test_normal_kick_angles_are_drawn_from_n_0_sigma_and_act_as_new_directions():
+    from scipy import stats as sps
+
+    from kicktimes.diagnostics import lyapunov
+
+    state = initial_conditions(1, 0.02, seed=2)[0][0]
+    kicks = np.sort(np.random.default_rng(0).uniform(0, 3000, 3000))
+    run = simulate_one_particle(state, 0.02, t_max=3000.0, kicks=kicks, kick_angle="normal",
+                               sigma=0.5, rng=7)
+    assert sps.kstest(run.kick_angles, sps.norm(scale=0.5).cdf).pvalue > 1e-3
+    # the same angles as "uniform" new directions give the very same run and FTLE
+    same = simulate_one_particle(state, 0.02, t_max=3000.0, kicks=run.kick_times,
+                                kick_angle="uniform", kick_angles=run.kick_angles)
+    np.testing.assert_array_equal(run.final_state, same.final_state)
+    short = dict(kicks=kicks[kicks < 600], kick_angles=run.kick_angles[kicks < 600],
+                 n_steps=3000, tau=0.2)
+    assert (lyapunov(state, 0.02, kick_angle="normal", **short)
+            == lyapunov(state, 0.02, kick_angle="uniform", **short))

@@ -83,7 +83,8 @@ def _is_schedule(kicks) -> bool:
 
 
 def draw_kick_angles(n: int, kick_angle: str, sigma: float, rng: np.random.Generator):
-    """Kick angles for ``n`` kicks: new directions (uniform) or rotations (gaussian).
+    """Kick angles for ``n`` kicks: new directions uniform on [0, 2 pi) (``"uniform"``) or
+    from N(0, sigma^2) (``"normal"``), or rotations from N(0, sigma^2) (``"gaussian"``).
 
     For ``"scatter"`` the per-kick numbers are two uniforms on (-1, 1), shape ``(n, 2)``
     (`kicktimes.billiard.scatter.draw_scatter_uniforms`).
@@ -269,19 +270,21 @@ def simulate_one_particle(state, r, *, t_max=None, kicks=None, kick_angle="unifo
         each kick is the kinetic collision rate of the disk's angular momentum (unit
         speed; the run's ``kick_times`` are then the times it drew). ``None``: no kicks
         (the integrable billiard).
-    kick_angle : {"uniform", "gaussian", "scatter"}
+    kick_angle : {"uniform", "gaussian", "normal", "scatter"}
         ``"uniform"``: a kick replaces the direction by an angle uniform on [0, 2 pi)
-        (the paper's choice). ``"gaussian"``: a kick rotates it by ``N(0, sigma^2)``.
+        (the paper's choice). The paper's other choice, angles from N(0, 1), has two
+        readings: ``"gaussian"``, a kick rotates the direction by ``N(0, sigma^2)``;
+        ``"normal"``, a kick replaces it by an angle drawn from ``N(0, sigma^2)``.
         ``"scatter"``: a kick is a collision with a virtual partner disk (radius
         ``partner_radius``, default ``r``) drawn from the two-disk collision statistics
         (docs/scatter.md).
     kick_angles : array_like, optional
-        Explicit angles, one per kick (new directions for ``"uniform"``, rotations for
-        ``"gaussian"``, shape (n, 2) uniforms on (-1, 1) for ``"scatter"``), e.g.
+        Explicit angles, one per kick (new directions for ``"uniform"`` and ``"normal"``,
+        rotations for ``"gaussian"``, shape (n, 2) uniforms on (-1, 1) for ``"scatter"``), e.g.
         ``run.kick_angles`` of another run, so that two runs share their kicks (common
         random numbers). Drawn from ``rng`` when omitted.
     sigma : float
-        Standard deviation of the gaussian rotation (``> 0``).
+        Standard deviation of the gaussian rotation, or of the normal new angle (``> 0``).
     rng : numpy.random.Generator or int, optional
         Source of the schedule's times (first) and the kick angles (second).
     seed : int, optional
@@ -428,7 +431,7 @@ def one_particle_run(st, r, state, out, *, sampling, mode, tau, n_steps, seed, k
         seed=seed,
         **sampling_fields(t_end, mode, sampling, tau, n_steps, stimes, samples),
         kick_angle=kick_angle,
-        sigma=sigma if kick_angle == "gaussian" else None,
+        sigma=sigma if kick_angle in ("gaussian", "normal") else None,
         kick_times=times[:n_applied],
         kick_angles=applied[:n_applied],
         rule=rule,

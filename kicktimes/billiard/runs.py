@@ -235,7 +235,8 @@ class OneParticleRun(_Run):
         ``(x, y, vx, vy)`` at ``t = 0`` and ``t = t_max``.
     kick_times, kick_angles : ndarray
         The kicks applied, so that a twin run can reuse them (common random numbers).
-        For ``kick_angle="uniform"`` the angle is the new velocity direction; for
+        For ``kick_angle="uniform"`` or ``"normal"`` the angle is the new velocity
+        direction; for
         ``"gaussian"`` it is the rotation applied to the current direction; for
         ``"scatter"`` it is an array of shape (n_kicks, 2), the two uniform numbers on
         (-1, 1) that fix each kick's partner and contact normal.

@@ -365,7 +365,8 @@ def lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rule
     ``dq``. The tangent method carries ``(dq, dv)`` exactly: free flight ``dq += dv t``;
     wall reflection ``dq' = dq + (v - v') dtau``, ``dv' = R dv - (2/rho)[(v.u) n + (v.n) u]``
     with ``dtau = -(n.dq)/(n.v)``, ``u = dq + v dtau``; the disk-disk maps of each rule;
-    a "uniform" kick keeps only the speed deviation, a "gaussian" kick rotates ``dv``
+    a "uniform" or "normal" kick (a new direction) keeps only the speed deviation, a
+    "gaussian" kick rotates ``dv``
     (derivations in docs/lyapunov.md). The vectors are rescaled only when their norm
     leaves ``[1e-100, 1e100]`` (the dynamics is linear, so the result does not depend on
     when), which keeps the cost near that of the bare simulation.

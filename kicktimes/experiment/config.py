@@ -39,7 +39,7 @@ SAMPLINGS = ("uniform", "paper")
 RULES = ("mirror", "elastic")
 LYAPUNOV_VARIANTS = ("norm", "paper")
 LYAPUNOV_METHODS = ("tangent", "twin")
-KICK_ANGLES = ("uniform", "gaussian")
+KICK_ANGLES = ("uniform", "gaussian", "normal")
 RR_SAMPLINGS = ("run", "uniform", "run+uniform")
 
 #: Fields added after the first store layout, with the value that reproduces the earlier
@@ -133,9 +133,10 @@ class Experiment:
         distance ``d0`` (the paper's method). See `kicktimes.diagnostics.lyapunov`.
     lyapunov_variant : {"norm", "paper"}
         ``"paper"``: ``max(lambda_x, lambda_y)`` (also stores both); ``"norm"``: 2-norm.
-    kick_angle : {"uniform", "gaussian"}
-        Kick law of the one-particle billiards; ``sigma`` (``> 0``) is the standard
-        deviation of the gaussian rotation (unused for ``"uniform"``).
+    kick_angle : {"uniform", "gaussian", "normal"}
+        Kick law of the one-particle billiards (`simulate_one_particle`): a new direction
+        uniform on [0, 2 pi), a rotation by N(0, sigma^2), or a new direction from
+        N(0, sigma^2); ``sigma`` (``> 0``) is unused for ``"uniform"``.
     systems : sequence of str
         Subset of ``("two_particle", "poisson", "actual", "poisson_scatter",
         "actual_scatter", "poisson_kinetic", "mmpp", "uniform_kinetic")`` whose diagnostics are

@@ -31,7 +31,8 @@ __all__ = ["KICK_ANGLES", "SCATTER", "SCATTER_PARAMS", "advance", "apply_kick", 
            "scatter_step", "store", "twin_scatter_step", "unit_speed_of", "wall_event", "wall_step"]
 
 #: kick laws and their codes in the kernels
-KICK_ANGLES = {"uniform": 0, "gaussian": 1, "scatter": 2}
+# "normal" draws the new direction from N(0, sigma^2): a new angle, applied as "uniform"
+KICK_ANGLES = {"uniform": 0, "gaussian": 1, "scatter": 2, "normal": 0}
 SCATTER = KICK_ANGLES["scatter"]
 #: the scattering kicks' parameter array ``sp`` (`scatter_step`), field by field
 SCATTER_PARAMS = ("sigma", "rule", "e0", "law", "rho1", "m0", "m1")
