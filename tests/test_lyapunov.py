@@ -10,6 +10,7 @@ from kicktimes import initial_conditions, schedules, simulate_one_particle, simu
 from kicktimes.billiard.kernels.drive_two import tangent_two_kernel
 from kicktimes.billiard.kernels.tangent import MAX_SAME_INSTANT
 from kicktimes.billiard.kernels.twins import ftle_two_kernel
+from kicktimes.billiard.one_particle import draw_kick_angles
 from kicktimes.diagnostics import UndefinedDiagnosticWarning, lyapunov
 from kicktimes.diagnostics.lyapunov import _check_status, lyapunov_spectrum
 
@@ -66,10 +67,16 @@ def test_kicks_make_the_one_particle_billiard_chaotic(ics, kick_angle):
     assert res.lam > 5 * unkicked.lam
 
 
-def test_independent_twin_kicks_are_gone(ics):
-    # each independent kick threw the twin O(1) away: lam ~ Gamma ln(tau / d0), no exponent
-    with pytest.raises(TypeError, match="twin_kicks"):
+def test_independent_twin_kicks_need_a_kicked_twin(ics):
+    with pytest.raises(ValueError, match="twin_kicks='independent' applies to method='twin'"):
         lyapunov(ics[1, 0], 0.03, n_steps=10, tau=0.2, twin_kicks="independent")
+    with pytest.raises(ValueError, match="not to two disks"):
+        lyapunov(ics[1], 0.03, n_steps=10, tau=0.2, method="twin", twin_kicks="independent")
+    with pytest.raises(ValueError, match="kick_angle='scatter'"):
+        lyapunov(ics[1, 0], 0.03, n_steps=10, tau=0.2, method="twin", kick_angle="scatter",
+                 kicks=np.array([0.5]), rng=1, twin_kicks="independent")
+    with pytest.raises(ValueError, match="twin_kicks"):
+        lyapunov(ics[1, 0], 0.03, n_steps=10, tau=0.2, method="twin", twin_kicks="own")
 
 
 @pytest.mark.parametrize("method", ["tangent", "twin"])
@@ -478,6 +485,34 @@ def test_the_literal_eq4_of_a_kicked_run_shares_its_kicks():
     got = lyapunov(reference, method="twin", variant="paper", d0=d0, renormalize=False)
     assert kicks.size > 5 and got.n_perturbations == kicks.size
     np.testing.assert_allclose([got.lam, got.lam_x, got.lam_y], [want, *parts], rtol=1e-7)
+
+
+@pytest.mark.parametrize("kick_angle", ["uniform", "gaussian"])
+def test_independent_twins_take_their_own_angles_at_the_shared_times(kick_angle):
+    r, tau, n, d0 = 0.02, 0.2, 150, 1 / 5000
+    state = initial_conditions(1, r, seed=5)[0][0]
+    kicks = schedules.Poisson(rate=0.2).sample(n * tau, rng=np.random.default_rng(3))
+    angles = draw_kick_angles(kicks.size, kick_angle, 0.5, np.random.default_rng(4))
+    common = dict(kick_angle=kick_angle, sigma=0.5, n_steps=n, tau=tau)
+    reference = simulate_one_particle(state, r, kicks=kicks, kick_angles=angles, **common)
+    # the twins' angles: drawn from rng after the run's (here given, so none drawn)
+    own = np.random.default_rng(7)
+    twins = []
+    for c in (0, 1):
+        moved = state.copy()
+        moved[c] += d0
+        twins.append(simulate_one_particle(
+            moved, r, kicks=kicks, kick_angles=draw_kick_angles(kicks.size, kick_angle, 0.5, own),
+            **common))
+    want, parts = _literal_eq4(reference, *twins, d0, tau)
+    got = lyapunov(state, r, kicks=kicks, kick_angles=angles, method="twin", variant="paper",
+                   d0=d0, renormalize=False, twin_kicks="independent", rng=7, **common)
+    np.testing.assert_allclose([got.lam, got.lam_x, got.lam_y], [want, *parts], rtol=1e-7)
+    shared = lyapunov(reference, method="twin", variant="paper", d0=d0, renormalize=False)
+    assert got.lam != shared.lam
+    # renormalised, each kick throws the twin O(1) away: far above the shared twins' value
+    own_kicks = lyapunov(reference, method="twin", d0=d0, twin_kicks="independent", rng=7)
+    assert own_kicks.lam > 3 * lyapunov(reference, method="twin", d0=d0).lam
 
 
 def test_renormalize_false_needs_the_twin_method_and_a_bool(ics):

@@ -251,7 +251,8 @@ def test_unkicked_disk_exponent_is_below_the_round_off_driven_twin(ics20):
             tangent = lyapunov(ic[0], R_AGREE, n_steps=n, tau=0.2).lam
             out = ftle_one_kernel(st.copy(), 1.0 - R_AGREE, np.empty(0), np.empty(0), 0, 1, n,
                                   0.2, np.array([[1e-14, 0.0]]), np.array([0]), 1e-14, 10,
-                                  10**8, NO_SCATTER, NO_PARTNER, None, True)
+                                  10**8, NO_SCATTER, NO_PARTNER, None, True,
+                                  np.empty((0, 0)))
             twin_tiny = out[0][0] / out[4][0]
             assert tangent < 0.75 * twin_tiny
 

@@ -210,13 +210,21 @@ def report_command(stores, out, workers, progress, pdf, force):
 
 
 @click.command("reproduce")
-@click.option("--study", type=click.Choice(["paper", "disks"]), default="paper",
+@click.option("--study", type=click.Choice(["paper", "protocol", "disks"]), default="paper",
               show_default=True,
-              help="paper: the paper's two families and their report; disks: the tagged disk "
-              "among N = 2..1000 disks (issue 42), its stores and docs/results-style page "
+              help="paper: the paper's two families and their report; protocol: the paper's "
+              "claims by its own protocol (every reading of its eq. (4) on both panels of "
+              "Fig. 6), the page paper.md (into --results, default OUT/results-protocol); "
+              "disks: the tagged disk among N = 2..1000 disks, its stores and the page "
               "disks.md (into --results, default OUT/results-disks).")
 @click.option("--results", "results", type=click.Path(file_okay=False), default=None,
-              help="--study disks: folder of the page disks.md (default OUT/results-disks).")
+              help="--study protocol / disks: folder of the page (default "
+              "OUT/results-protocol, OUT/results-disks).")
+@click.option("--findings", "findings", type=click.Path(file_okay=False, exists=True),
+              default=None,
+              help="--study protocol: folder of the paper study's paper-scale findings "
+              "tables (family_a_findings.csv, ...; e.g. docs/results), for the recurrence "
+              "and count claims (default: --results, if it holds them).")
 @option("--scale", type=click.Choice(["quick", "paper"]), default="quick",
         help="quick: small versions of both families; paper: the paper's full scale.")
 @click.option(
@@ -236,17 +244,39 @@ def report_command(stores, out, workers, progress, pdf, force):
 @_progress_option
 @_wait_option
 @_pdf_option
-def reproduce_command(study, results, scale, content, out, workers, scheduler, progress, wait,
-                      pdf):
+def reproduce_command(study, results, findings, scale, content, out, workers, scheduler,
+                      progress, wait, pdf):
     """Run the paper's experiment families (and, at paper scale, their controls) and report.
 
     Reruns resume the stores in --out. The experiments are the built-in presets, the
     same as analysis/<name>.toml (with --content paper, reduced to the paper's own
     systems and diagnostics: kicktimes.experiment.presets.PAPER_CONTENT). With
     --study disks: the disks presets (kicktimes.experiment.DISKS_PRESETS) and the page
-    disks.md (docs/results/disks.md is built with --results docs/results).
+    disks.md (docs/results/disks.md is built with --results docs/results). With --study
+    protocol: kicktimes.studies.protocol and the page paper.md (docs/results/paper.md is
+    built with --scale paper --results docs/results; about 25 minutes on 2 cores).
     """
     import os
+    import sys
+
+    if findings is not None and study != "protocol":
+        raise click.UsageError("--findings applies to --study protocol")
+    if study == "protocol":
+        from kicktimes.studies.protocol import reproduce_protocol
+
+        if scheduler is not None:
+            raise click.UsageError("--study protocol runs on the local pool (--workers); "
+                                   "--scheduler is not supported")
+        if progress is None:
+            progress = sys.stderr.isatty() and not os.environ.get("CI")
+        say = (lambda line: click.echo(line, err=True)) if progress else None
+        command = f"kicktimes reproduce --study protocol --scale {scale}"
+        with _cli_errors(_RUN_OPTIONS):
+            page = reproduce_protocol(out, scale=scale, results_dir=results,
+                                      findings_dir=findings, workers=workers, progress=say,
+                                      command=command)
+        click.echo(f"page written to {page}")
+        return
 
     if study == "disks":
         from kicktimes.report.disks_page import reproduce_disks

@@ -23,6 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from kicktimes._validation import check_rng
 from kicktimes.billiard import checks as chk
 from kicktimes.billiard.kernels.drive_one import simulate_tangent_one_kernel, tangent_one_kernel
 from kicktimes.billiard.kernels.drive_two import simulate_tangent_two_kernel, tangent_two_kernel
@@ -34,6 +35,7 @@ from kicktimes.billiard.one_particle import (
     check_kinetic_capacity,
     check_one_particle_state,
     check_scatter_options,
+    draw_kick_angles,
     kernel_limits,
     one_particle_run,
     resolve_kicks,
@@ -49,6 +51,8 @@ from kicktimes.billiard.two_particle import (
 from kicktimes.diagnostics.autocorrelation import UndefinedDiagnosticWarning
 
 VARIANTS = ("norm", "paper")
+#: the kicked twins' kicks: the run's angles, or each twin's own at the same times
+TWIN_KICKS = ("shared", "independent")
 METHODS = ("tangent", "twin")
 D0_DEFAULT = 1.0 / 5000.0  # the paper's
 D0_RANGE = (1e-10, 1e-2)
@@ -281,7 +285,7 @@ def lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rule
              track=0, kicks=None, kick_angles=None, kick_angle="uniform", sigma=1.0, rng=None,
              method="tangent", variant="norm", d0=None, max_defer=10, e0=None,
              partner="weighted", partner_radius=None, partner_mass=None, return_run=False,
-             holes=None, masses=None, renormalize=True):
+             holes=None, masses=None, renormalize=True, twin_kicks="shared"):
     """Finite-time Lyapunov exponent of a two-disk or a kicked one-disk billiard.
 
     Parameters
@@ -330,7 +334,17 @@ def lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rule
         tau`` as printed, also for ``sampling="paper"``, whose steps are shorter). Once
         the twin's separation saturates at the table's size this does not tend to 0 with
         ``n``: it is not an exponent, and docs/lyapunov.md compares the two readings. A
-        kicked twin shares the run's kick times and angles.
+        kicked twin shares the run's kick times and angles unless ``twin_kicks``.
+    twin_kicks : {"shared", "independent"}
+        Twin method, kicked disk only. ``"shared"`` (default): the twins are kicked at the
+        run's kick times with the run's angles (common random numbers; a kick is then a
+        map of the phase space, which is what an exponent linearises). ``"independent"``:
+        each twin is kicked at the same times with angles of its own, drawn from ``rng``
+        by the same law (``kick_angle``, ``sigma``) after the run's kicks. Ranković &
+        Porter do not say which their twins did. With its own angles a twin's velocity
+        differs by O(1) after the first kick, so the renormalised value measures
+        ``Gamma log(v tau / d0)``-like jumps rather than stretching. Not for scattering or
+        kinetic-rate kicks (the twin's own angle would change its kick times).
     return_run : bool
         Also return the simulated run: ``(result, run)``, where ``run`` is the
         `TwoParticleRun` / `OneParticleRun` that `simulate_two_particle` /
@@ -410,7 +424,7 @@ def lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rule
         method=method, variant=variant, d0=d0, max_defer=max_defer, e0=e0, partner=partner,
         partner_radius=partner_radius, partner_mass=partner_mass,
         return_run=bool(return_run), t_continue=0.0, holes=holes, masses=masses,
-        renormalize=renormalize,
+        renormalize=renormalize, twin_kicks=twin_kicks,
     )
     _warn_undefined(res)
     return (res, run) if return_run else res
@@ -448,12 +462,17 @@ def _lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rul
               track=0, kicks=None, kick_angles=None, kick_angle="uniform", sigma=1.0, rng=None,
               method="tangent", variant="norm", d0=None, max_defer=10, e0=None,
               partner="weighted", partner_radius=None, partner_mass=None, return_run=False,
-              t_continue=0.0, holes=None, masses=None, uniform_out=None, renormalize=True):
+              t_continue=0.0, holes=None, masses=None, uniform_out=None, renormalize=True,
+              twin_kicks="shared"):
     """`lyapunov`'s body: ``(result, run or None, pp_times or None)``; a list
     ``uniform_out`` receives the one pass's uniform samples (see `lyapunov_pass`)."""
     if not isinstance(renormalize, bool | np.bool_):
         raise TypeError(f"renormalize must be a bool, got {type(renormalize).__name__}")
     renormalize = bool(renormalize)
+    chk.check_choice("twin_kicks", twin_kicks, TWIN_KICKS)
+    if twin_kicks == "independent" and method != "twin":
+        raise ValueError("twin_kicks='independent' applies to method='twin' only (a tangent "
+                         f"vector has no kicks of its own), got method={method!r}")
     if not renormalize and method != "twin":
         raise ValueError("renormalize=False (eq. (4) read literally) applies to method='twin' "
                          f"only, got method={method!r}")
@@ -513,6 +532,9 @@ def _lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rul
             raise ValueError(f"track must be 0 or 1, got {track}")
         if kicks is not None:
             raise ValueError("kicks apply to a one-disk state (shape (4,)), not to two disks")
+        if twin_kicks != "shared":
+            raise ValueError("twin_kicks='independent' applies to a kicked one-disk state "
+                             "(shape (4,)), not to two disks")
         ic = check_two_particle_ic(arr, r, rule, name="system")
         masses = chk.check_masses(masses, rule)
         # the kernels' table and state, as the simulator sets them up
@@ -548,6 +570,13 @@ def _lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rul
     sp, options = check_scatter_options(state, r, kick_angle, rule, e0, partner,
                                         partner_radius, partner_mass)
     rule = options["rule"]
+    if twin_kicks == "independent":
+        if kick_angle == "scatter":
+            raise ValueError("twin_kicks='independent' needs kicks that set or rotate the "
+                             "direction (kick_angle 'uniform', 'normal' or 'gaussian'), got "
+                             "kick_angle='scatter'")
+        # one generator for the run's kicks and then the twins' angles
+        rng = check_rng(rng)
     times, angles, _, kinetic = resolve_kicks(kicks, kick_angles, kick_angle=kick_angle,
                                               sigma=sigma, rng=rng, horizon=horizon,
                                               t_max=horizon if mode == 1 else None, r=r)
@@ -576,9 +605,17 @@ def _lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rul
     offsets, measure = _twin_offsets(
         variant, d0, lambda dx, dy: math.hypot(state[0] + dx, state[1] + dy) <= rho
     )
+    twin_angles = np.empty((0, times.size))
+    if twin_kicks == "independent":
+        if kinetic is not None:
+            raise ValueError("twin_kicks='independent' needs given kick times: with "
+                             "kinetic-rate kicks the times depend on the trajectory")
+        twin_angles = np.empty((offsets.shape[0], times.size))
+        for j in range(offsets.shape[0]):
+            twin_angles[j] = draw_kick_angles(times.size, kick_angle, sigma, rng)
     out = ftle_one_kernel(st, rho, times, angles, KICK_ANGLES[kick_angle], mode, n_steps, tau,
                           offsets, measure, d0, max_defer, max_events, kick_u, sp, kinetic,
-                          renormalize)
+                          renormalize, twin_angles)
     check_kinetic_capacity(kinetic, int(np.searchsorted(times, np.inf)))
     return _twin_result(out, variant, d0, horizon, max_events, renormalize, tau), None, None
 

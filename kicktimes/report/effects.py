@@ -113,7 +113,7 @@ def _matrix(frame, column, radii, ics):
 
 
 def paired_ratio(numerator, denominator, *, rng, n_boot=2000, level=0.95, resamples=None,
-                 interval="percentile"):
+                 interval="percentile", draws=False):
     r"""Ratio of ensemble means per radius and averaged over radii, with bootstrap CIs.
 
     Parameters
@@ -137,12 +137,17 @@ def paired_ratio(numerator, denominator, *, rng, n_boot=2000, level=0.95, resamp
         and accelerated (BCa) interval (Efron 1987), whose acceleration comes from the
         jackknife over ICs: second-order accurate where per-IC values are skewed or
         heavy-tailed (sticky runs). Per-radius intervals are percentile intervals.
+    draws : bool
+        Also return the overall ratio of every resample (``n_boot`` values, NaN where a
+        resample has no usable radius), aligned across calls that share ``resamples``:
+        for statistics of several ratios at once (differences, decompositions).
 
     Returns
     -------
-    (pandas.DataFrame, dict)
+    (pandas.DataFrame, dict) or (pandas.DataFrame, dict, numpy.ndarray)
         Per radius ``radius, n_pairs, ratio, ci_low, ci_high`` and the overall
-        ``{"ratio", "ci_low", "ci_high", "n_ics", "n_radii"}``.
+        ``{"ratio", "ci_low", "ci_high", "n_ics", "n_radii"}``; with ``draws``, the
+        resamples' overall ratios.
 
     Notes
     -----
@@ -198,15 +203,11 @@ def paired_ratio(numerator, denominator, *, rng, n_boot=2000, level=0.95, resamp
         }
     )
     if not usable.any():
-        return per_radius, {
-            "ratio": math.nan,
-            "ci_low": math.nan,
-            "ci_high": math.nan,
-            "n_ics": n,
-            "n_radii": 0,
-        }
-    overall_boot = boot[:, usable].mean(axis=1)
-    overall_boot = overall_boot[np.isfinite(overall_boot)]
+        empty = {"ratio": math.nan, "ci_low": math.nan, "ci_high": math.nan, "n_ics": n,
+                 "n_radii": 0}
+        return (per_radius, empty, np.full(n_boot, np.nan)) if draws else (per_radius, empty)
+    aligned = boot[:, usable].mean(axis=1)
+    overall_boot = aligned[np.isfinite(aligned)]
     estimate = float(point[usable].mean())
     lo_q, hi_q = a, 100 - a
     if interval == "bca" and overall_boot.size:
@@ -220,7 +221,7 @@ def paired_ratio(numerator, denominator, *, rng, n_boot=2000, level=0.95, resamp
         "n_ics": n,
         "n_radii": int(usable.sum()),
     }
-    return per_radius, overall
+    return (per_radius, overall, aligned) if draws else (per_radius, overall)
 
 
 def store_ratio(ctx, numerator, denominator):

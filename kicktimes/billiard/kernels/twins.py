@@ -15,7 +15,8 @@ to the next sample at which both have processed the same sequence of events (eve
 counts and an order-sensitive hash). After ``max_defer`` consecutive deferrals it is
 *forced* (the twin has left the reference) and its logarithm counted (``n_forced``).
 
-Kicked twins share the reference's kick times and angles (common random numbers).
+Kicked twins share the reference's kick times and angles (common random numbers), or take
+their own angles at the shared times (`ftle_one_kernel`'s ``twin_angles``).
 
 The reference and every twin advance through the event steps of
 `kicktimes.billiard.kernels.two` and `.one` in their array form (`two.process_event_at`,
@@ -127,8 +128,9 @@ def _ftle(st0, rho, mode, n_steps, tau, track, offsets, measure, d0, max_defer, 
         for j in range(m + 1):
             two.init_events(traj[j], ev[j], rho, sigma)
     if kick is not None:
-        kicks, angles, kick_mode, kick_u, sp = kick
+        kicks, angles, kick_mode, kick_u, sp, twin_angles = kick
         nk = kicks.shape[0]
+        own_angles = twin_angles.shape[0] > 0
         unit_speed = one.unit_speed_of(st0, kick_mode, sp)
         # the partner of each scattering kick: centre and velocity at the kick time
         partners = np.zeros((nk if kick_mode == one.SCATTER else 0, 4))
@@ -210,7 +212,8 @@ def _ftle(st0, rho, mode, n_steps, tau, track, offsets, measure, d0, max_defer, 
                 if kick is not None and is_kick:
                     hit = True
                     if kick_mode != one.SCATTER:
-                        one.kick_step(traj[j], ev[j], dt, rho, kicks[ik], angles[ik], kick_mode)
+                        angle = angles[ik] if j == 0 or not own_angles else twin_angles[j - 1, ik]
+                        one.kick_step(traj[j], ev[j], dt, rho, kicks[ik], angle, kick_mode)
                     elif j == 0:
                         one.scatter_step(traj[j], ev[j], dt, rho, kicks[ik], kick_u[ik, 0],
                                          kick_u[ik, 1], sp, row)
@@ -327,10 +330,12 @@ def ftle_two_kernel(st0, rho, sigma, rule, mode, n_steps, tau, track, offsets, m
 
 @njit(cache=True)
 def ftle_one_kernel(st0, rho, kicks, angles, kick_mode, mode, n_steps, tau, offsets, measure, d0,
-                    max_defer, max_events, kick_u, sp, kinetic, renorm):
+                    max_defer, max_events, kick_u, sp, kinetic, renorm, twin_angles):
     """Benettin FTLE for the kicked one-disk billiard.
 
-    Twins share the kick times and angles (common random numbers). Returns as
+    Twins share the kick times and angles (common random numbers), or, when
+    ``twin_angles`` (shape ``(len(offsets), len(kicks))``) has rows, each twin takes its
+    own angles at the shared times (not with scattering or kinetic kicks). Returns as
     `ftle_two_kernel`, ``n_pert`` counting the kicks applied. Scattering kicks
     (``kick_mode == 2``, numbers ``kick_u``, parameters ``sp`` as in
     `kicktimes.billiard.kernels.one.scatter_step`): the reference draws the partner, placed
@@ -339,4 +344,4 @@ def ftle_one_kernel(st0, rho, kicks, angles, kick_mode, mode, n_steps, tau, offs
     `ftle_two_kernel`.
     """
     return _ftle(st0, rho, mode, n_steps, tau, 0, offsets, measure, d0, max_defer, max_events,
-                 None, (kicks, angles, kick_mode, kick_u, sp), kinetic, renorm)
+                 None, (kicks, angles, kick_mode, kick_u, sp, twin_angles), kinetic, renorm)

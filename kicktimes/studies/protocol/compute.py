@@ -1,0 +1,237 @@
+r"""The paper's FTLE by its own protocol: every reading of eq. (4), per IC.
+
+Ranković & Porter (2013, Sec. III C) compute
+
+.. math::
+
+    \lambda_{\max}(n) = \frac{1}{\tau n} \sum_{k=1}^{n}
+    \log\frac{\lVert \delta d(k\tau) \rVert}{\lVert \delta d(0) \rVert},
+    \qquad \lVert \delta d(0) \rVert = 1/5000,
+
+on ``n`` collision-truncated steps of ``tau``, perturbing and measuring x and y of the
+positions separately and keeping the larger exponent. What the text leaves open, each a
+*choice* here (`CHOICES`):
+
+* ``estimator``: ``"renormalised"`` (Benettin's algorithm, which the text names) or
+  ``"literal"`` (eq. (4) as printed: the twin is never renormalised);
+* ``measure``: ``"paper"`` (x and y separately, the max) or ``"norm"`` (one twin, the
+  2-norm of the position deviation);
+* ``twin_kicks`` (kicked systems): ``"shared"`` (the twin gets the run's kick angles) or
+  ``"independent"`` (its own angles at the same times);
+* ``kick_angle`` (kicked systems): ``"uniform"`` new directions (the paper's figures),
+  or its N(0, 1) angles read as the new direction (``"normal"``) or as a rotation
+  (``"gaussian"``).
+
+For every IC of both of the paper's panels (`PANELS`: family A, Fig. 6 top, and family
+B, Fig. 6 bottom) the three systems are computed under the factorial of the first three
+choices at uniform kicks, and under both N(0, 1) readings with the paper's measure and
+shared twins; kicktimes' tangent-space value is the reference row. Beside the FTLE, each
+IC's lag-1 autocorrelation ``R_1`` of the boundary angles over ``[0, n tau]`` (the quantity
+of the paper's Fig. 8; diagnostic ``"r1"``), for the uniform kicks. `CONVERGENCE` runs
+the paper's reading and Benettin's at ``T, 2T, 4T, 8T`` on a stated subset.
+
+The kicks of an IC are drawn once per system and shared by every reading: Poisson times
+at the rate of the IC's own two-disk run (its collision count over the horizon, as
+`kicktimes.experiment` does), the actual times those of that run; uniform angles, and
+one set of N(0, 1) numbers for both N(0, 1) readings (common random numbers across the
+readings, so their differences are paired).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import itertools
+import os
+import time
+import warnings
+
+import numpy as np
+import pandas as pd
+
+from kicktimes.billiard.initial import initial_conditions
+from kicktimes.billiard.one_particle import draw_kick_angles, simulate_one_particle
+from kicktimes.billiard.two_particle import simulate_two_particle
+from kicktimes.diagnostics.autocorrelation import (
+    UndefinedDiagnosticWarning,
+    autocorrelation,
+    boundary_angles,
+)
+from kicktimes.diagnostics.lyapunov import lyapunov
+from kicktimes.experiment.presets import PRESETS
+from kicktimes.fileio import atomic_write
+from kicktimes.schedules import Poisson
+
+__all__ = ["CHOICES", "COLUMNS", "CONVERGENCE", "D0", "Panel", "compute_task", "panels",
+           "run_rows", "tasks"]
+
+#: the paper's initial separation
+D0 = 1.0 / 5000.0
+#: the paper's N(0, 1) kick angles
+SIGMA = 1.0
+#: each choice: (kicktimes' default level, the other levels)
+CHOICES = {
+    "estimator": ("renormalised", ("literal",)),
+    "measure": ("paper", ("norm",)),
+    "twin_kicks": ("shared", ("independent",)),
+    "kick_angle": ("uniform", ("normal", "gaussian")),
+}
+#: the rows a task writes: one FTLE per IC, system and reading
+COLUMNS = ["panel", "radius", "ic", "system", "diagnostic", "estimator", "measure",
+           "twin_kicks", "kick_angle", "horizon", "lam", "n_kicks"]
+#: horizons of the convergence runs, in units of the panel's n_steps
+CONVERGENCE = (1, 2, 4, 8)
+_SYSTEM_ID = {"two_particle": 0, "poisson": 1, "actual": 2}
+
+
+@dataclasses.dataclass(frozen=True)
+class Panel:
+    """One panel of the paper's Fig. 6: its radii, ICs, steps and seed.
+
+    ``convergence_radii`` and ``convergence_ics``: the subset run at ``T, 2T, 4T, 8T``.
+    """
+
+    name: str
+    figure: str
+    radii: tuple
+    n_ics: int
+    n_steps: int
+    tau: float
+    seed: int
+    block: int
+    convergence_radii: tuple
+    convergence_ics: int
+
+    @property
+    def ic_radius(self) -> float:
+        return max(self.radii)
+
+    def initial_conditions(self) -> np.ndarray:
+        """The panel's ICs: the paper's procedure at the largest radius (as its family)."""
+        return initial_conditions(self.n_ics, self.ic_radius, seed=self.seed, method="paper")
+
+
+def panels(scale: str = "paper") -> tuple[Panel, ...]:
+    """The two panels of Fig. 6 at ``scale`` ``"paper"`` (the paper's radii, ICs, ``n`` and
+    ``tau``, the ICs of kicktimes' families A and B) or ``"quick"`` (2 radii, 8 ICs, 1500
+    steps: a pipeline check)."""
+    if scale not in ("paper", "quick"):
+        raise ValueError(f"scale must be 'paper' or 'quick', got {scale!r}")
+    out = []
+    for name, figure in (("family_a", "Fig. 6 top"), ("family_b", "Fig. 6 bottom")):
+        exp = PRESETS[name]
+        radii = tuple(exp.radii)
+        if scale == "paper":
+            conv = (radii[0], radii[len(radii) // 2], radii[-1])
+            out.append(Panel(name, figure, radii, exp.n_ics, exp.n_steps, exp.tau, exp.seed,
+                             25, conv, 100))
+        else:
+            out.append(Panel(name, figure, (radii[0], radii[-1]), 8, 1500, exp.tau, exp.seed,
+                             4, (radii[-1],), 4))
+    return tuple(out)
+
+
+def tasks(panel: Panel) -> list[tuple]:
+    """The tasks of a panel: ``("main", radius, first IC, last IC + 1)`` for every radius
+    and block of ICs, then ``("convergence", radius, 0, convergence_ics)`` blocks."""
+    out = [("main", r, a, min(a + panel.block, panel.n_ics))
+           for r in panel.radii for a in range(0, panel.n_ics, panel.block)]
+    for r in panel.convergence_radii:
+        for a in range(0, panel.convergence_ics, panel.block):
+            out.append(("convergence", r, a, min(a + panel.block, panel.convergence_ics)))
+    return out
+
+
+def _rng(panel: Panel, radius: float, ic: int, system: str, stream: int = 0):
+    return np.random.default_rng([panel.seed, 48, ic, round(radius * 10**6),
+                                  _SYSTEM_ID[system], stream])
+
+
+def _readings(kind: str, kicked: bool):
+    """(estimator, measure, twin_kicks, kick_angle) of the twin readings of a task."""
+    if kind == "convergence":
+        return [(e, "paper", "shared", "uniform") for e in ("renormalised", "literal")]
+    if not kicked:
+        return [(e, m, "shared", "uniform") for e, m in
+                itertools.product(("renormalised", "literal"), ("paper", "norm"))]
+    rows = list(itertools.product(("renormalised", "literal"), ("paper", "norm"),
+                                  ("shared", "independent"), ("uniform",)))
+    rows += [(e, "paper", "shared", a) for e in ("renormalised", "literal")
+             for a in ("normal", "gaussian")]
+    return rows
+
+
+def run_rows(panel: Panel, kind: str, radius: float, ic_index: int, ic: np.ndarray,
+             factor: int = 1) -> list[tuple]:
+    """The FTLE rows (`COLUMNS`) of one IC at one radius: the two-disk run, its Poisson-
+    and actual-time kicked disks, under every reading of ``kind`` (``"main"`` or
+    ``"convergence"``), over ``factor * n_steps`` collision-truncated steps."""
+    n, tau = factor * panel.n_steps, panel.tau
+    steps = {"n_steps": n, "tau": tau, "sampling": "paper"}
+    horizon = n * tau
+    rows = []
+
+    def add(system, reading, lam, n_kicks, diagnostic="ftle"):
+        rows.append((panel.name, radius, ic_index, system, diagnostic, *reading, factor,
+                     float(lam), int(n_kicks)))
+
+    two = simulate_two_particle(ic, radius, t_max=horizon)
+    if kind == "main":
+        add("two_particle", ("-", "-", "-", "-"), _r1(two, 0), two.n_pp, "r1")
+    for reading in _readings(kind, kicked=False):
+        e, m, _, _ = reading
+        res = lyapunov(ic, radius, method="twin", variant=m, d0=D0,
+                       renormalize=e == "renormalised", **steps)
+        add("two_particle", reading, res.lam, res.n_perturbations)
+    if kind == "main":
+        res = lyapunov(ic, radius, method="tangent", variant="paper", **steps)
+        add("two_particle", ("tangent", "paper", "-", "-"), res.lam, res.n_perturbations)
+    for system in ("poisson", "actual"):
+        rng = _rng(panel, radius, ic_index, system)
+        if system == "poisson":
+            times = Poisson(two.n_pp / horizon).sample(horizon, rng)
+        else:
+            times = np.asarray(two.pp_times, dtype=float)
+        angles = {"uniform": draw_kick_angles(times.size, "uniform", SIGMA, rng)}
+        angles["normal"] = angles["gaussian"] = draw_kick_angles(times.size, "normal",
+                                                                 SIGMA, rng)
+        kicked = {"kicks": times, "sigma": SIGMA, **steps}
+        for reading in _readings(kind, kicked=True):
+            e, m, k, a = reading
+            res = lyapunov(ic[0], radius, method="twin", variant=m, d0=D0,
+                           renormalize=e == "renormalised", twin_kicks=k, kick_angle=a,
+                           kick_angles=angles[a], rng=_rng(panel, radius, ic_index, system, 1),
+                           **kicked)
+            add(system, reading, res.lam, res.n_perturbations)
+        if kind == "main":
+            res = lyapunov(ic[0], radius, method="tangent", variant="paper",
+                           kick_angle="uniform", kick_angles=angles["uniform"], **kicked)
+            add(system, ("tangent", "paper", "-", "uniform"), res.lam, res.n_perturbations)
+            one = simulate_one_particle(ic[0], radius, t_max=horizon, kicks=times,
+                                        kick_angles=angles["uniform"], kick_angle="uniform")
+            add(system, ("-", "-", "-", "uniform"), _r1(one, None), one.n_kicks, "r1")
+    return rows
+
+
+def _r1(run, particle) -> float:
+    """The paper's lag-1 autocorrelation ``R_1`` of the boundary angles over ``[0, T]``;
+    NaN (kept in the rows, dropped from the ratios) for a constant series: an unkicked
+    stretch of a one-disk run repeats its angle."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", UndefinedDiagnosticWarning)
+        return float(autocorrelation(boundary_angles(run, particle), 1))
+
+
+def compute_task(panel: Panel, task: tuple, path: str | os.PathLike) -> float:
+    """Compute one task (see `tasks`) and write its rows to the parquet file ``path``
+    (atomically: a reader sees the whole file or none). Returns the seconds it took."""
+    start = time.perf_counter()
+    kind, radius, a, b = task
+    ics = panel.initial_conditions()
+    factors = CONVERGENCE[1:] if kind == "convergence" else (1,)
+    rows = []
+    for i in range(a, b):
+        for f in factors:
+            rows.extend(run_rows(panel, kind, radius, i, ics[i], f))
+    frame = pd.DataFrame(rows, columns=COLUMNS)
+    atomic_write(path, lambda f: frame.to_parquet(f, index=False))
+    return time.perf_counter() - start

@@ -1,0 +1,120 @@
+"""The protocol study (kicktimes.studies.protocol): rows, tables, Shapley shares, the page."""
+
+import itertools
+import re
+
+import numpy as np
+import pandas as pd
+import pytest
+from click.testing import CliRunner
+
+from kicktimes.cli import main
+from kicktimes.diagnostics import lyapunov
+from kicktimes.report.effects import paired_ratio
+from kicktimes.studies.protocol.compute import D0, Panel, compute_task, run_rows, tasks
+from kicktimes.studies.protocol.page import FIGURE, build_page
+from kicktimes.studies.protocol.tables import _shapley
+
+PANELS = (
+    Panel("family_a", "Fig. 6 top", (0.016, 0.024), 4, 400, 0.2, 1, 2, (0.024,), 2),
+    Panel("family_b", "Fig. 6 bottom", (0.016, 0.024), 4, 300, 0.3, 2, 2, (0.024,), 2),
+)
+
+
+@pytest.fixture(scope="module")
+def rows(tmp_path_factory):
+    store = tmp_path_factory.mktemp("protocol-store")
+    frames = []
+    for p in PANELS:
+        for k, task in enumerate(tasks(p)):
+            path = store / f"{p.name}-{k}.parquet"
+            compute_task(p, task, path)
+            frames.append(pd.read_parquet(path))
+    return pd.concat(frames, ignore_index=True)
+
+
+def test_every_reading_of_every_system_is_computed(rows):
+    main_rows = rows[(rows["horizon"] == 1) & (rows["panel"] == "family_a")
+                     & (rows["radius"] == 0.016) & (rows["ic"] == 0)]
+    per_system = main_rows.groupby("system").size().to_dict()
+    # two-disk: 2 estimators x 2 measures, tangent, R_1; kicked: the 2 x 2 x 2 factorial at
+    # uniform kicks, both N(0, 1) readings under both estimators, tangent, R_1
+    assert per_system == {"two_particle": 6, "poisson": 14, "actual": 14}
+    assert set(rows["horizon"]) == {1, 2, 4, 8}
+    conv = rows[rows["horizon"] == 8]
+    assert set(conv["radius"]) == {0.024} and set(conv["ic"]) == {0, 1}
+
+
+def test_the_literal_two_disk_row_is_eq4_of_lyapunov(rows):
+    p = PANELS[0]
+    ic = p.initial_conditions()[1]
+    want = lyapunov(ic, 0.024, method="twin", variant="paper", d0=D0, renormalize=False,
+                    n_steps=p.n_steps, tau=p.tau, sampling="paper").lam
+    got = rows[(rows["panel"] == p.name) & (rows["radius"] == 0.024) & (rows["ic"] == 1)
+               & (rows["system"] == "two_particle") & (rows["estimator"] == "literal")
+               & (rows["measure"] == "paper") & (rows["horizon"] == 1)]["lam"]
+    assert got.tolist() == [want]
+
+
+def test_rows_are_deterministic():
+    p = PANELS[1]
+    ic = p.initial_conditions()[0]
+    pd.testing.assert_frame_equal(pd.DataFrame(run_rows(p, "main", 0.016, 0, ic)),
+                                  pd.DataFrame(run_rows(p, "main", 0.016, 0, ic)))
+
+
+def test_shapley_shares_are_exact_for_an_additive_game_and_efficient():
+    a = (0.5, -1.0, 2.0)
+    additive = {frozenset(s): sum(a[i] for i in s)
+                for k in range(4) for s in itertools.combinations(range(3), k)}
+    np.testing.assert_allclose(_shapley(additive), a)
+    rng = np.random.default_rng(0)
+    game = {s: rng.normal() for s in additive}
+    phi = _shapley(game)
+    assert sum(phi) == pytest.approx(game[frozenset(range(3))] - game[frozenset()])
+
+
+def test_paired_ratio_draws_are_the_resamples_of_its_interval():
+    idx = pd.MultiIndex.from_product([[0.01, 0.02], range(30)], names=["radius", "ic"])
+    y = pd.Series(np.random.default_rng(2).uniform(1, 2, 60), index=idx)
+    x = y * np.random.default_rng(3).uniform(0.8, 1.2, 60)
+    shared = {}
+    _, overall, draws = paired_ratio(x, y, rng=np.random.default_rng(1), n_boot=500,
+                                     resamples=shared, draws=True)
+    assert draws.shape == (500,)
+    assert np.percentile(draws, 2.5) == pytest.approx(overall["ci_low"])
+    # a second ratio under the same resamples: its draws are paired with the first's
+    _, _, again = paired_ratio(x, y, rng=np.random.default_rng(99), n_boot=500,
+                               resamples=shared, draws=True)
+    np.testing.assert_array_equal(draws, again)
+
+
+def test_the_page_states_each_claim_from_its_tables(rows, tmp_path):
+    page = build_page(rows, tmp_path, None, command="kicktimes reproduce --study protocol",
+                      panel_list=PANELS, dpi=40)
+    text = page.read_text()
+    generated = next(line for line in text.splitlines() if line.startswith("Generated "))
+    assert "eq. (4)" in generated and "kicktimes reproduce --study protocol" in generated
+    first_screen = text[:text.index("\n|")]
+    assert len(first_screen) <= 1200
+    header = next(line for line in text.splitlines() if line.startswith("| Claim"))
+    assert header.count("|") - 1 <= 8
+    assert (tmp_path / FIGURE).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    findings = pd.read_csv(tmp_path / "paper_findings.csv")
+    claims = pd.read_csv(tmp_path / "paper_claims.csv")
+    # every verdict is its interval's (the rule of kicktimes.stats.ratio_verdict)
+    for row in findings.itertuples():
+        inside = row.ci_low >= 0.9 and row.ci_high <= 1.1
+        assert (row.verdict == "within 10 %") == inside
+    # the first screen quotes the FTLE claims' range by the paper's protocol
+    ftle = claims[claims["quantity"] == "FTLE ratio kicked / two-disk"]
+    low = f"{ftle['estimate'].min():.3g}"
+    assert re.search(rf"kicked/two-disk {re.escape(low)}", first_screen)
+    for name in ("paper_by_radius.csv", "paper_shapley.csv", "paper_convergence.csv"):
+        assert not pd.read_csv(tmp_path / name).empty
+
+
+def test_findings_belong_to_the_protocol_study(tmp_path):
+    res = CliRunner().invoke(main, ["reproduce", "--study", "paper", "--findings",
+                                    str(tmp_path), "--out", str(tmp_path / "x")])
+    assert res.exit_code == 2 and "--findings applies to --study protocol" in res.output
