@@ -118,3 +118,26 @@ def test_findings_belong_to_the_protocol_study(tmp_path):
     res = CliRunner().invoke(main, ["reproduce", "--study", "paper", "--findings",
                                     str(tmp_path), "--out", str(tmp_path / "x")])
     assert res.exit_code == 2 and "--findings applies to --study protocol" in res.output
+
+
+def test_the_results_first_screen_points_to_paper_md_and_keeps_the_family_tables(tmp_path):
+    import shutil
+    from pathlib import Path
+
+    from kicktimes.report.results import refresh_first_screen
+
+    results = Path(__file__).resolve().parents[1] / "docs" / "results"
+    for name in ("README.md", "family_a_findings.csv", "family_b_findings.csv",
+                 "paper_findings.csv", "paper_claims.csv"):
+        shutil.copy(results / name, tmp_path / name)
+    before = pd.read_csv(tmp_path / "family_a_findings.csv")
+    page = refresh_first_screen(tmp_path)
+    # the protocol study's paper_findings.csv is not a family's table: nothing merged in
+    after = pd.read_csv(tmp_path / "family_a_findings.csv")
+    assert len(after) == len(before) and set(after["control"]) == set(before["control"])
+    text = page.read_text()
+    answers = text[text.index("## The answers"):]
+    claims = pd.read_csv(tmp_path / "paper_claims.csv")
+    ftle = claims[claims["quantity"] == "FTLE ratio kicked / two-disk"]
+    assert "[paper.md](paper.md)" in answers.splitlines()[2]
+    assert f"{ftle['estimate'].min():.3g}–{ftle['estimate'].max():.3g}" in answers

@@ -111,6 +111,35 @@ def copy_first_screen(page, target):
     atomic_write_bytes(target, new.encode("utf-8"))
 
 
+def paper_protocol_sentence(out_dir) -> list[str]:
+    """The first screen's pointer to ``paper.md`` (``kicktimes reproduce --study protocol``),
+    built from its ``paper_claims.csv`` beside the page: the FTLE ratio of the paper's
+    eq. (4) as printed and renormalised, with their verdicts; ``[]`` when absent."""
+    path = Path(out_dir) / "paper_claims.csv"
+    if not path.exists():
+        return []
+    claims = pd.read_csv(path)
+    ftle = claims[claims["quantity"] == "FTLE ratio kicked / two-disk"]
+    if ftle.empty:
+        return []
+
+    def span(col):
+        lo, hi = ftle[col].min(), ftle[col].max()
+        return f"{lo:.3g}–{hi:.3g}"
+
+    def verdicts(col):
+        return " / ".join(dict.fromkeys(ftle[col]))
+
+    literal_agrees = (ftle["verdict"] == "within 10 %").all()
+    renormalised_not = (ftle["other_verdict"] != "within 10 %").all()
+    why = ("the paper's agreement comes from reading eq. (4) without renormalisation"
+           if literal_agrees and renormalised_not else "the reading of eq. (4) matters")
+    return [f"By the paper's own protocol ([paper.md](paper.md)), its eq. (4) read as printed "
+            f"gives a kicked/two-disk FTLE of {span('estimate')} ({verdicts('verdict')}), "
+            f"renormalised {span('other_estimate')} ({verdicts('other_verdict')}): {why}; "
+            "paper.md takes each of its claims in turn.", ""]
+
+
 def refresh_first_screen(out_dir) -> Path:
     """Rewrite the answers and the table of ``out_dir/README.md`` from the findings tables
     beside it (``<family>_findings.csv``, the merged ones that `write_results` wrote),
@@ -122,8 +151,14 @@ def refresh_first_screen(out_dir) -> Path:
 
     out = Path(out_dir)
     page = out / "README.md"
-    tables = [pd.read_csv(p, keep_default_na=False, na_values=[""])
-              for p in sorted(out.glob("*_findings.csv")) if "-" not in p.name]
+    tables = []
+    for p in sorted(out.glob("*_findings.csv")):
+        if "-" in p.name:
+            continue
+        t = pd.read_csv(p, keep_default_na=False, na_values=[""])
+        # a family's own table only (paper_findings.csv, the protocol study's, is not one)
+        if set(t["family"].astype(str)) == {p.name.removesuffix("_findings.csv")}:
+            tables.append(t)
     if not tables:
         raise ValueError(f"{out}: no <family>_findings.csv to build the first screen from")
     from kicktimes.report.controls import with_robustness
@@ -138,7 +173,7 @@ def refresh_first_screen(out_dir) -> Path:
     lines = page.read_text(encoding="utf-8").splitlines()
     start = lines.index("## The answers") + 2
     stop = next(k for k in range(start, len(lines)) if lines[k].startswith("![headline]"))
-    lines[start:stop] = first_screen(table)
+    lines[start:stop] = paper_protocol_sentence(out) + first_screen(table)
     now = _dt.datetime.now(_dt.UTC).isoformat(timespec="seconds")
     k = next(i for i, line in enumerate(lines) if line.startswith("Generated "))
     lines[k] = (lines[k].split(" The first screen was rewritten")[0]
@@ -305,7 +340,7 @@ def write_results(
         if not c.empty:
             c.to_csv(out / f"{c['family'].iloc[0]}_findings_by_radius.csv", index=False)
     table = pd.concat(list(merged.values()), ignore_index=True)
-    screen = ["## The answers", ""] + first_screen(table)
+    screen = ["## The answers", ""] + paper_protocol_sentence(out) + first_screen(table)
     curves = pd.concat(curves, ignore_index=True)
     figure = ratio_curves_figure(curves[curves["family"].isin(list(merged))])
     figure.savefig(out / "headline_ratios_vs_radius.png", dpi=dpi)

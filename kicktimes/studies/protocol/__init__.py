@@ -19,10 +19,12 @@ import os
 from pathlib import Path
 
 from kicktimes.studies.protocol.compute import CHOICES, panels, run_rows
-from kicktimes.studies.protocol.page import build_page
+from kicktimes.studies.protocol.page import build_page, fig6_figure
 from kicktimes.studies.protocol.run import load_rows, run_protocol_study
+from kicktimes.studies.protocol.tables import Ratios, per_radius_table, ratio_table
 
-__all__ = ["CHOICES", "build_page", "load_rows", "panels", "reproduce_protocol", "run_rows",
+__all__ = ["CHOICES", "Ratios", "build_page", "fig6_figure", "load_rows", "panels",
+           "per_radius_table", "ratio_table", "reproduce_protocol", "run_rows",
            "run_protocol_study"]
 
 
