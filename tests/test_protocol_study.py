@@ -16,8 +16,8 @@ from kicktimes.studies.protocol.page import FIGURE, build_page
 from kicktimes.studies.protocol.tables import _shapley
 
 PANELS = (
-    Panel("family_a", "Fig. 6 top", (0.016, 0.024), 4, 400, 0.2, 1, 2, (0.024,), 2),
-    Panel("family_b", "Fig. 6 bottom", (0.016, 0.024), 4, 300, 0.3, 2, 2, (0.024,), 2),
+    Panel("family_a", "Fig. 6 top", (0.012, 0.024), 4, 400, 0.2, 1, 2, (0.024,), 2),
+    Panel("family_b", "Fig. 6 bottom", (0.012, 0.024), 4, 300, 0.3, 2, 2, (0.024,), 2),
 )
 
 
@@ -35,11 +35,12 @@ def rows(tmp_path_factory):
 
 def test_every_reading_of_every_system_is_computed(rows):
     main_rows = rows[(rows["horizon"] == 1) & (rows["panel"] == "family_a")
-                     & (rows["radius"] == 0.016) & (rows["ic"] == 0)]
+                     & (rows["radius"] == 0.012) & (rows["ic"] == 0)]
     per_system = main_rows.groupby("system").size().to_dict()
-    # two-disk: 2 estimators x 2 measures, tangent, R_1; kicked: the 2 x 2 x 2 factorial at
-    # uniform kicks, both N(0, 1) readings under both estimators, tangent, R_1
-    assert per_system == {"two_particle": 6, "poisson": 14, "actual": 14}
+    # two-disk: 2 estimators x 2 measures, tangent, R_1, RR with and without the diagonal;
+    # kicked: the 2 x 2 x 2 factorial at uniform kicks, both N(0, 1) readings under both
+    # estimators, tangent, R_1, the two RR
+    assert per_system == {"two_particle": 8, "poisson": 16, "actual": 16}
     assert set(rows["horizon"]) == {1, 2, 4, 8}
     conv = rows[rows["horizon"] == 8]
     assert set(conv["radius"]) == {0.024} and set(conv["ic"]) == {0, 1}
@@ -56,11 +57,23 @@ def test_the_literal_two_disk_row_is_eq4_of_lyapunov(rows):
     assert got.tolist() == [want]
 
 
+def test_the_papers_rr_is_the_off_diagonal_rr_plus_its_diagonal(rows):
+    rr = rows[rows["diagnostic"] == "rr"].pivot_table(
+        index=["panel", "radius", "ic", "system"], columns="measure", values="lam")
+    n = {p.name: p.n_steps + 1 for p in PANELS}  # samples: the IC and n steps
+    big_n = rr.index.get_level_values("panel").map(n).to_numpy(float)
+    # RR = (N + R) / N^2 with the diagonal, R / (N (N - 1)) without it
+    np.testing.assert_allclose(rr["with_diagonal"],
+                               1 / big_n + rr["off_diagonal"] * (big_n - 1) / big_n,
+                               rtol=1e-12)
+    assert (rr["with_diagonal"] >= 1 / big_n).all()
+
+
 def test_rows_are_deterministic():
     p = PANELS[1]
     ic = p.initial_conditions()[0]
-    pd.testing.assert_frame_equal(pd.DataFrame(run_rows(p, "main", 0.016, 0, ic)),
-                                  pd.DataFrame(run_rows(p, "main", 0.016, 0, ic)))
+    pd.testing.assert_frame_equal(pd.DataFrame(run_rows(p, "main", 0.012, 0, ic)),
+                                  pd.DataFrame(run_rows(p, "main", 0.012, 0, ic)))
 
 
 def test_shapley_shares_are_exact_for_an_additive_game_and_efficient():
@@ -137,7 +150,8 @@ def test_the_results_first_screen_points_to_paper_md_and_keeps_the_family_tables
     assert len(after) == len(before) and set(after["control"]) == set(before["control"])
     text = page.read_text()
     answers = text[text.index("## The answers"):]
-    claims = pd.read_csv(tmp_path / "paper_claims.csv")
-    ftle = claims[claims["quantity"] == "FTLE ratio kicked / two-disk"]
+    findings = pd.read_csv(tmp_path / "paper_findings.csv")
+    literal = findings[(findings["estimator"] == "literal")
+                       & (findings["kick_angle"] == "uniform")]
     assert "[paper.md](paper.md)" in answers.splitlines()[2]
-    assert f"{ftle['estimate'].min():.3g}–{ftle['estimate'].max():.3g}" in answers
+    assert f"{literal['estimate'].min():.3g}–{literal['estimate'].max():.3g}" in answers

@@ -37,21 +37,20 @@ def reproduce_protocol(out: str | os.PathLike, *, scale: str = "paper",
 
     ``results_dir``: the page's folder (default ``out/results-protocol``); ``findings_dir``:
     the paper study's findings tables at the paper's scale (``family_a_findings.csv``,
-    ``family_b_findings.csv`` and their ``_by_radius`` tables, e.g. ``docs/results``),
-    which give the recurrence and count claims; default ``results_dir`` if it holds them,
-    else none (the page then states the FTLE, autocorrelation and angle claims only).
+    ``family_b_findings.csv``, e.g. ``docs/results``), which give the count claims; default
+    ``results_dir`` if it holds them, else none (the page then leaves the counts out).
     """
     out = Path(out)
     store = out / ("store-protocol" if scale == "paper" else f"store-protocol-{scale}")
     results = Path(results_dir) if results_dir is not None else out / "results-protocol"
-    names = [f"{p.name}_findings{s}.csv" for p in panels(scale) for s in ("", "_by_radius")]
+    names = [f"{p.name}_findings.csv" for p in panels(scale)]
     if findings_dir is not None:
         findings = Path(findings_dir)
         missing = [n for n in names if not (findings / n).exists()]
         if missing:
             raise FileNotFoundError(
-                f"findings_dir: {findings / missing[0]} is missing; the recurrence and count "
-                "claims come from the paper study's findings at the paper's scale "
+                f"findings_dir: {findings / missing[0]} is missing; the count claims come "
+                "from the paper study's findings at the paper's scale "
                 "(docs/results holds them)")
     else:
         findings = results if all((results / n).exists() for n in names) else None

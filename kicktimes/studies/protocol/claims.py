@@ -1,10 +1,8 @@
 """The paper's claims, one row each: its words, the reproduction by its protocol, the verdict.
 
-The FTLE and autocorrelation claims come from this study's tables
-(`kicktimes.studies.protocol.tables`); the recurrence and collision-count claims from the
-findings tables of the paper study (``family_*_findings.csv`` and
-``family_*_findings_by_radius.csv`` of ``kicktimes reproduce --study paper``), whose
-``paper_sampling`` control is the paper's own sampling.
+The FTLE, autocorrelation and recurrence claims come from this study's tables
+(`kicktimes.studies.protocol.tables`); the collision-count claims from the findings tables
+of the paper study (``family_*_findings.csv`` of ``kicktimes reproduce --study paper``).
 
 "Decided by" names the choices that change the verdict when switched alone, away from
 the paper's protocol; empty when none does.
@@ -19,15 +17,15 @@ import numpy as np
 import pandas as pd
 
 from kicktimes.stats import format_interval, ratio_verdict, robust_verdict
-from kicktimes.stats.findings import share_verdict
 from kicktimes.studies.protocol.tables import PAPER_READING, reading_label
 
-__all__ = ["claims_table", "SWITCHES"]
+__all__ = ["claims_table", "SMALL_RADIUS", "SWITCHES"]
 
-_RENORMALISED = ("renormalised", "paper", "shared", "uniform")
 #: the paper's "small radii" of Fig. 7 (its bottom panel) are not given; kicktimes takes
 #: r <= 0.014, the lower third of family A's radii
 SMALL_RADIUS = 0.014
+
+_RENORMALISED = ("renormalised", "paper", "shared", "uniform")
 #: the single switches away from the paper's reading, named by what they change
 SWITCHES = (
     ("estimator → renormalised", ("renormalised", "paper", "shared", "uniform")),
@@ -88,6 +86,25 @@ def _r1_claim(r1_tab, panel, system, words, figure):
                 "quantity (R₁ → 1 − R₁)" if paper[3] != other[3] else "")
 
 
+def _rr_claim(rr_tab, panel, system, subset, words):
+    sel = rr_tab[(rr_tab["family"] == panel.name) & (rr_tab["system"] == system)
+                 & (rr_tab["control"] == subset)].set_index("diagnostic")
+    if sel.empty:  # no radius of the panel in this subset
+        return None
+    paper, other = sel.loc["rr_with_diagonal"], sel.loc["rr_offdiag"]
+
+    def get(r):
+        return r["estimate"], r["ci_low"], r["ci_high"], r["verdict"]
+
+    label = "small" if subset == "small_radii" else "larger"
+    return _row(f"RR, {label} radii, {system}", words, "7", panel.name, system,
+                f"RR ratio kicked / two-disk (ε = 0.001), r = {paper['radii']}",
+                "with the main diagonal, the paper's steps", get(paper),
+                "off the diagonal", get(other), False,
+                "quantity (with → without the diagonal)" if paper["verdict"] != other["verdict"]
+                else "")
+
+
 def _findings(findings_dir, name):
     path = Path(findings_dir) / name
     if not path.exists():
@@ -114,56 +131,22 @@ def _family_claim(findings_dir, family, diagnostic, system, control, claim, word
                 f"controls ({len(changes)} of {len(others)})" if changes else "")
 
 
-def _verdict_counts(verdicts) -> str:
-    """``"higher at 3 of 4 radii; inconclusive at 1"``: the per-radius verdicts, counted."""
-    counts = pd.Series(list(verdicts)).value_counts()
-    parts = [f"{v} at {n}" + (f" of {len(verdicts)} radii" if k == 0 else "")
-             for k, (v, n) in enumerate(counts.items())]
-    return "; ".join(parts)
-
-
-def _radius_claim(findings_dir, family, diagnostic, system, radii, claim, words, figure,
-                  quantity):
-    """The per-radius ratios at ``radii`` under the paper's sampling and under uniform-time
-    samples (the paper study's ``primary`` recurrence rows): the lowest and highest ratio
-    (``estimate`` the median) and the per-radius verdicts, counted."""
-    frame = _findings(findings_dir, f"{family}_findings_by_radius.csv")
-    sel = frame[(frame["diagnostic"] == diagnostic) & (frame["system"] == system)
-                & frame["radius"].isin(radii)]
-
-    def summary(control):
-        part = sel[sel["control"] == control].sort_values("radius")
-        verdicts = [ratio_verdict(lo, hi) for lo, hi in zip(part["ci_low"], part["ci_high"],
-                                                            strict=True)]
-        return (part["ratio"].median(), part["ratio"].min(), part["ratio"].max(),
-                _verdict_counts(verdicts), verdicts, part)
-
-    paper, uniform = summary("paper_sampling"), summary("primary")
-    robust = (paper[4] == uniform[4]
-              and not ((paper[5]["ci_low"] > 1).any() and (uniform[5]["ci_high"] < 1).any()))
-    row = _row(f"{claim} (r = {min(radii):g}–{max(radii):g})", words, figure, family, system,
-               quantity, "paper_sampling", paper[:4], "uniform_sampling", uniform[:4],
-               robust, "" if robust else "sampling (paper's steps → uniform)")
-    # a range over radii, not an interval: the per-radius CIs are in the findings table
-    row.update(range_low=paper[1], range_high=paper[2], other_range_low=uniform[1],
-               other_range_high=uniform[2], ci_low=math.nan, ci_high=math.nan,
-               other_ci_low=math.nan, other_ci_high=math.nan, range=True,
-               interval=f"{paper[1]:.3g}–{paper[2]:.3g}",
-               other_interval=f"{uniform[1]:.3g}–{uniform[2]:.3g}")
-    return row
-
-
 def _closer(ratios, panel, reading):
-    """|log R_poisson| - |log R_actual| under ``reading``: point and 95 % CI (negative:
-    the Poisson kicks are closer to the two-disk value)."""
+    """|log R_poisson| - |log R_actual| under ``reading``: point, 95 % CI and verdict
+    (negative: the Poisson kicks are closer to the two-disk value). The verdict applies
+    the 10 % band to ``exp`` of the difference: *equally close* when the two distances
+    from 1 differ by less than a factor 1.1 either way (an equivalence test), *Poisson* /
+    *actual closer* when the CI lies beyond it."""
     _, op, dp = ratios.ratio(panel, "poisson", reading)
     _, oa, da = ratios.ratio(panel, "actual", reading)
     point = abs(math.log(op["ratio"])) - abs(math.log(oa["ratio"]))
     with np.errstate(invalid="ignore", divide="ignore"):
         diff = np.abs(np.log(dp)) - np.abs(np.log(da))
     lo, hi = np.percentile(diff[np.isfinite(diff)], [2.5, 97.5])
-    verdict = {"below": "Poisson closer", "above": "actual closer"}.get(
-        share_verdict(lo, hi, 0.0), "inconclusive")
+    # the ratio of the two distances from 1, exp(difference), through the 10 % band
+    verdict = {"within 10 %": "equally close", "lower": "Poisson closer",
+               "higher": "actual closer"}.get(ratio_verdict(math.exp(lo), math.exp(hi)),
+                                              "inconclusive")
     return point, float(lo), float(hi), verdict
 
 
@@ -177,14 +160,11 @@ def _angle_ratio(ratios, panel, system, angle, estimator):
     return o1["ratio"] / o0["ratio"], float(lo), float(hi), ratio_verdict(lo, hi)
 
 
-def claims_table(ratios, ratio_tab, r1_tab, findings_dir, panels) -> pd.DataFrame:
+def claims_table(ratios, ratio_tab, r1_tab, rr_tab, findings_dir, panels) -> pd.DataFrame:
     """One row per claim of the paper: its words and figure, the reproduction by the
     paper's protocol (estimate, 95 % CI, verdict), the other reading, whether the verdict
-    is robust, and the choices that decide it. Rows over several radii (``range``: the
-    recurrence rate per radius) give the median ratio as ``estimate``, the lowest and
-    highest as ``range_low`` / ``range_high`` (no CI), and the per-radius verdicts counted.
-    ``findings_dir``: the paper study's findings tables at the same scale, or ``None`` (no
-    recurrence and count rows)."""
+    is robust, and the choices that decide it. ``findings_dir``: the paper study's findings
+    tables at the same scale, or ``None`` (no count rows)."""
     a, b = panels[0], panels[1]
     rows = [
         _ftle_claim(ratio_tab, a.name, "poisson", "FTLE, Poisson kicks",
@@ -196,17 +176,13 @@ def claims_table(ratios, ratio_tab, r1_tab, findings_dir, panels) -> pd.DataFram
         _ftle_claim(ratio_tab, b.name, "poisson", "FTLE, Poisson kicks",
                     "also very similar", "6 bottom"),
     ]
-    small = [r for r in a.radii if r <= SMALL_RADIUS]
-    large = [r for r in a.radii if r > SMALL_RADIUS]
-    with_findings = findings_dir is not None
-    for system in ("poisson", "actual") if with_findings else ():
-        rows.append(_radius_claim(findings_dir, a.name, "rr_offdiag@0.001", system, small,
-                                  f"RR, small radii, {system}", "very good agreement", "7",
-                                  "RR ratio kicked / two-disk (ε = 0.001), per radius"))
-    for system in ("poisson", "actual") if with_findings else ():
-        rows.append(_radius_claim(findings_dir, a.name, "rr_offdiag@0.001", system, large,
-                                  f"RR, larger radii, {system}", "two-disk RR balloons", "7",
-                                  "RR ratio kicked / two-disk (ε = 0.001), per radius"))
+    for p in panels:
+        for subset, words in (("small_radii", "very good agreement (small radii)"),
+                              ("larger_radii", "a two-disk balloon (ratio < 1)")):
+            for system in ("poisson", "actual"):
+                row = _rr_claim(rr_tab, p, system, subset, words)
+                if row is not None:
+                    rows.append(row)
     for p, figure, words in ((a, "8 top", "excellent agreement"),
                              (b, "8 bottom", "good agreement")):
         for system in ("poisson", "actual"):
@@ -232,15 +208,14 @@ def claims_table(ratios, ratio_tab, r1_tab, findings_dir, panels) -> pd.DataFram
                 p.name, "poisson", "FTLE ratio R(N(0, 1)) / R(uniform)",
                 f"literal/paper/shared/{angle}", lit, f"renormalised/paper/shared/{angle}", ren,
                 robust, "" if robust else f"estimator → renormalised ({why})"))
-    for p in panels if with_findings else ():
+    for p in panels if findings_dir is not None else ():
         rows.append(_family_claim(
             findings_dir, p.name, "counts", "two_particle", "primary", "Counts vs radius",
             "linear fit reasonably good", "5",
             "counts / kinetic theory Γ(r)T (linear in r)"))
-    for row in rows:
-        if not row.get("range"):
-            row["interval"] = format_interval(row["estimate"], row["ci_low"], row["ci_high"])
-            row["other_interval"] = format_interval(row["other_estimate"],
-                                                    row["other_ci_low"], row["other_ci_high"])
-            row["range"] = False
-    return pd.DataFrame(rows)
+    out = pd.DataFrame(rows)
+    out["interval"] = [format_interval(e, lo, hi) for e, lo, hi in
+                       zip(out["estimate"], out["ci_low"], out["ci_high"], strict=True)]
+    out["other_interval"] = [format_interval(e, lo, hi) for e, lo, hi in zip(
+        out["other_estimate"], out["other_ci_low"], out["other_ci_high"], strict=True)]
+    return out

@@ -27,7 +27,8 @@ B, Fig. 6 bottom) the three systems are computed under the factorial of the firs
 choices at uniform kicks, and under both N(0, 1) readings with the paper's measure and
 shared twins; kicktimes' tangent-space value is the reference row. Beside the FTLE, each
 IC's lag-1 autocorrelation ``R_1`` of the boundary angles over ``[0, n tau]`` (the quantity
-of the paper's Fig. 8; diagnostic ``"r1"``), for the uniform kicks. `CONVERGENCE` runs
+of the paper's Fig. 8; diagnostic ``"r1"``), for the uniform kicks, and the recurrence rate
+of its Fig. 7 with and without the main diagonal (`rr_rows`). `CONVERGENCE` runs
 the paper's reading and Benettin's at ``T, 2T, 4T, 8T`` on a stated subset.
 
 The kicks of an IC are drawn once per system and shared by every reading: Poisson times
@@ -57,12 +58,13 @@ from kicktimes.diagnostics.autocorrelation import (
     boundary_angles,
 )
 from kicktimes.diagnostics.lyapunov import lyapunov
+from kicktimes.diagnostics.recurrence import recurrence_rate
 from kicktimes.experiment.presets import PRESETS
 from kicktimes.fileio import atomic_write
 from kicktimes.schedules import Poisson
 
-__all__ = ["CHOICES", "COLUMNS", "CONVERGENCE", "D0", "Panel", "compute_task", "panels",
-           "run_rows", "tasks"]
+__all__ = ["CHOICES", "COLUMNS", "CONVERGENCE", "D0", "EPS", "Panel", "compute_task",
+           "panels", "rr_rows", "run_rows", "tasks"]
 
 #: the paper's initial separation
 D0 = 1.0 / 5000.0
@@ -78,6 +80,8 @@ CHOICES = {
 #: the rows a task writes: one FTLE per IC, system and reading
 COLUMNS = ["panel", "radius", "ic", "system", "diagnostic", "estimator", "measure",
            "twin_kicks", "kick_angle", "horizon", "lam", "n_kicks"]
+#: the paper's recurrence threshold (Fig. 7)
+EPS = 1e-3
 #: horizons of the convergence runs, in units of the panel's n_steps
 CONVERGENCE = (1, 2, 4, 8)
 _SYSTEM_ID = {"two_particle": 0, "poisson": 1, "actual": 2}
@@ -132,12 +136,16 @@ def panels(scale: str = "paper") -> tuple[Panel, ...]:
 
 def tasks(panel: Panel) -> list[tuple]:
     """The tasks of a panel: ``("main", radius, first IC, last IC + 1)`` for every radius
-    and block of ICs, then ``("convergence", radius, 0, convergence_ics)`` blocks."""
+    and block of ICs, ``("convergence", radius, a, b)`` blocks of the convergence subset,
+    and ``("rr", radius, a, b)`` blocks of the recurrence rows."""
     out = [("main", r, a, min(a + panel.block, panel.n_ics))
            for r in panel.radii for a in range(0, panel.n_ics, panel.block)]
     for r in panel.convergence_radii:
         for a in range(0, panel.convergence_ics, panel.block):
             out.append(("convergence", r, a, min(a + panel.block, panel.convergence_ics)))
+    # the recurrence rate: blocks of four times as many ICs (a cheap task)
+    out += [("rr", r, a, min(a + 4 * panel.block, panel.n_ics))
+            for r in panel.radii for a in range(0, panel.n_ics, 4 * panel.block)]
     return out
 
 
@@ -186,14 +194,7 @@ def run_rows(panel: Panel, kind: str, radius: float, ic_index: int, ic: np.ndarr
         res = lyapunov(ic, radius, method="tangent", variant="paper", **steps)
         add("two_particle", ("tangent", "paper", "-", "-"), res.lam, res.n_perturbations)
     for system in ("poisson", "actual"):
-        rng = _rng(panel, radius, ic_index, system)
-        if system == "poisson":
-            times = Poisson(two.n_pp / horizon).sample(horizon, rng)
-        else:
-            times = np.asarray(two.pp_times, dtype=float)
-        angles = {"uniform": draw_kick_angles(times.size, "uniform", SIGMA, rng)}
-        angles["normal"] = angles["gaussian"] = draw_kick_angles(times.size, "normal",
-                                                                 SIGMA, rng)
+        times, angles = _kicks(panel, radius, ic_index, system, two, horizon)
         kicked = {"kicks": times, "sigma": SIGMA, **steps}
         for reading in _readings(kind, kicked=True):
             e, m, k, a = reading
@@ -209,6 +210,50 @@ def run_rows(panel: Panel, kind: str, radius: float, ic_index: int, ic: np.ndarr
             one = simulate_one_particle(ic[0], radius, t_max=horizon, kicks=times,
                                         kick_angles=angles["uniform"], kick_angle="uniform")
             add(system, ("-", "-", "-", "uniform"), _r1(one, None), one.n_kicks, "r1")
+    return rows
+
+
+def _kicks(panel, radius, ic_index, system, two, horizon):
+    """The kick times of ``system`` (Poisson at the two-disk run's rate, or its collision
+    times) and their angles: ``{"uniform", "normal", "gaussian"}`` (one set of N(0, 1)
+    numbers for both of their readings), drawn from the IC's own stream."""
+    rng = _rng(panel, radius, ic_index, system)
+    if system == "poisson":
+        times = Poisson(two.n_pp / horizon).sample(horizon, rng)
+    else:
+        times = np.asarray(two.pp_times, dtype=float)
+    angles = {"uniform": draw_kick_angles(times.size, "uniform", SIGMA, rng)}
+    angles["normal"] = angles["gaussian"] = draw_kick_angles(times.size, "normal", SIGMA, rng)
+    return times, angles
+
+
+def rr_rows(panel: Panel, radius: float, ic_index: int, ic: np.ndarray) -> list[tuple]:
+    """The recurrence rows (`COLUMNS`, diagnostic ``"rr"``) of one IC at one radius: the
+    paper's RR at ``EPS`` (Sec. III B: all pairs ``i, j`` of the ``n + 1`` samples, the
+    main diagonal included, so ``RR >= 1/(n + 1)``; ``measure="with_diagonal"``) and the
+    off-diagonal RR (pairs ``i != j``; ``measure="off_diagonal"``), on the paper's
+    collision-truncated steps (``estimator="paper_steps"``) of the two-disk run and of
+    its kicked disks with the main task's kicks (uniform angles)."""
+    n, tau = panel.n_steps, panel.tau
+    steps = {"n_steps": n, "tau": tau, "sampling": "paper"}
+    horizon = n * tau
+    rows = []
+
+    def add(system, points, n_kicks):
+        with_diagonal = recurrence_rate(points, EPS)
+        off = recurrence_rate(points, EPS, theiler=1)
+        for measure, value in (("with_diagonal", with_diagonal), ("off_diagonal", off)):
+            rows.append((panel.name, radius, ic_index, system, "rr", "paper_steps", measure,
+                         "-", "uniform", 1, float(value), int(n_kicks)))
+
+    two = simulate_two_particle(ic, radius, t_max=horizon)
+    sampled = simulate_two_particle(ic, radius, **steps)
+    add("two_particle", sampled.samples, sampled.n_pp)
+    for system in ("poisson", "actual"):
+        times, angles = _kicks(panel, radius, ic_index, system, two, horizon)
+        one = simulate_one_particle(ic[0], radius, kicks=times, kick_angles=angles["uniform"],
+                                    kick_angle="uniform", **steps)
+        add(system, one.samples, one.n_kicks)
     return rows
 
 
@@ -230,6 +275,9 @@ def compute_task(panel: Panel, task: tuple, path: str | os.PathLike) -> float:
     factors = CONVERGENCE[1:] if kind == "convergence" else (1,)
     rows = []
     for i in range(a, b):
+        if kind == "rr":
+            rows.extend(rr_rows(panel, radius, i, ics[i]))
+            continue
         for f in factors:
             rows.extend(run_rows(panel, kind, radius, i, ics[i], f))
     frame = pd.DataFrame(rows, columns=COLUMNS)
