@@ -648,18 +648,18 @@ def ftle_answer(table: pd.DataFrame) -> str:
 def first_screen(table: pd.DataFrame, shares=None) -> list[str]:
     """The Markdown lines that open a results page: at most three sentences (the Poisson
     question with the collision rule, the paper's kicked disk, how to read the table),
-    then the table (:func:`overview_table`). ``shares`` is accepted for compatibility and
-    unused: the Poisson numbers come from the table's rows."""
+    then the table (:func:`overview_table`) and the list of its controls. ``shares`` is
+    accepted for compatibility and unused: the Poisson numbers come from the table's rows."""
     controls = [c for c in dict.fromkeys(table["control"]) if c != "primary"]
     sentences = [poisson_answer(table), ftle_answer(table),
-                 "Below, each cell is the kicked/two-disk ratio's range over every control ("
-                 + ", ".join(_CONTROL_WORDS.get(c, c) for c in controls)
-                 + "; the kinetic-rate kicks under the mirror rule only) and both families: ✓ "
-                 "with its verdict when all agree in verdict and direction, else the control "
-                 "that changes it most, with both numbers (↕: the ratio lies above 1 under one "
-                 "control and below 1 under another)."]
+                 "Each cell: the kicked/two-disk ratio's range over every control (listed "
+                 "below the table) and both families; ✓ with its verdict when all agree in "
+                 "verdict and direction, else the control that changes it most, both numbers "
+                 "(↕: above 1 under one control, below 1 under another)."]
     lines = [" ".join(s for s in sentences if s), ""]
     lines += markdown_table(overview_table(table))
+    lines += ["", "Controls: " + ", ".join(_CONTROL_WORDS.get(c, c) for c in controls)
+              + "; the kinetic-rate kicks under the mirror rule only."]
     return lines + [""]
 
 

@@ -137,14 +137,12 @@ def paper_protocol_sentence(out_dir) -> list[str]:
     _, own_text = part("renormalised", "independent")
     only = ((literal["verdict"] == "within 10 %").all()
             and (ftle[ftle["estimator"] == "renormalised"]["verdict"] != "within 10 %").all())
-    why = ("only the reading without renormalisation gives the paper's agreement" if only
+    why = ("the paper's agreement needs the unrenormalised reading" if only
            else "the reading of eq. (4) decides")
-    return [f"By the paper's own protocol ([paper.md](paper.md)), every reading of its eq. "
-            f"(4) as printed gives a kicked/two-disk FTLE of {lit_text}; renormalised, as "
-            f"Benettin's algorithm, {shared_text} with twins sharing the kicks and "
-            f"{own_text} with their own: {why}. The ratios below are kicktimes' tangent-space "
-            "FTLE, twins sharing the kicks; paper.md takes each of the paper's claims in "
-            "turn.", ""]
+    return [f"By the paper's own protocol ([paper.md](paper.md)), its eq. (4) "
+            f"as printed gives a kicked/two-disk FTLE of {lit_text}; renormalised, "
+            f"{shared_text} with shared twin kicks, {own_text} with the twins' own: {why}. "
+            "Below: kicktimes' tangent-space FTLE.", ""]
 
 
 def refresh_first_screen(out_dir) -> Path:

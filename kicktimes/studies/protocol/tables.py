@@ -102,6 +102,7 @@ def ratio_table(ratios: Ratios, panels) -> pd.DataFrame:
                 lo, hi = overall["ci_low"], overall["ci_high"]
                 group.append({
                     "family": p.name, "figure": p.figure, "diagnostic": "ftle",
+                    "question": "FTLE by each reading of eq. (4)",
                     "system": system, "control": reading_label(reading),
                     **dict(zip(_READING, reading, strict=True)),
                     "estimate": overall["ratio"], "ci_low": lo, "ci_high": hi,
@@ -160,6 +161,7 @@ def r1_table(rows: pd.DataFrame, panels) -> pd.DataFrame:
                                           n_boot=N_BOOT, resamples=resamples)
                 lo, hi = overall["ci_low"], overall["ci_high"]
                 out.append({"family": p.name, "figure": p.figure, "diagnostic": diagnostic,
+                            "question": "autocorrelation of the boundary angles",
                             "system": system, "control": "paper_protocol",
                             "estimate": overall["ratio"], "ci_low": lo, "ci_high": hi,
                             "verdict": ratio_verdict(lo, hi), "robust": False,
@@ -201,6 +203,7 @@ def rr_table(rows: pd.DataFrame, panels, small_radius: float) -> pd.DataFrame:
                     per = per_r[per_r["radius"].isin(radii)]
                     out.append({
                         "family": p.name, "figure": p.figure, "diagnostic": diagnostic,
+                        "question": "recurrence rate on the paper's steps",
                         "system": system, "control": name,
                         "radii": f"{min(radii):g}-{max(radii):g}",
                         "estimate": overall["ratio"], "ci_low": lo, "ci_high": hi,
