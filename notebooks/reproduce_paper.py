@@ -300,7 +300,7 @@ for renormalize in (False, True):
 # size and eq. (4) tends to $E[\log(d/d_0)]/\tau$, the same in every system, whatever its
 # stretching. The protocol study computes the three systems under every reading on both
 # panels (`kicktimes reproduce --study protocol`; at the small size, 8 ICs and 1500 steps
-# per panel; the paper's scale takes about 25 minutes on 2 cores and writes
+# per panel; the paper's scale takes about 18 minutes on 2 cores and writes
 # docs/results/paper.md). Left: eq. (4) as printed; right: Benettin.
 
 # %%

@@ -254,7 +254,7 @@ def reproduce_command(study, results, findings, scale, content, out, workers, sc
     --study disks: the disks presets (kicktimes.experiment.DISKS_PRESETS) and the page
     disks.md (docs/results/disks.md is built with --results docs/results). With --study
     protocol: kicktimes.studies.protocol and the page paper.md (docs/results/paper.md is
-    built with --scale paper --results docs/results; about 25 minutes on 2 cores).
+    built with --scale paper --results docs/results; about 18 minutes on 2 cores).
     """
     import os
     import sys
