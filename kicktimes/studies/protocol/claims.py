@@ -113,7 +113,7 @@ def _findings(findings_dir, name):
 
 
 def _family_claim(findings_dir, family, diagnostic, system, control, claim, words, figure,
-                  quantity):
+                  quantity, other=None):
     frame = _findings(findings_dir, f"{family}_findings.csv")
     sel = frame[(frame["diagnostic"] == diagnostic) & (frame["system"] == system)]
     by = sel.set_index("control")
@@ -125,7 +125,7 @@ def _family_claim(findings_dir, family, diagnostic, system, control, claim, word
     paper = get(control)
     others = [c for c in by.index if c != control]
     changes = [c for c in others if by.loc[c, "verdict"] != paper[3]]
-    primary = "primary" if control != "primary" else others[0]
+    primary = other or ("primary" if control != "primary" else others[0])
     return _row(claim, words, figure, family, system, quantity, control, paper, primary,
                 get(primary), bool(by.loc[control, "robust"]),
                 f"controls ({len(changes)} of {len(others)})" if changes else "")
@@ -208,6 +208,12 @@ def claims_table(ratios, ratio_tab, r1_tab, rr_tab, findings_dir, panels) -> pd.
                 p.name, "poisson", "FTLE ratio R(N(0, 1)) / R(uniform)",
                 f"literal/paper/shared/{angle}", lit, f"renormalised/paper/shared/{angle}", ren,
                 robust, "" if robust else f"estimator → renormalised ({why})"))
+    for p in panels if findings_dir is not None else ():
+        rows.append(_family_claim(
+            findings_dir, p.name, "reject@uniformity_ks", "two_particle", "primary",
+            "Poisson collision times", "Poisson-process kick times", "4",
+            "share of runs whose collision times reject uniformity (α = 0.05)",
+            other="elastic"))
     for p in panels if findings_dir is not None else ():
         rows.append(_family_claim(
             findings_dir, p.name, "counts", "two_particle", "primary", "Counts vs radius",
