@@ -39,3 +39,11 @@ def test_every_relative_link_and_image_resolves(page):
     broken = [f"line {n}: {target}" for n, target in relative_links(page)
               if target and not (page.parent / target).exists()]
     assert not broken, f"{page.relative_to(ROOT)}: broken links\n" + "\n".join(broken)
+
+
+def test_every_results_page_is_in_the_sites_toctree():
+    # the documentation site (sphinx -W) refuses a page outside every toctree
+    index = (ROOT / "docs" / "index.md").read_text(encoding="utf-8")
+    pages = sorted(p.stem for p in (ROOT / "docs" / "results").glob("*.md"))
+    missing = [p for p in pages if f"results/{p}\n" not in index]
+    assert not missing, f"docs/index.md's toctree lacks {missing}"
