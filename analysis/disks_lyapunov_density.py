@@ -90,8 +90,8 @@ def _fit(x, y):
 def summarise(runs: pd.DataFrame, *, n_boot=2000, seed=0, fit_max_packing=FIT_MAX_PACKING):
     """The per-packing table and the per-N fit table (see the module docstring), the fit
     over the packings up to ``fit_max_packing``."""
-    from kicktimes.report.disks_kicked import density_form_reading
     from kicktimes.stats import ratio_verdict
+    from kicktimes.studies.disks.kicked import density_form_reading
 
     rng = np.random.default_rng(seed)
     rows, fits = [], []

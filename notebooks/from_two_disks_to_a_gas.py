@@ -49,9 +49,14 @@ import pandas as pd
 from IPython.display import display
 
 from kicktimes.experiment import DISKS_PRESETS, DisksExperiment, run_experiment
-from kicktimes.report.disks import disks_hazard, disks_table
-from kicktimes.report.disks_figures import hazard_figure, rates_figure, rejection_figure
 from kicktimes.stats import format_interval
+from kicktimes.studies.disks import (
+    disks_hazard,
+    disks_table,
+    hazard_figure,
+    rates_figure,
+    rejection_figure,
+)
 
 # %matplotlib inline
 SIZE = os.environ.get("KICKTIMES_NOTEBOOK_SIZE", "small")

@@ -19,8 +19,8 @@ from kicktimes.experiment import (
     disks_control,
     run_experiment,
 )
-from kicktimes.report.disks_controls import controls_findings, controls_lines, robust_text
 from kicktimes.stats import share_ratio_sample_size
+from kicktimes.studies.disks.controls import controls_findings, controls_lines, robust_text
 
 TINY = DisksExperiment(name="tiny-gas", n_disks=[2, 5], packing=0.1, n_tagged=6, min_runs=3,
                        collisions=5, block_sequences=2, seed=3)
@@ -161,7 +161,7 @@ def tiny(tmp_path_factory):
 
 def test_the_bulk_control_keeps_the_tagged_disks_that_start_near_the_centre(tiny):
     from kicktimes.experiment.disks_tasks import tagged_start_radii
-    from kicktimes.report.disks import bulk_rows, disks_table
+    from kicktimes.studies.disks.tables import bulk_rows, disks_table
 
     keep = bulk_rows(tiny, 0.5)
     col = tiny.collisions
@@ -178,7 +178,7 @@ def test_the_bulk_control_keeps_the_tagged_disks_that_start_near_the_centre(tiny
 def test_renewal_models_rank_gamma_intervals_gamma_and_check_the_halves():
     from types import SimpleNamespace
 
-    from kicktimes.report.disks_renewal import renewal_lines, renewal_models
+    from kicktimes.studies.disks.renewal import renewal_lines, renewal_models
 
     rng = np.random.default_rng(2)
     exp = DisksExperiment(name="x", n_disks=[10], packing=0.1, collisions=20)
@@ -193,8 +193,8 @@ def test_renewal_models_rank_gamma_intervals_gamma_and_check_the_halves():
 
 
 def test_the_scatter_kicked_system_is_compared_with_the_gas(tmp_path):
-    from kicktimes.report.disks import kicked_table
-    from kicktimes.report.disks_kicked import kicked_ftle_cells, kicked_section
+    from kicktimes.studies.disks.kicked import kicked_ftle_cells, kicked_section
+    from kicktimes.studies.disks.tables import kicked_table
 
     exp = dataclasses.replace(TINY, name="tiny-scatter", kicked_runs=3, kicked_time=20.0,
                               kicked_systems=("poisson", "actual", "scatter"))
@@ -213,7 +213,7 @@ def test_the_scatter_kicked_system_is_compared_with_the_gas(tmp_path):
 
 
 def test_the_ftle_check_section_is_rendered_from_its_table_or_skipped(tmp_path):
-    from kicktimes.report.disks_kicked import ftle_check_lines
+    from kicktimes.studies.disks.kicked import ftle_check_lines
 
     path = tmp_path / "disks_ftle_check.csv"
     lines = ftle_check_lines(path)
@@ -243,7 +243,7 @@ def test_the_ftle_check_section_is_rendered_from_its_table_or_skipped(tmp_path):
 
 
 def test_the_page_gives_every_finding_under_its_controls(tiny, tmp_path):
-    from kicktimes.report.disks_page import write_disks_page
+    from kicktimes.studies.disks.page import write_disks_page
 
     control = run_quiet(dataclasses.replace(TINY, name="tiny-gas-seed", seed=4),
                         tmp_path / "seed")
@@ -266,7 +266,7 @@ def test_the_page_gives_every_finding_under_its_controls(tiny, tmp_path):
 
 
 def test_the_bulk_control_refuses_a_store_whose_seeds_now_tag_other_disks(tiny):
-    from kicktimes.report.disks import bulk_rows
+    from kicktimes.studies.disks.tables import bulk_rows
 
     other = dataclasses.replace(tiny, collisions=tiny.collisions.assign(
         disk=tiny.collisions["disk"] + 1000))
@@ -310,7 +310,7 @@ def test_the_density_fit_finds_a_line_and_a_curve_on_data_with_known_answers():
 
 
 def test_the_density_section_is_rendered_from_its_tables_or_skipped(tmp_path):
-    from kicktimes.report.disks_kicked import density_lines
+    from kicktimes.studies.disks.kicked import density_lines
 
     script = _density_script()
     a, b = tmp_path / "disks_lyapunov_density.csv", tmp_path / "disks_lyapunov_density_fit.csv"

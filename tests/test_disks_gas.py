@@ -18,7 +18,7 @@ import kicktimes as kt
 from kicktimes.experiment import DISKS_PRESETS, DisksExperiment, load_store, run_experiment
 from kicktimes.experiment.disks_tasks import interval_speeds, run_disks
 from kicktimes.experiment.store import Store
-from kicktimes.report.disks import disks_hazard, disks_table, rescale_by_speed
+from kicktimes.studies.disks.tables import disks_hazard, disks_table, rescale_by_speed
 
 TINY = DisksExperiment(name="tiny-gas", n_disks=[2, 5], packing=0.1, n_tagged=6, min_runs=3,
                        collisions=5, block_sequences=2, seed=3)
@@ -220,7 +220,7 @@ def test_the_presets_cover_the_issue_sweep():
 
 
 def test_the_page_is_written_from_its_tables_and_names_stores_not_paths(reference, tmp_path):
-    from kicktimes.report.disks_page import write_disks_page
+    from kicktimes.studies.disks.page import write_disks_page
 
     page = write_disks_page([reference.path], tmp_path / "results", n_boot=199, n_mc=49,
                             dpi=40)
@@ -253,7 +253,7 @@ def test_the_twin_ftle_of_two_disks_is_the_two_disk_tangent_ftle_on_average():
 
 
 def test_the_kicked_comparison_gives_ratios_with_verdicts(tmp_path):
-    from kicktimes.report.disks import kicked_table
+    from kicktimes.studies.disks.tables import kicked_table
 
     exp = dataclasses.replace(TINY, name="tiny-kicked", kicked_runs=3, kicked_time=20.0)
     store = run_quiet(exp, tmp_path / "k", workers=1)
@@ -274,7 +274,7 @@ def test_the_kicked_comparison_gives_ratios_with_verdicts(tmp_path):
 
 def test_the_n2_row_is_checked_against_the_two_disk_simulator(reference, tmp_path):
     from kicktimes.experiment import Experiment
-    from kicktimes.report.disks import two_disk_check
+    from kicktimes.studies.disks.tables import two_disk_check
 
     r = TINY.radius(2)
     two = run_quiet(Experiment(name="tiny-two", radii=[r], n_ics=12, n_steps=200, tau=0.5,
@@ -299,7 +299,7 @@ def _row(**kw):
     (-0.2, 0.1, "no share detected"), (0.6, 1.2, "consistent with all"),
     (-0.7, -0.04, "negative"), (-5.0, 8.0, "undetermined"), (0.2, 0.4, "part of it")])
 def test_each_speed_share_is_given_its_reading(low, high, reading):
-    from kicktimes.report.disks_page import _share
+    from kicktimes.studies.disks.page import _share
 
     text = _share(_row(speed_share=(low + high) / 2, speed_share_low=low,
                        speed_share_high=high))
@@ -307,7 +307,7 @@ def test_each_speed_share_is_given_its_reading(low, high, reading):
 
 
 def test_no_kicked_ftle_ratio_where_the_kicked_disk_is_not_chaotic_or_the_gas_near_zero():
-    from kicktimes.report.disks_kicked import _kicked_cell
+    from kicktimes.studies.disks.kicked import _kicked_cell
 
     base = dict(reference=1.0, reference_low=0.9, reference_high=1.1, ratio=-0.01,
                 ratio_low=-0.02, ratio_high=-0.005, verdict="lower", value=-0.01,
@@ -322,7 +322,7 @@ def test_no_kicked_ftle_ratio_where_the_kicked_disk_is_not_chaotic_or_the_gas_ne
 
 
 def test_the_poisson_answer_uses_d_and_the_hazard_not_only_the_share():
-    from kicktimes.report.disks_page import _answers
+    from kicktimes.studies.disks.page import _answers
 
     def rows(d_low, p):
         out = []
@@ -345,7 +345,7 @@ def test_the_poisson_answer_uses_d_and_the_hazard_not_only_the_share():
 
 
 def test_the_hazard_bootstrap_over_runs_reproduces_the_pooled_hazard_with_unit_weights(reference):
-    from kicktimes.report.disks import HAZARD_EDGES, _hazard_replicates, _Sequences
+    from kicktimes.studies.disks.tables import HAZARD_EDGES, _hazard_replicates, _Sequences
 
     col = reference.collisions[reference.collisions["n_disks"] == 5]
     seqs = _Sequences(col, TINY.collisions, 1e9, rescale=False)

@@ -155,3 +155,13 @@ def test_the_results_first_screen_points_to_paper_md_and_keeps_the_family_tables
                        & (findings["kick_angle"] == "uniform")]
     assert "[paper.md](paper.md)" in answers.splitlines()[2]
     assert f"{literal['estimate'].min():.3g}–{literal['estimate'].max():.3g}" in answers
+
+
+def test_every_registered_study_is_a_choice_of_reproduce_with_its_line():
+    from kicktimes.studies import STUDIES
+
+    res = CliRunner().invoke(main, ["reproduce", "--help"], terminal_width=400)
+    assert res.exit_code == 0
+    for study in STUDIES.values():
+        assert f"{study.name}: {study.summary}" in " ".join(res.output.split())
+    assert f"[{'|'.join(STUDIES)}]" in res.output

@@ -5,6 +5,7 @@ from __future__ import annotations
 import click
 
 from kicktimes.cli._group import _cli_errors, _compile_first, option
+from kicktimes.studies import STUDIES
 
 
 # --- experiment commands ---
@@ -210,21 +211,17 @@ def report_command(stores, out, workers, progress, pdf, force):
 
 
 @click.command("reproduce")
-@click.option("--study", type=click.Choice(["paper", "protocol", "disks"]), default="paper",
-              show_default=True,
-              help="paper: the paper's two families and their report; protocol: the paper's "
-              "claims by its own protocol (every reading of its eq. (4) on both panels of "
-              "Fig. 6), the page paper.md (into --results, default OUT/results-protocol); "
-              "disks: the tagged disk among N = 2..1000 disks, its stores and the page "
-              "disks.md (into --results, default OUT/results-disks).")
+@click.option("--study", type=click.Choice(list(STUDIES)), default="paper", show_default=True,
+              help="; ".join(f"{s.name}: {s.summary} (page {s.page})"
+                             for s in STUDIES.values()) + ".")
 @click.option("--results", "results", type=click.Path(file_okay=False), default=None,
               help="--study protocol / disks: folder of the page (default "
               "OUT/results-protocol, OUT/results-disks).")
 @click.option("--findings", "findings", type=click.Path(file_okay=False, exists=True),
               default=None,
               help="--study protocol: folder of the paper study's paper-scale findings "
-              "tables (family_a_findings.csv, ...; e.g. docs/results), for the recurrence "
-              "and count claims (default: --results, if it holds them).")
+              "tables (family_a_findings.csv, family_b_findings.csv; e.g. docs/results), for "
+              "the count claims (default: --results, if it holds them).")
 @option("--scale", type=click.Choice(["quick", "paper"]), default="quick",
         help="quick: small versions of both families; paper: the paper's full scale.")
 @click.option(
@@ -279,7 +276,7 @@ def reproduce_command(study, results, findings, scale, content, out, workers, sc
         return
 
     if study == "disks":
-        from kicktimes.report.disks_page import reproduce_disks
+        from kicktimes.studies.disks import reproduce_disks
 
         if workers is not None and scheduler is not None:
             raise click.UsageError("--workers sizes the local pool; it cannot go with "

@@ -391,7 +391,7 @@ def write_results(
         "unequal disks: [unequal.md](unequal.md); scatter kicks: [scatter.md](scatter.md); "
         "MMPP fits to the collision times: [mmpp.md](mmpp.md); all written by "
         "`python analysis/make_science.py`. From two disks to a gas (N = 2 to 1000 disks): "
-        "[disks.md](disks.md), written by `python analysis/make_disks.py`. Below: per "
+        "[disks.md](disks.md), written by `kicktimes reproduce --study disks`. Below: per "
         "family, the scale, every statement under the primary setting, and the figures.", ""]
     lines[head:head] = screen
     path = out / "README.md"

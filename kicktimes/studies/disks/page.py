@@ -2,13 +2,13 @@
 
 `write_disks_page` reads the stores of the `kicktimes.experiment.DISKS_PRESETS` sweeps,
 their controls (`DISKS_CONTROLS`) and the two-disk references, computes their tables
-(`kicktimes.report.disks`; the findings under their controls,
-`kicktimes.report.disks_controls`; the renewal models, `kicktimes.report.disks_renewal`;
-the kicked comparison's sections, `kicktimes.report.disks_kicked`), writes them as CSV
-beside the page, draws the figures (`kicktimes.report.disks_figures`) and writes the page:
+(`kicktimes.studies.disks.tables`; the findings under their controls,
+`kicktimes.studies.disks.controls`; the renewal models, `kicktimes.studies.disks.renewal`;
+the kicked comparison's sections, `kicktimes.studies.disks.kicked`), writes them as CSV
+beside the page, draws the figures (`kicktimes.studies.disks.figures`) and writes the page:
 the answers first, each from the table through the verdict rules of `kicktimes.stats`,
 then one table per geometry with a row per N. `reproduce_disks` runs (or resumes) the
-sweeps first: ``kicktimes reproduce --study disks`` and ``analysis/make_disks.py``.
+sweeps first: ``kicktimes reproduce --study disks``.
 """
 
 from __future__ import annotations
@@ -22,8 +22,9 @@ import numpy as np
 import pandas as pd
 
 from kicktimes import __version__
-from kicktimes.report.disks import disks_hazard, disks_table, kicked_table, two_disk_check
-from kicktimes.report.disks_controls import (
+from kicktimes.stats import format_interval, ratio_rule, rejection_rule
+from kicktimes.stats.findings import share_verdict
+from kicktimes.studies.disks.controls import (
     BULK_WITHIN,
     CONTROL_NAMES,
     FINDINGS,
@@ -31,7 +32,7 @@ from kicktimes.report.disks_controls import (
     controls_lines,
     robust_text,
 )
-from kicktimes.report.disks_figures import (
+from kicktimes.studies.disks.figures import (
     ALPHA,
     HEADLINE,
     SHOWN_N,
@@ -43,7 +44,7 @@ from kicktimes.report.disks_figures import (
     rates_figure,
     rejection_figure,
 )
-from kicktimes.report.disks_kicked import (
+from kicktimes.studies.disks.kicked import (
     density_lines,
     ftle_check_lines,
     kicked_answer,
@@ -52,9 +53,8 @@ from kicktimes.report.disks_kicked import (
     kicked_section,
     scatter_answer,
 )
-from kicktimes.report.disks_renewal import renewal_lines, renewal_models
-from kicktimes.stats import format_interval, ratio_rule, rejection_rule
-from kicktimes.stats.findings import share_verdict
+from kicktimes.studies.disks.renewal import renewal_lines, renewal_models
+from kicktimes.studies.disks.tables import disks_hazard, disks_table, kicked_table, two_disk_check
 
 __all__ = ["reproduce_disks", "write_disks_page"]
 
@@ -479,7 +479,7 @@ def _left_out(table, long, kicked_stores, k, ftle_checked):
     return out
 
 
-def write_disks_page(store_paths, out_dir, *, command="python analysis/make_disks.py",
+def write_disks_page(store_paths, out_dir, *, command="kicktimes reproduce --study disks",
                      dpi=110, n_boot=999, n_mc=199, cost=None) -> Path:
     """Write ``disks.md``, its CSV tables and figures into ``out_dir``.
 
@@ -493,7 +493,7 @@ def write_disks_page(store_paths, out_dir, *, command="python analysis/make_disk
         The command the "Generated" line names.
     dpi, n_boot, n_mc : int
         PNG resolution; bootstrap replicates and Monte Carlo samples
-        (`kicktimes.report.disks.disks_table`).
+        (`kicktimes.studies.disks.tables.disks_table`).
     cost : pandas.DataFrame, optional
         The sweeps' cost (``experiment``, ``cpu_seconds``), written beside the page.
 

@@ -5,7 +5,7 @@
 ``claims_lint`` reads, ``family, diagnostic, system, control, estimate, ci_low, ci_high,
 verdict, robust``, and its verdicts are of three kinds.)
 
-Every finding of a row (geometry x rule x N) of `kicktimes.report.disks.disks_table` is
+Every finding of a row (geometry x rule x N) of `kicktimes.studies.disks.tables.disks_table` is
 computed under the primary design and under each control:
 
 * ``seed``: an independent replicate, the same sweep from another root seed (the store
@@ -14,7 +14,7 @@ computed under the primary design and under each control:
   ``<sweep>-k60``, another seed too): the tests' power grows with K, so this control can
   turn "nominal" into "above nominal";
 * ``bulk``: the primary store's tagged disks that start in the bulk, their centre within
-  `BULK_WITHIN` of the table's centre (`kicktimes.report.disks.disks_table`'s ``within``):
+  `BULK_WITHIN` of the table's centre (`kicktimes.studies.disks.tables.disks_table`'s ``within``):
   the wall changes a disk's surroundings, so a wall effect would show as a difference.
   The collision rate is a quantity of all disks of a run, so ``bulk`` is not a control of
   rate / Enskog.

@@ -1,11 +1,11 @@
 """docs/results/disks.md: the kicked single disk against the gas, and the gas's FTLE checks.
 
-The page's sections on the paper's question for a gas (`kicktimes.report.disks.kicked_table`:
-one disk of the gas against one disk kicked with uniform new directions at Poisson times of
-its rate or at its collision times, or scattered off virtual partners from the collision
-kernel at Poisson times) and on the checks of the gas's FTLE
-(``disks_ftle_check.csv``, written beside the page by `kicktimes.diagnostics.gas_lyapunov`'s
-checks, rendered when it exists).
+The page's sections on the paper's question for a gas
+(`kicktimes.studies.disks.tables.kicked_table`: one disk of the gas against one disk
+kicked with uniform new directions at Poisson times of its rate or at its collision times,
+or scattered off virtual partners from the collision kernel at Poisson times) and on the
+checks of the gas's FTLE (``disks_ftle_check.csv``, written beside the page by
+`kicktimes.diagnostics.gas_lyapunov`'s checks, rendered when it exists).
 """
 
 from __future__ import annotations

@@ -3,9 +3,9 @@
 `rejection_figure` (the Poisson battery's rejection shares against N), `hazard_figure` (the
 hazard of the next collision against the time since the last, per N) and `rates_figure`
 (collision frequency over Enskog's, index of dispersion and the hazard's first bin
-against N), from `kicktimes.report.disks.disks_table` and `disks_hazard`; `controls_figure`
+against N), from `kicktimes.studies.disks.tables.disks_table` and `disks_hazard`; `controls_figure`
 (the findings under their controls against N, from
-`kicktimes.report.disks_controls.controls_findings`).
+`kicktimes.studies.disks.controls.controls_findings`).
 """
 
 from __future__ import annotations
@@ -13,8 +13,8 @@ from __future__ import annotations
 import numpy as np
 from matplotlib.ticker import FuncFormatter
 
-from kicktimes.report.disks import HAZARD_EDGES
 from kicktimes.report.figures import plain_log_ticks
+from kicktimes.studies.disks.tables import HAZARD_EDGES
 
 __all__ = ["controls_figure", "geometries_of", "hazard_figure", "rates_figure",
            "rejection_figure"]
@@ -222,7 +222,7 @@ def controls_figure(long, *, n_min=10, names=None):
     rule, one column per finding of `CONTROL_PANELS`, the controls dodged sideways with
     their own colours and markers, 95 % CIs, the finding's band shaded (±10 % for the
     ratios, the nominal band for the share), one y scale per column, a hollow marker where
-    the finding is not robust (`kicktimes.report.disks_controls.controls_findings`, its
+    the finding is not robust (`kicktimes.studies.disks.controls.controls_findings`, its
     ``robust``)."""
     import matplotlib.pyplot as plt
 

@@ -1,0 +1,36 @@
+"""From two disks to a gas (``kicktimes reproduce --study disks``).
+
+The tagged disk's collision times among N equal hard disks in the circular table, from
+N = 2 to 1000 (`kicktimes.experiment.DISKS_PRESETS`, their controls and the two-disk
+references): `tables` (the per-N tables: Poisson battery, dispersion, hazard, Enskog's
+rate, the kicked comparison), `controls` (every finding under the controls), `renewal`
+(renewal models by AIC), `kicked` (the kicked comparison's sections), `figures` and
+`page` (``disks.md``).
+
+Examples
+--------
+>>> from kicktimes.studies.disks import disks_table, reproduce_disks
+>>> callable(disks_table) and callable(reproduce_disks)
+True
+"""
+
+from __future__ import annotations
+
+from kicktimes.studies.disks.figures import (
+    controls_figure,
+    hazard_figure,
+    rates_figure,
+    rejection_figure,
+)
+from kicktimes.studies.disks.page import reproduce_disks, write_disks_page
+from kicktimes.studies.disks.tables import (
+    disks_hazard,
+    disks_table,
+    kicked_table,
+    rescale_by_speed,
+    two_disk_check,
+)
+
+__all__ = ["controls_figure", "disks_hazard", "disks_table", "hazard_figure", "kicked_table",
+           "rates_figure", "rejection_figure", "rescale_by_speed", "reproduce_disks",
+           "two_disk_check", "write_disks_page"]
