@@ -19,7 +19,7 @@ import time
 
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("stores", nargs="+", help="result stores (e.g. family_a, family_b)")
+    parser.add_argument("stores", nargs="*", help="result stores (e.g. family_a, family_b)")
     parser.add_argument("--out", default="docs/results", help="output folder (docs/results)")
     parser.add_argument("--dpi", type=int, default=110, help="PNG resolution (110)")
     parser.add_argument("--workers", type=int, default=1, help="processes for the tests (1)")
@@ -37,6 +37,8 @@ def main(argv=None):
         help="only rewrite the first screen of OUT/README.md from the findings tables beside "
         "it (no store is read; the stores argument is ignored)")
     args = parser.parse_args(argv)
+    if not args.stores and not args.screen_only:
+        parser.error("give the result stores, or --screen-only")
     from kicktimes.report import write_results
 
     if args.screen_only:
@@ -53,6 +55,7 @@ def main(argv=None):
         path = write_results(
             args.stores,
             args.out,
+            command="python analysis/make_results.py",
             dpi=args.dpi,
             workers=args.workers,
             n_mc=args.n_mc,

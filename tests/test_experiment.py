@@ -169,10 +169,11 @@ def test_reproduce_content_paper_writes_its_own_stores_and_report(tmp_path, monk
             name,
             dataclasses.replace(presets.PRESETS[name], radii=[0.02], n_ics=2, n_steps=120),
         )
+    results = tmp_path / "results"
     result = CliRunner().invoke(
         main,
         ["reproduce", "--content", "paper", "--out", str(tmp_path), "--workers", "1",
-         "--no-progress"],
+         "--no-progress", "--results", str(results)],
     )
     assert result.exit_code == 0, result.output
     for name in ("quick_a", "quick_b"):
@@ -183,6 +184,11 @@ def test_reproduce_content_paper_writes_its_own_stores_and_report(tmp_path, monk
     assert not (tmp_path / "report").exists()
     assert not (tmp_path / "store-quick_a").exists()
     assert f"report written to {tmp_path / 'report-paper'}" in result.output
+    # --results: the study's page, its Generated line naming the command
+    page = (results / "README.md").read_text(encoding="utf-8")
+    generated = next(line for line in page.splitlines() if line.startswith("Generated "))
+    assert f"`kicktimes reproduce --study paper --scale quick --results {results}`" in generated
+    assert (results / "quick_a_findings.csv").is_file()
 
 
 @pytest.mark.parametrize(

@@ -215,8 +215,9 @@ def report_command(stores, out, workers, progress, pdf, force):
               help="; ".join(f"{s.name}: {s.summary} (page {s.page})"
                              for s in STUDIES.values()) + ".")
 @click.option("--results", "results", type=click.Path(file_okay=False), default=None,
-              help="--study protocol / disks: folder of the page (default "
-              "OUT/results-protocol, OUT/results-disks).")
+              help="Folder of the study's page: --study paper writes README.md there from its "
+              "stores (none by default), protocol paper.md (default OUT/results-protocol), "
+              "disks disks.md (default OUT/results-disks).")
 @click.option("--findings", "findings", type=click.Path(file_okay=False, exists=True),
               default=None,
               help="--study protocol: folder of the paper study's paper-scale findings "
@@ -328,4 +329,13 @@ def reproduce_command(study, results, findings, scale, content, out, workers, sc
         report_dir = os.path.join(out, f"report{suffix}")
         job = (stores, report_dir, workers, progress, pdf)
         report = report_process.build(*job) if report_process else _build_report(*job)
+        if results is not None:
+            # the study's page: docs/results/README.md from the same stores
+            from kicktimes.report import write_results
+
+            page = write_results(stores, results, workers=workers or os.cpu_count() or 1,
+                                 command=f"kicktimes reproduce --study paper --scale {scale} "
+                                 f"--results {results}")
     click.echo(f"report written to {report if report is not None else report_dir}")
+    if results is not None:
+        click.echo(f"page written to {page}")

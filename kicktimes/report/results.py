@@ -193,7 +193,8 @@ def _short(family):
 
 
 def write_results(
-    store_paths, out_dir, *, dpi=110, workers=1, n_mc=199, n_boot=2000, max_ics_model_fits=12
+    store_paths, out_dir, *, dpi=110, workers=1, n_mc=199, n_boot=2000, max_ics_model_fits=12,
+    command="kicktimes reproduce --study paper --scale paper --results docs/results",
 ) -> Path:
     r"""Write every report figure as PNG and a findings page ``README.md`` into ``out_dir``.
 
@@ -207,6 +208,8 @@ def write_results(
         Resolution of the PNG files.
     workers, n_mc, n_boot, max_ics_model_fits : int
         As in :func:`kicktimes.report.build_report`.
+    command : str
+        The command the page's "Generated" line names.
 
     Returns
     -------
@@ -245,8 +248,7 @@ def write_results(
         "# What the reproduction shows (generated)",
         "",
         f"Generated {_dt.datetime.now(_dt.UTC).isoformat(timespec='seconds')} by "
-        f"kicktimes {__version__} (`kicktimes.report.write_results`, "
-        "`python analysis/make_results.py`) from the stores "
+        f"kicktimes {__version__} (`{command}`) from the stores "
         + ", ".join(f"`{st.experiment.name}`" for st in stores)
         + ". Every number below is computed from the stores; nothing is typed.",
         "",

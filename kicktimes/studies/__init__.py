@@ -38,9 +38,8 @@ STUDIES = {
     s.name: s
     for s in (
         Study("paper", "README.md",
-              "the paper's two families and their controls, and the sweep report "
-              "(docs/results/README.md is written from its stores by "
-              "analysis/make_results.py)"),
+              "the paper's two families and their controls, the sweep report, and with "
+              "--results the page README.md"),
         Study("protocol", "paper.md",
               "the paper's claims by its own protocol: every reading of its eq. (4) on both "
               "panels of Fig. 6, its RR and R_1, claim by claim"),
