@@ -154,7 +154,7 @@ def test_the_results_first_screen_points_to_paper_md_and_keeps_the_family_tables
     literal = findings[(findings["estimator"] == "literal")
                        & (findings["kick_angle"] == "uniform")]
     assert "[paper.md](paper.md)" in answers.splitlines()[2]
-    assert f"{literal['estimate'].min():.3g}–{literal['estimate'].max():.3g}" in answers
+    assert f"{literal['estimate'].min():.3f}–{literal['estimate'].max():.3f}" in answers
 
 
 def test_every_registered_study_is_a_choice_of_reproduce_with_its_line():

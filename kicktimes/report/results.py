@@ -130,7 +130,7 @@ def paper_protocol_sentence(out_dir) -> list[str]:
         if twin_kicks is not None:
             sel = sel[sel["twin_kicks"] == twin_kicks]
         verdicts = " / ".join(dict.fromkeys(sel["verdict"]))
-        return sel, f"{sel['estimate'].min():.3g}–{sel['estimate'].max():.3g} ({verdicts})"
+        return sel, f"{sel['estimate'].min():.3f}–{sel['estimate'].max():.3f} ({verdicts})"
 
     literal, lit_text = part("literal")
     renormalised, shared_text = part("renormalised", "shared")
