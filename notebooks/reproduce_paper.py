@@ -20,8 +20,8 @@
 # two-disk billiard ("Two-particle"), a one-disk billiard kicked at Poisson times with the
 # rate of the two-disk run of the same IC ("Poisson"), and one kicked at that run's actual
 # disk-disk collision times ("Actual"). Their two families of experiments are built into
-# kicktimes (`analysis/family_a.toml`, `analysis/family_b.toml`), with small versions
-# (`analysis/quick_a.toml`, `analysis/quick_b.toml`).
+# kicktimes as the presets `family_a` and `family_b`, with small versions `quick_a` and
+# `quick_b`.
 #
 # This notebook runs the experiments into a temporary result store with
 # `kicktimes.experiment.run_experiment`, reads it back with `load_store`, draws the paper's
@@ -93,20 +93,19 @@ print(f"size {SIZE!r}: experiments {P['names']}; stores and report under {WORKDI
 # %% [markdown]
 # ## 1. The experiments
 #
-# An `Experiment` is a frozen dataclass with the same fields as its TOML file. The TOML files
-# in `analysis/` are read when the repository is at hand; the built-in presets are the same
-# experiments (checked by their hash).
+# An `Experiment` is a frozen dataclass with the same fields as its TOML file. The paper's
+# families and their small versions are built-in presets (`kicktimes presets` lists them;
+# `kicktimes presets NAME` prints one as TOML, to copy and edit); the TOML reads back to
+# the same experiment (the same hash, which names the store).
 
 # %%
-analysis = Path(kt.__file__).resolve().parents[1] / "analysis"
 experiments = {}
 for name in P["names"]:
-    path = analysis / f"{name}.toml"
-    exp = Experiment.from_toml(path) if path.is_file() else preset(name)
-    if exp.hash() != preset(name).hash():
-        raise RuntimeError(f"{path} differs from the built-in preset {name!r}")
+    exp = preset(name)
+    if Experiment.from_toml_string(exp.to_toml()).hash() != exp.hash():
+        raise RuntimeError(f"the TOML of preset {name!r} does not read back to it")
     experiments[name] = exp
-    print(f"--- {name} ({path if path.is_file() else 'built-in preset'})")
+    print(f"--- {name} (built-in preset; `kicktimes presets {name}` prints its TOML)")
     print(exp.summary())
 
 # %% [markdown]

@@ -4,13 +4,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from kicktimes.report.controls import (
-    COLUMNS,
-    answers,
-    compute_controls,
-    overview_table,
-    paired_median,
-)
+from kicktimes.report.answers import answers, overview_table
+from kicktimes.report.controls import COLUMNS, compute_controls, paired_median
 
 
 def _frame(values_by_system, radii, n_ics):
@@ -201,7 +196,8 @@ def _rows(spec, question="FTLE", diagnostic="ftle", system="poisson"):
 def test_a_verdict_that_changes_direction_is_never_robust():
     """Both 'higher' and 'lower' used to read 'differs' and pass as robust: 1.88 on the
     paper's samples against 0.774 on uniform-time ones is a change of sign, not a finding."""
-    from kicktimes.report.controls import overview_table, with_robustness
+    from kicktimes.report.answers import overview_table
+    from kicktimes.report.controls import with_robustness
 
     table = with_robustness(_rows([("family_b", "primary", 0.76, 0.79),
                                    ("family_b", "paper_sampling", 1.85, 1.90)],
@@ -222,7 +218,8 @@ def test_a_verdict_that_changes_direction_is_never_robust():
 
 
 def test_a_robust_cell_gives_its_verdict_and_the_range_over_every_control_and_family():
-    from kicktimes.report.controls import screen_cell, with_robustness
+    from kicktimes.report.answers import screen_cell
+    from kicktimes.report.controls import with_robustness
 
     table = with_robustness(_rows([("family_a", "primary", 0.32, 0.33),
                                    ("family_a", "elastic", 0.40, 0.42),
@@ -232,12 +229,8 @@ def test_a_robust_cell_gives_its_verdict_and_the_range_over_every_control_and_fa
 
 
 def test_the_poisson_question_is_a_row_per_test_with_the_rule_as_a_control():
-    from kicktimes.report.controls import (
-        POISSON_QUESTION,
-        first_screen,
-        merge_control_families,
-        poisson_rows,
-    )
+    from kicktimes.report.answers import first_screen
+    from kicktimes.report.controls import POISSON_QUESTION, merge_control_families, poisson_rows
 
     rej = pd.DataFrame({"radius": [0.01, 0.02] * 2,
                         "test": ["uniformity_ks"] * 2 + ["ljung_box"] * 2,
@@ -267,7 +260,8 @@ def test_the_poisson_question_is_a_row_per_test_with_the_rule_as_a_control():
 
 
 def test_the_first_screen_is_at_most_three_sentences_and_a_table_of_at_most_8_columns():
-    from kicktimes.report.controls import first_screen, with_robustness
+    from kicktimes.report.answers import first_screen
+    from kicktimes.report.controls import with_robustness
 
     spec = []
     for system in ("poisson", "actual", "poisson_scatter", "actual_scatter", "poisson_kinetic",
@@ -305,7 +299,7 @@ def test_every_family_has_the_rule_by_ic_design_as_control_experiments():
 
 
 def test_the_readme_block_is_replaced_by_the_generated_first_screen(tmp_path):
-    from kicktimes.report.results import BEGIN, END, copy_first_screen
+    from kicktimes.studies.paper import BEGIN, END, copy_first_screen
 
     page = tmp_path / "docs" / "results" / "README.md"
     page.parent.mkdir(parents=True)
@@ -324,7 +318,7 @@ def test_the_readme_block_is_replaced_by_the_generated_first_screen(tmp_path):
 
 
 def test_the_first_screen_is_rewritten_from_the_findings_tables_alone(tmp_path):
-    from kicktimes.report.results import refresh_first_screen
+    from kicktimes.studies.paper import refresh_first_screen
 
     table = _rows([("family_a", "primary", 0.30, 0.33), ("family_a", "elastic", 0.31, 0.34)])
     table.to_csv(tmp_path / "family_a_findings.csv", index=False)
@@ -335,3 +329,21 @@ def test_the_first_screen_is_rewritten_from_the_findings_tables_alone(tmp_path):
     text = refresh_first_screen(tmp_path).read_text()
     assert "old words" not in text and "| FTLE λ | ✓ lower: 0.315–0.325 |" in text
     assert "first screen was rewritten" in text and text.index("## Next") > text.index("![h")
+
+
+def test_the_paper_module_rewrites_the_first_screen_and_the_readme_block(tmp_path, capsys):
+    from kicktimes.studies.paper import BEGIN, END
+    from kicktimes.studies.paper.__main__ import main
+
+    table = _rows([("family_a", "primary", 0.30, 0.33)])
+    table.to_csv(tmp_path / "family_a_findings.csv", index=False)
+    (tmp_path / "README.md").write_text(
+        "# t\n\nGenerated 2026 from `a`.\n\n## The answers\n\nold words\n\n"
+        "![headline](h.png)\n\n## Next\n")
+    readme = tmp_path / "top.md"
+    readme.write_text(f"intro\n{BEGIN}\nold\n{END}\n")
+    assert main([str(tmp_path), "--readme", str(readme)]) == 0
+    assert "| FTLE λ | ✓ lower: 0.315–0.315 |" in readme.read_text()
+    with pytest.raises(SystemExit) as stop:
+        main([str(tmp_path / "nowhere")])
+    assert stop.value.code == 2 and "error:" in capsys.readouterr().err

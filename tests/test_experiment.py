@@ -84,9 +84,15 @@ def test_toml_round_trip_preserves_the_experiment_and_its_hash(tmp_path):
     assert Experiment.from_dict(json.loads(json.dumps(exp.to_dict()))) == exp
 
 
-def test_analysis_files_are_the_builtin_presets_with_the_papers_parameters():
+def test_the_presets_have_the_papers_parameters_and_their_toml_reads_back(tmp_path):
+    from click.testing import CliRunner
+
+    from kicktimes.cli import main
+
     for name, exp in PRESETS.items():
-        assert Experiment.from_toml(REPO / "analysis" / f"{name}.toml") == exp
+        printed = CliRunner().invoke(main, ["presets", name])
+        assert printed.exit_code == 0, printed.output
+        assert Experiment.from_toml_string(printed.output) == exp
     a, b = PRESETS["family_a"], PRESETS["family_b"]
     assert a.radii == tuple(k / 1000 for k in range(8, 31, 2)) and len(a.radii) == 12
     assert (a.n_ics, a.n_steps, a.tau) == (200, 25000, 0.2)

@@ -358,7 +358,8 @@ def test_the_report_sets_the_mmpp_against_poisson_and_renewal_with_poisson_twins
 def test_the_answers_ask_whether_clustered_kicks_bring_the_disk_closer():
     import pandas as pd
 
-    from kicktimes.report.controls import COLUMNS, answers
+    from kicktimes.report.answers import answers
+    from kicktimes.report.controls import COLUMNS
 
     rows = []
     for system, est in (("poisson", 0.32), ("mmpp", 0.30)):

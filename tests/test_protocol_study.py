@@ -137,7 +137,7 @@ def test_the_results_first_screen_points_to_paper_md_and_keeps_the_family_tables
     import shutil
     from pathlib import Path
 
-    from kicktimes.report.results import refresh_first_screen
+    from kicktimes.studies.paper import refresh_first_screen
 
     results = Path(__file__).resolve().parents[1] / "docs" / "results"
     for name in ("README.md", "family_a_findings.csv", "family_b_findings.csv",
@@ -162,6 +162,7 @@ def test_every_registered_study_is_a_choice_of_reproduce_with_its_line():
 
     res = CliRunner().invoke(main, ["reproduce", "--help"], terminal_width=400)
     assert res.exit_code == 0
+    lines = [" ".join(line.split()) for line in res.output.splitlines()]
     for study in STUDIES.values():
-        assert f"{study.name}: {study.summary}" in " ".join(res.output.split())
-    assert f"[{'|'.join(STUDIES)}]" in res.output
+        assert f"{study.name} {study.page} {study.summary}" in lines
+    assert f"[{'|'.join(STUDIES)}|all]" in res.output

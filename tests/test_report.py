@@ -366,7 +366,7 @@ def test_tables_are_rounded_and_scroll_instead_of_stretching_the_page(built):
 
 
 def test_write_results_gives_pngs_and_a_generated_findings_page(store_path, tmp_path):
-    from kicktimes.report import write_results
+    from kicktimes.studies.paper import write_results
 
     path = write_results(store_path, tmp_path, dpi=40, n_mc=19, max_ics_model_fits=1)
     text = path.read_text(encoding="utf-8")

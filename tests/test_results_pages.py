@@ -1,6 +1,6 @@
 """The committed results (docs/results) say no more than their numbers.
 
-The findings tables that ``python analysis/make_results.py`` writes are checked as a
+The findings tables that ``kicktimes reproduce --study paper --results DIR`` writes are checked as a
 referee would: every verdict agrees with its own interval (the rules of
 :mod:`kicktimes.stats`), no comparison flagged robust changes direction between controls,
 the Poisson question is there under the collision rule x IC design, and the first screen

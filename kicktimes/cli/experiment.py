@@ -5,7 +5,7 @@ from __future__ import annotations
 import click
 
 from kicktimes.cli._group import _cli_errors, _compile_first, option
-from kicktimes.studies import STUDIES
+from kicktimes.studies import STUDIES, studies_help
 
 
 # --- experiment commands ---
@@ -66,8 +66,27 @@ _RUN_OPTIONS = {"store": "--out", "workers": "--workers", "scheduler": "--schedu
                 "path": "--out"}
 
 
+def _experiment(name_or_path):
+    """The experiment of ``kicktimes run EXPERIMENT``: a TOML file, or a built-in preset's
+    name (`kicktimes presets` lists them)."""
+    import os
+
+    from kicktimes.experiment import Experiment, disks_preset, preset, preset_names
+
+    if os.path.isfile(name_or_path):
+        return Experiment.from_toml(name_or_path)
+    two, disks = preset_names()
+    if name_or_path in two:
+        return preset(name_or_path)
+    if name_or_path in disks:
+        return disks_preset(name_or_path)
+    raise click.BadParameter(
+        f"{name_or_path!r} is neither a TOML file nor a preset; the presets are "
+        + ", ".join(two + disks) + " (kicktimes presets)", param_hint="'EXPERIMENT'")
+
+
 @click.command("run")
-@click.argument("experiment", type=click.Path(exists=True, dir_okay=False))
+@click.argument("experiment")
 @click.option("--out", "out", type=click.Path(file_okay=False), required=True,
               help="Store directory (created; rerunning resumes it).")
 @_workers_option
@@ -75,24 +94,69 @@ _RUN_OPTIONS = {"store": "--out", "workers": "--workers", "scheduler": "--schedu
 @_progress_option
 @_wait_option
 def run_command(experiment, out, workers, scheduler, progress, wait):
-    """Run (or resume) the sweep of EXPERIMENT.toml into the store --out.
+    """Run (or resume) the sweep EXPERIMENT into the store --out.
+
+    EXPERIMENT is a TOML file or the name of a built-in preset (kicktimes presets lists
+    them; kicktimes presets NAME prints a preset's TOML, to copy and edit).
 
     \b
     Examples:
-      kicktimes run analysis/quick_a.toml --out stores/quick_a
-      kicktimes run analysis/family_b.toml --out stores/b --scheduler tcp://host:8786
+      kicktimes run quick_a --out stores/quick_a
+      kicktimes presets family_b > my_b.toml   # edit it, then
+      kicktimes run my_b.toml --out stores/b --scheduler tcp://host:8786
     """
-    from kicktimes.experiment import Experiment
-
     if workers is not None and scheduler is not None:
         raise click.UsageError("--workers sizes the local pool; it cannot go with --scheduler")
     with _cli_errors(_RUN_OPTIONS):
-        exp = Experiment.from_toml(experiment)
+        exp = _experiment(experiment)
         click.echo(exp.summary())
         if scheduler is None and _pending(exp, out):
             _compile_first(workers)
         store = _run_one(exp, out, workers, scheduler, progress, wait)
     click.echo(store.summary())
+
+
+@click.command("presets")
+@click.argument("name", required=False)
+def presets_command(name):
+    """List the built-in experiments, or print preset NAME as TOML.
+
+    The two-disk presets (the paper's families, their controls and quick versions) are
+    what kicktimes reproduce --study paper runs; the disks presets what --study disks
+    runs. A two-disk preset's TOML is the file to copy and edit for your own sweep; a
+    disks preset runs by its name (kicktimes run NAME).
+
+    \b
+    Examples:
+      kicktimes presets
+      kicktimes presets family_a > family_a.toml
+    """
+    from kicktimes.experiment import disks_preset, preset, preset_names
+
+    two, disks = preset_names()
+    if name is None:
+        import textwrap
+
+        width = max(map(len, two + disks)) + 2
+
+        def line(n, description):
+            return f"  {n:<{width}}" + textwrap.shorten(description, 96 - width,
+                                                          placeholder=" ...")
+
+        click.echo("two-disk presets (kicktimes presets NAME prints the TOML):")
+        for n in two:
+            click.echo(line(n, preset(n).description))
+        click.echo("disks presets (kicktimes run NAME):")
+        for n in disks:
+            click.echo(line(n, disks_preset(n).description))
+        return
+    if name in disks:
+        raise click.BadParameter(f"{name!r} is a disks preset: it has no TOML form; run it "
+                                 f"with kicktimes run {name}", param_hint="'NAME'")
+    if name not in two:
+        raise click.BadParameter(f"{name!r} is not a preset; the two-disk presets are "
+                                 + ", ".join(two), param_hint="'NAME'")
+    click.echo(preset(name).to_toml(), nl=False)
 
 
 def _build_report(stores, out, workers=None, progress=None, pdf=False, force=False):
@@ -210,33 +274,56 @@ def report_command(stores, out, workers, progress, pdf, force):
     click.echo(f"report written to {path if path is not None else out}")
 
 
-@click.command("reproduce")
-@click.option("--study", type=click.Choice(list(STUDIES)), default="paper", show_default=True,
-              help="; ".join(f"{s.name}: {s.summary} (page {s.page})"
-                             for s in STUDIES.values()) + ".")
+_REPRODUCE_HELP = f"""Build a study's results page: run (or resume) its computation into --out
+and write its page into --results.
+
+\b
+Studies (--study NAME, its page, what it answers):
+{studies_help()}
+  all        every study above, in this order, every page into --results
+
+--study paper runs the paper's two families (and, at paper scale, their controls) as the
+built-in presets (kicktimes presets lists them; with --content paper reduced to the
+paper's own systems and diagnostics), builds the sweep report into OUT/report and, with
+--results, the page README.md. Every page's "Generated" line names the command that
+built it; docs/results/NAME.md is built with --scale paper --results docs/results.
+
+\b
+Examples:
+  kicktimes reproduce --scale quick --out kicktimes-out
+  kicktimes reproduce --study escape --scale paper --out work --results docs/results
+  kicktimes reproduce --study all --scale paper --out work --results docs/results
+"""
+
+
+@click.command("reproduce", help=_REPRODUCE_HELP)
+@click.option("--study", type=click.Choice([*STUDIES, "all"]), default="paper",
+              show_default=True, help="The study to build (listed above).")
 @click.option("--results", "results", type=click.Path(file_okay=False), default=None,
               help="Folder of the study's page: --study paper writes README.md there from its "
-              "stores (none by default), protocol paper.md (default OUT/results-protocol), "
-              "disks disks.md (default OUT/results-disks).")
+              "stores (none by default); every other study writes its page there (default "
+              "OUT/results-NAME; with --study all, OUT/results).")
 @click.option("--findings", "findings", type=click.Path(file_okay=False, exists=True),
               default=None,
-              help="--study protocol: folder of the paper study's paper-scale findings "
-              "tables (family_a_findings.csv, family_b_findings.csv; e.g. docs/results), for "
-              "the count claims (default: --results, if it holds them).")
+              help="--study protocol and science: folder of the paper study's paper-scale "
+              "findings tables (family_a_findings.csv, ...; e.g. docs/results) (default: "
+              "--results, if it holds them).")
 @option("--scale", type=click.Choice(["quick", "paper"]), default="quick",
-        help="quick: small versions of both families; paper: the paper's full scale.")
+        help="quick: a small version of the study; paper: the scale of its page in "
+        "docs/results (the paper's full scale for paper and protocol).")
 @click.option(
     "--content",
     type=click.Choice(["full", "paper"]),
     default="full",
     show_default=True,
-    help="full: the presets (the paper's systems and diagnostics plus the scatter-kicked "
-    "systems, RQA at two thresholds, ACF curves); paper: the paper's own content only "
-    "(3 systems, RR at eps = 0.001, R_1), under half the sweep's work, into "
+    help="--study paper: full: the presets (the paper's systems and diagnostics plus the "
+    "scatter-kicked systems, RQA at two thresholds, ACF curves); paper: the paper's own "
+    "content only (3 systems, RR at eps = 0.001, R_1), under half the sweep's work, into "
     "store-<name>-paper and report-paper/.",
 )
 @click.option("--out", "out", type=click.Path(file_okay=False), required=True,
-              help="Directory for the stores (store-<name>) and the report (report/).")
+              help="Work folder: the studies' stores and caches (store-<name>, ...) and the "
+              "sweep report (report/).")
 @_workers_option
 @_scheduler_option
 @_progress_option
@@ -244,21 +331,46 @@ def report_command(stores, out, workers, progress, pdf, force):
 @_pdf_option
 def reproduce_command(study, results, findings, scale, content, out, workers, scheduler,
                       progress, wait, pdf):
-    """Run the paper's experiment families (and, at paper scale, their controls) and report.
+    import os
 
-    Reruns resume the stores in --out. The experiments are the built-in presets, the
-    same as analysis/<name>.toml (with --content paper, reduced to the paper's own
-    systems and diagnostics: kicktimes.experiment.presets.PAPER_CONTENT). With
-    --study disks: the disks presets (kicktimes.experiment.DISKS_PRESETS) and the page
-    disks.md (docs/results/disks.md is built with --results docs/results). With --study
-    protocol: kicktimes.studies.protocol and the page paper.md (docs/results/paper.md is
-    built with --scale paper --results docs/results; about 18 minutes on 2 cores).
-    """
+    if findings is not None and study not in ("protocol", "science", "all"):
+        raise click.UsageError("--findings applies to --study protocol, science or all")
+    if study == "all":
+        results = results if results is not None else os.path.join(out, "results")
+        for name in STUDIES:
+            click.echo(f"== --study {name}", err=True)
+            _reproduce_one(name, results, findings, scale, content, out, workers, scheduler,
+                           progress, wait, pdf, command=f"kicktimes reproduce --study all "
+                           f"--scale {scale}")
+        return
+    _reproduce_one(study, results, findings, scale, content, out, workers, scheduler,
+                   progress, wait, pdf)
+
+
+def _reproduce_one(study, results, findings, scale, content, out, workers, scheduler,
+                   progress, wait, pdf, command=None):
+    """`reproduce_command` for one study; ``command`` (default: the study's own) is the
+    command its page's Generated line names."""
     import os
     import sys
 
-    if findings is not None and study != "protocol":
-        raise click.UsageError("--findings applies to --study protocol")
+    if study not in ("paper", "protocol", "disks"):
+        if scheduler is not None:
+            raise click.UsageError(f"--study {study} runs on the local pool (--workers); "
+                                   "--scheduler is not supported")
+        if progress is None:
+            progress = sys.stderr.isatty() and not os.environ.get("CI")
+        say = (lambda line: click.echo(line, err=True)) if progress else None
+        options = {}
+        if study == "science":
+            options["findings_dir"] = findings
+        with _cli_errors(_RUN_OPTIONS):
+            page = STUDIES[study].reproduce(
+                out, scale=scale, results_dir=results, workers=workers or 1, progress=say,
+                command=command or f"kicktimes reproduce --study {study} --scale {scale}",
+                **options)
+        click.echo(f"page written to {page}")
+        return
     if study == "protocol":
         from kicktimes.studies.protocol import reproduce_protocol
 
@@ -268,7 +380,7 @@ def reproduce_command(study, results, findings, scale, content, out, workers, sc
         if progress is None:
             progress = sys.stderr.isatty() and not os.environ.get("CI")
         say = (lambda line: click.echo(line, err=True)) if progress else None
-        command = f"kicktimes reproduce --study protocol --scale {scale}"
+        command = command or f"kicktimes reproduce --study protocol --scale {scale}"
         with _cli_errors(_RUN_OPTIONS):
             page = reproduce_protocol(out, scale=scale, results_dir=results,
                                       findings_dir=findings, workers=workers, progress=say,
@@ -285,7 +397,7 @@ def reproduce_command(study, results, findings, scale, content, out, workers, sc
         with _cli_errors(_RUN_OPTIONS):
             page = reproduce_disks(out, results_dir=results, workers=workers or 1,
                                    scheduler=scheduler, progress=progress,
-                                   command="kicktimes reproduce --study disks")
+                                   command=command or "kicktimes reproduce --study disks")
         click.echo(f"page written to {page}")
         return
 
@@ -331,11 +443,11 @@ def reproduce_command(study, results, findings, scale, content, out, workers, sc
         report = report_process.build(*job) if report_process else _build_report(*job)
         if results is not None:
             # the study's page: docs/results/README.md from the same stores
-            from kicktimes.report import write_results
+            from kicktimes.studies.paper import write_results
 
             page = write_results(stores, results, workers=workers or os.cpu_count() or 1,
-                                 command=f"kicktimes reproduce --study paper --scale {scale} "
-                                 f"--results {results}")
+                                 command=command or f"kicktimes reproduce --study paper "
+                                 f"--scale {scale} --results {results}")
     click.echo(f"report written to {report if report is not None else report_dir}")
     if results is not None:
         click.echo(f"page written to {page}")

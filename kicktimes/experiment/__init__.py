@@ -28,7 +28,7 @@ from kicktimes.experiment.disks import (
     disks_preset,
 )
 from kicktimes.experiment.disks_tasks import execute_disks_task
-from kicktimes.experiment.presets import PRESETS, preset
+from kicktimes.experiment.presets import PRESETS, preset, preset_names
 from kicktimes.experiment.runner import run_experiment
 from kicktimes.experiment.store import (
     Store,
@@ -57,6 +57,7 @@ __all__ = [
     "DISKS_REFERENCES",
     "DisksExperiment",
     "PRESETS",
+    "preset_names",
     "RESULT_COLUMNS",
     "SYSTEMS",
     "Experiment",

@@ -1,8 +1,8 @@
 """The paper's two experiment families and their quick versions, built in.
 
-The same experiments are the files ``analysis/<name>.toml`` of the repository (a test
-checks that they agree); they are also built in so that ``kicktimes reproduce`` works
-from an installed package without the repository.
+They are the one definition of these experiments: ``kicktimes run NAME`` runs one,
+``kicktimes presets NAME`` prints it as TOML (the file to copy and edit for a sweep of
+one's own), and ``kicktimes reproduce`` runs them from an installed package.
 
 Why ``sampling = "paper"``: the paper's "time steps" end early at every collision
 (Section 2), its ``n`` counts those truncated steps, and its recurrence rates and
@@ -20,7 +20,7 @@ import dataclasses
 from kicktimes.experiment.config import Experiment
 
 __all__ = ["CONTENTS", "CONTROL_ICS_B", "CONTROL_PRESETS", "PAPER_CONTENT", "PRESETS", "SCALES",
-           "preset", "scale_presets"]
+           "preset", "preset_names", "scale_presets"]
 
 
 def _radii(start_mm: int, stop_mm: int) -> list[float]:
@@ -226,3 +226,17 @@ def preset(name: str, content: str = "full") -> Experiment:
             "recurrence rate at eps = 0.001, the lag-1 autocorrelation.",
         )
     return exp
+
+
+def preset_names() -> tuple[list[str], list[str]]:
+    """The names of the built-in experiments: the two-disk presets (`PRESETS`, with the
+    controls), and the disks presets with their controls and two-disk references
+    (`kicktimes.experiment.disks_preset`), each list in its registry's order.
+
+    >>> two, disks = preset_names()
+    >>> two[:4]
+    ['family_a', 'family_b', 'quick_a', 'quick_b']
+    """
+    from kicktimes.experiment.disks import DISKS_CONTROLS, DISKS_PRESETS, DISKS_REFERENCES
+
+    return list(PRESETS), [*DISKS_PRESETS, *DISKS_CONTROLS, *DISKS_REFERENCES]

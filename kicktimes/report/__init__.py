@@ -9,8 +9,8 @@ which renewal model? which model with an MMPP? counts against kinetic theory? ea
 kicked system against the two-particle system for the FTLE, the off-diagonal recurrence
 rate, DET and the autocorrelation), each with its effect size, 95 % confidence interval
 and a verdict from a printed rule (:mod:`kicktimes.report.effects`), and a banner when the
-store is below paper scale. :func:`write_results` writes the figures and a Markdown
-findings page (for ``docs/results/``).
+store is below paper scale. The paper study's page (``docs/results/README.md``) is written from the
+same sections by :func:`kicktimes.studies.paper.write_results`.
 
 One module per section, each holding its computation, figure and text:
 :mod:`~kicktimes.report.trajectories` (Poincaré sections, recurrence plot),
@@ -20,7 +20,10 @@ One module per section, each holding its computation, figure and text:
 :mod:`~kicktimes.report.autocorrelation`, :mod:`~kicktimes.report.poisson`,
 :mod:`~kicktimes.report.renewal`, :mod:`~kicktimes.report.mmpp` (the Markov-modulated
 Poisson model against Poisson and the renewal models), :mod:`~kicktimes.report.heterogeneity`,
-:mod:`~kicktimes.report.findings`; :mod:`~kicktimes.report.html` writes the page and
+:mod:`~kicktimes.report.findings` (with :mod:`~kicktimes.report.controls`,
+:mod:`~kicktimes.report.answers` and :mod:`~kicktimes.report.decomposition`);
+:mod:`~kicktimes.report.pages` holds the generated pages' header and Markdown helpers;
+:mod:`~kicktimes.report.html` writes the page and
 :mod:`~kicktimes.report.pipeline` runs them. See docs/report.md.
 """
 
@@ -28,6 +31,5 @@ from __future__ import annotations
 
 from kicktimes.report.common import REPORT_DOMAIN
 from kicktimes.report.pipeline import build_report
-from kicktimes.report.results import write_results
 
-__all__ = ["build_report", "write_results", "REPORT_DOMAIN"]
+__all__ = ["build_report", "REPORT_DOMAIN"]

@@ -226,7 +226,7 @@ def gap_figure(table: pd.DataFrame):
     from matplotlib.figure import Figure
     from matplotlib.lines import Line2D
 
-    from kicktimes.report.controls import PANELS
+    from kicktimes.report.answers import PANELS
 
     panels = [(d, t) for d, t in PANELS if d in set(table["diagnostic"])]
     families = list(dict.fromkeys(table["family"]))

@@ -22,14 +22,9 @@ from kicktimes.report import (
     recurrence,
     renewal,
 )
+from kicktimes.report.answers import answers, overview_table, poisson_share, ratio_curves_figure
 from kicktimes.report.common import PAPER_SCALE, Section, is_paper_scale
-from kicktimes.report.controls import (
-    answers,
-    compute_controls,
-    overview_table,
-    poisson_share,
-    ratio_curves_figure,
-)
+from kicktimes.report.controls import compute_controls
 from kicktimes.report.counts import experiment_kinetic
 from kicktimes.report.decomposition import gap_decomposition, gap_figure
 from kicktimes.report.effects import BUILT_IN, SHARE_RULE, ratio_rule

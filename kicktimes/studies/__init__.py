@@ -11,8 +11,8 @@ Adding a study is one folder and one entry here (docs/architecture.md, "Add a st
 Examples
 --------
 >>> from kicktimes.studies import STUDIES
->>> sorted(STUDIES)
-['disks', 'paper', 'protocol']
+>>> list(STUDIES)[:3]
+['paper', 'protocol', 'science']
 >>> STUDIES["protocol"].page
 'paper.md'
 """
@@ -21,30 +21,63 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-__all__ = ["STUDIES", "Study"]
+__all__ = ["STUDIES", "Study", "studies_help"]
 
 
 @dataclass(frozen=True)
 class Study:
     """A registered study: its name (``--study NAME``), the page it writes into
-    ``--results`` and one line for ``kicktimes reproduce --help``."""
+    ``--results``, one line for ``kicktimes reproduce --help``, and the names of the
+    stores of other studies it reads (``needs``; ``--study all`` runs those first).
+
+    Its package ``kicktimes.studies.<name>`` provides ``reproduce(out, *, scale,
+    results_dir, workers, progress, command)``, which runs (or resumes, from ``out``) its
+    computation and writes its page into ``results_dir``; it returns the page's path.
+    """
 
     name: str
     page: str
     summary: str
+    needs: tuple[str, ...] = ()
+
+    @property
+    def module(self) -> str:
+        """The study's package, ``kicktimes.studies.<name>``."""
+        return f"{__name__}.{self.name}"
+
+    def reproduce(self, out, **options):
+        """Import the study's package and run its ``reproduce(out, **options)``."""
+        import importlib
+
+        return importlib.import_module(self.module).reproduce(out, **options)
 
 
 STUDIES = {
     s.name: s
     for s in (
         Study("paper", "README.md",
-              "the paper's two families and their controls, the sweep report, and with "
-              "--results the page README.md"),
+              "the paper's two families under every control; the sweep report"),
         Study("protocol", "paper.md",
-              "the paper's claims by its own protocol: every reading of its eq. (4) on both "
-              "panels of Fig. 6, its RR and R_1, claim by claim"),
+              "the paper's claims by its own protocol (eq. (4), Fig. 6, RR, R_1)"),
+        Study("science", "science.md",
+              "stretching and decorrelation per kick, the rate over the run, sticky orbits",
+              needs=("paper",)),
+        Study("mechanism", "mechanism.md",
+              "why the collision times are not Poisson, under both collision rules"),
+        Study("escape", "escape.md",
+              "escape through a hole: kicked disk against two disks"),
+        Study("unequal", "unequal.md",
+              "unequal disks: collision times and kicked FTLE against the size ratio"),
+        Study("scatter", "scatter.md",
+              "scatter kicks against two disks: the FTLE per IC"),
+        Study("mmpp", "mmpp.md",
+              "MMPP fits to the two-disk collision times"),
         Study("disks", "disks.md",
-              "the tagged disk among N = 2..1000 disks: Poisson or not, Enskog's rate, the "
-              "kicked comparison"),
+              "a tagged disk among N = 2..1000 disks: Poisson or not, Enskog, kicked"),
     )
 }
+
+
+def studies_help() -> str:
+    """One line per study, ``NAME  PAGE  summary``, for ``kicktimes reproduce --help``."""
+    return "\n".join(f"  {s.name:<11}{s.page:<14}{s.summary}" for s in STUDIES.values())

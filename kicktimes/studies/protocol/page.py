@@ -15,7 +15,7 @@ from matplotlib.ticker import MultipleLocator  # noqa: E402
 
 from kicktimes import __version__  # noqa: E402
 from kicktimes.fileio import atomic_write  # noqa: E402
-from kicktimes.report.controls import markdown_table  # noqa: E402
+from kicktimes.report.pages import markdown_table  # noqa: E402
 from kicktimes.stats import format_interval  # noqa: E402
 from kicktimes.studies.protocol.claims import SMALL_RADIUS, SWITCHES, claims_table  # noqa: E402
 from kicktimes.studies.protocol.compute import D0, EPS, panels  # noqa: E402

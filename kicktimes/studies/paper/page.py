@@ -1,9 +1,9 @@
-r"""Results a reader can see without running anything: figures (PNG) and a generated
-Markdown findings page, written from the stores (for ``docs/results/``).
+r"""The paper study's page: figures (PNG) and a generated Markdown findings page,
+``README.md``, written from the stores (``docs/results/README.md``).
 
-``python analysis/make_results.py STORE [STORE ...] --out docs/results`` calls
-:func:`write_results`; every number on the page is computed from the stores by the same
-section modules as the HTML report.
+``kicktimes reproduce --study paper --scale paper --out OUT --results docs/results`` runs
+the families and calls :func:`write_results`; every number on the page is computed from
+the stores by the same section modules as the HTML report (:mod:`kicktimes.report`).
 """
 
 from __future__ import annotations
@@ -39,7 +39,8 @@ def _md_escape(text):
 def poisson_section(table):
     """The Markdown of the Poisson question under the rule x IC design: one row per test
     (and the headline test on the first collisions), one column per (family, control)."""
-    from kicktimes.report.controls import POISSON_QUESTION, markdown_table
+    from kicktimes.report.controls import POISSON_QUESTION
+    from kicktimes.report.pages import markdown_table
     from kicktimes.stats import format_interval, rejection_rule
 
     rows = table[table["question"] == POISSON_QUESTION]
@@ -68,7 +69,7 @@ def poisson_section(table):
 
 def counts_section(table):
     """The Markdown of the collision counts against kinetic theory under every control."""
-    from kicktimes.report.controls import markdown_table
+    from kicktimes.report.pages import markdown_table
     from kicktimes.stats import format_interval
 
     rows = table[table["diagnostic"] == "counts"]
@@ -152,7 +153,7 @@ def refresh_first_screen(out_dir) -> Path:
 
     For a change of the first screen's wording: the numbers are the tables' own.
     """
-    from kicktimes.report.controls import first_screen
+    from kicktimes.report.answers import first_screen
 
     out = Path(out_dir)
     page = out / "README.md"
@@ -183,7 +184,7 @@ def refresh_first_screen(out_dir) -> Path:
     k = next(i for i, line in enumerate(lines) if line.startswith("Generated "))
     lines[k] = (lines[k].split(" The first screen was rewritten")[0]
                 + f" The first screen was rewritten {now} from the findings tables "
-                "(`make_results.py --screen-only`).")
+                "(`python -m kicktimes.studies.paper`).")
     atomic_write_bytes(page, ("\n".join(lines) + "\n").encode("utf-8"))
     return page
 
@@ -223,11 +224,8 @@ def write_results(
     >>> from kicktimes.report import write_results
     >>> write_results("stores/family_a", "docs/results")  # doctest: +SKIP
     """
-    from kicktimes.report.controls import (
-        first_screen,
-        merge_control_families,
-        ratio_curves_figure,
-    )
+    from kicktimes.report.answers import first_screen, ratio_curves_figure
+    from kicktimes.report.controls import merge_control_families
     from kicktimes.report.findings import rules_text, scale_statement
     from kicktimes.report.pipeline import CONTROL_STAGES, analyse, n_stages
     from kicktimes.stats import ratio_rule
@@ -336,8 +334,8 @@ def write_results(
         pool.close()
     import pandas as pd
 
-    from kicktimes.report.controls import markdown_table
     from kicktimes.report.decomposition import STEPS, gap_figure, gap_summary
+    from kicktimes.report.pages import markdown_table
 
     # control experiments ("<family>-<control>") become rows of their family's table
     merged = merge_control_families(controls)

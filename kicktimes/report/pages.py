@@ -1,4 +1,4 @@
-"""The header and the verdict phrases shared by the generated science pages.
+"""The header and the verdict phrases shared by the generated pages of the studies.
 
 Every page under ``docs/results/`` that states results starts with one line, ::
 
@@ -6,6 +6,15 @@ Every page under ``docs/results/`` that states results starts with one line, ::
 
 (the model is ``docs/results/README.md``), and every comparative word in it comes from
 a verdict of :mod:`kicktimes.stats` (``ratio_verdict``, ``share_verdict``), never typed.
+The studies of :mod:`kicktimes.studies` import these from :mod:`kicktimes.report`.
+
+Examples
+--------
+>>> from kicktimes.report.pages import ratio_text, trend_verdict
+>>> ratio_text(0.771, 0.721, 0.825)
+'0.771 [0.721, 0.825], lower'
+>>> trend_verdict(0.1, 0.4)
+'rises'
 """
 
 from __future__ import annotations
@@ -16,9 +25,13 @@ import math
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 
 from kicktimes import __version__
 from kicktimes.stats import format_interval, ratio_verdict
+
+__all__ = ["MARGIN", "ci", "header", "markdown_table", "ratio_text", "store_name",
+           "trend_verdict"]
 
 #: the equivalence margin of every ratio on these pages, stated before any was computed
 MARGIN = 0.1
@@ -65,3 +78,16 @@ def trend_verdict(low, high) -> str:
     if high < 0:
         return "falls"
     return "no trend detected"
+
+
+def markdown_table(frame: pd.DataFrame) -> list[str]:
+    """``frame`` as the lines of a GitHub Markdown table (cells' ``|`` escaped)."""
+    def cell(v):
+        return str(v).replace("|", "\\|").replace("\n", " ")
+
+    lines = ["| " + " | ".join(cell(c) for c in frame.columns) + " |",
+             "|" + "---|" * len(frame.columns)]
+    lines += ["| " + " | ".join(cell(v) for v in row) + " |"
+              for row in frame.itertuples(index=False)]
+    return lines
+

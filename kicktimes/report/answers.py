@@ -1,0 +1,341 @@
+"""The answers of a sweep's findings table: the first screen, the overview and the headline
+figure.
+
+The findings table under its controls (:mod:`kicktimes.report.controls`) answers each
+question of the paper in one line: :func:`first_screen` (the paper's claim, the
+kicktimes answer and the control that decides it, per diagnostic), :func:`overview_table`
+(one cell per comparison, ✓ robust or ↕ depends on), the Poisson, FTLE and MMPP sentences
+(:func:`answers`) and the headline figure of every ratio against the radius with its band
+(:func:`ratio_curves_figure`). The sweep report's Findings section
+(:mod:`kicktimes.report.findings`) and the paper study's page
+(:mod:`kicktimes.studies.paper`) both read them from here.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pandas as pd
+
+from kicktimes.report.common import REFERENCE
+from kicktimes.report.controls import LOWER, POISSON_QUESTION, WITHIN
+from kicktimes.report.pages import markdown_table
+from kicktimes.stats import format_interval
+
+__all__ = ["PANELS", "PAPER_CLAIMS", "SCREEN_ROWS", "answers", "first_screen", "ftle_answer",
+           "log_ratio_axis", "mmpp_answer", "overview_table", "poisson_answer",
+           "poisson_share", "ratio_curves_figure", "screen_cell"]
+
+
+#: what the paper says of each diagnostic (Ranković & Porter 2013), beside the table's rows
+PAPER_CLAIMS = {
+    "ftle": "“very similar” λ (Fig. 6)",
+    "rr_offdiag": "“excellent agreement” of RR at small r (Fig. 7)",
+    "det": "not studied",
+    "one_minus_r1": "similar R₁ (Fig. 8)",
+}
+_CONTROL_WORDS = {
+    "paired_median": "paired median",
+    "sticky_excluded": "sticky runs excluded",
+    "uniform_sampling": "uniform-time samples",
+    "paper_sampling": "the paper's samples",
+    "invariant_ics": "invariant-measure ICs",
+    "elastic": "the elastic rule",
+    "elastic+invariant_ics": "the elastic rule with invariant-measure ICs",
+}
+_SHORT = {"poisson": "Poisson", "actual": "actual", "poisson_scatter": "Poisson, scatter",
+          "actual_scatter": "actual, scatter", "poisson_kinetic": "kinetic rate, scatter",
+          "uniform_kinetic": "kinetic rate, uniform", "mmpp": "MMPP"}
+#: the rows of the first screen's table, in order: (diagnostic, label)
+SCREEN_ROWS = (
+    ("ftle", "FTLE λ"),
+    ("rr_offdiag@0.01", "off-diagonal RR, ε = 10⁻² (uniform-time samples)"),
+    ("det@0.01", "DET, ε = 10⁻² (uniform-time samples)"),
+    ("rr_offdiag@0.001", "off-diagonal RR, ε = 10⁻³ (uniform-time samples)"),
+    ("one_minus_r1", "1 − R₁ (lag-1 decorrelation)"),
+)
+_FAMILY_SHORT = {"family_a": "A", "family_b": "B"}
+#: the Poisson battery's tests, as the first screen names them
+_TEST_NAMES = {"uniformity_ks": "uniformity (KS)", "laplace_trend": "Laplace trend",
+               "exponential_ks": "exponential-interval (KS)",
+               "exponential_ad": "exponential-interval (AD)", "ljung_box": "Ljung–Box",
+               "runs": "runs", "dispersion": "dispersion"}
+
+
+def _ci(row):
+    return format_interval(row.estimate, row.ci_low, row.ci_high)
+
+
+def _fam(family):
+    return _FAMILY_SHORT.get(family, family)
+
+
+def screen_cell(rows: pd.DataFrame) -> str:
+    """One cell of the first screen: a comparison over every control and family.
+
+    ``"✓ lower: 0.301–0.338"`` (the verdict word and the range of the estimate over every
+    control and family) when it is robust in every family with one verdict; otherwise
+    ``"depends on <control>: <primary> vs <control's value>"`` (the family named when there
+    are several), or ``"depends on the family"`` with both primaries.
+    """
+    families = list(dict.fromkeys(rows["family"]))
+    primary = rows[rows["control"] == "primary"].set_index("family")
+    lo, hi = rows["estimate"].min(), rows["estimate"].max()
+    missing = ""
+    if rows["system"].iloc[0] in ("poisson_kinetic", "uniform_kinetic"):
+        missing = " (mirror rule only)"
+    for fam in families:
+        mine = rows[rows["family"] == fam]
+        if not mine["robust"].all():
+            control = mine["depends_on"].iloc[0]
+            other = mine[mine["control"] == control].iloc[0]
+            where = f"{_fam(fam)}: " if len(families) > 1 else ""
+            flips = (mine["ci_low"] > 1).any() and (mine["ci_high"] < 1).any()
+            mark = "↕ " if flips else ""
+            return (f"{mark}depends on {control}: {where}{_ci(primary.loc[fam])} vs "
+                    f"{_ci(other)}{missing}")
+    verdicts = set(primary["verdict"])
+    if len(verdicts) > 1:
+        return ("depends on the family: " + "; ".join(
+            f"{_fam(f)} {_ci(primary.loc[f])}" for f in families) + missing)
+    if (rows["ci_low"] > 1).any() and (rows["ci_high"] < 1).any():
+        return ("depends on the family: " + "; ".join(
+            f"{_fam(f)} {_ci(primary.loc[f])}" for f in families) + missing)
+    return f"✓ {verdicts.pop()}: {lo:.3g}–{hi:.3g}{missing}"
+
+
+def overview_table(table: pd.DataFrame) -> pd.DataFrame:
+    """The first screen's table: diagnostics as rows (`SCREEN_ROWS`), kick laws as columns,
+    each cell :func:`screen_cell` over every control and family; the paper's claim beside."""
+    comp = table[(table["system"] != REFERENCE) & (table["question"] != POISSON_QUESTION)]
+    systems = [s for s in _SHORT if s in set(comp["system"])]
+    out = []
+    rows_wanted = [r for r in SCREEN_ROWS if r[0] in set(comp["diagnostic"])]
+    for diagnostic, label in rows_wanted:
+        line = {"diagnostic": label}
+        for system in systems:
+            rows = comp[(comp["diagnostic"] == diagnostic) & (comp["system"] == system)]
+            line[_SHORT[system]] = screen_cell(rows) if not rows.empty else ""
+        line["the paper"] = PAPER_CLAIMS.get(diagnostic.split("@")[0], "")
+        out.append(line)
+    return pd.DataFrame(out)
+
+
+def _pct(row):
+    return (f"{100 * row.estimate:.1f} % [{100 * row.ci_low:.1f}, {100 * row.ci_high:.1f}]")
+
+
+def poisson_answer(table: pd.DataFrame, alpha=0.05) -> str:
+    """The first screen's sentence on the Poisson question, with the collision rule as a
+    factor: the headline test's rejection share under the mirror and the elastic rule (the
+    paper's ICs) per family, whether the intervals are disjoint, and which tests reject at
+    their nominal rate under the elastic rule in every family."""
+    from kicktimes.report.poisson import HEADLINE_TEST
+
+    rows = table[table["question"] == POISSON_QUESTION]
+    head = rows[rows["diagnostic"] == f"reject@{HEADLINE_TEST}"]
+    if head.empty:
+        return ""
+    families = list(dict.fromkeys(head["family"]))
+
+    def cell(fam, control):
+        r = head[(head["family"] == fam) & (head["control"] == control)]
+        return r.iloc[0] if len(r) else None
+
+    mirror = [(f, cell(f, "primary")) for f in families]
+    mirror = [(f, r) for f, r in mirror if r is not None]
+    above = all(r.verdict == "above nominal" for _, r in mirror)
+    text = ("Under the paper's mirror rule the two-disk collision times are "
+            + ("not Poisson" if above else "not shown to differ from Poisson") + " ("
+            + ", ".join(f"{_pct(r)} ({_fam(f)})" for f, r in mirror)
+            + f" of runs reject uniform times at α = {alpha:g}, against {100 * alpha:g} % for a "
+            "Poisson process)")
+    elastic = [(f, cell(f, "elastic"), cell(f, "primary")) for f in families]
+    elastic = [(f, e, m) for f, e, m in elastic if e is not None and m is not None]
+    if elastic:
+        disjoint = all(e.ci_high < m.ci_low for _, e, m in elastic)
+        shares = ", ".join(f"{_pct(e)} ({_fam(f)})" for f, e, _ in elastic)
+        still = all(e.verdict == "above nominal" for _, e, _ in elastic)
+        text += (f"; under the elastic rule fewer runs reject ({shares}; intervals disjoint)"
+                 if disjoint else f"; under the elastic rule {shares} of runs reject")
+        if still:
+            text += f", still more than the nominal {100 * alpha:g} %, so not Poisson either"
+        nominal = []
+        for test in dict.fromkeys(rows["diagnostic"]):
+            cells = rows[(rows["diagnostic"] == test) & (rows["control"] == "elastic")]
+            if len(cells) == len(elastic) and (cells["verdict"] == "nominal").all():
+                name = test.split("@")[1]
+                nominal.append(_TEST_NAMES.get(name, name))
+        if nominal:
+            names = (", ".join(nominal[:-1]) + " and " + nominal[-1] if len(nominal) > 1
+                     else nominal[0])
+            text += (f", and the {names} test{'s' if len(nominal) > 1 else ''} reject"
+                     f"{'' if len(nominal) > 1 else 's'} at the nominal rate")
+    return text + "."
+
+
+def ftle_answer(table: pd.DataFrame) -> str:
+    """The first screen's sentence on the FTLE of the paper's kicked disk (Poisson and
+    actual kicks): its verdict over every control and family, or what it depends on."""
+    ftle = table[(table["diagnostic"] == "ftle") & table["system"].isin(["poisson", "actual"])]
+    if ftle.empty:
+        return ""
+    robust = ftle["robust"].all()
+    verdicts = set(ftle["verdict"])
+    lo, hi = ftle["estimate"].min(), ftle["estimate"].max()
+    n_controls = ftle["control"].nunique()
+    if robust and verdicts == {LOWER}:
+        return ("The paper's kicked disk does not reproduce the two-disk chaos: its FTLE is "
+                f"{lo:.3g}–{hi:.3g} of the two-disk value, lower under all {n_controls} "
+                "controls in every family.")
+    if robust and verdicts == {WITHIN}:
+        return ("The paper's kicked disk reproduces the two-disk FTLE within 10 % "
+                f"({lo:.3g}–{hi:.3g}) under all {n_controls} controls.")
+    cells = [screen_cell(ftle[ftle["system"] == s]) for s in ("poisson", "actual")]
+    return (f"The paper's kicked disk's FTLE, Poisson kicks: {cells[0]}; actual kicks: "
+            f"{cells[1]}.")
+
+
+def first_screen(table: pd.DataFrame, shares=None) -> list[str]:
+    """The Markdown lines that open a results page: at most three sentences (the Poisson
+    question with the collision rule, the paper's kicked disk, how to read the table),
+    then the table (:func:`overview_table`) and the list of its controls. ``shares`` is
+    accepted for compatibility and unused: the Poisson numbers come from the table's rows."""
+    controls = [c for c in dict.fromkeys(table["control"]) if c != "primary"]
+    sentences = [poisson_answer(table), ftle_answer(table),
+                 "Each cell: the kicked/two-disk ratio's range over every control (listed "
+                 "below the table) and both families; ✓ with its verdict when all agree in "
+                 "verdict and direction, else the control that changes it most, both numbers "
+                 "(↕: above 1 under one control, below 1 under another)."]
+    lines = [" ".join(s for s in sentences if s), ""]
+    lines += markdown_table(overview_table(table))
+    lines += ["", "Controls: " + ", ".join(_CONTROL_WORDS.get(c, c) for c in controls)
+              + "; the kinetic-rate kicks under the mirror rule only."]
+    return lines + [""]
+
+
+def mmpp_answer(table: pd.DataFrame) -> str:
+    """With the ``mmpp`` system: does clustering in the kick times bring the kicked disk
+    closer? Its FTLE ratio against the Poisson kicks' (primary, per family), and its cell."""
+    ftle = table[table["diagnostic"] == "ftle"]
+    if "mmpp" not in set(ftle["system"]):
+        return ""
+    primary = ftle[ftle["control"] == "primary"].set_index(["family", "system"])["estimate"]
+    pairs = [f"{fam}: {primary[fam, 'mmpp']:.2f} against {primary[fam, 'poisson']:.2f}"
+             for fam in dict.fromkeys(ftle["family"])
+             if (fam, "mmpp") in primary.index and (fam, "poisson") in primary.index]
+    return ("Does clustering in the kick times bring the kicked disk closer? MMPP kicks (a "
+            "two-state Markov-modulated Poisson process fitted to each IC's collision times) "
+            "against Poisson kicks at the same mean rate, FTLE ratio to the two-disk value"
+            + (f" ({'; '.join(pairs)})" if pairs else "") + ": MMPP kicks: "
+            + screen_cell(ftle[ftle["system"] == "mmpp"]) + ".")
+
+
+def answers(table: pd.DataFrame, poisson_share=None) -> list[str]:
+    """The answers that open a report's findings: the Poisson question, the paper's kicked
+    disk, and (with the ``mmpp`` system) clustered kicks."""
+    return [s for s in (poisson_answer(table), ftle_answer(table), mmpp_answer(table)) if s]
+
+
+def poisson_share(effects) -> tuple | None:
+    """``(share, ci_low, ci_high, alpha)`` of the Poisson-rejection finding, or None."""
+    for e in effects:
+        if e.question.startswith("Poisson"):
+            return (e.estimate, e.ci_low, e.ci_high, 0.05)
+    return None
+
+
+#: the headline figure's panels: (diagnostic, title)
+PANELS = (
+    ("ftle", "FTLE λ"),
+    ("rr_offdiag@0.001", "off-diagonal RR, ε = 10⁻³\n(uniform-time samples)"),
+    ("rr_offdiag@0.01", "off-diagonal RR, ε = 10⁻²\n(uniform-time samples)"),
+    ("det@0.01", "DET, ε = 10⁻²\n(uniform-time samples)"),
+    ("one_minus_r1", "1 − R₁\n(lag-1 decorrelation)"),
+)
+# y ticks of the ratio panels, by how many decades the panel spans (labels never overlap)
+_LOG_TICKS = (
+    (4.0, (0.2, 0.3, 0.5, 0.7, 0.9, 1.0, 1.1, 1.5, 2.0, 3.0)),
+    (20.0, (0.1, 0.2, 0.3, 0.5, 0.7, 1.0, 1.5, 2.0, 3.0, 5.0, 10.0)),
+    (math.inf, (0.01, 0.02, 0.05, 0.1, 0.2, 0.5, 1.0, 2.0, 5.0, 10.0, 20.0, 50.0)),
+)
+#: the statistic of the headline figure: robust to the few sticky runs
+HEADLINE_CONTROL = "paired_median"
+
+
+def log_ratio_axis(ax):
+    """A log y axis for ratios with plain tick labels that never overlap."""
+    from matplotlib.ticker import FixedLocator, FuncFormatter, NullLocator
+
+    ax.set_yscale("log")
+    lo, hi = ax.get_ylim()
+    choice = next(t for span, t in _LOG_TICKS if hi / lo <= span)
+    ax.yaxis.set_major_locator(FixedLocator([t for t in choice if lo <= t <= hi]))
+    ax.yaxis.set_minor_locator(NullLocator())
+    ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+
+
+def ratio_curves_figure(curves: pd.DataFrame, control=HEADLINE_CONTROL):
+    """The headline figure: the ratio of each kicked system to the two-disk value against
+    r, one line per kick law, one panel per diagnostic (columns) and family (rows), with
+    95 % CIs (bootstrap clustered on ICs) and the ±10 % band. Every panel shares one log y
+    scale, so the band has the same height everywhere. The statistic is ``control``'s
+    (default the paired median of per-IC ratios, which a few sticky runs cannot move); the
+    recurrence panels use uniform-time samples (the primary setting of recurrence).
+
+    Parameters
+    ----------
+    curves : pandas.DataFrame
+        ``Controls.curves`` of one or more stores (concatenated).
+    control : str
+        Which control's per-radius curves to draw.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    from matplotlib.figure import Figure
+    from matplotlib.lines import Line2D
+
+    from kicktimes.report.figures import radius_axis, system_label, system_style
+
+    curves = curves[curves["control"] == control]
+    panels = [(d, t) for d, t in PANELS if d in set(curves["diagnostic"])]
+    families = list(dict.fromkeys(curves["family"]))
+    systems = [s for s in _SHORT if s in set(curves["system"])]
+    ncol, nrow = max(len(panels), 1), max(len(families), 1)
+    fig = Figure(figsize=(3.0 * ncol, 2.9 * nrow + 0.9), layout="constrained")
+    axes = fig.subplots(nrow, ncol, squeeze=False, sharey=True, sharex="row")
+    shown = curves[curves["diagnostic"].isin([d for d, _ in panels])]
+    values = shown[["ratio", "ci_low", "ci_high"]].to_numpy(float)
+    values = values[np.isfinite(values) & (values > 0)]
+    lo = min(0.8, float(values.min()) / 1.1) if values.size else 0.5
+    hi = max(1.25, float(values.max()) * 1.1) if values.size else 2.0
+    for f, fam in enumerate(families):
+        for j, (diagnostic, title) in enumerate(panels):
+            ax = axes[f, j]
+            ax.axhspan(0.9, 1.1, color="0.85", zorder=0)
+            ax.axhline(1.0, color="0.5", linewidth=0.8, zorder=0)
+            part = curves[(curves["diagnostic"] == diagnostic) & (curves["family"] == fam)]
+            for k, system in enumerate(systems):
+                c = part[part["system"] == system].sort_values("radius")
+                if c.empty:
+                    continue
+                style = system_style(system, k)
+                err = np.vstack([c["ratio"] - c["ci_low"], c["ci_high"] - c["ratio"]])
+                ax.errorbar(c["radius"], c["ratio"], yerr=np.clip(err, 0, None),
+                            color=style["color"], marker=style["marker"], markersize=3,
+                            linewidth=1.0, capsize=1.5)
+            ax.set_title(f"{fam}: {title}" if j == 0 or f == 0 else title, fontsize="small")
+            radius_axis(ax)
+            ax.set_ylim(lo, hi)
+            log_ratio_axis(ax)
+        axes[f, 0].set_ylabel(f"{fam}\nkicked / two-disk\n(median of per-IC ratios)",
+                              fontsize="small")
+    handles = [Line2D([], [], color=system_style(s, k)["color"], marker=system_style(s, k)[
+        "marker"], linestyle="-", label=system_label(s)) for k, s in enumerate(systems)]
+    handles += [Line2D([], [], color="0.85", linewidth=6, label="±10 % band")]
+    fig.legend(handles=handles, loc="outside lower center", ncol=min(len(handles), 4),
+               fontsize="small")
+    return fig

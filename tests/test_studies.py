@@ -1,0 +1,105 @@
+"""The studies' registry and the command line that builds their pages.
+
+``kicktimes reproduce --study NAME`` runs the registered study's ``reproduce``; ``--study
+all`` runs every one in the registry's order (the paper study first: the science study
+reads its stores and findings) with every page in one folder; ``kicktimes run NAME`` and
+``kicktimes presets`` serve the built-in experiments, the one definition of the presets.
+"""
+
+import importlib
+
+import pytest
+from click.testing import CliRunner
+
+from kicktimes.cli import main
+from kicktimes.experiment import PRESETS, Experiment, preset, preset_names
+from kicktimes.studies import STUDIES, Study
+
+
+def test_every_study_has_its_package_with_reproduce_and_a_page_of_its_own():
+    pages = [s.page for s in STUDIES.values()]
+    assert len(set(pages)) == len(pages)
+    # the paper study's sweeps run from the command line (its report process compiles
+    # and builds while they run); its package writes the page
+    entry = {"paper": "write_results", "protocol": "reproduce_protocol",
+             "disks": "reproduce_disks"}
+    for study in STUDIES.values():
+        module = importlib.import_module(study.module)
+        assert callable(getattr(module, entry.get(study.name, "reproduce"))), study.name
+        assert all(need in STUDIES and list(STUDIES).index(need) < list(STUDIES).index(
+            study.name) for need in study.needs)
+
+
+def test_reproduce_dispatches_to_the_study_with_its_command(tmp_path, monkeypatch):
+    calls = []
+
+    def fake(self, out, **options):
+        calls.append((self.name, out, options))
+        return tmp_path / self.page
+
+    monkeypatch.setattr(Study, "reproduce", fake)
+    res = CliRunner().invoke(main, ["reproduce", "--study", "escape", "--scale", "paper",
+                                    "--out", str(tmp_path), "--workers", "1",
+                                    "--no-progress"])
+    assert res.exit_code == 0, res.output
+    (name, out, options), = calls
+    assert (name, out) == ("escape", str(tmp_path))
+    assert options["scale"] == "paper" and options["results_dir"] is None
+    assert options["command"] == "kicktimes reproduce --study escape --scale paper"
+    assert "page written to" in res.output
+
+
+def test_all_runs_every_study_in_order_into_one_results_folder(tmp_path, monkeypatch):
+    import kicktimes.cli.experiment as cli
+
+    seen = []
+
+    def fake(study, results, findings, scale, *args, command=None):
+        seen.append((study, results, command))
+
+    monkeypatch.setattr(cli, "_reproduce_one", fake)
+    res = CliRunner().invoke(main, ["reproduce", "--study", "all", "--out", str(tmp_path)])
+    assert res.exit_code == 0, res.output
+    assert [s for s, _, _ in seen] == list(STUDIES)
+    assert {r for _, r, _ in seen} == {str(tmp_path / "results")}
+    assert {c for *_, c in seen} == {"kicktimes reproduce --study all --scale quick"}
+
+
+def test_findings_is_refused_where_no_study_reads_it(tmp_path):
+    res = CliRunner().invoke(main, ["reproduce", "--study", "escape", "--findings",
+                                    str(tmp_path), "--out", str(tmp_path)])
+    assert res.exit_code == 2 and "--findings applies to" in res.output
+
+
+def test_presets_lists_every_preset_and_prints_the_toml_of_a_two_disk_one():
+    two, disks = preset_names()
+    assert two == list(PRESETS)
+    listing = CliRunner().invoke(main, ["presets"])
+    assert listing.exit_code == 0
+    for name in two + disks:
+        assert f"  {name} " in listing.output
+    toml = CliRunner().invoke(main, ["presets", "quick_b"])
+    assert Experiment.from_toml_string(toml.output) == preset("quick_b")
+    wrong = CliRunner().invoke(main, ["presets", "family_c"])
+    assert wrong.exit_code == 2 and "'family_c' is not a preset" in wrong.output
+    gas = CliRunner().invoke(main, ["presets", disks[0]])
+    assert gas.exit_code == 2 and "kicktimes run " + disks[0] in gas.output
+
+
+@pytest.mark.parametrize("how", ["name", "toml"])
+def test_run_takes_a_preset_name_or_a_toml_file(tmp_path, monkeypatch, how):
+    import kicktimes.cli.experiment as cli
+
+    ran = []
+    monkeypatch.setattr(cli, "_pending", lambda exp, out: False)
+    monkeypatch.setattr(cli, "_run_one", lambda exp, out, *a, **k: ran.append(exp) or
+                        type("S", (), {"summary": lambda self: "done"})())
+    arg = "quick_a"
+    if how == "toml":
+        arg = str(tmp_path / "mine.toml")
+        preset("quick_a").write_toml(arg)
+    res = CliRunner().invoke(main, ["run", arg, "--out", str(tmp_path / "s")])
+    assert res.exit_code == 0, res.output
+    assert ran == [preset("quick_a")]
+    bad = CliRunner().invoke(main, ["run", "quick_c", "--out", str(tmp_path / "s")])
+    assert bad.exit_code == 2 and "neither a TOML file nor a preset" in bad.output
