@@ -1,0 +1,178 @@
+"""Escape through a hole (``kicktimes reproduce --study escape``): does the kicked disk
+escape at the two-disk rate, and could the comparison tell kick laws apart at all?
+
+For each radius of `RADII`, the same paper ICs run with one hole of half-width 0.05 rad in
+the wall (`compute.escape_times`):
+
+* ``two_particle``: the two disks. The run ends at the first escape, so disk 0's escape
+  is censored by disk 1's (competing risks). Two estimators of the per-disk rate: disk 0's
+  cause-specific rate, and the rate pooled over both exchangeable disks (events over
+  twice the time at risk); a verdict is given only where both give it;
+* ``poisson``, ``poisson_scatter``: disk 0 alone, kicked at Poisson times at the kinetic
+  rate Γ(r), with uniform new directions (the paper's kick) or scattering kicks;
+* negative controls, which a comparison able to tell escape laws apart must find
+  different: a hole of half the width, and uniform kicks at the same mean rate Γ(r) from a
+  stationary gamma renewal process of shape 0.1 (bursty);
+* ``free``: disk 0 alone, never kicked (the integrable circle).
+
+The escape rate γ is the exponential tail rate beyond ``t_min``: escapes after ``t_min``
+over the time the runs alive there spend beyond it,
+
+.. math:: \\gamma = \\frac{\\#\\{i : t_{\\min} < T_i \\le t_{\\max}\\}}
+                         {\\sum_i (\\min(T_i, t_{\\max}) - t_{\\min})_+},
+
+and each kicked / two-disk ratio of γ has a 95 % interval from a bootstrap over ICs,
+paired across systems, and the verdict `kicktimes.stats.ratio_verdict` with the 10 %
+margin. Each γ is also set against the ergodic rate of the hole alone,
+:math:`2h / (\\pi^2 (1 - r))`, and the free disk's t S(t), on invariant-measure ICs,
+against Bunimovich & Dettmann's constant C of the circle
+(`kicktimes.stats.circle_escape_constant`).
+
+The page ``escape.md`` goes into ``results_dir`` with ``escape/escape_tails.csv``,
+``escape/escape_ratios.csv``, ``escape/escape_constant.csv`` and
+``escape/escape_survival.png``; the escape times per IC are cached in ``out``, one table
+per radius (`compute.escape_times`, `compute.free_disk_escapes`).
+
+References
+----------
+L. A. Bunimovich and C. P. Dettmann, "Open circular billiards and the Riemann
+hypothesis", Phys. Rev. Lett. 94, 100201 (2005).
+
+Examples
+--------
+>>> from kicktimes.studies.escape import SCALES, ergodic_rate
+>>> SCALES["paper"].n_ics, SCALES["paper"].n_free
+(4000, 40000)
+>>> round(ergodic_rate(0.01), 5)
+0.01023
+
+``reproduce("work", scale="quick")`` writes ``work/results-escape/escape.md`` in well
+under a minute on one core.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import pandas as pd
+
+from kicktimes.fileio import atomic_write
+from kicktimes.studies.cache import cached_tables
+from kicktimes.studies.escape.compute import (
+    BURSTY_SHAPE,
+    FREE_TIMES,
+    HOLE,
+    RADII,
+    SMALL_HOLE,
+    bootstrap_picks,
+    constant_rows,
+    ergodic_rate,
+    escape_tables,
+    escape_times,
+    free_disk_escapes,
+    tail_rates,
+)
+from kicktimes.studies.escape.figures import survival_figure
+from kicktimes.studies.escape.page import FIGURE, write_page
+from kicktimes.studies.options import check_scale, check_workers
+
+__all__ = ["SCALES", "Params", "constant_rows", "ergodic_rate", "escape_tables",
+           "escape_times", "free_disk_escapes", "reproduce", "survival_figure", "tail_rates",
+           "write_page"]
+
+
+@dataclass(frozen=True)
+class Params:
+    """The escape study's sizes: ``n_ics`` paper ICs per radius run to ``t_max``, tail
+    fits beyond ``t_min``, ``n_free`` invariant-measure ICs per radius for the free disk's
+    constant, every draw from ``seed``."""
+
+    n_ics: int
+    t_max: float
+    t_min: float
+    n_free: int
+    seed: int = 11
+
+
+#: ``paper``: the sizes of docs/results/escape.md; ``quick``: 400 ICs, 2000 free-disk ICs
+SCALES = {"quick": Params(n_ics=400, t_max=3000.0, t_min=50.0, n_free=2000),
+          "paper": Params(n_ics=4000, t_max=3000.0, t_min=50.0, n_free=40000)}
+
+
+def _escape_times(r, n_ics, t_max, seed):
+    from kicktimes import initial_conditions
+
+    ics = initial_conditions(n_ics, max(RADII), seed=seed)
+    return escape_times(r, ics, t_max, seed)
+
+
+def reproduce(out: str | os.PathLike, *, scale: str = "quick",
+              results_dir: str | os.PathLike | None = None, workers: int = 1,
+              progress=None, command: str | None = None) -> Path:
+    """Run (or reuse) the escape simulations in ``out`` and write ``escape.md``.
+
+    Parameters
+    ----------
+    out : path-like
+        The work folder: the escape times per IC are cached in ``out/cache-escape``
+        (``cache-escape-quick`` at the quick scale), one parquet table per radius with
+        its parameters beside it; a rerun with the same parameters reuses them.
+    scale : {"quick", "paper"}
+        ``paper``: the sizes of docs/results/escape.md (4000 ICs per radius to
+        t = 3000, 40 000 free-disk ICs per radius); ``quick``: 400 and 2000.
+    results_dir : path-like, optional
+        Folder of the page ``escape.md`` and its folder ``escape/`` (default
+        ``out/results-escape``).
+    workers : int
+        Processes for the simulations, one radius at a time each.
+    progress : callable, optional
+        Takes one line of text per step; ``None``: silent.
+    command : str, optional
+        The command the page's "Generated" line names (default
+        ``kicktimes reproduce --study escape --scale SCALE``).
+
+    Returns
+    -------
+    pathlib.Path
+        The page.
+    """
+    check_scale(scale, SCALES)
+    workers = check_workers(workers)
+    params = SCALES[scale]
+    start = time.perf_counter()
+    cache = Path(out) / ("cache-escape" if scale == "paper" else f"cache-escape-{scale}")
+    results = Path(results_dir) if results_dir is not None else Path(out) / "results-escape"
+    command = command or f"kicktimes reproduce --study escape --scale {scale}"
+    geometry = {"hole": HOLE, "small_hole": SMALL_HOLE, "bursty_shape": BURSTY_SHAPE}
+    free_t_max = max(params.t_max, 3000.0)
+    jobs = [(cache / f"escape_times_r{r:g}.parquet",
+             {"radius": r, "n_ics": params.n_ics, "t_max": params.t_max,
+              "seed": params.seed, **geometry},
+             _escape_times, (r, params.n_ics, params.t_max, params.seed)) for r in RADII]
+    jobs += [(cache / f"free_escapes_r{r:g}.parquet",
+              {"radius": r, "n_free": params.n_free, "t_max": free_t_max,
+               "seed": params.seed, "hole": HOLE},
+              free_disk_escapes, (r, params.n_free, free_t_max, params.seed)) for r in RADII]
+    cached = cached_tables(jobs, workers=workers, progress=progress)
+    times = {r: c.table for r, c in zip(RADII, cached[:len(RADII)], strict=True)}
+    table, ratio_tab, curves = escape_tables(times, params.t_max, params.t_min,
+                                             bootstrap_picks(params.n_ics, params.seed))
+    constant = pd.DataFrame([row for r, c in zip(RADII, cached[len(RADII):], strict=True)
+                             for row in constant_rows(r, c.table["escape_time"], FREE_TIMES)])
+    folder = results / "escape"
+    for name, frame in (("escape_tails.csv", table), ("escape_ratios.csv", ratio_tab),
+                        ("escape_constant.csv", constant)):
+        atomic_write(folder / name, lambda tmp, frame=frame: frame.to_csv(tmp, index=False))
+    fig = survival_figure(curves)
+    atomic_write(results / FIGURE, lambda tmp: fig.savefig(tmp, dpi=110, format="png"))
+    page = results / "escape.md"
+    # the build's seconds: this call's and those the reused simulations took when they ran
+    seconds = time.perf_counter() - start + sum(c.seconds for c in cached if c.reused)
+    lines = write_page(table, ratio_tab, constant, params, command, seconds, cache.name)
+    atomic_write(page, lambda tmp: Path(tmp).write_text("\n".join(lines), encoding="utf-8"))
+    if progress is not None:
+        progress(f"escape: {page} written")
+    return page

@@ -1,0 +1,85 @@
+"""The escape study (kicktimes.studies.escape): its page from its tables, its cache."""
+
+import re
+
+import numpy as np
+import pandas as pd
+import pytest
+
+import kicktimes.studies.escape as study
+from kicktimes.stats import format_interval, ratio_verdict
+
+TINY = study.Params(n_ics=40, t_max=400.0, t_min=50.0, n_free=300)
+MACHINE_PATH = re.compile(r"(/tmp/|/work/|/home/|/Users/|/root/|[A-Za-z]:\\\\)")
+
+
+@pytest.fixture(scope="module")
+def built(tmp_path_factory):
+    out = tmp_path_factory.mktemp("escape")
+    lines = []
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setitem(study.SCALES, "quick", TINY)
+        page = study.reproduce(out, progress=lines.append)
+    return out, page, lines
+
+
+def test_the_page_names_its_command_and_no_machine_path(built):
+    _, page, _ = built
+    text = page.read_text(encoding="utf-8")
+    assert page.name == "escape.md" and page.parent.name == "results-escape"
+    assert "(`kicktimes reproduce --study escape --scale quick`)" in text.splitlines()[2]
+    assert not MACHINE_PATH.search(text)
+    assert (page.parent / "escape" / "escape_survival.png").stat().st_size > 0
+
+
+def test_the_page_s_ratios_are_its_csv_with_their_verdicts(built):
+    _, page, _ = built
+    text = page.read_text(encoding="utf-8")
+    ratios = pd.read_csv(page.parent / "escape" / "escape_ratios.csv")
+    assert set(ratios.loc[ratios["negative_control"], "system"]) == set(study.compute.CONTROLS)
+    for row in ratios.itertuples():
+        assert row.verdict == ratio_verdict(row.ci_low, row.ci_high)
+        assert format_interval(row.ratio, row.ci_low, row.ci_high) in text
+    constant = pd.read_csv(page.parent / "escape" / "escape_constant.csv")
+    assert (constant["n"] == TINY.n_free).all()
+
+
+def test_a_rerun_reuses_the_cached_escape_times(built, monkeypatch):
+    out, page, _ = built
+    before = {p.name: p.read_bytes() for p in (page.parent / "escape").glob("*.csv")}
+
+    def no_simulation(*args, **kwargs):
+        raise AssertionError("simulated again")
+
+    monkeypatch.setattr(study, "escape_times", no_simulation)
+    monkeypatch.setattr(study, "free_disk_escapes", no_simulation)
+    monkeypatch.setitem(study.SCALES, "quick", TINY)
+    again = study.reproduce(out, command="my command")
+    assert "(`my command`)" in again.read_text(encoding="utf-8")
+    for name, data in before.items():
+        assert (again.parent / "escape" / name).read_bytes() == data, name
+
+
+def test_bad_scale_and_workers_are_refused_by_name(tmp_path):
+    with pytest.raises(ValueError, match="scale"):
+        study.reproduce(tmp_path, scale="huge")
+    for workers in (0, 1.5, True):
+        with pytest.raises(ValueError, match="workers"):
+            study.reproduce(tmp_path, workers=workers)
+    assert not any(tmp_path.iterdir())
+
+
+def test_the_tail_rate_is_events_over_time_at_risk_beyond_t_min():
+    rng = np.random.default_rng(1)
+    t = rng.exponential(100.0, 20000)
+    horizon = np.full(t.size, 3000.0)
+    t[t > 3000.0] = np.inf
+    picks = np.arange(t.size)[None, :]
+    one = study.tail_rates(t, horizon, 50.0, picks)[0]
+    assert one == pytest.approx(0.01, rel=0.03)
+    assert study.tail_rates(t, horizon, 50.0, picks, disks=2)[0] == pytest.approx(one / 2)
+
+
+def test_the_paper_scale_is_the_published_page_s():
+    assert study.SCALES["paper"] == study.Params(n_ics=4000, t_max=3000.0, t_min=50.0,
+                                                 n_free=40000, seed=11)
