@@ -1,0 +1,80 @@
+"""The unequal-disks study (kicktimes.studies.unequal): its page from its table, its cache."""
+
+import re
+
+import pandas as pd
+import pytest
+
+import kicktimes.studies.unequal as study
+from kicktimes.stats import format_interval, ratio_verdict
+
+TINY = study.Params(n_ics=8, n_steps=300)
+
+
+@pytest.fixture(scope="module")
+def built(tmp_path_factory):
+    out = tmp_path_factory.mktemp("unequal")
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setitem(study.SCALES, "quick", TINY)
+        page = study.reproduce(out)
+    return out, page
+
+
+def _cells(text, first):
+    for line in text.splitlines():
+        cells = [c.strip() for c in line.strip().strip("|").split("|")]
+        if cells[0] == first:
+            return cells
+    raise AssertionError(first)
+
+
+def test_the_page_names_its_command_and_its_numbers_are_its_csv(built):
+    _, page = built
+    text = page.read_text(encoding="utf-8")
+    assert page.name == "unequal.md" and page.parent.name == "results-unequal"
+    assert "(`kicktimes reproduce --study unequal --scale quick`)" in text.splitlines()[2]
+    assert not re.search(r"/tmp/|/work/|/home/", text)
+    table = pd.read_csv(page.parent / "size_ratio" / "size_ratio.csv")
+    assert table["size_ratio"].tolist() == [1.0, 1.5, 2.5, 4.0]
+    for row in table.itertuples():
+        cells = _cells(text, f"{row.size_ratio:g}")
+        lo, hi = row.ftle_partner_low_disk0, row.ftle_partner_high_disk0
+        assert cells[4] == (f"{format_interval(row.ftle_partner_ratio_disk0, lo, hi)}, "
+                            f"{ratio_verdict(lo, hi)}")
+        assert cells[3] == format_interval(row.dispersion_index, row.disp_low, row.disp_high,
+                                           edges=(1.0,))
+    assert (page.parent / "size_ratio" / "size_ratio.png").stat().st_size > 0
+
+
+def test_at_ratio_one_both_partners_are_the_same_kick(built):
+    out, _ = built
+    runs = pd.read_parquet(out / "cache-unequal-quick" / "runs_r1_0.01.parquet")
+    assert len(runs) == TINY.n_ics
+    for disk in (0, 1):
+        assert runs[f"kicked_partner_disk{disk}"].equals(runs[f"kicked_own_disk{disk}"])
+
+
+def test_a_rerun_reuses_the_cached_runs(built, monkeypatch):
+    out, page = built
+    before = (page.parent / "size_ratio" / "size_ratio.csv").read_bytes()
+
+    def no_simulation(*args, **kwargs):
+        raise AssertionError("simulated again")
+
+    monkeypatch.setattr(study, "size_ratio_runs", no_simulation)
+    monkeypatch.setitem(study.SCALES, "quick", TINY)
+    again = study.reproduce(out, command="my command")
+    assert "(`my command`)" in again.read_text(encoding="utf-8")
+    assert (again.parent / "size_ratio" / "size_ratio.csv").read_bytes() == before
+
+
+def test_bad_scale_and_workers_are_refused_by_name(tmp_path):
+    with pytest.raises(ValueError, match="scale"):
+        study.reproduce(tmp_path, scale="paper ")
+    with pytest.raises(ValueError, match="workers"):
+        study.reproduce(tmp_path, workers=0)
+    assert not any(tmp_path.iterdir())
+
+
+def test_the_paper_scale_is_the_published_page_s():
+    assert study.SCALES["paper"] == study.Params(n_ics=200, n_steps=10000, tau=0.3, seed=5)
