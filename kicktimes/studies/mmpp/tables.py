@@ -1,0 +1,129 @@
+"""The MMPP study's fits and checks: pooled and per-run MMPP fits to the two-disk
+collision times, their time-rescaling residuals through the Poisson battery, and the
+refractory dip against the fitted MMPP's exact hazard."""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+from scipy.linalg import expm
+
+from kicktimes import stats
+from kicktimes.stats import rejection_verdict
+from kicktimes.stats.findings import clopper_pearson
+
+__all__ = ["DIP", "MIN_EVENTS", "N_BOOT", "N_MC", "RENEWAL", "TESTS", "analyse", "battery",
+           "intervals", "mmpp_dip"]
+
+TESTS = ("uniformity_ks", "exponential_ks", "exponential_ad", "ljung_box", "runs", "dispersion")
+MIN_EVENTS = 20
+RENEWAL = ("gamma", "weibull", "hyperexponential")
+DIP = 0.5
+#: Monte Carlo samples of the Poisson battery's nulls; bootstrap resamples of the dip
+N_MC = 199
+N_BOOT = 1000
+
+
+def mmpp_dip(fit, d=DIP, n_grid=201):
+    """Mean hazard of the MMPP's interval law over [0, d), over its mean rate."""
+    lam = np.asarray(fit.rates, float)
+    pi = np.asarray(fit.stationary, float)
+    D = np.asarray(fit.generator, float) - np.diag(lam)
+    pe = pi * lam / (pi @ lam)
+    ts = np.linspace(0.0, d, n_grid)
+    surv = np.array([pe @ expm(D * t) @ np.ones_like(lam) for t in ts])
+    integral = np.trapezoid(surv, ts)
+    return float((1.0 - surv[-1]) / integral / (pi @ lam))
+
+
+def battery(times, windows, rng):
+    """Share of windows whose rescaled times reject each test, with its interval."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        res = stats.test_poisson_ensemble(times, windows, n_mc=N_MC, rng=rng)
+    per = res.per_sequence            # raw per-window p-values (``reject`` is after FDR)
+    rows = []
+    for test in TESTS:
+        k, n = int((per[f"p_{test}"] < 0.05).sum()), len(per)
+        lo, hi = clopper_pearson(k, n)
+        rows.append({"test": test, "n_windows": n, "rejected": k, "share": k / n,
+                     "ci_low": lo, "ci_high": hi, "verdict": rejection_verdict(lo, hi, 0.05)})
+    return rows
+
+
+def analyse(rule, times, sticky, t_max, per_run, seed):
+    """The rows of the three tables for one collision rule: the pooled fits (``pooled``),
+    the time-rescaling residual checks (``resid``) and the refractory dip (``dip``), from
+    the runs' collision ``times`` with the ``sticky`` ones left out; the per-run fits take
+    the first ``per_run`` runs with at least ``MIN_EVENTS`` collisions."""
+    rng = np.random.default_rng(seed)
+    calm = [t for t, s in zip(times, sticky, strict=True) if not s]
+    pooled, resid, dip = [], [], []
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        fits = {k: stats.fit_mmpp(calm, t_max, n_states=k, rng=seed) for k in (1, 2)}
+    two = fits[2]
+    # renewal models on the same windows: every gap a renewal interval (the first from
+    # t = 0: an ordinary renewal process), the last gap of each window censored
+    first_and_gaps = np.concatenate([np.diff(np.r_[0.0, t]) for t in calm])
+    last = np.array([t_max - (t[-1] if t.size else 0.0) for t in calm])
+    renewal = {}
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        for law in RENEWAL:
+            renewal[law] = stats.fit_renewal(first_and_gaps, law, censored=last).aic
+    pooled.append({"rule": rule, "n_runs": len(times), "n_sticky": int(sticky.sum()),
+                   "n_events": two.n_events, "rate_low": two.rates[0],
+                   "rate_high": two.rates[-1], "share_high": two.stationary[-1],
+                   "mean_stay_high": two.mean_sojourns[-1],
+                   "mean_stay_low": two.mean_sojourns[0], "t_max": t_max,
+                   "aic_poisson_minus_mmpp": fits[1].aic - two.aic,
+                   **{f"aic_{law}_minus_mmpp": aic - two.aic for law, aic in renewal.items()},
+                   "n_best_starts": two.n_best, "n_starts": two.n_starts})
+    for k, fit in fits.items():
+        rescaled = stats.mmpp_residuals(fit, calm, t_max)
+        for row in battery(rescaled.times, rescaled.windows, rng):
+            resid.append({"rule": rule, "fit": "pooled", "states": k, **row})
+    # per run: each run fitted alone
+    chosen = [t for t in calm if t.size >= MIN_EVENTS][:per_run]
+    per = []
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        for i, t in enumerate(chosen):
+            fit = stats.fit_mmpp(t, t_max, n_states=2, n_starts=6, rng=seed + i)
+            per.append(stats.mmpp_residuals(fit, t, t_max))
+    if per:
+        for row in battery([p.times[0] for p in per], [p.windows[0] for p in per], rng):
+            resid.append({"rule": rule, "fit": "per run", "states": 2, **row})
+    # the refractory dip
+    complete, censored = intervals(calm, t_max)
+    haz = stats.interval_hazard(complete, censored, edges=[0.0, DIP, float(
+        max(complete.max(), censored.max()))])
+    first = haz.table.iloc[0]
+    model = mmpp_dip(two)
+    boot_rng = np.random.default_rng(seed)
+    boot = []
+    for _ in range(N_BOOT):
+        pick = [calm[i] for i in boot_rng.integers(0, len(calm), len(calm))]
+        c, z = intervals(pick, t_max)
+        h = stats.interval_hazard(c, z, edges=[0.0, DIP, float(max(c.max(), z.max()))])
+        boot.append(h.table["hazard"].iloc[0] / h.rate)
+    b_lo, b_hi = np.percentile(boot, [2.5, 97.5])
+    dip.append({"rule": rule, "observed": first["hazard"] / haz.rate,
+                "ci_low": first["ci_low"] / haz.rate, "ci_high": first["ci_high"] / haz.rate,
+                "boot_low": b_lo, "boot_high": b_hi,
+                "mmpp": model, "poisson": 1.0,
+                "mean_stay_max": float(max(two.mean_sojourns)), "t_max": t_max,
+                "verdict": ("below the MMPP's" if max(first["ci_high"] / haz.rate, b_hi) < model
+                            else "above the MMPP's" if min(first["ci_low"] / haz.rate, b_lo) > model
+                            else "not distinguished from the MMPP's")})
+    return pooled, resid, dip
+
+
+def intervals(times, t_max):
+    """Complete intervals between collisions and the censored last gaps of each run (the
+    first gap, from t = 0, is not an interval after a collision and is left out)."""
+    complete = np.concatenate([np.diff(t) for t in times if t.size > 1])
+    censored = np.array([t_max - t[-1] for t in times if t.size])
+    return complete, censored

@@ -1,0 +1,81 @@
+"""The MMPP study (kicktimes.studies.mmpp): its page from its tables, its cache."""
+
+import re
+from types import SimpleNamespace
+
+import pandas as pd
+import pytest
+
+import kicktimes.studies.mmpp as study
+import kicktimes.studies.mmpp.tables as tables
+from kicktimes.stats import rejection_verdict
+
+TINY = study.Params(n_ics=12, t_max=300.0, per_run=3)
+#: fewer Monte Carlo samples and bootstrap resamples than the page's 199 and 1000
+FEW = {"N_MC": 19, "N_BOOT": 50}
+
+
+@pytest.fixture(scope="module")
+def built(tmp_path_factory):
+    out = tmp_path_factory.mktemp("mmpp")
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setitem(study.SCALES, "quick", TINY)
+        for name, value in FEW.items():
+            mp.setattr(tables, name, value)
+        page = study.reproduce(out)
+    return out, page
+
+
+def test_the_page_names_its_command_and_its_verdicts_are_its_csv(built):
+    _, page = built
+    text = page.read_text(encoding="utf-8")
+    assert page.name == "mmpp.md" and page.parent.name == "results-mmpp"
+    assert "(`kicktimes reproduce --study mmpp --scale quick`)" in text.splitlines()[2]
+    assert not re.search(r"/tmp/|/work/|/home/", text)
+    pooled = pd.read_csv(page.parent / "mmpp" / "mmpp_billiard_pooled.csv")
+    assert pooled["rule"].tolist() == list(study.RULES)
+    for p in pooled.itertuples():
+        assert f"| {p.rule} | {p.n_runs} ({p.n_sticky}) | {p.n_events} |" in text
+    resid = pd.read_csv(page.parent / "mmpp" / "mmpp_billiard_residuals.csv")
+    for row in resid.itertuples():
+        assert row.verdict == rejection_verdict(row.ci_low, row.ci_high, 0.05)
+    dip = pd.read_csv(page.parent / "mmpp" / "mmpp_billiard_dip.csv")
+    assert (dip["mmpp"] >= 1.0 - 1e-9).all()
+
+
+def test_a_rerun_reuses_the_cached_collision_times(built, monkeypatch):
+    out, page = built
+    before = (page.parent / "mmpp" / "mmpp_billiard_pooled.csv").read_bytes()
+
+    def no_simulation(*args, **kwargs):
+        raise AssertionError("simulated again")
+
+    monkeypatch.setattr(study, "collision_runs", no_simulation)
+    monkeypatch.setitem(study.SCALES, "quick", TINY)
+    for name, value in FEW.items():
+        monkeypatch.setattr(tables, name, value)
+    again = study.reproduce(out, command="my command")
+    assert "(`my command`)" in again.read_text(encoding="utf-8")
+    assert (again.parent / "mmpp" / "mmpp_billiard_pooled.csv").read_bytes() == before
+
+
+def test_bad_scale_and_workers_are_refused_by_name(tmp_path):
+    with pytest.raises(ValueError, match="scale"):
+        study.reproduce(tmp_path, scale="Paper")
+    with pytest.raises(ValueError, match="workers"):
+        study.reproduce(tmp_path, workers="1")
+    assert not any(tmp_path.iterdir())
+
+
+def test_an_mmpp_has_no_refractory_dip():
+    same = SimpleNamespace(rates=[0.5, 0.5], stationary=[0.5, 0.5],
+                           generator=[[-0.1, 0.1], [0.1, -0.1]])
+    assert study.mmpp_dip(same) == pytest.approx(1.0, rel=1e-6)
+    bursty = SimpleNamespace(rates=[0.05, 2.0], stationary=[0.9, 0.1],
+                             generator=[[-0.01, 0.01], [0.09, -0.09]])
+    assert study.mmpp_dip(bursty) > 1.0
+
+
+def test_the_paper_scale_is_the_published_page_s():
+    assert study.SCALES["paper"] == study.Params(n_ics=200, t_max=2000.0, per_run=200,
+                                                 radius=0.02, seed=29)
