@@ -129,27 +129,3 @@ def test_the_out_of_sample_rate_chain_keeps_the_order_of_its_training_states():
     np.testing.assert_array_equal(paths[:, 0], [1.0, 10.0])
     np.testing.assert_array_equal(paths[0, 1::2], 10.0)
     np.testing.assert_array_equal(paths[0, 2::2], 1.0)
-
-
-def test_the_escape_tail_rate_is_events_over_time_at_risk_beyond_t_min():
-    escape = _script("escape")
-    rng = np.random.default_rng(1)
-    t = rng.exponential(100.0, 20000)
-    horizon = np.full(t.size, 3000.0)
-    t[t > 3000.0] = np.inf
-    picks = np.arange(t.size)[None, :]
-    one = escape.tail_rates(t, horizon, 50.0, picks)[0]
-    assert one == pytest.approx(0.01, rel=0.03)
-    assert escape.tail_rates(t, horizon, 50.0, picks, disks=2)[0] == pytest.approx(one / 2)
-
-
-def test_an_mmpp_has_no_refractory_dip():
-    from types import SimpleNamespace
-
-    mm = _script("mmpp_billiard")
-    same = SimpleNamespace(rates=[0.5, 0.5], stationary=[0.5, 0.5],
-                           generator=[[-0.1, 0.1], [0.1, -0.1]])
-    assert mm.mmpp_dip(same) == pytest.approx(1.0, rel=1e-6)
-    bursty = SimpleNamespace(rates=[0.05, 2.0], stationary=[0.9, 0.1],
-                             generator=[[-0.01, 0.01], [0.09, -0.09]])
-    assert mm.mmpp_dip(bursty) > 1.0

@@ -128,6 +128,14 @@ def test_the_escape_page_answers_with_an_equivalence_test_and_its_controls():
     assert "Yes, at every radius" not in text
 
 
+@pytest.mark.parametrize("study, name", [("escape", "escape.md"), ("unequal", "unequal.md"),
+                                         ("scatter", "scatter.md"), ("mmpp", "mmpp.md")])
+def test_the_study_pages_name_the_command_that_builds_them(study, name):
+    generated = [line for line in _page(name).splitlines() if line.strip()][1]
+    assert f"(`kicktimes reproduce --study {study} --scale paper`)" in generated
+    assert "analysis/" not in generated
+
+
 def test_the_mmpp_page_s_residual_verdicts_are_their_intervals():
     from kicktimes.stats import rejection_verdict
 
