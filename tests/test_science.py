@@ -1,8 +1,5 @@
-"""analysis/science.py: the mechanism statements' estimators on data with known answers."""
-
-import importlib.util
-import sys
-from pathlib import Path
+"""kicktimes.studies.science and .mechanism: the mechanism statements' estimators on data
+with known answers."""
 
 import numpy as np
 import pandas as pd
@@ -10,16 +7,11 @@ import pytest
 
 from kicktimes.stats import ratio_verdict
 
-REPO = Path(__file__).resolve().parents[1]
-
 
 @pytest.fixture(scope="module")
 def science():
-    if str(REPO / "analysis") not in sys.path:   # the scripts import their helper `generated`
-        sys.path.insert(0, str(REPO / "analysis"))
-    spec = importlib.util.spec_from_file_location("science", REPO / "analysis" / "science.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
+    from kicktimes.studies import science as module
+
     return module
 
 
@@ -109,17 +101,9 @@ def test_twins_with_independent_kick_angles_separate_by_order_one_at_every_kick(
     assert lam / rate > math.log(1 / 2e-4) - 1.0
 
 
-def _script(name):
-    if str(REPO / "analysis") not in sys.path:
-        sys.path.insert(0, str(REPO / "analysis"))
-    spec = importlib.util.spec_from_file_location(name, REPO / "analysis" / f"{name}.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
-
 def test_the_out_of_sample_rate_chain_keeps_the_order_of_its_training_states():
-    mech = _script("mechanism")
+    from kicktimes.studies import mechanism as mech
+
     # training runs alternate a slow and a fast state: the chain must alternate too
     first = np.array([1.0, 1.0, 1.0])
     post = [np.tile([10.0, 1.0], 20) for _ in first]

@@ -97,7 +97,8 @@ def test_the_scatter_page_is_its_csv_and_no_longer_decomposes_the_gap():
 def _numbers(folder):
     path = RESULTS / "mechanism" / folder / "mechanism_numbers.csv"
     assert path.is_file(), (f"{path.name} of {folder or 'mirror'} is missing: rebuild it with "
-                            "analysis/mechanism.py")
+                            "kicktimes reproduce --study mechanism --scale paper "
+                            "--results docs/results")
     return pd.read_csv(path)
 
 

@@ -1,54 +1,44 @@
-"""Why the disk-disk collisions cluster, measured on runs (issue 29, item 2).
+"""The numbers of the mechanism study: one group (IC family, radius) at a time.
 
-Simulates a moderate ensemble of two-disk runs with their collision logs (radii 0.01 and
-0.02, paper ICs and invariant-measure ICs, ``t_max = 2000``) and measures:
-
-1. per collision the angular momenta before and after, the impact parameter and the
-   intervals (`kicktimes.diagnostics.mechanism.collision_tables`);
-2. the hazard of the intervals against the time since the last collision, in raw time,
-   in each run's own time unit (1 / its rate) and in the time rescaled by the predicted
-   rate (`kicktimes.stats.interval_hazard`);
-3. the share of re-collisions (at most one wall hit of each disk since the previous
-   collision) against randomly placed events at the same rate;
-4. with `kicktimes.stats.conditional_kinetic_rate`: each IC's predicted rate against its
-   observed rate, the pooled interval law as a mixture over the post-collision angular
-   momenta against the fitted hyperexponential, and the Poisson battery on Cox twins
-   (rate redrawn at every event from the run's own post-collision sequence) next to
-   Poisson, mixed-Poisson and observed sequences.
-
-Writes ``mechanism_*.png`` (drawn by ``analysis/mechanism_figures.py``) and
-``mechanism_numbers.csv`` (every number docs/mechanism.md quotes) into ``--out``. About
-one and a half minutes on two cores::
-
-    python analysis/mechanism.py --out docs/results/mechanism --workers 2
+`analyse` measures, on the runs of one group: per collision the angular momenta before
+and after, the impact parameter and the intervals
+(`kicktimes.diagnostics.mechanism.collision_tables`); the hazard of the intervals in raw
+time, in each run's own time unit and in the time rescaled by the predicted rate
+(`kicktimes.stats.interval_hazard`); the share of re-collisions against randomly placed
+events; each IC's predicted rate against its observed rate; the pooled interval law as a
+mixture over the post-collision states against the hyperexponential fit; and the Poisson
+battery on the twins of `kicktimes.studies.mechanism.twins` with the share of the
+observed excess each reproduces (`explained`). `state_rates` and `cell_rows` pool both IC
+families per radius by the post-collision (L0, L1).
 """
 
 from __future__ import annotations
 
-import argparse
 import math
-import time
-from concurrent.futures import ProcessPoolExecutor
-from pathlib import Path
 
 import numpy as np
 import pandas as pd
 import scipy.stats as sps
-from mechanism_figures import write_figures
 
-from kicktimes import initial_conditions, simulate_two_particle, stats
+from kicktimes import stats
 from kicktimes.diagnostics import mechanism
+from kicktimes.studies.mechanism.simulate import METHODS
+from kicktimes.studies.mechanism.twins import (
+    BATTERY,
+    CHAIN_STATES,
+    battery,
+    dispersion,
+    rate,
+    twin_batteries,
+)
 
-RADII = (0.01, 0.02)
-METHODS = ("paper", "uniform")
-BATTERY = ("uniformity_ks", "exponential_ks", "exponential_ad", "dispersion")
-TWINS = ("poisson", "mixed_poisson", "cox_iid", "cox_sequence", "cox_markov_oos")
+__all__ = ["EXPLAINERS", "LATE_RESCALED", "RETURN_TIME", "STICKY_FACTOR", "analyse",
+           "cell_rows", "clopper_pearson", "state_rates"]
+
 #: the models whose explained share is reported; cox_markov_oos is out of sample
 EXPLAINERS = ("mixed_poisson", "cox_iid", "cox_sequence", "cox_markov_oos")
 #: rescaled time beyond which the Gamma-rescaled hazard is read as one bin
 LATE_RESCALED = 5.0
-#: states drawn per out-of-sample twin (its path is recycled if a run needs more)
-CHAIN_STATES = 600
 STICKY_FACTOR = 5.0
 #: intervals shorter than this hold the wall round trips (the hazard's peak)
 RETURN_TIME = 4.0
@@ -60,77 +50,6 @@ HAZARD_EDGES = np.array([0, 0.5, 1, 1.5, 2, 2.5, 3, 4, 6, 10, 16, 25, 40, 63, 10
                          400, 630, 1000, 2000], float)
 
 
-# ------------------------------------------------------------------ simulation
-def _simulate(task):
-    ic, r, t_max, rule = task
-    return simulate_two_particle(ic, r, t_max=t_max, rule=rule, log_collisions=True)
-
-
-def simulate(n_ics, t_max, workers, seed, rule="mirror"):
-    """{(method, r): (ics, runs)} with the same ICs at both radii (drawn at the larger)."""
-    out = {}
-    with ProcessPoolExecutor(workers) as pool:
-        for method in METHODS:
-            ics = initial_conditions(n_ics, max(RADII), seed=seed, method=method, rule=rule)
-            for r in RADII:
-                runs = list(pool.map(_simulate, [(ic, r, t_max, rule) for ic in ics],
-                                     chunksize=10))
-                out[method, r] = (ics, runs)
-    return out
-
-
-def has_rate() -> bool:
-    return hasattr(stats, "conditional_kinetic_rate")
-
-
-def rate(r, L0, L1, speed0=None, speed1=None):
-    """Gamma(r; L0, L1), vectorised (`kicktimes.stats.conditional_kinetic_rate`); with the
-    speeds, the elastic rule's rate conditioned on them as well."""
-    L0, L1 = np.asarray(L0, float), np.asarray(L1, float)
-    if speed0 is None:
-        return np.asarray(stats.conditional_kinetic_rate(r, L0, L1), float)
-    return np.asarray(stats.conditional_kinetic_rate(
-        r, L0, L1, rule="elastic", speed1=np.asarray(speed0, float),
-        speed2=np.asarray(speed1, float)), float)
-
-
-def fit_rate_chain(first, post_by_run, n_bins=10):
-    """A first-order Markov chain of the post-collision rate, fitted on training runs.
-
-    The pairs (rate of the state before, rate of the state after) of consecutive
-    collisions of each run (the first "before" is the IC's predicted rate) are binned by
-    the rate before at its deciles; the chain's step from a rate in bin k draws the next
-    rate uniformly from the training pairs' "after" values in bin k. Returns
-    ``(edges, pool, counts)``.
-    """
-    prev = np.concatenate([np.r_[g, p[:-1]] for g, p in zip(first, post_by_run, strict=True)
-                           if p.size])
-    nxt = np.concatenate([p for p in post_by_run if p.size])
-    edges = np.unique(np.quantile(prev, np.linspace(0, 1, n_bins + 1)[1:-1]))
-    b = np.digitize(prev, edges)
-    counts = np.bincount(b, minlength=edges.size + 1)
-    pool = np.full((edges.size + 1, max(int(counts.max()), 1)), np.nan)
-    for k in range(edges.size + 1):
-        pool[k, :counts[k]] = nxt[b == k] if counts[k] else np.nan
-        if not counts[k]:                      # an empty bin steps like the whole sample
-            pool[k, :min(nxt.size, pool.shape[1])] = nxt[:pool.shape[1]]
-            counts[k] = min(nxt.size, pool.shape[1])
-    return edges, pool, counts
-
-
-def draw_rate_chains(chain, start, n_states, rng):
-    """Paths (len(start), n_states + 1) of the chain, each from its start rate."""
-    edges, pool, counts = chain
-    out = np.empty((len(start), n_states + 1))
-    out[:, 0] = cur = np.asarray(start, float)
-    for k in range(n_states):
-        b = np.digitize(cur, edges)
-        cur = pool[b, (rng.random(cur.size) * counts[b]).astype(int)]
-        out[:, k + 1] = cur
-    return out
-
-
-# ------------------------------------------------------------------ helpers
 def clopper_pearson(k, n):
     """Exact (Clopper-Pearson) 95 % interval of a share ``k / n``."""
     ci = sps.binomtest(int(k), int(n)).proportion_ci(0.95, method="exact")
@@ -162,8 +81,17 @@ def _sup_distance(t, sf_emp, sf_model):
     return float(np.max(np.abs(sf_emp - sf_model(t))))
 
 
-# ------------------------------------------------------------------ analysis of one group
-def analyse(key, ics, runs, *, n_twins, rng, rule="mirror"):
+def analyse(key, ics, runs, *, n_twins, rng, rule="mirror", n_boot=1000):
+    """Every number of one group (IC family, radius) and the data of its figures.
+
+    ``key`` is ``(method, r)``; ``ics`` and ``runs`` the group's ICs and runs (simulated
+    with ``log_collisions=True``); ``n_twins`` the twin ensembles per model; ``rng`` the
+    generator every random draw of the analysis takes (shared across groups, in order);
+    ``n_boot`` the resamples of its bootstrap intervals over ICs (the explained shares
+    take 200).
+    Returns ``(rows, data)``: the rows of ``mechanism_numbers.csv`` and a dict of tables,
+    hazards, fits and batteries for `kicktimes.studies.mechanism.figures`.
+    """
     method, r = key
     rows, data = [], {}
     t_max = runs[0].t_max
@@ -262,7 +190,7 @@ def analyse(key, ics, runs, *, n_twins, rng, rule="mirror"):
 
     # observed Poisson battery
     seqs = [run.pp_times for run in runs]
-    obs = _battery(seqs, t_max, rng)
+    obs = battery(seqs, t_max, rng)
     data["observed"] = obs
     for test in BATTERY:
         k = int(obs["reject"][test].sum())
@@ -270,10 +198,8 @@ def analyse(key, ics, runs, *, n_twins, rng, rule="mirror"):
         obs.setdefault("ci", {})[test] = (low, high)
         _row(rows, key, f"observed_reject_{test}", k / len(runs), low, high)
     _row(rows, key, "observed_dispersion_index", obs["dispersion_index"],
-         *_boot_ci(lambda p: _dispersion(n_pp[p]), len(runs), rng))
+         *_boot_ci(lambda p: dispersion(n_pp[p]), len(runs), rng, n_boot))
 
-    if not has_rate():
-        return rows, data
     # 4. predicted rates
     pred = np.asarray(mechanism.predicted_rates(ics, r, rule=rule), float)
     speeds = (tab["speed0_post"], tab["speed1_post"]) if rule == "elastic" else ()
@@ -295,12 +221,12 @@ def analyse(key, ics, runs, *, n_twins, rng, rule="mirror"):
         rho = sps.spearmanr(x, obs_rate).statistic
         _row(rows, key, f"spearman_observed_vs_{name}_rate", rho,
              *_boot_ci(lambda p, x=x: sps.spearmanr(x[p], obs_rate[p]).statistic,
-                       len(runs), rng))
+                       len(runs), rng, n_boot))
         pos = obs_rate > 0
         rr = np.corrcoef(np.log(x[pos]), np.log(obs_rate[pos]))[0, 1]
         _row(rows, key, f"pearson_log_observed_vs_{name}_rate", rr)
     _row(rows, key, "compensator_over_count", comp.sum() / n_pp.sum(),
-         *_boot_ci(lambda p: comp[p].sum() / n_pp[p].sum(), len(runs), rng),
+         *_boot_ci(lambda p: comp[p].sum() / n_pp[p].sum(), len(runs), rng, n_boot),
          note="sum of the predicted rate along each run over its collisions")
     _row(rows, key, "initial_prediction_over_kinetic", pred.mean() / gamma)
     sticky_ic = obs_rate > STICKY_FACTOR * gamma
@@ -360,7 +286,7 @@ def analyse(key, ics, runs, *, n_twins, rng, rule="mirror"):
              mt["ci_high"], note=f"Gamma-rescaled hazard over rescaled t in [{lo_t:g}, {hi_t:g})")
 
     # Cox twins through the same battery
-    twins = _twins(runs, tab, pred, post, t_max, n_twins, rng)
+    twins = twin_batteries(runs, tab, pred, post, t_max, n_twins, rng)
     _row(rows, key, "oos_chain_states", CHAIN_STATES,
          note="cox_markov_oos: rate chain fitted on the other half of the ICs (even / odd)")
     data["twins"] = twins
@@ -376,56 +302,16 @@ def analyse(key, ics, runs, *, n_twins, rng, rule="mirror"):
         _explained(rows, key, test, obs, twins, rng)
     _explained(rows, key, "dispersion_index", obs, twins, rng)
     calm_ic = obs_rate <= STICKY_FACTOR * gamma
-    _row(rows, key, "observed_dispersion_index_nonsticky", _dispersion(n_pp[calm_ic]),
-         *_boot_ci(lambda p: _dispersion(n_pp[calm_ic][p]), int(calm_ic.sum()), rng))
+    _row(rows, key, "observed_dispersion_index_nonsticky", dispersion(n_pp[calm_ic]),
+         *_boot_ci(lambda p: dispersion(n_pp[calm_ic][p]), int(calm_ic.sum()), rng,
+                   n_boot))
     for name, res in twins.items():
-        d = np.array([_dispersion(b["counts"][calm_ic]) for b in res])
+        d = np.array([dispersion(b["counts"][calm_ic]) for b in res])
         _row(rows, key, f"{name}_dispersion_index_nonsticky", d.mean(),
              *np.quantile(d, [0.025, 0.975]))
     _explained(rows, key, "dispersion_index", obs, twins, rng, subset=calm_ic,
                suffix="_nonsticky")
     return rows, data
-
-
-def _dispersion(counts):
-    counts = np.asarray(counts, float)
-    return counts.var(ddof=1) / counts.mean() if counts.mean() > 0 else math.nan
-
-
-def _battery(seqs, t_max, rng):
-    res = stats.poisson_group(seqs, t_max, n_mc=199, rng=rng)
-    per = res.ensemble.per_sequence
-    reject = pd.DataFrame({t: (per[f"p_{t}"] < 0.05).to_numpy() for t in BATTERY})
-    counts = per["n_events"].to_numpy()
-    return {"reject": reject, "counts": counts,
-            "dispersion_index": res.homogeneity["dispersion_index"]}
-
-
-def _twins(runs, tab, pred, post, t_max, n_twins, rng):
-    """The battery on n_twins ensembles of each twin model, paired with the runs."""
-    by_run = [post[tab["run"].to_numpy() == i] for i in range(len(runs))]
-    pooled = np.array([run.n_pp for run in runs]).sum() / (len(runs) * t_max)
-    out = {name: [] for name in TWINS}
-    # out of sample: each half of the ICs gets the chain fitted on the other half
-    half = np.arange(len(runs)) % 2
-    chains = {h: fit_rate_chain(pred[half != h], [by_run[i] for i in np.flatnonzero(half != h)])
-              for h in (0, 1)}
-    for _ in range(n_twins):
-        paths = np.empty((len(runs), CHAIN_STATES + 1))
-        for h in (0, 1):
-            paths[half == h] = draw_rate_chains(chains[h], pred[half == h], CHAIN_STATES, rng)
-        draws = {
-            "poisson": [stats.simulate_cox_times([pooled], t_max, rng=rng) for _ in runs],
-            "mixed_poisson": [stats.simulate_cox_times([g], t_max, rng=rng) for g in pred],
-            "cox_iid": [stats.simulate_cox_times(post, t_max, order="iid", rng=rng)
-                        for _ in runs],
-            "cox_sequence": [stats.simulate_cox_times(np.concatenate([[g], p]), t_max, rng=rng)
-                             for g, p in zip(pred, by_run, strict=True)],
-            "cox_markov_oos": [stats.simulate_cox_times(path, t_max, rng=rng) for path in paths],
-        }
-        for name, seqs in draws.items():
-            out[name].append(_battery(seqs, t_max, rng))
-    return out
 
 
 def _explained(rows, key, what, obs, twins, rng, *, subset=None, suffix=""):
@@ -440,12 +326,12 @@ def _explained(rows, key, what, obs, twins, rng, *, subset=None, suffix=""):
     def stat(name, p):
         p = ics[p]
         if what == "dispersion_index":
-            return np.mean([_dispersion(b["counts"][p]) for b in twins[name]])
+            return np.mean([dispersion(b["counts"][p]) for b in twins[name]])
         return np.mean([b["reject"][what].to_numpy()[p].mean() for b in twins[name]])
 
     def observed(p):
         p = ics[p]
-        return (_dispersion(obs["counts"][p]) if what == "dispersion_index"
+        return (dispersion(obs["counts"][p]) if what == "dispersion_index"
                 else obs["reject"][what].to_numpy()[p].mean())
 
     for name in EXPLAINERS:
@@ -494,67 +380,34 @@ def state_rates(results, r, n_bins=12):
         events.reshape(n_bins, n_bins)
 
 
-# ------------------------------------------------------------------ main
-def main(argv=None):
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--out", default="docs/results/mechanism")
-    ap.add_argument("--n-ics", type=int, default=200)
-    ap.add_argument("--t-max", type=float, default=2000.0)
-    ap.add_argument("--twins", type=int, default=20, help="twin ensembles per model (20)")
-    ap.add_argument("--workers", type=int, default=2)
-    ap.add_argument("--seed", type=int, default=29)
-    ap.add_argument("--rule", choices=("mirror", "elastic"), default="mirror",
-                    help="collision rule; elastic: rates conditioned on the speeds too")
-    args = ap.parse_args(argv)
-    out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
-    t0 = time.perf_counter()
-    groups = simulate(args.n_ics, args.t_max, args.workers, args.seed, args.rule)
-    print(f"simulated {sum(len(v[1]) for v in groups.values())} runs in "
-          f"{time.perf_counter() - t0:.0f} s", flush=True)
-    if not has_rate():
-        print("stats.conditional_kinetic_rate is missing: the predicted-rate parts are skipped")
-    rng = np.random.default_rng(args.seed)
-    rows, results = [], {}
-    for key, (ics, runs) in groups.items():
-        part, results[key] = analyse(key, ics, runs, n_twins=args.twins, rng=rng,
-                                     rule=args.rule)
-        rows += part
-        print(f"analysed {key} at {time.perf_counter() - t0:.0f} s", flush=True)
-    if has_rate():
-        for r in RADII:
-            _, emp, pred, events = state_rates(results, r)
-            ok = events >= 10
-            w = events[ok]
-            x, y = np.log(pred[ok]), np.log(emp[ok])
+def cell_rows(results, radii):
+    """The rows of the pooled (L0, L1) cells per radius (`state_rates`): the weighted
+    correlation and slope of log observed on log predicted cell rate over the cells with
+    at least 10 collisions, and the four corner cells over the kinetic rate."""
+    rows = []
+    for r in radii:
+        _, emp, pred, events = state_rates(results, r)
+        ok = events >= 10
+        w = events[ok]
+        x, y = np.log(pred[ok]), np.log(emp[ok])
+        corr = slope = math.nan                # no cell with 10 collisions (tiny runs)
+        if ok.any():
             xm, ym = np.average(x, weights=w), np.average(y, weights=w)
             corr = (np.average((x - xm) * (y - ym), weights=w)
                     / math.sqrt(np.average((x - xm) ** 2, weights=w)
                                 * np.average((y - ym) ** 2, weights=w)))
             slope = np.average((x - xm) * (y - ym), weights=w) / np.average((x - xm) ** 2,
                                                                              weights=w)
-            _row(rows, ("pooled", r), "cell_rate_log_correlation", corr,
-                 note=f"{int(ok.sum())} (L0, L1) cells with >= 10 collisions, weighted by "
-                 "collisions")
-            _row(rows, ("pooled", r), "cell_rate_log_slope", slope,
-                 note="weighted LS slope of log observed on log predicted cell rate")
-            gamma = stats.kinetic_rate(r)
-            # corner cells: (i, j) indexes (L0, L1) from -rho to rho
-            for (i, j), name in (((0, -1), "counter_rotating_-+"), ((-1, 0), "counter_rotating_+-"),
-                                 ((0, 0), "co_rotating_--"), ((-1, -1), "co_rotating_++")):
-                _row(rows, ("pooled", r), f"cell_rate_rim_{name}", emp[i, j] / gamma,
-                     note=f"corner cell (signs of L0, L1), over the kinetic rate; predicted "
-                     f"{pred[i, j] / gamma:.3g}; {int(events[i, j])} collisions")
-    for name, value in (("n_ics", args.n_ics), ("t_max", args.t_max), ("twins", args.twins),
-                        ("seed", args.seed)):
-        _row(rows, ("run", math.nan), name, value, note=f"rule {args.rule}")
-    table = pd.DataFrame(rows)
-    table.insert(0, "rule", args.rule)
-    table.to_csv(out / "mechanism_numbers.csv", index=False, float_format="%.6g")
-    cells = {r: state_rates(results, r) for r in RADII} if has_rate() else None
-    write_figures(results, out, cells=cells, rate=rate)
-    print(f"wrote {out} in {time.perf_counter() - t0:.0f} s")
-
-
-if __name__ == "__main__":
-    main()
+        _row(rows, ("pooled", r), "cell_rate_log_correlation", corr,
+             note=f"{int(ok.sum())} (L0, L1) cells with >= 10 collisions, weighted by "
+             "collisions")
+        _row(rows, ("pooled", r), "cell_rate_log_slope", slope,
+             note="weighted LS slope of log observed on log predicted cell rate")
+        gamma = stats.kinetic_rate(r)
+        # corner cells: (i, j) indexes (L0, L1) from -rho to rho
+        for (i, j), name in (((0, -1), "counter_rotating_-+"), ((-1, 0), "counter_rotating_+-"),
+                             ((0, 0), "co_rotating_--"), ((-1, -1), "co_rotating_++")):
+            _row(rows, ("pooled", r), f"cell_rate_rim_{name}", emp[i, j] / gamma,
+                 note=f"corner cell (signs of L0, L1), over the kinetic rate; predicted "
+                 f"{pred[i, j] / gamma:.3g}; {int(events[i, j])} collisions")
+    return rows

@@ -1,30 +1,24 @@
-"""Write docs/results/mechanism.md from the mechanism tables of both collision rules.
+"""The page ``mechanism.md`` from the numbers tables of both collision rules.
 
-Reads ``mechanism_numbers.csv`` of each rule (written by ``analysis/mechanism.py``:
-``--rule mirror --out docs/results/mechanism`` and ``--rule elastic --out
-docs/results/mechanism/elastic``) and writes the page: every number from a row, every
-comparative word from a verdict (`kicktimes.stats.ratio_verdict` for a hazard against
-the rate it should equal, disjoint 95 % intervals for "above chance"). Definitions and
-methods stay in docs/mechanism.md.
-
-Run::
-
-    python analysis/mechanism_page.py docs/results/mechanism docs/results/mechanism/elastic \\
-        --out docs/results/mechanism.md
+Reads the ``mechanism_numbers.csv`` of each rule (`kicktimes.studies.mechanism.run`
+writes them) and writes the page: every number from a row, every comparative word from a
+verdict (`kicktimes.stats.ratio_verdict` for a hazard against the rate it should equal,
+disjoint 95 % intervals for "above chance"). Definitions and methods stay in
+docs/mechanism.md.
 """
 
 from __future__ import annotations
 
-import argparse
 import math
-import os
 from pathlib import Path
 
 import pandas as pd
-from generated import MARGIN, header
-from mechanism_figures import NORMALISED_YLIM
 
+from kicktimes.report.pages import MARGIN, header
 from kicktimes.stats import format_interval, ratio_rule, ratio_verdict
+from kicktimes.studies.mechanism.figures import NORMALISED_YLIM
+
+__all__ = ["load", "rule_section", "summary", "write_page"]
 
 GROUPS = (("paper", 0.01), ("paper", 0.02), ("uniform", 0.01), ("uniform", 0.02))
 LABEL = {"paper": "paper ICs", "uniform": "invariant ICs"}
@@ -34,17 +28,14 @@ TESTS = (("uniformity_ks", "uniformity KS rejections"),
 MODELS = (("cox_sequence", "in sample: Cox twin replaying the run's own states"),
           ("cox_markov_oos", "out of sample: rate chain fitted on the other half of the ICs"),
           ("cox_iid", "rates drawn independently from the group's pooled states"))
-COMMAND = ("python analysis/mechanism.py --rule mirror --out docs/results/mechanism && "
-           "python analysis/mechanism.py --rule elastic --out docs/results/mechanism/elastic && "
-           "python analysis/mechanism_page.py docs/results/mechanism "
-           "docs/results/mechanism/elastic --out docs/results/mechanism.md")
 
 
 def load(folder):
     """The numbers of one rule, indexed by (method, radius, quantity)."""
     path = Path(folder) / "mechanism_numbers.csv"
     if not path.is_file():
-        raise ValueError(f"folders: {path} is missing (run analysis/mechanism.py)")
+        raise ValueError(f"folders: {path} is missing (the study writes it: "
+                         "kicktimes reproduce --study mechanism)")
     tab = pd.read_csv(path)
     if "rule" not in tab:
         raise ValueError(f"folders: {path} has no rule column (written before issue 41)")
@@ -285,31 +276,20 @@ def _carry(tab, groups, rule):
             "of sample); each share's interval is in the table above.")
 
 
-def _rel(folder, page):
-    """``folder`` relative to the page's folder (a link, never a machine path)."""
-    return Path(os.path.relpath(Path(folder).resolve(), Path(page).resolve().parent)).as_posix()
-
-
-def main(argv=None):
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("folders", nargs="+", help="folders holding mechanism_numbers.csv")
-    ap.add_argument("--out", default="docs/results/mechanism.md")
-    args = ap.parse_args(argv)
-    tabs = [load(f) for f in args.folders]
-    lines = header("Why the collision times are not Poisson: the mechanism, computed", COMMAND,
-                   [f"the direct simulations of `analysis/mechanism.py` under the "
-                    f"{t['rule'].iloc[0]} rule ([table]({_rel(f, args.out)}/mechanism_numbers.csv))"
-                    for t, f in zip(tabs, args.folders, strict=True)])
+def write_page(tables, folders, path, *, command):
+    """Write the page to ``path`` from the numbers ``tables`` of the rules, whose tables
+    and figures lie in ``folders`` (relative to the page's folder, e.g.
+    ``"mechanism/elastic"``); ``command`` is the one its "Generated" line names."""
+    lines = header("Why the collision times are not Poisson: the mechanism, computed", command,
+                   [f"the direct simulations of `kicktimes.studies.mechanism` under the "
+                    f"{t['rule'].iloc[0]} rule ([table]({f}/mechanism_numbers.csv))"
+                    for t, f in zip(tables, folders, strict=True)])
     lines += ["Definitions and methods: [../mechanism.md](../mechanism.md). Two radii "
               "(0.01, 0.02) × two IC families (the paper's, the invariant measure), the same "
               "ICs at both radii. Verdicts of a hazard against the rate it should equal: "
               f"{ratio_rule(MARGIN)}.", ""]
-    lines += summary(tabs)
-    for tab, folder in zip(tabs, args.folders, strict=True):
-        lines += rule_section(tab, _rel(folder, args.out))
-    Path(args.out).write_text("\n".join(lines), encoding="utf-8")
-    print(f"{args.out} written")
-
-
-if __name__ == "__main__":
-    main()
+    lines += summary(tables)
+    for tab, folder in zip(tables, folders, strict=True):
+        lines += rule_section(tab, folder)
+    Path(path).write_text("\n".join(lines), encoding="utf-8")
+    return Path(path)

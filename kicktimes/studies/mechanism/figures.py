@@ -1,12 +1,12 @@
-"""Figures of ``analysis/mechanism.py`` (docs/mechanism.md).
+"""The figures of the mechanism study (docs/results/mechanism.md).
 
-Each ``fig_*`` takes the per-group results of ``mechanism.analyse`` (a dict keyed by
-(IC family, radius)) and returns a `matplotlib.figure.Figure`; `write_figures` saves them.
+Each ``fig_*`` takes the per-group results of
+`kicktimes.studies.mechanism.analysis.analyse` (a dict keyed by (IC family, radius)) and
+returns a `matplotlib.figure.Figure`; `write_figures` saves them.
 """
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 
 import matplotlib
@@ -19,6 +19,11 @@ import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
 from kicktimes import stats  # noqa: E402
+from kicktimes.studies.mechanism.twins import dispersion  # noqa: E402
+
+__all__ = ["NORMALISED_YLIM", "fig_battery", "fig_hazard", "fig_hazard_normalised",
+           "fig_impact", "fig_rate_prediction", "fig_recollisions", "fig_state_rates",
+           "fig_survival", "write_figures"]
 
 TWIN_LABELS = {"poisson": "Poisson\n(pooled\nrate)",
                "mixed_poisson": "mixed\nPoisson\nΓ(initial)",
@@ -33,11 +38,6 @@ def _groups(results):
     methods = list(dict.fromkeys(m for m, _ in results))
     radii = list(dict.fromkeys(r for _, r in results))
     return methods, radii
-
-
-def _dispersion(counts):
-    counts = np.asarray(counts, float)
-    return counts.var(ddof=1) / counts.mean() if counts.mean() > 0 else math.nan
 
 
 def _panels(results, fn, title, *, sharey=False, figsize=(10, 7.5)):
@@ -185,12 +185,12 @@ def fig_battery(results):
         calm = d["calm_ic"]
         for ax, (what, _) in zip(axes, panels, strict=True):
             if what == "dispersion_index":
-                vals = [[_dispersion(b["counts"][calm]) for b in d["twins"][n]] for n in twins]
+                vals = [[dispersion(b["counts"][calm]) for b in d["twins"][n]] for n in twins]
                 counts = np.asarray(d["observed"]["counts"][calm], float)
-                obs = _dispersion(counts)
+                obs = dispersion(counts)
                 picks = np.random.default_rng(0).integers(0, counts.size,
                                                           (1000, counts.size))
-                obs_ci = tuple(np.percentile([_dispersion(counts[p]) for p in picks],
+                obs_ci = tuple(np.percentile([dispersion(counts[p]) for p in picks],
                                              [2.5, 97.5]))
             else:
                 vals = [[b["reject"][what].mean() for b in d["twins"][n]] for n in twins]
@@ -239,7 +239,7 @@ def fig_state_rates(cells, rate):
         se = np.sqrt(events[ok]) / events[ok]       # relative SE of a Poisson count
         row[2].errorbar(pred[ok] / gamma, emp[ok] / gamma, yerr=1.96 * se * emp[ok] / gamma,
                         fmt="o", ms=3, alpha=0.7)
-        lim = [0.3, max(8.0, np.nanmax(emp[ok] / gamma))]
+        lim = [0.3, np.nanmax(emp[ok] / gamma, initial=8.0)]
         row[2].plot(lim, lim, color="grey", lw=1)
         row[2].set_xscale("log")
         row[2].set_yscale("log")

@@ -1,0 +1,52 @@
+"""The figure of the science page: stretching per perturbation and its ratio per radius."""
+
+from __future__ import annotations
+
+import math
+
+from kicktimes.report.pages import MARGIN
+
+__all__ = ["LEGEND", "stretching_figure"]
+
+LEGEND = {"two_particle": "two disks (per disk-disk collision)",
+          "poisson": "uniform kick (Poisson times)",
+          "poisson_scatter": "scatter kick (Poisson times)"}
+
+
+def stretching_figure(per_radius, path):
+    """Left: stretching per perturbation against ln(1/r) with intervals; right: the
+    kicked / two-disk ratio per radius with its interval and the +-10 % band around 1."""
+    from matplotlib.figure import Figure
+
+    from kicktimes.report.figures import system_label, system_style
+
+    fig = Figure(figsize=(10.0, 4.2), layout="constrained")
+    ax, bx = fig.subplots(1, 2)
+    for k, (system, g) in enumerate(per_radius.groupby("system", sort=False, observed=True)):
+        st = system_style(system, k)
+        err = [g["stretch_per_perturbation"] - g["ci_low"], g["ci_high"]
+               - g["stretch_per_perturbation"]]
+        ax.errorbar(g["ln_inv_r"], g["stretch_per_perturbation"], yerr=err, linestyle="-",
+                    linewidth=0.8, marker=st["marker"], color=st["color"], capsize=2,
+                    label=LEGEND.get(system, system_label(system)))
+        if system != "two_particle":
+            err = [g["ratio"] - g["ratio_ci_low"], g["ratio_ci_high"] - g["ratio"]]
+            bx.errorbar(g["ln_inv_r"], g["ratio"], yerr=err, linestyle="-", linewidth=0.8,
+                        marker=st["marker"], color=st["color"], capsize=2,
+                        label=LEGEND.get(system, system_label(system)))
+    top = per_radius["ln_inv_r"].max()
+    for a in (ax, bx):
+        a.set_xlabel("ln(1/r)   (r: disk radius / table radius)")
+        sec = a.secondary_xaxis("top", functions=(lambda v: v, lambda v: v))
+        ticks = [0.03, 0.01, 0.005, 0.002]
+        sec.set_xticks([math.log(1 / t) for t in ticks], labels=[f"r={t:g}" for t in ticks])
+        a.set_xlim(per_radius["ln_inv_r"].min() - 0.15, top + 0.15)
+    ax.set_ylabel("stretching per perturbation λ/Γ (nats)")
+    ax.legend(fontsize="small", loc="upper left")
+    bx.axhspan(1 - MARGIN, 1 + MARGIN, color="0.88", label="±10 % around 1")
+    bx.axhline(1.0, color="0.5", linewidth=0.8)
+    bx.set_ylim(0, 1.2)
+    bx.set_ylabel("kicked / two-disk stretching (= FTLE ratio)")
+    bx.legend(fontsize="small", loc="lower right")
+    fig.savefig(path, dpi=110)
+    return fig

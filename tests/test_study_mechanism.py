@@ -1,0 +1,106 @@
+"""kicktimes reproduce --study mechanism: the page from the numbers of each rule, its
+cache, at a tiny size (the mirror rule only)."""
+
+from __future__ import annotations
+
+import pandas as pd
+import pytest
+
+from kicktimes.stats import format_interval, ratio_verdict
+from kicktimes.studies.mechanism import run
+
+TINY = run.MechanismScale(10, 1000.0, 1, n_boot=20)
+
+
+def _placeholders(results, folder, **kwargs):
+    """`write_figures` without drawing (the figures cost twice the tiny analysis; the
+    slow test below draws them)."""
+    for name in run.FIGURES:
+        (folder / f"mechanism_{name}.png").write_bytes(f"{name} {sorted(results)}".encode())
+
+
+@pytest.fixture(scope="module")
+def built(tmp_path_factory):
+    out = tmp_path_factory.mktemp("mechanism")
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setitem(run.SCALES, "quick", TINY)
+        mp.setattr(run, "RULES", {"mirror": "mechanism"})
+        mp.setattr(run, "write_figures", _placeholders)
+        page = run.reproduce(out)
+    return out, page
+
+
+def _cells(text, first):
+    for line in text.splitlines():
+        cells = [c.strip() for c in line.strip().strip("|").split("|")]
+        if cells[0] == first:
+            return cells
+    raise AssertionError(first)
+
+
+def test_the_page_names_the_command_and_reads_its_table(built):
+    out, page = built
+    assert page == out / "results-mechanism" / "mechanism.md"
+    text = page.read_text(encoding="utf-8")
+    generated = text.splitlines()[2]
+    assert generated.startswith("Generated ")
+    assert "(`kicktimes reproduce --study mechanism --scale quick`)" in generated
+    assert "[table](mechanism/mechanism_numbers.csv)" in generated and str(out) not in text
+    tab = pd.read_csv(page.parent / "mechanism" / "mechanism_numbers.csv")
+    run_rows = tab[tab["method"] == "run"].set_index("quantity")["estimate"]
+    assert run_rows.to_dict() == {"n_ics": 10, "t_max": 1000, "twins": 1, "seed": 29}
+    section = text.split("## The mirror rule")[1]
+    cells = _cells(section, "rescaled t > 5")
+    groups = [("paper", 0.01), ("paper", 0.02), ("uniform", 0.01), ("uniform", 0.02)]
+    for k, (method, r) in enumerate(groups):
+        row = tab[(tab["method"] == method) & (tab["radius"] == r)
+                  & (tab["quantity"] == "rescaled_hazard_late")].iloc[0]
+        if pd.notna(row["estimate"]):
+            assert cells[1 + k].startswith(format_interval(
+                row["estimate"], row["ci_low"], row["ci_high"], edges=(0.9, 1.0, 1.1)))
+            assert cells[1 + k].endswith(ratio_verdict(row["ci_low"], row["ci_high"]))
+    for name in run.FIGURES:
+        assert (page.parent / "mechanism" / f"mechanism_{name}.png").read_bytes().startswith(
+            name.encode())
+
+
+def test_a_rerun_reuses_each_rule_s_numbers_and_figures(built, monkeypatch):
+    out, page = built
+
+    def fail(*args, **kwargs):
+        raise AssertionError("simulated again")
+
+    monkeypatch.setitem(run.SCALES, "quick", TINY)
+    monkeypatch.setattr(run, "RULES", {"mirror": "mechanism"})
+    monkeypatch.setattr(run, "simulate", fail)
+    again = run.reproduce(out, results_dir=out / "again", command="kicktimes reproduce "
+                          "--study mechanism")
+    assert "(`kicktimes reproduce --study mechanism`)" in again.read_text(encoding="utf-8")
+    for name in ["mechanism_numbers.csv"] + [f"mechanism_{n}.png" for n in run.FIGURES]:
+        assert ((out / "again" / "mechanism" / name).read_bytes()
+                == (page.parent / "mechanism" / name).read_bytes()), name
+    # other parameters are another computation
+    monkeypatch.setitem(run.SCALES, "quick", run.MechanismScale(10, 1000.0, 1, seed=30,
+                                                                n_boot=20))
+    with pytest.raises(AssertionError, match="simulated again"):
+        run.reproduce(out, results_dir=out / "other")
+
+
+@pytest.mark.parametrize(("option", "value"), [("scale", "paper-ish"), ("workers", 0),
+                                               ("workers", "2")])
+def test_bad_options_are_refused_by_name(tmp_path, option, value):
+    with pytest.raises(ValueError, match=option):
+        run.reproduce(tmp_path, **{option: value})
+
+
+@pytest.mark.slow
+def test_every_figure_the_page_links_is_drawn(tmp_path):
+    from kicktimes.studies.mechanism.page import rule_section
+
+    table = run.run_rule("elastic", TINY, tmp_path)
+    assert set(table["rule"]) == {"elastic"}
+    drawn = {p.name for p in tmp_path.glob("mechanism_*.png")}
+    assert drawn == {f"mechanism_{name}.png" for name in run.FIGURES}
+    text = "\n".join(rule_section(table, "mechanism/elastic"))
+    for name in ("hazard", "hazard_normalised", "battery"):
+        assert f"(mechanism/elastic/mechanism_{name}.png)" in text

@@ -1,0 +1,133 @@
+"""kicktimes reproduce --study science: the study's page from its cache and the paper
+study's stores and findings, at a tiny size."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import pandas as pd
+import pytest
+
+from kicktimes.experiment import preset, run_experiment
+from kicktimes.stats import format_interval, ratio_verdict
+from kicktimes.studies.science import run
+
+TINY = run.ScienceScale("stretching_tiny", (0.03, 0.05), 4, 1000, (0.03,), 1, 10, (0.03,), 2,
+                        300.0)
+
+
+def _findings(folder, families, radius=0.03):
+    """Findings tables as the paper study writes them, with made-up ratios."""
+    for family in families:
+        rows = [{"family": family, "diagnostic": d, "system": s, "control": "primary",
+                 "estimate": e, "ci_low": e - 0.05, "ci_high": e + 0.05,
+                 "verdict": ratio_verdict(e - 0.05, e + 0.05)}
+                for d in ("ftle", "one_minus_r1")
+                for s, e in (("poisson", 0.3), ("actual", 0.32), ("poisson_scatter", 0.97),
+                             ("actual_scatter", 0.9))]
+        pd.DataFrame(rows).to_csv(folder / f"{family}_findings.csv", index=False)
+        by_radius = pd.DataFrame(rows).rename(columns={"estimate": "ratio"})
+        by_radius["radius"] = radius
+        by_radius.to_csv(folder / f"{family}_findings_by_radius.csv", index=False)
+
+
+@pytest.fixture(scope="module")
+def paper_study(tmp_path_factory):
+    """Tiny quick stores of the paper study and its findings tables (mirror rule only)."""
+    folder = tmp_path_factory.mktemp("paper")
+    for name in ("quick_a", "quick_b"):
+        exp = dataclasses.replace(preset(name), radii=[0.03], n_ics=2, n_steps=100,
+                                  systems=("two_particle",), diagnostics=("lyapunov",),
+                                  rr_sampling="run")
+        run_experiment(exp, folder / f"store-{name}", workers=1, progress=False)
+    _findings(folder, ["quick_a", "quick_b"])
+    return folder
+
+
+@pytest.fixture(scope="module")
+def built(paper_study, tmp_path_factory):
+    out = tmp_path_factory.mktemp("science")
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setitem(run.SCALES, "quick", TINY)
+        page = run.reproduce(out, stores_dir=paper_study, findings_dir=paper_study)
+    return out, page
+
+
+def test_the_page_names_the_command_and_quotes_its_csv(built):
+    out, page = built
+    assert page == out / "results-science" / "science.md"
+    lines = page.read_text(encoding="utf-8").splitlines()
+    assert lines[2].startswith("Generated ")
+    assert "(`kicktimes reproduce --study science --scale quick`)" in lines[2]
+    assert "`quick_a`, `quick_b`" in lines[2] and str(out) not in page.read_text()
+    table = pd.read_csv(page.parent / "science_stretching.csv")
+    text = page.read_text(encoding="utf-8")
+    for row in table[table["system"] != "two_particle"].itertuples():
+        assert row.verdict == ratio_verdict(row.ratio_ci_low, row.ratio_ci_high)
+        assert (f"{format_interval(row.ratio, row.ratio_ci_low, row.ratio_ci_high)}, "
+                f"{row.verdict}") in text
+    twins = pd.read_csv(page.parent / "science_independent_twins.csv")
+    assert f"- r = {twins['radius'].iloc[0]:g}: λ = " in text
+    assert "(1 paper ICs, T = 300 per run" not in text and "(2 paper ICs, T = 300 per run" in text
+    compare = pd.read_csv(page.parent / "science_decorrelation_prediction.csv")
+    assert list(compare["family"]) == ["quick_a", "quick_a"]    # no elastic tables: mirror only
+    assert (page.parent / "science_stretching.png").stat().st_size > 0
+
+
+def test_a_rerun_reuses_the_cache_and_recomputes_only_the_statistics(built, paper_study,
+                                                                       monkeypatch):
+    out, page = built
+    parts = sorted((out / f"store-{TINY.sweep}").rglob("*.parquet"))
+    stamps = [p.stat().st_mtime_ns for p in parts]
+
+    def fail(*args, **kwargs):
+        raise AssertionError("simulated again")
+
+    monkeypatch.setitem(run.SCALES, "quick", TINY)
+    monkeypatch.setattr(run, "twins_raw", fail)
+    monkeypatch.setattr(run, "decorrelation", fail)
+    again = run.reproduce(out, results_dir=out / "again", stores_dir=paper_study,
+                          findings_dir=paper_study, command="kicktimes reproduce --study science")
+    text = again.read_text(encoding="utf-8")
+    assert "(read from the study's cache of an earlier run)" in text
+    assert "(`kicktimes reproduce --study science`)" in text
+    assert [p.stat().st_mtime_ns for p in parts] == stamps
+    for name in ("science_stretching.csv", "science_decorrelation.csv",
+                 "science_independent_twins.csv", "science_rate_count.csv"):
+        assert (out / "again" / name).read_bytes() == (page.parent / name).read_bytes(), name
+
+
+def test_other_parameters_compute_again(built, paper_study, monkeypatch):
+    out, _ = built
+    calls = []
+
+    def twins(radii, **kwargs):
+        calls.append(kwargs["n_steps"])
+        return pd.DataFrame({"radius": list(radii), "lam": 1.0, "rate": 0.1, "lo": 0.9,
+                             "hi": 1.1})
+
+    monkeypatch.setitem(run.SCALES, "quick", dataclasses.replace(TINY, twin_steps=11))
+    monkeypatch.setattr(run, "twins_raw", twins)
+    page = run.reproduce(out, results_dir=out / "other", stores_dir=paper_study,
+                         findings_dir=paper_study)
+    assert calls == [11]
+    assert "11 steps of τ" in page.read_text(encoding="utf-8")
+
+
+@pytest.mark.parametrize(("option", "value"), [("scale", "huge"), ("workers", 0),
+                                               ("workers", 1.5)])
+def test_bad_options_are_refused_by_name(tmp_path, option, value):
+    with pytest.raises(ValueError, match=option):
+        run.reproduce(tmp_path, **{option: value})
+
+
+def test_missing_inputs_name_the_file_and_the_command_that_makes_it(tmp_path, paper_study):
+    with pytest.raises(ValueError, match=r"store-family_a.*kicktimes reproduce --study paper "
+                       r"--scale paper --out OUT"):
+        run.reproduce(tmp_path, scale="paper")
+    with pytest.raises(ValueError, match=r"store-quick_a or .*store-family_a.*--scale quick"):
+        run.reproduce(tmp_path)
+    with pytest.raises(ValueError, match=r"findings_dir: .*quick_a_findings_by_radius\.csv is "
+                       r"missing.*kicktimes reproduce --study paper --scale quick --out OUT "
+                       r"--results DIR"):
+        run.reproduce(tmp_path, stores_dir=paper_study, findings_dir=tmp_path)
