@@ -9,7 +9,7 @@ import pytest
 import kicktimes.studies.escape as study
 from kicktimes.stats import format_interval, ratio_verdict
 
-TINY = study.Params(n_ics=40, t_max=400.0, t_min=50.0, n_free=300)
+TINY = study.Params(n_ics=100, t_max=400.0, t_min=50.0, n_free=300)
 MACHINE_PATH = re.compile(r"(/tmp/|/work/|/home/|/Users/|/root/|[A-Za-z]:\\\\)")
 
 

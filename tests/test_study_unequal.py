@@ -8,7 +8,7 @@ import pytest
 import kicktimes.studies.unequal as study
 from kicktimes.stats import format_interval, ratio_verdict
 
-TINY = study.Params(n_ics=8, n_steps=300)
+TINY = study.Params(n_ics=10, n_steps=1000)
 
 
 @pytest.fixture(scope="module")
