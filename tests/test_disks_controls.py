@@ -274,19 +274,9 @@ def test_the_bulk_control_refuses_a_store_whose_seeds_now_tag_other_disks(tiny):
         bulk_rows(other, 0.5)
 
 
-def _density_script():
-    import importlib.util
-    from pathlib import Path
-
-    path = Path(__file__).resolve().parents[1] / "analysis" / "disks_lyapunov_density.py"
-    spec = importlib.util.spec_from_file_location("disks_lyapunov_density", path)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
-
 def test_the_density_fit_finds_a_line_and_a_curve_on_data_with_known_answers():
-    script = _density_script()
+    from kicktimes.studies.disks.density import summarise
+
     rng = np.random.default_rng(3)
     packings = [0.0025, 0.005, 0.01, 0.02, 0.04]
     x = np.log(1.0 / (4.0 * np.array(packings) / np.pi))
@@ -297,7 +287,7 @@ def test_the_density_fit_finds_a_line_and_a_curve_on_data_with_known_answers():
             for k in range(12):
                 rows.append({"n_disks": n_disks, "packing": p, "state": k,
                              "lam_per_coll": shape(v) + rng.normal(0.0, 0.02)})
-    table, fits = script.summarise(pd.DataFrame(rows), n_boot=400)
+    table, fits = summarise(pd.DataFrame(rows), n_boot=400)
     line, curve = fits.iloc[0], fits.iloc[1]
     assert line["b_lo"] < 3.0 < line["b_hi"] and line["c_lo"] < 0.0 < line["c_hi"]
     assert line["reading"].endswith("the form holds over this range")
@@ -306,18 +296,18 @@ def test_the_density_fit_finds_a_line_and_a_curve_on_data_with_known_answers():
     # only the dilute packings enter the fit: 4 at or below 0.02, 3 local slopes
     assert len(str(line["local_over_b"]).split(";")) == 3
     with pytest.raises(ValueError, match="fit_max_packing"):
-        script.summarise(pd.DataFrame(rows), n_boot=10, fit_max_packing=0.004)
+        summarise(pd.DataFrame(rows), n_boot=10, fit_max_packing=0.004)
 
 
 def test_the_density_section_is_rendered_from_its_tables_or_skipped(tmp_path):
+    from kicktimes.studies.disks.density import summarise
     from kicktimes.studies.disks.kicked import density_lines
 
-    script = _density_script()
     a, b = tmp_path / "disks_lyapunov_density.csv", tmp_path / "disks_lyapunov_density_fit.csv"
     assert density_lines(a, b)[2].startswith("Not run here")
     rows = [{"n_disks": 300, "packing": p, "state": k, "lam_per_coll": 10.0 - 100 * p + k % 2}
             for p in (0.0025, 0.005, 0.01, 0.02) for k in range(4)]
-    table, fits = script.summarise(pd.DataFrame(rows), n_boot=200)
+    table, fits = summarise(pd.DataFrame(rows), n_boot=200)
     table.to_csv(a, index=False)
     fits.to_csv(b, index=False)
     text = "\n".join(density_lines(a, b))

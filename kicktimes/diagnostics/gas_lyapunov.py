@@ -17,7 +17,7 @@ observer"):
   ``d_k`` is measured, ``log(d_k / d0)`` summed and the twin put back at distance ``d0``
   along the separation. Kept as the check of the tangent method: over 32 states the
   ratio of their means is within 2 % at N = 10, 100, 1000 under both rules and at N = 2
-  under the elastic one (analysis/disks_ftle_check.py, docs/results/disks_ftle_check.csv).
+  under the elastic one (kicktimes.studies.disks.ftle_check, docs/results/disks_ftle_check.csv).
 
 Both estimate ``lambda = sum_k log(growth of segment k) / t``.
 """

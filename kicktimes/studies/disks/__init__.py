@@ -4,8 +4,11 @@ The tagged disk's collision times among N equal hard disks in the circular table
 N = 2 to 1000 (`kicktimes.experiment.DISKS_PRESETS`, their controls and the two-disk
 references): `tables` (the per-N tables: Poisson battery, dispersion, hazard, Enskog's
 rate, the kicked comparison), `controls` (every finding under the controls), `renewal`
-(renewal models by AIC), `kicked` (the kicked comparison's sections), `figures` and
-`page` (``disks.md``).
+(renewal models by AIC), `kicked` (the kicked comparison's sections), `ftle_check` (the
+gas's FTLE: tangent vectors against a twin, the engine's N = 2 against the two-disk
+simulator), `density` (the gas's FTLE against density, the kinetic-theory form), `figures`,
+`page` (``disks.md``) and `run` (`reproduce_disks`: the sweeps and the FTLE computations,
+run or resumed from the work folder, then the page).
 
 Examples
 --------
@@ -22,7 +25,8 @@ from kicktimes.studies.disks.figures import (
     rates_figure,
     rejection_figure,
 )
-from kicktimes.studies.disks.page import reproduce_disks, write_disks_page
+from kicktimes.studies.disks.page import write_disks_page
+from kicktimes.studies.disks.run import reproduce_disks
 from kicktimes.studies.disks.tables import (
     disks_hazard,
     disks_table,

@@ -5,7 +5,9 @@ The page's sections on the paper's question for a gas
 kicked with uniform new directions at Poisson times of its rate or at its collision times,
 or scattered off virtual partners from the collision kernel at Poisson times) and on the
 checks of the gas's FTLE (``disks_ftle_check.csv``, written beside the page by
-`kicktimes.diagnostics.gas_lyapunov`'s checks, rendered when it exists).
+`kicktimes.studies.disks.ftle_check`) and on its kinetic-theory form against density
+(``disks_lyapunov_density*.csv``, by `kicktimes.studies.disks.density`), each rendered when
+its table exists.
 """
 
 from __future__ import annotations
@@ -74,7 +76,7 @@ def _method(exp):
 
 
 #: the margin of the N = 2 check of the gas's FTLE against the two-disk simulator's: that
-#: of the dedicated check (`analysis/disks_ftle_check.py`, "engine/two-disk"), set before
+#: of the dedicated check (`kicktimes.studies.disks.ftle_check`, "engine/two-disk"), set before
 #: either was run
 N2_FTLE_MARGIN = 0.05
 
@@ -264,8 +266,9 @@ def ftle_check_lines(path) -> list:
              "two-disk simulator", ""]
     path = Path(path)
     if not path.exists():
-        return title + [f"Not run here: no {path.name} beside the page (the checks of "
-                        "`kicktimes.diagnostics.gas_lyapunov` write it).", ""]
+        return title + [f"Not run here: no {path.name} beside the page "
+                        "(`kicktimes.studies.disks.ftle_check.write_ftle_check` writes it).",
+                        ""]
     tab = pd.read_csv(path)
     missing = [c for c in FTLE_CHECK_COLUMNS if c not in tab.columns]
     if missing:
@@ -313,7 +316,7 @@ def density_form_reading(c_low, c_high, local_verdicts, margin) -> str:
 def density_lines(table_path, fit_path) -> list:
     """The section on the gas's FTLE against density (the kinetic-theory form
     ``λ/ν = a + b ln(1/ñ)``) from ``disks_lyapunov_density.csv`` and its ``_fit.csv``
-    (`analysis/disks_lyapunov_density.py`); each local slope's verdict recomputed
+    (`kicktimes.studies.disks.density`); each local slope's verdict recomputed
     (`kicktimes.stats.ratio_verdict` at the file's margin); one line if a file is absent.
 
     Examples
@@ -325,7 +328,8 @@ def density_lines(table_path, fit_path) -> list:
     table_path, fit_path = Path(table_path), Path(fit_path)
     if not (table_path.exists() and fit_path.exists()):
         return title + [f"Not run here: no {table_path.name} and {fit_path.name} beside the "
-                        "page (`python analysis/disks_lyapunov_density.py` writes them).", ""]
+                        "page (`kicktimes.studies.disks.density.write_lyapunov_density` "
+                        "writes them).", ""]
     tab, fits = pd.read_csv(table_path), pd.read_csv(fit_path)
     out = title + [
         "Kinetic theory gives a dilute gas's largest exponent per collision as linear in the "

@@ -7,14 +7,14 @@ their controls (`DISKS_CONTROLS`) and the two-disk references, computes their ta
 the kicked comparison's sections, `kicktimes.studies.disks.kicked`), writes them as CSV
 beside the page, draws the figures (`kicktimes.studies.disks.figures`) and writes the page:
 the answers first, each from the table through the verdict rules of `kicktimes.stats`,
-then one table per geometry with a row per N. `reproduce_disks` runs (or resumes) the
-sweeps first: ``kicktimes reproduce --study disks``.
+then one table per geometry with a row per N. `kicktimes.studies.disks.run.reproduce_disks`
+runs (or resumes) the sweeps and the gas's FTLE computations first: ``kicktimes reproduce
+--study disks``.
 """
 
 from __future__ import annotations
 
 import datetime as _dt
-import os
 import time
 from pathlib import Path
 
@@ -56,7 +56,7 @@ from kicktimes.studies.disks.kicked import (
 from kicktimes.studies.disks.renewal import renewal_lines, renewal_models
 from kicktimes.studies.disks.tables import disks_hazard, disks_table, kicked_table, two_disk_check
 
-__all__ = ["reproduce_disks", "write_disks_page"]
+__all__ = ["write_disks_page"]
 
 #: the controls figure shows N from here on (where the page's "becomes Poisson" is decided)
 CONTROLS_MIN_N = 10
@@ -712,44 +712,3 @@ def write_disks_page(store_paths, out_dir, *, command="kicktimes reproduce --stu
     page = out / "disks.md"
     page.write_text("\n".join(lines), encoding="utf-8")
     return page
-
-
-def reproduce_disks(out, *, results_dir=None, names=None, workers=1, scheduler=None,
-                    progress=None, command="kicktimes reproduce --study disks") -> Path:
-    """Run (or resume) the disks presets into ``out/store-<name>`` and write the page.
-
-    Parameters
-    ----------
-    out : path-like
-        Folder of the stores.
-    results_dir : path-like, optional
-        Where the page goes (default ``out/results-disks``).
-    names : sequence of str, optional
-        Presets (default every one of `kicktimes.experiment.DISKS_PRESETS`, their controls
-        `DISKS_CONTROLS` and the two-disk references `DISKS_REFERENCES`).
-    workers, scheduler, progress :
-        As in `kicktimes.experiment.run_experiment`.
-    """
-    from kicktimes.experiment import (
-        DISKS_CONTROLS,
-        DISKS_PRESETS,
-        DISKS_REFERENCES,
-        disks_preset,
-        run_experiment,
-    )
-
-    names = list(names or [*DISKS_PRESETS, *DISKS_CONTROLS, *DISKS_REFERENCES])
-    paths, cost = [], []
-    for name in names:
-        path = os.path.join(out, f"store-{name}")
-        store = run_experiment(disks_preset(name), path, workers=workers if scheduler is None
-                               else None, scheduler=scheduler, progress=progress)
-        # disks tasks record their CPU time; a two-disk sweep's tasks their wall time only
-        timings = store.timings
-        wall = timings["simulate"] if "simulate" in timings else timings["total"]
-        cost.append({"experiment": name, "tasks": len(store.manifest["tasks"]),
-                     "cpu_seconds": float(timings["cpu"].sum()) if "cpu" in timings
-                     else float("nan"), "wall_seconds": float(wall.sum())})
-        paths.append(path)
-    target = results_dir if results_dir is not None else os.path.join(out, "results-disks")
-    return write_disks_page(paths, target, command=command, cost=pd.DataFrame(cost))

@@ -1,0 +1,111 @@
+"""``kicktimes reproduce --study disks``: the disks sweeps and the gas's FTLE computations,
+run or resumed in one work folder, then the page.
+
+`reproduce_disks` runs the presets of `kicktimes.experiment.DISKS_PRESETS` (their controls
+and the two-disk references) into ``out/store-<name>``, the checks of the gas's FTLE
+(`kicktimes.studies.disks.ftle_check`) and its sweep against density
+(`kicktimes.studies.disks.density`) into their caches in ``out``, writes those
+computations' CSV tables into the results folder and then the page
+(`kicktimes.studies.disks.page.write_disks_page`). A rerun reuses every complete store and
+every cached table whose parameters match.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+from pathlib import Path
+
+import pandas as pd
+
+from kicktimes.studies.disks.density import DENSITY, LyapunovDensity, write_lyapunov_density
+from kicktimes.studies.disks.ftle_check import FTLE_CHECK, FtleCheck, write_ftle_check
+from kicktimes.studies.disks.page import write_disks_page
+from kicktimes.studies.options import check_workers
+
+__all__ = ["reproduce_disks"]
+
+
+def _progress_lines(progress):
+    """``(say, bar)``: the callable taking the FTLE computations' lines (or None) and the
+    ``progress`` for `run_experiment`, from ``reproduce_disks``'s ``progress``."""
+    if callable(progress):
+        return progress, False
+    show = (progress if progress is not None
+            else sys.stderr.isatty() and not os.environ.get("CI"))
+    return ((lambda line: print(line, file=sys.stderr, flush=True)) if show else None,
+            progress)
+
+
+def reproduce_disks(out, *, results_dir=None, names=None, workers=1, scheduler=None,
+                    progress=None, command="kicktimes reproduce --study disks",
+                    ftle_check=FTLE_CHECK, density=DENSITY) -> Path:
+    """Run (or resume) the disks presets into ``out/store-<name>`` and the gas's FTLE
+    computations into ``out``, then write the page.
+
+    Parameters
+    ----------
+    out : path-like
+        Folder of the stores and of the FTLE computations' cache (``out/ftle-check``,
+        ``out/lyapunov-density``).
+    results_dir : path-like, optional
+        Where the page goes (default ``out/results-disks``).
+    names : sequence of str, optional
+        Presets (default every one of `kicktimes.experiment.DISKS_PRESETS`, their controls
+        `DISKS_CONTROLS` and the two-disk references `DISKS_REFERENCES`).
+    workers, scheduler :
+        As in `kicktimes.experiment.run_experiment`; the FTLE computations run on
+        ``workers`` local processes (one if ``workers`` is None).
+    progress : bool or callable, optional
+        As in `run_experiment` (a progress bar; default: on a terminal, not under CI);
+        the FTLE computations then say what they compute or reuse on stderr. A callable
+        takes those lines instead (and no bar is shown).
+    command : str
+        The command the page's "Generated" line names.
+    ftle_check : kicktimes.studies.disks.ftle_check.FtleCheck or None
+        The checks of the gas's FTLE (`write_ftle_check`; default the published ones,
+        about 10 minutes on one core from scratch); None: not run (the page renders a
+        ``disks_ftle_check.csv`` already in ``results_dir``, if any).
+    density : kicktimes.studies.disks.density.LyapunovDensity or None
+        The FTLE against density (`write_lyapunov_density`; default the published sweep);
+        None: not run, as ``ftle_check``.
+
+    Returns
+    -------
+    pathlib.Path
+        The page, ``results_dir / "disks.md"``.
+    """
+    from kicktimes.experiment import (
+        DISKS_CONTROLS,
+        DISKS_PRESETS,
+        DISKS_REFERENCES,
+        disks_preset,
+        run_experiment,
+    )
+
+    pool = 1 if workers is None else check_workers(workers)
+    # before the sweeps: a wrong argument is found in a second, not after hours
+    for name, value, kind in (("ftle_check", ftle_check, FtleCheck),
+                              ("density", density, LyapunovDensity)):
+        if value is not None and not isinstance(value, kind):
+            raise ValueError(f"{name} must be a {kind.__name__} or None, got {value!r}")
+    say, bar = _progress_lines(progress)
+    names = list(names or [*DISKS_PRESETS, *DISKS_CONTROLS, *DISKS_REFERENCES])
+    paths, cost = [], []
+    for name in names:
+        path = os.path.join(out, f"store-{name}")
+        store = run_experiment(disks_preset(name), path, workers=workers if scheduler is None
+                               else None, scheduler=scheduler, progress=bar)
+        # disks tasks record their CPU time; a two-disk sweep's tasks their wall time only
+        timings = store.timings
+        wall = timings["simulate"] if "simulate" in timings else timings["total"]
+        cost.append({"experiment": name, "tasks": len(store.manifest["tasks"]),
+                     "cpu_seconds": float(timings["cpu"].sum()) if "cpu" in timings
+                     else float("nan"), "wall_seconds": float(wall.sum())})
+        paths.append(path)
+    target = results_dir if results_dir is not None else os.path.join(out, "results-disks")
+    if ftle_check is not None:
+        write_ftle_check(out, target, ftle_check, workers=pool, progress=say)
+    if density is not None:
+        write_lyapunov_density(out, target, density, workers=pool, progress=say)
+    return write_disks_page(paths, target, command=command, cost=pd.DataFrame(cost))
