@@ -44,7 +44,7 @@ class MechanismScale:
     n_boot: int = 1000
 
 
-#: ``paper``: the sizes of docs/results/mechanism.md; ``quick``: well under a minute
+#: ``paper``: the sizes of docs/results/mechanism.md; ``quick``: under a minute on one core
 SCALES = {"paper": MechanismScale(200, 2000.0, 20),
           "quick": MechanismScale(16, 1000.0, 1, n_boot=100)}
 #: each rule's folder, relative to the page
@@ -113,9 +113,10 @@ def reproduce(out: str | os.PathLike, *, scale: str = "quick",
         their parameters) and the figures; a rerun with the same parameters reuses them.
     scale : {"quick", "paper"}
         ``"paper"``: the sizes of docs/results/mechanism.md (200 ICs per group, runs of
-        2000, 20 twin ensembles per model, seed 29, 1000 bootstrap resamples);
-        ``"quick"``: 16 ICs, runs of 1000, 1 twin ensemble, 100 resamples, for trying it
-        out.
+        2000, 20 twin ensembles per model, seed 29, 1000 bootstrap resamples; about 11
+        CPU-minutes, 26 minutes of wall on a busy 2-core machine, 7 s from the cache);
+        ``"quick"``: 16 ICs, runs of 1000, 1 twin ensemble, 100 resamples (under a
+        minute on one core, most of it the figures), for trying it out.
     results_dir : path-like, optional
         Where the page goes (default ``out/results-mechanism``): ``mechanism.md``, and per
         rule its ``mechanism_numbers.csv`` and figures in ``mechanism/`` (mirror) and

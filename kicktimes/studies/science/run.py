@@ -71,7 +71,7 @@ class ScienceScale:
     decorrelation_t_max: float
 
 
-#: ``paper``: the sizes of docs/results/science.md; ``quick``: well under a minute
+#: ``paper``: the sizes of docs/results/science.md; ``quick``: seconds (on the quick stores)
 SCALES = {
     "paper": ScienceScale("stretching_small_r", SMALL_RADII, 100, None, (0.008, 0.02), 8,
                           3000, (0.008, 0.02), 40, 20000.0),
@@ -194,7 +194,7 @@ def reproduce(out: str | os.PathLike, *, scale: str = "quick",
         ``"paper"``: the sizes of docs/results/science.md (`SCALES`; from scratch about
         1.5 CPU-minutes, 6.5 minutes of wall on a busy 2-core machine, most of it the
         decorrelation runs; from the cache 27 s); ``"quick"``: a small version for trying
-        it out.
+        it out (7 s on one core from the paper study's quick stores).
     results_dir : path-like, optional
         Where ``science.md``, its ``science_*.csv`` tables and its figure go (default
         ``out/results-science``).
