@@ -19,7 +19,7 @@ MACHINE_PATH = re.compile(r"(/tmp/|/work/|/home/|/Users/|/root/|[A-Za-z]:\\\\)")
 
 def _page(name):
     path = RESULTS / name
-    assert path.is_file(), f"{name} is missing: rebuild it with analysis/make_science.py"
+    assert path.is_file(), f"{name} is missing: rebuild it with kicktimes reproduce --study all"
     return path.read_text(encoding="utf-8")
 
 
@@ -148,27 +148,17 @@ def test_the_mmpp_page_s_residual_verdicts_are_their_intervals():
     assert (dip["mmpp"] >= 1.0 - 1e-9).all()   # an MMPP has no refractory dip
 
 
-def test_one_command_rebuilds_every_generated_science_page():
-    import importlib.util
-    import sys
+def test_every_results_page_names_the_study_command_that_builds_it():
+    from kicktimes.studies import STUDIES
 
-    analysis = RESULTS.parents[1] / "analysis"
-    sys.path.insert(0, str(analysis))
-    try:
-        spec = importlib.util.spec_from_file_location("make_science",
-                                                      analysis / "make_science.py")
-        module = importlib.util.module_from_spec(spec)
-        spec.loader.exec_module(module)
-    finally:
-        sys.path.remove(str(analysis))
-    steps = module.steps("paper", "paper/science", 1, reuse=False)
-    names = [name for name, _ in steps]
-    for page in PAGES[1:]:
-        assert page in names or any(page.split(".")[0] in n for n in names), page
-    for _, argv in steps:
-        assert Path(argv[1]).is_file(), argv[1]
+    pages = {s.page: s.name for s in STUDIES.values()}
+    assert set(pages) == {p.name for p in RESULTS.glob("*.md")}
+    for page, name in pages.items():
+        generated = next(line for line in _page(page).splitlines()
+                         if line.startswith("Generated "))
+        assert f"(`kicktimes reproduce --study {name}" in generated, (page, generated[:160])
     readme = (RESULTS.parents[1] / "README.md").read_text(encoding="utf-8")
-    assert "python analysis/make_science.py" in readme
+    assert "kicktimes reproduce --study NAME" in readme and "--study all" in readme
 
 
 def test_the_science_page_claims_a_direction_only_where_both_trend_measures_agree():

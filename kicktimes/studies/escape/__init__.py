@@ -59,7 +59,6 @@ from pathlib import Path
 
 import pandas as pd
 
-from kicktimes.fileio import atomic_write
 from kicktimes.studies.cache import cached_tables
 from kicktimes.studies.escape.compute import (
     BURSTY_SHAPE,
@@ -77,7 +76,7 @@ from kicktimes.studies.escape.compute import (
 )
 from kicktimes.studies.escape.figures import survival_figure
 from kicktimes.studies.escape.page import FIGURE, write_page
-from kicktimes.studies.options import check_scale, check_workers
+from kicktimes.studies.options import study_run
 
 __all__ = ["SCALES", "Params", "constant_rows", "ergodic_rate", "escape_tables",
            "escape_times", "free_disk_escapes", "reproduce", "survival_figure", "tail_rates",
@@ -116,36 +115,21 @@ def reproduce(out: str | os.PathLike, *, scale: str = "quick",
 
     Parameters
     ----------
-    out : path-like
-        The work folder: the escape times per IC are cached in ``out/cache-escape``
-        (``cache-escape-quick`` at the quick scale), one parquet table per radius with
-        its parameters beside it; a rerun with the same parameters reuses them.
-    scale : {"quick", "paper"}
-        ``paper``: the sizes of docs/results/escape.md (4000 ICs per radius to
-        t = 3000, 40 000 free-disk ICs per radius); ``quick``: 400 and 2000.
-    results_dir : path-like, optional
-        Folder of the page ``escape.md`` and its folder ``escape/`` (default
-        ``out/results-escape``).
-    workers : int
-        Processes for the simulations, one radius at a time each.
-    progress : callable, optional
-        Takes one line of text per step; ``None``: silent.
-    command : str, optional
-        The command the page's "Generated" line names (default
-        ``kicktimes reproduce --study escape --scale SCALE``).
+    out, scale, results_dir, workers, progress, command :
+        As every study's (`kicktimes.studies.options`). The escape times per IC are cached in
+        ``out/cache-escape``, one table per radius. ``scale="paper"``: 4000 ICs per radius
+        to t = 3000, 40 000 free-disk ICs per radius; ``"quick"``: 400 and 2000. The page
+        comes with its folder ``escape/``; ``workers`` run one radius at a time each.
 
     Returns
     -------
     pathlib.Path
         The page.
     """
-    check_scale(scale, SCALES)
-    workers = check_workers(workers)
-    params = SCALES[scale]
+    run = study_run("escape", out, scale=scale, scales=SCALES, results_dir=results_dir,
+                    workers=workers, progress=progress, command=command)
+    params, cache = run.params, run.cache
     start = time.perf_counter()
-    cache = Path(out) / ("cache-escape" if scale == "paper" else f"cache-escape-{scale}")
-    results = Path(results_dir) if results_dir is not None else Path(out) / "results-escape"
-    command = command or f"kicktimes reproduce --study escape --scale {scale}"
     geometry = {"hole": HOLE, "small_hole": SMALL_HOLE, "bursty_shape": BURSTY_SHAPE}
     free_t_max = max(params.t_max, 3000.0)
     jobs = [(cache / f"escape_times_r{r:g}.parquet",
@@ -156,23 +140,17 @@ def reproduce(out: str | os.PathLike, *, scale: str = "quick",
               {"radius": r, "n_free": params.n_free, "t_max": free_t_max,
                "seed": params.seed, "hole": HOLE},
               free_disk_escapes, (r, params.n_free, free_t_max, params.seed)) for r in RADII]
-    cached = cached_tables(jobs, workers=workers, progress=progress)
+    cached = cached_tables(jobs, workers=run.workers, progress=progress)
     times = {r: c.table for r, c in zip(RADII, cached[:len(RADII)], strict=True)}
     table, ratio_tab, curves = escape_tables(times, params.t_max, params.t_min,
                                              bootstrap_picks(params.n_ics, params.seed))
     constant = pd.DataFrame([row for r, c in zip(RADII, cached[len(RADII):], strict=True)
                              for row in constant_rows(r, c.table["escape_time"], FREE_TIMES)])
-    folder = results / "escape"
     for name, frame in (("escape_tails.csv", table), ("escape_ratios.csv", ratio_tab),
                         ("escape_constant.csv", constant)):
-        atomic_write(folder / name, lambda tmp, frame=frame: frame.to_csv(tmp, index=False))
-    fig = survival_figure(curves)
-    atomic_write(results / FIGURE, lambda tmp: fig.savefig(tmp, dpi=110, format="png"))
-    page = results / "escape.md"
+        run.write_csv(f"escape/{name}", frame)
+    run.write_figure(FIGURE, survival_figure(curves))
     # the build's seconds: this call's and those the reused simulations took when they ran
     seconds = time.perf_counter() - start + sum(c.seconds for c in cached if c.reused)
-    lines = write_page(table, ratio_tab, constant, params, command, seconds, cache.name)
-    atomic_write(page, lambda tmp: Path(tmp).write_text("\n".join(lines), encoding="utf-8"))
-    if progress is not None:
-        progress(f"escape: {page} written")
-    return page
+    return run.write_page(write_page(table, ratio_tab, constant, params, run.command, seconds,
+                                     cache.name))

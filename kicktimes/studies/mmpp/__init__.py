@@ -44,12 +44,11 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from kicktimes.fileio import atomic_write
 from kicktimes.studies.cache import cached_tables
 from kicktimes.studies.mmpp.compute import RULES, collision_runs, sticky_runs
 from kicktimes.studies.mmpp.page import write_page
 from kicktimes.studies.mmpp.tables import analyse, battery, intervals, mmpp_dip
-from kicktimes.studies.options import check_scale, check_workers
+from kicktimes.studies.options import study_run
 
 __all__ = ["RULES", "SCALES", "Params", "analyse", "battery", "collision_runs", "intervals",
            "mmpp_dip", "reproduce", "sticky_runs", "write_page"]
@@ -84,43 +83,28 @@ def reproduce(out: str | os.PathLike, *, scale: str = "quick",
 
     Parameters
     ----------
-    out : path-like
-        The work folder: the collision times are cached in ``out/cache-mmpp``
-        (``cache-mmpp-quick`` at the quick scale), one parquet table per rule with its
-        parameters beside it; a rerun with the same parameters reuses them and refits.
-    scale : {"quick", "paper"}
-        ``paper``: the sizes of docs/results/mmpp.md (200 ICs per rule at r = 0.02 to
-        t = 2000, 200 runs fitted alone); ``quick``: 40 ICs to t = 500, 10 alone.
-    results_dir : path-like, optional
-        Folder of the page ``mmpp.md`` and its folder ``mmpp/`` (default
-        ``out/results-mmpp``).
-    workers : int
-        Processes for the simulations, one rule at a time each (the fits run here).
-    progress : callable, optional
-        Takes one line of text per step; ``None``: silent.
-    command : str, optional
-        The command the page's "Generated" line names (default
-        ``kicktimes reproduce --study mmpp --scale SCALE``).
+    out, scale, results_dir, workers, progress, command :
+        As every study's (`kicktimes.studies.options`). The collision times are cached in
+        ``out/cache-mmpp``, one table per rule; a rerun refits them. ``scale="paper"``:
+        200 ICs per rule at r = 0.02 to t = 2000, 200 runs fitted alone; ``"quick"``: 40
+        ICs to t = 500, 10 alone. The page comes with its folder ``mmpp/``; ``workers``
+        simulate one rule at a time each (the fits run here).
 
     Returns
     -------
     pathlib.Path
         The page.
     """
-    check_scale(scale, SCALES)
-    workers = check_workers(workers)
-    params = SCALES[scale]
-    say = progress or (lambda line: None)
+    run = study_run("mmpp", out, scale=scale, scales=SCALES, results_dir=results_dir,
+                    workers=workers, progress=progress, command=command)
+    params = run.params
     start = time.perf_counter()
-    cache = Path(out) / ("cache-mmpp" if scale == "paper" else f"cache-mmpp-{scale}")
-    results = Path(results_dir) if results_dir is not None else Path(out) / "results-mmpp"
-    command = command or f"kicktimes reproduce --study mmpp --scale {scale}"
-    jobs = [(cache / f"collisions_{rule}.parquet",
+    jobs = [(run.cache / f"collisions_{rule}.parquet",
              {"rule": rule, "n_ics": params.n_ics, "radius": params.radius,
               "t_max": params.t_max, "seed": params.seed, "ic_method": "paper"},
              collision_runs, (rule, params.n_ics, params.radius, params.t_max, params.seed))
             for rule in RULES]
-    cached = cached_tables(jobs, workers=workers, progress=progress)
+    cached = cached_tables(jobs, workers=run.workers, progress=progress)
     pooled, resid, dip = [], [], []
     for rule, c in zip(RULES, cached, strict=True):
         times = [np.asarray(t, float) for t in c.table["pp_times"]]
@@ -129,14 +113,11 @@ def reproduce(out: str | os.PathLike, *, scale: str = "quick",
         pooled += p
         resid += r
         dip += d
-        say(f"mmpp: {rule} rule fitted at {time.perf_counter() - start:.0f} s")
+        run.say(f"mmpp: {rule} rule fitted at {time.perf_counter() - start:.0f} s")
     tables = [pd.DataFrame(rows) for rows in (pooled, resid, dip)]
     for name, frame in zip(TABLES, tables, strict=True):
-        atomic_write(results / name, lambda tmp, frame=frame: frame.to_csv(tmp, index=False))
-    page = results / "mmpp.md"
+        run.write_csv(name, frame)
     # the build's seconds: this call's and those the reused simulations took when they ran
     seconds = time.perf_counter() - start + sum(c.seconds for c in cached if c.reused)
-    lines = write_page(*tables, params, command, seconds, cache.name)
-    atomic_write(page, lambda tmp: Path(tmp).write_text("\n".join(lines), encoding="utf-8"))
-    say(f"mmpp: {page} written")
-    return page
+    return run.write_page(write_page(*tables, params, run.command, seconds,
+                                     run.cache.name))

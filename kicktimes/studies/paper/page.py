@@ -389,11 +389,12 @@ def write_results(
         "The mechanism behind these numbers: [science.md](science.md), "
         "[mechanism.md](mechanism.md); escape through a hole: [escape.md](escape.md); "
         "unequal disks: [unequal.md](unequal.md); scatter kicks: [scatter.md](scatter.md); "
-        "MMPP fits to the collision times: [mmpp.md](mmpp.md); all written by "
-        "`python analysis/make_science.py`. From two disks to a gas (N = 2 to 1000 disks): "
-        "[disks.md](disks.md), written by `kicktimes reproduce --study disks`. Below: per "
-        "family, the scale, every statement under the primary setting, and the figures.", ""]
+        "MMPP fits to the collision times: [mmpp.md](mmpp.md); from two disks to a gas "
+        "(N = 2 to 1000 disks): [disks.md](disks.md); the paper's claims by its own "
+        "protocol: [paper.md](paper.md). Each is written by its study, `kicktimes reproduce "
+        "--study NAME` (`--study all`: every page). Below: per family, the scale, every "
+        "statement under the primary setting, and the figures.", ""]
     lines[head:head] = screen
     path = out / "README.md"
-    path.write_text("\n".join(lines), encoding="utf-8")
+    atomic_write_bytes(path, "\n".join(lines).encode("utf-8"))
     return path

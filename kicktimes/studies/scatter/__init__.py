@@ -38,9 +38,8 @@ from pathlib import Path
 
 import pandas as pd
 
-from kicktimes.fileio import atomic_write
 from kicktimes.studies.cache import cached_tables
-from kicktimes.studies.options import check_scale, check_workers
+from kicktimes.studies.options import study_run
 from kicktimes.studies.scatter.compute import one_ic, scatter_runs, shape_rows
 from kicktimes.studies.scatter.kernel import fresh_lam, fresh_partner_tangent
 from kicktimes.studies.scatter.page import TABLE, write_page
@@ -93,42 +92,22 @@ def reproduce(out: str | os.PathLike, *, scale: str = "quick",
 
     Parameters
     ----------
-    out : path-like
-        The work folder: the per-IC tables are cached in ``out/cache-scatter``
-        (``cache-scatter-quick`` at the quick scale), one parquet table per radius with
-        its parameters beside it; a rerun with the same parameters reuses them.
-    scale : {"quick", "paper"}
-        ``paper``: the sizes of docs/results/scatter.md (family A's 12 radii, its first 40
-        ICs, 25 000 steps of 0.2); ``quick``: 4 ICs, 2000 steps.
-    results_dir : path-like, optional
-        Folder of the page ``scatter.md`` and ``scatter_ratios.csv`` (default
-        ``out/results-scatter``).
-    workers : int
-        Processes for the simulations, one radius at a time each.
-    progress : callable, optional
-        Takes one line of text per step; ``None``: silent.
-    command : str, optional
-        The command the page's "Generated" line names (default
-        ``kicktimes reproduce --study scatter --scale SCALE``).
+    out, scale, results_dir, workers, progress, command :
+        As every study's (`kicktimes.studies.options`). The per-IC tables are cached in
+        ``out/cache-scatter``, one per radius. ``scale="paper"``: family A's 12 radii, its
+        first 40 ICs, 25 000 steps of 0.2; ``"quick"``: 4 ICs, 2000 steps. The page comes
+        with ``scatter_ratios.csv``; ``workers`` run one radius at a time each.
 
     Returns
     -------
     pathlib.Path
         The page.
     """
-    check_scale(scale, SCALES)
-    workers = check_workers(workers)
-    params = SCALES[scale]
-    cache = Path(out) / ("cache-scatter" if scale == "paper" else f"cache-scatter-{scale}")
-    results = Path(results_dir) if results_dir is not None else Path(out) / "results-scatter"
-    command = command or f"kicktimes reproduce --study scatter --scale {scale}"
-    cached = cached_tables(cache_jobs(cache, params), workers=workers, progress=progress)
+    run = study_run("scatter", out, scale=scale, scales=SCALES, results_dir=results_dir,
+                    workers=workers, progress=progress, command=command)
+    cached = cached_tables(cache_jobs(run.cache, run.params), workers=run.workers,
+                           progress=progress)
     df = pd.concat([c.table for c in cached], ignore_index=True)
     tab = ratio_table(df)
-    atomic_write(results / TABLE, lambda tmp: tab.to_csv(tmp, index=False))
-    page = results / "scatter.md"
-    lines = write_page(df, tab, command, cache.name)
-    atomic_write(page, lambda tmp: Path(tmp).write_text("\n".join(lines), encoding="utf-8"))
-    if progress is not None:
-        progress(f"scatter: {page} written")
-    return page
+    run.write_csv(TABLE, tab)
+    return run.write_page(write_page(df, tab, run.command, run.cache.name))

@@ -39,9 +39,8 @@ import os
 from dataclasses import dataclass
 from pathlib import Path
 
-from kicktimes.fileio import atomic_write
 from kicktimes.studies.cache import cached_tables
-from kicktimes.studies.options import check_scale, check_workers
+from kicktimes.studies.options import study_run
 from kicktimes.studies.unequal.compute import R0, R1, size_ratio_runs
 from kicktimes.studies.unequal.figures import size_ratio_figure
 from kicktimes.studies.unequal.page import FIGURE, TABLE, write_page
@@ -80,49 +79,28 @@ def reproduce(out: str | os.PathLike, *, scale: str = "quick",
 
     Parameters
     ----------
-    out : path-like
-        The work folder: the per-IC runs are cached in ``out/cache-unequal``
-        (``cache-unequal-quick`` at the quick scale), one parquet table per size ratio
-        with its parameters beside it; a rerun with the same parameters reuses them.
-    scale : {"quick", "paper"}
-        ``paper``: the sizes of docs/results/unequal.md (200 ICs per ratio, 10 000 steps
-        of 0.3); ``quick``: 20 ICs, 2000 steps.
-    results_dir : path-like, optional
-        Folder of the page ``unequal.md`` and its folder ``size_ratio/`` (default
-        ``out/results-unequal``).
-    workers : int
-        Processes for the simulations, one size ratio at a time each.
-    progress : callable, optional
-        Takes one line of text per step; ``None``: silent.
-    command : str, optional
-        The command the page's "Generated" line names (default
-        ``kicktimes reproduce --study unequal --scale SCALE``).
+    out, scale, results_dir, workers, progress, command :
+        As every study's (`kicktimes.studies.options`). The per-IC runs are cached in
+        ``out/cache-unequal``, one table per size ratio. ``scale="paper"``: 200 ICs,
+        10 000 steps of 0.3; ``"quick"``: 20 ICs, 2000 steps. The page comes with its
+        folder ``size_ratio/``; ``workers`` run one size ratio at a time each.
 
     Returns
     -------
     pathlib.Path
         The page.
     """
-    check_scale(scale, SCALES)
-    workers = check_workers(workers)
-    params = SCALES[scale]
-    cache = Path(out) / ("cache-unequal" if scale == "paper" else f"cache-unequal-{scale}")
-    results = Path(results_dir) if results_dir is not None else Path(out) / "results-unequal"
-    command = command or f"kicktimes reproduce --study unequal --scale {scale}"
-    jobs = [(cache / f"runs_r1_{r1:g}.parquet",
+    run = study_run("unequal", out, scale=scale, scales=SCALES, results_dir=results_dir,
+                    workers=workers, progress=progress, command=command)
+    params = run.params
+    jobs = [(run.cache / f"runs_r1_{r1:g}.parquet",
              {"r0": R0, "r1": r1, "n_ics": params.n_ics, "n_steps": params.n_steps,
               "tau": params.tau, "seed": params.seed, "rule": "mirror"},
              size_ratio_runs, (r1, params.n_ics, params.n_steps, params.tau, params.seed))
             for r1 in R1]
-    cached = cached_tables(jobs, workers=workers, progress=progress)
+    cached = cached_tables(jobs, workers=run.workers, progress=progress)
     table = size_ratio_table({r1: c.table for r1, c in zip(R1, cached, strict=True)},
                              params.seed)
-    atomic_write(results / TABLE, lambda tmp: table.to_csv(tmp, index=False))
-    fig = size_ratio_figure(table, params.n_ics)
-    atomic_write(results / FIGURE, lambda tmp: fig.savefig(tmp, dpi=110, format="png"))
-    page = results / "unequal.md"
-    lines = write_page(table, params, command, cache.name)
-    atomic_write(page, lambda tmp: Path(tmp).write_text("\n".join(lines), encoding="utf-8"))
-    if progress is not None:
-        progress(f"unequal: {page} written")
-    return page
+    run.write_csv(TABLE, table)
+    run.write_figure(FIGURE, size_ratio_figure(table, params.n_ics))
+    return run.write_page(write_page(table, params, run.command, run.cache.name))
