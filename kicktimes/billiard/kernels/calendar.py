@@ -37,6 +37,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from kicktimes.billiard.kernels import cells
+
 __all__ = ["IN_HEAP", "NEVER", "OVERFLOW", "build", "new_calendar", "remove", "schedule",
            "top", "update"]
 
@@ -66,6 +68,14 @@ def new_calendar(n: int, mean_spacing: float):
 
 # --- the heap of the current bucket -------------------------------------------------------
 @njit(cache=True, inline="always", error_model="numpy")
+def _put(qi, ht, k, t, i):
+    """Heap slot ``k`` holds disk ``i`` with time ``t``; the disk knows its slot."""
+    ht[k] = t
+    qi[k, HEAP_DISK] = i
+    qi[i, SLOT] = k
+
+
+@njit(cache=True, inline="always", error_model="numpy")
 def _sift_up(qi, ht, k):
     t = ht[k]
     i = qi[k, HEAP_DISK]
@@ -73,14 +83,9 @@ def _sift_up(qi, ht, k):
         p = (k - 1) >> 1
         if ht[p] <= t:
             break
-        ht[k] = ht[p]
-        d = qi[p, HEAP_DISK]
-        qi[k, HEAP_DISK] = d
-        qi[d, SLOT] = k
+        _put(qi, ht, k, ht[p], qi[p, HEAP_DISK])
         k = p
-    ht[k] = t
-    qi[k, HEAP_DISK] = i
-    qi[i, SLOT] = k
+    _put(qi, ht, k, t, i)
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -95,14 +100,9 @@ def _sift_down(qi, ht, k, n):
             c += 1
         if ht[c] >= t:
             break
-        ht[k] = ht[c]
-        d = qi[c, HEAP_DISK]
-        qi[k, HEAP_DISK] = d
-        qi[d, SLOT] = k
+        _put(qi, ht, k, ht[c], qi[c, HEAP_DISK])
         k = c
-    ht[k] = t
-    qi[k, HEAP_DISK] = i
-    qi[i, SLOT] = k
+    _put(qi, ht, k, t, i)
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -121,9 +121,7 @@ def _heap_remove(qi, ht, qs, i):
     n = qs[HN] - 1
     qs[HN] = n
     if k < n:
-        ht[k] = ht[n]
-        qi[k, HEAP_DISK] = qi[n, HEAP_DISK]
-        qi[qi[k, HEAP_DISK], SLOT] = k
+        _put(qi, ht, k, ht[n], qi[n, HEAP_DISK])
         if k > 0 and ht[k] < ht[(k - 1) >> 1]:
             _sift_up(qi, ht, k)
         else:
@@ -133,25 +131,13 @@ def _heap_remove(qi, ht, qs, i):
 # --- the bucket lists ------------------------------------------------------------------------
 @njit(cache=True, inline="always", error_model="numpy")
 def _list_push(qi, qh, i, b, where):
-    f = qh[b]
-    qi[i, NEXT] = f
-    qi[i, PREV] = -1
-    if f >= 0:
-        qi[f, PREV] = i
-    qh[b] = i
+    cells.insert(qh, qi, NEXT, PREV, i, b)
     qi[i, WHERE] = where
 
 
 @njit(cache=True, inline="always", error_model="numpy")
 def _list_remove(qi, qh, i, b):
-    a = qi[i, PREV]
-    c = qi[i, NEXT]
-    if a >= 0:
-        qi[a, NEXT] = c
-    else:
-        qh[b] = c
-    if c >= 0:
-        qi[c, PREV] = a
+    cells.remove(qh, qi, NEXT, PREV, i, b)
 
 
 # --- the calendar ---------------------------------------------------------------------------
