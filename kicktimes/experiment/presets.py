@@ -53,55 +53,22 @@ _PAPER = {
 
 PRESETS = {
     "family_a": Experiment(
-        name="family_a",
-        radii=_radii(8, 30),
-        n_ics=200,
-        n_steps=25000,
-        tau=0.2,
-        seed=1,
-        block_size=25,
-        description=(
+        name="family_a", radii=_radii(8, 30), n_ics=200, n_steps=25000, tau=0.2, seed=1,
+        block_size=25, description=(
             "The paper's family A (Figs. 6-8, top): radii 0.008-0.030, 200 ICs drawn at "
-            "r = 0.030, 25000 collision-truncated steps of tau = 0.2."
-        ),
-        **_PAPER,
-    ),
+            "r = 0.030, 25000 collision-truncated steps of tau = 0.2."), **_PAPER),
     "family_b": Experiment(
-        name="family_b",
-        radii=_radii(8, 26),
-        n_ics=1000,
-        n_steps=15000,
-        tau=0.3,
-        seed=2,
-        block_size=50,
-        description=(
+        name="family_b", radii=_radii(8, 26), n_ics=1000, n_steps=15000, tau=0.3, seed=2,
+        block_size=50, description=(
             "The paper's family B (Figs. 6 and 8, bottom): radii 0.008-0.026, 1000 ICs drawn "
-            "at r = 0.026, 15000 collision-truncated steps of tau = 0.3."
-        ),
-        **_PAPER,
-    ),
-    "quick_a": Experiment(
-        name="quick_a",
-        radii=[0.008, 0.014, 0.02, 0.03],
-        n_ics=20,
-        n_steps=2000,
-        tau=0.2,
-        seed=1,
-        block_size=10,
-        description="A small version of family A for smoke tests (4 radii, 20 ICs, 2000 steps).",
-        **_PAPER,
-    ),
-    "quick_b": Experiment(
-        name="quick_b",
-        radii=[0.008, 0.014, 0.02, 0.026],
-        n_ics=20,
-        n_steps=2000,
-        tau=0.3,
-        seed=2,
-        block_size=10,
-        description="A small version of family B for smoke tests (4 radii, 20 ICs, 2000 steps).",
-        **_PAPER,
-    ),
+            "at r = 0.026, 15000 collision-truncated steps of tau = 0.3."), **_PAPER),
+    **{name: Experiment(
+        name=name, radii=radii, n_ics=20, n_steps=2000, tau=tau, seed=seed, block_size=10,
+        description=f"A small version of family {family} for smoke tests (4 radii, 20 ICs, "
+        "2000 steps).", **_PAPER)
+       for name, family, radii, tau, seed in (
+           ("quick_a", "A", [0.008, 0.014, 0.02, 0.03], 0.2, 1),
+           ("quick_b", "B", [0.008, 0.014, 0.02, 0.026], 0.3, 2))},
 }
 
 

@@ -287,9 +287,7 @@ def compute_controls(results, collisions, *, family, eps, rule="mirror", rng, n_
     resamples : dict, optional
         Shared bootstrap draws (`paired_ratio`).
     kinetic : callable, optional
-        The kinetic rate as a function of the radius (array in, array out), e.g.
-        ``Experiment.kinetic_rate`` for unequal disks; default
-        ``kicktimes.stats.kinetic_rate(r, rule)`` (equal disks).
+        The kinetic rate against the radius, as in `kicktimes.report.counts.sticky_ics`.
 
     Returns
     -------

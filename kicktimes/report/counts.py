@@ -131,9 +131,7 @@ def counts_vs_radius(collisions, regression=None, *, rule="mirror", ax=None, kin
         has one).
     ax : matplotlib Axes, optional
     kinetic : callable, optional
-        The kinetic rate as a function of the radius (array in, array out), e.g.
-        ``Experiment.kinetic_rate`` for unequal disks; default
-        ``kicktimes.stats.kinetic_rate(r, rule)`` (equal disks).
+        The kinetic rate against the radius, as in `sticky_ics`.
 
     Returns
     -------

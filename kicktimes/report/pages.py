@@ -30,8 +30,8 @@ import pandas as pd
 from kicktimes import __version__
 from kicktimes.stats import format_interval, ratio_verdict
 
-__all__ = ["MARGIN", "ci", "header", "markdown_table", "ratio_text", "store_name",
-           "trend_verdict"]
+__all__ = ["MARGIN", "ci", "header", "markdown_table", "ratio_text", "simulations_source",
+           "store_name", "trend_verdict"]
 
 #: the equivalence margin of every ratio on these pages, stated before any was computed
 MARGIN = 0.1
@@ -51,6 +51,17 @@ def header(title, command, sources) -> list[str]:
     return [f"# {title} (generated)", "",
             f"Generated {now} by kicktimes {__version__} (`{command}`) from "
             + ", ".join(sources) + ". Every number below is computed; nothing is typed.", ""]
+
+
+def simulations_source(study, cache, *extra) -> str:
+    """The source of a page built from a study's own simulations: ``"the direct
+    simulations of `kicktimes.studies.<study>` (its cache `<cache>`; <extra>; no store)"``.
+
+    >>> simulations_source("mmpp", "cache-mmpp")
+    'the direct simulations of `kicktimes.studies.mmpp` (its cache `cache-mmpp`; no store)'
+    """
+    parts = [f"its cache `{cache}`", *extra, "no store"]
+    return f"the direct simulations of `kicktimes.studies.{study}` ({'; '.join(parts)})"
 
 
 def ci(values, level=0.95):

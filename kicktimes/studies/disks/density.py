@@ -193,25 +193,11 @@ def _jobs(out, sweep: LyapunovDensity):
 
 def lyapunov_density_runs(out, sweep: LyapunovDensity = DENSITY, *, workers: int = 1,
                           progress=None) -> pd.DataFrame:
-    """Every state's exponent and collision rate (columns `RUNS_COLUMNS`), from the cache
-    in ``out/lyapunov-density`` where its parameters match, else computed and cached.
-
-    Parameters
-    ----------
-    out : path-like
-        The study's work folder.
-    sweep : LyapunovDensity
-        The parameters (default: the published ones).
-    workers : int
-        Processes computing the missing tables, one (N, packing) each.
-    progress : callable, optional
-        Takes one line of text per table computed.
-
-    Returns
-    -------
-    pandas.DataFrame
-        By N, packing (in the sweep's order) and state.
-    """
+    """Every state's exponent and collision rate (columns `RUNS_COLUMNS`), by N, packing
+    (in the sweep's order) and state: from the cache in ``out/lyapunov-density`` where its
+    parameters match, else computed and cached, one table per (N, packing) by each of
+    ``workers`` processes; ``sweep`` the parameters (default: the published ones),
+    ``progress`` as in `kicktimes.studies.disks.ftle_check.ftle_check_runs`."""
     cached = cached_tables(_jobs(out, sweep), workers=workers, progress=progress)
     _say_reused(cached, "the FTLE against density", progress)
     return pd.concat([c.table for c in cached], ignore_index=True)
@@ -295,23 +281,11 @@ def summarise(runs: pd.DataFrame, *, n_boot=2000, seed=0, fit_max_packing=FIT_MA
 
 def write_lyapunov_density(out, results_dir, sweep: LyapunovDensity = DENSITY, *,
                            workers: int = 1, progress=None) -> pd.DataFrame:
-    """Run (or reuse from ``out``) the sweep and write ``disks_lyapunov_density_runs.csv``,
-    ``disks_lyapunov_density.csv`` and ``disks_lyapunov_density_fit.csv`` into
-    ``results_dir``, each atomically.
-
-    Parameters
-    ----------
-    out : path-like
-        The study's work folder (the cache: ``out/lyapunov-density``).
-    results_dir : path-like
-        The disks page's folder.
-    sweep, workers, progress :
-        As in `lyapunov_density_runs`.
-
-    Returns
-    -------
-    pandas.DataFrame
-        The per-N fit table, as written.
+    """Run (or reuse from the cache ``out/lyapunov-density``) the sweep and write
+    ``disks_lyapunov_density_runs.csv``, ``disks_lyapunov_density.csv`` and
+    ``disks_lyapunov_density_fit.csv`` into the disks page's folder ``results_dir``, each
+    atomically; ``sweep``, ``workers`` and ``progress`` as in `lyapunov_density_runs`.
+    Returns the per-N fit table, as written.
     """
     runs = lyapunov_density_runs(out, sweep, workers=workers, progress=progress)
     table, fits = summarise(runs, fit_max_packing=sweep.fit_max_packing)

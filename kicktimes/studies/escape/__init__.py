@@ -33,10 +33,8 @@ The page ``escape.md`` goes into ``results_dir`` with ``escape/escape_tails.csv`
 ``escape/escape_survival.png``; the escape times per IC are cached in ``out``, one table
 per radius (`compute.escape_times`, `compute.free_disk_escapes`).
 
-References
-----------
-L. A. Bunimovich and C. P. Dettmann, "Open circular billiards and the Riemann
-hypothesis", Phys. Rev. Lett. 94, 100201 (2005).
+The constant C and the tail law t S(t) -> C are Bunimovich & Dettmann's (Phys. Rev. Lett.
+94, 100201, 2005; the reference of `kicktimes.stats.circle_escape_constant`).
 
 Examples
 --------
@@ -111,20 +109,13 @@ def _escape_times(r, n_ics, t_max, seed):
 def reproduce(out: str | os.PathLike, *, scale: str = "quick",
               results_dir: str | os.PathLike | None = None, workers: int = 1,
               progress=None, command: str | None = None) -> Path:
-    """Run (or reuse) the escape simulations in ``out`` and write ``escape.md``.
+    """Run (or reuse) the escape simulations in ``out`` and write ``escape.md``; returns its path.
 
-    Parameters
-    ----------
-    out, scale, results_dir, workers, progress, command :
-        As every study's (`kicktimes.studies.options`). The escape times per IC are cached in
-        ``out/cache-escape``, one table per radius. ``scale="paper"``: 4000 ICs per radius
-        to t = 3000, 40 000 free-disk ICs per radius; ``"quick"``: 400 and 2000. The page
-        comes with its folder ``escape/``; ``workers`` run one radius at a time each.
-
-    Returns
-    -------
-    pathlib.Path
-        The page.
+    The escape times per IC are cached in ``out/cache-escape``, one table per radius.
+    ``scale="paper"``: 4000 ICs per radius to t = 3000, 40 000 free-disk ICs per radius;
+    ``"quick"``: 400 and 2000. The page comes with its folder ``escape/``; ``workers``
+    run one radius at a time each. The other options are every study's
+    (`kicktimes.studies.options`).
     """
     run = study_run("escape", out, scale=scale, scales=SCALES, results_dir=results_dir,
                     workers=workers, progress=progress, command=command)

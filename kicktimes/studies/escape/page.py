@@ -7,7 +7,7 @@ import math
 
 import pandas as pd
 
-from kicktimes.report.pages import MARGIN, header, ratio_text
+from kicktimes.report.pages import MARGIN, header, ratio_text, simulations_source
 from kicktimes.stats import format_interval, ratio_rule, ratio_verdict
 from kicktimes.studies.escape.compute import BURSTY_SHAPE, CONTROLS, HOLE, LABELS, ergodic_rate
 
@@ -36,8 +36,7 @@ def write_page(table, ratios, constant, params, command, seconds, source):
     boot = table.set_index(["radius", "system"])
     gam = table.drop_duplicates("radius").set_index("radius")["kinetic_rate"]
     lines = header("Escape through a hole: kicked against two disks", command,
-                   [f"the direct simulations of `kicktimes.studies.escape` (its cache `{source}`; "
-                    "no store)"])
+                   [simulations_source("escape", source)])
     lines += [
         "Definitions, the exact circle constant and the sweep's escape section: "
         "[../escape.md](../escape.md). One hole of half-width "

@@ -79,21 +79,13 @@ TABLES = ("mmpp/mmpp_billiard_pooled.csv", "mmpp/mmpp_billiard_residuals.csv",
 def reproduce(out: str | os.PathLike, *, scale: str = "quick",
               results_dir: str | os.PathLike | None = None, workers: int = 1,
               progress=None, command: str | None = None) -> Path:
-    """Run (or reuse) the collision times in ``out``, fit them and write ``mmpp.md``.
+    """Run (or reuse) the collision times in ``out``, fit them, write ``mmpp.md`` (returned).
 
-    Parameters
-    ----------
-    out, scale, results_dir, workers, progress, command :
-        As every study's (`kicktimes.studies.options`). The collision times are cached in
-        ``out/cache-mmpp``, one table per rule; a rerun refits them. ``scale="paper"``:
-        200 ICs per rule at r = 0.02 to t = 2000, 200 runs fitted alone; ``"quick"``: 40
-        ICs to t = 500, 10 alone. The page comes with its folder ``mmpp/``; ``workers``
-        simulate one rule at a time each (the fits run here).
-
-    Returns
-    -------
-    pathlib.Path
-        The page.
+    The collision times are cached in ``out/cache-mmpp``, one table per rule; a rerun
+    refits them. ``scale="paper"``: 200 ICs per rule at r = 0.02 to t = 2000, 200 runs
+    fitted alone; ``"quick"``: 40 ICs to t = 500, 10 alone. The page comes with its
+    folder ``mmpp/``; ``workers`` simulate one rule at a time each (the fits run here).
+    The other options are every study's (`kicktimes.studies.options`).
     """
     run = study_run("mmpp", out, scale=scale, scales=SCALES, results_dir=results_dir,
                     workers=workers, progress=progress, command=command)

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from kicktimes.report.pages import header
+from kicktimes.report.pages import header, simulations_source
 from kicktimes.stats import format_interval, rejection_rule
 from kicktimes.stats.findings import clopper_pearson
 from kicktimes.studies.mmpp.compute import STICKY_FACTOR
@@ -16,8 +16,7 @@ def write_page(pooled, resid, dip, params, command, seconds, source):
     ``params`` the study's `Params`, ``source`` the name of its cache, ``seconds`` the
     build's."""
     lines = header("MMPP fits to the two-disk collision times", command,
-                   [f"the direct simulations of `kicktimes.studies.mmpp` (its cache "
-                    f"`{source}`; no store)"])
+                   [simulations_source("mmpp", source)])
     lines += [f"Definitions and the fit: [../mmpp.md](../mmpp.md). {params.n_ics} paper ICs at "
               f"r = {params.radius:g}, t_max = {params.t_max:g}, per collision rule; runs faster "
               f"than {STICKY_FACTOR:g} Γ(r) (sticky) left out. Residual checks: the "

@@ -88,20 +88,13 @@ def cache_jobs(cache: str | os.PathLike, params: Params) -> list[tuple]:
 def reproduce(out: str | os.PathLike, *, scale: str = "quick",
               results_dir: str | os.PathLike | None = None, workers: int = 1,
               progress=None, command: str | None = None) -> Path:
-    """Run (or reuse) the per-IC FTLE table in ``out`` and write ``scatter.md``.
+    """Run (or reuse) the per-IC FTLE table in ``out``, write ``scatter.md`` (returned).
 
-    Parameters
-    ----------
-    out, scale, results_dir, workers, progress, command :
-        As every study's (`kicktimes.studies.options`). The per-IC tables are cached in
-        ``out/cache-scatter``, one per radius. ``scale="paper"``: family A's 12 radii, its
-        first 40 ICs, 25 000 steps of 0.2; ``"quick"``: 4 ICs, 2000 steps. The page comes
-        with ``scatter_ratios.csv``; ``workers`` run one radius at a time each.
-
-    Returns
-    -------
-    pathlib.Path
-        The page.
+    The per-IC tables are cached in ``out/cache-scatter``, one per radius.
+    ``scale="paper"``: family A's 12 radii, its first 40 ICs, 25 000 steps of 0.2;
+    ``"quick"``: 4 ICs, 2000 steps. The page comes with ``scatter_ratios.csv``;
+    ``workers`` run one radius at a time each. The other options are every study's
+    (`kicktimes.studies.options`).
     """
     run = study_run("scatter", out, scale=scale, scales=SCALES, results_dir=results_dir,
                     workers=workers, progress=progress, command=command)

@@ -75,20 +75,12 @@ SCALES = {"quick": Params(n_ics=20, n_steps=2000),
 def reproduce(out: str | os.PathLike, *, scale: str = "quick",
               results_dir: str | os.PathLike | None = None, workers: int = 1,
               progress=None, command: str | None = None) -> Path:
-    """Run (or reuse) the size-ratio simulations in ``out`` and write ``unequal.md``.
+    """Run (or reuse) the size-ratio runs in ``out``, write ``unequal.md`` (returned).
 
-    Parameters
-    ----------
-    out, scale, results_dir, workers, progress, command :
-        As every study's (`kicktimes.studies.options`). The per-IC runs are cached in
-        ``out/cache-unequal``, one table per size ratio. ``scale="paper"``: 200 ICs,
-        10 000 steps of 0.3; ``"quick"``: 20 ICs, 2000 steps. The page comes with its
-        folder ``size_ratio/``; ``workers`` run one size ratio at a time each.
-
-    Returns
-    -------
-    pathlib.Path
-        The page.
+    The per-IC runs are cached in ``out/cache-unequal``, one table per size ratio.
+    ``scale="paper"``: 200 ICs, 10 000 steps of 0.3; ``"quick"``: 20 ICs, 2000 steps.
+    The page comes with its folder ``size_ratio/``; ``workers`` run one size ratio at a
+    time each. The other options are every study's (`kicktimes.studies.options`).
     """
     run = study_run("unequal", out, scale=scale, scales=SCALES, results_dir=results_dir,
                     workers=workers, progress=progress, command=command)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pandas as pd
 
-from kicktimes.report.pages import MARGIN, header
+from kicktimes.report.pages import MARGIN, header, simulations_source
 from kicktimes.stats import format_interval, ratio_rule, ratio_verdict
 from kicktimes.studies.unequal.compute import R0
 from kicktimes.studies.unequal.tables import ks_interval
@@ -21,8 +21,7 @@ def write_page(table, params, command, source):
     verdict beside every ratio; ``params`` the study's `Params`, ``source`` the name of its
     cache."""
     lines = header("Unequal disks: the size ratio", command,
-                   [f"the direct simulations of `kicktimes.studies.unequal` (its cache "
-                    f"`{source}`; `{TABLE}`; no store)"])
+                   [simulations_source("unequal", source, f"`{TABLE}`")])
     lines += [f"Definitions and methods: [../unequal.md](../unequal.md). Disk 0 keeps "
               f"r0 = {R0:g}; {params.n_ics} invariant ICs per ratio, {params.n_steps} steps of "
               f"{params.tau:g}, mirror rule; the kicked disk gets scattering kicks at Poisson "
