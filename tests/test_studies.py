@@ -21,8 +21,7 @@ def test_every_study_has_its_package_with_reproduce_and_a_page_of_its_own():
     assert len(set(pages)) == len(pages)
     # the paper study's sweeps run from the command line (its report process compiles
     # and builds while they run); its package writes the page
-    entry = {"paper": "write_results", "protocol": "reproduce_protocol",
-             "disks": "reproduce_disks"}
+    entry = {"paper": "write_results", "protocol": "reproduce_protocol"}
     for study in STUDIES.values():
         module = importlib.import_module(study.module)
         assert callable(getattr(module, entry.get(study.name, "reproduce"))), study.name

@@ -174,8 +174,9 @@ def test_reproduce_writes_the_ftle_tables_before_the_page(tmp_path, monkeypatch)
         # the page (tests/test_disks_controls.py) renders the tables found beside it
         pages.append({name: (Path(target) / name).exists()
                       for name in CHECK_CSVS + DENSITY_CSVS})
-        assert command == "kicktimes reproduce --study disks" and list(cost["experiment"]) \
-            == ["tiny-gas"] and [Path(p).name for p in paths] == ["store-tiny-gas"]
+        assert command == "kicktimes reproduce --study disks --scale paper"
+        assert list(cost["experiment"]) == ["tiny-gas"]
+        assert [Path(p).name for p in paths] == ["store-tiny-gas"]
         return Path(target) / "disks.md"
 
     monkeypatch.setattr(run_module, "write_disks_page", page_writer)
@@ -201,3 +202,29 @@ def test_reproduce_writes_the_ftle_tables_before_the_page(tmp_path, monkeypatch)
     reproduce_disks(tmp_path, names=["tiny-gas"], results_dir=tmp_path / "none",
                     progress=False, ftle_check=None, density=None)
     assert not any(pages[2].values())
+
+
+def test_the_quick_scale_runs_every_preset_smaller_under_its_own_name(tmp_path, monkeypatch):
+    import kicktimes.studies.disks.run as run
+    from kicktimes.experiment import DISKS_CONTROLS, DISKS_PRESETS, DISKS_REFERENCES
+    from kicktimes.studies.disks import QUICK_N, quick_experiment, reproduce
+
+    for exp in [*DISKS_PRESETS.values(), *DISKS_CONTROLS.values(), *DISKS_REFERENCES.values()]:
+        small = quick_experiment(exp)
+        assert small.name == exp.name and small.hash() != exp.hash()
+        if isinstance(exp, DisksExperiment):
+            assert set(small.n_disks) <= set(QUICK_N) and small.n_tagged <= 1000
+            assert len(small.tasks()) < len(exp.tasks())
+        else:
+            assert small.n_ics <= 1000 and small.radii == exp.radii
+    calls = []
+    monkeypatch.setattr(run, "reproduce_disks", lambda out, **kw: calls.append((out, kw)))
+    reproduce(tmp_path, scale="quick")
+    reproduce(tmp_path, scale="paper", results_dir=tmp_path / "r")
+    (quick_out, quick), (paper_out, paper) = calls
+    assert quick_out == str(tmp_path / "disks-quick") and quick["experiment"] is quick_experiment
+    assert quick["results_dir"] == str(tmp_path / "results-disks")
+    assert quick["command"] == "kicktimes reproduce --study disks --scale quick"
+    assert paper_out == tmp_path and "experiment" not in paper
+    with pytest.raises(ValueError, match="scale must be one of"):
+        reproduce(tmp_path, scale="huge")

@@ -389,15 +389,14 @@ def _reproduce_one(study, results, findings, scale, content, out, workers, sched
         return
 
     if study == "disks":
-        from kicktimes.studies.disks import reproduce_disks
+        from kicktimes.studies.disks import reproduce as reproduce_disks
 
         if workers is not None and scheduler is not None:
             raise click.UsageError("--workers sizes the local pool; it cannot go with "
                                    "--scheduler")
         with _cli_errors(_RUN_OPTIONS):
-            page = reproduce_disks(out, results_dir=results, workers=workers or 1,
-                                   scheduler=scheduler, progress=progress,
-                                   command=command or "kicktimes reproduce --study disks")
+            page = reproduce_disks(out, scale=scale, results_dir=results, workers=workers or 1,
+                                   scheduler=scheduler, progress=progress, command=command)
         click.echo(f"page written to {page}")
         return
 

@@ -8,7 +8,8 @@ rate, the kicked comparison), `controls` (every finding under the controls), `re
 gas's FTLE: tangent vectors against a twin, the engine's N = 2 against the two-disk
 simulator), `density` (the gas's FTLE against density, the kinetic-theory form), `figures`,
 `page` (``disks.md``) and `run` (`reproduce_disks`: the sweeps and the FTLE computations,
-run or resumed from the work folder, then the page).
+run or resumed from the work folder, then the page; `reproduce` at the quick or the paper
+scale).
 
 Examples
 --------
@@ -26,7 +27,7 @@ from kicktimes.studies.disks.figures import (
     rejection_figure,
 )
 from kicktimes.studies.disks.page import write_disks_page
-from kicktimes.studies.disks.run import reproduce_disks
+from kicktimes.studies.disks.run import QUICK_N, quick_experiment, reproduce, reproduce_disks
 from kicktimes.studies.disks.tables import (
     disks_hazard,
     disks_table,
@@ -35,6 +36,7 @@ from kicktimes.studies.disks.tables import (
     two_disk_check,
 )
 
-__all__ = ["controls_figure", "disks_hazard", "disks_table", "hazard_figure", "kicked_table",
-           "rates_figure", "rejection_figure", "rescale_by_speed", "reproduce_disks",
+__all__ = ["QUICK_N", "controls_figure", "disks_hazard", "disks_table", "hazard_figure",
+           "kicked_table", "quick_experiment", "rates_figure", "rejection_figure",
+           "rescale_by_speed", "reproduce", "reproduce_disks",
            "two_disk_check", "write_disks_page"]

@@ -592,7 +592,8 @@ def write_disks_page(store_paths, out_dir, *, command="kicktimes reproduce --stu
         "Every number below is computed from the stores ([disks.csv](disks.csv), "
         "[disks_hazard.csv](disks_hazard.csv)); nothing is typed.", "",
         "The tagged disk's disk-disk collision times among N equal hard disks in the unit "
-        "circular table (`kicktimes.simulate_disks`), from N = 2 to 1000, at packing 0.02, "
+        f"circular table (`kicktimes.simulate_disks`), from N = {min(exp0.n_disks)} to "
+        f"{max(exp0.n_disks)}, at packing 0.02, "
         "at packing 0.2 and at the fixed radius 0.0045, under the mirror and the elastic "
         f"rule. Each tagged disk is read at a fixed number of collisions, its first K = {k} "
         f"(the window ends at collision {k + 1}). Scale: about {exp0.n_tagged} tagged disks "

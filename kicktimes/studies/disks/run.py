@@ -12,18 +12,26 @@ every cached table whose parameters match.
 
 from __future__ import annotations
 
+import dataclasses
 import os
 import sys
 from pathlib import Path
 
 import pandas as pd
 
+from kicktimes.experiment import DisksExperiment
 from kicktimes.studies.disks.density import DENSITY, LyapunovDensity, write_lyapunov_density
 from kicktimes.studies.disks.ftle_check import FTLE_CHECK, FtleCheck, write_ftle_check
 from kicktimes.studies.disks.page import write_disks_page
-from kicktimes.studies.options import check_workers
+from kicktimes.studies.options import check_scale, check_workers
 
-__all__ = ["reproduce_disks"]
+__all__ = ["QUICK_N", "quick_experiment", "reproduce", "reproduce_disks"]
+
+#: the quick scale's numbers of disks (the paper scale's are 2 .. 1000)
+QUICK_N = (2, 10, 100)
+#: the quick scale's gas-FTLE checks and density law: a few states up to N = 100
+QUICK_FTLE_CHECK = FtleCheck(ics=4, scale=0.2, max_disks=100)
+QUICK_DENSITY = LyapunovDensity(n_disks=(100,), states=4, mean_free_times=30, skip=3)
 
 
 def _progress_lines(progress):
@@ -37,9 +45,42 @@ def _progress_lines(progress):
             progress)
 
 
+def quick_experiment(exp):
+    """The quick version of a disks preset (the same name and design): N in `QUICK_N`,
+    at most 200 tagged disks per N (the N = 2 validation 1000), the kicked comparison 4
+    runs of 50 mean free times, a two-disk reference with as many ICs as its row's
+    tagged disks."""
+    if isinstance(exp, DisksExperiment):
+        if exp.kicked_runs:
+            return dataclasses.replace(exp, n_disks=QUICK_N, n_tagged=4, min_runs=4,
+                                       kicked_runs=4, kicked_time=50.0)
+        n_disks = tuple(n for n in exp.n_disks if n in QUICK_N)
+        return dataclasses.replace(exp, n_disks=n_disks,
+                                   n_tagged=min(exp.n_tagged, 1000 if n_disks == (2,) else 200))
+    return dataclasses.replace(exp, n_ics=min(exp.n_ics, 1000 if exp.n_ics > 4000 else 200))
+
+
+def reproduce(out, *, scale="quick", results_dir=None, workers=1, progress=None,
+              command=None, scheduler=None) -> Path:
+    """The disks study at ``scale`` (`reproduce_disks`, the options of every study:
+    `kicktimes.studies.options`): ``"paper"`` the presets of docs/results/disks.md (N = 2 ..
+    1000, about an hour on 2 cores), ``"quick"`` their `quick_experiment` versions with
+    `QUICK_FTLE_CHECK` and `QUICK_DENSITY`, in ``out/disks-quick`` (a few minutes)."""
+    check_scale(scale, ("quick", "paper"))
+    command = command or f"kicktimes reproduce --study disks --scale {scale}"
+    options = dict(results_dir=results_dir, workers=workers, scheduler=scheduler,
+                   progress=progress, command=command)
+    if scale == "paper":
+        return reproduce_disks(out, **options)
+    if results_dir is None:
+        options["results_dir"] = os.path.join(out, "results-disks")
+    return reproduce_disks(os.path.join(out, "disks-quick"), experiment=quick_experiment,
+                           ftle_check=QUICK_FTLE_CHECK, density=QUICK_DENSITY, **options)
+
+
 def reproduce_disks(out, *, results_dir=None, names=None, workers=1, scheduler=None,
-                    progress=None, command="kicktimes reproduce --study disks",
-                    ftle_check=FTLE_CHECK, density=DENSITY) -> Path:
+                    progress=None, command="kicktimes reproduce --study disks --scale paper",
+                    ftle_check=FTLE_CHECK, density=DENSITY, experiment=None) -> Path:
     """Run (or resume) the disks presets into ``out/store-<name>`` and the gas's FTLE
     computations into ``out``, then write the page.
 
@@ -69,6 +110,9 @@ def reproduce_disks(out, *, results_dir=None, names=None, workers=1, scheduler=N
     density : kicktimes.studies.disks.density.LyapunovDensity or None
         The FTLE against density (`write_lyapunov_density`; default the published sweep);
         None: not run, as ``ftle_check``.
+    experiment : callable, optional
+        Maps each preset to the experiment run under its name (`quick_experiment` for the
+        quick scale); default the presets themselves.
 
     Returns
     -------
@@ -94,7 +138,8 @@ def reproduce_disks(out, *, results_dir=None, names=None, workers=1, scheduler=N
     paths, cost = [], []
     for name in names:
         path = os.path.join(out, f"store-{name}")
-        store = run_experiment(disks_preset(name), path, workers=workers if scheduler is None
+        exp = disks_preset(name) if experiment is None else experiment(disks_preset(name))
+        store = run_experiment(exp, path, workers=workers if scheduler is None
                                else None, scheduler=scheduler, progress=bar)
         # disks tasks record their CPU time; a two-disk sweep's tasks their wall time only
         timings = store.timings
