@@ -115,9 +115,8 @@ def test_other_parameters_recompute_only_their_tables(work, tmp_path, monkeypatc
 def test_a_published_runs_table_seeds_the_cache(work, tmp_path, monkeypatch):
     _no_simulation(monkeypatch)
     results = work / "results"
-    seed_ftle_check(tmp_path, pd.read_csv(results / "disks_ftle_check_runs.csv"), TINY_CHECK)
-    seed_lyapunov_density(tmp_path, pd.read_csv(results / "disks_lyapunov_density_runs.csv"),
-                          TINY_DENSITY)
+    seed_ftle_check(tmp_path, results / "disks_ftle_check_runs.csv", TINY_CHECK)
+    seed_lyapunov_density(tmp_path, results / "disks_lyapunov_density_runs.csv", TINY_DENSITY)
     write_ftle_check(tmp_path, tmp_path / "results", TINY_CHECK)
     write_lyapunov_density(tmp_path, tmp_path / "results", TINY_DENSITY)
     assert all(_same(results, tmp_path / "results", CHECK_CSVS + DENSITY_CSVS).values())

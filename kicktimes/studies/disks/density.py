@@ -47,6 +47,7 @@ Examples
 from __future__ import annotations
 
 import math
+import os
 from dataclasses import dataclass
 from numbers import Integral, Real
 from pathlib import Path
@@ -203,8 +204,9 @@ def lyapunov_density_runs(out, sweep: LyapunovDensity = DENSITY, *, workers: int
     return pd.concat([c.table for c in cached], ignore_index=True)
 
 
-def seed_lyapunov_density(out, runs: pd.DataFrame, sweep: LyapunovDensity = DENSITY) -> None:
-    """Put the states' rows ``runs`` (a ``disks_lyapunov_density_runs.csv``) into the cache
+def seed_lyapunov_density(out, runs, sweep: LyapunovDensity = DENSITY) -> None:
+    """Put the states' rows ``runs`` (a ``disks_lyapunov_density_runs.csv``, or its path:
+    read exactly) into the cache
     of ``sweep`` in ``out``, so that `lyapunov_density_runs` reuses them.
 
     Raises
@@ -213,6 +215,9 @@ def seed_lyapunov_density(out, runs: pd.DataFrame, sweep: LyapunovDensity = DENS
         If ``runs`` lacks an (N, packing) of ``sweep`` or its states are not ``0 ..
         states-1``.
     """
+    if isinstance(runs, str | os.PathLike):
+        # read exactly: pandas < 3 parses floats to the nearest-but-one double
+        runs = pd.read_csv(runs, float_precision="round_trip")
     runs = pd.DataFrame(runs)
     missing = [c for c in RUNS_COLUMNS if c not in runs.columns]
     if missing:

@@ -39,6 +39,7 @@ engine/two-disk 2 mirror 200.0
 from __future__ import annotations
 
 import math
+import os
 from dataclasses import dataclass
 from numbers import Integral
 from pathlib import Path
@@ -191,8 +192,9 @@ def ftle_check_runs(out, check: FtleCheck = FTLE_CHECK, *, workers: int = 1,
     return _sorted(pd.concat([c.table for c in cached], ignore_index=True))
 
 
-def seed_ftle_check(out, runs: pd.DataFrame, check: FtleCheck = FTLE_CHECK) -> None:
-    """Put the states' exponents ``runs`` (a ``disks_ftle_check_runs.csv``) into the cache
+def seed_ftle_check(out, runs, check: FtleCheck = FTLE_CHECK) -> None:
+    """Put the states' exponents ``runs`` (a ``disks_ftle_check_runs.csv``, or its path:
+    read exactly) into the cache
     of ``check`` in ``out``, so that `ftle_check_runs` reuses them.
 
     Raises
@@ -201,6 +203,9 @@ def seed_ftle_check(out, runs: pd.DataFrame, check: FtleCheck = FTLE_CHECK) -> N
         If ``runs`` lacks a (check, N, rule) of ``check``, its seeds are not ``0 ..
         ics-1`` or its ``t_max`` differs.
     """
+    if isinstance(runs, str | os.PathLike):
+        # read exactly: pandas < 3 parses floats to the nearest-but-one double
+        runs = pd.read_csv(runs, float_precision="round_trip")
     runs = pd.DataFrame(runs)
     missing = [c for c in RUNS_COLUMNS if c not in runs.columns]
     if missing:
