@@ -30,8 +30,9 @@ import pandas as pd
 from kicktimes import __version__
 from kicktimes.stats import format_interval, ratio_verdict
 
-__all__ = ["MARGIN", "ci", "header", "markdown_table", "ratio_text", "simulations_source",
-           "store_name", "trend_verdict"]
+__all__ = ["MARGIN", "NULL_CALIBRATION", "NULL_CALIBRATION_COLUMNS", "ci", "header",
+           "markdown_table", "ratio_text", "simulations_source", "store_name",
+           "trend_verdict", "write_null_calibration"]
 
 #: the equivalence margin of every ratio on these pages, stated before any was computed
 MARGIN = 0.1
@@ -102,3 +103,41 @@ def markdown_table(frame: pd.DataFrame) -> list[str]:
               for row in frame.itertuples(index=False)]
     return lines
 
+
+
+#: the file, in a results folder, of the null streams sent through the pages' tests
+NULL_CALIBRATION = "null_calibration.csv"
+#: its columns: the study that wrote the row, the data set it is shaped like, the test,
+#: the null design, the runs and clusters, the share rejected with its 95 % CI and the
+#: verdict of `kicktimes.stats.rejection_verdict` against the test's nominal level
+NULL_CALIBRATION_COLUMNS = ("study", "data", "test", "design", "alpha", "n_runs",
+                            "n_clusters", "share", "ci_low", "ci_high", "verdict")
+
+
+def write_null_calibration(results_dir, study, rows: pd.DataFrame) -> Path:
+    """Put ``study``'s rows into ``results_dir/null_calibration.csv``, keeping the other
+    studies' rows (each study owns its rows; the file is shared by the pages that cite
+    it). Written atomically; returns the path.
+
+    ``rows`` has the columns `NULL_CALIBRATION_COLUMNS` except ``study`` and ``verdict``,
+    which are filled in here (the verdict is `kicktimes.stats.rejection_verdict` of the
+    CI against ``alpha``).
+    """
+    from kicktimes.fileio import atomic_write
+    from kicktimes.stats import rejection_verdict
+
+    missing = set(NULL_CALIBRATION_COLUMNS) - {"study", "verdict"} - set(rows.columns)
+    if missing:
+        raise ValueError(f"rows: the null calibration needs the columns {sorted(missing)}")
+    rows = rows.copy()
+    rows.insert(0, "study", study)
+    rows["verdict"] = [rejection_verdict(lo, hi, a) for lo, hi, a
+                       in zip(rows["ci_low"], rows["ci_high"], rows["alpha"], strict=True)]
+    path = Path(results_dir) / NULL_CALIBRATION
+    if path.is_file():
+        old = pd.read_csv(path, keep_default_na=False, na_values=[""])
+        rows = pd.concat([old[old["study"] != study], rows], ignore_index=True)
+    rows = rows[list(NULL_CALIBRATION_COLUMNS)].sort_values(["study", "data", "test"],
+                                                            kind="stable")
+    atomic_write(path, lambda tmp: rows.to_csv(tmp, index=False))
+    return path

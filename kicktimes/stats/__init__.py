@@ -34,6 +34,8 @@ from .enskog import contact_value, enskog_frequency, speed_rate_factor
 from .findings import (
     Finding,
     format_interval,
+    poisson_rule,
+    poisson_verdict,
     ratio_rule,
     ratio_verdict,
     rejection_rule,
@@ -112,6 +114,8 @@ __all__ = [
     "share_ratio_sample_size",
     "format_interval",
     "rejection_verdict",
+    "poisson_verdict",
+    "poisson_rule",
     "rejection_rule",
     "ratio_rule",
     "interval_hazard",

@@ -31,6 +31,8 @@ __all__ = [
     "format_interval",
     "rejection_verdict",
     "rejection_rule",
+    "poisson_verdict",
+    "poisson_rule",
     "share_verdict",
     "SHARE_RULE",
     "clopper_pearson",
@@ -181,6 +183,78 @@ def rejection_rule(alpha=0.05, margin=0.5) -> str:
             f"[{lo:g}, {hi:g}] (the share a process satisfying the null gives, within "
             f"{100 * margin:g} % of α); above / below nominal: it lies entirely above / below "
             "that band; inconclusive otherwise")
+
+
+def poisson_verdict(reject_low, reject_high, null_level, dispersion_low, dispersion_high,
+                    *, margin=0.5, band=0.1):
+    """One standard for "Poisson": a calibrated test and an effect outside a stated band.
+
+    A stream is read against two things stated before any data: the share of runs that a
+    battery test rejects, compared with ``null_level``, the share that streams satisfying
+    the null reject through the same test, windows and runs (a null calibration, not the
+    nominal α); and its dispersion index D (variance over mean of the counts), compared
+    with the band ``[1 - band, 1 + band]``, the same equivalence margin as every ratio
+    (:func:`ratio_verdict`). The verdict is
+
+    - ``"not Poisson"``: the rejection share lies above the calibrated band
+      (:func:`rejection_verdict` with ``alpha = null_level``) **and** D's CI lies entirely
+      outside ``[1 - band, 1 + band]``: a calibrated test rejects and the effect is large;
+    - ``"not Poisson, D within 10 %"``: the test rejects above the calibrated band but D's
+      CI lies inside the band (a detectable departure that the counts do not show at the
+      margin, as a ratio "within 10 %" may still exclude 1);
+    - ``"Poisson within 10 %"``: the rejection share is at the calibrated level (its CI
+      inside the band around ``null_level``) and D's CI lies inside the band;
+    - ``"inconclusive"`` otherwise (an interval that straddles a band's edge, or a
+      non-finite endpoint).
+
+    Parameters
+    ----------
+    reject_low, reject_high : float
+        95 % CI of the share of runs the test rejects.
+    null_level : float
+        The share the same test rejects on null streams shaped like the runs (e.g. the
+        ``share`` column of ``docs/results/null_calibration.csv``).
+    dispersion_low, dispersion_high : float
+        95 % CI of the dispersion index D.
+    margin : float
+        Half-width of the rejection band, relative to ``null_level`` (default 0.5).
+    band : float
+        Half-width of D's band (default 0.1).
+
+    Examples
+    --------
+    >>> poisson_verdict(0.37, 0.41, 0.05, 1.31, 1.47)
+    'not Poisson'
+    >>> poisson_verdict(0.37, 0.41, 0.05, 1.03, 1.13)   # D straddles 1.1
+    'inconclusive'
+    >>> poisson_verdict(0.045, 0.06, 0.052, 0.97, 1.04)
+    'Poisson within 10 %'
+    >>> poisson_verdict(0.08, 0.11, 0.05, 1.01, 1.06)
+    'not Poisson, D within 10 %'
+    """
+    rejects = rejection_verdict(reject_low, reject_high, null_level, margin)
+    dispersion = ratio_verdict(dispersion_low, dispersion_high, band)
+    within = f"within {100 * band:g} %"
+    if rejects == "above nominal" and dispersion in ("higher", "lower"):
+        return "not Poisson"
+    if rejects == "above nominal" and dispersion == within:
+        return f"not Poisson, D {within}"
+    if rejects == "nominal" and dispersion == within:
+        return f"Poisson {within}"
+    return "inconclusive"
+
+
+def poisson_rule(margin=0.5, band=0.1) -> str:
+    """The printed rule of :func:`poisson_verdict`."""
+    lo, hi = f"{1 - band:g}", f"{1 + band:g}"
+    return (f"not Poisson: the share of runs a test rejects lies above the level that null "
+            f"streams shaped like the runs give through the same test (null calibration), by "
+            f"more than {100 * margin:g} % of that level, and the 95 % CI of the dispersion "
+            f"index D lies entirely outside [{lo}, {hi}]; not Poisson, D within "
+            f"{100 * band:g} %: the test rejects so but D's CI lies inside [{lo}, {hi}]; "
+            f"Poisson within {100 * band:g} %: the share is at the calibrated level (CI within "
+            f"{100 * margin:g} % of it) and D's CI lies inside [{lo}, {hi}]; inconclusive "
+            "otherwise")
 
 
 def share_verdict(low, high, level):
