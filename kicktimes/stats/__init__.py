@@ -30,6 +30,7 @@ from .comparison import VuongResult, compare_models, vuong
 from .counts import CountRegression, kinetic_rate, regress_counts
 from .distributions import hyperexpon
 from .ensemble import PoissonEnsembleResult, test_poisson_ensemble
+from .dilute import dilute_tagged_times
 from .enskog import contact_value, enskog_frequency, speed_rate_factor
 from .findings import (
     Finding,
@@ -90,6 +91,7 @@ __all__ = [
     "kinetic_rate",
     "enskog_frequency",
     "speed_rate_factor",
+    "dilute_tagged_times",
     "contact_value",
     "conditional_kinetic_rate",
     "mean_kinetic_rate",
