@@ -313,3 +313,66 @@ def test_the_density_section_is_rendered_from_its_tables_or_skipped(tmp_path):
     text = "\n".join(density_lines(a, b))
     assert "| 300 | 0.0025 |" in text and "N = 300, fitted at φ ≤ 0.02" in text
     assert "The prefactors a and b of the theory are not computed here" in text
+
+
+def test_the_kicked_rate_is_the_whole_gas_collision_frequency():
+    # issue 50: the kicks' rate (and lambda / nu) is the gas's 2 n_pp / (N T), the rate of
+    # disks.csv, not the followed disk's own n / T
+    from kicktimes.billiard import initial_state, simulate_disks
+    from kicktimes.experiment.disks_tasks import kicked_rate, kicked_rows
+
+    exp = dataclasses.replace(TINY, n_disks=[6], kicked_runs=1, kicked_time=20.0)
+    assert exp.kicked_rate == "gas"
+    rows = {(s, d): v for s, d, v in kicked_rows(exp, 6, 0)}
+    # the same gas run, redrawn from the run's seed as kicked_rows draws it
+    rng = np.random.default_rng(np.random.SeedSequence(exp.seed, spawn_key=(6, 0, 1)))
+    r = exp.radius(6)
+    state = initial_state(6, r, seed=rng, rule="mirror")
+    tau = 0.1 / exp.reference_frequency(6)
+    gas = simulate_disks(state, r, t_max=int(round(20.0 / 0.1)) * tau, rule="mirror",
+                         sample=[0], tau=tau, log_walls=True)
+    assert rows["gas", "rate"] == pytest.approx(gas.collision_frequency, rel=1e-12)
+    assert rows["gas", "rate"] == pytest.approx(2 * gas.n_pp / (6 * gas.t_max), rel=1e-12)
+    own = gas.collision_times(0).size / gas.t_max
+    assert own != pytest.approx(gas.collision_frequency, rel=1e-6)
+    disk = dataclasses.replace(exp, kicked_rate="disk")
+    assert kicked_rate(disk, gas, gas.collision_times(0)) == own
+
+
+def test_the_kicked_rate_is_in_the_hash_and_old_records_read_as_the_disk_rate():
+    k = dataclasses.replace(TINY, kicked_runs=1)
+    disk = dataclasses.replace(k, kicked_rate="disk")
+    assert k.hash() != disk.hash()
+    assert dataclasses.replace(TINY, kicked_rate="disk").hash() == TINY.hash()
+    old = disk.to_dict()
+    del old["kicked_rate"]
+    back = type(TINY).from_record(old)
+    assert back.kicked_rate == "disk" and back.hash() == disk.hash()
+    with pytest.raises(ValueError, match="kicked_rate"):
+        dataclasses.replace(k, kicked_rate="tagged")
+
+
+def test_the_null_streams_are_shaped_like_the_runs_and_calibrate_the_tests(tmp_path):
+    from kicktimes.studies.disks.null import calibration_rows, null_rows, null_streams
+
+    exp = dataclasses.replace(TINY, name="tiny-elastic", rule="elastic", n_disks=[5],
+                              n_tagged=40, collisions=10)
+    store = run_quiet(exp, tmp_path / "e")
+    res, col = null_streams(store, 5, "dilute", np.random.default_rng(0))
+    assert col[["ic", "disk", "t_window"]].equals(store.collisions[["ic", "disk", "t_window"]])
+    assert all(s.size == t.size + 1 for t, s in zip(col["pp_times"], col["speeds"],
+                                                      strict=True))
+    _, pois = null_streams(store, 5, "poisson", np.random.default_rng(0))
+    assert all(np.isnan(s).all() for s in pois["speeds"])
+    with pytest.raises(ValueError, match="design"):
+        null_streams(store, 5, "cox", np.random.default_rng(0))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        table = null_rows(store, n_boot=99, n_mc=19)
+    assert table["design"].tolist() == ["poisson", "dilute"]
+    assert (table["n_runs"] == store.results["ic"].nunique()).all()
+    rows = calibration_rows(table)
+    assert set(rows["design"]) == {"poisson", "dilute"}
+    assert rows["test"].str.endswith("speed-rescaled").any()
+    assert ((rows["ci_low"] <= rows["share"]) & (rows["share"] <= rows["ci_high"])).all()
+    assert (rows["n_clusters"] == store.results["ic"].nunique()).all()

@@ -50,6 +50,12 @@ _LATER_OPTIONAL = {"kicked_systems": ("poisson", "actual")}
 #: the default since they exist) or ``"twin"`` (a Benettin twin, what the stores written
 #: before carry: a record without the field is read as ``"twin"`` and keeps its hash)
 GAS_FTLE_METHODS = ("tangent", "twin")
+#: the kicks' rate in the kicked comparison (and its lambda / nu): ``"gas"`` the whole
+#: gas's collision frequency per disk, ``2 n_pp / (N T)`` (the default since issue 50, the
+#: rate disks.csv reads), or ``"disk"`` the followed disk's own ``n / T`` (about 200
+#: collisions: what the stores written before carry; a record without the field is read as
+#: ``"disk"`` and keeps its hash)
+KICKED_RATES = ("gas", "disk")
 #: the kicked single disk's systems: uniform new directions at Poisson times of the gas
 #: disk's rate (poisson) or at its collision times (actual); scattering kicks off a virtual
 #: partner from the collision kernel at Poisson times of that rate (scatter)
@@ -145,6 +151,12 @@ class DisksExperiment:
         (`kicktimes.diagnostics.gas_lyapunov.disks_lyapunov`'s ``method``): tangent vectors
         carried by the engine (default) or a Benettin twin. Stores written before the field
         existed used the twin and are read so.
+    kicked_rate : {"gas", "disk"}
+        The rate of that comparison's Poisson and scatter kicks and of its ``lambda / nu``:
+        the whole gas's collision frequency per disk, ``2 n_pp / (N T)`` (default, the
+        rate of the density tables), or the followed disk's own ``n / T`` (about 200
+        collisions, a few per cent of noise). Stores written before the field existed
+        used the disk's own rate and are read so.
     """
 
     name: str
@@ -165,6 +177,7 @@ class DisksExperiment:
     kicked_time: float = 60.0
     kicked_systems: tuple = ("poisson", "actual")
     gas_ftle: str = "tangent"
+    kicked_rate: str = "gas"
 
     #: what a store's record says this is (`Experiment` records have no ``kind``)
     kind = "disks"
@@ -228,6 +241,7 @@ class DisksExperiment:
                              f"{list(systems)}")
         put("kicked_systems", systems)
         check_choice("gas_ftle", self.gas_ftle, GAS_FTLE_METHODS)
+        check_choice("kicked_rate", self.kicked_rate, KICKED_RATES)
         if self.kicked_runs and self.rule != "mirror":
             raise ValueError(f"kicked_runs: the kicked disk keeps its speed, so the comparison "
                              f"needs rule='mirror', got rule={self.rule!r}")
@@ -302,6 +316,7 @@ class DisksExperiment:
             raise TypeError(f"expected a dict of experiment fields, got {type(d).__name__}")
         d = dict(d)
         d.setdefault("gas_ftle", "twin")  # a record from before the field: a twin's FTLE
+        d.setdefault("kicked_rate", "disk")  # before the field: the followed disk's rate
         if d.pop("kind", cls.kind) != cls.kind:
             raise ValueError(f"kind: a disks experiment's record has kind {cls.kind!r}")
         known = [f.name for f in fields(cls)]
@@ -329,6 +344,8 @@ class DisksExperiment:
             # the field is unused without the kicked comparison, and "twin" is what the
             # records written before it existed mean
             del record["gas_ftle"]
+        if not self.kicked_runs or self.kicked_rate == "disk":
+            del record["kicked_rate"]
         text = json.dumps(record, sort_keys=True, separators=(",", ":"), allow_nan=False)
         return hashlib.sha256(text.encode()).hexdigest()[:16]
 

@@ -28,7 +28,7 @@ import pandas as pd
 from kicktimes.experiment.disks import DisksExperiment, DisksTask
 
 __all__ = ["DISKS_COLLISION_COLUMNS", "DISKS_RESULT_COLUMNS", "KICKED_EPS", "KICKED_THEILER",
-           "execute_disks_task", "interval_speeds", "kicked_rows", "run_disks",
+           "execute_disks_task", "interval_speeds", "kicked_rate", "kicked_rows", "run_disks",
            "tagged_start_radii"]
 
 DISKS_RESULT_COLUMNS = ("n_disks", "radius", "ic", "system", "diagnostic", "value", "note")
@@ -143,6 +143,44 @@ KICKED_EPS = 0.05
 KICKED_THEILER = 20
 
 
+def kicked_rate(experiment: DisksExperiment, gas, times) -> float:
+    """The rate of the kicked comparison's Poisson and scatter kicks (and of its
+    ``lambda / nu``).
+
+    Parameters
+    ----------
+    experiment : DisksExperiment
+        Its ``kicked_rate`` chooses: ``"gas"`` the whole gas's collision frequency per
+        disk, ``nu = 2 n_pp / (N T)`` (`kicktimes.billiard.DisksRun.collision_frequency`,
+        every collision counted for both disks; the rate of disks.csv), or ``"disk"`` the
+        followed disk's own ``n / T``.
+    gas : kicktimes.billiard.DisksRun
+        The gas run of the comparison.
+    times : ndarray
+        The followed disk's collision times in it.
+
+    Returns
+    -------
+    float
+        The rate. With about 200 collisions of one disk, ``n / T`` has a relative noise of
+        about ``1 / sqrt(200)``, 7 %; the whole gas's, ``sqrt(2 / (N n))`` of it.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from kicktimes.experiment import disks_preset
+    >>> from kicktimes.billiard import initial_state, simulate_disks
+    >>> exp = disks_preset("disks-kicked-phi0.02-mirror")
+    >>> state = initial_state(10, exp.radius(10), seed=1, rule="mirror")
+    >>> run = simulate_disks(state, exp.radius(10), t_max=20.0, rule="mirror")
+    >>> kicked_rate(exp, run, run.collision_times(0)) == run.collision_frequency
+    True
+    """
+    if experiment.kicked_rate == "gas":
+        return float(gas.collision_frequency)
+    return float(np.asarray(times).size / gas.t_max)
+
+
 def kicked_rows(experiment: DisksExperiment, n_disks: int, k: int) -> list:
     """The kicked comparison of run ``k`` at ``n_disks`` (`DisksExperiment.kicked_runs`).
 
@@ -152,7 +190,7 @@ def kicked_rows(experiment: DisksExperiment, n_disks: int, k: int) -> list:
     its FTLE is the whole gas's, `kicktimes.diagnostics.gas_lyapunov.disks_lyapunov` with
     ``method=experiment.gas_ftle``),
     ``"poisson"`` and ``"actual"`` (one disk from disk 0's state, kicked with uniform new
-    directions at disk 0's own rate ``n / T`` or at its collision times; FTLE from tangent
+    directions at the rate `kicked_rate` or at disk 0's collision times; FTLE from tangent
     vectors, `kicktimes.diagnostics.lyapunov`), ``"scatter"`` (kicked at that rate, each
     kick a mirror collision with a virtual partner of radius ``r`` from the collision
     kernel, ``kick_angle="scatter"``, ``partner="weighted"``), those of
@@ -161,7 +199,8 @@ def kicked_rows(experiment: DisksExperiment, n_disks: int, k: int) -> list:
     boundary angles' lag-1 autocorrelation, `kicktimes.diagnostics.autocorrelation`),
     ``rr`` (the recurrence rate of the sampled positions at ``KICKED_EPS``, Theiler window
     ``KICKED_THEILER`` samples) and, for the
-    gas, ``rate`` (disk 0's collisions per unit time).
+    gas, ``rate`` (the kicks' rate, `kicked_rate`: by default the whole gas's collision
+    frequency per disk, the rate the gas's ``lambda / nu`` is read at).
     """
     import warnings
 
@@ -186,6 +225,7 @@ def kicked_rows(experiment: DisksExperiment, n_disks: int, k: int) -> list:
     gas = simulate_disks(state, r, t_max=t_max, rule="mirror", sample=[0], tau=tau,
                          log_walls=True)
     times = gas.collision_times(0)
+    rate = kicked_rate(experiment, gas, times)
     rows = []
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # an ACF of too few wall hits is NaN, with a reason
@@ -196,10 +236,10 @@ def kicked_rows(experiment: DisksExperiment, n_disks: int, k: int) -> list:
         rows += [("gas", "ftle", ftle), ("gas", "acf@1", autocorrelation(theta, 1)),
                  ("gas", "rr", recurrence_rate(gas.samples[:, 0], KICKED_EPS,
                                                theiler=KICKED_THEILER)),
-                 ("gas", "rate", times.size / t_max)]
-        schedules = {"poisson": Poisson(times.size / t_max),
+                 ("gas", "rate", rate)]
+        schedules = {"poisson": Poisson(rate),
                      "actual": Replay(times, t_max=t_max),
-                     "scatter": Poisson(times.size / t_max)}
+                     "scatter": Poisson(rate)}
         for system in experiment.kicked_systems:
             # scatter: each kick a mirror collision with a partner of the gas's radius drawn
             # from the collision kernel (flux-weighted direction, (w.n)+ normal)
