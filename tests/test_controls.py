@@ -235,28 +235,42 @@ def test_the_poisson_question_is_a_row_per_test_with_the_rule_as_a_control():
     rej = pd.DataFrame({"radius": [0.01, 0.02] * 2,
                         "test": ["uniformity_ks"] * 2 + ["ljung_box"] * 2,
                         "n_tested": [200, 200, 1000, 1000], "n_reject": [80, 76, 52, 48]})
+    rng = np.random.default_rng(3)
     per_ic = pd.DataFrame({"radius": np.repeat([0.01, 0.02], 200), "ic": np.tile(range(200), 2),
                            "p": np.r_[np.zeros(80), np.ones(120), np.zeros(76), np.ones(124)],
-                           "p_fixed": np.nan})
+                           "p_fixed": np.nan, "dispersion": rng.normal(1.4, 0.3, 400)})
+    # the null calibration: the uniformity test rejects 8 % of null streams (not nominal),
+    # Ljung-Box 5 %
+    null = pd.DataFrame({"test": ["uniformity_ks", "ljung_box"], "share": [0.08, 0.05]})
     mirror = pd.DataFrame(poisson_rows("family_a", rej, per_ic, alpha=0.05,
-                                       rng=np.random.default_rng(0), n_boot=300))
-    assert list(mirror["diagnostic"]) == ["reject@uniformity_ks", "reject@ljung_box"]
+                                       rng=np.random.default_rng(0), n_boot=300, null=null))
+    assert list(mirror["diagnostic"]) == ["reject@uniformity_ks", "reject@ljung_box",
+                                          "dispersion_index", "poisson@uniformity_ks"]
     assert mirror.loc[0, "estimate"] == pytest.approx(156 / 400)
     assert mirror.loc[0, "verdict"] == "above nominal" and mirror.loc[1, "verdict"] == "nominal"
+    assert "8.0 % (null_calibration.csv)" in mirror.loc[0, "detail"]
+    assert mirror.loc[2, "verdict"] == "higher"
+    assert mirror.loc[3, "verdict"] == "not Poisson"
+    # elastic: 13 % of runs reject, above the calibrated 8 % by more than half of it? No:
+    # the band is [4 %, 12 %], the CI straddles 12 %; D within 10 %
     rej_e = rej.assign(n_reject=[28, 24, 50, 45])
-    per_ic_e = per_ic.assign(p=np.r_[np.zeros(28), np.ones(172), np.zeros(24), np.ones(176)])
+    per_ic_e = per_ic.assign(p=np.r_[np.zeros(28), np.ones(172), np.zeros(24), np.ones(176)],
+                             dispersion=rng.normal(1.0, 0.2, 400))
     elastic = pd.DataFrame(poisson_rows("family_a-elastic", rej_e, per_ic_e, alpha=0.05,
-                                        rng=np.random.default_rng(0), n_boot=300))
+                                        rng=np.random.default_rng(0), n_boot=300, null=null))
+    assert elastic.loc[2, "verdict"] == "within 10 %"
+    assert elastic.loc[3, "verdict"] == "inconclusive"
     table = merge_control_families([mirror, elastic])["family_a"]
     assert (table["question"] == POISSON_QUESTION).all()
     assert set(table["control"]) == {"primary", "elastic"}
     head = table[table["diagnostic"] == "reject@uniformity_ks"]
-    assert head["robust"].all()  # above nominal under both rules
+    assert not head["robust"].all()  # above nominal under one rule only
     assert table[table["diagnostic"] == "reject@ljung_box"]["robust"].all()  # nominal twice
     text = first_screen(table)[0]
-    assert text.startswith("Under the paper's mirror rule the two-disk collision times are not "
-                           "Poisson (39.0 %")
-    assert "under the elastic rule fewer runs reject (13.0 %" in text and "disjoint" in text
+    assert text.startswith("Are the two-disk collision times Poisson? Under the paper's mirror "
+                           "rule: not Poisson (39.0 %")
+    assert "null streams shaped like the runs reject 8.0 % (A)" in text
+    assert "under the elastic rule: inconclusive (13.0 %" in text and "disjoint" in text
 
 
 def test_the_first_screen_is_at_most_three_sentences_and_a_table_of_at_most_8_columns():

@@ -408,17 +408,24 @@ def _count_rows(family, collisions, sticky, rule, kinetic, *, rng, n_boot, resam
     return rows
 
 
-def poisson_rows(family, rejections, per_ic, *, alpha, rng, n_boot=2000):
+def poisson_rows(family, rejections, per_ic, *, alpha, rng, n_boot=2000, null=None):
     """The Poisson question as rows of the findings table: per test of the battery, the
-    share of (radius, IC) runs whose two-disk collision times reject it at ``alpha``.
+    share of (radius, IC) runs whose two-disk collision times reject it at ``alpha``, read
+    against the share that null streams shaped like the runs reject through the same test
+    (``null``, a `kicktimes.report.poisson.null_calibration` table: the calibrated level;
+    ``alpha`` without one); then the dispersion index and the one standard for "Poisson".
 
     Rows ``diagnostic = "reject@<test>"`` pool the runs of every radius with a
     Clopper-Pearson interval; the headline test's rows (`poisson.HEADLINE_TEST`, on the
     whole window and ``"@first<n>"`` on the first `poisson.FIXED_EVENTS` collisions of
     every run that has them, the same power at every radius) have a bootstrap interval
     clustered on ICs instead (the runs of one IC at different radii share its initial
-    condition). The verdict is :func:`kicktimes.stats.rejection_verdict`'s: *nominal*,
-    *above nominal*, *below nominal* or *inconclusive*.
+    condition). Their verdict is :func:`kicktimes.stats.rejection_verdict`'s against the
+    calibrated level: *nominal*, *above nominal*, *below nominal* or *inconclusive*.
+    The row ``"dispersion_index"`` is the mean over runs of D, the variance over the mean
+    of the counts in 10 equal sub-windows (1 for Poisson; bootstrap clustered on ICs),
+    with :func:`kicktimes.stats.ratio_verdict`'s verdict in the 10 % band; the row
+    ``"poisson@<headline test>"`` is :func:`kicktimes.stats.poisson_verdict` of the two.
 
     Parameters
     ----------
@@ -427,26 +434,42 @@ def poisson_rows(family, rejections, per_ic, *, alpha, rng, n_boot=2000):
     rejections : pandas.DataFrame
         The Poisson section's table (``radius, test, n_tested, n_reject``).
     per_ic : pandas.DataFrame
-        The headline test's p-values per run (``radius, ic, p, p_fixed``).
+        The headline test's p-values and D per run (``radius, ic, p, p_fixed,
+        dispersion``).
     alpha : float
         The tests' level.
     rng : numpy.random.Generator
         The clustered bootstrap's stream.
     n_boot : int
         Its resamples.
+    null : pandas.DataFrame, optional
+        The null calibration of the same runs.
     """
-    from kicktimes.report.poisson import FIXED_EVENTS, HEADLINE_TEST, clustered_share
+    from kicktimes.report.poisson import (
+        FIXED_EVENTS,
+        HEADLINE_TEST,
+        clustered_mean,
+        clustered_share,
+        null_level,
+    )
+    from kicktimes.stats import poisson_verdict
     from kicktimes.stats.findings import clopper_pearson
 
     rows = []
 
-    def add(diagnostic, k, n, low, high, detail):
-        share = k / n if n else math.nan
+    def add(diagnostic, estimate, n, low, high, verdict, detail):
         rows.append({
             "family": family, "question": POISSON_QUESTION, "diagnostic": diagnostic,
-            "system": REFERENCE, "control": "primary", "estimate": share, "ci_low": low,
-            "ci_high": high, "verdict": rejection_verdict(low, high, alpha), "robust": False,
+            "system": REFERENCE, "control": "primary", "estimate": estimate, "ci_low": low,
+            "ci_high": high, "verdict": verdict, "robust": False,
             "depends_on": "", "n_pairs": int(n), "detail": detail})
+
+    def calibrated(test):
+        level = null_level(null, test, alpha)
+        return level, (f"; read against the share of null streams the test rejects, "
+                       f"{100 * level:.1f} % (null_calibration.csv)" if null is not None
+                       and not null.empty else f"; read against α = {alpha:g} (no null "
+                       "calibration)")
 
     totals = rejections.groupby("test", sort=False, observed=True)[["n_reject", "n_tested"]].sum()
     for test, (k, n) in totals.iterrows():
@@ -458,17 +481,34 @@ def poisson_rows(family, rejections, per_ic, *, alpha, rng, n_boot=2000):
         else:
             low, high = clopper_pearson(int(k), int(n))
             how = "Clopper-Pearson 95 % CI (runs of one IC at different radii counted apart)"
-        add(f"reject@{test}", int(k), int(n), low, high,
+        level, against = calibrated(test)
+        add(f"reject@{test}", k / n, n, low, high, rejection_verdict(low, high, level),
             f"share of runs rejecting {test} at α = {alpha:g}, every radius, whole window; "
-            + how)
+            + how + against)
     if per_ic is not None and np.isfinite(per_ic["p_fixed"]).any():
         p = per_ic["p_fixed"].to_numpy(float)
         ok = np.isfinite(p)
         low, high = clustered_share(per_ic, "p_fixed", alpha, rng=rng, n_boot=n_boot)
-        add(f"reject@{HEADLINE_TEST}@first{FIXED_EVENTS}", int((p[ok] < alpha).sum()),
-            int(ok.sum()), low, high,
+        add(f"reject@{HEADLINE_TEST}@first{FIXED_EVENTS}", (p[ok] < alpha).sum() / ok.sum(),
+            ok.sum(), low, high, rejection_verdict(low, high, alpha),
             f"{HEADLINE_TEST} on the first {FIXED_EVENTS} collisions of every run that has "
-            "them (the same power at every radius); 95 % CI from a bootstrap clustered on ICs")
+            "them (the same power at every radius); 95 % CI from a bootstrap clustered on "
+            f"ICs; read against α = {alpha:g}")
+    if per_ic is not None and "dispersion" in per_ic.columns and HEADLINE_TEST in totals.index:
+        d, d_low, d_high = clustered_mean(per_ic, "dispersion", rng=rng, n_boot=n_boot)
+        n_d = int(np.isfinite(per_ic["dispersion"].to_numpy(float)).sum())
+        add("dispersion_index", d, n_d, d_low, d_high, ratio_verdict(d_low, d_high, 0.1),
+            "mean over runs of D = variance / mean of the counts in 10 equal sub-windows of "
+            "the run's window (1 for a Poisson process given its count); 95 % CI from a "
+            "bootstrap clustered on ICs; verdict in the ±10 % band")
+        head = rows[[r["diagnostic"] for r in rows].index(f"reject@{HEADLINE_TEST}")]
+        level, _ = calibrated(HEADLINE_TEST)
+        add(f"poisson@{HEADLINE_TEST}", head["estimate"], head["n_pairs"], head["ci_low"],
+            head["ci_high"], poisson_verdict(head["ci_low"], head["ci_high"], level, d_low,
+                                             d_high),
+            f"kicktimes.stats.poisson_verdict: the {HEADLINE_TEST} rejection share against its "
+            f"calibrated level {100 * level:.1f} % and D {d:.3g} [{d_low:.3g}, {d_high:.3g}] "
+            "against [0.9, 1.1]")
     return rows
 
 

@@ -102,7 +102,8 @@ def section(ctx):
 
         extra = pd.DataFrame(poisson_rows(ctx.exp.name, ctx.found.rejections,
                                           ctx.found.poisson_per_ic, alpha=ctx.alpha,
-                                          rng=ctx.boot_rng(), n_boot=ctx.n_boot),
+                                          rng=ctx.boot_rng(), n_boot=ctx.n_boot,
+                                          null=ctx.found.null_calibration),
                              columns=list(COLUMNS))
         computed = Controls(with_robustness(pd.concat([computed.table, extra],
                                                       ignore_index=True)), computed.curves)

@@ -252,6 +252,7 @@ def _poisson_job(job):
                                 nulls=nulls)
     rows = group.rejections.drop(columns="rate")
     rows.insert(0, "radius", r)
+    ctrl = None
     if control is not None:
         # the control: the same tests on the sweep's own Poisson kick times of each IC;
         # every test should reject about alpha of them
@@ -269,7 +270,13 @@ def _poisson_job(job):
         p_fixed[long] = uniformity_ks(u)[1]
     per_ic = pd.DataFrame({"radius": r, "ic": ics,
                            "p": group.ensemble.per_sequence[f"p_{HEADLINE_TEST}"].to_numpy(float),
-                           "p_fixed": p_fixed})
+                           "p_fixed": p_fixed,
+                           "dispersion": group.ensemble.statistics["dispersion"].to_numpy(float)})
+    if ctrl is not None:
+        # the null calibration, run by run: the headline test's p-value and the dispersion
+        # index of the IC's Poisson control stream (same window, same tests)
+        per_ic["control_p"] = ctrl.ensemble.per_sequence[f"p_{HEADLINE_TEST}"].to_numpy(float)
+        per_ic["control_dispersion"] = ctrl.ensemble.statistics["dispersion"].to_numpy(float)
     hom = group.homogeneity
     hom_row = {
         "radius": r,
@@ -387,6 +394,9 @@ def sections(ctx):
               f"also at a fixed {FIXED_EVENTS} collisions: *_fixed)")
     ctx.found.rejections = rejections
     ctx.found.poisson_per_ic = per_ic
+    if "control_p" in per_ic.columns:
+        ctx.found.null_calibration = null_calibration(
+            ctx.exp.name, rejections, per_ic, alpha=alpha, rng=ctx.rng(6), n_boot=ctx.n_boot)
     ctx.found.homogeneity = homogeneity
     return [sec]
 
@@ -424,6 +434,82 @@ def clustered_share(per_ic, column, alpha, *, rng, n_boot=2000, level=0.95):
     return float(np.percentile(boot, a)), float(np.percentile(boot, 100 - a))
 
 
+def clustered_mean(per_ic, column, *, rng, n_boot=2000, level=0.95):
+    """``(mean, low, high)``: the mean of the finite ``per_ic[column]`` over runs and its
+    percentile CI from a bootstrap clustered on ICs (as :func:`clustered_share`).
+
+    Examples
+    --------
+    >>> import numpy as np, pandas as pd
+    >>> df = pd.DataFrame({"radius": np.repeat([0.01, 0.02], 50), "ic": np.tile(range(50), 2),
+    ...                    "d": np.tile(np.linspace(0.5, 1.5, 50), 2)})
+    >>> mean, low, high = clustered_mean(df, "d", rng=np.random.default_rng(0))
+    >>> round(mean, 6), bool(low < 1.0 < high)
+    (1.0, True)
+    """
+    table = per_ic.pivot_table(index="ic", columns="radius", values=column, dropna=False,
+                                observed=True)
+    v = table.to_numpy(float)
+    n_runs = np.isfinite(v).sum(axis=1).astype(float)
+    total = np.where(np.isfinite(v), v, 0.0).sum(axis=1)
+    if n_runs.sum() == 0:
+        return math.nan, math.nan, math.nan
+    n = n_runs.size
+    counts = rng.multinomial(n, np.full(n, 1.0 / n), size=n_boot).astype(float)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        boot = (counts @ total) / (counts @ n_runs)
+    boot = boot[np.isfinite(boot)]
+    a = (1 - level) / 2 * 100
+    return (float(total.sum() / n_runs.sum()), float(np.percentile(boot, a)),
+            float(np.percentile(boot, 100 - a)))
+
+
+#: the null design of the two-disk calibration
+NULL_DESIGN = ("Poisson at each run's rate (the sweep's own Poisson kick times of the run's "
+               "IC and radius, rate n_pp / t_window, cut at the run's window)")
+
+
+def null_calibration(name, rejections, per_ic, *, alpha, rng, n_boot=2000) -> pd.DataFrame:
+    """The null calibration of the Poisson battery on one experiment's runs.
+
+    Every run's Poisson control stream (:func:`_control_times`: Poisson by construction,
+    at the run's own rate and window) went through the same tests as the run's collision
+    times. One row per test: the share of control streams it rejects at ``alpha``, pooled
+    over radii, with the interval the data's row has: for the headline test a bootstrap
+    clustered on ICs (``per_ic["control_p"]``), for the others Clopper-Pearson on the
+    counts (runs of one IC at different radii counted apart). The columns are those of
+    `kicktimes.report.pages.NULL_CALIBRATION_COLUMNS` without ``study`` and ``verdict``.
+    """
+    from kicktimes.stats.findings import clopper_pearson
+
+    totals = rejections.groupby("test", sort=False, observed=True)[
+        ["control_n_reject", "control_n_tested"]].sum()
+    n_ics = int(per_ic["ic"].nunique())
+    rows = []
+    for test, (k, n) in totals.iterrows():
+        k, n = int(k), int(n)
+        if n == 0:
+            continue
+        if test == HEADLINE_TEST:
+            low, high = clustered_share(per_ic, "control_p", alpha, rng=rng, n_boot=n_boot)
+            clusters = n_ics
+        else:
+            low, high = clopper_pearson(k, n)
+            clusters = n
+        rows.append({"data": name, "test": test, "design": NULL_DESIGN, "alpha": alpha,
+                     "n_runs": n, "n_clusters": clusters, "share": k / n, "ci_low": low,
+                     "ci_high": high})
+    return pd.DataFrame(rows)
+
+
+def null_level(null, test, alpha) -> float:
+    """The share of null streams that ``test`` rejects (the calibrated level of its
+    verdicts), from a :func:`null_calibration` table; ``alpha`` when there is none."""
+    if null is None or null.empty or test not in set(null["test"]):
+        return alpha
+    return float(null.loc[null["test"] == test, "share"].iloc[0])
+
+
 def effects(ctx):
     """Share of (IC, radius) runs whose collision times reject a Poisson process."""
     rej = ctx.found.rejections
@@ -435,14 +521,15 @@ def effects(ctx):
     k, n = (int(v) for v in totals.loc[HEADLINE_TEST])
     per_ic = ctx.found.poisson_per_ic
     low, high = clustered_share(per_ic, "p", ctx.alpha, rng=ctx.rng(4), n_boot=ctx.n_boot)
-    verdict = share_verdict(low, high, ctx.alpha)
+    level = null_level(ctx.found.null_calibration, HEADLINE_TEST, ctx.alpha)
+    verdict = share_verdict(low, high, level)
     n_fixed = max(1, int(np.isfinite(per_ic["p_fixed"]).sum()))
     fixed_share = float((per_ic["p_fixed"] < ctx.alpha).sum()) / n_fixed
     f_low, f_high = clustered_share(per_ic, "p_fixed", ctx.alpha, rng=ctx.rng(5),
                                     n_boot=ctx.n_boot)
     words = {
-        "above": "Poisson rejected (more rejections than α)",
-        "below": "fewer rejections than α (conservative test)",
+        "above": "Poisson rejected (more rejections than null streams give)",
+        "below": "fewer rejections than null streams give (conservative test)",
         "inconclusive": "consistent with Poisson at this sample size",
     }[verdict]
     others = "; ".join(
@@ -463,7 +550,10 @@ def effects(ctx):
             ci_low=low,
             ci_high=high,
             verdict=words,
-            rule=SHARE_RULE.format(level=ctx.alpha) + " (level: α, the share under Poisson)",
+            rule=SHARE_RULE.format(level=level) + (
+                " (level: the share of the runs' Poisson control streams the same test "
+                "rejects, null_calibration.csv)" if ctx.found.null_calibration is not None
+                else " (level: α, the share under Poisson)"),
             method=(f"bootstrap clustered on {per_ic['ic'].nunique()} ICs ({n} runs at "
                     f"{per_ic['radius'].nunique()} radii)"),
             detail=(
