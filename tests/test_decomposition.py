@@ -54,7 +54,8 @@ def test_shapley_shares_average_both_orders_and_sum_to_one():
     assert est[STEPS[0]] == pytest.approx(0.5 * (order_1[0] + order_2[0]) / up)
     assert est[STEPS[1]] == pytest.approx(0.5 * (order_1[1] + order_2[1]) / up)
     assert est[STEPS[2]] == pytest.approx(sk / up)
-    assert est[list(STEPS)].sum() == pytest.approx(1.0)
+    assert est[list(STEPS[:3])].sum() == pytest.approx(1.0)
+    assert not set(STEPS[3:]) & set(est.index)  # no actual-times systems, no such shares
     assert set(tab["control"]) == {"primary", "paired_median", "sticky_excluded"}
     assert set(tab["diagnostic"]) == {"ftle", "one_minus_r1"}
 
@@ -95,8 +96,38 @@ def test_intervals_cover_the_estimate_and_widen_with_noise():
     assert (lo["ci_high"] - lo["ci_low"]) > (q["ci_high"] - q["ci_low"])
     # a share is robust only when no control's CI straddles 0
     summary = gap_summary(quiet).set_index("diagnostic")
-    assert summary.loc["ftle", f"{STEPS[0]} robust"] == "✓"
+    assert summary.loc["ftle", f"{STEPS[0]} robust"].startswith("sign ✓ (0.9")
+    assert summary.loc["ftle", f"{STEPS[2]} robust"] == "—"  # what is left: no mark
     assert summary.loc["ftle", f"{STEPS[1]} robust"].startswith("✗")
+
+
+def test_the_actual_times_factorial_switches_the_timing_to_the_real_collision_times():
+    values = {**FOUR, "actual": 0.3, "actual_scatter": 0.7}
+    tab = gap_decomposition(*_store(values), family="f", eps=(),
+                            rng=np.random.default_rng(1), n_boot=100)
+    est = tab[(tab["control"] == "primary") & (tab["diagnostic"] == "ftle")].set_index(
+        "quantity")["estimate"]
+    up, sp, ua, sa = np.abs(np.log([0.25, 0.5, 0.3, 0.7]))
+    assert est[STEPS[4]] == pytest.approx(0.5 * ((up - ua) + (sp - sa)) / up)
+    assert est[STEPS[3]] == pytest.approx(0.5 * ((up - sp) + (ua - sa)) / up)
+    assert est[STEPS[5]] == pytest.approx(sa / up)
+    # the kinetic-rate factorial's shares are unchanged by the extra systems
+    alone = gap_decomposition(*_store(FOUR), family="f", eps=(),
+                              rng=np.random.default_rng(1), n_boot=100)
+    base = alone[(alone["control"] == "primary") & (alone["diagnostic"] == "ftle")]
+    assert est[STEPS[1]] == pytest.approx(base.set_index("quantity")["estimate"][STEPS[1]])
+
+
+def test_control_experiments_become_controls_of_their_family():
+    from kicktimes.report.decomposition import merge_control_gaps
+
+    a = gap_decomposition(*_store(FOUR), family="fam", eps=(), rng=np.random.default_rng(0),
+                          n_boot=20)
+    b = gap_decomposition(*_store(FOUR, seed=1), family="fam-elastic", eps=(),
+                          rng=np.random.default_rng(0), n_boot=20)
+    merged = merge_control_gaps([a, b])
+    assert set(merged["family"]) == {"fam"}
+    assert set(merged["control"]) == {"primary", "paired_median", "sticky_excluded", "elastic"}
 
 
 def test_without_the_factorials_systems_the_table_is_empty_and_the_figure_draws():

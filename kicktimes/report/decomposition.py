@@ -1,36 +1,43 @@
 r"""How much of the kicked-versus-two-disk gap each ingredient of the kicks closes.
 
 Two ingredients of a real disk-disk collision, each switched on or off, give a 2 x 2
-factorial of kicked systems:
+factorial of kicked systems; the timing is switched two ways, so there are two
+factorials with the same deflection law:
 
-==================  ====================  ==============================
-deflection \ time   Poisson times         kinetic rate of the disk's L
-==================  ====================  ==============================
-uniform direction   ``poisson`` (paper)   ``uniform_kinetic``
-scatter kick        ``poisson_scatter``   ``poisson_kinetic``
-==================  ====================  ==============================
+==================  ====================  ==============================  ====================
+deflection \ time   Poisson times         kinetic rate of the disk's L    actual collision times
+==================  ====================  ==============================  ====================
+uniform direction   ``poisson`` (paper)   ``uniform_kinetic``             ``actual`` (paper)
+scatter kick        ``poisson_scatter``   ``poisson_kinetic``             ``actual_scatter``
+==================  ====================  ==============================  ====================
 
-For a diagnostic with kicked / two-disk ratio :math:`\rho_s`, the gap of system ``s`` is
-:math:`g_s = |\log \rho_s|`. The gap the two ingredients close together,
-:math:`g_{UP} - g_{SK}`, is split by Shapley values (the average of the two orders in
-which the ingredients can be added, so no order is privileged):
+The kinetic-rate factorial (`FACTORIAL`) switches the timing to a model of the collision
+process (a Cox process whose rate the disk's own angular momentum sets); the actual-times
+factorial (`ACTUAL_FACTORIAL`) to the two-disk run's own collision times, which carry
+the partner's memory as well. For a diagnostic with kicked / two-disk ratio
+:math:`\rho_s`, the gap of system ``s`` is :math:`g_s = |\log \rho_s|`. In each factorial
+the gap the two ingredients close together, :math:`g_{UP} - g_{ST}` (``T`` the factorial's
+timing), is split by Shapley values (the average of the two orders in which the
+ingredients can be added, so no order is privileged):
 
 .. math::
 
-    \phi_{\rm deflection} = \tfrac12\big[(g_{UP} - g_{SP}) + (g_{UK} - g_{SK})\big], \qquad
-    \phi_{\rm timing} = \tfrac12\big[(g_{UP} - g_{UK}) + (g_{SP} - g_{SK})\big],
+    \phi_{\rm deflection} = \tfrac12\big[(g_{UP} - g_{SP}) + (g_{UT} - g_{ST})\big], \qquad
+    \phi_{\rm timing} = \tfrac12\big[(g_{UP} - g_{UT}) + (g_{SP} - g_{ST})\big],
 
 and the shares of the paper's gap :math:`g_{UP}` are :math:`\phi_{\rm deflection}/g_{UP}`,
-:math:`\phi_{\rm timing}/g_{UP}` and the remainder :math:`g_{SK}/g_{UP}` (partner memory,
-re-collisions: what no kick law has; *not measured*, only left over). They sum to one; a
+:math:`\phi_{\rm timing}/g_{UP}` and what is left, :math:`g_{ST}/g_{UP}`: the gap the
+factorial's best system still has (one minus the two shares). It is not attributed to any
+mechanism: no experiment here switches partner memory or re-collisions on or off. A
 negative share is an ingredient that widens the gap. The shares are computed only where
 the paper's gap exists: where the CI of :math:`\rho_{UP}` lies entirely outside the
 ±10 % band under that control; elsewhere the row says "no gap to decompose" (a gap
 inside its own noise is not decomposed). Every quantity is computed under the findings'
 controls (`kicktimes.report.controls`; the recurrence diagnostics on uniform-time samples,
-the paper's samples as the control ``paper_sampling``), with a percentile bootstrap
-clustered on ICs: one resample draws IC indices and applies them to every system and
-radius, so the four ratios and their differences come from the same resampled ICs.
+the paper's samples as the control ``paper_sampling``; the control experiments' rows are
+folded in by :func:`merge_control_gaps`), with a percentile bootstrap clustered on ICs:
+one resample draws IC indices and applies them to every system and radius, so the ratios
+and their differences come from the same resampled ICs.
 """
 
 from __future__ import annotations
@@ -44,14 +51,23 @@ from kicktimes.report.common import REFERENCE, wide
 from kicktimes.report.controls import diagnostics_of
 from kicktimes.stats import bootstrap_nanmedians
 
-__all__ = ["FACTORIAL", "NO_GAP", "STEPS", "gap_decomposition", "gap_figure", "gap_summary"]
+__all__ = ["ACTUAL_FACTORIAL", "FACTORIAL", "NO_GAP", "STEPS", "gap_decomposition",
+           "gap_figure", "gap_summary", "merge_control_gaps"]
 
-#: the factorial's systems: (uniform, Poisson), (scatter, Poisson), (uniform, kinetic),
-#: (scatter, kinetic)
+#: the kinetic-rate factorial's systems: (uniform, Poisson), (scatter, Poisson),
+#: (uniform, kinetic), (scatter, kinetic)
 FACTORIAL = ("poisson", "poisson_scatter", "uniform_kinetic", "poisson_kinetic")
-#: the shares, in the table's order
-STEPS = ("deflection law (Shapley)", "state-dependent timing (Shapley)",
-         "remainder (partner memory, re-collisions; not measured)")
+#: the actual-times factorial's: (uniform, Poisson), (scatter, Poisson), (uniform, actual),
+#: (scatter, actual)
+ACTUAL_FACTORIAL = ("poisson", "poisson_scatter", "actual", "actual_scatter")
+#: the shares, in the table's order: the kinetic-rate factorial's three, then the
+#: actual-times factorial's three
+STEPS = ("deflection law (Shapley)", "kinetic-rate timing (Shapley)",
+         "left by the kinetic scatter kick (not attributed)",
+         "deflection law, actual-times factorial (Shapley)", "actual-times timing (Shapley)",
+         "left by the actual scatter kick (not attributed)")
+#: the shares with a tested ingredient (the others are what is left)
+INGREDIENTS = (STEPS[0], STEPS[1], STEPS[3], STEPS[4])
 #: what a share's row says where the paper's gap lies inside the ±10 % band
 NO_GAP = "no gap to decompose"
 _BAND = (0.9, 1.1)
@@ -166,6 +182,12 @@ def gap_decomposition(results, collisions, *, family, eps, rule="mirror", rng, n
     present = set(results["system"].unique())
     if not set(FACTORIAL) | {REFERENCE} <= present:
         return pd.DataFrame(columns=columns)
+    systems = list(dict.fromkeys(FACTORIAL + ACTUAL_FACTORIAL))
+    actual = set(ACTUAL_FACTORIAL) <= present
+    if not actual:
+        systems = list(FACTORIAL)
+    where = [systems.index(s) for s in FACTORIAL]
+    where_actual = [systems.index(s) for s in ACTUAL_FACTORIAL] if actual else None
     sticky = sticky_ics(collisions, rule, kinetic=kinetic).set_index(["radius", "ic"])["sticky"]
     alpha = (1.0 - level) / 2.0
     rows = []
@@ -182,7 +204,7 @@ def gap_decomposition(results, collisions, *, family, eps, rule="mirror", rng, n
                 table = 1.0 - table
             keep = (~sticky if control == "sticky_excluded"
                     else pd.Series(True, index=sticky.index))
-            xs, y, _ = _arrays(table, FACTORIAL, keep)
+            xs, y, _ = _arrays(table, systems, keep)
             if n_ic is None:
                 n_ic = y.shape[1]
                 idx = rng.integers(0, n_ic, size=(n_boot, n_ic))
@@ -196,18 +218,23 @@ def gap_decomposition(results, collisions, *, family, eps, rule="mirror", rng, n
                 every = np.arange(n_ic)[None, :]
                 point = np.array([_ratio_medians(x, y, every)[0] for x in xs])
                 boot = np.stack([_ratio_medians(x, y, idx) for x in xs])
-            shares = shapley_shares(point[:, None])[:, 0]
-            boot_shares = shapley_shares(boot)
+            shares = list(shapley_shares(point[where, None])[:, 0])
+            boot_shares = list(shapley_shares(boot[where]))
+            steps = list(STEPS[:3])
+            if actual:
+                shares += list(shapley_shares(point[where_actual, None])[:, 0])
+                boot_shares += list(shapley_shares(boot[where_actual]))
+                steps += list(STEPS[3:])
             finite = boot[0][np.isfinite(boot[0])]
             lo0, hi0 = (np.quantile(finite, [alpha, 1.0 - alpha]) if finite.size
                         else (np.nan, np.nan))
             gap = bool(hi0 < _BAND[0] or lo0 > _BAND[1])
-            names = [f"ratio {s}" for s in FACTORIAL] + list(STEPS)
+            names = [f"ratio {s}" for s in systems] + steps
             estimates = [*point, *shares]
             draws = [*boot, *boot_shares]
             for k, (quantity, est, dist) in enumerate(zip(names, estimates, draws, strict=True)):
                 note = ""
-                if k >= len(FACTORIAL) and not gap:
+                if k >= len(systems) and not gap:
                     rows.append((family, diagnostic, control, quantity, np.nan, np.nan, np.nan,
                                  NO_GAP))
                     continue
@@ -219,88 +246,139 @@ def gap_decomposition(results, collisions, *, family, eps, rule="mirror", rng, n
     return pd.DataFrame(rows, columns=columns)
 
 
+def merge_control_gaps(tables) -> pd.DataFrame:
+    """Fold the gap tables of control experiments into their family's, as
+    `kicktimes.report.controls.merge_control_families` does for the findings: the
+    ``primary`` rows of experiment ``"<family>-<control>"`` become rows of ``<family>``
+    with ``control = "<control>"`` (when ``<family>``'s own table is present)."""
+    tables = [t for t in tables if t is not None and not t.empty]
+    if not tables:
+        return pd.DataFrame()
+    names = {t["family"].iloc[0] for t in tables}
+    out = []
+    for t in tables:
+        family, _, control = t["family"].iloc[0].partition("-")
+        if control and family in names:
+            out.append(t[t["control"] == "primary"].assign(family=family, control=control))
+        else:
+            out.append(t)
+    return pd.concat(out, ignore_index=True)
+
+
+def _sides(part, step):
+    """Per control the side of 0 of the share's CI (1, -1, 0 straddles, None no gap)."""
+    sides = {}
+    for _, r in part[part["quantity"] == step].iterrows():
+        if not np.isfinite(r["estimate"]):
+            sides[r["control"]] = None
+        else:
+            sides[r["control"]] = (1 if r["ci_low"] > 0 else -1 if r["ci_high"] < 0 else 0)
+    return sides
+
+
 def gap_figure(table: pd.DataFrame):
-    """The Shapley shares of the paper's gap, one panel per diagnostic with a gap (primary
-    setting: uniform-time samples for recurrence), with their 95 % CIs (bootstrap clustered
-    on ICs), families side by side; a panel without a gap says so. One y scale for all."""
+    """The Shapley shares of the paper's gap closed by each tested ingredient (deflection
+    law; kinetic-rate timing; actual-times timing), one panel per diagnostic that has a gap
+    in some family (primary setting: uniform-time samples for recurrence), with their 95 %
+    CIs (bootstrap clustered on ICs), families side by side. What is left (one minus the
+    shares) is not drawn: no ingredient of it is tested. A share whose sign is not the same
+    under every control is drawn hollow and marked ✗. One y scale for all."""
     from matplotlib.figure import Figure
     from matplotlib.lines import Line2D
 
     from kicktimes.report.answers import PANELS
 
-    panels = [(d, t) for d, t in PANELS if d in set(table["diagnostic"])]
+    primary = table[table["control"] == "primary"]
+    with_gap = set(primary.loc[primary["quantity"].isin(INGREDIENTS)
+                               & np.isfinite(primary["estimate"]), "diagnostic"])
+    panels = [(d, t) for d, t in PANELS if d in with_gap]
+    steps = [s for s in INGREDIENTS if s in set(table["quantity"]) and s != STEPS[3]]
     families = list(dict.fromkeys(table["family"]))
-    fig = Figure(figsize=(2.9 * max(len(panels), 1), 3.9), layout="constrained")
+    fig = Figure(figsize=(3.2 * max(len(panels), 1), 4.1), layout="constrained")
     axes = fig.subplots(1, max(len(panels), 1), squeeze=False, sharey=True)[0]
-    colours = ("tab:red", "tab:purple", "0.45")
-    short = ("deflection", "timing", "remainder")
+    colours = ("tab:red", "tab:purple", "tab:green")
+    short = ("deflection", "kinetic-rate\ntiming", "actual-times\ntiming")
     for ax, (diagnostic, title) in zip(axes, panels, strict=False):
         ax.axhline(0.0, color="0.5", linewidth=0.8, zorder=0)
         ax.axhline(1.0, color="0.8", linewidth=0.8, linestyle=":", zorder=0)
-        part = table[(table["diagnostic"] == diagnostic) & (table["control"] == "primary")]
-        drawn = False
+        part = table[table["diagnostic"] == diagnostic]
         for f, family in enumerate(families):
-            rows = part[part["family"] == family].set_index("quantity")
-            for i, step in enumerate(STEPS):
+            fam = part[part["family"] == family]
+            rows = fam[fam["control"] == "primary"].set_index("quantity")
+            for i, step in enumerate(steps):
                 if step not in rows.index or not np.isfinite(rows.loc[step, "estimate"]):
                     continue
                 est, lo, hi = rows.loc[step, ["estimate", "ci_low", "ci_high"]]
-                err = [[max(est - lo, 0.0)], [max(hi - est, 0.0)]]
-                ax.errorbar([i + 0.2 * (f - (len(families) - 1) / 2)], [est], yerr=err,
+                sides = set(_sides(fam, step).values())
+                robust = len(sides) == 1 and sides <= {1, -1}
+                x = i + 0.22 * (f - (len(families) - 1) / 2)
+                ax.errorbar([x], [est], yerr=[[max(est - lo, 0.0)], [max(hi - est, 0.0)]],
                             fmt="os"[f % 2], color=colours[i], capsize=2.5, ms=5,
-                            mfc="white" if f else colours[i])
-                drawn = True
-        if not drawn:
-            ax.text(0.5, 0.5, "no gap to decompose:\nthe paper's kick is within\nthe ±10 % "
-                    "band or its CI\nstraddles an edge", transform=ax.transAxes,
-                    ha="center", va="center", fontsize="small", color="0.3")
-        ax.set_xticks(range(len(STEPS)), short, fontsize="small")
-        ax.set_xlim(-0.5, len(STEPS) - 0.5)
+                            mfc=colours[i] if robust else "white")
+                if not robust:
+                    ax.annotate("✗", (x, hi), textcoords="offset points", xytext=(0, 3),
+                                ha="center", fontsize="small", color=colours[i])
+        ax.set_xticks(range(len(steps)), short[:len(steps)], fontsize="small")
+        ax.set_xlim(-0.5, len(steps) - 0.5)
         ax.set_title(title, fontsize="medium")
+    if not panels:
+        axes[0].text(0.5, 0.5, "no gap to decompose: the paper's kick is within\nthe ±10 % "
+                     "band (or its CI on a band edge)\nfor every diagnostic",
+                     transform=axes[0].transAxes, ha="center", va="center",
+                     fontsize="small", color="0.3")
     axes[0].set_ylabel("share of the paper's gap |log(kicked / two-disk)|")
-    handles = [Line2D([], [], color="k", marker="os"[f % 2], mfc="white" if f else "k",
-                      linestyle="none", label=fam) for f, fam in enumerate(families)]
+    handles = [Line2D([], [], color="k", marker="os"[f % 2], linestyle="none", label=fam)
+               for f, fam in enumerate(families)]
+    handles.append(Line2D([], [], color="k", marker="o", mfc="white", linestyle="none",
+                          label="✗ hollow: the sign changes or the CI contains 0 under some "
+                                "control"))
     fig.legend(handles=handles, loc="outside lower center", ncol=max(len(handles), 1),
                fontsize="small")
-    fig.suptitle("Shapley shares of the paper's kicked-disk gap closed by the deflection law "
-                 "and the timing (95 % CI); the remainder is not measured", fontsize="medium")
+    fig.suptitle("Shares of the paper's kicked-disk gap closed by each ingredient (Shapley, "
+                 "95 % CI; diagnostics with a gap)", fontsize="medium")
     return fig
 
 
 def gap_summary(table: pd.DataFrame) -> pd.DataFrame:
-    """One row per (family, diagnostic): the three shares under the primary setting with
-    their 95 % CIs (or `NO_GAP`), and whether each is robust: every control has a gap, and
-    every control's CI lies on the same side of 0, none straddling it.
+    """One row per (family, diagnostic): each share under the primary setting with its
+    95 % CI (or `NO_GAP`), and for the shares of a tested ingredient whether its sign is
+    the same under every control: ``"sign ✓ (a to b)"`` with the range of the estimates
+    over the controls (the sign is all the mark checks; the range shows how much the size
+    moves), or ``"✗ <control>: ..."`` naming the first control that breaks it. What is
+    left gets no mark: it is not attributed.
 
-    Returns columns ``family, diagnostic`` and per step ``<step>`` (``"0.62 [0.41, 0.80]"``)
-    and ``<step> robust`` (``"✓"``, or ``"✗ <control>"`` naming the first control that breaks
-    it).
+    Returns columns ``family, diagnostic`` and per step ``<step>`` and ``<step> robust``.
     """
     from kicktimes.stats import format_interval
 
     rows = []
+    steps = [s for s in STEPS if s in set(table["quantity"])]
     for (family, diagnostic), part in table.groupby(["family", "diagnostic"], sort=False,
                                                     observed=True):
         head = part[part["control"] == "primary"].set_index("quantity")
         row = {"family": family, "diagnostic": diagnostic}
-        for step in STEPS:
+        for step in steps:
             est, lo, hi = head.loc[step, ["estimate", "ci_low", "ci_high"]]
             row[step] = (format_interval(est, lo, hi, edges=(0.0,)) if np.isfinite(est)
                          else NO_GAP)
-            verdict = "✓"
-            sides = []
-            for _, r in part[part["quantity"] == step].iterrows():
-                side = 1 if r["ci_low"] > 0 else -1 if r["ci_high"] < 0 else 0
-                if not np.isfinite(r["estimate"]):
-                    verdict = f"✗ {r['control']} (no gap)"
+            if step not in INGREDIENTS or not np.isfinite(est):
+                row[f"{step} robust"] = "—"
+                continue
+            verdict = None
+            first = None
+            for control, side in _sides(part, step).items():
+                if side is None:
+                    verdict = f"✗ {control} (no gap)"
+                elif side == 0:
+                    verdict = f"✗ {control}: CI contains 0"
+                elif first is not None and side != first:
+                    verdict = f"✗ {control}: other sign"
+                first = side if first is None else first
+                if verdict:
                     break
-                if side == 0:
-                    verdict = f"✗ {r['control']}: CI contains 0"
-                    break
-                if sides and side != sides[0]:
-                    verdict = f"✗ {r['control']}: other sign"
-                    break
-                sides.append(side)
-            row[f"{step} robust"] = verdict if np.isfinite(est) else "—"
+            if verdict is None:
+                values = part.loc[part["quantity"] == step, "estimate"]
+                verdict = f"sign ✓ ({values.min():.2g} to {values.max():.2g})"
+            row[f"{step} robust"] = verdict
         rows.append(row)
     return pd.DataFrame(rows)
