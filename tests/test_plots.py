@@ -412,7 +412,9 @@ def test_model_comparison_shares_add_up_to_one():
     low, high = plots.binomial_ci([2, 1], [3, 2])
     assert [seg[0][1] for seg in segments] == pytest.approx(low)
     assert [seg[1][1] for seg in segments] == pytest.approx(high)
-    assert {t.get_text() for t in ax1.texts} >= {"n = 3", "n = 2"}
+    # n under each radius's tick (against the radius), not over the bars
+    assert [t.get_text() for t in ax1.get_xticklabels()] == ["0.01\nn = 3", "0.02\nn = 2"]
+    assert not [t for t in ax1.texts if t.get_text().startswith("n = ")]
 
 
 def test_model_comparison_states_a_common_n_once_for_many_radii():
@@ -510,7 +512,7 @@ def test_rate_heterogeneity_draws_the_dispersion_without_the_sticky_runs():
     ax2 = fig.axes[1]
     (every,) = [ln for ln in ax2.get_lines() if ln.get_label().endswith("all ICs")]
     (without,) = [ln for ln in ax2.get_lines() if ln.get_gid() == "sticky_excluded"]
-    assert "2 sticky ICs" in without.get_label()
+    assert "2 sticky runs (radius, IC) of 2 ICs" in without.get_label()
     at = list(RADII).index(0.012)
     # two sticky runs blow the dispersion up; without them a common Poisson rate is back
     assert every.get_ydata()[at] > 50 and without.get_ydata()[at] < 3
@@ -522,7 +524,12 @@ def test_rate_heterogeneity_draws_the_dispersion_without_the_sticky_runs():
     flags[sticky[:1]] = True
     fig = plots.rate_heterogeneity(coll, sticky=flags)
     (without,) = [ln for ln in fig.axes[1].get_lines() if ln.get_gid() == "sticky_excluded"]
-    assert "1 sticky IC" in without.get_label()
+    assert "1 sticky run (radius, IC) of 1 IC" in without.get_label()
+    # one IC sticky at two radii: two runs, one IC (the legend counts both)
+    flags = ((coll["ic"] == 0) & coll["radius"].isin([0.012, 0.016])).to_numpy()
+    fig = plots.rate_heterogeneity(coll, sticky=flags)
+    (without,) = [ln for ln in fig.axes[1].get_lines() if ln.get_gid() == "sticky_excluded"]
+    assert "2 sticky runs (radius, IC) of 1 IC" in without.get_label()
     fig = plots.rate_heterogeneity(coll, sticky=np.zeros(len(coll), bool))
     (without,) = [ln for ln in fig.axes[1].get_lines() if ln.get_gid() == "sticky_excluded"]
     assert "(none: the same curve)" in without.get_label()

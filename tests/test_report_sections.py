@@ -222,15 +222,23 @@ def test_recurrence_figure_puts_the_uniform_samples_first_and_the_run_as_control
     assert "uniform_rr_offdiag@0.001" in set(rows["diagnostic"])
     fig = recurrence.rr_figure(rows, store.experiment)
     axes = [ax for ax in fig.axes if ax.get_visible()]
-    assert len(axes) == len(EPS) * 5
-    titles = [ax.get_title() for ax in axes[:5]]
+    # the uniform-time DET in two panels (uniform-angle, scattering kicks): 6 columns
+    assert len(axes) == len(EPS) * 6
+    titles = [ax.get_title() for ax in axes[:6]]
     assert "uniform-time samples" in titles[0] and titles[0].startswith("off-diagonal")
     assert "uniform-time samples" in titles[1] and titles[1].startswith("DET")
-    assert all("control" in t for t in titles[2:])
-    for ax in axes:
+    assert titles[1].endswith("uniform kick angles")
+    assert titles[2].startswith("DET") and titles[2].endswith("scattering kick angles")
+    assert all("control" in t for t in titles[3:])
+    assert axes[1].get_ylim() == axes[2].get_ylim()  # read side by side
+    # each split panel: the two-disk billiard beside its group's systems
+    shown = {1: ["Two-particle", "Poisson", "Actual"], 2: ["Two-particle", "Poisson, scatter"]}
+    for k, ax in enumerate(axes):
         assert ax.get_ylim()[0] == 0  # every axis from 0
         # one series per system (mean with bars): no more than the systems
-        assert len(ax.containers) == 2 * len(SYSTEMS)
+        labels = shown.get(k % 6, [system_label(s) for s in SYSTEMS])
+        assert len(ax.containers) == 2 * len(labels)
+        assert [c.get_label() for c in ax.containers[1::2]] == labels
         assert not [ln for ln in ax.get_lines() if ln.get_linestyle() == ":"]
 
 
@@ -256,6 +264,24 @@ def test_recurrence_figure_counts_the_means_above_the_axis():
     assert "above the axis" not in ax.get_title()
     assert ax.get_ylim()[1] > 2 * res.loc[far, "value"].max()
     assert not [t for t in ax.texts if t.get_text().endswith("↑")]
+
+
+def test_shared_peaks_name_the_radii_where_every_system_peaks_and_the_caption_says_so():
+    store = _with_uniform(synthetic_store(n_ics=6))
+    res = store.results
+    bump = (res["radius"] == 0.014) & (res["diagnostic"] == "uniform_det@0.01")
+    store.results = res.assign(value=np.where(bump, res["value"] + 5.0, res["value"]))
+    rows, _ = recurrence.recurrence_rows(store.results, store.experiment)
+    part = summary.diagnostic_summary(rows)
+    assert recurrence.shared_peaks(part, "uniform_det@0.01") == [0.014]
+    # one system without the peak: none shared
+    one = bump & (store.results["system"] == "poisson")
+    lower = store.results.assign(value=np.where(one, -1.0, store.results["value"]))
+    rows_low, _ = recurrence.recurrence_rows(lower, store.experiment)
+    assert recurrence.shared_peaks(summary.diagnostic_summary(rows_low),
+                                   "uniform_det@0.01") == []
+    caption = recurrence._peaks_note(rows, store.experiment)
+    assert "ε = 0.01: r = 0.014" in caption and "Inference" in caption
 
 
 def test_family_figure_has_one_row_per_store_with_uniform_samples_where_present():
@@ -329,6 +355,36 @@ def test_lag1_figure_draws_95_percent_intervals(ctx):
     half = [(seg[1][1] - seg[0][1]) / 2 for seg in bars]
     assert half == pytest.approx(autocorrelation.half_width95(two["sem"], two["n_valid"]))
     assert all(c.lines[2] for c in ax_ratio.containers)  # the ratios have intervals too
+    # the ratios' intervals: the findings tables' bootstrap over paired ICs, not the delta
+    # method of independent samples
+    ratios = autocorrelation.lag1_ratios(ctx).query("system == 'poisson'").sort_values("radius")
+    (poisson,) = [c for c in ax_ratio.containers
+                  if c.lines[0].get_color() == ax.containers[1].lines[0].get_color()]
+    segments = poisson.lines[2][0].get_segments()
+    assert [seg[0][1] for seg in segments] == pytest.approx(ratios["ci_low"].to_list())
+    assert [seg[1][1] for seg in segments] == pytest.approx(ratios["ci_high"].to_list())
+    assert "ICs resampled in pairs" in ax_ratio.get_title()
+    assert "stay paired" in sec.figures[0][2]
+
+
+def test_acf_paired_differences_keep_the_covariance_of_a_shared_ic():
+    # a large IC effect shared by both systems: independent intervals are wide, paired narrow
+    rng = np.random.default_rng(0)
+    base = rng.uniform(0.3, 0.9, 40)
+    rows = pd.concat([
+        pd.DataFrame({"radius": 0.01, "ic": np.arange(40), "system": system,
+                      "diagnostic": "acf@1", "value": base + shift + rng.normal(0, 1e-3, 40)})
+        for system, shift in (("two_particle", 0.0), ("poisson", 0.01))
+    ], ignore_index=True)
+    paired = autocorrelation.acf_paired_differences(rows)
+    independent = autocorrelation.acf_differences(autocorrelation.acf_curves(rows))
+    assert paired["difference"].iloc[0] == pytest.approx(independent["difference"].iloc[0])
+    assert paired["n_pairs"].iloc[0] == 40
+    assert paired["ci95"].iloc[0] < independent["ci95"].iloc[0] / 20
+    assert paired["ci95"].iloc[0] < 0.01  # the shift is resolved only by the pairing
+    # one IC missing in one system: that pair is left out
+    paired = autocorrelation.acf_paired_differences(rows.drop(index=0))
+    assert paired["n_pairs"].iloc[0] == 39
 
 
 def test_a_store_with_r1_only_has_no_curve_decorrelation_or_tau_int():

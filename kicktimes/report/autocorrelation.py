@@ -34,8 +34,8 @@ from kicktimes.report.figures import (
 )
 from kicktimes.report.summary import diagnostic_summary
 
-__all__ = ["predicted_lag1", "acf_curves", "acf_differences", "crossings", "acf_figure",
-           "half_width95", "sections", "effects"]
+__all__ = ["predicted_lag1", "acf_curves", "acf_differences", "acf_paired_differences",
+           "crossings", "acf_figure", "lag1_ratios", "half_width95", "sections", "effects"]
 
 _ACF = re.compile(r"^acf@(\d+)$")
 
@@ -104,6 +104,19 @@ def acf_curves(results) -> pd.DataFrame:
         ``radius, system, lag, mean, median, std, count, sem, ci95``: ``ci95`` the
         half-width of the 95 % t interval of the mean over ICs (:func:`half_width95`).
     """
+    part = _acf_rows(results)
+    if part.empty:
+        return pd.DataFrame(columns=["radius", "system", "lag", "mean", "sem", "median",
+                                     "ci95"])
+    g = part.groupby(["radius", "system", "lag"], observed=True)["value"]
+    out = g.agg(["mean", "median", "std", "count"]).reset_index()
+    out["sem"] = out["std"] / np.sqrt(out["count"].where(out["count"] > 0))
+    out["ci95"] = half_width95(out["sem"], out["count"])
+    return out
+
+
+def _acf_rows(results):
+    """The ``acf@l`` rows of ``results`` with their lag in a column ``lag`` (int)."""
     # the lag of each distinct diagnostic name, then per row through the category codes:
     # a regex per row took ~10 s on a paper store's million acf@l rows
     diag = results["diagnostic"]
@@ -113,16 +126,7 @@ def acf_curves(results) -> pd.DataFrame:
     lag_of = names.str.extract(_ACF)[0].astype(float).to_numpy()
     lag = np.append(lag_of, np.nan)[diag.cat.codes.to_numpy()]  # code -1 (missing): NaN
     keep = np.isfinite(lag)
-    part = results[keep]
-    if part.empty:
-        return pd.DataFrame(columns=["radius", "system", "lag", "mean", "sem", "median",
-                                     "ci95"])
-    part = part.assign(lag=lag[keep].astype(int))
-    g = part.groupby(["radius", "system", "lag"], observed=True)["value"]
-    out = g.agg(["mean", "median", "std", "count"]).reset_index()
-    out["sem"] = out["std"] / np.sqrt(out["count"].where(out["count"] > 0))
-    out["ci95"] = half_width95(out["sem"], out["count"])
-    return out
+    return results[keep].assign(lag=lag[keep].astype(int))
 
 
 def acf_differences(curves) -> pd.DataFrame:
@@ -156,6 +160,61 @@ def acf_differences(curves) -> pd.DataFrame:
     if not out:
         return pd.DataFrame(columns=["radius", "lag", "system", "difference", "ci95"])
     return pd.concat(out, ignore_index=True)
+
+
+def acf_paired_differences(results) -> pd.DataFrame:
+    r"""Each kicked system's R_l minus the two-particle R_l, paired on ICs.
+
+    Every system of a radius starts from the same ICs, so the difference is taken per IC,
+    :math:`d_{ri} = R_l^{\rm kicked}(r, i) - R_l^{\rm two}(r, i)`, and its mean over the
+    ICs with both values carries the t interval of the paired differences,
+    :math:`t_{0.975,\,n-1}\, s_d/\sqrt{n}`: the interval of a bootstrap clustered on ICs
+    to first order, and unlike :func:`acf_differences` it keeps the covariance of the
+    two systems that share an IC.
+
+    Parameters
+    ----------
+    results : pandas.DataFrame
+        Tidy results with the ``acf@l`` rows.
+
+    Returns
+    -------
+    pandas.DataFrame
+        ``radius, lag, system, difference, ci95, n_pairs``.
+
+    Examples
+    --------
+    >>> import pandas as pd
+    >>> rows = pd.DataFrame({"radius": 0.01, "ic": [0, 1, 2, 0, 1, 2],
+    ...                      "system": ["two_particle"] * 3 + ["poisson"] * 3,
+    ...                      "diagnostic": "acf@1", "value": [0.5, 0.6, 0.7, 0.4, 0.5, 0.6]})
+    >>> d = acf_paired_differences(rows)
+    >>> round(float(d["difference"].iloc[0]), 12), float(d["ci95"].iloc[0])
+    (-0.1, 0.0)
+    """
+    part = _acf_rows(results)
+    columns = ["radius", "lag", "system", "difference", "ci95", "n_pairs"]
+    if part.empty:
+        return pd.DataFrame(columns=columns)
+    table = part.pivot_table(index=["radius", "ic", "lag"], columns="system", values="value",
+                             observed=True)
+    if REFERENCE not in table.columns:
+        return pd.DataFrame(columns=columns)
+    out = []
+    for system in kicked_systems(part):
+        if system not in table.columns:
+            continue
+        d = (table[system] - table[REFERENCE]).dropna()
+        g = d.groupby(level=["radius", "lag"]).agg(["mean", "std", "count"])
+        out.append(pd.DataFrame({
+            "system": system,
+            "difference": g["mean"],
+            "ci95": half_width95(g["std"] / np.sqrt(g["count"]), g["count"]),
+            "n_pairs": g["count"].astype(int),
+        }, index=g.index).reset_index())
+    if not out:
+        return pd.DataFrame(columns=columns)
+    return pd.concat(out, ignore_index=True)[columns]
 
 
 def crossings(differences) -> pd.DataFrame:
@@ -194,7 +253,7 @@ def crossings(differences) -> pd.DataFrame:
                                        "first_lag_other_sign", "clear"])
 
 
-def acf_figure(curves, predicted, *, max_panels=6):
+def acf_figure(curves, predicted, *, differences=None, max_panels=6):
     """R_l against l per radius, and each kicked system's difference to the two-disk curve.
 
     Parameters
@@ -203,6 +262,10 @@ def acf_figure(curves, predicted, *, max_panels=6):
         :func:`acf_curves` output.
     predicted : pandas.DataFrame
         :func:`predicted_lag1` output (the built-in lag-1 prediction).
+    differences : pandas.DataFrame, optional
+        The differences to draw below, :func:`acf_paired_differences` output (paired on
+        ICs: what the report draws); default :func:`acf_differences` of ``curves`` (the
+        two systems' ICs taken as independent).
     max_panels : int
         At most this many radii (evenly chosen).
 
@@ -229,7 +292,7 @@ def acf_figure(curves, predicted, *, max_panels=6):
     diff_axes = grid[1::2].ravel()
     pred = predicted.groupby(["radius", "system"], observed=True)["value"].mean()
     systems = [s for s in (REFERENCE, *kicked_systems(curves)) if s in distinct(curves, "system")]
-    diffs = acf_differences(curves)
+    diffs = acf_differences(curves) if differences is None else differences
     if "ci95" not in curves.columns:
         curves = curves.assign(ci95=half_width95(curves["sem"], curves["count"]))
     for ax, dax, r in zip(top_axes, diff_axes, radii, strict=False):
@@ -272,17 +335,44 @@ def acf_figure(curves, predicted, *, max_panels=6):
         Line2D([], [], color="grey", marker="o", markerfacecolor="none", linestyle="none"),
         Line2D([], [], color="grey", linestyle=":"),
     ]
-    labels += ["95 % interval of the mean over ICs",
+    labels += ["95 % interval (top: of the mean; below: of the paired differences)"
+               if differences is not None else "95 % interval of the mean over ICs",
                "built-in prediction 1 − n_pert/n_boundary", "1/e (where reached)"]
     fig.legend(handles, labels, loc="outside lower center", ncol=min(5, len(labels)),
                fontsize="small")
     return fig
 
 
-def _lag1_figure(summary, predicted, lag):
+def lag1_ratios(ctx):
+    """Per radius, each kicked system's (1 − R_lag) over the two-particle value with the
+    95 % interval of the store's bootstrap clustered on ICs (`effects.store_ratio`: the
+    Findings' resamples, so the very ratios and intervals of the findings tables).
+
+    Returns
+    -------
+    pandas.DataFrame
+        ``system, radius, n_pairs, ratio, ci_low, ci_high`` (empty without the rows).
+    """
+    columns = ["system", "radius", "n_pairs", "ratio", "ci_low", "ci_high"]
+    results = ctx.results
+    if "autocorrelation" not in distinct(results, "diagnostic"):
+        return pd.DataFrame(columns=columns)
+    one_minus = 1.0 - wide(results, "autocorrelation")
+    out = []
+    for system in kicked_systems(results):
+        if system not in one_minus.columns or REFERENCE not in one_minus.columns:
+            continue
+        per_r, _ = store_ratio(ctx, one_minus[system], one_minus[REFERENCE])
+        out.append(per_r.assign(system=system))
+    return pd.concat(out, ignore_index=True)[columns] if out else pd.DataFrame(columns=columns)
+
+
+def _lag1_figure(summary, predicted, lag, ratios=None):
     """(a) the decorrelation per boundary collision 1 − R_lag against r, log axis, with the
     built-in prediction 1 − n_pert/n_boundary (open markers) at lag 1; (b) each kicked
-    system's 1 − R_lag over the two-disk value, with the ±10 % band. Plotting R_lag itself
+    system's 1 − R_lag over the two-disk value, with the ±10 % band: the intervals of
+    ``ratios`` (:func:`lag1_ratios`, bootstrap clustered on ICs) where given, else the
+    delta method with the two systems' ICs taken as independent. Plotting R_lag itself
     on [0.91, 0.98] would hide the difference in 1 − R_lag that the comparison is about."""
     from matplotlib.ticker import FuncFormatter, LogLocator
 
@@ -309,7 +399,15 @@ def _lag1_figure(summary, predicted, lag):
             ax.plot(p.index.to_numpy() + dodge(radii, k, len(order)), 1.0 - p.to_numpy(),
                     linestyle="none", marker=style["marker"], markerfacecolor="none",
                     markersize=8, color=style["color"])
-        if system != REFERENCE and not ref.empty:
+        if system != REFERENCE and ratios is not None:
+            mine = ratios[ratios["system"] == system].sort_values("radius")
+            ratio = mine["ratio"].to_numpy(float)
+            ax_ratio.errorbar(mine["radius"].to_numpy() + dodge(radii, k, len(order)), ratio,
+                              yerr=[ratio - mine["ci_low"].to_numpy(float),
+                                    mine["ci_high"].to_numpy(float) - ratio],
+                              color=style["color"], marker=style["marker"], markersize=5,
+                              **_SEM_BAR)
+        elif system != REFERENCE and not ref.empty:
             two = 1.0 - ref["mean"].reindex(part["radius"]).to_numpy()
             two_se = ref["sem"].reindex(part["radius"]).to_numpy()
             own = 1.0 - part["mean"].to_numpy()
@@ -337,8 +435,10 @@ def _lag1_figure(summary, predicted, lag):
     ax_ratio.axhline(1.0, color="0.5", linewidth=0.8, zorder=0)
     radius_axis(ax_ratio)
     ax_ratio.set_ylabel(f"(1 − {r_l}) kicked / (1 − {r_l}) two-disk")
-    ax_ratio.set_title("(b) ratio to the two-disk value, 95 % interval (delta method)\n"
-                       "grey: ±10 %", fontsize="medium")
+    how = ("95 % bootstrap interval, ICs resampled in pairs" if ratios is not None
+           else "95 % interval, delta method, ICs independent")
+    ax_ratio.set_title(f"(b) ratio to the two-disk value\n{how}; grey: ±10 %",
+                       fontsize="medium")
     handles, labels = ax.get_legend_handles_labels()
     if pred is not None:
         handles.append(Line2D([], [], color="grey", marker="o", markerfacecolor="none",
@@ -359,7 +459,7 @@ def sections(ctx):
     sec = Section("autocorrelation", "Autocorrelation of boundary angles")
     sec.figure(
         "fig07_autocorrelation_vs_radius",
-        _lag1_figure(summary, predicted, lag),
+        _lag1_figure(summary, predicted, lag, ratios=lag1_ratios(ctx)),
         f"(a) The decorrelation per boundary collision 1 − R_{lag} of disk 0's boundary "
         "angles against radius (log axis): mean over ICs with its 95 % t interval"
         + (
@@ -369,9 +469,13 @@ def sections(ctx):
             if lag == 1
             else ""
         )
-        + f". (b) Each kicked system's 1 − R_{lag} over the two-disk value, with its 95 % "
-        "interval (delta method, ICs of the two systems taken as independent) and the ±10 % "
-        "band. Lag 1 alone can mislead: the curves R_l cross at larger lags (fig07b).",
+        + f". (b) Each kicked system's 1 − R_{lag} over the two-disk value (ratio of the "
+        "means over ICs) with its 95 % percentile interval from the findings tables' "
+        f"bootstrap, {ctx.n_boot} resamples of the ICs, each resample applied to both "
+        "systems: the kicked and the two-disk run of an IC stay paired (they share the IC); "
+        "the ±10 % band of the ratio verdicts. (The bars of panel (a) are per system and "
+        "do not compare systems.) Lag 1 alone can mislead: the curves R_l cross at larger "
+        "lags (fig07b).",
     )
     curves = acf_curves(results)
     # a curve needs two lags: with R_1 alone (acf_max_lag = 1, e.g. `reproduce --content
@@ -393,17 +497,20 @@ def sections(ctx):
             )
         )
     else:
+        paired = acf_paired_differences(results)
         sec.figure(
             "fig07b_autocorrelation_curves",
-            acf_figure(curves, predicted),
+            acf_figure(curves, predicted, differences=paired),
             "R_l of the boundary angles over lags l = 1.."
             f"{int(curves['lag'].max())} per radius and system (mean over ICs, band: 95 % t "
-            "interval), with the built-in lag-1 prediction 1 − n_pert/n_boundary (open "
+            "interval of that system's mean alone, which says nothing about a difference "
+            "between systems), with the built-in lag-1 prediction 1 − n_pert/n_boundary (open "
             "markers at l ≈ 1) and 1/e (the decorrelation threshold); below each radius, "
-            "each kicked system's R_l minus the two-disk R_l with its 95 % interval: where "
-            "the curves cross, the difference changes sign.",
+            "each kicked system's R_l minus the two-disk R_l, the mean over ICs of the "
+            "per-IC difference (the two runs of an IC share it) with the 95 % t interval of "
+            "those paired differences: where the curves cross, the difference changes sign.",
         )
-        cross = crossings(acf_differences(curves))
+        cross = crossings(paired)
         if not cross.empty:
             crossing = cross[cross["crosses"]]
             clear = int(crossing["clear"].sum())
@@ -411,7 +518,8 @@ def sections(ctx):
                 f"Crossings of the R_l curves: {len(crossing)} of {len(cross)} (radius, "
                 "kicked system) pairs change the sign of the mean R_l − R_l(two-disk) between "
                 f"lag 1 and lag {int(curves['lag'].max())}; {clear} of them clearly (95 % "
-                "intervals excluding 0 at lag 1 and at a lag of the other sign)"
+                "intervals of the paired per-IC differences excluding 0 at lag 1 and at a "
+                "lag of the other sign)"
                 + ("; at those the ranking at lag 1 reverses at larger lags, so lag 1 alone "
                    "misleads there." if clear else
                    ": every crossing is within the intervals, none shows that the ranking at "

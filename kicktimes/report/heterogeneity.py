@@ -188,8 +188,7 @@ def rate_heterogeneity(collisions, *, homogeneity=None, rule="mirror", max_point
             markerfacecolor="none",
             color="tab:orange",
             linestyle="--" if axis.line != "none" else "none",
-            label=(f"without the {int(flag.sum())} sticky {nouns.many}" if flag.any()
-                   else f"without sticky {nouns.many} (none: the same curve)"),
+            label=_sticky_label(df, flag, nouns),
             gid="sticky_excluded",
         )
         for at, k in n_out.items():
@@ -235,6 +234,21 @@ def rate_heterogeneity(collisions, *, homogeneity=None, rule="mirror", max_point
     return fig
 
 
+def _sticky_label(df, flag, nouns):
+    """The legend of the sticky-excluded curve: the (radius, IC) runs left out and, where
+    the table has ICs, how many distinct ICs they come from (one IC is sticky at several
+    radii: 12 runs may be 4 ICs)."""
+    n_runs = int(flag.sum())
+    if not n_runs:
+        return f"without sticky {nouns.many} (none: the same curve)"
+    if "ic" not in df.columns:
+        return f"without the {n_runs} sticky {nouns.many if n_runs > 1 else nouns.one}"
+    n_ics = int(df.loc[flag, "ic"].nunique())
+    runs = "run" if n_runs == 1 else "runs"
+    return (f"without the {n_runs} sticky {runs} (radius, {nouns.one}) "
+            f"of {n_ics} {nouns.one if n_ics == 1 else nouns.many}")
+
+
 def _sticky_flags(df, sticky, rule, x, kinetic):
     """Per row of ``df``, whether it is a sticky run (None: no sticky-excluded curve)."""
     if sticky is None:
@@ -268,7 +282,8 @@ def sections(ctx):
         "(a) Disk-disk collision rate n_pp / t_window of every IC, the pooled and median rates "
         f"and the kinetic rate ({exp.rule}); (b) index of dispersion of the counts across ICs, "
         "of all ICs (black) and without the sticky runs (orange, collision rate above 5 times "
-        "the kinetic rate; −k: the runs left out at that radius); "
+        "the kinetic rate; a run is one IC at one radius, and one IC can be sticky at several "
+        "radii: the legend counts both; −k: the runs left out at that radius); "
         "on top, the asymptotic p-value of the Pearson χ² test of a common rate (given the "
         "total); the Monte Carlo p-value, exact but floored at 1/(n_mc + 1), is in the text.",
     )

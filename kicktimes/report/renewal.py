@@ -47,8 +47,9 @@ def model_comparison(per_ic, pooled, *, models=None, x="radius", xlabel=None):
     matplotlib.figure.Figure
         (a) one bar per model and radius: the share of ICs for which the model is
         AIC-best, with its Clopper-Pearson 95 % interval (:func:`binomial_ci`), and the
-        number n of ICs fitted on top of each group (in the title instead when more than
-        four groups all have the same n); (b) pooled ΔAIC per model on a
+        number n of ICs fitted under each radius's tick (``x="radius"``, at most 20
+        radii), else on top of each group; also in the title when more than four groups
+        all have the same n; (b) pooled ΔAIC per model on a
         symmetric-log axis, with the usual ΔAIC = 2 and 10 guides.
     """
     axis = x_axis(x, xlabel)
@@ -92,7 +93,7 @@ def model_comparison(per_ic, pooled, *, models=None, x="radius", xlabel=None):
     # same n (twelve "n = 12" run into each other)
     same_n = r.size > 4 and total.nunique() == 1
     for at, n in zip(r, total, strict=True):
-        if not same_n:
+        if not same_n and not (x == "radius" and r.size <= 20):  # else under the ticks
             ax1.text(at, 1.02, f"n = {int(n)}", ha="center", va="bottom", fontsize="x-small")
     for ax, empty in ((ax1, per_ic.empty), (ax2, pooled.empty)):
         if empty:
@@ -106,13 +107,17 @@ def model_comparison(per_ic, pooled, *, models=None, x="radius", xlabel=None):
             )
     ax1.set_ylim(0, 1.12)
     axis.draw(ax1)
-    if x == "radius" and 4 < r.size <= 20:  # a tick under every group of bars
-        ax1.set_xticks(r, [f"{v:g}" for v in r], fontsize="small")
+    if x == "radius" and r.size <= 20:
+        # a tick under every group of bars, with the number of ICs behind its shares: a
+        # share of n = 12 moves by 1/12 per IC, and the axis should say so
+        ax1.set_xticks(r, [f"{v:g}\nn = {int(n)}" for v, n in zip(r, total, strict=True)],
+                       fontsize="small")
     nouns = axis.nouns
     ax1.set_ylabel(f"share of {nouns.many} where the model is AIC-best")
     where = (f"n = {int(total.iloc[0])} {nouns.many} fitted at every "
              + ("radius" if x == "radius" else (xlabel or x))
-             if same_n else f"n = number of {nouns.many} fitted, on top")
+             if same_n else f"n = number of {nouns.many} fitted, "
+             + ("under each radius" if x == "radius" and r.size <= 20 else "on top"))
     ax1.set_title(f"(a) per {nouns.one}: share ± Clopper-Pearson 95 %\n({where})",
                   fontsize="medium")
     for m in models:
@@ -267,9 +272,9 @@ def sections(ctx):
             "fig09_renewal_model_comparison",
             model_comparison(fitted, pooled, models=list(stats.FULL_SAMPLE_MODELS)),
             "(a) Per IC: share of ICs for which each renewal model has the lowest AIC, with "
-            "Clopper-Pearson 95 % intervals (n, the ICs fitted at that radius, on top: at most "
-            f"{ctx.max_ics_model_fits} per radius, so the intervals are wide); (b) "
-            "intervals pooled over ICs: ΔAIC of each model (0 = best; 2 and 10 guides).",
+            "Clopper-Pearson 95 % intervals; " + _small_n_words(fitted, share_long, coll, ctx)
+            + " (b) Intervals pooled over ICs: ΔAIC of each model (0 = best; 2 and 10 "
+            "guides).",
         )
     if fitted.empty:
         sec.text(
@@ -306,6 +311,24 @@ def sections(ctx):
     ctx.found.renewal_best = best
     ctx.found.renewal_pooled = pooled
     return [sec]
+
+
+def _small_n_words(fitted, share_long, coll, ctx):
+    """The caption's words on how few ICs stand behind each share of fig09 (a)."""
+    n_fit = fitted.groupby("radius", observed=True)["ic"].nunique()
+    n_all = coll.groupby("radius", observed=True)["ic"].nunique()
+    lo, hi = int(n_fit.min()), int(n_fit.max())
+    n = str(lo) if lo == hi else f"{lo}–{hi}"
+    width = (share_long["ci_high"] - share_long["ci_low"]).to_numpy(float)
+    return (
+        f"n = {n} ICs fitted per radius (under each tick; of {int(n_all.min())}"
+        + (f"–{int(n_all.max())}" if n_all.max() != n_all.min() else "")
+        + f" ICs, the first {ctx.max_ics_model_fits} by index: each comparison fits six "
+        f"censored models), so one IC moves a share by 1/{hi} or more, and the 95 % "
+        f"intervals are {width.min():.2f} to {width.max():.2f} wide: read a share at one "
+        "radius, or the gap between two bars, against them; the share pooled over radii "
+        "and its Poisson-twin level are in the Findings."
+    )
 
 
 def effects(ctx):

@@ -14,6 +14,7 @@ import numpy as np
 import pandas as pd
 from matplotlib.colors import LogNorm
 from matplotlib.figure import Figure
+from matplotlib.ticker import MaxNLocator
 
 from kicktimes.report.common import REFERENCE, Section, eps_values, nearest, pct
 from kicktimes.report.figures import TIME_UNIT, check_frame, finite, new_axes
@@ -327,7 +328,11 @@ def _line_inset(ax, i, j, n, zoom, scale):
     inset.set_xlim(i0 * scale, (i0 + zoom) * scale)
     inset.set_ylim(j0 * scale, (j0 + zoom) * scale)
     inset.set_aspect("equal")
-    inset.tick_params(labelsize="xx-small")
+    # at most three ticks per side, none at the corners: the full sample indices (five
+    # digits) collide at the default ticks and where the two axes meet
+    for axis in (inset.xaxis, inset.yaxis):
+        axis.set_major_locator(MaxNLocator(nbins=2, integer=True, prune="both"))
+    inset.tick_params(labelsize="xx-small", pad=1.5)
     n_line = int((sel & lines).sum())
     # inside the inset, on white: above it the text would cross the main plot's dots
     inset.text(0.03, 0.97, f"{zoom} x {zoom} samples:\n{n_line} of {int(sel.sum())} pairs on "
