@@ -308,8 +308,8 @@ def test_every_family_has_the_rule_by_ic_design_as_control_experiments():
         assert exp.ic_method == ("uniform" if "invariant_ics" in control else "paper")
         assert exp.n_ics == (CONTROL_ICS_B if family.name == "family_b" else family.n_ics) >= 200
         assert (exp.radii, exp.n_steps, exp.tau) == (family.radii, family.n_steps, family.tau)
-        kicked = set(family.systems) - {"poisson_kinetic", "uniform_kinetic"}
-        assert set(exp.systems) == (kicked if exp.rule == "elastic" else set(family.systems))
+        # every control runs every system, the kinetic-rate kicks under the elastic rule too
+        assert set(exp.systems) == set(family.systems)
 
 
 def test_the_readme_block_is_replaced_by_the_generated_first_screen(tmp_path):

@@ -76,6 +76,16 @@ def test_a_law_comes_closest_only_when_its_distance_interval_is_clear(science, t
     out = science.closest_kick_law(tmp_path, ["fam"], diagnostics=("ftle",)).set_index("system")
     assert out["closest"].to_dict() == {"poisson": False, "actual": False,
                                         "poisson_scatter": True, "actual_scatter": True}
+    assert (out.loc[out["closest"], "disjoint_under"] == "").all()
+    # overlap under the primary is not agreement: a control under which the two scatter
+    # laws' intervals are disjoint is named
+    control = table.assign(control="paired_median")
+    control.loc[control["system"] == "actual_scatter", ["ci_low", "ci_high"]] = (0.90, 0.92)
+    control.loc[control["system"] == "poisson_scatter", ["ci_low", "ci_high"]] = (0.95, 1.0)
+    pd.concat([table, control]).to_csv(tmp_path / "fam_findings.csv", index=False)
+    out = science.closest_kick_law(tmp_path, ["fam"], diagnostics=("ftle",)).set_index("system")
+    assert out.loc["actual_scatter", "disjoint_under"] == "paired_median"
+    assert out.loc["poisson_scatter", "disjoint_under"] == ""
 
 
 def test_one_perturbation_decorrelates_and_none_keeps_the_angle(science):

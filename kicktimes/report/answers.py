@@ -214,13 +214,31 @@ def ftle_answer(table: pd.DataFrame) -> str:
     if robust and verdicts == {LOWER}:
         return ("The paper's kicked disk does not reproduce the two-disk chaos: its FTLE is "
                 f"{lo:.3g}–{hi:.3g} of the two-disk value, lower under all {n_controls} "
-                "controls in every family.")
+                "controls in every family" + _scatter_clause(table) + ".")
     if robust and verdicts == {WITHIN}:
         return ("The paper's kicked disk reproduces the two-disk FTLE within 10 % "
                 f"({lo:.3g}–{hi:.3g}) under all {n_controls} controls.")
     cells = [screen_cell(ftle[ftle["system"] == s]) for s in ("poisson", "actual")]
     return (f"The paper's kicked disk's FTLE, Poisson kicks: {cells[0]}; actual kicks: "
             f"{cells[1]}.")
+
+
+def _scatter_clause(table: pd.DataFrame) -> str:
+    """``"; scatter kicks bring it to a–b, below 1 under k of n (family, control) cells"``:
+    where the scatter kicks' FTLE ratios lie, and how many of their intervals exclude 1
+    from below (a deficit that a "within 10 %" verdict does not show)."""
+    rows = table[(table["diagnostic"] == "ftle")
+                 & table["system"].isin(["poisson_scatter", "actual_scatter"])]
+    if rows.empty:
+        return ""
+    below = int((rows["ci_high"] < 1.0).sum())
+    above = int((rows["ci_low"] > 1.0).sum())
+    text = (f"; scatter kicks bring it to {rows['estimate'].min():.3g}–"
+            f"{rows['estimate'].max():.3g}, with the CI below 1 in {below} of {len(rows)} "
+            "(kick time, family, control) cells")
+    if above:
+        text += f" and above 1 in {above}"
+    return text
 
 
 def first_screen(table: pd.DataFrame, shares=None) -> list[str]:

@@ -395,8 +395,7 @@ def _count_rows(family, collisions, sticky, rule, kinetic, *, rng, n_boot, resam
     per_r, tot = paired_ratio(observed, expected, rng=rng, n_boot=n_boot, resamples=resamples)
     rows.append(_row(family, "counts", REFERENCE, "primary", tot["ratio"], tot["ci_low"],
                      tot["ci_high"], per_r["n_pairs"].sum(),
-                     "ΣN / Σ Γ(r)T per radius, averaged over radii; paper ICs, not the "
-                     "invariant measure, so the ratio need not be 1"))
+                     "ΣN / Σ Γ(r)T per radius, averaged over radii"))
     med = paired_median(observed, expected, rng=rng, n_boot=max(200, n_boot // 2))
     rows.append(_row(family, "counts", REFERENCE, "paired_median", med["ratio"], med["ci_low"],
                      med["ci_high"], med["n_pairs"], "median of per-IC N / Γ(r)T"))
@@ -408,7 +407,8 @@ def _count_rows(family, collisions, sticky, rule, kinetic, *, rng, n_boot, resam
     return rows
 
 
-def poisson_rows(family, rejections, per_ic, *, alpha, rng, n_boot=2000, null=None):
+def poisson_rows(family, rejections, per_ic, *, alpha, rng, n_boot=2000, null=None,
+                 cis=None):
     """The Poisson question as rows of the findings table: per test of the battery, the
     share of (radius, IC) runs whose two-disk collision times reject it at ``alpha``, read
     against the share that null streams shaped like the runs reject through the same test
@@ -444,6 +444,9 @@ def poisson_rows(family, rejections, per_ic, *, alpha, rng, n_boot=2000, null=No
         Its resamples.
     null : pandas.DataFrame, optional
         The null calibration of the same runs.
+    cis : dict, optional
+        Clustered CIs already computed, by ``per_ic`` column (``"p"``, ``"p_fixed"``), so
+        that every page prints the same interval; the others are computed with ``rng``.
     """
     from kicktimes.report.poisson import (
         FIXED_EVENTS,
@@ -471,12 +474,17 @@ def poisson_rows(family, rejections, per_ic, *, alpha, rng, n_boot=2000, null=No
                        and not null.empty else f"; read against α = {alpha:g} (no null "
                        "calibration)")
 
+    def share_ci(column):
+        if cis is not None and column in cis:
+            return cis[column]
+        return clustered_share(per_ic, column, alpha, rng=rng, n_boot=n_boot)
+
     totals = rejections.groupby("test", sort=False, observed=True)[["n_reject", "n_tested"]].sum()
     for test, (k, n) in totals.iterrows():
         if n == 0:
             continue
         if test == HEADLINE_TEST and per_ic is not None:
-            low, high = clustered_share(per_ic, "p", alpha, rng=rng, n_boot=n_boot)
+            low, high = share_ci("p")
             how = "95 % CI from a bootstrap clustered on ICs"
         else:
             low, high = clopper_pearson(int(k), int(n))
@@ -488,7 +496,7 @@ def poisson_rows(family, rejections, per_ic, *, alpha, rng, n_boot=2000, null=No
     if per_ic is not None and np.isfinite(per_ic["p_fixed"]).any():
         p = per_ic["p_fixed"].to_numpy(float)
         ok = np.isfinite(p)
-        low, high = clustered_share(per_ic, "p_fixed", alpha, rng=rng, n_boot=n_boot)
+        low, high = share_ci("p_fixed")
         add(f"reject@{HEADLINE_TEST}@first{FIXED_EVENTS}", (p[ok] < alpha).sum() / ok.sum(),
             ok.sum(), low, high, rejection_verdict(low, high, alpha),
             f"{HEADLINE_TEST} on the first {FIXED_EVENTS} collisions of every run that has "

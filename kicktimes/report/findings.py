@@ -103,7 +103,8 @@ def section(ctx):
         extra = pd.DataFrame(poisson_rows(ctx.exp.name, ctx.found.rejections,
                                           ctx.found.poisson_per_ic, alpha=ctx.alpha,
                                           rng=ctx.boot_rng(), n_boot=ctx.n_boot,
-                                          null=ctx.found.null_calibration),
+                                          null=ctx.found.null_calibration,
+                                          cis=ctx.found.poisson_cis),
                              columns=list(COLUMNS))
         computed = Controls(with_robustness(pd.concat([computed.table, extra],
                                                       ignore_index=True)), computed.curves)

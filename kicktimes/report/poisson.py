@@ -28,6 +28,7 @@ from kicktimes.report.figures import (
     new_axes,
     x_axis,
 )
+from kicktimes.stats import format_interval
 from kicktimes.stats.poisson import TEST_NULLS
 
 __all__ = [
@@ -394,6 +395,12 @@ def sections(ctx):
               f"also at a fixed {FIXED_EVENTS} collisions: *_fixed)")
     ctx.found.rejections = rejections
     ctx.found.poisson_per_ic = per_ic
+    # the headline shares' clustered CIs, computed once: the statements and the findings
+    # table print the same interval
+    ctx.found.poisson_cis = {
+        "p": clustered_share(per_ic, "p", alpha, rng=ctx.rng(4), n_boot=ctx.n_boot),
+        "p_fixed": clustered_share(per_ic, "p_fixed", alpha, rng=ctx.rng(5),
+                                   n_boot=ctx.n_boot)}
     if "control_p" in per_ic.columns:
         ctx.found.null_calibration = null_calibration(
             ctx.exp.name, rejections, per_ic, alpha=alpha, rng=ctx.rng(6), n_boot=ctx.n_boot)
@@ -520,13 +527,12 @@ def effects(ctx):
         return []
     k, n = (int(v) for v in totals.loc[HEADLINE_TEST])
     per_ic = ctx.found.poisson_per_ic
-    low, high = clustered_share(per_ic, "p", ctx.alpha, rng=ctx.rng(4), n_boot=ctx.n_boot)
+    low, high = ctx.found.poisson_cis["p"]
     level = null_level(ctx.found.null_calibration, HEADLINE_TEST, ctx.alpha)
     verdict = share_verdict(low, high, level)
     n_fixed = max(1, int(np.isfinite(per_ic["p_fixed"]).sum()))
     fixed_share = float((per_ic["p_fixed"] < ctx.alpha).sum()) / n_fixed
-    f_low, f_high = clustered_share(per_ic, "p_fixed", ctx.alpha, rng=ctx.rng(5),
-                                    n_boot=ctx.n_boot)
+    f_low, f_high = ctx.found.poisson_cis["p_fixed"]
     words = {
         "above": "Poisson rejected (more rejections than null streams give)",
         "below": "fewer rejections than null streams give (conservative test)",
@@ -559,8 +565,9 @@ def effects(ctx):
             detail=(
                 f"{pct(by_r['rate'].iloc[0])} at r = {by_r['radius'].iloc[0]:g}, "
                 f"{pct(by_r['rate'].iloc[-1])} at r = {by_r['radius'].iloc[-1]:g}; at a fixed "
-                f"{FIXED_EVENTS} collisions per run {pct(fixed_share)} [{pct(f_low)}, "
-                f"{pct(f_high)}] ({pct(by_r['rate_fixed'].iloc[0])} at r = "
+                f"{FIXED_EVENTS} collisions per run "
+                f"{format_interval(100 * fixed_share, 100 * f_low, 100 * f_high)} % "
+                f"({pct(by_r['rate_fixed'].iloc[0])} at r = "
                 f"{by_r['radius'].iloc[0]:g}, {pct(by_r['rate_fixed'].iloc[-1])} at r = "
                 f"{by_r['radius'].iloc[-1]:g}); other tests (pooled): {others}"
             ),

@@ -157,6 +157,10 @@ def closest_kick_law(findings_dir, families, diagnostics=("ftle", "one_minus_r1"
     the ratio's interval. The *closest group* is the law with the lowest upper distance
     and every law whose distance interval reaches below that upper end (not distinguished
     from it); a single law in the group *comes closest*. ``closest`` marks the group.
+    Overlapping distance intervals are not agreement: ``disjoint_under`` lists, for each
+    member of the group, the controls of the table (every row of the same family and
+    diagnostic, primary included) under which its ratio interval and the best law's are
+    disjoint (``""`` for the best law and where they overlap under every control).
     """
     rows = []
     for family in families:
@@ -170,10 +174,20 @@ def closest_kick_law(findings_dir, families, diagnostics=("ftle", "one_minus_r1"
                 inside = g["ci_low"] <= 1 <= g["ci_high"]
                 dist[s] = (0.0 if inside else ends.min(), ends.max())
             best = min(dist, key=lambda s: dist[s][1])
+            every = tab[(tab["diagnostic"] == diag) & tab["system"].isin(systems)]
             for s, g in part.iterrows():
+                disjoint = []
+                if s != best:
+                    for control, c in every.groupby("control", sort=False, observed=True):
+                        c = c.set_index("system")
+                        if s in c.index and best in c.index and (
+                                c.loc[s, "ci_high"] < c.loc[best, "ci_low"]
+                                or c.loc[s, "ci_low"] > c.loc[best, "ci_high"]):
+                            disjoint.append(control)
                 rows.append({"family": family, "diagnostic": diag, "system": s,
                              "ratio": g["estimate"], "ci_low": g["ci_low"],
                              "ci_high": g["ci_high"], "verdict": g["verdict"],
                              "distance_low": dist[s][0], "distance_high": dist[s][1],
-                             "closest": bool(dist[s][0] <= dist[best][1])})
+                             "closest": bool(dist[s][0] <= dist[best][1]),
+                             "disjoint_under": ", ".join(disjoint)})
     return pd.DataFrame(rows)

@@ -214,12 +214,16 @@ def decorrelation_lines(dec, compare, closest, *, n_ics=40, t_max=20000.0):
                          f"overlap): {cells(best)}.")
             continue
         name = (f"{best['system'].iloc[0]} comes closest" if len(best) == 1 else
-                "nearer to 1 than the rest (distance intervals separate them), not "
-                "distinguished from one another")
+                "nearer to 1 than the rest (distance intervals separate them); their own "
+                "intervals overlap under the primary setting, which does not make them equal")
         if none_agree:
-            name += " though none agrees (verdicts: " + ", ".join(
+            name += " and none agrees (verdicts: " + ", ".join(
                 sorted(set(best["verdict"]))) + ")"
-        lines.append(f"- `{family}`, {diag}: {name}: {cells(best)}; further from 1: "
+        apart = [(s, d) for s, d in zip(best["system"], best["disjoint_under"], strict=True)
+                 if isinstance(d, str) and d]
+        differ = "".join(f"; {s}'s interval is disjoint from the best law's under {d}"
+                         for s, d in apart)
+        lines.append(f"- `{family}`, {diag}: {name}: {cells(best)}{differ}; further from 1: "
                      f"{cells(rest)}.")
     lines += ["", "Binned by θ before: `science_decorrelation_by_angle.csv`.", ""]
     return lines
