@@ -225,8 +225,13 @@ def test_the_page_is_written_from_its_tables_and_names_stores_not_paths(referenc
     page = write_disks_page([reference.path], tmp_path / "results", n_boot=199, n_mc=49,
                             dpi=40)
     text = page.read_text()
-    assert text.startswith("# From two disks to a gas (generated)\n\nGenerated ")
+    assert text.startswith("# From two disks to a gas (generated)\n\n**Is the tagged disk's")
+    assert "\nGenerated " in text
     assert "`tiny-gas`" in text and str(reference.path) not in text
+    assert_page_limits(text)
+    calib = pd.read_csv(tmp_path / "results" / "null_calibration.csv")
+    assert set(calib["study"]) == {"disks"} and set(calib["design"]) == {"poisson"}
+    assert "null_calibration.csv" in text
     table = pd.read_csv(tmp_path / "results" / "disks.csv")
     two = table.set_index("n_disks").loc[2]
     shown = kt.stats.format_interval(two["rate_enskog"], two["rate_enskog_low"],
@@ -235,6 +240,36 @@ def test_the_page_is_written_from_its_tables_and_names_stores_not_paths(referenc
     for png in ("disks_rejection_vs_n.png", "disks_hazard_vs_n.png",
                 "disks_rate_dispersion_vs_n.png"):
         assert (tmp_path / "results" / png).stat().st_size > 1000
+
+
+#: the first screen: at most this many characters from the top of the page before its
+#: first table, and at most this many columns in any table (issue 50)
+OPENING_MAX, COLUMNS_MAX = 1200, 8
+
+
+def assert_page_limits(text):
+    """The page opens with its answers (at most OPENING_MAX characters before its first
+    table) and every table has at most COLUMNS_MAX columns."""
+    lines = text.split("\n")
+    first = next(m for m, line in enumerate(lines) if line.startswith("|"))
+    opening = "\n".join(lines[:first])
+    assert len(opening) <= OPENING_MAX, len(opening)
+    assert "Poisson" in opening and "Enskog" in opening and "From which N" in opening
+    for line in lines:
+        if line.startswith("|"):
+            assert line.count("|") - 1 <= COLUMNS_MAX, line
+
+
+def test_the_published_disks_page_opens_with_its_answers_and_keeps_its_tables_narrow():
+    from pathlib import Path
+
+    page = Path(__file__).resolve().parents[1] / "docs" / "results" / "disks.md"
+    text = page.read_text(encoding="utf-8")
+    assert_page_limits(text)
+    # one standard for "Poisson": its rule is printed once, the calibration is cited
+    assert text.count("not Poisson: the share of runs a test rejects") == 1
+    assert "null_calibration.csv" in text
+    assert "hazard flatness p" not in text and "still not Poisson" not in text
 
 
 def test_the_twin_ftle_of_two_disks_is_the_two_disk_tangent_ftle_on_average():
@@ -295,15 +330,18 @@ def _row(**kw):
     return pd.Series(kw)
 
 
-@pytest.mark.parametrize(("low", "high", "reading"), [
-    (-0.2, 0.1, "no share detected"), (0.6, 1.2, "consistent with all"),
-    (-0.7, -0.04, "negative"), (-5.0, 8.0, "undetermined"), (0.2, 0.4, "part of it")])
-def test_each_speed_share_is_given_its_reading(low, high, reading):
+@pytest.mark.parametrize(("low", "high", "d_low", "reading"), [
+    (-0.2, 0.1, 1.2, "no share detected"), (0.6, 1.2, 1.2, "all of it not excluded"),
+    (-0.7, -0.04, 1.2, "negative (the rescaling makes D worse)"),
+    (-5.0, 8.0, 1.2, "not decomposed (interval 13 wide)"),
+    (0.81, 2.47, 1.05, "not decomposed (interval 1.7 wide)"),
+    (0.2, 0.4, 0.98, "not decomposed (D's interval reaches 1)"), (0.2, 0.4, 1.2, "part of it")])
+def test_each_speed_share_is_given_its_reading(low, high, d_low, reading):
     from kicktimes.studies.disks.page import _share
 
     text = _share(_row(speed_share=(low + high) / 2, speed_share_low=low,
-                       speed_share_high=high))
-    assert text.endswith(reading) or reading in text
+                       speed_share_high=high, dispersion_low=d_low))
+    assert text.endswith(reading)
 
 
 def test_no_kicked_ftle_ratio_where_the_kicked_disk_is_not_chaotic_or_the_gas_near_zero():
@@ -318,30 +356,35 @@ def test_no_kicked_ftle_ratio_where_the_kicked_disk_is_not_chaotic_or_the_gas_ne
     assert _kicked_cell(_row(**near), "acf@1").startswith("— (gas near 0")
     fine = dict(base, ratio=0.5, ratio_low=0.4, ratio_high=0.6, value=0.5, value_low=0.4,
                 value_high=0.6)
-    assert _kicked_cell(_row(**fine), "ftle") == "0.500 [0.400, 0.600] lower"
+    # a kicked/gas FTLE ratio is not like-for-like: printed without a verdict
+    assert _kicked_cell(_row(**fine), "ftle") == "0.500 [0.400, 0.600]"
+    assert _kicked_cell(_row(**fine), "rr") == "0.500 [0.400, 0.600] lower"
 
 
-def test_the_poisson_answer_uses_d_and_the_hazard_not_only_the_share():
-    from kicktimes.studies.disks.page import _answers
+def test_the_poisson_reading_is_the_calibrated_test_and_d():
+    from kicktimes.studies.disks.readings import poisson_from, poisson_readings, summary_lines
 
-    def rows(d_low, p):
+    def table(shares, d_lows):
         out = []
-        for n, (dl, pv) in zip((2, 30, 1000), ((5.0, 0.0), (d_low, p), (d_low, p)),
-                               strict=True):
-            r = {"geometry": "g", "rule": "mirror", "n_disks": n, "hazard_flat_pvalue": pv,
-                 "dispersion": dl + 0.05, "dispersion_low": dl, "dispersion_high": dl + 0.1,
-                 "dispersion_verdict": "inconclusive"}
-            for key in ("reject_uniformity_ks", "reject_exponential_ad"):
-                r.update({key: 0.06, f"{key}_low": 0.055, f"{key}_high": 0.066,
-                          f"{key}_verdict": "nominal"})
-            out.append(r)
+        for n, sh, dl in zip((2, 30, 1000), shares, d_lows, strict=True):
+            out.append({"geometry": "g", "rule": "mirror", "n_disks": n,
+                        "reject_uniformity_ks": sh, "reject_uniformity_ks_low": sh - 0.005,
+                        "reject_uniformity_ks_high": sh + 0.005, "dispersion": dl + 0.05,
+                        "dispersion_low": dl, "dispersion_high": dl + 0.1})
         return pd.DataFrame(out)
 
-    lines, tot = _answers(rows(1.03, 1e-9))
-    assert "still not Poisson at N = 1000 by D and the hazard" in lines[0]
-    assert (tot["d"], tot["h"], tot["s"], tot["sn"], tot["rows"]) == (2, 2, 2, 2, 2)
-    lines, tot = _answers(rows(0.95, 0.4))
-    assert "neither D's interval nor the hazard's flatness excludes Poisson" in lines[0]
+    gas = table((0.4, 0.061, 0.052), (5.0, 1.03, 0.95))
+    nulls = table((0.05, 0.05, 0.05), (0.95, 0.95, 0.95)).assign(design="poisson")
+    r = poisson_readings(gas, nulls)
+    # D = 1.08 [1.03, 1.13] straddles 1.1: not "not Poisson", whatever the share says
+    assert r["verdict"].tolist() == ["not Poisson", "inconclusive", "Poisson within 10 %"]
+    assert poisson_from(r) == {("g", "mirror"): 1000}
+    # against a calibrated level of 3 % the share 6.1 [5.6, 6.6] % lies above its band
+    low = poisson_readings(gas, nulls.assign(reject_uniformity_ks=0.03))
+    assert low["share_verdict"].tolist()[1] == "above nominal"
+    assert low["verdict"].tolist()[1] == "inconclusive"   # D's interval straddles 1.1
+    text = "\n".join(summary_lines(r))
+    assert "| g, mirror | 1000 |" in text and "Poisson within 10 % | 1000 |" in text
 
 
 def test_the_hazard_bootstrap_over_runs_reproduces_the_pooled_hazard_with_unit_weights(reference):
