@@ -86,7 +86,7 @@ def test_radial_orbits_are_kicked_more_often_than_orbits_near_the_rim(kinetic):
 
 
 @pytest.mark.parametrize("bad, match", [
-    ({"rule": "elastic"}, "kinetic kicks need unit speeds"),
+    ({"rule": "elastic"}, "mirror-rule KineticRate needs unit speeds"),
     ({"kick_angles": np.zeros((3, 2))}, "kick_angles: kinetic kicks"),
 ])
 def test_options_kinetic_kicks_cannot_honour_are_refused(kinetic, state, bad, match):

@@ -165,16 +165,43 @@ def resolve_kicks(kicks, kick_angles, *, kick_angle, sigma, rng, horizon, t_max,
     return times, _check_kick_angles(kick_angles, times, kick_angle), gen, kinetic
 
 
-def check_kinetic(kinetic, state, kick_angle, rule) -> None:
-    """Kinetic kicks need unit speed for the whole run (the rate is tabulated for it)."""
+def check_kinetic(kinetic, state, kick_angle, rule, sp=None) -> None:
+    """Kinetic kicks need the speeds their table is for.
+
+    A mirror-rule table (one row, `kicktimes.schedules.KineticRate`): unit speed for the
+    whole run, so no elastic scattering kicks. An elastic-rule table: a speed below
+    ``sqrt(2)`` (kicktimes' elastic energy shell ``|v0|^2 + |v1|^2 = 2``), and scattering
+    kicks, if any, under the elastic rule with that shell's partner: ``e0 = 1`` and equal
+    masses (checked when the scattering parameters ``sp`` are given).
+    """
     if kinetic is None:
         return
-    if abs(math.hypot(state[2], state[3]) - 1.0) > 1e-12:
-        raise ValueError("kicks: kinetic kicks are tabulated for unit speed; the disk's speed "
-                         f"is {math.hypot(state[2], state[3])!r}")
-    if kick_angle == "scatter" and rule != "mirror":
-        raise ValueError(f"rule={rule!r}: kinetic kicks need unit speeds, i.e. scattering "
-                         "kicks under rule='mirror'")
+    speed = math.hypot(state[2], state[3])
+    if kinetic[1].shape[0] == 1:
+        if abs(speed - 1.0) > 1e-12:
+            raise ValueError("kicks: kinetic kicks of a mirror-rule KineticRate are tabulated "
+                             f"for unit speed; the disk's speed is {speed!r} (build "
+                             "KineticRate(r, rule='elastic') for other speeds)")
+        if kick_angle == "scatter" and rule != "mirror":
+            raise ValueError(f"rule={rule!r}: a mirror-rule KineticRate needs unit speeds, "
+                             "which elastic scattering kicks change; build "
+                             "KineticRate(r, rule='elastic')")
+        return
+    if not speed < math.sqrt(2.0):
+        raise ValueError("kicks: an elastic-rule KineticRate is tabulated for speeds below "
+                         f"sqrt(2) (|v0|^2 + |v1|^2 = 2); the disk's speed is {speed!r}")
+    if kick_angle != "scatter":
+        return
+    if rule != "elastic":
+        raise ValueError(f"rule={rule!r}: an elastic-rule KineticRate averages over a partner "
+                         "on the elastic energy shell; scattering kicks with it need "
+                         "rule='elastic' (or use KineticRate(r) with the mirror rule)")
+    if sp is not None and abs(sp[2] - 1.0) > 1e-9:
+        raise ValueError(f"e0={float(sp[2])!r}: an elastic-rule KineticRate is tabulated for "
+                         "the pair's energy e0 = 1 (|v0|^2 + |v1|^2 = 2)")
+    if sp is not None and sp[5] != sp[6]:
+        raise ValueError("partner_mass: an elastic-rule KineticRate is tabulated for equal "
+                         f"masses, got partner_mass = {float(sp[6] / sp[5])!r}")
 
 
 def check_kinetic_capacity(kinetic, n_applied: int) -> None:
@@ -268,7 +295,9 @@ def simulate_one_particle(state, r, *, t_max=None, kicks=None, kick_angle="unifo
         ``sample(t_max, rng)`` method (see `kicktimes.schedules`), sampled here with
         ``rng``, or a `kicktimes.schedules.KineticRate`: kinetic kicks, whose rate after
         each kick is the kinetic collision rate of the disk's angular momentum (unit
-        speed; the run's ``kick_times`` are then the times it drew). ``None``: no kicks
+        speed), or of its angular momentum and speed (``KineticRate(r, rule="elastic")``,
+        with elastic scattering kicks of ``e0 = 1`` or kicks that keep the speed); the
+        run's ``kick_times`` are then the times it drew. ``None``: no kicks
         (the integrable billiard).
     kick_angle : {"uniform", "gaussian", "normal", "scatter"}
         ``"uniform"``: a kick replaces the direction by an angle uniform on [0, 2 pi)
@@ -366,7 +395,7 @@ def simulate_one_particle(state, r, *, t_max=None, kicks=None, kick_angle="unifo
     times, angles, _, kinetic = resolve_kicks(kicks, kick_angles, kick_angle=kick_angle,
                                               sigma=sigma, rng=rng, horizon=horizon,
                                               t_max=t_max if mode < 2 else None, r=r)
-    check_kinetic(kinetic, state, kick_angle, rule)
+    check_kinetic(kinetic, state, kick_angle, rule, sp)
     arcs = chk.check_holes(holes)
     st = np.zeros(7)
     st[1:5] = state

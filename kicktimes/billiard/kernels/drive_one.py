@@ -41,8 +41,8 @@ def drive(st, ev, rho, kicks, angles, kick_mode, kick_u, sp, unit_speed, t_end, 
     one.SCATTER``) take ``kick_u[i]`` and ``sp`` and log to ``klog[i]``.
     ``logs = (bt, bx, by, bs, klog)``; ``fin = [t_end, x, y, vx, vy]``, the run's final
     state; ``tan = (U, log_scale, tgi, tgf, max_events, n_orth, n_steps)`` or ``None``.
-    ``kinetic = (e, rates, l_first, dl)`` or ``None``: kinetic kicks, whose times the loop
-    writes into ``kicks`` as it goes: after kick ``i`` the next comes
+    ``kinetic = (e, rates, l_first, dl, c_first, dc)`` or ``None``: kinetic kicks, whose
+    times the loop writes into ``kicks`` as it goes: after kick ``i`` the next comes
     `one.kinetic_delay` later, with the number ``e[i + 1]``. ``holes = (arcs, escape)`` or
     ``None``: the table's holes, and ``uni`` (or ``None``) the uniform samples of a
     paper-sampled run, both as in `kicktimes.billiard.kernels.drive_two.drive`.
@@ -174,8 +174,9 @@ def drive(st, ev, rho, kicks, angles, kick_mode, kick_u, sp, unit_speed, t_end, 
             if tan is not None and tan_on:
                 n_pert += 1
             if kinetic is not None and ik + 1 < nk:
-                kicks[ik + 1] = kicks[ik] + one.kinetic_delay(st, kinetic[0][ik + 1], kinetic[1],
-                                                              kinetic[2], kinetic[3])
+                kicks[ik + 1] = kicks[ik] + one.kinetic_delay(
+                    st, kinetic[0][ik + 1], kinetic[1], kinetic[2], kinetic[3], kinetic[4],
+                    kinetic[5])
             ik += 1
         else:
             s, sin_theta = one.wall_step(s, dte, rho, unit_speed)
@@ -221,7 +222,7 @@ def _run(st, rho, kicks, angles, kick_mode, t_max, mode, n_steps, tau, b_cap, ki
     ev[0] = geo.boundary_hit_time(st[1], st[2], st[3], st[4], rho)
     if kinetic is not None and kicks.shape[0] > 0:
         kicks[0] = st[0] + one.kinetic_delay(st, kinetic[0][0], kinetic[1], kinetic[2],
-                                             kinetic[3])
+                                             kinetic[3], kinetic[4], kinetic[5])
     unit_speed = one.unit_speed_of(st, kick_mode, sp)
     klog = np.zeros((kicks.shape[0] if kick_mode == one.SCATTER else 0, 9))
     bt, bx, by, bs = ob.new_boundary_log(min(b_cap, max_events + 1) if sim else 0)

@@ -49,17 +49,32 @@ def unit_speed_of(st, kick_mode, sp):
 
 
 @njit(cache=True)
-def kinetic_delay(st, e, rates, l_first, dl):
-    """The delay ``e / rate(L)`` of the next kick at the rate of the disk's own angular
-    momentum ``L = x vy - y vx`` (kinetic kicks): ``e`` a standard exponential number,
-    ``rate`` interpolated linearly in ``rates`` on the grid ``l_first + i dl`` (clamped to
-    its ends). Between kicks ``L`` is conserved (wall reflections keep it), so the delay
-    is drawn once, right after a kick, from the state the kick left."""
+def kinetic_delay(st, e, rates, l_first, dl, c_first, dc):
+    """The delay ``e / rate`` of the next kick at the kinetic rate of the disk's own orbit
+    (kinetic kicks): ``e`` a standard exponential number, ``rate`` interpolated in the
+    table ``rates[j, i]`` of `kicktimes.schedules.KineticRate.kernel_table` (clamped to its
+    ends). One row (unit speed, the mirror rule): linearly in ``L = x vy - y vx`` on the
+    grid ``l_first + i dl``. More rows (the elastic rule): bilinearly in ``kappa = L / c``
+    on that grid and the speed ``c = |v|`` on ``c_first + j dc``. Between kicks ``L`` and
+    ``c`` are conserved (wall reflections keep them), so the delay is drawn once, right
+    after a kick, from the state the kick left (an elastic scattering kick changes ``c``)."""
     ell = st[1] * st[4] - st[2] * st[3]
-    f = (ell - l_first) / dl
-    i = min(max(int(math.floor(f)), 0), rates.shape[0] - 2)
+    n = rates.shape[1]
+    if rates.shape[0] == 1:
+        f = (ell - l_first) / dl
+        i = min(max(int(math.floor(f)), 0), n - 2)
+        w = min(max(f - i, 0.0), 1.0)
+        return e / (rates[0, i] * (1.0 - w) + rates[0, i + 1] * w)
+    c = math.sqrt(st[3] * st[3] + st[4] * st[4])
+    f = (ell / c - l_first) / dl
+    i = min(max(int(math.floor(f)), 0), n - 2)
     w = min(max(f - i, 0.0), 1.0)
-    return e / (rates[i] * (1.0 - w) + rates[i + 1] * w)
+    g = (c - c_first) / dc
+    j = min(max(int(math.floor(g)), 0), rates.shape[0] - 2)
+    u = min(max(g - j, 0.0), 1.0)
+    low = rates[j, i] * (1.0 - w) + rates[j, i + 1] * w
+    high = rates[j + 1, i] * (1.0 - w) + rates[j + 1, i + 1] * w
+    return e / (low * (1.0 - u) + high * u)
 
 
 @njit(cache=True)

@@ -141,7 +141,7 @@ def _ftle(st0, rho, mode, n_steps, tau, track, offsets, measure, d0, max_defer, 
             ev[j, 0] = boundary_hit_time(traj[j, 1], traj[j, 2], traj[j, 3], traj[j, 4], rho)
         if kinetic is not None and nk > 0:
             kicks[0] = st0[0] + one.kinetic_delay(st0, kinetic[0][0], kinetic[1], kinetic[2],
-                                                  kinetic[3])
+                                                  kinetic[3], kinetic[4], kinetic[5])
     ref = traj[0]
     log_sum = np.zeros(m)
     n_renorm = np.zeros(m, dtype=np.int64)
@@ -228,7 +228,8 @@ def _ftle(st0, rho, mode, n_steps, tau, track, offsets, measure, d0, max_defer, 
                                                     partners[ik], sp)
                     if kinetic is not None and j == 0 and ik + 1 < nk:
                         kicks[ik + 1] = kicks[ik] + one.kinetic_delay(
-                            ref, kinetic[0][ik + 1], kinetic[1], kinetic[2], kinetic[3])
+                            ref, kinetic[0][ik + 1], kinetic[1], kinetic[2], kinetic[3],
+                            kinetic[4], kinetic[5])
                     cnt[j, 0] += 1
                     cnt[j, 2] = (cnt[j, 2] * 4 + (4 if hit else 2)) % HASH_MOD
             if status != 0:
