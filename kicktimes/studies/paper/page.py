@@ -427,9 +427,11 @@ def write_results(
     screen += [
         "![headline](headline_ratios_vs_radius.png)", "",
         "**The ratio to the two-disk value against r**, one line per kick law, per diagnostic "
-        "and family: the median of per-IC ratios (robust to the few sticky runs), 95 % CIs "
-        "from a bootstrap clustered on ICs, one log scale for every panel with the ±10 % "
-        "band (grey); recurrence on uniform-time samples.", "",
+        "and family: the ratio of ensemble means per radius (the findings table's "
+        "statistic), 95 % CIs from a bootstrap clustered on ICs, one log scale for every "
+        "panel with the ±10 % band (grey); recurrence on uniform-time samples; the kick "
+        "laws dodged along r so that equal ratios stay visible. The paired median of per-IC "
+        "ratios is a control in the findings CSVs.", "",
         "Verdicts (`kicktimes.stats.ratio_verdict`): " + ratio_rule(0.1) + ". Every row "
         "under every control: " + ", ".join(f"[{f}_findings.csv]({f}_findings.csv)"
                                             for f in merged) + ".", ""]
