@@ -52,9 +52,7 @@ def test_every_kicked_system_is_under_every_control(path):
     for diagnostic in ("ftle", "rr_offdiag@0.01"):
         part = table[table["diagnostic"] == diagnostic]
         for system, rows in part.groupby("system"):
-            want = set(needed)
-            if system in ("poisson_kinetic", "uniform_kinetic"):
-                want -= {"elastic", "elastic+invariant_ics"}  # mirror rule only
+            want = set(needed)  # the kinetic-rate kicks under the elastic rule too
             if diagnostic.startswith("rr"):
                 want |= {"uniform_sampling", "paper_sampling"}
             assert want <= set(rows["control"]), (diagnostic, system)

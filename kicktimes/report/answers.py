@@ -83,7 +83,8 @@ def screen_cell(rows: pd.DataFrame) -> str:
     primary = rows[rows["control"] == "primary"].set_index("family")
     lo, hi = rows["estimate"].min(), rows["estimate"].max()
     missing = ""
-    if rows["system"].iloc[0] in ("poisson_kinetic", "uniform_kinetic"):
+    if (rows["system"].iloc[0] in ("poisson_kinetic", "uniform_kinetic")
+            and "elastic" not in set(rows["control"])):
         missing = " (mirror rule only)"
     for fam in families:
         mine = rows[rows["family"] == fam]
@@ -254,8 +255,11 @@ def first_screen(table: pd.DataFrame, shares=None) -> list[str]:
                  "(↕: above 1 under one control, below 1 under another)."]
     lines = [" ".join(s for s in sentences if s), ""]
     lines += markdown_table(overview_table(table))
+    kinetic = table[table["system"].isin(["poisson_kinetic", "uniform_kinetic"])]
+    missing = [c for c in controls if c not in set(kinetic["control"])] if len(kinetic) else []
     lines += ["", "Controls: " + ", ".join(_CONTROL_WORDS.get(c, c) for c in controls)
-              + "; the kinetic-rate kicks under the mirror rule only."]
+              + (f"; the kinetic-rate kicks not under {', '.join(missing)}" if missing else "")
+              + "."]
     return lines + [""]
 
 
