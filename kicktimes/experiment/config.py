@@ -28,8 +28,8 @@ __all__ = ["DEFAULT_SYSTEMS", "DIAGNOSTICS", "SYSTEMS", "Experiment"]
 
 SYSTEMS = ("two_particle", "poisson", "actual", "poisson_scatter", "actual_scatter",
            "poisson_kinetic", "mmpp", "uniform_kinetic")
-#: the systems kicked at the kinetic rate of the disk's own angular momentum (unit speeds:
-#: the mirror rule and equal disks only)
+#: the systems kicked at the kinetic rate of the disk's own angular momentum (and, under the
+#: elastic rule, speed): equal disks of equal masses only
 KINETIC_SYSTEMS = ("poisson_kinetic", "uniform_kinetic")
 #: The paper's systems, run when an experiment names none (scattering kicks are opt-in)
 DEFAULT_SYSTEMS = ("two_particle", "poisson", "actual")
@@ -146,7 +146,8 @@ class Experiment:
         same kinds of times but by scattering kicks (a collision with a virtual partner under
         ``rule``, docs/scatter.md) instead of ``kick_angle``. ``"poisson_kinetic"``: scattering
         kicks at the kinetic rate of the disk's own angular momentum, redrawn after every
-        kick (`kicktimes.schedules.KineticRate`; the mirror rule only);
+        kick (`kicktimes.schedules.KineticRate`; under ``rule = "elastic"`` the rate of
+        its angular momentum and speed, and elastic kicks with the IC's energy ``e0``);
         ``"uniform_kinetic"``: the kicks of ``kick_angle`` at that kinetic rate (with
         ``poisson``, ``poisson_scatter`` and ``poisson_kinetic`` the 2 x 2 factorial of
         deflection law and timing, `kicktimes.report.decomposition`). ``"mmpp"``: the
@@ -174,12 +175,13 @@ class Experiment:
         collisions with disk 1, and the report's kinetic rate is the pair's
         (`kicktimes.stats.kinetic_rate`). Disk 1 of the largest radius must fit:
         ``partner_ratio * max(radii) < 0.5`` (at most 1/3 for each disk with
-        ``ic_method = "uniform"``). Not with ``"poisson_kinetic"`` (its rate table,
-        `kicktimes.schedules.KineticRate`, is for equal disks).
+        ``ic_method = "uniform"``). Not with ``"poisson_kinetic"`` or
+        ``"uniform_kinetic"`` (their rate table, `kicktimes.schedules.KineticRate`, is for
+        equal disks).
     partner_mass : float
         Disk 1's mass in units of disk 0's, ``m1 / m0 > 0`` (default 1). Only the elastic
         rule has masses (``rule = "elastic"``), and only the invariant ICs draw their
-        speeds (``ic_method = "uniform"``).
+        speeds (``ic_method = "uniform"``). Not with the kinetic systems (equal masses).
     description : str
         Free text for the report.
 
@@ -255,10 +257,6 @@ class Experiment:
         check_choice("kick_angle", self.kick_angle, KICK_ANGLES)
         put("sigma", check_real("sigma", self.sigma, low=0.0))
         put("systems", _subset("systems", self.systems, SYSTEMS))
-        for system in KINETIC_SYSTEMS:
-            if system in self.systems and self.rule != "mirror":
-                raise ValueError(f"systems: {system!r} needs rule='mirror' (the kinetic rate "
-                                 f"is tabulated for unit speeds), got rule={self.rule!r}")
         put("diagnostics", _subset("diagnostics", self.diagnostics, DIAGNOSTICS))
         put("block_size", check_int("block_size", self.block_size, low=1))
         if self.holes is None or (hasattr(self.holes, "__len__") and len(self.holes) == 0):
@@ -284,6 +282,12 @@ class Experiment:
             raise ValueError(f"partner_mass: masses apply to rule='elastic' (the mirror rule "
                              f"keeps each disk's speed), got partner_mass={mass!r} with "
                              f"rule={self.rule!r}")
+        kinetic = [s for s in KINETIC_SYSTEMS if s in self.systems]
+        if mass != 1.0 and kinetic:
+            raise ValueError(f"partner_mass={mass!r}: the {kinetic[0]!r} system tabulates the "
+                             "kinetic rate of equal masses on the energy shell |v0|^2 + "
+                             "|v1|^2 = 2 (KineticRate); leave it out of systems or use "
+                             "partner_mass = 1")
         if mass != 1.0 and self.ic_method != "uniform":
             raise ValueError(f"partner_mass: the paper's ICs have unit speeds; masses need "
                              f"ic_method='uniform', got partner_mass={mass!r} with "
@@ -302,7 +306,6 @@ class Experiment:
         if self.ic_method == "uniform" and self.r_max > limit:
             raise ValueError(f"partner_ratio: unequal disks' invariant ICs need every radius "
                              f"at most 1/3, got max(radii) = {self.r_max!r}")
-        kinetic = [s for s in KINETIC_SYSTEMS if s in self.systems]
         if kinetic:
             raise ValueError(f"partner_ratio={ratio!r}: the {kinetic[0]!r} system tabulates "
                              "the kinetic rate of equal disks (KineticRate); leave it out of "

@@ -86,8 +86,6 @@ def _control(base: Experiment, control: str, label: str, what: str, **changes) -
 #: control's own draw) keeps the added cost of the controls bounded; their intervals come
 #: from these ICs alone
 CONTROL_ICS_B = 300
-_WITHOUT_KINETIC = tuple(s for s in PRESETS["family_a"].systems
-                         if s not in ("poisson_kinetic", "uniform_kinetic"))
 
 #: The controls of a family's findings that other experiments provide: the 2 x 2 design
 #: collision rule (mirror, elastic) x IC measure (the paper's procedure, the invariant
@@ -100,12 +98,11 @@ _DESIGN = (
     ("elastic",
      "under the elastic collision rule (energy exchanged between the disks), from the "
      "paper's initial conditions (unit speeds at the start)",
-     # the kinetic-rate kicks are tabulated for the mirror rule's unit speeds
-     {"rule": "elastic", "systems": _WITHOUT_KINETIC}),
+     {"rule": "elastic"}),
     ("elastic+invariant_ics",
      "under the elastic collision rule, with initial conditions drawn from the invariant "
      "measure (positions as for invariant_ics, velocities uniform on the energy shell)",
-     {"rule": "elastic", "ic_method": "uniform", "systems": _WITHOUT_KINETIC}),
+     {"rule": "elastic", "ic_method": "uniform"}),
 )
 _KEYS = {"invariant_ics": "invariant", "elastic": "elastic",
          "elastic+invariant_ics": "elastic_invariant"}
