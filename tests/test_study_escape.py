@@ -83,3 +83,44 @@ def test_the_tail_rate_is_events_over_time_at_risk_beyond_t_min():
 def test_the_paper_scale_is_the_published_page_s():
     assert study.SCALES["paper"] == study.Params(n_ics=4000, t_max=3000.0, t_min=50.0,
                                                  n_free=40000, seed=11)
+
+
+def test_the_c_over_t_law_gets_a_verdict_from_both_its_parts(built):
+    _, page, _ = built
+    text = page.read_text(encoding="utf-8")
+    (line,) = [ln for ln in text.splitlines() if ln.startswith("**Verdict on the law")]
+    verdict = re.search(r"C/t of the free disk: (\w+)\.", line).group(1)
+    tails = pd.read_csv(page.parent / "escape" / "escape_tails.csv").query("system == 'free'")
+    constant = pd.read_csv(page.parent / "escape" / "escape_constant.csv")
+    alpha = [ratio_verdict(lo, hi) for lo, hi in zip(tails["alpha_low"], tails["alpha_high"])]
+    const = [ratio_verdict(lo / c, hi / c) for lo, hi, c in
+             zip(constant["t_S_low"], constant["t_S_high"], constant["C_predicted"])]
+    assert verdict == study.page.law_verdict(alpha, const)
+    assert "10 %" in line and "stated in advance" in line
+    assert study.page.law_verdict(["within 10 %"] * 2, ["within 10 %"]) == "confirmed"
+    assert study.page.law_verdict(["within 10 %"], ["higher", "inconclusive"]) == "rejected"
+    assert study.page.law_verdict(["inconclusive"], ["within 10 %"]) == "unconfirmed"
+    with pytest.raises(ValueError, match="must not both be empty"):
+        study.page.law_verdict([], [])
+
+
+def test_the_survival_curves_turn_grey_below_the_at_risk_floor():
+    from kicktimes.stats import escape_survival
+    from kicktimes.studies.escape.figures import MIN_AT_RISK, survival_figure, thin_from
+
+    rng = np.random.default_rng(1)
+    t = rng.exponential(100.0, 400)
+    km = escape_survival(np.where(t < 1000, t, np.inf), 1000.0)
+    cut = thin_from(km)
+    assert km.loc[km["time"] < cut, "n_at_risk"].min() >= MIN_AT_RISK
+    assert km.loc[km["time"] == cut, "n_at_risk"].iloc[0] < MIN_AT_RISK
+    assert thin_from(km, floor=1) == float("inf") or thin_from(km, floor=1) > cut
+    with pytest.raises(ValueError, match="floor"):
+        thin_from(km, floor=0)
+    curves = {(r, "two_particle"): km for r in study.compute.RADII}
+    fig = survival_figure(curves)
+    ax = fig.axes[0]
+    (grey,) = [ln for ln in ax.get_lines() if ln.get_gid() == "few_at_risk_two_particle"]
+    (black,) = [ln for ln in ax.get_lines() if ln.get_label() == study.compute.LABELS["two_particle"]]
+    assert black.get_xdata().max() < cut <= grey.get_xdata().max()
+    assert grey.get_xdata()[0] == black.get_xdata()[-1]  # the two parts meet

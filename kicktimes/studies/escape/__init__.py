@@ -144,4 +144,4 @@ def reproduce(out: str | os.PathLike, *, scale: str = "quick",
     # the build's seconds: this call's and those the reused simulations took when they ran
     seconds = time.perf_counter() - start + sum(c.seconds for c in cached if c.reused)
     return run.write_page(write_page(table, ratio_tab, constant, params, run.command, seconds,
-                                     cache.name))
+                                     cache.name, curves=curves))

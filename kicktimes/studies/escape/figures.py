@@ -3,18 +3,57 @@
 from __future__ import annotations
 
 import numpy as np
+import pandas as pd
 from matplotlib.figure import Figure
+from matplotlib.lines import Line2D
 
 from kicktimes.report.figures import system_style
 from kicktimes.stats import kinetic_rate
 from kicktimes.studies.escape.compute import LABELS, RADII, SYSTEMS
 
-__all__ = ["survival_figure"]
+__all__ = ["MIN_AT_RISK", "survival_figure", "thin_from"]
+
+#: a Kaplan-Meier curve is drawn as measured while at least this many runs are at risk;
+#: beyond, where a few runs make each step (for the two disks: where disk 1's escapes have
+#: censored most of disk 0's runs), it is drawn thin and grey, without its band
+MIN_AT_RISK = 50
+
+
+def thin_from(km, floor=MIN_AT_RISK):
+    """The first time of a Kaplan-Meier table (`kicktimes.stats.escape_survival`) at which
+    fewer than ``floor`` runs are at risk (inf: never).
+
+    Parameters
+    ----------
+    km : pandas.DataFrame
+        ``time, survival, ci_low, ci_high, n_at_risk``.
+    floor : int
+        The least number of runs at risk of a step drawn as measured.
+
+    Returns
+    -------
+    float
+
+    Examples
+    --------
+    >>> import pandas as pd
+    >>> thin_from(pd.DataFrame({"time": [1.0, 2.0, 3.0], "n_at_risk": [80, 50, 49]}))
+    3.0
+    """
+    if isinstance(floor, bool) or not isinstance(floor, int) or floor < 1:
+        raise ValueError(f"floor must be a positive integer, got {floor!r}")
+    below = km.loc[km["n_at_risk"] < floor, "time"]
+    return float(below.iloc[0]) if len(below) else float("inf")
 
 
 def survival_figure(curves):
     """Kaplan-Meier survival of disk 0's escape per system, one log-log panel per radius
-    (``curves``: `escape_tables`' third value); returns a `matplotlib.figure.Figure`."""
+    (``curves``: `escape_tables`' third value); returns a `matplotlib.figure.Figure`.
+
+    Each curve is drawn with its 95 % band while at least :data:`MIN_AT_RISK` runs are at
+    risk, beyond that (:func:`thin_from`) as a thin grey dotted line without a band: the
+    two-disk curve's risk set is emptied by disk 1's escapes (partner censoring), and its
+    last steps, each one of a handful of runs, would read as physics."""
     styles = {"two_particle": system_style("two_particle"), "poisson": system_style("poisson"),
               "poisson_scatter": system_style("poisson_scatter"),
               "free": {"color": "tab:gray", "marker": "x"},
@@ -27,13 +66,23 @@ def survival_figure(curves):
             km = curves[(r, system)]
             if km.empty:
                 continue
-            ax.step(km["time"], km["survival"], where="post", color=styles[system]["color"],
-                    label=LABELS[system],
+            # as measured while MIN_AT_RISK runs or more are at risk; then thin and grey
+            # (the step into the thin part included, so the two parts meet)
+            cut = thin_from(km)
+            kept = km[km["time"] < cut]
+            rest = km[km["time"] >= cut]
+            if len(kept) and len(rest):
+                rest = pd.concat([kept.iloc[[-1]], rest])
+            ax.step(kept["time"], kept["survival"], where="post",
+                    color=styles[system]["color"], label=LABELS[system],
                     linestyle="--" if system == "poisson_scatter" else "-",
                     linewidth={"poisson": 3.0, "poisson_scatter": 1.0}.get(system, 1.5),
                     zorder=3 if system == "poisson_scatter" else 2)
-            ax.fill_between(km["time"], km["ci_low"], km["ci_high"], step="post",
+            ax.fill_between(kept["time"], kept["ci_low"], kept["ci_high"], step="post",
                             color=styles[system]["color"], alpha=0.15, linewidth=0)
+            if len(rest):
+                ax.step(rest["time"], rest["survival"], where="post", color="0.6",
+                        linewidth=0.8, linestyle=":", zorder=1, gid=f"few_at_risk_{system}")
         tt = np.geomspace(50.0, 3000.0, 20)
         ax.plot(tt, 50.0 / tt * 0.5, color="k", linestyle=":", linewidth=1,
                 label="slope of C / t")
@@ -46,6 +95,8 @@ def survival_figure(curves):
         ax.set_xlabel("time t")
     axes[0].set_ylabel("survival S(t) (Kaplan-Meier, 95 % CI)")
     handles, labels = axes[0].get_legend_handles_labels()
+    handles.append(Line2D([], [], color="0.6", linewidth=0.8, linestyle=":"))
+    labels.append(f"any curve where fewer than {MIN_AT_RISK} runs are at risk")
     fig.legend(handles, labels, loc="outside lower center", ncol=4,
                fontsize="small")
     fig.suptitle("Escape through one hole (half-width 0.05 rad): who escapes like the two "
