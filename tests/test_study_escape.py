@@ -92,9 +92,11 @@ def test_the_c_over_t_law_gets_a_verdict_from_both_its_parts(built):
     verdict = re.search(r"C/t of the free disk: (\w+)\.", line).group(1)
     tails = pd.read_csv(page.parent / "escape" / "escape_tails.csv").query("system == 'free'")
     constant = pd.read_csv(page.parent / "escape" / "escape_constant.csv")
-    alpha = [ratio_verdict(lo, hi) for lo, hi in zip(tails["alpha_low"], tails["alpha_high"])]
+    alpha = [ratio_verdict(lo, hi) for lo, hi in zip(tails["alpha_low"], tails["alpha_high"],
+                                                             strict=True)]
     const = [ratio_verdict(lo / c, hi / c) for lo, hi, c in
-             zip(constant["t_S_low"], constant["t_S_high"], constant["C_predicted"])]
+             zip(constant["t_S_low"], constant["t_S_high"], constant["C_predicted"],
+                 strict=True)]
     assert verdict == study.page.law_verdict(alpha, const)
     assert "10 %" in line and "stated in advance" in line
     assert study.page.law_verdict(["within 10 %"] * 2, ["within 10 %"]) == "confirmed"
@@ -121,6 +123,7 @@ def test_the_survival_curves_turn_grey_below_the_at_risk_floor():
     fig = survival_figure(curves)
     ax = fig.axes[0]
     (grey,) = [ln for ln in ax.get_lines() if ln.get_gid() == "few_at_risk_two_particle"]
-    (black,) = [ln for ln in ax.get_lines() if ln.get_label() == study.compute.LABELS["two_particle"]]
+    label = study.compute.LABELS["two_particle"]
+    (black,) = [ln for ln in ax.get_lines() if ln.get_label() == label]
     assert black.get_xdata().max() < cut <= grey.get_xdata().max()
     assert grey.get_xdata()[0] == black.get_xdata()[-1]  # the two parts meet
