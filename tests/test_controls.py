@@ -28,6 +28,20 @@ def test_the_band_verdict(low, high, verdict):
     assert ratio_verdict(low, high) == verdict
 
 
+def test_a_median_of_mostly_zero_ratios_is_not_an_estimate():
+    # DET of kicked runs without a single diagonal line: most per-IC ratios are 0, so
+    # their median is 0 whatever the others are; that radius has no estimate
+    idx = pd.MultiIndex.from_product([[0.01, 0.02], range(20)], names=["radius", "ic"])
+    y = pd.Series(1.0, index=idx)
+    x = pd.Series(np.r_[np.zeros(12), np.full(8, 1.2), np.full(20, 0.97)], index=idx)
+    med = paired_median(x, y, rng=np.random.default_rng(0), n_boot=200)
+    assert med["ratio"] == pytest.approx(0.97)  # the radius 0.02 alone
+    curve = med["per_radius"].set_index("radius")
+    assert np.isnan(curve.loc[0.01, "ratio"])
+    none = paired_median(x * 0, y, rng=np.random.default_rng(0), n_boot=200)
+    assert np.isnan(none["ratio"]) and np.isnan(none["ci_low"])
+
+
 def test_the_paired_median_ignores_a_few_extreme_runs_and_covers_the_true_ratio():
     rng = np.random.default_rng(5)
     idx = pd.MultiIndex.from_product([[0.01, 0.02, 0.03], range(200)], names=["radius", "ic"])

@@ -94,6 +94,20 @@ def screen_cell(rows: pd.DataFrame) -> str:
             where = f"{_fam(fam)}: " if len(families) > 1 else ""
             flips = (mine["ci_low"] > 1).any() and (mine["ci_high"] < 1).any()
             mark = "↕ " if flips else ""
+            if flips:
+                # show a pair that flips: the primary against a control on the other side
+                # of 1 (or, with the primary on 1, the two extremes)
+                p = primary.loc[fam]
+                below, above = mine[mine["ci_high"] < 1], mine[mine["ci_low"] > 1]
+                side = below if p.ci_low > 1 else above if p.ci_high < 1 else None
+                if side is not None:
+                    other = side.loc[(side["estimate"] - 1).abs().idxmax()]
+                    control = other["control"]
+                else:
+                    lo_row = below.loc[below["estimate"].idxmin()]
+                    other = above.loc[above["estimate"].idxmax()]
+                    return (f"↕ depends on {lo_row['control']} vs {other['control']}: "
+                            f"{where}{_ci(lo_row)} vs {_ci(other)}{missing}")
             return (f"{mark}depends on {control}: {where}{_ci(primary.loc[fam])} vs "
                     f"{_ci(other)}{missing}")
     verdicts = set(primary["verdict"])

@@ -104,7 +104,9 @@ def paired_median(numerator, denominator, *, rng, n_boot=1000, level=0.95):
     ----------
     numerator, denominator : pandas.Series
         Indexed by ``(radius, ic)``; a pair enters where both are finite and the
-        denominator is non-zero.
+        denominator is non-zero. A radius where at least half of the ratios are 0 has no
+        median ratio (it would be 0 whatever the other half): it is left out, and with no
+        radius left the result is NaN (verdict inconclusive).
     rng : numpy.random.Generator
         The bootstrap's stream.
     n_boot : int
@@ -132,7 +134,13 @@ def paired_median(numerator, denominator, *, rng, n_boot=1000, level=0.95):
     with np.errstate(divide="ignore", invalid="ignore"):
         q = (frame["x"] / frame["y"]).where(lambda s: np.isfinite(s))
     table = q.unstack("ic")  # radius x ic
-    values = table.to_numpy(float)
+    values = table.to_numpy(float, copy=True)
+    # a median of ratios at least half of which are 0 (a kicked run without a single
+    # recurrence line, say) is 0 whatever the rest: no estimate at that radius
+    finite = np.isfinite(values)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        zero_share = (values == 0).sum(axis=1) / finite.sum(axis=1)
+    values[zero_share >= 0.5] = np.nan
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)  # a radius without a finite pair
         per_radius = pd.Series(nanmedian(values, axis=1), index=table.index, dtype=float)
