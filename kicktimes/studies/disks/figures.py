@@ -42,12 +42,13 @@ def _n_ticks(ax, ns):
     ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
 
 
-def rejection_figure(table, tests=(HEADLINE, "exponential_ad")):
+def rejection_figure(table, tests=(HEADLINE, "exponential_ad"), nulls=None):
     """The share of tagged disks whose first K collision times reject each test at
     alpha = 0.05, against N: one column per geometry, one row per test, log y axis (the
     nominal band stays readable next to the N = 2 shares); mirror, elastic and elastic after
     the speed rescaling, dodged and with different markers; 95 % CIs; the nominal band
-    shaded."""
+    shaded; with ``nulls`` (`kicktimes.studies.disks.null.null_rows`), the share of the
+    Poisson null streams shaped like each rule's runs (the calibrated level), dotted."""
     import matplotlib.pyplot as plt
 
     geos = geometries_of(table)
@@ -72,6 +73,13 @@ def rejection_figure(table, tests=(HEADLINE, "exponential_ad")):
                 err = np.abs(100 * d[[f"{key}_low", f"{key}_high"]].to_numpy().T - y)
                 ax.errorbar(x, y, yerr=err, color=color, marker=marker, ms=4.5, lw=1,
                             capsize=2, label=label, mfc=face)
+                if nulls is not None and not prefix:
+                    z = nulls[(nulls["geometry"] == geo) & (nulls["rule"] == rule)
+                              & (nulls["design"] == "poisson")]
+                    if not z.empty and key in z:
+                        ax.plot(z["n_disks"].to_numpy() * (1.0 + 0.12 * (k - 1)),
+                                100 * z[key].to_numpy(), color=color, ls=":", marker="x",
+                                ms=4, lw=1, label=f"Poisson null, {rule} runs")
             _n_ticks(ax, ns)
             ax.set_yscale("log")
             ax.set_ylim(0.5, 100)

@@ -338,8 +338,10 @@ def _left_out(table, long, kicked_stores, k, ftle_checked):
             "the whole gas's largest exponent: the tagged disk's own share of the gas's "
             "stretching is not computed. The kinetic-theory form is tested for its shape "
             "only (its prefactors are not computed), in the table's unit circle with its "
-            "wall, at N = 300 and 1000; no null pipeline (synthetic Poisson or speed-driven "
-            "Cox streams through the same tests) calibrates the rejection shares."
+            "wall, at N = 300 and 1000. The null calibration is shaped like the primary "
+            "design's runs only: the controls' Poisson readings use the primary's calibrated "
+            "levels (the replicate has the same shape; K = 60 and the bulk disks have other "
+            "windows and fewer tagged disks)."
             + ("" if ftle_checked else " The checks of the gas's FTLE (tangent against "
                "twin, the engine's N = 2 against the two-disk simulator) are not on this "
                "page: their table, disks_ftle_check.csv, was not beside it when it was "
@@ -472,7 +474,7 @@ def write_disks_page(store_paths, out_dir, *, command="kicktimes reproduce --stu
     analysis_cpu = time.process_time() - t0
     table.to_csv(out / "disks.csv", index=False)
     hazard.to_csv(out / "disks_hazard.csv", index=False)
-    figures = {"disks_rejection_vs_n.png": rejection_figure(table),
+    figures = {"disks_rejection_vs_n.png": rejection_figure(table, nulls=nulls),
                "disks_hazard_vs_n.png": hazard_figure(hazard, table),
                "disks_rate_dispersion_vs_n.png": rates_figure(table)}
     with_controls_figure = not long.empty and (long["n_disks"] >= CONTROLS_MIN_N).any()
@@ -569,7 +571,9 @@ def write_disks_page(store_paths, out_dir, *, command="kicktimes reproduce --stu
         "![rejection shares](disks_rejection_vs_n.png)", "",
         "**Rejection shares against N**: uniform times (top) and exponential intervals "
         "(Anderson–Darling, bottom), per geometry, on a log y axis; grey: the nominal band "
-        f"[{100 * ALPHA * 0.5:g}, {100 * ALPHA * 1.5:g}] %, line: {100 * ALPHA:g} %; 95 % CIs; "
+        f"[{100 * ALPHA * 0.5:g}, {100 * ALPHA * 1.5:g}] %, line: {100 * ALPHA:g} %; dotted "
+        "with crosses: the share the Poisson null streams shaped like each rule's runs "
+        "reject (the calibrated level); 95 % CIs; "
         "the three series dodged sideways, with different markers.", "",
         "![hazard](disks_hazard_vs_n.png)", "",
         "**The hazard of the next collision against the time since the last**, in units of "
