@@ -21,7 +21,10 @@ RHO = 1.0 - R
 
 @pytest.fixture(scope="module")
 def table():
-    return KineticRate(R, rule="elastic")
+    # the experiment's cached table (the sweep test below then does not build another)
+    from kicktimes.experiment.tasks import kinetic_rate_table
+
+    return kinetic_rate_table(R, "elastic")
 
 
 @pytest.fixture(scope="module")
@@ -112,6 +115,9 @@ def test_an_elastic_kinetic_run_replays_bitwise_and_gives_one_exponent(table, st
     res, one = lyapunov(state, R, return_run=True, **kw)
     assert res.lam == lyapunov(state, R, **kw).lam == lyapunov(one).lam
     assert res.n_perturbations == one.n_kicks > 0
+    # the twins meet the reference's partners at the kick times the reference drew
+    twin = lyapunov(state, R, method="twin", d0=1e-9, **kw)
+    assert twin.lam == pytest.approx(res.lam, rel=0.05)
 
 
 def test_speed_keeping_kicks_use_the_row_of_the_disk_s_speed(table, state):
@@ -207,7 +213,7 @@ def test_the_two_disk_collision_rate_follows_the_elastic_table_in_every_bin(tabl
             assert ratio_verdict(low, high) == "within 10 %", (a, b, est, low, high)
 
 
-def test_the_experiment_runs_the_kinetic_systems_under_the_elastic_rule():
+def test_the_experiment_runs_the_kinetic_systems_under_the_elastic_rule(table):
     from kicktimes.experiment import Experiment, run_task
 
     exp = Experiment(name="kinetic-elastic", radii=[R], n_ics=1, n_steps=400, tau=0.5,
