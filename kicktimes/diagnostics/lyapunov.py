@@ -580,7 +580,7 @@ def _lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rul
     times, angles, _, kinetic = resolve_kicks(kicks, kick_angles, kick_angle=kick_angle,
                                               sigma=sigma, rng=rng, horizon=horizon,
                                               t_max=horizon if mode == 1 else None, r=r)
-    check_kinetic(kinetic, state, kick_angle, rule)
+    check_kinetic(kinetic, state, kick_angle, rule, sp)
     rho = 1.0 - r
     st = np.zeros(7)
     st[1:5] = state
