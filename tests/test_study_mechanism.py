@@ -86,6 +86,34 @@ def test_a_rerun_reuses_each_rule_s_numbers_and_figures(built, monkeypatch):
         run.reproduce(out, results_dir=out / "other")
 
 
+def test_the_whole_early_hazard_is_read_not_its_first_bin_alone(built):
+    _, page = built
+    text = page.read_text(encoding="utf-8")
+    tab = pd.read_csv(page.parent / "mechanism" / "mechanism_numbers.csv")
+    section = text.split("## The mirror rule")[1]
+    low_cells = _cells(section, "minimum over t < 4 (bin)")
+    count_cells = _cells(section, "bins below the rate, t < 4")
+    groups = [("paper", 0.01), ("paper", 0.02), ("uniform", 0.01), ("uniform", 0.02)]
+    for k, (method, r) in enumerate(groups):
+        g = tab[(tab["method"] == method) & (tab["radius"] == r)]
+        bins = g[g["quantity"].str.match(r"^hazard_nonsticky_bin_.*_over_rate$")]
+        assert bins["note"].tolist()[0] == "bin [0, 0.5)" and len(bins) == 7
+        first = g[g["quantity"] == "hazard_nonsticky_first_bin_over_rate"].iloc[0]
+        assert bins["estimate"].iloc[0] == pytest.approx(first["estimate"])
+        low = g[g["quantity"] == "hazard_nonsticky_min_over_rate"].iloc[0]
+        at = bins["estimate"].to_numpy().argmin()
+        assert low["estimate"] == pytest.approx(bins["estimate"].min())
+        assert low["note"] == bins["note"].iloc[at]
+        assert low_cells[1 + k].endswith(f"({low['note']})")
+        assert ratio_verdict(low["ci_low"], low["ci_high"]) in low_cells[1 + k]
+        lower = [b.note.removeprefix("bin ") for b in bins.itertuples()
+                 if ratio_verdict(b.ci_low, b.ci_high) == "lower"]
+        count = g[g["quantity"] == "hazard_nonsticky_bins_lower"].iloc[0]
+        assert count["estimate"] == len(lower)
+        assert count_cells[1 + k] == f"{len(lower)} of 7: " + (", ".join(lower) or "none")
+    assert "hazard minimum over t < 4" in text.split("## The mirror rule")[0]
+
+
 @pytest.mark.parametrize(("option", "value"), [("scale", "paper-ish"), ("workers", 0),
                                                ("workers", "2")])
 def test_bad_options_are_refused_by_name(tmp_path, option, value):
@@ -99,6 +127,8 @@ def test_every_figure_the_page_links_is_drawn(tmp_path):
 
     table = run.run_rule("elastic", TINY, tmp_path)
     assert set(table["rule"]) == {"elastic"}
+    table = pd.concat([table, run._cached_profile(tmp_path, "elastic", TINY, 1, print)],
+                      ignore_index=True)
     drawn = {p.name for p in tmp_path.glob("mechanism_*.png")}
     assert drawn == {f"mechanism_{name}.png" for name in run.FIGURES}
     text = "\n".join(rule_section(table, "mechanism/elastic"))

@@ -41,6 +41,15 @@ def test_the_page_names_its_command_and_its_verdicts_are_its_csv(built):
         assert row.verdict == rejection_verdict(row.ci_low, row.ci_high, 0.05)
     dip = pd.read_csv(page.parent / "mmpp" / "mmpp_billiard_dip.csv")
     assert (dip["mmpp"] >= 1.0 - 1e-9).all()
+    # the whole early hazard: its minimum, where it falls, the MMPP's hazard in that bin
+    for d in dip.itertuples():
+        assert d.min_observed <= d.observed + 1e-12
+        assert (d.min_bin_low, d.min_bin_high) in zip(tables.EARLY_EDGES[:-1],
+                                                      tables.EARLY_EDGES[1:], strict=True)
+        assert f"- {d.rule} rule, the whole early hazard: its minimum over t < 4 falls in " \
+               f"[{d.min_bin_low:g}, {d.min_bin_high:g})" in text
+        assert d.min_verdict in ("below the MMPP's", "above the MMPP's",
+                                 "not distinguished from the MMPP's")
 
 
 def test_a_rerun_reuses_the_cached_collision_times(built, monkeypatch):
@@ -74,6 +83,22 @@ def test_an_mmpp_has_no_refractory_dip():
     bursty = SimpleNamespace(rates=[0.05, 2.0], stationary=[0.9, 0.1],
                              generator=[[-0.01, 0.01], [0.09, -0.09]])
     assert study.mmpp_dip(bursty) > 1.0
+
+
+def test_the_mmpp_bin_hazard_is_exact_and_reads_the_mechanism_study_s_bins():
+    from kicktimes.studies.mechanism.analysis import HAZARD_EDGES, RETURN_TIME
+
+    assert tables.EARLY_EDGES == tuple(HAZARD_EDGES[HAZARD_EDGES <= RETURN_TIME])
+    poisson = SimpleNamespace(rates=[0.3], stationary=[1.0], generator=[[0.0]])
+    assert study.tables.mmpp_bin_hazard(poisson, 2.0, 3.0) == pytest.approx(1.0)
+    bursty = SimpleNamespace(rates=[0.05, 2.0], stationary=[0.9, 0.1],
+                             generator=[[-0.01, 0.01], [0.09, -0.09]])
+    # the burst right after an event decays: the hazard falls from bin to bin
+    early = study.tables.mmpp_bin_hazard(bursty, 0.0, 0.5)
+    assert early == pytest.approx(study.mmpp_dip(bursty), rel=1e-6)
+    assert early > study.tables.mmpp_bin_hazard(bursty, 3.0, 4.0)
+    with pytest.raises(ValueError, match="a, b"):
+        study.tables.mmpp_bin_hazard(bursty, 1.0, 1.0)
 
 
 def test_the_paper_scale_is_the_published_page_s():

@@ -32,8 +32,8 @@ from kicktimes.studies.mechanism.twins import (
     twin_batteries,
 )
 
-__all__ = ["EXPLAINERS", "LATE_RESCALED", "RETURN_TIME", "STICKY_FACTOR", "analyse",
-           "cell_rows", "clopper_pearson", "state_rates"]
+__all__ = ["EXPLAINERS", "HAZARD_EDGES", "LATE_RESCALED", "RETURN_TIME", "STICKY_FACTOR",
+           "analyse", "cell_rows", "clopper_pearson", "hazard_profile_rows", "state_rates"]
 
 #: the models whose explained share is reported; cox_markov_oos is out of sample
 EXPLAINERS = ("mixed_poisson", "cox_iid", "cox_sequence", "cox_markov_oos")
@@ -75,6 +75,66 @@ def _peak_row(rows, key, quantity, haz, *, scale):
     _row(rows, key, quantity, tab["hazard"].iloc[i] / scale, tab["ci_low"].iloc[i] / scale,
          tab["ci_high"].iloc[i] / scale,
          note=f"bin [{tab['t_low'].iloc[i]:g}, {tab['t_high'].iloc[i]:g})")
+
+
+def hazard_profile_rows(key, runs):
+    r"""The early hazard of the next collision read bin by bin, not by its first bin alone.
+
+    Over every bin of :data:`HAZARD_EDGES` that ends by :data:`RETURN_TIME` (the refractory
+    time and the wall round trips, [0, 0.5) to [3, 4)), the hazard of the intervals after
+    a collision, sticky runs left out, over the pooled rate, with its 95 % Garwood
+    interval: one row per bin, the minimum and the bin where it falls, and the number of
+    bins whose interval lies wholly below the 10 % band (`kicktimes.stats.ratio_verdict`
+    "lower"). The same `kicktimes.stats.interval_hazard` as :func:`analyse`'s
+    ``hazard_nonsticky_*`` rows, so the bin [0, 0.5) is its first-bin row.
+
+    Parameters
+    ----------
+    key : tuple
+        ``(method, r)``.
+    runs : sequence
+        The group's runs (simulated with ``log_collisions=True``).
+
+    Returns
+    -------
+    list of dict
+        Rows of ``mechanism_numbers.csv``: ``hazard_nonsticky_bin_<a>_<b>_over_rate``,
+        ``hazard_nonsticky_min_over_rate`` (note: its bin) and
+        ``hazard_nonsticky_bins_lower`` (estimate: the count; note: the bins, of how many).
+
+    Notes
+    -----
+    The minimum of several bins is a selected value: its Garwood interval is that of its
+    own bin, not adjusted for the choice; the count of bins lower than the rate, each by
+    its own interval, is the reading that does not select.
+    """
+    method, r = key
+    rows = []
+    t_max = runs[0].t_max
+    tab = mechanism.collision_tables(runs)
+    obs_rate = np.array([run.n_pp for run in runs]) / t_max
+    calm = ~(obs_rate > STICKY_FACTOR * stats.kinetic_rate(r))[tab["run"].to_numpy()]
+    done = ~tab["next_censored"].to_numpy()
+    nxt = tab["next_interval"].to_numpy()
+    edges = HAZARD_EDGES[HAZARD_EDGES < float(nxt.max())].tolist() + [float(nxt.max())]
+    ns = stats.interval_hazard(nxt[done & calm], nxt[~done & calm], edges=edges)
+    early = ns.table[ns.table["t_high"] <= RETURN_TIME].reset_index(drop=True)
+    ratio = early["hazard"] / ns.rate
+    low, high = early["ci_low"] / ns.rate, early["ci_high"] / ns.rate
+    for k in range(len(early)):
+        a, b = early["t_low"].iloc[k], early["t_high"].iloc[k]
+        _row(rows, key, f"hazard_nonsticky_bin_{a:g}_{b:g}_over_rate", ratio.iloc[k],
+             low.iloc[k], high.iloc[k], note=f"bin [{a:g}, {b:g})")
+    i = int(np.argmin(ratio.to_numpy()))
+    _row(rows, key, "hazard_nonsticky_min_over_rate", ratio.iloc[i], low.iloc[i], high.iloc[i],
+         note=f"bin [{early['t_low'].iloc[i]:g}, {early['t_high'].iloc[i]:g})")
+    lower = [k for k in range(len(early))
+             if stats.ratio_verdict(low.iloc[k], high.iloc[k]) == "lower"]
+    _row(rows, key, "hazard_nonsticky_bins_lower", len(lower),
+         note=f"of {len(early)} bins below t = {RETURN_TIME:g}: " + (", ".join(
+             f"[{early['t_low'].iloc[k]:g}, {early['t_high'].iloc[k]:g})" for k in lower)
+             or "none"))
+    return rows
 
 
 def _sup_distance(t, sf_emp, sf_model):

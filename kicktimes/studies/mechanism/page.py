@@ -64,6 +64,12 @@ def _hazard_cell(row):
     return f"{_iv(row, (0.9, 1.0, 1.1))}, {ratio_verdict(row['ci_low'], row['ci_high'], MARGIN)}"
 
 
+def _bins_cell(row):
+    """``k of n: [a, b), ...`` from a ``hazard_nonsticky_bins_lower`` row."""
+    of, _, where = row["note"].partition(": ")
+    return f"{int(row['estimate'])} {of.split(' bins')[0]}: {where}"
+
+
 #: the observed row of each explained quantity and the Poisson value it is measured from
 OBSERVED = {"uniformity_ks": ("observed_reject_uniformity_ks", 0.05),
             "exponential_ad": ("observed_reject_exponential_ad", 0.05),
@@ -112,12 +118,22 @@ def rule_section(tab, figures):
              "**Hazard of the next collision** (sticky runs left out; over the group's pooled "
              "rate, 95 % Garwood intervals, which treat every interval as independent and "
              "leave out the differences between runs; verdicts against 1 by "
-             "`ratio_verdict`. The first row at r = 0.02, paper ICs, is the refractory dip of "
-             "[mmpp.md](mmpp.md): the same ICs, the same `kicktimes.stats.interval_hazard`; "
-             "that page gives a bootstrap interval over runs beside it):", "",
+             "`ratio_verdict`. The whole early hazard is read, every bin up to t = 4 (the "
+             "refractory time and the wall round trips): its minimum, the bin where it falls "
+             "(the Garwood interval is that bin's own, not adjusted for picking the lowest of "
+             "several), and how many bins lie below the rate each by its own interval, beside "
+             "the first bin alone. At r = 0.02, paper ICs, the first bin and the minimum are "
+             "the refractory dip of [mmpp.md](mmpp.md): the same ICs, the same "
+             "`kicktimes.stats.interval_hazard`; that page gives a bootstrap interval over runs "
+             "beside them; every bin is in the table, rows `hazard_nonsticky_bin_*`):", "",
              head, sep,
-             line("in [0, 0.5) after a collision",
+             line("in [0, 0.5) after a collision (first bin)",
                   lambda m, r: _hazard_cell(g(m, r, "hazard_nonsticky_first_bin_over_rate"))),
+             line("minimum over t < 4 (bin)", lambda m, r: _hazard_cell(
+                 g(m, r, "hazard_nonsticky_min_over_rate"))
+                 + f" ({g(m, r, 'hazard_nonsticky_min_over_rate')['note']})"),
+             line("bins below the rate, t < 4", lambda m, r: _bins_cell(
+                 g(m, r, "hazard_nonsticky_bins_lower"))),
              line("peak (bin)", lambda m, r: f"{_iv(g(m, r, 'hazard_nonsticky_peak_over_rate'))}"
                   f" ({g(m, r, 'hazard_nonsticky_peak_over_rate')['note']})"),
              line("in [3, 4)", lambda m, r: _hazard_cell(
@@ -212,7 +228,9 @@ def summary(tabs):
     of groups whose verdict says so and ranges of explained shares."""
     rules = [t["rule"].iloc[0] for t in tabs]
     rows = [
-        ("hazard in [0, 0.5) after a collision lower than the rate (refractory dip)",
+        ("hazard minimum over t < 4 after a collision lower than the rate (refractory dip, "
+         "wherever it falls)", lambda t: _count(t, "hazard_nonsticky_min_over_rate", "lower")),
+        ("hazard in [0, 0.5) after a collision (the first bin alone) lower than the rate",
          lambda t: _count(t, "hazard_nonsticky_first_bin_over_rate", "lower")),
         ("re-collisions above chance", lambda t: str(sum(
             _above_chance(_get(t, m, r, "recollision_share_nonsticky"),
@@ -261,9 +279,14 @@ def _carry(tab, groups, rule):
               if math.isfinite(x["estimate"])} or {"no interval ends there"}
     first = [_get(tab, m, r, "hazard_nonsticky_first_bin_over_rate") for m, r in groups]
     first_v = {ratio_verdict(x["ci_low"], x["ci_high"], MARGIN) for x in first}
-    return (f"Read from the rows above ({rule} rule): in the first half time unit after a "
-            f"collision the hazard is {rng('hazard_nonsticky_first_bin_over_rate')} × the rate "
-            f"(verdicts: {', '.join(sorted(first_v))}); at rescaled t > 5 the Γ-rescaled "
+    low = [_get(tab, m, r, "hazard_nonsticky_min_over_rate") for m, r in groups]
+    low_v = {ratio_verdict(x["ci_low"], x["ci_high"], MARGIN) for x in low}
+    bins = sorted({x["note"] for x in low})
+    return (f"Read from the rows above ({rule} rule): over t < 4 after a collision the "
+            f"hazard falls to {rng('hazard_nonsticky_min_over_rate')} × the rate at its "
+            f"minimum ({'; '.join(bins)}; verdicts: {', '.join(sorted(low_v))}); in the first "
+            f"half time unit alone it is {rng('hazard_nonsticky_first_bin_over_rate')} × the "
+            f"rate (verdicts: {', '.join(sorted(first_v))}); at rescaled t > 5 the Γ-rescaled "
             f"hazard is {rng('rescaled_hazard_late')} (verdicts: {', '.join(sorted(late_v))}). "
             "The Cox twins that replay each run's own states reproduce "
             f"{rng('explained_uniformity_ks_by_cox_sequence', 'uniformity_ks')} of the excess "

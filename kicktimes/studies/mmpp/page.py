@@ -6,7 +6,7 @@ from kicktimes.report.pages import header, simulations_source
 from kicktimes.stats import format_interval, rejection_rule
 from kicktimes.stats.findings import clopper_pearson
 from kicktimes.studies.mmpp.compute import STICKY_FACTOR
-from kicktimes.studies.mmpp.tables import DIP, N_MC, RENEWAL, TESTS
+from kicktimes.studies.mmpp.tables import DIP, EARLY_EDGES, N_MC, RENEWAL, TESTS
 
 __all__ = ["write_page"]
 
@@ -67,7 +67,14 @@ def write_page(pooled, resid, dip, params, command, seconds, source):
               "a collision, sticky runs left out, so at r = 0.02 the observed value is the one on "
               "[mechanism.md](mechanism.md). Another IC draw of the same size can move the "
               "dip by more than the Garwood interval (it ignores the differences between "
-              "runs); the bootstrap over runs includes them.", ""]
+              "runs); the bootstrap over runs includes them. The first bin alone can miss the "
+              "dip: the whole early hazard is read too, over the bins "
+              + ", ".join(f"[{a:g}, {b:g})" for a, b in zip(EARLY_EDGES[:-1], EARLY_EDGES[1:],
+                                                           strict=True))
+              + " (those of [mechanism.md](mechanism.md)), with its minimum, the bin where it "
+              "falls and the MMPP-2's exact mean hazard in that bin (the interval of the "
+              "minimum is its bin's own, not adjusted for picking the lowest of several "
+              "bins; the bootstrap holds the bin fixed).", ""]
     for d in dip.itertuples():
         observed = format_interval(d.observed, d.ci_low, d.ci_high, edges=(d.mmpp,))
         burst = (f"the MMPP-2 predicts a hazard above the rate (a burst right after a "
@@ -76,9 +83,17 @@ def write_page(pooled, resid, dip, params, command, seconds, source):
         deficit = ("the data show a deficit (the observed interval lies below 1)"
                    if max(d.ci_high, d.boot_high) < 1 else
                    "the observed interval is not below 1")
-        lines.append(f"- {d.rule} rule: observed {observed} (bootstrap over runs "
-                     f"[{d.boot_low:.3f}, {d.boot_high:.3f}]); {burst}{deficit}: "
-                     f"{d.verdict}.")
+        lines.append(f"- {d.rule} rule, first bin [0, {DIP:g}): observed {observed} "
+                     f"(bootstrap over runs [{d.boot_low:.3f}, {d.boot_high:.3f}]); "
+                     f"{burst}{deficit}: {d.verdict}.")
+        low = format_interval(d.min_observed, d.min_ci_low, d.min_ci_high,
+                              edges=(d.min_mmpp, 1.0))
+        below = ("below 1" if max(d.min_ci_high, d.min_boot_high) < 1 else "not below 1")
+        lines.append(f"- {d.rule} rule, the whole early hazard: its minimum over t < "
+                     f"{EARLY_EDGES[-1]:g} falls in [{d.min_bin_low:g}, {d.min_bin_high:g}), "
+                     f"observed {low} (bootstrap over runs [{d.min_boot_low:.3f}, "
+                     f"{d.min_boot_high:.3f}], {below}); the MMPP-2 predicts "
+                     f"{d.min_mmpp:.3f} there: {d.min_verdict}.")
     for p in pooled.itertuples():
         if max(p.mean_stay_high, p.mean_stay_low) > p.t_max:
             lines.append(f"- {p.rule} rule: the longer mean stay in a state "

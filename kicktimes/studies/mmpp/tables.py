@@ -13,13 +13,17 @@ from kicktimes import stats
 from kicktimes.stats import rejection_verdict
 from kicktimes.stats.findings import clopper_pearson
 
-__all__ = ["DIP", "MIN_EVENTS", "N_BOOT", "N_MC", "RENEWAL", "TESTS", "analyse", "battery",
-           "intervals", "mmpp_dip"]
+__all__ = ["DIP", "EARLY_EDGES", "MIN_EVENTS", "N_BOOT", "N_MC", "RENEWAL", "TESTS", "analyse",
+           "battery", "intervals", "mmpp_bin_hazard", "mmpp_dip"]
 
 TESTS = ("uniformity_ks", "exponential_ks", "exponential_ad", "ljung_box", "runs", "dispersion")
 MIN_EVENTS = 20
 RENEWAL = ("gamma", "weibull", "hyperexponential")
 DIP = 0.5
+#: the early hazard is read over these bins (the refractory time and the wall round
+#: trips), the first bins of the mechanism study's hazard, so that both pages read the
+#: same bins: its minimum is the refractory dip wherever it falls, not only in [0, DIP)
+EARLY_EDGES = (0.0, 0.5, 1.0, 1.5, 2.0, 2.5, 3.0, 4.0)
 #: Monte Carlo samples of the Poisson battery's nulls; bootstrap resamples of the dip
 N_MC = 199
 N_BOOT = 1000
@@ -35,6 +39,33 @@ def mmpp_dip(fit, d=DIP, n_grid=201):
     surv = np.array([pe @ expm(D * t) @ np.ones_like(lam) for t in ts])
     integral = np.trapezoid(surv, ts)
     return float((1.0 - surv[-1]) / integral / (pi @ lam))
+
+
+def mmpp_bin_hazard(fit, a, b, n_grid=201):
+    r"""Mean hazard of the MMPP's interval law over [a, b), over its mean rate.
+
+    With :math:`S(t) = p_e\, e^{D t}\, \mathbf 1` the survival of the interval after an
+    event (:math:`p_e` the state law just after an event, :math:`D = Q - \Lambda`), the
+    mean hazard over the bin is :math:`(S(a) - S(b)) / \int_a^b S`, the quantity the
+    hazard table of `kicktimes.stats.interval_hazard` estimates there.
+
+    Examples
+    --------
+    >>> from types import SimpleNamespace
+    >>> poisson = SimpleNamespace(rates=[2.0], stationary=[1.0], generator=[[0.0]])
+    >>> round(mmpp_bin_hazard(poisson, 1.0, 1.5), 4)  # trapezoid rule on 201 points
+    1.0
+    """
+    if not 0.0 <= a < b:
+        raise ValueError(f"a, b: need 0 <= a < b, got a = {a!r}, b = {b!r}")
+    lam = np.asarray(fit.rates, float)
+    pi = np.asarray(fit.stationary, float)
+    D = np.asarray(fit.generator, float) - np.diag(lam)
+    pe = pi * lam / (pi @ lam)
+    ts = np.linspace(a, b, n_grid)
+    surv = np.array([pe @ expm(D * t) @ np.ones_like(lam) for t in ts])
+    integral = np.trapezoid(surv, ts)
+    return float((surv[0] - surv[-1]) / integral / (pi @ lam))
 
 
 def battery(times, windows, rng):
@@ -102,14 +133,25 @@ def analyse(rule, times, sticky, t_max, per_run, seed):
         max(complete.max(), censored.max()))])
     first = haz.table.iloc[0]
     model = mmpp_dip(two)
+    # the whole early hazard: its minimum over the bins of EARLY_EDGES and where it falls
+    early = _early_hazard(complete, censored)
+    ratio = (early.table["hazard"] / early.rate).to_numpy()[:len(EARLY_EDGES) - 1]
+    k = int(np.argmin(ratio))
+    low_row = early.table.iloc[k]
+    a, b = EARLY_EDGES[k], EARLY_EDGES[k + 1]
     boot_rng = np.random.default_rng(seed)
-    boot = []
+    boot, boot_min = [], []
     for _ in range(N_BOOT):
         pick = [calm[i] for i in boot_rng.integers(0, len(calm), len(calm))]
         c, z = intervals(pick, t_max)
         h = stats.interval_hazard(c, z, edges=[0.0, DIP, float(max(c.max(), z.max()))])
         boot.append(h.table["hazard"].iloc[0] / h.rate)
+        e = _early_hazard(c, z)
+        boot_min.append(e.table["hazard"].iloc[k] / e.rate)  # the data's bin, held fixed
     b_lo, b_hi = np.percentile(boot, [2.5, 97.5])
+    m_lo, m_hi = np.percentile(boot_min, [2.5, 97.5])
+    m_model = mmpp_bin_hazard(two, a, b)
+    m_obs_lo, m_obs_hi = low_row["ci_low"] / early.rate, low_row["ci_high"] / early.rate
     dip.append({"rule": rule, "observed": first["hazard"] / haz.rate,
                 "ci_low": first["ci_low"] / haz.rate, "ci_high": first["ci_high"] / haz.rate,
                 "boot_low": b_lo, "boot_high": b_hi,
@@ -117,8 +159,21 @@ def analyse(rule, times, sticky, t_max, per_run, seed):
                 "mean_stay_max": float(max(two.mean_sojourns)), "t_max": t_max,
                 "verdict": ("below the MMPP's" if max(first["ci_high"] / haz.rate, b_hi) < model
                             else "above the MMPP's" if min(first["ci_low"] / haz.rate, b_lo) > model
-                            else "not distinguished from the MMPP's")})
+                            else "not distinguished from the MMPP's"),
+                "min_bin_low": a, "min_bin_high": b, "min_observed": ratio[k],
+                "min_ci_low": m_obs_lo, "min_ci_high": m_obs_hi,
+                "min_boot_low": m_lo, "min_boot_high": m_hi, "min_mmpp": m_model,
+                "min_verdict": ("below the MMPP's" if max(m_obs_hi, m_hi) < m_model
+                                else "above the MMPP's" if min(m_obs_lo, m_lo) > m_model
+                                else "not distinguished from the MMPP's")})
     return pooled, resid, dip
+
+
+def _early_hazard(complete, censored):
+    """The hazard of the intervals on `EARLY_EDGES`, the rest of the time one last bin."""
+    edges = [*EARLY_EDGES, max(float(complete.max()), float(censored.max()),
+                               2 * EARLY_EDGES[-1])]
+    return stats.interval_hazard(complete, censored, edges=edges)
 
 
 def intervals(times, t_max):
