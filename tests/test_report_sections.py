@@ -282,6 +282,10 @@ def test_shared_peaks_name_the_radii_where_every_system_peaks_and_the_caption_sa
                                    "uniform_det@0.01") == []
     caption = recurrence._peaks_note(rows, store.experiment)
     assert "ε = 0.01: r = 0.014" in caption and "Inference" in caption
+    # the control, computed the same way on the run's own samples
+    own = recurrence.shared_peaks(part, "det@0.01")
+    assert "have shared peaks at" in caption
+    assert ("ε = 0.01: " + (", ".join(f"r = {r:g}" for r in own) or "none")) in caption
 
 
 def test_family_figure_has_one_row_per_store_with_uniform_samples_where_present():
