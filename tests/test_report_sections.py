@@ -191,7 +191,7 @@ def test_recurrence_findings_at_every_eps_off_diagonal_and_det(ctx):
 def test_acf_finding_is_marked_built_in(ctx):
     e = _effect(ctx, "Lag-1 ACF of boundary angles", "actual")
     assert e.verdict.startswith("within 10 %") and "built in" in e.verdict
-    assert "built-in prediction" in e.detail
+    assert "rate-matching prediction" in e.detail
 
 
 def test_recurrence_figure_has_a_row_per_eps_and_rr_offdiag_det_columns(ctx):
