@@ -52,6 +52,7 @@ from kicktimes.report.figures import (
 
 __all__ = [
     "AIC_MARGIN",
+    "AT_RISK_FLOOR",
     "ESCAPE_ROWS",
     "T_MIN_FRACTION",
     "escape_answer",
@@ -71,6 +72,10 @@ T_MIN_FRACTION = 1 / 20
 #: equivalence margin of the escape-rate ratio, fixed in advance
 MARGIN = 0.1
 AIC_MARGIN = 2.0
+#: a survival curve is drawn as measured, with its band, while at least this many runs are
+#: at risk; beyond, thin, grey and dotted (a handful of runs per step; for the two disks,
+#: where disk 1's escapes have censored most of disk 0's runs)
+AT_RISK_FLOOR = 50
 _RUN_COLUMNS = ["radius", "ic", "system", "time", "horizon", "other_disk", "followed"]
 
 
@@ -415,8 +420,10 @@ def escape_figure(curves, *, t_min=None):
     matplotlib.figure.Figure
         Per radius a panel; per system its survival (steps, up to the system's last
         observed time ``end``) with its pointwise 95 % band, in the report's system
-        colours, the two-disk system drawn thicker. The time axis starts at 1/1000 of the
-        longest horizon (earlier, S is near 1).
+        colours, the two-disk system drawn thicker, while :data:`AT_RISK_FLOOR` runs or
+        more are at risk (where ``curves`` has ``n_at_risk``); beyond, a thin grey dotted
+        line without a band. The time axis starts at 1/1000 of the longest horizon
+        (earlier, S is near 1).
     """
     check_frame("curves", curves, ["radius", "system", "time", "survival", "ci_low",
                                    "ci_high", "end"])
@@ -446,11 +453,24 @@ def escape_figure(curves, *, t_min=None):
             lo = np.r_[1.0, km["ci_low"].to_numpy(float), km["ci_low"].iloc[-1]]
             hi = np.r_[1.0, km["ci_high"].to_numpy(float), km["ci_high"].iloc[-1]]
             two = system == REFERENCE
-            ax.step(t, np.maximum(s, floor), where="post", color=style["color"],
+            # as measured up to the first step made by fewer than AT_RISK_FLOOR runs at
+            # risk (point k of t is row k - 1 of km), holding its value up to that step's
+            # time; from there thin and grey
+            cut = t.size
+            if "n_at_risk" in km.columns:
+                few = np.flatnonzero(km["n_at_risk"].to_numpy() < AT_RISK_FLOOR)
+                cut = 1 + int(few[0]) if few.size else t.size
+            upto = min(cut + 1, t.size)
+            held = [np.r_[v[:cut], v[cut - 1]] if cut < t.size else v for v in (s, lo, hi)]
+            ax.step(t[:upto], np.maximum(held[0], floor), where="post", color=style["color"],
                     linewidth=2.0 if two else 1.2, zorder=3 if two else 2,
                     label=system_label(system))
-            ax.fill_between(t, np.maximum(lo, floor), np.maximum(hi, floor), step="post",
-                            color=style["color"], alpha=0.12, linewidth=0)
+            ax.fill_between(t[:upto], np.maximum(held[1], floor), np.maximum(held[2], floor),
+                            step="post", color=style["color"], alpha=0.12, linewidth=0)
+            if cut < t.size:
+                ax.step(np.r_[t[cut], t[cut:]], np.maximum(np.r_[s[cut - 1], s[cut:]], floor),
+                        where="post", color="0.6", linewidth=0.8, linestyle=":", zorder=1,
+                        gid=f"few_at_risk_{system}")
         if t_min is not None:
             ax.axvline(t_min, color="0.4", linestyle=":", linewidth=1.0,
                        label="t_min (tail fits start)")
@@ -511,9 +531,11 @@ def sections(ctx):
         "S ∝ t^−α with exact 95 % intervals; the tail law is the one whose AIC is lower by "
         f"more than {AIC_MARGIN:g}, undecided otherwise. A kicked system escapes like the "
         "two disks at a radius when the tail laws do not conflict (exponential against "
-        "algebraic) and the 95 % intervals of the shared parameter overlap (α when a tail "
-        "is algebraic, γ otherwise): a lenient criterion; disjoint intervals are a clear "
-        "difference."
+        "algebraic) and the 95 % interval of the ratio of the shared parameter (α when a "
+        f"tail is algebraic, γ otherwise) lies within ±{100 * MARGIN:g} % (an equivalence "
+        "test, its margin fixed in advance); not like when the interval lies wholly outside "
+        "the band or the tail laws conflict; inconclusive otherwise. Overlapping intervals "
+        "of the two parameters (column ci_overlap) are not read as agreement."
     )
     sec.table("escape_comparison", comparison, "Each kicked system against the two disks")
     sec.table("escape_tails", table, "Escape per radius and system")
@@ -524,8 +546,13 @@ def sections(ctx):
         "pointwise 95 % bands, the two-disk system ("
         + ("the first escape of either disk" if either else
            "disk 0's escape; disk 1's censors it")
-        + ") drawn thicker; the dotted line is t_min, where the tail fits start. An "
-        "exponential tail bends down on these axes, an algebraic one is a straight line.",
+        + ") drawn thicker; the dotted line is t_min, where the tail fits start. Each curve "
+        f"is drawn with its band while at least {AT_RISK_FLOOR} runs are at risk, then thin, "
+        "grey and dotted: there a step is one of a handful of runs"
+        + ("" if either else ", and the two-disk risk set is emptied by disk 1's escapes, "
+           "which would read as physics")
+        + ". An exponential tail bends down on these axes, an algebraic one is a straight "
+        "line.",
     )
     sec.table("escape_survival", curves, "Kaplan–Meier survival curves", show=False)
     return [sec]

@@ -66,12 +66,14 @@ def survival_figure(curves):
             km = curves[(r, system)]
             if km.empty:
                 continue
-            # as measured while MIN_AT_RISK runs or more are at risk; then thin and grey
-            # (the step into the thin part included, so the two parts meet)
+            # as measured up to the first step made by fewer than MIN_AT_RISK runs at risk,
+            # holding its value up to that step's time; from there thin and grey (from the
+            # held value, so the two parts meet)
             cut = thin_from(km)
             kept = km[km["time"] < cut]
             rest = km[km["time"] >= cut]
             if len(kept) and len(rest):
+                kept = pd.concat([kept, kept.iloc[[-1]].assign(time=cut)])
                 rest = pd.concat([kept.iloc[[-1]], rest])
             ax.step(kept["time"], kept["survival"], where="post",
                     color=styles[system]["color"], label=LABELS[system],
