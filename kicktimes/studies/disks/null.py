@@ -70,7 +70,13 @@ def null_streams(store, n_disks, design, rng):
     for ic, g in col.groupby("ic", sort=False):
         window = float(g["t_window"].iloc[0])
         rule = "elastic" if design == "dilute" else "mirror"
-        t, s = dilute_tagged_times(rule, float(rate[ic]), window, len(g), rng, speeds=True)
+        if not float(rate[ic]) > 0:
+            # a run without a collision (two disks whose conserved state keeps them apart):
+            # its tagged disks' null streams are empty too
+            t, s = [np.empty(0)] * len(g), [np.full(1, np.nan)] * len(g)
+        else:
+            t, s = dilute_tagged_times(rule, float(rate[ic]), window, len(g), rng,
+                                       speeds=True)
         if design == "poisson":
             s = [np.full(x.size + 1, np.nan) if exp.rule == "elastic" else np.empty(0)
                  for x in t]
