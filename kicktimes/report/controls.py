@@ -510,14 +510,16 @@ def poisson_rows(family, rejections, per_ic, *, alpha, rng, n_boot=2000, null=No
             f"{HEADLINE_TEST} on the first {FIXED_EVENTS} collisions of every run that has "
             "them (the same power at every radius); 95 % CI from a bootstrap clustered on "
             f"ICs; read against α = {alpha:g}")
-    if per_ic is not None and "dispersion" in per_ic.columns and HEADLINE_TEST in totals.index:
+    names = [r["diagnostic"] for r in rows]
+    if (per_ic is not None and "dispersion" in per_ic.columns
+            and f"reject@{HEADLINE_TEST}" in names):
         d, d_low, d_high = clustered_mean(per_ic, "dispersion", rng=rng, n_boot=n_boot)
         n_d = int(np.isfinite(per_ic["dispersion"].to_numpy(float)).sum())
         add("dispersion_index", d, n_d, d_low, d_high, ratio_verdict(d_low, d_high, 0.1),
             "mean over runs of D = variance / mean of the counts in 10 equal sub-windows of "
             "the run's window (1 for a Poisson process given its count); 95 % CI from a "
             "bootstrap clustered on ICs; verdict in the ±10 % band")
-        head = rows[[r["diagnostic"] for r in rows].index(f"reject@{HEADLINE_TEST}")]
+        head = rows[names.index(f"reject@{HEADLINE_TEST}")]
         level, _ = calibrated(HEADLINE_TEST)
         add(f"poisson@{HEADLINE_TEST}", head["estimate"], head["n_pairs"], head["ci_low"],
             head["ci_high"], poisson_verdict(head["ci_low"], head["ci_high"], level, d_low,
