@@ -190,7 +190,7 @@ def test_renewal_models_rank_gamma_intervals_gamma_and_check_the_halves():
     assert row["best"] == "gamma" and row["n_intervals"] == 600 * 20
     assert row["delta_aic_exponential"] > 100 and row["stable"]
     text = "\n".join(renewal_lines(t))
-    assert "not independent" in text and "| 10 | gamma; exponential ΔAIC" in text
+    assert "not independent" in text and "| 10 | gamma; exp. ΔAIC" in text
 
 
 def test_the_scatter_kicked_system_is_compared_with_the_gas(tmp_path):

@@ -122,6 +122,15 @@ def _control_cell(controls, geo, rule, n):
             else "differs: " + ", ".join(differ["control"]))
 
 
+#: the share's verdict against its calibrated level, in words
+LEVEL_WORDS = {"nominal": "at its calibrated level", "above nominal": "above its calibrated level",
+               "below nominal": "below its calibrated level", "inconclusive": "inconclusive"}
+
+
+def _level(verdict):
+    return LEVEL_WORDS.get(verdict, verdict)
+
+
 def _groups(items):
     """``{verdict: [family, ...]}`` preserving order."""
     out = {}
@@ -134,7 +143,7 @@ def opening_lines(readings, table, rate_from, rate_robust_from) -> list:
     """The page's first screen: whether the tagged disk's process is Poisson (at the
     largest N), from which N, and how the gas compares with kinetic theory (Enskog's rate;
     the dilute tagged disk's D), each from a computed table."""
-    big = readings.sort_values("n_disks").groupby(["geometry", "rule"], sort=False).tail(1)
+    big = readings.groupby(["geometry", "rule"], sort=False).tail(1)
     n_max = int(big["n_disks"].max())
     by = _groups((r["verdict"], f"{r['geometry']} {r['rule']}") for _, r in big.iterrows())
     verdicts = "; ".join(f"{v}: {', '.join(f)}" for v, f in by.items())
@@ -211,9 +220,9 @@ def family_lines(readings) -> list:
         lo, hi = g.iloc[0], g.iloc[-1]
         text = (f"- **{geo}, {rule}** — N = {cells}. KS share at N = {int(lo['n_disks'])} "
                 f"{_pct(lo['share'], lo['share_low'], lo['share_high'], lo['null_level'])} "
-                f"({lo['share_verdict']}), at N = {int(hi['n_disks'])} "
+                f"({_level(lo['share_verdict'])}), at N = {int(hi['n_disks'])} "
                 f"{_pct(hi['share'], hi['share_low'], hi['share_high'], hi['null_level'])} "
-                f"({hi['share_verdict']}); D "
+                f"({_level(hi['share_verdict'])}); D "
                 f"{format_interval(lo['d'], lo['d_low'], lo['d_high'])} → "
                 f"{format_interval(hi['d'], hi['d_low'], hi['d_high'])}.")
         if rule == "elastic" and "rescaled_verdict" in g:

@@ -145,11 +145,12 @@ def renewal_lines(models: pd.DataFrame) -> list:
                 cells.append("—")
                 continue
             m = m.iloc[0]
-            mark = "" if m["stable"] else " (halves differ)"
+            mark = "" if m["stable"] else " †"
             exp_d = ("" if m["best"] == "exponential"
-                     else f"; exponential ΔAIC {_delta(m['delta_aic_exponential'])}")
+                     else f"; exp. ΔAIC {_delta(m['delta_aic_exponential'])}")
             cells.append(f"{m['best']}{mark}{exp_d}")
         lines.append(f"| {n} | " + " | ".join(cells) + " |")
-    return lines + ["", "Cells: the AIC-best model, and the exponential's ΔAIC where it is "
-                    "not the best (ΔAIC > 10 is conventionally strong evidence, on "
-                    "independent intervals).", ""]
+    return lines + ["", "Cells: the AIC-best model (†: the halves of the runs pick "
+                    "different models), and the exponential's ΔAIC where it is not the best "
+                    "(ΔAIC > 10 is conventionally strong evidence, on independent "
+                    "intervals).", ""]
