@@ -6,7 +6,10 @@ references): `tables` (the per-N tables: Poisson battery, dispersion, hazard, En
 rate, the kicked comparison), `controls` (every finding under the controls), `renewal`
 (renewal models by AIC), `kicked` (the kicked comparison's sections), `ftle_check` (the
 gas's FTLE: tangent vectors against a twin, the engine's N = 2 against the two-disk
-simulator), `density` (the gas's FTLE against density, the kinetic-theory form), `figures`,
+simulator), `density` (the gas's FTLE against density, the kinetic-theory form), `null`
+(null streams shaped like the runs: Poisson and the dilute tagged disk, the gas rows of
+``null_calibration.csv``), `readings` (the one reading of "Poisson", `stats.poisson_verdict`
+against the calibrated level, and the page's first screen), `figures`,
 `page` (``disks.md``) and `run` (`reproduce_disks`: the sweeps and the FTLE computations,
 run or resumed from the work folder, then the page; `reproduce` at the quick or the paper
 scale).
