@@ -281,10 +281,10 @@ def test_the_poisson_question_is_a_row_per_test_with_the_rule_as_a_control():
     assert not head["robust"].all()  # above nominal under one rule only
     assert table[table["diagnostic"] == "reject@ljung_box"]["robust"].all()  # nominal twice
     text = first_screen(table)[0]
-    assert text.startswith("Are the two-disk collision times Poisson? Under the paper's mirror "
-                           "rule: not Poisson (39.0 %")
-    assert "null streams shaped like the runs reject 8.0 % (A)" in text
-    assert "under the elastic rule: inconclusive (13.0 %" in text and "disjoint" in text
+    assert text.startswith("Poisson collision times? Mirror rule: not Poisson (uniformity "
+                           "rejected in 39.0 %")
+    assert "against null streams 8.0 % (A)" in text
+    assert "elastic rule: inconclusive (13.0 %" in text and "disjoint" in text
 
 
 def test_the_first_screen_is_at_most_three_sentences_and_a_table_of_at_most_8_columns():

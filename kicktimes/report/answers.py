@@ -162,41 +162,40 @@ def poisson_answer(table: pd.DataFrame, alpha=0.05) -> str:
         return r.iloc[0] if len(r) else None
 
     def rule_text(control):
-        parts, verdicts = [], set()
+        shares, ds, verdicts = [], [], set()
         for fam in families:
             share = cell(f"reject@{HEADLINE_TEST}", fam, control)
             d = cell("dispersion_index", fam, control)
             verdict = cell(f"poisson@{HEADLINE_TEST}", fam, control)
             if share is None:
                 continue
-            text = f"{_pct(share)} of runs reject"
+            shares.append(f"{_pct(share)} ({_fam(fam)})")
             if d is not None:
-                text += f", D = {format_interval(d.estimate, d.ci_low, d.ci_high)}"
-            parts.append(f"{text} ({_fam(fam)})")
+                ds.append(format_interval(d.estimate, d.ci_low, d.ci_high))
             verdicts.add(verdict.verdict if verdict is not None else share.verdict)
-        return parts, verdicts
-
-    mirror, v_mirror = rule_text("primary")
-    elastic, v_elastic = rule_text("elastic")
+        return shares, ds, verdicts
 
     def say(verdicts):
         return (next(iter(verdicts)) if len(verdicts) == 1
                 else "depends on the family (" + " / ".join(sorted(verdicts)) + ")")
 
+    shares, ds, v_mirror = rule_text("primary")
     null = cell(f"reject@{HEADLINE_TEST}", families[0], "primary")
-    level = ("null streams shaped like the runs reject "
-             + _level_text(rows, families) if "null_calibration" in str(null.detail)
-             else f"a Poisson process rejects {100 * alpha:g} %")
-    text = (f"Are the two-disk collision times Poisson? Under the paper's mirror rule: "
-            f"{say(v_mirror)} (" + "; ".join(mirror) + f"; {level}; D = 1 for Poisson)")
-    if elastic:
-        text += f"; under the elastic rule: {say(v_elastic)} (" + "; ".join(elastic) + ")"
+    level = ("null streams " + _level_text(rows, families)
+             if "null_calibration" in str(null.detail) else f"Poisson {100 * alpha:g} %")
+    text = (f"Poisson collision times? Mirror rule: {say(v_mirror)} (uniformity rejected in "
+            + ", ".join(shares) + f" of runs, against {level}"
+            + (f"; D = {', '.join(ds)}" if ds else "") + ")")
+    e_shares, e_ds, v_elastic = rule_text("elastic")
+    if e_shares:
+        text += (f"; elastic rule: {say(v_elastic)} (" + ", ".join(e_shares)
+                 + (f"; D = {', '.join(e_ds)}" if e_ds else "") + ")")
         pairs = [(cell(f"reject@{HEADLINE_TEST}", f, "elastic"),
                   cell(f"reject@{HEADLINE_TEST}", f, "primary")) for f in families]
         pairs = [(e, m) for e, m in pairs if e is not None and m is not None]
         if pairs and all(e.ci_high < m.ci_low for e, m in pairs):
-            text += ": fewer runs reject than under the mirror rule (intervals disjoint)"
-    return text + ". Rule: `kicktimes.stats.poisson_verdict`."
+            text += ", fewer rejections (disjoint)"
+    return text + "."
 
 
 def _level_text(rows, families) -> str:
@@ -248,9 +247,8 @@ def _scatter_clause(table: pd.DataFrame) -> str:
         return ""
     below = int((rows["ci_high"] < 1.0).sum())
     above = int((rows["ci_low"] > 1.0).sum())
-    text = (f"; scatter kicks bring it to {rows['estimate'].min():.3g}–"
-            f"{rows['estimate'].max():.3g}, with the CI below 1 in {below} of {len(rows)} "
-            "(kick time, family, control) cells")
+    text = (f"; scatter kicks: {rows['estimate'].min():.3g}–{rows['estimate'].max():.3g}, "
+            f"CI below 1 in {below} of {len(rows)} cells")
     if above:
         text += f" and above 1 in {above}"
     return text
@@ -263,10 +261,9 @@ def first_screen(table: pd.DataFrame, shares=None) -> list[str]:
     accepted for compatibility and unused: the Poisson numbers come from the table's rows."""
     controls = [c for c in dict.fromkeys(table["control"]) if c != "primary"]
     sentences = [poisson_answer(table), ftle_answer(table),
-                 "Each cell: the kicked/two-disk ratio's range over every control (listed "
-                 "below the table) and both families; ✓ with its verdict when all agree in "
-                 "verdict and direction, else the control that changes it most, both numbers "
-                 "(↕: above 1 under one control, below 1 under another)."]
+                 "Each cell: the kicked/two-disk ratio's range over every control (below the "
+                 "table) and family, ✓ when all agree in verdict and direction, else the "
+                 "control that changes it, both numbers (↕: crosses 1)."]
     lines = [" ".join(s for s in sentences if s), ""]
     lines += markdown_table(overview_table(table))
     kinetic = table[table["system"].isin(["poisson_kinetic", "uniform_kinetic"])]
