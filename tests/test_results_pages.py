@@ -12,7 +12,7 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
-from kicktimes.stats import ratio_verdict, rejection_verdict
+from kicktimes.stats import poisson_verdict, ratio_verdict, rejection_verdict
 
 RESULTS = Path(__file__).resolve().parents[1] / "docs" / "results"
 TABLES = sorted(RESULTS.glob("*_findings.csv"))
@@ -30,8 +30,26 @@ def test_every_verdict_is_the_one_its_interval_gives(path):
     poisson = table["question"] == "Poisson collision times?"
     for row in table[~poisson].itertuples():
         assert row.verdict == ratio_verdict(row.ci_low, row.ci_high), row
-    for row in table[poisson].itertuples():
-        assert row.verdict == rejection_verdict(row.ci_low, row.ci_high, 0.05), row
+    # the Poisson rows: each share against its test's level in null_calibration.csv (the
+    # runs' own Poisson control streams; alpha for the first-collisions row), D in the
+    # ratio band, and the one standard of the two
+    null = pd.read_csv(RESULTS / "null_calibration.csv")
+    null = null[null["study"] == "paper"].set_index(["data", "test"])["share"]
+    rows = table[poisson]
+    for row in rows.itertuples():
+        data = row.family if row.control == "primary" else f"{row.family}-{row.control}"
+        kind, _, test = row.diagnostic.partition("@")
+        if kind == "reject":
+            level = null.get((data, test), 0.05)
+            assert row.verdict == rejection_verdict(row.ci_low, row.ci_high, level), row
+        elif kind == "dispersion_index":
+            assert row.verdict == ratio_verdict(row.ci_low, row.ci_high), row
+        else:
+            assert kind == "poisson", row
+            d = rows[(rows["diagnostic"] == "dispersion_index")
+                     & (rows["control"] == row.control)].iloc[0]
+            assert row.verdict == poisson_verdict(row.ci_low, row.ci_high, null[data, test],
+                                                  d.ci_low, d.ci_high), row
 
 
 @pytest.mark.parametrize("path", TABLES, ids=[t.name for t in TABLES])
