@@ -69,7 +69,7 @@ def test_the_ftle_checks_give_the_ratio_of_the_means_over_their_states(work):
         assert row["margin"] == check_module.MARGINS[row["check"]]
     # the page's section is the table's rows
     text = "\n".join(ftle_check_lines(work / "results" / "disks_ftle_check.csv"))
-    assert text.count("| tangent/twin | 10 |") == 2
+    assert text.count(f"| tangent/twin ({check_module.PACKING:g}) | 10 |") == 2
 
 
 def test_the_density_sweep_writes_its_means_and_its_fit(work):
