@@ -222,7 +222,7 @@ def test_a_verdict_that_changes_direction_is_never_robust():
                                   diagnostic="rr_offdiag@0.01"))
     assert set(table["verdict"]) == {"inconclusive"} and not table["robust"].any()
     cell = overview_table(table).iloc[0]["Poisson"]
-    assert cell == "↕ depends on uniform: 1.12 [1.08, 1.16] vs 0.920 [0.890, 0.950]"
+    assert cell == "↕ depends on uniform: 1.12 [1.08, 1.16] vs 0.920 [0.890, 0.950] (uniform)"
     # the control named is the one that reverses the direction, not a milder one
     table = with_robustness(_rows([("f", "primary", 0.763, 0.823),
                                    ("f", "paired_median", 0.870, 0.922),

@@ -30,10 +30,10 @@ __all__ = ["PANELS", "PAPER_CLAIMS", "SCREEN_ROWS", "answers", "first_screen", "
 
 #: what the paper says of each diagnostic (Ranković & Porter 2013), beside the table's rows
 PAPER_CLAIMS = {
-    "ftle": "“very similar” λ (Fig. 6)",
-    "rr_offdiag": "“excellent agreement” of RR at small r (Fig. 7)",
+    "ftle": "“a good approximation” (Poisson), “an excellent approximation” (actual) (Fig. 6)",
+    "rr_offdiag": "“very good agreement” of RR at small r (Fig. 7)",
     "det": "not studied",
-    "one_minus_r1": "similar R₁ (Fig. 8)",
+    "one_minus_r1": "“excellent agreement” of R₁, top; “good agreement”, bottom (Fig. 8)",
 }
 _CONTROL_WORDS = {
     "paired_median": "paired median",
@@ -89,26 +89,34 @@ def screen_cell(rows: pd.DataFrame) -> str:
     for fam in families:
         mine = rows[rows["family"] == fam]
         if not mine["robust"].all():
-            control = mine["depends_on"].iloc[0]
-            other = mine[mine["control"] == control].iloc[0]
             where = f"{_fam(fam)}: " if len(families) > 1 else ""
-            flips = (mine["ci_low"] > 1).any() and (mine["ci_high"] < 1).any()
-            mark = "↕ " if flips else ""
-            if flips:
-                # show a pair that flips: the primary against a control on the other side
-                # of 1 (or, with the primary on 1, the two extremes)
-                p = primary.loc[fam]
-                below, above = mine[mine["ci_high"] < 1], mine[mine["ci_low"] > 1]
+            p = primary.loc[fam]
+            below, above = mine[mine["ci_high"] < 1], mine[mine["ci_low"] > 1]
+            if len(below) and len(above):
+                # ↕: name every control on the other side of 1 from the primary, and show
+                # the primary against the one farthest from it (with the primary on 1, the
+                # two extremes)
                 side = below if p.ci_low > 1 else above if p.ci_high < 1 else None
-                if side is not None:
-                    other = side.loc[(side["estimate"] - 1).abs().idxmax()]
-                    control = other["control"]
-                else:
+                if side is None:
                     lo_row = below.loc[below["estimate"].idxmin()]
                     other = above.loc[above["estimate"].idxmax()]
                     return (f"↕ depends on {lo_row['control']} vs {other['control']}: "
                             f"{where}{_ci(lo_row)} vs {_ci(other)}{missing}")
-            return (f"{mark}depends on {control}: {where}{_ci(primary.loc[fam])} vs "
+                other = side.loc[(np.log(side["estimate"]) - math.log(p.estimate))
+                                 .abs().idxmax()]
+                names = ", ".join(dict.fromkeys([other["control"], *side["control"]]))
+                return (f"↕ depends on {names}: {where}{_ci(p)} vs {_ci(other)} "
+                        f"({other['control']}){missing}")
+            # the control whose verdict differs from the primary's and that moves the
+            # estimate most (not merely the first one that breaks it)
+            differ = mine[(mine["verdict"] != p.verdict) & (mine["control"] != "primary")
+                          & np.isfinite(mine["estimate"]) & (mine["estimate"] > 0)]
+            if len(differ):
+                other = differ.loc[(np.log(differ["estimate"]) - math.log(p.estimate))
+                                   .abs().idxmax()]
+            else:
+                other = mine[mine["control"] == mine["depends_on"].iloc[0]].iloc[0]
+            return (f"depends on {other['control']}: {where}{_ci(p)} vs "
                     f"{_ci(other)}{missing}")
     verdicts = set(primary["verdict"])
     if len(verdicts) > 1:

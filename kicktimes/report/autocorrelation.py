@@ -614,8 +614,8 @@ def effects(ctx):
         if verdict.startswith("within"):
             verdict = f"{verdict} ({BUILT_IN}: kick rate = collision rate)"
         elif predicted is not None:
-            verdict = (f"{verdict} (kick rate = collision rate predicts {fmt(predicted)}; the "
-                       "decorrelation per perturbation differs)")
+            verdict = (f"{verdict} (kick rate = collision rate predicts {fmt(predicted)}: "
+                       "the rates do not explain it)")
         out.append(
             Effect.of_ratio(
                 "Lag-1 ACF of boundary angles",

@@ -52,7 +52,7 @@ from kicktimes.report.controls import diagnostics_of
 from kicktimes.stats import bootstrap_nanmedians
 
 __all__ = ["ACTUAL_FACTORIAL", "FACTORIAL", "NO_GAP", "STEPS", "gap_decomposition",
-           "gap_figure", "gap_summary", "merge_control_gaps"]
+           "gap_everywhere", "gap_figure", "gap_summary", "merge_control_gaps"]
 
 #: the kinetic-rate factorial's systems: (uniform, Poisson), (scatter, Poisson),
 #: (uniform, kinetic), (scatter, kinetic)
@@ -265,6 +265,18 @@ def merge_control_gaps(tables) -> pd.DataFrame:
     return pd.concat(out, ignore_index=True)
 
 
+def gap_everywhere(table: pd.DataFrame) -> dict:
+    """Per ``(family, diagnostic)``, ``""`` when the paper's gap exists under every control
+    (the only case decomposed on the pages: a gap that one control removes is inside its
+    own noise), else the first control without a gap."""
+    out = {}
+    shares = table[table["quantity"] == STEPS[0]]
+    for key, part in shares.groupby(["family", "diagnostic"], sort=False, observed=True):
+        missing = part.loc[~np.isfinite(part["estimate"]), "control"]
+        out[key] = str(missing.iloc[0]) if len(missing) else ""
+    return out
+
+
 def _sides(part, step):
     """Per control the side of 0 of the share's CI (1, -1, 0 straddles, None no gap)."""
     sides = {}
@@ -278,23 +290,22 @@ def _sides(part, step):
 
 def gap_figure(table: pd.DataFrame):
     """The Shapley shares of the paper's gap closed by each tested ingredient (deflection
-    law; kinetic-rate timing; actual-times timing), one panel per diagnostic that has a gap
-    in some family (primary setting: uniform-time samples for recurrence), with their 95 %
-    CIs (bootstrap clustered on ICs), families side by side. What is left (one minus the
-    shares) is not drawn: no ingredient of it is tested. A share whose sign is not the same
-    under every control is drawn hollow and marked ✗. One y scale for all."""
+    law; kinetic-rate timing; actual-times timing), one panel per diagnostic whose gap
+    exists under every control in some family (`gap_everywhere`; primary setting:
+    uniform-time samples for recurrence), with their 95 % CIs (bootstrap clustered on
+    ICs), families side by side. What is left (one minus the shares) is not drawn: no
+    ingredient of it is tested. A share whose sign is not the same under every control is
+    drawn faded and marked ✗. One y scale for all."""
     from matplotlib.figure import Figure
     from matplotlib.lines import Line2D
 
     from kicktimes.report.answers import PANELS
 
-    primary = table[table["control"] == "primary"]
-    with_gap = set(primary.loc[primary["quantity"].isin(INGREDIENTS)
-                               & np.isfinite(primary["estimate"]), "diagnostic"])
+    with_gap = {d for (_, d), missing in gap_everywhere(table).items() if not missing}
     panels = [(d, t) for d, t in PANELS if d in with_gap]
     steps = [s for s in INGREDIENTS if s in set(table["quantity"]) and s != STEPS[3]]
     families = list(dict.fromkeys(table["family"]))
-    fig = Figure(figsize=(3.2 * max(len(panels), 1), 4.1), layout="constrained")
+    fig = Figure(figsize=(max(3.4 * len(panels), 8.0), 4.3), layout="constrained")
     axes = fig.subplots(1, max(len(panels), 1), squeeze=False, sharey=True)[0]
     colours = ("tab:red", "tab:purple", "tab:green")
     short = ("deflection", "kinetic-rate\ntiming", "actual-times\ntiming")
@@ -302,7 +313,10 @@ def gap_figure(table: pd.DataFrame):
         ax.axhline(0.0, color="0.5", linewidth=0.8, zorder=0)
         ax.axhline(1.0, color="0.8", linewidth=0.8, linestyle=":", zorder=0)
         part = table[table["diagnostic"] == diagnostic]
+        everywhere = gap_everywhere(table)
         for f, family in enumerate(families):
+            if everywhere.get((family, diagnostic), "none"):
+                continue  # this family's gap vanishes under some control
             fam = part[part["family"] == family]
             rows = fam[fam["control"] == "primary"].set_index("quantity")
             for i, step in enumerate(steps):
@@ -314,7 +328,7 @@ def gap_figure(table: pd.DataFrame):
                 x = i + 0.22 * (f - (len(families) - 1) / 2)
                 ax.errorbar([x], [est], yerr=[[max(est - lo, 0.0)], [max(hi - est, 0.0)]],
                             fmt="os"[f % 2], color=colours[i], capsize=2.5, ms=5,
-                            mfc=colours[i] if robust else "white")
+                            alpha=1.0 if robust else 0.45)
                 if not robust:
                     ax.annotate("✗", (x, hi), textcoords="offset points", xytext=(0, 3),
                                 ha="center", fontsize="small", color=colours[i])
@@ -329,13 +343,13 @@ def gap_figure(table: pd.DataFrame):
     axes[0].set_ylabel("share of the paper's gap |log(kicked / two-disk)|")
     handles = [Line2D([], [], color="k", marker="os"[f % 2], linestyle="none", label=fam)
                for f, fam in enumerate(families)]
-    handles.append(Line2D([], [], color="k", marker="o", mfc="white", linestyle="none",
-                          label="✗ hollow: the sign changes or the CI contains 0 under some "
+    handles.append(Line2D([], [], color="k", marker="o", alpha=0.45, linestyle="none",
+                          label="✗ faded: the sign changes or the CI contains 0 under some "
                                 "control"))
-    fig.legend(handles=handles, loc="outside lower center", ncol=max(len(handles), 1),
+    fig.legend(handles=handles, loc="outside lower center", ncol=len(handles),
                fontsize="small")
-    fig.suptitle("Shares of the paper's kicked-disk gap closed by each ingredient (Shapley, "
-                 "95 % CI; diagnostics with a gap)", fontsize="medium")
+    fig.suptitle("Share of the paper's gap closed by each ingredient\n(Shapley, 95 % CI; "
+                 "gaps present under every control)", fontsize="medium")
     return fig
 
 

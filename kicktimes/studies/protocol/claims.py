@@ -134,16 +134,18 @@ def _family_claim(findings_dir, family, diagnostic, system, control, claim, word
 def _closer(ratios, panel, reading):
     """|log R_poisson| - |log R_actual| under ``reading``: point, 95 % CI and verdict
     (negative: the Poisson kicks are closer to the two-disk value). The verdict applies
-    the 10 % band to ``exp`` of the difference: *equally close* when the two distances
-    from 1 differ by less than a factor 1.1 either way (an equivalence test), *Poisson* /
-    *actual closer* when the CI lies beyond it."""
+    the 10 % band to ``exp`` of the difference of the two log-distances, which for two
+    ratios on the same side of 1 is the ratio of the two kicked values: *equally close*
+    when they agree within 10 % (an equivalence test; not the ratio of the two distances,
+    which is unstable when both are small), *Poisson* / *actual closer* when the CI lies
+    beyond the band."""
     _, op, dp = ratios.ratio(panel, "poisson", reading)
     _, oa, da = ratios.ratio(panel, "actual", reading)
     point = abs(math.log(op["ratio"])) - abs(math.log(oa["ratio"]))
     with np.errstate(invalid="ignore", divide="ignore"):
         diff = np.abs(np.log(dp)) - np.abs(np.log(da))
     lo, hi = np.percentile(diff[np.isfinite(diff)], [2.5, 97.5])
-    # the ratio of the two distances from 1, exp(difference), through the 10 % band
+    # exp(difference of log-distances): the ratio of the two kicked values, through the band
     verdict = {"within 10 %": "equally close", "lower": "Poisson closer",
                "higher": "actual closer"}.get(ratio_verdict(math.exp(lo), math.exp(hi)),
                                               "inconclusive")
