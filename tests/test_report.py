@@ -314,7 +314,10 @@ def test_every_finding_has_an_effect_a_confidence_interval_and_a_ruled_verdict(b
             w in row.verdict for w in ("Poisson", "model", "majority", "exponential")
         )
     acf = table[table["question"].str.startswith("Lag-1 ACF")]
-    assert acf["verdict"].str.contains("built in").all()  # never a confirmation
+    # never a confirmation: an agreement is marked built in, a difference is set beside the
+    # rate-matching prediction
+    assert (acf["verdict"].str.contains("built in")
+            | acf["verdict"].str.contains("kick rate = collision rate predicts")).all()
 
 
 def test_the_ftle_finding_is_the_mean_over_radii_of_the_ratio_of_means(built, store_path):

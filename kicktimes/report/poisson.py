@@ -506,7 +506,8 @@ def null_calibration(name, rejections, per_ic, *, alpha, rng, n_boot=2000) -> pd
         rows.append({"data": name, "test": test, "design": NULL_DESIGN, "alpha": alpha,
                      "n_runs": n, "n_clusters": clusters, "share": k / n, "ci_low": low,
                      "ci_high": high})
-    return pd.DataFrame(rows)
+    return pd.DataFrame(rows, columns=["data", "test", "design", "alpha", "n_runs",
+                                       "n_clusters", "share", "ci_low", "ci_high"])
 
 
 def null_level(null, test, alpha) -> float:

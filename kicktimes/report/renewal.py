@@ -317,6 +317,8 @@ def _small_n_words(fitted, share_long, coll, ctx):
     """The caption's words on how few ICs stand behind each share of fig09 (a)."""
     n_fit = fitted.groupby("radius", observed=True)["ic"].nunique()
     n_all = coll.groupby("radius", observed=True)["ic"].nunique()
+    if n_fit.empty or n_all.empty:
+        return "no IC had enough intervals for the comparison"
     lo, hi = int(n_fit.min()), int(n_fit.max())
     n = str(lo) if lo == hi else f"{lo}–{hi}"
     width = (share_long["ci_high"] - share_long["ci_low"]).to_numpy(float)

@@ -28,9 +28,9 @@ See ``docs/statistics.md`` for the conventions.
 from .analyze import Analysis, analyze
 from .comparison import VuongResult, compare_models, vuong
 from .counts import CountRegression, kinetic_rate, regress_counts
+from .dilute import dilute_tagged_times
 from .distributions import hyperexpon
 from .ensemble import PoissonEnsembleResult, test_poisson_ensemble
-from .dilute import dilute_tagged_times
 from .enskog import contact_value, enskog_frequency, speed_rate_factor
 from .findings import (
     Finding,

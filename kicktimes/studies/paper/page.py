@@ -355,7 +355,7 @@ def write_results(
             findings, secs, notes = analyse(ctx, bar=bar, timings=[],
                                             only=CONTROL_STAGES if is_control else None)
             paper, scale = scale_statement(st)
-            if ctx.found.null_calibration is not None:
+            if ctx.found.null_calibration is not None and len(ctx.found.null_calibration):
                 nulls.append(ctx.found.null_calibration)
             if ctx.found.gaps is not None and not ctx.found.gaps.empty:
                 gaps.append(ctx.found.gaps)

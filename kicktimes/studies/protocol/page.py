@@ -242,8 +242,8 @@ def build_page(rows: pd.DataFrame, results_dir: str | os.PathLike, findings_dir:
         "two log-distances from 1, and the 10 % band on exp(d) (for two ratios on the same "
         "side of 1 it is the ratio of the two kicked values: equally close when the Poisson- "
         "and actual-kicked values agree within 10 %; a CI of d that excludes 0 inside the "
-        "band is a real but smaller difference). The count rows come from the paper study's findings, "
-        "under its controls.", "",
+        "band is a real but smaller difference). The count rows come from the paper "
+        "study's findings, under its controls.", "",
         "## Fig. 6, both readings", "",
         f"![Fig. 6 reproduced]({FIGURE})", "",
         "Left: eq. (4) as printed; right: Benettin's algorithm. Rows: the paper's two "
