@@ -71,6 +71,18 @@ def _fam(family):
     return _FAMILY_SHORT.get(family, family)
 
 
+def _farthest(estimates: pd.Series, reference: float):
+    """The index of the estimate farthest from ``reference`` in log scale (the largest
+    ratio either way), or of the first when the reference is not a positive number."""
+    x = estimates.astype(float)
+    ok = np.isfinite(x) & (x > 0)
+    if not ok.any():
+        return None if x.empty else x.index[0]
+    if not (np.isfinite(reference) and reference > 0):
+        return x[ok].index[0]
+    return (np.log(x[ok]) - math.log(reference)).abs().idxmax()
+
+
 def screen_cell(rows: pd.DataFrame) -> str:
     """One cell of the first screen: a comparison over every control and family.
 
@@ -86,6 +98,8 @@ def screen_cell(rows: pd.DataFrame) -> str:
     if (rows["system"].iloc[0] in ("poisson_kinetic", "uniform_kinetic")
             and "elastic" not in set(rows["control"])):
         missing = " (mirror rule only)"
+    rows = rows.assign(estimate=pd.to_numeric(rows["estimate"], errors="coerce"))
+    primary = rows[rows["control"] == "primary"].set_index("family")
     for fam in families:
         mine = rows[rows["family"] == fam]
         if not mine["robust"].all():
@@ -102,8 +116,7 @@ def screen_cell(rows: pd.DataFrame) -> str:
                     other = above.loc[above["estimate"].idxmax()]
                     return (f"↕ depends on {lo_row['control']} vs {other['control']}: "
                             f"{where}{_ci(lo_row)} vs {_ci(other)}{missing}")
-                other = side.loc[(np.log(side["estimate"]) - math.log(p.estimate))
-                                 .abs().idxmax()]
+                other = side.loc[_farthest(side["estimate"], p.estimate)]
                 names = ", ".join(dict.fromkeys([other["control"], *side["control"]]))
                 return (f"↕ depends on {names}: {where}{_ci(p)} vs {_ci(other)} "
                         f"({other['control']}){missing}")
@@ -111,9 +124,8 @@ def screen_cell(rows: pd.DataFrame) -> str:
             # estimate most (not merely the first one that breaks it)
             differ = mine[(mine["verdict"] != p.verdict) & (mine["control"] != "primary")
                           & np.isfinite(mine["estimate"]) & (mine["estimate"] > 0)]
-            if len(differ):
-                other = differ.loc[(np.log(differ["estimate"]) - math.log(p.estimate))
-                                   .abs().idxmax()]
+            if len(differ) and _farthest(differ["estimate"], p.estimate) is not None:
+                other = differ.loc[_farthest(differ["estimate"], p.estimate)]
             else:
                 other = mine[mine["control"] == mine["depends_on"].iloc[0]].iloc[0]
             return (f"depends on {other['control']}: {where}{_ci(p)} vs "
