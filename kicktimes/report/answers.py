@@ -73,14 +73,19 @@ def _fam(family):
 
 def _farthest(estimates: pd.Series, reference: float):
     """The index of the estimate farthest from ``reference`` in log scale (the largest
-    ratio either way), or of the first when the reference is not a positive number."""
+    ratio either way; of equal ones, to 1e-9, the first), or of the first when the
+    reference is not a positive number."""
     x = estimates.astype(float)
     ok = np.isfinite(x) & (x > 0)
     if not ok.any():
         return None if x.empty else x.index[0]
     if not (np.isfinite(reference) and reference > 0):
         return x[ok].index[0]
-    return (np.log(x[ok]) - math.log(reference)).abs().idxmax()
+    distance = (np.log(x[ok]) - math.log(reference)).abs()
+    # ties (equal to rounding: the same value from two controls) go to the first control
+    # in the table's order, whatever the last bits of each library version
+    top = distance[distance >= distance.max() - 1e-9 * max(1.0, float(distance.max()))]
+    return top.index[0]
 
 
 def screen_cell(rows: pd.DataFrame) -> str:
