@@ -412,9 +412,8 @@ def clustered_share(per_ic, column, alpha, *, rng, n_boot=2000, level=0.95):
     """95 % CI of the share of runs with ``per_ic[column] < alpha``, by a bootstrap
     clustered on ICs.
 
-    The runs of one IC at different radii start from the same initial condition, so they
-    are not independent: one resample draws IC indices with replacement and takes all
-    their runs; the share is ``rejections / runs tested`` of the resample (percentile CI).
+    The share is :func:`clustered_mean` of the flags ``p < alpha`` over the runs whose
+    ``p`` is finite (``rejections / runs tested`` of each resample, percentile CI).
 
     Examples
     --------
@@ -425,25 +424,21 @@ def clustered_share(per_ic, column, alpha, *, rng, n_boot=2000, level=0.95):
     >>> bool(low < 0.2 < high)
     True
     """
-    table = per_ic.pivot_table(index="ic", columns="radius", values=column, dropna=False,
-                                observed=True)
-    p = table.to_numpy(float)
-    tested = np.isfinite(p).sum(axis=1).astype(float)
-    rejected = (np.where(np.isfinite(p), p, 1.0) < alpha).sum(axis=1).astype(float)
-    if tested.sum() == 0:
-        return math.nan, math.nan
-    n = tested.size
-    counts = rng.multinomial(n, np.full(n, 1.0 / n), size=n_boot).astype(float)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        boot = (counts @ rejected) / (counts @ tested)
-    boot = boot[np.isfinite(boot)]
-    a = (1 - level) / 2 * 100
-    return float(np.percentile(boot, a)), float(np.percentile(boot, 100 - a))
+    p = per_ic[column].to_numpy(float)
+    flags = per_ic.assign(**{column: np.where(np.isfinite(p), (p < alpha).astype(float),
+                                              np.nan)})
+    _, low, high = clustered_mean(flags, column, rng=rng, n_boot=n_boot, level=level)
+    return low, high
 
 
 def clustered_mean(per_ic, column, *, rng, n_boot=2000, level=0.95):
     """``(mean, low, high)``: the mean of the finite ``per_ic[column]`` over runs and its
-    percentile CI from a bootstrap clustered on ICs (as :func:`clustered_share`).
+    percentile CI from a bootstrap clustered on ICs.
+
+    The runs of one IC at different radii start from the same initial condition, so they
+    are not independent: one resample draws IC indices with replacement and takes all
+    their runs; its mean is the ratio of the sums ``sum(values) / runs`` (NaN runs left
+    out). :func:`clustered_share` is this mean of the rejection flags.
 
     Examples
     --------
