@@ -12,7 +12,7 @@ from kicktimes.cli import main
 from kicktimes.diagnostics import lyapunov
 from kicktimes.report.effects import paired_ratio
 from kicktimes.studies.protocol.compute import D0, Panel, compute_task, run_rows, tasks
-from kicktimes.studies.protocol.page import FIGURE, build_page
+from kicktimes.studies.protocol.page import FIGURE, build_page, fig6_figure
 from kicktimes.studies.protocol.tables import _shapley
 
 PANELS = (
@@ -125,6 +125,25 @@ def test_the_page_states_each_claim_from_its_tables(rows, tmp_path):
     assert re.search(rf"kicked/two-disk {re.escape(low)}", first_screen)
     for name in ("paper_by_radius.csv", "paper_shapley.csv", "paper_convergence.csv"):
         assert not pd.read_csv(tmp_path / name).empty
+
+
+def test_fig6_zooms_the_literal_column_on_its_data_and_says_so():
+    # the eq. (4)-as-printed values differ by ~1.5 % of ~37: from 0 they would look equal
+    frames = []
+    for system, level in (("two_particle", 37.5), ("poisson", 37.0), ("actual", 36.9)):
+        for estimator, scale in (("literal", 1.0), ("renormalised", 0.002)):
+            frames.append(pd.DataFrame({
+                "panel": "family_a", "radius": [0.012, 0.024], "system": system,
+                "estimator": estimator, "measure": "paper", "twin_kicks": "shared",
+                "kick_angle": "uniform", "mean": level * scale, "sd": 0.5 * scale,
+                "n": 200, "paper_bar": 0.05 * scale}))
+    fig = fig6_figure(pd.concat(frames, ignore_index=True), PANELS[:1])
+    literal, renormalised = fig.axes[0], fig.axes[1]
+    low, high = literal.get_ylim()
+    assert 36.5 < low < 36.9 and 37.5 < high < 38.5
+    assert any("not 0" in t.get_text() and f"{low:.3g}" in t.get_text() for t in literal.texts)
+    assert renormalised.get_ylim()[0] == 0.0
+    assert not renormalised.texts
 
 
 def test_findings_belong_to_the_protocol_study(tmp_path):
