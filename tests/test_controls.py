@@ -243,7 +243,7 @@ def test_a_robust_cell_gives_its_verdict_and_the_range_over_every_control_and_fa
 
 
 def test_the_poisson_question_is_a_row_per_test_with_the_rule_as_a_control():
-    from kicktimes.report.answers import first_screen
+    from kicktimes.report.answers import poisson_answer, qa_table
     from kicktimes.report.controls import POISSON_QUESTION, merge_control_families, poisson_rows
 
     rej = pd.DataFrame({"radius": [0.01, 0.02] * 2,
@@ -280,15 +280,21 @@ def test_the_poisson_question_is_a_row_per_test_with_the_rule_as_a_control():
     head = table[table["diagnostic"] == "reject@uniformity_ks"]
     assert not head["robust"].all()  # above nominal under one rule only
     assert table[table["diagnostic"] == "reject@ljung_box"]["robust"].all()  # nominal twice
-    text = first_screen(table)[0]
+    text = poisson_answer(table)
     assert text.startswith("Poisson collision times? Mirror rule: not Poisson (uniformity "
                            "rejected in 39.0 %")
     assert "against null streams 8.0 % (A)" in text
     assert "elastic rule: inconclusive (13.0 %" in text and "disjoint" in text
+    # the first screen's question: not robust, the elastic rule decides it
+    row = qa_table(table).iloc[0]
+    assert row["question"] == "Are the two disks' collision times Poisson?"
+    assert row["answer"].startswith("no under the primary, not under every control")
+    assert row["robust?"] == "✗" and row["deciding control"] == "elastic"
+    assert "39 % of runs reject uniformity (null streams: 8.0 % (A))" in row["number"]
 
 
-def test_the_first_screen_is_at_most_three_sentences_and_a_table_of_at_most_8_columns():
-    from kicktimes.report.answers import first_screen
+def test_the_first_screen_is_a_table_of_questions_then_a_table_of_at_most_8_columns():
+    from kicktimes.report.answers import QUESTIONS, first_screen
     from kicktimes.report.controls import with_robustness
 
     spec = []
@@ -300,10 +306,20 @@ def test_the_first_screen_is_at_most_three_sentences_and_a_table_of_at_most_8_co
                 spec.append((fam, c, system))
     rows = pd.concat([_rows([(f, c, 0.3, 0.33)], system=s) for f, c, s in spec],
                      ignore_index=True)
+    # one control breaks the scatter kicks' verdict
+    broken = (rows["system"] == "poisson_scatter") & (rows["control"] == "elastic")
+    rows.loc[broken, ["estimate", "ci_low", "ci_high"]] = [0.95, 0.93, 0.97]
+    rows.loc[broken, "verdict"] = "within 10 %"
     lines = first_screen(with_robustness(rows))
-    prose = lines[0]
-    assert len(prose) <= 1200 and prose.count(". ") <= 2
-    header = lines[2]
+    assert lines[0] == "| question | answer | number | robust? | deciding control |"
+    qa = lines[2:lines.index("")]
+    assert len(qa) == 2  # no Poisson rows and one diagnostic here: the two FTLE questions
+    assert qa[0] == (f"| {QUESTIONS[0][0]} | no: lower | 0.315 | ✓ | none of 6 |")
+    assert qa[1].startswith(f"| {QUESTIONS[1][0]} | no: lower under the primary, not under "
+                            "every control | primary 0.315; elastic 0.315–0.95 | ✗ | elastic |")
+    rest = lines[lines.index("") + 1:]
+    assert len(rest[0]) <= 300  # one sentence on reading the detailed table
+    header = rest[2]
     assert header.count("|") - 1 <= 8
 
 
