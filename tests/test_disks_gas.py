@@ -305,6 +305,29 @@ def test_the_kicked_comparison_gives_ratios_with_verdicts(tmp_path):
     assert (ftle["value"] <= ftle["value_high"]).all()
     per = tab[tab["diagnostic"] == "ftle/rate"]
     assert {"gas/gas", "poisson/gas", "actual/gas"} <= set(per["system"])
+    # the kicks' rate against a density table of the same gas: the ratio of the two rates
+    # with the two intervals combined, and its verdict at the 2 % margin
+    from kicktimes.studies.disks.kicked import kicked_rate_check
+
+    rates = per[per["system"] == "gas/gas"].set_index("n_disks")["reference"]
+    density = pd.DataFrame({"rule": exp.rule, "geometry": exp.geometry_label,
+                            "n_disks": [2, 5], "rate": [rates[2] * 1.01, rates[5] / 1.5],
+                            "enskog": 1.0, "rate_enskog_low": [rates[2] * 0.99, 0.1],
+                            "rate_enskog_high": [rates[2] * 1.03, 10.0]})
+    check = kicked_rate_check(tab, density, exp).set_index("n_disks")
+    assert check.loc[2, "ratio"] == pytest.approx(1 / 1.01)
+    assert check.loc[5, "ratio"] == pytest.approx(1.5)
+    assert check.loc[5, "verdict"] == "inconclusive"  # the density rate's interval: 100x
+    assert (check["states"] == 3).all()
+    assert (check["ratio_low"] < check["ratio"]).all()
+    assert (check["ratio"] < check["ratio_high"]).all()
+
+
+def test_few_disks_get_more_kicked_states_when_they_get_more_runs():
+    exp = dataclasses.replace(TINY, n_disks=[2, 3, 300], n_tagged=600, min_runs=4,
+                              kicked_runs=250)
+    assert [exp.kicked_states(n) for n in (2, 3, 300)] == [250, 200, 4]
+    assert [exp.n_runs(n) for n in (2, 3, 300)] == [600, 200, 4]
 
 
 def test_the_n2_row_is_checked_against_the_two_disk_simulator(reference, tmp_path):

@@ -279,7 +279,7 @@ def execute_disks_task(experiment: DisksExperiment, task: DisksTask):
                             ("energy", float(np.mean(np.sum(v * v, axis=1)))),
                             ("speed_known", known)):
             results.append((n, r, k, "disks", name, float(value), ""))
-        if k < experiment.kicked_runs:
+        if k < experiment.kicked_states(n):
             for system, name, value in kicked_rows(experiment, n, k):
                 results.append((n, r, k, system, name, value, ""))
         for m, d in enumerate(tagged):

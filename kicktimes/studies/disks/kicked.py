@@ -12,15 +12,18 @@ its table exists.
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 
 from kicktimes.experiment.disks_tasks import KICKED_THEILER
 from kicktimes.stats import format_interval, ratio_verdict
 
-__all__ = ["FTLE_CHECK_COLUMNS", "KICKED_NAMES", "ftle_check_lines", "kicked_answer",
-           "kicked_ftle_cells", "kicked_not_chaotic", "kicked_section", "scatter_answer"]
+__all__ = ["FTLE_CHECK_COLUMNS", "KICKED_NAMES", "RATE_MARGIN", "ftle_check_lines",
+           "kicked_answer", "kicked_ftle_cells", "kicked_not_chaotic", "kicked_rate_check",
+           "kicked_rate_lines", "kicked_section", "scatter_answer"]
 
 KICKED_NAMES = {"ftle": "FTLE λ", "acf@1": "boundary-angle ACF R₁", "rr": "recurrence rate"}
 #: the kicked systems the tables show, in order, with their page names
@@ -29,6 +32,11 @@ SYSTEM_NAMES = {"poisson": "Poisson-kicked", "actual": "actual-kicked",
 #: the columns of disks_ftle_check.csv
 FTLE_CHECK_COLUMNS = ("check", "n_disks", "rule", "packing", "n_ics", "t_max", "estimate",
                       "lo", "hi", "margin", "verdict")
+
+
+#: the margin, stated before the run, within which the kicked comparison's rate must equal
+#: the density table's (disks.csv) at every N
+RATE_MARGIN = 0.02
 
 
 def _systems(kicked):
@@ -72,6 +80,18 @@ def _per_collision(row):
 
 def _ftle(row):
     return format_interval(row["value"], row["value_low"], row["value_high"], edges=(0.0,))
+
+
+def _states_words(kicked):
+    """The kicked states per N, in words: ``"16"`` or ``"1000 (N = 2) to 16 (N = 1000)"``."""
+    f = kicked[(kicked["system"] == "gas/gas") & (kicked["diagnostic"] == "ftle/rate")]
+    states = f.set_index("n_disks")["n_runs"].sort_index()
+    if states.empty:
+        return "0"
+    if states.nunique() == 1:
+        return str(int(states.iloc[0]))
+    return (f"{int(states.iloc[0])} (N = {states.index[0]}) to {int(states.iloc[-1])} "
+            f"(N = {states.index[-1]})")
 
 
 def _method(exp):
@@ -204,7 +224,85 @@ def kicked_ftle_cells(kicked, n) -> list:
     return out
 
 
-def kicked_section(kicked, exp) -> list:
+def kicked_rate_check(kicked, table, exp) -> pd.DataFrame:
+    """The kicked comparison's rate against the density table's, N by N.
+
+    The Poisson and scatter kicks, and λ / ν, use the kicked states' own gas collision
+    frequency (`DisksExperiment.kicked_rate`); the density table (``disks.csv``) measures
+    the same gas (N, packing, rule) in independent runs. Their ratio's 95 % interval
+    combines the two intervals on the log scale (independent seeds, each interval read as
+    ±1.96 standard errors of the log rate) and gets
+    `kicktimes.stats.ratio_verdict` at `RATE_MARGIN`.
+
+    Parameters
+    ----------
+    kicked : DataFrame
+        `kicktimes.studies.disks.tables.kicked_table` (its ``gas/gas``, ``ftle/rate`` rows
+        carry the kicks' rate as ``reference``).
+    table : DataFrame
+        `kicktimes.studies.disks.tables.disks_table` rows (``disks.csv``).
+    exp : DisksExperiment
+        The kicked store's experiment: its rule and geometry pick the density rows.
+
+    Returns
+    -------
+    DataFrame
+        One row per N: ``n_disks``, ``states``, ``kicked_rate`` (``_low``, ``_high``),
+        ``density_rate`` (``_low``, ``_high``), ``ratio`` (``_low``, ``_high``),
+        ``verdict``. Empty when disks.csv has no sweep of the same gas.
+    """
+    k = kicked[(kicked["system"] == "gas/gas") & (kicked["diagnostic"] == "ftle/rate")]
+    d = table[(table["rule"] == exp.rule) & (table["geometry"] == exp.geometry_label)]
+    d = d.drop_duplicates("n_disks").set_index("n_disks")
+    rows = []
+    for _, row in k.iterrows():
+        n = int(row["n_disks"])
+        if n not in d.index:
+            continue
+        dens = d.loc[n]
+        rate = float(dens["rate"])
+        low, high = (float(dens["rate_enskog_low"] * dens["enskog"]),
+                     float(dens["rate_enskog_high"] * dens["enskog"]))
+        ratio = row["reference"] / rate
+        se = math.hypot(math.log(row["reference_high"] / row["reference_low"]),
+                        math.log(high / low)) / (2 * 1.96)
+        r_low, r_high = ratio * math.exp(-1.96 * se), ratio * math.exp(1.96 * se)
+        rows.append({"n_disks": n, "states": int(row["n_runs"]),
+                     "kicked_rate": row["reference"], "kicked_rate_low": row["reference_low"],
+                     "kicked_rate_high": row["reference_high"], "density_rate": rate,
+                     "density_rate_low": low, "density_rate_high": high, "ratio": ratio,
+                     "ratio_low": r_low, "ratio_high": r_high,
+                     "verdict": ratio_verdict(r_low, r_high, tolerance=RATE_MARGIN)})
+    return pd.DataFrame(rows)
+
+
+def kicked_rate_lines(check) -> list:
+    """The kicked section's table of `kicked_rate_check`, and one sentence reading it."""
+    if check.empty:
+        return []
+    off = check[np.abs(check["ratio"] - 1.0) > RATE_MARGIN]["n_disks"].tolist()
+    within = check[check["verdict"] == f"within {100 * RATE_MARGIN:g} %"]["n_disks"].tolist()
+    lines = ["**The kicks' rate against the density table's** "
+             "([disks_kicked_rate.csv](disks_kicked_rate.csv); the same gas in independent "
+             f"runs; margin {100 * RATE_MARGIN:g} %, stated before the run)", "",
+             "| N | states | kicks' rate | disks.csv | ratio |", "|---|---|---|---|---|"]
+    for _, r in check.iterrows():
+        kicked, density, ratio = (format_interval(r[c], r[f"{c}_low"], r[f"{c}_high"])
+                                  for c in ("kicked_rate", "density_rate", "ratio"))
+        lines.append(f"| {r['n_disks']} | {r['states']} | {kicked} | {density} | {ratio} "
+                     f"{r['verdict']} |")
+    lines += ["", ("The ratio's estimate is within "
+                   f"{100 * RATE_MARGIN:g} % at every N" if not off else
+                   f"The ratio's estimate is more than {100 * RATE_MARGIN:g} % from 1 at N = "
+                   + ", ".join(map(str, off)))
+              + "; its interval lies inside the margin at N = "
+              + (", ".join(map(str, within)) or "no N")
+              + (" (elsewhere the two rates' noise is wider than the margin: a state's rate "
+                 "varies most among few disks)" if len(within) < len(check) else "") + ".", ""]
+    return lines
+
+
+def kicked_section(kicked, exp, rate_check=None) -> list:
     """The section "Does a kicked disk reproduce a gas?"."""
     systems = _systems(kicked)
     scatter = (
@@ -225,7 +323,7 @@ def kicked_section(kicked, exp) -> list:
         "## Does a kicked disk reproduce a gas?", "",
         f"The paper's question for a gas ({exp.geometry_label}, {exp.rule} rule; store "
         f"`{exp.name}`): one disk of a gas, followed for {exp.kicked_time:g} mean free "
-        f"times in {exp.kicked_runs} states per N, against one disk from its initial state "
+        f"times in {_states_words(kicked)} states per N, against one disk from its initial state "
         f"kicked with uniform new directions at Poisson times of ν, {_rate_words(exp)} "
         "(poisson), or at its "
         f"collision times (actual).{scatter} The gas's FTLE is the whole gas's largest "
@@ -250,6 +348,7 @@ def kicked_section(kicked, exp) -> list:
         "system's). An ACF needs enough wall hits: at large N the disk seldom reaches the "
         "wall in this time, and states without a value are left out "
         "([disks_kicked.csv](disks_kicked.csv), column n_runs).", "",
+        *(kicked_rate_lines(rate_check) if rate_check is not None else []),
         *_ftle_table(kicked, systems),
         *_other_table(kicked, systems)]
 

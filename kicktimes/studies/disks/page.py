@@ -49,6 +49,7 @@ from kicktimes.studies.disks.kicked import (
     ftle_check_lines,
     kicked_answer,
     kicked_not_chaotic,
+    kicked_rate_check,
     kicked_section,
     scatter_answer,
 )
@@ -446,8 +447,12 @@ def write_disks_page(store_paths, out_dir, *, command="kicktimes reproduce --stu
     hazard = pd.concat([disks_hazard(st) for st in stores], ignore_index=True)
     kicked = (pd.concat([kicked_table(st, n_boot=n_boot, seed=42) for st in kicked_stores],
                         ignore_index=True) if kicked_stores else pd.DataFrame())
+    rate_check = pd.DataFrame()
     if not kicked.empty:
         kicked.to_csv(out / "disks_kicked.csv", index=False)
+        rate_check = kicked_rate_check(kicked, table, kicked_stores[0].experiment)
+        if not rate_check.empty:
+            rate_check.to_csv(out / "disks_kicked_rate.csv", index=False)
     checks = []
     for two in two_stores:
         # the engine's store of a two-disk reference "disks-two-<x>" is "disks-<x>" if given,
@@ -606,7 +611,7 @@ def write_disks_page(store_paths, out_dir, *, command="kicktimes reproduce --stu
             ""]
     lines += renewal_lines(renewal)
     if not kicked.empty:
-        lines += kicked_section(kicked, kicked_stores[0].experiment)
+        lines += kicked_section(kicked, kicked_stores[0].experiment, rate_check)
     lines += ftle_check_lines(out / "disks_ftle_check.csv")
     lines += density_lines(out / "disks_lyapunov_density.csv",
                            out / "disks_lyapunov_density_fit.csv")
