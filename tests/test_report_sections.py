@@ -424,15 +424,28 @@ def test_stretching_per_perturbation_is_mean_lambda_over_the_pooled_rate(ctx):
 def test_lyapunov_figure_shows_lambda_stretching_and_the_ln_inverse_r_relation(ctx):
     (sec,) = ctx.sections["lyapunov"]
     fig = sec.figures[0][1]
-    assert len(fig.axes) == 3
-    assert "ln(1/r)" in fig.axes[2].get_xlabel()
-    assert "nats" not in fig.axes[2].get_xlabel()  # ln(1/r) is a pure number
-    assert "nats" in fig.axes[1].get_ylabel()
-    # no legend inside the axes (it hid two-disk points); the legends are the figure's
-    assert all(ax.get_legend() is None for ax in fig.axes)
-    assert len(fig.legends) == 2
-    texts = [t.get_text() for t in fig.legends[0].get_texts()]
+    assert len(fig.axes) == 6
+    lam_uniform, lam_scatter, excess, stretch_uniform, stretch_scatter, cell = fig.axes
+    # the systems are split by kick kind (seven curves on one panel lay on each other)
+    assert "uniform kicks" in lam_uniform.get_title()
+    assert "scatter kicks" in lam_scatter.get_title()
+    assert "scatter kicks" in stretch_scatter.get_title()
+    assert lam_uniform.get_ylim() == lam_scatter.get_ylim()  # one y scale
+    # every mean inside its axes: none clipped, no clipping note
+    summary = ctx.found.summary
+    means = summary[summary["diagnostic"] == "lyapunov"]["mean"]
+    low, high = lam_uniform.get_ylim()
+    assert low < means.min() and means.max() < high
+    assert not lam_uniform.texts and not lam_scatter.texts
+    assert "ln(1/r)" in excess.get_xlabel()
+    assert "nats" not in excess.get_xlabel()  # ln(1/r) is a pure number
+    assert "nats" in stretch_uniform.get_ylabel()
+    # one legend, in its own cell: it covers no point
+    assert [ax.get_legend() is not None for ax in fig.axes] == [False] * 5 + [True]
+    assert not cell.axison and not fig.legends
+    texts = [t.get_text() for t in cell.get_legend().get_texts()]
     assert system_label("two_particle") in texts and "median over ICs" in texts
+    assert system_label("poisson_scatter") in texts
 
 
 def test_findings_section_states_the_rules_and_the_scale(ctx):

@@ -14,6 +14,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
+from matplotlib.lines import Line2D
 
 from kicktimes.report.common import REFERENCE, Section, distinct, fmt, kicked_systems, wide
 from kicktimes.report.effects import Effect, store_ratio
@@ -25,7 +26,7 @@ from kicktimes.report.figures import (
 )
 from kicktimes.report.summary import diagnostic_summary, diagnostic_vs_radius
 
-__all__ = ["stretching_table", "stretching_figure", "sections", "effects"]
+__all__ = ["SCATTER_SYSTEMS", "stretching_table", "stretching_figure", "sections", "effects"]
 
 
 def _perturbations(results, system):
@@ -75,9 +76,34 @@ def stretching_table(results) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
+#: the systems whose kicks scatter (the rule of a disk-disk collision) rather than redraw
+#: the direction by the kick-angle rule: panel (b) of fig05, the others panel (a)
+SCATTER_SYSTEMS = ("poisson_scatter", "actual_scatter", "poisson_kinetic")
+
+
+def _kick_groups(systems):
+    """``[(title, systems)]``: the two-particle system with the kick-angle systems, then
+    with the scatter-kick systems (a group with no kicked system is left out)."""
+    ref = [s for s in systems if s == REFERENCE]
+    uniform = [s for s in systems if s != REFERENCE and s not in SCATTER_SYSTEMS]
+    scatter = [s for s in systems if s in SCATTER_SYSTEMS]
+    groups = [("uniform kicks", ref + uniform), ("scatter kicks", ref + scatter)]
+    return [(name, members) for name, members in groups if len(members) > len(ref)] or [
+        ("", ref)
+    ]
+
+
 def stretching_figure(summary, table, *, title=None):
-    """(a) λ against r; (b) stretching per perturbation λ/Γ; (c) its excess in the
-    two-particle system over each kicked system against ln(1/r), with the identity line.
+    r"""The FTLE against r, split by kick kind, its stretching per perturbation and the
+    excess of a collision over a kick.
+
+    Top row: λ against r with the two-particle curve and (a) the kicked systems whose kicks
+    redraw the direction by the kick-angle rule ("uniform kicks"), (b) those whose kicks
+    scatter (``SCATTER_SYSTEMS``), on one y scale, so no curve lies on another's; (c) the
+    excess :math:`\lambda/\Gamma` of the two-particle system over each kicked system
+    against :math:`\ln(1/r)`, with the identity line. Bottom row: (d), (e) the stretching
+    per perturbation :math:`\lambda/\Gamma` of the same groups; the sixth cell holds the
+    one legend (systems in colour and marker, the same in every panel, and the error bars).
 
     Parameters
     ----------
@@ -91,66 +117,94 @@ def stretching_figure(summary, table, *, title=None):
     Returns
     -------
     matplotlib.figure.Figure
-        Three panels; every legend is outside the axes, below them (one for the systems
-        and error bars of (a) and (b), one for the differences of (c)), so no legend
-        covers a point.
+        2 x 3 cells; the legend has its own cell, so it covers no point.
     """
-    fig = Figure(figsize=(14.0, 5.6), layout="constrained")  # room for the legends below
-    ax1, ax2, ax3 = fig.subplots(1, 3)
-    diagnostic_vs_radius(summary, "lyapunov", ax=ax1, title="(a) FTLE λ", medians=True)
-    systems = [s for s in (REFERENCE, *kicked_systems(table)) if s in distinct(table, "system")]
-    for k, system in enumerate(systems):
-        part = table[table["system"] == system].sort_values("radius")
-        style = system_style(system, k)
-        ax2.plot(
-            part["radius"],
-            part["stretch_per_perturbation"],
-            marker=style["marker"],
-            color=style["color"],
-            label=system_label(system),
-        )
-    radius_axis(ax2)
-    ax2.set_ylabel("λ / Γ (nats per perturbation)")
-    ax2.set_title("(b) stretching per perturbation")
-    ax2.set_ylim(bottom=0)
+    fig = Figure(figsize=(13.0, 7.6), layout="constrained")
+    axes = fig.subplots(2, 3)
+    present = distinct(summary, "system") | distinct(table, "system")
+    systems = [s for s in (REFERENCE, *kicked_systems(table)) if s in present]
+    groups = _kick_groups(systems)
+    letters = "ab"
+    top = axes[0, :2]
+    lam_systems = distinct(summary, "system")
+    handles = {}
+    for k, (name, members) in enumerate(groups):
+        ax = top[k]
+        drawn = [s for s in members if s in lam_systems]
+        label = f"({letters[k]}) FTLE λ" + (f", {name}" if name else "")
+        if drawn:
+            diagnostic_vs_radius(summary, "lyapunov", systems=drawn, ax=ax, title=label,
+                                 medians=True)
+            legend = ax.get_legend()
+            texts = [t.get_text() for t in legend.get_texts()]
+            for h, t in zip(legend.legend_handles, texts, strict=True):
+                handles.setdefault(t, h)  # the bar and median proxies
+            legend.remove()
+        ax.set_title(label)
+    # one y scale for both groups, covering every mean, bar and median: no point is
+    # clipped (nor marked as clipped), as a single group's robust limits would do
+    shown = summary[summary["system"].isin([s for _, m in groups for s in m])]
+    reach = np.maximum(shown["paper_err"], shown["sem"])
+    ends = np.concatenate([shown["mean"] - reach, shown["mean"] + reach, shown["median"]])
+    ends = ends[np.isfinite(ends)]
+    for ax in top:
+        for note in list(ax.texts):
+            note.remove()
+        if ends.size:
+            pad = 0.05 * (ends.max() - ends.min() or abs(ends.max()) or 1.0)
+            ax.set_ylim(ends.min() - pad, ends.max() + pad)
+    if len(groups) == 1:
+        top[1].set_visible(False)
+    for k, (name, members) in enumerate(groups):
+        ax = axes[1, k]
+        for system in members:
+            part = table[table["system"] == system].sort_values("radius")
+            style = system_style(system, systems.index(system))
+            ax.plot(part["radius"], part["stretch_per_perturbation"], marker=style["marker"],
+                    color=style["color"], markersize=5, label=system_label(system))
+        radius_axis(ax)
+        ax.set_ylabel("λ / Γ (nats per perturbation)")
+        ax.set_title(f"({'de'[k]}) stretching per perturbation" + (f", {name}" if name else ""))
+        ax.set_ylim(bottom=0)
+    if len(groups) > 1:
+        top_y = max(ax.get_ylim()[1] for ax in axes[1, :2])
+        for ax in axes[1, :2]:
+            ax.set_ylim(0, top_y)
+    else:
+        axes[1, 1].set_visible(False)
+    ax3 = axes[0, 2]
     ref = table[table["system"] == REFERENCE].set_index("radius")
     grid = np.sort(ref["ln_inv_r"].to_numpy())
-    for k, system in enumerate(systems[1:], start=1):
+    # dodged along ln(1/r) by a third of the smallest gap, so equal values stay apart
+    gap = np.diff(grid).min() / 3 if grid.size > 1 else 0.0
+    kicked = systems[1:]
+    for k, system in enumerate(kicked, start=1):
         part = table[table["system"] == system].set_index("radius")
         excess = (ref["stretch_per_perturbation"] - part["stretch_per_perturbation"]).dropna()
         style = system_style(system, k)
-        ax3.plot(
-            np.log(1 / excess.index.to_numpy()),
-            excess.to_numpy(),
-            linestyle="none",
-            marker=style["marker"],
-            color=style["color"],
-            label=f"two-particle − {system_label(system)}",
-        )
+        shift = gap * ((k - 1) / max(len(kicked) - 1, 1) - 0.5)
+        ax3.plot(np.log(1 / excess.index.to_numpy()) + shift, excess.to_numpy(),
+                 linestyle="none", marker=style["marker"], markersize=5, color=style["color"])
     if grid.size:
         span = np.array([0.0, grid.max() * 1.05])
-        ax3.plot(span, span, color="grey", linestyle=":", label="ln(1/r) (identity)")
+        (identity,) = ax3.plot(span, span, color="grey", linestyle=":")
+        handles["ln(1/r), identity line of (c)"] = identity
         ax3.set_xlim(0.9 * grid.min(), 1.05 * grid.max())
     # ln(1/r) is a pure number; the identity line reads it as nats per collision
-    ax3.set_xlabel("ln(1/r), r the disk radius in table radii (dimensionless)")
+    ax3.set_xlabel("ln(1/r), r the disk radius in table radii")
     ax3.set_ylabel("excess λ/Γ (nats per perturbation)")
-    ax3.set_title("(c) excess of a collision over a kick")
-    # legends outside the axes: inside, (a)'s legend hid two-disk points at r = 0.012-0.016
-    handles, labels = ax1.get_legend_handles_labels()
-    legend = ax1.get_legend()
-    if legend is not None:  # (a)'s proxy entries (error bars, medians) follow the systems
-        texts = [t.get_text() for t in legend.get_texts()]
-        extra = [(h, t) for h, t in zip(legend.legend_handles, texts, strict=True)
-                 if t not in labels]
-        handles += [h for h, _ in extra]
-        labels += [t for _, t in extra]
-        legend.remove()
-    fig.legend(handles, labels, loc="outside lower left", ncol=4, fontsize="small",
-               title="(a), (b)", title_fontsize="small")
-    h3, l3 = ax3.get_legend_handles_labels()
-    if h3:
-        fig.legend(h3, l3, loc="outside lower right", ncol=1, fontsize="small",
-                   title="(c)", title_fontsize="small")
+    ax3.set_title("(c) two-particle λ/Γ minus each kicked one")
+    # the legend's own cell: systems first (their colour and marker in every panel)
+    cell = axes[1, 2]
+    cell.axis("off")
+    for k, system in enumerate(systems):
+        style = system_style(system, k)
+        handles[system_label(system)] = Line2D([], [], color=style["color"],
+                                               marker=style["marker"], markersize=5)
+    order = [system_label(s) for s in systems]
+    order += [t for t in handles if t not in order]
+    cell.legend([handles[t] for t in order], order, loc="center", fontsize="small",
+                frameon=False, title="systems (colour, marker) and bars", title_fontsize="small")
     if title:
         fig.suptitle(title)
     return fig
@@ -170,11 +224,16 @@ def sections(ctx):
     sec.figure(
         "fig05_lyapunov_vs_radius",
         stretching_figure(summary, table),
-        f"(a) {title} of disk 0, mean over ICs (filled, thick pale bars ± std/10 as in the "
-        "paper, thin capped bars ± s.e.m.) and median (open, dotted); (b) stretching per "
-        "perturbation λ/Γ, Γ the pooled rate of disk-disk collisions (two-particle) or kicks "
-        "(kicked); (c) two-particle minus kicked stretching per perturbation against ln(1/r), "
-        "the extra stretching a defocusing collision gives over a state-blind kick.",
+        f"(a), (b) {title} of disk 0, mean over ICs (filled, thick pale bars ± std/10 as in "
+        "the paper, thin capped bars ± s.e.m.) and median (open, dotted), with the "
+        "two-particle curve and (a) the kicked systems whose kicks redraw the direction "
+        "(uniform kicks), (b) those whose kicks scatter, on one y scale; (d), (e) stretching "
+        "per perturbation λ/Γ of the same groups, Γ the pooled rate of disk-disk collisions "
+        "(two-particle) or kicks (kicked); (c) two-particle minus kicked stretching per "
+        "perturbation against ln(1/r), in each kicked system's colour and marker, the extra "
+        "stretching a defocusing collision gives over a state-blind kick. Systems are "
+        "shifted slightly along r (along ln(1/r) in (c)) so that they do not hide each "
+        "other.",
     )
     parts = []
     ref = table[table["system"] == REFERENCE].set_index("radius")
