@@ -236,6 +236,14 @@ def test_kick_times_figure_shows_the_line_and_its_r_squared():
     assert "0.008" in fig.axes[0].get_title()
 
 
+def test_kick_times_legend_prints_a_negative_intercept_with_a_minus_sign():
+    pp = np.arange(1.0, 40.0) * 10
+    fig = plots.kick_times_vs_collision_times(pp, 1.1 * pp - 7.0, radius=0.008)
+    (label,) = [t.get_text() for t in fig.axes[0].get_legend().get_texts()
+                if t.get_text().startswith("least squares")]
+    assert "1.100 t − 7, R²" in label and "+ -" not in label
+
+
 # ------------------------------------------------------------------- counts
 
 

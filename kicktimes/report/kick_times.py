@@ -31,6 +31,21 @@ class TimesFit(NamedTuple):
     n: int
 
 
+def line_text(slope, intercept, var="t"):
+    """``slope t ± |intercept|`` with a true minus sign: ``line_text(1.102, -407)`` is
+    ``"1.102 t − 407"`` (not ``"1.102 t + -407"``).
+
+    Examples
+    --------
+    >>> line_text(1.102, -407.0)
+    '1.102 t − 407'
+    >>> line_text(0.5, 3.25)
+    '0.500 t + 3.25'
+    """
+    sign = "−" if intercept < 0 else "+"
+    return f"{slope:.3f} {var} {sign} {abs(intercept):.3g}"
+
+
 def kth_time_fit(pp_times, poisson_times) -> TimesFit:
     r"""Least-squares line of the k-th Poisson kick time on the k-th collision time.
 
@@ -100,7 +115,7 @@ def kick_times_vs_collision_times(pp_times, poisson_times, *, ax=None, radius=No
         grid,
         fit.intercept + fit.slope * grid,
         color="tab:red",
-        label=f"least squares: {fit.slope:.3f} t + {fit.intercept:.3g}, R² = {fit.r_squared:.4f}",
+        label=f"least squares: {line_text(fit.slope, fit.intercept)}, R² = {fit.r_squared:.4f}",
     )
     ax.plot(grid, grid, color="grey", linestyle=":", label="identity")
     # one level of parentheses: the unit (table radius / speed) is explained in captions
