@@ -28,7 +28,7 @@ See ``docs/statistics.md`` for the conventions.
 from .analyze import Analysis, analyze
 from .comparison import VuongResult, compare_models, vuong
 from .counts import CountRegression, kinetic_rate, regress_counts
-from .dilute import dilute_tagged_times
+from .dilute import DiluteEstimate, DiluteTaggedDisk, dilute_tagged_disk, dilute_tagged_times
 from .distributions import hyperexpon
 from .ensemble import PoissonEnsembleResult, test_poisson_ensemble
 from .enskog import contact_value, enskog_frequency, speed_rate_factor
@@ -92,6 +92,9 @@ __all__ = [
     "enskog_frequency",
     "speed_rate_factor",
     "dilute_tagged_times",
+    "dilute_tagged_disk",
+    "DiluteTaggedDisk",
+    "DiluteEstimate",
     "contact_value",
     "conditional_kinetic_rate",
     "mean_kinetic_rate",
