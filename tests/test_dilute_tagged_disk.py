@@ -139,7 +139,7 @@ def test_long_window_dispersion_matches_counts_in_disjoint_windows(elastic, d_in
     assert d.stderr < 0.003 and d.ci_low < d.value < d.ci_high
     # independent: another seed, raw counts in disjoint windows of 150 mean intervals
     # (their bias against the limit, about 0.17 / 150, is a tenth of the tolerance)
-    d_counts, se_counts = _disjoint_window_dispersion(150.0, 40_000, 7)
+    d_counts, se_counts = _disjoint_window_dispersion(150.0, 30_000, 7)
     assert se_counts < 0.01
     assert abs(d.value - d_counts) < 3.0 * math.hypot(d.stderr, se_counts)
     # and it is not the intervals' cv^2: the speed correlates successive intervals

@@ -227,12 +227,12 @@ _BURN_IN = 20
 
 @dataclass(frozen=True)
 class DiluteEstimate:
-    """A prediction of `DiluteTaggedDisk` with its error and how it was obtained.
+    """One prediction of `DiluteTaggedDisk`: the number, its error and the method.
 
     Attributes
     ----------
     quantity : str
-        What ``value`` is (``"dispersion"``, ``"dispersion, window 30"``,
+        The predicted quantity (``"dispersion"``, ``"dispersion, window 30"``,
         ``"KS share, k = 30"``).
     value : float
         The estimate (``float(estimate)`` is it).
