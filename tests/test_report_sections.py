@@ -326,9 +326,16 @@ def test_acf_curves_figure_draws_each_radius_with_the_prediction(ctx):
     fig = sec.figures[1][1]
     axes = [ax for ax in fig.axes if ax.get_visible()]
     titles = [ax.get_title() for ax in axes]
-    # per radius the curves, and below them each kicked system's difference to two disks
-    assert titles == [f"r = {r:g}" for r in RADII] + [
-        f"r = {r:g}: kicked − two-disk" for r in RADII]
+    # a column per radius; rows: the curves of the uniform-kick, then of the scatter-kick
+    # systems (each with the two-disk curve), then their differences to two disks
+    groups = ("uniform kicks", "scatter kicks")
+    assert titles == [f"r = {r:g}, {g}" for g in groups for r in RADII] + [
+        f"r = {r:g}: kicked − two-disk, {g}" for g in groups for r in RADII]
+    # at most four curves a panel (seven systems on one panel could not be told apart)
+    assert max(len(ax.get_lines()) for ax in axes) <= 4 + 4 + 1  # curves, predictions, 1/e
+    scatter_row = axes[len(RADII):2 * len(RADII)]
+    labels = {line.get_label() for ax in scatter_row for line in ax.get_lines()}
+    assert system_label("poisson_scatter") in labels and system_label("poisson") not in labels
     assert "95 %" in sec.figures[1][2] and "95 %" in sec.figures[0][2]
     table = {name: df for name, df, _, _ in sec.tables}["autocorrelation_summary"]
     assert np.allclose(table["R1_mean"], table["predicted_lag1"])

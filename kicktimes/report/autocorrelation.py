@@ -28,6 +28,7 @@ from kicktimes.report.effects import BUILT_IN, Effect, paired_ratio, ratio_verdi
 from kicktimes.report.figures import (
     _SEM_BAR,
     dodge,
+    kick_groups,
     radius_axis,
     system_label,
     system_style,
@@ -253,8 +254,9 @@ def crossings(differences) -> pd.DataFrame:
                                        "first_lag_other_sign", "clear"])
 
 
-def acf_figure(curves, predicted, *, differences=None, max_panels=6):
-    """R_l against l per radius, and each kicked system's difference to the two-disk curve.
+def acf_figure(curves, predicted, *, differences=None, max_panels=3):
+    """R_l against l at a few radii, and each kicked system's difference to the two-disk
+    curve, with the systems split by kick kind so that a panel holds at most four curves.
 
     Parameters
     ----------
@@ -267,80 +269,113 @@ def acf_figure(curves, predicted, *, differences=None, max_panels=6):
         ICs: what the report draws); default :func:`acf_differences` of ``curves`` (the
         two systems' ICs taken as independent).
     max_panels : int
-        At most this many radii (evenly chosen).
+        At most this many radii (evenly chosen, the smallest and the largest included);
+        one column each. Every radius is in the curves table.
 
     Returns
     -------
     matplotlib.figure.Figure
-        Per radius two panels, one above the other: (top, titled ``r = ...``) R_l per
-        system, mean with its 95 % interval over ICs as a band, the built-in lag-1
-        prediction as an open marker at l = 1; (below, titled ``r = ...: kicked −
-        two-disk``) each kicked system's R_l minus the two-disk R_l with its 95 % interval
-        and the zero line, where the curves cross the difference changes sign.
+        One column per radius; per kick group (`kick_groups`: the two-disk system with the
+        uniform-kick systems, then with the scatter-kick systems) a row of R_l per system,
+        mean with its 95 % interval over ICs as a band and the built-in lag-1 prediction as
+        an open marker at l ≈ 1 (titled ``r = ..., <group>``), then a row of each kicked
+        system's R_l minus the two-disk R_l with its 95 % interval and the zero line
+        (titled ``r = ...: kicked − two-disk, <group>``); where the curves cross, the
+        difference changes sign. The rows of a column share their y scale by kind.
     """
     from matplotlib.ticker import MaxNLocator
 
-    radii = np.sort(curves["radius"].unique())
-    if radii.size > max_panels:
-        radii = radii[np.unique(np.linspace(0, radii.size - 1, max_panels).round().astype(int))]
-    ncol = min(3, radii.size)
-    nblock = int(np.ceil(radii.size / ncol))
-    fig = Figure(figsize=(4.4 * ncol, 5.6 * nblock), layout="constrained")
-    grid = fig.subplots(2 * nblock, ncol, squeeze=False,
-                        gridspec_kw={"height_ratios": [3, 2] * nblock})
-    top_axes = grid[0::2].ravel()
-    diff_axes = grid[1::2].ravel()
-    pred = predicted.groupby(["radius", "system"], observed=True)["value"].mean()
+    if not isinstance(max_panels, int | np.integer) or max_panels < 1:
+        raise ValueError(f"max_panels must be an integer >= 1, got {max_panels!r}")
+    radii = _figure_radii(curves, max_panels)
     systems = [s for s in (REFERENCE, *kicked_systems(curves)) if s in distinct(curves, "system")]
+    groups = kick_groups(systems)
+    ncol = radii.size
+    rows = 2 * len(groups)
+    fig = Figure(figsize=(4.4 * ncol, 2.9 * rows + 0.8), layout="constrained")
+    grid = fig.subplots(rows, ncol, squeeze=False,
+                        gridspec_kw={"height_ratios": [3] * len(groups) + [2] * len(groups)})
+    pred = predicted.groupby(["radius", "system"], observed=True)["value"].mean()
     diffs = acf_differences(curves) if differences is None else differences
     if "ci95" not in curves.columns:
         curves = curves.assign(ci95=half_width95(curves["sem"], curves["count"]))
-    for ax, dax, r in zip(top_axes, diff_axes, radii, strict=False):
-        for k, system in enumerate(systems):
-            c = curves[(curves["radius"] == r) & (curves["system"] == system)].sort_values("lag")
-            style = system_style(system, k)
-            ax.plot(c["lag"], c["mean"], color=style["color"], marker=style["marker"],
-                    markersize=3, label=system_label(system))
-            ax.fill_between(c["lag"], c["mean"] - c["ci95"], c["mean"] + c["ci95"],
-                            color=style["color"], alpha=0.2, linewidth=0)
-            if (r, system) in pred.index:
-                # beside lag 1, shifted so it does not hide the measured value
-                ax.plot([1 - 0.25 + 0.25 * k], [pred[(r, system)]], linestyle="none",
-                        marker=style["marker"], markerfacecolor="none", markersize=7,
-                        color=style["color"])
-            if system == REFERENCE:
-                continue
-            d = diffs[(diffs["radius"] == r) & (diffs["system"] == system)].sort_values("lag")
-            dax.plot(d["lag"], d["difference"], color=style["color"], marker=style["marker"],
-                     markersize=3)
-            dax.fill_between(d["lag"], d["difference"] - d["ci95"],
-                             d["difference"] + d["ci95"], color=style["color"], alpha=0.2,
-                             linewidth=0)
-        lowest = curves.loc[curves["radius"] == r, "mean"].min()
-        if lowest < np.exp(-1):  # the 1/e level only where a curve reaches it
-            ax.axhline(np.exp(-1), color="grey", linestyle=":", linewidth=0.8)
-        dax.axhline(0.0, color="black", linewidth=0.8)
-        ax.set_title(f"r = {r:g}")
-        dax.set_title(f"r = {r:g}: kicked − two-disk", fontsize="small")
-        ax.set_ylabel(r"$R_l$ of $\theta$ (dimensionless)")
-        dax.set_ylabel(r"$\Delta R_l$ (dimensionless)")
-        dax.set_xlabel("lag l (boundary collisions)")
-        for a in (ax, dax):
-            a.xaxis.set_major_locator(MaxNLocator(integer=True))
-    for a in (*top_axes[radii.size:], *diff_axes[radii.size:]):
-        a.set_visible(False)
-    handles, labels = top_axes[0].get_legend_handles_labels()
+    for col, r in enumerate(radii):
+        for g, (name, members) in enumerate(groups):
+            ax, dax = grid[g, col], grid[len(groups) + g, col]
+            suffix = f", {name}" if name else ""
+            for system in members:
+                k = systems.index(system)
+                c = curves[(curves["radius"] == r) & (curves["system"] == system)]
+                c = c.sort_values("lag")
+                style = system_style(system, k)
+                ax.plot(c["lag"], c["mean"], color=style["color"], marker=style["marker"],
+                        markersize=3, label=system_label(system))
+                ax.fill_between(c["lag"], c["mean"] - c["ci95"], c["mean"] + c["ci95"],
+                                color=style["color"], alpha=0.2, linewidth=0)
+                if (r, system) in pred.index:
+                    # beside lag 1, shifted so it does not hide the measured value
+                    j = members.index(system)
+                    ax.plot([1 - 0.3 + 0.2 * j], [pred[(r, system)]], linestyle="none",
+                            marker=style["marker"], markerfacecolor="none", markersize=7,
+                            color=style["color"])
+                if system == REFERENCE:
+                    continue
+                d = diffs[(diffs["radius"] == r) & (diffs["system"] == system)]
+                d = d.sort_values("lag")
+                dax.plot(d["lag"], d["difference"], color=style["color"],
+                         marker=style["marker"], markersize=3)
+                dax.fill_between(d["lag"], d["difference"] - d["ci95"],
+                                 d["difference"] + d["ci95"], color=style["color"],
+                                 alpha=0.2, linewidth=0)
+            lowest = curves.loc[curves["radius"] == r, "mean"].min()
+            if lowest < np.exp(-1):  # the 1/e level only where a curve reaches it
+                ax.axhline(np.exp(-1), color="grey", linestyle=":", linewidth=0.8)
+            dax.axhline(0.0, color="black", linewidth=0.8)
+            ax.set_title(f"r = {r:g}{suffix}", fontsize="medium")
+            dax.set_title(f"r = {r:g}: kicked − two-disk{suffix}", fontsize="small")
+            if col == 0:
+                ax.set_ylabel(r"$R_l$ of $\theta$ (dimensionless)")
+                dax.set_ylabel(r"$\Delta R_l$ (dimensionless)")
+            for a in (ax, dax):
+                a.xaxis.set_major_locator(MaxNLocator(integer=True))
+        # one y scale per kind within a radius: the groups compare at a glance
+        for block in (grid[: len(groups), col], grid[len(groups):, col]):
+            lows, highs = zip(*(a.get_ylim() for a in block), strict=True)
+            for a in block:
+                a.set_ylim(min(lows), max(highs))
+        grid[-1, col].set_xlabel("lag l (boundary collisions)")
+    handles, labels = [], []
+    for k, system in enumerate(systems):
+        style = system_style(system, k)
+        handles.append(Line2D([], [], color=style["color"], marker=style["marker"],
+                              markersize=4))
+        labels.append(system_label(system))
     handles += [
         Line2D([], [], color="grey", linewidth=6, alpha=0.3),
         Line2D([], [], color="grey", marker="o", markerfacecolor="none", linestyle="none"),
         Line2D([], [], color="grey", linestyle=":"),
     ]
-    labels += ["95 % interval (top: of the mean; below: of the paired differences)"
+    labels += ["95 % interval (R_l rows: of the mean; ΔR_l rows: of the paired differences)"
                if differences is not None else "95 % interval of the mean over ICs",
                "built-in prediction 1 − n_pert/n_boundary", "1/e (where reached)"]
-    fig.legend(handles, labels, loc="outside lower center", ncol=min(5, len(labels)),
+    fig.legend(handles, labels, loc="outside lower center", ncol=min(4, len(labels)),
                fontsize="small")
     return fig
+
+
+def _figure_radii(curves, max_panels):
+    """At most ``max_panels`` radii of ``curves``, evenly chosen, both ends included."""
+    radii = np.sort(curves["radius"].unique())
+    if radii.size > max_panels:
+        radii = radii[np.unique(np.linspace(0, radii.size - 1, max_panels).round().astype(int))]
+    return radii
+
+
+def _shown_radii(curves, max_panels=3):
+    """The radii :func:`acf_figure` draws, as words (``"r = 0.008, 0.018 and 0.03"``)."""
+    radii = _figure_radii(curves, max_panels)
+    text = [f"{r:g}" for r in radii]
+    return "r = " + (", ".join(text[:-1]) + " and " + text[-1] if len(text) > 1 else text[0])
 
 
 def lag1_ratios(ctx):
@@ -502,10 +537,13 @@ def sections(ctx):
             "fig07b_autocorrelation_curves",
             acf_figure(curves, predicted, differences=paired),
             "R_l of the boundary angles over lags l = 1.."
-            f"{int(curves['lag'].max())} per radius and system (mean over ICs, band: 95 % t "
+            f"{int(curves['lag'].max())} at {_shown_radii(curves)} (columns; every radius is in "
+            "the autocorrelation_curves table), the two-disk curve with the uniform-kick "
+            "systems and with the scatter-kick systems in separate rows (mean over ICs, band: "
+            "95 % t "
             "interval of that system's mean alone, which says nothing about a difference "
             "between systems), with the built-in lag-1 prediction 1 − n_pert/n_boundary (open "
-            "markers at l ≈ 1) and 1/e (the decorrelation threshold); below each radius, "
+            "markers at l ≈ 1) and 1/e (the decorrelation threshold); in the lower rows, "
             "each kicked system's R_l minus the two-disk R_l, the mean over ICs of the "
             "per-IC difference (the two runs of an IC share it) with the 95 % t interval of "
             "those paired differences: where the curves cross, the difference changes sign.",

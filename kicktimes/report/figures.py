@@ -193,6 +193,34 @@ def x_axis(x="radius", xlabel=None):
     return XAxis(x, xlabel)
 
 
+#: the systems whose kicks scatter (the rule of a disk-disk collision) rather than redraw
+#: the direction by the kick-angle rule; figures with many systems draw them apart
+SCATTER_SYSTEMS = ("poisson_scatter", "actual_scatter", "poisson_kinetic")
+
+
+def kick_groups(systems, reference="two_particle"):
+    """``[(name, systems)]``: ``reference`` with the systems whose kicks follow the
+    kick-angle rule (``"uniform kicks"``), then with those whose kicks scatter
+    (``"scatter kicks"``, `SCATTER_SYSTEMS`), each in the order of ``systems``; a group
+    without a kicked system is left out, and ``[("", systems)]`` if both are.
+
+    Examples
+    --------
+    >>> for name, members in kick_groups(["two_particle", "poisson", "poisson_scatter"]):
+    ...     print(name, members)
+    uniform kicks ['two_particle', 'poisson']
+    scatter kicks ['two_particle', 'poisson_scatter']
+    """
+    systems = list(systems)
+    ref = [s for s in systems if s == reference]
+    uniform = [s for s in systems if s != reference and s not in SCATTER_SYSTEMS]
+    scatter = [s for s in systems if s in SCATTER_SYSTEMS]
+    groups = [("uniform kicks", ref + uniform), ("scatter kicks", ref + scatter)]
+    return [(name, members) for name, members in groups if len(members) > len(ref)] or [
+        ("", systems)
+    ]
+
+
 def system_label(system):
     return SYSTEM_LABELS.get(system, system.replace("_", " "))
 

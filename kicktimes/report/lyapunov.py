@@ -20,6 +20,8 @@ from kicktimes.report.common import REFERENCE, Section, distinct, fmt, kicked_sy
 from kicktimes.report.effects import Effect, store_ratio
 from kicktimes.report.figures import (
     DIAGNOSTIC_LABELS,
+    SCATTER_SYSTEMS,
+    kick_groups,
     radius_axis,
     system_label,
     system_style,
@@ -76,23 +78,6 @@ def stretching_table(results) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
-#: the systems whose kicks scatter (the rule of a disk-disk collision) rather than redraw
-#: the direction by the kick-angle rule: panel (b) of fig05, the others panel (a)
-SCATTER_SYSTEMS = ("poisson_scatter", "actual_scatter", "poisson_kinetic")
-
-
-def _kick_groups(systems):
-    """``[(title, systems)]``: the two-particle system with the kick-angle systems, then
-    with the scatter-kick systems (a group with no kicked system is left out)."""
-    ref = [s for s in systems if s == REFERENCE]
-    uniform = [s for s in systems if s != REFERENCE and s not in SCATTER_SYSTEMS]
-    scatter = [s for s in systems if s in SCATTER_SYSTEMS]
-    groups = [("uniform kicks", ref + uniform), ("scatter kicks", ref + scatter)]
-    return [(name, members) for name, members in groups if len(members) > len(ref)] or [
-        ("", ref)
-    ]
-
-
 def stretching_figure(summary, table, *, title=None):
     r"""The FTLE against r, split by kick kind, its stretching per perturbation and the
     excess of a collision over a kick.
@@ -123,7 +108,7 @@ def stretching_figure(summary, table, *, title=None):
     axes = fig.subplots(2, 3)
     present = distinct(summary, "system") | distinct(table, "system")
     systems = [s for s in (REFERENCE, *kicked_systems(table)) if s in present]
-    groups = _kick_groups(systems)
+    groups = kick_groups(systems)
     letters = "ab"
     top = axes[0, :2]
     lam_systems = distinct(summary, "system")
