@@ -401,3 +401,27 @@ def test_analyze_offers_the_mmpp_for_outside_data(tmp_path):
     # off by default, and said in --help
     help_text = CliRunner().invoke(main, ["analyze", "--help"]).output
     assert "--mmpp" in help_text and "Markov-modulated" in help_text
+
+
+def test_mmpp_figure_marks_a_quartile_beyond_its_axis_and_says_what_the_bars_are():
+    import pandas as pd
+
+    from kicktimes.report.mmpp import mmpp_comparison
+
+    rng = np.random.default_rng(4)
+    n = 24
+    per_ic = pd.DataFrame({
+        "radius": np.repeat([0.01, 0.02], n // 2), "rate": 1.0,
+        "mmpp_best": rng.random(n) < 0.5, "mmpp_beats_poisson": True,
+        "rate_low": rng.uniform(0.5, 0.9, n), "rate_high": rng.uniform(3, 9, n),
+        "switch_low": 0.1, "switch_high": 1.0})
+    per_ic.loc[per_ic.index[:8], "rate_high"] = 5e4  # a silent-state fit: far off the axis
+    fig = mmpp_comparison(per_ic)
+    rates = fig.axes[1]
+    assert rates.get_ylim()[1] <= 1e3
+    notes = [t.get_text() for t in rates.texts]
+    assert "5e+04" in notes  # the clipped upper quartile, at the edge
+    assert notes.count("12") == 2  # the number of sequences behind each median
+    labels = [t.get_text() for t in fig.legends[0].get_texts()]
+    assert any("Clopper-Pearson" in lab for lab in labels)
+    assert any("quartiles" in lab for lab in labels)

@@ -153,7 +153,8 @@ def mmpp_comparison(per_ic, *, x="radius", xlabel=None, alpha=None):
         y = shares[f"share_{name}"].to_numpy(float)
         err = np.vstack([y - shares[f"{name}_low"], shares[f"{name}_high"] - y])
         ax1.errorbar(at + shift, y, yerr=np.clip(err, 0, None), color=colour, marker=marker,
-                     linestyle=axis.line, capsize=2, label=f"{label} (data)")
+                     linestyle=axis.line, capsize=2,
+                     label=f"{label} (data; bars: 95 % Clopper-Pearson interval)")
         if f"share_null_{name}" in shares:
             y0 = shares[f"share_null_{name}"].to_numpy(float)
             ax1.plot(at + shift, y0, color=colour, marker=marker, markerfacecolor="white",
@@ -169,7 +170,7 @@ def mmpp_comparison(per_ic, *, x="radius", xlabel=None, alpha=None):
               (ax3, ("switch_low", "switch_high"), lambda d, c: d["rate"] / d[c],
                "mean sojourn 1/q (mean intervals T/n)", "(c) time in each state"))
     for ax, columns, value, ylabel, title in panels:
-        bounds = []
+        bounds, drawn = [], []
         for k, (column, colour) in enumerate(zip(columns, ("tab:cyan", "tab:red"),
                                                  strict=True)):
             rows = []
@@ -184,8 +185,9 @@ def mmpp_comparison(per_ic, *, x="radius", xlabel=None, alpha=None):
             state = "low" if k == 0 else "high"
             ax.errorbar(pos + (k - 0.5) * dx, med, yerr=[med - q1, q3 - med], color=colour,
                         marker="o", capsize=2, linestyle=axis.line,
-                        label=f"{state}-rate state")
+                        label=f"{state}-rate state (median; bars: quartiles)")
             bounds.append((q1.min(), q3.max()))
+            drawn.append((pos + (k - 0.5) * dx, q1, q3, colour))
         if clustered.empty:
             ax.text(0.5, 0.5, "no sequence where the MMPP-2 beats Poisson",
                     transform=ax.transAxes, ha="center", va="center")
@@ -196,17 +198,48 @@ def mmpp_comparison(per_ic, *, x="radius", xlabel=None, alpha=None):
             lo, hi = min(b[0] for b in bounds), max(b[1] for b in bounds)
             ax.set_ylim(max(0.7 * lo, 1e-2), min(1.4 * hi, 1e3))
             _log_axis(ax)
-            ax.legend(fontsize="x-small", loc="best")
+            _mark_clipped(ax, drawn)
+            # the number of sequences behind each median, in a row above the axes
+            counts = clustered.groupby(x, sort=True, observed=True).size()
+            for pos, n in counts.items():
+                ax.annotate(f"{n}", (pos, 1), xycoords=("data", "axes fraction"),
+                            xytext=(0, 5), textcoords="offset points", ha="center",
+                            va="bottom", fontsize="x-small", color="0.35",
+                            annotation_clip=False)
         ax.set_ylabel(ylabel)
-        ax.set_title(title)
+        # above the row of counts
+        ax.set_title(title + ("\n(n sequences above each radius)" if len(clustered) else ""),
+                     fontsize="medium", pad=16 if len(clustered) else 6)
         axis.draw(ax)
         ax.set_xlim(ax1.get_xlim())  # the same positions as (a), whichever have points
     handles = ax1.get_legend_handles_labels()[0]
-    handles.append(Line2D([], [], color="0.3", marker="o", linestyle="-",
-                          label="(b, c) median and quartiles over the sequences where the "
-                                "MMPP-2 beats Poisson"))
-    fig.legend(handles=handles, loc="outside lower center", ncol=3, fontsize="x-small")
+    for state, colour in (("low", "tab:cyan"), ("high", "tab:red")):
+        handles.append(Line2D([], [], color=colour, marker="o", linestyle="-",
+                              label=f"(b, c) {state}-rate state: median, bars: quartiles"))
+    handles.append(Line2D([], [], color="0.3", marker="^", linestyle="none",
+                          label="(b, c) a quartile beyond the axis: arrow and value"))
+    fig.legend(handles=handles, loc="outside lower center", ncol=2, fontsize="x-small")
     return fig
+
+
+def _mark_clipped(ax, drawn):
+    """Mark every quartile bar end beyond the y limits: an arrow at the edge, pointing
+    out, with the end's value beside it (a silent state or an instant stay gives ends
+    decades away, which the limits leave out, but never silently)."""
+    low, high = ax.get_ylim()
+    for pos, q1, q3, colour in drawn:
+        for x0, a, b in zip(pos, q1, q3, strict=True):
+            for end, beyond, edge in ((b, b > high, 1.0), (a, a < low, 0.0)):
+                if not beyond:
+                    continue
+                up = edge == 1.0
+                ax.plot([x0], [edge], transform=ax.get_xaxis_transform(), clip_on=False,
+                        marker="^" if up else "v", color=colour, markersize=6,
+                        linestyle="none")
+                ax.annotate(f"{end:.3g}", (x0, edge), xycoords=("data", "axes fraction"),
+                            xytext=(4, -2 if up else 2), textcoords="offset points",
+                            ha="left", va="top" if up else "bottom", fontsize="xx-small",
+                            color=colour)
 
 
 def _log_axis(ax):
@@ -301,7 +334,9 @@ def sections(ctx):
         "MMPP-2 beats Poisson, with 95 % Clopper-Pearson intervals; open markers: the same "
         "on the ICs' Poisson twins (the level). (b) The fitted low and high collision rates "
         "over the IC's rate n/T; (c) the mean time in each state (1/q) in mean collision "
-        "intervals T/n; medians and quartiles over the ICs where the MMPP-2 beats Poisson.",
+        "intervals T/n; medians and quartiles (bars) over the ICs where the MMPP-2 beats "
+        "Poisson, their number written above the x axis; a quartile beyond the axis is "
+        "marked by an arrow at the edge with its value.",
     )
     shares = _share_rows(ok, "radius")
     clustered = ok[ok["mmpp_beats_poisson"]]
