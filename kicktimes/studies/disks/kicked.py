@@ -12,14 +12,13 @@ its table exists.
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
 from kicktimes.experiment.disks_tasks import KICKED_THEILER
-from kicktimes.stats import format_interval, ratio_verdict
+from kicktimes.stats import format_interval, ratio_interval, ratio_verdict
 
 __all__ = ["FTLE_CHECK_COLUMNS", "KICKED_NAMES", "RATE_MARGIN", "ftle_check_lines",
            "kicked_answer", "kicked_ftle_cells", "kicked_not_chaotic", "kicked_rate_check",
@@ -230,9 +229,8 @@ def kicked_rate_check(kicked, table, exp) -> pd.DataFrame:
     The Poisson and scatter kicks, and λ / ν, use the kicked states' own gas collision
     frequency (`DisksExperiment.kicked_rate`); the density table (``disks.csv``) measures
     the same gas (N, packing, rule) in independent runs. Their ratio's 95 % interval
-    combines the two intervals on the log scale (independent seeds, each interval read as
-    ±1.96 standard errors of the log rate) and gets
-    `kicktimes.stats.ratio_verdict` at `RATE_MARGIN`.
+    combines the two intervals (`kicktimes.stats.ratio_interval`: independent seeds) and
+    gets `kicktimes.stats.ratio_verdict` at `RATE_MARGIN`.
 
     Parameters
     ----------
@@ -263,10 +261,8 @@ def kicked_rate_check(kicked, table, exp) -> pd.DataFrame:
         rate = float(dens["rate"])
         low, high = (float(dens["rate_enskog_low"] * dens["enskog"]),
                      float(dens["rate_enskog_high"] * dens["enskog"]))
-        ratio = row["reference"] / rate
-        se = math.hypot(math.log(row["reference_high"] / row["reference_low"]),
-                        math.log(high / low)) / (2 * 1.96)
-        r_low, r_high = ratio * math.exp(-1.96 * se), ratio * math.exp(1.96 * se)
+        ratio, r_low, r_high = ratio_interval(row["reference"], row["reference_low"],
+                                              row["reference_high"], rate, low, high)
         rows.append({"n_disks": n, "states": int(row["n_runs"]),
                      "kicked_rate": row["reference"], "kicked_rate_low": row["reference_low"],
                      "kicked_rate_high": row["reference_high"], "density_rate": rate,
