@@ -485,21 +485,21 @@ def test_rate_heterogeneity_draws_zero_rate_ics_at_the_floor_and_p_values():
     ax1, ax2 = fig.axes
     labels = [t.get_text() for t in ax1.get_legend().get_texts()]
     assert any("without disk-disk collisions" in lab for lab in labels)
-    # p-values on a second x axis on top (never over a marker), one per radius
+    # p-values on a second x axis on top (never over a marker), one per radius, horizontal
     (top,) = ax2.child_axes
-    assert [t.get_text() for t in top.get_xticklabels()] == [
-        "p < 10⁻³⁰⁰", "p = 0.01", "p = 0.2", "p = 0.5"]
-    assert "asymptotic" in top.get_xlabel()
+    assert [t.get_text() for t in top.get_xticklabels()] == ["< 10⁻³⁰⁰", "0.01", "0.2", "0.5"]
+    assert all(t.get_rotation() == 0 for t in top.get_xticklabels())
+    assert "asymptotic" in top.get_xlabel() and "below double precision" in top.get_xlabel()
     # with the Monte Carlo p-value beside (floored at 1/(n_mc + 1)) the labels stay the
     # asymptotic ones, which are not floored; with the Monte Carlo one alone, that one
     mc = hom.assign(pvalue_mc=[0.005, 0.02, 0.3, 0.6])
     (top,) = plots.rate_heterogeneity(coll, homogeneity=mc).axes[1].child_axes
     assert "asymptotic" in top.get_xlabel()
-    assert top.get_xticklabels()[0].get_text() == "p < 10⁻³⁰⁰"
+    assert top.get_xticklabels()[0].get_text() == "< 10⁻³⁰⁰"
     only_mc = mc.drop(columns="pvalue")
     (top,) = plots.rate_heterogeneity(coll, homogeneity=only_mc).axes[1].child_axes
     assert "Monte Carlo" in top.get_xlabel()
-    assert top.get_xticklabels()[0].get_text() == "p = 0.005"
+    assert top.get_xticklabels()[0].get_text() == "0.005"
     with pytest.raises(ValueError, match="pvalue"):
         plots.rate_heterogeneity(coll, homogeneity=hom.rename(columns={"pvalue": "p"}))
 
@@ -508,8 +508,11 @@ def test_rate_heterogeneity_writes_tiny_p_values_as_powers_of_ten():
     coll = make_collisions(n_ics=20)
     hom = pd.DataFrame({"radius": list(RADII), "pvalue": [3e-12, 2e-4, 0.04, np.nan]})
     (top,) = plots.rate_heterogeneity(coll, homogeneity=hom).axes[1].child_axes
-    assert [t.get_text() for t in top.get_xticklabels()] == [
-        "p < 10⁻¹¹", "p < 10⁻³", "p = 0.04", ""]
+    assert [t.get_text() for t in top.get_xticklabels()] == ["< 10⁻¹¹", "< 10⁻³", "0.04", ""]
+    # the same label everywhere (every radius of a paper store): one sentence, no ticks
+    (top,) = plots.rate_heterogeneity(coll, homogeneity=hom.assign(pvalue=0.0)).axes[1].child_axes
+    assert not [t.get_text() for t in top.get_xticklabels() if t.get_text()]
+    assert "p < 10⁻³⁰⁰ at every radius (below double precision)" in top.get_xlabel()
 
 
 def test_rate_heterogeneity_draws_the_dispersion_without_the_sticky_runs():

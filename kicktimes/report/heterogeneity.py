@@ -29,6 +29,29 @@ def _p_label(p):
     return f"p = {p:.1g}"
 
 
+def _p_row(ax, at, p, test, where):
+    """The p-values of a common rate on a second x axis on top of ``ax`` (never over a
+    marker), read horizontally: one sentence when every label is the same (``p < 10⁻³⁰⁰``
+    at every radius of a paper store: the χ² tail underflows double precision), else a
+    short label per position (without the ``p``), every second one raised when there are
+    more than 6, so that neighbours do not collide."""
+    labels = [_p_label(v).removeprefix("p ").removeprefix("= ") for v in p]
+    top = ax.secondary_xaxis("top")
+    shown = {lab for lab in labels if lab}
+    if len(shown) == 1 and all(labels):
+        (only,) = shown
+        top.set_xticks([])
+        note = " (below double precision)" if only.endswith("⁻³⁰⁰") else ""
+        top.set_xlabel(f"p of a common rate ({test}): p {only} at every {where}{note}",
+                       fontsize="small")
+        return
+    if len(at) > 6:
+        labels = [lab + ("\n" if k % 2 else "") for k, lab in enumerate(labels)]
+    top.set_xticks(at, labels, fontsize="x-small")
+    top.set_xlabel(f"p of a common rate ({test}; < 10⁻³⁰⁰: below double precision)",
+                   fontsize="small")
+
+
 def rate_heterogeneity(collisions, *, homogeneity=None, rule="mirror", max_points=4000,
                        x="radius", xlabel=None, kinetic=None, sticky="auto"):
     r"""Collision rates across ICs: per-IC rates and their dispersion, per radius.
@@ -76,7 +99,8 @@ def rate_heterogeneity(collisions, *, homogeneity=None, rule="mirror", max_point
     -----
     A few sticky ICs drive the index of dispersion at a radius to 100 or more; the curve
     without them shows the dispersion of the rest. Tick labels of p-values below 10⁻³
-    read ``p < 10⁻ᵏ``, and an asymptotic p-value that underflows to 0 reads ``p ≈ 0``.
+    read ``< 10⁻ᵏ``, and an asymptotic p-value that underflows to 0 reads ``< 10⁻³⁰⁰``;
+    when every position has the same label, one sentence on top says so instead.
     """
 
     axis = x_axis(x, xlabel)
@@ -188,7 +212,8 @@ def rate_heterogeneity(collisions, *, homogeneity=None, rule="mirror", max_point
             markerfacecolor="none",
             color="tab:orange",
             linestyle="--" if axis.line != "none" else "none",
-            label=_sticky_label(df, flag, nouns),
+            label=_sticky_label(df, flag, nouns)
+            + (" (−k: left out at that radius)" if n_out.any() else ""),
             gid="sticky_excluded",
         )
         for at, k in n_out.items():
@@ -212,24 +237,15 @@ def rate_heterogeneity(collisions, *, homogeneity=None, rule="mirror", max_point
         # the asymptotic chi-square p-value is shown, which can be as small as it is
         column = "pvalue" if "pvalue" in hom.columns else "pvalue_mc"
         p = hom[column].reindex(dispersion.index)
-        # the p-values go on a second x axis on top, one per radius: never over a marker
-        top = ax2.secondary_xaxis("top")
-        top.set_xticks(
-            dispersion.index.to_numpy(),
-            [_p_label(v) for v in p],
-            rotation=90,
-            fontsize="x-small",
-        )
-        top.set_xlabel(
-            "p of a common rate ("
-            + ("Monte Carlo" if column == "pvalue_mc" else "Pearson χ², asymptotic")
-            + ")",
-            fontsize="small",
-        )
+        _p_row(ax2, dispersion.index.to_numpy(), p.to_numpy(float),
+               "Monte Carlo" if column == "pvalue_mc" else "Pearson χ², asymptotic",
+               x)
     axis.draw(ax2)
     ax2.set_ylabel(f"index of dispersion of counts across {nouns.many}")
     ax2.set_title("(b) over-dispersion")
-    ax2.legend(fontsize="x-small")
+    # below the axes: inside, the long entries covered the curves and the Poisson level
+    ax2.legend(fontsize="x-small", loc="upper center", bbox_to_anchor=(0.5, -0.14),
+               frameon=False)
     plain_log_ticks(ax1.yaxis)
     return fig
 
@@ -285,7 +301,8 @@ def sections(ctx):
         "the kinetic rate; a run is one IC at one radius, and one IC can be sticky at several "
         "radii: the legend counts both; −k: the runs left out at that radius); "
         "on top, the asymptotic p-value of the Pearson χ² test of a common rate (given the "
-        "total); the Monte Carlo p-value, exact but floored at 1/(n_mc + 1), is in the text.",
+        "total; < 10⁻³⁰⁰: below double precision; one sentence when it is the same at every "
+        "radius); the Monte Carlo p-value, exact but floored at 1/(n_mc + 1), is in the text.",
     )
     sec.text(
         f"A common rate across ICs is rejected at α = {alpha:g} at "
