@@ -78,3 +78,19 @@ def test_bad_scale_and_workers_are_refused_by_name(tmp_path):
 
 def test_the_paper_scale_is_the_published_page_s():
     assert study.SCALES["paper"] == study.Params(n_ics=200, n_steps=10000, tau=0.3, seed=5)
+
+
+def test_the_figure_draws_ks_share_and_dispersion_on_their_own_axes():
+    from kicktimes.studies.unequal.figures import size_ratio_figure
+
+    from pathlib import Path
+
+    table = pd.read_csv(Path(__file__).parents[1] / "docs/results/size_ratio/size_ratio.csv")
+    fig = size_ratio_figure(table)
+    # four panels, no twin axes: two y scales on one panel misled
+    assert len(fig.axes) == 4
+    ks, disp = fig.axes[1], fig.axes[2]
+    assert "KS" in ks.get_title() and "dispersion" in disp.get_title()
+    # every interval inside its axes
+    assert ks.get_ylim()[1] > table["ks_reject_share"].max()
+    assert disp.get_ylim()[1] > table["disp_high"].max()

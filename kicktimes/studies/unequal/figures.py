@@ -12,42 +12,51 @@ __all__ = ["size_ratio_figure"]
 
 
 def size_ratio_figure(table, n_ics=200):
-    """Three panels against the size ratio: the collision rate over the kinetic rate, the
-    KS rejection share and the dispersion index, the kicked / two-disk FTLE ratios; from
-    `size_ratio_table` (``n_ics``: ICs per ratio). Returns a `matplotlib.figure.Figure`."""
-    fig = Figure(figsize=(11, 3.6), layout="constrained")
-    ax = fig.subplots(1, 3)
+    """Four panels against the size ratio, each on its own y scale: (a) the collision rate
+    over the kinetic rate, (b) the KS rejection share, (c) the dispersion index of the
+    counts, (d) the kicked / two-disk FTLE ratios; from `size_ratio_table` (``n_ics``: ICs
+    per ratio). Returns a `matplotlib.figure.Figure`.
+
+    The KS share and the dispersion index are apart (one y axis each): on twin axes of one
+    panel, two scales made their curves look comparable where they are not.
+    """
+    fig = Figure(figsize=(10.5, 7.0), layout="constrained")
+    ax = fig.subplots(2, 2).ravel()
     x = table["size_ratio"]
 
     err = np.vstack([table["rate_ratio"] - table["rate_low"],
                      table["rate_high"] - table["rate_ratio"]])
-    ax[0].errorbar(x, table["rate_ratio"], yerr=err, fmt="o-", color="black", capsize=3)
+    ax[0].errorbar(x, table["rate_ratio"], yerr=err, fmt="o-", color="black", capsize=3,
+                   label="rate / Γ (95 % CI)")
     ax[0].axhspan(0.9, 1.1, color="0.85", zorder=0, label="±10 % band")
     ax[0].axhline(1.0, color="0.5", lw=0.8)
     ax[0].set_ylim(0.8, 1.2)
     ax[0].legend(fontsize="small")
-    ax[0].set_title("collision rate / kinetic Γ(r0, r1)", fontsize="medium")
+    ax[0].set_ylabel("collision rate / kinetic rate")
+    ax[0].set_title("(a) collision rate / kinetic Γ(r0, r1)", fontsize="medium")
     ks = np.array([ks_interval(row, n_ics) for _, row in table.iterrows()])
     share = table["ks_reject_share"].to_numpy()
     ax[1].errorbar(x, share, yerr=np.vstack([share - ks[:, 0], ks[:, 1] - share]), fmt="o-",
-                   color="tab:blue", capsize=3, label="KS rejection share (Clopper–Pearson)")
+                   color="tab:blue", capsize=3,
+                   label="KS rejection share (95 % Clopper–Pearson)")
     ax[1].axhline(0.05, color="tab:blue", lw=0.8, ls=":", label="Poisson: 0.05")
-    ax[1].set_ylim(0, max(0.5, float(ks[:, 1].max()) * 1.1))
-    ax[1].set_ylabel("KS rejection share", color="tab:blue")
-    twin = ax[1].twinx()
+    # room above the highest bar for the legend, which covers no bar end
+    ax[1].set_ylim(0, max(0.5, float(ks[:, 1].max()) * 1.35))
+    ax[1].set_ylabel("share of ICs the KS test rejects")
+    ax[1].set_title("(b) KS rejection share", fontsize="medium")
+    ax[1].legend(fontsize="x-small", loc="upper left")
     d = table["dispersion_index"].to_numpy()
     if "disp_low" in table:
-        twin.errorbar(x, d, yerr=np.vstack([d - table["disp_low"], table["disp_high"] - d]),
-                      fmt="s--", color="tab:red", capsize=3, label="dispersion index (bootstrap)")
+        ax[2].errorbar(x, d, yerr=np.vstack([d - table["disp_low"], table["disp_high"] - d]),
+                       fmt="s--", color="tab:red", capsize=3,
+                       label="dispersion index (bootstrap 95 % CI)")
     else:
-        twin.plot(x, d, "s--", color="tab:red", label="dispersion index (no interval)")
-    twin.axhline(1.0, color="tab:red", lw=0.8, ls=":", label="Poisson: 1")
-    twin.set_ylim(0, max(6.0, float(np.nanmax(table.get("disp_high", d))) * 1.1))
-    twin.set_ylabel("dispersion index", color="tab:red")
-    ax[1].set_title("non-Poisson collision statistics", fontsize="medium")
-    h1, l1 = ax[1].get_legend_handles_labels()
-    h2, l2 = twin.get_legend_handles_labels()
-    ax[1].legend(h1 + h2, l1 + l2, fontsize="x-small", loc="upper left")
+        ax[2].plot(x, d, "s--", color="tab:red", label="dispersion index (no interval)")
+    ax[2].axhline(1.0, color="tab:red", lw=0.8, ls=":", label="Poisson: 1")
+    ax[2].set_ylim(0, max(6.0, float(np.nanmax(table.get("disp_high", d))) * 1.3))
+    ax[2].set_ylabel("dispersion index of the counts")
+    ax[2].set_title("(c) dispersion index D", fontsize="medium")
+    ax[2].legend(fontsize="x-small", loc="upper right")
     for disk, color in ((0, "tab:orange"), (1, "tab:green")):
         for kind, fmt in (("partner", "o-"), ("own", "s:")):
             est = table[f"ftle_{kind}_ratio_disk{disk}"]
@@ -55,12 +64,16 @@ def size_ratio_figure(table, n_ics=200):
                              table[f"ftle_{kind}_high_disk{disk}"] - est])
             label = (f"disk {disk} ({'r0 = 0.01' if disk == 0 else 'r1'}), "
                      f"{'the other disk as partner' if kind == 'partner' else 'own-size partner'}")
-            ax[2].errorbar(x, est, yerr=err, fmt=fmt, color=color, capsize=3, label=label,
+            ax[3].errorbar(x, est, yerr=err, fmt=fmt, color=color, capsize=3, label=label,
                            alpha=1.0 if kind == "partner" else 0.6)
-    ax[2].axhspan(0.9, 1.1, color="0.85", zorder=0)
-    ax[2].axhline(1.0, color="0.5", lw=0.8)
-    ax[2].set_title("FTLE: kicked (scatter) / two-disk", fontsize="medium")
-    ax[2].legend(fontsize="x-small")
+    ax[3].axhspan(0.9, 1.1, color="0.85", zorder=0)
+    ax[3].axhline(1.0, color="0.5", lw=0.8)
+    ax[3].set_ylabel("FTLE ratio kicked / two-disk")
+    ax[3].set_title("(d) FTLE: kicked (scatter) / two-disk", fontsize="medium")
+    # below the panel: inside, it covered the own-size points
+    ax[3].legend(fontsize="x-small", loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=2,
+                 frameon=False, title="bars: 95 % bootstrap CI over ICs",
+                 title_fontsize="x-small")
     for a in ax:
         a.set_xlabel("size ratio r1 / r0")
     return fig
