@@ -11,6 +11,7 @@ against N), from `kicktimes.studies.disks.tables.disks_table` and `disks_hazard`
 from __future__ import annotations
 
 import numpy as np
+from matplotlib.lines import Line2D
 from matplotlib.ticker import FuncFormatter
 
 from kicktimes.report.figures import plain_log_ticks
@@ -28,6 +29,10 @@ SHOWN_N = (2, 3, 10, 100, 1000)
 X_MIN = 0.003
 #: the hazard figure's zoomed rows show these N and more
 ZOOM_MIN_N = 10
+#: the y limits of the hazard figure's zoomed rows (linear) and full rows (log); a bin or
+#: a band beyond them is marked at the edge (`_mark_outside`), never left out silently
+ZOOM_LIMITS = (0.75, 1.3)
+FULL_LIMITS = (0.05, 20.0)
 
 
 def geometries_of(table):
@@ -103,7 +108,8 @@ def hazard_figure(hazard, table, n_shown=SHOWN_N):
     """The hazard of the tagged disk's next collision against the time since its last one,
     both in units of the mean interval, over the constant rate (1 for Poisson): per rule a
     row over the whole range (log y) and a row zoomed near 1 for N >= ZOOM_MIN_N (linear y,
-    ±10 % shaded); one
+    ±10 % shaded; a bin beyond the limits is a filled triangle at the edge with its value,
+    a bin whose 95 % band alone leaves them an open one); one
     column per geometry, one line per N (distinct colours and markers at the bins'
     middles), 95 % bands."""
     import matplotlib.pyplot as plt
@@ -145,22 +151,55 @@ def hazard_figure(hazard, table, n_shown=SHOWN_N):
                 ax.set_xlim(X_MIN, HAZARD_EDGES[-1])
                 plain_log_ticks(ax.xaxis)
                 if zoom:
-                    ax.set_ylim(0.75, 1.3)
-                    ax.set_title(f"{rule}, {geo}: N ≥ {ZOOM_MIN_N}, zoomed near 1", fontsize=9)
+                    ax.set_ylim(*ZOOM_LIMITS)
+                    ax.set_title(f"{rule}, {geo}: N ≥ {ZOOM_MIN_N}, zoomed near 1", fontsize=9,
+                                 pad=9)  # above the edge marks
                 else:
                     ax.set_yscale("log")
-                    ax.set_ylim(0.05, 20)
+                    ax.set_ylim(*FULL_LIMITS)
                     plain_log_ticks(ax.yaxis)
                     ax.set_title(f"{rule}, {geo}", fontsize=9)
+                for n in n_shown:  # nothing leaves the axes unmarked
+                    d = hazard[(hazard["experiment"] == name) & (hazard["n_disks"] == n)]
+                    if not d.empty and not (zoom and n < ZOOM_MIN_N):
+                        _mark_outside(ax, d, colors[n], *ax.get_ylim())
                 if 2 * i + zoom == 2 * len(rules) - 1:
                     ax.set_xlabel("time since the last collision / mean interval")
                 if j == 0:
                     ax.set_ylabel("hazard / constant rate")
     handles, labels = axes[0, 0].get_legend_handles_labels()
+    handles += [Line2D([], [], color="0.3", marker="^", ls="none", ms=6),
+                Line2D([], [], color="0.3", marker="^", mfc="none", ls="none", ms=6)]
+    labels += ["bin beyond the axis (value beside)", "only its 95 % band beyond"]
     fig.legend(handles, labels, loc="upper center", ncol=len(labels), fontsize=9,
                frameon=False)
     fig.tight_layout(rect=(0, 0, 1, 0.965))
     return fig
+
+
+def _mark_outside(ax, d, color, low, high):
+    """Mark at the edge of ``ax`` every hazard bin of ``d`` beyond ``(low, high)``: a
+    filled triangle pointing out with the bin's value beside it, or, where only the bin's
+    95 % band leaves, an open one. Returns the number of bins marked."""
+    lo_t = np.maximum(d["t_low"].to_numpy(float), X_MIN)
+    mid = np.sqrt(lo_t * d["t_high"].to_numpy(float))
+    h = d["hazard"].to_numpy(float)
+    c_lo, c_hi = d["ci_low"].to_numpy(float), d["ci_high"].to_numpy(float)
+    marked = 0
+    for x, v, a, b in zip(mid, h, c_lo, c_hi, strict=True):
+        for up, out, band_out in ((True, v > high, b > high), (False, v < low, a < low)):
+            if not band_out:
+                continue
+            edge = 1.0 if up else 0.0
+            ax.plot([x], [edge], transform=ax.get_xaxis_transform(), clip_on=False,
+                    marker="^" if up else "v", ms=6, ls="none", color=color,
+                    mfc=color if out else "none", zorder=5)
+            if out:
+                ax.annotate(f"{v:.3g}", (x, edge), xycoords=("data", "axes fraction"),
+                            xytext=(5, -3 if up else 3), textcoords="offset points",
+                            ha="left", va="top" if up else "bottom", fontsize=7, color=color)
+            marked += 1
+    return marked
 
 
 def rates_figure(table):
