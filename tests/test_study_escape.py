@@ -129,3 +129,20 @@ def test_the_survival_curves_turn_grey_below_the_at_risk_floor():
     assert black.get_xdata().max() == cut < grey.get_xdata().max()
     assert grey.get_xdata()[0] == black.get_xdata()[-1]  # the two parts meet
     assert grey.get_ydata()[0] == black.get_ydata()[-1]
+
+
+def test_no_survival_curve_hides_the_two_disk_one():
+    from kicktimes.stats import escape_survival
+    from kicktimes.studies.escape.figures import survival_figure
+
+    t = np.random.default_rng(2).exponential(100.0, 400)
+    km = escape_survival(np.where(t < 1000, t, np.inf), 1000.0)
+    # identical curves: the worst case, one on another
+    systems = ("two_particle", "poisson", "poisson_scatter")
+    fig = survival_figure({(r, s): km for r in study.compute.RADII for s in systems})
+    lines = {ln.get_label(): ln for ln in fig.axes[0].get_lines()}
+    two, uniform, scatter = (lines[study.compute.LABELS[s]] for s in systems)
+    # the two disks thin and on top; the uniform-kick curve wider, see-through, below
+    assert two.get_zorder() > scatter.get_zorder() > uniform.get_zorder()
+    assert uniform.get_linewidth() > two.get_linewidth()
+    assert uniform.get_alpha() < 1 and scatter.get_linestyle() != "-"

@@ -19,6 +19,18 @@ __all__ = ["MIN_AT_RISK", "survival_figure", "thin_from"]
 MIN_AT_RISK = 50
 
 
+#: how each system's measured curve is drawn: the two disks thin and on top (the
+#: reference every curve is read against), the uniform-kick curve that lies on it wider,
+#: half transparent and below, the scatter-kick curve dashed between them, so that all
+#: three show where they coincide; the controls plain
+_LINES = {
+    "two_particle": {"linewidth": 1.3, "linestyle": "-", "zorder": 6},
+    "poisson_scatter": {"linewidth": 1.3, "linestyle": (0, (4, 2)), "zorder": 5},
+    "poisson": {"linewidth": 2.6, "linestyle": "-", "alpha": 0.55, "zorder": 4},
+    None: {"linewidth": 1.4, "linestyle": "-", "zorder": 3},
+}
+
+
 def thin_from(km, floor=MIN_AT_RISK):
     """The first time of a Kaplan-Meier table (`kicktimes.stats.escape_survival`) at which
     fewer than ``floor`` runs are at risk (inf: never).
@@ -53,7 +65,9 @@ def survival_figure(curves):
     Each curve is drawn with its 95 % band while at least :data:`MIN_AT_RISK` runs are at
     risk, beyond that (:func:`thin_from`) as a thin grey dotted line without a band: the
     two-disk curve's risk set is emptied by disk 1's escapes (partner censoring), and its
-    last steps, each one of a handful of runs, would read as physics."""
+    last steps, each one of a handful of runs, would read as physics. The two-disk curve is
+    drawn thin and on top, the uniform-kick curve wide and half transparent below it, the
+    scatter-kick curve dashed between (``_LINES``): where they coincide, all three show."""
     styles = {"two_particle": system_style("two_particle"), "poisson": system_style("poisson"),
               "poisson_scatter": system_style("poisson_scatter"),
               "free": {"color": "tab:gray", "marker": "x"},
@@ -75,13 +89,11 @@ def survival_figure(curves):
             if len(kept) and len(rest):
                 kept = pd.concat([kept, kept.iloc[[-1]].assign(time=cut)])
                 rest = pd.concat([kept.iloc[[-1]], rest])
+            line = _LINES.get(system, _LINES[None])
             ax.step(kept["time"], kept["survival"], where="post",
-                    color=styles[system]["color"], label=LABELS[system],
-                    linestyle="--" if system == "poisson_scatter" else "-",
-                    linewidth={"poisson": 3.0, "poisson_scatter": 1.0}.get(system, 1.5),
-                    zorder=3 if system == "poisson_scatter" else 2)
+                    color=styles[system]["color"], label=LABELS[system], **line)
             ax.fill_between(kept["time"], kept["ci_low"], kept["ci_high"], step="post",
-                            color=styles[system]["color"], alpha=0.15, linewidth=0)
+                            color=styles[system]["color"], alpha=0.12, linewidth=0, zorder=1)
             if len(rest):
                 ax.step(rest["time"], rest["survival"], where="post", color="0.6",
                         linewidth=0.8, linestyle=":", zorder=1, gid=f"few_at_risk_{system}")
