@@ -24,8 +24,7 @@ from kicktimes.stats import format_interval, poisson_rule, poisson_verdict, reje
 from kicktimes.studies.disks.null import null_level
 
 __all__ = ["POISSON_TEST", "POISSON_WITHIN", "opening_lines", "poisson_by_control",
-           "poisson_from", "poisson_readings", "summary_lines", "family_lines",
-           "dilute_comparison"]
+           "poisson_from", "poisson_readings", "summary_lines", "family_lines"]
 
 #: the test whose calibrated rejection share `poisson_verdict` reads
 POISSON_TEST = "uniformity_ks"
@@ -139,10 +138,11 @@ def _groups(items):
     return out
 
 
-def opening_lines(readings, table, rate_from, rate_robust_from) -> list:
+def opening_lines(readings, table, rate_from, rate_robust_from, boltz=None) -> list:
     """The page's first screen: whether the tagged disk's process is Poisson (at the
     largest N), from which N, and how the gas compares with kinetic theory (Enskog's rate;
-    the dilute tagged disk's D), each from a computed table."""
+    D against the Boltzmann-kicked disk's, `kicktimes.studies.disks.boltzmann`, when
+    ``boltz`` is given, else the dilute tagged disk's D), each from a computed table."""
     big = readings.groupby(["geometry", "rule"], sort=False).tail(1)
     n_max = int(big["n_disks"].max())
     by = _groups((r["verdict"], f"{r['geometry']} {r['rule']}") for _, r in big.iterrows())
@@ -160,13 +160,24 @@ def opening_lines(readings, table, rate_from, rate_robust_from) -> list:
             if rate_from else "not within 10 % of Enskog's from one N on everywhere")
     rate += (f" (under every control from N = {rate_robust_from} on)" if rate_robust_from
              else "")
+    theory = (f"the elastic gas's D at N = {n_max} differs from the dilute tagged disk's "
+              f"(linear Boltzmann, same windows) at {diff} of {len(el)} geometries")
+    if boltz is not None and not boltz.empty:
+        d = boltz[(boltz["n_disks"] == n_max) & (boltz["statistic"] == "dispersion")]
+        agree = [f"{r['geometry']} {r['rule']}" for _, r in d.iterrows()
+                 if r["verdict"].startswith("within")]
+        depart = [f"{r['geometry']} {r['rule']} ({r['reading'].split(' by ')[-1]})"
+                  for _, r in d.iterrows() if r["verdict"] in ("higher", "lower")]
+        theory = (f"D at N = {n_max} beside the Boltzmann-kicked disk's (linear Boltzmann, "
+                  "same windows): within 10 % at " + (", ".join(agree) or "none")
+                  + "; departs at " + (", ".join(depart) or "none")
+                  + f"; inconclusive at the other {len(d) - len(agree) - len(depart)}")
     return [
         "# From two disks to a gas (generated)", "",
         f"**Is the tagged disk's collision process Poisson?** At N = {n_max}, by the one "
         f"rule stated below the table: {verdicts}. **From which N?** {POISSON_WITHIN} "
         f"at every larger N: {from_text}. **Against kinetic theory:** the collision rate is "
-        f"{rate}; the elastic gas's D at N = {n_max} differs from the dilute tagged disk's "
-        f"(linear Boltzmann, same windows) at {diff} of {len(el)} geometries.", ""]
+        f"{rate}; {theory}.", ""]
 
 
 def summary_lines(readings, controls=None) -> list:
@@ -231,27 +242,3 @@ def family_lines(readings) -> list:
                                  for _, r in g.iterrows()) + ".")
         lines.append(text)
     return lines
-
-
-def dilute_comparison(readings) -> list:
-    """Per elastic geometry and N, the gas's D beside the dilute tagged disk's (the kinetic
-    theory's prediction at the same windows): disjoint intervals read as a difference,
-    overlapping ones as not resolved (overlap is no agreement)."""
-    el = readings[readings["rule"] == "elastic"]
-    if el.empty or "dilute_d" not in el:
-        return []
-    head = ["geometry", "N", "D, gas", "D, dilute tagged disk", "reading"]
-    out = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
-    for _, r in el.iterrows():
-        if r["d_low"] > r["dilute_d_high"]:
-            word = "gas higher"
-        elif r["d_high"] < r["dilute_d_low"]:
-            word = "gas lower"
-        else:
-            word = "not resolved"
-        out.append("| " + " | ".join([
-            r["geometry"], str(int(r["n_disks"])),
-            format_interval(r["d"], r["d_low"], r["d_high"]),
-            format_interval(r["dilute_d"], r["dilute_d_low"], r["dilute_d_high"]),
-            word]) + " |")
-    return out
