@@ -19,8 +19,14 @@ Same-output baselines, where they finish:
 Also the robustness run of the issue: ``--robust 1e8`` collisions at packing 0.6 (N = 1000),
 checked for overlaps and disks outside at the end.
 
+The periodic box (issue 51): ``--box K`` runs N = 1000 disks at packing 0.3 (true area
+fraction, mirror rule) in the unit table and in the periodic box ``[0, 1)^2`` one after the
+other, K rounds, and prints both rates of each round and the ratio box / table (median and
+range): the machine is shared, so only the ratio measured in the same run means much.
+``--only-box`` skips the main table.
+
 Run: python benchmarks/bench_disks.py [--quick] [--packings 0.1 0.3 0.5] [--rounds 5]
-[--robust 1e8]
+[--robust 1e8] [--box 5 [--only-box]]
 """
 
 from __future__ import annotations
@@ -49,14 +55,28 @@ def cpu_best(func, repeats):
     return best, out
 
 
-def engine_rate(n, phi, collisions, repeats, rule="mirror"):
-    """``(collisions per CPU second, run)`` of simulate_disks at ``n``, ``phi``."""
-    r = math.sqrt(phi / n)
-    state = kt.initial_state(n, r, seed=1, rule=rule)
-    t_max = collisions / (0.5 * n * enskog_frequency(r, n))
-    kt.simulate_disks(state, r, t_max=t_max / 100, rule=rule)  # compiled, warm
-    sec, run = cpu_best(lambda: kt.simulate_disks(state, r, t_max=t_max, rule=rule), repeats)
+def engine_rate(n, phi, collisions, repeats, rule="mirror", box=None):
+    """``(collisions per CPU second, run)`` of simulate_disks at ``n``, ``phi`` (in the
+    periodic box of side ``box``: ``phi = n pi r^2 / box^2``)."""
+    area = math.pi if box is None else box * box
+    r = math.sqrt(phi / n) if box is None else math.sqrt(phi * area / (math.pi * n))
+    state = kt.initial_state(n, r, seed=1, rule=rule, box=box)
+    t_max = collisions / (0.5 * n * enskog_frequency(r, n, area=area))
+    kt.simulate_disks(state, r, t_max=t_max / 100, rule=rule, box=box)  # compiled, warm
+    sec, run = cpu_best(lambda: kt.simulate_disks(state, r, t_max=t_max, rule=rule, box=box),
+                        repeats)
     return run.n_pp / sec, run, state, r
+
+
+def box_rounds(rounds, collisions, n=1000, phi=0.3):
+    """The table and the box at ``n``, ``phi``, alternated: ``(table rates, box rates)``."""
+    table, box = [], []
+    for k in range(rounds):
+        table.append(engine_rate(n, phi, collisions, 1)[0])
+        box.append(engine_rate(n, phi, collisions, 1, box=1.0)[0])
+        print(f"  round {k + 1}: table {table[-1]:.4g} coll/s, box {box[-1]:.4g} coll/s, "
+              f"ratio {box[-1] / table[-1]:.3f}", flush=True)
+    return np.array(table), np.array(box)
 
 
 class ConcaveCircle:
@@ -120,8 +140,26 @@ def main(argv=None):
                          "rounds (one run of each per round): median and range")
     ap.add_argument("--robust", type=float, default=0.0,
                     help="also run this many collisions at packing 0.6, N = 1000")
+    ap.add_argument("--box", type=int, default=0,
+                    help="also compare the periodic box with the table at N = 1000, packing "
+                         "0.3, in this many alternated rounds")
+    ap.add_argument("--only-box", action="store_true", help="only the --box comparison")
     args = ap.parse_args(argv)
     collisions = 3e5 if args.quick else args.collisions
+    if args.box:
+        print(f"kicktimes {kt.__version__}, "
+              f"{time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}: N=1000, packing 0.3, "
+              f"mirror, ~{collisions:.2g} collisions per run, CPU seconds, table and box "
+              f"alternated")
+        table, box = box_rounds(args.box, collisions)
+        ratio = box / table
+        print(f"table: median {np.median(table):.4g} coll/s (range {table.min():.4g}-"
+              f"{table.max():.4g}); box: median {np.median(box):.4g} coll/s (range "
+              f"{box.min():.4g}-{box.max():.4g}); ratio box/table: median "
+              f"{np.median(ratio):.3f} (range {ratio.min():.3f}-{ratio.max():.3f})")
+        print(f"target: box >= 1.5e6 coll/s: {np.median(box):.3g}")
+        if args.only_box:
+            return
     rows = {}
     print(f"kicktimes {kt.__version__}, {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}, "
           f"CPU seconds, best of {args.repeats}, ~{collisions:.2g} collisions per run")

@@ -1,11 +1,12 @@
-"""Initial states of N disks in the unit table: `initial_state`.
+"""Initial states of N disks in the unit table or a periodic square box: `initial_state`.
 
 Positions: random sequential addition (RSA) up to packing `RSA_PACKING`; denser states
 are grown from there with the engine itself (Lubachevsky-Stillinger growth in steps: the
 disks move, then each grows by half the room it has, `grow_step`); finally the disks are
 relaxed by the dynamics (`RELAX_COLLISIONS` collisions per disk), whose invariant measure
-is uniform over the non-overlapping configurations. Velocities are drawn last.
-docs/disks.md, "Initial states".
+is uniform over the non-overlapping configurations. Velocities are drawn last. In the
+periodic box ``[0, L)^2`` the same, with nearest images and no wall (`box_side` gives
+``L`` for a packing). docs/disks.md, "Initial states".
 """
 
 from __future__ import annotations
@@ -17,10 +18,10 @@ from numba import njit
 
 from kicktimes._validation import check_int, check_real, check_rng
 from kicktimes.billiard import checks as chk
-from kicktimes.billiard.many_disks import check_radii_of, engine_run
+from kicktimes.billiard.many_disks import check_box, check_radii_of, engine_run
 from kicktimes.stats.enskog import PACKING_MAX, contact_value
 
-__all__ = ["initial_state", "grow_step"]
+__all__ = ["box_side", "initial_state", "grow_step"]
 
 #: RSA places disks directly up to this packing (its jamming limit is 0.547)
 RSA_PACKING = 0.35
@@ -81,10 +82,74 @@ def _rsa(radii, order, u, xy, m, w, head, nxt, k0, j0):
     return k, j
 
 
-def _rsa_positions(radii: np.ndarray, rng: np.random.Generator) -> np.ndarray:
-    """Centres by random sequential addition, largest disks first."""
+@njit(cache=True, error_model="numpy")
+def _rsa_box(radii, order, u, xy, m, w, head, nxt, k0, j0, box):
+    """`_rsa` in the periodic box ``[0, box)^2``: candidates ``box u[j]``, clear of the
+    nearest images of the disks placed (the grid of cells wraps)."""
+    k = k0
+    j = j0
+    n = order.shape[0]
+    r_max = radii[order[0]]
+    while k < n and j < u.shape[0]:
+        i = order[k]
+        x = box * u[j, 0]
+        y = box * u[j, 1]
+        j += 1
+        cx = min(int(x / w), m - 1)
+        cy = min(int(y / w), m - 1)
+        reach = int(math.ceil((radii[i] + r_max) / w))
+        # all cells once if the reach wraps round the box
+        lo_x, hi_x = (0, m - 1) if 2 * reach + 1 >= m else (cx - reach, cx + reach)
+        lo_y, hi_y = (0, m - 1) if 2 * reach + 1 >= m else (cy - reach, cy + reach)
+        ok = True
+        for gy in range(lo_y, hi_y + 1):
+            for gx in range(lo_x, hi_x + 1):
+                q = head[gx % m + m * (gy % m)]
+                while q >= 0:
+                    dx = x - xy[q, 0]
+                    dy = y - xy[q, 1]
+                    dx -= box * np.round(dx / box)
+                    dy -= box * np.round(dy / box)
+                    s = radii[i] + radii[q]
+                    if dx * dx + dy * dy < s * s:
+                        ok = False
+                        break
+                    q = nxt[q]
+                if not ok:
+                    break
+            if not ok:
+                break
+        if not ok:
+            continue
+        xy[i, 0] = x
+        xy[i, 1] = y
+        c = cx + m * cy
+        nxt[i] = head[c]
+        head[c] = i
+        k += 1
+    return k, j
+
+
+def _rsa_positions(radii: np.ndarray, rng: np.random.Generator, box=None) -> np.ndarray:
+    """Centres by random sequential addition, largest disks first (in the table, or in
+    the periodic box of side ``box``)."""
     n = radii.shape[0]
     order = np.argsort(-radii, kind="stable")
+    if box is not None:
+        m = max(1, min(int(box / (2.0 * radii.max())), int(math.ceil(2.0 * math.sqrt(n)))))
+        w = box / m
+        head = np.full(m * m, -1, dtype=np.int64)
+        nxt = np.full(n, -1, dtype=np.int64)
+        xy = np.zeros((n, 2))
+        k = 0
+        tries = 0
+        while k < n:
+            u = rng.random((max(4 * (n - k), 256), 2))
+            k, _ = _rsa_box(radii, order, u, xy, m, w, head, nxt, k, 0, float(box))
+            tries += u.shape[0]
+            if tries > 1000 * n + 10**6:  # pragma: no cover - RSA_PACKING is far from jamming
+                raise RuntimeError("random sequential addition did not place the disks")
+        return xy
     m = max(1, min(int(2.0 / (2.0 * radii.max())), int(math.ceil(2.0 * math.sqrt(n)))))
     w = 2.0 / m
     head = np.full(m * m, -1, dtype=np.int64)
@@ -101,17 +166,25 @@ def _rsa_positions(radii: np.ndarray, rng: np.random.Generator) -> np.ndarray:
     return xy
 
 
-def grow_step(xy: np.ndarray, radii: np.ndarray, target: np.ndarray) -> np.ndarray:
+def grow_step(xy: np.ndarray, radii: np.ndarray, target: np.ndarray, box=None) -> np.ndarray:
     """Radii grown by half the room each disk has (capped at ``target``): disk ``i`` may
-    reach ``min(1 - |x_i|, min_j (d_ij - r_j))``; if both disks of a pair take half their
-    room they still do not overlap."""
+    reach ``min(1 - |x_i|, min_j (d_ij - r_j))`` (the periodic box of side ``box``: no
+    wall, nearest images); if both disks of a pair take half their room they still do not
+    overlap."""
     from scipy.spatial import cKDTree
 
-    room = 1.0 - np.hypot(xy[:, 0], xy[:, 1]) - radii
-    pairs = cKDTree(xy).query_pairs(2.0 * float(target.max()), output_type="ndarray")
+    if box is None:
+        room = 1.0 - np.hypot(xy[:, 0], xy[:, 1]) - radii
+    else:
+        room = np.full(radii.shape, np.inf)
+    pairs = cKDTree(xy, boxsize=box).query_pairs(2.0 * float(target.max()),
+                                                 output_type="ndarray")
     if pairs.size:
         a, b = pairs[:, 0], pairs[:, 1]
-        gap = np.hypot(xy[a, 0] - xy[b, 0], xy[a, 1] - xy[b, 1]) - radii[a] - radii[b]
+        d = xy[a] - xy[b]
+        if box is not None:
+            d -= box * np.round(d / box)
+        gap = np.hypot(d[:, 0], d[:, 1]) - radii[a] - radii[b]
         np.minimum.at(room, a, gap)
         np.minimum.at(room, b, gap)
     # (a margin of 1e-9 of the room: the contact tests of the engine take touching disks)
@@ -123,24 +196,40 @@ def _unit_velocities(n: int, rng: np.random.Generator) -> np.ndarray:
     return np.column_stack([np.cos(theta), np.sin(theta)])
 
 
-def _relax(xy, radii, t, rng):
+def _relax(xy, radii, t, rng, box=None):
     """Positions after the mirror dynamics has run for ``t`` from unit velocities."""
     state = np.column_stack([xy, _unit_velocities(radii.shape[0], rng)])
-    out = engine_run(state, radii, chk.RULES["mirror"], t, log=False)
+    out = engine_run(state, radii, chk.RULES["mirror"], t, log=False, box=box)
     return out["final_state"][:, :2]
 
 
-def _collision_time(radii: np.ndarray, per_disk: float) -> float:
+def _collision_time(radii: np.ndarray, per_disk: float, box=None) -> float:
     """The time in which each disk collides about ``per_disk`` times (Enskog, unit speeds)."""
     n = radii.shape[0]
-    phi = float(np.sum(radii ** 2))
-    r = math.sqrt(phi / n)
-    nu = (n / math.pi) * 4.0 * r * float(contact_value(phi)) * 4.0 / math.pi
+    area = math.pi if box is None else box * box
+    phi = math.pi * float(np.sum(radii ** 2)) / area
+    r = math.sqrt(phi * area / (math.pi * n))
+    nu = (n / area) * 4.0 * r * float(contact_value(phi)) * 4.0 / math.pi
     return per_disk / max(nu, 1e-12) if n > 1 else per_disk
 
 
-def initial_state(n_disks, r, *, seed=0, rule="mirror", masses=None, packing=None) -> np.ndarray:
-    """A state of ``n_disks`` non-overlapping disks in the unit table, for `simulate_disks`.
+def box_side(n_disks, r, packing) -> float:
+    r"""The side :math:`L` of the periodic square box in which ``n_disks`` disks of radius
+    ``r`` have the area fraction ``packing``: :math:`\varphi = N\pi r^2 / L^2`.
+
+    >>> round(box_side(2000, 0.01, 0.3), 6)
+    1.447203
+    """
+    n = check_int("n_disks", n_disks, low=1, high=10**7)
+    r = check_real("r", r, low=0.0)
+    packing = check_real("packing", packing, low=0.0, high=PACKING_MAX)
+    return math.sqrt(n * math.pi * r * r / packing)
+
+
+def initial_state(n_disks, r, *, seed=0, rule="mirror", masses=None, packing=None,
+                  box=None) -> np.ndarray:
+    """A state of ``n_disks`` non-overlapping disks in the unit table (or a periodic square
+    box), for `simulate_disks`.
 
     Parameters
     ----------
@@ -158,12 +247,23 @@ def initial_state(n_disks, r, *, seed=0, rule="mirror", masses=None, packing=Non
         The masses of the energy shell (elastic rule; default 1).
     packing : float, optional
         The area fraction ``sum r_i^2`` (the table has area pi, a disk pi r^2), at most 0.7:
-        the radii ``r`` are scaled to it.
+        the radii ``r`` are scaled to it. In the box, the true area fraction
+        ``pi sum r_i^2 / L^2`` likewise (`box_side` gives ``L`` for given radii instead).
+    box : float, optional
+        The side ``L`` of the periodic square box ``[0, L)^2`` instead of the table:
+        centres in ``[0, L)``, nearest images; under the elastic rule the total momentum
+        is set to 0 (then the energy shell ``sum m |v|^2 = n_disks``, ``kT = 1/2``).
 
     Returns
     -------
     ndarray, shape (n_disks, 4)
         Rows ``(x, y, vx, vy)``.
+
+    Raises
+    ------
+    ValueError
+        Naming the argument: a packing that cannot exist or is above 0.7, radii of the
+        wrong shape, a box below three cells of one diameter (``L < 6 r_max``).
 
     Notes
     -----
@@ -180,10 +280,16 @@ def initial_state(n_disks, r, *, seed=0, rule="mirror", masses=None, packing=Non
     >>> s = kt.initial_state(100, None, packing=0.3, seed=2)
     >>> s.shape, bool(np.allclose(np.hypot(s[:, 2], s[:, 3]), 1.0))
     ((100, 4), True)
+    >>> b = kt.initial_state(2000, None, packing=0.3, box=1.0, rule="elastic", seed=2)
+    >>> bool(abs(b[:, 2:].sum(axis=0)).max() < 1e-9), round(float((b[:, 2:] ** 2).sum()))
+    (True, 2000)
     """
     n = check_int("n_disks", n_disks, low=1, high=10**7)
     rng = check_rng(seed, "seed")
     chk.check_choice("rule", rule, chk.RULES)
+    box = check_box(box)
+    # the table's packing sum r^2 is its area fraction (area pi); the box's, pi sum r^2/L^2
+    unit = 1.0 if box is None else math.pi / (box * box)
     if packing is not None:
         packing = check_real("packing", packing, low=0.0)
         if packing >= PACKING_MAX:
@@ -191,15 +297,18 @@ def initial_state(n_disks, r, *, seed=0, rule="mirror", masses=None, packing=Non
                              f"{packing!r} cannot exist (the densest is pi/sqrt(12) = "
                              f"{PACKING_MAX:.6g})")
         rel = np.ones(n) if r is None else check_radii_of(r, n)
-        radii = rel * math.sqrt(packing / float(np.sum(rel ** 2)))
-        if radii.max() >= 1.0:
+        radii = rel * math.sqrt(packing / (unit * float(np.sum(rel ** 2))))
+        if box is None and radii.max() >= 1.0:
             raise ValueError(f"packing={packing!r} makes a radius of {radii.max():.6g}, not "
                              f"below 1")
     else:
         if r is None:
             raise ValueError("give r (a radius, or one per disk) or packing")
-        radii = check_radii_of(r, n)
-    phi = float(np.sum(radii ** 2))
+        radii = check_radii_of(r, n, box=box)
+    if box is not None and box < 6.0 * float(radii.max()) * (1.0 + 1e-9):
+        raise ValueError(f"box must be at least 3 cells of one diameter wide, box >= 6 r_max "
+                         f"= {6.0 * float(radii.max()) * (1.0 + 1e-9):.6g}, got {box!r}")
+    phi = unit * float(np.sum(radii ** 2))
     if phi > PACKING_LIMIT:
         raise ValueError(f"packing must lie in (0.0, {PACKING_LIMIT}], got {phi:.6g}: denser "
                          f"states are not grown (hard disks freeze above about 0.70)")
@@ -213,21 +322,25 @@ def initial_state(n_disks, r, *, seed=0, rule="mirror", masses=None, packing=Non
             raise ValueError(f"masses must be {n} positive finite numbers (one per disk)")
     start = min(1.0, math.sqrt(RSA_PACKING / phi))
     cur = radii * start
-    xy = _rsa_positions(cur, rng)
+    xy = _rsa_positions(cur, rng, box)
     steps = 0
     while n > 1 and (cur < radii).any():
-        xy = _relax(xy, cur, _collision_time(cur, GROW_COLLISIONS), rng)
-        cur = grow_step(xy, cur, radii)
+        xy = _relax(xy, cur, _collision_time(cur, GROW_COLLISIONS, box), rng, box)
+        cur = grow_step(xy, cur, radii, box)
         steps += 1
         if steps > GROW_STEPS:
             raise RuntimeError(f"initial_state: the disks did not grow to packing {phi:.4g} "
-                               f"in {GROW_STEPS} steps (reached {float(np.sum(cur ** 2)):.4g})")
+                               f"in {GROW_STEPS} steps (reached "
+                               f"{unit * float(np.sum(cur ** 2)):.4g})")
     if n > 1:
-        xy = _relax(xy, radii, _collision_time(radii, RELAX_COLLISIONS), rng)
+        xy = _relax(xy, radii, _collision_time(radii, RELAX_COLLISIONS, box), rng, box)
     if rule == "mirror":
         v = _unit_velocities(n, rng)
     else:
         m = np.ones(n) if masses is None else masses
         v = rng.standard_normal((n, 2)) / np.sqrt(m)[:, None]
+        if box is not None and n > 1:
+            # no drift of the whole: the centre of mass at rest in the box
+            v -= (m[:, None] * v).sum(axis=0) / m.sum()
         v *= math.sqrt(n / float(np.sum(m * (v[:, 0] ** 2 + v[:, 1] ** 2))))
     return np.column_stack([xy, v])

@@ -1,8 +1,11 @@
-"""N hard disks in the unit circular table: the Python layer of the N-disk engine.
+"""N hard disks in the unit circular table or a periodic square box: the Python layer of
+the N-disk engine.
 
 `simulate_disks` checks its arguments (`check_disks`), sets up the engine
-(`kicktimes.billiard.kernels.disks`), runs its event loop, growing the logs as they fill,
-and returns a `DisksRun`. docs/disks.md describes the algorithm and its checks.
+(`kicktimes.billiard.kernels.disks`), runs its event loop, growing the logs as they fill
+and stopping every so often to count the centres of the central region (the pressure's
+log, `DisksRun.pressure`), and returns a `DisksRun`. docs/disks.md describes the
+algorithm and its checks.
 """
 
 from __future__ import annotations
@@ -19,8 +22,8 @@ from kicktimes.billiard.kernels import disks as kd
 from kicktimes.billiard.kernels.observe import DONE, FULL, OVER_BUDGET, STALLED
 from kicktimes.stats.enskog import PACKING_MAX, contact_value
 
-__all__ = ["check_disks", "engine_run", "expected_collisions", "raise_for_status",
-           "simulate_disks"]
+__all__ = ["check_box", "check_disks", "engine_run", "expected_collisions",
+           "raise_for_status", "simulate_disks"]
 
 #: most disks a run takes (int32 indices; about 180 bytes each)
 N_DISKS_MAX = 10**7
@@ -30,6 +33,13 @@ LOG_BYTES = 16
 #: collisions per disk, from this many disks on (fewer fit in the core's cache anyway)
 REORDER_SWEEPS = 10
 REORDER_MIN_DISKS = 2048
+#: the central region of the table whose pressure `DisksRun.pressure` calls the bulk: the
+#: centres within this radius (the box: the whole box)
+BULK_RADIUS = 0.5
+#: at most this many counts of the region's centres (stops of the loop, 35-60 us each) per
+#: run, one per `PRESSURE_EVERY` collisions per disk, at least 2 (`pressure_samples`)
+PRESSURE_SAMPLES = 100
+PRESSURE_EVERY = 4.0
 
 
 def _memory_bytes() -> float:
@@ -39,11 +49,26 @@ def _memory_bytes() -> float:
         return 8e9
 
 
-def check_radii_of(r, n: int, name: str = "r") -> np.ndarray:
-    """One radius per disk from ``r`` (a number, or ``n`` numbers), each in ``(0, 1)``, with a
-    packing ``sum r_i^2`` below the densest, ``pi / sqrt(12)``."""
-    if np.ndim(r) == 0:
-        radii = np.full(n, chk.check_real(name, r, low=0.0, high=1.0))
+def check_box(box):
+    """``box`` as a float: ``None`` (the unit table) or the side ``L > 0`` of the periodic
+    square box ``[0, L)^2``."""
+    if box is None:
+        return None
+    return chk.check_real("box", box, low=0.0, high=1e12)
+
+
+def check_radii_of(r, n: int, name: str = "r", box: float | None = None) -> np.ndarray:
+    """One radius per disk from ``r`` (a number, or ``n`` numbers), each in ``(0, 1)`` (the
+    box: in ``(0, box / 6]``), with a packing ``sum r_i^2`` (the box: ``pi sum r_i^2 /
+    box^2``) below the densest, ``pi / sqrt(12)``."""
+    high = 1.0 if box is None else box / 6.0
+    if np.ndim(r) == 0 and box is None:
+        radii = np.full(n, chk.check_real(name, r, low=0.0, high=high))
+    elif np.ndim(r) == 0:
+        radii = np.full(n, chk.check_real(name, r, low=0.0))
+        if radii[0] > high:
+            raise ValueError(f"{name} must lie in (0.0, box / 6 = {high:.6g}] (three cells of "
+                             f"one diameter per side), got {radii[0]!r}")
     else:
         try:
             radii = np.array(r, dtype=np.float64)
@@ -52,20 +77,29 @@ def check_radii_of(r, n: int, name: str = "r") -> np.ndarray:
         if radii.shape != (n,):
             raise ValueError(f"{name} must be one radius or {n} radii (one per disk), got "
                              f"shape {radii.shape}")
-        bad = np.flatnonzero(~(np.isfinite(radii) & (radii > 0.0) & (radii < 1.0)))
+        ok = (radii < 1.0) if box is None else (radii <= high)
+        bad = np.flatnonzero(~(np.isfinite(radii) & (radii > 0.0) & ok))
         if bad.size:
-            raise ValueError(f"{name}[{bad[0]}] must lie in (0.0, 1.0), got {radii[bad[0]]!r}")
-    packing = float(np.sum(radii * radii))
+            span = "(0.0, 1.0)" if box is None else f"(0.0, box / 6 = {high:.6g}]"
+            raise ValueError(f"{name}[{bad[0]}] must lie in {span}, got {radii[bad[0]]!r}")
+    if box is None:
+        packing = float(np.sum(radii * radii))
+        what = "sum(r^2)"
+    else:
+        packing = math.pi * float(np.sum(radii * radii)) / (box * box)
+        what = "pi sum(r^2) / box^2"
     if packing >= PACKING_MAX:
-        raise ValueError(f"{name}: the disks' packing sum(r^2) = {packing:.6g} cannot exist in "
-                         f"the table: it must be below the densest packing pi/sqrt(12) = "
-                         f"{PACKING_MAX:.6g}")
+        raise ValueError(f"{name}: the disks' packing {what} = {packing:.6g} cannot exist in "
+                         f"the {'table' if box is None else 'box'}: it must be below the "
+                         f"densest packing pi/sqrt(12) = {PACKING_MAX:.6g}")
     return radii
 
 
-def check_disks(state, r, rule: str, masses=None, name: str = "state"):
+def check_disks(state, r, rule: str, masses=None, name: str = "state", box=None):
     """Validate an N-disk state; returns ``(state, radii, masses)`` as float64 arrays
-    (``masses`` None for equal masses). Names the disk or pair at fault."""
+    (``masses`` None for equal masses). Names the disk or pair at fault. In the periodic
+    box (``box`` its side ``L``) centres must lie in ``[0, L]^2`` (``L`` is wrapped to 0)
+    and overlaps are measured between nearest images."""
     try:
         arr = np.array(state, dtype=np.float64, copy=True, order="C")
     except (TypeError, ValueError):
@@ -80,9 +114,17 @@ def check_disks(state, r, rule: str, masses=None, name: str = "state"):
         k = int(np.flatnonzero(~np.isfinite(arr).all(axis=1))[0])
         raise ValueError(f"{name} must be finite, got NaN or inf in disk {k}: {arr[k].tolist()}")
     chk.check_choice("rule", rule, chk.RULES)
-    radii = check_radii_of(r, n)
+    radii = check_radii_of(r, n, box=box)
+    if box is not None:
+        out = np.flatnonzero(((arr[:, :2] < 0.0) | (arr[:, :2] > box)).any(axis=1))
+        if out.size:
+            k = int(out[0])
+            raise ValueError(f"{name}: disk {k}'s centre ({arr[k, 0]:.15g}, {arr[k, 1]:.15g}) "
+                             f"lies outside the box; centres must lie in [0, box]^2, box = "
+                             f"{box!r}")
+        arr[:, :2] = np.where(arr[:, :2] >= box, arr[:, :2] - box, arr[:, :2])
     dist = np.hypot(arr[:, 0], arr[:, 1])
-    out = np.flatnonzero(dist > 1.0 - radii + chk.CONTACT_TOL)
+    out = np.flatnonzero(dist > 1.0 - radii + chk.CONTACT_TOL) if box is None else dist[:0]
     if out.size:
         k = int(out[0])
         raise ValueError(f"{name}: disk {k}'s centre at distance {dist[k]:.15g} from the table "
@@ -107,10 +149,14 @@ def check_disks(state, r, rule: str, masses=None, name: str = "state"):
     if n > 1:
         from scipy.spatial import cKDTree
 
-        pairs = cKDTree(arr[:, :2]).query_pairs(2.0 * float(radii.max()), output_type="ndarray")
+        tree = cKDTree(arr[:, :2], boxsize=box)
+        pairs = tree.query_pairs(2.0 * float(radii.max()), output_type="ndarray")
         if pairs.size:
             a, b = pairs[:, 0], pairs[:, 1]
-            gap = np.hypot(arr[a, 0] - arr[b, 0], arr[a, 1] - arr[b, 1])
+            d = arr[a, :2] - arr[b, :2]
+            if box is not None:
+                d -= box * np.round(d / box)
+            gap = np.hypot(d[:, 0], d[:, 1])
             sig = radii[a] + radii[b]
             bad = np.flatnonzero(gap < sig - chk.CONTACT_TOL)
             if bad.size:
@@ -136,21 +182,24 @@ def check_disks(state, r, rule: str, masses=None, name: str = "state"):
     return arr, radii, masses
 
 
-def expected_collisions(radii: np.ndarray, speed: float, t_max: float) -> tuple[float, float]:
+def expected_collisions(radii: np.ndarray, speed: float, t_max: float,
+                        box: float | None = None) -> tuple[float, float]:
     """Rough counts ``(disk-disk, wall)`` of collisions of a run: Enskog's frequency at the
     table's packing, and the wall flux ``2 n rho |v| / pi`` round the wall (``n`` the
-    density), for the budgets and the memory check."""
+    density), for the budgets and the memory check (the box: area ``box^2``, no wall)."""
     n = radii.shape[0]
-    phi = float(np.sum(radii * radii))
-    r = float(np.sqrt(phi / n))
-    nu = (n / math.pi) * 4.0 * r * float(contact_value(min(phi, 0.85))) * 4.0 / math.pi * speed
-    walls = 2.0 * n / math.pi * speed * t_max * (1.0 + 4.0 * phi)
+    area = math.pi if box is None else box * box
+    phi = float(np.sum(radii * radii)) * math.pi / area
+    r = float(np.sqrt(phi * area / (math.pi * n)))
+    nu = (n / area) * 4.0 * r * float(contact_value(min(phi, 0.85))) * 4.0 / math.pi * speed
+    walls = 2.0 * n / math.pi * speed * t_max * (1.0 + 4.0 * phi) if box is None else 0.0
     return 0.5 * n * nu * t_max, walls
 
 
 def engine_run(state, radii, rule_code, t_max, *, masses=None, arcs=None, walls_sel=None,
                sample=None, tau=None, contacts=False, max_events=None, log=True,
-               cap_hint=1024, debug=False, tangent=None, segment=None, on_segment=None):
+               cap_hint=1024, debug=False, tangent=None, segment=None, on_segment=None,
+               box=None, bulk_radius=BULK_RADIUS, pressure_samples=0):
     """Run the engine on a validated state; returns a dict of its raw outputs in the
     caller's disk numbering. ``log=False`` keeps no collision log (the log buffer is
     reused: the initial-state growth runs only need the final state). ``debug=True``
@@ -162,16 +211,27 @@ def engine_run(state, radii, rule_code, t_max, *, masses=None, arcs=None, walls_
     at ``t_max``) and calls ``on_segment(u, v, lg)`` with the vector flown to that time
     (``u``, caller's numbering, changed in place and carried on from there), the disks'
     velocities ``v`` and ``lg`` the log of the engine's own rescalings since the last stop
-    (`kd.shrink_tangent`). ``out["tangent"]``: the vector at ``t_max``."""
+    (`kd.shrink_tangent`). ``out["tangent"]``: the vector at ``t_max``.
+
+    ``box``: the side ``L`` of a periodic square box ``[0, L)^2`` instead of the table
+    (centres in ``[0, L)``; no wall). ``pressure_samples`` (``k >= 1``): the run also stops
+    at ``t_max j / k``, ``j = 1..k``, and ``out["pressure_log"]`` has rows ``(t, centres
+    within bulk_radius of the table's centre (the box: all), the sums of the wall's
+    impulse, the virial and the central region's virial up to t)``, the first at ``t = 0``
+    (`kd.collide`; `DisksRun.pressure`)."""
     n = state.shape[0]
-    m, w = cells.grid(n, float(radii.max()))
-    perm, eng = kd.new_engine(state, radii, m, w)
+    if box is None:
+        m, w = cells.grid(n, float(radii.max()))
+    else:
+        m, w = cells.grid_box(n, float(radii.max()), float(box))
+    perm, eng = kd.new_engine(state, radii, m, w, box)
     inv = np.empty(n, dtype=np.int64)
     inv[perm] = np.arange(n)
     ident = perm.astype(np.int32)  # engine disk k is the caller's ident[k]
     reorder_every = max(1, int(REORDER_SWEEPS * n)) if n >= REORDER_MIN_DISKS else 0
     mass = None if masses is None else np.ascontiguousarray(masses[perm])
-    clock = np.zeros(3)
+    clock = np.zeros(kd.N_CLOCK)
+    clock[kd.RB2] = bulk_radius * bulk_radius
     cnt = np.zeros(9, dtype=np.int64)
     cap = int(min(max(cap_hint, 64), 2**31 - 1)) if log else 4096
     pp_t, pp_i, pp_j = np.empty(cap), np.empty(cap, np.int32), np.empty(cap, np.int32)
@@ -207,18 +267,28 @@ def engine_run(state, radii, rule_code, t_max, *, masses=None, arcs=None, walls_
     if masses is not None:
         e = float(np.sum(masses * (state[:, 2] ** 2 + state[:, 3] ** 2)))
         speed = max(speed, math.sqrt(e / float(masses.min())))
-    stall_dt = 1e-9 * (1.0 - float(radii.max())) / (speed * n)
+    stall_dt = 1e-9 * (1.0 - float(radii.max()) if box is None else box) / (speed * n)
     budget = np.iinfo(np.int64).max if max_events is None else int(max_events)
     fs, iv, head, qt, qi, ht, qh, qs, qw = eng
     dropped = 0  # collisions of a reused log buffer (log=False)
     # the stops of the tangent's segments (the last at t_max)
     n_stop = 1 if tangent is None else max(1, int(math.floor(t_max / segment * (1 + 1e-12))))
     k_stop = 1
+    # the pressure's log: a row at 0, then one at each stop t_max j / k
+    plog = np.zeros((pressure_samples + 1, 5))
+    if pressure_samples:
+        plog[0] = _pressure_row(fs, iv, clock, 0.0, box)
+    k_samp = 1
     while True:
-        t_stop = float(t_max) if k_stop == n_stop else k_stop * segment
+        t_tan = float(t_max) if k_stop == n_stop else k_stop * segment
+        t_stop = t_tan
+        if k_samp <= pressure_samples:
+            t_samp = float(t_max) if k_samp == pressure_samples else \
+                t_max * k_samp / pressure_samples
+            t_stop = min(t_stop, t_samp)
         status = kd.drive(fs, iv, head, m, w, qt, qi, ht, qh, qs, qw, rule_code, mass,
                           t_stop, budget, stall_dt, clock, cnt, pp_t, pp_i, pp_j, esc,
-                          ident, reorder_every, arcs, walls, samp, con, tan, dbg)
+                          ident, reorder_every, arcs, walls, samp, con, tan, dbg, box)
         if status == kd.REORDER:
             order = cells.cell_order(iv[:, kd.CELL], m)
             new_of = kd.relabel(fs, iv, head, m, qt, qi, ht, qh, qs, qw, order)
@@ -232,6 +302,11 @@ def engine_run(state, radii, rule_code, t_max, *, masses=None, arcs=None, walls_
             if tangent is not None:
                 tan = (tan[0][order], tan[1])
             continue
+        if status == DONE and k_samp <= pressure_samples and t_stop == t_samp:
+            plog[k_samp] = _pressure_row(fs, iv, clock, t_stop, box)
+            k_samp += 1
+            if t_stop < t_tan:
+                continue
         if status == DONE and tangent is not None:
             common, dt = kd.tangent_at(tan[0], fs, clock, t_stop)
             at_stop = np.empty_like(common)
@@ -264,6 +339,10 @@ def engine_run(state, radii, rule_code, t_max, *, masses=None, arcs=None, walls_
     fin = kd.final_state(fs, iv, clock, float(t_max))
     final = np.empty_like(fin)
     final[ident] = fin
+    if box is not None:
+        # (centres leave [0, L) only at a crossing, a rounding error beyond the edge)
+        final[:, :2] -= box * np.floor(final[:, :2] / box)
+        final[:, :2] = np.where(final[:, :2] >= box, 0.0, final[:, :2])
     out = {"status": int(status), "final_state": final, "clock_time": float(clock[0]),
            "pp_times": pp_t[:n_pp].copy(), "pp_i": pp_i[:n_pp].copy(),
            "pp_j": pp_j[:n_pp].copy(), "n_wall": int(cnt[kd.N_WALL]),
@@ -284,7 +363,24 @@ def engine_run(state, radii, rule_code, t_max, *, masses=None, arcs=None, walls_
         out["contacts"] = (con[0][:n_pp].copy(), con[1][:n_pp].copy())
     if tangent is not None and status == DONE:
         out["tangent"] = at_stop
+    if pressure_samples:
+        out["pressure_log"] = plog[:k_samp]
+    out["sums"] = clock[kd.W_IMPULSE:kd.VIRIAL_B + 1].copy()
     return out
+
+
+def _pressure_row(fs, iv, clock, t, box):
+    """``(t, centres in the central region, wall impulse, virial, region's virial)`` at the
+    absolute time ``t`` (a stop of the loop: the disks flown there, not moved)."""
+    live = iv[:, kd.CELL] >= 0
+    if box is None:
+        dt = (t - clock[kd.OFFSET]) - fs[:, kd.T]
+        x = fs[:, kd.X] + fs[:, kd.VX] * dt
+        y = fs[:, kd.Y] + fs[:, kd.VY] * dt
+        inside = int(np.count_nonzero(live & (x * x + y * y < clock[kd.RB2])))
+    else:
+        inside = int(np.count_nonzero(live))
+    return (t, inside, clock[kd.W_IMPULSE], clock[kd.VIRIAL], clock[kd.VIRIAL_B])
 
 
 def raise_for_status(out: dict, budget: int) -> None:
@@ -300,16 +396,20 @@ def raise_for_status(out: dict, budget: int) -> None:
 
 
 def simulate_disks(state, r, *, t_max, rule="mirror", masses=None, holes=None, sample=None,
-                   tau=None, log_walls=False, max_events=None) -> DisksRun:
-    """Simulate N hard disks in the unit circular table, event by event.
+                   tau=None, log_walls=False, max_events=None, box=None,
+                   bulk_radius=BULK_RADIUS) -> DisksRun:
+    """Simulate N hard disks in the unit circular table, or a periodic square box, event
+    by event.
 
     Parameters
     ----------
     state : array_like, shape (n_disks, 4)
-        Rows ``(x, y, vx, vy)``: centres in the table (``|x_i| <= 1 - r_i``) without
-        overlaps, unit speeds under the mirror rule (`kicktimes.initial_state` draws one).
+        Rows ``(x, y, vx, vy)``: centres in the table (``|x_i| <= 1 - r_i``; the box:
+        ``0 <= x_i, y_i <= L``) without overlaps (the box: between nearest images), unit
+        speeds under the mirror rule (`kicktimes.initial_state` draws one).
     r : float or array_like, shape (n_disks,)
-        The disks' radius, or one radius per disk, each in ``(0, 1)``.
+        The disks' radius, or one radius per disk, each in ``(0, 1)`` (the box:
+        ``(0, L / 6]``).
     t_max : float
         End time (``0 < t_max <= 1e12``); collisions at ``t_max`` are included.
     rule : {"mirror", "elastic"}
@@ -330,19 +430,29 @@ def simulate_disks(state, r, *, t_max, rule="mirror", masses=None, holes=None, s
     max_events : int, optional
         Stop with a ValueError after this many collisions, disk-disk and wall (``>= 1``).
         Default: ten times the expected number plus 10^6.
+    box : float, optional
+        The side ``L`` of a periodic square box ``[0, L)^2`` instead of the table: no wall,
+        distances between nearest images, centres wrapped into ``[0, L)`` (``final_state``).
+        At least three cells of one diameter per side: ``L >= 6 r_max``. No ``holes`` or
+        ``log_walls`` then.
+    bulk_radius : float
+        The central region of the table, centres within ``bulk_radius`` of its centre
+        (``0 < bulk_radius <= 1 - r_max``), whose collisions and density give
+        `DisksRun.pressure`'s bulk pressure; the box's region is the whole box.
 
     Returns
     -------
     DisksRun
         ``collisions`` (``time, i, j``), ``final_state``, ``n_events``,
-        ``collision_times(k)``, ``walls``, ``samples``, ``escape_times``.
+        ``collision_times(k)``, ``walls``, ``samples``, ``escape_times``, ``pressure()``.
 
     Raises
     ------
     ValueError
         Naming the argument: disks that overlap (the pair), a disk outside the table, radii
         whose packing cannot exist, a log that would not fit in memory (``t_max``), a run
-        over ``max_events`` or one that makes no progress.
+        over ``max_events`` or one that makes no progress, a box too small for three
+        cells, wall options with a box.
 
     Notes
     -----
@@ -351,6 +461,13 @@ def simulate_disks(state, r, *, t_max, rule="mirror", masses=None, holes=None, s
     the rules are those of `simulate_two_particle`, and two disks agree with it event by
     event. Memory: about 180 bytes per disk plus 16 per logged collision.
 
+    The pressure's sums (the wall's impulse, the collisional virial, the central
+    region's) are accumulated by the engine as it goes, and the loop stops once per four
+    collisions per disk (at least 2, at most 100 times) to count the centres of the
+    central region:
+    `DisksRun.pressure` (Allen & Tildesley, *Computer Simulation of Liquids*, 2nd ed.,
+    2017, secs. 2.4 and 3.7).
+
     Examples
     --------
     >>> import kicktimes as kt
@@ -358,14 +475,30 @@ def simulate_disks(state, r, *, t_max, rule="mirror", masses=None, holes=None, s
     >>> run = kt.simulate_disks(state, 0.03, t_max=5.0)
     >>> bool((run.collisions.i < run.collisions.j).all())
     True
+    >>> s = kt.initial_state(200, 0.02, box=1.0, rule="elastic", seed=1)
+    >>> run = kt.simulate_disks(s, 0.02, t_max=2.0, rule="elastic", box=1.0)
+    >>> run.box, bool(((run.final_state[:, :2] >= 0) & (run.final_state[:, :2] < 1)).all())
+    (1.0, True)
     """
     chk.check_choice("rule", rule, chk.RULES)
     t_max = chk.check_real("t_max", t_max, low=0.0, high=chk.TIME_LIMIT, high_open=False)
-    state, radii, masses = check_disks(state, r, rule, masses)
+    box = check_box(box)
+    state, radii, masses = check_disks(state, r, rule, masses, box=box)
     n = state.shape[0]
+    if box is not None and holes is not None:
+        raise ValueError("holes: the periodic box has no wall to cut holes in; pass "
+                         "holes=None with box")
     arcs = chk.check_holes(holes)
     if not isinstance(log_walls, bool | np.bool_):
         raise TypeError(f"log_walls must be a bool, got {type(log_walls).__name__}")
+    if box is not None and log_walls:
+        raise ValueError("log_walls: the periodic box has no wall hits to log; pass "
+                         "log_walls=False with box")
+    if box is None:
+        bulk_radius = chk.check_real("bulk_radius", bulk_radius, low=0.0,
+                                     high=1.0 - float(radii.max()), high_open=False)
+    else:
+        bulk_radius = math.inf
     if sample is not None:
         try:
             sample = np.array(sample, dtype=np.int64, ndmin=1)
@@ -390,7 +523,7 @@ def simulate_disks(state, r, *, t_max, rule="mirror", masses=None, holes=None, s
                              f"than {chk.N_STEPS_MAX} positions; pass a larger tau or fewer "
                              f"disks in sample")
     speed = float(np.hypot(state[:, 2], state[:, 3]).max())
-    e_pp, e_wall = expected_collisions(radii, speed, t_max)
+    e_pp, e_wall = expected_collisions(radii, speed, t_max, box)
     if max_events is not None:
         max_events = chk.check_int("max_events", max_events, low=1)
     budget = max_events if max_events is not None else int(10.0 * (e_pp + e_wall) + 10**6)
@@ -401,9 +534,12 @@ def simulate_disks(state, r, *, t_max, rule="mirror", masses=None, holes=None, s
             f"{e_pp:.3g} disk-disk collisions, a log of {e_pp * LOG_BYTES / 1e9:.3g} GB, more "
             f"than half this machine's memory ({mem / 1e9:.3g} GB); pass a shorter t_max or "
             f"fewer disks")
+    n_samples = int(min(PRESSURE_SAMPLES, max(2, round(2.0 * e_pp / n / PRESSURE_EVERY))))
     out = engine_run(state, radii, chk.RULES[rule], t_max, masses=masses, arcs=arcs,
                      walls_sel=sample if log_walls else None, sample=sample, tau=tau,
-                     max_events=budget, cap_hint=int(1.2 * e_pp) + 1024)
+                     max_events=budget, cap_hint=int(1.2 * e_pp) + 1024, box=box,
+                     bulk_radius=bulk_radius if box is None else 0.0,
+                     pressure_samples=n_samples)
     raise_for_status(out, budget)
     return DisksRun(
         radii=radii, rule=rule, t_max=t_max, state=state, final_state=out["final_state"],
@@ -415,4 +551,6 @@ def simulate_disks(state, r, *, t_max, rule="mirror", masses=None, holes=None, s
         wall_log=out.get("wall_log"),
         engine={"cell_crossings": out["crossings"], "stale_events": out["stale"],
                 "cells_per_side": out["cells_per_side"], "buckets": out["buckets"]},
+        box=box, bulk_radius=None if box is not None else bulk_radius,
+        pressure_log=out["pressure_log"],
     )

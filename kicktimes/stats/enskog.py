@@ -12,7 +12,7 @@ import numpy as np
 
 from kicktimes._validation import check_choice, check_int, check_real
 
-__all__ = ["contact_value", "enskog_frequency", "speed_rate_factor"]
+__all__ = ["contact_value", "enskog_frequency", "henderson_z", "speed_rate_factor"]
 
 #: the densest packing of disks, pi / sqrt(12)
 PACKING_MAX = math.pi / math.sqrt(12.0)
@@ -29,6 +29,48 @@ def contact_value(packing):
     """
     phi = np.asarray(packing, dtype=float)
     return (1.0 - 7.0 * phi / 16.0) / (1.0 - phi) ** 2
+
+
+def henderson_z(packing):
+    r"""Henderson's compressibility factor of hard disks, :math:`Z = PA/(NkT)`.
+
+    Parameters
+    ----------
+    packing : array_like
+        Area fraction :math:`\varphi = n \pi r^2`, in ``[0, pi / sqrt(12))``.
+
+    Returns
+    -------
+    ndarray or float
+        :math:`Z = (1 + \varphi^2/8) / (1 - \varphi)^2` (Henderson, Mol. Phys. 30, 971
+        (1975)).
+
+    Notes
+    -----
+    The two-dimensional virial equation of state of hard disks is
+    :math:`Z = 1 + 2\varphi\, g(\sigma)`, :math:`g(\sigma)` the pair correlation at
+    contact; with Henderson's contact value (`contact_value`),
+    :math:`1 + 2\varphi (1 - 7\varphi/16)/(1 - \varphi)^2 = (1 + \varphi^2/8)/(1 -
+    \varphi)^2`: this function and `contact_value` are one approximation. Its virial
+    coefficients in powers of :math:`\varphi`, :math:`2, 3.125, 4.25, 5.375`, against the
+    exact :math:`2, 3.1280, 4.2579, 5.3369` (Clisby & McCoy, J. Stat. Phys. 122, 15
+    (2006)), differ by 0.1, 0.2 and 0.7 %: at :math:`\varphi = 0.3` the two series differ
+    by less than 0.1 % of :math:`Z`.
+
+    Examples
+    --------
+    >>> round(float(henderson_z(0.3)), 4)
+    2.0638
+    >>> bool(abs(henderson_z(0.3) - (1 + 2 * 0.3 * contact_value(0.3))) < 1e-12)
+    True
+    """
+    phi = np.asarray(packing, dtype=float)
+    if np.any(~(phi >= 0.0) | (phi >= PACKING_MAX)):
+        bad = float(phi[~(phi >= 0.0) | (phi >= PACKING_MAX)].ravel()[0])
+        raise ValueError(f"packing must lie in [0, pi/sqrt(12) = {PACKING_MAX:.6g}), got "
+                         f"{bad!r}")
+    z = (1.0 + phi * phi / 8.0) / (1.0 - phi) ** 2
+    return float(z) if z.ndim == 0 else z
 
 
 def enskog_frequency(r, n_disks, *, rule="mirror", area=math.pi, kT=0.5):

@@ -11,6 +11,12 @@ about ``4 n`` cells (`grid`), so memory is O(n) however dilute the disks.
 
 A disk's cell is kept exact by events: `crossing` gives the time to the next cell edge
 its centre reaches and the cell beyond; the engine moves the disk at that time.
+
+The periodic square box ``[0, L)^2`` (`grid_box`, `crossing_box`): ``m >= 3`` cells of
+width ``w = L / m >= 2 r_max`` per side; the grid wraps (the neighbours of a cell on an
+edge lie across the box, and a crossing out of the last cell enters the first), and
+``m >= 3`` makes the 3 x 3 cells around any cell distinct, so each pair of neighbouring
+cells is seen under exactly one image.
 """
 
 from __future__ import annotations
@@ -20,7 +26,8 @@ import math
 import numpy as np
 from numba import njit
 
-__all__ = ["cell_of", "cell_order", "crossing", "grid", "insert", "remove", "spatial_order"]
+__all__ = ["cell_of", "cell_of_box", "cell_order", "crossing", "crossing_box", "grid",
+           "grid_box", "insert", "remove", "spatial_order"]
 
 INF = np.inf
 
@@ -35,6 +42,58 @@ def grid(n: int, r_max: float) -> tuple[int, float]:
     m = int(math.floor(2.0 / (2.0 * r_max * (1.0 + 1e-9))))
     m = max(1, min(m, max(3, int(math.ceil(2.0 * math.sqrt(n))))))
     return m, 2.0 / m
+
+
+def grid_box(n: int, r_max: float, box: float) -> tuple[int, float]:
+    """``(m, w)`` of the periodic box ``[0, box)^2``: as `grid` (``w >= 2 r_max`` by a hair,
+    ``m^2 <= max(9, 4 n)``) with ``w = box / m`` and ``m >= 3``; a box narrower than three
+    diameters, ``box < 6 r_max``, raises a ValueError naming ``box``."""
+    m = int(math.floor(box / (2.0 * r_max * (1.0 + 1e-9))))
+    if m < 3:
+        raise ValueError(f"box must be at least 3 cells of one diameter wide, box >= 6 r_max "
+                         f"= {6.0 * r_max * (1.0 + 1e-9):.6g}, got {box!r} (a smaller box would "
+                         f"let a disk meet two images of one neighbour)")
+    m = min(m, max(3, int(math.ceil(2.0 * math.sqrt(n)))))
+    return m, box / m
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def cell_of_box(x, y, m, w):
+    """The cell ``cx + m cy`` of a centre ``(x, y)`` of the periodic box (clamped to the
+    grid: a centre a rounding error outside ``[0, L)`` stays in the edge cell)."""
+    cx = min(max(int(math.floor(x / w)), 0), m - 1)
+    cy = min(max(int(math.floor(y / w)), 0), m - 1)
+    return cx + m * cy
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def crossing_box(x, y, vx, vy, c, m, w):
+    """``(dt, c_new)`` of the periodic box: as `crossing` with edges ``k w`` and the grid
+    wrapped (out of column ``m - 1`` to the right into column 0, and so on); ``inf, -1``
+    only for a disk at rest."""
+    cx = c % m
+    cy = c // m
+    dt = INF
+    cn = -1
+    if vx > 0.0:
+        dt = ((cx + 1) * w - x) / vx
+        cn = c + 1 if cx < m - 1 else c - (m - 1)
+    elif vx < 0.0:
+        dt = (cx * w - x) / vx
+        cn = c - 1 if cx > 0 else c + (m - 1)
+    if vy > 0.0:
+        d = ((cy + 1) * w - y) / vy
+        if d < dt:
+            dt = d
+            cn = c + m if cy < m - 1 else c - m * (m - 1)
+    elif vy < 0.0:
+        d = (cy * w - y) / vy
+        if d < dt:
+            dt = d
+            cn = c - m if cy > 0 else c + m * (m - 1)
+    if dt < 0.0:
+        dt = 0.0
+    return dt, cn
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -115,8 +174,14 @@ def cell_order(c: np.ndarray, m: int) -> np.ndarray:
     return np.argsort(key, kind="stable")
 
 
-def spatial_order(x: np.ndarray, y: np.ndarray, m: int, w: float) -> np.ndarray:
-    """`cell_order` of the disks at centres ``(x, y)``."""
+def spatial_order(x: np.ndarray, y: np.ndarray, m: int, w: float,
+                  box: float | None = None) -> np.ndarray:
+    """`cell_order` of the disks at centres ``(x, y)`` (of the table, or of the periodic
+    box ``[0, box)^2``)."""
+    if box is not None:
+        cx = np.clip(np.floor(x / w).astype(np.int64), 0, m - 1)
+        cy = np.clip(np.floor(y / w).astype(np.int64), 0, m - 1)
+        return cell_order(cx + m * cy, m)
     cx = np.clip(((x + 1.0) / w).astype(np.int64), 0, m - 1)
     cy = np.clip(((y + 1.0) / w).astype(np.int64), 0, m - 1)
     return cell_order(cx + m * cy, m)

@@ -62,8 +62,11 @@ X, Y, VX, VY, T, TW, TP, RAD = range(8)
 KIND, STAMP, COUNT, KIND_P, STAMP_P, CELL, NEXT, PREV = range(8)
 #: event kinds other than a partner's index (`PREDICT`: the disk's first prediction is due)
 WALL, CROSS, NONE, PREDICT = -1, -2, -3, -4
-#: fields of ``clock`` (float64) and ``cnt`` (int64), the loop's position between calls
-OFFSET, COMP, T_CHECK = range(3)
+#: fields of ``clock`` (float64) and ``cnt`` (int64), the loop's position between calls;
+#: ``clock`` also carries the pressure's sums (`collide`, the wall events of `drive`) and
+#: the squared radius of the central region they are taken in
+OFFSET, COMP, T_CHECK, W_IMPULSE, VIRIAL, VIRIAL_B, RB2 = range(7)
+N_CLOCK = 7
 N_PP, N_WALL, N_CROSS, N_STALE, N_WLOG, K_SAMPLE, N_ESC, N_CHECK, N_SINCE = range(9)
 #: the engine's own status (beside `kicktimes.billiard.kernels.observe`'s): ``reorder_every``
 #: collisions since the last renumbering; the caller renumbers (`relabel`) and resumes
@@ -75,21 +78,48 @@ STALL_EVENTS = 100_000
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def scan(i, x, y, vx, vy, now, gx0, gx1, gy0, gy1, fs, iv, head, m, best, kind, stamp):
+def scan(i, x, y, vx, vy, now, gx0, gx1, gy0, gy1, fs, iv, head, m, best, kind, stamp, box):
     """The earliest contact of disk ``i`` (at ``(x, y)`` at ``now``) with the disks of
     cells ``gx0..gx1 x gy0..gy1`` (extrapolated to ``now``), if before ``best``; returns the
-    new ``(best, kind, stamp)``."""
+    new ``(best, kind, stamp)``.
+
+    In the periodic box (``box``: its side ``L``; ``None``: the table) the cell indices
+    may lie one beyond the grid: that cell across the box, its disks seen under the image
+    shifted by ``-L`` (index -1) or ``+L`` (index ``m``); the cell, not the distance, picks
+    the image, so a pair is scanned under one image only (``m >= 3``)."""
     ri = fs[i, RAD]
     for gy in range(gy0, gy1 + 1):
+        gyc = gy
+        sy = 0.0
+        if box is not None:
+            if gy < 0:
+                gyc = gy + m
+                sy = -box
+            elif gy >= m:
+                gyc = gy - m
+                sy = box
         for gx in range(gx0, gx1 + 1):
-            k = head[gx + m * gy]
+            gxc = gx
+            sx = 0.0
+            if box is not None:
+                if gx < 0:
+                    gxc = gx + m
+                    sx = -box
+                elif gx >= m:
+                    gxc = gx - m
+                    sx = box
+            k = head[gxc + m * gyc]
             while k >= 0:
                 if k != i:
                     dk = now - fs[k, T]
                     wx = vx - fs[k, VX]
                     wy = vy - fs[k, VY]
-                    dx = x - (fs[k, X] + fs[k, VX] * dk)
-                    dy = y - (fs[k, Y] + fs[k, VY] * dk)
+                    if box is None:
+                        dx = x - (fs[k, X] + fs[k, VX] * dk)
+                        dy = y - (fs[k, Y] + fs[k, VY] * dk)
+                    else:
+                        dx = x - (fs[k, X] + fs[k, VX] * dk + sx)
+                        dy = y - (fs[k, Y] + fs[k, VY] * dk + sy)
                     # (the approach test first: half the pairs separate)
                     if dx * wx + dy * wy < 0.0:
                         tk = now + pair_hit_time(dx, dy, wx, wy, ri + fs[k, RAD])
@@ -102,9 +132,11 @@ def scan(i, x, y, vx, vy, now, gx0, gx1, gy0, gy1, fs, iv, head, m, best, kind, 
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def schedule(i, x, y, vx, vy, now, best, kind, stamp, fs, iv, m, w, qt, qi, ht, qh, qs, qw):
+def schedule(i, x, y, vx, vy, now, best, kind, stamp, fs, iv, m, w, qt, qi, ht, qh, qs, qw,
+             box):
     """Keep ``(best, kind, stamp)`` as disk ``i``'s earliest contact with a disk, and
-    schedule the earliest of it, the wall contact and the next cell crossing."""
+    schedule the earliest of it, the wall contact (the box: none, ``tw = inf``) and the
+    next cell crossing."""
     fs[i, TP] = best
     iv[i, KIND_P] = kind
     iv[i, STAMP_P] = stamp
@@ -112,7 +144,10 @@ def schedule(i, x, y, vx, vy, now, best, kind, stamp, fs, iv, m, w, qt, qi, ht, 
         best = fs[i, TW]
         kind = WALL
         stamp = 0
-    dtc, cn = cells.crossing(x, y, vx, vy, iv[i, CELL], m, w)
+    if box is None:
+        dtc, cn = cells.crossing(x, y, vx, vy, iv[i, CELL], m, w)
+    else:
+        dtc, cn = cells.crossing_box(x, y, vx, vy, iv[i, CELL], m, w)
     if now + dtc < best:
         best = now + dtc
         kind = CROSS
@@ -124,7 +159,7 @@ def schedule(i, x, y, vx, vy, now, best, kind, stamp, fs, iv, m, w, qt, qi, ht, 
 
 @njit(cache=True, inline="always", error_model="numpy")
 def rescan(i, now, gx0, gx1, gy0, gy1, best, kind, stamp, fs, iv, head, m, w, qt, qi, ht, qh,
-           qs, qw, tan):
+           qs, qw, tan, box):
     """Bring disk ``i`` to ``now``, look for an earlier contact than ``(best, kind, stamp)``
     in cells ``gx0..gx1 x gy0..gy1`` and schedule its earliest event (`scan`, `schedule`).
 
@@ -135,30 +170,41 @@ def rescan(i, now, gx0, gx1, gy0, gy1, best, kind, stamp, fs, iv, head, m, w, qt
     vx = fs[i, VX]
     vy = fs[i, VY]
     best, kind, stamp = scan(i, x, y, vx, vy, now, gx0, gx1, gy0, gy1, fs, iv, head, m, best,
-                             kind, stamp)
-    schedule(i, x, y, vx, vy, now, best, kind, stamp, fs, iv, m, w, qt, qi, ht, qh, qs, qw)
+                             kind, stamp, box)
+    schedule(i, x, y, vx, vy, now, best, kind, stamp, fs, iv, m, w, qt, qi, ht, qh, qs, qw,
+             box)
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def neighbourhood(c, m):
-    """``(gx0, gx1, gy0, gy1)``: the block of 3 x 3 cells around cell ``c`` in the grid."""
+def neighbourhood(c, m, box):
+    """``(gx0, gx1, gy0, gy1)``: the block of 3 x 3 cells around cell ``c`` in the grid
+    (the box: not clipped, `scan` wraps it)."""
     cx = c % m
     cy = c // m
+    if box is not None:
+        return cx - 1, cx + 1, cy - 1, cy + 1
     return max(cx - 1, 0), min(cx + 1, m - 1), max(cy - 1, 0), min(cy + 1, m - 1)
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def enter_cell(i, c, fs, iv, head, m):
+def enter_cell(i, c, fs, iv, head, m, box):
     """Disk ``i`` enters cell ``c``: moved to its list. Returns the row of three cells that
     became neighbours (``gx0 > gx1``: none, beyond the grid) and the earliest contact kept
     from before, which still holds for the others (a partner that has moved since is a
     stale event, found when it comes due): ``(gx0, gx1, gy0, gy1, best, kind, stamp)``."""
-    cells.remove(head, iv, NEXT, PREV, i, iv[i, CELL])
-    d = c - iv[i, CELL]
+    old = iv[i, CELL]
+    cells.remove(head, iv, NEXT, PREV, i, old)
+    d = c - old
     iv[i, CELL] = c
     cells.insert(head, iv, NEXT, PREV, i, c)
-    gx0, gx1, gy0, gy1 = neighbourhood(c, m)
-    if d == 1 or d == -1:
+    gx0, gx1, gy0, gy1 = neighbourhood(c, m, box)
+    if box is not None:
+        # the grid wraps: the step is +-1 in one direction, modulo m (m >= 3)
+        if c // m == old // m:
+            gx0 = gx1 = c % m + (1 if c % m == (old % m + 1) % m else -1)
+        else:
+            gy0 = gy1 = c // m + (1 if c // m == (old // m + 1) % m else -1)
+    elif d == 1 or d == -1:
         gx0 = gx1 = c % m + d
         if gx0 < 0 or gx0 >= m:
             gx0, gx1 = 1, 0
@@ -170,13 +216,13 @@ def enter_cell(i, c, fs, iv, head, m):
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def predict(i, now, fs, iv, head, m, w, qt, qi, ht, qh, qs, qw):
+def predict(i, now, fs, iv, head, m, w, qt, qi, ht, qh, qs, qw, box):
     """Schedule disk ``i``'s earliest event from ``now``: its wall contact, its next cell
     crossing, or a contact with a disk of the 3 x 3 cells around it (extrapolated to
     ``now``); the disk is first brought to ``now``."""
-    gx0, gx1, gy0, gy1 = neighbourhood(iv[i, CELL], m)
+    gx0, gx1, gy0, gy1 = neighbourhood(iv[i, CELL], m, box)
     rescan(i, now, gx0, gx1, gy0, gy1, np.inf, NONE, 0, fs, iv, head, m, w, qt, qi, ht, qh, qs,
-           qw, None)
+           qw, None, box)
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -198,16 +244,39 @@ def bring(fs, i, now, tan):
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def collide(i, j, now, fs, rule, mass, tan):
-    """The disk-disk collision of ``i`` and ``j`` at ``now`` (both brought there, with their
+def collide(i, j, now, fs, rule, mass, tan, box, clock):
+    r"""The disk-disk collision of ``i`` and ``j`` at ``now`` (both brought there, with their
     tangent rows): the rule's velocity map, the elastic rule's energy anchored to the pair's
-    energy before, both wall times afresh. Returns the mass factors ``(ki, kj)`` of the
-    velocity map (1 for equal masses)."""
+    energy before, both wall times afresh (the box: none; ``j`` seen under its nearest
+    image). Returns the mass factors ``(ki, kj)`` of the velocity map (1 for equal masses).
+
+    The pressure's sums, into ``clock`` (Allen & Tildesley, *Computer Simulation of
+    Liquids*, 2nd ed. (2017), sec. 2.4 and 3.7.2: the collisional virial): with
+    :math:`\Delta p_i = m_i \Delta v_i`, the pair's virial
+    :math:`\tfrac12 r_{ij}\cdot(\Delta p_i - \Delta p_j)` (:math:`= \sigma |\Delta p|`
+    under the elastic rule, :math:`\Delta p_j = -\Delta p_i \parallel r_{ij}`) into
+    ``VIRIAL_B`` if the contact point :math:`x_i - r_i r_{ij}/\sigma` lies inside the
+    central disk of squared radius ``clock[RB2]`` (the box: always); into ``VIRIAL`` the
+    table's :math:`r_i\cdot\Delta p_i + r_j\cdot\Delta p_j` (absolute positions: the
+    virial theorem with the wall as external force holds for the mirror rule too) or the
+    box's pair virial (minimum image)."""
     xi, yi = bring(fs, i, now, tan)
     xj, yj = bring(fs, j, now, tan)
+    if box is not None:
+        # the image of j next to i (in contact: |x_i - x_j| = sigma < box / 3)
+        if xi - xj > 0.5 * box:
+            xj += box
+        elif xi - xj < -0.5 * box:
+            xj -= box
+        if yi - yj > 0.5 * box:
+            yj += box
+        elif yi - yj < -0.5 * box:
+            yj -= box
     ai, bi, aj, bj = fs[i, VX], fs[i, VY], fs[j, VX], fs[j, VY]
     ki = 1.0
     kj = 1.0
+    mi = 1.0
+    mj = 1.0
     if mass is not None:
         mi = mass[i]
         mj = mass[j]
@@ -224,8 +293,25 @@ def collide(i, j, now, fs, rule, mass, tan):
     fs[i, VY] = bi2
     fs[j, VX] = aj2
     fs[j, VY] = bj2
-    fs[i, TW] = now + boundary_hit_time(xi, yi, ai2, bi2, 1.0 - fs[i, RAD])
-    fs[j, TW] = now + boundary_hit_time(xj, yj, aj2, bj2, 1.0 - fs[j, RAD])
+    dpx = mi * (ai2 - ai)
+    dpy = mi * (bi2 - bi)
+    dqx = mj * (aj2 - aj)
+    dqy = mj * (bj2 - bj)
+    dx = xi - xj
+    dy = yi - yj
+    pv = 0.5 * (dx * (dpx - dqx) + dy * (dpy - dqy))
+    if box is None:
+        fs[i, TW] = now + boundary_hit_time(xi, yi, ai2, bi2, 1.0 - fs[i, RAD])
+        fs[j, TW] = now + boundary_hit_time(xj, yj, aj2, bj2, 1.0 - fs[j, RAD])
+        clock[VIRIAL] += xi * dpx + yi * dpy + xj * dqx + yj * dqy
+        s = fs[i, RAD] / (fs[i, RAD] + fs[j, RAD])
+        cx = xi - s * dx
+        cy = yi - s * dy
+        if cx * cx + cy * cy < clock[RB2]:
+            clock[VIRIAL_B] += pv
+    else:
+        clock[VIRIAL] += pv
+        clock[VIRIAL_B] += pv
     return ki, kj
 
 
@@ -284,21 +370,43 @@ def tangent_back(u, common, dt):
     u[:, :2] = common[:, :2] - common[:, 2:] * dt[:, None]
 
 
+@njit(cache=True, inline="always", error_model="numpy")
+def wrap(i, now, fs, iv, m, box, tan):
+    """Disk ``i``, whose crossing into cell ``iv[i, STAMP]`` is due at ``now``, brought
+    there and, if the crossing leaves the box, moved by ``-+box`` to the side it enters."""
+    bring(fs, i, now, tan)
+    c = iv[i, STAMP]
+    old = iv[i, CELL]
+    if old % m == m - 1 and c % m == 0:
+        fs[i, X] -= box
+    elif old % m == 0 and c % m == m - 1:
+        fs[i, X] += box
+    elif old // m == m - 1 and c // m == 0:
+        fs[i, Y] -= box
+    elif old // m == 0 and c // m == m - 1:
+        fs[i, Y] += box
+
+
 @njit(cache=True, error_model="numpy")
-def setup(fs, iv, head, m, w, qt, qi, ht, qh, qs, qw):
-    """Fill the cells and the wall times for the disks of ``fs`` at local time 0 (their
-    clocks set to 0), and file each disk's first prediction as a `PREDICT` event at time 0:
-    `drive` makes it (the scan is compiled once, in the loop)."""
+def setup(fs, iv, head, m, w, qt, qi, ht, qh, qs, qw, box):
+    """Fill the cells and the wall times (the box: none) for the disks of ``fs`` at local
+    time 0 (their clocks set to 0), and file each disk's first prediction as a `PREDICT`
+    event at time 0: `drive` makes it (the scan is compiled once, in the loop)."""
     n = fs.shape[0]
     for c in range(head.shape[0]):
         head[c] = -1
     for i in range(n):
         fs[i, T] = 0.0
-        fs[i, TW] = boundary_hit_time(fs[i, X], fs[i, Y], fs[i, VX], fs[i, VY], 1.0 - fs[i, RAD])
+        if box is None:
+            fs[i, TW] = boundary_hit_time(fs[i, X], fs[i, Y], fs[i, VX], fs[i, VY],
+                                          1.0 - fs[i, RAD])
+            c = cells.cell_of(fs[i, X], fs[i, Y], m, w)
+        else:
+            fs[i, TW] = np.inf
+            c = cells.cell_of_box(fs[i, X], fs[i, Y], m, w)
         fs[i, TP] = np.inf
         iv[i, COUNT] = 0
         iv[i, KIND] = PREDICT
-        c = cells.cell_of(fs[i, X], fs[i, Y], m, w)
         iv[i, CELL] = c
         cells.insert(head, iv, NEXT, PREV, i, c)
     cal.build(qt, qi, ht, qh, qs, qw, np.zeros(n))
@@ -321,28 +429,33 @@ def rebase(fs, iv, qt, qi, ht, qh, qs, qw, now):
 
 
 @njit(cache=True, error_model="numpy")
-def check_state(fs, iv, head, m, now, dbg):
+def check_state(fs, iv, head, m, now, dbg, box):
     """Debug observer: the largest overlap of two disks and the largest distance of a
-    centre outside its room ``1 - r``, at ``now`` (all disks flown there), into
-    ``dbg[0]``, ``dbg[1]`` (maxima over the calls); ``dbg[2]`` counts the calls."""
+    centre outside its room ``1 - r`` (the box: outside ``[0, L]^2``), at ``now`` (all
+    disks flown there), into ``dbg[0]``, ``dbg[1]`` (maxima over the calls); ``dbg[2]``
+    counts the calls. Overlaps in the box: nearest images."""
     for i in range(fs.shape[0]):
         if iv[i, CELL] < 0:
             continue
         dt = now - fs[i, T]
         x = fs[i, X] + fs[i, VX] * dt
         y = fs[i, Y] + fs[i, VY] * dt
-        dbg[1] = max(dbg[1], np.sqrt(x * x + y * y) - (1.0 - fs[i, RAD]))
-        c = iv[i, CELL]
-        cx = c % m
-        cy = c // m
-        for gy in range(max(cy - 1, 0), min(cy + 2, m)):
-            for gx in range(max(cx - 1, 0), min(cx + 2, m)):
-                k = head[gx + m * gy]
+        if box is None:
+            dbg[1] = max(dbg[1], np.sqrt(x * x + y * y) - (1.0 - fs[i, RAD]))
+        else:
+            dbg[1] = max(dbg[1], -x, -y, x - box, y - box)
+        gx0, gx1, gy0, gy1 = neighbourhood(iv[i, CELL], m, box)
+        for gy in range(gy0, gy1 + 1):
+            for gx in range(gx0, gx1 + 1):
+                k = head[gx % m + m * (gy % m)]
                 while k >= 0:
                     if k > i:
                         dk = now - fs[k, T]
                         dx = x - (fs[k, X] + fs[k, VX] * dk)
                         dy = y - (fs[k, Y] + fs[k, VY] * dk)
+                        if box is not None:
+                            dx -= box * np.round(dx / box)
+                            dy -= box * np.round(dy / box)
                         ov = fs[i, RAD] + fs[k, RAD] - np.sqrt(dx * dx + dy * dy)
                         dbg[0] = max(dbg[0], ov)
                     k = iv[k, NEXT]
@@ -352,8 +465,8 @@ def check_state(fs, iv, head, m, now, dbg):
 @njit(cache=True, error_model="numpy", _nrt=False)
 def drive(fs, iv, head, m, w, qt, qi, ht, qh, qs, qw, rule, mass, t_end, max_events,
           stall_dt, clock, cnt, pp_t, pp_i, pp_j, esc, ident, reorder_every, arcs, walls, samp,
-          contacts, tan, dbg):
-    """Run the event loop until ``t_end`` (absolute; events at ``t_end`` included).
+          contacts, tan, dbg, box):
+    r"""Run the event loop until ``t_end`` (absolute; events at ``t_end`` included).
 
     Returns a status of `kicktimes.billiard.kernels.observe`: ``DONE``, ``FULL`` (a log is
     full: grow it and call again, the loop resumes where it stopped), ``OVER_BUDGET``
@@ -372,6 +485,12 @@ def drive(fs, iv, head, m, w, qt, qi, ht, qh, qs, qw, rule, mass, t_end, max_eve
     `tangent.pair_tangent`, wall contacts by `tangent.wall_tangent`, zeroed at an escape;
     ``u`` of shape (0, 4): off), ``lg[0]`` the log of its rescalings;
     ``dbg`` (debug mode if ``dbg[3] != 0``): `check_state` after every event.
+
+    ``box``: ``None``, the unit table; else the side ``L`` of the periodic box
+    ``[0, L)^2`` (no wall events; a crossing out of an edge cell moves the centre by
+    ``-+L`` into the cell across, so centres stay in ``[0, L)``). The pressure's sums
+    accumulate in ``clock`` (`collide`; ``W_IMPULSE``: the wall's :math:`\sum m|\Delta
+    v|`, escapes excluded).
     """
     cap = pp_t.shape[0]
     t_loc = t_end - clock[OFFSET]
@@ -410,7 +529,7 @@ def drive(fs, iv, head, m, w, qt, qi, ht, qh, qs, qw, rule, mass, t_end, max_eve
             continue
         if dbg is not None:
             if dbg[3] != 0.0:
-                check_state(fs, iv, head, m, te, dbg)
+                check_state(fs, iv, head, m, te, dbg, box)
         kind = iv[i, KIND]
         if kind != PREDICT:
             # a stall: STALL_EVENTS events in less than STALL_EVENTS * stall_dt
@@ -437,7 +556,7 @@ def drive(fs, iv, head, m, w, qt, qi, ht, qh, qs, qw, rule, mass, t_end, max_eve
                 if n + cnt[N_WALL] >= max_events:
                     return ob.OVER_BUDGET
                 ai, bi, aj, bj = fs[i, VX], fs[i, VY], fs[j, VX], fs[j, VY]
-                ki, kj = collide(i, j, te, fs, rule, mass, tan)
+                ki, kj = collide(i, j, te, fs, rule, mass, tan, box, clock)
                 if tan is not None:
                     if tan[0].shape[0] > 0:
                         pair_tangent_rows(tan[0], tan[1], i, j, fs, ai, bi, aj, bj, rule, ki,
@@ -498,6 +617,10 @@ def drive(fs, iv, head, m, w, qt, qi, ht, qh, qs, qw, rule, mass, t_end, max_eve
                     walls[3][q] = y
                     walls[4][q] = sin_theta
                     cnt[N_WLOG] = q + 1
+            mw = 1.0
+            if mass is not None:
+                mw = mass[i]
+            clock[W_IMPULSE] += mw * np.sqrt((vx - fs[i, VX]) ** 2 + (vy - fs[i, VY]) ** 2)
             fs[i, X] = x
             fs[i, Y] = y
             fs[i, VX] = vx
@@ -506,19 +629,22 @@ def drive(fs, iv, head, m, w, qt, qi, ht, qh, qs, qw, rule, mass, t_end, max_eve
         elif kind == CROSS:
             cnt[N_CROSS] += 1
             enter = True
+            if box is not None:
+                wrap(i, te, fs, iv, m, box, tan)
         elif kind != PREDICT:
             return ob.DONE
         for k in range(1 if pb < 0 else 2):
             d = pa if k == 0 else pb
             if enter:
-                gx0, gx1, gy0, gy1, best, bk, bs = enter_cell(d, iv[d, STAMP], fs, iv, head, m)
+                gx0, gx1, gy0, gy1, best, bk, bs = enter_cell(d, iv[d, STAMP], fs, iv, head, m,
+                                                              box)
             else:
-                gx0, gx1, gy0, gy1 = neighbourhood(iv[d, CELL], m)
+                gx0, gx1, gy0, gy1 = neighbourhood(iv[d, CELL], m, box)
                 best = np.inf
                 bk = NONE
                 bs = 0
             rescan(d, te, gx0, gx1, gy0, gy1, best, bk, bs, fs, iv, head, m, w, qt, qi, ht,
-                   qh, qs, qw, tan)
+                   qh, qs, qw, tan, box)
         if pb >= 0 and reorder_every > 0:
             cnt[N_SINCE] += 1
             if cnt[N_SINCE] >= reorder_every:
@@ -580,7 +706,8 @@ def final_state(fs, iv, clock, t_end):
     return out
 
 
-def new_engine(state: np.ndarray, radii: np.ndarray, m: int, w: float) -> tuple:
+def new_engine(state: np.ndarray, radii: np.ndarray, m: int, w: float,
+               box: float | None = None) -> tuple:
     """``(perm, engine)``: the engine's arrays ``(fs, iv, head, qt, qi, ht, qh, qs, qw)`` for
     a validated ``state`` (n, 4), set up at time 0 (`setup`), its disk ``k`` the caller's
     disk ``perm[k]`` (`cells.spatial_order`: neighbours share cache lines).
@@ -589,19 +716,19 @@ def new_engine(state: np.ndarray, radii: np.ndarray, m: int, w: float) -> tuple:
     ``4 n`` cells) and per bucket (``2 n`` rounded up to a power of two): 153-161 bytes per
     disk at 10^4 disks (docs/disks.md)."""
     n = state.shape[0]
-    perm = cells.spatial_order(state[:, 0], state[:, 1], m, w)
+    perm = cells.spatial_order(state[:, 0], state[:, 1], m, w, box)
     fs = np.zeros((n, 8))
     fs[:, :4] = state[perm]
     fs[:, RAD] = radii[perm]
     iv = np.zeros((n, 8), dtype=np.int32)
     head = np.empty(m * m, dtype=np.int32)
     q = cal.new_calendar(n, 1.0)
-    setup(fs, iv, head, m, w, *q)
+    setup(fs, iv, head, m, w, *q, box)
     # the first predictions, made by the loop up to (not including) the first event at 0
     no_log = np.empty(0, dtype=np.int32)
-    drive(fs, iv, head, m, w, *q, 0, None, 0.0, 0, 0.0, np.zeros(3), np.zeros(9, np.int64),
-          np.empty(0), no_log, no_log, np.empty(n), np.arange(n, dtype=np.int32), 0, None,
-          None, None, None, None, None)
+    drive(fs, iv, head, m, w, *q, 0, None, 0.0, 0, 0.0, np.zeros(N_CLOCK),
+          np.zeros(9, np.int64), np.empty(0), no_log, no_log, np.empty(n),
+          np.arange(n, dtype=np.int32), 0, None, None, None, None, None, None, box)
     # buckets about two event spacings wide: a disk's next event is about mean(qt) away
     qt = q[0]
     finite = qt[np.isfinite(qt)]
