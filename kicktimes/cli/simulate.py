@@ -28,8 +28,11 @@ from kicktimes.cli._group import _cli_errors, _compile_first, _Real, option
         help="Simulate this many disks together in one table instead (with --packing).")
 @option("--packing", type=_Real(0.0), default=None,
         help="Area fraction of the --disks (sum r^2), 0 < packing <= 0.7.")
+@option("--box", "box", type=_Real(0.0), default=None,
+        help="With --disks: a periodic square box of this side instead of the table (area "
+             "fraction N pi r^2 / box^2).")
 def simulate_command(radii, n_ics, t_max, seed, rule, ic_method, out, save_runs, n_disks,
-                     packing):
+                     packing, box):
     """Simulate two-disk billiards and log every disk-disk collision.
 
     Writes OUT/collisions.parquet (one row per radius and IC: radius, ic, t_window, n_pp,
@@ -40,10 +43,12 @@ def simulate_command(radii, n_ics, t_max, seed, rule, ic_method, out, save_runs,
     With --disks N --packing PHI: N disks of radius sqrt(PHI / N) together, from an
     initial state of `kicktimes.initial_state` (--seed, --rule); writes the collision
     log OUT/disks.parquet (time, i, j) and prints the collision frequency per disk beside
-    Enskog's with Henderson's contact value.
+    Enskog's with Henderson's contact value, and the compressibility factor Z = PA/(NkT)
+    from the wall, the virial and the central region beside Henderson's equation of
+    state. With --box L: in the periodic square box [0, L)^2, r = L sqrt(PHI / (pi N)).
     """
-    if n_disks is not None or packing is not None:
-        _simulate_disks(n_disks, packing, t_max, seed, rule, out)
+    if n_disks is not None or packing is not None or box is not None:
+        _simulate_disks(n_disks, packing, t_max, seed, rule, out, box)
         return
     import json
     import os
@@ -117,8 +122,9 @@ def simulate_command(radii, n_ics, t_max, seed, rule, ic_method, out, save_runs,
     click.echo(f"wrote {path}")
 
 
-def _simulate_disks(n_disks, packing, t_max, seed, rule, out):
-    """``kicktimes simulate --disks N --packing PHI``: one N-disk run, its log to Parquet."""
+def _simulate_disks(n_disks, packing, t_max, seed, rule, out, box=None):
+    """``kicktimes simulate --disks N --packing PHI [--box L]``: one N-disk run, its log to
+    Parquet, its collision frequency and pressure beside Enskog's and Henderson's."""
     import math
     import os
 
@@ -130,23 +136,58 @@ def _simulate_disks(n_disks, packing, t_max, seed, rule, out):
         raise click.UsageError("--disks and --packing go together: give both")
     _compile_first(None, DISKS_KERNELS)
     options = {"n_disks": "--disks", "packing": "--packing", "r": "--packing",
-               "t_max": "--t-max", "seed": "--seed", "rule": "--rule", "state": "--packing"}
+               "t_max": "--t-max", "seed": "--seed", "rule": "--rule", "state": "--packing",
+               "box": "--box"}
+    area = math.pi if box is None else box * box
     with _cli_errors(options):
-        r = math.sqrt(packing / n_disks)
-        state = initial_state(n_disks, r, seed=seed, rule=rule)
+        if box is not None and packing > 0.7:
+            raise ValueError(f"packing must lie in (0.0, 0.7], got {packing!r}")
+        r = math.sqrt(packing / n_disks) if box is None else \
+            math.sqrt(packing * area / (math.pi * n_disks))
+        if box is not None and 6.0 * r > box:
+            raise ValueError(f"box must be at least 3 cells of one diameter wide, box >= 6 r = "
+                             f"{6.0 * r:.6g} for {n_disks} disks at packing {packing:g}, got "
+                             f"{box:g}")
+        state = initial_state(n_disks, r, seed=seed, rule=rule, box=box)
         os.makedirs(out, exist_ok=True)
-        run = simulate_disks(state, r, t_max=t_max, rule=rule)
+        run = simulate_disks(state, r, t_max=t_max, rule=rule, box=box)
     path = os.path.join(out, "disks.parquet")
     with _cli_errors():
         run.to_parquet(path)
     nu = run.collision_frequency
-    enskog = enskog_frequency(r, n_disks, rule=rule)
+    kT = run.kT if rule == "elastic" else 0.5
+    enskog = enskog_frequency(r, n_disks, rule=rule, area=area, kT=kT)
+    where = "the whole table, its wall layer included" if box is None else "the periodic box"
     click.echo(f"{n_disks} disks, r={r:.6g}, packing={packing:g}, rule={rule}, t_max={t_max:g}, "
-               f"seed={seed}")
+               f"seed={seed}" + ("" if box is None else f", box={box:g}"))
     click.echo(f"{run.n_pp} disk-disk collisions, {run.n_wall} wall collisions")
     click.echo(f"collision frequency per disk {nu:.6g}, Enskog-Henderson {enskog:.6g} "
-               f"(ratio {nu / enskog:.4f}; the whole table, its wall layer included)")
+               f"(ratio {nu / enskog:.4f}; {where})")
+    click.echo(_pressure_lines(run))
     click.echo(f"wrote {path}")
+
+
+def _pressure_lines(run) -> str:
+    """The run's compressibility factors beside Henderson's (`DisksRun.pressure`)."""
+    rows = 0 if run.pressure_log is None else run.pressure_log.shape[0]
+    if rows < 3:
+        return "Z = PA/(NkT): the run is too short for block errors (fewer than 2 blocks)"
+    try:
+        p = run.pressure(blocks=min(10, rows - 1))
+    except ValueError as exc:
+        return f"Z = PA/(NkT): not computed ({exc})"
+    area = "pi (1 - r)^2, the centres' room" if run.box is None else "box^2"
+    out = [f"Z = PA/(NkT) (A = {area}), +- one standard error over {p.blocks} blocks:"]
+    if run.box is None:
+        out.append(f"  wall   {p.z_wall:.4f} +- {p.se_wall:.4f}")
+        out.append(f"  virial {p.z_virial:.4f} +- {p.se_virial:.4f}")
+        out.append(f"  bulk   {p.z_bulk:.4f} +- {p.se_bulk:.4f} (centres within "
+                   f"{run.bulk_radius:g} of the centre, their packing {p.bulk_packing:.4f}); "
+                   f"Henderson {p.henderson:.4f} at that packing")
+    else:
+        out.append(f"  virial {p.z_virial:.4f} +- {p.se_virial:.4f}; Henderson "
+                   f"{p.henderson:.4f} at the packing {p.packing:.4f}")
+    return "\n".join(out)
 
 
 # --- end simulate command ---------------------------------------------------------------

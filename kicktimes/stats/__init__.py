@@ -31,7 +31,7 @@ from .counts import CountRegression, kinetic_rate, regress_counts
 from .dilute import DiluteEstimate, DiluteTaggedDisk, dilute_tagged_disk, dilute_tagged_times
 from .distributions import hyperexpon
 from .ensemble import PoissonEnsembleResult, test_poisson_ensemble
-from .enskog import contact_value, enskog_frequency, speed_rate_factor
+from .enskog import contact_value, enskog_frequency, henderson_z, speed_rate_factor
 from .findings import (
     Finding,
     format_interval,
@@ -90,7 +90,7 @@ __all__ = [
     "pooled_intervals",
     "regress_counts",
     "kinetic_rate",
-    "enskog_frequency",
+    "enskog_frequency", "henderson_z",
     "speed_rate_factor",
     "dilute_tagged_times",
     "dilute_tagged_disk",
