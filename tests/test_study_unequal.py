@@ -81,9 +81,9 @@ def test_the_paper_scale_is_the_published_page_s():
 
 
 def test_the_figure_draws_ks_share_and_dispersion_on_their_own_axes():
-    from kicktimes.studies.unequal.figures import size_ratio_figure
-
     from pathlib import Path
+
+    from kicktimes.studies.unequal.figures import size_ratio_figure
 
     table = pd.read_csv(Path(__file__).parents[1] / "docs/results/size_ratio/size_ratio.csv")
     fig = size_ratio_figure(table)
