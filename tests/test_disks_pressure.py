@@ -55,6 +55,19 @@ def test_a_radial_wall_hit_adds_twice_the_momentum_to_the_wall_impulse():
     assert count == 0 and out["pressure_log"][0, 1] == 1
 
 
+@pytest.mark.parametrize("box", [None, 1.0])
+def test_stopping_to_count_the_region_changes_no_event(box):
+    n = 300
+    s = kt.initial_state(n, None, packing=0.3, seed=6, box=box)
+    r = math.sqrt(0.3 / n) if box is None else math.sqrt(0.3 / (math.pi * n))
+    plain = engine_run(s, np.full(n, r), 0, 3.0, box=box)
+    stops = engine_run(s, np.full(n, r), 0, 3.0, box=box, pressure_samples=37)
+    assert stops["pressure_log"].shape == (38, 5)
+    for key in ("pp_times", "pp_i", "pp_j", "final_state"):
+        assert np.array_equal(plain[key], stops[key])
+    np.testing.assert_array_equal(plain["sums"], stops["pressure_log"][-1, 2:])
+
+
 # --- the table: wall = virial, bulk = Henderson ------------------------------------------
 def table_pressure(n, phi, per_disk, *, rule="elastic", seed=1, blocks=20):
     """A run of ``per_disk`` collisions per disk in the table after 20 of equilibration:
