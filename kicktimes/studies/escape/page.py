@@ -234,8 +234,10 @@ def write_page(table, ratios, constant, params, command, seconds, source, curves
     lines += _law_lines(free, constant)
     lines += ["", f"![escape survival]({FIGURE})", "",
               "**Kaplan–Meier survival** of disk 0's escape per system, one log-log panel per "
-              "radius, 95 % bands; the uniform-kick curve (thick, orange) and the scatter-kick "
-              "curve (thin, dashed, red) overlap over most of the range."
+              "radius, 95 % bands; the two-disk curve (black) is drawn thin and on top, the "
+              "uniform-kick curve (orange) wide and half transparent below it, the "
+              "scatter-kick curve (red) dashed between them, so all three show where they "
+              "overlap."
               + _at_risk_words(curves), "",
               f"Built in {seconds:.0f} s.", ""]
     return lines
