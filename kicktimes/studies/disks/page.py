@@ -65,6 +65,7 @@ from kicktimes.studies.disks.readings import (
 )
 from kicktimes.studies.disks.renewal import renewal_lines, renewal_models
 from kicktimes.studies.disks.tables import disks_hazard, disks_table, kicked_table, two_disk_check
+from kicktimes.studies.disks.windows import windows_lines
 
 __all__ = ["write_disks_page"]
 
@@ -587,7 +588,9 @@ def write_disks_page(store_paths, out_dir, *, command="kicktimes reproduce --stu
         f"the mean interval (log scale; the first bin, [0, 0.01), drawn from {X_MIN:g}), over "
         "the constant rate (1 for a Poisson process), for N = "
         f"{', '.join(str(n) for n in SHOWN_N)}; top rows: the whole range (log y); bottom "
-        f"rows: N ≥ {ZOOM_MIN_N} zoomed near 1 (linear y, ±10 % shaded); 95 % Garwood "
+        f"rows: N ≥ {ZOOM_MIN_N} zoomed near 1 (linear y, ±10 % shaded; a bin beyond a "
+        "row's limits is a filled triangle at the edge with its value, a bin whose 95 % "
+        "band alone leaves them an open triangle); 95 % Garwood "
         "bands (intervals pooled and taken as independent); per-bin values in "
         "[disks_hazard.csv](disks_hazard.csv).",
         "",
@@ -612,6 +615,7 @@ def write_disks_page(store_paths, out_dir, *, command="kicktimes reproduce --stu
             "hollow markers: the finding is not robust at that N (it depends on a control).",
             ""]
     lines += boltzmann_lines(boltz)
+    lines += windows_lines(out / "disks_dispersion_windows.csv")
     lines += renewal_lines(renewal)
     if not kicked.empty:
         lines += kicked_section(kicked, kicked_stores[0].experiment, rate_check)

@@ -4,7 +4,8 @@ run or resumed in one work folder, then the page.
 `reproduce_disks` runs the presets of `kicktimes.experiment.DISKS_PRESETS` (their controls
 and the two-disk references) into ``out/store-<name>``, the checks of the gas's FTLE
 (`kicktimes.studies.disks.ftle_check`) and its sweep against density
-(`kicktimes.studies.disks.density`) into their caches in ``out``, writes those
+(`kicktimes.studies.disks.density`) and the dispersion against the window in the circle
+and the box (`kicktimes.studies.disks.windows`) into their caches in ``out``, writes those
 computations' CSV tables into the results folder and then the page
 (`kicktimes.studies.disks.page.write_disks_page`). A rerun reuses every complete store and
 every cached table whose parameters match.
@@ -23,6 +24,11 @@ from kicktimes.experiment import DisksExperiment
 from kicktimes.studies.disks.density import DENSITY, LyapunovDensity, write_lyapunov_density
 from kicktimes.studies.disks.ftle_check import FTLE_CHECK, FtleCheck, write_ftle_check
 from kicktimes.studies.disks.page import write_disks_page
+from kicktimes.studies.disks.windows import (
+    DISPERSION_WINDOWS,
+    DispersionWindows,
+    write_dispersion_windows,
+)
 from kicktimes.studies.options import check_scale, check_workers
 
 __all__ = ["QUICK_N", "quick_experiment", "reproduce", "reproduce_disks"]
@@ -32,6 +38,9 @@ QUICK_N = (2, 10, 100)
 #: the quick scale's gas-FTLE checks and density law: a few states up to N = 100
 QUICK_FTLE_CHECK = FtleCheck(ics=4, scale=0.2, max_disks=100)
 QUICK_DENSITY = LyapunovDensity(n_disks=(100,), states=4, mean_free_times=30, skip=3)
+#: the quick scale's D against the window: 100 disks, packing 0.02, short runs
+QUICK_WINDOWS = DispersionWindows(n_disks=100, packings=(0.02,), windows=(15, 30, 60),
+                                  states=2, length=60.0, skip=5.0)
 
 
 def _progress_lines(progress):
@@ -75,12 +84,14 @@ def reproduce(out, *, scale="quick", results_dir=None, workers=1, progress=None,
     if results_dir is None:
         options["results_dir"] = os.path.join(out, "results-disks")
     return reproduce_disks(os.path.join(out, "disks-quick"), experiment=quick_experiment,
-                           ftle_check=QUICK_FTLE_CHECK, density=QUICK_DENSITY, **options)
+                           ftle_check=QUICK_FTLE_CHECK, density=QUICK_DENSITY,
+                           windows=QUICK_WINDOWS, **options)
 
 
 def reproduce_disks(out, *, results_dir=None, names=None, workers=1, scheduler=None,
                     progress=None, command="kicktimes reproduce --study disks --scale paper",
-                    ftle_check=FTLE_CHECK, density=DENSITY, experiment=None) -> Path:
+                    ftle_check=FTLE_CHECK, density=DENSITY, windows=DISPERSION_WINDOWS,
+                    experiment=None) -> Path:
     """Run (or resume) the disks presets into ``out/store-<name>`` and the gas's FTLE
     computations into ``out``, then write the page.
 
@@ -110,6 +121,9 @@ def reproduce_disks(out, *, results_dir=None, names=None, workers=1, scheduler=N
     density : kicktimes.studies.disks.density.LyapunovDensity or None
         The FTLE against density (`write_lyapunov_density`; default the published sweep);
         None: not run, as ``ftle_check``.
+    windows : kicktimes.studies.disks.windows.DispersionWindows or None
+        D against the window in the circle and the box (`write_dispersion_windows`;
+        default the published sweep); None: not run, as ``ftle_check``.
     experiment : callable, optional
         Maps each preset to the experiment run under its name (`quick_experiment` for the
         quick scale); default the presets themselves.
@@ -130,7 +144,8 @@ def reproduce_disks(out, *, results_dir=None, names=None, workers=1, scheduler=N
     pool = 1 if workers is None else check_workers(workers)
     # before the sweeps: a wrong argument is found in a second, not after hours
     for name, value, kind in (("ftle_check", ftle_check, FtleCheck),
-                              ("density", density, LyapunovDensity)):
+                              ("density", density, LyapunovDensity),
+                              ("windows", windows, DispersionWindows)):
         if value is not None and not isinstance(value, kind):
             raise ValueError(f"{name} must be a {kind.__name__} or None, got {value!r}")
     say, bar = _progress_lines(progress)
@@ -153,4 +168,6 @@ def reproduce_disks(out, *, results_dir=None, names=None, workers=1, scheduler=N
         write_ftle_check(out, target, ftle_check, workers=pool, progress=say)
     if density is not None:
         write_lyapunov_density(out, target, density, workers=pool, progress=say)
+    if windows is not None:
+        write_dispersion_windows(out, target, windows, workers=pool, progress=say)
     return write_disks_page(paths, target, command=command, cost=pd.DataFrame(cost))
