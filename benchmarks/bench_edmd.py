@@ -25,8 +25,9 @@ Workload, per number of bodies N and packing fraction eta:
   collision log on, as a user calls it; wall hits run but are not counted) on N disks in the
   unit circle at area fraction ``phi``, from `kicktimes.initial_state` run ``--warm``
   collisions per disk further (not timed); CPU seconds (``time.process_time``) of one call
-  giving about ``--collisions`` disk-disk collisions. With ``--box`` the periodic box is
-  used instead, where `simulate_disks` accepts ``box=``.
+  giving about ``--collisions`` disk-disk collisions. ``--geometry box`` uses the periodic
+  square box of the same area (side sqrt(pi): the same radius at the same packing) instead,
+  ``--geometry both`` runs the two in the same rounds.
 
 Two matchings of a 2-D area fraction to a 3-D volume fraction:
 
@@ -197,8 +198,9 @@ def main(argv=None):
                     help="collisions per particle before the measured window")
     ap.add_argument("--no-free-path", action="store_true",
                     help="skip the kicktimes runs at the free-path-matched packing")
-    ap.add_argument("--box", action="store_true",
-                    help="kicktimes in its periodic box (simulate_disks(box=L)) if it has one")
+    ap.add_argument("--geometry", choices=["circle", "box", "both"], default="circle",
+                    help="kicktimes in the unit circle, in the periodic box of the same area "
+                         "(simulate_disks(box=sqrt(pi))), or both in the same rounds")
     ap.add_argument("--csv", help="also write every run here")
     args = ap.parse_args(argv)
     if args.rounds < 1:
@@ -225,15 +227,18 @@ def main(argv=None):
             d = os.path.join(tmp, f"n{n}_eta{eta}")
             os.makedirs(d)
             write_sph(os.path.join(d, "init.sph"), *sphere_lattice(n, eta))
-            kts = [] if args.no_kicktimes else [("kicktimes phi=eta", eta)]
+            packs = [] if args.no_kicktimes else [("kicktimes phi=eta", eta)]
             if not (args.no_free_path or args.no_kicktimes):
-                kts.append(("kicktimes free path", free_path_match(eta)))
-            # a box of area pi, the unit circle's: the same radius at the same packing
-            box = math.sqrt(math.pi) if args.box else None
+                packs.append(("kicktimes free path", free_path_match(eta)))
+            # the box has the circle's area pi: the same radius at the same packing
+            boxes = {"circle": [None], "box": [math.sqrt(math.pi)],
+                     "both": [None, math.sqrt(math.pi)]}[args.geometry]
+            kts = [(lab + ("" if box is None else " box"), phi, box)
+                   for lab, phi in packs for box in boxes]
             prepared = []
-            for label, phi in kts:
+            for label, phi, box in kts:
                 t0 = time.perf_counter()
-                prepared.append((label, phi, disks_state(n, phi, args.warm, box=box)))
+                prepared.append((label, phi, box, disks_state(n, phi, args.warm, box=box)))
                 print(f"  prepared {label} n={n} phi={phi:.3f} in "
                       f"{time.perf_counter() - t0:.0f} s", flush=True)
             cells.append((n, eta, d, prepared))
@@ -243,9 +248,9 @@ def main(argv=None):
             jobs = [(lab, "3-D periodic", eta,
                      lambda b=b, d=d, n=n: edmd_rate(b, d, n, args.warm, collisions))
                     for lab, b in edmds]
-            jobs += [(lab, "2-D circle" if not args.box else "2-D periodic", phi,
-                      lambda s=s: disks_rate(*s, collisions))
-                     for lab, phi, s in prepared]
+            jobs += [(lab, "2-D circle" if box is None else "2-D periodic", phi,
+                      lambda s=s, box=box: disks_rate(*s, collisions, box=box))
+                     for lab, phi, box, s in prepared]
             if rnd % 2:
                 jobs.reverse()
             for label, geom, pack, job in jobs:
@@ -254,25 +259,25 @@ def main(argv=None):
                            packing=pack, rate_cpu=out["collisions"] / out["cpu_s"],
                            rate_wall=out["collisions"] / out["wall_s"])
                 rows.append(out)
-                print(f"round {rnd} n={n:>6} eta={eta} {label:>20} packing {pack:.3f}: "
+                print(f"round {rnd} n={n:>6} eta={eta} {label:>24} packing {pack:.3f}: "
                       f"{out['rate_cpu']:.3g} coll/CPU-s ({out['rate_wall']:.3g}/wall-s, "
                       f"{out['collisions']:.3g} in {out['cpu_s']:.2f} CPU-s)", flush=True)
     print(f"\nmedians over {args.rounds} rounds (range), collisions per CPU second; the ratio "
           f"kicktimes / EDMD of each round")
-    print(f"{'program':>20} {'geometry':>13} {'N':>6} {'packing':>7} {'coll/s':>9} "
+    print(f"{'program':>24} {'geometry':>13} {'N':>6} {'packing':>7} {'coll/s':>9} "
           f"{'range':>17} {'ratio':>6} {'ratio range':>12}")
     for n, eta, _d, prepared in cells:
         mine = [r for r in rows if r["n"] == n and r["eta"] == eta]
         ref = {r["round"]: r["rate_cpu"] for r in mine if r["program"] == "EDMD"}
-        for label in [lab for lab, _ in edmds] + [lab for lab, _p, _s in prepared]:
+        for label in [lab for lab, _ in edmds] + [lab for lab, _p, _b, _s in prepared]:
             got = [r for r in mine if r["program"] == label]
             med, lo, hi = spread([r["rate_cpu"] for r in got])
             ratio = spread([r["rate_cpu"] / ref[r["round"]] for r in got])
-            print(f"{label:>20} {got[0]['geometry']:>13} {n:>6} {got[0]['packing']:>7.3f} "
+            print(f"{label:>24} {got[0]['geometry']:>13} {n:>6} {got[0]['packing']:>7.3f} "
                   f"{med:>9.3g} {lo:>8.3g}-{hi:<8.3g} {ratio[0]:>6.2f} "
                   f"{ratio[1]:>5.2f}-{ratio[2]:<5.2f}")
         p = [r["pressure"] for r in mine if r["program"] == "EDMD"]
-        print(f"{'':>20} EDMD pressure {np.mean(p):.4g}, Carnahan-Starling "
+        print(f"{'':>24} EDMD pressure {np.mean(p):.4g}, Carnahan-Starling "
               f"{cs_pressure(eta):.4g}")
     if args.csv:
         keys = ["round", "program", "geometry", "n", "eta", "packing", "collisions", "cpu_s",
