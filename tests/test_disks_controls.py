@@ -114,8 +114,19 @@ def test_the_controls_are_presets_of_their_own_that_keep_the_sweeps_hashes():
         base = DISKS_PRESETS[disks_control(name)[0]]
         changed = {f.name for f in dataclasses.fields(exp)
                    if getattr(exp, f.name) != getattr(base, f.name)}
-        assert changed <= {"name", "seed", "collisions", "description"}
+        assert changed <= {"name", "seed", "collisions", "description", "boundary", "n_disks"}
         assert exp.seed != base.seed
+        # the box is the only control with other disk numbers: N = 2 left out
+        if exp.boundary == "box":
+            assert exp.n_disks == tuple(n for n in base.n_disks if n >= 3)
+        else:
+            assert exp.n_disks == base.n_disks
+    # a circle sweep's hash is the one it had before the box existed
+    assert DISKS_PRESETS["disks-phi0.2-elastic"].hash() == "775d19c3f9da73ab"
+    with pytest.raises(ValueError, match="kicked_runs"):
+        dataclasses.replace(TINY, boundary="box", kicked_runs=1)
+    with pytest.raises(ValueError, match="boundary"):
+        dataclasses.replace(TINY, boundary="square")
     # the kicked systems' field leaves the hash of a store without it unchanged
     assert dataclasses.replace(TINY, kicked_systems=("poisson", "actual")).hash() == TINY.hash()
     k = dataclasses.replace(TINY, kicked_runs=1)
@@ -383,3 +394,24 @@ def test_the_null_streams_are_shaped_like_the_runs_and_calibrate_the_tests(tmp_p
     assert rows["test"].str.endswith("speed-rescaled").any()
     assert ((rows["ci_low"] <= rows["share"]) & (rows["share"] <= rows["ci_high"])).all()
     assert (rows["n_clusters"] == store.results["ic"].nunique()).all()
+
+
+def test_the_walls_share_of_d_minus_one_is_read_only_outside_its_noise():
+    from kicktimes.studies.disks.controls import wall_share_lines, wall_shares
+
+    def rows(ds):
+        return pd.DataFrame([{"geometry": "packing 0.2", "rule": "mirror", "n_disks": n,
+                              "dispersion": d, "dispersion_low": d - w,
+                              "dispersion_high": d + w} for n, d, w in ds])
+
+    circle = rows([(10, 1.4, 0.05), (30, 1.4, 0.05), (100, 1.40, 0.05), (300, 1.02, 0.05)])
+    box = rows([(30, 1.2, 0.05), (100, 1.40, 0.05), (300, 1.0, 0.05)])
+    s = wall_shares(circle, box).set_index("n_disks")
+    assert list(s.index) == [30, 100, 300]  # N >= 30 with both
+    assert s.loc[30, "share"] == pytest.approx(0.5)
+    assert s.loc[30, "reading"].endswith("part of it")
+    assert s.loc[100, "reading"].endswith("no wall share detected")
+    assert s.loc[300, "reading"].endswith("not decomposed (D's interval reaches 1)")
+    lines = wall_share_lines(s.reset_index())
+    assert lines[0].startswith("## What the wall makes")
+    assert sum(x.startswith("| packing 0.2") for x in lines) == 3

@@ -50,6 +50,8 @@ _LATER_OPTIONAL = {"kicked_systems": ("poisson", "actual")}
 #: the default since they exist) or ``"twin"`` (a Benettin twin, what the stores written
 #: before carry: a record without the field is read as ``"twin"`` and keeps its hash)
 GAS_FTLE_METHODS = ("tangent", "twin")
+#: where the disks are (`DisksExperiment.boundary`)
+BOUNDARIES = ("circle", "box")
 #: the kicks' rate in the kicked comparison (and its lambda / nu): ``"gas"`` the whole
 #: gas's collision frequency per disk, ``2 n_pp / (N T)`` (the default since issue 50, the
 #: rate disks.csv reads), or ``"disk"`` the followed disk's own ``n / T`` (about 200
@@ -158,6 +160,11 @@ class DisksExperiment:
         rate of the density tables), or the followed disk's own ``n / T`` (about 200
         collisions, a few per cent of noise). Stores written before the field existed
         used the disk's own rate and are read so.
+    boundary : {"circle", "box"}
+        The unit circular table (default), or the periodic square box of the same area
+        (side `box_side` ``= sqrt(pi)``: the same radius gives the same packing ``N r^2``
+        and the same Enskog rate; no wall). The box needs at least 3 cells of width 2 r
+        per side (``N >= 3`` at packing 0.2) and no kicked comparison.
     """
 
     name: str
@@ -179,6 +186,7 @@ class DisksExperiment:
     kicked_systems: tuple = ("poisson", "actual")
     gas_ftle: str = "tangent"
     kicked_rate: str = "gas"
+    boundary: str = "circle"
 
     #: what a store's record says this is (`Experiment` records have no ``kind``)
     kind = "disks"
@@ -243,6 +251,10 @@ class DisksExperiment:
         put("kicked_systems", systems)
         check_choice("gas_ftle", self.gas_ftle, GAS_FTLE_METHODS)
         check_choice("kicked_rate", self.kicked_rate, KICKED_RATES)
+        check_choice("boundary", self.boundary, BOUNDARIES)
+        if self.boundary == "box" and self.kicked_runs:
+            raise ValueError("kicked_runs: the kicked comparison is in the circle; give "
+                             "kicked_runs=0 with boundary='box'")
         if self.kicked_runs and self.rule != "mirror":
             raise ValueError(f"kicked_runs: the kicked disk keeps its speed, so the comparison "
                              f"needs rule='mirror', got rule={self.rule!r}")
@@ -264,6 +276,12 @@ class DisksExperiment:
     def n_runs(self, n_disks: int) -> int:
         """Runs at ``n_disks``: enough for ``n_tagged`` sequences, at least ``min_runs``."""
         return max(self.min_runs, -(-self.n_tagged // self.tagged_per_run(n_disks)))
+
+    @property
+    def box_side(self) -> float | None:
+        """The periodic box's side ``sqrt(pi)`` (the unit circle's area), or ``None`` in the
+        circle."""
+        return math.sqrt(math.pi) if self.boundary == "box" else None
 
     def kicked_states(self, n_disks: int) -> int:
         """States of the kicked comparison at ``n_disks``: its first ``min(kicked_runs,
@@ -350,6 +368,8 @@ class DisksExperiment:
             del record["gas_ftle"]
         if not self.kicked_runs or self.kicked_rate == "disk":
             del record["kicked_rate"]
+        if self.boundary == "circle":
+            del record["boundary"]  # as before the field existed
         text = json.dumps(record, sort_keys=True, separators=(",", ":"), allow_nan=False)
         return hashlib.sha256(text.encode()).hexdigest()[:16]
 
@@ -402,12 +422,23 @@ DISKS_PRESETS["disks-kicked-phi0.02-mirror"] = DisksExperiment(
                 "boundary-angle ACF, recurrence.")
 
 #: the controls of every sweep, named ``<sweep>-<control>``: an independent replicate
-#: (``seed``: another root seed, the same design) and another number of collisions per tagged
-#: disk (``k60``: K = 60, another seed too; the tests' power grows with K)
-_CONTROL_FIELDS = {"seed": {"seed": 1042}, "k60": {"collisions": 60, "seed": 2042}}
+#: (``seed``: another root seed, the same design), another number of collisions per tagged
+#: disk (``k60``: K = 60, another seed too; the tests' power grows with K) and the periodic
+#: box of the same area (``box``: no wall, N >= 3, another seed), which says what the wall
+#: makes of each finding
+_CONTROL_FIELDS = {"seed": {"seed": 1042}, "k60": {"collisions": 60, "seed": 2042},
+                   "box": {"boundary": "box", "seed": 3042}}
+
+
+def _control_n(exp, control):
+    """The numbers of disks of a control: the box leaves out N = 2 (two disks on a torus
+    of side sqrt(pi) have fewer than 3 cells of width 2 r at packing 0.2)."""
+    return tuple(n for n in exp.n_disks if n >= 3) if control == "box" else exp.n_disks
+
+
 DISKS_CONTROLS = {
     f"{name}-{control}": dataclasses.replace(
-        exp, name=f"{name}-{control}", **change,
+        exp, name=f"{name}-{control}", n_disks=_control_n(exp, control), **change,
         description=f"{exp.description} Control {control!r} of {name}: "
                     + ", ".join(f"{k} = {v}" for k, v in change.items()) + ".")
     for name, exp in DISKS_PRESETS.items() if not exp.kicked_runs

@@ -36,7 +36,8 @@ DISKS_COLLISION_COLUMNS = ("n_disks", "radius", "ic", "disk", "t_window", "n_pp"
                            "speeds")
 
 
-def interval_speeds(pp_times, wall_times, sample_times, positions, wall_positions=None):
+def interval_speeds(pp_times, wall_times, sample_times, positions, wall_positions=None, *,
+                    box=None):
     """The speed a disk flew each interval between its disk-disk collisions at.
 
     Parameters
@@ -49,6 +50,10 @@ def interval_speeds(pp_times, wall_times, sample_times, positions, wall_position
         Its positions sampled at increasing times.
     wall_positions : array_like, shape (len(wall_times), 2), optional
         Its centre at each wall hit: more observed positions.
+    box : float, optional
+        The periodic box's side: displacements are taken to their nearest image (the
+        positions are wrapped into ``[0, box)``; a flight between two samples is shorter
+        than ``box / 2``).
 
     Returns
     -------
@@ -82,8 +87,11 @@ def interval_speeds(pp_times, wall_times, sample_times, positions, wall_position
     inside = (np.searchsorted(events, s[1:], side="left")
               - np.searchsorted(events, s[:-1], side="right"))
     step = np.diff(s)
+    dx, dy = pos[1:, 0] - pos[:-1, 0], pos[1:, 1] - pos[:-1, 1]
+    if box is not None:
+        dx, dy = dx - box * np.round(dx / box), dy - box * np.round(dy / box)
     with np.errstate(divide="ignore", invalid="ignore"):
-        speed = np.hypot(pos[1:, 0] - pos[:-1, 0], pos[1:, 1] - pos[:-1, 1]) / step
+        speed = np.hypot(dx, dy) / step
     ok = (inside == 0) & (step > 0) & np.isfinite(speed)
     which = np.searchsorted(pp, s[:-1], side="right")[ok]
     total = np.bincount(which, weights=speed[ok], minlength=pp.size + 1)
@@ -98,7 +106,8 @@ def _start(experiment: DisksExperiment, n_disks: int, k: int):
     from kicktimes.billiard import initial_state
 
     rng = np.random.default_rng(np.random.SeedSequence(experiment.seed, spawn_key=(n_disks, k)))
-    state = initial_state(n_disks, experiment.radius(n_disks), seed=rng, rule=experiment.rule)
+    state = initial_state(n_disks, experiment.radius(n_disks), seed=rng, rule=experiment.rule,
+                          box=experiment.box_side)
     tagged = np.sort(rng.choice(n_disks, experiment.tagged_per_run(n_disks), replace=False))
     return rng, state, tagged
 
@@ -119,9 +128,17 @@ def run_disks(experiment: DisksExperiment, n_disks: int, k: int):
     rng, state, tagged = _start(experiment, n_disks, k)
     r = experiment.radius(n_disks)
     t_max = experiment.t_max(n_disks)
+    box = experiment.box_side
     if experiment.rule == "mirror":
-        return simulate_disks(state, r, t_max=t_max, rule="mirror"), tagged, None
+        return simulate_disks(state, r, t_max=t_max, rule="mirror", box=box), tagged, None
     tau = 1.0 / (experiment.samples_per_collision * experiment.reference_frequency(n_disks))
+    if box is not None:
+        # no wall: the speeds from consecutive samples, displacements to the nearest image
+        run = simulate_disks(state, r, t_max=t_max, rule="elastic", sample=tagged, tau=tau,
+                             box=box)
+        return run, tagged, [interval_speeds(run.collision_times(int(d)), [], run.sample_times,
+                                             run.samples[:, m], box=box)
+                             for m, d in enumerate(tagged)]
     run = simulate_disks(state, r, t_max=t_max, rule="elastic", sample=tagged, tau=tau,
                          log_walls=True)
     w_time, w_disk, w_x, w_y, _ = run.wall_log

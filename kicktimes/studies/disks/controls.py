@@ -34,15 +34,19 @@ import pandas as pd
 
 from kicktimes.stats import format_interval, robust_verdict
 
-__all__ = ["BULK_WITHIN", "CONTROL_NAMES", "FINDINGS", "NOT_READ", "controls_findings",
-           "controls_lines", "robust_text"]
+__all__ = ["BULK_WITHIN", "CONTROL_NAMES", "FINDINGS", "NOT_READ", "WALL_SHARE_MAX_WIDTH",
+           "controls_findings", "controls_lines", "robust_text", "wall_share_lines",
+           "wall_shares"]
 
 #: the bulk control keeps the tagged disks starting within this distance of the centre
 #: (a quarter of the table's area)
 BULK_WITHIN = 0.5
 #: the controls, in the page's order, and how the page names them
 CONTROL_NAMES = {"primary": "primary (K = 30, seed 42)", "seed": "replicate (seed 1042)",
-                 "k60": "K = 60", "bulk": f"bulk tagged disks (start |x| ≤ {BULK_WITHIN:g})"}
+                 "k60": "K = 60", "bulk": f"bulk tagged disks (start |x| ≤ {BULK_WITHIN:g})",
+                 "box": "periodic box of the same area (no wall; seed 3042)"}
+#: a wall share is not decomposed when its interval is this wide or wider
+WALL_SHARE_MAX_WIDTH = 1.0
 #: finding -> (column of disks_table, level of its direction, kind of verdict); the names
 #: are the CSV's ``diagnostic``
 FINDINGS = {
@@ -238,3 +242,73 @@ def controls_lines(long, *, n_min=30) -> list:
                                                     for f in findings) + " |")
         lines.append("")
     return lines
+
+
+def wall_shares(primary, box, *, n_min=30, n_draws=4000, seed=0) -> pd.DataFrame:
+    """The share of the circle's departure from Poisson, ``D - 1``, that the wall makes:
+    ``(D_circle - D_box) / (D_circle - 1)``, per geometry, rule and N (``>= n_min``),
+    from the primary sweep (``primary``, `disks_table` rows) and its periodic-box control
+    (``box``). The two are independent runs; the share's 95 % interval draws each D from
+    a normal with its interval's width (±1.96 standard errors) and takes percentiles.
+    Columns ``geometry, rule, n_disks, d_circle(_low, _high), d_box(_low, _high), share,
+    share_low, share_high, reading`` (the reading of the speed share's rules: not
+    decomposed where the circle's D reaches 1 or the interval is `WALL_SHARE_MAX_WIDTH`
+    wide)."""
+    rng = np.random.default_rng(seed)
+    keys = ["geometry", "rule", "n_disks"]
+    both = primary.merge(box, on=keys, suffixes=("", "_box"))
+    rows = []
+    for _, r in both[both["n_disks"] >= n_min].iterrows():
+        dc, db = r["dispersion"], r["dispersion_box"]
+        sc = (r["dispersion_high"] - r["dispersion_low"]) / (2 * 1.96)
+        sb = (r["dispersion_high_box"] - r["dispersion_low_box"]) / (2 * 1.96)
+        draws_c = rng.normal(dc, sc, n_draws)
+        draws_b = rng.normal(db, sb, n_draws)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            share = (dc - db) / (dc - 1.0)
+            low, high = np.percentile((draws_c - draws_b) / (draws_c - 1.0), [2.5, 97.5])
+        text = format_interval(share, low, high, edges=(0.0, 1.0))
+        if not r["dispersion_low"] > 1.0:
+            reading = f"{text}: not decomposed (D's interval reaches 1)"
+        elif high - low >= WALL_SHARE_MAX_WIDTH:
+            reading = f"{text}: not decomposed (interval {high - low:.2g} wide)"
+        elif low <= 0.0 <= high:
+            reading = f"{text}: no wall share detected"
+        elif low <= 1.0 <= high:
+            reading = f"{text}: all of it not excluded"
+        elif high < 0.0:
+            reading = f"{text}: negative (the box departs more)"
+        else:
+            reading = f"{text}: part of it"
+        rows.append({"geometry": r["geometry"], "rule": r["rule"],
+                     "n_disks": int(r["n_disks"]), "d_circle": dc,
+                     "d_circle_low": r["dispersion_low"], "d_circle_high": r["dispersion_high"],
+                     "d_box": db, "d_box_low": r["dispersion_low_box"],
+                     "d_box_high": r["dispersion_high_box"], "share": share,
+                     "share_low": low, "share_high": high, "reading": reading})
+    return pd.DataFrame(rows)
+
+
+def wall_share_lines(shares) -> list:
+    """The section "What the wall makes": `wall_shares` as a table of 6 columns."""
+    if shares.empty:
+        return []
+    head = ["geometry", "rule", "N", "D, circle", "D, box", "the wall's share of D − 1"]
+    lines = [
+        "## What the wall makes: the circle against the periodic box", "",
+        "The same sweeps in the periodic square box of the same area (side √π, the same "
+        "radius and packing, no wall; the control `box` of the table above, N ≥ 3), and "
+        "the share of the circle's departure from Poisson that the wall makes, "
+        "(D_circle − D_box) / (D_circle − 1), with a 95 % interval from both D's "
+        "intervals (independent runs; normal draws); it is read only where the circle's "
+        "D lies above 1 and the interval is narrower than "
+        f"{WALL_SHARE_MAX_WIDTH:g}. Every control's other findings in the box: "
+        "[disks_controls.csv](disks_controls.csv).", "",
+        "| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    for _, r in shares.iterrows():
+        lines.append("| " + " | ".join([
+            r["geometry"], r["rule"], str(r["n_disks"]),
+            format_interval(r["d_circle"], r["d_circle_low"], r["d_circle_high"]),
+            format_interval(r["d_box"], r["d_box_low"], r["d_box_high"]),
+            r["reading"]]) + " |")
+    return lines + [""]

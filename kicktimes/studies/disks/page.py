@@ -32,6 +32,8 @@ from kicktimes.studies.disks.controls import (
     NOT_READ,
     controls_findings,
     controls_lines,
+    wall_share_lines,
+    wall_shares,
 )
 from kicktimes.studies.disks.figures import (
     ALPHA,
@@ -433,7 +435,7 @@ def write_disks_page(store_paths, out_dir, *, command="kicktimes reproduce --stu
     table = tables(stores)
     # the controls: other stores of the same sweeps, and the primary's bulk tagged disks
     by_control = {"primary": table}
-    for control in ("seed", "k60"):
+    for control in ("seed", "k60", "box"):
         group = [st for st in control_stores if disks_control(st.experiment.name)[1] == control
                  and disks_control(st.experiment.name)[0] in {s.experiment.name for s in stores}]
         if group:
@@ -615,6 +617,10 @@ def write_disks_page(store_paths, out_dir, *, command="kicktimes reproduce --stu
             "hollow markers: the finding is not robust at that N (it depends on a control).",
             ""]
     lines += boltzmann_lines(boltz)
+    if "box" in by_control:
+        shares = wall_shares(table, by_control["box"])
+        shares.to_csv(out / "disks_wall_share.csv", index=False)
+        lines += wall_share_lines(shares)
     lines += windows_lines(out / "disks_dispersion_windows.csv")
     lines += renewal_lines(renewal)
     if not kicked.empty:
