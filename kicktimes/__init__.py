@@ -29,6 +29,8 @@ _LAZY_ATTRS = {
     "simulate_disks": ("kicktimes.billiard.many_disks", "simulate_disks"),
     "initial_state": ("kicktimes.billiard.disk_states", "initial_state"),
     "DisksRun": ("kicktimes.billiard.disks_run", "DisksRun"),
+    "DisksPressure": ("kicktimes.billiard.disks_run", "DisksPressure"),
+    "box_side": ("kicktimes.billiard.disk_states", "box_side"),
 }
 _LAZY_MODULES = {"billiard", "schedules", "stats", "diagnostics", "experiment", "plots", "report"}
 
