@@ -54,6 +54,7 @@ import csv
 import math
 import os
 import re
+import shutil
 import subprocess
 import tempfile
 import time
@@ -221,6 +222,14 @@ def main(argv=None):
     print(f"{stamp}, load {os.getloadavg()[0]:.2f}, "
           f"{args.rounds} rounds, ~{collisions:.2g} collisions per run, CPU seconds")
     tmp = tempfile.mkdtemp(prefix="bench_edmd_")
+    try:
+        _run(args, edmds, collisions, tmp)
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+
+
+def _run(args, edmds, collisions, tmp):
+    """The rounds, the table and the CSV of `main`, EDMD's start files in ``tmp``."""
     cells = []
     for n in args.sizes:
         for eta in args.packings:
