@@ -404,14 +404,16 @@ def test_the_walls_share_of_d_minus_one_is_read_only_outside_its_noise():
                               "dispersion": d, "dispersion_low": d - w,
                               "dispersion_high": d + w} for n, d, w in ds])
 
-    circle = rows([(10, 1.4, 0.05), (30, 1.4, 0.05), (100, 1.40, 0.05), (300, 1.02, 0.05)])
-    box = rows([(30, 1.2, 0.05), (100, 1.40, 0.05), (300, 1.0, 0.05)])
+    circle = rows([(10, 1.4, 0.05), (30, 1.4, 0.05), (100, 1.40, 0.05), (300, 1.02, 0.05),
+                   (1000, 1.4, 0.02)])
+    box = rows([(30, 1.2, 0.05), (100, 1.40, 0.05), (300, 1.0, 0.05), (1000, 0.9, 0.02)])
     s = wall_shares(circle, box).set_index("n_disks")
-    assert list(s.index) == [30, 100, 300]  # N >= 30 with both
+    assert list(s.index) == [30, 100, 300, 1000]  # N >= 30 with both
     assert s.loc[30, "share"] == pytest.approx(0.5)
     assert s.loc[30, "reading"].endswith("part of it")
     assert s.loc[100, "reading"].endswith("no wall share detected")
     assert s.loc[300, "reading"].endswith("not decomposed (D's interval reaches 1)")
+    assert s.loc[1000, "reading"].endswith("more than all (the box lies below Poisson)")
     lines = wall_share_lines(s.reset_index())
     assert lines[0].startswith("## What the wall makes")
-    assert sum(x.startswith("| packing 0.2") for x in lines) == 3
+    assert sum(x.startswith("| packing 0.2") for x in lines) == 4

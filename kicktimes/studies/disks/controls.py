@@ -278,6 +278,8 @@ def wall_shares(primary, box, *, n_min=30, n_draws=4000, seed=0) -> pd.DataFrame
             reading = f"{text}: all of it not excluded"
         elif high < 0.0:
             reading = f"{text}: negative (the box departs more)"
+        elif low > 1.0:
+            reading = f"{text}: more than all (the box lies below Poisson)"
         else:
             reading = f"{text}: part of it"
         rows.append({"geometry": r["geometry"], "rule": r["rule"],

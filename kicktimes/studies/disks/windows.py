@@ -252,16 +252,18 @@ def windows_lines(path) -> list:
         f"{n_states} states per row (`kicktimes.studies.disks.windows`; "
         "[disks_dispersion_windows.csv](disks_dispersion_windows.csv)), in the unit circle "
         "and in the periodic square box of the same area (side √π: the same radius, the "
-        "same packing, no wall). Each cell: D [95 % CI, bootstrap over states] and its "
+        "same packing, no wall). Each cell: D [95 % CI, bootstrap over states]; its "
         "ratio to the dilute tagged disk's prediction at the same K "
-        "(`DiluteTaggedDisk.dispersion`: 1 under the mirror rule), read by `ratio_verdict` "
-        "(within 10 %, stated before the run).", "",
+        "(`DiluteTaggedDisk.dispersion`: 1 under the mirror rule; last row) and that "
+        "ratio's verdict (`ratio_verdict`, within 10 %, stated before the run, on the "
+        "ratio's interval from both intervals).", "",
         "| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     for (packing, rule, boundary), g in t.groupby(["packing", "rule", "boundary"],
                                                   sort=False):
         g = g.set_index("window")
-        cells = [f"{format_interval(g.loc[k, 'd'], g.loc[k, 'd_low'], g.loc[k, 'd_high'])} "
-                 f"{g.loc[k, 'verdict']}" if k in g.index else "—" for k in ks]
+        cells = [f"{format_interval(g.loc[k, 'd'], g.loc[k, 'd_low'], g.loc[k, 'd_high'])}; "
+                 f"{g.loc[k, 'ratio']:.2f}× predicted, {g.loc[k, 'verdict']}"
+                 if k in g.index else "—" for k in ks]
         lines.append(f"| {packing:g}, {rule}, {boundary} | " + " | ".join(cells) + " |")
     el = t[t["rule"] == "elastic"].drop_duplicates("window").set_index("window")
     if len(el):
