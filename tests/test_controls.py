@@ -290,6 +290,7 @@ def test_the_poisson_question_is_a_row_per_test_with_the_rule_as_a_control():
     assert row["question"] == "Are the two disks' collision times Poisson?"
     assert row["answer"].startswith("no under the primary, not under every control")
     assert row["robust?"] == "✗" and row["deciding control"] == "elastic"
+    assert "CI below" not in row["number"]  # shares, not ratios: no side of 1 is read
     assert "39 % of runs reject uniformity (null streams: 8.0 % (A))" in row["number"]
 
 
@@ -314,9 +315,11 @@ def test_the_first_screen_is_a_table_of_questions_then_a_table_of_at_most_8_colu
     assert lines[0] == "| question | answer | number | robust? | deciding control |"
     qa = lines[2:lines.index("")]
     assert len(qa) == 2  # no Poisson rows and one diagnostic here: the two FTLE questions
-    assert qa[0] == (f"| {QUESTIONS[0][0]} | no: lower | 0.315 | ✓ | none of 6 |")
+    assert qa[0] == (f"| {QUESTIONS[0][0]} | no: lower | 0.315; CI below 1 in 24 of 24 "
+                     "cells | ✓ | none of 5 controls |")
     assert qa[1].startswith(f"| {QUESTIONS[1][0]} | no: lower under the primary, not under "
-                            "every control | primary 0.315; elastic 0.315–0.95 | ✗ | elastic |")
+                            "every control | primary 0.315; elastic 0.315–0.95; CI below 1 in "
+                            "36 of 36 cells | ✗ | elastic |")
     rest = lines[lines.index("") + 1:]
     assert len(rest[0]) <= 300  # one sentence on reading the detailed table
     header = rest[2]
