@@ -29,3 +29,10 @@ def test_hazard_bins_beyond_the_zoom_are_marked_at_the_edge_with_their_value():
     assert len(edge) == 4 and len(filled) == 2  # two open: the band alone leaves
     assert not fig.axes[0].texts  # within the full row's limits: nothing marked
 
+
+
+def test_every_control_of_the_page_has_a_style_in_the_controls_figure():
+    from kicktimes.studies.disks.controls import CONTROL_NAMES
+    from kicktimes.studies.disks.figures import CONTROL_STYLES
+
+    assert set(CONTROL_NAMES) <= set(CONTROL_STYLES)

@@ -261,7 +261,7 @@ CONTROL_PANELS = (("count dispersion D", "index of dispersion D", (0.9, 1.1), 1.
                    (100 * ALPHA * 0.5, 100 * ALPHA * 1.5), 100.0),
                   ("hazard first bin", "first hazard bin / rate", (0.9, 1.1), 1.0))
 CONTROL_STYLES = {"primary": ("k", "o"), "seed": ("C0", "s"), "k60": ("C3", "^"),
-                  "bulk": ("C2", "D")}
+                  "bulk": ("C2", "D"), "box": ("C4", "v")}
 
 
 def controls_figure(long, *, n_min=10, names=None):
