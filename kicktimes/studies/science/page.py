@@ -192,10 +192,14 @@ def decorrelation_lines(dec, compare, closest, *, n_ics=40, t_max=20000.0):
             " |")
     agree = compare["quotient_verdict"].str.startswith("within").sum()
     off = compare["quotient_verdict"].isin(["lower", "higher"]).sum()
+    failing = compare[compare["quotient_verdict"].isin(["lower", "higher"])]
+    rules = ", ".join(f"{n} under the {rule} rule"
+                      for rule, n in failing["rule"].value_counts(sort=False).items())
     lines += ["", f"The one-collision model agrees to 10 % in {agree} of {len(compare)} rows. "
               + (f"It fails: {off} of {len(compare)} rows lie outside its 10 % band (verdict "
-                 "lower or higher) and falsify it; the others are inconclusive." if off else
-                 "No row falsifies it; the inconclusive rows cannot confirm it."), "",
+                 f"lower or higher) and falsify it ({rules}); the others are inconclusive."
+                 if off else "No row falsifies it; the inconclusive rows cannot confirm it."),
+              "",
               "Which kick law comes closest to the two-disk value (pooled findings, control "
               "primary; distance from 1: |ln ratio|, its interval the image of the ratio's; "
               "the closest group is the law with the lowest upper distance and every law whose "
