@@ -28,6 +28,9 @@ def test_hazard_bins_beyond_the_zoom_are_marked_at_the_edge_with_their_value():
     filled = [line for line in edge if line.get_markerfacecolor() != "none"]
     assert len(edge) == 4 and len(filled) == 2  # two open: the band alone leaves
     assert not fig.axes[0].texts  # within the full row's limits: nothing marked
+    import matplotlib.pyplot as plt
+
+    plt.close(fig)
 
 
 

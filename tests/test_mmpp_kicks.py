@@ -425,3 +425,6 @@ def test_mmpp_figure_marks_a_quartile_beyond_its_axis_and_says_what_the_bars_are
     labels = [t.get_text() for t in fig.legends[0].get_texts()]
     assert any("Clopper-Pearson" in lab for lab in labels)
     assert any("quartiles" in lab for lab in labels)
+    import matplotlib.pyplot as plt
+
+    plt.close(fig)

@@ -242,6 +242,9 @@ def test_kick_times_legend_prints_a_negative_intercept_with_a_minus_sign():
     (label,) = [t.get_text() for t in fig.axes[0].get_legend().get_texts()
                 if t.get_text().startswith("least squares")]
     assert "1.100 t − 7, R²" in label and "+ -" not in label
+    import matplotlib.pyplot as plt
+
+    plt.close(fig)
 
 
 # ------------------------------------------------------------------- counts

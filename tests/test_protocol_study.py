@@ -144,6 +144,9 @@ def test_fig6_zooms_the_literal_column_on_its_data_and_says_so():
     assert any("not 0" in t.get_text() and f"{low:.3g}" in t.get_text() for t in literal.texts)
     assert renormalised.get_ylim()[0] == 0.0
     assert not renormalised.texts
+    import matplotlib.pyplot as plt
+
+    plt.close(fig)
 
 
 def test_findings_belong_to_the_protocol_study(tmp_path):

@@ -129,6 +129,9 @@ def test_the_survival_curves_turn_grey_below_the_at_risk_floor():
     assert black.get_xdata().max() == cut < grey.get_xdata().max()
     assert grey.get_xdata()[0] == black.get_xdata()[-1]  # the two parts meet
     assert grey.get_ydata()[0] == black.get_ydata()[-1]
+    import matplotlib.pyplot as plt
+
+    plt.close(fig)
 
 
 def test_no_survival_curve_hides_the_two_disk_one():
@@ -146,3 +149,6 @@ def test_no_survival_curve_hides_the_two_disk_one():
     assert two.get_zorder() > scatter.get_zorder() > uniform.get_zorder()
     assert uniform.get_linewidth() > two.get_linewidth()
     assert uniform.get_alpha() < 1 and scatter.get_linestyle() != "-"
+    import matplotlib.pyplot as plt
+
+    plt.close(fig)

@@ -94,3 +94,6 @@ def test_the_figure_draws_ks_share_and_dispersion_on_their_own_axes():
     # every interval inside its axes
     assert ks.get_ylim()[1] > table["ks_reject_share"].max()
     assert disp.get_ylim()[1] > table["disp_high"].max()
+    import matplotlib.pyplot as plt
+
+    plt.close(fig)
