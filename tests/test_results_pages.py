@@ -87,3 +87,24 @@ def test_the_first_screen_is_short_and_generated():
     assert len(prose) <= 1200, len(prose)
     header = screen.split("\n|", 1)[1].split("\n", 1)[0]
     assert header.count("|") - 1 <= 8
+
+
+def test_the_kicked_comparisons_rate_is_the_density_tables_at_every_n():
+    """disks.md's kicked section uses the gas's collision rate of its own states; the
+    density table (disks.csv) measures the same gas in independent runs: the two agree to
+    2 % at every N, each N with the states its preset gives it."""
+    from kicktimes.experiment import disks_preset
+    from kicktimes.studies.disks.kicked import RATE_MARGIN, kicked_rate_check
+
+    check = pd.read_csv(RESULTS / "disks_kicked_rate.csv")
+    exp = disks_preset("disks-kicked-phi0.02-mirror")
+    assert set(check["n_disks"]) == set(exp.n_disks)
+    assert (check["ratio"] - 1.0).abs().max() <= RATE_MARGIN, check
+    for row in check.itertuples():
+        assert row.states == exp.kicked_states(row.n_disks), row
+        assert row.verdict == ratio_verdict(row.ratio_low, row.ratio_high,
+                                            tolerance=RATE_MARGIN), row
+    # and the CSV is what the function computes from the published tables
+    again = kicked_rate_check(pd.read_csv(RESULTS / "disks_kicked.csv"),
+                              pd.read_csv(RESULTS / "disks.csv"), exp)
+    pd.testing.assert_frame_equal(again, check, check_dtype=False)

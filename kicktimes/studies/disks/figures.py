@@ -317,7 +317,9 @@ def controls_figure(long, *, n_min=10, names=None):
                 labels.append(lab)
     handles.append(axes[0, 0].plot([], [], ls="none", marker="o", mfc="white", color="0.3")[0])
     labels.append("hollow: not robust at that N")
-    fig.legend(handles, labels, loc="upper center", ncol=len(labels), fontsize=8.5,
-               frameon=False)
-    fig.tight_layout(rect=(0, 0, 1, 1 - 0.5 / (2.3 * len(families) + 0.8)))
+    # at most 3 entries a row: six long control names overflow one row of the figure
+    ncol = min(len(labels), 3)
+    rows = -(-len(labels) // ncol)
+    fig.legend(handles, labels, loc="upper center", ncol=ncol, fontsize=8.5, frameon=False)
+    fig.tight_layout(rect=(0, 0, 1, 1 - 0.5 * rows / (2.3 * len(families) + 0.8)))
     return fig
