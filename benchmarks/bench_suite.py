@@ -8,9 +8,9 @@ twice, sharing one new, empty numba cache folder (``NUMBA_CACHE_DIR``):
    reference measured in the same run: cold minus warm is the compile time.
 
 The cold run records every numba compilation in the pytest processes
-(``benchmarks/_compile_log_plugin.py``): per kernel and signature its exclusive seconds,
-and how many processes compiled the same signature (a signature compiled by both workers
-costs twice). Compilations inside subprocesses (the notebooks' kernels, the command-line
+(``benchmarks/_compile_log_plugin.py``): per kernel, and per kernel and signature, its
+exclusive seconds, how many processes compiled the same signature (a signature compiled
+by both workers costs twice) and the tests that compiled it. Compilations inside subprocesses (the notebooks' kernels, the command-line
 tests) are in the cold-warm difference only.
 
 Usage::
@@ -73,6 +73,20 @@ def compile_table(log):
     return table, sum(r["seconds"] for r in table), twice
 
 
+def compile_by_signature(log):
+    """Per kernel and signature: the compile seconds (exclusive, summed over processes),
+    how many processes compiled it (more than one: a duplicate) and the tests that did."""
+    per = collections.defaultdict(lambda: [0.0, 0, set()])
+    for path in sorted(Path(log).glob("*.json")):
+        for kernel, sig, exclusive, _, test in json.loads(path.read_text()):
+            row = per[kernel, sig]
+            row[0] += exclusive
+            row[1] += 1
+            row[2].add(test)
+    return sorted(((k, s, sec, n, sorted(tests)) for (k, s), (sec, n, tests) in per.items()),
+                  key=lambda r: -r[2])
+
+
 def compile_by_test(log):
     """Per test: the compile seconds it caused (exclusive, summed) and the kernels."""
     per = collections.defaultdict(lambda: [0.0, set()])
@@ -103,6 +117,7 @@ def main(argv=None):
             res = run_suite(cache, log, args.workers, args.extra)
             res["kernels"], res["compile_s"], res["duplicate_compilations"] = compile_table(log)
             res["by_test"] = compile_by_test(log)
+            res["by_signature"] = compile_by_signature(log)
             if name == "cold" and args.keep_log:
                 import shutil
 
@@ -118,6 +133,10 @@ def main(argv=None):
         for row in results["cold"]["kernels"][:25]:
             print(f"{row['kernel']} | {row['seconds']:.1f} | {row['signatures']} | "
                   f"{row['compilations']}")
+        print("\nkernel | signature | compile s (summed) | compilations | tests")
+        for kernel, sig, seconds, n, tests in results["cold"]["by_signature"][:25]:
+            who = tests[0] + (f" and {len(tests) - 1} more" if len(tests) > 1 else "")
+            print(f"{kernel} | {sig[:60]} | {seconds:.1f} | {n} | {who}")
         print("\ntests that compiled the most (exclusive s, kernels):")
         for test, seconds, kernels in results["cold"]["by_test"][:20]:
             print(f"{seconds:6.1f}  {test}  {', '.join(kernels[:6])}")

@@ -31,7 +31,8 @@
 #    collision times of disks in a box from that independent simulator, against the 2D
 #    kinetic-theory (Enskog) rate.
 #
-# **Size.** `KICKTIMES_NOTEBOOK_SIZE=small` (default, what CI runs) or `full`.
+# **Size.** `KICKTIMES_NOTEBOOK_SIZE`: `small` (default), `test` (fewer and shorter
+# sequences: what the default test suite runs) or `full`.
 
 # %%
 import os
@@ -44,9 +45,12 @@ import pandas as pd
 from kicktimes import stats
 from kicktimes.report.analyze_page import write_analysis
 
-SMALL = os.environ.get("KICKTIMES_NOTEBOOK_SIZE", "small") != "full"
-N_PER_GROUP = 6 if SMALL else 40
-T_END = 100.0 if SMALL else 1000.0
+SIZE = os.environ.get("KICKTIMES_NOTEBOOK_SIZE", "small")
+SIZES = {"test": (4, 60.0), "small": (6, 100.0), "full": (40, 1000.0)}  # sequences per group, T
+if SIZE not in SIZES:
+    raise ValueError(f"KICKTIMES_NOTEBOOK_SIZE must be one of {sorted(SIZES)}, got {SIZE!r}")
+N_PER_GROUP, T_END = SIZES[SIZE]
+SMALL = SIZE != "full"
 rng = np.random.default_rng(2024)
 t_start = time.perf_counter()
 

@@ -34,8 +34,9 @@
 # Every conclusion is printed from the computed table through the verdict rules of
 # `kicktimes.stats`.
 #
-# **Size.** `KICKTIMES_NOTEBOOK_SIZE`: `"small"` (default; CI; N = 2, 10, 100 with 60
-# tagged disks each (at least 4 runs), seconds once the engine is compiled) or `"full"`
+# **Size.** `KICKTIMES_NOTEBOOK_SIZE`: `"small"` (default; N = 2, 10, 100 with 60 tagged
+# disks each (at least 4 runs), seconds once the engine is compiled), `"test"` (N = 2, 10
+# with 20 tagged disks: what the default test suite runs) or `"full"`
 # (the presets of docs/results/disks.md at packing 0.2: N = 2 .. 1000, about 4000 tagged
 # disks per N; a few minutes).
 
@@ -60,12 +61,13 @@ from kicktimes.studies.disks import (
 
 # %matplotlib inline
 SIZE = os.environ.get("KICKTIMES_NOTEBOOK_SIZE", "small")
-if SIZE not in ("small", "full"):
-    raise ValueError(f"KICKTIMES_NOTEBOOK_SIZE must be 'small' or 'full', got {SIZE!r}")
+if SIZE not in ("test", "small", "full"):
+    raise ValueError(f"KICKTIMES_NOTEBOOK_SIZE must be 'test', 'small' or 'full', got {SIZE!r}")
 t_start = time.perf_counter()
-if SIZE == "small":
-    experiments = [DisksExperiment(name=f"gas-{rule}", n_disks=(2, 10, 100), packing=0.2,
-                                   rule=rule, n_tagged=60, min_runs=4, seed=1)
+if SIZE in ("test", "small"):
+    n_disks, n_tagged, min_runs = ((2, 10), 20, 2) if SIZE == "test" else ((2, 10, 100), 60, 4)
+    experiments = [DisksExperiment(name=f"gas-{rule}", n_disks=n_disks, packing=0.2,
+                                   rule=rule, n_tagged=n_tagged, min_runs=min_runs, seed=1)
                    for rule in ("mirror", "elastic")]
 else:
     experiments = [DISKS_PRESETS["disks-phi0.2-mirror"], DISKS_PRESETS["disks-phi0.2-elastic"]]

@@ -31,8 +31,9 @@
 #    radius.
 #
 # **Size.** The environment variable `KICKTIMES_NOTEBOOK_SIZE` selects the size: `"small"`
-# (default; what CI runs, about 15 s on 2 cores) or `"full"` (a real study: 200 ICs of
-# 25 000 steps, the paper's family-A length; a few minutes). Set it before starting Jupyter,
+# (default, about 15 s on 2 cores), `"test"` (a few seconds: what the default test suite
+# runs, to check that every cell works) or `"full"` (a real study: 200 ICs of 25 000 steps,
+# the paper's family-A length; a few minutes). Set it before starting Jupyter,
 # e.g. `KICKTIMES_NOTEBOOK_SIZE=full jupyter lab`.
 
 # %%
@@ -56,6 +57,7 @@ SIZE = os.environ.get("KICKTIMES_NOTEBOOK_SIZE", "small")
 SIZES = {
     # ICs of the training ensemble (fits) and of the comparison, steps of the comparison runs,
     # window of the training runs, Monte Carlo samples of the goodness-of-fit tests
+    "test": dict(n_train=10, train_window=2000.0, n_ics=6, n_steps=2000, gof_mc=19),
     "small": dict(n_train=40, train_window=5000.0, n_ics=30, n_steps=10000, gof_mc=99),
     "full": dict(n_train=400, train_window=50000.0, n_ics=200, n_steps=25000, gof_mc=499),
 }

@@ -36,7 +36,8 @@
 # Every conclusion below is printed from the computed numbers.
 #
 # **Size.** The environment variable `KICKTIMES_NOTEBOOK_SIZE` selects the size:
-# `"small"` (default; what CI runs, about half a minute on 2 cores) or `"full"` (a real
+# `"small"` (default; about half a minute on 2 cores), `"test"` (two radii and small
+# ensembles: what the default test suite runs) or `"full"` (a real
 # study: 7 radii, 1000 ICs per ensemble, windows of 20 000 time units; tens of minutes).
 # Set it before starting Jupyter, e.g. `KICKTIMES_NOTEBOOK_SIZE=full jupyter lab`.
 
@@ -60,6 +61,14 @@ SIZES = {
     # radii, ICs per (method, rule, radius), observation window T, Monte Carlo samples of the
     # conditional nulls, ICs per radius with their own renewal-model comparison, ICs of the
     # dedicated search for sticky orbits
+    "test": dict(
+        radii=(0.01, 0.03),
+        n_ics=24,
+        t_window=1500.0,
+        n_mc=99,
+        n_fit_ics=2,
+        n_search=300,
+    ),
     "small": dict(
         radii=(0.01, 0.02, 0.03),
         n_ics=120,

@@ -29,7 +29,8 @@
 # number quoted is computed from the store.
 #
 # **Size.** The environment variable `KICKTIMES_NOTEBOOK_SIZE` selects the size: `"small"`
-# (default; the quick experiments, what CI runs, well under a minute on 2 cores) or `"full"`
+# (default; the quick experiments, well under a minute on 2 cores), `"test"` (one quick
+# experiment and a lighter report: what the default test suite runs) or `"full"`
 # (the paper's families A and B at full scale; expect roughly half an hour on 2 cores, or
 # pass a Dask scheduler address in `SCHEDULER`). Set it before starting Jupyter, e.g.
 # `KICKTIMES_NOTEBOOK_SIZE=full jupyter lab`.
@@ -68,6 +69,7 @@ SIZE = os.environ.get("KICKTIMES_NOTEBOOK_SIZE", "small")
 SIZES = {
     # experiments to run; report options (ICs with their own renewal fits, Monte Carlo
     # samples of the Poisson tests, PNG resolution) and the stores it covers
+    "test": dict(names=("quick_a",), report_stores=("quick_a",), fits=1, n_mc=19, dpi=40),
     "small": dict(
         names=("quick_a", "quick_b"), report_stores=("quick_a", "quick_b"), fits=3, n_mc=99, dpi=72
     ),
@@ -285,7 +287,7 @@ for (name, diagnostic), part in agg.groupby(level=["experiment", "diagnostic"]):
 # renormalize=False)` computes it as printed; `renormalize=True` is Benettin's. One IC first:
 
 # %%
-panel = panels("quick" if SIZE == "small" else "paper")[0]
+panel = panels("paper" if SIZE == "full" else "quick")[0]
 ic, r = panel.initial_conditions()[0], panel.radii[-1]
 steps = dict(n_steps=panel.n_steps, tau=panel.tau, sampling="paper")
 for renormalize in (False, True):
@@ -304,7 +306,7 @@ for renormalize in (False, True):
 
 # %%
 t0 = time.perf_counter()
-scale = "quick" if SIZE == "small" else "paper"
+scale = "paper" if SIZE == "full" else "quick"
 rows_protocol = run_protocol_study(WORKDIR / f"store-protocol-{scale}", scale, workers=WORKERS)
 panel_list = panels(scale)
 ratios = Ratios(rows_protocol)

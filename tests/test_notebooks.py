@@ -1,10 +1,12 @@
-"""The notebooks: each runs from top to bottom at the small size, and its pair agrees.
+"""The notebooks: each runs from top to bottom, and its pair agrees.
 
 Every notebook is kept twice, as a jupytext percent script (``notebooks/X.py``, the file to
 edit and review) and as ``notebooks/X.ipynb`` executed at the small size (so it renders with
 its outputs). These tests execute each notebook with nbclient in a temporary working
-directory (``TMPDIR`` too, so nothing is left in the repository or in /tmp), with
-``KICKTIMES_NOTEBOOK_SIZE=small``, and check that the two files hold the same cells.
+directory (``TMPDIR`` too, so nothing is left in the repository or in /tmp) and check that
+the two files hold the same cells. The default suite executes each notebook at its
+``KICKTIMES_NOTEBOOK_SIZE=test`` size (seconds: every cell runs); the ``full`` marker
+executes it at the ``small`` size its committed outputs show.
 """
 
 from __future__ import annotations
@@ -80,13 +82,14 @@ def test_committed_notebook_was_executed_without_errors(name):
     assert not errors, f"{name}.ipynb holds error outputs: {errors[0].get('ename')}"
 
 
+@pytest.mark.parametrize("size", ["test", pytest.param("small", marks=pytest.mark.full)])
 @pytest.mark.parametrize("name", NOTEBOOKS)
-def test_notebook_executes_at_the_small_size(
-    name, tmp_path, monkeypatch, kernel_env, record_property
+def test_notebook_executes_from_top_to_bottom(
+    name, size, tmp_path, monkeypatch, kernel_env, record_property
 ):
     for key, value in kernel_env.items():
         monkeypatch.setenv(key, value)
-    monkeypatch.setenv("KICKTIMES_NOTEBOOK_SIZE", "small")
+    monkeypatch.setenv("KICKTIMES_NOTEBOOK_SIZE", size)
     monkeypatch.setenv("TMPDIR", str(tmp_path))  # the kernel's tempfile goes here
     cwd = tmp_path / "cwd"
     cwd.mkdir()
@@ -103,7 +106,7 @@ def test_notebook_executes_at_the_small_size(
     client.execute()  # raises CellExecutionError, naming the cell, if a cell fails
     seconds = time.perf_counter() - t0
     record_property("execution_seconds", round(seconds, 1))
-    print(f"{name}: executed in {seconds:.1f} s")
+    print(f"{name} ({size}): executed in {seconds:.1f} s")
     outputs = [o for cell in notebook.cells if cell.cell_type == "code" for o in cell.outputs]
     assert not [o for o in outputs if o.output_type == "error"]
     texts = "".join(o.get("text", "") for o in outputs if o.output_type == "stream")

@@ -233,6 +233,7 @@ SECOND = Experiment(
 )
 
 
+@pytest.mark.full
 def test_several_stores_give_one_report_with_a_part_per_experiment(built, store_path, tmp_path):
     # in this process (the single-store build used two workers): same numbers
     second = tmp_path / "store_b"
@@ -368,6 +369,7 @@ def test_tables_are_rounded_and_scroll_instead_of_stretching_the_page(built):
     assert cells and max(digits) <= 4
 
 
+@pytest.mark.full
 def test_write_results_gives_pngs_and_a_generated_findings_page(store_path, tmp_path):
     from kicktimes.studies.paper import write_results
 
@@ -413,6 +415,7 @@ def test_a_rebuild_with_nothing_changed_writes_nothing_within_3_seconds(built, s
     assert _snapshot(out) == before
 
 
+@pytest.mark.full
 def test_a_damaged_output_is_rebuilt_and_no_temporary_file_is_left(built, store_path, tmp_path):
     import shutil
 
@@ -430,6 +433,7 @@ def test_a_damaged_output_is_rebuilt_and_no_temporary_file_is_left(built, store_
     assert not [p for p in out.iterdir() if p.name.endswith(".tmp")]
 
 
+@pytest.mark.full
 def test_pdf_copies_are_written_on_request_and_removed_when_no_longer_asked(
     built, store_path, tmp_path
 ):
@@ -461,6 +465,7 @@ def test_a_forced_rebuild_reuses_nothing_but_removes_what_it_no_longer_writes(tm
     assert (tmp_path / "fig.png").exists() and not (tmp_path / "fig.pdf").exists()
 
 
+@pytest.mark.full
 def test_a_store_that_gains_a_task_rebuilds_only_its_own_part(store_path, tmp_path):
     import json
 

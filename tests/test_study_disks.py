@@ -161,6 +161,7 @@ def test_reproduce_refuses_bad_arguments_before_running_anything(tmp_path, optio
     assert not list(tmp_path.iterdir())
 
 
+@pytest.mark.full
 def test_reproduce_writes_the_ftle_tables_before_the_page(tmp_path, monkeypatch):
     import kicktimes.experiment as experiment
 
