@@ -353,3 +353,16 @@ def test_the_boundary_rule_agrees_with_the_optimiser_from_many_starts():
             assert reg.alpha > 0 and reg.loglik["negbin"] >= best - 1e-4
             assert reg.loglik["negbin"] > reg.loglik["poisson"]
     assert seen == {True, False}  # both branches were exercised
+
+
+def test_the_sticky_rule_is_a_rate_above_five_kinetic_rates():
+    g = stats.kinetic_rate(np.array([0.01, 0.02]))
+    assert stats.STICKY_FACTOR == 5.0
+    assert stats.is_sticky(5.0 * g * (1 + 1e-12), g).tolist() == [True, True]
+    assert stats.is_sticky(5.0 * g, g).tolist() == [False, False]  # strictly above
+    assert stats.is_sticky(np.nan, g[0]) is False
+    assert stats.is_sticky(3.0, 1.0, factor=2.0) is True
+    # the rule every study applies: a run of 600 collisions in 1000 time units at r = 0.02
+    # (kinetic rate 0.0329) is sticky, one of 30 is not
+    assert [stats.is_sticky(n / 1000.0, stats.kinetic_rate(0.02)) for n in (30, 600)] == [
+        False, True]

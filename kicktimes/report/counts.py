@@ -17,14 +17,12 @@ from kicktimes.report.figures import (
     new_axes,
     radius_axis,
 )
+from kicktimes.stats import STICKY_FACTOR
 
 __all__ = ["counts_by_radius", "counts_vs_radius", "experiment_kinetic", "kinetic_rate_of",
            "sticky_ics",
            "STICKY_FACTOR", "sections"]
 
-#: an IC is "sticky" when its disk-disk collision rate exceeds this multiple of the
-#: kinetic rate (the disks stay close together for long stretches)
-STICKY_FACTOR = 5.0
 
 
 def kinetic_rate_of(radius, rule="mirror", kinetic=None):

@@ -27,7 +27,7 @@ See ``docs/statistics.md`` for the conventions.
 
 from .analyze import Analysis, analyze
 from .comparison import VuongResult, compare_models, vuong
-from .counts import CountRegression, kinetic_rate, regress_counts
+from .counts import STICKY_FACTOR, CountRegression, is_sticky, kinetic_rate, regress_counts
 from .dilute import DiluteEstimate, DiluteTaggedDisk, dilute_tagged_disk, dilute_tagged_times
 from .distributions import hyperexpon
 from .ensemble import PoissonEnsembleResult, test_poisson_ensemble
@@ -90,6 +90,8 @@ __all__ = [
     "pooled_intervals",
     "regress_counts",
     "kinetic_rate",
+    "STICKY_FACTOR",
+    "is_sticky",
     "enskog_frequency", "henderson_z",
     "speed_rate_factor",
     "dilute_tagged_times",

@@ -101,6 +101,44 @@ def configuration_volume(r):
     return (np.pi * a**2) ** 2 - excluded
 
 
+#: A two-disk run is *sticky* when its disk-disk collision rate exceeds this multiple of the
+#: kinetic rate Gamma(r) (`kinetic_rate`): the disks stay close together for long stretches
+#: near a regular orbit. The one definition of the rule (`is_sticky`), used by every page.
+STICKY_FACTOR = 5.0
+
+
+def is_sticky(rate, kinetic, *, factor=STICKY_FACTOR):
+    r"""Whether runs are sticky: :math:`\hat\Gamma > c\,\Gamma(r)`, ``c = factor``.
+
+    Parameters
+    ----------
+    rate : float or array_like
+        Observed disk-disk collision rates :math:`\hat\Gamma = N / T` of the runs.
+    kinetic : float or array_like
+        The kinetic rate :math:`\Gamma(r)` of each run's disks (`kinetic_rate`),
+        broadcast against ``rate``.
+    factor : float
+        The multiple ``c`` (default `STICKY_FACTOR`, 5): a run faster than ``c`` kinetic
+        rates is sticky. Invariant-measure runs have :math:`E[\hat\Gamma] = \Gamma`, so
+        the rule flags the runs caught near a regular orbit, not the spread of ordinary
+        ones.
+
+    Returns
+    -------
+    bool or ndarray of bool
+        ``rate > factor * kinetic`` (a NaN rate is not sticky).
+
+    Examples
+    --------
+    >>> from kicktimes import stats
+    >>> g = stats.kinetic_rate(0.02)
+    >>> stats.is_sticky([0.5 * g, 4.9 * g, 5.1 * g], g).tolist()
+    [False, False, True]
+    """
+    out = np.asarray(rate, dtype=float) > factor * np.asarray(kinetic, dtype=float)
+    return out if out.ndim else bool(out)
+
+
 def kinetic_rate(r, rule="mirror", *, masses=None):
     r"""Disk-disk collision rate of two disks of radius ``r`` under the invariant measure.
 

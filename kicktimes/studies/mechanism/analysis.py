@@ -22,6 +22,7 @@ import scipy.stats as sps
 
 from kicktimes import stats
 from kicktimes.diagnostics import mechanism
+from kicktimes.stats import STICKY_FACTOR
 from kicktimes.studies.mechanism.simulate import METHODS
 from kicktimes.studies.mechanism.twins import (
     BATTERY,
@@ -39,7 +40,6 @@ __all__ = ["EXPLAINERS", "HAZARD_EDGES", "LATE_RESCALED", "RETURN_TIME", "STICKY
 EXPLAINERS = ("mixed_poisson", "cox_iid", "cox_sequence", "cox_markov_oos")
 #: rescaled time beyond which the Gamma-rescaled hazard is read as one bin
 LATE_RESCALED = 5.0
-STICKY_FACTOR = 5.0
 #: intervals shorter than this hold the wall round trips (the hazard's peak)
 RETURN_TIME = 4.0
 #: hazard bins of rescaled times (in units of a mean interval)
@@ -113,7 +113,7 @@ def hazard_profile_rows(key, runs):
     t_max = runs[0].t_max
     tab = mechanism.collision_tables(runs)
     obs_rate = np.array([run.n_pp for run in runs]) / t_max
-    calm = ~(obs_rate > STICKY_FACTOR * stats.kinetic_rate(r))[tab["run"].to_numpy()]
+    calm = ~stats.is_sticky(obs_rate, stats.kinetic_rate(r))[tab["run"].to_numpy()]
     done = ~tab["next_censored"].to_numpy()
     nxt = tab["next_interval"].to_numpy()
     edges = HAZARD_EDGES[HAZARD_EDGES < float(nxt.max())].tolist() + [float(nxt.max())]
@@ -164,13 +164,13 @@ def analyse(key, ics, runs, *, n_twins, rng, rule="mirror", n_boot=1000):
     _row(rows, key, "n_runs", len(runs))
     _row(rows, key, "n_collisions", n_pp.sum())
     _row(rows, key, "pooled_rate_over_kinetic", obs_rate.mean() / gamma)
-    _row(rows, key, "sticky_runs", (obs_rate > STICKY_FACTOR * gamma).sum(),
+    _row(rows, key, "sticky_runs", stats.is_sticky(obs_rate, gamma).sum(),
          note=f"rate > {STICKY_FACTOR:g} kinetic")
 
     # 2. hazard: raw time, each run's own time unit
     done = ~tab["next_censored"].to_numpy()
     nxt = tab["next_interval"].to_numpy()
-    sticky_run = (obs_rate > STICKY_FACTOR * gamma)[tab["run"].to_numpy()]
+    sticky_run = stats.is_sticky(obs_rate, gamma)[tab["run"].to_numpy()]
     data["sticky"] = pd.Series(sticky_run)
     longest = float(nxt.max())
     edges = HAZARD_EDGES[HAZARD_EDGES < longest].tolist() + [longest]
@@ -289,7 +289,7 @@ def analyse(key, ics, runs, *, n_twins, rng, rule="mirror", n_boot=1000):
          *_boot_ci(lambda p: comp[p].sum() / n_pp[p].sum(), len(runs), rng, n_boot),
          note="sum of the predicted rate along each run over its collisions")
     _row(rows, key, "initial_prediction_over_kinetic", pred.mean() / gamma)
-    sticky_ic = obs_rate > STICKY_FACTOR * gamma
+    sticky_ic = stats.is_sticky(obs_rate, gamma)
     if sticky_ic.any():
         _row(rows, key, "sticky_count_over_compensator", n_pp[sticky_ic].sum()
              / comp[sticky_ic].sum(), note="observed / predicted collisions in the sticky runs")

@@ -6,12 +6,11 @@ import numpy as np
 import pandas as pd
 
 from kicktimes import initial_conditions, simulate_two_particle, stats
+from kicktimes.stats import STICKY_FACTOR
 
 __all__ = ["RULES", "STICKY_FACTOR", "collision_runs", "sticky_runs"]
 
 RULES = ("mirror", "elastic")
-#: a run faster than this many kinetic rates Γ(r) is sticky and left out
-STICKY_FACTOR = 5.0
 
 
 def collision_runs(rule, n_ics, r, t_max, seed) -> pd.DataFrame:
@@ -25,4 +24,4 @@ def collision_runs(rule, n_ics, r, t_max, seed) -> pd.DataFrame:
 
 def sticky_runs(times, r, t_max):
     """Which runs are sticky: collision rate above ``STICKY_FACTOR`` Γ(r)."""
-    return np.array([t.size / t_max > STICKY_FACTOR * stats.kinetic_rate(r) for t in times])
+    return np.array([stats.is_sticky(t.size / t_max, stats.kinetic_rate(r)) for t in times])

@@ -15,12 +15,10 @@ import pandas as pd
 
 from kicktimes import initial_conditions
 from kicktimes.report.pages import MARGIN, ci
-from kicktimes.stats import kinetic_rate, ratio_verdict
+from kicktimes.stats import STICKY_FACTOR, kinetic_rate, ratio_verdict
 from kicktimes.studies.science.stretching import N_BOOT
 
 __all__ = ["STICKY_FACTOR", "rate_relaxation", "sticky_orbits"]
-
-STICKY_FACTOR = 5.0
 
 
 def rate_relaxation(store, n_windows=10, n_boot=N_BOOT, seed=0):
