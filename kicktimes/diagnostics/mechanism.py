@@ -28,6 +28,7 @@ import numpy as np
 import pandas as pd
 
 from kicktimes._validation import check_int, check_real, check_rng
+from kicktimes.stats import resample_indices
 
 __all__ = [
     "RecollisionShare",
@@ -295,7 +296,7 @@ def recollision_share(table, *, max_wall_hits=1, level=0.95, n_boot=999,
     if n.sum() == 0:
         return RecollisionShare(math.nan, math.nan, math.nan, 0, 0, int(ids.size),
                                 max_wall_hits, level)
-    pick = rng.integers(0, ids.size, (n_boot, ids.size))
+    pick = resample_indices(ids.size, n_boot, rng)
     with np.errstate(invalid="ignore"):
         boots = k[pick].sum(axis=1) / n[pick].sum(axis=1)
     a = (1.0 - level) / 2.0

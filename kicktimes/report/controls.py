@@ -61,6 +61,7 @@ from kicktimes.stats import (
     nanmedian,
     ratio_verdict,
     rejection_verdict,
+    resample_indices,
     robust_verdict,
 )
 
@@ -152,7 +153,7 @@ def paired_median(numerator, denominator, *, rng, n_boot=1000, level=0.95):
         return {"ratio": math.nan, "ci_low": math.nan, "ci_high": math.nan, "n_pairs": n_pairs,
                 "per_radius": curve}
     n = values.shape[1]
-    idx = rng.integers(0, n, size=(n_boot, n))
+    idx = resample_indices(n, n_boot, rng)
     # boot_r[b] = nanmedian(values[:, idx[b]], axis=1), bit for bit, without a sort each
     boot_r = bootstrap_nanmedians(values, idx)
     with warnings.catch_warnings():

@@ -49,7 +49,7 @@ import pandas as pd
 
 from kicktimes.report.common import REFERENCE, wide
 from kicktimes.report.controls import diagnostics_of
-from kicktimes.stats import bootstrap_nanmedians
+from kicktimes.stats import bootstrap_nanmedians, resample_indices
 
 __all__ = ["ACTUAL_FACTORIAL", "FACTORIAL", "NO_GAP", "STEPS", "gap_decomposition",
            "gap_everywhere", "gap_figure", "gap_summary", "merge_control_gaps"]
@@ -207,7 +207,7 @@ def gap_decomposition(results, collisions, *, family, eps, rule="mirror", rng, n
             xs, y, _ = _arrays(table, systems, keep)
             if n_ic is None:
                 n_ic = y.shape[1]
-                idx = rng.integers(0, n_ic, size=(n_boot, n_ic))
+                idx = resample_indices(n_ic, n_boot, rng)
                 counts = np.zeros((n_boot, n_ic))
                 np.add.at(counts, (np.arange(n_boot)[:, None], idx), 1.0)
             ones = np.ones((1, n_ic))

@@ -21,7 +21,6 @@ from __future__ import annotations
 
 import datetime as _dt
 import json
-import math
 from pathlib import Path
 
 import numpy as np
@@ -30,7 +29,7 @@ import pandas as pd
 from kicktimes import __version__
 from kicktimes.stats import format_interval, ratio_verdict
 
-__all__ = ["MARGIN", "NULL_CALIBRATION", "NULL_CALIBRATION_COLUMNS", "ci", "header",
+__all__ = ["MARGIN", "NULL_CALIBRATION", "NULL_CALIBRATION_COLUMNS", "header",
            "markdown_table", "ratio_text", "simulations_source", "store_name",
            "trend_verdict", "write_null_calibration"]
 
@@ -63,16 +62,6 @@ def simulations_source(study, cache, *extra) -> str:
     """
     parts = [f"its cache `{cache}`", *extra, "no store"]
     return f"the direct simulations of `kicktimes.studies.{study}` ({'; '.join(parts)})"
-
-
-def ci(values, level=0.95):
-    """Percentile interval of the finite ``values`` (NaNs when there are none)."""
-    v = np.asarray(values, float)
-    v = v[np.isfinite(v)]
-    if not v.size:
-        return math.nan, math.nan
-    a = (1 - level) / 2 * 100
-    return float(np.percentile(v, a)), float(np.percentile(v, 100 - a))
 
 
 def ratio_text(estimate, low, high, tolerance=MARGIN) -> str:

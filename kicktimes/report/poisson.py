@@ -28,7 +28,7 @@ from kicktimes.report.figures import (
     new_axes,
     x_axis,
 )
-from kicktimes.stats import format_interval
+from kicktimes.stats import clopper_pearson, format_interval
 from kicktimes.stats.poisson import TEST_NULLS
 
 __all__ = [
@@ -61,18 +61,9 @@ FIXED_EVENTS = 30
 
 
 def binomial_ci(k, n, level=0.95):
-    """Clopper-Pearson interval of ``k`` successes in ``n`` trials (NaN where n = 0)."""
-    from statsmodels.stats.proportion import proportion_confint
-
-    k = np.asarray(k, dtype=float)
-    n = np.asarray(n, dtype=float)
-    ok = n > 0
-    low = np.full(k.shape, np.nan)
-    high = np.full(k.shape, np.nan)
-    if ok.any():
-        lo, hi = proportion_confint(k[ok], n[ok], alpha=1 - level, method="beta")
-        low[ok], high[ok] = lo, hi
-    return low, high
+    """Clopper-Pearson interval of ``k`` successes in ``n`` trials (NaN where n = 0): the
+    arrays of `kicktimes.stats.clopper_pearson`."""
+    return clopper_pearson(k, n, level)
 
 
 def rejection_table(rejections, *, level=0.95, x="radius") -> pd.DataFrame:
@@ -482,7 +473,6 @@ def null_calibration(name, rejections, per_ic, *, alpha, rng, n_boot=2000) -> pd
     counts (runs of one IC at different radii counted apart). The columns are those of
     `kicktimes.report.pages.NULL_CALIBRATION_COLUMNS` without ``study`` and ``verdict``.
     """
-    from kicktimes.stats.findings import clopper_pearson
 
     totals = rejections.groupby("test", sort=False, observed=True)[
         ["control_n_reject", "control_n_tested"]].sum()

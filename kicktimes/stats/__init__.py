@@ -26,6 +26,13 @@ See ``docs/statistics.md`` for the conventions.
 """
 
 from .analyze import Analysis, analyze
+from .bootstrap import (
+    ClusterBootstrap,
+    cluster_bootstrap,
+    percentile_interval,
+    ratio_of_means,
+    resample_indices,
+)
 from .comparison import VuongResult, compare_models, vuong
 from .counts import STICKY_FACTOR, CountRegression, is_sticky, kinetic_rate, regress_counts
 from .dilute import DiluteEstimate, DiluteTaggedDisk, dilute_tagged_disk, dilute_tagged_times
@@ -34,6 +41,7 @@ from .ensemble import PoissonEnsembleResult, test_poisson_ensemble
 from .enskog import contact_value, enskog_frequency, henderson_z, speed_rate_factor
 from .findings import (
     Finding,
+    clopper_pearson,
     format_interval,
     poisson_rule,
     poisson_verdict,
@@ -91,6 +99,11 @@ __all__ = [
     "regress_counts",
     "kinetic_rate",
     "STICKY_FACTOR",
+    "ClusterBootstrap",
+    "cluster_bootstrap",
+    "percentile_interval",
+    "ratio_of_means",
+    "resample_indices",
     "is_sticky",
     "enskog_frequency", "henderson_z",
     "speed_rate_factor",
@@ -118,6 +131,7 @@ __all__ = [
     "FitWarning",
     "Finding",
     "ratio_verdict",
+    "clopper_pearson",
     "robust_verdict",
     "share_ratio_sample_size",
     "format_interval",

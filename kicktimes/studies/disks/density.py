@@ -56,6 +56,7 @@ import numpy as np
 import pandas as pd
 
 from kicktimes.fileio import atomic_write
+from kicktimes.stats import resample_indices
 from kicktimes.studies.cache import cached_tables, write_cached
 from kicktimes.studies.disks.ftle_check import _say_reused
 
@@ -253,7 +254,9 @@ def summarise(runs: pd.DataFrame, *, n_boot=2000, seed=0, fit_max_packing=FIT_MA
         x = np.array([math.log(1.0 / reduced_density(p)) for p in packings])
         per = [g.loc[g["packing"] == p, "lam_per_coll"].to_numpy() for p in packings]
         means = np.array([v.mean() for v in per])
-        boot = np.array([[rng.choice(v, v.size).mean() for v in per] for _ in range(n_boot)])
+        # per replicate one resample of each packing's states, in turn (the stream of the page)
+        boot = np.array([[v[resample_indices(v.size, 1, rng)[0]].mean() for v in per]
+                         for _ in range(n_boot)])
         lo, hi = np.percentile(boot, [2.5, 97.5], axis=0)
         for p, xv, v, m, a, b in zip(packings, x, per, means, lo, hi, strict=True):
             rows.append({"n_disks": n_disks, "packing": p, "reduced_density":

@@ -37,6 +37,7 @@ import pandas as pd
 
 from kicktimes.stats import (
     TESTS,
+    cluster_bootstrap,
     enskog_frequency,
     fit_renewal,
     interval_hazard,
@@ -435,9 +436,8 @@ def _share_replicates(times, windows, *, alpha, n_mc, n_boot, rng):
 def _boot_means(x, n_boot, rng, chunk=100):
     """Percentile-bootstrap replicates of the mean of ``x`` (each value its own cluster),
     drawn ``chunk`` replicates at a time (the same stream as all at once)."""
-    out = [x[rng.integers(0, x.size, size=(min(chunk, n_boot - m), x.size))].mean(axis=1)
-           for m in range(0, n_boot, chunk)]
-    return np.concatenate(out)
+    return cluster_bootstrap(lambda idx: x[idx].mean(axis=1), x.size, n_boot=n_boot, rng=rng,
+                             chunk=chunk).replicates
 
 
 def two_disk_check(disks_store, two_store, *, alpha=0.05, n_boot=999, n_mc=199, seed=0):

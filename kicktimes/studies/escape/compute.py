@@ -10,13 +10,15 @@ import pandas as pd
 import scipy.stats as sps
 
 from kicktimes import initial_conditions, schedules, simulate_one_particle, simulate_two_particle
-from kicktimes.report.pages import MARGIN, ci
+from kicktimes.report.pages import MARGIN
 from kicktimes.stats import (
     circle_escape_constant,
     escape_survival,
     fit_escape_tail,
     kinetic_rate,
+    percentile_interval,
     ratio_verdict,
+    resample_indices,
 )
 
 __all__ = ["BURSTY_SHAPE", "CONTROLS", "FREE_TIMES", "HOLE", "KICKED", "LABELS", "N_BOOT",
@@ -127,7 +129,7 @@ def bootstrap_picks(n_ics, seed, n_boot=N_BOOT):
     """The IC indices of the estimate (first row) and of ``n_boot`` bootstrap resamples,
     shared by every radius and system (the bootstrap is paired)."""
     rng = np.random.default_rng(seed)
-    return np.vstack([np.arange(n_ics), rng.integers(0, n_ics, (n_boot, n_ics))])
+    return resample_indices(n_ics, n_boot, rng, with_identity=True)
 
 
 def escape_tables(times_by_radius, t_max, t_min, picks):
@@ -159,7 +161,7 @@ def escape_tables(times_by_radius, t_max, t_min, picks):
             disks = 2 if system == "two_particle_pooled" else 1
             gammas[system] = tail_rates(t, horizon, t_min, picks, disks)
             tail = fit_escape_tail(t, horizon, t_min=t_min)
-            lo, hi = ci(gammas[system][1:])
+            lo, hi = percentile_interval(gammas[system][1:])
             rows.append({"radius": r, "system": system, "kinetic_rate": float(kinetic_rate(r)),
                          "n": t.size, "escaped": int(np.isfinite(t).sum()),
                          "censored_by_partner": int((times["escaped"] == 1).sum())
@@ -172,7 +174,7 @@ def escape_tables(times_by_radius, t_max, t_min, picks):
         for system in KICKED:
             for reference in ("two_particle", "two_particle_pooled"):
                 q = gammas[system] / gammas[reference]
-                lo, hi = ci(q[1:])
+                lo, hi = percentile_interval(q[1:])
                 ratios.append({"radius": r, "system": system, "reference": reference,
                                "ratio": q[0], "ci_low": lo, "ci_high": hi,
                                "verdict": ratio_verdict(lo, hi, MARGIN),

@@ -34,7 +34,7 @@ from kicktimes.studies.mechanism.twins import (
 )
 
 __all__ = ["EXPLAINERS", "HAZARD_EDGES", "LATE_RESCALED", "RETURN_TIME", "STICKY_FACTOR",
-           "analyse", "cell_rows", "clopper_pearson", "hazard_profile_rows", "state_rates"]
+           "analyse", "cell_rows", "hazard_profile_rows", "state_rates"]
 
 #: the models whose explained share is reported; cox_markov_oos is out of sample
 EXPLAINERS = ("mixed_poisson", "cox_iid", "cox_sequence", "cox_markov_oos")
@@ -50,14 +50,10 @@ HAZARD_EDGES = np.array([0, 0.5, 1, 1.5, 2, 2.5, 3, 4, 6, 10, 16, 25, 40, 63, 10
                          400, 630, 1000, 2000], float)
 
 
-def clopper_pearson(k, n):
-    """Exact (Clopper-Pearson) 95 % interval of a share ``k / n``."""
-    ci = sps.binomtest(int(k), int(n)).proportion_ci(0.95, method="exact")
-    return ci.low, ci.high
 
 
 def _boot_ci(values_fn, n, rng, n_boot=1000):
-    picks = rng.integers(0, n, (n_boot, n))
+    picks = stats.resample_indices(n, n_boot, rng)
     vals = np.array([values_fn(p) for p in picks], float)
     return tuple(np.nanquantile(vals, [0.025, 0.975]))
 
@@ -254,7 +250,7 @@ def analyse(key, ics, runs, *, n_twins, rng, rule="mirror", n_boot=1000):
     data["observed"] = obs
     for test in BATTERY:
         k = int(obs["reject"][test].sum())
-        low, high = clopper_pearson(k, len(runs))
+        low, high = stats.clopper_pearson(int(k), len(runs))
         obs.setdefault("ci", {})[test] = (low, high)
         _row(rows, key, f"observed_reject_{test}", k / len(runs), low, high)
     _row(rows, key, "observed_dispersion_index", obs["dispersion_index"],

@@ -188,8 +188,7 @@ def fig_battery(results):
                 vals = [[dispersion(b["counts"][calm]) for b in d["twins"][n]] for n in twins]
                 counts = np.asarray(d["observed"]["counts"][calm], float)
                 obs = dispersion(counts)
-                picks = np.random.default_rng(0).integers(0, counts.size,
-                                                          (1000, counts.size))
+                picks = stats.resample_indices(counts.size, 1000, 0)
                 obs_ci = tuple(np.percentile([dispersion(counts[p]) for p in picks],
                                              [2.5, 97.5]))
             else:

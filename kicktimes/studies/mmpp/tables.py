@@ -141,8 +141,8 @@ def analyse(rule, times, sticky, t_max, per_run, seed):
     a, b = EARLY_EDGES[k], EARLY_EDGES[k + 1]
     boot_rng = np.random.default_rng(seed)
     boot, boot_min = [], []
-    for _ in range(N_BOOT):
-        pick = [calm[i] for i in boot_rng.integers(0, len(calm), len(calm))]
+    for idx in stats.resample_indices(len(calm), N_BOOT, boot_rng, chunk=1):
+        pick = [calm[i] for i in idx]
         c, z = intervals(pick, t_max)
         h = stats.interval_hazard(c, z, edges=[0.0, DIP, float(max(c.max(), z.max()))])
         boot.append(h.table["hazard"].iloc[0] / h.rate)

@@ -6,8 +6,8 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from kicktimes.report.pages import MARGIN, ci
-from kicktimes.stats import ratio_verdict
+from kicktimes.report.pages import MARGIN
+from kicktimes.stats import percentile_interval, ratio_verdict, resample_indices
 
 __all__ = ["RATIOS", "ratio_table", "sticky", "summary_tables"]
 
@@ -35,10 +35,10 @@ def ratio_table(df, n_boot=1000, seed=0):
     rows = []
     for ics, part in (("without sticky ICs", df[calm]), ("all ICs", df)):
         for r, g in part.groupby("radius", observed=True):
-            picks = np.vstack([np.arange(len(g)), rng.integers(0, len(g), (n_boot, len(g)))])
+            picks = resample_indices(len(g), n_boot, rng, with_identity=True)
             for num, den, label in RATIOS:
                 q = g[num].to_numpy()[picks].mean(1) / g[den].to_numpy()[picks].mean(1)
-                lo, hi = ci(q[1:])
+                lo, hi = percentile_interval(q[1:])
                 rows.append({"ics": ics, "radius": r, "n": len(g), "ratio": label,
                              "estimate": q[0], "ci_low": lo, "ci_high": hi,
                              "verdict": ratio_verdict(lo, hi, MARGIN)})

@@ -17,8 +17,8 @@ import numpy as np
 import pandas as pd
 
 from kicktimes import initial_conditions, schedules, simulate_one_particle, simulate_two_particle
-from kicktimes.report.pages import MARGIN, ci
-from kicktimes.stats import ratio_verdict
+from kicktimes.report.pages import MARGIN
+from kicktimes.stats import percentile_interval, ratio_verdict, resample_indices
 from kicktimes.studies.science.stretching import N_BOOT
 
 __all__ = ["closest_kick_law", "decorrelation", "prediction_against_measurement"]
@@ -80,13 +80,13 @@ def decorrelation(radii=(0.008, 0.02), *, rule="mirror", n_ics=40, t_max=20000.0
                 a, b, n = _pairs(np.asarray(lg.time), th, np.asarray(one.kick_times))
                 kinds[name].append((a[n == 1], b[n == 1]))
         rng = np.random.default_rng(seed)
-        picks = np.vstack([np.arange(n_ics), rng.integers(0, n_ics, (n_boot, n_ics))])
+        picks = resample_indices(n_ics, n_boot, rng, with_identity=True)
         boot = {name: np.array([_corr(per_ic, p) for p in picks]) for name, per_ic in
                 kinds.items()}
         for name, per_ic in kinds.items():
             a = np.concatenate([p[0] for p in per_ic])
             b = np.concatenate([p[1] for p in per_ic])
-            lo, hi = ci(boot[name][1:])
+            lo, hi = percentile_interval(boot[name][1:])
             rows.append({"rule": rule, "radius": r, "perturbation": name,
                          "n_pairs": int(a.size), "correlation": boot[name][0], "ci_low": lo,
                          "ci_high": hi})
@@ -102,7 +102,7 @@ def decorrelation(radii=(0.008, 0.02), *, rule="mirror", n_ics=40, t_max=20000.0
                                   if sel.any() else math.nan})
         for name, system in (("uniform kick", "poisson"), ("scatter kick", "poisson_scatter")):
             p = (1 - boot[name]) / (1 - boot["disk-disk collision"])
-            lo, hi = ci(p[1:])
+            lo, hi = percentile_interval(p[1:])
             preds.append({"rule": rule, "radius": r, "system": system, "predicted": p[0],
                           "predicted_ci_low": lo, "predicted_ci_high": hi})
     return pd.DataFrame(rows), pd.DataFrame(bins_rows), pd.DataFrame(preds)

@@ -14,8 +14,14 @@ import numpy as np
 import pandas as pd
 
 from kicktimes import initial_conditions
-from kicktimes.report.pages import MARGIN, ci
-from kicktimes.stats import STICKY_FACTOR, kinetic_rate, ratio_verdict
+from kicktimes.report.pages import MARGIN
+from kicktimes.stats import (
+    STICKY_FACTOR,
+    kinetic_rate,
+    percentile_interval,
+    ratio_verdict,
+    resample_indices,
+)
 from kicktimes.studies.science.stretching import N_BOOT
 
 __all__ = ["STICKY_FACTOR", "rate_relaxation", "sticky_orbits"]
@@ -37,7 +43,7 @@ def rate_relaxation(store, n_windows=10, n_boot=N_BOOT, seed=0):
         counts = per_ic.sum(0)
         width = edges[1] - edges[0]
         gamma = kinetic_rate(float(r))
-        picks = rng.integers(0, len(per_ic), (n_boot, len(per_ic)))
+        picks = resample_indices(len(per_ic), n_boot, rng)
         boot_sum += per_ic[picks].mean(1) / width / gamma
         est_sum += counts / (len(part) * width) / gamma
         n_r += 1
@@ -47,14 +53,14 @@ def rate_relaxation(store, n_windows=10, n_boot=N_BOOT, seed=0):
                          "rate_over_kinetic": counts[k] / (len(part) * width) / gamma})
         n = part["n_pp"].to_numpy(float)
         t = part["t_window"].to_numpy(float)
-        picks = rng.integers(0, n.size, (n_boot, n.size))
-        lo, hi = ci(n[picks].sum(1) / t[picks].sum(1) / gamma)
+        picks = resample_indices(n.size, n_boot, rng)
+        lo, hi = percentile_interval(n[picks].sum(1) / t[picks].sum(1) / gamma)
         whole.append({"family": store.experiment.name, "radius": r,
                       "count_over_kinetic": n.sum() / t.sum() / gamma, "ci_low": lo,
                       "ci_high": hi, "verdict": ratio_verdict(lo, hi, MARGIN)})
     windows = []
     for k in range(n_windows):
-        lo, hi = ci(boot_sum[:, k] / n_r)
+        lo, hi = percentile_interval(boot_sum[:, k] / n_r)
         windows.append({"family": store.experiment.name, "window": k,
                         "rate_over_kinetic": est_sum[k] / n_r, "ci_low": lo, "ci_high": hi,
                         "verdict": ratio_verdict(lo, hi, MARGIN)})

@@ -16,8 +16,8 @@ import numpy as np
 import pandas as pd
 
 from kicktimes.experiment import preset
-from kicktimes.report.pages import MARGIN, ci, trend_verdict
-from kicktimes.stats import ratio_verdict
+from kicktimes.report.pages import MARGIN, trend_verdict
+from kicktimes.stats import percentile_interval, ratio_verdict, resample_indices
 
 __all__ = ["KICKED", "N_BOOT", "SMALL_RADII", "SYSTEMS", "stretching", "stretching_experiment"]
 
@@ -97,7 +97,7 @@ def stretching(results, n_boot=N_BOOT, seed=0):
     radii = arrays["two_particle"]["lam"].index.to_numpy(float)
     n_ics = arrays["two_particle"]["lam"].shape[1]
     x = np.log(1 / radii)
-    picks = np.vstack([np.arange(n_ics), rng.integers(0, n_ics, (n_boot, n_ics))])
+    picks = resample_indices(n_ics, n_boot, rng, with_identity=True)
 
     def stretch(system):
         a = {k: v.to_numpy(float) for k, v in arrays[system].items()}
@@ -117,9 +117,9 @@ def stretching(results, n_boot=N_BOOT, seed=0):
         for j, r in enumerate(radii):
             row = {"system": system, "radius": r, "ln_inv_r": x[j],
                    "stretch_per_perturbation": s[system][0, j]}
-            row["ci_low"], row["ci_high"] = ci(s[system][1:, j])
+            row["ci_low"], row["ci_high"] = percentile_interval(s[system][1:, j])
             if system != "two_particle":
-                lo, hi = ci(ratio[1:, j])
+                lo, hi = percentile_interval(ratio[1:, j])
                 row.update(ratio=ratio[0, j], ratio_ci_low=lo, ratio_ci_high=hi,
                            verdict=ratio_verdict(lo, hi, MARGIN))
             per_radius.append(row)
@@ -128,13 +128,13 @@ def stretching(results, n_boot=N_BOOT, seed=0):
         row = {"system": system, "intercept": coef[0, 0], "slope": coef[0, 1],
                "ln_inv_r_min": x.min(), "ln_inv_r_max": x.max(),
                "local_slope_min": local.min(), "local_slope_max": local.max()}
-        row["intercept_ci_low"], row["intercept_ci_high"] = ci(coef[1:, 0])
-        row["slope_ci_low"], row["slope_ci_high"] = ci(coef[1:, 1])
+        row["intercept_ci_low"], row["intercept_ci_high"] = percentile_interval(coef[1:, 0])
+        row["slope_ci_low"], row["slope_ci_high"] = percentile_interval(coef[1:, 1])
         fits.append(row)
         if system != "two_particle":
             for what, y in (("ratio", ratio), ("abs_log_ratio", np.abs(np.log(ratio)))):
                 b = lstsq(y)[:, 1]
-                lo, hi = ci(b[1:])
+                lo, hi = percentile_interval(b[1:])
                 trend.append({"system": system, "quantity": what, "slope_per_ln_inv_r": b[0],
                               "ci_low": lo, "ci_high": hi, "verdict": trend_verdict(lo, hi)})
     return pd.DataFrame(per_radius), pd.DataFrame(fits), pd.DataFrame(trend)

@@ -15,8 +15,7 @@ import numpy as np
 import pandas as pd
 
 from kicktimes import initial_conditions, schedules, simulate_one_particle
-from kicktimes.report.pages import ci
-from kicktimes.stats import kinetic_rate
+from kicktimes.stats import kinetic_rate, percentile_interval, resample_indices
 
 __all__ = ["independent_angle_twin", "twin_table", "twins_raw"]
 
@@ -73,8 +72,9 @@ def independent_angle_twin(r, *, n_ics=8, n_steps=3000, tau=0.2, d0=2e-4, seed=3
                 b[0] += d0 if a[0] < 0 else -d0
         lams.append(total / (n_steps * tau))
     boot_rng = np.random.default_rng(1)
-    boot = [np.mean(boot_rng.choice(lams, len(lams))) for _ in range(N_BOOT)]
-    return float(np.mean(lams)), rate, ci(boot)
+    lams = np.asarray(lams, float)
+    boot = [np.mean(lams[p]) for p in resample_indices(lams.size, N_BOOT, boot_rng, chunk=1)]
+    return float(np.mean(lams)), rate, percentile_interval(boot)
 
 
 def twins_raw(radii, *, tau, d0, n_ics=8, n_steps=3000):

@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from kicktimes.stats import kinetic_rate, poisson_group
+from kicktimes.stats import kinetic_rate, poisson_group, resample_indices
 from kicktimes.stats.findings import clopper_pearson
 from kicktimes.studies.unequal.compute import KINDS, R0
 
@@ -17,7 +17,7 @@ __all__ = ["dispersion_ci", "ks_interval", "ratio_ci", "size_ratio_table"]
 def ratio_ci(x, y, rng, n_boot=2000):
     """Ratio of means ``sum x / sum y`` and its percentile bootstrap CI over pairs."""
     x, y = np.asarray(x, float), np.asarray(y, float)
-    idx = rng.integers(0, x.size, size=(n_boot, x.size))
+    idx = resample_indices(x.size, n_boot, rng)
     boot = x[idx].sum(1) / y[idx].sum(1)
     return x.sum() / y.sum(), *np.quantile(boot, [0.025, 0.975])
 
@@ -25,7 +25,7 @@ def ratio_ci(x, y, rng, n_boot=2000):
 def dispersion_ci(counts, rng, n_boot=2000):
     """95 % bootstrap interval over ICs of the dispersion index var / mean of the counts."""
     counts = np.asarray(counts, float)
-    b = counts[rng.integers(0, counts.size, (n_boot, counts.size))]
+    b = counts[resample_indices(counts.size, n_boot, rng)]
     lo, hi = np.percentile(b.var(1, ddof=1) / b.mean(1), [2.5, 97.5])
     return float(lo), float(hi)
 
