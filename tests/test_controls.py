@@ -364,33 +364,19 @@ def test_the_readme_block_is_replaced_by_the_generated_first_screen(tmp_path):
         copy_first_screen(page, tmp_path / "plain.md")
 
 
-def test_the_first_screen_is_rewritten_from_the_findings_tables_alone(tmp_path):
-    from kicktimes.studies.paper import refresh_first_screen
-
-    table = _rows([("family_a", "primary", 0.30, 0.33), ("family_a", "elastic", 0.31, 0.34)])
-    table.to_csv(tmp_path / "family_a_findings.csv", index=False)
-    table.to_csv(tmp_path / "family_a-elastic_findings.csv", index=False)  # ignored
-    (tmp_path / "README.md").write_text(
-        "# t\n\nGenerated 2026 from `a`.\n\n## The answers\n\nold words\n\n| old |\n\n"
-        "![headline](h.png)\n\n## Next\n")
-    text = refresh_first_screen(tmp_path).read_text()
-    assert "old words" not in text and "| FTLE λ | ✓ lower: 0.315–0.325 |" in text
-    assert "first screen was rewritten" in text and text.index("## Next") > text.index("![h")
-
-
-def test_the_paper_module_rewrites_the_first_screen_and_the_readme_block(tmp_path, capsys):
+def test_the_paper_module_copies_the_first_screen_and_leaves_the_page_alone(tmp_path, capsys):
     from kicktimes.studies.paper import BEGIN, END
     from kicktimes.studies.paper.__main__ import main
 
-    table = _rows([("family_a", "primary", 0.30, 0.33)])
-    table.to_csv(tmp_path / "family_a_findings.csv", index=False)
-    (tmp_path / "README.md").write_text(
-        "# t\n\nGenerated 2026 from `a`.\n\n## The answers\n\nold words\n\n"
-        "![headline](h.png)\n\n## Next\n")
+    page = tmp_path / "README.md"
+    page.write_text("# t\n\nGenerated 2026 from `a`.\n\n## The answers\n\n| FTLE λ | x |\n\n"
+                    "![headline](h.png)\n\n## Next\n")
+    before = page.read_bytes()
     readme = tmp_path / "top.md"
     readme.write_text(f"intro\n{BEGIN}\nold\n{END}\n")
     assert main([str(tmp_path), "--readme", str(readme)]) == 0
-    assert "| FTLE λ | ✓ lower: 0.315–0.315 |" in readme.read_text()
+    assert "| FTLE λ | x |" in readme.read_text() and "old" not in readme.read_text()
+    assert page.read_bytes() == before  # the page has one writer: write_results
     with pytest.raises(SystemExit) as stop:
-        main([str(tmp_path / "nowhere")])
+        main([str(tmp_path / "nowhere"), "--readme", str(readme)])
     assert stop.value.code == 2 and "error:" in capsys.readouterr().err

@@ -155,31 +155,34 @@ def test_findings_belong_to_the_protocol_study(tmp_path):
     assert res.exit_code == 2 and "--findings applies to --study protocol" in res.output
 
 
-def test_the_results_first_screen_points_to_paper_md_and_keeps_the_family_tables(tmp_path):
+def test_the_results_first_screen_quotes_paper_md_from_the_protocols_table(tmp_path):
     import shutil
     from pathlib import Path
 
-    from kicktimes.studies.paper import refresh_first_screen
+    from kicktimes.studies.paper import paper_protocol_sentence
 
+    assert paper_protocol_sentence(tmp_path) == []  # no protocol table: no sentence
     results = Path(__file__).resolve().parents[1] / "docs" / "results"
-    for name in ("README.md", "family_a_findings.csv", "family_b_findings.csv",
-                 "paper_findings.csv", "paper_claims.csv"):
-        shutil.copy(results / name, tmp_path / name)
-    before = pd.read_csv(tmp_path / "family_a_findings.csv")
-    page = refresh_first_screen(tmp_path)
-    # the protocol study's paper_findings.csv is not a family's table: nothing merged in
-    after = pd.read_csv(tmp_path / "family_a_findings.csv")
-    assert len(after) == len(before) and set(after["control"]) == set(before["control"])
-    text = page.read_text()
-    answers = text[text.index("## The answers"):]
+    shutil.copy(results / "paper_findings.csv", tmp_path / "paper_findings.csv")
+    sentence = paper_protocol_sentence(tmp_path)[0]
     findings = pd.read_csv(tmp_path / "paper_findings.csv")
     literal = findings[(findings["estimator"] == "literal")
                        & (findings["kick_angle"] == "uniform")]
-    assert "[paper.md](paper.md)" in answers.splitlines()[2]
+    assert sentence.startswith("By the paper's own protocol ([paper.md](paper.md))")
     # as printed, with shared twin kicks (paper.md's reading) and with the twins' own
     for kicks in ("shared", "independent"):
         part = literal[literal["twin_kicks"] == kicks]["estimate"]
-        assert f"{part.min():.3f}–{part.max():.3f}" in answers, kicks
+        assert f"{part.min():.3f}–{part.max():.3f}" in sentence, kicks
+    # the published page was made in one command and carries the same sentence
+    page = (results / "README.md").read_text(encoding="utf-8")
+    assert sentence in page
+
+
+def test_the_paper_study_needs_the_protocol_study_which_runs_first():
+    from kicktimes.studies import STUDIES
+
+    assert STUDIES["paper"].needs == ("protocol",)
+    assert list(STUDIES).index("protocol") < list(STUDIES).index("paper")
 
 
 def test_every_registered_study_is_a_choice_of_reproduce_with_its_line():

@@ -12,7 +12,7 @@ Examples
 --------
 >>> from kicktimes.studies import STUDIES
 >>> list(STUDIES)[:3]
-['paper', 'protocol', 'science']
+['protocol', 'paper', 'science']
 >>> STUDIES["protocol"].page
 'paper.md'
 """
@@ -28,7 +28,9 @@ __all__ = ["STUDIES", "Study", "studies_help"]
 class Study:
     """A registered study: its name (``--study NAME``), the page it writes into
     ``--results``, one line for ``kicktimes reproduce --help``, and the names of the
-    stores of other studies it reads (``needs``; ``--study all`` runs those first).
+    other studies whose stores or tables it reads (``needs``; ``--study all`` runs those
+    first: the paper study's first screen quotes the protocol study's
+    ``paper_findings.csv`` from the same ``--results`` folder).
 
     Its package ``kicktimes.studies.<name>`` provides ``reproduce(out, *, scale,
     results_dir, workers, progress, command)``, which runs (or resumes, from ``out``) its
@@ -55,10 +57,11 @@ class Study:
 STUDIES = {
     s.name: s
     for s in (
-        Study("paper", "README.md",
-              "the paper's two families under every control; the sweep report"),
         Study("protocol", "paper.md",
               "the paper's claims by its own protocol (eq. (4), Fig. 6, RR, R_1)"),
+        Study("paper", "README.md",
+              "the paper's two families under every control; the sweep report",
+              needs=("protocol",)),
         Study("science", "science.md",
               "stretching and decorrelation per kick, the rate over the run, sticky orbits",
               needs=("paper",)),

@@ -8,14 +8,16 @@ and writes the page ``README.md`` with :func:`write_results`: the answers first 
 comparison under its controls, :mod:`kicktimes.report.answers`), the headline figure, the
 findings tables ``<family>_findings.csv`` and the gap decomposition.
 
-:func:`refresh_first_screen` rewrites the page's first screen from the findings tables
-beside it (no store read), for instance after the protocol study's ``paper_findings.csv``
-changed; :func:`copy_first_screen` copies it into the repository's README.
+:func:`write_results` is the page's only writer: its first screen quotes the protocol
+study's ``paper_findings.csv`` from the same folder (`paper_protocol_sentence`), which
+``kicktimes reproduce --study all`` writes first (the study ``needs`` it), so one command
+makes the page. :func:`copy_first_screen` copies the first screen into the repository's
+README (``python -m kicktimes.studies.paper docs/results --readme README.md``).
 
 Examples
 --------
->>> from kicktimes.studies.paper import write_results, refresh_first_screen
->>> callable(write_results) and callable(refresh_first_screen)
+>>> from kicktimes.studies.paper import copy_first_screen, write_results
+>>> callable(write_results) and callable(copy_first_screen)
 True
 """
 
@@ -26,9 +28,7 @@ from kicktimes.studies.paper.page import (
     END,
     copy_first_screen,
     paper_protocol_sentence,
-    refresh_first_screen,
     write_results,
 )
 
-__all__ = ["BEGIN", "END", "copy_first_screen", "paper_protocol_sentence",
-           "refresh_first_screen", "write_results"]
+__all__ = ["BEGIN", "END", "copy_first_screen", "paper_protocol_sentence", "write_results"]

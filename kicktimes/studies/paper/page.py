@@ -27,7 +27,7 @@ from kicktimes.report.common import (
 )
 from kicktimes.stats import format_interval
 
-__all__ = ["copy_first_screen", "counts_section", "poisson_section", "refresh_first_screen",
+__all__ = ["copy_first_screen", "counts_section", "paper_protocol_sentence", "poisson_section",
            "write_results"]
 
 BEGIN, END = "<!-- results:begin -->", "<!-- results:end -->"
@@ -230,49 +230,6 @@ def paper_protocol_sentence(out_dir) -> list[str]:
             f"({lit_own_text} with the twins' own); renormalised, "
             f"{shared_text} with shared twin kicks, {own_text} with the twins' own: {why}. "
             "Below: kicktimes' tangent-space FTLE.", ""]
-
-
-def refresh_first_screen(out_dir) -> Path:
-    """Rewrite the answers and the table of ``out_dir/README.md`` from the findings tables
-    beside it (``<family>_findings.csv``, the merged ones that `write_results` wrote),
-    without recomputing anything else; the "Generated" line says so. Returns the page.
-
-    For a change of the first screen's wording: the numbers are the tables' own.
-    """
-    from kicktimes.report.answers import first_screen
-
-    out = Path(out_dir)
-    page = out / "README.md"
-    tables = []
-    for p in sorted(out.glob("*_findings.csv")):
-        if "-" in p.name:
-            continue
-        t = pd.read_csv(p, keep_default_na=False, na_values=[""])
-        # a family's own table only (paper_findings.csv, the protocol study's, is not one)
-        if set(t["family"].astype(str)) == {p.name.removesuffix("_findings.csv")}:
-            tables.append(t)
-    if not tables:
-        raise ValueError(f"{out}: no <family>_findings.csv to build the first screen from")
-    from kicktimes.report.controls import with_robustness
-
-    table = pd.concat(tables, ignore_index=True)
-    table["depends_on"] = table["depends_on"].astype(object).where(table["depends_on"].notna(),
-                                                                    "")
-    table = with_robustness(table)
-    # the derived columns, again
-    for family, part in table.groupby("family", sort=False, observed=True):
-        part.to_csv(out / f"{family}_findings.csv", index=False)
-    lines = page.read_text(encoding="utf-8").splitlines()
-    start = lines.index("## The answers") + 2
-    stop = next(k for k in range(start, len(lines)) if lines[k].startswith("![headline]"))
-    lines[start:stop] = paper_protocol_sentence(out) + first_screen(table)
-    now = _dt.datetime.now(_dt.UTC).isoformat(timespec="seconds")
-    k = next(i for i, line in enumerate(lines) if line.startswith("Generated "))
-    lines[k] = (lines[k].split(" The first screen was rewritten")[0]
-                + f" The first screen was rewritten {now} from the findings tables "
-                "(`python -m kicktimes.studies.paper`).")
-    atomic_write_bytes(page, ("\n".join(lines) + "\n").encode("utf-8"))
-    return page
 
 
 def _short(family):
