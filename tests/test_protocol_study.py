@@ -155,34 +155,25 @@ def test_findings_belong_to_the_protocol_study(tmp_path):
     assert res.exit_code == 2 and "--findings applies to --study protocol" in res.output
 
 
-def test_the_results_first_screen_quotes_paper_md_from_the_protocols_table(tmp_path):
-    import shutil
+def test_the_results_first_screen_points_to_paper_md_without_its_numbers():
     from pathlib import Path
 
-    from kicktimes.studies.paper import paper_protocol_sentence
+    from kicktimes.studies.paper import PROTOCOL_POINTER
 
-    assert paper_protocol_sentence(tmp_path) == []  # no protocol table: no sentence
+    pointer = PROTOCOL_POINTER[0]
+    assert "[paper.md](paper.md)" in pointer
+    # names (eq. (4), Fig. 6), no number of paper.md
+    assert not re.search(r"[0-9]", pointer.replace("eq. (4)", "").replace("Fig. 6", ""))
+    # the protocol page states the readings of eq. (4) the pointer names
     results = Path(__file__).resolve().parents[1] / "docs" / "results"
-    shutil.copy(results / "paper_findings.csv", tmp_path / "paper_findings.csv")
-    sentence = paper_protocol_sentence(tmp_path)[0]
-    findings = pd.read_csv(tmp_path / "paper_findings.csv")
-    literal = findings[(findings["estimator"] == "literal")
-                       & (findings["kick_angle"] == "uniform")]
-    assert sentence.startswith("By the paper's own protocol ([paper.md](paper.md))")
-    # as printed, with shared twin kicks (paper.md's reading) and with the twins' own
-    for kicks in ("shared", "independent"):
-        part = literal[literal["twin_kicks"] == kicks]["estimate"]
-        assert f"{part.min():.3f}–{part.max():.3f}" in sentence, kicks
-    # the published page was made in one command and carries the same sentence
-    page = (results / "README.md").read_text(encoding="utf-8")
-    assert sentence in page
+    assert "eq. (4) as printed gives kicked/two-disk" in (results / "paper.md").read_text()
 
 
-def test_the_paper_study_needs_the_protocol_study_which_runs_first():
+def test_the_protocol_study_needs_the_paper_study_which_runs_first():
     from kicktimes.studies import STUDIES
 
-    assert STUDIES["paper"].needs == ("protocol",)
-    assert list(STUDIES).index("protocol") < list(STUDIES).index("paper")
+    assert STUDIES["paper"].needs == () and STUDIES["protocol"].needs == ("paper",)
+    assert list(STUDIES).index("paper") < list(STUDIES).index("protocol")
 
 
 def test_every_registered_study_is_a_choice_of_reproduce_with_its_line():

@@ -12,7 +12,7 @@ Examples
 --------
 >>> from kicktimes.studies import STUDIES
 >>> list(STUDIES)[:3]
-['protocol', 'paper', 'science']
+['paper', 'protocol', 'science']
 >>> STUDIES["protocol"].page
 'paper.md'
 """
@@ -29,8 +29,8 @@ class Study:
     """A registered study: its name (``--study NAME``), the page it writes into
     ``--results``, one line for ``kicktimes reproduce --help``, and the names of the
     other studies whose stores or tables it reads (``needs``; ``--study all`` runs those
-    first: the paper study's first screen quotes the protocol study's
-    ``paper_findings.csv`` from the same ``--results`` folder).
+    first: the protocol study's count claims come from the paper study's
+    ``family_*_findings.csv`` in the same ``--results`` folder).
 
     Its package ``kicktimes.studies.<name>`` provides ``reproduce(out, *, scale,
     results_dir, workers, progress, command)``, which runs (or resumes, from ``out``) its
@@ -57,11 +57,11 @@ class Study:
 STUDIES = {
     s.name: s
     for s in (
-        Study("protocol", "paper.md",
-              "the paper's claims by its own protocol (eq. (4), Fig. 6, RR, R_1)"),
         Study("paper", "README.md",
-              "the paper's two families under every control; the sweep report",
-              needs=("protocol",)),
+              "the paper's two families under every control; the sweep report"),
+        Study("protocol", "paper.md",
+              "the paper's claims by its own protocol (eq. (4), Fig. 6, RR, R_1)",
+              needs=("paper",)),
         Study("science", "science.md",
               "stretching and decorrelation per kick, the rate over the run, sticky orbits",
               needs=("paper",)),

@@ -8,10 +8,10 @@ and writes the page ``README.md`` with :func:`write_results`: the answers first 
 comparison under its controls, :mod:`kicktimes.report.answers`), the headline figure, the
 findings tables ``<family>_findings.csv`` and the gap decomposition.
 
-:func:`write_results` is the page's only writer: its first screen quotes the protocol
-study's ``paper_findings.csv`` from the same folder (`paper_protocol_sentence`), which
-``kicktimes reproduce --study all`` writes first (the study ``needs`` it), so one command
-makes the page. :func:`copy_first_screen` copies the first screen into the repository's
+:func:`write_results` is the page's only writer, in one command: its first screen points
+to the protocol study's page (``PROTOCOL_POINTER``) without quoting its numbers, so the
+study needs no other (the protocol study reads this one's findings tables and runs after
+it). :func:`copy_first_screen` copies the first screen into the repository's
 README (``python -m kicktimes.studies.paper docs/results --readme README.md``).
 
 Examples
@@ -26,9 +26,9 @@ from __future__ import annotations
 from kicktimes.studies.paper.page import (
     BEGIN,
     END,
+    PROTOCOL_POINTER,
     copy_first_screen,
-    paper_protocol_sentence,
     write_results,
 )
 
-__all__ = ["BEGIN", "END", "copy_first_screen", "paper_protocol_sentence", "write_results"]
+__all__ = ["BEGIN", "END", "PROTOCOL_POINTER", "copy_first_screen", "write_results"]

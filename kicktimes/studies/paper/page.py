@@ -27,7 +27,7 @@ from kicktimes.report.common import (
 )
 from kicktimes.stats import format_interval
 
-__all__ = ["copy_first_screen", "counts_section", "paper_protocol_sentence", "poisson_section",
+__all__ = ["PROTOCOL_POINTER", "copy_first_screen", "counts_section", "poisson_section",
            "write_results"]
 
 BEGIN, END = "<!-- results:begin -->", "<!-- results:end -->"
@@ -196,40 +196,13 @@ def copy_first_screen(page, target):
     atomic_write_bytes(target, new.encode("utf-8"))
 
 
-def paper_protocol_sentence(out_dir) -> list[str]:
-    """The first screen's pointer to ``paper.md`` (``kicktimes reproduce --study protocol``),
-    built from its ``paper_findings.csv`` beside the page: the kicked/two-disk FTLE ratio
-    under every reading of the paper's eq. (4) without renormalisation, and with it (twins
-    sharing the kicks, twins with their own), with their verdicts; ``[]`` when absent."""
-    path = Path(out_dir) / "paper_findings.csv"
-    if not path.exists():
-        return []
-    table = pd.read_csv(path)
-    ftle = table[(table["diagnostic"] == "ftle") & table["estimator"].isin(
-        ["literal", "renormalised"]) & (table["kick_angle"] == "uniform")]
-    if ftle.empty:
-        return []
-
-    def part(estimator, twin_kicks=None):
-        sel = ftle[ftle["estimator"] == estimator]
-        if twin_kicks is not None:
-            sel = sel[sel["twin_kicks"] == twin_kicks]
-        verdicts = " / ".join(dict.fromkeys(sel["verdict"]))
-        return sel, f"{sel['estimate'].min():.3f}–{sel['estimate'].max():.3f} ({verdicts})"
-
-    literal, lit_text = part("literal", "shared")
-    _, lit_own_text = part("literal", "independent")
-    renormalised, shared_text = part("renormalised", "shared")
-    _, own_text = part("renormalised", "independent")
-    only = ((ftle[ftle["estimator"] == "literal"]["verdict"] == "within 10 %").all()
-            and (ftle[ftle["estimator"] == "renormalised"]["verdict"] != "within 10 %").all())
-    why = ("the paper's agreement needs the unrenormalised reading" if only
-           else "the reading of eq. (4) decides")
-    return [f"By the paper's own protocol ([paper.md](paper.md)), its eq. (4) "
-            f"as printed gives a kicked/two-disk FTLE of {lit_text} with shared twin kicks "
-            f"({lit_own_text} with the twins' own); renormalised, "
-            f"{shared_text} with shared twin kicks, {own_text} with the twins' own: {why}. "
-            "Below: kicktimes' tangent-space FTLE.", ""]
+#: the first screen's pointer to the protocol study's page: no number of another study on
+#: this page, so the paper study needs no other study (the protocol study reads this one's
+#: findings tables, and runs after it)
+PROTOCOL_POINTER = [
+    "The paper's claims read by its own protocol (its eq. (4) as printed and renormalised, "
+    "Fig. 6, RR, R₁) are on [paper.md](paper.md) (`kicktimes reproduce --study protocol`). "
+    "Below: kicktimes' tangent-space FTLE and every comparison under its controls.", ""]
 
 
 def _short(family):
@@ -389,7 +362,7 @@ def write_results(
         if not c.empty:
             c.to_csv(out / f"{c['family'].iloc[0]}_findings_by_radius.csv", index=False)
     table = pd.concat(list(merged.values()), ignore_index=True)
-    screen = ["## The answers", ""] + paper_protocol_sentence(out) + first_screen(table)
+    screen = ["## The answers", ""] + PROTOCOL_POINTER + first_screen(table)
     curves = pd.concat(curves, ignore_index=True)
     figure = ratio_curves_figure(curves[curves["family"].isin(list(merged))])
     figure.savefig(out / "headline_ratios_vs_radius.png", dpi=dpi)
