@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import sys
 
-__all__ = ["cold_kernels", "announce", "warm_up", "warm_sweep", "warm_report"]
+__all__ = ["cold_kernels", "announce", "compile_first", "warm_up", "warm_sweep", "warm_report"]
 
 #: (module, kernel, compile seconds measured by benchmarks/bench_compile.py on the
 #: project's 2-core machine, inclusive of the kernels each one calls; the recurrence entry,
@@ -213,3 +213,28 @@ def warm_up(workers: int, *, report: bool = False) -> None:
         futures = [pool.submit(_warm_group_two, report), pool.submit(_warm_group_one, report)]
         for fut in futures:
             fut.result()
+
+
+def compile_first(workers, kernels=None, *, report=False, report_process=False):
+    """On a cold numba cache, say so once and compile the sweep's kernels (and the
+    report's, with ``report``) up front, the independent groups in parallel
+    (:mod:`kicktimes.compilation`); then, for a pool of several workers, load the sweep's
+    kernels in this process, which the workers fork from. With ``report_process`` the
+    report's kernels are left to the report process
+    (`kicktimes.report.process.ReportProcess`), which compiles them while the sweeps run;
+    the estimate includes them, and their modules (scipy.stats, statsmodels: about 1 s)
+    are not imported here. ``kernels``: only announce those (the simulate commands)."""
+    import os
+
+    if kernels is not None:
+        announce(kernels)
+        return
+    here = report and not report_process
+    elsewhere = sum(s for *_, s in REPORT_KERNELS) if report and report_process else 0
+    wanted = SWEEP_KERNELS + (REPORT_KERNELS if here else ())
+    n_workers = workers or os.cpu_count() or 1
+    if announce(wanted, extra_seconds=elsewhere):
+        warm_up(n_workers, report=here)
+    if n_workers > 1:
+        # load them here, once: the pool's workers, forked from this process, inherit them
+        warm_sweep()

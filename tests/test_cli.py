@@ -125,13 +125,13 @@ def test_python_dash_m_runs_the_cli():
 
 def test_the_report_process_builds_the_report_the_driver_sends(tmp_path):
     # `reproduce` forks it before the sweeps: it imports the report's modules meanwhile
-    from kicktimes.cli.experiment import _ReportProcess
     from kicktimes.experiment import run_experiment
+    from kicktimes.report.process import ReportProcess
 
     exp = Experiment(name="tiny_rp", radii=[0.02], n_ics=2, n_steps=200, tau=0.3,
                      diagnostics=["recurrence_rate"])
     run_experiment(exp, tmp_path / "store", workers=1, progress=False)
-    process = _ReportProcess()
+    process = ReportProcess()
     try:
         path = process.build([str(tmp_path / "store")], str(tmp_path / "report"), 1, False,
                              False)
@@ -142,21 +142,21 @@ def test_the_report_process_builds_the_report_the_driver_sends(tmp_path):
 
 
 def test_the_report_process_hands_its_errors_to_the_driver(tmp_path):
-    from kicktimes.cli.experiment import _ReportProcess
+    from kicktimes.report.process import ReportProcess
 
-    process = _ReportProcess()
+    process = ReportProcess()
     try:
         with pytest.raises(ValueError, match="is not a kicktimes store"):
             process.build([str(tmp_path)], str(tmp_path / "report"), 1, False, False)
     finally:
         process.close()
-    idle = _ReportProcess()
+    idle = ReportProcess()
     idle.close()  # no job: it ends when the driver closes the pipe
     assert idle._proc.exitcode == 0
 
 
 def test_an_unpicklable_error_of_the_report_process_still_reaches_the_driver(monkeypatch):
-    from kicktimes.cli import experiment as cli
+    from kicktimes.report import process as cli
 
     class LocalError(Exception):  # a local class: pickle cannot name it
         pass
@@ -164,11 +164,11 @@ def test_an_unpicklable_error_of_the_report_process_still_reaches_the_driver(mon
     def fail(*job):
         raise LocalError("the figures could not be drawn")
 
-    monkeypatch.setattr(cli, "_build_report", fail)  # the forked process inherits it
-    process = cli._ReportProcess()
+    monkeypatch.setattr(cli, "build_stores_report", fail)  # the forked process inherits it
+    process = cli.ReportProcess()
     try:
         with pytest.raises(RuntimeError, match="LocalError: the figures could not be drawn"):
-            process.build("job")
+            process.build(["store"], "out")
     finally:
         process.close()
 

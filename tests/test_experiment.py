@@ -189,7 +189,7 @@ def test_reproduce_content_paper_writes_its_own_stores_and_report(tmp_path, monk
     assert (tmp_path / "report-paper" / "report.html").is_file()
     assert not (tmp_path / "report").exists()
     assert not (tmp_path / "store-quick_a").exists()
-    assert f"report written to {tmp_path / 'report-paper'}" in result.output
+    assert f"page written to {tmp_path / 'results' / 'README.md'}" in result.output
     # --results: the study's page, its Generated line naming the command
     page = (results / "README.md").read_text(encoding="utf-8")
     generated = next(line for line in page.splitlines() if line.startswith("Generated "))

@@ -11,6 +11,7 @@ import re
 import click
 
 from kicktimes import __version__
+from kicktimes.compilation import compile_first as _compile_first  # noqa: F401 (the commands')
 
 # numpy 2 reprs ("np.float64(-2.0)") leak into messages built with !r
 _NUMPY_REPR = re.compile(r"\bnp\.(?:float|int|uint|bool_?)\d*\((.*?)\)")
@@ -94,27 +95,3 @@ def main():
     click.get_current_context().with_resource(fewer_collections())
 
 
-def _compile_first(workers, kernels=None, *, report=False, report_process=False):
-    """On a cold numba cache, say so once and compile the sweep's kernels (and the
-    report's, with ``report``) up front, the independent groups in parallel
-    (:mod:`kicktimes.compilation`); then, for a pool of several workers, load the sweep's
-    kernels in this process, which the workers fork from. With ``report_process`` the
-    report's kernels are left to the report process (`_ReportProcess`), which compiles
-    them while the sweeps run; the estimate includes them, and their modules (scipy.stats,
-    statsmodels: about 1 s) are not imported here."""
-    import os
-
-    from kicktimes import compilation as _compile
-
-    if kernels is not None:
-        _compile.announce(kernels)
-        return
-    here = report and not report_process
-    elsewhere = sum(s for *_, s in _compile.REPORT_KERNELS) if report and report_process else 0
-    wanted = _compile.SWEEP_KERNELS + (_compile.REPORT_KERNELS if here else ())
-    n_workers = workers or os.cpu_count() or 1
-    if _compile.announce(wanted, extra_seconds=elsewhere):
-        _compile.warm_up(n_workers, report=here)
-    if n_workers > 1:
-        # load them here, once: the pool's workers, forked from this process, inherit them
-        _compile.warm_sweep()

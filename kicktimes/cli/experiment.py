@@ -160,83 +160,9 @@ def presets_command(name):
 
 
 def _build_report(stores, out, workers=None, progress=None, pdf=False, force=False):
-    try:
-        from kicktimes.report import build_report
-    except ImportError as exc:
-        raise click.ClickException(f"the report module is not available: {exc}") from None
-    target = stores[0] if len(stores) == 1 else list(stores)
-    return build_report(target, out, workers=workers, progress=progress, pdf=pdf, force=force)
+    from kicktimes.report.process import build_stores_report
 
-
-def _report_server(conn, driver_end):
-    """Body of `_ReportProcess`: import the report's modules, then build the one report
-    the driver sends and send back ``("ok", path)`` or ``("error", exception)``."""
-    import pickle
-
-    driver_end.close()  # the fork's copy: else closing the driver's would never reach us
-    from kicktimes import compilation as _compile
-    from kicktimes.report import pipeline
-
-    pipeline._stages()
-    _compile.warm_report()
-    try:
-        job = conn.recv()
-    except EOFError:  # the driver is gone, or had no report to build
-        return
-    try:
-        result = ("ok", _build_report(*job))
-    except BaseException as exc:  # noqa: BLE001  (handed to the driver, which raises it)
-        result = ("error", exc)
-    try:
-        try:
-            conn.send(result)
-        except (TypeError, AttributeError, pickle.PicklingError):  # an unpicklable error
-            exc = result[1]
-            conn.send(("error", RuntimeError(f"{type(exc).__name__}: {exc}")))
-    except OSError:  # the driver is gone (e.g. interrupted): nobody to tell
-        pass
-
-
-class _ReportProcess:
-    """A process forked at the start of ``reproduce`` that builds its report.
-
-    It imports the report's modules (matplotlib, scipy, statsmodels: about 2 s) and loads
-    (on a cold cache: compiles) the report's kernels while the driver checks the numba
-    cache and runs the sweeps, on the core the driver's imports leave idle; the report
-    starts at once when the sweeps end, and its workers, forked from this process,
-    inherit all of it. Forked before the driver starts any thread or pool (measured:
-    docs/benchmarks.md, "Measurements behind design choices").
-    """
-
-    def __init__(self):
-        import multiprocessing as mp
-
-        ctx = mp.get_context("fork")
-        self._conn, child = ctx.Pipe()
-        self._proc = ctx.Process(target=_report_server, args=(child, self._conn),
-                                 name="kicktimes-report")
-        self._proc.start()
-        child.close()
-
-    def build(self, *job):
-        """`_build_report` of ``job`` in the report process; raises what it raised."""
-        self._conn.send(job)
-        try:
-            status, value = self._conn.recv()
-        except EOFError:
-            raise RuntimeError(
-                f"the report process ended unexpectedly (exit code {self._proc.exitcode})"
-            ) from None
-        if status == "error":
-            raise value
-        return value
-
-    def close(self):
-        self._conn.close()  # a process still waiting for a job ends
-        self._proc.join(timeout=10)
-        if self._proc.is_alive():
-            self._proc.terminate()
-            self._proc.join()
+    return build_stores_report(stores, out, workers, progress, pdf, force)
 
 
 _pdf_option = click.option(
@@ -333,8 +259,6 @@ def reproduce_command(study, results, findings, scale, content, out, workers, sc
                       progress, wait, pdf):
     import os
 
-    if findings is not None and study not in ("protocol", "science", "all"):
-        raise click.UsageError("--findings applies to --study protocol, science or all")
     if study == "all":
         results = results if results is not None else os.path.join(out, "results")
         for name in STUDIES:
@@ -347,106 +271,49 @@ def reproduce_command(study, results, findings, scale, content, out, workers, sc
                    progress, wait, pdf)
 
 
+#: the options of some studies only: (reproduce's keyword, the command line's option)
+_STUDY_OPTIONS = (("findings_dir", "--findings"), ("scheduler", "--scheduler"),
+                  ("content", "--content"), ("wait", "--wait"), ("pdf", "--pdf"))
+
+
 def _reproduce_one(study, results, findings, scale, content, out, workers, scheduler,
                    progress, wait, pdf, command=None):
-    """`reproduce_command` for one study; ``command`` (default: the study's own) is the
-    command its page's Generated line names."""
+    """`reproduce_command` for one study: ``STUDIES[study].reproduce`` with the common
+    options and those of its own (`Study.options`) that were given; ``command`` (default:
+    the study's own, `Study.command`) is the command its page's Generated line names."""
     import os
     import sys
+    import warnings
 
-    if study not in ("paper", "protocol", "disks"):
-        if scheduler is not None:
-            raise click.UsageError(f"--study {study} runs on the local pool (--workers); "
-                                   "--scheduler is not supported")
-        if progress is None:
-            progress = sys.stderr.isatty() and not os.environ.get("CI")
-        say = (lambda line: click.echo(line, err=True)) if progress else None
-        options = {}
-        if study == "science":
-            options["findings_dir"] = findings
-        with _cli_errors(_RUN_OPTIONS):
-            page = STUDIES[study].reproduce(
-                out, scale=scale, results_dir=results, workers=workers or 1, progress=say,
-                command=command or f"kicktimes reproduce --study {study} --scale {scale}",
-                **options)
-        click.echo(f"page written to {page}")
-        return
-    if study == "protocol":
-        from kicktimes.studies.protocol import reproduce_protocol
+    from kicktimes.experiment import StoreWarning
 
-        if scheduler is not None:
-            raise click.UsageError("--study protocol runs on the local pool (--workers); "
-                                   "--scheduler is not supported")
-        if progress is None:
-            progress = sys.stderr.isatty() and not os.environ.get("CI")
-        say = (lambda line: click.echo(line, err=True)) if progress else None
-        command = command or f"kicktimes reproduce --study protocol --scale {scale}"
-        with _cli_errors(_RUN_OPTIONS):
-            page = reproduce_protocol(out, scale=scale, results_dir=results,
-                                      findings_dir=findings, workers=workers, progress=say,
-                                      command=command)
-        click.echo(f"page written to {page}")
-        return
-
-    if study == "disks":
-        from kicktimes.studies.disks import reproduce as reproduce_disks
-
-        if workers is not None and scheduler is not None:
-            raise click.UsageError("--workers sizes the local pool; it cannot go with "
-                                   "--scheduler")
-        with _cli_errors(_RUN_OPTIONS):
-            page = reproduce_disks(out, scale=scale, results_dir=results, workers=workers or 1,
-                                   scheduler=scheduler, progress=progress, command=command)
-        click.echo(f"page written to {page}")
-        return
-
-    from kicktimes.experiment.presets import preset, scale_presets
-
+    spec = STUDIES[study]
+    given = {"findings_dir": findings, "scheduler": scheduler,
+             "content": None if content == "full" else content,
+             "wait": wait or None, "pdf": pdf or None}
+    options = {}
+    for name, flag in _STUDY_OPTIONS:
+        if given[name] is None:
+            continue
+        if name not in spec.options:
+            where = ", ".join(s.name for s in STUDIES.values() if name in s.options)
+            raise click.UsageError(f"{flag} applies to --study {where}, not to --study "
+                                   f"{study}")
+        options[name] = given[name]
     if workers is not None and scheduler is not None:
         raise click.UsageError("--workers sizes the local pool; it cannot go with --scheduler")
-    from contextlib import ExitStack
-
-    from kicktimes.experiment.runner import local_pool
-
-    stores = []
-    with _cli_errors(_RUN_OPTIONS), ExitStack() as stack:
-        # the paper's content goes to its own stores and report: both contents can share --out
-        suffix = "-paper" if content == "paper" else ""
-        names = scale_presets(scale, content)
-        exps = [preset(n, content) for n in names]
-        paths = [os.path.join(out, f"store-{exp.name}{suffix}") for exp in exps]
-        pending = scheduler is None and any(
-            _pending(e, p) for e, p in zip(exps, paths, strict=True)
-        )
-        pool = None
-        n_workers = workers or os.cpu_count() or 1
-        report_process = None
-        if pending and n_workers > 1:
-            report_process = _ReportProcess()
-            stack.callback(report_process.close)
-        if pending:
-            _compile_first(workers, report=True, report_process=report_process is not None)
-            if n_workers > 1:
-                # one pool for both families: each worker starts (imports, loads the
-                # compiled kernels) once
-                pool = stack.enter_context(local_pool(workers))
-        for exp, path in zip(exps, paths, strict=True):
-            click.echo(exp.summary())
-            store = _run_one(exp, path, workers, scheduler, progress, wait, executor=pool)
-            click.echo(store.summary())
-            stores.append(path)
-        if pool is not None:
-            pool.shutdown()  # the sweep workers end before the report starts its own
-        report_dir = os.path.join(out, f"report{suffix}")
-        job = (stores, report_dir, workers, progress, pdf)
-        report = report_process.build(*job) if report_process else _build_report(*job)
-        if results is not None:
-            # the study's page: docs/results/README.md from the same stores
-            from kicktimes.studies.paper import write_results
-
-            page = write_results(stores, results, workers=workers or os.cpu_count() or 1,
-                                 command=command or f"kicktimes reproduce --study paper "
-                                 f"--scale {scale} --results {results}")
-    click.echo(f"report written to {report if report is not None else report_dir}")
-    if results is not None:
-        click.echo(f"page written to {page}")
+    if progress is None:
+        progress = sys.stderr.isatty() and not os.environ.get("CI")
+    with _cli_errors(_RUN_OPTIONS), warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", StoreWarning)
+        try:
+            page = spec.reproduce(out, scale=scale, results_dir=results, workers=workers,
+                                  progress=progress,
+                                  command=command or spec.command(scale, results), **options)
+        finally:
+            for w in caught:
+                if issubclass(w.category, StoreWarning):
+                    click.echo(f"warning: {w.message}", err=True)
+                else:
+                    warnings.showwarning(w.message, w.category, w.filename, w.lineno)
+    click.echo(f"page written to {page}")

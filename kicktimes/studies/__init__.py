@@ -41,11 +41,29 @@ class Study:
     page: str
     summary: str
     needs: tuple[str, ...] = ()
+    #: the keyword arguments its ``reproduce`` takes beyond the common ones (``scale,
+    #: results_dir, workers, progress, command``): ``findings_dir``, ``scheduler``,
+    #: ``content``, ``wait``, ``pdf``; the command line refuses the others' options
+    options: tuple[str, ...] = ()
+    #: whether ``--results`` is part of its command (the paper study writes its page only
+    #: when given one; the others write theirs always, by default in ``out``)
+    results_in_command: bool = False
 
     @property
     def module(self) -> str:
         """The study's package, ``kicktimes.studies.<name>``."""
         return f"{__name__}.{self.name}"
+
+    def command(self, scale: str, results_dir=None) -> str:
+        """The command its page's "Generated" line names by default.
+
+        >>> STUDIES["escape"].command("paper", "docs/results")
+        'kicktimes reproduce --study escape --scale paper'
+        """
+        text = f"kicktimes reproduce --study {self.name} --scale {scale}"
+        if self.results_in_command and results_dir is not None:
+            text += f" --results {results_dir}"
+        return text
 
     def reproduce(self, out, **options):
         """Import the study's package and run its ``reproduce(out, **options)``."""
@@ -58,13 +76,14 @@ STUDIES = {
     s.name: s
     for s in (
         Study("paper", "README.md",
-              "the paper's two families under every control; the sweep report"),
+              "the paper's two families under every control; the sweep report",
+              options=("content", "scheduler", "wait", "pdf"), results_in_command=True),
         Study("protocol", "paper.md",
               "the paper's claims by its own protocol (eq. (4), Fig. 6, RR, R_1)",
-              needs=("paper",)),
+              needs=("paper",), options=("findings_dir",)),
         Study("science", "science.md",
               "stretching and decorrelation per kick, the rate over the run, sticky orbits",
-              needs=("paper",)),
+              needs=("paper",), options=("findings_dir",)),
         Study("mechanism", "mechanism.md",
               "why the collision times are not Poisson, under both collision rules"),
         Study("escape", "escape.md",
@@ -76,7 +95,8 @@ STUDIES = {
         Study("mmpp", "mmpp.md",
               "MMPP fits to the two-disk collision times"),
         Study("disks", "disks.md",
-              "a tagged disk among N = 2..1000 disks: Poisson or not, Enskog, kicked"),
+              "a tagged disk among N = 2..1000 disks: Poisson or not, Enskog, kicked",
+              options=("scheduler",)),
     )
 }
 

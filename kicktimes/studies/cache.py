@@ -38,6 +38,7 @@ from pathlib import Path
 import pandas as pd
 
 from kicktimes.fileio import atomic_write
+from kicktimes.studies.options import status_lines
 
 __all__ = ["Cached", "cached_table", "cached_tables", "read_cached", "write_cached"]
 
@@ -102,7 +103,7 @@ def cached_table(path: str | os.PathLike, params, compute, *, progress=None) -> 
     -------
     Cached
     """
-    say = progress or (lambda line: None)
+    say = status_lines(progress)
     found = read_cached(path, params)
     if found is not None:
         say(f"{Path(path).name}: reused")
@@ -143,7 +144,7 @@ def cached_tables(jobs, *, workers: int = 1, progress=None) -> list[Cached]:
     list of Cached
         In the order of ``jobs``.
     """
-    say = progress or (lambda line: None)
+    say = status_lines(progress)
     jobs = list(jobs)
     todo = [k for k, (path, params, _, _) in enumerate(jobs)
             if read_cached(path, params) is None]

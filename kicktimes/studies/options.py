@@ -18,8 +18,10 @@ results_dir : path-like, optional
     Folder of the page, its CSVs and figures (default ``out/results-NAME``).
 workers : int
     Processes for the simulations (``>= 1``).
-progress : callable, optional
-    Takes one line of text per step; ``None``: silent.
+progress : bool or callable, optional
+    A callable takes one line of text per step; ``True`` prints those lines on stderr
+    (and shows the study's progress bars, if it has any); ``None`` or ``False``: silent
+    (`status_lines`).
 command : str, optional
     The command the page's "Generated" line names.
 
@@ -41,6 +43,7 @@ ValueError: workers must be an integer >= 1, got 0
 from __future__ import annotations
 
 import os
+import sys
 from dataclasses import dataclass
 from numbers import Integral
 from pathlib import Path
@@ -65,6 +68,21 @@ def check_workers(workers) -> int:
     return int(workers)
 
 
+def status_lines(progress):
+    """The callable that takes a study's status lines: ``progress`` itself if it is
+    callable; for ``True``, one that prints each line on stderr; for ``None`` or
+    ``False``, one that drops them.
+
+    >>> status_lines(None)("dropped") is None
+    True
+    """
+    if callable(progress):
+        return progress
+    if progress:
+        return lambda line: print(line, file=sys.stderr, flush=True)
+    return lambda line: None
+
+
 @dataclass(frozen=True)
 class StudyRun:
     """One run of a study: its ``name``, sizes ``params``, ``cache`` and ``results``
@@ -79,9 +97,8 @@ class StudyRun:
     progress: object = None
 
     def say(self, line: str) -> None:
-        """Pass ``line`` to ``progress``, if any."""
-        if self.progress is not None:
-            self.progress(line)
+        """Pass ``line`` to ``progress`` (`status_lines`)."""
+        status_lines(self.progress)(line)
 
     def write_csv(self, name: str, frame) -> None:
         """``frame`` as ``results/name`` (CSV, no index), atomically."""

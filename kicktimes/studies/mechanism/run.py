@@ -32,7 +32,7 @@ from kicktimes.studies.mechanism.figures import write_figures
 from kicktimes.studies.mechanism.page import load, write_page
 from kicktimes.studies.mechanism.simulate import RADII, simulate
 from kicktimes.studies.mechanism.twins import rate
-from kicktimes.studies.options import check_scale, check_workers
+from kicktimes.studies.options import check_scale, check_workers, status_lines
 
 __all__ = ["FIGURES", "RULES", "SCALES", "MechanismScale", "reproduce", "run_rule"]
 
@@ -62,7 +62,7 @@ NUMBERS = "mechanism_numbers.csv"
 def run_rule(rule, sizes, folder, *, workers=1, progress=None) -> pd.DataFrame:
     """Simulate and analyse the four groups under ``rule``; write the figures
     (``mechanism_<name>.png``) into ``folder`` and return the numbers table."""
-    say = progress or (lambda line: None)
+    say = status_lines(progress)
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
@@ -171,7 +171,7 @@ def reproduce(out: str | os.PathLike, *, scale: str = "quick",
     out = Path(out)
     results = Path(results_dir) if results_dir is not None else out / "results-mechanism"
     command = command or f"kicktimes reproduce --study mechanism --scale {scale}"
-    say = progress or (lambda line: None)
+    say = status_lines(progress)
     tables = []
     for rule, rel in RULES.items():
         table, cache = _cached_rule(out, rule, sizes, workers, say)

@@ -1,6 +1,7 @@
 """The paper study: Ranković & Porter's two families under every control, and its page.
 
-``kicktimes reproduce --study paper --scale paper --out OUT --results docs/results`` runs
+``kicktimes reproduce --study paper --scale paper --out OUT --results docs/results``
+(:func:`reproduce`) runs
 the presets of `kicktimes.experiment.SCALES` (both families and the 2 x 2 design of
 collision rule x initial conditions, `kicktimes.experiment.CONTROL_PRESETS`) into
 ``OUT/store-<name>``, builds the sweep report (:mod:`kicktimes.report`) into ``OUT/report``
@@ -30,5 +31,6 @@ from kicktimes.studies.paper.page import (
     copy_first_screen,
     write_results,
 )
+from kicktimes.studies.paper.run import reproduce
 
-__all__ = ["BEGIN", "END", "PROTOCOL_POINTER", "copy_first_screen", "write_results"]
+__all__ = ["BEGIN", "END", "PROTOCOL_POINTER", "copy_first_screen", "reproduce", "write_results"]

@@ -24,15 +24,14 @@ from kicktimes.studies.protocol.run import load_rows, run_protocol_study
 from kicktimes.studies.protocol.tables import Ratios, per_radius_table, ratio_table
 
 __all__ = ["CHOICES", "Ratios", "build_page", "fig6_figure", "load_rows", "panels",
-           "per_radius_table", "ratio_table", "reproduce_protocol", "run_rows",
+           "per_radius_table", "ratio_table", "reproduce", "run_rows",
            "run_protocol_study"]
 
 
-def reproduce_protocol(out: str | os.PathLike, *, scale: str = "paper",
-                       results_dir: str | os.PathLike | None = None,
-                       findings_dir: str | os.PathLike | None = None, workers: int | None = None,
-                       progress=None, command: str = "kicktimes reproduce --study protocol"
-                       ) -> Path:
+def reproduce(out: str | os.PathLike, *, scale: str = "quick",
+              results_dir: str | os.PathLike | None = None, workers: int | None = None,
+              progress=None, command: str | None = None,
+              findings_dir: str | os.PathLike | None = None) -> Path:
     """Run (or resume) the study into ``out/store-protocol[-quick]`` and write ``paper.md``.
 
     ``results_dir``: the page's folder (default ``out/results-protocol``); ``findings_dir``:
@@ -55,5 +54,6 @@ def reproduce_protocol(out: str | os.PathLike, *, scale: str = "paper",
     else:
         findings = results if all((results / n).exists() for n in names) else None
     rows = run_protocol_study(store, scale, workers=workers, progress=progress)
+    command = command or f"kicktimes reproduce --study protocol --scale {scale}"
     return build_page(rows, results, findings, command=command, scale=scale,
                       store=store.name)

@@ -9,6 +9,7 @@ from pathlib import Path
 import pandas as pd
 
 from kicktimes.experiment.runner import local_pool
+from kicktimes.studies.options import status_lines
 from kicktimes.studies.protocol.compute import compute_task, panels, tasks
 
 __all__ = ["load_rows", "run_protocol_study", "task_path"]
@@ -31,7 +32,7 @@ def run_protocol_study(store: str | os.PathLike, scale: str = "paper", *,
     """
     todo = [(p, t) for p in panels(scale) for t in tasks(p)
             if not task_path(store, p, t).exists()]
-    say = progress or (lambda line: None)
+    say = status_lines(progress)
     total = 0.0
     if todo and (workers == 1 or (workers is None and (os.cpu_count() or 1) == 1)):
         for k, (p, t) in enumerate(todo, 1):

@@ -23,7 +23,7 @@ from kicktimes.experiment import load_store, run_experiment
 from kicktimes.report.pages import MARGIN, header, store_name
 from kicktimes.stats import ratio_rule
 from kicktimes.studies.cache import cached_table, read_cached, write_cached
-from kicktimes.studies.options import check_scale, check_workers
+from kicktimes.studies.options import check_scale, check_workers, status_lines
 from kicktimes.studies.science.decorrelation import (
     closest_kick_law,
     decorrelation,
@@ -235,7 +235,7 @@ def reproduce(out: str | os.PathLike, *, scale: str = "quick",
     stores_dir = Path(stores_dir) if stores_dir is not None else out
     findings = Path(findings_dir) if findings_dir is not None else results
     command = command or f"kicktimes reproduce --study science --scale {scale}"
-    say = progress or (lambda line: None)
+    say = status_lines(progress)
     paths = find_stores(stores_dir, scale)
     names = [store_name(p) for p in paths]
     families, closest_families = findings_families(findings, names, scale)
