@@ -27,6 +27,7 @@ from kicktimes.report.figures import (
     system_style,
 )
 from kicktimes.report.summary import diagnostic_summary, diagnostic_vs_radius
+from kicktimes.stats import stretching_per_perturbation
 
 __all__ = ["SCATTER_SYSTEMS", "stretching_table", "stretching_figure", "sections", "effects"]
 
@@ -70,7 +71,8 @@ def stretching_table(results) -> pd.DataFrame:
                     "system": system,
                     "lambda_mean": g["lam"].mean(),
                     "perturbation_rate": rate,
-                    "stretch_per_perturbation": g["lam"].mean() / rate if rate > 0 else np.nan,
+                    "stretch_per_perturbation": stretching_per_perturbation(
+                        g["lam"].to_numpy(), g["n"].to_numpy(), g["t"].to_numpy()),
                     "stored_median": stored.get(r, np.nan),
                     "ln_inv_r": np.log(1 / r),
                 }

@@ -66,6 +66,7 @@ from .mmpp import (
     mmpp_lr_test,
     simulate_mmpp,
 )
+from .perturbation import stretching_per_perturbation
 from .poisson import TESTS, Intervals, MonteCarloNulls, intervals_from_times, test_poisson
 from .renewal import (
     FULL_SAMPLE_MODELS,
@@ -105,6 +106,7 @@ __all__ = [
     "ratio_of_means",
     "resample_indices",
     "is_sticky",
+    "stretching_per_perturbation",
     "enskog_frequency", "henderson_z",
     "speed_rate_factor",
     "dilute_tagged_times",

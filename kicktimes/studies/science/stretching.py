@@ -17,7 +17,12 @@ import pandas as pd
 
 from kicktimes.experiment import preset
 from kicktimes.report.pages import MARGIN, trend_verdict
-from kicktimes.stats import percentile_interval, ratio_verdict, resample_indices
+from kicktimes.stats import (
+    percentile_interval,
+    ratio_verdict,
+    resample_indices,
+    stretching_per_perturbation,
+)
 
 __all__ = ["KICKED", "N_BOOT", "SMALL_RADII", "SYSTEMS", "stretching", "stretching_experiment"]
 
@@ -101,9 +106,9 @@ def stretching(results, n_boot=N_BOOT, seed=0):
 
     def stretch(system):
         a = {k: v.to_numpy(float) for k, v in arrays[system].items()}
-        lam = np.nanmean(a["lam"][:, picks], axis=-1)
-        rate = np.nansum(a["n"][:, picks], axis=-1) / np.nansum(a["t"][:, picks], axis=-1)
-        return (lam / rate).T            # (1 + n_boot, radii); row 0 the estimate
+        s = stretching_per_perturbation(a["lam"][:, picks], a["n"][:, picks],
+                                        a["t"][:, picks])
+        return s.T                       # (1 + n_boot, radii); row 0 the estimate
 
     s = {k: stretch(k) for k in SYSTEMS}
     design = np.vstack([np.ones_like(x), x]).T
