@@ -101,3 +101,32 @@ def test_run_takes_a_preset_name_or_a_toml_file(tmp_path, monkeypatch, how):
     assert ran == [preset("quick_a")]
     bad = CliRunner().invoke(main, ["run", "quick_c", "--out", str(tmp_path / "s")])
     assert bad.exit_code == 2 and "neither a TOML file nor a preset" in bad.output
+
+
+def test_reproduce_says_a_stores_warning_in_one_line_and_keeps_no_warning(tmp_path,
+                                                                          monkeypatch):
+    import warnings
+
+    from kicktimes.experiment import StoreWarning
+
+    def fake(self, out, **options):
+        warnings.warn("the store was written by another version", StoreWarning)
+        for k in range(1000):  # a study may warn many times: none is kept for later
+            warnings.warn(f"value {k}", RuntimeWarning)
+        return tmp_path / self.page
+
+    monkeypatch.setattr(Study, "reproduce", fake)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        res = CliRunner().invoke(main, ["reproduce", "--study", "escape", "--out",
+                                        str(tmp_path), "--no-progress"])
+    assert res.exit_code == 0, res.output
+    assert "warning: the store was written by another version" in res.output
+    assert "page written to" in res.output
+
+
+def test_an_option_of_another_study_is_refused_naming_it(tmp_path):
+    res = CliRunner().invoke(main, ["reproduce", "--study", "escape", "--scheduler",
+                                    "tcp://h:1", "--out", str(tmp_path)])
+    assert res.exit_code == 2
+    assert "--scheduler applies to --study paper, disks, not to --study escape" in res.output

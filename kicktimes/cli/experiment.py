@@ -304,16 +304,20 @@ def _reproduce_one(study, results, findings, scale, content, out, workers, sched
         raise click.UsageError("--workers sizes the local pool; it cannot go with --scheduler")
     if progress is None:
         progress = sys.stderr.isatty() and not os.environ.get("CI")
-    with _cli_errors(_RUN_OPTIONS), warnings.catch_warnings(record=True) as caught:
+    show = warnings.showwarning
+
+    def store_warnings_as_lines(message, category, *args, **kwargs):
+        # a store's warning is one plain line; every other warning is shown as usual (and
+        # none is kept: a study may warn millions of times)
+        if issubclass(category, StoreWarning):
+            click.echo(f"warning: {message}", err=True)
+        else:
+            show(message, category, *args, **kwargs)
+
+    with _cli_errors(_RUN_OPTIONS), warnings.catch_warnings():
         warnings.simplefilter("always", StoreWarning)
-        try:
-            page = spec.reproduce(out, scale=scale, results_dir=results, workers=workers,
-                                  progress=progress,
-                                  command=command or spec.command(scale, results), **options)
-        finally:
-            for w in caught:
-                if issubclass(w.category, StoreWarning):
-                    click.echo(f"warning: {w.message}", err=True)
-                else:
-                    warnings.showwarning(w.message, w.category, w.filename, w.lineno)
+        warnings.showwarning = store_warnings_as_lines
+        page = spec.reproduce(out, scale=scale, results_dir=results, workers=workers,
+                              progress=progress,
+                              command=command or spec.command(scale, results), **options)
     click.echo(f"page written to {page}")
