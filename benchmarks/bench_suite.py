@@ -10,8 +10,9 @@ twice, sharing one new, empty numba cache folder (``NUMBA_CACHE_DIR``):
 The cold run records every numba compilation in the pytest processes
 (``benchmarks/_compile_log_plugin.py``): per kernel, and per kernel and signature, its
 exclusive seconds, how many processes compiled the same signature (a signature compiled
-by both workers costs twice) and the tests that compiled it. Compilations inside subprocesses (the notebooks' kernels, the command-line
-tests) are in the cold-warm difference only.
+by both workers costs twice) and the tests that compiled it. Compilations inside
+subprocesses (the notebooks' kernels, the command-line tests) are in the cold-warm
+difference only.
 
 Usage::
 

@@ -110,9 +110,9 @@ def test_reproduce_says_a_stores_warning_in_one_line_and_keeps_no_warning(tmp_pa
     from kicktimes.experiment import StoreWarning
 
     def fake(self, out, **options):
-        warnings.warn("the store was written by another version", StoreWarning)
+        warnings.warn("the store was written by another version", StoreWarning, stacklevel=2)
         for k in range(1000):  # a study may warn many times: none is kept for later
-            warnings.warn(f"value {k}", RuntimeWarning)
+            warnings.warn(f"value {k}", RuntimeWarning, stacklevel=2)
         return tmp_path / self.page
 
     monkeypatch.setattr(Study, "reproduce", fake)
