@@ -28,17 +28,19 @@ def test_no_module_is_over_800_lines_and_each_over_600_is_named_with_its_concern
                                f"{sorted(set(long) - named)}"
 
 
-def test_the_sticky_rule_and_clopper_pearson_are_defined_once():
-    sticky, clopper = [], []
+def test_the_sticky_rule_clopper_pearson_and_the_margin_are_defined_once():
+    sticky, clopper, margin = [], [], []
     for path in _modules():
         text = path.read_text(encoding="utf-8")
         rel = str(path.relative_to(PACKAGE))
         sticky += [rel] * len(re.findall(r"^STICKY_FACTOR\s*=", text, flags=re.M))
+        margin += [rel] * len(re.findall(r"^MARGIN\s*=", text, flags=re.M))
         # a definition, or a call of another library's interval (not its name in a docstring)
         clopper += [rel] * len(re.findall(r"^def \w*clopper\w*\(|(?<!`)\b(?:binomtest|"
                                           r"proportion_confint)\(", text, flags=re.M))
     assert sticky == ["stats/counts.py"]
     assert clopper == ["stats/findings.py"]
+    assert margin == ["stats/findings.py"]
 
 
 def test_no_page_draws_its_own_cluster_resamples():

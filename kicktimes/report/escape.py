@@ -49,6 +49,7 @@ from kicktimes.report.figures import (
     system_label,
     system_style,
 )
+from kicktimes.stats import MARGIN
 
 __all__ = [
     "AIC_MARGIN",
@@ -69,8 +70,6 @@ ESCAPE_ROWS = ("escape_time", "escaped_disk")
 #: default ``t_min`` of the tail fits: this fraction of the experiment's horizon n_steps·tau
 T_MIN_FRACTION = 1 / 20
 #: AIC difference beyond which a tail law is decided (one parameter each)
-#: equivalence margin of the escape-rate ratio, fixed in advance
-MARGIN = 0.1
 AIC_MARGIN = 2.0
 #: a survival curve is drawn as measured, with its band, while at least this many runs are
 #: at risk; beyond, thin, grey and dotted (a handful of runs per step; for the two disks,

@@ -27,14 +27,13 @@ import numpy as np
 import pandas as pd
 
 from kicktimes import __version__
-from kicktimes.stats import format_interval, ratio_verdict
+from kicktimes.stats import MARGIN, format_interval, ratio_verdict
 
-__all__ = ["MARGIN", "NULL_CALIBRATION", "NULL_CALIBRATION_COLUMNS", "header",
+__all__ = ["NULL_CALIBRATION", "NULL_CALIBRATION_COLUMNS", "header",
            "markdown_table", "ratio_text", "simulations_source", "store_name",
            "trend_verdict", "write_null_calibration"]
 
 #: the equivalence margin of every ratio on these pages, stated before any was computed
-MARGIN = 0.1
 
 
 def store_name(path) -> str:

@@ -40,6 +40,7 @@ from .distributions import hyperexpon
 from .ensemble import PoissonEnsembleResult, test_poisson_ensemble
 from .enskog import contact_value, enskog_frequency, henderson_z, speed_rate_factor
 from .findings import (
+    MARGIN,
     Finding,
     clopper_pearson,
     format_interval,
@@ -133,6 +134,7 @@ __all__ = [
     "FitWarning",
     "Finding",
     "ratio_verdict",
+    "MARGIN",
     "clopper_pearson",
     "robust_verdict",
     "share_ratio_sample_size",

@@ -22,6 +22,7 @@ import pandas as pd
 from scipy import stats as sps
 
 __all__ = [
+    "MARGIN",
     "Finding",
     "findings",
     "findings_table",
@@ -66,7 +67,12 @@ def ratio_rule(tolerance=0.1) -> str:
     )
 
 
-def ratio_verdict(low, high, tolerance=0.1):
+#: The equivalence margin of every ratio kicktimes reads, fixed in advance: "within 10 %"
+#: when the whole CI of the ratio lies in [1 - MARGIN, 1 + MARGIN] (`ratio_verdict`).
+MARGIN = 0.1
+
+
+def ratio_verdict(low, high, tolerance=MARGIN):
     """``"within 10 %"``, ``"higher"``, ``"lower"`` or ``"inconclusive"`` for a ratio's 95 % CI.
 
     The verdict of every ratio kicktimes states (:func:`ratio_rule` prints it): *within* when

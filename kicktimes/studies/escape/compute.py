@@ -10,8 +10,8 @@ import pandas as pd
 import scipy.stats as sps
 
 from kicktimes import initial_conditions, schedules, simulate_one_particle, simulate_two_particle
-from kicktimes.report.pages import MARGIN
 from kicktimes.stats import (
+    MARGIN,
     circle_escape_constant,
     escape_survival,
     fit_escape_tail,

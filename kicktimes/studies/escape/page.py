@@ -7,8 +7,8 @@ import math
 
 import pandas as pd
 
-from kicktimes.report.pages import MARGIN, header, ratio_text, simulations_source
-from kicktimes.stats import format_interval, ratio_rule, ratio_verdict
+from kicktimes.report.pages import header, ratio_text, simulations_source
+from kicktimes.stats import MARGIN, format_interval, ratio_rule, ratio_verdict
 from kicktimes.studies.escape.compute import BURSTY_SHAPE, CONTROLS, HOLE, LABELS, ergodic_rate
 from kicktimes.studies.escape.figures import MIN_AT_RISK, thin_from
 

@@ -14,8 +14,8 @@ from pathlib import Path
 
 import pandas as pd
 
-from kicktimes.report.pages import MARGIN, header
-from kicktimes.stats import format_interval, ratio_rule, ratio_verdict
+from kicktimes.report.pages import header
+from kicktimes.stats import MARGIN, format_interval, ratio_rule, ratio_verdict
 from kicktimes.studies.mechanism.figures import NORMALISED_YLIM
 
 __all__ = ["load", "rule_section", "summary", "write_page"]

@@ -6,8 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from kicktimes.report.pages import MARGIN
-from kicktimes.stats import percentile_interval, ratio_verdict, resample_indices
+from kicktimes.stats import MARGIN, percentile_interval, ratio_verdict, resample_indices
 
 __all__ = ["RATIOS", "ratio_table", "sticky", "summary_tables"]
 

@@ -17,8 +17,7 @@ import numpy as np
 import pandas as pd
 
 from kicktimes import initial_conditions, schedules, simulate_one_particle, simulate_two_particle
-from kicktimes.report.pages import MARGIN
-from kicktimes.stats import percentile_interval, ratio_verdict, resample_indices
+from kicktimes.stats import MARGIN, percentile_interval, ratio_verdict, resample_indices
 from kicktimes.studies.science.stretching import N_BOOT
 
 __all__ = ["closest_kick_law", "decorrelation", "prediction_against_measurement"]

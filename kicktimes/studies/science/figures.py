@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 
-from kicktimes.report.pages import MARGIN
+from kicktimes.stats import MARGIN
 
 __all__ = ["LEGEND", "stretching_figure"]
 

@@ -14,8 +14,8 @@ import numpy as np
 import pandas as pd
 
 from kicktimes import initial_conditions
-from kicktimes.report.pages import MARGIN
 from kicktimes.stats import (
+    MARGIN,
     STICKY_FACTOR,
     kinetic_rate,
     percentile_interval,

@@ -20,8 +20,8 @@ from pathlib import Path
 import pandas as pd
 
 from kicktimes.experiment import load_store, run_experiment
-from kicktimes.report.pages import MARGIN, header, store_name
-from kicktimes.stats import ratio_rule
+from kicktimes.report.pages import header, store_name
+from kicktimes.stats import MARGIN, ratio_rule
 from kicktimes.studies.cache import cached_table, read_cached, write_cached
 from kicktimes.studies.options import check_scale, check_workers, status_lines
 from kicktimes.studies.science.decorrelation import (

@@ -16,8 +16,9 @@ import numpy as np
 import pandas as pd
 
 from kicktimes.experiment import preset
-from kicktimes.report.pages import MARGIN, trend_verdict
+from kicktimes.report.pages import trend_verdict
 from kicktimes.stats import (
+    MARGIN,
     percentile_interval,
     ratio_verdict,
     resample_indices,

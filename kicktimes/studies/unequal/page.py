@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import pandas as pd
 
-from kicktimes.report.pages import MARGIN, header, simulations_source
-from kicktimes.stats import format_interval, ratio_rule, ratio_verdict
+from kicktimes.report.pages import header, simulations_source
+from kicktimes.stats import MARGIN, format_interval, ratio_rule, ratio_verdict
 from kicktimes.studies.unequal.compute import R0
 from kicktimes.studies.unequal.tables import ks_interval
 
