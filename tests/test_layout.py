@@ -45,7 +45,8 @@ def test_the_sticky_rule_clopper_pearson_and_the_margin_are_defined_once():
 
 def test_no_page_draws_its_own_cluster_resamples():
     # the bootstrap clustered on runs draws its indices in kicktimes.stats (resample_indices)
-    draw = re.compile(r"\.integers\(0,|\.choice\([^)]*\)\)?\.mean|\.choice\(\w+, len\(")
+    draw = re.compile(r"\.integers\(0,|\.choice\([^)]*\)\)?\.mean|\.choice\(\w+, len\(|"
+                      r"\.multinomial\(")
     found = [str(p.relative_to(PACKAGE)) for p in _modules()
              if not p.is_relative_to(PACKAGE / "stats") and draw.search(p.read_text())]
     # the Bootstrap kick schedule resamples intervals (not runs); the compile warm-up

@@ -84,3 +84,14 @@ def test_bad_arguments_are_refused_naming_them(kwargs, match):
         stats.cluster_bootstrap(lambda idx: idx.mean(axis=1), args.pop("n_clusters"), **args)
     with pytest.raises(ValueError, match="same length"):
         stats.ratio_of_means([1.0, 2.0], [1.0])
+
+
+def test_the_counts_are_the_generators_multinomial_and_count_like_the_indices():
+    counts = stats.resample_counts(9, 300, 4)
+    ref = np.random.default_rng(4).multinomial(9, np.full(9, 1 / 9), size=300)
+    np.testing.assert_array_equal(counts, ref)
+    assert counts.dtype == float and (counts.sum(axis=1) == 9).all()
+    # the same law as the indices: each cluster is drawn once per resample on average
+    assert abs(counts.mean() - 1.0) < 1e-12
+    idx = stats.resample_indices(9, 300, 5)
+    assert abs(np.bincount(idx.ravel(), minlength=9).mean() / 300 - 1.0) < 1e-12

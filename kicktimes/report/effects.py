@@ -21,6 +21,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
+from kicktimes.stats import resample_counts
 from kicktimes.stats.findings import (
     SHARE_RULE,
     Finding,
@@ -176,7 +177,7 @@ def paired_ratio(numerator, denominator, *, rng, n_boot=2000, level=0.95, resamp
     n = ics.size
     counts = None if resamples is None else resamples.get((n, n_boot))
     if counts is None:
-        counts = rng.multinomial(n, np.full(n, 1.0 / n), size=n_boot).astype(float)
+        counts = resample_counts(n, n_boot, rng)
         if resamples is not None:
             resamples[(n, n_boot)] = counts
     with np.errstate(invalid="ignore", divide="ignore"):

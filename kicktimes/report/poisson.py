@@ -28,7 +28,7 @@ from kicktimes.report.figures import (
     new_axes,
     x_axis,
 )
-from kicktimes.stats import clopper_pearson, format_interval
+from kicktimes.stats import clopper_pearson, format_interval, resample_counts
 from kicktimes.stats.poisson import TEST_NULLS
 
 __all__ = [
@@ -448,7 +448,7 @@ def clustered_mean(per_ic, column, *, rng, n_boot=2000, level=0.95):
     if n_runs.sum() == 0:
         return math.nan, math.nan, math.nan
     n = n_runs.size
-    counts = rng.multinomial(n, np.full(n, 1.0 / n), size=n_boot).astype(float)
+    counts = resample_counts(n, n_boot, rng)
     with np.errstate(invalid="ignore", divide="ignore"):
         boot = (counts @ total) / (counts @ n_runs)
     boot = boot[np.isfinite(boot)]

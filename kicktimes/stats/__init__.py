@@ -31,6 +31,7 @@ from .bootstrap import (
     cluster_bootstrap,
     percentile_interval,
     ratio_of_means,
+    resample_counts,
     resample_indices,
 )
 from .comparison import VuongResult, compare_models, vuong
@@ -105,6 +106,7 @@ __all__ = [
     "cluster_bootstrap",
     "percentile_interval",
     "ratio_of_means",
+    "resample_counts",
     "resample_indices",
     "is_sticky",
     "stretching_per_perturbation",

@@ -19,7 +19,8 @@ indices (paired), so a ratio keeps the covariance of its numerator and denominat
 
 * `resample_indices`: the :math:`(B, n)` indices, drawn from ``rng`` as
   ``rng.integers(0, n, size=(B, n))`` (optionally ``chunk`` resamples per draw, and the
-  identity resample first);
+  identity resample first); `resample_counts`: the same resampling as counts per cluster
+  (multinomial), for statistics that are matrix products;
 * `percentile_interval`: the interval of the finite replicates;
 * `cluster_bootstrap`: both, for a statistic given as a function of the indices;
 * `ratio_of_means`: the paired ratio :math:`\sum x_i / \sum y_i` with its interval.
@@ -35,7 +36,7 @@ import numpy as np
 from kicktimes._validation import check_int, check_real, check_rng
 
 __all__ = ["ClusterBootstrap", "cluster_bootstrap", "percentile_interval", "ratio_of_means",
-           "resample_indices"]
+           "resample_counts", "resample_indices"]
 
 
 def resample_indices(n_clusters, n_boot, rng=None, *, with_identity=False, chunk=None):
@@ -83,6 +84,36 @@ def resample_indices(n_clusters, n_boot, rng=None, *, with_identity=False, chunk
     if with_identity:
         idx = np.vstack([np.arange(n), idx])
     return idx
+
+
+def resample_counts(n_clusters, n_boot, rng=None):
+    r"""How often each cluster is drawn in each of ``n_boot`` bootstrap resamples.
+
+    The same resampling as `resample_indices`, counted: row ``b`` is multinomial with
+    ``n`` trials over the ``n`` clusters, :math:`c_{bj} = \#\{k : I_{bk} = j\}`, drawn
+    as ``rng.multinomial(n, [1/n] * n, size=B)``. A statistic linear in the clusters'
+    sums is then one matrix product, e.g. a ratio of means ``(c @ x) / (c @ y)``.
+
+    Parameters
+    ----------
+    n_clusters, n_boot : int
+        :math:`n \ge 1` clusters, :math:`B \ge 1` resamples.
+    rng : numpy.random.Generator or int or None
+
+    Returns
+    -------
+    numpy.ndarray of float64, shape (B, n)
+        Every row sums to ``n``.
+
+    Examples
+    --------
+    >>> from kicktimes.stats import resample_counts
+    >>> resample_counts(4, 3, rng=0).sum(axis=1).tolist()
+    [4.0, 4.0, 4.0]
+    """
+    n = check_int("n_clusters", n_clusters, low=1)
+    b = check_int("n_boot", n_boot, low=1)
+    return check_rng(rng).multinomial(n, np.full(n, 1.0 / n), size=b).astype(float)
 
 
 def percentile_interval(replicates, level=0.95):

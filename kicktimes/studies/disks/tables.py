@@ -45,6 +45,7 @@ from kicktimes.stats import (
     poisson_group,
     ratio_verdict,
     rejection_verdict,
+    resample_counts,
     share_ratio_sample_size,
     speed_rate_factor,
 )
@@ -189,8 +190,7 @@ def _row(exp, n, res, col, *, alpha, n_boot, n_mc, rng):
     k = exp.collisions
     r = exp.radius(n)
     runs = np.unique(res["ic"].to_numpy())
-    weights = rng.multinomial(runs.size, np.full(runs.size, 1.0 / runs.size), size=n_boot)
-    weights = weights.astype(float)
+    weights = resample_counts(runs.size, n_boot, rng)
     freq = (res[res["diagnostic"] == "collision_frequency"].set_index("ic")["value"]
             .reindex(runs).to_numpy())
     nu_hat = float(freq.mean())
@@ -381,7 +381,7 @@ def kicked_table(store, *, n_boot=999, seed=0) -> pd.DataFrame:
                               observed=True)
         runs = wide.index.size
         rng = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(int(n), 7)))
-        weights = rng.multinomial(runs, np.full(runs, 1.0 / runs), size=n_boot).astype(float)
+        weights = resample_counts(runs, n_boot, rng)
         # (system, diagnostic, reference system, reference diagnostic)
         systems = [s for s in KICKED_SYSTEMS if (s, "ftle") in wide]
         pairs = [(s, d, "gas", d) for s in systems for d in KICKED_DIAGNOSTICS]

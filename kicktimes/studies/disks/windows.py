@@ -29,7 +29,13 @@ import numpy as np
 import pandas as pd
 
 from kicktimes.fileio import atomic_write
-from kicktimes.stats import dilute_tagged_disk, format_interval, ratio_interval, ratio_verdict
+from kicktimes.stats import (
+    dilute_tagged_disk,
+    format_interval,
+    ratio_interval,
+    ratio_verdict,
+    resample_counts,
+)
 from kicktimes.studies.cache import cached_tables
 
 __all__ = ["BOUNDARIES", "DISPERSION_WINDOWS", "RUNS_COLUMNS", "DispersionWindows",
@@ -198,7 +204,7 @@ def summarise(runs, *, n_boot=2000, seed=0, n_events=2_000_000) -> pd.DataFrame:
     for (n_disks, packing, rule, boundary, k), g in runs.groupby(
             ["n_disks", "packing", "rule", "boundary", "window"], sort=False):
         n, s1, s2 = (g[c].to_numpy(float) for c in ("n", "s1", "s2"))
-        w = rng.multinomial(n.size, np.full(n.size, 1.0 / n.size), size=n_boot).astype(float)
+        w = resample_counts(n.size, n_boot, rng)
         d = float(_d(n.sum(), s1.sum(), s2.sum()))
         boot = _d(w @ n, w @ s1, w @ s2)
         low, high = (float(v) for v in np.percentile(boot, [2.5, 97.5]))
