@@ -95,3 +95,11 @@ def test_the_counts_are_the_generators_multinomial_and_count_like_the_indices():
     assert abs(counts.mean() - 1.0) < 1e-12
     idx = stats.resample_indices(9, 300, 5)
     assert abs(np.bincount(idx.ravel(), minlength=9).mean() / 300 - 1.0) < 1e-12
+
+
+def test_no_resample_is_an_empty_array_and_draws_nothing():
+    rng = np.random.default_rng(8)
+    assert stats.resample_counts(5, 0, rng).shape == (0, 5)
+    assert stats.resample_indices(5, 0, rng).shape == (0, 5)
+    assert stats.resample_indices(5, 0, rng, chunk=2, with_identity=True).shape == (1, 5)
+    assert rng.integers(0, 100) == np.random.default_rng(8).integers(0, 100)

@@ -47,7 +47,7 @@ def resample_indices(n_clusters, n_boot, rng=None, *, with_identity=False, chunk
     n_clusters : int
         The number of clusters (runs, ICs) :math:`n \ge 1`.
     n_boot : int
-        The number of resamples :math:`B \ge 1`.
+        The number of resamples :math:`B \ge 0` (0: none, an empty array).
     rng : numpy.random.Generator or int or None
         The source of the draws (a seed makes a new generator).
     with_identity : bool
@@ -73,14 +73,14 @@ def resample_indices(n_clusters, n_boot, rng=None, *, with_identity=False, chunk
            [1, 0, 0, 0]])
     """
     n = check_int("n_clusters", n_clusters, low=1)
-    b = check_int("n_boot", n_boot, low=1)
+    b = check_int("n_boot", n_boot, low=0)
     rng = check_rng(rng)
     if chunk is None:
         idx = rng.integers(0, n, size=(b, n))
     else:
         step = check_int("chunk", chunk, low=1)
         idx = np.concatenate([rng.integers(0, n, size=(min(step, b - m), n))
-                              for m in range(0, b, step)])
+                              for m in range(0, b, step)] or [np.empty((0, n), np.int64)])
     if with_identity:
         idx = np.vstack([np.arange(n), idx])
     return idx
@@ -97,7 +97,7 @@ def resample_counts(n_clusters, n_boot, rng=None):
     Parameters
     ----------
     n_clusters, n_boot : int
-        :math:`n \ge 1` clusters, :math:`B \ge 1` resamples.
+        :math:`n \ge 1` clusters, :math:`B \ge 0` resamples (0: none, an empty array).
     rng : numpy.random.Generator or int or None
 
     Returns
@@ -112,7 +112,7 @@ def resample_counts(n_clusters, n_boot, rng=None):
     [4.0, 4.0, 4.0]
     """
     n = check_int("n_clusters", n_clusters, low=1)
-    b = check_int("n_boot", n_boot, low=1)
+    b = check_int("n_boot", n_boot, low=0)
     return check_rng(rng).multinomial(n, np.full(n, 1.0 / n), size=b).astype(float)
 
 
