@@ -136,7 +136,7 @@ def test_the_fixed_interval_poisson_test_has_its_size_on_poisson_times():
 
 
 def test_the_bca_interval_shifts_with_skew_and_keeps_the_estimate_inside():
-    from kicktimes.report.effects import paired_ratio
+    from kicktimes.stats import paired_ratio
 
     rng = np.random.default_rng(4)
     idx = pd.MultiIndex.from_product([[0.01, 0.02], range(150)], names=["radius", "ic"])

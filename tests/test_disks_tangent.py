@@ -20,7 +20,7 @@ from kicktimes.billiard import many_disks as md
 from kicktimes.billiard.checks import RULES
 from kicktimes.diagnostics import disks_lyapunov, lyapunov
 from kicktimes.diagnostics.gas_lyapunov import project_trivial
-from kicktimes.report.effects import paired_ratio
+from kicktimes.stats import paired_ratio
 
 
 def carry(state, r, rule, t, u, masses=None, segment=None):

@@ -10,7 +10,7 @@ from click.testing import CliRunner
 
 from kicktimes.cli import main
 from kicktimes.diagnostics import lyapunov
-from kicktimes.report.effects import paired_ratio
+from kicktimes.stats import paired_ratio
 from kicktimes.studies.protocol.compute import D0, Panel, compute_task, run_rows, tasks
 from kicktimes.studies.protocol.page import FIGURE, build_page, fig6_figure
 from kicktimes.studies.protocol.tables import _shapley

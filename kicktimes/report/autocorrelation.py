@@ -24,7 +24,7 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
 from kicktimes.report.common import REFERENCE, Section, distinct, fmt, kicked_systems, wide
-from kicktimes.report.effects import BUILT_IN, Effect, paired_ratio, ratio_verdict, store_ratio
+from kicktimes.report.effects import BUILT_IN, Effect, ratio_verdict, store_ratio
 from kicktimes.report.figures import (
     _SEM_BAR,
     dodge,
@@ -34,6 +34,7 @@ from kicktimes.report.figures import (
     system_style,
 )
 from kicktimes.report.summary import diagnostic_summary
+from kicktimes.stats import paired_ratio
 
 __all__ = ["predicted_lag1", "acf_curves", "acf_differences", "acf_paired_differences",
            "crossings", "acf_figure", "lag1_ratios", "half_width95", "sections", "effects"]

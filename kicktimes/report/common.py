@@ -110,7 +110,7 @@ class Context:
     #: results of jobs started ahead of their section (see :func:`start_ahead`)
     pending: dict = field(default_factory=dict)
     #: the bootstrap resamples of the ICs shared by every ratio of the Findings
-    #: (`kicktimes.report.effects.paired_ratio`'s ``resamples``, drawn from ``boot_rng()``)
+    #: (`kicktimes.stats.paired_ratio`'s ``resamples``, drawn from ``boot_rng()``)
     resamples: dict = field(default_factory=dict)
     notes: list = field(default_factory=list)
     found: Found = field(default_factory=Found)

@@ -7,7 +7,7 @@ changes it. The controls:
 ``primary``
     The report's setting: per radius the ratio of ensemble means
     :math:`\rho_r = \sum_i x_{ri} / \sum_i y_{ri}`, averaged over radii
-    (:func:`kicktimes.report.effects.paired_ratio`).
+    (:func:`kicktimes.stats.paired_ratio`).
 ``paired_median``
     A robust paired statistic: per radius the median over ICs of the per-IC ratio
     :math:`x_{ri} / y_{ri}`, averaged over radii. A few runs with extreme values (sticky
@@ -55,10 +55,10 @@ import numpy as np
 import pandas as pd
 
 from kicktimes.report.common import REFERENCE, kicked_systems, wide
-from kicktimes.report.effects import paired_ratio
 from kicktimes.stats import (
     bootstrap_nanmedians,
     nanmedian,
+    paired_ratio,
     ratio_verdict,
     rejection_verdict,
     resample_indices,

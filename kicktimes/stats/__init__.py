@@ -29,6 +29,7 @@ from .analyze import Analysis, analyze
 from .bootstrap import (
     ClusterBootstrap,
     cluster_bootstrap,
+    paired_ratio,
     percentile_interval,
     ratio_of_means,
     resample_counts,
@@ -104,6 +105,7 @@ __all__ = [
     "STICKY_FACTOR",
     "ClusterBootstrap",
     "cluster_bootstrap",
+    "paired_ratio",
     "percentile_interval",
     "ratio_of_means",
     "resample_counts",

@@ -14,7 +14,7 @@ Each method's runs of one state follow different trajectories after some ``37 / 
 (the twin's restarts, and the two simulators, round differently; chaos amplifies it), so
 only means over states compare: ``estimate`` is the ratio of the means over the states,
 ``lo, hi`` its 95 % percentile interval from a paired bootstrap over the states
-(`kicktimes.report.effects.paired_ratio`), ``verdict`` `kicktimes.stats.ratio_verdict`
+(`kicktimes.stats.paired_ratio`), ``verdict`` `kicktimes.stats.ratio_verdict`
 with ``tolerance=margin`` (an equivalence test: "within" when the whole interval lies in
 ``[1 - margin, 1 + margin]``).
 
@@ -223,8 +223,7 @@ def seed_ftle_check(out, runs, check: FtleCheck = FTLE_CHECK) -> None:
 
 def summarise(runs: pd.DataFrame) -> pd.DataFrame:
     """The checks' table (columns `FTLE_CHECK_COLUMNS`) from the states' exponents."""
-    from kicktimes.report.effects import paired_ratio
-    from kicktimes.stats import ratio_verdict
+    from kicktimes.stats import paired_ratio, ratio_verdict
 
     rows = []
     for (check, n, rule), g in runs.groupby(["check", "n_disks", "rule"], sort=False,

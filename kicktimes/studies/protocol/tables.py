@@ -1,7 +1,7 @@
 r"""The protocol study's tables: ratios per reading, the choices' Shapley shares, convergence.
 
 Every ratio is kicked over two-disk FTLE, the ratio of the ensemble means at each radius
-averaged over the radii (`kicktimes.report.effects.paired_ratio`), with a 95 % bootstrap
+averaged over the radii (`kicktimes.stats.paired_ratio`), with a 95 % bootstrap
 CI clustered on ICs: one set of resampled IC indices (``N_BOOT`` draws from ``BOOT_SEED``)
 is applied to every radius, system and reading, so differences between readings are
 paired. Verdicts come from `kicktimes.stats.ratio_verdict` (the ±10 % band, an
@@ -29,8 +29,7 @@ import math
 import numpy as np
 import pandas as pd
 
-from kicktimes.report.effects import paired_ratio
-from kicktimes.stats import ratio_verdict, robust_verdict
+from kicktimes.stats import paired_ratio, ratio_verdict, robust_verdict
 from kicktimes.stats.findings import share_verdict
 from kicktimes.studies.protocol.compute import CONVERGENCE
 
