@@ -197,12 +197,12 @@ def test_the_sweep_kernels_are_loaded_before_a_pool_forks(monkeypatch, workers, 
     import os
 
     from kicktimes import compilation as _compile
-    from kicktimes.cli._group import _compile_first
+    from kicktimes.compilation import compile_first
 
     calls = []
     monkeypatch.setattr(_compile, "announce", lambda *a, **k: 0.0)
     monkeypatch.setattr(_compile, "warm_sweep", lambda: calls.append("warm_sweep"))
-    _compile_first(workers)
+    compile_first(workers)
     if loads is None:  # the default pool: one worker per core
         loads = (os.cpu_count() or 1) > 1
     assert calls == (["warm_sweep"] if loads else [])

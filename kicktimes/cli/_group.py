@@ -11,7 +11,6 @@ import re
 import click
 
 from kicktimes import __version__
-from kicktimes.compilation import compile_first as _compile_first  # noqa: F401 (the commands')
 
 # numpy 2 reprs ("np.float64(-2.0)") leak into messages built with !r
 _NUMPY_REPR = re.compile(r"\bnp\.(?:float|int|uint|bool_?)\d*\((.*?)\)")

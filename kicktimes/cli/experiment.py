@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import click
 
-from kicktimes.cli._group import _cli_errors, _compile_first, option
+from kicktimes.cli._group import _cli_errors, option
+from kicktimes.compilation import compile_first
 from kicktimes.studies import STUDIES, studies_help
 
 
@@ -111,7 +112,7 @@ def run_command(experiment, out, workers, scheduler, progress, wait):
         exp = _experiment(experiment)
         click.echo(exp.summary())
         if scheduler is None and _pending(exp, out):
-            _compile_first(workers)
+            compile_first(workers)
         store = _run_one(exp, out, workers, scheduler, progress, wait)
     click.echo(store.summary())
 
@@ -159,10 +160,6 @@ def presets_command(name):
     click.echo(preset(name).to_toml(), nl=False)
 
 
-def _build_report(stores, out, workers=None, progress=None, pdf=False, force=False):
-    from kicktimes.report.process import build_stores_report
-
-    return build_stores_report(stores, out, workers, progress, pdf, force)
 
 
 _pdf_option = click.option(
@@ -196,7 +193,9 @@ def report_command(stores, out, workers, progress, pdf, force):
       kicktimes report stores/family_a stores/family_b --out report --pdf
     """
     with _cli_errors(_RUN_OPTIONS):
-        path = _build_report(stores, out, workers, progress, pdf, force)
+        from kicktimes.report.process import build_stores_report
+
+        path = build_stores_report(stores, out, workers, progress, pdf, force)
     click.echo(f"report written to {path if path is not None else out}")
 
 

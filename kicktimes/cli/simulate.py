@@ -6,7 +6,8 @@ from __future__ import annotations
 import click
 
 from kicktimes import __version__
-from kicktimes.cli._group import _cli_errors, _compile_first, _Real, option
+from kicktimes.cli._group import _cli_errors, _Real, option
+from kicktimes.compilation import compile_first
 
 
 # --- simulate command -------------------------------------------------------------------
@@ -69,7 +70,7 @@ def simulate_command(radii, n_ics, t_max, seed, rule, ic_method, out, save_runs,
                "seed": "--seed", "rule": "--rule", "method": "--ic-method"}
     from kicktimes.compilation import SIMULATE_KERNELS
 
-    _compile_first(None, SIMULATE_KERNELS)
+    compile_first(None, SIMULATE_KERNELS)
     with _cli_errors(options):
         ics = initial_conditions(n_ics, max(radii), seed=seed, method=ic_method, rule=rule)
         for r in radii:
@@ -134,7 +135,7 @@ def _simulate_disks(n_disks, packing, t_max, seed, rule, out, box=None):
 
     if n_disks is None or packing is None:
         raise click.UsageError("--disks and --packing go together: give both")
-    _compile_first(None, DISKS_KERNELS)
+    compile_first(None, DISKS_KERNELS)
     options = {"n_disks": "--disks", "packing": "--packing", "r": "--packing",
                "t_max": "--t-max", "seed": "--seed", "rule": "--rule", "state": "--packing",
                "box": "--box"}

@@ -235,7 +235,7 @@ def cluster_bootstrap(statistic, n_clusters, *, n_boot=999, level=0.95, rng=None
     estimate = np.asarray(statistic(np.arange(n)[None, :]), float)[0]
     step = b if chunk is None else check_int("chunk", chunk, low=1)
     replicates = np.concatenate([
-        np.asarray(statistic(rng.integers(0, n, size=(min(step, b - m), n))), float)
+        np.asarray(statistic(resample_indices(n, min(step, b - m), rng)), float)
         for m in range(0, b, step)])
     if replicates.ndim == 1:
         low, high = percentile_interval(replicates, level)

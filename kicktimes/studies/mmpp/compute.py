@@ -24,4 +24,5 @@ def collision_runs(rule, n_ics, r, t_max, seed) -> pd.DataFrame:
 
 def sticky_runs(times, r, t_max):
     """Which runs are sticky: collision rate above ``STICKY_FACTOR`` Γ(r)."""
-    return np.array([stats.is_sticky(t.size / t_max, stats.kinetic_rate(r)) for t in times])
+    sizes = np.array([t.size for t in times], dtype=float)
+    return stats.is_sticky(sizes / t_max, stats.kinetic_rate(r))
