@@ -30,7 +30,7 @@ import pandas as pd
 
 from kicktimes import stats
 from kicktimes.experiment import load_store
-from kicktimes.report.common import seeded_rng
+from kicktimes.report.context import seeded_rng
 
 
 def report_seed(exp_seed: int, radius: float, ic: int) -> int:

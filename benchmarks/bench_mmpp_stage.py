@@ -25,7 +25,8 @@ _CHILD = r"""
 import json, sys, time, warnings
 warnings.simplefilter("ignore")
 from kicktimes.report import mmpp, renewal
-from kicktimes.report.common import Context, load_report_store
+from kicktimes.report.context import Context
+from kicktimes.report.store import load_report_store
 ctx = Context(load_report_store(sys.argv[1]))
 renewal.sections(ctx)
 t0, c0 = time.perf_counter(), time.process_time()

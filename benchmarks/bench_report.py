@@ -131,12 +131,13 @@ def bench_build(paths, out_root, skip_renewal):
 
 def bench_render(paths, out_root, rounds=2):
     """The report's figures drawn by ``savefig`` (two draws: a layout pass, then the real
-    one) against one Agg draw (`kicktimes.report.html._png`): builds of the same stores
+    one) against one Agg draw (`kicktimes.render.html._png`): builds of the same stores
     with ``workers=1``, alternating, summing each build's rendering time; the PNG bytes
     of the two methods are compared."""
     import io
 
-    from kicktimes.report import build_report, html
+    from kicktimes.render import html
+    from kicktimes.report import build_report
 
     one_draw = html._png
 
@@ -207,7 +208,7 @@ def bench_load(paths, rounds=7):
     import pandas as pd
 
     from kicktimes.experiment import load_store
-    from kicktimes.report.common import load_report_store, report_store
+    from kicktimes.report.store import load_report_store, report_store
 
     def former(path):
         return report_store(load_store(path))

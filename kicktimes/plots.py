@@ -8,14 +8,14 @@ Every function takes data and returns a :class:`matplotlib.figure.Figure` built 
 
 from __future__ import annotations
 
-from kicktimes.report.counts import counts_by_radius, counts_vs_radius
-from kicktimes.report.figures import (
+from kicktimes.render.figures import (
     DIAGNOSTIC_LABELS,
     RADIUS_LABEL,
     SYSTEM_LABELS,
     SYSTEMS,
     TIME_UNIT,
 )
+from kicktimes.report.counts import counts_by_radius, counts_vs_radius
 from kicktimes.report.heterogeneity import rate_heterogeneity
 from kicktimes.report.kick_times import TimesFit, kick_times_vs_collision_times, kth_time_fit
 from kicktimes.report.poisson import binomial_ci, poisson_rejection_rates, rejection_table

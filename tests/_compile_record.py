@@ -39,3 +39,22 @@ def string_formatting(sigs: dict) -> list[str]:
     slice assignments or of ``raise`` with formatted text: seconds of compilation)."""
     return [name for name in sigs if "unicode" in name or "raise_with_shape" in name
             or "ol_str_generic" in name]
+
+
+#: the drivers, compiled once per set of observers (simulation alone, with tangent
+#: vectors, tangent vectors alone; the twins once per system): an argument passed as None
+#: is compiled out, so up to 3 signatures each
+DRIVERS = ({f"kicktimes.billiard.kernels.{m}.{f}" for m in ("drive_two", "drive_one")
+            for f in ("drive", "_run")}
+           | {"kicktimes.billiard.kernels.twins._ftle",
+              "kicktimes.billiard.kernels.drive_one._simulate"})
+
+
+def compiled_more_than_once(ours: dict) -> dict:
+    """The kernels of ``ours`` (name -> signatures) with more signatures than they should
+    have: more than 3 for a driver (`DRIVERS`), more than 1 for any other kernel except
+    the buffer growth ``observe.grow_to`` (generic over the dtype)."""
+    return {name: s for name, s in ours.items()
+            if len(s) > (3 if name in DRIVERS else 1)
+            and name != "kicktimes.billiard.kernels.observe.grow_to"}
+

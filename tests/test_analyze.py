@@ -346,7 +346,7 @@ def test_text_groups_are_categories_drawn_without_joining_lines():
 
 
 def test_a_numeric_group_with_few_values_is_ticked_at_its_values():
-    from kicktimes.report.figures import XAxis
+    from kicktimes.render.figures import XAxis
 
     t = pd.DataFrame({"clustered": [0, 1, 0]})
     (_, axis) = XAxis("clustered", "clustered").positions(t=t)

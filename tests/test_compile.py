@@ -66,7 +66,11 @@ def test_simulator_and_ftle_kernels_compile_once_without_error_strings(tmp_path)
     # kernel must compile one signature (literal int/bool arguments would add more), and
     # none may pull in numba's string formatting (error messages of slice assignments
     # or of raise with formatted text cost seconds of compilation).
-    from _compile_record import compiled_signatures, string_formatting
+    from _compile_record import (
+        compiled_more_than_once,
+        compiled_signatures,
+        string_formatting,
+    )
 
     sigs = compiled_signatures(_SETUP, _CALLS, tmp_path)
     ours = {name: s for name, s in sigs.items() if name.startswith("kicktimes.")}
@@ -75,13 +79,7 @@ def test_simulator_and_ftle_kernels_compile_once_without_error_strings(tmp_path)
     # the drivers compile once per set of observers (simulation alone, with tangent vectors,
     # tangent vectors alone; the twins once per system), which is how an argument passed as
     # None is compiled out
-    drivers = {f"kicktimes.billiard.kernels.{m}.{f}" for m in ("drive_two", "drive_one")
-               for f in ("drive", "_run")} | {"kicktimes.billiard.kernels.twins._ftle",
-                                              "kicktimes.billiard.kernels.drive_one._simulate"}
-    several = {name: s for name, s in ours.items()
-               if len(s) > (3 if name in drivers else 1)
-               and name != "kicktimes.billiard.kernels.observe.grow_to"}
-    assert several == {}
+    assert compiled_more_than_once(ours) == {}
     assert len(ours["kicktimes.billiard.kernels.observe.grow_to"]) <= 2
     strings = string_formatting(sigs)
     assert strings == []

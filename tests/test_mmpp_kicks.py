@@ -327,9 +327,9 @@ def _clustered_store(n_ics=4, t=2000.0):
 
 
 def test_the_report_sets_the_mmpp_against_poisson_and_renewal_with_poisson_twins(tmp_path):
+    from kicktimes.render.html import write_outputs
     from kicktimes.report import mmpp, renewal
-    from kicktimes.report.common import Context
-    from kicktimes.report.html import write_outputs
+    from kicktimes.report.context import Context
 
     ctx = Context(_clustered_store(), n_boot=200, max_ics_model_fits=4)
     secs = renewal.sections(ctx) + mmpp.sections(ctx)

@@ -7,7 +7,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from kicktimes.report.pages import NULL_CALIBRATION_COLUMNS, write_null_calibration
+from kicktimes.render.pages import NULL_CALIBRATION_COLUMNS, write_null_calibration
 from kicktimes.stats import poisson_rule, poisson_verdict, ratio_verdict, rejection_verdict
 
 

@@ -10,6 +10,7 @@ from click.testing import CliRunner
 
 from kicktimes.cli import main
 from kicktimes.diagnostics import lyapunov
+from kicktimes.render.provenance import PROVENANCE_TITLE
 from kicktimes.stats import paired_ratio
 from kicktimes.studies.protocol.compute import D0, Panel, compute_task, run_rows, tasks
 from kicktimes.studies.protocol.page import FIGURE, build_page, fig6_figure
@@ -125,6 +126,10 @@ def test_the_page_states_each_claim_from_its_tables(rows, tmp_path):
     assert re.search(rf"kicked/two-disk {re.escape(low)}", first_screen)
     for name in ("paper_by_radius.csv", "paper_shapley.csv", "paper_convergence.csv"):
         assert not pd.read_csv(tmp_path / name).empty
+    # the page closes with where its numbers come from: every CSV beside it, by function
+    assert [h for h in text.splitlines() if h.startswith("## ")][-1] == PROVENANCE_TITLE
+    named = re.findall(r"^\| \[([^]]+)\]", text[text.index(PROVENANCE_TITLE):], re.M)
+    assert set(named) == {p.name for p in tmp_path.glob("*.csv")}
 
 
 def test_fig6_zooms_the_literal_column_on_its_data_and_says_so():

@@ -7,6 +7,7 @@ import types
 
 import numpy as np
 import pytest
+from _references import chord_trajectory
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from numpy.testing import assert_array_equal
@@ -66,36 +67,11 @@ def clustered(n: int, seed: int) -> np.ndarray:
     return pts
 
 
-def billiard_trajectory(n: int, seed: int, tau: float = 0.2, kicked: bool = True):
-    """Centre of a point particle in the unit disk sampled every tau (chords)."""
-    rng = np.random.default_rng(seed)
-    x = np.array([0.3, -0.2])
-    a = rng.uniform(0.0, 2.0 * np.pi)
-    v = np.array([np.cos(a), np.sin(a)])
-    pts = np.empty((n, 2))
-    t, k = 0.0, 0
-    while k < n:
-        b = x @ v
-        dt = -b + np.sqrt(b * b - x @ x + 1.0)
-        while k < n and k * tau <= t + dt:
-            pts[k] = x + (k * tau - t) * v
-            k += 1
-        x = x + dt * v
-        if kicked:  # new direction pointing inwards
-            a = np.arctan2(x[1], x[0]) + np.pi + rng.uniform(-0.5 * np.pi, 0.5 * np.pi)
-            v = np.array([np.cos(a), np.sin(a)])
-        else:
-            nrm = x / np.linalg.norm(x)
-            v = v - 2.0 * (v @ nrm) * nrm
-        t += dt
-    return pts
-
-
 POINT_SETS = {
     "uniform": uniform_disk(2500, seed=1),
     "clustered": clustered(3000, seed=2),
-    "trajectory": billiard_trajectory(3000, seed=3),
-    "integrable_trajectory": billiard_trajectory(2000, seed=4, kicked=False),
+    "trajectory": chord_trajectory(3000, seed=3),
+    "integrable_trajectory": chord_trajectory(2000, seed=4, kicked=False),
 }
 
 
@@ -281,7 +257,7 @@ def test_run_records_are_read_through_their_samples():
 
 @pytest.mark.parametrize("name", ["uniform", "trajectory"])
 def test_count_agrees_with_scipy_kdtree_at_larger_n(name):
-    pts = uniform_disk(40_000, seed=6) if name == "uniform" else billiard_trajectory(20_000, seed=7)
+    pts = uniform_disk(40_000, seed=6) if name == "uniform" else chord_trajectory(20_000, seed=7)
     tree = cKDTree(pts)
     for eps in (1e-3, 1e-2):
         ordered = tree.count_neighbors(tree, eps)  # ordered pairs, diagonal included

@@ -392,6 +392,13 @@ def test_write_results_gives_pngs_and_a_generated_findings_page(store_path, tmp_
     assert "[null_calibration.csv](null_calibration.csv)" in text
     findings = pd.read_csv(tmp_path / "tiny_report_findings.csv")
     assert {"dispersion_index", "poisson@uniformity_ks"} <= set(findings["diagnostic"])
+    # last, where the numbers come from: the CSVs written beside the page, by function
+    from kicktimes.render.provenance import PROVENANCE_TITLE
+
+    closing = text[text.rindex("\n## ") + 1:]
+    assert closing.startswith(PROVENANCE_TITLE + "\n") and "`kicktimes." in closing
+    named = set(re.findall(r"^\| \[([^]]+)\]\(", closing, re.M))
+    assert named == {p.name for p in tmp_path.glob("*.csv")}
 
 
 # ------------------------------------------------------------------ cache
@@ -501,7 +508,7 @@ def test_one_draw_png_is_byte_identical_to_savefig():
 
     from matplotlib.figure import Figure
 
-    from kicktimes.report.html import _png
+    from kicktimes.render.html import _png
 
     def figure():
         fig = Figure(figsize=(7.0, 3.5), layout="constrained")
@@ -544,7 +551,7 @@ def test_the_report_reads_a_store_as_report_store_of_load_store(store_path, tmp_
     import shutil
 
     from kicktimes.experiment.store import _part_path
-    from kicktimes.report.common import load_report_store, report_store
+    from kicktimes.report.store import load_report_store, report_store
 
     def same(path):
         ref, got = report_store(load_store(path)), load_report_store(path)

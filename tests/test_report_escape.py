@@ -165,7 +165,7 @@ def test_a_store_that_does_not_say_which_disk_left_is_not_compared():
 def test_a_store_without_holes_gets_no_escape_section():
     from test_report_sections import synthetic_store
 
-    from kicktimes.report.common import Context
+    from kicktimes.report.context import Context
 
     ctx = Context(synthetic_store(n_ics=4))
     assert not getattr(ctx.exp, "holes", ())
@@ -191,7 +191,7 @@ def test_bad_input_is_refused_with_clear_errors(tmp_path):
 def test_the_figure_has_a_panel_per_radius_in_the_system_colours():
     from matplotlib.colors import to_rgba
 
-    from kicktimes.report.figures import system_style
+    from kicktimes.render.figures import system_style
 
     rng = np.random.default_rng(5)
     law = {s: rng.exponential(40.0, 200) for s in ("two_particle", "poisson")}

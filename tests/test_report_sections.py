@@ -11,15 +11,15 @@ import pandas as pd
 import pytest
 
 from kicktimes import stats
+from kicktimes.render.figures import system_label
 from kicktimes.report import autocorrelation, counts, findings, lyapunov, recurrence, summary
-from kicktimes.report.common import Context
+from kicktimes.report.context import Context
 from kicktimes.report.effects import (
     clopper_pearson,
     paired_ratio,
     ratio_verdict,
     share_verdict,
 )
-from kicktimes.report.figures import system_label
 
 RADII = (0.008, 0.014, 0.02)
 EPS = (0.001, 0.01)
@@ -467,7 +467,7 @@ def test_findings_section_states_the_rules_and_the_scale(ctx):
 
 
 def test_sections_of_a_new_store_are_written_as_png_pdf_and_csv(ctx, tmp_path):
-    from kicktimes.report.html import write_outputs
+    from kicktimes.render.html import write_outputs
 
     secs = [ctx.findings] + [s for v in ctx.sections.values() for s in v]
     page = write_outputs(secs, tmp_path, 40)
@@ -493,7 +493,7 @@ def _tables_as_csv(store):
 def test_the_categorical_results_view_writes_the_same_tables():
     # report_store turns system/diagnostic into categoricals (speed); every table the
     # sections write must be the same text as from the plain string columns
-    from kicktimes.report.common import report_store
+    from kicktimes.report.store import report_store
 
     store = synthetic_store(n_ics=8)
     view = report_store(store)
@@ -511,7 +511,7 @@ def test_acf_curves_read_the_lag_from_every_acf_row_and_only_those():
     ref = res[res["diagnostic"].str.match(r"^acf@(\d+)$")]
     ref = ref.assign(lag=ref["diagnostic"].str.slice(4).astype(int))
     ref = ref.groupby(["radius", "system", "lag"])["value"].agg(["mean", "median"]).reset_index()
-    from kicktimes.report.common import report_store
+    from kicktimes.report.store import report_store
 
     for results in (res, report_store(store).results):
         got = autocorrelation.acf_curves(results)
@@ -523,7 +523,7 @@ def test_acf_curves_read_the_lag_from_every_acf_row_and_only_those():
 
 @pytest.mark.reproducibility
 def test_figures_render_to_the_same_bytes_on_forked_workers():
-    from kicktimes.report.html import render_figures
+    from kicktimes.render.html import render_figures
 
     def figures():
         context = Context(synthetic_store(n_ics=6), n_boot=100)
@@ -539,7 +539,7 @@ def test_figures_render_to_the_same_bytes_on_forked_workers():
 
 def test_poisson_tests_started_ahead_on_a_pool_equal_the_tests_run_in_place():
     from kicktimes.report import poisson
-    from kicktimes.report.common import Mapper
+    from kicktimes.report.context import Mapper
 
     store = synthetic_store(n_ics=6)
     in_place = Context(store, n_mc=39)
@@ -588,7 +588,7 @@ def test_the_report_findings_are_stats_findings_with_an_effect_size(ctx):
 
 
 def test_one_writer_writes_the_page_of_the_report_and_of_kicktimes_analyze(tmp_path):
-    from kicktimes.report.html import CSS, toc_item, write_page
+    from kicktimes.render.html import CSS, toc_item, write_page
 
     files = {}
     toc = [toc_item("s", "S & T", [toc_item("u", "U")]), toc_item("v", "V")]

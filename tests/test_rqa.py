@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from _references import chord_trajectory
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -87,23 +88,7 @@ def trajectory(n: int, seed: int, tau: float = 0.05) -> np.ndarray:
 
     Short steps make consecutive samples recur, so there are long diagonal lines.
     """
-    rng = np.random.default_rng(seed)
-    x = np.array([0.3, -0.2])
-    a = rng.uniform(0.0, 2.0 * np.pi)
-    v = np.array([np.cos(a), np.sin(a)])
-    pts = np.empty((n, 2))
-    t, k = 0.0, 0
-    while k < n:
-        b = x @ v
-        dt = -b + np.sqrt(b * b - x @ x + 1.0)
-        while k < n and k * tau <= t + dt:
-            pts[k] = x + (k * tau - t) * v
-            k += 1
-        x = x + dt * v
-        a = np.arctan2(x[1], x[0]) + np.pi + rng.uniform(-0.5 * np.pi, 0.5 * np.pi)
-        v = np.array([np.cos(a), np.sin(a)])
-        t += dt
-    return pts
+    return chord_trajectory(n, seed, tau=tau)
 
 
 def periodic_with_duplicates(n: int) -> np.ndarray:

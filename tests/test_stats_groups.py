@@ -66,7 +66,7 @@ def test_analyze_and_the_report_build_the_same_homogeneity_numbers():
     from types import SimpleNamespace
 
     from kicktimes.report import poisson
-    from kicktimes.report.common import Context, seeded_rng
+    from kicktimes.report.context import Context, seeded_rng
 
     seqs = _sequences([12, 30, 7, 22], window=40.0, seed=4)
     collisions = pd.DataFrame({"radius": 0.02, "ic": range(4), "t_window": 40.0,

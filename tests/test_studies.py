@@ -130,3 +130,31 @@ def test_an_option_of_another_study_is_refused_naming_it(tmp_path):
                                     "tcp://h:1", "--out", str(tmp_path)])
     assert res.exit_code == 2
     assert "--scheduler applies to --study paper, disks, not to --study escape" in res.output
+
+
+def test_the_paper_page_s_closing_table_is_what_it_wrote_and_never_in_the_readme(tmp_path):
+    import pandas as pd
+
+    from kicktimes.render.pages import write_results_page
+    from kicktimes.render.provenance import PROVENANCE_TITLE
+    from kicktimes.report.controls import COLUMNS, POISSON_QUESTION
+    from kicktimes.studies.paper.page import BEGIN, END, copy_first_screen, results_sources
+
+    family = pd.DataFrame([dict.fromkeys(COLUMNS, "x") | {"question": POISSON_QUESTION}])
+    curves = pd.DataFrame(columns=["family", "control", "radius", "ratio", "ci_low", "ci_high"])
+    for name in ("fam", "fam-elastic"):
+        family.to_csv(tmp_path / f"{name}_findings.csv", index=False)
+        curves.to_csv(tmp_path / f"{name}_findings_by_radius.csv", index=False)
+    rows = results_sources(["fam", "fam-elastic"], {"fam": family}, ["fam", "fam-elastic"],
+                           gaps=False, nulls=False)
+    # the family's table twice (its comparisons, its Poisson rows), the control's once
+    assert [(r.csv, r.computed_by.__name__) for r in rows[:3]] == [
+        ("fam_findings.csv", "compute_controls"), ("fam_findings.csv", "poisson_rows"),
+        ("fam-elastic_findings.csv", "compute_controls")]
+    assert {r.csv for r in rows} == {p.name for p in tmp_path.glob("*.csv")}
+    page = write_results_page(tmp_path / "README.md", [
+        "# t", "", "Generated now from `fam`.", "", "## The answers", "", "One.", ""], rows)
+    readme = tmp_path / "top.md"
+    readme.write_text(f"intro\n{BEGIN}\nold\n{END}\n", encoding="utf-8")
+    copy_first_screen(page, readme)
+    assert "One." in readme.read_text() and PROVENANCE_TITLE not in readme.read_text()

@@ -1,12 +1,14 @@
 """The disks study's own computations: the checks of the gas's FTLE and its sweep against
 density run through `kicktimes.studies.disks` at a tiny size, write their tables beside the
 page, are cached in the work folder with their parameters (a rerun simulates nothing, a
-published runs table seeds the cache), and ``reproduce_disks`` writes them before the page.
+published runs table seeds the cache), and ``reproduce_disks`` writes them before the page,
+which closes with the table of where its numbers come from.
 """
 
 from __future__ import annotations
 
 import filecmp
+import re
 import shutil
 import warnings
 from pathlib import Path
@@ -17,7 +19,8 @@ import pytest
 import kicktimes.studies.disks.density as density_module
 import kicktimes.studies.disks.ftle_check as check_module
 import kicktimes.studies.disks.run as run_module
-from kicktimes.experiment import DisksExperiment
+from kicktimes.experiment import DisksExperiment, run_experiment
+from kicktimes.render.provenance import PROVENANCE_TITLE
 from kicktimes.studies.disks import reproduce_disks
 from kicktimes.studies.disks.density import (
     LyapunovDensity,
@@ -84,6 +87,36 @@ def test_the_density_sweep_writes_its_means_and_its_fit(work):
     assert len(fits) == 1 and isinstance(fits["reading"].iloc[0], str)
     text = "\n".join(density_lines(results / DENSITY_CSVS[0], results / DENSITY_CSVS[1]))
     assert "| 20 | 0.005 |" in text and "N = 20, fitted at φ ≤ 0.02" in text
+
+
+def test_the_page_ends_with_where_its_numbers_come_from(work, tmp_path):
+    from kicktimes.studies.disks.page import write_disks_page
+
+    # the page beside the FTLE tables reproduce_disks writes first, from a tiny mirror gas
+    results = tmp_path / "results"
+    results.mkdir()
+    for name in CHECK_CSVS + DENSITY_CSVS:
+        shutil.copy(work / "results" / name, results / name)
+    gas = DisksExperiment(name="tiny-gas", n_disks=[2, 5], packing=0.1, n_tagged=6,
+                          min_runs=3, collisions=5, block_sequences=2, seed=3)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        store = run_experiment(gas, tmp_path / "store", progress=False, workers=1)
+        page = write_disks_page([store.path], results, n_boot=99, n_mc=19, dpi=30)
+    text = page.read_text(encoding="utf-8")
+    headings = [line for line in text.split("\n") if line.startswith("## ")]
+    assert headings[-1] == PROVENANCE_TITLE
+    table = text.split(f"\n{PROVENANCE_TITLE}\n", 1)[1]
+    named = re.findall(r"^\| \[([^\]]+)\]\(\1\) \| [^|]+ \| `kicktimes\.[\w.]+` \|$",
+                       table, flags=re.MULTILINE)
+    assert len(named) == table.count("\n| [")
+    assert all((results / name).is_file() for name in named)
+    # every table written beside the page is named; a table not written is not
+    assert {"disks.csv", "disks_null.csv", "null_calibration.csv",
+            *CHECK_CSVS, *DENSITY_CSVS} <= set(named)
+    assert "disks_kicked.csv" not in named and "disks_cost.csv" not in named
+    # a mirror gas has no speed-rescaled columns: the page names none
+    assert "rescaled_" not in table
 
 
 def test_a_rerun_with_the_same_parameters_simulates_nothing(work, tmp_path, monkeypatch):

@@ -5,6 +5,7 @@ import re
 import numpy as np
 import pandas as pd
 import pytest
+from conftest import assert_provenance
 
 import kicktimes.studies.escape as study
 from kicktimes.stats import format_interval, ratio_verdict
@@ -152,3 +153,12 @@ def test_no_survival_curve_hides_the_two_disk_one():
     import matplotlib.pyplot as plt
 
     plt.close(fig)
+
+
+def test_the_page_ends_with_where_its_numbers_come_from(built):
+    _, page, _ = built
+    rows = assert_provenance(page)
+    assert {csv for csv, _, _ in rows} == {f"escape/{p.name}"
+                                           for p in (page.parent / "escape").glob("*.csv")}
+    assert ("escape/escape_tails.csv", "alpha, alpha_low, alpha_high, aic_exp_minus_alg",
+            "kicktimes.stats.survival.fit_escape_tail") in rows

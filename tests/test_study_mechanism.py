@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import pandas as pd
 import pytest
+from conftest import assert_provenance
 
 from kicktimes.stats import format_interval, ratio_verdict
 from kicktimes.studies.mechanism import run
@@ -134,3 +135,14 @@ def test_every_figure_the_page_links_is_drawn(tmp_path):
     text = "\n".join(rule_section(table, "mechanism/elastic"))
     for name in ("hazard", "hazard_normalised", "battery"):
         assert f"(mechanism/elastic/mechanism_{name}.png)" in text
+
+
+def test_the_page_ends_with_where_its_numbers_come_from(built):
+    _, page = built
+    rows = assert_provenance(page)
+    # one table per rule of the run (here the mirror rule only), each from both functions
+    assert {csv for csv, _, _ in rows} == {f"{p.parent.relative_to(page.parent)}/{p.name}"
+                                           for p in page.parent.rglob("*.csv")}
+    assert [f for _, _, f in rows] == [
+        "kicktimes.studies.mechanism.analysis.analyse",
+        "kicktimes.studies.mechanism.analysis.hazard_profile_rows"]

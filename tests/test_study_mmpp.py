@@ -5,6 +5,7 @@ from types import SimpleNamespace
 
 import pandas as pd
 import pytest
+from conftest import assert_provenance
 
 import kicktimes.studies.mmpp as study
 import kicktimes.studies.mmpp.tables as tables
@@ -104,3 +105,12 @@ def test_the_mmpp_bin_hazard_is_exact_and_reads_the_mechanism_study_s_bins():
 def test_the_paper_scale_is_the_published_page_s():
     assert study.SCALES["paper"] == study.Params(n_ics=200, t_max=2000.0, per_run=200,
                                                  radius=0.02, seed=29)
+
+
+def test_the_page_ends_with_where_its_numbers_come_from(built):
+    _, page = built
+    rows = assert_provenance(page)
+    assert {csv for csv, _, _ in rows} == {f"mmpp/{p.name}"
+                                           for p in (page.parent / "mmpp").glob("*.csv")}
+    assert ("mmpp/mmpp_billiard_dip.csv", "mmpp",
+            "kicktimes.studies.mmpp.tables.mmpp_dip") in rows

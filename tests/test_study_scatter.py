@@ -5,6 +5,7 @@ import re
 import numpy as np
 import pandas as pd
 import pytest
+from conftest import assert_provenance
 
 import kicktimes.studies.scatter as study
 from kicktimes.experiment.presets import preset
@@ -78,3 +79,10 @@ def test_the_paper_scale_is_family_a_s():
     assert (paper.n_steps, paper.tau, paper.ic_seed, paper.ic_method) == (
         fam.n_steps, fam.tau, fam.seed, fam.ic_method)
     assert paper.ic_radius == fam.r_max
+
+
+def test_the_page_ends_with_where_its_numbers_come_from(built):
+    _, page = built
+    rows = assert_provenance(page)
+    assert {csv for csv, _, _ in rows} == {p.name for p in page.parent.glob("*.csv")}
+    assert ("scatter_ratios.csv", "verdict", "kicktimes.stats.findings.ratio_verdict") in rows

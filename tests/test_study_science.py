@@ -9,8 +9,10 @@ import pandas as pd
 import pytest
 
 from kicktimes.experiment import preset, run_experiment
+from kicktimes.render.provenance import PROVENANCE_TITLE
 from kicktimes.stats import format_interval, ratio_verdict
 from kicktimes.studies.science import run
+from kicktimes.studies.science.page import SOURCES
 
 TINY = run.ScienceScale("stretching_tiny", (0.03, 0.05), 4, 1000, (0.03,), 1, 10, (0.03,), 2,
                         300.0)
@@ -72,6 +74,11 @@ def test_the_page_names_the_command_and_quotes_its_csv(built):
     compare = pd.read_csv(page.parent / "science_decorrelation_prediction.csv")
     assert list(compare["family"]) == ["quick_a", "quick_a"]    # no elastic tables: mirror only
     assert (page.parent / "science_stretching.png").stat().st_size > 0
+    # last, the table of where the numbers come from: one row per CSV beside the page
+    closing = text[text.rindex("\n## ") + 1:]
+    assert closing.startswith(PROVENANCE_TITLE + "\n")
+    csvs = {line.split("](")[0].removeprefix("| [") for line in closing.splitlines()[4:]}
+    assert csvs == {p.name for p in page.parent.glob("*.csv")} == {s.csv for s in SOURCES}
 
 
 def test_a_rerun_reuses_the_cache_and_recomputes_only_the_statistics(built, paper_study,

@@ -4,6 +4,7 @@ import re
 
 import pandas as pd
 import pytest
+from conftest import assert_provenance
 
 import kicktimes.studies.unequal as study
 from kicktimes.stats import format_interval, ratio_verdict
@@ -97,3 +98,11 @@ def test_the_figure_draws_ks_share_and_dispersion_on_their_own_axes():
     import matplotlib.pyplot as plt
 
     plt.close(fig)
+
+
+def test_the_page_ends_with_where_its_numbers_come_from(built):
+    _, page = built
+    rows = assert_provenance(page)
+    assert {csv for csv, _, _ in rows} == {study.page.TABLE}
+    assert ("size_ratio/size_ratio.csv", "disp_low, disp_high",
+            "kicktimes.studies.unequal.tables.dispersion_ci") in rows

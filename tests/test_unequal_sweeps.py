@@ -11,7 +11,7 @@ from kicktimes import initial_conditions
 from kicktimes.experiment import Experiment, load_store, preset, run_experiment
 from kicktimes.experiment.tasks import execute_task
 from kicktimes.report.counts import sticky_ics
-from kicktimes.report.html import store_header
+from kicktimes.report.store import store_header
 from kicktimes.stats import kinetic_rate
 
 BASE = dict(name="unequal", radii=[0.01, 0.02], n_ics=3, n_steps=1200, tau=0.2,

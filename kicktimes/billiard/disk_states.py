@@ -35,6 +35,33 @@ GROW_STEPS = 2000
 
 
 @njit(cache=True, error_model="numpy")
+def _clear_of_cell(x, y, r, q, xy, radii, nxt, box):
+    """Whether a disk of radius ``r`` at ``(x, y)`` overlaps none of the disks of one cell
+    (the linked list from ``q``); in the periodic box of side ``box`` the nearest images
+    (``box = 0``: no wrap, the circle)."""
+    while q >= 0:
+        dx = x - xy[q, 0]
+        dy = y - xy[q, 1]
+        if box > 0.0:
+            dx -= box * np.round(dx / box)
+            dy -= box * np.round(dy / box)
+        s = r + radii[q]
+        if dx * dx + dy * dy < s * s:
+            return False
+        q = nxt[q]
+    return True
+
+
+@njit(cache=True, error_model="numpy")
+def _place(i, x, y, c, xy, head, nxt):
+    """Put disk ``i`` at ``(x, y)`` and at the head of cell ``c``'s list."""
+    xy[i, 0] = x
+    xy[i, 1] = y
+    nxt[i] = head[c]
+    head[c] = i
+
+
+@njit(cache=True, error_model="numpy")
 def _rsa(radii, order, u, xy, m, w, head, nxt, k0, j0):
     """Place disks ``order[k0:]`` one by one at candidates ``u[j]`` (uniform in [0, 1)^2,
     mapped to the square) inside the table and clear of the disks placed; returns
@@ -58,26 +85,14 @@ def _rsa(radii, order, u, xy, m, w, head, nxt, k0, j0):
         ok = True
         for gy in range(max(cy - reach, 0), min(cy + reach + 1, m)):
             for gx in range(max(cx - reach, 0), min(cx + reach + 1, m)):
-                q = head[gx + m * gy]
-                while q >= 0:
-                    dx = x - xy[q, 0]
-                    dy = y - xy[q, 1]
-                    s = radii[i] + radii[q]
-                    if dx * dx + dy * dy < s * s:
-                        ok = False
-                        break
-                    q = nxt[q]
+                ok = _clear_of_cell(x, y, radii[i], head[gx + m * gy], xy, radii, nxt, 0.0)
                 if not ok:
                     break
             if not ok:
                 break
         if not ok:
             continue
-        xy[i, 0] = x
-        xy[i, 1] = y
-        c = cx + m * cy
-        nxt[i] = head[c]
-        head[c] = i
+        _place(i, x, y, cx + m * cy, xy, head, nxt)
         k += 1
     return k, j
 
@@ -104,28 +119,15 @@ def _rsa_box(radii, order, u, xy, m, w, head, nxt, k0, j0, box):
         ok = True
         for gy in range(lo_y, hi_y + 1):
             for gx in range(lo_x, hi_x + 1):
-                q = head[gx % m + m * (gy % m)]
-                while q >= 0:
-                    dx = x - xy[q, 0]
-                    dy = y - xy[q, 1]
-                    dx -= box * np.round(dx / box)
-                    dy -= box * np.round(dy / box)
-                    s = radii[i] + radii[q]
-                    if dx * dx + dy * dy < s * s:
-                        ok = False
-                        break
-                    q = nxt[q]
+                ok = _clear_of_cell(x, y, radii[i], head[gx % m + m * (gy % m)], xy, radii,
+                                    nxt, box)
                 if not ok:
                     break
             if not ok:
                 break
         if not ok:
             continue
-        xy[i, 0] = x
-        xy[i, 1] = y
-        c = cx + m * cy
-        nxt[i] = head[c]
-        head[c] = i
+        _place(i, x, y, cx + m * cy, xy, head, nxt)
         k += 1
     return k, j
 

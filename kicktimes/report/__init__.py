@@ -22,14 +22,14 @@ One module per section, each holding its computation, figure and text:
 Poisson model against Poisson and the renewal models), :mod:`~kicktimes.report.heterogeneity`,
 :mod:`~kicktimes.report.findings` (with :mod:`~kicktimes.report.controls`,
 :mod:`~kicktimes.report.answers` and :mod:`~kicktimes.report.decomposition`);
-:mod:`~kicktimes.report.pages` holds the generated pages' header and Markdown helpers;
-:mod:`~kicktimes.report.html` writes the page and
+:mod:`~kicktimes.render.pages` holds the generated pages' header and Markdown helpers;
+:mod:`~kicktimes.render.html` writes the page and
 :mod:`~kicktimes.report.pipeline` runs them. See docs/report.md.
 """
 
 from __future__ import annotations
 
-from kicktimes.report.common import REPORT_DOMAIN
+from kicktimes.report.context import REPORT_DOMAIN
 from kicktimes.report.pipeline import build_report
 
 __all__ = ["build_report", "REPORT_DOMAIN"]

@@ -44,11 +44,6 @@ def _sha256_file(path: Path) -> str | None:
         return None
 
 
-def atomic_write(path: Path, data: bytes) -> str:
-    """Write ``data`` to ``path`` whole or not at all (`kicktimes.fileio`); its SHA-256."""
-    return atomic_write_bytes(path, data)
-
-
 def content_key(*parts) -> str:
     """SHA-256 of a JSON-serialisable description (dict keys sorted: order-free)."""
     text = json.dumps([__version__, CACHE_LAYOUT, *parts], sort_keys=True, default=str)
@@ -117,4 +112,4 @@ class ReportCache:
 
     def save(self) -> None:
         text = json.dumps({"layout": CACHE_LAYOUT, "parts": self.parts}, indent=1)
-        atomic_write(self.path, text.encode("utf-8"))
+        atomic_write_bytes(self.path, text.encode("utf-8"))

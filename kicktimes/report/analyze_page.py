@@ -1,7 +1,7 @@
 """The page of ``kicktimes analyze``: findings first, then the report's own sections.
 
 :func:`write_analysis` turns an :class:`kicktimes.stats.Analysis` into ``report.html``
-(self-contained, written by :func:`kicktimes.report.html.write_page` as the sweep report
+(self-contained, written by :func:`kicktimes.render.html.write_page` as the sweep report
 is), ``findings.md``, one PNG + PDF per figure and one CSV per table. The figures are the
 sweep report's (Poisson rejection rates, renewal-model comparison, rate heterogeneity),
 drawn against the sequences' group where the report draws against the disk radius (their
@@ -18,9 +18,9 @@ import os
 import warnings
 from pathlib import Path
 
-from kicktimes.report.common import Section
+from kicktimes.render.html import toc_item, write_outputs, write_page, write_table, write_text
+from kicktimes.report.context import Section
 from kicktimes.report.heterogeneity import rate_heterogeneity
-from kicktimes.report.html import toc_item, write_outputs, write_page, write_table, write_text
 from kicktimes.report.poisson import poisson_rejection_rates
 from kicktimes.report.renewal import model_comparison
 from kicktimes.stats.findings import findings_table

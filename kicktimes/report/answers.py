@@ -18,9 +18,9 @@ import math
 import numpy as np
 import pandas as pd
 
-from kicktimes.report.common import REFERENCE
+from kicktimes.render.pages import markdown_table
 from kicktimes.report.controls import LOWER, POISSON_QUESTION, WITHIN
-from kicktimes.report.pages import markdown_table
+from kicktimes.report.store import REFERENCE
 from kicktimes.stats import format_interval
 
 __all__ = ["PANELS", "PAPER_CLAIMS", "QUESTIONS", "SCREEN_ROWS", "answers", "first_screen",
@@ -495,7 +495,7 @@ def ratio_curves_figure(curves: pd.DataFrame, control=HEADLINE_CONTROL):
     from matplotlib.figure import Figure
     from matplotlib.lines import Line2D
 
-    from kicktimes.report.figures import radius_axis, system_label, system_style
+    from kicktimes.render.figures import radius_axis, system_label, system_style
 
     curves = curves[curves["control"] == control]
     panels = [(d, t) for d, t in PANELS if d in set(curves["diagnostic"])]

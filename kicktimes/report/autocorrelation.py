@@ -23,9 +23,7 @@ import pandas as pd
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
-from kicktimes.report.common import REFERENCE, Section, distinct, fmt, kicked_systems, wide
-from kicktimes.report.effects import BUILT_IN, Effect, ratio_verdict, store_ratio
-from kicktimes.report.figures import (
+from kicktimes.render.figures import (
     _SEM_BAR,
     dodge,
     kick_groups,
@@ -33,6 +31,10 @@ from kicktimes.report.figures import (
     system_label,
     system_style,
 )
+from kicktimes.render.pages import number_text
+from kicktimes.report.context import Section
+from kicktimes.report.effects import BUILT_IN, Effect, ratio_verdict, store_ratio
+from kicktimes.report.store import REFERENCE, distinct, kicked_systems, wide
 from kicktimes.report.summary import diagnostic_summary
 from kicktimes.stats import paired_ratio
 
@@ -609,8 +611,9 @@ def sections(ctx):
         gap = (table["R1_mean"] - table["predicted_lag1"]).abs()
         sec.text(
             "R_1 against its built-in prediction 1 − n_pert/n_boundary: largest gap "
-            f"{fmt(gap.max())} over all radii and systems (R_1 ranges from "
-            f"{fmt(table['R1_mean'].min())} to {fmt(table['R1_mean'].max())}). Because each "
+            f"{number_text(gap.max())} over all radii and systems (R_1 ranges from "
+            f"{number_text(table['R1_mean'].min())} to {number_text(table['R1_mean'].max())}). "
+            f"Because each "
             "kicked system is given the two-particle collision rate, its lag-1 agreement with "
             "the two-particle system is built in: it is not evidence that the kicked billiard "
             "reproduces the two-particle dynamics."
@@ -647,13 +650,13 @@ def effects(ctx):
             predicted = ptot["ratio"]
             detail = (
                 f"the rate-matching prediction (perturbations per boundary collision, kicked "
-                f"/ two-particle) gives {fmt(predicted)}"
+                f"/ two-particle) gives {number_text(predicted)}"
             )
         verdict = ratio_verdict(tot["ci_low"], tot["ci_high"], ctx.tolerance)
         if verdict.startswith("within"):
             verdict = f"{verdict} ({BUILT_IN}: kick rate = collision rate)"
         elif predicted is not None:
-            verdict = (f"{verdict} (kick rate = collision rate predicts {fmt(predicted)}: "
+            verdict = (f"{verdict} (kick rate = collision rate predicts {number_text(predicted)}: "
                        "the rates do not explain it)")
         out.append(
             Effect.of_ratio(

@@ -54,7 +54,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from kicktimes.report.common import REFERENCE, kicked_systems, wide
+from kicktimes.report.store import REFERENCE, kicked_systems, wide
 from kicktimes.stats import (
     bootstrap_nanmedians,
     nanmedian,

@@ -9,14 +9,15 @@ import warnings
 import numpy as np
 import pandas as pd
 
-from kicktimes.report.common import Section, fmt_p
-from kicktimes.report.figures import (
+from kicktimes.render.figures import (
     check_frame,
     check_radii,
     finite,
     new_axes,
     radius_axis,
 )
+from kicktimes.render.pages import p_value_text
+from kicktimes.report.context import Section
 from kicktimes.stats import STICKY_FACTOR
 
 __all__ = ["counts_by_radius", "counts_vs_radius", "experiment_kinetic", "kinetic_rate_of",
@@ -242,7 +243,8 @@ def sections(ctx):
         + ("over-dispersed" if od["lr_pvalue"] < 0.05 else "not significantly over-dispersed")
         + f" across ICs: Poisson Pearson dispersion {od['pearson_dispersion']:.3g}, "
         f"negative-binomial α = {od['alpha']:.3g} (LR test of α = 0: p = "
-        f"{fmt_p(od['lr_pvalue'])}); AIC Poisson {reg.aic['poisson']:.6g} vs negative binomial "
+        f"{p_value_text(od['lr_pvalue'])}); AIC Poisson {reg.aic['poisson']:.6g} vs negative "
+        f"binomial "
         f"{reg.aic['negbin']:.6g}. The negative-binomial exponent of r is {b1['estimate']:.3f} "
         f"(95% CI {b1['ci_low']:.3f} to {b1['ci_high']:.3f}; kinetic theory: about 1). The "
         f"pooled rate is {table['rate_over_kinetic'].min():.3g} to "

@@ -47,8 +47,8 @@ import warnings
 import numpy as np
 import pandas as pd
 
-from kicktimes.report.common import REFERENCE, wide
 from kicktimes.report.controls import diagnostics_of
+from kicktimes.report.store import REFERENCE, wide
 from kicktimes.stats import bootstrap_nanmedians, resample_indices
 
 __all__ = ["ACTUAL_FACTORIAL", "FACTORIAL", "NO_GAP", "STEPS", "gap_decomposition",

@@ -74,7 +74,7 @@ class Effect(Finding):
     system: str = ""
 
     def __post_init__(self):
-        from kicktimes.report.figures import system_label
+        from kicktimes.render.figures import system_label
 
         who = f", {system_label(self.system)} vs two-particle" if self.system else ""
         text = effect_statement(self.question + who, self.quantity, self.estimate, self.ci_low,

@@ -40,8 +40,7 @@ import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 
-from kicktimes.report.common import REFERENCE, Section, fmt
-from kicktimes.report.figures import (
+from kicktimes.render.figures import (
     SYSTEMS,
     check_frame,
     plain_log_ticks,
@@ -49,6 +48,9 @@ from kicktimes.report.figures import (
     system_label,
     system_style,
 )
+from kicktimes.render.pages import number_text
+from kicktimes.report.context import Section
+from kicktimes.report.store import REFERENCE
 from kicktimes.stats import MARGIN
 
 __all__ = [
@@ -319,9 +321,11 @@ def _case(row):
     if row.reason.startswith("one tail"):
         numbers = f"{row.tail_law} tail against the two disks' {row.tail_law_two_particle}"
     else:
-        numbers = (f"{name} = {fmt(row.estimate)} [{fmt(row.low)}, {fmt(row.high)}] against "
-                   f"{fmt(row.estimate_two_particle)} [{fmt(row.low_two_particle)}, "
-                   f"{fmt(row.high_two_particle)}], {row.reason}")
+        numbers = (f"{name} = {number_text(row.estimate)} [{number_text(row.low)}, "
+                   f"{number_text(row.high)}] against "
+                   f"{number_text(row.estimate_two_particle)} "
+                   f"[{number_text(row.low_two_particle)}, "
+                   f"{number_text(row.high_two_particle)}], {row.reason}")
     return f"r = {row.radius:g}, {system_label(row.system)}: {numbers}"
 
 
@@ -525,7 +529,7 @@ def sections(ctx):
     sec.text(
         f"Holes: {widths}. Every run ends at its escape; a run that does not escape is "
         "censored at its end (its t_max). " + censoring + " Survival: Kaplan–Meier with "
-        f"pointwise 95 % intervals. Tails beyond t_min = {fmt(t_min)} ({origin}): censored "
+        f"pointwise 95 % intervals. Tails beyond t_min = {number_text(t_min)} ({origin}): censored "
         "maximum-likelihood fits of an exponential tail S ∝ exp(−γt) and an algebraic one "
         "S ∝ t^−α with exact 95 % intervals; the tail law is the one whose AIC is lower by "
         f"more than {AIC_MARGIN:g}, undecided otherwise. A kicked system escapes like the "

@@ -9,9 +9,10 @@ import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 
-from kicktimes.report.common import Section, fmt
+from kicktimes.render.figures import check_frame, plain_log_ticks, x_axis
+from kicktimes.render.pages import number_text
+from kicktimes.report.context import Section
 from kicktimes.report.counts import counts_by_radius, experiment_kinetic, kinetic_rate_of
-from kicktimes.report.figures import check_frame, plain_log_ticks, x_axis
 
 __all__ = ["rate_heterogeneity", "sections"]
 
@@ -309,12 +310,12 @@ def sections(ctx):
         f"{int((het['pvalue_mc'] < alpha).sum())}/{len(het)} radii (Pearson χ² given the total, "
         f"Monte Carlo p-value at resolution 1/{n_mc + 1}; the asymptotic χ² p-value, in the "
         f"table, rejects at {int((het['pvalue'] < alpha).sum())}); the index of dispersion of "
-        f"the counts ranges from {fmt(het['dispersion_index'].min())} to "
-        f"{fmt(het['dispersion_index'].max())} (1 for a common Poisson rate); "
+        f"the counts ranges from {number_text(het['dispersion_index'].min())} to "
+        f"{number_text(het['dispersion_index'].max())} (1 for a common Poisson rate); "
         f"{int(het['n_flagged_fdr'].sum())} (IC, radius) pairs have a rate incompatible with "
         "the pooled one after FDR control. The median per-IC rate is "
-        f"{fmt((het['median_rate'] / het['kinetic_rate']).min())} to "
-        f"{fmt((het['median_rate'] / het['kinetic_rate']).max())} times the kinetic rate."
+        f"{number_text((het['median_rate'] / het['kinetic_rate']).min())} to "
+        f"{number_text((het['median_rate'] / het['kinetic_rate']).max())} times the kinetic rate."
     )
     sec.table("rate_homogeneity", het, "Rate homogeneity per radius")
     return [sec]

@@ -13,8 +13,9 @@ import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 
-from kicktimes.report.common import Section, nearest
-from kicktimes.report.figures import TIME_UNIT, check_times, finite, new_axes
+from kicktimes.render.figures import TIME_UNIT, check_times, finite, new_axes
+from kicktimes.report.context import Section
+from kicktimes.report.store import nearest
 
 __all__ = ["TimesFit", "kth_time_fit", "kick_times_vs_collision_times", "rescaled_intervals",
            "time_rescaling_qq", "sections"]

@@ -16,9 +16,7 @@ import pandas as pd
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
-from kicktimes.report.common import REFERENCE, Section, distinct, fmt, kicked_systems, wide
-from kicktimes.report.effects import Effect, store_ratio
-from kicktimes.report.figures import (
+from kicktimes.render.figures import (
     DIAGNOSTIC_LABELS,
     SCATTER_SYSTEMS,
     kick_groups,
@@ -26,6 +24,10 @@ from kicktimes.report.figures import (
     system_label,
     system_style,
 )
+from kicktimes.render.pages import number_text
+from kicktimes.report.context import Section
+from kicktimes.report.effects import Effect, store_ratio
+from kicktimes.report.store import REFERENCE, distinct, kicked_systems, wide
 from kicktimes.report.summary import diagnostic_summary, diagnostic_vs_radius
 from kicktimes.stats import stretching_per_perturbation
 
@@ -237,10 +239,12 @@ def sections(ctx):
             slope = float(np.sum(x * ok.to_numpy()) / np.sum(x * x))
         parts.append(
             f"{system_label(system)}: at r = {r0:g} the stretching per perturbation is "
-            f"{fmt(ref.loc[r0, 'stretch_per_perturbation'])} nats per disk-disk collision "
-            f"against {fmt(part.loc[r0, 'stretch_per_perturbation'])} per kick, an excess of "
-            f"{fmt(excess.loc[r0])} nats (ln(1/r) = {fmt(np.log(1 / r0))}); least-squares "
-            f"slope of the excess on ln(1/r) through 0: {fmt(slope)} (1 if the excess is "
+            f"{number_text(ref.loc[r0, 'stretch_per_perturbation'])} nats per disk-disk collision "
+            f"against {number_text(part.loc[r0, 'stretch_per_perturbation'])} per kick, an excess "
+            f"of "
+            f"{number_text(excess.loc[r0])} nats (ln(1/r) = {number_text(np.log(1 / r0))}); "
+            f"least-squares "
+            f"slope of the excess on ln(1/r) through 0: {number_text(slope)} (1 if the excess is "
             "ln(1/r))"
         )
     if parts:
@@ -269,14 +273,15 @@ def effects(ctx):
         per_r, tot = store_ratio(ctx, lam[system], lam[REFERENCE])
         ref = table[table["system"] == REFERENCE].set_index("radius")
         kick = table[table["system"] == system].set_index("radius")
-        detail = f"per-radius ratio {fmt(per_r['ratio'].min())} to {fmt(per_r['ratio'].max())}"
+        detail = (f"per-radius ratio {number_text(per_r['ratio'].min())} to "
+                  f"{number_text(per_r['ratio'].max())}")
         if not ref.empty and not kick.empty:
             r0 = float(ref.index.min())
             detail += (
                 f"; stretching per perturbation at r = {r0:g}: "
-                f"{fmt(ref.loc[r0, 'stretch_per_perturbation'])} nats per collision vs "
-                f"{fmt(kick.loc[r0, 'stretch_per_perturbation'])} per kick "
-                f"(ln(1/r) = {fmt(np.log(1 / r0))})"
+                f"{number_text(ref.loc[r0, 'stretch_per_perturbation'])} nats per collision vs "
+                f"{number_text(kick.loc[r0, 'stretch_per_perturbation'])} per kick "
+                f"(ln(1/r) = {number_text(np.log(1 / r0))})"
             )
         out.append(
             Effect.of_ratio(

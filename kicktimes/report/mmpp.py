@@ -29,9 +29,10 @@ import pandas as pd
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
-from kicktimes.report.common import Section, pct
+from kicktimes.render.figures import check_frame, x_axis
+from kicktimes.render.pages import percent_text
+from kicktimes.report.context import Section
 from kicktimes.report.effects import Effect, clopper_pearson
-from kicktimes.report.figures import check_frame, x_axis
 
 __all__ = ["MIN_EVENTS", "fit_job", "mmpp_comparison", "sections", "effects"]
 
@@ -340,10 +341,12 @@ def sections(ctx):
     )
     shares = _share_rows(ok, "radius")
     clustered = ok[ok["mmpp_beats_poisson"]]
-    text = (f"The MMPP-2 is AIC-best for {pct(ok['mmpp_best'].mean())} of the {len(ok)} fitted "
-            f"ICs ({pct(ok['null_mmpp_best'].mean())} of their Poisson twins) and beats Poisson "
-            f"for {pct(ok['mmpp_beats_poisson'].mean())} "
-            f"({pct(ok['null_mmpp_beats_poisson'].mean())} of the twins).")
+    text = (f"The MMPP-2 is AIC-best for {percent_text(ok['mmpp_best'].mean())} of the {len(ok)} "
+            f"fitted "
+            f"ICs ({percent_text(ok['null_mmpp_best'].mean())} of their Poisson twins) and beats "
+            f"Poisson "
+            f"for {percent_text(ok['mmpp_beats_poisson'].mean())} "
+            f"({percent_text(ok['null_mmpp_beats_poisson'].mean())} of the twins).")
     if len(clustered):
         ratio = clustered["rate_high"] / clustered["rate_low"]
         text += (f" Where it beats Poisson, the high rate is a median "
@@ -387,8 +390,9 @@ def effects(ctx):
             quantity="share of fitted ICs whose AIC-best model (Poisson, renewal models, "
                      "MMPP-2) is the MMPP-2",
             verdict=verdict,
-            detail=(f"the MMPP-2 beats Poisson for {pct(ok['mmpp_beats_poisson'].mean())} of "
-                    f"the ICs ({pct(ok['null_mmpp_beats_poisson'].mean())} of the twins); "
+            detail=(f"the MMPP-2 beats Poisson for "
+                    f"{percent_text(ok['mmpp_beats_poisson'].mean())} of "
+                    f"the ICs ({percent_text(ok['null_mmpp_beats_poisson'].mean())} of the twins); "
                     "AIC-best otherwise: " + ", ".join(f"{m} {c}" for m, c in others.items())),
             **share,
         )

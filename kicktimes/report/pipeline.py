@@ -27,19 +27,10 @@ from contextlib import closing, contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
+from kicktimes._validation import check_int, check_real
 from kicktimes.memory import fewer_collections, keep_freed_memory
-from kicktimes.report._cache import ReportCache, content_key, store_key
-from kicktimes.report.common import (
-    Context,
-    Mapper,
-    Progress,
-    check_fraction,
-    check_int,
-    load_report_store,
-)
-from kicktimes.report.html import (
+from kicktimes.render.html import (
     embed_figures,
-    store_header,
     table_html,
     toc_item,
     write_outputs,
@@ -47,6 +38,9 @@ from kicktimes.report.html import (
     write_table,
     write_text,
 )
+from kicktimes.report._cache import ReportCache, content_key, store_key
+from kicktimes.report.context import Context, Mapper, Progress
+from kicktimes.report.store import load_report_store, store_header
 
 __all__ = ["build_report", "analyse", "STAGES"]  # noqa: F822 (STAGES: module __getattr__)
 
@@ -283,7 +277,7 @@ def families_section(stores):
     autocorrelation of every family are in each family's fig05 and fig07, and their ratios
     to the two-disk values, both families together, in the Findings' fig00.)"""
     from kicktimes.report import recurrence
-    from kicktimes.report.common import Section
+    from kicktimes.report.context import Section
 
     sec = Section("families", "Diagnostics against radius, all experiments")
     rr = recurrence.family_figure(stores)
@@ -452,17 +446,18 @@ def _check_options(out_dir, *, progress, alpha, n_mc, max_ics_tests, max_ics_mod
     if not isinstance(out_dir, str | os.PathLike):
         raise TypeError(f"out_dir must be a path, got {type(out_dir).__name__}")
     options = {
-        "alpha": check_fraction("alpha", alpha),
-        "n_mc": check_int("n_mc", n_mc, 19),
-        "max_ics_tests": check_int("max_ics_tests", max_ics_tests, 2, allow_none=True),
-        "max_ics_model_fits": check_int("max_ics_model_fits", max_ics_model_fits, 1),
-        "max_pooled_intervals": check_int("max_pooled_intervals", max_pooled_intervals, 100),
-        "n_boot": check_int("n_boot", n_boot, 100),
-        "tolerance": check_fraction("tolerance", tolerance),
+        "alpha": check_real("alpha", alpha, low=0, high=1),
+        "n_mc": check_int("n_mc", n_mc, low=19),
+        "max_ics_tests": (None if max_ics_tests is None
+                          else check_int("max_ics_tests", max_ics_tests, low=2)),
+        "max_ics_model_fits": check_int("max_ics_model_fits", max_ics_model_fits, low=1),
+        "max_pooled_intervals": check_int("max_pooled_intervals", max_pooled_intervals, low=100),
+        "n_boot": check_int("n_boot", n_boot, low=100),
+        "tolerance": check_real("tolerance", tolerance, low=0, high=1),
         "escape_t_min": _check_t_min(escape_t_min),
     }
-    render = {"dpi": check_int("dpi", dpi, 30), "pdf": pdf}
-    workers = check_int("workers", (os.cpu_count() or 1) if workers is None else workers, 1)
+    render = {"dpi": check_int("dpi", dpi, low=30), "pdf": pdf}
+    workers = check_int("workers", (os.cpu_count() or 1) if workers is None else workers, low=1)
     for flag, value in (("pdf", pdf), ("force", force)):
         if not isinstance(value, bool):
             raise TypeError(f"{flag} must be True or False, got {type(value).__name__}")

@@ -17,10 +17,7 @@ import pandas as pd
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
-from kicktimes.report.common import Section, fmt_rho, pct, seeded_rng, spearman
-from kicktimes.report.counts import experiment_kinetic, kinetic_rate_of
-from kicktimes.report.effects import SHARE_RULE, Effect, share_verdict
-from kicktimes.report.figures import (
+from kicktimes.render.figures import (
     check_alpha,
     check_frame,
     dodge,
@@ -28,7 +25,11 @@ from kicktimes.report.figures import (
     new_axes,
     x_axis,
 )
-from kicktimes.stats import clopper_pearson, format_interval, resample_counts
+from kicktimes.render.pages import percent_text, rho_text
+from kicktimes.report.context import Section, seeded_rng
+from kicktimes.report.counts import experiment_kinetic, kinetic_rate_of
+from kicktimes.report.effects import SHARE_RULE, Effect, share_verdict
+from kicktimes.stats import clopper_pearson, format_interval, resample_counts, spearman
 from kicktimes.stats.poisson import TEST_NULLS
 
 __all__ = [
@@ -349,14 +350,14 @@ def sections(ctx):
         t = t.sort_values("radius")
         rho, p = spearman(t["radius"], t["rate"])
         lines.append(
-            f"{test}: {pct(t['rate'].iloc[0])} at r = {t['radius'].iloc[0]:g}, "
-            f"{pct(t['rate'].iloc[-1])} at r = {t['radius'].iloc[-1]:g} "
-            f"(Spearman ρ with r: {fmt_rho(rho, p)})"
+            f"{test}: {percent_text(t['rate'].iloc[0])} at r = {t['radius'].iloc[0]:g}, "
+            f"{percent_text(t['rate'].iloc[-1])} at r = {t['radius'].iloc[-1]:g} "
+            f"(Spearman ρ with r: {rho_text(rho, p)})"
         )
     above = rejections[rejections["ci_low"] > alpha]
     tested = rejections[rejections["n_tested"] > 0]
     sec.text(
-        f"Under the null each test rejects {pct(alpha)} of ICs. Rejection rates — "
+        f"Under the null each test rejects {percent_text(alpha)} of ICs. Rejection rates — "
         + "; ".join(lines)
         + f". The 95% interval lies above α for {len(above)} of {len(tested)} "
         f"(test, radius) cells with tested ICs; the Fisher-combined p-value is below {alpha:g} for "
@@ -370,15 +371,15 @@ def sections(ctx):
             "Control: the same tests on the sweep's own Poisson kick times of each run (rate "
             "n_pp / t_window, cut at the same window; Poisson by construction) reject "
             + "; ".join(f"{TEST_TITLES.get(t, t)} "
-                        f"{pct(row.control_n_reject / row.control_n_tested)}"
+                        f"{percent_text(row.control_n_reject / row.control_n_tested)}"
                         for t, row in c.iterrows() if row.control_n_tested > 0)
-            + f" of them, against the nominal {pct(alpha)}."
+            + f" of them, against the nominal {percent_text(alpha)}."
         )
     t = rejections[headline].sort_values("radius")
     sec.text(
         f"At a fixed number of intervals ({HEADLINE_TEST} on the first {FIXED_EVENTS} "
         "collisions of every run that has them, so every radius has the same power): "
-        + ", ".join(f"{pct(v)} at r = {r:g} ({int(n)} runs)" for r, v, n in
+        + ", ".join(f"{percent_text(v)} at r = {r:g} ({int(n)} runs)" for r, v, n in
                     zip(t["radius"], t["rate_fixed"], t["n_tested_fixed"], strict=True))
         + "."
     )
@@ -471,7 +472,7 @@ def null_calibration(name, rejections, per_ic, *, alpha, rng, n_boot=2000) -> pd
     over radii, with the interval the data's row has: for the headline test a bootstrap
     clustered on ICs (``per_ic["control_p"]``), for the others Clopper-Pearson on the
     counts (runs of one IC at different radii counted apart). The columns are those of
-    `kicktimes.report.pages.NULL_CALIBRATION_COLUMNS` without ``study`` and ``verdict``.
+    `kicktimes.render.pages.NULL_CALIBRATION_COLUMNS` without ``study`` and ``verdict``.
     """
 
     totals = rejections.groupby("test", sort=False, observed=True)[
@@ -525,7 +526,7 @@ def effects(ctx):
         "inconclusive": "consistent with Poisson at this sample size",
     }[verdict]
     others = "; ".join(
-        f"{t} {pct(row.n_reject / row.n_tested)}"
+        f"{t} {percent_text(row.n_reject / row.n_tested)}"
         for t, row in totals.iterrows()
         if t != HEADLINE_TEST and row.n_tested > 0
     )
@@ -549,12 +550,13 @@ def effects(ctx):
             method=(f"bootstrap clustered on {per_ic['ic'].nunique()} ICs ({n} runs at "
                     f"{per_ic['radius'].nunique()} radii)"),
             detail=(
-                f"{pct(by_r['rate'].iloc[0])} at r = {by_r['radius'].iloc[0]:g}, "
-                f"{pct(by_r['rate'].iloc[-1])} at r = {by_r['radius'].iloc[-1]:g}; at a fixed "
+                f"{percent_text(by_r['rate'].iloc[0])} at r = {by_r['radius'].iloc[0]:g}, "
+                f"{percent_text(by_r['rate'].iloc[-1])} at r = {by_r['radius'].iloc[-1]:g}; at a "
+                f"fixed "
                 f"{FIXED_EVENTS} collisions per run "
                 f"{format_interval(100 * fixed_share, 100 * f_low, 100 * f_high)} % "
-                f"({pct(by_r['rate_fixed'].iloc[0])} at r = "
-                f"{by_r['radius'].iloc[0]:g}, {pct(by_r['rate_fixed'].iloc[-1])} at r = "
+                f"({percent_text(by_r['rate_fixed'].iloc[0])} at r = "
+                f"{by_r['radius'].iloc[0]:g}, {percent_text(by_r['rate_fixed'].iloc[-1])} at r = "
                 f"{by_r['radius'].iloc[-1]:g}); other tests (pooled): {others}"
             ),
         )

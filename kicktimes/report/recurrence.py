@@ -23,17 +23,11 @@ import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 
-from kicktimes.report.common import (
-    REFERENCE,
-    Section,
-    distinct,
-    eps_values,
-    fmt,
-    kicked_systems,
-    wide,
-)
+from kicktimes.render.figures import plain_ticks, radius_axis, shared_legend
+from kicktimes.render.pages import number_text
+from kicktimes.report.context import Section
 from kicktimes.report.effects import Effect, store_ratio
-from kicktimes.report.figures import plain_ticks, radius_axis, shared_legend
+from kicktimes.report.store import REFERENCE, distinct, eps_values, kicked_systems, wide
 from kicktimes.report.summary import diagnostic_summary, diagnostic_vs_radius
 
 __all__ = ["recurrence_rows", "sampling_statement", "rr_figure", "family_figure", "sections",
@@ -430,9 +424,10 @@ def sections(ctx):
             continue
         share = 1.0 / (n * rr["mean"])
         sec.text(
-            f"ε = {e:g}: the two-particle RR is {fmt(rr['mean'].min() * n)}/N to "
-            f"{fmt(rr['mean'].max() * n)}/N over the radii, so the main diagonal is "
-            f"{fmt(100 * share.min())}–{fmt(100 * share.max())} % of it; compare the systems "
+            f"ε = {e:g}: the two-particle RR is {number_text(rr['mean'].min() * n)}/N to "
+            f"{number_text(rr['mean'].max() * n)}/N over the radii, so the main diagonal is "
+            f"{number_text(100 * share.min())}–{number_text(100 * share.max())} % of it; compare "
+            f"the systems "
             "on the off-diagonal rate and DET, not on the paper's RR."
         )
     sec.table(
@@ -541,10 +536,10 @@ def effects(ctx):
                         tot,
                         tolerance=ctx.tolerance,
                         detail=(
-                            f"per-radius ratio {fmt(per_r['ratio'].min())} to "
-                            f"{fmt(per_r['ratio'].max())}; ratio of per-radius medians "
-                            f"{fmt((med[system] / med[REFERENCE]).min())} to "
-                            f"{fmt((med[system] / med[REFERENCE]).max())}"
+                            f"per-radius ratio {number_text(per_r['ratio'].min())} to "
+                            f"{number_text(per_r['ratio'].max())}; ratio of per-radius medians "
+                            f"{number_text((med[system] / med[REFERENCE]).min())} to "
+                            f"{number_text((med[system] / med[REFERENCE]).max())}"
                         ),
                     )
                 )

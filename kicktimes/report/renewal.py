@@ -13,9 +13,10 @@ import pandas as pd
 from matplotlib.figure import Figure
 from matplotlib.patches import Patch
 
-from kicktimes.report.common import Section, pct
+from kicktimes.render.figures import check_frame, finite, x_axis
+from kicktimes.render.pages import percent_text
+from kicktimes.report.context import Section
 from kicktimes.report.effects import SHARE_RULE, Effect, clopper_pearson, share_verdict
-from kicktimes.report.figures import check_frame, finite, x_axis
 from kicktimes.report.poisson import binomial_ci, subsample
 from kicktimes.stats.analyze import MIN_INTERVALS
 
@@ -286,9 +287,10 @@ def sections(ctx):
             lambda b: (b == "exponential").mean()
         )
         sec.text(
-            f"Per IC, the exponential (Poisson) model is AIC-best for {pct(exp_share.mean())} "
-            f"of the fitted ICs on average over radii (from {pct(exp_share.min())} to "
-            f"{pct(exp_share.max())}); {len(best) - len(fitted)} ICs had fewer than "
+            f"Per IC, the exponential (Poisson) model is AIC-best for "
+            f"{percent_text(exp_share.mean())} "
+            f"of the fitted ICs on average over radii (from {percent_text(exp_share.min())} to "
+            f"{percent_text(exp_share.max())}); {len(best) - len(fitted)} ICs had fewer than "
             f"{MIN_INTERVALS} intervals and were not fitted."
         )
     if not pooled.empty:
@@ -365,7 +367,8 @@ def effects(ctx):
             system="",
             quantity="share of fitted ICs whose AIC-best model is the exponential",
             verdict=verdict,
-            detail=(f"under Poisson times {pct(level)} of the same fits pick the exponential; "
+            detail=(f"under Poisson times {percent_text(level)} of the same fits pick the "
+                    f"exponential; "
                     "AIC-best counts: " + detail),
             **share,
         )

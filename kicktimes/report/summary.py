@@ -10,9 +10,7 @@ import numpy as np
 import pandas as pd
 from matplotlib.lines import Line2D
 
-from kicktimes.report.common import REFERENCE, Section, distinct
-from kicktimes.report.escape import ESCAPE_ROWS
-from kicktimes.report.figures import (
+from kicktimes.render.figures import (
     _PAPER_BAR,
     _SEM_BAR,
     DIAGNOSTIC_LABELS,
@@ -26,6 +24,9 @@ from kicktimes.report.figures import (
     system_label,
     system_style,
 )
+from kicktimes.report.context import Section
+from kicktimes.report.escape import ESCAPE_ROWS
+from kicktimes.report.store import REFERENCE, distinct
 
 __all__ = ["diagnostic_summary", "diagnostic_vs_radius", "comparison_table", "sections"]
 

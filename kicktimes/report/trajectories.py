@@ -16,8 +16,10 @@ from matplotlib.colors import LogNorm
 from matplotlib.figure import Figure
 from matplotlib.ticker import MaxNLocator
 
-from kicktimes.report.common import REFERENCE, Section, eps_values, nearest, pct
-from kicktimes.report.figures import TIME_UNIT, check_frame, finite, new_axes
+from kicktimes.render.figures import TIME_UNIT, check_frame, finite, new_axes
+from kicktimes.render.pages import percent_text
+from kicktimes.report.context import Section
+from kicktimes.report.store import REFERENCE, eps_values, nearest
 
 __all__ = ["poincare_section", "poincare_panels", "recurrence_plot", "line_pairs", "sections"]
 
@@ -425,7 +427,7 @@ def sections(ctx):
     parts = [
         f"r = {row.radius:g}: {row.n_boundary_disk0} boundary collisions of disk 0 and "
         f"{row.n_pp} disk-disk collisions in t = {row.t_max:.4g}; "
-        f"{pct(row.share_sin_theta_kept)} of consecutive boundary collisions keep sin θ "
+        f"{percent_text(row.share_sin_theta_kept)} of consecutive boundary collisions keep sin θ "
         f"(the horizontal segments of regular motion), {row.n_distinct_sin_theta} distinct "
         f"values of sin θ"
         for row in table.itertuples()

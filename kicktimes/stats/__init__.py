@@ -36,6 +36,7 @@ from .bootstrap import (
     resample_indices,
 )
 from .comparison import VuongResult, compare_models, vuong
+from .correlation import spearman
 from .counts import STICKY_FACTOR, CountRegression, is_sticky, kinetic_rate, regress_counts
 from .dilute import DiluteEstimate, DiluteTaggedDisk, dilute_tagged_disk, dilute_tagged_times
 from .distributions import hyperexpon
@@ -141,6 +142,7 @@ __all__ = [
     "MARGIN",
     "clopper_pearson",
     "robust_verdict",
+    "spearman",
     "share_ratio_sample_size",
     "format_interval",
     "rejection_verdict",

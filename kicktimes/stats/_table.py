@@ -194,6 +194,13 @@ def _frame(name, value):
     raise TypeError(f"{name} must be a DataFrame or a CSV/Parquet path, got {type(value).__name__}")
 
 
+def _merge_per_sequence(values, col, series):
+    """Put ``series`` (one value per sequence) into ``values[col]``, keeping the values
+    an earlier table gave."""
+    prev = values.get(col)
+    values[col] = series if prev is None else prev.combine_first(series)
+
+
 def event_table(
     events,
     *,
@@ -379,25 +386,20 @@ def event_table(
         labels = list(labels)
         _check_names(**{f"labels[{k}]": c for k, c in enumerate(labels)})
         wanted = [c for c in wanted if c not in labels]
+    def holders(col):
+        """``(table, its rows' sequence ids)`` for each table that has ``col``, lazily."""
+        return ((df, wid if df is win else _ids(df, sequence)) for df in sources
+                if col in df.columns)
+
     for col in labels or []:
-        found = False
-        for df in sources:
-            if col not in df.columns:
-                continue
-            found = True
-            ids = wid if df is win else _ids(df, sequence)
-            series = _text_per_sequence(df, ids, col)
-            prev = label_values.get(col)
-            label_values[col] = series if prev is None else prev.combine_first(series)
-        if not found:
+        if not any(col in df.columns for df in sources):
             raise ValueError(f"labels: no table has a column {col!r}")
+        for df, ids in holders(col):
+            _merge_per_sequence(label_values, col, _text_per_sequence(df, ids, col))
     for col in wanted:
-        found = False
-        for df in sources:
-            if col not in df.columns:
-                continue
-            found = True
-            ids = wid if df is win else _ids(df, sequence)
+        if not any(col in df.columns for df in sources):
+            raise ValueError(f"covariates: no table has a column {col!r}")
+        for df, ids in holders(col):
             if auto and pd.to_numeric(df[col], errors="coerce").isna().all():
                 # a text label (e.g. a material name): kept as a label, out of the
                 # regressions; an event-level text column (not constant) is dropped
@@ -406,8 +408,7 @@ def event_table(
                 except ValueError:
                     label_values.pop(col, None)
                     break
-                prev = label_values.get(col)
-                label_values[col] = series if prev is None else prev.combine_first(series)
+                _merge_per_sequence(label_values, col, series)
                 continue
             try:
                 values = _numeric(df, col, allow_missing=False)
@@ -418,10 +419,7 @@ def event_table(
                     cov_values.pop(col, None)
                     break
                 raise
-            prev = cov_values.get(col)
-            cov_values[col] = series if prev is None else prev.combine_first(series)
-        if not found:
-            raise ValueError(f"covariates: no table has a column {col!r}")
+            _merge_per_sequence(cov_values, col, series)
     for col, series in list(cov_values.items()):
         lacking = [s for s in order if s not in series.index]
         if lacking and auto:

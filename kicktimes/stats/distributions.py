@@ -379,6 +379,13 @@ def fit_hyperexponential(complete, censored=None, *, n_em=40, max_polish=500, em
     # of equal likelihood: it is kept only if it is at least as good as the EM start
     if not ll_polish >= best[0]:
         theta = best[1]
+    return _mixture_fit(theta, x, c)
+
+
+def _mixture_fit(theta, x, c):
+    """``(p, lam1, lam2, loglik)`` of the fitted ``theta = (logit p, log lam1, log lam2)``:
+    the weight's logit clipped to +-37 (p within 1e-16 of 0 or 1 is a boundary fit), the
+    faster component first, and the censored log-likelihood at those values."""
     theta = np.array([np.clip(theta[0], -37.0, 37.0), theta[1], theta[2]])
     p, lam1, lam2 = float(expit(theta[0])), float(np.exp(theta[1])), float(np.exp(theta[2]))
     if lam1 < lam2:
@@ -467,11 +474,4 @@ def _fit_hyperexponential_reference(complete, censored=None, *, n_em=40, max_pol
         options={"maxiter": max_polish, "gtol": 1e-9},
     )
     theta = res.x if np.isfinite(res.fun) and -res.fun * n_obs >= best[0] else best[1]
-    theta = np.array([np.clip(theta[0], -37.0, 37.0), theta[1], theta[2]])
-    p, lam1, lam2 = float(expit(theta[0])), float(np.exp(theta[1])), float(np.exp(theta[2]))
-    if lam1 < lam2:
-        p, lam1, lam2 = 1.0 - p, lam2, lam1
-    ax, bx = _log_components(x, p, lam1, lam2, density=True)
-    ac, bc = _log_components(c, p, lam1, lam2, density=False)
-    ll = np.logaddexp(ax, bx).sum() + np.logaddexp(ac, bc).sum()
-    return p, lam1, lam2, float(ll)
+    return _mixture_fit(theta, x, c)

@@ -49,6 +49,7 @@ from numbers import Integral
 from pathlib import Path
 
 from kicktimes.fileio import atomic_write
+from kicktimes.render.pages import write_results_page
 
 __all__ = ["StudyRun", "check_scale", "check_workers", "study_run"]
 
@@ -108,11 +109,11 @@ class StudyRun:
         """``fig`` as the PNG ``results/name``, atomically."""
         atomic_write(self.results / name, lambda tmp: fig.savefig(tmp, dpi=dpi, format="png"))
 
-    def write_page(self, lines) -> Path:
-        """The page ``results/<name>.md`` from its Markdown ``lines``; returns its path."""
-        page = self.results / f"{self.name}.md"
-        atomic_write(page, lambda tmp: Path(tmp).write_text("\n".join(lines),
-                                                            encoding="utf-8"))
+    def write_page(self, lines, sources) -> Path:
+        """The page ``results/<name>.md`` from its Markdown ``lines``, closed by the table
+        of its ``sources`` (`kicktimes.render.pages.write_results_page`); returns its
+        path."""
+        page = write_results_page(self.results / f"{self.name}.md", lines, sources)
         self.say(f"{self.name}: {page} written")
         return page
 

@@ -51,7 +51,13 @@ from kicktimes.billiard.kernels import calendar as cal
 from kicktimes.billiard.kernels import cells
 from kicktimes.billiard.kernels import observe as ob
 from kicktimes.billiard.kernels.tangent import BIG, pair_tangent, wall_tangent
-from kicktimes.billiard.kernels.two import anchor_energy, pair_event, wall_event
+from kicktimes.billiard.kernels.two import (
+    anchor_energy,
+    mass_factors,
+    pair_energy,
+    pair_event,
+    wall_event,
+)
 
 __all__ = ["CROSS", "NONE", "PREDICT", "REORDER", "WALL", "drive", "final_state", "relabel",
            "setup", "tangent_at", "tangent_back"]
@@ -280,14 +286,10 @@ def collide(i, j, now, fs, rule, mass, tan, box, clock):
     if mass is not None:
         mi = mass[i]
         mj = mass[j]
-        ki = 2.0 * mj / (mi + mj)
-        kj = 2.0 * mi / (mi + mj)
+        ki, kj = mass_factors(mi, mj)
     ai2, bi2, aj2, bj2 = pair_event(xi, yi, ai, bi, xj, yj, aj, bj, rule, ki, kj)
     if rule != 0:
-        if ki == 1.0 and kj == 1.0:
-            e = ai * ai + bi * bi + aj * aj + bj * bj
-        else:
-            e = kj * (ai * ai + bi * bi) + ki * (aj * aj + bj * bj)
+        e = pair_energy(ai, bi, aj, bj, ki, kj)
         ai2, bi2, aj2, bj2 = anchor_energy(ai2, bi2, aj2, bj2, e, ki, kj)
     fs[i, VX] = ai2
     fs[i, VY] = bi2

@@ -298,13 +298,8 @@ def _ftle(st0, rho, mode, n_steps, tau, track, offsets, measure, d0, max_defer, 
                 traj[j, q + 2] = c2
                 traj[j, q + 3] = d2
             if pair is not None:
-                if rho[2] == 1.0 and rho[3] == 1.0:
-                    traj[j, 10] = (traj[j, 3] * traj[j, 3] + traj[j, 4] * traj[j, 4]
-                                   + traj[j, 7] * traj[j, 7] + traj[j, 8] * traj[j, 8])
-                else:  # the kernels' energy with masses (kernels.two.anchor_energy)
-                    traj[j, 10] = (rho[3] * (traj[j, 3] * traj[j, 3] + traj[j, 4] * traj[j, 4])
-                                   + rho[2] * (traj[j, 7] * traj[j, 7]
-                                               + traj[j, 8] * traj[j, 8]))
+                traj[j, 10] = two.pair_energy(traj[j, 3], traj[j, 4], traj[j, 7], traj[j, 8],
+                                              rho[2], rho[3])
                 two.init_events(traj[j], ev[j], rho, sigma)
             if kick is not None:
                 ev[j, 0] = boundary_hit_time(traj[j, 1], traj[j, 2], traj[j, 3], traj[j, 4],

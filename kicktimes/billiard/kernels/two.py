@@ -59,9 +59,9 @@ from kicktimes.billiard.geometry import (
     reflect,
 )
 
-__all__ = ["PAIR", "table", "advance", "anchor_energy", "disk", "init_events", "load", "next_event",
-           "pair_event", "process_event", "process_event_at", "resolve", "step", "store",
-           "wall_event"]
+__all__ = ["PAIR", "table", "advance", "anchor_energy", "mass_factors", "pair_energy", "disk",
+           "init_events", "load", "next_event", "pair_event", "process_event", "process_event_at",
+           "resolve", "step", "store", "wall_event"]
 
 #: fields of the state tuple
 (S_T, S_COMP, S_X0, S_Y0, S_VX0, S_VY0, S_X1, S_Y1, S_VX1, S_VY1, S_TB0, S_TB1,
@@ -120,8 +120,25 @@ def table(rho0, rho1, m0=1.0, m1=1.0) -> tuple:
     """The disks' table ``(rho0, rho1, k0, k1)`` the kernels take as ``rho``: the room
     left to each centre and the elastic rule's momentum-exchange factors
     ``k0 = 2 m1 / (m0 + m1)``, ``k1 = 2 m0 / (m0 + m1)`` (1 and 1 for equal masses)."""
-    m0, m1 = float(m0), float(m1)
-    return (float(rho0), float(rho1), 2.0 * m1 / (m0 + m1), 2.0 * m0 / (m0 + m1))
+    k0, k1 = mass_factors(float(m0), float(m1))
+    return (float(rho0), float(rho1), k0, k1)
+
+
+@njit(cache=True, error_model="numpy")
+def mass_factors(m0, m1):
+    """The elastic rule's momentum-exchange factors of disks of masses ``m0`` and ``m1``:
+    ``(k0, k1) = (2 m1 / (m0 + m1), 2 m0 / (m0 + m1))``, ``(1, 1)`` for equal masses."""
+    return 2.0 * m1 / (m0 + m1), 2.0 * m0 / (m0 + m1)
+
+
+@njit(cache=True, error_model="numpy")
+def pair_energy(vx0, vy0, vx1, vy1, k0=1.0, k1=1.0):
+    """Twice the pair's kinetic energy in the kernels' units: ``|v0|^2 + |v1|^2`` for
+    equal masses, ``k1 |v0|^2 + k0 |v1|^2`` (proportional to ``m0 |v0|^2 + m1 |v1|^2``)
+    with the mass factors of `mass_factors`; the anchor of the elastic rule."""
+    if k0 == 1.0 and k1 == 1.0:
+        return vx0 * vx0 + vy0 * vy0 + vx1 * vx1 + vy1 * vy1
+    return k1 * (vx0 * vx0 + vy0 * vy0) + k0 * (vx1 * vx1 + vy1 * vy1)
 
 
 @njit(cache=True, error_model="numpy")
@@ -154,11 +171,7 @@ def anchor_energy(vx0, vy0, vx1, vy1, e0, k0=1.0, k1=1.0):
     10^6 events accumulate to 1e-10; anchoring to the initial value does not. With masses
     the energy is ``k1 |v0|^2 + k0 |v1|^2`` (proportional to ``m0 |v0|^2 + m1 |v1|^2``).
     """
-    if k0 == 1.0 and k1 == 1.0:
-        e = vx0 * vx0 + vy0 * vy0 + vx1 * vx1 + vy1 * vy1
-    else:
-        e = k1 * (vx0 * vx0 + vy0 * vy0) + k0 * (vx1 * vx1 + vy1 * vy1)
-    f = 1.5 - 0.5 * e / e0
+    f = 1.5 - 0.5 * pair_energy(vx0, vy0, vx1, vy1, k0, k1) / e0
     return vx0 * f, vy0 * f, vx1 * f, vy1 * f
 
 

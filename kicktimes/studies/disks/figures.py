@@ -14,7 +14,7 @@ import numpy as np
 from matplotlib.lines import Line2D
 from matplotlib.ticker import FuncFormatter
 
-from kicktimes.report.figures import plain_log_ticks
+from kicktimes.render.figures import plain_log_ticks
 from kicktimes.studies.disks.tables import HAZARD_EDGES
 
 __all__ = ["controls_figure", "geometries_of", "hazard_figure", "rates_figure",

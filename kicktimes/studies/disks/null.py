@@ -17,7 +17,7 @@ per run). Designs:
 The share a test rejects on these streams is the level a Poisson (or a dilute-gas) process
 gives through the page's pipeline: the calibrated level of `kicktimes.stats.poisson_verdict`
 (`calibration_rows` writes them to ``docs/results/null_calibration.csv`` through
-`kicktimes.report.pages.write_null_calibration`).
+`kicktimes.render.pages.write_null_calibration`).
 """
 
 from __future__ import annotations
@@ -123,7 +123,7 @@ def null_rows(store, *, designs=None, alpha=0.05, n_boot=999, n_mc=199, seed=0):
 
 
 def calibration_rows(null_table, *, alpha=0.05):
-    """The rows of ``null_calibration.csv`` (`kicktimes.report.pages.write_null_calibration`)
+    """The rows of ``null_calibration.csv`` (`kicktimes.render.pages.write_null_calibration`)
     from `null_rows` tables: one per (geometry, rule, N), test and design; the speed-rescaled
     tests as ``"<test>, speed-rescaled"``. ``n_runs`` the tagged disks tested, ``n_clusters``
     the runs the bootstrap resamples."""

@@ -9,7 +9,9 @@ beside the page, draws the figures (`kicktimes.studies.disks.figures`) and write
 the answers first, each from the table through the verdict rules of `kicktimes.stats`,
 then one table per geometry with a row per N. `kicktimes.studies.disks.run.reproduce_disks`
 runs (or resumes) the sweeps and the gas's FTLE computations first: ``kicktimes reproduce
---study disks``.
+--study disks``. The page closes with the table of where its numbers come from
+(`kicktimes.render.pages.write_results_page`): the rows of `sources`, one per CSV beside
+it (or per group of its columns) and the function that computed them.
 """
 
 from __future__ import annotations
@@ -22,7 +24,17 @@ import numpy as np
 import pandas as pd
 
 from kicktimes import __version__
-from kicktimes.stats import format_interval, ratio_rule, rejection_rule
+from kicktimes.render.pages import write_results_page
+from kicktimes.render.provenance import Source
+from kicktimes.stats import (
+    format_interval,
+    paired_ratio,
+    poisson_verdict,
+    ratio_rule,
+    rejection_rule,
+    rejection_verdict,
+    share_ratio_sample_size,
+)
 from kicktimes.stats.findings import share_verdict
 from kicktimes.studies.disks.boltzmann import boltzmann_answer, boltzmann_lines, boltzmann_table
 from kicktimes.studies.disks.controls import (
@@ -35,6 +47,8 @@ from kicktimes.studies.disks.controls import (
     wall_share_lines,
     wall_shares,
 )
+from kicktimes.studies.disks.density import one_state as density_state
+from kicktimes.studies.disks.density import summarise as density_summary
 from kicktimes.studies.disks.figures import (
     ALPHA,
     HEADLINE,
@@ -47,6 +61,7 @@ from kicktimes.studies.disks.figures import (
     rates_figure,
     rejection_figure,
 )
+from kicktimes.studies.disks.ftle_check import pair as ftle_check_pair
 from kicktimes.studies.disks.kicked import (
     density_lines,
     ftle_check_lines,
@@ -66,10 +81,17 @@ from kicktimes.studies.disks.readings import (
     summary_lines,
 )
 from kicktimes.studies.disks.renewal import renewal_lines, renewal_models
-from kicktimes.studies.disks.tables import disks_hazard, disks_table, kicked_table, two_disk_check
+from kicktimes.studies.disks.tables import (
+    disks_hazard,
+    disks_table,
+    kicked_table,
+    sweep_cost,
+    two_disk_check,
+)
+from kicktimes.studies.disks.windows import summarise as windows_summary
 from kicktimes.studies.disks.windows import windows_lines
 
-__all__ = ["write_disks_page"]
+__all__ = ["ELASTIC_SOURCES", "SOURCES", "sources", "write_disks_page"]
 
 #: the controls figure shows N from here on (where the page's "becomes Poisson" is decided)
 CONTROLS_MIN_N = 10
@@ -377,9 +399,78 @@ def _left_out(table, long, kicked_stores, k, ftle_checked):
     return out
 
 
+#: the rows of the page's closing table, "where the numbers come from": per CSV beside the
+#: page (or per group of its columns) the columns the page quotes, each with its ``_low``,
+#: ``_high`` and ``_verdict`` columns where it has them, and the function that computes
+#: them. A CSV written only when its table is not empty (the controls, the kicked
+#: comparison, the two-disk check, the wall's share, the cost) or only by
+#: `kicktimes.studies.disks.run.reproduce_disks` (the FTLE checks, the FTLE against
+#: density, D against the window) is named only when it is there: `sources`
+SOURCES = (
+    Source("disks.csv", "radius, n_tagged, n_short, rate, rate_enskog, reject_uniformity_ks, "
+           "dispersion, hazard_first, hazard_peak, gamma_shape", disks_table),
+    Source("disks_poisson.csv", "share, null_level, share_verdict, d", poisson_readings),
+    Source("disks_poisson.csv", "verdict", poisson_verdict),
+    Source("disks_null.csv", "design, reject_uniformity_ks, dispersion", null_rows),
+    Source("null_calibration.csv", "share, ci_low, ci_high", null_rows),
+    Source("null_calibration.csv", "verdict", rejection_verdict),
+    Source("disks_controls.csv", "control, estimate, ci_low, ci_high, verdict, robust, "
+           "depends_on", controls_findings),
+    Source("disks_renewal.csv", "best, second, delta_aic_second, delta_aic_exponential, "
+           "stable", renewal_models),
+    Source("disks_boltzmann_kicks.csv", "gas, kicked, prediction, ratio, verdict, reading",
+           boltzmann_table),
+    Source("disks_hazard.csv", "t_mid, hazard, ci_low, ci_high, flat_pvalue", disks_hazard),
+    Source("disks_kicked.csv", "system, diagnostic, value, reference, ratio, verdict, n_runs",
+           kicked_table),
+    Source("disks_kicked_rate.csv", "kicked_rate, density_rate, ratio, verdict",
+           kicked_rate_check),
+    Source("disks_two_disk.csv", "engine, two_disk, ratio, ratio_verdict, rate_ratio",
+           two_disk_check),
+    Source("disks_two_disk.csv", "n_needed", share_ratio_sample_size),
+    Source("disks_wall_share.csv", "d_circle, d_box, share, reading", wall_shares),
+    Source("disks_dispersion_windows.csv", "d, prediction, ratio, verdict", windows_summary),
+    Source("disks_ftle_check.csv", "estimate, lo, hi", paired_ratio),
+    Source("disks_ftle_check_runs.csv", "numerator, denominator", ftle_check_pair),
+    Source("disks_lyapunov_density.csv", "lam_per_coll, lo, hi", density_summary),
+    Source("disks_lyapunov_density_fit.csv", "a, b, c, local_over_b, reading",
+           density_summary),
+    Source("disks_lyapunov_density_runs.csv", "lam, nu", density_state),
+    Source("disks_cost.csv", "cpu_seconds, wall_seconds", sweep_cost),
+)
+#: the rows of the columns only an elastic sweep has (the speed-rescaled reading)
+ELASTIC_SOURCES = (
+    Source("disks.csv", "speed_known, rescaled_reject_uniformity_ks, rescaled_dispersion, "
+           "speed_share", disks_table),
+    Source("disks_poisson.csv", "rescaled_null_level, rescaled_verdict, dilute_d",
+           poisson_readings),
+)
+
+
+def _has_table(path) -> bool:
+    """Whether ``path`` is a CSV with a header (an empty table is written as a blank line)."""
+    path = Path(path)
+    if not path.is_file():
+        return False
+    with path.open(encoding="utf-8") as f:
+        return bool(f.readline().strip())
+
+
+def sources(out_dir, *, elastic=True) -> list:
+    """The closing table's rows for the page in ``out_dir``: those of `SOURCES` (with
+    ``elastic``, of `ELASTIC_SOURCES` too) whose CSV is there with a header, a CSV's rows
+    together. Their columns are checked against the CSVs when the page is written
+    (`kicktimes.render.provenance.check_sources`)."""
+    rows = [*SOURCES, *(ELASTIC_SOURCES if elastic else ())]
+    order = list(dict.fromkeys(s.csv for s in rows))
+    rows.sort(key=lambda s: order.index(s.csv))  # stable: a CSV's rows together
+    return [s for s in rows if _has_table(Path(out_dir) / s.csv)]
+
+
 def write_disks_page(store_paths, out_dir, *, command="kicktimes reproduce --study disks",
                      dpi=110, n_boot=999, n_mc=199, cost=None) -> Path:
-    """Write ``disks.md``, its CSV tables and figures into ``out_dir``.
+    """Write ``disks.md``, its CSV tables and figures into ``out_dir``; the page, written
+    last, closes with the table of where its numbers come from (`sources`).
 
     Parameters
     ----------
@@ -406,7 +497,7 @@ def write_disks_page(store_paths, out_dir, *, command="kicktimes reproduce --stu
     import matplotlib.pyplot as plt
 
     from kicktimes.experiment import DisksExperiment, disks_control, load_store
-    from kicktimes.report.pages import write_null_calibration
+    from kicktimes.render.pages import write_null_calibration
     from kicktimes.stats import TESTS
 
     paths = list(store_paths)
@@ -642,6 +733,5 @@ def write_disks_page(store_paths, out_dir, *, command="kicktimes reproduce --stu
     lines += [f"{sweeps}these tables and figures: {analysis_cpu:.0f} s of CPU.", "",
               "## Left out", "", *_left_out(table, long, kicked_stores, k,
                                           (out / "disks_ftle_check.csv").exists()), ""]
-    page = out / "disks.md"
-    page.write_text("\n".join(lines), encoding="utf-8")
-    return page
+    elastic = bool((table["rule"] == "elastic").any())
+    return write_results_page(out / "disks.md", lines, sources(out, elastic=elastic))

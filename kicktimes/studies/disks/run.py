@@ -24,6 +24,7 @@ from kicktimes.experiment import DisksExperiment
 from kicktimes.studies.disks.density import DENSITY, LyapunovDensity, write_lyapunov_density
 from kicktimes.studies.disks.ftle_check import FTLE_CHECK, FtleCheck, write_ftle_check
 from kicktimes.studies.disks.page import write_disks_page
+from kicktimes.studies.disks.tables import sweep_cost
 from kicktimes.studies.disks.windows import (
     DISPERSION_WINDOWS,
     DispersionWindows,
@@ -156,12 +157,7 @@ def reproduce_disks(out, *, results_dir=None, names=None, workers=1, scheduler=N
         exp = disks_preset(name) if experiment is None else experiment(disks_preset(name))
         store = run_experiment(exp, path, workers=workers if scheduler is None
                                else None, scheduler=scheduler, progress=bar)
-        # disks tasks record their CPU time; a two-disk sweep's tasks their wall time only
-        timings = store.timings
-        wall = timings["simulate"] if "simulate" in timings else timings["total"]
-        cost.append({"experiment": name, "tasks": len(store.manifest["tasks"]),
-                     "cpu_seconds": float(timings["cpu"].sum()) if "cpu" in timings
-                     else float("nan"), "wall_seconds": float(wall.sum())})
+        cost.append(sweep_cost(name, store))
         paths.append(path)
     target = results_dir if results_dir is not None else os.path.join(out, "results-disks")
     if ftle_check is not None:

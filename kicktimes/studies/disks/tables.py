@@ -495,3 +495,15 @@ def two_disk_check(disks_store, two_store, *, alpha=0.05, n_boot=999, n_mc=199, 
     out["rate_ratio_low"], out["rate_ratio_high"] = _ci(rates[0][1] / rates[1][1])
     out["rate_ratio_verdict"] = ratio_verdict(out["rate_ratio_low"], out["rate_ratio_high"])
     return out
+
+
+def sweep_cost(name, store) -> dict:
+    """One row of ``disks_cost.csv``: the sweep ``name``'s tasks and the seconds its tasks
+    recorded (``cpu_seconds``: a disks sweep's CPU time, NaN for a two-disk sweep, whose
+    tasks record their wall time only; ``wall_seconds``)."""
+    timings = store.timings
+    wall = timings["simulate"] if "simulate" in timings else timings["total"]
+    return {"experiment": name, "tasks": len(store.manifest["tasks"]),
+            "cpu_seconds": float(timings["cpu"].sum()) if "cpu" in timings else float("nan"),
+            "wall_seconds": float(wall.sum())}
+

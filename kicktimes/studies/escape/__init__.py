@@ -73,7 +73,7 @@ from kicktimes.studies.escape.compute import (
     tail_rates,
 )
 from kicktimes.studies.escape.figures import survival_figure
-from kicktimes.studies.escape.page import FIGURE, write_page
+from kicktimes.studies.escape.page import CONSTANT, FIGURE, RATIOS, SOURCES, TAILS, write_page
 from kicktimes.studies.options import study_run
 
 __all__ = ["SCALES", "Params", "constant_rows", "ergodic_rate", "escape_tables",
@@ -137,11 +137,10 @@ def reproduce(out: str | os.PathLike, *, scale: str = "quick",
                                              bootstrap_picks(params.n_ics, params.seed))
     constant = pd.DataFrame([row for r, c in zip(RADII, cached[len(RADII):], strict=True)
                              for row in constant_rows(r, c.table["escape_time"], FREE_TIMES)])
-    for name, frame in (("escape_tails.csv", table), ("escape_ratios.csv", ratio_tab),
-                        ("escape_constant.csv", constant)):
-        run.write_csv(f"escape/{name}", frame)
+    for name, frame in ((TAILS, table), (RATIOS, ratio_tab), (CONSTANT, constant)):
+        run.write_csv(name, frame)
     run.write_figure(FIGURE, survival_figure(curves))
     # the build's seconds: this call's and those the reused simulations took when they ran
     seconds = time.perf_counter() - start + sum(c.seconds for c in cached if c.reused)
     return run.write_page(write_page(table, ratio_tab, constant, params, run.command, seconds,
-                                     cache.name, curves=curves))
+                                     cache.name, curves=curves), SOURCES)

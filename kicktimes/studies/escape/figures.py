@@ -7,7 +7,7 @@ import pandas as pd
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
-from kicktimes.report.figures import system_style
+from kicktimes.render.figures import system_style
 from kicktimes.stats import kinetic_rate
 from kicktimes.studies.escape.compute import LABELS, RADII, SYSTEMS
 

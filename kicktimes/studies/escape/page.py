@@ -7,15 +7,48 @@ import math
 
 import pandas as pd
 
-from kicktimes.report.pages import header, ratio_text, simulations_source
-from kicktimes.stats import MARGIN, format_interval, ratio_rule, ratio_verdict
-from kicktimes.studies.escape.compute import BURSTY_SHAPE, CONTROLS, HOLE, LABELS, ergodic_rate
+from kicktimes.render.pages import header, ratio_text, simulations_source
+from kicktimes.render.provenance import Source
+from kicktimes.stats import (
+    MARGIN,
+    circle_escape_constant,
+    fit_escape_tail,
+    format_interval,
+    kinetic_rate,
+    ratio_rule,
+    ratio_verdict,
+)
+from kicktimes.studies.escape.compute import (
+    BURSTY_SHAPE,
+    CONTROLS,
+    HOLE,
+    LABELS,
+    constant_rows,
+    ergodic_rate,
+    escape_tables,
+    tail_rates,
+)
 from kicktimes.studies.escape.figures import MIN_AT_RISK, thin_from
 
-__all__ = ["FIGURE", "law_verdict", "write_page"]
+__all__ = ["CONSTANT", "FIGURE", "RATIOS", "SOURCES", "TAILS", "law_verdict", "write_page"]
 
-#: the figure, relative to the page
+#: the figure and the tables, relative to the page
 FIGURE = "escape/escape_survival.png"
+TAILS = "escape/escape_tails.csv"
+RATIOS = "escape/escape_ratios.csv"
+CONSTANT = "escape/escape_constant.csv"
+
+#: the page's closing table: the columns it quotes and the functions that computed them
+SOURCES = (
+    Source(TAILS, "n, censored_by_partner", escape_tables),
+    Source(TAILS, "kinetic_rate", kinetic_rate),
+    Source(TAILS, "rate, rate_boot_low, rate_boot_high", tail_rates),
+    Source(TAILS, "alpha, alpha_low, alpha_high, aic_exp_minus_alg", fit_escape_tail),
+    Source(RATIOS, "ratio, ci_low, ci_high", escape_tables),
+    Source(RATIOS, "verdict", ratio_verdict),
+    Source(CONSTANT, "t, t_S, t_S_low, t_S_high", constant_rows),
+    Source(CONSTANT, "C_predicted", circle_escape_constant),
+)
 
 
 def _robust(g):

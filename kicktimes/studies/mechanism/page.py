@@ -3,8 +3,8 @@
 Reads the ``mechanism_numbers.csv`` of each rule (`kicktimes.studies.mechanism.run`
 writes them) and writes the page: every number from a row, every comparative word from a
 verdict (`kicktimes.stats.ratio_verdict` for a hazard against the rate it should equal,
-disjoint 95 % intervals for "above chance"). Definitions and methods stay in
-docs/mechanism.md.
+disjoint 95 % intervals for "above chance"), closed by the table of where its numbers come
+from (`sources`). Definitions and methods stay in docs/mechanism.md.
 """
 
 from __future__ import annotations
@@ -14,11 +14,13 @@ from pathlib import Path
 
 import pandas as pd
 
-from kicktimes.report.pages import header
+from kicktimes.render.pages import header, write_results_page
+from kicktimes.render.provenance import Source
 from kicktimes.stats import MARGIN, format_interval, ratio_rule, ratio_verdict
+from kicktimes.studies.mechanism.analysis import analyse, hazard_profile_rows
 from kicktimes.studies.mechanism.figures import NORMALISED_YLIM
 
-__all__ = ["load", "rule_section", "summary", "write_page"]
+__all__ = ["load", "rule_section", "sources", "summary", "write_page"]
 
 GROUPS = (("paper", 0.01), ("paper", 0.02), ("uniform", 0.01), ("uniform", 0.02))
 LABEL = {"paper": "paper ICs", "uniform": "invariant ICs"}
@@ -299,10 +301,22 @@ def _carry(tab, groups, rule):
             "of sample); each share's interval is in the table above.")
 
 
+def sources(folders):
+    """The page's closing table, per rule's folder in ``folders`` (relative to the page;
+    which rules, and so which CSVs, is the run's): the columns of its
+    ``mechanism_numbers.csv`` the page quotes and the functions that computed them. The
+    rows the page quotes come from `analyse`, except the early hazard read bin by bin
+    (its minimum, the bins below the rate), from `hazard_profile_rows`; the rows
+    ``method == "run"`` are the run's sizes."""
+    return tuple(Source(f"{folder}/mechanism_numbers.csv", "estimate, ci_low, ci_high, note",
+                        fn) for folder in folders for fn in (analyse, hazard_profile_rows))
+
+
 def write_page(tables, folders, path, *, command):
     """Write the page to ``path`` from the numbers ``tables`` of the rules, whose tables
     and figures lie in ``folders`` (relative to the page's folder, e.g.
-    ``"mechanism/elastic"``); ``command`` is the one its "Generated" line names."""
+    ``"mechanism/elastic"``); ``command`` is the one its "Generated" line names. The
+    page closes with the table of its `sources`."""
     lines = header("Why the collision times are not Poisson: the mechanism, computed", command,
                    [f"the direct simulations of `kicktimes.studies.mechanism` under the "
                     f"{t['rule'].iloc[0]} rule ([table]({f}/mechanism_numbers.csv))"
@@ -314,5 +328,4 @@ def write_page(tables, folders, path, *, command):
     lines += summary(tables)
     for tab, folder in zip(tables, folders, strict=True):
         lines += rule_section(tab, folder)
-    Path(path).write_text("\n".join(lines), encoding="utf-8")
-    return Path(path)
+    return write_results_page(path, lines, sources(folders))

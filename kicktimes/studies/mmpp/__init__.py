@@ -46,7 +46,7 @@ import pandas as pd
 
 from kicktimes.studies.cache import cached_tables
 from kicktimes.studies.mmpp.compute import RULES, collision_runs, sticky_runs
-from kicktimes.studies.mmpp.page import write_page
+from kicktimes.studies.mmpp.page import SOURCES, TABLES, write_page
 from kicktimes.studies.mmpp.tables import analyse, battery, intervals, mmpp_dip
 from kicktimes.studies.options import study_run
 
@@ -70,10 +70,6 @@ class Params:
 #: ``paper``: the sizes of docs/results/mmpp.md; ``quick``: 40 ICs to t = 500, 10 per run
 SCALES = {"quick": Params(n_ics=40, t_max=500.0, per_run=10),
           "paper": Params(n_ics=200, t_max=2000.0, per_run=200)}
-
-#: the page's tables, relative to the page
-TABLES = ("mmpp/mmpp_billiard_pooled.csv", "mmpp/mmpp_billiard_residuals.csv",
-          "mmpp/mmpp_billiard_dip.csv")
 
 
 def reproduce(out: str | os.PathLike, *, scale: str = "quick",
@@ -112,4 +108,4 @@ def reproduce(out: str | os.PathLike, *, scale: str = "quick",
     # the build's seconds: this call's and those the reused simulations took when they ran
     seconds = time.perf_counter() - start + sum(c.seconds for c in cached if c.reused)
     return run.write_page(write_page(*tables, params, run.command, seconds,
-                                     run.cache.name))
+                                     run.cache.name), SOURCES)

@@ -2,13 +2,46 @@
 
 from __future__ import annotations
 
-from kicktimes.report.pages import header, simulations_source
-from kicktimes.stats import format_interval, rejection_rule
+from kicktimes.render.pages import header, simulations_source
+from kicktimes.render.provenance import Source
+from kicktimes.stats import fit_mmpp, format_interval, rejection_rule, rejection_verdict
 from kicktimes.stats.findings import clopper_pearson
 from kicktimes.studies.mmpp.compute import STICKY_FACTOR
-from kicktimes.studies.mmpp.tables import DIP, EARLY_EDGES, N_MC, RENEWAL, TESTS
+from kicktimes.studies.mmpp.tables import (
+    DIP,
+    EARLY_EDGES,
+    N_MC,
+    RENEWAL,
+    TESTS,
+    analyse,
+    battery,
+    mmpp_bin_hazard,
+    mmpp_dip,
+)
 
-__all__ = ["write_page"]
+__all__ = ["SOURCES", "TABLES", "write_page"]
+
+#: the page's tables, relative to the page
+POOLED = "mmpp/mmpp_billiard_pooled.csv"
+RESIDUALS = "mmpp/mmpp_billiard_residuals.csv"
+DIP_TABLE = "mmpp/mmpp_billiard_dip.csv"
+TABLES = (POOLED, RESIDUALS, DIP_TABLE)
+
+#: the page's closing table: the columns it quotes and the functions that computed them
+SOURCES = (
+    Source(POOLED, "n_runs, n_sticky, t_max, aic_poisson_minus_mmpp, "
+           + ", ".join(f"aic_{law}_minus_mmpp" for law in RENEWAL), analyse),
+    Source(POOLED, "n_events, rate_low, rate_high, share_high, mean_stay_high, "
+           "mean_stay_low, n_best_starts, n_starts", fit_mmpp),
+    Source(RESIDUALS, "n_windows, share", battery),
+    Source(RESIDUALS, "ci_low, ci_high", clopper_pearson),
+    Source(RESIDUALS, "verdict", rejection_verdict),
+    Source(DIP_TABLE, "observed, ci_low, ci_high, boot_low, boot_high, verdict, min_bin_low, "
+           "min_bin_high, min_observed, min_ci_low, min_ci_high, min_boot_low, "
+           "min_boot_high, min_verdict", analyse),
+    Source(DIP_TABLE, "mmpp", mmpp_dip),
+    Source(DIP_TABLE, "min_mmpp", mmpp_bin_hazard),
+)
 
 
 def write_page(pooled, resid, dip, params, command, seconds, source):

@@ -17,18 +17,14 @@ from pathlib import Path
 import pandas as pd
 
 from kicktimes import __version__
+from kicktimes._validation import check_int
 from kicktimes.fileio import atomic_write_bytes
-from kicktimes.report.common import (
-    Context,
-    Mapper,
-    Progress,
-    check_int,
-    load_report_store,
-)
+from kicktimes.report.context import Context, Mapper, Progress
+from kicktimes.report.store import load_report_store
 from kicktimes.stats import format_interval
 
 __all__ = ["PROTOCOL_POINTER", "copy_first_screen", "counts_section", "poisson_section",
-           "write_results"]
+           "results_sources", "write_results"]
 
 BEGIN, END = "<!-- results:begin -->", "<!-- results:end -->"
 
@@ -41,8 +37,8 @@ def poisson_section(table, calibrated=False):
     """The Markdown of the Poisson question under the rule x IC design: one row per test
     (and the headline test on the first collisions, the dispersion index and the one
     standard for "Poisson"), one column per (family, control)."""
+    from kicktimes.render.pages import markdown_table
     from kicktimes.report.controls import POISSON_QUESTION
-    from kicktimes.report.pages import markdown_table
     from kicktimes.stats import poisson_rule
 
     rows = table[table["question"] == POISSON_QUESTION]
@@ -84,8 +80,8 @@ def poisson_section(table, calibrated=False):
 def gap_section(gaps):
     """The Markdown of the gap decomposition: the shares under the primary setting, the
     sign marks over every control, and how to read them."""
+    from kicktimes.render.pages import markdown_table
     from kicktimes.report.decomposition import STEPS, gap_everywhere, gap_summary
-    from kicktimes.report.pages import markdown_table
 
     summary = gap_summary(gaps)
     missing = gap_everywhere(gaps)
@@ -129,7 +125,7 @@ def gap_section(gaps):
 
 def counts_section(table):
     """The Markdown of the collision counts against kinetic theory under every control."""
-    from kicktimes.report.pages import markdown_table
+    from kicktimes.render.pages import markdown_table
 
     rows = table[table["diagnostic"] == "counts"]
     if rows.empty:
@@ -174,7 +170,9 @@ def _counts_reading(rows) -> list[str]:
 def copy_first_screen(page, target):
     """Replace the block between `BEGIN` and `END` of ``target`` (the repository's README)
     by the first screen of the generated ``page`` (its "Generated ..." line, the answers,
-    the table and the figure, with links made relative to ``target``), atomically.
+    the table and the figure, with links made relative to ``target``; it ends at the next
+    ``## `` heading, so never takes the page's closing table of where its numbers come
+    from), atomically.
 
     Raises ``ValueError`` when ``target`` has no such block.
     """
@@ -205,6 +203,43 @@ PROTOCOL_POINTER = [
     "Below: kicktimes' tangent-space FTLE and every comparison under its controls.", ""]
 
 
+def results_sources(findings, families, by_radius, *, gaps, nulls):
+    """The closing table of ``README.md``, from what `write_results` wrote there (the names
+    depend on the stores): ``<name>_findings.csv`` per name of ``findings`` (those in
+    ``families``, ``{family: table}`` of `merge_control_families`, hold every control, and
+    the Poisson question where the table has it), ``<name>_findings_by_radius.csv`` per
+    name of ``by_radius``, and, when written, ``gap_decomposition.csv`` (``gaps``) and the
+    paper study's rows of ``null_calibration.csv`` (``nulls``)."""
+    from kicktimes.render.pages import NULL_CALIBRATION
+    from kicktimes.render.provenance import Source
+    from kicktimes.report.controls import POISSON_QUESTION, compute_controls, poisson_rows
+    from kicktimes.report.decomposition import gap_decomposition
+    from kicktimes.report.poisson import null_calibration
+    from kicktimes.stats import paired_ratio
+
+    rows = []
+    for name in findings:
+        csv = f"{name}_findings.csv"
+        if name not in families:  # not folded: a control experiment's own table
+            rows.append(Source(csv, "control, estimate, ci_low, ci_high, verdict",
+                               compute_controls))
+            continue
+        rows.append(Source(csv, "diagnostic, system, control, estimate, ci_low, ci_high, "
+                           "verdict, robust, depends_on", compute_controls))
+        if (families[name]["question"] == POISSON_QUESTION).any():
+            rows.append(Source(csv, "question, diagnostic, estimate, ci_low, ci_high, verdict",
+                               poisson_rows))
+    rows += [Source(f"{name}_findings_by_radius.csv", "radius, ratio, ci_low, ci_high",
+                    paired_ratio) for name in by_radius]
+    if gaps:
+        rows.append(Source("gap_decomposition.csv", "diagnostic, control, quantity, estimate, "
+                           "ci_low, ci_high", gap_decomposition))
+    if nulls:
+        rows.append(Source(NULL_CALIBRATION, "study, test, share, ci_low, ci_high",
+                           null_calibration))
+    return rows
+
+
 def _short(family):
     return {"family_a": "A", "family_b": "B"}.get(family, family)
 
@@ -233,11 +268,12 @@ def write_results(
     pathlib.Path
         ``out_dir / "README.md"``: per store the scale (with a banner below paper scale),
         the Findings statements with effect sizes, CIs and verdicts, the verdict rules,
-        and every figure with its caption.
+        and every figure with its caption; last, the table of where its numbers come from
+        (`results_sources`).
 
     Examples
     --------
-    >>> from kicktimes.report import write_results
+    >>> from kicktimes.studies.paper import write_results
     >>> write_results("stores/family_a", "docs/results")  # doctest: +SKIP
     """
     from kicktimes.report.answers import first_screen, ratio_curves_figure
@@ -251,8 +287,8 @@ def write_results(
         raise TypeError("store_paths must be a path or a non-empty sequence of paths")
     if not isinstance(out_dir, str | os.PathLike):
         raise TypeError(f"out_dir must be a path, got {type(out_dir).__name__}")
-    dpi = check_int("dpi", dpi, 30)
-    workers = check_int("workers", workers, 1)
+    dpi = check_int("dpi", dpi, low=30)
+    workers = check_int("workers", workers, low=1)
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     stores = [load_report_store(p) for p in paths]
@@ -269,15 +305,16 @@ def write_results(
     ]
     head = len(lines)
     controls, curves, gaps, control_lines, nulls = [], [], [], [], []
+    written = []  # the experiments whose <name>_findings.csv is written
     names = {st.experiment.name for st in stores}
     try:
         for st in stores:
             t0 = time.perf_counter()
             ctx = Context(
                 st,
-                n_mc=check_int("n_mc", n_mc, 19),
-                n_boot=check_int("n_boot", n_boot, 100),
-                max_ics_model_fits=check_int("max_ics_model_fits", max_ics_model_fits, 1),
+                n_mc=check_int("n_mc", n_mc, low=19),
+                n_boot=check_int("n_boot", n_boot, low=100),
+                max_ics_model_fits=check_int("max_ics_model_fits", max_ics_model_fits, low=1),
                 pmap=pool.map,
             )
             name = st.experiment.name
@@ -296,6 +333,7 @@ def write_results(
                 controls.append(ctx.found.controls.table)
                 curves.append(ctx.found.controls.curves)
                 findings.tables[0][1].to_csv(out / f"{name}_findings.csv", index=False)
+                written.append(name)
                 control_lines += [f"- `{name}`: {scale}; its primary rows are the control "
                                   f"`{control}` of {family}'s findings "
                                   f"([{name}_findings.csv]({name}_findings.csv), built in "
@@ -321,6 +359,7 @@ def write_results(
             if notes:
                 lines += ["Subsampling: " + " ".join(notes), ""]
             findings.tables[0][1].to_csv(out / f"{name}_findings.csv", index=False)
+            written.append(name)
             lines += ["### Figures", ""]
             for sec in secs:
                 for fname, fig, caption in sec.figures:
@@ -358,9 +397,9 @@ def write_results(
     merged = merge_control_families(controls)
     for family, t in merged.items():
         t.to_csv(out / f"{family}_findings.csv", index=False)
-    for c in curves:
-        if not c.empty:
-            c.to_csv(out / f"{c['family'].iloc[0]}_findings_by_radius.csv", index=False)
+    by_radius = {c["family"].iloc[0]: c for c in curves if not c.empty}
+    for name, c in by_radius.items():
+        c.to_csv(out / f"{name}_findings_by_radius.csv", index=False)
     table = pd.concat(list(merged.values()), ignore_index=True)
     screen = ["## The answers", ""] + PROTOCOL_POINTER + first_screen(table)
     curves = pd.concat(curves, ignore_index=True)
@@ -378,11 +417,12 @@ def write_results(
         "under every control: " + ", ".join(f"[{f}_findings.csv]({f}_findings.csv)"
                                             for f in merged) + ".", ""]
     if nulls:
-        from kicktimes.report.pages import write_null_calibration
+        from kicktimes.render.pages import write_null_calibration
 
         write_null_calibration(out, "paper", pd.concat(nulls, ignore_index=True))
     screen += poisson_section(table, calibrated=bool(nulls))
-    if gaps:
+    has_gaps = bool(gaps)
+    if has_gaps:
         gaps = merge_control_gaps(gaps)
         gaps = gaps[gaps["family"].isin(list(merged))]
         gaps.to_csv(out / "gap_decomposition.csv", index=False)
@@ -401,6 +441,7 @@ def write_results(
         "--study NAME` (`--study all`: every page). Below: per family, the scale, every "
         "statement under the primary setting, and the figures.", ""]
     lines[head:head] = screen
-    path = out / "README.md"
-    atomic_write_bytes(path, "\n".join(lines).encode("utf-8"))
-    return path
+    from kicktimes.render.pages import write_results_page
+
+    return write_results_page(out / "README.md", lines, results_sources(
+        written, merged, by_radius, gaps=has_gaps, nulls=bool(nulls)))

@@ -16,8 +16,9 @@ from matplotlib.ticker import MultipleLocator  # noqa: E402
 
 from kicktimes import __version__  # noqa: E402
 from kicktimes.fileio import atomic_write  # noqa: E402
-from kicktimes.report.pages import markdown_table  # noqa: E402
-from kicktimes.stats import format_interval  # noqa: E402
+from kicktimes.render.pages import markdown_table, write_results_page  # noqa: E402
+from kicktimes.render.provenance import Source  # noqa: E402
+from kicktimes.stats import format_interval, paired_ratio  # noqa: E402
 from kicktimes.studies.protocol.claims import SMALL_RADIUS, SWITCHES, claims_table  # noqa: E402
 from kicktimes.studies.protocol.compute import D0, EPS, panels  # noqa: E402
 from kicktimes.studies.protocol.tables import (  # noqa: E402
@@ -32,9 +33,26 @@ from kicktimes.studies.protocol.tables import (  # noqa: E402
     shapley_table,
 )
 
-__all__ = ["FIGURE", "build_page", "fig6_figure"]
+__all__ = ["FIGURE", "SOURCES", "build_page", "fig6_figure"]
 
 FIGURE = "paper_fig06_ftle_both_readings.png"
+#: the closing table of ``paper.md``: its five CSVs (the same at every scale and with or
+#: without the paper study's findings), the columns the page quotes and their functions
+SOURCES = (
+    Source("paper_claims.csv", "claim, figure, paper_says, estimate, interval, verdict, "
+           "other_estimate, other_interval, other_verdict, decided_by", claims_table),
+    Source("paper_findings.csv", "control, estimate, ci_low, ci_high, verdict, robust, "
+           "depends_on", ratio_table),
+    Source("paper_findings.csv", "diagnostic, estimate, ci_low, ci_high, verdict", r1_table),
+    Source("paper_findings.csv", "diagonal_share, lowest_radius_ratio, highest_radius_ratio",
+           rr_table),
+    Source("paper_by_radius.csv", "mean, sd, n, paper_bar", per_radius_table),
+    Source("paper_by_radius.csv", "ratio, ratio_ci_low, ratio_ci_high", paired_ratio),
+    Source("paper_shapley.csv", "choice, share, ci_low, ci_high, fraction_of_change, verdict, "
+           "distance_from, distance_to", shapley_table),
+    Source("paper_convergence.csv", "horizon, estimate, ci_low, ci_high, two_particle_mean",
+           convergence_table),
+)
 _SYSTEMS = (("two_particle", "Two Particle", "k", "o"), ("poisson", "Poisson", "C0", "s"),
             ("actual", "Actual", "C3", "^"))
 SWITCHES_NAMES = [name for name, _ in SWITCHES]
@@ -182,8 +200,9 @@ def build_page(rows: pd.DataFrame, results_dir: str | os.PathLike, findings_dir:
                os.PathLike | None, *, command: str, scale: str = "paper", store: str = "",
                dpi: int = 110, panel_list=None) -> Path:
     """Write ``paper.md``, its CSVs and its figure into ``results_dir`` from the study's
-    ``rows`` and the paper study's findings in ``findings_dir`` (or ``None``). The panels
-    are those of ``scale``, or ``panel_list`` (two `Panel`). Returns the page."""
+    ``rows`` and the paper study's findings in ``findings_dir`` (or ``None``); the page
+    closes with the table of `SOURCES`. The panels are those of ``scale``, or
+    ``panel_list`` (two `Panel`). Returns the page."""
     out = Path(results_dir)
     out.mkdir(parents=True, exist_ok=True)
     panel_list = panels(scale) if panel_list is None else tuple(panel_list)
@@ -294,6 +313,4 @@ def build_page(rows: pd.DataFrame, results_dir: str | os.PathLike, findings_dir:
         "All readings of every claim: [paper_findings.csv](paper_findings.csv), "
         "[paper_claims.csv](paper_claims.csv).", "",
     ]
-    page = out / "paper.md"
-    atomic_write(page, lambda tmp: Path(tmp).write_text("\n".join(lines), encoding="utf-8"))
-    return page
+    return write_results_page(out / "paper.md", lines, SOURCES)

@@ -42,7 +42,7 @@ from kicktimes.studies.cache import cached_tables
 from kicktimes.studies.options import study_run
 from kicktimes.studies.scatter.compute import one_ic, scatter_runs, shape_rows
 from kicktimes.studies.scatter.kernel import fresh_lam, fresh_partner_tangent
-from kicktimes.studies.scatter.page import TABLE, write_page
+from kicktimes.studies.scatter.page import SOURCES, TABLE, write_page
 from kicktimes.studies.scatter.tables import RATIOS, ratio_table, sticky, summary_tables
 
 __all__ = ["RATIOS", "SCALES", "Params", "cache_jobs", "fresh_lam", "fresh_partner_tangent",
@@ -103,4 +103,4 @@ def reproduce(out: str | os.PathLike, *, scale: str = "quick",
     df = pd.concat([c.table for c in cached], ignore_index=True)
     tab = ratio_table(df)
     run.write_csv(TABLE, tab)
-    return run.write_page(write_page(df, tab, run.command, run.cache.name))
+    return run.write_page(write_page(df, tab, run.command, run.cache.name), SOURCES)

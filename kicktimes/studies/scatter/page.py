@@ -2,14 +2,19 @@
 
 from __future__ import annotations
 
-from kicktimes.report.pages import header
-from kicktimes.stats import format_interval, ratio_rule
-from kicktimes.studies.scatter.tables import RATIOS, sticky
+from kicktimes.render.pages import header
+from kicktimes.render.provenance import Source
+from kicktimes.stats import format_interval, ratio_rule, ratio_verdict
+from kicktimes.studies.scatter.tables import RATIOS, ratio_table, sticky
 
-__all__ = ["TABLE", "write_page"]
+__all__ = ["SOURCES", "TABLE", "write_page"]
 
 #: the page's table, relative to the page
 TABLE = "scatter_ratios.csv"
+
+#: the page's closing table: the columns it quotes and the functions that computed them
+SOURCES = (Source(TABLE, "estimate, ci_low, ci_high", ratio_table),
+           Source(TABLE, "verdict", ratio_verdict))
 
 
 def write_page(df, tab, command, source):

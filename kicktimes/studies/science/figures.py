@@ -18,7 +18,7 @@ def stretching_figure(per_radius, path):
     kicked / two-disk ratio per radius with its interval and the +-10 % band around 1."""
     from matplotlib.figure import Figure
 
-    from kicktimes.report.figures import system_label, system_style
+    from kicktimes.render.figures import system_label, system_style
 
     fig = Figure(figsize=(10.0, 4.2), layout="constrained")
     ax, bx = fig.subplots(1, 2)

@@ -1,19 +1,59 @@
 """The science page's sections: Markdown lines from the tables, every number from a row.
 
 Every comparative word comes from a verdict of :mod:`kicktimes.stats` (`ratio_verdict`)
-or from `kicktimes.report.pages.trend_verdict`, never typed.
+or from `kicktimes.render.pages.trend_verdict`, never typed.
 """
 
 from __future__ import annotations
 
 import math
 
-from kicktimes.report.pages import ratio_text
+from kicktimes.render.pages import ratio_text
+from kicktimes.render.provenance import Source
 from kicktimes.stats import format_interval
-from kicktimes.studies.science.rates import STICKY_FACTOR
-from kicktimes.studies.science.stretching import KICKED
+from kicktimes.studies.science.decorrelation import (
+    closest_kick_law,
+    decorrelation,
+    prediction_against_measurement,
+)
+from kicktimes.studies.science.rates import STICKY_FACTOR, rate_relaxation, sticky_orbits
+from kicktimes.studies.science.stretching import KICKED, stretching
+from kicktimes.studies.science.twins import twin_table
 
-__all__ = ["decorrelation_lines", "store_lines", "stretching_lines", "twin_lines"]
+__all__ = ["SOURCES", "decorrelation_lines", "store_lines", "stretching_lines", "twin_lines"]
+
+#: the closing table of ``science.md``: every CSV the study writes beside it (the same
+#: twelve at every scale), the columns the page quotes and the function that computes them
+SOURCES = (
+    Source("science_stretching.csv", "stretch_per_perturbation, ci_low, ci_high, ratio, "
+           "ratio_ci_low, ratio_ci_high, verdict", stretching),
+    Source("science_stretching_fits.csv", "intercept, slope, intercept_ci_low, "
+           "intercept_ci_high, slope_ci_low, slope_ci_high, local_slope_min, "
+           "local_slope_max", stretching),
+    Source("science_stretching_trend.csv", "quantity, slope_per_ln_inv_r, ci_low, ci_high, "
+           "verdict", stretching),
+    Source("science_independent_twins.csv", "lam, ci_low, ci_high, per_kick, "
+           "predicted_per_kick, over_predicted, over_predicted_ci_low, "
+           "over_predicted_ci_high, two_disk_per_collision, ratio, ratio_ci_low, "
+           "ratio_ci_high", twin_table),
+    Source("science_decorrelation.csv", "perturbation, correlation, ci_low, ci_high, n_pairs",
+           decorrelation),
+    Source("science_decorrelation_by_angle.csv", "all", decorrelation),
+    Source("science_decorrelation_prediction.csv", "predicted, predicted_ci_low, "
+           "predicted_ci_high, measured, measured_ci_low, measured_ci_high, "
+           "measured_over_predicted, quotient_ci_low, quotient_ci_high, quotient_verdict",
+           prediction_against_measurement),
+    Source("science_closest.csv", "ratio, ci_low, ci_high, verdict, closest, disjoint_under",
+           closest_kick_law),
+    Source("science_rate_count.csv", "count_over_kinetic, ci_low, ci_high, verdict",
+           rate_relaxation),
+    Source("science_rate_windows.csv", "rate_over_kinetic, ci_low, ci_high, verdict",
+           rate_relaxation),
+    Source("science_rate_relaxation.csv", "all", rate_relaxation),
+    Source("science_sticky.csv", "n_sticky, n_runs, share_runs, n_ics_sticky, "
+           "median_interval_sticky, median_max_abs_L_sticky, median_max_abs_L_all, "
+           "share_all_ics_below_sticky_max", sticky_orbits),
+)
 
 
 def _fmt(x, lo, hi, digits=3):

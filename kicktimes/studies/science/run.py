@@ -20,7 +20,7 @@ from pathlib import Path
 import pandas as pd
 
 from kicktimes.experiment import load_store, run_experiment
-from kicktimes.report.pages import header, store_name
+from kicktimes.render.pages import header, store_name, write_results_page
 from kicktimes.stats import MARGIN, ratio_rule
 from kicktimes.studies.cache import cached_table, read_cached, write_cached
 from kicktimes.studies.options import check_scale, check_workers, status_lines
@@ -31,6 +31,7 @@ from kicktimes.studies.science.decorrelation import (
 )
 from kicktimes.studies.science.figures import stretching_figure
 from kicktimes.studies.science.page import (
+    SOURCES,
     decorrelation_lines,
     store_lines,
     stretching_lines,
@@ -299,7 +300,6 @@ def reproduce(out: str | os.PathLike, *, scale: str = "quick",
     lines += ["Intervals are 95 % bootstrap intervals over ICs unless said otherwise. "
               f"Verdicts of ratios: {ratio_rule(MARGIN)}.", ""]
     lines += body + [f"Built in {time.perf_counter() - t0:.0f} s.", ""]
-    page = results / "science.md"
-    page.write_text("\n".join(lines), encoding="utf-8")
+    page = write_results_page(results / "science.md", lines, SOURCES)
     say(f"{page.name} written in {time.perf_counter() - t0:.0f} s")
     return page

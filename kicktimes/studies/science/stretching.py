@@ -16,7 +16,7 @@ import numpy as np
 import pandas as pd
 
 from kicktimes.experiment import preset
-from kicktimes.report.pages import trend_verdict
+from kicktimes.render.pages import trend_verdict
 from kicktimes.stats import (
     MARGIN,
     percentile_interval,

@@ -43,7 +43,7 @@ from kicktimes.studies.cache import cached_tables
 from kicktimes.studies.options import study_run
 from kicktimes.studies.unequal.compute import R0, R1, size_ratio_runs
 from kicktimes.studies.unequal.figures import size_ratio_figure
-from kicktimes.studies.unequal.page import FIGURE, TABLE, write_page
+from kicktimes.studies.unequal.page import FIGURE, SOURCES, TABLE, write_page
 from kicktimes.studies.unequal.tables import (
     dispersion_ci,
     ks_interval,
@@ -95,4 +95,4 @@ def reproduce(out: str | os.PathLike, *, scale: str = "quick",
                              params.seed)
     run.write_csv(TABLE, table)
     run.write_figure(FIGURE, size_ratio_figure(table, params.n_ics))
-    return run.write_page(write_page(table, params, run.command, run.cache.name))
+    return run.write_page(write_page(table, params, run.command, run.cache.name), SOURCES)

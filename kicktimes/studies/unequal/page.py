@@ -4,16 +4,32 @@ from __future__ import annotations
 
 import pandas as pd
 
-from kicktimes.report.pages import header, simulations_source
-from kicktimes.stats import MARGIN, format_interval, ratio_rule, ratio_verdict
-from kicktimes.studies.unequal.compute import R0
-from kicktimes.studies.unequal.tables import ks_interval
+from kicktimes.render.pages import header, simulations_source
+from kicktimes.render.provenance import Source
+from kicktimes.stats import MARGIN, format_interval, poisson_group, ratio_rule, ratio_verdict
+from kicktimes.studies.unequal.compute import KINDS, R0
+from kicktimes.studies.unequal.tables import (
+    dispersion_ci,
+    ks_interval,
+    ratio_ci,
+    size_ratio_table,
+)
 
-__all__ = ["FIGURE", "TABLE", "write_page"]
+__all__ = ["FIGURE", "SOURCES", "TABLE", "write_page"]
 
 #: the table and the figure, relative to the page
 TABLE = "size_ratio/size_ratio.csv"
 FIGURE = "size_ratio/size_ratio.png"
+
+#: the page's closing table: the columns it quotes and the functions that computed them
+SOURCES = (
+    Source(TABLE, "size_ratio", size_ratio_table),
+    Source(TABLE, "rate_ratio, rate_low, rate_high", ratio_ci),
+    Source(TABLE, ", ".join(f"ftle_{kind}_{part}_disk{disk}" for disk in (0, 1)
+                            for kind in KINDS for part in ("ratio", "low", "high")), ratio_ci),
+    Source(TABLE, "ks_reject_share, dispersion_index", poisson_group),
+    Source(TABLE, "disp_low, disp_high", dispersion_ci),
+)
 
 
 def write_page(table, params, command, source):

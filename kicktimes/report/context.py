@@ -1,9 +1,10 @@
-"""Plumbing shared by the report's sections: the section record, the build context,
-progress, the process pool, seeded streams, validation and number formatting."""
+"""What every section of the sweep report sees while it is built: the section record
+(:class:`Section`), the build context of one store (:class:`Context`, with the typed
+results the sections leave for later ones, :class:`Found`), the progress reporting and
+the process pool (:class:`Mapper`), and the report's seeded Monte Carlo streams."""
 
 from __future__ import annotations
 
-import math
 import os
 import sys
 from dataclasses import dataclass, field
@@ -16,13 +17,12 @@ from kicktimes.memory import keep_freed_memory
 if TYPE_CHECKING:  # pandas and scipy load with the sections that use them
     import pandas as pd
 
+__all__ = ["Context", "Found", "Mapper", "Progress", "REPORT_DOMAIN", "Section",
+           "seeded_rng"]
+
 #: first spawn-key word of the report's Monte Carlo streams ("rprt"), distinct from the
 #: IC and kick streams of the sweep
 REPORT_DOMAIN = 0x72707274
-#: the reference system every other ("kicked") system is compared with
-REFERENCE = "two_particle"
-#: ICs and steps of the paper's smaller family (A): below this a report is a smoke test
-PAPER_SCALE = {"n_ics": 200, "n_steps": 15000}
 
 
 class Section:
@@ -205,143 +205,7 @@ class Mapper:
             self.pool.shutdown()
 
 
-def check_int(name, value, low, allow_none=False):
-    if value is None and allow_none:
-        return None
-    if isinstance(value, bool) or not isinstance(value, int | np.integer):
-        raise TypeError(f"{name} must be an integer, got {type(value).__name__}")
-    if value < low:
-        raise ValueError(f"{name} must be >= {low}, got {int(value)}")
-    return int(value)
-
-
-def check_fraction(name, value):
-    if isinstance(value, bool) or not isinstance(value, int | float | np.floating):
-        raise TypeError(f"{name} must be a number, got {type(value).__name__}")
-    if not 0 < value < 1:
-        raise ValueError(f"{name} must satisfy 0 < {name} < 1, got {float(value)}")
-    return float(value)
-
-
 def seeded_rng(seed, *key):
+    """The report's stream ``key`` of the experiment seeded ``seed`` (spawn key
+    ``(REPORT_DOMAIN, *key)``)."""
     return np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(REPORT_DOMAIN, *key)))
-
-
-def nearest(radii, target):
-    radii = np.asarray(radii, dtype=float)
-    return float(radii[np.argmin(np.abs(radii - target))])
-
-
-def pct(x):
-    return "n/a" if not np.isfinite(x) else f"{100 * x:.1f}%"
-
-
-def fmt_p(p):
-    if not np.isfinite(p):
-        return "n/a"
-    return "< 1e-300" if p == 0 else f"{p:.3g}"
-
-
-def fmt(x, digits=3):
-    """A number with ``digits`` significant figures, 'n/a' when not finite."""
-    return "n/a" if x is None or not np.isfinite(x) else f"{x:.{digits}g}"
-
-
-def spearman(x, y):
-    """Spearman's rho and two-sided p-value (exact permutation for n <= 8), NaN when
-    fewer than 3 finite points or a constant variable."""
-    from scipy import stats as sps
-
-    x, y = np.asarray(x, float), np.asarray(y, float)
-    ok = np.isfinite(x) & np.isfinite(y)
-    x, y = x[ok], y[ok]
-    if x.size < 3 or np.ptp(x) == 0 or np.ptp(y) == 0:
-        return math.nan, math.nan
-    rho = float(sps.spearmanr(x, y).statistic)
-    if x.size <= 8:
-        # the t approximation is meaningless for a handful of radii (it gives p = 0 at
-        # |rho| = 1); enumerate the permutations instead
-        from itertools import permutations
-
-        ry = sps.rankdata(y)
-        null = [sps.spearmanr(x, ry[list(p)]).statistic for p in permutations(range(x.size))]
-        return rho, float(np.mean(np.abs(null) >= abs(rho) - 1e-12))
-    p = float(sps.spearmanr(x, y).pvalue)
-    return rho, p if p > 0 else 2.0 / math.factorial(x.size)
-
-
-def fmt_rho(rho, p):
-    return "n/a" if not np.isfinite(rho) else f"{rho:.2f}, p = {fmt_p(p)}"
-
-
-def kicked_systems(results):
-    """Every system of the store except the reference, in a stable order."""
-    from kicktimes.report.figures import SYSTEMS
-
-    present = set(results["system"].unique())
-    known = [s for s in SYSTEMS if s in present and s != REFERENCE]
-    return known + sorted(present - set(SYSTEMS))
-
-
-def is_paper_scale(exp):
-    return exp.n_ics >= PAPER_SCALE["n_ics"] and exp.n_steps >= PAPER_SCALE["n_steps"]
-
-
-def eps_values(exp):
-    """The experiment's recurrence thresholds as a tuple (old stores: one float)."""
-    eps = exp.eps
-    return tuple(float(e) for e in eps) if isinstance(eps, list | tuple) else (float(eps),)
-
-
-def report_store(store):
-    """The store as the report reads it: ``results`` with ``system`` and ``diagnostic`` as
-    categoricals (sorted categories) and without the ``note`` column no section reads.
-
-    The sections filter the results by system and diagnostic dozens of times, and ask
-    which are present (``set(results["diagnostic"])``); on Arrow strings each filter copies
-    every string and each ``set`` iterates the rows in Python (~1 s per call on a paper
-    store's 2 million rows); on categoricals both work on integer codes. Groupings and
-    sort orders are unchanged (sorted categories sort as the strings; groupby keeps the
-    observed groups only), and so is every table written.
-    """
-    import copy
-    import dataclasses
-
-    import pandas as pd
-
-    res = store.results
-    if isinstance(res["diagnostic"].dtype, pd.CategoricalDtype):
-        return store
-    res = res.drop(columns=[c for c in ("note",) if c in res.columns])
-    res = res.astype({"system": "category", "diagnostic": "category"})
-    if dataclasses.is_dataclass(store):
-        return dataclasses.replace(store, results=res)
-    view = copy.copy(store)  # a store-like namespace (tests, notebooks)
-    view.results = res
-    return view
-
-
-def load_report_store(path):
-    """``report_store(load_store(path))``, read straight into that form: the results
-    without ``note``, ``system`` and ``diagnostic`` read from Parquet as dictionaries
-    (categoricals, then their categories sorted), never as 2 million strings. The same
-    frames (a test compares them), read faster
-    (``python benchmarks/bench_report.py --load-only --stores ...``; docs/benchmarks.md).
-    """
-    from kicktimes.experiment import load_store
-
-    columns = ["radius", "ic", "system", "diagnostic", "value"]
-    return load_store(path, result_columns=columns, categories=("system", "diagnostic"))
-
-
-def distinct(frame, column):
-    """The distinct values of ``frame[column]`` as a set (fast on categoricals: only the
-    observed values, not the categories)."""
-    return set(frame[column].unique())
-
-
-def wide(results, diagnostic):
-    """``value`` of one diagnostic as a (radius, ic) x system table."""
-    part = results[results["diagnostic"] == diagnostic]
-    return part.pivot_table(index=["radius", "ic"], columns="system", values="value", dropna=False,
-                            observed=True)

@@ -2,7 +2,7 @@
 sections and the page around them (:func:`write_page`: the sweep report of
 :func:`kicktimes.report.build_report` and the page of ``kicktimes analyze``,
 :func:`kicktimes.report.analyze_page.write_analysis`); every file atomically
-(:func:`kicktimes.report._cache.atomic_write`)."""
+(:func:`kicktimes.fileio.atomic_write_bytes`)."""
 
 from __future__ import annotations
 
@@ -10,13 +10,12 @@ import base64
 import datetime as _dt
 import html
 import io
-import os
 import re
 from pathlib import Path
 
 from kicktimes import __version__
+from kicktimes.fileio import atomic_write_bytes
 from kicktimes.memory import keep_freed_memory
-from kicktimes.report._cache import atomic_write
 
 __all__ = [
     "write_page",
@@ -27,7 +26,6 @@ __all__ = [
     "render_figures",
     "write_table",
     "write_text",
-    "store_header",
     "table_html",
     "CSS",
 ]
@@ -134,9 +132,9 @@ def render_figures(figs, dpi, *, pdf=False, workers=1):
 
 def _store_rendered(out, name, rendered, files):
     png, pdf_bytes = rendered
-    files[f"{name}.png"] = atomic_write(out / f"{name}.png", png)
+    files[f"{name}.png"] = atomic_write_bytes(out / f"{name}.png", png)
     if pdf_bytes is not None:
-        files[f"{name}.pdf"] = atomic_write(out / f"{name}.pdf", pdf_bytes)
+        files[f"{name}.pdf"] = atomic_write_bytes(out / f"{name}.pdf", pdf_bytes)
     return png
 
 
@@ -148,12 +146,12 @@ def save_figure(fig, out, name, dpi, files, *, pdf=False):
 
 def write_table(out, name, df, files):
     """``df`` as ``name.csv`` (no index), atomically, its SHA-256 recorded in ``files``."""
-    files[f"{name}.csv"] = atomic_write(out / f"{name}.csv", df.to_csv(index=False).encode())
+    files[f"{name}.csv"] = atomic_write_bytes(out / f"{name}.csv", df.to_csv(index=False).encode())
 
 
 def write_text(out, filename, text, files):
     """``text`` as ``filename`` (UTF-8), atomically, its SHA-256 recorded in ``files``."""
-    files[filename] = atomic_write(out / filename, text.encode("utf-8"))
+    files[filename] = atomic_write_bytes(out / filename, text.encode("utf-8"))
 
 
 #: the page embeds each figure's PNG; the cached HTML fragments name the file instead
@@ -229,52 +227,6 @@ def write_outputs(
         sec.figures.clear()  # drop the Figure objects: nothing stays alive
     text = "\n".join(body)
     return embed_figures(text, out) if embed else text
-
-
-def store_header(store, notes):
-    """Metadata of one store and its experiment: (HTML, parameter table)."""
-    import pandas as pd
-
-    exp = store.experiment
-    man = store.manifest
-    # unequal disks (docs/unequal.md): the partner, and the pair the ICs are drawn at
-    partner = exp.partner_line() if hasattr(exp, "partner_line") else ""
-    ic_at = exp.ic_radius_label() if hasattr(exp, "ic_radius_label") else f"{exp.r_max:g}"
-    meta = [
-        ("experiment", f"{exp.name} (hash {man.get('experiment_hash', exp.hash())})"),
-        ("description", exp.description or "—"),
-        ("seed", str(exp.seed)),
-        ("rule", exp.rule),
-        *([("disks", partner)] if partner else []),
-        ("IC method", f"{exp.ic_method}, {exp.n_ics} ICs drawn at r_max = {ic_at}"),
-        ("steps", f"{exp.n_steps} steps of τ = {exp.tau:g} ({exp.sampling} sampling)"),
-        ("kicktimes version (store)", str(man.get("kicktimes_version", "unknown"))),
-        ("kicktimes version (report)", __version__),
-        ("store", os.fspath(Path(store.path).resolve())),
-        ("store created / updated", f"{man.get('created', '?')} / {man.get('updated', '?')}"),
-        ("tasks", f"{len(exp.tasks()) - len(store.missing_tasks)}/{len(exp.tasks())} finished"),
-    ]
-    rows = "".join(
-        f"<tr><td><b>{html.escape(k)}</b></td><td>{html.escape(v)}</td></tr>" for k, v in meta
-    )
-    params = pd.DataFrame(
-        [
-            (k, ", ".join(map(str, v)) if isinstance(v, list | tuple) else str(v))
-            for k, v in exp.to_dict().items()
-        ],
-        columns=["parameter", "value"],
-    )
-    parts = [f'<table class="meta">{rows}</table>']
-    if store.missing_tasks:
-        parts.append(
-            f'<p class="note">The store is unfinished: {len(store.missing_tasks)} tasks '
-            "are missing; every number below uses the finished tasks only.</p>"
-        )
-    if notes:
-        items = "".join(f"<li>{html.escape(n)}</li>" for n in notes)
-        parts.append(f'<div class="note"><b>Subsampling (deterministic):</b><ul>{items}</ul></div>')
-    parts.append("<h3>Parameters</h3>" + table_html(params))
-    return "\n".join(parts), params
 
 
 def toc_item(anchor, title, children=()):

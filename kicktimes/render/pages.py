@@ -6,11 +6,12 @@ Every page under ``docs/results/`` that states results starts with one line, ::
 
 (the model is ``docs/results/README.md``), and every comparative word in it comes from
 a verdict of :mod:`kicktimes.stats` (``ratio_verdict``, ``share_verdict``), never typed.
-The studies of :mod:`kicktimes.studies` import these from :mod:`kicktimes.report`.
+The sweep report (:mod:`kicktimes.report`) and the studies of
+:mod:`kicktimes.studies` import these from here.
 
 Examples
 --------
->>> from kicktimes.report.pages import ratio_text, trend_verdict
+>>> from kicktimes.render.pages import ratio_text, trend_verdict
 >>> ratio_text(0.771, 0.721, 0.825)
 '0.771 [0.721, 0.825], lower'
 >>> trend_verdict(0.1, 0.4)
@@ -30,10 +31,9 @@ from kicktimes import __version__
 from kicktimes.stats import MARGIN, format_interval, ratio_verdict
 
 __all__ = ["NULL_CALIBRATION", "NULL_CALIBRATION_COLUMNS", "header",
-           "markdown_table", "ratio_text", "simulations_source", "store_name",
-           "trend_verdict", "write_null_calibration"]
-
-#: the equivalence margin of every ratio on these pages, stated before any was computed
+           "markdown_table", "number_text", "p_value_text", "percent_text", "ratio_text",
+           "rho_text", "simulations_source", "store_name", "trend_verdict",
+           "write_null_calibration", "write_results_page"]
 
 
 def store_name(path) -> str:
@@ -67,6 +67,32 @@ def ratio_text(estimate, low, high, tolerance=MARGIN) -> str:
     """``"0.771 [0.721, 0.825], lower"``: the interval and its `ratio_verdict`."""
     return (f"{format_interval(estimate, low, high)}, "
             f"{ratio_verdict(low, high, tolerance)}")
+
+
+def number_text(x, digits=3) -> str:
+    """``x`` with ``digits`` significant figures; ``"n/a"`` when None or not finite.
+
+    >>> number_text(0.123456), number_text(float("nan"))
+    ('0.123', 'n/a')
+    """
+    return "n/a" if x is None or not np.isfinite(x) else f"{x:.{digits}g}"
+
+
+def percent_text(x) -> str:
+    """A share as a percentage with one decimal: ``percent_text(0.0512) == '5.1%'``."""
+    return "n/a" if not np.isfinite(x) else f"{100 * x:.1f}%"
+
+
+def p_value_text(p) -> str:
+    """A p-value with 3 significant figures; ``"< 1e-300"`` for an underflowed 0."""
+    if not np.isfinite(p):
+        return "n/a"
+    return "< 1e-300" if p == 0 else f"{p:.3g}"
+
+
+def rho_text(rho, p) -> str:
+    """A rank correlation and its p-value: ``rho_text(0.9, 0.037) == '0.90, p = 0.037'``."""
+    return "n/a" if not np.isfinite(rho) else f"{rho:.2f}, p = {p_value_text(p)}"
 
 
 def trend_verdict(low, high) -> str:
@@ -128,4 +154,27 @@ def write_null_calibration(results_dir, study, rows: pd.DataFrame) -> Path:
     rows = rows[list(NULL_CALIBRATION_COLUMNS)].sort_values(["study", "data", "test"],
                                                             kind="stable")
     atomic_write(path, lambda tmp: rows.to_csv(tmp, index=False))
+    return path
+
+
+def write_results_page(path, lines, sources) -> Path:
+    """Write the results page ``path`` from its Markdown ``lines``, closed by the table of
+    where its numbers come from (`kicktimes.render.provenance`), atomically; returns the
+    path.
+
+    ``sources`` are the page's `kicktimes.render.provenance.Source` rows, checked first
+    against the CSVs in the page's folder (`check_sources`): a page never names a CSV or
+    a column that is not there, and a failed check leaves the old page in place.
+    """
+    from kicktimes.fileio import atomic_write
+    from kicktimes.render.provenance import check_sources, provenance_lines
+
+    path = Path(path)
+    sources = list(sources)
+    check_sources(path.parent, sources)
+    lines = list(lines)
+    while lines and lines[-1] == "":
+        lines.pop()
+    text = "\n".join([*lines, "", *provenance_lines(sources)])
+    atomic_write(path, lambda tmp: Path(tmp).write_text(text, encoding="utf-8"))
     return path
