@@ -44,8 +44,8 @@ from pathlib import Path
 import pandas as pd
 
 from kicktimes.experiment import execute_task, preset, run_experiment
-from kicktimes.experiment.presets import SCALES, scale_presets
 from kicktimes.experiment.runner import local_pool
+from kicktimes.studies.paper import SCALES, scale_presets
 
 # with the tangent FTLE (the presets) each trajectory is simulated once, together with its
 # FTLE (one pass): that time is under lyapunov_*; simulation_* is what runs without it

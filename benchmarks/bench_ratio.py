@@ -47,7 +47,8 @@ from two_disk import load as load_c_reference  # noqa: E402
 
 from kicktimes import initial_conditions  # noqa: E402
 from kicktimes.experiment import load_store  # noqa: E402
-from kicktimes.experiment.presets import preset, scale_presets  # noqa: E402
+from kicktimes.experiment.presets import preset  # noqa: E402
+from kicktimes.studies.paper import scale_presets  # noqa: E402
 
 
 def c_loop_seconds(c_ref, scale: str, content: str) -> tuple[float, int]:

@@ -327,7 +327,8 @@ def test_the_first_screen_is_a_table_of_questions_then_a_table_of_at_most_8_colu
 
 
 def test_every_family_has_the_rule_by_ic_design_as_control_experiments():
-    from kicktimes.experiment.presets import CONTROL_ICS_B, CONTROL_PRESETS, PRESETS, SCALES
+    from kicktimes.experiment.presets import CONTROL_ICS_B, CONTROL_PRESETS, PRESETS
+    from kicktimes.studies.paper import SCALES
 
     names = {PRESETS[k].name for k in CONTROL_PRESETS}
     assert names == {f"{fam}-{c}" for fam in ("family_a", "family_b")

@@ -2,7 +2,7 @@
 
 ``kicktimes reproduce --study paper --scale paper --out OUT --results docs/results``
 (:func:`reproduce`) runs
-the presets of `kicktimes.experiment.SCALES` (both families and the 2 x 2 design of
+the presets of `SCALES` (`presets.py`) (both families and the 2 x 2 design of
 collision rule x initial conditions, `kicktimes.experiment.CONTROL_PRESETS`) into
 ``OUT/store-<name>``, builds the sweep report (:mod:`kicktimes.report`) into ``OUT/report``
 and writes the page ``README.md`` with :func:`write_results`: the answers first (each
@@ -31,6 +31,8 @@ from kicktimes.studies.paper.page import (
     copy_first_screen,
     write_results,
 )
+from kicktimes.studies.paper.presets import SCALES, scale_presets
 from kicktimes.studies.paper.run import reproduce
 
-__all__ = ["BEGIN", "END", "PROTOCOL_POINTER", "copy_first_screen", "reproduce", "write_results"]
+__all__ = ["BEGIN", "END", "PROTOCOL_POINTER", "SCALES", "copy_first_screen", "reproduce",
+           "scale_presets", "write_results"]

@@ -23,7 +23,7 @@ def reproduce(out, *, scale="quick", results_dir=None, workers=None, progress=No
     out : path-like
         Work folder: the stores and the report.
     scale : {"quick", "paper"}
-        ``"paper"``: both families and their controls (`kicktimes.experiment.SCALES`);
+        ``"paper"``: both families and their controls (`kicktimes.studies.paper.SCALES`);
         ``"quick"``: the small versions ``quick_a``, ``quick_b``.
     results_dir : path-like, optional
         Folder of the page (none by default: the report alone).
@@ -52,11 +52,12 @@ def reproduce(out, *, scale="quick", results_dir=None, workers=None, progress=No
     """
     from kicktimes.compilation import compile_first
     from kicktimes.experiment import run_experiment
-    from kicktimes.experiment.presets import CONTENTS, SCALES, preset, scale_presets
+    from kicktimes.experiment.presets import CONTENTS, preset
     from kicktimes.experiment.runner import local_pool
     from kicktimes.experiment.store import pending_tasks
     from kicktimes.report.process import ReportProcess, build_stores_report
     from kicktimes.studies.paper.page import write_results
+    from kicktimes.studies.paper.presets import SCALES, scale_presets
 
     check_scale(scale, SCALES)
     if content not in CONTENTS:
