@@ -1,6 +1,7 @@
 """Test-suite settings shared by every test module."""
 
 import os
+import re
 
 from hypothesis import settings
 
@@ -41,3 +42,52 @@ def assert_provenance(page):
         assert set(named) <= have, f"{csv} lacks {sorted(set(named) - have)}"
         rows.append((csv, columns, function.strip("`")))
     return rows
+
+
+#: a path of the machine the page was built on (a page names stores and commands, never
+#: where they lay)
+MACHINE_PATH = re.compile(r"(/tmp/|/work/|/home/|/Users/|/root/|[A-Za-z]:\\\\)")
+
+
+def build_study(tmp_path_factory, name, reproduce, scales, params, patches=()):
+    """``reproduce(out)`` of a study at a tiny size: its ``scales["quick"]`` set to
+    ``params`` and each ``(object, attribute, value)`` of ``patches`` in place for the
+    run; returns ``(out, page)``."""
+    import pytest
+
+    out = tmp_path_factory.mktemp(name)
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setitem(scales, "quick", params)
+        for target, attribute, value in patches:
+            mp.setattr(target, attribute, value)
+        page = reproduce(out)
+    return out, page
+
+
+def assert_study_page(page, study, scale="quick"):
+    """The page of ``reproduce`` for ``study`` at ``scale``: ``results-<study>/<study>.md``,
+    its Generated line naming the command, no path of this machine. Returns its text."""
+    text = page.read_text(encoding="utf-8")
+    assert page.name == f"{study}.md" and page.parent.name == f"results-{study}"
+    assert f"(`kicktimes reproduce --study {study} --scale {scale}`)" in text.splitlines()[2]
+    assert not MACHINE_PATH.search(text), MACHINE_PATH.search(text).group(0)
+    return text
+
+
+def refuse_simulations(monkeypatch, module, *names):
+    """Replace ``module``'s functions ``names`` by one that fails: a rerun that reuses its
+    cache never calls them."""
+    def simulated_again(*args, **kwargs):
+        raise AssertionError("simulated again")
+
+    for name in names:
+        monkeypatch.setattr(module, name, simulated_again)
+
+
+def table_cells(text, first):
+    """The cells of the Markdown table row of ``text`` whose first cell is ``first``."""
+    for line in text.splitlines():
+        cells = [c.strip() for c in line.strip().strip("|").split("|")]
+        if cells and cells[0] == first:
+            return cells
+    raise AssertionError(f"no table row {first!r}")

@@ -9,12 +9,12 @@ from pathlib import Path
 
 import pandas as pd
 import pytest
+from conftest import MACHINE_PATH, table_cells
 
 from kicktimes.stats import format_interval, ratio_verdict
 
 RESULTS = Path(__file__).resolve().parents[1] / "docs" / "results"
 PAGES = ["README.md", "science.md", "mechanism.md", "escape.md", "unequal.md", "scatter.md"]
-MACHINE_PATH = re.compile(r"(/tmp/|/work/|/home/|/Users/|/root/|[A-Za-z]:\\\\)")
 
 
 def _page(name):
@@ -33,15 +33,6 @@ def test_every_page_starts_with_its_generated_line_and_names_no_machine_path(nam
     assert not MACHINE_PATH.search(text), MACHINE_PATH.search(text).group(0)
 
 
-def _cells(text, first_column):
-    """The row of the page's markdown table whose first cell is ``first_column``."""
-    for line in text.splitlines():
-        cells = [c.strip() for c in line.strip().strip("|").split("|")]
-        if cells and cells[0] == first_column:
-            return cells
-    raise AssertionError(f"no table row {first_column!r}")
-
-
 def test_the_science_page_s_ratio_per_radius_is_its_csv_with_its_verdict():
     text = _page("science.md")
     table = pd.read_csv(RESULTS / "science_stretching.csv")
@@ -49,7 +40,7 @@ def test_the_science_page_s_ratio_per_radius_is_its_csv_with_its_verdict():
     for row in kicked.itertuples():
         assert row.verdict == ratio_verdict(row.ratio_ci_low, row.ratio_ci_high)
     for r, g in kicked.groupby("radius"):
-        cells = _cells(text, f"{r:g}")
+        cells = table_cells(text, f"{r:g}")
         for k, system in enumerate(("poisson", "poisson_scatter")):
             row = g[g["system"] == system].iloc[0]
             want = (f"{format_interval(row.ratio, row.ratio_ci_low, row.ratio_ci_high)}, "
@@ -73,7 +64,7 @@ def test_the_unequal_page_gives_every_ratio_the_verdict_of_its_interval():
     text = _page("unequal.md")
     table = pd.read_csv(RESULTS / "size_ratio" / "size_ratio.csv")
     for row in table.itertuples():
-        cells = _cells(text, f"{row.size_ratio:g}")
+        cells = table_cells(text, f"{row.size_ratio:g}")
         want = (f"{format_interval(row.ftle_partner_ratio_disk0, row.ftle_partner_low_disk0, row.ftle_partner_high_disk0)}, "  # noqa: E501
                 f"{ratio_verdict(row.ftle_partner_low_disk0, row.ftle_partner_high_disk0)}")
         assert cells[4] == want
@@ -87,7 +78,7 @@ def test_the_scatter_page_is_its_csv_and_no_longer_decomposes_the_gap():
         assert row.verdict == ratio_verdict(row.ci_low, row.ci_high)
     main = table[table["ics"] == "without sticky ICs"]
     for r, g in main.groupby("radius"):
-        cells = _cells(text, f"{r:g}")
+        cells = table_cells(text, f"{r:g}")
         first = g.iloc[0]
         assert cells[1] == (f"{format_interval(first.estimate, first.ci_low, first.ci_high)}, "
                             f"{first.verdict}")
@@ -108,7 +99,7 @@ def test_the_mechanism_page_reads_the_late_hazard_from_its_table(folder):
     tab = _numbers(folder)
     rule = tab["rule"].iloc[0]
     section = text.split(f"## The {rule} rule")[1].split("\n## ")[0]
-    cells = _cells(section, "rescaled t > 5")
+    cells = table_cells(section, "rescaled t > 5")
     groups = [("paper", 0.01), ("paper", 0.02), ("uniform", 0.01), ("uniform", 0.02)]
     for k, (method, r) in enumerate(groups):
         row = tab[(tab["method"] == method) & (tab["radius"] == r)
@@ -212,7 +203,7 @@ def test_the_escape_page_sets_every_rate_beside_the_hole_s_ergodic_rate():
     block = text.split("**The hole alone.**")[1].split("**Ratio of escape rates")[0]
     for r in (0.005, 0.01, 0.02, 0.03):
         erg = 0.1 / (math.pi ** 2 * (1 - r))          # 2h / (pi^2 (1 - r)), h = 0.05
-        cells = _cells(block, f"{r:g}")
+        cells = table_cells(block, f"{r:g}")
         assert cells[1] == f"{erg:.5f}"
         row = tails.loc[(r, "poisson")]
         lo, hi = row["rate_boot_low"] / erg, row["rate_boot_high"] / erg
@@ -224,7 +215,7 @@ def test_the_unequal_page_names_the_ftle_and_gives_ks_and_dispersion_intervals()
     assert "finite-time Lyapunov exponent" in text
     table = pd.read_csv(RESULTS / "size_ratio" / "size_ratio.csv")
     for row in table.itertuples():
-        cells = _cells(text, f"{row.size_ratio:g}")
+        cells = table_cells(text, f"{row.size_ratio:g}")
         assert re.fullmatch(r"[\d.]+ % \[[\d.]+, [\d.]+\]", cells[2])
         assert cells[3] == format_interval(row.dispersion_index, row.disp_low, row.disp_high,
                                            edges=(1.0,))

@@ -15,6 +15,7 @@ from pathlib import Path
 
 import pandas as pd
 import pytest
+from conftest import refuse_simulations
 
 import kicktimes.studies.disks.density as density_module
 import kicktimes.studies.disks.ftle_check as check_module
@@ -48,11 +49,8 @@ def work(tmp_path_factory):
 
 
 def _no_simulation(monkeypatch):
-    def refuse(*args, **kwargs):
-        raise AssertionError("simulated although the cache holds the runs")
-
-    monkeypatch.setattr(check_module, "pair", refuse)
-    monkeypatch.setattr(density_module, "one_state", refuse)
+    refuse_simulations(monkeypatch, check_module, "pair")
+    refuse_simulations(monkeypatch, density_module, "one_state")
 
 
 def _same(a, b, names):

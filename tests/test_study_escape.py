@@ -5,13 +5,12 @@ import re
 import numpy as np
 import pandas as pd
 import pytest
-from conftest import assert_provenance
+from conftest import assert_provenance, assert_study_page, refuse_simulations
 
 import kicktimes.studies.escape as study
 from kicktimes.stats import format_interval, ratio_verdict
 
 TINY = study.Params(n_ics=100, t_max=400.0, t_min=50.0, n_free=300)
-MACHINE_PATH = re.compile(r"(/tmp/|/work/|/home/|/Users/|/root/|[A-Za-z]:\\\\)")
 
 
 @pytest.fixture(scope="module")
@@ -26,10 +25,7 @@ def built(tmp_path_factory):
 
 def test_the_page_names_its_command_and_no_machine_path(built):
     _, page, _ = built
-    text = page.read_text(encoding="utf-8")
-    assert page.name == "escape.md" and page.parent.name == "results-escape"
-    assert "(`kicktimes reproduce --study escape --scale quick`)" in text.splitlines()[2]
-    assert not MACHINE_PATH.search(text)
+    assert_study_page(page, "escape")
     assert (page.parent / "escape" / "escape_survival.png").stat().st_size > 0
 
 
@@ -48,12 +44,7 @@ def test_the_page_s_ratios_are_its_csv_with_their_verdicts(built):
 def test_a_rerun_reuses_the_cached_escape_times(built, monkeypatch):
     out, page, _ = built
     before = {p.name: p.read_bytes() for p in (page.parent / "escape").glob("*.csv")}
-
-    def no_simulation(*args, **kwargs):
-        raise AssertionError("simulated again")
-
-    monkeypatch.setattr(study, "escape_times", no_simulation)
-    monkeypatch.setattr(study, "free_disk_escapes", no_simulation)
+    refuse_simulations(monkeypatch, study, "escape_times", "free_disk_escapes")
     monkeypatch.setitem(study.SCALES, "quick", TINY)
     again = study.reproduce(out, command="my command")
     assert "(`my command`)" in again.read_text(encoding="utf-8")

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import pandas as pd
 import pytest
-from conftest import assert_provenance
+from conftest import assert_provenance, build_study, refuse_simulations, table_cells
 
 from kicktimes.stats import format_interval, ratio_verdict
 from kicktimes.studies.mechanism import run
@@ -22,21 +22,9 @@ def _placeholders(results, folder, **kwargs):
 
 @pytest.fixture(scope="module")
 def built(tmp_path_factory):
-    out = tmp_path_factory.mktemp("mechanism")
-    with pytest.MonkeyPatch.context() as mp:
-        mp.setitem(run.SCALES, "quick", TINY)
-        mp.setattr(run, "RULES", {"mirror": "mechanism"})
-        mp.setattr(run, "write_figures", _placeholders)
-        page = run.reproduce(out)
-    return out, page
-
-
-def _cells(text, first):
-    for line in text.splitlines():
-        cells = [c.strip() for c in line.strip().strip("|").split("|")]
-        if cells[0] == first:
-            return cells
-    raise AssertionError(first)
+    return build_study(tmp_path_factory, "mechanism", run.reproduce, run.SCALES, TINY,
+                       [(run, "RULES", {"mirror": "mechanism"}),
+                        (run, "write_figures", _placeholders)])
 
 
 def test_the_page_names_the_command_and_reads_its_table(built):
@@ -51,7 +39,7 @@ def test_the_page_names_the_command_and_reads_its_table(built):
     run_rows = tab[tab["method"] == "run"].set_index("quantity")["estimate"]
     assert run_rows.to_dict() == {"n_ics": 10, "t_max": 1000, "twins": 1, "seed": 29}
     section = text.split("## The mirror rule")[1]
-    cells = _cells(section, "rescaled t > 5")
+    cells = table_cells(section, "rescaled t > 5")
     groups = [("paper", 0.01), ("paper", 0.02), ("uniform", 0.01), ("uniform", 0.02)]
     for k, (method, r) in enumerate(groups):
         row = tab[(tab["method"] == method) & (tab["radius"] == r)
@@ -67,13 +55,9 @@ def test_the_page_names_the_command_and_reads_its_table(built):
 
 def test_a_rerun_reuses_each_rule_s_numbers_and_figures(built, monkeypatch):
     out, page = built
-
-    def fail(*args, **kwargs):
-        raise AssertionError("simulated again")
-
     monkeypatch.setitem(run.SCALES, "quick", TINY)
     monkeypatch.setattr(run, "RULES", {"mirror": "mechanism"})
-    monkeypatch.setattr(run, "simulate", fail)
+    refuse_simulations(monkeypatch, run, "simulate")
     again = run.reproduce(out, results_dir=out / "again", command="kicktimes reproduce "
                           "--study mechanism")
     assert "(`kicktimes reproduce --study mechanism`)" in again.read_text(encoding="utf-8")
@@ -92,8 +76,8 @@ def test_the_whole_early_hazard_is_read_not_its_first_bin_alone(built):
     text = page.read_text(encoding="utf-8")
     tab = pd.read_csv(page.parent / "mechanism" / "mechanism_numbers.csv")
     section = text.split("## The mirror rule")[1]
-    low_cells = _cells(section, "minimum over t < 4 (bin)")
-    count_cells = _cells(section, "bins below the rate, t < 4")
+    low_cells = table_cells(section, "minimum over t < 4 (bin)")
+    count_cells = table_cells(section, "bins below the rate, t < 4")
     groups = [("paper", 0.01), ("paper", 0.02), ("uniform", 0.01), ("uniform", 0.02)]
     for k, (method, r) in enumerate(groups):
         g = tab[(tab["method"] == method) & (tab["radius"] == r)]

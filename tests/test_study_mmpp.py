@@ -1,11 +1,10 @@
 """The MMPP study (kicktimes.studies.mmpp): its page from its tables, its cache."""
 
-import re
 from types import SimpleNamespace
 
 import pandas as pd
 import pytest
-from conftest import assert_provenance
+from conftest import assert_provenance, assert_study_page, build_study, refuse_simulations
 
 import kicktimes.studies.mmpp as study
 import kicktimes.studies.mmpp.tables as tables
@@ -18,21 +17,13 @@ FEW = {"N_MC": 19, "N_BOOT": 50}
 
 @pytest.fixture(scope="module")
 def built(tmp_path_factory):
-    out = tmp_path_factory.mktemp("mmpp")
-    with pytest.MonkeyPatch.context() as mp:
-        mp.setitem(study.SCALES, "quick", TINY)
-        for name, value in FEW.items():
-            mp.setattr(tables, name, value)
-        page = study.reproduce(out)
-    return out, page
+    return build_study(tmp_path_factory, "mmpp", study.reproduce, study.SCALES, TINY,
+                       [(tables, name, value) for name, value in FEW.items()])
 
 
 def test_the_page_names_its_command_and_its_verdicts_are_its_csv(built):
     _, page = built
-    text = page.read_text(encoding="utf-8")
-    assert page.name == "mmpp.md" and page.parent.name == "results-mmpp"
-    assert "(`kicktimes reproduce --study mmpp --scale quick`)" in text.splitlines()[2]
-    assert not re.search(r"/tmp/|/work/|/home/", text)
+    text = assert_study_page(page, "mmpp")
     pooled = pd.read_csv(page.parent / "mmpp" / "mmpp_billiard_pooled.csv")
     assert pooled["rule"].tolist() == list(study.RULES)
     for p in pooled.itertuples():
@@ -56,11 +47,7 @@ def test_the_page_names_its_command_and_its_verdicts_are_its_csv(built):
 def test_a_rerun_reuses_the_cached_collision_times(built, monkeypatch):
     out, page = built
     before = (page.parent / "mmpp" / "mmpp_billiard_pooled.csv").read_bytes()
-
-    def no_simulation(*args, **kwargs):
-        raise AssertionError("simulated again")
-
-    monkeypatch.setattr(study, "collision_runs", no_simulation)
+    refuse_simulations(monkeypatch, study, "collision_runs")
     monkeypatch.setitem(study.SCALES, "quick", TINY)
     for name, value in FEW.items():
         monkeypatch.setattr(tables, name, value)

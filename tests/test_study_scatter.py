@@ -1,11 +1,9 @@
 """The scatter study (kicktimes.studies.scatter): its page from its table, its cache."""
 
-import re
-
 import numpy as np
 import pandas as pd
 import pytest
-from conftest import assert_provenance
+from conftest import assert_provenance, assert_study_page, build_study, refuse_simulations
 
 import kicktimes.studies.scatter as study
 from kicktimes.experiment.presets import preset
@@ -16,19 +14,12 @@ TINY = study.Params(n_ics=3, n_steps=300, radii=(0.01, 0.03))
 
 @pytest.fixture(scope="module")
 def built(tmp_path_factory):
-    out = tmp_path_factory.mktemp("scatter")
-    with pytest.MonkeyPatch.context() as mp:
-        mp.setitem(study.SCALES, "quick", TINY)
-        page = study.reproduce(out)
-    return out, page
+    return build_study(tmp_path_factory, "scatter", study.reproduce, study.SCALES, TINY)
 
 
 def test_the_page_names_its_command_and_its_numbers_are_its_csv(built):
     _, page = built
-    text = page.read_text(encoding="utf-8")
-    assert page.name == "scatter.md" and page.parent.name == "results-scatter"
-    assert "(`kicktimes reproduce --study scatter --scale quick`)" in text.splitlines()[2]
-    assert not re.search(r"/tmp/|/work/|/home/", text)
+    text = assert_study_page(page, "scatter")
     table = pd.read_csv(page.parent / "scatter_ratios.csv")
     assert set(table["radius"]) == set(TINY.radii)
     for row in table.itertuples():
@@ -54,11 +45,7 @@ def test_the_per_ic_table_has_every_system_and_a_fresh_partner_exponent(built):
 def test_a_rerun_reuses_the_cached_table(built, monkeypatch):
     out, page = built
     before = (page.parent / "scatter_ratios.csv").read_bytes()
-
-    def no_simulation(*args, **kwargs):
-        raise AssertionError("simulated again")
-
-    monkeypatch.setattr(study, "scatter_runs", no_simulation)
+    refuse_simulations(monkeypatch, study, "scatter_runs")
     monkeypatch.setitem(study.SCALES, "quick", TINY)
     again = study.reproduce(out, command="my command")
     assert "(`my command`)" in again.read_text(encoding="utf-8")

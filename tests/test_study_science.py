@@ -7,6 +7,7 @@ import dataclasses
 
 import pandas as pd
 import pytest
+from conftest import refuse_simulations
 
 from kicktimes.experiment import preset, run_experiment
 from kicktimes.render.provenance import PROVENANCE_TITLE
@@ -87,12 +88,8 @@ def test_a_rerun_reuses_the_cache_and_recomputes_only_the_statistics(built, pape
     parts = sorted((out / f"store-{TINY.sweep}").rglob("*.parquet"))
     stamps = [p.stat().st_mtime_ns for p in parts]
 
-    def fail(*args, **kwargs):
-        raise AssertionError("simulated again")
-
     monkeypatch.setitem(run.SCALES, "quick", TINY)
-    monkeypatch.setattr(run, "twins_raw", fail)
-    monkeypatch.setattr(run, "decorrelation", fail)
+    refuse_simulations(monkeypatch, run, "twins_raw", "decorrelation")
     again = run.reproduce(out, results_dir=out / "again", stores_dir=paper_study,
                           findings_dir=paper_study, command="kicktimes reproduce --study science")
     text = again.read_text(encoding="utf-8")

@@ -1,10 +1,14 @@
 """The unequal-disks study (kicktimes.studies.unequal): its page from its table, its cache."""
 
-import re
-
 import pandas as pd
 import pytest
-from conftest import assert_provenance
+from conftest import (
+    assert_provenance,
+    assert_study_page,
+    build_study,
+    refuse_simulations,
+    table_cells,
+)
 
 import kicktimes.studies.unequal as study
 from kicktimes.stats import format_interval, ratio_verdict
@@ -14,31 +18,16 @@ TINY = study.Params(n_ics=10, n_steps=1000)
 
 @pytest.fixture(scope="module")
 def built(tmp_path_factory):
-    out = tmp_path_factory.mktemp("unequal")
-    with pytest.MonkeyPatch.context() as mp:
-        mp.setitem(study.SCALES, "quick", TINY)
-        page = study.reproduce(out)
-    return out, page
-
-
-def _cells(text, first):
-    for line in text.splitlines():
-        cells = [c.strip() for c in line.strip().strip("|").split("|")]
-        if cells[0] == first:
-            return cells
-    raise AssertionError(first)
+    return build_study(tmp_path_factory, "unequal", study.reproduce, study.SCALES, TINY)
 
 
 def test_the_page_names_its_command_and_its_numbers_are_its_csv(built):
     _, page = built
-    text = page.read_text(encoding="utf-8")
-    assert page.name == "unequal.md" and page.parent.name == "results-unequal"
-    assert "(`kicktimes reproduce --study unequal --scale quick`)" in text.splitlines()[2]
-    assert not re.search(r"/tmp/|/work/|/home/", text)
+    text = assert_study_page(page, "unequal")
     table = pd.read_csv(page.parent / "size_ratio" / "size_ratio.csv")
     assert table["size_ratio"].tolist() == [1.0, 1.5, 2.5, 4.0]
     for row in table.itertuples():
-        cells = _cells(text, f"{row.size_ratio:g}")
+        cells = table_cells(text, f"{row.size_ratio:g}")
         lo, hi = row.ftle_partner_low_disk0, row.ftle_partner_high_disk0
         assert cells[4] == (f"{format_interval(row.ftle_partner_ratio_disk0, lo, hi)}, "
                             f"{ratio_verdict(lo, hi)}")
@@ -58,11 +47,7 @@ def test_at_ratio_one_both_partners_are_the_same_kick(built):
 def test_a_rerun_reuses_the_cached_runs(built, monkeypatch):
     out, page = built
     before = (page.parent / "size_ratio" / "size_ratio.csv").read_bytes()
-
-    def no_simulation(*args, **kwargs):
-        raise AssertionError("simulated again")
-
-    monkeypatch.setattr(study, "size_ratio_runs", no_simulation)
+    refuse_simulations(monkeypatch, study, "size_ratio_runs")
     monkeypatch.setitem(study.SCALES, "quick", TINY)
     again = study.reproduce(out, command="my command")
     assert "(`my command`)" in again.read_text(encoding="utf-8")

@@ -53,6 +53,18 @@ def _clear_of_cell(x, y, r, q, xy, radii, nxt, box):
 
 
 @njit(cache=True, error_model="numpy")
+def _clear_of_cells(x, y, r, lo_x, hi_x, lo_y, hi_y, m, head, xy, radii, nxt, box):
+    """Whether a disk of radius ``r`` at ``(x, y)`` overlaps none of the disks of the cells
+    ``lo_x..hi_x x lo_y..hi_y`` (indices taken modulo the grid's ``m``: the box wraps),
+    row by row (`_clear_of_cell`)."""
+    for gy in range(lo_y, hi_y + 1):
+        for gx in range(lo_x, hi_x + 1):
+            if not _clear_of_cell(x, y, r, head[gx % m + m * (gy % m)], xy, radii, nxt, box):
+                return False
+    return True
+
+
+@njit(cache=True, error_model="numpy")
 def _place(i, x, y, c, xy, head, nxt):
     """Put disk ``i`` at ``(x, y)`` and at the head of cell ``c``'s list."""
     xy[i, 0] = x
@@ -82,15 +94,9 @@ def _rsa(radii, order, u, xy, m, w, head, nxt, k0, j0):
         cx = min(int((x + 1.0) / w), m - 1)
         cy = min(int((y + 1.0) / w), m - 1)
         reach = int(math.ceil((radii[i] + r_max) / w))
-        ok = True
-        for gy in range(max(cy - reach, 0), min(cy + reach + 1, m)):
-            for gx in range(max(cx - reach, 0), min(cx + reach + 1, m)):
-                ok = _clear_of_cell(x, y, radii[i], head[gx + m * gy], xy, radii, nxt, 0.0)
-                if not ok:
-                    break
-            if not ok:
-                break
-        if not ok:
+        if not _clear_of_cells(x, y, radii[i], max(cx - reach, 0), min(cx + reach, m - 1),
+                               max(cy - reach, 0), min(cy + reach, m - 1), m, head, xy, radii,
+                               nxt, 0.0):
             continue
         _place(i, x, y, cx + m * cy, xy, head, nxt)
         k += 1
@@ -116,16 +122,8 @@ def _rsa_box(radii, order, u, xy, m, w, head, nxt, k0, j0, box):
         # all cells once if the reach wraps round the box
         lo_x, hi_x = (0, m - 1) if 2 * reach + 1 >= m else (cx - reach, cx + reach)
         lo_y, hi_y = (0, m - 1) if 2 * reach + 1 >= m else (cy - reach, cy + reach)
-        ok = True
-        for gy in range(lo_y, hi_y + 1):
-            for gx in range(lo_x, hi_x + 1):
-                ok = _clear_of_cell(x, y, radii[i], head[gx % m + m * (gy % m)], xy, radii,
-                                    nxt, box)
-                if not ok:
-                    break
-            if not ok:
-                break
-        if not ok:
+        if not _clear_of_cells(x, y, radii[i], lo_x, hi_x, lo_y, hi_y, m, head, xy, radii, nxt,
+                               box):
             continue
         _place(i, x, y, cx + m * cy, xy, head, nxt)
         k += 1

@@ -110,16 +110,9 @@ def drive(st, ev, rho, kicks, angles, kick_mode, kick_u, sp, unit_speed, t_end, 
                     tan_on = False
         if uni is not None and uni_on:
             # the uniform samples of the same flight (see drive_two.drive)
-            if sim_on:
-                ku = ob.sample_uniform(u_times, u_samples, ku, u_times.shape[0], t, dte,
-                                       s[one.S_X], s[one.S_Y], s[one.S_VX], s[one.S_VY], tau)
-            else:
-                if u_limit < 0:
-                    u_limit = ob.uniform_limit(fin[0], tau, u_times.shape[0])
-                ku = ob.sample_uniform(u_times, u_samples, ku, u_limit, t, dte, s[one.S_X],
-                                       s[one.S_Y], s[one.S_VX], s[one.S_VY], tau)
-                if t + dte > fin[0]:
-                    uni_on = False
+            ku, u_limit, uni_on = ob.sample_uniform_flight(
+                u_times, u_samples, ku, u_limit, uni_on, sim_on, t, dte, s[one.S_X], s[one.S_Y],
+                s[one.S_VX], s[one.S_VY], tau, fin[0])
         if tan is not None:
             # the tangent vectors' step ends before the next event
             # (the kicked disk's tangent vectors have one step in mode 1: no Gram-Schmidt,

@@ -142,16 +142,9 @@ def drive(st, ev, phys, t_end, mode, tau, track, logs, stimes, samples, cnt, nex
             # the uniform samples of the same flight; once the run has ended at T = fin[0],
             # up to floor(T / tau) steps, and no flight beyond the one a run to T ends in
             x, y, vx, vy = two.disk(s, track)
-            if sim_on:
-                ku = ob.sample_uniform(u_times, u_samples, ku, u_times.shape[0], t, dte, x, y,
-                                       vx, vy, tau)
-            else:
-                if u_limit < 0:
-                    u_limit = ob.uniform_limit(fin[0], tau, u_times.shape[0])
-                ku = ob.sample_uniform(u_times, u_samples, ku, u_limit, t, dte, x, y, vx, vy,
-                                       tau)
-                if t + dte > fin[0]:
-                    uni_on = False
+            ku, u_limit, uni_on = ob.sample_uniform_flight(u_times, u_samples, ku, u_limit,
+                                                           uni_on, sim_on, t, dte, x, y, vx, vy,
+                                                           tau, fin[0])
         if tan is not None:
             # the tangent vectors' step ends before the next event
             while tan_on and not t + dte <= tk:

@@ -159,6 +159,24 @@ def uniform_limit(t_end, tau, cap):
 
 
 @njit(cache=True, inline="always", error_model="numpy")
+def sample_uniform_flight(u_times, u_samples, ku, u_limit, uni_on, sim_on, t, dt, x, y, vx, vy,
+                          tau, t_fin):
+    """The uniform samples of one free flight of both drivers' ``uni`` observer: while the
+    simulation runs, as far as the buffer goes; once it has ended at ``t_fin``, up to
+    ``floor(t_fin / tau)`` samples (`uniform_limit`) and no flight beyond the one a run to
+    ``t_fin`` ends in. Returns ``(ku, u_limit, uni_on)``."""
+    if sim_on:
+        ku = sample_uniform(u_times, u_samples, ku, u_times.shape[0], t, dt, x, y, vx, vy, tau)
+    else:
+        if u_limit < 0:
+            u_limit = uniform_limit(t_fin, tau, u_times.shape[0])
+        ku = sample_uniform(u_times, u_samples, ku, u_limit, t, dt, x, y, vx, vy, tau)
+        if t + dt > t_fin:
+            uni_on = False
+    return ku, u_limit, uni_on
+
+
+@njit(cache=True, inline="always", error_model="numpy")
 def sample_at_event(stimes, samples, k, t, x, y, tau):
     """The paper's step cut short by the event at ``t``: a sample there; returns
     ``(k, next_time)``."""
