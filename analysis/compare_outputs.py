@@ -78,6 +78,31 @@ def _html_equal(a: Path, b: Path, roots) -> bool:
     return plain[0] == plain[1]
 
 
+def _numeric_difference(a: Path, b: Path) -> str:
+    """How far two CSVs of the same shape differ: ``"; largest relative difference X in
+    column C"`` over their numeric columns (text columns must agree), or ``""`` when they
+    differ in shape, columns or text."""
+    import numpy as np
+    import pandas as pd
+
+    x, y = pd.read_csv(a), pd.read_csv(b)
+    if x.shape != y.shape or list(x.columns) != list(y.columns):
+        return " (shape or columns)"
+    worst, where = 0.0, None
+    for col in x.columns:
+        u, v = x[col], y[col]
+        if u.dtype.kind in "fi" and v.dtype.kind in "fi":
+            u, v = u.to_numpy(float), v.to_numpy(float)
+            same = (u == v) | (np.isnan(u) & np.isnan(v))
+            if not same.all():
+                rel = np.abs(u - v)[~same] / np.maximum(np.abs(u), np.abs(v))[~same]
+                if np.nanmax(rel) > worst or where is None:
+                    worst, where = float(np.nanmax(rel)), col
+        elif not u.astype(str).equals(v.astype(str)):
+            return f" (text of column {col})"
+    return "" if where is None else f"; largest relative difference {worst:.2g} in {where}"
+
+
 def compare(before: Path, after: Path) -> list[str]:
     """The differences, one line each (empty: the trees say the same)."""
     problems = []
@@ -88,7 +113,7 @@ def compare(before: Path, after: Path) -> list[str]:
         a, b = before / rel, after / rel
         if rel.suffix == ".csv":
             if not TIMINGS.search(rel.name) and a.read_bytes() != b.read_bytes():
-                problems.append(f"CSV differs: {rel}")
+                problems.append(f"CSV differs: {rel}{_numeric_difference(a, b)}")
         elif rel.suffix == ".png":
             if a.read_bytes() != b.read_bytes() and not _pixels_equal(a, b):
                 problems.append(f"figure differs: {rel}")

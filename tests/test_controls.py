@@ -103,8 +103,8 @@ def test_sticky_runs_are_left_out_and_a_control_that_flips_the_verdict_is_named(
 def test_a_share_pooled_over_radii_gets_an_interval_clustered_on_ics():
     # every IC rejects at all 12 radii or at none: 12 x 200 runs are 200 independent
     # units, and the clustered interval is as wide as a binomial interval over 200
-    from kicktimes.report.effects import clopper_pearson
     from kicktimes.report.poisson import clustered_share
+    from kicktimes.stats import clopper_pearson
 
     rng = np.random.default_rng(3)
     rejects = rng.uniform(size=200) < 0.3

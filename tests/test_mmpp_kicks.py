@@ -256,7 +256,8 @@ def test_a_schedule_from_a_fit_kicks_at_the_fits_stationary_rate():
 
 # ------------------------------------------------------------------- the sweep's system
 def test_mmpp_kicks_fit_the_ics_collisions_or_fall_back_to_poisson():
-    from kicktimes.experiment.tasks import MIN_MMPP_EVENTS, MMPP_ROWS, mmpp_kicks
+    from kicktimes.experiment.tasks import MMPP_ROWS, mmpp_kicks
+    from kicktimes.stats import MMPP_MIN_EVENTS
 
     clustered = CLUSTERED.sample(400.0, rng=11)
     schedule, rows = mmpp_kicks(clustered, 400.0, np.random.default_rng(12))
@@ -265,9 +266,9 @@ def test_mmpp_kicks_fit_the_ics_collisions_or_fall_back_to_poisson():
     assert rows["kick_rate"][0] == pytest.approx(clustered.size / 400.0, rel=0.05)
     assert rows["mmpp_rate_low"][0] < rows["mmpp_rate_high"][0]
     assert rows["mmpp_delta_aic"][0] < -10  # the clustering is plain at 480 kicks
-    few = np.sort(np.random.default_rng(13).uniform(0, 100.0, MIN_MMPP_EVENTS - 1))
+    few = np.sort(np.random.default_rng(13).uniform(0, 100.0, MMPP_MIN_EVENTS - 1))
     schedule, rows = mmpp_kicks(few, 100.0, np.random.default_rng(12))
-    assert schedule == Poisson((MIN_MMPP_EVENTS - 1) / 100.0)
+    assert schedule == Poisson((MMPP_MIN_EVENTS - 1) / 100.0)
     for name, value, note in rows:
         assert note.startswith("Poisson kicks at the IC's rate: 49 collisions")
         assert math.isnan(value) == (name != "kick_rate")

@@ -14,12 +14,7 @@ from kicktimes import stats
 from kicktimes.render.figures import system_label
 from kicktimes.report import autocorrelation, counts, findings, lyapunov, recurrence, summary
 from kicktimes.report.context import Context
-from kicktimes.report.effects import (
-    clopper_pearson,
-    paired_ratio,
-    ratio_verdict,
-    share_verdict,
-)
+from kicktimes.stats import clopper_pearson, paired_ratio, ratio_verdict, share_verdict
 
 RADII = (0.008, 0.014, 0.02)
 EPS = (0.001, 0.01)

@@ -38,6 +38,7 @@ import pandas as pd
 
 from kicktimes.experiment.config import Experiment
 from kicktimes.experiment.plan import Task, make_tasks
+from kicktimes.stats import MMPP_MIN_EVENTS
 
 __all__ = [
     "COLLISION_COLUMNS",
@@ -63,9 +64,6 @@ KICK_DOMAIN = 0x6B69636B  # "kick"
 SYSTEM_CODES = {"two_particle": 0, "poisson": 1, "actual": 2, "poisson_scatter": 3,
                 "actual_scatter": 4, "poisson_kinetic": 5, "mmpp": 6,
                 "uniform_kinetic": 7}
-#: the fewest disk-disk collisions for an IC's own MMPP-2 fit (4 parameters); fewer, or a
-#: fit that fails, and the ``mmpp`` system is kicked at Poisson times of the IC's rate
-MIN_MMPP_EVENTS = 50
 #: the rows of the ``mmpp`` system that describe its fit (NaN, with the reason, without one)
 MMPP_ROWS = ("mmpp_rate_low", "mmpp_rate_high", "mmpp_switch_low", "mmpp_switch_high",
              "mmpp_delta_aic")
@@ -427,7 +425,7 @@ def mmpp_kicks(pp_times, t_window: float, rng: np.random.Generator) -> tuple:
     A two-state MMPP fitted to the IC's disk-disk collision times on ``(0, t_window]``
     (`kicktimes.stats.fit_mmpp`, its starts drawn from a child of ``rng``), started in its
     stationary law (`kicktimes.schedules.MMPP.from_fit`): kicks at the IC's own mean rate,
-    clustered as its collisions are. With fewer than `MIN_MMPP_EVENTS` collisions, or a fit
+    clustered as its collisions are. With fewer than `MMPP_MIN_EVENTS` collisions, or a fit
     that fails, Poisson kicks at the IC's rate ``n_pp / t_window`` (the ``poisson`` system's
     law, from this system's stream), and every row's note says so.
 
@@ -448,8 +446,8 @@ def mmpp_kicks(pp_times, t_window: float, rng: np.random.Generator) -> tuple:
     n = times.size
     rate = n / t_window
     reason = ""
-    if n < MIN_MMPP_EVENTS:
-        reason = f"{n} collisions, fewer than {MIN_MMPP_EVENTS} for an MMPP-2 fit"
+    if n < MMPP_MIN_EVENTS:
+        reason = f"{n} collisions, fewer than {MMPP_MIN_EVENTS} for an MMPP-2 fit"
     else:
         from kicktimes.stats import FitWarning, fit_mmpp
 

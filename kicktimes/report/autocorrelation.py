@@ -33,10 +33,10 @@ from kicktimes.render.figures import (
 )
 from kicktimes.render.pages import number_text
 from kicktimes.report.context import Section
-from kicktimes.report.effects import BUILT_IN, Effect, ratio_verdict, store_ratio
+from kicktimes.report.effects import BUILT_IN, Effect, store_ratio
 from kicktimes.report.store import REFERENCE, distinct, kicked_systems, wide
 from kicktimes.report.summary import diagnostic_summary
-from kicktimes.stats import paired_ratio
+from kicktimes.stats import paired_ratio, ratio_verdict
 
 __all__ = ["predicted_lag1", "acf_curves", "acf_differences", "acf_paired_differences",
            "crossings", "acf_figure", "lag1_ratios", "half_width95", "sections", "effects"]

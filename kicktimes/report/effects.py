@@ -18,25 +18,13 @@ from dataclasses import dataclass, field
 
 from kicktimes.stats import paired_ratio
 from kicktimes.stats.findings import (
-    SHARE_RULE,
     Finding,
-    clopper_pearson,
     effect_statement,
     ratio_rule,
     ratio_verdict,
-    share_verdict,
 )
 
-__all__ = [
-    "Effect",
-    "ratio_rule",
-    "SHARE_RULE",
-    "BUILT_IN",
-    "ratio_verdict",
-    "share_verdict",
-    "store_ratio",
-    "clopper_pearson",
-]
+__all__ = ["BUILT_IN", "Effect", "store_ratio"]
 
 #: appended to a verdict whose agreement is guaranteed by how the kicked system is built
 BUILT_IN = "built in"

@@ -27,8 +27,9 @@ from kicktimes.report.context import Section
 from kicktimes.report.controls import compute_controls
 from kicktimes.report.counts import experiment_kinetic
 from kicktimes.report.decomposition import gap_decomposition, gap_figure
-from kicktimes.report.effects import BUILT_IN, SHARE_RULE, ratio_rule
+from kicktimes.report.effects import BUILT_IN
 from kicktimes.report.store import PAPER_SCALE, is_paper_scale
+from kicktimes.stats import SHARE_RULE, ratio_rule
 from kicktimes.stats.findings import findings_table
 
 __all__ = ["collect", "scale_statement", "section", "EFFECT_MODULES", "STATEMENT_COLUMNS"]

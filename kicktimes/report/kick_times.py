@@ -13,6 +13,7 @@ import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 
+from kicktimes import stats
 from kicktimes.render.figures import TIME_UNIT, check_times, finite, new_axes
 from kicktimes.report.context import Section
 from kicktimes.report.store import nearest
@@ -169,7 +170,7 @@ def time_rescaling_qq(seqs, windows, *, rng, n_rep=200, ax=None, radius=None):
     for k in range(n_rep):
         sim = [np.sort(rng.uniform(0.0, w, n)) for n, w in zip(counts, windows, strict=True)]
         null[k] = np.sort(rescaled_intervals(sim, windows))
-    low, high = np.percentile(null, [2.5, 97.5], axis=0)
+    low, high = stats.percentile_interval(null, axis=0)
     ax.fill_between(theory, low, high, color="0.8", label="95 % band, Poisson (same n, T)")
     ax.plot(theory, obs, color="tab:blue", linewidth=1.2,
             label=f"disk-disk collisions ({obs.size} intervals)")

@@ -32,13 +32,14 @@ from matplotlib.lines import Line2D
 from kicktimes.render.figures import check_frame, x_axis
 from kicktimes.render.pages import percent_text
 from kicktimes.report.context import Section
-from kicktimes.report.effects import Effect, clopper_pearson
+from kicktimes.report.effects import Effect
+from kicktimes.stats import MMPP_MIN_EVENTS, clopper_pearson
 
 __all__ = ["MIN_EVENTS", "fit_job", "mmpp_comparison", "sections", "effects"]
 
-#: the fewest events of a sequence fitted by an MMPP-2 (4 parameters); the sweep's
-#: ``mmpp`` system uses the same threshold (`kicktimes.experiment.tasks.MIN_MMPP_EVENTS`)
-MIN_EVENTS = 50
+#: the fewest events of a sequence fitted by an MMPP-2: `kicktimes.stats.MMPP_MIN_EVENTS`
+#: (the sweep's ``mmpp`` system and the MMPP study use the same)
+MIN_EVENTS = MMPP_MIN_EVENTS
 #: EM starts of each fit (the comparison's and the parameters'), each run to convergence:
 #: `kicktimes.stats.fit_mmpp`'s search with 5 structured starts and one random (issue 39:
 #: on its 132 two-disk fits, 2 stayed short of the optimum by more than 0.01 (up to 0.63)

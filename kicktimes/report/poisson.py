@@ -28,8 +28,15 @@ from kicktimes.render.figures import (
 from kicktimes.render.pages import percent_text, rho_text
 from kicktimes.report.context import Section, seeded_rng
 from kicktimes.report.counts import experiment_kinetic, kinetic_rate_of
-from kicktimes.report.effects import SHARE_RULE, Effect, share_verdict
-from kicktimes.stats import clopper_pearson, format_interval, resample_counts, spearman
+from kicktimes.report.effects import Effect
+from kicktimes.stats import (
+    SHARE_RULE,
+    clopper_pearson,
+    format_interval,
+    resample_counts,
+    share_verdict,
+    spearman,
+)
 from kicktimes.stats.poisson import TEST_NULLS
 
 __all__ = [

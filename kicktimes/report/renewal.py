@@ -16,8 +16,9 @@ from matplotlib.patches import Patch
 from kicktimes.render.figures import check_frame, finite, x_axis
 from kicktimes.render.pages import percent_text
 from kicktimes.report.context import Section
-from kicktimes.report.effects import SHARE_RULE, Effect, clopper_pearson, share_verdict
+from kicktimes.report.effects import Effect
 from kicktimes.report.poisson import binomial_ci, subsample
+from kicktimes.stats import SHARE_RULE, clopper_pearson, share_verdict
 from kicktimes.stats.analyze import MIN_INTERVALS
 
 __all__ = ["model_comparison", "sections", "effects"]

@@ -44,6 +44,7 @@ from .ensemble import PoissonEnsembleResult, test_poisson_ensemble
 from .enskog import contact_value, enskog_frequency, henderson_z, speed_rate_factor
 from .findings import (
     MARGIN,
+    SHARE_RULE,
     Finding,
     clopper_pearson,
     format_interval,
@@ -56,6 +57,7 @@ from .findings import (
     rejection_verdict,
     robust_verdict,
     share_ratio_sample_size,
+    share_verdict,
 )
 from .gof import GofResult, goodness_of_fit
 from .groups import PoissonGroup, poisson_group, pooled_intervals
@@ -63,6 +65,7 @@ from .hazard import HazardTable, interval_hazard
 from .kinetic import conditional_kinetic_rate, mean_kinetic_rate
 from .mixture import RateMixture, rate_mixture, simulate_cox_times
 from .mmpp import (
+    MMPP_MIN_EVENTS,
     MMPPFit,
     MMPPLRTest,
     compare_point_processes,
@@ -85,6 +88,8 @@ from .robust import bootstrap_nanmedians, nanmedian
 from .survival import EscapeTail, circle_escape_constant, escape_survival, fit_escape_tail
 
 __all__ = [
+    "MMPP_MIN_EVENTS",
+    "SHARE_RULE",
     "MODELS",
     "FULL_SAMPLE_MODELS",
     "PARAM_NAMES",
@@ -144,6 +149,7 @@ __all__ = [
     "robust_verdict",
     "spearman",
     "share_ratio_sample_size",
+    "share_verdict",
     "format_interval",
     "rejection_verdict",
     "poisson_verdict",

@@ -120,23 +120,28 @@ def resample_counts(n_clusters, n_boot, rng=None):
     return check_rng(rng).multinomial(n, np.full(n, 1.0 / n), size=b).astype(float)
 
 
-def percentile_interval(replicates, level=0.95):
+def percentile_interval(replicates, level=0.95, *, axis=None):
     r"""Percentile interval of the finite bootstrap replicates.
 
-    ``(p_a, p_{100-a})`` with ``a = (1 - level) / 2 * 100`` percent, `numpy.percentile`'s
-    linear interpolation, over the finite values only (a resample whose statistic is
-    undefined, e.g. a ratio over a resample without events, drops out).
+    ``(p_a, p_{100-a})`` with ``a = 50 (1 - level)`` percent (2.5 and 97.5 for the 95 %
+    interval), `numpy.percentile`'s linear interpolation, over the finite values only (a
+    resample whose statistic is undefined, e.g. a ratio over a resample without events,
+    drops out).
 
     Parameters
     ----------
     replicates : array_like of float
-        The replicates :math:`\hat\theta^*_b` (any shape; flattened).
+        The replicates :math:`\hat\theta^*_b`: any shape, flattened (``axis=None``), or
+        one interval per slice along the other axes (``axis``: the replicates' axis).
     level : float
         Coverage, in (0, 1).
+    axis : int, optional
+        The replicates' axis; then ``low`` and ``high`` are arrays over the other axes,
+        each over the finite replicates of its slice (NaN where a slice has none).
 
     Returns
     -------
-    (float, float)
+    (float, float) or (ndarray, ndarray)
         ``(low, high)``; ``(nan, nan)`` when no replicate is finite.
 
     Examples
@@ -144,14 +149,26 @@ def percentile_interval(replicates, level=0.95):
     >>> from kicktimes.stats import percentile_interval
     >>> percentile_interval([1.0, 2.0, float("nan"), 3.0, 4.0], level=0.5)
     (1.75, 3.25)
+    >>> low, high = percentile_interval([[1.0, 10.0], [2.0, 20.0], [3.0, 30.0]], axis=0)
+    >>> low.tolist(), high.tolist()
+    ([1.05, 10.5], [2.95, 29.5])
     """
     level = check_real("level", level, low=0.0, high=1.0)
+    # 1 - 0.95 is 0.050000000000000044 in binary: the percentile is 2.5 %, not 2.5 % plus
+    # that rounding error
+    a = round(50.0 * (1.0 - level), 12)
+    if axis is not None:
+        v = np.asarray(replicates, float)
+        v = np.where(np.isfinite(v), v, np.nan)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)  # a slice without a finite value
+            low, high = np.nanpercentile(v, [a, 100.0 - a], axis=axis)
+        return low, high
     v = np.asarray(replicates, float).ravel()
     v = v[np.isfinite(v)]
     if not v.size:
         return math.nan, math.nan
-    a = (1 - level) / 2 * 100
-    return float(np.percentile(v, a)), float(np.percentile(v, 100 - a))
+    return float(np.percentile(v, a)), float(np.percentile(v, 100.0 - a))
 
 
 @dataclass(frozen=True)

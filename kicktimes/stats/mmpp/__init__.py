@@ -15,8 +15,8 @@ The public names are re-exported by :mod:`kicktimes.stats`.
 """
 
 from .choice import MMPPLRTest, compare_point_processes, mmpp_lr_test
-from .fit import MMPPFit, check_windows, fit_mmpp
+from .fit import MMPP_MIN_EVENTS, MMPPFit, check_windows, fit_mmpp
 from .simulation import simulate_mmpp
 
-__all__ = ["MMPPFit", "MMPPLRTest", "check_windows", "compare_point_processes", "fit_mmpp",
-           "mmpp_lr_test", "simulate_mmpp"]
+__all__ = ["MMPP_MIN_EVENTS", "MMPPFit", "MMPPLRTest", "check_windows",
+           "compare_point_processes", "fit_mmpp", "mmpp_lr_test", "simulate_mmpp"]

@@ -36,6 +36,12 @@ from .simulation import simulate_mmpp
 
 INITIAL = ("stationary", "free")
 MAX_STATES = 4
+#: the fewest events of one sequence fitted by an MMPP-2 alone (4 parameters: two rates,
+#: two switching rates): about 12 events per parameter. Fewer, and kicktimes does not fit
+#: it on its own: the sweep's ``mmpp`` system falls back to Poisson times, the report and
+#: ``kicktimes analyze --mmpp`` leave the sequence out, the MMPP study's per-run fits skip
+#: the run
+MMPP_MIN_EVENTS = 50
 #: Data over _SEARCH_INTERVALS intervals (in 4 windows or more) are searched on a random
 #: subset of whole windows of about that size: every start runs to convergence there, and
 #: the _FINALISTS best distinct optima continue on all the data

@@ -32,7 +32,7 @@ import math
 import numpy as np
 import pandas as pd
 
-from kicktimes.stats import format_interval, robust_verdict
+from kicktimes.stats import format_interval, percentile_interval, robust_verdict
 
 __all__ = ["BULK_WITHIN", "CONTROL_NAMES", "FINDINGS", "NOT_READ", "WALL_SHARE_MAX_WIDTH",
            "controls_findings", "controls_lines", "robust_text", "wall_share_lines",
@@ -266,7 +266,7 @@ def wall_shares(primary, box, *, n_min=30, n_draws=4000, seed=0) -> pd.DataFrame
         draws_b = rng.normal(db, sb, n_draws)
         with np.errstate(divide="ignore", invalid="ignore"):
             share = (dc - db) / (dc - 1.0)
-            low, high = np.percentile((draws_c - draws_b) / (draws_c - 1.0), [2.5, 97.5])
+            low, high = percentile_interval((draws_c - draws_b) / (draws_c - 1.0))
         text = format_interval(share, low, high, edges=(0.0, 1.0))
         if not r["dispersion_low"] > 1.0:
             reading = f"{text}: not decomposed (D's interval reaches 1)"

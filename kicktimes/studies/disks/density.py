@@ -56,7 +56,7 @@ import numpy as np
 import pandas as pd
 
 from kicktimes.fileio import atomic_write
-from kicktimes.stats import resample_indices
+from kicktimes.stats import percentile_interval, resample_indices
 from kicktimes.studies.cache import cached_tables, write_cached
 from kicktimes.studies.disks.ftle_check import _say_reused
 
@@ -257,7 +257,7 @@ def summarise(runs: pd.DataFrame, *, n_boot=2000, seed=0, fit_max_packing=FIT_MA
         # per replicate one resample of each packing's states, in turn (the stream of the page)
         boot = np.array([[v[resample_indices(v.size, 1, rng)[0]].mean() for v in per]
                          for _ in range(n_boot)])
-        lo, hi = np.percentile(boot, [2.5, 97.5], axis=0)
+        lo, hi = percentile_interval(boot, axis=0)
         for p, xv, v, m, a, b in zip(packings, x, per, means, lo, hi, strict=True):
             rows.append({"n_disks": n_disks, "packing": p, "reduced_density":
                          reduced_density(p), "ln_inv_density": xv, "n_states": v.size,
@@ -271,7 +271,7 @@ def summarise(runs: pd.DataFrame, *, n_boot=2000, seed=0, fit_max_packing=FIT_MA
 
         est = _fit(xd, means[dilute])
         bs = [_fit(xd, y[dilute]) for y in boot]
-        ci = {k: np.percentile([f[k] for f in bs], [2.5, 97.5], axis=0) for k in range(4)}
+        ci = {k: percentile_interval([f[k] for f in bs], axis=0) for k in range(4)}
         local_verdicts = [ratio_verdict(ci[3][0][i], ci[3][1][i], tolerance=SLOPE_MARGIN)
                           for i in range(int(dilute.sum()) - 1)]
         reading = density_form_reading(ci[2][0], ci[2][1], local_verdicts, SLOPE_MARGIN)

@@ -42,6 +42,7 @@ from kicktimes.stats import (
     fit_renewal,
     interval_hazard,
     kinetic_rate,
+    percentile_interval,
     poisson_group,
     ratio_verdict,
     rejection_verdict,
@@ -96,9 +97,7 @@ def rescale_by_speed(times, speeds, t_end, *, kT=KT):
 
 
 def _ci(samples):
-    lo, hi = np.nanpercentile(samples, [2.5, 97.5]) if np.isfinite(samples).any() else (
-        math.nan, math.nan)
-    return float(lo), float(hi)
+    return percentile_interval(samples)
 
 
 def _dispersion(s0, s1, s2):

@@ -32,6 +32,7 @@ from kicktimes.fileio import atomic_write
 from kicktimes.stats import (
     dilute_tagged_disk,
     format_interval,
+    percentile_interval,
     ratio_interval,
     ratio_verdict,
     resample_counts,
@@ -207,7 +208,7 @@ def summarise(runs, *, n_boot=2000, seed=0, n_events=2_000_000) -> pd.DataFrame:
         w = resample_counts(n.size, n_boot, rng)
         d = float(_d(n.sum(), s1.sum(), s2.sum()))
         boot = _d(w @ n, w @ s1, w @ s2)
-        low, high = (float(v) for v in np.percentile(boot, [2.5, 97.5]))
+        low, high = percentile_interval(boot)
         if (rule, k) not in predictions:
             est = dilute_tagged_disk(rule).dispersion(int(k), n_events=n_events, rng=int(k))
             p = float(est)

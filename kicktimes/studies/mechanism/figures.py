@@ -189,8 +189,7 @@ def fig_battery(results):
                 counts = np.asarray(d["observed"]["counts"][calm], float)
                 obs = dispersion(counts)
                 picks = stats.resample_indices(counts.size, 1000, 0)
-                obs_ci = tuple(np.percentile([dispersion(counts[p]) for p in picks],
-                                             [2.5, 97.5]))
+                obs_ci = stats.percentile_interval([dispersion(counts[p]) for p in picks])
             else:
                 vals = [[b["reject"][what].mean() for b in d["twins"][n]] for n in twins]
                 obs = d["observed"]["reject"][what].mean()

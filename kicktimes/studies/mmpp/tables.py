@@ -10,14 +10,13 @@ import numpy as np
 from scipy.linalg import expm
 
 from kicktimes import stats
-from kicktimes.stats import rejection_verdict
+from kicktimes.stats import MMPP_MIN_EVENTS, percentile_interval, rejection_verdict
 from kicktimes.stats.findings import clopper_pearson
 
-__all__ = ["DIP", "EARLY_EDGES", "MIN_EVENTS", "N_BOOT", "N_MC", "RENEWAL", "TESTS", "analyse",
+__all__ = ["DIP", "EARLY_EDGES", "N_BOOT", "N_MC", "RENEWAL", "TESTS", "analyse",
            "battery", "intervals", "mmpp_bin_hazard", "mmpp_dip"]
 
 TESTS = ("uniformity_ks", "exponential_ks", "exponential_ad", "ljung_box", "runs", "dispersion")
-MIN_EVENTS = 20
 RENEWAL = ("gamma", "weibull", "hyperexponential")
 DIP = 0.5
 #: the early hazard is read over these bins (the refractory time and the wall round
@@ -87,7 +86,7 @@ def analyse(rule, times, sticky, t_max, per_run, seed):
     """The rows of the three tables for one collision rule: the pooled fits (``pooled``),
     the time-rescaling residual checks (``resid``) and the refractory dip (``dip``), from
     the runs' collision ``times`` with the ``sticky`` ones left out; the per-run fits take
-    the first ``per_run`` runs with at least ``MIN_EVENTS`` collisions."""
+    the first ``per_run`` runs with at least `kicktimes.stats.MMPP_MIN_EVENTS` collisions."""
     rng = np.random.default_rng(seed)
     calm = [t for t, s in zip(times, sticky, strict=True) if not s]
     pooled, resid, dip = [], [], []
@@ -117,7 +116,7 @@ def analyse(rule, times, sticky, t_max, per_run, seed):
         for row in battery(rescaled.times, rescaled.windows, rng):
             resid.append({"rule": rule, "fit": "pooled", "states": k, **row})
     # per run: each run fitted alone
-    chosen = [t for t in calm if t.size >= MIN_EVENTS][:per_run]
+    chosen = [t for t in calm if t.size >= MMPP_MIN_EVENTS][:per_run]
     per = []
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
@@ -148,8 +147,8 @@ def analyse(rule, times, sticky, t_max, per_run, seed):
         boot.append(h.table["hazard"].iloc[0] / h.rate)
         e = _early_hazard(c, z)
         boot_min.append(e.table["hazard"].iloc[k] / e.rate)  # the data's bin, held fixed
-    b_lo, b_hi = np.percentile(boot, [2.5, 97.5])
-    m_lo, m_hi = np.percentile(boot_min, [2.5, 97.5])
+    b_lo, b_hi = percentile_interval(boot)
+    m_lo, m_hi = percentile_interval(boot_min)
     m_model = mmpp_bin_hazard(two, a, b)
     m_obs_lo, m_obs_hi = low_row["ci_low"] / early.rate, low_row["ci_high"] / early.rate
     dip.append({"rule": rule, "observed": first["hazard"] / haz.rate,

@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from kicktimes.stats import format_interval, ratio_verdict, robust_verdict
+from kicktimes.stats import format_interval, percentile_interval, ratio_verdict, robust_verdict
 from kicktimes.studies.protocol.tables import PAPER_READING, reading_label
 
 __all__ = ["claims_table", "SMALL_RADIUS", "SWITCHES"]
@@ -144,7 +144,7 @@ def _closer(ratios, panel, reading):
     point = abs(math.log(op["ratio"])) - abs(math.log(oa["ratio"]))
     with np.errstate(invalid="ignore", divide="ignore"):
         diff = np.abs(np.log(dp)) - np.abs(np.log(da))
-    lo, hi = np.percentile(diff[np.isfinite(diff)], [2.5, 97.5])
+    lo, hi = percentile_interval(diff)
     # exp(difference of log-distances): the ratio of the two kicked values, through the band
     verdict = {"within 10 %": "equally close", "lower": "Poisson closer",
                "higher": "actual closer"}.get(ratio_verdict(math.exp(lo), math.exp(hi)),
@@ -158,7 +158,7 @@ def _angle_ratio(ratios, panel, system, angle, estimator):
     _, o0, d0 = ratios.ratio(panel, system, (estimator, "paper", "shared", "uniform"))
     with np.errstate(invalid="ignore", divide="ignore"):
         q = d1 / d0
-    lo, hi = np.percentile(q[np.isfinite(q)], [2.5, 97.5])
+    lo, hi = percentile_interval(q)
     return o1["ratio"] / o0["ratio"], float(lo), float(hi), ratio_verdict(lo, hi)
 
 

@@ -29,7 +29,7 @@ import math
 import numpy as np
 import pandas as pd
 
-from kicktimes.stats import paired_ratio, ratio_verdict, robust_verdict
+from kicktimes.stats import paired_ratio, percentile_interval, ratio_verdict, robust_verdict
 from kicktimes.stats.findings import share_verdict
 from kicktimes.studies.protocol.compute import CONVERGENCE
 
@@ -252,8 +252,7 @@ def shapley_table(ratios: Ratios, panels) -> pd.DataFrame:
             total = point[frozenset(range(len(FACTORS)))] - point[frozenset()]
             for (column, default, alternative), value, draws in zip(FACTORS, phi, phi_boot,
                                                                    strict=True):
-                finite = draws[np.isfinite(draws)]
-                lo, hi = np.percentile(finite, [2.5, 97.5])
+                lo, hi = percentile_interval(draws)
                 out.append({
                     "family": p.name, "system": system, "choice": column,
                     "from": default, "to": alternative, "share": value,

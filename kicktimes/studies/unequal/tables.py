@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from kicktimes.stats import kinetic_rate, poisson_group, resample_indices
+from kicktimes.stats import kinetic_rate, percentile_interval, poisson_group, resample_indices
 from kicktimes.stats.findings import clopper_pearson
 from kicktimes.studies.unequal.compute import KINDS, R0
 
@@ -26,8 +26,7 @@ def dispersion_ci(counts, rng, n_boot=2000):
     """95 % bootstrap interval over ICs of the dispersion index var / mean of the counts."""
     counts = np.asarray(counts, float)
     b = counts[resample_indices(counts.size, n_boot, rng)]
-    lo, hi = np.percentile(b.var(1, ddof=1) / b.mean(1), [2.5, 97.5])
-    return float(lo), float(hi)
+    return percentile_interval(b.var(1, ddof=1) / b.mean(1))
 
 
 def ks_interval(row, n):
