@@ -243,8 +243,9 @@ def test_a_robust_cell_gives_its_verdict_and_the_range_over_every_control_and_fa
 
 
 def test_the_poisson_question_is_a_row_per_test_with_the_rule_as_a_control():
-    from kicktimes.report.answers import poisson_answer, qa_table
+    from kicktimes.report.answers import poisson_answer
     from kicktimes.report.controls import POISSON_QUESTION, merge_control_families, poisson_rows
+    from kicktimes.studies.paper.first_screen import qa_table
 
     rej = pd.DataFrame({"radius": [0.01, 0.02] * 2,
                         "test": ["uniformity_ks"] * 2 + ["ljung_box"] * 2,
@@ -295,8 +296,8 @@ def test_the_poisson_question_is_a_row_per_test_with_the_rule_as_a_control():
 
 
 def test_the_first_screen_is_a_table_of_questions_then_a_table_of_at_most_8_columns():
-    from kicktimes.report.answers import QUESTIONS, first_screen
     from kicktimes.report.controls import with_robustness
+    from kicktimes.studies.paper.first_screen import QUESTIONS, first_screen
 
     spec = []
     for system in ("poisson", "actual", "poisson_scatter", "actual_scatter", "poisson_kinetic",

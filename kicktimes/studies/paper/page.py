@@ -276,11 +276,12 @@ def write_results(
     >>> from kicktimes.studies.paper import write_results
     >>> write_results("stores/family_a", "docs/results")  # doctest: +SKIP
     """
-    from kicktimes.report.answers import first_screen, ratio_curves_figure
+    from kicktimes.report.answers import ratio_curves_figure
     from kicktimes.report.controls import merge_control_families
     from kicktimes.report.findings import rules_text, scale_statement
     from kicktimes.report.pipeline import CONTROL_STAGES, analyse, n_stages
     from kicktimes.stats import ratio_rule
+    from kicktimes.studies.paper.first_screen import first_screen
 
     paths = [store_paths] if isinstance(store_paths, str | os.PathLike) else list(store_paths)
     if not paths or not all(isinstance(p, str | os.PathLike) for p in paths):
