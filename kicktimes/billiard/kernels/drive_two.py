@@ -37,7 +37,8 @@ from kicktimes.billiard.kernels import observe as ob
 from kicktimes.billiard.kernels import tangent as tg
 from kicktimes.billiard.kernels import two
 
-__all__ = ["drive", "simulate_tangent_two_kernel", "simulate_two_kernel", "tangent_two_kernel"]
+__all__ = ["drive", "fresh_partner_tangent_two_kernel", "simulate_tangent_two_kernel",
+           "simulate_two_kernel", "tangent_two_kernel"]
 
 # the int64 carry array ``cnt`` of the loop (its position between calls)
 N_PP, N_B, K, SIM_ON, N_PP_RUN, CONT_ON, N_B_CONT, CONT_STATUS = range(8)
@@ -193,6 +194,10 @@ def drive(st, ev, phys, t_end, mode, tau, track, logs, stimes, samples, cnt, nex
         if ke == two.PAIR:
             if tan is not None and tan_on:
                 n_pert += 1
+                if tgi[tg.FRESH_PARTNER] != 0:
+                    for j in range(m):
+                        for i in range(4, 8):
+                            U[j, i] = 0.0
                 for j in range(m):
                     (U[j, 0], U[j, 1], U[j, 2], U[j, 3], U[j, 4], U[j, 5], U[j, 6],
                      U[j, 7]) = tg.pair_tangent(
@@ -433,3 +438,23 @@ def tangent_two_kernel(st, rho, sigma, rule, mode, n_steps, tau, U, max_events, 
         st[o + 1] += st[o + 3] * dt
     st[0] = tgf[tg.T_PREV]
     return log_scale, tgi[tg.N_RESC], tgi[tg.N_PERT], tgf[tg.T_PREV], tgi[tg.TAN_STATUS]
+
+
+@njit(cache=True, error_model="numpy")
+def fresh_partner_tangent_two_kernel(st, rho, sigma, n_steps, tau, U, max_events):
+    """`tangent_two_kernel` (the paper's steps, the mirror rule) with disk 1's deviation set
+    to zero just before every disk-disk collision: the two disks as the scatter model sees
+    them, where each collision meets a partner that carries no memory of the earlier ones
+    (docs/scatter.md). The same event loop (`drive`), with the tangent observer's
+    ``FRESH_PARTNER`` switch on. Returns ``(log_scale, n_rescaled, n_pp, t_end,
+    status)``."""
+    # (int64 arguments, not literals: the loop and its helpers compile once for every
+    # tangent kernel)
+    mirror, paper = np.int64(0), np.int64(2)
+    tan = tg.tangent_state(U, paper, n_steps, tau, max_events, np.int64(0))
+    tan[2][tg.FRESH_PARTNER] = 1
+    _run(st, rho, sigma, mirror, 0.0, paper, n_steps, tau, 0, 0, 0, max_events, 0.0, False,
+         False, tan, None, None)
+    _, log_scale, tgi, tgf, _, _, _ = tan
+    return log_scale, tgi[tg.N_RESC], tgi[tg.N_PERT], tgf[tg.T_PREV], tgi[tg.TAN_STATUS]
+

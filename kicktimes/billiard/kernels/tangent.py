@@ -36,8 +36,11 @@ __all__ = ["BIG", "MAX_SAME_INSTANT", "end_step", "event_guard", "gram_schmidt",
            "step_end", "store_carry", "tangent_flight", "tangent_state", "wall_tangent"]
 
 #: the tangent half of a driver carries its position between calls in ``tgi`` (int64) and
-#: ``tgf`` (float64), at these indices
-TAN_ON, I_LOOP, N_LOOP, N_EV, N_SAME, N_RESC, N_PERT, TAN_STATUS = range(8)
+#: ``tgf`` (float64), at these indices; ``tgi[FRESH_PARTNER]`` (1: disk 1's deviation set
+#: to zero just before each disk-disk collision, the scatter model's view of the two
+#: disks, `kicktimes.billiard.kernels.drive_two.fresh_partner_tangent_two_kernel`) is set
+#: at the start and never changes
+TAN_ON, I_LOOP, N_LOOP, N_EV, N_SAME, N_RESC, N_PERT, TAN_STATUS, FRESH_PARTNER = range(9)
 TK, T_PREV = range(2)
 
 MAX_SAME_INSTANT = 1000
@@ -229,7 +232,7 @@ def tangent_state(U, mode, n_steps, tau, max_events, n_orth):
     """The tangent half of a driver (`kicktimes.billiard.kernels.drive_two.drive`):
     ``(U, log_scale, tgi, tgf, max_events, n_orth, n_steps)`` at the start; the driver sets
     the first step's end from the initial state."""
-    tgi = np.zeros(8, dtype=np.int64)
+    tgi = np.zeros(9, dtype=np.int64)
     tgi[TAN_ON] = 1
     tgi[N_LOOP] = max(1, n_orth) if mode == 1 else n_steps
     return (U, np.zeros(U.shape[0]), tgi, np.zeros(2), max_events, n_orth, n_steps)

@@ -6,8 +6,8 @@ For each radius of family A and each of its first ICs (paper ICs drawn at r = 0.
 tangent-space exponents), `compute.scatter_runs` gives the FTLE of the two disks, of the
 kicked disk under uniform kicks and under scattering kicks (at Poisson times at the
 two-disk run's own rate, or at its actual collision times), and of the two disks with
-the partner's deviation zeroed before every collision (`kernel.fresh_lam`, its own numba
-kernel: the two-disk system as the scatter model sees it).
+the partner's deviation zeroed before every collision (`kernel.fresh_lam`, through the two-disk
+driver's own event loop: the two-disk system as the scatter model sees it).
 
 Per radius, each ratio of mean FTLE over ICs,
 :math:`\\bar\\lambda_{\\rm num} / \\bar\\lambda_{\\rm den}`, has a 95 % bootstrap interval
@@ -41,11 +41,11 @@ import pandas as pd
 from kicktimes.studies.cache import cached_tables
 from kicktimes.studies.options import study_run
 from kicktimes.studies.scatter.compute import one_ic, scatter_runs, shape_rows
-from kicktimes.studies.scatter.kernel import fresh_lam, fresh_partner_tangent
+from kicktimes.studies.scatter.kernel import fresh_lam
 from kicktimes.studies.scatter.page import SOURCES, TABLE, write_page
 from kicktimes.studies.scatter.tables import RATIOS, ratio_table, sticky, summary_tables
 
-__all__ = ["RATIOS", "SCALES", "Params", "cache_jobs", "fresh_lam", "fresh_partner_tangent",
+__all__ = ["RATIOS", "SCALES", "Params", "cache_jobs", "fresh_lam",
            "one_ic", "ratio_table", "reproduce", "scatter_runs", "shape_rows", "sticky",
            "summary_tables", "write_page"]
 
