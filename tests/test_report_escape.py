@@ -14,7 +14,6 @@ import pytest
 from kicktimes.experiment import load_store, preset, run_experiment
 from kicktimes.report import build_report
 from kicktimes.report.escape import (
-    AT_RISK_FLOOR,
     escape_answer,
     escape_comparison,
     escape_curves,
@@ -23,6 +22,7 @@ from kicktimes.report.escape import (
     escape_table,
     sections,
 )
+from kicktimes.stats import MIN_AT_RISK
 
 HOLES = [(0.0, 0.15)]
 
@@ -205,11 +205,11 @@ def test_the_figure_has_a_panel_per_radius_in_the_system_colours():
         colours = {line.get_label(): to_rgba(line.get_color()) for line in ax.lines}
         assert colours["Two-particle"] == to_rgba(system_style("two_particle")["color"])
         assert colours["Poisson"] == to_rgba(system_style("poisson")["color"])
-        # below AT_RISK_FLOOR runs at risk: thin and grey, joined to the measured part
+        # below MIN_AT_RISK runs at risk: thin and grey, joined to the measured part
         (grey,) = [ln for ln in ax.lines if ln.get_gid() == "few_at_risk_poisson"]
         (line,) = [ln for ln in ax.lines if ln.get_label() == "Poisson"]
         assert grey.get_xdata()[0] == line.get_xdata()[-1]
         assert grey.get_ydata()[0] == line.get_ydata()[-1]
         km = curves[(curves["system"] == "poisson") & (curves["radius"] == 0.01)]
-        first_few = km.loc[km["n_at_risk"] < AT_RISK_FLOOR, "time"].iloc[0]
+        first_few = km.loc[km["n_at_risk"] < MIN_AT_RISK, "time"].iloc[0]
         assert line.get_xdata()[-1] == pytest.approx(first_few)

@@ -99,18 +99,18 @@ def test_the_c_over_t_law_gets_a_verdict_from_both_its_parts(built):
 
 
 def test_the_survival_curves_turn_grey_below_the_at_risk_floor():
-    from kicktimes.stats import escape_survival
-    from kicktimes.studies.escape.figures import MIN_AT_RISK, survival_figure, thin_from
+    from kicktimes.stats import MIN_AT_RISK, escape_survival, reliable_until
+    from kicktimes.studies.escape.figures import survival_figure
 
     rng = np.random.default_rng(1)
     t = rng.exponential(100.0, 400)
     km = escape_survival(np.where(t < 1000, t, np.inf), 1000.0)
-    cut = thin_from(km)
+    cut = reliable_until(km)
     assert km.loc[km["time"] < cut, "n_at_risk"].min() >= MIN_AT_RISK
     assert km.loc[km["time"] == cut, "n_at_risk"].iloc[0] < MIN_AT_RISK
-    assert thin_from(km, floor=1) == float("inf") or thin_from(km, floor=1) > cut
+    assert reliable_until(km, floor=1) == float("inf") or reliable_until(km, floor=1) > cut
     with pytest.raises(ValueError, match="floor"):
-        thin_from(km, floor=0)
+        reliable_until(km, floor=0)
     curves = {(r, "two_particle"): km for r in study.compute.RADII}
     fig = survival_figure(curves)
     ax = fig.axes[0]

@@ -343,3 +343,46 @@ def dodge(radii, k, n):
     u = np.unique(radii)
     step = np.min(np.diff(u)) if u.size > 1 else 0.01 * max(u[0], 1e-3)
     return (k - (n - 1) / 2) * 0.12 * step
+
+
+def survival_steps(ax, km, *, color, label=None, line=None, start=None, end=None, clip=None,
+                   gid=None):
+    """Draw a Kaplan-Meier table (`kicktimes.stats.escape_survival`) on ``ax``: the survival
+    as steps with its 95 % band while at least `kicktimes.stats.MIN_AT_RISK` runs are at
+    risk (`kicktimes.stats.reliable_until`), holding its value up to that time; from there
+    a thin grey dotted line without a band (``gid`` names it).
+
+    ``line``: the measured steps' line properties; ``start``: begin at S = 1 there;
+    ``end``: hold the last value up to it (the last observed time); ``clip``: draw values
+    below it at it (a log axis' floor).
+    """
+    from kicktimes.stats import reliable_until
+
+    cols = ["time", "survival", "ci_low", "ci_high"] + (
+        ["n_at_risk"] if "n_at_risk" in km.columns else [])
+    km = km[cols]
+    if start is not None:
+        first = pd.DataFrame({"time": [start], "survival": [1.0], "ci_low": [1.0],
+                              "ci_high": [1.0]})
+        if "n_at_risk" in cols:
+            first["n_at_risk"] = np.inf
+        km = pd.concat([first, km], ignore_index=True)
+    if end is not None:
+        km = pd.concat([km, km.iloc[[-1]].assign(time=end)], ignore_index=True)
+    cut = reliable_until(km) if "n_at_risk" in cols else np.inf
+    kept = km[km["time"] < cut]
+    rest = km[km["time"] >= cut]
+    if len(kept) and len(rest):
+        kept = pd.concat([kept, kept.iloc[[-1]].assign(time=cut)])
+        rest = pd.concat([kept.iloc[[-1]], rest])
+
+    def shown(values):
+        return values if clip is None else np.maximum(values, clip)
+
+    ax.step(kept["time"], shown(kept["survival"]), where="post", color=color, label=label,
+            **(line or {}))
+    ax.fill_between(kept["time"], shown(kept["ci_low"]), shown(kept["ci_high"]), step="post",
+                    color=color, alpha=0.12, linewidth=0, zorder=1)
+    if len(rest):
+        ax.step(rest["time"], shown(rest["survival"]), where="post", color="0.6",
+                linewidth=0.8, linestyle=":", zorder=1, gid=gid)

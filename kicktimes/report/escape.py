@@ -45,17 +45,17 @@ from kicktimes.render.figures import (
     check_frame,
     plain_log_ticks,
     shared_legend,
+    survival_steps,
     system_label,
     system_style,
 )
 from kicktimes.render.pages import number_text
 from kicktimes.report.context import Section
 from kicktimes.report.store import REFERENCE
-from kicktimes.stats import MARGIN
+from kicktimes.stats import MARGIN, MIN_AT_RISK
 
 __all__ = [
     "AIC_MARGIN",
-    "AT_RISK_FLOOR",
     "ESCAPE_ROWS",
     "T_MIN_FRACTION",
     "escape_answer",
@@ -73,10 +73,6 @@ ESCAPE_ROWS = ("escape_time", "escaped_disk")
 T_MIN_FRACTION = 1 / 20
 #: AIC difference beyond which a tail law is decided (one parameter each)
 AIC_MARGIN = 2.0
-#: a survival curve is drawn as measured, with its band, while at least this many runs are
-#: at risk; beyond, thin, grey and dotted (a handful of runs per step; for the two disks,
-#: where disk 1's escapes have censored most of disk 0's runs)
-AT_RISK_FLOOR = 50
 _RUN_COLUMNS = ["radius", "ic", "system", "time", "horizon", "other_disk", "followed"]
 
 
@@ -423,8 +419,8 @@ def escape_figure(curves, *, t_min=None):
     matplotlib.figure.Figure
         Per radius a panel; per system its survival (steps, up to the system's last
         observed time ``end``) with its pointwise 95 % band, in the report's system
-        colours, the two-disk system drawn thicker, while :data:`AT_RISK_FLOOR` runs or
-        more are at risk (where ``curves`` has ``n_at_risk``); beyond, a thin grey dotted
+        colours, the two-disk system drawn thicker, while `kicktimes.stats.MIN_AT_RISK`
+        runs or more are at risk (where ``curves`` has ``n_at_risk``); beyond, a thin grey dotted
         line without a band. The time axis starts at 1/1000 of the longest horizon
         (earlier, S is near 1).
     """
@@ -449,31 +445,13 @@ def escape_figure(curves, *, t_min=None):
             if km.empty:
                 continue
             style = system_style(system, k)
-            # the curve starts at S = 1 on the left edge and holds its last value up to
-            # the system's last observed time
-            t = np.maximum(np.r_[t_lo, km["time"].to_numpy(float), km["end"].iloc[0]], t_lo)
-            s = np.r_[1.0, km["survival"].to_numpy(float), km["survival"].iloc[-1]]
-            lo = np.r_[1.0, km["ci_low"].to_numpy(float), km["ci_low"].iloc[-1]]
-            hi = np.r_[1.0, km["ci_high"].to_numpy(float), km["ci_high"].iloc[-1]]
             two = system == REFERENCE
-            # as measured up to the first step made by fewer than AT_RISK_FLOOR runs at
-            # risk (point k of t is row k - 1 of km), holding its value up to that step's
-            # time; from there thin and grey
-            cut = t.size
-            if "n_at_risk" in km.columns:
-                few = np.flatnonzero(km["n_at_risk"].to_numpy() < AT_RISK_FLOOR)
-                cut = 1 + int(few[0]) if few.size else t.size
-            upto = min(cut + 1, t.size)
-            held = [np.r_[v[:cut], v[cut - 1]] if cut < t.size else v for v in (s, lo, hi)]
-            ax.step(t[:upto], np.maximum(held[0], floor), where="post", color=style["color"],
-                    linewidth=2.0 if two else 1.2, zorder=3 if two else 2,
-                    label=system_label(system))
-            ax.fill_between(t[:upto], np.maximum(held[1], floor), np.maximum(held[2], floor),
-                            step="post", color=style["color"], alpha=0.12, linewidth=0)
-            if cut < t.size:
-                ax.step(np.r_[t[cut], t[cut:]], np.maximum(np.r_[s[cut - 1], s[cut:]], floor),
-                        where="post", color="0.6", linewidth=0.8, linestyle=":", zorder=1,
-                        gid=f"few_at_risk_{system}")
+            # from S = 1 at the left edge, held up to the system's last observed time
+            survival_steps(ax, km.assign(time=np.maximum(km["time"], t_lo)),
+                           color=style["color"], label=system_label(system),
+                           line={"linewidth": 2.0 if two else 1.2, "zorder": 3 if two else 2},
+                           start=t_lo, end=km["end"].iloc[0], clip=floor,
+                           gid=f"few_at_risk_{system}")
         if t_min is not None:
             ax.axvline(t_min, color="0.4", linestyle=":", linewidth=1.0,
                        label="t_min (tail fits start)")
@@ -550,7 +528,7 @@ def sections(ctx):
         + ("the first escape of either disk" if either else
            "disk 0's escape; disk 1's censors it")
         + ") drawn thicker; the dotted line is t_min, where the tail fits start. Each curve "
-        f"is drawn with its band while at least {AT_RISK_FLOOR} runs are at risk, then thin, "
+        f"is drawn with its band while at least {MIN_AT_RISK} runs are at risk, then thin, "
         "grey and dotted: there a step is one of a handful of runs"
         + ("" if either else ", and the two-disk risk set is emptied by disk 1's escapes, "
            "which would read as physics")

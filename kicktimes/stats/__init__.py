@@ -85,9 +85,17 @@ from .renewal import (
 )
 from .rescaling import RescaledTimes, mmpp_residuals
 from .robust import bootstrap_nanmedians, nanmedian
-from .survival import EscapeTail, circle_escape_constant, escape_survival, fit_escape_tail
+from .survival import (
+    MIN_AT_RISK,
+    EscapeTail,
+    circle_escape_constant,
+    escape_survival,
+    fit_escape_tail,
+    reliable_until,
+)
 
 __all__ = [
+    "MIN_AT_RISK",
     "MMPP_MIN_EVENTS",
     "SHARE_RULE",
     "MODELS",
@@ -144,6 +152,7 @@ __all__ = [
     "FitWarning",
     "Finding",
     "ratio_verdict",
+    "reliable_until",
     "MARGIN",
     "clopper_pearson",
     "robust_verdict",

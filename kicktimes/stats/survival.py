@@ -20,7 +20,13 @@ import pandas as pd
 
 from ._checks import check_real
 
-__all__ = ["EscapeTail", "circle_escape_constant", "escape_survival", "fit_escape_tail"]
+__all__ = ["MIN_AT_RISK", "EscapeTail", "circle_escape_constant", "escape_survival",
+           "fit_escape_tail", "reliable_until"]
+
+#: the fewest runs at risk of a Kaplan-Meier step read as measured: beyond, each step is
+#: made by a handful of runs (for the two disks: where disk 1's escapes have censored
+#: most of disk 0's runs), and the figures draw it thin and grey, without its band
+MIN_AT_RISK = 50
 
 
 def _censored(escape_times, t_max):
@@ -84,6 +90,33 @@ def escape_survival(escape_times, t_max) -> pd.DataFrame:
     hi = np.where(np.isfinite(hi), hi, 1.0)
     return pd.DataFrame({"time": sf.surv_times, "survival": s, "ci_low": lo, "ci_high": hi,
                          "n_at_risk": sf.n_risk})
+
+
+def reliable_until(km, floor=MIN_AT_RISK) -> float:
+    """The first time of a Kaplan-Meier table (`escape_survival`) at which fewer than
+    ``floor`` runs are at risk (inf: never): the curve is read as measured before it.
+
+    Parameters
+    ----------
+    km : pandas.DataFrame
+        ``time, n_at_risk`` (as `escape_survival` gives them), in time order.
+    floor : int
+        The fewest runs at risk of a step read as measured (default `MIN_AT_RISK`).
+
+    Returns
+    -------
+    float
+
+    Examples
+    --------
+    >>> import pandas as pd
+    >>> reliable_until(pd.DataFrame({"time": [1.0, 2.0, 3.0], "n_at_risk": [80, 50, 49]}))
+    3.0
+    """
+    if isinstance(floor, bool) or not isinstance(floor, int) or floor < 1:
+        raise ValueError(f"floor must be a positive integer, got {floor!r}")
+    below = km.loc[km["n_at_risk"] < floor, "time"]
+    return float(below.iloc[0]) if len(below) else float("inf")
 
 
 @dataclass(frozen=True)

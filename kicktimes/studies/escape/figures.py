@@ -3,21 +3,14 @@
 from __future__ import annotations
 
 import numpy as np
-import pandas as pd
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
-from kicktimes.render.figures import system_style
-from kicktimes.stats import kinetic_rate
+from kicktimes.render.figures import survival_steps, system_style
+from kicktimes.stats import MIN_AT_RISK, kinetic_rate
 from kicktimes.studies.escape.compute import LABELS, RADII, SYSTEMS
 
-__all__ = ["MIN_AT_RISK", "survival_figure", "thin_from"]
-
-#: a Kaplan-Meier curve is drawn as measured while at least this many runs are at risk;
-#: beyond, where a few runs make each step (for the two disks: where disk 1's escapes have
-#: censored most of disk 0's runs), it is drawn thin and grey, without its band
-MIN_AT_RISK = 50
-
+__all__ = ["survival_figure"]
 
 #: how each system's measured curve is drawn: the two disks thin and on top (the
 #: reference every curve is read against), the uniform-kick curve that lies on it wider,
@@ -31,39 +24,13 @@ _LINES = {
 }
 
 
-def thin_from(km, floor=MIN_AT_RISK):
-    """The first time of a Kaplan-Meier table (`kicktimes.stats.escape_survival`) at which
-    fewer than ``floor`` runs are at risk (inf: never).
-
-    Parameters
-    ----------
-    km : pandas.DataFrame
-        ``time, survival, ci_low, ci_high, n_at_risk``.
-    floor : int
-        The least number of runs at risk of a step drawn as measured.
-
-    Returns
-    -------
-    float
-
-    Examples
-    --------
-    >>> import pandas as pd
-    >>> thin_from(pd.DataFrame({"time": [1.0, 2.0, 3.0], "n_at_risk": [80, 50, 49]}))
-    3.0
-    """
-    if isinstance(floor, bool) or not isinstance(floor, int) or floor < 1:
-        raise ValueError(f"floor must be a positive integer, got {floor!r}")
-    below = km.loc[km["n_at_risk"] < floor, "time"]
-    return float(below.iloc[0]) if len(below) else float("inf")
-
-
 def survival_figure(curves):
     """Kaplan-Meier survival of disk 0's escape per system, one log-log panel per radius
     (``curves``: `escape_tables`' third value); returns a `matplotlib.figure.Figure`.
 
-    Each curve is drawn with its 95 % band while at least :data:`MIN_AT_RISK` runs are at
-    risk, beyond that (:func:`thin_from`) as a thin grey dotted line without a band: the
+    Each curve is drawn with its 95 % band while at least `kicktimes.stats.MIN_AT_RISK`
+    runs are at risk, beyond that (`kicktimes.stats.reliable_until`) as a thin grey dotted
+    line without a band (`kicktimes.render.figures.survival_steps`): the
     two-disk curve's risk set is emptied by disk 1's escapes (partner censoring), and its
     last steps, each one of a handful of runs, would read as physics. The two-disk curve is
     drawn thin and on top, the uniform-kick curve wide and half transparent below it, the
@@ -80,23 +47,8 @@ def survival_figure(curves):
             km = curves[(r, system)]
             if km.empty:
                 continue
-            # as measured up to the first step made by fewer than MIN_AT_RISK runs at risk,
-            # holding its value up to that step's time; from there thin and grey (from the
-            # held value, so the two parts meet)
-            cut = thin_from(km)
-            kept = km[km["time"] < cut]
-            rest = km[km["time"] >= cut]
-            if len(kept) and len(rest):
-                kept = pd.concat([kept, kept.iloc[[-1]].assign(time=cut)])
-                rest = pd.concat([kept.iloc[[-1]], rest])
-            line = _LINES.get(system, _LINES[None])
-            ax.step(kept["time"], kept["survival"], where="post",
-                    color=styles[system]["color"], label=LABELS[system], **line)
-            ax.fill_between(kept["time"], kept["ci_low"], kept["ci_high"], step="post",
-                            color=styles[system]["color"], alpha=0.12, linewidth=0, zorder=1)
-            if len(rest):
-                ax.step(rest["time"], rest["survival"], where="post", color="0.6",
-                        linewidth=0.8, linestyle=":", zorder=1, gid=f"few_at_risk_{system}")
+            survival_steps(ax, km, color=styles[system]["color"], label=LABELS[system],
+                           line=_LINES.get(system, _LINES[None]), gid=f"few_at_risk_{system}")
         tt = np.geomspace(50.0, 3000.0, 20)
         ax.plot(tt, 50.0 / tt * 0.5, color="k", linestyle=":", linewidth=1,
                 label="slope of C / t")

@@ -11,12 +11,14 @@ from kicktimes.render.pages import header, ratio_text, simulations_source
 from kicktimes.render.provenance import Source
 from kicktimes.stats import (
     MARGIN,
+    MIN_AT_RISK,
     circle_escape_constant,
     fit_escape_tail,
     format_interval,
     kinetic_rate,
     ratio_rule,
     ratio_verdict,
+    reliable_until,
 )
 from kicktimes.studies.escape.compute import (
     BURSTY_SHAPE,
@@ -28,7 +30,6 @@ from kicktimes.studies.escape.compute import (
     escape_tables,
     tail_rates,
 )
-from kicktimes.studies.escape.figures import MIN_AT_RISK, thin_from
 
 __all__ = ["CONSTANT", "FIGURE", "RATIOS", "SOURCES", "TAILS", "law_verdict", "write_page"]
 
@@ -123,9 +124,9 @@ def _at_risk_words(curves):
     """The caption's sentence on where each curve leaves the at-risk floor."""
     if not curves:
         return ""
-    two = {r: thin_from(km) for (r, s), km in sorted(curves.items())
+    two = {r: reliable_until(km) for (r, s), km in sorted(curves.items())
            if s == "two_particle" and not km.empty}
-    kicked = [thin_from(km) for (r, s), km in curves.items()
+    kicked = [reliable_until(km) for (r, s), km in curves.items()
               if s in ("poisson", "poisson_scatter") and not km.empty]
     kicked = [t for t in kicked if math.isfinite(t)]
     return (
