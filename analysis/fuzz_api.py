@@ -50,6 +50,22 @@ NAN, INF = math.nan, math.inf
 
 
 # ------------------------------------------------------------------ argument pools
+def _time_options(rng, kw, modes, *, simulator):
+    """The run's length into ``kw``: ``t_max`` (a simulator only), steps of ``tau``, the
+    paper's steps, or (``"mixed"``, a simulator) steps and a ``t_max`` together; valid or
+    not."""
+    mode = _pick(rng, modes)
+    if mode == "t_max" and simulator:
+        kw["t_max"] = _maybe(rng, TIMES, BAD_TIMES)
+        return
+    kw["n_steps"] = _maybe(rng, STEPS, BAD_STEPS, 0.25)
+    kw["tau"] = _maybe(rng, TAUS, BAD_TAUS, 0.25)
+    if mode == "paper":
+        kw["sampling"] = "paper"
+    if mode == "mixed" and simulator:
+        kw["t_max"] = _maybe(rng, TIMES, BAD_TIMES)
+
+
 def _pick(rng, pool):
     return pool[int(rng.integers(len(pool)))]
 
@@ -187,16 +203,8 @@ def _call_spec(seed: int, i: int):
         ic = _two_ic(rng)
         r = 0.05 if isinstance(ic, list) and rng.uniform() < 0.7 else _maybe(rng, RADII, BAD_RADII)
         args = (ic, r)
-        mode = _pick(rng, ["t_max", "steps", "paper", "mixed"])
-        if mode == "t_max" and target == "simulate_two_particle":
-            kw["t_max"] = _maybe(rng, TIMES, BAD_TIMES)
-        else:
-            kw["n_steps"] = _maybe(rng, STEPS, BAD_STEPS, 0.25)
-            kw["tau"] = _maybe(rng, TAUS, BAD_TAUS, 0.25)
-            if mode == "paper":
-                kw["sampling"] = "paper"
-            if mode == "mixed" and target == "simulate_two_particle":
-                kw["t_max"] = _maybe(rng, TIMES, BAD_TIMES)
+        _time_options(rng, kw, ["t_max", "steps", "paper", "mixed"],
+                      simulator=target == "simulate_two_particle")
         kw["rule"] = _maybe(rng, ["mirror", "elastic"], ["bounce", None], 0.1)
         if rng.uniform() < 0.2:
             kw["track"] = _pick(rng, [0, 1, 2, -1, 0.5])
@@ -205,14 +213,8 @@ def _call_spec(seed: int, i: int):
         r = 0.05 if rng.uniform() < 0.5 else _maybe(rng, RADII + [0.5, 0.9],
                                                      BAD_RADII + [0.99999999])
         args = (state, r)
-        mode = _pick(rng, ["t_max", "steps", "paper"])
-        if mode == "t_max" and target == "simulate_one_particle":
-            kw["t_max"] = _maybe(rng, TIMES, BAD_TIMES)
-        else:
-            kw["n_steps"] = _maybe(rng, STEPS, BAD_STEPS, 0.25)
-            kw["tau"] = _maybe(rng, TAUS, BAD_TAUS, 0.25)
-            if mode == "paper":
-                kw["sampling"] = "paper"
+        _time_options(rng, kw, ["t_max", "steps", "paper"],
+                      simulator=target == "simulate_one_particle")
         horizon = kw.get("t_max", 10.0)
         kicks = _kicks(rng, horizon)
         if kicks is not None:

@@ -135,23 +135,9 @@ def _rsa_positions(radii: np.ndarray, rng: np.random.Generator, box=None) -> np.
     the periodic box of side ``box``)."""
     n = radii.shape[0]
     order = np.argsort(-radii, kind="stable")
-    if box is not None:
-        m = max(1, min(int(box / (2.0 * radii.max())), int(math.ceil(2.0 * math.sqrt(n)))))
-        w = box / m
-        head = np.full(m * m, -1, dtype=np.int64)
-        nxt = np.full(n, -1, dtype=np.int64)
-        xy = np.zeros((n, 2))
-        k = 0
-        tries = 0
-        while k < n:
-            u = rng.random((max(4 * (n - k), 256), 2))
-            k, _ = _rsa_box(radii, order, u, xy, m, w, head, nxt, k, 0, float(box))
-            tries += u.shape[0]
-            if tries > 1000 * n + 10**6:  # pragma: no cover - RSA_PACKING is far from jamming
-                raise RuntimeError("random sequential addition did not place the disks")
-        return xy
-    m = max(1, min(int(2.0 / (2.0 * radii.max())), int(math.ceil(2.0 * math.sqrt(n)))))
-    w = 2.0 / m
+    side = 2.0 if box is None else box  # the square the candidates are drawn in
+    m = max(1, min(int(side / (2.0 * radii.max())), int(math.ceil(2.0 * math.sqrt(n)))))
+    w = side / m
     head = np.full(m * m, -1, dtype=np.int64)
     nxt = np.full(n, -1, dtype=np.int64)
     xy = np.zeros((n, 2))
@@ -159,7 +145,10 @@ def _rsa_positions(radii: np.ndarray, rng: np.random.Generator, box=None) -> np.
     tries = 0
     while k < n:
         u = rng.random((max(4 * (n - k), 256), 2))
-        k, _ = _rsa(radii, order, u, xy, m, w, head, nxt, k, 0)
+        if box is None:
+            k, _ = _rsa(radii, order, u, xy, m, w, head, nxt, k, 0)
+        else:
+            k, _ = _rsa_box(radii, order, u, xy, m, w, head, nxt, k, 0, float(box))
         tries += u.shape[0]
         if tries > 1000 * n + 10**6:  # pragma: no cover - RSA_PACKING is far from jamming
             raise RuntimeError("random sequential addition did not place the disks")
