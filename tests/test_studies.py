@@ -16,6 +16,17 @@ from kicktimes.experiment import PRESETS, Experiment, preset, preset_names
 from kicktimes.studies import STUDIES, Study
 
 
+@pytest.mark.parametrize("name", list(STUDIES))
+@pytest.mark.parametrize(("option", "value"), [("scale", "huge"), ("scale", "Paper"),
+                                               ("workers", 0), ("workers", 1.5),
+                                               ("workers", True), ("workers", "2")])
+def test_every_study_refuses_a_bad_scale_or_workers_by_name_writing_nothing(tmp_path, name,
+                                                                           option, value):
+    with pytest.raises(ValueError, match=option):
+        STUDIES[name].reproduce(tmp_path, **{option: value})
+    assert not any(tmp_path.iterdir())
+
+
 def test_every_study_has_its_package_with_reproduce_and_a_page_of_its_own():
     pages = [s.page for s in STUDIES.values()]
     assert len(set(pages)) == len(pages)

@@ -52,15 +52,6 @@ def test_a_rerun_reuses_the_cached_escape_times(built, monkeypatch):
         assert (again.parent / "escape" / name).read_bytes() == data, name
 
 
-def test_bad_scale_and_workers_are_refused_by_name(tmp_path):
-    with pytest.raises(ValueError, match="scale"):
-        study.reproduce(tmp_path, scale="huge")
-    for workers in (0, 1.5, True):
-        with pytest.raises(ValueError, match="workers"):
-            study.reproduce(tmp_path, workers=workers)
-    assert not any(tmp_path.iterdir())
-
-
 def test_the_tail_rate_is_events_over_time_at_risk_beyond_t_min():
     rng = np.random.default_rng(1)
     t = rng.exponential(100.0, 20000)

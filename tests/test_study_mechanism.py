@@ -99,13 +99,6 @@ def test_the_whole_early_hazard_is_read_not_its_first_bin_alone(built):
     assert "hazard minimum over t < 4" in text.split("## The mirror rule")[0]
 
 
-@pytest.mark.parametrize(("option", "value"), [("scale", "paper-ish"), ("workers", 0),
-                                               ("workers", "2")])
-def test_bad_options_are_refused_by_name(tmp_path, option, value):
-    with pytest.raises(ValueError, match=option):
-        run.reproduce(tmp_path, **{option: value})
-
-
 @pytest.mark.slow
 def test_every_figure_the_page_links_is_drawn(tmp_path):
     from kicktimes.studies.mechanism.page import rule_section

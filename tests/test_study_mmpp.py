@@ -56,14 +56,6 @@ def test_a_rerun_reuses_the_cached_collision_times(built, monkeypatch):
     assert (again.parent / "mmpp" / "mmpp_billiard_pooled.csv").read_bytes() == before
 
 
-def test_bad_scale_and_workers_are_refused_by_name(tmp_path):
-    with pytest.raises(ValueError, match="scale"):
-        study.reproduce(tmp_path, scale="Paper")
-    with pytest.raises(ValueError, match="workers"):
-        study.reproduce(tmp_path, workers="1")
-    assert not any(tmp_path.iterdir())
-
-
 def test_an_mmpp_has_no_refractory_dip():
     same = SimpleNamespace(rates=[0.5, 0.5], stationary=[0.5, 0.5],
                            generator=[[-0.1, 0.1], [0.1, -0.1]])

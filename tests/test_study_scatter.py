@@ -52,14 +52,6 @@ def test_a_rerun_reuses_the_cached_table(built, monkeypatch):
     assert (again.parent / "scatter_ratios.csv").read_bytes() == before
 
 
-def test_bad_scale_and_workers_are_refused_by_name(tmp_path):
-    with pytest.raises(ValueError, match="scale"):
-        study.reproduce(tmp_path, scale=None)
-    with pytest.raises(ValueError, match="workers"):
-        study.reproduce(tmp_path, workers=-2)
-    assert not any(tmp_path.iterdir())
-
-
 def test_the_paper_scale_is_family_a_s():
     fam, paper = preset("family_a"), study.SCALES["paper"]
     assert paper.radii == tuple(fam.radii) and paper.n_ics == 40

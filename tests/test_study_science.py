@@ -118,13 +118,6 @@ def test_other_parameters_compute_again(built, paper_study, monkeypatch):
     assert "11 steps of τ" in page.read_text(encoding="utf-8")
 
 
-@pytest.mark.parametrize(("option", "value"), [("scale", "huge"), ("workers", 0),
-                                               ("workers", 1.5)])
-def test_bad_options_are_refused_by_name(tmp_path, option, value):
-    with pytest.raises(ValueError, match=option):
-        run.reproduce(tmp_path, **{option: value})
-
-
 def test_missing_inputs_name_the_file_and_the_command_that_makes_it(tmp_path, paper_study):
     with pytest.raises(ValueError, match=r"store-family_a.*kicktimes reproduce --study paper "
                        r"--scale paper --out OUT"):

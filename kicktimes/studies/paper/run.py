@@ -7,7 +7,7 @@ import os
 from contextlib import ExitStack
 from pathlib import Path
 
-from kicktimes.studies.options import check_scale, status_lines
+from kicktimes.studies.options import check_scale, check_workers, status_lines
 
 __all__ = ["reproduce"]
 
@@ -60,6 +60,8 @@ def reproduce(out, *, scale="quick", results_dir=None, workers=None, progress=No
     from kicktimes.studies.paper.presets import SCALES, scale_presets
 
     check_scale(scale, SCALES)
+    if workers is not None:
+        workers = check_workers(workers)
     if content not in CONTENTS:
         raise ValueError(f"content must be one of {sorted(CONTENTS)}, got {content!r}")
     if workers is not None and scheduler is not None:

@@ -18,6 +18,7 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
+from kicktimes.studies.options import check_workers
 from kicktimes.studies.protocol.compute import CHOICES, panels, run_rows
 from kicktimes.studies.protocol.page import build_page, fig6_figure
 from kicktimes.studies.protocol.run import load_rows, run_protocol_study
@@ -39,10 +40,12 @@ def reproduce(out: str | os.PathLike, *, scale: str = "quick",
     ``family_b_findings.csv``, e.g. ``docs/results``), which give the count claims; default
     ``results_dir`` if it holds them, else none (the page then leaves the counts out).
     """
+    names = [f"{p.name}_findings.csv" for p in panels(scale)]  # (refuses an unknown scale)
+    if workers is not None:
+        workers = check_workers(workers)
     out = Path(out)
     store = out / ("store-protocol" if scale == "paper" else f"store-protocol-{scale}")
     results = Path(results_dir) if results_dir is not None else out / "results-protocol"
-    names = [f"{p.name}_findings.csv" for p in panels(scale)]
     if findings_dir is not None:
         findings = Path(findings_dir)
         missing = [n for n in names if not (findings / n).exists()]
