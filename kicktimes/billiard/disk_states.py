@@ -74,54 +74,40 @@ def _place(i, x, y, c, xy, head, nxt):
 
 
 @njit(cache=True, error_model="numpy")
-def _rsa(radii, order, u, xy, m, w, head, nxt, k0, j0):
+def _rsa(radii, order, u, xy, m, w, head, nxt, k0, j0, box):
     """Place disks ``order[k0:]`` one by one at candidates ``u[j]`` (uniform in [0, 1)^2,
-    mapped to the square) inside the table and clear of the disks placed; returns
-    ``(k, j)``: disks placed so far and candidates used (more candidates are needed if
-    ``j == len(u)``)."""
+    mapped to the square) inside the table (``box = 0``) or in the periodic box ``[0,
+    box)^2`` (the grid of cells wraps; the nearest images count), clear of the disks
+    placed; returns ``(k, j)``: disks placed so far and candidates used (more candidates
+    are needed if ``j == len(u)``)."""
     k = k0
     j = j0
     n = order.shape[0]
     r_max = radii[order[0]]
     while k < n and j < u.shape[0]:
         i = order[k]
-        x = 2.0 * u[j, 0] - 1.0
-        y = 2.0 * u[j, 1] - 1.0
-        j += 1
-        rho = 1.0 - radii[i]
-        if x * x + y * y > rho * rho:
-            continue
-        cx = min(int((x + 1.0) / w), m - 1)
-        cy = min(int((y + 1.0) / w), m - 1)
-        reach = int(math.ceil((radii[i] + r_max) / w))
-        if not _clear_of_cells(x, y, radii[i], max(cx - reach, 0), min(cx + reach, m - 1),
-                               max(cy - reach, 0), min(cy + reach, m - 1), m, head, xy, radii,
-                               nxt, 0.0):
-            continue
-        _place(i, x, y, cx + m * cy, xy, head, nxt)
-        k += 1
-    return k, j
-
-
-@njit(cache=True, error_model="numpy")
-def _rsa_box(radii, order, u, xy, m, w, head, nxt, k0, j0, box):
-    """`_rsa` in the periodic box ``[0, box)^2``: candidates ``box u[j]``, clear of the
-    nearest images of the disks placed (the grid of cells wraps)."""
-    k = k0
-    j = j0
-    n = order.shape[0]
-    r_max = radii[order[0]]
-    while k < n and j < u.shape[0]:
-        i = order[k]
-        x = box * u[j, 0]
-        y = box * u[j, 1]
-        j += 1
-        cx = min(int(x / w), m - 1)
-        cy = min(int(y / w), m - 1)
-        reach = int(math.ceil((radii[i] + r_max) / w))
-        # all cells once if the reach wraps round the box
-        lo_x, hi_x = (0, m - 1) if 2 * reach + 1 >= m else (cx - reach, cx + reach)
-        lo_y, hi_y = (0, m - 1) if 2 * reach + 1 >= m else (cy - reach, cy + reach)
+        reach_cells = int(math.ceil((radii[i] + r_max) / w))
+        if box > 0.0:
+            x = box * u[j, 0]
+            y = box * u[j, 1]
+            j += 1
+            cx = min(int(x / w), m - 1)
+            cy = min(int(y / w), m - 1)
+            # all cells once if the reach wraps round the box
+            whole = 2 * reach_cells + 1 >= m
+            lo_x, hi_x = (0, m - 1) if whole else (cx - reach_cells, cx + reach_cells)
+            lo_y, hi_y = (0, m - 1) if whole else (cy - reach_cells, cy + reach_cells)
+        else:
+            x = 2.0 * u[j, 0] - 1.0
+            y = 2.0 * u[j, 1] - 1.0
+            j += 1
+            rho = 1.0 - radii[i]
+            if x * x + y * y > rho * rho:
+                continue
+            cx = min(int((x + 1.0) / w), m - 1)
+            cy = min(int((y + 1.0) / w), m - 1)
+            lo_x, hi_x = max(cx - reach_cells, 0), min(cx + reach_cells, m - 1)
+            lo_y, hi_y = max(cy - reach_cells, 0), min(cy + reach_cells, m - 1)
         if not _clear_of_cells(x, y, radii[i], lo_x, hi_x, lo_y, hi_y, m, head, xy, radii, nxt,
                                box):
             continue
@@ -145,10 +131,8 @@ def _rsa_positions(radii: np.ndarray, rng: np.random.Generator, box=None) -> np.
     tries = 0
     while k < n:
         u = rng.random((max(4 * (n - k), 256), 2))
-        if box is None:
-            k, _ = _rsa(radii, order, u, xy, m, w, head, nxt, k, 0)
-        else:
-            k, _ = _rsa_box(radii, order, u, xy, m, w, head, nxt, k, 0, float(box))
+        k, _ = _rsa(radii, order, u, xy, m, w, head, nxt, k, 0,
+                    0.0 if box is None else float(box))
         tries += u.shape[0]
         if tries > 1000 * n + 10**6:  # pragma: no cover - RSA_PACKING is far from jamming
             raise RuntimeError("random sequential addition did not place the disks")
