@@ -7,7 +7,7 @@ import math
 
 import numpy as np
 
-from kicktimes._validation import check_choice, check_int, check_real
+from kicktimes.validation import check_choice, check_int, check_real
 
 __all__ = ["check_choice", "check_holes", "check_masses", "check_radii", "check_int", "check_real",
            "check_state", "check_inside",

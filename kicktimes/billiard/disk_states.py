@@ -16,10 +16,10 @@ import math
 import numpy as np
 from numba import njit
 
-from kicktimes._validation import check_int, check_real, check_rng
 from kicktimes.billiard import checks as chk
 from kicktimes.billiard.many_disks import check_box, check_radii_of, engine_run
 from kicktimes.stats.enskog import PACKING_MAX, contact_value
+from kicktimes.validation import check_int, check_real, check_rng
 
 __all__ = ["box_side", "initial_state", "grow_step"]
 
@@ -212,7 +212,7 @@ def initial_state(n_disks, r, *, seed=0, rule="mirror", masses=None, packing=Non
         The disks' radius, or one radius per disk (each in ``(0, 1)``); with ``packing``,
         relative radii (``None``: equal disks).
     seed : int or numpy.random.Generator
-        The random stream (`kicktimes._validation.check_rng`).
+        The random stream (`kicktimes.validation.check_rng`).
     rule : {"mirror", "elastic"}
         The velocities: unit speeds with uniform directions (``"mirror"``), or uniform on
         the energy shell ``sum_i m_i |v_i|^2 = n_disks`` (``"elastic"``).

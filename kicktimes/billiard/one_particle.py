@@ -18,13 +18,13 @@ import warnings
 
 import numpy as np
 
-from kicktimes._validation import check_rng
 from kicktimes.billiard import checks as chk
 from kicktimes.billiard.kernels.drive_one import simulate_one_kernel
 from kicktimes.billiard.kernels.one import KICK_ANGLES
 from kicktimes.billiard.runs import BoundaryLog, OneParticleRun, sampling_fields
 from kicktimes.billiard.scatter import PARTNER_LAWS, draw_scatter_uniforms
 from kicktimes.billiard.two_particle import raise_for_status
+from kicktimes.validation import check_rng
 
 #: The largest radius of a single disk: the table left to its centre, 1 - r, stays >= 1e-6,
 #: far above the contact tolerance (1e-12).

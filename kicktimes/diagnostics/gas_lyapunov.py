@@ -29,7 +29,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from kicktimes._validation import check_choice, check_real, check_rng
+from kicktimes.validation import check_choice, check_real, check_rng
 
 __all__ = ["DisksLyapunov", "disks_lyapunov", "project_trivial"]
 

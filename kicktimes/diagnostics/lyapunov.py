@@ -23,7 +23,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from kicktimes._validation import check_rng
 from kicktimes.billiard import checks as chk
 from kicktimes.billiard.kernels.drive_one import simulate_tangent_one_kernel, tangent_one_kernel
 from kicktimes.billiard.kernels.drive_two import simulate_tangent_two_kernel, tangent_two_kernel
@@ -49,6 +48,7 @@ from kicktimes.billiard.two_particle import (
     two_particle_run,
 )
 from kicktimes.diagnostics.autocorrelation import UndefinedDiagnosticWarning
+from kicktimes.validation import check_rng
 
 VARIANTS = ("norm", "paper")
 #: the kicked twins' kicks: the run's angles, or each twin's own at the same times

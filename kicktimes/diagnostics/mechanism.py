@@ -27,8 +27,8 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from kicktimes._validation import check_int, check_real, check_rng
 from kicktimes.stats import resample_indices
+from kicktimes.validation import check_int, check_real, check_rng
 
 __all__ = [
     "RecollisionShare",

@@ -22,7 +22,7 @@ import os
 import re
 from dataclasses import asdict, dataclass, field, fields
 
-from kicktimes._validation import check_choice, check_int, check_real
+from kicktimes.validation import check_choice, check_int, check_real
 
 __all__ = ["DEFAULT_SYSTEMS", "DIAGNOSTICS", "SYSTEMS", "Experiment"]
 

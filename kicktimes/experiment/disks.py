@@ -31,7 +31,7 @@ import json
 import math
 from dataclasses import asdict, dataclass, field, fields
 
-from kicktimes._validation import check_choice, check_int, check_real
+from kicktimes.validation import check_choice, check_int, check_real
 
 __all__ = ["DISKS_CONTROLS", "DISKS_PRESETS", "DISKS_REFERENCES", "DisksExperiment", "DisksTask",
            "KICKED_SYSTEMS", "disks_control", "disks_preset"]

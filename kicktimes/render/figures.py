@@ -49,8 +49,9 @@ DIAGNOSTIC_LABELS = {
 RADIUS_LABEL = "disk radius $r$ (table radii)"
 #: the time unit is the table radius over the (unit) speed; captions say so once
 TIME_UNIT = "time units"
-_PAPER_BAR = {"linewidth": 5.0, "alpha": 0.3}
-_SEM_BAR = {"linewidth": 1.0, "capsize": 3.0}
+#: the error bars of the paper's summaries (wide, pale) and of a mean's s.e.m. (thin, capped)
+PAPER_BAR = {"linewidth": 5.0, "alpha": 0.3}
+SEM_BAR = {"linewidth": 1.0, "capsize": 3.0}
 
 
 def radius_axis(ax):

@@ -24,7 +24,7 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
 from kicktimes.render.figures import (
-    _SEM_BAR,
+    SEM_BAR,
     dodge,
     kick_groups,
     radius_axis,
@@ -431,7 +431,7 @@ def _lag1_figure(summary, predicted, lag, ratios=None):
         half = half_width95(part["sem"], part["n_valid"])
         ax.errorbar(x, 1.0 - part["mean"].to_numpy(), yerr=half,
                     color=style["color"], marker=style["marker"], markersize=5,
-                    label=system_label(system), **_SEM_BAR)
+                    label=system_label(system), **SEM_BAR)
         if pred is not None and system in pred.index.get_level_values(1):
             p = pred.xs(system, level="system")
             ax.plot(p.index.to_numpy() + dodge(radii, k, len(order)), 1.0 - p.to_numpy(),
@@ -444,7 +444,7 @@ def _lag1_figure(summary, predicted, lag, ratios=None):
                               yerr=[ratio - mine["ci_low"].to_numpy(float),
                                     mine["ci_high"].to_numpy(float) - ratio],
                               color=style["color"], marker=style["marker"], markersize=5,
-                              **_SEM_BAR)
+                              **SEM_BAR)
         elif system != REFERENCE and not ref.empty:
             two = 1.0 - ref["mean"].reindex(part["radius"]).to_numpy()
             two_se = ref["sem"].reindex(part["radius"]).to_numpy()
@@ -456,7 +456,7 @@ def _lag1_figure(summary, predicted, lag, ratios=None):
                            ref["n_valid"].reindex(part["radius"]).to_numpy())
             ax_ratio.errorbar(part["radius"].to_numpy() + dodge(radii, k, len(order)), ratio,
                               yerr=half_width95(se, n), color=style["color"],
-                              marker=style["marker"], markersize=5, **_SEM_BAR)
+                              marker=style["marker"], markersize=5, **SEM_BAR)
     decorrelation = 1.0 - summary["mean"].to_numpy(float)
     if np.any(np.isfinite(decorrelation) & (decorrelation > 0)):  # else a linear axis
         ax.set_yscale("log")

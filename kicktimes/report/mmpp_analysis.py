@@ -78,7 +78,7 @@ def analyze_mmpp(res, *, n_boot=99, max_fits_per_group=12, rng=None) -> pd.DataF
         Poisson, the best renewal model and its AIC, ``mmpp_best`` (the MMPP-2 has the
         lowest AIC of all) and ``mmpp_beats_poisson``.
     """
-    from kicktimes._validation import check_int, check_rng
+    from kicktimes.validation import check_int, check_rng
 
     n_boot = check_int("n_boot", n_boot, low=1)
     if max_fits_per_group is not None:

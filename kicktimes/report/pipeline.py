@@ -27,7 +27,6 @@ from contextlib import closing, contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
-from kicktimes._validation import check_int, check_real
 from kicktimes.memory import fewer_collections, keep_freed_memory
 from kicktimes.render.html import (
     embed_figures,
@@ -41,6 +40,7 @@ from kicktimes.render.html import (
 from kicktimes.report._cache import ReportCache, content_key, store_key
 from kicktimes.report.context import Context, Mapper, Progress
 from kicktimes.report.store import load_report_store, store_header
+from kicktimes.validation import check_int, check_real
 
 __all__ = ["build_report", "analyse", "STAGES"]  # noqa: F822 (STAGES: module __getattr__)
 

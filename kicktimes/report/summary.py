@@ -11,9 +11,9 @@ import pandas as pd
 from matplotlib.lines import Line2D
 
 from kicktimes.render.figures import (
-    _PAPER_BAR,
-    _SEM_BAR,
     DIAGNOSTIC_LABELS,
+    PAPER_BAR,
+    SEM_BAR,
     SYSTEMS,
     check_frame,
     check_radii,
@@ -135,7 +135,7 @@ def diagnostic_vs_radius(
             yerr=part["paper_err"].to_numpy(),
             linestyle="none",
             color=style["color"],
-            **_PAPER_BAR,
+            **PAPER_BAR,
         )
         ax.errorbar(
             x,
@@ -146,7 +146,7 @@ def diagnostic_vs_radius(
             markersize=5,
             linestyle="-",
             label=system_label(system),
-            **_SEM_BAR,
+            **SEM_BAR,
         )
         if medians:
             ax.plot(
@@ -161,7 +161,7 @@ def diagnostic_vs_radius(
     _robust_ylim(ax, summary[summary["system"].isin(systems)], medians)
     handles, labels = ax.get_legend_handles_labels()
     handles += [
-        Line2D([], [], color="grey", **_PAPER_BAR),
+        Line2D([], [], color="grey", **PAPER_BAR),
         Line2D([], [], color="grey", linewidth=1.0, marker="_", markersize=8),
     ]
     labels += ["± std/10 (paper's bar)", "± std/√n_valid (standard error)"]

@@ -10,7 +10,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from kicktimes._validation import check_rng
 from kicktimes.schedules._distributions import (
     _check_dist,
     _dist_from_dict,
@@ -35,6 +34,7 @@ from kicktimes.schedules._validate import (
     _float_array,
     _run_times,
 )
+from kicktimes.validation import check_rng
 
 
 # ---------------------------------------------------------------------------- sampling

@@ -7,7 +7,7 @@ import math
 
 import numpy as np
 
-from kicktimes._validation import check_real
+from kicktimes.validation import check_real
 
 
 # ------------------------------------------------------------------------ distributions

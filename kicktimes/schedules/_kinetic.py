@@ -20,7 +20,7 @@ import math
 
 import numpy as np
 
-from kicktimes._validation import check_choice, check_int, check_real
+from kicktimes.validation import check_choice, check_int, check_real
 
 __all__ = ["KineticRate"]
 

@@ -11,7 +11,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from kicktimes._validation import check_rng
 from kicktimes.schedules._base import Schedule, _register, _renewal_times
 from kicktimes.schedules._validate import (
     _FIRST_CHUNK,
@@ -22,6 +21,7 @@ from kicktimes.schedules._validate import (
     _check_t_max,
     _float_array,
 )
+from kicktimes.validation import check_rng
 
 __all__ = ["MMPP"]
 

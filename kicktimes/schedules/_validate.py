@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from kicktimes._validation import check_int, check_real
+from kicktimes.validation import check_int, check_real
 
 DEFAULT_MAX_KICKS = 10**8
 _FORMAT_VERSION = 1

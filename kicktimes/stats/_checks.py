@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from kicktimes._validation import check_choice, check_int, check_real, check_rng
+from kicktimes.validation import check_choice, check_int, check_real, check_rng
 
 __all__ = [
     "as_1d_float", "check_choice", "check_int", "check_intervals", "check_real", "check_rng",

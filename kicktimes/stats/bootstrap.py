@@ -37,7 +37,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from kicktimes._validation import check_int, check_real, check_rng
+from kicktimes.validation import check_int, check_real, check_rng
 
 __all__ = ["ClusterBootstrap", "cluster_bootstrap", "paired_ratio", "percentile_interval",
            "ratio_of_means", "resample_counts", "resample_indices"]

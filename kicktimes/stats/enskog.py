@@ -10,7 +10,7 @@ import math
 
 import numpy as np
 
-from kicktimes._validation import check_choice, check_int, check_real
+from kicktimes.validation import check_choice, check_int, check_real
 
 __all__ = ["contact_value", "enskog_frequency", "henderson_z", "speed_rate_factor"]
 

@@ -17,11 +17,11 @@ from pathlib import Path
 import pandas as pd
 
 from kicktimes import __version__
-from kicktimes._validation import check_int
 from kicktimes.fileio import atomic_write_bytes
 from kicktimes.report.context import Context, Mapper, Progress
 from kicktimes.report.store import load_report_store
 from kicktimes.stats import format_interval
+from kicktimes.validation import check_int
 
 __all__ = ["PROTOCOL_POINTER", "copy_first_screen", "counts_section", "poisson_section",
            "results_sources", "write_results"]
