@@ -5,7 +5,8 @@ import pandas as pd
 import pytest
 
 from kicktimes.report.answers import answers, overview_table
-from kicktimes.report.controls import COLUMNS, compute_controls, paired_median
+from kicktimes.report.controls import COLUMNS, compute_controls
+from kicktimes.stats import paired_median
 
 
 def _frame(values_by_system, radii, n_ics):

@@ -57,7 +57,8 @@ def test_no_page_draws_its_own_cluster_resamples():
 def test_no_page_writes_its_own_percentile_interval():
     # every bootstrap (and Monte Carlo) interval of the pages is stats.percentile_interval:
     # the same percentiles (exactly 2.5 and 97.5 %), the same handling of undefined draws
-    literal = re.compile(r"percentile\([^)]*\[\s*2\.5\s*,\s*97\.5\s*\]")
+    literal = re.compile(r"percentile\([^)]*\[\s*2\.5\s*,\s*97\.5\s*\]|"
+                         r"\(1(\.0)? - level\) / 2")
     found = [str(p.relative_to(PACKAGE)) for p in _modules()
              if not p.is_relative_to(PACKAGE / "stats") and literal.search(p.read_text())]
     assert found == [], found

@@ -27,7 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from kicktimes.stats import resample_indices
+from kicktimes.stats import percentile_interval, resample_indices
 from kicktimes.validation import check_int, check_real, check_rng
 
 __all__ = [
@@ -299,8 +299,7 @@ def recollision_share(table, *, max_wall_hits=1, level=0.95, n_boot=999,
     pick = resample_indices(ids.size, n_boot, rng)
     with np.errstate(invalid="ignore"):
         boots = k[pick].sum(axis=1) / n[pick].sum(axis=1)
-    a = (1.0 - level) / 2.0
-    low, high = np.nanquantile(boots, [a, 1.0 - a])
+    low, high = percentile_interval(boots, level)
     return RecollisionShare(float(k.sum() / n.sum()), float(low), float(high), int(k.sum()),
                             int(n.sum()), int(ids.size), max_wall_hits, level)
 

@@ -48,7 +48,6 @@ runs whose two-disk collision times reject it, with the verdict of
 from __future__ import annotations
 
 import math
-import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -56,12 +55,10 @@ import pandas as pd
 
 from kicktimes.report.store import REFERENCE, kicked_systems, wide
 from kicktimes.stats import (
-    bootstrap_nanmedians,
-    nanmedian,
+    paired_median,
     paired_ratio,
     ratio_verdict,
     rejection_verdict,
-    resample_indices,
     robust_verdict,
 )
 
@@ -96,83 +93,6 @@ _QUESTIONS = {
     "one_minus_r1": "decorrelation 1 − R₁ of boundary angles",
     "counts": "collision counts / kinetic theory Γ(r)T",
 }
-
-
-def paired_median(numerator, denominator, *, rng, n_boot=1000, level=0.95):
-    r"""Median over ICs of the per-IC ratio, per radius, averaged over radii, with a CI.
-
-    Parameters
-    ----------
-    numerator, denominator : pandas.Series
-        Indexed by ``(radius, ic)``; a pair enters where both are finite and the
-        denominator is non-zero. A radius where at least half of the ratios are 0 has no
-        median ratio (it would be 0 whatever the other half): it is left out, and with no
-        radius left the result is NaN (verdict inconclusive).
-    rng : numpy.random.Generator
-        The bootstrap's stream.
-    n_boot : int
-        Resamples of the IC indices (one resample is applied at every radius).
-    level : float
-        Confidence level of the percentile interval.
-
-    Returns
-    -------
-    dict
-        ``ratio, ci_low, ci_high, n_pairs`` and ``per_radius``, a DataFrame ``radius,
-        n_pairs, ratio, ci_low, ci_high`` (per-radius medians and their intervals).
-
-    Examples
-    --------
-    >>> import numpy as np, pandas as pd
-    >>> idx = pd.MultiIndex.from_product([[0.01, 0.02], range(9)], names=["radius", "ic"])
-    >>> y = pd.Series(np.arange(1.0, 19.0), index=idx)
-    >>> x = 0.5 * y
-    >>> x.iloc[0] = 1e6  # one extreme run does not move a median
-    >>> paired_median(x, y, rng=np.random.default_rng(0))["ratio"]
-    0.5
-    """
-    frame = pd.concat({"x": numerator, "y": denominator}, axis=1)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        q = (frame["x"] / frame["y"]).where(lambda s: np.isfinite(s))
-    table = q.unstack("ic")  # radius x ic
-    values = table.to_numpy(float, copy=True)
-    # a median of ratios at least half of which are 0 (a kicked run without a single
-    # recurrence line, say) is 0 whatever the rest: no estimate at that radius
-    finite = np.isfinite(values)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        zero_share = (values == 0).sum(axis=1) / finite.sum(axis=1)
-    values[zero_share >= 0.5] = np.nan
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", RuntimeWarning)  # a radius without a finite pair
-        per_radius = pd.Series(nanmedian(values, axis=1), index=table.index, dtype=float)
-    usable = np.isfinite(per_radius.to_numpy())
-    n_pairs = int(np.isfinite(values).sum())
-    if not usable.any():
-        curve = pd.DataFrame({"radius": table.index.to_numpy(float), "n_pairs": 0,
-                              "ratio": np.nan, "ci_low": np.nan, "ci_high": np.nan})
-        return {"ratio": math.nan, "ci_low": math.nan, "ci_high": math.nan, "n_pairs": n_pairs,
-                "per_radius": curve}
-    n = values.shape[1]
-    idx = resample_indices(n, n_boot, rng)
-    # boot_r[b] = nanmedian(values[:, idx[b]], axis=1), bit for bit, without a sort each
-    boot_r = bootstrap_nanmedians(values, idx)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", RuntimeWarning)  # a resample without a finite pair
-        boot = np.nanmean(boot_r[:, usable], axis=1)
-        a = (1 - level) / 2 * 100
-        low_r = np.nanpercentile(boot_r, a, axis=0)
-        high_r = np.nanpercentile(boot_r, 100 - a, axis=0)
-    boot = boot[np.isfinite(boot)]
-    curve = pd.DataFrame({"radius": table.index.to_numpy(float),
-                          "n_pairs": np.isfinite(values).sum(axis=1),
-                          "ratio": per_radius.to_numpy(), "ci_low": low_r, "ci_high": high_r})
-    return {
-        "ratio": float(per_radius[usable].mean()),
-        "ci_low": float(np.percentile(boot, a)) if boot.size else math.nan,
-        "ci_high": float(np.percentile(boot, 100 - a)) if boot.size else math.nan,
-        "n_pairs": n_pairs,
-        "per_radius": curve,
-    }
 
 
 def diagnostics_of(results, eps):

@@ -49,7 +49,7 @@ import pandas as pd
 
 from kicktimes.report.controls import diagnostics_of
 from kicktimes.report.store import REFERENCE, wide
-from kicktimes.stats import bootstrap_nanmedians, resample_indices
+from kicktimes.stats import bootstrap_nanmedians, percentile_interval, resample_indices
 
 __all__ = ["ACTUAL_FACTORIAL", "FACTORIAL", "NO_GAP", "STEPS", "gap_decomposition",
            "gap_everywhere", "gap_figure", "gap_summary", "merge_control_gaps"]
@@ -189,7 +189,6 @@ def gap_decomposition(results, collisions, *, family, eps, rule="mirror", rng, n
     where = [systems.index(s) for s in FACTORIAL]
     where_actual = [systems.index(s) for s in ACTUAL_FACTORIAL] if actual else None
     sticky = sticky_ics(collisions, rule, kinetic=kinetic).set_index(["radius", "ic"])["sticky"]
-    alpha = (1.0 - level) / 2.0
     rows = []
     for diagnostic, row, uniform in diagnostics_of(results, eps):
         # recurrence: uniform-time samples are the primary setting (as in the findings)
@@ -225,9 +224,7 @@ def gap_decomposition(results, collisions, *, family, eps, rule="mirror", rng, n
                 shares += list(shapley_shares(point[where_actual, None])[:, 0])
                 boot_shares += list(shapley_shares(boot[where_actual]))
                 steps += list(STEPS[3:])
-            finite = boot[0][np.isfinite(boot[0])]
-            lo0, hi0 = (np.quantile(finite, [alpha, 1.0 - alpha]) if finite.size
-                        else (np.nan, np.nan))
+            lo0, hi0 = percentile_interval(boot[0], level)
             gap = bool(hi0 < _BAND[0] or lo0 > _BAND[1])
             names = [f"ratio {s}" for s in systems] + steps
             estimates = [*point, *shares]
@@ -238,9 +235,7 @@ def gap_decomposition(results, collisions, *, family, eps, rule="mirror", rng, n
                     rows.append((family, diagnostic, control, quantity, np.nan, np.nan, np.nan,
                                  NO_GAP))
                     continue
-                dist = dist[np.isfinite(dist)]
-                lo, hi = (np.quantile(dist, [alpha, 1.0 - alpha]) if dist.size
-                          else (np.nan, np.nan))
+                lo, hi = percentile_interval(dist, level)
                 rows.append((family, diagnostic, control, quantity, float(est), float(lo),
                              float(hi), note))
     return pd.DataFrame(rows, columns=columns)

@@ -33,6 +33,7 @@ from kicktimes.stats import (
     SHARE_RULE,
     clopper_pearson,
     format_interval,
+    percentile_interval,
     resample_counts,
     share_verdict,
     spearman,
@@ -459,10 +460,7 @@ def clustered_mean(per_ic, column, *, rng, n_boot=2000, level=0.95):
     counts = resample_counts(n, n_boot, rng)
     with np.errstate(invalid="ignore", divide="ignore"):
         boot = (counts @ total) / (counts @ n_runs)
-    boot = boot[np.isfinite(boot)]
-    a = (1 - level) / 2 * 100
-    return (float(total.sum() / n_runs.sum()), float(np.percentile(boot, a)),
-            float(np.percentile(boot, 100 - a)))
+    return (float(total.sum() / n_runs.sum()), *percentile_interval(boot, level))
 
 
 #: the null design of the two-disk calibration

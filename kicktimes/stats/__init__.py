@@ -29,6 +29,7 @@ from .analyze import Analysis, analyze
 from .bootstrap import (
     ClusterBootstrap,
     cluster_bootstrap,
+    paired_median,
     paired_ratio,
     percentile_interval,
     ratio_of_means,
@@ -119,6 +120,7 @@ __all__ = [
     "STICKY_FACTOR",
     "ClusterBootstrap",
     "cluster_bootstrap",
+    "paired_median",
     "paired_ratio",
     "percentile_interval",
     "ratio_of_means",

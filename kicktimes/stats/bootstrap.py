@@ -22,6 +22,7 @@ indices (paired), so a ratio keeps the covariance of its numerator and denominat
   identity resample first); `resample_counts`: the same resampling as counts per cluster
   (multinomial), for statistics that are matrix products;
 * `percentile_interval`: the interval of the finite replicates;
+* `paired_median`: the findings' robust control, the median over ICs of the per-IC ratio;
 * `cluster_bootstrap`: both, for a statistic given as a function of the indices;
 * `ratio_of_means`: the paired ratio :math:`\sum x_i / \sum y_i` with its interval;
 * `paired_ratio`: that ratio per radius and averaged over radii, for tables indexed by
@@ -39,8 +40,10 @@ import pandas as pd
 
 from kicktimes.validation import check_int, check_real, check_rng
 
-__all__ = ["ClusterBootstrap", "cluster_bootstrap", "paired_ratio", "percentile_interval",
-           "ratio_of_means", "resample_counts", "resample_indices"]
+from .robust import bootstrap_nanmedians, nanmedian
+
+__all__ = ["ClusterBootstrap", "cluster_bootstrap", "paired_median", "paired_ratio",
+           "percentile_interval", "ratio_of_means", "resample_counts", "resample_indices"]
 
 
 def resample_indices(n_clusters, n_boot, rng=None, *, with_identity=False, chunk=None):
@@ -120,6 +123,13 @@ def resample_counts(n_clusters, n_boot, rng=None):
     return check_rng(rng).multinomial(n, np.full(n, 1.0 / n), size=b).astype(float)
 
 
+def _tail_percent(level):
+    """The percent left out on each side of a central ``level`` interval: 2.5 for 0.95.
+    (1 - 0.95 is 0.050000000000000044 in binary: the percentile is 2.5 %, not 2.5 % plus
+    that rounding error.)"""
+    return round(50.0 * (1.0 - level), 12)
+
+
 def percentile_interval(replicates, level=0.95, *, axis=None):
     r"""Percentile interval of the finite bootstrap replicates.
 
@@ -154,9 +164,7 @@ def percentile_interval(replicates, level=0.95, *, axis=None):
     ([1.05, 10.5], [2.95, 29.5])
     """
     level = check_real("level", level, low=0.0, high=1.0)
-    # 1 - 0.95 is 0.050000000000000044 in binary: the percentile is 2.5 %, not 2.5 % plus
-    # that rounding error
-    a = round(50.0 * (1.0 - level), 12)
+    a = _tail_percent(level)
     if axis is not None:
         v = np.asarray(replicates, float)
         v = np.where(np.isfinite(v), v, np.nan)
@@ -371,16 +379,12 @@ def paired_ratio(numerator, denominator, *, rng, n_boot=2000, level=0.95, resamp
         point = x.sum(axis=1) / y.sum(axis=1)
         boot = (counts @ x.T) / (counts @ y.T)  # (n_boot, n_radii)
     point = np.where(ok.any(axis=1), point, np.nan)
-    a = (1 - level) / 2 * 100
+    a = _tail_percent(level)
     usable = np.isfinite(point)
-    finite_boot = np.where(np.isfinite(boot), boot, np.nan)
     low = high = np.full(radii.size, np.nan)
     if n_boot:
-        with warnings.catch_warnings():
-            # a radius without any usable resample gives an all-NaN column: its CI is NaN
-            warnings.simplefilter("ignore", RuntimeWarning)
-            low = np.nanpercentile(finite_boot, a, axis=0)
-            high = np.nanpercentile(finite_boot, 100 - a, axis=0)
+        # a radius without any usable resample gives an all-NaN column: its CI is NaN
+        low, high = percentile_interval(boot, level, axis=0)
     per_radius = pd.DataFrame(
         {
             "radius": radii,
@@ -436,3 +440,79 @@ def _bca_levels(boot, estimate, x, y, level):
         zq = z0 + ndtri(q)
         out.append(100.0 * float(ndtr(z0 + zq / (1.0 - acc * zq))))
     return out[0], out[1]
+
+
+def paired_median(numerator, denominator, *, rng, n_boot=1000, level=0.95):
+    r"""Median over ICs of the per-IC ratio, per radius, averaged over radii, with a CI.
+
+    Parameters
+    ----------
+    numerator, denominator : pandas.Series
+        Indexed by ``(radius, ic)``; a pair enters where both are finite and the
+        denominator is non-zero. A radius where at least half of the ratios are 0 has no
+        median ratio (it would be 0 whatever the other half): it is left out, and with no
+        radius left the result is NaN (verdict inconclusive).
+    rng : numpy.random.Generator
+        The bootstrap's stream.
+    n_boot : int
+        Resamples of the IC indices (one resample is applied at every radius).
+    level : float
+        Confidence level of the percentile interval.
+
+    Returns
+    -------
+    dict
+        ``ratio, ci_low, ci_high, n_pairs`` and ``per_radius``, a DataFrame ``radius,
+        n_pairs, ratio, ci_low, ci_high`` (per-radius medians and their intervals).
+
+    Examples
+    --------
+    >>> import numpy as np, pandas as pd
+    >>> idx = pd.MultiIndex.from_product([[0.01, 0.02], range(9)], names=["radius", "ic"])
+    >>> y = pd.Series(np.arange(1.0, 19.0), index=idx)
+    >>> x = 0.5 * y
+    >>> x.iloc[0] = 1e6  # one extreme run does not move a median
+    >>> from kicktimes.stats import paired_median
+    >>> paired_median(x, y, rng=np.random.default_rng(0))["ratio"]
+    0.5
+    """
+    frame = pd.concat({"x": numerator, "y": denominator}, axis=1)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        q = (frame["x"] / frame["y"]).where(lambda s: np.isfinite(s))
+    table = q.unstack("ic")  # radius x ic
+    values = table.to_numpy(float, copy=True)
+    # a median of ratios at least half of which are 0 (a kicked run without a single
+    # recurrence line, say) is 0 whatever the rest: no estimate at that radius
+    finite = np.isfinite(values)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        zero_share = (values == 0).sum(axis=1) / finite.sum(axis=1)
+    values[zero_share >= 0.5] = np.nan
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # a radius without a finite pair
+        per_radius = pd.Series(nanmedian(values, axis=1), index=table.index, dtype=float)
+    usable = np.isfinite(per_radius.to_numpy())
+    n_pairs = int(np.isfinite(values).sum())
+    if not usable.any():
+        curve = pd.DataFrame({"radius": table.index.to_numpy(float), "n_pairs": 0,
+                              "ratio": np.nan, "ci_low": np.nan, "ci_high": np.nan})
+        return {"ratio": math.nan, "ci_low": math.nan, "ci_high": math.nan, "n_pairs": n_pairs,
+                "per_radius": curve}
+    n = values.shape[1]
+    idx = resample_indices(n, n_boot, rng)
+    # boot_r[b] = nanmedian(values[:, idx[b]], axis=1), bit for bit, without a sort each
+    boot_r = bootstrap_nanmedians(values, idx)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # a resample without a finite pair
+        boot = np.nanmean(boot_r[:, usable], axis=1)
+    low_r, high_r = percentile_interval(boot_r, level, axis=0)
+    low, high = percentile_interval(boot, level)
+    curve = pd.DataFrame({"radius": table.index.to_numpy(float),
+                          "n_pairs": np.isfinite(values).sum(axis=1),
+                          "ratio": per_radius.to_numpy(), "ci_low": low_r, "ci_high": high_r})
+    return {
+        "ratio": float(per_radius[usable].mean()),
+        "ci_low": low,
+        "ci_high": high,
+        "n_pairs": n_pairs,
+        "per_radius": curve,
+    }
