@@ -1,6 +1,5 @@
 """The protocol study (kicktimes.studies.protocol): rows, tables, Shapley shares, the page."""
 
-import itertools
 import re
 
 import numpy as np
@@ -14,7 +13,6 @@ from kicktimes.render.provenance import PROVENANCE_TITLE
 from kicktimes.stats import paired_ratio
 from kicktimes.studies.protocol.compute import D0, Panel, compute_task, run_rows, tasks
 from kicktimes.studies.protocol.page import FIGURE, build_page, fig6_figure
-from kicktimes.studies.protocol.tables import _shapley
 
 PANELS = (
     Panel("family_a", "Fig. 6 top", (0.012, 0.024), 4, 400, 0.2, 1, 2, (0.024,), 2),
@@ -75,17 +73,6 @@ def test_rows_are_deterministic():
     ic = p.initial_conditions()[0]
     pd.testing.assert_frame_equal(pd.DataFrame(run_rows(p, "main", 0.012, 0, ic)),
                                   pd.DataFrame(run_rows(p, "main", 0.012, 0, ic)))
-
-
-def test_shapley_shares_are_exact_for_an_additive_game_and_efficient():
-    a = (0.5, -1.0, 2.0)
-    additive = {frozenset(s): sum(a[i] for i in s)
-                for k in range(4) for s in itertools.combinations(range(3), k)}
-    np.testing.assert_allclose(_shapley(additive), a)
-    rng = np.random.default_rng(0)
-    game = {s: rng.normal() for s in additive}
-    phi = _shapley(game)
-    assert sum(phi) == pytest.approx(game[frozenset(range(3))] - game[frozenset()])
 
 
 def test_paired_ratio_draws_are_the_resamples_of_its_interval():

@@ -49,7 +49,12 @@ import pandas as pd
 
 from kicktimes.report.controls import diagnostics_of
 from kicktimes.report.store import REFERENCE, wide
-from kicktimes.stats import bootstrap_nanmedians, percentile_interval, resample_indices
+from kicktimes.stats import (
+    bootstrap_nanmedians,
+    percentile_interval,
+    resample_indices,
+    shapley_values,
+)
 
 __all__ = ["ACTUAL_FACTORIAL", "FACTORIAL", "NO_GAP", "STEPS", "gap_decomposition",
            "gap_everywhere", "gap_figure", "gap_summary", "merge_control_gaps"]
@@ -126,8 +131,11 @@ def shapley_shares(rho):
     """
     with np.errstate(invalid="ignore", divide="ignore"):
         g_up, g_sp, g_uk, g_sk = np.abs(np.log(np.asarray(rho, float)))
-        deflection = 0.5 * ((g_up - g_sp) + (g_uk - g_sk))
-        timing = 0.5 * ((g_up - g_uk) + (g_sp - g_sk))
+        # players 0 (the deflection law) and 1 (the kinetic-rate timing); a coalition's
+        # value is minus the gap left with its ingredients
+        deflection, timing = shapley_values(
+            {frozenset(): -g_up, frozenset({0}): -g_sp, frozenset({1}): -g_uk,
+             frozenset({0, 1}): -g_sk}, 2)
         return np.stack([deflection / g_up, timing / g_up, g_sk / g_up])
 
 

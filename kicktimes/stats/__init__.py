@@ -86,6 +86,7 @@ from .renewal import (
 )
 from .rescaling import RescaledTimes, mmpp_residuals
 from .robust import bootstrap_nanmedians, nanmedian
+from .shapley import shapley_values
 from .survival import (
     MIN_AT_RISK,
     EscapeTail,
@@ -160,6 +161,7 @@ __all__ = [
     "robust_verdict",
     "spearman",
     "share_ratio_sample_size",
+    "shapley_values",
     "share_verdict",
     "format_interval",
     "rejection_verdict",

@@ -29,7 +29,13 @@ import math
 import numpy as np
 import pandas as pd
 
-from kicktimes.stats import paired_ratio, percentile_interval, ratio_verdict, robust_verdict
+from kicktimes.stats import (
+    paired_ratio,
+    percentile_interval,
+    ratio_verdict,
+    robust_verdict,
+    shapley_values,
+)
 from kicktimes.stats.findings import share_verdict
 from kicktimes.studies.protocol.compute import CONVERGENCE
 
@@ -217,20 +223,6 @@ def rr_table(rows: pd.DataFrame, panels, small_radius: float) -> pd.DataFrame:
     return pd.DataFrame(out)
 
 
-def _shapley(values: dict, n: int = 3) -> list[float]:
-    """Exact Shapley values of ``n`` players from ``values[frozenset]``."""
-    phi = []
-    for i in range(n):
-        total = 0.0
-        others = [j for j in range(n) if j != i]
-        for k in range(n):
-            for s in itertools.combinations(others, k):
-                w = math.factorial(k) * math.factorial(n - k - 1) / math.factorial(n)
-                total = total + w * (values[frozenset(s) | {i}] - values[frozenset(s)])
-        phi.append(total)
-    return phi
-
-
 def shapley_table(ratios: Ratios, panels) -> pd.DataFrame:
     """Per panel and kicked system, each choice's Shapley share of the change in the
     distance from 1, ``|log R|``, from kicktimes' reading (renormalised, paper measure,
@@ -248,7 +240,7 @@ def shapley_table(ratios: Ratios, panels) -> pd.DataFrame:
                     point[frozenset(s)] = abs(math.log(overall["ratio"]))
                     with np.errstate(invalid="ignore", divide="ignore"):
                         boot[frozenset(s)] = np.abs(np.log(draws))
-            phi, phi_boot = _shapley(point), _shapley(boot)
+            phi, phi_boot = shapley_values(point, 3), shapley_values(boot, 3)
             total = point[frozenset(range(len(FACTORS)))] - point[frozenset()]
             for (column, default, alternative), value, draws in zip(FACTORS, phi, phi_boot,
                                                                    strict=True):
