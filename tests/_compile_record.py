@@ -58,3 +58,15 @@ def compiled_more_than_once(ours: dict) -> dict:
             if len(s) > (3 if name in DRIVERS else 1)
             and name != "kicktimes.billiard.kernels.observe.grow_to"}
 
+
+def kicktimes_compiles(setup: str, calls: str, cache_dir) -> dict:
+    """Run ``calls`` after ``setup`` in a fresh process with an empty numba cache in
+    ``cache_dir``; returns kicktimes' own kernels' signatures (name -> signatures), and
+    asserts what every kernel must: no kernel compiled more often than it should
+    (`compiled_more_than_once`) and no numba string formatting pulled in."""
+    sigs = compiled_signatures(setup, calls, cache_dir)
+    ours = {name: s for name, s in sigs.items() if name.startswith("kicktimes.")}
+    assert compiled_more_than_once(ours) == {}
+    assert string_formatting(sigs) == []
+    return ours
+
