@@ -27,7 +27,7 @@ from pathlib import Path
 
 TIMINGS = re.compile(r"(_timings|^disks_cost)\.csv$")
 #: page lines that state when or how fast the page was made, not what it says
-VOLATILE = re.compile(r"^Generated \d{4}-\d\d-\d\dT|Built in \d|\bs of CPU\b|\bs of wall\b")
+VOLATILE = re.compile(r"^Generated \d{4}-\d\d-\d\dT|[Bb]uilt in \d|\bs of CPU\b|\bs of wall\b")
 
 
 def _files(root: Path):
