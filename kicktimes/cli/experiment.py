@@ -260,11 +260,11 @@ def reproduce_command(study, results, findings, scale, content, out, workers, sc
 
     if study == "all":
         results = results if results is not None else os.path.join(out, "results")
+        # each page names its own study's command, the one that rebuilds it alone
         for name in STUDIES:
             click.echo(f"== --study {name}", err=True)
             _reproduce_one(name, results, findings, scale, content, out, workers, scheduler,
-                           progress, wait, pdf, command=f"kicktimes reproduce --study all "
-                           f"--scale {scale}")
+                           progress, wait, pdf)
         return
     _reproduce_one(study, results, findings, scale, content, out, workers, scheduler,
                    progress, wait, pdf)
