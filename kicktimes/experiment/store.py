@@ -642,7 +642,7 @@ def _load(path, *, verify=True, result_columns=None, categories=()) -> Store:
     """`load_store`, optionally reading only ``result_columns`` of the results and the
     string columns ``categories`` of the results as categoricals with sorted categories
     (as ``astype("category")`` of the strings gives, without materialising 2 million
-    strings: what the report reads, see `kicktimes.report.common.report_store`).
+    strings: what the report reads, see `kicktimes.report.store.report_store`).
     """
     import pandas as pd
     import pyarrow as pa
