@@ -15,7 +15,8 @@ import os
 import tempfile
 from pathlib import Path
 
-__all__ = ["TMP_PREFIX", "atomic_write", "atomic_write_bytes", "file_sha256", "umask"]
+__all__ = ["TMP_PREFIX", "atomic_write", "atomic_write_bytes", "file_sha256", "read_csv_exact",
+           "umask"]
 
 #: Prefix of the temporary files (a store treats leftovers with it as debris).
 TMP_PREFIX = ".tmp-"
@@ -94,3 +95,15 @@ def file_sha256(path: str | os.PathLike) -> str:
         for block in iter(lambda: fh.read(1 << 20), b""):
             h.update(block)
     return h.hexdigest()
+
+
+def read_csv_exact(path):
+    """``pandas.read_csv(path)`` with every float exactly as written: pandas' round-trip
+    parser, which pandas 3 made the default (and deprecated the option for); before it,
+    the default parser misses the last bit of some floats."""
+    import pandas as pd
+
+    if int(pd.__version__.split(".")[0]) >= 3:
+        return pd.read_csv(path)
+    return pd.read_csv(path, float_precision="round_trip")
+

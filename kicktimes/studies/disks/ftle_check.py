@@ -47,7 +47,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from kicktimes.fileio import atomic_write
+from kicktimes.fileio import atomic_write, read_csv_exact
 from kicktimes.studies.cache import cached_tables, write_cached
 from kicktimes.studies.disks.kicked import FTLE_CHECK_COLUMNS
 
@@ -205,7 +205,7 @@ def seed_ftle_check(out, runs, check: FtleCheck = FTLE_CHECK) -> None:
     """
     if isinstance(runs, str | os.PathLike):
         # read exactly: pandas < 3 parses floats to the nearest-but-one double
-        runs = pd.read_csv(runs, float_precision="round_trip")
+        runs = read_csv_exact(runs)
     runs = pd.DataFrame(runs)
     missing = [c for c in RUNS_COLUMNS if c not in runs.columns]
     if missing:
