@@ -40,7 +40,8 @@ import pandas as pd
 from kicktimes.fileio import atomic_write
 from kicktimes.studies.options import status_lines
 
-__all__ = ["Cached", "cached_table", "cached_tables", "read_cached", "write_cached"]
+__all__ = ["Cached", "cached_table", "cached_tables", "read_cached", "runs_table",
+           "write_cached"]
 
 
 @dataclass(frozen=True)
@@ -174,3 +175,19 @@ def cached_tables(jobs, *, workers: int = 1, progress=None) -> list[Cached]:
         results.append(found if k not in computed else
                        Cached(found.table, found.seconds, False))
     return results
+
+
+def runs_table(runs, columns) -> pd.DataFrame:
+    """``runs``, a table of runs to seed a cache with, as a DataFrame: ``runs`` itself, or
+    the CSV at that path read exactly (`kicktimes.fileio.read_csv_exact`); ValueError
+    naming the ``columns`` it lacks."""
+    from kicktimes.fileio import read_csv_exact
+
+    if isinstance(runs, str | os.PathLike):
+        runs = read_csv_exact(runs)
+    runs = pd.DataFrame(runs)
+    missing = [c for c in columns if c not in runs.columns]
+    if missing:
+        raise ValueError(f"runs: missing columns {missing}")
+    return runs
+

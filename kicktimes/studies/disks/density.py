@@ -47,7 +47,6 @@ Examples
 from __future__ import annotations
 
 import math
-import os
 from dataclasses import dataclass
 from numbers import Integral, Real
 from pathlib import Path
@@ -55,9 +54,9 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from kicktimes.fileio import atomic_write, read_csv_exact
+from kicktimes.fileio import atomic_write
 from kicktimes.stats import percentile_interval, resample_indices
-from kicktimes.studies.cache import cached_tables, write_cached
+from kicktimes.studies.cache import cached_tables, runs_table, write_cached
 from kicktimes.studies.disks.ftle_check import _say_reused
 
 __all__ = ["DENSITY", "FIT_MAX_PACKING", "PACKINGS", "RUNS_COLUMNS", "SLOPE_MARGIN",
@@ -216,13 +215,7 @@ def seed_lyapunov_density(out, runs, sweep: LyapunovDensity = DENSITY) -> None:
         If ``runs`` lacks an (N, packing) of ``sweep`` or its states are not ``0 ..
         states-1``.
     """
-    if isinstance(runs, str | os.PathLike):
-        # read exactly: pandas < 3 parses floats to the nearest-but-one double
-        runs = read_csv_exact(runs)
-    runs = pd.DataFrame(runs)
-    missing = [c for c in RUNS_COLUMNS if c not in runs.columns]
-    if missing:
-        raise ValueError(f"runs: missing columns {missing}")
+    runs = runs_table(runs, RUNS_COLUMNS)
     for path, params, _, _ in _jobs(out, sweep):
         g = runs[(runs["n_disks"] == params["n_disks"])
                  & (runs["packing"] == params["packing"])].sort_values("state",

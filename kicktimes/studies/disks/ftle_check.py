@@ -39,7 +39,6 @@ engine/two-disk 2 mirror 200.0
 from __future__ import annotations
 
 import math
-import os
 from dataclasses import dataclass
 from numbers import Integral
 from pathlib import Path
@@ -47,8 +46,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from kicktimes.fileio import atomic_write, read_csv_exact
-from kicktimes.studies.cache import cached_tables, write_cached
+from kicktimes.fileio import atomic_write
+from kicktimes.studies.cache import cached_tables, runs_table, write_cached
 from kicktimes.studies.disks.kicked import FTLE_CHECK_COLUMNS
 
 __all__ = ["FTLE_CHECK", "MARGINS", "RUNS_COLUMNS", "FtleCheck", "ftle_check_runs", "pair",
@@ -203,13 +202,7 @@ def seed_ftle_check(out, runs, check: FtleCheck = FTLE_CHECK) -> None:
         If ``runs`` lacks a (check, N, rule) of ``check``, its seeds are not ``0 ..
         ics-1`` or its ``t_max`` differs.
     """
-    if isinstance(runs, str | os.PathLike):
-        # read exactly: pandas < 3 parses floats to the nearest-but-one double
-        runs = read_csv_exact(runs)
-    runs = pd.DataFrame(runs)
-    missing = [c for c in RUNS_COLUMNS if c not in runs.columns]
-    if missing:
-        raise ValueError(f"runs: missing columns {missing}")
+    runs = runs_table(runs, RUNS_COLUMNS)
     for path, params, _, _ in _jobs(out, check):
         g = runs[(runs["check"] == params["check"]) & (runs["n_disks"] == params["n_disks"])
                  & (runs["rule"] == params["rule"])].sort_values("seed", ignore_index=True)
