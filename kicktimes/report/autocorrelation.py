@@ -613,9 +613,9 @@ def sections(ctx):
             "R_1 against its built-in prediction 1 − n_pert/n_boundary: largest gap "
             f"{number_text(gap.max())} over all radii and systems (R_1 ranges from "
             f"{number_text(table['R1_mean'].min())} to {number_text(table['R1_mean'].max())}). "
-            f"Because each "
-            "kicked system is given the two-particle collision rate, its lag-1 agreement with "
-            "the two-particle system is built in: it is not evidence that the kicked billiard "
+            "Because each kicked system is given the two-particle collision rate, its lag-1 "
+            "agreement with the two-particle system is built in: it is not evidence that the "
+            "kicked billiard "
             "reproduces the two-particle dynamics."
         )
     if "decorrelation_lag_mean" in table.columns:

@@ -241,11 +241,9 @@ def sections(ctx):
             f"{system_label(system)}: at r = {r0:g} the stretching per perturbation is "
             f"{number_text(ref.loc[r0, 'stretch_per_perturbation'])} nats per disk-disk collision "
             f"against {number_text(part.loc[r0, 'stretch_per_perturbation'])} per kick, an excess "
-            f"of "
-            f"{number_text(excess.loc[r0])} nats (ln(1/r) = {number_text(np.log(1 / r0))}); "
-            f"least-squares "
-            f"slope of the excess on ln(1/r) through 0: {number_text(slope)} (1 if the excess is "
-            "ln(1/r))"
+            f"of {number_text(excess.loc[r0])} nats (ln(1/r) = {number_text(np.log(1 / r0))}); "
+            f"least-squares slope of the excess on ln(1/r) through 0: {number_text(slope)} "
+            "(1 if the excess is ln(1/r))"
         )
     if parts:
         sec.text(

@@ -345,8 +345,7 @@ def sections(ctx):
     text = (f"The MMPP-2 is AIC-best for {percent_text(ok['mmpp_best'].mean())} of the {len(ok)} "
             f"fitted "
             f"ICs ({percent_text(ok['null_mmpp_best'].mean())} of their Poisson twins) and beats "
-            f"Poisson "
-            f"for {percent_text(ok['mmpp_beats_poisson'].mean())} "
+            f"Poisson for {percent_text(ok['mmpp_beats_poisson'].mean())} "
             f"({percent_text(ok['null_mmpp_beats_poisson'].mean())} of the twins).")
     if len(clustered):
         ratio = clustered["rate_high"] / clustered["rate_low"]

@@ -557,8 +557,7 @@ def effects(ctx):
             detail=(
                 f"{percent_text(by_r['rate'].iloc[0])} at r = {by_r['radius'].iloc[0]:g}, "
                 f"{percent_text(by_r['rate'].iloc[-1])} at r = {by_r['radius'].iloc[-1]:g}; at a "
-                f"fixed "
-                f"{FIXED_EVENTS} collisions per run "
+                f"fixed {FIXED_EVENTS} collisions per run "
                 f"{format_interval(100 * fixed_share, 100 * f_low, 100 * f_high)} % "
                 f"({percent_text(by_r['rate_fixed'].iloc[0])} at r = "
                 f"{by_r['radius'].iloc[0]:g}, {percent_text(by_r['rate_fixed'].iloc[-1])} at r = "

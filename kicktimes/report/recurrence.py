@@ -427,8 +427,7 @@ def sections(ctx):
             f"ε = {e:g}: the two-particle RR is {number_text(rr['mean'].min() * n)}/N to "
             f"{number_text(rr['mean'].max() * n)}/N over the radii, so the main diagonal is "
             f"{number_text(100 * share.min())}–{number_text(100 * share.max())} % of it; compare "
-            f"the systems "
-            "on the off-diagonal rate and DET, not on the paper's RR."
+            "the systems on the off-diagonal rate and DET, not on the paper's RR."
         )
     sec.table(
         "recurrence_by_radius",

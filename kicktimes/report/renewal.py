@@ -369,8 +369,7 @@ def effects(ctx):
             quantity="share of fitted ICs whose AIC-best model is the exponential",
             verdict=verdict,
             detail=(f"under Poisson times {percent_text(level)} of the same fits pick the "
-                    f"exponential; "
-                    "AIC-best counts: " + detail),
+                    "exponential; AIC-best counts: " + detail),
             **share,
         )
     ]
