@@ -92,6 +92,8 @@ def drive(st, ev, phys, t_end, mode, tau, track, logs, stimes, samples, cnt, nex
         m = U.shape[0]
         i_loop, n_loop, n_ev, n_same, n_resc, n_pert, tk, t_prev, tan_code = tg.load_carry(
             tgi, tgf)
+        # set at the start and never changed: read once, not at every collision
+        fresh_partner = tgi[tg.FRESH_PARTNER] != 0
     uni_on = False
     if uni is not None:
         u_times, u_samples, ku, uni_on, u_limit = ob.load_uniform(uni)
@@ -194,7 +196,7 @@ def drive(st, ev, phys, t_end, mode, tau, track, logs, stimes, samples, cnt, nex
         if ke == two.PAIR:
             if tan is not None and tan_on:
                 n_pert += 1
-                if tgi[tg.FRESH_PARTNER] != 0:
+                if fresh_partner:
                     for j in range(m):
                         for i in range(4, 8):
                             U[j, i] = 0.0
