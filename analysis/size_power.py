@@ -65,14 +65,8 @@ def ear1(rho):
     lag-k autocorrelation rho**k."""
 
     def make(rng):
-        n = int(3 * (T + BURN_IN)) + 100
-        keep = rng.uniform(size=n) > rho
-        e = rng.exponential(size=n)
-        x = np.empty(n)
-        x[0] = rng.exponential()
-        for i in range(1, n):
-            x[i] = rho * x[i - 1] + keep[i] * e[i]
-        return keep_window(np.cumsum(x))
+        return keep_window(np.cumsum(stats.ear1_intervals(int(3 * (T + BURN_IN)) + 100, rho,
+                                                          rng=rng)))
 
     return make
 

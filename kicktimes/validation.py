@@ -8,6 +8,7 @@ conditions, event times, intervals) live beside the code that needs them.
 from __future__ import annotations
 
 import math
+import re
 from numbers import Integral, Real
 
 import numpy as np
@@ -53,6 +54,40 @@ def check_choice(name: str, value, choices) -> str:
     if not isinstance(value, str) or value not in choices:
         raise ValueError(f"{name} must be one of {sorted(choices)!r}, got {value!r}")
     return value
+
+
+#: a name that may name files: a letter or digit, then letters, digits and ``_ . + -``
+_FILE_NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9_.+-]*")
+
+
+def check_file_name(name: str, value) -> str:
+    """A string that may name files: a letter or digit, then letters, digits and ``_ . + -``.
+
+    >>> check_file_name("name", "family_a")
+    'family_a'
+    """
+    if not isinstance(value, str) or not _FILE_NAME.fullmatch(value):  # (no trailing newline)
+        raise ValueError(f"{name}: must be a non-empty identifier of letters, digits, '_', '.', "
+                         f"'+', '-' (it names files), got {value!r}")
+    return value
+
+
+def check_distinct(name: str, values, check_item, *, what: str) -> tuple:
+    """The distinct ``values``, each passed through ``check_item(f"{name}[k]", v)``, sorted
+    increasingly; a string or a non-iterable raises TypeError, an empty or repeating list
+    ValueError (``what``: the items' name in the messages).
+
+    >>> check_distinct("radii", [0.02, 0.01], lambda n, v: check_real(n, v, low=0), what="radii")
+    (0.01, 0.02)
+    """
+    if isinstance(values, str | bytes) or not hasattr(values, "__iter__"):
+        raise TypeError(f"{name}: expected a list of {what}, got {values!r}")
+    items = [check_item(f"{name}[{k}]", v) for k, v in enumerate(values)]
+    if not items:
+        raise ValueError(f"{name}: must contain at least one of the {what}, got []")
+    if len(set(items)) != len(items):
+        raise ValueError(f"{name}: must be distinct, got {items}")
+    return tuple(sorted(items))
 
 
 def check_rng(rng, name: str = "rng") -> np.random.Generator:

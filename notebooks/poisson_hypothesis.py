@@ -61,30 +61,12 @@ SIZES = {
     # radii, ICs per (method, rule, radius), observation window T, Monte Carlo samples of the
     # conditional nulls, ICs per radius with their own renewal-model comparison, ICs of the
     # dedicated search for sticky orbits
-    "test": dict(
-        radii=(0.01, 0.03),
-        n_ics=24,
-        t_window=1500.0,
-        n_mc=99,
-        n_fit_ics=2,
-        n_search=300,
-    ),
-    "small": dict(
-        radii=(0.01, 0.02, 0.03),
-        n_ics=120,
-        t_window=3000.0,
-        n_mc=999,
-        n_fit_ics=6,
-        n_search=1500,
-    ),
-    "full": dict(
-        radii=(0.006, 0.008, 0.01, 0.014, 0.02, 0.026, 0.03),
-        n_ics=1000,
-        t_window=20000.0,
-        n_mc=999,
-        n_fit_ics=100,
-        n_search=20000,
-    ),
+    "test": dict(radii=(0.01, 0.03), n_ics=24, t_window=1500.0, n_mc=99, n_fit_ics=2,
+                 n_search=300),
+    "small": dict(radii=(0.01, 0.02, 0.03), n_ics=120, t_window=3000.0, n_mc=999, n_fit_ics=6,
+                  n_search=1500),
+    "full": dict(radii=(0.006, 0.008, 0.01, 0.014, 0.02, 0.026, 0.03), n_ics=1000,
+                 t_window=20000.0, n_mc=999, n_fit_ics=100, n_search=20000),
 }
 if SIZE not in SIZES:
     raise ValueError(f"KICKTIMES_NOTEBOOK_SIZE must be one of {sorted(SIZES)}, got {SIZE!r}")

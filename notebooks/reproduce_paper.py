@@ -70,16 +70,10 @@ SIZES = {
     # experiments to run; report options (ICs with their own renewal fits, Monte Carlo
     # samples of the Poisson tests, PNG resolution) and the stores it covers
     "test": dict(names=("quick_a",), report_stores=("quick_a",), fits=1, n_mc=19, dpi=40),
-    "small": dict(
-        names=("quick_a", "quick_b"), report_stores=("quick_a", "quick_b"), fits=3, n_mc=99, dpi=72
-    ),
-    "full": dict(
-        names=("family_a", "family_b"),
-        report_stores=("family_a", "family_b"),
-        fits=12,
-        n_mc=999,
-        dpi=150,
-    ),
+    "small": dict(names=("quick_a", "quick_b"), report_stores=("quick_a", "quick_b"), fits=3,
+                  n_mc=99, dpi=72),
+    "full": dict(names=("family_a", "family_b"), report_stores=("family_a", "family_b"),
+                 fits=12, n_mc=999, dpi=150),
 }
 if SIZE not in SIZES:
     raise ValueError(f"KICKTIMES_NOTEBOOK_SIZE must be one of {sorted(SIZES)}, got {SIZE!r}")

@@ -1,7 +1,9 @@
 """Test-suite settings shared by every test module."""
 
+import contextlib
 import os
 import re
+import warnings
 
 from hypothesis import settings
 
@@ -49,19 +51,24 @@ def assert_provenance(page):
 MACHINE_PATH = re.compile(r"(/tmp/|/work/|/home/|/Users/|/root/|[A-Za-z]:\\\\)")
 
 
-def build_study(tmp_path_factory, name, reproduce, scales, params, patches=()):
-    """``reproduce(out)`` of a study at a tiny size: its ``scales["quick"]`` set to
-    ``params`` and each ``(object, attribute, value)`` of ``patches`` in place for the
-    run; returns ``(out, page)``."""
+def built_study(name, study, params, patches=()):
+    """A module-scoped fixture ``(out, page)``: ``study.reproduce(out)`` at a tiny size, its
+    ``study.SCALES["quick"]`` set to ``params`` and each ``(object, attribute, value)`` of
+    ``patches`` in place for the run. Use as ``built = built_study("scatter", study, TINY)``.
+    """
     import pytest
 
-    out = tmp_path_factory.mktemp(name)
-    with pytest.MonkeyPatch.context() as mp:
-        mp.setitem(scales, "quick", params)
-        for target, attribute, value in patches:
-            mp.setattr(target, attribute, value)
-        page = reproduce(out)
-    return out, page
+    @pytest.fixture(scope="module")
+    def built(tmp_path_factory):
+        out = tmp_path_factory.mktemp(name)
+        with pytest.MonkeyPatch.context() as mp:
+            mp.setitem(study.SCALES, "quick", params)
+            for target, attribute, value in patches:
+                mp.setattr(target, attribute, value)
+            page = study.reproduce(out)
+        return out, page
+
+    return built
 
 
 def assert_study_page(page, study, scale="quick"):
@@ -91,3 +98,18 @@ def table_cells(text, first):
         if cells and cells[0] == first:
             return cells
     raise AssertionError(f"no table row {first!r}")
+
+
+@contextlib.contextmanager
+def local_dask(n_workers):
+    """``(cluster, client)`` of a local Dask cluster of ``n_workers`` one-thread processes
+    (the test is skipped without kicktimes[dask]); dask's start-up chatter is silenced."""
+    import pytest
+
+    distributed = pytest.importorskip("distributed")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # ports, versions
+        with distributed.LocalCluster(n_workers=n_workers, processes=True, threads_per_worker=1,
+                                      dashboard_address=None) as cluster:
+            with distributed.Client(cluster) as client:
+                yield cluster, client

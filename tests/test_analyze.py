@@ -422,15 +422,8 @@ def test_outside_hard_disk_simulator_matches_kinetic_theory(tmp_path):
     mod = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(mod)
     events, seqs = mod.generate(collisions_per_disk=150.0, n_runs=2, seed=7)
-    res = stats.analyze(
-        events,
-        windows=seqs,
-        covariates=["density", "kinetic_rate"],
-        group="density",
-        reference="kinetic_rate",
-        rng=0,
-        max_fits_per_group=2,
-    )
+    res = stats.analyze(events, windows=seqs, covariates=["density", "kinetic_rate"],
+                        group="density", reference="kinetic_rate", rng=0, max_fits_per_group=2)
     ref = res.reference
     assert ((ref["ratio"] > 0.93) & (ref["ratio"] < 1.07)).all(), ref
     reg = res.regressions.set_index(["covariate", "model", "term"])

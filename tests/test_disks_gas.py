@@ -13,6 +13,7 @@ import warnings
 import numpy as np
 import pandas as pd
 import pytest
+from conftest import local_dask
 
 import kicktimes as kt
 from kicktimes.experiment import DISKS_PRESETS, DisksExperiment, load_store, run_experiment
@@ -53,13 +54,8 @@ def test_the_sweep_has_a_task_per_block_of_runs_and_tags_one_of_two_disks(refere
 
 @pytest.mark.reproducibility
 def test_the_sweep_is_the_same_on_a_dask_local_cluster(reference, tmp_path):
-    distributed = pytest.importorskip("distributed")
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        with distributed.LocalCluster(n_workers=1, processes=True, threads_per_worker=1,
-                                      dashboard_address=None) as cluster:
-            with distributed.Client(cluster) as client:
-                on_dask = run_quiet(TINY, tmp_path / "dask", executor=client.get_executor())
+    with local_dask(n_workers=1) as (_, client):
+        on_dask = run_quiet(TINY, tmp_path / "dask", executor=client.get_executor())
     assert_same_store(reference, on_dask)
 
 

@@ -20,6 +20,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
+from conftest import local_dask
 
 from kicktimes.experiment import (
     COLLISION_COLUMNS,
@@ -542,15 +543,9 @@ def test_results_are_identical_for_one_or_two_processes_and_threads(reference, t
 
 @pytest.mark.reproducibility
 def test_results_are_identical_on_a_dask_local_cluster(reference, tmp_path):
-    distributed = pytest.importorskip("distributed")
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")  # dask's own start-up chatter (ports, versions)
-        with distributed.LocalCluster(
-            n_workers=2, processes=True, threads_per_worker=1, dashboard_address=None
-        ) as cluster:
-            with distributed.Client(cluster) as client:
-                on_dask = run_quiet(TINY, tmp_path / "dask", executor=client.get_executor())
-            via_address = run_quiet(TINY, tmp_path / "addr", scheduler=cluster.scheduler_address)
+    with local_dask(n_workers=2) as (cluster, client):
+        on_dask = run_quiet(TINY, tmp_path / "dask", executor=client.get_executor())
+        via_address = run_quiet(TINY, tmp_path / "addr", scheduler=cluster.scheduler_address)
     assert_same_store(reference, on_dask)
     assert_same_store(reference, via_address)
 

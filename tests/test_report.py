@@ -221,16 +221,9 @@ def test_no_figure_is_left_open(built):
     assert plt.get_fignums() == []
 
 
-SECOND = Experiment(
-    name="tiny_report_b",
-    radii=[0.01, 0.016],
-    n_ics=4,
-    n_steps=1000,
-    tau=0.2,
-    seed=8,
-    diagnostics=["autocorrelation"],
-    block_size=4,
-)
+# a second family, with the default sampling and exponent (unlike EXPERIMENT)
+SECOND = Experiment(name="tiny_report_b", radii=[0.01, 0.016], n_ics=4, n_steps=1000, tau=0.2,
+                    seed=8, diagnostics=["autocorrelation"], block_size=4)
 
 
 @pytest.mark.full

@@ -38,14 +38,7 @@ def ear1_sequences(k, rho, rng, t_window=T):
     lag-k correlation rho**k, so only the serial-dependence tests can see them."""
     out = []
     for _ in range(k):
-        m = int(3 * t_window) + 50
-        keep = rng.uniform(size=m) > rho
-        e = rng.exponential(size=m)
-        x = np.empty(m)
-        x[0] = rng.exponential()
-        for i in range(1, m):
-            x[i] = rho * x[i - 1] + keep[i] * e[i]
-        t = np.cumsum(x)
+        t = np.cumsum(stats.ear1_intervals(int(3 * t_window) + 50, rho, rng=rng))
         out.append(t[t <= t_window])
     return out
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import pandas as pd
 import pytest
-from conftest import assert_provenance, build_study, refuse_simulations, table_cells
+from conftest import assert_provenance, built_study, refuse_simulations, table_cells
 
 from kicktimes.stats import format_interval, ratio_verdict
 from kicktimes.studies.mechanism import run
@@ -20,11 +20,8 @@ def _placeholders(results, folder, **kwargs):
         (folder / f"mechanism_{name}.png").write_bytes(f"{name} {sorted(results)}".encode())
 
 
-@pytest.fixture(scope="module")
-def built(tmp_path_factory):
-    return build_study(tmp_path_factory, "mechanism", run.reproduce, run.SCALES, TINY,
-                       [(run, "RULES", {"mirror": "mechanism"}),
-                        (run, "write_figures", _placeholders)])
+built = built_study("mechanism", run, TINY, [(run, "RULES", {"mirror": "mechanism"}),
+                                             (run, "write_figures", _placeholders)])
 
 
 def test_the_page_names_the_command_and_reads_its_table(built):

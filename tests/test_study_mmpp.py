@@ -4,7 +4,7 @@ from types import SimpleNamespace
 
 import pandas as pd
 import pytest
-from conftest import assert_provenance, assert_study_page, build_study, refuse_simulations
+from conftest import assert_provenance, assert_study_page, built_study, refuse_simulations
 
 import kicktimes.studies.mmpp as study
 import kicktimes.studies.mmpp.tables as tables
@@ -15,10 +15,7 @@ TINY = study.Params(n_ics=12, t_max=300.0, per_run=3)
 FEW = {"N_MC": 19, "N_BOOT": 50}
 
 
-@pytest.fixture(scope="module")
-def built(tmp_path_factory):
-    return build_study(tmp_path_factory, "mmpp", study.reproduce, study.SCALES, TINY,
-                       [(tables, name, value) for name, value in FEW.items()])
+built = built_study("mmpp", study, TINY, [(tables, name, value) for name, value in FEW.items()])
 
 
 def test_the_page_names_its_command_and_its_verdicts_are_its_csv(built):

@@ -2,8 +2,7 @@
 
 import numpy as np
 import pandas as pd
-import pytest
-from conftest import assert_provenance, assert_study_page, build_study, refuse_simulations
+from conftest import assert_provenance, assert_study_page, built_study, refuse_simulations
 
 import kicktimes.studies.scatter as study
 from kicktimes.experiment.presets import preset
@@ -12,9 +11,7 @@ from kicktimes.stats import format_interval, ratio_verdict
 TINY = study.Params(n_ics=3, n_steps=300, radii=(0.01, 0.03))
 
 
-@pytest.fixture(scope="module")
-def built(tmp_path_factory):
-    return build_study(tmp_path_factory, "scatter", study.reproduce, study.SCALES, TINY)
+built = built_study("scatter", study, TINY)
 
 
 def test_the_page_names_its_command_and_its_numbers_are_its_csv(built):

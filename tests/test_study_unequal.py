@@ -1,11 +1,10 @@
 """The unequal-disks study (kicktimes.studies.unequal): its page from its table, its cache."""
 
 import pandas as pd
-import pytest
 from conftest import (
     assert_provenance,
     assert_study_page,
-    build_study,
+    built_study,
     refuse_simulations,
     table_cells,
 )
@@ -16,9 +15,7 @@ from kicktimes.stats import format_interval, ratio_verdict
 TINY = study.Params(n_ics=10, n_steps=1000)
 
 
-@pytest.fixture(scope="module")
-def built(tmp_path_factory):
-    return build_study(tmp_path_factory, "unequal", study.reproduce, study.SCALES, TINY)
+built = built_study("unequal", study, TINY)
 
 
 def test_the_page_names_its_command_and_its_numbers_are_its_csv(built):

@@ -62,6 +62,16 @@ _wait_option = click.option(
     is_flag=True,
     help="If another run is writing the store, wait for it instead of stopping.",
 )
+
+
+def _sweep_options(command):
+    """The options of a command that runs sweeps: --workers, --scheduler, --progress, --wait
+    (in that order in its help)."""
+    for add in (_wait_option, _progress_option, _scheduler_option, _workers_option):
+        command = add(command)
+    return command
+
+
 # library argument names -> the options that set them
 _RUN_OPTIONS = {"store": "--out", "workers": "--workers", "scheduler": "--scheduler",
                 "path": "--out"}
@@ -90,10 +100,7 @@ def _experiment(name_or_path):
 @click.argument("experiment")
 @click.option("--out", "out", type=click.Path(file_okay=False), required=True,
               help="Store directory (created; rerunning resumes it).")
-@_workers_option
-@_scheduler_option
-@_progress_option
-@_wait_option
+@_sweep_options
 def run_command(experiment, out, workers, scheduler, progress, wait):
     """Run (or resume) the sweep EXPERIMENT into the store --out.
 
@@ -249,10 +256,7 @@ Examples:
 @click.option("--out", "out", type=click.Path(file_okay=False), required=True,
               help="Work folder: the studies' stores and caches (store-<name>, ...) and the "
               "sweep report (report/).")
-@_workers_option
-@_scheduler_option
-@_progress_option
-@_wait_option
+@_sweep_options
 @_pdf_option
 def reproduce_command(study, results, findings, scale, content, out, workers, scheduler,
                       progress, wait, pdf):

@@ -96,15 +96,8 @@ def simulate_command(radii, n_ics, t_max, seed, rule, ic_method, out, save_runs,
             "pp_times": pa.array([row[4] for row in rows], pa.list_(pa.float64())),
         }
     )
-    meta = dict(
-        radii=list(radii),
-        n_ics=n_ics,
-        t_max=t_max,
-        seed=seed,
-        rule=rule,
-        ic_method=ic_method,
-        version=__version__,
-    )
+    meta = {"radii": list(radii), "n_ics": n_ics, "t_max": t_max, "seed": seed, "rule": rule,
+            "ic_method": ic_method, "version": __version__}
     table = table.replace_schema_metadata({b"kicktimes": json.dumps(meta).encode()})
     path = os.path.join(out, "collisions.parquet")
     with _cli_errors():

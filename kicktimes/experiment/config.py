@@ -16,13 +16,19 @@ records it and refuses to mix results of two experiments.
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import json
 import os
-import re
 from dataclasses import asdict, dataclass, field, fields
 
-from kicktimes.validation import check_choice, check_int, check_real
+from kicktimes.validation import (
+    check_choice,
+    check_distinct,
+    check_file_name,
+    check_int,
+    check_real,
+)
 
 __all__ = ["DEFAULT_SYSTEMS", "DIAGNOSTICS", "SYSTEMS", "Experiment"]
 
@@ -51,7 +57,6 @@ _LATER_FIELDS = {"acf_max_lag": 20, "rr_sampling": "run", "lyapunov_method": "tw
 
 _REQUIRED = ("name", "radii", "n_ics", "n_steps", "tau")
 
-_NAME_RE = re.compile(r"[A-Za-z0-9][A-Za-z0-9_.+-]*")  # used with fullmatch: no trailing newline
 
 
 def _eps_tuple(value):
@@ -223,23 +228,10 @@ class Experiment:
     partner_mass: float = 1.0
 
     def __post_init__(self):
-        def put(name, value):
-            object.__setattr__(self, name, value)
-
-        if not isinstance(self.name, str) or not _NAME_RE.fullmatch(self.name):
-            raise ValueError(
-                f"name: must be a non-empty identifier of letters, digits, '_', '.', '+', '-' "
-                f"(it names files), got {self.name!r}"
-            )
-        radii = self.radii
-        if isinstance(radii, (str, bytes)) or not hasattr(radii, "__iter__"):
-            raise TypeError(f"radii: expected a list of radii, got {radii!r}")
-        radii = [check_real(f"radii[{k}]", r, low=0.0, high=0.5) for k, r in enumerate(radii)]
-        if not radii:
-            raise ValueError("radii: must contain at least one radius, got []")
-        if len(set(radii)) != len(radii):
-            raise ValueError(f"radii: must be distinct, got {radii}")
-        put("radii", tuple(sorted(radii)))
+        put = functools.partial(object.__setattr__, self)  # (the dataclass is frozen)
+        check_file_name("name", self.name)
+        put("radii", check_distinct("radii", self.radii, what="radii",
+                                    check_item=lambda n, r: check_real(n, r, low=0.0, high=0.5)))
         put("n_ics", check_int("n_ics", self.n_ics, low=1))
         put("n_steps", check_int("n_steps", self.n_steps, low=1))
         put("tau", check_real("tau", self.tau, low=0.0))

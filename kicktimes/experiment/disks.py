@@ -26,12 +26,19 @@ True
 from __future__ import annotations
 
 import dataclasses
+import functools
 import hashlib
 import json
 import math
 from dataclasses import asdict, dataclass, field, fields
 
-from kicktimes.validation import check_choice, check_int, check_real
+from kicktimes.validation import (
+    check_choice,
+    check_distinct,
+    check_file_name,
+    check_int,
+    check_real,
+)
 
 __all__ = ["DISKS_CONTROLS", "DISKS_PRESETS", "DISKS_REFERENCES", "DisksExperiment", "DisksTask",
            "KICKED_SYSTEMS", "disks_control", "disks_preset"]
@@ -97,9 +104,9 @@ class DisksExperiment:
     Parameters
     ----------
     name : str
-        Identifier (letters, digits, ``_ . -``), used in store and page names.
+        The store's and the page's name: letters, digits and ``_ . -``.
     n_disks : sequence of int
-        Numbers of disks ``>= 2``, distinct; stored sorted increasingly.
+        Numbers of disks ``>= 2``, distinct (stored sorted increasingly).
     packing : float, optional
         Area fraction ``N r^2`` in ``(0, 0.7]``, the same for every N (``r = sqrt(packing /
         N)``). Give exactly one of ``packing`` and ``r``.
@@ -192,23 +199,10 @@ class DisksExperiment:
     kind = "disks"
 
     def __post_init__(self):
-        def put(name, value):
-            object.__setattr__(self, name, value)
-
-        from kicktimes.experiment.config import _NAME_RE
-
-        if not isinstance(self.name, str) or not _NAME_RE.fullmatch(self.name):
-            raise ValueError(f"name: must be a non-empty identifier of letters, digits, '_', "
-                             f"'.', '+', '-' (it names files), got {self.name!r}")
-        ns = self.n_disks
-        if isinstance(ns, (str, bytes)) or not hasattr(ns, "__iter__"):
-            raise TypeError(f"n_disks: expected a list of disk numbers, got {ns!r}")
-        ns = [check_int(f"n_disks[{k}]", n, low=2, high=100_000) for k, n in enumerate(ns)]
-        if not ns:
-            raise ValueError("n_disks: must contain at least one number of disks, got []")
-        if len(set(ns)) != len(ns):
-            raise ValueError(f"n_disks: must be distinct, got {ns}")
-        put("n_disks", tuple(sorted(ns)))
+        put = functools.partial(object.__setattr__, self)  # (the dataclass is frozen)
+        check_file_name("name", self.name)
+        put("n_disks", check_distinct("n_disks", self.n_disks, what="disk numbers",
+                                      check_item=lambda n, v: check_int(n, v, low=2, high=100_000)))
         if (self.packing is None) == (self.r is None):
             raise ValueError(f"packing, r: give exactly one of them, got packing={self.packing!r}"
                              f", r={self.r!r}")
@@ -217,11 +211,12 @@ class DisksExperiment:
                                       high_open=False))
         else:
             r = check_real("r", self.r, low=0.0, high=0.5)
-            phi = self.n_disks[-1] * r * r
+            n_max = self.n_disks[-1]
+            phi = n_max * r * r
             if phi > PACKING_MAX:
-                raise ValueError(f"r: {self.n_disks[-1]} disks of radius {r!r} have packing "
+                raise ValueError(f"r: {n_max} disks of radius {r!r} have packing "
                                  f"{phi:.6g}; N r^2 must be at most {PACKING_MAX} at the "
-                                 f"largest N, i.e. r <= {math.sqrt(PACKING_MAX / ns[-1]):.6g}")
+                                 f"largest N, i.e. r <= {math.sqrt(PACKING_MAX / n_max):.6g}")
             put("r", r)
         check_choice("rule", self.rule, RULES)
         put("n_tagged", check_int("n_tagged", self.n_tagged, low=1))

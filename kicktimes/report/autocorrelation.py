@@ -179,7 +179,7 @@ def acf_paired_differences(results) -> pd.DataFrame:
     Parameters
     ----------
     results : pandas.DataFrame
-        Tidy results with the ``acf@l`` rows.
+        Tidy results (the ``acf@l`` rows are read), each IC once per system.
 
     Returns
     -------
@@ -227,7 +227,7 @@ def crossings(differences) -> pd.DataFrame:
     Parameters
     ----------
     differences : pandas.DataFrame
-        :func:`acf_differences` output.
+        The differences of the curves, as :func:`acf_differences` returns them.
 
     Returns
     -------

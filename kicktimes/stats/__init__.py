@@ -41,6 +41,7 @@ from .correlation import spearman
 from .counts import STICKY_FACTOR, CountRegression, is_sticky, kinetic_rate, regress_counts
 from .dilute import DiluteEstimate, DiluteTaggedDisk, dilute_tagged_disk, dilute_tagged_times
 from .distributions import hyperexpon
+from .ear1 import ear1_intervals
 from .ensemble import PoissonEnsembleResult, test_poisson_ensemble
 from .enskog import contact_value, enskog_frequency, henderson_z, speed_rate_factor
 from .findings import (
@@ -178,6 +179,7 @@ __all__ = [
     "fit_mmpp",
     "MMPPFit",
     "simulate_mmpp",
+    "ear1_intervals",
     "compare_point_processes",
     "mmpp_lr_test",
     "MMPPLRTest",

@@ -207,9 +207,7 @@ def _odds_sums(v, offset, d):
 def _responsibility_sums(v, offset, d):
     """``sum w``, ``sum w v``, ``sum (1 - w) v`` for the odds of :func:`_odds_sums`;
     ``1 - w`` is formed directly, without cancellation, when ``w`` is near 1."""
-    sum_w = 0.0
-    sum_wv = 0.0
-    sum_qv = 0.0
+    sum_w = sum_wv = sum_qv = 0.0
     for i in range(v.size):
         lr = offset - d * v[i]
         e = math.exp(-abs(lr))

@@ -27,7 +27,7 @@ import numpy as np
 from numba import njit
 
 __all__ = ["cell_of", "cell_of_box", "cell_order", "crossing", "crossing_box", "grid",
-           "grid_box", "insert", "remove", "spatial_order"]
+           "grid_box", "image_of", "insert", "remove", "spatial_order"]
 
 INF = np.inf
 
@@ -64,6 +64,18 @@ def cell_of_box(x, y, m, w):
     cx = min(max(int(math.floor(x / w)), 0), m - 1)
     cy = min(max(int(math.floor(y / w)), 0), m - 1)
     return cx + m * cy
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def image_of(g, m, box):
+    """``(g', shift)`` of a grid index ``g`` of the periodic box that may lie one beyond the
+    grid (``-1`` or ``m``): the cell across the box, ``g' = g mod m``, and the shift of
+    the image its disks are seen under, ``-box`` or ``+box`` (``0`` inside the grid)."""
+    if g < 0:
+        return g + m, -box
+    if g >= m:
+        return g - m, box
+    return g, 0.0
 
 
 @njit(cache=True, inline="always", error_model="numpy")

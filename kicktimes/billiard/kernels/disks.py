@@ -95,25 +95,13 @@ def scan(i, x, y, vx, vy, now, gx0, gx1, gy0, gy1, fs, iv, head, m, best, kind, 
     the image, so a pair is scanned under one image only (``m >= 3``)."""
     ri = fs[i, RAD]
     for gy in range(gy0, gy1 + 1):
-        gyc = gy
-        sy = 0.0
+        gyc, sy = gy, 0.0
         if box is not None:
-            if gy < 0:
-                gyc = gy + m
-                sy = -box
-            elif gy >= m:
-                gyc = gy - m
-                sy = box
+            gyc, sy = cells.image_of(gy, m, box)
         for gx in range(gx0, gx1 + 1):
-            gxc = gx
-            sx = 0.0
+            gxc, sx = gx, 0.0
             if box is not None:
-                if gx < 0:
-                    gxc = gx + m
-                    sx = -box
-                elif gx >= m:
-                    gxc = gx - m
-                    sx = box
+                gxc, sx = cells.image_of(gx, m, box)
             k = head[gxc + m * gyc]
             while k >= 0:
                 if k != i:

@@ -277,6 +277,16 @@ def hopeless(loglik, floor, gain, used, max_iter):
 ABANDON_AFTER = 30
 
 
+@njit(cache=True, inline="always")
+def _em_step(rates, Q, st, free, x, start, bt, e, r, tol):
+    """One Baum-Welch step from the E-step statistics ``st`` at ``(rates, Q)``: the M-step,
+    the E-step at its parameters, and whether the log-likelihood moved by at most
+    ``tol * |loglik|``; returns ``(rates, Q, alpha, st, done)``."""
+    rates1, Q1, alpha1 = _mstep(rates, Q, st[1], st[2], st[3], st[4], free)
+    st1 = estep_reversible(rates1, Q1, alpha1, x, start, bt, e, r)
+    return rates1, Q1, alpha1, st1, abs(st1[0] - st[0]) <= tol * abs(st1[0])
+
+
 @njit(cache=True)
 def em_run_reversible(rates, Q, alpha, x, start, free, max_iter, tol, floor=-np.inf):
     """``_em.run_em`` compiled, for a reversible chain: Baum-Welch iterations with SQUAREM
@@ -296,16 +306,12 @@ def em_run_reversible(rates, Q, alpha, x, start, free, max_iter, tol, floor=-np.
     step_max = 1.0
     while used < max_iter:
         cycle_loglik, cycle_used = st[0], used
-        rates1, Q1, alpha1 = _mstep(rates, Q, st[1], st[2], st[3], st[4], free)
-        st1 = estep_reversible(rates1, Q1, alpha1, x, start, bt, e, r)
+        rates1, Q1, alpha1, st1, done = _em_step(rates, Q, st, free, x, start, bt, e, r, tol)
         used += 1
-        done = abs(st1[0] - st[0]) <= tol * abs(st1[0])
         if done or used >= max_iter:
             return (rates1, Q1, alpha1) + st1 + (used, done)
-        rates2, Q2, alpha2 = _mstep(rates1, Q1, st1[1], st1[2], st1[3], st1[4], free)
-        st2 = estep_reversible(rates2, Q2, alpha2, x, start, bt, e, r)
+        rates2, Q2, alpha2, st2, done = _em_step(rates1, Q1, st1, free, x, start, bt, e, r, tol)
         used += 1
-        done = abs(st2[0] - st1[0]) <= tol * abs(st2[0])
         if done or used >= max_iter:
             return (rates2, Q2, alpha2) + st2 + (used, done)
         phi0 = _pack(rates, Q, alpha, free)

@@ -206,8 +206,8 @@ def lyapunov_density_runs(out, sweep: LyapunovDensity = DENSITY, *, workers: int
 
 def seed_lyapunov_density(out, runs, sweep: LyapunovDensity = DENSITY) -> None:
     """Put the states' rows ``runs`` (a ``disks_lyapunov_density_runs.csv``, or its path:
-    read exactly) into the cache
-    of ``sweep`` in ``out``, so that `lyapunov_density_runs` reuses them.
+    read exactly) into the cache of ``sweep`` in ``out``, so that `lyapunov_density_runs`
+    reuses them.
 
     Raises
     ------

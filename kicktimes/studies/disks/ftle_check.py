@@ -192,9 +192,9 @@ def ftle_check_runs(out, check: FtleCheck = FTLE_CHECK, *, workers: int = 1,
 
 
 def seed_ftle_check(out, runs, check: FtleCheck = FTLE_CHECK) -> None:
-    """Put the states' exponents ``runs`` (a ``disks_ftle_check_runs.csv``, or its path:
-    read exactly) into the cache
-    of ``check`` in ``out``, so that `ftle_check_runs` reuses them.
+    """Seed the cache of ``check`` in ``out`` with the exponents ``runs`` (a
+    ``disks_ftle_check_runs.csv``, or its path: read exactly), so that `ftle_check_runs`
+    reuses them instead of simulating.
 
     Raises
     ------

@@ -21,9 +21,12 @@ from kicktimes.stats import (
     resample_indices,
 )
 
-__all__ = ["BURSTY_SHAPE", "CONTROLS", "FREE_TIMES", "HOLE", "KICKED", "LABELS", "N_BOOT",
-           "RADII", "SMALL_HOLE", "SYSTEMS", "bootstrap_picks", "censor", "constant_rows",
-           "ergodic_rate", "escape_tables", "escape_times", "free_disk_escapes", "tail_rates"]
+__all__ = [
+    "BURSTY_SHAPE", "CONTROLS", "FREE_TIMES", "HOLE", "KICKED", "LABELS", "N_BOOT", "RADII",
+    "SMALL_HOLE", "SYSTEMS",
+    "bootstrap_picks", "censor", "constant_rows", "ergodic_rate", "escape_tables",
+    "escape_times", "free_disk_escapes", "tail_rates",
+]
 
 RADII = (0.005, 0.01, 0.02, 0.03)
 HOLE = [(0.0, 0.05)]

@@ -33,8 +33,10 @@ from kicktimes.studies.mechanism.twins import (
     twin_batteries,
 )
 
-__all__ = ["EXPLAINERS", "HAZARD_EDGES", "LATE_RESCALED", "RETURN_TIME", "STICKY_FACTOR",
-           "analyse", "cell_rows", "hazard_profile_rows", "state_rates"]
+__all__ = [
+    "EXPLAINERS", "HAZARD_EDGES", "LATE_RESCALED", "RETURN_TIME", "STICKY_FACTOR",
+    "analyse", "cell_rows", "hazard_profile_rows", "state_rates",
+]
 
 #: the models whose explained share is reported; cox_markov_oos is out of sample
 EXPLAINERS = ("mixed_poisson", "cox_iid", "cox_sequence", "cox_markov_oos")
