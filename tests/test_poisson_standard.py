@@ -76,3 +76,12 @@ def test_each_study_owns_its_rows_of_the_shared_calibration_file(tmp_path):
 def test_rows_without_a_column_are_refused_naming_it(tmp_path):
     with pytest.raises(ValueError, match="n_clusters"):
         write_null_calibration(tmp_path, "paper", _rows("a", 0.05).drop(columns="n_clusters"))
+
+
+def test_other_statistics_are_read_against_1_and_an_unknown_one_is_refused(tmp_path):
+    d = _rows("N=2", 0.0).drop(columns="share").assign(
+        statistic="D", value=5.06, ci_low=4.47, ci_high=5.69)
+    table = pd.read_csv(write_null_calibration(tmp_path, "disks", d))
+    assert table.loc[0, "statistic"] == "D" and table.loc[0, "verdict"] == "higher"
+    with pytest.raises(ValueError, match="statistic must be one of"):
+        write_null_calibration(tmp_path, "disks", d.assign(statistic="mean"))

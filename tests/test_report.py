@@ -381,7 +381,7 @@ def test_write_results_gives_pngs_and_a_generated_findings_page(store_path, tmp_
     null = pd.read_csv(tmp_path / "null_calibration.csv")
     assert set(null["study"]) == {"paper"} and set(null["data"]) == {"tiny_report"}
     assert "uniformity_ks" in set(null["test"]) and (null["n_runs"] > 0).all()
-    assert ((null["ci_low"] <= null["share"]) & (null["share"] <= null["ci_high"])).all()
+    assert ((null["ci_low"] <= null["value"]) & (null["value"] <= null["ci_high"])).all()
     assert "[null_calibration.csv](null_calibration.csv)" in text
     findings = pd.read_csv(tmp_path / "tiny_report_findings.csv")
     assert {"dispersion_index", "poisson@uniformity_ks"} <= set(findings["diagnostic"])

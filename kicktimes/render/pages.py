@@ -30,7 +30,7 @@ import pandas as pd
 from kicktimes import __version__
 from kicktimes.stats import MARGIN, format_interval, ratio_verdict
 
-__all__ = ["NULL_CALIBRATION", "NULL_CALIBRATION_COLUMNS", "header",
+__all__ = ["NULL_CALIBRATION", "NULL_CALIBRATION_COLUMNS", "NULL_STATISTICS", "header",
            "markdown_table", "number_text", "p_value_text", "percent_text", "ratio_text",
            "rho_text", "simulations_source", "store_name", "trend_verdict",
            "write_null_calibration", "write_results_page"]
@@ -121,11 +121,20 @@ def markdown_table(frame: pd.DataFrame) -> list[str]:
 
 #: the file, in a results folder, of the null streams sent through the pages' tests
 NULL_CALIBRATION = "null_calibration.csv"
-#: its columns: the study that wrote the row, the data set it is shaped like, the test,
-#: the null design, the runs and clusters, the share rejected with its 95 % CI and the
-#: verdict of `kicktimes.stats.rejection_verdict` against the test's nominal level
-NULL_CALIBRATION_COLUMNS = ("study", "data", "test", "design", "alpha", "n_runs",
-                            "n_clusters", "share", "ci_low", "ci_high", "verdict")
+#: its columns: the study that wrote the row, the data set it is shaped like, the
+#: statistic (`NULL_STATISTICS`), the test (for a rejection share; else empty), the null
+#: design, the runs and clusters, the statistic's value on the null streams with its 95 %
+#: CI, and its verdict against the naive reference: for a rejection share
+#: `kicktimes.stats.rejection_verdict` against the nominal level ``alpha``, for the others
+#: `kicktimes.stats.ratio_verdict` against 1 (where the null's own value is not 1, a page
+#: reads the statistic against this row, never against 1)
+NULL_CALIBRATION_COLUMNS = ("study", "data", "statistic", "test", "design", "alpha", "n_runs",
+                            "n_clusters", "value", "ci_low", "ci_high", "verdict")
+#: the statistics a null calibration row may carry: the share of null streams a test
+#: rejects; the dispersion index of the counts; the interval hazard in units of the rate
+#: (first bin, highest bin); the fitted gamma shape of the intervals
+NULL_STATISTICS = ("rejection share", "D", "hazard, first bin", "hazard, highest bin",
+                   "gamma shape")
 
 
 def write_null_calibration(results_dir, study, rows: pd.DataFrame) -> Path:
@@ -134,25 +143,36 @@ def write_null_calibration(results_dir, study, rows: pd.DataFrame) -> Path:
     it). Written atomically; returns the path.
 
     ``rows`` has the columns `NULL_CALIBRATION_COLUMNS` except ``study`` and ``verdict``,
-    which are filled in here (the verdict is `kicktimes.stats.rejection_verdict` of the
-    CI against ``alpha``).
+    which are filled in here; a table without ``statistic`` holds rejection shares (its
+    ``share`` column is the ``value``). The verdict: `kicktimes.stats.rejection_verdict` of
+    a share's CI against ``alpha``, `kicktimes.stats.ratio_verdict` of another statistic's
+    CI against 1.
     """
     from kicktimes.fileio import atomic_write
-    from kicktimes.stats import rejection_verdict
+    from kicktimes.stats import ratio_verdict, rejection_verdict
 
+    rows = rows.rename(columns={"share": "value"})
+    if "statistic" not in rows:
+        rows = rows.assign(statistic="rejection share")
     missing = set(NULL_CALIBRATION_COLUMNS) - {"study", "verdict"} - set(rows.columns)
     if missing:
         raise ValueError(f"rows: the null calibration needs the columns {sorted(missing)}")
+    unknown = set(rows["statistic"]) - set(NULL_STATISTICS)
+    if unknown:
+        raise ValueError(f"rows: statistic must be one of {list(NULL_STATISTICS)}, "
+                         f"got {sorted(unknown)}")
     rows = rows.copy()
     rows.insert(0, "study", study)
-    rows["verdict"] = [rejection_verdict(lo, hi, a) for lo, hi, a
-                       in zip(rows["ci_low"], rows["ci_high"], rows["alpha"], strict=True)]
+    share = rows["statistic"] == "rejection share"
+    rows["verdict"] = [rejection_verdict(lo, hi, a) if s else ratio_verdict(lo, hi)
+                       for lo, hi, a, s in zip(rows["ci_low"], rows["ci_high"], rows["alpha"],
+                                               share, strict=True)]
     path = Path(results_dir) / NULL_CALIBRATION
     if path.is_file():
         old = pd.read_csv(path, keep_default_na=False, na_values=[""])
         rows = pd.concat([old[old["study"] != study], rows], ignore_index=True)
-    rows = rows[list(NULL_CALIBRATION_COLUMNS)].sort_values(["study", "data", "test"],
-                                                            kind="stable")
+    rows = rows[list(NULL_CALIBRATION_COLUMNS)].sort_values(
+        ["study", "data", "statistic", "test"], kind="stable")
     atomic_write(path, lambda tmp: rows.to_csv(tmp, index=False))
     return path
 
