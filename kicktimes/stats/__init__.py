@@ -45,11 +45,15 @@ from .ear1 import ear1_intervals
 from .ensemble import PoissonEnsembleResult, test_poisson_ensemble
 from .enskog import contact_value, enskog_frequency, henderson_z, speed_rate_factor
 from .findings import (
+    D_MARGIN,
     MARGIN,
     SHARE_RULE,
     Finding,
     clopper_pearson,
+    equivalence_sample_size,
     format_interval,
+    null_rule,
+    null_verdict,
     poisson_rule,
     poisson_verdict,
     ratio_interval,
@@ -158,6 +162,10 @@ __all__ = [
     "ratio_verdict",
     "reliable_until",
     "MARGIN",
+    "D_MARGIN",
+    "null_verdict",
+    "null_rule",
+    "equivalence_sample_size",
     "clopper_pearson",
     "robust_verdict",
     "spearman",

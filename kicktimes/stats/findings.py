@@ -38,6 +38,10 @@ __all__ = [
     "share_verdict",
     "SHARE_RULE",
     "clopper_pearson",
+    "D_MARGIN",
+    "null_verdict",
+    "null_rule",
+    "equivalence_sample_size",
     "share_ratio_sample_size",
     "effect_statement",
     "format_p",
@@ -215,6 +219,77 @@ def rejection_rule(alpha=0.05, margin=0.5) -> str:
             f"[{lo:g}, {hi:g}] (the share a process satisfying the null gives, within "
             f"{100 * margin:g} % of α); above / below nominal: it lies entirely above / below "
             "that band; inconclusive otherwise")
+
+
+#: the margin of a dispersion index D read against its null stream's D (`null_verdict`):
+#: half the smallest effect the gas pages mean to detect, the elastic linear-Boltzmann
+#: excess D_inf - 1 = 0.14 of a dilute tagged disk (docs/definitions.md, "Margins")
+D_MARGIN = 0.07
+
+
+def null_verdict(low, high, margin):
+    """A statistic read against its null stream: the 95 % CI ``[low, high]`` of the
+    difference *statistic - its value on null streams shaped like the runs*.
+
+    ``"at its null"`` when the whole CI lies in ``[-margin, margin]`` (an equivalence test,
+    the margin stated in advance); ``"above its null"`` / ``"below its null"`` when it lies
+    entirely above ``margin`` / below ``-margin``; ``"inconclusive"`` otherwise (and when an
+    endpoint is not finite). A statistic whose null value is not exactly 1 (a dispersion
+    index over runs of unequal rates, a hazard of binned intervals) is read this way, never
+    against 1.
+
+    Examples
+    --------
+    >>> null_verdict(0.005, 0.077, D_MARGIN), null_verdict(1.2, 1.7, D_MARGIN)
+    ('inconclusive', 'above its null')
+    >>> null_verdict(-0.06, 0.065, D_MARGIN)
+    'at its null'
+    """
+    if not (np.isfinite(low) and np.isfinite(high)):
+        return "inconclusive"
+    if -margin <= low and high <= margin:
+        return "at its null"
+    if low > margin:
+        return "above its null"
+    if high < -margin:
+        return "below its null"
+    return "inconclusive"
+
+
+def null_rule(margin, name="D") -> str:
+    """The printed rule of :func:`null_verdict` for ``name`` with ``margin``."""
+    return (f"{name} is read against its null stream's {name} (the same statistic on Poisson "
+            f"streams shaped like the runs): at its null when the 95 % CI of the difference "
+            f"lies in [-{margin:g}, {margin:g}], above / below its null when it lies entirely "
+            f"beyond {margin:g} / -{margin:g}, inconclusive otherwise")
+
+
+def equivalence_sample_size(se, n, margin, *, level=0.95, power=0.8):
+    """The number of units (ICs, runs) at which a difference with standard error ``se`` at
+    ``n`` units gets its ``level`` CI inside ``[-margin, margin]`` with probability
+    ``power`` when the true difference is 0: ``se`` scales as ``1/sqrt(n)`` and the CI
+    ``estimate +- z_level se`` must fit in the margin, so ``se_needed = margin / (z_level +
+    z_power)`` with ``z_power = Phi^-1((1 + power) / 2)`` (the estimate may fall on either
+    side) and ``n_needed = n (se / se_needed)^2``, never below ``n``.
+
+    Examples
+    --------
+    >>> equivalence_sample_size(0.05, 400, 0.07)      # a half-width of 0.1 at 400 runs
+    2145
+    >>> equivalence_sample_size(0.01, 400, 0.07)
+    400
+    """
+    from scipy.stats import norm
+
+    se = float(se)
+    if not (math.isfinite(se) and se > 0):
+        raise ValueError(f"se must be a finite number > 0, got {se!r}")
+    if not (isinstance(n, int | np.integer) and n >= 1):
+        raise ValueError(f"n must be an integer >= 1, got {n!r}")
+    if not (math.isfinite(margin) and margin > 0):
+        raise ValueError(f"margin must be a finite number > 0, got {margin!r}")
+    z = norm.ppf(0.5 + level / 2) + norm.ppf(0.5 + power / 2)
+    return max(int(n), int(math.ceil(n * (se * z / margin) ** 2)))
 
 
 def poisson_verdict(reject_low, reject_high, null_level, dispersion_low, dispersion_high,
