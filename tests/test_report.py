@@ -583,6 +583,15 @@ def test_the_findings_table_has_every_control_and_consistent_robust_flags(built)
         flips = (part["ci_low"] > 1).any() and (part["ci_high"] < 1).any()
         assert bool(part["robust"].iloc[0]) == (part["verdict"].nunique() == 1 and not flips)
     assert set(ratios["verdict"]) <= {"within 10 %", "higher", "lower", "inconclusive"}
-    shares = table[table["question"] == "Poisson collision times?"]
+    poisson = table[table["question"] == "Poisson collision times?"]
+    shares = poisson[poisson["diagnostic"].str.startswith("reject@")]
     assert set(shares["verdict"]) <= {"nominal", "above nominal", "below nominal",
                                       "inconclusive"}
+    # D, the first hazard bin and the gamma shape are read against their null streams
+    against = poisson[poisson["diagnostic"].isin(
+        ["dispersion_index", "hazard_first", "gamma_shape"])]
+    assert set(against["diagnostic"]) == {"dispersion_index", "hazard_first", "gamma_shape"}
+    assert set(against["verdict"]) <= {"at its null", "above its null", "below its null",
+                                       "inconclusive"}
+    assert against["detail"].str.contains("its null (the runs' Poisson control streams) ",
+                                       regex=False).all()

@@ -78,6 +78,7 @@ class Found:
     homogeneity: object = None  # poisson: rate-homogeneity tests per radius
     poisson_per_ic: object = None  # poisson: per-IC p-values of the headline test
     null_calibration: object = None  # poisson: the Poisson control streams through the tests
+    null_referenced: object = None  # poisson: D, hazard, gamma shape against the controls'
     poisson_cis: object = None  # poisson: the headline shares' clustered CIs, by column
     renewal_best: object = None  # renewal: the AIC-best model of every fitted IC
     renewal_pooled: object = None  # renewal: the comparison of pooled intervals

@@ -337,7 +337,7 @@ def _count_rows(family, collisions, sticky, rule, kinetic, *, rng, n_boot, resam
 
 
 def poisson_rows(family, rejections, per_ic, *, alpha, rng, n_boot=2000, null=None,
-                 cis=None):
+                 cis=None, referenced=None):
     """The Poisson question as rows of the findings table: per test of the battery, the
     share of (radius, IC) runs whose two-disk collision times reject it at ``alpha``, read
     against the share that null streams shaped like the runs reject through the same test
@@ -376,6 +376,12 @@ def poisson_rows(family, rejections, per_ic, *, alpha, rng, n_boot=2000, null=No
     cis : dict, optional
         Clustered CIs already computed, by ``per_ic`` column (``"p"``, ``"p_fixed"``), so
         that every page prints the same interval; the others are computed with ``rng``.
+    referenced : pandas.DataFrame, optional
+        `kicktimes.report.poisson.null_referenced` of the same runs: then D, the first
+        hazard bin and the gamma shape are read against their control streams' values
+        (rows ``<statistic>_excess``, the paired difference, by
+        :func:`kicktimes.stats.null_verdict`), and the one standard reads D against its
+        null (``against_null``).
     """
     from kicktimes.report.poisson import (
         FIXED_EVENTS,
@@ -434,14 +440,38 @@ def poisson_rows(family, rejections, per_ic, *, alpha, rng, n_boot=2000, null=No
     names = [r["diagnostic"] for r in rows]
     if (per_ic is not None and "dispersion" in per_ic.columns
             and f"reject@{HEADLINE_TEST}" in names):
-        d, d_low, d_high = clustered_mean(per_ic, "dispersion", rng=rng, n_boot=n_boot)
         n_d = int(np.isfinite(per_ic["dispersion"].to_numpy(float)).sum())
-        add("dispersion_index", d, n_d, d_low, d_high, ratio_verdict(d_low, d_high, 0.1),
-            "mean over runs of D = variance / mean of the counts in 10 equal sub-windows of "
-            "the run's window (1 for a Poisson process given its count); 95 % CI from a "
-            "bootstrap clustered on ICs; verdict in the ±10 % band")
         head = rows[names.index(f"reject@{HEADLINE_TEST}")]
         level, _ = calibrated(HEADLINE_TEST)
+        if referenced is not None and len(referenced):
+            from kicktimes.report.poisson import NULL_REFERENCED
+            from kicktimes.stats import D_MARGIN, null_verdict
+
+            for r in referenced.itertuples():
+                margin = D_MARGIN if r.statistic == "D" else SHAPE_MARGIN
+                diagnostic = NULL_REFERENCED[r.statistic]
+                verdict = null_verdict(r.excess_low, r.excess_high, margin)
+                null_text = (f"its null (the runs' Poisson control streams) "
+                             f"{r.null:.3g} [{r.null_low:.3g}, {r.null_high:.3g}]")
+                add(diagnostic, r.value, n_d, r.low, r.high, verdict,
+                    f"{NULL_WORDS[r.statistic]}; 95 % CI from a bootstrap clustered on ICs; "
+                    f"read against {null_text} (the {diagnostic}_excess row)")
+                add(f"{diagnostic}_excess", r.excess, n_d, r.excess_low, r.excess_high,
+                    verdict, f"{r.statistic} minus {null_text}, paired by run; "
+                    f"kicktimes.stats.null_verdict with margin {margin:g}")
+            d = referenced.set_index("statistic").loc["D"]
+            add(f"poisson@{HEADLINE_TEST}", head["estimate"], head["n_pairs"], head["ci_low"],
+                head["ci_high"], poisson_verdict(head["ci_low"], head["ci_high"], level,
+                                                 d.excess_low, d.excess_high,
+                                                 against_null=True),
+                f"kicktimes.stats.poisson_verdict: the {HEADLINE_TEST} rejection share against "
+                f"its calibrated level {100 * level:.1f} % and D − null D {d.excess:.3g} "
+                f"[{d.excess_low:.3g}, {d.excess_high:.3g}] against ±{D_MARGIN:g}")
+            return rows
+        d, d_low, d_high = clustered_mean(per_ic, "dispersion", rng=rng, n_boot=n_boot)
+        add("dispersion_index", d, n_d, d_low, d_high, ratio_verdict(d_low, d_high, 0.1),
+            NULL_WORDS["D"] + "; 95 % CI from a bootstrap clustered on ICs; no null streams: "
+            "verdict in the ±10 % band around 1")
         add(f"poisson@{HEADLINE_TEST}", head["estimate"], head["n_pairs"], head["ci_low"],
             head["ci_high"], poisson_verdict(head["ci_low"], head["ci_high"], level, d_low,
                                              d_high),
@@ -449,6 +479,19 @@ def poisson_rows(family, rejections, per_ic, *, alpha, rng, n_boot=2000, null=No
             f"calibrated level {100 * level:.1f} % and D {d:.3g} [{d_low:.3g}, {d_high:.3g}] "
             "against [0.9, 1.1]")
     return rows
+
+
+#: the margin of the first hazard bin and of the gamma shape read against their null
+#: streams' values: half the 10 % equivalence margin of every ratio (docs/definitions.md)
+SHAPE_MARGIN = 0.05
+#: what each null-referenced statistic of the two-disk runs is
+NULL_WORDS = {
+    "D": "within-run dispersion index: mean over runs of D = variance / mean of the run's "
+         "counts in 10 equal sub-windows of its window",
+    "hazard, first bin": "hazard of the intervals in [0, 0.1) of each run's mean interval, "
+                         "pooled, over the constant rate",
+    "gamma shape": "shape of a gamma fit to the pooled intervals in units of each run's "
+                   "mean interval"}
 
 
 def merge_control_families(tables):

@@ -106,7 +106,8 @@ def section(ctx):
                                           ctx.found.poisson_per_ic, alpha=ctx.alpha,
                                           rng=ctx.boot_rng(), n_boot=ctx.n_boot,
                                           null=ctx.found.null_calibration,
-                                          cis=ctx.found.poisson_cis),
+                                          cis=ctx.found.poisson_cis,
+                                          referenced=ctx.found.null_referenced),
                              columns=list(COLUMNS))
         computed = Controls(with_robustness(pd.concat([computed.table, extra],
                                                       ignore_index=True)), computed.curves)

@@ -220,6 +220,30 @@ def _control_times(seqs, windows, ics, r, control):
     return out
 
 
+#: the first bin of the interval hazard, in units of the run's mean interval
+HAZARD_BIN = 0.1
+
+
+def interval_sums(seqs, windows, prefix):
+    """Per run, the sufficient sums of its intervals in units of its own mean interval
+    (``x = diff(t) n / w``): the first hazard bin's events and exposure
+    (``x < HAZARD_BIN``; hazard = events / exposure, 1 for a Poisson process) and the
+    count, sum and sum of logs of ``x`` (the gamma MLE of pooled intervals depends on
+    ``mean x`` and ``mean log x`` only), as columns ``<prefix>hz_events, <prefix>hz_exposure,
+    <prefix>n_x, <prefix>sum_x, <prefix>sum_log_x``."""
+    cols = {k: np.zeros(len(seqs)) for k in ("hz_events", "hz_exposure", "n_x", "sum_x",
+                                              "sum_log_x")}
+    for k, (t, w) in enumerate(zip(seqs, windows, strict=True)):
+        if t.size < 3:
+            continue
+        x = np.diff(t) * (t.size / w)
+        x = x[x > 0]
+        cols["hz_events"][k] = np.count_nonzero(x < HAZARD_BIN)
+        cols["hz_exposure"][k] = np.minimum(x, HAZARD_BIN).sum()
+        cols["n_x"][k], cols["sum_x"][k], cols["sum_log_x"][k] = x.size, x.sum(), np.log(x).sum()
+    return {prefix + k: v for k, v in cols.items()}
+
+
 #: the columns of the rate-homogeneity table, in order (`kicktimes.stats.PoissonGroup`'s
 #: ``homogeneity`` with ``n_sequences`` named ``n_ics`` and the kinetic rate beside)
 _HOMOGENEITY = ("dispersion_index", "pearson_statistic", "df", "pvalue", "pvalue_mc",
@@ -257,7 +281,8 @@ def _poisson_job(job):
     if control is not None:
         # the control: the same tests on the sweep's own Poisson kick times of each IC;
         # every test should reject about alpha of them
-        ctrl = stats.poisson_group(_control_times(seqs, windows, ics, r, control), windows,
+        control_seqs = _control_times(seqs, windows, ics, r, control)
+        ctrl = stats.poisson_group(control_seqs, windows,
                                    alpha=alpha, n_mc=n_mc, rng=seeded_rng(*seed_key, 9),
                                    nulls=nulls)
         rows["control_n_tested"] = ctrl.rejections["n_tested"]
@@ -278,6 +303,8 @@ def _poisson_job(job):
         # index of the IC's Poisson control stream (same window, same tests)
         per_ic["control_p"] = ctrl.ensemble.per_sequence[f"p_{HEADLINE_TEST}"].to_numpy(float)
         per_ic["control_dispersion"] = ctrl.ensemble.statistics["dispersion"].to_numpy(float)
+        per_ic = per_ic.assign(**interval_sums(seqs, windows, ""),
+                               **interval_sums(control_seqs, windows, "control_"))
     hom = group.homogeneity
     hom_row = {
         "radius": r,
@@ -402,8 +429,11 @@ def sections(ctx):
         "p_fixed": clustered_share(per_ic, "p_fixed", alpha, rng=ctx.rng(5),
                                    n_boot=ctx.n_boot)}
     if "control_p" in per_ic.columns:
+        # computed once: the calibration file and the findings print the same intervals
+        ctx.found.null_referenced = null_referenced(per_ic, rng=ctx.rng(7), n_boot=ctx.n_boot)
         ctx.found.null_calibration = null_calibration(
-            ctx.exp.name, rejections, per_ic, alpha=alpha, rng=ctx.rng(6), n_boot=ctx.n_boot)
+            ctx.exp.name, rejections, per_ic, alpha=alpha, rng=ctx.rng(6), n_boot=ctx.n_boot,
+            referenced=ctx.found.null_referenced)
     ctx.found.homogeneity = homogeneity
     return [sec]
 
@@ -463,12 +493,78 @@ def clustered_mean(per_ic, column, *, rng, n_boot=2000, level=0.95):
     return (float(total.sum() / n_runs.sum()), *percentile_interval(boot, level))
 
 
+#: the statistics read against the runs' Poisson control streams (null_calibration.csv):
+#: name in the null calibration -> the findings table's diagnostic
+NULL_REFERENCED = {"D": "dispersion_index", "hazard, first bin": "hazard_first",
+                   "gamma shape": "gamma_shape"}
+
+
+def null_referenced(per_ic, *, rng, n_boot=2000, level=0.95) -> pd.DataFrame:
+    """The dispersion index D, the hazard of the first interval bin and the pooled gamma
+    shape of the runs' collision times and of their Poisson control streams, and the
+    difference of the two, with 95 % CIs from one bootstrap clustered on ICs (the same
+    resamples for the data, the null and their difference: the difference is paired).
+
+    D is the mean over runs of each run's D; the hazard is the events over the exposure in
+    ``[0, HAZARD_BIN)`` of the intervals in units of each run's mean interval, pooled
+    (1 for a Poisson process); the gamma shape is the MLE of those pooled intervals
+    (`kicktimes.stats.gamma_shape_mle` of their two sufficient means; 1 for exponential
+    intervals). Returns one row per statistic of `NULL_REFERENCED`: ``statistic,
+    value, low, high, null, null_low, null_high, excess, excess_low, excess_high,
+    n_runs, n_clusters``; empty when ``per_ic`` has no control columns.
+    """
+    from kicktimes.stats import cluster_bootstrap, gamma_shape_mle
+
+    if "control_dispersion" not in per_ic.columns:
+        return pd.DataFrame()
+    d, cd = per_ic["dispersion"].to_numpy(float), per_ic["control_dispersion"].to_numpy(float)
+    columns = {"d": np.where(np.isfinite(d), d, 0.0), "d_n": np.isfinite(d).astype(float),
+               "cd": np.where(np.isfinite(cd), cd, 0.0), "cd_n": np.isfinite(cd).astype(float)}
+    for prefix in ("", "control_"):
+        for k in ("hz_events", "hz_exposure", "n_x", "sum_x", "sum_log_x"):
+            columns[prefix + k] = per_ic[prefix + k].to_numpy(float)
+    by_ic = pd.DataFrame(columns).groupby(per_ic["ic"].to_numpy()).sum()
+    sums = by_ic.to_numpy(float)
+    col = {name: j for j, name in enumerate(by_ic.columns)}
+
+    def statistic(idx):
+        s = sums[idx].sum(axis=1)  # (m, columns)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            out = []
+            for data, null in (
+                    (s[:, col["d"]] / s[:, col["d_n"]], s[:, col["cd"]] / s[:, col["cd_n"]]),
+                    (s[:, col["hz_events"]] / s[:, col["hz_exposure"]],
+                     s[:, col["control_hz_events"]] / s[:, col["control_hz_exposure"]]),
+                    (gamma_shape_mle(s[:, col["sum_x"]] / s[:, col["n_x"]],
+                                     s[:, col["sum_log_x"]] / s[:, col["n_x"]]),
+                     gamma_shape_mle(s[:, col["control_sum_x"]] / s[:, col["control_n_x"]],
+                                     s[:, col["control_sum_log_x"]]
+                                     / s[:, col["control_n_x"]]))):
+                out += [data, null, data - null]
+        return np.column_stack(out)
+
+    res = cluster_bootstrap(statistic, len(by_ic), n_boot=n_boot, level=level, rng=rng,
+                            chunk=250)
+    est, low, high = (np.atleast_1d(np.asarray(v, float))
+                      for v in (res.estimate, res.ci_low, res.ci_high))
+    rows = []
+    for j, name in enumerate(NULL_REFERENCED):
+        k = 3 * j
+        rows.append({"statistic": name, "value": est[k], "low": low[k], "high": high[k],
+                     "null": est[k + 1], "null_low": low[k + 1], "null_high": high[k + 1],
+                     "excess": est[k + 2], "excess_low": low[k + 2],
+                     "excess_high": high[k + 2], "n_runs": int(np.isfinite(d).sum()),
+                     "n_clusters": len(by_ic)})
+    return pd.DataFrame(rows)
+
+
 #: the null design of the two-disk calibration
 NULL_DESIGN = ("Poisson at each run's rate (the sweep's own Poisson kick times of the run's "
                "IC and radius, rate n_pp / t_window, cut at the run's window)")
 
 
-def null_calibration(name, rejections, per_ic, *, alpha, rng, n_boot=2000) -> pd.DataFrame:
+def null_calibration(name, rejections, per_ic, *, alpha, rng, n_boot=2000,
+                     referenced=None) -> pd.DataFrame:
     """The null calibration of the Poisson battery on one experiment's runs.
 
     Every run's Poisson control stream (:func:`_control_times`: Poisson by construction,
@@ -477,7 +573,10 @@ def null_calibration(name, rejections, per_ic, *, alpha, rng, n_boot=2000) -> pd
     over radii, with the interval the data's row has: for the headline test a bootstrap
     clustered on ICs (``per_ic["control_p"]``), for the others Clopper-Pearson on the
     counts (runs of one IC at different radii counted apart). The columns are those of
-    `kicktimes.render.pages.NULL_CALIBRATION_COLUMNS` without ``study`` and ``verdict``.
+    `kicktimes.render.pages.NULL_CALIBRATION_COLUMNS` without ``study`` and ``verdict``
+    (``share`` for ``value``). Then the rows of D, the first hazard bin and the gamma shape
+    of the control streams (``referenced``, a :func:`null_referenced` table; computed
+    with ``rng`` when not given).
     """
 
     totals = rejections.groupby("test", sort=False, observed=True)[
@@ -494,19 +593,28 @@ def null_calibration(name, rejections, per_ic, *, alpha, rng, n_boot=2000) -> pd
         else:
             low, high = clopper_pearson(k, n)
             clusters = n
-        rows.append({"data": name, "test": test, "design": NULL_DESIGN, "alpha": alpha,
-                     "n_runs": n, "n_clusters": clusters, "share": k / n, "ci_low": low,
-                     "ci_high": high})
-    return pd.DataFrame(rows, columns=["data", "test", "design", "alpha", "n_runs",
-                                       "n_clusters", "share", "ci_low", "ci_high"])
+        rows.append({"data": name, "statistic": "rejection share", "test": test,
+                     "design": NULL_DESIGN, "alpha": alpha, "n_runs": n,
+                     "n_clusters": clusters, "share": k / n, "ci_low": low, "ci_high": high})
+    if referenced is None:
+        referenced = null_referenced(per_ic, rng=rng, n_boot=n_boot)
+    for r in referenced.itertuples():
+        rows.append({"data": name, "statistic": r.statistic, "test": "", "design": NULL_DESIGN,
+                     "alpha": alpha, "n_runs": r.n_runs, "n_clusters": r.n_clusters,
+                     "share": r.null, "ci_low": r.null_low, "ci_high": r.null_high})
+    return pd.DataFrame(rows, columns=["data", "statistic", "test", "design", "alpha",
+                                       "n_runs", "n_clusters", "share", "ci_low", "ci_high"])
 
 
 def null_level(null, test, alpha) -> float:
     """The share of null streams that ``test`` rejects (the calibrated level of its
     verdicts), from a :func:`null_calibration` table; ``alpha`` when there is none."""
-    if null is None or null.empty or test not in set(null["test"]):
+    if null is None or null.empty:
         return alpha
-    return float(null.loc[null["test"] == test, "share"].iloc[0])
+    shares = null[null["statistic"] == "rejection share"] if "statistic" in null else null
+    if test not in set(shares["test"]):
+        return alpha
+    return float(shares.loc[shares["test"] == test, "share"].iloc[0])
 
 
 def effects(ctx):

@@ -65,6 +65,7 @@ from .findings import (
     share_ratio_sample_size,
     share_verdict,
 )
+from .gamma_shape import gamma_shape_mle
 from .gof import GofResult, goodness_of_fit
 from .groups import PoissonGroup, poisson_group, pooled_intervals
 from .hazard import HazardTable, interval_hazard
@@ -188,6 +189,7 @@ __all__ = [
     "MMPPFit",
     "simulate_mmpp",
     "ear1_intervals",
+    "gamma_shape_mle",
     "compare_point_processes",
     "mmpp_lr_test",
     "MMPPLRTest",

@@ -293,7 +293,7 @@ def equivalence_sample_size(se, n, margin, *, level=0.95, power=0.8):
 
 
 def poisson_verdict(reject_low, reject_high, null_level, dispersion_low, dispersion_high,
-                    *, margin=0.5, band=0.1):
+                    *, margin=0.5, band=0.1, against_null=False):
     """One standard for "Poisson": a calibrated test and an effect outside a stated band.
 
     A stream is read against two things stated before any data: the share of runs that a
@@ -327,6 +327,13 @@ def poisson_verdict(reject_low, reject_high, null_level, dispersion_low, dispers
         Half-width of the rejection band, relative to ``null_level`` (default 0.5).
     band : float
         Half-width of D's band (default 0.1).
+    against_null : bool
+        ``dispersion_low, dispersion_high`` are the CI of *D minus the D of null streams
+        shaped like the runs* (where the null's D is not 1), read by :func:`null_verdict`
+        with `D_MARGIN` (``band`` unused): ``"not Poisson"`` when the test rejects above
+        its calibrated band and D lies above (or below) its null; ``"not Poisson, D at its
+        null"``; ``"Poisson (D at its null)"`` when the share is at its calibrated level and
+        D at its null; ``"inconclusive"`` otherwise.
 
     Examples
     --------
@@ -338,8 +345,19 @@ def poisson_verdict(reject_low, reject_high, null_level, dispersion_low, dispers
     'Poisson within 10 %'
     >>> poisson_verdict(0.08, 0.11, 0.05, 1.01, 1.06)
     'not Poisson, D within 10 %'
+    >>> poisson_verdict(0.37, 0.41, 0.05, 1.2, 1.6, against_null=True)   # D - null D
+    'not Poisson'
     """
     rejects = rejection_verdict(reject_low, reject_high, null_level, margin)
+    if against_null:
+        dispersion = null_verdict(dispersion_low, dispersion_high, D_MARGIN)
+        if rejects == "above nominal" and dispersion in ("above its null", "below its null"):
+            return "not Poisson"
+        if rejects == "above nominal" and dispersion == "at its null":
+            return "not Poisson, D at its null"
+        if rejects == "nominal" and dispersion == "at its null":
+            return "Poisson (D at its null)"
+        return "inconclusive"
     dispersion = ratio_verdict(dispersion_low, dispersion_high, band)
     within = f"within {100 * band:g} %"
     if rejects == "above nominal" and dispersion in ("higher", "lower"):
@@ -351,8 +369,17 @@ def poisson_verdict(reject_low, reject_high, null_level, dispersion_low, dispers
     return "inconclusive"
 
 
-def poisson_rule(margin=0.5, band=0.1) -> str:
-    """The printed rule of :func:`poisson_verdict`."""
+def poisson_rule(margin=0.5, band=0.1, *, against_null=False) -> str:
+    """The printed rule of :func:`poisson_verdict` (``against_null``: D read against its
+    null stream's D)."""
+    if against_null:
+        return (f"not Poisson: the share of runs a test rejects lies above the level that "
+                f"null streams shaped like the runs give through the same test, by more than "
+                f"{100 * margin:g} % of that level, and D lies above (or below) the D of those "
+                f"null streams by more than {D_MARGIN:g} (95 % CI of the paired difference); "
+                f"not Poisson, D at its null: the test rejects so but the difference's CI lies "
+                f"in [-{D_MARGIN:g}, {D_MARGIN:g}]; Poisson (D at its null): the share is at its "
+                f"calibrated level and D at its null; inconclusive otherwise")
     lo, hi = f"{1 - band:g}", f"{1 + band:g}"
     return (f"not Poisson: the share of runs a test rejects lies above the level that null "
             f"streams shaped like the runs give through the same test (null calibration), by "
