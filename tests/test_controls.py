@@ -246,7 +246,7 @@ def test_a_robust_cell_gives_its_verdict_and_the_range_over_every_control_and_fa
 def test_the_poisson_question_is_a_row_per_test_with_the_rule_as_a_control():
     from kicktimes.report.answers import poisson_answer
     from kicktimes.report.controls import POISSON_QUESTION, merge_control_families, poisson_rows
-    from kicktimes.studies.paper.first_screen import qa_table
+    from kicktimes.studies.paper.first_screen import answer_lines
 
     rej = pd.DataFrame({"radius": [0.01, 0.02] * 2,
                         "test": ["uniformity_ks"] * 2 + ["ljung_box"] * 2,
@@ -287,16 +287,15 @@ def test_the_poisson_question_is_a_row_per_test_with_the_rule_as_a_control():
                            "rejected in 39.0 %")
     assert "against null streams 8.0 % (A)" in text
     assert "elastic rule: inconclusive (13.0 %" in text and "disjoint" in text
-    # the first screen's question: not robust, the elastic rule decides it
-    row = qa_table(table).iloc[0]
-    assert row["question"] == "Are the two disks' collision times Poisson?"
-    assert row["answer"].startswith("no under the primary, not under every control")
-    assert row["robust?"] == "✗" and row["deciding control"] == "elastic"
-    assert "CI below" not in row["number"]  # shares, not ratios: no side of 1 is read
-    assert "39 % of runs reject uniformity (null streams: 8.0 % (A))" in row["number"]
+    # the first screen's answer: the mirror rule's verdict and share against its calibrated
+    # level; not robust over the rule, so no "robust"; then the elastic rule's share
+    line = answer_lines(table)[0]
+    assert line.startswith("- **Are the two disks' collision times Poisson?** no: 39.0 [")
+    assert "of runs reject uniformity, their Poisson control streams 8.0 % (A);" in line
+    assert "robust" not in line and "; the elastic rule: 13.0 [" in line
 
 
-def test_the_first_screen_is_a_table_of_questions_then_a_table_of_at_most_8_columns():
+def test_the_first_screen_is_at_most_five_one_line_answers_then_a_compact_table():
     from kicktimes.report.controls import with_robustness
     from kicktimes.studies.paper.first_screen import QUESTIONS, first_screen
 
@@ -314,18 +313,18 @@ def test_the_first_screen_is_a_table_of_questions_then_a_table_of_at_most_8_colu
     rows.loc[broken, ["estimate", "ci_low", "ci_high"]] = [0.95, 0.93, 0.97]
     rows.loc[broken, "verdict"] = "within 10 %"
     lines = first_screen(with_robustness(rows))
-    assert lines[0] == "| question | answer | number | robust? | deciding control |"
-    qa = lines[2:lines.index("")]
-    assert len(qa) == 2  # no Poisson rows and one diagnostic here: the two FTLE questions
-    assert qa[0] == (f"| {QUESTIONS[0][0]} | no: lower | 0.315; CI below 1 in 24 of 24 "
-                     "cells | ✓ | none of 5 controls |")
-    assert qa[1].startswith(f"| {QUESTIONS[1][0]} | no: lower under the primary, not under "
-                            "every control | primary 0.315; elastic 0.315–0.95; CI below 1 in "
-                            "36 of 36 cells | ✗ | elastic |")
-    rest = lines[lines.index("") + 1:]
-    assert len(rest[0]) <= 300  # one sentence on reading the detailed table
-    header = rest[2]
-    assert header.count("|") - 1 <= 8
+    answers = lines[:lines.index("")]
+    assert len(answers) == 2  # no Poisson rows and one diagnostic here: the two FTLE questions
+    assert answers[0] == (f"- **{QUESTIONS[0][0]}** no, lower: 0.315 [0.300, 0.330] (A, "
+                          "Poisson kicks); robust over 5 controls and both families (0.315).")
+    assert answers[1] == (f"- **{QUESTIONS[1][0]}** no, lower: 0.315 [0.300, 0.330] (A, "
+                          "Poisson scatter kicks); depends on the elastic rule: 0.950 "
+                          "[0.930, 0.970] (within 10 %; A, Poisson scatter kicks).")
+    assert all(len(a.split()) <= 45 for a in answers)  # one line each
+    table = lines[lines.index("") + 3:]
+    assert table[0].count("|") - 1 <= 8
+    assert table[2] == ("| FTLE λ | no, lower 0.315 ✓ | no, lower 0.315 ✓ | no, lower 0.315 ✗ "
+                        "elastic | no, lower 0.315 ✓ | no, lower 0.315 ✓ | no, lower 0.315 ✓ |")
 
 
 def test_every_family_has_the_rule_by_ic_design_as_control_experiments():

@@ -971,7 +971,8 @@ def test_reproduce_quick_runs_both_quick_families_and_builds_the_report(tmp_path
             assert bool(part["robust"].iloc[0]) == (part["verdict"].nunique() == 1)
         recurrence = comparisons[comparisons["diagnostic"].str.startswith(("rr_", "det"))]
         assert (recurrence.groupby(["diagnostic", "system"])["control"]
-                .apply(lambda c: "uniform_sampling" in set(c)).all())
+                .apply(lambda c: "paper_sampling" in set(c)
+                       and "uniform_sampling" not in set(c)).all())
 
 
 def test_the_uniform_control_rows_are_those_of_a_uniform_rr_sampling_run():

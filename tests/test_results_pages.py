@@ -72,7 +72,7 @@ def test_every_kicked_system_is_under_every_control(path):
         for system, rows in part.groupby("system"):
             want = set(needed)  # the kinetic-rate kicks under the elastic rule too
             if diagnostic.startswith("rr"):
-                want |= {"uniform_sampling", "paper_sampling"}
+                want |= {"paper_sampling"}
             assert want <= set(rows["control"]), (diagnostic, system)
     poisson = table[table["question"] == "Poisson collision times?"]
     assert {"primary", "invariant_ics", "elastic", "elastic+invariant_ics"} <= set(

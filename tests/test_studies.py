@@ -159,11 +159,14 @@ def test_the_paper_page_s_closing_table_is_what_it_wrote_and_never_in_the_readme
         curves.to_csv(tmp_path / f"{name}_findings_by_radius.csv", index=False)
     rows = results_sources(["fam", "fam-elastic"], {"fam": family}, ["fam", "fam-elastic"],
                            gaps=False, nulls=False)
-    # the family's table twice (its comparisons, its Poisson rows), the control's once
+    pd.DataFrame({"diagnostic": ["FTLE λ"]}).to_csv(tmp_path / "overview.csv", index=False)
+    # the overview, then the family's table twice (its comparisons, its Poisson rows); the
+    # control's own table is folded into the family's, not listed
     assert [(r.csv, r.computed_by.__name__) for r in rows[:3]] == [
-        ("fam_findings.csv", "compute_controls"), ("fam_findings.csv", "poisson_rows"),
-        ("fam-elastic_findings.csv", "compute_controls")]
-    assert {r.csv for r in rows} == {p.name for p in tmp_path.glob("*.csv")}
+        ("overview.csv", "overview_table"), ("fam_findings.csv", "compute_controls"),
+        ("fam_findings.csv", "poisson_rows")]
+    assert {r.csv for r in rows} == {p.name for p in tmp_path.glob("*.csv")} - {
+        "fam-elastic_findings.csv"}
     page = write_results_page(tmp_path / "README.md", [
         "# t", "", "Generated now from `fam`.", "", "## The answers", "", "One.", ""], rows)
     readme = tmp_path / "top.md"

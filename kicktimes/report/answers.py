@@ -324,6 +324,9 @@ _LOG_TICKS = (
 )
 #: the statistic of the headline figure: the findings table's (the ratio of ensemble means)
 HEADLINE_CONTROL = "primary"
+#: the kick laws the headline figure draws (the others overplot them; every law and
+#: radius: the findings_by_radius CSVs): the paper's two uniform kicks and the scatter kick
+HEADLINE_SYSTEMS = ("poisson", "actual", "poisson_scatter")
 
 
 def log_ratio_axis(ax):
@@ -338,7 +341,8 @@ def log_ratio_axis(ax):
     ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
 
 
-def ratio_curves_figure(curves: pd.DataFrame, control=HEADLINE_CONTROL):
+def ratio_curves_figure(curves: pd.DataFrame, control=HEADLINE_CONTROL,
+                        systems=HEADLINE_SYSTEMS):
     """The headline figure: the ratio of each kicked system to the two-disk value against
     r, one line per kick law, one panel per diagnostic (columns) and family (rows), with
     95 % CIs (bootstrap clustered on ICs) and the ±10 % band. Every panel shares one log y
@@ -354,6 +358,8 @@ def ratio_curves_figure(curves: pd.DataFrame, control=HEADLINE_CONTROL):
         ``Controls.curves`` of one or more stores (concatenated).
     control : str
         Which control's per-radius curves to draw.
+    systems : sequence of str
+        The kick laws drawn (default `HEADLINE_SYSTEMS`; ``None``: every one).
 
     Returns
     -------
@@ -367,7 +373,9 @@ def ratio_curves_figure(curves: pd.DataFrame, control=HEADLINE_CONTROL):
     curves = curves[curves["control"] == control]
     panels = [(d, t) for d, t in PANELS if d in set(curves["diagnostic"])]
     families = list(dict.fromkeys(curves["family"]))
-    systems = [s for s in _SHORT if s in set(curves["system"])]
+    systems = [s for s in _SHORT if s in set(curves["system"])
+               and (systems is None or s in systems)]
+    curves = curves[curves["system"].isin(systems)]
     ncol, nrow = max(len(panels), 1), max(len(families), 1)
     fig = Figure(figsize=(3.0 * ncol, 2.9 * nrow + 0.9), layout="constrained")
     axes = fig.subplots(nrow, ncol, squeeze=False, sharey=True, sharex="row")

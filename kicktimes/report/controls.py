@@ -22,9 +22,9 @@ changes it. The controls:
     computed on the same trajectories sampled at uniform times :math:`k\tau` (the store's
     ``uniform_`` rows, ``rr_sampling = "run+uniform"``; its detail says so), and the
     paper's collision-truncated steps, whose samples sit on the rim at every wall hit and
-    differ in number between the systems, are the control ``paper_sampling``. Its
-    ``uniform_sampling`` row repeats the primary value under its own name, so that every
-    recurrence diagnostic lists the uniform-time samples explicitly.
+    differ in number between the systems, are the control ``paper_sampling`` (the
+    primary row's detail names its uniform-time samples; no row repeats it, so that no
+    control is counted twice).
 ``invariant_ics``, ``elastic``, ``elastic+invariant_ics``
     Other experiments (`merge_control_families`): the 2 x 2 design collision rule (the
     paper's mirror rule, the elastic rule) x initial conditions (the paper's procedure, the
@@ -74,8 +74,7 @@ __all__ = [
 ]
 
 #: the controls, in the order of the table (then the other experiments' controls)
-CONTROLS = ("primary", "paired_median", "sticky_excluded", "uniform_sampling",
-            "paper_sampling")
+CONTROLS = ("primary", "paired_median", "sticky_excluded", "paper_sampling")
 #: the columns of the findings table
 COLUMNS = ("family", "question", "diagnostic", "system", "control", "estimate", "ci_low",
            "ci_high", "verdict", "robust", "depends_on", "n_pairs", "detail")
@@ -167,8 +166,6 @@ def _ratio_rows(family, diagnostic, system, x, y, sticky, *, x_uniform, y_unifor
     add("sticky_excluded", per_r, tot, per_r["n_pairs"].sum(),
         samples + f"{int((~keep).sum())} sticky (radius, IC) runs left out")
     if x_uniform is not None:
-        rows.append({**rows[0], "control": "uniform_sampling",
-                     "detail": "the primary row: samples at uniform times k τ"})
         per_r, tot = paired_ratio(paper_x, paper_y, rng=rng, n_boot=n_boot,
                                   resamples=resamples)
         add("paper_sampling", per_r, tot, per_r["n_pairs"].sum(),

@@ -296,9 +296,10 @@ def gap_figure(table: pd.DataFrame):
     law; kinetic-rate timing; actual-times timing), one panel per diagnostic whose gap
     exists under every control in some family (`gap_everywhere`; primary setting:
     uniform-time samples for recurrence), with their 95 % CIs (bootstrap clustered on
-    ICs), families side by side. What is left (one minus the shares) is not drawn: no
-    ingredient of it is tested. A share whose sign is not the same under every control is
-    drawn faded and marked ✗. One y scale for all."""
+    ICs), families side by side, and what is left of the kinetic factorial's gap (one
+    minus its two shares; grey: at 1 nothing here closes the gap; no ingredient of it is
+    tested). A share whose sign is not the same under every control is drawn faded and
+    marked ✗. One y scale for all."""
     from matplotlib.figure import Figure
     from matplotlib.lines import Line2D
 
@@ -307,11 +308,15 @@ def gap_figure(table: pd.DataFrame):
     with_gap = {d for (_, d), missing in gap_everywhere(table).items() if not missing}
     panels = [(d, t) for d, t in PANELS if d in with_gap]
     steps = [s for s in INGREDIENTS if s in set(table["quantity"]) and s != STEPS[3]]
+    if STEPS[2] in set(table["quantity"]):
+        steps.append(STEPS[2])
     families = list(dict.fromkeys(table["family"]))
     fig = Figure(figsize=(max(3.4 * len(panels), 8.0), 4.3), layout="constrained")
     axes = fig.subplots(1, max(len(panels), 1), squeeze=False, sharey=True)[0]
-    colours = ("tab:red", "tab:purple", "tab:green")
-    short = ("deflection", "kinetic-rate\ntiming", "actual-times\ntiming")
+    colours = {STEPS[0]: "tab:red", STEPS[1]: "tab:purple", STEPS[4]: "tab:green",
+               STEPS[2]: "0.35"}
+    short = {STEPS[0]: "deflection", STEPS[1]: "kinetic-rate\ntiming",
+             STEPS[4]: "actual-times\ntiming", STEPS[2]: "left\n(1 − shares)"}
     for ax, (diagnostic, title) in zip(axes, panels, strict=False):
         ax.axhline(0.0, color="0.5", linewidth=0.8, zorder=0)
         ax.axhline(1.0, color="0.8", linewidth=0.8, linestyle=":", zorder=0)
@@ -327,15 +332,15 @@ def gap_figure(table: pd.DataFrame):
                     continue
                 est, lo, hi = rows.loc[step, ["estimate", "ci_low", "ci_high"]]
                 sides = set(_sides(fam, step).values())
-                robust = len(sides) == 1 and sides <= {1, -1}
+                robust = step == STEPS[2] or (len(sides) == 1 and sides <= {1, -1})
                 x = i + 0.22 * (f - (len(families) - 1) / 2)
                 ax.errorbar([x], [est], yerr=[[max(est - lo, 0.0)], [max(hi - est, 0.0)]],
-                            fmt="os"[f % 2], color=colours[i], capsize=2.5, ms=5,
+                            fmt="os"[f % 2], color=colours[step], capsize=2.5, ms=5,
                             alpha=1.0 if robust else 0.45)
                 if not robust:
                     ax.annotate("✗", (x, hi), textcoords="offset points", xytext=(0, 3),
-                                ha="center", fontsize="small", color=colours[i])
-        ax.set_xticks(range(len(steps)), short[:len(steps)], fontsize="small")
+                                ha="center", fontsize="small", color=colours[step])
+        ax.set_xticks(range(len(steps)), [short[s] for s in steps], fontsize="small")
         ax.set_xlim(-0.5, len(steps) - 0.5)
         ax.set_title(title, fontsize="medium")
     if not panels:

@@ -1,6 +1,11 @@
-"""The first screen of the main results page (docs/results/README.md): the paper's
-questions, each answered over every control and family of the findings table, then the
-overview of every diagnostic by every kick law (`kicktimes.report.answers`).
+"""The first screen of the main results page (docs/results/README.md): five one-line
+answers, each with one number, its 95 % interval and its caveat, then one compact table
+of every diagnostic by every kick law (family A, the primary setting; every control and
+family: ``overview.csv``, `kicktimes.report.answers.overview_table`).
+
+Every word of a line comes from the findings table through the verdict rules of
+`kicktimes.stats` (`ratio_verdict`, `rejection_verdict`, `null_verdict`,
+`poisson_verdict`) and the robustness rule of `kicktimes.report.controls.with_robustness`.
 """
 
 from __future__ import annotations
@@ -9,139 +14,192 @@ import numpy as np
 import pandas as pd
 
 from kicktimes.render.pages import markdown_table
-from kicktimes.report.answers import CONTROL_WORDS, null_level_text, overview_table
+from kicktimes.report.answers import CONTROL_WORDS, SCREEN_ROWS, family_short
 from kicktimes.report.controls import LOWER, POISSON_QUESTION, WITHIN
+from kicktimes.stats import format_interval
 
-__all__ = ["QUESTIONS", "first_screen", "qa_table"]
+__all__ = ["QUESTIONS", "answer_lines", "compact_overview", "first_screen", "qa_table"]
 
-#: the first screen's questions, in order: (question, diagnostic, kicked systems); the
-#: Poisson question comes first and reads the one standard's rows
+#: the first screen's ratio questions, in order: (question, diagnostic, kicked systems); the
+#: first system is the one whose number the line gives; the Poisson question comes first
 QUESTIONS = (
     ("Does the paper's kicked disk (uniform kicks) have the two-disk FTLE?", "ftle",
      ("poisson", "actual")),
     ("Do scatter kicks (virtual partners) give the two-disk FTLE?", "ftle",
      ("poisson_scatter", "actual_scatter", "poisson_kinetic")),
-    ("Does the kicked disk have the two-disk recurrence rate (ε = 10⁻²)?", "rr_offdiag@0.01",
-     ("poisson", "actual")),
-    ("Does it decorrelate like the two disks at lag 1 (1 − R₁)?", "one_minus_r1",
+    ("Does it decorrelate like the two disks at lag 1 (1 − R₁ at uniform-time samples)?",
+     "one_minus_r1", ("poisson", "actual")),
+    ("Does it have the two-disk recurrence rate (ε = 10⁻²)?", "rr_offdiag@0.01",
      ("poisson", "actual")),
 )
+POISSON_LINE = "Are the two disks' collision times Poisson?"
+_WORDS = {LOWER: "no, lower", "higher": "no, higher", WITHIN: "yes, within 10 %",
+          "inconclusive": "undecided"}
+_KICKS = {"poisson": "Poisson kicks", "actual": "kicks at the actual times",
+          "poisson_scatter": "Poisson scatter kicks", "actual_scatter": "actual scatter kicks",
+          "poisson_kinetic": "scatter kicks at the kinetic rate",
+          "uniform_kinetic": "uniform kicks at the kinetic rate"}
 
 
-_ANSWER_WORDS = {LOWER: "no: lower", "higher": "no: higher", WITHIN: "yes, within 10 %",
-                 "not Poisson": "no", "Poisson within 10 %": "yes, within 10 %"}
+#: the compact table's names of the controls
+_CONTROL_SHORT = {"paired_median": "median", "sticky_excluded": "sticky",
+                  "paper_sampling": "sampling", "invariant_ics": "ICs", "elastic": "elastic",
+                  "elastic+invariant_ics": "elastic+ICs"}
+
+
+def _ci(row) -> str:
+    return format_interval(row.estimate, row.ci_low, row.ci_high)
+
+
+def _pct(row) -> str:
+    return format_interval(100 * row.estimate, 100 * row.ci_low, 100 * row.ci_high,
+                           edges=(2.5, 5.0, 7.5)) + " %"
 
 
 def _range(rows) -> str:
     x = pd.to_numeric(rows["estimate"], errors="coerce")
     x = x[np.isfinite(x)]
-    if x.empty:
-        return "—"
-    lo, hi = x.min(), x.max()
-    return f"{lo:.3g}" if f"{lo:.3g}" == f"{hi:.3g}" else f"{lo:.3g}–{hi:.3g}"
+    lo, hi = (f"{x.min():.3g}", f"{x.max():.3g}") if len(x) else ("—", "—")
+    return lo if lo == hi else f"{lo}–{hi}"
 
 
-def _qa_row(question, rows) -> dict:
-    """One row of :func:`qa_table`: a question answered over every control and family.
-    The deciding control's count excludes the primary; a row whose primary verdicts differ
-    between kick laws or families says so; the number adds how many (family, control,
-    kick law) cells have their interval below (above) 1, a deficit a "within 10 %"
-    verdict does not show."""
-    n_controls = rows.loc[rows["control"] != "primary", "control"].nunique()
-    verdicts = set(rows["verdict"])
-    primary = rows[rows["control"] == "primary"]
-    first = set(primary["verdict"]) if len(primary) else {rows["verdict"].iloc[0]}
-    main = primary["verdict"].mode().iloc[0] if len(primary) else rows["verdict"].iloc[0]
-    robust = bool(rows["robust"].all()) and len(verdicts) == 1
-    below = int((rows["ci_high"] < 1).sum())
-    above = int((rows["ci_low"] > 1).sum())
-    sides = ""
-    if rows["question"].iloc[0] != POISSON_QUESTION and (below or above):
-        sides = "; CI " + " and ".join(
-            part for part in (f"below 1 in {below}" if below else "",
-                              f"above 1 in {above}" if above else "") if part
-        ) + f" of {len(rows)} cells"
-    if robust:
-        return {"question": question, "answer": _ANSWER_WORDS.get(main, main),
-                "number": _range(rows) + sides, "robust?": "✓",
-                "deciding control": f"none of {n_controls} controls"}
-    # the controls that give another verdict than the primary's, the most cells first
+def _one(rows, **where):
+    for key, value in where.items():
+        rows = rows[rows[key] == value]
+    return rows.iloc[0] if len(rows) else None
+
+
+def _deciding(rows, main) -> list[str]:
+    """The controls whose verdict differs from the primary's ``main``, most cells first;
+    else those that put the interval on the other side of 1."""
     other = rows[(rows["verdict"] != main) & (rows["control"] != "primary")]
-    deciding = list(other["control"].value_counts().index) or [
-        c for c in dict.fromkeys(rows["depends_on"]) if c]
-    crosses = (rows["ci_low"] > 1).any() and (rows["ci_high"] < 1).any()
-    number = f"primary {_range(primary)}"
-    if deciding:
-        number += f"; {deciding[0]} {_range(rows[rows['control'] == deciding[0]])}"
-    head = (f"{_ANSWER_WORDS.get(main, main)} under the primary" if len(first) == 1 else
-            "under the primary: " + " / ".join(sorted(first)) + " by kick law or family")
-    return {"question": question,
-            "answer": head + ", not under every control"
-                      + ("; CIs on both sides of 1" if crosses else ""),
-            "number": number + sides, "robust?": "✗",
-            "deciding control": ", ".join(deciding) or "the family"}
+    found = list(other["control"].value_counts().index)
+    return found or [c for c in dict.fromkeys(rows["depends_on"].fillna("")) if c]
 
 
-def qa_table(table: pd.DataFrame) -> pd.DataFrame:
-    """The first screen's questions (`QUESTIONS`, after the Poisson question), each
-    answered over every control and family of the findings table: the answer (the verdict
-    of `kicktimes.stats.ratio_verdict` or `poisson_verdict`), the number (the range of the
-    estimate over every control and family; when not robust, the primary's range and that
-    of the control that decides), whether it is robust (`with_robustness`: one verdict and
-    one direction under every control) and the controls that change it.
+def _ratio_line(question, rows) -> str:
+    """One answer: the primary verdict and number of the first family and kick law, then
+    the caveat: robust over every control and family (with the range), or the control
+    that decides, with its number; a verdict "within 10 %" whose interval excludes 1 says
+    how many cells lie on one side of 1 (a real difference smaller than the margin)."""
+    family = rows["family"].iloc[0]
+    system = rows["system"].iloc[0]
+    primary = _one(rows, family=family, system=system, control="primary")
+    n_controls = rows.loc[rows["control"] != "primary", "control"].nunique()
+    robust = bool(rows["robust"].astype(str).str.lower().eq("true").all())
+    main = primary.verdict
+    text = (f"**{question}** {_WORDS.get(main, main)}: {_ci(primary)} "
+            f"({family_short(family)}, {_KICKS.get(system, system)})")
+    if robust and rows["verdict"].nunique() == 1:
+        text += f"; robust over {n_controls} controls and both families ({_range(rows)})"
+    else:
+        other = rows[(rows["verdict"] != main) & (rows["control"] != "primary")]
+        if len(other):
+            control = other["control"].value_counts().index[0]
+            c = other[other["control"] == control].iloc[0]
+            text += (f"; depends on {CONTROL_WORDS.get(control, control)}: {_ci(c)} "
+                     f"({c.verdict}; {family_short(c.family)}, {_KICKS.get(c.system, c.system)})")
+        else:
+            text += "; the interval lies on both sides of 1 under different controls"
+    below = int((rows["ci_high"] < 1).sum())
+    if main == WITHIN and below:
+        text += f"; CI below 1 in {below} of {len(rows)} cells"
+    return text + "."
 
-    Columns ``question``, ``answer``, ``number``, ``robust?``, ``deciding control``.
-    """
+
+def _poisson_line(table) -> str | None:
+    """The Poisson answer: the one standard's verdict (`kicktimes.stats.poisson_verdict`,
+    D read against its null), family A's rejection share against its calibrated level and
+    D's excess over its null, then the elastic rule's two numbers."""
     from kicktimes.report.poisson import HEADLINE_TEST
 
+    rows = table[table["question"] == POISSON_QUESTION]
+    verdicts = rows[rows["diagnostic"] == f"poisson@{HEADLINE_TEST}"]
+    if verdicts.empty:
+        return None
+    family = verdicts["family"].iloc[0]
+    main = _one(verdicts, family=family, control="primary")
+    share = _one(rows, diagnostic=f"reject@{HEADLINE_TEST}", family=family, control="primary")
+    excess = _one(rows, diagnostic="dispersion_index_excess", family=family, control="primary")
+    robust = verdicts["verdict"].nunique() == 1
+    level = _null_share(share)
+    text = (f"**{POISSON_LINE}** {'no' if main.verdict == 'not Poisson' else main.verdict}: "
+            f"{_pct(share)} of runs reject uniformity, their Poisson control streams {level}")
+    if excess is not None:
+        text += f"; D exceeds its null by {_ci(excess)}"
+    text += f" (A{', robust over rule × ICs' if robust else ''})"
+    e_share = _one(rows, diagnostic=f"reject@{HEADLINE_TEST}", family=family, control="elastic")
+    e_excess = _one(rows, diagnostic="dispersion_index_excess", family=family,
+                    control="elastic")
+    if e_share is not None:
+        text += (f"; the elastic rule: {_pct(e_share)}"
+                 + (f", D + {_ci(e_excess)}" if e_excess is not None else ""))
+    return text + "."
+
+
+def _null_share(row) -> str:
+    """``"5.0 %"``: the calibrated level a share row's detail names."""
+    import re
+
+    m = re.search(r"rejects, ([0-9.]+) % \(null_calibration", str(row.detail))
+    return f"{m.group(1)} %" if m else "α"
+
+
+def answer_lines(table: pd.DataFrame) -> list[str]:
+    """At most five one-line answers (Markdown bullets): the Poisson question, then
+    `QUESTIONS` in order, each from every control and family of ``table``."""
     out = []
-    poisson = table[table["diagnostic"] == f"poisson@{HEADLINE_TEST}"]
-    if len(poisson):
-        row = _qa_row("Are the two disks' collision times Poisson?", poisson)
-        shares = table[(table["diagnostic"] == f"reject@{HEADLINE_TEST}")
-                       & (table["control"] == "primary")]
-        ds = table[(table["diagnostic"] == "dispersion_index")
-                   & (table["control"] == "primary")]
-        level = null_level_text(table[table["question"] == POISSON_QUESTION],
-                            list(dict.fromkeys(shares["family"])))
-        row["number"] = (f"mirror: {_range(shares.assign(estimate=100 * shares['estimate']))}"
-                         f" % of runs reject uniformity"
-                         + (f" (null streams: {level})" if level else "")
-                         + f", D {_range(ds)}")
-        elastic = table[table["diagnostic"].isin([f"reject@{HEADLINE_TEST}",
-                                                  "dispersion_index"])
-                        & (table["control"] == "elastic")]
-        if len(elastic) and row["robust?"] == "✓":
-            e_share = elastic[elastic["diagnostic"] == f"reject@{HEADLINE_TEST}"]
-            e_d = elastic[elastic["diagnostic"] == "dispersion_index"]
-            row["deciding control"] += (
-                f"; the elastic rule moves it most: "
-                f"{_range(e_share.assign(estimate=100 * e_share['estimate']))} %, "
-                f"D {_range(e_d)}")
-        out.append(row)
+    poisson = _poisson_line(table)
+    if poisson:
+        out.append("- " + poisson)
     for question, diagnostic, systems in QUESTIONS:
         rows = table[(table["diagnostic"] == diagnostic) & table["system"].isin(systems)]
         if len(rows):
-            out.append(_qa_row(question, rows))
-    return pd.DataFrame(out, columns=["question", "answer", "number", "robust?",
-                                      "deciding control"])
+            order = {s: k for k, s in enumerate(systems)}
+            rows = rows.sort_values("system", key=lambda s: s.map(order), kind="stable")
+            out.append("- " + _ratio_line(question, rows))
+    return out[:5]
 
 
-def first_screen(table: pd.DataFrame, shares=None) -> list[str]:
-    """The Markdown lines that open a results page: the questions' table (:func:`qa_table`:
-    question, answer, number, robust?, deciding control), one sentence on how to read the
-    detailed table, that table (:func:`overview_table`: every diagnostic by every kick law)
-    and the list of its controls. ``shares`` is accepted for compatibility and unused: the
-    Poisson numbers come from the table's rows (the full sentence: :func:`poisson_answer`)."""
-    controls = [c for c in dict.fromkeys(table["control"]) if c != "primary"]
-    lines = markdown_table(qa_table(table)) + [""]
-    lines += ["In detail, each cell: the kicked/two-disk ratio's range over every control "
-              "(below the table) and family, ✓ when all agree in verdict and direction, else "
-              "the control that changes it, both numbers (↕: crosses 1).", ""]
-    lines += markdown_table(overview_table(table))
-    kinetic = table[table["system"].isin(["poisson_kinetic", "uniform_kinetic"])]
-    missing = [c for c in controls if c not in set(kinetic["control"])] if len(kinetic) else []
-    lines += ["", "Controls: " + ", ".join(CONTROL_WORDS.get(c, c) for c in controls)
-              + (f"; the kinetic-rate kicks not under {', '.join(missing)}" if missing else "")
-              + "."]
-    return lines + [""]
+def compact_overview(table: pd.DataFrame) -> pd.DataFrame:
+    """Every diagnostic of `SCREEN_ROWS` by every kick law: family A's primary ratio,
+    ✓ when robust over every control and both families, else ✗ and the control that
+    decides (its number: ``overview.csv``)."""
+    comp = table[table["question"] != POISSON_QUESTION]
+    family = comp["family"].iloc[0] if len(comp) else ""
+    systems = [s for s in _KICKS if s in set(comp["system"])]
+    out = []
+    for diagnostic, label in SCREEN_ROWS:
+        part = comp[comp["diagnostic"] == diagnostic]
+        if part.empty:
+            continue
+        line = {"diagnostic": label}
+        for system in systems:
+            rows = part[part["system"] == system]
+            p = _one(rows, family=family, control="primary")
+            if p is None:
+                line[_KICKS[system]] = ""
+                continue
+            robust = (rows["robust"].astype(str).str.lower().eq("true").all()
+                      and rows["verdict"].nunique() == 1)
+            deciding = _deciding(rows, p.verdict)[:1]
+            mark = "✓" if robust else "✗ " + "".join(_CONTROL_SHORT.get(c, c) for c in deciding)
+            line[_KICKS[system]] = f"{_WORDS.get(p.verdict, p.verdict)} {p.estimate:.3g} {mark}"
+        out.append(line)
+    return pd.DataFrame(out)
+
+
+def qa_table(table: pd.DataFrame) -> pd.DataFrame:
+    """The answers as a table (question, answer line), for the report and tests."""
+    lines = answer_lines(table)
+    return pd.DataFrame({"answer": [line[2:] for line in lines]})
+
+
+def first_screen(table: pd.DataFrame) -> list[str]:
+    """The Markdown lines that open the page: :func:`answer_lines`, then the compact table
+    (:func:`compact_overview`) with one sentence on how to read it."""
+    lines = answer_lines(table) + [""]
+    lines += ["Every diagnostic by kick law (family A, primary; ✓ robust over every control "
+              "and both families, ✗ the control that changes it; every cell: "
+              "[overview.csv](overview.csv)):", ""]
+    return lines + markdown_table(compact_overview(table)) + [""]
