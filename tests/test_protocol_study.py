@@ -13,6 +13,13 @@ from kicktimes.render.provenance import PROVENANCE_TITLE
 from kicktimes.stats import paired_ratio
 from kicktimes.studies.protocol.compute import D0, Panel, compute_task, run_rows, tasks
 from kicktimes.studies.protocol.page import FIGURE, build_page, fig6_figure
+from kicktimes.studies.protocol.tables import count_line_table, fig4_table
+from kicktimes.studies.protocol.verdicts import (
+    CLOSER_MARGIN,
+    balloon_verdict,
+    closer_verdict,
+    reproduces,
+)
 
 PANELS = (
     Panel("family_a", "Fig. 6 top", (0.012, 0.024), 4, 400, 0.2, 1, 2, (0.024,), 2),
@@ -38,8 +45,11 @@ def test_every_reading_of_every_system_is_computed(rows):
     per_system = main_rows.groupby("system").size().to_dict()
     # two-disk: 2 estimators x 2 measures, tangent, R_1, RR with and without the diagonal;
     # kicked: the 2 x 2 x 2 factorial at uniform kicks, both N(0, 1) readings under both
-    # estimators, tangent, R_1, the two RR
-    assert per_system == {"two_particle": 8, "poisson": 16, "actual": 16}
+    # estimators, tangent, R_1, the two RR; Poisson: Fig. 4's slope and R² at the
+    # smallest radius
+    assert per_system == {"two_particle": 8, "poisson": 18, "actual": 16}
+    fig4 = rows[rows["diagnostic"].isin(["fig4_slope", "fig4_r2"])]
+    assert set(fig4["radius"]) == {0.012} and len(fig4) == 2 * sum(p.n_ics for p in PANELS)
     assert set(rows["horizon"]) == {1, 2, 4, 8}
     conv = rows[rows["horizon"] == 8]
     assert set(conv["radius"]) == {0.024} and set(conv["ic"]) == {0, 1}
@@ -97,7 +107,11 @@ def test_the_page_states_each_claim_from_its_tables(rows, tmp_path):
     generated = next(line for line in text.splitlines() if line.startswith("Generated "))
     assert "eq. (4)" in generated and "kicktimes reproduce --study protocol" in generated
     first_screen = text[:text.index("\n|")]
-    assert len(first_screen) <= 1200
+    answers = [line for line in first_screen.splitlines() if line.startswith("- ")]
+    # at most five one-line answers before the first table
+    assert 1 <= len(answers) <= 5 and all(len(line) <= 260 for line in answers)
+    # nothing but the title, the Generated line and the answers before the table
+    assert len(first_screen.strip().split("\n\n")) == 3
     header = next(line for line in text.splitlines() if line.startswith("| Claim"))
     assert header.count("|") - 1 <= 8
     assert (tmp_path / FIGURE).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
@@ -107,6 +121,20 @@ def test_the_page_states_each_claim_from_its_tables(rows, tmp_path):
     for row in findings.itertuples():
         inside = row.ci_low >= 0.9 and row.ci_high <= 1.1
         assert (row.verdict == "within 10 %") == inside
+    # the figures: FTLE Fig. 6, ACF Fig. 8, RR Fig. 7 for panel A only
+    by = findings.groupby("diagnostic")["figure"].agg(set)
+    assert by["ftle"] == {"Fig. 6 top", "Fig. 6 bottom"}
+    assert by["r1"] == by["one_minus_r1"] == {"Fig. 8 top", "Fig. 8 bottom"}
+    rr = findings[findings["diagnostic"] == "rr_with_diagonal"].set_index(["family", "control"])
+    assert rr.loc[("family_a", "small_radii"), "figure"].eq("Fig. 7 bottom").all()
+    assert rr.loc[("family_a", "larger_radii"), "figure"].eq("Fig. 7 top").all()
+    assert not rr.loc["family_b", "figure"].str.startswith("Fig. 7").any()
+    # every claim's "reproduces?" is the rule's, from its kind and verdict
+    assert claims["reproduces"].tolist() == [reproduces(k, v) for k, v in zip(
+        claims["kind"], claims["verdict"], strict=True)]
+    assert set(claims.loc[claims["family"] == "family_b", "reproduces"][
+        claims["claim"].str.startswith("RR")]) == {"not in the paper"}
+    assert "| reproduces? |" in text
     # the first screen quotes the FTLE claims' range by the paper's protocol
     ftle = claims[claims["quantity"] == "FTLE ratio kicked / two-disk"]
     low = f"{ftle['estimate'].min():.3g}"
@@ -158,7 +186,8 @@ def test_the_results_first_screen_points_to_paper_md_without_its_numbers():
     assert not re.search(r"[0-9]", pointer.replace("eq. (4)", "").replace("Fig. 6", ""))
     # the protocol page states the readings of eq. (4) the pointer names
     results = Path(__file__).resolve().parents[1] / "docs" / "results"
-    assert "eq. (4) as printed gives kicked/two-disk" in (results / "paper.md").read_text()
+    first = (results / "paper.md").read_text().split("\n|")[0]
+    assert re.search(r"\*\*FTLE \(Fig\. 6\)\*\* .*eq\. \(4\) as printed.*kicked/two-disk", first)
 
 
 def test_the_protocol_study_needs_the_paper_study_which_runs_first():
@@ -177,3 +206,107 @@ def test_every_registered_study_is_a_choice_of_reproduce_with_its_line():
     for study in STUDIES.values():
         assert f"{study.name} {study.page} {study.summary}" in lines
     assert f"[{'|'.join(STUDIES)}|all]" in res.output
+
+
+def test_equally_close_needs_the_whole_interval_inside_the_margin():
+    m = CLOSER_MARGIN
+    assert m == pytest.approx(0.01)
+    # the renormalised reading: the CI lies beyond -m, a difference the margin resolves
+    assert closer_verdict(-0.0807, -0.0679) == "Poisson closer"
+    # eq. (4) as printed: the CI excludes 0 but lies inside the margin, real but negligible
+    assert closer_verdict(-0.00327, -0.00103) == "Poisson closer, inside the margin"
+    assert closer_verdict(0.001, 0.004) == "actual closer, inside the margin"
+    assert closer_verdict(-0.004, 0.003) == "equally close"
+    assert closer_verdict(0.2 * m, 3 * m) == "inconclusive"  # straddles the margin's edge
+    assert closer_verdict(1.5 * m, 3 * m) == "actual closer"
+    assert closer_verdict(float("nan"), 0.0) == "inconclusive"
+    # overlapping intervals are not agreement: a CI wider than the margin is undecided
+    assert closer_verdict(-0.5 * m, 1.5 * m) == "inconclusive"
+    with pytest.raises(ValueError, match="margin"):
+        closer_verdict(-0.001, 0.001, margin=0.0)
+
+
+def test_the_balloon_is_a_sign_below_one():
+    assert balloon_verdict(0.80, 0.95) == "balloon (ratio < 1)"
+    # the paper's balloon at larger radii, measured: every CI above 1 (1.020-1.040)
+    assert balloon_verdict(1.020, 1.040) == "no balloon (ratio > 1)"
+    assert balloon_verdict(0.99, 1.01) == "inconclusive"
+    # within 10 % and the balloon are different questions: this CI is both
+    assert balloon_verdict(1.02, 1.03) != "balloon (ratio < 1)"
+
+
+@pytest.mark.parametrize(("kind", "verdict", "answer"), [
+    ("agreement", "within 10 %", "yes"),
+    ("agreement", "lower", "no"),
+    ("agreement", "higher", "no"),
+    ("agreement", "inconclusive", "undecided"),
+    ("balloon", "balloon (ratio < 1)", "yes"),
+    ("balloon", "no balloon (ratio > 1)", "no, opposite sign"),
+    ("balloon", "inconclusive", "undecided"),
+    ("poisson_better", "Poisson closer", "yes"),
+    ("poisson_better", "Poisson closer, inside the margin", "in sign only"),
+    ("poisson_better", "equally close", "no"),
+    ("poisson_better", "actual closer", "no, opposite sign"),
+    ("poisson_better", "inconclusive: not resolved at this size (3000 ICs would)",
+     "undecided"),
+    ("not_tested", "not run", "not tested"),
+    ("not_in_paper", "within 10 %", "not in the paper"),
+])
+def test_reproduces_is_read_off_the_verdict_by_the_claims_kind(kind, verdict, answer):
+    assert reproduces(kind, verdict) == answer
+
+
+def test_reproduces_refuses_an_unknown_kind():
+    with pytest.raises(ValueError, match="kind"):
+        reproduces("agrees", "within 10 %")
+
+
+def _count_rows(panel, law, n_ics=40, seed=0):
+    rng = np.random.default_rng(seed)
+    out = []
+    for r in (0.01, 0.02, 0.03, 0.04):
+        for ic in range(n_ics):
+            out.append({"panel": panel, "radius": r, "ic": ic, "system": "two_particle",
+                        "diagnostic": "r1", "horizon": 1, "lam": 0.9,
+                        "n_kicks": law(r) * rng.uniform(0.98, 1.02)})
+    return pd.DataFrame(out)
+
+
+def test_fig5_line_is_within_10_percent_for_linear_counts_only():
+    linear = _count_rows("family_a", lambda r: 100 + 5000 * r)
+    # counts that grow as r^3 lie up to ~40 % off any straight line through them
+    cubic = _count_rows("family_b", lambda r: 20 + 3e6 * r ** 3)
+    tab = count_line_table(pd.concat([linear, cubic]), PANELS).set_index("family")
+    assert tab.loc["family_a", "verdict"] == "within 10 %"
+    assert tab.loc["family_a", "slope"] == pytest.approx(5000, rel=0.05)
+    assert tab.loc["family_a", "estimate"] < 0.01
+    assert tab.loc["family_b", "verdict"] == "higher"
+    assert tab.loc["family_b", "ci_low"] > 0.1
+
+
+def test_fig5_line_needs_three_radii():
+    two = _count_rows("family_a", lambda r: 100 + 5000 * r)
+    two = two[two["radius"] <= 0.02]
+    assert count_line_table(two, PANELS[:1]).empty
+
+
+def test_fig4_slope_is_the_mean_of_the_ics_slopes():
+    slopes = {"family_a": np.linspace(0.9, 1.1, 50), "family_b": np.linspace(1.3, 1.7, 50)}
+    frames = []
+    for panel, values in slopes.items():
+        for name, lam in (("fig4_slope", values), ("fig4_r2", np.full(50, 0.95))):
+            frames.append(pd.DataFrame({
+                "panel": panel, "radius": 0.012, "ic": range(50), "system": "poisson",
+                "diagnostic": name, "horizon": 1, "lam": lam}))
+    # an IC with fewer than 3 collisions has no slope: left out, not counted as 0
+    frames.append(pd.DataFrame({"panel": ["family_a"], "radius": [0.012], "ic": [50],
+                                "system": ["poisson"], "diagnostic": ["fig4_slope"],
+                                "horizon": [1], "lam": [np.nan]}))
+    tab = fig4_table(pd.concat(frames, ignore_index=True), PANELS).set_index("family")
+    assert tab.loc["family_a", "estimate"] == pytest.approx(1.0)
+    assert tab.loc["family_a", "verdict"] == "within 10 %"
+    assert tab.loc["family_a", "n_ics"] == 50
+    assert tab.loc["family_b", "estimate"] == pytest.approx(1.5)
+    assert tab.loc["family_b", "verdict"] == "higher"
+    assert tab.loc["family_b", "r2"] == pytest.approx(0.95)
+    assert fig4_table(frames[0].iloc[:0], PANELS).empty

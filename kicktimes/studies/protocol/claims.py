@@ -5,7 +5,9 @@ The FTLE, autocorrelation and recurrence claims come from this study's tables
 of the paper study (``family_*_findings.csv`` of ``kicktimes reproduce --study paper``).
 
 "Decided by" names the choices that change the verdict when switched alone, away from
-the paper's protocol; empty when none does.
+the paper's protocol; empty when none does. "reproduces?" comes from the verdict by the
+paper's protocol through `kicktimes.studies.protocol.verdicts.reproduces`, by the claim's
+``kind``.
 """
 
 from __future__ import annotations
@@ -16,8 +18,20 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from kicktimes.stats import format_interval, percentile_interval, ratio_verdict, robust_verdict
+from kicktimes.stats import (
+    equivalence_sample_size,
+    format_interval,
+    percentile_interval,
+    ratio_verdict,
+    robust_verdict,
+)
 from kicktimes.studies.protocol.tables import PAPER_READING, reading_label
+from kicktimes.studies.protocol.verdicts import (
+    CLOSER_MARGIN,
+    balloon_verdict,
+    closer_verdict,
+    reproduces,
+)
 
 __all__ = ["claims_table", "SMALL_RADIUS", "SWITCHES"]
 
@@ -37,14 +51,14 @@ SWITCHES = (
 
 
 def _row(claim, words, figure, family, system, quantity, protocol, est, other_name, other,
-         robust, decided_by):
+         robust, decided_by, kind):
     return {
         "claim": claim, "paper_says": words, "figure": figure, "family": family,
         "system": system, "quantity": quantity, "paper_protocol": protocol,
         "estimate": est[0], "ci_low": est[1], "ci_high": est[2], "verdict": est[3],
         "other_reading": other_name, "other_estimate": other[0], "other_ci_low": other[1],
         "other_ci_high": other[2], "other_verdict": other[3], "robust": bool(robust),
-        "decided_by": decided_by,
+        "decided_by": decided_by, "kind": kind,
     }
 
 
@@ -68,7 +82,7 @@ def _ftle_claim(ratio_tab, panel, system, claim, words, figure):
     robust = bool(by.loc[reading_label(PAPER_READING), "robust"])
     return _row(claim, words, figure, panel, system, "FTLE ratio kicked / two-disk",
                 reading_label(PAPER_READING), paper, reading_label(_RENORMALISED),
-                get(_RENORMALISED), robust, "; ".join(changes))
+                get(_RENORMALISED), robust, "; ".join(changes), "agreement")
 
 
 def _r1_claim(r1_tab, panel, system, words, figure):
@@ -81,9 +95,9 @@ def _r1_claim(r1_tab, panel, system, words, figure):
 
     paper, other = get("r1"), get("one_minus_r1")
     return _row(f"ACF, {system}", words, figure, panel, system,
-                "R₁ ratio kicked / two-disk", "R₁ (the paper's Fig. 8)", paper,
-                "1 − R₁ (decorrelation)", other, False,
-                "quantity (R₁ → 1 − R₁)" if paper[3] != other[3] else "")
+                "R₁ ratio kicked / two-disk, t ≤ nτ", "R₁ (the paper's Fig. 8)", paper,
+                "1 − R₁ over t ≤ nτ (decorrelation)", other, False,
+                "quantity (R₁ → 1 − R₁)" if paper[3] != other[3] else "", "agreement")
 
 
 def _rr_claim(rr_tab, panel, system, subset, words):
@@ -92,17 +106,23 @@ def _rr_claim(rr_tab, panel, system, subset, words):
     if sel.empty:  # no radius of the panel in this subset
         return None
     paper, other = sel.loc["rr_with_diagonal"], sel.loc["rr_offdiag"]
+    small = subset == "small_radii"
 
     def get(r):
-        return r["estimate"], r["ci_low"], r["ci_high"], r["verdict"]
+        # the balloon is a sign (the two-disk RR above the kicked one), not an agreement
+        verdict = r["verdict"] if small else balloon_verdict(r["ci_low"], r["ci_high"])
+        return r["estimate"], r["ci_low"], r["ci_high"], verdict
 
-    label = "small" if subset == "small_radii" else "larger"
-    return _row(f"RR, {label} radii, {system}", words, "7", panel.name, system,
+    est, alt = get(paper), get(other)
+    kind = "agreement" if small else "balloon"
+    if not paper["figure"].startswith("Fig. 7"):
+        kind = "not_in_paper"
+    return _row(f"RR, {'small' if small else 'larger'} radii, {system}", words,
+                paper["figure"].removeprefix("Fig. "), panel.name, system,
                 f"RR ratio kicked / two-disk (ε = 0.001), r = {paper['radii']}",
-                "with the main diagonal, the paper's steps", get(paper),
-                "off the diagonal", get(other), False,
-                "quantity (with → without the diagonal)" if paper["verdict"] != other["verdict"]
-                else "")
+                "with the main diagonal, the paper's steps", est, "off the diagonal", alt,
+                False, "quantity (with → without the diagonal)" if est[3] != alt[3] else "",
+                kind)
 
 
 def _findings(findings_dir, name):
@@ -112,43 +132,97 @@ def _findings(findings_dir, name):
     return pd.read_csv(path)
 
 
-def _family_claim(findings_dir, family, diagnostic, system, control, claim, words, figure,
-                  quantity, other=None):
+def _finding(findings_dir, family, diagnostic, system):
+    """The paper study's rows of one diagnostic and system, by control."""
     frame = _findings(findings_dir, f"{family}_findings.csv")
     sel = frame[(frame["diagnostic"] == diagnostic) & (frame["system"] == system)]
-    by = sel.set_index("control")
+    if sel.empty:
+        raise ValueError(f"findings_dir: {family}_findings.csv has no {diagnostic} row of "
+                         f"{system}")
+    return sel.set_index("control")
 
-    def get(c):
-        r = by.loc[c]
-        return r["estimate"], r["ci_low"], r["ci_high"], r["verdict"]
 
-    paper = get(control)
+def _get(by, control):
+    r = by.loc[control]
+    return r["estimate"], r["ci_low"], r["ci_high"], r["verdict"]
+
+
+def _controls_note(by, control="primary"):
+    """"controls (k of n)": how many of the paper study's other controls change its
+    verdict; empty when none does."""
     others = [c for c in by.index if c != control]
-    changes = [c for c in others if by.loc[c, "verdict"] != paper[3]]
-    primary = other or ("primary" if control != "primary" else others[0])
-    return _row(claim, words, figure, family, system, quantity, control, paper, primary,
-                get(primary), bool(by.loc[control, "robust"]),
-                f"controls ({len(changes)} of {len(others)})" if changes else "")
+    changes = [c for c in others if by.loc[c, "verdict"] != by.loc[control, "verdict"]]
+    return f"controls ({len(changes)} of {len(others)})" if changes else ""
+
+
+def _decided(est, other, switch, note):
+    """"Decided by" of a row whose other reading is another test: ``switch`` when both
+    readings ran and their verdicts differ, then the controls' ``note``."""
+    ran = np.isfinite(est[0]) and np.isfinite(other[0])
+    return "; ".join(x for x in (switch if ran and est[3] != other[3] else "", note) if x)
+
+
+def _fig4_claim(fig4_tab, findings_dir, panel):
+    """Fig. 4: the paper's least-squares line (slope of the Poisson kick times on the
+    collision times), beside the other reading of its conclusion, the share of runs whose
+    collision times reject uniformity (the paper study's findings)."""
+    sel = fig4_tab[fig4_tab["family"] == panel.name] if not fig4_tab.empty else fig4_tab
+    if sel.empty:
+        est, kind = (math.nan, math.nan, math.nan, "not run"), "not_tested"
+        radius = min(panel.radii)
+    else:
+        r = sel.iloc[0]
+        est, kind, radius = (r["estimate"], r["ci_low"], r["ci_high"], r["verdict"]), \
+            "agreement", r["radius"]
+    other, note = (math.nan, math.nan, math.nan, "not read"), ""
+    if findings_dir is not None:
+        by = _finding(findings_dir, panel.name, "reject@uniformity_ks", "two_particle")
+        other, note = _get(by, "primary"), _controls_note(by)
+    return _row("Poisson kick times (fit)", "high-quality linear fit: Poisson a reasonable "
+                "approximation", "4", panel.name, "poisson",
+                f"slope of Poisson kick times on collision times, r = {radius:g}",
+                "least-squares line, per IC", est,
+                "share of runs rejecting uniform collision times (α = 0.05, every radius)",
+                other, False, _decided(est, other, "reading (fit → uniformity test)", note),
+                kind)
+
+
+def _fig5_claim(line_tab, findings_dir, panel):
+    """Fig. 5: the paper's least-squares line through the mean counts against r, beside
+    the other reading, the counts over kinetic theory's Γ(r)T (the paper study's)."""
+    sel = line_tab[line_tab["family"] == panel.name] if not line_tab.empty else line_tab
+    if sel.empty:
+        est, kind = (math.nan, math.nan, math.nan, "not run"), "not_tested"
+    else:
+        r = sel.iloc[0]
+        est, kind = (r["estimate"], r["ci_low"], r["ci_high"], r["verdict"]), "agreement"
+    other, note = (math.nan, math.nan, math.nan, "not read"), ""
+    if findings_dir is not None:
+        by = _finding(findings_dir, panel.name, "counts", "two_particle")
+        other, note = _get(by, "primary"), _controls_note(by)
+    return _row("Counts vs radius (line)", "linear fit reasonably good", "5", panel.name,
+                "two_particle", "RMS relative residual of the mean counts about their line",
+                "least-squares line of mean counts on r", est,
+                "counts / kinetic theory Γ(r)T (the paper study's)", other, False,
+                _decided(est, other, "reading (line → kinetic theory)", note), kind)
 
 
 def _closer(ratios, panel, reading):
     """|log R_poisson| - |log R_actual| under ``reading``: point, 95 % CI and verdict
-    (negative: the Poisson kicks are closer to the two-disk value). The verdict applies
-    the 10 % band to ``exp`` of the difference of the two log-distances, which for two
-    ratios on the same side of 1 is the ratio of the two kicked values: *equally close*
-    when they agree within 10 % (an equivalence test; not the ratio of the two distances,
-    which is unstable when both are small), *Poisson* / *actual closer* when the CI lies
-    beyond the band."""
+    (`kicktimes.studies.protocol.verdicts.closer_verdict`, margin `CLOSER_MARGIN`;
+    negative: the Poisson kicks are closer to the two-disk value). An inconclusive
+    verdict names the ICs at which the margin would be resolved
+    (`kicktimes.stats.equivalence_sample_size` from the resamples' standard error)."""
     _, op, dp = ratios.ratio(panel, "poisson", reading)
     _, oa, da = ratios.ratio(panel, "actual", reading)
     point = abs(math.log(op["ratio"])) - abs(math.log(oa["ratio"]))
     with np.errstate(invalid="ignore", divide="ignore"):
         diff = np.abs(np.log(dp)) - np.abs(np.log(da))
     lo, hi = percentile_interval(diff)
-    # exp(difference of log-distances): the ratio of the two kicked values, through the band
-    verdict = {"within 10 %": "equally close", "lower": "Poisson closer",
-               "higher": "actual closer"}.get(ratio_verdict(math.exp(lo), math.exp(hi)),
-                                              "inconclusive")
+    verdict = closer_verdict(lo, hi)
+    if verdict == "inconclusive":
+        n = equivalence_sample_size(float(np.nanstd(diff)), int(op["n_ics"]), CLOSER_MARGIN)
+        verdict = f"inconclusive ({n} ICs would resolve it)"
     return point, float(lo), float(hi), verdict
 
 
@@ -162,12 +236,19 @@ def _angle_ratio(ratios, panel, system, angle, estimator):
     return o1["ratio"] / o0["ratio"], float(lo), float(hi), ratio_verdict(lo, hi)
 
 
-def claims_table(ratios, ratio_tab, r1_tab, rr_tab, findings_dir, panels) -> pd.DataFrame:
+def claims_table(ratios, ratio_tab, r1_tab, rr_tab, findings_dir, panels, *,
+                 line_tab=None, fig4_tab=None) -> pd.DataFrame:
     """One row per claim of the paper: its words and figure, the reproduction by the
     paper's protocol (estimate, 95 % CI, verdict), the other reading, whether the verdict
-    is robust, and the choices that decide it. ``findings_dir``: the paper study's findings
-    tables at the same scale, or ``None`` (no count rows)."""
+    is robust, the choices that decide it, and "reproduces?" (`verdicts.reproduces`).
+    ``findings_dir``: the paper study's findings tables at the same scale, or ``None``
+    (their readings then say "not read"); ``line_tab`` / ``fig4_tab``: the Fig. 5 and
+    Fig. 4 lines (`tables.count_line_table`, `tables.fig4_table`), or ``None`` (the
+    paper's protocol is then "not tested" there)."""
     a, b = panels[0], panels[1]
+    empty = pd.DataFrame(columns=["family"])
+    line_tab = empty if line_tab is None else line_tab
+    fig4_tab = empty if fig4_tab is None else fig4_tab
     rows = [
         _ftle_claim(ratio_tab, a.name, "poisson", "FTLE, Poisson kicks",
                     "a good approximation", "6 top"),
@@ -197,8 +278,8 @@ def claims_table(ratios, ratio_tab, r1_tab, rr_tab, findings_dir, panels) -> pd.
             p.name, "poisson − actual", "|log R_Poisson| − |log R_actual| (FTLE)",
             reading_label(PAPER_READING), (point, lo, hi, verdict),
             reading_label(_RENORMALISED), alt,
-            verdict == alt[3] and verdict != "inconclusive",
-            "estimator → renormalised" if verdict != alt[3] else ""))
+            verdict == alt[3] and not verdict.startswith("inconclusive"),
+            "estimator → renormalised" if verdict != alt[3] else "", "poisson_better"))
     for p in panels:
         for angle, name in (("normal", "new direction"), ("gaussian", "rotation")):
             lit = _angle_ratio(ratios, p.name, "poisson", angle, "literal")
@@ -209,19 +290,12 @@ def claims_table(ratios, ratio_tab, r1_tab, rr_tab, findings_dir, panels) -> pd.
                 f"N(0, 1) as {name}", "similar qualitative results", f"Sec. IV A, {p.figure[5:]}",
                 p.name, "poisson", "FTLE ratio R(N(0, 1)) / R(uniform)",
                 f"literal/paper/shared/{angle}", lit, f"renormalised/paper/shared/{angle}", ren,
-                robust, "" if robust else f"estimator → renormalised ({why})"))
-    for p in panels if findings_dir is not None else ():
-        rows.append(_family_claim(
-            findings_dir, p.name, "reject@uniformity_ks", "two_particle", "primary",
-            "Poisson collision times", "Poisson-process kick times", "4",
-            "share of runs whose collision times reject uniformity (α = 0.05)",
-            other="elastic"))
-    for p in panels if findings_dir is not None else ():
-        rows.append(_family_claim(
-            findings_dir, p.name, "counts", "two_particle", "primary", "Counts vs radius",
-            "linear fit reasonably good", "5",
-            "counts / kinetic theory Γ(r)T (linear in r)"))
+                robust, "" if robust else f"estimator → renormalised ({why})", "agreement"))
+    rows += [_fig4_claim(fig4_tab, findings_dir, p) for p in panels]
+    rows += [_fig5_claim(line_tab, findings_dir, p) for p in panels]
     out = pd.DataFrame(rows)
+    out["reproduces"] = [reproduces(k, v) for k, v in zip(out["kind"], out["verdict"],
+                                                         strict=True)]
     out["interval"] = [format_interval(e, lo, hi) for e, lo, hi in
                        zip(out["estimate"], out["ci_low"], out["ci_high"], strict=True)]
     out["other_interval"] = [format_interval(e, lo, hi) for e, lo, hi in zip(

@@ -28,8 +28,10 @@ choices at uniform kicks, and under both N(0, 1) readings with the paper's measu
 shared twins; kicktimes' tangent-space value is the reference row. Beside the FTLE, each
 IC's lag-1 autocorrelation ``R_1`` of the boundary angles over ``[0, n tau]`` (the quantity
 of the paper's Fig. 8; diagnostic ``"r1"``), for the uniform kicks, and the recurrence rate
-of its Fig. 7 with and without the main diagonal (`rr_rows`). `CONVERGENCE` runs
-the paper's reading and Benettin's at ``T, 2T, 4T, 8T`` on a stated subset.
+of its Fig. 7 with and without the main diagonal (`rr_rows`), and, at the panel's
+smallest radius, the least-squares line of its Fig. 4 (`times_rows`: Poisson kick times
+against the two-disk collision times). `CONVERGENCE` runs the paper's reading and
+Benettin's at ``T, 2T, 4T, 8T`` on a stated subset.
 
 The kicks of an IC are drawn once per system and shared by every reading: Poisson times
 at the rate of the IC's own two-disk run (its collision count over the horizon, as
@@ -64,7 +66,7 @@ from kicktimes.fileio import atomic_write
 from kicktimes.schedules import Poisson
 
 __all__ = ["CHOICES", "COLUMNS", "CONVERGENCE", "D0", "EPS", "Panel", "compute_task",
-           "panels", "rr_rows", "run_rows", "tasks"]
+           "panels", "rr_rows", "run_rows", "tasks", "times_rows"]
 
 #: the paper's initial separation
 D0 = 1.0 / 5000.0
@@ -137,7 +139,8 @@ def panels(scale: str = "paper") -> tuple[Panel, ...]:
 def tasks(panel: Panel) -> list[tuple]:
     """The tasks of a panel: ``("main", radius, first IC, last IC + 1)`` for every radius
     and block of ICs, ``("convergence", radius, a, b)`` blocks of the convergence subset,
-    and ``("rr", radius, a, b)`` blocks of the recurrence rows."""
+    ``("rr", radius, a, b)`` blocks of the recurrence rows, and ``("times", r_min, 0,
+    n_ics)``, the Fig. 4 rows at the smallest radius (one cheap task)."""
     out = [("main", r, a, min(a + panel.block, panel.n_ics))
            for r in panel.radii for a in range(0, panel.n_ics, panel.block)]
     for r in panel.convergence_radii:
@@ -146,6 +149,7 @@ def tasks(panel: Panel) -> list[tuple]:
     # the recurrence rate: blocks of four times as many ICs (a cheap task)
     out += [("rr", r, a, min(a + 4 * panel.block, panel.n_ics))
             for r in panel.radii for a in range(0, panel.n_ics, 4 * panel.block)]
+    out.append(("times", min(panel.radii), 0, panel.n_ics))
     return out
 
 
@@ -257,6 +261,26 @@ def rr_rows(panel: Panel, radius: float, ic_index: int, ic: np.ndarray) -> list[
     return rows
 
 
+def times_rows(panel: Panel, radius: float, ic_index: int, ic: np.ndarray) -> list[tuple]:
+    """The rows of the paper's Fig. 4 (`COLUMNS`, system ``"poisson"``) of one IC: the
+    least-squares line through the points ``(t_k, s_k)``, the k-th two-disk collision time
+    against the k-th Poisson kick time (the main task's kicks, at the IC's own rate), for
+    ``k`` up to the shorter sequence; diagnostic ``"fig4_slope"`` its slope and
+    ``"fig4_r2"`` its coefficient of determination, ``n_kicks`` the points (NaN below 3)."""
+    horizon = panel.n_steps * panel.tau
+    two = simulate_two_particle(ic, radius, t_max=horizon)
+    kicks, _ = _kicks(panel, radius, ic_index, "poisson", two, horizon)
+    actual = np.asarray(two.pp_times, dtype=float)
+    k = min(actual.size, kicks.size)
+    slope = r2 = np.nan
+    if k >= 3:
+        slope, intercept = np.polyfit(actual[:k], kicks[:k], 1)
+        residual = kicks[:k] - (intercept + slope * actual[:k])
+        r2 = 1.0 - residual @ residual / np.sum((kicks[:k] - kicks[:k].mean()) ** 2)
+    return [(panel.name, radius, ic_index, "poisson", name, "-", "-", "-", "uniform", 1,
+             float(value), int(k)) for name, value in (("fig4_slope", slope), ("fig4_r2", r2))]
+
+
 def _r1(run, particle) -> float:
     """The paper's lag-1 autocorrelation ``R_1`` of the boundary angles over ``[0, T]``;
     NaN (kept in the rows, dropped from the ratios) for a constant series: an unkicked
@@ -275,8 +299,8 @@ def compute_task(panel: Panel, task: tuple, path: str | os.PathLike) -> float:
     factors = CONVERGENCE[1:] if kind == "convergence" else (1,)
     rows = []
     for i in range(a, b):
-        if kind == "rr":
-            rows.extend(rr_rows(panel, radius, i, ics[i]))
+        if kind in ("rr", "times"):
+            rows.extend((rr_rows if kind == "rr" else times_rows)(panel, radius, i, ics[i]))
             continue
         for f in factors:
             rows.extend(run_rows(panel, kind, radius, i, ics[i], f))

@@ -19,18 +19,26 @@ from kicktimes.fileio import atomic_write  # noqa: E402
 from kicktimes.render.pages import markdown_table, write_results_page  # noqa: E402
 from kicktimes.render.provenance import Source  # noqa: E402
 from kicktimes.stats import format_interval, paired_ratio  # noqa: E402
-from kicktimes.studies.protocol.claims import SMALL_RADIUS, SWITCHES, claims_table  # noqa: E402
+from kicktimes.studies.protocol.claims import SMALL_RADIUS, claims_table  # noqa: E402
 from kicktimes.studies.protocol.compute import D0, EPS, panels  # noqa: E402
 from kicktimes.studies.protocol.tables import (  # noqa: E402
     N_BOOT,
     PAPER_READING,
     Ratios,
     convergence_table,
+    count_line_table,
+    fig4_table,
     per_radius_table,
     r1_table,
     ratio_table,
     rr_table,
     shapley_table,
+)
+from kicktimes.studies.protocol.verdicts import (  # noqa: E402
+    CLOSER_MARGIN,
+    CLOSER_RULE,
+    REPRODUCES_RULE,
+    reproduces,
 )
 
 __all__ = ["FIGURE", "SOURCES", "build_page", "fig6_figure"]
@@ -41,6 +49,11 @@ FIGURE = "paper_fig06_ftle_both_readings.png"
 SOURCES = (
     Source("paper_claims.csv", "claim, figure, paper_says, estimate, interval, verdict, "
            "other_estimate, other_interval, other_verdict, decided_by", claims_table),
+    Source("paper_claims.csv", "reproduces", reproduces),
+    Source("paper_lines.csv", "diagnostic, radius, estimate, ci_low, ci_high, verdict, r2",
+           fig4_table),
+    Source("paper_lines.csv", "estimate, ci_low, ci_high, verdict, slope, intercept",
+           count_line_table),
     Source("paper_findings.csv", "control, estimate, ci_low, ci_high, verdict, robust, "
            "depends_on", ratio_table),
     Source("paper_findings.csv", "diagnostic, estimate, ci_low, ci_high, verdict", r1_table),
@@ -55,7 +68,10 @@ SOURCES = (
 )
 _SYSTEMS = (("two_particle", "Two Particle", "k", "o"), ("poisson", "Poisson", "C0", "s"),
             ("actual", "Actual", "C3", "^"))
-SWITCHES_NAMES = [name for name, _ in SWITCHES]
+#: the columns of paper_lines.csv (Figs. 4 and 5: `fig4_table`, `count_line_table`)
+LINE_COLUMNS = ["family", "figure", "diagnostic", "question", "radius", "estimate", "ci_low",
+                "ci_high", "verdict", "r2", "r2_ci_low", "r2_ci_high", "slope", "intercept",
+                "n_radii", "n_ics"]
 _COLUMNS = (("literal", "eq. (4) as printed (twin never renormalised)"),
             ("renormalised", "Benettin (twin renormalised every step)"))
 
@@ -65,13 +81,16 @@ def fig6_figure(by_radius: pd.DataFrame, panel_list):
     over ICs against the radius, with the paper's error bars (±SD/10) and, shaded, the
     95 % normal interval of the mean.
 
-    The Benettin column's y axis starts at 0. The eq.-(4)-as-printed column is zoomed on
-    its data (bars and bands included): there the systems differ by about 1.5 % of a value
-    near 37 (top) or 25 (bottom), which an axis from 0 flattens into one line; each zoomed
-    axis says so in its corner, with the value it starts at.
+    The Benettin column's y axis starts at 0 and is shared by both rows. The eq.-(4)-as-
+    printed column is zoomed on its data (bars and bands included): there the systems
+    differ by about 1.5 % of a value near 37 (top) or 25 (bottom), which an axis from 0
+    flattens into one line; every zoomed axis spans the same height (the largest any
+    panel needs), so equal gaps are equal differences in both rows, and says so in its
+    corner, with the value it starts at.
     """
     fig, axes = plt.subplots(len(panel_list), 2, figsize=(10, 7.5), layout="constrained",
                              squeeze=False)
+    zoom, top = {}, 0.0
     for i, p in enumerate(panel_list):
         for j, (estimator, title) in enumerate(_COLUMNS):
             ax = axes[i, j]
@@ -92,26 +111,35 @@ def fig6_figure(by_radius: pd.DataFrame, panel_list):
                 ax.errorbar(sel["radius"], sel["mean"], yerr=sel["paper_bar"], color=color,
                             marker=marker, ms=4, capsize=2, lw=1, label=label)
             ax.set_title(f"{p.figure} ({p.n_ics} ICs, n = {p.n_steps}, τ = {p.tau:g})\n{title}",
-                         fontsize=9)
+                         fontsize=10)
             ax.set_xlabel("disk radius r")
             ax.set_ylabel("λ_max(n)  [1 / time]" if estimator == "renormalised"
                           else "eq. (4) value  [1 / time]")
             if estimator == "renormalised":
-                # from 0, as a reader sets it beside the paper's: equal gaps look equal
-                ax.set_ylim(0.0, 1.15 * ax.get_ylim()[1])
+                top = max(top, np.nanmax(high) if np.isfinite(high).any() else 0.0)
             elif np.isfinite(low).any():
-                # from 0 the systems' 1.5 % difference vanishes: zoom, and say so on the axes
-                lo, hi = np.nanmin(low), np.nanmax(high)
-                pad = 0.15 * (hi - lo)
-                ax.set_ylim(lo - pad, hi + 3 * pad)  # room above for the legend
-                ax.text(0.02, 0.03, f"zoomed: y axis starts at {lo - pad:.3g}, not 0",
-                        transform=ax.transAxes, fontsize=8, ha="left", va="bottom",
-                        bbox={"boxstyle": "round", "fc": "lightyellow", "ec": "0.6"})
+                zoom[i] = (np.nanmin(low), np.nanmax(high))
             ax.xaxis.set_major_locator(MultipleLocator(0.005))
             ax.grid(alpha=0.3)
             if i == 0:
                 ax.legend(fontsize=8, loc="upper right" if j == 0 else "upper left",
                           title="bars ±SD/10 (paper); band 95 % CI", title_fontsize=7)
+    # from 0, as a reader sets it beside the paper's: equal gaps look equal; one x range
+    radii = [r for p in panel_list for r in p.radii]
+    pad = 0.04 * (max(radii) - min(radii)) or 0.001
+    for i in range(len(panel_list)):
+        axes[i, 1].set_ylim(0.0, 1.2 * top if top > 0 else 1.0)
+        for ax in axes[i]:
+            ax.set_xlim(min(radii) - pad, max(radii) + pad)
+    # zoomed, the same height in every row; room above for the legend
+    span = max((hi - lo for lo, hi in zoom.values()), default=0.0) * 1.6
+    for i, (lo, hi) in zoom.items():
+        start = 0.5 * (lo + hi) - 0.4 * span
+        axes[i, 0].set_ylim(start, start + span)
+        axes[i, 0].text(0.02, 0.03, f"zoomed: y axis starts at {start:.3g}, not 0; "
+                        f"height {span:.2g} in every row", transform=axes[i, 0].transAxes,
+                        fontsize=8, ha="left", va="bottom",
+                        bbox={"boxstyle": "round", "fc": "lightyellow", "ec": "0.6"})
     return fig
 
 
@@ -120,80 +148,146 @@ def _cell(row, prefix=""):
                            row[f"{prefix}ci_high"])
 
 
+def _g(x, digits=3) -> str:
+    return f"{x:#.{digits}g}".rstrip(".")
+
+
 def _span(frame, column="estimate"):
     values = frame if isinstance(frame, pd.Series) else frame[column]
-    lo, hi = values.min(), values.max()
-    return f"{lo:.3g}" if f"{lo:.3g}" == f"{hi:.3g}" else f"{lo:.3g}–{hi:.3g}"
+    lo, hi = _g(values.min()), _g(values.max())
+    return lo if lo == hi else f"{lo}–{hi}"
+
+
+def _envelope(frame, prefix="", scale=1.0):
+    """"[lowest CI end, highest CI end]" of the rows' 95 % CIs, with the digits that keep
+    the two ends apart."""
+    lo = scale * frame[f"{prefix}ci_low"]
+    hi = scale * frame[f"{prefix}ci_high"]
+    lo, hi = (hi.min(), lo.max()) if scale < 0 else (lo.min(), hi.max())
+    digits = next((d for d in range(3, 7) if _g(lo, d) != _g(hi, d)), 7)
+    return f"[{_g(lo, digits)}, {_g(hi, digits)}]"
 
 
 def _verdicts(frame, column="verdict"):
-    return " / ".join(dict.fromkeys(frame[column]))
+    return " / ".join(dict.fromkeys(str(v) for v in frame[column]))
 
 
-def _reproduces(frame, want="within 10 %") -> str:
-    """"reproduces" when every row's verdict is ``want``, "undecided" when every one is
-    inconclusive, "does not reproduce" when none is ``want`` or inconclusive, else
-    "partly" (per-radius counts: their most frequent verdict)."""
-    verdicts = [str(v).split(" at ")[0] for v in frame["verdict"]]
-    if all(v == want for v in verdicts):
-        return "reproduces"
-    if all(v == "inconclusive" for v in verdicts):
-        return "undecided"
-    if not any(v in (want, "inconclusive") for v in verdicts):
-        return "does not reproduce"
-    return "partly"
+def _short(frame, column="verdict"):
+    """The rows' verdicts, each once, without their parenthesised detail."""
+    return " / ".join(dict.fromkeys(str(v).split(" (")[0] for v in frame[column]))
 
 
-def _first_screen(claims: pd.DataFrame, conv: pd.DataFrame, rr_tab: pd.DataFrame,
+def _answer(frame) -> str:
+    """The rows' "reproduces?" answers, each once (`verdicts.reproduces`)."""
+    return _verdicts(frame, "reproduces")
+
+
+def _first_screen(claims: pd.DataFrame, rr_tab: pd.DataFrame,
                   by_radius: pd.DataFrame) -> list[str]:
-    """One line per claim: whether it reproduces by the paper's protocol, the numbers, and
-    what decides it."""
+    """At most five one-line answers: whether each claim reproduces by the paper's
+    protocol, its numbers with their 95 % CIs, and the caveat."""
     def rows(prefix):
         return claims[claims["claim"].str.startswith(prefix)]
 
-    ftle, rr, balloon = rows("FTLE"), rows("RR, small"), rows("RR, larger")
-    acf, closer, angles, counts = (rows("ACF"), rows("Poisson vs"), rows("N(0, 1)"),
-                                   rows("Counts"))
-    times = rows("Poisson collision")
-    lit_end = conv[(conv["estimator"] == "literal") & (conv["horizon"] == conv["horizon"].max())]
-    decisive = [name for name in SWITCHES_NAMES
-                if all(name in d.split("; ") for d in ftle["decided_by"])]
-    estimator = SWITCHES_NAMES[0] in decisive
-    decided = ("Decided by the estimator" if estimator else
-               f"Decided by {' and '.join(decisive)}" if decisive else
-               "No single switch changes every panel's verdict")
-    mechanism = ("the twins saturate and eq. (4) measures log(d_sat/d0)/τ "
-                 "(two-disk {} at 8T)").format(_span(lit_end, "two_particle_mean"))
+    ftle, acf, closer = rows("FTLE"), rows("ACF"), rows("Poisson vs")
+    fig4, fig5 = rows("Poisson kick times"), rows("Counts vs radius")
+    in_paper = claims["kind"] != "not_in_paper"
+    rr = claims[claims["claim"].str.startswith("RR, small") & in_paper]
+    balloon = claims[claims["claim"].str.startswith("RR, larger") & in_paper]
     r1 = by_radius[by_radius["diagnostic"] == "r1"]
-    diagonal = rr_tab["diagonal_share"].dropna()
+    only = ((ftle["reproduces"] == "yes").all()
+            and (ftle["other_verdict"] != ftle["verdict"]).all())
+    lead = ("reproduces only by eq. (4) as printed, which never renormalises its twins" if only
+            else f"by eq. (4) as printed (twins never renormalised): {_answer(ftle)}")
     out = [
-        f"- **FTLE, Fig. 6** {_reproduces(ftle)}: eq. (4) as printed gives kicked/two-disk "
-        f"{_span(ftle)} ({_verdicts(ftle)}); renormalised (Benettin) "
-        f"{_span(ftle, 'other_estimate')} ({_verdicts(ftle, 'other_verdict')}). {decided}"
-        f"{': ' + mechanism if estimator else ''}.",
-
-        f"- **ACF, Fig. 8** {_reproduces(acf)}: R₁ ratio {_span(acf)} ({_verdicts(acf)}), "
-        f"but R₁ is {_span(r1, 'mean')} everywhere; 1 − R₁ "
+        f"- **FTLE (Fig. 6)** {lead}: kicked/two-disk {_span(ftle)}, CIs in {_envelope(ftle)}; "
+        f"renormalised, like the README's tangent FTLE, {_span(ftle, 'other_estimate')} "
+        f"({_verdicts(ftle, 'other_verdict')}).",
+        f"- **ACF (Fig. 8)** {_answer(acf)}: R₁ ratio {_span(acf)}, CIs in {_envelope(acf)}, "
+        f"but R₁ is {_span(r1, 'mean')} everywhere; 1 − R₁ over t ≤ nτ "
         f"{_span(acf, 'other_estimate')} ({_verdicts(acf, 'other_verdict')}).",
-        f"- **Poisson vs actual** {_reproduces(closer, 'Poisson closer')}: "
-        f"{_verdicts(closer)} (|log R| differs by {_span(-closer['estimate'])}; "
-        f"renormalised, {_span(-closer['other_estimate'])}).",
-        f"- **N(0, 1) angles** {_reproduces(angles)}: {_verdicts(angles)} (eq. (4)).",
+        f"- **Poisson vs actual (Sec. IV)** {_answer(closer)}: {_short(closer)} (m = "
+        f"{CLOSER_MARGIN:g}), |d| = {_span(closer['estimate'].abs())}, CIs in "
+        f"{_envelope(closer, scale=-1)}; renormalised {_span(closer['other_estimate'].abs())} "
+        f"({_short(closer, 'other_verdict')}).",
     ]
     if not rr.empty and not balloon.empty:
-        bulge = "a balloon" if (balloon["verdict"] == "lower").any() else "no balloon"
+        diagonal = rr_tab.loc[rr_tab["figure"].str.startswith("Fig. 7"), "diagonal_share"]
         out.insert(1, (
-            f"- **RR, Fig. 7** {_reproduces(rr)} at small radii: with the diagonal (as "
-            f"printed) {_span(rr)} ({_verdicts(rr)}; {bulge} at larger radii), but the "
-            f"diagonal is {_span(100 * diagonal)} % of the two-disk RR; off it, "
-            f"{_span(rr, 'other_estimate')} ({_verdicts(rr, 'other_verdict')})."))
-    if counts.empty:
-        return [*out, "- **Figs. 4–5**: not stated; they need the paper study's findings "
-                "tables (`--findings`)."]
-    return [*out, f"- **Figs. 4–5** {_reproduces(times, 'nominal')} / "
-                  f"{_reproduces(counts)}: {_span(100 * times['estimate'])} % of runs reject "
-                  f"Poisson times ({_verdicts(times)}); counts/kinetic theory {_span(counts)} "
-                  f"({_verdicts(counts)})."]
+            f"- **RR (Fig. 7, panel A)**: small radii {_answer(rr)}, {_span(rr)}, CIs in "
+            f"{_envelope(rr)} (the diagonal is {_span(100 * diagonal.dropna())} % of the RR); "
+            f"balloon {_answer(balloon)}: {_span(balloon)}, CIs in {_envelope(balloon)}, "
+            f"{_verdicts(balloon)}."))
+    tested4 = fig4[fig4["kind"] != "not_tested"]
+    tested5 = fig5[fig5["kind"] != "not_tested"]
+    parts = []
+    if not tested4.empty:
+        parts.append(f"Fig. 4's slope {_span(tested4)}, CIs in {_envelope(tested4)}")
+    if not tested5.empty:
+        parts.append(f"Fig. 5's RMS residual {_span(tested5)}, CIs in {_envelope(tested5)}")
+    other = fig4.dropna(subset=["other_estimate"])
+    caveat = (f"; yet {_span(100 * other['other_estimate'])} % of runs reject uniform "
+              f"times ({_verdicts(other, 'other_verdict')})") if not other.empty else ""
+    out.append(f"- **Figs. 4–5 (lines)** {_answer(fig4)} / {_answer(fig5)}: "
+               f"{'; '.join(parts) or 'not run'}{caveat}.")
+    return out
+
+
+def _paper_study(findings_dir, panel_list, diagnostic):
+    """The paper study's primary Poisson and actual rows of ``diagnostic`` (the README's
+    numbers), or an empty frame without ``findings_dir``."""
+    if findings_dir is None:
+        return pd.DataFrame(columns=["estimate"])
+    frames = [pd.read_csv(Path(findings_dir) / f"{p.name}_findings.csv") for p in panel_list]
+    table = pd.concat(frames, ignore_index=True)
+    return table[(table["diagnostic"] == diagnostic) & (table["control"] == "primary")
+                 & table["system"].isin(["poisson", "actual"])]
+
+
+def _notes(claims, conv, shapley_src, findings_dir, panel_list) -> list[str]:
+    """The rules and caveats under the claims table, generated from the tables."""
+    lit_end = conv[(conv["estimator"] == "literal") & (conv["horizon"] == conv["horizon"].max())]
+    ftle = claims[claims["claim"].str.startswith("FTLE")]
+    acf = claims[claims["claim"].str.startswith("ACF")]
+    readme_acf = _paper_study(findings_dir, panel_list, "one_minus_r1")
+    readme_ftle = _paper_study(findings_dir, panel_list, "ftle")
+    out = [
+        f"*Verdicts* (95 % CIs, bootstrap clustered on ICs, {N_BOOT} resamples shared by "
+        "every reading): a ratio inside [0.9, 1.1] is *within 10 %* (equivalence, margin "
+        "`kicktimes.stats.MARGIN`), beyond it *higher* / *lower*, else *inconclusive*. "
+        "*Poisson vs actual*: " + CLOSER_RULE + ". *The balloon* (Fig. 7 top: the two-disk "
+        "RR above the kicked ones at larger radii) is a sign: a ratio's CI below 1 is "
+        "*balloon*, above 1 *no balloon* (`verdicts.balloon_verdict`). " + REPRODUCES_RULE
+        + ".",
+        "",
+        "*The paper's protocol* (Sec. III C): eq. (4), λ_max(n) = 1/(τn) Σₖ "
+        f"log(‖δd(kτ)‖/‖δd(0)‖), ‖δd(0)‖ = 1/{1 / D0:.0f}, x and y measured separately, the "
+        "larger kept, n collision-truncated steps of τ, read as printed "
+        f"({'/'.join(PAPER_READING)}: estimator, measure, twin kicks, kick angle); *Other "
+        "reading* renormalises the twins; *Decided by*: the single switches that change the "
+        "verdict. Never renormalised, the twins saturate and eq. (4) measures "
+        f"log(d_sat/d0)/τ (two-disk {_span(lit_end, 'two_particle_mean')} at 8T): the FTLE "
+        f"reproduces by that reading only ({_span(ftle)}); renormalised it is "
+        f"{_span(ftle, 'other_estimate')}"
+        + (f", the paper study's tangent-space ratio (the README's) {_span(readme_ftle)}"
+           if not readme_ftle.empty else "") + ".",
+        "",
+        f"*RR*: the paper's RR (all pairs, the diagonal included) at ε = {EPS:g} on its "
+        f"steps, and off the diagonal; small radii r ≤ {SMALL_RADIUS:g} (not given by the "
+        "paper). Fig. 7 shows panel A only, so panel B's RR rows are *not in the paper*. "
+        "*ACF*: the mean R₁ the paper plots, and 1 − R₁, both over t ≤ nτ for every "
+        "system"
+        + (f" ({_span(acf, 'other_estimate')}); the paper study's 1 − R₁ ratios (the "
+           f"README's, {_span(readme_acf)}) end each run after its n collision-truncated "
+           "steps instead, a window that depends on the system (both disks' boundary "
+           "collisions truncate the two-disk steps)" if not readme_acf.empty else "") + ". "
+        "*Figs. 4–5*: the paper's least-squares lines (Fig. 4: each IC's Poisson kick "
+        "times on its collision times at the smallest radius, slope averaged over ICs; "
+        "Fig. 5: the mean counts against r, their RMS relative residual read in the 10 % "
+        "band) in [paper_lines.csv](paper_lines.csv); the other readings are the paper "
+        "study's uniformity test and Γ(r)T, under its controls.",
+    ]
+    return out
 
 
 def build_page(rows: pd.DataFrame, results_dir: str | os.PathLike, findings_dir: str |
@@ -213,11 +307,15 @@ def build_page(rows: pd.DataFrame, results_dir: str | os.PathLike, findings_dir:
     shapley = shapley_table(ratios, panel_list)
     conv = convergence_table(rows, panel_list)
     rr_tab = rr_table(rows, panel_list, SMALL_RADIUS)
-    claims = claims_table(ratios, ratio_tab, r1_tab, rr_tab, findings_dir, panel_list)
+    line_tab, fig4_tab = count_line_table(rows, panel_list), fig4_table(rows, panel_list)
+    claims = claims_table(ratios, ratio_tab, r1_tab, rr_tab, findings_dir, panel_list,
+                          line_tab=line_tab, fig4_tab=fig4_tab)
     findings = pd.concat([ratio_tab, r1_tab, rr_tab], ignore_index=True)
+    lines_csv = pd.concat([fig4_tab, line_tab], ignore_index=True).reindex(
+        columns=LINE_COLUMNS)
     tables = {"paper_findings.csv": findings, "paper_by_radius.csv": by_radius,
               "paper_shapley.csv": shapley, "paper_convergence.csv": conv,
-              "paper_claims.csv": claims}
+              "paper_claims.csv": claims, "paper_lines.csv": lines_csv}
     for name, frame in tables.items():
         atomic_write(out / name, lambda tmp, frame=frame: frame.to_csv(tmp, index=False))
     fig = fig6_figure(by_radius, panel_list)
@@ -233,9 +331,13 @@ def build_page(rows: pd.DataFrame, results_dir: str | os.PathLike, findings_dir:
         "Claim": [f"{r.claim} ({r.family[-1].upper()})" for r in claims.itertuples()],
         "Fig.": claims["figure"],
         "Paper says": claims["paper_says"],
-        "By its protocol": claims["interval"],
+        "By its protocol": [i if k != "not_tested" else "not run" for i, k in
+                            zip(claims["interval"], claims["kind"], strict=True)],
         "Verdict": claims["verdict"],
-        "Other reading": [f"{r.other_interval} {r.other_verdict}" for r in claims.itertuples()],
+        "reproduces?": claims["reproduces"],
+        "Other reading": [f"{r.other_interval} {r.other_verdict}"
+                          if np.isfinite(r.other_estimate) else "not read"
+                          for r in claims.itertuples()],
         "Decided by": [r.decided_by or "no switch" for r in claims.itertuples()],
     })
     shares = pd.DataFrame({
@@ -262,46 +364,26 @@ def build_page(rows: pd.DataFrame, results_dir: str | os.PathLike, findings_dir:
         "# Ranković & Porter's claims by their own protocol (generated)", "",
         f"Generated {now} by kicktimes {__version__} (`{command}`) from {n_rows} rows"
         f"{' of ' + store if store else ''}{also}, by the paper's eq. (4).", "",
-        *_first_screen(claims, conv, rr_tab, by_radius), "",
+        *_first_screen(claims, rr_tab, by_radius), "",
         *markdown_table(main_table), "",
-        f"Verdicts: the 95 % CI of a ratio (bootstrap clustered on ICs, {N_BOOT} resamples) "
-        "inside [0.9, 1.1] is *within 10 %*, an equivalence test; entirely above or below "
-        "is *higher* / *lower*; otherwise *inconclusive* (`kicktimes.stats.ratio_verdict`). "
-        "*Robust* means every reading of the protocol gives the same verdict. The paper's "
-        "protocol (Sec. III C): eq. (4), λ_max(n) = 1/(τn) Σₖ log(‖δd(kτ)‖/‖δd(0)‖) with "
-        f"‖δd(0)‖ = 1/{1 / D0:.0f}, x and y perturbed and measured separately on the "
-        "positions, the larger exponent kept, n collision-truncated steps of τ, read "
-        f"as printed ({'/'.join(PAPER_READING)}: estimator, measure, twin kicks, kick "
-        "angle); the other reading renormalises the twins. *Decided by*: the single "
-        "switches away from the paper's protocol that change the verdict. The ACF rows "
-        "compare the mean R₁ the paper plots, and kicktimes' 1 − R₁; the RR rows the paper's "
-        f"RR (all pairs, the main diagonal included) at ε = {EPS:g} on its steps, and the "
-        f"RR off the diagonal, at r ≤ {SMALL_RADIUS:g} (the paper's small radii are not "
-        "given) and above (where the paper sees a balloon, a ratio < 1); one control each. "
-        "*Poisson vs actual*: d = |ln R_poisson| − |ln R_actual|, the difference of the "
-        "two log-distances from 1, and the 10 % band on exp(d) (for two ratios on the same "
-        "side of 1 it is the ratio of the two kicked values: equally close when the Poisson- "
-        "and actual-kicked values agree within 10 %; a CI of d that excludes 0 inside the "
-        "band is a real but smaller difference). The count rows come from the paper "
-        "study's findings, under its controls.", "",
+        *_notes(claims, conv, shapley, findings_dir, panel_list), "",
         "## Fig. 6, both readings", "",
         f"![Fig. 6 reproduced]({FIGURE})", "",
-        "Left: eq. (4) as printed; right: Benettin's algorithm. Rows: the paper's two "
-        f"panels ({p0.n_ics} ICs, n = {p0.n_steps}, τ = {p0.tau:g}; "
+        "Left: eq. (4) as printed, zoomed (every panel of the column spans the same "
+        "height, so equal gaps are equal differences); right: Benettin's algorithm, one y "
+        "axis from 0 for both rows. Rows: the paper's two panels "
+        f"({p0.n_ics} ICs, n = {p0.n_steps}, τ = {p0.tau:g}; "
         f"{panel_list[1].n_ics} ICs, n = {panel_list[1].n_steps}, τ = {panel_list[1].tau:g}). "
-        "Bars: ±SD/10, the paper's; bands: 95 % CI of the mean. The paper's bars are what "
-        "its figure could resolve; the per-radius means, SDs and ratios are in "
-        "[paper_by_radius.csv](paper_by_radius.csv).", "",
+        "Bars: ±SD/10, the paper's; bands: 95 % CI of the mean. Means, SDs and ratios per "
+        "radius: [paper_by_radius.csv](paper_by_radius.csv).", "",
         "## Which choice decides the ratio", "",
-        "Shapley shares of the change in the ratio's distance from 1, |log R|, from "
-        "kicktimes' reading (renormalised, x/y measure, shared kicks: distance "
-        f"{_span(shapley, 'distance_from')}) to the reading with all three switched "
-        f"(literal, norm, independent: {_span(shapley, 'distance_to')}); a negative share "
-        "brings R towards 1. 95 % CIs from the same IC resamples "
-        "([paper_shapley.csv](paper_shapley.csv)); a share whose CI contains 0 is inside "
-        "its noise and is not read. The twin-kick share is not agreement: under Benettin, "
-        "twins with their own kicks overshoot, "
-        f"{_span(overshoot)} ({_verdicts(overshoot)}), where twins sharing them give "
+        "Shapley shares of the change in |log R|, from kicktimes' reading (renormalised, "
+        f"x/y measure, shared kicks: {_span(shapley, 'distance_from')}) to all three "
+        f"switched (literal, norm, independent: {_span(shapley, 'distance_to')}); negative "
+        "brings R towards 1; CIs from the same IC resamples "
+        "([paper_shapley.csv](paper_shapley.csv)); a share whose CI contains 0 is not read. "
+        "The twin-kick share is not agreement: under Benettin, twins with their own kicks "
+        f"give {_span(overshoot)} ({_verdicts(overshoot)}), sharing them "
         f"{_span(shared)} ({_verdicts(shared)}).", "",
         *markdown_table(shares), "",
         "## Convergence: the same ratios at T, 2T, 4T, 8T", "",

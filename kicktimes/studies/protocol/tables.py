@@ -33,6 +33,7 @@ from kicktimes.stats import (
     paired_ratio,
     percentile_interval,
     ratio_verdict,
+    resample_indices,
     robust_verdict,
     shapley_values,
 )
@@ -40,8 +41,8 @@ from kicktimes.stats.findings import share_verdict
 from kicktimes.studies.protocol.compute import CONVERGENCE
 
 __all__ = ["BOOT_SEED", "FACTORS", "N_BOOT", "PAPER_READING", "Ratios", "convergence_table",
-           "per_radius_table", "r1_table", "ratio_table", "reading_label", "rr_table",
-           "shapley_table"]
+           "count_line_table", "fig4_table", "figure_of", "per_radius_table", "r1_table",
+           "ratio_table", "reading_label", "rr_table", "shapley_table"]
 
 N_BOOT = 2000
 BOOT_SEED = 48
@@ -57,6 +58,30 @@ _KICKED = ("poisson", "actual")
 def reading_label(reading) -> str:
     """A reading as a short name, e.g. ``literal/paper/shared/uniform``."""
     return "/".join(str(x) for x in reading)
+
+
+def figure_of(panel, number: int, *, small: bool | None = None) -> str:
+    """The paper's figure of a panel's diagnostic: ``"Fig. 6 top"`` (FTLE, ``number`` 6)
+    and ``"Fig. 8 bottom"`` (autocorrelation, 8) follow the panel; the recurrence rate's
+    Fig. 7 (``number`` 7) shows family A only, all radii on top and the small radii
+    (``small``) at the bottom, so family B's RR has no figure (``"none (Fig. 7: A only)"``).
+
+    Examples
+    --------
+    >>> from kicktimes.studies.protocol.compute import panels
+    >>> a, b = panels("quick")
+    >>> figure_of(a, 8), figure_of(a, 7, small=True), figure_of(b, 7, small=False)
+    ('Fig. 8 top', 'Fig. 7 bottom', 'none (Fig. 7: A only)')
+    """
+    if number not in (6, 7, 8):
+        raise ValueError(f"number must be 6, 7 or 8 (the paper's Figs. 6-8), got {number!r}")
+    if number != 7:
+        return panel.figure.replace("Fig. 6", f"Fig. {number}")
+    if small is None:
+        raise ValueError("small: the RR's panel of Fig. 7 depends on the radii (True/False)")
+    if panel.figure != "Fig. 6 top":
+        return "none (Fig. 7: A only)"
+    return "Fig. 7 bottom" if small else "Fig. 7 top"
 
 
 def _two_disk_reading(reading):
@@ -165,8 +190,9 @@ def r1_table(rows: pd.DataFrame, panels) -> pd.DataFrame:
                 _, overall = paired_ratio(a, b, rng=np.random.default_rng(BOOT_SEED),
                                           n_boot=N_BOOT, resamples=resamples)
                 lo, hi = overall["ci_low"], overall["ci_high"]
-                out.append({"family": p.name, "figure": p.figure, "diagnostic": diagnostic,
-                            "question": "autocorrelation of the boundary angles",
+                out.append({"family": p.name, "figure": figure_of(p, 8),
+                            "diagnostic": diagnostic,
+                            "question": "autocorrelation of the boundary angles, t ≤ nτ",
                             "system": system, "control": "paper_protocol",
                             "estimate": overall["ratio"], "ci_low": lo, "ci_high": hi,
                             "verdict": ratio_verdict(lo, hi), "robust": False,
@@ -207,7 +233,8 @@ def rr_table(rows: pd.DataFrame, panels, small_radius: float) -> pd.DataFrame:
                     lo, hi = overall["ci_low"], overall["ci_high"]
                     per = per_r[per_r["radius"].isin(radii)]
                     out.append({
-                        "family": p.name, "figure": p.figure, "diagnostic": diagnostic,
+                        "family": p.name, "figure": figure_of(p, 7, small=name == "small_radii"),
+                        "diagnostic": diagnostic,
                         "question": "recurrence rate on the paper's steps",
                         "system": system, "control": name,
                         "radii": f"{min(radii):g}-{max(radii):g}",
@@ -220,6 +247,77 @@ def rr_table(rows: pd.DataFrame, panels, small_radius: float) -> pd.DataFrame:
                         "diagonal_share": float((1.0 / (p.n_steps + 1) / two).mean())
                         if measure == "with_diagonal" else math.nan,
                     })
+    return pd.DataFrame(out)
+
+
+def _counts(rows, panel, diagnostic="r1", system="two_particle", column="n_kicks"):
+    """(radii, matrix radius x IC) of ``column`` of one panel's rows."""
+    sel = rows[(rows["panel"] == panel.name) & (rows["diagnostic"] == diagnostic)
+               & (rows["system"] == system) & (rows["horizon"] == 1)]
+    wide = sel.pivot_table(index="radius", columns="ic", values=column).sort_index()
+    return wide.index.to_numpy(float), wide.to_numpy(float)
+
+
+def count_line_table(rows: pd.DataFrame, panels) -> pd.DataFrame:
+    r"""The paper's Fig. 5 by its protocol, per panel: the least-squares line through the
+    mean two-disk collision count over ``[0, n tau]`` at each radius, :math:`\bar N(r)
+    \approx a + b r`, and how far the means lie from it: the RMS relative residual
+
+    .. math:: s = \Big[\frac{1}{R} \sum_r \big(\bar N(r) / (a + b r) - 1\big)^2\Big]^{1/2},
+
+    with its 95 % CI over IC resamples (the line refitted in each). Verdict: ``s`` read in
+    the 10 % band, `kicktimes.stats.ratio_verdict` on ``1 + s`` (*within 10 %*: the CI of
+    ``s`` lies below 0.1, the means within 10 % of their line in RMS; *higher*: above it).
+    A panel with fewer than 3 radii has no row (a line through 2 points fits exactly)."""
+    out = []
+    for p in panels:
+        radii, counts = _counts(rows, p)
+        if radii.size < 3:
+            continue
+        if not np.isfinite(counts).all():
+            raise ValueError(f"rows: panel {p.name} has a missing or non-finite count")
+        idx = resample_indices(counts.shape[1], N_BOOT, np.random.default_rng(BOOT_SEED),
+                               with_identity=True)
+        means = counts[:, idx].mean(axis=2).T  # (1 + B, radii)
+        design = np.column_stack([np.ones_like(radii), radii])
+        coef = np.linalg.lstsq(design, means.T, rcond=None)[0]  # (2, 1 + B)
+        rms = np.sqrt(((means / (design @ coef).T - 1.0) ** 2).mean(axis=1))
+        lo, hi = percentile_interval(rms[1:])
+        out.append({"family": p.name, "figure": "Fig. 5", "diagnostic": "count_line",
+                    "question": "RMS relative residual of the mean counts about their line",
+                    "estimate": float(rms[0]), "ci_low": float(lo), "ci_high": float(hi),
+                    "verdict": ratio_verdict(1.0 + lo, 1.0 + hi),
+                    "intercept": float(coef[0, 0]), "slope": float(coef[1, 0]),
+                    "n_radii": int(radii.size), "n_ics": int(counts.shape[1])})
+    return pd.DataFrame(out)
+
+
+def fig4_table(rows: pd.DataFrame, panels) -> pd.DataFrame:
+    """The paper's Fig. 4 by its protocol, per panel at its smallest radius: the mean over
+    ICs of the slope of the least-squares line of the Poisson kick times against the
+    two-disk collision times (`compute.times_rows`), with its 95 % CI (bootstrap over ICs)
+    and `kicktimes.stats.ratio_verdict` (the kicks keep the collisions' pace within 10 %),
+    and beside it the mean R² of those lines with its CI. A panel without a finite Fig. 4
+    row (no rows, or every IC with fewer than 3 collisions) has no row."""
+    out = []
+    for p in panels:
+        values, n = {}, 0
+        for name in ("fig4_slope", "fig4_r2"):
+            radii, v = _counts(rows, p, name, "poisson", "lam")
+            if radii.size == 0:
+                break
+            v = v[0][np.isfinite(v[0])]
+            n = n or v.size
+            idx = resample_indices(v.size, N_BOOT, np.random.default_rng(BOOT_SEED))
+            values[name] = (float(v.mean()), *percentile_interval(v[idx].mean(axis=1)))
+        if len(values) < 2:
+            continue
+        (est, lo, hi), (r2, r2_lo, r2_hi) = values["fig4_slope"], values["fig4_r2"]
+        out.append({"family": p.name, "figure": "Fig. 4", "diagnostic": "fig4_slope",
+                    "question": "slope of Poisson kick times on collision times",
+                    "radius": float(radii[0]), "estimate": est, "ci_low": float(lo),
+                    "ci_high": float(hi), "verdict": ratio_verdict(lo, hi), "r2": r2,
+                    "r2_ci_low": float(r2_lo), "r2_ci_high": float(r2_hi), "n_ics": int(n)})
     return pd.DataFrame(out)
 
 
