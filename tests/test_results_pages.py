@@ -12,7 +12,14 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
-from kicktimes.stats import poisson_verdict, ratio_verdict, rejection_verdict
+from kicktimes.report.controls import SHAPE_MARGIN
+from kicktimes.stats import (
+    D_MARGIN,
+    null_verdict,
+    poisson_verdict,
+    ratio_verdict,
+    rejection_verdict,
+)
 
 RESULTS = Path(__file__).resolve().parents[1] / "docs" / "results"
 TABLES = sorted(RESULTS.glob("*_findings.csv"))
@@ -31,25 +38,58 @@ def test_every_verdict_is_the_one_its_interval_gives(path):
     for row in table[~poisson].itertuples():
         assert row.verdict == ratio_verdict(row.ci_low, row.ci_high), row
     # the Poisson rows: each share against its test's level in null_calibration.csv (the
-    # runs' own Poisson control streams; alpha for the first-collisions row), D in the
-    # ratio band, and the one standard of the two
+    # runs' own Poisson control streams; alpha for the first-collisions row); D, the first
+    # hazard bin and the gamma shape against their control streams' values (the paired
+    # difference, the <statistic>_excess row); the one standard of the share and D
     null = pd.read_csv(RESULTS / "null_calibration.csv")
-    null = null[null["study"] == "paper"].set_index(["data", "test"])["share"]
+    null = null[(null["study"] == "paper") & (null["statistic"] == "rejection share")]
+    null = null.set_index(["data", "test"])["value"]
     rows = table[poisson]
+    margins = {"dispersion_index": D_MARGIN, "hazard_first": SHAPE_MARGIN,
+               "gamma_shape": SHAPE_MARGIN}
     for row in rows.itertuples():
         data = row.family if row.control == "primary" else f"{row.family}-{row.control}"
         kind, _, test = row.diagnostic.partition("@")
+        base = kind.removesuffix("_excess")
         if kind == "reject":
             level = null.get((data, test), 0.05)
             assert row.verdict == rejection_verdict(row.ci_low, row.ci_high, level), row
-        elif kind == "dispersion_index":
-            assert row.verdict == ratio_verdict(row.ci_low, row.ci_high), row
+        elif base in margins:
+            excess = rows[(rows["diagnostic"] == f"{base}_excess")
+                          & (rows["control"] == row.control)].iloc[0]
+            assert row.verdict == null_verdict(excess.ci_low, excess.ci_high,
+                                               margins[base]), row
         else:
             assert kind == "poisson", row
-            d = rows[(rows["diagnostic"] == "dispersion_index")
+            d = rows[(rows["diagnostic"] == "dispersion_index_excess")
                      & (rows["control"] == row.control)].iloc[0]
             assert row.verdict == poisson_verdict(row.ci_low, row.ci_high, null[data, test],
-                                                  d.ci_low, d.ci_high), row
+                                                  d.ci_low, d.ci_high, against_null=True), row
+
+
+@pytest.mark.parametrize("path", FAMILIES, ids=[t.name for t in FAMILIES])
+def test_every_d_verdict_names_its_null_value(path):
+    """No page reads D against 1 where its null is not 1: every D row of the two-disk
+    findings says the value of its null streams, and that value is in null_calibration.csv."""
+    table = _table(path)
+    null = pd.read_csv(RESULTS / "null_calibration.csv")
+    null = null[(null["study"] == "paper") & (null["statistic"] == "D")]
+    d = table[table["diagnostic"] == "dispersion_index"]
+    assert len(d) >= 4  # the rule x IC design
+    for row in d.itertuples():
+        data = row.family if row.control == "primary" else f"{row.family}-{row.control}"
+        value = null.loc[null["data"] == data, "value"].iloc[0]
+        assert f"its null (the runs' Poisson control streams) {value:.3g} [" in row.detail, row
+
+
+def test_every_page_is_short_and_opens_with_at_most_five_answers():
+    for page in sorted(RESULTS.glob("*.md")):
+        text = page.read_text(encoding="utf-8")
+        words = len(text.split())
+        assert words <= (1500 if page.name == "README.md" else 2500), (page.name, words)
+        head = text.split("\n|", 1)[0]
+        bullets = [line for line in head.splitlines() if line.startswith(("- ", "* "))]
+        assert len(bullets) <= 5, (page.name, bullets)
 
 
 @pytest.mark.parametrize("path", TABLES, ids=[t.name for t in TABLES])
@@ -79,12 +119,13 @@ def test_every_kicked_system_is_under_every_control(path):
         poisson["control"])
 
 
-def test_the_first_screen_is_short_and_generated():
+def test_the_first_screen_is_five_answers_and_generated():
     text = (RESULTS / "README.md").read_text(encoding="utf-8")
     assert "\nGenerated " in text
     screen = text.split("## The answers", 1)[1].lstrip("\n")
-    prose = screen.split("\n|", 1)[0]
-    assert len(prose) <= 1200, len(prose)
+    answers = screen.split("\n\n", 1)[0].splitlines()
+    assert 1 <= len(answers) <= 5 and all(a.startswith("- **") for a in answers), answers
+    assert all(len(a.split()) <= 45 for a in answers), answers
     header = screen.split("\n|", 1)[1].split("\n", 1)[0]
     assert header.count("|") - 1 <= 8
 

@@ -342,11 +342,17 @@ def acf_figure(curves, predicted, *, differences=None, max_panels=3):
             for a in (ax, dax):
                 a.xaxis.set_major_locator(MaxNLocator(integer=True))
         # one y scale per kind within a radius: the groups compare at a glance
-        for block in (grid[: len(groups), col], grid[len(groups):, col]):
-            lows, highs = zip(*(a.get_ylim() for a in block), strict=True)
-            for a in block:
-                a.set_ylim(min(lows), max(highs))
+        block = grid[: len(groups), col]
+        lows, highs = zip(*(a.get_ylim() for a in block), strict=True)
+        for a in block:
+            a.set_ylim(min(lows), max(highs))
         grid[-1, col].set_xlabel("lag l (boundary collisions)")
+    # the differences on one y scale over every radius and group: a ΔR of 0.05 is as tall
+    # in every column, and the columns are read against each other
+    block = grid[len(groups):, :].ravel()
+    lows, highs = zip(*(a.get_ylim() for a in block), strict=True)
+    for a in block:
+        a.set_ylim(min(lows), max(highs))
     handles, labels = [], []
     for k, system in enumerate(systems):
         style = system_style(system, k)

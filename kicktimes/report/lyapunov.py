@@ -47,10 +47,14 @@ def stretching_table(results) -> pd.DataFrame:
     :math:`\Gamma = \sum_i n_i / \sum_i T_i` is the pooled perturbation rate of the system
     (disk-disk collisions of disk 0 for the two-particle system, kicks for a kicked one),
     :math:`\bar\lambda` the mean FTLE over the ICs; :math:`\bar\lambda/\Gamma` is in nats
-    per perturbation. ``stored_median`` is the median of the store's per-IC
+    per perturbation, with its 95 % interval ``stretch_low, stretch_high`` from a
+    bootstrap over the ICs of the radius (`kicktimes.stats.cluster_bootstrap`, 999
+    resamples, seeded by the radius). ``stored_median`` is the median of the store's per-IC
     ``lyapunov_per_perturbation`` rows when the store has them (NaN otherwise).
     Also ``ln_inv_r`` = ln(1/r).
     """
+    from kicktimes.stats import cluster_bootstrap
+
     rows = []
     for system in results["system"].unique():
         lam = results[(results["diagnostic"] == "lyapunov") & (results["system"] == system)]
@@ -67,6 +71,10 @@ def stretching_table(results) -> pd.DataFrame:
         frame = pd.concat({"lam": lam, "t": t, "n": n}, axis=1).dropna()
         for r, g in frame.groupby(level="radius", observed=True):
             rate = g["n"].sum() / g["t"].sum()
+            arrays = [g[c].to_numpy(float) for c in ("lam", "n", "t")]
+            boot = cluster_bootstrap(
+                lambda idx, a=arrays: stretching_per_perturbation(*(v[idx] for v in a), axis=1),
+                len(g), n_boot=999, rng=np.random.default_rng([2013, round(r * 1e6)]))
             rows.append(
                 {
                     "radius": r,
@@ -75,6 +83,7 @@ def stretching_table(results) -> pd.DataFrame:
                     "perturbation_rate": rate,
                     "stretch_per_perturbation": stretching_per_perturbation(
                         g["lam"].to_numpy(), g["n"].to_numpy(), g["t"].to_numpy()),
+                    "stretch_low": boot.ci_low, "stretch_high": boot.ci_high,
                     "stored_median": stored.get(r, np.nan),
                     "ln_inv_r": np.log(1 / r),
                 }
@@ -149,8 +158,11 @@ def stretching_figure(summary, table, *, title=None):
         for system in members:
             part = table[table["system"] == system].sort_values("radius")
             style = system_style(system, systems.index(system))
-            ax.plot(part["radius"], part["stretch_per_perturbation"], marker=style["marker"],
-                    color=style["color"], markersize=5, label=system_label(system))
+            y = part["stretch_per_perturbation"].to_numpy(float)
+            err = np.vstack([y - part["stretch_low"], part["stretch_high"] - y])
+            ax.errorbar(part["radius"], y, yerr=np.clip(err, 0, None), marker=style["marker"],
+                        color=style["color"], markersize=4, capsize=2, linewidth=1.0,
+                        label=system_label(system))
         radius_axis(ax)
         ax.set_ylabel("λ / Γ (nats per perturbation)")
         ax.set_title(f"({'de'[k]}) stretching per perturbation" + (f", {name}" if name else ""))
@@ -163,24 +175,23 @@ def stretching_figure(summary, table, *, title=None):
         axes[1, 1].set_visible(False)
     ax3 = axes[0, 2]
     ref = table[table["system"] == REFERENCE].set_index("radius")
-    grid = np.sort(ref["ln_inv_r"].to_numpy())
-    # dodged along ln(1/r) by a third of the smallest gap, so equal values stay apart
-    gap = np.diff(grid).min() / 3 if grid.size > 1 else 0.0
+    grid = np.sort(ref.index.to_numpy(float))
+    # against r, as every other panel, dodged by a fifth of the smallest gap
+    gap = np.diff(grid).min() / 5 if grid.size > 1 else 0.0
     kicked = systems[1:]
     for k, system in enumerate(kicked, start=1):
         part = table[table["system"] == system].set_index("radius")
         excess = (ref["stretch_per_perturbation"] - part["stretch_per_perturbation"]).dropna()
         style = system_style(system, k)
         shift = gap * ((k - 1) / max(len(kicked) - 1, 1) - 0.5)
-        ax3.plot(np.log(1 / excess.index.to_numpy()) + shift, excess.to_numpy(),
+        ax3.plot(excess.index.to_numpy() + shift, excess.to_numpy(),
                  linestyle="none", marker=style["marker"], markersize=5, color=style["color"])
     if grid.size:
-        span = np.array([0.0, grid.max() * 1.05])
-        (identity,) = ax3.plot(span, span, color="grey", linestyle=":")
-        handles["ln(1/r), identity line of (c)"] = identity
-        ax3.set_xlim(0.9 * grid.min(), 1.05 * grid.max())
-    # ln(1/r) is a pure number; the identity line reads it as nats per collision
-    ax3.set_xlabel("ln(1/r), r the disk radius in table radii")
+        r = np.linspace(grid.min(), grid.max(), 60)
+        (identity,) = ax3.plot(r, np.log(1 / r), color="grey", linestyle=":")
+        handles["ln(1/r), the guide of (c)"] = identity
+    radius_axis(ax3)
+    # ln(1/r) is a pure number; the guide reads it as nats per collision
     ax3.set_ylabel("excess λ/Γ (nats per perturbation)")
     ax3.set_title("(c) two-particle λ/Γ minus each kicked one")
     # the legend's own cell: systems first (their colour and marker in every panel)
@@ -217,12 +228,13 @@ def sections(ctx):
         "the paper, thin capped bars ± s.e.m.) and median (open, dotted), with the "
         "two-particle curve and (a) the kicked systems whose kicks redraw the direction "
         "(uniform kicks), (b) those whose kicks scatter, on one y scale; (d), (e) stretching "
-        "per perturbation λ/Γ of the same groups, Γ the pooled rate of disk-disk collisions "
-        "(two-particle) or kicks (kicked); (c) two-particle minus kicked stretching per "
-        "perturbation against ln(1/r), in each kicked system's colour and marker, the extra "
-        "stretching a defocusing collision gives over a state-blind kick. Systems are "
-        "shifted slightly along r (along ln(1/r) in (c)) so that they do not hide each "
-        "other.",
+        "per perturbation λ/Γ of the same groups with 95 % bootstrap intervals over ICs, Γ "
+        "the pooled rate of disk-disk collisions (two-particle, sticky runs included: they "
+        "raise Γ where they occur) or kicks (kicked); (c) two-particle minus kicked "
+        "stretching per perturbation against r, in each kicked system's colour and marker, "
+        "with the guide ln(1/r): the extra stretching a defocusing collision gives over a "
+        "state-blind kick. Systems are shifted slightly along r so that they do not hide "
+        "each other.",
     )
     parts = []
     ref = table[table["system"] == REFERENCE].set_index("radius")

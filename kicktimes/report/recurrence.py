@@ -209,7 +209,20 @@ def _panel(ax, summary, name, title, ylabel, n, systems=None):
         top = max(top, 1.08 * full)
         for note in [t for t in ax.texts if t.get_text().endswith(("↑", "↓"))]:
             note.remove()  # the clipping notes of diagnostic_vs_radius: nothing is clipped
-    ax.set_ylim(0.0, top)
+    bottom = 0.0
+    if q == "rr_offdiag":
+        # a point that fills the table uniformly recurs at rate eps^2 / (1 - r)^2: the
+        # guide every system's off-diagonal RR is read against; the axis is not from 0,
+        # so that differences of a few per cent stay visible
+        eps = float(name.split("@")[1])
+        r = np.linspace(part["radius"].min(), part["radius"].max(), 50)
+        guide = eps**2 / (1.0 - r) ** 2
+        ax.plot(r, guide, color="0.3", linestyle=":", linewidth=1.2, zorder=1,
+                label="ε²/(1 − r)²: uniform filling")
+        low = float(np.nanmin(part["mean"].to_numpy(float)))
+        bottom = 0.8 * min(low, guide.min()) if np.isfinite(low) else 0.0
+        top = min(top, 1.25 * max(float(np.nanmax(part["mean"])), guide.max()))
+    ax.set_ylim(bottom, top)
     above = part[part["mean"] > top]
     if len(above):
         above = above.sort_values(["radius", "mean"])
@@ -313,9 +326,11 @@ def rr_figure(rows, exp, *, radii=None, title=None):
     -------
     matplotlib.figure.Figure
         Per panel the mean over ICs of each system with its two error bars (no medians:
-        they are in the section's table), one series per system; the y axis starts at 0,
-        and a mean above the axis is written at the top edge and counted, with its radius,
-        in the panel's title. One legend below the panels.
+        they are in the section's table), one series per system, at most three panels a
+        row; the y axis starts at 0 (the off-diagonal RR: near its data, with the guide
+        ε²/(1 − r)² of a point filling the table uniformly), and a mean above the axis
+        is written at the top edge and counted, with its radius, in the panel's title.
+        One legend below the panels.
     """
     if radii is not None:
         rows = rows[rows["radius"].isin(list(radii))]
@@ -323,9 +338,19 @@ def rr_figure(rows, exp, *, radii=None, title=None):
            if any(f"{p}rr@{e:g}" in distinct(rows, "diagnostic") for p in ("", UNIFORM))
            or f"{UNIFORM}rr_offdiag@{e:g}" in distinct(rows, "diagnostic")]
     columns = _columns(rows, eps)
-    fig = Figure(figsize=(4.4 * max(len(columns), 1), 3.9 * max(len(eps), 1)),
+    # at most three panels a row (a row of six is an unreadable strip): each ε takes
+    # `blocks` rows, the uniform-time panels first
+    per_row = min(3, max(len(columns), 1))
+    blocks = -(-max(len(columns), 1) // per_row)
+    fig = Figure(figsize=(4.6 * per_row, 3.6 * blocks * max(len(eps), 1)),
                  layout="constrained")
-    axes = np.atleast_2d(fig.subplots(max(len(eps), 1), max(len(columns), 1), squeeze=False))
+    grid = np.atleast_2d(fig.subplots(blocks * max(len(eps), 1), per_row, squeeze=False))
+    for extra in range(len(columns), blocks * per_row):
+        for i in range(max(len(eps), 1)):
+            grid[i * blocks + extra // per_row, extra % per_row].set_visible(False)
+    axes = np.array([[grid[i * blocks + j // per_row, j % per_row]
+                      for j in range(max(len(columns), 1))]
+                     for i in range(max(len(eps), 1))])
     summary = diagnostic_summary(rows) if len(rows) else None
     n = n_samples(exp)
     for i, e in enumerate(eps):
@@ -349,7 +374,7 @@ def rr_figure(rows, exp, *, radii=None, title=None):
             for ax in split:
                 ax.set_ylim(0.0, top)
     for ax in axes.ravel():
-        ax.title.set_fontsize("small")
+        ax.title.set_fontsize("medium")
     shared_legend(fig, axes.ravel())
     if title:
         fig.suptitle(title)

@@ -51,8 +51,8 @@ def model_comparison(per_ic, pooled, *, models=None, x="radius", xlabel=None):
         AIC-best, with its Clopper-Pearson 95 % interval (:func:`binomial_ci`), and the
         number n of ICs fitted under each radius's tick (``x="radius"``, at most 20
         radii), else on top of each group; also in the title when more than four groups
-        all have the same n; (b) pooled ΔAIC per model on a
-        symmetric-log axis, with the usual ΔAIC = 2 and 10 guides.
+        all have the same n; (b) pooled ΔAIC per model on a log
+        axis of ΔAIC + 1 labelled in ΔAIC, with the usual ΔAIC = 2 and 10 guides.
     """
     axis = x_axis(x, xlabel)
     per_ic = check_frame("per_ic", per_ic, [x, "best_model"], allow_empty=True)
@@ -89,8 +89,9 @@ def model_comparison(per_ic, pooled, *, models=None, x="radius", xlabel=None):
                 yerr=np.vstack([y - low, high - y]),
                 error_kw={"elinewidth": 0.9, "capsize": 2.0, "ecolor": "black"})
         # a share of 0 has no bar: a dash in the model's colour says which interval it is
-        ax1.plot(at, y, linestyle="none", marker="_", markersize=6, markeredgewidth=2,
-                 color=colour[m])
+        zero = y == 0
+        ax1.plot(at[zero], y[zero], linestyle="none", marker="o", markersize=3.5,
+                 color=colour[m], clip_on=False, zorder=4)
     # n on top of each group, or once in the title when every one of many groups has the
     # same n (twelve "n = 12" run into each other)
     same_n = r.size > 4 and total.nunique() == 1
@@ -107,7 +108,7 @@ def model_comparison(per_ic, pooled, *, models=None, x="radius", xlabel=None):
                 ha="center",
                 va="center",
             )
-    ax1.set_ylim(0, 1.12)
+    ax1.set_ylim(-0.02, 1.12)  # a share of 0: a dot on the axis, in the model's colour
     axis.draw(ax1)
     if x == "radius" and r.size <= 20:
         # a tick under every group of bars, with the number of ICs behind its shares: a
@@ -127,34 +128,39 @@ def model_comparison(per_ic, pooled, *, models=None, x="radius", xlabel=None):
         if len(part):
             ax2.plot(
                 part[x],
-                part["delta_aic"],
+                part["delta_aic"] + 1.0,
                 marker="o",
                 markersize=4,
                 linestyle=axis.line,
                 color=colour[m],
                 label=m,
             )
+    # a log axis of ΔAIC + 1, labelled in ΔAIC: 0 (the best model) is the bottom line, and
+    # no label of 0 sits below one of 1 (a symmetric-log axis reads so)
     for level in (2.0, 10.0):
-        ax2.axhline(level, color="grey", linestyle=":", linewidth=0.8)
+        ax2.axhline(level + 1.0, color="grey", linestyle=":", linewidth=0.8)
         ax2.annotate(
             f"ΔAIC = {level:g}",
-            (0.01, level),
+            (0.01, level + 1.0),
             xycoords=("axes fraction", "data"),
             fontsize="x-small",
             color="grey",
             va="bottom",
         )
-    ax2.set_yscale("symlog", linthresh=1.0)
-    # ΔAIC >= 0: no negative band below the best model
+    from matplotlib.ticker import FixedLocator, FuncFormatter, NullLocator
+
+    ax2.set_yscale("log")
     top = float(np.nanmax(delta)) if delta.size and np.isfinite(delta).any() else 10.0
-    # below 0 a little: the best model of each radius (ΔAIC = 0) sits on a visible line
-    # above the axis, not on it
-    ax2.set_ylim(-0.8, max(20.0, 2.0 * top))
-    ax2.axhline(0.0, color="grey", linewidth=0.8, zorder=0)
-    ax2.annotate("ΔAIC = 0: the best model", (0.01, 0.0), xycoords=("axes fraction", "data"),
+    ax2.set_ylim(0.8, max(30.0, 2.0 * (top + 1.0)))
+    ticks = [1.0, 3.0, 11.0] + [10.0**k + 1.0 for k in range(2, 8) if 10.0**k < 2 * top + 2]
+    ax2.yaxis.set_major_locator(FixedLocator(ticks))
+    ax2.yaxis.set_minor_locator(NullLocator())
+    ax2.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v - 1.0:g}"))
+    ax2.axhline(1.0, color="grey", linewidth=0.8, zorder=0)
+    ax2.annotate("ΔAIC = 0: the best model", (0.01, 1.0), xycoords=("axes fraction", "data"),
                  fontsize="x-small", color="grey", va="bottom")
     axis.draw(ax2)
-    ax2.set_ylabel("ΔAIC = AIC − min AIC (pooled intervals)")
+    ax2.set_ylabel("ΔAIC = AIC − min AIC (pooled intervals;\nlog scale of ΔAIC + 1)")
     ax2.set_title(f"(b) intervals pooled over {nouns.many}")
     # one legend for both panels, outside the axes: it never covers data
     handles = [Patch(color=colour[m], label=m) for m in models]

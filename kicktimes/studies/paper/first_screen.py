@@ -23,12 +23,13 @@ __all__ = ["QUESTIONS", "answer_lines", "compact_overview", "first_screen", "qa_
 #: the first screen's ratio questions, in order: (question, diagnostic, kicked systems); the
 #: first system is the one whose number the line gives; the Poisson question comes first
 QUESTIONS = (
-    ("Does the paper's kicked disk (uniform kicks) have the two-disk FTLE?", "ftle",
+    ("Does the paper's kicked disk (uniform kicks) have the two-disk tangent-space FTLE?",
+     "ftle",
      ("poisson", "actual")),
     ("Do scatter kicks (virtual partners) give the two-disk FTLE?", "ftle",
      ("poisson_scatter", "actual_scatter", "poisson_kinetic")),
-    ("Does it decorrelate like the two disks at lag 1 (1 − R₁ at uniform-time samples)?",
-     "one_minus_r1", ("poisson", "actual")),
+    ("Does it decorrelate like the two disks at lag 1 (1 − R₁)?", "one_minus_r1",
+     ("poisson", "actual")),
     ("Does it have the two-disk recurrence rate (ε = 10⁻²)?", "rr_offdiag@0.01",
      ("poisson", "actual")),
 )
