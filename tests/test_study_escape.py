@@ -73,10 +73,11 @@ def test_the_c_over_t_law_gets_a_verdict_from_both_its_parts(built):
     text = page.read_text(encoding="utf-8")
     (line,) = [ln for ln in text.splitlines() if ln.startswith("**Verdict on the law")]
     verdict = re.search(r"C/t of the free disk: (\w+)\.", line).group(1)
-    tails = pd.read_csv(page.parent / "escape" / "escape_tails.csv").query("system == 'free'")
+    alpha_tab = pd.read_csv(page.parent / "escape" / "escape_alpha.csv")
     constant = pd.read_csv(page.parent / "escape" / "escape_constant.csv")
-    alpha = [ratio_verdict(lo, hi) for lo, hi in zip(tails["alpha_low"], tails["alpha_high"],
-                                                             strict=True)]
+    # the exponent under both IC samples: the paper ICs' fit and the invariant measure's
+    alpha = [ratio_verdict(lo, hi) for lo, hi in zip(alpha_tab["alpha_low"],
+                                                     alpha_tab["alpha_high"], strict=True)]
     const = [ratio_verdict(lo / c, hi / c) for lo, hi, c in
              zip(constant["t_S_low"], constant["t_S_high"], constant["C_predicted"],
                  strict=True)]
@@ -144,3 +145,57 @@ def test_the_page_ends_with_where_its_numbers_come_from(built):
                                            for p in (page.parent / "escape").glob("*.csv")}
     assert ("escape/escape_tails.csv", "alpha, alpha_low, alpha_high, aic_exp_minus_alg",
             "kicktimes.stats.survival.fit_escape_tail") in rows
+
+
+def _first_screen(text):
+    """The answer lines before the page's first table."""
+    head = text.split("\n|")[0]
+    return [line for line in head.splitlines() if line.startswith("- ")]
+
+
+def test_the_page_opens_with_at_most_five_answers_each_with_an_interval(built):
+    _, page, _ = built
+    answers = _first_screen(page.read_text(encoding="utf-8"))
+    assert 1 <= len(answers) <= 5
+    assert all(re.search(r"\d \[[-\d.]+, [-\d.]+\]", line) for line in answers), answers
+
+
+def test_the_exponent_answer_names_both_ic_samples(built):
+    from kicktimes.stats import robust_verdict
+
+    _, page, _ = built
+    (line,) = [a for a in _first_screen(page.read_text(encoding="utf-8"))
+               if a.startswith("- **Free disk's exponent")]
+    assert "paper ICs" in line and "invariant measure" in line
+    alpha = pd.read_csv(page.parent / "escape" / "escape_alpha.csv")
+    for _, g in alpha.groupby("radius"):
+        assert list(g["sample"]) == list(study.compute.ALPHA_SAMPLES)
+        robust, why = robust_verdict(list(g["verdict"]), g["alpha_low"], g["alpha_high"])
+        reasons = {"" if pd.isna(x) else x for x in g["not_robust_by"]}
+        assert (g["robust"] == robust).all() and reasons == {why}
+    assert ("depends on the IC sample" in line) == (not alpha["robust"].all())
+
+
+def test_the_bursty_answer_says_where_the_escape_rate_cannot_tell_the_kicks_apart(built):
+    _, page, _ = built
+    (line,) = [a for a in _first_screen(page.read_text(encoding="utf-8"))
+               if a.startswith("- **Bursty kicks")]
+    ratios = pd.read_csv(page.parent / "escape" / "escape_ratios.csv").query(
+        "system == 'bursty'")
+    undetected = (~ratios["verdict"].isin(["lower", "higher"])).any()
+    assert ("cannot tell them" in line) == bool(
+        undetected and (~ratios.query("reference == 'two_particle_pooled'")["verdict"]
+                        .isin(["lower", "higher"])).any())
+
+
+def test_the_ratios_over_radii_are_geometric_means_with_their_verdicts(built):
+    _, page, _ = built
+    over = pd.read_csv(page.parent / "escape" / "escape_over_radii.csv")
+    ratios = pd.read_csv(page.parent / "escape" / "escape_ratios.csv")
+    for row in over.itertuples():
+        assert row.verdict == ratio_verdict(row.ci_low, row.ci_high)
+        if row.reference != "ergodic":
+            per = ratios[(ratios["system"] == row.system)
+                         & (ratios["reference"] == row.reference)]["ratio"]
+            assert row.ratio == pytest.approx(float(np.exp(np.log(per).mean())))
+        assert row.n_ics_to_resolve >= row.n_ics

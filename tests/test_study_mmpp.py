@@ -90,3 +90,54 @@ def test_the_page_ends_with_where_its_numbers_come_from(built):
                                            for p in (page.parent / "mmpp").glob("*.csv")}
     assert ("mmpp/mmpp_billiard_dip.csv", "mmpp",
             "kicktimes.studies.mmpp.tables.mmpp_dip") in rows
+
+
+def _first_screen(text):
+    """The answer lines before the page's first table."""
+    head = text.split("\n|")[0]
+    return [line for line in head.splitlines() if line.startswith("- ")]
+
+
+def test_the_page_opens_with_at_most_five_answers_each_with_an_interval(built):
+    _, page = built
+    answers = _first_screen(page.read_text(encoding="utf-8"))
+    assert 1 <= len(answers) <= 5
+    assert all("[" in line and "]" in line for line in answers)
+    assert not any("intervals are not independent" in line for line in answers)
+
+
+def test_the_residuals_are_read_against_their_calibrated_null(built):
+    from kicktimes.stats import null_verdict
+
+    _, page = built
+    nulls = pd.read_csv(page.parent / "mmpp" / "mmpp_billiard_null.csv")
+    resid = pd.read_csv(page.parent / "mmpp" / "mmpp_billiard_residuals.csv")
+    assert len(nulls) == len(resid)
+    for row in nulls.itertuples():
+        assert row.verdict == null_verdict(row.diff_low, row.diff_high, tables.SHARE_MARGIN)
+        assert row.diff_low <= row.difference <= row.diff_high
+        assert row.difference == pytest.approx(row.share - row.null_share)
+        assert row.null_vs_alpha == rejection_verdict(row.null_ci_low, row.null_ci_high, 0.05)
+
+
+def test_a_shuffled_twin_keeps_the_intervals_and_loses_their_order():
+    import numpy as np
+
+    t = np.cumsum(np.r_[np.full(20, 0.1), np.full(20, 5.0)])   # a burst, then calm
+    twin = tables.shuffled_twin(t, t[-1] + 1.0, np.random.default_rng(3))
+    assert sorted(np.round(np.diff(np.r_[0.0, twin]), 9)) == sorted(
+        np.round(np.diff(np.r_[0.0, t]), 9))
+    assert not np.allclose(twin, t)
+
+
+def test_the_model_choice_finds_a_switching_process_and_not_its_shuffle():
+    import numpy as np
+
+    from kicktimes import stats
+
+    bursty = dict(rates=[0.05, 2.0], generator=[[-0.01, 0.01], [0.09, -0.09]])
+    runs = [np.asarray(stats.simulate_mmpp(**bursty, t_max=400.0, rng=k)) for k in range(12)]
+    (row,) = tables.choice_rows("test", runs, 400.0, seed=1)
+    assert row["share_billiard"] > row["share_shuffled"]
+    assert row["ci_low_billiard"] <= row["share_billiard"] <= row["ci_high_billiard"]
+    assert tables.choice_rows("test", [], 400.0, seed=1) == []

@@ -62,3 +62,48 @@ def test_the_page_ends_with_where_its_numbers_come_from(built):
     rows = assert_provenance(page)
     assert {csv for csv, _, _ in rows} == {p.name for p in page.parent.glob("*.csv")}
     assert ("scatter_ratios.csv", "verdict", "kicktimes.stats.findings.ratio_verdict") in rows
+
+
+def _first_screen(text):
+    """The answer lines before the page's first table."""
+    head = text.split("\n|")[0]
+    return [line for line in head.splitlines() if line.startswith("- ")]
+
+
+def test_the_page_opens_with_at_most_five_answers_each_with_an_interval(built):
+    _, page = built
+    answers = _first_screen(page.read_text(encoding="utf-8"))
+    assert 1 <= len(answers) <= 5
+    assert all("[" in line and "margin" in line for line in answers)
+
+
+def test_the_ratios_over_radii_are_read_at_both_margins_and_name_a_real_deficit(built):
+    from kicktimes.studies.scatter.tables import FINE_MARGIN
+
+    _, page = built
+    text = page.read_text(encoding="utf-8")
+    over = pd.read_csv(page.parent / "scatter_over_radii.csv")
+    assert FINE_MARGIN < 0.1
+    for row in over.itertuples():
+        assert row.verdict == ratio_verdict(row.ci_low, row.ci_high)
+        assert row.verdict_fine == ratio_verdict(row.ci_low, row.ci_high, FINE_MARGIN)
+        assert row.deficit == 1 - row.estimate
+    main = over[over["ics"] == "without sticky ICs"].set_index("ratio")
+    first = main.loc["scatter kicks / two disks"]
+    (line,) = [a for a in _first_screen(text) if a.startswith("- **Scatter kicks / two disks")]
+    assert format_interval(first.estimate, first.ci_low, first.ci_high,
+                           edges=(0.9, 0.95, 1.0, 1.05, 1.1)) in line
+    assert ("a real deficit" in line) == bool(first.ci_high < 1)
+
+
+def test_a_resample_of_only_sticky_ics_is_left_out_not_averaged_as_nan():
+    from kicktimes.studies.scatter.tables import over_radii
+
+    rng = np.random.default_rng(0)
+    rows = [{"radius": r, "ic": i, "two": 0.01 if i == 0 else 1.0 + 0.1 * rng.random(),
+             **{k: 0.93 for k in ("scatter", "uniform", "scatter_actual", "two_fresh")}}
+            for r in (0.01, 0.02) for i in range(3)]
+    over = over_radii(pd.DataFrame(rows), n_boot=200)
+    main = over[over["ics"] == "without sticky ICs"]
+    assert np.isfinite(main[["estimate", "ci_low", "ci_high"]]).all().all()
+    assert (main["n_draws"] <= 200).all() and (main["n_draws"] > 150).all()

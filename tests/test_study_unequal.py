@@ -80,3 +80,42 @@ def test_the_page_ends_with_where_its_numbers_come_from(built):
     assert {csv for csv, _, _ in rows} == {study.page.TABLE}
     assert ("size_ratio/size_ratio.csv", "disp_low, disp_high",
             "kicktimes.studies.unequal.tables.dispersion_ci") in rows
+
+
+def _first_screen(text):
+    """The answer lines before the page's first table."""
+    head = text.split("\n|")[0]
+    return [line for line in head.splitlines() if line.startswith("- ")]
+
+
+def test_the_page_opens_with_at_most_five_answers_each_with_an_interval(built):
+    _, page = built
+    answers = _first_screen(page.read_text(encoding="utf-8"))
+    assert 1 <= len(answers) <= 5
+    assert all("[" in line and "]" in line for line in answers)
+
+
+def test_d_is_read_against_its_null_and_the_ks_share_against_its_exact_alpha(built):
+    from kicktimes.stats import D_MARGIN, null_verdict, rejection_verdict
+
+    _, page = built
+    table = pd.read_csv(page.parent / "size_ratio" / "size_ratio.csv")
+    for row in table.itertuples():
+        assert row.d_verdict == null_verdict(row.d_minus_null_low, row.d_minus_null_high,
+                                             D_MARGIN)
+        assert row.d_minus_null == row.dispersion_index - row.d_null
+        assert row.d_null_low <= row.d_null <= row.d_null_high
+        assert row.ks_verdict == rejection_verdict(row.ks_low, row.ks_high, 0.05)
+        cells = table_cells(page.read_text(encoding="utf-8"), f"{row.size_ratio:g}")
+        assert cells[-1].endswith(row.d_verdict)
+
+
+def test_the_null_dispersion_of_poisson_counts_is_one_in_equal_windows_and_more_in_unequal():
+    import numpy as np
+
+    rng = np.random.default_rng(4)
+    equal, lo, hi = study.tables.dispersion_null(np.full(200, 3000.0), 0.05, rng)
+    assert abs(equal - 1.0) < 0.01 and lo < 1.0 < hi
+    unequal, _, _ = study.tables.dispersion_null(np.r_[np.full(100, 1000.0),
+                                                       np.full(100, 5000.0)], 0.05, rng)
+    assert unequal > 10.0

@@ -29,7 +29,9 @@ against Bunimovich & Dettmann's constant C of the circle
 (`kicktimes.stats.circle_escape_constant`).
 
 The page ``escape.md`` goes into ``results_dir`` with ``escape/escape_tails.csv``,
-``escape/escape_ratios.csv``, ``escape/escape_constant.csv`` and
+``escape/escape_ratios.csv``, ``escape/escape_constant.csv``,
+``escape/escape_over_radii.csv`` (each ratio over the radii, `compute.over_radii`),
+``escape/escape_alpha.csv`` (α under both IC samples, `compute.alpha_table`) and
 ``escape/escape_survival.png``; the escape times per IC are cached in ``out``, one table
 per radius (`compute.escape_times`, `compute.free_disk_escapes`).
 
@@ -64,21 +66,32 @@ from kicktimes.studies.escape.compute import (
     HOLE,
     RADII,
     SMALL_HOLE,
+    alpha_table,
     bootstrap_picks,
     constant_rows,
     ergodic_rate,
     escape_tables,
     escape_times,
     free_disk_escapes,
+    over_radii,
     tail_rates,
 )
 from kicktimes.studies.escape.figures import survival_figure
-from kicktimes.studies.escape.page import CONSTANT, FIGURE, RATIOS, SOURCES, TAILS, write_page
+from kicktimes.studies.escape.page import (
+    ALPHA,
+    CONSTANT,
+    FIGURE,
+    OVER_RADII,
+    RATIOS,
+    SOURCES,
+    TAILS,
+    write_page,
+)
 from kicktimes.studies.options import study_run
 
-__all__ = ["SCALES", "Params", "constant_rows", "ergodic_rate", "escape_tables",
-           "escape_times", "free_disk_escapes", "reproduce", "survival_figure", "tail_rates",
-           "write_page"]
+__all__ = ["SCALES", "Params", "alpha_table", "constant_rows", "ergodic_rate",
+           "escape_tables", "escape_times", "free_disk_escapes", "over_radii", "reproduce",
+           "survival_figure", "tail_rates", "write_page"]
 
 
 @dataclass(frozen=True)
@@ -133,14 +146,18 @@ def reproduce(out: str | os.PathLike, *, scale: str = "quick",
               free_disk_escapes, (r, params.n_free, free_t_max, params.seed)) for r in RADII]
     cached = cached_tables(jobs, workers=run.workers, progress=progress)
     times = {r: c.table for r, c in zip(RADII, cached[:len(RADII)], strict=True)}
-    table, ratio_tab, curves = escape_tables(times, params.t_max, params.t_min,
-                                             bootstrap_picks(params.n_ics, params.seed))
+    picks = bootstrap_picks(params.n_ics, params.seed)
+    table, ratio_tab, curves = escape_tables(times, params.t_max, params.t_min, picks)
+    summary = over_radii(times, params.t_max, params.t_min, picks)
     constant = pd.DataFrame([row for r, c in zip(RADII, cached[len(RADII):], strict=True)
                              for row in constant_rows(r, c.table["escape_time"], FREE_TIMES)])
-    for name, frame in ((TAILS, table), (RATIOS, ratio_tab), (CONSTANT, constant)):
+    alpha = alpha_table(table, constant, params.t_min, params.t_max)
+    for name, frame in ((TAILS, table), (RATIOS, ratio_tab), (CONSTANT, constant),
+                        (OVER_RADII, summary), (ALPHA, alpha)):
         run.write_csv(name, frame)
     run.write_figure(FIGURE, survival_figure(curves))
     # the build's seconds: this call's and those the reused simulations took when they ran
     seconds = time.perf_counter() - start + sum(c.seconds for c in cached if c.reused)
     return run.write_page(write_page(table, ratio_tab, constant, params, run.command, seconds,
-                                     cache.name, curves=curves), SOURCES)
+                                     cache.name, summary=summary, alpha=alpha, curves=curves),
+                          SOURCES)

@@ -13,19 +13,22 @@ from kicktimes import initial_conditions, schedules, simulate_one_particle, simu
 from kicktimes.stats import (
     MARGIN,
     circle_escape_constant,
+    equivalence_sample_size,
     escape_survival,
     fit_escape_tail,
     kinetic_rate,
     percentile_interval,
     ratio_verdict,
     resample_indices,
+    robust_verdict,
 )
 
 __all__ = [
-    "BURSTY_SHAPE", "CONTROLS", "FREE_TIMES", "HOLE", "KICKED", "LABELS", "N_BOOT", "RADII",
-    "SMALL_HOLE", "SYSTEMS",
-    "bootstrap_picks", "censor", "constant_rows", "ergodic_rate", "escape_tables",
-    "escape_times", "free_disk_escapes", "tail_rates",
+    "ALPHA_SAMPLES", "BURSTY_SHAPE", "CONTROLS", "FREE_TIMES", "HOLE", "KICKED", "LABELS",
+    "N_BOOT", "RADII", "SMALL_HOLE", "SYSTEMS",
+    "alpha_table", "bootstrap_picks", "censor", "constant_rows", "ergodic_rate",
+    "escape_tables", "escape_times", "free_disk_escapes", "local_alpha", "over_radii",
+    "tail_rates",
 ]
 
 RADII = (0.005, 0.01, 0.02, 0.03)
@@ -183,3 +186,88 @@ def escape_tables(times_by_radius, t_max, t_min, picks):
                                "verdict": ratio_verdict(lo, hi, MARGIN),
                                "negative_control": system in CONTROLS})
     return pd.DataFrame(rows), pd.DataFrame(ratios), curves
+
+
+def over_radii(times_by_radius, t_max, t_min, picks) -> pd.DataFrame:
+    r"""``escape_over_radii.csv``: each ratio of escape rates summarised over the radii.
+
+    Per (system, reference), the geometric mean over radii of the per-radius ratio of γ,
+    :math:`\exp(\overline{\log(\gamma_s / \gamma_{\rm ref})})`, with its 95 % interval
+    from the same paired bootstrap over ICs (`bootstrap_picks`: one resample of the ICs
+    for every radius and system), its `ratio_verdict` and, from the standard error of its
+    logarithm, the ICs at which a ratio of 1 would be resolved within the margin
+    (`kicktimes.stats.equivalence_sample_size` with the margin ``log(1 + MARGIN)``, the
+    band's narrower side). References: the two-disk estimators and ``"ergodic"``, the
+    hole's `ergodic_rate`.
+    """
+    logs = {}
+    for r, times in times_by_radius.items():
+        gammas = {}
+        for system in SYSTEMS:
+            t, horizon = censor(times[system].to_numpy(), t_max)
+            disks = 2 if system == "two_particle_pooled" else 1
+            gammas[system] = tail_rates(t, horizon, t_min, picks, disks)
+        pairs = [(s, ref) for s in KICKED for ref in ("two_particle", "two_particle_pooled")]
+        pairs += [(s, "ergodic") for s in ("two_particle", "two_particle_pooled", "poisson",
+                                             "poisson_scatter")]
+        for s, ref in pairs:
+            den = ergodic_rate(r) if ref == "ergodic" else gammas[ref]
+            logs.setdefault((s, ref), []).append(np.log(gammas[s] / den))
+    rows = []
+    n_ics = int(picks.shape[1])
+    for (s, ref), per in logs.items():
+        mean = np.mean(per, axis=0)
+        lo, hi = percentile_interval(np.exp(mean[1:]))
+        se = float(np.std(mean[1:], ddof=1))
+        rows.append({"system": s, "reference": ref, "n_radii": len(per),
+                     "ratio": float(np.exp(mean[0])), "ci_low": lo, "ci_high": hi,
+                     "verdict": ratio_verdict(lo, hi, MARGIN), "se_log": se, "n_ics": n_ics,
+                     "n_ics_to_resolve": equivalence_sample_size(se, n_ics,
+                                                                 math.log1p(MARGIN)),
+                     "negative_control": s in CONTROLS})
+    return pd.DataFrame(rows)
+
+
+def local_alpha(g) -> tuple[float, float, float]:
+    """The local exponent of the free disk between the first and last times of ``g`` (its
+    `constant_rows`), ``1 + ln(t1 S(t1) / t2 S(t2)) / ln(t2 / t1)``, with the ends of the
+    two binomial intervals divided crosswise (conservative); NaN where an interval
+    reaches 0 (too few runs alive)."""
+    g = g.sort_values("t")
+    a, b = g.iloc[0], g.iloc[-1]
+    span = math.log(b.t / a.t)
+    if min(a.t_S_low, b.t_S_low) <= 0:
+        return math.nan, math.nan, math.nan
+    return (1 + math.log(a.t_S / b.t_S) / span, 1 + math.log(a.t_S_low / b.t_S_high) / span,
+            1 + math.log(a.t_S_high / b.t_S_low) / span)
+
+
+#: the two readings of the free disk's exponent: the IC samples are the control
+ALPHA_SAMPLES = ("paper ICs", "invariant measure")
+
+
+def alpha_table(table, constant, t_min, t_max) -> pd.DataFrame:
+    """``escape_alpha.csv``: the free disk's exponent α per radius under each IC sample,
+    with its `ratio_verdict` against C/t's α = 1 and whether it is robust over the two
+    samples (`kicktimes.stats.robust_verdict`: the same verdict and no CI above 1 while
+    the other lies below 1).
+
+    ``paper ICs``: the Pareto fit on (``t_min``, ``t_max``] of disk 0 of the paper ICs (``table``,
+    `escape_tables`, exact χ² interval); ``invariant measure``: `local_alpha` of the
+    invariant-measure sample (``constant``, `constant_rows`) over its times.
+    """
+    free = table[table["system"] == "free"].set_index("radius")
+    rows = []
+    for r, g in constant.groupby("radius", observed=True):
+        fit = free.loc[r]
+        loc = local_alpha(g)
+        got = [(ALPHA_SAMPLES[0], float(t_min), float(t_max),
+                fit.alpha, fit.alpha_low, fit.alpha_high),
+               (ALPHA_SAMPLES[1], float(g["t"].min()), float(g["t"].max()), *loc)]
+        verdicts = [ratio_verdict(lo, hi, MARGIN) for *_, lo, hi in got]
+        robust, reason = robust_verdict(verdicts, [x[4] for x in got], [x[5] for x in got])
+        for (sample, t0, t1, a, lo, hi), v in zip(got, verdicts, strict=True):
+            rows.append({"radius": r, "sample": sample, "t_from": t0, "t_to": t1,
+                         "alpha": a, "alpha_low": lo, "alpha_high": hi, "verdict": v,
+                         "robust": robust, "not_robust_by": reason})
+    return pd.DataFrame(rows)

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 import pandas as pd
 
 from kicktimes.render.pages import header, ratio_text, simulations_source
@@ -16,28 +17,34 @@ from kicktimes.stats import (
     fit_escape_tail,
     format_interval,
     kinetic_rate,
-    ratio_rule,
     ratio_verdict,
     reliable_until,
+    robust_verdict,
 )
 from kicktimes.studies.escape.compute import (
+    ALPHA_SAMPLES,
     BURSTY_SHAPE,
     CONTROLS,
     HOLE,
     LABELS,
+    alpha_table,
     constant_rows,
     ergodic_rate,
     escape_tables,
+    over_radii,
     tail_rates,
 )
 
-__all__ = ["CONSTANT", "FIGURE", "RATIOS", "SOURCES", "TAILS", "law_verdict", "write_page"]
+__all__ = ["ALPHA", "CONSTANT", "FIGURE", "OVER_RADII", "RATIOS", "SOURCES", "TAILS",
+           "answers", "law_verdict", "write_page"]
 
 #: the figure and the tables, relative to the page
 FIGURE = "escape/escape_survival.png"
 TAILS = "escape/escape_tails.csv"
 RATIOS = "escape/escape_ratios.csv"
 CONSTANT = "escape/escape_constant.csv"
+OVER_RADII = "escape/escape_over_radii.csv"
+ALPHA = "escape/escape_alpha.csv"
 
 #: the page's closing table: the columns it quotes and the functions that computed them
 SOURCES = (
@@ -49,6 +56,8 @@ SOURCES = (
     Source(RATIOS, "verdict", ratio_verdict),
     Source(CONSTANT, "t, t_S, t_S_low, t_S_high", constant_rows),
     Source(CONSTANT, "C_predicted", circle_escape_constant),
+    Source(OVER_RADII, "ratio, ci_low, ci_high, verdict, se_log, n_ics_to_resolve", over_radii),
+    Source(ALPHA, "alpha, alpha_low, alpha_high, verdict, robust, not_robust_by", alpha_table),
 )
 
 
@@ -60,6 +69,96 @@ def _robust(g):
     if a.verdict == b.verdict:
         return f"{a.verdict}: {fa} (disk 0), {fb} (pooled)"
     return f"depends on the estimator: {a.verdict} {fa} (disk 0) vs {b.verdict} {fb} (pooled)"
+
+
+def _over(summary, system, reference):
+    return summary[(summary["system"] == system) & (summary["reference"] == reference)].iloc[0]
+
+
+def _kick_answer(summary, ratios, system, name, caveat=""):
+    """One answer line: a kicked / two-disk ratio over radii under both estimators, with
+    the per-radius verdicts as its caveat."""
+    a, b = _over(summary, system, "two_particle_pooled"), _over(summary, system, "two_particle")
+    robust, reason = robust_verdict([a.verdict, b.verdict], [a.ci_low, b.ci_low],
+                                    [a.ci_high, b.ci_high])
+    fa, fb = (format_interval(x.ratio, x.ci_low, x.ci_high) for x in (a, b))
+    verdict = (f"{a.verdict} under both two-disk estimators (disk 0: {fb})" if robust else
+               f"depends on the estimator ({reason}): {a.verdict} pooled vs {b.verdict} {fb} "
+               "disk 0")
+    if a.verdict.startswith("within") and (a.ci_low > 1 or a.ci_high < 1):
+        verdict += (f", a real {'excess' if a.ci_low > 1 else 'deficit'} of "
+                    f"{100 * abs(a.ratio - 1):.1f} % smaller than the margin")
+    if a.verdict == "inconclusive":
+        verdict += (f"; not resolved at {int(a.n_ics)} ICs per radius: "
+                    f"~{int(a.n_ics_to_resolve)} would resolve the {100 * MARGIN:g} % margin")
+    per = ratios[(ratios["system"] == system)
+                 & (ratios["reference"] == "two_particle_pooled")]["verdict"].value_counts()
+    return (f"- **{name} / two disks, escape rate γ** (geometric mean over "
+            f"{int(a.n_radii)} radii, pooled two-disk estimator): {fa}, {verdict}; caveat: "
+            "per radius " + ", ".join(f"{k} at {v}" for k, v in per.items())
+            + f" of {int(a.n_radii)}{caveat}.")
+
+
+def answers(summary, alpha, constant, ratios) -> list[str]:
+    """The page's first screen: at most five one-line answers, each one number with its
+    95 % interval, its verdict and its caveat, from the tables `over_radii`,
+    `alpha_table`, `constant_rows` and `escape_tables`' ratios."""
+    erg = _over(summary, "two_particle_pooled", "ergodic")
+    hole = (f"; the two disks' own γ is {format_interval(erg.ratio, erg.ci_low, erg.ci_high)} "
+            f"of the hole's ergodic rate ({erg.verdict}): the hole sets it")
+    lines = [_kick_answer(summary, ratios, "poisson", "Uniform kicks", hole),
+             _kick_answer(summary, ratios, "poisson_scatter", "Scatter kicks")]
+    bursty = ratios[ratios["system"] == "bursty"]
+    differ = bursty["verdict"].isin(["lower", "higher"])
+    same = bursty[~differ & (bursty["reference"] == "two_particle_pooled")]
+    where = ", ".join(f"{r:g}" for r in sorted(bursty.loc[differ, "radius"].unique()))
+    if len(same):
+        pick = same.iloc[int(np.argmin(np.abs(np.log(same["ratio"].to_numpy()))))]
+        lines.append(
+            f"- **Bursty kicks (negative control: gamma({BURSTY_SHAPE:g}) times, CV "
+            f"{1 / math.sqrt(BURSTY_SHAPE):.1f})** / two disks at r = {pick.radius:g}: "
+            f"{format_interval(pick.ratio, pick.ci_low, pick.ci_high)} (pooled), "
+            f"{pick.verdict}: the escape rate cannot tell them from the two disks there; it "
+            f"detects them in {int(differ.sum())} of {len(bursty)} (radius, estimator) cells"
+            + (f", at r = {where}" if where else "") + ".")
+    else:
+        pick = bursty.iloc[int(np.argmin(np.abs(np.log(bursty["ratio"].to_numpy()))))]
+        lines.append(f"- **Bursty kicks (negative control)** / two disks: detected in every "
+                     f"cell, closest {format_interval(pick.ratio, pick.ci_low, pick.ci_high)} "
+                     f"(r = {pick.radius:g}).")
+    by = alpha.set_index(["radius", "sample"])
+    radii = alpha["radius"].unique()
+    conflict = [r for r in radii if alpha[alpha["radius"] == r]["not_robust_by"].iloc[0]
+                == "direction"]
+    r = conflict[0] if conflict else radii[0]
+    p, q = by.loc[(r, ALPHA_SAMPLES[0])], by.loc[(r, ALPHA_SAMPLES[1])]
+    counts = {s: alpha[alpha["sample"] == s]["verdict"].value_counts() for s in ALPHA_SAMPLES}
+    robust = bool(alpha["robust"].all())
+    lines.append(
+        f"- **Free disk's exponent α (C/t predicts 1)** at r = {r:g}: "
+        + ("" if robust else "depends on the IC sample: ")
+        + f"{format_interval(p.alpha, p.alpha_low, p.alpha_high, edges=(0.9, 1.0, 1.1))} on the "
+        f"paper ICs (fit on t = {p.t_from:g}–{p.t_to:g}; "
+        + ", ".join(f"{k} at {v}" for k, v in counts[ALPHA_SAMPLES[0]].items())
+        + f" of {len(radii)} radii) vs {format_interval(q.alpha, q.alpha_low, q.alpha_high)} "
+        f"on the invariant measure (local, t = {q.t_from:g}–{q.t_to:g}; "
+        + ", ".join(f"{k} at {v}" for k, v in counts[ALPHA_SAMPLES[1]].items())
+        + f" of {len(radii)})" + (f"; the two CIs lie on opposite sides of 1 at {len(conflict)} "
+                                  "radii" if conflict else "") + ".")
+    c = constant.assign(q=constant["t_S"] / constant["C_predicted"],
+                        lo=constant["t_S_low"] / constant["C_predicted"],
+                        hi=constant["t_S_high"] / constant["C_predicted"])
+    v = [ratio_verdict(lo, hi, MARGIN) for lo, hi in zip(c["lo"], c["hi"], strict=True)]
+    first = c[c["t"] == c["t"].min()].iloc[0]
+    late = c[c["t"] == c["t"].max()]
+    lines.append(
+        f"- **Free disk's constant, t S(t) / C** at t = {first.t:g}, r = {first.radius:g}: "
+        f"{format_interval(first.q, first.lo, first.hi)}, {v[0]} (over all cells: "
+        + ", ".join(f"{k} at {n}" for k, n in pd.Series(v).value_counts().items())
+        + f" of {len(v)}); it drifts to {late['q'].min():.3g}–"
+        f"{late['q'].max():.3g} by t = {late['t'].iloc[0]:g}, so C/t is "
+        f"{law_verdict(list(alpha['verdict']), v)} at the {100 * MARGIN:g} % margin.")
+    return lines
 
 
 def law_verdict(alpha_verdicts, constant_verdicts):
@@ -87,36 +186,26 @@ def law_verdict(alpha_verdicts, constant_verdicts):
     return "unconfirmed"
 
 
-def _law_lines(free, constant):
+def _law_lines(alpha, constant):
     """The verdict paragraph on C/t: the prediction beside each measurement, the margin."""
-    alpha_v = [ratio_verdict(lo, hi, MARGIN) for lo, hi in
-               zip(free["alpha_low"], free["alpha_high"], strict=True)]
-    excl = int(((free["alpha_low"] > 1) | (free["alpha_high"] < 1)).sum())
+    alpha_v = list(alpha["verdict"])
     const_v = [ratio_verdict(lo / c, hi / c, MARGIN) for lo, hi, c in
                zip(constant["t_S_low"], constant["t_S_high"], constant["C_predicted"],
                    strict=True)]
     q = constant["t_S"] / constant["C_predicted"]
-    early, late = constant["t"].min(), constant["t"].max()
-    at = constant.groupby("t", observed=True).apply(
-        lambda g: (g["t_S"] / g["C_predicted"]).agg(["min", "max"]), include_groups=False)
     verdict = law_verdict(alpha_v, const_v)
-    count = pd.Series([*alpha_v]).value_counts()
     count_c = pd.Series(const_v).value_counts()
+    per = "; ".join(f"{s_}: " + ", ".join(f"{k} at {v}" for k, v in
+                                          g["verdict"].value_counts().items())
+                    for s_, g in alpha.groupby("sample", sort=False))
     return [
-        "", f"**Verdict on the law S(t) = C/t of the free disk: {verdict}.** The law predicts "
-        "two things, each set beside its measurement above with the 10 % margin of every "
-        "ratio here, stated in advance: the exponent α = 1 (measured α / 1, per radius: "
-        + ", ".join(f"{k} at {v}" for k, v in count.items())
-        + f" of {len(alpha_v)} radii; {excl} of the intervals exclude 1, a difference "
-        "smaller than the band where it is within 10 %) and the constant, t S(t) = C "
-        "(t S(t) / C per radius and time: " + ", ".join(f"{k} at {v}" for k, v in
-                                                       count_c.items())
-        + f" of {len(const_v)} cells). The ratio t S(t) / C drifts from "
-        f"{at.loc[early, 'min']:.3g}–{at.loc[early, 'max']:.3g} at t = {early:g} to "
-        f"{at.loc[late, 'min']:.3g}–{at.loc[late, 'max']:.3g} at t = {late:g} "
-        f"(over all cells {q.min():.3g} to {q.max():.3g}). Rule: confirmed when every part "
-        "is within 10 %, rejected when a part's interval lies wholly outside the band, "
-        "otherwise unconfirmed: the data neither confirm nor reject C/t at 10 %."
+        "", f"**Verdict on the law S(t) = C/t of the free disk: {verdict}.** Its two "
+        "predictions, each beside its measurement with the 10 % margin stated in advance: "
+        f"α = 1 (α / 1 per radius and IC sample: {per}) and t S(t) = C (t S(t) / C per "
+        "radius and time: " + ", ".join(f"{k} at {v}" for k, v in count_c.items())
+        + f" of {len(const_v)} cells, {q.min():.3g} to {q.max():.3g}). Confirmed when every "
+        "part is within 10 %, rejected when a part's interval lies wholly outside the band, "
+        "otherwise unconfirmed."
     ]
 
 
@@ -140,25 +229,37 @@ def _at_risk_words(curves):
     )
 
 
-def write_page(table, ratios, constant, params, command, seconds, source, curves=None):
+def write_page(table, ratios, constant, params, command, seconds, source, *, summary,
+               alpha, curves=None):
     """The lines of ``escape.md``: every number from ``table``, ``ratios`` and ``constant``
-    (`escape_tables`, `constant_rows`); ``params`` the study's `Params`, ``source`` the
-    name of its cache, ``seconds`` the build's; ``curves`` the Kaplan-Meier tables
-    (`escape_tables`' third value) for the caption's at-risk floor."""
+    (`escape_tables`, `constant_rows`), ``summary`` (`over_radii`) and ``alpha``
+    (`alpha_table`); ``params`` the study's `Params`, ``source`` the name of its cache,
+    ``seconds`` the build's; ``curves`` the Kaplan-Meier tables (`escape_tables`' third
+    value) for the caption's at-risk floor."""
     two = table[table["system"] == "two_particle"].set_index("radius")
     rates = table.pivot(index="radius", columns="system", values="rate")
     boot = table.set_index(["radius", "system"])
     gam = table.drop_duplicates("radius").set_index("radius")["kinetic_rate"]
     lines = header("Escape through a hole: kicked against two disks", command,
                    [simulations_source("escape", source)])
+    lines += answers(summary, alpha, constant, ratios)
     lines += [
+        "",
+        f"Verdicts: a ratio is within {100 * MARGIN:g} % when its whole 95 % CI lies in "
+        f"[{1 - MARGIN:g}, {1 + MARGIN:g}] (margin fixed before any rate was computed; a CI "
+        "inside the band that excludes 1 is a real difference smaller than the margin), "
+        "higher / lower when it lies wholly beyond, inconclusive otherwise; robust when "
+        "every control (the two-disk estimator; for α the IC sample) gives the same "
+        "verdict and no CI lies above 1 while another's lies below. Over radii: the "
+        "geometric mean of the per-radius ratios, the same paired bootstrap "
+        f"(`{OVER_RADII.split('/')[-1]}`).",
+        "",
         "Definitions, the exact circle constant and the sweep's escape section: "
         "[../escape.md](../escape.md). One hole of half-width "
         f"{HOLE[0][1]:g} rad; {params.n_ics} paper ICs per radius, the same at every radius "
         f"and in every system; runs to t = {params.t_max:g}. The escape rate γ is the "
-        f"exponential tail rate beyond t = {params.t_min:g} (escapes / time at risk beyond it); "
-        "intervals: 95 % bootstrap over ICs, paired across systems. Verdicts of ratios: "
-        f"{ratio_rule(MARGIN)}. The margin, 10 %, was fixed before any rate was computed.",
+        f"exponential tail rate beyond t = {params.t_min:g} (escapes / time at risk beyond "
+        "it); intervals: 95 % bootstrap over ICs, paired across systems and radii.",
         "",
         "**Censoring.** The two-disk run ends at the first escape, so disk 0's escape is "
         "censored whenever disk 1 leaves first: " + ", ".join(
@@ -244,28 +345,23 @@ def write_page(table, ratios, constant, params, command, seconds, source, curves
               "", "| r | C | " + " | ".join(f"t = {t:g}" for t in constant["t"].unique())
               + f" | local α, t = {constant['t'].min():g}–{constant['t'].max():g} |",
               "|---|---|" + "---|" * (constant["t"].nunique() + 1)]
+    local = alpha[alpha["sample"] == ALPHA_SAMPLES[1]].set_index("radius")
     for r, g in constant.groupby("radius", observed=True):
         c = g["C_predicted"].iloc[0]
         g = g.sort_values("t")
-        a, b = g.iloc[0], g.iloc[-1]
-        span = math.log(b.t / a.t)
-        if min(a.t_S_low, b.t_S_low) > 0:
-            loc = (1 + math.log(a.t_S / b.t_S) / span,
-                   1 + math.log(a.t_S_low / b.t_S_high) / span,
-                   1 + math.log(a.t_S_high / b.t_S_low) / span)
-            local = format_interval(*loc, edges=(1.0,))
-        else:  # too few runs alive at one end (a small sample): no logarithm
-            local = "undefined (an interval reaches 0)"
+        x = local.loc[r]
+        loc = (format_interval(x.alpha, x.alpha_low, x.alpha_high, edges=(1.0,))
+               if math.isfinite(x.alpha_low) else "undefined (an interval reaches 0)")
         lines.append(f"| {r:g} | {c:.2f} | " + " | ".join(
             f"{x:.1f} [{lo:.1f}, {hi:.1f}], / C {ratio_text(x / c, lo / c, hi / c)}"
             for x, lo, hi in zip(g["t_S"], g["t_S_low"], g["t_S_high"], strict=True))
-            + f" | {local} |")
+            + f" | {loc} |")
     lines += ["", "The local α of the last column, 1 + ln(t₁S(t₁) / t₂S(t₂)) / ln(t₂/t₁) with "
               "the ends of the two intervals divided crosswise (conservative), is that of the "
               "invariant-measure sample at late times; the fitted α above is that of the "
-              f"paper ICs over all t > {params.t_min:g}. The two are different samples and "
-              "ranges of t, so they need not agree."]
-    lines += _law_lines(free, constant)
+              f"paper ICs over all t > {params.t_min:g}. The IC sample is a control of α "
+              f"(`{ALPHA.split('/')[-1]}`): where the two differ, α depends on it."]
+    lines += _law_lines(alpha, constant)
     lines += ["", f"![escape survival]({FIGURE})", "",
               "**Kaplan–Meier survival** of disk 0's escape per system, one log-log panel per "
               "radius, 95 % bands; the two-disk curve (black) is drawn thin and on top, the "

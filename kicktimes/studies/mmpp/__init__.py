@@ -21,7 +21,11 @@ faster than 5 Γ(r) (sticky) are left out and counted. Then (`tables.analyse`):
   for any MMPP at t -> 0 (:math:`\\pi \\Lambda^2 1 / (\\pi \\Lambda 1)^2 \\ge 1`).
 
 The page ``mmpp.md`` goes into ``results_dir`` with ``mmpp/mmpp_billiard_pooled.csv``,
-``mmpp/mmpp_billiard_residuals.csv`` and ``mmpp/mmpp_billiard_dip.csv``; the collision
+``mmpp/mmpp_billiard_residuals.csv``, ``mmpp/mmpp_billiard_dip.csv``,
+``mmpp/mmpp_billiard_choice.csv`` (per run: is the MMPP-2 AIC-best, against the run's
+intervals shuffled, `tables.choice_rows`) and ``mmpp/mmpp_billiard_null.csv`` (each
+residual check against windows simulated from its fit and fitted the same way,
+`tables.null_rows`); the collision
 times are cached in ``out``, one table per rule.
 
 Examples
@@ -47,11 +51,19 @@ import pandas as pd
 from kicktimes.studies.cache import cached_tables
 from kicktimes.studies.mmpp.compute import RULES, collision_runs, sticky_runs
 from kicktimes.studies.mmpp.page import SOURCES, TABLES, write_page
-from kicktimes.studies.mmpp.tables import analyse, battery, intervals, mmpp_dip
+from kicktimes.studies.mmpp.tables import (
+    CHOICE_COLUMNS,
+    analyse,
+    battery,
+    choice_rows,
+    intervals,
+    mmpp_dip,
+    null_rows,
+)
 from kicktimes.studies.options import study_run
 
-__all__ = ["RULES", "SCALES", "Params", "analyse", "battery", "collision_runs", "intervals",
-           "mmpp_dip", "reproduce", "sticky_runs", "write_page"]
+__all__ = ["RULES", "SCALES", "Params", "analyse", "battery", "choice_rows", "collision_runs",
+           "intervals", "mmpp_dip", "null_rows", "reproduce", "sticky_runs", "write_page"]
 
 
 @dataclass(frozen=True)
@@ -93,16 +105,16 @@ def reproduce(out: str | os.PathLike, *, scale: str = "quick",
              collision_runs, (rule, params.n_ics, params.radius, params.t_max, params.seed))
             for rule in RULES]
     cached = cached_tables(jobs, workers=run.workers, progress=progress)
-    pooled, resid, dip = [], [], []
+    parts = [[], [], [], [], []]   # pooled, resid, dip, choice, nulls
     for rule, c in zip(RULES, cached, strict=True):
         times = [np.asarray(t, float) for t in c.table["pp_times"]]
         sticky = sticky_runs(times, params.radius, params.t_max)
-        p, r, d = analyse(rule, times, sticky, params.t_max, params.per_run, params.seed)
-        pooled += p
-        resid += r
-        dip += d
+        for rows, new in zip(parts, analyse(rule, times, sticky, params.t_max, params.per_run,
+                                            params.seed), strict=True):
+            rows += new
         run.say(f"mmpp: {rule} rule fitted at {time.perf_counter() - start:.0f} s")
-    tables = [pd.DataFrame(rows) for rows in (pooled, resid, dip)]
+    tables = [pd.DataFrame(rows) for rows in parts]
+    tables[3] = pd.DataFrame(parts[3], columns=list(CHOICE_COLUMNS))
     for name, frame in zip(TABLES, tables, strict=True):
         run.write_csv(name, frame)
     # the build's seconds: this call's and those the reused simulations took when they ran

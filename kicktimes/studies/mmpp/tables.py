@@ -10,11 +10,19 @@ import numpy as np
 from scipy.linalg import expm
 
 from kicktimes import stats
-from kicktimes.stats import MMPP_MIN_EVENTS, percentile_interval, rejection_verdict
+from kicktimes.stats import (
+    MMPP_MIN_EVENTS,
+    equivalence_sample_size,
+    null_verdict,
+    percentile_interval,
+    rejection_verdict,
+)
 from kicktimes.stats.findings import clopper_pearson
 
-__all__ = ["DIP", "EARLY_EDGES", "N_BOOT", "N_MC", "RENEWAL", "TESTS", "analyse",
-           "battery", "intervals", "mmpp_bin_hazard", "mmpp_dip"]
+__all__ = ["CHOICE_COLUMNS", "DIP", "EARLY_EDGES", "N_BOOT", "N_MC", "PER_RUN_STARTS",
+           "RENEWAL", "SHARE_MARGIN", "TESTS", "analyse", "battery", "choice_rows",
+           "intervals", "mmpp_bin_hazard", "mmpp_dip", "null_rows", "rejections",
+           "shuffled_twin"]
 
 TESTS = ("uniformity_ks", "exponential_ks", "exponential_ad", "ljung_box", "runs", "dispersion")
 RENEWAL = ("gamma", "weibull", "hyperexponential")
@@ -26,6 +34,17 @@ EARLY_EDGES = (0.0, 0.5, 1.0, 1.5, 2.0, 2.5, 3.0, 4.0)
 #: Monte Carlo samples of the Poisson battery's nulls; bootstrap resamples of the dip
 N_MC = 199
 N_BOOT = 1000
+#: EM starts of a run fitted alone (its MMPP-2, and those of its twins, fitted the same way)
+PER_RUN_STARTS = 6
+#: the margin of a share read against its null stream's share (`null_verdict` on the CI
+#: of share - null share), stated in advance: half of α = 0.05, the half-width of the band
+#: `rejection_verdict` allows a rejection share around α
+SHARE_MARGIN = 0.025
+#: the columns of `choice_rows`' table (a rule without runs fitted alone has no row)
+CHOICE_COLUMNS = ("rule", "n_runs", "n_best_billiard", "share_billiard", "ci_low_billiard",
+                  "ci_high_billiard", "n_best_shuffled", "share_shuffled", "ci_low_shuffled",
+                  "ci_high_shuffled", "share_beats_poisson", "difference", "diff_low",
+                  "diff_high", "margin", "verdict", "n_to_resolve")
 
 
 def mmpp_dip(fit, d=DIP, n_grid=201):
@@ -67,15 +86,25 @@ def mmpp_bin_hazard(fit, a, b, n_grid=201):
     return float((surv[0] - surv[-1]) / integral / (pi @ lam))
 
 
-def battery(times, windows, rng):
-    """Share of windows whose rescaled times reject each test, with its interval."""
+def rejections(times, windows, rng) -> dict:
+    """Per test of `TESTS`, which windows' rescaled times the Poisson battery rejects at
+    α = 0.05 (raw per-window p-values, before any FDR): a boolean array per test."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         res = stats.test_poisson_ensemble(times, windows, n_mc=N_MC, rng=rng)
-    per = res.per_sequence            # raw per-window p-values (``reject`` is after FDR)
+    per = res.per_sequence
+    return {test: (per[f"p_{test}"] < 0.05).to_numpy() for test in TESTS}
+
+
+def battery(times, windows, rng):
+    """Share of windows whose rescaled times reject each test, with its interval."""
+    return _battery_rows(rejections(times, windows, rng))
+
+
+def _battery_rows(rejected):
     rows = []
     for test in TESTS:
-        k, n = int((per[f"p_{test}"] < 0.05).sum()), len(per)
+        k, n = int(rejected[test].sum()), len(rejected[test])
         lo, hi = clopper_pearson(k, n)
         rows.append({"test": test, "n_windows": n, "rejected": k, "share": k / n,
                      "ci_low": lo, "ci_high": hi, "verdict": rejection_verdict(lo, hi, 0.05)})
@@ -83,9 +112,11 @@ def battery(times, windows, rng):
 
 
 def analyse(rule, times, sticky, t_max, per_run, seed):
-    """The rows of the three tables for one collision rule: the pooled fits (``pooled``),
-    the time-rescaling residual checks (``resid``) and the refractory dip (``dip``), from
-    the runs' collision ``times`` with the ``sticky`` ones left out; the per-run fits take
+    """The rows of the five tables for one collision rule: the pooled fits (``pooled``),
+    the time-rescaling residual checks (``resid``), the refractory dip (``dip``), the
+    per-run model choice against shuffled twins (``choice``, `choice_rows`) and the
+    residual checks against their calibrated null (``nulls``, `null_rows`), from the
+    runs' collision ``times`` with the ``sticky`` ones left out; the per-run fits take
     the first ``per_run`` runs with at least `kicktimes.stats.MMPP_MIN_EVENTS` collisions."""
     rng = np.random.default_rng(seed)
     calm = [t for t, s in zip(times, sticky, strict=True) if not s]
@@ -111,21 +142,28 @@ def analyse(rule, times, sticky, t_max, per_run, seed):
                    "aic_poisson_minus_mmpp": fits[1].aic - two.aic,
                    **{f"aic_{law}_minus_mmpp": aic - two.aic for law, aic in renewal.items()},
                    "n_best_starts": two.n_best, "n_starts": two.n_starts})
+    observed = {}
     for k, fit in fits.items():
         rescaled = stats.mmpp_residuals(fit, calm, t_max)
-        for row in battery(rescaled.times, rescaled.windows, rng):
+        observed[("pooled", k)] = rejections(rescaled.times, rescaled.windows, rng)
+        for row in _battery_rows(observed[("pooled", k)]):
             resid.append({"rule": rule, "fit": "pooled", "states": k, **row})
     # per run: each run fitted alone
     chosen = [t for t in calm if t.size >= MMPP_MIN_EVENTS][:per_run]
-    per = []
+    per, per_fits = [], []
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         for i, t in enumerate(chosen):
-            fit = stats.fit_mmpp(t, t_max, n_states=2, n_starts=6, rng=seed + i)
+            fit = stats.fit_mmpp(t, t_max, n_states=2, n_starts=PER_RUN_STARTS, rng=seed + i)
+            per_fits.append(fit)
             per.append(stats.mmpp_residuals(fit, t, t_max))
     if per:
-        for row in battery([p.times[0] for p in per], [p.windows[0] for p in per], rng):
+        observed[("per run", 2)] = rejections([p.times[0] for p in per],
+                                              [p.windows[0] for p in per], rng)
+        for row in _battery_rows(observed[("per run", 2)]):
             resid.append({"rule": rule, "fit": "per run", "states": 2, **row})
+    nulls = null_rows(rule, observed, fits, per_fits, len(calm), t_max, seed)
+    choice = choice_rows(rule, chosen, t_max, seed)
     # the refractory dip
     complete, censored = intervals(calm, t_max)
     haz = stats.interval_hazard(complete, censored, edges=[0.0, DIP, float(
@@ -165,7 +203,7 @@ def analyse(rule, times, sticky, t_max, per_run, seed):
                 "min_verdict": ("below the MMPP's" if max(m_obs_hi, m_hi) < m_model
                                 else "above the MMPP's" if min(m_obs_lo, m_lo) > m_model
                                 else "not distinguished from the MMPP's")})
-    return pooled, resid, dip
+    return pooled, resid, dip, choice, nulls
 
 
 def _early_hazard(complete, censored):
@@ -181,3 +219,112 @@ def intervals(times, t_max):
     complete = np.concatenate([np.diff(t) for t in times if t.size > 1])
     censored = np.array([t_max - t[-1] for t in times if t.size])
     return complete, censored
+
+
+def _difference(a, b, rng, margin=SHARE_MARGIN):
+    """Share of ``a`` minus share of ``b`` (boolean arrays of independent units) with its
+    95 % bootstrap interval (each arm resampled on its own), its `null_verdict` and the
+    units per arm that would resolve ``margin`` (`equivalence_sample_size`)."""
+    a, b = np.asarray(a, float), np.asarray(b, float)
+    ia = stats.resample_indices(a.size, N_BOOT, rng)
+    ib = stats.resample_indices(b.size, N_BOOT, rng)
+    boot = a[ia].mean(1) - b[ib].mean(1)
+    lo, hi = percentile_interval(boot)
+    se = float(np.std(boot, ddof=1))
+    n = int(min(a.size, b.size))
+    return {"difference": a.mean() - b.mean(), "diff_low": lo, "diff_high": hi,
+            "margin": margin, "verdict": null_verdict(lo, hi, margin),
+            "n_to_resolve": equivalence_sample_size(se, n, margin) if se > 0 else n}
+
+
+def shuffled_twin(t, t_max, rng):
+    """The run ``t`` with its intervals (the first gap from 0 included) in random order:
+    the same interval law and censored end, every dependence between intervals gone."""
+    gaps = np.diff(np.r_[0.0, np.asarray(t, float)])
+    out = np.cumsum(rng.permutation(gaps))
+    return out[out < t_max]
+
+
+def choice_rows(rule, chosen, t_max, seed):
+    """Per run of ``chosen`` (the runs fitted alone), whether the MMPP-2 is its AIC-best
+    model among Poisson, the renewal models and the MMPP-2
+    (`kicktimes.stats.compare_point_processes`, `PER_RUN_STARTS` starts), against the same
+    on the run's `shuffled_twin`: the null level of "AIC-best" when the intervals are
+    independent with the run's own law. One row per rule: both shares with their
+    Clopper-Pearson intervals and their difference read against the twins'
+    (`_difference`)."""
+    rng = np.random.default_rng((seed, 2))
+    best = {"billiard": [], "shuffled": []}
+    beats = []
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        for i, t in enumerate(chosen):
+            for data, seq in (("billiard", t), ("shuffled", shuffled_twin(t, t_max, rng))):
+                tab = stats.compare_point_processes(seq, t_max, n_starts=PER_RUN_STARTS,
+                                                    rng=seed + i)
+                best[data].append(tab.index[0] == "mmpp2")
+                if data == "billiard":
+                    beats.append(tab.loc["mmpp2", "aic"] < tab.loc["poisson", "aic"])
+    if not chosen:
+        return []
+    row = {"rule": rule, "n_runs": len(chosen)}
+    for data, flags in best.items():
+        k = int(np.sum(flags))
+        lo, hi = clopper_pearson(k, len(flags))
+        row.update({f"n_best_{data}": k, f"share_{data}": k / len(flags),
+                    f"ci_low_{data}": lo, f"ci_high_{data}": hi})
+    row["share_beats_poisson"] = float(np.mean(beats))
+    row.update(_difference(best["billiard"], best["shuffled"], rng))
+    return [row]
+
+
+def _null_windows(fit, n, t_max, rng, min_events=0, tries=50):
+    """``n`` windows simulated from ``fit``, each redrawn until it has ``min_events``."""
+    out = []
+    for _ in range(n):
+        for _ in range(tries):
+            w = np.asarray(stats.simulate_mmpp(fit.rates, fit.generator, t_max, rng=rng), float)
+            if w.size >= min_events:
+                break
+        out.append(w)
+    return out
+
+
+def null_rows(rule, observed, fits, per_fits, n_windows, t_max, seed):
+    """The residual checks' calibrated null: the battery's rejection share on windows
+    simulated from each fit, fitted and rescaled the same way (pooled: ``n_windows``
+    windows from the pooled fit, refitted pooled; per run: one window from each run's own
+    fit with at least `MMPP_MIN_EVENTS` events, refitted alone), beside the billiard's
+    share (``observed``: `rejections` per (fit, states)) and their difference read
+    against it (`_difference`, `null_verdict` with `SHARE_MARGIN`)."""
+    rng = np.random.default_rng((seed, 3))
+    rows = []
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        null = {}
+        for k, fit in fits.items():
+            sim = _null_windows(fit, n_windows, t_max, rng)
+            refit = stats.fit_mmpp(sim, t_max, n_states=k, rng=seed)
+            res = stats.mmpp_residuals(refit, sim, t_max)
+            null[("pooled", k)] = rejections(res.times, res.windows, rng)
+        if per_fits:
+            times, windows = [], []
+            for i, fit in enumerate(per_fits):
+                (w,) = _null_windows(fit, 1, t_max, rng, min_events=MMPP_MIN_EVENTS)
+                refit = stats.fit_mmpp(w, t_max, n_states=2, n_starts=PER_RUN_STARTS,
+                                       rng=seed + i)
+                res = stats.mmpp_residuals(refit, w, t_max)
+                times.append(res.times[0])
+                windows.append(res.windows[0])
+            null[("per run", 2)] = rejections(times, windows, rng)
+    for (fit, k), got in observed.items():
+        for test in TESTS:
+            ref = null[(fit, k)][test]
+            lo, hi = clopper_pearson(int(ref.sum()), ref.size)
+            rows.append({"rule": rule, "fit": fit, "states": k, "test": test,
+                         "n_windows": int(got[test].size), "share": float(got[test].mean()),
+                         "n_null": int(ref.size), "null_share": float(ref.mean()),
+                         "null_ci_low": lo, "null_ci_high": hi,
+                         "null_vs_alpha": rejection_verdict(lo, hi, 0.05),
+                         **_difference(got[test], ref, rng)})
+    return rows

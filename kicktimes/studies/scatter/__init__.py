@@ -15,7 +15,8 @@ over ICs (paired: the same resampled ICs for both means) and its
 `kicktimes.stats.ratio_verdict` (10 % margin), without the sticky two-disk orbits
 (exponent below a quarter of the radius's median) and, as the control, with them
 (`tables.ratio_table`). The page ``scatter.md`` goes into ``results_dir`` with
-``scatter_ratios.csv``; the per-IC tables are cached in ``out``, one per radius.
+``scatter_ratios.csv`` and ``scatter_over_radii.csv`` (each ratio over the radii, at the
+10 % margin and at `tables.FINE_MARGIN`); the per-IC tables are cached in ``out``, one per radius.
 Definitions and methods: docs/scatter.md.
 
 Examples
@@ -42,11 +43,17 @@ from kicktimes.studies.cache import cached_tables
 from kicktimes.studies.options import study_run
 from kicktimes.studies.scatter.compute import one_ic, scatter_runs, shape_rows
 from kicktimes.studies.scatter.kernel import fresh_lam
-from kicktimes.studies.scatter.page import SOURCES, TABLE, write_page
-from kicktimes.studies.scatter.tables import RATIOS, ratio_table, sticky, summary_tables
+from kicktimes.studies.scatter.page import OVER_RADII, SOURCES, TABLE, write_page
+from kicktimes.studies.scatter.tables import (
+    RATIOS,
+    over_radii,
+    ratio_table,
+    sticky,
+    summary_tables,
+)
 
-__all__ = ["RATIOS", "SCALES", "Params", "cache_jobs", "fresh_lam",
-           "one_ic", "ratio_table", "reproduce", "scatter_runs", "shape_rows", "sticky",
+__all__ = ["RATIOS", "SCALES", "Params", "cache_jobs", "fresh_lam", "one_ic", "over_radii",
+           "ratio_table", "reproduce", "scatter_runs", "shape_rows", "sticky",
            "summary_tables", "write_page"]
 
 #: family A's radii (`kicktimes.experiment.preset("family_a")`)
@@ -102,5 +109,7 @@ def reproduce(out: str | os.PathLike, *, scale: str = "quick",
                            progress=progress)
     df = pd.concat([c.table for c in cached], ignore_index=True)
     tab = ratio_table(df)
+    over = over_radii(df)
     run.write_csv(TABLE, tab)
-    return run.write_page(write_page(df, tab, run.command, run.cache.name), SOURCES)
+    run.write_csv(OVER_RADII, over)
+    return run.write_page(write_page(df, tab, run.command, run.cache.name, over), SOURCES)

@@ -6,16 +6,27 @@ import pandas as pd
 
 from kicktimes.render.pages import header, simulations_source
 from kicktimes.render.provenance import Source
-from kicktimes.stats import MARGIN, format_interval, poisson_group, ratio_rule, ratio_verdict
+from kicktimes.stats import (
+    MARGIN,
+    clopper_pearson,
+    format_interval,
+    null_verdict,
+    poisson_group,
+    ratio_verdict,
+    rejection_verdict,
+)
 from kicktimes.studies.unequal.compute import KINDS, R0
 from kicktimes.studies.unequal.tables import (
+    D_MARGIN,
+    FINE_MARGIN,
     dispersion_ci,
+    dispersion_null,
     ks_interval,
     ratio_ci,
     size_ratio_table,
 )
 
-__all__ = ["FIGURE", "SOURCES", "TABLE", "write_page"]
+__all__ = ["FIGURE", "SOURCES", "TABLE", "answers", "write_page"]
 
 #: the table and the figure, relative to the page
 TABLE = "size_ratio/size_ratio.csv"
@@ -29,7 +40,87 @@ SOURCES = (
                             for kind in KINDS for part in ("ratio", "low", "high")), ratio_ci),
     Source(TABLE, "ks_reject_share, dispersion_index", poisson_group),
     Source(TABLE, "disp_low, disp_high", dispersion_ci),
+    Source(TABLE, "d_null, d_null_low, d_null_high", dispersion_null),
+    Source(TABLE, "d_minus_null, d_minus_null_low, d_minus_null_high", size_ratio_table),
+    Source(TABLE, "d_verdict", null_verdict),
+    Source(TABLE, "ks_low, ks_high", clopper_pearson),
+    Source(TABLE, "ks_verdict", rejection_verdict),
 )
+
+#: the FTLE columns of the table: (estimate, low, high) per disk and partner
+_FTLE = [(f"ftle_{kind}_ratio_disk{d}", f"ftle_{kind}_low_disk{d}", f"ftle_{kind}_high_disk{d}")
+         for d in (0, 1) for kind in KINDS]
+
+
+def _at(table, column, pick):
+    """The row of ``table`` where ``column`` is smallest (``pick="min"``) or largest."""
+    k = table[column].idxmin() if pick == "min" else table[column].idxmax()
+    return table.loc[k]
+
+
+def _ftle(row, c):
+    lo, hi = row[c[1]], row[c[2]]
+    text = (f"{format_interval(row[c[0]], lo, hi, edges=(0.9, 0.95, 1.0, 1.05, 1.1))}, "
+            f"{ratio_verdict(lo, hi, FINE_MARGIN)} at the {100 * FINE_MARGIN:g} % margin "
+            f"(10 %: {ratio_verdict(lo, hi, MARGIN)})")
+    if hi < 1 or lo > 1:
+        text += (f", a real {'deficit' if hi < 1 else 'excess'} of "
+                 f"{100 * abs(1 - row[c[0]]):.1f} %")
+    return text
+
+
+def _apart(row, a, b):
+    return bool(row[a[2]] < row[b[1]] or row[b[2]] < row[a[1]])
+
+
+def _d_cell(row):
+    if "d_minus_null" not in row:
+        return "n/a"
+    text = format_interval(row["d_minus_null"], row["d_minus_null_low"],
+                           row["d_minus_null_high"], edges=())
+    return f"{text}, {row['d_verdict']}"
+
+
+def answers(table) -> list[str]:
+    """The page's first screen: at most five one-line answers, each one number with its
+    95 % interval, its verdict against its own null and its caveat."""
+    n = len(table)
+
+    def count(verdicts):
+        return ", ".join(f"{k} at {v}" for k, v in pd.Series(verdicts).value_counts().items())
+
+    rate_v = [ratio_verdict(lo, hi, MARGIN) for lo, hi in zip(table["rate_low"],
+                                                               table["rate_high"], strict=True)]
+    worst = table.loc[(table["rate_ratio"] - 1).abs().idxmax()]
+    ks = _at(table, "ks_reject_share", "min")
+    d = _at(table, "d_minus_null", "min")
+    large = table.iloc[-1]
+    small_v = [ratio_verdict(lo, hi) for lo, hi in zip(table[_FTLE[0][1]], table[_FTLE[0][2]],
+                                                        strict=True)]
+    return [
+        f"- **Collision rate / kinetic Γ(r0, r1)** at r1 / r0 = {worst.size_ratio:g} (the "
+        f"furthest from 1): {format_interval(worst.rate_ratio, worst.rate_low, worst.rate_high)}"
+        f"; {count(rate_v)} of {n} ratios: kinetic theory holds for unequal disks.",
+        f"- **KS rejections of uniform collision times** at r1 / r0 = {ks.size_ratio:g} (the "
+        f"fewest): {100 * ks.ks_reject_share:.1f} % [{100 * ks.ks_low:.1f}, "
+        f"{100 * ks.ks_high:.1f}] of runs against α = 0.05, which the test has exactly (the "
+        f"uniformity KS given the number of collisions): {count(table['ks_verdict'])} of "
+        f"{n} ratios.",
+        f"- **Dispersion index D − its null** at r1 / r0 = {d.size_ratio:g} (the smallest): "
+        f"{format_interval(d.d_minus_null, d.d_minus_null_low, d.d_minus_null_high, edges=())} "
+        f"(D {format_interval(d.dispersion_index, d.disp_low, d.disp_high, edges=(1.0,))}, "
+        f"null {d.d_null:.3f}, Poisson counts in the same windows): "
+        f"{count(table['d_verdict'])} of {n} ratios; the counts vary between ICs.",
+        f"- **Small disk's FTLE, kicked / two disks** at r1 / r0 = {large.size_ratio:g}: "
+        f"{_ftle(large, _FTLE[0])}; caveat: at the 10 % margin {count(small_v)} of {n} ratios.",
+        f"- **Large disk's FTLE, kicked / two disks, by the partner radius** at r1 / r0 = "
+        f"{large.size_ratio:g}: with the other disk as scattering partner {_ftle(large, _FTLE[2])}"
+        f", with an own-size partner {format_interval(*(large[c] for c in _FTLE[3]))}, "
+        f"{ratio_verdict(large[_FTLE[3][1]], large[_FTLE[3][2]], FINE_MARGIN)} at the "
+        f"{100 * FINE_MARGIN:g} % margin" + (
+            ": the two partners' intervals lie apart." if _apart(large, _FTLE[2], _FTLE[3])
+            else "; the two partners' intervals overlap."),
+    ]
 
 
 def write_page(table, params, command, source):
@@ -38,23 +129,36 @@ def write_page(table, params, command, source):
     cache."""
     lines = header("Unequal disks: the size ratio", command,
                    [simulations_source("unequal", source, f"`{TABLE}`")])
-    lines += [f"Definitions and methods: [../unequal.md](../unequal.md). Disk 0 keeps "
+    lines += answers(table)
+    lines += ["", f"Verdicts: a ratio is within {100 * MARGIN:g} % when its whole 95 % CI lies "
+              f"in [{1 - MARGIN:g}, {1 + MARGIN:g}], higher / lower when wholly beyond, "
+              "inconclusive otherwise (a CI inside the band that excludes 1 is a real "
+              "difference smaller than the margin); the FTLE ratios are first read at a "
+              f"{100 * FINE_MARGIN:g} % margin, stated in advance, half the effect of the "
+              "partner radius the page means to resolve. A share of runs rejected is read "
+              "against α only where the test has exactly α under Poisson (the uniformity KS, "
+              "given the number of collisions); D is read against its null stream's D "
+              f"(D − null within ±{D_MARGIN:g}: at its null; wholly beyond: above / below).",
+              "",
+              f"Definitions and methods: [../unequal.md](../unequal.md). Disk 0 keeps "
               f"r0 = {R0:g}; {params.n_ics} invariant ICs per ratio, {params.n_steps} steps of "
               f"{params.tau:g}, mirror rule; the kicked disk gets scattering kicks at Poisson "
               "times at its IC's own collision rate. Ratios of means with 95 % bootstrap "
-              f"intervals over ICs; verdicts: {ratio_rule(MARGIN)}.", "",
+              "intervals over ICs.", "",
               "The four FTLE columns are ratios of the **finite-time Lyapunov exponent** "
               "(tangent FTLE of the named disk, mean over ICs): the kicked disk's over the "
               "same disk's in the two-disk system, with the partner radius of the scattering "
               "kicks as named. KS rejections: share of the two-disk runs whose collision "
               "times reject uniformity at α = 0.05 (Clopper–Pearson interval; 0.05 for a "
               "Poisson process); dispersion: variance / mean of the collision counts over ICs "
-              "(1 for a Poisson process), with a 95 % bootstrap interval over ICs"
+              "(near 1 for a Poisson process), with a 95 % bootstrap interval over ICs, and "
+              "D − its null (the mean D of Poisson counts in the same windows at the pooled "
+              "rate) with its verdict"
               + ("" if "disp_low" in table else " where the per-IC counts are stored (not "
                  "for this table)") + ".", "",
               "| r1 / r0 | rate / Γ(r0, r1) | KS rejections | dispersion | small disk FTLE, "
-              "partner r1 | own-size partner | large disk FTLE, partner r0 | own-size partner |",
-              "|---|---|---|---|---|---|---|---|"]
+              "partner r1 | own-size partner | large disk FTLE, partner r0 | own-size partner | "
+              "D − null |", "|---|---|---|---|---|---|---|---|---|"]
     cols = [("ftle_partner_ratio_disk0", "ftle_partner_low_disk0", "ftle_partner_high_disk0"),
             ("ftle_own_ratio_disk0", "ftle_own_low_disk0", "ftle_own_high_disk0"),
             ("ftle_partner_ratio_disk1", "ftle_partner_low_disk1", "ftle_partner_high_disk1"),
@@ -73,7 +177,8 @@ def write_page(table, params, command, source):
         lines.append(f"| {row['size_ratio']:g} | {rate}"
                      f" | {100 * row['ks_reject_share']:.1f} % [{100 * ks_lo:.1f}, "
                      f"{100 * ks_hi:.1f}] | {disp} | "
-                     + " | ".join(cell(row, c) for c in cols) + " |")
+                     + " | ".join(cell(row, c) for c in cols) + " | "
+                     + _d_cell(row) + " |")
     lines.append("")
     for c, name in ((("rate_ratio", "rate_low", "rate_high"), "collision rate / kinetic rate"),
                     (cols[0], "small disk, partner of the other disk's size"),

@@ -7,11 +7,40 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from kicktimes.stats import kinetic_rate, percentile_interval, poisson_group, resample_indices
+from kicktimes.stats import (
+    D_MARGIN,
+    kinetic_rate,
+    null_verdict,
+    percentile_interval,
+    poisson_group,
+    rejection_verdict,
+    resample_indices,
+)
 from kicktimes.stats.findings import clopper_pearson
 from kicktimes.studies.unequal.compute import KINDS, R0
 
-__all__ = ["dispersion_ci", "ks_interval", "ratio_ci", "size_ratio_table"]
+__all__ = ["D_MARGIN", "FINE_MARGIN", "N_NULL", "dispersion_ci", "dispersion_null",
+           "ks_interval", "ratio_ci", "size_ratio_table"]
+
+#: Monte Carlo draws of the dispersion index's null (Poisson counts shaped like the runs)
+N_NULL = 4000
+#: the margin the FTLE ratios must resolve, stated in advance: half the smallest effect
+#: the page means to detect, the partner radius of the scattering kicks (own-size against
+#: the other disk's size: about 10 % at the largest ratio); `kicktimes.stats.MARGIN`
+#: (10 %) is as large as that effect
+FINE_MARGIN = 0.05
+
+
+def dispersion_null(windows, rate, rng, n=N_NULL):
+    """The dispersion index :math:`s_N^2 / \\bar N` of Poisson counts shaped like the runs
+    (one count per window of ``windows`` at the common ``rate``): its mean over ``n``
+    draws, the value D is read against (`null_verdict`), and its 2.5 and 97.5 %
+    percentiles."""
+    mean = rate * np.asarray(windows, float)
+    counts = rng.poisson(mean, size=(n, mean.size)).astype(float)
+    d = counts.var(1, ddof=1) / counts.mean(1)
+    lo, hi = percentile_interval(d)
+    return float(d.mean()), lo, hi
 
 
 def ratio_ci(x, y, rng, n_boot=2000):
@@ -46,13 +75,19 @@ def size_ratio_table(runs_by_r1, seed) -> pd.DataFrame:
 
     Notes
     -----
-    Two streams from ``seed``, as the published table drew them: one for the battery and
+    Three streams from ``seed``, as the published table drew them: one for the battery and
     the ratios (per ratio: the battery, the rate ratio, then the FTLE ratios disk by disk,
-    partner before own), and one for the dispersion intervals (added to the table later,
-    from the same per-IC counts).
+    partner before own), one for the dispersion intervals (added to the table later,
+    from the same per-IC counts), and one for the dispersion index's null
+    (`dispersion_null`), against which D is read (``d_minus_null``, its interval the
+    bootstrap interval of D less the null's mean, ``d_verdict`` its `null_verdict` with
+    `D_MARGIN`); the KS share has its Clopper-Pearson interval (``ks_low``, ``ks_high``)
+    and its `rejection_verdict` against α = 0.05, exact for the uniformity test given
+    the number of collisions.
     """
     rng = np.random.default_rng(seed)
     disp_rng = np.random.default_rng(seed)
+    null_rng = np.random.default_rng((seed, 1))
     rows = []
     for r1, runs in runs_by_r1.items():
         gamma = kinetic_rate((R0, r1))
@@ -76,5 +111,17 @@ def size_ratio_table(runs_by_r1, seed) -> pd.DataFrame:
                 row[f"ftle_{kind}_high_disk{disk}"] = hi
             row[f"ftle_two_disk{disk}"] = float(np.mean(lam))
         row["disp_low"], row["disp_high"] = dispersion_ci(counts, disp_rng)
+        # D against its own null (Poisson counts in the same windows at the pooled rate),
+        # the KS share against α, which the conditional uniformity test has exactly
+        d0, d0_lo, d0_hi = dispersion_null(windows, counts.sum() / np.sum(windows), null_rng)
+        row.update({"d_null": d0, "d_null_low": d0_lo, "d_null_high": d0_hi,
+                    "d_minus_null": row["dispersion_index"] - d0,
+                    "d_minus_null_low": row["disp_low"] - d0,
+                    "d_minus_null_high": row["disp_high"] - d0})
+        row["d_verdict"] = null_verdict(row["d_minus_null_low"], row["d_minus_null_high"],
+                                        D_MARGIN)
+        row["ks_low"], row["ks_high"] = clopper_pearson(
+            int(round(row["ks_reject_share"] * len(times))), len(times))
+        row["ks_verdict"] = rejection_verdict(row["ks_low"], row["ks_high"], 0.05)
         rows.append(row)
     return pd.DataFrame(rows)
