@@ -45,7 +45,10 @@ def test_the_science_page_s_ratio_per_radius_is_its_csv_with_its_verdict():
             row = g[g["system"] == system].iloc[0]
             want = (f"{format_interval(row.ratio, row.ratio_ci_low, row.ratio_ci_high)}, "
                     f"{row.verdict}")
-            assert cells[1 + k] == want
+            # an inconclusive ratio names the size that would resolve it
+            assert cells[1 + k].split(" (not resolved")[0] == want
+            assert ("(not resolved at this size" in cells[1 + k]) == (
+                row.verdict == "inconclusive")
 
 
 def test_the_science_page_extrapolates_nothing_and_quotes_predictions_with_measurements():
@@ -99,13 +102,13 @@ def test_the_mechanism_page_reads_the_late_hazard_from_its_table(folder):
     tab = _numbers(folder)
     rule = tab["rule"].iloc[0]
     section = text.split(f"## The {rule} rule")[1].split("\n## ")[0]
-    cells = table_cells(section, "rescaled t > 5")
+    cells = table_cells(section, "Γ-rescaled hazard, t > 5")
     groups = [("paper", 0.01), ("paper", 0.02), ("uniform", 0.01), ("uniform", 0.02)]
     for k, (method, r) in enumerate(groups):
         row = tab[(tab["method"] == method) & (tab["radius"] == r)
                   & (tab["quantity"] == "rescaled_hazard_late")].iloc[0]
         verdict = ratio_verdict(row["ci_low"], row["ci_high"])
-        assert cells[1 + k].endswith(verdict), (cells[1 + k], verdict)
+        assert cells[1 + k].split(" (")[0].endswith(verdict), (cells[1 + k], verdict)
     assert "explains about half to two-thirds" not in text
 
 
@@ -159,6 +162,12 @@ def test_the_science_page_claims_a_direction_only_where_both_trend_measures_agre
     assert "holds in direction" not in text and "Named: *radial orbits*" not in text
     assert "## 6. Cost" not in text
     bullets = text.split("The paper's expectation")[1].split("What happens below")[0]
+    screen = text.split("\n|")[0]
+    for system, name in (("poisson", "Uniform kick"), ("poisson_scatter", "Scatter kick")):
+        line = next(x for x in screen.splitlines() if x.startswith(f"- **{name}"))
+        ratio, dist = (trend.loc[(system, q), "verdict"] for q in ("ratio", "abs_log_ratio"))
+        if "no trend detected" in (ratio, dist) and ratio != dist:
+            assert "no direction of the trend is claimed" in line
     for system, name in (("poisson", "uniform kick"), ("poisson_scatter", "scatter kick")):
         line = next(x for x in bullets.splitlines() if x.startswith(f"- {name}:"))
         ratio, dist = (trend.loc[(system, q), "verdict"] for q in ("ratio", "abs_log_ratio"))
@@ -192,7 +201,36 @@ def test_the_mmpp_page_s_dip_is_the_mechanism_page_s_at_the_same_ics():
 def test_the_mechanism_page_reads_no_share_as_a_bound_or_an_overshoot_inside_noise():
     text = _page("mechanism.md")
     assert "upper bound" not in text and "(the model overshoots)" not in text
-    assert "an interval containing 1 does not tell either" in text
+    assert "read as short of it only where its interval lies below 1" in text
+
+
+def test_the_mechanism_page_reads_the_rate_dispersion_across_ics_against_its_null():
+    from kicktimes.stats import D_MARGIN, null_verdict
+
+    text = _page("mechanism.md")
+    assert "dispersion index" not in text and "index of dispersion" not in text
+    for folder in ("", "elastic"):
+        tab = _numbers(folder)
+        rule = tab["rule"].iloc[0]
+        section = text.split(f"## The {rule} rule")[1].split("\n## ")[0]
+        cells = table_cells(section, "rate dispersion across ICs vs its Poisson null")
+        for k, (method, r) in enumerate([("paper", 0.01), ("paper", 0.02), ("uniform", 0.01),
+                                         ("uniform", 0.02)]):
+            g = tab[(tab["method"] == method) & (tab["radius"] == r)].set_index("quantity")
+            diff, null = g.loc["rate_dispersion_minus_null"], g.loc[
+                "rate_dispersion_poisson_null"]
+            verdict = null_verdict(diff["ci_low"], diff["ci_high"], D_MARGIN)
+            assert f"vs {null['estimate']:.3f}: {verdict}" in cells[1 + k]
+
+
+@pytest.mark.parametrize("name", ["mechanism.md", "science.md"])
+def test_the_mechanism_and_science_pages_open_with_five_answers_at_most(name):
+    text = _page(name)
+    assert len(text.split()) <= 2500
+    lines = text.splitlines()
+    first = next(i for i, x in enumerate(lines) if x.startswith("|"))
+    answers = [x for x in lines[:first] if x.startswith("- ")]
+    assert 1 <= len(answers) <= 5 and all("[" in x and "caveat" in x for x in answers)
 
 
 def test_the_escape_page_sets_every_rate_beside_the_hole_s_ergodic_rate():

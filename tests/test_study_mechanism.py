@@ -3,12 +3,13 @@ cache, at a tiny size (the mirror rule only)."""
 
 from __future__ import annotations
 
+import numpy as np
 import pandas as pd
 import pytest
 from conftest import assert_provenance, built_study, refuse_simulations, table_cells
 
-from kicktimes.stats import format_interval, ratio_verdict
-from kicktimes.studies.mechanism import run
+from kicktimes.stats import D_MARGIN, format_interval, null_verdict, ratio_verdict
+from kicktimes.studies.mechanism import analysis, page, run
 
 TINY = run.MechanismScale(10, 1000.0, 1, n_boot=20)
 
@@ -36,7 +37,7 @@ def test_the_page_names_the_command_and_reads_its_table(built):
     run_rows = tab[tab["method"] == "run"].set_index("quantity")["estimate"]
     assert run_rows.to_dict() == {"n_ics": 10, "t_max": 1000, "twins": 1, "seed": 29}
     section = text.split("## The mirror rule")[1]
-    cells = table_cells(section, "rescaled t > 5")
+    cells = table_cells(section, "Γ-rescaled hazard, t > 5")
     groups = [("paper", 0.01), ("paper", 0.02), ("uniform", 0.01), ("uniform", 0.02)]
     for k, (method, r) in enumerate(groups):
         row = tab[(tab["method"] == method) & (tab["radius"] == r)
@@ -44,7 +45,9 @@ def test_the_page_names_the_command_and_reads_its_table(built):
         if pd.notna(row["estimate"]):
             assert cells[1 + k].startswith(format_interval(
                 row["estimate"], row["ci_low"], row["ci_high"], edges=(0.9, 1.0, 1.1)))
-            assert cells[1 + k].endswith(ratio_verdict(row["ci_low"], row["ci_high"]))
+            verdict = ratio_verdict(row["ci_low"], row["ci_high"])
+            assert cells[1 + k].split(" (")[0].endswith(verdict)
+            assert ("not resolved at this size" in cells[1 + k]) == (verdict == "inconclusive")
     for name in run.FIGURES:
         assert (page.parent / "mechanism" / f"mechanism_{name}.png").read_bytes().startswith(
             name.encode())
@@ -73,8 +76,7 @@ def test_the_whole_early_hazard_is_read_not_its_first_bin_alone(built):
     text = page.read_text(encoding="utf-8")
     tab = pd.read_csv(page.parent / "mechanism" / "mechanism_numbers.csv")
     section = text.split("## The mirror rule")[1]
-    low_cells = table_cells(section, "minimum over t < 4 (bin)")
-    count_cells = table_cells(section, "bins below the rate, t < 4")
+    low_cells = table_cells(section, "hazard minimum over t < 4 / rate vs its Poisson null")
     groups = [("paper", 0.01), ("paper", 0.02), ("uniform", 0.01), ("uniform", 0.02)]
     for k, (method, r) in enumerate(groups):
         g = tab[(tab["method"] == method) & (tab["radius"] == r)]
@@ -87,13 +89,19 @@ def test_the_whole_early_hazard_is_read_not_its_first_bin_alone(built):
         assert low["estimate"] == pytest.approx(bins["estimate"].min())
         assert low["note"] == bins["note"].iloc[at]
         assert low_cells[1 + k].endswith(f"({low['note']})")
-        assert ratio_verdict(low["ci_low"], low["ci_high"]) in low_cells[1 + k]
+        # read against the Poisson null of its own bin, not against 1
+        a, b = low["note"].removeprefix("bin [").rstrip(")").split(", ")
+        null = g[g["quantity"] == f"hazard_nonsticky_bin_{a}_{b}_poisson_null"].iloc[0]
+        diff = g[g["quantity"] == "hazard_min_minus_null"].iloc[0]
+        assert diff["estimate"] == pytest.approx(low["estimate"] - null["estimate"], abs=1e-5)
+        verdict = null_verdict(diff["ci_low"], diff["ci_high"], analysis.HAZARD_NULL_MARGIN)
+        assert f"vs {null['estimate']:.3f}: {verdict}" in low_cells[1 + k]
         lower = [b.note.removeprefix("bin ") for b in bins.itertuples()
                  if ratio_verdict(b.ci_low, b.ci_high) == "lower"]
         count = g[g["quantity"] == "hazard_nonsticky_bins_lower"].iloc[0]
         assert count["estimate"] == len(lower)
-        assert count_cells[1 + k] == f"{len(lower)} of 7: " + (", ".join(lower) or "none")
-    assert "hazard minimum over t < 4" in text.split("## The mirror rule")[0]
+        assert count["note"].endswith(", ".join(lower) or "none")
+    assert "hazard's minimum over t < 4" in text.split("## The mirror rule")[0]
 
 
 @pytest.mark.slow
@@ -119,4 +127,132 @@ def test_the_page_ends_with_where_its_numbers_come_from(built):
                                            for p in page.parent.rglob("*.csv")}
     assert [f for _, _, f in rows] == [
         "kicktimes.studies.mechanism.analysis.analyse",
-        "kicktimes.studies.mechanism.analysis.hazard_profile_rows"]
+        "kicktimes.studies.mechanism.analysis.hazard_profile_rows",
+        "kicktimes.studies.mechanism.analysis.poisson_null_rows",
+        "kicktimes.studies.mechanism.analysis.against_null"]
+
+
+def _first_table_at(text):
+    """The index of the first line of the page's first Markdown table."""
+    lines = text.splitlines()
+    return lines, next(i for i, x in enumerate(lines) if x.startswith("|"))
+
+
+def test_the_page_opens_with_at_most_five_one_line_answers_before_its_first_table(built):
+    _, page_path = built
+    lines, first = _first_table_at(page_path.read_text(encoding="utf-8"))
+    answers = [x for x in lines[:first] if x.startswith("- ")]
+    assert 1 <= len(answers) <= page.FIRST_SCREEN_MAX
+    assert not [x for x in answers if "caveat" not in x]
+    # one number with its interval each, unless no group has an excess to share out
+    assert not [x for x in answers if "[" not in x and "no group with an excess" not in x
+                and "no interval ends there" not in x]
+    assert not any(x.startswith("Verdicts of") for x in lines[:first])
+
+
+def test_the_first_screen_refuses_a_sixth_answer(monkeypatch, built):
+    monkeypatch.setattr(page, "FIRST_SCREEN_MAX", 2)
+    _, page_path = built
+    tab = page.load(page_path.parent / "mechanism")
+    with pytest.raises(ValueError, match="at most 2"):
+        page.first_screen([tab])
+
+
+def test_each_rate_dispersion_verdict_names_its_poisson_null(built):
+    _, page_path = built
+    text = page_path.read_text(encoding="utf-8")
+    tab = page.load(page_path.parent / "mechanism")
+    cells = table_cells(text.split("## The mirror rule")[1],
+                        "rate dispersion across ICs vs its Poisson null")
+    for k, (method, r) in enumerate(page.GROUPS):
+        g = tab[(tab["method"] == method) & (tab["radius"] == r)].set_index("quantity")
+        obs, null = g.loc["observed_dispersion_index_nonsticky"], g.loc[
+            "rate_dispersion_poisson_null"]
+        diff = g.loc["rate_dispersion_minus_null"]
+        assert diff["estimate"] == pytest.approx(obs["estimate"] - null["estimate"], abs=1e-5)
+        verdict = null_verdict(diff["ci_low"], diff["ci_high"], D_MARGIN)
+        assert f"vs {null['estimate']:.3f}: {verdict} (difference " in cells[1 + k]
+        assert diff["note"].startswith(verdict)
+    # the old name, read against 1, is gone from the page
+    assert "dispersion index" not in text and "index of dispersion" not in text
+
+
+def test_a_poisson_ensemble_s_rate_dispersion_is_its_own_null():
+    """Constructed data with a known answer: equal-rate runs are a Poisson ensemble, so the
+    null's mean is about 1 and a Poisson group's dispersion lies at its null, while
+    runs of two rates lie above it."""
+    from types import SimpleNamespace
+
+    rng = np.random.default_rng(4)
+    counts = rng.poisson(40.0, 400)
+    runs = [SimpleNamespace(n_pp=int(n), t_max=2000.0) for n in counts]
+    null = analysis.poisson_null_rows(("paper", 0.01), runs, rng=rng, n_draws=2000)[0]
+    assert null["estimate"] == pytest.approx(1.0, abs=0.01)
+    assert null["ci_low"] < 1 < null["ci_high"]
+
+    def table(n):
+        d = n.var(ddof=1) / n.mean()
+        picks = rng.integers(0, n.size, (2000, n.size))
+        boot = np.array([x.var(ddof=1) / x.mean() for x in n[picks]])
+        return pd.DataFrame({"rule": "mirror", "method": "paper", "radius": 0.01,
+                             "quantity": ["observed_dispersion_index_nonsticky",
+                                          "rate_dispersion_poisson_null"],
+                             "estimate": [d, null["estimate"]],
+                             "ci_low": [np.quantile(boot, 0.025), null["ci_low"]],
+                             "ci_high": [np.quantile(boot, 0.975), null["ci_high"]],
+                             "note": ""})
+
+    mixed = np.r_[rng.poisson(20.0, 200), rng.poisson(60.0, 200)]
+    at = analysis.against_null(table(counts))[0]
+    above = analysis.against_null(table(mixed))[0]
+    assert at["ci_low"] < 0 < at["ci_high"]          # no excess: not decomposed
+    assert above["note"].startswith("above its null")
+    assert above["estimate"] == pytest.approx(mixed.var(ddof=1) / mixed.mean()
+                                              - null["estimate"])
+
+
+def test_the_hazard_null_is_flat_for_equal_rates_and_falls_for_a_rate_mixture():
+    """Known answers: Poisson streams at one rate have a flat hazard (1 in every bin);
+    at two rates the pooled first bin is about E[rate^2] / E[rate]^2 of the pooled rate
+    and the later bins lower."""
+    from types import SimpleNamespace
+
+    rng = np.random.default_rng(0)
+    equal = [SimpleNamespace(n_pp=40, t_max=2000.0) for _ in range(10)]
+    rows = {r["quantity"]: r for r in analysis.poisson_null_rows(("paper", 0.01), equal,
+                                                                rng=rng, n_draws=10)}
+    bins = [q for q in rows if q.endswith("_poisson_null") and q.startswith("hazard")]
+    assert len(bins) == 7 and all(rows[q]["estimate"] == pytest.approx(1.0) for q in bins)
+    mixed = [SimpleNamespace(n_pp=n, t_max=2000.0) for n in (20, 60) * 5]
+    rows = {r["quantity"]: r for r in analysis.poisson_null_rows(("paper", 0.01), mixed,
+                                                                rng=rng, n_draws=10)}
+    lam = np.array([20, 60]) / 2000.0
+    first = rows["hazard_nonsticky_bin_0_0.5_poisson_null"]["estimate"]
+    assert first == pytest.approx((lam ** 2).mean() / lam.mean() ** 2, rel=1e-3)
+    assert rows["hazard_nonsticky_bin_3_4_poisson_null"]["estimate"] < first
+
+
+def test_the_rate_dispersion_null_refuses_bad_input():
+    from types import SimpleNamespace
+
+    runs = [SimpleNamespace(n_pp=0, t_max=100.0) for _ in range(3)]
+    with pytest.raises(ValueError, match="runs"):
+        analysis.poisson_null_rows(("paper", 0.01), runs, rng=np.random.default_rng(0))
+    with pytest.raises(ValueError, match="n_draws"):
+        analysis.poisson_null_rows(("paper", 0.01), runs, rng=np.random.default_rng(0),
+                                      n_draws=1)
+
+
+def test_an_inconclusive_ratio_names_the_size_that_would_resolve_it():
+    from kicktimes.stats import equivalence_sample_size
+
+    # half-width 0.15 at 200 ICs around 1: the CI must shrink into [0.9, 1.1]
+    se = 0.3 / (2 * page.Z95)
+    assert page.needed_ics(1.0, 0.85, 1.15, 200) == (
+        f"not resolved at this size; needs ≈ {equivalence_sample_size(se, 200, 0.1)} ICs")
+    # an estimate 0.05 inside the band has half the room: four times the ICs
+    n1 = int(page.needed_ics(1.0, 0.9, 1.1, 100).split("≈ ")[1].split()[0])
+    n2 = int(page.needed_ics(1.05, 0.95, 1.15, 100).split("≈ ")[1].split()[0])
+    assert n2 == pytest.approx(4 * n1, rel=0.02)
+    with pytest.raises(ValueError, match="n must be"):
+        page.needed_ics(1.0, 0.9, 1.1, 0)

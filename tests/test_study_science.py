@@ -11,7 +11,8 @@ from conftest import refuse_simulations
 
 from kicktimes.experiment import preset, run_experiment
 from kicktimes.render.provenance import PROVENANCE_TITLE
-from kicktimes.stats import format_interval, ratio_verdict
+from kicktimes.stats import equivalence_sample_size, format_interval, ratio_verdict
+from kicktimes.studies.science import page as science_page
 from kicktimes.studies.science import run
 from kicktimes.studies.science.page import SOURCES
 
@@ -71,7 +72,7 @@ def test_the_page_names_the_command_and_quotes_its_csv(built):
                 f"{row.verdict}") in text
     twins = pd.read_csv(page.parent / "science_independent_twins.csv")
     assert f"- r = {twins['radius'].iloc[0]:g}: λ = " in text
-    assert "(1 paper ICs, T = 300 per run" not in text and "(2 paper ICs, T = 300 per run" in text
+    assert "(1 paper ICs, T = 300;" not in text and "(2 paper ICs, T = 300;" in text
     compare = pd.read_csv(page.parent / "science_decorrelation_prediction.csv")
     assert list(compare["family"]) == ["quick_a", "quick_a"]    # no elastic tables: mirror only
     assert (page.parent / "science_stretching.png").stat().st_size > 0
@@ -128,3 +129,47 @@ def test_missing_inputs_name_the_file_and_the_command_that_makes_it(tmp_path, pa
                        r"missing.*kicktimes reproduce --study paper --scale quick --out OUT "
                        r"--results DIR"):
         run.reproduce(tmp_path, stores_dir=paper_study, findings_dir=tmp_path)
+
+
+def test_the_page_opens_with_at_most_five_one_line_answers_before_its_first_table(built):
+    _, page = built
+    lines = page.read_text(encoding="utf-8").splitlines()
+    first = next(i for i, x in enumerate(lines) if x.startswith("|"))
+    answers = [x for x in lines[:first] if x.startswith("- ")]
+    assert 1 <= len(answers) <= science_page.FIRST_SCREEN_MAX
+    assert not [x for x in answers if "caveat" not in x or "[" not in x]
+    assert not [x for x in lines[:first] if x.startswith("Verdicts of ratios")]
+
+
+def test_every_inconclusive_ratio_of_the_page_names_the_size_that_would_resolve_it(built):
+    _, page = built
+    text = page.read_text(encoding="utf-8")
+    table = pd.read_csv(page.parent / "science_stretching.csv")
+    for row in table[table["verdict"] == "inconclusive"].itertuples():
+        cell = (f"{format_interval(row.ratio, row.ratio_ci_low, row.ratio_ci_high)}, "
+                "inconclusive (not resolved at this size")
+        assert cell in text
+
+
+def test_the_size_an_inconclusive_ratio_needs_is_the_equivalence_sample_size():
+    # CI [0.85, 1.15] around 1 at 100 ICs: the whole 0.1 of room to the band's edge
+    se = 0.3 / (2 * science_page.Z95)
+    assert science_page.needed_ics(1.0, 0.85, 1.15, 100) == (
+        f"not resolved at this size; needs ≈ {equivalence_sample_size(se, 100, 0.1)} ICs")
+    # an estimate just inside the band's edge has little room: many more ICs
+    near = science_page.needed_ics(1.09, 0.94, 1.24, 100)
+    assert int(near.split("≈ ")[1].split()[0]) == equivalence_sample_size(se, 100, 0.01)
+    with pytest.raises(ValueError, match="n must be"):
+        science_page.needed_ics(1.0, 0.9, 1.1, 0)
+
+
+def test_the_first_screen_refuses_a_sixth_answer(built, monkeypatch):
+    _, page = built
+    folder = page.parent
+    args = [pd.read_csv(folder / f"science_{n}.csv") for n in (
+        "stretching", "stretching_trend", "independent_twins", "decorrelation_prediction",
+        "rate_windows", "rate_count")]
+    assert len(science_page.first_screen(*args, n_ics=1, n_dec=2)) <= 6
+    monkeypatch.setattr(science_page, "FIRST_SCREEN_MAX", 1)
+    with pytest.raises(ValueError, match="at most 1"):
+        science_page.first_screen(*args, n_ics=1, n_dec=2)

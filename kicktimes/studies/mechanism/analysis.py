@@ -15,6 +15,7 @@ families per radius by the post-collision (L0, L1).
 from __future__ import annotations
 
 import math
+import warnings
 
 import numpy as np
 import pandas as pd
@@ -34,8 +35,9 @@ from kicktimes.studies.mechanism.twins import (
 )
 
 __all__ = [
-    "EXPLAINERS", "HAZARD_EDGES", "LATE_RESCALED", "RETURN_TIME", "STICKY_FACTOR",
-    "analyse", "cell_rows", "hazard_profile_rows", "state_rates",
+    "EXPLAINERS", "HAZARD_EDGES", "LATE_RESCALED", "NULL_DRAWS", "RATE_DISPERSION_MARGIN",
+    "HAZARD_NULL_MARGIN", "RETURN_TIME", "STICKY_FACTOR", "analyse", "cell_rows",
+    "hazard_profile_rows", "against_null", "poisson_null_rows", "state_rates",
 ]
 
 #: the models whose explained share is reported; cox_markov_oos is out of sample
@@ -44,6 +46,15 @@ EXPLAINERS = ("mixed_poisson", "cox_iid", "cox_sequence", "cox_markov_oos")
 LATE_RESCALED = 5.0
 #: intervals shorter than this hold the wall round trips (the hazard's peak)
 RETURN_TIME = 4.0
+#: Poisson ensembles drawn for the null of the rate dispersion across ICs
+NULL_DRAWS = 4000
+#: the margin of the rate dispersion across ICs against its null (`stats.null_verdict`):
+#: the same var / mean of counts as D, so D's margin, `stats.D_MARGIN`; the smallest excess
+#: the page reads is over 1, so the margin is far below the effect it resolves
+RATE_DISPERSION_MARGIN = stats.D_MARGIN
+#: the margin of an early hazard bin over the rate against its null: the first hazard
+#: bin's margin of docs/definitions.md (`kicktimes.report.controls.SHAPE_MARGIN`)
+HAZARD_NULL_MARGIN = 0.05
 #: hazard bins of rescaled times (in units of a mean interval)
 RESCALED_EDGES = np.array([0, 0.01, 0.02, 0.04, 0.07, 0.1, 0.15, 0.2, 0.3, 0.5, 0.7, 1, 1.5,
                            2, 3, 5, 8], float)
@@ -132,6 +143,137 @@ def hazard_profile_rows(key, runs):
          note=f"of {len(early)} bins below t = {RETURN_TIME:g}: " + (", ".join(
              f"[{early['t_low'].iloc[k]:g}, {early['t_high'].iloc[k]:g})" for k in lower)
              or "none"))
+    return rows
+
+
+def poisson_null_rows(key, runs, *, rng, n_draws=NULL_DRAWS):
+    r"""The page's statistics on Poisson streams shaped like the group's calm runs.
+
+    Two nulls, both over the calm runs (sticky runs left out, as the statistics are):
+
+    - the *rate dispersion across ICs*, the index of dispersion var / mean (``ddof = 1``)
+      of the whole-run collision counts over the group's ICs (the row
+      ``observed_dispersion_index_nonsticky`` of :func:`analyse`; not the within-run D of
+      counts in windows of one run). Its null is the same statistic on a Poisson ensemble
+      of the same design: as many ICs, each a Poisson count at the calm runs' mean count;
+      close to 1 but not exactly 1, drawn by Monte Carlo (``n_draws`` ensembles);
+    - the *early hazard* over the pooled rate, per bin ``[a, b)`` of
+      :data:`HAZARD_EDGES` up to :data:`RETURN_TIME`: on Poisson streams at each run's own
+      rate :math:`\lambda_i = n_i / T` with its :math:`n_i` intervals, a bin's events and
+      exposure are :math:`n_i (e^{-\lambda_i a} - e^{-\lambda_i b})` and that over
+      :math:`\lambda_i`, so the pooled hazard over the pooled rate is
+      :math:`\sum_i n_i \Delta_i / \sum_i n_i \Delta_i / \lambda_i` over
+      :math:`\sum_i n_i / \sum_i T`, above 1 where the rates differ between runs (a rate
+      mixture's hazard falls); exact, no draw.
+
+    Parameters
+    ----------
+    key : tuple
+        ``(method, r)``.
+    runs : sequence
+        The group's runs (``n_pp`` and ``t_max`` are read).
+    rng : numpy.random.Generator
+        The generator of the Poisson ensembles.
+    n_draws : int
+        Poisson ensembles drawn.
+
+    Returns
+    -------
+    list of dict
+        Rows ``rate_dispersion_poisson_null`` (estimate: the mean over the ensembles;
+        interval: their 2.5 and 97.5 % percentiles, the null's spread at this design),
+        ``rate_dispersion_poisson_null_mc_se`` (the Monte Carlo standard error of that
+        mean) and ``hazard_nonsticky_bin_<a>_<b>_poisson_null`` per early bin (note: the
+        bin).
+
+    Examples
+    --------
+    >>> from types import SimpleNamespace
+    >>> runs = [SimpleNamespace(n_pp=40, t_max=2000.0) for _ in range(200)]
+    >>> rows = poisson_null_rows(("paper", 0.01), runs, rng=np.random.default_rng(0))
+    >>> round(rows[0]["estimate"], 2), rows[0]["ci_low"] < 1 < rows[0]["ci_high"]
+    (1.0, True)
+    >>> round(rows[2]["estimate"], 12), rows[2]["note"]   # equal rates: a flat hazard
+    (1.0, 'bin [0, 0.5)')
+    """
+    if not (isinstance(n_draws, int | np.integer) and n_draws >= 2):
+        raise ValueError(f"n_draws must be an integer >= 2, got {n_draws!r}")
+    method, r = key
+    t_max = runs[0].t_max
+    n_pp = np.array([run.n_pp for run in runs], float)
+    counts = n_pp[n_pp / t_max <= STICKY_FACTOR * stats.kinetic_rate(r)]
+    if counts.size < 2 or counts.mean() <= 0:
+        raise ValueError(f"runs: the group {method}, r = {r:g} has fewer than two calm runs "
+                         "with collisions; its nulls are undefined")
+    draws = rng.poisson(counts.mean(), size=(int(n_draws), counts.size)).astype(float)
+    mean = draws.mean(axis=1)
+    d = draws.var(axis=1, ddof=1) / np.where(mean > 0, mean, np.nan)
+    d = d[np.isfinite(d)]
+    rows = []
+    _row(rows, key, "rate_dispersion_poisson_null", d.mean(), *stats.percentile_interval(d),
+         note=f"var / mean of {counts.size} Poisson counts at the calm runs' mean count "
+         f"{counts.mean():.4g}; {d.size} ensembles")
+    _row(rows, key, "rate_dispersion_poisson_null_mc_se", d.std(ddof=1) / math.sqrt(d.size),
+         note="Monte Carlo standard error of the null's mean")
+    n = counts[counts > 0]
+    lam = n / t_max
+    rate = n.sum() / (n.size * t_max)
+    edges = HAZARD_EDGES[HAZARD_EDGES <= RETURN_TIME]
+    for a, b in zip(edges[:-1], edges[1:], strict=True):
+        part = n * (np.exp(-lam * a) - np.exp(-lam * b))
+        _row(rows, key, f"hazard_nonsticky_bin_{a:g}_{b:g}_poisson_null",
+             part.sum() / (part / lam).sum() / rate, note=f"bin [{a:g}, {b:g})")
+    return rows
+
+
+def against_null(table):
+    """The page's statistics minus their Poisson nulls (:func:`poisson_null_rows`), per
+    group of ``table``, each with `stats.null_verdict` in its note.
+
+    - ``rate_dispersion_minus_null``: the rate dispersion across ICs
+      (``observed_dispersion_index_nonsticky``, bootstrap interval over ICs) minus the
+      null's mean, margin :data:`RATE_DISPERSION_MARGIN`;
+    - ``hazard_first_bin_minus_null`` and ``hazard_min_minus_null``: the hazard over the
+      rate in the first bin and in the bin of the early minimum
+      (``hazard_nonsticky_first_bin_over_rate``, ``hazard_nonsticky_min_over_rate``,
+      Garwood intervals) minus the null of that bin, margin :data:`HAZARD_NULL_MARGIN`.
+
+    The interval of a difference is the statistic's interval shifted by the null (the
+    nulls' own errors, a Monte Carlo standard error or none, are far below it).
+
+    Examples
+    --------
+    >>> t = pd.DataFrame({"rule": "mirror", "method": "paper", "radius": 0.01,
+    ...     "quantity": ["observed_dispersion_index_nonsticky", "rate_dispersion_poisson_null"],
+    ...     "estimate": [2.5, 1.01], "ci_low": [2.0, 0.8], "ci_high": [3.0, 1.2], "note": ""})
+    >>> row = against_null(t)[0]
+    >>> round(row["estimate"], 2), round(row["ci_low"], 2), row["note"][:15]
+    (1.49, 0.99, 'above its null ')
+    """
+    rows = []
+    for (method, r), g in table.groupby(["method", "radius"], sort=False):
+        q = g.set_index("quantity")
+        reads = [("rate_dispersion_minus_null", "observed_dispersion_index_nonsticky",
+                  "rate_dispersion_poisson_null", RATE_DISPERSION_MARGIN)]
+        if "hazard_nonsticky_min_over_rate" in q.index:
+            low = q.loc["hazard_nonsticky_min_over_rate", "note"].removeprefix("bin [")
+            a, b = low.rstrip(")").split(", ")
+            reads += [("hazard_first_bin_minus_null", "hazard_nonsticky_first_bin_over_rate",
+                       f"hazard_nonsticky_bin_0_{HAZARD_EDGES[1]:g}_poisson_null",
+                       HAZARD_NULL_MARGIN),
+                      ("hazard_min_minus_null", "hazard_nonsticky_min_over_rate",
+                       f"hazard_nonsticky_bin_{a}_{b}_poisson_null", HAZARD_NULL_MARGIN)]
+        for name, stat, null_name, margin in reads:
+            if not {stat, null_name} <= set(q.index):
+                continue
+            obs, null = q.loc[stat], q.loc[null_name]
+            lo, hi = obs["ci_low"] - null["estimate"], obs["ci_high"] - null["estimate"]
+            verdict = stats.null_verdict(lo, hi, margin)
+            _row(rows, (method, r), name, obs["estimate"] - null["estimate"], lo, hi,
+                 note=f"{verdict} (stats.null_verdict, margin {margin:g}); null "
+                 f"{null['estimate']:.4f}")
+    for row in rows:
+        row["rule"] = table["rule"].iloc[0]
     return rows
 
 
@@ -298,7 +440,12 @@ def analyse(key, ics, runs, *, n_twins, rng, rule="mirror", n_boot=1000):
     mix = stats.rate_mixture(post)
     hyp = stats.fit_renewal(nxt[done], "hyperexponential", censored=nxt[~done])
     expo = stats.fit_renewal(nxt[done], "exponential", censored=nxt[~done])
-    data.update(km=(t_km, sf_km), mixture=mix, hyper=hyp, expo=expo)
+    with warnings.catch_warnings():           # Greenwood's band is undefined where S = 0
+        warnings.simplefilter("ignore", RuntimeWarning)
+        band = km.confidence_interval(0.95)   # no random draw: the numbers stay the same
+    data.update(km=(t_km, sf_km), km_ci=(np.nan_to_num(band.low.probabilities),
+                                         np.nan_to_num(band.high.probabilities, nan=1.0)),
+                mixture=mix, hyper=hyp, expo=expo)
     late = t_km >= RETURN_TIME
     s_late = sf_km[late][0] if late.any() else math.nan
     for name, sf in (("mixture", mix.sf), ("hyperexponential", hyp.dist.sf),

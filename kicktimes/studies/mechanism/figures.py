@@ -40,10 +40,10 @@ def _groups(results):
     return methods, radii
 
 
-def _panels(results, fn, title, *, sharey=False, figsize=(10, 7.5)):
+def _panels(results, fn, title, *, sharey=False, sharex=False, figsize=(10, 7.5)):
     methods, radii = _groups(results)
     fig, axes = plt.subplots(len(methods), len(radii), figsize=figsize, sharey=sharey,
-                             squeeze=False)
+                             sharex=sharex, squeeze=False)
     for i, method in enumerate(methods):
         for j, r in enumerate(radii):
             ax = axes[i, j]
@@ -121,11 +121,14 @@ def fig_recollisions(results):
         ax.set_yscale("log")
         ax.set_xlabel("max wall hits of the two disks since the previous event")
         ax.set_ylabel("share of events")
-        ax.text(0.3, 0.9, f"re-collisions (≤ 1 each): {rec.share:.3f} "
-                f"[{rec.ci_low:.3f}, {rec.ci_high:.3f}]\nrandom placement: {null.share:.4f}",
-                transform=ax.transAxes, fontsize=7.5, va="top")
+        # all runs here; the page's table leaves the sticky runs out
+        ax.text(0.3, 0.9, f"re-collisions (≤ 1 each), all runs: {rec.share:.3f} "
+                f"[{rec.ci_low:.3f}, {rec.ci_high:.3f}]\nrandom placement: {null.share:.3f} "
+                f"[{null.ci_low:.3f}, {null.ci_high:.3f}]",
+                transform=ax.transAxes, fontsize=8, va="top")
         ax.legend(fontsize=7, loc="lower left")
-    return _panels(results, draw, "Re-collisions: returns after at most one wall hit")
+    return _panels(results, draw, "Re-collisions: returns after at most one wall hit "
+                   "(one x and y scale)", sharex=True, sharey=True)
 
 
 def fig_rate_prediction(results):
@@ -153,22 +156,28 @@ def fig_rate_prediction(results):
 def fig_survival(results):
     def draw(ax, key, d):
         t, sf = d["km"]
+        if "km_ci" in d:
+            lo, hi = d["km_ci"]
+            ax.fill_between(t, np.maximum(lo, 1e-12), hi, step="post", color="k", alpha=0.2,
+                            lw=0, label="Kaplan-Meier 95 % CI")
         ax.step(t, sf, where="post", color="k", label="pooled intervals (Kaplan-Meier)")
         grid = np.linspace(0, t.max(), 300)
         ax.plot(grid, d["mixture"].sf(grid), color="C0", label="mixture over post-collision L")
         ax.plot(grid, d["hyper"].dist.sf(grid), color="C1", ls="--", label="hyperexponential fit")
         ax.plot(grid, d["expo"].dist.sf(grid), color="grey", ls=":", label="exponential fit")
         ax.set_yscale("log")
-        ax.set_ylim(max(sf[sf > 0].min(), 1e-4), 1.05)
+        ax.set_ylim(1e-4, 1.05)
         back = d["return_time"]
         s_obs = sf[t >= back][0]
-        ax.text(0.3, 0.55, f"S({back:g}): observed {s_obs:.3f}, mixture "
+        ax.text(0.97, 0.97, f"S({back:g}): observed {s_obs:.3f}, mixture "
                 f"{float(d['mixture'].sf(back)):.3f}\n(the returns within a wall round "
-                "trip)", transform=ax.transAxes, fontsize=8)
+                "trip)", transform=ax.transAxes, fontsize=8, ha="right", va="top")
         ax.set_xlabel("interval between collisions")
         ax.set_ylabel("survival")
-        ax.legend(fontsize=7)
-    return _panels(results, draw, "The pooled interval law")
+        if key == next(iter(results)):      # one legend, clear of the tails
+            ax.legend(fontsize=7, loc="center right", framealpha=0.9)
+    return _panels(results, draw, "The pooled interval law (one x and y scale)", sharex=True,
+                   sharey=True)
 
 
 def fig_battery(results):
@@ -178,7 +187,8 @@ def fig_battery(results):
     width = 0.8 / len(results)
     panels = (("uniformity_ks", "share of runs rejected, uniformity KS (α = 0.05)"),
               ("exponential_ad", "share of runs rejected, exponential AD (α = 0.05)"),
-              ("dispersion_index", "index of dispersion of the counts (sticky runs left out)"))
+              ("dispersion_index", "rate dispersion across ICs: var / mean of the\n"
+               "whole-run counts over ICs (sticky runs left out)"))
     for k, ((method, r), d) in enumerate(results.items()):
         x = np.arange(len(names)) + (k - (len(results) - 1) / 2) * width
         label = f"{'paper' if method == 'paper' else 'invariant'}, r = {r:g}"
@@ -207,7 +217,8 @@ def fig_battery(results):
         ax.set_ylabel(ylabel, fontsize=9)
     axes[0].legend(fontsize=7)
     fig.suptitle("The Poisson battery on twins of the runs (bars: twins' 95 % range over "
-                 "ensembles; observed: Clopper-Pearson, dispersion: bootstrap over ICs)")
+                 "ensembles; observed: Clopper-Pearson; rate dispersion across ICs: bootstrap "
+                 "over ICs, dashed: its Poisson value)", fontsize=11)
     fig.tight_layout()
     return fig
 

@@ -1,10 +1,17 @@
 """The page ``mechanism.md`` from the numbers tables of both collision rules.
 
 Reads the ``mechanism_numbers.csv`` of each rule (`kicktimes.studies.mechanism.run`
-writes them) and writes the page: every number from a row, every comparative word from a
-verdict (`kicktimes.stats.ratio_verdict` for a hazard against the rate it should equal,
-disjoint 95 % intervals for "above chance"), closed by the table of where its numbers come
-from (`sources`). Definitions and methods stay in docs/mechanism.md.
+writes them) and writes the page: at most five one-line answers first (`first_screen`),
+then one table per rule (`rule_section`), every number from a row and every comparative
+word from a verdict: `kicktimes.stats.ratio_verdict` for a hazard against the rate it
+should equal, `kicktimes.stats.null_verdict` for the rate dispersion across ICs against
+its Poisson null and for the early hazard against the hazard of Poisson streams at each
+run's own rate (`analysis.against_null`), disjoint 95 % intervals for
+"above chance". An inconclusive ratio names the size that would resolve it
+(`kicktimes.stats.equivalence_sample_size`). The page closes with the table of where its
+numbers come from (`sources`). Definitions and methods stay in docs/mechanism.md; the rows
+the page does not quote (the hazard bin by bin, its peak, the iid twins, ...) are in the
+CSVs it links.
 """
 
 from __future__ import annotations
@@ -16,20 +23,37 @@ import pandas as pd
 
 from kicktimes.render.pages import header, write_results_page
 from kicktimes.render.provenance import Source
-from kicktimes.stats import MARGIN, format_interval, ratio_rule, ratio_verdict
-from kicktimes.studies.mechanism.analysis import analyse, hazard_profile_rows
-from kicktimes.studies.mechanism.figures import NORMALISED_YLIM
+from kicktimes.stats import (
+    MARGIN,
+    equivalence_sample_size,
+    format_interval,
+    null_verdict,
+    ratio_verdict,
+)
+from kicktimes.studies.mechanism.analysis import (
+    HAZARD_NULL_MARGIN,
+    RATE_DISPERSION_MARGIN,
+    against_null,
+    analyse,
+    hazard_profile_rows,
+    poisson_null_rows,
+)
 
-__all__ = ["load", "rule_section", "sources", "summary", "write_page"]
+__all__ = ["FIRST_SCREEN_MAX", "first_screen", "load", "needed_ics", "rule_section",
+           "sources", "write_page"]
 
 GROUPS = (("paper", 0.01), ("paper", 0.02), ("uniform", 0.01), ("uniform", 0.02))
 LABEL = {"paper": "paper ICs", "uniform": "invariant ICs"}
-TESTS = (("uniformity_ks", "uniformity KS rejections"),
-         ("exponential_ad", "exponential AD rejections"),
-         ("dispersion_index_nonsticky", "dispersion index, sticky runs left out"))
-MODELS = (("cox_sequence", "in sample: Cox twin replaying the run's own states"),
-          ("cox_markov_oos", "out of sample: rate chain fitted on the other half of the ICs"),
-          ("cox_iid", "rates drawn independently from the group's pooled states"))
+#: the explained shares the page quotes: (test, its label) x (model, its short label)
+TESTS = (("uniformity_ks", "uniformity-KS rejections"),
+         ("exponential_ad", "exponential-AD rejections"),
+         ("dispersion_index_nonsticky", "rate dispersion across ICs"))
+MODELS = (("cox_sequence", "in sample"), ("cox_markov_oos", "out of sample"))
+#: the answers a page may open with before its first table
+FIRST_SCREEN_MAX = 5
+#: the name the page gives the var / mean of whole-run counts over ICs (not D in windows)
+DISPERSION_NAME = "rate dispersion across ICs"
+Z95 = 1.959963984540054
 
 
 def load(folder):
@@ -51,6 +75,10 @@ def _get(tab, method, r, quantity):
     return m.iloc[0]
 
 
+def _groups_of(tab):
+    return [g for g in GROUPS if ((tab["method"] == g[0]) & (tab["radius"] == g[1])).any()]
+
+
 def _iv(row, edges=()):
     if not math.isfinite(row["estimate"]):
         return "n/a"
@@ -59,37 +87,59 @@ def _iv(row, edges=()):
     return format_interval(row["estimate"], row["ci_low"], row["ci_high"], edges=edges)
 
 
-def _hazard_cell(row):
-    """A hazard over its reference rate (1), with the ratio verdict against it."""
+def needed_ics(estimate, low, high, n, tolerance=MARGIN, center=1.0):
+    """What an inconclusive ratio needs: ``"not resolved at this size; needs ≈ N ICs"``.
+
+    N is `kicktimes.stats.equivalence_sample_size` with the standard error of the 95 %
+    interval ``[low, high]`` at ``n`` ICs and, as margin, the distance of the estimate
+    from the nearer band edge ``center ± tolerance`` (1 for a ratio, 0 for a difference
+    from a null): the interval around the estimate must
+    shrink to that distance to fall on one side of the edge (inside the band: "within";
+    outside: "higher" or "lower"), at the measured estimate.
+
+    Examples
+    --------
+    >>> needed_ics(1.0, 0.85, 1.15, 200)
+    'not resolved at this size; needs ≈ 1231 ICs'
+    >>> needed_ics(0.8, 0.55, 1.05, 200)
+    'not resolved at this size; needs ≈ 3420 ICs'
+    >>> needed_ics(1.1, 1.0, 1.2, 200)
+    'not resolved at this size: the estimate lies on the band edge 1.1'
+    """
+    if not (isinstance(n, int) and n >= 1):
+        raise ValueError(f"n must be an integer >= 1, got {n!r}")
+    room = abs(tolerance - abs(float(estimate) - center))
+    if room < 1e-9:
+        edge = center + tolerance if estimate > center else center - tolerance
+        return f"not resolved at this size: the estimate lies on the band edge {edge:g}"
+    se = (float(high) - float(low)) / (2 * Z95)
+    return f"not resolved at this size; needs ≈ {equivalence_sample_size(se, n, room)} ICs"
+
+
+def _ratio_cell(row, n):
+    """A hazard over the rate it should equal (1), with its `ratio_verdict`; an
+    inconclusive one with the size that would resolve it."""
     if not math.isfinite(row["estimate"]):
         return "no interval ends there"
-    return f"{_iv(row, (0.9, 1.0, 1.1))}, {ratio_verdict(row['ci_low'], row['ci_high'], MARGIN)}"
+    verdict = ratio_verdict(row["ci_low"], row["ci_high"], MARGIN)
+    cell = f"{_iv(row, (0.9, 1.0, 1.1))}, {verdict}"
+    if verdict == "inconclusive":
+        cell += f" ({needed_ics(row['estimate'], row['ci_low'], row['ci_high'], n)})"
+    return cell
 
 
-def _bins_cell(row):
-    """``k of n: [a, b), ...`` from a ``hazard_nonsticky_bins_lower`` row."""
-    of, _, where = row["note"].partition(": ")
-    return f"{int(row['estimate'])} {of.split(' bins')[0]}: {where}"
-
-
-#: the observed row of each explained quantity and the Poisson value it is measured from
-OBSERVED = {"uniformity_ks": ("observed_reject_uniformity_ks", 0.05),
-            "exponential_ad": ("observed_reject_exponential_ad", 0.05),
-            "dispersion_index_nonsticky": ("observed_dispersion_index_nonsticky", 1.0)}
-
-
-def _excess(tab, m, r, test):
-    """Whether the observed value's 95 % interval lies above the Poisson value (an excess
-    to explain; a gap inside its own noise is not decomposed)."""
-    name, base = OBSERVED[test]
-    row = _get(tab, m, r, name)
-    return bool(row["ci_low"] > base)
-
-
-def _explained_cell(tab, m, r, test, model):
-    if not _excess(tab, m, r, test):
-        return "no excess to explain"
-    return _iv(_get(tab, m, r, f"explained_{test}_by_{model}"))
+def _hazard_null_cell(tab, m, r, stat, diff_name, n):
+    """An early hazard over the rate beside its Poisson null, with `null_verdict` on the
+    difference; an inconclusive one with the size that would resolve it."""
+    row, diff = _get(tab, m, r, stat), _get(tab, m, r, diff_name)
+    null = row["estimate"] - diff["estimate"]
+    verdict = null_verdict(diff["ci_low"], diff["ci_high"], HAZARD_NULL_MARGIN)
+    cell = f"{_iv(row, (0.9, 1.0, 1.1))} vs {null:.3f}: {verdict}"
+    if verdict == "inconclusive":
+        need = needed_ics(diff["estimate"], diff["ci_low"], diff["ci_high"], n,
+                          HAZARD_NULL_MARGIN, center=0.0)
+        cell += f" ({need})"
+    return cell
 
 
 def _above_chance(share, chance):
@@ -100,232 +150,257 @@ def _above_chance(share, chance):
     return "not distinguished from chance (intervals overlap)"
 
 
+def _dispersion_verdict(tab, m, r):
+    row = _get(tab, m, r, "rate_dispersion_minus_null")
+    return null_verdict(row["ci_low"], row["ci_high"], RATE_DISPERSION_MARGIN)
+
+
+def _excess(tab, m, r, test):
+    """Whether the observed value lies above its null (an excess to explain; a gap
+    inside its own noise is not decomposed): a rejection share's interval above the
+    exact tests' level 0.05, the rate dispersion across ICs "above its null"."""
+    if test == "dispersion_index_nonsticky":
+        return _dispersion_verdict(tab, m, r) == "above its null"
+    return bool(_get(tab, m, r, f"observed_reject_{test}")["ci_low"] > 0.05)
+
+
+def _share_iv(tab, m, r, test, model):
+    if not _excess(tab, m, r, test):
+        return "no excess"
+    return _iv(_get(tab, m, r, f"explained_{test}_by_{model}"), (1.0,))
+
+
 def rule_section(tab, figures):
-    """The section of one rule; ``figures`` is its folder relative to the page."""
+    """The section of one rule: its sizes, one table (rows: quantities; columns: the
+    groups) and its three figures; ``figures`` is its folder relative to the page."""
     rule = tab["rule"].iloc[0]
     run = tab[tab["method"] == "run"].set_index("quantity")["estimate"]
-    groups = [g for g in GROUPS if ((tab["method"] == g[0]) & (tab["radius"] == g[1])).any()]
-    head = "| | " + " | ".join(f"{LABEL[m]}, r = {r:g}" for m, r in groups) + " |"
-    sep = "|---|" + "---|" * len(groups)
+    n = int(run["n_ics"])
+    groups = _groups_of(tab)
+    g = lambda m, r, q: _get(tab, m, r, q)  # noqa: E731
 
     def line(label, fn):
         return f"| {label} | " + " | ".join(fn(m, r) for m, r in groups) + " |"
 
-    g = lambda m, r, q: _get(tab, m, r, q)  # noqa: E731
+    def chance(m, r):
+        s, c = g(m, r, "recollision_share_nonsticky"), g(
+            m, r, "recollision_share_poisson_null_nonsticky")
+        return f"{_iv(s)} vs {_iv(c)}: {_above_chance(s, c)}"
+
+    def dispersion(m, r):
+        obs, null = g(m, r, "observed_dispersion_index_nonsticky"), g(
+            m, r, "rate_dispersion_poisson_null")
+        diff = g(m, r, "rate_dispersion_minus_null")
+        return (f"{_iv(obs)} vs {null['estimate']:.3f}: {_dispersion_verdict(tab, m, r)} "
+                f"(difference {_iv(diff, (0.0,))})")
+
     lines = [f"## The {rule} rule", "",
-             f"{int(run['n_ics'])} ICs per group, `t_max = {run['t_max']:g}`, "
-             f"{int(run['twins'])} twin ensembles per model, seed {int(run['seed'])}; "
-             "collisions per group: " + ", ".join(
-                 f"{int(g(m, r, 'n_collisions')['estimate'])}" for m, r in groups) + ".", "",
-             "**Hazard of the next collision** (sticky runs left out; over the group's pooled "
-             "rate, 95 % Garwood intervals, which treat every interval as independent and "
-             "leave out the differences between runs; verdicts against 1 by "
-             "`ratio_verdict`. The whole early hazard is read, every bin up to t = 4 (the "
-             "refractory time and the wall round trips): its minimum, the bin where it falls "
-             "(the Garwood interval is that bin's own, not adjusted for picking the lowest of "
-             "several), and how many bins lie below the rate each by its own interval, beside "
-             "the first bin alone. At r = 0.02, paper ICs, the first bin and the minimum are "
-             "the refractory dip of [mmpp.md](mmpp.md): the same ICs, the same "
-             "`kicktimes.stats.interval_hazard`; that page gives a bootstrap interval over runs "
-             "beside them; every bin is in the table, rows `hazard_nonsticky_bin_*`):", "",
-             head, sep,
-             line("in [0, 0.5) after a collision (first bin)",
-                  lambda m, r: _hazard_cell(g(m, r, "hazard_nonsticky_first_bin_over_rate"))),
-             line("minimum over t < 4 (bin)", lambda m, r: _hazard_cell(
-                 g(m, r, "hazard_nonsticky_min_over_rate"))
-                 + f" ({g(m, r, 'hazard_nonsticky_min_over_rate')['note']})"),
-             line("bins below the rate, t < 4", lambda m, r: _bins_cell(
-                 g(m, r, "hazard_nonsticky_bins_lower"))),
-             line("peak (bin)", lambda m, r: f"{_iv(g(m, r, 'hazard_nonsticky_peak_over_rate'))}"
-                  f" ({g(m, r, 'hazard_nonsticky_peak_over_rate')['note']})"),
-             line("in [3, 4)", lambda m, r: _hazard_cell(
-                 g(m, r, "hazard_nonsticky_dip_over_rate"))),
-             "", "**Γ-rescaled hazard** (each interval times the predicted rate Γ of the state "
-             "it starts in" + (", conditioned on the speeds as well as on the angular momenta"
-                               if rule == "elastic" else "")
-             + "; all runs; 1 at every rescaled time if the phase-averaged rate held):", "",
-             head, sep,
-             line("overall rate",
-                  lambda m, r: f"{g(m, r, 'rescaled_hazard_rate')['estimate']:.3f}"),
-             line("rescaled t in [0.2, 1)", lambda m, r: _hazard_cell(
-                 g(m, r, "rescaled_hazard_0.2_1"))),
-             line("rescaled t in [1, 5)", lambda m, r: _hazard_cell(
-                 g(m, r, "rescaled_hazard_1_5"))),
-             line("rescaled t > 5", lambda m, r: _hazard_cell(g(m, r, "rescaled_hazard_late"))),
-             "", f"![hazard]({figures}/mechanism_hazard.png)", "",
-             f"![rescaled hazard]({figures}/mechanism_hazard_normalised.png)", "",
-             "**The hazard** (top, raw time, one y scale over the four panels; open black: "
-             "all runs, red: sticky runs left out; the hyperexponential fit and the mixture "
-             "over post-collision L are smooth laws that miss the data below t ≈ 10, the "
-             "refractory dip and the wall round-trip peak, and follow them only beyond) and "
-             "**the hazard after removing the rate differences** (bottom, the same y range "
-             f"{NORMALISED_YLIM[0]:g}–{NORMALISED_YLIM[1]:g} under both rules: green, "
-             "intervals in units of the run's own mean interval; blue, intervals times Γ of "
-             "the state they start in), 95 % intervals.",
-             "", "**Re-collisions** (at most one wall hit of each disk since the previous "
-             "collision; sticky runs left out; bootstrap over runs) against randomly placed "
-             "events at each run's rate (\"above chance\": the two 95 % intervals are "
-             "disjoint):", "", head, sep,
-             line("share", lambda m, r: _iv(g(m, r, "recollision_share_nonsticky"))),
-             line("chance level", lambda m, r: _iv(
-                 g(m, r, "recollision_share_poisson_null_nonsticky"))),
-             line("verdict", lambda m, r: _above_chance(
-                 g(m, r, "recollision_share_nonsticky"),
-                 g(m, r, "recollision_share_poisson_null_nonsticky"))),
-             "", "**The Poisson battery** (share of runs rejected at α = 0.05, "
-             "Clopper–Pearson; dispersion index of the counts, bootstrap over ICs) and the "
-             "share of its excess over a Poisson process that each twin model reproduces, "
-             "(twin − Poisson) / (observed − Poisson), bootstrap over ICs; given only where "
-             "the observed value's interval lies above the Poisson value (0.05, or 1 for the "
-             "dispersion index), otherwise \"no excess to explain\":", "", head, sep,
-             line("uniformity KS, observed", lambda m, r: _iv(
-                 g(m, r, "observed_reject_uniformity_ks"))),
-             line("exponential AD, observed", lambda m, r: _iv(
-                 g(m, r, "observed_reject_exponential_ad"))),
-             line("dispersion index (no sticky), observed", lambda m, r: _iv(
-                 g(m, r, "observed_dispersion_index_nonsticky")))]
-    for model, label in MODELS:
-        for test, tlabel in TESTS:
-            lines.append(line(f"explained, {tlabel}: {label}", lambda m, r, test=test,
-                              model=model: _explained_cell(tab, m, r, test, model)))
-    lines += ["", f"![battery]({figures}/mechanism_battery.png)", "",
-              "**The Poisson battery on the twins** (bars: the twins' 95 % range over the "
-              "ensembles; observed: Clopper–Pearson).", "", _carry(tab, groups, rule), ""]
+             f"{n} ICs per group, `t_max = {run['t_max']:g}`, {int(run['twins'])} twin "
+             f"ensembles per model, seed {int(run['seed'])}; collisions per group: "
+             + ", ".join(f"{int(g(m, r, 'n_collisions')['estimate'])}" for m, r in groups)
+             + ".", "",
+             "| | " + " | ".join(f"{LABEL[m]}, r = {r:g}" for m, r in groups) + " |",
+             "|---|" + "---|" * len(groups),
+             line("hazard in [0, 0.5) / rate vs its Poisson null", lambda m, r:
+                  _hazard_null_cell(tab, m, r, "hazard_nonsticky_first_bin_over_rate",
+                                    "hazard_first_bin_minus_null", n)),
+             line("hazard minimum over t < 4 / rate vs its Poisson null", lambda m, r:
+                  _hazard_null_cell(tab, m, r, "hazard_nonsticky_min_over_rate",
+                                    "hazard_min_minus_null", n)
+                  + f" ({g(m, r, 'hazard_nonsticky_min_over_rate')['note']})"),
+             line("Γ-rescaled hazard, t in [1, 5)", lambda m, r: _ratio_cell(
+                 g(m, r, "rescaled_hazard_1_5"), n)),
+             line("Γ-rescaled hazard, t > 5", lambda m, r: _ratio_cell(
+                 g(m, r, "rescaled_hazard_late"), n)),
+             line("re-collision share vs chance", chance),
+             line(f"{DISPERSION_NAME} vs its Poisson null", dispersion)]
+    for test, label in TESTS:
+        lines.append(line(f"explained share of the excess {label}, in / out of sample",
+                          lambda m, r, test=test: " / ".join(
+                              _share_iv(tab, m, r, test, model) for model, _ in MODELS)))
+    lines += ["", f"![hazard]({figures}/mechanism_hazard.png)", "",
+              f"![rescaled hazard]({figures}/mechanism_hazard_normalised.png)", "",
+              f"![battery]({figures}/mechanism_battery.png)", ""]
     return lines
 
 
-def _groups_of(tab):
-    return [g for g in GROUPS if ((tab["method"] == g[0]) & (tab["radius"] == g[1])).any()]
+def _cases(tabs, quantity):
+    """Every (rule, method, r, row) of ``quantity`` over the rules' tables."""
+    return [(t["rule"].iloc[0], m, r, _get(t, m, r, quantity)) for t in tabs
+            for m, r in _groups_of(t)]
 
 
-def _count(tab, quantity, verdict):
-    """``"k of n groups"`` whose ``quantity`` gets ``verdict`` from `ratio_verdict`."""
-    groups = _groups_of(tab)
-    k = sum(ratio_verdict(_get(tab, m, r, quantity)["ci_low"],
-                          _get(tab, m, r, quantity)["ci_high"], MARGIN) == verdict
-            for m, r in groups)
-    return f"{k} of {len(groups)}"
+def _finite(cases):
+    """The cases whose row has a finite estimate and interval (a group where no interval
+    ends in the bin has none)."""
+    return [c for c in cases if all(math.isfinite(c[3][k])
+                                     for k in ("estimate", "ci_low", "ci_high"))]
 
 
-def _share_sides(rows):
-    """How many explained shares' 95 % intervals lie below 1, contain 1, lie above 1."""
-    below = sum(x["ci_high"] < 1 for x in rows)
-    above = sum(x["ci_low"] > 1 for x in rows)
-    return f"CI below 1 in {below}, containing 1 in {len(rows) - below - above}, above 1 in {above}"
+def _where(rule, m, r):
+    return f"{rule}, {LABEL[m]}, r = {r:g}"
 
 
-def _explained_range(tab, test, model):
-    groups = [g for g in _groups_of(tab) if _excess(tab, *g, test)]
-    rows = [_get(tab, m, r, f"explained_{test}_by_{model}") for m, r in groups]
-    rows = [x for x in rows if math.isfinite(x["estimate"])]
-    if not rows:
-        return "no group with an excess"
-    v = [x["estimate"] for x in rows]
-    span = f"{v[0]:.2f}" if len(v) == 1 else f"{min(v):.2f}–{max(v):.2f}"
-    return f"{span} ({len(v)} groups; {_share_sides(rows)})"
+def _tally(tabs, verdict_of, wanted):
+    """``"in k of n groups under both rules"`` when every group gets ``wanted``, else
+    ``"depends on the rule: mirror k of n, elastic ..."``; and whether all agree."""
+    per = {t["rule"].iloc[0]: [verdict_of(t, m, r) for m, r in _groups_of(t)] for t in tabs}
+    total = sum(len(v) for v in per.values())
+    hits = sum(v.count(wanted) for v in per.values())
+    if hits == total:
+        return f"in {hits} of {total} groups, both rules", True
+    return "in " + ", ".join(f"{rule} {v.count(wanted)} of {len(v)}" for rule, v in
+                             per.items()) + " groups (depends on the rule)", False
 
 
-def summary(tabs):
-    """The first table: what carries the non-Poisson statistics under each rule, as counts
-    of groups whose verdict says so and ranges of explained shares."""
-    rules = [t["rule"].iloc[0] for t in tabs]
-    rows = [
-        ("hazard minimum over t < 4 after a collision lower than the rate (refractory dip, "
-         "wherever it falls)", lambda t: _count(t, "hazard_nonsticky_min_over_rate", "lower")),
-        ("hazard in [0, 0.5) after a collision (the first bin alone) lower than the rate",
-         lambda t: _count(t, "hazard_nonsticky_first_bin_over_rate", "lower")),
-        ("re-collisions above chance", lambda t: str(sum(
-            _above_chance(_get(t, m, r, "recollision_share_nonsticky"),
-                          _get(t, m, r, "recollision_share_poisson_null_nonsticky"))
-            == "above chance" for m, r in _groups_of(t))) + f" of {len(_groups_of(t))}"),
-        ("Γ-rescaled hazard in [1, 5) within 10 % of 1",
-         lambda t: _count(t, "rescaled_hazard_1_5", "within 10 %")),
-        ("Γ-rescaled hazard beyond rescaled t = 5 lower than 1",
-         lambda t: _count(t, "rescaled_hazard_late", "lower")),
-    ]
-    for test, label in TESTS:
-        rows.append((f"explained out of sample (rate chain), {label}",
-                     lambda t, test=test: _explained_range(t, test, "cox_markov_oos")))
-        rows.append((f"explained in sample (run's own states), {label}",
-                     lambda t, test=test: _explained_range(t, test, "cox_sequence")))
-    lines = ["## What carries the non-Poisson statistics, per rule", "",
-             "Counts of the four groups (IC family × radius) whose verdict, in the tables "
-             "below, says so; explained shares only over the groups whose observed value "
-             "lies above the Poisson value.", "",
-             "| | " + " | ".join(f"{r} rule" for r in rules) + " |",
-             "|---|" + "---|" * len(rules)]
-    for label, fn in rows:
-        lines.append(f"| {label} | " + " | ".join(fn(t) for t in tabs) + " |")
-    return lines + ["", "A share is read as falling short of the excess only where its 95 % "
-                    "interval lies below 1, and as overshooting it (the twins departing from "
-                    "Poisson more often than the runs) only where the interval lies above 1; "
-                    "an interval containing 1 does not tell either. In sample and out of "
-                    "sample are two estimates side by side; neither bounds the other.", ""]
+def first_screen(tabs):
+    """The page's opening: at most :data:`FIRST_SCREEN_MAX` one-line answers, each one
+    number with its 95 % interval, where it comes from and its caveat."""
+    def ratio_of(q):
+        return lambda t, m, r: ratio_verdict(_get(t, m, r, q)["ci_low"],
+                                             _get(t, m, r, q)["ci_high"], MARGIN)
+
+    lines = []
+    # 1. the refractory dip: the weakest group is the one whose upper end is highest
+    def null_of(name, margin):
+        return lambda t, m, r: null_verdict(_get(t, m, r, name)["ci_low"],
+                                            _get(t, m, r, name)["ci_high"], margin)
+
+    said, _ = _tally(tabs, null_of("hazard_min_minus_null", HAZARD_NULL_MARGIN),
+                     "below its null")
+    rule, m, r, diff = max(_finite(_cases(tabs, "hazard_min_minus_null")),
+                           key=lambda c: c[3]["ci_high"])
+    t = next(t for t in tabs if t["rule"].iloc[0] == rule)
+    row = _get(t, m, r, "hazard_nonsticky_min_over_rate")
+    lines.append(f"- **Refractory dip**: the hazard's minimum over t < 4 after a collision, "
+                 f"over the rate, lies below its Poisson null {said}; weakest "
+                 f"{_iv(row, (0.9, 1.0, 1.1))} against "
+                 f"{row['estimate'] - diff['estimate']:.3f} ({_where(rule, m, r)}, "
+                 f"{row['note']}); caveat: the interval is that bin's own, not adjusted for "
+                 "picking the lowest of 7 bins.")
+    # 2. re-collisions against randomly placed events
+    def chance_of(t, m, r):
+        return _above_chance(_get(t, m, r, "recollision_share_nonsticky"),
+                             _get(t, m, r, "recollision_share_poisson_null_nonsticky"))
+    said, all_above = _tally(tabs, chance_of, "above chance")
+    above = [c for c in _cases(tabs, "recollision_share_nonsticky")
+             if chance_of(next(t for t in tabs if t["rule"].iloc[0] == c[0]), c[1], c[2])
+             == "above chance"]
+    if above:
+        rule, m, r, row = min(above, key=lambda c: c[3]["ci_low"])
+        t = next(t for t in tabs if t["rule"].iloc[0] == rule)
+        null = _get(t, m, r, "recollision_share_poisson_null_nonsticky")
+        others = sorted({chance_of(t2, m2, r2) for t2 in tabs for m2, r2 in _groups_of(t2)}
+                        - {"above chance"})
+        lines.append(f"- **Re-collisions** (after at most one wall hit each): above chance "
+                     f"{said}; weakest {_iv(row)} against chance {_iv(null)} "
+                     f"({_where(rule, m, r)})"
+                     + ("" if all_above else f"; the other groups: {', '.join(others)}")
+                     + "; caveat: chance is randomly placed events at each run's rate.")
+    # 3. the long intervals the state's rate misses
+    q = "rescaled_hazard_late"
+    said, _ = _tally(tabs, ratio_of(q), "lower")
+    found = _finite(_cases(tabs, q))
+    closest = "no interval ends there in any group"
+    if found:
+        rule, m, r, row = max(found, key=lambda c: c[3]["ci_high"])
+        closest = f"closest to 1 {_iv(row, (0.9, 1.0, 1.1))} ({_where(rule, m, r)})"
+    lines.append(f"- **Long waits**: the Γ-rescaled hazard beyond rescaled t = 5 (1 if each "
+                 f"state's predicted rate held) lies below 1 {said}; {closest}; caveat: "
+                 "Garwood intervals treat the pooled intervals as independent.")
+    # 4. the rate dispersion across ICs against its Poisson null
+    said, _ = _tally(tabs, lambda t, m, r: _dispersion_verdict(t, m, r), "above its null")
+    rule, m, r, row = min(_finite(_cases(tabs, "rate_dispersion_minus_null")),
+                          key=lambda c: c[3]["ci_low"])
+    t = next(t for t in tabs if t["rule"].iloc[0] == rule)
+    null = _get(t, m, r, "rate_dispersion_poisson_null")
+    name = DISPERSION_NAME[0].upper() + DISPERSION_NAME[1:]
+    lines.append(f"- **{name}** (var / mean of the whole-run counts over ICs): above its "
+                 f"Poisson null {said}; smallest excess "
+                 f"{_iv(row, (0.0,))} over the null {null['estimate']:.3f} "
+                 f"({_where(rule, m, r)}); caveat: a spread of rates between ICs, not the "
+                 "within-run D of counts in windows.")
+    # 5. how much of the excess AD rejections the in-sample Cox twins reproduce
+    test, model = "exponential_ad", "cox_sequence"
+    parts = []
+    for tb in tabs:
+        rows = [(m, r, _get(tb, m, r, f"explained_{test}_by_{model}"))
+                for m, r in _groups_of(tb) if _excess(tb, m, r, test)]
+        short = [x for x in rows if x[2]["ci_high"] < 1]
+        if rows and len(short) == len(rows):
+            m, r, row = max(short, key=lambda x: x[2]["estimate"])
+            parts.append(f"{tb['rule'].iloc[0]}: short of it in {len(short)} of {len(rows)} "
+                         f"groups, at most {_iv(row, (1.0,))} ({LABEL[m]}, r = {r:g})")
+        elif rows:
+            m, r, row = max(rows, key=lambda x: x[2]["ci_high"])
+            parts.append(f"{tb['rule'].iloc[0]}: not resolved (the interval lies below 1 in "
+                         f"{len(short)} of {len(rows)} groups with an excess; widest "
+                         f"{_iv(row, (1.0,))}, {LABEL[m]}, r = {r:g})")
+        else:
+            parts.append(f"{tb['rule'].iloc[0]}: no group with an excess")
+    lines.append("- **Cox twins** replaying each run's own states, share of the excess "
+                 "exponential-AD rejections they reproduce: " + "; ".join(parts)
+                 + "; caveat: in sample (out of sample in the tables).")
+    if len(lines) > FIRST_SCREEN_MAX:
+        raise ValueError(f"first_screen: {len(lines)} answers, at most {FIRST_SCREEN_MAX}")
+    return lines + [""]
 
 
-def _carry(tab, groups, rule):
-    """What carries the non-Poisson statistics under this rule: sentences from the rows."""
-    def rng(q, test=None):
-        rows = [_get(tab, m, r, q) for m, r in groups
-                if test is None or _excess(tab, m, r, test)]
-        rows = [x for x in rows if math.isfinite(x["estimate"])]
-        v = [x["estimate"] for x in rows]
-        if not v:
-            return "n/a (no group with an excess to explain)" if test else "n/a"
-        n = (f" ({len(v)} of {len(groups)} groups with an excess; {_share_sides(rows)})"
-             if test else "")
-        return (f"{v[0]:.2f}" if len(v) == 1 else f"{min(v):.2f}–{max(v):.2f}") + n
+def _null_gap(tabs):
+    """The largest distance of the rate dispersion's Poisson null from 1 over the groups."""
+    return max(abs(row["estimate"] - 1) for *_, row in _cases(
+        tabs, "rate_dispersion_poisson_null"))
 
-    late = [_get(tab, m, r, "rescaled_hazard_late") for m, r in groups]
-    late_v = {ratio_verdict(x["ci_low"], x["ci_high"], MARGIN) for x in late
-              if math.isfinite(x["estimate"])} or {"no interval ends there"}
-    first = [_get(tab, m, r, "hazard_nonsticky_first_bin_over_rate") for m, r in groups]
-    first_v = {ratio_verdict(x["ci_low"], x["ci_high"], MARGIN) for x in first}
-    low = [_get(tab, m, r, "hazard_nonsticky_min_over_rate") for m, r in groups]
-    low_v = {ratio_verdict(x["ci_low"], x["ci_high"], MARGIN) for x in low}
-    bins = sorted({x["note"] for x in low})
-    return (f"Read from the rows above ({rule} rule): over t < 4 after a collision the "
-            f"hazard falls to {rng('hazard_nonsticky_min_over_rate')} × the rate at its "
-            f"minimum ({'; '.join(bins)}; verdicts: {', '.join(sorted(low_v))}); in the first "
-            f"half time unit alone it is {rng('hazard_nonsticky_first_bin_over_rate')} × the "
-            f"rate (verdicts: {', '.join(sorted(first_v))}); at rescaled t > 5 the Γ-rescaled "
-            f"hazard is {rng('rescaled_hazard_late')} (verdicts: {', '.join(sorted(late_v))}). "
-            "The Cox twins that replay each run's own states reproduce "
-            f"{rng('explained_uniformity_ks_by_cox_sequence', 'uniformity_ks')} of the excess "
-            "uniformity-KS rejections and "
-            f"{rng('explained_exponential_ad_by_cox_sequence', 'exponential_ad')} of the "
-            "excess exponential-AD rejections (in sample); the rate chain "
-            "fitted on the other half of the ICs reproduces "
-            f"{rng('explained_uniformity_ks_by_cox_markov_oos', 'uniformity_ks')} and "
-            f"{rng('explained_exponential_ad_by_cox_markov_oos', 'exponential_ad')} (out "
-            "of sample); each share's interval is in the table above.")
+
+def reading(tabs):
+    """How the verdicts are read, once (the rules are those of docs/definitions.md)."""
+    return [
+        "How to read it: an early hazard is over the group's pooled rate (sticky runs left "
+        "out) and read against the same on Poisson streams at each run's own rate (above 1 "
+        "where rates differ; `null_verdict`, margin "
+        f"{HAZARD_NULL_MARGIN:g}); a Γ-rescaled hazard is read against 1, its prediction, "
+        f"by `ratio_verdict` ({100 * MARGIN:g} % band, [definitions](../definitions.md)); "
+        "an inconclusive verdict names the ICs that would resolve it "
+        f"(`equivalence_sample_size`). The {DISPERSION_NAME} is read against "
+        "its Poisson null, the same statistic on Poisson ensembles of the same design "
+        f"(`null_verdict`, margin {RATE_DISPERSION_MARGIN:g}); that null lies within "
+        f"{_null_gap(tabs):.2g} of 1, the base of its explained share (twin − 1) / "
+        "(observed − 1); a rejection share's base is the exact tests' 0.05. A share is "
+        "given only where there is an excess, and read as short of it only where its "
+        "interval lies below 1. Re-collisions: \"above chance\" when the two intervals are "
+        "disjoint. Every row, the hazard bin by bin and the iid twins are in the tables "
+        "linked above; definitions: [../mechanism.md](../mechanism.md).", ""]
 
 
 def sources(folders):
     """The page's closing table, per rule's folder in ``folders`` (relative to the page;
     which rules, and so which CSVs, is the run's): the columns of its
-    ``mechanism_numbers.csv`` the page quotes and the functions that computed them. The
-    rows the page quotes come from `analyse`, except the early hazard read bin by bin
-    (its minimum, the bins below the rate), from `hazard_profile_rows`; the rows
-    ``method == "run"`` are the run's sizes."""
+    ``mechanism_numbers.csv`` the page quotes and the functions that computed them: the
+    rows of `analyse`; the early hazard read bin by bin (its minimum) from
+    `hazard_profile_rows`; the Poisson null of the rate dispersion across ICs from
+    `poisson_null_rows` and the differences from them from `against_null`.
+    The rows ``method == "run"`` are the run's sizes."""
+    fns = (analyse, hazard_profile_rows, poisson_null_rows, against_null)
     return tuple(Source(f"{folder}/mechanism_numbers.csv", "estimate, ci_low, ci_high, note",
-                        fn) for folder in folders for fn in (analyse, hazard_profile_rows))
+                        fn) for folder in folders for fn in fns)
 
 
 def write_page(tables, folders, path, *, command):
     """Write the page to ``path`` from the numbers ``tables`` of the rules, whose tables
     and figures lie in ``folders`` (relative to the page's folder, e.g.
     ``"mechanism/elastic"``); ``command`` is the one its "Generated" line names. The
-    page closes with the table of its `sources`."""
+    page opens with `first_screen` and closes with the table of its `sources`."""
     lines = header("Why the collision times are not Poisson: the mechanism, computed", command,
                    [f"the direct simulations of `kicktimes.studies.mechanism` under the "
                     f"{t['rule'].iloc[0]} rule ([table]({f}/mechanism_numbers.csv))"
                     for t, f in zip(tables, folders, strict=True)])
-    lines += ["Definitions and methods: [../mechanism.md](../mechanism.md). Two radii "
-              "(0.01, 0.02) × two IC families (the paper's, the invariant measure), the same "
-              "ICs at both radii. Verdicts of a hazard against the rate it should equal: "
-              f"{ratio_rule(MARGIN)}.", ""]
-    lines += summary(tables)
+    lines += first_screen(tables)
+    lines += reading(tables)
     for tab, folder in zip(tables, folders, strict=True):
         lines += rule_section(tab, folder)
+    lines += ["Figures: the hazard in raw time (open: all runs, red: sticky runs left out; "
+              "the smooth laws miss the dip and the wall round-trip peak below t ≈ 10), the "
+              "hazard after removing the rate differences (one y range under both rules) "
+              "and the battery on the twins (bars: 95 % range over the ensembles); 95 % "
+              "intervals throughout.", ""]
     return write_results_page(path, lines, sources(folders))

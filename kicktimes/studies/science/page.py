@@ -10,7 +10,7 @@ import math
 
 from kicktimes.render.pages import ratio_text
 from kicktimes.render.provenance import Source
-from kicktimes.stats import format_interval
+from kicktimes.stats import MARGIN, equivalence_sample_size, format_interval, ratio_verdict
 from kicktimes.studies.science.decorrelation import (
     closest_kick_law,
     decorrelation,
@@ -20,7 +20,12 @@ from kicktimes.studies.science.rates import STICKY_FACTOR, rate_relaxation, stic
 from kicktimes.studies.science.stretching import KICKED, stretching
 from kicktimes.studies.science.twins import twin_table
 
-__all__ = ["SOURCES", "decorrelation_lines", "store_lines", "stretching_lines", "twin_lines"]
+__all__ = ["FIRST_SCREEN_MAX", "SOURCES", "decorrelation_lines", "first_screen",
+           "needed_ics", "reading", "store_lines", "stretching_lines", "twin_lines"]
+
+#: the answers a page may open with before its first table
+FIRST_SCREEN_MAX = 5
+Z95 = 1.959963984540054
 
 #: the closing table of ``science.md``: every CSV the study writes beside it (the same
 #: twelve at every scale), the columns the page quotes and the function that computes them
@@ -65,138 +70,194 @@ def _iv(x, lo, hi, edges=()):
     return format_interval(x, lo, hi, edges=edges)
 
 
+def needed_ics(estimate, low, high, n, tolerance=MARGIN, unit="ICs"):
+    """What an inconclusive ratio needs: ``"not resolved at this size; needs ≈ N ICs"``.
+
+    N is `kicktimes.stats.equivalence_sample_size` with the standard error of the 95 %
+    interval ``[low, high]`` at ``n`` units and, as margin, the distance of the estimate
+    from the nearer band edge ``1 ± tolerance`` (the interval around the measured estimate
+    must shrink to that distance to fall on one side of the edge).
+
+    Examples
+    --------
+    >>> needed_ics(0.998, 0.913, 1.15, 100)
+    'not resolved at this size; needs ≈ 400 ICs'
+    """
+    if not (isinstance(n, int) and n >= 1):
+        raise ValueError(f"n must be an integer >= 1, got {n!r}")
+    room = abs(tolerance - abs(float(estimate) - 1.0))
+    if room < 1e-9:
+        return "not resolved at this size: the estimate lies on the band's edge"
+    se = (float(high) - float(low)) / (2 * Z95)
+    return (f"not resolved at this size; needs ≈ {equivalence_sample_size(se, n, room)} "
+            f"{unit}")
+
+
+def _ratio_cell(x, lo, hi, n, unit="ICs"):
+    """``ratio_text``, and for an inconclusive ratio the size that would resolve it."""
+    text = ratio_text(x, lo, hi)
+    if ratio_verdict(lo, hi, MARGIN) == "inconclusive":
+        text += f" ({needed_ics(x, lo, hi, n, unit=unit)})"
+    return text
+
+
+def _verdict_counts(verdicts):
+    counts = verdicts.value_counts()
+    return ", ".join(f"{k} at {v}" for k, v in counts.items())
+
+
+def reading():
+    """How the page's verdicts are read, stated once."""
+    return ["How to read it: intervals are 95 % bootstrap intervals over ICs unless said "
+            "otherwise; a ratio is read by `ratio_verdict` against the 10 % band around 1 "
+            "(an equivalence test, [definitions](../definitions.md)); an inconclusive one "
+            "names the ICs that would resolve it (`equivalence_sample_size` at the measured "
+            "estimate). A prediction is quoted beside its measurement; a direction is "
+            "claimed only where both trend measures agree. Every per-radius value is in the "
+            "CSVs linked below.", ""]
+
+
+def first_screen(per_radius, trend, twins, compare, windows, whole, *, n_ics, n_dec):
+    """The page's opening: at most :data:`FIRST_SCREEN_MAX` one-line answers, each one
+    number with its 95 % interval, where it comes from and its caveat."""
+    lines = []
+    kicked = per_radius[per_radius["system"] != "two_particle"]
+    lo_r, hi_r = kicked["radius"].min(), kicked["radius"].max()
+    t = trend.set_index(["system", "quantity"])
+    for system, name in KICKED.items():
+        g = kicked[kicked["system"] == system].set_index("radius")
+        row = g.loc[lo_r]
+        tr, tc = t.loc[(system, "ratio")], t.loc[(system, "abs_log_ratio")]
+        agree = _trend_agrees(g, tr, tc)
+        lines.append(
+            f"- **{name[0].upper()}{name[1:]}, FTLE / two-disk FTLE**: "
+            f"{_verdict_counts(g['verdict'])} of {len(g)} radii ({lo_r:g}–{hi_r:g}); at "
+            f"r = {lo_r:g}: {ratio_text(row.ratio, row.ratio_ci_low, row.ratio_ci_high)}; "
+            "caveat: " + (f"the ratio {tr.verdict} towards 1 as r falls (both trend measures)"
+                          if agree and tc.verdict == "falls" else
+                          "no direction of the trend is claimed (the two trend measures "
+                          f"disagree: {tr.verdict}, {tc.verdict})" if not agree else
+                          f"trend: {tr.verdict}") + f"; nothing below r = {lo_r:g}.")
+    best = twins.iloc[(twins["over_predicted"].map(lambda v: abs(math.log(v)))).argmin()]
+    tv = twins.apply(lambda x: ratio_verdict(x.over_predicted_ci_low,
+                                             x.over_predicted_ci_high), axis=1)
+    lines.append(f"- **Twins with their own kick angles**, measured / predicted stretching "
+                 f"per kick (Γ ln(τ/d0)): {_verdict_counts(tv)} of {len(twins)} radii; "
+                 f"closest to 1 {ratio_text(best.over_predicted, best.over_predicted_ci_low, best.over_predicted_ci_high)}"  # noqa: E501
+                 f" (r = {best.radius:g}); caveat: {int(n_ics)} ICs per radius.")
+    off = compare[compare["quotient_verdict"].isin(["lower", "higher"])]
+    rest = compare[~compare.index.isin(off.index)]
+    if len(off):
+        near = off.iloc[(off["measured_over_predicted"].map(lambda v: abs(math.log(v)))).argmin()]
+        where = ", ".join(f"{k} {v}" for k, v in off["rule"].value_counts(sort=False).items())
+        unresolved = (f"; the other {len(rest)} rows not resolved at this size"
+                      if len(rest) else "")
+        lines.append(f"- **One-collision decorrelation model** (predicts the kicked / two-disk "
+                     f"1 − R₁): measurement / prediction outside the 10 % band in {len(off)} "
+                     f"of {len(compare)} rows ({where}); closest to 1 "
+                     f"{ratio_text(near.measured_over_predicted, near.quotient_ci_low, near.quotient_ci_high)}"  # noqa: E501
+                     f" ({near.rule}, r = {near.radius:g}, {KICKED[near.system]}){unresolved}; "
+                     f"caveat: {int(n_dec)} ICs of direct runs against the family store.")
+    first = windows[windows["window"] == windows["window"].min()]
+    last = windows[windows["window"] == windows["window"].max()]
+    fv = first.apply(lambda x: ratio_verdict(x.ci_low, x.ci_high), axis=1)
+    lv = last.apply(lambda x: ratio_verdict(x.ci_low, x.ci_high), axis=1)
+    weakest = first.iloc[first["ci_low"].argmin()]
+    wv = whole["verdict"]
+    lines.append(f"- **Collision rate / kinetic Γ(r), first tenth of the run**: "
+                 f"{_verdict_counts(fv)} of {len(first)} families; weakest "
+                 f"{ratio_text(weakest.rate_over_kinetic, weakest.ci_low, weakest.ci_high)} "
+                 f"(`{weakest.family}`); caveat: last tenth {_verdict_counts(lv)} of "
+                 f"{len(last)}; whole run per radius: {_verdict_counts(wv)} of {len(whole)}.")
+    if len(lines) > FIRST_SCREEN_MAX:
+        raise ValueError(f"first_screen: {len(lines)} answers, at most {FIRST_SCREEN_MAX}")
+    return lines + [""]
+
+
+def _trend_agrees(g, tr, tc):
+    """Whether the two trend measures agree (both slopes' intervals tell the same story:
+    the ratio moving towards 1 and |ln ratio| falling, or both away, or neither moving)."""
+    side = 1 if bool((g["ratio"] < 1).all()) else -1 if bool((g["ratio"] > 1).all()) else 0
+    toward = {1: "rises", -1: "falls"}.get(side)
+    away = {1: "falls", -1: "rises"}.get(side)
+    return ((tr.verdict == toward and tc.verdict == "falls")
+            or (tr.verdict == away and tc.verdict == "rises")
+            or (tr.verdict == tc.verdict == "no trend detected"))
+
+
 def stretching_lines(exp, per_radius, fits, trend):
     """Section 1: the stretching per perturbation of the FTLE sweep ``exp``."""
-    two = per_radius[per_radius["system"] == "two_particle"].set_index("radius")
-    f = fits.set_index("system")
     lo_r, hi_r = min(exp.radii), max(exp.radii)
     lines = [
-        "## 1. Stretching per perturbation, per measured radius", "",
+        "## 1. Stretching per perturbation", "",
         f"FTLE sweep `{exp.name}`: {exp.n_ics} paper ICs at {len(exp.radii)} radii from "
         f"{lo_r:g} to {hi_r:g}, {exp.n_steps} collision-truncated steps of τ = {exp.tau:g}. "
-        "Stretching per perturbation s = mean λ over ICs / pooled perturbation rate (nats); "
-        "intervals: 95 % bootstrap over ICs, the same resampled ICs for every system and "
-        f"radius (`science_stretching.csv`). Two-disk, per disk-disk collision: "
-        + "; ".join(f"r = {r:g}: {_iv(g.stretch_per_perturbation, g.ci_low, g.ci_high)}"
-                    for r, g in two.iloc[::-1].iterrows()) + ".", "",
-        "The least-squares line s = a + b ln(1/r) over the measured range ln(1/r) = "
-        f"{f.loc['two_particle', 'ln_inv_r_min']:.2f}–{f.loc['two_particle', 'ln_inv_r_max']:.2f}"
-        " (`science_stretching_fits.csv`) is a summary of that range, not a law: its local "
-        "slopes between adjacent radii run from "
-        f"{f.loc['two_particle', 'local_slope_min']:.2f} to "
-        f"{f.loc['two_particle', 'local_slope_max']:.2f} for the two disks, and the stretching "
-        "at a radius is a + b ln(1/r), never b ln(1/r) alone. It is not extrapolated.", "",
-        "| system | intercept a | slope b | local slopes |", "|---|---|---|---|"]
-    for s, g in f.iterrows():
-        a = _iv(g.intercept, g.intercept_ci_low, g.intercept_ci_high)
-        b = _iv(g.slope, g.slope_ci_low, g.slope_ci_high)
-        lines.append(f"| {s} | {a} | {b} | {g.local_slope_min:.2f} to "
-                     f"{g.local_slope_max:.2f} |")
-    lines += ["", "Since the kicks come at the two-disk collision rate, the FTLE ratio "
-              "λ_kicked / λ_two equals s_kicked / s_two. Per radius (verdicts by "
-              "`ratio_verdict`, 10 % margin):", "",
-              "| r | " + " | ".join(f"{KICKED[s]} / two-disk" for s in KICKED) + " |",
-              "|---|" + "---|" * len(KICKED)]
+        "Stretching per perturbation s = mean λ over ICs / pooled perturbation rate; the "
+        "kicks come at the two-disk collision rate, so λ_kicked / λ_two = s_kicked / s_two "
+        "(per radius: `science_stretching.csv`; the line s = a + b ln(1/r) over the measured "
+        "range, a summary and not a law, never extrapolated: `science_stretching_fits.csv`).",
+        "",
+        "| r | " + " | ".join(f"{KICKED[s]} / two-disk" for s in KICKED) + " |",
+        "|---|" + "---|" * len(KICKED)]
     kicked = per_radius[per_radius["system"] != "two_particle"]
     for r in sorted(kicked["radius"].unique(), reverse=True):
         cells = []
         for s in KICKED:
             g = kicked[(kicked["system"] == s) & (kicked["radius"] == r)].iloc[0]
-            cells.append(ratio_text(g.ratio, g.ratio_ci_low, g.ratio_ci_high))
+            cells.append(_ratio_cell(g.ratio, g.ratio_ci_low, g.ratio_ci_high, exp.n_ics))
         lines.append(f"| {r:g} | " + " | ".join(cells) + " |")
-    lines.append("")
+    lines += ["", "The paper's expectation, agreement that improves for smaller disks "
+              "(slopes against ln(1/r): `science_stretching_trend.csv`):", ""]
     t = trend.set_index(["system", "quantity"])
     for s, name in KICKED.items():
         g = kicked[kicked["system"] == s].set_index("radius")
-        verdicts = g["verdict"].value_counts()
         tr, tc = t.loc[(s, "ratio")], t.loc[(s, "abs_log_ratio")]
-        closer = {"falls": "closer to 1 at smaller r", "rises": "further from 1 at smaller r",
-                  "no trend detected": "no trend of the distance from 1 detected"}[tc.verdict]
-        lines.append(
-            f"- {name}: the ratio is {g.loc[hi_r, 'ratio']:.3f} at r = {hi_r:g} and "
-            f"{g.loc[lo_r, 'ratio']:.3f} at r = {lo_r:g}; its least-squares slope against "
-            f"ln(1/r) is {_iv(tr.slope_per_ln_inv_r, tr.ci_low, tr.ci_high, (0.0,))} per "
-            f"unit ln(1/r) ({tr.verdict} as r decreases), and that of |ln ratio| is "
-            f"{_iv(tc.slope_per_ln_inv_r, tc.ci_low, tc.ci_high, (0.0,))} ({closer}). "
-            f"Verdicts over the {len(g)} radii: "
-            + ", ".join(f"{v} at {k}" for v, k in zip(verdicts.to_numpy(), verdicts.index,
-                                                       strict=True)) + ".")
-    lines += ["", "The paper's expectation that the kicked disk agrees better for smaller disks. "
-              "Agreement is decided per radius by the equivalence verdict; a direction is "
-              "claimed only when the two trend measures above agree (both slope intervals "
-              "exclude 0, the ratio moving towards 1 and |ln ratio| falling, or both away); "
-              "where they disagree no direction is claimed:", ""]
-    for s, name in KICKED.items():
-        g = kicked[kicked["system"] == s].set_index("radius")
-        tr, tc = t.loc[(s, "ratio")], t.loc[(s, "abs_log_ratio")]
-        side = 1 if bool((g["ratio"] < 1).all()) else -1 if bool((g["ratio"] > 1).all()) else 0
-        toward = {1: "rises", -1: "falls"}.get(side)
-        away = {1: "falls", -1: "rises"}.get(side)
-        agree = ((tr.verdict == toward and tc.verdict == "falls")
-                 or (tr.verdict == away and tc.verdict == "rises")
-                 or (tr.verdict == tc.verdict == "no trend detected"))
-        if not agree:
-            trend_txt = (f"the two trend measures disagree (ratio: {tr.verdict}; |ln ratio|: "
-                         f"{tc.verdict}), so no direction is claimed")
+        if not _trend_agrees(g, tr, tc):
+            trend_txt = (f"the two trend measures disagree (ratio: {tr.verdict}, slope "
+                         f"{_iv(tr.slope_per_ln_inv_r, tr.ci_low, tr.ci_high, (0.0,))}; "
+                         f"|ln ratio|: {tc.verdict}), so no direction is claimed")
         elif tc.verdict == "falls":
-            trend_txt = (f"the ratio {tr.verdict} from {g.loc[hi_r, 'ratio']:.3f} at "
-                         f"r = {hi_r:g} to "
-                         f"{g.loc[lo_r, 'ratio']:.3f} at r = {lo_r:g}, towards 1 (both trend "
-                         "measures agree)")
+            trend_txt = (f"the ratio {tr.verdict} towards 1 as r decreases, slope "
+                         f"{_iv(tr.slope_per_ln_inv_r, tr.ci_low, tr.ci_high, (0.0,))} per "
+                         "unit ln(1/r) (both trend measures agree)")
         elif tc.verdict == "rises":
             trend_txt = "the ratio moves away from 1 as r decreases (both trend measures agree)"
         else:
             trend_txt = "no trend detected by either measure"
         n_within = int(g["verdict"].str.startswith("within").sum())
-        counts = g["verdict"].value_counts()
-        lines.append(f"- {name}: {trend_txt}; within 10 % of the two-disk value at {n_within} "
-                     f"of {len(g)} radii (" + ", ".join(
-                         f"{k} at {v}/{len(g)}" for k, v in counts.items())
-                     + f"), down to r = {lo_r:g}; the expectation of agreement "
-                     + ("is met at no measured radius." if n_within == 0 else
-                        f"is met at {n_within} of {len(g)} radii."))
+        lines.append(f"- {name}: {trend_txt}; within 10 % at {n_within} of {len(g)} radii"
+                     + ("; the expectation of agreement is met at no measured radius."
+                        if n_within == 0 else "."))
     lines += ["", f"What happens below r = {lo_r:g} is not measured here. "
-              "[scatter.md](scatter.md) gives the same quantity (mean FTLE of the scatter-kicked "
-              "disk over the mean two-disk FTLE, ratio of means over ICs) at family A's radii "
-              "from another sample: its first 40 paper ICs drawn with seed 1, its own kick "
-              "draws and its sticky orbits (FTLE below a quarter of the radius's median) left "
-              "out, against the 100 ICs drawn with seed 11 here, all kept; where the two "
-              "pages' intervals differ at a shared radius, that is the difference of the "
-              "samples, not of the definition.", "",
+              "[scatter.md](scatter.md) measures the scatter-kick ratio on another sample "
+              "(40 ICs, sticky orbits left out); differences at a shared radius are the "
+              "samples'.", "",
               "![stretching](science_stretching.png)", "",
-              "**Left:** stretching per perturbation against ln(1/r) (top axis: r), 95 % "
-              "intervals over ICs. **Right:** the kicked / two-disk ratio per radius with its "
-              "interval; grey: the ±10 % band of the equivalence test.", ""]
+              "**Left:** stretching per perturbation against ln(1/r); **right:** the kicked / "
+              "two-disk ratio with the ±10 % band; 95 % intervals over ICs.", ""]
     return lines
 
 
 def twin_lines(twins, exp, *, n_ics=8, n_steps=3000):
     """Section 2: the twins with independent kick angles (``n_ics`` ICs, ``n_steps``
-    steps of the sweep's tau each)."""
+    steps of the sweep's tau each), the first estimate beside the measurement."""
     tau, d0 = exp.tau, exp.d0
     lines = ["## 2. Twins with independent kick angles", "",
-             "A twin that draws its own kick angles is thrown O(1) away from the reference at "
-             "every kick. A first estimate, O(τ) of position separation renormalised to d0 "
-             f"every τ, gives λ ≈ Γ ln(τ/d0) = {math.log(tau / d0):.2f} Γ at the paper's "
-             f"τ = {tau:g}, d0 = {d0:g}. Simulated (Benettin on (x, y, vx, vy), {n_ics} paper "
-             f"ICs, {n_steps} steps of τ, Poisson kicks at Γ(r); "
-             "`science_independent_twins.csv`); the "
-             "ratio's interval is the twin's interval over the two-disk stretching's "
-             "interval, ends divided crosswise (conservative):", ""]
+             "A twin that draws its own kick angles is thrown O(1) away at every kick; the "
+             f"first estimate λ ≈ Γ ln(τ/d0) = {math.log(tau / d0):.2f} Γ (τ = {tau:g}, "
+             f"d0 = {d0:g}) against Benettin runs ({n_ics} paper ICs, {n_steps} steps of τ; "
+             "`science_independent_twins.csv`; the ratio's ends divided crosswise):", ""]
     for row in twins.itertuples():
         lines.append(
             f"- r = {row.radius:g}: λ = {_fmt(row.lam, row.ci_low, row.ci_high)}, "
             f"{row.per_kick:.2f} nats per kick against the estimate's "
             f"{row.predicted_per_kick:.2f}: measured / predicted "
             + ratio_text(row.over_predicted, row.over_predicted_ci_low,
-                         row.over_predicted_ci_high) +
-            f"; against {row.two_disk_per_collision:.2f} per collision for the two disks: "
-            f"ratio {ratio_text(row.ratio, row.ratio_ci_low, row.ratio_ci_high)}.")
-    lines += ["", "The first estimate is a prediction per kick; the verdicts above say whether "
-              f"the simulated twins agree with it to 10 % ({n_ics} ICs per radius).", "",
-              "Twins that do not share their kicks measure the kick's O(1) randomisation "
-              "of the direction, not a stretching; kicktimes' twins share the kicks (common "
-              "random numbers).", ""]
+                         row.over_predicted_ci_high)
+            + f"; against the two disks' {row.two_disk_per_collision:.2f} per collision: "
+            f"{ratio_text(row.ratio, row.ratio_ci_low, row.ratio_ci_high)}.")
+    lines += ["", "Such twins measure the kick's randomisation of the direction, not a "
+              "stretching; kicktimes' twins share the kicks.", ""]
     return lines
 
 
@@ -205,115 +266,89 @@ def decorrelation_lines(dec, compare, closest, *, n_ics=40, t_max=20000.0):
     ``t_max``), the prediction beside the measurement, the closest kick law."""
     t_text = f"{t_max:,.0f}".replace(",", " ")
     lines = ["## 3. Decorrelation per single perturbation", "",
-             "Correlation of the boundary angle θ at the wall hit before and the wall hit "
-             f"after exactly one perturbation ({n_ics} paper ICs, T = {t_text} per run; "
-             "kicked runs "
-             "at their two-disk run's collision rate; `science_decorrelation.csv`):", ""]
-    for (rule, r), g in dec.groupby(["rule", "radius"], sort=False, observed=True):
-        lines.append(f"- {rule} rule, r = {r:g}: " + "; ".join(
-            f"{row.perturbation} {_fmt(row.correlation, row.ci_low, row.ci_high)} "
-            f"({row.n_pairs} pairs)" for row in g.itertuples()) + ".")
-    lines += ["", "With as many perturbations per wall hit in both systems, 1 − R₁ scales as "
-              "1 − (correlation across one perturbation), which predicts the kicked / "
-              "two-disk ratio of 1 − R₁. The prediction beside the ratio measured in the "
-              "family store (control primary, `science_decorrelation_prediction.csv`); "
-              "measured / predicted has the interval of the two intervals combined on the "
-              "log scale, and its verdict says whether the prediction agrees with the "
-              "measurement to 10 %:", "",
-              "| rule | r | kick | predicted | measured (store) | measured / predicted |",
-              "|---|---|---|---|---|---|"]
+             "The correlation of the boundary angle θ across exactly one perturbation "
+             f"({n_ics} paper ICs, T = {t_text}; `science_decorrelation.csv`, by angle "
+             "`science_decorrelation_by_angle.csv`) predicts the kicked / two-disk ratio of "
+             "1 − R₁; beside it the ratio measured in the family store (control primary; "
+             "`science_decorrelation_prediction.csv`; the quotient's interval combines both "
+             "on the log scale):", "",
+             "| rule | r | kick | predicted | measured (store) | measured / predicted |",
+             "|---|---|---|---|---|---|"]
     for row in compare.itertuples():
         lines.append(
             f"| {row.rule} | {row.radius:g} | {KICKED[row.system]} | "
             f"{format_interval(row.predicted, row.predicted_ci_low, row.predicted_ci_high)} | "
             f"{ratio_text(row.measured, row.measured_ci_low, row.measured_ci_high)} "
             f"(`{row.family}`) | "
-            f"{ratio_text(row.measured_over_predicted, row.quotient_ci_low, row.quotient_ci_high)}"
-            " |")
-    agree = compare["quotient_verdict"].str.startswith("within").sum()
-    off = compare["quotient_verdict"].isin(["lower", "higher"]).sum()
-    failing = compare[compare["quotient_verdict"].isin(["lower", "higher"])]
-    rules = ", ".join(f"{n} under the {rule} rule"
-                      for rule, n in failing["rule"].value_counts(sort=False).items())
-    lines += ["", f"The one-collision model agrees to 10 % in {agree} of {len(compare)} rows. "
-              + (f"It fails: {off} of {len(compare)} rows lie outside its 10 % band (verdict "
-                 f"lower or higher) and falsify it ({rules}); the others are inconclusive."
-                 if off else "No row falsifies it; the inconclusive rows cannot confirm it."),
-              "",
-              "Which kick law comes closest to the two-disk value (pooled findings, control "
-              "primary; distance from 1: |ln ratio|, its interval the image of the ratio's; "
-              "the closest group is the law with the lowest upper distance and every law whose "
-              "distance interval reaches below it; `science_closest.csv`):", ""]
+            + _ratio_cell(row.measured_over_predicted, row.quotient_ci_low,
+                          row.quotient_ci_high, n_ics, unit="ICs in both samples")
+            + " |")
+    lines += ["", "Which kick law comes closest to the two-disk value (distance |ln ratio|; "
+              "the closest group: the lowest upper distance and every law whose distance "
+              "interval reaches below it; overlapping intervals do not make laws equal; "
+              "every law and control: `science_closest.csv`):", "",
+              "| family | quantity | closest | their verdicts | further from 1 |",
+              "|---|---|---|---|---|"]
     for (family, diag), g in closest.groupby(["family", "diagnostic"], sort=False, observed=True):
         best, rest = g[g["closest"]], g[~g["closest"]]
-
-        def cells(part):
-            return ", ".join(f"{s} {format_interval(x, lo, hi)}" for s, x, lo, hi in
-                             zip(part["system"], part["ratio"], part["ci_low"], part["ci_high"],
-                                 strict=True))
-
-        none_agree = not best["verdict"].str.startswith("within").any()
-        if not len(rest):
-            lines.append(f"- `{family}`, {diag}: no law is closest (distance intervals "
-                         f"overlap): {cells(best)}.")
-            continue
-        name = (f"{best['system'].iloc[0]} comes closest" if len(best) == 1 else
-                "nearer to 1 than the rest (distance intervals separate them); their own "
-                "intervals overlap under the primary setting, which does not make them equal")
-        if none_agree:
-            name += " and none agrees (verdicts: " + ", ".join(
-                sorted(set(best["verdict"]))) + ")"
-        apart = [(s, d) for s, d in zip(best["system"], best["disjoint_under"], strict=True)
-                 if isinstance(d, str) and d]
-        differ = "".join(f"; {s}'s interval is disjoint from the best law's under {d}"
-                         for s, d in apart)
-        lines.append(f"- `{family}`, {diag}: {name}: {cells(best)}{differ}; further from 1: "
-                     f"{cells(rest)}.")
-    lines += ["", "Binned by θ before: `science_decorrelation_by_angle.csv`.", ""]
+        names = ", ".join(f"{s} {format_interval(x, lo, hi)}" for s, x, lo, hi in zip(
+            best["system"], best["ratio"], best["ci_low"], best["ci_high"], strict=True))
+        lines.append(f"| `{family}` | {diag} | {names if len(rest) else 'none (all overlap)'} "
+                     f"| {', '.join(sorted(set(best['verdict'])))} | "
+                     f"{', '.join(rest['system']) or '—'} |")
+    lines.append("")
     return lines
 
 
-def store_lines(whole, windows, sticky):
-    """Sections 4 and 5: the collision rate over the run and the sticky orbits."""
+def store_lines(whole, windows, sticky, n_ics=None):
+    """Sections 4 and 5: the collision rate over the run and the sticky orbits;
+    ``n_ics`` maps a family to its ICs (the size an inconclusive ratio is scaled from)."""
     lines = ["## 4. The collision rate over the run", "",
-             "Ensemble disk-disk collision rate of the paper's ICs over the kinetic rate "
-             "Γ(r): per radius over the whole run, count / Γ(r)T with a 95 % bootstrap "
-             "interval over ICs and its `ratio_verdict` (`science_rate_count.csv`); in ten "
-             "equal windows of the shortest run, averaged over radii, with a 95 % bootstrap "
-             "interval over ICs and its `ratio_verdict` (`science_rate_windows.csv`; per "
-             "radius: `science_rate_relaxation.csv`):", ""]
+             "Ensemble collision rate of the paper's ICs over the kinetic rate Γ(r), in ten "
+             "equal windows of the shortest run averaged over radii "
+             "(`science_rate_windows.csv`; per radius `science_rate_relaxation.csv`) and per "
+             "radius over the whole run (`science_rate_count.csv`):", "",
+             "| family | first window | last window | later windows | whole run, over radii |",
+             "|---|---|---|---|---|"]
     for fam, g in whole.groupby("family", sort=False, observed=True):
         w = windows[windows["family"] == fam].set_index("window")
-        counts = g["verdict"].value_counts()
-        wv = w["verdict"].value_counts()
-        est, lo_w, hi_w = w["rate_over_kinetic"], w["ci_low"], w["ci_high"]
+        n = (n_ics or {}).get(fam)
+
+        def cell(k, n=n, w=w):
+            x, lo, hi = w["rate_over_kinetic"].iloc[k], w["ci_low"].iloc[k], w["ci_high"].iloc[k]
+            return _ratio_cell(x, lo, hi, n) if n else ratio_text(x, lo, hi)
+
+        unresolved = g[g["verdict"] == "inconclusive"]
+        need = ""
+        if n and len(unresolved):
+            sizes = sorted(equivalence_sample_size(
+                (x.ci_high - x.ci_low) / (2 * Z95), int(n),
+                max(abs(MARGIN - abs(x.count_over_kinetic - 1)), 1e-9))
+                for x in unresolved.itertuples())
+            span = f"{sizes[0]}" if len(sizes) == 1 else f"{sizes[0]}–{sizes[-1]}"
+            need = f"; the inconclusive ones not resolved at this size (need ≈ {span} ICs)"
         lines.append(
-            f"- `{fam}`: first window {ratio_text(est.iloc[0], lo_w.iloc[0], hi_w.iloc[0])}"
-            f", windows 2–{len(w)} {w['rate_over_kinetic'].iloc[1:].min():.3f}–"
-            f"{w['rate_over_kinetic'].iloc[1:].max():.3f}, last "
-            f"{ratio_text(est.iloc[-1], lo_w.iloc[-1], hi_w.iloc[-1])}"
-            "; window verdicts: " + ", ".join(f"{k} at {v} of {len(w)}" for k, v in wv.items())
-            + f"; over the whole run {g['count_over_kinetic'].min():.3f}–"
-            f"{g['count_over_kinetic'].max():.3f} over the radii, verdicts: " + ", ".join(
-                f"{k} at {v} of {len(g)} radii" for k, v in counts.items()) + ".")
-    lines += ["", "Whether the rate relaxes to Γ(r) is read from the window verdicts only: a "
-              "family whose later windows are not within 10 % of 1 is not said to relax."]
-    lines += ["", "## 5. The sticky orbits", "",
-              f"A run is sticky when its two-disk collision rate exceeds {STICKY_FACTOR:g} "
-              "Γ(r) (`science_sticky.csv`).", ""]
+            f"| `{fam}` | {cell(0)} | {cell(len(w) - 1)} | "
+            f"{w['rate_over_kinetic'].iloc[1:].min():.3f}–"
+            f"{w['rate_over_kinetic'].iloc[1:].max():.3f}: {_verdict_counts(w['verdict'])} of "
+            f"{len(w)} windows | {g['count_over_kinetic'].min():.3f}–"
+            f"{g['count_over_kinetic'].max():.3f}: {_verdict_counts(g['verdict'])} of {len(g)}"
+            f" radii{need} |")
+    lines += ["", "A family is said to relax to Γ(r) only where its later windows are within "
+              "10 % of 1; a window within 10 % whose interval excludes 1 measures a real "
+              "offset smaller than the band.", "",
+              "## 5. The sticky orbits", "",
+              f"A run is sticky when its collision rate exceeds {STICKY_FACTOR:g} Γ(r) "
+              "(`science_sticky.csv`); small |L| is not specific to them where many ICs are "
+              "as radial (see [scatter.md](scatter.md) for the set flagged by the FTLE "
+              "instead):", ""]
     for row in sticky.itertuples():
         lines.append(
             f"- `{row.family}`: {row.n_sticky} of {row.n_runs} runs "
-            f"({100 * row.share_runs:.1f} %), from {row.n_ics_sticky} ICs; they collide every "
-            f"{row.median_interval_sticky:.2f} time units (median). The larger initial "
-            f"angular momentum |x v_y − y v_x| of the two disks has median "
-            f"{row.median_max_abs_L_sticky:.3f} over the sticky ICs against "
-            f"{row.median_max_abs_L_all:.3f} over all ICs "
-            f"({100 * row.share_all_ics_below_sticky_max:.1f} % of all ICs are as radial as "
-            "the least radial sticky one).")
-    lines += ["", "No name is given to these orbits: small |L| is not specific to them where a "
-              "large share of all ICs is as radial as the least radial sticky one. The "
-              "definition here is by the collision rate; [scatter.md](scatter.md) flags a "
-              "different set, two-disk orbits whose FTLE is below a quarter of their radius's "
-              "median (by the exponent, not the rate).", ""]
+            f"({100 * row.share_runs:.1f} %) from {row.n_ics_sticky} ICs, one collision per "
+            f"{row.median_interval_sticky:.2f} time units (median); median larger initial "
+            f"|L| {row.median_max_abs_L_sticky:.3f} against {row.median_max_abs_L_all:.3f} "
+            f"over all ICs ({100 * row.share_all_ics_below_sticky_max:.1f} % of all ICs as "
+            "radial as the least radial sticky one).")
+    lines.append("")
     return lines

@@ -21,7 +21,6 @@ import pandas as pd
 
 from kicktimes.experiment import load_store, run_experiment
 from kicktimes.render.pages import header, store_name, write_results_page
-from kicktimes.stats import MARGIN, ratio_rule
 from kicktimes.studies.cache import cached_table, read_cached, write_cached
 from kicktimes.studies.options import check_scale, check_workers, status_lines
 from kicktimes.studies.science.decorrelation import (
@@ -33,6 +32,8 @@ from kicktimes.studies.science.figures import stretching_figure
 from kicktimes.studies.science.page import (
     SOURCES,
     decorrelation_lines,
+    first_screen,
+    reading,
     store_lines,
     stretching_lines,
     twin_lines,
@@ -288,7 +289,8 @@ def reproduce(out: str | os.PathLike, *, scale: str = "quick",
     whole.to_csv(results / "science_rate_count.csv", index=False)
     sticky = pd.DataFrame([sticky_orbits(s) for s in stores])
     sticky.to_csv(results / "science_sticky.csv", index=False)
-    body += store_lines(whole, windows, sticky)
+    body += store_lines(whole, windows, sticky,
+                        n_ics={s.experiment.name: s.experiment.n_ics for s in stores})
 
     lines = header(
         "The mechanism, computed", command,
@@ -297,9 +299,9 @@ def reproduce(out: str | os.PathLike, *, scale: str = "quick",
            "the findings tables of " + ", ".join(f"`{f}`" for f in families.values()),
            "the direct simulations of sections 2–3"
            + (" (read from the study's cache of an earlier run)" if reused else "")])
-    lines += ["Intervals are 95 % bootstrap intervals over ICs unless said otherwise. "
-              f"Verdicts of ratios: {ratio_rule(MARGIN)}.", ""]
-    lines += body + [f"Built in {time.perf_counter() - t0:.0f} s.", ""]
+    lines += first_screen(per_radius, trend, twins, compare, windows, whole,
+                          n_ics=sizes.twin_ics, n_dec=sizes.decorrelation_ics)
+    lines += reading() + body + [f"Built in {time.perf_counter() - t0:.0f} s.", ""]
     page = write_results_page(results / "science.md", lines, SOURCES)
     say(f"{page.name} written in {time.perf_counter() - t0:.0f} s")
     return page
