@@ -110,8 +110,11 @@ def test_every_figure_the_page_links_is_drawn(tmp_path):
 
     table = run.run_rule("elastic", TINY, tmp_path)
     assert set(table["rule"]) == {"elastic"}
-    table = pd.concat([table, run._cached_profile(tmp_path, "elastic", TINY, 1, print)],
+    table = pd.concat([run.public_names(table),
+                       run._cached_profile(tmp_path, "elastic", TINY, 1, print),
+                       run._cached_null(tmp_path, "elastic", TINY, 1, print)],
                       ignore_index=True)
+    table = pd.concat([table, pd.DataFrame(analysis.against_null(table))], ignore_index=True)
     drawn = {p.name for p in tmp_path.glob("mechanism_*.png")}
     assert drawn == {f"mechanism_{name}.png" for name in run.FIGURES}
     text = "\n".join(rule_section(table, "mechanism/elastic"))
@@ -166,15 +169,17 @@ def test_each_rate_dispersion_verdict_names_its_poisson_null(built):
                         "rate dispersion across ICs vs its Poisson null")
     for k, (method, r) in enumerate(page.GROUPS):
         g = tab[(tab["method"] == method) & (tab["radius"] == r)].set_index("quantity")
-        obs, null = g.loc["observed_dispersion_index_nonsticky"], g.loc[
+        obs, null = g.loc["observed_rate_dispersion_across_ics_nonsticky"], g.loc[
             "rate_dispersion_poisson_null"]
         diff = g.loc["rate_dispersion_minus_null"]
         assert diff["estimate"] == pytest.approx(obs["estimate"] - null["estimate"], abs=1e-5)
         verdict = null_verdict(diff["ci_low"], diff["ci_high"], D_MARGIN)
         assert f"vs {null['estimate']:.3f}: {verdict} (difference " in cells[1 + k]
         assert diff["note"].startswith(verdict)
-    # the old name, read against 1, is gone from the page
+    # the old name, read against 1, is gone from the page and from the CSV
     assert "dispersion index" not in text and "index of dispersion" not in text
+    assert not tab["quantity"].str.contains("dispersion_index").any()
+    assert not tab["note"].fillna("").str.contains("index of dispersion").any()
 
 
 def test_a_poisson_ensemble_s_rate_dispersion_is_its_own_null():
@@ -195,7 +200,7 @@ def test_a_poisson_ensemble_s_rate_dispersion_is_its_own_null():
         picks = rng.integers(0, n.size, (2000, n.size))
         boot = np.array([x.var(ddof=1) / x.mean() for x in n[picks]])
         return pd.DataFrame({"rule": "mirror", "method": "paper", "radius": 0.01,
-                             "quantity": ["observed_dispersion_index_nonsticky",
+                             "quantity": ["observed_rate_dispersion_across_ics_nonsticky",
                                           "rate_dispersion_poisson_null"],
                              "estimate": [d, null["estimate"]],
                              "ci_low": [np.quantile(boot, 0.025), null["ci_low"]],

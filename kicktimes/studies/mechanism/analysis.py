@@ -231,7 +231,9 @@ def against_null(table):
     group of ``table``, each with `stats.null_verdict` in its note.
 
     - ``rate_dispersion_minus_null``: the rate dispersion across ICs
-      (``observed_dispersion_index_nonsticky``, bootstrap interval over ICs) minus the
+      (``observed_rate_dispersion_across_ics_nonsticky``, `analyse`'s
+      ``observed_dispersion_index_nonsticky`` as the CSV names it; bootstrap interval over
+      ICs) minus the
       null's mean, margin :data:`RATE_DISPERSION_MARGIN`;
     - ``hazard_first_bin_minus_null`` and ``hazard_min_minus_null``: the hazard over the
       rate in the first bin and in the bin of the early minimum
@@ -244,7 +246,8 @@ def against_null(table):
     Examples
     --------
     >>> t = pd.DataFrame({"rule": "mirror", "method": "paper", "radius": 0.01,
-    ...     "quantity": ["observed_dispersion_index_nonsticky", "rate_dispersion_poisson_null"],
+    ...     "quantity": ["observed_rate_dispersion_across_ics_nonsticky",
+    ...                  "rate_dispersion_poisson_null"],
     ...     "estimate": [2.5, 1.01], "ci_low": [2.0, 0.8], "ci_high": [3.0, 1.2], "note": ""})
     >>> row = against_null(t)[0]
     >>> round(row["estimate"], 2), round(row["ci_low"], 2), row["note"][:15]
@@ -253,7 +256,7 @@ def against_null(table):
     rows = []
     for (method, r), g in table.groupby(["method", "radius"], sort=False):
         q = g.set_index("quantity")
-        reads = [("rate_dispersion_minus_null", "observed_dispersion_index_nonsticky",
+        reads = [("rate_dispersion_minus_null", "observed_rate_dispersion_across_ics_nonsticky",
                   "rate_dispersion_poisson_null", RATE_DISPERSION_MARGIN)]
         if "hazard_nonsticky_min_over_rate" in q.index:
             low = q.loc["hazard_nonsticky_min_over_rate", "note"].removeprefix("bin [")

@@ -47,7 +47,7 @@ LABEL = {"paper": "paper ICs", "uniform": "invariant ICs"}
 #: the explained shares the page quotes: (test, its label) x (model, its short label)
 TESTS = (("uniformity_ks", "uniformity-KS rejections"),
          ("exponential_ad", "exponential-AD rejections"),
-         ("dispersion_index_nonsticky", "rate dispersion across ICs"))
+         ("rate_dispersion_across_ics_nonsticky", "rate dispersion across ICs"))
 MODELS = (("cox_sequence", "in sample"), ("cox_markov_oos", "out of sample"))
 #: the answers a page may open with before its first table
 FIRST_SCREEN_MAX = 5
@@ -159,7 +159,7 @@ def _excess(tab, m, r, test):
     """Whether the observed value lies above its null (an excess to explain; a gap
     inside its own noise is not decomposed): a rejection share's interval above the
     exact tests' level 0.05, the rate dispersion across ICs "above its null"."""
-    if test == "dispersion_index_nonsticky":
+    if test == "rate_dispersion_across_ics_nonsticky":
         return _dispersion_verdict(tab, m, r) == "above its null"
     return bool(_get(tab, m, r, f"observed_reject_{test}")["ci_low"] > 0.05)
 
@@ -188,7 +188,7 @@ def rule_section(tab, figures):
         return f"{_iv(s)} vs {_iv(c)}: {_above_chance(s, c)}"
 
     def dispersion(m, r):
-        obs, null = g(m, r, "observed_dispersion_index_nonsticky"), g(
+        obs, null = g(m, r, "observed_rate_dispersion_across_ics_nonsticky"), g(
             m, r, "rate_dispersion_poisson_null")
         diff = g(m, r, "rate_dispersion_minus_null")
         return (f"{_iv(obs)} vs {null['estimate']:.3f}: {_dispersion_verdict(tab, m, r)} "

@@ -37,7 +37,8 @@ from kicktimes.studies.mechanism.simulate import RADII, simulate
 from kicktimes.studies.mechanism.twins import rate
 from kicktimes.studies.options import check_scale, check_workers, status_lines
 
-__all__ = ["FIGURES", "RULES", "SCALES", "MechanismScale", "reproduce", "run_rule"]
+__all__ = ["CSV_NAMES", "FIGURES", "RULES", "SCALES", "MechanismScale", "public_names",
+           "reproduce", "run_rule"]
 
 
 @dataclass(frozen=True)
@@ -130,6 +131,22 @@ def _cached_profile(out, rule, sizes, workers, say):
     return table
 
 
+#: the CSV's name of the index of dispersion of whole-run counts over ICs (analyse's
+#: ``dispersion_index`` rows): a spread of rates between ICs, not the within-run D
+CSV_NAMES = {"dispersion_index": "rate_dispersion_across_ics"}
+
+
+def public_names(table):
+    """``table`` with the quantities and notes of `CSV_NAMES` renamed as the CSV and the
+    page name them (the cache keeps the names `analyse` wrote)."""
+    table = table.copy()
+    for old, new in CSV_NAMES.items():
+        table["quantity"] = table["quantity"].str.replace(old, new, regex=False)
+    table["note"] = table["note"].fillna("").str.replace(
+        "index of dispersion", "rate dispersion across ICs", regex=False)
+    return table
+
+
 def _cached_null(out, rule, sizes, workers, say):
     """The Poisson nulls of the rate dispersion across ICs and of the early hazard
     (`poisson_null_rows`) of
@@ -203,7 +220,7 @@ def reproduce(out: str | os.PathLike, *, scale: str = "quick",
     tables = []
     for rule, rel in RULES.items():
         table, cache = _cached_rule(out, rule, sizes, workers, say)
-        table = pd.concat([table, _cached_profile(out, rule, sizes, workers, say),
+        table = pd.concat([public_names(table), _cached_profile(out, rule, sizes, workers, say),
                            _cached_null(out, rule, sizes, workers, say)], ignore_index=True)
         table = pd.concat([table, pd.DataFrame(against_null(table))],
                           ignore_index=True)
