@@ -6,7 +6,6 @@ import pytest
 
 from kicktimes.studies.disks.boltzmann import (
     BOLTZMANN_COLUMNS,
-    boltzmann_answer,
     boltzmann_lines,
     boltzmann_table,
     dilute_predictions,
@@ -30,7 +29,7 @@ def _row(rule, d, d_lo, d_hi, share=0.07, design=None, n=1000):
 
 
 def test_each_statistic_is_read_against_the_kicked_disk_of_its_rule():
-    gas = pd.DataFrame([_row("elastic", 1.15, 1.10, 1.20), _row("mirror", 1.40, 1.32, 1.48)])
+    gas = pd.DataFrame([_row("elastic", 1.15, 1.12, 1.18), _row("mirror", 1.40, 1.32, 1.48)])
     nulls = pd.DataFrame([
         _row("elastic", 1.14, 1.10, 1.18, design="dilute"),
         _row("elastic", 1.0, 0.97, 1.03, design="poisson"),  # not the elastic kicked disk
@@ -38,23 +37,25 @@ def test_each_statistic_is_read_against_the_kicked_disk_of_its_rule():
     b = boltzmann_table(gas, nulls, PRED)
     assert list(b.columns) == list(BOLTZMANN_COLUMNS)
     d = b[b["statistic"] == "dispersion"].set_index("rule")
-    assert d.loc["elastic", "kicked"] == 1.14 and d.loc["elastic", "verdict"] == "within 10 %"
-    assert d.loc["elastic", "reading"] == "agrees within 10 %"
+    # gas - kicked disk, read with D's margin 0.07: 1.15 [1.12, 1.18] - 1.14 [1.10, 1.18]
+    # = 0.01 [-0.04, 0.06]: inside +-0.07
+    assert d.loc["elastic", "kicked"] == 1.14 and d.loc["elastic", "verdict"] == "at its null"
+    assert d.loc["elastic", "diff"] == pytest.approx(0.01)
+    assert d.loc["elastic", "diff_low"] == pytest.approx(0.01 - np.hypot(0.03, 0.04))
+    assert d.loc["elastic", "reading"] == "at the kicked disk's"
     assert d.loc["elastic", "prediction"] == 1.13 and d.loc["mirror", "prediction"] == 1.0
-    assert d.loc["mirror", "verdict"] == "higher"
-    assert d.loc["mirror", "ratio"] == pytest.approx(1.40 / 0.98)
-    assert d.loc["mirror", "reading"].startswith("departs from the kicked disk by +43 %")
+    assert d.loc["mirror", "verdict"] == "above its null"
+    assert d.loc["mirror", "diff"] == pytest.approx(1.40 - 0.98)
     ks = b[b["statistic"] == "reject_uniformity_ks"].set_index("rule")
-    # the mirror gas's 7 % [6, 8] against the kicked disk's 5 %: above its band [2.5, 7.5]?
-    # no, the interval straddles 7.5 %: inconclusive
+    # the mirror gas's 7 % [6, 8] against the kicked disk's 5 % [4, 6]: 2 [0.6, 3.4] points,
+    # straddling the margin of 1 point: inconclusive
     assert ks.loc["mirror", "verdict"] == "inconclusive"
-    assert ks.loc["elastic", "verdict"] == "nominal"  # 7 % [6, 8] at a 7 % level
+    assert ks.loc["mirror", "margin"] == 0.01
     lines = boltzmann_lines(b)
     assert lines[0] == "## The gas beside the Boltzmann-kicked disk"
-    table = [x for x in lines if x.startswith("| packing")]
-    assert len(table) == 2 and all(x.count(" | ") == 4 for x in table)
-    answer = boltzmann_answer(b)
-    assert len(answer) == 4 and "departs from the kicked disk" in answer[-1]
+    assert ("packing 0.02, mirror: 1.4 vs 0.98: +0.420 [+0.331, +0.509] above the kicked "
+            "disk's") in lines[2]
+    assert "The other 6 (hazard's first bin, gamma shape, KS share)" in lines[2]
 
 
 def test_a_row_without_its_kicked_disk_is_left_out():

@@ -32,14 +32,20 @@ def run_quiet(exp, path):
         return run_experiment(exp, path, progress=False, workers=1)
 
 
-def _table(n=1000, d=(1.2, 1.15, 1.25, "higher"), share=(0.06, 0.05, 0.07, "nominal"),
-           p=1e-5, first=(0.92, 0.86, 0.98, "inconclusive"), rate=(1.01, 1.0, 1.02,
-                                                                   "within 10 %")):
+def _table(n=1000, d=(0.2, 0.15, 0.25, "above its null"),
+           share=(0.005, -0.004, 0.009, "at its null"), p=1e-5,
+           first=(-0.08, -0.14, -0.02, "inconclusive"), rate=(1.01, 1.005, 1.012,
+                                                               "within 1.5 %")):
+    """A control's row: D, the KS share and the first hazard bin as differences from their
+    own null (`versus_null`'s ``<s>_diff`` and ``<s>_verdict``), the rate as a ratio."""
     row = {"geometry": "packing 0.02", "rule": "mirror", "n_disks": n,
            "hazard_flat_pvalue": p}
-    for key, (est, lo, hi, v) in (("dispersion", d), ("reject_uniformity_ks", share),
-                                  ("hazard_first", first), ("rate_enskog", rate)):
-        row.update({key: est, f"{key}_low": lo, f"{key}_high": hi, f"{key}_verdict": v})
+    for key, (est, lo, hi, v) in (("d", d), ("ks", share), ("hazard_first", first)):
+        row.update({f"{key}_diff": est, f"{key}_diff_low": lo, f"{key}_diff_high": hi,
+                    f"{key}_verdict": v})
+    est, lo, hi, v = rate
+    row.update({"rate_enskog": est, "rate_enskog_low": lo, "rate_enskog_high": hi,
+                "rate_enskog_verdict": v})
     return pd.DataFrame([row])
 
 
@@ -49,31 +55,32 @@ def _group(long, finding):
 
 def test_a_finding_with_the_same_verdict_under_every_control_is_robust():
     long = controls_findings({"primary": _table(), "seed": _table(),
-                              "k60": _table(d=(1.3, 1.2, 1.4, "higher"))})
-    g = _group(long, "count dispersion D")
+                              "k60": _table(d=(0.3, 0.2, 0.4, "above its null"))})
+    g = _group(long, "D − null D")
     assert g["robust"].all() and list(g["control"]) == ["primary", "seed", "k60"]
-    assert robust_text(g) == "robust: higher"
+    assert robust_text(g) == "robust: above its null"
 
 
 def test_a_finding_whose_verdict_changes_depends_on_that_control_with_both_numbers():
     long = controls_findings({"primary": _table(), "seed": _table(),
-                              "k60": _table(share=(0.11, 0.09, 0.13, "above nominal"))})
-    g = _group(long, "uniform-times rejection share")
+                              "k60": _table(share=(0.03, 0.02, 0.04, "above its null"))})
+    g = _group(long, "KS share − null")
     assert not g["robust"].any() and set(g["depends_on"]) == {"k60"}
     text = robust_text(g)
     assert text.startswith("depends on k60: ")
-    assert "6.00 [5.00, 7.00] % nominal (primary)" in text
-    assert "11.0 [9.00, 13.0] % above nominal (k60)" in text
+    assert "+0.005 [−0.004, +0.009] at its null (primary)" in text
+    assert "+0.030 [+0.020, +0.040] above its null (k60)" in text
     assert "(seed)" not in text  # the controls that agree are not listed
 
 
 def test_a_change_of_direction_alone_is_not_robust():
-    # both inconclusive, one interval above 1 and the other below it
-    long = controls_findings({"primary": _table(first=(1.08, 1.02, 1.14, "inconclusive")),
-                              "bulk": _table(first=(0.93, 0.88, 0.98, "inconclusive"))})
-    g = _group(long, "hazard first bin")
+    # both inconclusive, one interval above the null and the other below it
+    long = controls_findings({"primary": _table(first=(0.08, 0.02, 0.14, "inconclusive")),
+                              "bulk": _table(first=(-0.07, -0.12, -0.02, "inconclusive"))})
+    g = _group(long, "hazard first bin − null")
     assert not g["robust"].any() and set(g["reason"]) == {"direction"}
-    assert robust_text(g).startswith("depends on bulk: 1.08 [1.02, 1.14] inconclusive (primary)")
+    assert robust_text(g).startswith("depends on bulk: +0.080 [+0.020, +0.140] inconclusive "
+                                     "(primary)")
 
 
 def test_the_hazard_flatness_verdict_is_its_p_value_and_bulk_is_no_control_of_the_rate():
@@ -86,21 +93,21 @@ def test_the_hazard_flatness_verdict_is_its_p_value_and_bulk_is_no_control_of_th
 
 
 def test_the_controls_section_counts_robust_and_dependent_findings():
-    long = controls_findings({"primary": _table(), "k60": _table(
-        share=(0.11, 0.09, 0.13, "above nominal"))})
+    long = controls_findings({"primary": _table(), "seed": _table(), "k60": _table(
+        share=(0.03, 0.02, 0.04, "above its null"))})
     text = "\n".join(controls_lines(long))
     assert "## Under the controls" in text
     # the hazard's flatness is not read on the page: 4 findings, not 5
-    assert "Over the 4 findings of the rows at N ≥ 30" in text
-    assert "3 robust, 1 depend on a control (k60: 1)" in text
-    assert "| 1000 | robust: higher | depends on k60 |" in text
+    assert "Of the 4 findings at N ≥ 30, 3 are robust and 1 depend on a control" in text
+    assert "(seed: 0, k60: 1)" in text
+    assert "The replicate alone (another seed, the same design) changes 0 of 4" in text
 
 
 def test_the_controls_table_is_lint_clean(tmp_path):
-    long = controls_findings({"primary": _table(), "seed": _table(d=(1.05, 0.95, 1.09,
-                                                                     "within 10 %"))})
-    d = long[long["diagnostic"] == "count dispersion D"]
-    assert set(d["verdict"]) == {"higher", "within 10 %"} and not d["robust"].any()
+    long = controls_findings({"primary": _table(), "seed": _table(d=(0.05, -0.01, 0.09,
+                                                                     "inconclusive"))})
+    d = long[long["diagnostic"] == "D − null D"]
+    assert set(d["verdict"]) == {"above its null", "inconclusive"} and not d["robust"].any()
     assert {"family", "diagnostic", "system", "control", "estimate", "ci_low", "ci_high",
             "verdict", "robust"} <= set(long.columns)
 
@@ -269,68 +276,18 @@ def test_the_page_gives_every_finding_under_its_controls(tiny, tmp_path):
     # not a sweep report's findings table (tests/test_results_pages.py reads *_findings.csv)
     assert not list((tmp_path / "results").glob("*_findings.csv"))
     assert set(long["control"]) == {"primary", "seed", "bulk"}
-    assert "## Under the controls" in text and "No controls were run" not in text
-    assert "## Which renewal model?" in text
+    assert "## Under the controls" in text and "[disks_controls.csv]" in text
     assert (tmp_path / "results" / "disks_renewal.csv").exists()
-    assert "Not run here: no disks_ftle_check.csv" in text
-    # every finding read on the page has a short cell, "robust: <verdict>" or "depends on
-    # <controls>" (the numbers are in the CSV); the hazard's flatness is in the CSV only
-    for (_, _, diagnostic), g in long.groupby(["family", "n_disks", "diagnostic"]):
-        if diagnostic != "hazard flatness":
-            assert robust_text(g).split(":")[0] in text
-    assert "| hazard flatness" not in text
-    # the Poisson readings under the controls are in the first table's last column
-    assert "same under all" in text or "differs: " in text
-
-
-def test_the_bulk_control_refuses_a_store_whose_seeds_now_tag_other_disks(tiny):
-    from kicktimes.studies.disks.tables import bulk_rows
-
-    other = dataclasses.replace(tiny, collisions=tiny.collisions.assign(
-        disk=tiny.collisions["disk"] + 1000))
-    with pytest.raises(ValueError, match="rerun the store"):
-        bulk_rows(other, 0.5)
-
-
-def test_the_density_fit_finds_a_line_and_a_curve_on_data_with_known_answers():
-    from kicktimes.studies.disks.density import summarise
-
-    rng = np.random.default_rng(3)
-    packings = [0.0025, 0.005, 0.01, 0.02, 0.04]
-    x = np.log(1.0 / (4.0 * np.array(packings) / np.pi))
-    rows = []
-    for n_disks, shape in ((300, lambda v: -5.0 + 3.0 * v),             # the form exactly
-                           (1000, lambda v: -5.0 + 3.0 * v + 0.6 * v * v)):  # curved
-        for p, v in zip(packings, x, strict=True):
-            for k in range(12):
-                rows.append({"n_disks": n_disks, "packing": p, "state": k,
-                             "lam_per_coll": shape(v) + rng.normal(0.0, 0.02)})
-    table, fits = summarise(pd.DataFrame(rows), n_boot=400)
-    line, curve = fits.iloc[0], fits.iloc[1]
-    assert line["b_lo"] < 3.0 < line["b_hi"] and line["c_lo"] < 0.0 < line["c_hi"]
-    assert line["reading"].endswith("the form holds over this range")
-    assert curve["c_lo"] > 0.0 and curve["reading"].startswith("curvature detected")
-    assert set(table["n_states"]) == {12}
-    # only the dilute packings enter the fit: 4 at or below 0.02, 3 local slopes
-    assert len(str(line["local_over_b"]).split(";")) == 3
-    with pytest.raises(ValueError, match="fit_max_packing"):
-        summarise(pd.DataFrame(rows), n_boot=10, fit_max_packing=0.004)
-
-
-def test_the_density_section_is_rendered_from_its_tables_or_skipped(tmp_path):
-    from kicktimes.studies.disks.density import summarise
-    from kicktimes.studies.disks.kicked import density_lines
-
-    a, b = tmp_path / "disks_lyapunov_density.csv", tmp_path / "disks_lyapunov_density_fit.csv"
-    assert density_lines(a, b)[2].startswith("Not run here")
-    rows = [{"n_disks": 300, "packing": p, "state": k, "lam_per_coll": 10.0 - 100 * p + k % 2}
-            for p in (0.0025, 0.005, 0.01, 0.02) for k in range(4)]
-    table, fits = summarise(pd.DataFrame(rows), n_boot=200)
-    table.to_csv(a, index=False)
-    fits.to_csv(b, index=False)
-    text = "\n".join(density_lines(a, b))
-    assert "| 300 | 0.0025 |" in text and "N = 300, fitted at φ ≤ 0.02" in text
-    assert "The prefactors a and b of the theory are not computed here" in text
+    # D, the KS share and the first hazard bin are read under every control against their
+    # own null: differences with the null's verdicts
+    d = long[long["diagnostic"] == "D − null D"]
+    assert set(d["verdict"]) <= {"at its null", "above its null", "below its null",
+                                 "inconclusive"}
+    assert "count dispersion D" not in set(long["diagnostic"])
+    # the replicate's D against the primary's null, in the answers' table
+    answers = pd.read_csv(tmp_path / "results" / "disks_poisson.csv")
+    assert answers["replicate_diff"].notna().all()
+    assert set(answers["answer"]) <= {"Poisson", "not Poisson", "not resolved"}
 
 
 def test_the_kicked_rate_is_the_whole_gas_collision_frequency():
@@ -392,8 +349,14 @@ def test_the_null_streams_are_shaped_like_the_runs_and_calibrate_the_tests(tmp_p
     rows = calibration_rows(table)
     assert set(rows["design"]) == {"poisson", "dilute"}
     assert rows["test"].str.endswith("speed-rescaled").any()
-    assert ((rows["ci_low"] <= rows["share"]) & (rows["share"] <= rows["ci_high"])).all()
+    assert ((rows["ci_low"] <= rows["value"]) & (rows["value"] <= rows["ci_high"])).all()
     assert (rows["n_clusters"] == store.results["ic"].nunique()).all()
+    # the null values a page reads its statistics against, beside the rejection shares
+    assert {"rejection share", "D", "hazard, first bin", "hazard, highest bin",
+            "gamma shape"} == set(rows["statistic"])
+    d = rows[(rows["statistic"] == "D") & (rows["design"] == "poisson")].iloc[0]
+    assert d["value"] == table.set_index("design").loc["poisson", "dispersion"]
+    assert d["test"] == "" and d["n_runs"] > 0
 
 
 def test_the_walls_share_of_d_minus_one_is_read_only_outside_its_noise():

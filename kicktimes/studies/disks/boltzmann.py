@@ -18,10 +18,9 @@ hazard's first bin after a collision and a gamma renewal fit's shape.
 What the Boltzmann equation leaves out is what the gas does beyond this process:
 correlated re-collisions (ring events), the density's structure at contact beyond
 Enskog's constant g(σ), and, in the circle, the wall layer. `boltzmann_table` sets each
-statistic of the gas beside the kicked disk's, with their ratio and its verdict
-(`kicktimes.stats.ratio_verdict`, margin 10 %, stated before the run) or, for the share,
-the gas's share read against the kicked disk's as a calibrated level
-(`kicktimes.stats.rejection_verdict`), and the large-sample prediction of
+statistic of the gas beside the kicked disk's, with their difference and its verdict
+(`kicktimes.stats.null_verdict`, the statistic's margin stated before the run:
+`kicktimes.studies.disks.versus_null.MARGINS`), and the large-sample prediction of
 `kicktimes.stats.dilute_tagged_disk` beside both.
 """
 
@@ -30,15 +29,9 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from kicktimes.stats import (
-    dilute_tagged_disk,
-    format_interval,
-    ratio_interval,
-    ratio_verdict,
-    rejection_verdict,
-)
+from kicktimes.stats import dilute_tagged_disk, null_verdict
 
-__all__ = ["BOLTZMANN_COLUMNS", "STATISTICS", "boltzmann_answer", "boltzmann_lines",
+__all__ = ["BOLTZMANN_COLUMNS", "STATISTICS", "boltzmann_lines",
            "boltzmann_table", "dilute_predictions"]
 
 #: the statistics compared, with the page's words: disks.csv's column names
@@ -46,8 +39,8 @@ STATISTICS = {"dispersion": "D", "hazard_first": "hazard, first bin",
               "gamma_shape": "gamma shape", "reject_uniformity_ks": "KS share"}
 #: the columns of docs/results/disks_boltzmann_kicks.csv
 BOLTZMANN_COLUMNS = ("geometry", "rule", "n_disks", "statistic", "gas", "gas_low", "gas_high",
-                     "kicked", "kicked_low", "kicked_high", "prediction", "ratio", "ratio_low",
-                     "ratio_high", "verdict", "reading")
+                     "kicked", "kicked_low", "kicked_high", "prediction", "diff", "diff_low",
+                     "diff_high", "margin", "verdict", "reading")
 
 
 def dilute_predictions(rule, collisions, *, hazard_bin=(0.0, 0.01), n_events=2_000_000,
@@ -83,19 +76,6 @@ def dilute_predictions(rule, collisions, *, hazard_bin=(0.0, 0.01), n_events=2_0
             "gamma_shape": float(disk.gamma_shape), "reject_uniformity_ks": np.nan}
 
 
-def _reading(verdict, ratio, low, high, statistic) -> str:
-    if statistic == "reject_uniformity_ks":
-        return {"nominal": "agrees (at the kicked disk's level)",
-                "above nominal": "above the kicked disk's",
-                "below nominal": "below the kicked disk's"}.get(verdict, "inconclusive")
-    if verdict.startswith("within"):
-        return f"agrees {verdict}"
-    if verdict in ("higher", "lower"):
-        return (f"departs from the kicked disk by {100 * (ratio - 1):+.0f} % "
-                f"[{100 * (low - 1):+.0f}, {100 * (high - 1):+.0f}]")
-    return "inconclusive"
-
-
 def boltzmann_table(table, nulls, predictions=None) -> pd.DataFrame:
     """Each statistic of the gas beside the Boltzmann-kicked disk's, per geometry, rule and N.
 
@@ -113,12 +93,16 @@ def boltzmann_table(table, nulls, predictions=None) -> pd.DataFrame:
     Returns
     -------
     DataFrame
-        Columns `BOLTZMANN_COLUMNS`. ``ratio`` is gas over kicked with the interval of
-        `kicktimes.stats.ratio_interval` (independent samples) and the verdict of
-        `ratio_verdict` (10 %); for the KS share, ``ratio`` is the gas's share over the
-        kicked disk's and the verdict is `rejection_verdict` of the gas's interval at the
-        kicked disk's share.
+        Columns `BOLTZMANN_COLUMNS`. ``diff`` is gas minus kicked disk, its 95 % interval
+        from both intervals (independent samples: the half-widths added in quadrature, on
+        each side), and ``verdict`` `kicktimes.stats.null_verdict` of it with the
+        statistic's margin (`kicktimes.studies.disks.versus_null.MARGINS`: half the
+        Boltzmann tagged disk's own departure from Poisson in it).
     """
+    from kicktimes.studies.disks.versus_null import MARGINS
+
+    margins = {"dispersion": MARGINS["d"], "hazard_first": MARGINS["hazard_first"],
+               "gamma_shape": MARGINS["gamma"], "reject_uniformity_ks": MARGINS["ks"]}
     predictions = {} if predictions is None else dict(predictions)
     rows = []
     for _, gas in table.iterrows():
@@ -137,92 +121,52 @@ def boltzmann_table(table, nulls, predictions=None) -> pd.DataFrame:
             values = [float(v) if v is not None else np.nan for v in values]
             if not np.isfinite(values[0]) or not np.isfinite(values[3]):
                 continue
-            if stat == "reject_uniformity_ks":
-                ratio = values[0] / values[3] if values[3] > 0 else np.nan
-                low = high = np.nan
-                verdict = rejection_verdict(values[1], values[2], values[3])
-            else:
-                ratio, low, high = ratio_interval(*values)
-                verdict = ratio_verdict(low, high)
+            g, g_lo, g_hi, k, k_lo, k_hi = values
+            diff = g - k
+            low = diff - np.hypot(g - g_lo, k_hi - k)
+            high = diff + np.hypot(g_hi - g, k - k_lo)
+            verdict = null_verdict(low, high, margins[stat])
             rows.append({"geometry": gas["geometry"], "rule": gas["rule"],
                          "n_disks": int(gas["n_disks"]), "statistic": stat,
-                         "gas": values[0], "gas_low": values[1], "gas_high": values[2],
-                         "kicked": values[3], "kicked_low": values[4],
-                         "kicked_high": values[5], "prediction": predictions[key][stat],
-                         "ratio": ratio, "ratio_low": low, "ratio_high": high,
+                         "gas": g, "gas_low": g_lo, "gas_high": g_hi,
+                         "kicked": k, "kicked_low": k_lo, "kicked_high": k_hi,
+                         "prediction": predictions[key][stat], "diff": diff,
+                         "diff_low": low, "diff_high": high, "margin": margins[stat],
                          "verdict": verdict,
-                         "reading": _reading(verdict, ratio, low, high, stat)})
+                         "reading": verdict.replace("its null", "the kicked disk's")})
     return pd.DataFrame(rows, columns=list(BOLTZMANN_COLUMNS))
 
 
 def _cell(row) -> str:
-    if row["statistic"] == "reject_uniformity_ks":
-        return (f"{100 * row['gas']:.3g} % vs {100 * row['kicked']:.3g} %: "
-                f"{row['reading']}")
-    return (f"{format_interval(row['gas'], row['gas_low'], row['gas_high'])} vs "
-            f"{format_interval(row['kicked'], row['kicked_low'], row['kicked_high'])}: "
-            f"{row['reading']}")
+    from kicktimes.studies.disks.readings import diff_text
 
-
-def boltzmann_answer(boltz, statistic="dispersion") -> list:
-    """The answers' table: at the largest N, per geometry and rule, the gas's statistic
-    beside the Boltzmann-kicked disk's and its reading (`boltzmann_table`)."""
-    if boltz.empty:
-        return []
-    at = boltz[(boltz["n_disks"] == boltz["n_disks"].max())
-               & (boltz["statistic"] == statistic)]
-    head = ["geometry", "rule", "N", f"{STATISTICS[statistic]}, gas",
-            f"{STATISTICS[statistic]}, kicked disk", "reading"]
-    out = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
-    for _, r in at.iterrows():
-        out.append("| " + " | ".join([
-            r["geometry"], r["rule"], str(int(r["n_disks"])),
-            format_interval(r["gas"], r["gas_low"], r["gas_high"]),
-            format_interval(r["kicked"], r["kicked_low"], r["kicked_high"]),
-            r["reading"]]) + " |")
-    return out
+    return (f"{row['gas']:.4g} vs {row['kicked']:.4g}: "
+            + diff_text(row["diff"], row["diff_low"], row["diff_high"], row["margin"])
+            + f" {row['reading']}")
 
 
 def boltzmann_lines(boltz, *, n_disks=None) -> list:
-    """The section "The gas beside the Boltzmann-kicked disk": the method in a paragraph,
-    one table at the largest N (rows: geometry and rule; columns: the statistics, each
-    "gas vs kicked: reading"), the predictions, and the full table's file."""
+    """The section "The gas beside the Boltzmann-kicked disk" at the largest N: the method
+    in a sentence, D per geometry and rule (gas - kicked disk, its interval and reading),
+    and how many of the other statistics lie within their margins; every N and statistic
+    in the CSV."""
     if boltz.empty:
         return []
     n = int(boltz["n_disks"].max()) if n_disks is None else n_disks
     at = boltz[boltz["n_disks"] == n]
-    heads = ["geometry, rule", *STATISTICS.values()]
-    lines = [
+    d = at[at["statistic"] == "dispersion"]
+    rest = at[at["statistic"] != "dispersion"]
+    counts = rest["verdict"].value_counts()
+    cells = "; ".join(f"{r['geometry']}, {r['rule']}: {_cell(r)}" for _, r in d.iterrows())
+    return [
         "## The gas beside the Boltzmann-kicked disk", "",
-        "The paper's question, transposed to the gas like for like: one disk kicked at the "
-        "rate λ(v) g(σ) of its own speed by virtual partners from the bath (the Maxwellian "
-        "under the elastic rule, the unit-speed kernel under the mirror rule). Its walls "
-        "keep its speed, so its kick times are the linear Boltzmann process "
-        "(`kicktimes.stats.dilute_tagged_disk`) whatever the table: they are drawn exactly "
-        "(`dilute_tagged_times`), shaped like the gas's runs (same runs, tagged disks, "
-        "windows, each run's measured rate) and put through this page's estimators. Gas "
-        "vs kicked disk, ratio's 95 % interval from both intervals "
-        "(`kicktimes.stats.ratio_interval`), agreement: the interval inside ±10 % "
-        "(`ratio_verdict`, margin stated before the run); the KS share is read against "
-        "the kicked disk's share as a calibrated level (`rejection_verdict`). What departs "
-        "is what the Boltzmann equation leaves out: re-collisions, structure at contact "
-        "beyond Enskog's g(σ), the wall layer. Every N: "
-        "[disks_boltzmann_kicks.csv](disks_boltzmann_kicks.csv).", "",
-        f"**N = {n}** (gas vs Boltzmann-kicked disk)", "",
-        "| " + " | ".join(heads) + " |", "|" + "---|" * len(heads)]
-    for (geo, rule), g in at.groupby(["geometry", "rule"], sort=False):
-        cells = []
-        for stat in STATISTICS:
-            r = g[g["statistic"] == stat]
-            cells.append(_cell(r.iloc[0]) if len(r) else "—")
-        lines.append(f"| {geo}, {rule} | " + " | ".join(cells) + " |")
-    pred = (boltz.drop_duplicates(["rule", "statistic"])
-            .set_index(["rule", "statistic"])["prediction"])
-    if ("elastic", "dispersion") in pred.index:
-        lines += ["", "The large-sample predictions of the dilute tagged disk "
-                  "(`dilute_tagged_disk`), elastic rule: D over the window "
-                  f"{pred['elastic', 'dispersion']:.4g}, first hazard bin "
-                  f"{pred['elastic', 'hazard_first']:.4g}, gamma shape "
-                  f"{pred['elastic', 'gamma_shape']:.4g}; mirror rule: 1, 1, 1. The kicked "
-                  "disk's columns are these with the runs' finite samples and estimators."]
-    return lines + [""]
+        "One disk kicked at the rate of its own speed by partners from the bath: the linear "
+        "Boltzmann process (`stats.dilute_tagged_disk`; under the mirror rule a Poisson "
+        "process), drawn exactly, shaped like the gas's runs and put through this page's "
+        "estimators; gas − kicked disk with its 95 % interval (independent samples), read "
+        f"with each statistic's margin (`stats.null_verdict`). At N = {n}, D (gas vs kicked "
+        f"disk: gas − kicked): {cells}. The other {len(rest)} (hazard's first bin, gamma "
+        f"shape, KS share): {int(counts.get('at its null', 0))} within their margin, "
+        f"{int(counts.get('above its null', 0) + counts.get('below its null', 0))} depart, "
+        f"{int(counts.get('inconclusive', 0))} inconclusive. Every N and statistic: "
+        "[disks_boltzmann_kicks.csv](disks_boltzmann_kicks.csv).", ""]

@@ -15,7 +15,8 @@ from matplotlib.lines import Line2D
 from matplotlib.ticker import FuncFormatter
 
 from kicktimes.render.figures import plain_log_ticks
-from kicktimes.studies.disks.tables import HAZARD_EDGES
+from kicktimes.studies.disks.tables import RATE_MARGIN
+from kicktimes.studies.disks.versus_null import HAZARD_MARGIN
 
 __all__ = ["controls_figure", "geometries_of", "hazard_figure", "rates_figure",
            "rejection_figure"]
@@ -53,7 +54,9 @@ def rejection_figure(table, tests=(HEADLINE, "exponential_ad"), nulls=None):
     nominal band stays readable next to the N = 2 shares); mirror, elastic and elastic after
     the speed rescaling, dodged and with different markers; 95 % CIs; the nominal band
     shaded; with ``nulls`` (`kicktimes.studies.disks.null.null_rows`), the share of the
-    Poisson null streams shaped like each rule's runs (the calibrated level), dotted."""
+    Poisson null streams shaped like each rule's runs (the calibrated level), dotted, and
+    under the elastic rule the linear Boltzmann tagged disk's share (the ``"dilute"``
+    design), dashed."""
     import matplotlib.pyplot as plt
 
     geos = geometries_of(table)
@@ -85,6 +88,12 @@ def rejection_figure(table, tests=(HEADLINE, "exponential_ad"), nulls=None):
                         ax.plot(z["n_disks"].to_numpy() * (1.0 + 0.12 * (k - 1)),
                                 100 * z[key].to_numpy(), color=color, ls=":", marker="x",
                                 ms=4, lw=1, label=f"Poisson null, {rule} runs")
+                    b = nulls[(nulls["geometry"] == geo) & (nulls["rule"] == rule)
+                              & (nulls["design"] == "dilute")]
+                    if rule == "elastic" and not b.empty and key in b:
+                        ax.plot(b["n_disks"].to_numpy() * (1.0 + 0.12 * (k - 1)),
+                                100 * b[key].to_numpy(), color="0.2", ls="--", marker="+",
+                                ms=5, lw=0.9, label="linear Boltzmann, elastic runs")
             _n_ticks(ax, ns)
             ax.set_yscale("log")
             ax.set_ylim(0.5, 100)
@@ -108,8 +117,9 @@ def hazard_figure(hazard, table, n_shown=SHOWN_N):
     """The hazard of the tagged disk's next collision against the time since its last one,
     both in units of the mean interval, over the constant rate (1 for Poisson): per rule a
     row over the whole range (log y) and a row zoomed near 1 for N >= ZOOM_MIN_N (linear y,
-    ±10 % shaded; a bin beyond the limits is a filled triangle at the edge with its value,
-    a bin whose 95 % band alone leaves them an open one); one
+    ±`HAZARD_MARGIN` shaded; under the elastic rule the linear Boltzmann h(t) dashed; a
+    bin beyond the limits is a filled triangle at the edge with its value, a bin whose
+    95 % band alone leaves them an open one); one
     column per geometry, one line per N (distinct colours and markers at the bins'
     middles), 95 % bands."""
     import matplotlib.pyplot as plt
@@ -117,6 +127,9 @@ def hazard_figure(hazard, table, n_shown=SHOWN_N):
     geos = geometries_of(table)
     rules = ("mirror", "elastic")
     exp_of = table.drop_duplicates(["rule", "geometry"]).set_index(["rule", "geometry"])
+    # the axis ends where the last bin with an interval in it ends
+    t_end = float(hazard.loc[hazard["events"] > 0, "t_high"].max() if "events" in hazard
+                  else hazard["t_high"].max())
     fig, axes = plt.subplots(2 * len(rules), len(geos), figsize=(4.4 * len(geos), 11.5),
                              sharex=True, squeeze=False)
     palette = ("C3", "C1", "C2", "C0", "k", "C4", "C5", "C6", "C7", "C8")
@@ -128,11 +141,14 @@ def hazard_figure(hazard, table, n_shown=SHOWN_N):
             for j, geo in enumerate(geos):
                 ax = axes[2 * i + zoom, j]
                 if zoom:
-                    ax.axhspan(0.9, 1.1, color="0.9", zorder=0)
+                    ax.axhspan(1 - HAZARD_MARGIN, 1 + HAZARD_MARGIN, color="0.9", zorder=0)
                 ax.axhline(1.0, color="0.5", lw=0.8)
                 if (rule, geo) not in exp_of.index:
                     continue
                 name = exp_of.loc[(rule, geo), "experiment"]
+                if rule == "elastic":
+                    ax.plot(BOLTZMANN_T, _boltzmann_curve(), color="0.15", ls="--", lw=1.0,
+                            label="linear Boltzmann h(t)", zorder=4)
                 for n in n_shown:
                     d = hazard[(hazard["experiment"] == name) & (hazard["n_disks"] == n)]
                     if d.empty or (zoom and n < ZOOM_MIN_N):
@@ -148,7 +164,7 @@ def hazard_figure(hazard, table, n_shown=SHOWN_N):
                                     np.r_[d["ci_high"], d["ci_high"].iloc[-1]], step="post",
                                     color=colors[n], alpha=0.15, lw=0)
                 ax.set_xscale("log")
-                ax.set_xlim(X_MIN, HAZARD_EDGES[-1])
+                ax.set_xlim(X_MIN, t_end)
                 plain_log_ticks(ax.xaxis)
                 if zoom:
                     ax.set_ylim(*ZOOM_LIMITS)
@@ -167,14 +183,32 @@ def hazard_figure(hazard, table, n_shown=SHOWN_N):
                     ax.set_xlabel("time since the last collision / mean interval")
                 if j == 0:
                     ax.set_ylabel("hazard / constant rate")
-    handles, labels = axes[0, 0].get_legend_handles_labels()
+    handles, labels = axes[2, 0].get_legend_handles_labels()
     handles += [Line2D([], [], color="0.3", marker="^", ls="none", ms=6),
                 Line2D([], [], color="0.3", marker="^", mfc="none", ls="none", ms=6)]
     labels += ["bin beyond the axis (value beside)", "only its 95 % band beyond"]
-    fig.legend(handles, labels, loc="upper center", ncol=len(labels), fontsize=9,
+    fig.legend(handles, labels, loc="upper center", ncol=(len(labels) + 1) // 2, fontsize=9,
                frameon=False)
-    fig.tight_layout(rect=(0, 0, 1, 0.965))
+    fig.tight_layout(rect=(0, 0, 1, 0.95))
     return fig
+
+
+#: the times (mean intervals) at which the hazard figure draws the Boltzmann h(t)
+BOLTZMANN_T = np.geomspace(X_MIN, 20.0, 40)
+
+
+def _boltzmann_curve():
+    """The elastic linear Boltzmann tagged disk's hazard over the mean rate at
+    `BOLTZMANN_T` (`kicktimes.stats.dilute_tagged_disk`), computed once."""
+    global _BOLTZMANN_H
+    if _BOLTZMANN_H is None:
+        from kicktimes.stats import dilute_tagged_disk
+
+        _BOLTZMANN_H = dilute_tagged_disk("elastic").hazard(BOLTZMANN_T)
+    return _BOLTZMANN_H
+
+
+_BOLTZMANN_H = None
 
 
 def _mark_outside(ax, d, color, low, high):
@@ -202,13 +236,17 @@ def _mark_outside(ax, d, color, low, high):
     return marked
 
 
-def rates_figure(table):
+def rates_figure(table, nulls=None, boltzmann=None):
     """Against N: the collision frequency over Enskog's (at N = 2 also over the two-disk
     kinetic rate, stars: Enskog is not the reference for two disks), the index of
     dispersion of the tagged disks' counts in K mean intervals (log y), and the hazard of a
     collision within 0.01 mean intervals of the last over the constant rate (the refractory
-    dip); 95 % CIs, the ±10 % band shaded, one line per (geometry, rule), panel titles, one
-    legend below the panels."""
+    dip); 95 % CIs, one line per (geometry, rule), panel titles, one legend below the
+    panels; the rate's ±10 % band shaded; with ``nulls`` (`versus_null` rows: ``null_d``,
+    ``null_hazard_first``) the same statistic on the Poisson null streams of the same runs,
+    crosses; with ``boltzmann`` (``{"dispersion": D, "hazard_first": h}``) the elastic
+    linear Boltzmann tagged disk's values, dashed."""
+    boltzmann = boltzmann or {}
     import matplotlib.pyplot as plt
 
     panels = (("rate_enskog", "collision frequency / Enskog", "collision rate / Enskog",
@@ -219,8 +257,13 @@ def rates_figure(table):
     ns = sorted(set(table["n_disks"]))
     fig, axes = plt.subplots(1, len(panels), figsize=(14, 4.6), squeeze=False)
     for ax, (key, label, title, log) in zip(axes[0], panels, strict=True):
-        ax.axhspan(0.9, 1.1, color="0.88", zorder=0)
+        if key == "rate_enskog":
+            ax.axhspan(1 - RATE_MARGIN, 1 + RATE_MARGIN, color="0.88", zorder=0)
         ax.axhline(1.0, color="0.5", lw=0.8, zorder=0)
+        level = boltzmann.get(key)
+        if level is not None:
+            ax.axhline(level, color="0.15", ls="--", lw=1.0, zorder=1,
+                       label=f"linear Boltzmann, elastic: {level:.3g}")
         for k, ((_, geo, rule), d) in enumerate(table.groupby(
                 ["experiment", "geometry", "rule"], sort=False, observed=True)):
             shift = 1.0 + 0.04 * (k - 2.5)
@@ -230,6 +273,15 @@ def rates_figure(table):
             ax.errorbar(x, y, yerr=err, marker="os"[rule == "elastic"], ms=3.5, lw=1,
                         capsize=2, color=f"C{k // 2}", ls="-" if rule == "mirror" else "--",
                         label=f"{geo}, {rule}")
+            null_key = {"dispersion": "null_d", "hazard_first": "null_hazard_first"}.get(key)
+            if null_key and nulls is not None:
+                z = nulls[(nulls["geometry"] == geo) & (nulls["rule"] == rule)]
+                if not z.empty:
+                    ax.plot(z["n_disks"].to_numpy() * shift, z[null_key].to_numpy(),
+                            ls="none", marker="x", ms=5, mew=1.2, color=f"C{k // 2}")
+                    if k == 0:
+                        ax.plot([], [], ls="none", marker="x", ms=5, mew=1.2, color="k",
+                                label="Poisson null of the same runs (colour: family)")
             if key == "rate_enskog" and "rate_two_disk" in d:
                 two = d[(d["n_disks"] == 2) & d["rate_two_disk"].notna()]
                 if not two.empty:
@@ -243,23 +295,27 @@ def rates_figure(table):
         ax.tick_params(axis="x", labelsize=7)
         if log:
             ax.set_yscale("log")
-            ax.set_yticks([0.8, 1, 1.5, 2, 3, 5, 8])
+            ax.set_yticks([0.8, 1, 1.14, 1.5, 2, 3, 5, 8])
             ax.set_yticks([], minor=True)
             ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
         ax.set_title(title, fontsize=10)
         ax.set_xlabel("number of disks N")
         ax.set_ylabel(label)
-    handles, labels = axes[0, 0].get_legend_handles_labels()
-    fig.legend(handles, labels, loc="lower center", ncol=4, fontsize=8, frameon=False)
-    fig.tight_layout(rect=(0, 0.1, 1, 1))
+    handles, labels = [], []
+    for ax in axes.ravel():
+        for h, lab in zip(*ax.get_legend_handles_labels(), strict=True):
+            if lab not in labels:
+                handles.append(h)
+                labels.append(lab)
+    fig.legend(handles, labels, loc="lower center", ncol=3, fontsize=8, frameon=False)
+    fig.tight_layout(rect=(0, 0.17, 1, 1))
     return fig
 
 
-#: the controls figure's findings: (the controls table's diagnostic, y label, band, scale)
-CONTROL_PANELS = (("count dispersion D", "index of dispersion D", (0.9, 1.1), 1.0),
-                  ("uniform-times rejection share", "uniform times rejected (%)",
-                   (100 * ALPHA * 0.5, 100 * ALPHA * 1.5), 100.0),
-                  ("hazard first bin", "first hazard bin / rate", (0.9, 1.1), 1.0))
+#: the controls figure's findings: (the controls table's diagnostic, y label, margin)
+CONTROL_PANELS = (("D − null D", "D − null D", 0.07),
+                  ("KS share − null", "KS share − null (share)", 0.01),
+                  ("hazard first bin − null", "first hazard bin − null", 0.03))
 CONTROL_STYLES = {"primary": ("k", "o"), "seed": ("C0", "s"), "k60": ("C3", "^"),
                   "bulk": ("C2", "D"), "box": ("C4", "v")}
 
@@ -267,8 +323,8 @@ CONTROL_STYLES = {"primary": ("k", "o"), "seed": ("C0", "s"), "k60": ("C3", "^")
 def controls_figure(long, *, n_min=10, names=None):
     """The findings under their controls against N (``N >= n_min``): one row per geometry x
     rule, one column per finding of `CONTROL_PANELS`, the controls dodged sideways with
-    their own colours and markers, 95 % CIs, the finding's band shaded (±10 % for the
-    ratios, the nominal band for the share), one y scale per column, a hollow marker where
+    their own colours and markers, 95 % CIs, each finding's difference from its own null
+    with its margin shaded, one y scale per column, a hollow marker where
     the finding is not robust (`kicktimes.studies.disks.controls.controls_findings`, its
     ``robust``)."""
     import matplotlib.pyplot as plt
@@ -283,10 +339,11 @@ def controls_figure(long, *, n_min=10, names=None):
                              figsize=(4.3 * len(CONTROL_PANELS), 2.3 * len(families) + 0.8),
                              sharex=True, sharey="col", squeeze=False)
     for i, fam in enumerate(families):
-        for j, (finding, label, band, scale) in enumerate(CONTROL_PANELS):
+        for j, (finding, label, margin) in enumerate(CONTROL_PANELS):
             ax = axes[i, j]
-            ax.axhspan(*band, color="0.88", zorder=0)
-            ax.axhline(1.0 if scale == 1.0 else 100 * ALPHA, color="0.5", lw=0.8, zorder=0)
+            scale = 1.0
+            ax.axhspan(-margin, margin, color="0.88", zorder=0)
+            ax.axhline(0.0, color="0.5", lw=0.8, zorder=0)
             for k, control in enumerate(controls):
                 g = d[(d["family"] == fam) & (d["diagnostic"] == finding)
                       & (d["control"] == control)]

@@ -27,11 +27,17 @@ import pandas as pd
 
 from kicktimes.stats import TESTS, dilute_tagged_times
 
-__all__ = ["NULL_DESIGNS", "calibration_rows", "null_level", "null_rows", "null_streams"]
+__all__ = ["NULL_DESIGNS", "NULL_VALUES", "calibration_rows", "null_level", "null_rows",
+           "null_streams"]
 
 #: the null designs and what they are
 NULL_DESIGNS = {"poisson": "Poisson at each run's collision frequency",
                 "dilute": "dilute tagged disk (linear Boltzmann Cox process)"}
+
+
+#: null_calibration.csv's statistics other than rejection shares -> disks.csv's column
+NULL_VALUES = {"D": "dispersion", "hazard, first bin": "hazard_first",
+               "hazard, highest bin": "hazard_peak", "gamma shape": "gamma_shape"}
 
 
 def null_streams(store, n_disks, design, rng):
@@ -125,8 +131,10 @@ def null_rows(store, *, designs=None, alpha=0.05, n_boot=999, n_mc=199, seed=0):
 def calibration_rows(null_table, *, alpha=0.05):
     """The rows of ``null_calibration.csv`` (`kicktimes.render.pages.write_null_calibration`)
     from `null_rows` tables: one per (geometry, rule, N), test and design; the speed-rescaled
-    tests as ``"<test>, speed-rescaled"``. ``n_runs`` the tagged disks tested, ``n_clusters``
-    the runs the bootstrap resamples."""
+    tests as ``"<test>, speed-rescaled"``; and per (geometry, rule, N) and design the
+    statistics of `NULL_VALUES` on the null streams (D, the hazard's first and highest
+    bin, the gamma shape), which the page reads the gas's against. ``n_runs`` the tagged
+    disks tested, ``n_clusters`` the runs the bootstrap resamples."""
     out = []
     for _, r in null_table.iterrows():
         data = f"{r['geometry']}, {r['rule']}, N = {int(r['n_disks'])}"
@@ -135,11 +143,21 @@ def calibration_rows(null_table, *, alpha=0.05):
                 key = f"{prefix}reject_{test}"
                 if key not in r or not np.isfinite(r.get(key, np.nan)):
                     continue
-                out.append({"data": data, "test": test + suffix, "design": r["design"],
+                out.append({"data": data, "statistic": "rejection share",
+                            "test": test + suffix, "design": r["design"],
                             "alpha": alpha, "n_runs": int(r[f"{key}_n"]),
-                            "n_clusters": int(r["n_runs"]), "share": float(r[key]),
+                            "n_clusters": int(r["n_runs"]), "value": float(r[key]),
                             "ci_low": float(r[f"{key}_low"]),
                             "ci_high": float(r[f"{key}_high"])})
+        # the statistics whose null value is not 1: the page reads each against these
+        for statistic, key in NULL_VALUES.items():
+            if key not in r or not np.isfinite(r.get(key, np.nan)):
+                continue
+            out.append({"data": data, "statistic": statistic, "test": "",
+                        "design": r["design"], "alpha": alpha,
+                        "n_runs": int(r["n_tagged"] - r["n_short"]),
+                        "n_clusters": int(r["n_runs"]), "value": float(r[key]),
+                        "ci_low": float(r[f"{key}_low"]), "ci_high": float(r[f"{key}_high"])})
     return pd.DataFrame(out)
 
 

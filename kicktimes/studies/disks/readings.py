@@ -1,18 +1,29 @@
-"""docs/results/disks.md: the one reading of "Poisson", against the null calibration.
+"""docs/results/disks.md: one answer to "Poisson?" from every statistic against its null.
 
-Every "Poisson" / "not Poisson" on the page is `kicktimes.stats.poisson_verdict` of a row
-of `kicktimes.studies.disks.tables.disks_table`: the share of tagged disks whose first K
-collision times reject uniform times (KS, `POISSON_TEST`) against the share that Poisson
-streams shaped like the runs reject through the same pipeline (the calibrated level,
-`kicktimes.studies.disks.null`), and the dispersion index D against the band [0.9, 1.1].
-Under the elastic rule the speed-rescaled stream is read the same way, against the share
-the dilute tagged disk's rescaled streams reject (linear Boltzmann, whose rescaled stream
-is exactly Poisson), and the dilute tagged disk's D at the same windows is the kinetic
-theory's prediction quoted beside the gas's D.
+A Poisson process gives every statistic its null value; a departure shows in some of
+them. So the page's "Poisson" / "not Poisson" (`poisson_answer`) reads each statistic of a
+row against the same statistic on Poisson streams shaped like the runs
+(`kicktimes.studies.disks.versus_null`, `kicktimes.stats.null_verdict`, each with its
+margin stated in advance, `MARGINS`):
 
-`poisson_readings` is the table (``disks_poisson.csv``), `opening_lines` the page's first
-screen (the answers before the first table), `summary_lines` its first table,
-`family_lines` the reading per geometry and rule against N.
+* ``D``: the dispersion index of the tagged disk's counts in K mean intervals, pooled over
+  the runs of one N (the spread of rates across runs is in it, and in its null);
+* ``KS share``: the share of tagged disks whose first K collision times reject uniform
+  times, against the share its null streams reject through the same pipeline;
+* ``gamma shape``: the shape of a gamma renewal fit to the pooled intervals;
+* ``hazard bins``: the hazard of the next collision in every bin of the time since the
+  last (`versus_null.bin_rows`), each against its null's;
+* ``ΔAIC``: the exponential's AIC excess over the best renewal model
+  (`kicktimes.studies.disks.renewal`), departing when it exceeds what a gamma shape at its
+  margin would give on as many intervals (`versus_null.aic_margin`), at its null when it is
+  at most 2;
+* ``replicate``: the independent replicate's D (the ``seed`` control) against the null D.
+
+`poisson_answer`: **Poisson** when every statistic is at its null; **not Poisson** when at
+least one departs beyond its margin (the answer then names the statistics that do not
+depart, with their numbers); **not resolved** otherwise (none departs, some intervals are
+wider than their margins allow; the answer names them and the runs that would resolve
+them, `kicktimes.stats.equivalence_sample_size`).
 """
 
 from __future__ import annotations
@@ -20,16 +31,233 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from kicktimes.stats import format_interval, poisson_rule, poisson_verdict, rejection_verdict
-from kicktimes.studies.disks.null import null_level
+from kicktimes.stats import format_interval, null_verdict
+from kicktimes.studies.disks.versus_null import MARGINS, aic_margin
 
-__all__ = ["POISSON_TEST", "POISSON_WITHIN", "opening_lines", "poisson_by_control",
-           "poisson_from", "poisson_readings", "summary_lines", "family_lines"]
+__all__ = ["ANSWER_RULE", "ANSWER_STATISTICS", "answer_table", "diff_text", "family_table",
+           "opening_lines", "poisson_answer", "summary_lines"]
 
-#: the test whose calibrated rejection share `poisson_verdict` reads
-POISSON_TEST = "uniformity_ks"
-#: the verdict of a stream read as Poisson
-POISSON_WITHIN = "Poisson within 10 %"
+#: the statistics `poisson_answer` reads, in the page's order and words
+ANSWER_STATISTICS = ("D", "KS share", "gamma shape", "hazard bins", "ΔAIC", "replicate D")
+#: the answer's rule, printed once on the page
+ANSWER_RULE = (
+    "Poisson: every statistic at its null (the 95 % CI of statistic − null inside ± its "
+    "margin); not Poisson: at least one departs (its CI entirely beyond its margin), the "
+    "others named with their numbers; not resolved: none departs and at least one CI is "
+    "wider than its margin allows")
+
+_DEPARTS = ("above its null", "below its null")
+
+
+def poisson_answer(verdicts) -> tuple[str, list, list]:
+    """The combined reading of a row's statistics.
+
+    Parameters
+    ----------
+    verdicts : dict
+        Statistic name -> its `kicktimes.stats.null_verdict` (``"at its null"``,
+        ``"above its null"``, ``"below its null"`` or ``"inconclusive"``).
+
+    Returns
+    -------
+    (str, list, list)
+        The answer (``"Poisson"``, ``"not Poisson"``, ``"not resolved"``), the statistics
+        that give it (those that depart, for "not Poisson"; every one, for "Poisson"; the
+        inconclusive ones, for "not resolved") and the others (those that disagree or do
+        not resolve it).
+
+    Examples
+    --------
+    >>> poisson_answer({"D": "at its null", "KS share": "at its null"})
+    ('Poisson', ['D', 'KS share'], [])
+    >>> poisson_answer({"D": "at its null", "hazard bins": "below its null"})
+    ('not Poisson', ['hazard bins'], ['D'])
+    >>> poisson_answer({"D": "at its null", "KS share": "inconclusive"})
+    ('not resolved', ['KS share'], ['D'])
+    """
+    if not verdicts:
+        raise ValueError("verdicts: give at least one statistic's verdict")
+    bad = {v for v in verdicts.values()} - {"at its null", "inconclusive", *_DEPARTS}
+    if bad:
+        raise ValueError(f"verdicts: unknown verdicts {sorted(bad)}")
+    departs = [s for s, v in verdicts.items() if v in _DEPARTS]
+    if departs:
+        return "not Poisson", departs, [s for s in verdicts if s not in departs]
+    at = [s for s, v in verdicts.items() if v == "at its null"]
+    if len(at) == len(verdicts):
+        return "Poisson", at, []
+    return "not resolved", [s for s in verdicts if s not in at], at
+
+
+def _signed(x):
+    return f"{x:+.3f}".replace("-", "−")
+
+
+def diff_text(est, low, high, margin=None) -> str:
+    """``"+0.005 [−0.084, +0.096]"``: a difference and its interval, signed, to three
+    decimals (every margin of the page is at least 0.01, so the third decimal places both
+    ends against it).
+
+    Examples
+    --------
+    >>> diff_text(0.00512, -0.0837, 0.0956)
+    '+0.005 [−0.084, +0.096]'
+    """
+    return " ".join([_signed(est), f"[{_signed(low)}, {_signed(high)}]"])
+
+
+def _aic_verdict(delta, n_intervals):
+    if not np.isfinite(delta):
+        return "inconclusive"
+    if delta > aic_margin(n_intervals):
+        return "above its null"
+    return "at its null" if delta <= 2.0 else "inconclusive"
+
+
+def _bins_verdict(bins):
+    """The hazard bins' reading: departs when any bin departs, at its null when every bin
+    is, else inconclusive; with the text of the bins that depart (or of the widest)."""
+    v = bins["verdict"]
+    dep = bins[v.isin(_DEPARTS)]
+    if not dep.empty:
+        r = dep.loc[(dep["diff"]).abs().idxmax()]
+        side = "above its null" if r["diff"] > 0 else "below its null"
+        text = (f"{len(dep)} of {len(bins)} bins depart, e.g. [{r['t_low']:g}, "
+                f"{r['t_high']:g}): "
+                + diff_text(r["diff"], r["diff_low"], r["diff_high"], MARGINS["hazard_first"]))
+        return side, text
+    if v.eq("at its null").all():
+        return "at its null", f"all {len(bins)} bins at their null"
+    n_at = int(v.eq("at its null").sum())
+    return "inconclusive", f"{n_at} of {len(bins)} bins at their null, none departs"
+
+
+def answer_table(vn, bins, renewal=None, replicate=None) -> pd.DataFrame:
+    """One row per geometry, rule and N: each statistic of `ANSWER_STATISTICS` against its
+    null (``<name>_verdict`` and ``<name>_text``), the answer of `poisson_answer`
+    (``answer``), its statistics (``by``) and the others (``others``).
+
+    Parameters
+    ----------
+    vn : DataFrame
+        `kicktimes.studies.disks.versus_null.versus_null` rows of the primary sweeps.
+    bins : DataFrame
+        Their hazard bins (`versus_null`'s second table).
+    renewal : DataFrame, optional
+        `kicktimes.studies.disks.renewal.renewal_models` rows (``delta_aic_exponential``,
+        ``n_intervals``); without it the ΔAIC is not read.
+    replicate : DataFrame, optional
+        Per geometry, rule and N the replicate's D against the primary's null
+        (``replicate_diff``, ``_low``, ``_high``); without it the replicate is not read.
+    """
+    out = []
+    keys = ["geometry", "rule", "n_disks"]
+    for _, r in vn.iterrows():
+        row = {k: r[k] for k in keys}
+        texts, verdicts = {}, {}
+        for name, s in (("D", "d"), ("KS share", "ks"), ("gamma shape", "gamma")):
+            verdicts[name] = r[f"{s}_verdict"]
+            texts[name] = (f"{name} {format_interval(r[s], r[f'{s}_low'], r[f'{s}_high'])}, "
+                           f"null {r[f'null_{s}']:.4g}: "
+                           + diff_text(r[f"{s}_diff"], r[f"{s}_diff_low"],
+                                       r[f"{s}_diff_high"], MARGINS[s]))
+        b = bins[(bins["geometry"] == r["geometry"]) & (bins["rule"] == r["rule"])
+                 & (bins["n_disks"] == r["n_disks"])]
+        if not b.empty:
+            verdicts["hazard bins"], texts["hazard bins"] = _bins_verdict(b)
+        if renewal is not None and not renewal.empty:
+            g = renewal[(renewal["geometry"] == r["geometry"]) & (renewal["rule"] == r["rule"])
+                        & (renewal["n_disks"] == r["n_disks"])]
+            if not g.empty:
+                delta, n_iv = float(g.iloc[0]["delta_aic_exponential"]), int(
+                    g.iloc[0]["n_intervals"])
+                verdicts["ΔAIC"] = _aic_verdict(delta, n_iv)
+                texts["ΔAIC"] = f"ΔAIC {delta:.3g} (margin {aic_margin(n_iv):.3g})"
+                row["delta_aic_exponential"], row["aic_margin"] = delta, aic_margin(n_iv)
+        if replicate is not None and not replicate.empty:
+            g = replicate[(replicate["geometry"] == r["geometry"])
+                          & (replicate["rule"] == r["rule"])
+                          & (replicate["n_disks"] == r["n_disks"])]
+            if not g.empty:
+                q = g.iloc[0]
+                verdicts["replicate D"] = null_verdict(q["replicate_diff_low"],
+                                                       q["replicate_diff_high"], MARGINS["d"])
+                texts["replicate D"] = (
+                    f"replicate D {q['replicate_d']:.4g}, null {r['null_d']:.4g}: "
+                    + diff_text(q["replicate_diff"], q["replicate_diff_low"],
+                                q["replicate_diff_high"], MARGINS["d"]))
+        answer, by, others = poisson_answer(verdicts)
+        for name in ANSWER_STATISTICS:
+            if name in verdicts:
+                row[f"{name}_verdict"], row[f"{name}_text"] = verdicts[name], texts[name]
+        row.update(answer=answer, by="; ".join(by), others="; ".join(others),
+                   d_n_needed=r.get("d_n_needed", np.nan), n_runs=int(r["n_runs"]))
+        out.append(row)
+    return pd.DataFrame(out)
+
+
+def _largest_n(table):
+    """Each geometry and rule's row at its largest N, in the table's order of families."""
+    return table.loc[table.groupby(["geometry", "rule"], sort=False)["n_disks"].idxmax()]
+
+
+def _short(verdict):
+    return {"at its null": "at null", "above its null": "above", "below its null": "below",
+            "inconclusive": "inconcl."}.get(verdict, verdict)
+
+
+def _replicate_cell(a):
+    text = a.get("replicate D_text")
+    if not isinstance(text, str):
+        return "—"
+    return text.split(": ")[-1] + f" {_short(a['replicate D_verdict'])}"
+
+
+def summary_lines(answers, vn) -> list:
+    """The first table: at the largest N, per geometry and rule, D beside its null, the
+    other statistics' verdicts and the answer."""
+    head = ["geometry, rule", "D (null D): D − null D", "KS share − null", "gamma shape − null",
+            "hazard bins − null", "ΔAIC, exponential", "replicate D − null D", "answer"]
+    out = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    big = _largest_n(answers)
+    for _, a in big.iterrows():
+        r = vn[(vn["geometry"] == a["geometry"]) & (vn["rule"] == a["rule"])
+               & (vn["n_disks"] == a["n_disks"])].iloc[0]
+
+        def cell(s, r=r):
+            return (diff_text(r[f"{s}_diff"], r[f"{s}_diff_low"], r[f"{s}_diff_high"],
+                              MARGINS[s]) + f" {_short(r[f'{s}_verdict'])}")
+
+        out.append("| " + " | ".join([
+            f"{a['geometry']}, {a['rule']}, N = {int(a['n_disks'])}",
+            f"{format_interval(r['d'], r['d_low'], r['d_high'])} "
+            f"(null {format_interval(r['null_d'], r['null_d_low'], r['null_d_high'])}): "
+            + cell("d"),
+            cell("ks"), cell("gamma"),
+            f"{a.get('hazard bins_text', '—')} {_short(a.get('hazard bins_verdict', ''))}",
+            f"{a.get('delta_aic_exponential', np.nan):.3g} (margin "
+            f"{a.get('aic_margin', np.nan):.3g}) {_short(a.get('ΔAIC_verdict', '—'))}",
+            _replicate_cell(a), f"**{a['answer']}**"]) + " |")
+    return out
+
+
+def family_table(vn) -> list:
+    """D − null D at every N (rows) for every geometry and rule (columns), with verdicts."""
+    fams = list(dict.fromkeys(zip(vn["geometry"], vn["rule"], strict=True)))
+    head = ["N", *[f"{g}, {r}" for g, r in fams]]
+    out = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    for n in sorted(set(vn["n_disks"])):
+        cells = []
+        for g, rule in fams:
+            r = vn[(vn["geometry"] == g) & (vn["rule"] == rule) & (vn["n_disks"] == n)]
+            if r.empty:
+                cells.append("—")
+                continue
+            r = r.iloc[0]
+            cells.append(diff_text(r["d_diff"], r["d_diff_low"], r["d_diff_high"],
+                                   MARGINS["d"]) + f" {_short(r['d_verdict'])}")
+        out.append(f"| {n} | " + " | ".join(cells) + " |")
+    return out
 
 
 def _holds_from(ns, ok):
@@ -37,208 +265,71 @@ def _holds_from(ns, ok):
     return next((int(ns[m]) for m in range(len(ns)) if ok[m:].all()), None)
 
 
-def _pct(est, lo, hi, level=None):
-    edges = (100 * level * 0.5, 100 * level, 100 * level * 1.5) if level else (5.0,)
-    return f"{format_interval(100 * est, 100 * lo, 100 * hi, edges=edges)} %"
-
-
-def poisson_readings(table, nulls, *, test=POISSON_TEST) -> pd.DataFrame:
-    """One row per row of ``table`` (a `disks_table`): the gas's rejection share of
-    ``test`` and D, the calibrated level (the ``"poisson"`` null's share of the same row,
-    `kicktimes.studies.disks.null.null_rows`), the share's verdict against it
-    (`rejection_verdict`, within 50 %) and `poisson_verdict`; elastic rows also the
-    speed-rescaled reading (against the ``"dilute"`` null's rescaled share) and the
-    dilute tagged disk's D (``dilute_d``), the kinetic theory's prediction of D."""
-    key = f"reject_{test}"
-    out = []
-    for _, r in table.iterrows():
-        geo, rule, n = r["geometry"], r["rule"], int(r["n_disks"])
-        level = null_level(nulls, geo, rule, n, key)
-        row = {"geometry": geo, "rule": rule, "n_disks": n, "test": test,
-               "share": r[key], "share_low": r[f"{key}_low"], "share_high": r[f"{key}_high"],
-               "null_level": level,
-               "share_verdict": rejection_verdict(r[f"{key}_low"], r[f"{key}_high"], level)
-               if np.isfinite(level) else "not calibrated",
-               "d": r["dispersion"], "d_low": r["dispersion_low"],
-               "d_high": r["dispersion_high"],
-               "verdict": poisson_verdict(r[f"{key}_low"], r[f"{key}_high"], level,
-                                          r["dispersion_low"], r["dispersion_high"])
-               if np.isfinite(level) else "not calibrated"}
-        g = nulls[(nulls["geometry"] == geo) & (nulls["rule"] == rule)
-                  & (nulls["n_disks"] == n)].set_index("design")
-        if "poisson" in g.index:
-            p = g.loc["poisson"]
-            row.update(null_low=p[f"{key}_low"], null_high=p[f"{key}_high"],
-                       null_d=p["dispersion"], null_d_low=p["dispersion_low"],
-                       null_d_high=p["dispersion_high"])
-        if rule == "elastic" and "dilute" in g.index:
-            dl = g.loc["dilute"]
-            lvl = float(dl[f"rescaled_{key}"])
-            row.update(
-                rescaled_share=r[f"rescaled_{key}"],
-                rescaled_share_low=r[f"rescaled_{key}_low"],
-                rescaled_share_high=r[f"rescaled_{key}_high"], rescaled_null_level=lvl,
-                rescaled_d=r["rescaled_dispersion"],
-                rescaled_d_low=r["rescaled_dispersion_low"],
-                rescaled_d_high=r["rescaled_dispersion_high"],
-                rescaled_verdict=poisson_verdict(
-                    r[f"rescaled_{key}_low"], r[f"rescaled_{key}_high"], lvl,
-                    r["rescaled_dispersion_low"], r["rescaled_dispersion_high"]),
-                dilute_share=dl[key], dilute_share_low=dl[f"{key}_low"],
-                dilute_share_high=dl[f"{key}_high"], dilute_d=dl["dispersion"],
-                dilute_d_low=dl["dispersion_low"], dilute_d_high=dl["dispersion_high"])
-        out.append(row)
-    return pd.DataFrame(out)
-
-
-def poisson_from(readings, verdict=POISSON_WITHIN, column="verdict") -> dict:
-    """Per (geometry, rule): the smallest N from which ``column`` is ``verdict`` at every
-    larger N (None: no such N)."""
-    out = {}
-    for (geo, rule), g in readings.groupby(["geometry", "rule"], sort=False):
-        g = g.sort_values("n_disks")
-        out[geo, rule] = _holds_from(g["n_disks"].to_numpy(), g[column].eq(verdict))
-    return out
-
-
-def poisson_by_control(by_control, nulls) -> pd.DataFrame:
-    """`poisson_readings` of every control's table (the primary design's calibrated
-    levels: the nulls are shaped like the primary runs), with a ``control`` column."""
-    return pd.concat([poisson_readings(t, nulls).assign(control=c)
-                      for c, t in by_control.items()], ignore_index=True)
-
-
-def _control_cell(controls, geo, rule, n):
-    if controls is None or controls.empty:
-        return "not run"
-    g = controls[(controls["geometry"] == geo) & (controls["rule"] == rule)
-                 & (controls["n_disks"] == n)]
-    prim = g[g["control"] == "primary"]["verdict"]
-    if prim.empty:
-        return "—"
-    differ = g[(g["control"] != "primary") & (g["verdict"] != prim.iloc[0])]
-    return ("same under all" if differ.empty
-            else "differs: " + ", ".join(differ["control"]))
-
-
-#: the share's verdict against its calibrated level, in words
-LEVEL_WORDS = {"nominal": "at its calibrated level", "above nominal": "above its calibrated level",
-               "below nominal": "below its calibrated level", "inconclusive": "inconclusive"}
-
-
-def _level(verdict):
-    return LEVEL_WORDS.get(verdict, verdict)
-
-
-def _groups(items):
-    """``{verdict: [family, ...]}`` preserving order."""
-    out = {}
-    for verdict, fam in items:
-        out.setdefault(verdict, []).append(fam)
-    return out
-
-
-def opening_lines(readings, table, rate_from, rate_robust_from, boltz=None) -> list:
-    """The page's first screen: whether the tagged disk's process is Poisson (at the
-    largest N), from which N, and how the gas compares with kinetic theory (Enskog's rate;
-    D against the Boltzmann-kicked disk's, `kicktimes.studies.disks.boltzmann`, when
-    ``boltz`` is given, else the dilute tagged disk's D), each from a computed table."""
-    big = readings.groupby(["geometry", "rule"], sort=False).tail(1)
+def opening_lines(answers, vn, boltz_d, rate_line) -> list:
+    """The page's first screen: five one-line answers, each a number, its interval and its
+    caveat, from the computed tables."""
+    big = _largest_n(answers)
     n_max = int(big["n_disks"].max())
-    by = _groups((r["verdict"], f"{r['geometry']} {r['rule']}") for _, r in big.iterrows())
-    verdicts = "; ".join(f"{v}: {', '.join(f)}" for v, f in by.items())
-    froms = poisson_from(readings)
-    found = {f"{g} {r}": n for (g, r), n in froms.items() if n is not None}
-    from_text = ("; ".join(f"{f} from N = {n}" for f, n in found.items())
-                 + ("; at no N in the others" if len(found) < len(froms) else "")
-                 if found else "at no geometry and rule (no N from which every larger N "
-                 "reads so)")
-    el = big[big["rule"] == "elastic"]
-    diff = sum(1 for _, r in el.iterrows() if "dilute_d" in r and np.isfinite(r["dilute_d"])
-               and (r["d_low"] > r["dilute_d_high"] or r["d_high"] < r["dilute_d_low"]))
-    rate = (f"within 10 % of Enskog's from N = {rate_from} on at every geometry and rule"
-            if rate_from else "not within 10 % of Enskog's from one N on everywhere")
-    rate += (f" (under every control from N = {rate_robust_from} on)" if rate_robust_from
-             else "")
-    theory = (f"the elastic gas's D at N = {n_max} differs from the dilute tagged disk's "
-              f"(linear Boltzmann, same windows) at {diff} of {len(el)} geometries")
-    if boltz is not None and not boltz.empty:
-        d = boltz[(boltz["n_disks"] == n_max) & (boltz["statistic"] == "dispersion")]
-        agree = [f"{r['geometry']} {r['rule']}" for _, r in d.iterrows()
-                 if r["verdict"].startswith("within")]
-        depart = [f"{r['geometry']} {r['rule']} ({r['reading'].split(' by ')[-1]})"
-                  for _, r in d.iterrows() if r["verdict"] in ("higher", "lower")]
-        theory = (f"D at N = {n_max} beside the Boltzmann-kicked disk's (linear Boltzmann, "
-                  "same windows): within 10 % at " + (", ".join(agree) or "none")
-                  + "; departs at " + (", ".join(depart) or "none")
-                  + f"; inconclusive at the other {len(d) - len(agree) - len(depart)}")
-    return [
-        "# From two disks to a gas (generated)", "",
-        f"**Is the tagged disk's collision process Poisson?** At N = {n_max}, by the one "
-        f"rule stated below the table: {verdicts}. **From which N?** {POISSON_WITHIN} "
-        f"at every larger N: {from_text}. **Against kinetic theory:** the collision rate is "
-        f"{rate}; {theory}.", ""]
-
-
-def summary_lines(readings, controls=None) -> list:
-    """The first table: per geometry and rule at the largest N, the share against its
-    calibrated level, D, the verdict, from which N it reads Poisson, and under the
-    controls."""
-    head = ["geometry, rule", "N", "KS rejected", "Poisson null", "D", "reading",
-            "Poisson from N", "controls"]
-    out = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
-    froms = poisson_from(readings)
-    for (geo, rule), g in readings.groupby(["geometry", "rule"], sort=False):
-        r = g.sort_values("n_disks").iloc[-1]
-        n = int(r["n_disks"])
-        out.append("| " + " | ".join([
-            f"{geo}, {rule}", str(n),
-            _pct(r["share"], r["share_low"], r["share_high"], r["null_level"]),
-            f"{100 * r['null_level']:.2f} %",
-            format_interval(r["d"], r["d_low"], r["d_high"]), r["verdict"],
-            str(froms[geo, rule]) if froms[geo, rule] else "none",
-            _control_cell(controls, geo, rule, n)]) + " |")
-    return out
-
-
-def rule_lines(readings, alpha) -> list:
-    """The rule, printed once, and what it says of the shares entirely above their level."""
-    n_above = int((readings["share_low"] > readings["null_level"]).sum())
-    n_at = int(((readings["share_low"] > readings["null_level"])
-                & (readings["share_verdict"] == "nominal")).sum())
-    lo, hi = readings["null_level"].min(), readings["null_level"].max()
-    return [
-        f"The rule (`stats.poisson_verdict`): {poisson_rule()}. The test is KS of the first "
-        f"K collision times against uniform times (α = {alpha:g}); its calibrated level is "
-        f"the share the same test rejects on Poisson streams at each run's collision "
-        f"frequency, with the runs' windows, numbers of runs and tagged disks and bootstrap "
-        f"clusters ({100 * lo:.2f}–{100 * hi:.2f} % over the rows; every null row in "
-        f"[null_calibration.csv](null_calibration.csv), the page's readings in "
-        f"[disks_poisson.csv](disks_poisson.csv)). Of the {len(readings)} rows, {n_above} "
-        f"have a share whose interval lies entirely above its calibrated level; {n_at} of "
-        "them are at the level by the rule (within 50 % of it): a departure smaller than the "
-        "rule's margin, not read as one. The hazard's flatness p-value takes the intervals "
-        "as independent and may be too small by an unknown factor: no reading rests on it.",
-        ""]
-
-
-def family_lines(readings) -> list:
-    """Per geometry and rule, the reading at every N."""
-    lines = []
-    for (geo, rule), g in readings.groupby(["geometry", "rule"], sort=False):
-        g = g.sort_values("n_disks")
-        cells = "; ".join(f"{int(r['n_disks'])}: {r['verdict']}" for _, r in g.iterrows())
-        lo, hi = g.iloc[0], g.iloc[-1]
-        text = (f"- **{geo}, {rule}** — N = {cells}. KS share at N = {int(lo['n_disks'])} "
-                f"{_pct(lo['share'], lo['share_low'], lo['share_high'], lo['null_level'])} "
-                f"({_level(lo['share_verdict'])}), at N = {int(hi['n_disks'])} "
-                f"{_pct(hi['share'], hi['share_low'], hi['share_high'], hi['null_level'])} "
-                f"({_level(hi['share_verdict'])}); D "
-                f"{format_interval(lo['d'], lo['d_low'], lo['d_high'])} → "
-                f"{format_interval(hi['d'], hi['d_low'], hi['d_high'])}.")
-        if rule == "elastic" and "rescaled_verdict" in g:
-            text += (" Speed-rescaled (against the dilute null's rescaled level): N = "
-                     + "; ".join(f"{int(r['n_disks'])}: {r['rescaled_verdict']}"
-                                 for _, r in g.iterrows()) + ".")
-        lines.append(text)
-    return lines
+    counts = big["answer"].value_counts()
+    # the example of the answer: the first row that is not Poisson, with its strongest
+    # departing statistic
+    lines = ["# From two disks to a gas (generated)", ""]
+    ex = big[big["answer"] == "not Poisson"]
+    ex_text = ""
+    if not ex.empty:
+        e = ex.iloc[0]
+        first = e["by"].split("; ")[0]
+        ex_text = f"; e.g. {e['geometry']}, {e['rule']}: {e[f'{first}_text']} "
+        ex_text += f"{e[f'{first}_verdict']}"
+    cols = [f"{name}_verdict" for name in ANSWER_STATISTICS if f"{name}_verdict" in big]
+    verdicts = big[cols].to_numpy().ravel()
+    verdicts = verdicts[pd.notna(verdicts)]
+    n_inc = int((verdicts == "inconclusive").sum())
+    lines.append(
+        f"1. **Poisson at N = {n_max}?** not Poisson at {int(counts.get('not Poisson', 0))} "
+        f"of {len(big)} geometries and rules, not resolved at "
+        f"{int(counts.get('not resolved', 0))}, Poisson at {int(counts.get('Poisson', 0))}"
+        f"{ex_text}. Caveat: {n_inc} of the {verdicts.size} single verdicts there are "
+        "inconclusive at their margins.")
+    froms = {}
+    for (g, r), d in vn.groupby(["geometry", "rule"], sort=False):
+        d = d.sort_values("n_disks")
+        froms[g, r] = _holds_from(d["n_disks"].to_numpy(), d["d_verdict"].eq("at its null"))
+    found = [f"{g}, {r} from N = {n}" for (g, r), n in froms.items() if n]
+    inc = vn[vn["d_verdict"] == "inconclusive"]
+    if (inc["n_disks"] == n_max).any():
+        inc = inc[inc["n_disks"] == n_max]
+    worst = inc.sort_values("d_n_needed").tail(1)
+    w_text = ""
+    if not worst.empty:
+        w = worst.iloc[0]
+        w_text = (f"; e.g. {w['geometry']}, {w['rule']}, N = {int(w['n_disks'])}: D − null "
+                  + diff_text(w["d_diff"], w["d_diff_low"], w["d_diff_high"], MARGINS["d"])
+                  + f", needs ≈ {int(w['d_n_needed'])} runs (has {int(w['n_runs'])})")
+    lines.append(
+        "2. **From which N is D at its null?** " + ("; ".join(found) if found else
+                                                     "at no geometry and rule from any N")
+        + f" (within ±{MARGINS['d']:g}). Caveat: elsewhere not resolved at this size"
+        + w_text + ".")
+    head = vn[(vn["geometry"] == vn["geometry"].iloc[0])
+              & (vn["rule"] == vn["rule"].iloc[0])].sort_values("n_disks")
+    lo, hi = head.iloc[0], head.iloc[-1]
+    lines.append(
+        f"3. **D − null D, {lo['geometry']}, {lo['rule']}:** "
+        + diff_text(lo["d_diff"], lo["d_diff_low"], lo["d_diff_high"], MARGINS["d"])
+        + f" at N = {int(lo['n_disks'])} → "
+        + diff_text(hi["d_diff"], hi["d_diff_low"], hi["d_diff_high"], MARGINS["d"])
+        + f" at N = {int(hi['n_disks'])}. Caveat: the null D itself goes "
+        f"{lo['null_d']:.3g} → {hi['null_d']:.3g} (the spread of rates across runs).")
+    if boltz_d is not None and not boltz_d.empty:
+        at = boltz_d[(boltz_d["n_disks"] == n_max) & (boltz_d["rule"] == "elastic")]
+    if boltz_d is not None and not boltz_d.empty and not at.empty:
+        n_at = int(at["verdict"].eq("at its null").sum())
+        e = at.iloc[0]
+        lines.append(
+            f"4. **Elastic D beside linear Boltzmann's (N = {n_max}):** within "
+            f"±{MARGINS['d']:g} at {n_at} of {len(at)}; e.g. {e['geometry']}: gas − "
+            "Boltzmann " + diff_text(e["diff"], e["diff_low"], e["diff_high"], MARGINS["d"])
+            + ". Caveat: Boltzmann's D∞ − 1 = 0.14 is twice the margin.")
+    lines.append(f"5. {rate_line}")
+    return [*lines, ""]
