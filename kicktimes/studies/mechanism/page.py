@@ -304,7 +304,7 @@ def first_screen(tabs):
     closest = "no interval ends there in any group"
     if found:
         rule, m, r, row = max(found, key=lambda c: c[3]["ci_high"])
-        closest = f"closest to 1 {_iv(row, (0.9, 1.0, 1.1))} ({_where(rule, m, r)})"
+        closest = f"closest to 1: {_iv(row, (0.9, 1.0, 1.1))} ({_where(rule, m, r)})"
     lines.append(f"- **Long waits**: the Γ-rescaled hazard beyond rescaled t = 5 (1 if each "
                  f"state's predicted rate held) lies below 1 {said}; {closest}; caveat: "
                  "Garwood intervals treat the pooled intervals as independent.")

@@ -143,7 +143,7 @@ def first_screen(per_radius, trend, twins, compare, windows, whole, *, n_ics, n_
                                              x.over_predicted_ci_high), axis=1)
     lines.append(f"- **Twins with their own kick angles**, measured / predicted stretching "
                  f"per kick (Γ ln(τ/d0)): {_verdict_counts(tv)} of {len(twins)} radii; "
-                 f"closest to 1 {ratio_text(best.over_predicted, best.over_predicted_ci_low, best.over_predicted_ci_high)}"  # noqa: E501
+                 f"closest to 1: {ratio_text(best.over_predicted, best.over_predicted_ci_low, best.over_predicted_ci_high)}"  # noqa: E501
                  f" (r = {best.radius:g}); caveat: {int(n_ics)} ICs per radius.")
     off = compare[compare["quotient_verdict"].isin(["lower", "higher"])]
     rest = compare[~compare.index.isin(off.index)]
@@ -154,7 +154,7 @@ def first_screen(per_radius, trend, twins, compare, windows, whole, *, n_ics, n_
                       if len(rest) else "")
         lines.append(f"- **One-collision decorrelation model** (predicts the kicked / two-disk "
                      f"1 − R₁): measurement / prediction outside the 10 % band in {len(off)} "
-                     f"of {len(compare)} rows ({where}); closest to 1 "
+                     f"of {len(compare)} rows ({where}); closest to 1: "
                      f"{ratio_text(near.measured_over_predicted, near.quotient_ci_low, near.quotient_ci_high)}"  # noqa: E501
                      f" ({near.rule}, r = {near.radius:g}, {KICKED[near.system]}){unresolved}; "
                      f"caveat: {int(n_dec)} ICs of direct runs against the family store.")
