@@ -113,3 +113,14 @@ def local_dask(n_workers):
                                       dashboard_address=None) as cluster:
             with distributed.Client(cluster) as client:
                 yield cluster, client
+
+
+def first_screen_answers(page):
+    """The answer lines (``- `` bullets) of a results page before its first table, checked:
+    one to five of them, each with a number and its interval ``x [low, high]``."""
+    head = page.read_text(encoding="utf-8").split("\n|")[0]
+    answers = [line for line in head.splitlines() if line.startswith("- ")]
+    assert 1 <= len(answers) <= 5, answers
+    interval = re.compile(r"\d %? ?\[[-−+]?[\d.]+, [-−+]?[\d.]+\]")
+    assert all(interval.search(line) for line in answers), answers
+    return answers

@@ -125,7 +125,7 @@ def test_the_first_screen_is_five_answers_and_generated():
     screen = text.split("## The answers", 1)[1].lstrip("\n")
     answers = screen.split("\n\n", 1)[0].splitlines()
     assert 1 <= len(answers) <= 5 and all(a.startswith("- **") for a in answers), answers
-    assert all(len(a.split()) <= 45 for a in answers), answers
+    assert all(len(a.split()) <= 50 for a in answers), answers
     header = screen.split("\n|", 1)[1].split("\n", 1)[0]
     assert header.count("|") - 1 <= 8
 

@@ -5,7 +5,7 @@ import re
 import numpy as np
 import pandas as pd
 import pytest
-from conftest import assert_provenance, assert_study_page, refuse_simulations
+from conftest import assert_provenance, assert_study_page, first_screen_answers, refuse_simulations
 
 import kicktimes.studies.escape as study
 from kicktimes.stats import format_interval, ratio_verdict
@@ -147,24 +147,15 @@ def test_the_page_ends_with_where_its_numbers_come_from(built):
             "kicktimes.stats.survival.fit_escape_tail") in rows
 
 
-def _first_screen(text):
-    """The answer lines before the page's first table."""
-    head = text.split("\n|")[0]
-    return [line for line in head.splitlines() if line.startswith("- ")]
-
-
 def test_the_page_opens_with_at_most_five_answers_each_with_an_interval(built):
-    _, page, _ = built
-    answers = _first_screen(page.read_text(encoding="utf-8"))
-    assert 1 <= len(answers) <= 5
-    assert all(re.search(r"\d \[[-\d.]+, [-\d.]+\]", line) for line in answers), answers
+    first_screen_answers(built[1])
 
 
 def test_the_exponent_answer_names_both_ic_samples(built):
     from kicktimes.stats import robust_verdict
 
     _, page, _ = built
-    (line,) = [a for a in _first_screen(page.read_text(encoding="utf-8"))
+    (line,) = [a for a in first_screen_answers(page)
                if a.startswith("- **Free disk's exponent")]
     assert "paper ICs" in line and "invariant measure" in line
     alpha = pd.read_csv(page.parent / "escape" / "escape_alpha.csv")
@@ -178,7 +169,7 @@ def test_the_exponent_answer_names_both_ic_samples(built):
 
 def test_the_bursty_answer_says_where_the_escape_rate_cannot_tell_the_kicks_apart(built):
     _, page, _ = built
-    (line,) = [a for a in _first_screen(page.read_text(encoding="utf-8"))
+    (line,) = [a for a in first_screen_answers(page)
                if a.startswith("- **Bursty kicks")]
     ratios = pd.read_csv(page.parent / "escape" / "escape_ratios.csv").query(
         "system == 'bursty'")

@@ -2,7 +2,13 @@
 
 import numpy as np
 import pandas as pd
-from conftest import assert_provenance, assert_study_page, built_study, refuse_simulations
+from conftest import (
+    assert_provenance,
+    assert_study_page,
+    built_study,
+    first_screen_answers,
+    refuse_simulations,
+)
 
 import kicktimes.studies.scatter as study
 from kicktimes.experiment.presets import preset
@@ -64,24 +70,14 @@ def test_the_page_ends_with_where_its_numbers_come_from(built):
     assert ("scatter_ratios.csv", "verdict", "kicktimes.stats.findings.ratio_verdict") in rows
 
 
-def _first_screen(text):
-    """The answer lines before the page's first table."""
-    head = text.split("\n|")[0]
-    return [line for line in head.splitlines() if line.startswith("- ")]
-
-
 def test_the_page_opens_with_at_most_five_answers_each_with_an_interval(built):
-    _, page = built
-    answers = _first_screen(page.read_text(encoding="utf-8"))
-    assert 1 <= len(answers) <= 5
-    assert all("[" in line and "margin" in line for line in answers)
+    assert all("margin" in line for line in first_screen_answers(built[1]))
 
 
 def test_the_ratios_over_radii_are_read_at_both_margins_and_name_a_real_deficit(built):
     from kicktimes.studies.scatter.tables import FINE_MARGIN
 
     _, page = built
-    text = page.read_text(encoding="utf-8")
     over = pd.read_csv(page.parent / "scatter_over_radii.csv")
     assert FINE_MARGIN < 0.1
     for row in over.itertuples():
@@ -90,7 +86,8 @@ def test_the_ratios_over_radii_are_read_at_both_margins_and_name_a_real_deficit(
         assert row.deficit == 1 - row.estimate
     main = over[over["ics"] == "without sticky ICs"].set_index("ratio")
     first = main.loc["scatter kicks / two disks"]
-    (line,) = [a for a in _first_screen(text) if a.startswith("- **Scatter kicks / two disks")]
+    (line,) = [a for a in first_screen_answers(page)
+               if a.startswith("- **Scatter kicks / two disks")]
     assert format_interval(first.estimate, first.ci_low, first.ci_high,
                            edges=(0.9, 0.95, 1.0, 1.05, 1.1)) in line
     assert ("a real deficit" in line) == bool(first.ci_high < 1)

@@ -5,6 +5,7 @@ from conftest import (
     assert_provenance,
     assert_study_page,
     built_study,
+    first_screen_answers,
     refuse_simulations,
     table_cells,
 )
@@ -82,17 +83,8 @@ def test_the_page_ends_with_where_its_numbers_come_from(built):
             "kicktimes.studies.unequal.tables.dispersion_ci") in rows
 
 
-def _first_screen(text):
-    """The answer lines before the page's first table."""
-    head = text.split("\n|")[0]
-    return [line for line in head.splitlines() if line.startswith("- ")]
-
-
 def test_the_page_opens_with_at_most_five_answers_each_with_an_interval(built):
-    _, page = built
-    answers = _first_screen(page.read_text(encoding="utf-8"))
-    assert 1 <= len(answers) <= 5
-    assert all("[" in line and "]" in line for line in answers)
+    first_screen_answers(built[1])
 
 
 def test_d_is_read_against_its_null_and_the_ks_share_against_its_exact_alpha(built):

@@ -170,6 +170,9 @@ def write_null_calibration(results_dir, study, rows: pd.DataFrame) -> Path:
     path = Path(results_dir) / NULL_CALIBRATION
     if path.is_file():
         old = pd.read_csv(path, keep_default_na=False, na_values=[""])
+        old = old.rename(columns={"share": "value"})  # a file from before `statistic`
+        if "statistic" not in old:
+            old = old.assign(statistic="rejection share")
         rows = pd.concat([old[old["study"] != study], rows], ignore_index=True)
     rows = rows[list(NULL_CALIBRATION_COLUMNS)].sort_values(
         ["study", "data", "statistic", "test"], kind="stable")

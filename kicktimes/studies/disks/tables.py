@@ -8,8 +8,10 @@ From the stores of `kicktimes.experiment.DisksExperiment` sweeps, one row per (s
   `kicktimes.stats.TESTS`) on each tagged disk's first ``K = collisions`` collisions, its
   window ending at collision ``K + 1`` (given that collision, the first K of a Poisson
   process are uniform on the window): the share of tagged disks rejected at ``alpha``;
-* the index of dispersion of the tagged disks' counts in a common window of ``K`` mean
-  intervals, ``D = s^2 / mean`` (1 for Poisson counts of one rate);
+* the dispersion index across tagged disks (``dispersion``): of each tagged disk's count of
+  collisions in one common window of ``K`` mean intervals, over the tagged disks of all
+  runs of one N, ``D = s^2 / mean`` (1 for Poisson counts of one rate; more when the runs'
+  rates differ, as they do: read against its null, `kicktimes.studies.disks.versus_null`);
 * the hazard of the intervals against the time since the last collision, in units of the
   mean interval (`kicktimes.stats.interval_hazard`): its first bin over the constant rate
   (``hazard_first``, the refractory dip) and its highest later bin (``hazard_peak`` at

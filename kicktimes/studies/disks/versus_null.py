@@ -12,9 +12,10 @@ same seeds) and computes, for the gas and its null from one set of run weights (
 percentile bootstrap clustered on runs, `kicktimes.stats.resample_counts`, the null paired
 with the gas by run), the difference *gas - null* of
 
-* ``d``: the dispersion index D of the tagged disk's counts in a common window of K mean
-  intervals, over the tagged disks of all runs of one N (variance over mean across disks:
-  the run-to-run spread of rates is in it);
+* ``d``: the dispersion index D across tagged disks: the variance over the mean of each
+  tagged disk's count of collisions in one common window of K mean intervals, over the
+  tagged disks of all runs of one N (not one disk's counts in sub-windows: the run-to-run
+  spread of rates is in it);
 * ``ks``: the share of tagged disks whose first K collision times reject uniform times
   (exact KS, ``alpha``);
 * ``gamma``: the shape of a gamma renewal model fitted by maximum likelihood to the pooled

@@ -126,16 +126,16 @@ def _poisson_line(table) -> str | None:
     robust = verdicts["verdict"].nunique() == 1
     level = _null_share(share)
     text = (f"**{POISSON_LINE}** {'no' if main.verdict == 'not Poisson' else main.verdict}: "
-            f"{_pct(share)} of runs reject uniformity, their Poisson control streams {level}")
+            f"{_pct(share)} of runs reject uniformity (null streams {level})")
     if excess is not None:
-        text += f"; D exceeds its null by {_ci(excess)}"
+        text += f", D − null D {_ci(excess)}"
     text += f" (A{', robust over rule × ICs' if robust else ''})"
     e_share = _one(rows, diagnostic=f"reject@{HEADLINE_TEST}", family=family, control="elastic")
     e_excess = _one(rows, diagnostic="dispersion_index_excess", family=family,
                     control="elastic")
     if e_share is not None:
-        text += (f"; the elastic rule: {_pct(e_share)}"
-                 + (f", D + {_ci(e_excess)}" if e_excess is not None else ""))
+        text += (f"; elastic rule {_pct(e_share)}"
+                 + (f", D − null D {_ci(e_excess)}" if e_excess is not None else ""))
     return text + "."
 
 
