@@ -53,8 +53,9 @@ def test_each_statistic_is_read_against_the_kicked_disk_of_its_rule():
     assert ks.loc["mirror", "margin"] == 0.01
     lines = boltzmann_lines(b)
     assert lines[0] == "## The gas beside the Boltzmann-kicked disk"
-    assert ("packing 0.02, mirror: 1.4 vs 0.98: +0.420 [+0.331, +0.509] above the kicked "
-            "disk's") in lines[2]
+    # D of the elastic rows only: the mirror rule's kicked disk is the Poisson null itself
+    assert ("packing 0.02, elastic: 1.15 vs 1.14: +0.010 [−0.040, +0.060] at the kicked "
+            "disk's") in lines[2] and "mirror: 1.4" not in lines[2]
     assert "The other 6 (hazard's first bin, gamma shape, KS share)" in lines[2]
 
 

@@ -154,7 +154,10 @@ def boltzmann_lines(boltz, *, n_disks=None) -> list:
         return []
     n = int(boltz["n_disks"].max()) if n_disks is None else n_disks
     at = boltz[boltz["n_disks"] == n]
-    d = at[at["statistic"] == "dispersion"]
+    # the mirror rule's kicked disk is a Poisson process: its D is the page's null D
+    d = at[(at["statistic"] == "dispersion") & (at["rule"] == "elastic")]
+    if d.empty:
+        d = at[at["statistic"] == "dispersion"]
     rest = at[at["statistic"] != "dispersion"]
     counts = rest["verdict"].value_counts()
     cells = "; ".join(f"{r['geometry']}, {r['rule']}: {_cell(r)}" for _, r in d.iterrows())

@@ -16,7 +16,7 @@ from matplotlib.ticker import FuncFormatter
 
 from kicktimes.render.figures import plain_log_ticks
 from kicktimes.studies.disks.tables import RATE_MARGIN
-from kicktimes.studies.disks.versus_null import HAZARD_MARGIN
+from kicktimes.studies.disks.versus_null import HAZARD_MARGIN, KS_MARGIN
 
 __all__ = ["controls_figure", "geometries_of", "hazard_figure", "rates_figure",
            "rejection_figure"]
@@ -51,11 +51,11 @@ def _n_ticks(ax, ns):
 def rejection_figure(table, tests=(HEADLINE, "exponential_ad"), nulls=None):
     """The share of tagged disks whose first K collision times reject each test at
     alpha = 0.05, against N: one column per geometry, one row per test, log y axis (the
-    nominal band stays readable next to the N = 2 shares); mirror, elastic and elastic after
-    the speed rescaling, dodged and with different markers; 95 % CIs; the nominal band
-    shaded; with ``nulls`` (`kicktimes.studies.disks.null.null_rows`), the share of the
-    Poisson null streams shaped like each rule's runs (the calibrated level), dotted, and
-    under the elastic rule the linear Boltzmann tagged disk's share (the ``"dilute"``
+    5 % band stays readable next to the N = 2 shares); mirror, elastic and elastic after
+    the speed rescaling, dodged and with different markers; 95 % CIs; alpha +- the KS
+    share's margin (`KS_MARGIN`) shaded; with ``nulls``
+    (`kicktimes.studies.disks.null.null_rows`), the share of the Poisson null streams
+    shaped like each rule's runs (the calibrated level), dotted, and under the elastic rule the linear Boltzmann tagged disk's share (the ``"dilute"``
     design), dashed."""
     import matplotlib.pyplot as plt
 
@@ -69,7 +69,9 @@ def rejection_figure(table, tests=(HEADLINE, "exponential_ad"), nulls=None):
     for i, test in enumerate(tests):
         for j, geo in enumerate(geos):
             ax = axes[i, j]
-            ax.axhspan(100 * ALPHA * 0.5, 100 * ALPHA * 1.5, color="0.88", zorder=0)
+            # the KS share's margin around alpha (the share is read against its null's)
+            ax.axhspan(100 * (ALPHA - KS_MARGIN), 100 * (ALPHA + KS_MARGIN), color="0.88",
+                       zorder=0)
             ax.axhline(100 * ALPHA, color="0.5", lw=0.8, zorder=0)
             for k, (rule, prefix, label, color, marker, face) in enumerate(styles):
                 d = table[(table["geometry"] == geo) & (table["rule"] == rule)]
@@ -147,7 +149,7 @@ def hazard_figure(hazard, table, n_shown=SHOWN_N):
                     continue
                 name = exp_of.loc[(rule, geo), "experiment"]
                 if rule == "elastic":
-                    ax.plot(BOLTZMANN_T, _boltzmann_curve(), color="0.15", ls="--", lw=1.0,
+                    ax.plot(BOLTZMANN_T, _boltzmann_curve(), color="C4", ls="--", lw=1.6,
                             label="linear Boltzmann h(t)", zorder=4)
                 for n in n_shown:
                     d = hazard[(hazard["experiment"] == name) & (hazard["n_disks"] == n)]
