@@ -55,8 +55,8 @@ def rejection_figure(table, tests=(HEADLINE, "exponential_ad"), nulls=None):
     the speed rescaling, dodged and with different markers; 95 % CIs; alpha +- the KS
     share's margin (`KS_MARGIN`) shaded; with ``nulls``
     (`kicktimes.studies.disks.null.null_rows`), the share of the Poisson null streams
-    shaped like each rule's runs (the calibrated level), dotted, and under the elastic rule the linear Boltzmann tagged disk's share (the ``"dilute"``
-    design), dashed."""
+    shaped like each rule's runs (the calibrated level), dotted, and under the elastic rule
+    the linear Boltzmann tagged disk's share (the ``"dilute"`` design), dashed."""
     import matplotlib.pyplot as plt
 
     geos = geometries_of(table)
