@@ -15,11 +15,12 @@ settings.register_profile("explore", derandomize=False, max_examples=500)
 settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "deterministic"))
 
 
-def assert_provenance(page):
+def assert_provenance(page, every_csv_in=None):
     """Assert that the results page ``page`` ends with the table of where its numbers come
     from (`kicktimes.render.provenance`): its title is the page's last ``## `` heading,
     nothing but the table follows it, and every CSV the table names lies beside the page
-    with the columns it names. Returns the table's rows as (csv, columns, function)."""
+    with the columns it names; with ``every_csv_in`` (a folder beside the page), that the
+    table names every CSV of that folder. Returns the rows as (csv, columns, function)."""
     from pathlib import Path
 
     import pandas as pd
@@ -43,6 +44,9 @@ def assert_provenance(page):
         named = [] if columns == "all" else [c.strip() for c in columns.split(",")]
         assert set(named) <= have, f"{csv} lacks {sorted(set(named) - have)}"
         rows.append((csv, columns, function.strip("`")))
+    if every_csv_in is not None:
+        written = {f"{every_csv_in}/{p.name}" for p in (page.parent / every_csv_in).glob("*.csv")}
+        assert {csv for csv, _, _ in rows} == written
     return rows
 
 

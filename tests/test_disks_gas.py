@@ -53,15 +53,14 @@ def test_the_sweep_has_a_task_per_block_of_runs_and_tags_one_of_two_disks(refere
 
 
 @pytest.mark.reproducibility
-def test_the_sweep_is_the_same_on_a_dask_local_cluster(reference, tmp_path):
-    with local_dask(n_workers=1) as (_, client):
-        on_dask = run_quiet(TINY, tmp_path / "dask", executor=client.get_executor())
-    assert_same_store(reference, on_dask)
-
-
-@pytest.mark.reproducibility
-def test_the_sweep_does_not_depend_on_the_block_size(reference, tmp_path):
-    other = run_quiet(dataclasses.replace(TINY, block_sequences=100), tmp_path / "b", workers=1)
+@pytest.mark.parametrize("where", ["dask", "blocks of 100"])
+def test_the_sweep_is_the_same_on_dask_and_in_other_blocks(reference, tmp_path, where):
+    if where == "dask":
+        with local_dask(n_workers=1) as (_, client):
+            other = run_quiet(TINY, tmp_path / "dask", executor=client.get_executor())
+    else:
+        other = run_quiet(dataclasses.replace(TINY, block_sequences=100), tmp_path / "b",
+                          workers=1)
     assert_same_store(reference, other)
 
 

@@ -33,19 +33,19 @@ TABLE = "size_ratio/size_ratio.csv"
 FIGURE = "size_ratio/size_ratio.png"
 
 #: the page's closing table: the columns it quotes and the functions that computed them
-SOURCES = (
-    Source(TABLE, "size_ratio", size_ratio_table),
-    Source(TABLE, "rate_ratio, rate_low, rate_high", ratio_ci),
-    Source(TABLE, ", ".join(f"ftle_{kind}_{part}_disk{disk}" for disk in (0, 1)
-                            for kind in KINDS for part in ("ratio", "low", "high")), ratio_ci),
-    Source(TABLE, "ks_reject_share, dispersion_index", poisson_group),
-    Source(TABLE, "disp_low, disp_high", dispersion_ci),
-    Source(TABLE, "d_null, d_null_low, d_null_high", dispersion_null),
-    Source(TABLE, "d_minus_null, d_minus_null_low, d_minus_null_high", size_ratio_table),
-    Source(TABLE, "d_verdict", null_verdict),
-    Source(TABLE, "ks_low, ks_high", clopper_pearson),
-    Source(TABLE, "ks_verdict", rejection_verdict),
-)
+SOURCES = tuple(Source(TABLE, columns, computed_by) for columns, computed_by in (
+    ("size_ratio", size_ratio_table),
+    ("rate_ratio, rate_low, rate_high", ratio_ci),
+    (", ".join(f"ftle_{kind}_{part}_disk{disk}" for disk in (0, 1) for kind in KINDS
+               for part in ("ratio", "low", "high")), ratio_ci),
+    ("ks_reject_share, dispersion_index", poisson_group),
+    ("disp_low, disp_high", dispersion_ci),
+    ("d_null, d_null_low, d_null_high", dispersion_null),
+    ("d_minus_null, d_minus_null_low, d_minus_null_high", size_ratio_table),
+    ("d_verdict", null_verdict),
+    ("ks_low, ks_high", clopper_pearson),
+    ("ks_verdict", rejection_verdict),
+))
 
 #: the FTLE columns of the table: (estimate, low, high) per disk and partner
 _FTLE = [(f"ftle_{kind}_ratio_disk{d}", f"ftle_{kind}_low_disk{d}", f"ftle_{kind}_high_disk{d}")
