@@ -94,13 +94,13 @@ def controls_findings(tables: dict) -> pd.DataFrame:
     Examples
     --------
     >>> import pandas as pd
-    >>> row = dict(geometry="packing 0.02", rule="mirror", n_disks=30, dispersion=1.2,
-    ...            dispersion_low=1.15, dispersion_high=1.25, dispersion_verdict="higher")
-    >>> other = dict(row, dispersion=1.05, dispersion_low=0.97, dispersion_high=1.09,
-    ...              dispersion_verdict="within 10 %")
+    >>> row = dict(geometry="packing 0.02", rule="mirror", n_disks=30, d_diff=0.2,
+    ...            d_diff_low=0.15, d_diff_high=0.25, d_verdict="above its null")
+    >>> other = dict(row, d_diff=0.05, d_diff_low=-0.03, d_diff_high=0.09,
+    ...              d_verdict="inconclusive")
     >>> t = controls_findings({"primary": pd.DataFrame([row]), "k60": pd.DataFrame([other])})
     >>> t[["control", "verdict", "robust", "depends_on"]].values.tolist()
-    [['primary', 'higher', False, 'k60'], ['k60', 'within 10 %', False, 'k60']]
+    [['primary', 'above its null', False, 'k60'], ['k60', 'inconclusive', False, 'k60']]
     """
     if "primary" not in tables:
         raise ValueError(f"tables: needs the 'primary' table, got {sorted(tables)}")

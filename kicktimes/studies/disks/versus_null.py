@@ -113,7 +113,7 @@ def aic_margin(n_intervals, margin=GAMMA_MARGIN):
     Examples
     --------
     >>> round(aic_margin(120000), 1)
-    30.5
+    29.9
     """
     k = 1.0 - margin
     kl = (k - 1.0) * (digamma(k) - math.log(k)) - (k - 1.0) + k * math.log(k) - gammaln(k)
