@@ -137,7 +137,7 @@ def _rate_line(table, rate_from, robust_from):
             f"{int(worst['n_disks'])}: {worst['geometry']}, {worst['rule']} "
             + format_interval(worst["rate_enskog"], worst["rate_enskog_low"],
                               worst["rate_enskog_high"]) + ". "
-            "Caveat: N = 2 is read against the exact two-disk rate, not Enskog's.")
+            "Caveat: N = 2 against the two-disk rate Γ(r) instead.")
 
 
 def replicate_rows(primary, replicate, *, n_boot=999) -> pd.DataFrame:
@@ -513,15 +513,14 @@ def write_disks_page(store_paths, out_dir, *, command="kicktimes reproduce --stu
         *summary_lines(answers, vn), "",
         f"**The answer's rule** (`studies.disks.readings.poisson_answer`): {ANSWER_RULE}. "
         "Each cell: statistic − its null (Poisson streams at each run's collision frequency, "
-        "shaped like the runs, `studies.disks.versus_null`; 95 % interval of the difference "
-        "by the bootstrap clustered on runs, the null paired with the gas by run) and its "
-        "verdict (`stats.null_verdict`). D, on this page, is the dispersion index across "
+        "shaped like the runs, `studies.disks.versus_null`; 95 % interval by the bootstrap "
+        "clustered on runs, the null paired by run), its verdict (`stats.null_verdict`). "
+        "D, on this page, is the dispersion index across "
         "tagged disks: the variance over the mean of each tagged disk's number of "
         f"collisions in one window of K = {k} mean intervals, over the tagged disks of all "
         "runs of one N (not one disk's counts in sub-windows; the spread of rates across "
-        "runs is in it, and in its null). Hazard bins: departs when "
-        "any bin departs. Replicate D: the independent replicate's D against the same null. "
-        "Every N: [disks_poisson.csv](disks_poisson.csv); the null values: "
+        "runs is in it, and in its null). Replicate D: the independent replicate's D "
+        "against the same null. Every N: [disks_poisson.csv](disks_poisson.csv); nulls: "
         "[null_calibration.csv](null_calibration.csv) and [disks_null.csv](disks_null.csv).",
         "", *_margin_lines(),
         f"Generated {now} by kicktimes {__version__} (`{command}`) from the stores {names}. "

@@ -213,6 +213,20 @@ def _replicate_cell(a):
     return text.split(": ")[-1] + f" {_short(a['replicate D_verdict'])}"
 
 
+def _answer_cell(a):
+    """The answer with the statistics that give it and those that disagree (at their null
+    while the answer is "not Poisson")."""
+    by = [x for x in str(a["by"]).split("; ") if x]
+    others = [x for x in str(a["others"]).split("; ") if x]
+    if a["answer"] == "not Poisson":
+        against = [x for x in others if a.get(f"{x}_verdict") == "at its null"]
+        return (f"**not Poisson** (by {len(by)} of {len(by) + len(others)}; "
+                + (f"at its null: {', '.join(against)})" if against else "none at its null)"))
+    if a["answer"] == "not resolved":
+        return f"**not resolved** (none departs; {len(by)} inconclusive)"
+    return f"**{a['answer']}**"
+
+
 def summary_lines(answers, vn) -> list:
     """The first table: at the largest N, per geometry and rule, D beside its null, the
     other statistics' verdicts and the answer."""
@@ -237,7 +251,7 @@ def summary_lines(answers, vn) -> list:
             f"{a.get('hazard bins_text', '—')} {_short(a.get('hazard bins_verdict', ''))}",
             f"{a.get('delta_aic_exponential', np.nan):.3g} (margin "
             f"{a.get('aic_margin', np.nan):.3g}) {_short(a.get('ΔAIC_verdict', '—'))}",
-            _replicate_cell(a), f"**{a['answer']}**"]) + " |")
+            _replicate_cell(a), _answer_cell(a)]) + " |")
     return out
 
 
@@ -287,10 +301,9 @@ def opening_lines(answers, vn, boltz_d, rate_line) -> list:
     n_inc = int((verdicts == "inconclusive").sum())
     lines.append(
         f"1. **Poisson at N = {n_max}?** not Poisson at {int(counts.get('not Poisson', 0))} "
-        f"of {len(big)} geometries and rules, not resolved at "
+        f"of {len(big)} geometry × rule, not resolved at "
         f"{int(counts.get('not resolved', 0))}, Poisson at {int(counts.get('Poisson', 0))}"
-        f"{ex_text}. Caveat: {n_inc} of {verdicts.size} single verdicts there are "
-        "inconclusive.")
+        f"{ex_text}. Caveat: {n_inc} of {verdicts.size} single verdicts are inconclusive.")
     froms = {}
     for (g, r), d in vn.groupby(["geometry", "rule"], sort=False):
         d = d.sort_values("n_disks")
@@ -305,7 +318,8 @@ def opening_lines(answers, vn, boltz_d, rate_line) -> list:
         w = worst.iloc[0]
         w_text = (f"; e.g. {w['geometry']}, {w['rule']}, N = {int(w['n_disks'])}: D − null "
                   + diff_text(w["d_diff"], w["d_diff_low"], w["d_diff_high"], MARGINS["d"])
-                  + f", needs ≈ {int(w['d_n_needed'])} runs (has {int(w['n_runs'])})")
+                  + f", needs ≈ {int(w['d_n_needed'])} runs (has {int(w['n_runs'])}) if "
+                  "it is 0")
     lines.append(
         "2. **From which N is D at its null?** " + ("; ".join(found) if found else
                                                      "at no geometry and rule from any N")
