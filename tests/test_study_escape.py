@@ -8,7 +8,8 @@ import pytest
 from conftest import assert_provenance, assert_study_page, first_screen_answers, refuse_simulations
 
 import kicktimes.studies.escape as study
-from kicktimes.stats import format_interval, ratio_verdict
+from kicktimes.stats import format_interval
+from kicktimes.studies.escape.compute import edge_verdict as ratio_verdict
 
 TINY = study.Params(n_ics=100, t_max=400.0, t_min=50.0, n_free=300)
 
@@ -165,16 +166,51 @@ def test_the_exponent_answer_names_both_ic_samples(built):
     assert ("depends on the IC sample" in line) == (not alpha["robust"].all())
 
 
-def test_the_bursty_answer_says_where_the_escape_rate_cannot_tell_the_kicks_apart(built):
+def test_the_first_answer_says_what_the_escape_rate_can_tell_apart(built):
     _, page, _ = built
-    (line,) = [a for a in first_screen_answers(page)
-               if a.startswith("- **Bursty kicks")]
-    ratios = pd.read_csv(page.parent / "escape" / "escape_ratios.csv").query(
-        "system == 'bursty'")
-    undetected = (~ratios["verdict"].isin(["lower", "higher"])).any()
-    assert ("cannot tell them" in line) == bool(
-        undetected and (~ratios.query("reference == 'two_particle_pooled'")["verdict"]
-                        .isin(["lower", "higher"])).any())
+    first = first_screen_answers(page)[0]
+    assert first.startswith("- **What the escape rate can tell apart")
+    ratios = pd.read_csv(page.parent / "escape" / "escape_ratios.csv")
+    for system in study.compute.CONTROLS:
+        v = ratios.loc[ratios["system"] == system, "verdict"]
+        assert f"{v.isin(['lower', 'higher']).sum()} of {len(v)}" in first
+
+
+def test_an_interval_beyond_a_band_edge_that_excludes_1_is_not_inconclusive():
+    # the general rule: 1.13 [1.09, 1.16] lies above 1 and straddles 1.1
+    assert ratio_verdict(1.09, 1.16) == "above 1 by about the margin or less"
+    assert ratio_verdict(0.854, 0.988) == "below 1 by about the margin or less"
+    assert ratio_verdict(0.9661, 1.101) == "inconclusive"  # contains 1: only then a size
+    assert ratio_verdict(0.95, 1.05) == "within 10 %"
+    assert ratio_verdict(1.2, 1.3) == "higher" and ratio_verdict(0.2, 0.3) == "lower"
+    assert ratio_verdict(float("nan"), 1.2) == "inconclusive"
+
+
+def test_the_headline_and_the_ratio_table_count_one_per_radius_verdict(built):
+    _, page, _ = built
+    text = page.read_text(encoding="utf-8")
+    ratios = pd.read_csv(page.parent / "escape" / "escape_ratios.csv")
+    (table,) = [ln for ln in text.splitlines() if ln.startswith("Per radius, the verdict")]
+    for system, name in (("poisson", "Uniform kicks"), ("poisson_scatter", "Scatter kicks")):
+        per = study.page.per_radius_verdicts(ratios, system)
+        assert len(per) == ratios["radius"].nunique()
+        g = ratios[ratios["system"] == system]
+        for r, v in per.items():
+            both = set(g.loc[g["radius"] == r, "verdict"])
+            assert v == (both.pop() if len(both) == 1 else "depends on the estimator")
+        count = study.page.count_text(per)
+        (line,) = [a for a in first_screen_answers(page) if a.startswith(f"- **{name}")]
+        assert f"under both estimators: {count}" in line
+        assert count + " radii" in table
+
+
+def test_an_exponent_within_the_margin_says_when_it_excludes_1(built):
+    _, page, _ = built
+    alpha = pd.read_csv(page.parent / "escape" / "escape_alpha.csv")
+    g = alpha.assign(verdict="within 10 %",
+                     alpha_low=0.91, alpha_high=0.99)
+    assert study.page._side_text(g) == f"; of those within, below 1 at {len(g)}"
+    assert study.page._side_text(g.assign(alpha_high=1.01)) == ""
 
 
 def test_the_ratios_over_radii_are_geometric_means_with_their_verdicts(built):

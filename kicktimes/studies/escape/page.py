@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pandas as pd
 
-from kicktimes.render.pages import header, ratio_text, simulations_source
+from kicktimes.render.pages import header, simulations_source
 from kicktimes.render.provenance import Source
 from kicktimes.stats import (
     MARGIN,
@@ -17,7 +17,6 @@ from kicktimes.stats import (
     fit_escape_tail,
     format_interval,
     kinetic_rate,
-    ratio_verdict,
     reliable_until,
     robust_verdict,
 )
@@ -29,6 +28,7 @@ from kicktimes.studies.escape.compute import (
     LABELS,
     alpha_table,
     constant_rows,
+    edge_verdict,
     ergodic_rate,
     escape_tables,
     over_radii,
@@ -53,12 +53,33 @@ SOURCES = (
     Source(TAILS, "rate, rate_boot_low, rate_boot_high", tail_rates),
     Source(TAILS, "alpha, alpha_low, alpha_high, aic_exp_minus_alg", fit_escape_tail),
     Source(RATIOS, "ratio, ci_low, ci_high", escape_tables),
-    Source(RATIOS, "verdict", ratio_verdict),
+    Source(RATIOS, "verdict", edge_verdict),
     Source(CONSTANT, "t, t_S, t_S_low, t_S_high", constant_rows),
     Source(CONSTANT, "C_predicted", circle_escape_constant),
     Source(OVER_RADII, "ratio, ci_low, ci_high, verdict, se_log, n_ics_to_resolve", over_radii),
     Source(ALPHA, "alpha, alpha_low, alpha_high, verdict, robust, not_robust_by", alpha_table),
 )
+
+
+def ratio_text(estimate, low, high) -> str:
+    """``"1.13 [1.09, 1.16], above 1 by about the margin or less"``: the interval and its
+    `edge_verdict`."""
+    return f"{format_interval(estimate, low, high)}, {edge_verdict(low, high)}"
+
+
+def per_radius_verdicts(ratios, system) -> pd.Series:
+    """The one per-radius verdict of a kicked / two-disk ratio that the page counts: the
+    verdict both two-disk estimators give, else ``"depends on the estimator"``; indexed by
+    radius (the headline and the ratio table count these same verdicts)."""
+    g = ratios[ratios["system"] == system]
+    return g.groupby("radius", observed=True)["verdict"].agg(
+        lambda v: v.iloc[0] if v.nunique() == 1 else "depends on the estimator")
+
+
+def count_text(verdicts) -> str:
+    """``"inconclusive at 3, within 10 % at 1 of 4"``: verdict counts, most common first."""
+    counts = pd.Series(list(verdicts)).value_counts()
+    return ", ".join(f"{k} at {v}" for k, v in counts.items()) + f" of {counts.sum()}"
 
 
 def _robust(g):
@@ -91,12 +112,32 @@ def _kick_answer(summary, ratios, system, name, caveat=""):
     if a.verdict == "inconclusive":
         verdict += (f"; not resolved at {int(a.n_ics)} ICs per radius: "
                     f"~{int(a.n_ics_to_resolve)} would resolve the {100 * MARGIN:g} % margin")
-    per = ratios[(ratios["system"] == system)
-                 & (ratios["reference"] == "two_particle_pooled")]["verdict"].value_counts()
     return (f"- **{name} / two disks, escape rate γ** (geometric mean over "
             f"{int(a.n_radii)} radii, pooled two-disk estimator): {fa}, {verdict}; caveat: "
-            "per radius " + ", ".join(f"{k} at {v}" for k, v in per.items())
-            + f" of {int(a.n_radii)}{caveat}.")
+            "per radius, under both estimators: "
+            + count_text(per_radius_verdicts(ratios, system)) + f"{caveat}.")
+
+
+def _power_answer(ratios) -> str:
+    """The first answer: what the escape rate can and cannot tell apart, from the two
+    negative controls of `escape_tables`' ratios (per (radius, estimator) cell)."""
+    half, bursty = (ratios[ratios["system"] == s] for s in CONTROLS)
+    differ = bursty["verdict"].isin(["lower", "higher"])
+    where = ", ".join(f"{r:g}" for r in sorted(bursty.loc[differ, "radius"].unique()))
+    same = bursty[~differ & (bursty["reference"] == "two_particle_pooled")]
+    pool = same if len(same) else bursty
+    pick = pool.iloc[int(np.argmin(np.abs(np.log(pool["ratio"].to_numpy()))))]
+    n_half = int(half["verdict"].isin(["lower", "higher"]).sum())
+    at = format_interval(pick.ratio, pick.ci_low, pick.ci_high)
+    return (
+        f"- **What the escape rate can tell apart** (negative controls, kicked / two disks "
+        f"per (radius, estimator) cell): a hole of half the width, detected in {n_half} of "
+        f"{len(half)} cells ({half['ratio'].min():#.3g}–{half['ratio'].max():#.3g}); bursty "
+        f"kicks (gamma({BURSTY_SHAPE:g}) times, CV {1 / math.sqrt(BURSTY_SHAPE):.1f}) only "
+        f"in {int(differ.sum())} of {len(bursty)}" + (f" (r = {where})" if where else "")
+        + f": at r = {pick.radius:g} they give {at} (pooled), {pick.verdict}; caveat: "
+        "γ is set by the hole, so an agreement of escape rates below does not show that "
+        "the kick law matches.")
 
 
 def answers(summary, alpha, constant, ratios) -> list[str]:
@@ -106,26 +147,9 @@ def answers(summary, alpha, constant, ratios) -> list[str]:
     erg = _over(summary, "two_particle_pooled", "ergodic")
     hole = (f"; the two disks' own γ is {format_interval(erg.ratio, erg.ci_low, erg.ci_high)} "
             f"of the hole's ergodic rate ({erg.verdict}): the hole sets it")
-    lines = [_kick_answer(summary, ratios, "poisson", "Uniform kicks", hole),
+    lines = [_power_answer(ratios),
+             _kick_answer(summary, ratios, "poisson", "Uniform kicks", hole),
              _kick_answer(summary, ratios, "poisson_scatter", "Scatter kicks")]
-    bursty = ratios[ratios["system"] == "bursty"]
-    differ = bursty["verdict"].isin(["lower", "higher"])
-    same = bursty[~differ & (bursty["reference"] == "two_particle_pooled")]
-    where = ", ".join(f"{r:g}" for r in sorted(bursty.loc[differ, "radius"].unique()))
-    if len(same):
-        pick = same.iloc[int(np.argmin(np.abs(np.log(same["ratio"].to_numpy()))))]
-        lines.append(
-            f"- **Bursty kicks (negative control: gamma({BURSTY_SHAPE:g}) times, CV "
-            f"{1 / math.sqrt(BURSTY_SHAPE):.1f})** / two disks at r = {pick.radius:g}: "
-            f"{format_interval(pick.ratio, pick.ci_low, pick.ci_high)} (pooled), "
-            f"{pick.verdict}: the escape rate cannot tell them from the two disks there; it "
-            f"detects them in {int(differ.sum())} of {len(bursty)} (radius, estimator) cells"
-            + (f", at r = {where}" if where else "") + ".")
-    else:
-        pick = bursty.iloc[int(np.argmin(np.abs(np.log(bursty["ratio"].to_numpy()))))]
-        lines.append(f"- **Bursty kicks (negative control)** / two disks: detected in every "
-                     f"cell, closest {format_interval(pick.ratio, pick.ci_low, pick.ci_high)} "
-                     f"(r = {pick.radius:g}).")
     by = alpha.set_index(["radius", "sample"])
     radii = alpha["radius"].unique()
     conflict = [r for r in radii if alpha[alpha["radius"] == r]["not_robust_by"].iloc[0]
@@ -133,6 +157,7 @@ def answers(summary, alpha, constant, ratios) -> list[str]:
     r = conflict[0] if conflict else radii[0]
     p, q = by.loc[(r, ALPHA_SAMPLES[0])], by.loc[(r, ALPHA_SAMPLES[1])]
     counts = {s: alpha[alpha["sample"] == s]["verdict"].value_counts() for s in ALPHA_SAMPLES}
+    sides = {s: _side_text(alpha[alpha["sample"] == s]) for s in ALPHA_SAMPLES}
     robust = bool(alpha["robust"].all())
     lines.append(
         f"- **Free disk's exponent α (C/t predicts 1)** at r = {r:g}: "
@@ -140,15 +165,17 @@ def answers(summary, alpha, constant, ratios) -> list[str]:
         + f"{format_interval(p.alpha, p.alpha_low, p.alpha_high, edges=(0.9, 1.0, 1.1))} on the "
         f"paper ICs (fit on t = {p.t_from:g}–{p.t_to:g}; "
         + ", ".join(f"{k} at {v}" for k, v in counts[ALPHA_SAMPLES[0]].items())
-        + f" of {len(radii)} radii) vs {format_interval(q.alpha, q.alpha_low, q.alpha_high)} "
+        + f" of {len(radii)} radii{sides[ALPHA_SAMPLES[0]]}) vs "
+        f"{format_interval(q.alpha, q.alpha_low, q.alpha_high)} "
         f"on the invariant measure (local, t = {q.t_from:g}–{q.t_to:g}; "
         + ", ".join(f"{k} at {v}" for k, v in counts[ALPHA_SAMPLES[1]].items())
-        + f" of {len(radii)})" + (f"; the two CIs lie on opposite sides of 1 at {len(conflict)} "
-                                  "radii" if conflict else "") + ".")
+        + f" of {len(radii)}{sides[ALPHA_SAMPLES[1]]})"
+        + (f"; the two CIs lie on opposite sides of 1 at {len(conflict)} radii"
+           if conflict else "") + ".")
     c = constant.assign(q=constant["t_S"] / constant["C_predicted"],
                         lo=constant["t_S_low"] / constant["C_predicted"],
                         hi=constant["t_S_high"] / constant["C_predicted"])
-    v = [ratio_verdict(lo, hi, MARGIN) for lo, hi in zip(c["lo"], c["hi"], strict=True)]
+    v = [edge_verdict(lo, hi) for lo, hi in zip(c["lo"], c["hi"], strict=True)]
     first = c[c["t"] == c["t"].min()].iloc[0]
     late = c[c["t"] == c["t"].max()]
     lines.append(
@@ -159,6 +186,15 @@ def answers(summary, alpha, constant, ratios) -> list[str]:
         f"{late['q'].max():.3g} by t = {late['t'].iloc[0]:g}, so C/t is "
         f"{law_verdict(list(alpha['verdict']), v)} at the {100 * MARGIN:g} % margin.")
     return lines
+
+
+def _side_text(g) -> str:
+    """``"; below 1 at 3"``: how many of the within-margin α of ``g`` (rows of
+    `alpha_table`) still exclude 1, and on which side; ``""`` when none does."""
+    within = g[g["verdict"].str.startswith("within")]
+    below, above = int((within["alpha_high"] < 1).sum()), int((within["alpha_low"] > 1).sum())
+    parts = [f"below 1 at {below}"] * bool(below) + [f"above 1 at {above}"] * bool(above)
+    return ("; of those within, " + ", ".join(parts)) if parts else ""
 
 
 def law_verdict(alpha_verdicts, constant_verdicts):
@@ -189,14 +225,14 @@ def law_verdict(alpha_verdicts, constant_verdicts):
 def _law_lines(alpha, constant):
     """The verdict paragraph on C/t: the prediction beside each measurement, the margin."""
     alpha_v = list(alpha["verdict"])
-    const_v = [ratio_verdict(lo / c, hi / c, MARGIN) for lo, hi, c in
+    const_v = [edge_verdict(lo / c, hi / c) for lo, hi, c in
                zip(constant["t_S_low"], constant["t_S_high"], constant["C_predicted"],
                    strict=True)]
     q = constant["t_S"] / constant["C_predicted"]
     verdict = law_verdict(alpha_v, const_v)
     count_c = pd.Series(const_v).value_counts()
     per = "; ".join(f"{s_}: " + ", ".join(f"{k} at {v}" for k, v in
-                                          g["verdict"].value_counts().items())
+                                          g["verdict"].value_counts().items()) + _side_text(g)
                     for s_, g in alpha.groupby("sample", sort=False))
     return [
         "", f"**Verdict on the law S(t) = C/t of the free disk: {verdict}.** Its two "
@@ -248,7 +284,9 @@ def write_page(table, ratios, constant, params, command, seconds, source, *, sum
         f"Verdicts: a ratio is within {100 * MARGIN:g} % when its whole 95 % CI lies in "
         f"[{1 - MARGIN:g}, {1 + MARGIN:g}] (margin fixed before any rate was computed; a CI "
         "inside the band that excludes 1 is a real difference smaller than the margin), "
-        "higher / lower when it lies wholly beyond, inconclusive otherwise; robust when "
+        "higher / lower when it lies wholly beyond; above / below 1 by about the margin or "
+        "less when it straddles a band edge but excludes 1; inconclusive when it contains 1 "
+        "and straddles a band edge (only then is a sample size named); robust when "
         "every control (the two-disk estimator; for α the IC sample) gives the same "
         "verdict and no CI lies above 1 while another's lies below. Over radii: the "
         "geometric mean of the per-radius ratios, the same paired bootstrap "
@@ -293,7 +331,7 @@ def write_page(table, ratios, constant, params, command, seconds, source, *, sum
             x, lo, hi = (boot.loc[(r, sy), c] / erg for c in ("rate", "rate_boot_low",
                                                                 "rate_boot_high"))
             cells.append(ratio_text(x, lo, hi))
-            erg_v.append(ratio_verdict(lo, hi, MARGIN))
+            erg_v.append(edge_verdict(lo, hi))
         lines.append(f"| {r:g} | {erg:.5f} | " + " | ".join(cells) + " |")
     counts = pd.Series(erg_v).value_counts()
     lines += ["", "Verdicts over the " + str(len(erg_v)) + " (radius, system) cells: "
@@ -306,12 +344,10 @@ def write_page(table, ratios, constant, params, command, seconds, source, *, sum
     for r, g in ratios.groupby("radius", observed=True):
         lines.append(f"| {r:g} | " + " | ".join(_robust(g[g["system"] == s])
                                                 for s in ("poisson", "poisson_scatter")) + " |")
-    both = {sy: sum(all(g[(g["system"] == sy)]["verdict"] == "within 10 %")
-                    for _, g in ratios.groupby("radius", observed=True))
-               for sy in ("poisson", "poisson_scatter")}
-    lines += ["", "Within 10 % under both estimators: " + ", ".join(
-        f"{LABELS[sy]} at {n} of {ratios['radius'].nunique()} radii" for sy, n in both.items())
-        + "."]
+    lines += ["", "Per radius, the verdict both estimators give (the count of the answers "
+              "above): " + "; ".join(f"{LABELS[sy]}: "
+                                     + count_text(per_radius_verdicts(ratios, sy)) + " radii"
+                                     for sy in ("poisson", "poisson_scatter")) + "."]
     lines += ["", "**Negative controls**, which a comparison able to tell escape laws apart "
               "must find different from the two disks: a hole of half the width (uniform "
               f"kicks at Γ(r)), and uniform kicks at the same mean rate Γ(r) from a "
