@@ -449,8 +449,11 @@ def test_model_comparison_keeps_legend_off_the_data_and_no_negative_delta_aic_ba
     ax1, ax2 = fig.axes
     assert ax1.get_legend() is None and ax2.get_legend() is None
     assert len(fig.legends) == 1  # one legend, outside the panels
-    # a little below 0: the best model (delta AIC = 0) sits on a line above the axis
-    assert -1.0 < ax2.get_ylim()[0] < 0 and ax2.get_ylim()[1] >= 150
+    # a log axis of delta AIC + 1, labelled in delta AIC: the best model (0) on a line
+    # just above the bottom, and no label "0" below one of 1
+    assert ax2.get_yscale() == "log" and 0 < ax2.get_ylim()[0] < 1 <= 151 <= ax2.get_ylim()[1]
+    labels = [t.get_text() for t in ax2.get_yticklabels()]
+    assert labels[:3] == ["0", "2", "10"]
 
 
 def test_log_axes_have_plain_tick_labels():

@@ -166,7 +166,7 @@ def test_the_paper_page_s_closing_table_is_what_it_wrote_and_never_in_the_readme
         ("overview.csv", "overview_table"), ("fam_findings.csv", "compute_controls"),
         ("fam_findings.csv", "poisson_rows")]
     assert {r.csv for r in rows} == {p.name for p in tmp_path.glob("*.csv")} - {
-        "fam-elastic_findings.csv"}
+        "fam-elastic_findings.csv", "fam-elastic_findings_by_radius.csv"}
     page = write_results_page(tmp_path / "README.md", [
         "# t", "", "Generated now from `fam`.", "", "## The answers", "", "One.", ""], rows)
     readme = tmp_path / "top.md"

@@ -338,7 +338,7 @@ def _small_n_words(fitted, share_long, coll, ctx):
         f"censored models), so one IC moves a share by 1/{hi} or more, and the 95 % "
         f"intervals are {width.min():.2f} to {width.max():.2f} wide: read a share at one "
         "radius, or the gap between two bars, against them; the share pooled over radii "
-        "and its Poisson-twin level are in the Findings."
+        "and its Poisson-twin level are in the statements CSV."
     )
 
 

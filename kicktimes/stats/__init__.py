@@ -46,6 +46,7 @@ from .ensemble import PoissonEnsembleResult, test_poisson_ensemble
 from .enskog import contact_value, enskog_frequency, henderson_z, speed_rate_factor
 from .findings import (
     D_MARGIN,
+    FINE_MARGIN,
     MARGIN,
     SHARE_RULE,
     Finding,
@@ -164,6 +165,7 @@ __all__ = [
     "reliable_until",
     "MARGIN",
     "D_MARGIN",
+    "FINE_MARGIN",
     "null_verdict",
     "null_rule",
     "equivalence_sample_size",

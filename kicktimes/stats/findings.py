@@ -39,6 +39,7 @@ __all__ = [
     "SHARE_RULE",
     "clopper_pearson",
     "D_MARGIN",
+    "FINE_MARGIN",
     "null_verdict",
     "null_rule",
     "equivalence_sample_size",
@@ -220,6 +221,12 @@ def rejection_rule(alpha=0.05, margin=0.5) -> str:
             f"{100 * margin:g} % of α); above / below nominal: it lies entirely above / below "
             "that band; inconclusive otherwise")
 
+
+#: the margin of the scatter-kick and unequal-disk FTLE ratios, stated in advance: half
+#: the smallest effect those comparisons mean to detect, the exponent the partner's
+#: tangent memory carries (zeroing it costs the two disks 10.6 % of their FTLE,
+#: docs/results/scatter.md); `MARGIN` (10 %) equals that effect and cannot resolve it
+FINE_MARGIN = 0.05
 
 #: the margin of a dispersion index D read against its null stream's D (`null_verdict`):
 #: half the smallest effect the gas pages mean to detect, the elastic linear-Boltzmann

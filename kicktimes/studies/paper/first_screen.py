@@ -15,28 +15,27 @@ import pandas as pd
 
 from kicktimes.render.pages import markdown_table
 from kicktimes.report.answers import CONTROL_WORDS, SCREEN_ROWS, family_short
-from kicktimes.report.controls import LOWER, POISSON_QUESTION, WITHIN
-from kicktimes.stats import format_interval
+from kicktimes.report.controls import LOWER, POISSON_QUESTION
+from kicktimes.stats import FINE_MARGIN, MARGIN, format_interval, ratio_verdict
 
 __all__ = ["QUESTIONS", "answer_lines", "compact_overview", "first_screen", "qa_table"]
 
-#: the first screen's ratio questions, in order: (question, diagnostic, kicked systems); the
-#: first system is the one whose number the line gives; the Poisson question comes first
+#: the first screen's ratio questions, in order: (question, diagnostic, kicked systems,
+#: margin); the first system is the one whose number the line gives; the Poisson question
+#: comes first. The scatter kicks are read at `kicktimes.stats.FINE_MARGIN`: the deficit
+#: they leave (the partner's tangent memory, about 10 %) equals the 10 % band
 QUESTIONS = (
     ("Does the paper's kicked disk (uniform kicks) have the two-disk tangent-space FTLE?",
-     "ftle",
-     ("poisson", "actual")),
+     "ftle", ("poisson", "actual"), MARGIN),
     ("Do scatter kicks (virtual partners) give the two-disk FTLE?", "ftle",
-     ("poisson_scatter", "actual_scatter", "poisson_kinetic")),
+     ("poisson_scatter", "actual_scatter", "poisson_kinetic"), FINE_MARGIN),
     ("Does it decorrelate like the two disks at lag 1 (1 − R₁ over each system's n steps)?",
-     "one_minus_r1",
-     ("poisson", "actual")),
+     "one_minus_r1", ("poisson", "actual"), MARGIN),
     ("Does it have the two-disk recurrence rate (ε = 10⁻²)?", "rr_offdiag@0.01",
-     ("poisson", "actual")),
+     ("poisson", "actual"), MARGIN),
 )
 POISSON_LINE = "Are the two disks' collision times Poisson?"
-_WORDS = {LOWER: "no, lower", "higher": "no, higher", WITHIN: "yes, within 10 %",
-          "inconclusive": "undecided"}
+_WORDS = {LOWER: "no, lower", "higher": "no, higher", "inconclusive": "inconclusive"}
 _KICKS = {"poisson": "Poisson kicks", "actual": "kicks at the actual times",
           "poisson_scatter": "Poisson scatter kicks", "actual_scatter": "actual scatter kicks",
           "poisson_kinetic": "scatter kicks at the kinetic rate",
@@ -79,32 +78,49 @@ def _deciding(rows, main) -> list[str]:
     return found or [c for c in dict.fromkeys(rows["depends_on"].fillna("")) if c]
 
 
-def _ratio_line(question, rows) -> str:
-    """One answer: the primary verdict and number of the first family and kick law, then
-    the caveat: robust over every control and family (with the range), or the control
-    that decides, with its number; a verdict "within 10 %" whose interval excludes 1 says
-    how many cells lie on one side of 1 (a real difference smaller than the margin)."""
+def _word(verdict) -> str:
+    return ("yes, " + verdict) if verdict.startswith("within") else _WORDS.get(verdict, verdict)
+
+
+def _sides(rows) -> bool:
+    """Whether some row's CI lies above 1 and another's below 1."""
+    return bool((rows["ci_low"] > 1).any() and (rows["ci_high"] < 1).any())
+
+
+def _ratio_line(question, rows, margin=MARGIN) -> str:
+    """One answer at ``margin`` (`kicktimes.stats.ratio_verdict`): when every control and
+    family gives one verdict and no two CIs lie on opposite sides of 1 (robust), the
+    primary verdict and number of the first family and kick law, with the range; else
+    "depends on" the control that changes it, both numbers. A verdict "within" whose
+    interval excludes 1 says in how many cells (a real difference smaller than the
+    margin)."""
+    rows = rows.assign(verdict=[ratio_verdict(lo, hi, margin) for lo, hi
+                                in zip(rows["ci_low"], rows["ci_high"], strict=True)])
     family = rows["family"].iloc[0]
     system = rows["system"].iloc[0]
     primary = _one(rows, family=family, system=system, control="primary")
     n_controls = rows.loc[rows["control"] != "primary", "control"].nunique()
-    robust = bool(rows["robust"].astype(str).str.lower().eq("true").all())
-    main = primary.verdict
-    text = (f"**{question}** {_WORDS.get(main, main)}: {_ci(primary)} "
-            f"({family_short(family)}, {_KICKS.get(system, system)})")
-    if robust and rows["verdict"].nunique() == 1:
-        text += f"; robust over {n_controls} controls and both families ({_range(rows)})"
+    families = rows["family"].nunique()
+    where = f"({family_short(family)}, {_KICKS.get(system, system)})"
+    at = "" if margin == MARGIN else f" at a {100 * margin:g} % margin"
+    over = (f"{n_controls} controls" + (" and both families" if families > 1 else "")
+            if n_controls else "both families" if families > 1 else "")
+    if rows["verdict"].nunique() == 1:
+        text = f"**{question}** {_word(primary.verdict)}{at}: {_ci(primary)} {where}"
+        if _sides(rows):  # one verdict, but intervals on both sides of 1: not robust
+            text += f"; not robust: CIs on both sides of 1 ({_range(rows)})"
+        elif over:
+            text += f"; robust over {over} ({_range(rows)})"
     else:
-        other = rows[(rows["verdict"] != main) & (rows["control"] != "primary")]
-        if len(other):
-            control = other["control"].value_counts().index[0]
-            c = other[other["control"] == control].iloc[0]
-            text += (f"; depends on {CONTROL_WORDS.get(control, control)}: {_ci(c)} "
-                     f"({c.verdict}; {family_short(c.family)}, {_KICKS.get(c.system, c.system)})")
-        else:
-            text += "; the interval lies on both sides of 1 under different controls"
+        other = rows[rows["verdict"] != primary.verdict]
+        control = other["control"].value_counts().index[0]
+        c = other[other["control"] == control].iloc[0]
+        text = (f"**{question}** depends on {CONTROL_WORDS.get(control, control)}{at}: "
+                f"{primary.verdict} {_ci(primary)} {where} under the primary, {c.verdict} "
+                f"{_ci(c)} ({family_short(c.family)}, {_KICKS.get(c.system, c.system)}) "
+                f"under it")
     below = int((rows["ci_high"] < 1).sum())
-    if main == WITHIN and below:
+    if primary.verdict.startswith("within") and below:
         text += f"; CI below 1 in {below} of {len(rows)} cells"
     return text + "."
 
@@ -123,13 +139,13 @@ def _poisson_line(table) -> str | None:
     main = _one(verdicts, family=family, control="primary")
     share = _one(rows, diagnostic=f"reject@{HEADLINE_TEST}", family=family, control="primary")
     excess = _one(rows, diagnostic="dispersion_index_excess", family=family, control="primary")
-    robust = verdicts["verdict"].nunique() == 1
+    robust = verdicts["verdict"].nunique() == 1 and verdicts["control"].nunique() > 1
     level = _null_share(share)
     text = (f"**{POISSON_LINE}** {'no' if main.verdict == 'not Poisson' else main.verdict}: "
             f"{_pct(share)} of runs reject uniformity (null streams {level})")
     if excess is not None:
         text += f", D − null D {_ci(excess)}"
-    text += f" (A{', robust over rule × ICs' if robust else ''})"
+    text += f" ({family_short(family)}{', robust over rule × ICs' if robust else ''})"
     e_share = _one(rows, diagnostic=f"reject@{HEADLINE_TEST}", family=family, control="elastic")
     e_excess = _one(rows, diagnostic="dispersion_index_excess", family=family,
                     control="elastic")
@@ -154,12 +170,12 @@ def answer_lines(table: pd.DataFrame) -> list[str]:
     poisson = _poisson_line(table)
     if poisson:
         out.append("- " + poisson)
-    for question, diagnostic, systems in QUESTIONS:
+    for question, diagnostic, systems, margin in QUESTIONS:
         rows = table[(table["diagnostic"] == diagnostic) & table["system"].isin(systems)]
         if len(rows):
             order = {s: k for k, s in enumerate(systems)}
             rows = rows.sort_values("system", key=lambda s: s.map(order), kind="stable")
-            out.append("- " + _ratio_line(question, rows))
+            out.append("- " + _ratio_line(question, rows, margin))
     return out[:5]
 
 
@@ -184,9 +200,11 @@ def compact_overview(table: pd.DataFrame) -> pd.DataFrame:
                 continue
             robust = (rows["robust"].astype(str).str.lower().eq("true").all()
                       and rows["verdict"].nunique() == 1)
-            deciding = _deciding(rows, p.verdict)[:1]
+            # the control that changes it: the findings table's own (`with_robustness`)
+            deciding = [c.strip() for c in str(p.depends_on or "").split(",") if c.strip()]
+            deciding = deciding[:1] or _deciding(rows, p.verdict)[:1]
             mark = "✓" if robust else "✗ " + "".join(_CONTROL_SHORT.get(c, c) for c in deciding)
-            line[_KICKS[system]] = f"{_WORDS.get(p.verdict, p.verdict)} {p.estimate:.3g} {mark}"
+            line[_KICKS[system]] = f"{_word(p.verdict)} {p.estimate:.3g} {mark}"
         out.append(line)
     return pd.DataFrame(out)
 
@@ -201,7 +219,7 @@ def first_screen(table: pd.DataFrame) -> list[str]:
     """The Markdown lines that open the page: :func:`answer_lines`, then the compact table
     (:func:`compact_overview`) with one sentence on how to read it."""
     lines = answer_lines(table) + [""]
-    lines += ["Every diagnostic by kick law (family A, primary; ✓ robust over every control "
-              "and both families, ✗ the control that changes it; every cell: "
-              "[overview.csv](overview.csv)):", ""]
+    lines += ["Every diagnostic by kick law (family A, primary, at the 10 % margin; ✓ robust "
+              "over every control and both families, ✗ the first control that changes it; "
+              "every cell with both numbers: [overview.csv](overview.csv)):", ""]
     return lines + markdown_table(compact_overview(table)) + [""]

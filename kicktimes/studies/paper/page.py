@@ -116,7 +116,8 @@ def gap_section(gaps):
         "timing (two 2 × 2 factorials), 95 % CIs clustered on ICs; sign ✓: the same sign "
         "under every control (their range beside); 'left' = 1 − both shares. "
         + (open_gaps + " " if open_gaps else "")
-        + "Not decomposed (the gap is inside its noise): "
+        + "Not decomposed (the paper's kick's CI reaches into the ±10 % band under the named "
+        "control: no gap beyond the margin): "
         + _not_decomposed(summary.loc[[not g for g in robust_gap], ["family", "diagnostic"]],
                           missing)
         + ". Every control: [gap_decomposition.csv](gap_decomposition.csv).", "",
@@ -212,7 +213,8 @@ def copy_first_screen(page, target):
 #: this page, so the paper study needs no other study (the protocol study reads this one's
 #: findings tables, and runs after it)
 PROTOCOL_POINTER = [
-    "The FTLE here is kicktimes' tangent-space exponent; the paper's claims read by its "
+    "The FTLE here is kicktimes' tangent-space exponent (the paper's variant: the larger of "
+    "the x- and y-perturbation exponents); the paper's claims read by its "
     "own protocol (its eq. (4) as printed, which never renormalises its twins) are on "
     "[paper.md](paper.md)."]
 
@@ -253,13 +255,17 @@ def results_sources(findings, families, by_radius, *, gaps, nulls):
     return rows
 
 
-def _family_page(out, name, paper, scale, ctx, secs, notes, *, dpi, seconds, command) -> str:
-    """Write ``out/<name>.md``, the family's detail page: its scale, the statements under
-    the primary setting (``<name>_statements.csv``: every Effect of the sweep report, with
-    its rule and method) and every report figure with its caption; returns ``name``."""
+def _family_page(out, name, paper, scale, ctx, secs, notes, *, dpi, seconds, command,
+                 table=None) -> str:
+    """Write ``out/<name>.md``, the family's detail page: the first screen's answers read
+    over this family's controls alone (``table``, its merged findings), its scale, the
+    statements under the primary setting (``<name>_statements.csv``: every Effect of the
+    sweep report, with its rule and method) and every report figure with its caption;
+    returns ``name``."""
     from kicktimes.render.pages import write_results_page
     from kicktimes.render.provenance import Source
     from kicktimes.report.pipeline import analyse
+    from kicktimes.studies.paper.first_screen import answer_lines
 
     statements = pd.DataFrame([{
         "question": e.question, "system": e.system, "quantity": e.quantity,
@@ -272,6 +278,8 @@ def _family_page(out, name, paper, scale, ctx, secs, notes, *, dpi, seconds, com
              f"kicktimes {__version__} (`{command}`) from the store `{name}` in "
              f"{seconds:.0f} s. The answers, read over every control: [README.md](README.md).",
              ""]
+    if table is not None and len(table):
+        lines += ["Its answers, over its own controls:", "", *answer_lines(table), ""]
     lines += ([f"> **Below paper scale** ({scale}): a pipeline check; its verdicts answer "
                "nothing.", ""] if not paper else [f"Scale: {scale}.", ""])
     lines += [f"Every statement under the primary setting, with its rule and interval: "
@@ -391,8 +399,7 @@ def write_results(
             curves.append(ctx.found.controls.curves)
             findings.tables[0][1].to_csv(out / f"{name}_findings.csv", index=False)
             written.append(name)
-            details.append(_family_page(out, name, paper, scale, ctx, secs, notes, dpi=dpi,
-                                        seconds=time.perf_counter() - t0, command=command))
+            details.append((name, paper, scale, ctx, secs, notes, time.perf_counter() - t0))
         if len(stores) > 1:
             from kicktimes.report.pipeline import families_section
 
@@ -415,6 +422,10 @@ def write_results(
     by_radius = {c["family"].iloc[0]: c for c in curves if not c.empty}
     for name, c in by_radius.items():
         c.to_csv(out / f"{name}_findings_by_radius.csv", index=False)
+    details = [_family_page(out, name, paper, scale, ctx, secs, notes, dpi=dpi,
+                            seconds=seconds, command=command,
+                            table=merged.get(name))
+               for name, paper, scale, ctx, secs, notes, seconds in details]
     table = pd.concat(list(merged.values()), ignore_index=True)
     overview_table(table).to_csv(out / "overview.csv", index=False)
     screen = ["## The answers", ""] + first_screen(table)

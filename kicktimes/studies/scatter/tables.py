@@ -7,6 +7,7 @@ import numpy as np
 import pandas as pd
 
 from kicktimes.stats import (
+    FINE_MARGIN,
     MARGIN,
     percentile_interval,
     ratio_verdict,
@@ -16,11 +17,6 @@ from kicktimes.stats import (
 
 __all__ = ["FINE_MARGIN", "RATIOS", "over_radii", "ratio_table", "sticky", "summary_tables"]
 
-#: the margin the page's FTLE ratios must resolve, stated in advance: half the smallest
-#: effect the page means to detect, the exponent the partner's tangent memory carries
-#: (zeroing it costs the two disks about 10 %: "partner tangent zeroed / two disks"); the
-#: project's 10 % margin (`kicktimes.stats.MARGIN`) equals that effect and cannot resolve it
-FINE_MARGIN = 0.05
 
 
 #: (numerator, denominator, label) of the page's ratios of means
