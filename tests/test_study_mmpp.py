@@ -2,6 +2,7 @@
 
 from types import SimpleNamespace
 
+import numpy as np
 import pandas as pd
 import pytest
 from conftest import (
@@ -102,8 +103,7 @@ def test_the_page_opens_with_at_most_five_answers_each_with_an_interval(built):
 
 
 def test_the_residuals_are_read_against_their_calibrated_null(built):
-    from kicktimes.stats import null_verdict
-
+    null_verdict = tables.edge_null_verdict
     _, page = built
     nulls = pd.read_csv(page.parent / "mmpp" / "mmpp_billiard_null.csv")
     resid = pd.read_csv(page.parent / "mmpp" / "mmpp_billiard_residuals.csv")
@@ -113,6 +113,25 @@ def test_the_residuals_are_read_against_their_calibrated_null(built):
         assert row.diff_low <= row.difference <= row.diff_high
         assert row.difference == pytest.approx(row.share - row.null_share)
         assert row.null_vs_alpha == rejection_verdict(row.null_ci_low, row.null_ci_high, 0.05)
+    # the residual table quotes each share with its null share and the verdict against it
+    text = page.read_text(encoding="utf-8")
+    assert "against α itself" not in text
+    for row in nulls.itertuples():
+        r = resid[(resid["rule"] == row.rule) & (resid["fit"] == row.fit)
+                  & (resid["states"] == row.states) & (resid["test"] == row.test)].iloc[0]
+        assert (f"{100 * r.share:.1f} % [{100 * r.ci_low:.1f}, {100 * r.ci_high:.1f}] "
+                f"(null {100 * row.null_share:.1f} %), {row.verdict}") in text
+
+
+def test_a_share_difference_beyond_a_margin_edge_that_excludes_0_is_not_inconclusive():
+    v = tables.edge_null_verdict
+    assert v(0.015, 0.13) == "above its null by about the margin or less"
+    assert v(-0.13, -0.01) == "below its null by about the margin or less"
+    assert v(-0.01, 0.05) == "inconclusive"
+    assert v(0.03, 0.2) == "above its null" and v(-0.02, 0.02) == "at its null"
+    assert v(float("nan"), 0.1) == "inconclusive"
+    assert tables._difference([1, 0] * 50, [0] * 100, np.random.default_rng(0))[
+        "verdict"] == "above its null"
 
 
 def test_a_shuffled_twin_keeps_the_intervals_and_loses_their_order():

@@ -21,6 +21,7 @@ from kicktimes.stats.findings import clopper_pearson
 
 __all__ = ["CHOICE_COLUMNS", "DIP", "EARLY_EDGES", "N_BOOT", "N_MC", "PER_RUN_STARTS",
            "RENEWAL", "SHARE_MARGIN", "TESTS", "analyse", "battery", "choice_rows",
+           "edge_null_verdict",
            "intervals", "mmpp_bin_hazard", "mmpp_dip", "null_rows", "rejections",
            "shuffled_twin"]
 
@@ -221,6 +222,29 @@ def intervals(times, t_max):
     return complete, censored
 
 
+def edge_null_verdict(low, high, margin=SHARE_MARGIN):
+    """`null_verdict` of the CI of a difference from the null, with the pages' general rule
+    for a CI that straddles a margin edge: when it excludes 0 it says on which side
+    (``"above its null by about the margin or less"``); ``"inconclusive"`` is kept for a CI
+    that contains 0, the only case where a sample size is named.
+
+    Examples
+    --------
+    >>> edge_null_verdict(0.015, 0.13), edge_null_verdict(-0.05, 0.07)
+    ('above its null by about the margin or less', 'inconclusive')
+    >>> edge_null_verdict(0.033, 0.116), edge_null_verdict(-0.02, -0.01)
+    ('above its null', 'at its null')
+    """
+    verdict = null_verdict(low, high, margin)
+    if verdict != "inconclusive" or not (np.isfinite(low) and np.isfinite(high)):
+        return verdict
+    if low > 0:
+        return "above its null by about the margin or less"
+    if high < 0:
+        return "below its null by about the margin or less"
+    return verdict
+
+
 def _difference(a, b, rng, margin=SHARE_MARGIN):
     """Share of ``a`` minus share of ``b`` (boolean arrays of independent units) with its
     95 % bootstrap interval (each arm resampled on its own), its `null_verdict` and the
@@ -233,7 +257,7 @@ def _difference(a, b, rng, margin=SHARE_MARGIN):
     se = float(np.std(boot, ddof=1))
     n = int(min(a.size, b.size))
     return {"difference": a.mean() - b.mean(), "diff_low": lo, "diff_high": hi,
-            "margin": margin, "verdict": null_verdict(lo, hi, margin),
+            "margin": margin, "verdict": edge_null_verdict(lo, hi, margin),
             "n_to_resolve": equivalence_sample_size(se, n, margin) if se > 0 else n}
 
 
