@@ -90,6 +90,11 @@ def test_the_hazard_flatness_verdict_is_its_p_value_and_bulk_is_no_control_of_th
     assert g["ci_low"].isna().all()
     assert "p = 1e-05 flatness rejected (primary)" in robust_text(g)
     assert list(_group(long, "rate / Enskog")["control"]) == ["primary"]
+    # the page names, per finding, only the controls run for it: no bulk for the rate
+    text = "\n".join(controls_lines(controls_findings(
+        {"primary": _table(), "seed": _table(), "bulk": _table()})))
+    assert "D − null D, KS share − null, hazard first bin − null: seed, bulk" in text
+    assert "rate / Enskog: seed)" in text
 
 
 def test_the_controls_section_counts_robust_and_dependent_findings():

@@ -88,7 +88,53 @@ def test_a_d_at_its_null_does_not_hide_a_departure_of_the_other_statistics():
     # the first table is each family's largest N
     assert "| g, elastic, N = 1000 |" in text
     # the answer names the statistics that disagree with it
-    assert "**not Poisson** (by 3 of 6; at its null: D, KS share)" in text
+    assert ("**not Poisson** (by gamma shape, hazard bins, ΔAIC, 3 of 6; at its null: D, "
+            "KS share)") in text
+
+
+def test_a_verdict_the_replicate_changes_is_not_read_in_the_answer():
+    # packing 0.2, elastic at N = 1000 on the page: the first hazard bin departs in the
+    # primary (+0.129 [0.039, 0.213]) and not in the replicate (+0.072 [-0.006, 0.151])
+    m = MARGINS["hazard_first"]
+    vn = pd.DataFrame([_vn(1000, gamma=(-0.039, -0.021))])
+    bins = _bins(1000, ((0.039, 0.213), (-0.01, 0.01)))
+    seed_bins = _bins(1000, ((-0.006, 0.151), (-0.01, 0.01)))
+    renewal = pd.DataFrame({"geometry": "g", "rule": "elastic", "n_disks": [1000],
+                            "delta_aic_exponential": [72.0], "n_intervals": 120000})
+    # the replicate keeps the gamma shape's departure and the ΔAIC
+    seed_vn = pd.DataFrame([_vn(1000, gamma=(-0.05, -0.03))])
+    a = answer_table(vn, bins, renewal, seed_vn=seed_vn, seed_bins=seed_bins,
+                     seed_renewal=renewal.assign(delta_aic_exponential=60.0)).iloc[0]
+    assert a["hazard bins_verdict"] == "above its null" and 0.039 > m
+    assert a["replicate_changed"] == "hazard bins"
+    assert a["answer"] == "not Poisson" and a["by"] == "gamma shape; ΔAIC"
+    assert "the replicate keeps 0 of the 1" in a["hazard bins_text"]
+    # a replicate that loses the gamma shape and the ΔAIC too: nothing departs that it keeps
+    b = answer_table(vn, bins, renewal, seed_vn=pd.DataFrame([_vn(1000)]),
+                     seed_bins=seed_bins,
+                     seed_renewal=renewal.assign(delta_aic_exponential=1.0)).iloc[0]
+    assert b["replicate_changed"] == "gamma shape; hazard bins; ΔAIC"
+    assert b["answer"] == "not resolved"
+    text = "\n".join(summary_lines(pd.DataFrame([b]), vn))
+    assert "changed by the replicate: gamma shape, hazard bins, ΔAIC" in text
+    # without a replicate the primary's verdicts stand
+    c = answer_table(vn, bins, renewal).iloc[0]
+    assert c["answer"] == "not Poisson" and c["replicate_changed"] == ""
+
+
+def test_a_difference_beyond_a_margin_edge_that_excludes_0_says_its_side():
+    from kicktimes.studies.disks.versus_null import EDGE_VERDICTS, edge_null_verdict
+
+    m = MARGINS["d"]
+    # r = 0.0045, mirror, N = 1000 on the page: D - null +0.083 [+0.018, +0.157]
+    assert edge_null_verdict(0.018, 0.157, m) == EDGE_VERDICTS[0]
+    assert edge_null_verdict(-0.157, -0.018, m) == EDGE_VERDICTS[1]
+    assert edge_null_verdict(-0.014, 0.140, m) == "inconclusive"  # contains 0
+    assert edge_null_verdict(0.108, 0.239, m) == "above its null"
+    assert edge_null_verdict(-0.06, 0.065, m) == "at its null"
+    # an edge verdict neither departs nor is at its null: the answer is not resolved
+    assert poisson_answer({"D": EDGE_VERDICTS[0], "KS share": "at its null"})[0] == (
+        "not resolved")
 
 
 def test_the_aic_margin_is_the_gain_of_a_gamma_at_the_margin_shape():

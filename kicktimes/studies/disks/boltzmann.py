@@ -29,7 +29,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from kicktimes.stats import dilute_tagged_disk, null_verdict
+from kicktimes.stats import dilute_tagged_disk
 
 __all__ = ["BOLTZMANN_COLUMNS", "STATISTICS", "boltzmann_lines",
            "boltzmann_table", "dilute_predictions"]
@@ -95,11 +95,11 @@ def boltzmann_table(table, nulls, predictions=None) -> pd.DataFrame:
     DataFrame
         Columns `BOLTZMANN_COLUMNS`. ``diff`` is gas minus kicked disk, its 95 % interval
         from both intervals (independent samples: the half-widths added in quadrature, on
-        each side), and ``verdict`` `kicktimes.stats.null_verdict` of it with the
+        each side), and ``verdict`` `versus_null.edge_null_verdict` of it with the
         statistic's margin (`kicktimes.studies.disks.versus_null.MARGINS`: half the
         Boltzmann tagged disk's own departure from Poisson in it).
     """
-    from kicktimes.studies.disks.versus_null import MARGINS
+    from kicktimes.studies.disks.versus_null import MARGINS, edge_null_verdict
 
     margins = {"dispersion": MARGINS["d"], "hazard_first": MARGINS["hazard_first"],
                "gamma_shape": MARGINS["gamma"], "reject_uniformity_ks": MARGINS["ks"]}
@@ -125,7 +125,7 @@ def boltzmann_table(table, nulls, predictions=None) -> pd.DataFrame:
             diff = g - k
             low = diff - np.hypot(g - g_lo, k_hi - k)
             high = diff + np.hypot(g_hi - g, k - k_lo)
-            verdict = null_verdict(low, high, margins[stat])
+            verdict = edge_null_verdict(low, high, margins[stat])
             rows.append({"geometry": gas["geometry"], "rule": gas["rule"],
                          "n_disks": int(gas["n_disks"]), "statistic": stat,
                          "gas": g, "gas_low": g_lo, "gas_high": g_hi,
@@ -158,6 +158,8 @@ def boltzmann_lines(boltz, *, n_disks=None) -> list:
     d = at[(at["statistic"] == "dispersion") & (at["rule"] == "elastic")]
     if d.empty:
         d = at[at["statistic"] == "dispersion"]
+    from kicktimes.studies.disks.versus_null import EDGE_VERDICTS as EDGE
+
     rest = at[at["statistic"] != "dispersion"]
     counts = rest["verdict"].value_counts()
     cells = "; ".join(f"{r['geometry']}, {r['rule']}: {_cell(r)}" for _, r in d.iterrows())
@@ -171,5 +173,6 @@ def boltzmann_lines(boltz, *, n_disks=None) -> list:
         f"disk: gas − kicked): {cells}. The other {len(rest)} (hazard's first bin, gamma "
         f"shape, KS share): {int(counts.get('at its null', 0))} within their margin, "
         f"{int(counts.get('above its null', 0) + counts.get('below its null', 0))} depart, "
+        f"{sum(int(counts.get(v, 0)) for v in EDGE)} beyond it by about the margin or less, "
         f"{int(counts.get('inconclusive', 0))} inconclusive. Every N and statistic: "
         "[disks_boltzmann_kicks.csv](disks_boltzmann_kicks.csv).", ""]

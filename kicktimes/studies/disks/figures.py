@@ -51,8 +51,8 @@ def _n_ticks(ax, ns):
 def rejection_figure(table, tests=(HEADLINE, "exponential_ad"), nulls=None):
     """The share of tagged disks whose first K collision times reject each test at
     alpha = 0.05, against N: one column per geometry, one row per test, log y axis (the
-    5 % band stays readable next to the N = 2 shares); mirror, elastic and elastic after
-    the speed rescaling, dodged and with different markers; 95 % CIs; alpha +- the KS
+    5 % band stays readable next to the N = 2 shares); mirror and elastic, dodged and with
+    different markers; 95 % CIs; alpha +- the KS
     share's margin (`KS_MARGIN`) shaded; with ``nulls``
     (`kicktimes.studies.disks.null.null_rows`), the share of the Poisson null streams
     shaped like each rule's runs (the calibrated level), dotted, and under the elastic rule
@@ -63,9 +63,9 @@ def rejection_figure(table, tests=(HEADLINE, "exponential_ad"), nulls=None):
     ns = sorted(set(table["n_disks"]))
     fig, axes = plt.subplots(len(tests), len(geos), figsize=(4.4 * len(geos), 3.6 * len(tests)),
                              sharex=True, sharey=True, squeeze=False)
+    # the speed-rescaled shares are not drawn: the page reads no verdict of them
     styles = (("mirror", "", "mirror", "C0", "o", "C0"),
-              ("elastic", "", "elastic", "C3", "s", "C3"),
-              ("elastic", "rescaled_", "elastic, speed-rescaled", "C2", "^", "none"))
+              ("elastic", "", "elastic", "C3", "s", "C3"))
     for i, test in enumerate(tests):
         for j, geo in enumerate(geos):
             ax = axes[i, j]
@@ -78,7 +78,7 @@ def rejection_figure(table, tests=(HEADLINE, "exponential_ad"), nulls=None):
                 key = f"{prefix}reject_{test}"
                 if d.empty or key not in d:
                     continue
-                x = d["n_disks"].to_numpy() * (1.0 + 0.12 * (k - 1))
+                x = d["n_disks"].to_numpy() * (1.0 + 0.12 * (k - 0.5))
                 y = 100 * d[key].to_numpy()
                 err = np.abs(100 * d[[f"{key}_low", f"{key}_high"]].to_numpy().T - y)
                 ax.errorbar(x, y, yerr=err, color=color, marker=marker, ms=4.5, lw=1,
@@ -87,13 +87,13 @@ def rejection_figure(table, tests=(HEADLINE, "exponential_ad"), nulls=None):
                     z = nulls[(nulls["geometry"] == geo) & (nulls["rule"] == rule)
                               & (nulls["design"] == "poisson")]
                     if not z.empty and key in z:
-                        ax.plot(z["n_disks"].to_numpy() * (1.0 + 0.12 * (k - 1)),
+                        ax.plot(z["n_disks"].to_numpy() * (1.0 + 0.12 * (k - 0.5)),
                                 100 * z[key].to_numpy(), color=color, ls=":", marker="x",
                                 ms=4, lw=1, label=f"Poisson null, {rule} runs")
                     b = nulls[(nulls["geometry"] == geo) & (nulls["rule"] == rule)
                               & (nulls["design"] == "dilute")]
                     if rule == "elastic" and not b.empty and key in b:
-                        ax.plot(b["n_disks"].to_numpy() * (1.0 + 0.12 * (k - 1)),
+                        ax.plot(b["n_disks"].to_numpy() * (1.0 + 0.12 * (k - 0.5)),
                                 100 * b[key].to_numpy(), color="0.2", ls="--", marker="+",
                                 ms=5, lw=0.9, label="linear Boltzmann, elastic runs")
             _n_ticks(ax, ns)
@@ -117,8 +117,9 @@ def rejection_figure(table, tests=(HEADLINE, "exponential_ad"), nulls=None):
 
 def hazard_figure(hazard, table, n_shown=SHOWN_N):
     """The hazard of the tagged disk's next collision against the time since its last one,
-    both in units of the mean interval, over the constant rate (1 for Poisson): per rule a
-    row over the whole range (log y) and a row zoomed near 1 for N >= ZOOM_MIN_N (linear y,
+    both in units of the mean interval, over the constant rate (1 for Poisson): on top one
+    row per rule over the whole range (log y), below them one row per rule zoomed near 1
+    for N >= ZOOM_MIN_N (linear y,
     ±`HAZARD_MARGIN` shaded; under the elastic rule the linear Boltzmann h(t) dashed; a
     bin beyond the limits is a filled triangle at the edge with its value, a bin whose
     95 % band alone leaves them an open one); one
@@ -141,7 +142,8 @@ def hazard_figure(hazard, table, n_shown=SHOWN_N):
     for i, rule in enumerate(rules):
         for zoom in (False, True):
             for j, geo in enumerate(geos):
-                ax = axes[2 * i + zoom, j]
+                row = zoom * len(rules) + i  # the log rows on top, the linear rows below
+                ax = axes[row, j]
                 if zoom:
                     ax.axhspan(1 - HAZARD_MARGIN, 1 + HAZARD_MARGIN, color="0.9", zorder=0)
                 ax.axhline(1.0, color="0.5", lw=0.8)
@@ -170,22 +172,23 @@ def hazard_figure(hazard, table, n_shown=SHOWN_N):
                 plain_log_ticks(ax.xaxis)
                 if zoom:
                     ax.set_ylim(*ZOOM_LIMITS)
-                    ax.set_title(f"{rule}, {geo}: N ≥ {ZOOM_MIN_N}, zoomed near 1", fontsize=9,
-                                 pad=9)  # above the edge marks
+                    ax.set_title(f"{rule}, {geo}: N ≥ {ZOOM_MIN_N}, linear y near 1",
+                                 fontsize=9, pad=9)  # above the edge marks
                 else:
                     ax.set_yscale("log")
                     ax.set_ylim(*FULL_LIMITS)
                     plain_log_ticks(ax.yaxis)
-                    ax.set_title(f"{rule}, {geo}", fontsize=9)
+                    ax.set_title(f"{rule}, {geo}: every N, log y", fontsize=9)
+                taken = {}
                 for n in n_shown:  # nothing leaves the axes unmarked
                     d = hazard[(hazard["experiment"] == name) & (hazard["n_disks"] == n)]
                     if not d.empty and not (zoom and n < ZOOM_MIN_N):
-                        _mark_outside(ax, d, colors[n], *ax.get_ylim())
-                if 2 * i + zoom == 2 * len(rules) - 1:
+                        _mark_outside(ax, d, colors[n], *ax.get_ylim(), taken=taken)
+                if row == 2 * len(rules) - 1:
                     ax.set_xlabel("time since the last collision / mean interval")
                 if j == 0:
-                    ax.set_ylabel("hazard / constant rate")
-    handles, labels = axes[2, 0].get_legend_handles_labels()
+                    ax.set_ylabel("hazard / rate" + (" (linear)" if zoom else " (log)"))
+    handles, labels = axes[len(rules) - 1, 0].get_legend_handles_labels()
     handles += [Line2D([], [], color="0.3", marker="^", ls="none", ms=6),
                 Line2D([], [], color="0.3", marker="^", mfc="none", ls="none", ms=6)]
     labels += ["bin beyond the axis (value beside)", "only its 95 % band beyond"]
@@ -213,15 +216,19 @@ def _boltzmann_curve():
 _BOLTZMANN_H = None
 
 
-def _mark_outside(ax, d, color, low, high):
+def _mark_outside(ax, d, color, low, high, taken=None):
     """Mark at the edge of ``ax`` every hazard bin of ``d`` beyond ``(low, high)``: a
     filled triangle pointing out with the bin's value beside it, or, where only the bin's
-    95 % band leaves, an open one. Returns the number of bins marked."""
+    95 % band leaves, an open one. ``taken`` (a dict shared by the calls on one axis)
+    counts the labels already at each bin's edge, so that the next stacks below them; a
+    label near the right edge is set inward. Returns the number of bins marked."""
     lo_t = np.maximum(d["t_low"].to_numpy(float), X_MIN)
     mid = np.sqrt(lo_t * d["t_high"].to_numpy(float))
     h = d["hazard"].to_numpy(float)
     c_lo, c_hi = d["ci_low"].to_numpy(float), d["ci_high"].to_numpy(float)
     marked = 0
+    x0, x1 = (np.log(v) for v in ax.get_xlim())
+    taken = {} if taken is None else taken
     for x, v, a, b in zip(mid, h, c_lo, c_hi, strict=True):
         for up, out, band_out in ((True, v > high, b > high), (False, v < low, a < low)):
             if not band_out:
@@ -231,9 +238,15 @@ def _mark_outside(ax, d, color, low, high):
                     marker="^" if up else "v", ms=6, ls="none", color=color,
                     mfc=color if out else "none", zorder=5)
             if out:
+                # inward near the right edge, stacked where another N marks the same bin
+                right = (np.log(x) - x0) > 0.8 * (x1 - x0)
+                k = taken.get((round(float(x), 9), up), 0)
+                taken[(round(float(x), 9), up)] = k + 1
+                dy = (-3 - 9 * k) if up else (3 + 9 * k)
                 ax.annotate(f"{v:.3g}", (x, edge), xycoords=("data", "axes fraction"),
-                            xytext=(5, -3 if up else 3), textcoords="offset points",
-                            ha="left", va="top" if up else "bottom", fontsize=7, color=color)
+                            xytext=(-6 if right else 5, dy), textcoords="offset points",
+                            ha="right" if right else "left", va="top" if up else "bottom",
+                            fontsize=7, color=color)
             marked += 1
     return marked
 
@@ -242,12 +255,13 @@ def rates_figure(table, nulls=None, boltzmann=None):
     """Against N: the collision frequency over Enskog's (at N = 2 also over the two-disk
     kinetic rate, stars: Enskog is not the reference for two disks), the index of
     dispersion of the tagged disks' counts in K mean intervals (log y), and the hazard of a
-    collision within 0.01 mean intervals of the last over the constant rate (the refractory
-    dip); 95 % CIs, one line per (geometry, rule), panel titles, one legend below the
+    collision within 0.01 mean intervals of the last over the constant rate (the first
+    hazard bin); 95 % CIs, one line per (geometry, rule), panel titles, one legend below the
     panels; the rate's ±10 % band shaded; with ``nulls`` (`versus_null` rows: ``null_d``,
     ``null_hazard_first``) the same statistic on the Poisson null streams of the same runs,
     crosses; with ``boltzmann`` (``{"dispersion": D, "hazard_first": h}``) the elastic
-    linear Boltzmann tagged disk's values, dashed."""
+    linear Boltzmann tagged disk's values, dashed (D) and dash-dotted (h), each named by
+    its quantity in the legend."""
     boltzmann = boltzmann or {}
     import matplotlib.pyplot as plt
 
@@ -255,7 +269,9 @@ def rates_figure(table, nulls=None, boltzmann=None):
                False),
               ("dispersion", "index of dispersion D (log)", "index of dispersion", True),
               ("hazard_first", "hazard in [0, 0.01) mean intervals / rate",
-               "refractory dip: first hazard bin", False))
+               "first hazard bin, [0, 0.01) mean intervals", False))
+    # the Boltzmann level of each panel, named by its quantity, each its own dash
+    level_names = {"dispersion": ("D∞", "--"), "hazard_first": ("h(0.005)", "-.")}
     ns = sorted(set(table["n_disks"]))
     fig, axes = plt.subplots(1, len(panels), figsize=(14, 4.6), squeeze=False)
     for ax, (key, label, title, log) in zip(axes[0], panels, strict=True):
@@ -264,8 +280,9 @@ def rates_figure(table, nulls=None, boltzmann=None):
         ax.axhline(1.0, color="0.5", lw=0.8, zorder=0)
         level = boltzmann.get(key)
         if level is not None:
-            ax.axhline(level, color="0.15", ls="--", lw=1.0, zorder=1,
-                       label=f"linear Boltzmann, elastic: {level:.3g}")
+            what, dash = level_names.get(key, (key, "--"))
+            ax.axhline(level, color="0.15", ls=dash, lw=1.0, zorder=1,
+                       label=f"linear Boltzmann, elastic: {what} = {level:.3g}")
         for k, ((_, geo, rule), d) in enumerate(table.groupby(
                 ["experiment", "geometry", "rule"], sort=False, observed=True)):
             shift = 1.0 + 0.04 * (k - 2.5)

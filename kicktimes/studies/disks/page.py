@@ -30,7 +30,6 @@ from kicktimes.render.provenance import Source
 from kicktimes.stats import (
     D_MARGIN,
     format_interval,
-    null_verdict,
     paired_ratio,
     percentile_interval,
     rejection_verdict,
@@ -79,6 +78,7 @@ from kicktimes.studies.disks.versus_null import (
     MARGINS,
     aic_margin,
     bin_rows,
+    edge_null_verdict,
     versus_null,
 )
 from kicktimes.studies.disks.windows import summarise as windows_summary
@@ -128,10 +128,14 @@ def _rate_line(table, rate_from, robust_from):
     """The fifth answer: the collision rate against Enskog-Henderson."""
     big = table[table["n_disks"] == table["n_disks"].max()]
     worst = big.loc[(big["rate_enskog"] - 1.0).abs().idxmax()]
-    where = (f"within {100 * RATE_MARGIN:g} % from N = {rate_from} on at every geometry and "
-             "rule" if rate_from else f"not within {100 * RATE_MARGIN:g} % from one N on "
-             "everywhere")
-    robust = (f" (under every control from N = {robust_from})" if robust_from
+    n_top = int(table["n_disks"].max())
+
+    def at(n):
+        return (f"at N = {n} (the largest N run)" if n == n_top else f"from N = {n} on")
+
+    where = (f"within {100 * RATE_MARGIN:g} % {at(rate_from)} at every geometry and rule"
+             if rate_from else f"not within {100 * RATE_MARGIN:g} % from one N on everywhere")
+    robust = (f" (under every control {at(robust_from)})" if robust_from
               else " (not under every control)")
     return (f"**Collision rate / Enskog:** {where}{robust}; farthest at N = "
             f"{int(worst['n_disks'])}: {worst['geometry']}, {worst['rule']} "
@@ -169,7 +173,7 @@ def replicate_rows(primary, replicate, *, n_boot=999) -> pd.DataFrame:
                          "replicate_d_high": float(d_high), "null_d": float(null_d[0]),
                          "replicate_diff": float(d[0] - null_d[0]),
                          "replicate_diff_low": float(low), "replicate_diff_high": float(high),
-                         "replicate_verdict": null_verdict(low, high, D_MARGIN)})
+                         "replicate_verdict": edge_null_verdict(low, high, D_MARGIN)})
     return pd.DataFrame(rows)
 
 
@@ -274,8 +278,11 @@ def _checks_lines(out, checks) -> list:
 def _left_out(long, kicked_stores) -> list:
     """The page's "Left out" list, from what was run."""
     out = [
-        "- The elastic gas's speed-rescaled statistics (disks.csv's `rescaled_*`) and the "
-        "shares of D − 1 carried by the speed or the wall: their nulls are not computed.",
+        "- The elastic gas's speed-rescaled statistics (disks.csv's `rescaled_*`; their "
+        "null streams' shares are in null_calibration.csv as `<test>, speed-rescaled`, but "
+        "no difference from the null, margin or verdict is computed for them, so neither the "
+        "page nor its figures read them) and the shares of D − 1 carried by the speed or the "
+        "wall (not computed).",
         "- The renewal models' ranking (AIC on pooled intervals, no standard error)."]
     if kicked_stores:
         out.append("- The kicked comparison (packing 0.02, mirror; disks_kicked.csv).")
@@ -296,6 +303,7 @@ SOURCES = (
            "gamma_verdict, hazard_first_diff, hazard_peak, null_hazard_peak", versus_null),
     Source("disks_poisson.csv", "delta_aic_exponential, aic_margin", aic_margin),
     Source("disks_poisson.csv", "answer, by, others", poisson_answer),
+    Source("disks_poisson.csv", "replicate_changed", answer_table),
     Source("disks_hazard_null.csv", "t_low, t_high, hazard, null_hazard, diff, verdict, "
            "boltzmann, boltzmann_verdict", bin_rows),
     Source("disks.csv", "radius, n_tagged, n_short, rate, rate_enskog, reject_uniformity_ks, "
@@ -431,7 +439,7 @@ def write_disks_page(store_paths, out_dir, *, command="kicktimes reproduce --stu
     # the controls: other stores of the same sweeps, and the primary's bulk tagged disks,
     # each against its own null
     by_control = {"primary": merged(primary)}
-    seed_parts = {}
+    seed_parts, seed_group = {}, []
     for control in ("seed", "k60", "box"):
         group = [st for st in control_stores if disks_control(st.experiment.name)[1] == control
                  and disks_control(st.experiment.name)[0] in {s.experiment.name for s in stores}]
@@ -439,7 +447,7 @@ def write_disks_page(store_paths, out_dir, *, command="kicktimes reproduce --stu
             parts = against(group)
             by_control[control] = merged(parts)
             if control == "seed":
-                seed_parts = parts
+                seed_parts, seed_group = parts, group
     if control_stores:
         by_control["bulk"] = merged(against(stores, within=BULK_WITHIN))
     long = controls_findings(by_control) if len(by_control) > 1 else pd.DataFrame()
@@ -449,7 +457,15 @@ def write_disks_page(store_paths, out_dir, *, command="kicktimes reproduce --stu
                                {k: p[3] for k, p in seed_parts.items()}, n_boot=n_boot)
     renewal = pd.concat([renewal_models(st) for st in stores], ignore_index=True)
     renewal.to_csv(out / "disks_renewal.csv", index=False)
-    answers = answer_table(vn, bins, renewal, replicate)
+    # the replicate's own readings (each against its own null), for the answer's rule
+    seed_vn = (pd.concat([p[1] for p in seed_parts.values()], ignore_index=True)
+               if seed_parts else None)
+    seed_bins = (pd.concat([p[2] for p in seed_parts.values()], ignore_index=True)
+                 if seed_parts else None)
+    seed_renewal = (pd.concat([renewal_models(st) for st in seed_group], ignore_index=True)
+                    if seed_group else None)
+    answers = answer_table(vn, bins, renewal, replicate, seed_vn=seed_vn,
+                           seed_bins=seed_bins, seed_renewal=seed_renewal)
     keys = ["geometry", "rule", "n_disks"]
     poisson = vn.merge(answers.drop(columns=["n_runs", "d_n_needed"]), on=keys)
     if not replicate.empty:
@@ -523,8 +539,9 @@ def write_disks_page(store_paths, out_dir, *, command="kicktimes reproduce --stu
         "against the same null. Every N: [disks_poisson.csv](disks_poisson.csv); nulls: "
         "[null_calibration.csv](null_calibration.csv) and [disks_null.csv](disks_null.csv).",
         "", *_margin_lines(),
-        f"Generated {now} by kicktimes {__version__} (`{command}`) from the stores {names}. "
-        "Every number is computed from the stores; nothing is typed.", "",
+        f"Generated {now} by kicktimes {__version__} (`{command}`) from the {len(every)} "
+        "stores listed under \"Stores\" at the end. Every number is computed from the "
+        "stores; nothing is typed.", "",
         "The tagged disk's collision times among N equal hard disks in the unit circle "
         f"(`kicktimes.simulate_disks`), N = {min(exp0.n_disks)} to {max(exp0.n_disks)}, "
         "mirror and elastic rule, at its first "
@@ -537,7 +554,7 @@ def write_disks_page(store_paths, out_dir, *, command="kicktimes reproduce --stu
         "![rates and dispersion](disks_rate_dispersion_vs_n.png)", "",
         "**Against N**: rate / Enskog (±1.5 % shaded; stars: N = 2 over the two-disk "
         "rate), D (log y), the first hazard bin; 95 % CIs; crosses: the Poisson null of the "
-        "same runs; black dashed: elastic linear Boltzmann (D∞ = 1.14, "
+        "same runs; black: elastic linear Boltzmann (dashed D∞ = 1.14, dash-dotted "
         f"h(0.005) = {levels['hazard_first']:.3g}).", "",
         "![rejection shares](disks_rejection_vs_n.png)", "",
         "**Rejection shares against N** (log y): uniform times (KS, top), exponential "
@@ -546,9 +563,10 @@ def write_disks_page(store_paths, out_dir, *, command="kicktimes reproduce --stu
         "margin).", "",
         "![hazard](disks_hazard_vs_n.png)", "",
         "**The hazard against the time since the last collision** (mean intervals, log x to "
-        "the last bin with data) over the constant rate; bottom rows N ≥ 10 near 1 "
-        f"(±{MARGINS['hazard_first']:g} shaded); 95 % Garwood bands; purple dashed: linear "
-        "Boltzmann h(t).", "",
+        "the last bin with data) over the constant rate; top two rows: every N, log y; "
+        f"bottom two rows: N ≥ 10, linear y near 1 (±{MARGINS['hazard_first']:g} shaded; a "
+        "bin beyond the axis is a triangle at its edge with its value); 95 % Garwood bands; "
+        "purple dashed: linear Boltzmann h(t).", "",
         *_hazard_lines(bins, vn),
         *controls_lines(long), *(_window_growth(out) if not long.empty else [])]
     if with_controls_figure:
@@ -566,7 +584,8 @@ def write_disks_page(store_paths, out_dir, *, command="kicktimes reproduce --stu
                   "([disks_cost.csv](disks_cost.csv)); ")
         cost.to_csv(out / "disks_cost.csv", index=False)
     lines += [f"{sweeps}these tables and figures: {analysis_cpu:.0f} s of CPU.", "",
-              "## Left out", "", *_left_out(long, kicked_stores), ""]
+              "## Left out", "", *_left_out(long, kicked_stores), "",
+              "## Stores", "", f"The {len(every)} stores this page reads: {names}.", ""]
     for stale in ("disks_wall_share.csv",):
         (out / stale).unlink(missing_ok=True)
     return write_results_page(out / "disks.md", lines,

@@ -31,8 +31,13 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from kicktimes.stats import format_interval, null_verdict
-from kicktimes.studies.disks.versus_null import MARGINS, aic_margin
+from kicktimes.stats import format_interval
+from kicktimes.studies.disks.versus_null import (
+    EDGE_VERDICTS,
+    MARGINS,
+    aic_margin,
+    edge_null_verdict,
+)
 
 __all__ = ["ANSWER_RULE", "ANSWER_STATISTICS", "answer_table", "diff_text", "family_table",
            "opening_lines", "poisson_answer", "summary_lines"]
@@ -44,7 +49,9 @@ ANSWER_RULE = (
     "Poisson: every statistic at its null (the 95 % CI of statistic − null inside ± its "
     "margin); not Poisson: at least one departs (its CI entirely beyond its margin), the "
     "others named with their numbers; not resolved: none departs and at least one CI is "
-    "wider than its margin allows")
+    "wider than its margin allows. A verdict that the independent replicate (seed 1042) "
+    "changes is not read as a finding: it counts as inconclusive in the answer (D, KS share, "
+    "gamma shape, every hazard bin and ΔAIC are computed on the replicate too)")
 
 _DEPARTS = ("above its null", "below its null")
 
@@ -77,7 +84,8 @@ def poisson_answer(verdicts) -> tuple[str, list, list]:
     """
     if not verdicts:
         raise ValueError("verdicts: give at least one statistic's verdict")
-    bad = {v for v in verdicts.values()} - {"at its null", "inconclusive", *_DEPARTS}
+    bad = {v for v in verdicts.values()} - {"at its null", "inconclusive", *_DEPARTS,
+                                             *EDGE_VERDICTS}
     if bad:
         raise ValueError(f"verdicts: unknown verdicts {sorted(bad)}")
     departs = [s for s, v in verdicts.items() if v in _DEPARTS]
@@ -132,10 +140,29 @@ def _bins_verdict(bins):
     return "inconclusive", f"{n_at} of {len(bins)} bins at their null, none departs"
 
 
-def answer_table(vn, bins, renewal=None, replicate=None) -> pd.DataFrame:
+def _match(table, r):
+    """The row(s) of ``table`` at ``r``'s geometry, rule and N (empty when none)."""
+    if table is None or table.empty:
+        return pd.DataFrame()
+    return table[(table["geometry"] == r["geometry"]) & (table["rule"] == r["rule"])
+                 & (table["n_disks"] == r["n_disks"])]
+
+
+def _replicated_bins(b, seed_b):
+    """``b`` (hazard bins of one row) with the verdict of every bin whose replicate bin
+    (``seed_b``, the same bin of the seed store against its own null) gives another verdict
+    set to inconclusive."""
+    rep = seed_b.set_index("t_low")["verdict"]
+    same = b["t_low"].map(rep).eq(b["verdict"]).to_numpy()
+    return b.assign(verdict=np.where(same, b["verdict"], "inconclusive"))
+
+
+def answer_table(vn, bins, renewal=None, replicate=None, *, seed_vn=None, seed_bins=None,
+                 seed_renewal=None) -> pd.DataFrame:
     """One row per geometry, rule and N: each statistic of `ANSWER_STATISTICS` against its
     null (``<name>_verdict`` and ``<name>_text``), the answer of `poisson_answer`
-    (``answer``), its statistics (``by``) and the others (``others``).
+    (``answer``), its statistics (``by``), the others (``others``) and the statistics whose
+    verdict the replicate changes (``replicate_changed``).
 
     Parameters
     ----------
@@ -149,48 +176,77 @@ def answer_table(vn, bins, renewal=None, replicate=None) -> pd.DataFrame:
     replicate : DataFrame, optional
         Per geometry, rule and N the replicate's D against the primary's null
         (``replicate_diff``, ``_low``, ``_high``); without it the replicate is not read.
+    seed_vn, seed_bins, seed_renewal : DataFrame, optional
+        The same three tables of the independent replicate (the ``seed`` control), each
+        against its own null. A statistic whose replicate verdict differs (for the hazard,
+        bin by bin) counts as inconclusive in the answer: a verdict that a replicate
+        changes is not read as a finding.
     """
     out = []
     keys = ["geometry", "rule", "n_disks"]
     for _, r in vn.iterrows():
         row = {k: r[k] for k in keys}
-        texts, verdicts = {}, {}
+        texts, verdicts, changed = {}, {}, []
+        sv = _match(seed_vn, r)
         for name, s in (("D", "d"), ("KS share", "ks"), ("gamma shape", "gamma")):
             verdicts[name] = r[f"{s}_verdict"]
             texts[name] = (f"{name} {format_interval(r[s], r[f'{s}_low'], r[f'{s}_high'])}, "
                            f"null {r[f'null_{s}']:.4g}: "
                            + diff_text(r[f"{s}_diff"], r[f"{s}_diff_low"],
                                        r[f"{s}_diff_high"], MARGINS[s]))
-        b = bins[(bins["geometry"] == r["geometry"]) & (bins["rule"] == r["rule"])
-                 & (bins["n_disks"] == r["n_disks"])]
+            if not sv.empty:
+                q = sv.iloc[0]
+                rep = diff_text(q[f"{s}_diff"], q[f"{s}_diff_low"], q[f"{s}_diff_high"])
+                texts[name] += f" (replicate {rep} {_short(q[f'{s}_verdict'])})"
+                if q[f"{s}_verdict"] != verdicts[name]:
+                    changed.append(name)
+        b = _match(bins, r)
         if not b.empty:
             verdicts["hazard bins"], texts["hazard bins"] = _bins_verdict(b)
+            sb = _match(seed_bins, r)
+            if not sb.empty:
+                kept = _replicated_bins(b, sb)
+                v, t = _bins_verdict(kept)
+                if v != verdicts["hazard bins"] or t != texts["hazard bins"]:
+                    n_dep = int(b["verdict"].isin(_DEPARTS).sum())
+                    n_kept = int(kept["verdict"].isin(_DEPARTS).sum())
+                    texts["hazard bins"] += (f"; the replicate keeps {n_kept} of the {n_dep}"
+                                             if n_dep else "; the replicate changes bins")
+                    if v != verdicts["hazard bins"]:
+                        changed.append("hazard bins")
         if renewal is not None and not renewal.empty:
-            g = renewal[(renewal["geometry"] == r["geometry"]) & (renewal["rule"] == r["rule"])
-                        & (renewal["n_disks"] == r["n_disks"])]
+            g = _match(renewal, r)
             if not g.empty:
                 delta, n_iv = float(g.iloc[0]["delta_aic_exponential"]), int(
                     g.iloc[0]["n_intervals"])
                 verdicts["ΔAIC"] = _aic_verdict(delta, n_iv)
                 texts["ΔAIC"] = f"ΔAIC {delta:.3g} (margin {aic_margin(n_iv):.3g})"
                 row["delta_aic_exponential"], row["aic_margin"] = delta, aic_margin(n_iv)
+                sg = _match(seed_renewal, r)
+                if not sg.empty:
+                    d2, n2 = float(sg.iloc[0]["delta_aic_exponential"]), int(
+                        sg.iloc[0]["n_intervals"])
+                    row["replicate_delta_aic"] = d2
+                    texts["ΔAIC"] += f" (replicate {d2:.3g})"
+                    if _aic_verdict(d2, n2) != verdicts["ΔAIC"]:
+                        changed.append("ΔAIC")
         if replicate is not None and not replicate.empty:
-            g = replicate[(replicate["geometry"] == r["geometry"])
-                          & (replicate["rule"] == r["rule"])
-                          & (replicate["n_disks"] == r["n_disks"])]
+            g = _match(replicate, r)
             if not g.empty:
                 q = g.iloc[0]
-                verdicts["replicate D"] = null_verdict(q["replicate_diff_low"],
-                                                       q["replicate_diff_high"], MARGINS["d"])
+                verdicts["replicate D"] = edge_null_verdict(
+                    q["replicate_diff_low"], q["replicate_diff_high"], MARGINS["d"])
                 texts["replicate D"] = (
                     f"replicate D {q['replicate_d']:.4g}, null {r['null_d']:.4g}: "
                     + diff_text(q["replicate_diff"], q["replicate_diff_low"],
                                 q["replicate_diff_high"], MARGINS["d"]))
-        answer, by, others = poisson_answer(verdicts)
+        read = {k: ("inconclusive" if k in changed else v) for k, v in verdicts.items()}
+        answer, by, others = poisson_answer(read)
         for name in ANSWER_STATISTICS:
             if name in verdicts:
                 row[f"{name}_verdict"], row[f"{name}_text"] = verdicts[name], texts[name]
         row.update(answer=answer, by="; ".join(by), others="; ".join(others),
+                   replicate_changed="; ".join(changed),
                    d_n_needed=r.get("d_n_needed", np.nan), n_runs=int(r["n_runs"]))
         out.append(row)
     return pd.DataFrame(out)
@@ -203,7 +259,8 @@ def _largest_n(table):
 
 def _short(verdict):
     return {"at its null": "at null", "above its null": "above", "below its null": "below",
-            "inconclusive": "inconcl."}.get(verdict, verdict)
+            "inconclusive": "inconcl.", EDGE_VERDICTS[0]: "above by ≤ margin",
+            EDGE_VERDICTS[1]: "below by ≤ margin"}.get(verdict, verdict)
 
 
 def _replicate_cell(a):
@@ -218,12 +275,16 @@ def _answer_cell(a):
     while the answer is "not Poisson")."""
     by = [x for x in str(a["by"]).split("; ") if x]
     others = [x for x in str(a["others"]).split("; ") if x]
+    changed = [x for x in str(a.get("replicate_changed", "") or "").split("; ") if x]
+    moved = f"; changed by the replicate: {', '.join(changed)}" if changed else ""
     if a["answer"] == "not Poisson":
-        against = [x for x in others if a.get(f"{x}_verdict") == "at its null"]
-        return (f"**not Poisson** (by {len(by)} of {len(by) + len(others)}; "
-                + (f"at its null: {', '.join(against)})" if against else "none at its null)"))
+        against = [x for x in others if a.get(f"{x}_verdict") == "at its null"
+                   and x not in changed]
+        return (f"**not Poisson** (by {', '.join(by)}, {len(by)} of {len(by) + len(others)}; "
+                + (f"at its null: {', '.join(against)}" if against else "none at its null")
+                + f"{moved})")
     if a["answer"] == "not resolved":
-        return f"**not resolved** (none departs; {len(by)} inconclusive)"
+        return f"**not resolved** (none departs; {len(by)} not at their null{moved})"
     return f"**{a['answer']}**"
 
 
@@ -299,11 +360,17 @@ def opening_lines(answers, vn, boltz_d, rate_line) -> list:
     verdicts = big[cols].to_numpy().ravel()
     verdicts = verdicts[pd.notna(verdicts)]
     n_inc = int((verdicts == "inconclusive").sum())
+    n_edge = int(np.isin(verdicts, EDGE_VERDICTS).sum())
+    changed = [(f"{a['geometry']}, {a['rule']}", x) for _, a in big.iterrows()
+               for x in str(a.get("replicate_changed", "") or "").split("; ") if x]
+    moved = (f"; {len(changed)} changed by the replicate and so not read ("
+             + ", ".join(f"{x} at {f}" for f, x in changed) + ")" if changed else "")
     lines.append(
         f"1. **Poisson at N = {n_max}?** not Poisson at {int(counts.get('not Poisson', 0))} "
         f"of {len(big)} geometry × rule, not resolved at "
         f"{int(counts.get('not resolved', 0))}, Poisson at {int(counts.get('Poisson', 0))}"
-        f"{ex_text}. Caveat: {n_inc} of {verdicts.size} single verdicts are inconclusive.")
+        f"{ex_text}. Caveat: of {verdicts.size} single verdicts {n_inc} are inconclusive, "
+        f"{n_edge} beyond their null by about the margin or less{moved}.")
     froms = {}
     for (g, r), d in vn.groupby(["geometry", "rule"], sort=False):
         d = d.sort_values("n_disks")

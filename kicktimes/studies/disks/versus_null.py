@@ -60,9 +60,36 @@ from kicktimes.stats.poisson import uniformity_ks
 from kicktimes.studies.disks.null import null_streams
 from kicktimes.studies.disks.tables import HAZARD_EDGES, _Sequences, peak_bin
 
-__all__ = ["GAMMA_MARGIN", "HAZARD_MARGIN", "KS_MARGIN", "MARGINS", "STATISTICS",
-           "aic_margin", "bin_rows", "boltzmann_bin_hazard", "gamma_shape_mle",
-           "versus_null"]
+__all__ = ["EDGE_VERDICTS", "GAMMA_MARGIN", "HAZARD_MARGIN", "KS_MARGIN", "MARGINS",
+           "STATISTICS", "aic_margin", "bin_rows", "boltzmann_bin_hazard", "edge_null_verdict",
+           "gamma_shape_mle", "versus_null"]
+
+#: the verdicts of a CI that straddles a margin edge but excludes 0 (`edge_null_verdict`)
+EDGE_VERDICTS = ("above its null by about the margin or less",
+                 "below its null by about the margin or less")
+
+
+def edge_null_verdict(low, high, margin):
+    """`kicktimes.stats.null_verdict` of the CI of statistic - null, with the pages' general
+    rule for a CI that straddles a margin edge: when it excludes 0 the verdict says on which
+    side (`EDGE_VERDICTS`); ``"inconclusive"`` is kept for a CI that contains 0, the only
+    case where a sample size is named.
+
+    Examples
+    --------
+    >>> edge_null_verdict(0.018, 0.157, 0.07)
+    'above its null by about the margin or less'
+    >>> edge_null_verdict(-0.014, 0.140, 0.07), edge_null_verdict(0.108, 0.239, 0.07)
+    ('inconclusive', 'above its null')
+    """
+    verdict = null_verdict(low, high, margin)
+    if verdict != "inconclusive" or not (np.isfinite(low) and np.isfinite(high)):
+        return verdict
+    if low > 0:
+        return EDGE_VERDICTS[0]
+    if high < 0:
+        return EDGE_VERDICTS[1]
+    return verdict
 
 #: the KS share's margin: half the elastic linear Boltzmann tagged disk's excess over a
 #: Poisson stream at K = 30 (`dilute_tagged_disk("elastic").ks_share(30)`: 0.070 against
@@ -246,7 +273,7 @@ def versus_null(store, *, within=None, n_boot=999, alpha=0.05, seed=42, edges=HA
         Per N (``geometry, rule, n_disks, n_runs``) each statistic of `STATISTICS`
         (``<s>``, ``<s>_low``, ``<s>_high``), its null's (``null_<s>`` ...), their
         difference (``<s>_diff`` ...), its verdict (``<s>_verdict``,
-        `kicktimes.stats.null_verdict` with `MARGINS`) and, for an inconclusive one, the
+        `edge_null_verdict` with `MARGINS`) and, for an inconclusive one, the
         runs that would resolve its margin (``<s>_n_needed``); ``hazard_peak_t``, its
         null's and ``n_intervals``. And per N and hazard bin (`bin_rows`'s columns).
         And the bootstrap replicates of D and of its null, ``{n: (gas, null)}`` (row 0 the
@@ -312,7 +339,7 @@ def versus_null(store, *, within=None, n_boot=999, alpha=0.05, seed=42, edges=HA
                     row[f"{who}{s}_high"] = max(row[f"{who}{s}_high"],
                                                 row[f"{who}{s}"] + _Z * se1)
             row[f"{s}_diff"], row[f"{s}_diff_low"], row[f"{s}_diff_high"] = est, lo, hi
-            verdict = null_verdict(lo, hi, margin)
+            verdict = edge_null_verdict(lo, hi, margin)
             row[f"{s}_verdict"] = verdict
             se_boot = float(np.nanstd((a - b)[1:]))
             row[f"{s}_n_needed"] = (equivalence_sample_size(se_boot, int(runs.size), margin)
@@ -328,7 +355,7 @@ def bin_rows(exp, n, edges, gas_sums, null_sums, gas_haz, null_haz) -> pd.DataFr
     """Per hazard bin with events in both streams: ``t_low, t_high, events, hazard`` (over
     the constant rate, the wider of the clustered bootstrap and the independent-intervals
     interval), ``null_hazard``, ``diff`` (gas - null, paired) and its interval and
-    ``verdict`` (`null_verdict`, `HAZARD_MARGIN`), ``boltzmann`` (`boltzmann_bin_hazard`)
+    ``verdict`` (`edge_null_verdict`, `HAZARD_MARGIN`), ``boltzmann`` (`boltzmann_bin_hazard`)
     and the gas's ``boltzmann_verdict`` (gas - Boltzmann: the gas's interval, the
     prediction exact)."""
     e = np.asarray(edges, float)
@@ -351,8 +378,8 @@ def bin_rows(exp, n, edges, gas_sums, null_sums, gas_haz, null_haz) -> pd.DataFr
                      "hazard": h, "hazard_low": lo, "hazard_high": hi,
                      "null_hazard": hn, "null_hazard_low": nlo, "null_hazard_high": nhi,
                      "diff": est, "diff_low": dlo, "diff_high": dhi,
-                     "verdict": null_verdict(dlo, dhi, HAZARD_MARGIN),
+                     "verdict": edge_null_verdict(dlo, dhi, HAZARD_MARGIN),
                      "boltzmann": float(boltz[b]),
-                     "boltzmann_verdict": null_verdict(lo - boltz[b], hi - boltz[b],
-                                                       HAZARD_MARGIN)})
+                     "boltzmann_verdict": edge_null_verdict(lo - boltz[b], hi - boltz[b],
+                                                            HAZARD_MARGIN)})
     return pd.DataFrame(rows)
