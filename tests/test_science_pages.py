@@ -12,6 +12,7 @@ import pytest
 from conftest import MACHINE_PATH, table_cells
 
 from kicktimes.stats import format_interval, ratio_verdict
+from kicktimes.studies.science.readings import null_reading, ratio_reading
 
 RESULTS = Path(__file__).resolve().parents[1] / "docs" / "results"
 PAGES = ["README.md", "science.md", "mechanism.md", "escape.md", "unequal.md", "scatter.md"]
@@ -43,12 +44,13 @@ def test_the_science_page_s_ratio_per_radius_is_its_csv_with_its_verdict():
         cells = table_cells(text, f"{r:g}")
         for k, system in enumerate(("poisson", "poisson_scatter")):
             row = g[g["system"] == system].iloc[0]
+            said = ratio_reading(row.ratio_ci_low, row.ratio_ci_high)
             want = (f"{format_interval(row.ratio, row.ratio_ci_low, row.ratio_ci_high)}, "
-                    f"{row.verdict}")
-            # an inconclusive ratio names the size that would resolve it
+                    f"{said}")
+            # an inconclusive ratio whose CI contains 1 names the size that would resolve
+            # it; one whose CI excludes 1 is a departure and names none
             assert cells[1 + k].split(" (not resolved")[0] == want
-            assert ("(not resolved at this size" in cells[1 + k]) == (
-                row.verdict == "inconclusive")
+            assert ("(not resolved at this size" in cells[1 + k]) == (said == "inconclusive")
 
 
 def test_the_science_page_extrapolates_nothing_and_quotes_predictions_with_measurements():
@@ -207,7 +209,7 @@ def test_the_mechanism_page_reads_no_share_as_a_bound_or_an_overshoot_inside_noi
 
 
 def test_the_mechanism_page_reads_the_rate_dispersion_across_ics_against_its_null():
-    from kicktimes.stats import D_MARGIN, null_verdict
+    from kicktimes.stats import D_MARGIN
 
     text = _page("mechanism.md")
     assert "dispersion index" not in text and "index of dispersion" not in text
@@ -221,7 +223,7 @@ def test_the_mechanism_page_reads_the_rate_dispersion_across_ics_against_its_nul
             g = tab[(tab["method"] == method) & (tab["radius"] == r)].set_index("quantity")
             diff, null = g.loc["rate_dispersion_minus_null"], g.loc[
                 "rate_dispersion_poisson_null"]
-            verdict = null_verdict(diff["ci_low"], diff["ci_high"], D_MARGIN)
+            verdict = null_reading(diff["ci_low"], diff["ci_high"], D_MARGIN)
             assert f"vs {null['estimate']:.3f}: {verdict}" in cells[1 + k]
 
 
@@ -259,3 +261,26 @@ def test_the_unequal_page_names_the_ftle_and_gives_ks_and_dispersion_intervals()
         assert re.fullmatch(r"[\d.]+ % \[[\d.]+, [\d.]+\]", cells[2])
         assert cells[3] == format_interval(row.dispersion_index, row.disp_low, row.disp_high,
                                            edges=(1.0,))
+
+
+def test_the_science_page_pairs_each_closest_kick_law_with_its_own_verdict():
+    text = _page("science.md")
+    table = pd.read_csv(RESULTS / "science_closest.csv")
+    for (family, diag), g in table.groupby(["family", "diagnostic"], sort=False):
+        best = g[g["closest"]]
+        if len(best) == len(g):
+            continue
+        cell = next(c[2] for c in ([x.strip() for x in line.strip().strip("|").split("|")]
+                                   for line in text.splitlines())
+                    if c[:2] == [f"`{family}`", diag])
+        for row in best.itertuples():
+            assert (f"{row.system} {format_interval(row.ratio, row.ci_low, row.ci_high)}, "
+                    f"{ratio_reading(row.ci_low, row.ci_high)}") in cell.split("; ")
+
+
+def test_no_science_or_mechanism_cell_asks_for_ics_where_its_interval_excludes_the_null():
+    for name in ("science.md", "mechanism.md"):
+        for line in _page(name).splitlines():
+            if "needs ≈" in line and "by less than or about" in line:
+                for cell in line.split(" | "):
+                    assert not ("needs ≈" in cell and "by less than or about" in cell), cell

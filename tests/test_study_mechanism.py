@@ -10,6 +10,7 @@ from conftest import assert_provenance, built_study, refuse_simulations, table_c
 
 from kicktimes.stats import D_MARGIN, format_interval, null_verdict, ratio_verdict
 from kicktimes.studies.mechanism import analysis, page, run
+from kicktimes.studies.science.readings import ratio_reading
 
 TINY = run.MechanismScale(10, 1000.0, 1, n_boot=20)
 
@@ -45,7 +46,7 @@ def test_the_page_names_the_command_and_reads_its_table(built):
         if pd.notna(row["estimate"]):
             assert cells[1 + k].startswith(format_interval(
                 row["estimate"], row["ci_low"], row["ci_high"], edges=(0.9, 1.0, 1.1)))
-            verdict = ratio_verdict(row["ci_low"], row["ci_high"])
+            verdict = ratio_reading(row["ci_low"], row["ci_high"])
             assert cells[1 + k].split(" (")[0].endswith(verdict)
             assert ("not resolved at this size" in cells[1 + k]) == (verdict == "inconclusive")
     for name in run.FIGURES:
@@ -88,7 +89,7 @@ def test_the_whole_early_hazard_is_read_not_its_first_bin_alone(built):
         at = bins["estimate"].to_numpy().argmin()
         assert low["estimate"] == pytest.approx(bins["estimate"].min())
         assert low["note"] == bins["note"].iloc[at]
-        assert low_cells[1 + k].endswith(f"({low['note']})")
+        assert low_cells[1 + k].endswith(f"({low['note']} time units)")
         # read against the Poisson null of its own bin, not against 1
         a, b = low["note"].removeprefix("bin [").rstrip(")").split(", ")
         null = g[g["quantity"] == f"hazard_nonsticky_bin_{a}_{b}_poisson_null"].iloc[0]
@@ -148,8 +149,9 @@ def test_the_page_opens_with_at_most_five_one_line_answers_before_its_first_tabl
     assert 1 <= len(answers) <= page.FIRST_SCREEN_MAX
     assert not [x for x in answers if "caveat" not in x]
     # one number with its interval each, unless no group has an excess to share out
+    # (or the size that would resolve a share inside its own noise)
     assert not [x for x in answers if "[" not in x and "no group with an excess" not in x
-                and "no interval ends there" not in x]
+                and "no interval ends there" not in x and "needs ≈" not in x]
     assert not any(x.startswith("Verdicts of") for x in lines[:first])
 
 
@@ -261,3 +263,37 @@ def test_an_inconclusive_ratio_names_the_size_that_would_resolve_it():
     assert n2 == pytest.approx(4 * n1, rel=0.02)
     with pytest.raises(ValueError, match="n must be"):
         page.needed_ics(1.0, 0.9, 1.1, 0)
+
+
+def test_a_hazard_whose_interval_excludes_its_null_is_a_departure_not_a_sample_size():
+    # the elastic Γ-rescaled hazard in [1, 5): 1.10 [1.06, 1.15] lies wholly above 1
+    row = pd.Series({"estimate": 1.10, "ci_low": 1.06, "ci_high": 1.15})
+    assert page._ratio_cell(row, 200) == (
+        "1.10 [1.06, 1.15], above 1 by less than or about the 10 % margin")
+    assert "needs ≈" in page._ratio_cell(
+        pd.Series({"estimate": 1.0, "ci_low": 0.85, "ci_high": 1.15}), 200)
+
+
+def test_an_explained_share_inside_its_own_noise_is_not_stated():
+    assert page.share_cell({"estimate": 0.41, "ci_low": 0.336, "ci_high": 0.498}, 200) == (
+        "0.410 [0.336, 0.498]")
+    wide = page.share_cell({"estimate": 1.69, "ci_low": 0.875, "ci_high": 12.4}, 200)
+    assert wide.startswith("not resolved at this size; needs ≈") and "1.69" not in wide
+    assert int(wide.split("≈ ")[1].split()[0]) > 200
+    assert page.share_cell({"estimate": 1.35, "ci_low": 0.802, "ci_high": 3.74},
+                           200).startswith("not resolved")
+
+
+def test_the_csv_names_the_first_hazard_bin_by_its_unit():
+    tab = pd.DataFrame({"quantity": ["hazard_first_bin_over_rate", "rescaled_hazard_first_bin"],
+                        "note": ["first bin [0, 0.5)", "first bin [0, 0.01) of Gamma t"]})
+    assert run.public_names(tab)["note"].tolist() == [
+        "hazard in [0, 0.5) time units after a collision",
+        "hazard in [0, 0.01) of Γ-rescaled time"]
+
+
+def test_the_battery_puts_both_rules_on_one_y_range():
+    from kicktimes.studies.mechanism import figures
+
+    assert figures.BATTERY_SHARE_YLIM == (0.0, 0.65)
+    assert figures.BATTERY_DISPERSION_YLIM[0] < 1 < figures.BATTERY_DISPERSION_YLIM[1]

@@ -15,6 +15,7 @@ from kicktimes.stats import equivalence_sample_size, format_interval, ratio_verd
 from kicktimes.studies.science import page as science_page
 from kicktimes.studies.science import run
 from kicktimes.studies.science.page import SOURCES
+from kicktimes.studies.science.readings import null_reading, ratio_reading, side_of
 
 TINY = run.ScienceScale("stretching_tiny", (0.03, 0.05), 4, 1000, (0.03,), 1, 10, (0.03,), 2,
                         300.0)
@@ -146,6 +147,8 @@ def test_every_inconclusive_ratio_of_the_page_names_the_size_that_would_resolve_
     text = page.read_text(encoding="utf-8")
     table = pd.read_csv(page.parent / "science_stretching.csv")
     for row in table[table["verdict"] == "inconclusive"].itertuples():
+        if side_of(row.ratio_ci_low, row.ratio_ci_high):
+            continue                  # a departure from 1: it names no size
         cell = (f"{format_interval(row.ratio, row.ratio_ci_low, row.ratio_ci_high)}, "
                 "inconclusive (not resolved at this size")
         assert cell in text
@@ -173,3 +176,57 @@ def test_the_first_screen_refuses_a_sixth_answer(built, monkeypatch):
     monkeypatch.setattr(science_page, "FIRST_SCREEN_MAX", 1)
     with pytest.raises(ValueError, match="at most 1"):
         science_page.first_screen(*args, n_ics=1, n_dec=2)
+
+
+def test_the_closest_table_pairs_each_law_with_its_own_verdict():
+    # the two closest laws have different verdicts, in the order the referee found
+    # reversed: each name must be followed by its own
+    closest = pd.DataFrame({
+        "family": ["family_a"] * 3, "diagnostic": ["ftle"] * 3,
+        "system": ["poisson_scatter", "actual_scatter", "poisson"],
+        "ratio": [0.966, 0.922, 0.4], "ci_low": [0.932, 0.897, 0.38],
+        "ci_high": [1.02, 0.962, 0.42],
+        "verdict": ["within 10 %", "inconclusive", "lower"],
+        "closest": [True, True, False]})
+    (row,) = science_page.closest_cells(closest)
+    laws = row.split(" | ")[2].split("; ")
+    assert laws == ["poisson_scatter 0.966 [0.932, 1.02], within 10 %",
+                    "actual_scatter 0.922 [0.897, 0.962], below 1 by less than or about the "
+                    "10 % margin"]
+    assert row.endswith("| poisson |")
+    bad = closest.assign(verdict=["inconclusive", "within 10 %", "lower"])
+    with pytest.raises(ValueError, match="poisson_scatter"):
+        science_page.closest_cells(bad)
+
+
+def test_an_interval_that_excludes_1_is_a_departure_and_names_no_sample_size():
+    # point 4: a CI wholly above (below) 1 that straddles the band edge
+    assert ratio_reading(1.06, 1.15) == "above 1 by less than or about the 10 % margin"
+    assert ratio_reading(0.815, 0.942) == "below 1 by less than or about the 10 % margin"
+    assert ratio_reading(0.913, 1.15) == "inconclusive"
+    assert ratio_reading(0.95, 1.04) == "within 10 %" and ratio_reading(1.2, 1.3) == "higher"
+    assert null_reading(0.01, 0.09, 0.05) == "above its null by less than or about the margin 0.05"
+    assert null_reading(-0.01, 0.09, 0.05) == "inconclusive"
+    assert side_of(float("nan"), 1.2) is None
+    with pytest.raises(ValueError, match="low"):
+        side_of(1.2, 1.1)
+    cell = science_page._ratio_cell(1.10, 1.06, 1.15, 200)
+    assert cell == "1.10 [1.06, 1.15], above 1 by less than or about the 10 % margin"
+    assert "needs ≈" in science_page._ratio_cell(0.998, 0.913, 1.15, 100)
+
+
+def test_the_decorrelation_answer_says_the_model_overpredicts_and_picks_the_closest_row():
+    compare = pd.DataFrame({
+        "rule": ["mirror"] * 2 + ["elastic"] * 2, "radius": [0.008, 0.02] * 2,
+        "system": ["poisson", "poisson_scatter"] * 2,
+        "measured_over_predicted": [0.876, 0.819, 0.467, 0.535],
+        "quotient_ci_low": [0.815, 0.705, 0.421, 0.482],
+        "quotient_ci_high": [0.942, 0.951, 0.519, 0.594]})
+    line = science_page._decorrelation_answer(compare, 40)
+    assert "the model overpredicts in 4 of 4 rows (interval below 1)" in line
+    assert "below 1 by less than or about the 10 % margin in 2 (mirror 2)" in line
+    assert "lower in 2 (elastic 2)" in line and "not resolved" not in line
+    assert "closest to 1: 0.876 [0.815, 0.942]" in line and "(mirror, r = 0.008" in line
+    mixed = compare.assign(quotient_ci_high=[1.05, 0.951, 0.519, 0.594])
+    assert "1 of 4 rows not resolved at this size" in science_page._decorrelation_answer(
+        mixed, 40)

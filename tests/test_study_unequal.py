@@ -11,7 +11,8 @@ from conftest import (
 )
 
 import kicktimes.studies.unequal as study
-from kicktimes.stats import format_interval, ratio_verdict
+from kicktimes.stats import format_interval
+from kicktimes.studies.science.readings import null_reading, ratio_reading
 
 TINY = study.Params(n_ics=10, n_steps=1000)
 
@@ -28,7 +29,7 @@ def test_the_page_names_its_command_and_its_numbers_are_its_csv(built):
         cells = table_cells(text, f"{row.size_ratio:g}")
         lo, hi = row.ftle_partner_low_disk0, row.ftle_partner_high_disk0
         assert cells[4] == (f"{format_interval(row.ftle_partner_ratio_disk0, lo, hi)}, "
-                            f"{ratio_verdict(lo, hi)}")
+                            f"{ratio_reading(lo, hi)}")
         assert cells[3] == format_interval(row.dispersion_index, row.disp_low, row.disp_high,
                                            edges=(1.0,))
     assert (page.parent / "size_ratio" / "size_ratio.png").stat().st_size > 0
@@ -66,7 +67,7 @@ def test_the_figure_draws_ks_share_and_dispersion_on_their_own_axes():
     # four panels, no twin axes: two y scales on one panel misled
     assert len(fig.axes) == 4
     ks, disp = fig.axes[1], fig.axes[2]
-    assert "KS" in ks.get_title() and "dispersion" in disp.get_title()
+    assert "KS" in ks.get_title() and "rate dispersion across ICs" in disp.get_title()
     # every interval inside its axes
     assert ks.get_ylim()[1] > table["ks_reject_share"].max()
     assert disp.get_ylim()[1] > table["disp_high"].max()
@@ -99,7 +100,17 @@ def test_d_is_read_against_its_null_and_the_ks_share_against_its_exact_alpha(bui
         assert row.d_null_low <= row.d_null <= row.d_null_high
         assert row.ks_verdict == rejection_verdict(row.ks_low, row.ks_high, 0.05)
         cells = table_cells(page.read_text(encoding="utf-8"), f"{row.size_ratio:g}")
-        assert cells[-1].endswith(row.d_verdict)
+        # the page's reading: the CSV's verdict, or a departure where the CI excludes 0
+        said = null_reading(row.d_minus_null_low, row.d_minus_null_high, D_MARGIN)
+        assert said == row.d_verdict or (row.d_verdict == "inconclusive"
+                                         and "by less than or about" in said)
+        assert cells[-1].endswith(said)
+
+
+def test_the_page_names_its_dispersion_across_ics_not_d(built):
+    text = built[1].read_text(encoding="utf-8")
+    assert "rate dispersion across ICs" in text
+    assert "D − null" not in text and "Dispersion index D" not in text
 
 
 def test_the_null_dispersion_of_poisson_counts_is_one_in_equal_windows_and_more_in_unequal():

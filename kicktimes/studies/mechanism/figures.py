@@ -21,7 +21,8 @@ import pandas as pd  # noqa: E402
 from kicktimes import stats  # noqa: E402
 from kicktimes.studies.mechanism.twins import dispersion  # noqa: E402
 
-__all__ = ["NORMALISED_YLIM", "fig_battery", "fig_hazard", "fig_hazard_normalised",
+__all__ = ["BATTERY_DISPERSION_YLIM", "BATTERY_SHARE_YLIM", "NORMALISED_YLIM", "fig_battery",
+           "fig_hazard", "fig_hazard_normalised",
            "fig_impact", "fig_rate_prediction", "fig_recollisions", "fig_state_rates",
            "fig_survival", "write_figures"]
 
@@ -57,6 +58,11 @@ def _panels(results, fn, title, *, sharey=False, sharex=False, figsize=(10, 7.5)
 
 #: one y-range for the rescaled hazard under every rule (mirror and elastic figures alike)
 NORMALISED_YLIM = (1e-3, 10.0)
+#: the battery's y ranges under every rule (so that the mirror and elastic figures read
+#: alike): rejection shares, and the rate dispersion across ICs (log); a value beyond one
+#: widens it rather than being cut off
+BATTERY_SHARE_YLIM = (0.0, 0.65)
+BATTERY_DISPERSION_YLIM = (0.5, 100.0)
 
 
 def _hazard_steps(ax, haz, *, scale=1.0, label, color, hollow=False, zorder=2):
@@ -211,8 +217,11 @@ def fig_battery(results):
             ax.bar(x, mean, width, yerr=err, capsize=2, label=label)
     for ax, (what, ylabel) in zip(axes, panels, strict=True):
         ax.axhline(1.0 if what == "dispersion_index" else 0.05, color="grey", ls="--", lw=1)
+        lo, hi = BATTERY_DISPERSION_YLIM if what == "dispersion_index" else BATTERY_SHARE_YLIM
         if what == "dispersion_index":
             ax.set_yscale("log")       # the twins reach tens, the observed lie at a few
+        drawn = ax.get_ylim()
+        ax.set_ylim(min(lo, drawn[0]), max(hi, drawn[1]))
         ax.set_xticks(np.arange(len(names)), [TWIN_LABELS[n] for n in names], fontsize=7)
         ax.set_ylabel(ylabel, fontsize=9)
     axes[0].legend(fontsize=7)

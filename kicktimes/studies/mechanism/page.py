@@ -38,9 +38,10 @@ from kicktimes.studies.mechanism.analysis import (
     hazard_profile_rows,
     poisson_null_rows,
 )
+from kicktimes.studies.science.readings import null_reading, ratio_reading
 
-__all__ = ["FIRST_SCREEN_MAX", "first_screen", "load", "needed_ics", "rule_section",
-           "sources", "write_page"]
+__all__ = ["FIRST_SCREEN_MAX", "SHARE_HALF_WIDTH", "first_screen", "load", "needed_ics",
+           "rule_section", "share_cell", "sources", "write_page"]
 
 GROUPS = (("paper", 0.01), ("paper", 0.02), ("uniform", 0.01), ("uniform", 0.02))
 LABEL = {"paper": "paper ICs", "uniform": "invariant ICs"}
@@ -53,6 +54,12 @@ MODELS = (("cox_sequence", "in sample"), ("cox_markov_oos", "out of sample"))
 FIRST_SCREEN_MAX = 5
 #: the name the page gives the var / mean of whole-run counts over ICs (not D in windows)
 DISPERSION_NAME = "rate dispersion across ICs"
+#: an explained share is stated only where its 95 % interval is at most twice this wide:
+#: it then tells none of the excess from all of it (a share of 0 from one of 1)
+SHARE_HALF_WIDTH = 0.5
+#: the early hazard's first bin, named as such wherever it appears (not the README's
+#: first bin in mean intervals, nor disks.md's)
+FIRST_BIN = "hazard in [0, 0.5) time units after a collision"
 Z95 = 1.959963984540054
 
 
@@ -121,7 +128,7 @@ def _ratio_cell(row, n):
     inconclusive one with the size that would resolve it."""
     if not math.isfinite(row["estimate"]):
         return "no interval ends there"
-    verdict = ratio_verdict(row["ci_low"], row["ci_high"], MARGIN)
+    verdict = ratio_reading(row["ci_low"], row["ci_high"], MARGIN)
     cell = f"{_iv(row, (0.9, 1.0, 1.1))}, {verdict}"
     if verdict == "inconclusive":
         cell += f" ({needed_ics(row['estimate'], row['ci_low'], row['ci_high'], n)})"
@@ -133,7 +140,7 @@ def _hazard_null_cell(tab, m, r, stat, diff_name, n):
     difference; an inconclusive one with the size that would resolve it."""
     row, diff = _get(tab, m, r, stat), _get(tab, m, r, diff_name)
     null = row["estimate"] - diff["estimate"]
-    verdict = null_verdict(diff["ci_low"], diff["ci_high"], HAZARD_NULL_MARGIN)
+    verdict = null_reading(diff["ci_low"], diff["ci_high"], HAZARD_NULL_MARGIN)
     cell = f"{_iv(row, (0.9, 1.0, 1.1))} vs {null:.3f}: {verdict}"
     if verdict == "inconclusive":
         need = needed_ics(diff["estimate"], diff["ci_low"], diff["ci_high"], n,
@@ -150,9 +157,12 @@ def _above_chance(share, chance):
     return "not distinguished from chance (intervals overlap)"
 
 
-def _dispersion_verdict(tab, m, r):
+def _dispersion_verdict(tab, m, r, *, strict=True):
+    """`null_verdict` of the rate dispersion across ICs minus its null (``strict``), or
+    its `null_reading` (an inconclusive interval that excludes 0 read as a departure)."""
     row = _get(tab, m, r, "rate_dispersion_minus_null")
-    return null_verdict(row["ci_low"], row["ci_high"], RATE_DISPERSION_MARGIN)
+    read = null_verdict if strict else null_reading
+    return read(row["ci_low"], row["ci_high"], RATE_DISPERSION_MARGIN)
 
 
 def _excess(tab, m, r, test):
@@ -164,10 +174,32 @@ def _excess(tab, m, r, test):
     return bool(_get(tab, m, r, f"observed_reject_{test}")["ci_low"] > 0.05)
 
 
-def _share_iv(tab, m, r, test, model):
+def share_cell(row, n):
+    """An explained share with its interval where that interval is at most
+    2 :data:`SHARE_HALF_WIDTH` wide; else ``"not resolved at this size; needs ≈ N ICs"``
+    (the share is not stated: a gap inside its own noise is not decomposed), N from
+    `kicktimes.stats.equivalence_sample_size` at the interval's standard error with
+    margin :data:`SHARE_HALF_WIDTH`.
+
+    >>> share_cell({"estimate": 0.41, "ci_low": 0.336, "ci_high": 0.498}, 200)
+    '0.410 [0.336, 0.498]'
+    >>> share_cell({"estimate": 1.69, "ci_low": 0.875, "ci_high": 12.4}, 200)
+    'not resolved at this size; needs ≈ 72663 ICs'
+    """
+    if not (math.isfinite(row["ci_low"]) and math.isfinite(row["ci_high"])):
+        return "not resolved at this size (no interval)"
+    width = row["ci_high"] - row["ci_low"]
+    if width <= 2 * SHARE_HALF_WIDTH:
+        return _iv(row, (1.0,))
+    se = width / (2 * Z95)
+    return (f"not resolved at this size; needs ≈ "
+            f"{equivalence_sample_size(se, n, SHARE_HALF_WIDTH)} ICs")
+
+
+def _share_iv(tab, m, r, test, model, n):
     if not _excess(tab, m, r, test):
         return "no excess"
-    return _iv(_get(tab, m, r, f"explained_{test}_by_{model}"), (1.0,))
+    return share_cell(_get(tab, m, r, f"explained_{test}_by_{model}"), n)
 
 
 def rule_section(tab, figures):
@@ -191,7 +223,8 @@ def rule_section(tab, figures):
         obs, null = g(m, r, "observed_rate_dispersion_across_ics_nonsticky"), g(
             m, r, "rate_dispersion_poisson_null")
         diff = g(m, r, "rate_dispersion_minus_null")
-        return (f"{_iv(obs)} vs {null['estimate']:.3f}: {_dispersion_verdict(tab, m, r)} "
+        return (f"{_iv(obs)} vs {null['estimate']:.3f}: "
+                f"{_dispersion_verdict(tab, m, r, strict=False)} "
                 f"(difference {_iv(diff, (0.0,))})")
 
     lines = [f"## The {rule} rule", "",
@@ -201,13 +234,13 @@ def rule_section(tab, figures):
              + ".", "",
              "| | " + " | ".join(f"{LABEL[m]}, r = {r:g}" for m, r in groups) + " |",
              "|---|" + "---|" * len(groups),
-             line("hazard in [0, 0.5) / rate vs its Poisson null", lambda m, r:
+             line(f"{FIRST_BIN} / rate vs its Poisson null", lambda m, r:
                   _hazard_null_cell(tab, m, r, "hazard_nonsticky_first_bin_over_rate",
                                     "hazard_first_bin_minus_null", n)),
              line("hazard minimum over t < 4 / rate vs its Poisson null", lambda m, r:
                   _hazard_null_cell(tab, m, r, "hazard_nonsticky_min_over_rate",
                                     "hazard_min_minus_null", n)
-                  + f" ({g(m, r, 'hazard_nonsticky_min_over_rate')['note']})"),
+                  + f" ({g(m, r, 'hazard_nonsticky_min_over_rate')['note']} time units)"),
              line("Γ-rescaled hazard, t in [1, 5)", lambda m, r: _ratio_cell(
                  g(m, r, "rescaled_hazard_1_5"), n)),
              line("Γ-rescaled hazard, t > 5", lambda m, r: _ratio_cell(
@@ -217,7 +250,7 @@ def rule_section(tab, figures):
     for test, label in TESTS:
         lines.append(line(f"explained share of the excess {label}, in / out of sample",
                           lambda m, r, test=test: " / ".join(
-                              _share_iv(tab, m, r, test, model) for model, _ in MODELS)))
+                              _share_iv(tab, m, r, test, model, n) for model, _ in MODELS)))
     lines += ["", f"![hazard]({figures}/mechanism_hazard.png)", "",
               f"![rescaled hazard]({figures}/mechanism_hazard_normalised.png)", "",
               f"![battery]({figures}/mechanism_battery.png)", ""]
@@ -276,8 +309,8 @@ def first_screen(tabs):
                  f"over the rate, lies below its Poisson null {said}; weakest "
                  f"{_iv(row, (0.9, 1.0, 1.1))} against "
                  f"{row['estimate'] - diff['estimate']:.3f} ({_where(rule, m, r)}, "
-                 f"{row['note']}); caveat: the interval is that bin's own, not adjusted for "
-                 "picking the lowest of 7 bins.")
+                 f"{row['note']} time units); caveat: the interval is that bin's own, not "
+                 "adjusted for picking the lowest of 7 bins.")
     # 2. re-collisions against randomly placed events
     def chance_of(t, m, r):
         return _above_chance(_get(t, m, r, "recollision_share_nonsticky"),
@@ -327,15 +360,22 @@ def first_screen(tabs):
         rows = [(m, r, _get(tb, m, r, f"explained_{test}_by_{model}"))
                 for m, r in _groups_of(tb) if _excess(tb, m, r, test)]
         short = [x for x in rows if x[2]["ci_high"] < 1]
+        loose = [x for x in rows if x not in short and not (
+            x[2]["ci_high"] - x[2]["ci_low"] <= 2 * SHARE_HALF_WIDTH)]
         if rows and len(short) == len(rows):
             m, r, row = max(short, key=lambda x: x[2]["estimate"])
             parts.append(f"{tb['rule'].iloc[0]}: short of it in {len(short)} of {len(rows)} "
                          f"groups, at most {_iv(row, (1.0,))} ({LABEL[m]}, r = {r:g})")
         elif rows:
-            m, r, row = max(rows, key=lambda x: x[2]["ci_high"])
-            parts.append(f"{tb['rule'].iloc[0]}: not resolved (the interval lies below 1 in "
-                         f"{len(short)} of {len(rows)} groups with an excess; widest "
-                         f"{_iv(row, (1.0,))}, {LABEL[m]}, r = {r:g})")
+            n = int(tb[tb["method"] == "run"].set_index("quantity")["estimate"]["n_ics"])
+            widest = max(loose or rows, key=lambda x: x[2]["ci_high"] - x[2]["ci_low"])[2]
+            said = (f"the share not resolved at this size in {len(loose)} of {len(rows)} "
+                    "groups with an excess (the widest "
+                    + share_cell(widest, n).removeprefix("not resolved at this size; ")
+                    + ")" if loose else f"resolved in {len(rows)} of {len(rows)} groups "
+                    f"with an excess, widest {share_cell(widest, n)}")
+            parts.append(f"{tb['rule'].iloc[0]}: {said}; short of it (interval below 1) "
+                         f"in {len(short)} of {len(rows)}")
         else:
             parts.append(f"{tb['rule'].iloc[0]}: no group with an excess")
     lines.append("- **Cox twins** replaying each run's own states, share of the excess "
@@ -360,14 +400,19 @@ def reading(tabs):
         "where rates differ; `null_verdict`, margin "
         f"{HAZARD_NULL_MARGIN:g}); a Γ-rescaled hazard is read against 1, its prediction, "
         f"by `ratio_verdict` ({100 * MARGIN:g} % band, [definitions](../definitions.md)); "
-        "an inconclusive verdict names the ICs that would resolve it "
-        f"(`equivalence_sample_size`). The {DISPERSION_NAME} is read against "
+        "an inconclusive interval that excludes the null value reads \"above (below) its null "
+        "(1) by less than or about the margin\", a real departure; one that contains it "
+        "names the ICs that would resolve it (`equivalence_sample_size`). The first bin of "
+        f"the early hazard is the {FIRST_BIN} (not the README's bin in mean intervals, nor "
+        f"disks.md's). The {DISPERSION_NAME} is read against "
         "its Poisson null, the same statistic on Poisson ensembles of the same design "
         f"(`null_verdict`, margin {RATE_DISPERSION_MARGIN:g}); that null lies within "
         f"{_null_gap(tabs):.2g} of 1, the base of its explained share (twin − 1) / "
         "(observed − 1); a rejection share's base is the exact tests' 0.05. A share is "
-        "given only where there is an excess, and read as short of it only where its "
-        "interval lies below 1. Re-collisions: \"above chance\" when the two intervals are "
+        "given only where there is an excess and its interval is at most "
+        f"{2 * SHARE_HALF_WIDTH:g} wide (else \"not resolved\" with the ICs that would resolve "
+        "it), and read as short of it only where its interval lies below 1. "
+        "Re-collisions: \"above chance\" when the two intervals are "
         "disjoint. Every row, the hazard bin by bin and the iid twins are in the tables "
         "linked above; definitions: [../mechanism.md](../mechanism.md).", ""]
 
@@ -390,7 +435,8 @@ def write_page(tables, folders, path, *, command):
     and figures lie in ``folders`` (relative to the page's folder, e.g.
     ``"mechanism/elastic"``); ``command`` is the one its "Generated" line names. The
     page opens with `first_screen` and closes with the table of its `sources`."""
-    lines = header("Why the collision times are not Poisson: the mechanism, computed", command,
+    lines = header("Why the collision times are not Poisson: hazard, re-collisions, twins",
+                   command,
                    [f"the direct simulations of `kicktimes.studies.mechanism` under the "
                     f"{t['rule'].iloc[0]} rule ([table]({f}/mechanism_numbers.csv))"
                     for t, f in zip(tables, folders, strict=True)])

@@ -142,8 +142,14 @@ def public_names(table):
     table = table.copy()
     for old, new in CSV_NAMES.items():
         table["quantity"] = table["quantity"].str.replace(old, new, regex=False)
-    table["note"] = table["note"].fillna("").str.replace(
-        "index of dispersion", "rate dispersion across ICs", regex=False)
+    table["note"] = (table["note"].fillna("")
+                     .str.replace("index of dispersion", "rate dispersion across ICs",
+                                  regex=False)
+                     .str.replace(r"^first bin \[0, ([0-9.]+)\) of Gamma t$",
+                                  r"hazard in [0, \1) of Γ-rescaled time", regex=True)
+                     .str.replace(r"^first bin \[0, ([0-9.]+)\)$",
+                                  r"hazard in [0, \1) time units after a collision",
+                                  regex=True))
     return table
 
 

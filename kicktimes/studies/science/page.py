@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import math
 
-from kicktimes.render.pages import ratio_text
 from kicktimes.render.provenance import Source
 from kicktimes.stats import MARGIN, equivalence_sample_size, format_interval, ratio_verdict
 from kicktimes.studies.science.decorrelation import (
@@ -17,11 +16,13 @@ from kicktimes.studies.science.decorrelation import (
     prediction_against_measurement,
 )
 from kicktimes.studies.science.rates import STICKY_FACTOR, rate_relaxation, sticky_orbits
+from kicktimes.studies.science.readings import ratio_reading, side_of
 from kicktimes.studies.science.stretching import KICKED, stretching
 from kicktimes.studies.science.twins import twin_table
 
-__all__ = ["FIRST_SCREEN_MAX", "SOURCES", "decorrelation_lines", "first_screen",
-           "needed_ics", "reading", "store_lines", "stretching_lines", "twin_lines"]
+__all__ = ["FIRST_SCREEN_MAX", "SOURCES", "closest_cells", "decorrelation_lines",
+           "first_screen", "needed_ics", "reading", "reading_text", "store_lines",
+           "stretching_lines", "twin_lines"]
 
 #: the answers a page may open with before its first table
 FIRST_SCREEN_MAX = 5
@@ -93,12 +94,28 @@ def needed_ics(estimate, low, high, n, tolerance=MARGIN, unit="ICs"):
             f"{unit}")
 
 
+def reading_text(x, lo, hi):
+    """A ratio's interval and its `ratio_reading` (an inconclusive interval that excludes
+    1 reads as a departure of about the margin or less).
+
+    >>> reading_text(0.876, 0.815, 0.942)
+    '0.876 [0.815, 0.942], below 1 by less than or about the 10 % margin'
+    """
+    return f"{format_interval(x, lo, hi)}, {ratio_reading(lo, hi, MARGIN)}"
+
+
 def _ratio_cell(x, lo, hi, n, unit="ICs"):
-    """``ratio_text``, and for an inconclusive ratio the size that would resolve it."""
-    text = ratio_text(x, lo, hi)
-    if ratio_verdict(lo, hi, MARGIN) == "inconclusive":
+    """`reading_text`, and for an interval that contains 1 and is inconclusive the size
+    that would resolve it (never for one that excludes 1: that is a departure)."""
+    text = reading_text(x, lo, hi)
+    if ratio_reading(lo, hi, MARGIN) == "inconclusive" and n:
         text += f" ({needed_ics(x, lo, hi, n, unit=unit)})"
     return text
+
+
+def _readings(frame, low="ci_low", high="ci_high"):
+    """The `ratio_reading` of every row of ``frame``."""
+    return frame.apply(lambda x: ratio_reading(x[low], x[high], MARGIN), axis=1)
 
 
 def _verdict_counts(verdicts):
@@ -110,11 +127,12 @@ def reading():
     """How the page's verdicts are read, stated once."""
     return ["How to read it: intervals are 95 % bootstrap intervals over ICs unless said "
             "otherwise; a ratio is read by `ratio_verdict` against the 10 % band around 1 "
-            "(an equivalence test, [definitions](../definitions.md)); an inconclusive one "
-            "names the ICs that would resolve it (`equivalence_sample_size` at the measured "
-            "estimate). A prediction is quoted beside its measurement; a direction is "
-            "claimed only where both trend measures agree. Every per-radius value is in the "
-            "CSVs linked below.", ""]
+            "(an equivalence test, [definitions](../definitions.md)); an inconclusive "
+            "interval that excludes 1 reads \"below (above) 1 by less than or about the 10 % "
+            "margin\", a real departure; one that contains 1 names the ICs that would "
+            "resolve it (`equivalence_sample_size` at the measured estimate). A prediction is "
+            "quoted beside its measurement; a direction is claimed only where both trend "
+            "measures agree. Every per-radius value is in the CSVs linked below.", ""]
 
 
 def first_screen(per_radius, trend, twins, compare, windows, whole, *, n_ics, n_dec):
@@ -132,46 +150,67 @@ def first_screen(per_radius, trend, twins, compare, windows, whole, *, n_ics, n_
         lines.append(
             f"- **{name[0].upper()}{name[1:]}, FTLE / two-disk FTLE**: "
             f"{_verdict_counts(g['verdict'])} of {len(g)} radii ({lo_r:g}–{hi_r:g}); at "
-            f"r = {lo_r:g}: {ratio_text(row.ratio, row.ratio_ci_low, row.ratio_ci_high)}; "
+            f"r = {lo_r:g}: {reading_text(row.ratio, row.ratio_ci_low, row.ratio_ci_high)}; "
             "caveat: " + (f"the ratio {tr.verdict} towards 1 as r falls (both trend measures)"
                           if agree and tc.verdict == "falls" else
                           "no direction of the trend is claimed (the two trend measures "
                           f"disagree: {tr.verdict}, {tc.verdict})" if not agree else
                           f"trend: {tr.verdict}") + f"; nothing below r = {lo_r:g}.")
     best = twins.iloc[(twins["over_predicted"].map(lambda v: abs(math.log(v)))).argmin()]
-    tv = twins.apply(lambda x: ratio_verdict(x.over_predicted_ci_low,
-                                             x.over_predicted_ci_high), axis=1)
+    tv = _readings(twins, "over_predicted_ci_low", "over_predicted_ci_high")
     lines.append(f"- **Twins with their own kick angles**, measured / predicted stretching "
                  f"per kick (Γ ln(τ/d0)): {_verdict_counts(tv)} of {len(twins)} radii; "
-                 f"closest to 1: {ratio_text(best.over_predicted, best.over_predicted_ci_low, best.over_predicted_ci_high)}"  # noqa: E501
+                 f"closest to 1: {reading_text(best.over_predicted, best.over_predicted_ci_low, best.over_predicted_ci_high)}"  # noqa: E501
                  f" (r = {best.radius:g}); caveat: {int(n_ics)} ICs per radius.")
-    off = compare[compare["quotient_verdict"].isin(["lower", "higher"])]
-    rest = compare[~compare.index.isin(off.index)]
-    if len(off):
-        near = off.iloc[(off["measured_over_predicted"].map(lambda v: abs(math.log(v)))).argmin()]
-        where = ", ".join(f"{k} {v}" for k, v in off["rule"].value_counts(sort=False).items())
-        unresolved = (f"; the other {len(rest)} rows not resolved at this size"
-                      if len(rest) else "")
-        lines.append(f"- **One-collision decorrelation model** (predicts the kicked / two-disk "
-                     f"1 − R₁): measurement / prediction outside the 10 % band in {len(off)} "
-                     f"of {len(compare)} rows ({where}); closest to 1: "
-                     f"{ratio_text(near.measured_over_predicted, near.quotient_ci_low, near.quotient_ci_high)}"  # noqa: E501
-                     f" ({near.rule}, r = {near.radius:g}, {KICKED[near.system]}){unresolved}; "
-                     f"caveat: {int(n_dec)} ICs of direct runs against the family store.")
+    if len(compare):
+        lines.append(_decorrelation_answer(compare, n_dec))
     first = windows[windows["window"] == windows["window"].min()]
     last = windows[windows["window"] == windows["window"].max()]
-    fv = first.apply(lambda x: ratio_verdict(x.ci_low, x.ci_high), axis=1)
-    lv = last.apply(lambda x: ratio_verdict(x.ci_low, x.ci_high), axis=1)
+    fv, lv = _readings(first), _readings(last)
     weakest = first.iloc[first["ci_low"].argmin()]
-    wv = whole["verdict"]
+    wv = _readings(whole)
     lines.append(f"- **Collision rate / kinetic Γ(r), first tenth of the run**: "
                  f"{_verdict_counts(fv)} of {len(first)} families; weakest "
-                 f"{ratio_text(weakest.rate_over_kinetic, weakest.ci_low, weakest.ci_high)} "
+                 f"{reading_text(weakest.rate_over_kinetic, weakest.ci_low, weakest.ci_high)} "
                  f"(`{weakest.family}`); caveat: last tenth {_verdict_counts(lv)} of "
                  f"{len(last)}; whole run per radius: {_verdict_counts(wv)} of {len(whole)}.")
     if len(lines) > FIRST_SCREEN_MAX:
         raise ValueError(f"first_screen: {len(lines)} answers, at most {FIRST_SCREEN_MAX}")
     return lines + [""]
+
+
+def _decorrelation_answer(compare, n_dec):
+    """The one-line answer on the one-collision model: on which side of 1 the quotients
+    measured / predicted lie (the model over- or underpredicts), their readings by rule,
+    and the quotient closest to 1 (smallest |ln quotient|) over every row."""
+    lo, hi = compare["quotient_ci_low"], compare["quotient_ci_high"]
+    sides = [side_of(a, b) for a, b in zip(lo, hi, strict=True)]
+    reads = _readings(compare, "quotient_ci_low", "quotient_ci_high")
+    parts = []
+    for side, says in (("below", "overpredicts"), ("above", "underpredicts")):
+        mine = [k for k, s in enumerate(sides) if s == side]
+        if not mine:
+            continue
+        by = []
+        for verdict in dict.fromkeys(reads.iloc[mine]):
+            rows = [k for k in mine if reads.iloc[k] == verdict]
+            rules = compare["rule"].iloc[rows].value_counts(sort=False)
+            by.append(f"{verdict} in {len(rows)} ("
+                      + ", ".join(f"{k} {v}" for k, v in rules.items()) + ")")
+        parts.append(f"the model {says} in {len(mine)} of {len(compare)} rows "
+                     f"(interval {side} 1): " + "; ".join(by))
+    unresolved = sides.count(None)
+    if unresolved:
+        parts.append(f"{unresolved} of {len(compare)} rows not resolved at this size "
+                     "(interval contains 1)")
+    near = compare.iloc[compare["measured_over_predicted"].map(
+        lambda v: abs(math.log(v))).argmin()]
+    return ("- **One-collision decorrelation model** (predicts the kicked / two-disk "
+            "1 − R₁), measurement / prediction: " + "; ".join(parts) + "; closest to 1: "
+            + reading_text(near.measured_over_predicted, near.quotient_ci_low,
+                           near.quotient_ci_high)
+            + f" ({near.rule}, r = {near.radius:g}, {KICKED[near.system]}); caveat: "
+            f"{int(n_dec)} ICs of direct runs against the family store.")
 
 
 def _trend_agrees(g, tr, tc):
@@ -252,10 +291,10 @@ def twin_lines(twins, exp, *, n_ics=8, n_steps=3000):
             f"- r = {row.radius:g}: λ = {_fmt(row.lam, row.ci_low, row.ci_high)}, "
             f"{row.per_kick:.2f} nats per kick against the estimate's "
             f"{row.predicted_per_kick:.2f}: measured / predicted "
-            + ratio_text(row.over_predicted, row.over_predicted_ci_low,
+            + reading_text(row.over_predicted, row.over_predicted_ci_low,
                          row.over_predicted_ci_high)
             + f"; against the two disks' {row.two_disk_per_collision:.2f} per collision: "
-            f"{ratio_text(row.ratio, row.ratio_ci_low, row.ratio_ci_high)}.")
+            f"{reading_text(row.ratio, row.ratio_ci_low, row.ratio_ci_high)}.")
     lines += ["", "Such twins measure the kick's randomisation of the direction, not a "
               "stretching; kicktimes' twins share the kicks.", ""]
     return lines
@@ -278,7 +317,7 @@ def decorrelation_lines(dec, compare, closest, *, n_ics=40, t_max=20000.0):
         lines.append(
             f"| {row.rule} | {row.radius:g} | {KICKED[row.system]} | "
             f"{format_interval(row.predicted, row.predicted_ci_low, row.predicted_ci_high)} | "
-            f"{ratio_text(row.measured, row.measured_ci_low, row.measured_ci_high)} "
+            f"{reading_text(row.measured, row.measured_ci_low, row.measured_ci_high)} "
             f"(`{row.family}`) | "
             + _ratio_cell(row.measured_over_predicted, row.quotient_ci_low,
                           row.quotient_ci_high, n_ics, unit="ICs in both samples")
@@ -287,16 +326,34 @@ def decorrelation_lines(dec, compare, closest, *, n_ics=40, t_max=20000.0):
               "the closest group: the lowest upper distance and every law whose distance "
               "interval reaches below it; overlapping intervals do not make laws equal; "
               "every law and control: `science_closest.csv`):", "",
-              "| family | quantity | closest | their verdicts | further from 1 |",
-              "|---|---|---|---|---|"]
+              "| family | quantity | closest, each with its verdict | further from 1 |",
+              "|---|---|---|---|"]
+    lines += closest_cells(closest)
+    lines.append("")
+    return lines
+
+
+def closest_cells(closest):
+    """The rows of the closest-kick-law table: per (family, diagnostic), every law of the
+    closest group with its own ratio and its own verdict (`reading_text` of its row, so a
+    verdict can never be paired with another law), and the laws further from 1.
+
+    Raises
+    ------
+    ValueError
+        A row whose ``verdict`` column disagrees with `ratio_verdict` of its interval.
+    """
+    lines = []
     for (family, diag), g in closest.groupby(["family", "diagnostic"], sort=False, observed=True):
         best, rest = g[g["closest"]], g[~g["closest"]]
-        names = ", ".join(f"{s} {format_interval(x, lo, hi)}" for s, x, lo, hi in zip(
-            best["system"], best["ratio"], best["ci_low"], best["ci_high"], strict=True))
+        for row in best.itertuples():
+            if ratio_verdict(row.ci_low, row.ci_high, MARGIN) != row.verdict:
+                raise ValueError(f"closest: {family}/{diag}/{row.system} has verdict "
+                                 f"{row.verdict!r}, its interval says otherwise")
+        names = "; ".join(f"{row.system} {reading_text(row.ratio, row.ci_low, row.ci_high)}"
+                          for row in best.itertuples())
         lines.append(f"| `{family}` | {diag} | {names if len(rest) else 'none (all overlap)'} "
-                     f"| {', '.join(sorted(set(best['verdict'])))} | "
-                     f"{', '.join(rest['system']) or '—'} |")
-    lines.append("")
+                     f"| {', '.join(rest['system']) or '—'} |")
     return lines
 
 
@@ -316,9 +373,9 @@ def store_lines(whole, windows, sticky, n_ics=None):
 
         def cell(k, n=n, w=w):
             x, lo, hi = w["rate_over_kinetic"].iloc[k], w["ci_low"].iloc[k], w["ci_high"].iloc[k]
-            return _ratio_cell(x, lo, hi, n) if n else ratio_text(x, lo, hi)
+            return _ratio_cell(x, lo, hi, n) if n else reading_text(x, lo, hi)
 
-        unresolved = g[g["verdict"] == "inconclusive"]
+        unresolved = g[_readings(g) == "inconclusive"]
         need = ""
         if n and len(unresolved):
             sizes = sorted(equivalence_sample_size(
@@ -330,9 +387,9 @@ def store_lines(whole, windows, sticky, n_ics=None):
         lines.append(
             f"| `{fam}` | {cell(0)} | {cell(len(w) - 1)} | "
             f"{w['rate_over_kinetic'].iloc[1:].min():.3f}–"
-            f"{w['rate_over_kinetic'].iloc[1:].max():.3f}: {_verdict_counts(w['verdict'])} of "
+            f"{w['rate_over_kinetic'].iloc[1:].max():.3f}: {_verdict_counts(_readings(w))} of "
             f"{len(w)} windows | {g['count_over_kinetic'].min():.3f}–"
-            f"{g['count_over_kinetic'].max():.3f}: {_verdict_counts(g['verdict'])} of {len(g)}"
+            f"{g['count_over_kinetic'].max():.3f}: {_verdict_counts(_readings(g))} of {len(g)}"
             f" radii{need} |")
     lines += ["", "A family is said to relax to Γ(r) only where its later windows are within "
               "10 % of 1; a window within 10 % whose interval excludes 1 measures a real "

@@ -293,7 +293,8 @@ def reproduce(out: str | os.PathLike, *, scale: str = "quick",
                         n_ics={s.experiment.name: s.experiment.n_ics for s in stores})
 
     lines = header(
-        "The mechanism, computed", command,
+        "Kicks against the two-disk system: stretching, decorrelation, collision rate",
+        command,
         ["the stores " + ", ".join(f"`{n}`" for n in names)]
         + [f"the FTLE sweep `{exp.name}` (run here)",
            "the findings tables of " + ", ".join(f"`{f}`" for f in families.values()),

@@ -8,8 +8,10 @@ tangent FTLE of each disk (`compute.size_ratio_runs`); `tables.size_ratio_table`
 * the collision rate against the exact kinetic rate Γ(r0, r1), a ratio of means with a
   95 % bootstrap interval over ICs;
 * the Poisson battery on each IC's collision times (the share rejecting uniformity, with
-  its Clopper-Pearson interval) and the dispersion index of the counts,
-  :math:`D = s_N^2 / \\bar N` (1 for a Poisson process), with a bootstrap interval;
+  its Clopper-Pearson interval) and the rate dispersion across ICs, var / mean of the
+  whole-run counts over ICs :math:`s_N^2 / \\bar N` (near 1 for a Poisson process; not the
+  within-run D of counts in windows, nor the D across tagged disks of ``disks.md``), with a
+  bootstrap interval and read against the same statistic on Poisson counts;
 * per disk, the FTLE of the disk alone with scattering kicks at Poisson times at its IC's
   own collision rate over its FTLE in the two-disk system,
   :math:`\\sum_i \\lambda^{\\rm kicked}_i / \\sum_i \\lambda^{\\rm two}_i`, with the other

@@ -14,12 +14,12 @@ __all__ = ["size_ratio_figure"]
 def size_ratio_figure(table, n_ics=200):
     """Four panels against the size ratio, each on its own y scale: (a) the collision rate
     over the kinetic rate, (b) the KS rejection share against α (exact for this test),
-    (c) the dispersion index of the counts against its null band (Poisson counts in the
-    same windows), (d) the kicked / two-disk FTLE ratios, each series shifted a little
+    (c) the rate dispersion across ICs against its null band (Poisson counts over the
+    same run lengths), (d) the kicked / two-disk FTLE ratios, each series shifted a little
     along x so that coinciding points stay apart, with the 10 % and 5 % bands; from
     `size_ratio_table` (``n_ics``: ICs per ratio). Returns a `matplotlib.figure.Figure`.
 
-    The KS share and the dispersion index are apart (one y axis each): on twin axes of one
+    The KS share and the rate dispersion are apart (one y axis each): on twin axes of one
     panel, two scales made their curves look comparable where they are not.
     """
     fig = Figure(figsize=(10.5, 7.0), layout="constrained")
@@ -52,19 +52,19 @@ def size_ratio_figure(table, n_ics=200):
     if "disp_low" in table:
         ax[2].errorbar(x, d, yerr=np.vstack([d - table["disp_low"], table["disp_high"] - d]),
                        fmt="s--", color="tab:red", capsize=3,
-                       label="dispersion index (bootstrap 95 % CI)")
+                       label="rate dispersion across ICs (bootstrap 95 % CI)")
     else:
-        ax[2].plot(x, d, "s--", color="tab:red", label="dispersion index (no interval)")
+        ax[2].plot(x, d, "s--", color="tab:red", label="rate dispersion across ICs (no interval)")
     if "d_null" in table:
-        # D is read against its null (Poisson counts in the same windows), not against 1
+        # read against its null (Poisson counts over the same run lengths), not against 1
         ax[2].fill_between(x, table["d_null_low"], table["d_null_high"], color="0.8",
-                           zorder=0, label="null: Poisson counts, same windows (95 %)")
+                           zorder=0, label="null: Poisson counts, same run lengths (95 %)")
         ax[2].plot(x, table["d_null"], color="0.3", lw=1.0, ls=":", label="null mean")
     else:
         ax[2].axhline(1.0, color="tab:red", lw=0.8, ls=":", label="Poisson: 1")
     ax[2].set_ylim(0, max(6.0, float(np.nanmax(table.get("disp_high", d))) * 1.3))
-    ax[2].set_ylabel("dispersion index of the counts")
-    ax[2].set_title("(c) dispersion index D", fontsize="medium")
+    ax[2].set_ylabel("var / mean of the whole-run counts over ICs")
+    ax[2].set_title("(c) rate dispersion across ICs", fontsize="medium")
     ax[2].legend(fontsize="x-small", loc="upper right")
     # each series a little apart along x: at ratio 1 the two partners are the same kick
     shift = 0.04 * (float(x.max()) - float(x.min()) or 1.0)

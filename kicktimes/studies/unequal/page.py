@@ -12,9 +12,9 @@ from kicktimes.stats import (
     format_interval,
     null_verdict,
     poisson_group,
-    ratio_verdict,
     rejection_verdict,
 )
+from kicktimes.studies.science.readings import null_reading, ratio_reading
 from kicktimes.studies.unequal.compute import KINDS, R0
 from kicktimes.studies.unequal.tables import (
     D_MARGIN,
@@ -26,7 +26,12 @@ from kicktimes.studies.unequal.tables import (
     size_ratio_table,
 )
 
-__all__ = ["FIGURE", "SOURCES", "TABLE", "answers", "write_page"]
+__all__ = ["DISPERSION_NAME", "FIGURE", "SOURCES", "TABLE", "answers", "write_page"]
+
+#: the page's name of the var / mean of whole-run counts over ICs (the CSV's
+#: ``dispersion_index``, ``d_null``, ``d_minus_null``): not the README's within-run D of
+#: counts in windows, nor disks.md's D across tagged disks
+DISPERSION_NAME = "rate dispersion across ICs"
 
 #: the table and the figure, relative to the page
 TABLE = "size_ratio/size_ratio.csv"
@@ -58,11 +63,16 @@ def _at(table, column, pick):
     return table.loc[k]
 
 
+def _fine(lo, hi):
+    """`ratio_reading` at :data:`FINE_MARGIN`, naming that margin once."""
+    said = ratio_reading(lo, hi, FINE_MARGIN)
+    return said if "margin" in said else f"{said} at the {100 * FINE_MARGIN:g} % margin"
+
+
 def _ftle(row, c):
     lo, hi = row[c[1]], row[c[2]]
     text = (f"{format_interval(row[c[0]], lo, hi, edges=(0.9, 0.95, 1.0, 1.05, 1.1))}, "
-            f"{ratio_verdict(lo, hi, FINE_MARGIN)} at the {100 * FINE_MARGIN:g} % margin "
-            f"(10 %: {ratio_verdict(lo, hi, MARGIN)})")
+            f"{_fine(lo, hi)} (10 %: {ratio_reading(lo, hi, MARGIN)})")
     if hi < 1 or lo > 1:
         text += (f", a real {'deficit' if hi < 1 else 'excess'} of "
                  f"{100 * abs(1 - row[c[0]]):.1f} %")
@@ -78,7 +88,7 @@ def _d_cell(row):
         return "n/a"
     text = format_interval(row["d_minus_null"], row["d_minus_null_low"],
                            row["d_minus_null_high"], edges=())
-    return f"{text}, {row['d_verdict']}"
+    return f"{text}, {null_reading(row['d_minus_null_low'], row['d_minus_null_high'], D_MARGIN)}"
 
 
 def answers(table) -> list[str]:
@@ -89,13 +99,15 @@ def answers(table) -> list[str]:
     def count(verdicts):
         return ", ".join(f"{k} at {v}" for k, v in pd.Series(verdicts).value_counts().items())
 
-    rate_v = [ratio_verdict(lo, hi, MARGIN) for lo, hi in zip(table["rate_low"],
+    rate_v = [ratio_reading(lo, hi, MARGIN) for lo, hi in zip(table["rate_low"],
                                                                table["rate_high"], strict=True)]
     worst = table.loc[(table["rate_ratio"] - 1).abs().idxmax()]
     ks = _at(table, "ks_reject_share", "min")
     d = _at(table, "d_minus_null", "min")
     large = table.iloc[-1]
-    small_v = [ratio_verdict(lo, hi) for lo, hi in zip(table[_FTLE[0][1]], table[_FTLE[0][2]],
+    d_reads = [null_reading(lo, hi, D_MARGIN) for lo, hi in zip(
+        table["d_minus_null_low"], table["d_minus_null_high"], strict=True)]
+    small_v = [ratio_reading(lo, hi) for lo, hi in zip(table[_FTLE[0][1]], table[_FTLE[0][2]],
                                                         strict=True)]
     return [
         f"- **Collision rate / kinetic Γ(r0, r1)** at r1 / r0 = {worst.size_ratio:g} (the "
@@ -106,18 +118,19 @@ def answers(table) -> list[str]:
         f"{100 * ks.ks_high:.1f}] of runs against α = 0.05, which the test has exactly (the "
         f"uniformity KS given the number of collisions): {count(table['ks_verdict'])} of "
         f"{n} ratios.",
-        f"- **Dispersion index D − its null** at r1 / r0 = {d.size_ratio:g} (the smallest): "
+        f"- **{DISPERSION_NAME[0].upper()}{DISPERSION_NAME[1:]} − its null** (var / mean "
+        f"of the whole-run counts over ICs) at r1 / r0 = {d.size_ratio:g} (the smallest): "
         f"{format_interval(d.d_minus_null, d.d_minus_null_low, d.d_minus_null_high, edges=())} "
-        f"(D {format_interval(d.dispersion_index, d.disp_low, d.disp_high, edges=(1.0,))}, "
-        f"null {d.d_null:.3f}, Poisson counts in the same windows): "
-        f"{count(table['d_verdict'])} of {n} ratios; the counts vary between ICs.",
+        f"({format_interval(d.dispersion_index, d.disp_low, d.disp_high, edges=(1.0,))}, "
+        f"null {d.d_null:.3f}, Poisson counts over the same runs): "
+        f"{count(d_reads)} of {n} ratios; caveat: a spread of rates between ICs, not the "
+        "within-run D of counts in windows.",
         f"- **Small disk's FTLE, kicked / two disks** at r1 / r0 = {large.size_ratio:g}: "
         f"{_ftle(large, _FTLE[0])}; caveat: at the 10 % margin {count(small_v)} of {n} ratios.",
         f"- **Large disk's FTLE, kicked / two disks, by the partner radius** at r1 / r0 = "
         f"{large.size_ratio:g}: with the other disk as scattering partner {_ftle(large, _FTLE[2])}"
         f", with an own-size partner {format_interval(*(large[c] for c in _FTLE[3]))}, "
-        f"{ratio_verdict(large[_FTLE[3][1]], large[_FTLE[3][2]], FINE_MARGIN)} at the "
-        f"{100 * FINE_MARGIN:g} % margin" + (
+        f"{_fine(large[_FTLE[3][1]], large[_FTLE[3][2]])}" + (
             ": the two partners' intervals lie apart." if _apart(large, _FTLE[2], _FTLE[3])
             else "; the two partners' intervals overlap."),
     ]
@@ -132,13 +145,17 @@ def write_page(table, params, command, source):
     lines += answers(table)
     lines += ["", f"Verdicts: a ratio is within {100 * MARGIN:g} % when its whole 95 % CI lies "
               f"in [{1 - MARGIN:g}, {1 + MARGIN:g}], higher / lower when wholly beyond, "
-              "inconclusive otherwise (a CI inside the band that excludes 1 is a real "
-              "difference smaller than the margin); the FTLE ratios are first read at a "
+              "inconclusive otherwise; a CI that excludes 1 but crosses a band edge reads "
+              "\"below (above) 1 by less than or about the margin\", a real difference; the "
+              "FTLE ratios are first read at a "
               f"{100 * FINE_MARGIN:g} % margin, stated in advance, half the effect of the "
               "partner radius the page means to resolve. A share of runs rejected is read "
               "against α only where the test has exactly α under Poisson (the uniformity KS, "
-              "given the number of collisions); D is read against its null stream's D "
-              f"(D − null within ±{D_MARGIN:g}: at its null; wholly beyond: above / below).",
+              f"given the number of collisions); the {DISPERSION_NAME} (var / mean of the "
+              "whole-run counts over ICs; not the README's within-run D of counts in windows, "
+              "nor disks.md's D across tagged disks) is read against the same statistic on "
+              f"Poisson counts (the difference within ±{D_MARGIN:g}: at its null; wholly "
+              "beyond: above / below).",
               "",
               f"Definitions and methods: [../unequal.md](../unequal.md). Disk 0 keeps "
               f"r0 = {R0:g}; {params.n_ics} invariant ICs per ratio, {params.n_steps} steps of "
@@ -150,15 +167,17 @@ def write_page(table, params, command, source):
               "same disk's in the two-disk system, with the partner radius of the scattering "
               "kicks as named. KS rejections: share of the two-disk runs whose collision "
               "times reject uniformity at α = 0.05 (Clopper–Pearson interval; 0.05 for a "
-              "Poisson process); dispersion: variance / mean of the collision counts over ICs "
-              "(near 1 for a Poisson process), with a 95 % bootstrap interval over ICs, and "
-              "D − its null (the mean D of Poisson counts in the same windows at the pooled "
-              "rate) with its verdict"
+              "Poisson process); rate dispersion across ICs: variance / mean of the whole-run "
+              "collision counts over ICs (near 1 for a Poisson process), with a 95 % "
+              "bootstrap interval over ICs, and its difference from its null (the mean of the "
+              "same statistic on Poisson counts over the same runs at the pooled rate) with "
+              "its verdict"
               + ("" if "disp_low" in table else " where the per-IC counts are stored (not "
                  "for this table)") + ".", "",
-              "| r1 / r0 | rate / Γ(r0, r1) | KS rejections | dispersion | small disk FTLE, "
-              "partner r1 | own-size partner | large disk FTLE, partner r0 | own-size partner | "
-              "D − null |", "|---|---|---|---|---|---|---|---|---|"]
+              "| r1 / r0 | rate / Γ(r0, r1) | KS rejections | rate dispersion across ICs | small "
+              "disk FTLE, partner r1 | own-size partner | large disk FTLE, partner r0 | "
+              "own-size partner | rate dispersion across ICs − null |",
+              "|---|---|---|---|---|---|---|---|---|"]
     cols = [("ftle_partner_ratio_disk0", "ftle_partner_low_disk0", "ftle_partner_high_disk0"),
             ("ftle_own_ratio_disk0", "ftle_own_low_disk0", "ftle_own_high_disk0"),
             ("ftle_partner_ratio_disk1", "ftle_partner_low_disk1", "ftle_partner_high_disk1"),
@@ -166,7 +185,7 @@ def write_page(table, params, command, source):
 
     def cell(row, c):
         return (f"{format_interval(row[c[0]], row[c[1]], row[c[2]])}, "
-                f"{ratio_verdict(row[c[1]], row[c[2]], MARGIN)}")
+                f"{ratio_reading(row[c[1]], row[c[2]], MARGIN)}")
 
     for _, row in table.iterrows():
         rate = cell(row, ("rate_ratio", "rate_low", "rate_high"))
@@ -183,7 +202,7 @@ def write_page(table, params, command, source):
     for c, name in ((("rate_ratio", "rate_low", "rate_high"), "collision rate / kinetic rate"),
                     (cols[0], "small disk, partner of the other disk's size"),
                     (cols[2], "large disk, partner of the other disk's size")):
-        v = [ratio_verdict(lo, hi, MARGIN) for lo, hi in zip(table[c[1]], table[c[2]],
+        v = [ratio_reading(lo, hi, MARGIN) for lo, hi in zip(table[c[1]], table[c[2]],
                                                              strict=True)]
         counts = pd.Series(v).value_counts()
         odd = [f"ratio {x:g}: {vv}" for x, vv in zip(table["size_ratio"], v, strict=True)

@@ -1,5 +1,5 @@
 """The unequal-disks study's statistics: per size ratio, the collision rate against the
-kinetic rate, the Poisson battery, the dispersion index and the kicked / two-disk FTLE
+kinetic rate, the Poisson battery, the rate dispersion across ICs and the kicked / two-disk FTLE
 ratios, each with its 95 % bootstrap interval over ICs."""
 
 from __future__ import annotations
@@ -22,7 +22,8 @@ from kicktimes.studies.unequal.compute import KINDS, R0
 __all__ = ["D_MARGIN", "FINE_MARGIN", "N_NULL", "dispersion_ci", "dispersion_null",
            "ks_interval", "ratio_ci", "size_ratio_table"]
 
-#: Monte Carlo draws of the dispersion index's null (Poisson counts shaped like the runs)
+#: Monte Carlo draws of the null of the rate dispersion across ICs (Poisson counts shaped
+#: like the runs)
 N_NULL = 4000
 #: the margin the FTLE ratios must resolve, stated in advance: half the smallest effect
 #: the page means to detect, the partner radius of the scattering kicks (own-size against
@@ -32,10 +33,11 @@ FINE_MARGIN = 0.05
 
 
 def dispersion_null(windows, rate, rng, n=N_NULL):
-    """The dispersion index :math:`s_N^2 / \\bar N` of Poisson counts shaped like the runs
-    (one count per window of ``windows`` at the common ``rate``): its mean over ``n``
-    draws, the value D is read against (`null_verdict`), and its 2.5 and 97.5 %
-    percentiles."""
+    """The rate dispersion across ICs :math:`s_N^2 / \\bar N` (var / mean of the
+    whole-run counts over ICs; not the within-run D of counts in windows) of Poisson counts
+    shaped like the runs (one count per run length of ``windows`` at the common ``rate``):
+    its mean over ``n`` draws, the value the runs' is read against (`null_verdict`), and
+    its 2.5 and 97.5 % percentiles."""
     mean = rate * np.asarray(windows, float)
     counts = rng.poisson(mean, size=(n, mean.size)).astype(float)
     d = counts.var(1, ddof=1) / counts.mean(1)
@@ -52,7 +54,7 @@ def ratio_ci(x, y, rng, n_boot=2000):
 
 
 def dispersion_ci(counts, rng, n_boot=2000):
-    """95 % bootstrap interval over ICs of the dispersion index var / mean of the counts."""
+    """95 % bootstrap interval of the rate dispersion across ICs, var / mean of the counts."""
     counts = np.asarray(counts, float)
     b = counts[resample_indices(counts.size, n_boot, rng)]
     return percentile_interval(b.var(1, ddof=1) / b.mean(1))
@@ -78,12 +80,12 @@ def size_ratio_table(runs_by_r1, seed) -> pd.DataFrame:
     Three streams from ``seed``, as the published table drew them: one for the battery and
     the ratios (per ratio: the battery, the rate ratio, then the FTLE ratios disk by disk,
     partner before own), one for the dispersion intervals (added to the table later,
-    from the same per-IC counts), and one for the dispersion index's null
-    (`dispersion_null`), against which D is read (``d_minus_null``, its interval the
-    bootstrap interval of D less the null's mean, ``d_verdict`` its `null_verdict` with
-    `D_MARGIN`); the KS share has its Clopper-Pearson interval (``ks_low``, ``ks_high``)
-    and its `rejection_verdict` against α = 0.05, exact for the uniformity test given
-    the number of collisions.
+    from the same per-IC counts), and one for the null of the rate dispersion across ICs
+    (`dispersion_null`), against which it is read (``d_minus_null``, its interval the
+    bootstrap interval of the rate dispersion less the null's mean, ``d_verdict`` its
+    `null_verdict` with `D_MARGIN`); the KS share has its Clopper-Pearson interval
+    (``ks_low``, ``ks_high``) and its `rejection_verdict` against α = 0.05, exact for the
+    uniformity test given the number of collisions.
     """
     rng = np.random.default_rng(seed)
     disp_rng = np.random.default_rng(seed)

@@ -1,0 +1,64 @@
+"""How the science, mechanism and unequal pages read a verdict that is "inconclusive".
+
+An inconclusive equivalence verdict has a 95 % interval that straddles an edge of the
+margin. Two cases differ, and the pages say which:
+
+- the interval excludes the null value (1 for a ratio, 0 for a difference from a null
+  stream): a real departure, of about the margin's size or less; it reads "below 1 by
+  less than or about the 10 % margin" (or "above its null by less than or about the
+  margin 0.05") and names no sample size;
+- the interval contains the null value: "not resolved at this size", with the size that
+  would resolve it (`kicktimes.stats.equivalence_sample_size`).
+"""
+
+from __future__ import annotations
+
+import math
+
+from kicktimes.stats import MARGIN, null_verdict, ratio_verdict
+
+__all__ = ["null_reading", "ratio_reading", "side_of"]
+
+
+def side_of(low, high, null=1.0):
+    """``"above"`` / ``"below"`` when the interval ``[low, high]`` lies entirely above /
+    below ``null``, else ``None`` (also for a non-finite end).
+
+    >>> side_of(1.06, 1.15), side_of(0.815, 0.942), side_of(0.913, 1.15)
+    ('above', 'below', None)
+    """
+    if not (math.isfinite(low) and math.isfinite(high)):
+        return None
+    if low > high:
+        raise ValueError(f"low must not exceed high, got [{low!r}, {high!r}]")
+    return "above" if low > null else "below" if high < null else None
+
+
+def ratio_reading(low, high, tolerance=MARGIN):
+    """`kicktimes.stats.ratio_verdict` of a ratio's 95 % CI, except that an inconclusive
+    interval lying entirely on one side of 1 reads ``"below 1 by less than or about the
+    10 % margin"`` (or above): a departure from 1, not an unresolved one.
+
+    >>> ratio_reading(0.815, 0.942), ratio_reading(0.3, 0.4), ratio_reading(0.913, 1.15)
+    ('below 1 by less than or about the 10 % margin', 'lower', 'inconclusive')
+    """
+    verdict = ratio_verdict(low, high, tolerance)
+    side = side_of(low, high, 1.0) if verdict == "inconclusive" else None
+    if side:
+        return f"{side} 1 by less than or about the {100 * tolerance:g} % margin"
+    return verdict
+
+
+def null_reading(low, high, margin):
+    """`kicktimes.stats.null_verdict` of the 95 % CI of *statistic − its null value*,
+    except that an inconclusive interval lying entirely on one side of 0 reads ``"above
+    its null by less than or about the margin 0.05"`` (or below).
+
+    >>> null_reading(0.005, 0.077, 0.07), null_reading(-0.03, 0.09, 0.07)
+    ('above its null by less than or about the margin 0.07', 'inconclusive')
+    """
+    verdict = null_verdict(low, high, margin)
+    side = side_of(low, high, 0.0) if verdict == "inconclusive" else None
+    if side:
+        return f"{side} its null by less than or about the margin {margin:g}"
+    return verdict
