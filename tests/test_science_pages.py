@@ -11,8 +11,7 @@ import pandas as pd
 import pytest
 from conftest import MACHINE_PATH, table_cells
 
-from kicktimes.stats import format_interval, ratio_verdict
-from kicktimes.studies.science.readings import null_reading, ratio_reading
+from kicktimes.stats import format_interval, null_reading, ratio_reading, ratio_verdict
 
 RESULTS = Path(__file__).resolve().parents[1] / "docs" / "results"
 PAGES = ["README.md", "science.md", "mechanism.md", "escape.md", "unequal.md", "scatter.md"]

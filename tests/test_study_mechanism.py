@@ -8,9 +8,8 @@ import pandas as pd
 import pytest
 from conftest import assert_provenance, built_study, refuse_simulations, table_cells
 
-from kicktimes.stats import D_MARGIN, format_interval, null_verdict, ratio_verdict
+from kicktimes.stats import D_MARGIN, format_interval, null_verdict, ratio_reading, ratio_verdict
 from kicktimes.studies.mechanism import analysis, page, run
-from kicktimes.studies.science.readings import ratio_reading
 
 TINY = run.MechanismScale(10, 1000.0, 1, n_boot=20)
 

@@ -11,11 +11,17 @@ from conftest import refuse_simulations
 
 from kicktimes.experiment import preset, run_experiment
 from kicktimes.render.provenance import PROVENANCE_TITLE
-from kicktimes.stats import equivalence_sample_size, format_interval, ratio_verdict
+from kicktimes.stats import (
+    equivalence_sample_size,
+    format_interval,
+    null_reading,
+    ratio_reading,
+    ratio_verdict,
+    side_of,
+)
 from kicktimes.studies.science import page as science_page
 from kicktimes.studies.science import run
 from kicktimes.studies.science.page import SOURCES
-from kicktimes.studies.science.readings import null_reading, ratio_reading, side_of
 
 TINY = run.ScienceScale("stretching_tiny", (0.03, 0.05), 4, 1000, (0.03,), 1, 10, (0.03,), 2,
                         300.0)

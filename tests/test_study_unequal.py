@@ -11,8 +11,7 @@ from conftest import (
 )
 
 import kicktimes.studies.unequal as study
-from kicktimes.stats import format_interval
-from kicktimes.studies.science.readings import null_reading, ratio_reading
+from kicktimes.stats import format_interval, null_reading, ratio_reading
 
 TINY = study.Params(n_ics=10, n_steps=1000)
 

@@ -49,7 +49,6 @@ from .findings import (
     FINE_MARGIN,
     MARGIN,
     SHARE_RULE,
-    SIDED_NULL_VERDICTS,
     Finding,
     clopper_pearson,
     equivalence_sample_size,
@@ -84,6 +83,7 @@ from .mmpp import (
 )
 from .perturbation import stretching_per_perturbation
 from .poisson import TESTS, Intervals, MonteCarloNulls, intervals_from_times, test_poisson
+from .readings import null_reading, ratio_reading, side_of
 from .renewal import (
     FULL_SAMPLE_MODELS,
     MODELS,
@@ -167,7 +167,9 @@ __all__ = [
     "MARGIN",
     "D_MARGIN",
     "FINE_MARGIN",
-    "SIDED_NULL_VERDICTS",
+    "null_reading",
+    "ratio_reading",
+    "side_of",
     "null_verdict",
     "null_rule",
     "equivalence_sample_size",

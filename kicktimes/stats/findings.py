@@ -40,7 +40,6 @@ __all__ = [
     "clopper_pearson",
     "D_MARGIN",
     "FINE_MARGIN",
-    "SIDED_NULL_VERDICTS",
     "null_verdict",
     "null_rule",
     "equivalence_sample_size",
@@ -235,12 +234,7 @@ FINE_MARGIN = 0.05
 D_MARGIN = 0.07
 
 
-#: the words of a `null_verdict` whose CI excludes the null but straddles the margin's edge
-SIDED_NULL_VERDICTS = ("above its null by about the margin or less",
-                       "below its null by about the margin or less")
-
-
-def null_verdict(low, high, margin, *, sided=False):
+def null_verdict(low, high, margin):
     """A statistic read against its null stream: the 95 % CI ``[low, high]`` of the
     difference *statistic - its value on null streams shaped like the runs*.
 
@@ -249,9 +243,8 @@ def null_verdict(low, high, margin, *, sided=False):
     entirely above ``margin`` / below ``-margin``; ``"inconclusive"`` otherwise (and when an
     endpoint is not finite). A statistic whose null value is not exactly 1 (a dispersion
     index over runs of unequal rates, a hazard of binned intervals) is read this way, never
-    against 1. With ``sided``, an inconclusive CI that excludes 0 says on which side
-    (`SIDED_NULL_VERDICTS`: a real departure of about the margin or less); a sample size
-    that would resolve the margin is then beside the point.
+    against 1. An inconclusive CI that excludes 0 is read further by
+    `kicktimes.stats.readings.null_reading` (a real departure of about the margin or less).
 
     Examples
     --------
@@ -259,8 +252,6 @@ def null_verdict(low, high, margin, *, sided=False):
     ('inconclusive', 'above its null')
     >>> null_verdict(-0.06, 0.065, D_MARGIN)
     'at its null'
-    >>> null_verdict(0.005, 0.077, D_MARGIN, sided=True)
-    'above its null by about the margin or less'
     """
     if not (np.isfinite(low) and np.isfinite(high)):
         return "inconclusive"
@@ -270,10 +261,6 @@ def null_verdict(low, high, margin, *, sided=False):
         return "above its null"
     if high < -margin:
         return "below its null"
-    if sided and low > 0:
-        return SIDED_NULL_VERDICTS[0]
-    if sided and high < 0:
-        return SIDED_NULL_VERDICTS[1]
     return "inconclusive"
 
 

@@ -27,7 +27,9 @@ from kicktimes.stats import (
     MARGIN,
     equivalence_sample_size,
     format_interval,
+    null_reading,
     null_verdict,
+    ratio_reading,
     ratio_verdict,
 )
 from kicktimes.studies.mechanism.analysis import (
@@ -38,7 +40,6 @@ from kicktimes.studies.mechanism.analysis import (
     hazard_profile_rows,
     poisson_null_rows,
 )
-from kicktimes.studies.science.readings import null_reading, ratio_reading
 
 __all__ = ["FIRST_SCREEN_MAX", "SHARE_HALF_WIDTH", "first_screen", "load", "needed_ics",
            "rule_section", "share_cell", "sources", "write_page"]

@@ -9,14 +9,20 @@ from __future__ import annotations
 import math
 
 from kicktimes.render.provenance import Source
-from kicktimes.stats import MARGIN, equivalence_sample_size, format_interval, ratio_verdict
+from kicktimes.stats import (
+    MARGIN,
+    equivalence_sample_size,
+    format_interval,
+    ratio_reading,
+    ratio_verdict,
+    side_of,
+)
 from kicktimes.studies.science.decorrelation import (
     closest_kick_law,
     decorrelation,
     prediction_against_measurement,
 )
 from kicktimes.studies.science.rates import STICKY_FACTOR, rate_relaxation, sticky_orbits
-from kicktimes.studies.science.readings import ratio_reading, side_of
 from kicktimes.studies.science.stretching import KICKED, stretching
 from kicktimes.studies.science.twins import twin_table
 

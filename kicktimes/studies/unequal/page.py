@@ -10,11 +10,12 @@ from kicktimes.stats import (
     MARGIN,
     clopper_pearson,
     format_interval,
+    null_reading,
     null_verdict,
     poisson_group,
+    ratio_reading,
     rejection_verdict,
 )
-from kicktimes.studies.science.readings import null_reading, ratio_reading
 from kicktimes.studies.unequal.compute import KINDS, R0
 from kicktimes.studies.unequal.tables import (
     D_MARGIN,

@@ -1,4 +1,4 @@
-"""How the science, mechanism and unequal pages read a verdict that is "inconclusive".
+"""How every results page reads a verdict that is "inconclusive".
 
 An inconclusive equivalence verdict has a 95 % interval that straddles an edge of the
 margin. Two cases differ, and the pages say which:
@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import math
 
-from kicktimes.stats import MARGIN, null_verdict, ratio_verdict
+from .findings import MARGIN, null_verdict, ratio_verdict
 
 __all__ = ["null_reading", "ratio_reading", "side_of"]
 
