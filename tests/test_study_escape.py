@@ -9,7 +9,7 @@ from conftest import assert_provenance, assert_study_page, first_screen_answers,
 
 import kicktimes.studies.escape as study
 from kicktimes.stats import format_interval
-from kicktimes.studies.escape.compute import edge_verdict as ratio_verdict
+from kicktimes.stats import ratio_reading as ratio_verdict
 
 TINY = study.Params(n_ics=100, t_max=400.0, t_min=50.0, n_free=300)
 

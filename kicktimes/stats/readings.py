@@ -5,8 +5,8 @@ margin. Two cases differ, and the pages say which:
 
 - the interval excludes the null value (1 for a ratio, 0 for a difference from a null
   stream): a real departure, of about the margin's size or less; it reads "below 1 by
-  less than or about the 10 % margin" (or "above its null by less than or about the
-  margin 0.05") and names no sample size;
+  about the margin or less" (or "above its null by about the margin or less") and names
+  no sample size;
 - the interval contains the null value: "not resolved at this size", with the size that
   would resolve it (`kicktimes.stats.equivalence_sample_size`).
 """
@@ -36,29 +36,29 @@ def side_of(low, high, null=1.0):
 
 def ratio_reading(low, high, tolerance=MARGIN):
     """`kicktimes.stats.ratio_verdict` of a ratio's 95 % CI, except that an inconclusive
-    interval lying entirely on one side of 1 reads ``"below 1 by less than or about the
-    10 % margin"`` (or above): a departure from 1, not an unresolved one.
+    interval lying entirely on one side of 1 reads ``"below 1 by about the margin or
+    less"`` (or above): a departure from 1, not an unresolved one.
 
     >>> ratio_reading(0.815, 0.942), ratio_reading(0.3, 0.4), ratio_reading(0.913, 1.15)
-    ('below 1 by less than or about the 10 % margin', 'lower', 'inconclusive')
+    ('below 1 by about the margin or less', 'lower', 'inconclusive')
     """
     verdict = ratio_verdict(low, high, tolerance)
     side = side_of(low, high, 1.0) if verdict == "inconclusive" else None
     if side:
-        return f"{side} 1 by less than or about the {100 * tolerance:g} % margin"
+        return f"{side} 1 by about the margin or less"
     return verdict
 
 
 def null_reading(low, high, margin):
     """`kicktimes.stats.null_verdict` of the 95 % CI of *statistic − its null value*,
     except that an inconclusive interval lying entirely on one side of 0 reads ``"above
-    its null by less than or about the margin 0.05"`` (or below).
+    its null by about the margin or less"`` (or below).
 
     >>> null_reading(0.005, 0.077, 0.07), null_reading(-0.03, 0.09, 0.07)
-    ('above its null by less than or about the margin 0.07', 'inconclusive')
+    ('above its null by about the margin or less', 'inconclusive')
     """
     verdict = null_verdict(low, high, margin)
     side = side_of(low, high, 0.0) if verdict == "inconclusive" else None
     if side:
-        return f"{side} its null by less than or about the margin {margin:g}"
+        return f"{side} its null by about the margin or less"
     return verdict

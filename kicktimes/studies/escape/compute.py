@@ -18,7 +18,7 @@ from kicktimes.stats import (
     fit_escape_tail,
     kinetic_rate,
     percentile_interval,
-    ratio_verdict,
+    ratio_reading,
     resample_indices,
     robust_verdict,
 )
@@ -26,7 +26,7 @@ from kicktimes.stats import (
 __all__ = [
     "ALPHA_SAMPLES", "BURSTY_SHAPE", "CONTROLS", "FREE_TIMES", "HOLE", "KICKED", "LABELS",
     "N_BOOT", "RADII", "SMALL_HOLE", "SYSTEMS",
-    "alpha_table", "bootstrap_picks", "censor", "constant_rows", "edge_verdict", "ergodic_rate",
+    "alpha_table", "bootstrap_picks", "censor", "constant_rows", "ergodic_rate",
     "escape_tables", "escape_times", "free_disk_escapes", "local_alpha", "over_radii",
     "tail_rates",
 ]
@@ -183,7 +183,7 @@ def escape_tables(times_by_radius, t_max, t_min, picks):
                 lo, hi = percentile_interval(q[1:])
                 ratios.append({"radius": r, "system": system, "reference": reference,
                                "ratio": q[0], "ci_low": lo, "ci_high": hi,
-                               "verdict": edge_verdict(lo, hi),
+                               "verdict": ratio_reading(lo, hi),
                                "negative_control": system in CONTROLS})
     return pd.DataFrame(rows), pd.DataFrame(ratios), curves
 
@@ -194,7 +194,8 @@ def over_radii(times_by_radius, t_max, t_min, picks) -> pd.DataFrame:
     Per (system, reference), the geometric mean over radii of the per-radius ratio of γ,
     :math:`\exp(\overline{\log(\gamma_s / \gamma_{\rm ref})})`, with its 95 % interval
     from the same paired bootstrap over ICs (`bootstrap_picks`: one resample of the ICs
-    for every radius and system), its `edge_verdict` and, from the standard error of its
+    for every radius and system), its `kicktimes.stats.ratio_reading` and, from the standard
+    error of its
     logarithm, the ICs at which a ratio of 1 would be resolved within the margin
     (`kicktimes.stats.equivalence_sample_size` with the margin ``log(1 + MARGIN)``, the
     band's narrower side). References: the two-disk estimators and ``"ergodic"``, the
@@ -221,34 +222,11 @@ def over_radii(times_by_radius, t_max, t_min, picks) -> pd.DataFrame:
         se = float(np.std(mean[1:], ddof=1))
         rows.append({"system": s, "reference": ref, "n_radii": len(per),
                      "ratio": float(np.exp(mean[0])), "ci_low": lo, "ci_high": hi,
-                     "verdict": edge_verdict(lo, hi), "se_log": se, "n_ics": n_ics,
+                     "verdict": ratio_reading(lo, hi), "se_log": se, "n_ics": n_ics,
                      "n_ics_to_resolve": equivalence_sample_size(se, n_ics,
                                                                  math.log1p(MARGIN)),
                      "negative_control": s in CONTROLS})
     return pd.DataFrame(rows)
-
-
-def edge_verdict(low, high, margin=MARGIN, null=1.0, name="1"):
-    """`ratio_verdict` of a ratio's 95 % CI, with the general rule of the pages for an
-    interval that straddles a band edge: when it excludes ``null`` it says so (``"above 1
-    by about the margin or less"``), and ``"inconclusive"`` is kept for an interval that
-    contains ``null``, the only case where a sample size is named.
-
-    Examples
-    --------
-    >>> edge_verdict(1.09, 1.16), edge_verdict(0.86, 0.99), edge_verdict(0.95, 1.12)
-    ('above 1 by about the margin or less', 'below 1 by about the margin or less', 'inconclusive')
-    >>> edge_verdict(0.95, 1.05)
-    'within 10 %'
-    """
-    verdict = ratio_verdict(low, high, margin)
-    if verdict != "inconclusive" or not (np.isfinite(low) and np.isfinite(high)):
-        return verdict
-    if low > null:
-        return f"above {name} by about the margin or less"
-    if high < null:
-        return f"below {name} by about the margin or less"
-    return verdict
 
 
 def local_alpha(g) -> tuple[float, float, float]:
@@ -287,7 +265,7 @@ def alpha_table(table, constant, t_min, t_max) -> pd.DataFrame:
         got = [(ALPHA_SAMPLES[0], float(t_min), float(t_max),
                 fit.alpha, fit.alpha_low, fit.alpha_high),
                (ALPHA_SAMPLES[1], float(g["t"].min()), float(g["t"].max()), *loc)]
-        verdicts = [edge_verdict(lo, hi) for *_, lo, hi in got]
+        verdicts = [ratio_reading(lo, hi) for *_, lo, hi in got]
         robust, reason = robust_verdict(verdicts, [x[4] for x in got], [x[5] for x in got])
         for (sample, t0, t1, a, lo, hi), v in zip(got, verdicts, strict=True):
             rows.append({"radius": r, "sample": sample, "t_from": t0, "t_to": t1,

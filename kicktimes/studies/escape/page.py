@@ -17,6 +17,7 @@ from kicktimes.stats import (
     fit_escape_tail,
     format_interval,
     kinetic_rate,
+    ratio_reading,
     reliable_until,
     robust_verdict,
 )
@@ -28,7 +29,6 @@ from kicktimes.studies.escape.compute import (
     LABELS,
     alpha_table,
     constant_rows,
-    edge_verdict,
     ergodic_rate,
     escape_tables,
     over_radii,
@@ -53,7 +53,7 @@ SOURCES = (
     Source(TAILS, "rate, rate_boot_low, rate_boot_high", tail_rates),
     Source(TAILS, "alpha, alpha_low, alpha_high, aic_exp_minus_alg", fit_escape_tail),
     Source(RATIOS, "ratio, ci_low, ci_high", escape_tables),
-    Source(RATIOS, "verdict", edge_verdict),
+    Source(RATIOS, "verdict", ratio_reading),
     Source(CONSTANT, "t, t_S, t_S_low, t_S_high", constant_rows),
     Source(CONSTANT, "C_predicted", circle_escape_constant),
     Source(OVER_RADII, "ratio, ci_low, ci_high, verdict, se_log, n_ics_to_resolve", over_radii),
@@ -63,8 +63,8 @@ SOURCES = (
 
 def ratio_text(estimate, low, high) -> str:
     """``"1.13 [1.09, 1.16], above 1 by about the margin or less"``: the interval and its
-    `edge_verdict`."""
-    return f"{format_interval(estimate, low, high)}, {edge_verdict(low, high)}"
+    `kicktimes.stats.ratio_reading`."""
+    return f"{format_interval(estimate, low, high)}, {ratio_reading(low, high)}"
 
 
 def per_radius_verdicts(ratios, system) -> pd.Series:
@@ -175,7 +175,7 @@ def answers(summary, alpha, constant, ratios) -> list[str]:
     c = constant.assign(q=constant["t_S"] / constant["C_predicted"],
                         lo=constant["t_S_low"] / constant["C_predicted"],
                         hi=constant["t_S_high"] / constant["C_predicted"])
-    v = [edge_verdict(lo, hi) for lo, hi in zip(c["lo"], c["hi"], strict=True)]
+    v = [ratio_reading(lo, hi) for lo, hi in zip(c["lo"], c["hi"], strict=True)]
     first = c[c["t"] == c["t"].min()].iloc[0]
     late = c[c["t"] == c["t"].max()]
     lines.append(
@@ -225,7 +225,7 @@ def law_verdict(alpha_verdicts, constant_verdicts):
 def _law_lines(alpha, constant):
     """The verdict paragraph on C/t: the prediction beside each measurement, the margin."""
     alpha_v = list(alpha["verdict"])
-    const_v = [edge_verdict(lo / c, hi / c) for lo, hi, c in
+    const_v = [ratio_reading(lo / c, hi / c) for lo, hi, c in
                zip(constant["t_S_low"], constant["t_S_high"], constant["C_predicted"],
                    strict=True)]
     q = constant["t_S"] / constant["C_predicted"]
@@ -331,7 +331,7 @@ def write_page(table, ratios, constant, params, command, seconds, source, *, sum
             x, lo, hi = (boot.loc[(r, sy), c] / erg for c in ("rate", "rate_boot_low",
                                                                 "rate_boot_high"))
             cells.append(ratio_text(x, lo, hi))
-            erg_v.append(edge_verdict(lo, hi))
+            erg_v.append(ratio_reading(lo, hi))
         lines.append(f"| {r:g} | {erg:.5f} | " + " | ".join(cells) + " |")
     counts = pd.Series(erg_v).value_counts()
     lines += ["", "Verdicts over the " + str(len(erg_v)) + " (radius, system) cells: "

@@ -13,7 +13,7 @@ from kicktimes import stats
 from kicktimes.stats import (
     MMPP_MIN_EVENTS,
     equivalence_sample_size,
-    null_verdict,
+    null_reading,
     percentile_interval,
     rejection_verdict,
 )
@@ -223,10 +223,9 @@ def intervals(times, t_max):
 
 
 def edge_null_verdict(low, high, margin=SHARE_MARGIN):
-    """`null_verdict` of the CI of a difference from the null, with the pages' general rule
-    for a CI that straddles a margin edge: when it excludes 0 it says on which side
-    (``"above its null by about the margin or less"``); ``"inconclusive"`` is kept for a CI
-    that contains 0, the only case where a sample size is named.
+    """`kicktimes.stats.null_reading` of the CI of a share's difference from its null share,
+    at the page's margin `SHARE_MARGIN` (a CI that excludes 0 but crosses the margin's edge
+    says on which side; ``"inconclusive"`` only for a CI that contains 0).
 
     Examples
     --------
@@ -235,14 +234,7 @@ def edge_null_verdict(low, high, margin=SHARE_MARGIN):
     >>> edge_null_verdict(0.033, 0.116), edge_null_verdict(-0.02, -0.01)
     ('above its null', 'at its null')
     """
-    verdict = null_verdict(low, high, margin)
-    if verdict != "inconclusive" or not (np.isfinite(low) and np.isfinite(high)):
-        return verdict
-    if low > 0:
-        return "above its null by about the margin or less"
-    if high < 0:
-        return "below its null by about the margin or less"
-    return verdict
+    return null_reading(low, high, margin)
 
 
 def _difference(a, b, rng, margin=SHARE_MARGIN):

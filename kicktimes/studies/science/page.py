@@ -105,7 +105,7 @@ def reading_text(x, lo, hi):
     1 reads as a departure of about the margin or less).
 
     >>> reading_text(0.876, 0.815, 0.942)
-    '0.876 [0.815, 0.942], below 1 by less than or about the 10 % margin'
+    '0.876 [0.815, 0.942], below 1 by about the margin or less'
     """
     return f"{format_interval(x, lo, hi)}, {ratio_reading(lo, hi, MARGIN)}"
 
@@ -134,8 +134,8 @@ def reading():
     return ["How to read it: intervals are 95 % bootstrap intervals over ICs unless said "
             "otherwise; a ratio is read by `ratio_verdict` against the 10 % band around 1 "
             "(an equivalence test, [definitions](../definitions.md)); an inconclusive "
-            "interval that excludes 1 reads \"below (above) 1 by less than or about the 10 % "
-            "margin\", a real departure; one that contains 1 names the ICs that would "
+            "interval that excludes 1 reads \"below (above) 1 by about the margin or less\", "
+            "a real departure; one that contains 1 names the ICs that would "
             "resolve it (`equivalence_sample_size` at the measured estimate). A prediction is "
             "quoted beside its measurement; a direction is claimed only where both trend "
             "measures agree. Every per-radius value is in the CSVs linked below.", ""]

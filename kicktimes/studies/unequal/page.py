@@ -147,7 +147,7 @@ def write_page(table, params, command, source):
     lines += ["", f"Verdicts: a ratio is within {100 * MARGIN:g} % when its whole 95 % CI lies "
               f"in [{1 - MARGIN:g}, {1 + MARGIN:g}], higher / lower when wholly beyond, "
               "inconclusive otherwise; a CI that excludes 1 but crosses a band edge reads "
-              "\"below (above) 1 by less than or about the margin\", a real difference; the "
+              "\"below (above) 1 by about the margin or less\", a real difference; the "
               "FTLE ratios are first read at a "
               f"{100 * FINE_MARGIN:g} % margin, stated in advance, half the effect of the "
               "partner radius the page means to resolve. A share of runs rejected is read "
