@@ -82,7 +82,7 @@ def test_the_scatter_page_is_its_csv_and_no_longer_decomposes_the_gap():
     text = _page("scatter.md")
     table = pd.read_csv(RESULTS / "scatter_ratios.csv")
     for row in table.itertuples():
-        assert row.verdict == ratio_reading(row.ci_low, row.ci_high)
+        assert row.verdict == ratio_verdict(row.ci_low, row.ci_high)
     main = table[table["ics"] == "without sticky ICs"]
     for r, g in main.groupby("radius"):
         cells = table_cells(text, f"{r:g}")
@@ -120,7 +120,7 @@ def test_the_escape_page_answers_with_an_equivalence_test_and_its_controls():
     text = _page("escape.md")
     ratios = pd.read_csv(RESULTS / "escape" / "escape_ratios.csv")
     for row in ratios.itertuples():
-        assert row.verdict == ratio_verdict(row.ci_low, row.ci_high)
+        assert row.verdict == ratio_reading(row.ci_low, row.ci_high)
         assert format_interval(row.ratio, row.ci_low, row.ci_high) in text
     assert set(ratios.loc[ratios["negative_control"], "system"]) == {"poisson_small_hole",
                                                                       "bursty"}
