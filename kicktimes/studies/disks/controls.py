@@ -231,8 +231,7 @@ def controls_lines(long, *, n_min=30) -> list:
         "Each finding under the primary design and under the controls run for it ("
         + per + "); the controls: "
         + "; ".join(f"**{c}**: {CONTROL_NAMES[c]}" for c in controls if c != "primary")
-        + ". Every control is read against Poisson streams shaped like its own runs (K = 60 "
-        "against a null at K = 60: D depends on its window). Robust "
+        + ". Every control is read against Poisson streams shaped like its own runs. Robust "
         "(`stats.robust_verdict`): every control gives the "
         f"primary's verdict in the same direction. Of the {n_all} findings at N ≥ {n_min}, "
         f"{n_rob} are robust and {n_all - n_rob} depend on a control ("

@@ -220,7 +220,7 @@ def _mark_outside(ax, d, color, low, high, taken=None):
     """Mark at the edge of ``ax`` every hazard bin of ``d`` beyond ``(low, high)``: a
     filled triangle pointing out with the bin's value beside it, or, where only the bin's
     95 % band leaves, an open one. ``taken`` (a dict shared by the calls on one axis)
-    counts the labels already at each bin's edge, so that the next stacks below them; a
+    counts the labels already on each edge, so that the next stacks beside them; a
     label near the right edge is set inward. Returns the number of bins marked."""
     lo_t = np.maximum(d["t_low"].to_numpy(float), X_MIN)
     mid = np.sqrt(lo_t * d["t_high"].to_numpy(float))
@@ -240,13 +240,14 @@ def _mark_outside(ax, d, color, low, high, taken=None):
             if out:
                 # inward near the right edge, stacked where another N marks the same bin
                 right = (np.log(x) - x0) > 0.8 * (x1 - x0)
-                k = taken.get((round(float(x), 9), up), 0)
-                taken[(round(float(x), 9), up)] = k + 1
+                k = taken.get(up, 0)  # every label on this edge gets its own line
+                taken[up] = k + 1
                 dy = (-3 - 9 * k) if up else (3 + 9 * k)
                 ax.annotate(f"{v:.3g}", (x, edge), xycoords=("data", "axes fraction"),
                             xytext=(-6 if right else 5, dy), textcoords="offset points",
                             ha="right" if right else "left", va="top" if up else "bottom",
-                            fontsize=7, color=color)
+                            fontsize=7, color=color, zorder=6,
+                            bbox={"fc": "white", "ec": "none", "alpha": 0.85, "pad": 0.4})
             marked += 1
     return marked
 

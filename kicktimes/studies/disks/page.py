@@ -94,6 +94,11 @@ RATE_WITHIN = f"within {100 * RATE_MARGIN:g} %"
 RATE_FINDING = next(name for name, spec in FINDINGS.items() if spec[0] == "rate_enskog")
 
 
+def load_store_names(stores) -> list:
+    """The names of the stores a page reads (disks_stores.csv's ``store``), in order."""
+    return [st.experiment.name for st in stores]
+
+
 def _holds_from(ns, ok):
     """The smallest N of ``ns`` (increasing) from which ``ok`` holds at every larger N, or
     None."""
@@ -129,14 +134,14 @@ def _rate_line(table, rate_from, robust_from):
     big = table[table["n_disks"] == table["n_disks"].max()]
     worst = big.loc[(big["rate_enskog"] - 1.0).abs().idxmax()]
     n_top = int(table["n_disks"].max())
-
-    def at(n):
-        return (f"at N = {n} (the largest N run)" if n == n_top else f"from N = {n} on")
-
-    where = (f"within {100 * RATE_MARGIN:g} % {at(rate_from)} at every geometry and rule"
+    at = (f"at N = {n_top}, the largest N run," if rate_from == n_top
+          else f"from N = {rate_from} on")
+    where = (f"within {100 * RATE_MARGIN:g} % {at} at every geometry and rule"
              if rate_from else f"not within {100 * RATE_MARGIN:g} % from one N on everywhere")
-    robust = (f" (under every control {at(robust_from)})" if robust_from
-              else " (not under every control)")
+    robust = (" (not under every control)" if not robust_from else
+              " (there under every control too)" if robust_from == rate_from == n_top else
+              f" (under every control at N = {n_top}, the largest N run)"
+              if robust_from == n_top else f" (under every control from N = {robust_from} on)")
     return (f"**Collision rate / Enskog:** {where}{robust}; farthest at N = "
             f"{int(worst['n_disks'])}: {worst['geometry']}, {worst['rule']} "
             + format_interval(worst["rate_enskog"], worst["rate_enskog_low"],
@@ -188,8 +193,7 @@ def _margin_lines() -> list:
         "(Boltzmann h(0) = 1.064); the exponential's ΔAIC departs above what a gamma shape "
         f"1 − {MARGINS['gamma']:g} gives on as many intervals (2 n KL − 2), is at its null at "
         f"≤ 2; the rate over Enskog's ±{100 * RATE_MARGIN:g} % (half the contact value's "
-        "g(σ) − 1 = 0.032 at packing 0.02). An inconclusive D names the runs that would "
-        "resolve its margin (`stats.equivalence_sample_size`, in disks_poisson.csv).", ""]
+        "g(σ) − 1 = 0.032 at packing 0.02).", ""]
 
 
 def _hazard_lines(bins, vn) -> list:
@@ -205,10 +209,9 @@ def _hazard_lines(bins, vn) -> list:
     peak_null = ", ".join(f"{r['null_hazard_peak']:.3g}" for _, r in big.iterrows())
     lines = [
         "## The hazard against its null and linear Boltzmann", "",
-        f"Every bin of the hazard of the next collision (time since the last in mean "
-        f"intervals, over the constant rate) against the same bin of the null streams "
-        f"(paired by run) and, elastic, beside the linear Boltzmann tagged disk's h(t) in that "
-        f"bin ([disks_hazard_null.csv](disks_hazard_null.csv), every N). At N = {n_max}: "
+        f"Every hazard bin against the null streams' (paired by run) and, elastic, "
+        "linear Boltzmann's h(t) in that bin ([disks_hazard_null.csv]"
+        f"(disks_hazard_null.csv), every N). At N = {n_max}: "
         f"{len(dep)} of {len(at)} bins depart from their null by more than "
         f"±{MARGINS['hazard_first']:g}"]
     if not dep.empty:
@@ -223,11 +226,7 @@ def _hazard_lines(bins, vn) -> list:
                   f"bin (among bins with ≥ {100 * PEAK_MIN_SHARE:g} % of the intervals) is a "
                   f"maximum over bins, read against the null's own ({peak_null} at "
                   f"N = {n_max}). A bin's interval is the wider of the bootstrap clustered on "
-                  "runs and Garwood's: with 16 runs (N ≥ 300) the bootstrap's variance has 15 "
-                  "degrees of freedom, and at packing 0.02, elastic, N = 1000 it came out "
-                  "narrower than Garwood's although the first bin's per-run counts have a "
-                  "dispersion 0.72 of Poisson's, consistent with 1 (no negative correlation "
-                  "within runs).")
+                  "runs and Garwood's.")
     return [*lines, ""]
 
 
@@ -269,20 +268,16 @@ def _checks_lines(out, checks) -> list:
         "disks_renewal.csv", "disks_kicked.csv", "disks_ftle_check.csv",
         "disks_lyapunov_density.csv", "disks_dispersion_windows.csv") if (out / name).is_file()]
     if found:
-        lines.append("- Not read here: renewal models by AIC, the kicked single disk against "
-                     "the gas, the gas's FTLE checks and its density law, D against the "
-                     "window: " + ", ".join(found) + ".")
+        lines.append("- Not read here: " + ", ".join(found) + ".")
     return [*lines, ""]
 
 
 def _left_out(long, kicked_stores) -> list:
     """The page's "Left out" list, from what was run."""
     out = [
-        "- The elastic gas's speed-rescaled statistics (disks.csv's `rescaled_*`; their "
-        "null streams' shares are in null_calibration.csv as `<test>, speed-rescaled`, but "
-        "no difference from the null, margin or verdict is computed for them, so neither the "
-        "page nor its figures read them) and the shares of D − 1 carried by the speed or the "
-        "wall (not computed).",
+        "- The speed-rescaled statistics (disks.csv's `rescaled_*`): their null shares are "
+        "in null_calibration.csv (`<test>, speed-rescaled`), but no verdict is computed, so "
+        "neither page nor figures read them; the shares of D − 1 from speed or wall.",
         "- The renewal models' ranking (AIC on pooled intervals, no standard error)."]
     if kicked_stores:
         out.append("- The kicked comparison (packing 0.02, mirror; disks_kicked.csv).")
@@ -333,6 +328,7 @@ SOURCES = (
            density_summary),
     Source("disks_lyapunov_density_runs.csv", "lam, nu", density_state),
     Source("disks_cost.csv", "cpu_seconds, wall_seconds", sweep_cost),
+    Source("disks_stores.csv", "store", load_store_names),
 )
 #: the rows of the columns only an elastic sweep has (none is read on the page)
 ELASTIC_SOURCES = ()
@@ -519,7 +515,6 @@ def write_disks_page(store_paths, out_dir, *, command="kicktimes reproduce --stu
         fig.savefig(out / name, dpi=dpi)
         plt.close(fig)
     exp0 = stores[0].experiment
-    names = ", ".join(f"`{st.experiment.name}`" for st in every)
     now = _dt.datetime.now(_dt.UTC).isoformat(timespec="seconds")
     k = exp0.collisions
     rate_from, rate_robust_from = _rate_from(table, long)
@@ -531,16 +526,14 @@ def write_disks_page(store_paths, out_dir, *, command="kicktimes reproduce --stu
         "Each cell: statistic − its null (Poisson streams at each run's collision frequency, "
         "shaped like the runs, `studies.disks.versus_null`; 95 % interval by the bootstrap "
         "clustered on runs, the null paired by run), its verdict (`stats.null_verdict`). "
-        "D, on this page, is the dispersion index across "
-        "tagged disks: the variance over the mean of each tagged disk's number of "
-        f"collisions in one window of K = {k} mean intervals, over the tagged disks of all "
-        "runs of one N (not one disk's counts in sub-windows; the spread of rates across "
-        "runs is in it, and in its null). Replicate D: the independent replicate's D "
+        "D: the variance over the mean of each tagged disk's collisions in one window of "
+        f"K = {k} mean intervals, over all runs of one N (the spread of rates across runs "
+        "is in it and in its null). Replicate D: the independent replicate's D "
         "against the same null. Every N: [disks_poisson.csv](disks_poisson.csv); nulls: "
         "[null_calibration.csv](null_calibration.csv) and [disks_null.csv](disks_null.csv).",
         "", *_margin_lines(),
-        f"Generated {now} by kicktimes {__version__} (`{command}`) from the {len(every)} "
-        "stores listed under \"Stores\" at the end. Every number is computed from the "
+        f"Generated {now} by kicktimes {__version__} (`{command}`) from {len(every)} "
+        "stores (disks_stores.csv). Every number is computed from the "
         "stores; nothing is typed.", "",
         "The tagged disk's collision times among N equal hard disks in the unit circle "
         f"(`kicktimes.simulate_disks`), N = {min(exp0.n_disks)} to {max(exp0.n_disks)}, "
@@ -563,9 +556,8 @@ def write_disks_page(store_paths, out_dir, *, command="kicktimes reproduce --stu
         "margin).", "",
         "![hazard](disks_hazard_vs_n.png)", "",
         "**The hazard against the time since the last collision** (mean intervals, log x to "
-        "the last bin with data) over the constant rate; top two rows: every N, log y; "
-        f"bottom two rows: N ≥ 10, linear y near 1 (±{MARGINS['hazard_first']:g} shaded; a "
-        "bin beyond the axis is a triangle at its edge with its value); 95 % Garwood bands; "
+        "the last bin with data) over the constant rate; top rows: every N, log y; bottom "
+        f"rows: N ≥ 10, linear y (±{MARGINS['hazard_first']:g} shaded); 95 % Garwood bands; "
         "purple dashed: linear Boltzmann h(t).", "",
         *_hazard_lines(bins, vn),
         *controls_lines(long), *(_window_growth(out) if not long.empty else [])]
@@ -585,7 +577,9 @@ def write_disks_page(store_paths, out_dir, *, command="kicktimes reproduce --stu
         cost.to_csv(out / "disks_cost.csv", index=False)
     lines += [f"{sweeps}these tables and figures: {analysis_cpu:.0f} s of CPU.", "",
               "## Left out", "", *_left_out(long, kicked_stores), "",
-              "## Stores", "", f"The {len(every)} stores this page reads: {names}.", ""]
+              "## Stores", "", "[disks_stores.csv](disks_stores.csv).", ""]
+    pd.DataFrame({"store": load_store_names(every)}).to_csv(
+        out / "disks_stores.csv", index=False)
     for stale in ("disks_wall_share.csv",):
         (out / stale).unlink(missing_ok=True)
     return write_results_page(out / "disks.md", lines,

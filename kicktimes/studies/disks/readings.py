@@ -49,9 +49,9 @@ ANSWER_RULE = (
     "Poisson: every statistic at its null (the 95 % CI of statistic − null inside ± its "
     "margin); not Poisson: at least one departs (its CI entirely beyond its margin), the "
     "others named with their numbers; not resolved: none departs and at least one CI is "
-    "wider than its margin allows. A verdict that the independent replicate (seed 1042) "
-    "changes is not read as a finding: it counts as inconclusive in the answer (D, KS share, "
-    "gamma shape, every hazard bin and ΔAIC are computed on the replicate too)")
+    "wider than its margin allows. A finding the independent replicate (seed 1042) changes "
+    "counts as inconclusive (D, KS share, gamma shape, each hazard bin and ΔAIC are also "
+    "computed on it)")
 
 _DEPARTS = ("above its null", "below its null")
 
@@ -148,6 +148,12 @@ def _match(table, r):
                  & (table["n_disks"] == r["n_disks"])]
 
 
+def _is_finding(verdict) -> bool:
+    """Whether a verdict is one the answer reads as a finding (at its null, or departing):
+    only those can be changed by the replicate; the others are not read as findings."""
+    return verdict == "at its null" or verdict in _DEPARTS
+
+
 def _replicated_bins(b, seed_b):
     """``b`` (hazard bins of one row) with the verdict of every bin whose replicate bin
     (``seed_b``, the same bin of the seed store against its own null) gives another verdict
@@ -198,7 +204,7 @@ def answer_table(vn, bins, renewal=None, replicate=None, *, seed_vn=None, seed_b
                 q = sv.iloc[0]
                 rep = diff_text(q[f"{s}_diff"], q[f"{s}_diff_low"], q[f"{s}_diff_high"])
                 texts[name] += f" (replicate {rep} {_short(q[f'{s}_verdict'])})"
-                if q[f"{s}_verdict"] != verdicts[name]:
+                if _is_finding(verdicts[name]) and q[f"{s}_verdict"] != verdicts[name]:
                     changed.append(name)
         b = _match(bins, r)
         if not b.empty:
@@ -207,13 +213,12 @@ def answer_table(vn, bins, renewal=None, replicate=None, *, seed_vn=None, seed_b
             if not sb.empty:
                 kept = _replicated_bins(b, sb)
                 v, t = _bins_verdict(kept)
-                if v != verdicts["hazard bins"] or t != texts["hazard bins"]:
-                    n_dep = int(b["verdict"].isin(_DEPARTS).sum())
+                n_dep = int(b["verdict"].isin(_DEPARTS).sum())
+                if n_dep:
                     n_kept = int(kept["verdict"].isin(_DEPARTS).sum())
-                    texts["hazard bins"] += (f"; the replicate keeps {n_kept} of the {n_dep}"
-                                             if n_dep else "; the replicate changes bins")
-                    if v != verdicts["hazard bins"]:
-                        changed.append("hazard bins")
+                    texts["hazard bins"] += f"; the replicate keeps {n_kept} of the {n_dep}"
+                if _is_finding(verdicts["hazard bins"]) and v != verdicts["hazard bins"]:
+                    changed.append("hazard bins")
         if renewal is not None and not renewal.empty:
             g = _match(renewal, r)
             if not g.empty:
@@ -228,7 +233,7 @@ def answer_table(vn, bins, renewal=None, replicate=None, *, seed_vn=None, seed_b
                         sg.iloc[0]["n_intervals"])
                     row["replicate_delta_aic"] = d2
                     texts["ΔAIC"] += f" (replicate {d2:.3g})"
-                    if _aic_verdict(d2, n2) != verdicts["ΔAIC"]:
+                    if _is_finding(verdicts["ΔAIC"]) and _aic_verdict(d2, n2) != verdicts["ΔAIC"]:
                         changed.append("ΔAIC")
         if replicate is not None and not replicate.empty:
             g = _match(replicate, r)
@@ -259,15 +264,8 @@ def _largest_n(table):
 
 def _short(verdict):
     return {"at its null": "at null", "above its null": "above", "below its null": "below",
-            "inconclusive": "inconcl.", EDGE_VERDICTS[0]: "above by ≤ margin",
-            EDGE_VERDICTS[1]: "below by ≤ margin"}.get(verdict, verdict)
-
-
-def _replicate_cell(a):
-    text = a.get("replicate D_text")
-    if not isinstance(text, str):
-        return "—"
-    return text.split(": ")[-1] + f" {_short(a['replicate D_verdict'])}"
+            "inconclusive": "inconcl.", EDGE_VERDICTS[0]: "above ≤ margin",
+            EDGE_VERDICTS[1]: "below ≤ margin"}.get(verdict, verdict)
 
 
 def _answer_cell(a):
@@ -280,7 +278,8 @@ def _answer_cell(a):
     if a["answer"] == "not Poisson":
         against = [x for x in others if a.get(f"{x}_verdict") == "at its null"
                    and x not in changed]
-        return (f"**not Poisson** (by {', '.join(by)}, {len(by)} of {len(by) + len(others)}; "
+        names = "" if not others else f"{', '.join(by)}, "
+        return (f"**not Poisson** (by {names}{len(by)} of {len(by) + len(others)}; "
                 + (f"at its null: {', '.join(against)}" if against else "none at its null")
                 + f"{moved})")
     if a["answer"] == "not resolved":
@@ -292,7 +291,7 @@ def summary_lines(answers, vn) -> list:
     """The first table: at the largest N, per geometry and rule, D beside its null, the
     other statistics' verdicts and the answer."""
     head = ["geometry, rule", "D (null D): D − null D", "KS share − null", "gamma shape − null",
-            "hazard bins − null", "ΔAIC, exponential", "replicate D − null D", "answer"]
+            "hazard bins − null", "ΔAIC, exponential", "answer"]
     out = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     big = _largest_n(answers)
     for _, a in big.iterrows():
@@ -312,7 +311,7 @@ def summary_lines(answers, vn) -> list:
             f"{a.get('hazard bins_text', '—')} {_short(a.get('hazard bins_verdict', ''))}",
             f"{a.get('delta_aic_exponential', np.nan):.3g} (margin "
             f"{a.get('aic_margin', np.nan):.3g}) {_short(a.get('ΔAIC_verdict', '—'))}",
-            _replicate_cell(a), _answer_cell(a)]) + " |")
+            _answer_cell(a)]) + " |")
     return out
 
 
@@ -354,8 +353,9 @@ def opening_lines(answers, vn, boltz_d, rate_line) -> list:
     if not ex.empty:
         e = ex.iloc[0]
         first = e["by"].split("; ")[0]
-        ex_text = f"; e.g. {e['geometry']}, {e['rule']}: {e[f'{first}_text']} "
-        ex_text += f"{e[f'{first}_verdict']}"
+        base, _, rep = str(e[f"{first}_text"]).partition(" (replicate ")
+        ex_text = (f"; e.g. {e['geometry']}, {e['rule']}: {base} {e[f'{first}_verdict']}"
+                   + (f" (replicate {rep}" if rep else ""))
     cols = [f"{name}_verdict" for name in ANSWER_STATISTICS if f"{name}_verdict" in big]
     verdicts = big[cols].to_numpy().ravel()
     verdicts = verdicts[pd.notna(verdicts)]
@@ -363,8 +363,8 @@ def opening_lines(answers, vn, boltz_d, rate_line) -> list:
     n_edge = int(np.isin(verdicts, EDGE_VERDICTS).sum())
     changed = [(f"{a['geometry']}, {a['rule']}", x) for _, a in big.iterrows()
                for x in str(a.get("replicate_changed", "") or "").split("; ") if x]
-    moved = (f"; {len(changed)} changed by the replicate and so not read ("
-             + ", ".join(f"{x} at {f}" for f, x in changed) + ")" if changed else "")
+    moved = (f"; {len(changed)} changed by the replicate, so not read (answer column)"
+             if changed else "")
     lines.append(
         f"1. **Poisson at N = {n_max}?** not Poisson at {int(counts.get('not Poisson', 0))} "
         f"of {len(big)} geometry × rule, not resolved at "
