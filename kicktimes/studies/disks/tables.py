@@ -57,9 +57,11 @@ from kicktimes.stats import (
 )
 from kicktimes.stats.findings import clopper_pearson
 
-__all__ = ["HAZARD_EDGES", "KICKED_DIAGNOSTICS", "PEAK_MIN_SHARE", "RATE_MARGIN", "bulk_rows",
-           "disks_hazard", "disks_table", "kicked_table", "peak_bin", "rescale_by_speed",
-           "two_disk_check"]
+__all__ = [
+    "HAZARD_EDGES", "KICKED_DIAGNOSTICS", "PEAK_MIN_SHARE", "RATE_MARGIN", "bulk_rows",
+    "disks_hazard", "disks_table", "kicked_table", "peak_bin", "rescale_by_speed",
+    "two_disk_check",
+]
 
 #: bins of the hazard, in units of the mean interval
 #: (to 20: the longest of about 120000 intervals of a Poisson stream is about 12)

@@ -52,7 +52,7 @@ from kicktimes.stats import (
     D_MARGIN,
     dilute_tagged_disk,
     equivalence_sample_size,
-    null_verdict,
+    null_reading,
     percentile_interval,
     resample_counts,
 )
@@ -60,9 +60,11 @@ from kicktimes.stats.poisson import uniformity_ks
 from kicktimes.studies.disks.null import null_streams
 from kicktimes.studies.disks.tables import HAZARD_EDGES, _Sequences, peak_bin
 
-__all__ = ["EDGE_VERDICTS", "GAMMA_MARGIN", "HAZARD_MARGIN", "KS_MARGIN", "MARGINS",
-           "STATISTICS", "aic_margin", "bin_rows", "boltzmann_bin_hazard", "edge_null_verdict",
-           "gamma_shape_mle", "versus_null"]
+__all__ = [
+    "EDGE_VERDICTS", "GAMMA_MARGIN", "HAZARD_MARGIN", "KS_MARGIN", "MARGINS", "STATISTICS",
+    "aic_margin", "bin_rows", "boltzmann_bin_hazard", "edge_null_verdict", "gamma_shape_mle",
+    "versus_null",
+]
 
 #: the verdicts of a CI that straddles a margin edge but excludes 0 (`edge_null_verdict`)
 EDGE_VERDICTS = ("above its null by about the margin or less",
@@ -70,10 +72,10 @@ EDGE_VERDICTS = ("above its null by about the margin or less",
 
 
 def edge_null_verdict(low, high, margin):
-    """`kicktimes.stats.null_verdict` of the CI of statistic - null, with the pages' general
-    rule for a CI that straddles a margin edge: when it excludes 0 the verdict says on which
-    side (`EDGE_VERDICTS`); ``"inconclusive"`` is kept for a CI that contains 0, the only
-    case where a sample size is named.
+    """`kicktimes.stats.null_reading`, the pages' one reading of the CI of statistic - null:
+    a CI that straddles a margin edge but excludes 0 says on which side (`EDGE_VERDICTS`);
+    ``"inconclusive"`` is kept for a CI that contains 0, the only case where a sample size
+    is named.
 
     Examples
     --------
@@ -82,14 +84,8 @@ def edge_null_verdict(low, high, margin):
     >>> edge_null_verdict(-0.014, 0.140, 0.07), edge_null_verdict(0.108, 0.239, 0.07)
     ('inconclusive', 'above its null')
     """
-    verdict = null_verdict(low, high, margin)
-    if verdict != "inconclusive" or not (np.isfinite(low) and np.isfinite(high)):
-        return verdict
-    if low > 0:
-        return EDGE_VERDICTS[0]
-    if high < 0:
-        return EDGE_VERDICTS[1]
-    return verdict
+    return null_reading(low, high, margin)
+
 
 #: the KS share's margin: half the elastic linear Boltzmann tagged disk's excess over a
 #: Poisson stream at K = 30 (`dilute_tagged_disk("elastic").ks_share(30)`: 0.070 against

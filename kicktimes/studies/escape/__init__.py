@@ -89,9 +89,11 @@ from kicktimes.studies.escape.page import (
 )
 from kicktimes.studies.options import study_run
 
-__all__ = ["SCALES", "Params", "alpha_table", "constant_rows", "ergodic_rate",
-           "escape_tables", "escape_times", "free_disk_escapes", "over_radii", "reproduce",
-           "survival_figure", "tail_rates", "write_page"]
+__all__ = [
+    "SCALES", "Params", "alpha_table", "constant_rows", "ergodic_rate", "escape_tables",
+    "escape_times", "free_disk_escapes", "over_radii", "reproduce", "survival_figure",
+    "tail_rates", "write_page",
+]
 
 
 @dataclass(frozen=True)

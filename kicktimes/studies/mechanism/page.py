@@ -41,8 +41,10 @@ from kicktimes.studies.mechanism.analysis import (
     poisson_null_rows,
 )
 
-__all__ = ["FIRST_SCREEN_MAX", "SHARE_HALF_WIDTH", "first_screen", "load", "needed_ics",
-           "rule_section", "share_cell", "sources", "write_page"]
+__all__ = [
+    "FIRST_SCREEN_MAX", "SHARE_HALF_WIDTH", "first_screen", "load", "needed_ics", "rule_section",
+    "share_cell", "sources", "write_page",
+]
 
 GROUPS = (("paper", 0.01), ("paper", 0.02), ("uniform", 0.01), ("uniform", 0.02))
 LABEL = {"paper": "paper ICs", "uniform": "invariant ICs"}
