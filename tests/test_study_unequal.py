@@ -11,6 +11,7 @@ from conftest import (
 )
 
 import kicktimes.studies.unequal as study
+from kicktimes.fileio import read_csv_exact
 from kicktimes.stats import format_interval, null_reading, ratio_reading
 
 TINY = study.Params(n_ics=10, n_steps=1000)
@@ -91,7 +92,7 @@ def test_d_is_read_against_its_null_and_the_ks_share_against_its_exact_alpha(bui
     from kicktimes.stats import D_MARGIN, null_verdict, rejection_verdict
 
     _, page = built
-    table = pd.read_csv(page.parent / "size_ratio" / "size_ratio.csv")
+    table = read_csv_exact(page.parent / "size_ratio" / "size_ratio.csv")  # exact floats
     for row in table.itertuples():
         assert row.d_verdict == null_verdict(row.d_minus_null_low, row.d_minus_null_high,
                                              D_MARGIN)
