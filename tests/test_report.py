@@ -370,12 +370,16 @@ def test_write_results_gives_pngs_and_a_generated_findings_page(store_path, tmp_
     text = path.read_text(encoding="utf-8")
     assert text.startswith("# What the reproduction shows (generated)")
     assert "**Below paper scale**" in text and "## The answers" in text
-    assert "### All statements" in text
-    assert "FTLE, Poisson vs two-particle: ratio of mean λ" in text
+    # every statement and figure on the family's own page, the statements in its CSV
+    family = (tmp_path / "tiny_report.md").read_text(encoding="utf-8")
+    assert "**Below paper scale**" in family and "## Figures" in family
+    statements = pd.read_csv(tmp_path / "tiny_report_statements.csv")
+    assert statements["statement"].str.contains("FTLE, Poisson vs two-particle: ratio of mean λ",
+                                                regex=False).any()
     pngs = {p.name for p in tmp_path.glob("*.png")}
     assert "tiny_report_fig05_lyapunov_vs_radius.png" in pngs
-    for name in pngs:
-        assert f"]({name})" in text
+    for name in pngs:  # each on the README or on the family's page
+        assert f"]({name})" in text + family
     assert (tmp_path / "tiny_report_findings.csv").is_file()
     # the null calibration: the runs' own Poisson control streams through the same tests
     null = pd.read_csv(tmp_path / "null_calibration.csv")
@@ -391,7 +395,9 @@ def test_write_results_gives_pngs_and_a_generated_findings_page(store_path, tmp_
     closing = text[text.rindex("\n## ") + 1:]
     assert closing.startswith(PROVENANCE_TITLE + "\n") and "`kicktimes." in closing
     named = set(re.findall(r"^\| \[([^]]+)\]\(", closing, re.M))
-    assert named == {p.name for p in tmp_path.glob("*.csv")}
+    # the statements CSV is named by the family's page (its own closing table)
+    assert named == {p.name for p in tmp_path.glob("*.csv")} - {"tiny_report_statements.csv"}
+    assert "[tiny_report_statements.csv](tiny_report_statements.csv)" in family
 
 
 # ------------------------------------------------------------------ cache

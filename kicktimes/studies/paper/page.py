@@ -422,6 +422,7 @@ def write_results(
     by_radius = {c["family"].iloc[0]: c for c in curves if not c.empty}
     for name, c in by_radius.items():
         c.to_csv(out / f"{name}_findings_by_radius.csv", index=False)
+    details_args = list(details)
     details = [_family_page(out, name, paper, scale, ctx, secs, notes, dpi=dpi,
                             seconds=seconds, command=command,
                             table=merged.get(name))
@@ -467,6 +468,10 @@ def write_results(
                " [escape.md](escape.md), [unequal.md](unequal.md), [scatter.md](scatter.md), "
                "[mmpp.md](mmpp.md), [disks.md](disks.md), [paper.md](paper.md) (`kicktimes "
                "reproduce --study NAME`).", ""]
+    below = [f"{name}: {scale}" for name, paper, scale, *_ in details_args if not paper]
+    if below:  # the page's answers stand on stores below the paper's scale: it says so first
+        screen = [f"> **Below paper scale** ({'; '.join(below)}): a pipeline check; its "
+                  "verdicts answer nothing.", ""] + screen
     lines[head:head] = screen
     from kicktimes.render.pages import write_results_page
 
