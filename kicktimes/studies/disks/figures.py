@@ -36,6 +36,17 @@ ZOOM_LIMITS = (0.75, 1.3)
 FULL_LIMITS = (0.05, 20.0)
 
 
+
+def _unique_handles(axes):
+    """``(handles, labels)`` of every panel's legend entries, each label once, in order."""
+    handles, labels = [], []
+    for ax in axes.ravel():
+        for h, lab in zip(*ax.get_legend_handles_labels(), strict=True):
+            if lab not in labels:
+                handles.append(h)
+                labels.append(lab)
+    return handles, labels
+
 def geometries_of(table):
     """The table's geometries (``packing 0.02``, ``r = 0.0045``), in order of appearance."""
     return list(dict.fromkeys(table["geometry"]))
@@ -321,12 +332,7 @@ def rates_figure(table, nulls=None, boltzmann=None):
         ax.set_title(title, fontsize=10)
         ax.set_xlabel("number of disks N")
         ax.set_ylabel(label)
-    handles, labels = [], []
-    for ax in axes.ravel():
-        for h, lab in zip(*ax.get_legend_handles_labels(), strict=True):
-            if lab not in labels:
-                handles.append(h)
-                labels.append(lab)
+    handles, labels = _unique_handles(axes)
     fig.legend(handles, labels, loc="lower center", ncol=3, fontsize=8, frameon=False)
     fig.tight_layout(rect=(0, 0.17, 1, 1))
     return fig
@@ -386,12 +392,7 @@ def controls_figure(long, *, n_min=10, names=None):
             ax.set_ylabel(label, fontsize=8)
             if i == len(families) - 1:
                 ax.set_xlabel("number of disks N")
-    handles, labels = [], []
-    for ax in axes.ravel():
-        for h, lab in zip(*ax.get_legend_handles_labels(), strict=True):
-            if lab not in labels:
-                handles.append(h)
-                labels.append(lab)
+    handles, labels = _unique_handles(axes)
     handles.append(axes[0, 0].plot([], [], ls="none", marker="o", mfc="white", color="0.3")[0])
     labels.append("hollow: not robust at that N")
     # at most 3 entries a row: six long control names overflow one row of the figure
