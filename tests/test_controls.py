@@ -89,7 +89,8 @@ def test_sticky_runs_are_left_out_and_a_control_that_flips_the_verdict_is_named(
     assert ftle.loc["primary", "estimate"] > 1.3
     assert ftle.loc["sticky_excluded", "estimate"] == pytest.approx(0.93)
     assert ftle.loc["paired_median", "estimate"] == pytest.approx(0.93)
-    assert ftle.loc["sticky_excluded", "verdict"] == "within 10 %"
+    # the FTLE is read at its own margin, ±5 % (`margin_of`): 0.93 lies below it
+    assert ftle.loc["sticky_excluded", "verdict"] == "lower"
     assert not ftle["robust"].any() and (ftle["depends_on"] == "paired_median").all()
     cell = overview_table(table).loc[0, "Poisson, scatter"]
     assert cell.startswith("depends on paired_median: 2.36 [")
@@ -315,13 +316,14 @@ def test_the_first_screen_is_at_most_five_one_line_answers_then_a_compact_table(
     lines = first_screen(with_robustness(rows))
     answers = lines[:lines.index("")]
     assert len(answers) == 2  # no Poisson rows and one diagnostic here: the two FTLE questions
-    assert answers[0] == (f"- **{QUESTIONS[0][0]}** no, lower: 0.315 [0.300, 0.330] (A, "
-                          "Poisson kicks); robust over 5 controls and both families (0.315).")
+    assert answers[0] == (f"- **{QUESTIONS[0][0]}** no, lower at a 5 % margin: 0.315 [0.300, "
+                          "0.330] (A, Poisson kicks); robust over 5 controls and both families "
+                          "(0.315).")
     # the scatter kicks at their 5 % margin: 0.950 [0.930, 0.970] straddles 0.95
     assert answers[1] == (f"- **{QUESTIONS[1][0]}** depends on the elastic rule at a 5 % "
                           "margin: lower 0.315 [0.300, 0.330] (A, Poisson scatter kicks) under "
                           "the primary, inconclusive 0.950 [0.930, 0.970] (A, Poisson scatter "
-                          "kicks) under it.")
+                          "kicks) under the elastic rule.")
     assert all(len(a.split()) <= 45 for a in answers)  # one line each
     table = lines[lines.index("") + 3:]
     assert table[0].count("|") - 1 <= 8
@@ -384,3 +386,24 @@ def test_the_paper_module_copies_the_first_screen_and_leaves_the_page_alone(tmp_
     with pytest.raises(SystemExit) as stop:
         main([str(tmp_path / "nowhere"), "--readme", str(readme)])
     assert stop.value.code == 2 and "error:" in capsys.readouterr().err
+
+
+def test_a_verdict_robust_in_direction_but_not_in_size_names_the_farthest_cell():
+    """One verdict ("lower") under every control, but estimates from 0.43 to 0.84: the
+    answer says the direction is robust and names the cell whose size differs most, not
+    "robust" alone (a referee's point: 1 − R₁ "robust" over 0.426–0.842)."""
+    from kicktimes.report.controls import with_robustness
+    from kicktimes.studies.paper.first_screen import _ratio_line
+
+    spec = [("family_a", c, 0.76, 0.81) for c in ("primary", "paired_median", "invariant_ics")]
+    spec += [("family_b", "primary", 0.80, 0.84), ("family_b", "elastic", 0.40, 0.45)]
+    rows = with_robustness(_rows(spec, question="decorrelation", diagnostic="one_minus_r1"))
+    line = _ratio_line("Q?", rows, 0.1)
+    assert line == ("**Q?** no, lower at a 10 % margin: 0.785 [0.760, 0.810] (A, Poisson "
+                    "kicks); robust in direction over 3 controls and both families "
+                    "(0.425–0.82), not in size: 0.425 in B, Poisson kicks, the elastic rule.")
+    # the same cells inside one margin band: plain "robust"
+    spec[-1] = ("family_b", "elastic", 0.74, 0.79)
+    rows = with_robustness(_rows(spec, question="decorrelation", diagnostic="one_minus_r1"))
+    assert _ratio_line("Q?", rows, 0.1).endswith(
+        "; robust over 3 controls and both families (0.765–0.82).")

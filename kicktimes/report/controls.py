@@ -33,9 +33,10 @@ changes it. The controls:
 Every interval is a percentile bootstrap clustered on ICs: one resample draws IC indices
 with replacement and applies them at every radius and to every system (the same IC is
 the same initial condition everywhere), so the correlation of one IC across radii and
-systems is kept. Verdicts use one band (:func:`kicktimes.stats.ratio_verdict`): *within 10 %*
-when the whole 95 % interval lies in [0.9, 1.1], *higher* / *lower* when it lies entirely
-above / below it, *inconclusive* otherwise. A comparison is *robust*
+systems is kept. Verdicts use each diagnostic's band (:func:`kicktimes.stats.ratio_verdict`
+with :func:`kicktimes.stats.margin_of`: ±5 % for the FTLE, ±3 % for the off-diagonal RR, ±10 %
+otherwise): *within* when the whole 95 % interval lies in the band, *higher* / *lower*
+when it lies entirely above / below it, *inconclusive* otherwise. A comparison is *robust*
 (:func:`kicktimes.stats.robust_verdict`) only when every control gives the same verdict and
 no control's interval lies above 1 while another's lies below 1; otherwise it *depends on*
 the first control that breaks it (the ``depends_on`` column).
@@ -55,6 +56,7 @@ import pandas as pd
 
 from kicktimes.report.store import REFERENCE, kicked_systems, wide
 from kicktimes.stats import (
+    margin_of,
     paired_median,
     paired_ratio,
     ratio_verdict,
@@ -78,7 +80,6 @@ CONTROLS = ("primary", "paired_median", "sticky_excluded", "paper_sampling")
 #: the columns of the findings table
 COLUMNS = ("family", "question", "diagnostic", "system", "control", "estimate", "ci_low",
            "ci_high", "verdict", "robust", "depends_on", "n_pairs", "detail")
-WITHIN = "within 10 %"
 HIGHER = "higher"
 LOWER = "lower"
 INCONCLUSIVE = "inconclusive"
@@ -126,7 +127,7 @@ def _row(family, diagnostic, system, control, est, low, high, n_pairs, detail):
         "estimate": est,
         "ci_low": low,
         "ci_high": high,
-        "verdict": ratio_verdict(low, high),
+        "verdict": ratio_verdict(low, high, margin_of(diagnostic)),
         "robust": False,
         "depends_on": "",
         "n_pairs": int(n_pairs),

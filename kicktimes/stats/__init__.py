@@ -46,13 +46,16 @@ from .ensemble import PoissonEnsembleResult, test_poisson_ensemble
 from .enskog import contact_value, enskog_frequency, henderson_z, speed_rate_factor
 from .findings import (
     D_MARGIN,
+    DIAGNOSTIC_MARGINS,
     FINE_MARGIN,
     MARGIN,
+    RR_MARGIN,
     SHARE_RULE,
     Finding,
     clopper_pearson,
     equivalence_sample_size,
     format_interval,
+    margin_of,
     null_rule,
     null_verdict,
     poisson_rule,
@@ -83,7 +86,7 @@ from .mmpp import (
 )
 from .perturbation import stretching_per_perturbation
 from .poisson import TESTS, Intervals, MonteCarloNulls, intervals_from_times, test_poisson
-from .readings import null_reading, ratio_reading, side_of
+from .readings import null_reading, ratio_reading, ratio_words, side_of
 from .renewal import (
     FULL_SAMPLE_MODELS,
     MODELS,
@@ -167,8 +170,12 @@ __all__ = [
     "MARGIN",
     "D_MARGIN",
     "FINE_MARGIN",
+    "DIAGNOSTIC_MARGINS",
+    "RR_MARGIN",
+    "margin_of",
     "null_reading",
     "ratio_reading",
+    "ratio_words",
     "side_of",
     "null_verdict",
     "null_rule",

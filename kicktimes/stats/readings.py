@@ -17,7 +17,7 @@ import math
 
 from .findings import MARGIN, null_verdict, ratio_verdict
 
-__all__ = ["null_reading", "ratio_reading", "side_of"]
+__all__ = ["null_reading", "ratio_reading", "ratio_words", "side_of"]
 
 
 def side_of(low, high, null=1.0):
@@ -47,6 +47,19 @@ def ratio_reading(low, high, tolerance=MARGIN):
     if side:
         return f"{side} 1 by about the margin or less"
     return verdict
+
+
+def ratio_words(low, high, tolerance=MARGIN):
+    """`ratio_reading` in a page's words: a verdict *within* the margin whose interval
+    excludes 1 says on which side (a real difference smaller than the margin), so that
+    "within 10 %" never hides an interval that excludes the null.
+
+    >>> ratio_words(1.046, 1.099), ratio_words(0.95, 1.02), ratio_words(0.815, 0.942)
+    ('within 10 %, above 1', 'within 10 %', 'below 1 by about the margin or less')
+    """
+    verdict = ratio_reading(low, high, tolerance)
+    side = side_of(low, high, 1.0) if verdict.startswith("within") else None
+    return f"{verdict}, {side} 1" if side else verdict
 
 
 def null_reading(low, high, margin):

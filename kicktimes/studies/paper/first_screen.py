@@ -16,23 +16,23 @@ import pandas as pd
 from kicktimes.render.pages import markdown_table
 from kicktimes.report.answers import CONTROL_WORDS, SCREEN_ROWS, family_short
 from kicktimes.report.controls import LOWER, POISSON_QUESTION
-from kicktimes.stats import FINE_MARGIN, MARGIN, format_interval, ratio_verdict
+from kicktimes.stats import MARGIN, format_interval, margin_of, ratio_verdict
 
 __all__ = ["QUESTIONS", "answer_lines", "compact_overview", "first_screen", "qa_table"]
 
-#: the first screen's ratio questions, in order: (question, diagnostic, kicked systems,
-#: margin); the first system is the one whose number the line gives; the Poisson question
-#: comes first. The scatter kicks are read at `kicktimes.stats.FINE_MARGIN`: the deficit
-#: they leave (the partner's tangent memory, about 10 %) equals the 10 % band
+#: the first screen's ratio questions, in order: (question, diagnostic, kicked systems);
+#: the first system is the one whose number the line gives; the Poisson question comes
+#: first. Each is read at its diagnostic's margin (`kicktimes.stats.margin_of`), the
+#: margin of the compact table and the findings CSVs
 QUESTIONS = (
     ("Does the paper's kicked disk (uniform kicks) have the two-disk tangent-space FTLE?",
-     "ftle", ("poisson", "actual"), MARGIN),
+     "ftle", ("poisson", "actual")),
     ("Do scatter kicks (virtual partners) give the two-disk FTLE?", "ftle",
-     ("poisson_scatter", "actual_scatter", "poisson_kinetic"), FINE_MARGIN),
+     ("poisson_scatter", "actual_scatter", "poisson_kinetic")),
     ("Does it decorrelate like the two disks at lag 1 (1 − R₁ over each system's n steps)?",
-     "one_minus_r1", ("poisson", "actual"), MARGIN),
-    ("Does it have the two-disk recurrence rate (ε = 10⁻²)?", "rr_offdiag@0.01",
-     ("poisson", "actual"), MARGIN),
+     "one_minus_r1", ("poisson", "actual")),
+    ("Does it have the two-disk off-diagonal recurrence rate (ε = 10⁻²)?", "rr_offdiag@0.01",
+     ("poisson", "actual")),
 )
 POISSON_LINE = "Are the two disks' collision times Poisson?"
 _WORDS = {LOWER: "no, lower", "higher": "no, higher", "inconclusive": "inconclusive"}
@@ -88,12 +88,15 @@ def _sides(rows) -> bool:
 
 
 def _ratio_line(question, rows, margin=MARGIN) -> str:
-    """One answer at ``margin`` (`kicktimes.stats.ratio_verdict`): when every control and
-    family gives one verdict and no two CIs lie on opposite sides of 1 (robust), the
-    primary verdict and number of the first family and kick law, with the range; else
-    "depends on" the control that changes it, both numbers. A verdict "within" whose
-    interval excludes 1 says in how many cells (a real difference smaller than the
-    margin)."""
+    """One answer at ``margin`` (`kicktimes.stats.ratio_verdict`).
+
+    When every control and family gives one verdict and no two CIs lie on opposite sides
+    of 1, the verdict is robust in direction: the line gives the primary verdict and number
+    of the first family and kick law, with the range over the cells; when that range is
+    wider than the margin band, it names the control whose estimate lies farthest from the
+    primary's (the size depends on it). Otherwise the line says "depends on" the control
+    that changes the verdict, with both numbers. A verdict "within" whose interval
+    excludes 1 says in how many cells (a real difference smaller than the margin)."""
     rows = rows.assign(verdict=[ratio_verdict(lo, hi, margin) for lo, hi
                                 in zip(rows["ci_low"], rows["ci_high"], strict=True)])
     family = rows["family"].iloc[0]
@@ -102,7 +105,7 @@ def _ratio_line(question, rows, margin=MARGIN) -> str:
     n_controls = rows.loc[rows["control"] != "primary", "control"].nunique()
     families = rows["family"].nunique()
     where = f"({family_short(family)}, {_KICKS.get(system, system)})"
-    at = "" if margin == MARGIN else f" at a {100 * margin:g} % margin"
+    at = f" at a {100 * margin:g} % margin"
     over = (f"{n_controls} controls" + (" and both families" if families > 1 else "")
             if n_controls else "both families" if families > 1 else "")
     if rows["verdict"].nunique() == 1:
@@ -110,19 +113,47 @@ def _ratio_line(question, rows, margin=MARGIN) -> str:
         if _sides(rows):  # one verdict, but intervals on both sides of 1: not robust
             text += f"; not robust: CIs on both sides of 1 ({_range(rows)})"
         elif over:
-            text += f"; robust over {over} ({_range(rows)})"
+            far = _size_control(rows, primary, margin)
+            text += (f"; robust over {over} ({_range(rows)})" if far is None else
+                     f"; robust in direction over {over} ({_range(rows)}), not in size: "
+                     f"{far.estimate:.3g} in {_cell(far)}")
     else:
         other = rows[rows["verdict"] != primary.verdict]
-        control = other["control"].value_counts().index[0]
+        # the control that decides: the findings table's own (`with_robustness`: an
+        # interval on the other side of 1 first), else the one that changes most cells
+        named_first = [c.strip() for c in str(primary.depends_on or "").split(",")
+                       if c.strip() in set(other["control"])]
+        control = (named_first or list(other["control"].value_counts().index))[0]
         c = other[other["control"] == control].iloc[0]
-        text = (f"**{question}** depends on {CONTROL_WORDS.get(control, control)}{at}: "
+        named = CONTROL_WORDS.get(control, control)
+        text = (f"**{question}** depends on {named}{at}: "
                 f"{primary.verdict} {_ci(primary)} {where} under the primary, {c.verdict} "
                 f"{_ci(c)} ({family_short(c.family)}, {_KICKS.get(c.system, c.system)}) "
-                f"under it")
+                f"under {named}")
     below = int((rows["ci_high"] < 1).sum())
     if primary.verdict.startswith("within") and below:
         text += f"; CI below 1 in {below} of {len(rows)} cells"
     return text + "."
+
+
+def _cell(row) -> str:
+    """``"B, Poisson kicks, the elastic rule"``: the family, kick law and control of a
+    findings row."""
+    control = "" if row.control == "primary" else ", " + CONTROL_WORDS.get(row.control,
+                                                                            row.control)
+    return f"{family_short(row.family)}, {_KICKS.get(row.system, row.system)}{control}"
+
+
+def _size_control(rows, primary, margin):
+    """The row whose estimate lies farthest from ``primary``'s on a log scale, when the
+    cells' estimates span more than the margin band ((1 + margin) / (1 - margin)); else
+    None."""
+    x = pd.to_numeric(rows["estimate"], errors="coerce")
+    ok = np.isfinite(x) & (x > 0)
+    if ok.sum() < 2 or x[ok].max() / x[ok].min() <= (1 + margin) / (1 - margin):
+        return None
+    distance = np.abs(np.log(x[ok] / primary.estimate))
+    return rows[ok].loc[distance.idxmax()]
 
 
 def _poisson_line(table) -> str | None:
@@ -152,7 +183,31 @@ def _poisson_line(table) -> str | None:
     if e_share is not None:
         text += (f"; elastic rule {_pct(e_share)}"
                  + (f", D − null D {_ci(e_excess)}" if e_excess is not None else ""))
-    return text + "."
+    return text + _sign_flips(rows, family) + "."
+
+
+def _sign_flips(rows, family) -> str:
+    """``"; the first hazard bin − its null changes sign with the rule (0.656 mirror,
+    -0.331 elastic)"``: the statistics whose departure from their null lies on one side
+    under the primary rule and on the other under the elastic rule (both not Poisson,
+    in opposite directions)."""
+    from kicktimes.stats import side_of
+
+    names = {"hazard_first_excess": "the first hazard bin", "gamma_shape_excess":
+             "the gamma shape"}
+    flips = []
+    for diagnostic, name in names.items():
+        p = _one(rows, diagnostic=diagnostic, family=family, control="primary")
+        e = _one(rows, diagnostic=diagnostic, family=family, control="elastic")
+        if p is None or e is None:
+            continue
+        sides = side_of(p.ci_low, p.ci_high, 0.0), side_of(e.ci_low, e.ci_high, 0.0)
+        if None not in sides and sides[0] != sides[1]:
+            flips.append(f"{name} {p.estimate:.3g} (primary) vs {e.estimate:.3g} (elastic)")
+    if not flips:
+        return ""
+    return ("; against their nulls, " + " and ".join(flips)
+            + " change sign with the rule (clustered vs regular times)")
 
 
 def _null_share(row) -> str:
@@ -170,12 +225,12 @@ def answer_lines(table: pd.DataFrame) -> list[str]:
     poisson = _poisson_line(table)
     if poisson:
         out.append("- " + poisson)
-    for question, diagnostic, systems, margin in QUESTIONS:
+    for question, diagnostic, systems in QUESTIONS:
         rows = table[(table["diagnostic"] == diagnostic) & table["system"].isin(systems)]
         if len(rows):
             order = {s: k for k, s in enumerate(systems)}
             rows = rows.sort_values("system", key=lambda s: s.map(order), kind="stable")
-            out.append("- " + _ratio_line(question, rows, margin))
+            out.append("- " + _ratio_line(question, rows, margin_of(diagnostic)))
     return out[:5]
 
 
@@ -219,7 +274,9 @@ def first_screen(table: pd.DataFrame) -> list[str]:
     """The Markdown lines that open the page: :func:`answer_lines`, then the compact table
     (:func:`compact_overview`) with one sentence on how to read it."""
     lines = answer_lines(table) + [""]
-    lines += ["Every diagnostic by kick law (family A, primary, at the 10 % margin; ✓ robust "
-              "over every control and both families, ✗ the first control that changes it; "
+    lines += ["Every diagnostic by kick law (family A, primary, each at its margin: "
+              f"±{100 * margin_of('ftle'):g} % for the FTLE, ±{100 * margin_of('rr_offdiag'):g} "
+              f"% for the off-diagonal RR, ±{100 * MARGIN:g} % otherwise; ✓ robust over every "
+              "control and both families, ✗ the first control that changes it; "
               "every cell with both numbers: [overview.csv](overview.csv)):", ""]
     return lines + markdown_table(compact_overview(table)) + [""]

@@ -20,7 +20,7 @@ from kicktimes import __version__
 from kicktimes.fileio import atomic_write_bytes
 from kicktimes.report.context import Context, Mapper, Progress
 from kicktimes.report.store import load_report_store
-from kicktimes.stats import format_interval
+from kicktimes.stats import MARGIN, format_interval, margin_of
 from kicktimes.validation import check_int
 
 __all__ = ["PROTOCOL_POINTER", "copy_first_screen", "counts_section", "poisson_section",
@@ -116,7 +116,8 @@ def gap_section(gaps):
         "timing (two 2 × 2 factorials), 95 % CIs clustered on ICs; sign ✓: the same sign "
         "under every control (their range beside); 'left' = 1 − both shares. "
         + (open_gaps + " " if open_gaps else "")
-        + "Not decomposed (the paper's kick's CI reaches into the ±10 % band under the named "
+        + "Not decomposed (the paper's kick's CI reaches into its diagnostic's band under the "
+        "named "
         "control: no gap beyond the margin): "
         + _not_decomposed(summary.loc[[not g for g in robust_gap], ["family", "diagnostic"]],
                           missing)
@@ -136,17 +137,27 @@ def _not_decomposed(rows, missing) -> str:
 
 def _open_gaps(gaps) -> str:
     """The sentence on the gaps that nothing here closes: primary rows of 'left' whose CI
-    contains 1 (the ingredients' shares add up to nothing)."""
+    contains 1 (the ingredients' shares add up to nothing), with the two shares when they
+    cancel (opposite signs)."""
     from kicktimes.report.decomposition import STEPS
 
+    primary = gaps[gaps["control"] == "primary"].set_index(["family", "diagnostic",
+                                                            "quantity"])
     left = gaps[(gaps["control"] == "primary") & (gaps["quantity"] == STEPS[2])]
     open_ = left[(left["ci_low"] <= 1) & (left["ci_high"] >= 1)]
     if open_.empty:
         return ""
-    return ("Nothing here closes " + "; ".join(
-        f"{_short(r.family)}'s {r.diagnostic} gap (left "
-        f"{format_interval(r.estimate, r.ci_low, r.ci_high)})"
-        for r in open_.itertuples()) + ".")
+    parts = []
+    for r in open_.itertuples():
+        text = (f"{r.diagnostic} of {_short(r.family)} (left "
+                f"{format_interval(r.estimate, r.ci_low, r.ci_high)}")
+        shares = [primary["estimate"].get((r.family, r.diagnostic, step)) for step in
+                  STEPS[:2]]
+        if None not in shares and shares[0] * shares[1] < 0:
+            text += (f": the deflection's {shares[0]:.3g} and the timing's {shares[1]:.3g} "
+                     "cancel")
+        parts.append(text + ")")
+    return "Nothing here closes the gap of " + "; nor of ".join(parts) + "."
 
 
 def counts_section(table):
@@ -178,8 +189,20 @@ def _counts_reading(rows) -> list[str]:
             e = by.loc["elastic"]
             text += (f", elastic rule {format_interval(e.estimate, e.ci_low, e.ci_high)}"
                      f" ({e.verdict})")
+        text += _counts_robustness(part)
         out.append(text)
     return [" " + "; ".join(out) + "."] if out else []
+
+
+def _counts_robustness(part) -> str:
+    """``" — robust"`` or ``" — not robust: 0.992–1.095 over its 7 controls, CIs on both
+    sides of 1"``: what the counts' controls say together (`with_robustness`)."""
+    x = part["estimate"].astype(float)
+    if part["robust"].astype(str).str.lower().eq("true").all():
+        return f" — robust over its {len(part)} settings ({x.min():.3g}–{x.max():.3g})"
+    sides = (part["ci_low"] > 1).any() and (part["ci_high"] < 1).any()
+    return (f" — not robust over its {len(part)} settings ({x.min():.3g}–{x.max():.3g}"
+            + (", CIs on both sides of 1" if sides else ", the verdict changes") + ")")
 
 
 def copy_first_screen(page, target):
@@ -216,7 +239,9 @@ PROTOCOL_POINTER = [
     "The FTLE here is kicktimes' tangent-space exponent (the paper's variant: the larger of "
     "the x- and y-perturbation exponents); the paper's claims read by its "
     "own protocol (its eq. (4) as printed, which never renormalises its twins) are on "
-    "[paper.md](paper.md)."]
+    "[paper.md](paper.md), measured on its own runs (its panels' ICs and steps, the RR at "
+    "the paper's ε on the paper's steps); each of its lines quotes this page's number beside "
+    "its own."]
 
 
 def results_sources(findings, families, by_radius, *, gaps, nulls):
@@ -437,9 +462,13 @@ def write_results(
         "![headline](headline_ratios_vs_radius.png)", "",
         "Kicked / two-disk ratio of ensemble means against r for the paper's two uniform "
         "kicks and the scatter kick, per diagnostic and family (95 % CIs clustered on ICs; "
-        "grey: the ±10 % band; every kick law and DET at ε = 10⁻³: the findings_by_radius "
-        "CSVs). Ratios (`kicktimes.stats.ratio_verdict`): within 10 % when the whole CI lies "
-        "in [0.9, 1.1], higher / lower when it lies beyond, undecided otherwise; robust when "
+        "grey: the diagnostic's band; every kick law and DET at ε = 10⁻³: the "
+        "findings_by_radius CSVs). Ratios (`kicktimes.stats.ratio_verdict`): within the "
+        f"margin when the whole CI lies in the band (`kicktimes.stats.margin_of`: "
+        f"±{100 * margin_of('ftle'):g} % for the FTLE, ±{100 * margin_of('rr_offdiag'):g} % "
+        f"for the off-diagonal RR, ±{100 * MARGIN:g} % otherwise), higher / lower when it "
+        "lies beyond, "
+        "undecided otherwise; robust when "
         "every control gives the same verdict and no two controls' CIs lie on opposite sides "
         "of 1 (margins: [definitions](../definitions.md#margins-and-nulls)). "
         + PROTOCOL_POINTER[0], ""]

@@ -15,6 +15,7 @@ from kicktimes.stats import (
     format_interval,
     ratio_reading,
     ratio_verdict,
+    ratio_words,
     side_of,
 )
 from kicktimes.studies.science.decorrelation import (
@@ -101,13 +102,16 @@ def needed_ics(estimate, low, high, n, tolerance=MARGIN, unit="ICs"):
 
 
 def reading_text(x, lo, hi):
-    """A ratio's interval and its `ratio_reading` (an inconclusive interval that excludes
-    1 reads as a departure of about the margin or less).
+    """A ratio's interval and its `ratio_words` (an inconclusive interval that excludes
+    1 reads as a departure of about the margin or less; one within the margin that
+    excludes 1 says on which side).
 
     >>> reading_text(0.876, 0.815, 0.942)
     '0.876 [0.815, 0.942], below 1 by about the margin or less'
+    >>> reading_text(1.072, 1.046, 1.099)
+    '1.072 [1.046, 1.099], within 10 %, above 1'
     """
-    return f"{format_interval(x, lo, hi)}, {ratio_reading(lo, hi, MARGIN)}"
+    return f"{format_interval(x, lo, hi)}, {ratio_words(lo, hi, MARGIN)}"
 
 
 def _ratio_cell(x, lo, hi, n, unit="ICs"):
@@ -120,8 +124,8 @@ def _ratio_cell(x, lo, hi, n, unit="ICs"):
 
 
 def _readings(frame, low="ci_low", high="ci_high"):
-    """The `ratio_reading` of every row of ``frame``."""
-    return frame.apply(lambda x: ratio_reading(x[low], x[high], MARGIN), axis=1)
+    """The `ratio_words` of every row of ``frame``."""
+    return frame.apply(lambda x: ratio_words(x[low], x[high], MARGIN), axis=1)
 
 
 def _verdict_counts(verdicts):
@@ -209,14 +213,18 @@ def _decorrelation_answer(compare, n_dec):
     if unresolved:
         parts.append(f"{unresolved} of {len(compare)} rows not resolved at this size "
                      "(interval contains 1)")
-    near = compare.iloc[compare["measured_over_predicted"].map(
-        lambda v: abs(math.log(v))).argmin()]
+    distance = compare["measured_over_predicted"].map(lambda v: abs(math.log(v)))
+    near, far = compare.iloc[distance.argmin()], compare.iloc[distance.argmax()]
+
+    def cell(row):
+        return (reading_text(row.measured_over_predicted, row.quotient_ci_low,
+                             row.quotient_ci_high)
+                + f" ({row.rule}, r = {row.radius:g}, {KICKED[row.system]})")
+
     return ("- **One-collision decorrelation model** (predicts the kicked / two-disk "
             "1 − R₁), measurement / prediction: " + "; ".join(parts) + "; closest to 1: "
-            + reading_text(near.measured_over_predicted, near.quotient_ci_low,
-                           near.quotient_ci_high)
-            + f" ({near.rule}, r = {near.radius:g}, {KICKED[near.system]}); caveat: "
-            f"{int(n_dec)} ICs of direct runs against the family store.")
+            + cell(near) + "; farthest: " + cell(far) + f"; caveat: {int(n_dec)} ICs of "
+            "direct runs against the family store.")
 
 
 def _trend_agrees(g, tr, tc):

@@ -75,7 +75,7 @@ class ScienceScale:
 
 #: ``paper``: the sizes of docs/results/science.md; ``quick``: seconds (on the quick stores)
 SCALES = {
-    "paper": ScienceScale("stretching_small_r", SMALL_RADII, 100, None, (0.008, 0.02), 8,
+    "paper": ScienceScale("stretching_small_r", SMALL_RADII, 100, None, (0.008, 0.02), 40,
                           3000, (0.008, 0.02), 40, 20000.0),
     "quick": ScienceScale("stretching_small_r-quick", (0.014, 0.02, 0.03), 8, 1000, (0.02,),
                           2, 150, (0.008, 0.02), 4, 2000.0),
