@@ -16,7 +16,7 @@ import pandas as pd
 from kicktimes.render.pages import markdown_table
 from kicktimes.report.answers import CONTROL_WORDS, SCREEN_ROWS, family_short
 from kicktimes.report.controls import LOWER, POISSON_QUESTION
-from kicktimes.stats import MARGIN, format_interval, margin_of, ratio_verdict
+from kicktimes.stats import MARGIN, format_interval, margin_of, ratio_verdict, side_of
 
 __all__ = ["QUESTIONS", "answer_lines", "compact_overview", "first_screen", "qa_table"]
 
@@ -78,7 +78,13 @@ def _deciding(rows, main) -> list[str]:
     return found or [c for c in dict.fromkeys(rows["depends_on"].fillna("")) if c]
 
 
-def _word(verdict) -> str:
+def _word(verdict, row=None, short=False) -> str:
+    """The answer's word for ``verdict``; an inconclusive ``row`` whose interval lies on
+    one side of 1 says so (`kicktimes.stats.side_of`): a departure of about the margin or
+    less, not an unresolved one."""
+    side = side_of(row.ci_low, row.ci_high) if row is not None else None
+    if verdict == "inconclusive" and side:
+        return f"{side} 1, ≲ margin" if short else f"{side} 1 by about the margin or less"
     return ("yes, " + verdict) if verdict.startswith("within") else _WORDS.get(verdict, verdict)
 
 
@@ -109,7 +115,7 @@ def _ratio_line(question, rows, margin=MARGIN) -> str:
     over = (f"{n_controls} controls" + (" and both families" if families > 1 else "")
             if n_controls else "both families" if families > 1 else "")
     if rows["verdict"].nunique() == 1:
-        text = f"**{question}** {_word(primary.verdict)}{at}: {_ci(primary)} {where}"
+        text = f"**{question}** {_word(primary.verdict, primary)}{at}: {_ci(primary)} {where}"
         if _sides(rows):  # one verdict, but intervals on both sides of 1: not robust
             text += f"; not robust: CIs on both sides of 1 ({_range(rows)})"
         elif over:
@@ -127,13 +133,19 @@ def _ratio_line(question, rows, margin=MARGIN) -> str:
         c = other[other["control"] == control].iloc[0]
         named = CONTROL_WORDS.get(control, control)
         text = (f"**{question}** depends on {named}{at}: "
-                f"{primary.verdict} {_ci(primary)} {where} under the primary, {c.verdict} "
+                f"{_read(primary)} {_ci(primary)} {where} under the primary, {_read(c)} "
                 f"{_ci(c)} ({family_short(c.family)}, {_KICKS.get(c.system, c.system)}) "
                 f"under {named}")
     below = int((rows["ci_high"] < 1).sum())
     if primary.verdict.startswith("within") and below:
         text += f"; CI below 1 in {below} of {len(rows)} cells"
     return text + "."
+
+
+def _read(row) -> str:
+    """A row's verdict as the answer reads it (`_word` without the "yes, " / "no, ")."""
+    word = _word(row.verdict, row)
+    return row.verdict if word.startswith(("yes, ", "no, ")) else word
 
 
 def _cell(row) -> str:
@@ -259,7 +271,7 @@ def compact_overview(table: pd.DataFrame) -> pd.DataFrame:
             deciding = [c.strip() for c in str(p.depends_on or "").split(",") if c.strip()]
             deciding = deciding[:1] or _deciding(rows, p.verdict)[:1]
             mark = "✓" if robust else "✗ " + "".join(_CONTROL_SHORT.get(c, c) for c in deciding)
-            line[_KICKS[system]] = f"{_word(p.verdict)} {p.estimate:.3g} {mark}"
+            line[_KICKS[system]] = f"{_word(p.verdict, p, short=True)} {p.estimate:.3g} {mark}"
         out.append(line)
     return pd.DataFrame(out)
 
