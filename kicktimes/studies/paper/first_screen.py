@@ -115,14 +115,15 @@ def _ratio_line(question, rows, margin=MARGIN) -> str:
     over = (f"{n_controls} controls" + (" and both families" if families > 1 else "")
             if n_controls else "both families" if families > 1 else "")
     if rows["verdict"].nunique() == 1:
-        text = f"**{question}** {_word(primary.verdict, primary)}{at}: {_ci(primary)} {where}"
+        text = (f"**{question}** {_word(primary.verdict, primary, short=True)}{at}: "
+                f"{_ci(primary)} {where}")
         if _sides(rows):  # one verdict, but intervals on both sides of 1: not robust
             text += f"; not robust: CIs on both sides of 1 ({_range(rows)})"
         elif over:
             far = _size_control(rows, primary, margin)
             text += (f"; robust over {over} ({_range(rows)})" if far is None else
                      f"; robust in direction over {over} ({_range(rows)}), not in size: "
-                     f"{far.estimate:.3g} in {_cell(far)}")
+                     f"{far.estimate:.3g} ({_cell(far)})")
     else:
         other = rows[rows["verdict"] != primary.verdict]
         # the control that decides: the findings table's own (`with_robustness`: an
@@ -134,8 +135,10 @@ def _ratio_line(question, rows, margin=MARGIN) -> str:
         named = CONTROL_WORDS.get(control, control)
         text = (f"**{question}** depends on {named}{at}: "
                 f"{_read(primary)} {_ci(primary)} {where} under the primary, {_read(c)} "
-                f"{_ci(c)} ({family_short(c.family)}, {_KICKS.get(c.system, c.system)}) "
-                f"under {named}")
+                f"{_ci(c)}"
+                + ("" if (c.family, c.system) == (family, system) else
+                   f" ({family_short(c.family)}, {_KICKS.get(c.system, c.system)})")
+                + f" under {named}")
     below = int((rows["ci_high"] < 1).sum())
     if primary.verdict.startswith("within") and below:
         text += f"; CI below 1 in {below} of {len(rows)} cells"
@@ -144,14 +147,14 @@ def _ratio_line(question, rows, margin=MARGIN) -> str:
 
 def _read(row) -> str:
     """A row's verdict as the answer reads it (`_word` without the "yes, " / "no, ")."""
-    word = _word(row.verdict, row)
+    word = _word(row.verdict, row, short=True)
     return row.verdict if word.startswith(("yes, ", "no, ")) else word
 
 
 def _cell(row) -> str:
-    """``"B, Poisson kicks, the elastic rule"``: the family, kick law and control of a
-    findings row."""
-    control = "" if row.control == "primary" else ", " + CONTROL_WORDS.get(row.control,
+    """``"B, Poisson kicks, elastic"``: the family, kick law and control (its short name)
+    of a findings row."""
+    control = "" if row.control == "primary" else ", " + _CONTROL_SHORT.get(row.control,
                                                                             row.control)
     return f"{family_short(row.family)}, {_KICKS.get(row.system, row.system)}{control}"
 
@@ -164,8 +167,8 @@ def _size_control(rows, primary, margin):
     ok = np.isfinite(x) & (x > 0)
     if ok.sum() < 2 or x[ok].max() / x[ok].min() <= (1 + margin) / (1 - margin):
         return None
-    distance = np.abs(np.log(x[ok] / primary.estimate))
-    return rows[ok].loc[distance.idxmax()]
+    distance = np.abs(np.log(x[ok].to_numpy(float) / primary.estimate))
+    return rows[ok.to_numpy()].iloc[int(np.argmax(distance))]
 
 
 def _poisson_line(table) -> str | None:
@@ -185,24 +188,23 @@ def _poisson_line(table) -> str | None:
     robust = verdicts["verdict"].nunique() == 1 and verdicts["control"].nunique() > 1
     level = _null_share(share)
     text = (f"**{POISSON_LINE}** {'no' if main.verdict == 'not Poisson' else main.verdict}: "
-            f"{_pct(share)} of runs reject uniformity (null streams {level})")
+            f"{_pct(share)} of runs reject uniformity (null {level})")
     if excess is not None:
-        text += f", D − null D {_ci(excess)}"
+        text += f", D − null {_ci(excess)}"
     text += f" ({family_short(family)}{', robust over rule × ICs' if robust else ''})"
     e_share = _one(rows, diagnostic=f"reject@{HEADLINE_TEST}", family=family, control="elastic")
     e_excess = _one(rows, diagnostic="dispersion_index_excess", family=family,
                     control="elastic")
     if e_share is not None:
-        text += (f"; elastic rule {_pct(e_share)}"
-                 + (f", D − null D {_ci(e_excess)}" if e_excess is not None else ""))
+        text += (f"; elastic {_pct(e_share)}"
+                 + (f", D − null {_ci(e_excess)}" if e_excess is not None else ""))
     return text + _sign_flips(rows, family) + "."
 
 
 def _sign_flips(rows, family) -> str:
-    """``"; the first hazard bin − its null changes sign with the rule (0.656 mirror,
-    -0.331 elastic)"``: the statistics whose departure from their null lies on one side
-    under the primary rule and on the other under the elastic rule (both not Poisson,
-    in opposite directions)."""
+    """``"; the first hazard bin changes sign with the rule (table below)"``: the statistics whose departure from
+    their null lies on one side under the primary rule and on the other under the elastic
+    rule (both not Poisson, in opposite directions)."""
     from kicktimes.stats import side_of
 
     names = {"hazard_first_excess": "the first hazard bin", "gamma_shape_excess":
@@ -215,11 +217,11 @@ def _sign_flips(rows, family) -> str:
             continue
         sides = side_of(p.ci_low, p.ci_high, 0.0), side_of(e.ci_low, e.ci_high, 0.0)
         if None not in sides and sides[0] != sides[1]:
-            flips.append(f"{name} {p.estimate:.3g} (primary) vs {e.estimate:.3g} (elastic)")
+            flips.append(name)
     if not flips:
         return ""
-    return ("; against their nulls, " + " and ".join(flips)
-            + " change sign with the rule (clustered vs regular times)")
+    return (f"; {' and '.join(flips)} {'change' if len(flips) > 1 else 'changes'} sign "
+            "with the rule (table below)")
 
 
 def _null_share(row) -> str:
@@ -289,6 +291,8 @@ def first_screen(table: pd.DataFrame) -> list[str]:
     lines += ["Every diagnostic by kick law (family A, primary, each at its margin: "
               f"±{100 * margin_of('ftle'):g} % for the FTLE, ±{100 * margin_of('rr_offdiag'):g} "
               f"% for the off-diagonal RR, ±{100 * MARGIN:g} % otherwise; ✓ robust over every "
-              "control and both families, ✗ the first control that changes it; "
+              "control and both families, ✗ the first control that changes it; ≲ margin: the "
+              "CI lies on one side of 1 but reaches into the band, a departure of about the "
+              "margin or less; "
               "every cell with both numbers: [overview.csv](overview.csv)):", ""]
     return lines + markdown_table(compact_overview(table)) + [""]
