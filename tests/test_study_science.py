@@ -14,6 +14,7 @@ from kicktimes.render.provenance import PROVENANCE_TITLE
 from kicktimes.stats import (
     equivalence_sample_size,
     format_interval,
+    margin_of,
     null_reading,
     ratio_reading,
     ratio_verdict,
@@ -32,7 +33,7 @@ def _findings(folder, families, radius=0.03):
     for family in families:
         rows = [{"family": family, "diagnostic": d, "system": s, "control": "primary",
                  "estimate": e, "ci_low": e - 0.05, "ci_high": e + 0.05,
-                 "verdict": ratio_verdict(e - 0.05, e + 0.05)}
+                 "verdict": ratio_verdict(e - 0.05, e + 0.05, margin_of(d))}
                 for d in ("ftle", "one_minus_r1")
                 for s, e in (("poisson", 0.3), ("actual", 0.32), ("poisson_scatter", 0.97),
                              ("actual_scatter", 0.9))]
@@ -74,7 +75,8 @@ def test_the_page_names_the_command_and_quotes_its_csv(built):
     table = pd.read_csv(page.parent / "science_stretching.csv")
     text = page.read_text(encoding="utf-8")
     for row in table[table["system"] != "two_particle"].itertuples():
-        assert row.verdict == ratio_verdict(row.ratio_ci_low, row.ratio_ci_high)
+        assert row.verdict == ratio_verdict(row.ratio_ci_low, row.ratio_ci_high,
+                                            margin_of("ftle"))
         assert (f"{format_interval(row.ratio, row.ratio_ci_low, row.ratio_ci_high)}, "
                 f"{row.verdict}") in text
     twins = pd.read_csv(page.parent / "science_independent_twins.csv")
@@ -190,16 +192,16 @@ def test_the_closest_table_pairs_each_law_with_its_own_verdict():
     closest = pd.DataFrame({
         "family": ["family_a"] * 3, "diagnostic": ["ftle"] * 3,
         "system": ["poisson_scatter", "actual_scatter", "poisson"],
-        "ratio": [0.966, 0.922, 0.4], "ci_low": [0.932, 0.897, 0.38],
+        "ratio": [0.976, 0.922, 0.4], "ci_low": [0.962, 0.897, 0.38],
         "ci_high": [1.02, 0.962, 0.42],
-        "verdict": ["within 10 %", "inconclusive", "lower"],
+        "verdict": ["within 5 %", "inconclusive", "lower"],
         "closest": [True, True, False]})
     (row,) = science_page.closest_cells(closest)
     laws = row.split(" | ")[2].split("; ")
-    assert laws == ["poisson_scatter 0.966 [0.932, 1.02], within 10 %",
+    assert laws == ["poisson_scatter 0.976 [0.962, 1.02], within 5 %",
                     "actual_scatter 0.922 [0.897, 0.962], below 1 by about the margin or less"]
     assert row.endswith("| poisson |")
-    bad = closest.assign(verdict=["inconclusive", "within 10 %", "lower"])
+    bad = closest.assign(verdict=["inconclusive", "within 5 %", "lower"])
     with pytest.raises(ValueError, match="poisson_scatter"):
         science_page.closest_cells(bad)
 

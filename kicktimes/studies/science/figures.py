@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 
-from kicktimes.stats import MARGIN
+from kicktimes.stats import margin_of
 
 __all__ = ["LEGEND", "stretching_figure"]
 
@@ -43,7 +43,8 @@ def stretching_figure(per_radius, path):
         a.set_xlim(per_radius["ln_inv_r"].min() - 0.15, top + 0.15)
     ax.set_ylabel("stretching per perturbation λ/Γ (nats)")
     ax.legend(fontsize="small", loc="upper left")
-    bx.axhspan(1 - MARGIN, 1 + MARGIN, color="0.88", label="±10 % around 1")
+    band = margin_of("ftle")  # the FTLE's margin, the findings tables' and the README's
+    bx.axhspan(1 - band, 1 + band, color="0.88", label=f"±{100 * band:g} % around 1")
     bx.axhline(1.0, color="0.5", linewidth=0.8)
     bx.set_ylim(0, 1.2)
     bx.set_ylabel("kicked / two-disk stretching (= FTLE ratio)")

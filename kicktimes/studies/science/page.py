@@ -13,6 +13,7 @@ from kicktimes.stats import (
     MARGIN,
     equivalence_sample_size,
     format_interval,
+    margin_of,
     ratio_reading,
     ratio_verdict,
     ratio_words,
@@ -101,7 +102,7 @@ def needed_ics(estimate, low, high, n, tolerance=MARGIN, unit="ICs"):
             f"{unit}")
 
 
-def reading_text(x, lo, hi):
+def reading_text(x, lo, hi, tolerance=MARGIN):
     """A ratio's interval and its `ratio_words` (an inconclusive interval that excludes
     1 reads as a departure of about the margin or less; one within the margin that
     excludes 1 says on which side).
@@ -111,15 +112,15 @@ def reading_text(x, lo, hi):
     >>> reading_text(1.072, 1.046, 1.099)
     '1.072 [1.046, 1.099], within 10 %, above 1'
     """
-    return f"{format_interval(x, lo, hi)}, {ratio_words(lo, hi, MARGIN)}"
+    return f"{format_interval(x, lo, hi)}, {ratio_words(lo, hi, tolerance)}"
 
 
-def _ratio_cell(x, lo, hi, n, unit="ICs"):
+def _ratio_cell(x, lo, hi, n, unit="ICs", tolerance=MARGIN):
     """`reading_text`, and for an interval that contains 1 and is inconclusive the size
     that would resolve it (never for one that excludes 1: that is a departure)."""
-    text = reading_text(x, lo, hi)
-    if ratio_reading(lo, hi, MARGIN) == "inconclusive" and n:
-        text += f" ({needed_ics(x, lo, hi, n, unit=unit)})"
+    text = reading_text(x, lo, hi, tolerance)
+    if ratio_reading(lo, hi, tolerance) == "inconclusive" and n:
+        text += f" ({needed_ics(x, lo, hi, n, tolerance=tolerance, unit=unit)})"
     return text
 
 
@@ -137,6 +138,7 @@ def reading():
     """How the page's verdicts are read, stated once."""
     return ["How to read it: intervals are 95 % bootstrap intervals over ICs unless said "
             "otherwise; a ratio is read by `ratio_verdict` against the 10 % band around 1 "
+            f"(the FTLE's against ±{100 * margin_of('ftle'):g} %, `margin_of`) "
             "(an equivalence test, [definitions](../definitions.md)); an inconclusive "
             "interval that excludes 1 reads \"below (above) 1 by about the margin or less\", "
             "a real departure; one that contains 1 names the ICs that would "
@@ -160,7 +162,8 @@ def first_screen(per_radius, trend, twins, compare, windows, whole, *, n_ics, n_
         lines.append(
             f"- **{name[0].upper()}{name[1:]}, FTLE / two-disk FTLE**: "
             f"{_verdict_counts(g['verdict'])} of {len(g)} radii ({lo_r:g}–{hi_r:g}); at "
-            f"r = {lo_r:g}: {reading_text(row.ratio, row.ratio_ci_low, row.ratio_ci_high)}; "
+            f"r = {lo_r:g}: "
+            f"{reading_text(row.ratio, row.ratio_ci_low, row.ratio_ci_high, margin_of('ftle'))}; "
             "caveat: " + (f"the ratio {tr.verdict} towards 1 as r falls (both trend measures)"
                           if agree and tc.verdict == "falls" else
                           "no direction of the trend is claimed (the two trend measures "
@@ -257,7 +260,8 @@ def stretching_lines(exp, per_radius, fits, trend):
         cells = []
         for s in KICKED:
             g = kicked[(kicked["system"] == s) & (kicked["radius"] == r)].iloc[0]
-            cells.append(_ratio_cell(g.ratio, g.ratio_ci_low, g.ratio_ci_high, exp.n_ics))
+            cells.append(_ratio_cell(g.ratio, g.ratio_ci_low, g.ratio_ci_high, exp.n_ics,
+                                     tolerance=margin_of("ftle")))
         lines.append(f"| {r:g} | " + " | ".join(cells) + " |")
     lines += ["", "The paper's expectation, agreement that improves for smaller disks "
               "(slopes against ln(1/r): `science_stretching_trend.csv`):", ""]
@@ -278,7 +282,8 @@ def stretching_lines(exp, per_radius, fits, trend):
         else:
             trend_txt = "no trend detected by either measure"
         n_within = int(g["verdict"].str.startswith("within").sum())
-        lines.append(f"- {name}: {trend_txt}; within 10 % at {n_within} of {len(g)} radii"
+        lines.append(f"- {name}: {trend_txt}; within {100 * margin_of('ftle'):g} % at "
+                     f"{n_within} of {len(g)} radii"
                      + ("; the expectation of agreement is met at no measured radius."
                         if n_within == 0 else "."))
     lines += ["", f"What happens below r = {lo_r:g} is not measured here. "
@@ -287,7 +292,8 @@ def stretching_lines(exp, per_radius, fits, trend):
               "samples'.", "",
               "![stretching](science_stretching.png)", "",
               "**Left:** stretching per perturbation against ln(1/r); **right:** the kicked / "
-              "two-disk ratio with the ±10 % band; 95 % intervals over ICs.", ""]
+              f"two-disk ratio with the ±{100 * margin_of('ftle'):g} % band (the FTLE's margin, "
+              "`kicktimes.stats.margin_of`); 95 % intervals over ICs.", ""]
     return lines
 
 
@@ -360,11 +366,13 @@ def closest_cells(closest):
     lines = []
     for (family, diag), g in closest.groupby(["family", "diagnostic"], sort=False, observed=True):
         best, rest = g[g["closest"]], g[~g["closest"]]
+        margin = margin_of(diag)  # the findings table's margin of this diagnostic
         for row in best.itertuples():
-            if ratio_verdict(row.ci_low, row.ci_high, MARGIN) != row.verdict:
+            if ratio_verdict(row.ci_low, row.ci_high, margin) != row.verdict:
                 raise ValueError(f"closest: {family}/{diag}/{row.system} has verdict "
                                  f"{row.verdict!r}, its interval says otherwise")
-        names = "; ".join(f"{row.system} {reading_text(row.ratio, row.ci_low, row.ci_high)}"
+        names = "; ".join(f"{row.system} "
+                          f"{reading_text(row.ratio, row.ci_low, row.ci_high, margin)}"
                           for row in best.itertuples())
         lines.append(f"| `{family}` | {diag} | {names if len(rest) else 'none (all overlap)'} "
                      f"| {', '.join(rest['system']) or '—'} |")

@@ -18,7 +18,7 @@ import pandas as pd
 from kicktimes.experiment import preset
 from kicktimes.render.pages import trend_verdict
 from kicktimes.stats import (
-    MARGIN,
+    margin_of,
     percentile_interval,
     ratio_verdict,
     resample_indices,
@@ -127,7 +127,7 @@ def stretching(results, n_boot=N_BOOT, seed=0):
             if system != "two_particle":
                 lo, hi = percentile_interval(ratio[1:, j])
                 row.update(ratio=ratio[0, j], ratio_ci_low=lo, ratio_ci_high=hi,
-                           verdict=ratio_verdict(lo, hi, MARGIN))
+                           verdict=ratio_verdict(lo, hi, margin_of("ftle")))
             per_radius.append(row)
         coef = lstsq(s[system])
         local = np.diff(s[system][0]) / np.diff(x)
