@@ -15,6 +15,7 @@ import pytest
 from kicktimes.report.controls import SHAPE_MARGIN
 from kicktimes.stats import (
     D_MARGIN,
+    margin_of,
     null_verdict,
     poisson_verdict,
     ratio_verdict,
@@ -37,6 +38,10 @@ def test_every_verdict_is_the_one_its_interval_gives(path):
     poisson = table["question"] == "Poisson collision times?"
     for row in table[~poisson].itertuples():
         assert row.verdict == ratio_verdict(row.ci_low, row.ci_high), row
+        # the diagnostic's own margin, the one the pages read (`margin_of`)
+        assert row.margin == margin_of(row.diagnostic), row
+        assert row.verdict_at_margin == ratio_verdict(row.ci_low, row.ci_high,
+                                                      margin_of(row.diagnostic)), row
     # the Poisson rows: each share against its test's level in null_calibration.csv (the
     # runs' own Poisson control streams; alpha for the first-collisions row); D, the first
     # hazard bin and the gamma shape against their control streams' values (the paired

@@ -79,7 +79,8 @@ __all__ = [
 CONTROLS = ("primary", "paired_median", "sticky_excluded", "paper_sampling")
 #: the columns of the findings table
 COLUMNS = ("family", "question", "diagnostic", "system", "control", "estimate", "ci_low",
-           "ci_high", "verdict", "robust", "depends_on", "n_pairs", "detail")
+           "ci_high", "verdict", "margin", "verdict_at_margin", "robust", "depends_on",
+           "n_pairs", "detail")
 HIGHER = "higher"
 LOWER = "lower"
 INCONCLUSIVE = "inconclusive"
@@ -127,7 +128,11 @@ def _row(family, diagnostic, system, control, est, low, high, n_pairs, detail):
         "estimate": est,
         "ci_low": low,
         "ci_high": high,
-        "verdict": ratio_verdict(low, high, margin_of(diagnostic)),
+        # ``verdict``: the tables' common ±10 % band (`MARGIN`); ``verdict_at_margin``: the
+        # diagnostic's own margin (`margin_of`), the one the pages read and robustness uses
+        "verdict": ratio_verdict(low, high),
+        "margin": margin_of(diagnostic),
+        "verdict_at_margin": ratio_verdict(low, high, margin_of(diagnostic)),
         "robust": False,
         "depends_on": "",
         "n_pairs": int(n_pairs),
@@ -268,7 +273,7 @@ def with_robustness(table: pd.DataFrame) -> pd.DataFrame:
     depends = np.array([""] * len(out), dtype=object)
     for _, g in out.groupby(["family", "diagnostic", "system"], sort=False, observed=True):
         share = (g["question"] == POISSON_QUESTION).all()
-        ok, _ = robust_verdict(list(g["verdict"]), g["ci_low"], g["ci_high"],
+        ok, _ = robust_verdict(list(_read_verdicts(g)), g["ci_low"], g["ci_high"],
                                level=np.inf if share else 1.0)
         pos = out.index.get_indexer(g.index)
         robust[pos] = ok
@@ -277,6 +282,15 @@ def with_robustness(table: pd.DataFrame) -> pd.DataFrame:
     out["robust"] = robust
     out["depends_on"] = depends
     return out
+
+
+def _read_verdicts(g: pd.DataFrame) -> pd.Series:
+    """The verdicts robustness reads: each row's ``verdict_at_margin`` (its diagnostic's
+    own margin) where it has one, else its ``verdict`` (the Poisson rows)."""
+    if "verdict_at_margin" not in g.columns:
+        return g["verdict"]
+    at = g["verdict_at_margin"]
+    return at.where(at.notna() & (at.astype(str) != ""), g["verdict"])
 
 
 def _deciding_control(g: pd.DataFrame, share: bool) -> str:
@@ -297,7 +311,8 @@ def _deciding_control(g: pd.DataFrame, share: bool) -> str:
             far = max(flipped, key=lambda r: abs(math.log(r["estimate"] / first["estimate"]))
                       if r["estimate"] > 0 and first["estimate"] > 0 else 0.0)
             return str(far["control"])
-    changed = others[others["verdict"] != first["verdict"]]
+    verdicts = _read_verdicts(g)
+    changed = others[verdicts.iloc[1:].to_numpy() != verdicts.iloc[0]]
     if changed.empty:
         changed = others
     with np.errstate(divide="ignore", invalid="ignore"):

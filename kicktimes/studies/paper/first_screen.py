@@ -202,9 +202,9 @@ def _poisson_line(table) -> str | None:
 
 
 def _sign_flips(rows, family) -> str:
-    """``"; the first hazard bin changes sign with the rule (table below)"``: the statistics whose departure from
-    their null lies on one side under the primary rule and on the other under the elastic
-    rule (both not Poisson, in opposite directions)."""
+    """``"; the first hazard bin changes sign with the rule (table below)"``: the
+    statistics whose departure from their null lies on one side under the primary rule
+    and on the other under the elastic rule (both not Poisson, in opposite directions)."""
     from kicktimes.stats import side_of
 
     names = {"hazard_first_excess": "the first hazard bin", "gamma_shape_excess":
@@ -263,6 +263,9 @@ def compact_overview(table: pd.DataFrame) -> pd.DataFrame:
         line = {"diagnostic": label}
         for system in systems:
             rows = part[part["system"] == system]
+            # each cell at its diagnostic's margin, as the answers read it
+            rows = rows.assign(verdict=[ratio_verdict(lo, hi, margin_of(diagnostic)) for lo, hi
+                                        in zip(rows["ci_low"], rows["ci_high"], strict=True)])
             p = _one(rows, family=family, control="primary")
             if p is None:
                 line[_KICKS[system]] = ""

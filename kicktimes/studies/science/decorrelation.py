@@ -185,7 +185,8 @@ def closest_kick_law(findings_dir, families, diagnostics=("ftle", "one_minus_r1"
                             disjoint.append(control)
                 rows.append({"family": family, "diagnostic": diag, "system": s,
                              "ratio": g["estimate"], "ci_low": g["ci_low"],
-                             "ci_high": g["ci_high"], "verdict": g["verdict"],
+                             "ci_high": g["ci_high"],
+                             "verdict": g.get("verdict_at_margin", g["verdict"]),
                              "distance_low": dist[s][0], "distance_high": dist[s][1],
                              "closest": bool(dist[s][0] <= dist[best][1]),
                              "disjoint_under": ", ".join(disjoint)})
