@@ -20,7 +20,7 @@ from kicktimes import __version__
 from kicktimes.fileio import atomic_write_bytes
 from kicktimes.report.context import Context, Mapper, Progress
 from kicktimes.report.store import load_report_store
-from kicktimes.stats import MARGIN, format_interval, margin_of
+from kicktimes.stats import format_interval
 from kicktimes.validation import check_int
 
 __all__ = ["PROTOCOL_POINTER", "copy_first_screen", "counts_section", "poisson_section",
@@ -81,12 +81,11 @@ def poisson_section(table, calibrated=False):
     return [
         "## Are the collision times Poisson? The collision rule as a factor", "",
         *markdown_table(pd.DataFrame(frame)), "",
-        f"A share is read against {level} (`rejection_verdict`: above nominal when its CI "
-        f"lies above 1.5 times that level). D, the first hazard bin (intervals below 0.1 "
-        f"mean intervals) and the gamma shape are read against the same statistic on those "
-        f"streams (`null_verdict`: the CI of the paired difference against ±{D_MARGIN:g} for "
-        f"D, ±{SHAPE_MARGIN:g} for the others). Every test, control and the invariant-measure "
-        "ICs: [family_a_findings.csv](family_a_findings.csv).", ""]
+        f"A share is read against {level} (`rejection_verdict`: above nominal beyond 1.5 "
+        f"times it); D, the first hazard bin (intervals below 0.1 mean intervals) and the "
+        f"gamma shape against the same statistic on those streams (`null_verdict`, ±{D_MARGIN:g} "
+        f"for D, ±{SHAPE_MARGIN:g} otherwise). Every test and control: "
+        "[family_a_findings.csv](family_a_findings.csv).", ""]
 
 
 def gap_section(gaps):
@@ -116,9 +115,7 @@ def gap_section(gaps):
         "timing (two 2 × 2 factorials), 95 % CIs clustered on ICs; sign ✓: the same sign "
         "under every control (their range beside); 'left' = 1 − both shares. "
         + (open_gaps + " " if open_gaps else "")
-        + "Not decomposed (the paper's kick's CI reaches into its diagnostic's band under the "
-        "named "
-        "control: no gap beyond the margin): "
+        + "Not decomposed (no gap beyond the margin under the named control): "
         + _not_decomposed(summary.loc[[not g for g in robust_gap], ["family", "diagnostic"]],
                           missing)
         + ". Every control: [gap_decomposition.csv](gap_decomposition.csv).", "",
@@ -182,12 +179,11 @@ def _counts_reading(rows) -> list[str]:
             continue
         p, k = by.loc["primary"], by.loc["sticky_excluded"]
         text = (f"{_short(family)}: {format_interval(p.estimate, p.ci_low, p.ci_high)} "
-                f"({p.verdict}) with every run, "
-                f"{format_interval(k.estimate, k.ci_low, k.ci_high)} ({k.verdict}) without "
-                "the sticky runs")
+                f"({p.verdict}), without the sticky runs "
+                f"{format_interval(k.estimate, k.ci_low, k.ci_high)} ({k.verdict})")
         if "elastic" in by.index:
             e = by.loc["elastic"]
-            text += (f", elastic rule {format_interval(e.estimate, e.ci_low, e.ci_high)}"
+            text += (f", elastic {format_interval(e.estimate, e.ci_low, e.ci_high)}"
                      f" ({e.verdict})")
         text += _counts_robustness(part)
         out.append(text)
@@ -195,13 +191,13 @@ def _counts_reading(rows) -> list[str]:
 
 
 def _counts_robustness(part) -> str:
-    """``" — robust"`` or ``" — not robust: 0.992–1.095 over its 7 controls, CIs on both
-    sides of 1"``: what the counts' controls say together (`with_robustness`)."""
+    """``"; not robust (0.982–1.1 over 6 settings, CIs on both sides of 1)"``: what the
+    counts' controls say together (`with_robustness`)."""
     x = part["estimate"].astype(float)
     if part["robust"].astype(str).str.lower().eq("true").all():
-        return f" — robust over its {len(part)} settings ({x.min():.3g}–{x.max():.3g})"
+        return f"; robust ({x.min():.3g}–{x.max():.3g} over {len(part)} settings)"
     sides = (part["ci_low"] > 1).any() and (part["ci_high"] < 1).any()
-    return (f" — not robust over its {len(part)} settings ({x.min():.3g}–{x.max():.3g}"
+    return (f"; not robust ({x.min():.3g}–{x.max():.3g} over {len(part)} settings"
             + (", CIs on both sides of 1" if sides else ", the verdict changes") + ")")
 
 
@@ -460,17 +456,11 @@ def write_results(
     figure.savefig(out / "headline_ratios_vs_radius.png", dpi=dpi)
     screen += [
         "![headline](headline_ratios_vs_radius.png)", "",
-        "Kicked / two-disk ratio of ensemble means against r for the paper's two uniform "
-        "kicks and the scatter kick, per diagnostic and family (95 % CIs clustered on ICs; "
-        "grey: the diagnostic's band; every kick law and DET at ε = 10⁻³: the "
-        "findings_by_radius CSVs). Ratios (`kicktimes.stats.ratio_verdict`): within the "
-        f"margin when the whole CI lies in the band (`kicktimes.stats.margin_of`: "
-        f"±{100 * margin_of('ftle'):g} % for the FTLE, ±{100 * margin_of('rr_offdiag'):g} % "
-        f"for the off-diagonal RR, ±{100 * MARGIN:g} % otherwise), higher / lower when it "
-        "lies beyond, "
-        "undecided otherwise; robust when "
-        "every control gives the same verdict and no two controls' CIs lie on opposite sides "
-        "of 1 (margins: [definitions](../definitions.md#margins-and-nulls)). "
+        "Kicked / two-disk ratio of ensemble means against r (the paper's two uniform kicks "
+        "and the scatter kick; 95 % CIs clustered on ICs; grey: the diagnostic's band; every "
+        "kick law: the findings_by_radius CSVs). Verdicts (`ratio_verdict` at `margin_of`) "
+        "and robustness (one verdict under every control, no two CIs on opposite sides of "
+        "1): [definitions](../definitions.md#margins-and-nulls). "
         + PROTOCOL_POINTER[0], ""]
     if nulls:
         from kicktimes.render.pages import write_null_calibration
@@ -491,8 +481,6 @@ def write_results(
                + (" (the families side by side: "
                   + ", ".join(f"[{f}]({f}.png)" for f, _ in family_figures) + ")"
                   if family_figures else "")
-               + (". Control experiments: " + ", ".join(f"`{c}`" for c in control_lines)
-                  if control_lines else "")
                + ". The other studies: [science.md](science.md), [mechanism.md](mechanism.md),"
                " [escape.md](escape.md), [unequal.md](unequal.md), [scatter.md](scatter.md), "
                "[mmpp.md](mmpp.md), [disks.md](disks.md), [paper.md](paper.md) (`kicktimes "
