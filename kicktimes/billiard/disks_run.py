@@ -13,6 +13,7 @@ import numpy as np
 import pandas as pd
 
 from kicktimes import __version__
+from kicktimes._results import Result
 from kicktimes.fileio import atomic_write
 
 __all__ = ["DisksPressure", "DisksRun"]
@@ -70,7 +71,7 @@ class DisksPressure:
 
 
 @dataclass(frozen=True, repr=False)
-class DisksRun:
+class DisksRun(Result):
     """N hard disks in the unit circular table: their collision log and final state.
 
     Attributes
@@ -116,6 +117,18 @@ class DisksRun:
         Rows ``(t, centres in the central region, wall impulse, virial, region's virial)``:
         the engine's running sums at ``t`` (`pressure`).
     """
+
+    _title = "N hard disks (simulate_disks): the collision log"
+    _summary_fields = ("n_disks", "radii", "rule", "t_max", "n_pp", "n_events", "n_wall", "box",
+                       "tau")
+    _frame = "collisions"
+
+    def _summary_extra(self) -> list[str]:
+        if self.holes is None:
+            return []
+        return [f"escaped: {int(np.isfinite(self.escape_times).sum())} of {self.n_disks} "
+                f"through {len(self.holes)} hole(s)"]
+
 
     radii: np.ndarray
     rule: str

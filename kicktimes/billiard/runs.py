@@ -23,6 +23,7 @@ import numpy as np
 import pandas as pd
 
 from kicktimes import __version__
+from kicktimes._results import Result
 from kicktimes.fileio import atomic_write
 
 TWO_PI = 2.0 * np.pi
@@ -62,7 +63,14 @@ def sampling_fields(t_end, mode, sampling, tau, n_steps, sample_times, samples) 
 
 
 @dataclass(frozen=True, repr=False)
-class _Run:
+class _Run(Result):
+    _frame = "boundary"
+
+    def _summary_extra(self) -> list[str]:
+        if self.escaped < 0:
+            return []
+        return [f"escaped: disk {self.escaped} at t = {self.escape_time:.6g}"]
+
     r: float
     t_max: float
     sampling: str | None
@@ -169,6 +177,11 @@ class TwoParticleRun(_Run):
         the same as a DataFrame with the time and the contact normal.
     """
 
+    _title = "Two disks in the unit circular table (simulate_two_particle)"
+    _summary_fields = ("r", "rule", "t_max", "n_pp", "n_boundary", "masses", "sampling", "tau",
+                       "n_steps", "seed")
+
+
     rule: str = "mirror"
     track: int = 0
     pp_times: np.ndarray = field(default_factory=lambda: np.empty(0))
@@ -256,6 +269,11 @@ class OneParticleRun(_Run):
     sample_times, samples : ndarray
         Sample times and the disk's centre at them.
     """
+
+    _title = "One kicked disk in the unit circular table (simulate_one_particle)"
+    _summary_fields = ("r", "t_max", "kick_angle", "sigma", "n_kicks", "n_boundary", "rule",
+                       "sampling", "tau", "n_steps", "seed")
+
 
     kick_angle: str = "uniform"
     sigma: float | None = None

@@ -36,6 +36,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
+from kicktimes._results import Result
 from kicktimes.experiment.config import Experiment
 from kicktimes.experiment.plan import Task, make_tasks
 from kicktimes.stats import MMPP_MIN_EVENTS
@@ -95,9 +96,13 @@ class _Timer:
             self.seconds[name] = self.seconds.get(name, 0.0) + time.perf_counter() - t0
 
 
-@dataclass
-class TaskOutput:
+@dataclass(frozen=True, repr=False)
+class TaskOutput(Result):
     """What a worker returns: the task's two tables and its stage timings (seconds)."""
+
+    _title = "The tables of one task of a sweep (what a worker returns)"
+    _frame = "results"
+
 
     task: Task
     results: pd.DataFrame

@@ -22,13 +22,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from kicktimes._results import Result
+
 from .ensemble import test_poisson_ensemble
 from .mmpp import _em as em
 from .mmpp.fit import MMPPFit, check_windows
 
 
 @dataclass(frozen=True, repr=False)
-class RescaledTimes:
+class RescaledTimes(Result):
     """Time-rescaled windows (result of :func:`mmpp_residuals`).
 
     Attributes
@@ -43,6 +45,15 @@ class RescaledTimes:
     censored : ndarray
         :math:`\\Lambda(T) - \\Lambda(t_N)` of each window (right-censored Exp(1)).
     """
+
+    _title = "Time-rescaled windows under a fitted MMPP (IID Exp(1) intervals if it is right)"
+    _summary_fields = ("windows", "intervals", "censored")
+
+    def _summary_extra(self) -> list[str]:
+        mean = self.intervals.mean() if self.intervals.size else np.nan
+        return [f"windows: {len(self.times)}, events: {self.intervals.size}, mean rescaled "
+                f"interval {mean:.4g} (1 under the model)"]
+
 
     times: list
     windows: np.ndarray
