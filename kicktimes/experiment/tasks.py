@@ -30,6 +30,7 @@ import functools
 import math
 import struct
 import time
+import warnings
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 
@@ -589,6 +590,7 @@ def autocorrelation_rows(theta: np.ndarray, lag: int, max_lag: int) -> list[tupl
     ``R_l <= 0`` up to ``max_lag``). NaN values carry the reason.
     """
     from kicktimes.diagnostics import (
+        UndefinedDiagnosticWarning,
         acf_curve,
         autocorrelation,
         decorrelation_lag,
@@ -596,11 +598,15 @@ def autocorrelation_rows(theta: np.ndarray, lag: int, max_lag: int) -> list[tupl
     )
 
     # one curve: R_lag is its entry lag - 1, bitwise autocorrelation(theta, lag)
-    acf, lag_reasons, curve_reason = acf_curve(theta, max_lag, name="theta")
+    curve = acf_curve(theta, max_lag, name="theta")
+    acf, curve_reason = curve.acf, curve.reason
     if 1 <= lag <= max_lag:
-        value, reason = float(acf[lag - 1]), lag_reasons[lag - 1]
+        value, reason = float(acf[lag - 1]), curve.lag_reasons[lag - 1]
     else:
-        value, reason = autocorrelation(theta, lag, return_reason=True)
+        with warnings.catch_warnings():  # the reason goes into the row's note
+            warnings.simplefilter("ignore", UndefinedDiagnosticWarning)
+            r_lag = autocorrelation(theta, lag)
+        value, reason = float(r_lag), r_lag.reason
     rows = [("autocorrelation", value, reason or "")]
     for k, value in enumerate(acf.tolist()):
         rows.append((f"acf@{k + 1}", value, (curve_reason or "") if math.isnan(value) else ""))
