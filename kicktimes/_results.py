@@ -7,8 +7,8 @@ A result class mixes in :class:`Result` and declares only what is special to it:
 * ``_intervals`` -- ``{estimate: (low, high)}`` or ``{estimate: ci_tuple_field}``: the
   estimate is shown with its 95 % interval (:func:`format_interval`), its bounds are not
   shown again;
-* ``_frame`` -- the field (or property) holding the result's table, returned by
-  ``to_frame()``;
+* ``_frame`` -- with :class:`TableResult`: the field (or property) holding the result's
+  table, returned by ``to_frame()``;
 * ``_summary_extra(self)`` -- further lines (a method, for what fields cannot say).
 
 ``summary()`` is the title, then one ``  name: value`` line per field (arrays by shape and
@@ -50,7 +50,7 @@ from typing import ClassVar
 
 import numpy as np
 
-__all__ = ["Result", "TupleCompat", "Value", "format_interval", "format_value"]
+__all__ = ["Result", "TableResult", "TupleCompat", "Value", "format_interval", "format_value"]
 
 #: values of a short 1-D array (or sequence) shown in full; longer ones show their first 3
 _SHOWN = 6
@@ -137,6 +137,8 @@ def _repr_value(value) -> str:
         return repr(value)
     if isinstance(value, float | np.floating):
         return repr(float(value))
+    if isinstance(value, np.ndarray) and value.size <= _SHOWN:
+        return repr(value)
     return format_value(value)
 
 
@@ -189,10 +191,13 @@ class Result:
         shown = ", ".join(f"{n}={_repr_value(getattr(self, n))}" for n in self._field_names())
         return f"{type(self).__name__}({shown})"
 
+
+
+class TableResult(Result):
+    """A result that holds a table: ``to_frame()`` returns it (the ``_frame`` attribute)."""
+
     def to_frame(self):
         """The result's table as a pandas DataFrame (a copy)."""
-        if self._frame is None:
-            raise TypeError(f"{type(self).__name__} holds no table")
         return getattr(self, self._frame).copy()
 
 

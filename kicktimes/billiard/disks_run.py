@@ -13,7 +13,7 @@ import numpy as np
 import pandas as pd
 
 from kicktimes import __version__
-from kicktimes._results import Result
+from kicktimes._results import TableResult
 from kicktimes.fileio import atomic_write
 
 __all__ = ["DisksPressure", "DisksRun"]
@@ -71,7 +71,7 @@ class DisksPressure:
 
 
 @dataclass(frozen=True, repr=False)
-class DisksRun(Result):
+class DisksRun(TableResult):
     """N hard disks in the unit circular table: their collision log and final state.
 
     Attributes

@@ -23,7 +23,7 @@ import numpy as np
 import pandas as pd
 
 from kicktimes import __version__
-from kicktimes._results import Result
+from kicktimes._results import TableResult
 from kicktimes.fileio import atomic_write
 
 TWO_PI = 2.0 * np.pi
@@ -63,7 +63,7 @@ def sampling_fields(t_end, mode, sampling, tau, n_steps, sample_times, samples) 
 
 
 @dataclass(frozen=True, repr=False)
-class _Run(Result):
+class _Run(TableResult):
     _frame = "boundary"
 
     def _summary_extra(self) -> list[str]:

@@ -171,7 +171,7 @@ class AcfCurve(TupleCompat, Result):
     """
 
     _title = "Autocorrelation curve R_1 .. R_max_lag of one series"
-    _summary_fields = ("acf",)
+    _summary_fields = ("acf", "reason")
     _tuple_fields = ("acf", "lag_reasons", "reason")
 
     acf: np.ndarray

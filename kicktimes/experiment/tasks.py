@@ -37,7 +37,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-from kicktimes._results import Result
+from kicktimes._results import TableResult
 from kicktimes.experiment.config import Experiment
 from kicktimes.experiment.plan import Task, make_tasks
 from kicktimes.stats import MMPP_MIN_EVENTS
@@ -98,7 +98,7 @@ class _Timer:
 
 
 @dataclass(frozen=True, repr=False)
-class TaskOutput(Result):
+class TaskOutput(TableResult):
     """What a worker returns: the task's two tables and its stage timings (seconds)."""
 
     _title = "The tables of one task of a sweep (what a worker returns)"

@@ -391,6 +391,10 @@ class CountRegression:
             out["kinetic"] = kinetic_rate(r, self.rule) * t
         return out
 
+    def to_frame(self) -> pd.DataFrame:
+        """The coefficient table of every model (`coefficients`)."""
+        return self.coefficients()
+
     def summary(self) -> str:
         """Coefficient tables, overdispersion and the per-radius table as text."""
         fmt = {"float_format": lambda v: f"{v:.5g}"}

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from kicktimes._results import Result
+from kicktimes._results import TableResult
 
 from ._checks import check_int
 from .ensemble import PoissonEnsembleResult, test_poisson_ensemble
@@ -25,7 +25,7 @@ __all__ = ["PoissonGroup", "poisson_group", "pooled_intervals"]
 
 
 @dataclass(frozen=True, repr=False)
-class PoissonGroup(Result):
+class PoissonGroup(TableResult):
     """Result of :func:`poisson_group`: the tests of one group of sequences, as table rows.
 
     Attributes

@@ -60,7 +60,7 @@ COMBINE_METHODS = ("fisher", "pearson", "tippett", "stouffer", "mudholkar_george
 FDR_METHODS = ("fdr_bh", "fdr_by", "bonferroni", "holm", "fdr_tsbh", "fdr_tsbky")
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class Intervals(TupleCompat, Result):
     """Complete and right-censored intervals of one or several sequences.
 

@@ -51,7 +51,7 @@ class RescaledTimes(Result):
 
     def _summary_extra(self) -> list[str]:
         mean = self.intervals.mean() if self.intervals.size else np.nan
-        return [f"windows: {len(self.times)}, events: {self.intervals.size}, mean rescaled "
+        return [f"n: {len(self.times)} windows, events: {self.intervals.size}, mean rescaled "
                 f"interval {mean:.4g} (1 under the model)"]
 
 
