@@ -50,7 +50,8 @@ from typing import ClassVar
 
 import numpy as np
 
-__all__ = ["Result", "TableResult", "TupleCompat", "Value", "format_interval", "format_value"]
+__all__ = ["Result", "TableResult", "TupleCompat", "Value", "format_interval", "format_value",
+           "nan_reason"]
 
 #: values of a short 1-D array (or sequence) shown in full; longer ones show their first 3
 _SHOWN = 6
@@ -85,6 +86,21 @@ def format_interval(estimate, low, high, *, edges=(0.9, 1.0, 1.1), digits=3):
         if ok and (lo < hi or not low < high):
             break
     return f"{text(estimate, d)} [{text(low, d)}, {text(high, d)}]"
+
+
+def nan_reason(values, notes=(), fallback="undefined for this input") -> str | None:
+    """The ``reason`` of a result: None when every one of ``values`` is finite, else the
+    ``notes`` (the result's warnings) joined by ``; ``, or ``fallback`` without notes.
+
+    Examples
+    --------
+    >>> nan_reason([1.0, 2.0], ["ignored"]) is None, nan_reason([1.0, float("nan")], ["a", "b"])
+    (True, 'a; b')
+    """
+    values = np.asarray(list(values) if not isinstance(values, np.ndarray) else values, float)
+    if np.isfinite(values).all():
+        return None
+    return "; ".join(notes) or fallback
 
 
 def format_value(value) -> str:

@@ -199,6 +199,21 @@ def test_undefined_results_say_why_in_a_reason():
     assert rqa(np.zeros((4, 2)), 0.1).reason is None
 
 
+def test_fits_name_the_reason_of_a_nan_estimate_beside_converged(instances):
+    from kicktimes import stats
+
+    assert instances["RenewalFit"].reason is None and instances["MMPPFit"].reason is None
+    rng = np.random.default_rng(0)
+    poisson = pd.DataFrame({"radius": np.repeat([0.01, 0.02, 0.03], 10),
+                            "count": rng.poisson(50, 30), "t_window": 100.0})
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", stats.FitWarning)
+        counts = stats.regress_counts(poisson)
+    assert counts.converged  # a different thing: alpha's standard error is undefined
+    assert "alpha has no standard error" in counts.reason
+    assert instances["DisksPressure"].reason is None and instances["TimesFit"].reason is None
+
+
 def test_existing_summaries_keep_their_text(instances):
     fit = instances["RenewalFit"]
     assert fit.summary().splitlines()[0] == "Renewal fit: gamma (censored maximum likelihood)"

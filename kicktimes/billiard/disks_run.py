@@ -13,7 +13,7 @@ import numpy as np
 import pandas as pd
 
 from kicktimes import __version__
-from kicktimes._results import TableResult
+from kicktimes._results import TableResult, nan_reason
 from kicktimes.fileio import atomic_write
 
 __all__ = ["DisksPressure", "DisksRun"]
@@ -56,6 +56,13 @@ class DisksPressure:
     henderson: float
     kT: float
     blocks: int
+
+    @property
+    def reason(self) -> str | None:
+        """Why an estimate is NaN (None when all are defined): the wall's needs a wall."""
+        if math.isfinite(self.z_wall):
+            return nan_reason([self.z_virial, self.z_bulk])
+        return "the periodic box has no wall: z_wall is undefined"
 
     def summary(self) -> str:
         """One line per estimate, with its standard error and Henderson's beside it."""

@@ -36,6 +36,13 @@ class TimesFit(TupleCompat, Result):
     _title = "Least-squares line of the k-th Poisson kick time on the k-th collision time"
     _tuple_fields = ("slope", "intercept", "r_squared", "n")
 
+    @property
+    def reason(self) -> str | None:
+        """Why ``r_squared`` is NaN (None when it is defined)."""
+        if math.isfinite(self.r_squared):
+            return None
+        return "the Poisson kick times do not vary: R² is undefined"
+
     slope: float
     intercept: float
     r_squared: float

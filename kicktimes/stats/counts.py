@@ -35,6 +35,8 @@ from statsmodels.genmod.generalized_linear_model import GLM
 from statsmodels.regression.linear_model import OLS
 from statsmodels.tools.tools import add_constant
 
+from kicktimes._results import nan_reason
+
 from ._checks import as_1d_float, check_choice
 from ._information import inverse_information
 from .renewal import FitWarning
@@ -317,6 +319,13 @@ class CountRegression:
             f"CountRegression(n={len(self.data)}, radii={len(self.by_radius)}, "
             f"covariate={self.covariate!r}, alpha={self.alpha:.4g}{flag})"
         )
+
+    @property
+    def reason(self) -> str | None:
+        """Why an estimate or a standard error is NaN (the `warnings`, where every NaN is
+        explained), None when all are finite."""
+        return nan_reason(self.estimates[["estimate", "stderr"]].to_numpy().ravel(),
+                          self.warnings)
 
     @property
     def alpha(self) -> float:
