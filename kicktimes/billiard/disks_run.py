@@ -130,13 +130,6 @@ class DisksRun(TableResult):
                        "tau")
     _frame = "collisions"
 
-    def _summary_extra(self) -> list[str]:
-        if self.holes is None:
-            return []
-        return [f"escaped: {int(np.isfinite(self.escape_times).sum())} of {self.n_disks} "
-                f"through {len(self.holes)} hole(s)"]
-
-
     radii: np.ndarray
     rule: str
     t_max: float
@@ -160,6 +153,12 @@ class DisksRun(TableResult):
     bulk_radius: float | None = None
     pressure_log: np.ndarray | None = None
     version: str = field(default=__version__)
+
+    def _summary_extra(self) -> list[str]:
+        if self.holes is None:
+            return []
+        return [f"escaped: {int(np.isfinite(self.escape_times).sum())} of {self.n_disks} "
+                f"through {len(self.holes)} hole(s)"]
 
     @property
     def n_disks(self) -> int:

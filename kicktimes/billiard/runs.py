@@ -64,13 +64,6 @@ def sampling_fields(t_end, mode, sampling, tau, n_steps, sample_times, samples) 
 
 @dataclass(frozen=True, repr=False)
 class _Run(TableResult):
-    _frame = "boundary"
-
-    def _summary_extra(self) -> list[str]:
-        if self.escaped < 0:
-            return []
-        return [f"escaped: disk {self.escaped} at t = {self.escape_time:.6g}"]
-
     r: float
     t_max: float
     sampling: str | None
@@ -96,6 +89,13 @@ class _Run(TableResult):
     _scalar_fields: ClassVar[tuple[str, ...]] = ()
     #: scalar fields recorded only when not None (added later: older records lack them)
     _optional_fields: ClassVar[tuple[str, ...]] = ()
+
+    _frame = "boundary"
+
+    def _summary_extra(self) -> list[str]:
+        if self.escaped < 0:
+            return []
+        return [f"escaped: disk {self.escaped} at t = {self.escape_time:.6g}"]
 
     @property
     def n_boundary(self) -> int:
@@ -180,7 +180,6 @@ class TwoParticleRun(_Run):
     _title = "Two disks in the unit circular table (simulate_two_particle)"
     _summary_fields = ("r", "rule", "t_max", "n_pp", "n_boundary", "masses", "sampling", "tau",
                        "n_steps", "seed")
-
 
     rule: str = "mirror"
     track: int = 0
@@ -273,7 +272,6 @@ class OneParticleRun(_Run):
     _title = "One kicked disk in the unit circular table (simulate_one_particle)"
     _summary_fields = ("r", "t_max", "kick_angle", "sigma", "n_kicks", "n_boundary", "rule",
                        "sampling", "tau", "n_steps", "seed")
-
 
     kick_angle: str = "uniform"
     sigma: float | None = None

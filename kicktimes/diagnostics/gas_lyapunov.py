@@ -63,7 +63,6 @@ class DisksLyapunov(Result):
     _title = "Largest Lyapunov exponent of the N-disk gas (disks_lyapunov)"
     _summary_fields = ("exponent", "method", "t_max", "segment", "d0", "n_collisions", "logs")
 
-
     exponent: float
     logs: np.ndarray
     segment: float

@@ -111,7 +111,6 @@ class LyapunovResult(Result):
                        "n_perturbations", "lam_per_perturbation", "n_renorm", "n_forced",
                        "n_deferred", "d0", "renormalized")
 
-
     lam: float
     lam_x: float
     lam_y: float
@@ -711,15 +710,14 @@ class LyapunovSpectrum(Result):
     _title = "Lyapunov spectrum of the two-disk billiard (8 exponents, largest first)"
     _summary_fields = ("rule", "total_time", "n_orthonormalisations")
 
-    def _summary_extra(self) -> list[str]:
-        values = ", ".join(f"{v:.4g}" for v in np.asarray(self.exponents).tolist())
-        return [f"exponents: {values}", f"sum: {float(np.sum(self.exponents)):.4g}"]
-
-
     exponents: np.ndarray
     total_time: float
     n_orthonormalisations: int
     rule: str
+
+    def _summary_extra(self) -> list[str]:
+        values = ", ".join(f"{v:.4g}" for v in np.asarray(self.exponents).tolist())
+        return [f"exponents: {values}", f"sum: {float(np.sum(self.exponents)):.4g}"]
 
 
 def lyapunov_spectrum(ic, r, *, t_max, rule="mirror", every=1.0) -> LyapunovSpectrum:

@@ -215,14 +215,6 @@ class RecollisionShare(Result):
                        "max_wall_hits")
     _intervals = {"share": ("ci_low", "ci_high")}
 
-    @property
-    def reason(self) -> str | None:
-        """Why ``share`` is NaN (None when it is defined)."""
-        if self.n_collisions > 0:
-            return None
-        return "no disk-disk collision with a previous one to compare (n_collisions = 0)"
-
-
     share: float
     ci_low: float
     ci_high: float
@@ -231,6 +223,13 @@ class RecollisionShare(Result):
     n_runs: int
     max_wall_hits: int
     level: float
+
+    @property
+    def reason(self) -> str | None:
+        """Why ``share`` is NaN (None when it is defined)."""
+        if self.n_collisions > 0:
+            return None
+        return "no disk-disk collision with a previous one to compare (n_collisions = 0)"
 
     @property
     def definition(self) -> str:

@@ -74,15 +74,6 @@ class RQAResult(Result):
     _summary_fields = ("n_points", "eps", "theiler", "l_min", "rr", "det", "l_mean", "l_max",
                        "n_lines", "lam", "tt", "v_max")
 
-    @property
-    def reason(self) -> str | None:
-        """Why some measure is NaN (``field: reason`` joined by ``; ``), None when all are
-        defined: `undefined` as one sentence."""
-        if not self.undefined:
-            return None
-        return "; ".join(f"{name}: {why}" for name, why in self.undefined.items())
-
-
     eps: float
     theiler: int
     l_min: int
@@ -98,6 +89,14 @@ class RQAResult(Result):
     tt: float | None
     v_max: int | None
     undefined: dict = field(default_factory=dict)
+
+    @property
+    def reason(self) -> str | None:
+        """Why some measure is NaN (``field: reason`` joined by ``; ``), None when all are
+        defined: `undefined` as one sentence."""
+        if not self.undefined:
+            return None
+        return "; ".join(f"{name}: {why}" for name, why in self.undefined.items())
 
     def to_dict(self) -> dict:
         """The fields as a plain dict (``undefined`` included)."""

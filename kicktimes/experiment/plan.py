@@ -21,14 +21,13 @@ class Task(Result):
 
     _title = "One task of a sweep"
 
-    def _summary_extra(self) -> list[str]:
-        return [f"id: {self.id}, {self.n_ics} IC(s)"]
-
-
     radius_index: int
     radius: float
     ic_start: int
     ic_stop: int
+
+    def _summary_extra(self) -> list[str]:
+        return [f"id: {self.id}, {self.n_ics} IC(s)"]
 
     @property
     def id(self) -> str:

@@ -104,7 +104,6 @@ class TaskOutput(TableResult):
     _title = "The tables of one task of a sweep (what a worker returns)"
     _frame = "results"
 
-
     task: Task
     results: pd.DataFrame
     collisions: pd.DataFrame

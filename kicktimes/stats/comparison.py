@@ -206,7 +206,6 @@ class VuongResult(Result):
     _summary_fields = ("model1", "model2", "statistic", "pvalue", "preferred", "loglik_ratio",
                        "n", "correction", "x_min", "note")
 
-
     statistic: float
     pvalue: float
     preferred: str | None

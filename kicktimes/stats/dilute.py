@@ -252,7 +252,6 @@ class DiluteEstimate(Result):
     _summary_fields = ("quantity", "value", "stderr", "n", "method")
     _intervals = {"value": ("ci_low", "ci_high")}
 
-
     quantity: str
     value: float
     stderr: float
@@ -351,7 +350,6 @@ class DiluteTaggedDisk(Result):
 
     _title = ("The tagged disk of a dilute gas of equal hard disks (a model, in units of the "
               "mean interval)")
-
 
     rule: str
     kT: float = 0.5

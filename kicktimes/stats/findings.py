@@ -518,13 +518,6 @@ class Finding(Result):
     _title = "Finding"
     _intervals = {"estimate": ("ci_low", "ci_high")}
 
-    def _field_names(self) -> tuple[str, ...]:
-        own = ("question", "verdict", "statement", "rule")
-        if not self.quantity:
-            return own
-        return (*own, "quantity", "estimate", "ci_low", "ci_high", "method", "detail")
-
-
     question: str
     verdict: str
     statement: str
@@ -535,6 +528,12 @@ class Finding(Result):
     ci_high: float = math.nan
     method: str = ""
     detail: str = ""
+
+    def _field_names(self) -> tuple[str, ...]:
+        own = ("question", "verdict", "statement", "rule")
+        if not self.quantity:
+            return own
+        return (*own, "quantity", "estimate", "ci_low", "ci_high", "method", "detail")
 
     def sentence(self) -> str:
         """The statement, with the supporting numbers (``detail``) in parentheses."""

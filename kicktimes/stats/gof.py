@@ -57,7 +57,6 @@ class GofResult(Result):
     _title = "Goodness of fit of a renewal model (Monte Carlo p-value)"
     _summary_fields = ("statistic_name", "statistic", "pvalue", "method", "n_mc", "n_failed")
 
-
     statistic: float
     pvalue: float
     statistic_name: str

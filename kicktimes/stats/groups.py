@@ -50,6 +50,10 @@ class PoissonGroup(TableResult):
     _summary_fields = ()
     _frame = "rejections"
 
+    ensemble: PoissonEnsembleResult
+    rejections: pd.DataFrame
+    homogeneity: dict
+
     def _summary_extra(self) -> list[str]:
         h = self.homogeneity
         table = self.rejections.to_string(index=False, float_format=lambda v: f"{v:.4g}")
@@ -62,11 +66,6 @@ class PoissonGroup(TableResult):
             "sequence(s) flagged after FDR",
             *table.split("\n"),
         ]
-
-
-    ensemble: PoissonEnsembleResult
-    rejections: pd.DataFrame
-    homogeneity: dict
 
     def __repr__(self) -> str:
         h = self.homogeneity

@@ -33,13 +33,12 @@ class RateMixture(Result):
     _title = "Mixture of exponential interval laws (rate redrawn after every event)"
     _summary_fields = ("rates", "weights")
 
+    rates: np.ndarray
+    weights: np.ndarray
+
     def _summary_extra(self) -> list[str]:
         return [f"mean rate: {float(self.weights @ self.rates):.6g}",
                 f"mean interval: {self.mean():.6g}"]
-
-
-    rates: np.ndarray
-    weights: np.ndarray
 
     def sf(self, t) -> np.ndarray:
         """Survival function ``sum_k w_k exp(-rate_k t)``."""

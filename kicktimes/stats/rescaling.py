@@ -49,16 +49,15 @@ class RescaledTimes(Result):
     _title = "Time-rescaled windows under a fitted MMPP (IID Exp(1) intervals if it is right)"
     _summary_fields = ("windows", "intervals", "censored")
 
-    def _summary_extra(self) -> list[str]:
-        mean = self.intervals.mean() if self.intervals.size else np.nan
-        return [f"n: {len(self.times)} windows, events: {self.intervals.size}, mean rescaled "
-                f"interval {mean:.4g} (1 under the model)"]
-
-
     times: list
     windows: np.ndarray
     intervals: np.ndarray
     censored: np.ndarray
+
+    def _summary_extra(self) -> list[str]:
+        mean = self.intervals.mean() if self.intervals.size else np.nan
+        return [f"n: {len(self.times)} windows, events: {self.intervals.size}, mean rescaled "
+                f"interval {mean:.4g} (1 under the model)"]
 
     def __repr__(self) -> str:
         return (f"RescaledTimes(n_windows={len(self.times)}, n_events={self.intervals.size}, "

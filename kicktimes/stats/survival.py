@@ -142,7 +142,6 @@ class EscapeTail(Result):
     _title = "Tail of the escape times beyond t_min: exponential against algebraic"
     _intervals = {"rate": "rate_ci", "alpha": "alpha_ci"}
 
-
     t_min: float
     n_tail: int
     n_escaped: int

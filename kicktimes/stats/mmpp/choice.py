@@ -204,11 +204,6 @@ class MMPPLRTest(Result):
     _title = "Parametric-bootstrap likelihood-ratio test of an MMPP against Poisson"
     _summary_fields = ("n_states", "statistic", "pvalue", "n_boot")
 
-    def _summary_extra(self) -> list[str]:
-        return [f"log-likelihood: Poisson {self.poisson.loglik:.6g}, {self.n_states}-state MMPP "
-                f"{self.mmpp.loglik:.6g}"]
-
-
     statistic: float
     pvalue: float
     null_statistics: np.ndarray = field(repr=False)
@@ -216,6 +211,10 @@ class MMPPLRTest(Result):
     n_states: int
     poisson: MMPPFit = field(repr=False)
     mmpp: MMPPFit = field(repr=False)
+
+    def _summary_extra(self) -> list[str]:
+        return [f"log-likelihood: Poisson {self.poisson.loglik:.6g}, {self.n_states}-state MMPP "
+                f"{self.mmpp.loglik:.6g}"]
 
 
 def mmpp_lr_test(times, t_max, *, n_states=2, n_boot=99, n_starts=12, rng=None):
