@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import argparse
 import time
+import warnings
 
 import numpy as np
 from numba import njit
@@ -31,6 +32,7 @@ from statsmodels.tsa.stattools import acf
 
 from kicktimes import initial_conditions, simulate_two_particle
 from kicktimes.diagnostics import (
+    UndefinedDiagnosticWarning,
     autocorrelation,
     autocorrelation_function,
     boundary_angles,
@@ -86,7 +88,10 @@ def masked_angles(run):
 
 def previous_rows(run):
     theta = masked_angles(run)
-    value, reason = autocorrelation(theta, 1, return_reason=True)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", UndefinedDiagnosticWarning)
+        value = autocorrelation(theta, 1)
+    value, reason = float(value), value.reason
     rows = [("autocorrelation", value, reason or "")]
     curve = previous_curve(theta, 20)
     rows += [(f"acf@{k + 1}", v, "") for k, v in enumerate(curve)]

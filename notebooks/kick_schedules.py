@@ -282,7 +282,8 @@ for name, run in (
     ("Poisson", poisson_run),
     ("actual", actual_run),
 ):
-    acf, reason = dg.autocorrelation(dg.boundary_angles(run), return_reason=True)
+    curve = dg.acf_curve(dg.boundary_angles(run), 1)  # R_1 and its reason, no warning
+    acf, reason = float(curve.acf[0]), curve.lag_reasons[0]
     ftle = dg.lyapunov(run)
     rows.append(
         {
@@ -349,7 +350,8 @@ rows = []
 
 
 def record(i, system, run, ftle):
-    acf, reason = dg.autocorrelation(dg.boundary_angles(run), return_reason=True)
+    curve = dg.acf_curve(dg.boundary_angles(run), 1)  # R_1 and its reason, no warning
+    acf, reason = float(curve.acf[0]), curve.lag_reasons[0]
     for diagnostic, value, note in (
         ("lyapunov", ftle.lam, ""),
         ("recurrence_rate", dg.recurrence_rate(run.samples, 1e-3), ""),

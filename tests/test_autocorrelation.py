@@ -120,14 +120,36 @@ def test_constant_series_gives_nan_with_a_warning_that_says_why():
         assert np.isnan(autocorrelation(np.full(100, 0.42)))
 
 
-def test_constant_series_reason_without_a_warning():
+def acf_and_reason(series, lag=1, **options):
+    """`autocorrelation`'s value and its ``.reason``, the undefined-value warning filtered
+    (the tests of the warning call `autocorrelation` itself)."""
     with warnings.catch_warnings():
-        warnings.simplefilter("error")  # any warning would fail the test
-        value, reason = autocorrelation(np.zeros(10), return_reason=True)
-    assert np.isnan(value)
-    assert reason.startswith("constant series")
-    value, reason = autocorrelation(np.arange(10.0), return_reason=True)
-    assert reason is None and np.isfinite(value)
+        warnings.simplefilter("ignore", UndefinedDiagnosticWarning)
+        value = autocorrelation(series, lag, **options)
+    return value, value.reason
+
+
+def test_an_undefined_value_is_nan_with_its_reason_and_a_warning():
+    with pytest.warns(UndefinedDiagnosticWarning, match="constant series"):
+        value = autocorrelation(np.zeros(10))
+    assert np.isnan(value) and isinstance(value, float)
+    assert value.reason.startswith("constant series") and value.n == 10 and value.lag == 1
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # a defined value warns of nothing
+        value = autocorrelation(np.arange(10.0))
+    assert value.reason is None and np.isfinite(value)
+    assert value + 0.0 == float(value) and type(value + 0.0) is float
+    assert "reason" not in value.summary() and "constant series" in acf_and_reason(
+        np.zeros(10))[0].summary()
+
+
+def test_return_reason_still_returns_the_tuple_for_one_release_with_a_deprecation_warning():
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", UndefinedDiagnosticWarning)  # and no undefined warning
+        with pytest.warns(DeprecationWarning, match=r"return_reason=True\) is deprecated.*"
+                          r"\.reason"):
+            value, reason = autocorrelation(np.zeros(10), return_reason=True)
+    assert type(value) is float and np.isnan(value) and reason.startswith("constant series")
 
 
 def test_round_off_around_a_constant_is_still_constant():
@@ -135,7 +157,7 @@ def test_round_off_around_a_constant_is_still_constant():
     # dividing round-off by round-off must not produce a number
     theta = np.arcsin(point_billiard_sin_theta(3000, seed=7))
     assert 0.0 < theta.std() < 1e-12
-    value, reason = autocorrelation(theta, return_reason=True)
+    value, reason = acf_and_reason(theta)
     assert np.isnan(value) and reason.startswith("constant")
 
 
@@ -143,7 +165,7 @@ def test_kicked_billiard_angles_are_valid_and_tolerance_is_adjustable():
     theta = np.arcsin(point_billiard_sin_theta(3000, seed=8, kick_prob=0.05))
     assert np.isfinite(autocorrelation(theta))
     tiny = 0.5 + 1e-13 * np.random.default_rng(9).normal(size=500)
-    assert np.isnan(autocorrelation(tiny, return_reason=True)[0])
+    assert np.isnan(acf_and_reason(tiny)[0])
     assert np.isfinite(autocorrelation(tiny, rtol=0.0, atol=0.0))  # exact zero only
 
 
@@ -156,7 +178,7 @@ def test_warning_can_be_silenced_for_ensembles():
 
 @pytest.mark.parametrize(("n", "lag"), [(0, 1), (1, 1), (3, 3), (3, 5), (1, 0)])
 def test_too_short_series_give_nan_with_reason(n, lag):
-    value, reason = autocorrelation(np.arange(float(n)), lag, return_reason=True)
+    value, reason = acf_and_reason(np.arange(float(n)), lag)
     assert np.isnan(value)
     assert reason.startswith("series too short")
     with pytest.warns(UndefinedDiagnosticWarning, match="too short"):
@@ -171,7 +193,7 @@ def test_many_equals_one_by_one_for_ragged_series():
     series = [rng.normal(size=k).cumsum() for k in (5, 50, 500)] + [np.ones(7), [1.0]]
     df = autocorrelation_many(series, lag=2)
     for k, x in enumerate(series):
-        value, reason = autocorrelation(x, 2, return_reason=True)
+        value, reason = acf_and_reason(x, 2)
         assert_array_equal(df["autocorrelation"].iloc[k], value)
         assert df["valid"].iloc[k] == (reason is None)
     assert df["reason"].tolist() == ["ok", "ok", "ok", "constant", "too_short"]
@@ -372,7 +394,7 @@ def test_angle_series_feeds_the_autocorrelation():
     theta = boundary_angles(
         pd.DataFrame({"time": np.arange(3000.0), "sin_theta": point_billiard_sin_theta(3000, 13)})
     )
-    value, reason = autocorrelation(theta, return_reason=True)
+    value, reason = acf_and_reason(theta)
     assert np.isnan(value) and reason.startswith("constant")
 
 
@@ -382,7 +404,7 @@ def test_simulated_runs_unkicked_disk_is_constant_and_two_disks_are_not():
     ic = kt.initial_conditions(1, 0.03, seed=3)[0]
     two = kt.simulate_two_particle(ic, 0.03, n_steps=5000, tau=0.2)
     one = kt.simulate_one_particle(ic[0], 0.03, n_steps=5000, tau=0.2)
-    value, reason = autocorrelation(boundary_angles(one), return_reason=True)
+    value, reason = acf_and_reason(boundary_angles(one))
     assert np.isnan(value) and reason.startswith("constant")  # integrable: sin(theta) fixed
     r1 = autocorrelation(boundary_angles(two))
     assert np.isfinite(r1) and -1.0 <= r1 <= 1.0
@@ -440,7 +462,7 @@ def test_curve_is_bitwise_lag_by_lag_for_any_series(n, max_lag, scale_exp, kind,
         x = np.full(n, 0.3)
     x = x * 2.0**scale_exp
     curve, _ = autocorrelation_function(x, max_lag, return_reason=True)
-    expected = [autocorrelation(x, lag, return_reason=True)[0] for lag in range(1, max_lag + 1)]
+    expected = [acf_and_reason(x, lag)[0] for lag in range(1, max_lag + 1)]
     assert_array_equal(curve.view(np.int64), np.array(expected).view(np.int64))
 
 
@@ -557,7 +579,6 @@ def test_acf_curve_is_autocorrelation_lag_by_lag_with_its_reasons():
     from kicktimes.diagnostics import (
         UndefinedDiagnosticWarning,
         acf_curve,
-        autocorrelation,
         autocorrelation_function,
     )
 
@@ -568,8 +589,27 @@ def test_acf_curve_is_autocorrelation_lag_by_lag_with_its_reasons():
     for lag in range(1, 16):
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", UndefinedDiagnosticWarning)
-            value, reason = autocorrelation(x, lag, return_reason=True)
+            value, reason = acf_and_reason(x, lag)
         assert np.array_equal(curve.acf[lag - 1], value, equal_nan=True)
         assert curve.lag_reasons[lag - 1] == reason
     assert "series too short" in curve.reason
     assert acf_curve(np.ones(5), 2).reason.startswith("constant series")
+
+
+def test_acf_curve_is_a_frozen_result_that_still_unpacks_for_one_release():
+    import dataclasses
+
+    from kicktimes.diagnostics import acf_curve
+
+    curve = acf_curve([1.0, 2.0, 1.0, 2.0], 4)
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        curve.reason = "x"
+    with pytest.warns(DeprecationWarning, match=r"\.acf, \.lag_reasons, \.reason"):
+        acf, lag_reasons, reason = curve
+    assert acf is curve.acf and lag_reasons is curve.lag_reasons and reason is curve.reason
+    with pytest.warns(DeprecationWarning, match="AcfCurve as a tuple"):
+        assert curve[0] is curve.acf and len(curve) == 3
+    table = curve.to_frame()
+    assert table.columns.tolist() == ["lag", "acf", "reason"]
+    assert table["lag"].tolist() == [1, 2, 3, 4]
+    assert table["reason"].iloc[3] == curve.lag_reasons[3] and "max_lag: 4" in curve.summary()

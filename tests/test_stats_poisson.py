@@ -58,9 +58,19 @@ def test_intervals_drop_the_forward_recurrence_time_and_censor_the_last_one():
     np.testing.assert_allclose(iv.censored, [1.0])
     kept = stats.intervals_from_times([1.0, 1.5, 3.0], 4.0, first="keep")
     np.testing.assert_allclose(kept.complete, [1.0, 0.5, 1.5])
-    complete, censored = stats.intervals_from_times([1.0, 4.0], 4.0)  # unpacks
+    end = stats.intervals_from_times([1.0, 4.0], 4.0)
+    np.testing.assert_allclose(end.complete, [3.0])
+    assert end.censored.size == 0  # an event at T leaves no censored interval
+
+
+def test_intervals_still_unpack_for_one_release_with_a_deprecation_warning():
+    iv = stats.intervals_from_times([1.0, 4.0], 4.0)
+    with pytest.warns(DeprecationWarning, match=r"\.complete, \.censored"):
+        complete, censored = iv
+    with pytest.warns(DeprecationWarning, match="Intervals as a tuple"):
+        assert iv[0] is iv.complete and len(iv) == 2
     np.testing.assert_allclose(complete, [3.0])
-    assert censored.size == 0  # an event at T leaves no censored interval
+    assert censored is iv.censored
 
 
 def test_intervals_of_empty_windows_and_of_ensembles():

@@ -13,6 +13,7 @@ import numpy as np
 import pandas as pd
 
 from kicktimes import __version__
+from kicktimes._results import TableResult, nan_reason
 from kicktimes.fileio import atomic_write
 
 __all__ = ["DisksPressure", "DisksRun"]
@@ -56,6 +57,13 @@ class DisksPressure:
     kT: float
     blocks: int
 
+    @property
+    def reason(self) -> str | None:
+        """Why an estimate is NaN (None when all are defined): the wall's needs a wall."""
+        if math.isfinite(self.z_wall):
+            return nan_reason([self.z_virial, self.z_bulk])
+        return "the periodic box has no wall: z_wall is undefined"
+
     def summary(self) -> str:
         """One line per estimate, with its standard error and Henderson's beside it."""
         def row(name, z, se):
@@ -70,7 +78,7 @@ class DisksPressure:
 
 
 @dataclass(frozen=True, repr=False)
-class DisksRun:
+class DisksRun(TableResult):
     """N hard disks in the unit circular table: their collision log and final state.
 
     Attributes
@@ -117,6 +125,11 @@ class DisksRun:
         the engine's running sums at ``t`` (`pressure`).
     """
 
+    _title = "N hard disks (simulate_disks): the collision log"
+    _summary_fields = ("n_disks", "radii", "rule", "t_max", "n_pp", "n_events", "n_wall", "box",
+                       "tau")
+    _frame = "collisions"
+
     radii: np.ndarray
     rule: str
     t_max: float
@@ -140,6 +153,12 @@ class DisksRun:
     bulk_radius: float | None = None
     pressure_log: np.ndarray | None = None
     version: str = field(default=__version__)
+
+    def _summary_extra(self) -> list[str]:
+        if self.holes is None:
+            return []
+        return [f"escaped: {int(np.isfinite(self.escape_times).sum())} of {self.n_disks} "
+                f"through {len(self.holes)} hole(s)"]
 
     @property
     def n_disks(self) -> int:

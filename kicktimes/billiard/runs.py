@@ -23,6 +23,7 @@ import numpy as np
 import pandas as pd
 
 from kicktimes import __version__
+from kicktimes._results import TableResult
 from kicktimes.fileio import atomic_write
 
 TWO_PI = 2.0 * np.pi
@@ -62,7 +63,7 @@ def sampling_fields(t_end, mode, sampling, tau, n_steps, sample_times, samples) 
 
 
 @dataclass(frozen=True, repr=False)
-class _Run:
+class _Run(TableResult):
     r: float
     t_max: float
     sampling: str | None
@@ -88,6 +89,13 @@ class _Run:
     _scalar_fields: ClassVar[tuple[str, ...]] = ()
     #: scalar fields recorded only when not None (added later: older records lack them)
     _optional_fields: ClassVar[tuple[str, ...]] = ()
+
+    _frame = "boundary"
+
+    def _summary_extra(self) -> list[str]:
+        if self.escaped < 0:
+            return []
+        return [f"escaped: disk {self.escaped} at t = {self.escape_time:.6g}"]
 
     @property
     def n_boundary(self) -> int:
@@ -168,6 +176,10 @@ class TwoParticleRun(_Run):
         both centres at contact and both velocities before and after; `collisions` is
         the same as a DataFrame with the time and the contact normal.
     """
+
+    _title = "Two disks in the unit circular table (simulate_two_particle)"
+    _summary_fields = ("r", "rule", "t_max", "n_pp", "n_boundary", "masses", "sampling", "tau",
+                       "n_steps", "seed")
 
     rule: str = "mirror"
     track: int = 0
@@ -256,6 +268,10 @@ class OneParticleRun(_Run):
     sample_times, samples : ndarray
         Sample times and the disk's centre at them.
     """
+
+    _title = "One kicked disk in the unit circular table (simulate_one_particle)"
+    _summary_fields = ("r", "t_max", "kick_angle", "sigma", "n_kicks", "n_boundary", "rule",
+                       "sampling", "tau", "n_steps", "seed")
 
     kick_angle: str = "uniform"
     sigma: float | None = None

@@ -14,6 +14,7 @@ parameters and wall hits per collision, re-collisions, predicted rates) is in
 """
 
 from kicktimes.diagnostics.autocorrelation import (
+    AcfValue,
     UndefinedDiagnosticWarning,
     autocorrelation,
     autocorrelation_many,
@@ -47,6 +48,7 @@ from kicktimes.diagnostics.rqa import RQAResult, rqa
 
 __all__ = [
     "AcfCurve",
+    "AcfValue",
     "DisksLyapunov",
     "LyapunovResult",
     "LyapunovSpectrum",

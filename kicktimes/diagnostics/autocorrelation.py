@@ -8,8 +8,8 @@ the biased estimator (the same normalisation as ``statsmodels.tsa.stattools.acf`
 its default ``adjusted=False``). It is undefined for a constant series (the integrable
 disk without kicks hits the boundary at the same angle forever) and for a series with
 no pair at lag ``l``. Then NaN is returned together with a *reason*: `autocorrelation`
-issues an `UndefinedDiagnosticWarning` (or returns the reason with
-``return_reason=True``), and `autocorrelation_many` puts it in a ``reason`` column, so
+returns an `AcfValue` whose ``.reason`` says why, with an `UndefinedDiagnosticWarning`,
+and `autocorrelation_many` puts it in a ``reason`` column, so
 that ensemble means can count the valid values.
 """
 
@@ -24,7 +24,10 @@ import numpy as np
 import pandas as pd
 from numba import njit
 
+from kicktimes._results import Value
+
 __all__ = [
+    "AcfValue",
     "UndefinedDiagnosticWarning",
     "autocorrelation",
     "autocorrelation_many",
@@ -51,7 +54,8 @@ class UndefinedDiagnosticWarning(RuntimeWarning):
 
     Silence it in ensemble loops with
     ``warnings.simplefilter("ignore", UndefinedDiagnosticWarning)``, or use the
-    warning-free ``autocorrelation(..., return_reason=True)`` / `autocorrelation_many`.
+    warning-free `autocorrelation_many` or `acf_curve`; the value itself carries the reason
+    (``autocorrelation(...).reason``).
     """
 
 
@@ -292,6 +296,25 @@ def _reason_text(code: int, n: int, lag: int) -> str:
 # ------------------------------------------------------------------------ public API
 
 
+class AcfValue(Value):
+    """The result of `autocorrelation`: ``R_lag`` as a float, with ``reason`` (None when it
+    is defined, why it is NaN otherwise), ``lag`` and ``n`` (the series' length ``N``).
+
+    Examples
+    --------
+    >>> from kicktimes.diagnostics import autocorrelation
+    >>> value = autocorrelation([1.0, 2.0, 3.0, 4.0])
+    >>> value, value.reason, value.n
+    (0.25, None, 4)
+    >>> print(value.summary())
+    Autocorrelation R_lag: 0.25
+      lag: 1
+      n: 4
+    """
+
+    _title = "Autocorrelation R_lag"
+
+
 def autocorrelation(series, lag=1, *, rtol=_RTOL, atol=_ATOL, return_reason=False):
     r"""The paper's lag-``l`` autocorrelation of a series.
 
@@ -313,15 +336,17 @@ def autocorrelation(series, lag=1, *, rtol=_RTOL, atol=_ATOL, return_reason=Fals
         series in radians; for series in other units scale ``atol`` (``atol=0`` keeps
         only the relative test; ``rtol=atol=0`` only an exactly zero variance).
     return_reason : bool, default False
-        If True return ``(value, reason)`` with ``reason`` ``None`` for a valid value and
-        a sentence otherwise, and issue no warning.
+        Deprecated (until 0.3.0): the result's ``.reason`` says why it is NaN. If True
+        return the old ``(value, reason)`` tuple and issue no `UndefinedDiagnosticWarning`
+        (a DeprecationWarning instead).
 
     Returns
     -------
-    float, or (float, str or None)
-        ``R_l`` in ``[-1, 1]``, or NaN when undefined: constant series, or too short
-        (``N <= lag`` or ``N < 2``). Without ``return_reason`` the NaN comes with an
-        `UndefinedDiagnosticWarning` stating the reason.
+    AcfValue
+        ``R_l`` in ``[-1, 1]`` (a float), or NaN when undefined: constant series, or too
+        short (``N <= lag`` or ``N < 2``); its ``.reason`` says why (None when defined), and
+        the NaN comes with an `UndefinedDiagnosticWarning` stating the reason (filter it, or
+        use `acf_curve`, for a warning-free call).
 
     Raises
     ------
@@ -342,7 +367,10 @@ def autocorrelation(series, lag=1, *, rtol=_RTOL, atol=_ATOL, return_reason=Fals
     >>> from kicktimes.diagnostics import autocorrelation
     >>> autocorrelation([1.0, 2.0, 3.0, 4.0])
     0.25
-    >>> autocorrelation([0.3, 0.3, 0.3], return_reason=True)[1][:15]
+    >>> import warnings
+    >>> with warnings.catch_warnings():
+    ...     warnings.simplefilter("ignore", UndefinedDiagnosticWarning)
+    ...     autocorrelation([0.3, 0.3, 0.3]).reason[:15]
     'constant series'
     """
     x = _as_series(series)
@@ -355,10 +383,17 @@ def autocorrelation(series, lag=1, *, rtol=_RTOL, atol=_ATOL, return_reason=Fals
     value = float(out[0])
     reason = None if code[0] == 0 else _reason_text(int(code[0]), x.size, lag)
     if return_reason:
+        warnings.warn(
+            "autocorrelation(..., return_reason=True) is deprecated and stops working in 0.3.0; "
+            "autocorrelation returns an AcfValue whose .reason says why it is NaN (filter "
+            "UndefinedDiagnosticWarning, or use acf_curve, for no warning)",
+            DeprecationWarning,
+            stacklevel=2,
+        )
         return value, reason
     if reason is not None:
         warnings.warn(f"autocorrelation is NaN: {reason}", UndefinedDiagnosticWarning, stacklevel=2)
-    return value
+    return AcfValue(value, reason, lag=lag, n=int(x.size))
 
 
 def autocorrelation_many(series, lag=1, *, rtol=_RTOL, atol=_ATOL):

@@ -13,10 +13,12 @@ from __future__ import annotations
 import math
 import numbers
 import warnings
-from typing import NamedTuple
+from dataclasses import dataclass
 
 import numpy as np
+import pandas as pd
 
+from kicktimes._results import Result, TupleCompat
 from kicktimes.diagnostics.autocorrelation import (
     _ATOL,
     _RTOL,
@@ -149,7 +151,8 @@ def _curve(x: np.ndarray, max_lag: int, rtol: float = _RTOL, atol: float = _ATOL
     return out, code
 
 
-class AcfCurve(NamedTuple):
+@dataclass(frozen=True, repr=False)
+class AcfCurve(TupleCompat, Result):
     """The autocorrelation curve of one series and why any of it is undefined.
 
     Attributes
@@ -161,11 +164,29 @@ class AcfCurve(NamedTuple):
         ``autocorrelation(series, l, return_reason=True)``.
     reason : str or None
         Why some of the curve is NaN (None when every lag is defined).
+
+    ``to_frame()`` is the curve as a table (``lag``, ``acf``, ``reason``). Unpacking
+    (``acf, lag_reasons, reason = acf_curve(...)``) and indexing still work until 0.3.0,
+    with a DeprecationWarning: use the fields.
     """
+
+    _title = "Autocorrelation curve R_1 .. R_max_lag of one series"
+    _summary_fields = ("acf", "reason")
+    _tuple_fields = ("acf", "lag_reasons", "reason")
 
     acf: np.ndarray
     lag_reasons: tuple
     reason: str | None
+
+    def _summary_extra(self) -> list[str]:
+        defined = int(np.isfinite(self.acf).sum())
+        return [f"max_lag: {self.acf.size}, defined at {defined} lag(s)"]
+
+    def to_frame(self) -> pd.DataFrame:
+        """The curve as a table: ``lag`` (1 .. max_lag), ``acf`` and ``reason`` (None where
+        defined)."""
+        return pd.DataFrame({"lag": np.arange(1, self.acf.size + 1), "acf": self.acf,
+                             "reason": list(self.lag_reasons)})
 
 
 def acf_curve(series, max_lag=20, *, name="series") -> AcfCurve:

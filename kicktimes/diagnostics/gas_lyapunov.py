@@ -29,6 +29,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from kicktimes._results import Result
 from kicktimes.validation import check_choice, check_real, check_rng
 
 __all__ = ["DisksLyapunov", "disks_lyapunov", "project_trivial"]
@@ -37,7 +38,7 @@ METHODS = ("tangent", "twin")
 
 
 @dataclass(frozen=True, repr=False)
-class DisksLyapunov:
+class DisksLyapunov(Result):
     """Result of `disks_lyapunov`.
 
     Attributes
@@ -58,6 +59,9 @@ class DisksLyapunov:
     method : str
         ``"tangent"`` or ``"twin"``.
     """
+
+    _title = "Largest Lyapunov exponent of the N-disk gas (disks_lyapunov)"
+    _summary_fields = ("exponent", "method", "t_max", "segment", "d0", "n_collisions", "logs")
 
     exponent: float
     logs: np.ndarray

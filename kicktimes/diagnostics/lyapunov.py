@@ -23,6 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from kicktimes._results import Result
 from kicktimes.billiard import checks as chk
 from kicktimes.billiard.kernels.drive_one import simulate_tangent_one_kernel, tangent_one_kernel
 from kicktimes.billiard.kernels.drive_two import simulate_tangent_two_kernel, tangent_two_kernel
@@ -63,7 +64,7 @@ EVENTS_PER_TIME = 1e5
 
 
 @dataclass(frozen=True)
-class LyapunovResult:
+class LyapunovResult(Result):
     """A finite-time Lyapunov exponent and how it was obtained.
 
     Attributes
@@ -104,6 +105,11 @@ class LyapunovResult:
         Ranković & Porter read literally; ``lam`` is then that sum, not an exponent, and
         ``n_renorm``, ``n_forced`` and ``n_deferred`` are 0).
     """
+
+    _title = "Finite-time Lyapunov exponent (lyapunov)"
+    _summary_fields = ("lam", "lam_x", "lam_y", "method", "variant", "total_time",
+                       "n_perturbations", "lam_per_perturbation", "n_renorm", "n_forced",
+                       "n_deferred", "d0", "renormalized")
 
     lam: float
     lam_x: float
@@ -689,7 +695,7 @@ def _pass_one(st, state, r, times, angles, kick_u, sp, mode, n_steps, tau, U, va
 
 
 @dataclass(frozen=True)
-class LyapunovSpectrum:
+class LyapunovSpectrum(Result):
     """The full Lyapunov spectrum of the two-disk billiard (8 exponents).
 
     Attributes
@@ -701,10 +707,17 @@ class LyapunovSpectrum:
     rule : str
     """
 
+    _title = "Lyapunov spectrum of the two-disk billiard (8 exponents, largest first)"
+    _summary_fields = ("rule", "total_time", "n_orthonormalisations")
+
     exponents: np.ndarray
     total_time: float
     n_orthonormalisations: int
     rule: str
+
+    def _summary_extra(self) -> list[str]:
+        values = ", ".join(f"{v:.4g}" for v in np.asarray(self.exponents).tolist())
+        return [f"exponents: {values}", f"sum: {float(np.sum(self.exponents)):.4g}"]
 
 
 def lyapunov_spectrum(ic, r, *, t_max, rule="mirror", every=1.0) -> LyapunovSpectrum:

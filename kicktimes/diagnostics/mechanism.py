@@ -27,6 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
+from kicktimes._results import Result
 from kicktimes.stats import percentile_interval, resample_indices
 from kicktimes.validation import check_int, check_real, check_rng
 
@@ -204,10 +205,15 @@ def collision_tables(runs, *, keys=None) -> pd.DataFrame:
 
 
 @dataclass(frozen=True, repr=False)
-class RecollisionShare:
+class RecollisionShare(Result):
     """Result of `recollision_share`: ``share`` of ``n_collisions`` (those with a previous
     collision) that are re-collisions, its bootstrap interval ``ci_low``, ``ci_high`` at
     ``level``, the counts and the definition (``max_wall_hits``)."""
+
+    _title = "Share of disk-disk collisions that are re-collisions of the same pair"
+    _summary_fields = ("share", "level", "n_recollisions", "n_collisions", "n_runs",
+                       "max_wall_hits")
+    _intervals = {"share": ("ci_low", "ci_high")}
 
     share: float
     ci_low: float
@@ -217,6 +223,13 @@ class RecollisionShare:
     n_runs: int
     max_wall_hits: int
     level: float
+
+    @property
+    def reason(self) -> str | None:
+        """Why ``share`` is NaN (None when it is defined)."""
+        if self.n_collisions > 0:
+            return None
+        return "no disk-disk collision with a previous one to compare (n_collisions = 0)"
 
     @property
     def definition(self) -> str:

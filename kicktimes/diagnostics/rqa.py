@@ -31,6 +31,7 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
+from kicktimes._results import Result
 from kicktimes.diagnostics.recurrence import (
     _as_points,
     _check_eps,
@@ -42,7 +43,7 @@ __all__ = ["RQAResult", "rqa"]
 
 
 @dataclass(frozen=True)
-class RQAResult:
+class RQAResult(Result):
     """Recurrence quantification measures of one point set (see `rqa` for the definitions).
 
     Attributes
@@ -69,6 +70,10 @@ class RQAResult:
         ``{field: reason}`` for every field that is NaN (empty when all are defined).
     """
 
+    _title = "Recurrence quantification (rqa)"
+    _summary_fields = ("n_points", "eps", "theiler", "l_min", "rr", "det", "l_mean", "l_max",
+                       "n_lines", "lam", "tt", "v_max")
+
     eps: float
     theiler: int
     l_min: int
@@ -84,6 +89,14 @@ class RQAResult:
     tt: float | None
     v_max: int | None
     undefined: dict = field(default_factory=dict)
+
+    @property
+    def reason(self) -> str | None:
+        """Why some measure is NaN (``field: reason`` joined by ``; ``), None when all are
+        defined: `undefined` as one sentence."""
+        if not self.undefined:
+            return None
+        return "; ".join(f"{name}: {why}" for name, why in self.undefined.items())
 
     def to_dict(self) -> dict:
         """The fields as a plain dict (``undefined`` included)."""

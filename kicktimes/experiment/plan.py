@@ -10,17 +10,24 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from kicktimes._results import Result
+
 __all__ = ["Task", "make_tasks"]
 
 
 @dataclass(frozen=True)
-class Task:
+class Task(Result):
     """One unit of work: radius ``radii[radius_index]`` and ICs ``ic_start .. ic_stop - 1``."""
+
+    _title = "One task of a sweep"
 
     radius_index: int
     radius: float
     ic_start: int
     ic_stop: int
+
+    def _summary_extra(self) -> list[str]:
+        return [f"id: {self.id}, {self.n_ics} IC(s)"]
 
     @property
     def id(self) -> str:

@@ -30,12 +30,14 @@ import functools
 import math
 import struct
 import time
+import warnings
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 
 import numpy as np
 import pandas as pd
 
+from kicktimes._results import TableResult
 from kicktimes.experiment.config import Experiment
 from kicktimes.experiment.plan import Task, make_tasks
 from kicktimes.stats import MMPP_MIN_EVENTS
@@ -95,9 +97,12 @@ class _Timer:
             self.seconds[name] = self.seconds.get(name, 0.0) + time.perf_counter() - t0
 
 
-@dataclass
-class TaskOutput:
+@dataclass(frozen=True, repr=False)
+class TaskOutput(TableResult):
     """What a worker returns: the task's two tables and its stage timings (seconds)."""
+
+    _title = "The tables of one task of a sweep (what a worker returns)"
+    _frame = "results"
 
     task: Task
     results: pd.DataFrame
@@ -584,6 +589,7 @@ def autocorrelation_rows(theta: np.ndarray, lag: int, max_lag: int) -> list[tupl
     ``R_l <= 0`` up to ``max_lag``). NaN values carry the reason.
     """
     from kicktimes.diagnostics import (
+        UndefinedDiagnosticWarning,
         acf_curve,
         autocorrelation,
         decorrelation_lag,
@@ -591,11 +597,15 @@ def autocorrelation_rows(theta: np.ndarray, lag: int, max_lag: int) -> list[tupl
     )
 
     # one curve: R_lag is its entry lag - 1, bitwise autocorrelation(theta, lag)
-    acf, lag_reasons, curve_reason = acf_curve(theta, max_lag, name="theta")
+    curve = acf_curve(theta, max_lag, name="theta")
+    acf, curve_reason = curve.acf, curve.reason
     if 1 <= lag <= max_lag:
-        value, reason = float(acf[lag - 1]), lag_reasons[lag - 1]
+        value, reason = float(acf[lag - 1]), curve.lag_reasons[lag - 1]
     else:
-        value, reason = autocorrelation(theta, lag, return_reason=True)
+        with warnings.catch_warnings():  # the reason goes into the row's note
+            warnings.simplefilter("ignore", UndefinedDiagnosticWarning)
+            r_lag = autocorrelation(theta, lag)
+        value, reason = float(r_lag), r_lag.reason
     rows = [("autocorrelation", value, reason or "")]
     for k, value in enumerate(acf.tolist()):
         rows.append((f"acf@{k + 1}", value, (curve_reason or "") if math.isnan(value) else ""))

@@ -7,13 +7,14 @@ two-particle run and the sweep's ``kick_rng(seed, ic, radius, "poisson")`` strea
 from __future__ import annotations
 
 import math
-from typing import NamedTuple
+from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 
 from kicktimes import stats
+from kicktimes._results import Result, TupleCompat
 from kicktimes.render.figures import TIME_UNIT, check_times, finite, new_axes
 from kicktimes.report.context import Section
 from kicktimes.report.store import nearest
@@ -24,8 +25,23 @@ __all__ = ["TimesFit", "kth_time_fit", "kick_times_vs_collision_times", "rescale
 _TIMES_RADIUS = 0.008
 
 
-class TimesFit(NamedTuple):
-    """Least-squares line ``poisson_k = intercept + slope * actual_k`` over k."""
+@dataclass(frozen=True)
+class TimesFit(TupleCompat, Result):
+    """Least-squares line ``poisson_k = intercept + slope * actual_k`` over k.
+
+    Unpacking (``slope, intercept, r_squared, n = kth_time_fit(...)``) and indexing still
+    work until 0.3.0, with a DeprecationWarning: use the fields.
+    """
+
+    _title = "Least-squares line of the k-th Poisson kick time on the k-th collision time"
+    _tuple_fields = ("slope", "intercept", "r_squared", "n")
+
+    @property
+    def reason(self) -> str | None:
+        """Why ``r_squared`` is NaN (None when it is defined)."""
+        if math.isfinite(self.r_squared):
+            return None
+        return "the Poisson kick times do not vary: R² is undefined"
 
     slope: float
     intercept: float

@@ -10,6 +10,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from kicktimes._results import format_value
 from kicktimes.schedules._distributions import (
     _check_dist,
     _dist_from_dict,
@@ -86,6 +87,19 @@ class Schedule(abc.ABC):
     def sample(self, t_max, rng=None, *, max_kicks=DEFAULT_MAX_KICKS):
         """Sorted float64 kick times in ``(0, t_max]`` (see the subclass)."""
 
+    #: the law of the kick times in words (the first line of `summary`)
+    _law = ""
+
+    def summary(self) -> str:
+        """One paragraph: the schedule's law and its parameters (a schedule is a model, not
+        a result, but summarises itself like one)."""
+        lines = [f"{type(self).__name__} kick schedule: {self._law}"]
+        lines += [f"  {name}: {format_value(value)}" for name, value in self._params().items()]
+        mean = getattr(self, "mean_interval", None)
+        if isinstance(mean, int | float):
+            lines.append(f"  mean interval: {mean:.6g}")
+        return "\n".join(lines)
+
     def to_dict(self):
         """JSON-ready dict ``{"kicktimes_schedule": 1, "type": ..., ...parameters}``."""
         return {"kicktimes_schedule": _FORMAT_VERSION, "type": self._type, **self._params()}
@@ -139,6 +153,8 @@ class Poisson(Schedule):
     >>> bool(1900 < times.size < 2100)
     True
     """
+
+    _law = "homogeneous Poisson kicks (IID exponential intervals of mean 1 / rate)"
 
     rate: float
     _type = "poisson"
@@ -231,6 +247,8 @@ class Renewal(Schedule):
     >>> times = schedule.sample(100.0, rng=7)
     """
 
+    _law = "renewal kicks (IID intervals from a continuous law on [0, inf))"
+
     dist: object
     stationary: bool = field(default=False, kw_only=True)
     _type = "renewal"
@@ -319,6 +337,8 @@ class Replay(Schedule):
     array([0.5 , 1.25])
     """
 
+    _law = "the given kick times, replayed"
+
     times: np.ndarray
     t_max: float | None = field(default=None, kw_only=True)
     _type = "replay"
@@ -398,6 +418,8 @@ class Bootstrap(Schedule):
     >>> bool(set(np.round(np.diff(times), 12)) <= {0.5, 1.0, 2.5})
     True
     """
+
+    _law = "renewal kicks whose intervals are drawn with replacement from a sample"
 
     intervals: np.ndarray
     stationary: bool = field(default=False, kw_only=True)

@@ -198,6 +198,17 @@ class KineticRate:
                              f"has r={float(r)!r}; build it with the run's radius")
         return self.rates, self.l_first, self.dl, self.c_first, self.dc
 
+    def summary(self) -> str:
+        """One paragraph: the law of the kicks and the table's parameters."""
+        partner = self.partner if isinstance(self.partner, str) else "an empirical sample"
+        lines = ["KineticRate kick schedule: exponential intervals at the kinetic collision rate "
+                 "of the disk's own orbit, redrawn after every kick",
+                 f"  r: {self.r!r}", f"  rule: {self.rule}", f"  partner: {partner}",
+                 f"  scale: {self.scale!r}", f"  n_grid: {self.rates.shape[1]}"]
+        if self.rule == "elastic":
+            lines.append(f"  n_speed: {self.rates.shape[0]}")
+        return "\n".join(lines)
+
     def __repr__(self) -> str:
         shape = (f"n_grid={self.rates.shape[1]}" if self.rule == "mirror" else
                  f"n_grid={self.rates.shape[1]}, rule='elastic', n_speed={self.rates.shape[0]}")

@@ -213,6 +213,8 @@ class MMPP(Schedule):
     >>> times = kicks.sample(1000.0, rng=1)
     """
 
+    _law = "Markov-modulated Poisson kicks (a Poisson rate switched by a hidden Markov chain)"
+
     rates: np.ndarray
     generator: np.ndarray
     initial: object = field(default="stationary", kw_only=True)

@@ -21,6 +21,8 @@ import numpy as np
 import pandas as pd
 from scipy import stats
 
+from kicktimes._results import Result
+
 from ._checks import check_choice, check_int, check_real, check_rng
 from .renewal import FULL_SAMPLE_MODELS, MODELS, FitWarning, _fit, check_sample
 
@@ -193,12 +195,16 @@ def compare_models(
 
 
 @dataclass(frozen=True)
-class VuongResult:
+class VuongResult(Result):
     """Vuong's non-nested likelihood-ratio test (result of :func:`vuong`).
 
     ``statistic > 0`` favours ``model1``; ``preferred`` is the favoured model when
     ``pvalue < alpha`` and None otherwise.
     """
+
+    _title = "Vuong's likelihood-ratio test of two renewal models (statistic > 0 favours model1)"
+    _summary_fields = ("model1", "model2", "statistic", "pvalue", "preferred", "loglik_ratio",
+                       "n", "correction", "x_min", "note")
 
     statistic: float
     pvalue: float

@@ -35,6 +35,8 @@ from statsmodels.genmod.generalized_linear_model import GLM
 from statsmodels.regression.linear_model import OLS
 from statsmodels.tools.tools import add_constant
 
+from kicktimes._results import nan_reason
+
 from ._checks import as_1d_float, check_choice
 from ._information import inverse_information
 from .renewal import FitWarning
@@ -319,6 +321,13 @@ class CountRegression:
         )
 
     @property
+    def reason(self) -> str | None:
+        """Why an estimate or a standard error is NaN (the `warnings`, where every NaN is
+        explained), None when all are finite."""
+        return nan_reason(self.estimates[["estimate", "stderr"]].to_numpy().ravel(),
+                          self.warnings)
+
+    @property
     def alpha(self) -> float:
         """Negative-binomial dispersion ``alpha`` (``Var N = mu + alpha mu^2``)."""
         return float(self.estimates.loc[("negbin", "alpha"), "estimate"])
@@ -390,6 +399,10 @@ class CountRegression:
         if self.rule is not None:
             out["kinetic"] = kinetic_rate(r, self.rule) * t
         return out
+
+    def to_frame(self) -> pd.DataFrame:
+        """The coefficient table of every model (`coefficients`)."""
+        return self.coefficients()
 
     def summary(self) -> str:
         """Coefficient tables, overdispersion and the per-radius table as text."""

@@ -33,6 +33,8 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 
+from kicktimes._results import Result
+
 from ._checks import check_choice, check_int, check_real, check_rng
 from .enskog import speed_rate_factor
 from .findings import clopper_pearson
@@ -226,7 +228,7 @@ _BURN_IN = 20
 
 
 @dataclass(frozen=True)
-class DiluteEstimate:
+class DiluteEstimate(Result):
     """One prediction of `DiluteTaggedDisk`: the number, its error and the method.
 
     Attributes
@@ -245,6 +247,10 @@ class DiluteEstimate:
     method : str
         How it was computed, in words.
     """
+
+    _title = "Dilute-gas prediction (DiluteTaggedDisk)"
+    _summary_fields = ("quantity", "value", "stderr", "n", "method")
+    _intervals = {"value": ("ci_low", "ci_high")}
 
     quantity: str
     value: float
@@ -277,7 +283,7 @@ def _normal_estimate(quantity, value, stderr, n, method):
 
 
 @dataclass(frozen=True)
-class DiluteTaggedDisk:
+class DiluteTaggedDisk(Result):
     r"""The tagged disk of a dilute gas of equal hard disks (`dilute_tagged_disk`), in
     units of the mean interval: the mean collision rate :math:`\bar\nu` is 1.
 
@@ -341,6 +347,9 @@ class DiluteTaggedDisk:
     >>> dilute_tagged_disk("mirror").hazard(3.0).tolist()
     1.0
     """
+
+    _title = ("The tagged disk of a dilute gas of equal hard disks (a model, in units of the "
+              "mean interval)")
 
     rule: str
     kT: float = 0.5

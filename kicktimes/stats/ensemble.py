@@ -77,6 +77,10 @@ class PoissonEnsembleResult:
             f"combine={self.combine!r}, fdr={self.fdr!r})"
         )
 
+    def to_frame(self) -> pd.DataFrame:
+        """The per-sequence table (`per_sequence`, a copy)."""
+        return self.per_sequence.copy()
+
     def summary(self) -> str:
         """Combined p-values, FDR counts and the rate-homogeneity test as text."""
         k = len(self.per_sequence)

@@ -21,6 +21,11 @@ import numpy as np
 import pandas as pd
 from scipy import stats as sps
 
+from kicktimes._results import (
+    Result,
+    format_interval,  # one place for result formatting
+)
+
 __all__ = [
     "MARGIN",
     "Finding",
@@ -157,35 +162,6 @@ def robust_verdict(verdicts, lows, highs, level=1.0):
     if len(set(verdicts)) > 1:
         return False, "verdict"
     return True, ""
-
-
-def format_interval(estimate, low, high, *, edges=(0.9, 1.0, 1.1), digits=3):
-    """``"0.886 [0.883, 0.892]"``: three significant digits, more where rounding would move
-    an endpoint across one of ``edges`` (the band and 1) or merge distinct endpoints, so
-    that the printed interval shows the verdict it was given.
-
-    Examples
-    --------
-    >>> format_interval(0.913, 0.89996, 0.927)
-    '0.91300 [0.89996, 0.92700]'
-    >>> format_interval(0.889, 0.886, 0.892)
-    '0.889 [0.886, 0.892]'
-    >>> format_interval(0.32, 0.3219, 0.3273)
-    '0.320 [0.322, 0.327]'
-    """
-    def side(x, e):
-        return int(x > e) - int(x < e)
-
-    def text(x, d):
-        return f"{x:#.{d}g}".rstrip(".") if np.isfinite(x) else "n/a"
-
-    estimate, low, high = float(estimate), float(low), float(high)
-    for d in range(digits, 8):
-        lo, hi = (float(text(v, d)) if np.isfinite(v) else v for v in (low, high))
-        ok = all(side(lo, e) == side(low, e) and side(hi, e) == side(high, e) for e in edges)
-        if ok and (lo < hi or not low < high):
-            break
-    return f"{text(estimate, d)} [{text(low, d)}, {text(high, d)}]"
 
 
 def rejection_verdict(low, high, alpha, margin=0.5):
@@ -530,7 +506,7 @@ def clopper_pearson(k, n, level=0.95):
 
 
 @dataclass(frozen=True)
-class Finding:
+class Finding(Result):
     """One answered question: ``question``, ``verdict``, ``statement`` and the ``rule``.
 
     A finding that is one effect size (a share, a ratio) also carries it: ``quantity``
@@ -538,6 +514,9 @@ class Finding:
     the ``method`` of the interval and the supporting numbers in ``detail``; the others
     leave them empty (NaN, ``""``) and give their numbers in the statement.
     """
+
+    _title = "Finding"
+    _intervals = {"estimate": ("ci_low", "ci_high")}
 
     question: str
     verdict: str
@@ -549,6 +528,12 @@ class Finding:
     ci_high: float = math.nan
     method: str = ""
     detail: str = ""
+
+    def _field_names(self) -> tuple[str, ...]:
+        own = ("question", "verdict", "statement", "rule")
+        if not self.quantity:
+            return own
+        return (*own, "quantity", "estimate", "ci_low", "ci_high", "method", "detail")
 
     def sentence(self) -> str:
         """The statement, with the supporting numbers (``detail``) in parentheses."""

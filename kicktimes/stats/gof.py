@@ -31,6 +31,8 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy import stats
 
+from kicktimes._results import Result
+
 from ._checks import check_choice, check_int, check_rng
 from .distributions import hyperexpon
 from .renewal import _TIME_POWER, PARAM_NAMES, RenewalFit, frozen_distribution, mle
@@ -49,8 +51,11 @@ _SCIPY_ROUTE = {
 
 
 @dataclass(frozen=True)
-class GofResult:
+class GofResult(Result):
     """Result of :func:`goodness_of_fit`."""
+
+    _title = "Goodness of fit of a renewal model (Monte Carlo p-value)"
+    _summary_fields = ("statistic_name", "statistic", "pvalue", "method", "n_mc", "n_failed")
 
     statistic: float
     pvalue: float

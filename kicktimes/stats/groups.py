@@ -15,6 +15,8 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
+from kicktimes._results import TableResult
+
 from ._checks import check_int
 from .ensemble import PoissonEnsembleResult, test_poisson_ensemble
 from .poisson import TESTS, Intervals, intervals_from_times
@@ -23,7 +25,7 @@ __all__ = ["PoissonGroup", "poisson_group", "pooled_intervals"]
 
 
 @dataclass(frozen=True, repr=False)
-class PoissonGroup:
+class PoissonGroup(TableResult):
     """Result of :func:`poisson_group`: the tests of one group of sequences, as table rows.
 
     Attributes
@@ -44,9 +46,26 @@ class PoissonGroup:
         incompatible with the group's rate after FDR).
     """
 
+    _title = "Poisson tests of one group of sequences"
+    _summary_fields = ()
+    _frame = "rejections"
+
     ensemble: PoissonEnsembleResult
     rejections: pd.DataFrame
     homogeneity: dict
+
+    def _summary_extra(self) -> list[str]:
+        h = self.homogeneity
+        table = self.rejections.to_string(index=False, float_format=lambda v: f"{v:.4g}")
+        return [
+            f"sequences: {h['n_sequences']} ({h['n_empty']} without events); pooled rate "
+            f"{h['pooled_rate']:.6g}, median rate {h['median_rate']:.6g}",
+            f"common rate: dispersion index {h['dispersion_index']:.4g}, Pearson "
+            f"{h['pearson_statistic']:.4g} on {h['df']} df (p = {h['pvalue']:.3g}, Monte Carlo "
+            f"{h['pvalue_mc']:.3g}), LR p = {h['lr_pvalue']:.3g}; {h['n_flagged_fdr']} "
+            "sequence(s) flagged after FDR",
+            *table.split("\n"),
+        ]
 
     def __repr__(self) -> str:
         h = self.homogeneity

@@ -55,6 +55,10 @@ class HazardTable:
         """Hazard of the first bin over the constant rate (1 for a Poisson process)."""
         return float(self.table["hazard"].iloc[0] / self.rate)
 
+    def to_frame(self) -> pd.DataFrame:
+        """The hazard per bin (`table`, a copy)."""
+        return self.table.copy()
+
     def summary(self) -> str:
         """The table and the flatness test as text."""
         head = (f"hazard of {int(self.table['events'].sum())} intervals in "

@@ -15,21 +15,30 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from kicktimes._results import Result
+
 from ._checks import as_1d_float, check_choice, check_real, check_rng
 
 __all__ = ["RateMixture", "rate_mixture", "simulate_cox_times"]
 
 
 @dataclass(frozen=True, repr=False)
-class RateMixture:
+class RateMixture(Result):
     """The mixture of exponential laws with ``rates`` and ``weights`` (summing to 1).
 
     Built by :func:`rate_mixture`; ``sf``, ``pdf``, ``hazard`` take times in the rates'
     inverse unit.
     """
 
+    _title = "Mixture of exponential interval laws (rate redrawn after every event)"
+    _summary_fields = ("rates", "weights")
+
     rates: np.ndarray
     weights: np.ndarray
+
+    def _summary_extra(self) -> list[str]:
+        return [f"mean rate: {float(self.weights @ self.rates):.6g}",
+                f"mean interval: {self.mean():.6g}"]
 
     def sf(self, t) -> np.ndarray:
         """Survival function ``sum_k w_k exp(-rate_k t)``."""

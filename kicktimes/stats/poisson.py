@@ -17,12 +17,13 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import NamedTuple
 
 import numpy as np
 import pandas as pd
 from numba import njit
 from statsmodels.stats.multitest import multipletests
+
+from kicktimes._results import Result, TupleCompat
 
 from . import iid_tests as iid
 from ._checks import check_choice, check_int, check_real, check_rng, check_times
@@ -59,11 +60,31 @@ COMBINE_METHODS = ("fisher", "pearson", "tippett", "stouffer", "mudholkar_george
 FDR_METHODS = ("fdr_bh", "fdr_by", "bonferroni", "holm", "fdr_tsbh", "fdr_tsbky")
 
 
-class Intervals(NamedTuple):
-    """Complete and right-censored intervals of one or several sequences."""
+@dataclass(frozen=True, repr=False)
+class Intervals(TupleCompat, Result):
+    """Complete and right-censored intervals of one or several sequences.
+
+    Attributes
+    ----------
+    complete : ndarray
+        The complete intervals ``t_{k+1} - t_k``.
+    censored : ndarray
+        The right-censored ones, ``T - t_n`` per sequence.
+
+    Unpacking (``complete, censored = intervals_from_times(...)``) and indexing still work
+    until 0.3.0, with a DeprecationWarning: use the fields.
+    """
+
+    _title = "Inter-event intervals (complete and right-censored)"
+    _tuple_fields = ("complete", "censored")
 
     complete: np.ndarray
     censored: np.ndarray
+
+    def _summary_extra(self) -> list[str]:
+        mean = self.complete.mean() if self.complete.size else math.nan
+        return [f"n: {self.complete.size} complete, {self.censored.size} censored; mean "
+                f"complete interval {mean:.6g}"]
 
 
 def _is_ensemble(times) -> bool:
@@ -324,6 +345,16 @@ class MonteCarloNulls:
 
     def __repr__(self) -> str:
         return f"MonteCarloNulls(seed={self.seed}, keys={len(self._values)})"
+
+    def summary(self) -> str:
+        """The bank as text: its seed and the nulls drawn so far, per test."""
+        lines = ["Monte Carlo nulls of the conditional Poisson tests (a shared bank)",
+                 f"  seed: {self.seed}", f"  keys drawn: {len(self._values)}"]
+        for index, test in enumerate(MC_TESTS):
+            sizes = [np.asarray(v).size for k, v in self._values.items() if k[0] == index]
+            if sizes:
+                lines.append(f"  {test}: {len(sizes)} key(s), up to {max(sizes)} statistics")
+        return "\n".join(lines)
 
     def sample(self, test: str, n_events: int, size: int, *, lags: int = 0,
                n_bins: int = 2) -> np.ndarray:

@@ -40,6 +40,8 @@ from scipy import optimize, stats
 from scipy.special import expit, logit
 from statsmodels.tools.numdiff import approx_hess
 
+from kicktimes._results import nan_reason
+
 from ._checks import check_choice, check_int, check_intervals, check_real
 from ._information import inverse_information
 from ._renewal_mle import CLOSED_FORM_MODELS, FAST_FITS, log_density_and_survival
@@ -357,6 +359,15 @@ class RenewalFit:
         for tail fits). Built on first use: freezing a scipy distribution costs about a
         millisecond, more than many fits, and model comparison never needs it."""
         return frozen_distribution(self.model, self.theta, self.x_min)
+
+    @property
+    def reason(self) -> str | None:
+        """Why an estimate or a standard error of the free parameters is NaN (the fit's
+        `warnings`), None when all are finite (``x_min``'s standard error, NaN by
+        design, does not count)."""
+        names = PARAM_NAMES[self.model]
+        return nan_reason([*(self.params[n] for n in names), *(self.stderr[n] for n in names)],
+                          self.warnings)
 
     @property
     def aic(self) -> float:

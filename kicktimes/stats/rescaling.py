@@ -22,13 +22,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from kicktimes._results import Result
+
 from .ensemble import test_poisson_ensemble
 from .mmpp import _em as em
 from .mmpp.fit import MMPPFit, check_windows
 
 
 @dataclass(frozen=True, repr=False)
-class RescaledTimes:
+class RescaledTimes(Result):
     """Time-rescaled windows (result of :func:`mmpp_residuals`).
 
     Attributes
@@ -44,10 +46,18 @@ class RescaledTimes:
         :math:`\\Lambda(T) - \\Lambda(t_N)` of each window (right-censored Exp(1)).
     """
 
+    _title = "Time-rescaled windows under a fitted MMPP (IID Exp(1) intervals if it is right)"
+    _summary_fields = ("windows", "intervals", "censored")
+
     times: list
     windows: np.ndarray
     intervals: np.ndarray
     censored: np.ndarray
+
+    def _summary_extra(self) -> list[str]:
+        mean = self.intervals.mean() if self.intervals.size else np.nan
+        return [f"n: {len(self.times)} windows, events: {self.intervals.size}, mean rescaled "
+                f"interval {mean:.4g} (1 under the model)"]
 
     def __repr__(self) -> str:
         return (f"RescaledTimes(n_windows={len(self.times)}, n_events={self.intervals.size}, "

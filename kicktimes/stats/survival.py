@@ -18,6 +18,8 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
+from kicktimes._results import Result
+
 from ._checks import check_real
 
 __all__ = ["MIN_AT_RISK", "EscapeTail", "circle_escape_constant", "escape_survival",
@@ -120,7 +122,7 @@ def reliable_until(km, floor=MIN_AT_RISK) -> float:
 
 
 @dataclass(frozen=True)
-class EscapeTail:
+class EscapeTail(Result):
     """Result of `fit_escape_tail`: the two tail laws fitted beyond ``t_min``.
 
     Attributes
@@ -136,6 +138,9 @@ class EscapeTail:
     best : str
         ``"exponential"`` or ``"algebraic"`` (lower AIC; both have one parameter).
     """
+
+    _title = "Tail of the escape times beyond t_min: exponential against algebraic"
+    _intervals = {"rate": "rate_ci", "alpha": "alpha_ci"}
 
     t_min: float
     n_tail: int

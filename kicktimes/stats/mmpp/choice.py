@@ -32,6 +32,8 @@ import numpy as np
 import pandas as pd
 from scipy import optimize
 
+from kicktimes._results import Result
+
 from .._checks import check_choice, check_int, check_rng
 from ..comparison import compare_models
 from ..poisson import intervals_from_times
@@ -147,7 +149,8 @@ def compare_point_processes(times, t_max, *, models=None, n_states=(2,), n_start
     sizes = [check_int("n_states", k, low=2, high=MAX_STATES) for k in np.atleast_1d(n_states)]
     rng = check_rng(rng)
     data = em.Windows.of(seqs, lengths)
-    complete, censored = intervals_from_times(seqs, lengths, first="drop")
+    iv = intervals_from_times(seqs, lengths, first="drop")
+    complete, censored = iv.complete, iv.censored
     n_obs = complete.size + censored.size
     if complete.size < 1:
         raise ValueError("times: the comparison needs at least one window with two events "
@@ -193,10 +196,13 @@ def compare_point_processes(times, t_max, *, models=None, n_states=(2,), n_start
 
 
 @dataclass(frozen=True)
-class MMPPLRTest:
+class MMPPLRTest(Result):
     """Parametric-bootstrap likelihood-ratio test of an MMPP against Poisson (result of
     :func:`mmpp_lr_test`): ``statistic = 2 (loglik_mmpp - loglik_poisson)``, ``pvalue =
     (1 + #{null >= statistic}) / (1 + n_boot)``."""
+
+    _title = "Parametric-bootstrap likelihood-ratio test of an MMPP against Poisson"
+    _summary_fields = ("n_states", "statistic", "pvalue", "n_boot")
 
     statistic: float
     pvalue: float
@@ -205,6 +211,10 @@ class MMPPLRTest:
     n_states: int
     poisson: MMPPFit = field(repr=False)
     mmpp: MMPPFit = field(repr=False)
+
+    def _summary_extra(self) -> list[str]:
+        return [f"log-likelihood: Poisson {self.poisson.loglik:.6g}, {self.n_states}-state MMPP "
+                f"{self.mmpp.loglik:.6g}"]
 
 
 def mmpp_lr_test(times, t_max, *, n_states=2, n_boot=99, n_starts=12, rng=None):

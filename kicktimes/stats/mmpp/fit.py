@@ -26,6 +26,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from kicktimes._results import nan_reason
+
 from .._checks import as_1d_float, check_choice, check_int, check_real, check_rng, check_times
 from .._information import inverse_information
 from ..poisson import _is_ensemble
@@ -148,6 +150,13 @@ class MMPPFit:
         for a free start."""
         n = self.n_states
         return n * n + (n - 1 if self.initial_method == "free" else 0)
+
+    @property
+    def reason(self) -> str | None:
+        """Why a rate, a switching rate or a standard error is NaN (the fit's `warnings`),
+        None when all are finite."""
+        return nan_reason(np.concatenate([np.ravel(a) for a in (
+            self.rates, self.generator, self.rates_se, self.generator_se)]), self.warnings)
 
     @property
     def aic(self) -> float:
