@@ -38,10 +38,12 @@ def test_every_verdict_is_the_one_its_interval_gives(path):
     poisson = table["question"] == "Poisson collision times?"
     for row in table[~poisson].itertuples():
         assert row.verdict == ratio_verdict(row.ci_low, row.ci_high), row
-        # the diagnostic's own margin, the one the pages read (`margin_of`)
-        assert row.margin == margin_of(row.diagnostic), row
-        assert row.verdict_at_margin == ratio_verdict(row.ci_low, row.ci_high,
-                                                      margin_of(row.diagnostic)), row
+        # the diagnostic's own margin, the one the pages read (`margin_of`), where the
+        # table has it (the paper study's; paper.md's claims read the paper's 10 %)
+        if hasattr(row, "verdict_at_margin"):
+            assert row.margin == margin_of(row.diagnostic), row
+            assert row.verdict_at_margin == ratio_verdict(row.ci_low, row.ci_high,
+                                                          margin_of(row.diagnostic)), row
     # the Poisson rows: each share against its test's level in null_calibration.csv (the
     # runs' own Poisson control streams; alpha for the first-collisions row); D, the first
     # hazard bin and the gamma shape against their control streams' values (the paired
@@ -104,7 +106,8 @@ def test_no_comparison_flagged_robust_changes_direction(path):
     for key, group in ratios.groupby(["family", "diagnostic", "system"]):
         if group["robust"].astype(str).str.lower().eq("true").all():
             assert not ((group["ci_low"] > 1).any() and (group["ci_high"] < 1).any()), key
-            assert group["verdict"].nunique() == 1, key
+            read = "verdict_at_margin" if "verdict_at_margin" in group else "verdict"
+            assert group[read].nunique() == 1, key
 
 
 @pytest.mark.parametrize("path", FAMILIES, ids=[t.name for t in FAMILIES])

@@ -25,11 +25,11 @@ __all__ = ["QUESTIONS", "answer_lines", "compact_overview", "first_screen", "qa_
 #: first. Each is read at its diagnostic's margin (`kicktimes.stats.margin_of`), the
 #: margin of the compact table and the findings CSVs
 QUESTIONS = (
-    ("Does the paper's kicked disk (uniform kicks) have the two-disk tangent-space FTLE?",
+    ("Does the paper's kicked disk (uniform kicks) have the two-disk FTLE?",
      "ftle", ("poisson", "actual")),
     ("Do scatter kicks (virtual partners) give the two-disk FTLE?", "ftle",
      ("poisson_scatter", "actual_scatter", "poisson_kinetic")),
-    ("Does it decorrelate like the two disks at lag 1 (1 − R₁ over each system's n steps)?",
+    ("Does it decorrelate like the two disks (1 − R₁ at lag 1)?",
      "one_minus_r1", ("poisson", "actual")),
     ("Does it have the two-disk off-diagonal recurrence rate (ε = 10⁻²)?", "rr_offdiag@0.01",
      ("poisson", "actual")),
