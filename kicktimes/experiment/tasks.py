@@ -30,6 +30,7 @@ import functools
 import math
 import struct
 import time
+import warnings
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 
@@ -39,6 +40,7 @@ import pandas as pd
 from kicktimes.experiment.config import Experiment
 from kicktimes.experiment.plan import Task, make_tasks
 from kicktimes.stats import MMPP_MIN_EVENTS
+from kicktimes.validation import RENAMED_MARKER, check_seed_sequence
 
 __all__ = [
     "COLLISION_COLUMNS",
@@ -74,10 +76,43 @@ def _radius_key(radius: float) -> int:
     return struct.unpack("<Q", struct.pack("<d", float(radius)))[0]
 
 
-def kick_rng(seed: int, ic: int, radius: float, system: str) -> np.random.Generator:
-    """The generator of the kick times and angles of one (IC, radius, system)."""
-    key = (KICK_DOMAIN, int(ic), _radius_key(radius), SYSTEM_CODES[system])
-    return np.random.default_rng(np.random.SeedSequence(seed, spawn_key=key))
+def _kick_rng(ic: int, radius: float, system: str, *, rng) -> np.random.Generator:
+    """The generator of the kick times and angles of one (IC, radius, system).
+
+    ``rng`` is the sweep's root (`kicktimes.validation.check_seed_sequence`: an int seed
+    or a SeedSequence; a Generator is consumed): the stream is the root's child
+    ``spawn_key=(KICK_DOMAIN, ic, radius bits, system code)``, so ``rng=seed`` gives
+    exactly the stream of the old ``kick_rng(seed, ic, radius, system)``.
+
+    >>> bool(kick_rng(0, 0.01, "poisson", rng=7).random() == kick_rng(0, 0.01, "poisson",
+    ...                                                              rng=7).random())
+    True
+    """
+    root = check_seed_sequence(rng, "rng")
+    key = (*root.spawn_key, KICK_DOMAIN, int(ic), _radius_key(radius), SYSTEM_CODES[system])
+    return np.random.default_rng(
+        np.random.SeedSequence(root.entropy, spawn_key=key, pool_size=root.pool_size))
+
+
+@functools.wraps(_kick_rng)
+def kick_rng(*args, **kwargs) -> np.random.Generator:
+    # the old spelling kick_rng(seed, ic, radius, system) (or seed=): the root first, by
+    # position; deprecated since 0.2.0 (CHANGELOG.md), the stream unchanged
+    if "seed" in kwargs or len(args) == 4:
+        if "rng" in kwargs:
+            raise TypeError("kick_rng() got both the old root (seed) and rng=; pass only rng=")
+        if len(args) == 4:
+            seed, args = args[0], args[1:]
+        else:
+            seed = kwargs.pop("seed")
+        warnings.warn("kick_rng(seed, ic, radius, system) is deprecated since 0.2.0 and will "
+                      "be removed in 0.3.0; use kick_rng(ic, radius, system, rng=seed)",
+                      DeprecationWarning, stacklevel=2)
+        kwargs["rng"] = seed
+    return _kick_rng(*args, **kwargs)
+
+
+setattr(kick_rng, RENAMED_MARKER, {"seed": "rng"})
 
 
 class _Timer:

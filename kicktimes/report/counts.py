@@ -19,6 +19,7 @@ from kicktimes.render.figures import (
 from kicktimes.render.pages import p_value_text
 from kicktimes.report.context import Section
 from kicktimes.stats import STICKY_FACTOR
+from kicktimes.validation import keyword_only_after
 
 __all__ = ["counts_by_radius", "counts_vs_radius", "experiment_kinetic", "kinetic_rate_of",
            "sticky_ics",
@@ -114,7 +115,8 @@ def counts_by_radius(collisions, *, x="radius") -> pd.DataFrame:
     return out
 
 
-def counts_vs_radius(collisions, regression=None, *, rule="mirror", ax=None, kinetic=None):
+@keyword_only_after(1, since="0.2.0", names=('regression',))
+def counts_vs_radius(collisions, *, regression=None, rule="mirror", ax=None, kinetic=None):
     r"""Mean number of disk-disk collisions against radius, with the fitted curves.
 
     Parameters

@@ -39,6 +39,7 @@ from kicktimes.stats import (
     spearman,
 )
 from kicktimes.stats.poisson import TEST_NULLS
+from kicktimes.validation import keyword_only_after
 
 __all__ = [
     "binomial_ci",
@@ -69,7 +70,8 @@ TEST_TITLES = {
 FIXED_EVENTS = 30
 
 
-def binomial_ci(k, n, level=0.95):
+@keyword_only_after(2, since="0.2.0")
+def binomial_ci(k, n, *, level=0.95):
     """Clopper-Pearson interval of ``k`` successes in ``n`` trials (NaN where n = 0): the
     arrays of `kicktimes.stats.clopper_pearson`."""
     return clopper_pearson(k, n, level)

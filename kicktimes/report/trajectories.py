@@ -20,6 +20,7 @@ from kicktimes.render.figures import TIME_UNIT, check_frame, finite, new_axes
 from kicktimes.render.pages import percent_text
 from kicktimes.report.context import Section
 from kicktimes.report.store import REFERENCE, eps_values, nearest
+from kicktimes.validation import keyword_only_after
 
 __all__ = ["poincare_section", "poincare_panels", "recurrence_plot", "line_pairs", "sections"]
 
@@ -54,7 +55,9 @@ def _boundary_frame(data, particle):
     return s, st, radius
 
 
-def poincare_section(data, particle=0, *, ax=None, title=None, markersize=0.6, color="C0"):
+@keyword_only_after(1, since="0.2.0", names=('particle',))
+def poincare_section(data, *, particle=0, ax=None, title=None, markersize=0.6,
+                     color="C0"):
     r"""Poincaré section ``(s, sin θ)`` of one disk's boundary collisions.
 
     Parameters

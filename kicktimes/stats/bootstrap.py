@@ -38,7 +38,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from kicktimes.validation import check_int, check_real, check_rng
+from kicktimes.validation import check_int, check_real, check_rng, keyword_only_after
 
 from .robust import bootstrap_nanmedians, nanmedian
 
@@ -46,7 +46,8 @@ __all__ = ["ClusterBootstrap", "cluster_bootstrap", "paired_median", "paired_rat
            "percentile_interval", "ratio_of_means", "resample_counts", "resample_indices"]
 
 
-def resample_indices(n_clusters, n_boot, rng=None, *, with_identity=False, chunk=None):
+@keyword_only_after(1, since="0.2.0", names=('n_boot', 'rng'))
+def resample_indices(n_clusters, *, n_boot, rng=None, with_identity=False, chunk=None):
     r"""Cluster indices of ``n_boot`` bootstrap resamples of ``n_clusters`` runs.
 
     Parameters
@@ -93,7 +94,8 @@ def resample_indices(n_clusters, n_boot, rng=None, *, with_identity=False, chunk
     return idx
 
 
-def resample_counts(n_clusters, n_boot, rng=None):
+@keyword_only_after(1, since="0.2.0")
+def resample_counts(n_clusters, *, n_boot, rng=None):
     r"""How often each cluster is drawn in each of ``n_boot`` bootstrap resamples.
 
     The same resampling as `resample_indices`, counted: row ``b`` is multinomial with
@@ -130,7 +132,8 @@ def _tail_percent(level):
     return round(50.0 * (1.0 - level), 12)
 
 
-def percentile_interval(replicates, level=0.95, *, axis=None):
+@keyword_only_after(1, since="0.2.0", names=('level',))
+def percentile_interval(replicates, *, level=0.95, axis=None):
     r"""Percentile interval of the finite bootstrap replicates.
 
     ``(p_a, p_{100-a})`` with ``a = 50 (1 - level)`` percent (2.5 and 97.5 for the 95 %

@@ -35,6 +35,8 @@ from statsmodels.genmod.generalized_linear_model import GLM
 from statsmodels.regression.linear_model import OLS
 from statsmodels.tools.tools import add_constant
 
+from kicktimes.validation import keyword_only_after
+
 from ._checks import as_1d_float, check_choice
 from ._information import inverse_information
 from .renewal import FitWarning
@@ -139,7 +141,8 @@ def is_sticky(rate, kinetic, *, factor=STICKY_FACTOR):
     return out if out.ndim else bool(out)
 
 
-def kinetic_rate(r, rule="mirror", *, masses=None):
+@keyword_only_after(1, since="0.2.0", names=('rule',))
+def kinetic_rate(r, *, rule="mirror", masses=None):
     r"""Disk-disk collision rate of two disks of radius ``r`` under the invariant measure.
 
     Parameters
@@ -368,7 +371,8 @@ class CountRegression:
             }
         )
 
-    def predict(self, radius, t_window=1.0) -> pd.DataFrame:
+    @keyword_only_after(1, since="0.2.0")
+    def predict(self, radius, *, t_window=1.0) -> pd.DataFrame:
         """Expected counts at ``radius`` over ``t_window`` from each model.
 
         Columns ``radius``, ``t_window``, ``ols``, ``poisson``, ``negbin`` and, when

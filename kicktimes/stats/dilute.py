@@ -33,6 +33,8 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 
+from kicktimes.validation import keyword_only_after
+
 from ._checks import check_choice, check_int, check_real, check_rng
 from .enskog import speed_rate_factor
 from .findings import clopper_pearson
@@ -115,7 +117,8 @@ def _elastic_streams(gen, n_runs, t_window, c, kT):  # pragma: no cover - compil
     return times[:nt], speeds[:ns], lengths
 
 
-def dilute_tagged_times(rule, rate, t_window, n_runs, rng, *, kT=0.5, speeds=False):
+@keyword_only_after(3, since="0.2.0", names=("n_runs", "rng"))
+def dilute_tagged_times(rule, rate, t_window, *, n_runs, rng=None, kT=0.5, speeds=False):
     r"""Collision times of a tagged disk in a dilute gas of equal hard disks (linear
     Boltzmann process), ``n_runs`` independent stationary streams on ``[0, t_window]``.
 
@@ -202,7 +205,7 @@ def dilute_tagged_times(rule, rate, t_window, n_runs, rng, *, kT=0.5, speeds=Fal
         raise TypeError(f"n_runs must be an integer >= 1, got {n_runs!r}")
     if n_runs < 1:
         raise ValueError(f"n_runs must be an integer >= 1, got {n_runs!r}")
-    rng = np.random.default_rng(rng)
+    rng = check_rng(rng, "rng")
     if rule == "mirror":
         counts = rng.poisson(float(rate) * float(t_window), size=int(n_runs))
         times = [np.sort(rng.uniform(0.0, float(t_window), k)) for k in counts]
@@ -480,7 +483,8 @@ class DiluteTaggedDisk:
         out = [self._moment(2, x) / self._moment(1, x) for x in arr.ravel()]
         return np.asarray(out, dtype=float).reshape(arr.shape)
 
-    def dispersion(self, window=None, *, n_events=2_000_000, batch=500, rng=0):
+    @keyword_only_after(0, since="0.2.0", names=('window',))
+    def dispersion(self, *, window=None, n_events=2_000_000, batch=500, rng=0):
         r"""The index of dispersion :math:`D = \operatorname{Var}N/\operatorname{E}N` of
         the collisions counted in a window of ``window`` mean intervals of the
         stationary process; its long-window limit :math:`D_\infty` for ``None``.
@@ -578,7 +582,8 @@ class DiluteTaggedDisk:
                                 f"variance over mean of the counts of {c.size} independent "
                                 f"stationary streams, delta-method error")
 
-    def ks_share(self, k, alpha=0.05, *, n_runs=4000, rng=0):
+    @keyword_only_after(1, since="0.2.0", names=('alpha',))
+    def ks_share(self, k, *, alpha=0.05, n_runs=4000, rng=0):
         r"""The share of tagged disks whose first ``k`` collision times a KS test of
         uniformity on the window up to collision ``k + 1`` rejects at ``alpha``.
 

@@ -21,6 +21,8 @@ import numpy as np
 import pandas as pd
 from scipy import stats as sps
 
+from kicktimes.validation import keyword_only_after
+
 __all__ = [
     "MARGIN",
     "Finding",
@@ -58,7 +60,8 @@ SHARE_RULE = (
 )
 
 
-def ratio_rule(tolerance=0.1) -> str:
+@keyword_only_after(0, since="0.2.0")
+def ratio_rule(*, tolerance=0.1) -> str:
     """The printed rule of :func:`ratio_verdict` for a band of half-width ``tolerance``.
 
     >>> ratio_rule(0.1)[:58]
@@ -80,7 +83,8 @@ def ratio_rule(tolerance=0.1) -> str:
 MARGIN = 0.1
 
 
-def ratio_verdict(low, high, tolerance=MARGIN):
+@keyword_only_after(2, since="0.2.0")
+def ratio_verdict(low, high, *, tolerance=MARGIN):
     """``"within 10 %"``, ``"higher"``, ``"lower"`` or ``"inconclusive"`` for a ratio's 95 % CI.
 
     The verdict of every ratio kicktimes states (:func:`ratio_rule` prints it): *within* when
@@ -132,7 +136,8 @@ def ratio_interval(estimate, low, high, reference, ref_low, ref_high):
     return ratio, ratio * math.exp(-1.96 * se), ratio * math.exp(1.96 * se)
 
 
-def robust_verdict(verdicts, lows, highs, level=1.0):
+@keyword_only_after(3, since="0.2.0")
+def robust_verdict(verdicts, lows, highs, *, level=1.0):
     """Whether a comparison keeps its verdict and its direction under every control.
 
     ``(robust, reason)``: robust when every control gives the same verdict **and** no
@@ -188,7 +193,8 @@ def format_interval(estimate, low, high, *, edges=(0.9, 1.0, 1.1), digits=3):
     return f"{text(estimate, d)} [{text(low, d)}, {text(high, d)}]"
 
 
-def rejection_verdict(low, high, alpha, margin=0.5):
+@keyword_only_after(2, since="0.2.0")
+def rejection_verdict(low, high, *, alpha, margin=0.5):
     """The verdict on a share of runs that reject a test at level ``alpha``.
 
     ``"nominal"`` when the 95 % CI lies in ``[alpha (1 - margin), alpha (1 + margin)]`` (an
@@ -216,7 +222,8 @@ def rejection_verdict(low, high, alpha, margin=0.5):
     return "inconclusive"
 
 
-def rejection_rule(alpha=0.05, margin=0.5) -> str:
+@keyword_only_after(0, since="0.2.0")
+def rejection_rule(*, alpha=0.05, margin=0.5) -> str:
     """The printed rule of :func:`rejection_verdict`."""
     lo, hi = alpha * (1 - margin), alpha * (1 + margin)
     return (f"nominal: the 95 % CI of the share of runs rejected at α = {alpha:g} lies in "
@@ -245,7 +252,8 @@ RR_MARGIN = 0.03
 DIAGNOSTIC_MARGINS = {"ftle": FINE_MARGIN, "rr_offdiag": RR_MARGIN}
 
 
-def margin_of(diagnostic, default=MARGIN):
+@keyword_only_after(1, since="0.2.0")
+def margin_of(diagnostic, *, default=MARGIN):
     """The equivalence margin of a findings table's ``diagnostic`` (``"ftle"``,
     ``"rr_offdiag@0.01"``, ``"det@0.001"``, ...): `DIAGNOSTIC_MARGINS` by the name before
     the ``@``, else ``default``.
@@ -265,7 +273,8 @@ def margin_of(diagnostic, default=MARGIN):
 D_MARGIN = 0.07
 
 
-def null_verdict(low, high, margin):
+@keyword_only_after(2, since="0.2.0")
+def null_verdict(low, high, *, margin):
     """A statistic read against its null stream: the 95 % CI ``[low, high]`` of the
     difference *statistic - its value on null streams shaped like the runs*.
 
@@ -295,7 +304,8 @@ def null_verdict(low, high, margin):
     return "inconclusive"
 
 
-def null_rule(margin, name="D") -> str:
+@keyword_only_after(0, since="0.2.0")
+def null_rule(*, margin, name="D") -> str:
     """The printed rule of :func:`null_verdict` for ``name`` with ``margin``."""
     return (f"{name} is read against its null stream's {name} (the same statistic on Poisson "
             f"streams shaped like the runs): at its null when the 95 % CI of the difference "
@@ -303,7 +313,8 @@ def null_rule(margin, name="D") -> str:
             f"beyond {margin:g} / -{margin:g}, inconclusive otherwise")
 
 
-def equivalence_sample_size(se, n, margin, *, level=0.95, power=0.8):
+@keyword_only_after(2, since="0.2.0", names=("margin",))
+def equivalence_sample_size(se, n, *, margin, level=0.95, power=0.8):
     """The number of units (ICs, runs) at which a difference with standard error ``se`` at
     ``n`` units gets its ``level`` CI inside ``[-margin, margin]`` with probability
     ``power`` when the true difference is 0: ``se`` scales as ``1/sqrt(n)`` and the CI
@@ -331,8 +342,9 @@ def equivalence_sample_size(se, n, margin, *, level=0.95, power=0.8):
     return max(int(n), int(math.ceil(n * (se * z / margin) ** 2)))
 
 
-def poisson_verdict(reject_low, reject_high, null_level, dispersion_low, dispersion_high,
-                    *, margin=0.5, band=0.1, against_null=False):
+@keyword_only_after(2, since="0.2.0", names=("null_level", "dispersion_low", "dispersion_high"))
+def poisson_verdict(reject_low, reject_high, *, null_level, dispersion_low, dispersion_high,
+                    margin=0.5, band=0.1, against_null=False):
     """One standard for "Poisson": a calibrated test and an effect outside a stated band.
 
     A stream is read against two things stated before any data: the share of runs that a
@@ -408,7 +420,8 @@ def poisson_verdict(reject_low, reject_high, null_level, dispersion_low, dispers
     return "inconclusive"
 
 
-def poisson_rule(margin=0.5, band=0.1, *, against_null=False) -> str:
+@keyword_only_after(0, since="0.2.0")
+def poisson_rule(*, margin=0.5, band=0.1, against_null=False) -> str:
     """The printed rule of :func:`poisson_verdict` (``against_null``: D read against its
     null stream's D)."""
     if against_null:
@@ -430,7 +443,8 @@ def poisson_rule(margin=0.5, band=0.1, *, against_null=False) -> str:
             "otherwise")
 
 
-def share_verdict(low, high, level):
+@keyword_only_after(2, since="0.2.0")
+def share_verdict(low, high, *, level):
     """``"above"``, ``"below"`` or ``"inconclusive"`` for a share's CI against ``level``
     (:data:`SHARE_RULE`; inconclusive when an endpoint is not finite).
 
@@ -448,7 +462,8 @@ def share_verdict(low, high, level):
     return "inconclusive"
 
 
-def share_ratio_sample_size(share, tolerance=0.1, power=0.8, level=0.95):
+@keyword_only_after(1, since="0.2.0")
+def share_ratio_sample_size(share, *, tolerance=0.1, power=0.8, level=0.95):
     """Runs per arm for the ratio of two equal shares to be called within ``tolerance``.
 
     The sample size at which the ratio of two independent shares, both equal to ``share``
@@ -477,7 +492,8 @@ def share_ratio_sample_size(share, tolerance=0.1, power=0.8, level=0.95):
     return int(math.ceil(2 * (1 - p) / p * (z / math.log1p(tolerance)) ** 2))
 
 
-def clopper_pearson(k, n, level=0.95):
+@keyword_only_after(2, since="0.2.0")
+def clopper_pearson(k, n, *, level=0.95):
     r"""Exact (Clopper-Pearson) interval of a binomial share: ``k`` successes in ``n``.
 
     The one implementation kicktimes uses: the Poisson tests' rejection shares, the renewal

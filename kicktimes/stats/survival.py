@@ -18,6 +18,8 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
+from kicktimes.validation import keyword_only_after
+
 from ._checks import check_real
 
 __all__ = ["MIN_AT_RISK", "EscapeTail", "circle_escape_constant", "escape_survival",
@@ -92,7 +94,8 @@ def escape_survival(escape_times, t_max) -> pd.DataFrame:
                          "n_at_risk": sf.n_risk})
 
 
-def reliable_until(km, floor=MIN_AT_RISK) -> float:
+@keyword_only_after(1, since="0.2.0")
+def reliable_until(km, *, floor=MIN_AT_RISK) -> float:
     """The first time of a Kaplan-Meier table (`escape_survival`) at which fewer than
     ``floor`` runs are at risk (inf: never): the curve is read as measured before it.
 
