@@ -197,7 +197,7 @@ def box_side(n_disks, r, *, packing) -> float:
     r"""The side :math:`L` of the periodic square box in which ``n_disks`` disks of radius
     ``r`` have the area fraction ``packing``: :math:`\varphi = N\pi r^2 / L^2`.
 
-    >>> round(box_side(2000, 0.01, 0.3), 6)
+    >>> round(box_side(2000, 0.01, packing=0.3), 6)
     1.447203
     """
     n = check_int("n_disks", n_disks, low=1, high=10**7)

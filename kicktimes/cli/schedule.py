@@ -126,7 +126,7 @@ def schedule_command(
             )
         if seed is None:
             seed = int(np.random.SeedSequence().entropy)
-        times = schedule.sample(t_max, seed)
+        times = schedule.sample(t_max, rng=seed)
         path = schedules.write_kick_times(times, output, t_max=t_max, schedule=schedule, seed=seed)
     except (ValueError, TypeError) as exc:
         raise click.UsageError(_plain(str(exc), _SCHEDULE_OPTIONS)) from None

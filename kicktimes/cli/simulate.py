@@ -72,7 +72,7 @@ def simulate_command(radii, n_ics, t_max, seed, rule, ic_method, out, save_runs,
 
     compile_first(None, SIMULATE_KERNELS)
     with _cli_errors(options):
-        ics = initial_conditions(n_ics, max(radii), seed=seed, method=ic_method, rule=rule)
+        ics = initial_conditions(n_ics, max(radii), rng=seed, method=ic_method, rule=rule)
         for r in radii:
             simulate_two_particle(ics[0], r, t_max=t_max, rule=rule)  # validates r, t_max
         os.makedirs(out, exist_ok=True)
@@ -142,7 +142,7 @@ def _simulate_disks(n_disks, packing, t_max, seed, rule, out, box=None):
             raise ValueError(f"box must be at least 3 cells of one diameter wide, box >= 6 r = "
                              f"{6.0 * r:.6g} for {n_disks} disks at packing {packing:g}, got "
                              f"{box:g}")
-        state = initial_state(n_disks, r, seed=seed, rule=rule, box=box)
+        state = initial_state(n_disks, r, rng=seed, rule=rule, box=box)
         os.makedirs(out, exist_ok=True)
         run = simulate_disks(state, r, t_max=t_max, rule=rule, box=box)
     path = os.path.join(out, "disks.parquet")

@@ -211,7 +211,7 @@ def disks_lyapunov(state, r, *, t_max, segment, rule="mirror", method="tangent",
     --------
     >>> import kicktimes as kt
     >>> from kicktimes.diagnostics.gas_lyapunov import disks_lyapunov
-    >>> s = kt.initial_state(20, 0.05, seed=3)
+    >>> s = kt.initial_state(20, 0.05, rng=3)
     >>> res = disks_lyapunov(s, 0.05, t_max=20.0, segment=1.0, rng=1)
     >>> res.logs.size, res.method, bool(res.exponent > 0)
     (20, 'tangent', True)

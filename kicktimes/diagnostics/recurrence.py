@@ -259,7 +259,7 @@ def recurrence_pairs(points, *, eps=1e-3, theiler=0):
     Returns the nonzero entries of the recurrence matrix
     ``R_ij = Theta(eps - |x_i - x_j|)`` (both orders, main diagonal included unless a
     Theiler window removes it), never the N x N matrix. ``len(i) / N**2`` equals
-    ``recurrence_rate(points, eps)`` for ``theiler=0``.
+    ``recurrence_rate(points, eps=eps)`` for ``theiler=0``.
 
     Parameters
     ----------
@@ -292,7 +292,7 @@ def recurrence_pairs(points, *, eps=1e-3, theiler=0):
     --------
     >>> import numpy as np
     >>> from kicktimes.diagnostics import recurrence_pairs
-    >>> i, j = recurrence_pairs(np.array([[0.0, 0.0], [0.0005, 0.0], [0.5, 0.5]]), 1e-3)
+    >>> i, j = recurrence_pairs(np.array([[0.0, 0.0], [0.0005, 0.0], [0.5, 0.5]]), eps=1e-3)
     >>> i.tolist(), j.tolist()
     ([0, 0, 1, 1, 2], [0, 1, 0, 1, 2])
 

@@ -234,7 +234,7 @@ def task_initial_conditions(experiment: Experiment, task: Task) -> np.ndarray:
 def _cached_ics(n_ics, ic_radius, seed, method, rule, start, masses):
     from kicktimes.billiard.initial import initial_conditions
 
-    ics = initial_conditions(n_ics, ic_radius, seed=seed, method=method, rule=rule,
+    ics = initial_conditions(n_ics, ic_radius, rng=seed, method=method, rule=rule,
                              start=start, masses=masses)
     ics.flags.writeable = False  # shared by every radius: nothing may change it
     return ics
@@ -300,7 +300,7 @@ def _run_ic(exp: Experiment, r: float, ic_index: int, ic: np.ndarray, rows, coll
                             add(system, UNIFORM_PREFIX + diagnostic, value, note)
         if "autocorrelation" in diags:
             with timer("autocorrelation"):
-                theta = boundary_angles(run, 0 if system == "two_particle" else None)
+                theta = boundary_angles(run, particle=0 if system == "two_particle" else None)
                 acf_rows = autocorrelation_rows(theta, exp.lag, exp.acf_max_lag)
             for diagnostic, value, note in acf_rows:
                 add(system, diagnostic, value, note)
@@ -377,7 +377,7 @@ def _run_ic(exp: Experiment, r: float, ic_index: int, ic: np.ndarray, rows, coll
         if system not in exp.systems:
             continue
         kick = kick_law(exp, system, ic, r)
-        rng = kick_rng(exp.seed, ic_index, r, system)
+        rng = kick_rng(ic_index, r, system, rng=exp.seed)
         if system in ("poisson_kinetic", "uniform_kinetic"):
             # the event loop draws the kick times (and their scattering numbers) from rng
             one_kw = {"kicks": kinetic_rate_table(r, exp.rule), "rng": rng, **kick, **holes,
@@ -401,10 +401,10 @@ def _run_ic(exp: Experiment, r: float, ic_index: int, ic: np.ndarray, rows, coll
         with timer("simulation_one_particle"):
             if system.startswith("poisson"):
                 rate = two.n_pp / two.t_max
-                kick_times = Poisson(rate).sample(horizon, rng)
+                kick_times = Poisson(rate).sample(horizon, rng=rng)
                 extra = (("kick_rate", rate),)
             elif system == "mmpp":
-                kick_times = schedule.sample(horizon, rng)
+                kick_times = schedule.sample(horizon, rng=rng)
             kick_angles = draw_kick_angles(kick_times.size, kick["kick_angle"], exp.sigma, rng)
         one_kw = {"kicks": kick_times, "kick_angles": kick_angles, **kick, **holes, **steps}
         _kicked(system, one_kw, one_pass, exp, ic, r, timer, add, diagnose, extra,
@@ -580,7 +580,7 @@ def recurrence_rows(points: np.ndarray, eps: tuple) -> list[tuple]:
     each threshold ``e``: ``rr@e`` (the same RR), ``rr_offdiag@e`` (Theiler window 1:
     pairs ``i != j``), ``det@e``, ``l_mean@e``, ``l_max@e`` (Theiler 1, ``l_min = 2``).
     One `rqa` call (one sweep) for all thresholds; ``rr@e = (N + R) / N^2`` from its
-    ``R`` recurrent off-diagonal entries is bitwise ``recurrence_rate(points, e)``.
+    ``R`` recurrent off-diagonal entries is bitwise ``recurrence_rate(points, eps=e)``.
     """
     from kicktimes.diagnostics import rqa
 
@@ -595,10 +595,10 @@ def recurrence_rows(points: np.ndarray, eps: tuple) -> list[tuple]:
                 rows.append((f"{name}@{tag}", math.nan, "a single sample: no pair i != j"))
         return rows
     # one sweep of the points for all thresholds
-    results = rqa(points, list(eps), theiler=1, l_min=2, laminarity=False)
+    results = rqa(points, eps=list(eps), theiler=1, l_min=2, laminarity=False)
     for k, (e, res) in enumerate(zip(eps, results, strict=True)):
         tag = eps_label(e)
-        # Python ints: the expression of recurrence_rate(points, e), so bitwise equal
+        # Python ints: the expression of recurrence_rate(points, eps=e), so bitwise equal
         rr = (n + res.n_recurrent) / (n * n)
         if k == 0:
             rows.append(("recurrence_rate", rr, ""))

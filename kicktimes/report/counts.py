@@ -35,7 +35,7 @@ def kinetic_rate_of(radius, rule="mirror", kinetic=None):
         return kinetic(radius)
     from kicktimes import stats
 
-    return stats.kinetic_rate(radius, rule)
+    return stats.kinetic_rate(radius, rule=rule)
 
 
 def experiment_kinetic(exp):
@@ -233,7 +233,7 @@ def sections(ctx):
         od = reg.overdispersion()
     sec.figure(
         "fig04_counts_vs_radius",
-        counts_vs_radius(coll, reg, rule=exp.rule, kinetic=kinetic),
+        counts_vs_radius(coll, regression=reg, rule=exp.rule, kinetic=kinetic),
         "Mean number of disk-disk collisions per run against radius (± s.e.m. over ICs) with "
         "the paper's least-squares line, Poisson and negative-binomial regressions and the "
         f"kinetic-theory count Γ(r)·T ({exp.rule} rule), curves at the mean window T(r).",

@@ -114,7 +114,7 @@ def diagnostic_vs_radius(
         if len(summary) == 0:
             raise ValueError(f"diagnostic {diagnostic!r} is not in the summary")
     else:
-        summary = diagnostic_summary(results, diagnostic)
+        summary = diagnostic_summary(results, diagnostic=diagnostic)
     present = [s for s in SYSTEMS if s in distinct(summary, "system")]
     present += sorted(distinct(summary, "system") - set(SYSTEMS))
     if systems is None:

@@ -314,7 +314,7 @@ class Replay(Schedule):
 
     Notes
     -----
-    ``sample(t_max, rng)`` ignores ``rng`` and returns a copy of the times ``<= t_max``.
+    ``sample(t_max, rng=rng)`` ignores ``rng`` and returns a copy of the times ``<= t_max``.
 
     Examples
     --------

@@ -392,7 +392,7 @@ class CountRegression:
         out["poisson"] = np.exp(b_poi[0] + b_poi[1] * g) * t
         out["negbin"] = np.exp(b_nb[0] + b_nb[1] * g) * t
         if self.rule is not None:
-            out["kinetic"] = kinetic_rate(r, self.rule) * t
+            out["kinetic"] = kinetic_rate(r, rule=self.rule) * t
         return out
 
     def summary(self) -> str:

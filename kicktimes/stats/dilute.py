@@ -187,10 +187,10 @@ def dilute_tagged_times(rule, rate, t_window, *, n_runs, rng=None, kT=0.5, speed
     Examples
     --------
     >>> import numpy as np
-    >>> times = dilute_tagged_times("elastic", 2.0, 50.0, 200, np.random.default_rng(1))
+    >>> times = dilute_tagged_times("elastic", 2.0, 50.0, n_runs=200, rng=np.random.default_rng(1))
     >>> len(times), bool(abs(np.mean([t.size for t in times]) / 100 - 1) < 0.05)
     (200, True)
-    >>> t, v = dilute_tagged_times("mirror", 1.0, 10.0, 3, 0, speeds=True)
+    >>> t, v = dilute_tagged_times("mirror", 1.0, 10.0, n_runs=3, rng=0, speeds=True)
     >>> [bool(np.all(s == 1.0)) and s.size == x.size + 1 for x, s in zip(t, v)]
     [True, True, True]
     """
@@ -543,7 +543,7 @@ class DiluteTaggedDisk:
         >>> d = dilute_tagged_disk("elastic").dispersion(n_events=200_000)
         >>> bool(1.1 < d.value < 1.2), 390 < d.n <= 400
         (True, True)
-        >>> float(dilute_tagged_disk("mirror").dispersion(30.0))
+        >>> float(dilute_tagged_disk("mirror").dispersion(window=30.0))
         1.0
         """
         if window is not None:
@@ -556,8 +556,8 @@ class DiluteTaggedDisk:
             return DiluteEstimate(name, 1.0, 0.0, 1.0, 1.0, 0, "exact: a Poisson process")
         if window is None:
             n_streams = 4
-            _, speeds = dilute_tagged_times("elastic", 1.0, n_events / n_streams, n_streams,
-                                            rng, kT=self.kT, speeds=True)
+            _, speeds = dilute_tagged_times("elastic", 1.0, n_events / n_streams, n_runs=n_streams,
+                                            rng=rng, kT=self.kT, speeds=True)
             dev = []
             for s in speeds:
                 g = 1.0 / self.rate(s[1 + _BURN_IN:])
@@ -573,7 +573,7 @@ class DiluteTaggedDisk:
                 dev.size, f"E_post[1/rho^2] by quadrature + batch means of 1/rho over the "
                 f"post-collision speed chain ({dev.size} batches of {batch} collisions)")
         n_runs = max(int(math.ceil(n_events / window)), 200)
-        times = dilute_tagged_times("elastic", 1.0, window, n_runs, rng, kT=self.kT)
+        times = dilute_tagged_times("elastic", 1.0, window, n_runs=n_runs, rng=rng, kT=self.kT)
         c = np.array([x.size for x in times], dtype=float)
         mu, var = c.mean(), c.var(ddof=1)
         d = var / mu
@@ -635,7 +635,7 @@ class DiluteTaggedDisk:
                                   "exact: uniform times given collision k + 1 (Poisson)")
         window = 2.0 * (k + 1) + 50.0
         while True:
-            times = dilute_tagged_times("elastic", 1.0, window, n_runs, rng, kT=self.kT)
+            times = dilute_tagged_times("elastic", 1.0, window, n_runs=n_runs, rng=rng, kT=self.kT)
             if min(x.size for x in times) > k:
                 break
             window *= 2.0

@@ -64,7 +64,7 @@ SHARE_RULE = (
 def ratio_rule(*, tolerance=0.1) -> str:
     """The printed rule of :func:`ratio_verdict` for a band of half-width ``tolerance``.
 
-    >>> ratio_rule(0.1)[:58]
+    >>> ratio_rule(tolerance=0.1)[:58]
     'within 10 %: the whole 95 % CI of the ratio lies in [0.9, '
     """
     p, lo, hi = f"{100 * tolerance:g}", f"{1 - tolerance:g}", f"{1 + tolerance:g}"
@@ -205,9 +205,9 @@ def rejection_verdict(low, high, *, alpha, margin=0.5):
 
     Examples
     --------
-    >>> rejection_verdict(0.37, 0.41, 0.05), rejection_verdict(0.037, 0.054, 0.05)
+    >>> rejection_verdict(0.37, 0.41, alpha=0.05), rejection_verdict(0.037, 0.054, alpha=0.05)
     ('above nominal', 'nominal')
-    >>> rejection_verdict(0.03, 0.09, 0.05)
+    >>> rejection_verdict(0.03, 0.09, alpha=0.05)
     'inconclusive'
     """
     if not (np.isfinite(low) and np.isfinite(high)):
@@ -288,9 +288,9 @@ def null_verdict(low, high, *, margin):
 
     Examples
     --------
-    >>> null_verdict(0.005, 0.077, D_MARGIN), null_verdict(1.2, 1.7, D_MARGIN)
+    >>> null_verdict(0.005, 0.077, margin=D_MARGIN), null_verdict(1.2, 1.7, margin=D_MARGIN)
     ('inconclusive', 'above its null')
-    >>> null_verdict(-0.06, 0.065, D_MARGIN)
+    >>> null_verdict(-0.06, 0.065, margin=D_MARGIN)
     'at its null'
     """
     if not (np.isfinite(low) and np.isfinite(high)):
@@ -324,9 +324,9 @@ def equivalence_sample_size(se, n, *, margin, level=0.95, power=0.8):
 
     Examples
     --------
-    >>> equivalence_sample_size(0.05, 400, 0.07)      # a half-width of 0.1 at 400 runs
+    >>> equivalence_sample_size(0.05, 400, margin=0.07)      # a half-width of 0.1 at 400 runs
     2145
-    >>> equivalence_sample_size(0.01, 400, 0.07)
+    >>> equivalence_sample_size(0.01, 400, margin=0.07)
     400
     """
     from scipy.stats import norm
@@ -388,20 +388,22 @@ def poisson_verdict(reject_low, reject_high, *, null_level, dispersion_low, disp
 
     Examples
     --------
-    >>> poisson_verdict(0.37, 0.41, 0.05, 1.31, 1.47)
+    >>> poisson_verdict(0.37, 0.41, null_level=0.05, dispersion_low=1.31, dispersion_high=1.47)
     'not Poisson'
-    >>> poisson_verdict(0.37, 0.41, 0.05, 1.03, 1.13)   # D straddles 1.1
+    >>> poisson_verdict(0.37, 0.41, null_level=0.05, dispersion_low=1.03,
+    ...                 dispersion_high=1.13)   # D straddles 1.1
     'inconclusive'
-    >>> poisson_verdict(0.045, 0.06, 0.052, 0.97, 1.04)
+    >>> poisson_verdict(0.045, 0.06, null_level=0.052, dispersion_low=0.97, dispersion_high=1.04)
     'Poisson within 10 %'
-    >>> poisson_verdict(0.08, 0.11, 0.05, 1.01, 1.06)
+    >>> poisson_verdict(0.08, 0.11, null_level=0.05, dispersion_low=1.01, dispersion_high=1.06)
     'not Poisson, D within 10 %'
-    >>> poisson_verdict(0.37, 0.41, 0.05, 1.2, 1.6, against_null=True)   # D - null D
+    >>> poisson_verdict(0.37, 0.41, null_level=0.05, dispersion_low=1.2, dispersion_high=1.6,
+    ...                 against_null=True)   # D - null D
     'not Poisson'
     """
-    rejects = rejection_verdict(reject_low, reject_high, null_level, margin)
+    rejects = rejection_verdict(reject_low, reject_high, alpha=null_level, margin=margin)
     if against_null:
-        dispersion = null_verdict(dispersion_low, dispersion_high, D_MARGIN)
+        dispersion = null_verdict(dispersion_low, dispersion_high, margin=D_MARGIN)
         if rejects == "above nominal" and dispersion in ("above its null", "below its null"):
             return "not Poisson"
         if rejects == "above nominal" and dispersion == "at its null":
@@ -409,7 +411,7 @@ def poisson_verdict(reject_low, reject_high, *, null_level, dispersion_low, disp
         if rejects == "nominal" and dispersion == "at its null":
             return "Poisson (D at its null)"
         return "inconclusive"
-    dispersion = ratio_verdict(dispersion_low, dispersion_high, band)
+    dispersion = ratio_verdict(dispersion_low, dispersion_high, tolerance=band)
     within = f"within {100 * band:g} %"
     if rejects == "above nominal" and dispersion in ("higher", "lower"):
         return "not Poisson"
@@ -450,7 +452,8 @@ def share_verdict(low, high, *, level):
 
     Examples
     --------
-    >>> share_verdict(0.1, 0.3, 0.05), share_verdict(0.0, 0.02, 0.05), share_verdict(0.0, 0.1, 0.05)
+    >>> (share_verdict(0.1, 0.3, level=0.05), share_verdict(0.0, 0.02, level=0.05),
+    ...  share_verdict(0.0, 0.1, level=0.05))
     ('above', 'below', 'inconclusive')
     """
     if not (np.isfinite(low) and np.isfinite(high)):
@@ -541,7 +544,7 @@ def clopper_pearson(k, n, *, level=0.95):
     low = np.empty(k.shape)
     high = np.empty(k.shape)
     for i in np.ndindex(k.shape):  # the scalar bounds, bit for bit
-        low[i], high[i] = clopper_pearson(float(k[i]), float(n[i]), level)
+        low[i], high[i] = clopper_pearson(float(k[i]), float(n[i]), level=level)
     return low, high
 
 
@@ -777,7 +780,7 @@ def _reference(res):
     ref = res.reference
     if ref is None or ref.empty:
         return None
-    rule = "Observed / reference rate: " + ratio_rule(0.1) + "."
+    rule = "Observed / reference rate: " + ratio_rule(tolerance=0.1) + "."
     verdicts, parts = [], []
     for r in ref.itertuples():
         verdicts.append(ratio_verdict(r.ci_low, r.ci_high))

@@ -46,8 +46,8 @@ def ratio_reading(low, high, *, tolerance=MARGIN):
     >>> ratio_reading(0.815, 0.942), ratio_reading(0.3, 0.4), ratio_reading(0.913, 1.15)
     ('below 1 by about the margin or less', 'lower', 'inconclusive')
     """
-    verdict = ratio_verdict(low, high, tolerance)
-    side = side_of(low, high, 1.0) if verdict == "inconclusive" else None
+    verdict = ratio_verdict(low, high, tolerance=tolerance)
+    side = side_of(low, high, null=1.0) if verdict == "inconclusive" else None
     if side:
         return f"{side} 1 by about the margin or less"
     return verdict
@@ -62,8 +62,8 @@ def ratio_words(low, high, *, tolerance=MARGIN):
     >>> ratio_words(1.046, 1.099), ratio_words(0.95, 1.02), ratio_words(0.815, 0.942)
     ('within 10 %, above 1', 'within 10 %', 'below 1 by about the margin or less')
     """
-    verdict = ratio_reading(low, high, tolerance)
-    side = side_of(low, high, 1.0) if verdict.startswith("within") else None
+    verdict = ratio_reading(low, high, tolerance=tolerance)
+    side = side_of(low, high, null=1.0) if verdict.startswith("within") else None
     return f"{verdict}, {side} 1" if side else verdict
 
 
@@ -73,11 +73,11 @@ def null_reading(low, high, *, margin):
     except that an inconclusive interval lying entirely on one side of 0 reads ``"above
     its null by about the margin or less"`` (or below).
 
-    >>> null_reading(0.005, 0.077, 0.07), null_reading(-0.03, 0.09, 0.07)
+    >>> null_reading(0.005, 0.077, margin=0.07), null_reading(-0.03, 0.09, margin=0.07)
     ('above its null by about the margin or less', 'inconclusive')
     """
-    verdict = null_verdict(low, high, margin)
-    side = side_of(low, high, 0.0) if verdict == "inconclusive" else None
+    verdict = null_verdict(low, high, margin=margin)
+    side = side_of(low, high, null=0.0) if verdict == "inconclusive" else None
     if side:
         return f"{side} its null by about the margin or less"
     return verdict

@@ -97,7 +97,7 @@ def _ratio_line(question, rows, margin=MARGIN) -> str:
     primary's (the size depends on it). Otherwise the line says "depends on" the control
     that changes the verdict, with both numbers. A verdict "within" whose interval
     excludes 1 says in how many cells (a real difference smaller than the margin)."""
-    rows = rows.assign(verdict=[ratio_verdict(lo, hi, margin) for lo, hi
+    rows = rows.assign(verdict=[ratio_verdict(lo, hi, tolerance=margin) for lo, hi
                                 in zip(rows["ci_low"], rows["ci_high"], strict=True)])
     family = rows["family"].iloc[0]
     system = rows["system"].iloc[0]
@@ -201,7 +201,7 @@ def _sign_flips(rows, family) -> str:
         e = _one(rows, diagnostic=diagnostic, family=family, control="elastic")
         if p is None or e is None:
             continue
-        sides = side_of(p.ci_low, p.ci_high, 0.0), side_of(e.ci_low, e.ci_high, 0.0)
+        sides = side_of(p.ci_low, p.ci_high, null=0.0), side_of(e.ci_low, e.ci_high, null=0.0)
         if None not in sides and sides[0] != sides[1]:
             flips.append(f"{name} {p.estimate:.3g} (primary) vs {e.estimate:.3g} (elastic)")
     if not flips:
