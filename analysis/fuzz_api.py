@@ -264,8 +264,8 @@ def _call_spec(seed: int, i: int):
         args = (iv, _maybe(rng, ["exponential", "weibull", "gamma", "lognormal"],
                            ["nonsense", 3, None], 0.2))
     elif target == "kinetic_rate":
-        args = (_maybe(rng, RADII, BAD_RADII, 0.5),
-                _maybe(rng, ["mirror", "elastic"], ["x", None], 0.2))
+        args = (_maybe(rng, RADII, BAD_RADII, 0.5),)
+        kw["rule"] = _maybe(rng, ["mirror", "elastic"], ["x", None], 0.2)
     elif target == "run_theta":
         args = (_two_ic(rng), 0.05, _maybe(rng, [0, 1, None], [2, -1, "a"], 0.3))
     else:  # kick_file

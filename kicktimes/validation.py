@@ -135,7 +135,7 @@ def check_seed_sequence(rng, name: str = "rng") -> np.random.SeedSequence:
         check_rng(rng, name)  # (the same TypeError/ValueError as everywhere)
         return np.random.SeedSequence(None if rng is None else int(rng))
     gen = check_rng(rng, name)
-    return np.random.SeedSequence(int(gen.integers(0, 2**63)))
+    return np.random.SeedSequence(int(gen.integers(2**63)))
 
 
 # -- Deprecations: one shared path for every renamed keyword and every option made

@@ -53,7 +53,7 @@ def test_elastic_invariant_measure_has_total_energy_two():
         (dict(n=0, r_max=0.02), "n must be an integer >= 1"),
         (dict(n=3, r_max=0.5), "r_max must lie in"),
         (dict(n=3, r_max=0.02, method="grid"), "method must be one of"),
-        (dict(n=3, r_max=0.02, seed=-1), "seed must be an integer >= 0"),
+        (dict(n=3, r_max=0.02, rng=-1), "rng must be an int seed >= 0"),
         (dict(n=3, r_max=0.02, rule="soft"), "rule must be one of"),
     ],
 )

@@ -23,7 +23,9 @@ from kicktimes.stats import poisson_rule, poisson_verdict, ratio_verdict, reject
 ])
 def test_the_verdict_needs_both_a_calibrated_rejection_and_an_effect(reject, dispersion,
                                                                      expected):
-    assert poisson_verdict(*reject, 0.05, *dispersion) == expected
+    low, high = dispersion
+    assert poisson_verdict(*reject, null_level=0.05, dispersion_low=low,
+                           dispersion_high=high) == expected
 
 
 def test_the_verdict_is_symmetric_with_the_ratio_rule():

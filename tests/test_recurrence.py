@@ -321,7 +321,7 @@ def test_points_spreading_beyond_the_float_range_raise_value_error(points):
     match = r"points: the coordinates must span at most 1e\+150 in x and in y"
     for fun in (recurrence_rate, recurrence_pairs):
         with pytest.raises(ValueError, match=match):
-            fun(points, 1e-3)
+            fun(points, eps=1e-3)
 
 
 def test_points_spreading_up_to_the_bound_are_counted_exactly():

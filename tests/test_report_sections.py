@@ -111,7 +111,7 @@ def test_ratio_verdict_follows_the_printed_rule():
 def test_share_verdict_and_clopper_pearson():
     low, high = clopper_pearson(30, 100)
     assert low < 0.3 < high and share_verdict(low, high, level=0.05) == "above"
-    assert share_verdict(*clopper_pearson(5, 100), 0.05) == "inconclusive"
+    assert share_verdict(*clopper_pearson(5, 100), level=0.05) == "inconclusive"
     assert clopper_pearson(0, 10)[0] == 0.0 and clopper_pearson(10, 10)[1] == 1.0
 
 

@@ -165,7 +165,7 @@ def _dispersion_verdict(tab, m, r, *, strict=True):
     its `null_reading` (an inconclusive interval that excludes 0 read as a departure)."""
     row = _get(tab, m, r, "rate_dispersion_minus_null")
     read = null_verdict if strict else null_reading
-    return read(row["ci_low"], row["ci_high"], RATE_DISPERSION_MARGIN)
+    return read(row["ci_low"], row["ci_high"], margin=RATE_DISPERSION_MARGIN)
 
 
 def _excess(tab, m, r, test):
