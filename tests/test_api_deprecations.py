@@ -210,3 +210,14 @@ def test_the_decorators_check_what_they_wrap():
     with pytest.warns(DeprecationWarning, match="old= is deprecated since 0.2.0.*use new="):
         assert f(old=4) == 4
     assert f(new=4) == 4
+
+
+# -- names
+
+
+def test_disks_lyapunov_exponent_is_lam():
+    state = kt.initial_state(20, None, packing=0.1, rng=1)
+    res = dg.disks_lyapunov(state, (0.1 / 20) ** 0.5, t_max=4.0, segment=1.0, rng=1)
+    with pytest.warns(DeprecationWarning, match="DisksLyapunov.exponent is deprecated.*lam"):
+        assert res.exponent == res.lam
+    assert repr(res).startswith("DisksLyapunov(lam=")

@@ -249,7 +249,7 @@ def kicked_rows(experiment: DisksExperiment, n_disks: int, k: int) -> list:
         theta = np.arcsin(np.clip(gas.walls["sin_theta"].to_numpy()[
             gas.walls["disk"].to_numpy() == 0], -1.0, 1.0))
         ftle = disks_lyapunov(state, r, t_max=t_max, segment=1.0 / nu, rng=rng,
-                              method=experiment.gas_ftle).exponent
+                              method=experiment.gas_ftle).lam
         rows += [("gas", "ftle", ftle), ("gas", "acf@1", autocorrelation(theta, 1)),
                  ("gas", "rr", recurrence_rate(gas.samples[:, 0], eps=KICKED_EPS,
                                                theiler=KICKED_THEILER)),
