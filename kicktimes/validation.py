@@ -246,19 +246,3 @@ def keyword_only_after(n: int, *, since: str = "0.2.0", until: str = "0.3.0", na
 
     return decorate
 
-
-def deprecated_alias(new, *, old: str, since: str = "0.2.0", until: str = "0.3.0"):
-    """A function ``old`` that warns (DeprecationWarning naming ``new``) and calls ``new``:
-    the one spelling of a renamed public function for one more release."""
-    import functools
-    import warnings
-
-    @functools.wraps(new)
-    def alias(*args, **kwargs):
-        warnings.warn(f"{old} is deprecated since {since} and will be removed in {until}; "
-                      f"use {new.__name__} instead", DeprecationWarning, stacklevel=2)
-        return new(*args, **kwargs)
-
-    alias.__name__ = alias.__qualname__ = old.rsplit(".", 1)[-1]
-    alias.__doc__ = f"Deprecated alias of `{new.__name__}` (since {since}, until {until})."
-    return alias

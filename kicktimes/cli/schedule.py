@@ -40,7 +40,7 @@ def _fitted_mmpp(input_path, params, stationary, window):
     return schedules.MMPP.from_fit(fit_mmpp(times, float(window), n_states=2, rng=0))
 
 
-_SCHEDULE_OPTIONS = {"t_max": "--t-max", "seed": "--seed", "window": "--window",
+_SCHEDULE_OPTIONS = {"t_max": "--t-max", "seed": "--seed", "rng": "--seed", "window": "--window",
                      "times": "--input", "dist": "--dist", "path": "--output"}
 
 

@@ -67,7 +67,7 @@ def simulate_command(radii, n_ics, t_max, seed, rule, ic_method, out, save_runs,
     # the options are range-checked by click; this maps anything the library still
     # refuses back to the option that caused it
     options = {"r_max": "--radius", "r": "--radius", "n": "--n-ics", "t_max": "--t-max",
-               "seed": "--seed", "rule": "--rule", "method": "--ic-method"}
+               "seed": "--seed", "rng": "--seed", "rule": "--rule", "method": "--ic-method"}
     from kicktimes.compilation import SIMULATE_KERNELS
 
     compile_first(None, SIMULATE_KERNELS)
@@ -130,7 +130,8 @@ def _simulate_disks(n_disks, packing, t_max, seed, rule, out, box=None):
         raise click.UsageError("--disks and --packing go together: give both")
     compile_first(None, DISKS_KERNELS)
     options = {"n_disks": "--disks", "packing": "--packing", "r": "--packing",
-               "t_max": "--t-max", "seed": "--seed", "rule": "--rule", "state": "--packing",
+               "t_max": "--t-max", "seed": "--seed", "rng": "--seed", "rule": "--rule",
+               "state": "--packing",
                "box": "--box"}
     area = math.pi if box is None else box * box
     with _cli_errors(options):
