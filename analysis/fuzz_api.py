@@ -167,7 +167,7 @@ def _materialise(value):
     if isinstance(value, tuple) and value:
         tag = value[0]
         if tag == "ic":
-            return kt.initial_conditions(1, 0.1, seed=value[1])[0]
+            return kt.initial_conditions(1, 0.1, rng=value[1])[0]
         if tag == "sorted":
             g = np.random.default_rng(value[1])
             return np.sort(g.uniform(0.0, value[2], size=value[1]))
@@ -264,8 +264,8 @@ def _call_spec(seed: int, i: int):
         args = (iv, _maybe(rng, ["exponential", "weibull", "gamma", "lognormal"],
                            ["nonsense", 3, None], 0.2))
     elif target == "kinetic_rate":
-        args = (_maybe(rng, RADII, BAD_RADII, 0.5),
-                _maybe(rng, ["mirror", "elastic"], ["x", None], 0.2))
+        args = (_maybe(rng, RADII, BAD_RADII, 0.5),)
+        kw["rule"] = _maybe(rng, ["mirror", "elastic"], ["x", None], 0.2)
     elif target == "run_theta":
         args = (_two_ic(rng), 0.05, _maybe(rng, [0, 1, None], [2, -1, "a"], 0.3))
     else:  # kick_file
@@ -311,7 +311,7 @@ def _run_call(target, args, kw):
             sched = schedules.Bootstrap([param, 1.0, 2.0])
         else:
             sched = schedules.Replay([param, 1.0, 2.0], window=param + 5.0)
-        return sched.sample(t_max, seed)
+        return sched.sample(t_max, rng=seed)
     if target == "recurrence_rate":
         return diagnostics.recurrence_rate(*args, **kw)
     if target == "autocorrelation":
@@ -459,7 +459,7 @@ def worker_main(seed, mem_gb):
     import kicktimes as kt
     from kicktimes import diagnostics, schedules, stats  # noqa: F401 - import cost up front
 
-    kt.simulate_two_particle(kt.initial_conditions(1, 0.05, seed=0)[0], 0.05, t_max=1.0)
+    kt.simulate_two_particle(kt.initial_conditions(1, 0.05, rng=0)[0], 0.05, t_max=1.0)
     out.write("ready\n")
     for line in sys.stdin:
         i = int(line)

@@ -26,7 +26,7 @@ def main():
     print(f"{'rule':8s} {'r':>6s} {'mean N':>9s} {'sem':>7s} {'Gamma T':>9s} {'z':>6s}")
     for rule in ("mirror", "elastic"):
         for r in args.radii:
-            ics = initial_conditions(args.n_ics, r, seed=7, method="uniform", rule=rule)
+            ics = initial_conditions(args.n_ics, r, rng=7, method="uniform", rule=rule)
             counts = np.array([simulate_two_particle(ic, r, t_max=args.t_max, rule=rule).n_pp
                                for ic in ics])
             expected = kinetic_rate(r, rule=rule) * args.t_max

@@ -52,7 +52,7 @@ def collision_sets(cache=None):
     if cache is not None and Path(cache).is_file():
         runs = list(np.load(cache, allow_pickle=True))
     else:
-        ics = initial_conditions(60, RADIUS, seed=5)
+        ics = initial_conditions(60, RADIUS, rng=5)
         runs = [simulate_two_particle(ic, RADIUS, t_max=T_MAX).pp_times for ic in ics]
         if cache is not None:
             np.save(cache, np.array(runs, dtype=object), allow_pickle=True)

@@ -105,13 +105,13 @@ def main():
     parser.add_argument("--ics", type=int, default=5, help="runs (paper ICs of family B)")
     parser.add_argument("--repeat", type=int, default=5, help="rounds; the best is kept")
     args = parser.parse_args()
-    ics = initial_conditions(args.ics, 0.026, method="paper", seed=2)
+    ics = initial_conditions(args.ics, 0.026, method="paper", rng=2)
     runs = [
         simulate_two_particle(ic, 0.016, n_steps=15000, tau=0.3, sampling="paper", track=0,
                               rule="mirror")
         for ic in ics
     ]
-    thetas = [boundary_angles(run, 0) for run in runs]
+    thetas = [boundary_angles(run, particle=0) for run in runs]
     for theta in thetas:
         curve = autocorrelation_function(theta, 20)
         assert np.array_equal(curve, previous_curve(theta, 20))
@@ -129,18 +129,18 @@ def main():
     print(f"   statsmodels acf:          {sm_us:7.1f}  -> {sm_us / curve_us:.2f}x")
 
     for run in runs:
-        got = autocorrelation_rows(boundary_angles(run, 0), 1, 20)
+        got = autocorrelation_rows(boundary_angles(run, particle=0), 1, 20)
         ref = previous_rows(run)
         assert [r[:2] for r in got] == [r[:2] for r in ref]
-    stage_us = per_call_us(lambda r: autocorrelation_rows(boundary_angles(r, 0), 1, 20), runs,
-                           args.repeat)
+    stage_us = per_call_us(lambda r: autocorrelation_rows(boundary_angles(r, particle=0), 1, 20),
+                           runs, args.repeat)
     ref_us = per_call_us(previous_rows, runs, args.repeat)
     print("2. the sweep's stage: angles + rows (us per run)")
     print(f"   one curve, one-pass angles: {stage_us:7.1f}")
     print(f"   as it was (reference):      {ref_us:7.1f}  -> {ref_us / stage_us:.2f}x")
     for run in runs:
-        assert np.array_equal(boundary_angles(run, 0), masked_angles(run))
-    angles_us = per_call_us(lambda r: boundary_angles(r, 0), runs, args.repeat)
+        assert np.array_equal(boundary_angles(run, particle=0), masked_angles(run))
+    angles_us = per_call_us(lambda r: boundary_angles(r, particle=0), runs, args.repeat)
     masked_us = per_call_us(masked_angles, runs, args.repeat)
     n_log = [run.boundary_log.time.size for run in runs]
     print(f"3. boundary angles of a {min(n_log)}-{max(n_log)} row two-disk log (us per run)")

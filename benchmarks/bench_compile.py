@@ -55,9 +55,9 @@ def _steps():
         from kicktimes.diagnostics import rqa
         from kicktimes.stats import compare_models, test_poisson
 
-        ic = initial_conditions(1, 0.02, seed=0)[0]
+        ic = initial_conditions(1, 0.02, rng=0)[0]
         run = simulate_two_particle(ic, 0.02, n_steps=200, tau=0.3, log_collisions=True)
-        rqa(np.column_stack([run.boundary_log.x, run.boundary_log.sin_theta])[:300], 0.05)
+        rqa(np.column_stack([run.boundary_log.x, run.boundary_log.sin_theta])[:300], eps=0.05)
         rng = np.random.default_rng(0)
         compare_models(rng.exponential(size=200), censored=rng.exponential(size=3))
         test_poisson(np.sort(rng.uniform(0.0, 60.0, 60)), 60.0, n_mc=99, rng=rng)
@@ -66,7 +66,7 @@ def _steps():
         # the N-disk engine's two compiled loops: no observers, and all of them
         from kicktimes import initial_state, simulate_disks
 
-        state = initial_state(20, 0.05, seed=0)
+        state = initial_state(20, 0.05, rng=0)
         return lambda: simulate_disks(state, 0.05, t_max=1.0, **observers)
 
     return [

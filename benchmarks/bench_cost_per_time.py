@@ -39,7 +39,7 @@ def cpu(fn, repeat):
 
 def measure(t_max=20000.0, n_ics=5, repeat=3, radii=RADII) -> pd.DataFrame:
     """One row per radius: CPU microseconds per unit time of each run and their ratio."""
-    ics = initial_conditions(n_ics, max(radii), seed=3)
+    ics = initial_conditions(n_ics, max(radii), rng=3)
     rows = []
     # warm the kernels
     simulate_two_particle(ics[0], radii[0], t_max=10.0)

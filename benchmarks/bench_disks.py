@@ -60,7 +60,7 @@ def engine_rate(n, phi, collisions, repeats, rule="mirror", box=None):
     periodic box of side ``box``: ``phi = n pi r^2 / box^2``)."""
     area = math.pi if box is None else box * box
     r = math.sqrt(phi / n) if box is None else math.sqrt(phi * area / (math.pi * n))
-    state = kt.initial_state(n, r, seed=1, rule=rule, box=box)
+    state = kt.initial_state(n, r, rng=1, rule=rule, box=box)
     t_max = collisions / (0.5 * n * enskog_frequency(r, n, area=area))
     kt.simulate_disks(state, r, t_max=t_max / 100, rule=rule, box=box)  # compiled, warm
     sec, run = cpu_best(lambda: kt.simulate_disks(state, r, t_max=t_max, rule=rule, box=box),
@@ -172,7 +172,7 @@ def main(argv=None):
             bil = brute = "-"
             if n == 100:
                 # python-billiards: elastic rule, the same state, same output first
-                es = kt.initial_state(n, r, seed=1, rule="elastic")
+                es = kt.initial_state(n, r, rng=1, rule="elastic")
                 ours = kt.simulate_disks(es, r, t_max=200 / (0.5 * n * enskog_frequency(
                     r, n, rule="elastic")), rule="elastic")
                 b_rate, b_log = billiards_rate(es, r, 1000 if not args.quick else 300)
@@ -214,7 +214,7 @@ def main(argv=None):
         from kicktimes.billiard.many_disks import engine_run
 
         r = math.sqrt(phi / n)
-        state = kt.initial_state(n, r, seed=7)
+        state = kt.initial_state(n, r, rng=7)
         t_max = args.robust / (0.5 * n * enskog_frequency(r, n))
         t0 = time.process_time()
         out = engine_run(state, np.full(n, r), 0, t_max, log=False)

@@ -72,7 +72,7 @@ def main(argv=None):
     for n in args.n:
         r = math.sqrt(args.packing / n)
         for rule in ("mirror", "elastic"):
-            state = kt.initial_state(n, r, seed=1, rule=rule)
+            state = kt.initial_state(n, r, rng=1, rule=rule)
             probe = md.engine_run(*md.check_disks(state, r, rule)[:2], RULES[rule], 1.0,
                                   log=False)
             per_time = max(probe["n_pp_total"], 1)

@@ -159,7 +159,7 @@ def disks_state(n, phi, warm, box=None):
     state run ``warm`` collisions per disk further (not timed; compiles the engine)."""
     extra = {} if box is None else {"box": box}
     r = math.sqrt(phi / n)
-    state = kt.initial_state(n, r, seed=1, rule="elastic", **extra)
+    state = kt.initial_state(n, r, rng=1, rule="elastic", **extra)
     nu = enskog_frequency(r, n, rule="elastic")
     state = kt.simulate_disks(state, r, t_max=warm / nu, rule="elastic", **extra).final_state
     return state, r, nu

@@ -37,8 +37,8 @@ def workloads(pkg: str, n_ics: int):
     lyapunov_pass = import_module(pkg + ".diagnostics.lyapunov").lyapunov_pass
     sim2, sim1, lyap = kt.simulate_two_particle, kt.simulate_one_particle, diag.lyapunov
     r, tau, n = 0.01, 0.3, 15000
-    ics = kt.initial_conditions(n_ics, r, seed=2026, method="paper")
-    el = kt.initial_conditions(n_ics, r, seed=2026, method="uniform", rule="elastic")
+    ics = kt.initial_conditions(n_ics, r, rng=2026, method="paper")
+    el = kt.initial_conditions(n_ics, r, rng=2026, method="uniform", rule="elastic")
     few = ics[: max(1, n_ics // 4)]
     one = {"n_steps": n, "tau": tau, "kicks": kicks}
     scatter = {**one, "kick_angle": "scatter", "sampling": "paper"}

@@ -57,17 +57,17 @@ def one_pass(n_ics, repeat):
     exp = preset("family_b")
     r = 0.01
     ri = exp.radii.index(r)
-    ics = initial_conditions(n_ics, exp.r_max, seed=exp.seed, method=exp.ic_method,
+    ics = initial_conditions(n_ics, exp.r_max, rng=exp.seed, method=exp.ic_method,
                              rule=exp.rule)
     steps = {"n_steps": exp.n_steps, "tau": exp.tau, "sampling": exp.sampling}
     var = exp.lyapunov_variant
     kicked = [s for s in exp.systems if s != "two_particle"]
 
     def kicks(i, system, two, actual):
-        rng = kick_rng(exp.seed, i, r, system)
+        rng = kick_rng(i, r, system, rng=exp.seed)
         kick = kick_law(exp, system, ics[i])
         if system.startswith("poisson"):
-            times = schedules.Poisson(two.n_pp / two.t_max).sample(exp.horizon, rng)
+            times = schedules.Poisson(two.n_pp / two.t_max).sample(exp.horizon, rng=rng)
         else:
             times = actual
         return times, draw_kick_angles(times.size, kick["kick_angle"], exp.sigma, rng), kick
@@ -128,7 +128,7 @@ def main():
         return
     args.n_ics = args.n_ics or 100
     r, tau, n_steps = 0.01, 0.3, 15000
-    ics = initial_conditions(args.n_ics, r, seed=2026, method="paper")
+    ics = initial_conditions(args.n_ics, r, rng=2026, method="paper")
 
     # warm-up: compile (or load from the numba cache) every kernel timed below
     for method in ("tangent", "twin"):

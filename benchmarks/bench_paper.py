@@ -83,7 +83,7 @@ def bare_simulation(names) -> tuple[float, int]:
     for name in names:
         exp = preset(name)
         ics = initial_conditions(
-            exp.n_ics, exp.r_max, seed=exp.seed, method=exp.ic_method, rule=exp.rule
+            exp.n_ics, exp.r_max, rng=exp.seed, method=exp.ic_method, rule=exp.rule
         )
         for r in exp.radii:
             for ic in ics:

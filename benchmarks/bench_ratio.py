@@ -57,7 +57,7 @@ def c_loop_seconds(c_ref, scale: str, content: str) -> tuple[float, int]:
     prepared = []
     for name in scale_presets(scale, content):
         exp = preset(name, content)
-        ics = initial_conditions(exp.n_ics, exp.r_max, seed=exp.seed, method=exp.ic_method,
+        ics = initial_conditions(exp.n_ics, exp.r_max, rng=exp.seed, method=exp.ic_method,
                                  rule=exp.rule)
         for r in exp.radii:
             prepared.append(c_ref.prepare_many(ics, r, rule=exp.rule, sampling=exp.sampling,

@@ -123,10 +123,10 @@ def first_call(fn):
 def child_rqa(size, eps):
     """`rqa(points, eps)` with its defaults (laminarity included) on the chords: the time
     (min of a first call and 2 more) and the peak RSS the first call added."""
-    rqa(uniform_disk(300, 0), eps)  # load the kernels of this grid outside the timing
+    rqa(uniform_disk(300, 0), eps=eps)  # load the kernels of this grid outside the timing
     pts = kicked_chords(size, 0.2, 3)
-    res, dt, extra = first_call(lambda: rqa(pts, eps))
-    dt = min(dt, timeit(lambda: rqa(pts, eps), 2)[0])
+    res, dt, extra = first_call(lambda: rqa(pts, eps=eps))
+    dt = min(dt, timeit(lambda: rqa(pts, eps=eps), 2)[0])
     print(json.dumps({"n": size, "pairs": res.n_recurrent // 2, "lam": res.lam,
                       "time": dt, "extra_bytes": extra}))
 
@@ -161,12 +161,12 @@ def _status_kb(field):
 def child(size, eps):
     """Generate the points, then report RR, its time, and the peak RSS it added
     (`first_call`)."""
-    recurrence_rate(uniform_disk(100, 0), eps)
+    recurrence_rate(uniform_disk(100, 0), eps=eps)
     pts = kicked_chords(size, 0.2, 3)
-    rr, dt, extra = first_call(lambda: recurrence_rate(pts, eps))
+    rr, dt, extra = first_call(lambda: recurrence_rate(pts, eps=eps))
     row = {"n": size, "rr": rr, "time": dt, "extra_bytes": extra}
     if size <= 10**6:
-        row["time"] = min(dt, timeit(lambda: recurrence_rate(pts, eps), 5)[0])
+        row["time"] = min(dt, timeit(lambda: recurrence_rate(pts, eps=eps), 5)[0])
         k_dt, _, count = timeit(lambda: (lambda tr: tr.count_neighbors(tr, eps))(cKDTree(pts)), 1)
         assert count == round(rr * size * size)
         row["kdtree_time"] = k_dt
@@ -177,7 +177,7 @@ def paper_run_samples(n_steps):
     """Disk 0's samples of a paper-sampled two-disk run (family A: r = 0.02, tau = 0.2)."""
     from kicktimes import initial_conditions, simulate_two_particle
 
-    ic = initial_conditions(1, 0.03, seed=1)[0]
+    ic = initial_conditions(1, 0.03, rng=1)[0]
     return simulate_two_particle(ic, 0.02, sampling="paper", n_steps=n_steps, tau=0.2).samples
 
 
@@ -189,7 +189,7 @@ def rqa_table(rep):
         ("uniform", uniform_disk(n, 2)),
         ("paper run", paper_run_samples(n - 1)),
     ]
-    rqa(uniform_disk(100, 0), 1e-3)  # compile / load the cache outside timings
+    rqa(uniform_disk(100, 0), eps=1e-3)  # compile / load the cache outside timings
     print(f"RQA against the recurrence rate, N = {n}  (min / median of {rep} runs)")
     header = (
         f"{'point set':<11} {'eps':>6} {'RR offdiag':>11} {'DET':>6} {'Lmax':>5} "
@@ -199,10 +199,10 @@ def rqa_table(rep):
     print("-" * len(header))
     for name, pts in sets:
         for eps in (1e-3, 1e-2):
-            r_min, r_med, _ = timeit(lambda p=pts, e=eps: recurrence_rate(p, e), rep)
-            q_min, q_med, res = timeit(lambda p=pts, e=eps: rqa(p, e, laminarity=False), rep)
-            lam_min, _, _ = timeit(lambda p=pts, e=eps: rqa(p, e), rep)
-            assert res.rr == recurrence_rate(pts, eps, theiler=1)
+            r_min, r_med, _ = timeit(lambda p=pts, e=eps: recurrence_rate(p, eps=e), rep)
+            q_min, q_med, res = timeit(lambda p=pts, e=eps: rqa(p, eps=e, laminarity=False), rep)
+            lam_min, _, _ = timeit(lambda p=pts, e=eps: rqa(p, eps=e), rep)
+            assert res.rr == recurrence_rate(pts, eps=eps, theiler=1)
             print(
                 f"{name:<11} {eps:6g} {res.rr:11.3e} {res.det:6.3f} {res.l_max:5d} "
                 f"{r_min * 1e3:7.3f} / {r_med * 1e3:5.3f} {q_min * 1e3:7.3f} / "
@@ -228,7 +228,7 @@ def grid_table(sets, rep):
     saved = recurrence._DENSE_CELLS_PER_POINT, recurrence._DENSE_CELLS_MIN
     for name, pts in sets:
         def call(p=pts):
-            return rqa(p, [1e-3, 1e-2], laminarity=False)
+            return rqa(p, eps=[1e-3, 1e-2], laminarity=False)
 
         d_min, d_med, dense = timeit(call, rep)
         recurrence._DENSE_CELLS_PER_POINT, recurrence._DENSE_CELLS_MIN = 0, 0
@@ -405,7 +405,7 @@ def main():
         rqa_scaling([10**5, 10**6])
         return
 
-    recurrence_rate(uniform_disk(100, 0), eps)  # compile / load the cache outside timings
+    recurrence_rate(uniform_disk(100, 0), eps=eps)  # compile / load the cache outside timings
     kicked_chords(10, 0.2, 0)
 
     print(f"Recurrence rate, eps = {eps:g}, N = {n}  (times: min / median of {rep} runs)")
@@ -416,7 +416,7 @@ def main():
     print(header)
     print("-" * len(header))
     for name, pts in [("trajectory", kicked_chords(n, 0.2, 1)), ("uniform", uniform_disk(n, 2))]:
-        t_min, t_med, rr = timeit(lambda p=pts: recurrence_rate(p, eps), rep)
+        t_min, t_med, rr = timeit(lambda p=pts: recurrence_rate(p, eps=eps), rep)
         tree = cKDTree(pts)
         k_min, k_med, count = timeit(
             lambda p=pts: (lambda tr: tr.count_neighbors(tr, eps))(cKDTree(p)), rep
@@ -425,7 +425,7 @@ def main():
         assert count == round(rr * n * n), (count, rr * n * n)
         small = pts[:n_brute]
         b_min, _, bcount = timeit(lambda s=small: brute_count(s, eps), 3)
-        assert bcount == round(recurrence_rate(small, eps) * n_brute**2)
+        assert bcount == round(recurrence_rate(small, eps=eps) * n_brute**2)
         b_scaled = b_min * (n / n_brute) ** 2
         print(
             f"{name:<12} {rr:11.4e} {t_min * 1e3:7.3f} / {t_med * 1e3:5.3f} "

@@ -85,11 +85,11 @@ def main():
     for name, schedule, draw_one in cases:
         mean = schedule.mean_interval
         t_max = N_KICKS * mean if np.isfinite(mean) else 1.5e8  # lomax(0.8): N(t) ~ t^0.8
-        schedule.sample(1.0, rng)  # set up cached samplers (PINV tables) outside the timing
+        schedule.sample(1.0, rng=rng)  # set up cached samplers (PINV tables) outside the timing
         # a pickled copy has no cached sampler: its first sample() pays the set-up
-        setup = best_time(lambda s=schedule: pickle.loads(pickle.dumps(s)).sample(1.0, 0), 1)
-        n = schedule.sample(t_max, rng).size
-        elapsed = best_time(lambda s=schedule, t=t_max: s.sample(t, rng))
+        setup = best_time(lambda s=schedule: pickle.loads(pickle.dumps(s)).sample(1.0, rng=0), 1)
+        n = schedule.sample(t_max, rng=rng).size
+        elapsed = best_time(lambda s=schedule, t=t_max: s.sample(t, rng=rng))
         row = f"{name:32s} {n:9d} {elapsed * 1e3:8.2f} {elapsed / n * 1e9:8.1f}"
         row += f" {elapsed / floor * N_KICKS / n:7.2f}"
         if draw_one is not None:
@@ -104,7 +104,7 @@ def main():
     print("\nper sample() call with ~1000 kicks (an IC of a sweep):")
     for name, schedule, _ in cases[:5]:
         t_max = 1000 * schedule.mean_interval
-        per_call = best_time(lambda s=schedule, t=t_max: [s.sample(t, rng) for _ in range(200)])
+        per_call = best_time(lambda s=schedule, t=t_max: [s.sample(t, rng=rng) for _ in range(200)])
         print(f"  {name:32s} {per_call / 200 * 1e6:8.1f} us")
 
 

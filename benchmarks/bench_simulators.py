@@ -46,7 +46,7 @@ def check_c_matches(c_ref, r, tau, n_steps):
     for rule in ("mirror", "elastic"):
         for sampling in ("uniform", "paper"):
             method = "paper" if rule == "mirror" else "uniform"
-            for ic in initial_conditions(3, r, seed=7, method=method, rule=rule):
+            for ic in initial_conditions(3, r, rng=7, method=method, rule=rule):
                 run = simulate_two_particle(ic, r, rule=rule, sampling=sampling,
                                             n_steps=n_steps, tau=tau)
                 out = c_ref.run(ic, r, rule=rule, sampling=sampling, n_steps=n_steps, tau=tau)
@@ -108,7 +108,7 @@ def main():
     ap.add_argument("--c-only", action="store_true", help="only the comparison with the C loop")
     args = ap.parse_args()
     r, tau, n_steps = 0.01, 0.3, 15000
-    ics = initial_conditions(args.n_ics, r, seed=2026, method="paper")
+    ics = initial_conditions(args.n_ics, r, rng=2026, method="paper")
     simulate_two_particle(ics[0], r, n_steps=10, tau=tau)
     c_times = compare_with_c(ics, r, tau, n_steps)
     if c_times is not None:

@@ -140,7 +140,7 @@ def _warm_report_two(_):
     from kicktimes.stats.iid_tests import ljung_box
     from kicktimes.stats.poisson import pomeranz_cdf
 
-    ic = initial_conditions(1, 0.02, seed=0)[0]
+    ic = initial_conditions(1, 0.02, rng=0)[0]
     simulate_two_particle(ic, 0.02, n_steps=50, tau=0.3, log_collisions=True)
     simulate_one_particle(ic[0], 0.02, kicks=np.array([0.5, 1.0]), kick_angles=np.zeros(2),
                           kick_angle="uniform", sigma=1.0, n_steps=50, tau=0.3,
@@ -158,7 +158,7 @@ def _warm_report_one(_):
     from kicktimes.stats import bootstrap_nanmedians, compare_models
 
     rng = np.random.default_rng(0)
-    recurrence_pairs(rng.uniform(-1.0, 1.0, (60, 2)), 1e-3)
+    recurrence_pairs(rng.uniform(-1.0, 1.0, (60, 2)), eps=1e-3)
     compare_models(rng.exponential(size=60), censored=rng.exponential(size=2))
     bootstrap_nanmedians(rng.uniform(size=(2, 5)), rng.integers(0, 5, size=(3, 5)))
 

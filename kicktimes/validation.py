@@ -114,3 +114,135 @@ def check_rng(rng, name: str = "rng") -> np.random.Generator:
             raise ValueError(f"{name} must be an int seed >= 0, got {int(rng)}")
         rng = int(rng)
     return np.random.default_rng(rng)
+
+
+def check_seed_sequence(rng, name: str = "rng") -> np.random.SeedSequence:
+    """The `numpy.random.SeedSequence` behind ``rng``, for functions whose draws are a pure
+    function of a root seed and an index (IC ``i`` of an ensemble is drawn from the root's
+    child ``spawn_key=(i,)``, whatever block it is drawn in).
+
+    An int ``s`` gives ``SeedSequence(s)`` (so its children are exactly
+    ``SeedSequence(s, spawn_key=(i,))``), a SeedSequence is used as is, None fresh entropy;
+    a Generator or BitGenerator is consumed: the root's entropy is drawn from it. The
+    accepted inputs and the errors are those of `check_rng`.
+
+    >>> check_seed_sequence(3).entropy
+    3
+    """
+    if isinstance(rng, np.random.SeedSequence):
+        return rng
+    if rng is None or (isinstance(rng, Integral | np.integer) and not isinstance(rng, bool)):
+        check_rng(rng, name)  # (the same TypeError/ValueError as everywhere)
+        return np.random.SeedSequence(None if rng is None else int(rng))
+    gen = check_rng(rng, name)
+    return np.random.SeedSequence(int(gen.integers(2**63)))
+
+
+# -- Deprecations: one shared path for every renamed keyword and every option made
+# keyword-only (CHANGELOG.md, "0.2.0"). Each wrapper records what it accepts for one more
+# release in a marker attribute, which tests/test_api_signatures.py reads.
+
+#: the marker attribute of `renamed_keyword`: ``{old: new}``
+RENAMED_MARKER = "__kicktimes_renamed__"
+#: the marker attribute of `keyword_only_after`: the names once accepted by position
+POSITIONAL_MARKER = "__kicktimes_formerly_positional__"
+
+
+def renamed_keyword(*, old: str, new: str, since: str = "0.2.0", until: str = "0.3.0"):
+    """Decorator: the keyword ``old`` still works, with a DeprecationWarning naming ``new``,
+    until release ``until``; passing both is a TypeError.
+
+    >>> @renamed_keyword(old="seed", new="rng")
+    ... def draw(*, rng=0):
+    ...     return rng
+    >>> import warnings
+    >>> with warnings.catch_warnings(record=True) as w:
+    ...     warnings.simplefilter("always")
+    ...     draw(seed=3), w[0].category.__name__
+    (3, 'DeprecationWarning')
+    """
+    import functools
+    import warnings
+
+    def decorate(func):
+        @functools.wraps(func)
+        def wrapper(*args, **kwargs):
+            if old in kwargs:
+                if new in kwargs:
+                    raise TypeError(f"{func.__name__}() got both {old}= and {new}=; pass only "
+                                    f"{new}= ({old}= is deprecated since {since})")
+                warnings.warn(f"{func.__name__}(): {old}= is deprecated since {since} and will "
+                              f"be removed in {until}; use {new}= instead", DeprecationWarning,
+                              stacklevel=2)
+                kwargs[new] = kwargs.pop(old)
+            return func(*args, **kwargs)
+
+        renamed = dict(getattr(func, RENAMED_MARKER, {}))
+        renamed[old] = new
+        setattr(wrapper, RENAMED_MARKER, renamed)
+        return wrapper
+
+    return decorate
+
+
+def keyword_only_after(n: int, *, since: str = "0.2.0", until: str = "0.3.0", names=None):
+    """Decorator for a function whose options became keyword-only: it takes ``n`` positional
+    parameters (``self`` not counted), and until ``until`` more positional arguments are
+    still mapped, in order, to ``names`` (default: the keyword-only parameters in signature
+    order, which is their old positional order), with one DeprecationWarning per call
+    naming the keywords to use.
+
+    >>> @keyword_only_after(1)
+    ... def scaled(x, *, factor=2.0):
+    ...     return x * factor
+    >>> import warnings
+    >>> with warnings.catch_warnings(record=True) as w:
+    ...     warnings.simplefilter("always")
+    ...     scaled(1.0, 3.0), str(w[0].message).split(";")[0]
+    (3.0, 'scaled(): pass factor= by keyword')
+    """
+    import functools
+    import inspect
+    import warnings
+
+    def decorate(func):
+        params = list(inspect.signature(func).parameters.values())
+        positional = [p for p in params
+                      if p.kind in (p.POSITIONAL_ONLY, p.POSITIONAL_OR_KEYWORD)]
+        offset = 1 if positional and positional[0].name in ("self", "cls") else 0
+        if len(positional) - offset != n:
+            raise TypeError(f"keyword_only_after({n}) on {func.__qualname__}, which takes "
+                            f"{len(positional) - offset} positional parameters")
+        extra = tuple(names) if names is not None else tuple(
+            p.name for p in params if p.kind is p.KEYWORD_ONLY)
+        n_pos = n + offset
+
+        @functools.wraps(func)
+        def wrapper(*args, **kwargs):
+            if len(args) > n_pos:
+                moved = args[n_pos:]
+                if len(moved) > len(extra):
+                    raise TypeError(f"{func.__name__}() takes at most "
+                                    f"{n + len(extra)} arguments by position "
+                                    f"({n} from {until} on), got {len(args) - offset}")
+                keys = extra[:len(moved)]
+                for key in keys:
+                    if key in kwargs:
+                        raise TypeError(f"{func.__name__}() got multiple values for "
+                                        f"argument {key!r}")
+                warnings.warn(
+                    f"{func.__name__}(): pass {', '.join(f'{k}=' for k in keys)} by keyword; "
+                    f"passing it by position is deprecated since {since} and will fail "
+                    f"in {until}", DeprecationWarning, stacklevel=2)
+                kwargs.update(zip(keys, moved, strict=True))
+                args = args[:n_pos]
+            return func(*args, **kwargs)
+
+        setattr(wrapper, POSITIONAL_MARKER, extra)
+        for marker in (RENAMED_MARKER,):
+            if hasattr(func, marker):
+                setattr(wrapper, marker, getattr(func, marker))
+        return wrapper
+
+    return decorate
+

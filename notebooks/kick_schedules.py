@@ -88,7 +88,7 @@ def stream(*key):
 # right-censored ones (the interval $T - t_n$ still running at the end of each window).
 
 # %%
-train_ics = kt.initial_conditions(P["n_train"], R_MAX, seed=SEED + 1, method="paper")
+train_ics = kt.initial_conditions(P["n_train"], R_MAX, rng=SEED + 1, method="paper")
 train = [kt.simulate_two_particle(ic, R, t_max=P["train_window"]) for ic in train_ics]
 iv = stats.intervals_from_times([run.pp_times for run in train], [run.t_max for run in train])
 print(train[0])
@@ -128,7 +128,7 @@ print(
 # %% [markdown]
 # ## 2. Schedules
 #
-# A schedule is an immutable value with `sample(t_max, rng)`, returning sorted kick times in
+# A schedule is an immutable value with `sample(t_max, rng=rng)`, returning sorted kick times in
 # $(0, t_{max}]$. They are built from fits (`Renewal.from_fit`, or any frozen
 # `scipy.stats` distribution) and from runs (`Poisson.from_run`: the paper's per-IC rate
 # $n_{pp}/T$; `Replay.from_run`: the actual collision times; `Bootstrap.from_run`:
@@ -167,7 +167,7 @@ for name, s in catalogue.items():
         counts = np.full(n_draws, s.sample(h).size)
     else:
         rng = stream(2, len(rows))
-        counts = np.array([s.sample(h, rng).size for _ in range(n_draws)])
+        counts = np.array([s.sample(h, rng=rng).size for _ in range(n_draws)])
     mean_interval = getattr(s, "mean_interval", np.nan)
     rows.append(
         {
@@ -230,7 +230,7 @@ with tempfile.TemporaryDirectory() as tmp:
 # every boundary collision has the same $\sin\theta$.
 
 # %%
-ic = kt.initial_conditions(1, R_MAX, seed=SEED)[0]
+ic = kt.initial_conditions(1, R_MAX, rng=SEED)[0]
 steps = dict(n_steps=P["n_steps"], tau=TAU)
 two = kt.simulate_two_particle(ic, R, **steps)
 free = kt.simulate_one_particle(ic[0], R, **steps)
@@ -264,7 +264,7 @@ display(
 # %% [markdown]
 # ## 4. Diagnostics of one IC
 #
-# * `dg.recurrence_rate(run.samples, eps)`: the share of sample pairs (main diagonal
+# * `dg.recurrence_rate(run.samples, eps=eps)`: the share of sample pairs (main diagonal
 #   included) closer than ε, counted with a cell list, never an N × N matrix;
 # * `dg.autocorrelation(dg.boundary_angles(run), lag=1)`: the paper's $R_1$ of
 #   $\theta = \arcsin(\sin\theta)$ at the disk's boundary collisions; NaN with a reason for
@@ -288,9 +288,9 @@ for name, run in (
     rows.append(
         {
             "system": name,
-            "RR(1e-3)": dg.recurrence_rate(run.samples, 1e-3),
-            "RR(1e-2)": dg.recurrence_rate(run.samples, 1e-2),
-            "RR(1e-2), off-diagonal": dg.recurrence_rate(run.samples, 1e-2, theiler=1),
+            "RR(1e-3)": dg.recurrence_rate(run.samples, eps=1e-3),
+            "RR(1e-2)": dg.recurrence_rate(run.samples, eps=1e-2),
+            "RR(1e-2), off-diagonal": dg.recurrence_rate(run.samples, eps=1e-2, theiler=1),
             "R_1": acf,
             "R_1 note": reason or "",
             "lambda": ftle.lam,
@@ -344,7 +344,7 @@ systems = {
     "renewal": lambda two: catalogue[f"renewal {best}, stationary"],
     "bootstrap": lambda two: catalogue["bootstrap (pooled), stationary"],
 }
-ics = kt.initial_conditions(P["n_ics"], R_MAX, seed=SEED + 2, method="paper")
+ics = kt.initial_conditions(P["n_ics"], R_MAX, rng=SEED + 2, method="paper")
 t0 = time.perf_counter()
 rows = []
 
@@ -354,7 +354,7 @@ def record(i, system, run, ftle):
     acf, reason = float(curve.acf[0]), curve.lag_reasons[0]
     for diagnostic, value, note in (
         ("lyapunov", ftle.lam, ""),
-        ("recurrence_rate", dg.recurrence_rate(run.samples, 1e-3), ""),
+        ("recurrence_rate", dg.recurrence_rate(run.samples, eps=1e-3), ""),
         ("autocorrelation", acf, reason or ""),
     ):
         rows.append((R, i, system, diagnostic, value, note))

@@ -106,7 +106,7 @@ def stream(*key):
 # %%
 def simulate_ensemble(method, rule, radius):
     r_max = radius if method == "uniform" else max(RADII)
-    ics = kt.initial_conditions(P["n_ics"], r_max, seed=SEED, method=method, rule=rule)
+    ics = kt.initial_conditions(P["n_ics"], r_max, rng=SEED, method=method, rule=rule)
     rows = []
     for i, ic in enumerate(ics):
         run = kt.simulate_two_particle(ic, radius, t_max=T, rule=rule)
@@ -126,7 +126,7 @@ collisions = pd.DataFrame(
     rows, columns=["method", "rule", "radius", "ic", "t_window", "n_pp", "pp_times"]
 )
 collisions["kinetic"] = [
-    stats.kinetic_rate(r, rule) * t
+    stats.kinetic_rate(r, rule=rule) * t
     for r, rule, t in zip(
         collisions["radius"], collisions["rule"], collisions["t_window"], strict=True
     )
@@ -369,7 +369,7 @@ for (method, rule), part in kinds.groupby(level=["method", "rule"]):
 # %%
 r_search = 0.02
 t0 = time.perf_counter()
-search_ics = kt.initial_conditions(P["n_search"], max(RADII), seed=SEED + 1, method="paper")
+search_ics = kt.initial_conditions(P["n_search"], max(RADII), rng=SEED + 1, method="paper")
 search_counts = np.array(
     [kt.simulate_two_particle(ic, r_search, t_max=T).n_pp for ic in search_ics]
 )
@@ -600,7 +600,7 @@ for rule in RULES:
         f"{rule}, r={r_big:g}: pooled hyperexponential rates {fit.params['rate1']:.4g} (weight "
         f"{fit.params['p']:.2f}) and {fit.params['rate2']:.4g}; the per-IC rates n_pp/T span "
         f"{rates.quantile(0.1):.4g}..{rates.quantile(0.9):.4g} (10-90%), kinetic "
-        f"{stats.kinetic_rate(r_big, rule):.4g}"
+        f"{stats.kinetic_rate(r_big, rule=rule):.4g}"
     )
 
 # %% [markdown]
@@ -621,7 +621,7 @@ for i, method in enumerate(METHODS):
         frame = sel[["radius", "n_pp", "t_window"]].rename(columns={"n_pp": "count"})
         reg = stats.regress_counts(frame, rule=rule)
         regressions[method, rule] = reg
-        plots.counts_vs_radius(sel[["radius", "n_pp", "t_window"]], reg, ax=axes[i, j])
+        plots.counts_vs_radius(sel[["radius", "n_pp", "t_window"]], regression=reg, ax=axes[i, j])
         axes[i, j].set_title(f"{rule} rule, {method} ICs")
 
 grid = np.asarray(RADII)
@@ -631,7 +631,7 @@ for (method, rule), reg in regressions.items():
     b, se = coef.loc[("poisson", "log_radius"), ["estimate", "stderr"]]
     bn, sen = coef.loc[("negbin", "log_radius"), ["estimate", "stderr"]]
     od = reg.overdispersion()
-    slope_k = np.polyfit(np.log(grid), np.log(stats.kinetic_rate(grid, rule)), 1)[0]
+    slope_k = np.polyfit(np.log(grid), np.log(stats.kinetic_rate(grid, rule=rule)), 1)[0]
     print(
         f"{method} ICs, {rule}: log-log slope {b:.3f} ± {se:.3f} (Poisson), {bn:.3f} ± {sen:.3f} "
         f"(negative binomial), kinetic {slope_k:.3f}; NB alpha = {od['alpha']:.3g} "

@@ -135,7 +135,7 @@ display(store.collisions.head(3))
 
 # %%
 exp = experiments[P["names"][0]]
-ic0 = kt.initial_conditions(1, exp.r_max, seed=exp.seed, method=exp.ic_method, rule=exp.rule)[0]
+ic0 = kt.initial_conditions(1, exp.r_max, rng=exp.seed, method=exp.ic_method, rule=exp.rule)[0]
 paper_steps = dict(n_steps=15000, tau=0.3, sampling="paper", rule=exp.rule)
 runs = [kt.simulate_two_particle(ic0, r, **paper_steps) for r in (0.02, 0.014)]
 display(plots.poincare_panels(runs))
@@ -155,7 +155,7 @@ display(plots.recurrence_plot(runs[0].samples, eps=1e-3, title="IC 0, r = 0.02, 
 # The k-th Poisson kick time against the k-th disk-disk collision time at r = 0.008, for
 # the IC with the median number of collisions in the store. The Poisson times are the
 # sweep's own (rate $n_{pp}/T$ of that IC's run, random stream
-# `kick_rng(seed, ic, radius, "poisson")`). A quick run has only a handful of collisions at
+# `kick_rng(ic, radius, "poisson", rng=seed)`). A quick run has only a handful of collisions at
 # this radius, so the figure is redrawn for the same IC run to the paper's family-A length
 # (25 000 steps of 0.2), with Poisson times at that run's rate from the same stream.
 
@@ -169,7 +169,7 @@ for label, n_steps, tau in (("store", exp.n_steps, exp.tau), ("paper length", 25
         pp_times, t_window = row["pp_times"], row["t_window"]
     else:
         ic = kt.initial_conditions(
-            1, exp.r_max, seed=exp.seed, method=exp.ic_method, rule=exp.rule, start=ic_times
+            1, exp.r_max, rng=exp.seed, method=exp.ic_method, rule=exp.rule, start=ic_times
         )[0]
         run = kt.simulate_two_particle(
             ic, r_times, n_steps=n_steps, tau=tau, sampling=exp.sampling, rule=exp.rule
@@ -177,7 +177,7 @@ for label, n_steps, tau in (("store", exp.n_steps, exp.tau), ("paper length", 25
         pp_times, t_window = run.pp_times, run.t_max
     rate = len(pp_times) / t_window
     poisson_times = kt.schedules.Poisson(rate).sample(
-        n_steps * tau, kick_rng(exp.seed, ic_times, r_times, "poisson")
+        n_steps * tau, rng=kick_rng(ic_times, r_times, "poisson", rng=exp.seed)
     )
     fit = plots.kth_time_fit(pp_times, poisson_times)
     print(
@@ -199,11 +199,11 @@ fig, axes = plt.subplots(1, len(stores), figsize=(6 * len(stores), 4.4), layout=
 for ax, (name, st) in zip(np.atleast_1d(axes), stores.items(), strict=True):
     frame = st.collisions[["radius", "n_pp", "t_window"]]
     reg = stats.regress_counts(frame.rename(columns={"n_pp": "count"}), rule=st.experiment.rule)
-    plots.counts_vs_radius(frame, reg, ax=ax)
+    plots.counts_vs_radius(frame, regression=reg, ax=ax)
     ax.set_title(name)
     slope, intercept = reg.ols.params[1], reg.ols.params[0]
     table = plots.counts_by_radius(frame)
-    kinetic = stats.kinetic_rate(table.index.to_numpy(), st.experiment.rule)
+    kinetic = stats.kinetic_rate(table.index.to_numpy(), rule=st.experiment.rule)
     ratio = table["mean_count"] / (kinetic * table["mean_t_window"])
     print(
         f"{name}: paper's line, rate = {intercept:.4g} + {slope:.4g} r (R^2 = "
@@ -226,7 +226,7 @@ fig, axes = plt.subplots(
 )
 summaries = {}
 for i, (name, st) in enumerate(stores.items()):
-    summaries[name] = plots.diagnostic_summary(st.results, list(diagnostics))
+    summaries[name] = plots.diagnostic_summary(st.results, diagnostic=list(diagnostics))
     for j, diagnostic in enumerate(diagnostics):
         plots.diagnostic_vs_radius(
             summaries[name],

@@ -401,7 +401,7 @@ def test_angle_series_feeds_the_autocorrelation():
 def test_simulated_runs_unkicked_disk_is_constant_and_two_disks_are_not():
     import kicktimes as kt
 
-    ic = kt.initial_conditions(1, 0.03, seed=3)[0]
+    ic = kt.initial_conditions(1, 0.03, rng=3)[0]
     two = kt.simulate_two_particle(ic, 0.03, n_steps=5000, tau=0.2)
     one = kt.simulate_one_particle(ic[0], 0.03, n_steps=5000, tau=0.2)
     value, reason = acf_and_reason(boundary_angles(one))

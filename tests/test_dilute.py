@@ -11,7 +11,7 @@ RATE, WINDOW, RUNS = 2.0, 100.0, 6000
 
 @pytest.fixture(scope="module")
 def elastic():
-    return dilute_tagged_times("elastic", RATE, WINDOW, RUNS, np.random.default_rng(3),
+    return dilute_tagged_times("elastic", RATE, WINDOW, n_runs=RUNS, rng=np.random.default_rng(3),
                                speeds=True)
 
 
@@ -54,7 +54,7 @@ def test_long_window_dispersion_above_one(elastic):
 
 
 def test_mirror_streams_are_poisson():
-    times, speeds = dilute_tagged_times("mirror", RATE, WINDOW, 4000, 7, speeds=True)
+    times, speeds = dilute_tagged_times("mirror", RATE, WINDOW, n_runs=4000, rng=7, speeds=True)
     counts = np.array([np.searchsorted(t, 150.0 / RATE) for t in times], float)
     d = counts.var(ddof=1) / counts.mean()
     assert abs(d - 1) < 3 * np.sqrt(2 / 4000)            # D = 1 within 0.067
@@ -65,8 +65,8 @@ def test_mirror_streams_are_poisson():
 
 
 def test_elastic_streams_are_sorted_and_reproducible():
-    a = dilute_tagged_times("elastic", 1.0, 20.0, 5, 11)
-    b = dilute_tagged_times("elastic", 1.0, 20.0, 5, 11)
+    a = dilute_tagged_times("elastic", 1.0, 20.0, n_runs=5, rng=11)
+    b = dilute_tagged_times("elastic", 1.0, 20.0, n_runs=5, rng=11)
     assert all(np.array_equal(x, y) for x, y in zip(a, b, strict=True))
     assert all(np.all(np.diff(x) > 0) and (x.size == 0 or x[-1] <= 20.0) for x in a)
 

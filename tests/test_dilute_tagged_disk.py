@@ -67,7 +67,7 @@ def elastic():
 def intervals():
     """Stationary intervals of the exact event Monte Carlo, in mean intervals: two long
     streams, their first 20 intervals (the start's transient) and the censored last dropped."""
-    times = dilute_tagged_times("elastic", 1.0, 1.0e6, 2, np.random.default_rng(51))
+    times = dilute_tagged_times("elastic", 1.0, 1.0e6, n_runs=2, rng=np.random.default_rng(51))
     return np.concatenate([np.diff(t)[20:] for t in times])
 
 
@@ -127,8 +127,8 @@ def d_infinity(elastic):
 def _disjoint_window_dispersion(window, n_windows, seed):
     """D and its standard error from the counts of ``n_windows`` disjoint windows of one
     long stream (not independent stationary starts, not the speed chain)."""
-    (t,) = dilute_tagged_times("elastic", 1.0, window * n_windows, 1,
-                               np.random.default_rng(seed))
+    (t,) = dilute_tagged_times("elastic", 1.0, window * n_windows, n_runs=1,
+                               rng=np.random.default_rng(seed))
     counts = np.bincount((t // window).astype(int), minlength=n_windows)[:n_windows]
     d = counts.var(ddof=1) / counts.mean()
     return d, d * math.sqrt(2.0 / n_windows)
@@ -147,7 +147,7 @@ def test_long_window_dispersion_matches_counts_in_disjoint_windows(elastic, d_in
 
 
 def test_finite_window_dispersion_matches_disjoint_windows(elastic):
-    d = elastic.dispersion(30.0, n_events=600_000, rng=3)
+    d = elastic.dispersion(window=30.0, n_events=600_000, rng=3)
     assert d.n == 20_000 and d.quantity == "dispersion, window 30"
     d_counts, se_counts = _disjoint_window_dispersion(30.0, 20_000, 11)
     assert abs(d.value - d_counts) < 3.0 * math.hypot(d.stderr, se_counts)
@@ -156,7 +156,8 @@ def test_finite_window_dispersion_matches_disjoint_windows(elastic):
 
 def test_ks_share_is_the_gas_pages_uniformity_ks(elastic):
     share = elastic.ks_share(10, n_runs=60, rng=5)
-    times = dilute_tagged_times("elastic", 1.0, 2.0 * 11 + 50.0, 60, np.random.default_rng(5))
+    times = dilute_tagged_times("elastic", 1.0, 2.0 * 11 + 50.0, n_runs=60,
+                                rng=np.random.default_rng(5))
     group = poisson_group([x[:10] for x in times], [float(x[10]) for x in times], n_mc=19,
                           rng=0)
     p = group.ensemble.per_sequence["p_uniformity_ks"].to_numpy()
@@ -167,7 +168,7 @@ def test_ks_share_is_the_gas_pages_uniformity_ks(elastic):
 def test_mirror_is_poisson_exactly():
     disk = dilute_tagged_disk("mirror")
     assert float(disk.dispersion()) == 1.0 and disk.dispersion().stderr == 0.0
-    assert float(disk.dispersion(30.0)) == 1.0
+    assert float(disk.dispersion(window=30.0)) == 1.0
     assert disk.interval_cv2 == 1.0
     assert np.all(disk.hazard([0.0, 5.0, 40.0]) == 1.0)
     assert np.all(disk.rate([0.0, 1.0, 3.0]) == 1.0)
@@ -186,9 +187,9 @@ def test_predictions_do_not_depend_on_the_temperature(elastic):
     (lambda: dilute_tagged_disk("elastic", kT=0.0), "kT"),
     (lambda: dilute_tagged_disk("elastic", kT=-1.0), "kT"),
     (lambda: DiluteTaggedDisk("elastic", kT=float("nan")), "kT"),
-    (lambda: dilute_tagged_disk("elastic").dispersion(0.0), "window"),
-    (lambda: dilute_tagged_disk("elastic").dispersion(-5.0), "window"),
-    (lambda: dilute_tagged_disk("mirror").dispersion(-5.0), "window"),
+    (lambda: dilute_tagged_disk("elastic").dispersion(window=0.0), "window"),
+    (lambda: dilute_tagged_disk("elastic").dispersion(window=-5.0), "window"),
+    (lambda: dilute_tagged_disk("mirror").dispersion(window=-5.0), "window"),
     (lambda: dilute_tagged_disk("elastic").hazard([1.0, -0.5]), "t"),
     (lambda: dilute_tagged_disk("elastic").hazard(float("nan")), "t"),
     (lambda: dilute_tagged_disk("elastic").rate(-1.0), "v"),
@@ -216,7 +217,7 @@ def test_the_gamma_shape_is_the_maximum_likelihood_limit_on_many_intervals():
     from kicktimes.stats import dilute_tagged_disk, dilute_tagged_times
 
     k = dilute_tagged_disk("elastic").gamma_shape
-    times = dilute_tagged_times("elastic", 1.0, 2e5, 1, np.random.default_rng(1))[0]
+    times = dilute_tagged_times("elastic", 1.0, 2e5, n_runs=1, rng=np.random.default_rng(1))[0]
     fitted = stats.gamma.fit(np.diff(times), floc=0)[0]
     assert k == pytest.approx(fitted, abs=0.01)
     assert k < 0.97  # over-dispersed intervals: a shape below 1

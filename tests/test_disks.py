@@ -99,7 +99,7 @@ def test_two_disks_agree_with_the_two_disk_simulator_event_by_event(rule, r):
     masses = (1.0, 2.5) if rule == "elastic" and isinstance(r, tuple) else None
     rr = list(r) if isinstance(r, tuple) else r
     worst = 0.0
-    for ic in initial_conditions(3, max(np.atleast_1d(r)), seed=5, rule=rule, method="uniform"):
+    for ic in initial_conditions(3, max(np.atleast_1d(r)), rng=5, rule=rule, method="uniform"):
         for state in _states_along(ic, r, rule, 8, 23.7, masses):
             two = simulate_two_particle(state, r, t_max=150.0, rule=rule, masses=masses)
             many = kt.simulate_disks(state, rr, t_max=150.0, rule=rule, masses=masses)
@@ -112,7 +112,7 @@ def test_two_disks_agree_with_the_two_disk_simulator_event_by_event(rule, r):
 def test_two_disk_collision_counts_agree_within_their_standard_error(rule):
     # whole runs agree only statistically (chaos): the mean counts of many ICs
     r, t_max = 0.1, 400.0
-    ics = initial_conditions(40, r, seed=9, rule=rule, method="uniform")
+    ics = initial_conditions(40, r, rng=9, rule=rule, method="uniform")
     a = np.array([simulate_two_particle(ic, r, t_max=t_max, rule=rule).n_pp for ic in ics])
     b = np.array([kt.simulate_disks(ic, r, t_max=t_max, rule=rule).n_pp for ic in ics])
     diff = b - a
@@ -127,7 +127,7 @@ def test_the_brute_force_reference_gives_the_same_next_collisions(n, rule, unequ
     rng = np.random.default_rng(n)
     radii = rng.uniform(0.04, 0.09, n) if unequal else np.full(n, 0.07)
     masses = rng.uniform(0.5, 2.0, n) if rule == "elastic" and unequal else None
-    state = kt.initial_state(n, radii, seed=n, rule=rule, masses=masses)
+    state = kt.initial_state(n, radii, rng=n, rule=rule, masses=masses)
     compared = 0
     worst = 0.0
     window = 4.0 if n > 5 else 40.0
@@ -147,7 +147,7 @@ def test_the_brute_force_reference_gives_the_same_next_collisions(n, rule, unequ
 def test_the_brute_force_reference_agrees_over_a_window():
     # a whole window of 20 disks: every collision, and the state at its end
     n = 20
-    state = kt.initial_state(n, 0.08, seed=4)
+    state = kt.initial_state(n, 0.08, rng=4)
     run = kt.simulate_disks(state, 0.08, t_max=1.5)
     log, end = ref.simulate(state, 0.08, 1.5)
     assert run.n_pp == len(log) > 15
@@ -165,7 +165,7 @@ def _debug_run(state, radii, rule, t_max, masses=None):
 
 def test_no_overlap_and_no_disk_outside_at_any_event_mirror_unit_speeds():
     n, phi = 150, 0.5
-    state = kt.initial_state(n, None, packing=phi, seed=11)
+    state = kt.initial_state(n, None, packing=phi, rng=11)
     radii = np.full(n, math.sqrt(phi / n))
     out = _debug_run(state, radii, MIRROR, 8.0)
     overlap, outside, checks = out["debug"]
@@ -181,7 +181,7 @@ def test_elastic_runs_conserve_energy_and_total_angular_momentum():
     rng = np.random.default_rng(3)
     radii = rng.uniform(0.03, 0.06, n)
     masses = rng.uniform(0.5, 3.0, n)
-    state = kt.initial_state(n, radii, seed=3, rule="elastic", masses=masses)
+    state = kt.initial_state(n, radii, rng=3, rule="elastic", masses=masses)
     out = _debug_run(state, radii, ELASTIC, 200.0, masses)
     overlap, outside, _ = out["debug"]
     assert overlap < 1e-12 and outside < 1e-12 and out["n_pp_total"] > 20_000
@@ -199,7 +199,7 @@ def test_elastic_runs_conserve_energy_and_total_angular_momentum():
 
 def test_no_overlap_or_stall_at_packing_0_6():
     n, phi = 400, 0.6
-    state = kt.initial_state(n, None, packing=phi, seed=6)
+    state = kt.initial_state(n, None, packing=phi, rng=6)
     r = math.sqrt(phi / n)
     run = kt.simulate_disks(state, r, t_max=8.0)
     assert run.n_pp > 100_000
@@ -217,7 +217,7 @@ def test_no_overlap_or_stall_at_packing_0_6():
 @pytest.mark.slow
 def test_no_overlap_lost_collision_or_stall_over_1e8_collisions_at_packing_0_6():
     n, phi = 1000, 0.6
-    state = kt.initial_state(n, None, packing=phi, seed=7)
+    state = kt.initial_state(n, None, packing=phi, rng=7)
     r = math.sqrt(phi / n)
     nu = enskog_frequency(r, n)
     t_max = 1e8 / (0.5 * n * nu)
@@ -232,7 +232,7 @@ def test_no_overlap_lost_collision_or_stall_over_1e8_collisions_at_packing_0_6()
 # --- holes, samples, wall log ----------------------------------------------------------------
 def test_disks_escape_through_holes_and_the_rest_go_on():
     n = 40
-    state = kt.initial_state(n, 0.04, seed=8)
+    state = kt.initial_state(n, 0.04, rng=8)
     run = kt.simulate_disks(state, 0.04, t_max=30.0, holes=[(0.0, 0.4)], sample=[0, 1],
                             tau=0.5, log_walls=True)
     esc = run.escape_times
@@ -255,7 +255,7 @@ def test_renumbering_the_disks_in_space_changes_no_event(monkeypatch, observers)
     # the engine renumbers its disks by cell as they diffuse (kd.relabel, from 2048 disks
     # on); renumbering after every collision must leave every output as it was, bitwise
     n, r = 60, 0.04
-    state = kt.initial_state(n, r, seed=8)
+    state = kt.initial_state(n, r, rng=8)
     kw = dict(holes=[(0.0, 0.1)], sample=[0, 5, 17], tau=0.5, log_walls=True) if observers \
         else {}
 
@@ -276,7 +276,7 @@ def test_renumbering_the_disks_in_space_changes_no_event(monkeypatch, observers)
 
 
 def test_samples_are_the_positions_at_k_tau():
-    state = kt.initial_state(30, 0.05, seed=12)
+    state = kt.initial_state(30, 0.05, rng=12)
     run = kt.simulate_disks(state, 0.05, t_max=2.0, sample=[3, 7], tau=0.25)
     for k, t in enumerate(run.sample_times):
         if t == 0:
@@ -287,7 +287,7 @@ def test_samples_are_the_positions_at_k_tau():
 
 
 def test_collisions_are_sorted_by_time_with_i_below_j():
-    state = kt.initial_state(200, None, packing=0.3, seed=13)
+    state = kt.initial_state(200, None, packing=0.3, rng=13)
     run = kt.simulate_disks(state, math.sqrt(0.3 / 200), t_max=2.0)
     df = run.collisions
     assert list(df.columns) == ["time", "i", "j"]
@@ -301,7 +301,7 @@ def test_collisions_are_sorted_by_time_with_i_below_j():
 @pytest.mark.parametrize("phi", [0.1, 0.45, 0.7])
 def test_initial_states_have_the_packing_asked_and_no_overlap(phi):
     n = 300
-    s = kt.initial_state(n, None, packing=phi, seed=1)
+    s = kt.initial_state(n, None, packing=phi, rng=1)
     r = math.sqrt(phi / n)
     from scipy.spatial import cKDTree
 
@@ -313,14 +313,14 @@ def test_initial_states_have_the_packing_asked_and_no_overlap(phi):
 
 def test_elastic_initial_states_lie_on_the_energy_shell():
     m = np.linspace(1.0, 4.0, 50)
-    s = kt.initial_state(50, 0.05, seed=2, rule="elastic", masses=m)
+    s = kt.initial_state(50, 0.05, rng=2, rule="elastic", masses=m)
     assert abs(np.sum(m * (s[:, 2] ** 2 + s[:, 3] ** 2)) - 50.0) < 1e-10
 
 
 def test_initial_positions_are_close_to_uniform():
     # the relaxation: the density in the inner half of the room is its area's share
     n = 2000
-    s = kt.initial_state(n, None, packing=0.1, seed=3)
+    s = kt.initial_state(n, None, packing=0.1, rng=3)
     rho = 1.0 - math.sqrt(0.1 / n)
     inner = (np.hypot(s[:, 0], s[:, 1]) < rho / math.sqrt(2)).mean()
     assert abs(inner - 0.5) < 4 * math.sqrt(0.25 / n)
@@ -330,7 +330,7 @@ def test_initial_positions_are_close_to_uniform():
 def test_the_whole_table_collision_frequency_is_enskogs_within_4_percent():
     n, phi = 3000, 0.2
     r = math.sqrt(phi / n)
-    state = kt.initial_state(n, r, seed=21)
+    state = kt.initial_state(n, r, rng=21)
     run = kt.simulate_disks(state, r, t_max=1.0)
     assert abs(run.collision_frequency / enskog_frequency(r, n) - 1.0) < 0.04
 
@@ -339,7 +339,7 @@ def _bulk_ratio(n, phi, t_max, seed, rule="mirror", r_bulk=0.6):
     """Measured / Enskog collision frequency in the bulk ``|x| < r_bulk``: the collisions
     whose contact point lies there, per unit area and time, over ``n_b nu(n_b) / 2``."""
     r = math.sqrt(phi / n)
-    state = kt.initial_state(n, r, seed=seed, rule=rule)
+    state = kt.initial_state(n, r, rng=seed, rule=rule)
     out = engine_run(state, np.full(n, r), MIRROR if rule == "mirror" else ELASTIC, t_max,
                      contacts=True, sample=np.arange(n), tau=t_max / 40, cap_hint=10**6)
     cx, cy = out["contacts"]
@@ -364,7 +364,7 @@ def test_bulk_and_whole_table_frequencies_against_enskog_henderson(phi):
     ratio, _ = _bulk_ratio(n, phi, 40.0 / enskog_frequency(r, n), 41)
     assert abs(ratio - 1.0) < 0.02
     if 0.1 <= phi <= 0.3:
-        state = kt.initial_state(n, r, seed=42)
+        state = kt.initial_state(n, r, rng=42)
         run = kt.simulate_disks(state, r, t_max=40.0 / enskog_frequency(r, n))
         assert abs(run.collision_frequency / enskog_frequency(r, n) - 1.0) < 0.04
 
@@ -376,7 +376,7 @@ def test_elastic_bulk_frequency_uses_the_maxwellian_mean_relative_speed():
 
 # --- bad input ----------------------------------------------------------------------------
 def test_bad_input_names_the_argument():
-    s = kt.initial_state(10, 0.05, seed=0)
+    s = kt.initial_state(10, 0.05, rng=0)
     bad = s.copy()
     bad[4, :2] = bad[7, :2] + [0.05, 0.0]
     with pytest.raises(ValueError, match="disks 4 and 7 overlap"):
@@ -390,7 +390,7 @@ def test_bad_input_names_the_argument():
     with pytest.raises(ValueError, match="t_max"):
         kt.simulate_disks(s, 0.05, t_max=-1.0)
     with pytest.raises(ValueError, match="t_max=1000000000000.0: .* memory"):
-        kt.simulate_disks(kt.initial_state(1000, 0.02, seed=0), 0.02, t_max=1e12)
+        kt.simulate_disks(kt.initial_state(1000, 0.02, rng=0), 0.02, t_max=1e12)
     with pytest.raises(ValueError, match="speed must be 1"):
         kt.simulate_disks(s * [1, 1, 2, 2], 0.05, t_max=1.0)
     with pytest.raises(ValueError, match="masses apply to rule='elastic'"):

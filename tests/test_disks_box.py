@@ -80,7 +80,7 @@ def test_the_engine_makes_the_brute_force_collision_sequence(n, unequal):
     radii = rng.uniform(0.05, 0.08, n) if unequal else np.full(n, 0.07)
     masses = rng.uniform(0.5, 2.0, n) if unequal else None
     box = 1.0
-    state = kt.initial_state(n, radii, seed=n, rule="elastic", masses=masses, box=box)
+    state = kt.initial_state(n, radii, rng=n, rule="elastic", masses=masses, box=box)
     compared = 0
     worst = 0.0
     # windows of 25 collisions, each from the engine's state at the last one's time:
@@ -105,7 +105,7 @@ def test_a_window_of_50_collisions_matches_the_reference_in_one_piece():
     # the disks (measured: beyond 1e-9 after 30-90 collisions of 8-20 disks, the pairs
     # after 60-180), so one piece is 50 collisions of 20 disks; the 200 above are windows
     n, r, box = 20, 0.05, 1.0
-    state = kt.initial_state(n, r, seed=2, rule="elastic", box=box)
+    state = kt.initial_state(n, r, rng=2, rule="elastic", box=box)
     log, _ = brute_force_box(state, r, box, 51)
     run = kt.simulate_disks(state, r, t_max=0.5 * (log[-2, 0] + log[-1, 0]), rule="elastic",
                             box=box)
@@ -142,7 +142,7 @@ def test_energy_and_total_momentum_are_conserved_over_a_long_elastic_run():
     rng = np.random.default_rng(5)
     masses = rng.uniform(0.5, 2.0, n)
     state = kt.initial_state(n, None, packing=0.3, box=box, rule="elastic", masses=masses,
-                             seed=5)
+                             rng=5)
     r = math.sqrt(0.3 * box * box / (math.pi * n))
     run = kt.simulate_disks(state, r, t_max=40.0, rule="elastic", masses=masses, box=box)
     assert run.n_pp > 3 * 10**5
@@ -159,7 +159,7 @@ def test_energy_and_total_momentum_are_conserved_over_a_long_elastic_run():
 def test_no_overlap_at_any_event_and_at_the_end(rule):
     # (the debug observer checks every disk after every event: O(n) per event)
     n, phi, box = 150, 0.5, 1.0
-    state = kt.initial_state(n, None, packing=phi, box=box, seed=9,
+    state = kt.initial_state(n, None, packing=phi, box=box, rng=9,
                              rule="mirror" if rule == 0 else "elastic")
     r = math.sqrt(phi * box * box / (math.pi * n))
     out = engine_run(state, np.full(n, r), rule, 3.0, debug=True, box=box, cap_hint=10**6)
@@ -175,7 +175,7 @@ def test_no_overlap_at_any_event_and_at_the_end(rule):
 # --- initial states -------------------------------------------------------------------------
 def test_initial_states_in_the_box_reach_packing_0_3_at_2000_disks():
     n, phi, box = 2000, 0.3, 1.0
-    s = kt.initial_state(n, None, packing=phi, box=box, rule="elastic", seed=1)
+    s = kt.initial_state(n, None, packing=phi, box=box, rule="elastic", rng=1)
     r = math.sqrt(phi * box * box / (math.pi * n))
     assert n * math.pi * r * r / box ** 2 == pytest.approx(0.3)
     assert ((s[:, :2] >= 0.0) & (s[:, :2] < box)).all()
@@ -189,13 +189,13 @@ def test_initial_states_in_the_box_reach_packing_0_3_at_2000_disks():
 
 def test_dense_box_states_are_grown_without_overlap():
     n, phi = 300, 0.6
-    s = kt.initial_state(n, 0.02, packing=phi, box=1.0, seed=2)
+    s = kt.initial_state(n, 0.02, packing=phi, box=1.0, rng=2)
     r = math.sqrt(phi / (math.pi * n))
     assert len(cKDTree(s[:, :2], boxsize=1.0).query_pairs(2.0 * r * (1 - 1e-12))) == 0
 
 
 def test_box_side_gives_the_packing():
-    L = box_side(2000, 0.01, 0.3)
+    L = box_side(2000, 0.01, packing=0.3)
     assert 2000 * math.pi * 0.01 ** 2 / L ** 2 == pytest.approx(0.3, rel=1e-14)
 
 
@@ -206,7 +206,7 @@ def box_frequency(n, phi, collisions_per_disk, blocks=10, seed=1):
     box = 1.0
     r = math.sqrt(phi * box * box / (math.pi * n))
     nu = enskog_frequency(r, n, rule="elastic", area=box * box, kT=0.5)
-    s = kt.initial_state(n, r, box=box, rule="elastic", seed=seed)
+    s = kt.initial_state(n, r, box=box, rule="elastic", rng=seed)
     s = kt.simulate_disks(s, r, t_max=20.0 / nu, rule="elastic", box=box).final_state
     t_max = collisions_per_disk / nu
     run = kt.simulate_disks(s, r, t_max=t_max, rule="elastic", box=box)
@@ -229,18 +229,18 @@ def test_the_box_is_recorded_and_written(tmp_path):
 
     import pyarrow.parquet as pq
 
-    s = kt.initial_state(50, 0.03, box=1.0, seed=1)
+    s = kt.initial_state(50, 0.03, box=1.0, rng=1)
     run = kt.simulate_disks(s, 0.03, t_max=1.0, box=1.0)
     assert run.box == 1.0 and "box=1.0" in repr(run)
     run.to_parquet(tmp_path / "b.parquet")
     meta = json.loads(pq.read_table(tmp_path / "b.parquet").schema.metadata[b"kicktimes"])
     assert meta["box"] == 1.0
-    circle = kt.simulate_disks(kt.initial_state(50, 0.03, seed=1), 0.03, t_max=0.5)
+    circle = kt.simulate_disks(kt.initial_state(50, 0.03, rng=1), 0.03, t_max=0.5)
     assert circle.box is None and circle.meta["box"] is None
 
 
 def test_bad_box_input_names_the_argument():
-    s = kt.initial_state(50, 0.03, box=1.0, seed=1)
+    s = kt.initial_state(50, 0.03, box=1.0, rng=1)
     with pytest.raises(ValueError, match="holes"):
         kt.simulate_disks(s, 0.03, t_max=1.0, box=1.0, holes=[[0.0, 0.1]])
     with pytest.raises(ValueError, match="log_walls"):

@@ -307,7 +307,7 @@ def test_the_kicked_rate_is_the_whole_gas_collision_frequency():
     # the same gas run, redrawn from the run's seed as kicked_rows draws it
     rng = np.random.default_rng(np.random.SeedSequence(exp.seed, spawn_key=(6, 0, 1)))
     r = exp.radius(6)
-    state = initial_state(6, r, seed=rng, rule="mirror")
+    state = initial_state(6, r, rng=rng, rule="mirror")
     tau = 0.1 / exp.reference_frequency(6)
     gas = simulate_disks(state, r, t_max=int(round(20.0 / 0.1)) * tau, rule="mirror",
                          sample=[0], tau=tau, log_walls=True)

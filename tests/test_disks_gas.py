@@ -279,9 +279,9 @@ def test_the_twin_ftle_of_two_disks_is_the_two_disk_tangent_ftle_on_average():
 
     twin, tangent = [], []
     for seed in range(12):
-        state = kt.initial_state(2, 0.1, seed=seed)
+        state = kt.initial_state(2, 0.1, rng=seed)
         twin.append(disks_lyapunov(state, 0.1, t_max=600.0, segment=2.0, method="twin",
-                                   rng=seed).exponent)
+                                   rng=seed).lam)
         tangent.append(lyapunov(state, 0.1, n_steps=300, tau=2.0).lam)
     # each restart of the engine moves the reference by round-off, which the chaos
     # amplifies: after about 100 time units the two follow different trajectories, so only

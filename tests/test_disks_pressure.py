@@ -58,7 +58,7 @@ def test_a_radial_wall_hit_adds_twice_the_momentum_to_the_wall_impulse():
 @pytest.mark.parametrize("box", [None, 1.0])
 def test_stopping_to_count_the_region_changes_no_event(box):
     n = 300
-    s = kt.initial_state(n, None, packing=0.3, seed=6, box=box)
+    s = kt.initial_state(n, None, packing=0.3, rng=6, box=box)
     r = math.sqrt(0.3 / n) if box is None else math.sqrt(0.3 / (math.pi * n))
     plain = engine_run(s, np.full(n, r), 0, 3.0, box=box)
     stops = engine_run(s, np.full(n, r), 0, 3.0, box=box, pressure_samples=37)
@@ -73,7 +73,7 @@ def table_pressure(n, phi, per_disk, *, rule="elastic", seed=1, blocks=20):
     """A run of ``per_disk`` collisions per disk in the table after 20 of equilibration:
     ``(pressure, (wall / virial - 1, its standard error from the blocks))``."""
     r = math.sqrt(phi / n)
-    s = kt.initial_state(n, r, seed=seed, rule=rule)
+    s = kt.initial_state(n, r, rng=seed, rule=rule)
     nu = enskog_frequency(r, n, rule=rule, kT=0.5)
     s = kt.simulate_disks(s, r, t_max=20.0 / nu, rule=rule).final_state
     run = kt.simulate_disks(s, r, t_max=per_disk / nu, rule=rule)
@@ -128,7 +128,7 @@ def test_the_box_virial_pressure_is_hendersons_within_1_percent():
     n, phi, box = 2000, 0.3, 1.0
     r = math.sqrt(phi / (math.pi * n))
     nu = enskog_frequency(r, n, rule="elastic", area=box * box, kT=0.5)
-    s = kt.initial_state(n, r, box=box, rule="elastic", seed=2)
+    s = kt.initial_state(n, r, box=box, rule="elastic", rng=2)
     s = kt.simulate_disks(s, r, t_max=20.0 / nu, rule="elastic", box=box).final_state
     run = kt.simulate_disks(s, r, t_max=400.0 / nu, rule="elastic", box=box)
     p = run.pressure(blocks=20)
@@ -141,7 +141,7 @@ def test_the_box_virial_pressure_is_hendersons_within_1_percent():
 
 # --- the record and bad input ---------------------------------------------------------------
 def test_the_pressure_log_starts_at_zero_and_its_sums_grow():
-    s = kt.initial_state(200, 0.03, seed=4, rule="elastic")
+    s = kt.initial_state(200, 0.03, rng=4, rule="elastic")
     run = kt.simulate_disks(s, 0.03, t_max=3.0, rule="elastic")
     log = run.pressure_log
     assert log[0, 0] == 0.0 and log[-1, 0] == 3.0 and log.shape[0] >= 3
@@ -153,15 +153,15 @@ def test_the_pressure_log_starts_at_zero_and_its_sums_grow():
 
 
 def test_bad_pressure_requests_name_the_argument():
-    s = kt.initial_state(100, 0.03, box=1.0, seed=1)
+    s = kt.initial_state(100, 0.03, box=1.0, rng=1)
     run = kt.simulate_disks(s, 0.03, t_max=1.0, box=1.0)
     with pytest.raises(ValueError, match="rule"):
         run.pressure(blocks=2)
     radii = np.r_[np.full(50, 0.03), np.full(50, 0.04)]
-    u = kt.initial_state(100, radii, seed=1, rule="elastic")
+    u = kt.initial_state(100, radii, rng=1, rule="elastic")
     with pytest.raises(ValueError, match="^r: "):
         kt.simulate_disks(u, radii, t_max=1.0, rule="elastic").pressure(blocks=2)
-    e = kt.initial_state(100, 0.03, seed=1, rule="elastic")
+    e = kt.initial_state(100, 0.03, rng=1, rule="elastic")
     run = kt.simulate_disks(e, 0.03, t_max=1.0, rule="elastic")
     with pytest.raises(ValueError, match="blocks"):
         run.pressure(blocks=1)

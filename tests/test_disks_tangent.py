@@ -66,7 +66,7 @@ def finite_difference(state, r, rule, t, u, eps, masses=None):
 def test_one_disk_tangent_is_the_finite_difference_across_walls_and_rebases(rule):
     # one disk: walls only (the map's error is the difference's, O(eps^2)); t = 100 crosses
     # the clock's rebasing (every 32 time units) three times
-    state = kt.initial_state(1, 0.2, seed=4, rule=rule)
+    state = kt.initial_state(1, 0.2, rng=4, rule=rule)
     u = direction(state, rule, 1)
     out, tan = carry(state, 0.2, rule, 100.0, u, segment=7.0)
     assert out["n_wall"] > 50
@@ -79,7 +79,7 @@ def test_tangent_is_the_finite_difference_across_collisions(rule):
     # N = 12 at packing 0.1: about 30 disk-disk collisions; the difference of two runs
     # eps = 1e-8 apart is linear while eps e^(lambda t) << r
     n, r = 12, math.sqrt(0.1 / 12)
-    state = kt.initial_state(n, r, seed=5, rule=rule)
+    state = kt.initial_state(n, r, rng=5, rule=rule)
     u = direction(state, rule, 2)
     out, tan = carry(state, r, rule, 1.5, u, segment=0.5)
     assert out["n_pp_total"] > 15
@@ -91,7 +91,7 @@ def test_tangent_is_the_finite_difference_across_collisions(rule):
 def test_tangent_is_the_finite_difference_with_unequal_masses():
     # pair_tangent's mass factors k0 = 2 m_j / (m_i + m_j), as the engine's velocity map
     n, r = 10, 0.08
-    state = kt.initial_state(n, r, seed=6, rule="elastic")
+    state = kt.initial_state(n, r, rng=6, rule="elastic")
     masses = np.linspace(0.5, 3.0, n)
     u = direction(state, "elastic", 3)
     out, tan = carry(state, r, "elastic", 1.5, u, masses=masses)
@@ -107,7 +107,7 @@ def test_tangent_is_the_finite_difference_with_unequal_masses():
 def test_the_flow_direction_is_carried_to_the_flow_direction(rule):
     # (dq, dv) = (v, 0) is a shift along the trajectory: every event maps it to (v', 0)
     n, r = 20, 0.05
-    state = kt.initial_state(n, r, seed=7, rule=rule)
+    state = kt.initial_state(n, r, rng=7, rule=rule)
     u = np.zeros_like(state)
     u[:, :2] = state[:, 2:]
     out, tan = carry(state, r, rule, 2.0, u, segment=0.5)
@@ -123,7 +123,7 @@ def test_the_flow_direction_is_carried_to_the_flow_direction(rule):
 def test_the_tangent_observer_changes_no_event(rule):
     # t = 40 crosses a rebasing; stops every 3 time units for the segment ends
     n, r = 40, math.sqrt(0.2 / 40)
-    state, radii, _ = md.check_disks(kt.initial_state(n, r, seed=8, rule=rule), r, rule)
+    state, radii, _ = md.check_disks(kt.initial_state(n, r, rng=8, rule=rule), r, rule)
     plain = md.engine_run(state, radii, RULES[rule], 40.0)
     seen = md.engine_run(state, radii, RULES[rule], 40.0, contacts=True)
     tan = md.engine_run(state, radii, RULES[rule], 40.0, tangent=direction(state, rule, 4),
@@ -138,7 +138,7 @@ def test_the_tangent_observer_changes_no_event(rule):
 def test_an_escaped_disk_takes_its_deviation_with_it():
     # holes: the observer zeroes the row of a disk that leaves the table; the others go on
     n, r = 30, 0.05
-    state, radii, _ = md.check_disks(kt.initial_state(n, r, seed=10), r, "mirror")
+    state, radii, _ = md.check_disks(kt.initial_state(n, r, rng=10), r, "mirror")
     arcs = np.array([[0.0, 0.3]])
     out = md.engine_run(state, radii, 0, 20.0, arcs=arcs, tangent=direction(state, "mirror", 5),
                         segment=5.0, on_segment=lambda *_: None)
@@ -152,7 +152,7 @@ def test_renumbering_the_disks_changes_no_exponent(monkeypatch):
     # kd.relabel moves the tangent rows with the disks: renumbering after every collision
     # gives the same exponent, bitwise (t = 40: a rebasing too)
     n, r = 60, 0.04
-    state = kt.initial_state(n, r, seed=9)
+    state = kt.initial_state(n, r, rng=9)
 
     def exponent(sweeps, min_disks):
         monkeypatch.setattr(md, "REORDER_SWEEPS", sweeps)
@@ -168,11 +168,11 @@ def test_renumbering_the_disks_changes_no_exponent(monkeypatch):
 def test_the_engine_rescales_a_vector_that_grows_past_1e50():
     # one segment of lambda t ~ 400 nats: the engine divides by 1e100 on the way
     n, r = 20, 0.05
-    state = kt.initial_state(n, r, seed=3)
+    state = kt.initial_state(n, r, rng=3)
     long = disks_lyapunov(state, r, t_max=60.0, segment=60.0, rng=2)
     short = disks_lyapunov(state, r, t_max=60.0, segment=1.0, rng=2)
     assert long.logs[0] > 2 * 115.0
-    assert long.exponent == pytest.approx(short.exponent, rel=0.02)
+    assert long.lam == pytest.approx(short.lam, rel=0.02)
 
 
 # --- the exponent ----------------------------------------------------------------------
@@ -189,10 +189,10 @@ def tangent_and_twin(n, packing, rule, t_max, segment, n_ics):
     r = math.sqrt(packing / n)
     tangent, twin = [], []
     for seed in range(n_ics):
-        state = kt.initial_state(n, r, seed=seed, rule=rule)
+        state = kt.initial_state(n, r, rng=seed, rule=rule)
         kw = dict(t_max=t_max, segment=segment, rule=rule, rng=seed)
-        tangent.append(disks_lyapunov(state, r, **kw).exponent)
-        twin.append(disks_lyapunov(state, r, method="twin", **kw).exponent)
+        tangent.append(disks_lyapunov(state, r, **kw).lam)
+        twin.append(disks_lyapunov(state, r, method="twin", **kw).lam)
     return ratio_ci(tangent, twin)
 
 
@@ -230,9 +230,9 @@ def test_two_mirror_disks_tangent_exponent_is_the_twins_within_5_percent():
 def engine_and_two_disk(r, rule, t_max, n_ics):
     engine, two = [], []
     for seed in range(n_ics):
-        state = kt.initial_state(2, r, seed=seed, rule=rule)
+        state = kt.initial_state(2, r, rng=seed, rule=rule)
         engine.append(disks_lyapunov(state, r, t_max=t_max, segment=10.0, rule=rule,
-                                     rng=seed).exponent)
+                                     rng=seed).lam)
         two.append(lyapunov(state, r, n_steps=int(t_max / 10.0), tau=10.0, rule=rule).lam)
     return ratio_ci(engine, two)
 
@@ -254,7 +254,7 @@ def test_two_disks_through_the_engine_have_the_two_disk_exponent_within_5_percen
 # --- the API ---------------------------------------------------------------------------
 
 def test_disks_lyapunov_names_the_bad_argument():
-    state = kt.initial_state(5, 0.05, seed=1)
+    state = kt.initial_state(5, 0.05, rng=1)
     with pytest.raises(ValueError, match="method"):
         disks_lyapunov(state, 0.05, t_max=1.0, segment=0.5, method="qr")
     with pytest.raises(ValueError, match="segment"):
@@ -272,10 +272,10 @@ def test_disks_lyapunov_names_the_bad_argument():
 
 
 def test_the_tangent_result_has_no_d0_and_keeps_the_run():
-    state = kt.initial_state(20, 0.05, seed=3)
+    state = kt.initial_state(20, 0.05, rng=3)
     res = disks_lyapunov(state, 0.05, t_max=5.0, segment=1.0, rng=1)
     assert res.method == "tangent" and res.d0 is None and res.logs.size == 5
-    assert res.exponent == pytest.approx(res.logs.sum() / 5.0)
+    assert res.lam == pytest.approx(res.logs.sum() / 5.0)
     run = kt.simulate_disks(state, 0.05, t_max=5.0)
     assert res.n_collisions == run.n_pp
     np.testing.assert_array_equal(res.final_state, run.final_state)

@@ -353,17 +353,17 @@ def test_recurrence_and_acf_rows_are_the_library_diagnostics_of_the_run():
                               "autocorrelation"], acf_max_lag=5, eps=(0.01, 0.05))
     res, _ = run_task(exp, exp.tasks()[3])  # r = 0.025, ICs 2 and 3
     got = res[res.ic == 2].set_index("diagnostic")["value"]
-    ic = initial_conditions(4, 0.025, seed=7)[2]
+    ic = initial_conditions(4, 0.025, rng=7)[2]
     run = simulate_two_particle(ic, 0.025, sampling="paper", n_steps=400, tau=0.3)
     pts, n = run.samples, len(run.samples)
-    assert got["recurrence_rate"] == got["rr@0.01"] == recurrence_rate(pts, 0.01)
+    assert got["recurrence_rate"] == got["rr@0.01"] == recurrence_rate(pts, eps=0.01)
     for e in (0.01, 0.05):
-        q = rqa(pts, e)
-        assert got[f"rr@{e:g}"] == recurrence_rate(pts, e)
-        assert got[f"rr_offdiag@{e:g}"] == q.rr == recurrence_rate(pts, e, theiler=1)
+        q = rqa(pts, eps=e)
+        assert got[f"rr@{e:g}"] == recurrence_rate(pts, eps=e)
+        assert got[f"rr_offdiag@{e:g}"] == q.rr == recurrence_rate(pts, eps=e, theiler=1)
         assert n * got[f"rr@{e:g}"] - 1 == pytest.approx((n - 1) * q.rr, rel=1e-12)
         np.testing.assert_equal([got[f"det@{e:g}"], got[f"l_max@{e:g}"]], [q.det, q.l_max])
-    theta = boundary_angles(run, 0)
+    theta = boundary_angles(run, particle=0)
     assert got["autocorrelation"] == got["acf@1"] == autocorrelation(theta, 1)
     np.testing.assert_array_equal(
         got[[f"acf@{lag}" for lag in range(1, 6)]], autocorrelation_function(theta, 5)
@@ -418,10 +418,10 @@ def test_uniform_rr_sampling_uses_a_uniform_rerun_of_the_same_trajectory():
     rr_rows = a.index.get_level_values("diagnostic").str.contains("rr|recurrence|det|l_")
     pd.testing.assert_series_equal(a[~rr_rows], b[~rr_rows])  # nothing else changes
     assert (a[rr_rows] != b[rr_rows]).any()
-    ic = initial_conditions(2, 0.025, seed=7)[0]
+    ic = initial_conditions(2, 0.025, rng=7)[0]
     run = simulate_two_particle(ic, 0.01, sampling="paper", n_steps=400, tau=0.3)
     again = simulate_two_particle(ic, 0.01, t_max=run.t_max, tau=0.3, sampling="uniform")
-    assert b[(0.01, 0, "two_particle", "rr@0.001")] == recurrence_rate(again.samples, 1e-3)
+    assert b[(0.01, 0, "two_particle", "rr@0.001")] == recurrence_rate(again.samples, eps=1e-3)
     # the uniform re-run retraces the paper-sampled run's trajectory, kicks included
     from kicktimes import simulate_one_particle
 
@@ -451,7 +451,7 @@ def test_ics_are_drawn_once_at_the_largest_radius_and_shared_by_all_radii():
 
     exp = dataclasses.replace(TINY, systems=["two_particle"], diagnostics=["recurrence_rate"])
     _, coll = run_task(exp, exp.tasks()[0])  # r = 0.01, ICs 0 and 1
-    ic = initial_conditions(2, 0.025, seed=7)[1]
+    ic = initial_conditions(2, 0.025, rng=7)[1]
     run = simulate_two_particle(ic, 0.01, sampling="paper", n_steps=400, tau=0.3)
     np.testing.assert_array_equal(coll["pp_times"][1], run.pp_times)
 
@@ -459,7 +459,7 @@ def test_ics_are_drawn_once_at_the_largest_radius_and_shared_by_all_radii():
 def test_actual_kicks_cover_the_whole_paper_sampled_one_particle_run():
     from kicktimes import initial_conditions, simulate_two_particle
 
-    ic = initial_conditions(1, 0.03, seed=3)[0]
+    ic = initial_conditions(1, 0.03, rng=3)[0]
     two = simulate_two_particle(ic, 0.03, sampling="paper", n_steps=2000, tau=0.3)
     times = _actual_times(dataclasses.replace(TINY, n_steps=2000), ic, 0.03, two)
     # the sampled run ends before n_steps * tau; its collisions are the continuation's start
@@ -492,7 +492,7 @@ def test_one_pass_continues_the_two_disk_run_to_the_horizon_for_the_actual_kicks
     from kicktimes.diagnostics.lyapunov import lyapunov_pass
 
     exp = dataclasses.replace(TINY, n_steps=2000)
-    ic = initial_conditions(1, 0.03, seed=3)[0]
+    ic = initial_conditions(1, 0.03, rng=3)[0]
     two = simulate_two_particle(ic, 0.03, sampling="paper", n_steps=2000, tau=0.3)
     _, run, times = lyapunov_pass(ic, 0.03, sampling="paper", n_steps=2000, tau=0.3,
                                   t_continue=exp.horizon)
@@ -515,7 +515,7 @@ def test_the_one_pass_sweep_keeps_its_stage_timings_under_the_ftle_keys():
 
 def test_kick_streams_differ_by_ic_radius_and_system_and_ignore_the_radius_list():
     draws = {
-        key: kick_rng(7, *key).random()
+        key: kick_rng(*key, rng=7).random()
         for key in [
             (0, 0.01, "poisson"),
             (1, 0.01, "poisson"),

@@ -34,7 +34,7 @@ def exact_escape(state, holes, horizon):
 
 
 def test_one_disk_escape_times_equal_the_exact_circle_map():
-    states = initial_conditions(1000, R, seed=41)[:, 0]
+    states = initial_conditions(1000, R, rng=41)[:, 0]
     horizon = 300.0
     agree = 0
     for state in states:
@@ -48,7 +48,7 @@ def test_one_disk_escape_times_equal_the_exact_circle_map():
 
 
 def test_the_run_ends_at_the_escape_with_the_disk_at_its_contact():
-    ic = initial_conditions(1, R, seed=4)[0]
+    ic = initial_conditions(1, R, rng=4)[0]
     run = simulate_two_particle(ic, R, n_steps=3000, tau=0.3, holes=HOLES)
     assert 0 < run.escape_time == run.t_max < 900.0 and run.escaped in (0, 1)
     x, y = run.final_state[run.escaped, :2]
@@ -66,7 +66,7 @@ def test_the_run_ends_at_the_escape_with_the_disk_at_its_contact():
 def test_a_kicked_disk_escapes_and_a_table_without_holes_keeps_it():
     from kicktimes import schedules
 
-    state = initial_conditions(1, R, seed=5)[0, 0]
+    state = initial_conditions(1, R, rng=5)[0, 0]
     run = simulate_one_particle(state, R, t_max=2000.0, kicks=schedules.Poisson(0.1), rng=3,
                                 holes=HOLES)
     assert math.isfinite(run.escape_time) and run.escaped == 0
@@ -87,14 +87,14 @@ def test_bad_holes_are_refused(holes, match):
 def test_the_ftle_is_measured_up_to_the_escape():
     from kicktimes.diagnostics import lyapunov
 
-    state = initial_conditions(1, R, seed=6)[0, 0]
+    state = initial_conditions(1, R, rng=6)[0, 0]
     kw = {"n_steps": 4000, "tau": 0.3, "kicks": np.sort(np.random.default_rng(2).uniform(
         0, 1200, 60)), "kick_angles": np.random.default_rng(3).uniform(0, 6.28, 60)}
     res, run = lyapunov(state, R, holes=HOLES, return_run=True, **kw)
     assert math.isfinite(run.escape_time) and res.total_time == run.escape_time
     assert lyapunov(state, R, holes=HOLES, **kw).lam == res.lam
     # two disks: the FTLE's time is the run's, which ends at the first escape
-    ic = initial_conditions(1, R, seed=6)[0]
+    ic = initial_conditions(1, R, rng=6)[0]
     two, run2 = lyapunov(ic, R, n_steps=4000, tau=0.3, holes=HOLES, return_run=True)
     assert two.total_time == run2.t_max <= 1200.0
     with pytest.raises(ValueError, match="method='tangent'"):

@@ -10,7 +10,7 @@ from kicktimes.stats import kinetic_rate
 @pytest.mark.parametrize("method", ["paper", "uniform"])
 def test_ics_are_valid_at_r_max_and_have_unit_speeds(method):
     r_max = 0.03
-    ics = initial_conditions(500, r_max, seed=4, method=method)
+    ics = initial_conditions(500, r_max, rng=4, method=method)
     assert ics.shape == (500, 2, 4)
     assert (np.hypot(ics[:, :, 0], ics[:, :, 1]) <= 1 - r_max).all()
     gap = np.hypot(ics[:, 0, 0] - ics[:, 1, 0], ics[:, 0, 1] - ics[:, 1, 1])
@@ -20,28 +20,28 @@ def test_ics_are_valid_at_r_max_and_have_unit_speeds(method):
 
 @pytest.mark.reproducibility
 def test_ic_i_does_not_depend_on_chunking():
-    whole = initial_conditions(40, 0.02, seed=9)
-    parts = np.concatenate([initial_conditions(n, 0.02, seed=9, start=s)
+    whole = initial_conditions(40, 0.02, rng=9)
+    parts = np.concatenate([initial_conditions(n, 0.02, rng=9, start=s)
                             for s, n in [(0, 7), (7, 20), (27, 13)]])
     assert np.array_equal(whole, parts)
-    assert not np.array_equal(whole, initial_conditions(40, 0.02, seed=10))
+    assert not np.array_equal(whole, initial_conditions(40, 0.02, rng=10))
 
 
 def test_paper_method_draws_distance_uniform_not_area_uniform():
-    ics = initial_conditions(4000, 0.01, seed=1, method="paper")
+    ics = initial_conditions(4000, 0.01, rng=1, method="paper")
     dist = np.hypot(ics[:, 0, 0], ics[:, 0, 1])
     # distance uniform on (0, 0.99): median ~0.495; area-uniform would give ~0.70
     assert abs(np.median(dist) - 0.495) < 0.03
 
 
 def test_uniform_method_is_area_uniform():
-    ics = initial_conditions(4000, 0.01, seed=1, method="uniform")
+    ics = initial_conditions(4000, 0.01, rng=1, method="uniform")
     dist = np.hypot(ics[:, 0, 0], ics[:, 0, 1])
     assert abs(np.median(dist) - 0.99 / np.sqrt(2)) < 0.03
 
 
 def test_elastic_invariant_measure_has_total_energy_two():
-    ics = initial_conditions(300, 0.02, seed=2, method="uniform", rule="elastic")
+    ics = initial_conditions(300, 0.02, rng=2, method="uniform", rule="elastic")
     np.testing.assert_allclose((ics[:, :, 2:] ** 2).sum(axis=(1, 2)), 2.0)
     speeds = np.hypot(ics[:, :, 2], ics[:, :, 3])
     assert speeds.std() > 0.1  # speeds vary, unlike the mirror rule
@@ -53,7 +53,7 @@ def test_elastic_invariant_measure_has_total_energy_two():
         (dict(n=0, r_max=0.02), "n must be an integer >= 1"),
         (dict(n=3, r_max=0.5), "r_max must lie in"),
         (dict(n=3, r_max=0.02, method="grid"), "method must be one of"),
-        (dict(n=3, r_max=0.02, seed=-1), "seed must be an integer >= 0"),
+        (dict(n=3, r_max=0.02, rng=-1), "rng must be an int seed >= 0"),
         (dict(n=3, r_max=0.02, rule="soft"), "rule must be one of"),
     ],
 )
@@ -64,7 +64,7 @@ def test_bad_arguments_raise(kwargs, match):
 
 def assert_mean_count_matches_kinetic_theory(rule, r, n, t_max, seed):
     # E[N(T)] = Gamma T exactly for ICs drawn from the invariant measure (docs/architecture.md)
-    ics = initial_conditions(n, r, seed=seed, method="uniform", rule=rule)
+    ics = initial_conditions(n, r, rng=seed, method="uniform", rule=rule)
     counts = np.array([simulate_two_particle(ic, r, t_max=t_max, rule=rule).n_pp for ic in ics])
     expected = kinetic_rate(r, rule=rule) * t_max
     sem = counts.std(ddof=1) / np.sqrt(n)
@@ -102,7 +102,7 @@ def test_the_paper_radii_give_the_same_ensembles_bit_for_bit(method, rule, r_max
     # correctly rounded on every draw.
     import hashlib
 
-    ics = initial_conditions(200, r_max, seed=2026, method=method, rule=rule)
+    ics = initial_conditions(200, r_max, rng=2026, method=method, rule=rule)
     assert hashlib.sha256(ics.tobytes()).hexdigest()[:16] == digest
 
 
@@ -114,7 +114,7 @@ def test_every_radius_up_to_one_half_gives_valid_ics_in_bounded_time(method, r_m
     # a bound against a hang, not a benchmark: 2-5 s on a 2-core machine, more when it is
     # shared (CPU time, so other processes do not count)
     t0 = time.process_time()
-    ics = initial_conditions(20, r_max, seed=1, method=method, rule="elastic")
+    ics = initial_conditions(20, r_max, rng=1, method=method, rule="elastic")
     assert time.process_time() - t0 < 15.0
     assert (np.hypot(ics[:, :, 0], ics[:, :, 1]) <= 1 - r_max).all()
     gap = np.hypot(ics[:, 0, 0] - ics[:, 1, 0], ics[:, 0, 1] - ics[:, 1, 1])
@@ -122,7 +122,7 @@ def test_every_radius_up_to_one_half_gives_valid_ics_in_bounded_time(method, r_m
 
 
 def test_the_issue_example_returns():
-    ic = initial_conditions(1, 0.4, seed=1)[0]
+    ic = initial_conditions(1, 0.4, rng=1)[0]
     assert np.hypot(ic[0, 0] - ic[1, 0], ic[0, 1] - ic[1, 1]) >= 0.8
 
 
@@ -141,7 +141,7 @@ def test_the_direct_pair_sampler_matches_joint_rejection():
     r = 0.45
     rng = np.random.default_rng(3)
     direct = np.array([_uniform_pair(rng, r) for _ in range(400)])  # (400, 2 xy, 2 disks)
-    rej = initial_conditions(400, r, seed=5, method="uniform")
+    rej = initial_conditions(400, r, rng=5, method="uniform")
     d_direct = np.hypot(direct[:, 0, 0], direct[:, 1, 0])
     d_rej = np.hypot(rej[:, 0, 0], rej[:, 0, 1])
     assert ks_2samp(d_direct, d_rej).pvalue > 1e-3
@@ -206,7 +206,7 @@ def test_ics_use_no_blas_and_no_c_library_trigonometry(monkeypatch, method, rule
     for mod, names in ((np, ("cos", "sin", "dot", "arctan2")), (math, ("cos", "sin", "atan2"))):
         for name in names:
             monkeypatch.setattr(mod, name, refuse)
-    ics = initial_conditions(50, 0.1, seed=4, method=method, rule=rule)
+    ics = initial_conditions(50, 0.1, rng=4, method=method, rule=rule)
     assert np.isfinite(ics).all()
 
 

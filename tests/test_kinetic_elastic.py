@@ -30,7 +30,7 @@ def table():
 @pytest.fixture(scope="module")
 def state():
     # disk 0 of an invariant elastic IC: speed 1.32, not 1
-    return initial_conditions(1, R, seed=3, method="uniform", rule="elastic")[0, 0]
+    return initial_conditions(1, R, rng=3, method="uniform", rule="elastic")[0, 0]
 
 
 @pytest.fixture(scope="module")
@@ -192,7 +192,7 @@ def test_the_two_disk_collision_rate_follows_the_elastic_table_over_many_short_r
     # units (~20 000 collisions): the observed over the table's expected count; margin
     # stated in advance: the ratio band [0.9, 1.1] (the invariant partner is an
     # approximation). Measured with 400 ICs of 20 000: 0.990 [0.967, 1.015] (slow test).
-    ics = initial_conditions(120, R, seed=7, method="uniform", rule="elastic")
+    ics = initial_conditions(120, R, rng=7, method="uniform", rule="elastic")
     obs, exp = observed_over_kinetic(ics, table, 5000.0)
     assert obs.sum() > 15000
     est, low, high = ratio_ci(obs.sum(axis=(1, 2)), exp.sum(axis=(1, 2)))
@@ -202,7 +202,7 @@ def test_the_two_disk_collision_rate_follows_the_elastic_table_over_many_short_r
 @pytest.mark.slow
 def test_the_two_disk_collision_rate_follows_the_elastic_table_in_every_bin(table):
     # 400 ICs of 20 000 (~270 000 collisions, 4 s): every (|kappa|, c) bin within 10 %
-    ics = initial_conditions(400, R, seed=7, method="uniform", rule="elastic")
+    ics = initial_conditions(400, R, rng=7, method="uniform", rule="elastic")
     obs, exp = observed_over_kinetic(ics, table, 20000.0)
     est, low, high = ratio_ci(obs.sum(axis=(1, 2)), exp.sum(axis=(1, 2)))
     assert ratio_verdict(low, high) == "within 10 %", (est, low, high)

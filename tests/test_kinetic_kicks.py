@@ -19,7 +19,7 @@ def kinetic():
 
 @pytest.fixture(scope="module")
 def state():
-    return initial_conditions(1, R, seed=11)[0, 0]
+    return initial_conditions(1, R, rng=11)[0, 0]
 
 
 @pytest.fixture(scope="module")

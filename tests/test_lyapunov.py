@@ -17,7 +17,7 @@ from kicktimes.diagnostics.lyapunov import _check_status, lyapunov_spectrum
 
 @pytest.fixture(scope="module")
 def ics():
-    return initial_conditions(6, 0.03, seed=3)
+    return initial_conditions(6, 0.03, rng=3)
 
 
 @pytest.mark.parametrize("method", ["tangent", "twin"])
@@ -226,7 +226,7 @@ def test_every_event_loop_has_a_budget(ics):
 
 @pytest.mark.slow
 def test_two_particle_exponent_at_r_003_with_paper_scale_runs():
-    ics = initial_conditions(50, 0.03, seed=8)
+    ics = initial_conditions(50, 0.03, rng=8)
     lam = np.array([lyapunov(ic, 0.03, n_steps=25000, tau=0.2).lam for ic in ics])
     lam_half = np.array([lyapunov(ic, 0.03, n_steps=25000, tau=0.2, method="twin", d0=1e-4).lam
                          for ic in ics])
@@ -246,7 +246,7 @@ def test_sweeps_pass_the_lyapunov_method_through():
                          diagnostics=("lyapunov",))
         results, _ = run_task(exp, exp.tasks()[0])
         values[method] = results.loc[results.diagnostic == "lyapunov", "value"].item()
-    ic = initial_conditions(1, 0.02, seed=0)[0]
+    ic = initial_conditions(1, 0.02, rng=0)[0]
     assert values["tangent"] == lyapunov(ic, 0.02, n_steps=300, tau=0.3).lam
     assert values["twin"] == lyapunov(ic, 0.02, n_steps=300, tau=0.3, method="twin").lam
     with pytest.raises(ValueError, match="lyapunov_method"):
@@ -284,7 +284,7 @@ def assert_results_bitwise_equal(a, b):
 @pytest.mark.parametrize("variant", ["norm", "paper"])
 def test_one_pass_gives_the_two_disk_run_and_exponent_of_separate_calls(r, rule, sampling,
                                                                         variant):
-    for k, ic in enumerate(initial_conditions(2, r, seed=11, rule=rule)):
+    for k, ic in enumerate(initial_conditions(2, r, rng=11, rule=rule)):
         kw = dict(n_steps=800, tau=0.3, sampling=sampling, rule=rule, track=k)
         res, run = lyapunov(ic, r, variant=variant, return_run=True, **kw)
         assert_results_bitwise_equal(res, lyapunov(ic, r, variant=variant, **kw))
@@ -300,7 +300,7 @@ def test_one_pass_gives_the_two_disk_run_and_exponent_of_separate_calls(r, rule,
 @pytest.mark.parametrize("variant", ["norm", "paper"])
 def test_one_pass_gives_the_kicked_run_and_exponent_of_separate_calls(r, kick_angle, extra,
                                                                       sampling, variant):
-    state = initial_conditions(1, r, seed=12)[0, 0]
+    state = initial_conditions(1, r, rng=12)[0, 0]
     kw = dict(n_steps=800, tau=0.3, sampling=sampling, kick_angle=kick_angle, **extra)
     # drawn from a schedule with rng (the same draws both ways), and given explicitly with
     # kicks beyond the run's end (paper sampling: applied only while the run lasts)
@@ -347,7 +347,7 @@ def test_the_continued_pass_has_the_collision_times_of_a_fresh_run_to_the_horizo
     from kicktimes.diagnostics.lyapunov import lyapunov_pass
 
     horizon = 1500 * 0.3
-    for ic in initial_conditions(3, r, seed=13, rule=rule):
+    for ic in initial_conditions(3, r, rng=13, rule=rule):
         kw = dict(n_steps=1500, tau=0.3, rule=rule)
         res, run, times = lyapunov_pass(ic, r, sampling="paper", variant="paper",
                                         t_continue=horizon, **kw)
@@ -406,14 +406,14 @@ def test_the_one_pass_records_the_uniform_samples_of_a_uniform_rerun(rule):
     from kicktimes.diagnostics.lyapunov import lyapunov_pass
 
     steps = {"sampling": "paper", "n_steps": 1500, "tau": 0.3}
-    for i, ic in enumerate(initial_conditions(6, 0.03, seed=17, rule=rule)):
+    for i, ic in enumerate(initial_conditions(6, 0.03, rng=17, rule=rule)):
         res, run, _, u = lyapunov_pass(ic, 0.02, rule=rule, t_continue=450.0, uniform=True,
                                        **steps)
         again = simulate_two_particle(ic, 0.02, t_max=run.t_max, tau=0.3, rule=rule)
         assert u.tobytes() == again.samples.tobytes()
         assert res == lyapunov_pass(ic, 0.02, rule=rule, t_continue=450.0, **steps)[0]
         for law in ("uniform", "scatter"):
-            kicks = schedules.Poisson(0.05).sample(450.0, np.random.default_rng(i))
+            kicks = schedules.Poisson(0.05).sample(450.0, rng=np.random.default_rng(i))
             _, one, _, u1 = lyapunov_pass(ic[0], 0.02, kicks=kicks, kick_angle=law,
                                           rng=np.random.default_rng(i), uniform=True, **steps)
             again = simulate_one_particle(ic[0], 0.02, t_max=one.t_max, tau=0.3,
@@ -421,7 +421,7 @@ def test_the_one_pass_records_the_uniform_samples_of_a_uniform_rerun(rule):
                                           kick_angle=law)
             assert u1.tobytes() == again.samples.tobytes()
     # no uniform samples to record: uniform sampling, or holes (the run ends at an escape)
-    ic = initial_conditions(1, 0.03, seed=18)[0]
+    ic = initial_conditions(1, 0.03, rng=18)[0]
     assert lyapunov_pass(ic, 0.02, n_steps=100, tau=0.3, uniform=True)[3] is None
     assert lyapunov_pass(ic, 0.02, holes=[(0.0, 0.1)], uniform=True, **steps)[3] is None
     with pytest.raises(TypeError, match="uniform"):
@@ -441,7 +441,7 @@ def _literal_eq4(reference, twin_x, twin_y, d0, tau):
 
 def test_the_literal_eq4_is_the_sum_of_log_raw_separations_of_two_trajectories():
     r, tau, n, d0 = 0.05, 0.2, 100, 1 / 5000
-    ic = initial_conditions(1, r, seed=11)[0]
+    ic = initial_conditions(1, r, rng=11)[0]
     reference = simulate_two_particle(ic, r, n_steps=n, tau=tau)
     twins = []
     for c in (0, 1):  # the paper's twins: the tracked disk moved by +d0 along x, along y
@@ -460,7 +460,7 @@ def test_the_literal_eq4_is_the_sum_of_log_raw_separations_of_two_trajectories()
 
 def test_the_literal_eq4_of_a_kicked_run_shares_its_kicks():
     r, tau, n, d0 = 0.02, 0.2, 150, 1 / 5000
-    state = initial_conditions(1, r, seed=5)[0][0]
+    state = initial_conditions(1, r, rng=5)[0][0]
     kicks = schedules.Poisson(rate=0.2).sample(n * tau, rng=np.random.default_rng(3))
     angles = np.random.default_rng(4).uniform(0, 2 * np.pi, kicks.size)
     common = dict(kicks=kicks, kick_angles=angles, kick_angle="uniform", n_steps=n, tau=tau)
@@ -479,7 +479,7 @@ def test_the_literal_eq4_of_a_kicked_run_shares_its_kicks():
 @pytest.mark.parametrize("kick_angle", ["uniform", "gaussian"])
 def test_independent_twins_take_their_own_angles_at_the_shared_times(kick_angle):
     r, tau, n, d0 = 0.02, 0.2, 150, 1 / 5000
-    state = initial_conditions(1, r, seed=5)[0][0]
+    state = initial_conditions(1, r, rng=5)[0][0]
     kicks = schedules.Poisson(rate=0.2).sample(n * tau, rng=np.random.default_rng(3))
     angles = draw_kick_angles(kicks.size, kick_angle, 0.5, np.random.default_rng(4))
     common = dict(kick_angle=kick_angle, sigma=0.5, n_steps=n, tau=tau)

@@ -17,7 +17,7 @@ needs_conditional_rate = pytest.mark.skipif(
 
 @pytest.fixture(scope="module")
 def logged_run():
-    ic = initial_conditions(1, 0.03, seed=4)[0]
+    ic = initial_conditions(1, 0.03, rng=4)[0]
     return simulate_two_particle(ic, 0.03, t_max=3000.0, log_collisions=True)
 
 
@@ -122,7 +122,7 @@ def test_the_flat_hazard_test_has_its_size_on_exponential_data():
 def test_censoring_adds_exposure_without_events():
     rng = np.random.default_rng(2)
     x, c = rng.exponential(1.0, 20_000), rng.exponential(1.0, 20_000)
-    haz = stats.interval_hazard(x[x <= c], c[c < x], bins=6)
+    haz = stats.interval_hazard(x[x <= c], censored=c[c < x], bins=6)
     assert haz.rate == pytest.approx(1.0, rel=0.04)
     assert haz.pvalue > 1e-3
     # dropping the censored intervals would bias the rate up (to ~2)
@@ -187,14 +187,14 @@ def test_predicted_rates_are_the_conditional_rate_at_the_initial_angular_momenta
 @needs_conditional_rate
 def test_predicted_rates_average_to_the_kinetic_rate_over_invariant_ics():
     r = 0.02
-    ics = initial_conditions(2000, r, seed=5, method="uniform")
+    ics = initial_conditions(2000, r, rng=5, method="uniform")
     rates = mechanism.predicted_rates(ics, r)
     se = rates.std() / np.sqrt(rates.size)
     assert abs(rates.mean() - stats.kinetic_rate(r)) < 3 * se + 0.05 * stats.kinetic_rate(r)
 
 
 def test_the_elastic_rule_s_speeds_change_at_collisions_and_keep_the_energy():
-    ic = initial_conditions(1, 0.03, seed=4)[0]
+    ic = initial_conditions(1, 0.03, rng=4)[0]
     run = simulate_two_particle(ic, 0.03, t_max=1500.0, rule="elastic", log_collisions=True)
     tab = mechanism.collision_table(run)
     energy = tab["speed0_post"] ** 2 + tab["speed1_post"] ** 2
@@ -207,7 +207,7 @@ def test_the_elastic_rule_s_speeds_change_at_collisions_and_keep_the_energy():
 
 @needs_conditional_rate
 def test_predicted_rates_under_the_elastic_rule_condition_on_the_speeds():
-    ic = initial_conditions(1, 0.02, seed=2, method="uniform", rule="elastic")
+    ic = initial_conditions(1, 0.02, rng=2, method="uniform", rule="elastic")
     slow, fast = ic.copy(), ic.copy()
     slow[0, :, 2:] *= 0.5
     fast[0, :, 2:] *= 2.0

@@ -67,7 +67,7 @@ def test_mmpp_intervals_follow_the_exact_interval_law():
 def test_mmpp_counts_are_overdispersed_as_the_theory_says():
     t, n = 20.0, 4000
     rng = np.random.default_rng(2)
-    counts = np.array([CLUSTERED.sample(t, rng).size for _ in range(n)])
+    counts = np.array([CLUSTERED.sample(t, rng=rng).size for _ in range(n)])
     assert counts.mean() == pytest.approx(1.2 * t, abs=4 * math.sqrt(count_variance(
         CLUSTERED, t) / n))
     # the variance within 10 % (its standard error here is about 4 %); Poisson would be 24
@@ -91,7 +91,7 @@ def test_initial_law_sets_the_first_state():
     # a silent start that switches once, for ever, to rate 2: first kick at Exp(0.5) + Exp(2)
     late = MMPP([0.0, 2.0], [[-0.5, 0.5], [0.0, 0.0]], initial=[1.0, 0.0])
     rng = np.random.default_rng(5)
-    first = np.array([late.sample(200.0, rng)[0] for _ in range(4000)])
+    first = np.array([late.sample(200.0, rng=rng)[0] for _ in range(4000)])
     assert first.mean() == pytest.approx(2.5, abs=4 * math.sqrt(4.25 / 4000))
     # the absorbing state's law is the unique stationary one
     assert late.stationary == pytest.approx([0.0, 1.0]) and late.stationary_rate == 2.0
@@ -241,7 +241,7 @@ def test_a_schedule_from_a_fit_kicks_at_the_fits_stationary_rate():
     # the "must show": MMPP.from_fit(fit).sample(...) at fit.stationary_rate, 5 %
     from kicktimes import stats
 
-    data = [CLUSTERED.sample(100.0, rng) for rng in np.random.default_rng(8).spawn(60)]
+    data = [CLUSTERED.sample(100.0, rng=rng) for rng in np.random.default_rng(8).spawn(60)]
     fit = stats.fit_mmpp(data, 100.0, rng=9)
     kicks = MMPP.from_fit(fit)
     assert kicks.stationary_rate == pytest.approx(fit.stationary_rate, rel=1e-12)
@@ -319,7 +319,7 @@ def _clustered_store(n_ics=4, t=2000.0):
     for r in (0.01, 0.02):
         for ic in range(n_ics):
             rng = np.random.default_rng([ic, int(r * 1000)])
-            times = (busy if ic < 2 else Poisson(busy.stationary_rate)).sample(t, rng)
+            times = (busy if ic < 2 else Poisson(busy.stationary_rate)).sample(t, rng=rng)
             coll.append((r, ic, t, times.size, times))
     collisions = pd.DataFrame(coll, columns=["radius", "ic", "t_window", "n_pp", "pp_times"])
     exp = SimpleNamespace(name="clustered", radii=[0.01, 0.02], n_ics=n_ics, seed=4)

@@ -261,7 +261,7 @@ def test_normal_kick_angles_are_drawn_from_n_0_sigma_and_act_as_new_directions()
 
     from kicktimes.diagnostics import lyapunov
 
-    state = initial_conditions(1, 0.02, seed=2)[0][0]
+    state = initial_conditions(1, 0.02, rng=2)[0][0]
     kicks = np.sort(np.random.default_rng(0).uniform(0, 3000, 3000))
     run = simulate_one_particle(state, 0.02, t_max=3000.0, kicks=kicks, kick_angle="normal",
                                sigma=0.5, rng=7)

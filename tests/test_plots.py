@@ -68,7 +68,7 @@ def assert_labelled(fig):
 
 @pytest.fixture(scope="module")
 def run():
-    ic = initial_conditions(1, 0.02, seed=1)[0]
+    ic = initial_conditions(1, 0.02, rng=1)[0]
     return simulate_two_particle(ic, 0.02, n_steps=2000, tau=0.2)
 
 
@@ -92,7 +92,7 @@ def test_poincare_section_accepts_a_boundary_dataframe():
 
 
 def test_poincare_panels_stacks_one_panel_per_radius_with_the_same_ic():
-    ic = initial_conditions(1, 0.02, seed=3)[0]
+    ic = initial_conditions(1, 0.02, rng=3)[0]
     runs = [simulate_two_particle(ic, r, n_steps=500, tau=0.3) for r in (0.02, 0.014)]
     fig = plots.poincare_panels(runs)
     assert len(fig.axes) == 2
@@ -123,7 +123,7 @@ def test_recurrence_plot_from_points_reports_the_recurrence_rate(run):
 
     fig = plots.recurrence_plot(run.samples, eps=1e-2)
     assert_labelled(fig)
-    rr = recurrence_rate(run.samples, 1e-2)
+    rr = recurrence_rate(run.samples, eps=1e-2)
     assert f"RR = {rr:.3g}" in fig.axes[0].get_title()
 
 
@@ -276,7 +276,7 @@ def test_counts_vs_radius_uses_a_given_regression():
     coll = make_collisions()
     frame = coll[["radius", "n_pp", "t_window"]].rename(columns={"n_pp": "count"})
     reg = stats.regress_counts(frame, rule="mirror")
-    fig = plots.counts_vs_radius(coll, reg)
+    fig = plots.counts_vs_radius(coll, regression=reg)
     labels = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
     assert any(f"α = {reg.alpha:.3g}" in lab for lab in labels)
     with pytest.raises(TypeError):
@@ -311,7 +311,7 @@ def test_diagnostic_summary_rejects_infinite_values_and_unknown_diagnostics():
     with pytest.raises(ValueError, match="infinite"):
         plots.diagnostic_summary(df.assign(value=np.inf))
     with pytest.raises(ValueError, match="not in results"):
-        plots.diagnostic_summary(df, "entropy")
+        plots.diagnostic_summary(df, diagnostic="entropy")
 
 
 @pytest.mark.parametrize("diagnostic", ["lyapunov", "recurrence_rate", "autocorrelation"])
@@ -325,7 +325,7 @@ def test_diagnostic_vs_radius_draws_three_systems_with_both_bars(diagnostic):
     assert any("std/10" in lab for lab in labels) and any("√n_valid" in lab for lab in labels)
     # first container of a system: the paper's bar (2 std/10 long), then the standard error
     # (2 std/sqrt(n_valid) long), both at the smallest radius first
-    summary = plots.diagnostic_summary(make_results(), diagnostic)
+    summary = plots.diagnostic_summary(make_results(), diagnostic=diagnostic)
     row = summary[summary["system"] == "two_particle"].sort_values("radius").iloc[0]
     paper, sem = ax.containers[0], ax.containers[1]
     seg_p = paper.lines[2][0].get_segments()[0]

@@ -23,28 +23,33 @@ from kicktimes.stats import poisson_rule, poisson_verdict, ratio_verdict, reject
 ])
 def test_the_verdict_needs_both_a_calibrated_rejection_and_an_effect(reject, dispersion,
                                                                      expected):
-    assert poisson_verdict(*reject, 0.05, *dispersion) == expected
+    low, high = dispersion
+    assert poisson_verdict(*reject, null_level=0.05, dispersion_low=low,
+                           dispersion_high=high) == expected
 
 
 def test_the_verdict_is_symmetric_with_the_ratio_rule():
     # the dispersion index is read with the band of every ratio: 0.921 [0.915, 0.926]
     # is "within 10 %" as a ratio, so as D it is Poisson within 10 % at a nominal share
     assert ratio_verdict(0.915, 0.926) == "within 10 %"
-    assert poisson_verdict(0.04, 0.06, 0.05, 0.915, 0.926) == "Poisson within 10 %"
+    assert poisson_verdict(0.04, 0.06, null_level=0.05, dispersion_low=0.915,
+                           dispersion_high=0.926) == "Poisson within 10 %"
     # and D = 1.08 [1.03, 1.13] is not "not Poisson"
-    assert poisson_verdict(0.3, 0.4, 0.05, 1.03, 1.13) == "inconclusive"
+    assert poisson_verdict(0.3, 0.4, null_level=0.05, dispersion_low=1.03,
+                           dispersion_high=1.13) == "inconclusive"
 
 
 def test_the_rejection_is_read_against_the_calibrated_level_not_alpha():
     # a test whose null streams reject 8 % (not nominal): 10 % of runs is at that level
-    assert rejection_verdict(0.09, 0.11, 0.05) == "above nominal"
-    assert poisson_verdict(0.09, 0.11, 0.08, 0.95, 1.05) == "Poisson within 10 %"
+    assert rejection_verdict(0.09, 0.11, alpha=0.05) == "above nominal"
+    assert poisson_verdict(0.09, 0.11, null_level=0.08, dispersion_low=0.95,
+                           dispersion_high=1.05) == "Poisson within 10 %"
 
 
 def test_every_combination_gives_one_of_four_verdicts_and_the_rule_names_them():
     values = [0.0, 0.03, 0.05, 0.07, 0.1, 0.2, np.nan]
     d = [0.5, 0.89, 0.95, 1.05, 1.11, 1.5]
-    seen = {poisson_verdict(lo, hi, 0.05, dlo, dhi)
+    seen = {poisson_verdict(lo, hi, null_level=0.05, dispersion_low=dlo, dispersion_high=dhi)
             for lo, hi in itertools.combinations(values, 2)
             for dlo, dhi in itertools.combinations(d, 2)}
     assert seen == {"not Poisson", "not Poisson, D within 10 %", "Poisson within 10 %",

@@ -33,7 +33,7 @@ SHORT_TIMES = hs.one_of(hs.floats(0.5, 30.0), WEIRD_FLOATS)
 
 @pytest.fixture(scope="module", autouse=True)
 def _compiled():
-    ic = initial_conditions(1, 0.05, seed=0)[0]
+    ic = initial_conditions(1, 0.05, rng=0)[0]
     simulate_two_particle(ic, 0.05, t_max=1.0)
     simulate_one_particle(ic[0], 0.05, n_steps=3, tau=0.1, kicks=[0.1], sampling="paper")
 
@@ -99,7 +99,7 @@ def _check_run(run, r):
        rule=hs.sampled_from(["mirror", "elastic"]))
 def test_initial_conditions_are_valid_or_refused(n, r_max, seed, method, rule):
     try:
-        ics = initial_conditions(n, r_max, seed=seed, method=method, rule=rule)
+        ics = initial_conditions(n, r_max, rng=seed, method=method, rule=rule)
     except (ValueError, TypeError) as exc:
         _names_an_argument(exc, ["n", "r_max"])
         return
@@ -190,7 +190,7 @@ def test_schedules_sample_sorted_times_in_the_window_or_name_the_argument(kind, 
             sched = schedules.Bootstrap([param, 1.0])
         else:
             sched = schedules.Replay([param, 1.0], window=param + 2.0)
-        times = sched.sample(t_max, seed)
+        times = sched.sample(t_max, rng=seed)
     except (ValueError, TypeError) as exc:
         _names_an_argument(exc, ["rate", "intervals", "times", "t_max", "window", "max_kicks"])
         return
@@ -201,7 +201,7 @@ def test_schedules_sample_sorted_times_in_the_window_or_name_the_argument(kind, 
 @settings(max_examples=15, deadline=4000, derandomize=True)
 @given(seed=hs.integers(0, 1000), particle=hs.sampled_from([None, 0, 1]))
 def test_run_objects_give_finite_angles_and_a_consistent_boundary_table(seed, particle):
-    ic = initial_conditions(1, 0.05, seed=seed)[0]
+    ic = initial_conditions(1, 0.05, rng=seed)[0]
     run = simulate_two_particle(ic, 0.05, t_max=20.0)
     theta = run.theta(particle)
     assert np.isfinite(theta).all() and (np.abs(theta) <= math.pi / 2).all()

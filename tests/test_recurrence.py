@@ -98,14 +98,14 @@ def test_recurrence_rate_equals_brute_force(name, eps, theiler):
     for d in range(1, theiler):  # the Theiler band |i - j| < w, both sides
         count -= 2 * int(np.diagonal(recurrent, d).sum())
     expected = (count + n) / n**2 if theiler == 0 else count / ((n - theiler) * (n - theiler + 1))
-    assert recurrence_rate(pts, eps, theiler=theiler) == expected
+    assert recurrence_rate(pts, eps=eps, theiler=theiler) == expected
 
 
 @pytest.mark.parametrize("name", sorted(POINT_SETS))
 @pytest.mark.parametrize("theiler", [0, 3])
 def test_recurrence_pairs_equal_brute_force_pair_set_in_sorted_order(name, theiler):
     pts = POINT_SETS[name][:1500]
-    i, j = recurrence_pairs(pts, 0.02, theiler=theiler)
+    i, j = recurrence_pairs(pts, eps=0.02, theiler=theiler)
     bi, bj = np.nonzero(brute_matrix(pts, 0.02, theiler))  # row-major: sorted by (i, j)
     assert i.dtype == np.int64 and j.dtype == np.int64
     assert_array_equal(i, bi)
@@ -114,13 +114,13 @@ def test_recurrence_pairs_equal_brute_force_pair_set_in_sorted_order(name, theil
 
 def test_pair_count_over_n_squared_is_the_recurrence_rate():
     pts = POINT_SETS["clustered"]
-    i, _ = recurrence_pairs(pts, 0.01)
-    assert i.size / len(pts) ** 2 == recurrence_rate(pts, 0.01)
+    i, _ = recurrence_pairs(pts, eps=0.01)
+    assert i.size / len(pts) ** 2 == recurrence_rate(pts, eps=0.01)
 
 
 def test_recurrence_plot_is_symmetric_and_contains_the_diagonal():
     pts = POINT_SETS["trajectory"]
-    i, j = recurrence_pairs(pts, 0.05)
+    i, j = recurrence_pairs(pts, eps=0.05)
     pairs = set(zip(i.tolist(), j.tolist(), strict=True))
     assert all((b, a) in pairs for a, b in pairs)
     assert all((a, a) in pairs for a in range(len(pts)))
@@ -128,8 +128,8 @@ def test_recurrence_plot_is_symmetric_and_contains_the_diagonal():
 
 def test_theiler_window_of_one_removes_exactly_the_diagonal():
     pts = POINT_SETS["uniform"]
-    i, j = recurrence_pairs(pts, 0.05, theiler=1)
-    i0, j0 = recurrence_pairs(pts, 0.05)
+    i, j = recurrence_pairs(pts, eps=0.05, theiler=1)
+    i0, j0 = recurrence_pairs(pts, eps=0.05)
     assert not np.any(i == j)
     assert i.size == i0.size - len(pts)
 
@@ -137,9 +137,9 @@ def test_theiler_window_of_one_removes_exactly_the_diagonal():
 def test_theiler_normalisation_counts_admissible_pairs_only():
     # three coincident points: every admissible entry is a recurrence, so RR = 1
     pts = np.zeros((3, 2))
-    assert recurrence_rate(pts, 0.1) == 1.0
-    assert recurrence_rate(pts, 0.1, theiler=1) == 1.0  # 6 of 6 off-diagonal entries
-    assert recurrence_rate(pts, 0.1, theiler=2) == 1.0  # (0, 2) and (2, 0) only
+    assert recurrence_rate(pts, eps=0.1) == 1.0
+    assert recurrence_rate(pts, eps=0.1, theiler=1) == 1.0  # 6 of 6 off-diagonal entries
+    assert recurrence_rate(pts, eps=0.1, theiler=2) == 1.0  # (0, 2) and (2, 0) only
 
 
 @pytest.mark.parametrize("eps", [5e-324, 1e-320, 1e-200, 1.4e-154])
@@ -158,15 +158,15 @@ def test_the_smallest_threshold_counts_exactly():
 def test_points_exactly_eps_apart_are_recurrent():
     # 0.25 and its squares are exact in binary: the tie |x_i - x_j| = eps counts
     pts = np.array([[0.0, 0.0], [0.25, 0.0], [0.25, 0.25], [0.75, 0.25]])
-    assert recurrence_rate(pts, 0.25) * 16 == 4 + 2 * 2
-    assert recurrence_rate(pts, np.nextafter(0.25, 0.0)) * 16 == 4
+    assert recurrence_rate(pts, eps=0.25) * 16 == 4 + 2 * 2
+    assert recurrence_rate(pts, eps=np.nextafter(0.25, 0.0)) * 16 == 4
 
 
 def test_lattice_with_spacing_eps_matches_brute_force():
     # many near-ties: spacing eps in float arithmetic lands on both sides of eps
     g = np.arange(40) * 1e-3
     pts = np.column_stack([np.repeat(g, 40), np.tile(g, 40)]) + 0.123
-    assert recurrence_rate(pts, 1e-3) == brute_rate(pts, 1e-3)
+    assert recurrence_rate(pts, eps=1e-3) == brute_rate(pts, 1e-3)
 
 
 def test_pairs_almost_exactly_eps_apart_are_found_wherever_they_sit():
@@ -187,29 +187,29 @@ def test_pairs_almost_exactly_eps_apart_are_found_wherever_they_sit():
     assert 5000 < recurrent < 10_000  # both sides of the tie occur
     pts = np.concatenate([base, partner])
     n = len(pts)
-    assert recurrence_rate(pts, eps) == (n + 2 * recurrent) / n**2
+    assert recurrence_rate(pts, eps=eps) == (n + 2 * recurrent) / n**2
 
 
 def test_rate_includes_the_diagonal_so_is_at_least_one_over_n():
     pts = POINT_SETS["uniform"]
     n = len(pts)
-    assert recurrence_rate(pts, 1e-9) == 1.0 / n  # no two points that close
+    assert recurrence_rate(pts, eps=1e-9) == 1.0 / n  # no two points that close
     for eps in (1e-4, 1e-3, 1e-2):
-        assert recurrence_rate(pts, eps) >= 1.0 / n
+        assert recurrence_rate(pts, eps=eps) >= 1.0 / n
 
 
 def test_duplicated_points_all_recur():
     pts = np.repeat(POINT_SETS["uniform"][:50], 4, axis=0)
-    assert recurrence_rate(pts, 1e-12) == 4 / len(pts)  # each point has 4 copies
+    assert recurrence_rate(pts, eps=1e-12) == 4 / len(pts)  # each point has 4 copies
 
 
 def test_single_point_has_rate_one():
-    assert recurrence_rate(np.array([[0.1, 0.2]]), 1e-3) == 1.0
+    assert recurrence_rate(np.array([[0.1, 0.2]]), eps=1e-3) == 1.0
 
 
 def test_rate_grows_with_eps_and_reaches_one():
     pts = POINT_SETS["trajectory"]
-    rates = recurrence_rate(pts, np.array([1e-3, 1e-2, 0.1, 1.0, 2.0]))
+    rates = recurrence_rate(pts, eps=np.array([1e-3, 1e-2, 0.1, 1.0, 2.0]))
     assert np.all(np.diff(rates) > 0)
     assert rates[-1] == 1.0  # the diameter of the table is 2
 
@@ -217,13 +217,13 @@ def test_rate_grows_with_eps_and_reaches_one():
 def test_array_of_eps_gives_the_scalar_values():
     pts = POINT_SETS["clustered"]
     eps = [1e-3, 0.02, 0.2]
-    assert_array_equal(recurrence_rate(pts, eps), [recurrence_rate(pts, e) for e in eps])
+    assert_array_equal(recurrence_rate(pts, eps=eps), [recurrence_rate(pts, eps=e) for e in eps])
 
 
 def test_rate_does_not_depend_on_the_order_of_points():
     pts = POINT_SETS["clustered"]
     perm = np.random.default_rng(0).permutation(len(pts))
-    assert recurrence_rate(pts[perm], 0.01) == recurrence_rate(pts, 0.01)
+    assert recurrence_rate(pts[perm], eps=0.01) == recurrence_rate(pts, eps=0.01)
 
 
 def test_tiny_eps_on_a_large_extent_uses_coarse_cells_exactly():
@@ -231,24 +231,24 @@ def test_tiny_eps_on_a_large_extent_uses_coarse_cells_exactly():
     rng = np.random.default_rng(5)
     base = rng.uniform(0.0, 1e6, (300, 2))
     pts = np.concatenate([base, base + rng.normal(0.0, 1e-3, base.shape), [[0.0, 0.0]]])
-    assert recurrence_rate(pts, 1e-3) == brute_rate(pts, 1e-3)
-    assert recurrence_rate(pts, 1e-3) > 1.0 / len(pts)
+    assert recurrence_rate(pts, eps=1e-3) == brute_rate(pts, 1e-3)
+    assert recurrence_rate(pts, eps=1e-3) > 1.0 / len(pts)
 
 
 def test_strided_integer_and_run_inputs_are_accepted():
     pts = POINT_SETS["uniform"][:1000]
-    ref = recurrence_rate(pts, 0.03)
-    assert recurrence_rate(np.asfortranarray(pts), 0.03) == ref
-    assert recurrence_rate(np.hstack([pts, pts])[:, :2], 0.03) == ref  # strided view
-    assert recurrence_rate(types.SimpleNamespace(samples=pts), 0.03) == ref
+    ref = recurrence_rate(pts, eps=0.03)
+    assert recurrence_rate(np.asfortranarray(pts), eps=0.03) == ref
+    assert recurrence_rate(np.hstack([pts, pts])[:, :2], eps=0.03) == ref  # strided view
+    assert recurrence_rate(types.SimpleNamespace(samples=pts), eps=0.03) == ref
     grid = np.array([[0, 0], [1, 0], [5, 5]])
-    assert recurrence_rate(grid, 1.0) * 9 == 5
+    assert recurrence_rate(grid, eps=1.0) * 9 == 5
 
 
 def test_run_records_are_read_through_their_samples():
     import kicktimes as kt
 
-    ic = kt.initial_conditions(1, 0.03, seed=3)[0]
+    ic = kt.initial_conditions(1, 0.03, rng=3)[0]
     run = kt.simulate_two_particle(ic, 0.03, n_steps=5000, tau=0.2)
     n = len(run.samples)
     assert recurrence_rate(run) == recurrence_rate(run.samples) >= 1.0 / n
@@ -261,7 +261,7 @@ def test_count_agrees_with_scipy_kdtree_at_larger_n(name):
     tree = cKDTree(pts)
     for eps in (1e-3, 1e-2):
         ordered = tree.count_neighbors(tree, eps)  # ordered pairs, diagonal included
-        assert recurrence_rate(pts, eps) == ordered / len(pts) ** 2
+        assert recurrence_rate(pts, eps=eps) == ordered / len(pts) ** 2
 
 
 @settings(max_examples=150, deadline=None)
@@ -280,8 +280,8 @@ def test_count_agrees_with_scipy_kdtree_at_larger_n(name):
 def test_property_rate_and_pairs_equal_brute_force(data, eps, theiler):
     pts = np.array(data, dtype=float)
     theiler = min(theiler, len(pts) - 1)
-    assert recurrence_rate(pts, eps, theiler=theiler) == brute_rate(pts, eps, theiler)
-    i, j = recurrence_pairs(pts, eps, theiler=theiler)
+    assert recurrence_rate(pts, eps=eps, theiler=theiler) == brute_rate(pts, eps, theiler)
+    i, j = recurrence_pairs(pts, eps=eps, theiler=theiler)
     bi, bj = np.nonzero(brute_matrix(pts, eps, theiler))
     assert_array_equal(i, bi)
     assert_array_equal(j, bj)
@@ -302,9 +302,9 @@ def test_property_rate_and_pairs_equal_brute_force(data, eps, theiler):
 )
 def test_bad_points_raise_value_error(points, match):
     with pytest.raises(ValueError, match=match):
-        recurrence_rate(points, 1e-3)
+        recurrence_rate(points, eps=1e-3)
     with pytest.raises(ValueError, match=match):
-        recurrence_pairs(points, 1e-3)
+        recurrence_pairs(points, eps=1e-3)
 
 
 @pytest.mark.parametrize(
@@ -321,32 +321,32 @@ def test_points_spreading_beyond_the_float_range_raise_value_error(points):
     match = r"points: the coordinates must span at most 1e\+150 in x and in y"
     for fun in (recurrence_rate, recurrence_pairs):
         with pytest.raises(ValueError, match=match):
-            fun(points, 1e-3)
+            fun(points, eps=1e-3)
 
 
 def test_points_spreading_up_to_the_bound_are_counted_exactly():
     pts = np.array([[0.0, 0.0], [1e-4, 0.0], [1e150, 0.0], [1e150, 1e-4], [0.0, 1e150]])
-    assert recurrence_rate(pts, 1e-3) == (5 + 2 * 2) / 25
-    assert recurrence_rate(pts, 1e300) == 1.0  # eps**2 = inf: every (finite) d**2 is below
+    assert recurrence_rate(pts, eps=1e-3) == (5 + 2 * 2) / 25
+    assert recurrence_rate(pts, eps=1e300) == 1.0  # eps**2 = inf: every (finite) d**2 is below
 
 
 def test_non_numeric_points_raise_type_error():
     with pytest.raises(TypeError, match="points"):
-        recurrence_rate(np.array([["a", "b"]]), 1e-3)
+        recurrence_rate(np.array([["a", "b"]]), eps=1e-3)
 
 
 @pytest.mark.parametrize("eps", [0.0, -1e-3, np.nan, np.inf])
 def test_bad_eps_raises_value_error(eps):
     with pytest.raises(ValueError, match="eps: must be positive and finite"):
-        recurrence_rate(np.zeros((3, 2)), eps)
+        recurrence_rate(np.zeros((3, 2)), eps=eps)
     with pytest.raises(ValueError, match="eps"):
-        recurrence_rate(np.zeros((3, 2)), [1e-3, eps])
+        recurrence_rate(np.zeros((3, 2)), eps=[1e-3, eps])
 
 
 @pytest.mark.parametrize("eps", ["0.1", None, True])
 def test_non_numeric_eps_raises_type_error(eps):
     with pytest.raises(TypeError, match="eps"):
-        recurrence_pairs(np.zeros((3, 2)), eps)
+        recurrence_pairs(np.zeros((3, 2)), eps=eps)
 
 
 @pytest.mark.parametrize(
@@ -360,9 +360,9 @@ def test_non_numeric_eps_raises_type_error(eps):
 )
 def test_bad_theiler_raises(theiler, error, match):
     with pytest.raises(error, match=match):
-        recurrence_rate(np.zeros((3, 2)), 0.1, theiler=theiler)
+        recurrence_rate(np.zeros((3, 2)), eps=0.1, theiler=theiler)
     with pytest.raises(error, match=match):
-        recurrence_pairs(np.zeros((3, 2)), 0.1, theiler=theiler)
+        recurrence_pairs(np.zeros((3, 2)), eps=0.1, theiler=theiler)
 
 
 # ------------------------------------------------------------------ paper scale
@@ -372,4 +372,4 @@ def test_bad_theiler_raises(theiler, error, match):
 def test_paper_scale_count_agrees_with_kdtree():
     pts = uniform_disk(1_000_000, seed=8)
     tree = cKDTree(pts)
-    assert recurrence_rate(pts, 1e-3) == tree.count_neighbors(tree, 1e-3) / len(pts) ** 2
+    assert recurrence_rate(pts, eps=1e-3) == tree.count_neighbors(tree, 1e-3) / len(pts) ** 2

@@ -110,8 +110,8 @@ def test_ratio_verdict_follows_the_printed_rule():
 
 def test_share_verdict_and_clopper_pearson():
     low, high = clopper_pearson(30, 100)
-    assert low < 0.3 < high and share_verdict(low, high, 0.05) == "above"
-    assert share_verdict(*clopper_pearson(5, 100), 0.05) == "inconclusive"
+    assert low < 0.3 < high and share_verdict(low, high, level=0.05) == "above"
+    assert share_verdict(*clopper_pearson(5, 100), level=0.05) == "inconclusive"
     assert clopper_pearson(0, 10)[0] == 0.0 and clopper_pearson(10, 10)[1] == 1.0
 
 
@@ -360,7 +360,7 @@ def test_acf_intervals_are_95_percent_t_intervals_and_crossings_are_found():
 def test_lag1_figure_draws_95_percent_intervals(ctx):
     (sec,) = ctx.sections["autocorrelation"]
     ax, ax_ratio = sec.figures[0][1].axes
-    part = summary.diagnostic_summary(ctx.results, "autocorrelation")
+    part = summary.diagnostic_summary(ctx.results, diagnostic="autocorrelation")
     two = part[part["system"] == "two_particle"].sort_values("radius")
     bars = ax.containers[0].lines[2][0].get_segments()
     half = [(seg[1][1] - seg[0][1]) / 2 for seg in bars]

@@ -60,18 +60,21 @@ def test_every_verdict_is_the_one_its_interval_gives(path):
         base = kind.removesuffix("_excess")
         if kind == "reject":
             level = null.get((data, test), 0.05)
-            assert row.verdict == rejection_verdict(row.ci_low, row.ci_high, level), row
+            assert row.verdict == rejection_verdict(row.ci_low, row.ci_high, alpha=level), row
         elif base in margins:
             excess = rows[(rows["diagnostic"] == f"{base}_excess")
                           & (rows["control"] == row.control)].iloc[0]
             assert row.verdict == null_verdict(excess.ci_low, excess.ci_high,
-                                               margins[base]), row
+                                               margin=margins[base]), row
         else:
             assert kind == "poisson", row
             d = rows[(rows["diagnostic"] == "dispersion_index_excess")
                      & (rows["control"] == row.control)].iloc[0]
-            assert row.verdict == poisson_verdict(row.ci_low, row.ci_high, null[data, test],
-                                                  d.ci_low, d.ci_high, against_null=True), row
+            assert row.verdict == poisson_verdict(row.ci_low, row.ci_high,
+                                                  null_level=null[data, test],
+                                                  dispersion_low=d.ci_low,
+                                                  dispersion_high=d.ci_high,
+                                                  against_null=True), row
 
 
 @pytest.mark.parametrize("path", FAMILIES, ids=[t.name for t in FAMILIES])

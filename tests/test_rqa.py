@@ -60,10 +60,10 @@ def brute_rqa(points: np.ndarray, eps: float, theiler: int, l_min: int) -> dict:
 
 
 def assert_matches_brute_force(points, eps, theiler, l_min):
-    res = rqa(points, eps, theiler=theiler, l_min=l_min)
+    res = rqa(points, eps=eps, theiler=theiler, l_min=l_min)
     ref = brute_rqa(np.asarray(points, dtype=float), eps, theiler, l_min)
     # without laminarity only the upper triangle is built: the same diagonal measures
-    half = rqa(points, eps, theiler=theiler, l_min=l_min, laminarity=False)
+    half = rqa(points, eps=eps, theiler=theiler, l_min=l_min, laminarity=False)
     assert half.lam is None and half.tt is None and half.v_max is None
     full, part = res.to_dict(), half.to_dict()
     for key in set(full) - {"lam", "tt", "v_max", "undefined"}:
@@ -119,16 +119,16 @@ def test_dense_and_sparse_cell_grids_give_the_same_line_statistics(name, eps, mo
     if name == "paper_samples":
         from kicktimes import initial_conditions, simulate_two_particle
 
-        ic = initial_conditions(1, 0.02, seed=4, method="paper")[0]
+        ic = initial_conditions(1, 0.02, rng=4, method="paper")[0]
         pts = simulate_two_particle(ic, 0.01, n_steps=3000, tau=0.3, sampling="paper").samples
     else:
         pts = POINT_SETS[name]
     eps_list = [eps, eps / 3]
     monkeypatch.setattr(recurrence, "_DENSE_CELLS_MIN", 2**62)
-    dense = rqa(pts, eps_list, theiler=1, laminarity=False)
+    dense = rqa(pts, eps=eps_list, theiler=1, laminarity=False)
     monkeypatch.setattr(recurrence, "_DENSE_CELLS_PER_POINT", 0)
     monkeypatch.setattr(recurrence, "_DENSE_CELLS_MIN", 0)
-    sparse = rqa(pts, eps_list, theiler=1, laminarity=False)
+    sparse = rqa(pts, eps=eps_list, theiler=1, laminarity=False)
     assert dense == sparse
     assert dense[0].n_recurrent > 0  # there is something to count
 
@@ -161,7 +161,7 @@ def test_many_batches_of_pairs_equal_the_definition(theiler, l_min):
 
     pts = trajectory(900, seed=3, tau=0.02)
     eps = [0.15, 0.05]
-    res = rqa(pts, eps, theiler=theiler, l_min=l_min)
+    res = rqa(pts, eps=eps, theiler=theiler, l_min=l_min)
     assert res[0].n_recurrent / 2 > 6 * _recurrence_kernels._BATCH
     for e, got in zip(eps, res, strict=True):
         ref = brute_rqa(pts, e, theiler, l_min)
@@ -183,7 +183,7 @@ def test_a_point_with_more_candidates_than_the_buffer(grid, monkeypatch):
         monkeypatch.setattr(recurrence, "_DENSE_CELLS_MIN", 0)
     assert n > 2 * _recurrence_kernels._BATCH
     for l_min in (1, 2, 3):
-        res = rqa(pts, 1e-3, theiler=1, l_min=l_min)
+        res = rqa(pts, eps=1e-3, theiler=1, l_min=l_min)
         assert res.n_recurrent == n * (n - 1)
         assert res.n_lines == 2 * (n - l_min)  # diagonals d = 1 .. n - l_min, both sides
         on_lines = 2 * sum(n - d for d in range(1, n - l_min + 1))
@@ -193,7 +193,7 @@ def test_a_point_with_more_candidates_than_the_buffer(grid, monkeypatch):
         runs = [v for j in range(n) for v in (j, n - 1 - j) if v >= l_min]
         assert res.lam == sum(runs) / (n * (n - 1)) and res.v_max == n - 1
         assert res.tt == sum(runs) / len(runs)
-    res0 = rqa(pts, 1e-3, theiler=0)  # with the diagonal: every column is one run of n
+    res0 = rqa(pts, eps=1e-3, theiler=0)  # with the diagonal: every column is one run of n
     assert (res0.lam, res0.tt, res0.v_max) == (1.0, n, n)
 
 
@@ -221,24 +221,24 @@ def test_several_thresholds_in_one_sweep_equal_one_call_each(laminarity):
     pts = trajectory(1500, seed=9)
     eps = [0.01, 0.2, 0.001, 0.05]  # any order; the sweep runs at the largest
     for w in (0, 1, 3):
-        many = rqa(pts, eps, theiler=w, laminarity=laminarity)
+        many = rqa(pts, eps=eps, theiler=w, laminarity=laminarity)
         assert isinstance(many, tuple) and len(many) == 4
         for e, res in zip(eps, many, strict=True):
-            one = rqa(pts, e, theiler=w, laminarity=laminarity)
+            one = rqa(pts, eps=e, theiler=w, laminarity=laminarity)
             assert res.eps == e
             for key, value in one.to_dict().items():
                 np.testing.assert_equal(res.to_dict()[key], value, err_msg=key)
-    assert rqa(pts, np.array([0.01]))[0].eps == 0.01
+    assert rqa(pts, eps=np.array([0.01]))[0].eps == 0.01
     with pytest.raises(ValueError, match="eps"):
-        rqa(pts, [])
+        rqa(pts, eps=[])
     with pytest.raises(ValueError, match="eps"):
-        rqa(pts, [0.01, -1.0])
+        rqa(pts, eps=[0.01, -1.0])
 
 
 def test_rr_is_the_recurrence_rate_with_the_same_theiler_window():
     pts = trajectory(2000, seed=5)
     for w in (0, 1, 4):
-        assert rqa(pts, 0.02, theiler=w).rr == recurrence_rate(pts, 0.02, theiler=w)
+        assert rqa(pts, eps=0.02, theiler=w).rr == recurrence_rate(pts, eps=0.02, theiler=w)
 
 
 def test_off_diagonal_rate_is_n_rr_minus_one_over_n_minus_one():
@@ -246,11 +246,11 @@ def test_off_diagonal_rate_is_n_rr_minus_one_over_n_minus_one():
     pts = trajectory(3000, seed=6, tau=0.2)
     n = len(pts)
     for eps in (1e-3, 1e-2):
-        rr = recurrence_rate(pts, eps)
-        off = recurrence_rate(pts, eps, theiler=1)
+        rr = recurrence_rate(pts, eps=eps)
+        off = recurrence_rate(pts, eps=eps, theiler=1)
         assert off > 0
         assert n * rr - 1 == pytest.approx((n - 1) * off, rel=1e-12)
-        assert rqa(pts, eps).rr == off
+        assert rqa(pts, eps=eps).rr == off
 
 
 # ------------------------------------------------------------------ meaning
@@ -260,7 +260,7 @@ def test_a_repeated_segment_is_one_diagonal_line_on_each_side():
     seg = np.column_stack([np.linspace(0, 0.9, 10), np.zeros(10)])
     far = np.array([[0.0, 0.9], [0.3, 0.9], [0.6, 0.9]])
     pts = np.vstack([seg, far, seg])  # samples 0..9 recur as 13..22
-    res = rqa(pts, 1e-3)
+    res = rqa(pts, eps=1e-3)
     assert res.n_recurrent == 20
     assert (res.det, res.l_mean, res.l_max, res.n_lines) == (1.0, 10.0, 10, 2)
     assert res.lam == 0.0 and np.isnan(res.tt) and res.v_max == 1
@@ -268,14 +268,14 @@ def test_a_repeated_segment_is_one_diagonal_line_on_each_side():
 
 def test_isolated_recurrences_have_zero_determinism():
     pts = np.array([[0.0, 0.0], [0.5, 0.0], [0.0, 0.9], [0.0, 0.0]])
-    res = rqa(pts, 1e-3)
+    res = rqa(pts, eps=1e-3)
     assert res.n_recurrent == 2 and res.det == 0.0 and res.l_max == 1
     assert np.isnan(res.l_mean) and "l_mean" in res.undefined
 
 
 def test_a_point_at_rest_is_one_vertical_block():
     pts = np.zeros((6, 2))
-    res = rqa(pts, 1e-3, theiler=0)
+    res = rqa(pts, eps=1e-3, theiler=0)
     assert res.rr == 1.0 and res.lam == 1.0 and res.tt == 6.0 and res.v_max == 6
     # the main diagonal counts for theiler = 0; the corners (0, 5), (5, 0) are lines of 1
     assert res.l_max == 6 and res.det == 34 / 36 and res.n_lines == 9
@@ -283,7 +283,7 @@ def test_a_point_at_rest_is_one_vertical_block():
 
 def test_no_recurrence_gives_nan_with_reasons():
     pts = np.array([[0.0, 0.0], [0.5, 0.0], [0.0, 0.5]])
-    res = rqa(pts, 1e-3)
+    res = rqa(pts, eps=1e-3)
     assert res.n_recurrent == 0 and res.rr == 0.0 and res.l_max == 0 and res.v_max == 0
     assert np.isnan(res.det) and np.isnan(res.lam)
     assert "no recurrent pair" in res.undefined["det"]
@@ -292,8 +292,8 @@ def test_no_recurrence_gives_nan_with_reasons():
 
 def test_theiler_window_removes_the_lines_along_the_trajectory():
     pts = trajectory(1000, seed=2, tau=0.002)  # consecutive samples recur: long lines
-    near = rqa(pts, 0.01, theiler=1)
-    far = rqa(pts, 0.01, theiler=5)
+    near = rqa(pts, eps=0.01, theiler=1)
+    far = rqa(pts, eps=0.01, theiler=5)
     assert near.l_max > 900 and far.l_max < near.l_max
     assert near.det > far.det
 
@@ -322,6 +322,6 @@ def test_bad_arguments_raise(kwargs, error, match):
 
 def test_bad_points_raise():
     with pytest.raises(ValueError, match="points"):
-        rqa(np.zeros((4, 3)), 1e-3)
+        rqa(np.zeros((4, 3)), eps=1e-3)
     with pytest.raises(ValueError, match="finite"):
-        rqa(np.array([[0.0, np.nan], [0.0, 0.0]]), 1e-3)
+        rqa(np.array([[0.0, np.nan], [0.0, 0.0]]), eps=1e-3)

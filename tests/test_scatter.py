@@ -82,7 +82,7 @@ def test_elastic_partner_has_the_energy_left_by_the_disk():
 def _two_disk_collisions(rule):
     # invariant ICs, so every logged collision is drawn from the collision measure;
     # disk 0 only (the two disks of one collision are not independent)
-    ics = initial_conditions(30, R_LAW, seed=5, method="uniform", rule=rule)
+    ics = initial_conditions(30, R_LAW, rng=5, method="uniform", rule=rule)
     v, w = [], []
     for ic in ics:
         c = simulate_two_particle(ic, R_LAW, t_max=3000.0, rule=rule, log_collisions=True)
@@ -107,7 +107,7 @@ def law_samples(request):
 
 def test_collision_log_is_a_contact_and_the_rule_applied_to_its_normal(law_samples):
     rule, _ = law_samples
-    ic = initial_conditions(1, R_LAW, seed=5, method="uniform", rule=rule)[0]
+    ic = initial_conditions(1, R_LAW, rng=5, method="uniform", rule=rule)[0]
     c = simulate_two_particle(ic, R_LAW, t_max=2000.0, rule=rule, log_collisions=True).collisions
     assert len(c) > 20
     gap = np.hypot(c.x1 - c.x0, c.y1 - c.y0)

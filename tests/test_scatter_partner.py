@@ -106,7 +106,7 @@ def test_the_run_records_its_partner_and_a_file_keeps_it(tmp_path):
 
 def test_elastic_kicks_with_masses_reproduce_the_collision_law_of_unequal_disks():
     radii, masses = (0.02, 0.04), (1.0, 3.0)
-    ics = initial_conditions(30, radii, seed=5, method="uniform", rule="elastic",
+    ics = initial_conditions(30, radii, rng=5, method="uniform", rule="elastic",
                              masses=masses)
     v2, w2 = [], []
     for ic in ics:

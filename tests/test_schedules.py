@@ -33,7 +33,7 @@ def first_kicks(schedule, n, t_max=60.0, seed=0):
     first = np.empty(n)
     counts = np.empty((n, 2))
     for i in range(n):
-        times = schedule.sample(t_max, rng)
+        times = schedule.sample(t_max, rng=rng)
         first[i] = times[0]
         counts[i] = np.searchsorted(times, [0.5, 5.0], side="right")
     return first, counts
@@ -657,7 +657,7 @@ def test_poisson_with_a_subnormal_rate_has_no_kick_and_no_overflow_warning():
 
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        times = Poisson(1e-310).sample(1e6, np.random.default_rng(0))
+        times = Poisson(1e-310).sample(1e6, rng=np.random.default_rng(0))
     assert times.size == 0 and times.dtype == np.float64
 
 

@@ -141,7 +141,7 @@ def test_the_mmpp_page_s_residual_verdicts_are_their_intervals():
     _page("mmpp.md")
     resid = pd.read_csv(RESULTS / "mmpp" / "mmpp_billiard_residuals.csv")
     for row in resid.itertuples():
-        assert row.verdict == rejection_verdict(row.ci_low, row.ci_high, 0.05)
+        assert row.verdict == rejection_verdict(row.ci_low, row.ci_high, alpha=0.05)
     dip = pd.read_csv(RESULTS / "mmpp" / "mmpp_billiard_dip.csv")
     assert (dip["mmpp"] >= 1.0 - 1e-9).all()   # an MMPP has no refractory dip
 
@@ -226,7 +226,7 @@ def test_the_mechanism_page_reads_the_rate_dispersion_across_ics_against_its_nul
             g = tab[(tab["method"] == method) & (tab["radius"] == r)].set_index("quantity")
             diff, null = g.loc["rate_dispersion_minus_null"], g.loc[
                 "rate_dispersion_poisson_null"]
-            verdict = null_reading(diff["ci_low"], diff["ci_high"], D_MARGIN)
+            verdict = null_reading(diff["ci_low"], diff["ci_high"], margin=D_MARGIN)
             assert f"vs {null['estimate']:.3f}: {verdict}" in cells[1 + k]
 
 

@@ -10,19 +10,19 @@ from kicktimes import stats
 
 
 def test_the_indices_are_the_generators_integers_with_the_identity_first():
-    idx = stats.resample_indices(7, 50, np.random.default_rng(3))
+    idx = stats.resample_indices(7, n_boot=50, rng=np.random.default_rng(3))
     np.testing.assert_array_equal(idx, np.random.default_rng(3).integers(0, 7, size=(50, 7)))
-    with_id = stats.resample_indices(7, 50, 3, with_identity=True)
+    with_id = stats.resample_indices(7, n_boot=50, rng=3, with_identity=True)
     np.testing.assert_array_equal(with_id[0], np.arange(7))
     np.testing.assert_array_equal(with_id[1:], idx)
     assert idx.min() >= 0 and idx.max() <= 6
 
 
 def test_chunks_draw_the_same_stream_when_chunk_times_n_is_even():
-    whole = stats.resample_indices(6, 25, 1)
-    np.testing.assert_array_equal(stats.resample_indices(6, 25, 1, chunk=4), whole)
+    whole = stats.resample_indices(6, n_boot=25, rng=1)
+    np.testing.assert_array_equal(stats.resample_indices(6, n_boot=25, rng=1, chunk=4), whole)
     # an odd chunk * n splits numpy's pairs of 32-bit draws: chunk is part of the definition
-    one_at_a_time = stats.resample_indices(5, 4, 2, chunk=1)
+    one_at_a_time = stats.resample_indices(5, n_boot=4, rng=2, chunk=1)
     rng = np.random.default_rng(2)
     np.testing.assert_array_equal(one_at_a_time, [rng.integers(0, 5, 5) for _ in range(4)])
 
@@ -87,19 +87,19 @@ def test_bad_arguments_are_refused_naming_them(kwargs, match):
 
 
 def test_the_counts_are_the_generators_multinomial_and_count_like_the_indices():
-    counts = stats.resample_counts(9, 300, 4)
+    counts = stats.resample_counts(9, n_boot=300, rng=4)
     ref = np.random.default_rng(4).multinomial(9, np.full(9, 1 / 9), size=300)
     np.testing.assert_array_equal(counts, ref)
     assert counts.dtype == float and (counts.sum(axis=1) == 9).all()
     # the same law as the indices: each cluster is drawn once per resample on average
     assert abs(counts.mean() - 1.0) < 1e-12
-    idx = stats.resample_indices(9, 300, 5)
+    idx = stats.resample_indices(9, n_boot=300, rng=5)
     assert abs(np.bincount(idx.ravel(), minlength=9).mean() / 300 - 1.0) < 1e-12
 
 
 def test_no_resample_is_an_empty_array_and_draws_nothing():
     rng = np.random.default_rng(8)
-    assert stats.resample_counts(5, 0, rng).shape == (0, 5)
-    assert stats.resample_indices(5, 0, rng).shape == (0, 5)
-    assert stats.resample_indices(5, 0, rng, chunk=2, with_identity=True).shape == (1, 5)
+    assert stats.resample_counts(5, n_boot=0, rng=rng).shape == (0, 5)
+    assert stats.resample_indices(5, n_boot=0, rng=rng).shape == (0, 5)
+    assert stats.resample_indices(5, n_boot=0, rng=rng, chunk=2, with_identity=True).shape == (1, 5)
     assert rng.integers(0, 100) == np.random.default_rng(8).integers(0, 100)

@@ -57,7 +57,7 @@ def test_mean_approach_speeds_are_the_design_values():
     approach = np.maximum(0.0, g[:, 2] - g[:, 0])
     se = approach.std() / math.sqrt(approach.size)
     assert approach.mean() == pytest.approx(4 / (3 * np.pi), abs=5 * se)
-    ratio = stats.kinetic_rate(0.1, "elastic") / stats.kinetic_rate(0.1, "mirror")
+    ratio = stats.kinetic_rate(0.1, rule="elastic") / stats.kinetic_rate(0.1, rule="mirror")
     assert ratio == pytest.approx((4 / (3 * np.pi)) / (4 / np.pi**2), rel=1e-12)
 
 
@@ -107,9 +107,9 @@ def test_kinetic_rate_has_the_small_radius_limit():
 def test_kinetic_rate_accepts_scalars_and_arrays():
     assert isinstance(stats.kinetic_rate(0.01), float)
     grid = np.array([[0.01, 0.02], [0.03, 0.4]])
-    out = stats.kinetic_rate(grid, "elastic")
+    out = stats.kinetic_rate(grid, rule="elastic")
     assert out.shape == grid.shape
-    assert out[0, 1] == pytest.approx(stats.kinetic_rate(0.02, "elastic"))
+    assert out[0, 1] == pytest.approx(stats.kinetic_rate(0.02, rule="elastic"))
 
 
 @pytest.mark.parametrize("bad", [0.0, 0.5, -0.1, 0.7, np.nan, np.inf])

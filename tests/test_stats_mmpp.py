@@ -243,7 +243,7 @@ def run_22():
     state (gaps of 0.022, 0.026 and 0.031 against a mean gap of 27.6)."""
     from kicktimes import initial_conditions, simulate_two_particle
 
-    ic = initial_conditions(60, 0.02, seed=5)[22]
+    ic = initial_conditions(60, 0.02, rng=5)[22]
     return simulate_two_particle(ic, 0.02, t_max=3000.0).pp_times
 
 

@@ -22,7 +22,7 @@ def test_a_missing_value_is_left_out_and_no_perturbation_gives_nan():
 def test_resamples_along_the_last_axis_give_one_value_each():
     rng = np.random.default_rng(1)
     lam, n, t = rng.uniform(0.1, 1, 20), rng.poisson(30, 20).astype(float), np.full(20, 50.0)
-    idx = stats.resample_indices(20, 7, 2, with_identity=True)
+    idx = stats.resample_indices(20, n_boot=7, rng=2, with_identity=True)
     s = stats.stretching_per_perturbation(lam[idx], n[idx], t[idx])
     assert s.shape == (8,)
     assert s[0] == stats.stretching_per_perturbation(lam, n, t)

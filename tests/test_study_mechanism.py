@@ -94,7 +94,7 @@ def test_the_whole_early_hazard_is_read_not_its_first_bin_alone(built):
         null = g[g["quantity"] == f"hazard_nonsticky_bin_{a}_{b}_poisson_null"].iloc[0]
         diff = g[g["quantity"] == "hazard_min_minus_null"].iloc[0]
         assert diff["estimate"] == pytest.approx(low["estimate"] - null["estimate"], abs=1e-5)
-        verdict = null_verdict(diff["ci_low"], diff["ci_high"], analysis.HAZARD_NULL_MARGIN)
+        verdict = null_verdict(diff["ci_low"], diff["ci_high"], margin=analysis.HAZARD_NULL_MARGIN)
         assert f"vs {null['estimate']:.3f}: {verdict}" in low_cells[1 + k]
         lower = [b.note.removeprefix("bin ") for b in bins.itertuples()
                  if ratio_verdict(b.ci_low, b.ci_high) == "lower"]
@@ -174,7 +174,7 @@ def test_each_rate_dispersion_verdict_names_its_poisson_null(built):
             "rate_dispersion_poisson_null"]
         diff = g.loc["rate_dispersion_minus_null"]
         assert diff["estimate"] == pytest.approx(obs["estimate"] - null["estimate"], abs=1e-5)
-        verdict = null_verdict(diff["ci_low"], diff["ci_high"], D_MARGIN)
+        verdict = null_verdict(diff["ci_low"], diff["ci_high"], margin=D_MARGIN)
         assert f"vs {null['estimate']:.3f}: {verdict} (difference " in cells[1 + k]
         assert diff["note"].startswith(verdict)
     # the old name, read against 1, is gone from the page and from the CSV
@@ -255,7 +255,7 @@ def test_an_inconclusive_ratio_names_the_size_that_would_resolve_it():
     # half-width 0.15 at 200 ICs around 1: the CI must shrink into [0.9, 1.1]
     se = 0.3 / (2 * page.Z95)
     assert page.needed_ics(1.0, 0.85, 1.15, 200) == (
-        f"not resolved at this size; needs ≈ {equivalence_sample_size(se, 200, 0.1)} ICs")
+        f"not resolved at this size; needs ≈ {equivalence_sample_size(se, 200, margin=0.1)} ICs")
     # an estimate 0.05 inside the band has half the room: four times the ICs
     n1 = int(page.needed_ics(1.0, 0.9, 1.1, 100).split("≈ ")[1].split()[0])
     n2 = int(page.needed_ics(1.05, 0.95, 1.15, 100).split("≈ ")[1].split()[0])

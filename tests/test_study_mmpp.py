@@ -34,7 +34,7 @@ def test_the_page_names_its_command_and_its_verdicts_are_its_csv(built):
         assert f"| {p.rule} | {p.n_runs} ({p.n_sticky}) | {p.n_events} |" in text
     resid = pd.read_csv(page.parent / "mmpp" / "mmpp_billiard_residuals.csv")
     for row in resid.itertuples():
-        assert row.verdict == rejection_verdict(row.ci_low, row.ci_high, 0.05)
+        assert row.verdict == rejection_verdict(row.ci_low, row.ci_high, alpha=0.05)
     dip = pd.read_csv(page.parent / "mmpp" / "mmpp_billiard_dip.csv")
     assert (dip["mmpp"] >= 1.0 - 1e-9).all()
     # the whole early hazard: its minimum, where it falls, the MMPP's hazard in that bin
@@ -109,10 +109,10 @@ def test_the_residuals_are_read_against_their_calibrated_null(built):
     resid = pd.read_csv(page.parent / "mmpp" / "mmpp_billiard_residuals.csv")
     assert len(nulls) == len(resid)
     for row in nulls.itertuples():
-        assert row.verdict == null_verdict(row.diff_low, row.diff_high, tables.SHARE_MARGIN)
+        assert row.verdict == null_verdict(row.diff_low, row.diff_high, margin=tables.SHARE_MARGIN)
         assert row.diff_low <= row.difference <= row.diff_high
         assert row.difference == pytest.approx(row.share - row.null_share)
-        assert row.null_vs_alpha == rejection_verdict(row.null_ci_low, row.null_ci_high, 0.05)
+        assert row.null_vs_alpha == rejection_verdict(row.null_ci_low, row.null_ci_high, alpha=0.05)
     # the residual table quotes each share with its null share and the verdict against it
     text = page.read_text(encoding="utf-8")
     assert "against α itself" not in text

@@ -84,7 +84,7 @@ def test_the_ratios_over_radii_are_read_at_both_margins_and_name_a_real_deficit(
     assert FINE_MARGIN < 0.1
     for row in over.itertuples():
         assert row.verdict == ratio_verdict(row.ci_low, row.ci_high)
-        assert row.verdict_fine == ratio_verdict(row.ci_low, row.ci_high, FINE_MARGIN)
+        assert row.verdict_fine == ratio_verdict(row.ci_low, row.ci_high, tolerance=FINE_MARGIN)
         assert row.deficit == 1 - row.estimate
     main = over[over["ics"] == "without sticky ICs"].set_index("ratio")
     first = main.loc["scatter kicks / two disks"]

@@ -33,7 +33,7 @@ def _findings(folder, families, radius=0.03):
     for family in families:
         rows = [{"family": family, "diagnostic": d, "system": s, "control": "primary",
                  "estimate": e, "ci_low": e - 0.05, "ci_high": e + 0.05,
-                 "verdict": ratio_verdict(e - 0.05, e + 0.05, margin_of(d))}
+                 "verdict": ratio_verdict(e - 0.05, e + 0.05, tolerance=margin_of(d))}
                 for d in ("ftle", "one_minus_r1")
                 for s, e in (("poisson", 0.3), ("actual", 0.32), ("poisson_scatter", 0.97),
                              ("actual_scatter", 0.9))]
@@ -166,10 +166,10 @@ def test_the_size_an_inconclusive_ratio_needs_is_the_equivalence_sample_size():
     # CI [0.85, 1.15] around 1 at 100 ICs: the whole 0.1 of room to the band's edge
     se = 0.3 / (2 * science_page.Z95)
     assert science_page.needed_ics(1.0, 0.85, 1.15, 100) == (
-        f"not resolved at this size; needs ≈ {equivalence_sample_size(se, 100, 0.1)} ICs")
+        f"not resolved at this size; needs ≈ {equivalence_sample_size(se, 100, margin=0.1)} ICs")
     # an estimate just inside the band's edge has little room: many more ICs
     near = science_page.needed_ics(1.09, 0.94, 1.24, 100)
-    assert int(near.split("≈ ")[1].split()[0]) == equivalence_sample_size(se, 100, 0.01)
+    assert int(near.split("≈ ")[1].split()[0]) == equivalence_sample_size(se, 100, margin=0.01)
     with pytest.raises(ValueError, match="n must be"):
         science_page.needed_ics(1.0, 0.9, 1.1, 0)
 
@@ -212,8 +212,8 @@ def test_an_interval_that_excludes_1_is_a_departure_and_names_no_sample_size():
     assert ratio_reading(0.815, 0.942) == "below 1 by about the margin or less"
     assert ratio_reading(0.913, 1.15) == "inconclusive"
     assert ratio_reading(0.95, 1.04) == "within 10 %" and ratio_reading(1.2, 1.3) == "higher"
-    assert null_reading(0.01, 0.09, 0.05) == "above its null by about the margin or less"
-    assert null_reading(-0.01, 0.09, 0.05) == "inconclusive"
+    assert null_reading(0.01, 0.09, margin=0.05) == "above its null by about the margin or less"
+    assert null_reading(-0.01, 0.09, margin=0.05) == "inconclusive"
     assert side_of(float("nan"), 1.2) is None
     with pytest.raises(ValueError, match="low"):
         side_of(1.2, 1.1)

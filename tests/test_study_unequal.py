@@ -95,13 +95,13 @@ def test_d_is_read_against_its_null_and_the_ks_share_against_its_exact_alpha(bui
     table = read_csv_exact(page.parent / "size_ratio" / "size_ratio.csv")  # exact floats
     for row in table.itertuples():
         assert row.d_verdict == null_verdict(row.d_minus_null_low, row.d_minus_null_high,
-                                             D_MARGIN)
+                                             margin=D_MARGIN)
         assert row.d_minus_null == row.dispersion_index - row.d_null
         assert row.d_null_low <= row.d_null <= row.d_null_high
-        assert row.ks_verdict == rejection_verdict(row.ks_low, row.ks_high, 0.05)
+        assert row.ks_verdict == rejection_verdict(row.ks_low, row.ks_high, alpha=0.05)
         cells = table_cells(page.read_text(encoding="utf-8"), f"{row.size_ratio:g}")
         # the page's reading: the CSV's verdict, or a departure where the CI excludes 0
-        said = null_reading(row.d_minus_null_low, row.d_minus_null_high, D_MARGIN)
+        said = null_reading(row.d_minus_null_low, row.d_minus_null_high, margin=D_MARGIN)
         assert said == row.d_verdict or (row.d_verdict == "inconclusive"
                                          and "by about the margin or less" in said)
         assert cells[-1].endswith(said)

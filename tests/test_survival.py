@@ -38,7 +38,7 @@ def test_kicks_turn_the_circles_algebraic_escape_into_an_exponential_one():
     # the integrable circle with a hole: survival ~ C / t (Bunimovich & Dettmann 2005);
     # a disk kicked at Poisson times forgets its orbit: an exponential tail
     r, horizon, hole = 0.02, 1500.0, [(0.0, 0.05)]
-    states = initial_conditions(400, r, seed=8)[:, 0]
+    states = initial_conditions(400, r, rng=8)[:, 0]
     free = [simulate_one_particle(s, r, t_max=horizon, holes=hole).escape_time for s in states]
     kicked = [simulate_one_particle(s, r, t_max=horizon, holes=hole, rng=i,
                                     kicks=schedules.Poisson(0.5)).escape_time

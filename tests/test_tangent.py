@@ -190,7 +190,7 @@ SYSTEMS = {
 
 @pytest.fixture(scope="module")
 def ics20():
-    return initial_conditions(20, R_AGREE, seed=5)
+    return initial_conditions(20, R_AGREE, rng=5)
 
 
 @pytest.mark.parametrize("system", list(SYSTEMS))
@@ -268,7 +268,7 @@ def test_unkicked_disk_ensemble_mean_is_below_the_default_twin(ics20):
 # ----------------------------------------------------------- stretching per perturbation
 def test_disk_disk_collisions_stretch_more_than_kicks_by_about_log_one_over_r():
     r = 0.02
-    ics = initial_conditions(12, r, seed=9)
+    ics = initial_conditions(12, r, rng=9)
     two = [lyapunov(ic, r, **STEPS) for ic in ics]
     kicked = [lyapunov(ic[0], r, **STEPS, rng=i, kicks=schedules.Poisson(
         res.n_perturbations / res.total_time)) for i, (ic, res) in enumerate(zip(ics, two,
@@ -291,7 +291,7 @@ def test_lam_per_perturbation_is_lam_times_time_over_count(ics20):
 @pytest.mark.slow
 @pytest.mark.parametrize("system", list(SYSTEMS))
 def test_tangent_agrees_with_the_twin_at_paper_scale(system):
-    ics = initial_conditions(50, R_AGREE, seed=12)
+    ics = initial_conditions(50, R_AGREE, rng=12)
     steps = dict(n_steps=25000, tau=0.2)
     fn = SYSTEMS[system]
     for ic in ics:
@@ -338,7 +338,7 @@ def test_one_pass_kernel_carries_every_tangent_vector_as_the_tangent_kernel(mode
         simulate_two_kernel,
     )
 
-    ic = initial_conditions(1, R, seed=21, rule="elastic")[0]
+    ic = initial_conditions(1, R, rng=21, rule="elastic")[0]
     args = _two_args(ic, R, mode=mode, n_steps=600, tau=0.3, rule="elastic")
     U, U_ref = np.eye(8), np.eye(8)
     out = simulate_tangent_two_kernel(*(a.copy() if isinstance(a, np.ndarray) else a
@@ -359,7 +359,7 @@ def test_an_exhausted_tangent_budget_stops_only_the_tangent_half():
         simulate_two_kernel,
     )
 
-    ic = initial_conditions(1, R, seed=22)[0]
+    ic = initial_conditions(1, R, rng=22)[0]
     args = _two_args(ic, R, mode=2, n_steps=500, tau=0.3)
     out = simulate_tangent_two_kernel(*(a.copy() if isinstance(a, np.ndarray) else a
                                         for a in args), np.eye(8)[[0]], 50, 0.0)
@@ -372,7 +372,7 @@ def test_the_continuation_has_the_event_budget_of_a_run_to_t_continue():
     from kicktimes import simulate_two_particle
     from kicktimes.billiard.kernels.drive_two import simulate_tangent_two_kernel
 
-    ic = initial_conditions(1, R, seed=23)[0]
+    ic = initial_conditions(1, R, rng=23)[0]
     run = simulate_two_particle(ic, R, sampling="paper", n_steps=500, tau=0.3)
     budget = run.n_pp + run.n_boundary + 5  # enough for the run, not for its continuation
     with pytest.raises(ValueError, match="max_events"):

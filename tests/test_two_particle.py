@@ -46,7 +46,7 @@ def _invariant_violations(st, r, rule, n_events):
 def test_invariants_hold_over_a_million_events(rule):
     r = 0.05  # large disks: many disk-disk collisions per boundary collision
     method = "paper" if rule == "mirror" else "uniform"
-    ic = initial_conditions(1, r, seed=11, method=method, rule=rule)[0]
+    ic = initial_conditions(1, r, rng=11, method=method, rule=rule)[0]
     st = np.concatenate([[0.0], ic.ravel(), [0.0, (ic[:, 2:] ** 2).sum()]])
     outside, overlap, speed_err, energy_err, n_pp = _invariant_violations(
         st, r, 0 if rule == "mirror" else 1, 1_000_000
@@ -62,7 +62,7 @@ def test_invariants_hold_over_a_million_events(rule):
 @pytest.mark.parametrize("rule", ["mirror", "elastic"])
 def test_sin_theta_unchanged_between_boundary_collisions_without_disk_disk_collision(rule):
     r = 0.03
-    ic = initial_conditions(1, r, seed=5, method="uniform", rule=rule)[0]
+    ic = initial_conditions(1, r, rng=5, method="uniform", rule=rule)[0]
     run = simulate_two_particle(ic, r, t_max=20000.0, rule=rule)
     b = run.boundary
     changed_any = False
@@ -116,7 +116,7 @@ def test_disks_starting_nearly_in_contact_collide_at_once_when_approaching():
 
 def test_mirror_rule_is_time_reversible():
     r = 0.04
-    ic = initial_conditions(1, r, seed=2)[0]
+    ic = initial_conditions(1, r, rng=2)[0]
     fwd = simulate_two_particle(ic, r, t_max=30.0)
     assert fwd.n_pp >= 1
     back_ic = fwd.final_state.copy()
@@ -129,7 +129,7 @@ def test_mirror_rule_is_time_reversible():
 
 def test_records_have_the_documented_shapes_and_ranges():
     r = 0.02
-    ic = initial_conditions(1, r, seed=3)[0]
+    ic = initial_conditions(1, r, rng=3)[0]
     run = simulate_two_particle(ic, r, t_max=500.0)
     assert run.pp_times.dtype == np.float64
     assert (np.diff(run.pp_times) > 0).all()
@@ -146,7 +146,7 @@ def test_records_have_the_documented_shapes_and_ranges():
 
 def test_final_state_continues_the_run():
     r = 0.02
-    ic = initial_conditions(1, r, seed=4)[0]
+    ic = initial_conditions(1, r, rng=4)[0]
     whole = simulate_two_particle(ic, r, t_max=200.0)
     first = simulate_two_particle(ic, r, t_max=120.0)
     rest = simulate_two_particle(first.final_state, r, t_max=80.0)
@@ -156,7 +156,7 @@ def test_final_state_continues_the_run():
 
 def test_uniform_sampling_gives_n_steps_plus_one_samples_on_the_grid():
     r = 0.02
-    ic = initial_conditions(1, r, seed=6)[0]
+    ic = initial_conditions(1, r, rng=6)[0]
     run = simulate_two_particle(ic, r, n_steps=1000, tau=0.3, track=1)
     assert run.t_max == pytest.approx(300.0)
     np.testing.assert_allclose(run.sample_times, 0.3 * np.arange(1001))
@@ -170,7 +170,7 @@ def test_uniform_sampling_gives_n_steps_plus_one_samples_on_the_grid():
 
 def test_paper_sampling_cuts_steps_at_every_collision():
     r = 0.02
-    ic = initial_conditions(1, r, seed=7)[0]
+    ic = initial_conditions(1, r, rng=7)[0]
     run = simulate_two_particle(ic, r, n_steps=3000, tau=0.3, sampling="paper")
     steps = np.diff(run.sample_times)
     assert run.sample_times.shape == (3001,)
@@ -186,7 +186,7 @@ def test_paper_sampling_cuts_steps_at_every_collision():
 
 
 def test_same_input_gives_identical_arrays():
-    ic = initial_conditions(1, 0.02, seed=8)[0]
+    ic = initial_conditions(1, 0.02, rng=8)[0]
     a = simulate_two_particle(ic, 0.02, n_steps=500, tau=0.2)
     b = simulate_two_particle(ic, 0.02, n_steps=500, tau=0.2)
     assert np.array_equal(a.pp_times, b.pp_times)
@@ -195,7 +195,7 @@ def test_same_input_gives_identical_arrays():
 
 
 def test_run_round_trips_through_parquet(tmp_path):
-    ic = initial_conditions(1, 0.02, seed=9)[0]
+    ic = initial_conditions(1, 0.02, rng=9)[0]
     run = simulate_two_particle(ic, 0.02, n_steps=200, tau=0.3, rule="elastic", seed=9)
     path = tmp_path / "run.parquet"
     run.to_parquet(path)
@@ -340,14 +340,14 @@ def test_a_grazing_contact_keeps_the_energy_under_the_elastic_rule():
 
 
 def test_the_event_budget_ends_a_run_with_an_error_naming_max_events():
-    ic = initial_conditions(1, 0.05, seed=3)[0]
+    ic = initial_conditions(1, 0.05, rng=3)[0]
     with pytest.raises(ValueError, match=r"max_events=50 collisions"):
         simulate_two_particle(ic, 0.05, t_max=1000.0, max_events=50)
     assert simulate_two_particle(ic, 0.05, t_max=10.0, max_events=10**4).n_boundary > 0
 
 
 def test_a_run_too_long_for_the_default_budget_is_refused_up_front():
-    ic = initial_conditions(1, 0.05, seed=3)[0]
+    ic = initial_conditions(1, 0.05, rng=3)[0]
     with pytest.raises(ValueError, match=r"t_max=1000000000.0 needs about .* max_events="):
         simulate_two_particle(ic, 0.05, t_max=1e9)
 
@@ -355,7 +355,7 @@ def test_a_run_too_long_for_the_default_budget_is_refused_up_front():
 def test_jammed_disks_end_in_a_clear_error_or_a_valid_run():
     # r close to 1/2: the disks only fit nearly diametrically opposite
     r = 0.4999
-    ic = initial_conditions(1, r, seed=2, method="uniform", rule="elastic")[0]
+    ic = initial_conditions(1, r, rng=2, method="uniform", rule="elastic")[0]
     try:
         run = simulate_two_particle(ic, r, t_max=5.0, rule="elastic")
     except ValueError as exc:
@@ -372,7 +372,7 @@ def test_jammed_disks_end_in_a_clear_error_or_a_valid_run():
     (dict(t_max=10.0, max_events=0), r"max_events must be an integer >= 1"),
 ])
 def test_time_arguments_are_range_checked(kwargs, match):
-    ic = initial_conditions(1, 0.02, seed=1)[0]
+    ic = initial_conditions(1, 0.02, rng=1)[0]
     with pytest.raises(ValueError, match=match):
         simulate_two_particle(ic, 0.02, **kwargs)
 

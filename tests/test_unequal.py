@@ -34,7 +34,7 @@ def test_the_kinetic_rate_of_unequal_disks_matches_a_monte_carlo_of_its_definiti
 
 
 def test_the_mean_count_from_invariant_ics_is_the_kinetic_count():
-    ics = initial_conditions(2000, RADII, seed=3, method="uniform")
+    ics = initial_conditions(2000, RADII, rng=3, method="uniform")
     t_max = 1000.0
     counts = np.array([simulate_two_particle(ic, RADII, t_max=t_max).n_pp for ic in ics])
     z = (counts.mean() - kinetic_rate(RADII) * t_max) / (counts.std(ddof=1) / np.sqrt(2000))
@@ -42,7 +42,7 @@ def test_the_mean_count_from_invariant_ics_is_the_kinetic_count():
 
 
 def test_each_disk_keeps_to_its_own_table_and_they_touch_at_r0_plus_r1():
-    ic = initial_conditions(1, max(RADII), seed=4)[0]
+    ic = initial_conditions(1, max(RADII), rng=4)[0]
     run = simulate_two_particle(ic, RADII, t_max=3000.0, log_collisions=True)
     log = run.boundary_log
     for disk, r in enumerate(RADII):
@@ -58,7 +58,7 @@ def test_each_disk_keeps_to_its_own_table_and_they_touch_at_r0_plus_r1():
 
 
 def test_the_tangent_ftle_of_unequal_disks_agrees_with_a_small_twin():
-    ic = initial_conditions(1, max(RADII), seed=4)[0]
+    ic = initial_conditions(1, max(RADII), rng=4)[0]
     tangent = lyapunov(ic, RADII, n_steps=3000, tau=0.3)
     twin = lyapunov(ic, RADII, n_steps=3000, tau=0.3, method="twin", d0=1e-9)
     assert tangent.lam > 0 and twin.lam == pytest.approx(tangent.lam, rel=1e-3)
@@ -67,7 +67,7 @@ def test_the_tangent_ftle_of_unequal_disks_agrees_with_a_small_twin():
 @pytest.mark.parametrize("r, match", [((0.01, 0.6), r"r\[1\]"), ((0.01, 0.02, 0.03), "pair"),
                                       ((0.0, 0.02), r"r\[0\]")])
 def test_bad_radii_are_refused(r, match):
-    ic = initial_conditions(1, 0.03, seed=1)[0]
+    ic = initial_conditions(1, 0.03, rng=1)[0]
     with pytest.raises(ValueError, match=match):
         simulate_two_particle(ic, r, t_max=10.0)
 
@@ -76,7 +76,7 @@ MASSES = (1.0, 3.0)
 
 
 def test_collisions_with_masses_conserve_momentum_and_energy():
-    ic = initial_conditions(1, 0.03, seed=2, method="uniform", rule="elastic")[0]
+    ic = initial_conditions(1, 0.03, rng=2, method="uniform", rule="elastic")[0]
     run = simulate_two_particle(ic, 0.03, t_max=3000.0, rule="elastic", masses=MASSES,
                                 log_collisions=True)
     log, (m0, m1) = run.pp_log, MASSES
@@ -90,18 +90,18 @@ def test_collisions_with_masses_conserve_momentum_and_energy():
 
 
 def test_the_mean_count_with_masses_is_the_kinetic_count_with_masses():
-    ics = initial_conditions(2000, RADII, seed=5, method="uniform", rule="elastic",
+    ics = initial_conditions(2000, RADII, rng=5, method="uniform", rule="elastic",
                              masses=MASSES)
     t_max = 1000.0
     counts = np.array([simulate_two_particle(ic, RADII, t_max=t_max, rule="elastic",
                                              masses=MASSES).n_pp for ic in ics])
-    gamma = kinetic_rate(RADII, "elastic", masses=MASSES)
+    gamma = kinetic_rate(RADII, rule="elastic", masses=MASSES)
     z = (counts.mean() - gamma * t_max) / (counts.std(ddof=1) / np.sqrt(counts.size))
-    assert abs(z) < 3.5 and gamma > kinetic_rate(RADII, "elastic")
+    assert abs(z) < 3.5 and gamma > kinetic_rate(RADII, rule="elastic")
 
 
 def test_the_tangent_ftle_with_masses_agrees_with_a_small_twin():
-    ic = initial_conditions(1, 0.03, seed=2, method="uniform", rule="elastic")[0]
+    ic = initial_conditions(1, 0.03, rng=2, method="uniform", rule="elastic")[0]
     kw = {"n_steps": 3000, "tau": 0.3, "rule": "elastic", "masses": MASSES}
     tangent = lyapunov(ic, RADII, **kw)
     twin = lyapunov(ic, RADII, method="twin", d0=1e-9, **kw)
@@ -112,7 +112,7 @@ def test_the_tangent_ftle_with_masses_agrees_with_a_small_twin():
     ((1.0, 2.0), "mirror", "rule='elastic'"), ((1.0, 0.0), "elastic", r"masses\[1\]"),
     ((1.0,), "elastic", "pair")])
 def test_bad_masses_are_refused(masses, rule, match):
-    ic = initial_conditions(1, 0.03, seed=2, method="uniform", rule=rule)[0]
+    ic = initial_conditions(1, 0.03, rng=2, method="uniform", rule=rule)[0]
     with pytest.raises(ValueError, match=match):
         simulate_two_particle(ic, 0.03, t_max=10.0, rule=rule, masses=masses)
 

@@ -46,7 +46,7 @@ def test_the_partner_is_a_toml_key_shown_in_the_summary():
     assert "disk 1" not in Experiment(**BASE).summary()
     assert "drawn at r_max = (0.02, 0.04)" in exp.summary()
     assert exp.radius_pair(0.01) == (0.01, 0.02) and exp.masses == (1.0, 3.0)
-    assert exp.kinetic_rate(0.01) == kinetic_rate((0.01, 0.02), "elastic", masses=(1.0, 3.0))
+    assert exp.kinetic_rate(0.01) == kinetic_rate((0.01, 0.02), rule="elastic", masses=(1.0, 3.0))
     np.testing.assert_array_equal(
         Experiment(**BASE).kinetic_rate(np.array([0.01, 0.02])),
         kinetic_rate(np.array([0.01, 0.02])))
@@ -78,7 +78,7 @@ def test_bad_partners_are_refused_naming_the_key(kwargs, error, match):
 def test_the_ics_are_valid_for_the_pair_at_every_radius(method, ratio):
     exp = Experiment(**{**BASE, "n_ics": 200, "radii": [0.01, 0.05, 0.1]},
                      partner_ratio=ratio, ic_method=method)
-    ics = initial_conditions(exp.n_ics, exp.ic_radius, seed=exp.seed, method=method)
+    ics = initial_conditions(exp.n_ics, exp.ic_radius, rng=exp.seed, method=method)
     for r in exp.radii:
         r0, r1 = exp.radius_pair(r)
         assert (np.hypot(ics[:, 0, 0], ics[:, 0, 1]) <= 1 - r0).all()
@@ -87,7 +87,7 @@ def test_the_ics_are_valid_for_the_pair_at_every_radius(method, ratio):
         assert (gap >= r0 + r1).all()
     if method == "paper" and ratio < 1:  # the larger disk is disk 0: the equal-disk ICs
         np.testing.assert_array_equal(
-            ics, initial_conditions(exp.n_ics, exp.r_max, seed=exp.seed))
+            ics, initial_conditions(exp.n_ics, exp.r_max, rng=exp.seed))
 
 
 @pytest.mark.parametrize("extra", [

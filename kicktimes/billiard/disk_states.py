@@ -19,7 +19,13 @@ from numba import njit
 from kicktimes.billiard import checks as chk
 from kicktimes.billiard.many_disks import check_box, check_radii_of, engine_run
 from kicktimes.stats.enskog import PACKING_MAX, contact_value
-from kicktimes.validation import check_int, check_real, check_rng
+from kicktimes.validation import (
+    check_int,
+    check_real,
+    check_rng,
+    keyword_only_after,
+    renamed_keyword,
+)
 
 __all__ = ["box_side", "initial_state", "grow_step"]
 
@@ -186,11 +192,12 @@ def _collision_time(radii: np.ndarray, per_disk: float, box=None) -> float:
     return per_disk / max(nu, 1e-12) if n > 1 else per_disk
 
 
-def box_side(n_disks, r, packing) -> float:
+@keyword_only_after(2, since="0.2.0")
+def box_side(n_disks, r, *, packing) -> float:
     r"""The side :math:`L` of the periodic square box in which ``n_disks`` disks of radius
     ``r`` have the area fraction ``packing``: :math:`\varphi = N\pi r^2 / L^2`.
 
-    >>> round(box_side(2000, 0.01, 0.3), 6)
+    >>> round(box_side(2000, 0.01, packing=0.3), 6)
     1.447203
     """
     n = check_int("n_disks", n_disks, low=1, high=10**7)
@@ -199,7 +206,8 @@ def box_side(n_disks, r, packing) -> float:
     return math.sqrt(n * math.pi * r * r / packing)
 
 
-def initial_state(n_disks, r, *, seed=0, rule="mirror", masses=None, packing=None,
+@renamed_keyword(old="seed", new="rng", since="0.2.0")
+def initial_state(n_disks, r, *, rng=0, rule="mirror", masses=None, packing=None,
                   box=None) -> np.ndarray:
     """A state of ``n_disks`` non-overlapping disks in the unit table (or a periodic square
     box), for `simulate_disks`.
@@ -211,8 +219,9 @@ def initial_state(n_disks, r, *, seed=0, rule="mirror", masses=None, packing=Non
     r : float or array_like or None
         The disks' radius, or one radius per disk (each in ``(0, 1)``); with ``packing``,
         relative radii (``None``: equal disks).
-    seed : int or numpy.random.Generator
-        The random stream (`kicktimes.validation.check_rng`).
+    rng : None, int, numpy.random.SeedSequence or numpy.random.Generator, default 0
+        The random stream (`kicktimes.validation.check_rng`); ``seed=`` is its deprecated
+        spelling (until 0.3.0).
     rule : {"mirror", "elastic"}
         The velocities: unit speeds with uniform directions (``"mirror"``), or uniform on
         the energy shell ``sum_i m_i |v_i|^2 = n_disks`` (``"elastic"``).
@@ -250,15 +259,15 @@ def initial_state(n_disks, r, *, seed=0, rule="mirror", masses=None, packing=Non
     Examples
     --------
     >>> import numpy as np, kicktimes as kt
-    >>> s = kt.initial_state(100, None, packing=0.3, seed=2)
+    >>> s = kt.initial_state(100, None, packing=0.3, rng=2)
     >>> s.shape, bool(np.allclose(np.hypot(s[:, 2], s[:, 3]), 1.0))
     ((100, 4), True)
-    >>> b = kt.initial_state(2000, None, packing=0.3, box=1.0, rule="elastic", seed=2)
+    >>> b = kt.initial_state(2000, None, packing=0.3, box=1.0, rule="elastic", rng=2)
     >>> bool(abs(b[:, 2:].sum(axis=0)).max() < 1e-9), round(float((b[:, 2:] ** 2).sum()))
     (True, 2000)
     """
     n = check_int("n_disks", n_disks, low=1, high=10**7)
-    rng = check_rng(seed, "seed")
+    rng = check_rng(rng, "rng")
     chk.check_choice("rule", rule, chk.RULES)
     box = check_box(box)
     # the table's packing sum r^2 is its area fraction (area pi); the box's, pi sum r^2/L^2

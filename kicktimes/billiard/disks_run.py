@@ -244,7 +244,7 @@ ho
         Examples
         --------
         >>> import kicktimes as kt
-        >>> s = kt.initial_state(300, None, packing=0.2, rule="elastic", seed=3)
+        >>> s = kt.initial_state(300, None, packing=0.2, rule="elastic", rng=3)
         >>> run = kt.simulate_disks(s, (0.2 / 300) ** 0.5, t_max=2.0, rule="elastic")
         >>> p = run.pressure(blocks=4)
         >>> bool(abs(p.z_wall / p.z_virial - 1) < 0.05)

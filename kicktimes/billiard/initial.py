@@ -3,8 +3,8 @@
 IC ``i`` of an ensemble is drawn from its own generator,
 ``numpy.random.default_rng(SeedSequence(seed, spawn_key=(i,)))`` (the ``i``-th child of
 ``SeedSequence(seed)``), so it does not depend on how the ensemble is split into blocks
-or across workers: ``initial_conditions(10, r, seed=s)[7]`` equals
-``initial_conditions(3, r, seed=s, start=7)[0]``.
+or across workers: ``initial_conditions(10, r, rng=s)[7]`` equals
+``initial_conditions(3, r, rng=s, start=7)[0]``.
 """
 
 from __future__ import annotations
@@ -16,6 +16,7 @@ import numpy as np
 
 from kicktimes.billiard import checks as chk
 from kicktimes.billiard._crmath import cos_sin
+from kicktimes.validation import check_seed_sequence, renamed_keyword
 
 METHODS = ("paper", "uniform")
 
@@ -203,7 +204,8 @@ def _uniform_ic(rng: np.random.Generator, r_max, rule: str, masses=None) -> np.n
     return out
 
 
-def initial_conditions(n, r_max, *, seed=0, method="paper", rule="mirror", start=0,
+@renamed_keyword(old="seed", new="rng", since="0.2.0")
+def initial_conditions(n, r_max, *, rng=0, method="paper", rule="mirror", start=0,
                        masses=None) -> np.ndarray:
     """Draw an ensemble of two-disk initial conditions.
 
@@ -216,8 +218,11 @@ def initial_conditions(n, r_max, *, seed=0, method="paper", rule="mirror", start
         ICs are valid (inside the table, no overlap) for every ``r <= r_max``. A tuple
         ``(r0, r1)`` (with ``method="uniform"``, each at most 1/3): the invariant measure of
         two disks of those radii.
-    seed : int
-        Root seed (``>= 0``). The ensemble is a pure function of ``seed``.
+    rng : int, numpy.random.SeedSequence or numpy.random.Generator, default 0
+        The root of the ensemble's streams (`kicktimes.validation.check_seed_sequence`):
+        IC ``i`` is drawn from the root's child ``spawn_key=(i,)``, so the ensemble is a
+        pure function of an int or SeedSequence root (a Generator is consumed: the root is
+        drawn from it). ``seed=`` is its deprecated spelling (until 0.3.0).
     method : {"paper", "uniform"}
         ``"paper"``: per disk, distance from the centre uniform on (0, 1), polar angle
         and velocity angle uniform on [0, 2 pi), redrawn while it overlaps the boundary or
@@ -248,10 +253,10 @@ def initial_conditions(n, r_max, *, seed=0, method="paper", rule="mirror", start
 
     Examples
     --------
-    >>> ics = initial_conditions(5, 0.03, seed=1)
+    >>> ics = initial_conditions(5, 0.03, rng=1)
     >>> ics.shape
     (5, 2, 4)
-    >>> bool((initial_conditions(2, 0.03, seed=1, start=3) == ics[3:5]).all())
+    >>> bool((initial_conditions(2, 0.03, rng=1, start=3) == ics[3:5]).all())
     True
     """
     n = chk.check_int("n", n, low=1)
@@ -269,7 +274,7 @@ def initial_conditions(n, r_max, *, seed=0, method="paper", rule="mirror", start
             f"r_max must lie in (0.0, {R_MAX_IC!r}], got {r_max!r}: two disks this large "
             "only fit diametrically opposite, against the wall, with no room to move"
         )
-    seed = chk.check_int("seed", seed, low=0)
+    root = check_seed_sequence(rng, "rng")
     start = chk.check_int("start", start, low=0)
     chk.check_choice("method", method, METHODS)
     chk.check_choice("rule", rule, chk.RULES)
@@ -284,7 +289,8 @@ def initial_conditions(n, r_max, *, seed=0, method="paper", rule="mirror", start
             "draw them in blocks with start= (IC i does not depend on the block)"
         ) from None
     for k in range(n):
-        rng = ic_generator(seed, start + k)
-        out[k] = (_paper_ic(rng, r_max) if method == "paper"
-                  else _uniform_ic(rng, r_max, rule, masses))
+        gen = np.random.default_rng(np.random.SeedSequence(
+            root.entropy, spawn_key=(*root.spawn_key, start + k), pool_size=root.pool_size))
+        out[k] = (_paper_ic(gen, r_max) if method == "paper"
+                  else _uniform_ic(gen, r_max, rule, masses))
     return out

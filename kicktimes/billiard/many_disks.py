@@ -471,11 +471,11 @@ def simulate_disks(state, r, *, t_max, rule="mirror", masses=None, holes=None, s
     Examples
     --------
     >>> import kicktimes as kt
-    >>> state = kt.initial_state(50, 0.03, seed=1)
+    >>> state = kt.initial_state(50, 0.03, rng=1)
     >>> run = kt.simulate_disks(state, 0.03, t_max=5.0)
     >>> bool((run.collisions.i < run.collisions.j).all())
     True
-    >>> s = kt.initial_state(200, 0.02, box=1.0, rule="elastic", seed=1)
+    >>> s = kt.initial_state(200, 0.02, box=1.0, rule="elastic", rng=1)
     >>> run = kt.simulate_disks(s, 0.02, t_max=2.0, rule="elastic", box=1.0)
     >>> run.box, bool(((run.final_state[:, :2] >= 0) & (run.final_state[:, :2] < 1)).all())
     (1.0, True)

@@ -70,6 +70,12 @@ def check_kick_times(kicks, t_max: float | None, name: str = "kicks") -> np.ndar
     return times
 
 
+def _is_kicktimes_schedule(kicks) -> bool:
+    from kicktimes.schedules import Schedule
+
+    return isinstance(kicks, Schedule)
+
+
 def _is_schedule(kicks) -> bool:
     """A kick schedule: a `Schedule`, or any object with a ``sample`` method that is not
     array-like (a pandas Series has a ``sample`` method too, but it holds times)."""
@@ -153,7 +159,11 @@ def resolve_kicks(kicks, kick_angles, *, kick_angle, sigma, rng, horizon, t_max,
         times = np.full(n, np.inf)
     elif _is_schedule(kicks):
         gen = check_rng(rng)
-        times = check_kick_times(kicks.sample(horizon, gen), horizon, name="kicks.sample()")
+        # (a kicktimes Schedule takes rng= by keyword; any other object with the schedule
+        # protocol sample(t_max, rng) gets it by position, as before 0.2.0)
+        drawn = (kicks.sample(horizon, rng=gen) if _is_kicktimes_schedule(kicks)
+                 else kicks.sample(horizon, gen))
+        times = check_kick_times(drawn, horizon, name="kicks.sample()")
     else:
         times = check_kick_times(kicks, t_max)
     if kick_angles is None:

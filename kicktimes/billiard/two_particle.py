@@ -152,7 +152,7 @@ def simulate_two_particle(ic, r, *, t_max=None, rule="mirror", sampling="uniform
     Examples
     --------
     >>> from kicktimes import simulate_two_particle, initial_conditions
-    >>> ic = initial_conditions(1, 0.02, seed=1)[0]
+    >>> ic = initial_conditions(1, 0.02, rng=1)[0]
     >>> run = simulate_two_particle(ic, 0.02, t_max=200.0)
     >>> bool((run.pp_times > 0).all() and (run.pp_times <= 200.0).all())
     True

@@ -40,7 +40,7 @@ def _fitted_mmpp(input_path, params, stationary, window):
     return schedules.MMPP.from_fit(fit_mmpp(times, float(window), n_states=2, rng=0))
 
 
-_SCHEDULE_OPTIONS = {"t_max": "--t-max", "seed": "--seed", "window": "--window",
+_SCHEDULE_OPTIONS = {"t_max": "--t-max", "seed": "--seed", "rng": "--seed", "window": "--window",
                      "times": "--input", "dist": "--dist", "path": "--output"}
 
 
@@ -126,7 +126,7 @@ def schedule_command(
             )
         if seed is None:
             seed = int(np.random.SeedSequence().entropy)
-        times = schedule.sample(t_max, seed)
+        times = schedule.sample(t_max, rng=seed)
         path = schedules.write_kick_times(times, output, t_max=t_max, schedule=schedule, seed=seed)
     except (ValueError, TypeError) as exc:
         raise click.UsageError(_plain(str(exc), _SCHEDULE_OPTIONS)) from None

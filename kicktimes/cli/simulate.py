@@ -67,12 +67,12 @@ def simulate_command(radii, n_ics, t_max, seed, rule, ic_method, out, save_runs,
     # the options are range-checked by click; this maps anything the library still
     # refuses back to the option that caused it
     options = {"r_max": "--radius", "r": "--radius", "n": "--n-ics", "t_max": "--t-max",
-               "seed": "--seed", "rule": "--rule", "method": "--ic-method"}
+               "seed": "--seed", "rng": "--seed", "rule": "--rule", "method": "--ic-method"}
     from kicktimes.compilation import SIMULATE_KERNELS
 
     compile_first(None, SIMULATE_KERNELS)
     with _cli_errors(options):
-        ics = initial_conditions(n_ics, max(radii), seed=seed, method=ic_method, rule=rule)
+        ics = initial_conditions(n_ics, max(radii), rng=seed, method=ic_method, rule=rule)
         for r in radii:
             simulate_two_particle(ics[0], r, t_max=t_max, rule=rule)  # validates r, t_max
         os.makedirs(out, exist_ok=True)
@@ -130,7 +130,8 @@ def _simulate_disks(n_disks, packing, t_max, seed, rule, out, box=None):
         raise click.UsageError("--disks and --packing go together: give both")
     compile_first(None, DISKS_KERNELS)
     options = {"n_disks": "--disks", "packing": "--packing", "r": "--packing",
-               "t_max": "--t-max", "seed": "--seed", "rule": "--rule", "state": "--packing",
+               "t_max": "--t-max", "seed": "--seed", "rng": "--seed", "rule": "--rule",
+               "state": "--packing",
                "box": "--box"}
     area = math.pi if box is None else box * box
     with _cli_errors(options):
@@ -142,7 +143,7 @@ def _simulate_disks(n_disks, packing, t_max, seed, rule, out, box=None):
             raise ValueError(f"box must be at least 3 cells of one diameter wide, box >= 6 r = "
                              f"{6.0 * r:.6g} for {n_disks} disks at packing {packing:g}, got "
                              f"{box:g}")
-        state = initial_state(n_disks, r, seed=seed, rule=rule, box=box)
+        state = initial_state(n_disks, r, rng=seed, rule=rule, box=box)
         os.makedirs(out, exist_ok=True)
         run = simulate_disks(state, r, t_max=t_max, rule=rule, box=box)
     path = os.path.join(out, "disks.parquet")

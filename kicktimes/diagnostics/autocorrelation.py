@@ -25,6 +25,7 @@ import pandas as pd
 from numba import njit
 
 from kicktimes._results import Value
+from kicktimes.validation import keyword_only_after
 
 __all__ = [
     "AcfValue",
@@ -396,7 +397,8 @@ def autocorrelation(series, lag=1, *, rtol=_RTOL, atol=_ATOL, return_reason=Fals
     return AcfValue(value, reason, lag=lag, n=int(x.size))
 
 
-def autocorrelation_many(series, lag=1, *, rtol=_RTOL, atol=_ATOL):
+@keyword_only_after(1, since="0.2.0", names=('lag',))
+def autocorrelation_many(series, *, lag=1, rtol=_RTOL, atol=_ATOL):
     r"""`autocorrelation` of many series at once, with the reasons in a column.
 
     One compiled pass over all series (no Python loop per series, no warnings), for
@@ -484,7 +486,8 @@ def autocorrelation_many(series, lag=1, *, rtol=_RTOL, atol=_ATOL):
     return df
 
 
-def boundary_angles(run, particle=None):
+@keyword_only_after(1, since="0.2.0")
+def boundary_angles(run, *, particle=None):
     r"""Boundary-collision angles ``theta = arcsin(sin_theta)`` of one disk, in time order.
 
     ``sin_theta`` is the tangential component of the incoming unit velocity at each

@@ -25,6 +25,7 @@ Both estimate ``lambda = sum_k log(growth of segment k) / t``.
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -43,8 +44,9 @@ class DisksLyapunov(Result):
 
     Attributes
     ----------
-    exponent : float
-        ``sum(logs) / t_max``, per unit time.
+    lam : float
+        ``sum(logs) / t_max``, per unit time: the largest exponent, named as
+        `LyapunovResult.lam` (``exponent`` is its deprecated alias, until 0.3.0).
     logs : ndarray
         The log-growth of each segment: ``log |u_k|`` of the tangent vector (rescaled to 1
         at each segment's start), or ``log(d_k / d0)`` of the twin.
@@ -61,9 +63,9 @@ class DisksLyapunov(Result):
     """
 
     _title = "Largest Lyapunov exponent of the N-disk gas (disks_lyapunov)"
-    _summary_fields = ("exponent", "method", "t_max", "segment", "d0", "n_collisions", "logs")
+    _summary_fields = ("lam", "method", "t_max", "segment", "d0", "n_collisions", "logs")
 
-    exponent: float
+    lam: float
     logs: np.ndarray
     segment: float
     t_max: float
@@ -72,9 +74,16 @@ class DisksLyapunov(Result):
     final_state: np.ndarray
     method: str = "twin"
 
+    @property
+    def exponent(self) -> float:
+        """Deprecated alias of `lam` (since 0.2.0, until 0.3.0)."""
+        warnings.warn("DisksLyapunov.exponent is deprecated since 0.2.0 and will be removed in "
+                      "0.3.0; use DisksLyapunov.lam", DeprecationWarning, stacklevel=2)
+        return self.lam
+
     def __repr__(self) -> str:
         d0 = "" if self.d0 is None else f", d0={self.d0:g}"
-        return (f"DisksLyapunov(exponent={self.exponent:.5g}, method={self.method!r}, "
+        return (f"DisksLyapunov(lam={self.lam:.5g}, method={self.method!r}, "
                 f"segments={self.logs.size}, t_max={self.t_max:g}{d0})")
 
 
@@ -115,7 +124,7 @@ def _tangent(state, radii, rule, n_seg, segment, gen):
     u0 /= np.linalg.norm(u0)
     logs = []
 
-    def renormalise(u, v, lg):
+    def renormalize(u, v, lg):
         project_trivial(u, v, rule)
         d = float(np.linalg.norm(u))
         logs.append(lg + math.log(d) if d > 0.0 else math.nan)
@@ -123,7 +132,7 @@ def _tangent(state, radii, rule, n_seg, segment, gen):
             u /= d
 
     out = engine_run(state, radii, chk.RULES[rule], n_seg * segment, log=False,
-                     tangent=u0, segment=segment, on_segment=renormalise)
+                     tangent=u0, segment=segment, on_segment=renormalize)
     raise_for_status(out, np.iinfo(np.int64).max)
     logs = np.array(logs)
     if not np.isfinite(logs).all():
@@ -215,9 +224,9 @@ def disks_lyapunov(state, r, *, t_max, segment, rule="mirror", method="tangent",
     --------
     >>> import kicktimes as kt
     >>> from kicktimes.diagnostics.gas_lyapunov import disks_lyapunov
-    >>> s = kt.initial_state(20, 0.05, seed=3)
+    >>> s = kt.initial_state(20, 0.05, rng=3)
     >>> res = disks_lyapunov(s, 0.05, t_max=20.0, segment=1.0, rng=1)
-    >>> res.logs.size, res.method, bool(res.exponent > 0)
+    >>> res.logs.size, res.method, bool(res.lam > 0)
     (20, 'tangent', True)
     >>> twin = disks_lyapunov(s, 0.05, t_max=20.0, segment=1.0, method="twin", rng=1)
     >>> twin.d0

@@ -404,7 +404,7 @@ def lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rule
     --------
     >>> from kicktimes import initial_conditions
     >>> from kicktimes.diagnostics import lyapunov
-    >>> ic = initial_conditions(1, 0.03, seed=3)[0]
+    >>> ic = initial_conditions(1, 0.03, rng=3)[0]
     >>> res = lyapunov(ic, 0.03, n_steps=2000, tau=0.2)
     >>> bool(res.lam > 0), res.method
     (True, 'tangent')
@@ -756,7 +756,7 @@ def lyapunov_spectrum(ic, r, *, t_max, rule="mirror", every=1.0) -> LyapunovSpec
     --------
     >>> from kicktimes import initial_conditions
     >>> from kicktimes.diagnostics.lyapunov import lyapunov_spectrum
-    >>> ic = initial_conditions(1, 0.03, seed=3)[0]
+    >>> ic = initial_conditions(1, 0.03, rng=3)[0]
     >>> spec = lyapunov_spectrum(ic, 0.03, t_max=200.0, rule="elastic")
     >>> bool(abs(spec.exponents.sum()) < 1e-6)
     True

@@ -136,7 +136,7 @@ def collision_table(run) -> pd.DataFrame:
     Examples
     --------
     >>> from kicktimes import initial_conditions, simulate_two_particle
-    >>> ic = initial_conditions(1, 0.02, seed=1)[0]
+    >>> ic = initial_conditions(1, 0.02, rng=1)[0]
     >>> run = simulate_two_particle(ic, 0.02, t_max=500.0, log_collisions=True)
     >>> tab = collision_table(run)
     >>> len(tab) == run.n_pp, bool(np.allclose(tab["L0_pre"][1:], tab["L0_post"][:-1]))
@@ -309,10 +309,10 @@ def recollision_share(table, *, max_wall_hits=1, level=0.95, n_boot=999,
     if n.sum() == 0:
         return RecollisionShare(math.nan, math.nan, math.nan, 0, 0, int(ids.size),
                                 max_wall_hits, level)
-    pick = resample_indices(ids.size, n_boot, rng)
+    pick = resample_indices(ids.size, n_boot=n_boot, rng=rng)
     with np.errstate(invalid="ignore"):
         boots = k[pick].sum(axis=1) / n[pick].sum(axis=1)
-    low, high = percentile_interval(boots, level)
+    low, high = percentile_interval(boots, level=level)
     return RecollisionShare(float(k.sum() / n.sum()), float(low), float(high), int(k.sum()),
                             int(n.sum()), int(ids.size), max_wall_hits, level)
 

@@ -31,6 +31,8 @@ import numbers
 
 import numpy as np
 
+from kicktimes.validation import keyword_only_after
+
 __all__ = ["recurrence_pairs", "recurrence_rate"]
 
 # Cells are a hair larger than eps so that round-off in the cell coordinate
@@ -159,7 +161,8 @@ def _cells(pts: np.ndarray, eps: float):
 _EMPTY = np.empty(0, np.int64)
 
 
-def recurrence_rate(points, eps=1e-3, *, theiler=0):
+@keyword_only_after(1, since="0.2.0", names=('eps',))
+def recurrence_rate(points, *, eps=1e-3, theiler=0):
     r"""Recurrence rate of a sampled planar trajectory.
 
     .. math::
@@ -249,13 +252,14 @@ def _recurrence_rate_one(pts: np.ndarray, eps: float, w: int) -> float:
     return 2 * int(pairs) / (k * (k + 1))
 
 
-def recurrence_pairs(points, eps=1e-3, *, theiler=0):
+@keyword_only_after(1, since="0.2.0", names=('eps',))
+def recurrence_pairs(points, *, eps=1e-3, theiler=0):
     r"""The recurrence plot as index pairs: every ``(i, j)`` of samples within ``eps``.
 
     Returns the nonzero entries of the recurrence matrix
     ``R_ij = Theta(eps - |x_i - x_j|)`` (both orders, main diagonal included unless a
     Theiler window removes it), never the N x N matrix. ``len(i) / N**2`` equals
-    ``recurrence_rate(points, eps)`` for ``theiler=0``.
+    ``recurrence_rate(points, eps=eps)`` for ``theiler=0``.
 
     Parameters
     ----------
@@ -288,7 +292,7 @@ def recurrence_pairs(points, eps=1e-3, *, theiler=0):
     --------
     >>> import numpy as np
     >>> from kicktimes.diagnostics import recurrence_pairs
-    >>> i, j = recurrence_pairs(np.array([[0.0, 0.0], [0.0005, 0.0], [0.5, 0.5]]), 1e-3)
+    >>> i, j = recurrence_pairs(np.array([[0.0, 0.0], [0.0005, 0.0], [0.5, 0.5]]), eps=1e-3)
     >>> i.tolist(), j.tolist()
     ([0, 0, 1, 1, 2], [0, 1, 0, 1, 2])
 

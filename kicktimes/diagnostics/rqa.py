@@ -38,6 +38,7 @@ from kicktimes.diagnostics.recurrence import (
     _check_theiler,
     _line_sums,
 )
+from kicktimes.validation import keyword_only_after
 
 __all__ = ["RQAResult", "rqa"]
 
@@ -111,7 +112,8 @@ def _check_l_min(l_min) -> int:
     return int(l_min)
 
 
-def rqa(points, eps=1e-3, *, theiler=1, l_min=2, laminarity=True):
+@keyword_only_after(1, since="0.2.0", names=('eps',))
+def rqa(points, *, eps=1e-3, theiler=1, l_min=2, laminarity=True):
     r"""Recurrence quantification analysis: RR, determinism, line lengths, laminarity.
 
     Parameters

@@ -347,8 +347,8 @@ class Experiment:
         from kicktimes.stats import kinetic_rate
 
         if self.partner_ratio == 1.0 and self.masses is None:
-            return kinetic_rate(radius, self.rule)
-        rates = [kinetic_rate(self.radius_pair(float(r)), self.rule, masses=self.masses)
+            return kinetic_rate(radius, rule=self.rule)
+        rates = [kinetic_rate(self.radius_pair(float(r)), rule=self.rule, masses=self.masses)
                  for r in np.ravel(radius)]
         return np.reshape(rates, np.shape(radius)) if np.ndim(radius) else rates[0]
 

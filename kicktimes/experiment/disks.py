@@ -295,7 +295,7 @@ class DisksExperiment:
         nu = enskog_frequency(r, n_disks, rule=self.rule)
         if r < 1.0 / 3.0:
             # two disks of radius r collide at the rate Gamma(r); a few disks nearly so
-            nu = min(nu, float(kinetic_rate(r, self.rule)) * (n_disks - 1))
+            nu = min(nu, float(kinetic_rate(r, rule=self.rule)) * (n_disks - 1))
         return nu
 
     def t_max(self, n_disks: int) -> float:

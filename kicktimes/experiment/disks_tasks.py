@@ -106,7 +106,7 @@ def _start(experiment: DisksExperiment, n_disks: int, k: int):
     from kicktimes.billiard import initial_state
 
     rng = np.random.default_rng(np.random.SeedSequence(experiment.seed, spawn_key=(n_disks, k)))
-    state = initial_state(n_disks, experiment.radius(n_disks), seed=rng, rule=experiment.rule,
+    state = initial_state(n_disks, experiment.radius(n_disks), rng=rng, rule=experiment.rule,
                           box=experiment.box_side)
     tagged = np.sort(rng.choice(n_disks, experiment.tagged_per_run(n_disks), replace=False))
     return rng, state, tagged
@@ -188,7 +188,7 @@ def kicked_rate(experiment: DisksExperiment, gas, times) -> float:
     >>> from kicktimes.experiment import disks_preset
     >>> from kicktimes.billiard import initial_state, simulate_disks
     >>> exp = disks_preset("disks-kicked-phi0.02-mirror")
-    >>> state = initial_state(10, exp.radius(10), seed=1, rule="mirror")
+    >>> state = initial_state(10, exp.radius(10), rng=1, rule="mirror")
     >>> run = simulate_disks(state, exp.radius(10), t_max=20.0, rule="mirror")
     >>> kicked_rate(exp, run, run.collision_times(0)) == run.collision_frequency
     True
@@ -234,7 +234,7 @@ def kicked_rows(experiment: DisksExperiment, n_disks: int, k: int) -> list:
     rng = np.random.default_rng(np.random.SeedSequence(experiment.seed,
                                                        spawn_key=(n_disks, k, 1)))
     r = experiment.radius(n_disks)
-    state = initial_state(n_disks, r, seed=rng, rule="mirror")
+    state = initial_state(n_disks, r, rng=rng, rule="mirror")
     nu = experiment.reference_frequency(n_disks)
     tau = 0.1 / nu
     n_steps = int(round(experiment.kicked_time / 0.1))
@@ -249,9 +249,9 @@ def kicked_rows(experiment: DisksExperiment, n_disks: int, k: int) -> list:
         theta = np.arcsin(np.clip(gas.walls["sin_theta"].to_numpy()[
             gas.walls["disk"].to_numpy() == 0], -1.0, 1.0))
         ftle = disks_lyapunov(state, r, t_max=t_max, segment=1.0 / nu, rng=rng,
-                              method=experiment.gas_ftle).exponent
+                              method=experiment.gas_ftle).lam
         rows += [("gas", "ftle", ftle), ("gas", "acf@1", autocorrelation(theta, 1)),
-                 ("gas", "rr", recurrence_rate(gas.samples[:, 0], KICKED_EPS,
+                 ("gas", "rr", recurrence_rate(gas.samples[:, 0], eps=KICKED_EPS,
                                                theiler=KICKED_THEILER)),
                  ("gas", "rate", rate)]
         schedules = {"poisson": Poisson(rate),
@@ -266,7 +266,7 @@ def kicked_rows(experiment: DisksExperiment, n_disks: int, k: int) -> list:
                                         rng=rng, tau=tau, **kind)
             rows += [(system, "ftle", lyapunov(one).lam),
                      (system, "acf@1", autocorrelation(boundary_angles(one), 1)),
-                     (system, "rr", recurrence_rate(one.samples[:, :2], KICKED_EPS,
+                     (system, "rr", recurrence_rate(one.samples[:, :2], eps=KICKED_EPS,
                                                           theiler=KICKED_THEILER))]
         if n_disks == 2:
             rows.append(("two_particle", "ftle",

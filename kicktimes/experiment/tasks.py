@@ -41,6 +41,7 @@ from kicktimes._results import TableResult
 from kicktimes.experiment.config import Experiment
 from kicktimes.experiment.plan import Task, make_tasks
 from kicktimes.stats import MMPP_MIN_EVENTS
+from kicktimes.validation import RENAMED_MARKER, check_seed_sequence
 
 __all__ = [
     "COLLISION_COLUMNS",
@@ -76,10 +77,43 @@ def _radius_key(radius: float) -> int:
     return struct.unpack("<Q", struct.pack("<d", float(radius)))[0]
 
 
-def kick_rng(seed: int, ic: int, radius: float, system: str) -> np.random.Generator:
-    """The generator of the kick times and angles of one (IC, radius, system)."""
-    key = (KICK_DOMAIN, int(ic), _radius_key(radius), SYSTEM_CODES[system])
-    return np.random.default_rng(np.random.SeedSequence(seed, spawn_key=key))
+def _kick_rng(ic: int, radius: float, system: str, *, rng) -> np.random.Generator:
+    """The generator of the kick times and angles of one (IC, radius, system).
+
+    ``rng`` is the sweep's root (`kicktimes.validation.check_seed_sequence`: an int seed
+    or a SeedSequence; a Generator is consumed): the stream is the root's child
+    ``spawn_key=(KICK_DOMAIN, ic, radius bits, system code)``, so ``rng=seed`` gives
+    exactly the stream of the old ``kick_rng(seed, ic, radius, system)``.
+
+    >>> bool(kick_rng(0, 0.01, "poisson", rng=7).random() == kick_rng(0, 0.01, "poisson",
+    ...                                                              rng=7).random())
+    True
+    """
+    root = check_seed_sequence(rng, "rng")
+    key = (*root.spawn_key, KICK_DOMAIN, int(ic), _radius_key(radius), SYSTEM_CODES[system])
+    return np.random.default_rng(
+        np.random.SeedSequence(root.entropy, spawn_key=key, pool_size=root.pool_size))
+
+
+@functools.wraps(_kick_rng)
+def kick_rng(*args, **kwargs) -> np.random.Generator:
+    # the old spelling kick_rng(seed, ic, radius, system) (or seed=): the root first, by
+    # position; deprecated since 0.2.0 (CHANGELOG.md), the stream unchanged
+    if "seed" in kwargs or len(args) == 4:
+        if "rng" in kwargs:
+            raise TypeError("kick_rng() got both the old root (seed) and rng=; pass only rng=")
+        if len(args) == 4:
+            seed, args = args[0], args[1:]
+        else:
+            seed = kwargs.pop("seed")
+        warnings.warn("kick_rng(seed, ic, radius, system) is deprecated since 0.2.0 and will "
+                      "be removed in 0.3.0; use kick_rng(ic, radius, system, rng=seed)",
+                      DeprecationWarning, stacklevel=2)
+        kwargs["rng"] = seed
+    return _kick_rng(*args, **kwargs)
+
+
+setattr(kick_rng, RENAMED_MARKER, {"seed": "rng"})
 
 
 class _Timer:
@@ -204,7 +238,7 @@ def task_initial_conditions(experiment: Experiment, task: Task) -> np.ndarray:
 def _cached_ics(n_ics, ic_radius, seed, method, rule, start, masses):
     from kicktimes.billiard.initial import initial_conditions
 
-    ics = initial_conditions(n_ics, ic_radius, seed=seed, method=method, rule=rule,
+    ics = initial_conditions(n_ics, ic_radius, rng=seed, method=method, rule=rule,
                              start=start, masses=masses)
     ics.flags.writeable = False  # shared by every radius: nothing may change it
     return ics
@@ -270,7 +304,7 @@ def _run_ic(exp: Experiment, r: float, ic_index: int, ic: np.ndarray, rows, coll
                             add(system, UNIFORM_PREFIX + diagnostic, value, note)
         if "autocorrelation" in diags:
             with timer("autocorrelation"):
-                theta = boundary_angles(run, 0 if system == "two_particle" else None)
+                theta = boundary_angles(run, particle=0 if system == "two_particle" else None)
                 acf_rows = autocorrelation_rows(theta, exp.lag, exp.acf_max_lag)
             for diagnostic, value, note in acf_rows:
                 add(system, diagnostic, value, note)
@@ -347,7 +381,7 @@ def _run_ic(exp: Experiment, r: float, ic_index: int, ic: np.ndarray, rows, coll
         if system not in exp.systems:
             continue
         kick = kick_law(exp, system, ic, r)
-        rng = kick_rng(exp.seed, ic_index, r, system)
+        rng = kick_rng(ic_index, r, system, rng=exp.seed)
         if system in ("poisson_kinetic", "uniform_kinetic"):
             # the event loop draws the kick times (and their scattering numbers) from rng
             one_kw = {"kicks": kinetic_rate_table(r, exp.rule), "rng": rng, **kick, **holes,
@@ -371,10 +405,10 @@ def _run_ic(exp: Experiment, r: float, ic_index: int, ic: np.ndarray, rows, coll
         with timer("simulation_one_particle"):
             if system.startswith("poisson"):
                 rate = two.n_pp / two.t_max
-                kick_times = Poisson(rate).sample(horizon, rng)
+                kick_times = Poisson(rate).sample(horizon, rng=rng)
                 extra = (("kick_rate", rate),)
             elif system == "mmpp":
-                kick_times = schedule.sample(horizon, rng)
+                kick_times = schedule.sample(horizon, rng=rng)
             kick_angles = draw_kick_angles(kick_times.size, kick["kick_angle"], exp.sigma, rng)
         one_kw = {"kicks": kick_times, "kick_angles": kick_angles, **kick, **holes, **steps}
         _kicked(system, one_kw, one_pass, exp, ic, r, timer, add, diagnose, extra,
@@ -550,7 +584,7 @@ def recurrence_rows(points: np.ndarray, eps: tuple) -> list[tuple]:
     each threshold ``e``: ``rr@e`` (the same RR), ``rr_offdiag@e`` (Theiler window 1:
     pairs ``i != j``), ``det@e``, ``l_mean@e``, ``l_max@e`` (Theiler 1, ``l_min = 2``).
     One `rqa` call (one sweep) for all thresholds; ``rr@e = (N + R) / N^2`` from its
-    ``R`` recurrent off-diagonal entries is bitwise ``recurrence_rate(points, e)``.
+    ``R`` recurrent off-diagonal entries is bitwise ``recurrence_rate(points, eps=e)``.
     """
     from kicktimes.diagnostics import rqa
 
@@ -565,10 +599,10 @@ def recurrence_rows(points: np.ndarray, eps: tuple) -> list[tuple]:
                 rows.append((f"{name}@{tag}", math.nan, "a single sample: no pair i != j"))
         return rows
     # one sweep of the points for all thresholds
-    results = rqa(points, list(eps), theiler=1, l_min=2, laminarity=False)
+    results = rqa(points, eps=list(eps), theiler=1, l_min=2, laminarity=False)
     for k, (e, res) in enumerate(zip(eps, results, strict=True)):
         tag = eps_label(e)
-        # Python ints: the expression of recurrence_rate(points, e), so bitwise equal
+        # Python ints: the expression of recurrence_rate(points, eps=e), so bitwise equal
         rr = (n + res.n_recurrent) / (n * n)
         if k == 0:
             rows.append(("recurrence_rate", rr, ""))

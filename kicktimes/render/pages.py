@@ -66,7 +66,7 @@ def simulations_source(study, cache, *extra) -> str:
 def ratio_text(estimate, low, high, tolerance=MARGIN) -> str:
     """``"0.771 [0.721, 0.825], lower"``: the interval and its `ratio_verdict`."""
     return (f"{format_interval(estimate, low, high)}, "
-            f"{ratio_verdict(low, high, tolerance)}")
+            f"{ratio_verdict(low, high, tolerance=tolerance)}")
 
 
 def number_text(x, digits=3) -> str:
@@ -164,7 +164,7 @@ def write_null_calibration(results_dir, study, rows: pd.DataFrame) -> Path:
     rows = rows.copy()
     rows.insert(0, "study", study)
     share = rows["statistic"] == "rejection share"
-    rows["verdict"] = [rejection_verdict(lo, hi, a) if s else ratio_verdict(lo, hi)
+    rows["verdict"] = [rejection_verdict(lo, hi, alpha=a) if s else ratio_verdict(lo, hi)
                        for lo, hi, a, s in zip(rows["ci_low"], rows["ci_high"], rows["alpha"],
                                                share, strict=True)]
     path = Path(results_dir) / NULL_CALIBRATION

@@ -499,7 +499,7 @@ def sections(ctx):
         return []
     lag = getattr(exp, "lag", 1)
     predicted = predicted_lag1(results)
-    summary = diagnostic_summary(results, "autocorrelation")
+    summary = diagnostic_summary(results, diagnostic="autocorrelation")
     sec = Section("autocorrelation", "Autocorrelation of boundary angles")
     sec.figure(
         "fig07_autocorrelation_vs_radius",
@@ -658,7 +658,7 @@ def effects(ctx):
                 f"the rate-matching prediction (perturbations per boundary collision, kicked "
                 f"/ two-particle) gives {number_text(predicted)}"
             )
-        verdict = ratio_verdict(tot["ci_low"], tot["ci_high"], ctx.tolerance)
+        verdict = ratio_verdict(tot["ci_low"], tot["ci_high"], tolerance=ctx.tolerance)
         if verdict.startswith("within"):
             verdict = f"{verdict} ({BUILT_IN}: kick rate = collision rate)"
         elif predicted is not None:

@@ -132,7 +132,7 @@ def _row(family, diagnostic, system, control, est, low, high, n_pairs, detail):
         # diagnostic's own margin (`margin_of`), the one the pages read and robustness uses
         "verdict": ratio_verdict(low, high),
         "margin": margin_of(diagnostic),
-        "verdict_at_margin": ratio_verdict(low, high, margin_of(diagnostic)),
+        "verdict_at_margin": ratio_verdict(low, high, tolerance=margin_of(diagnostic)),
         "robust": False,
         "depends_on": "",
         "n_pairs": int(n_pairs),
@@ -438,7 +438,7 @@ def poisson_rows(family, rejections, per_ic, *, alpha, rng, n_boot=2000, null=No
             low, high = clopper_pearson(int(k), int(n))
             how = "Clopper-Pearson 95 % CI (runs of one IC at different radii counted apart)"
         level, against = calibrated(test)
-        add(f"reject@{test}", k / n, n, low, high, rejection_verdict(low, high, level),
+        add(f"reject@{test}", k / n, n, low, high, rejection_verdict(low, high, alpha=level),
             f"share of runs rejecting {test} at α = {alpha:g}, every radius, whole window; "
             + how + against)
     if per_ic is not None and np.isfinite(per_ic["p_fixed"]).any():
@@ -446,7 +446,7 @@ def poisson_rows(family, rejections, per_ic, *, alpha, rng, n_boot=2000, null=No
         ok = np.isfinite(p)
         low, high = share_ci("p_fixed")
         add(f"reject@{HEADLINE_TEST}@first{FIXED_EVENTS}", (p[ok] < alpha).sum() / ok.sum(),
-            ok.sum(), low, high, rejection_verdict(low, high, alpha),
+            ok.sum(), low, high, rejection_verdict(low, high, alpha=alpha),
             f"{HEADLINE_TEST} on the first {FIXED_EVENTS} collisions of every run that has "
             "them (the same power at every radius); 95 % CI from a bootstrap clustered on "
             f"ICs; read against α = {alpha:g}")
@@ -463,7 +463,7 @@ def poisson_rows(family, rejections, per_ic, *, alpha, rng, n_boot=2000, null=No
             for r in referenced.itertuples():
                 margin = D_MARGIN if r.statistic == "D" else SHAPE_MARGIN
                 diagnostic = NULL_REFERENCED[r.statistic]
-                verdict = null_verdict(r.excess_low, r.excess_high, margin)
+                verdict = null_verdict(r.excess_low, r.excess_high, margin=margin)
                 null_text = (f"its null (the runs' Poisson control streams) "
                              f"{r.null:.3g} [{r.null_low:.3g}, {r.null_high:.3g}]")
                 add(diagnostic, r.value, n_d, r.low, r.high, verdict,
@@ -474,20 +474,21 @@ def poisson_rows(family, rejections, per_ic, *, alpha, rng, n_boot=2000, null=No
                     f"kicktimes.stats.null_verdict with margin {margin:g}")
             d = referenced.set_index("statistic").loc["D"]
             add(f"poisson@{HEADLINE_TEST}", head["estimate"], head["n_pairs"], head["ci_low"],
-                head["ci_high"], poisson_verdict(head["ci_low"], head["ci_high"], level,
-                                                 d.excess_low, d.excess_high,
+                head["ci_high"], poisson_verdict(head["ci_low"], head["ci_high"], null_level=level,
+                                                 dispersion_low=d.excess_low,
+                                                 dispersion_high=d.excess_high,
                                                  against_null=True),
                 f"kicktimes.stats.poisson_verdict: the {HEADLINE_TEST} rejection share against "
                 f"its calibrated level {100 * level:.1f} % and D − null D {d.excess:.3g} "
                 f"[{d.excess_low:.3g}, {d.excess_high:.3g}] against ±{D_MARGIN:g}")
             return rows
         d, d_low, d_high = clustered_mean(per_ic, "dispersion", rng=rng, n_boot=n_boot)
-        add("dispersion_index", d, n_d, d_low, d_high, ratio_verdict(d_low, d_high, 0.1),
+        add("dispersion_index", d, n_d, d_low, d_high, ratio_verdict(d_low, d_high, tolerance=0.1),
             NULL_WORDS["D"] + "; 95 % CI from a bootstrap clustered on ICs; no null streams: "
             "verdict in the ±10 % band around 1")
         add(f"poisson@{HEADLINE_TEST}", head["estimate"], head["n_pairs"], head["ci_low"],
-            head["ci_high"], poisson_verdict(head["ci_low"], head["ci_high"], level, d_low,
-                                             d_high),
+            head["ci_high"], poisson_verdict(head["ci_low"], head["ci_high"], null_level=level,
+                                             dispersion_low=d_low, dispersion_high=d_high),
             f"kicktimes.stats.poisson_verdict: the {HEADLINE_TEST} rejection share against its "
             f"calibrated level {100 * level:.1f} % and D {d:.3g} [{d_low:.3g}, {d_high:.3g}] "
             "against [0.9, 1.1]")

@@ -19,6 +19,7 @@ from kicktimes.render.figures import (
 from kicktimes.render.pages import p_value_text
 from kicktimes.report.context import Section
 from kicktimes.stats import STICKY_FACTOR
+from kicktimes.validation import keyword_only_after
 
 __all__ = ["counts_by_radius", "counts_vs_radius", "experiment_kinetic", "kinetic_rate_of",
            "sticky_ics",
@@ -34,7 +35,7 @@ def kinetic_rate_of(radius, rule="mirror", kinetic=None):
         return kinetic(radius)
     from kicktimes import stats
 
-    return stats.kinetic_rate(radius, rule)
+    return stats.kinetic_rate(radius, rule=rule)
 
 
 def experiment_kinetic(exp):
@@ -114,7 +115,8 @@ def counts_by_radius(collisions, *, x="radius") -> pd.DataFrame:
     return out
 
 
-def counts_vs_radius(collisions, regression=None, *, rule="mirror", ax=None, kinetic=None):
+@keyword_only_after(1, since="0.2.0", names=('regression',))
+def counts_vs_radius(collisions, *, regression=None, rule="mirror", ax=None, kinetic=None):
     r"""Mean number of disk-disk collisions against radius, with the fitted curves.
 
     Parameters
@@ -231,7 +233,7 @@ def sections(ctx):
         od = reg.overdispersion()
     sec.figure(
         "fig04_counts_vs_radius",
-        counts_vs_radius(coll, reg, rule=exp.rule, kinetic=kinetic),
+        counts_vs_radius(coll, regression=reg, rule=exp.rule, kinetic=kinetic),
         "Mean number of disk-disk collisions per run against radius (± s.e.m. over ICs) with "
         "the paper's least-squares line, Poisson and negative-binomial regressions and the "
         f"kinetic-theory count Γ(r)·T ({exp.rule} rule), curves at the mean window T(r).",

@@ -215,7 +215,7 @@ def gap_decomposition(results, collisions, *, family, eps, rule="mirror", rng, n
             xs, y, _ = _arrays(table, systems, keep)
             if n_ic is None:
                 n_ic = y.shape[1]
-                idx = resample_indices(n_ic, n_boot, rng)
+                idx = resample_indices(n_ic, n_boot=n_boot, rng=rng)
                 counts = np.zeros((n_boot, n_ic))
                 np.add.at(counts, (np.arange(n_boot)[:, None], idx), 1.0)
             ones = np.ones((1, n_ic))
@@ -233,7 +233,7 @@ def gap_decomposition(results, collisions, *, family, eps, rule="mirror", rng, n
                 shares += list(shapley_shares(point[where_actual, None])[:, 0])
                 boot_shares += list(shapley_shares(boot[where_actual]))
                 steps += list(STEPS[3:])
-            lo0, hi0 = percentile_interval(boot[0], level)
+            lo0, hi0 = percentile_interval(boot[0], level=level)
             margin = margin_of(diagnostic)
             gap = bool(hi0 < 1 - margin or lo0 > 1 + margin)
             names = [f"ratio {s}" for s in systems] + steps
@@ -245,7 +245,7 @@ def gap_decomposition(results, collisions, *, family, eps, rule="mirror", rng, n
                     rows.append((family, diagnostic, control, quantity, np.nan, np.nan, np.nan,
                                  NO_GAP))
                     continue
-                lo, hi = percentile_interval(dist, level)
+                lo, hi = percentile_interval(dist, level=level)
                 rows.append((family, diagnostic, control, quantity, float(est), float(lo),
                              float(hi), note))
     return pd.DataFrame(rows, columns=columns)

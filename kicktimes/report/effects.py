@@ -84,8 +84,8 @@ class Effect(Finding):
             estimate=overall["ratio"],
             ci_low=low,
             ci_high=high,
-            verdict=verdict or ratio_verdict(low, high, tolerance),
-            rule=ratio_rule(tolerance),
+            verdict=verdict or ratio_verdict(low, high, tolerance=tolerance),
+            rule=ratio_rule(tolerance=tolerance),
             method=method or f"paired bootstrap over {overall['n_ics']} ICs",
             detail=detail,
         )

@@ -284,7 +284,7 @@ def escape_comparison(table) -> pd.DataFrame:
                 verdict, reason = "not like", "one tail is exponential, the other algebraic"
             else:
                 name = "γ" if compared == "rate" else "α"
-                rv = ratio_verdict(ratio_low, ratio_high, MARGIN)
+                rv = ratio_verdict(ratio_low, ratio_high, tolerance=MARGIN)
                 verdict = {"lower": "not like", "higher": "not like",
                            "inconclusive": "inconclusive"}.get(rv, "like")
                 reason = (f"ratio of {name} {format_interval(ratio, ratio_low, ratio_high)}: "

@@ -66,7 +66,7 @@ def scale_statement(store):
 def rules_text(ctx):
     return (
         "Verdict rules. Ratios (kicked / two-particle, observed / kinetic): "
-        + ratio_rule(ctx.tolerance)
+        + ratio_rule(tolerance=ctx.tolerance)
         + ". Shares (of rejections against α, of fitted ICs against 1/2): "
         + SHARE_RULE.format(level=0.5).replace("0.5", "the level")
         + ". Ratios average the per-radius ratios of ensemble means; their CIs come from "

@@ -1,7 +1,7 @@
 r"""Poisson kick times against the actual disk-disk collision times (the paper's Fig. 3).
 
 The Poisson kick times are the sweep's own: rate ``n_pp / t_window`` of each IC's
-two-particle run and the sweep's ``kick_rng(seed, ic, radius, "poisson")`` stream.
+two-particle run and the sweep's ``kick_rng(ic, radius, "poisson", rng=seed)`` stream.
 """
 
 from __future__ import annotations
@@ -212,7 +212,7 @@ def sections(ctx):
         pp = np.asarray(row.pp_times, dtype=float)
         rate = row.n_pp / row.t_window
         kicks = (
-            Poisson(rate).sample(exp.horizon, kick_rng(exp.seed, int(row.ic), r, "poisson"))
+            Poisson(rate).sample(exp.horizon, rng=kick_rng(int(row.ic), r, "poisson", rng=exp.seed))
             if rate > 0
             else np.empty(0)
         )

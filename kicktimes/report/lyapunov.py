@@ -219,7 +219,7 @@ def sections(ctx):
     if getattr(exp, "lyapunov_variant", "") == "paper":
         title += " (paper variant: max(λˣ, λʸ))"
     sec = Section("lyapunov", f"{title} against radius")
-    summary = diagnostic_summary(results, "lyapunov")
+    summary = diagnostic_summary(results, diagnostic="lyapunov")
     table = stretching_table(results)
     sec.figure(
         "fig05_lyapunov_vs_radius",

@@ -39,6 +39,7 @@ from kicktimes.stats import (
     spearman,
 )
 from kicktimes.stats.poisson import TEST_NULLS
+from kicktimes.validation import keyword_only_after
 
 __all__ = [
     "binomial_ci",
@@ -69,10 +70,11 @@ TEST_TITLES = {
 FIXED_EVENTS = 30
 
 
-def binomial_ci(k, n, level=0.95):
+@keyword_only_after(2, since="0.2.0")
+def binomial_ci(k, n, *, level=0.95):
     """Clopper-Pearson interval of ``k`` successes in ``n`` trials (NaN where n = 0): the
     arrays of `kicktimes.stats.clopper_pearson`."""
-    return clopper_pearson(k, n, level)
+    return clopper_pearson(k, n, level=level)
 
 
 def rejection_table(rejections, *, level=0.95, x="radius") -> pd.DataFrame:
@@ -89,7 +91,7 @@ def rejection_table(rejections, *, level=0.95, x="radius") -> pd.DataFrame:
     out = df.copy()
     with np.errstate(invalid="ignore", divide="ignore"):
         out["rate"] = np.where(n > 0, k / np.where(n > 0, n, 1), np.nan)
-    out["ci_low"], out["ci_high"] = binomial_ci(k, n, level)
+    out["ci_low"], out["ci_high"] = binomial_ci(k, n, level=level)
     if {"control_n_tested", "control_n_reject"} <= set(df.columns):
         nc, kc = df["control_n_tested"].to_numpy(float), df["control_n_reject"].to_numpy(float)
         with np.errstate(invalid="ignore", divide="ignore"):
@@ -215,7 +217,8 @@ def _control_times(seqs, windows, ics, r, control):
         if t.size == 0:
             out.append(np.empty(0))
             continue
-        kicks = Poisson(t.size / w).sample(horizon, kick_rng(exp_seed, int(ic), r, "poisson"))
+        kicks = Poisson(t.size / w).sample(
+            horizon, rng=kick_rng(int(ic), r, "poisson", rng=exp_seed))
         out.append(kicks[kicks <= w])
     return out
 
@@ -487,10 +490,10 @@ def clustered_mean(per_ic, column, *, rng, n_boot=2000, level=0.95):
     if n_runs.sum() == 0:
         return math.nan, math.nan, math.nan
     n = n_runs.size
-    counts = resample_counts(n, n_boot, rng)
+    counts = resample_counts(n, n_boot=n_boot, rng=rng)
     with np.errstate(invalid="ignore", divide="ignore"):
         boot = (counts @ total) / (counts @ n_runs)
-    return (float(total.sum() / n_runs.sum()), *percentile_interval(boot, level))
+    return (float(total.sum() / n_runs.sum()), *percentile_interval(boot, level=level))
 
 
 #: the statistics read against the runs' Poisson control streams (null_calibration.csv):
@@ -629,7 +632,7 @@ def effects(ctx):
     per_ic = ctx.found.poisson_per_ic
     low, high = ctx.found.poisson_cis["p"]
     level = null_level(ctx.found.null_calibration, HEADLINE_TEST, ctx.alpha)
-    verdict = share_verdict(low, high, level)
+    verdict = share_verdict(low, high, level=level)
     n_fixed = max(1, int(np.isfinite(per_ic["p_fixed"]).sum()))
     fixed_share = float((per_ic["p_fixed"] < ctx.alpha).sum()) / n_fixed
     f_low, f_high = ctx.found.poisson_cis["p_fixed"]

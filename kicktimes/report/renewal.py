@@ -405,5 +405,5 @@ def calibrated_share(ctx, fitted, hit, null_hit, *, rng, under, what="fits") -> 
             f" (level: the share {under} with the same numbers of collisions and windows, by "
             f"simulation: {level:.3g} [{lvl_low:.3g}, {lvl_high:.3g}])"),
         "method": f"bootstrap clustered on {fitted['ic'].nunique()} ICs ({n} {what})",
-        "level": level, "verdict": share_verdict(low, high, level),
+        "level": level, "verdict": share_verdict(low, high, level=level),
     }

@@ -27,11 +27,13 @@ from kicktimes.render.figures import (
 from kicktimes.report.context import Section
 from kicktimes.report.escape import ESCAPE_ROWS
 from kicktimes.report.store import REFERENCE, distinct
+from kicktimes.validation import keyword_only_after
 
 __all__ = ["diagnostic_summary", "diagnostic_vs_radius", "comparison_table", "sections"]
 
 
-def diagnostic_summary(results, diagnostic=None) -> pd.DataFrame:
+@keyword_only_after(1, since="0.2.0")
+def diagnostic_summary(results, *, diagnostic=None) -> pd.DataFrame:
     r"""Ensemble summary of a tidy results table, per radius x system x diagnostic.
 
     Parameters
@@ -112,7 +114,7 @@ def diagnostic_vs_radius(
         if len(summary) == 0:
             raise ValueError(f"diagnostic {diagnostic!r} is not in the summary")
     else:
-        summary = diagnostic_summary(results, diagnostic)
+        summary = diagnostic_summary(results, diagnostic=diagnostic)
     present = [s for s in SYSTEMS if s in distinct(summary, "system")]
     present += sorted(distinct(summary, "system") - set(SYSTEMS))
     if systems is None:

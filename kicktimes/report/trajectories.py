@@ -20,6 +20,7 @@ from kicktimes.render.figures import TIME_UNIT, check_frame, finite, new_axes
 from kicktimes.render.pages import percent_text
 from kicktimes.report.context import Section
 from kicktimes.report.store import REFERENCE, eps_values, nearest
+from kicktimes.validation import keyword_only_after
 
 __all__ = ["poincare_section", "poincare_panels", "recurrence_plot", "line_pairs", "sections"]
 
@@ -54,7 +55,9 @@ def _boundary_frame(data, particle):
     return s, st, radius
 
 
-def poincare_section(data, particle=0, *, ax=None, title=None, markersize=0.6, color="C0"):
+@keyword_only_after(1, since="0.2.0", names=('particle',))
+def poincare_section(data, *, particle=0, ax=None, title=None, markersize=0.6,
+                     color="C0"):
     r"""Poincaré section ``(s, sin θ)`` of one disk's boundary collisions.
 
     Parameters
@@ -86,7 +89,7 @@ def poincare_section(data, particle=0, *, ax=None, title=None, markersize=0.6, c
     --------
     >>> from kicktimes import simulate_two_particle, initial_conditions
     >>> from kicktimes.report.trajectories import poincare_section
-    >>> run = simulate_two_particle(initial_conditions(1, 0.02, seed=1)[0], 0.02, t_max=500.0)
+    >>> run = simulate_two_particle(initial_conditions(1, 0.02, rng=1)[0], 0.02, t_max=500.0)
     >>> fig = poincare_section(run)
     >>> fig.axes[0].get_ylabel()
     '$\\sin\\theta$ (dimensionless)'
@@ -138,7 +141,7 @@ def poincare_panels(runs, *, particle=0, titles=None, markersize=0.6):
         title = None if titles is None else titles[k]
         if title is None and getattr(run, "r", None) is not None:
             title = f"({chr(ord('a') + k)}) disk {particle}, r = {run.r:g}"
-        poincare_section(run, particle, ax=ax, title=title, markersize=markersize)
+        poincare_section(run, particle=particle, ax=ax, title=title, markersize=markersize)
         if k < len(runs) - 1:
             ax.set_xlabel("")
     return fig
@@ -174,7 +177,7 @@ def _as_pairs(data, eps, n_points):
     from kicktimes.diagnostics import recurrence_pairs
 
     points = data.samples if hasattr(data, "samples") else data
-    i, j = recurrence_pairs(points, eps)
+    i, j = recurrence_pairs(points, eps=eps)
     return i, j, int(np.asarray(points).shape[0])
 
 
@@ -346,14 +349,14 @@ def _line_inset(ax, i, j, n, zoom, scale):
 
 def _sweep_poisson_run(exp, ic, r, two):
     """The sweep's Poisson-kicked run of IC 0 at ``r``: its kick times and angles from the
-    ``kick_rng(seed, 0, r, "poisson")`` stream, as the sweep draws them."""
+    ``kick_rng(0, r, "poisson", rng=seed)`` stream, as the sweep draws them."""
     from kicktimes.billiard.one_particle import draw_kick_angles, simulate_one_particle
     from kicktimes.experiment import kick_rng
     from kicktimes.schedules import Poisson
 
-    rng = kick_rng(exp.seed, 0, r, "poisson")
+    rng = kick_rng(0, r, "poisson", rng=exp.seed)
     rate = two.n_pp / two.t_max if two.t_max > 0 else 0.0
-    times = Poisson(rate).sample(exp.horizon, rng) if rate > 0 else np.empty(0)
+    times = Poisson(rate).sample(exp.horizon, rng=rng) if rate > 0 else np.empty(0)
     angles = draw_kick_angles(times.size, exp.kick_angle, exp.sigma, rng)
     return simulate_one_particle(ic[0], r, kicks=times, kick_angles=angles,
                                  kick_angle=exp.kick_angle, sigma=exp.sigma,
@@ -368,7 +371,7 @@ def sections(ctx):
 
     store, exp = ctx.store, ctx.exp
     secs = []
-    ic = initial_conditions(1, exp.r_max, seed=exp.seed, method=exp.ic_method, rule=exp.rule)[0]
+    ic = initial_conditions(1, exp.r_max, rng=exp.seed, method=exp.ic_method, rule=exp.rule)[0]
     radii = list(dict.fromkeys(nearest(exp.radii, r) for r in _POINCARE_RADII))
     runs = {
         r: simulate_two_particle(
@@ -405,9 +408,9 @@ def sections(ctx):
     fig = Figure(figsize=(11.0, 3.2 * len(radii)), layout="constrained")
     axes = np.atleast_2d(fig.subplots(len(radii), 2, sharex=True, sharey=True, squeeze=False))
     for k, r in enumerate(radii):
-        poincare_section(runs[r], 0, ax=axes[k, 0],
+        poincare_section(runs[r], particle=0, ax=axes[k, 0],
                          title=f"({chr(ord('a') + 2 * k)}) two disks, disk 0, r = {r:g}")
-        poincare_section(kicked[r], 0, ax=axes[k, 1], color="tab:orange",
+        poincare_section(kicked[r], particle=0, ax=axes[k, 1], color="tab:orange",
                          title=f"({chr(ord('b') + 2 * k)}) one disk, Poisson kicks, r = {r:g}")
         if k < len(radii) - 1:
             for ax in axes[k]:
@@ -444,7 +447,7 @@ def sections(ctx):
     r_rr = nearest(exp.radii, 0.02)
     run = runs[r_rr]
     eps = eps_values(exp)[0]
-    i, j = recurrence_pairs(run.samples, eps)
+    i, j = recurrence_pairs(run.samples, eps=eps)
     n = run.samples.shape[0]
     rr = i.size / float(n) ** 2
     stored = store.results[

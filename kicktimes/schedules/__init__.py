@@ -1,7 +1,7 @@
 """Kick schedules: the random (or replayed) times at which the one-particle billiard is kicked.
 
 A schedule is a small immutable *value* that describes a point process on ``(0, t_max]``;
-``schedule.sample(t_max, rng)`` draws one realisation as a sorted float64 array. The
+``schedule.sample(t_max, rng=rng)`` draws one realisation as a sorted float64 array. The
 schedules are the bridge between the statistics of disk-disk collision times and the
 perturbed one-particle billiard (docs/architecture.md, "Perturbed one-particle billiard"):
 

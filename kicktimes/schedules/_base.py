@@ -35,7 +35,7 @@ from kicktimes.schedules._validate import (
     _float_array,
     _run_times,
 )
-from kicktimes.validation import check_rng
+from kicktimes.validation import check_rng, keyword_only_after
 
 
 # ---------------------------------------------------------------------------- sampling
@@ -84,7 +84,8 @@ class Schedule(abc.ABC):
     _type = ""
 
     @abc.abstractmethod
-    def sample(self, t_max, rng=None, *, max_kicks=DEFAULT_MAX_KICKS):
+    @keyword_only_after(1, since="0.2.0", names=('rng',))
+    def sample(self, t_max, *, rng=None, max_kicks=DEFAULT_MAX_KICKS):
         """Sorted float64 kick times in ``(0, t_max]`` (see the subclass)."""
 
     #: the law of the kick times in words (the first line of `summary`)
@@ -181,7 +182,8 @@ class Poisson(Schedule):
             raise ValueError("runs must contain at least one run, got none")
         return cls(sum(t.size for t, _ in pairs) / sum(T for _, T in pairs))
 
-    def sample(self, t_max, rng=None, *, max_kicks=DEFAULT_MAX_KICKS):
+    @keyword_only_after(1, since="0.2.0", names=('rng',))
+    def sample(self, t_max, *, rng=None, max_kicks=DEFAULT_MAX_KICKS):
         """Kick times of a Poisson process on ``(0, t_max]``, sorted float64."""
         t_max = _check_t_max(t_max)
         max_kicks = _check_max_kicks(max_kicks)
@@ -277,7 +279,8 @@ class Renewal(Schedule):
         """``E[X]`` of the interval law (inf or nan when it does not exist)."""
         return self._cached("mean", lambda: float(self.dist.mean()))
 
-    def sample(self, t_max, rng=None, *, max_kicks=DEFAULT_MAX_KICKS):
+    @keyword_only_after(1, since="0.2.0", names=('rng',))
+    def sample(self, t_max, *, rng=None, max_kicks=DEFAULT_MAX_KICKS):
         """Kick times of the renewal process on ``(0, t_max]``, sorted float64."""
         t_max = _check_t_max(t_max)
         max_kicks = _check_max_kicks(max_kicks)
@@ -329,7 +332,7 @@ class Replay(Schedule):
 
     Notes
     -----
-    ``sample(t_max, rng)`` ignores ``rng`` and returns a copy of the times ``<= t_max``.
+    ``sample(t_max, rng=rng)`` ignores ``rng`` and returns a copy of the times ``<= t_max``.
 
     Examples
     --------
@@ -360,7 +363,8 @@ class Replay(Schedule):
         times, t_max = _run_times(run)
         return cls(times, t_max=t_max)
 
-    def sample(self, t_max, rng=None, *, max_kicks=DEFAULT_MAX_KICKS):
+    @keyword_only_after(1, since="0.2.0", names=('rng',))
+    def sample(self, t_max, *, rng=None, max_kicks=DEFAULT_MAX_KICKS):
         """The stored times in ``(0, t_max]`` (a copy); ``rng`` is validated and ignored."""
         t_max = _check_t_max(t_max)
         max_kicks = _check_max_kicks(max_kicks)
@@ -462,7 +466,8 @@ class Bootstrap(Schedule):
         """Mean of the observed intervals."""
         return float(self.intervals.mean())
 
-    def sample(self, t_max, rng=None, *, max_kicks=DEFAULT_MAX_KICKS):
+    @keyword_only_after(1, since="0.2.0", names=('rng',))
+    def sample(self, t_max, *, rng=None, max_kicks=DEFAULT_MAX_KICKS):
         """Kick times with resampled intervals on ``(0, t_max]``, sorted float64."""
         t_max = _check_t_max(t_max)
         max_kicks = _check_max_kicks(max_kicks)

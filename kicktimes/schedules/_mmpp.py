@@ -21,7 +21,7 @@ from kicktimes.schedules._validate import (
     _check_t_max,
     _float_array,
 )
-from kicktimes.validation import check_rng
+from kicktimes.validation import check_rng, keyword_only_after
 
 __all__ = ["MMPP"]
 
@@ -294,7 +294,8 @@ class MMPP(Schedule):
         return -np.diag(self.generator)
 
     # -------------------------------------------------------------------- sampling
-    def sample(self, t_max, rng=None, *, max_kicks=DEFAULT_MAX_KICKS):
+    @keyword_only_after(1, since="0.2.0", names=('rng',))
+    def sample(self, t_max, *, rng=None, max_kicks=DEFAULT_MAX_KICKS):
         """Kick times of the MMPP on ``(0, t_max]``, sorted float64 (see Notes)."""
         t_max = _check_t_max(t_max)
         max_kicks = _check_max_kicks(max_kicks)

@@ -38,7 +38,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from kicktimes.validation import check_int, check_real, check_rng
+from kicktimes.validation import check_int, check_real, check_rng, keyword_only_after
 
 from .robust import bootstrap_nanmedians, nanmedian
 
@@ -46,7 +46,8 @@ __all__ = ["ClusterBootstrap", "cluster_bootstrap", "paired_median", "paired_rat
            "percentile_interval", "ratio_of_means", "resample_counts", "resample_indices"]
 
 
-def resample_indices(n_clusters, n_boot, rng=None, *, with_identity=False, chunk=None):
+@keyword_only_after(1, since="0.2.0", names=('n_boot', 'rng'))
+def resample_indices(n_clusters, *, n_boot, rng=None, with_identity=False, chunk=None):
     r"""Cluster indices of ``n_boot`` bootstrap resamples of ``n_clusters`` runs.
 
     Parameters
@@ -74,7 +75,7 @@ def resample_indices(n_clusters, n_boot, rng=None, *, with_identity=False, chunk
     Examples
     --------
     >>> from kicktimes.stats import resample_indices
-    >>> resample_indices(4, 2, rng=0, with_identity=True)
+    >>> resample_indices(4, n_boot=2, rng=0, with_identity=True)
     array([[0, 1, 2, 3],
            [3, 2, 2, 1],
            [1, 0, 0, 0]])
@@ -93,7 +94,8 @@ def resample_indices(n_clusters, n_boot, rng=None, *, with_identity=False, chunk
     return idx
 
 
-def resample_counts(n_clusters, n_boot, rng=None):
+@keyword_only_after(1, since="0.2.0")
+def resample_counts(n_clusters, *, n_boot, rng=None):
     r"""How often each cluster is drawn in each of ``n_boot`` bootstrap resamples.
 
     The same resampling as `resample_indices`, counted: row ``b`` is multinomial with
@@ -115,7 +117,7 @@ def resample_counts(n_clusters, n_boot, rng=None):
     Examples
     --------
     >>> from kicktimes.stats import resample_counts
-    >>> resample_counts(4, 3, rng=0).sum(axis=1).tolist()
+    >>> resample_counts(4, n_boot=3, rng=0).sum(axis=1).tolist()
     [4.0, 4.0, 4.0]
     """
     n = check_int("n_clusters", n_clusters, low=1)
@@ -130,7 +132,8 @@ def _tail_percent(level):
     return round(50.0 * (1.0 - level), 12)
 
 
-def percentile_interval(replicates, level=0.95, *, axis=None):
+@keyword_only_after(1, since="0.2.0", names=('level',))
+def percentile_interval(replicates, *, level=0.95, axis=None):
     r"""Percentile interval of the finite bootstrap replicates.
 
     ``(p_a, p_{100-a})`` with ``a = 50 (1 - level)`` percent (2.5 and 97.5 for the 95 %
@@ -260,12 +263,12 @@ def cluster_bootstrap(statistic, n_clusters, *, n_boot=999, level=0.95, rng=None
     estimate = np.asarray(statistic(np.arange(n)[None, :]), float)[0]
     step = b if chunk is None else check_int("chunk", chunk, low=1)
     replicates = np.concatenate([
-        np.asarray(statistic(resample_indices(n, min(step, b - m), rng)), float)
+        np.asarray(statistic(resample_indices(n, n_boot=min(step, b - m), rng=rng)), float)
         for m in range(0, b, step)])
     if replicates.ndim == 1:
-        low, high = percentile_interval(replicates, level)
+        low, high = percentile_interval(replicates, level=level)
         return ClusterBootstrap(float(estimate), low, high, replicates, level, n)
-    bounds = np.array([percentile_interval(replicates[:, j], level)
+    bounds = np.array([percentile_interval(replicates[:, j], level=level)
                        for j in range(replicates.shape[1])])
     return ClusterBootstrap(estimate, bounds[:, 0], bounds[:, 1], replicates, level, n)
 
@@ -372,7 +375,7 @@ def paired_ratio(numerator, denominator, *, rng, n_boot=2000, level=0.95, resamp
     n = ics.size
     counts = None if resamples is None else resamples.get((n, n_boot))
     if counts is None:
-        counts = resample_counts(n, n_boot, rng)
+        counts = resample_counts(n, n_boot=n_boot, rng=rng)
         if resamples is not None:
             resamples[(n, n_boot)] = counts
     with np.errstate(invalid="ignore", divide="ignore"):
@@ -384,7 +387,7 @@ def paired_ratio(numerator, denominator, *, rng, n_boot=2000, level=0.95, resamp
     low = high = np.full(radii.size, np.nan)
     if n_boot:
         # a radius without any usable resample gives an all-NaN column: its CI is NaN
-        low, high = percentile_interval(boot, level, axis=0)
+        low, high = percentile_interval(boot, level=level, axis=0)
     per_radius = pd.DataFrame(
         {
             "radius": radii,
@@ -498,14 +501,14 @@ def paired_median(numerator, denominator, *, rng, n_boot=1000, level=0.95):
         return {"ratio": math.nan, "ci_low": math.nan, "ci_high": math.nan, "n_pairs": n_pairs,
                 "per_radius": curve}
     n = values.shape[1]
-    idx = resample_indices(n, n_boot, rng)
+    idx = resample_indices(n, n_boot=n_boot, rng=rng)
     # boot_r[b] = nanmedian(values[:, idx[b]], axis=1), bit for bit, without a sort each
     boot_r = bootstrap_nanmedians(values, idx)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)  # a resample without a finite pair
         boot = np.nanmean(boot_r[:, usable], axis=1)
-    low_r, high_r = percentile_interval(boot_r, level, axis=0)
-    low, high = percentile_interval(boot, level)
+    low_r, high_r = percentile_interval(boot_r, level=level, axis=0)
+    low, high = percentile_interval(boot, level=level)
     curve = pd.DataFrame({"radius": table.index.to_numpy(float),
                           "n_pairs": np.isfinite(values).sum(axis=1),
                           "ratio": per_radius.to_numpy(), "ci_low": low_r, "ci_high": high_r})

@@ -36,6 +36,7 @@ from statsmodels.regression.linear_model import OLS
 from statsmodels.tools.tools import add_constant
 
 from kicktimes._results import nan_reason
+from kicktimes.validation import keyword_only_after
 
 from ._checks import as_1d_float, check_choice
 from ._information import inverse_information
@@ -141,7 +142,8 @@ def is_sticky(rate, kinetic, *, factor=STICKY_FACTOR):
     return out if out.ndim else bool(out)
 
 
-def kinetic_rate(r, rule="mirror", *, masses=None):
+@keyword_only_after(1, since="0.2.0", names=('rule',))
+def kinetic_rate(r, *, rule="mirror", masses=None):
     r"""Disk-disk collision rate of two disks of radius ``r`` under the invariant measure.
 
     Parameters
@@ -377,7 +379,8 @@ class CountRegression:
             }
         )
 
-    def predict(self, radius, t_window=1.0) -> pd.DataFrame:
+    @keyword_only_after(1, since="0.2.0")
+    def predict(self, radius, *, t_window=1.0) -> pd.DataFrame:
         """Expected counts at ``radius`` over ``t_window`` from each model.
 
         Columns ``radius``, ``t_window``, ``ols``, ``poisson``, ``negbin`` and, when
@@ -397,7 +400,7 @@ class CountRegression:
         out["poisson"] = np.exp(b_poi[0] + b_poi[1] * g) * t
         out["negbin"] = np.exp(b_nb[0] + b_nb[1] * g) * t
         if self.rule is not None:
-            out["kinetic"] = kinetic_rate(r, self.rule) * t
+            out["kinetic"] = kinetic_rate(r, rule=self.rule) * t
         return out
 
     def to_frame(self) -> pd.DataFrame:

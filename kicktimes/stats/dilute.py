@@ -34,6 +34,7 @@ import numba
 import numpy as np
 
 from kicktimes._results import Result
+from kicktimes.validation import keyword_only_after
 
 from ._checks import check_choice, check_int, check_real, check_rng
 from .enskog import speed_rate_factor
@@ -117,7 +118,8 @@ def _elastic_streams(gen, n_runs, t_window, c, kT):  # pragma: no cover - compil
     return times[:nt], speeds[:ns], lengths
 
 
-def dilute_tagged_times(rule, rate, t_window, n_runs, rng, *, kT=0.5, speeds=False):
+@keyword_only_after(3, since="0.2.0", names=("n_runs", "rng"))
+def dilute_tagged_times(rule, rate, t_window, *, n_runs, rng=None, kT=0.5, speeds=False):
     r"""Collision times of a tagged disk in a dilute gas of equal hard disks (linear
     Boltzmann process), ``n_runs`` independent stationary streams on ``[0, t_window]``.
 
@@ -186,10 +188,10 @@ def dilute_tagged_times(rule, rate, t_window, n_runs, rng, *, kT=0.5, speeds=Fal
     Examples
     --------
     >>> import numpy as np
-    >>> times = dilute_tagged_times("elastic", 2.0, 50.0, 200, np.random.default_rng(1))
+    >>> times = dilute_tagged_times("elastic", 2.0, 50.0, n_runs=200, rng=np.random.default_rng(1))
     >>> len(times), bool(abs(np.mean([t.size for t in times]) / 100 - 1) < 0.05)
     (200, True)
-    >>> t, v = dilute_tagged_times("mirror", 1.0, 10.0, 3, 0, speeds=True)
+    >>> t, v = dilute_tagged_times("mirror", 1.0, 10.0, n_runs=3, rng=0, speeds=True)
     >>> [bool(np.all(s == 1.0)) and s.size == x.size + 1 for x, s in zip(t, v)]
     [True, True, True]
     """
@@ -204,7 +206,7 @@ def dilute_tagged_times(rule, rate, t_window, n_runs, rng, *, kT=0.5, speeds=Fal
         raise TypeError(f"n_runs must be an integer >= 1, got {n_runs!r}")
     if n_runs < 1:
         raise ValueError(f"n_runs must be an integer >= 1, got {n_runs!r}")
-    rng = np.random.default_rng(rng)
+    rng = check_rng(rng, "rng")
     if rule == "mirror":
         counts = rng.poisson(float(rate) * float(t_window), size=int(n_runs))
         times = [np.sort(rng.uniform(0.0, float(t_window), k)) for k in counts]
@@ -489,7 +491,8 @@ class DiluteTaggedDisk(Result):
         out = [self._moment(2, x) / self._moment(1, x) for x in arr.ravel()]
         return np.asarray(out, dtype=float).reshape(arr.shape)
 
-    def dispersion(self, window=None, *, n_events=2_000_000, batch=500, rng=0):
+    @keyword_only_after(0, since="0.2.0", names=('window',))
+    def dispersion(self, *, window=None, n_events=2_000_000, batch=500, rng=0):
         r"""The index of dispersion :math:`D = \operatorname{Var}N/\operatorname{E}N` of
         the collisions counted in a window of ``window`` mean intervals of the
         stationary process; its long-window limit :math:`D_\infty` for ``None``.
@@ -548,7 +551,7 @@ class DiluteTaggedDisk(Result):
         >>> d = dilute_tagged_disk("elastic").dispersion(n_events=200_000)
         >>> bool(1.1 < d.value < 1.2), 390 < d.n <= 400
         (True, True)
-        >>> float(dilute_tagged_disk("mirror").dispersion(30.0))
+        >>> float(dilute_tagged_disk("mirror").dispersion(window=30.0))
         1.0
         """
         if window is not None:
@@ -561,8 +564,8 @@ class DiluteTaggedDisk(Result):
             return DiluteEstimate(name, 1.0, 0.0, 1.0, 1.0, 0, "exact: a Poisson process")
         if window is None:
             n_streams = 4
-            _, speeds = dilute_tagged_times("elastic", 1.0, n_events / n_streams, n_streams,
-                                            rng, kT=self.kT, speeds=True)
+            _, speeds = dilute_tagged_times("elastic", 1.0, n_events / n_streams, n_runs=n_streams,
+                                            rng=rng, kT=self.kT, speeds=True)
             dev = []
             for s in speeds:
                 g = 1.0 / self.rate(s[1 + _BURN_IN:])
@@ -578,7 +581,7 @@ class DiluteTaggedDisk(Result):
                 dev.size, f"E_post[1/rho^2] by quadrature + batch means of 1/rho over the "
                 f"post-collision speed chain ({dev.size} batches of {batch} collisions)")
         n_runs = max(int(math.ceil(n_events / window)), 200)
-        times = dilute_tagged_times("elastic", 1.0, window, n_runs, rng, kT=self.kT)
+        times = dilute_tagged_times("elastic", 1.0, window, n_runs=n_runs, rng=rng, kT=self.kT)
         c = np.array([x.size for x in times], dtype=float)
         mu, var = c.mean(), c.var(ddof=1)
         d = var / mu
@@ -587,7 +590,8 @@ class DiluteTaggedDisk(Result):
                                 f"variance over mean of the counts of {c.size} independent "
                                 f"stationary streams, delta-method error")
 
-    def ks_share(self, k, alpha=0.05, *, n_runs=4000, rng=0):
+    @keyword_only_after(1, since="0.2.0", names=('alpha',))
+    def ks_share(self, k, *, alpha=0.05, n_runs=4000, rng=0):
         r"""The share of tagged disks whose first ``k`` collision times a KS test of
         uniformity on the window up to collision ``k + 1`` rejects at ``alpha``.
 
@@ -639,7 +643,7 @@ class DiluteTaggedDisk(Result):
                                   "exact: uniform times given collision k + 1 (Poisson)")
         window = 2.0 * (k + 1) + 50.0
         while True:
-            times = dilute_tagged_times("elastic", 1.0, window, n_runs, rng, kT=self.kT)
+            times = dilute_tagged_times("elastic", 1.0, window, n_runs=n_runs, rng=rng, kT=self.kT)
             if min(x.size for x in times) > k:
                 break
             window *= 2.0

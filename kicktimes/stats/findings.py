@@ -25,6 +25,7 @@ from kicktimes._results import (
     Result,
     format_interval,  # one place for result formatting
 )
+from kicktimes.validation import keyword_only_after
 
 __all__ = [
     "MARGIN",
@@ -63,10 +64,11 @@ SHARE_RULE = (
 )
 
 
-def ratio_rule(tolerance=0.1) -> str:
+@keyword_only_after(0, since="0.2.0")
+def ratio_rule(*, tolerance=0.1) -> str:
     """The printed rule of :func:`ratio_verdict` for a band of half-width ``tolerance``.
 
-    >>> ratio_rule(0.1)[:58]
+    >>> ratio_rule(tolerance=0.1)[:58]
     'within 10 %: the whole 95 % CI of the ratio lies in [0.9, '
     """
     p, lo, hi = f"{100 * tolerance:g}", f"{1 - tolerance:g}", f"{1 + tolerance:g}"
@@ -85,7 +87,8 @@ def ratio_rule(tolerance=0.1) -> str:
 MARGIN = 0.1
 
 
-def ratio_verdict(low, high, tolerance=MARGIN):
+@keyword_only_after(2, since="0.2.0")
+def ratio_verdict(low, high, *, tolerance=MARGIN):
     """``"within 10 %"``, ``"higher"``, ``"lower"`` or ``"inconclusive"`` for a ratio's 95 % CI.
 
     The verdict of every ratio kicktimes states (:func:`ratio_rule` prints it): *within* when
@@ -137,7 +140,8 @@ def ratio_interval(estimate, low, high, reference, ref_low, ref_high):
     return ratio, ratio * math.exp(-1.96 * se), ratio * math.exp(1.96 * se)
 
 
-def robust_verdict(verdicts, lows, highs, level=1.0):
+@keyword_only_after(3, since="0.2.0")
+def robust_verdict(verdicts, lows, highs, *, level=1.0):
     """Whether a comparison keeps its verdict and its direction under every control.
 
     ``(robust, reason)``: robust when every control gives the same verdict **and** no
@@ -164,7 +168,8 @@ def robust_verdict(verdicts, lows, highs, level=1.0):
     return True, ""
 
 
-def rejection_verdict(low, high, alpha, margin=0.5):
+@keyword_only_after(2, since="0.2.0")
+def rejection_verdict(low, high, *, alpha, margin=0.5):
     """The verdict on a share of runs that reject a test at level ``alpha``.
 
     ``"nominal"`` when the 95 % CI lies in ``[alpha (1 - margin), alpha (1 + margin)]`` (an
@@ -175,9 +180,9 @@ def rejection_verdict(low, high, alpha, margin=0.5):
 
     Examples
     --------
-    >>> rejection_verdict(0.37, 0.41, 0.05), rejection_verdict(0.037, 0.054, 0.05)
+    >>> rejection_verdict(0.37, 0.41, alpha=0.05), rejection_verdict(0.037, 0.054, alpha=0.05)
     ('above nominal', 'nominal')
-    >>> rejection_verdict(0.03, 0.09, 0.05)
+    >>> rejection_verdict(0.03, 0.09, alpha=0.05)
     'inconclusive'
     """
     if not (np.isfinite(low) and np.isfinite(high)):
@@ -192,7 +197,8 @@ def rejection_verdict(low, high, alpha, margin=0.5):
     return "inconclusive"
 
 
-def rejection_rule(alpha=0.05, margin=0.5) -> str:
+@keyword_only_after(0, since="0.2.0")
+def rejection_rule(*, alpha=0.05, margin=0.5) -> str:
     """The printed rule of :func:`rejection_verdict`."""
     lo, hi = alpha * (1 - margin), alpha * (1 + margin)
     return (f"nominal: the 95 % CI of the share of runs rejected at α = {alpha:g} lies in "
@@ -221,7 +227,8 @@ RR_MARGIN = 0.03
 DIAGNOSTIC_MARGINS = {"ftle": FINE_MARGIN, "rr_offdiag": RR_MARGIN}
 
 
-def margin_of(diagnostic, default=MARGIN):
+@keyword_only_after(1, since="0.2.0")
+def margin_of(diagnostic, *, default=MARGIN):
     """The equivalence margin of a findings table's ``diagnostic`` (``"ftle"``,
     ``"rr_offdiag@0.01"``, ``"det@0.001"``, ...): `DIAGNOSTIC_MARGINS` by the name before
     the ``@``, else ``default``.
@@ -241,7 +248,8 @@ def margin_of(diagnostic, default=MARGIN):
 D_MARGIN = 0.07
 
 
-def null_verdict(low, high, margin):
+@keyword_only_after(2, since="0.2.0")
+def null_verdict(low, high, *, margin):
     """A statistic read against its null stream: the 95 % CI ``[low, high]`` of the
     difference *statistic - its value on null streams shaped like the runs*.
 
@@ -255,9 +263,9 @@ def null_verdict(low, high, margin):
 
     Examples
     --------
-    >>> null_verdict(0.005, 0.077, D_MARGIN), null_verdict(1.2, 1.7, D_MARGIN)
+    >>> null_verdict(0.005, 0.077, margin=D_MARGIN), null_verdict(1.2, 1.7, margin=D_MARGIN)
     ('inconclusive', 'above its null')
-    >>> null_verdict(-0.06, 0.065, D_MARGIN)
+    >>> null_verdict(-0.06, 0.065, margin=D_MARGIN)
     'at its null'
     """
     if not (np.isfinite(low) and np.isfinite(high)):
@@ -271,7 +279,8 @@ def null_verdict(low, high, margin):
     return "inconclusive"
 
 
-def null_rule(margin, name="D") -> str:
+@keyword_only_after(0, since="0.2.0")
+def null_rule(*, margin, name="D") -> str:
     """The printed rule of :func:`null_verdict` for ``name`` with ``margin``."""
     return (f"{name} is read against its null stream's {name} (the same statistic on Poisson "
             f"streams shaped like the runs): at its null when the 95 % CI of the difference "
@@ -279,7 +288,8 @@ def null_rule(margin, name="D") -> str:
             f"beyond {margin:g} / -{margin:g}, inconclusive otherwise")
 
 
-def equivalence_sample_size(se, n, margin, *, level=0.95, power=0.8):
+@keyword_only_after(2, since="0.2.0", names=("margin",))
+def equivalence_sample_size(se, n, *, margin, level=0.95, power=0.8):
     """The number of units (ICs, runs) at which a difference with standard error ``se`` at
     ``n`` units gets its ``level`` CI inside ``[-margin, margin]`` with probability
     ``power`` when the true difference is 0: ``se`` scales as ``1/sqrt(n)`` and the CI
@@ -289,9 +299,9 @@ def equivalence_sample_size(se, n, margin, *, level=0.95, power=0.8):
 
     Examples
     --------
-    >>> equivalence_sample_size(0.05, 400, 0.07)      # a half-width of 0.1 at 400 runs
+    >>> equivalence_sample_size(0.05, 400, margin=0.07)      # a half-width of 0.1 at 400 runs
     2145
-    >>> equivalence_sample_size(0.01, 400, 0.07)
+    >>> equivalence_sample_size(0.01, 400, margin=0.07)
     400
     """
     from scipy.stats import norm
@@ -307,8 +317,9 @@ def equivalence_sample_size(se, n, margin, *, level=0.95, power=0.8):
     return max(int(n), int(math.ceil(n * (se * z / margin) ** 2)))
 
 
-def poisson_verdict(reject_low, reject_high, null_level, dispersion_low, dispersion_high,
-                    *, margin=0.5, band=0.1, against_null=False):
+@keyword_only_after(2, since="0.2.0", names=("null_level", "dispersion_low", "dispersion_high"))
+def poisson_verdict(reject_low, reject_high, *, null_level, dispersion_low, dispersion_high,
+                    margin=0.5, band=0.1, against_null=False):
     """One standard for "Poisson": a calibrated test and an effect outside a stated band.
 
     A stream is read against two things stated before any data: the share of runs that a
@@ -352,20 +363,22 @@ def poisson_verdict(reject_low, reject_high, null_level, dispersion_low, dispers
 
     Examples
     --------
-    >>> poisson_verdict(0.37, 0.41, 0.05, 1.31, 1.47)
+    >>> poisson_verdict(0.37, 0.41, null_level=0.05, dispersion_low=1.31, dispersion_high=1.47)
     'not Poisson'
-    >>> poisson_verdict(0.37, 0.41, 0.05, 1.03, 1.13)   # D straddles 1.1
+    >>> poisson_verdict(0.37, 0.41, null_level=0.05, dispersion_low=1.03,
+    ...                 dispersion_high=1.13)   # D straddles 1.1
     'inconclusive'
-    >>> poisson_verdict(0.045, 0.06, 0.052, 0.97, 1.04)
+    >>> poisson_verdict(0.045, 0.06, null_level=0.052, dispersion_low=0.97, dispersion_high=1.04)
     'Poisson within 10 %'
-    >>> poisson_verdict(0.08, 0.11, 0.05, 1.01, 1.06)
+    >>> poisson_verdict(0.08, 0.11, null_level=0.05, dispersion_low=1.01, dispersion_high=1.06)
     'not Poisson, D within 10 %'
-    >>> poisson_verdict(0.37, 0.41, 0.05, 1.2, 1.6, against_null=True)   # D - null D
+    >>> poisson_verdict(0.37, 0.41, null_level=0.05, dispersion_low=1.2, dispersion_high=1.6,
+    ...                 against_null=True)   # D - null D
     'not Poisson'
     """
-    rejects = rejection_verdict(reject_low, reject_high, null_level, margin)
+    rejects = rejection_verdict(reject_low, reject_high, alpha=null_level, margin=margin)
     if against_null:
-        dispersion = null_verdict(dispersion_low, dispersion_high, D_MARGIN)
+        dispersion = null_verdict(dispersion_low, dispersion_high, margin=D_MARGIN)
         if rejects == "above nominal" and dispersion in ("above its null", "below its null"):
             return "not Poisson"
         if rejects == "above nominal" and dispersion == "at its null":
@@ -373,7 +386,7 @@ def poisson_verdict(reject_low, reject_high, null_level, dispersion_low, dispers
         if rejects == "nominal" and dispersion == "at its null":
             return "Poisson (D at its null)"
         return "inconclusive"
-    dispersion = ratio_verdict(dispersion_low, dispersion_high, band)
+    dispersion = ratio_verdict(dispersion_low, dispersion_high, tolerance=band)
     within = f"within {100 * band:g} %"
     if rejects == "above nominal" and dispersion in ("higher", "lower"):
         return "not Poisson"
@@ -384,7 +397,8 @@ def poisson_verdict(reject_low, reject_high, null_level, dispersion_low, dispers
     return "inconclusive"
 
 
-def poisson_rule(margin=0.5, band=0.1, *, against_null=False) -> str:
+@keyword_only_after(0, since="0.2.0")
+def poisson_rule(*, margin=0.5, band=0.1, against_null=False) -> str:
     """The printed rule of :func:`poisson_verdict` (``against_null``: D read against its
     null stream's D)."""
     if against_null:
@@ -406,13 +420,15 @@ def poisson_rule(margin=0.5, band=0.1, *, against_null=False) -> str:
             "otherwise")
 
 
-def share_verdict(low, high, level):
+@keyword_only_after(2, since="0.2.0")
+def share_verdict(low, high, *, level):
     """``"above"``, ``"below"`` or ``"inconclusive"`` for a share's CI against ``level``
     (:data:`SHARE_RULE`; inconclusive when an endpoint is not finite).
 
     Examples
     --------
-    >>> share_verdict(0.1, 0.3, 0.05), share_verdict(0.0, 0.02, 0.05), share_verdict(0.0, 0.1, 0.05)
+    >>> (share_verdict(0.1, 0.3, level=0.05), share_verdict(0.0, 0.02, level=0.05),
+    ...  share_verdict(0.0, 0.1, level=0.05))
     ('above', 'below', 'inconclusive')
     """
     if not (np.isfinite(low) and np.isfinite(high)):
@@ -424,7 +440,8 @@ def share_verdict(low, high, level):
     return "inconclusive"
 
 
-def share_ratio_sample_size(share, tolerance=0.1, power=0.8, level=0.95):
+@keyword_only_after(1, since="0.2.0")
+def share_ratio_sample_size(share, *, tolerance=0.1, power=0.8, level=0.95):
     """Runs per arm for the ratio of two equal shares to be called within ``tolerance``.
 
     The sample size at which the ratio of two independent shares, both equal to ``share``
@@ -453,7 +470,8 @@ def share_ratio_sample_size(share, tolerance=0.1, power=0.8, level=0.95):
     return int(math.ceil(2 * (1 - p) / p * (z / math.log1p(tolerance)) ** 2))
 
 
-def clopper_pearson(k, n, level=0.95):
+@keyword_only_after(2, since="0.2.0")
+def clopper_pearson(k, n, *, level=0.95):
     r"""Exact (Clopper-Pearson) interval of a binomial share: ``k`` successes in ``n``.
 
     The one implementation kicktimes uses: the Poisson tests' rejection shares, the renewal
@@ -501,7 +519,7 @@ def clopper_pearson(k, n, level=0.95):
     low = np.empty(k.shape)
     high = np.empty(k.shape)
     for i in np.ndindex(k.shape):  # the scalar bounds, bit for bit
-        low[i], high[i] = clopper_pearson(float(k[i]), float(n[i]), level)
+        low[i], high[i] = clopper_pearson(float(k[i]), float(n[i]), level=level)
     return low, high
 
 
@@ -746,7 +764,7 @@ def _reference(res):
     ref = res.reference
     if ref is None or ref.empty:
         return None
-    rule = "Observed / reference rate: " + ratio_rule(0.1) + "."
+    rule = "Observed / reference rate: " + ratio_rule(tolerance=0.1) + "."
     verdicts, parts = [], []
     for r in ref.itertuples():
         verdicts.append(ratio_verdict(r.ci_low, r.ci_high))

@@ -17,6 +17,8 @@ import numpy as np
 import pandas as pd
 import scipy.stats as sps
 
+from kicktimes.validation import keyword_only_after
+
 from ._checks import check_int, check_intervals, check_real
 
 __all__ = ["HazardTable", "interval_hazard"]
@@ -79,7 +81,9 @@ def _edges(x, y_max, bins):
     return edges
 
 
-def interval_hazard(complete, censored=None, *, bins=10, edges=None, level=0.95) -> HazardTable:
+@keyword_only_after(1, since="0.2.0", names=('censored',))
+def interval_hazard(complete, *, censored=None, bins=10, edges=None,
+                    level=0.95) -> HazardTable:
     r"""Piecewise-constant hazard of intervals, with exact Poisson intervals per bin and a
     test of a flat hazard.
 

@@ -23,10 +23,13 @@ import warnings
 
 import numpy as np
 
+from kicktimes.validation import keyword_only_after
+
 __all__ = ["stretching_per_perturbation"]
 
 
-def stretching_per_perturbation(lam, n, t, axis=-1):
+@keyword_only_after(3, since="0.2.0")
+def stretching_per_perturbation(lam, n, t, *, axis=-1):
     r"""The stretching per perturbation :math:`\bar\lambda / \hat\Gamma` (module docstring).
 
     Parameters

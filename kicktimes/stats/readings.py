@@ -15,12 +15,15 @@ from __future__ import annotations
 
 import math
 
+from kicktimes.validation import keyword_only_after
+
 from .findings import MARGIN, null_verdict, ratio_verdict
 
 __all__ = ["null_reading", "ratio_reading", "ratio_words", "side_of"]
 
 
-def side_of(low, high, null=1.0):
+@keyword_only_after(2, since="0.2.0")
+def side_of(low, high, *, null=1.0):
     """``"above"`` / ``"below"`` when the interval ``[low, high]`` lies entirely above /
     below ``null``, else ``None`` (also for a non-finite end).
 
@@ -34,7 +37,8 @@ def side_of(low, high, null=1.0):
     return "above" if low > null else "below" if high < null else None
 
 
-def ratio_reading(low, high, tolerance=MARGIN):
+@keyword_only_after(2, since="0.2.0")
+def ratio_reading(low, high, *, tolerance=MARGIN):
     """`kicktimes.stats.ratio_verdict` of a ratio's 95 % CI, except that an inconclusive
     interval lying entirely on one side of 1 reads ``"below 1 by about the margin or
     less"`` (or above): a departure from 1, not an unresolved one.
@@ -42,14 +46,15 @@ def ratio_reading(low, high, tolerance=MARGIN):
     >>> ratio_reading(0.815, 0.942), ratio_reading(0.3, 0.4), ratio_reading(0.913, 1.15)
     ('below 1 by about the margin or less', 'lower', 'inconclusive')
     """
-    verdict = ratio_verdict(low, high, tolerance)
-    side = side_of(low, high, 1.0) if verdict == "inconclusive" else None
+    verdict = ratio_verdict(low, high, tolerance=tolerance)
+    side = side_of(low, high, null=1.0) if verdict == "inconclusive" else None
     if side:
         return f"{side} 1 by about the margin or less"
     return verdict
 
 
-def ratio_words(low, high, tolerance=MARGIN):
+@keyword_only_after(2, since="0.2.0")
+def ratio_words(low, high, *, tolerance=MARGIN):
     """`ratio_reading` in a page's words: a verdict *within* the margin whose interval
     excludes 1 says on which side (a real difference smaller than the margin), so that
     "within 10 %" never hides an interval that excludes the null.
@@ -57,21 +62,22 @@ def ratio_words(low, high, tolerance=MARGIN):
     >>> ratio_words(1.046, 1.099), ratio_words(0.95, 1.02), ratio_words(0.815, 0.942)
     ('within 10 %, above 1', 'within 10 %', 'below 1 by about the margin or less')
     """
-    verdict = ratio_reading(low, high, tolerance)
-    side = side_of(low, high, 1.0) if verdict.startswith("within") else None
+    verdict = ratio_reading(low, high, tolerance=tolerance)
+    side = side_of(low, high, null=1.0) if verdict.startswith("within") else None
     return f"{verdict}, {side} 1" if side else verdict
 
 
-def null_reading(low, high, margin):
+@keyword_only_after(2, since="0.2.0")
+def null_reading(low, high, *, margin):
     """`kicktimes.stats.null_verdict` of the 95 % CI of *statistic − its null value*,
     except that an inconclusive interval lying entirely on one side of 0 reads ``"above
     its null by about the margin or less"`` (or below).
 
-    >>> null_reading(0.005, 0.077, 0.07), null_reading(-0.03, 0.09, 0.07)
+    >>> null_reading(0.005, 0.077, margin=0.07), null_reading(-0.03, 0.09, margin=0.07)
     ('above its null by about the margin or less', 'inconclusive')
     """
-    verdict = null_verdict(low, high, margin)
-    side = side_of(low, high, 0.0) if verdict == "inconclusive" else None
+    verdict = null_verdict(low, high, margin=margin)
+    side = side_of(low, high, null=0.0) if verdict == "inconclusive" else None
     if side:
         return f"{side} its null by about the margin or less"
     return verdict

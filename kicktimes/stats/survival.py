@@ -19,6 +19,7 @@ import numpy as np
 import pandas as pd
 
 from kicktimes._results import Result
+from kicktimes.validation import keyword_only_after
 
 from ._checks import check_real
 
@@ -94,7 +95,8 @@ def escape_survival(escape_times, t_max) -> pd.DataFrame:
                          "n_at_risk": sf.n_risk})
 
 
-def reliable_until(km, floor=MIN_AT_RISK) -> float:
+@keyword_only_after(1, since="0.2.0")
+def reliable_until(km, *, floor=MIN_AT_RISK) -> float:
     """The first time of a Kaplan-Meier table (`escape_survival`) at which fewer than
     ``floor`` runs are at risk (inf: never): the curve is read as measured before it.
 

@@ -30,7 +30,7 @@ def _two_cases(small: bool):
     for i, r in enumerate((0.005, 0.01, 0.03, 0.1, 0.2, 0.3)):
         for rule in ("mirror", "elastic"):
             method = "paper" if rule == "mirror" and i % 2 == 0 else "uniform"
-            ic = initial_conditions(1, r, seed=100 + i, method=method, rule=rule)[0]
+            ic = initial_conditions(1, r, rng=100 + i, method=method, rule=rule)[0]
             track = i % 2
             cases.append((f"two_{rule}_{r}_uniform", ic, r,
                           dict(rule=rule, n_steps=n, tau=0.3, track=track)))
@@ -48,7 +48,7 @@ def _one_cases(small: bool):
     n = 60 if small else 1500
     cases = []
     for i, r in enumerate((0.005, 0.02, 0.1, 0.3)):
-        state = initial_conditions(1, r, seed=200 + i)[0, 0]
+        state = initial_conditions(1, r, rng=200 + i)[0, 0]
         for law, extra in (("uniform", {}), ("gaussian", {"sigma": 0.3}),
                            ("scatter", {"rule": "mirror"}), ("scatter", {"rule": "elastic"})):
             for sampling in ("uniform", "paper"):
@@ -111,7 +111,7 @@ def lyapunov_outputs(small: bool = False) -> dict[str, np.ndarray]:
         out.update(_fields(f"{name}/pass_run", run, ("kick_times", "kick_log_array")))
     for i, rule in enumerate(("mirror", "elastic")):
         r = 0.05
-        ic = initial_conditions(1, r, seed=300 + i, method="uniform", rule=rule)[0]
+        ic = initial_conditions(1, r, rng=300 + i, method="uniform", rule=rule)[0]
         put(f"spectrum_{rule}", lyapunov_spectrum(ic, r, t_max=0.1 * n, rule=rule))
     del schedules
     return out

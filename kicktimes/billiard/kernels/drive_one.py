@@ -155,14 +155,14 @@ def drive(st, ev, rho, kicks, angles, kick_mode, kick_u, sp, unit_speed, t_end, 
                         U[j, 0], U[j, 1], U[j, 2], U[j, 3] = scatter_tangent(
                             ux, uy, row[6], row[7], row[4], row[5], sp[0], int(sp[1]), sp[6],
                             U[j, 0], U[j, 1], U[j, 2], U[j, 3])
-                        n_resc += tg.renormalise(U, log_scale, j)
+                        n_resc += tg.renormalize(U, log_scale, j)
             else:
                 one.kick_step(st, ev, dte, rho, kicks[ik], angles[ik], kick_mode)
                 if tan is not None and tan_on:
                     for j in range(m):
                         U[j, 2], U[j, 3] = tg.kick_tangent(U[j, 2], U[j, 3], ux, uy, st[3], st[4],
                                                            angles[ik], kick_mode)
-                        n_resc += tg.renormalise(U, log_scale, j)
+                        n_resc += tg.renormalize(U, log_scale, j)
             s = one.load(st, ev)
             if tan is not None and tan_on:
                 n_pert += 1

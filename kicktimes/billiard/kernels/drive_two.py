@@ -208,7 +208,7 @@ def drive(st, ev, phys, t_end, mode, tau, track, logs, stimes, samples, cnt, nex
                         before[two.S_VX0], before[two.S_VY0], before[two.S_VX1],
                         before[two.S_VY1], s[two.S_VX0], s[two.S_VY0], s[two.S_VX1],
                         s[two.S_VY1], rule, rho[2], rho[3])
-                    n_resc += tg.renormalise(U, log_scale, j)
+                    n_resc += tg.renormalize(U, log_scale, j)
             if sim_on or cont_on:
                 pp[n_pp] = t
                 if sim_on and log_pp:

@@ -18,7 +18,7 @@ Every map includes the variation of the collision time ``dtau = -(n.dq_rel)/(n.v
 
 Layouts: two disks ``U[j] = [dx0, dy0, dvx0, dvy0, dx1, dy1, dvx1, dvy1]`` (as ``st[1:9]``),
 one disk ``U[j] = [dx, dy, dvx, dvy]`` (as ``st[1:5]``). Also here: the free flight of the
-tangent vectors (`tangent_flight`), their rescaling (`renormalise`, `gram_schmidt`) and
+tangent vectors (`tangent_flight`), their rescaling (`renormalize`, `gram_schmidt`) and
 the guard of the tangent loops (`event_guard`, status codes 0 ok, 1 event budget
 exhausted, 2 more than ``MAX_SAME_INSTANT`` events at one instant, 3 a non-finite event
 time).
@@ -32,7 +32,7 @@ import numpy as np
 from numba import njit
 
 __all__ = ["BIG", "MAX_SAME_INSTANT", "end_step", "event_guard", "gram_schmidt",
-           "guard", "kick_tangent", "load_carry", "pair_tangent", "renormalise", "start",
+           "guard", "kick_tangent", "load_carry", "pair_tangent", "renormalize", "start",
            "step_end", "store_carry", "tangent_flight", "tangent_state", "wall_tangent"]
 
 #: the tangent half of a driver carries its position between calls in ``tgi`` (int64) and
@@ -181,7 +181,7 @@ def event_guard(dt, n_ev, n_same, max_events):
 
 
 @njit(cache=True)
-def renormalise(U, log_scale, j):
+def renormalize(U, log_scale, j):
     """Rescale ``U[j]`` to unit norm if it left ``[1/BIG, BIG]``; returns 1 if it did."""
     s = 0.0
     for i in range(U.shape[1]):

@@ -27,6 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from kicktimes._results import nan_reason
+from kicktimes.validation import keyword_only_after
 
 from .._checks import as_1d_float, check_choice, check_int, check_real, check_rng, check_times
 from .._information import inverse_information
@@ -224,7 +225,8 @@ class MMPPFit:
         lines.extend(f"  warning: {w}" for w in self.warnings)
         return "\n".join(lines)
 
-    def simulate(self, t_max, rng=None, *, n_windows=1, stationary=True):
+    @keyword_only_after(1, since="0.2.0", names=('rng',))
+    def simulate(self, t_max, *, rng=None, n_windows=1, stationary=True):
         """Event times of the fitted process: see :func:`simulate_mmpp`. Each window
         starts from :attr:`stationary` (``stationary=True``) or from :attr:`initial`."""
         return simulate_mmpp(self.rates, self.generator, t_max, n_windows=n_windows,

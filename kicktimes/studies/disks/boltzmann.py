@@ -71,7 +71,7 @@ def dilute_predictions(rule, collisions, *, hazard_bin=(0.0, 0.01), n_events=2_0
     """
     disk = dilute_tagged_disk(rule)
     middle = 0.5 * (hazard_bin[0] + hazard_bin[1])
-    return {"dispersion": float(disk.dispersion(collisions, n_events=n_events, rng=seed)),
+    return {"dispersion": float(disk.dispersion(window=collisions, n_events=n_events, rng=seed)),
             "hazard_first": float(disk.hazard(middle)),
             "gamma_shape": float(disk.gamma_shape), "reject_uniformity_ks": np.nan}
 

@@ -166,7 +166,7 @@ def one_state(task):
     r = math.sqrt(packing / n_disks)
     rng = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(n_disks, i_packing,
                                                                         state)))
-    x = kt.initial_state(n_disks, r, seed=rng, rule="mirror")
+    x = kt.initial_state(n_disks, r, rng=rng, rule="mirror")
     segment = 1.0 / enskog_frequency(r, n_disks)
     t_max = mean_free_times * segment
     res = disks_lyapunov(x, r, t_max=t_max, segment=segment, rng=rng, method="tangent")
@@ -248,7 +248,7 @@ def summarise(runs: pd.DataFrame, *, n_boot=2000, seed=0, fit_max_packing=FIT_MA
         per = [g.loc[g["packing"] == p, "lam_per_coll"].to_numpy() for p in packings]
         means = np.array([v.mean() for v in per])
         # per replicate one resample of each packing's states, in turn (the stream of the page)
-        boot = np.array([[v[resample_indices(v.size, 1, rng)[0]].mean() for v in per]
+        boot = np.array([[v[resample_indices(v.size, n_boot=1, rng=rng)[0]].mean() for v in per]
                          for _ in range(n_boot)])
         lo, hi = percentile_interval(boot, axis=0)
         for p, xv, v, m, a, b in zip(packings, x, per, means, lo, hi, strict=True):

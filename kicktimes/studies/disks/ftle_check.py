@@ -126,14 +126,14 @@ def pair(task):
     check, n, rule, seed, t_max, segment = task
     if check == "tangent/twin":
         r = math.sqrt(PACKING / n)
-        state = kt.initial_state(n, r, seed=seed, rule=rule)
+        state = kt.initial_state(n, r, rng=seed, rule=rule)
         kw = dict(t_max=t_max, segment=segment, rule=rule, rng=seed)
-        num = disks_lyapunov(state, r, **kw).exponent
-        den = disks_lyapunov(state, r, method="twin", **kw).exponent
+        num = disks_lyapunov(state, r, **kw).lam
+        den = disks_lyapunov(state, r, method="twin", **kw).lam
     else:
-        state = kt.initial_state(2, TWO_DISK_R, seed=seed, rule=rule)
+        state = kt.initial_state(2, TWO_DISK_R, rng=seed, rule=rule)
         num = disks_lyapunov(state, TWO_DISK_R, t_max=t_max, segment=segment, rule=rule,
-                             rng=seed).exponent
+                             rng=seed).lam
         den = lyapunov(state, TWO_DISK_R, n_steps=int(round(t_max / segment)), tau=segment,
                        rule=rule).lam
     return check, n, rule, seed, t_max, num, den

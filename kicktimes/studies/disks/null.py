@@ -81,7 +81,7 @@ def null_streams(store, n_disks, design, rng):
             # its tagged disks' null streams are empty too
             t, s = [np.empty(0)] * len(g), [np.full(1, np.nan)] * len(g)
         else:
-            t, s = dilute_tagged_times(rule, float(rate[ic]), window, len(g), rng,
+            t, s = dilute_tagged_times(rule, float(rate[ic]), window, n_runs=len(g), rng=rng,
                                        speeds=True)
         if design == "poisson":
             s = [np.full(x.size + 1, np.nan) if exp.rule == "elastic" else np.empty(0)

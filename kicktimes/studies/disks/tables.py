@@ -186,7 +186,7 @@ def _tests(seqs, runs, weights, rng, alpha, n_mc, prefix):
         lo, hi = min(lo, cp_lo), max(hi, cp_hi)
         out[f"{prefix}reject_{test}"] = share
         out[f"{prefix}reject_{test}_low"], out[f"{prefix}reject_{test}_high"] = lo, hi
-        out[f"{prefix}reject_{test}_verdict"] = rejection_verdict(lo, hi, alpha)
+        out[f"{prefix}reject_{test}_verdict"] = rejection_verdict(lo, hi, alpha=alpha)
         out[f"{prefix}reject_{test}_n"] = int(n.sum())
     return out
 
@@ -222,7 +222,7 @@ def _row(exp, n, res, col, *, alpha, n_boot, n_mc, rng):
     k = exp.collisions
     r = exp.radius(n)
     runs = np.unique(res["ic"].to_numpy())
-    weights = resample_counts(runs.size, n_boot, rng)
+    weights = resample_counts(runs.size, n_boot=n_boot, rng=rng)
     freq = (res[res["diagnostic"] == "collision_frequency"].set_index("ic")["value"]
             .reindex(runs).to_numpy())
     nu_hat = float(freq.mean())
@@ -234,13 +234,14 @@ def _row(exp, n, res, col, *, alpha, n_boot, n_mc, rng):
            "rate": nu_hat, "enskog": nu_e, "rate_enskog": nu_hat / nu_e}
     row["rate_enskog_low"], row["rate_enskog_high"] = _ci(boot_freq / nu_e)
     row["rate_enskog_verdict"] = ratio_verdict(row["rate_enskog_low"], row["rate_enskog_high"],
-                                               RATE_MARGIN)
+                                               tolerance=RATE_MARGIN)
     if n == 2:
-        gamma = float(kinetic_rate(r, exp.rule))
+        gamma = float(kinetic_rate(r, rule=exp.rule))
         row["rate_two_disk"] = nu_hat / gamma
         row["rate_two_disk_low"], row["rate_two_disk_high"] = _ci(boot_freq / gamma)
         row["rate_two_disk_verdict"] = ratio_verdict(row["rate_two_disk_low"],
-                                                     row["rate_two_disk_high"], RATE_MARGIN)
+                                                     row["rate_two_disk_high"],
+                                                     tolerance=RATE_MARGIN)
     t_count = min(k / nu_hat, float(col["t_window"].min()))
     plain = _Sequences(col, k, t_count, rescale=False)
     row["n_short"] = len(col) - len(plain.times)
@@ -411,7 +412,7 @@ def kicked_table(store, *, n_boot=999, seed=0) -> pd.DataFrame:
                               observed=True)
         runs = wide.index.size
         rng = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(int(n), 7)))
-        weights = resample_counts(runs, n_boot, rng)
+        weights = resample_counts(runs, n_boot=n_boot, rng=rng)
         # (system, diagnostic, reference system, reference diagnostic)
         systems = [s for s in KICKED_SYSTEMS if (s, "ftle") in wide]
         pairs = [(s, d, "gas", d) for s in systems for d in KICKED_DIAGNOSTICS]
@@ -511,7 +512,7 @@ def two_disk_check(disks_store, two_store, *, alpha=0.05, n_boot=999, n_mc=199, 
     for name, (share, boot, n) in (("engine", engine), ("two_disk", ref)):
         lo, hi = _ci(boot)
         out.update({f"{name}": share, f"{name}_low": lo, f"{name}_high": hi,
-                    f"{name}_n": n, f"{name}_verdict": rejection_verdict(lo, hi, alpha)})
+                    f"{name}_n": n, f"{name}_verdict": rejection_verdict(lo, hi, alpha=alpha)})
     with np.errstate(divide="ignore", invalid="ignore"):
         out["ratio"] = engine[0] / ref[0] if ref[0] > 0 else math.nan
         out["ratio_low"], out["ratio_high"] = _ci(engine[1] / ref[1])

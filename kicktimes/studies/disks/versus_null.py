@@ -84,7 +84,7 @@ def edge_null_verdict(low, high, margin):
     >>> edge_null_verdict(-0.014, 0.140, 0.07), edge_null_verdict(0.108, 0.239, 0.07)
     ('inconclusive', 'above its null')
     """
-    return null_reading(low, high, margin)
+    return null_reading(low, high, margin=margin)
 
 
 #: the KS share's margin: half the elastic linear Boltzmann tagged disk's excess over a
@@ -307,7 +307,7 @@ def versus_null(store, *, within=None, n_boot=999, alpha=0.05, seed=42, edges=HA
         # the run weights of disks_table's row (its first draw from the same stream), so
         # that the gas's intervals are disks.csv's; the null shares them (paired by run)
         wrng = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(n,)))
-        w = np.vstack([np.ones(runs.size), resample_counts(runs.size, n_boot, wrng)])
+        w = np.vstack([np.ones(runs.size), resample_counts(runs.size, n_boot=n_boot, rng=wrng)])
         gas_sums = _sums(gas_seq, runs, nu_hat, edges, alpha)
         null_sums = _sums(null_seq, runs, nu_hat, edges, alpha)
         gas, peak = _statistics(gas_sums, w)
@@ -338,7 +338,7 @@ def versus_null(store, *, within=None, n_boot=999, alpha=0.05, seed=42, edges=HA
             verdict = edge_null_verdict(lo, hi, margin)
             row[f"{s}_verdict"] = verdict
             se_boot = float(np.nanstd((a - b)[1:]))
-            row[f"{s}_n_needed"] = (equivalence_sample_size(se_boot, int(runs.size), margin)
+            row[f"{s}_n_needed"] = (equivalence_sample_size(se_boot, int(runs.size), margin=margin)
                                     if verdict == "inconclusive" and se_boot > 0 else np.nan)
         rows.append(row)
         reps[int(n)] = (gas["d"], null["d"])

@@ -141,7 +141,7 @@ def one_state(n_disks, packing, packing_index, rule, boundary, windows, length, 
     key = (n_disks, packing_index, ("mirror", "elastic").index(rule),
            BOUNDARIES.index(boundary), state)
     rng = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=key))
-    x = initial_state(n_disks, r, seed=rng, rule=rule, box=box)
+    x = initial_state(n_disks, r, rng=rng, rule=rule, box=box)
     nu_e = enskog_frequency(r, n_disks, rule=rule)
     run = simulate_disks(x, r, t_max=(skip + length) / nu_e, rule=rule, box=box)
     t0 = skip / nu_e
@@ -205,12 +205,12 @@ def summarise(runs, *, n_boot=2000, seed=0, n_events=2_000_000) -> pd.DataFrame:
     for (n_disks, packing, rule, boundary, k), g in runs.groupby(
             ["n_disks", "packing", "rule", "boundary", "window"], sort=False):
         n, s1, s2 = (g[c].to_numpy(float) for c in ("n", "s1", "s2"))
-        w = resample_counts(n.size, n_boot, rng)
+        w = resample_counts(n.size, n_boot=n_boot, rng=rng)
         d = float(_d(n.sum(), s1.sum(), s2.sum()))
         boot = _d(w @ n, w @ s1, w @ s2)
         low, high = percentile_interval(boot)
         if (rule, k) not in predictions:
-            est = dilute_tagged_disk(rule).dispersion(int(k), n_events=n_events, rng=int(k))
+            est = dilute_tagged_disk(rule).dispersion(window=int(k), n_events=n_events, rng=int(k))
             p = float(est)
             p_low, p_high = ((p, p) if rule == "mirror" else (est.ci_low, est.ci_high))
             predictions[rule, k] = (p, p_low, p_high)

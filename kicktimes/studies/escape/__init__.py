@@ -117,7 +117,7 @@ SCALES = {"quick": Params(n_ics=400, t_max=3000.0, t_min=50.0, n_free=2000),
 def _escape_times(r, n_ics, t_max, seed):
     from kicktimes import initial_conditions
 
-    ics = initial_conditions(n_ics, max(RADII), seed=seed)
+    ics = initial_conditions(n_ics, max(RADII), rng=seed)
     return escape_times(r, ics, t_max, seed)
 
 

@@ -94,7 +94,7 @@ def tail_rates(times, horizon, t_min, picks, disks=1):
 def free_disk_escapes(r, n, t_max, seed) -> pd.DataFrame:
     """Escape times (column ``escape_time``) of the free disk from ``n`` unit-speed ICs of
     the invariant measure (the measure the circle's C is derived for)."""
-    states = initial_conditions(n, r, method="uniform", seed=seed)[:, 0].copy()
+    states = initial_conditions(n, r, method="uniform", rng=seed)[:, 0].copy()
     states[:, 2:] /= np.hypot(states[:, 2], states[:, 3])[:, None]
     escapes = np.array([simulate_one_particle(s, r, t_max=t_max, holes=HOLE).escape_time
                         for s in states])
@@ -135,7 +135,7 @@ def bootstrap_picks(n_ics, seed, n_boot=N_BOOT):
     """The IC indices of the estimate (first row) and of ``n_boot`` bootstrap resamples,
     shared by every radius and system (the bootstrap is paired)."""
     rng = np.random.default_rng(seed)
-    return resample_indices(n_ics, n_boot, rng, with_identity=True)
+    return resample_indices(n_ics, n_boot=n_boot, rng=rng, with_identity=True)
 
 
 def escape_tables(times_by_radius, t_max, t_min, picks):
@@ -224,7 +224,7 @@ def over_radii(times_by_radius, t_max, t_min, picks) -> pd.DataFrame:
                      "ratio": float(np.exp(mean[0])), "ci_low": lo, "ci_high": hi,
                      "verdict": ratio_reading(lo, hi), "se_log": se, "n_ics": n_ics,
                      "n_ics_to_resolve": equivalence_sample_size(se, n_ics,
-                                                                 math.log1p(MARGIN)),
+                                                                 margin=math.log1p(MARGIN)),
                      "negative_control": s in CONTROLS})
     return pd.DataFrame(rows)
 

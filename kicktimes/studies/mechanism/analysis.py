@@ -66,7 +66,7 @@ HAZARD_EDGES = np.array([0, 0.5, 1, 1.5, 2, 2.5, 3, 4, 6, 10, 16, 25, 40, 63, 10
 
 
 def _boot_ci(values_fn, n, rng, n_boot=1000):
-    picks = stats.resample_indices(n, n_boot, rng)
+    picks = stats.resample_indices(n, n_boot=n_boot, rng=rng)
     vals = np.array([values_fn(p) for p in picks], float)
     return tuple(np.nanquantile(vals, [0.025, 0.975]))
 
@@ -126,7 +126,7 @@ def hazard_profile_rows(key, runs):
     done = ~tab["next_censored"].to_numpy()
     nxt = tab["next_interval"].to_numpy()
     edges = HAZARD_EDGES[HAZARD_EDGES < float(nxt.max())].tolist() + [float(nxt.max())]
-    ns = stats.interval_hazard(nxt[done & calm], nxt[~done & calm], edges=edges)
+    ns = stats.interval_hazard(nxt[done & calm], censored=nxt[~done & calm], edges=edges)
     early = ns.table[ns.table["t_high"] <= RETURN_TIME].reset_index(drop=True)
     ratio = early["hazard"] / ns.rate
     low, high = early["ci_low"] / ns.rate, early["ci_high"] / ns.rate
@@ -271,7 +271,7 @@ def against_null(table):
                 continue
             obs, null = q.loc[stat], q.loc[null_name]
             lo, hi = obs["ci_low"] - null["estimate"], obs["ci_high"] - null["estimate"]
-            verdict = stats.null_verdict(lo, hi, margin)
+            verdict = stats.null_verdict(lo, hi, margin=margin)
             _row(rows, (method, r), name, obs["estimate"] - null["estimate"], lo, hi,
                  note=f"{verdict} (stats.null_verdict, margin {margin:g}); null "
                  f"{null['estimate']:.4f}")
@@ -317,10 +317,10 @@ def analyse(key, ics, runs, *, n_twins, rng, rule="mirror", n_boot=1000):
     data["sticky"] = pd.Series(sticky_run)
     longest = float(nxt.max())
     edges = HAZARD_EDGES[HAZARD_EDGES < longest].tolist() + [longest]
-    haz = stats.interval_hazard(nxt[done], nxt[~done], edges=edges)
+    haz = stats.interval_hazard(nxt[done], censored=nxt[~done], edges=edges)
     data["hazard"] = haz
     calm = ~sticky_run
-    data["hazard_nonsticky"] = stats.interval_hazard(nxt[done & calm], nxt[~done & calm],
+    data["hazard_nonsticky"] = stats.interval_hazard(nxt[done & calm], censored=nxt[~done & calm],
                                                      edges=edges)
     _row(rows, key, "hazard_first_bin_over_rate", haz.ratio_first_to_rate,
          haz.table["ci_low"].iloc[0] / haz.rate, haz.table["ci_high"].iloc[0] / haz.rate,
@@ -342,7 +342,7 @@ def analyse(key, ics, runs, *, n_twins, rng, rule="mirror", n_boot=1000):
     own = np.maximum(obs_rate, 1.0 / t_max)[tab["run"].to_numpy()]
     v = nxt * own
     v_edges = RESCALED_EDGES[RESCALED_EDGES < v.max()].tolist() + [float(v.max())]
-    haz_own = stats.interval_hazard(v[done & calm], v[~done & calm], edges=v_edges)
+    haz_own = stats.interval_hazard(v[done & calm], censored=v[~done & calm], edges=v_edges)
     data["hazard_own"] = haz_own
     _row(rows, key, "hazard_own_time_first_bin_over_rate", haz_own.ratio_first_to_rate,
          haz_own.table["ci_low"].iloc[0] / haz_own.rate,
@@ -471,7 +471,7 @@ def analyse(key, ics, runs, *, n_twins, rng, rule="mirror", n_boot=1000):
     # time rescaled by the predicted rate: Exp(1) if the phase-averaged Cox model held
     u = nxt * post
     u_edges = RESCALED_EDGES[RESCALED_EDGES < u.max()].tolist() + [float(u.max())]
-    haz_u = stats.interval_hazard(u[done], u[~done], edges=u_edges)
+    haz_u = stats.interval_hazard(u[done], censored=u[~done], edges=u_edges)
     data["hazard_rescaled"] = haz_u
     _row(rows, key, "rescaled_hazard_first_bin", haz_u.table["hazard"].iloc[0],
          haz_u.table["ci_low"].iloc[0], haz_u.table["ci_high"].iloc[0],
@@ -480,14 +480,14 @@ def analyse(key, ics, runs, *, n_twins, rng, rule="mirror", n_boot=1000):
     _row(rows, key, "rescaled_hazard_rate", haz_u.rate, note="1 if the rate is right on average")
     _row(rows, key, "rescaled_hazard_flat_lr_pvalue", haz_u.pvalue)
     # the long-time end of the same figure, read as one bin: Gamma t > LATE_RESCALED
-    late = stats.interval_hazard(u[done], u[~done], edges=[0.0, LATE_RESCALED,
+    late = stats.interval_hazard(u[done], censored=u[~done], edges=[0.0, LATE_RESCALED,
                                                           max(float(u.max()), 2 * LATE_RESCALED)])
     lt = late.table.iloc[1]
     _row(rows, key, "rescaled_hazard_late", lt["hazard"], lt["ci_low"], lt["ci_high"],
          note=f"Gamma-rescaled hazard over rescaled t > {LATE_RESCALED:g} "
          f"({int(lt['events'])} intervals end there); 1 if the phase-averaged rate held")
     for lo_t, hi_t in ((0.2, 1.0), (1.0, LATE_RESCALED)):
-        mid = stats.interval_hazard(u[done], u[~done], edges=[0.0, lo_t, hi_t,
+        mid = stats.interval_hazard(u[done], censored=u[~done], edges=[0.0, lo_t, hi_t,
                                                              max(float(u.max()), 2 * hi_t)])
         mt = mid.table.iloc[1]
         _row(rows, key, f"rescaled_hazard_{lo_t:g}_{hi_t:g}", mt["hazard"], mt["ci_low"],

@@ -204,7 +204,7 @@ def fig_battery(results):
                 vals = [[dispersion(b["counts"][calm]) for b in d["twins"][n]] for n in twins]
                 counts = np.asarray(d["observed"]["counts"][calm], float)
                 obs = dispersion(counts)
-                picks = stats.resample_indices(counts.size, 1000, 0)
+                picks = stats.resample_indices(counts.size, n_boot=1000, rng=0)
                 obs_ci = stats.percentile_interval([dispersion(counts[p]) for p in picks])
             else:
                 vals = [[b["reject"][what].mean() for b in d["twins"][n]] for n in twins]

@@ -123,7 +123,7 @@ def needed_ics(estimate, low, high, n, tolerance=MARGIN, center=1.0):
         edge = center + tolerance if estimate > center else center - tolerance
         return f"not resolved at this size: the estimate lies on the band edge {edge:g}"
     se = (float(high) - float(low)) / (2 * Z95)
-    return f"not resolved at this size; needs ≈ {equivalence_sample_size(se, n, room)} ICs"
+    return f"not resolved at this size; needs ≈ {equivalence_sample_size(se, n, margin=room)} ICs"
 
 
 def _ratio_cell(row, n):
@@ -131,7 +131,7 @@ def _ratio_cell(row, n):
     inconclusive one with the size that would resolve it."""
     if not math.isfinite(row["estimate"]):
         return "no interval ends there"
-    verdict = ratio_reading(row["ci_low"], row["ci_high"], MARGIN)
+    verdict = ratio_reading(row["ci_low"], row["ci_high"], tolerance=MARGIN)
     cell = f"{_iv(row, (0.9, 1.0, 1.1))}, {verdict}"
     if verdict == "inconclusive":
         cell += f" ({needed_ics(row['estimate'], row['ci_low'], row['ci_high'], n)})"
@@ -143,7 +143,7 @@ def _hazard_null_cell(tab, m, r, stat, diff_name, n):
     difference; an inconclusive one with the size that would resolve it."""
     row, diff = _get(tab, m, r, stat), _get(tab, m, r, diff_name)
     null = row["estimate"] - diff["estimate"]
-    verdict = null_reading(diff["ci_low"], diff["ci_high"], HAZARD_NULL_MARGIN)
+    verdict = null_reading(diff["ci_low"], diff["ci_high"], margin=HAZARD_NULL_MARGIN)
     cell = f"{_iv(row, (0.9, 1.0, 1.1))} vs {null:.3f}: {verdict}"
     if verdict == "inconclusive":
         need = needed_ics(diff["estimate"], diff["ci_low"], diff["ci_high"], n,
@@ -165,7 +165,7 @@ def _dispersion_verdict(tab, m, r, *, strict=True):
     its `null_reading` (an inconclusive interval that excludes 0 read as a departure)."""
     row = _get(tab, m, r, "rate_dispersion_minus_null")
     read = null_verdict if strict else null_reading
-    return read(row["ci_low"], row["ci_high"], RATE_DISPERSION_MARGIN)
+    return read(row["ci_low"], row["ci_high"], margin=RATE_DISPERSION_MARGIN)
 
 
 def _excess(tab, m, r, test):
@@ -196,7 +196,7 @@ def share_cell(row, n):
         return _iv(row, (1.0,))
     se = width / (2 * Z95)
     return (f"not resolved at this size; needs ≈ "
-            f"{equivalence_sample_size(se, n, SHARE_HALF_WIDTH)} ICs")
+            f"{equivalence_sample_size(se, n, margin=SHARE_HALF_WIDTH)} ICs")
 
 
 def _share_iv(tab, m, r, test, model, n):
@@ -294,13 +294,13 @@ def first_screen(tabs):
     number with its 95 % interval, where it comes from and its caveat."""
     def ratio_of(q):
         return lambda t, m, r: ratio_verdict(_get(t, m, r, q)["ci_low"],
-                                             _get(t, m, r, q)["ci_high"], MARGIN)
+                                             _get(t, m, r, q)["ci_high"], tolerance=MARGIN)
 
     lines = []
     # 1. the refractory dip: the weakest group is the one whose upper end is highest
     def null_of(name, margin):
         return lambda t, m, r: null_verdict(_get(t, m, r, name)["ci_low"],
-                                            _get(t, m, r, name)["ci_high"], margin)
+                                            _get(t, m, r, name)["ci_high"], margin=margin)
 
     said, _ = _tally(tabs, null_of("hazard_min_minus_null", HAZARD_NULL_MARGIN),
                      "below its null")

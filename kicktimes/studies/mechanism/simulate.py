@@ -37,7 +37,7 @@ def simulate(n_ics, t_max, workers, seed, rule="mirror"):
     out = {}
     tasks = {}
     for method in METHODS:
-        ics = initial_conditions(n_ics, max(RADII), seed=seed, method=method, rule=rule)
+        ics = initial_conditions(n_ics, max(RADII), rng=seed, method=method, rule=rule)
         for r in RADII:
             tasks[method, r] = (ics, [(ic, r, t_max, rule) for ic in ics])
     if workers == 1:

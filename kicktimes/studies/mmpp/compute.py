@@ -16,7 +16,7 @@ RULES = ("mirror", "elastic")
 def collision_runs(rule, n_ics, r, t_max, seed) -> pd.DataFrame:
     """The collision times (column ``pp_times``) of ``n_ics`` paper ICs (``seed``, drawn
     at ``r`` under ``rule``) run to ``t_max``, one row per IC (``ic``)."""
-    ics = initial_conditions(n_ics, r, seed=seed, method="paper", rule=rule)
+    ics = initial_conditions(n_ics, r, rng=seed, method="paper", rule=rule)
     times = [np.asarray(simulate_two_particle(ic, r, t_max=t_max, rule=rule).pp_times, float)
              for ic in ics]
     return pd.DataFrame({"ic": np.arange(n_ics), "pp_times": times})

@@ -108,7 +108,7 @@ def _battery_rows(rejected):
         k, n = int(rejected[test].sum()), len(rejected[test])
         lo, hi = clopper_pearson(k, n)
         rows.append({"test": test, "n_windows": n, "rejected": k, "share": k / n,
-                     "ci_low": lo, "ci_high": hi, "verdict": rejection_verdict(lo, hi, 0.05)})
+                     "ci_low": lo, "ci_high": hi, "verdict": rejection_verdict(lo, hi, alpha=0.05)})
     return rows
 
 
@@ -167,7 +167,7 @@ def analyse(rule, times, sticky, t_max, per_run, seed):
     choice = choice_rows(rule, chosen, t_max, seed)
     # the refractory dip
     complete, censored = intervals(calm, t_max)
-    haz = stats.interval_hazard(complete, censored, edges=[0.0, DIP, float(
+    haz = stats.interval_hazard(complete, censored=censored, edges=[0.0, DIP, float(
         max(complete.max(), censored.max()))])
     first = haz.table.iloc[0]
     model = mmpp_dip(two)
@@ -179,10 +179,10 @@ def analyse(rule, times, sticky, t_max, per_run, seed):
     a, b = EARLY_EDGES[k], EARLY_EDGES[k + 1]
     boot_rng = np.random.default_rng(seed)
     boot, boot_min = [], []
-    for idx in stats.resample_indices(len(calm), N_BOOT, boot_rng, chunk=1):
+    for idx in stats.resample_indices(len(calm), n_boot=N_BOOT, rng=boot_rng, chunk=1):
         pick = [calm[i] for i in idx]
         c, z = intervals(pick, t_max)
-        h = stats.interval_hazard(c, z, edges=[0.0, DIP, float(max(c.max(), z.max()))])
+        h = stats.interval_hazard(c, censored=z, edges=[0.0, DIP, float(max(c.max(), z.max()))])
         boot.append(h.table["hazard"].iloc[0] / h.rate)
         e = _early_hazard(c, z)
         boot_min.append(e.table["hazard"].iloc[k] / e.rate)  # the data's bin, held fixed
@@ -211,7 +211,7 @@ def _early_hazard(complete, censored):
     """The hazard of the intervals on `EARLY_EDGES`, the rest of the time one last bin."""
     edges = [*EARLY_EDGES, max(float(complete.max()), float(censored.max()),
                                2 * EARLY_EDGES[-1])]
-    return stats.interval_hazard(complete, censored, edges=edges)
+    return stats.interval_hazard(complete, censored=censored, edges=edges)
 
 
 def intervals(times, t_max):
@@ -234,7 +234,7 @@ def edge_null_verdict(low, high, margin=SHARE_MARGIN):
     >>> edge_null_verdict(0.033, 0.116), edge_null_verdict(-0.02, -0.01)
     ('above its null', 'at its null')
     """
-    return null_reading(low, high, margin)
+    return null_reading(low, high, margin=margin)
 
 
 def _difference(a, b, rng, margin=SHARE_MARGIN):
@@ -242,15 +242,15 @@ def _difference(a, b, rng, margin=SHARE_MARGIN):
     95 % bootstrap interval (each arm resampled on its own), its `null_verdict` and the
     units per arm that would resolve ``margin`` (`equivalence_sample_size`)."""
     a, b = np.asarray(a, float), np.asarray(b, float)
-    ia = stats.resample_indices(a.size, N_BOOT, rng)
-    ib = stats.resample_indices(b.size, N_BOOT, rng)
+    ia = stats.resample_indices(a.size, n_boot=N_BOOT, rng=rng)
+    ib = stats.resample_indices(b.size, n_boot=N_BOOT, rng=rng)
     boot = a[ia].mean(1) - b[ib].mean(1)
     lo, hi = percentile_interval(boot)
     se = float(np.std(boot, ddof=1))
     n = int(min(a.size, b.size))
     return {"difference": a.mean() - b.mean(), "diff_low": lo, "diff_high": hi,
             "margin": margin, "verdict": edge_null_verdict(lo, hi, margin),
-            "n_to_resolve": equivalence_sample_size(se, n, margin) if se > 0 else n}
+            "n_to_resolve": equivalence_sample_size(se, n, margin=margin) if se > 0 else n}
 
 
 def shuffled_twin(t, t_max, rng):
@@ -341,6 +341,6 @@ def null_rows(rule, observed, fits, per_fits, n_windows, t_max, seed):
                          "n_windows": int(got[test].size), "share": float(got[test].mean()),
                          "n_null": int(ref.size), "null_share": float(ref.mean()),
                          "null_ci_low": lo, "null_ci_high": hi,
-                         "null_vs_alpha": rejection_verdict(lo, hi, 0.05),
+                         "null_vs_alpha": rejection_verdict(lo, hi, alpha=0.05),
                          **_difference(got[test], ref, rng)})
     return rows

@@ -103,7 +103,7 @@ def _ratio_line(question, rows, margin=MARGIN) -> str:
     primary's (the size depends on it). Otherwise the line says "depends on" the control
     that changes the verdict, with both numbers. A verdict "within" whose interval
     excludes 1 says in how many cells (a real difference smaller than the margin)."""
-    rows = rows.assign(verdict=[ratio_verdict(lo, hi, margin) for lo, hi
+    rows = rows.assign(verdict=[ratio_verdict(lo, hi, tolerance=margin) for lo, hi
                                 in zip(rows["ci_low"], rows["ci_high"], strict=True)])
     family = rows["family"].iloc[0]
     system = rows["system"].iloc[0]
@@ -215,7 +215,7 @@ def _sign_flips(rows, family) -> str:
         e = _one(rows, diagnostic=diagnostic, family=family, control="elastic")
         if p is None or e is None:
             continue
-        sides = side_of(p.ci_low, p.ci_high, 0.0), side_of(e.ci_low, e.ci_high, 0.0)
+        sides = side_of(p.ci_low, p.ci_high, null=0.0), side_of(e.ci_low, e.ci_high, null=0.0)
         if None not in sides and sides[0] != sides[1]:
             flips.append(name)
     if not flips:
@@ -264,7 +264,7 @@ def compact_overview(table: pd.DataFrame) -> pd.DataFrame:
         for system in systems:
             rows = part[part["system"] == system]
             # each cell at its diagnostic's margin, as the answers read it
-            rows = rows.assign(verdict=[ratio_verdict(lo, hi, margin_of(diagnostic)) for lo, hi
+            rows = rows.assign(verdict=[ratio_verdict(lo, hi, tolerance=margin_of(diagnostic)) for lo, hi
                                         in zip(rows["ci_low"], rows["ci_high"], strict=True)])
             p = _one(rows, family=family, control="primary")
             if p is None:

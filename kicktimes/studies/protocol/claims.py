@@ -221,7 +221,7 @@ def _closer(ratios, panel, reading):
     lo, hi = percentile_interval(diff)
     verdict = closer_verdict(lo, hi)
     if verdict == "inconclusive":
-        n = equivalence_sample_size(float(np.nanstd(diff)), int(op["n_ics"]), CLOSER_MARGIN)
+        n = equivalence_sample_size(float(np.nanstd(diff)), int(op["n_ics"]), margin=CLOSER_MARGIN)
         verdict = f"inconclusive ({n} ICs would resolve it)"
     return point, float(lo), float(hi), verdict
 

@@ -113,7 +113,7 @@ class Panel:
 
     def initial_conditions(self) -> np.ndarray:
         """The panel's ICs: the paper's procedure at the largest radius (as its family)."""
-        return initial_conditions(self.n_ics, self.ic_radius, seed=self.seed, method="paper")
+        return initial_conditions(self.n_ics, self.ic_radius, rng=self.seed, method="paper")
 
 
 def panels(scale: str = "paper") -> tuple[Panel, ...]:
@@ -223,7 +223,7 @@ def _kicks(panel, radius, ic_index, system, two, horizon):
     numbers for both of their readings), drawn from the IC's own stream."""
     rng = _rng(panel, radius, ic_index, system)
     if system == "poisson":
-        times = Poisson(two.n_pp / horizon).sample(horizon, rng)
+        times = Poisson(two.n_pp / horizon).sample(horizon, rng=rng)
     else:
         times = np.asarray(two.pp_times, dtype=float)
     angles = {"uniform": draw_kick_angles(times.size, "uniform", SIGMA, rng)}
@@ -244,8 +244,8 @@ def rr_rows(panel: Panel, radius: float, ic_index: int, ic: np.ndarray) -> list[
     rows = []
 
     def add(system, points, n_kicks):
-        with_diagonal = recurrence_rate(points, EPS)
-        off = recurrence_rate(points, EPS, theiler=1)
+        with_diagonal = recurrence_rate(points, eps=EPS)
+        off = recurrence_rate(points, eps=EPS, theiler=1)
         for measure, value in (("with_diagonal", with_diagonal), ("off_diagonal", off)):
             rows.append((panel.name, radius, ic_index, system, "rr", "paper_steps", measure,
                          "-", "uniform", 1, float(value), int(n_kicks)))
@@ -287,7 +287,7 @@ def _r1(run, particle) -> float:
     stretch of a one-disk run repeats its angle."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", UndefinedDiagnosticWarning)
-        return float(autocorrelation(boundary_angles(run, particle), 1))
+        return float(autocorrelation(boundary_angles(run, particle=particle), 1))
 
 
 def compute_task(panel: Panel, task: tuple, path: str | os.PathLike) -> float:

@@ -276,7 +276,7 @@ def count_line_table(rows: pd.DataFrame, panels) -> pd.DataFrame:
             continue
         if not np.isfinite(counts).all():
             raise ValueError(f"rows: panel {p.name} has a missing or non-finite count")
-        idx = resample_indices(counts.shape[1], N_BOOT, np.random.default_rng(BOOT_SEED),
+        idx = resample_indices(counts.shape[1], n_boot=N_BOOT, rng=np.random.default_rng(BOOT_SEED),
                                with_identity=True)
         means = counts[:, idx].mean(axis=2).T  # (1 + B, radii)
         design = np.column_stack([np.ones_like(radii), radii])
@@ -308,7 +308,7 @@ def fig4_table(rows: pd.DataFrame, panels) -> pd.DataFrame:
                 break
             v = v[0][np.isfinite(v[0])]
             n = n or v.size
-            idx = resample_indices(v.size, N_BOOT, np.random.default_rng(BOOT_SEED))
+            idx = resample_indices(v.size, n_boot=N_BOOT, rng=np.random.default_rng(BOOT_SEED))
             values[name] = (float(v.mean()), *percentile_interval(v[idx].mean(axis=1)))
         if len(values) < 2:
             continue
@@ -348,7 +348,7 @@ def shapley_table(ratios: Ratios, panels) -> pd.DataFrame:
                     "from": default, "to": alternative, "share": value,
                     "ci_low": float(lo), "ci_high": float(hi),
                     "fraction_of_change": value / total,
-                    "verdict": share_verdict(lo, hi, 0.0),
+                    "verdict": share_verdict(lo, hi, level=0.0),
                     "distance_from": point[frozenset()],
                     "distance_to": point[frozenset(range(len(FACTORS)))],
                 })

@@ -58,13 +58,13 @@ def closer_verdict(low: float, high: float, margin: float = CLOSER_MARGIN) -> st
     """
     if not margin > 0:
         raise ValueError(f"margin must be > 0, got {margin!r}")
-    verdict = null_verdict(low, high, margin)
+    verdict = null_verdict(low, high, margin=margin)
     if verdict == "below its null":
         return "Poisson closer"
     if verdict == "above its null":
         return "actual closer"
     if verdict == "at its null":
-        side = share_verdict(low, high, 0.0)
+        side = share_verdict(low, high, level=0.0)
         return {"below": "Poisson closer, inside the margin",
                 "above": "actual closer, inside the margin"}.get(side, "equally close")
     return "inconclusive"
@@ -82,7 +82,7 @@ def balloon_verdict(low: float, high: float) -> str:
     ('balloon (ratio < 1)', 'inconclusive')
     """
     return {"below": "balloon (ratio < 1)", "above": "no balloon (ratio > 1)"}.get(
-        share_verdict(low, high, 1.0), "inconclusive")
+        share_verdict(low, high, level=1.0), "inconclusive")
 
 
 #: each kind of claim: {verdict: answer}; a verdict not listed is "undecided"

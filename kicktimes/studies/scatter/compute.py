@@ -37,11 +37,11 @@ __all__ = ["one_ic", "scatter_runs", "shape_rows"]
 def shape_rows(run, particle):
     """Off-diagonal RR and DET (eps = 0.001, Theiler 1) of ``run``'s samples and the ACF
     R_1..R_5 of the boundary angles of ``particle`` (None: the one disk)."""
-    res = rqa(run.samples, 1e-3, theiler=1, l_min=2)
+    res = rqa(run.samples, eps=1e-3, theiler=1, l_min=2)
     with warnings.catch_warnings():
         # the 20-step warm-up run has too few boundary collisions for an ACF
         warnings.simplefilter("ignore")
-        acf = autocorrelation_function(boundary_angles(run, particle), 5)
+        acf = autocorrelation_function(boundary_angles(run, particle=particle), 5)
     return {"rr_offdiag": res.rr, "det": res.det, **{f"acf{k + 1}": acf[k] for k in range(5)}}
 
 
@@ -54,7 +54,7 @@ def one_ic(r, i, ic, n_steps, tau):
     two = simulate_two_particle(ic, r, **steps)
     rate = two.n_pp / two.t_max
     rng = np.random.default_rng(np.random.SeedSequence(2026, spawn_key=(i, int(r * 1e6))))
-    times = Poisson(rate).sample(n_steps * tau, rng)
+    times = Poisson(rate).sample(n_steps * tau, rng=rng)
     u_angles = rng.uniform(0.0, 2.0 * np.pi, times.size)
     s_numbers = rng.uniform(-1.0, 1.0, (times.size, 2))
     # actual collision times, continued to cover the kicked run (paper steps are longer)
@@ -85,5 +85,5 @@ def one_ic(r, i, ic, n_steps, tau):
 def scatter_runs(r, n_ics, n_steps, tau, ic_radius, ic_seed, ic_method) -> pd.DataFrame:
     """The per-IC table at radius ``r``: `one_ic` for the first ``n_ics`` ICs drawn at
     ``ic_radius`` (the same ICs at every radius)."""
-    ics = initial_conditions(n_ics, ic_radius, seed=ic_seed, method=ic_method)
+    ics = initial_conditions(n_ics, ic_radius, rng=ic_seed, method=ic_method)
     return pd.DataFrame([one_ic(r, i, ics[i], n_steps, tau) for i in range(n_ics)])

@@ -42,13 +42,13 @@ def ratio_table(df, n_boot=1000, seed=0):
     rows = []
     for ics, part in (("without sticky ICs", df[calm]), ("all ICs", df)):
         for r, g in part.groupby("radius", observed=True):
-            picks = resample_indices(len(g), n_boot, rng, with_identity=True)
+            picks = resample_indices(len(g), n_boot=n_boot, rng=rng, with_identity=True)
             for num, den, label in RATIOS:
                 q = g[num].to_numpy()[picks].mean(1) / g[den].to_numpy()[picks].mean(1)
                 lo, hi = percentile_interval(q[1:])
                 rows.append({"ics": ics, "radius": r, "n": len(g), "ratio": label,
                              "estimate": q[0], "ci_low": lo, "ci_high": hi,
-                             "verdict": ratio_verdict(lo, hi, MARGIN)})
+                             "verdict": ratio_verdict(lo, hi, tolerance=MARGIN)})
     return pd.DataFrame(rows)
 
 
@@ -103,7 +103,7 @@ def over_radii(df, n_boot=1000, seed=0) -> pd.DataFrame:
     verdict is robust over the two IC sets (`kicktimes.stats.robust_verdict`)."""
     rng = np.random.default_rng(seed)
     ics = np.sort(df["ic"].unique())
-    picks = resample_indices(len(ics), n_boot, rng, with_identity=True)
+    picks = resample_indices(len(ics), n_boot=n_boot, rng=rng, with_identity=True)
     calm = ~sticky(df)
     rows = []
     for label_ics, keep in (("without sticky ICs", calm), ("all ICs", calm | True)):
@@ -119,8 +119,8 @@ def over_radii(df, n_boot=1000, seed=0) -> pd.DataFrame:
                          "n_ics": len(ics), "n_draws": int(np.isfinite(q[1:]).sum()),
                          "estimate": q[0], "ci_low": lo, "ci_high": hi,
                          "deficit": 1 - q[0], "deficit_low": 1 - hi, "deficit_high": 1 - lo,
-                         "verdict": ratio_verdict(lo, hi, MARGIN),
-                         "verdict_fine": ratio_verdict(lo, hi, FINE_MARGIN)})
+                         "verdict": ratio_verdict(lo, hi, tolerance=MARGIN),
+                         "verdict_fine": ratio_verdict(lo, hi, tolerance=FINE_MARGIN)})
     out = pd.DataFrame(rows)
     for column, name in (("verdict", "robust"), ("verdict_fine", "robust_fine")):
         robust = {label: robust_verdict(list(g[column]), g["ci_low"], g["ci_high"])[0]

@@ -54,7 +54,7 @@ def decorrelation(radii=(0.008, 0.02), *, rule="mirror", n_ics=40, t_max=20000.0
     """
     rows, bins_rows, preds = [], [], []
     edges = np.linspace(-np.pi / 2, np.pi / 2, 9)
-    ics = initial_conditions(n_ics, max(radii), seed=seed)
+    ics = initial_conditions(n_ics, max(radii), rng=seed)
     for r in radii:
         kinds = {"disk-disk collision": [], "uniform kick": [], "scatter kick": [],
                  "no perturbation": []}
@@ -79,7 +79,7 @@ def decorrelation(radii=(0.008, 0.02), *, rule="mirror", n_ics=40, t_max=20000.0
                 a, b, n = _pairs(np.asarray(lg.time), th, np.asarray(one.kick_times))
                 kinds[name].append((a[n == 1], b[n == 1]))
         rng = np.random.default_rng(seed)
-        picks = resample_indices(n_ics, n_boot, rng, with_identity=True)
+        picks = resample_indices(n_ics, n_boot=n_boot, rng=rng, with_identity=True)
         boot = {name: np.array([_corr(per_ic, p) for p in picks]) for name, per_ic in
                 kinds.items()}
         for name, per_ic in kinds.items():
@@ -139,10 +139,10 @@ def prediction_against_measurement(preds, findings_dir, families):
         q_lo, q_hi = q * math.exp(-1.96 * sd), q * math.exp(1.96 * sd)
         rows.append({**row._asdict(), "family": family, "measured": m["ratio"],
                      "measured_ci_low": m["ci_low"], "measured_ci_high": m["ci_high"],
-                     "measured_verdict": ratio_verdict(m["ci_low"], m["ci_high"], MARGIN),
+                     "measured_verdict": ratio_verdict(m["ci_low"], m["ci_high"], tolerance=MARGIN),
                      "measured_over_predicted": q, "quotient_ci_low": q_lo,
                      "quotient_ci_high": q_hi,
-                     "quotient_verdict": ratio_verdict(q_lo, q_hi, MARGIN)})
+                     "quotient_verdict": ratio_verdict(q_lo, q_hi, tolerance=MARGIN)})
     out = pd.DataFrame(rows)
     return out.drop(columns=[c for c in out.columns if c == "Index"])
 

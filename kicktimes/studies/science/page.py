@@ -98,7 +98,7 @@ def needed_ics(estimate, low, high, n, tolerance=MARGIN, unit="ICs"):
     if room < 1e-9:
         return "not resolved at this size: the estimate lies on the band's edge"
     se = (float(high) - float(low)) / (2 * Z95)
-    return (f"not resolved at this size; needs ≈ {equivalence_sample_size(se, n, room)} "
+    return (f"not resolved at this size; needs ≈ {equivalence_sample_size(se, n, margin=room)} "
             f"{unit}")
 
 
@@ -112,21 +112,21 @@ def reading_text(x, lo, hi, tolerance=MARGIN):
     >>> reading_text(1.072, 1.046, 1.099)
     '1.072 [1.046, 1.099], within 10 %, above 1'
     """
-    return f"{format_interval(x, lo, hi)}, {ratio_words(lo, hi, tolerance)}"
+    return f"{format_interval(x, lo, hi)}, {ratio_words(lo, hi, tolerance=tolerance)}"
 
 
 def _ratio_cell(x, lo, hi, n, unit="ICs", tolerance=MARGIN):
     """`reading_text`, and for an interval that contains 1 and is inconclusive the size
     that would resolve it (never for one that excludes 1: that is a departure)."""
     text = reading_text(x, lo, hi, tolerance)
-    if ratio_reading(lo, hi, tolerance) == "inconclusive" and n:
+    if ratio_reading(lo, hi, tolerance=tolerance) == "inconclusive" and n:
         text += f" ({needed_ics(x, lo, hi, n, tolerance=tolerance, unit=unit)})"
     return text
 
 
 def _readings(frame, low="ci_low", high="ci_high"):
     """The `ratio_words` of every row of ``frame``."""
-    return frame.apply(lambda x: ratio_words(x[low], x[high], MARGIN), axis=1)
+    return frame.apply(lambda x: ratio_words(x[low], x[high], tolerance=MARGIN), axis=1)
 
 
 def _verdict_counts(verdicts):
@@ -368,7 +368,7 @@ def closest_cells(closest):
         best, rest = g[g["closest"]], g[~g["closest"]]
         margin = margin_of(diag)  # the findings table's margin of this diagnostic
         for row in best.itertuples():
-            if ratio_verdict(row.ci_low, row.ci_high, margin) != row.verdict:
+            if ratio_verdict(row.ci_low, row.ci_high, tolerance=margin) != row.verdict:
                 raise ValueError(f"closest: {family}/{diag}/{row.system} has verdict "
                                  f"{row.verdict!r}, its interval says otherwise")
         names = "; ".join(f"{row.system} "
@@ -402,7 +402,7 @@ def store_lines(whole, windows, sticky, n_ics=None):
         if n and len(unresolved):
             sizes = sorted(equivalence_sample_size(
                 (x.ci_high - x.ci_low) / (2 * Z95), int(n),
-                max(abs(MARGIN - abs(x.count_over_kinetic - 1)), 1e-9))
+                margin=max(abs(MARGIN - abs(x.count_over_kinetic - 1)), 1e-9))
                 for x in unresolved.itertuples())
             span = f"{sizes[0]}" if len(sizes) == 1 else f"{sizes[0]}–{sizes[-1]}"
             need = f"; the inconclusive ones not resolved at this size (need ≈ {span} ICs)"

@@ -43,7 +43,7 @@ def rate_relaxation(store, n_windows=10, n_boot=N_BOOT, seed=0):
         counts = per_ic.sum(0)
         width = edges[1] - edges[0]
         gamma = kinetic_rate(float(r))
-        picks = resample_indices(len(per_ic), n_boot, rng)
+        picks = resample_indices(len(per_ic), n_boot=n_boot, rng=rng)
         boot_sum += per_ic[picks].mean(1) / width / gamma
         est_sum += counts / (len(part) * width) / gamma
         n_r += 1
@@ -53,17 +53,17 @@ def rate_relaxation(store, n_windows=10, n_boot=N_BOOT, seed=0):
                          "rate_over_kinetic": counts[k] / (len(part) * width) / gamma})
         n = part["n_pp"].to_numpy(float)
         t = part["t_window"].to_numpy(float)
-        picks = resample_indices(n.size, n_boot, rng)
+        picks = resample_indices(n.size, n_boot=n_boot, rng=rng)
         lo, hi = percentile_interval(n[picks].sum(1) / t[picks].sum(1) / gamma)
         whole.append({"family": store.experiment.name, "radius": r,
                       "count_over_kinetic": n.sum() / t.sum() / gamma, "ci_low": lo,
-                      "ci_high": hi, "verdict": ratio_verdict(lo, hi, MARGIN)})
+                      "ci_high": hi, "verdict": ratio_verdict(lo, hi, tolerance=MARGIN)})
     windows = []
     for k in range(n_windows):
         lo, hi = percentile_interval(boot_sum[:, k] / n_r)
         windows.append({"family": store.experiment.name, "window": k,
                         "rate_over_kinetic": est_sum[k] / n_r, "ci_low": lo, "ci_high": hi,
-                        "verdict": ratio_verdict(lo, hi, MARGIN)})
+                        "verdict": ratio_verdict(lo, hi, tolerance=MARGIN)})
     return pd.DataFrame(rows), pd.DataFrame(whole), pd.DataFrame(windows)
 
 
@@ -76,7 +76,7 @@ def sticky_orbits(store):
                                  zip(coll["n_pp"], coll["t_window"], coll["radius"],
                                      strict=True)]
     coll["sticky"] = coll["rate_over_kinetic"] > STICKY_FACTOR
-    ics = initial_conditions(exp.n_ics, exp.r_max, seed=exp.seed, method=exp.ic_method,
+    ics = initial_conditions(exp.n_ics, exp.r_max, rng=exp.seed, method=exp.ic_method,
                              rule=exp.rule)
     ang = np.abs(ics[:, :, 0] * ics[:, :, 3] - ics[:, :, 1] * ics[:, :, 2])  # (n, 2)
     coll["max_abs_L"] = ang.max(axis=1)[coll["ic"].to_numpy()]

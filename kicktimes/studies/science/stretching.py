@@ -103,7 +103,7 @@ def stretching(results, n_boot=N_BOOT, seed=0):
     radii = arrays["two_particle"]["lam"].index.to_numpy(float)
     n_ics = arrays["two_particle"]["lam"].shape[1]
     x = np.log(1 / radii)
-    picks = resample_indices(n_ics, n_boot, rng, with_identity=True)
+    picks = resample_indices(n_ics, n_boot=n_boot, rng=rng, with_identity=True)
 
     def stretch(system):
         a = {k: v.to_numpy(float) for k, v in arrays[system].items()}
@@ -127,7 +127,7 @@ def stretching(results, n_boot=N_BOOT, seed=0):
             if system != "two_particle":
                 lo, hi = percentile_interval(ratio[1:, j])
                 row.update(ratio=ratio[0, j], ratio_ci_low=lo, ratio_ci_high=hi,
-                           verdict=ratio_verdict(lo, hi, margin_of("ftle")))
+                           verdict=ratio_verdict(lo, hi, tolerance=margin_of("ftle")))
             per_radius.append(row)
         coef = lstsq(s[system])
         local = np.diff(s[system][0]) / np.diff(x)

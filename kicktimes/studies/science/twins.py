@@ -42,12 +42,12 @@ def independent_angle_twin(r, *, n_ics=8, n_steps=3000, tau=0.2, d0=2e-4, seed=3
     True
     """
     rate = kinetic_rate(r)
-    ics = initial_conditions(n_ics, r, seed=seed)
+    ics = initial_conditions(n_ics, r, rng=seed)
     lams = []
     for k, ic in enumerate(ics):
         rng = np.random.default_rng([seed, k])
         horizon = n_steps * tau
-        kicks = schedules.Poisson(rate).sample(horizon, rng)
+        kicks = schedules.Poisson(rate).sample(horizon, rng=rng)
         ang_a = rng.uniform(0.0, 2.0 * np.pi, kicks.size)
         ang_b = rng.uniform(0.0, 2.0 * np.pi, kicks.size)
         a = np.array(ic[0], dtype=float)
@@ -73,7 +73,8 @@ def independent_angle_twin(r, *, n_ics=8, n_steps=3000, tau=0.2, d0=2e-4, seed=3
         lams.append(total / (n_steps * tau))
     boot_rng = np.random.default_rng(1)
     lams = np.asarray(lams, float)
-    boot = [np.mean(lams[p]) for p in resample_indices(lams.size, N_BOOT, boot_rng, chunk=1)]
+    boot = [np.mean(lams[p])
+            for p in resample_indices(lams.size, n_boot=N_BOOT, rng=boot_rng, chunk=1)]
     return float(np.mean(lams)), rate, percentile_interval(boot)
 
 

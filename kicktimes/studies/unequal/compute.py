@@ -29,7 +29,7 @@ def size_ratio_runs(r1, n_ics, n_steps, tau, seed) -> pd.DataFrame:
     ``partner``, or its own, ``own``; the same kick times and numbers for both kinds).
     """
     radii = (R0, r1)
-    ics = initial_conditions(n_ics, radii, seed=seed, method="uniform")
+    ics = initial_conditions(n_ics, radii, rng=seed, method="uniform")
     rows = []
     for i, ic in enumerate(ics):
         row = {"ic": i}

@@ -66,14 +66,14 @@ def _at(table, column, pick):
 
 def _fine(lo, hi):
     """`ratio_reading` at :data:`FINE_MARGIN`, naming that margin once."""
-    said = ratio_reading(lo, hi, FINE_MARGIN)
+    said = ratio_reading(lo, hi, tolerance=FINE_MARGIN)
     return said if "margin" in said else f"{said} at the {100 * FINE_MARGIN:g} % margin"
 
 
 def _ftle(row, c):
     lo, hi = row[c[1]], row[c[2]]
     text = (f"{format_interval(row[c[0]], lo, hi, edges=(0.9, 0.95, 1.0, 1.05, 1.1))}, "
-            f"{_fine(lo, hi)} (10 %: {ratio_reading(lo, hi, MARGIN)})")
+            f"{_fine(lo, hi)} (10 %: {ratio_reading(lo, hi, tolerance=MARGIN)})")
     if hi < 1 or lo > 1:
         text += (f", a real {'deficit' if hi < 1 else 'excess'} of "
                  f"{100 * abs(1 - row[c[0]]):.1f} %")
@@ -89,7 +89,8 @@ def _d_cell(row):
         return "n/a"
     text = format_interval(row["d_minus_null"], row["d_minus_null_low"],
                            row["d_minus_null_high"], edges=())
-    return f"{text}, {null_reading(row['d_minus_null_low'], row['d_minus_null_high'], D_MARGIN)}"
+    reading = null_reading(row['d_minus_null_low'], row['d_minus_null_high'], margin=D_MARGIN)
+    return f"{text}, {reading}"
 
 
 def answers(table) -> list[str]:
@@ -100,13 +101,13 @@ def answers(table) -> list[str]:
     def count(verdicts):
         return ", ".join(f"{k} at {v}" for k, v in pd.Series(verdicts).value_counts().items())
 
-    rate_v = [ratio_reading(lo, hi, MARGIN) for lo, hi in zip(table["rate_low"],
+    rate_v = [ratio_reading(lo, hi, tolerance=MARGIN) for lo, hi in zip(table["rate_low"],
                                                                table["rate_high"], strict=True)]
     worst = table.loc[(table["rate_ratio"] - 1).abs().idxmax()]
     ks = _at(table, "ks_reject_share", "min")
     d = _at(table, "d_minus_null", "min")
     large = table.iloc[-1]
-    d_reads = [null_reading(lo, hi, D_MARGIN) for lo, hi in zip(
+    d_reads = [null_reading(lo, hi, margin=D_MARGIN) for lo, hi in zip(
         table["d_minus_null_low"], table["d_minus_null_high"], strict=True)]
     small_v = [ratio_reading(lo, hi) for lo, hi in zip(table[_FTLE[0][1]], table[_FTLE[0][2]],
                                                         strict=True)]
@@ -186,7 +187,7 @@ def write_page(table, params, command, source):
 
     def cell(row, c):
         return (f"{format_interval(row[c[0]], row[c[1]], row[c[2]])}, "
-                f"{ratio_reading(row[c[1]], row[c[2]], MARGIN)}")
+                f"{ratio_reading(row[c[1]], row[c[2]], tolerance=MARGIN)}")
 
     for _, row in table.iterrows():
         rate = cell(row, ("rate_ratio", "rate_low", "rate_high"))
@@ -203,7 +204,7 @@ def write_page(table, params, command, source):
     for c, name in ((("rate_ratio", "rate_low", "rate_high"), "collision rate / kinetic rate"),
                     (cols[0], "small disk, partner of the other disk's size"),
                     (cols[2], "large disk, partner of the other disk's size")):
-        v = [ratio_reading(lo, hi, MARGIN) for lo, hi in zip(table[c[1]], table[c[2]],
+        v = [ratio_reading(lo, hi, tolerance=MARGIN) for lo, hi in zip(table[c[1]], table[c[2]],
                                                              strict=True)]
         counts = pd.Series(v).value_counts()
         odd = [f"ratio {x:g}: {vv}" for x, vv in zip(table["size_ratio"], v, strict=True)

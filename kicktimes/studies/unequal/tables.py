@@ -48,7 +48,7 @@ def dispersion_null(windows, rate, rng, n=N_NULL):
 def ratio_ci(x, y, rng, n_boot=2000):
     """Ratio of means ``sum x / sum y`` and its percentile bootstrap CI over pairs."""
     x, y = np.asarray(x, float), np.asarray(y, float)
-    idx = resample_indices(x.size, n_boot, rng)
+    idx = resample_indices(x.size, n_boot=n_boot, rng=rng)
     boot = x[idx].sum(1) / y[idx].sum(1)
     return x.sum() / y.sum(), *np.quantile(boot, [0.025, 0.975])
 
@@ -56,7 +56,7 @@ def ratio_ci(x, y, rng, n_boot=2000):
 def dispersion_ci(counts, rng, n_boot=2000):
     """95 % bootstrap interval of the rate dispersion across ICs, var / mean of the counts."""
     counts = np.asarray(counts, float)
-    b = counts[resample_indices(counts.size, n_boot, rng)]
+    b = counts[resample_indices(counts.size, n_boot=n_boot, rng=rng)]
     return percentile_interval(b.var(1, ddof=1) / b.mean(1))
 
 
@@ -121,9 +121,9 @@ def size_ratio_table(runs_by_r1, seed) -> pd.DataFrame:
                     "d_minus_null_low": row["disp_low"] - d0,
                     "d_minus_null_high": row["disp_high"] - d0})
         row["d_verdict"] = null_verdict(row["d_minus_null_low"], row["d_minus_null_high"],
-                                        D_MARGIN)
+                                        margin=D_MARGIN)
         row["ks_low"], row["ks_high"] = clopper_pearson(
             int(round(row["ks_reject_share"] * len(times))), len(times))
-        row["ks_verdict"] = rejection_verdict(row["ks_low"], row["ks_high"], 0.05)
+        row["ks_verdict"] = rejection_verdict(row["ks_low"], row["ks_high"], alpha=0.05)
         rows.append(row)
     return pd.DataFrame(rows)
