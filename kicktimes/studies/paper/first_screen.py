@@ -264,7 +264,8 @@ def compact_overview(table: pd.DataFrame) -> pd.DataFrame:
         for system in systems:
             rows = part[part["system"] == system]
             # each cell at its diagnostic's margin, as the answers read it
-            rows = rows.assign(verdict=[ratio_verdict(lo, hi, tolerance=margin_of(diagnostic)) for lo, hi
+            margin = margin_of(diagnostic)
+            rows = rows.assign(verdict=[ratio_verdict(lo, hi, tolerance=margin) for lo, hi
                                         in zip(rows["ci_low"], rows["ci_high"], strict=True)])
             p = _one(rows, family=family, control="primary")
             if p is None:
