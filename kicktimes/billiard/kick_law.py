@@ -195,10 +195,16 @@ class KickLaw:
     ...                             kicks=law, rng=1)
     >>> KickLaw.from_run(run).angle
     'gaussian'
-    >>> KickLaw(angle="uniform", partner_mass=3.0)
+    >>> KickLaw(angle="uniform", partner_mass=3.0)  # doctest: +ELLIPSIS
     Traceback (most recent call last):
     ...
-    ValueError: rule, e0, partner, partner_radius and partner_mass describe scattering kicks; they need angle='scatter', got angle='uniform'
+    ValueError: rule, e0, partner, partner_radius and partner_mass describe scattering ...
+    >>> print(KickLaw(schedules.Poisson(0.1), angle="scatter").summary())
+    Kick law
+      when   : at the times of Poisson(rate=0.1), drawn with the run's rng
+      what   : a kick is a collision with a virtual partner disk (docs/scatter.md)
+      angles : drawn from the run's rng after the times
+      partner: rule='mirror', direction 'weighted', radius r (the disk's own), mass 1
     """
 
     times: object = None

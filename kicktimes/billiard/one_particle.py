@@ -20,6 +20,8 @@ import numpy as np
 
 from kicktimes._old_keywords import old_keywords, pop_old, translator, warn_old
 from kicktimes.billiard import checks as chk
+from kicktimes.billiard.kernels.drive_one import simulate_one_kernel
+from kicktimes.billiard.kernels.one import KICK_ANGLES
 from kicktimes.billiard.kick_law import (
     KickLaw,
     _is_schedule,
@@ -27,8 +29,6 @@ from kicktimes.billiard.kick_law import (
     check_kick_angles,
     check_kick_times,
 )
-from kicktimes.billiard.kernels.drive_one import simulate_one_kernel
-from kicktimes.billiard.kernels.one import KICK_ANGLES
 from kicktimes.billiard.runs import BoundaryLog, OneParticleRun, sampling_fields
 from kicktimes.billiard.scatter import PARTNER_LAWS, draw_scatter_uniforms
 from kicktimes.billiard.two_particle import raise_for_status

@@ -25,11 +25,11 @@ import numpy as np
 
 from kicktimes._old_keywords import old_keywords, pop_old, translator, warn_old
 from kicktimes.billiard import checks as chk
-from kicktimes.billiard.kick_law import KickLaw, as_kick_law
 from kicktimes.billiard.kernels.drive_one import simulate_tangent_one_kernel, tangent_one_kernel
 from kicktimes.billiard.kernels.drive_two import simulate_tangent_two_kernel, tangent_two_kernel
 from kicktimes.billiard.kernels.tangent import MAX_SAME_INSTANT
 from kicktimes.billiard.kernels.twins import ftle_one_kernel, ftle_two_kernel
+from kicktimes.billiard.kick_law import as_kick_law
 from kicktimes.billiard.one_particle import (
     KICK_ANGLES,
     OLD_KICK_KEYWORDS,
