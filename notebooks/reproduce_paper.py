@@ -51,7 +51,7 @@ import kicktimes as kt
 from kicktimes import plots, stats
 from kicktimes.diagnostics import lyapunov
 from kicktimes.experiment import Experiment, kick_rng, load_store, preset, run_experiment
-from kicktimes.report import build_report
+from kicktimes.report import Render, Subsampling, build_report
 from kicktimes.studies.protocol import (
     Ratios,
     fig6_figure,
@@ -333,9 +333,9 @@ html = build_report(
     [WORKDIR / f"store-{name}" for name in P["report_stores"]],
     out,
     progress=False,
-    max_ics_model_fits=P["fits"],
+    subsampling=Subsampling(max_ics_model_fits=P["fits"]),
     n_mc=P["n_mc"],
-    dpi=P["dpi"],
+    render=Render(dpi=P["dpi"]),
     workers=WORKERS,
 )
 files = sorted(p.name for p in out.iterdir())
