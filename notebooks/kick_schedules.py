@@ -51,6 +51,8 @@ from scipy import stats as sps
 import kicktimes as kt
 from kicktimes import diagnostics as dg
 from kicktimes import plots, schedules, stats
+from kicktimes.billiard import KickLaw
+from kicktimes.diagnostics import Tangent
 
 # %matplotlib inline
 SIZE = os.environ.get("KICKTIMES_NOTEBOOK_SIZE", "small")
@@ -309,9 +311,9 @@ print(
     f"{one_ic.loc['no kicks', 'RR(1e-2), off-diagonal']:.3g} (the periodic unkicked disk)"
 )
 explicit = dg.lyapunov(
-    ic[0], R, kicks=poisson_run.kick_times, kick_angles=poisson_run.kick_angles, **steps
+    ic[0], R, kicks=KickLaw(poisson_run.kick_times, angles=poisson_run.kick_angles), **steps
 )
-paper_variant = dg.lyapunov(two, variant="paper")
+paper_variant = dg.lyapunov(two, method=Tangent(variant="paper"))
 print(
     f"lyapunov(run) = {one_ic.loc['Poisson', 'lambda']:.6g} and the explicit call with the "
     f"run's kicks = {explicit.lam:.6g} (equal: {explicit.lam == one_ic.loc['Poisson', 'lambda']})"

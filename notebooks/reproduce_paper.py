@@ -49,7 +49,7 @@ from IPython.display import Image, display
 
 import kicktimes as kt
 from kicktimes import plots, stats
-from kicktimes.diagnostics import lyapunov
+from kicktimes.diagnostics import Twin, lyapunov
 from kicktimes.experiment import Experiment, kick_rng, load_store, preset, run_experiment
 from kicktimes.report import Render, Subsampling, build_report
 from kicktimes.studies.protocol import (
@@ -286,7 +286,7 @@ ic, r = panel.initial_conditions()[0], panel.radii[-1]
 steps = dict(n_steps=panel.n_steps, tau=panel.tau, sampling="paper")
 for renormalize in (False, True):
     res = lyapunov(
-        ic, r, method="twin", variant="paper", d0=1 / 5000, renormalize=renormalize, **steps
+        ic, r, method=Twin(variant="paper", d0=1 / 5000, renormalize=renormalize), **steps
     )
     print(f"two disks, r = {r}: renormalize={renormalize}: {res.lam:.4g}")
 

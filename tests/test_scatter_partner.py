@@ -7,9 +7,10 @@ import pytest
 from scipy import stats
 
 from kicktimes import initial_conditions, schedules, simulate_one_particle, simulate_two_particle
+from kicktimes.billiard import KickLaw
 from kicktimes.billiard.runs import read_run
 from kicktimes.billiard.scatter import scatter_kick
-from kicktimes.diagnostics import lyapunov
+from kicktimes.diagnostics import Tangent, Twin, lyapunov
 
 STATE = np.array([0.1, -0.2, 0.6, 0.8])
 R0 = 0.02
@@ -72,8 +73,8 @@ def test_a_smaller_partner_defocuses_more():
     base = _run(n_steps=5000, tau=0.2, t_max=None)
     kw = dict(kicks=base.kick_times, kick_angles=base.kick_angles, kick_angle="scatter",
               n_steps=5000, tau=0.2)
-    small = lyapunov(STATE, R0, partner_radius=0.005, **kw)
-    large = lyapunov(STATE, R0, partner_radius=0.08, **kw)
+    small = lyapunov(STATE, R0, kicks=KickLaw(None, partner_radius=0.005), **kw)
+    large = lyapunov(STATE, R0, kicks=KickLaw(None, partner_radius=0.08), **kw)
     # per kick about log of the ratio of contact distances, ln(0.1 / 0.025) = 1.4
     per_kick = (small.lam - large.lam) * base.t_max / base.n_kicks
     assert 0.7 < per_kick < 2.1
@@ -83,13 +84,14 @@ def test_a_smaller_partner_defocuses_more():
 def test_tangent_and_twin_ftle_agree_with_a_partner_of_another_radius(rule, extra):
     run = _run(rule=rule, partner_radius=0.045, n_steps=4000, tau=0.2, t_max=None, **extra)
     tangent = lyapunov(run)
-    twin = lyapunov(run, method="twin", d0=1e-9)
+    twin = lyapunov(run, method=Twin(d0=1e-9))
     assert tangent.n_perturbations == run.n_kicks > 100 and tangent.lam > 0.05
     assert twin.lam == pytest.approx(tangent.lam, rel=0.02)
     # the one pass (run and FTLE from one event loop) is the run and the FTLE
-    again, same = lyapunov(STATE, R0, kicks=run.kick_times, kick_angles=run.kick_angles,
-                           kick_angle="scatter", rule=rule, partner_radius=0.045,
-                           n_steps=4000, tau=0.2, return_run=True, **extra)
+    again, same = lyapunov(STATE, R0,
+                           kicks=KickLaw(run.kick_times, angle="scatter", angles=run.kick_angles,
+                                         rule=rule, partner_radius=0.045), n_steps=4000, tau=0.2,
+                                         method=Tangent(return_run=True), **extra)
     assert again == tangent
     np.testing.assert_array_equal(same.kick_log_array, run.kick_log_array)
 
@@ -116,9 +118,10 @@ def test_elastic_kicks_with_masses_reproduce_the_collision_law_of_unequal_disks(
         w2.append(c[["vx0_post", "vy0_post"]].to_numpy())
     v2, w2 = np.concatenate(v2), np.concatenate(w2)
     kicked = simulate_one_particle(STATE, radii[0], t_max=16000.0,
-                                   kicks=schedules.Poisson(0.5), kick_angle="scatter",
-                                   rule="elastic", partner_radius=radii[1],
-                                   partner_mass=masses[1] / masses[0], rng=3).kick_log
+                                   kicks=KickLaw(schedules.Poisson(0.5), angle="scatter",
+                                                 rule="elastic", partner_radius=radii[1],
+                                                 partner_mass=masses[1] / masses[0]),
+                                                 rng=3).kick_log
     v1 = kicked[["vx", "vy"]].to_numpy()
     w1 = kicked[["vx_post", "vy_post"]].to_numpy()
     assert v2.shape[0] > 2000 and v1.shape[0] > 4000
@@ -127,8 +130,9 @@ def test_elastic_kicks_with_masses_reproduce_the_collision_law_of_unequal_disks(
     assert stats.ks_2samp(np.hypot(*v2.T), np.hypot(*v1.T)).pvalue > 0.01
     # an equal-mass partner does not: the mass sets the size of the velocity change
     equal = simulate_one_particle(STATE, radii[0], t_max=16000.0,
-                                  kicks=schedules.Poisson(0.5), kick_angle="scatter",
-                                  rule="elastic", partner_radius=radii[1], rng=3).kick_log
+                                  kicks=KickLaw(schedules.Poisson(0.5), angle="scatter",
+                                                rule="elastic", partner_radius=radii[1]),
+                                                rng=3).kick_log
     change_eq = np.hypot(*(equal[["vx_post", "vy_post"]].to_numpy()
                            - equal[["vx", "vy"]].to_numpy()).T)
     assert stats.ks_2samp(change2, change_eq).pvalue < 1e-6

@@ -21,6 +21,8 @@ import sys
 
 import numpy as np
 
+from kicktimes.diagnostics import Tangent, Twin
+
 
 def _two_cases(small: bool):
     from kicktimes import initial_conditions
@@ -92,9 +94,8 @@ def lyapunov_outputs(small: bool = False) -> dict[str, np.ndarray]:
             continue
         kw = {k: v for k, v in kw.items() if k != "log_collisions"}
         for method, variant in (("tangent", "norm"), ("tangent", "paper"), ("twin", "paper")):
-            extra = {"d0": 1e-8} if method == "twin" else {}
-            put(f"{name}/{method}_{variant}",
-                lyapunov(ic, r, method=method, variant=variant, **extra, **kw))
+            how = Twin(d0=1e-8, variant=variant) if method == "twin" else Tangent(variant=variant)
+            put(f"{name}/{method}_{variant}", lyapunov(ic, r, method=how, **kw))
         if kw.get("sampling") == "paper":
             res, run, pp = lyapunov_pass(ic, r, t_continue=0.5 * n, **kw)
             put(f"{name}/pass", res)
@@ -104,9 +105,9 @@ def lyapunov_outputs(small: bool = False) -> dict[str, np.ndarray]:
         if "t_max" in kw:
             continue
         for method in ("tangent", "twin"):
-            extra = {"d0": 1e-8} if method == "twin" else {}
-            put(f"{name}/{method}", lyapunov(state, r, method=method, **extra, **kw))
-        res, run = lyapunov(state, r, return_run=True, **kw)
+            how = Twin(d0=1e-8) if method == "twin" else "tangent"
+            put(f"{name}/{method}", lyapunov(state, r, method=how, **kw))
+        res, run = lyapunov(state, r, method=Tangent(return_run=True), **kw)
         put(f"{name}/pass", res)
         out.update(_fields(f"{name}/pass_run", run, ("kick_times", "kick_log_array")))
     for i, rule in enumerate(("mirror", "elastic")):
