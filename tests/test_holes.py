@@ -7,6 +7,7 @@ import pandas as pd
 import pytest
 
 from kicktimes import initial_conditions, simulate_one_particle, simulate_two_particle
+from kicktimes.billiard import KickLaw
 from kicktimes.diagnostics import Tangent
 
 R = 0.02
@@ -89,8 +90,9 @@ def test_the_ftle_is_measured_up_to_the_escape():
     from kicktimes.diagnostics import lyapunov
 
     state = initial_conditions(1, R, seed=6)[0, 0]
-    kw = {"n_steps": 4000, "tau": 0.3, "kicks": np.sort(np.random.default_rng(2).uniform(
-        0, 1200, 60)), "kick_angles": np.random.default_rng(3).uniform(0, 6.28, 60)}
+    kw = {"n_steps": 4000, "tau": 0.3, "kicks": KickLaw(
+        np.sort(np.random.default_rng(2).uniform(0, 1200, 60)),
+        angles=np.random.default_rng(3).uniform(0, 6.28, 60))}
     res, run = lyapunov(state, R, holes=HOLES, method=Tangent(return_run=True), **kw)
     assert math.isfinite(run.escape_time) and res.total_time == run.escape_time
     assert lyapunov(state, R, holes=HOLES, **kw).lam == res.lam

@@ -109,11 +109,10 @@ def test_each_interval_is_its_exponential_number_over_the_rate_of_the_post_kick_
 def test_an_elastic_kinetic_run_replays_bitwise_and_gives_one_exponent(table, state, run):
     again = simulate_one_particle(state, R, t_max=3000.0,
                                   kicks=KickLaw(run.kick_times, angle="scatter",
-                                                angles=run.kick_angles, rule="elastic"),
-                                  )
+                                                angles=run.kick_angles, rule="elastic"))
     assert again.final_state.tobytes() == run.final_state.tobytes()
-    kw = {"n_steps": 3000, "tau": 0.3, "kicks": table, "kick_angle": "scatter",
-          "rule": "elastic", "rng": 2}
+    kw = {"n_steps": 3000, "tau": 0.3, "kicks": KickLaw(table, angle="scatter", rule="elastic"),
+          "rng": 2}
     res, one = lyapunov(state, R, method=Tangent(return_run=True), **kw)
     assert res.lam == lyapunov(state, R, **kw).lam == lyapunov(one).lam
     assert res.n_perturbations == one.n_kicks > 0
@@ -142,8 +141,8 @@ def test_scattering_kicks_the_elastic_table_does_not_describe_are_refused(table,
                                                                           match):
     state = np.array([0.1, 0.2, 0.6, 0.8])
     with pytest.raises(ValueError, match=match):
-        simulate_one_particle(state, R, t_max=10.0, kicks=KickLaw(table, angle="scatter"), rng=1,
-                              **kwargs)
+        simulate_one_particle(state, R, t_max=10.0, kicks=KickLaw(table, angle="scatter", **kwargs),
+                              rng=1)
 
 
 def test_unequal_masses_are_refused_by_the_elastic_table(table):

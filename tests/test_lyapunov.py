@@ -70,8 +70,8 @@ def test_kicks_make_the_one_particle_billiard_chaotic(ics, kick_angle):
 
 
 def test_independent_twin_kicks_need_a_kicked_twin(ics):
-    with pytest.raises(ValueError, match="twin_kicks='independent' applies to method='twin'"):
-        lyapunov(ics[1, 0], 0.03, n_steps=10, tau=0.2, method=Twin(twin_kicks="independent"))
+    with pytest.raises(TypeError, match="twin_kicks"):
+        Tangent(twin_kicks="independent")  # a tangent vector has no kicks of its own
     with pytest.raises(ValueError, match="not to two disks"):
         lyapunov(ics[1], 0.03, n_steps=10, tau=0.2, method=Twin(twin_kicks="independent"))
     with pytest.raises(ValueError, match="kick_angle='scatter'"):
@@ -113,12 +113,6 @@ def test_results_are_deterministic(ics, method):
 @pytest.mark.parametrize(
     ("kwargs", "match"),
     [
-        (dict(n_steps=10, tau=0.2, variant="max"), "variant must be one of"),
-        (dict(n_steps=10, tau=0.2, method="twin", d0=0.0), "d0 must lie in"),
-        (dict(n_steps=10, tau=0.2, method="twin", d0=5e-324), "d0 must lie in"),
-        (dict(n_steps=10, tau=0.2, method="twin", d0=1e-12), "d0 must lie in"),
-        (dict(n_steps=10, tau=0.2, method="twin", d0=0.05), "d0 must lie in"),
-        (dict(n_steps=10, tau=0.2, d0=1e-8), "d0 applies to method='twin' only"),
         (dict(n_steps=10, tau=0.2, method="benettin"), "method must be one of"),
         (dict(n_steps=10**7, tau=100.0), "horizon n_steps \\* tau must be at most"),
         (dict(n_steps=10, tau=1e307), "tau must lie in"),
@@ -129,6 +123,22 @@ def test_results_are_deterministic(ics, method):
 def test_bad_arguments_raise(ics, kwargs, match):
     with pytest.raises(ValueError, match=match):
         lyapunov(ics[0], 0.03, **kwargs)
+
+
+@pytest.mark.parametrize(
+    ("options", "match"),
+    [
+        (lambda: Tangent(variant="max"), "variant must be one of"),
+        (lambda: Twin(variant="max"), "variant must be one of"),
+        (lambda: Twin(d0=0.0), "d0 must lie in"),
+        (lambda: Twin(d0=5e-324), "d0 must lie in"),
+        (lambda: Twin(d0=1e-12), "d0 must lie in"),
+        (lambda: Twin(d0=0.05), "d0 must lie in"),
+    ],
+)
+def test_bad_method_options_raise_naming_them(options, match):
+    with pytest.raises(ValueError, match=match):
+        options()
 
 
 @pytest.mark.parametrize("sigma", [math.inf, math.nan, 0.0, -1.0])
@@ -171,14 +181,15 @@ ON_THE_WALL = [[0.95, 0.0, 0.0, 1.0], [0.0, 0.5, 0.0, 1.0]]  # disk 0 tangent to
     ],
 )
 def test_an_undefined_tangent_exponent_is_nan_with_a_reason_and_a_warning(ic, r, kwargs, reason):
+    variant = kwargs.pop("variant", "norm")
     kwargs = {"n_steps": 100, "tau": 0.3, **kwargs}
     with pytest.warns(UndefinedDiagnosticWarning, match=f"lyapunov: lam is NaN: .*{reason}"):
-        res = lyapunov(ic, r, **kwargs)
+        res = lyapunov(ic, r, method=Tangent(variant=variant), **kwargs)
     assert math.isnan(res.lam) and reason in res.reason
     assert math.isnan(res.lam_per_perturbation)
     # one pass with the run: the same result
     with pytest.warns(UndefinedDiagnosticWarning):
-        res2, _ = lyapunov(ic, r, method=Tangent(return_run=True), **kwargs)
+        res2, _ = lyapunov(ic, r, method=Tangent(variant=variant, return_run=True), **kwargs)
     assert_results_bitwise_equal(res2, res)
 
 
@@ -307,26 +318,24 @@ def test_one_pass_gives_the_two_disk_run_and_exponent_of_separate_calls(r, rule,
 def test_one_pass_gives_the_kicked_run_and_exponent_of_separate_calls(r, kick_angle, extra,
                                                                       sampling, variant):
     state = initial_conditions(1, r, seed=12)[0, 0]
-    kw = dict(n_steps=800, tau=0.3, sampling=sampling, kick_angle=kick_angle, **extra)
+    kw = dict(n_steps=800, tau=0.3, sampling=sampling)
+    law = KickLaw(schedules.Poisson(0.2), angle=kick_angle, **extra)
     # drawn from a schedule with rng (the same draws both ways), and given explicitly with
     # kicks beyond the run's end (paper sampling: applied only while the run lasts)
-    res, run = lyapunov(state, r, kicks=schedules.Poisson(0.2), rng=3,
-                        method=Tangent(variant=variant, return_run=True),
-                        **kw)
-    assert_results_bitwise_equal(res, lyapunov(state, r, kicks=schedules.Poisson(0.2), rng=3,
+    res, run = lyapunov(state, r, kicks=law, rng=3,
+                        method=Tangent(variant=variant, return_run=True), **kw)
+    assert_results_bitwise_equal(res, lyapunov(state, r, kicks=law, rng=3,
                                                method=Tangent(variant=variant), **kw))
-    assert_runs_bitwise_equal(run, simulate_one_particle(state, r, kicks=schedules.Poisson(0.2),
-                                                         rng=3, **kw))
+    assert_runs_bitwise_equal(run, simulate_one_particle(state, r, kicks=law, rng=3, **kw))
     assert run.n_kicks > 0 and res.n_perturbations == run.n_kicks
     if sampling == "paper":
         late = 0.3 * 800 + 1.0
         kicks = np.r_[run.kick_times, late]
         angles = np.concatenate([run.kick_angles, run.kick_angles[:1]])
-        res, run2 = lyapunov(state, r, kicks=KickLaw(kicks, angles=angles),
-                             method=Tangent(variant=variant, return_run=True),
-                             **kw)
-        again = simulate_one_particle(state, r, kicks=KickLaw(kicks, angles=angles), **kw)
-        assert_runs_bitwise_equal(run2, again)
+        given = law.replace(times=kicks, angles=angles)
+        res, run2 = lyapunov(state, r, kicks=given,
+                             method=Tangent(variant=variant, return_run=True), **kw)
+        assert_runs_bitwise_equal(run2, simulate_one_particle(state, r, kicks=given, **kw))
         assert_runs_bitwise_equal(run2, run)
 
 
@@ -474,7 +483,7 @@ def test_the_literal_eq4_of_a_kicked_run_shares_its_kicks():
     state = initial_conditions(1, r, seed=5)[0][0]
     kicks = schedules.Poisson(rate=0.2).sample(n * tau, rng=np.random.default_rng(3))
     angles = np.random.default_rng(4).uniform(0, 2 * np.pi, kicks.size)
-    common = dict(kicks=kicks, kick_angles=angles, kick_angle="uniform", n_steps=n, tau=tau)
+    common = dict(kicks=KickLaw(kicks, angles=angles, angle="uniform"), n_steps=n, tau=tau)
     reference = simulate_one_particle(state, r, **common)
     twins = []
     for c in (0, 1):
@@ -493,20 +502,20 @@ def test_independent_twins_take_their_own_angles_at_the_shared_times(kick_angle)
     state = initial_conditions(1, r, seed=5)[0][0]
     kicks = schedules.Poisson(rate=0.2).sample(n * tau, rng=np.random.default_rng(3))
     angles = draw_kick_angles(kicks.size, kick_angle, 0.5, np.random.default_rng(4))
-    common = dict(kick_angle=kick_angle, sigma=0.5, n_steps=n, tau=tau)
-    reference = simulate_one_particle(state, r, kicks=KickLaw(kicks, angles=angles), **common)
+    common = dict(n_steps=n, tau=tau)
+    law = KickLaw(kicks, angle=kick_angle, sigma=0.5)
+    reference = simulate_one_particle(state, r, kicks=law.replace(angles=angles), **common)
     # the twins' angles: drawn from rng after the run's (here given, so none drawn)
     own = np.random.default_rng(7)
     twins = []
     for c in (0, 1):
         moved = state.copy()
         moved[c] += d0
-        twins.append(simulate_one_particle(
-            moved, r, kicks=KickLaw(kicks,
-                                    angles=draw_kick_angles(kicks.size, kick_angle, 0.5, own)),
-                                    **common))
+        own_angles = draw_kick_angles(kicks.size, kick_angle, 0.5, own)
+        twins.append(simulate_one_particle(moved, r, kicks=law.replace(angles=own_angles),
+                                           **common))
     want, parts = _literal_eq4(reference, *twins, d0, tau)
-    got = lyapunov(state, r, kicks=KickLaw(kicks, angles=angles),
+    got = lyapunov(state, r, kicks=law.replace(angles=angles),
                    method=Twin(variant="paper", d0=d0, renormalize=False, twin_kicks="independent"),
                    rng=7, **common)
     np.testing.assert_allclose([got.lam, got.lam_x, got.lam_y], [want, *parts], rtol=1e-7)
@@ -519,7 +528,7 @@ def test_independent_twins_take_their_own_angles_at_the_shared_times(kick_angle)
 
 def test_renormalize_false_needs_the_twin_method_and_a_bool(ics):
     ic = ics[0]
-    with pytest.raises(ValueError, match="method='twin'"):
-        lyapunov(ic, 0.03, n_steps=10, tau=0.2, method=Twin(renormalize=False))
+    with pytest.raises(TypeError, match="renormalize"):
+        Tangent(renormalize=False)  # eq. (4) read literally is a reading of the twin
     with pytest.raises(TypeError, match="renormalize must be a bool"):
         lyapunov(ic, 0.03, n_steps=10, tau=0.2, method=Twin(renormalize="no"))

@@ -143,9 +143,6 @@ def test_run_round_trips_through_parquet(tmp_path):
         (dict(r=0.02, t_max=10.0, kicks=[-1.0]), ">= 0"),
         (dict(r=0.02, t_max=10.0, kicks=[11.0]), r"\[0, t_max"),
         (dict(r=0.02, t_max=10.0, kicks=[np.nan]), "finite"),
-        (dict(r=0.02, t_max=10.0, kicks=[1.0], kick_angles=[1.0, 2.0]), "one angle per kick"),
-        (dict(r=0.02, t_max=10.0, kick_angle="cauchy"), "kick_angle must be one of"),
-        (dict(r=0.02, t_max=10.0, sigma=0.0), "sigma must lie in"),
     ],
 )
 def test_bad_arguments_raise(kwargs, match):
@@ -219,7 +216,6 @@ def test_messages_show_plain_floats():
     (dict(r=1 - 1e-9), r"r must lie in \(0.0, 0.999999\] for one disk", ValueError),
     (dict(t_max=1e300), r"t_max must lie in", ValueError),
     (dict(rng="seed", kicks=schedules.Poisson(1.0)), r"rng must be None, an int seed", TypeError),
-    (dict(kick_angles="x", kicks=[1.0]), r"kick_angles must be a sequence", TypeError),
 ])
 def test_ranges_that_keep_the_arithmetic_finite(kwargs, match, exc):
     args = dict(state=STATE, r=0.02, t_max=10.0)
@@ -274,10 +270,8 @@ def test_normal_kick_angles_are_drawn_from_n_0_sigma_and_act_as_new_directions()
     # the same angles as "uniform" new directions give the very same run and FTLE
     same = simulate_one_particle(state, 0.02, t_max=3000.0,
                                  kicks=KickLaw(run.kick_times, angle="uniform",
-                                               angles=run.kick_angles),
-                                )
+                                               angles=run.kick_angles))
     np.testing.assert_array_equal(run.final_state, same.final_state)
-    short = dict(kicks=kicks[kicks < 600], kick_angles=run.kick_angles[kicks < 600],
-                 n_steps=3000, tau=0.2)
-    assert (lyapunov(state, 0.02, kicks=KickLaw(None, angle="normal"), **short)
-            == lyapunov(state, 0.02, kicks=KickLaw(None, angle="uniform"), **short))
+    short = KickLaw(kicks[kicks < 600], angles=run.kick_angles[kicks < 600])
+    assert (lyapunov(state, 0.02, kicks=short.replace(angle="normal"), n_steps=3000, tau=0.2)
+            == lyapunov(state, 0.02, kicks=short, n_steps=3000, tau=0.2))

@@ -240,10 +240,11 @@ def test_elastic_scatter_kicks_keep_the_pair_energy():
 
 
 def test_same_seed_same_partners_for_both_rules_and_both_partner_laws():
-    kw = dict(t_max=2000.0, kicks=schedules.Poisson(0.05), kick_angle="scatter", rng=7)
-    a = simulate_one_particle(STATE, 0.02, **kw)
-    b = simulate_one_particle(STATE, 0.02, kicks=KickLaw(None, rule="elastic"), **kw)
-    c = simulate_one_particle(STATE, 0.02, kicks=KickLaw(None, partner="uniform"), **kw)
+    law = KickLaw(schedules.Poisson(0.05), angle="scatter")
+    kw = dict(t_max=2000.0, rng=7)
+    a = simulate_one_particle(STATE, 0.02, kicks=law, **kw)
+    b = simulate_one_particle(STATE, 0.02, kicks=law.replace(rule="elastic"), **kw)
+    c = simulate_one_particle(STATE, 0.02, kicks=law.replace(partner="uniform"), **kw)
     for other in (b, c):
         np.testing.assert_array_equal(a.kick_times, other.kick_times)
         np.testing.assert_array_equal(a.kick_angles, other.kick_angles)
@@ -272,19 +273,19 @@ def test_scatter_run_round_trips_through_parquet(tmp_path):
 @pytest.mark.parametrize(
     "kwargs, match",
     [
-        (dict(rule="elastic"), "kick_angle='scatter'"),
-        (dict(partner="uniform"), "kick_angle='scatter'"),
-        (dict(kick_angle="scatter", e0=1.0), "e0"),
-        (dict(kick_angle="scatter", rule="elastic", e0=0.3), "e0"),
-        (dict(kick_angle="scatter", rule="bouncy"), "rule"),
-        (dict(kick_angle="scatter", partner="random"), "partner"),
-        (dict(kick_angle="scatter", kick_angles=[0.1, 0.2]), r"shape \(2, 2\)"),
-        (dict(kick_angle="scatter", kick_angles=[[0.1, 2.0], [0.0, 0.0]]), r"\[-1, 1\]"),
+        (dict(rule="elastic"), "angle='scatter'"),
+        (dict(partner="uniform"), "angle='scatter'"),
+        (dict(angle="scatter", e0=1.0), "e0"),
+        (dict(angle="scatter", rule="elastic", e0=0.3), "e0"),
+        (dict(angle="scatter", rule="bouncy"), "rule"),
+        (dict(angle="scatter", partner="random"), "partner"),
+        (dict(angle="scatter", angles=[0.1, 0.2]), r"shape \(2, 2\)"),
+        (dict(angle="scatter", angles=[[0.1, 2.0], [0.0, 0.0]]), r"\[-1, 1\]"),
     ],
 )
 def test_bad_scatter_options_raise_naming_the_argument(kwargs, match):
     with pytest.raises(ValueError, match=match):
-        simulate_one_particle(STATE, 0.02, t_max=10.0, kicks=[1.0, 2.0], **kwargs)
+        simulate_one_particle(STATE, 0.02, t_max=10.0, kicks=KickLaw([1.0, 2.0], **kwargs))
 
 
 def test_scatter_needs_two_disks_that_fit():
@@ -324,7 +325,7 @@ def test_scatter_kicks_stretch_more_than_state_blind_kicks(scatter_run):
 def test_tangent_scatter_exponent_matches_twin_for_both_rules(rule):
     from kicktimes.diagnostics import lyapunov
 
-    kw = dict(kicks=schedules.Poisson(0.05), kick_angle="scatter", rule=rule, rng=5,
+    kw = dict(kicks=KickLaw(schedules.Poisson(0.05), angle="scatter", rule=rule), rng=5,
               n_steps=4000, tau=0.2)
     tangent = lyapunov(STATE, 0.02, **kw)
     twin = lyapunov(STATE, 0.02, method=Twin(d0=1e-9), **kw)
@@ -334,8 +335,8 @@ def test_tangent_scatter_exponent_matches_twin_for_both_rules(rule):
 def test_lyapunov_refuses_scatter_options_without_scatter_kicks():
     from kicktimes.diagnostics import lyapunov
 
-    with pytest.raises(ValueError, match="kick_angle='scatter'"):
-        lyapunov(STATE, 0.02, kicks=[1.0], rule="elastic", n_steps=10, tau=0.2)
+    with pytest.raises(ValueError, match="angle='scatter'"):
+        lyapunov(STATE, 0.02, kicks=KickLaw([1.0], rule="elastic"), n_steps=10, tau=0.2)
 
 
 # --- scatter-kicked systems in an experiment ---------------------------------------------

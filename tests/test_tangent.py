@@ -200,7 +200,7 @@ def test_tangent_agrees_with_the_twin_at_small_d0_on_every_ic(ics20, system):
     fn = SYSTEMS[system]
     for ic in ics20:
         tangent = fn(ic)
-        twin = fn(ic, method="twin", d0=1e-8)
+        twin = fn(ic, method=Twin(d0=1e-8))
         assert tangent.method == "tangent" and twin.method == "twin"
         assert tangent.n_perturbations == twin.n_perturbations > 0
         assert abs(tangent.lam - twin.lam) <= 0.02 * abs(twin.lam), (tangent, twin)
@@ -209,8 +209,8 @@ def test_tangent_agrees_with_the_twin_at_small_d0_on_every_ic(ics20, system):
 @pytest.mark.parametrize("system", list(SYSTEMS))
 def test_twin_exponent_does_not_depend_on_d0_on_average(ics20, system):
     fn = SYSTEMS[system]
-    big = np.mean([fn(ic, method="twin", d0=2e-4).lam for ic in ics20])
-    small = np.mean([fn(ic, method="twin", d0=2e-6).lam for ic in ics20])
+    big = np.mean([fn(ic, method=Twin(d0=2e-4)).lam for ic in ics20])
+    small = np.mean([fn(ic, method=Twin(d0=2e-6)).lam for ic in ics20])
     assert abs(big - small) <= 0.05 * small
 
 
@@ -298,7 +298,7 @@ def test_tangent_agrees_with_the_twin_at_paper_scale(system):
     fn = SYSTEMS[system]
     for ic in ics:
         tangent = fn(ic, **steps)
-        twin = fn(ic, method="twin", d0=1e-8, **steps)
+        twin = fn(ic, method=Twin(d0=1e-8), **steps)
         assert abs(tangent.lam - twin.lam) <= 0.02 * abs(twin.lam)
 
 

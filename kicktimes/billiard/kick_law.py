@@ -71,31 +71,33 @@ def _is_schedule(kicks) -> bool:
     return callable(getattr(kicks, "sample", None))
 
 
-def check_kick_angles(kick_angles, times: np.ndarray, kick_angle: str) -> np.ndarray:
+def check_kick_angles(kick_angles, times: np.ndarray, kick_angle: str,
+                      name: str = "kick_angles") -> np.ndarray:
+    """``kick_angles`` (named ``name`` in errors) checked against the times and the law."""
     if isinstance(kick_angles, str | bytes):
-        raise TypeError(f"kick_angles must be a sequence of angles, got the string {kick_angles!r}")
+        raise TypeError(f"{name} must be a sequence of angles, got the string {kick_angles!r}")
     try:
         arr = np.array(kick_angles, dtype=np.float64, copy=True, order="C")
     except (TypeError, ValueError) as exc:
         raise TypeError(
-            f"kick_angles must be a sequence of angles, got {type(kick_angles).__name__} ({exc})"
+            f"{name} must be a sequence of angles, got {type(kick_angles).__name__} ({exc})"
         ) from None
     if kick_angle == "scatter":
         if arr.shape != (times.size, 2):
             raise ValueError(
-                f"kick_angles of scattering kicks must have shape ({times.size}, 2) (two "
+                f"{name} of scattering kicks must have shape ({times.size}, 2) (two "
                 f"uniforms on (-1, 1) per kick), got {arr.shape}"
             )
         if not np.isfinite(arr).all() or (np.abs(arr) > 1.0).any():
-            raise ValueError("kick_angles of scattering kicks must lie in [-1, 1]")
+            raise ValueError(f"{name} of scattering kicks must lie in [-1, 1]")
         return arr
     angles = arr.ravel()
     if angles.shape != times.shape:
         raise ValueError(
-            f"kick_angles must have one angle per kick ({times.size}), got {angles.size}"
+            f"{name} must have one angle per kick ({times.size}), got {angles.size}"
         )
     if not np.isfinite(angles).all():
-        raise ValueError("kick_angles must be finite; got NaN or inf")
+        raise ValueError(f"{name} must be finite; got NaN or inf")
     return angles
 
 
@@ -255,8 +257,11 @@ class KickLaw:
                 raise ValueError("angles: kinetic kicks draw their angles with their times; "
                                  "to replay a kinetic run pass KickLaw.from_run(run)")
             if isinstance(times, np.ndarray):
-                angles = check_kick_angles(self.angles, times, self.angle)
-            else:
+                angles = check_kick_angles(self.angles, times, self.angle, name="angles")
+            else:  # checked against the times a run draws
+                if isinstance(self.angles, str | bytes):
+                    raise TypeError("angles must be a sequence of angles, got the string "
+                                    f"{self.angles!r}")
                 angles = np.array(self.angles, dtype=np.float64, copy=True, order="C")
             setattr_(self, "angles", _frozen(angles))
 

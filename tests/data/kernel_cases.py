@@ -21,6 +21,7 @@ import sys
 
 import numpy as np
 
+from kicktimes.billiard import KickLaw
 from kicktimes.diagnostics import Tangent, Twin
 
 
@@ -54,8 +55,8 @@ def _one_cases(small: bool):
         for law, extra in (("uniform", {}), ("gaussian", {"sigma": 0.3}),
                            ("scatter", {"rule": "mirror"}), ("scatter", {"rule": "elastic"})):
             for sampling in ("uniform", "paper"):
-                kw = dict(kicks=schedules.Poisson(0.5), kick_angle=law, rng=10 * i + len(cases),
-                          n_steps=n, tau=0.3, sampling=sampling, **extra)
+                kw = dict(kicks=KickLaw(schedules.Poisson(0.5), angle=law, **extra),
+                          rng=10 * i + len(cases), n_steps=n, tau=0.3, sampling=sampling)
                 cases.append((f"one_{r}_{law}_{extra.get('rule', '')}_{sampling}", state, r, kw))
         cases.append((f"one_{r}_free", state, r, dict(t_max=0.2 * n)))
     return cases
