@@ -410,9 +410,9 @@ def build_report(
     >>> build_report(store, tempfile.mkdtemp(), progress=False, workers=1).name
     'report.html'
     """
-    paths = _check_paths(store_path)
     subsampling = _check_group("subsampling", subsampling, Subsampling)
     render = _check_group("render", render, Render)
+    paths = _check_paths(store_path)
     options, render, workers = _check_options(
         out_dir,
         progress=progress,
