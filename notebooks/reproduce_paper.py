@@ -277,8 +277,8 @@ for (name, diagnostic), part in agg.groupby(level=["experiment", "diagnostic"]):
 # The paper's eq. (4), $\lambda_{\max}(n) = \frac{1}{\tau n}\sum_{k=1}^{n}
 # \log(\lVert\delta d(k\tau)\rVert / \lVert\delta d(0)\rVert)$ with
 # $\lVert\delta d(0)\rVert = 1/5000$, names Benettin's algorithm but prints no
-# renormalisation. `lyapunov(..., method="twin", variant="paper", d0=1/5000,
-# renormalize=False)` computes it as printed; `renormalize=True` is Benettin's. One IC first:
+# renormalisation. `lyapunov(..., method=Twin(variant="paper", d0=1/5000,
+# renormalize=False))` computes it as printed; `renormalize=True` is Benettin's. One IC first:
 
 # %%
 panel = panels("paper" if SIZE == "full" else "quick")[0]
