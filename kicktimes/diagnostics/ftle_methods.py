@@ -16,7 +16,8 @@ import numpy as np
 
 from kicktimes.validation import check_choice, check_int, check_real
 
-__all__ = ["D0_DEFAULT", "D0_RANGE", "TWIN_KICKS", "Tangent", "Twin", "VARIANTS", "as_method"]
+__all__ = ["D0_DEFAULT", "D0_RANGE", "OLD_METHOD_KEYWORDS", "TWIN_KICKS", "Tangent", "Twin",
+           "VARIANTS", "as_method", "method_from_old"]
 
 VARIANTS = ("norm", "paper")
 #: the kicked twins' kicks: the run's angles, or each twin's own at the same times
@@ -133,3 +134,38 @@ def as_method(method) -> Tangent | Twin:
         return _BY_NAME[method]()
     raise ValueError(f"method must be one of ['tangent', 'twin'] or a Tangent(...) / Twin(...), "
                      f"got {method!r}")
+
+
+#: lyapunov's method options before 0.2.0: each became a field of `Tangent` / `Twin`
+OLD_METHOD_KEYWORDS = ("variant", "d0", "max_defer", "renormalize", "twin_kicks", "return_run")
+#: (default, message) of a twin option given with method="tangent", as before 0.2.0
+_TWIN_ONLY = {
+    "d0": (None, "d0 applies to method='twin' only (the tangent method has no separation "
+                 "scale); got d0={!r} with method='tangent'"),
+    "renormalize": (True, "renormalize=False (eq. (4) read literally) applies to "
+                          "method='twin' only, got method='tangent'"),
+    "twin_kicks": ("shared", "twin_kicks='independent' applies to method='twin' only (a "
+                             "tangent vector has no kicks of its own), got method='tangent'"),
+}
+
+
+def method_from_old(method, old: dict):
+    """The `Tangent` / `Twin` of a method name and its old flat options."""
+    if not isinstance(method, str):
+        raise TypeError(f"lyapunov: method is {method!r}; give {', '.join(old)} as its fields, "
+                        "not as keywords")
+    if method == "twin":
+        if old.pop("return_run", False):
+            raise ValueError("return_run=True needs method='tangent' (the one-pass kernels "
+                             "carry tangent vectors; for the twin method call "
+                             "simulate_two_particle / simulate_one_particle and lyapunov "
+                             "separately), got method='twin'")
+        if old.get("d0") is None:
+            old.pop("d0", None)
+        return Twin(**old)
+    if method == "tangent":
+        for name, (default, message) in _TWIN_ONLY.items():
+            if name in old and old[name] != default:
+                raise ValueError(message.format(old[name]))
+        return Tangent(**{k: v for k, v in old.items() if k in ("variant", "return_run")})
+    return as_method(method)

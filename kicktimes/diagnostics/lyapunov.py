@@ -2,13 +2,13 @@
 
 Two methods (docs/lyapunov.md has the derivations):
 
-* ``method="tangent"`` (default): the linearised dynamics, exact. A tangent vector
+* ``method=Tangent()`` (default, ``"tangent"``): the linearised dynamics, exact. A tangent vector
   ``(dq, dv)`` starts along ``x`` of the tracked disk and is carried through free flights,
   wall reflections, disk-disk collisions and kicks by the exact linearised event maps
   (`kicktimes.billiard.kernels.tangent`). No ``d0``, no round-off floor, no deferrals.
-* ``method="twin"``: Benettin's twin trajectory at distance ``d0``, renormalised at the
-  sample times (`kicktimes.billiard.kernels.twins`); kept for fidelity to the paper, which used
-  it. For small enough ``d0`` it converges to the tangent result.
+* ``method=Twin(d0=...)`` (``"twin"``): Benettin's twin at distance ``d0``, renormalised at
+  the sample times (`kicktimes.billiard.kernels.twins`); kept for fidelity to the paper, which
+  used it; for small enough ``d0`` it converges to the tangent result.
 
 Both measure the same quantity: the growth rate of the tracked disk's position
 deviation, ``lambda = log(|dq_track(T)| / |dq_track(0)|) / T`` (``|dx|`` and ``|dy|``
@@ -39,6 +39,7 @@ from kicktimes.billiard.one_particle import (
     check_scatter_options,
     draw_kick_angles,
     kernel_limits,
+    law_from_old_keywords,
     one_particle_run,
     resolve_kicks,
 )
@@ -54,11 +55,12 @@ from kicktimes.diagnostics.autocorrelation import UndefinedDiagnosticWarning
 from kicktimes.diagnostics.ftle_methods import (
     D0_DEFAULT,
     D0_RANGE,
+    OLD_METHOD_KEYWORDS,
     TWIN_KICKS,
     VARIANTS,
-    Tangent,
     Twin,
     as_method,
+    method_from_old,
 )
 from kicktimes.validation import check_rng
 
@@ -288,44 +290,9 @@ def _start_vectors(variant: str, size: int, offset: int) -> np.ndarray:
     return U
 
 
-#: lyapunov's method options before 0.2.0: each became a field of `Tangent` / `Twin`
-OLD_METHOD_KEYWORDS = ("variant", "d0", "max_defer", "renormalize", "twin_kicks", "return_run")
-#: (default, message) of a twin option given with method="tangent", as before 0.2.0
-_TWIN_ONLY = {
-    "d0": (None, "d0 applies to method='twin' only (the tangent method has no separation "
-                 "scale); got d0={!r} with method='tangent'"),
-    "renormalize": (True, "renormalize=False (eq. (4) read literally) applies to "
-                          "method='twin' only, got method='tangent'"),
-    "twin_kicks": ("shared", "twin_kicks='independent' applies to method='twin' only (a "
-                             "tangent vector has no kicks of its own), got method='tangent'"),
-}
-
-
 def _one_disk(system) -> bool:
     return isinstance(system, OneParticleRun) or (
         not isinstance(system, TwoParticleRun) and np.shape(system) == (4,))
-
-
-def _method_from_old(method, old: dict):
-    """The `Tangent` / `Twin` of a method name and its old flat options."""
-    if not isinstance(method, str):
-        raise TypeError(f"lyapunov: method is {method!r}; give {', '.join(old)} as its fields, "
-                        "not as keywords")
-    if method == "twin":
-        if old.pop("return_run", False):
-            raise ValueError("return_run=True needs method='tangent' (the one-pass kernels "
-                             "carry tangent vectors; for the twin method call "
-                             "simulate_two_particle / simulate_one_particle and lyapunov "
-                             "separately), got method='twin'")
-        if old.get("d0") is None:
-            old.pop("d0", None)
-        return Twin(**old)
-    if method == "tangent":
-        for name, (default, message) in _TWIN_ONLY.items():
-            if name in old and old[name] != default:
-                raise ValueError(message.format(old[name]))
-        return Tangent(**{k: v for k, v in old.items() if k in ("variant", "return_run")})
-    return as_method(method)
 
 
 @translator(*OLD_METHOD_KEYWORDS, *OLD_KICK_KEYWORDS)
@@ -335,16 +302,14 @@ def _old_lyapunov(args, kwargs):
     old = pop_old(kwargs, OLD_METHOD_KEYWORDS)
     if old:
         method = kwargs.get("method", "tangent")
-        kind = "Twin" if method == "twin" else "Tangent"
+        kind = "Twin" if method == "twin" or "d0" in old else "Tangent"
+        fields = ", ".join(f"{k}=..." for k in old)
         warn_old(", ".join(f"lyapunov({k}=...)" for k in old),
-                 f"lyapunov(..., method={kind}({', '.join(f'{k}=...' for k in old)})) "
-                 "(kicktimes.diagnostics.Tangent / Twin)")
-        kwargs["method"] = _method_from_old(method, old)
+                 f"lyapunov(..., method={kind}({fields})) (kicktimes.diagnostics.{kind})")
+        kwargs["method"] = method_from_old(method, old)
     names = [k for k in OLD_KICK_KEYWORDS if k != "rule" or _one_disk(system)]
     old = pop_old(kwargs, names)
     if old:
-        from kicktimes.billiard.one_particle import law_from_old_keywords
-
         law_from_old_keywords(kwargs, old, "lyapunov")
     return kwargs, None
 
@@ -352,20 +317,18 @@ def _old_lyapunov(args, kwargs):
 def _flat(system, rule, kicks, method) -> dict:
     """The keywords of `_lyapunov` for the kick law ``kicks`` and the method object."""
     method = as_method(method)
-    flat = {"method": method.name, "variant": method.variant, "rule": rule}
+    flat = {"method": method.name, "variant": method.variant, "rule": rule,
+            "return_run": getattr(method, "return_run", False)}
     if isinstance(method, Twin):
         flat.update(d0=method.d0, max_defer=method.max_defer, renormalize=method.renormalize,
-                    twin_kicks=method.twin_kicks, return_run=False)
-    else:
-        flat["return_run"] = method.return_run
+                    twin_kicks=method.twin_kicks)
     if kicks is None:
         return flat
     law = as_kick_law(kicks)
     if _one_disk(system):
         if rule != "mirror":
-            raise ValueError(f"rule={rule!r}: rule is the two-disk collision rule; a kicked "
-                             "disk's scattering rule is a field of its kick law, "
-                             "kicks=KickLaw(..., angle='scatter', rule=...)")
+            raise ValueError(f"rule={rule!r}: a kicked disk's scattering rule is its kick "
+                             "law's, kicks=KickLaw(..., angle='scatter', rule=...)")
         flat["rule"] = law.rule
     flat.update(kicks=law.times, kick_angles=law.angles, kick_angle=law.angle,
                 sigma=law.sigma, e0=law.e0, partner=law.partner,
