@@ -12,8 +12,9 @@ calls the sweep made before the one pass (simulation, then the FTLE re-simulatin
 the two-disk run again to the horizon for the actual kick times; per kicked system a
 simulation and an FTLE), against the one pass (`lyapunov_pass` and
 ``lyapunov(..., method=Tangent(return_run=True))``), in the same run, interleaved per IC.
-Both compute the same numbers (checked). Also timed: the whole sweep task of one IC (`execute_task`, with
-the recurrence and autocorrelation diagnostics, which the one pass does not change).
+Both compute the same numbers (checked). Also timed: the whole sweep task of one IC
+(`execute_task`, with the recurrence and autocorrelation diagnostics, which the one pass
+does not change).
 
 Run: python benchmarks/bench_lyapunov.py [--n-ics 100] [--repeat 3]
      python benchmarks/bench_lyapunov.py --one-pass [--n-ics 20] [--repeat 3]
