@@ -287,6 +287,14 @@ def _run_call(target, args, kw):
 
     args = tuple(_materialise(a) for a in args)
     kw = {k: _materialise(v) for k, v in kw.items()}
+    if target in ("simulate_one_particle", "lyapunov_one"):
+        # the kick law's fields (the spec keeps the flat names) as one KickLaw, built here
+        # so that its checks are exercised by the call
+        law = {new: kw.pop(old) for old, new in (("kick_angle", "angle"),
+                                                 ("kick_angles", "angles"), ("sigma", "sigma"))
+               if old in kw}
+        if law:
+            kw["kicks"] = kt.billiard.KickLaw(kw.pop("kicks", None), **law)
     if target == "initial_conditions":
         return kt.initial_conditions(*args, **kw)
     if target == "simulate_two_particle":

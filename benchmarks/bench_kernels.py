@@ -41,7 +41,14 @@ def workloads(pkg: str, n_ics: int):
     el = kt.initial_conditions(n_ics, r, rng=2026, method="uniform", rule="elastic")
     few = ics[: max(1, n_ics // 4)]
     one = {"n_steps": n, "tau": tau, "kicks": kicks}
-    scatter = {**one, "kick_angle": "scatter", "sampling": "paper"}
+    billiard = import_module(pkg + ".billiard")
+    if hasattr(billiard, "KickLaw"):  # kicktimes >= 0.2: the kick law and the method as values
+        scatter = {**one, "kicks": billiard.KickLaw(kicks, angle="scatter"), "sampling": "paper"}
+        twin_paper, with_run = {"method": diag.Twin(variant="paper")}, {
+            "method": diag.Tangent(return_run=True)}
+    else:  # a baseline before 0.2.0: the flat keywords
+        scatter = {**one, "kick_angle": "scatter", "sampling": "paper"}
+        twin_paper, with_run = {"method": "twin", "variant": "paper"}, {"return_run": True}
 
     def each(fn, items):
         return lambda: [fn(i, x) for i, x in enumerate(items)]
@@ -58,15 +65,13 @@ def workloads(pkg: str, n_ics: int):
         "ftle two paper": each(lambda i, ic: lyap(ic, r, n_steps=n, tau=tau, sampling="paper"),
                                ics),
         "ftle one tangent": each(lambda i, ic: lyap(ic[0], r, rng=i, **one), ics),
-        "ftle two twin": each(lambda i, ic: lyap(ic, r, n_steps=n, tau=tau, method="twin",
-                                                 variant="paper"), few),
+        "ftle two twin": each(lambda i, ic: lyap(ic, r, n_steps=n, tau=tau, **twin_paper), few),
         "ftle one twin": each(lambda i, ic: lyap(ic[0], r, rng=i, method="twin", **one), few),
         "pass two paper": each(lambda i, ic: lyapunov_pass(
             ic, r, n_steps=n, tau=tau, sampling="paper", t_continue=1.2 * n * tau), ics),
-        "pass one uniform": each(lambda i, ic: lyap(ic[0], r, rng=i, return_run=True, **one),
+        "pass one uniform": each(lambda i, ic: lyap(ic[0], r, rng=i, **with_run, **one), ics),
+        "pass one scatter": each(lambda i, ic: lyap(ic[0], r, rng=i, **with_run, **scatter),
                                  ics),
-        "pass one scatter": each(lambda i, ic: lyap(ic[0], r, rng=i, return_run=True,
-                                                    **scatter), ics),
         "spectrum two": each(lambda i, ic: diag.lyapunov_spectrum(ic, r, t_max=n * tau / 4),
                              few),
     }

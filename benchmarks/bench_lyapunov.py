@@ -11,9 +11,10 @@ Each trajectory's calls are timed back to back, each the best of ``--repeat``.
 calls the sweep made before the one pass (simulation, then the FTLE re-simulating it, then
 the two-disk run again to the horizon for the actual kick times; per kicked system a
 simulation and an FTLE), against the one pass (`lyapunov_pass` and
-``lyapunov(..., return_run=True)``), in the same run, interleaved per IC. Both compute the
-same numbers (checked). Also timed: the whole sweep task of one IC (`execute_task`, with
-the recurrence and autocorrelation diagnostics, which the one pass does not change).
+``lyapunov(..., method=Tangent(return_run=True))``), in the same run, interleaved per IC.
+Both compute the same numbers (checked). Also timed: the whole sweep task of one IC
+(`execute_task`, with the recurrence and autocorrelation diagnostics, which the one pass
+does not change).
 
 Run: python benchmarks/bench_lyapunov.py [--n-ics 100] [--repeat 3]
      python benchmarks/bench_lyapunov.py --one-pass [--n-ics 20] [--repeat 3]
@@ -24,7 +25,8 @@ import os
 import time
 
 from kicktimes import initial_conditions, schedules, simulate_one_particle, simulate_two_particle
-from kicktimes.diagnostics import lyapunov
+from kicktimes.billiard import KickLaw
+from kicktimes.diagnostics import Tangent, Twin, lyapunov
 
 
 def interleaved_min(calls, n, repeat):
@@ -70,30 +72,31 @@ def one_pass(n_ics, repeat):
             times = schedules.Poisson(two.n_pp / two.t_max).sample(exp.horizon, rng=rng)
         else:
             times = actual
-        return times, draw_kick_angles(times.size, kick["kick_angle"], exp.sigma, rng), kick
+        angles = draw_kick_angles(times.size, kick.angle, exp.sigma, rng)
+        return kick.replace(times=times, angles=angles)
 
     def separate(i):
         ic = ics[i]
-        two = simulate_two_particle(ic, r, rule=exp.rule, track=0, seed=exp.seed, **steps)
-        out = [lyapunov(ic, r, rule=exp.rule, track=0, variant=var, **steps).lam]
+        two = simulate_two_particle(ic, r, rule=exp.rule, track=0, **steps)
+        out = [lyapunov(ic, r, rule=exp.rule, track=0, method=Tangent(variant=var), **steps).lam]
         actual = _actual_times(exp, ic, r, two)
         for system in kicked:
-            times, angles, kick = kicks(i, system, two, actual)
-            one = simulate_one_particle(ic[0], r, kicks=times, kick_angles=angles,
-                                        seed=exp.seed, **kick, **steps)
-            out += [one.n_boundary, lyapunov(ic[0], r, kicks=times, kick_angles=angles,
-                                             variant=var, **kick, **steps).lam]
+            law = kicks(i, system, two, actual)
+            one = simulate_one_particle(ic[0], r, kicks=law, **steps)
+            out += [one.n_boundary,
+                    lyapunov(ic[0], r, kicks=law, method=Tangent(variant=var), **steps).lam]
         return out + [two.n_pp, actual.size]
 
     def together(i):
         ic = ics[i]
-        res, two, actual = lyapunov_pass(ic, r, rule=exp.rule, track=0, variant=var,
-                                         t_continue=exp.horizon, **steps)
+        res, two, actual = lyapunov_pass(ic, r, rule=exp.rule, track=0,
+                                         method=Tangent(variant=var), t_continue=exp.horizon,
+                                         **steps)
         out = [res.lam]
         for system in kicked:
-            times, angles, kick = kicks(i, system, two, np.array(actual, dtype=np.float64))
-            res, one = lyapunov(ic[0], r, kicks=times, kick_angles=angles, variant=var,
-                                return_run=True, **kick, **steps)
+            law = kicks(i, system, two, np.array(actual, dtype=np.float64))
+            res, one = lyapunov(ic[0], r, kicks=law, method=Tangent(variant=var, return_run=True),
+                                **steps)
             out += [one.n_boundary, res.lam]
         return out + [two.n_pp, actual.size]
 
@@ -133,9 +136,9 @@ def main():
     # warm-up: compile (or load from the numba cache) every kernel timed below
     for method in ("tangent", "twin"):
         for variant in ("norm", "paper"):
-            lyapunov(ics[0], r, n_steps=10, tau=tau, method=method, variant=variant)
-            lyapunov(ics[0, 0], r, n_steps=10, tau=tau, kicks=[0.1], rng=0, method=method,
-                     variant=variant)
+            m = (Twin if method == "twin" else Tangent)(variant=variant)
+            lyapunov(ics[0], r, n_steps=10, tau=tau, method=m)
+            lyapunov(ics[0, 0], r, n_steps=10, tau=tau, kicks=[0.1], rng=0, method=m)
     simulate_one_particle(ics[0, 0], r, n_steps=10, tau=tau, kicks=[0.1], rng=0)
 
     runs = [simulate_two_particle(ic, r, n_steps=n_steps, tau=tau) for ic in ics]
@@ -147,16 +150,16 @@ def main():
         "simulate_two_particle": lambda i: simulate_two_particle(ics[i], r, n_steps=n_steps,
                                                                  tau=tau),
         "simulate_one_particle (Poisson kicks)": lambda i: simulate_one_particle(
-            ones[i].ic, r, n_steps=n_steps, tau=tau, kicks=ones[i].kick_times,
-            kick_angles=ones[i].kick_angles),
+            ones[i].ic, r, n_steps=n_steps, tau=tau, kicks=KickLaw(ones[i].kick_times,
+                                                                   angles=ones[i].kick_angles)),
     }
     for method in ("tangent", "twin"):
         for variant in ("norm", "paper"):
+            m = (Twin if method == "twin" else Tangent)(variant=variant)
             calls[f"lyapunov two-disk, {method}, {variant}"] = (
-                lambda i, m=method, v=variant: lyapunov(ics[i], r, n_steps=n_steps, tau=tau,
-                                                        method=m, variant=v))
+                lambda i, m=m: lyapunov(ics[i], r, n_steps=n_steps, tau=tau, method=m))
             calls[f"lyapunov kicked disk, {method}, {variant}"] = (
-                lambda i, m=method, v=variant: lyapunov(ones[i], method=m, variant=v))
+                lambda i, m=m: lyapunov(ones[i], method=m))
     totals = interleaved_min(calls, args.n_ics, args.repeat)
     t_two = totals["simulate_two_particle"]
     t_one = totals["simulate_one_particle (Poisson kicks)"]

@@ -92,7 +92,6 @@ def bare_simulation(names) -> tuple[float, int]:
                     r,
                     rule=exp.rule,
                     track=0,
-                    seed=exp.seed,
                     n_steps=exp.n_steps,
                     tau=exp.tau,
                     sampling=exp.sampling,

@@ -23,6 +23,8 @@ import time
 
 import numpy as np
 
+from kicktimes.diagnostics import Tangent
+
 sys.path.insert(0, os.path.dirname(__file__))
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "c_reference"))
 from paper_timestep import paper_timestep  # noqa: E402
@@ -154,7 +156,8 @@ def main():
     n_ftle = min(50, args.n_ics)
     t_ftle_norm, _ = best_of(lambda: [lyapunov(ic, r, n_steps=n_steps, tau=tau)
                                       for ic in ics[:n_ftle]], repeat=1)
-    t_ftle_paper, _ = best_of(lambda: [lyapunov(ic, r, n_steps=n_steps, tau=tau, variant="paper")
+    t_ftle_paper, _ = best_of(lambda: [lyapunov(ic, r, n_steps=n_steps, tau=tau,
+                                                method=Tangent(variant="paper"))
                                        for ic in ics[:n_ftle]], repeat=1)
     t_ftle_one, _ = best_of(lambda: [lyapunov(o) for o in ones[:n_ftle]], repeat=1)
 

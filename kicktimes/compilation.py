@@ -17,6 +17,8 @@ from __future__ import annotations
 
 import sys
 
+from kicktimes.billiard import KickLaw
+
 __all__ = ["cold_kernels", "announce", "compile_first", "warm_up", "warm_sweep", "warm_report"]
 
 #: (module, kernel, compile seconds measured by benchmarks/bench_compile.py on the
@@ -142,8 +144,9 @@ def _warm_report_two(_):
 
     ic = initial_conditions(1, 0.02, rng=0)[0]
     simulate_two_particle(ic, 0.02, n_steps=50, tau=0.3, log_collisions=True)
-    simulate_one_particle(ic[0], 0.02, kicks=np.array([0.5, 1.0]), kick_angles=np.zeros(2),
-                          kick_angle="uniform", sigma=1.0, n_steps=50, tau=0.3,
+    simulate_one_particle(ic[0], 0.02, kicks=KickLaw(np.array([0.5, 1.0]), angle="uniform",
+                                                     angles=np.zeros(2), sigma=1.0),
+                          n_steps=50, tau=0.3,
                           sampling="paper")
     pomeranz_cdf(12, 0.3)
     ljung_box(np.arange(12.0), 2)

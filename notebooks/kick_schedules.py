@@ -271,8 +271,8 @@ display(
 #   a constant series (the unkicked disk);
 # * `dg.lyapunov(run)`: Benettin's finite-time exponent with twins $d_0 = 1/5000$ away.
 #   For a kicked run the twins get the run's own kick times *and* angles (common random
-#   numbers), which is the same as passing `kicks=run.kick_times,
-#   kick_angles=run.kick_angles` explicitly.
+#   numbers), which is the same as passing their kick law,
+#   `kicks=kt.billiard.KickLaw.from_run(run)`, explicitly.
 
 # %%
 rows = []
@@ -310,9 +310,9 @@ print(
     f"{one_ic.loc['no kicks', 'RR(1e-2), off-diagonal']:.3g} (the periodic unkicked disk)"
 )
 explicit = dg.lyapunov(
-    ic[0], R, kicks=poisson_run.kick_times, kick_angles=poisson_run.kick_angles, **steps
+    ic[0], R, kicks=kt.billiard.KickLaw.from_run(poisson_run), **steps
 )
-paper_variant = dg.lyapunov(two, variant="paper")
+paper_variant = dg.lyapunov(two, method=dg.Tangent(variant="paper"))
 print(
     f"lyapunov(run) = {one_ic.loc['Poisson', 'lambda']:.6g} and the explicit call with the "
     f"run's kicks = {explicit.lam:.6g} (equal: {explicit.lam == one_ic.loc['Poisson', 'lambda']})"

@@ -49,9 +49,9 @@ from IPython.display import Image, display
 
 import kicktimes as kt
 from kicktimes import plots, stats
-from kicktimes.diagnostics import lyapunov
+from kicktimes.diagnostics import Twin, lyapunov
 from kicktimes.experiment import Experiment, kick_rng, load_store, preset, run_experiment
-from kicktimes.report import build_report
+from kicktimes.report import Render, Subsampling, build_report
 from kicktimes.studies.protocol import (
     Ratios,
     fig6_figure,
@@ -277,8 +277,8 @@ for (name, diagnostic), part in agg.groupby(level=["experiment", "diagnostic"]):
 # The paper's eq. (4), $\lambda_{\max}(n) = \frac{1}{\tau n}\sum_{k=1}^{n}
 # \log(\lVert\delta d(k\tau)\rVert / \lVert\delta d(0)\rVert)$ with
 # $\lVert\delta d(0)\rVert = 1/5000$, names Benettin's algorithm but prints no
-# renormalisation. `lyapunov(..., method="twin", variant="paper", d0=1/5000,
-# renormalize=False)` computes it as printed; `renormalize=True` is Benettin's. One IC first:
+# renormalisation. `lyapunov(..., method=Twin(variant="paper", d0=1/5000,
+# renormalize=False))` computes it as printed; `renormalize=True` is Benettin's. One IC first:
 
 # %%
 panel = panels("paper" if SIZE == "full" else "quick")[0]
@@ -286,7 +286,7 @@ ic, r = panel.initial_conditions()[0], panel.radii[-1]
 steps = dict(n_steps=panel.n_steps, tau=panel.tau, sampling="paper")
 for renormalize in (False, True):
     res = lyapunov(
-        ic, r, method="twin", variant="paper", d0=1 / 5000, renormalize=renormalize, **steps
+        ic, r, method=Twin(variant="paper", d0=1 / 5000, renormalize=renormalize), **steps
     )
     print(f"two disks, r = {r}: renormalize={renormalize}: {res.lam:.4g}")
 
@@ -333,9 +333,9 @@ html = build_report(
     [WORKDIR / f"store-{name}" for name in P["report_stores"]],
     out,
     progress=False,
-    max_ics_model_fits=P["fits"],
+    subsampling=Subsampling(max_ics_model_fits=P["fits"]),
     n_mc=P["n_mc"],
-    dpi=P["dpi"],
+    render=Render(dpi=P["dpi"]),
     workers=WORKERS,
 )
 files = sorted(p.name for p in out.iterdir())

@@ -7,6 +7,8 @@ import pandas as pd
 import pytest
 
 from kicktimes import initial_conditions, simulate_one_particle, simulate_two_particle
+from kicktimes.billiard import KickLaw
+from kicktimes.diagnostics import Tangent
 
 R = 0.02
 RHO = 1.0 - R
@@ -88,14 +90,15 @@ def test_the_ftle_is_measured_up_to_the_escape():
     from kicktimes.diagnostics import lyapunov
 
     state = initial_conditions(1, R, rng=6)[0, 0]
-    kw = {"n_steps": 4000, "tau": 0.3, "kicks": np.sort(np.random.default_rng(2).uniform(
-        0, 1200, 60)), "kick_angles": np.random.default_rng(3).uniform(0, 6.28, 60)}
-    res, run = lyapunov(state, R, holes=HOLES, return_run=True, **kw)
+    kw = {"n_steps": 4000, "tau": 0.3, "kicks": KickLaw(
+        np.sort(np.random.default_rng(2).uniform(0, 1200, 60)),
+        angles=np.random.default_rng(3).uniform(0, 6.28, 60))}
+    res, run = lyapunov(state, R, holes=HOLES, method=Tangent(return_run=True), **kw)
     assert math.isfinite(run.escape_time) and res.total_time == run.escape_time
     assert lyapunov(state, R, holes=HOLES, **kw).lam == res.lam
     # two disks: the FTLE's time is the run's, which ends at the first escape
     ic = initial_conditions(1, R, rng=6)[0]
-    two, run2 = lyapunov(ic, R, n_steps=4000, tau=0.3, holes=HOLES, return_run=True)
+    two, run2 = lyapunov(ic, R, n_steps=4000, tau=0.3, holes=HOLES, method=Tangent(return_run=True))
     assert two.total_time == run2.t_max <= 1200.0
     with pytest.raises(ValueError, match="method='tangent'"):
         lyapunov(ic, R, n_steps=100, tau=0.3, holes=HOLES, method="twin")

@@ -11,7 +11,8 @@ import numpy as np
 import pytest
 
 from kicktimes import initial_conditions, simulate_one_particle, simulate_two_particle
-from kicktimes.diagnostics import lyapunov
+from kicktimes.billiard import KickLaw
+from kicktimes.diagnostics import Tangent, Twin, lyapunov
 from kicktimes.schedules import KineticRate
 from kicktimes.stats import mean_kinetic_rate, ratio_verdict
 
@@ -35,8 +36,8 @@ def state():
 
 @pytest.fixture(scope="module")
 def run(table, state):
-    return simulate_one_particle(state, R, t_max=3000.0, kicks=table, kick_angle="scatter",
-                                 rule="elastic", rng=4)
+    return simulate_one_particle(state, R, t_max=3000.0,
+                                 kicks=KickLaw(table, angle="scatter", rule="elastic"), rng=4)
 
 
 def test_the_table_interpolates_the_elastic_partner_averaged_rate_off_its_grids(table):
@@ -106,17 +107,17 @@ def test_each_interval_is_its_exponential_number_over_the_rate_of_the_post_kick_
 
 
 def test_an_elastic_kinetic_run_replays_bitwise_and_gives_one_exponent(table, state, run):
-    again = simulate_one_particle(state, R, t_max=3000.0, kicks=run.kick_times,
-                                  kick_angles=run.kick_angles, kick_angle="scatter",
-                                  rule="elastic")
+    again = simulate_one_particle(state, R, t_max=3000.0,
+                                  kicks=KickLaw(run.kick_times, angle="scatter",
+                                                angles=run.kick_angles, rule="elastic"))
     assert again.final_state.tobytes() == run.final_state.tobytes()
-    kw = {"n_steps": 3000, "tau": 0.3, "kicks": table, "kick_angle": "scatter",
-          "rule": "elastic", "rng": 2}
-    res, one = lyapunov(state, R, return_run=True, **kw)
+    kw = {"n_steps": 3000, "tau": 0.3, "kicks": KickLaw(table, angle="scatter", rule="elastic"),
+          "rng": 2}
+    res, one = lyapunov(state, R, method=Tangent(return_run=True), **kw)
     assert res.lam == lyapunov(state, R, **kw).lam == lyapunov(one).lam
     assert res.n_perturbations == one.n_kicks > 0
     # the twins meet the reference's partners at the kick times the reference drew
-    twin = lyapunov(state, R, method="twin", d0=1e-9, **kw)
+    twin = lyapunov(state, R, method=Twin(d0=1e-9), **kw)
     assert twin.lam == pytest.approx(res.lam, rel=0.05)
 
 
@@ -140,16 +141,17 @@ def test_scattering_kicks_the_elastic_table_does_not_describe_are_refused(table,
                                                                           match):
     state = np.array([0.1, 0.2, 0.6, 0.8])
     with pytest.raises(ValueError, match=match):
-        simulate_one_particle(state, R, t_max=10.0, kicks=table, kick_angle="scatter", rng=1,
-                              **kwargs)
+        simulate_one_particle(state, R, t_max=10.0, kicks=KickLaw(table, angle="scatter", **kwargs),
+                              rng=1)
 
 
 def test_unequal_masses_are_refused_by_the_elastic_table(table):
     # masses (1, 3) normalised to (0.5, 1.5): e0 = 1 is the shell, but the partner differs
     state = np.array([0.1, 0.2, 0.6, 0.8])
     with pytest.raises(ValueError, match="partner_mass: an elastic-rule KineticRate"):
-        simulate_one_particle(state, R, t_max=10.0, kicks=table, kick_angle="scatter",
-                              rule="elastic", partner_mass=3.0, rng=1)
+        simulate_one_particle(state, R, t_max=10.0,
+                              kicks=KickLaw(table, angle="scatter", rule="elastic",
+                                            partner_mass=3.0), rng=1)
 
 
 def test_a_disk_at_the_top_of_the_energy_shell_is_refused(table):

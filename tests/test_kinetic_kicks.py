@@ -4,7 +4,8 @@ import numpy as np
 import pytest
 
 from kicktimes import initial_conditions, simulate_one_particle
-from kicktimes.diagnostics import lyapunov
+from kicktimes.billiard import KickLaw
+from kicktimes.diagnostics import Tangent, Twin, lyapunov
 from kicktimes.schedules import KineticRate
 from kicktimes.stats import mean_kinetic_rate
 
@@ -24,7 +25,7 @@ def state():
 
 @pytest.fixture(scope="module")
 def run(kinetic, state):
-    return simulate_one_particle(state, R, t_max=3000.0, kicks=kinetic, kick_angle="scatter",
+    return simulate_one_particle(state, R, t_max=3000.0, kicks=KickLaw(kinetic, angle="scatter"),
                                  rng=5)
 
 
@@ -58,18 +59,19 @@ def test_each_interval_is_its_exponential_number_over_the_rate_the_previous_kick
 
 
 def test_a_kinetic_run_replays_bitwise_from_its_kicks(state, run):
-    again = simulate_one_particle(state, R, t_max=3000.0, kicks=run.kick_times,
-                                  kick_angles=run.kick_angles, kick_angle="scatter")
+    again = simulate_one_particle(state, R, t_max=3000.0,
+                                  kicks=KickLaw(run.kick_times, angle="scatter",
+                                                angles=run.kick_angles))
     assert again.boundary_log.time.tobytes() == run.boundary_log.time.tobytes()
     assert again.final_state.tobytes() == run.final_state.tobytes()
 
 
 def test_the_one_pass_the_tangent_kernel_and_the_replay_give_one_exponent(kinetic, state):
-    kw = {"n_steps": 4000, "tau": 0.3, "kicks": kinetic, "kick_angle": "scatter", "rng": 2}
-    res, run = lyapunov(state, R, return_run=True, **kw)
+    kw = {"n_steps": 4000, "tau": 0.3, "kicks": KickLaw(kinetic, angle="scatter"), "rng": 2}
+    res, run = lyapunov(state, R, method=Tangent(return_run=True), **kw)
     assert res.lam == lyapunov(state, R, **kw).lam == lyapunov(run).lam
     assert res.n_perturbations == run.n_kicks > 0
-    twin = lyapunov(state, R, method="twin", d0=1e-9, **kw)
+    twin = lyapunov(state, R, method=Twin(d0=1e-9), **kw)
     assert twin.lam == pytest.approx(res.lam, rel=0.05)
 
 
@@ -87,11 +89,11 @@ def test_radial_orbits_are_kicked_more_often_than_orbits_near_the_rim(kinetic):
 
 @pytest.mark.parametrize("bad, match", [
     ({"rule": "elastic"}, "mirror-rule KineticRate needs unit speeds"),
-    ({"kick_angles": np.zeros((3, 2))}, "kick_angles: kinetic kicks"),
+    ({"angles": np.zeros((3, 2))}, "angles: kinetic kicks"),
 ])
 def test_options_kinetic_kicks_cannot_honour_are_refused(kinetic, state, bad, match):
     with pytest.raises(ValueError, match=match):
-        simulate_one_particle(state, R, t_max=10.0, kicks=kinetic, kick_angle="scatter", **bad)
+        simulate_one_particle(state, R, t_max=10.0, kicks=KickLaw(kinetic, angle="scatter", **bad))
 
 
 def test_a_table_of_another_radius_or_a_slow_disk_is_refused(kinetic, state):

@@ -8,7 +8,7 @@ import pytest
 from click.testing import CliRunner
 
 from kicktimes.cli import main
-from kicktimes.diagnostics import lyapunov
+from kicktimes.diagnostics import Twin, lyapunov
 from kicktimes.render.provenance import PROVENANCE_TITLE
 from kicktimes.stats import paired_ratio
 from kicktimes.studies.protocol.compute import D0, Panel, compute_task, run_rows, tasks
@@ -58,7 +58,7 @@ def test_every_reading_of_every_system_is_computed(rows):
 def test_the_literal_two_disk_row_is_eq4_of_lyapunov(rows):
     p = PANELS[0]
     ic = p.initial_conditions()[1]
-    want = lyapunov(ic, 0.024, method="twin", variant="paper", d0=D0, renormalize=False,
+    want = lyapunov(ic, 0.024, method=Twin(variant="paper", d0=D0, renormalize=False),
                     n_steps=p.n_steps, tau=p.tau, sampling="paper").lam
     got = rows[(rows["panel"] == p.name) & (rows["radius"] == 0.024) & (rows["ic"] == 1)
                & (rows["system"] == "two_particle") & (rows["estimator"] == "literal")

@@ -12,7 +12,7 @@ import pandas as pd
 import pytest
 
 from kicktimes.experiment import load_store, preset, run_experiment
-from kicktimes.report import build_report
+from kicktimes.report import Render, Subsampling, build_report
 from kicktimes.report.escape import (
     escape_answer,
     escape_comparison,
@@ -35,7 +35,7 @@ def report(tmp_path_factory):
     run_experiment(exp, store, workers=1, progress=False)
     out = tmp_path_factory.mktemp("report")
     build_report(store, out, progress=False, workers=1, n_mc=19, n_boot=100,
-                 max_ics_model_fits=1, dpi=40)
+                 subsampling=Subsampling(max_ics_model_fits=1), render=Render(dpi=40))
     return exp, load_store(store), out
 
 

@@ -13,6 +13,7 @@ from kicktimes import (
     simulate_one_particle,
     simulate_two_particle,
 )
+from kicktimes.billiard import KickLaw
 from kicktimes.billiard.scatter import (
     collide_with_partner,
     draw_partner,
@@ -20,6 +21,7 @@ from kicktimes.billiard.scatter import (
     scatter_tangent,
     twin_meets_partner,
 )
+from kicktimes.diagnostics import Twin
 
 STATE = np.array([0.12, -0.31, 0.6, 0.8])
 R_LAW = 0.03
@@ -93,8 +95,10 @@ def _two_disk_collisions(rule):
 
 def _scatter_kicks(rule, partner):
     run = simulate_one_particle(STATE, R_LAW,
-                                t_max=16000.0, kicks=schedules.Poisson(0.5),
-                                kick_angle="scatter", rule=rule, partner=partner, rng=3)
+                                t_max=16000.0,
+                                kicks=KickLaw(schedules.Poisson(0.5), angle="scatter", rule=rule,
+                                              partner=partner),
+                                rng=3)
     log = run.kick_log
     return log[["vx", "vy"]].to_numpy(), log[["vx_post", "vy_post"]].to_numpy()
 
@@ -212,8 +216,9 @@ def test_a_twin_off_the_partner_line_misses_it():
 
 
 def test_mirror_scatter_kicks_keep_the_speed_and_change_the_direction():
-    run = simulate_one_particle(STATE, 0.02, t_max=3000.0, kicks=schedules.Poisson(0.05),
-                                kick_angle="scatter", rng=4)
+    run = simulate_one_particle(STATE, 0.02, t_max=3000.0,
+                                kicks=KickLaw(schedules.Poisson(0.05), angle="scatter"),
+                                rng=4)
     log = run.kick_log
     assert run.n_kicks > 100 and len(log) == run.n_kicks
     np.testing.assert_allclose(np.hypot(log.vx_post, log.vy_post), 1.0, atol=1e-12)
@@ -223,8 +228,10 @@ def test_mirror_scatter_kicks_keep_the_speed_and_change_the_direction():
 
 
 def test_elastic_scatter_kicks_keep_the_pair_energy():
-    run = simulate_one_particle(STATE, 0.02, t_max=3000.0, kicks=schedules.Poisson(0.05),
-                                kick_angle="scatter", rule="elastic", e0=1.0, rng=4)
+    run = simulate_one_particle(STATE, 0.02, t_max=3000.0,
+                                kicks=KickLaw(schedules.Poisson(0.05), angle="scatter",
+                                              rule="elastic", e0=1.0),
+                                rng=4)
     log = run.kick_log
     e_before = log.vx**2 + log.vy**2 + log.ux**2 + log.uy**2
     np.testing.assert_allclose(e_before, 2.0, atol=1e-12)
@@ -233,23 +240,28 @@ def test_elastic_scatter_kicks_keep_the_pair_energy():
 
 
 def test_same_seed_same_partners_for_both_rules_and_both_partner_laws():
-    kw = dict(t_max=2000.0, kicks=schedules.Poisson(0.05), kick_angle="scatter", rng=7)
-    a = simulate_one_particle(STATE, 0.02, **kw)
-    b = simulate_one_particle(STATE, 0.02, rule="elastic", **kw)
-    c = simulate_one_particle(STATE, 0.02, partner="uniform", **kw)
+    law = KickLaw(schedules.Poisson(0.05), angle="scatter")
+    kw = dict(t_max=2000.0, rng=7)
+    a = simulate_one_particle(STATE, 0.02, kicks=law, **kw)
+    b = simulate_one_particle(STATE, 0.02, kicks=law.replace(rule="elastic"), **kw)
+    c = simulate_one_particle(STATE, 0.02, kicks=law.replace(partner="uniform"), **kw)
     for other in (b, c):
         np.testing.assert_array_equal(a.kick_times, other.kick_times)
         np.testing.assert_array_equal(a.kick_angles, other.kick_angles)
     # the first kick meets the same partner normal angle relative to w; replaying the
     # recorded numbers reproduces the run exactly
-    again = simulate_one_particle(STATE, 0.02, t_max=2000.0, kicks=a.kick_times,
-                                  kick_angles=a.kick_angles, kick_angle="scatter")
+    again = simulate_one_particle(STATE, 0.02, t_max=2000.0,
+                                  kicks=KickLaw(a.kick_times, angle="scatter",
+                                                angles=a.kick_angles),
+                                  )
     np.testing.assert_array_equal(again.final_state, a.final_state)
 
 
 def test_scatter_run_round_trips_through_parquet(tmp_path):
-    run = simulate_one_particle(STATE, 0.02, t_max=500.0, kicks=schedules.Poisson(0.05),
-                                kick_angle="scatter", rule="elastic", rng=4, n_steps=100,
+    run = simulate_one_particle(STATE, 0.02, t_max=500.0,
+                                kicks=KickLaw(schedules.Poisson(0.05), angle="scatter",
+                                              rule="elastic"),
+                                rng=4, n_steps=100,
                                 tau=5.0)
     run.to_parquet(tmp_path / "run.parquet")
     back = read_run(tmp_path / "run.parquet")
@@ -261,25 +273,25 @@ def test_scatter_run_round_trips_through_parquet(tmp_path):
 @pytest.mark.parametrize(
     "kwargs, match",
     [
-        (dict(rule="elastic"), "kick_angle='scatter'"),
-        (dict(partner="uniform"), "kick_angle='scatter'"),
-        (dict(kick_angle="scatter", e0=1.0), "e0"),
-        (dict(kick_angle="scatter", rule="elastic", e0=0.3), "e0"),
-        (dict(kick_angle="scatter", rule="bouncy"), "rule"),
-        (dict(kick_angle="scatter", partner="random"), "partner"),
-        (dict(kick_angle="scatter", kick_angles=[0.1, 0.2]), r"shape \(2, 2\)"),
-        (dict(kick_angle="scatter", kick_angles=[[0.1, 2.0], [0.0, 0.0]]), r"\[-1, 1\]"),
+        (dict(rule="elastic"), "angle='scatter'"),
+        (dict(partner="uniform"), "angle='scatter'"),
+        (dict(angle="scatter", e0=1.0), "e0"),
+        (dict(angle="scatter", rule="elastic", e0=0.3), "e0"),
+        (dict(angle="scatter", rule="bouncy"), "rule"),
+        (dict(angle="scatter", partner="random"), "partner"),
+        (dict(angle="scatter", angles=[0.1, 0.2]), r"shape \(2, 2\)"),
+        (dict(angle="scatter", angles=[[0.1, 2.0], [0.0, 0.0]]), r"\[-1, 1\]"),
     ],
 )
 def test_bad_scatter_options_raise_naming_the_argument(kwargs, match):
     with pytest.raises(ValueError, match=match):
-        simulate_one_particle(STATE, 0.02, t_max=10.0, kicks=[1.0, 2.0], **kwargs)
+        simulate_one_particle(STATE, 0.02, t_max=10.0, kicks=KickLaw([1.0, 2.0], **kwargs))
 
 
 def test_scatter_needs_two_disks_that_fit():
     with pytest.raises(ValueError, match="r must be < 0.5"):
-        simulate_one_particle([0.0, 0.0, 1.0, 0.0], 0.6, t_max=10.0, kicks=[1.0],
-                              kick_angle="scatter")
+        simulate_one_particle([0.0, 0.0, 1.0, 0.0], 0.6, t_max=10.0,
+                              kicks=KickLaw([1.0], angle="scatter"))
 
 
 # --- Lyapunov exponents of scatter-kicked runs ------------------------------------------
@@ -287,15 +299,16 @@ def test_scatter_needs_two_disks_that_fit():
 
 @pytest.fixture(scope="module")
 def scatter_run():
-    return simulate_one_particle(STATE, 0.02, kicks=schedules.Poisson(0.05),
-                                 kick_angle="scatter", rng=11, n_steps=5000, tau=0.2)
+    return simulate_one_particle(STATE, 0.02,
+                                 kicks=KickLaw(schedules.Poisson(0.05), angle="scatter"),
+                                 rng=11, n_steps=5000, tau=0.2)
 
 
 def test_lyapunov_of_a_scatter_run_agrees_between_tangent_and_small_twin(scatter_run):
     from kicktimes.diagnostics import lyapunov
 
     tangent = lyapunov(scatter_run)
-    twin = lyapunov(scatter_run, method="twin", d0=1e-9)
+    twin = lyapunov(scatter_run, method=Twin(d0=1e-9))
     assert tangent.n_perturbations == scatter_run.n_kicks > 20
     assert tangent.lam > 0.05
     assert twin.lam == pytest.approx(tangent.lam, rel=0.02)
@@ -312,18 +325,18 @@ def test_scatter_kicks_stretch_more_than_state_blind_kicks(scatter_run):
 def test_tangent_scatter_exponent_matches_twin_for_both_rules(rule):
     from kicktimes.diagnostics import lyapunov
 
-    kw = dict(kicks=schedules.Poisson(0.05), kick_angle="scatter", rule=rule, rng=5,
+    kw = dict(kicks=KickLaw(schedules.Poisson(0.05), angle="scatter", rule=rule), rng=5,
               n_steps=4000, tau=0.2)
     tangent = lyapunov(STATE, 0.02, **kw)
-    twin = lyapunov(STATE, 0.02, method="twin", d0=1e-9, **kw)
+    twin = lyapunov(STATE, 0.02, method=Twin(d0=1e-9), **kw)
     assert twin.lam == pytest.approx(tangent.lam, rel=0.02)
 
 
 def test_lyapunov_refuses_scatter_options_without_scatter_kicks():
     from kicktimes.diagnostics import lyapunov
 
-    with pytest.raises(ValueError, match="kick_angle='scatter'"):
-        lyapunov(STATE, 0.02, kicks=[1.0], rule="elastic", n_steps=10, tau=0.2)
+    with pytest.raises(ValueError, match="angle='scatter'"):
+        lyapunov(STATE, 0.02, kicks=KickLaw([1.0], rule="elastic"), n_steps=10, tau=0.2)
 
 
 # --- scatter-kicked systems in an experiment ---------------------------------------------

@@ -7,17 +7,22 @@ import pytest
 from scipy import stats
 
 from kicktimes import initial_conditions, schedules, simulate_one_particle, simulate_two_particle
+from kicktimes.billiard import KickLaw
 from kicktimes.billiard.runs import read_run
 from kicktimes.billiard.scatter import scatter_kick
-from kicktimes.diagnostics import lyapunov
+from kicktimes.diagnostics import Tangent, Twin, lyapunov
 
 STATE = np.array([0.1, -0.2, 0.6, 0.8])
 R0 = 0.02
 
 
+_LAW_FIELDS = ("rule", "e0", "partner", "partner_radius", "partner_mass")
+
+
 def _run(**kw):
-    base = dict(t_max=4000.0, kicks=schedules.Poisson(0.2), kick_angle="scatter", rng=7)
-    return simulate_one_particle(STATE, R0, **{**base, **kw})
+    law = KickLaw(schedules.Poisson(0.2), angle="scatter",
+                  **{k: kw.pop(k) for k in _LAW_FIELDS if k in kw})
+    return simulate_one_particle(STATE, R0, kicks=law, **{"t_max": 4000.0, "rng": 7, **kw})
 
 
 @pytest.mark.parametrize("rule, extra", [("mirror", {}), ("elastic", {"partner_mass": 1.0})])
@@ -70,10 +75,10 @@ def test_the_partner_touches_at_r0_plus_r1_and_is_flagged_outside_its_own_room()
 def test_a_smaller_partner_defocuses_more():
     # common random numbers: the same kicks, only the contact distance r0 + r1 differs
     base = _run(n_steps=5000, tau=0.2, t_max=None)
-    kw = dict(kicks=base.kick_times, kick_angles=base.kick_angles, kick_angle="scatter",
-              n_steps=5000, tau=0.2)
-    small = lyapunov(STATE, R0, partner_radius=0.005, **kw)
-    large = lyapunov(STATE, R0, partner_radius=0.08, **kw)
+    law = KickLaw.from_run(base)
+    kw = dict(n_steps=5000, tau=0.2)
+    small = lyapunov(STATE, R0, kicks=law.replace(partner_radius=0.005), **kw)
+    large = lyapunov(STATE, R0, kicks=law.replace(partner_radius=0.08), **kw)
     # per kick about log of the ratio of contact distances, ln(0.1 / 0.025) = 1.4
     per_kick = (small.lam - large.lam) * base.t_max / base.n_kicks
     assert 0.7 < per_kick < 2.1
@@ -83,13 +88,12 @@ def test_a_smaller_partner_defocuses_more():
 def test_tangent_and_twin_ftle_agree_with_a_partner_of_another_radius(rule, extra):
     run = _run(rule=rule, partner_radius=0.045, n_steps=4000, tau=0.2, t_max=None, **extra)
     tangent = lyapunov(run)
-    twin = lyapunov(run, method="twin", d0=1e-9)
+    twin = lyapunov(run, method=Twin(d0=1e-9))
     assert tangent.n_perturbations == run.n_kicks > 100 and tangent.lam > 0.05
     assert twin.lam == pytest.approx(tangent.lam, rel=0.02)
     # the one pass (run and FTLE from one event loop) is the run and the FTLE
-    again, same = lyapunov(STATE, R0, kicks=run.kick_times, kick_angles=run.kick_angles,
-                           kick_angle="scatter", rule=rule, partner_radius=0.045,
-                           n_steps=4000, tau=0.2, return_run=True, **extra)
+    again, same = lyapunov(STATE, R0, kicks=KickLaw.from_run(run), n_steps=4000, tau=0.2,
+                           method=Tangent(return_run=True))
     assert again == tangent
     np.testing.assert_array_equal(same.kick_log_array, run.kick_log_array)
 
@@ -116,9 +120,10 @@ def test_elastic_kicks_with_masses_reproduce_the_collision_law_of_unequal_disks(
         w2.append(c[["vx0_post", "vy0_post"]].to_numpy())
     v2, w2 = np.concatenate(v2), np.concatenate(w2)
     kicked = simulate_one_particle(STATE, radii[0], t_max=16000.0,
-                                   kicks=schedules.Poisson(0.5), kick_angle="scatter",
-                                   rule="elastic", partner_radius=radii[1],
-                                   partner_mass=masses[1] / masses[0], rng=3).kick_log
+                                   kicks=KickLaw(schedules.Poisson(0.5), angle="scatter",
+                                                 rule="elastic", partner_radius=radii[1],
+                                                 partner_mass=masses[1] / masses[0]),
+                                   rng=3).kick_log
     v1 = kicked[["vx", "vy"]].to_numpy()
     w1 = kicked[["vx_post", "vy_post"]].to_numpy()
     assert v2.shape[0] > 2000 and v1.shape[0] > 4000
@@ -127,8 +132,9 @@ def test_elastic_kicks_with_masses_reproduce_the_collision_law_of_unequal_disks(
     assert stats.ks_2samp(np.hypot(*v2.T), np.hypot(*v1.T)).pvalue > 0.01
     # an equal-mass partner does not: the mass sets the size of the velocity change
     equal = simulate_one_particle(STATE, radii[0], t_max=16000.0,
-                                  kicks=schedules.Poisson(0.5), kick_angle="scatter",
-                                  rule="elastic", partner_radius=radii[1], rng=3).kick_log
+                                  kicks=KickLaw(schedules.Poisson(0.5), angle="scatter",
+                                                rule="elastic", partner_radius=radii[1]),
+                                  rng=3).kick_log
     change_eq = np.hypot(*(equal[["vx_post", "vy_post"]].to_numpy()
                            - equal[["vx", "vy"]].to_numpy()).T)
     assert stats.ks_2samp(change2, change_eq).pvalue < 1e-6
@@ -141,12 +147,12 @@ def test_elastic_kicks_with_masses_reproduce_the_collision_law_of_unequal_disks(
     (dict(partner_mass=2.0), ValueError, "partner_mass applies to rule='elastic'"),
     (dict(partner_mass=-1.0, rule="elastic"), ValueError, r"partner_mass must lie in \(0.0"),
     (dict(partner_mass=math.nan, rule="elastic"), ValueError, "partner_mass must be finite"),
-    (dict(partner_radius=0.03, kick_angle="uniform"), ValueError, "kick_angle='scatter'"),
+    (dict(partner_radius=0.03, angle="uniform"), ValueError, "angle='scatter'"),
     (dict(partner_mass=3.0, rule="elastic", e0=0.2), ValueError, r"m0 \|v\|\^2 / 2 = 0.25"),
 ])
 def test_bad_partner_options_are_refused_naming_the_argument(kwargs, error, match):
-    kw = {"kick_angle": "scatter", **kwargs}
+    kw = {"angle": "scatter", **kwargs}
     with pytest.raises(error, match=match):
-        simulate_one_particle(STATE, R0, t_max=10.0, kicks=[1.0, 2.0], **kw)
+        simulate_one_particle(STATE, R0, t_max=10.0, kicks=KickLaw([1.0, 2.0], **kw))
     with pytest.raises(error, match=match):
-        lyapunov(STATE, R0, kicks=[1.0, 2.0], n_steps=10, tau=0.2, **kw)
+        lyapunov(STATE, R0, kicks=KickLaw([1.0, 2.0], **kw), n_steps=10, tau=0.2)

@@ -6,12 +6,13 @@ import numpy as np
 import pytest
 
 from kicktimes import initial_conditions, schedules
+from kicktimes.billiard import KickLaw
 from kicktimes.billiard.geometry import boundary_hit_time
 from kicktimes.billiard.kernels import two
 from kicktimes.billiard.kernels.drive_one import tangent_one_kernel
 from kicktimes.billiard.kernels.drive_two import tangent_two_kernel
 from kicktimes.billiard.kernels.twins import ftle_one_kernel
-from kicktimes.diagnostics import lyapunov
+from kicktimes.diagnostics import Tangent, Twin, lyapunov
 from kicktimes.diagnostics.lyapunov import lyapunov_spectrum
 
 R = 0.05
@@ -183,8 +184,9 @@ SYSTEMS = {
     "two-disk elastic": lambda ic, **kw: lyapunov(ic, R_AGREE, rule="elastic", **(STEPS | kw)),
     "kicked uniform": lambda ic, **kw: lyapunov(ic[0], R_AGREE, kicks=schedules.Poisson(0.05),
                                                 rng=7, **(STEPS | kw)),
-    "kicked gaussian": lambda ic, **kw: lyapunov(ic[0], R_AGREE, kicks=schedules.Poisson(0.05),
-                                                 rng=7, kick_angle="gaussian", **(STEPS | kw)),
+    "kicked gaussian": lambda ic,
+    **kw: lyapunov(ic[0], R_AGREE, kicks=KickLaw(schedules.Poisson(0.05), angle="gaussian"),
+                                                 rng=7, **(STEPS | kw)),
 }
 
 
@@ -198,7 +200,7 @@ def test_tangent_agrees_with_the_twin_at_small_d0_on_every_ic(ics20, system):
     fn = SYSTEMS[system]
     for ic in ics20:
         tangent = fn(ic)
-        twin = fn(ic, method="twin", d0=1e-8)
+        twin = fn(ic, method=Twin(d0=1e-8))
         assert tangent.method == "tangent" and twin.method == "twin"
         assert tangent.n_perturbations == twin.n_perturbations > 0
         assert abs(tangent.lam - twin.lam) <= 0.02 * abs(twin.lam), (tangent, twin)
@@ -207,15 +209,15 @@ def test_tangent_agrees_with_the_twin_at_small_d0_on_every_ic(ics20, system):
 @pytest.mark.parametrize("system", list(SYSTEMS))
 def test_twin_exponent_does_not_depend_on_d0_on_average(ics20, system):
     fn = SYSTEMS[system]
-    big = np.mean([fn(ic, method="twin", d0=2e-4).lam for ic in ics20])
-    small = np.mean([fn(ic, method="twin", d0=2e-6).lam for ic in ics20])
+    big = np.mean([fn(ic, method=Twin(d0=2e-4)).lam for ic in ics20])
+    small = np.mean([fn(ic, method=Twin(d0=2e-6)).lam for ic in ics20])
     assert abs(big - small) <= 0.05 * small
 
 
 def test_paper_variant_tangent_vectors_agree_with_the_paper_twins(ics20):
     for ic in ics20[:3]:
-        tangent = lyapunov(ic, R_AGREE, **STEPS, variant="paper")
-        twin = lyapunov(ic, R_AGREE, **STEPS, variant="paper", method="twin", d0=1e-8)
+        tangent = lyapunov(ic, R_AGREE, **STEPS, method=Tangent(variant="paper"))
+        twin = lyapunov(ic, R_AGREE, **STEPS, method=Twin(variant="paper", d0=1e-8))
         assert tangent.lam == max(tangent.lam_x, tangent.lam_y)
         for a, b in ((tangent.lam_x, twin.lam_x), (tangent.lam_y, twin.lam_y)):
             assert abs(a - b) <= 0.02 * abs(b)
@@ -224,7 +226,7 @@ def test_paper_variant_tangent_vectors_agree_with_the_paper_twins(ics20):
 @pytest.mark.parametrize("sampling", ["uniform", "paper"])
 def test_paper_sampling_ends_where_the_twin_ends(ics20, sampling):
     tangent = lyapunov(ics20[0], R_AGREE, sampling=sampling, **STEPS)
-    twin = lyapunov(ics20[0], R_AGREE, sampling=sampling, method="twin", d0=1e-8, **STEPS)
+    twin = lyapunov(ics20[0], R_AGREE, sampling=sampling, method=Twin(d0=1e-8), **STEPS)
     assert tangent.total_time == twin.total_time
     assert abs(tangent.lam - twin.lam) <= 0.02 * twin.lam
 
@@ -296,7 +298,7 @@ def test_tangent_agrees_with_the_twin_at_paper_scale(system):
     fn = SYSTEMS[system]
     for ic in ics:
         tangent = fn(ic, **steps)
-        twin = fn(ic, method="twin", d0=1e-8, **steps)
+        twin = fn(ic, method=Twin(d0=1e-8), **steps)
         assert abs(tangent.lam - twin.lam) <= 0.02 * abs(twin.lam)
 
 

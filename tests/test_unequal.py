@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from kicktimes import initial_conditions, simulate_two_particle
-from kicktimes.diagnostics import lyapunov
+from kicktimes.diagnostics import Twin, lyapunov
 from kicktimes.stats import kinetic_rate
 
 RADII = (0.01, 0.025)
@@ -60,7 +60,7 @@ def test_each_disk_keeps_to_its_own_table_and_they_touch_at_r0_plus_r1():
 def test_the_tangent_ftle_of_unequal_disks_agrees_with_a_small_twin():
     ic = initial_conditions(1, max(RADII), rng=4)[0]
     tangent = lyapunov(ic, RADII, n_steps=3000, tau=0.3)
-    twin = lyapunov(ic, RADII, n_steps=3000, tau=0.3, method="twin", d0=1e-9)
+    twin = lyapunov(ic, RADII, n_steps=3000, tau=0.3, method=Twin(d0=1e-9))
     assert tangent.lam > 0 and twin.lam == pytest.approx(tangent.lam, rel=1e-3)
 
 
@@ -104,7 +104,7 @@ def test_the_tangent_ftle_with_masses_agrees_with_a_small_twin():
     ic = initial_conditions(1, 0.03, rng=2, method="uniform", rule="elastic")[0]
     kw = {"n_steps": 3000, "tau": 0.3, "rule": "elastic", "masses": MASSES}
     tangent = lyapunov(ic, RADII, **kw)
-    twin = lyapunov(ic, RADII, method="twin", d0=1e-9, **kw)
+    twin = lyapunov(ic, RADII, method=Twin(d0=1e-9), **kw)
     assert tangent.lam > 0 and twin.lam == pytest.approx(tangent.lam, rel=1e-3)
 
 

@@ -18,9 +18,17 @@ import warnings
 
 import numpy as np
 
+from kicktimes._old_keywords import old_keywords, pop_old, translator, warn_old
 from kicktimes.billiard import checks as chk
 from kicktimes.billiard.kernels.drive_one import simulate_one_kernel
 from kicktimes.billiard.kernels.one import KICK_ANGLES
+from kicktimes.billiard.kick_law import (
+    KickLaw,
+    _is_schedule,
+    as_kick_law,
+    check_kick_angles,
+    check_kick_times,
+)
 from kicktimes.billiard.runs import BoundaryLog, OneParticleRun, sampling_fields
 from kicktimes.billiard.scatter import PARTNER_LAWS, draw_scatter_uniforms
 from kicktimes.billiard.two_particle import raise_for_status
@@ -43,51 +51,6 @@ def check_one_particle_state(state, r: float, name: str = "state") -> np.ndarray
     return arr
 
 
-def check_kick_times(kicks, t_max: float | None, name: str = "kicks") -> np.ndarray:
-    """Sorted, finite, non-negative kick times, none beyond ``t_max`` (if known)."""
-    if isinstance(kicks, str | bytes):
-        raise TypeError(
-            f"{name} must be None, a sequence of kick times or a schedule (e.g. "
-            f"kicktimes.schedules.Poisson(rate)), got the string {kicks!r}"
-        )
-    try:
-        times = np.array(kicks, dtype=np.float64, copy=True).ravel()
-    except (TypeError, ValueError) as exc:
-        raise TypeError(
-            f"{name} must be None, a sequence of kick times or a schedule, got "
-            f"{type(kicks).__name__} ({exc})"
-        ) from None
-    if not np.isfinite(times).all():
-        raise ValueError(f"{name} must be finite; got NaN or inf")
-    if times.size and times.min() < 0.0:
-        raise ValueError(f"{name} must be >= 0, got {float(times.min())!r}")
-    if times.size > 1 and (np.diff(times) < 0.0).any():
-        raise ValueError(f"{name} must be sorted in increasing order")
-    if t_max is not None and times.size and times[-1] > t_max:
-        raise ValueError(
-            f"{name} must lie in [0, t_max={float(t_max)!r}], got a kick at {float(times[-1])!r}"
-        )
-    return times
-
-
-def _is_kicktimes_schedule(kicks) -> bool:
-    from kicktimes.schedules import Schedule
-
-    return isinstance(kicks, Schedule)
-
-
-def _is_schedule(kicks) -> bool:
-    """A kick schedule: a `Schedule`, or any object with a ``sample`` method that is not
-    array-like (a pandas Series has a ``sample`` method too, but it holds times)."""
-    from kicktimes.schedules import Schedule
-
-    if isinstance(kicks, Schedule):
-        return True
-    if isinstance(kicks, np.ndarray) or hasattr(kicks, "__array__") or hasattr(kicks, "__len__"):
-        return False
-    return callable(getattr(kicks, "sample", None))
-
-
 def draw_kick_angles(n: int, kick_angle: str, sigma: float, rng: np.random.Generator):
     """Kick angles for ``n`` kicks: new directions uniform on [0, 2 pi) (``"uniform"``) or
     from N(0, sigma^2) (``"normal"``), or rotations from N(0, sigma^2) (``"gaussian"``).
@@ -100,34 +63,6 @@ def draw_kick_angles(n: int, kick_angle: str, sigma: float, rng: np.random.Gener
     if kick_angle == "scatter":
         return draw_scatter_uniforms(n, rng)
     return rng.normal(0.0, sigma, size=n)
-
-
-def _check_kick_angles(kick_angles, times: np.ndarray, kick_angle: str) -> np.ndarray:
-    if isinstance(kick_angles, str | bytes):
-        raise TypeError(f"kick_angles must be a sequence of angles, got the string {kick_angles!r}")
-    try:
-        arr = np.array(kick_angles, dtype=np.float64, copy=True, order="C")
-    except (TypeError, ValueError) as exc:
-        raise TypeError(
-            f"kick_angles must be a sequence of angles, got {type(kick_angles).__name__} ({exc})"
-        ) from None
-    if kick_angle == "scatter":
-        if arr.shape != (times.size, 2):
-            raise ValueError(
-                f"kick_angles of scattering kicks must have shape ({times.size}, 2) (two "
-                f"uniforms on (-1, 1) per kick), got {arr.shape}"
-            )
-        if not np.isfinite(arr).all() or (np.abs(arr) > 1.0).any():
-            raise ValueError("kick_angles of scattering kicks must lie in [-1, 1]")
-        return arr
-    angles = arr.ravel()
-    if angles.shape != times.shape:
-        raise ValueError(
-            f"kick_angles must have one angle per kick ({times.size}), got {angles.size}"
-        )
-    if not np.isfinite(angles).all():
-        raise ValueError("kick_angles must be finite; got NaN or inf")
-    return angles
 
 
 def resolve_kicks(kicks, kick_angles, *, kick_angle, sigma, rng, horizon, t_max, r=None):
@@ -172,7 +107,7 @@ def resolve_kicks(kicks, kick_angles, *, kick_angle, sigma, rng, horizon, t_max,
             return times, empty, gen, kinetic
         gen = gen if gen is not None else check_rng(rng)
         return times, draw_kick_angles(times.size, kick_angle, sigma, gen), gen, kinetic
-    return times, _check_kick_angles(kick_angles, times, kick_angle), gen, kinetic
+    return times, check_kick_angles(kick_angles, times, kick_angle), gen, kinetic
 
 
 def check_kinetic(kinetic, state, kick_angle, rule, sp=None) -> None:
@@ -283,11 +218,53 @@ def check_scatter_options(state, r, kick_angle, rule, e0, partner, partner_radiu
 SCATTER_OPTIONS = ("rule", "e0", "partner", "partner_radius", "partner_mass")
 
 
-def simulate_one_particle(state, r, *, t_max=None, kicks=None, kick_angle="uniform",
-                          kick_angles=None, sigma=1.0, rng=None, sampling="uniform",
-                          n_steps=None, tau=None, seed=None, rule="mirror", e0=None,
-                          partner="weighted", partner_radius=None, partner_mass=None,
-                          max_events=None, holes=None) -> OneParticleRun:
+#: the flat kick keywords of `simulate_one_particle` and `lyapunov` before 0.2.0 and the
+#: `KickLaw` field each became (``kicks`` stays: it takes a `KickLaw`, or its times)
+OLD_KICK_KEYWORDS = {"kick_angle": "angle", "kick_angles": "angles", "sigma": "sigma",
+                     "rule": "rule", "e0": "e0", "partner": "partner",
+                     "partner_radius": "partner_radius", "partner_mass": "partner_mass"}
+
+
+def law_from_old_keywords(kwargs: dict, old: dict, where: str) -> None:
+    """Replace ``kwargs["kicks"]`` by the `KickLaw` of the old flat keywords ``old``
+    (already popped), warning once that names the replacement."""
+    if isinstance(kwargs.get("kicks"), KickLaw):
+        raise TypeError(f"{where}: kicks is a KickLaw; give {', '.join(old)} as its fields, "
+                        "not as keywords")
+    fields = ", ".join(f"{OLD_KICK_KEYWORDS[k]}=..." for k in old)
+    warn_old(", ".join(f"{where}({k}=...)" for k in old),
+             f"{where}(..., kicks=KickLaw(times, {fields})) (kicktimes.billiard.KickLaw)",
+             stacklevel=5)
+    law = as_kick_law(kwargs.get("kicks"))
+    kwargs["kicks"] = law.replace(**{OLD_KICK_KEYWORDS[k]: v for k, v in old.items()})
+
+
+def seed_after(seed):
+    """The deprecated ``seed=`` of the simulators: the run with ``seed`` in its metadata."""
+    import dataclasses
+
+    return lambda run: dataclasses.replace(run, seed=seed)
+
+
+@translator("seed", *OLD_KICK_KEYWORDS)
+def _old_one_particle(args, kwargs):
+    kwargs = dict(kwargs)
+    after = None
+    if "seed" in kwargs:
+        seed = kwargs.pop("seed")
+        warn_old("simulate_one_particle(seed=...)", "dataclasses.replace(run, seed=...) (the "
+                 "keyword only recorded a number in run.seed; the random numbers come from rng)")
+        after = seed_after(seed)
+    old = pop_old(kwargs, OLD_KICK_KEYWORDS)
+    if old:
+        law_from_old_keywords(kwargs, old, "simulate_one_particle")
+    return kwargs, after
+
+
+@old_keywords(_old_one_particle)
+def simulate_one_particle(state, r, *, t_max=None, kicks=None, rng=None, sampling="uniform",
+                          n_steps=None, tau=None, max_events=None,
+                          holes=None) -> OneParticleRun:
     """Simulate one disk of radius ``r`` in the unit table, kicked at given times.
 
     Parameters
@@ -300,53 +277,17 @@ def simulate_one_particle(state, r, *, t_max=None, kicks=None, kick_angle="unifo
     t_max, sampling, n_steps, tau
         As in `simulate_two_particle`. Under ``sampling="paper"`` a step is cut short by a
         boundary collision or a kick.
-    kicks : array_like or schedule, optional
-        Kick times (sorted, in ``[0, t_max]``), or a schedule object with a
-        ``sample(t_max, rng)`` method (see `kicktimes.schedules`), sampled here with
-        ``rng``, or a `kicktimes.schedules.KineticRate`: kinetic kicks, whose rate after
-        each kick is the kinetic collision rate of the disk's angular momentum (unit
-        speed), or of its angular momentum and speed (``KineticRate(r, rule="elastic")``,
-        with elastic scattering kicks of ``e0 = 1`` or kicks that keep the speed); the
-        run's ``kick_times`` are then the times it drew. ``None``: no kicks
-        (the integrable billiard).
-    kick_angle : {"uniform", "gaussian", "normal", "scatter"}
-        ``"uniform"``: a kick replaces the direction by an angle uniform on [0, 2 pi)
-        (the paper's choice). The paper's other choice, angles from N(0, 1), has two
-        readings: ``"gaussian"``, a kick rotates the direction by ``N(0, sigma^2)``;
-        ``"normal"``, a kick replaces it by an angle drawn from ``N(0, sigma^2)``.
-        ``"scatter"``: a kick is a collision with a virtual partner disk (radius
-        ``partner_radius``, default ``r``) drawn from the two-disk collision statistics
-        (docs/scatter.md).
-    kick_angles : array_like, optional
-        Explicit angles, one per kick (new directions for ``"uniform"`` and ``"normal"``,
-        rotations for ``"gaussian"``, shape (n, 2) uniforms on (-1, 1) for ``"scatter"``), e.g.
-        ``run.kick_angles`` of another run, so that two runs share their kicks (common
-        random numbers). Drawn from ``rng`` when omitted.
-    sigma : float
-        Standard deviation of the gaussian rotation, or of the normal new angle (``> 0``).
-    rng : numpy.random.Generator or int, optional
+    kicks : KickLaw, array_like or schedule, optional
+        The kick law (`kicktimes.billiard.KickLaw`): when the disk is kicked (times, a
+        schedule sampled here with ``rng``, or kinetic kicks of a
+        `kicktimes.schedules.KineticRate`, whose times the run draws) and what a kick does
+        (a new direction, a rotation, or a collision with a virtual partner disk; the
+        partner's rule, energy, radius and mass). Kick times or a schedule alone are
+        short for ``KickLaw(kicks)``: new directions uniform on [0, 2 pi), the paper's
+        choice. Times must lie in ``[0, t_max]``. ``None``: no kicks (the integrable
+        billiard).
+    rng : None, int, SeedSequence or numpy.random.Generator, optional
         Source of the schedule's times (first) and the kick angles (second).
-    seed : int, optional
-        Recorded in the run's metadata.
-    rule : {"mirror", "elastic"}
-        Scattering kicks: the collision rule with the partner. The mirror partner has the
-        disk's speed; the elastic partner has speed ``sqrt((2 e0 - m0 |v|^2) / m1)``.
-    e0 : float, optional
-        Scattering kicks with ``rule="elastic"``: the pair's kinetic energy
-        ``(m0 |v|^2 + m1 |u|^2) / 2`` with the masses normalised to ``(m0 + m1) / 2 = 1``
-        (default 1, the two-disk invariant measure's).
-    partner : {"weighted", "uniform"}
-        Scattering kicks: the partner's direction, weighted by ``|v - u|`` as at a real
-        collision (default) or uniform, independent of ``|v - u|``.
-    partner_radius : float, optional
-        Scattering kicks: the partner's radius ``r1``, ``0 < r1 < 0.5`` (default ``r``,
-        the disk's own). The partner touches the disk at the distance ``r + r1``; the
-        kick log's ``outside`` flags a partner centre beyond its room ``1 - r1``.
-    partner_mass : float, optional
-        Scattering kicks with ``rule="elastic"``: the partner's mass in units of the
-        disk's, ``m1 / m0 > 0`` (default 1). The disk leaves with
-        ``v' = v - 2 m1 / (m0 + m1) ((v - u).n) n`` (momentum and energy of the pair
-        kept, docs/unequal.md).
     max_events : int, optional
         Stop with a ValueError after this many boundary collisions (as in
         `simulate_two_particle`; kicks do not count).
@@ -374,28 +315,31 @@ def simulate_one_particle(state, r, *, t_max=None, kicks=None, kick_angle="unifo
     --------
     >>> import numpy as np
     >>> from kicktimes import simulate_one_particle, schedules
+    >>> from kicktimes.billiard import KickLaw
     >>> state = np.array([0.1, 0.2, 0.6, 0.8])
     >>> run = simulate_one_particle(state, 0.02, t_max=100.0, kicks=schedules.Poisson(0.1),
     ...                             rng=1)
     >>> bool(np.all(run.kick_times <= 100.0))
     True
-    >>> hit = simulate_one_particle(state, 0.02, t_max=100.0, kicks=schedules.Poisson(0.1),
-    ...                             kick_angle="scatter", rng=1)
+    >>> hit = simulate_one_particle(state, 0.02, t_max=100.0,
+    ...                             kicks=KickLaw(schedules.Poisson(0.1), angle="scatter"), rng=1)
     >>> hit.kick_log.shape[0] == hit.n_kicks
     True
 
     A partner of another radius (and, under the elastic rule, mass), e.g. the other disk
     of an unequal pair (docs/unequal.md):
 
-    >>> big = simulate_one_particle(state, 0.02, t_max=100.0, kicks=schedules.Poisson(0.1),
-    ...                             kick_angle="scatter", rule="elastic", partner_radius=0.05,
-    ...                             partner_mass=3.0, rng=1)
+    >>> law = KickLaw(schedules.Poisson(0.1), angle="scatter", rule="elastic",
+    ...               partner_radius=0.05, partner_mass=3.0)
+    >>> big = simulate_one_particle(state, 0.02, t_max=100.0, kicks=law, rng=1)
     >>> big.partner_radius, big.partner_mass
     (0.05, 3.0)
     """
     r = chk.check_real("r", r, low=0.0, high=1.0)
-    chk.check_choice("kick_angle", kick_angle, KICK_ANGLES)
-    sigma = chk.check_real("sigma", sigma, low=0.0)
+    law = as_kick_law(kicks)
+    kicks, kick_angles, kick_angle, sigma = law.times, law.angles, law.angle, law.sigma
+    rule, e0, partner = law.rule, law.e0, law.partner
+    partner_radius, partner_mass = law.partner_radius, law.partner_mass
     t_max, n_steps, tau, mode = chk.check_sampling(t_max, n_steps, tau, sampling)
     state = check_one_particle_state(state, r)
     sp, options = check_scatter_options(state, r, kick_angle, rule, e0, partner,
@@ -428,10 +372,10 @@ def simulate_one_particle(state, r, *, t_max=None, kicks=None, kick_angle="unifo
             f"state: the paper-sampled run covers no time (t_max = 0.0): all n_steps = "
             f"{n_steps} steps ended at events at t = 0 ({out[6]} kicks, {out[0].shape[0]} "
             "boundary collisions); more steps, or kicks after t = 0, give it a duration",
-            RuntimeWarning, stacklevel=2,
+            RuntimeWarning, stacklevel=3,  # through the old_keywords wrapper
         )
     return one_particle_run(st, r, state, out[:9], sampling=sampling, mode=mode, tau=tau,
-                            n_steps=n_steps, seed=seed, kick_angle=kick_angle, sigma=sigma,
+                            n_steps=n_steps, seed=None, kick_angle=kick_angle, sigma=sigma,
                             times=times, applied=angles, escape_time=float(out[10][0]),
                             **options)
 

@@ -11,11 +11,13 @@ events. Nothing is ever stepped through time and tested for overlap.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import warnings
 
 import numpy as np
 
+from kicktimes._old_keywords import old_keywords, translator, warn_old
 from kicktimes.billiard import checks as chk
 from kicktimes.billiard.checks import STALL_EVENTS
 from kicktimes.billiard.kernels import two
@@ -67,9 +69,19 @@ def check_two_particle_ic(ic, r, rule: str, name: str = "ic") -> np.ndarray:
     return arr
 
 
+@translator("seed")
+def _old_two_particle(args, kwargs):
+    kwargs = dict(kwargs)
+    seed = kwargs.pop("seed")
+    warn_old("simulate_two_particle(seed=...)", "dataclasses.replace(run, seed=...) (the "
+             "keyword only recorded a number in run.seed; the simulation is deterministic)")
+    return kwargs, lambda run: dataclasses.replace(run, seed=seed)
+
+
+@old_keywords(_old_two_particle)
 def simulate_two_particle(ic, r, *, t_max=None, rule="mirror", sampling="uniform", n_steps=None,
-                          tau=None, track=0, seed=None, max_events=None,
-                          log_collisions=False, holes=None, masses=None) -> TwoParticleRun:
+                          tau=None, track=0, max_events=None, log_collisions=False, holes=None,
+                          masses=None) -> TwoParticleRun:
     """Simulate two disks of radius ``r`` in the unit circular table.
 
     Event-driven and exact: the disks move freely between collisions whose times are
@@ -100,8 +112,6 @@ def simulate_two_particle(ic, r, *, t_max=None, rule="mirror", sampling="uniform
         Step length (``> 0``).
     track : {0, 1}
         The disk whose centre is sampled.
-    seed : int, optional
-        Recorded in the run's metadata (the simulation itself is deterministic).
     max_events : int, optional
         Stop with a ValueError after this many collisions (``>= 1``). The default is a
         hundred times the expected number plus 10^6, at most 2e7; a run expected to need
@@ -171,7 +181,7 @@ def simulate_two_particle(ic, r, *, t_max=None, rule="mirror", sampling="uniform
     args = kernel_args(ic, r, rule, mode, t_max, n_steps, tau, track, max_events, masses)
     out = simulate_two_kernel(*args, bool(log_collisions), arcs)
     return two_particle_run(out, args, r=r, rule=rule, sampling=sampling, tau=tau,
-                            n_steps=n_steps, ic=ic, track=track, seed=seed, name="ic")
+                            n_steps=n_steps, ic=ic, track=track, seed=None, name="ic")
 
 
 def kernel_args(ic, r, rule, mode, t_max, n_steps, tau, track, max_events, masses=None) -> tuple:

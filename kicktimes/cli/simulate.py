@@ -3,6 +3,8 @@ with ``--disks N``, one run of N disks (`kicktimes.simulate_disks`) and its coll
 
 from __future__ import annotations
 
+import dataclasses
+
 import click
 
 from kicktimes import __version__
@@ -82,7 +84,9 @@ def simulate_command(radii, n_ics, t_max, seed, rule, ic_method, out, save_runs,
                                     desc="simulate") as bar:
         for r in radii:
             for i, ic in enumerate(ics):
-                run = simulate_two_particle(ic, r, t_max=t_max, rule=rule, seed=seed)
+                # the run file records the IC seed
+                run = dataclasses.replace(simulate_two_particle(ic, r, t_max=t_max, rule=rule),
+                                          seed=seed)
                 rows.append((r, i, run.t_max, run.n_pp, run.pp_times))
                 if save_runs:
                     run.to_parquet(os.path.join(out, "runs", f"r{r:.4f}-ic{i:05d}.parquet"))

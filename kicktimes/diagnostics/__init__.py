@@ -27,6 +27,7 @@ from kicktimes.diagnostics.decorrelation import (
     decorrelation_lag,
     integrated_autocorrelation_time,
 )
+from kicktimes.diagnostics.ftle_methods import Tangent, Twin
 from kicktimes.diagnostics.gas_lyapunov import DisksLyapunov, disks_lyapunov
 from kicktimes.diagnostics.lyapunov import (
     LyapunovResult,
@@ -54,6 +55,8 @@ __all__ = [
     "LyapunovSpectrum",
     "RQAResult",
     "RecollisionShare",
+    "Tangent",
+    "Twin",
     "UndefinedDiagnosticWarning",
     "acf_curve",
     "disks_lyapunov",

@@ -2,13 +2,13 @@
 
 Two methods (docs/lyapunov.md has the derivations):
 
-* ``method="tangent"`` (default): the linearised dynamics, exact. A tangent vector
+* ``method=Tangent()`` (default, ``"tangent"``): the linearised dynamics, exact. A tangent vector
   ``(dq, dv)`` starts along ``x`` of the tracked disk and is carried through free flights,
   wall reflections, disk-disk collisions and kicks by the exact linearised event maps
   (`kicktimes.billiard.kernels.tangent`). No ``d0``, no round-off floor, no deferrals.
-* ``method="twin"``: Benettin's twin trajectory at distance ``d0``, renormalised at the
-  sample times (`kicktimes.billiard.kernels.twins`); kept for fidelity to the paper, which used
-  it. For small enough ``d0`` it converges to the tangent result.
+* ``method=Twin(d0=...)`` (``"twin"``): Benettin's twin at distance ``d0``, renormalised at
+  the sample times (`kicktimes.billiard.kernels.twins`); kept for fidelity to the paper, which
+  used it; for small enough ``d0`` it converges to the tangent result.
 
 Both measure the same quantity: the growth rate of the tracked disk's position
 deviation, ``lambda = log(|dq_track(T)| / |dq_track(0)|) / T`` (``|dx|`` and ``|dy|``
@@ -24,19 +24,23 @@ from dataclasses import dataclass
 import numpy as np
 
 from kicktimes._results import Result
+from kicktimes._old_keywords import old_keywords, pop_old, translator, warn_old
 from kicktimes.billiard import checks as chk
 from kicktimes.billiard.kernels.drive_one import simulate_tangent_one_kernel, tangent_one_kernel
 from kicktimes.billiard.kernels.drive_two import simulate_tangent_two_kernel, tangent_two_kernel
 from kicktimes.billiard.kernels.tangent import MAX_SAME_INSTANT
 from kicktimes.billiard.kernels.twins import ftle_one_kernel, ftle_two_kernel
+from kicktimes.billiard.kick_law import as_kick_law
 from kicktimes.billiard.one_particle import (
     KICK_ANGLES,
+    OLD_KICK_KEYWORDS,
     check_kinetic,
     check_kinetic_capacity,
     check_one_particle_state,
     check_scatter_options,
     draw_kick_angles,
     kernel_limits,
+    law_from_old_keywords,
     one_particle_run,
     resolve_kicks,
 )
@@ -49,14 +53,19 @@ from kicktimes.billiard.two_particle import (
     two_particle_run,
 )
 from kicktimes.diagnostics.autocorrelation import UndefinedDiagnosticWarning
+from kicktimes.diagnostics.ftle_methods import (
+    D0_DEFAULT,
+    D0_RANGE,
+    OLD_METHOD_KEYWORDS,
+    TWIN_KICKS,
+    VARIANTS,
+    Twin,
+    as_method,
+    method_from_old,
+)
 from kicktimes.validation import check_rng
 
-VARIANTS = ("norm", "paper")
-#: the kicked twins' kicks: the run's angles, or each twin's own at the same times
-TWIN_KICKS = ("shared", "independent")
 METHODS = ("tangent", "twin")
-D0_DEFAULT = 1.0 / 5000.0  # the paper's
-D0_RANGE = (1e-10, 1e-2)
 MAX_HORIZON = 1e8
 # Event budget per unit time: a unit-speed disk on a whispering-gallery orbit with chords
 # of 1e-5 (|sin theta| = 1 - 1e-10) makes 1e5 boundary collisions per unit time.
@@ -179,11 +188,11 @@ def _per_perturbation(lam, t, n):
     return lam * t / n if n > 0 else math.nan
 
 
-def _warn_undefined(res: LyapunovResult) -> None:
+def _warn_undefined(res: LyapunovResult, stacklevel: int = 3) -> None:
     """Issue ``res.reason`` (an undefined exponent) as an `UndefinedDiagnosticWarning`."""
     if res.reason is not None:
         warnings.warn(f"lyapunov: lam is NaN: {res.reason}", UndefinedDiagnosticWarning,
-                      stacklevel=3)
+                      stacklevel=stacklevel)
 
 
 _PARTS = {"norm": ("the position deviation",), "paper": ("|dx|", "|dy|")}
@@ -287,11 +296,55 @@ def _start_vectors(variant: str, size: int, offset: int) -> np.ndarray:
     return U
 
 
+def _one_disk(system) -> bool:
+    return isinstance(system, OneParticleRun) or (
+        not isinstance(system, TwoParticleRun) and np.shape(system) == (4,))
+
+
+@translator(*OLD_METHOD_KEYWORDS, *OLD_KICK_KEYWORDS)
+def _old_lyapunov(args, kwargs):
+    kwargs = dict(kwargs)
+    system = args[0] if args else kwargs.get("system")
+    old = pop_old(kwargs, OLD_METHOD_KEYWORDS)
+    if old:
+        method = kwargs.get("method", "tangent")
+        kind = "Twin" if method == "twin" or "d0" in old else "Tangent"
+        fields = ", ".join(f"{k}=..." for k in old)
+        warn_old(", ".join(f"lyapunov({k}=...)" for k in old),
+                 f"lyapunov(..., method={kind}({fields})) (kicktimes.diagnostics.{kind})")
+        kwargs["method"] = method_from_old(method, old)
+    names = [k for k in OLD_KICK_KEYWORDS if k != "rule" or _one_disk(system)]
+    old = pop_old(kwargs, names)
+    if old:
+        law_from_old_keywords(kwargs, old, "lyapunov")
+    return kwargs, None
+
+
+def _flat(system, rule, kicks, method) -> dict:
+    """The keywords of `_lyapunov` for the kick law ``kicks`` and the method object."""
+    method = as_method(method)
+    flat = {"method": method.name, "variant": method.variant, "rule": rule,
+            "return_run": getattr(method, "return_run", False)}
+    if isinstance(method, Twin):
+        flat.update(d0=method.d0, max_defer=method.max_defer, renormalize=method.renormalize,
+                    twin_kicks=method.twin_kicks)
+    if kicks is None:
+        return flat
+    law = as_kick_law(kicks)
+    if _one_disk(system):
+        if rule != "mirror":
+            raise ValueError(f"rule={rule!r}: a kicked disk's scattering rule is its kick "
+                             "law's, kicks=KickLaw(..., angle='scatter', rule=...)")
+        flat["rule"] = law.rule
+    flat.update(kicks=law.times, kick_angles=law.angles, kick_angle=law.angle,
+                sigma=law.sigma, e0=law.e0, partner=law.partner,
+                partner_radius=law.partner_radius, partner_mass=law.partner_mass)
+    return flat
+
+
+@old_keywords(_old_lyapunov)
 def lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rule="mirror",
-             track=0, kicks=None, kick_angles=None, kick_angle="uniform", sigma=1.0, rng=None,
-             method="tangent", variant="norm", d0=None, max_defer=10, e0=None,
-             partner="weighted", partner_radius=None, partner_mass=None, return_run=False,
-             holes=None, masses=None, renormalize=True, twin_kicks="shared"):
+             track=0, kicks=None, rng=None, method="tangent", holes=None, masses=None):
     """Finite-time Lyapunov exponent of a two-disk or a kicked one-disk billiard.
 
     Parameters
@@ -306,58 +359,30 @@ def lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rule
         ``n_steps`` collision-truncated steps. The twin method renormalises at these
         sample times. ``n_steps * tau`` must be at most 1e8.
     rule, track
-        Two-disk collision rule and the disk whose position deviation is measured. For a
-        one-disk state with ``kick_angle="scatter"``, ``rule`` is the rule of the
-        collision with the virtual partner.
-    kicks, kick_angles, kick_angle, sigma, rng, e0, partner, partner_radius, partner_mass
-        One-disk kicks, as in `simulate_one_particle` (``sigma`` finite, ``> 0``). Kick
-        times and angles are given data, the same for every perturbed trajectory (common
-        random numbers): a kick is linearised at fixed time and angle. A scattering kick
-        (``kick_angle="scatter"``) is a collision with a virtual partner placed in
-        contact with the reference (at the distance ``r + partner_radius``): the tangent
-        vector goes through the linearised collision with a partner of zero deviation; a
-        twin meets the same partner at its own contact time, or misses it
-        (docs/scatter.md).
-    method : {"tangent", "twin"}
-        ``"tangent"``: exact propagation of tangent vectors. ``"twin"``: Benettin's twin at
-        distance ``d0`` (the paper's method; converges to the tangent value as ``d0 -> 0``
-        until round-off takes over).
-    variant : {"norm", "paper"}
-        ``"norm"``: one perturbation along x of the tracked disk, the 2-norm of its
-        position deviation is measured. ``"paper"``: perturbations along x and along y,
-        ``|dx|`` and ``|dy|`` measured separately, ``lam = max(lam_x, lam_y)``.
-    d0 : float, optional
-        Twin only: initial separation and renormalisation length, in ``[1e-10, 1e-2]``
-        (default the paper's 1/5000). Must be ``None`` for ``method="tangent"``.
-    max_defer : int
-        Twin only: consecutive deferred renormalisations after which one is forced.
-    renormalize : bool
-        Twin only. ``True`` (default): Benettin's algorithm, the twin renormalised to
-        ``d0`` at every sample. ``False``: eq. (4) of Ranković & Porter (2013) read
-        literally, "λ_max(n) = 1/(τn) Σ_{k=1}^{n} log(‖δd(kτ)‖/‖δd(0)‖)": the twin is never
-        renormalised and the sum runs over the logs of its raw separations ``d_k`` from
-        the reference at the ``n`` samples, ``lam = Σ_k log(d_k / d0) / (n tau)`` (``n
-        tau`` as printed, also for ``sampling="paper"``, whose steps are shorter). Once
-        the twin's separation saturates at the table's size this does not tend to 0 with
-        ``n``: it is not an exponent, and docs/lyapunov.md compares the two readings. A
-        kicked twin shares the run's kick times and angles unless ``twin_kicks``.
-    twin_kicks : {"shared", "independent"}
-        Twin method, kicked disk only. ``"shared"`` (default): the twins are kicked at the
-        run's kick times with the run's angles (common random numbers; a kick is then a
-        map of the phase space, which is what an exponent linearises). ``"independent"``:
-        each twin is kicked at the same times with angles of its own, drawn from ``rng``
-        by the same law (``kick_angle``, ``sigma``) after the run's kicks. Ranković &
-        Porter do not say which their twins did. With its own angles a twin's velocity
-        differs by O(1) after the first kick, so the renormalised value measures
-        ``Gamma log(v tau / d0)``-like jumps rather than stretching. Not for scattering or
-        kinetic-rate kicks (the twin's own angle would change its kick times).
-    return_run : bool
-        Also return the simulated run: ``(result, run)``, where ``run`` is the
-        `TwoParticleRun` / `OneParticleRun` that `simulate_two_particle` /
-        `simulate_one_particle` return for the same arguments (every field bitwise
-        equal, ``seed=None``), from the same single pass of the event loop that carries
-        the tangent vectors (no second simulation). Tangent method only: with
-        ``method="twin"`` it raises a ValueError.
+        Two-disk collision rule and the disk whose position deviation is measured. (A
+        kicked disk's scattering rule is its kick law's, ``KickLaw(rule=...)``.)
+    kicks : KickLaw, array_like or schedule, optional
+        One-disk kicks, as in `simulate_one_particle` (`kicktimes.billiard.KickLaw`; times
+        or a schedule alone: uniform new directions). Kick times and angles are given
+        data, the same for every perturbed trajectory (common random numbers): a kick is
+        linearised at fixed time and angle. A scattering kick (``angle="scatter"``) is a
+        collision with a virtual partner placed in contact with the reference (at the
+        distance ``r + partner_radius``): the tangent vector goes through the linearised
+        collision with a partner of zero deviation; a twin meets the same partner at its
+        own contact time, or misses it (docs/scatter.md).
+    rng : None, int, SeedSequence or numpy.random.Generator, optional
+        Source of a schedule's kick times and the kick angles (as in
+        `simulate_one_particle`), then of independent twins' own angles.
+    method : Tangent, Twin, "tangent" or "twin"
+        `Tangent` (default, ``"tangent"``): exact propagation of tangent vectors; its
+        options ``variant`` (``"norm"``: the 2-norm of the tracked disk's position
+        deviation; ``"paper"``: ``|dx|`` and ``|dy|`` separately, ``lam = max(lam_x,
+        lam_y)``) and ``return_run`` (also return the run, from the same single pass).
+        `Twin` (``"twin"``): Benettin's twin at distance ``d0`` (the paper's method;
+        converges to the tangent value as ``d0 -> 0`` until round-off takes over), with
+        ``d0``, ``variant``, ``renormalize`` (``False``: eq. (4) of Ranković & Porter read
+        literally), ``twin_kicks`` and ``max_defer``. A name stands for the method with
+        its default options (`kicktimes.diagnostics.ftle_methods`).
     masses : (float, float), optional
         Two disks, elastic rule: their masses (as in `simulate_two_particle`).
     holes : array_like, shape (n, 2), optional
@@ -366,7 +391,7 @@ def lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rule
 
     Returns
     -------
-    LyapunovResult, or ``(LyapunovResult, run)`` with ``return_run=True``
+    LyapunovResult, or ``(LyapunovResult, run)`` with ``Tangent(return_run=True)``
 
     Warns
     -----
@@ -408,36 +433,35 @@ def lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rule
     >>> res = lyapunov(ic, 0.03, n_steps=2000, tau=0.2)
     >>> bool(res.lam > 0), res.method
     (True, 'tangent')
-    >>> twin = lyapunov(ic, 0.03, n_steps=2000, tau=0.2, method="twin", d0=1e-8)
+    >>> from kicktimes.diagnostics import Twin
+    >>> twin = lyapunov(ic, 0.03, n_steps=2000, tau=0.2, method=Twin(d0=1e-8))
     >>> bool(abs(twin.lam - res.lam) < 0.02 * res.lam)
     True
 
     One pass for the exponent and the run (its samples, boundary log, collision times):
 
     >>> from kicktimes import simulate_two_particle
-    >>> res2, run = lyapunov(ic, 0.03, n_steps=2000, tau=0.2, return_run=True)
+    >>> from kicktimes.diagnostics import Tangent
+    >>> res2, run = lyapunov(ic, 0.03, n_steps=2000, tau=0.2,
+    ...                      method=Tangent(return_run=True))
     >>> res2 == res
     True
     >>> same = simulate_two_particle(ic, 0.03, n_steps=2000, tau=0.2)
     >>> bool((run.pp_times == same.pp_times).all() and (run.samples == same.samples).all())
     True
     """
-    if not isinstance(return_run, bool | np.bool_):
-        raise TypeError(f"return_run must be a bool, got {type(return_run).__name__}")
-    res, run, _ = _lyapunov(
-        system, r, n_steps=n_steps, tau=tau, sampling=sampling, rule=rule, track=track,
-        kicks=kicks, kick_angles=kick_angles, kick_angle=kick_angle, sigma=sigma, rng=rng,
-        method=method, variant=variant, d0=d0, max_defer=max_defer, e0=e0, partner=partner,
-        partner_radius=partner_radius, partner_mass=partner_mass,
-        return_run=bool(return_run), t_continue=0.0, holes=holes, masses=masses,
-        renormalize=renormalize, twin_kicks=twin_kicks,
-    )
-    _warn_undefined(res)
-    return (res, run) if return_run else res
+    flat = _flat(system, rule, kicks, method)
+    res, run, _ = _lyapunov(system, r, n_steps=n_steps, tau=tau, sampling=sampling,
+                            track=track, rng=rng, t_continue=0.0, holes=holes, masses=masses,
+                            **flat)
+    _warn_undefined(res, stacklevel=4)
+    return (res, run) if flat["return_run"] else res
 
 
-def lyapunov_pass(system, r=None, *, t_continue=0.0, uniform=False, **options):
-    """`lyapunov` with ``return_run=True``, and the two-disk run continued: for the sweep.
+def lyapunov_pass(system, r=None, *, t_continue=0.0, uniform=False, rule="mirror", kicks=None,
+                  method="tangent", **options):
+    """`lyapunov` with ``Tangent(return_run=True)``, and the two-disk run continued: for
+    the sweep (``method`` a `Tangent` or ``"tangent"``; its ``return_run`` is implied).
 
     Returns ``(result, run, pp_times)``. With two disks, ``sampling="paper"`` and a run
     that ends before ``t_continue``, the event loop goes on (no samples, no tangent work)
@@ -456,8 +480,11 @@ def lyapunov_pass(system, r=None, *, t_continue=0.0, uniform=False, **options):
     if not isinstance(uniform, bool | np.bool_):
         raise TypeError(f"uniform must be a bool, got {type(uniform).__name__}")
     sink = [] if uniform else None
-    out = _lyapunov(system, r, return_run=True, t_continue=t_continue, uniform_out=sink,
-                    **options)
+    flat = _flat(system, rule, kicks, method)
+    if flat["method"] != "tangent":
+        raise ValueError(f"method: lyapunov_pass is the tangent method's one pass, got {method!r}")
+    flat["return_run"] = True
+    out = _lyapunov(system, r, t_continue=t_continue, uniform_out=sink, **options, **flat)
     _warn_undefined(out[0])
     if not uniform:
         return out

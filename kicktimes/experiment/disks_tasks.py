@@ -221,7 +221,7 @@ def kicked_rows(experiment: DisksExperiment, n_disks: int, k: int) -> list:
     """
     import warnings
 
-    from kicktimes.billiard import initial_state, simulate_disks, simulate_one_particle
+    from kicktimes.billiard import KickLaw, initial_state, simulate_disks, simulate_one_particle
     from kicktimes.diagnostics import (
         autocorrelation,
         boundary_angles,
@@ -260,10 +260,10 @@ def kicked_rows(experiment: DisksExperiment, n_disks: int, k: int) -> list:
         for system in experiment.kicked_systems:
             # scatter: each kick a mirror collision with a partner of the gas's radius drawn
             # from the collision kernel (flux-weighted direction, (w.n)+ normal)
-            kind = ({"kick_angle": "scatter", "rule": "mirror", "partner": "weighted",
+            kind = ({"angle": "scatter", "rule": "mirror", "partner": "weighted",
                      "partner_radius": r} if system == "scatter" else {})
-            one = simulate_one_particle(state[0], r, t_max=t_max, kicks=schedules[system],
-                                        rng=rng, tau=tau, **kind)
+            one = simulate_one_particle(state[0], r, t_max=t_max, rng=rng, tau=tau,
+                                        kicks=KickLaw(schedules[system], **kind))
             rows += [(system, "ftle", lyapunov(one).lam),
                      (system, "acf@1", autocorrelation(boundary_angles(one), 1)),
                      (system, "rr", recurrence_rate(one.samples[:, :2], eps=KICKED_EPS,

@@ -33,12 +33,16 @@ import time
 import warnings
 from contextlib import contextmanager
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 import pandas as pd
 
 from kicktimes._results import TableResult
 from kicktimes.experiment.config import Experiment
+
+if TYPE_CHECKING:
+    from kicktimes.billiard.kick_law import KickLaw
 from kicktimes.experiment.plan import Task, make_tasks
 from kicktimes.stats import MMPP_MIN_EVENTS
 from kicktimes.validation import RENAMED_MARKER, check_seed_sequence
@@ -269,9 +273,7 @@ def _run_ic(exp: Experiment, r: float, ic_index: int, ic: np.ndarray, rows, coll
     holes = {"holes": np.array(exp.holes)} if exp.holes else {}
     # the two-disk system: disk 0 of radius r, disk 1 of the partner's radius and mass
     pair, two_kw = exp.radius_pair(r), _two_disk_kw(exp)
-    ftle_method = {"method": exp.lyapunov_method}
-    if exp.lyapunov_method == "twin":
-        ftle_method["d0"] = exp.d0
+    ftle_method = _ftle_method(exp)
     diags = exp.diagnostics
 
     def add(system, diagnostic, value, note=""):
@@ -335,22 +337,21 @@ def _run_ic(exp: Experiment, r: float, ic_index: int, ic: np.ndarray, rows, coll
     if two_pass and holes:
         # the run ends at its escape: no continuation to the horizon
         with timer("lyapunov_two_particle"):
-            res_two, two = _lyapunov()(ic, pair, track=0, method="tangent",
-                                       variant=exp.lyapunov_variant, return_run=True, **holes,
-                                       **two_kw, **steps)
+            res_two, two = _lyapunov()(ic, pair, track=0,
+                                       method=_tangent(exp.lyapunov_variant, return_run=True),
+                                       **holes, **two_kw, **steps)
         continued = two.pp_times
     elif two_pass:
         with timer("lyapunov_two_particle"):
             res_two, two, continued, *more = _lyapunov_pass()(
-                ic, pair, track=0, variant=exp.lyapunov_variant, method="tangent",
+                ic, pair, track=0, method=_tangent(exp.lyapunov_variant),
                 t_continue=horizon if exp.sampling == "paper" else 0.0, **two_kw, **steps,
                 **uniform_kw,
             )
         two_uniform = more[0] if more else None
     else:
         with timer("simulation_two_particle"):
-            two = simulate_two_particle(ic, pair, track=0, seed=exp.seed, **holes, **two_kw,
-                                        **steps)
+            two = simulate_two_particle(ic, pair, track=0, **holes, **two_kw, **steps)
         if holes:
             continued = two.pp_times
     n_b0 = int(np.count_nonzero(two.boundary_log.particle == 0))
@@ -369,8 +370,7 @@ def _run_ic(exp: Experiment, r: float, ic_index: int, ic: np.ndarray, rows, coll
             "two_particle",
             two,
             (lambda: res_two) if two_pass else lambda: _lyapunov()(
-                ic, pair, track=0, variant=exp.lyapunov_variant, **ftle_method,
-                **holes, **two_kw, **steps,
+                ic, pair, track=0, method=ftle_method, **holes, **two_kw, **steps,
             ),
             two_uniform,
         )
@@ -384,8 +384,8 @@ def _run_ic(exp: Experiment, r: float, ic_index: int, ic: np.ndarray, rows, coll
         rng = kick_rng(ic_index, r, system, rng=exp.seed)
         if system in ("poisson_kinetic", "uniform_kinetic"):
             # the event loop draws the kick times (and their scattering numbers) from rng
-            one_kw = {"kicks": kinetic_rate_table(r, exp.rule), "rng": rng, **kick, **holes,
-                      **steps}
+            one_kw = {"kicks": kick.replace(times=kinetic_rate_table(r, exp.rule)), "rng": rng,
+                      **holes, **steps}
             _kicked(system, one_kw, one_pass, exp, ic, r, timer, add, diagnose,
                     uniform_kw=uniform_kw)
             continue
@@ -409,8 +409,8 @@ def _run_ic(exp: Experiment, r: float, ic_index: int, ic: np.ndarray, rows, coll
                 extra = (("kick_rate", rate),)
             elif system == "mmpp":
                 kick_times = schedule.sample(horizon, rng=rng)
-            kick_angles = draw_kick_angles(kick_times.size, kick["kick_angle"], exp.sigma, rng)
-        one_kw = {"kicks": kick_times, "kick_angles": kick_angles, **kick, **holes, **steps}
+            kick_angles = draw_kick_angles(kick_times.size, kick.angle, exp.sigma, rng)
+        one_kw = {"kicks": kick.replace(times=kick_times, angles=kick_angles), **holes, **steps}
         _kicked(system, one_kw, one_pass, exp, ic, r, timer, add, diagnose, extra,
                 uniform_kw=uniform_kw)
 
@@ -423,14 +423,12 @@ def _kicked(system, one_kw, one_pass, exp, ic, r, timer, add, diagnose, extra=()
     records the run's uniform samples (`lyapunov_pass`)."""
     from kicktimes.billiard.one_particle import simulate_one_particle
 
-    ftle_method = {"method": exp.lyapunov_method}
-    if exp.lyapunov_method == "twin":
-        ftle_method["d0"] = exp.d0
+    ftle_method = _ftle_method(exp)
     uniform = None
     if one_pass:
         with timer("lyapunov_kicked"):
             res_one, one, _, *more = _lyapunov_pass()(
-                ic[0], r, variant=exp.lyapunov_variant, method="tangent", **one_kw,
+                ic[0], r, method=_tangent(exp.lyapunov_variant), **one_kw,
                 **(uniform_kw or {}))
         uniform = more[0] if more else None
 
@@ -438,15 +436,16 @@ def _kicked(system, one_kw, one_pass, exp, ic, r, timer, add, diagnose, extra=()
             return res_one
     else:
         with timer("simulation_one_particle"):
-            one = simulate_one_particle(ic[0], r, seed=exp.seed, **one_kw)
+            one = simulate_one_particle(ic[0], r, **one_kw)
 
         def ftle():
             kw = one_kw
             if "rng" in kw:
                 # kinetic kicks are drawn by the run: the FTLE replays the ones it applied
-                kw = {**one_kw, "kicks": one.kick_times, "kick_angles": one.kick_angles}
+                kw = {**one_kw, "kicks": one_kw["kicks"].replace(times=one.kick_times,
+                                                                 angles=one.kick_angles)}
                 del kw["rng"]
-            return _lyapunov()(ic[0], r, variant=exp.lyapunov_variant, **ftle_method, **kw)
+            return _lyapunov()(ic[0], r, method=ftle_method, **kw)
     add(system, "t_max", one.t_max)
     if "holes" in one_kw:
         add(system, "escape_time", one.escape_time,
@@ -531,8 +530,10 @@ def _two_disk_kw(exp: Experiment) -> dict:
     return {"rule": exp.rule, **({"masses": exp.masses} if exp.masses else {})}
 
 
-def kick_law(exp: Experiment, system: str, ic: np.ndarray, r: float | None = None) -> dict:
-    """Keyword arguments of the kicks of a one-particle ``system`` at sweep radius ``r``.
+def kick_law(exp: Experiment, system: str, ic: np.ndarray, r: float | None = None) -> KickLaw:
+    """The kick law of a one-particle ``system`` at sweep radius ``r``, without its times
+    (`KickLaw.replace` gives it them): the TOML's kick keys (``kick_angle``, ``sigma``, the
+    rule and partner) as one value.
 
     The paper's systems use ``exp.kick_angle``; the ``*_scatter`` systems (and
     ``poisson_kinetic``, of equal disks and masses) collide with a
@@ -543,15 +544,15 @@ def kick_law(exp: Experiment, system: str, ic: np.ndarray, r: float | None = Non
     """
     if system == "poisson_kinetic":
         if exp.rule == "mirror":
-            return {"kick_angle": "scatter", "sigma": exp.sigma, "rule": "mirror"}
+            return _law({"kick_angle": "scatter", "sigma": exp.sigma, "rule": "mirror"})
         # the elastic table's partner is on the shell |v0|^2 + |v1|^2 = 2: e0 = 1 up to
         # round-off (equal masses; Experiment refuses the kinetic systems with others)
-        return {"kick_angle": "scatter", "sigma": exp.sigma, "rule": exp.rule,
-                "e0": 0.5 * float((ic[:, 2:] ** 2).sum())}
+        return _law({"kick_angle": "scatter", "sigma": exp.sigma, "rule": exp.rule,
+                     "e0": 0.5 * float((ic[:, 2:] ** 2).sum())})
     if system == "uniform_kinetic":
-        return {"kick_angle": exp.kick_angle, "sigma": exp.sigma}
+        return _law({"kick_angle": exp.kick_angle, "sigma": exp.sigma})
     if not system.endswith("_scatter"):
-        return {"kick_angle": exp.kick_angle, "sigma": exp.sigma}
+        return _law({"kick_angle": exp.kick_angle, "sigma": exp.sigma})
     partner = {}
     if exp.partner_ratio != 1.0:
         if r is None:
@@ -563,8 +564,31 @@ def kick_law(exp: Experiment, system: str, ic: np.ndarray, r: float | None = Non
         partner["partner_mass"] = exp.partner_mass
         m0, m1 = 2.0 / (1.0 + exp.partner_mass), 2.0 * exp.partner_mass / (1.0 + exp.partner_mass)
         e0 = 0.5 * float(m0 * (ic[0, 2:] ** 2).sum() + m1 * (ic[1, 2:] ** 2).sum())
-    return {"kick_angle": "scatter", "sigma": exp.sigma, "rule": exp.rule, "e0": e0,
-            **partner}
+    return _law({"kick_angle": "scatter", "sigma": exp.sigma, "rule": exp.rule, "e0": e0,
+                 **partner})
+
+
+def _law(kw: dict) -> KickLaw:
+    """The `KickLaw` of the TOML's kick keys (``kick_angle`` is the law's ``angle``)."""
+    from kicktimes.billiard.kick_law import KickLaw
+
+    return KickLaw(angle=kw.pop("kick_angle"), **kw)
+
+
+def _tangent(variant: str, return_run: bool = False):
+    from kicktimes.diagnostics.ftle_methods import Tangent
+
+    return Tangent(variant=variant, return_run=return_run)
+
+
+def _ftle_method(exp: Experiment):
+    """The sweep's FTLE method (`kicktimes.diagnostics.Tangent` / `Twin`) from its TOML keys
+    ``lyapunov_method``, ``lyapunov_variant`` and ``d0``."""
+    from kicktimes.diagnostics.ftle_methods import Tangent, Twin
+
+    if exp.lyapunov_method == "twin":
+        return Twin(d0=exp.d0, variant=exp.lyapunov_variant)
+    return Tangent(variant=exp.lyapunov_variant)
 
 
 #: prefix of the recurrence rows computed on uniform-time samples when
@@ -676,10 +700,9 @@ def uniform_samples(exp: Experiment, system: str, ic: np.ndarray, r: float, run)
             r,
             t_max=run.t_max,
             tau=exp.tau,
-            kicks=run.kick_times,
-            kick_angles=run.kick_angles,
+            kicks=kick_law(exp, system, ic, r).replace(times=run.kick_times,
+                                                       angles=run.kick_angles),
             sampling="uniform",
-            **kick_law(exp, system, ic, r),
         )
     return again.samples
 

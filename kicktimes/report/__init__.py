@@ -30,6 +30,7 @@ Poisson model against Poisson and the renewal models), :mod:`~kicktimes.report.h
 from __future__ import annotations
 
 from kicktimes.report.context import REPORT_DOMAIN
+from kicktimes.report.options import Render, Subsampling
 from kicktimes.report.pipeline import build_report
 
-__all__ = ["build_report", "REPORT_DOMAIN"]
+__all__ = ["build_report", "REPORT_DOMAIN", "Render", "Subsampling"]

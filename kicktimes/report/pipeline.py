@@ -27,6 +27,7 @@ from contextlib import closing, contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
+from kicktimes._old_keywords import old_keywords, pop_old, translator, warn_old
 from kicktimes.memory import fewer_collections, keep_freed_memory
 from kicktimes.render.html import (
     embed_figures,
@@ -39,6 +40,7 @@ from kicktimes.render.html import (
 )
 from kicktimes.report._cache import ReportCache, content_key, store_key
 from kicktimes.report.context import Context, Mapper, Progress
+from kicktimes.report.options import Render, Subsampling
 from kicktimes.report.store import load_report_store, store_header
 from kicktimes.validation import check_int, check_real
 
@@ -286,6 +288,30 @@ def families_section(stores):
     return sec if sec.figures else None
 
 
+#: build_report's keywords before 0.2.0 that became fields of `Render` / `Subsampling`
+OLD_RENDER = ("dpi", "pdf")
+OLD_SUBSAMPLING = ("max_ics_tests", "max_ics_model_fits", "max_pooled_intervals")
+
+
+@translator(*OLD_RENDER, *OLD_SUBSAMPLING)
+def _old_report(args, kwargs):
+    kwargs = dict(kwargs)
+    for key, cls, names in (("render", Render, OLD_RENDER),
+                            ("subsampling", Subsampling, OLD_SUBSAMPLING)):
+        old = pop_old(kwargs, names)
+        if not old:
+            continue
+        warn_old(", ".join(f"build_report({k}=...)" for k in old),
+                 f"build_report(..., {key}={cls.__name__}({', '.join(f'{k}=...' for k in old)}))"
+                 " (kicktimes.report." + cls.__name__ + ")")
+        if kwargs.get(key) is not None:
+            raise TypeError(f"build_report: give {', '.join(old)} as fields of {key}=, not as "
+                            "keywords")
+        kwargs[key] = cls(**old)
+    return kwargs, None
+
+
+@old_keywords(_old_report)
 def build_report(
     store_path,
     out_dir,
@@ -293,15 +319,12 @@ def build_report(
     progress=None,
     alpha=0.05,
     n_mc=199,
-    max_ics_tests=None,
-    max_ics_model_fits=12,
-    max_pooled_intervals=200_000,
-    dpi=150,
+    subsampling=None,
+    render=None,
     workers=None,
     n_boot=2000,
     tolerance=0.1,
     escape_t_min=None,
-    pdf=False,
     force=False,
 ) -> Path:
     r"""Build the report of one or several sweeps: tables, figures, a self-contained page.
@@ -323,16 +346,15 @@ def build_report(
     n_mc : int, optional
         Monte Carlo samples of the conditional nulls of the Poisson tests (p-value
         resolution ``1/(n_mc + 1)``).
-    max_ics_tests : int, optional
-        Use only the first ``max_ics_tests`` ICs (by index) per radius in the Poisson
-        tests (default: all).
-    max_ics_model_fits : int, optional
-        ICs (first by index) per radius whose intervals get a per-IC renewal-model
-        comparison (6 censored fits each, ~0.4 s per IC).
-    max_pooled_intervals : int, optional
-        Interval budget of the pooled fits per radius (whole ICs in index order).
-    dpi : int, optional
-        Resolution of the PNG files.
+    subsampling : Subsampling, optional
+        How far the tests and fits subsample the store (`kicktimes.report.Subsampling`:
+        ``max_ics_tests``, ICs per radius in the Poisson tests, default all;
+        ``max_ics_model_fits``, ICs per radius with a per-IC renewal-model comparison,
+        default 12; ``max_pooled_intervals``, the pooled fits' interval budget per radius,
+        default 200 000).
+    render : Render, optional
+        How the figures are written (`kicktimes.report.Render`: ``dpi``, default 150, the
+        PNGs' resolution; ``pdf``, default False, also a PDF of every figure).
     workers : int, optional
         Processes (default ``os.cpu_count()``; ``1`` computes everything in this
         process). With several stores to (re)build, each store's part runs in its own
@@ -349,8 +371,6 @@ def build_report(
         Where the escape section's tail fits start, in time units (stores of experiments
         with holes; default: 1/20 of the experiment's horizon ``n_steps * tau``; see
         :mod:`kicktimes.report.escape`).
-    pdf : bool, optional
-        Also write a PDF of every figure (the page embeds the PNGs; default False).
     force : bool, optional
         Rebuild everything, ignoring the cache ``out_dir/.cache.json``.
 
@@ -390,21 +410,23 @@ def build_report(
     >>> build_report(store, tempfile.mkdtemp(), progress=False, workers=1).name
     'report.html'
     """
+    subsampling = _check_group("subsampling", subsampling, Subsampling)
+    render = _check_group("render", render, Render)
     paths = _check_paths(store_path)
     options, render, workers = _check_options(
         out_dir,
         progress=progress,
         alpha=alpha,
         n_mc=n_mc,
-        max_ics_tests=max_ics_tests,
-        max_ics_model_fits=max_ics_model_fits,
-        max_pooled_intervals=max_pooled_intervals,
-        dpi=dpi,
+        max_ics_tests=subsampling.max_ics_tests,
+        max_ics_model_fits=subsampling.max_ics_model_fits,
+        max_pooled_intervals=subsampling.max_pooled_intervals,
+        dpi=render.dpi,
         workers=workers,
         n_boot=n_boot,
         tolerance=tolerance,
         escape_t_min=escape_t_min,
-        pdf=pdf,
+        pdf=render.pdf,
         force=force,
     )
     t_start = time.perf_counter()
@@ -436,6 +458,15 @@ def build_report(
         page = _write_page(plan, timings, built)
         bar.advance()
         return page
+
+
+def _check_group(name, value, cls):
+    if value is None:
+        return cls()
+    if not isinstance(value, cls):
+        raise TypeError(f"{name} must be a kicktimes.report.{cls.__name__}(...) or None, got "
+                        f"{type(value).__name__}")
+    return value
 
 
 def _check_options(out_dir, *, progress, alpha, n_mc, max_ics_tests, max_ics_model_fits,

@@ -19,10 +19,11 @@ __all__ = ["ReportProcess", "build_stores_report"]
 def build_stores_report(stores, out, workers=None, progress=None, pdf=False, force=False):
     """`kicktimes.report.build_report` of the store ``stores[0]`` or of the stores
     ``stores`` (one part per experiment); returns the page's path."""
-    from kicktimes.report import build_report
+    from kicktimes.report import Render, build_report
 
     target = stores[0] if len(stores) == 1 else list(stores)
-    return build_report(target, out, workers=workers, progress=progress, pdf=pdf, force=force)
+    return build_report(target, out, workers=workers, progress=progress, render=Render(pdf=pdf),
+                        force=force)
 
 
 def _serve(conn, driver_end):

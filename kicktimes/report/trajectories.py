@@ -16,6 +16,7 @@ from matplotlib.colors import LogNorm
 from matplotlib.figure import Figure
 from matplotlib.ticker import MaxNLocator
 
+from kicktimes.billiard import KickLaw
 from kicktimes.render.figures import TIME_UNIT, check_frame, finite, new_axes
 from kicktimes.render.pages import percent_text
 from kicktimes.report.context import Section
@@ -358,9 +359,9 @@ def _sweep_poisson_run(exp, ic, r, two):
     rate = two.n_pp / two.t_max if two.t_max > 0 else 0.0
     times = Poisson(rate).sample(exp.horizon, rng=rng) if rate > 0 else np.empty(0)
     angles = draw_kick_angles(times.size, exp.kick_angle, exp.sigma, rng)
-    return simulate_one_particle(ic[0], r, kicks=times, kick_angles=angles,
-                                 kick_angle=exp.kick_angle, sigma=exp.sigma,
-                                 n_steps=exp.n_steps, tau=exp.tau, sampling=exp.sampling)
+    law = KickLaw(times, angle=exp.kick_angle, angles=angles, sigma=exp.sigma)
+    return simulate_one_particle(ic[0], r, kicks=law, n_steps=exp.n_steps, tau=exp.tau,
+                                 sampling=exp.sampling)
 
 
 def sections(ctx):
@@ -382,8 +383,7 @@ def sections(ctx):
             n_steps=exp.n_steps,
             tau=exp.tau,
             track=0,
-            seed=exp.seed,
-        )
+            )
         for r in radii
     }
     sec = Section("poincare", "Poincaré sections of one disk")

@@ -88,10 +88,11 @@ class KineticRate:
     --------
     >>> import numpy as np
     >>> from kicktimes import simulate_one_particle
+    >>> from kicktimes.billiard import KickLaw
     >>> from kicktimes.schedules import KineticRate
-    >>> kicks = KineticRate(0.02)
+    >>> kicks = KickLaw(KineticRate(0.02), angle="scatter")
     >>> run = simulate_one_particle(np.array([0.1, 0.2, 0.6, 0.8]), 0.02, t_max=500.0,
-    ...                             kicks=kicks, kick_angle="scatter", rng=1)
+    ...                             kicks=kicks, rng=1)
     >>> bool(run.n_kicks > 0)
     True
     >>> fast = KineticRate(0.02, rule="elastic", n_grid=16, n_speed=8)

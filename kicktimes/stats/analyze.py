@@ -33,6 +33,8 @@ import numpy as np
 import pandas as pd
 from scipy import stats as sps
 
+from kicktimes._old_keywords import old_keywords, pop_old, translator, warn_old
+
 from ._checks import check_int, check_real, check_rng
 from ._table import EventTable, event_table
 from .comparison import compare_models
@@ -143,15 +145,47 @@ class Analysis:
         )
 
 
+#: the events' column roles and their default names (``columns=`` of `analyze`)
+COLUMNS = {"sequence": "sequence", "time": "time", "start": "t_start", "end": "t_end"}
+
+
+def check_columns(columns) -> dict:
+    """``columns`` (None or a dict from the roles of `COLUMNS` to column names) with the
+    default name of every role it leaves out."""
+    if columns is None:
+        return dict(COLUMNS)
+    if not isinstance(columns, dict):
+        raise TypeError(f"columns must be None or a dict from {sorted(COLUMNS)} to column "
+                        f"names, got {type(columns).__name__}")
+    unknown = sorted(set(columns) - set(COLUMNS))
+    if unknown:
+        raise ValueError(f"columns: unknown roles {unknown}; the roles are {sorted(COLUMNS)}")
+    for role, name in columns.items():
+        if not isinstance(name, str):
+            raise TypeError(f"columns[{role!r}] must be a column name (str), got "
+                            f"{type(name).__name__}")
+    return {**COLUMNS, **columns}
+
+
+@translator(*COLUMNS)
+def _old_analyze(args, kwargs):
+    kwargs = dict(kwargs)
+    old = pop_old(kwargs, COLUMNS)
+    warn_old(", ".join(f"analyze({k}=...)" for k in old),
+             "analyze(..., columns={" + ", ".join(f"{k!r}: ..." for k in old) + "})")
+    if kwargs.get("columns") is not None:
+        raise TypeError(f"analyze: give {', '.join(old)} in columns=, not as keywords")
+    kwargs["columns"] = old
+    return kwargs, None
+
+
+@old_keywords(_old_analyze)
 def analyze(
     events,
     *,
     windows=None,
     window=None,
-    sequence="sequence",
-    time="time",
-    start="t_start",
-    end="t_end",
+    columns=None,
     covariates=None,
     group=None,
     reference=None,
@@ -167,8 +201,13 @@ def analyze(
     ----------
     events : DataFrame, path, list of them, or EventTable
         One row per event (see :func:`kicktimes.stats._table.event_table` for the
-        contract: ``windows``, ``window``, ``sequence``, ``time``, ``start``, ``end`` and
-        ``covariates`` are passed to it).
+        contract: ``windows``, ``window``, the ``columns`` and ``covariates`` are passed
+        to it).
+    columns : dict, optional
+        The names of the events' columns by role, those left out keeping their defaults:
+        ``{"sequence": "sequence", "time": "time", "start": "t_start", "end": "t_end"}``
+        (the sequence id, the event time, and the window's start and end), e.g.
+        ``columns={"sequence": "run", "time": "t"}``.
     group : str, optional
         A per-sequence column whose values group the sequences (pooled fits, one Poisson
         ensemble and one rate-homogeneity test per group): a numeric covariate, or a
@@ -218,6 +257,7 @@ def analyze(
     >>> round(float(slope.iloc[0]), 1)   # the rate doubles with the density: slope near 1
     1.1
     """
+    columns = check_columns(columns)
     named = [covariates] if isinstance(covariates, str) else covariates
     tab = (
         events
@@ -226,10 +266,10 @@ def analyze(
             events,
             windows=windows,
             window=window,
-            sequence=sequence,
-            time=time,
-            start=start,
-            end=end,
+            sequence=columns["sequence"],
+            time=columns["time"],
+            start=columns["start"],
+            end=columns["end"],
             covariates=covariates,
             # a group outside the named covariates is kept as a label (text)
             labels=[group]

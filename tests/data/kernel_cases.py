@@ -21,6 +21,9 @@ import sys
 
 import numpy as np
 
+from kicktimes.billiard import KickLaw
+from kicktimes.diagnostics import Tangent, Twin
+
 
 def _two_cases(small: bool):
     from kicktimes import initial_conditions
@@ -52,8 +55,8 @@ def _one_cases(small: bool):
         for law, extra in (("uniform", {}), ("gaussian", {"sigma": 0.3}),
                            ("scatter", {"rule": "mirror"}), ("scatter", {"rule": "elastic"})):
             for sampling in ("uniform", "paper"):
-                kw = dict(kicks=schedules.Poisson(0.5), kick_angle=law, rng=10 * i + len(cases),
-                          n_steps=n, tau=0.3, sampling=sampling, **extra)
+                kw = dict(kicks=KickLaw(schedules.Poisson(0.5), angle=law, **extra),
+                          rng=10 * i + len(cases), n_steps=n, tau=0.3, sampling=sampling)
                 cases.append((f"one_{r}_{law}_{extra.get('rule', '')}_{sampling}", state, r, kw))
         cases.append((f"one_{r}_free", state, r, dict(t_max=0.2 * n)))
     return cases
@@ -92,9 +95,8 @@ def lyapunov_outputs(small: bool = False) -> dict[str, np.ndarray]:
             continue
         kw = {k: v for k, v in kw.items() if k != "log_collisions"}
         for method, variant in (("tangent", "norm"), ("tangent", "paper"), ("twin", "paper")):
-            extra = {"d0": 1e-8} if method == "twin" else {}
-            put(f"{name}/{method}_{variant}",
-                lyapunov(ic, r, method=method, variant=variant, **extra, **kw))
+            how = Twin(d0=1e-8, variant=variant) if method == "twin" else Tangent(variant=variant)
+            put(f"{name}/{method}_{variant}", lyapunov(ic, r, method=how, **kw))
         if kw.get("sampling") == "paper":
             res, run, pp = lyapunov_pass(ic, r, t_continue=0.5 * n, **kw)
             put(f"{name}/pass", res)
@@ -104,9 +106,9 @@ def lyapunov_outputs(small: bool = False) -> dict[str, np.ndarray]:
         if "t_max" in kw:
             continue
         for method in ("tangent", "twin"):
-            extra = {"d0": 1e-8} if method == "twin" else {}
-            put(f"{name}/{method}", lyapunov(state, r, method=method, **extra, **kw))
-        res, run = lyapunov(state, r, return_run=True, **kw)
+            how = Twin(d0=1e-8) if method == "twin" else "tangent"
+            put(f"{name}/{method}", lyapunov(state, r, method=how, **kw))
+        res, run = lyapunov(state, r, method=Tangent(return_run=True), **kw)
         put(f"{name}/pass", res)
         out.update(_fields(f"{name}/pass_run", run, ("kick_times", "kick_log_array")))
     for i, rule in enumerate(("mirror", "elastic")):

@@ -10,6 +10,7 @@ import pandas as pd
 import scipy.stats as sps
 
 from kicktimes import initial_conditions, schedules, simulate_one_particle, simulate_two_particle
+from kicktimes.billiard import KickLaw
 from kicktimes.stats import (
     MARGIN,
     circle_escape_constant,
@@ -74,8 +75,9 @@ def escape_times(r, ics, t_max, seed) -> pd.DataFrame:
                 ("poisson_scatter", "scatter", schedules.Poisson(rate), HOLE),
                 ("poisson_small_hole", "uniform", schedules.Poisson(rate), SMALL_HOLE),
                 ("bursty", "uniform", bursty, HOLE)):
-            run = simulate_one_particle(ic[0], r, t_max=t_max, holes=holes, kick_angle=law,
-                                        kicks=kicks, rng=np.random.default_rng((seed, i)))
+            run = simulate_one_particle(ic[0], r, t_max=t_max, holes=holes,
+                                        kicks=KickLaw(kicks, angle=law),
+                                        rng=np.random.default_rng((seed, i)))
             out[system][i] = run.escape_time
         out["free"][i] = simulate_one_particle(ic[0], r, t_max=t_max, holes=HOLE).escape_time
     return pd.DataFrame(out)

@@ -51,9 +51,11 @@ import warnings
 import numpy as np
 import pandas as pd
 
+from kicktimes.billiard import KickLaw
 from kicktimes.billiard.initial import initial_conditions
 from kicktimes.billiard.one_particle import draw_kick_angles, simulate_one_particle
 from kicktimes.billiard.two_particle import simulate_two_particle
+from kicktimes.diagnostics import Tangent, Twin
 from kicktimes.diagnostics.autocorrelation import (
     UndefinedDiagnosticWarning,
     autocorrelation,
@@ -191,28 +193,27 @@ def run_rows(panel: Panel, kind: str, radius: float, ic_index: int, ic: np.ndarr
         add("two_particle", ("-", "-", "-", "-"), _r1(two, 0), two.n_pp, "r1")
     for reading in _readings(kind, kicked=False):
         e, m, _, _ = reading
-        res = lyapunov(ic, radius, method="twin", variant=m, d0=D0,
-                       renormalize=e == "renormalised", **steps)
+        res = lyapunov(ic, radius, **steps,
+                       method=Twin(variant=m, d0=D0, renormalize=e == "renormalised"))
         add("two_particle", reading, res.lam, res.n_perturbations)
     if kind == "main":
-        res = lyapunov(ic, radius, method="tangent", variant="paper", **steps)
+        res = lyapunov(ic, radius, method=Tangent(variant="paper"), **steps)
         add("two_particle", ("tangent", "paper", "-", "-"), res.lam, res.n_perturbations)
     for system in ("poisson", "actual"):
         times, angles = _kicks(panel, radius, ic_index, system, two, horizon)
-        kicked = {"kicks": times, "sigma": SIGMA, **steps}
         for reading in _readings(kind, kicked=True):
             e, m, k, a = reading
-            res = lyapunov(ic[0], radius, method="twin", variant=m, d0=D0,
-                           renormalize=e == "renormalised", twin_kicks=k, kick_angle=a,
-                           kick_angles=angles[a], rng=_rng(panel, radius, ic_index, system, 1),
-                           **kicked)
+            twin = Twin(variant=m, d0=D0, renormalize=e == "renormalised", twin_kicks=k)
+            res = lyapunov(ic[0], radius, method=twin,
+                           kicks=KickLaw(times, angle=a, angles=angles[a], sigma=SIGMA),
+                           rng=_rng(panel, radius, ic_index, system, 1), **steps)
             add(system, reading, res.lam, res.n_perturbations)
         if kind == "main":
-            res = lyapunov(ic[0], radius, method="tangent", variant="paper",
-                           kick_angle="uniform", kick_angles=angles["uniform"], **kicked)
+            uniform = KickLaw(times, angle="uniform", angles=angles["uniform"], sigma=SIGMA)
+            res = lyapunov(ic[0], radius, method=Tangent(variant="paper"), kicks=uniform,
+                           **steps)
             add(system, ("tangent", "paper", "-", "uniform"), res.lam, res.n_perturbations)
-            one = simulate_one_particle(ic[0], radius, t_max=horizon, kicks=times,
-                                        kick_angles=angles["uniform"], kick_angle="uniform")
+            one = simulate_one_particle(ic[0], radius, t_max=horizon, kicks=uniform)
             add(system, ("-", "-", "-", "uniform"), _r1(one, None), one.n_kicks, "r1")
     return rows
 
@@ -255,8 +256,8 @@ def rr_rows(panel: Panel, radius: float, ic_index: int, ic: np.ndarray) -> list[
     add("two_particle", sampled.samples, sampled.n_pp)
     for system in ("poisson", "actual"):
         times, angles = _kicks(panel, radius, ic_index, system, two, horizon)
-        one = simulate_one_particle(ic[0], radius, kicks=times, kick_angles=angles["uniform"],
-                                    kick_angle="uniform", **steps)
+        one = simulate_one_particle(ic[0], radius, **steps,
+                                    kicks=KickLaw(times, angle="uniform", angles=angles["uniform"]))
         add(system, one.samples, one.n_kicks)
     return rows
 

@@ -27,7 +27,14 @@ import numpy as np
 import pandas as pd
 
 from kicktimes import initial_conditions, simulate_one_particle, simulate_two_particle
-from kicktimes.diagnostics import autocorrelation_function, boundary_angles, lyapunov, rqa
+from kicktimes.billiard import KickLaw
+from kicktimes.diagnostics import (
+    Tangent,
+    autocorrelation_function,
+    boundary_angles,
+    lyapunov,
+    rqa,
+)
 from kicktimes.schedules import Poisson
 from kicktimes.studies.scatter.kernel import fresh_lam
 
@@ -50,7 +57,7 @@ def one_ic(r, i, ic, n_steps, tau):
     system (the module's docstring), its kick numbers drawn from
     ``SeedSequence(2026, spawn_key=(i, int(r * 1e6)))``."""
     steps = dict(n_steps=n_steps, tau=tau, sampling="paper")
-    ftle = dict(variant="paper", **steps)
+    ftle = dict(method=Tangent(variant="paper"), **steps)
     two = simulate_two_particle(ic, r, **steps)
     rate = two.n_pp / two.t_max
     rng = np.random.default_rng(np.random.SeedSequence(2026, spawn_key=(i, int(r * 1e6))))
@@ -60,20 +67,20 @@ def one_ic(r, i, ic, n_steps, tau):
     # actual collision times, continued to cover the kicked run (paper steps are longer)
     actual = simulate_two_particle(ic, r, t_max=n_steps * tau).pp_times
     a_numbers = rng.uniform(-1.0, 1.0, (actual.size, 2))
-    uni = simulate_one_particle(ic[0], r, kicks=times, kick_angles=u_angles, **steps)
-    sca = simulate_one_particle(ic[0], r, kicks=times, kick_angles=s_numbers,
-                                kick_angle="scatter", **steps)
+    uni = simulate_one_particle(ic[0], r, kicks=KickLaw(times, angles=u_angles), **steps)
+    sca = simulate_one_particle(ic[0], r, kicks=KickLaw(times, angle="scatter", angles=s_numbers),
+                                **steps)
     row = {
         "radius": r, "ic": i, "rate": rate,
-        "two": lyapunov(two, variant="paper").lam,
+        "two": lyapunov(two, method=Tangent(variant="paper")).lam,
         "two_fresh": fresh_lam(ic, r, n_steps, tau),
-        "uniform": lyapunov(uni, variant="paper").lam,
-        "scatter": lyapunov(sca, variant="paper").lam,
-        "scatter_unw": lyapunov(ic[0], r, kicks=times, kick_angles=s_numbers,
-                                kick_angle="scatter", partner="uniform", **ftle).lam,
-        "scatter_actual": lyapunov(ic[0], r, kicks=actual[actual <= n_steps * tau],
-                                   kick_angles=a_numbers[actual <= n_steps * tau],
-                                   kick_angle="scatter", **ftle).lam,
+        "uniform": lyapunov(uni, method=Tangent(variant="paper")).lam,
+        "scatter": lyapunov(sca, method=Tangent(variant="paper")).lam,
+        "scatter_unw": lyapunov(ic[0], r, kicks=KickLaw(times, angle="scatter", angles=s_numbers,
+                                                        partner="uniform"), **ftle).lam,
+        "scatter_actual": lyapunov(ic[0], r, **ftle, kicks=KickLaw(
+            actual[actual <= n_steps * tau], angle="scatter",
+            angles=a_numbers[actual <= n_steps * tau])).lam,
         "outside": sca.kick_log.outside.mean() if sca.n_kicks else math.nan,
     }
     for name, run, particle in (("two", two, 0), ("uniform", uni, None), ("scatter", sca, None)):

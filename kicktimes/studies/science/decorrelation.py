@@ -17,6 +17,7 @@ import numpy as np
 import pandas as pd
 
 from kicktimes import initial_conditions, schedules, simulate_one_particle, simulate_two_particle
+from kicktimes.billiard import KickLaw
 from kicktimes.stats import MARGIN, percentile_interval, ratio_verdict, resample_indices
 from kicktimes.studies.science.stretching import N_BOOT
 
@@ -69,11 +70,10 @@ def decorrelation(radii=(0.008, 0.02), *, rule="mirror", n_ics=40, t_max=20000.0
             kinds["no perturbation"].append((a[n == 0], b[n == 0]))
             rate = two.n_pp / two.t_max
             e0 = 0.5 * float((ic[:, 2:] ** 2).sum()) if rule == "elastic" else None
-            for name, kw in (("uniform kick", {"kick_angle": "uniform"}),
-                             ("scatter kick", {"kick_angle": "scatter", "rule": rule,
-                                               "e0": e0})):
-                one = simulate_one_particle(ic[0], r, t_max=t_max, kicks=schedules.Poisson(rate),
-                                            rng=1000 * i + len(name), **kw)
+            for name, kw in (("uniform kick", {"angle": "uniform"}),
+                             ("scatter kick", {"angle": "scatter", "rule": rule, "e0": e0})):
+                one = simulate_one_particle(ic[0], r, t_max=t_max, rng=1000 * i + len(name),
+                                            kicks=KickLaw(schedules.Poisson(rate), **kw))
                 lg = one.boundary_log
                 th = np.arcsin(np.clip(np.asarray(lg.sin_theta), -1, 1))
                 a, b, n = _pairs(np.asarray(lg.time), th, np.asarray(one.kick_times))

@@ -15,6 +15,7 @@ import numpy as np
 import pandas as pd
 
 from kicktimes import initial_conditions, schedules, simulate_one_particle
+from kicktimes.billiard import KickLaw
 from kicktimes.stats import kinetic_rate, percentile_interval, resample_indices
 
 __all__ = ["independent_angle_twin", "twin_table", "twins_raw"]
@@ -58,9 +59,9 @@ def independent_angle_twin(r, *, n_ics=8, n_steps=3000, tau=0.2, d0=2e-4, seed=3
             t0 = step * tau
             sel = (kicks > t0) & (kicks <= t0 + tau)
             ks = kicks[sel] - t0
-            a = simulate_one_particle(a, r, t_max=tau, kicks=ks, kick_angles=ang_a[sel]
+            a = simulate_one_particle(a, r, t_max=tau, kicks=KickLaw(ks, angles=ang_a[sel])
                                       ).final_state.ravel()[:4]
-            b = simulate_one_particle(b, r, t_max=tau, kicks=ks, kick_angles=ang_b[sel]
+            b = simulate_one_particle(b, r, t_max=tau, kicks=KickLaw(ks, angles=ang_b[sel])
                                       ).final_state.ravel()[:4]
             diff = b - a
             d = float(np.sqrt(diff @ diff))

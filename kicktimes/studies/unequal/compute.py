@@ -7,6 +7,7 @@ import numpy as np
 import pandas as pd
 
 from kicktimes import initial_conditions, schedules
+from kicktimes.billiard import KickLaw
 from kicktimes.diagnostics import lyapunov
 from kicktimes.diagnostics.lyapunov import lyapunov_pass
 
@@ -43,8 +44,8 @@ def size_ratio_runs(r1, n_ics, n_steps, tau, seed) -> pd.DataFrame:
             partners = {"partner": radii[1 - disk], "own": radii[disk]}
             for kind, partner_radius in partners.items():
                 one = lyapunov(ic[disk], radii[disk], n_steps=n_steps, tau=tau,
-                               kicks=schedules.Poisson(rate), kick_angle="scatter",
-                               partner_radius=partner_radius,
+                               kicks=KickLaw(schedules.Poisson(rate), angle="scatter",
+                                             partner_radius=partner_radius),
                                rng=np.random.default_rng((seed, i, disk)))
                 row[f"kicked_{kind}_disk{disk}"] = one.lam
         rows.append(row)
