@@ -1,7 +1,7 @@
 """Does the default ``fit_mmpp`` reach the MMPP-2 optimum on two-disk collision times?
 (issue 39, "Must show").
 
-Data: the disk-disk collision times of ``initial_conditions(60, 0.02, seed=5)``, one run
+Data: the disk-disk collision times of ``initial_conditions(60, 0.02, rng=5)``, one run
 of ``t_max = 3000`` per IC (``simulate_two_particle``, mirror rule). Sets: the 59 single
 runs with at least 4 collisions, the 6 groups of 10 runs (runs 0-9, ..., 50-59; one
 window per run) and all 60 together: 66 sets.

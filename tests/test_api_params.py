@@ -186,7 +186,7 @@ def test_old_kick_keywords_give_the_very_same_exponent(old, new):
     assert a == b and math.isfinite(a.lam)
 
 
-IC = initial_conditions(1, 0.03, seed=3)[0]
+IC = initial_conditions(1, 0.03, rng=3)[0]
 
 
 @pytest.mark.parametrize("old, new", [
@@ -266,7 +266,7 @@ def test_the_kicked_disk_rule_is_its_kick_law_s():
 
 
 @pytest.mark.parametrize("simulate, data", [
-    (simulate_one_particle, STATE), (simulate_two_particle, initial_conditions(1, R, seed=1)[0])])
+    (simulate_one_particle, STATE), (simulate_two_particle, initial_conditions(1, R, rng=1)[0])])
 def test_seed_only_recorded_a_number_and_is_deprecated(simulate, data):
     with pytest.warns(DeprecationWarning, match=r"seed=\.\.\.\) is deprecated.*replace"):
         run = simulate(data, R, t_max=20.0, seed=11)

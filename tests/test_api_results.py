@@ -56,10 +56,10 @@ def instances(tmp_path_factory):
     from kicktimes.plots import kth_time_fit
 
     rng = np.random.default_rng(1)
-    ic = kt.initial_conditions(1, R, seed=3)[0]
+    ic = kt.initial_conditions(1, R, rng=3)[0]
     two = kt.simulate_two_particle(ic, R, t_max=200.0, log_collisions=True, tau=0.5)
     one = kt.simulate_one_particle(ic[0], R, t_max=50.0, tau=0.5, kicks=sch.Poisson(1.0), rng=1)
-    gas = kt.simulate_disks(kt.initial_state(5, R, seed=1), R, t_max=5.0)
+    gas = kt.simulate_disks(kt.initial_state(5, R, rng=1), R, t_max=5.0)
     x = rng.exponential(size=200)
     fit = stats.fit_renewal(x, "gamma")
     times = [np.sort(rng.uniform(0, 50, size=k)) for k in (40, 60, 50)]
@@ -117,7 +117,7 @@ def instances(tmp_path_factory):
         # kicktimes.diagnostics
         "AcfCurve": dg.acf_curve(two.theta(0), 5),
         "AcfValue": undefined,
-        "DisksLyapunov": dg.disks_lyapunov(kt.initial_state(5, R, seed=3), R, t_max=4.0,
+        "DisksLyapunov": dg.disks_lyapunov(kt.initial_state(5, R, rng=3), R, t_max=4.0,
                                            segment=1.0, rng=1),
         "LyapunovResult": dg.lyapunov(ic, R, n_steps=200, tau=0.2),
         "LyapunovSpectrum": dg.lyapunov_spectrum(ic, R, t_max=20.0),

@@ -43,7 +43,7 @@ _SETUP = """
 from kicktimes import initial_conditions, schedules, simulate_one_particle, simulate_two_particle
 from kicktimes.diagnostics import lyapunov
 
-ic = initial_conditions(1, 0.02, seed=0)[0]
+ic = initial_conditions(1, 0.02, rng=0)[0]
 """
 _CALLS = """
 for rule in ("mirror", "elastic"):

@@ -387,7 +387,7 @@ from kicktimes.billiard import KickLaw
 from kicktimes.diagnostics import Tangent, lyapunov
 from kicktimes.diagnostics.lyapunov import lyapunov_pass
 
-ic = initial_conditions(1, 0.02, seed=0)[0]
+ic = initial_conditions(1, 0.02, rng=0)[0]
 """
 _ONE_PASS_CALLS = """
 for rule in ("mirror", "elastic"):

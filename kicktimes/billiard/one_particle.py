@@ -39,6 +39,12 @@ from kicktimes.validation import check_rng
 R_MAX_ONE = 1.0 - 1e-6
 
 
+
+def _is_kicktimes_schedule(kicks) -> bool:
+    from kicktimes.schedules import Schedule
+
+    return isinstance(kicks, Schedule)
+
 def check_one_particle_state(state, r: float, name: str = "state") -> np.ndarray:
     """Validate a one-disk state ``(x, y, vx, vy)`` for radius ``r``; a float64 copy."""
     if r > R_MAX_ONE:

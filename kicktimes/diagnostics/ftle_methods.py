@@ -53,7 +53,7 @@ class Tangent:
     --------
     >>> from kicktimes import initial_conditions
     >>> from kicktimes.diagnostics import Tangent, lyapunov
-    >>> ic = initial_conditions(1, 0.03, seed=3)[0]
+    >>> ic = initial_conditions(1, 0.03, rng=3)[0]
     >>> res, run = lyapunov(ic, 0.03, n_steps=2000, tau=0.2,
     ...                     method=Tangent(variant="paper", return_run=True))
     >>> res.variant, run.n_steps
@@ -100,7 +100,7 @@ class Twin:
     --------
     >>> from kicktimes import initial_conditions
     >>> from kicktimes.diagnostics import Twin, lyapunov
-    >>> ic = initial_conditions(1, 0.03, seed=3)[0]
+    >>> ic = initial_conditions(1, 0.03, rng=3)[0]
     >>> res = lyapunov(ic, 0.03, n_steps=2000, tau=0.2, method=Twin(d0=1e-8))
     >>> res.method, res.d0
     ('twin', 1e-08)

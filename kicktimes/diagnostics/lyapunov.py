@@ -23,8 +23,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from kicktimes._results import Result
 from kicktimes._old_keywords import old_keywords, pop_old, translator, warn_old
+from kicktimes._results import Result
 from kicktimes.billiard import checks as chk
 from kicktimes.billiard.kernels.drive_one import simulate_tangent_one_kernel, tangent_one_kernel
 from kicktimes.billiard.kernels.drive_two import simulate_tangent_two_kernel, tangent_two_kernel
