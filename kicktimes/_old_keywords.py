@@ -19,7 +19,7 @@ _USER = 4
 
 def warn_old(old: str, new: str, *, stacklevel: int = _USER) -> None:
     """Warn that keyword ``old`` is deprecated in favour of ``new`` (until 0.3.0)."""
-    warnings.warn(f"{old} is deprecated and will be removed in kicktimes 0.3.0; use {new} "
+    warnings.warn(f"{old} is deprecated since 0.2.0 and will be removed in 0.3.0; use {new} "
                   "instead", DeprecationWarning, stacklevel=stacklevel)
 
 

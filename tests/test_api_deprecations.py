@@ -130,7 +130,6 @@ OLD_POSITIONAL = [
     (stats.rejection_rule, (0.05, 0.5), ((), {"alpha": 0.05, "margin": 0.5})),
     (stats.ratio_rule, (0.1,), ((), {"tolerance": 0.1})),
     (stats.null_rule, (0.1, "D"), ((), {"margin": 0.1, "name": "D"})),
-    (stats.margin_of, ("ftle", 0.2), (("ftle",), {"default": 0.2})),
     (stats.resample_counts, (10, 5, 1), ((10,), {"n_boot": 5, "rng": 1})),
     (stats.resample_indices, (10, 5, 1), ((10,), {"n_boot": 5, "rng": 1})),
     (stats.percentile_interval, (np.arange(100.0), 0.9), ((np.arange(100.0),), {"level": 0.9})),

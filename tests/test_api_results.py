@@ -121,7 +121,7 @@ def instances(tmp_path_factory):
                                            segment=1.0, rng=1),
         "LyapunovResult": dg.lyapunov(ic, R, n_steps=200, tau=0.2),
         "LyapunovSpectrum": dg.lyapunov_spectrum(ic, R, t_max=20.0),
-        "RQAResult": dg.rqa(two.samples, 0.05),
+        "RQAResult": dg.rqa(two.samples, eps=0.05),
         "RecollisionShare": dg.recollision_share(dg.collision_table(two), n_boot=99, rng=0),
         # kicktimes.experiment
         "Experiment": exp,
@@ -129,6 +129,12 @@ def instances(tmp_path_factory):
         "Store": store,
         "Task": task,
         "TaskOutput": ex.execute_task(exp, task),
+        # kicktimes.billiard, diagnostics, report: the option values
+        "KickLaw": kt.billiard.KickLaw(sch.Poisson(0.1), angle="gaussian", sigma=0.5),
+        "Tangent": dg.Tangent(),
+        "Twin": dg.Twin(d0=1e-4),
+        "Render": kt.report.Render(dpi=90),
+        "Subsampling": kt.report.Subsampling(),
         # kicktimes.plots
         "TimesFit": kth_time_fit(two.pp_times, sch.Poisson(1.0).sample(200.0, rng=1)),
     }
@@ -194,9 +200,9 @@ def test_undefined_results_say_why_in_a_reason():
     nan_share = recollision_share(empty, rng=0)
     assert np.isnan(nan_share.share) and "n_collisions = 0" in nan_share.reason
     assert "reason: " in nan_share.summary()
-    apart = rqa(np.array([[0.0, 0.0], [1.0, 1.0], [2.0, 2.0]]), 0.1)
+    apart = rqa(np.array([[0.0, 0.0], [1.0, 1.0], [2.0, 2.0]]), eps=0.1)
     assert np.isnan(apart.det) and apart.reason.startswith("det: no recurrent pair")
-    assert rqa(np.zeros((4, 2)), 0.1).reason is None
+    assert rqa(np.zeros((4, 2)), eps=0.1).reason is None
 
 
 def test_fits_name_the_reason_of_a_nan_estimate_beside_converged(instances):

@@ -67,6 +67,8 @@ EXCEPT_POSITIONAL = {
     "from_spec": "the spec's data",
     # a preset is named by (name, content)
     "preset": "the preset's key",
+    # a float that carries its reason: float(value) and the reason are its data
+    "AcfValue": "a value and its reason",
 }
 
 

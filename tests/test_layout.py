@@ -40,7 +40,7 @@ def test_the_sticky_rule_clopper_pearson_and_the_margin_are_defined_once():
                                           r"proportion_confint)\(", text, flags=re.M))
     assert sticky == ["stats/counts.py"]
     assert clopper == ["stats/findings.py"]
-    assert margin == ["stats/findings.py"]
+    assert margin == ["stats/margins.py"]
 
 
 def test_no_page_draws_its_own_cluster_resamples():

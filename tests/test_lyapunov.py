@@ -13,7 +13,8 @@ from kicktimes.billiard.kernels.tangent import MAX_SAME_INSTANT
 from kicktimes.billiard.kernels.twins import ftle_two_kernel
 from kicktimes.billiard.one_particle import draw_kick_angles
 from kicktimes.diagnostics import Tangent, Twin, UndefinedDiagnosticWarning, lyapunov
-from kicktimes.diagnostics.lyapunov import _check_status, lyapunov_spectrum
+from kicktimes.diagnostics.lyapunov import check_kernel_status
+from kicktimes.diagnostics.spectrum import lyapunov_spectrum
 
 
 @pytest.fixture(scope="module")
@@ -236,9 +237,9 @@ def test_every_event_loop_has_a_budget(ics):
                           np.array([0]), 1e-8, 10, 50, True)
     assert out[6] == 1
     with pytest.raises(RuntimeError, match="budget of 50 events"):
-        _check_status(1, 200.0, 50)
+        check_kernel_status(1, 200.0, 50)
     with pytest.raises(ValueError, match="non-finite event time"):
-        _check_status(3, 200.0, 50)
+        check_kernel_status(3, 200.0, 50)
 
 
 @pytest.mark.slow

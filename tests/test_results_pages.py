@@ -42,8 +42,8 @@ def test_every_verdict_is_the_one_its_interval_gives(path):
         # table has it (the paper study's; paper.md's claims read the paper's 10 %)
         if hasattr(row, "verdict_at_margin"):
             assert row.margin == margin_of(row.diagnostic), row
-            assert row.verdict_at_margin == ratio_verdict(row.ci_low, row.ci_high,
-                                                          margin_of(row.diagnostic)), row
+            assert row.verdict_at_margin == ratio_verdict(
+                row.ci_low, row.ci_high, tolerance=margin_of(row.diagnostic)), row
     # the Poisson rows: each share against its test's level in null_calibration.csv (the
     # runs' own Poisson control streams; alpha for the first-collisions row); D, the first
     # hazard bin and the gamma shape against their control streams' values (the paired

@@ -11,7 +11,14 @@ import pandas as pd
 import pytest
 from conftest import MACHINE_PATH, table_cells
 
-from kicktimes.stats import format_interval, null_reading, ratio_reading, ratio_verdict
+from kicktimes.stats import (
+    format_interval,
+    margin_of,
+    null_reading,
+    ratio_reading,
+    ratio_verdict,
+    ratio_words,
+)
 
 RESULTS = Path(__file__).resolve().parents[1] / "docs" / "results"
 PAGES = ["README.md", "science.md", "mechanism.md", "escape.md", "unequal.md", "scatter.md"]
@@ -38,12 +45,13 @@ def test_the_science_page_s_ratio_per_radius_is_its_csv_with_its_verdict():
     table = pd.read_csv(RESULTS / "science_stretching.csv")
     kicked = table[table["system"] != "two_particle"]
     for row in kicked.itertuples():
-        assert row.verdict == ratio_verdict(row.ratio_ci_low, row.ratio_ci_high)
+        assert row.verdict == ratio_verdict(row.ratio_ci_low, row.ratio_ci_high,
+                                            tolerance=margin_of("ftle"))
     for r, g in kicked.groupby("radius"):
         cells = table_cells(text, f"{r:g}")
         for k, system in enumerate(("poisson", "poisson_scatter")):
             row = g[g["system"] == system].iloc[0]
-            said = ratio_reading(row.ratio_ci_low, row.ratio_ci_high)
+            said = ratio_words(row.ratio_ci_low, row.ratio_ci_high, tolerance=margin_of("ftle"))
             want = (f"{format_interval(row.ratio, row.ratio_ci_low, row.ratio_ci_high)}, "
                     f"{said}")
             # an inconclusive ratio whose CI contains 1 names the size that would resolve
@@ -278,7 +286,8 @@ def test_the_science_page_pairs_each_closest_kick_law_with_its_own_verdict():
                     if c[:2] == [f"`{family}`", diag])
         for row in best.itertuples():
             assert (f"{row.system} {format_interval(row.ratio, row.ci_low, row.ci_high)}, "
-                    f"{ratio_reading(row.ci_low, row.ci_high)}") in cell.split("; ")
+                    f"{ratio_words(row.ci_low, row.ci_high, tolerance=margin_of(diag))}"
+                    ) in cell.split("; ")
 
 
 def test_no_science_or_mechanism_cell_asks_for_ics_where_its_interval_excludes_the_null():

@@ -76,7 +76,7 @@ def test_the_page_names_the_command_and_quotes_its_csv(built):
     text = page.read_text(encoding="utf-8")
     for row in table[table["system"] != "two_particle"].itertuples():
         assert row.verdict == ratio_verdict(row.ratio_ci_low, row.ratio_ci_high,
-                                            margin_of("ftle"))
+                                            tolerance=margin_of("ftle"))
         assert (f"{format_interval(row.ratio, row.ratio_ci_low, row.ratio_ci_high)}, "
                 f"{row.verdict}") in text
     twins = pd.read_csv(page.parent / "science_independent_twins.csv")

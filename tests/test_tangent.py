@@ -13,7 +13,7 @@ from kicktimes.billiard.kernels.drive_one import tangent_one_kernel
 from kicktimes.billiard.kernels.drive_two import tangent_two_kernel
 from kicktimes.billiard.kernels.twins import ftle_one_kernel
 from kicktimes.diagnostics import Tangent, Twin, lyapunov
-from kicktimes.diagnostics.lyapunov import lyapunov_spectrum
+from kicktimes.diagnostics.spectrum import lyapunov_spectrum
 
 R = 0.05
 RHO, SIG = 1.0 - R, 2.0 * R

@@ -29,12 +29,7 @@ from kicktimes.diagnostics.decorrelation import (
 )
 from kicktimes.diagnostics.ftle_methods import Tangent, Twin
 from kicktimes.diagnostics.gas_lyapunov import DisksLyapunov, disks_lyapunov
-from kicktimes.diagnostics.lyapunov import (
-    LyapunovResult,
-    LyapunovSpectrum,
-    lyapunov,
-    lyapunov_spectrum,
-)
+from kicktimes.diagnostics.lyapunov import LyapunovResult, lyapunov
 from kicktimes.diagnostics.mechanism import (
     RecollisionShare,
     collision_table,
@@ -46,6 +41,7 @@ from kicktimes.diagnostics.mechanism import (
 )
 from kicktimes.diagnostics.recurrence import recurrence_pairs, recurrence_rate
 from kicktimes.diagnostics.rqa import RQAResult, rqa
+from kicktimes.diagnostics.spectrum import LyapunovSpectrum, lyapunov_spectrum
 
 __all__ = [
     "AcfCurve",

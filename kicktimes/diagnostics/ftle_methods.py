@@ -14,6 +14,7 @@ from typing import ClassVar
 
 import numpy as np
 
+from kicktimes._results import Result
 from kicktimes.validation import check_choice, check_int, check_real
 
 __all__ = ["D0_DEFAULT", "D0_RANGE", "OLD_METHOD_KEYWORDS", "TWIN_KICKS", "Tangent", "Twin",
@@ -32,8 +33,8 @@ def _check_bool(name, value) -> bool:
     return bool(value)
 
 
-@dataclass(frozen=True)
-class Tangent:
+@dataclass(frozen=True, repr=False)
+class Tangent(Result):
     """The tangent method of `lyapunov`: exact propagation of tangent vectors (default).
 
     Parameters
@@ -60,6 +61,8 @@ class Tangent:
     ('paper', 2000)
     """
 
+    _title = 'FTLE method: tangent vectors'
+
     name: ClassVar[str] = "tangent"
     variant: str = "norm"
     return_run: bool = False
@@ -69,8 +72,8 @@ class Tangent:
         object.__setattr__(self, "return_run", _check_bool("return_run", self.return_run))
 
 
-@dataclass(frozen=True)
-class Twin:
+@dataclass(frozen=True, repr=False)
+class Twin(Result):
     """Benettin's twin trajectory at distance ``d0``, renormalised at the sample times.
 
     The paper's method; for small enough ``d0`` it converges to the tangent result.
@@ -105,6 +108,8 @@ class Twin:
     >>> res.method, res.d0
     ('twin', 1e-08)
     """
+
+    _title = 'FTLE method: Benettin twin trajectory'
 
     name: ClassVar[str] = "twin"
     d0: float = D0_DEFAULT

@@ -156,7 +156,7 @@ def _twin_offsets(variant: str, d0: float, ok) -> tuple[np.ndarray, np.ndarray]:
     return np.array(offsets), np.array(measure, dtype=np.int64)
 
 
-def _check_status(status: int, horizon: float, max_events: int) -> None:
+def check_kernel_status(status: int, horizon: float, max_events: int) -> None:
     """Turn a kernel's status code into an error naming the inputs."""
     if status == 1:
         raise RuntimeError(
@@ -201,7 +201,7 @@ _PARTS = {"norm": ("the position deviation",), "paper": ("|dx|", "|dy|")}
 def _twin_result(out, variant, d0, horizon, max_events, renormalize=True,
                  tau=None) -> LyapunovResult:
     log_sum, n_renorm, n_forced, n_deferred, t_last, n_pert, status = out
-    _check_status(status, horizon, max_events)
+    check_kernel_status(status, horizon, max_events)
     if not renormalize:
         # eq. (4) as printed: the sum over the n samples divided by n tau
         with np.errstate(invalid="ignore", divide="ignore"):
@@ -244,7 +244,7 @@ def _tangent_result(out, U, cols, variant, horizon, max_events, who) -> Lyapunov
     """``cols``: the (x, y) columns of the tracked disk's position deviation in ``U``;
     ``who`` names that disk in the reason of an undefined exponent."""
     log_scale, n_resc, n_pert, t_end, status = out
-    _check_status(status, horizon, max_events)
+    check_kernel_status(status, horizon, max_events)
     ix, iy = cols
     if variant == "norm":
         meas = [math.hypot(U[0, ix], U[0, iy])]
@@ -719,95 +719,3 @@ def _pass_one(st, state, r, times, angles, kick_u, sp, mode, n_steps, tau, U, va
     res = _tangent_result(out[10:15], U, (0, 1), variant, horizon, max_ev_tan, "the disk")
     _uniform_samples(uniform_out, run, tau, holes, out[17])
     return res, run, None
-
-
-@dataclass(frozen=True)
-class LyapunovSpectrum(Result):
-    """The full Lyapunov spectrum of the two-disk billiard (8 exponents).
-
-    Attributes
-    ----------
-    exponents : numpy.ndarray
-        The 8 exponents, largest first (per unit time).
-    total_time : float
-    n_orthonormalisations : int
-    rule : str
-    """
-
-    _title = "Lyapunov spectrum of the two-disk billiard (8 exponents, largest first)"
-    _summary_fields = ("rule", "total_time", "n_orthonormalisations")
-
-    exponents: np.ndarray
-    total_time: float
-    n_orthonormalisations: int
-    rule: str
-
-    def _summary_extra(self) -> list[str]:
-        values = ", ".join(f"{v:.4g}" for v in np.asarray(self.exponents).tolist())
-        return [f"exponents: {values}", f"sum: {float(np.sum(self.exponents)):.4g}"]
-
-
-def lyapunov_spectrum(ic, r, *, t_max, rule="mirror", every=1.0) -> LyapunovSpectrum:
-    """All 8 Lyapunov exponents of the two-disk billiard (tangent vectors + QR).
-
-    Parameters
-    ----------
-    ic : array_like, shape (2, 4)
-        Two-disk initial condition.
-    r : float
-        Disk radius.
-    t_max : float
-        Horizon (``<= 1e8``).
-    rule : {"mirror", "elastic"}
-    every : float
-        Time between Gram-Schmidt (QR) re-orthonormalisations of the 8 vectors (``> 0``).
-
-    Returns
-    -------
-    LyapunovSpectrum
-
-    Raises
-    ------
-    ValueError
-        Bad input (naming it), and a trajectory with a contact exactly tangent to the
-        wall, where the linearised dynamics is singular (naming ``ic``).
-
-    Notes
-    -----
-    Benettin's QR method on exact tangent vectors: ``U <- Q`` after each interval and
-    ``lambda_i = sum log |R_ii| / T``. Checks: under the elastic rule (Hamiltonian) the
-    exponents come in pairs ``lambda_i + lambda_{9-i} = 0`` and four are zero (time
-    translation, energy, rotation, angular momentum).
-
-    Examples
-    --------
-    >>> from kicktimes import initial_conditions
-    >>> from kicktimes.diagnostics.lyapunov import lyapunov_spectrum
-    >>> ic = initial_conditions(1, 0.03, rng=3)[0]
-    >>> spec = lyapunov_spectrum(ic, 0.03, t_max=200.0, rule="elastic")
-    >>> bool(abs(spec.exponents.sum()) < 1e-6)
-    True
-    """
-    r0, r1, r = chk.check_radii(r)
-    chk.check_choice("rule", rule, chk.RULES)
-    t_max = chk.check_real("t_max", t_max, low=0.0, high=MAX_HORIZON, high_open=False)
-    every = chk.check_real("every", every, low=0.0)
-    ic = check_two_particle_ic(ic, r, rule)
-    st = np.zeros(11)
-    st[1:9] = ic.ravel()
-    st[10] = (ic[:, 2:] ** 2).sum()
-    n = max(1, int(math.ceil(t_max / every)))
-    max_events = int(EVENTS_PER_TIME * t_max) + 10**6
-    U = np.eye(8)
-    sigma = r0 + r1 if isinstance(r, tuple) else 2.0 * r
-    out = tangent_two_kernel(st, kernel_args(ic, r, rule, 1, 1.0, 1, 1.0, 0, None)[1], sigma,
-                             chk.RULES[rule], 1, 1, t_max, U, max_events, n)
-    _check_status(out[4], t_max, max_events)
-    if not np.isfinite(out[0]).all():
-        raise ValueError(
-            "ic: the linearised dynamics is singular along this trajectory (a contact exactly "
-            "tangent to the wall, v.n = 0, e.g. a disk starting on the wall with a tangential "
-            "velocity): the Lyapunov spectrum is undefined"
-        )
-    return LyapunovSpectrum(exponents=np.sort(out[0] / t_max)[::-1], total_time=t_max,
-                            n_orthonormalisations=n, rule=rule)

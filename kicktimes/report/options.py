@@ -5,13 +5,14 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from kicktimes._results import Result
 from kicktimes.validation import check_int
 
 __all__ = ["Render", "Subsampling"]
 
 
-@dataclass(frozen=True)
-class Render:
+@dataclass(frozen=True, repr=False)
+class Render(Result):
     """How `build_report` writes its figures.
 
     Parameters
@@ -28,6 +29,8 @@ class Render:
     Render(dpi=110, pdf=True)
     """
 
+    _title = 'Figure options of build_report'
+
     dpi: int = 150
     pdf: bool = False
 
@@ -37,8 +40,8 @@ class Render:
             raise TypeError(f"pdf must be True or False, got {type(self.pdf).__name__}")
 
 
-@dataclass(frozen=True)
-class Subsampling:
+@dataclass(frozen=True, repr=False)
+class Subsampling(Result):
     """How far `build_report`'s tests and fits subsample a store (every subsampling is
     listed in the report).
 
@@ -59,6 +62,8 @@ class Subsampling:
     >>> Subsampling(max_ics_model_fits=2)
     Subsampling(max_ics_tests=None, max_ics_model_fits=2, max_pooled_intervals=200000)
     """
+
+    _title = 'Subsampling options of build_report'
 
     max_ics_tests: int | None = None
     max_ics_model_fits: int = 12

@@ -295,8 +295,7 @@ def first_screen(table: pd.DataFrame) -> list[str]:
     lines += ["Every diagnostic by kick law (family A, primary, each at its margin: "
               f"±{100 * margin_of('ftle'):g} % for the FTLE, ±{100 * margin_of('rr_offdiag'):g} "
               f"% for the off-diagonal RR, ±{100 * MARGIN:g} % otherwise; ✓ robust over every "
-              "control and both families, ✗ the first control that changes it; ≲ margin: the "
-              "CI lies on one side of 1 but reaches into the band, a departure of about the "
-              "margin or less; "
+              "control and both families, ✗ the first control that changes it; ≲ margin: a "
+              "CI on one side of 1 that reaches into the band; "
               "every cell with both numbers: [overview.csv](overview.csv)):", ""]
     return lines + markdown_table(compact_overview(table)) + [""]

@@ -232,12 +232,10 @@ def copy_first_screen(page, target):
 #: this page, so the paper study needs no other study (the protocol study reads this one's
 #: findings tables, and runs after it)
 PROTOCOL_POINTER = [
-    "The FTLE here is kicktimes' tangent-space exponent (the paper's variant: the larger of "
-    "the x- and y-perturbation exponents); the paper's claims read by its "
-    "own protocol (its eq. (4) as printed, which never renormalises its twins) are on "
-    "[paper.md](paper.md), measured on its own runs (its panels' ICs and steps, the RR at "
-    "the paper's ε on the paper's steps); each of its lines quotes this page's number beside "
-    "its own."]
+    "The FTLE is the tangent-space exponent (the paper's variant: the larger of the x- and "
+    "y-perturbation exponents). [paper.md](paper.md) reads the paper's claims by its own "
+    "protocol (eq. (4) as printed, which never renormalises its twins) on its own runs, "
+    "and quotes this page's numbers beside its own."]
 
 
 def results_sources(findings, families, by_radius, *, gaps, nulls):
@@ -483,8 +481,7 @@ def write_results(
                   if family_figures else "")
                + ". The other studies: [science.md](science.md), [mechanism.md](mechanism.md),"
                " [escape.md](escape.md), [unequal.md](unequal.md), [scatter.md](scatter.md), "
-               "[mmpp.md](mmpp.md), [disks.md](disks.md), [paper.md](paper.md) (`kicktimes "
-               "reproduce --study NAME`).", ""]
+               "[mmpp.md](mmpp.md), [disks.md](disks.md), [paper.md](paper.md).", ""]
     below = [f"{name}: {scale}" for name, paper, scale, *_ in details_args if not paper]
     if below:  # the page's answers stand on stores below the paper's scale: it says so first
         screen = [f"> **Below paper scale** ({'; '.join(below)}): a pipeline check; its "
