@@ -191,37 +191,34 @@ def _poisson_line(table) -> str | None:
             f"{_pct(share)} of runs reject uniformity (null {level})")
     if excess is not None:
         text += f", D − null {_ci(excess)}"
-    text += f" ({family_short(family)}{', robust over rule × ICs' if robust else ''})"
+    text += f" ({family_short(family)}{'; robust: rule × ICs' if robust else ''})"
     e_share = _one(rows, diagnostic=f"reject@{HEADLINE_TEST}", family=family, control="elastic")
     e_excess = _one(rows, diagnostic="dispersion_index_excess", family=family,
                     control="elastic")
     if e_share is not None:
         text += (f"; elastic {_pct(e_share)}"
-                 + (f", D − null {_ci(e_excess)}" if e_excess is not None else ""))
+                 + (f" and {_ci(e_excess)}" if e_excess is not None else ""))
     return text + _sign_flips(rows, family) + "."
 
 
 def _sign_flips(rows, family) -> str:
-    """``"; the first hazard bin changes sign with the rule (table below)"``: the
-    statistics whose departure from their null lies on one side under the primary rule
-    and on the other under the elastic rule (both not Poisson, in opposite directions)."""
-    from kicktimes.stats import side_of
-
+    """``"; the first hazard bin flips sign with the rule"``: the statistics read beyond
+    their margin above their null under the primary rule and below it under the elastic
+    rule, or the reverse (not Poisson both, in opposite directions: `null_verdict`)."""
     names = {"hazard_first_excess": "the first hazard bin", "gamma_shape_excess":
              "the gamma shape"}
+    beyond = {"above its null", "below its null"}
     flips = []
     for diagnostic, name in names.items():
         p = _one(rows, diagnostic=diagnostic, family=family, control="primary")
         e = _one(rows, diagnostic=diagnostic, family=family, control="elastic")
         if p is None or e is None:
             continue
-        sides = side_of(p.ci_low, p.ci_high, null=0.0), side_of(e.ci_low, e.ci_high, null=0.0)
-        if None not in sides and sides[0] != sides[1]:
+        if {p.verdict, e.verdict} == beyond:
             flips.append(name)
     if not flips:
         return ""
-    return (f"; {' and '.join(flips)} {'change' if len(flips) > 1 else 'changes'} sign "
-            "with the rule (table below)")
+    return f"; {' and '.join(flips)} flip{'' if len(flips) > 1 else 's'} sign with the rule"
 
 
 def _null_share(row) -> str:
