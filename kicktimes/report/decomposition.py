@@ -400,9 +400,15 @@ def gap_summary(table: pd.DataFrame) -> pd.DataFrame:
                 first = side if first is None else first
                 if verdict:
                     break
+            values = part.loc[part["quantity"] == step, "estimate"]
             if verdict is None:
-                values = part.loc[part["quantity"] == step, "estimate"]
                 verdict = f"sign ✓ ({values.min():.2g} to {values.max():.2g})"
+            elif verdict.endswith("other sign"):
+                # a share whose sign changes with the control has no size to quote: the
+                # range over the controls, not the primary's interval
+                row[step] = (f"sign depends on the control ({values.min():.2g} to "
+                             f"{values.max():.2g})")
+                verdict = f"✗ {verdict[2:].split(':')[0]}"
             row[f"{step} robust"] = verdict
         rows.append(row)
     return pd.DataFrame(rows)

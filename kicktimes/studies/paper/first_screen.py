@@ -14,7 +14,7 @@ import numpy as np
 import pandas as pd
 
 from kicktimes.render.pages import markdown_table
-from kicktimes.report.answers import CONTROL_WORDS, SCREEN_ROWS, family_short
+from kicktimes.report.answers import SCREEN_ROWS, family_short
 from kicktimes.report.controls import LOWER, POISSON_QUESTION
 from kicktimes.stats import MARGIN, format_interval, margin_of, ratio_verdict, side_of
 
@@ -29,7 +29,7 @@ QUESTIONS = (
      "ftle", ("poisson", "actual")),
     ("Do scatter kicks (virtual partners) give the two-disk FTLE?", "ftle",
      ("poisson_scatter", "actual_scatter", "poisson_kinetic")),
-    ("Does it decorrelate like the two disks (1 − R₁ at lag 1)?",
+    ("Does it decorrelate like the two disks (1 − R₁ at lag 1, over n steps)?",
      "one_minus_r1", ("poisson", "actual")),
     ("Does it have the two-disk off-diagonal recurrence rate (ε = 10⁻²)?", "rr_offdiag@0.01",
      ("poisson", "actual")),
@@ -125,20 +125,22 @@ def _ratio_line(question, rows, margin=MARGIN) -> str:
                      f"; robust in direction over {over} ({_range(rows)}), not in size: "
                      f"{far.estimate:.3g} ({_cell(far)})")
     else:
-        other = rows[rows["verdict"] != primary.verdict]
-        # the control that decides: the findings table's own (`with_robustness`: an
-        # interval on the other side of 1 first), else the one that changes most cells
-        named_first = [c.strip() for c in str(primary.depends_on or "").split(",")
-                       if c.strip() in set(other["control"])]
-        control = (named_first or list(other["control"].value_counts().index))[0]
-        c = other[other["control"] == control].iloc[0]
-        named = CONTROL_WORDS.get(control, control)
-        text = (f"**{question}** depends on {named}{at}: "
-                f"{_read(primary)} {_ci(primary)} {where} under the primary, {_read(c)} "
-                f"{_ci(c)}"
-                + ("" if (c.family, c.system) == (family, system) else
-                   f" ({family_short(c.family)}, {_KICKS.get(c.system, c.system)})")
-                + f" under {named}")
+        # every control of the line's own cell (family, kick law) whose verdict differs,
+        # grouped by verdict: no control that changes it is left unnamed
+        cell = rows[(rows["family"] == family) & (rows["system"] == system)]
+        other = cell[cell["verdict"] != primary.verdict]
+        if other.empty:  # the cell agrees with itself; another family or law differs
+            other = rows[rows["verdict"] != primary.verdict]
+        groups = []
+        for _, g in other.groupby("verdict", sort=False):
+            names = ", ".join(_CONTROL_SHORT.get(c, c) if (f, k) == (family, system) else
+                              f"{family_short(f)} {_CONTROL_SHORT.get(c, c)}"
+                              for f, k, c in zip(g["family"], g["system"], g["control"],
+                                                 strict=True))
+            numbers = _ci(g.iloc[0]) if len(g) == 1 else _range(g)
+            groups.append(f"{_read(g.iloc[0])} {numbers} under {names}")
+        text = (f"**{question}** depends on the control{at}: {_read(primary)} "
+                f"{_ci(primary)} {where} under the primary; " + "; ".join(groups))
     below = int((rows["ci_high"] < 1).sum())
     if primary.verdict.startswith("within") and below:
         text += f"; CI below 1 in {below} of {len(rows)} cells"
@@ -205,7 +207,7 @@ def _sign_flips(rows, family) -> str:
     """``"; the first hazard bin flips sign with the rule"``: the statistics read beyond
     their margin above their null under the primary rule and below it under the elastic
     rule, or the reverse (not Poisson both, in opposite directions: `null_verdict`)."""
-    names = {"hazard_first_excess": "the first hazard bin", "gamma_shape_excess":
+    names = {"hazard_first_excess": "the short-interval hazard", "gamma_shape_excess":
              "the gamma shape"}
     beyond = {"above its null", "below its null"}
     flips = []
@@ -270,10 +272,11 @@ def compact_overview(table: pd.DataFrame) -> pd.DataFrame:
                 continue
             robust = (rows["robust"].astype(str).str.lower().eq("true").all()
                       and rows["verdict"].nunique() == 1)
-            # the control that changes it: the findings table's own (`with_robustness`)
-            deciding = [c.strip() for c in str(p.depends_on or "").split(",") if c.strip()]
-            deciding = deciding[:1] or _deciding(rows, p.verdict)[:1]
-            mark = "✓" if robust else "✗ " + "".join(_CONTROL_SHORT.get(c, c) for c in deciding)
+            # every control that changes it (most cells first): none is hidden behind
+            # the first
+            deciding = _deciding(rows, p.verdict)
+            mark = "✓" if robust else "✗ " + ", ".join(_CONTROL_SHORT.get(c, c)
+                                                       for c in deciding[:3])
             line[_KICKS[system]] = f"{_word(p.verdict, p, short=True)} {p.estimate:.3g} {mark}"
         out.append(line)
     return pd.DataFrame(out)
@@ -292,7 +295,7 @@ def first_screen(table: pd.DataFrame) -> list[str]:
     lines += ["Every diagnostic by kick law (family A, primary, each at its margin: "
               f"±{100 * margin_of('ftle'):g} % for the FTLE, ±{100 * margin_of('rr_offdiag'):g} "
               f"% for the off-diagonal RR, ±{100 * MARGIN:g} % otherwise; ✓ robust over every "
-              "control and both families, ✗ the first control that changes it; ≲ margin: a "
+              "control and both families, ✗ the controls that change it; ≲ margin: a "
               "CI on one side of 1 that reaches into the band; "
               "every cell with both numbers: [overview.csv](overview.csv)):", ""]
     return lines + markdown_table(compact_overview(table)) + [""]

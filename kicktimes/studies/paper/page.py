@@ -53,7 +53,7 @@ def poisson_section(table, calibrated=False):
     labels = {"share": f"{HEADLINE_TEST} share (vs its null streams' level)",
               "others": "other tests above their level",
               "dispersion_index_excess": "D − null D (within-run dispersion)",
-              "hazard_first_excess": "first hazard bin − its null",
+              "hazard_first_excess": "hazard at t < 0.1 mean intervals − its null",
               "gamma_shape_excess": "gamma shape − its null",
               "standard": "one standard (`poisson_verdict`)"}
     frame = {"": list(labels.values())}
@@ -82,7 +82,7 @@ def poisson_section(table, calibrated=False):
         "## Are the collision times Poisson? The collision rule as a factor", "",
         *markdown_table(pd.DataFrame(frame)), "",
         f"A share is read against {level} (`rejection_verdict`: above nominal beyond 1.5 "
-        f"times it); D, the first hazard bin (intervals below 0.1 mean intervals) and the "
+        f"times it); D, the hazard at t < 0.1 mean intervals and the "
         f"gamma shape against the same statistic on those streams (`null_verdict`, ±{D_MARGIN:g} "
         f"for D, ±{SHAPE_MARGIN:g} otherwise). Every test and control: "
         "[family_a_findings.csv](family_a_findings.csv).", ""]

@@ -220,7 +220,8 @@ def _first_screen(claims: pd.DataFrame, rr_tab: pd.DataFrame,
         + (f", the README's tangent FTLE on the paper study's runs {_span(readme['ftle'])}"
            if "ftle" in readme else "") + ".",
         f"- **ACF (Fig. 8)** {_answer(acf)}: R₁ ratio {_span(acf)}, CIs in {_envelope(acf)}, "
-        f"but R₁ is {_span(r1, 'mean')} everywhere; 1 − R₁ over t ≤ nτ "
+        f"but R₁ is {_span(r1, 'mean')} everywhere, so the ratio leaves the band only if the "
+        "kicked R₁ falls below 0.9 of the two-disk's; 1 − R₁ over t ≤ nτ "
         f"{_span(acf, 'other_estimate')} ({_verdicts(acf, 'other_verdict')}).",
         f"- **Poisson vs actual (Sec. IV)** {_answer(closer)}: {_short(closer)} (m = "
         f"{CLOSER_MARGIN:g}), |d| = {_span(closer['estimate'].abs())}, CIs in "

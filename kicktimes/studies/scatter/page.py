@@ -106,12 +106,12 @@ def write_page(df, tab, command, source, over):
         g = g.set_index("ratio")
         lines.append(f"| {r:g} | " + " | ".join(
             f"{format_interval(g.loc[x, 'estimate'], g.loc[x, 'ci_low'], g.loc[x, 'ci_high'])}"
-            f", {g.loc[x, 'verdict']}" for x in labels) + " |")
+            f", {g.loc[x, 'verdict_fine']}" for x in labels) + " |")
     lines.append("")
-    for label in labels:
+    for label in labels:  # at the page's margin, FINE_MARGIN (the 10 % verdicts: the CSV)
         both = tab[tab["ratio"] == label]
-        counts = main[main["ratio"] == label]["verdict"].value_counts()
-        changed = (both.pivot(index="radius", columns="ics", values="verdict")
+        counts = main[main["ratio"] == label]["verdict_fine"].value_counts()
+        changed = (both.pivot(index="radius", columns="ics", values="verdict_fine")
                    .nunique(axis=1) > 1).sum()
         lines.append(f"- {label}: " + ", ".join(
             f"{v} at {k} radi{'us' if k == 1 else 'i'}"

@@ -48,7 +48,8 @@ def ratio_table(df, n_boot=1000, seed=0):
                 lo, hi = percentile_interval(q[1:])
                 rows.append({"ics": ics, "radius": r, "n": len(g), "ratio": label,
                              "estimate": q[0], "ci_low": lo, "ci_high": hi,
-                             "verdict": ratio_verdict(lo, hi, tolerance=MARGIN)})
+                             "verdict": ratio_verdict(lo, hi, tolerance=MARGIN),
+                             "verdict_fine": ratio_verdict(lo, hi, tolerance=FINE_MARGIN)})
     return pd.DataFrame(rows)
 
 

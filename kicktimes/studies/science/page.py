@@ -124,9 +124,9 @@ def _ratio_cell(x, lo, hi, n, unit="ICs", tolerance=MARGIN):
     return text
 
 
-def _readings(frame, low="ci_low", high="ci_high"):
+def _readings(frame, low="ci_low", high="ci_high", tolerance=MARGIN):
     """The `ratio_words` of every row of ``frame``."""
-    return frame.apply(lambda x: ratio_words(x[low], x[high], tolerance=MARGIN), axis=1)
+    return frame.apply(lambda x: ratio_words(x[low], x[high], tolerance=tolerance), axis=1)
 
 
 def _verdict_counts(verdicts):
@@ -161,7 +161,8 @@ def first_screen(per_radius, trend, twins, compare, windows, whole, *, n_ics, n_
         agree = _trend_agrees(g, tr, tc)
         lines.append(
             f"- **{name[0].upper()}{name[1:]}, FTLE / two-disk FTLE**: "
-            f"{_verdict_counts(g['verdict'])} of {len(g)} radii ({lo_r:g}–{hi_r:g}); at "
+            f"{_verdict_counts(_readings(g, 'ratio_ci_low', 'ratio_ci_high', margin_of('ftle')))}"
+            f" of {len(g)} radii ({lo_r:g}–{hi_r:g}); at "
             f"r = {lo_r:g}: "
             f"{reading_text(row.ratio, row.ratio_ci_low, row.ratio_ci_high, margin_of('ftle'))}; "
             "caveat: " + (f"the ratio {tr.verdict} towards 1 as r falls (both trend measures)"

@@ -185,9 +185,10 @@ def write_page(table, params, command, source):
             ("ftle_partner_ratio_disk1", "ftle_partner_low_disk1", "ftle_partner_high_disk1"),
             ("ftle_own_ratio_disk1", "ftle_own_low_disk1", "ftle_own_high_disk1")]
 
-    def cell(row, c):
+    def cell(row, c):  # the FTLE at the page's margin, FINE_MARGIN; the rate at MARGIN
+        margin = MARGIN if c[0] == "rate_ratio" else FINE_MARGIN
         return (f"{format_interval(row[c[0]], row[c[1]], row[c[2]])}, "
-                f"{ratio_reading(row[c[1]], row[c[2]], tolerance=MARGIN)}")
+                f"{ratio_reading(row[c[1]], row[c[2]], tolerance=margin)}")
 
     for _, row in table.iterrows():
         rate = cell(row, ("rate_ratio", "rate_low", "rate_high"))
@@ -204,7 +205,8 @@ def write_page(table, params, command, source):
     for c, name in ((("rate_ratio", "rate_low", "rate_high"), "collision rate / kinetic rate"),
                     (cols[0], "small disk, partner of the other disk's size"),
                     (cols[2], "large disk, partner of the other disk's size")):
-        v = [ratio_reading(lo, hi, tolerance=MARGIN) for lo, hi in zip(table[c[1]], table[c[2]],
+        margin = MARGIN if c[0] == "rate_ratio" else FINE_MARGIN
+        v = [ratio_reading(lo, hi, tolerance=margin) for lo, hi in zip(table[c[1]], table[c[2]],
                                                              strict=True)]
         counts = pd.Series(v).value_counts()
         odd = [f"ratio {x:g}: {vv}" for x, vv in zip(table["size_ratio"], v, strict=True)
