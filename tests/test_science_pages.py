@@ -81,8 +81,8 @@ def test_the_unequal_page_gives_every_ratio_the_verdict_of_its_interval():
     for row in table.itertuples():
         cells = table_cells(text, f"{row.size_ratio:g}")
         want = (f"{format_interval(row.ftle_partner_ratio_disk0, row.ftle_partner_low_disk0, row.ftle_partner_high_disk0)}, "  # noqa: E501
-                f"{ratio_reading(row.ftle_partner_low_disk0, row.ftle_partner_high_disk0)}")
-        assert cells[4] == want
+                f"{ratio_reading(row.ftle_partner_low_disk0, row.ftle_partner_high_disk0, tolerance=0.05)}")  # noqa: E501
+        assert cells[4] == want  # the FTLE at the page's margin, 5 %
     assert "within 10 % … at every ratio" not in text
 
 
@@ -91,12 +91,13 @@ def test_the_scatter_page_is_its_csv_and_no_longer_decomposes_the_gap():
     table = pd.read_csv(RESULTS / "scatter_ratios.csv")
     for row in table.itertuples():
         assert row.verdict == ratio_verdict(row.ci_low, row.ci_high)
+        assert row.verdict_fine == ratio_verdict(row.ci_low, row.ci_high, tolerance=0.05)
     main = table[table["ics"] == "without sticky ICs"]
     for r, g in main.groupby("radius"):
         cells = table_cells(text, f"{r:g}")
         first = g.iloc[0]
         assert cells[1] == (f"{format_interval(first.estimate, first.ci_low, first.ci_high)}, "
-                            f"{first.verdict}")
+                            f"{first.verdict_fine}")  # the page's margin, 5 %
     assert "almost all" not in text.lower()
 
 

@@ -84,7 +84,7 @@ def _word(verdict, row=None, short=False) -> str:
     less, not an unresolved one."""
     side = side_of(row.ci_low, row.ci_high) if row is not None else None
     if verdict == "inconclusive" and side:
-        return f"{side} 1, ≲ margin" if short else f"{side} 1 by about the margin or less"
+        return f"just {side} 1" if short else f"{side} 1 by about the margin or less"
     return ("yes, " + verdict) if verdict.startswith("within") else _WORDS.get(verdict, verdict)
 
 
@@ -277,7 +277,8 @@ def compact_overview(table: pd.DataFrame) -> pd.DataFrame:
             deciding = _deciding(rows, p.verdict)
             mark = "✓" if robust else "✗ " + ", ".join(_CONTROL_SHORT.get(c, c)
                                                        for c in deciding[:3])
-            line[_KICKS[system]] = f"{_word(p.verdict, p, short=True)} {p.estimate:.3g} {mark}"
+            word = _word(p.verdict, p, short=True).removeprefix("no, ").removeprefix("yes, ")
+            line[_KICKS[system]] = f"{word} {p.estimate:.3g} {mark}"
         out.append(line)
     return pd.DataFrame(out)
 
@@ -295,7 +296,7 @@ def first_screen(table: pd.DataFrame) -> list[str]:
     lines += ["Every diagnostic by kick law (family A, primary, each at its margin: "
               f"±{100 * margin_of('ftle'):g} % for the FTLE, ±{100 * margin_of('rr_offdiag'):g} "
               f"% for the off-diagonal RR, ±{100 * MARGIN:g} % otherwise; ✓ robust over every "
-              "control and both families, ✗ the controls that change it; ≲ margin: a "
-              "CI on one side of 1 that reaches into the band; "
+              "control and both families, ✗ the controls that change it; just below 1: a "
+              "CI below 1 that reaches into the band; "
               "every cell with both numbers: [overview.csv](overview.csv)):", ""]
     return lines + markdown_table(compact_overview(table)) + [""]
