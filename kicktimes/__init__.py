@@ -7,6 +7,7 @@ collisions, and randomly kicked one-disk billiards driven by those times
 The main entry points::
 
     from kicktimes import simulate_two_particle, simulate_one_particle, initial_conditions
+    from kicktimes import KickLaw                         # a kicked disk's kick law
     from kicktimes import simulate_disks, initial_state   # N disks (docs/disks.md)
     from kicktimes import schedules, stats, diagnostics
 
@@ -31,6 +32,7 @@ _LAZY_ATTRS = {
     "DisksRun": ("kicktimes.billiard.disks_run", "DisksRun"),
     "DisksPressure": ("kicktimes.billiard.disks_run", "DisksPressure"),
     "box_side": ("kicktimes.billiard.disk_states", "box_side"),
+    "KickLaw": ("kicktimes.billiard.kick_law", "KickLaw"),
 }
 _LAZY_MODULES = {"billiard", "schedules", "stats", "diagnostics", "experiment", "plots", "report"}
 

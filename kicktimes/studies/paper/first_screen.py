@@ -31,7 +31,7 @@ QUESTIONS = (
      ("poisson_scatter", "actual_scatter", "poisson_kinetic")),
     ("Does it decorrelate like the two disks (1 − R₁ at lag 1, over n steps)?",
      "one_minus_r1", ("poisson", "actual")),
-    ("Does it have the two-disk off-diagonal recurrence rate (ε = 10⁻²)?", "rr_offdiag@0.01",
+    ("Does it have the two-disk off-diagonal RR (ε = 10⁻²)?", "rr_offdiag@0.01",
      ("poisson", "actual")),
 )
 POISSON_LINE = "Are the two disks' collision times Poisson?"
