@@ -101,20 +101,6 @@ def check_kick_angles(kick_angles, times: np.ndarray, kick_angle: str,
     return angles
 
 
-
-
-def _is_schedule(kicks) -> bool:
-    """A kick schedule: a `Schedule`, or any object with a ``sample`` method that is not
-    array-like (a pandas Series has a ``sample`` method too, but it holds times)."""
-    from kicktimes.schedules import Schedule
-
-    if isinstance(kicks, Schedule):
-        return True
-    if isinstance(kicks, np.ndarray) or hasattr(kicks, "__array__") or hasattr(kicks, "__len__"):
-        return False
-    return callable(getattr(kicks, "sample", None))
-
-
 def _is_kinetic(kicks) -> bool:
     from kicktimes.schedules import KineticRate
 
