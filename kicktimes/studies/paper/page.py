@@ -143,7 +143,8 @@ def _open_gaps(gaps) -> str:
             and a * b < 0 for r in g.itertuples())
         parts.append(f"the {diagnostic} gap: left {values}"
                      + ("; its deflection and timing shares cancel" if cancel else ""))
-    return "Nothing here closes " + "; nor ".join(parts) + "."
+    return ("The kinetic-rate factorial closes none of " + "; nor ".join(parts)
+            + " (the actual-times factorial's shares: gap_decomposition.csv).")
 
 
 def counts_section(table):
