@@ -34,8 +34,9 @@ Every interval is a percentile bootstrap clustered on ICs: one resample draws IC
 with replacement and applies them at every radius and to every system (the same IC is
 the same initial condition everywhere), so the correlation of one IC across radii and
 systems is kept. Verdicts use each diagnostic's band (:func:`kicktimes.stats.ratio_verdict`
-with :func:`kicktimes.stats.margin_of`: ±5 % for the FTLE, ±3 % for the off-diagonal RR, ±10 %
-otherwise): *within* when the whole 95 % interval lies in the band, *higher* / *lower*
+with :func:`kicktimes.stats.margin_of`: ±5 % for the FTLE, ±3 % for the off-diagonal RR,
+±2.5 % for the counts, ±10 % otherwise): *within* when the whole 95 % interval lies in the
+band, *higher* / *lower*
 when it lies entirely above / below it, *inconclusive* otherwise. A comparison is *robust*
 (:func:`kicktimes.stats.robust_verdict`) only when every control gives the same verdict and
 no control's interval lies above 1 while another's lies below 1; otherwise it *depends on*

@@ -74,6 +74,7 @@ from .gof import GofResult, goodness_of_fit
 from .groups import PoissonGroup, poisson_group, pooled_intervals
 from .hazard import HazardTable, interval_hazard
 from .kinetic import conditional_kinetic_rate, mean_kinetic_rate
+from .margins import COUNTS_MARGIN
 from .mixture import RateMixture, rate_mixture, simulate_cox_times
 from .mmpp import (
     MMPP_MIN_EVENTS,
@@ -172,6 +173,7 @@ __all__ = [
     "FINE_MARGIN",
     "DIAGNOSTIC_MARGINS",
     "RR_MARGIN",
+    "COUNTS_MARGIN",
     "margin_of",
     "null_reading",
     "ratio_reading",

@@ -275,8 +275,8 @@ def compact_overview(table: pd.DataFrame) -> pd.DataFrame:
             # every control that changes it (most cells first): none is hidden behind
             # the first
             deciding = _deciding(rows, p.verdict)
-            mark = "✓" if robust else "✗ " + ", ".join(_CONTROL_SHORT.get(c, c)
-                                                       for c in deciding[:3])
+            mark = "✓" if robust else ("✗↕ " if _sides(rows) else "✗ ") + ", ".join(
+                _CONTROL_SHORT.get(c, c) for c in deciding[:3])
             word = _word(p.verdict, p, short=True).removeprefix("no, ").removeprefix("yes, ")
             line[_KICKS[system]] = f"{word} {p.estimate:.3g} {mark}"
         out.append(line)
@@ -296,7 +296,7 @@ def first_screen(table: pd.DataFrame) -> list[str]:
     lines += ["Every diagnostic by kick law (family A, primary, each at its margin: "
               f"±{100 * margin_of('ftle'):g} % for the FTLE, ±{100 * margin_of('rr_offdiag'):g} "
               f"% for the off-diagonal RR, ±{100 * MARGIN:g} % otherwise; ✓ robust over every "
-              "control and both families, ✗ the controls that change it; just below 1: a "
-              "CI below 1 that reaches into the band; "
+              "control and both families, ✗ the controls that change it (↕: CIs on both "
+              "sides of 1); just below 1: a CI below 1 that reaches into the band; "
               "every cell with both numbers: [overview.csv](overview.csv)):", ""]
     return lines + markdown_table(compact_overview(table)) + [""]

@@ -20,7 +20,7 @@ from kicktimes import __version__
 from kicktimes.fileio import atomic_write_bytes
 from kicktimes.report.context import Context, Mapper, Progress
 from kicktimes.report.store import load_report_store
-from kicktimes.stats import format_interval
+from kicktimes.stats import format_interval, margin_of
 from kicktimes.validation import check_int
 
 __all__ = ["PROTOCOL_POINTER", "copy_first_screen", "counts_section", "poisson_section",
@@ -155,7 +155,8 @@ def counts_section(table):
         return []
     return ["## Do the collision counts follow kinetic theory?", "",
             "Observed two-disk collisions over the kinetic-theory count Γ(r)T (the rule's own "
-            "Γ), 95 % CI (bootstrap clustered on ICs)." + "".join(_counts_reading(rows))
+            f"Γ), 95 % CI (bootstrap clustered on ICs), at a ±{100 * margin_of('counts'):g} % "
+            "margin." + "".join(_counts_reading(rows))
             + " Every control: the findings CSVs (diagnostic `counts`).", ""]
 
 
@@ -168,13 +169,17 @@ def _counts_reading(rows) -> list[str]:
         if not {"primary", "sticky_excluded"} <= set(by.index):
             continue
         p, k = by.loc["primary"], by.loc["sticky_excluded"]
+
+        def said(row):  # at the counts' own margin (`margin_of("counts")`)
+            return row.get("verdict_at_margin", row.verdict)
+
         text = (f"{_short(family)}: {format_interval(p.estimate, p.ci_low, p.ci_high)} "
-                f"({p.verdict}), without the sticky runs "
-                f"{format_interval(k.estimate, k.ci_low, k.ci_high)} ({k.verdict})")
+                f"({said(p)}), without the sticky runs "
+                f"{format_interval(k.estimate, k.ci_low, k.ci_high)} ({said(k)})")
         if "elastic" in by.index:
             e = by.loc["elastic"]
             text += (f", elastic {format_interval(e.estimate, e.ci_low, e.ci_high)}"
-                     f" ({e.verdict})")
+                     f" ({said(e)})")
         text += _counts_robustness(part)
         out.append(text)
     return [" " + "; ".join(out) + "."] if out else []
