@@ -154,10 +154,9 @@ def counts_section(table):
     if rows.empty:
         return []
     return ["## Do the collision counts follow kinetic theory?", "",
-            "Observed two-disk collisions over the kinetic-theory count Γ(r)T (the rule's own "
-            f"Γ), 95 % CI (bootstrap clustered on ICs), at a ±{100 * margin_of('counts'):g} % "
-            "margin." + "".join(_counts_reading(rows))
-            + " Every control: the findings CSVs (diagnostic `counts`).", ""]
+            "Observed two-disk collisions over the kinetic-theory count Γ(r)T (95 % CIs), at a "
+            f"±{100 * margin_of('counts'):g} % margin." + "".join(_counts_reading(rows))
+            + " Every control: the findings CSVs.", ""]
 
 
 def _counts_reading(rows) -> list[str]:
@@ -450,8 +449,8 @@ def write_results(
     screen += [
         "![headline](headline_ratios_vs_radius.png)", "",
         "Kicked / two-disk ratio of ensemble means against r (the paper's two uniform kicks "
-        "and the scatter kick; 95 % CIs clustered on ICs; grey: the diagnostic's band; every "
-        "kick law: the findings_by_radius CSVs). Verdicts (`ratio_verdict` at `margin_of`) "
+        "and the scatter kick; 95 % CIs clustered on ICs; grey: the diagnostic's band). "
+        "Verdicts (`ratio_verdict` at `margin_of`) "
         "and robustness (one verdict under every control, no two CIs on opposite sides of "
         "1): [definitions](../definitions.md#margins-and-nulls). "
         + PROTOCOL_POINTER[0], ""]
@@ -469,7 +468,7 @@ def write_results(
         screen += gap_section(gaps)
     screen += counts_section(table)
     screen += ["## More", "",
-               "Per family, every statement and figure: "
+               "Per family: "
                + ", ".join(f"[{d}.md]({d}.md)" for d in details)
                + "".join(f" ([both families]({f}.png))" for f, _ in family_figures)
                + ". The other studies: [science.md](science.md), [mechanism.md](mechanism.md),"
