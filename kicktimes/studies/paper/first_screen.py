@@ -298,5 +298,5 @@ def first_screen(table: pd.DataFrame) -> list[str]:
               f"% for the off-diagonal RR, ±{100 * MARGIN:g} % otherwise; ✓ robust over every "
               "control and both families, ✗ the controls that change it (↕: CIs on both "
               "sides of 1); just below 1: a CI below 1 that reaches into the band; "
-              "every cell with both numbers: [overview.csv](overview.csv)):", ""]
+              "every cell's numbers: [overview.csv](overview.csv)):", ""]
     return lines + markdown_table(compact_overview(table)) + [""]

@@ -113,7 +113,8 @@ def gap_section(gaps):
         *markdown_table(shown), "",
         "Shapley shares of |log(kicked / two-disk)| closed by the deflection law and by the "
         "timing (two 2 × 2 factorials), 95 % CIs clustered on ICs; sign ✓: the same sign "
-        "under every control (their range beside); 'left' = 1 − both shares. "
+        "under every control (their range beside); 'left' = 1 − both shares (a share beyond "
+        "[0, 1]: the two factors interact, not add). "
         + (open_gaps + " " if open_gaps else "")
         + "Not decomposed (no gap beyond the margin under some control): "
         + ", ".join(dict.fromkeys(summary.loc[[not g for g in robust_gap], "diagnostic"]))
@@ -450,9 +451,8 @@ def write_results(
         "![headline](headline_ratios_vs_radius.png)", "",
         "Kicked / two-disk ratio of ensemble means against r (the paper's two uniform kicks "
         "and the scatter kick; 95 % CIs clustered on ICs; grey: the diagnostic's band). "
-        "Verdicts (`ratio_verdict` at `margin_of`) "
-        "and robustness (one verdict under every control, no two CIs on opposite sides of "
-        "1): [definitions](../definitions.md#margins-and-nulls). "
+        "Verdicts (`ratio_verdict` at `margin_of`) and robustness: "
+        "[definitions](../definitions.md#margins-and-nulls). "
         + PROTOCOL_POINTER[0], ""]
     if nulls:
         from kicktimes.render.pages import write_null_calibration
