@@ -53,7 +53,11 @@ RR_SAMPLINGS = ("run", "uniform", "run+uniform")
 #: single ``eps`` as a float, as before), so stores written before the field existed keep
 #: their hash and still load. Their results simply lack the rows added since.
 _LATER_FIELDS = {"acf_max_lag": 20, "rr_sampling": "run", "lyapunov_method": "twin",
-                 "holes": [], "partner_ratio": 1.0, "partner_mass": 1.0}
+                 "holes": [], "partner_ratio": 1.0, "partner_mass": 1.0, "log_events": True}
+#: the systems an FTLE-only sweep without event logs (``log_events = false``) can run: those
+#: whose kicks need no two-disk collision times beyond their rate
+LOG_FREE_SYSTEMS = ("two_particle", "poisson", "poisson_scatter", "poisson_kinetic",
+                    "uniform_kinetic")
 
 _REQUIRED = ("name", "radii", "n_ics", "n_steps", "tau")
 
@@ -226,6 +230,7 @@ class Experiment:
     holes: tuple = ()
     partner_ratio: float = 1.0
     partner_mass: float = 1.0
+    log_events: bool = True
 
     def __post_init__(self):
         put = functools.partial(object.__setattr__, self)  # (the dataclass is frozen)
@@ -263,6 +268,29 @@ class Experiment:
         if not isinstance(self.description, str):
             raise TypeError(f"description: expected a string, got {self.description!r}")
         self._check_partner(put)
+        self._check_log_events()
+
+    def _check_log_events(self):
+        """``log_events = false``: an FTLE-only sweep (tangent method, uniform sampling, no
+        holes, systems of `LOG_FREE_SYSTEMS`) whose runs keep no event log."""
+        if not isinstance(self.log_events, bool):
+            raise TypeError(f"log_events: expected true or false, got {self.log_events!r}")
+        if self.log_events:
+            return
+        wrong = [s for s in self.systems if s not in LOG_FREE_SYSTEMS]
+        problems = [
+            (tuple(self.diagnostics) != ("lyapunov",),
+             f"diagnostics must be ['lyapunov'], got {list(self.diagnostics)}"),
+            (self.lyapunov_method != "tangent",
+             f"lyapunov_method must be 'tangent', got {self.lyapunov_method!r}"),
+            (self.sampling != "uniform", f"sampling must be 'uniform', got {self.sampling!r}"),
+            (bool(self.holes), "holes are not allowed"),
+            (bool(wrong), f"systems must be among {list(LOG_FREE_SYSTEMS)}, got {wrong}"),
+        ]
+        for bad, text in problems:
+            if bad:
+                raise ValueError(f"log_events=false (an FTLE-only sweep without event logs): "
+                                 f"{text}")
 
     def _check_partner(self, put):
         """Validate ``partner_ratio`` and ``partner_mass`` against the radii, rule and ICs."""

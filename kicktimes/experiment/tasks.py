@@ -39,7 +39,7 @@ import numpy as np
 import pandas as pd
 
 from kicktimes._results import TableResult
-from kicktimes.experiment.config import Experiment
+from kicktimes.experiment.config import KINETIC_SYSTEMS, Experiment
 
 if TYPE_CHECKING:
     from kicktimes.billiard.kick_law import KickLaw
@@ -269,6 +269,9 @@ def _run_ic(exp: Experiment, r: float, ic_index: int, ic: np.ndarray, rows, coll
     from kicktimes.schedules import Poisson
 
     steps = {"n_steps": exp.n_steps, "tau": exp.tau, "sampling": exp.sampling}
+    if not exp.log_events:
+        _run_ic_log_free(exp, r, ic_index, ic, rows, timer, steps)
+        return
     # holes in the wall: every run (and its FTLE) ends at its escape
     holes = {"holes": np.array(exp.holes)} if exp.holes else {}
     # the two-disk system: disk 0 of radius r, disk 1 of the partner's radius and mass
@@ -413,6 +416,54 @@ def _run_ic(exp: Experiment, r: float, ic_index: int, ic: np.ndarray, rows, coll
         one_kw = {"kicks": kick.replace(times=kick_times, angles=kick_angles), **holes, **steps}
         _kicked(system, one_kw, one_pass, exp, ic, r, timer, add, diagnose, extra,
                 uniform_kw=uniform_kw)
+
+
+def _run_ic_log_free(exp, r, ic_index, ic, rows, timer, steps):
+    """One IC of an FTLE-only sweep without event logs (``exp.log_events`` false): each
+    system's tangent FTLE from the event loop alone, with its perturbation count and
+    duration from the `LyapunovResult` (memory O(1) in the horizon). The Poisson systems
+    are kicked at the IC's own two-disk rate, as in `_run_ic`; nothing is sampled but the
+    FTLE's renormalisation times. No collision times are stored (``coll`` stays empty)."""
+    from kicktimes.billiard.one_particle import draw_kick_angles
+    from kicktimes.schedules import Poisson
+
+    lyapunov = _lyapunov()
+    method = _tangent(exp.lyapunov_variant)
+
+    def add(system, diagnostic, value):
+        value = float(value)
+        note = "" if math.isfinite(value) else f"{diagnostic} is not finite ({value!r})"
+        rows.append((r, ic_index, system, diagnostic, value, note))
+
+    def record(system, res, count):
+        add(system, "t_max", res.total_time)
+        add(system, count, res.n_perturbations)
+        add(system, "lyapunov", res.lam)
+        add(system, "lyapunov_n_renorm", res.n_renorm)
+        add(system, "lyapunov_n_forced", res.n_forced)
+
+    with timer("lyapunov_two_particle"):
+        two = lyapunov(ic, exp.radius_pair(r), track=0, method=method, **_two_disk_kw(exp),
+                       **steps)
+    if "two_particle" in exp.systems:
+        record("two_particle", two, "n_pp")
+    for system in ("poisson", "poisson_scatter", "poisson_kinetic", "uniform_kinetic"):
+        if system not in exp.systems:
+            continue
+        kick = kick_law(exp, system, ic, r)
+        rng = kick_rng(ic_index, r, system, rng=exp.seed)
+        with timer("lyapunov_kicked"):
+            if system in KINETIC_SYSTEMS:
+                res = lyapunov(ic[0], r, kicks=kick.replace(
+                    times=kinetic_rate_table(r, exp.rule)), rng=rng, method=method, **steps)
+            else:
+                rate = two.n_perturbations / two.total_time
+                times = Poisson(rate).sample(exp.horizon, rng=rng)
+                angles = draw_kick_angles(times.size, kick.angle, exp.sigma, rng)
+                res = lyapunov(ic[0], r, kicks=kick.replace(times=times, angles=angles),
+                               method=method, **steps)
+                add(system, "kick_rate", rate)
+        record(system, res, "n_kicks")
 
 
 def _kicked(system, one_kw, one_pass, exp, ic, r, timer, add, diagnose, extra=(), *,

@@ -97,6 +97,9 @@ STUDIES = {
         Study("disks", "disks.md",
               "a tagged disk among N = 2..1000 disks: Poisson or not, Enskog, kicked",
               options=("scheduler",)),
+        Study("small_r", "small_r.md",
+              "the premise at its limit r -> 0: low-density theory and FTLE to r = 1e-4",
+              options=("scheduler",)),
     )
 }
 
