@@ -107,6 +107,10 @@ SLOPES = {"two_particle": 2, "poisson": 1, "uniform_kinetic": 1, "poisson_scatte
 _CODES = {s: k for k, s in enumerate(THEORY_SYSTEMS)}
 _RULES = ("mirror", "elastic")
 _EULER_GAMMA = 0.5772156649015329
+#: Gauss-Legendre nodes of the rates' quadrature: against 24 nodes the rate moves by at most
+#: 0.2 % and its mean log by 7e-5 nats, far inside the Monte Carlo error, at a quarter of
+#: the cost
+_RATE_NODES = 12
 
 
 @njit(cache=True, inline="always")
@@ -411,7 +415,7 @@ def stretching_theory(r, system="two_particle", *, rule="mirror", n_chains=400,
         lim = rho * flat[:, [1, 3]] * (1 - 1e-12)
         L1 = np.clip(flat[:, 0] * flat[:, 1], -lim[:, 0], lim[:, 0])
         L2 = np.clip(flat[:, 2] * flat[:, 3], -lim[:, 1], lim[:, 1])
-        rates = conditional_kinetic_rate(r, L1, L2, rule=rule, **speeds)
+        rates = conditional_kinetic_rate(r, L1, L2, rule=rule, n_nodes=_RATE_NODES, **speeds)
     elif system in ("poisson", "poisson_scatter"):
         rates = np.full(len(flat), kinetic_rate(r, rule=rule))
     else:
@@ -419,7 +423,7 @@ def stretching_theory(r, system="two_particle", *, rule="mirror", n_chains=400,
             speeds = {"speed": flat[:, 1]}
         lim = (1.0 - r) * flat[:, 1] * (1 - 1e-12)
         L = np.clip(flat[:, 0] * flat[:, 1], -lim, lim)
-        rates = mean_kinetic_rate(r, L, rule=rule, **speeds)
+        rates = mean_kinetic_rate(r, L, rule=rule, n_nodes=_RATE_NODES, **speeds)
     rates = np.asarray(rates, float).reshape(n_chains, n_steps)
     log_time = -_EULER_GAMMA - np.log(rates)
     growth = log_time + logs
