@@ -473,7 +473,8 @@ def write_results(
                + "".join(f" ([both families]({f}.png))" for f, _ in family_figures)
                + ". The other studies: [science.md](science.md), [mechanism.md](mechanism.md),"
                " [escape.md](escape.md), [unequal.md](unequal.md), [scatter.md](scatter.md), "
-               "[mmpp.md](mmpp.md), [disks.md](disks.md), [paper.md](paper.md).", ""]
+               "[mmpp.md](mmpp.md), [disks.md](disks.md), [small_r.md](small_r.md), "
+               "[paper.md](paper.md).", ""]
     below = [f"{name}: {scale}" for name, paper, scale, *_ in details_args if not paper]
     if below:  # the page's answers stand on stores below the paper's scale: it says so first
         screen = [f"> **Below paper scale** ({'; '.join(below)}): a pipeline check; its "
