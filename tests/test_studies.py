@@ -141,7 +141,8 @@ def test_an_option_of_another_study_is_refused_naming_it(tmp_path):
     res = CliRunner().invoke(main, ["reproduce", "--study", "escape", "--scheduler",
                                     "tcp://h:1", "--out", str(tmp_path)])
     assert res.exit_code == 2
-    assert "--scheduler applies to --study paper, disks, not to --study escape" in res.output
+    assert ("--scheduler applies to --study paper, disks, small_r, not to --study escape"
+            in res.output)
 
 
 def test_the_paper_page_s_closing_table_is_what_it_wrote_and_never_in_the_readme(tmp_path):

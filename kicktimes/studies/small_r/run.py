@@ -17,13 +17,16 @@ from kicktimes.studies.cache import cached_table
 from kicktimes.studies.options import study_run
 from kicktimes.studies.small_r.figures import small_r_figure
 from kicktimes.studies.small_r.page import SOURCES, answers, body
-from kicktimes.studies.small_r.sweep import run_sweep, seconds_per_ic
+from kicktimes.studies.small_r.sweep import control_experiments, run_sweep, seconds_per_ic
 from kicktimes.studies.small_r.tables import (
     against_theory,
+    control_runs,
     findings,
     measured,
     per_ic,
+    rate_check,
     ratio_table,
+    slopes,
     theory_table,
 )
 
@@ -35,13 +38,15 @@ RULES = ("mirror", "elastic")
 @dataclass(frozen=True)
 class SmallRScale:
     """The sizes of one scale: the radii, the ICs per radius and rule, the collisions per
-    IC (``collisions``, the horizon ``collisions / kinetic_rate(r)``), and the theory's
-    chains per rule ``(n_chains, n_steps, burn_in)``."""
+    IC (``collisions``, the horizon ``collisions / kinetic_rate(r)``), the theory's
+    chains per rule ``(n_chains, n_steps, burn_in)`` and the radius of the controls'
+    stores (`kicktimes.studies.small_r.sweep.CONTROL_STORES`)."""
 
     radii: tuple
     n_ics: int
     collisions: int
     chains: dict
+    control_radius: float
 
 
 #: ``paper``: the sizes of docs/results/small_r.md (six radii 1e-4..3e-2, 100 ICs, 10^4
@@ -50,9 +55,9 @@ class SmallRScale:
 #: ``quick``: seconds
 SCALES = {
     "paper": SmallRScale((1e-4, 3e-4, 1e-3, 3e-3, 1e-2, 3e-2), 100, 10_000,
-                         {"mirror": (400, 1000, 100), "elastic": (2000, 200, 50)}),
+                         {"mirror": (400, 1000, 100), "elastic": (2000, 200, 50)}, 1e-3),
     "quick": SmallRScale((1e-3, 1e-2), 4, 500,
-                         {"mirror": (20, 200, 20), "elastic": (40, 100, 20)}),
+                         {"mirror": (20, 200, 20), "elastic": (40, 100, 20)}, 1e-3),
 }
 
 
@@ -93,8 +98,10 @@ def reproduce(out: str | os.PathLike, *, scale: str = "quick", results_dir=None,
     run.cache.mkdir(parents=True, exist_ok=True)
     run.results.mkdir(parents=True, exist_ok=True)
     collisions = dict.fromkeys(sizes.radii, sizes.collisions)
+    controls = control_experiments(sizes.n_ics, sizes.collisions, radius=sizes.control_radius)
     stores, _ = run_sweep(out, collisions, RULES, n_ics=sizes.n_ics, workers=run.workers,
-                          scheduler=scheduler, say=run.say)
+                          scheduler=scheduler, controls=controls, say=run.say)
+    extra = stores.pop("controls")
     run.say(f"sweep done at {time.perf_counter() - t0:.0f} s")
     params = {"radii": list(sizes.radii), "rules": list(RULES),
               "chains": {k: list(v) for k, v in sizes.chains.items()}, "seed": 62}
@@ -106,22 +113,26 @@ def reproduce(out: str | os.PathLike, *, scale: str = "quick", results_dir=None,
     meas = measured(runs)
     compare = against_theory(meas, theory)
     ratios = ratio_table(meas, theory)
-    robust = findings(runs)
+    robust = findings(runs, control_runs(extra))
+    slope = slopes(runs)
+    rates = rate_check(runs)
     cost = seconds_per_ic(stores)
     for name, frame in (("measured", meas), ("theory", theory), ("against_theory", compare),
-                        ("ratios", ratios), ("findings", robust), ("cost", cost)):
+                        ("ratios", ratios), ("findings", robust), ("slopes", slope),
+                        ("rate_check", rates), ("cost", cost)):
         run.write_csv(f"small_r_{name}.csv", frame)
-    run.write_figure("small_r.png", small_r_figure(meas, theory, ratios))
+    run.write_figure("small_r.png", small_r_figure(meas, compare, ratios))
 
     smallest = min(sizes.radii)
     lines = header(
         "The paper's premise at its limit r → 0: kicked disk against two disks",
         run.command,
-        ["the sweep's stores " + ", ".join(f"`{s.experiment.name}`" for s in stores.values()),
+        ["the sweep's stores " + ", ".join(f"`{s.experiment.name}`" for s in stores.values())
+         + ", the controls' " + ", ".join(f"`{s.experiment.name}`" for s in extra.values()),
          "the low-density theory (`kicktimes.diagnostics.low_density`, cached in "
          f"`{run.cache.name}`)"])
-    lines += answers(ratios, compare, robust, smallest) + [""]
-    lines += body(meas, theory, compare, ratios, robust, cost, n_ics=sizes.n_ics,
+    lines += answers(ratios, compare, robust, slope, theory, smallest) + [""]
+    lines += body(meas, theory, compare, ratios, robust, rates, cost, n_ics=sizes.n_ics,
                   collisions=sizes.collisions)
-    lines += [f"Built in {time.perf_counter() - t0:.0f} s.", ""]
+    run.say(f"page at {time.perf_counter() - t0:.0f} s")
     return run.write_page(lines, SOURCES)

@@ -22,8 +22,8 @@ import pandas as pd
 from kicktimes.experiment import Experiment, load_store, run_experiment
 from kicktimes.stats import kinetic_rate
 
-__all__ = ["N_SAMPLES", "SYSTEMS", "load_sweep", "run_sweep", "seconds_per_ic",
-           "small_r_experiment"]
+__all__ = ["CONTROL_RADIUS", "CONTROL_STORES", "N_SAMPLES", "SYSTEMS", "control_experiments",
+           "load_sweep", "run_sweep", "seconds_per_ic", "small_r_experiment"]
 
 #: the two disks, then the kicked systems the theory covers (`THEORY_SYSTEMS`)
 SYSTEMS = ("two_particle", "poisson", "uniform_kinetic", "poisson_scatter", "poisson_kinetic")
@@ -32,8 +32,11 @@ N_SAMPLES = 1000
 SEED = 62
 
 
-def small_r_experiment(r, rule, *, n_ics, n_collisions, block_size=10) -> Experiment:
-    """The sweep's experiment at one radius and rule (module docstring).
+def small_r_experiment(r, rule, *, n_ics, n_collisions, block_size=10, seed=SEED,
+                       ic_method="uniform", control="") -> Experiment:
+    """The sweep's experiment at one radius and rule (module docstring); ``control``
+    names a control's store (another ``seed``, the paper's ``ic_method``, a shorter
+    horizon) and goes into its name.
 
     >>> exp = small_r_experiment(1e-3, "mirror", n_ics=100, n_collisions=10_000)
     >>> exp.name, round(exp.horizon * exp.kinetic_rate(1e-3))
@@ -41,36 +44,71 @@ def small_r_experiment(r, rule, *, n_ics, n_collisions, block_size=10) -> Experi
     """
     horizon = n_collisions / kinetic_rate(r, rule=rule)
     return Experiment(
-        name=f"small_r-{rule}-r{r:g}", radii=[r], n_ics=n_ics, n_steps=N_SAMPLES,
-        tau=horizon / N_SAMPLES, ic_method="uniform", seed=SEED, sampling="uniform",
-        rule=rule, systems=SYSTEMS, diagnostics=("lyapunov",), lyapunov_method="tangent",
-        block_size=block_size, log_events=False,
+        name=f"small_r-{rule}-r{r:g}" + (f"-{control}" if control else ""), radii=[r],
+        n_ics=n_ics, n_steps=N_SAMPLES, tau=horizon / N_SAMPLES, ic_method=ic_method,
+        seed=seed, sampling="uniform", rule=rule, systems=SYSTEMS, diagnostics=("lyapunov",),
+        lyapunov_method="tangent", block_size=block_size, log_events=False,
         description=f"tangent FTLE at r = {r:g} over {n_collisions} collisions per IC "
-                    "(invariant ICs), for the low-density theory of the stretching")
+                    f"({ic_method} ICs, seed {seed}), for the low-density theory of the "
+                    "stretching")
 
 
-def run_sweep(out, collisions, rules, *, n_ics, workers=1, scheduler=None,
+#: the controls' stores, at one radius (`CONTROL_RADIUS`): ``name: (rules, changes)``; a
+#: seed replicate under both rules (the radii of the sweep share their ICs' seed, so their
+#: errors are correlated), the paper's ICs (drawn at r_max = r), a ten times shorter horizon
+CONTROL_STORES = {
+    "seed": (("mirror", "elastic"), {"seed": SEED + 1}),
+    "paper_ics": (("mirror",), {"ic_method": "paper"}),
+    "horizon": (("mirror",), {"n_collisions_factor": 0.1}),
+}
+CONTROL_RADIUS = 1e-3
+
+
+def control_experiments(n_ics, n_collisions, radius=CONTROL_RADIUS) -> dict:
+    """``{(control, rule, r): Experiment}`` of `CONTROL_STORES`."""
+    out = {}
+    for control, (rules, changes) in CONTROL_STORES.items():
+        kw = dict(changes)
+        factor = kw.pop("n_collisions_factor", 1.0)
+        for rule in rules:
+            out[control, rule, radius] = small_r_experiment(
+                radius, rule, n_ics=n_ics, n_collisions=round(factor * n_collisions),
+                control=control, **kw)
+    return out
+
+
+def _run_store(exp, out, workers, scheduler, say):
+    path = Path(out) / f"store-{exp.name}"
+    manifest = path / "manifest.json"
+    if manifest.is_file():
+        record = json.loads(manifest.read_text(encoding="utf-8"))
+        if record.get("experiment_hash") != exp.hash():
+            say(f"{path.name}: made with other parameters; recomputed")
+            shutil.rmtree(path)
+    start = time.perf_counter()
+    kwargs = {"scheduler": scheduler} if scheduler else {"workers": workers}
+    store = run_experiment(exp, path, progress=False, **kwargs)
+    seconds = time.perf_counter() - start
+    say(f"{path.name}: {seconds:.0f} s")
+    return store, seconds
+
+
+def run_sweep(out, collisions, rules, *, n_ics, workers=1, scheduler=None, controls=None,
               say=print) -> tuple[dict, dict]:
     """Run (or resume) every store of the sweep in ``out``: ``collisions`` maps each
-    radius to its collisions per IC. Returns ``{(rule, r): Store}`` and the seconds each
-    took in this call (a store made with other parameters is this study's stale cache:
-    removed and recomputed). Largest radii first, both rules at each radius."""
+    radius to its collisions per IC; ``controls`` (`control_experiments`) adds the
+    controls' stores. Returns ``{(rule, r): Store}`` (and ``{(control, rule, r): Store}``
+    under the key ``"controls"``) and the seconds each took in this call (a store made
+    with other parameters is this study's stale cache: removed and recomputed). Largest
+    radii first, both rules at each radius, the controls last."""
     stores, seconds = {}, {}
     for r in sorted(collisions, reverse=True):
         for rule in rules:
             exp = small_r_experiment(r, rule, n_ics=n_ics, n_collisions=collisions[r])
-            path = Path(out) / f"store-{exp.name}"
-            manifest = path / "manifest.json"
-            if manifest.is_file():
-                record = json.loads(manifest.read_text(encoding="utf-8"))
-                if record.get("experiment_hash") != exp.hash():
-                    say(f"{path.name}: made with other parameters; recomputed")
-                    shutil.rmtree(path)
-            start = time.perf_counter()
-            kwargs = {"scheduler": scheduler} if scheduler else {"workers": workers}
-            stores[rule, r] = run_experiment(exp, path, progress=False, **kwargs)
-            seconds[rule, r] = time.perf_counter() - start
-            say(f"{path.name}: {seconds[rule, r]:.0f} s")
+            stores[rule, r], seconds[rule, r] = _run_store(exp, out, workers, scheduler, say)
+    stores["controls"] = {}
+    for key, exp in (controls or {}).items():
+        stores["controls"][key], seconds[key] = _run_store(exp, out, workers, scheduler, say)
     return stores, seconds
 
 
@@ -86,7 +124,7 @@ def seconds_per_ic(stores) -> pd.DataFrame:
     """Per (rule, radius): the CPU seconds of the sweep's tasks (each task's own timing in
     its worker, all five systems), per IC, and the two-disk collisions per IC."""
     rows = []
-    for (rule, r), store in sorted(stores.items()):
+    for (rule, r), store in sorted((k, v) for k, v in stores.items() if k != "controls"):
         res = store.results
         n_pp = res[(res["system"] == "two_particle") & (res["diagnostic"] == "n_pp")]["value"]
         seconds = float(store.timings["total"].sum())
