@@ -91,7 +91,8 @@ class _Table(Result):
         if q.shape != v.shape:
             raise ValueError(f"positions and velocities must have the same shape, got "
                              f"{q.shape} and {v.shape}")
-        return np.array([_k.wall_time(kind, p0, p1, p2, *qi, *vi) for qi, vi in zip(q, v)])
+        return np.array([_k.wall_time(kind, p0, p1, p2, *qi, *vi)
+                         for qi, vi in zip(q, v, strict=True)])
 
 
 @dataclass(frozen=True, repr=False)
@@ -332,8 +333,9 @@ class TableRun(Result):
         """``(n, 2)`` Birkhoff coordinates ``(s, sin_theta)`` of the recorded contacts
         (`kicktimes.billiard.kernels.tables.boundary_coordinates`)."""
         kind, p0, p1, p2 = self.table.kernel(self.r)
+        pairs = zip(self.positions, self.velocities, strict=True)
         return np.array([_k.boundary_coordinates(kind, p0, p1, p2, *q, *v)
-                         for q, v in zip(self.positions, self.velocities)]).reshape(-1, 2)
+                         for q, v in pairs]).reshape(-1, 2)
 
 
 _STATUS = {2: "more than 1000 wall contacts at one instant",
