@@ -349,7 +349,7 @@ def test_areas_and_perimeters():
     table, r = Ellipse(1.5, 1.0), 0.1
     run = free_run(table, uniform_state(table, r, rng=3), r, n_bounces=10, tangent=False)
     assert run.n_bounces == 10
-    assert table.area(r) < math.pi * 1.5 and table.perimeter(r) < table.perimeter()
+    assert table.area(r) < math.pi * 1.5 and table.perimeter(r) < table.perimeter(0.0)
 
 
 @pytest.mark.parametrize(("make", "match"), [

@@ -64,15 +64,20 @@ class _Table(Result):
         """``(kind, p0, p1, p2)`` of `kicktimes.billiard.kernels.tables` for radius ``r``."""
         raise NotImplementedError
 
-    def area(self, r=0.0) -> float:
-        """Area of the region the centre of a disk of radius ``r`` keeps to."""
+    def area(self, r) -> float:
+        """Area of the region the centre of a disk of radius ``r`` keeps to (``r = 0``:
+        the table's)."""
         raise NotImplementedError
 
-    def perimeter(self, r=0.0) -> float:
+    def _size_radius(self, r) -> float:
+        """``r`` in ``[0, max_radius)``: a disk's radius, or 0 for the table itself."""
+        return check_real("r", r, low=0.0, high=self.max_radius, low_open=False)
+
+    def perimeter(self, r) -> float:
         """Length of the centre's curve for a disk of radius ``r``."""
         raise NotImplementedError
 
-    def mean_free_time(self, r=0.0) -> float:
+    def mean_free_time(self, r) -> float:
         """Mean time between wall contacts at unit speed, ``pi area / perimeter`` (the
         billiard's invariant measure; Santalo's formula)."""
         return math.pi * self.area(r) / self.perimeter(r)
@@ -113,11 +118,11 @@ class Circle(_Table):
         r = self.check_radius(r)
         return self._kind, 1.0 - r, 0.0, 0.0
 
-    def area(self, r=0.0):
-        return math.pi * (1.0 - r) ** 2
+    def area(self, r):
+        return math.pi * (1.0 - self._size_radius(r)) ** 2
 
-    def perimeter(self, r=0.0):
-        return 2.0 * math.pi * (1.0 - r)
+    def perimeter(self, r):
+        return 2.0 * math.pi * (1.0 - self._size_radius(r))
 
     def contains(self, positions, r):
         q = np.asarray(positions, dtype=float)
@@ -140,7 +145,7 @@ class Stadium(_Table):
 
     Examples
     --------
-    >>> Stadium(1.0).area(), Stadium(1.0).perimeter()
+    >>> Stadium(1.0).area(0.0), Stadium(1.0).perimeter(0.0)
     (7.141592653589793, 10.283185307179586)
     """
 
@@ -155,12 +160,12 @@ class Stadium(_Table):
         r = self.check_radius(r)
         return self._kind, self.a, 1.0 - r, 0.0
 
-    def area(self, r=0.0):
-        rho = 1.0 - r
+    def area(self, r):
+        rho = 1.0 - self._size_radius(r)
         return math.pi * rho * rho + 4.0 * self.a * rho
 
-    def perimeter(self, r=0.0):
-        return 2.0 * math.pi * (1.0 - r) + 4.0 * self.a
+    def perimeter(self, r):
+        return 2.0 * math.pi * (1.0 - self._size_radius(r)) + 4.0 * self.a
 
     def contains(self, positions, r):
         q = np.asarray(positions, dtype=float)
@@ -228,12 +233,13 @@ class Ellipse(_Table):
     def _ellipse_perimeter(self):
         return 4.0 * self.a * _k._elliptic_e(0.5 * math.pi, 1.0 - (self.b / self.a) ** 2)
 
-    def area(self, r=0.0):
+    def area(self, r):
         # Steiner's formula for the inner parallel body (valid for r below b^2/a)
+        r = self._size_radius(r)
         return math.pi * self.a * self.b - self._ellipse_perimeter() * r + math.pi * r * r
 
-    def perimeter(self, r=0.0):
-        return self._ellipse_perimeter() - 2.0 * math.pi * r
+    def perimeter(self, r):
+        return self._ellipse_perimeter() - 2.0 * math.pi * self._size_radius(r)
 
     def contains(self, positions, r):
         kind, p0, p1, p2 = self.kernel(r)
@@ -380,7 +386,7 @@ def free_run(table, state, r, *, n_bounces=None, t_max=None, n_record=None, tang
     --------
     >>> run = free_run(Circle(), [0.1, 0.2, 0.6, 0.8], 0.05, n_bounces=3)
     >>> run.times.round(6)
-    array([0.694725, 2.117391, 3.540057])
+    array([0.729158, 2.627473, 4.525788])
     """
     table = _check_table(table)
     r = table.check_radius(r)
