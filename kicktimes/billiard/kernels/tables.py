@@ -111,24 +111,30 @@ def stadium_contact(x, y, vx, vy, a, rho, piece):
 def _ellipse_g(c, s, x, y, wx, wy, A, B, r):
     """``(g, g', Cx, Cy)`` at ``t`` (``c = cos t``, ``s = sin t``): ``g = (C(t) - q).w``
     and its derivative ``C'(t).w``, ``C' = (1 - r kappa) P'``, ``kappa = A B / h^3``."""
-    h = math.sqrt(B * B * c * c + A * A * s * s)
-    ih = 1.0 / h
-    cx = (A - r * B * ih) * c
-    cy = (B - r * A * ih) * s
-    f = 1.0 - r * A * B * ih * ih * ih
-    return ((cx - x) * wx + (cy - y) * wy, f * (-A * s * wx + B * c * wy), cx, cy)
+    ih = 1.0 / math.sqrt(B * B * c * c + A * A * s * s)
+    rih = r * ih
+    cx = (A - B * rih) * c
+    cy = (B - A * rih) * s
+    f = 1.0 - A * B * rih * ih * ih
+    return ((cx - x) * wx + (cy - y) * wy, f * (B * c * wy - A * s * wx), cx, cy)
 
 
 @njit(cache=True, error_model="numpy")
 def _rotate(c, s, d):
-    """``(cos, sin)`` of ``t + d`` from those of ``t`` (a series for small ``d``)."""
-    if abs(d) < 1e-3:
-        d2 = d * d
-        sd = d * (1.0 - d2 / 6.0 * (1.0 - d2 / 20.0))
-        cd = 1.0 - 0.5 * d2 * (1.0 - d2 / 12.0)
-    else:
-        sd = math.sin(d)
-        cd = math.cos(d)
+    """``(cos, sin)`` of ``t + d + O(d^3)`` from those of ``t``, of norm 1 to ``O(d^8)``.
+
+    Newton's iteration converges quadratically with any step ``d (1 + O(d^2))``, so small
+    steps rotate by ``(1 - d^2 / 2, d)`` and renormalise with one Newton step of the norm
+    (no trigonometry, no square root); large ones (a poor start) rotate exactly.
+    """
+    if abs(d) < 0.1:
+        cd = 1.0 - 0.5 * d * d
+        c2 = c * cd - s * d
+        s2 = s * cd + c * d
+        k = 1.5 - 0.5 * (c2 * c2 + s2 * s2)
+        return c2 * k, s2 * k
+    sd = math.sin(d)
+    cd = math.cos(d)
     return c * cd - s * sd, s * cd + c * sd
 
 
@@ -175,7 +181,7 @@ def ellipse_hit(x, y, vx, vy, A, B, r):
     the flight, on the arc where the normal turns through ``+v`` (``N.v > 0``: the exit,
     not the entry behind). Fast path: the flight's exit from the ellipse of semi-axes
     ``(A - r, B - r)`` (exact at the four vertices) gives a start, Newton's iteration on
-    ``u`` (rotating ``(cos u, sin u)`` by the step, no trigonometry) converges
+    ``u`` (rotating ``(cos u, sin u)`` by the step, `_rotate`: no trigonometry) converges
     quadratically; it is accepted if the step fell below ``1e-10`` and the root is an exit.
     Otherwise (near-tangent flights, where the entry and exit roots merge) the bracketed
     root of `_ellipse_bracketed`. Then ``t = (C(u) - q).v / |v|^2``, the foot of ``C(u)``
@@ -186,12 +192,12 @@ def ellipse_hit(x, y, vx, vy, A, B, r):
         return INF, 1.0, 0.0
     wx = vy
     wy = -vx
-    al = A - r
-    be = B - r
-    X = x / al
-    Y = y / be
-    VX = vx / al
-    VY = vy / be
+    ial = 1.0 / (A - r)
+    ibe = 1.0 / (B - r)
+    X = x * ial
+    Y = y * ibe
+    VX = vx * ial
+    VY = vy * ibe
     aa = VX * VX + VY * VY
     bb = X * VX + Y * VY
     cc = 1.0 - X * X - Y * Y
@@ -204,11 +210,16 @@ def ellipse_hit(x, y, vx, vy, A, B, r):
         t0 = (-bb + math.sqrt(disc)) / aa
     c = X + VX * t0
     s = Y + VY * t0
-    nrm = math.sqrt(c * c + s * s)
+    nrm2 = c * c + s * s
     ok = False
-    if nrm > 0.0:
-        c /= nrm
-        s /= nrm
+    if nrm2 > 0.0:
+        # on the unit circle up to round-off unless the flight missed the start's ellipse
+        if abs(nrm2 - 1.0) < 1e-4:
+            inrm = 1.5 - 0.5 * nrm2
+        else:
+            inrm = 1.0 / math.sqrt(nrm2)
+        c *= inrm
+        s *= inrm
         for _ in range(_NEWTON_MAX):
             g, gp, _, _ = _ellipse_g(c, s, x, y, wx, wy, A, B, r)
             if gp == 0.0:
@@ -226,9 +237,9 @@ def ellipse_hit(x, y, vx, vy, A, B, r):
     k = 1.5 - 0.5 * (c * c + s * s)
     c *= k
     s *= k
-    h = math.sqrt(B * B * c * c + A * A * s * s)
-    cx = (A - r * B / h) * c
-    cy = (B - r * A / h) * s
+    rih = r / math.sqrt(B * B * c * c + A * A * s * s)
+    cx = (A - B * rih) * c
+    cy = (B - A * rih) * s
     t = ((cx - x) * vx + (cy - y) * vy) / vv
     if t < 0.0:
         t = 0.0
@@ -240,9 +251,9 @@ def ellipse_normal(c, s, A, B, r):
     """``(nx, ny, kappa)`` at the parameter ``(cos u, sin u) = (c, s)``: the outward unit
     normal ``N = (B c, A s) / h`` and the curvature of the centre's curve,
     ``kappa / (1 - r kappa)`` with the ellipse's ``kappa = A B / h^3``."""
-    h = math.sqrt(B * B * c * c + A * A * s * s)
-    k = A * B / (h * h * h)
-    return B * c / h, A * s / h, k / (1.0 - r * k)
+    ih = 1.0 / math.sqrt(B * B * c * c + A * A * s * s)
+    k = A * B * ih * ih * ih
+    return B * c * ih, A * s * ih, k / (1.0 - r * k)
 
 
 @njit(cache=True, error_model="numpy")
