@@ -182,7 +182,8 @@ def ellipse_hit(x, y, vx, vy, A, B, r):
     not the entry behind). Fast path: the flight's exit from the ellipse of semi-axes
     ``(A - r, B - r)`` (exact at the four vertices) gives a start, Newton's iteration on
     ``u`` (rotating ``(cos u, sin u)`` by the step, `_rotate`: no trigonometry) converges
-    quadratically; it is accepted if the step fell below ``1e-10`` and the root is an exit.
+    quadratically (2 to 4 evaluations); it is accepted if the step fell below ``1e-10`` and
+    the root is an exit.
     Otherwise (near-tangent flights, where the entry and exit roots merge) the bracketed
     root of `_ellipse_bracketed`. Then ``t = (C(u) - q).v / |v|^2``, the foot of ``C(u)``
     on the flight line, so the advanced centre ``q + v t`` is within round-off of the wall.
