@@ -23,7 +23,8 @@ from kicktimes.tables import (
 )
 
 N_STATES = 10_000
-#: Benettin & Strelcyn, Phys. Rev. A 17, 773 (1978): see test_stadium_lyapunov_is_the_published
+#: the stadium's exponent per unit time, quoted from Benettin & Strelcyn, Phys. Rev. A 17, 773
+#: (1978): see test_stadium_lyapunov_is_the_published
 STADIUM_LYAPUNOV = 0.43
 
 
@@ -245,9 +246,11 @@ def test_point_particle_in_the_ellipse_keeps_the_focal_angular_momenta_product(n
 
 def test_stadium_lyapunov_is_the_published():
     """The point particle's maximal exponent in the stadium of unit radius and a = 1 (the
-    straight segments 2a = 2), unit speed, per unit time: lambda = 0.43 (Benettin &
-    Strelcyn, Phys. Rev. A 17, 773 (1978)). Averaged over 10 orbits of 2e5 bounces (the
-    finite-time spread of one orbit is about 1 %)."""
+    straight segments 2a = 2), unit speed, per unit time: lambda ~ 0.43, the value quoted
+    from Benettin & Strelcyn, Phys. Rev. A 17, 773 (1978) (per bounce it is lambda times the
+    mean free time pi A / L = 2.18, about 0.94). The paper's text was not reachable with the
+    project's search tools: re-check its value and convention against the paper.
+    Averaged over 10 orbits of 2e5 bounces (the spread of one orbit's exponent is ~1 %)."""
     table, r = Stadium(1.0), 1e-9
     rng = np.random.default_rng(2026)
     values = [table_lyapunov(table, uniform_state(table, r, rng=rng), r, n_bounces=200_000,

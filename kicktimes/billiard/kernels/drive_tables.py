@@ -54,7 +54,7 @@ def free_kernel(kind, p0, p1, p2, state, n_max, t_max, rec, u, tangent):
 
     One copy of the loop per table, its ``kind`` a constant: the compiler then drops the
     other tables' branches from the loop (a single loop dispatching on ``kind`` at every
-    contact measured 1.4x slower in the ellipse, benchmarks/bench_tables.py).
+    contact measured 1.5x slower in the ellipse, benchmarks/bench_tables.py).
     """
     if kind == tables.CIRCLE:
         return _free_loop(tables.CIRCLE, p0, p1, p2, state, n_max, t_max, rec, u, tangent)
