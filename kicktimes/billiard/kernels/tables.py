@@ -12,7 +12,7 @@ A disk of radius ``r`` keeps its centre inside the table's inner parallel curve 
   (B - r A / h) sin t)``, smooth and convex for ``r < B^2 / A``.
 
 `hit` returns the time to the next contact and a "where" ``(w1, w2)`` (the stadium's piece;
-the ellipse's ``(cos t, sin t)`` of the contact), `contact` puts a centre advanced by that
+the ellipse's normal at the contact), `contact` puts a centre advanced by that
 time back on the wall and gives the outward unit normal and the curvature of the centre's
 curve there, `bounce` reflects (or, at a grazing contact, lets the disk slide on, as
 `kicktimes.billiard.geometry.graze` does in the circle). `boundary_coordinates` gives the
@@ -173,9 +173,9 @@ def _ellipse_bracketed(x, y, vx, vy, A, B, r):
 
 
 @njit(cache=True, error_model="numpy")
-def ellipse_hit(x, y, vx, vy, A, B, r):
-    """``(t, cos u, sin u)``: time until the centre reaches the ellipse's parallel curve and
-    the curve parameter ``u`` of the contact.
+def _ellipse_hit(x, y, vx, vy, A, B, r):
+    """``(t, cos u, sin u, 1 / h)``: time until the centre reaches the ellipse's parallel
+    curve, the curve parameter ``u`` of the contact and ``1 / h(u)``.
 
     The contact solves ``g(u) = (C(u) - q).w = 0`` with ``w = (vy, -vx)`` perpendicular to
     the flight, on the arc where the normal turns through ``+v`` (``N.v > 0``: the exit,
@@ -190,7 +190,7 @@ def ellipse_hit(x, y, vx, vy, A, B, r):
     """
     vv = vx * vx + vy * vy
     if vv == 0.0:
-        return INF, 1.0, 0.0
+        return INF, 1.0, 0.0, 1.0 / B
     wx = vy
     wy = -vx
     ial = 1.0 / (A - r)
@@ -238,12 +238,21 @@ def ellipse_hit(x, y, vx, vy, A, B, r):
     k = 1.5 - 0.5 * (c * c + s * s)
     c *= k
     s *= k
-    rih = r / math.sqrt(B * B * c * c + A * A * s * s)
+    ih = 1.0 / math.sqrt(B * B * c * c + A * A * s * s)
+    rih = r * ih
     cx = (A - B * rih) * c
     cy = (B - A * rih) * s
     t = ((cx - x) * vx + (cy - y) * vy) / vv
     if t < 0.0:
         t = 0.0
+    return t, c, s, ih
+
+
+@njit(cache=True, error_model="numpy")
+def ellipse_hit(x, y, vx, vy, A, B, r):
+    """``(t, cos u, sin u)``: time until the centre reaches the ellipse's parallel curve and
+    the curve parameter ``u`` of the contact (`_ellipse_hit`)."""
+    t, c, s, _ = _ellipse_hit(x, y, vx, vy, A, B, r)
     return t, c, s
 
 
@@ -386,13 +395,17 @@ def ellipse_arc_length(c, s, A, B, r):
 
 @njit(cache=True, error_model="numpy")
 def hit(kind, p0, p1, p2, x, y, vx, vy):
-    """``(t, w1, w2)``: time to the next wall contact and where (see the module docstring)."""
+    """``(t, w1, w2)``: time to the next wall contact and where: nothing for the circle,
+    ``(piece, 0)`` for the stadium, the outward unit normal for the ellipse."""
     if kind == CIRCLE:
         return geo.boundary_hit_time(x, y, vx, vy, p0), 0.0, 0.0
     if kind == STADIUM:
         t, piece = stadium_hit(x, y, vx, vy, p0, p1)
         return t, float(piece), 0.0
-    return ellipse_hit(x, y, vx, vy, p0, p1, p2)
+    t, c, s, ih = _ellipse_hit(x, y, vx, vy, p0, p1, p2)
+    # the outward normal (B c, A s) / h: the contact needs it at once, so it is made here,
+    # where 1 / h is known (`contact` recovers the curvature from it off the critical path)
+    return t, p1 * c * ih, p0 * s * ih
 
 
 @njit(cache=True, error_model="numpy")
@@ -422,8 +435,12 @@ def contact(kind, p0, p1, p2, x, y, vx, vy, w1, w2):
         return x, y, x / rho, y / rho, 1.0 / rho
     if kind == STADIUM:
         return stadium_contact(x, y, vx, vy, p0, p1, int(w1))
-    nx, ny, kappa = ellipse_normal(w1, w2, p0, p1, p2)
-    return x, y, nx, ny, kappa
+    # w = the normal N = (B c, A s) / h, so 1 / h = sqrt((N_x / B)^2 + (N_y / A)^2)
+    ex = w1 * (1.0 / p1)  # (1 / B, 1 / A: loop invariants, hoisted out of a driver's loop)
+    ey = w2 * (1.0 / p0)
+    ih = math.sqrt(ex * ex + ey * ey)
+    k = p0 * p1 * ih * ih * ih
+    return x, y, w1, w2, k / (1.0 - p2 * k)
 
 
 @njit(cache=True, error_model="numpy")
