@@ -395,3 +395,22 @@ def test_tables_are_frozen_values_that_summarise_themselves():
     assert Circle().summary().startswith("Circle")
     run = free_run(Stadium(1.0), [0, 0, 0.6, 0.8], 0.05, n_bounces=10, rng=1)
     assert isinstance(run, TableRun) and "lyapunov" in run.summary()
+
+
+@pytest.mark.parametrize(("table", "r", "state"), [
+    (Stadium(1.0), 0.05, [0.0, 0.95, 1.0, 0.0]),     # along the top segment into the join
+    (Stadium(1.0), 0.05, [1.0, 0.95, -1.0, 0.0]),    # from the join, along the segment
+    (Stadium(1.0), 0.05, [1.95, 0.0, 0.0, 1.0]),     # tangent to the right arc
+    (Ellipse(2.0, 1.0), 0.3, [1.7, 0.0, 0.0, 1.0]),  # tangent at the sharpest point
+    (Ellipse(2.0, 1.0), 0.3, [0.0, 0.7, -1.0, 0.0]),  # tangent at the flattest point
+    (Circle(), 0.05, [0.95, 0.0, 0.0, 1.0]),
+], ids=repr)
+def test_exactly_tangent_flights_slide_on_and_stay_inside(table, r, state):
+    run = free_run(table, state, r, n_bounces=5000, tangent=False)
+    assert run.reason == "tangent=False: no exponent" and run.n_bounces == 5000
+    assert np.all(np.diff(run.times) > 0)  # no contact twice at one instant
+    assert table.contains(run.positions, r).all()
+    assert abs(run.speed_drift) < 1e-12
+    # it moves along the wall: the contacts run over a finite stretch of it
+    s = run.boundary_coordinates()[:, 0]
+    assert np.ptp(s) > 0.1
