@@ -10,6 +10,7 @@ The main entry points::
     from kicktimes import KickLaw                         # a kicked disk's kick law
     from kicktimes import simulate_disks, initial_state   # N disks (docs/disks.md)
     from kicktimes import schedules, stats, diagnostics
+    from kicktimes.tables import Stadium, Ellipse, free_run   # tables beyond the circle
 
 Subpackages are imported lazily, so ``import kicktimes`` stays cheap.
 """
@@ -34,7 +35,8 @@ _LAZY_ATTRS = {
     "box_side": ("kicktimes.billiard.disk_states", "box_side"),
     "KickLaw": ("kicktimes.billiard.kick_law", "KickLaw"),
 }
-_LAZY_MODULES = {"billiard", "schedules", "stats", "diagnostics", "experiment", "plots", "report"}
+_LAZY_MODULES = {"billiard", "schedules", "stats", "diagnostics", "experiment", "plots", "report",
+                 "tables"}
 
 __all__ = sorted([*_LAZY_ATTRS, *_LAZY_MODULES, "__version__"])
 

@@ -18,7 +18,7 @@ from kicktimes.stats import analyze
 
 PUBLIC = ["kicktimes", *(f"kicktimes.{m}" for m in
                          ("billiard", "schedules", "stats", "diagnostics", "experiment", "plots",
-                          "report"))]
+                          "report", "tables"))]
 MAX_PARAMETERS = 12
 STATE = np.array([0.1, 0.2, 0.6, 0.8])
 R = 0.02

@@ -26,7 +26,8 @@ import pandas as pd
 import pytest
 from scipy import stats as sps
 
-SUBPACKAGES = ("billiard", "schedules", "stats", "diagnostics", "experiment", "plots", "report")
+SUBPACKAGES = ("billiard", "schedules", "stats", "diagnostics", "experiment", "plots", "report",
+               "tables")
 R = 0.05
 #: the longest summary the protocol allows
 MAX_LINES = 25
@@ -135,6 +136,14 @@ def instances(tmp_path_factory):
         "Twin": dg.Twin(d0=1e-4),
         "Render": kt.report.Render(dpi=90),
         "Subsampling": kt.report.Subsampling(),
+        # kicktimes.tables
+        "Circle": kt.tables.Circle(),
+        "Stadium": kt.tables.Stadium(1.0),
+        "Ellipse": kt.tables.Ellipse(1.5, 1.0),
+        "TableRun": kt.tables.free_run(kt.tables.Stadium(1.0), [0.0, 0.0, 0.6, 0.8], R,
+                                       n_bounces=50, rng=1),
+        "TableLyapunov": kt.tables.table_lyapunov(kt.tables.Stadium(1.0), [0.0, 0.0, 0.6, 0.8],
+                                                  R, n_bounces=200, rng=1),
         # kicktimes.plots
         "TimesFit": kth_time_fit(two.pp_times, sch.Poisson(1.0).sample(200.0, rng=1)),
     }

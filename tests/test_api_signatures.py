@@ -10,7 +10,8 @@ only of options (the verdict rules: ``poisson_rule(*, margin, band)``) takes not
 position.
 
 So, for every public function and method (walking ``kicktimes.__all__`` and the ``__all__``
-of kicktimes.billiard, .schedules, .stats, .diagnostics, .experiment, .plots, .report):
+of kicktimes.billiard, .schedules, .stats, .diagnostics, .experiment, .plots, .report,
+.tables):
 
 (a) no parameter is called ``seed`` unless it is a record (a result field, a config or
     file key: ``EXCEPT_SEED``); a renamed ``seed=`` survives only through
@@ -32,7 +33,8 @@ import inspect
 from kicktimes.validation import POSITIONAL_MARKER, RENAMED_MARKER
 
 PUBLIC = ["kicktimes", "kicktimes.billiard", "kicktimes.schedules", "kicktimes.stats",
-          "kicktimes.diagnostics", "kicktimes.experiment", "kicktimes.plots", "kicktimes.report"]
+          "kicktimes.diagnostics", "kicktimes.experiment", "kicktimes.plots", "kicktimes.report",
+          "kicktimes.tables"]
 
 #: part "kicklaw" of issue 61 owns these signatures (rng=, keywords); tested in its part
 KICKLAW = {"simulate_one_particle", "simulate_two_particle", "lyapunov", "analyze",
