@@ -17,8 +17,8 @@ import math
 import time
 
 import numpy as np
-
 from _timing import best_time
+
 from kicktimes.billiard import KickLaw, initial_conditions
 from kicktimes.diagnostics import lyapunov
 from kicktimes.schedules import Poisson
