@@ -71,7 +71,7 @@ def small_r_figure(meas, compare, ratios):
         mid.set_title(f"{rule} rule: simulation − theory", fontsize=10)
         mid.legend(fontsize=7, loc="upper right")
         right.axhspan(0.95, 1.05, color="0.9", zorder=0)
-        right.set_ylim(0.2, 1.08)
+        right.set_ylim(0.1, 1.08)
         right.set_ylabel("kicked / two-disk FTLE")
         right.set_title(f"{rule} rule: FTLE ratio (band: ±5 %)", fontsize=10)
         right.legend(fontsize=7, loc="center left", bbox_to_anchor=(0.0, 0.62))

@@ -35,6 +35,8 @@ SOURCES = (
            "limit", ratio_table),
     Source("small_r_rate_check.csv", "count_over_kinetic, ci_low, ci_high, per_ic_min, "
            "per_ic_max", rate_check),
+    Source("small_r_seed_replicate.csv", "difference, difference_ci_low, difference_ci_high, "
+           "count_over_kinetic, count_ci_low, count_ci_high", against_theory),
     Source("small_r_findings.csv", "estimate, ci_low, ci_high, verdict, verdict_at_margin, "
            "robust", findings),
     Source("small_r_cost.csv", "seconds_per_ic, collisions_per_ic", seconds_per_ic),
@@ -91,7 +93,7 @@ def _robust_summary(robust):
     return "; ".join(parts)
 
 
-def answers(ratios, compare, robust, slope, theory, smallest) -> list[str]:
+def answers(ratios, compare, robust, slope, theory, smallest, replicate) -> list[str]:
     """At most five one-line answers, each with its number, interval and caveat."""
     at = ratios[ratios["radius"] == smallest].set_index(["rule", "system"])
     uni_m, uni_e = at.loc[("mirror", "poisson")], at.loc[("elastic", "poisson")]
@@ -112,7 +114,7 @@ def answers(ratios, compare, robust, slope, theory, smallest) -> list[str]:
         f"theory {100 * (1 - sca_e['predicted_ratio']):.1f} %); caveat: the gap closes like "
         f"1/ln(1/r) (theory at r = {FAR:g}: "
         f"{100 * (1 - _far_ratio(theory, 'mirror', 'poisson_scatter')):.1f} %), and under "
-        "the elastic rule the theory puts it lower than measured.",
+        "the elastic rule the theory's gap is smaller than the measured one.",
     ]
     sl = slope.set_index(["rule", "system"])
     coll = sl[sl["theory_slope"] == 2]
@@ -134,7 +136,8 @@ def answers(ratios, compare, robust, slope, theory, smallest) -> list[str]:
         f"{small['difference'].min():+.2f} to {small['difference'].max():+.2f} nats per "
         f"perturbation ({int(within.sum())} of {len(small)} cells within ±{_pct(TOL)}); "
         f"largest {_nats(worst)} ({worst['rule']}, {_name(worst['system'])}, "
-        f"r = {worst['radius']:g}); caveat: the gap does not vanish like r, and at "
+        f"r = {worst['radius']:g}{_replicated(worst, replicate)}); caveat: the gap does not "
+        "vanish like r, and at "
         f"r = {far['radius']:g} it reaches {_nats(far)} ({far['rule']}, {_name(far['system'])}).")
     lines.append(
         f"- **Controls**: the verdict against 1 at ±{_pct(TOL)} is robust for "
@@ -168,7 +171,23 @@ def _ratio_rows(ratios, rule):
     return lines + [""]
 
 
-def body(meas, theory, compare, ratios, robust, rates, cost, *, n_ics,
+def _replicated(row, replicate):
+    """``"; its seed replicate -0.042 [...]"`` where the seed replicate has the cell."""
+    hit = replicate[(replicate["rule"] == row["rule"]) & (replicate["system"] == row["system"])
+                    & (replicate["radius"] == row["radius"])]
+    return f"; its seed replicate {_nats(hit.iloc[0])}" if len(hit) else ""
+
+
+def _replicate_text(replicate):
+    """The seed replicate's two-disk gap to the theory and collision count, per rule."""
+    two = replicate[replicate["system"] == "two_particle"]
+    return "; ".join(
+        f"{x['rule']}: simulation − theory {_nats(x)} nats, collisions over Γ(r)T "
+        f"{_ci(x, 'count_over_kinetic', 'count_ci_low', 'count_ci_high')}"
+        for _, x in two.iterrows())
+
+
+def body(meas, theory, compare, ratios, robust, rates, replicate, cost, *, n_ics,
          collisions) -> list[str]:
     """The sections after the answers."""
     lines = ["How to read it: intervals are 95 % percentile-bootstrap intervals over ICs "
@@ -190,7 +209,7 @@ def body(meas, theory, compare, ratios, robust, rates, cost, *, n_ics,
               "their errors are correlated (the seed replicate is in §3).", ""]
     for rule in ("mirror", "elastic"):
         lines += _difference_table(compare, rule)
-    kin = compare[~compare["system"].isin(MAIN)]
+    kin = compare[~compare["system"].isin(MAIN) & (compare["radius"] <= 1e-3)]
     lines += [f"The kinetic-rate kicks (not shown): simulation − theory "
               f"{kin['difference'].min():+.2f} to {kin['difference'].max():+.2f} nats at "
               "r ≤ 1e-3 and their ratios as the constant-rate kicks' "
@@ -203,7 +222,9 @@ def body(meas, theory, compare, ratios, robust, rates, cost, *, n_ics,
                           f"at r = {g.iloc[0]['radius']:g} (per IC "
                           f"{g.iloc[0]['per_ic_min']:.2f}–{g.iloc[0]['per_ic_max']:.2f})"
                           for u, g in rates[rates["radius"] == rates["radius"].min()]
-                          .groupby("rule")) + ".", ""]
+                          .groupby("rule")) + ". The seed replicate at r = "
+              f"{replicate['radius'].iloc[0]:g} (other ICs; `small_r_seed_replicate.csv`), "
+              "two disks: " + _replicate_text(replicate) + ".", ""]
     lines += ["## 2. The kicked / two-disk FTLE ratio against r", "",
               "Paired bootstrap over ICs; in parentheses the theory's ratio "
               "(`small_r_ratios.csv`, with measured / theory and its verdict).", ""]

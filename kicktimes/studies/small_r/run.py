@@ -116,10 +116,16 @@ def reproduce(out: str | os.PathLike, *, scale: str = "quick", results_dir=None,
     robust = findings(runs, control_runs(extra))
     slope = slopes(runs)
     rates = rate_check(runs)
+    seed_runs = control_runs(extra)
+    seed_runs = seed_runs[seed_runs["control"] == "seed"].drop(columns="control")
+    replicate = against_theory(measured(seed_runs), theory).merge(
+        rate_check(seed_runs)[["rule", "radius", "count_over_kinetic", "ci_low", "ci_high"]]
+        .rename(columns={"ci_low": "count_ci_low", "ci_high": "count_ci_high"}),
+        on=["rule", "radius"])
     cost = seconds_per_ic(stores)
     for name, frame in (("measured", meas), ("theory", theory), ("against_theory", compare),
                         ("ratios", ratios), ("findings", robust), ("slopes", slope),
-                        ("rate_check", rates), ("cost", cost)):
+                        ("rate_check", rates), ("seed_replicate", replicate), ("cost", cost)):
         run.write_csv(f"small_r_{name}.csv", frame)
     run.write_figure("small_r.png", small_r_figure(meas, compare, ratios))
 
@@ -131,8 +137,8 @@ def reproduce(out: str | os.PathLike, *, scale: str = "quick", results_dir=None,
          + ", the controls' " + ", ".join(f"`{s.experiment.name}`" for s in extra.values()),
          "the low-density theory (`kicktimes.diagnostics.low_density`, cached in "
          f"`{run.cache.name}`)"])
-    lines += answers(ratios, compare, robust, slope, theory, smallest) + [""]
-    lines += body(meas, theory, compare, ratios, robust, rates, cost, n_ics=sizes.n_ics,
-                  collisions=sizes.collisions)
+    lines += answers(ratios, compare, robust, slope, theory, smallest, replicate) + [""]
+    lines += body(meas, theory, compare, ratios, robust, rates, replicate, cost,
+                  n_ics=sizes.n_ics, collisions=sizes.collisions)
     run.say(f"page at {time.perf_counter() - t0:.0f} s")
     return run.write_page(lines, SOURCES)
