@@ -34,6 +34,8 @@ def small_r_figure(meas, compare, ratios):
 
     rules = [u for u in ("mirror", "elastic") if u in set(meas["rule"])]
     fig, axes = plt.subplots(len(rules), 3, figsize=(15, 4.3 * len(rules)), squeeze=False)
+    for ax in axes[1:, 1]:                      # one y scale for the rules' differences
+        ax.sharey(axes[0, 1])
     x_all = np.log(1 / meas["radius"])
     span = (x_all.min() - 0.3, x_all.max() + 0.3)
     for row, rule in zip(axes, rules, strict=True):

@@ -118,7 +118,10 @@ def reproduce(out: str | os.PathLike, *, scale: str = "quick", results_dir=None,
     rates = rate_check(runs)
     seed_runs = control_runs(extra)
     seed_runs = seed_runs[seed_runs["control"] == "seed"].drop(columns="control")
-    replicate = against_theory(measured(seed_runs), theory).merge(
+    rep_meas = measured(seed_runs)
+    replicate = against_theory(rep_meas, theory).merge(
+        rep_meas[["rule", "system", "radius", "ratio", "ratio_ci_low", "ratio_ci_high"]],
+        on=["rule", "system", "radius"]).merge(
         rate_check(seed_runs)[["rule", "radius", "count_over_kinetic", "ci_low", "ci_high"]]
         .rename(columns={"ci_low": "count_ci_low", "ci_high": "count_ci_high"}),
         on=["rule", "radius"])
