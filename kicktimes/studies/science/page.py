@@ -287,7 +287,11 @@ def stretching_lines(exp, per_radius, fits, trend):
                      f"{n_within} of {len(g)} radii"
                      + ("; the expectation of agreement is met at no measured radius."
                         if n_within == 0 else "."))
-    lines += ["", f"What happens below r = {lo_r:g} is not measured here. "
+    lines += ["", f"What happens below r = {lo_r:g} is not measured here: "
+              "[small_r.md](small_r.md) follows the ratio to r = 1e-4 on another design "
+              "(invariant-measure ICs drawn at each radius, runs of about 10⁴ collisions, "
+              f"where these runs of {exp.n_steps} steps of τ = {exp.tau:g} see few at the "
+              "smallest radii), beside the low-density theory of its limit r → 0. "
               "[scatter.md](scatter.md) measures the scatter-kick ratio on another sample "
               "(40 ICs, sticky orbits left out); differences at a shared radius are the "
               "samples'.", "",
