@@ -279,8 +279,7 @@ def test_tangent_exponent_agrees_with_the_renormalised_twin(table, r, positive):
 
 
 def test_curved_wall_tangent_is_the_circle_s_at_constant_curvature():
-    from kicktimes.billiard.kernels.drive_tables import curved_wall_tangent
-    from kicktimes.billiard.kernels.tangent import wall_tangent
+    from kicktimes.billiard.kernels.tangent import curved_wall_tangent, wall_tangent
 
     rho = 0.95
     x, y = rho * math.cos(0.3), rho * math.sin(0.3)

@@ -355,7 +355,7 @@ def free_run(table, state, r, *, n_bounces=None, t_max=None, n_record=None, tang
     The disk flies straight between specular reflections at the wall of its centre's
     curve (`kicktimes.billiard.kernels.tables`). The tangent vector ``(dq, dv)`` flies as
     ``dq += dv t`` and crosses each reflection by the exact linearised map at a wall of
-    local curvature ``kappa`` (`kicktimes.billiard.kernels.drive_tables.curved_wall_tangent`):
+    local curvature ``kappa`` (`kicktimes.billiard.kernels.tangent.curved_wall_tangent`):
     ``lyapunov = log(|u(T)| / |u(0)|) / T``.
 
     Parameters

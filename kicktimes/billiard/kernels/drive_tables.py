@@ -3,7 +3,8 @@ tangent vector, and Benettin's renormalised twin for a cross-check.
 
 The event is a wall contact: fly to it (``q += v t``, tangent ``dq += dv t``), put the
 centre back on the wall (`tables.contact`), reflect (`tables.bounce`) and carry the tangent
-vector across the reflection with the wall's local curvature (`curved_wall_tangent`).
+vector across the reflection with the wall's local curvature
+(`kicktimes.billiard.kernels.tangent.curved_wall_tangent`).
 
 Status codes as in `kicktimes.billiard.kernels.tangent`: 0 ok, 2 more than
 ``MAX_SAME_INSTANT`` contacts at one instant, 3 a non-finite contact time.
@@ -17,34 +18,9 @@ import numpy as np
 from numba import njit
 
 from kicktimes.billiard.kernels import tables
-from kicktimes.billiard.kernels.tangent import BIG2, MAX_SAME_INSTANT
+from kicktimes.billiard.kernels.tangent import BIG2, MAX_SAME_INSTANT, curved_wall_tangent
 
-__all__ = ["curved_wall_tangent", "free_kernel", "twin_kernel"]
-
-
-@njit(cache=True, error_model="numpy")
-def curved_wall_tangent(dqx, dqy, dvx, dvy, vx, vy, wx, wy, nx, ny, kappa):
-    """Tangent vector across a reflection at a wall of curvature ``kappa``, outward normal
-    ``n``, incoming velocity ``v`` and outgoing ``w``.
-
-    `kicktimes.billiard.kernels.tangent.wall_tangent` with the circle's ``1 / rho``
-    replaced by the local curvature (the normal turns as ``dn = kappa u`` along the wall):
-    ``dtau = -(n.dq)/(n.v)``, ``u = dq + v dtau`` (``u.n = 0``),
-    ``dq' = dq + (v - w) dtau``, ``dv' = R dv - 2 kappa [(v.u) n + (v.n) u]``,
-    ``R = I - 2 n n^T`` (Dellago, Posch & Hoover, Phys. Rev. E 53, 1485 (1996)). A flat
-    wall (``kappa = 0``) only mirrors ``dv``. NaN at an exactly tangent contact.
-    """
-    vn = vx * nx + vy * ny
-    if vn == 0.0:
-        return math.nan, math.nan, math.nan, math.nan
-    dtau = -(nx * dqx + ny * dqy) / vn
-    ux = dqx + vx * dtau
-    uy = dqy + vy * dtau
-    k = 2.0 * kappa
-    vu = vx * ux + vy * uy
-    dvn = 2.0 * (dvx * nx + dvy * ny)
-    return (dqx + (vx - wx) * dtau, dqy + (vy - wy) * dtau,
-            dvx - dvn * nx - k * (vu * nx + vn * ux), dvy - dvn * ny - k * (vu * ny + vn * uy))
+__all__ = ["free_kernel", "twin_kernel"]
 
 
 @njit(cache=True)

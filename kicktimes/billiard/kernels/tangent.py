@@ -6,7 +6,8 @@ the linearised event map (docs/lyapunov.md), written here once as scalar functio
 reference state at the event (contact position, incoming and outgoing velocities), beside
 the events themselves (`kicktimes.billiard.kernels.two`, `.one`):
 
-* `wall_tangent`: specular reflection at the table's wall ``|q| = rho`` (curvature term);
+* `wall_tangent`: specular reflection at the table's wall ``|q| = rho`` (curvature term),
+  the circle's case of `curved_wall_tangent` (a wall of any local curvature);
 * `pair_tangent`: disk-disk collision, rule 0 (mirror) or 1 (elastic); a partner whose
   state is fixed (a "scatter" kick off a virtual disk,
   `kicktimes.billiard.scatter.scatter_tangent`) is the case ``dq2 = dv2 = 0``;
@@ -31,9 +32,10 @@ import math
 import numpy as np
 from numba import njit
 
-__all__ = ["BIG", "MAX_SAME_INSTANT", "end_step", "event_guard", "gram_schmidt",
-           "guard", "kick_tangent", "load_carry", "pair_tangent", "renormalize", "start",
-           "step_end", "store_carry", "tangent_flight", "tangent_state", "wall_tangent"]
+__all__ = ["BIG", "MAX_SAME_INSTANT", "curved_wall_tangent", "end_step", "event_guard",
+           "gram_schmidt", "guard", "kick_tangent", "load_carry", "pair_tangent",
+           "renormalize", "start", "step_end", "store_carry", "tangent_flight",
+           "tangent_state", "wall_tangent"]
 
 #: the tangent half of a driver carries its position between calls in ``tgi`` (int64) and
 #: ``tgf`` (float64), at these indices; ``tgi[FRESH_PARTNER]`` (1: disk 1's deviation set
@@ -53,6 +55,32 @@ BIG2 = BIG * BIG
 
 
 @njit(cache=True, inline="always")
+def curved_wall_tangent(dqx, dqy, dvx, dvy, vx, vy, wx, wy, nx, ny, kappa):
+    """Tangent vector across a reflection at a wall of curvature ``kappa``, outward normal
+    ``n``, incoming velocity ``v`` and outgoing ``w``.
+
+    The map of every table's wall (the circle's `wall_tangent` is the case ``kappa = 1 /
+    rho``, ``n = q / rho``; the normal turns as ``dn = kappa u`` along the wall):
+    ``dtau = -(n.dq)/(n.v)``, ``u = dq + v dtau`` (``u.n = 0``),
+    ``dq' = dq + (v - w) dtau``, ``dv' = R dv - 2 kappa [(v.u) n + (v.n) u]``,
+    ``R = I - 2 n n^T`` (Dellago, Posch & Hoover, Phys. Rev. E 53, 1485 (1996)). A flat
+    wall (``kappa = 0``) only mirrors ``dv``. NaN at an exactly tangent contact.
+    """
+    vn = vx * nx + vy * ny
+    if vn == 0.0:
+        return math.nan, math.nan, math.nan, math.nan
+    dtau = -(nx * dqx + ny * dqy) / vn
+    ux = dqx + vx * dtau
+    uy = dqy + vy * dtau
+    k = 2.0 * kappa
+    vu = vx * ux + vy * uy
+    dvn = 2.0 * (dvx * nx + dvy * ny)
+    return (dqx + (vx - wx) * dtau, dqy + (vy - wy) * dtau,
+            dvx - dvn * nx - k * (vu * nx + vn * ux), dvy - dvn * ny - k * (vu * ny + vn * uy))
+
+
+
+@njit(cache=True, inline="always")
 def wall_tangent(dqx, dqy, dvx, dvy, x, y, vx, vy, wx, wy, rho):
     """Tangent vector across a reflection at the wall ``|q| = rho``.
 
@@ -67,20 +95,11 @@ def wall_tangent(dqx, dqy, dvx, dvy, x, y, vx, vy, wx, wy, rho):
     `kicktimes.billiard.geometry.graze` event) the contact time's variation is infinite:
     the linearised dynamics is singular there, and the result is NaN (the Python layer
     reports an undefined exponent instead of dividing by zero).
+    (``2 (1 / rho)`` is ``2 / rho`` to the bit: scaling by two is exact, so this is the
+    circle's map exactly as it was written before the curved walls shared it.)
     """
-    nx = x / rho
-    ny = y / rho
-    vn = vx * nx + vy * ny
-    if vn == 0.0:
-        return math.nan, math.nan, math.nan, math.nan
-    dtau = -(nx * dqx + ny * dqy) / vn
-    ux = dqx + vx * dtau
-    uy = dqy + vy * dtau
-    k = 2.0 / rho
-    vu = vx * ux + vy * uy
-    dvn = 2.0 * (dvx * nx + dvy * ny)
-    return (dqx + (vx - wx) * dtau, dqy + (vy - wy) * dtau,
-            dvx - dvn * nx - k * (vu * nx + vn * ux), dvy - dvn * ny - k * (vu * ny + vn * uy))
+    return curved_wall_tangent(dqx, dqy, dvx, dvy, vx, vy, wx, wy, x / rho, y / rho,
+                               1.0 / rho)
 
 
 @njit(cache=True)
