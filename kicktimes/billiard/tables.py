@@ -30,6 +30,7 @@ Stadium(a=1.0)
 
 from __future__ import annotations
 
+import abc
 import math
 from dataclasses import dataclass
 from typing import ClassVar
@@ -45,7 +46,7 @@ __all__ = ["Circle", "Ellipse", "Stadium", "TableLyapunov", "TableRun", "free_ru
            "table_lyapunov", "uniform_state"]
 
 
-class _Table(Result):
+class _Table(Result, abc.ABC):
     """What every table has: the admissible disk radii, the kernel's parameters, the
     centre's region (area, perimeter, membership) and its wall times."""
 
@@ -60,32 +61,32 @@ class _Table(Result):
         """``r`` as a float, or ValueError naming ``r`` and its range for this table."""
         return check_real("r", r, low=0.0, high=self.max_radius)
 
+    @abc.abstractmethod
     def kernel(self, r) -> tuple[int, float, float, float]:
         """``(kind, p0, p1, p2)`` of `kicktimes.billiard.kernels.tables` for radius ``r``."""
-        raise NotImplementedError
 
+    @abc.abstractmethod
     def area(self, r) -> float:
         """Area of the region the centre of a disk of radius ``r`` keeps to (``r = 0``:
         the table's)."""
-        raise NotImplementedError
 
     def _size_radius(self, r) -> float:
         """``r`` in ``[0, max_radius)``: a disk's radius, or 0 for the table itself."""
         return check_real("r", r, low=0.0, high=self.max_radius, low_open=False)
 
+    @abc.abstractmethod
     def perimeter(self, r) -> float:
         """Length of the centre's curve for a disk of radius ``r``."""
-        raise NotImplementedError
 
     def mean_free_time(self, r) -> float:
         """Mean time between wall contacts at unit speed, ``pi area / perimeter`` (the
         billiard's invariant measure; Santalo's formula)."""
         return math.pi * self.area(r) / self.perimeter(r)
 
+    @abc.abstractmethod
     def contains(self, positions, r) -> np.ndarray:
         """Whether each centre of ``positions`` (``(..., 2)``) keeps a disk of radius ``r``
         inside the table (on the centre's curve counts as inside, to ``1e-12``)."""
-        raise NotImplementedError
 
     def wall_time(self, positions, velocities, r) -> np.ndarray:
         """Time until each centre ``positions[i]`` (``(n, 2)``) moving with

@@ -30,7 +30,8 @@ from numba import njit
 
 from kicktimes.billiard import geometry as geo
 
-__all__ = ["CIRCLE", "ELLIPSE", "STADIUM", "boundary_coordinates", "bounce", "contact",
+__all__ = ["CIRCLE", "ELLIPSE", "STADIUM", "boundary_coordinates", "bounce", "circle_contact",
+           "contact",
            "ellipse_arc_length", "ellipse_hit", "ellipse_normal", "ellipse_parameter", "hit",
            "stadium_contact", "stadium_hit", "wall_time"]
 
@@ -89,20 +90,30 @@ def stadium_contact(x, y, vx, vy, a, rho, piece):
             x -= vx * ((y - yw) / vy)
         return x, yw, 0.0, 1.0 if piece == TOP else -1.0, 0.0
     cx = a if piece == RIGHT else -a
-    dx = x - cx
-    xv = dx * vx + y * vy
-    e2 = dx * dx + y * y - rho * rho
+    px, py, nx, ny, kappa = circle_contact(x - cx, y, vx, vy, rho)
+    return px + cx, py, nx, ny, kappa
+
+
+@njit(cache=True, error_model="numpy")
+def circle_contact(x, y, vx, vy, rho):
+    """``(x, y, nx, ny, kappa)`` of a contact with the circle ``|x| = rho`` centred at the
+    origin: the centre put back on the circle by one Newton step along the flight (as
+    `kicktimes.billiard.kernels.one.wall_event` does), or radially if the flight is
+    (nearly) tangent to it, the outward normal ``x / rho`` and the curvature ``1 / rho``.
+    The circle table's contact, and the stadium's on its arcs (shifted to the arc's
+    centre)."""
+    xv = x * vx + y * vy
     vv = vx * vx + vy * vy
     gz = geo.GRAZE_THRESHOLD * rho
     if xv > 0.0 and xv * xv >= gz * gz * vv:
-        e = e2 / (2.0 * xv)
-        dx -= vx * e
+        e = (x * x + y * y - rho * rho) / (2.0 * xv)
+        x -= vx * e
         y -= vy * e
     else:
-        s = 1.5 - 0.5 * (dx * dx + y * y) / (rho * rho)
-        dx *= s
-        y *= s
-    return dx + cx, y, dx / rho, y / rho, 1.0 / rho
+        k = 1.5 - 0.5 * (x * x + y * y) / (rho * rho)
+        x *= k
+        y *= k
+    return x, y, x / rho, y / rho, 1.0 / rho
 
 
 # --- the ellipse ---------------------------------------------------------------------------
@@ -199,16 +210,8 @@ def _ellipse_hit(x, y, vx, vy, A, B, r):
     Y = y * ibe
     VX = vx * ial
     VY = vy * ibe
-    aa = VX * VX + VY * VY
-    bb = X * VX + Y * VY
-    cc = 1.0 - X * X - Y * Y
-    disc = bb * bb + aa * cc
-    if disc < 0.0:
-        disc = 0.0
-    if bb > 0.0:
-        t0 = cc / (bb + math.sqrt(disc))
-    else:
-        t0 = (-bb + math.sqrt(disc)) / aa
+    # the first guess: the exit from the scaled unit circle (the ellipse of the start)
+    t0 = geo.boundary_hit_time(X, Y, VX, VY, 1.0)
     c = X + VX * t0
     s = Y + VY * t0
     nrm2 = c * c + s * s
@@ -420,19 +423,7 @@ def contact(kind, p0, p1, p2, x, y, vx, vy, w1, w2):
     time): the centre put back on the wall, the outward unit normal, the curvature of the
     centre's curve (positive: the wall curves towards the inside)."""
     if kind == CIRCLE:
-        rho = p0
-        xv = x * vx + y * vy
-        vv = vx * vx + vy * vy
-        gz = geo.GRAZE_THRESHOLD * rho
-        if xv > 0.0 and xv * xv >= gz * gz * vv:
-            e = (x * x + y * y - rho * rho) / (2.0 * xv)
-            x -= vx * e
-            y -= vy * e
-        else:
-            k = 1.5 - 0.5 * (x * x + y * y) / (rho * rho)
-            x *= k
-            y *= k
-        return x, y, x / rho, y / rho, 1.0 / rho
+        return circle_contact(x, y, vx, vy, p0)
     if kind == STADIUM:
         return stadium_contact(x, y, vx, vy, p0, p1, int(w1))
     # w = the normal N = (B c, A s) / h, so 1 / h = sqrt((N_x / B)^2 + (N_y / A)^2)
