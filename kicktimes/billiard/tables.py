@@ -42,7 +42,7 @@ from kicktimes.billiard.kernels import drive_tables as _drive
 from kicktimes.billiard.kernels import tables as _k
 from kicktimes.validation import check_int, check_real, check_rng
 
-__all__ = ["Circle", "Ellipse", "Stadium", "TableLyapunov", "TableRun", "free_run",
+__all__ = ["Circle", "Ellipse", "Stadium", "TableLyapunov", "TableRun", "check_table", "free_run",
            "table_lyapunov", "uniform_state"]
 
 
@@ -257,10 +257,25 @@ class Ellipse(_Table):
         return out.reshape(q.shape[:-1])
 
 
-def _check_table(table):
+def check_table(table, name: str = "table"):
+    """The table a simulator runs in: ``None`` is the unit circle, `Circle()`; a `Circle`,
+    `Stadium` or `Ellipse` is itself; anything else is a TypeError naming ``name``.
+
+    Every function that takes ``table=`` reads it through this check, so the circle's
+    default path is one test away: ``check_table(table) == Circle()``.
+
+    Examples
+    --------
+    >>> check_table(None)
+    Circle()
+    >>> check_table(Stadium(1.0)) == Stadium(1.0)
+    True
+    """
+    if table is None:
+        return Circle()
     if not isinstance(table, _Table):
-        raise TypeError(f"table must be a kicktimes.tables Circle, Stadium or Ellipse, got "
-                        f"{type(table).__name__}")
+        raise TypeError(f"{name} must be None or a kicktimes.tables Circle, Stadium or "
+                        f"Ellipse, got {type(table).__name__}")
     return table
 
 
@@ -286,7 +301,7 @@ def uniform_state(table, r, *, rng=None) -> np.ndarray:
     >>> bool(Ellipse(1.5, 1.0).contains(s[:2], 0.05)), float(round(s[2]**2 + s[3]**2, 12))
     (True, 1.0)
     """
-    table = _check_table(table)
+    table = check_table(table)
     r = table.check_radius(r)
     gen = check_rng(rng)
     box = (1.0 + getattr(table, "a", 0.0) if isinstance(table, Stadium)
@@ -389,7 +404,7 @@ def free_run(table, state, r, *, n_bounces=None, t_max=None, n_record=None, tang
     >>> run.times.round(6)
     array([0.729158, 2.627473, 4.525788])
     """
-    table = _check_table(table)
+    table = check_table(table)
     r = table.check_radius(r)
     s = _check_state(table, state, r)
     if n_bounces is None and t_max is None:
@@ -485,7 +500,7 @@ def table_lyapunov(table, state, r, *, n_bounces, method="tangent", d0=1e-9, eve
     >>> bool(abs(lt.exponent - lw.exponent) < 0.1 * lt.exponent)
     True
     """
-    table = _check_table(table)
+    table = check_table(table)
     r = table.check_radius(r)
     s = _check_state(table, state, r)
     n = check_int("n_bounces", n_bounces, low=1)
