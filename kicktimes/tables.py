@@ -5,15 +5,20 @@ The public home of `kicktimes.billiard.tables` (docs/tables.md); see there.
 """
 
 from kicktimes.billiard.tables import (
+    TABLE_KINDS,
     Circle,
     Ellipse,
     Stadium,
     TableLyapunov,
     TableRun,
+    check_table,
     free_run,
+    parse_table,
     table_lyapunov,
+    table_spec,
     uniform_state,
 )
 
-__all__ = ["Circle", "Ellipse", "Stadium", "TableLyapunov", "TableRun", "free_run",
-           "table_lyapunov", "uniform_state"]
+__all__ = ["TABLE_KINDS", "Circle", "Ellipse", "Stadium", "TableLyapunov", "TableRun",
+           "check_table", "free_run", "parse_table", "table_lyapunov", "table_spec",
+           "uniform_state"]

@@ -42,8 +42,9 @@ from kicktimes.billiard.kernels import drive_tables as _drive
 from kicktimes.billiard.kernels import tables as _k
 from kicktimes.validation import check_int, check_real, check_rng
 
-__all__ = ["Circle", "Ellipse", "Stadium", "TableLyapunov", "TableRun", "check_table", "free_run",
-           "table_lyapunov", "uniform_state"]
+__all__ = ["TABLE_KINDS", "Circle", "Ellipse", "Stadium", "TableLyapunov", "TableRun",
+           "check_table", "free_run", "parse_table", "table_lyapunov", "table_spec",
+           "uniform_state"]
 
 
 class _Table(Result, abc.ABC):
@@ -531,3 +532,63 @@ def table_lyapunov(table, state, r, *, n_bounces, method="tangent", d0=1e-9, eve
     return TableLyapunov(table=table, r=r, method=method, exponent=float(exponent),
                          per_bounce=float(per), n_bounces=int(ref[8]), t_end=float(t_last),
                          n_forced=int(n_forced), reason=reason)
+
+
+# --- tables as text (TOML presets, stores, the command line) -----------------------------
+
+#: the table names of `table_spec` and `parse_table`, with their parameters
+TABLE_KINDS = {"circle": (), "stadium": ("a",), "ellipse": ("a", "b")}
+
+
+def table_spec(table) -> str:
+    """A table as one line of text: ``"circle"``, ``"stadium a=1"``, ``"ellipse a=1.5 b=1"``
+    (each parameter by ``repr``, so `parse_table` gives the same value back).
+
+    Examples
+    --------
+    >>> table_spec(None), table_spec(Stadium(1.0)), table_spec(Ellipse(1.5, 1.0))
+    ('circle', 'stadium a=1.0', 'ellipse a=1.5 b=1.0')
+    """
+    table = check_table(table)
+    kind = {Circle: "circle", Stadium: "stadium", Ellipse: "ellipse"}[type(table)]
+    return " ".join([kind] + [f"{p}={getattr(table, p)!r}" for p in TABLE_KINDS[kind]])
+
+
+def parse_table(spec, name: str = "table"):
+    """The table written by `table_spec`: a name of `TABLE_KINDS` followed by its parameters
+    as ``key=value`` words (``"stadium a=1"``); a ValueError naming ``name`` otherwise.
+
+    Examples
+    --------
+    >>> parse_table("ellipse a=1.5 b=1")
+    Ellipse(a=1.5, b=1.0)
+    >>> parse_table("circle") == Circle()
+    True
+    """
+    if not isinstance(spec, str):
+        raise TypeError(f"{name}: expected a table as text such as 'stadium a=1', got "
+                        f"{type(spec).__name__}")
+    words = spec.split()
+    def form(kind):
+        return " ".join([kind] + [f"{p}=..." for p in TABLE_KINDS[kind]])
+
+    kinds = ", ".join(f"'{form(k)}'" for k in TABLE_KINDS)
+    if not words or words[0] not in TABLE_KINDS:
+        raise ValueError(f"{name}: expected one of {kinds}, got {spec!r}")
+    kind, params = words[0], {}
+    for word in words[1:]:
+        key, eq, value = word.partition("=")
+        if not eq or key not in TABLE_KINDS[kind] or key in params:
+            raise ValueError(f"{name}: expected '{form(kind)}', got {spec!r}")
+        try:
+            params[key] = float(value)
+        except ValueError:
+            raise ValueError(f"{name}: {key} must be a number, got {value!r} in "
+                             f"{spec!r}") from None
+    missing = [p for p in TABLE_KINDS[kind] if p not in params]
+    if missing:
+        raise ValueError(f"{name}: expected '{form(kind)}', got {spec!r}")
+    try:
+        return {"circle": Circle, "stadium": Stadium, "ellipse": Ellipse}[kind](**params)
+    except ValueError as exc:
+        raise ValueError(f"{name}: {exc}") from None
