@@ -8,7 +8,13 @@ robust to a shared machine), interleaved table by table in this process, so the 
 compare like with like. Without and with the tangent vector. The issue's targets: the
 stadium at most 1.3x the circle, the ellipse at most 3x.
 
+The section ``two`` times two disks (`kicktimes.simulate_two_particle`, no samples, and
+the tangent FTLE `kicktimes.diagnostics.lyapunov`) in the same tables at the same ``--r``
+over the horizon ``--two-horizon``, per event (disk-disk and wall), as a ratio to the
+circle (``table=None``, the circle's own kernels).
+
 Run: python benchmarks/bench_tables.py [--bounces 1000000] [--repeat 5] [--r 0.02]
+     [--section free|two|all] [--two-horizon 20000]
 """
 
 import argparse
@@ -16,7 +22,46 @@ import time
 
 from _timing import best_time
 
+from kicktimes import initial_conditions, simulate_two_particle
+from kicktimes.diagnostics import lyapunov
 from kicktimes.tables import Circle, Ellipse, Stadium, free_run, uniform_state
+
+
+def two_disks(args):
+    """Two disks, mirror rule, per event: the simulation and the tangent FTLE."""
+    horizon = args.two_horizon
+    cases = [("Circle()", None), ("Stadium(1)", Stadium(1.0)),
+             ("Ellipse(1.5, 1)", Ellipse(1.5, 1.0))]
+    ics = {name: initial_conditions(1, args.r, rng=1, method="uniform", table=table)[0]
+           for name, table in cases}
+    n_steps = int(horizon / 0.5)
+    for name, table in cases:  # compile and warm up
+        simulate_two_particle(ics[name], args.r, t_max=10.0, table=table)
+        lyapunov(ics[name], args.r, n_steps=20, tau=0.5, table=table)
+    best, events = {}, {}
+    for _ in range(args.repeat):
+        for name, table in cases:
+            ic = ics[name]
+            sim = best_time(lambda ic=ic, t=table: simulate_two_particle(
+                ic, args.r, t_max=horizon, table=t), 1, clock=time.process_time)
+            tan = best_time(lambda ic=ic, t=table: lyapunov(
+                ic, args.r, n_steps=n_steps, tau=0.5, table=t), 1, clock=time.process_time)
+            best[(name, False)] = min(best.get((name, False), float("inf")), sim)
+            best[(name, True)] = min(best.get((name, True), float("inf")), tan)
+            if name not in events:
+                run = simulate_two_particle(ic, args.r, t_max=horizon, table=table)
+                events[name] = run.n_pp + run.n_boundary
+    print(f"\ntwo disks, mirror rule, r = {args.r:g}, t_max = {horizon:g}, best of "
+          f"{args.repeat} CPU times (tangent: lyapunov, tau = 0.5)")
+    print("| table | events | ns/event | × circle | ns/event, tangent | × circle |")
+    print("|---|---|---|---|---|---|")
+    c_sim = best[("Circle()", False)] / events["Circle()"]
+    c_tan = best[("Circle()", True)] / events["Circle()"]
+    for name, _ in cases:
+        sim = best[(name, False)] / events[name]
+        tan = best[(name, True)] / events[name]
+        print(f"| {name} | {events[name]} | {1e9 * sim:.1f} | {sim / c_sim:.2f} | "
+              f"{1e9 * tan:.1f} | {tan / c_tan:.2f} |")
 
 
 def main():
@@ -25,7 +70,17 @@ def main():
     parser.add_argument("--repeat", type=int, default=5)
     parser.add_argument("--r", type=float, default=0.02)
     parser.add_argument("--r-large", type=float, default=0.3)
+    parser.add_argument("--section", choices=("free", "two", "all"), default="all")
+    parser.add_argument("--two-horizon", type=float, default=2e4)
     args = parser.parse_args()
+    if args.section in ("free", "all"):
+        free_disk(args)
+    if args.section in ("two", "all"):
+        two_disks(args)
+
+
+def free_disk(args):
+    """One free disk per table: the wall step alone."""
     cases = [("Circle()", Circle(), args.r), ("Stadium(1)", Stadium(1.0), args.r),
              ("Ellipse(1.5, 1)", Ellipse(1.5, 1.0), args.r),
              (f"Ellipse(2, 1), r = {args.r_large:g}", Ellipse(2.0, 1.0), args.r_large)]

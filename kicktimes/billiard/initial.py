@@ -1,4 +1,5 @@
-"""Initial-condition ensembles for the two-disk billiard.
+"""Initial-condition ensembles for the two-disk billiard (in the unit circle, or in another
+table of `kicktimes.tables`).
 
 IC ``i`` of an ensemble is drawn from its own generator,
 ``numpy.random.default_rng(SeedSequence(seed, spawn_key=(i,)))`` (the ``i``-th child of
@@ -16,6 +17,7 @@ import numpy as np
 
 from kicktimes.billiard import checks as chk
 from kicktimes.billiard._crmath import cos_sin
+from kicktimes.billiard.tables import Circle, Ellipse, Stadium, check_table
 from kicktimes.validation import check_seed_sequence, renamed_keyword
 
 METHODS = ("paper", "uniform")
@@ -183,6 +185,12 @@ def _uniform_ic(rng: np.random.Generator, r_max, rule: str, masses=None) -> np.n
         x, y = _uniform_pair(rng, r_max)
     out[:, 0] = x
     out[:, 1] = y
+    _velocities(rng, out, rule, masses)
+    return out
+
+
+def _velocities(rng, out, rule, masses):
+    """The velocities of the invariant measure of ``rule`` into ``out[:, 2:]``."""
     if rule == "mirror":
         angle = rng.uniform(0.0, 2.0 * np.pi, size=2)
         out[0, 2:] = cos_sin(angle[0])
@@ -201,12 +209,40 @@ def _uniform_ic(rng: np.random.Generator, r_max, rule: str, masses=None) -> np.n
             g[2:] /= math.sqrt(2.0 * masses[1] / total)
         out[0, 2:] = g[:2]
         out[1, 2:] = g[2:]
+
+
+def _half_widths(table, r):
+    """Half the sides of the box ``[-X, X] x [-Y, Y]`` holding the centres' region."""
+    if isinstance(table, Stadium):
+        return table.a + 1.0 - r, 1.0 - r
+    if isinstance(table, Ellipse):
+        return table.a - r, table.b - r
+    return 1.0 - r, 1.0 - r
+
+
+def _table_ic(rng: np.random.Generator, r, rule: str, masses, table) -> np.ndarray:
+    # The invariant measure in another table: the pair of centres uniform on the
+    # non-overlapping configurations in the centre's region (joint rejection from the
+    # region's bounding box, `table.contains`), the velocities as in the circle.
+    hx, hy = _half_widths(table, r)
+    out = np.empty((2, 4))
+    scale = np.array([hx, hy, hx, hy])
+    for _ in range(100 * N_TRY):
+        q = rng.uniform(-1.0, 1.0, size=4) * scale
+        if (math.hypot(q[0] - q[2], q[1] - q[3]) >= 2.0 * r
+                and table.contains(q.reshape(2, 2), r).all()):
+            break
+    else:
+        raise RuntimeError(f"r_max={r!r}: no non-overlapping pair in {table!r} in "
+                           f"{100 * N_TRY} draws")
+    out[:, :2] = q.reshape(2, 2)
+    _velocities(rng, out, rule, masses)
     return out
 
 
 @renamed_keyword(old="seed", new="rng", since="0.2.0")
 def initial_conditions(n, r_max, *, rng=0, method="paper", rule="mirror", start=0,
-                       masses=None) -> np.ndarray:
+                       masses=None, table=None) -> np.ndarray:
     """Draw an ensemble of two-disk initial conditions.
 
     Parameters
@@ -238,6 +274,14 @@ def initial_conditions(n, r_max, *, rng=0, method="paper", rule="mirror", start=
     masses : (float, float), optional
         ``method="uniform"``, ``rule="elastic"``: the disks' masses; velocities uniform on
         ``m0 |v0|^2 + m1 |v1|^2 = 2`` with the masses normalised to ``(m0 + m1) / 2 = 1``.
+    table : Circle, Stadium or Ellipse, optional
+        The table (`kicktimes.tables`; ``None``: the unit circle, whose ensembles do not
+        change). In a `Stadium` or an `Ellipse` only ``method="uniform"``: both centres
+        uniform in the region of a disk of radius ``r_max`` (the inner parallel curve,
+        ``table.contains``), not overlapping (``|q0 - q1| >= 2 r_max``), by joint
+        rejection from the region's bounding box; the velocities as the circle's uniform
+        method draws them for ``rule``. ``r_max`` must be one radius that the table admits
+        (``table.check_radius``).
 
     Notes
     -----
@@ -258,8 +302,25 @@ def initial_conditions(n, r_max, *, rng=0, method="paper", rule="mirror", start=
     (5, 2, 4)
     >>> bool((initial_conditions(2, 0.03, rng=1, start=3) == ics[3:5]).all())
     True
+
+    In an ellipse:
+
+    >>> from kicktimes.tables import Ellipse
+    >>> ics = initial_conditions(3, 0.05, rng=1, method="uniform", table=Ellipse(1.5, 1.0))
+    >>> bool(Ellipse(1.5, 1.0).contains(ics[..., :2], 0.05).all())
+    True
     """
     n = chk.check_int("n", n, low=1)
+    table = check_table(table)
+    if table != Circle():
+        if isinstance(r_max, tuple):
+            raise ValueError(f"r_max: two disks in {table!r} must be equal (one radius), got "
+                             f"{r_max!r}")
+        r_max = table.check_radius(chk.check_real("r_max", r_max, low=0.0, high=0.5))
+        if method != "uniform":
+            raise ValueError(f"method: only method='uniform' (the invariant measure) draws in "
+                             f"{table!r}; the paper's procedure is the unit circle's, got "
+                             f"method={method!r}")
     if isinstance(r_max, tuple):
         # unequal disks: the invariant measure of the pair of radii
         r0, r1, r_max = chk.check_radii(r_max)
@@ -291,6 +352,9 @@ def initial_conditions(n, r_max, *, rng=0, method="paper", rule="mirror", start=
     for k in range(n):
         gen = np.random.default_rng(np.random.SeedSequence(
             root.entropy, spawn_key=(*root.spawn_key, start + k), pool_size=root.pool_size))
-        out[k] = (_paper_ic(gen, r_max) if method == "paper"
-                  else _uniform_ic(gen, r_max, rule, masses))
+        if table != Circle():
+            out[k] = _table_ic(gen, r_max, rule, masses, table)
+        else:
+            out[k] = (_paper_ic(gen, r_max) if method == "paper"
+                      else _uniform_ic(gen, r_max, rule, masses))
     return out

@@ -24,6 +24,7 @@ import pandas as pd
 
 from kicktimes import __version__
 from kicktimes._results import TableResult
+from kicktimes.billiard.tables import Circle, Ellipse, Stadium
 from kicktimes.fileio import atomic_write
 
 TWO_PI = 2.0 * np.pi
@@ -53,6 +54,24 @@ def _arclength(x: np.ndarray, y: np.ndarray) -> np.ndarray:
     # arctan2 of a tiny negative y gives -0.0 + 2 pi = 2 pi exactly; keep the half-open range
     s[s >= TWO_PI] = 0.0
     return s
+
+
+def table_meta(table) -> dict:
+    """A table as JSON-able parameters: ``{"name": "Stadium", "a": 1.0}``."""
+    out = {"name": type(table).__name__}
+    for name in ("a", "b"):
+        if hasattr(table, name):
+            out[name] = float(getattr(table, name))
+    return out
+
+
+_TABLES = {cls.__name__: cls for cls in (Circle, Stadium, Ellipse)}
+
+
+def table_from_meta(meta: dict):
+    """The table of `table_meta`'s parameters."""
+    params = dict(meta)
+    return _TABLES[params.pop("name")](**params)
 
 
 def sampling_fields(t_end, mode, sampling, tau, n_steps, sample_times, samples) -> dict:
@@ -168,7 +187,17 @@ class TwoParticleRun(_Run):
     pp_times : ndarray
         Every disk-disk collision time, increasing, in ``(0, t_max]``.
     boundary : DataFrame
-        Columns ``time, particle, s, sin_theta`` (docs/architecture.md conventions), time order.
+        Columns ``time, particle, s, sin_theta`` (docs/architecture.md conventions), time
+        order: ``s`` the contact's polar angle in ``[0, 2 pi)``, ``sin_theta`` the incoming
+        velocity's tangential component. In another table (``table`` not the circle) the
+        Birkhoff coordinates of `kicktimes.billiard.kernels.tables.boundary_coordinates`:
+        columns ``time, particle, arc, s, sin_theta``, ``arc`` the arc length along the
+        centre's curve counter-clockwise from its rightmost point, in ``[0, L(r))``, and
+        ``s = 2 pi arc / L(r)`` the same as an angle (in the circle that is the polar angle,
+        so ``s`` keeps its range and meaning of "where on the wall").
+    table : Circle, Stadium or Ellipse
+        The table (docs/tables.md); ``Circle()`` for the unit circle, the default, which
+        the run's record (``meta``, Parquet) leaves out.
     sample_times, samples : ndarray, shapes (n,) and (n, 2)
         Sample times and the tracked disk's centre at them (empty without sampling).
     pp_log : ndarray, shape (n_pp, 12) or (0, 12)
@@ -177,9 +206,9 @@ class TwoParticleRun(_Run):
         the same as a DataFrame with the time and the contact normal.
     """
 
-    _title = "Two disks in the unit circular table (simulate_two_particle)"
-    _summary_fields = ("r", "rule", "t_max", "n_pp", "n_boundary", "masses", "sampling", "tau",
-                       "n_steps", "seed")
+    _title = "Two disks in a billiard table (simulate_two_particle)"
+    _summary_fields = ("table", "r", "rule", "t_max", "n_pp", "n_boundary", "masses",
+                       "sampling", "tau", "n_steps", "seed")
 
     rule: str = "mirror"
     track: int = 0
@@ -187,6 +216,8 @@ class TwoParticleRun(_Run):
     pp_log: np.ndarray = field(default_factory=lambda: np.empty((0, 12)))
     #: the elastic rule's masses, normalised to ``(m0, m1) * 2 / (m0 + m1)`` (None: equal)
     masses: tuple | None = None
+    #: the table (`kicktimes.tables`); the circle's runs leave it out of their record
+    table: object = Circle()
 
     kind = "two_particle"
     _array_fields = ("pp_times", "pp_log")
@@ -194,14 +225,36 @@ class TwoParticleRun(_Run):
     _scalar_fields = ("r", "rule", "t_max", "sampling", "tau", "n_steps", "track", "seed",
                       "version")
 
+    @property
+    def meta(self) -> dict:
+        out = super().meta
+        if self.table != Circle():
+            out["table"] = table_meta(self.table)
+        return out
+
     @cached_property
     def boundary(self) -> pd.DataFrame:
         log = self.boundary_log
+        if self.table == Circle():
+            return pd.DataFrame(
+                {
+                    "time": log.time,
+                    "particle": log.particle,
+                    "s": _arclength(log.x, log.y),
+                    "sin_theta": log.sin_theta,
+                }
+            )
+        from kicktimes.billiard.kernels.two import table_arc_lengths
+
+        arc = table_arc_lengths(*self.table.kernel(self.r), np.ascontiguousarray(log.x),
+                                np.ascontiguousarray(log.y))
+        length = self.table.perimeter(self.r)
         return pd.DataFrame(
             {
                 "time": log.time,
                 "particle": log.particle,
-                "s": _arclength(log.x, log.y),
+                "arc": arc,
+                "s": np.minimum(arc * (TWO_PI / length), np.nextafter(TWO_PI, 0.0)),
                 "sin_theta": log.sin_theta,
             }
         )
@@ -353,6 +406,8 @@ def read_run(path: str | os.PathLike) -> TwoParticleRun | OneParticleRun:
         kwargs[name] = arr[name]
         if name in cls._array_columns:
             kwargs[name] = arr[name].reshape(-1, cls._array_columns[name])
+    if isinstance(kwargs.get("table"), dict):
+        kwargs["table"] = table_from_meta(kwargs["table"])
     if meta.get("kick_angle") == "scatter":
         kwargs["kick_angles"] = kwargs["kick_angles"].reshape(-1, 2)
     known = {f.name for f in fields(cls)}

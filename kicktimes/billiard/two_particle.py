@@ -1,4 +1,5 @@
-"""Two equal hard disks in the unit circular table: the simulator's Python layer.
+"""Two hard disks in a billiard table (the unit circle, a stadium, an ellipse): the
+simulator's Python layer.
 
 `simulate_two_particle` checks its arguments, sets up the run (`kernel_args`: state, event
 budget, first log sizes) and turns the kernel's output into a `TwoParticleRun`
@@ -24,6 +25,7 @@ from kicktimes.billiard.kernels import two
 from kicktimes.billiard.kernels.drive_two import simulate_two_kernel
 from kicktimes.billiard.kernels.observe import DONE, OVER_BUDGET, STALLED
 from kicktimes.billiard.runs import BoundaryLog, TwoParticleRun, sampling_fields
+from kicktimes.billiard.tables import Circle, check_table
 
 
 def raise_for_status(status: int, st_time: float, n_events: int, *, max_events: int,
@@ -43,16 +45,23 @@ def raise_for_status(status: int, st_time: float, n_events: int, *, max_events: 
         )
 
 
-def check_two_particle_ic(ic, r, rule: str, name: str = "ic") -> np.ndarray:
-    """Validate a two-disk initial condition for radius ``r`` (or radii ``(r0, r1)``);
-    returns a float64 (2, 4) copy."""
+def check_two_particle_ic(ic, r, rule: str, name: str = "ic", table=None) -> np.ndarray:
+    """Validate a two-disk initial condition for radius ``r`` (or radii ``(r0, r1)``) in
+    ``table`` (``None``: the unit circle; another table: equal disks, each centre inside
+    its region, ``table.contains``); returns a float64 (2, 4) copy."""
     arr = chk.check_state(name, ic, (2, 4))
     radii = tuple(r) if isinstance(r, tuple) else (r, r)
     # plain floats: the checks run on every simulator call, and numpy scalars cost ~10x
     rows = arr.tolist()
+    if table is not None and table != Circle():
+        inside = table.contains(arr[:, :2], radii[0])
     for i, (x, y, vx, vy) in enumerate(rows):
         which = "disk 0" if i == 0 else "disk 1"
-        chk.check_inside(name, x, y, 1.0 - radii[i], radii[i], which)
+        if table is None or table == Circle():
+            chk.check_inside(name, x, y, 1.0 - radii[i], radii[i], which)
+        elif not inside[i]:
+            raise ValueError(f"{name}: {which}'s centre ({x!r}, {y!r}) keeps no disk of "
+                             f"radius {radii[i]!r} inside {table!r}")
         if rule == "mirror":
             chk.check_unit_speed(name, vx, vy, which)
         else:
@@ -81,8 +90,8 @@ def _old_two_particle(args, kwargs):
 @old_keywords(_old_two_particle)
 def simulate_two_particle(ic, r, *, t_max=None, rule="mirror", sampling="uniform", n_steps=None,
                           tau=None, track=0, max_events=None, log_collisions=False, holes=None,
-                          masses=None) -> TwoParticleRun:
-    """Simulate two disks of radius ``r`` in the unit circular table.
+                          masses=None, table=None) -> TwoParticleRun:
+    """Simulate two disks of radius ``r`` in the unit circular table, or in another table.
 
     Event-driven and exact: the disks move freely between collisions whose times are
     roots of quadratics (docs/architecture.md); boundary collisions are specular, disk-disk
@@ -126,7 +135,19 @@ def simulate_two_particle(ic, r, *, t_max=None, rule="mirror", sampling="uniform
         Holes in the table's wall: rows ``(centre angle, half-width)`` in radians. A disk
         whose wall contact lies in a hole escapes there: the run ends at that time
         (``run.escape_time``, ``run.escaped`` the disk; ``inf`` and -1 if none escaped by
-        the end), and its samples stop there.
+        the end), and its samples stop there. The unit circle only (a ValueError in
+        another table).
+    table : Circle, Stadium or Ellipse, optional
+        The table (`kicktimes.tables`; ``None``: ``Circle()``, the unit circle, whose runs
+        are bitwise those without the keyword). In a `Stadium` or an `Ellipse` the disks
+        must be equal (one ``r``, which the table must admit: ``table.check_radius``, e.g.
+        ``r < b^2 / a`` in the ellipse) and ``holes`` is refused; each disk's centre keeps
+        to the table's inner parallel curve at distance ``r`` (docs/tables.md), its wall
+        contacts found, put back on the wall and reflected by
+        `kicktimes.billiard.kernels.tables` (``hit``, ``contact``, ``bounce``), its speed
+        kept by one Newton step after each reflection. The run records the table
+        (``run.table``) and ``run.boundary`` gives the contacts' Birkhoff coordinates
+        (``arc``, ``s = 2 pi arc / L``, ``sin_theta``).
 
     Returns
     -------
@@ -166,34 +187,64 @@ def simulate_two_particle(ic, r, *, t_max=None, rule="mirror", sampling="uniform
     >>> run = simulate_two_particle(ic, 0.02, t_max=200.0)
     >>> bool((run.pp_times > 0).all() and (run.pp_times <= 200.0).all())
     True
+
+    In a stadium (initial conditions drawn from its invariant measure):
+
+    >>> from kicktimes.tables import Stadium
+    >>> ic = initial_conditions(1, 0.02, rng=1, method="uniform", table=Stadium(1.0))[0]
+    >>> run = simulate_two_particle(ic, 0.02, t_max=200.0, table=Stadium(1.0))
+    >>> run.table, bool(Stadium(1.0).contains(run.final_state[:, :2], 0.02).all())
+    (Stadium(a=1.0), True)
     """
     _, _, r = chk.check_radii(r)
+    table = check_table(table)
+    circle = table == Circle()
+    if not circle:
+        if isinstance(r, tuple):
+            raise ValueError(f"r: two disks in {table!r} must be equal (one radius), got "
+                             f"{r!r}; unequal disks run in the unit circle only")
+        r = table.check_radius(r)
+        if holes is not None:
+            raise ValueError(f"holes: holes are arcs of the unit circle's wall; {table!r} "
+                             "has none")
     chk.check_choice("rule", rule, chk.RULES)
     t_max, n_steps, tau, mode = chk.check_sampling(t_max, n_steps, tau, sampling)
     track = chk.check_int("track", track, low=0)
     if track > 1:
         raise ValueError(f"track must be 0 or 1, got {track}")
     masses = chk.check_masses(masses, rule)
-    ic = check_two_particle_ic(ic, r, rule)
+    ic = check_two_particle_ic(ic, r, rule, table=None if circle else table)
     if not isinstance(log_collisions, bool | np.bool_):
         raise TypeError(f"log_collisions must be a bool, got {type(log_collisions).__name__}")
     arcs = chk.check_holes(holes)
-    args = kernel_args(ic, r, rule, mode, t_max, n_steps, tau, track, max_events, masses)
-    out = simulate_two_kernel(*args, bool(log_collisions), arcs)
+    if circle:
+        args = kernel_args(ic, r, rule, mode, t_max, n_steps, tau, track, max_events, masses)
+        out = simulate_two_kernel(*args, bool(log_collisions), arcs)
+    else:
+        args = kernel_args(ic, r, rule, mode, t_max, n_steps, tau, track, max_events, masses,
+                           table=table)
+        out = simulate_two_kernel(*args, bool(log_collisions), None, table.kernel(r))
     return two_particle_run(out, args, r=r, rule=rule, sampling=sampling, tau=tau,
-                            n_steps=n_steps, ic=ic, track=track, seed=None, name="ic")
+                            n_steps=n_steps, ic=ic, track=track, seed=None, name="ic",
+                            table=table)
 
 
-def kernel_args(ic, r, rule, mode, t_max, n_steps, tau, track, max_events, masses=None) -> tuple:
+def kernel_args(ic, r, rule, mode, t_max, n_steps, tau, track, max_events, masses=None, *,
+                table=None) -> tuple:
     """`simulate_two_kernel`'s arguments (all but ``log_pp``) for validated inputs.
 
     ``ic``, ``r``, ``rule``, ``track`` validated, ``(t_max, n_steps, tau, mode)`` from
-    `check_sampling`, ``max_events`` as given (``None``: the default budget). Shared with
+    `check_sampling`, ``max_events`` as given (``None``: the default budget); ``table``
+    another table than the circle (its mean free path sets the budget). Shared with
     the one-pass FTLE (`kicktimes.diagnostics.lyapunov`), which must run the very same
     simulation.
     """
     x0, y0, vx0, vy0, x1, y1, vx1, vy1 = ic.ravel().tolist()
     r0, r1 = r if isinstance(r, tuple) else (r, r)
+    # the budget counts collisions per mean free path, pi rho / 2 in the circle: in another
+    # table the radius of the circle of the same mean free path (pi A / L, Santalo)
+    budget_rho = (min(1.0 - r0, 1.0 - r1) if table is None
+                  else 2.0 * table.mean_free_time(r0) / math.pi)
     table = two.table(1.0 - r0, 1.0 - r1, *(masses if masses is not None else (1.0, 1.0)))
     # the initial kinetic energy, summed in this order (numpy's, bits of older runs kept);
     # with masses, k1 |v0|^2 + k0 |v1|^2, as the kernels' anchor computes it
@@ -208,7 +259,7 @@ def kernel_args(ic, r, rule, mode, t_max, n_steps, tau, track, max_events, masse
     speed = 1.0 if rule == "mirror" else math.sqrt(e0 / min(table[2], table[3]))
     max_events = chk.event_budget(max_events, horizon=horizon,
                                   horizon_name="t_max" if mode < 2 else "n_steps * tau",
-                                  speed=speed, rho=rho, n_disks=2)
+                                  speed=speed, rho=budget_rho, n_disks=2)
     # capacities are only a first guess: the kernel grows its buffers when needed
     b_cap = int(3.0 * speed * horizon) + 64
     pp_cap = int(10.0 * (r0 + r1) * speed * horizon) + 16
@@ -219,7 +270,7 @@ def kernel_args(ic, r, rule, mode, t_max, n_steps, tau, track, max_events, masse
 
 
 def two_particle_run(out, args, *, r, rule, sampling, tau, n_steps, ic, track, seed,
-                     name) -> TwoParticleRun:
+                     name, table=None) -> TwoParticleRun:
     """The `TwoParticleRun` of `simulate_two_kernel`'s output ``out`` for ``args``
     (`kernel_args`); raises the ValueError of an early stop, naming the argument ``name``."""
     pp, bt, bp, bx, by, bs, stimes, samples, t_end, ppl, status = out[:11]
@@ -253,5 +304,6 @@ def two_particle_run(out, args, *, r, rule, sampling, tau, n_steps, ic, track, s
         escape_time=float(escape[0]),
         escaped=int(escape[1]),
         masses=None if args[1][2] == 1.0 == args[1][3] else (args[1][3], args[1][2]),
+        table=Circle() if table is None else table,
         **sampling_fields(t_end, mode, sampling, tau, n_steps, stimes, samples),
     )

@@ -19,6 +19,7 @@ from kicktimes.diagnostics.autocorrelation import (
     autocorrelation,
     autocorrelation_many,
     boundary_angles,
+    boundary_map,
 )
 from kicktimes.diagnostics.decorrelation import (
     AcfCurve,
@@ -60,6 +61,7 @@ __all__ = [
     "autocorrelation_function",
     "autocorrelation_many",
     "boundary_angles",
+    "boundary_map",
     "collision_table",
     "collision_tables",
     "decorrelation_lag",

@@ -33,6 +33,7 @@ __all__ = [
     "autocorrelation",
     "autocorrelation_many",
     "boundary_angles",
+    "boundary_map",
 ]
 
 REASON_OK = "ok"
@@ -492,7 +493,9 @@ def boundary_angles(run, *, particle=None):
 
     ``sin_theta`` is the tangential component of the incoming unit velocity at each
     disk-boundary collision (docs/architecture.md); ``theta`` in ``[-pi/2, pi/2]`` is the series
-    whose autocorrelation the paper reports.
+    whose autocorrelation the paper reports. In another table (a run's ``table``, a
+    stadium or an ellipse) it is the same Birkhoff coordinate at the local wall,
+    ``v.t / |v|`` with ``t`` the counter-clockwise tangent (docs/tables.md).
 
     Parameters
     ----------
@@ -569,6 +572,58 @@ def boundary_angles(run, *, particle=None):
 
 
 _NO_PARTICLE = np.empty(0, np.int8)
+
+
+def boundary_map(run, *, particle=None) -> np.ndarray:
+    r"""The boundary map of one disk: Birkhoff's coordinates ``(arc / L, sin_theta)`` of its
+    wall contacts, in time order, in any table.
+
+    ``arc`` is the arc length along the centre's curve counter-clockwise from its
+    rightmost point and ``L`` that curve's length, so the first coordinate lies in
+    ``[0, 1)`` in every table; in the unit circle it is the contact's polar angle over
+    ``2 pi`` (the run's ``s / (2 pi)``). ``sin_theta`` is `boundary_angles`' ``sin``. Points
+    of this map are what `kicktimes.diagnostics.recurrence_rate` takes to measure the
+    recurrences of the boundary map rather than of the sampled positions (its ``eps`` then
+    is a distance in these coordinates).
+
+    Parameters
+    ----------
+    run : TwoParticleRun or OneParticleRun
+        A run record with a ``boundary`` table (``s`` or, in another table, ``arc``).
+    particle : int, optional
+        Which disk (0 or 1) of a two-disk run; default ``run.track``.
+
+    Returns
+    -------
+    ndarray of float64, shape (n, 2)
+
+    Examples
+    --------
+    >>> from kicktimes import initial_conditions, simulate_two_particle
+    >>> from kicktimes.tables import Stadium
+    >>> ic = initial_conditions(1, 0.05, rng=1, method="uniform", table=Stadium(1.0))[0]
+    >>> run = simulate_two_particle(ic, 0.05, t_max=100.0, table=Stadium(1.0))
+    >>> pts = boundary_map(run)
+    >>> bool(((0 <= pts[:, 0]) & (pts[:, 0] < 1) & (abs(pts[:, 1]) <= 1)).all())
+    True
+    """
+    if not hasattr(run, "boundary") or isinstance(run, pd.DataFrame):
+        raise TypeError(f"run: expected a run record, got {type(run).__name__}")
+    df = run.boundary
+    if "particle" in df.columns:
+        if particle is None:
+            particle = getattr(run, "track", 0)
+        if not (_is_int(particle, 0) or _is_int(particle, 1)):
+            raise ValueError(f"particle: must be 0 or 1 (the disk to analyse), got {particle!r}")
+        df = df[df["particle"].to_numpy() == int(particle)]
+    elif particle is not None and not _is_int(particle, 0):
+        raise ValueError(f"particle: a one-disk run has disk 0 only, got {particle!r}")
+    if "arc" in df.columns:
+        frac = df["arc"].to_numpy() / run.table.perimeter(run.r)
+    else:
+        frac = df["s"].to_numpy() / (2.0 * math.pi)
+    order = np.argsort(df["time"].to_numpy(), kind="stable")
+    return np.column_stack([frac, df["sin_theta"].to_numpy()])[order]
 
 
 def _fast_columns(time, sin_theta, particles) -> bool:

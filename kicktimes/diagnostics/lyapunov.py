@@ -45,6 +45,7 @@ from kicktimes.billiard.one_particle import (
     resolve_kicks,
 )
 from kicktimes.billiard.runs import OneParticleRun, TwoParticleRun
+from kicktimes.billiard.tables import Circle, check_table
 from kicktimes.billiard.two_particle import (
     DONE,
     check_two_particle_ic,
@@ -344,7 +345,8 @@ def _flat(system, rule, kicks, method) -> dict:
 
 @old_keywords(_old_lyapunov)
 def lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rule="mirror",
-             track=0, kicks=None, rng=None, method="tangent", holes=None, masses=None):
+             track=0, kicks=None, rng=None, method="tangent", holes=None, masses=None,
+             table=None):
     """Finite-time Lyapunov exponent of a two-disk or a kicked one-disk billiard.
 
     Parameters
@@ -388,6 +390,12 @@ def lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rule
     holes : array_like, shape (n, 2), optional
         Holes in the table's wall (as in `simulate_two_particle`): the exponent is
         measured up to the escape (``total_time`` the escape time), tangent method only.
+    table : Circle, Stadium or Ellipse, optional
+        Two disks: the table (as in `simulate_two_particle`; ``None``: the unit circle;
+        taken from a run). The tangent map at a wall contact is
+        `kicktimes.billiard.kernels.tangent.curved_wall_tangent` with the contact's normal
+        and the curvature of the centre's curve (0 on the stadium's segments); the twins
+        run through the same table kernels.
 
     Returns
     -------
@@ -453,7 +461,7 @@ def lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rule
     flat = _flat(system, rule, kicks, method)
     res, run, _ = _lyapunov(system, r, n_steps=n_steps, tau=tau, sampling=sampling,
                             track=track, rng=rng, t_continue=0.0, holes=holes, masses=masses,
-                            **flat)
+                            table=table, **flat)
     _warn_undefined(res, stacklevel=4)
     return (res, run) if flat["return_run"] else res
 
@@ -495,8 +503,8 @@ def _lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rul
               track=0, kicks=None, kick_angles=None, kick_angle="uniform", sigma=1.0, rng=None,
               method="tangent", variant="norm", d0=None, max_defer=10, e0=None,
               partner="weighted", partner_radius=None, partner_mass=None, return_run=False,
-              t_continue=0.0, holes=None, masses=None, uniform_out=None, renormalize=True,
-              twin_kicks="shared"):
+              t_continue=0.0, holes=None, masses=None, table=None, uniform_out=None,
+              renormalize=True, twin_kicks="shared"):
     """`lyapunov`'s body: ``(result, run or None, pp_times or None)``; a list
     ``uniform_out`` receives the one pass's uniform samples (see `lyapunov_pass`)."""
     if not isinstance(renormalize, bool | np.bool_):
@@ -523,7 +531,7 @@ def _lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rul
             raise ValueError("system: the run has no sampling (n_steps, tau); the FTLE needs it")
         r, n_steps, tau, sampling = run.r, run.n_steps, run.tau, run.sampling
         if isinstance(run, TwoParticleRun):
-            rule, track, system = run.rule, run.track, run.ic
+            rule, track, system, table = run.rule, run.track, run.ic, run.table
         else:
             # the FTLE covers n_steps samples; a run may have gone on beyond them
             horizon = n_steps * tau
@@ -559,6 +567,18 @@ def _lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rul
     arr = np.asarray(system, dtype=np.float64)
     if arr.shape == (2, 4):
         r0, r1, r = chk.check_radii(r)
+        table = check_table(table)
+        if table == Circle():
+            table = None  # the circle's own kernels, bit for bit
+        else:
+            if isinstance(r, tuple):
+                raise ValueError(f"r: two disks in {table!r} must be equal (one radius), got "
+                                 f"{r!r}")
+            r = table.check_radius(r)
+            if arcs is not None:
+                raise ValueError(f"holes: holes are arcs of the unit circle's wall; {table!r} "
+                                 "has none")
+        wall = None if table is None else table.kernel(r)
         chk.check_choice("rule", rule, chk.RULES)
         track = chk.check_int("track", track, low=0)
         if track > 1:
@@ -568,19 +588,23 @@ def _lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rul
         if twin_kicks != "shared":
             raise ValueError("twin_kicks='independent' applies to a kicked one-disk state "
                              "(shape (4,)), not to two disks")
-        ic = check_two_particle_ic(arr, r, rule, name="system")
+        ic = check_two_particle_ic(arr, r, rule, name="system", table=table)
         masses = chk.check_masses(masses, rule)
         # the kernels' table and state, as the simulator sets them up
-        args = kernel_args(ic, r, rule, 1, 1.0, 1, 1.0, 0, None, masses)
+        args = kernel_args(ic, r, rule, 1, 1.0, 1, 1.0, 0, None, masses, table=table)
         rho, sig, st = args[1], args[2], args[0]
         if return_run or arcs is not None:
             res, run, pp = _pass_two(ic, r, rule, sampling, mode, n_steps, tau, track, variant,
-                                     max_events, t_continue, arcs, masses, uniform_out)
+                                     max_events, t_continue, arcs, masses, uniform_out, table)
             return (res, run, pp) if return_run else (res, None, None)
         if method == "tangent":
             U = _start_vectors(variant, 8, 4 * track)
-            out = tangent_two_kernel(st, rho, sig, chk.RULES[rule], mode, n_steps, tau, U,
-                                     max_events, 0)
+            if wall is None:
+                out = tangent_two_kernel(st, rho, sig, chk.RULES[rule], mode, n_steps, tau, U,
+                                         max_events, 0)
+            else:
+                out = tangent_two_kernel(st, rho, sig, chk.RULES[rule], mode, n_steps, tau, U,
+                                         max_events, 0, wall)
             return _tangent_result(out, U, (4 * track, 4 * track + 1), variant, horizon,
                                    max_events, f"disk {track}"), None, None
         o = track
@@ -588,14 +612,24 @@ def _lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rul
         def ok(dx, dy):
             x, y = ic[o, 0] + dx, ic[o, 1] + dy
             other = ic[1 - o]
-            return math.hypot(x, y) <= rho[o] and math.hypot(x - other[0], y - other[1]) >= sig
+            inside = (math.hypot(x, y) <= rho[o] if table is None
+                      else bool(table.contains(np.array([x, y]), r)))
+            return inside and math.hypot(x - other[0], y - other[1]) >= sig
 
         offsets, measure = _twin_offsets(variant, d0, ok)
-        out = ftle_two_kernel(st, rho, sig, chk.RULES[rule], mode, n_steps, tau, track, offsets,
-                              measure, d0, max_defer, max_events, renormalize)
+        if wall is None:
+            out = ftle_two_kernel(st, rho, sig, chk.RULES[rule], mode, n_steps, tau, track,
+                                  offsets, measure, d0, max_defer, max_events, renormalize)
+        else:
+            out = ftle_two_kernel(st, rho, sig, chk.RULES[rule], mode, n_steps, tau, track,
+                                  offsets, measure, d0, max_defer, max_events, renormalize,
+                                  wall)
         return _twin_result(out, variant, d0, horizon, max_events, renormalize, tau), None, None
     if arr.shape != (4,):
         raise ValueError(f"system must have shape (2, 4) or (4,), got {arr.shape}")
+    if check_table(table) != Circle():
+        raise ValueError(f"table: the kicked one-disk FTLE runs in the unit circle only, got "
+                         f"table={table!r}")
     r = chk.check_real("r", r, low=0.0, high=1.0)
     chk.check_choice("kick_angle", kick_angle, KICK_ANGLES)
     sigma = chk.check_real("sigma", sigma, low=0.0)
@@ -654,21 +688,30 @@ def _lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rul
 
 
 def _pass_two(ic, r, rule, sampling, mode, n_steps, tau, track, variant, max_ev_tan,
-              t_continue, holes=None, masses=None, uniform_out=None):
+              t_continue, holes=None, masses=None, uniform_out=None, table=None):
     """The two-disk run and its tangent FTLE from one pass (`simulate_tangent_two_kernel`);
-    its uniform samples appended to the list ``uniform_out`` (see `_uniform_samples`)."""
+    its uniform samples appended to the list ``uniform_out`` (see `_uniform_samples`);
+    ``table`` another table than the circle (or ``None``)."""
     args = kernel_args(ic, r, rule, mode, n_steps * tau if mode == 1 else None, n_steps, tau,
-                       track, None, masses)
+                       track, None, masses, table=table)
     U = _start_vectors(variant, 8, 4 * track)
+    if table is None:
+        out = simulate_tangent_two_kernel(*args, U, max_ev_tan,
+                                          t_continue if mode == 2 else 0.0, holes,
+                                          uniform_out is not None and mode == 2)
+    else:
+        out = simulate_tangent_two_kernel(*args, U, max_ev_tan,
+                                          t_continue if mode == 2 else 0.0, None,
+                                          uniform_out is not None and mode == 2,
+                                          table.kernel(r))
     (pp, n_pp_run, bt, bp, bx, by, bs, stimes, samples, t_end, status, log_scale, n_resc,
-     n_pert, t_tan, status_tan, status_cont, escape, u_times, u_samples) = (
-        simulate_tangent_two_kernel(*args, U, max_ev_tan, t_continue if mode == 2 else 0.0,
-                                    holes, uniform_out is not None and mode == 2))
+     n_pert, t_tan, status_tan, status_cont, escape, u_times, u_samples) = out
     # errors in the order of separate calls: the simulation's, the FTLE's, the continuation's
     out = (pp[:n_pp_run], bt, bp, bx, by, bs, stimes, samples, t_end, np.empty((0, 12)), status,
            escape)
     run = two_particle_run(out, args, r=r, rule=rule, sampling=sampling, tau=tau,
-                           n_steps=n_steps, ic=ic, track=track, seed=None, name="system")
+                           n_steps=n_steps, ic=ic, track=track, seed=None, name="system",
+                           table=table)
     horizon = n_steps * tau
     res = _tangent_result((log_scale, n_resc, n_pert, t_tan, status_tan), U,
                           (4 * track, 4 * track + 1), variant, horizon, max_ev_tan,

@@ -178,7 +178,10 @@ def recurrence_rate(points, *, eps=1e-3, theiler=0):
     ----------
     points : array_like, shape (N, 2), or a run record
         Sampled positions (e.g. ``run.samples``, the tracked disk's centre at the sample
-        times; a run record is accepted directly). Only planar points are supported.
+        times; a run record is accepted directly, in any table). Only planar points are
+        supported. For the recurrences of the boundary map pass
+        `kicktimes.diagnostics.boundary_map` (Birkhoff's ``(arc / L, sin_theta)``, the
+        same coordinates in the circle, the stadium and the ellipse).
     eps : float or array_like of float, default 1e-3
         Recurrence threshold(s) ``eps > 0``. A pair is recurrent when
         ``dx**2 + dy**2 <= eps**2`` in float64. An array gives one RR per threshold.

@@ -47,7 +47,7 @@ N_PP, N_B, K, SIM_ON, N_PP_RUN, CONT_ON, N_B_CONT, CONT_STATUS = range(8)
 
 @njit(cache=True, error_model="numpy")
 def drive(st, ev, phys, t_end, mode, tau, track, logs, stimes, samples, cnt, next_s, fin, tan,
-          cont, holes, uni=None):
+          cont, holes, uni=None, wall=None):
     """Run the event loop from ``st``/``ev``; returns `ob.DONE`, or `ob.FULL` when a log is full.
 
     ``phys = (rho, sigma, rule)`` with ``rho = (rho0, rho1)``, one per disk;
@@ -64,6 +64,11 @@ def drive(st, ev, phys, t_end, mode, tau, track, logs, stimes, samples, cnt, nex
     paper-sampled run (`observe.sample_uniform`) at ``k tau`` over the run's duration
     ``T``, recorded in this loop as a uniform run to ``t_max = T`` records them; ``u_cnt =
     [k, on, limit]`` (``limit`` -1 until ``T`` is known).
+    ``wall = ((kind, p0, p1, p2), wh)`` or ``None`` (the unit circle): another table
+    (`kicktimes.billiard.kernels.tables`, equal disks), its wall events through
+    `two.table_step` and the tangent map at a wall of the contact's curvature
+    (`tangent.curved_wall_tangent`); ``wh`` (4,) carries both disks' "where" of their next
+    contact between calls.
 
     The state lives in a tuple of locals for the whole loop (numba keeps it in registers;
     kept in arrays, every event stored and reloaded it, since numba cannot prove that the
@@ -97,6 +102,14 @@ def drive(st, ev, phys, t_end, mode, tau, track, logs, stimes, samples, cnt, nex
     uni_on = False
     if uni is not None:
         u_times, u_samples, ku, uni_on, u_limit = ob.load_uniform(uni)
+    # the table path's "where" of both disks' next wall contacts, and the last contact's
+    # normal and curvature (for the tangent map); unused (compiled out) in the circle
+    wh = (0.0, 0.0, 0.0, 0.0)
+    if wall is not None:
+        wh = (wall[1][0], wall[1][1], wall[1][2], wall[1][3])
+    cnx = 0.0
+    cny = 0.0
+    ckap = 0.0
     ns = stimes.shape[0]
     pp_cap = pp.shape[0]
     b_cap = bt.shape[0]
@@ -191,7 +204,11 @@ def drive(st, ev, phys, t_end, mode, tau, track, logs, stimes, samples, cnt, nex
             if tan_on:
                 tg.tangent_flight(U, dte)
         before = s
-        s, sin_theta = two.step(s, ke, dte, rho, sigma, rule, e0)
+        if wall is None:
+            s, sin_theta = two.step(s, ke, dte, rho, sigma, rule, e0)
+        else:
+            s, wh, sin_theta, cnx, cny, ckap = two.table_step(s, wh, ke, dte, rho, sigma, rule,
+                                                              e0, wall[0])
         t = s[two.S_T]
         if ke == two.PAIR:
             if tan is not None and tan_on:
@@ -225,7 +242,15 @@ def drive(st, ev, phys, t_end, mode, tau, track, logs, stimes, samples, cnt, nex
             x, y, wx, wy = two.disk(s, ke)
             if tan is not None and tan_on:
                 _, _, vx, vy = two.disk(before, ke)
-                if vx != wx or vy != wy:
+                if wall is not None:
+                    # the table's wall: its normal and curvature at this contact
+                    c = 4 * ke
+                    for j in range(m):
+                        (U[j, c], U[j, c + 1], U[j, c + 2], U[j, c + 3]) = (
+                            tg.curved_wall_tangent(U[j, c], U[j, c + 1], U[j, c + 2],
+                                                   U[j, c + 3], vx, vy, wx, wy, cnx, cny,
+                                                   ckap))
+                elif vx != wx or vy != wy:
                     # (a disk already moving inward is not reflected: identity map)
                     c = 4 * ke
                     for j in range(m):
@@ -246,6 +271,8 @@ def drive(st, ev, phys, t_end, mode, tau, track, logs, stimes, samples, cnt, nex
             x, y, _, _ = two.disk(s, track)
             k, ns_next = ob.sample_at_event(stimes, samples, k, t, x, y, tau)
     two.store(st, ev, s)
+    if wall is not None:
+        wall[1][0], wall[1][1], wall[1][2], wall[1][3] = wh
     cnt[N_PP] = n_pp
     cnt[N_B] = n_b
     cnt[K] = k
@@ -263,15 +290,19 @@ def drive(st, ev, phys, t_end, mode, tau, track, logs, stimes, samples, cnt, nex
 
 @njit(cache=True, error_model="numpy")
 def _run(st, rho, sigma, rule, t_max, mode, n_steps, tau, track, pp_cap, b_cap, max_events,
-         stall_dt, log_pp, sim, tan, cont, holes, uni=None):
+         stall_dt, log_pp, sim, tan, cont, holes, uni=None, wall=None):
     """Allocate the logs, run `drive` to its end, growing them when full.
 
     ``sim``: record the simulation; ``tan`` (`tg.tangent_state`, or ``None``): carry tangent
-    vectors; ``cont``: the continuation; ``uni``: the uniform samples (see `drive`).
+    vectors; ``cont``: the continuation; ``uni``: the uniform samples; ``wall``: another table (see
+    `drive`).
     Returns ``(logs, stimes, samples, cnt, fin, tan, status)``.
     """
     ev = np.empty(3)
-    two.init_events(st, ev, rho, sigma)
+    if wall is None:
+        two.init_events(st, ev, rho, sigma)
+    else:
+        two.table_init_events(st, ev, wall[1], rho, sigma, wall[0])
     pp = np.empty(min(pp_cap, max_events + 1) if sim else 0)
     ppl = np.empty((pp.shape[0] if log_pp else 0, 12))
     bt, bx, by, bs = ob.new_boundary_log(min(b_cap, max_events + 1) if sim else 0)
@@ -288,8 +319,12 @@ def _run(st, rho, sigma, rule, t_max, mode, n_steps, tau, track, pp_cap, b_cap, 
     status = ob.DONE
     while True:
         logs = (pp, bt, bp, bx, by, bs, ppl, log_pp)
-        loop = drive(st, ev, phys, t_end, mode, tau, track, logs, stimes, samples, cnt, next_s,
-                     fin, tan, cont, holes, uni)
+        if wall is None:
+            loop = drive(st, ev, phys, t_end, mode, tau, track, logs, stimes, samples, cnt,
+                         next_s, fin, tan, cont, holes, uni)
+        else:
+            loop = drive(st, ev, phys, t_end, mode, tau, track, logs, stimes, samples, cnt,
+                         next_s, fin, tan, cont, holes, uni, wall)
         if cnt[SIM_ON] != 0:
             # budget and stalls are checked only here, when a log is full: nothing in the
             # hot loop
@@ -329,7 +364,7 @@ def _run(st, rho, sigma, rule, t_max, mode, n_steps, tau, track, pp_cap, b_cap, 
 
 @njit(cache=True, error_model="numpy")
 def simulate_two_kernel(st, rho, sigma, rule, t_max, mode, n_steps, tau, track, pp_cap, b_cap,
-                        max_events, stall_dt, log_pp=False, holes=None):
+                        max_events, stall_dt, log_pp=False, holes=None, wall=None):
     """Run the two-disk billiard, logging every event and sampling the tracked disk.
 
     ``st`` is ``[t, x0, y0, vx0, vy0, x1, y1, vx1, vy1, clock compensation, energy]``.
@@ -344,11 +379,18 @@ def simulate_two_kernel(st, rho, sigma, rule, t_max, mode, n_steps, tau, track, 
     pp_log, status, escape)``; ``pp_log`` has a row per disk-disk collision if ``log_pp``,
     else none. ``holes`` (an array of rows ``[centre angle, half-width]``, or ``None``):
     the table's holes; ``escape = [t, disk]`` of the first escape (``[inf, -1]``: none),
-    where the run then ends (its samples stop there).
+    where the run then ends (its samples stop there). ``wall`` (``(kind, p0, p1, p2)`` of
+    `kicktimes.billiard.kernels.tables`, or ``None``: the unit circle): another table, for
+    equal disks of room ``rho[0]`` (no holes).
     """
     escape = np.array([np.inf, -1.0])
-    # (two calls, not a conditional argument: numba compiles the holes out when absent)
-    if holes is None:
+    # (separate calls, not a conditional argument: numba compiles the holes and the table
+    # out when absent)
+    if wall is not None:
+        logs, stimes, samples, cnt, fin, _, status = _run(
+            st, rho, sigma, rule, t_max, mode, n_steps, tau, track, pp_cap, b_cap, max_events,
+            stall_dt, log_pp, True, None, None, None, None, (wall, np.zeros(4)))
+    elif holes is None:
         logs, stimes, samples, cnt, fin, _, status = _run(
             st, rho, sigma, rule, t_max, mode, n_steps, tau, track, pp_cap, b_cap, max_events,
             stall_dt, log_pp, True, None, None, None)
@@ -369,7 +411,7 @@ def simulate_two_kernel(st, rho, sigma, rule, t_max, mode, n_steps, tau, track, 
 @njit(cache=True, error_model="numpy")
 def simulate_tangent_two_kernel(st, rho, sigma, rule, t_max, mode, n_steps, tau, track, pp_cap,
                                 b_cap, max_events, stall_dt, U, max_ev_tan, t_continue,
-                                holes=None, uniform=False):
+                                holes=None, uniform=False, wall=None):
     """`simulate_two_kernel` (without the collision log) and `tangent_two_kernel` in one pass.
 
     The simulation's arguments are `simulate_two_kernel`'s, ``U`` (m, 8) and
@@ -384,7 +426,8 @@ def simulate_tangent_two_kernel(st, rho, sigma, rule, t_max, mode, n_steps, tau,
     t_end, status, log_scale, n_rescaled, n_pp_tangent, t_end_tangent, status_tangent,
     status_continuation, escape, uniform_times, uniform_samples)``: ``pp_times[:n_pp_run]``
     are the run's disk-disk times, ``pp_times`` with the continuation's after them; the
-    uniform samples are empty unless ``uniform``.
+    uniform samples are empty unless ``uniform``. ``wall``: another table (as in
+    `simulate_two_kernel`; no holes).
     """
     tan = tg.tangent_state(U, mode, n_steps, tau, max_ev_tan, np.int64(0))
     escape = np.array([np.inf, -1.0])
@@ -393,7 +436,12 @@ def simulate_tangent_two_kernel(st, rho, sigma, rule, t_max, mode, n_steps, tau,
     u_cnt = np.zeros(3, dtype=np.int64)
     u_cnt[1] = 1 if on else 0
     u_cnt[2] = -1
-    if holes is None:
+    if wall is not None:
+        logs, stimes, samples, cnt, fin, tan, status = _run(
+            st, rho, sigma, rule, t_max, mode, n_steps, tau, track, pp_cap, b_cap, max_events,
+            stall_dt, False, True, tan, (t_continue, max_events), None,
+            (u_times, u_samples, u_cnt), (wall, np.zeros(4)))
+    elif holes is None:
         logs, stimes, samples, cnt, fin, tan, status = _run(
             st, rho, sigma, rule, t_max, mode, n_steps, tau, track, pp_cap, b_cap, max_events,
             stall_dt, False, True, tan, (t_continue, max_events), None,
@@ -416,7 +464,8 @@ def simulate_tangent_two_kernel(st, rho, sigma, rule, t_max, mode, n_steps, tau,
 
 
 @njit(cache=True, error_model="numpy")
-def tangent_two_kernel(st, rho, sigma, rule, mode, n_steps, tau, U, max_events, n_orth):
+def tangent_two_kernel(st, rho, sigma, rule, mode, n_steps, tau, U, max_events, n_orth,
+                       wall=None):
     """Carry the tangent vectors ``U`` (m, 8) along the two-disk trajectory from ``st``.
 
     ``mode`` 1: up to ``n_steps * tau``; mode 2: through ``n_steps`` of the paper's
@@ -427,11 +476,17 @@ def tangent_two_kernel(st, rho, sigma, rule, mode, n_steps, tau, U, max_events, 
     re-orthonormalised by Gram-Schmidt at ``n_orth`` equally spaced times, the last at
     ``t_end`` (for the spectrum: then ``log_scale[j]`` sums ``log |R_jj|``).
 
+    ``wall``: another table (as in `simulate_two_kernel`).
+
     Returns ``(log_scale, n_rescaled, n_pp, t_end, status)``.
     """
     tan = tg.tangent_state(U, mode, n_steps, tau, max_events, n_orth)
-    _run(st, rho, sigma, rule, 0.0, mode, n_steps, tau, 0, 0, 0, max_events, 0.0, False, False,
-         tan, None, None)
+    if wall is None:
+        _run(st, rho, sigma, rule, 0.0, mode, n_steps, tau, 0, 0, 0, max_events, 0.0, False,
+             False, tan, None, None)
+    else:
+        _run(st, rho, sigma, rule, 0.0, mode, n_steps, tau, 0, 0, 0, max_events, 0.0, False,
+             False, tan, None, None, None, (wall, np.zeros(4)))
     _, log_scale, tgi, tgf, _, _, _ = tan
     # the state flies on to the end, as the vectors did
     dt = tgf[tg.T_PREV] - st[0]

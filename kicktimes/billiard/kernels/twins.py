@@ -90,7 +90,7 @@ def _separation(dx, dy, measure):
 
 @njit(cache=True)
 def _ftle(st0, rho, mode, n_steps, tau, track, offsets, measure, d0, max_defer, max_events, pair,
-          kick, kinetic, renorm):
+          kick, kinetic, renorm, wall=None):
     """Benettin FTLE of either system: ``pair = (sigma, rule)`` for two disks (``kick`` is
     ``None``), ``kick = (kicks, angles, kick_mode, kick_u, sp)`` for the kicked disk
     (``pair`` is ``None``); the other system's code is compiled out. ``kinetic`` (or
@@ -104,6 +104,8 @@ def _ftle(st0, rho, mode, n_steps, tau, track, offsets, measure, d0, max_defer, 
     ``renorm=False``: the twins are never renormalised (eq. (4) of Ranković & Porter read
     literally): ``log_sum`` sums ``log(d_k / d0)`` over every sample ``k``, ``n_renorm``
     counts the samples, and a separation of exactly 0 makes the sum ``-inf``.
+    ``wall`` (two disks; ``None``: the unit circle): another table's ``(kind, p0, p1, p2)``
+    (`kicktimes.billiard.kernels.tables`), each row's next wall contacts' "where" in ``wh``.
     """
     m = offsets.shape[0]
     nst = st0.shape[0]
@@ -125,8 +127,13 @@ def _ftle(st0, rho, mode, n_steps, tau, track, offsets, measure, d0, max_defer, 
         unit_speed = rule == 0
         ev = np.empty((m + 1, 3))
         cnt = np.zeros((m + 1, 5), dtype=np.int64)
-        for j in range(m + 1):
-            two.init_events(traj[j], ev[j], rho, sigma)
+        if wall is None:
+            for j in range(m + 1):
+                two.init_events(traj[j], ev[j], rho, sigma)
+        else:
+            wh = np.zeros((m + 1, 4))
+            for j in range(m + 1):
+                two.table_init_events(traj[j], ev[j], wh[j], rho, sigma, wall)
     if kick is not None:
         kicks, angles, kick_mode, kick_u, sp, twin_angles = kick
         nk = kicks.shape[0]
@@ -197,7 +204,10 @@ def _ftle(st0, rho, mode, n_steps, tau, track, offsets, measure, d0, max_defer, 
                 if status != 0:
                     break
                 if pair is not None:
-                    two.process_event_at(traj, ev, j, ke, rho, sigma, rule)
+                    if wall is None:
+                        two.process_event_at(traj, ev, j, ke, rho, sigma, rule)
+                    else:
+                        two.table_process_event_at(traj, ev, wh, j, ke, rho, sigma, rule, wall)
                     if ke == 2:
                         cnt[j, 0] += 1
                     else:
@@ -300,7 +310,10 @@ def _ftle(st0, rho, mode, n_steps, tau, track, offsets, measure, d0, max_defer, 
             if pair is not None:
                 traj[j, 10] = two.pair_energy(traj[j, 3], traj[j, 4], traj[j, 7], traj[j, 8],
                                               rho[2], rho[3])
-                two.init_events(traj[j], ev[j], rho, sigma)
+                if wall is None:
+                    two.init_events(traj[j], ev[j], rho, sigma)
+                else:
+                    two.table_init_events(traj[j], ev[j], wh[j], rho, sigma, wall)
             if kick is not None:
                 ev[j, 0] = boundary_hit_time(traj[j, 1], traj[j, 2], traj[j, 3], traj[j, 4],
                                              rho)
@@ -312,16 +325,20 @@ def _ftle(st0, rho, mode, n_steps, tau, track, offsets, measure, d0, max_defer, 
 
 @njit(cache=True)
 def ftle_two_kernel(st0, rho, sigma, rule, mode, n_steps, tau, track, offsets, measure, d0,
-                    max_defer, max_events, renorm):
+                    max_defer, max_events, renorm, wall=None):
     """Benettin FTLE for the two-disk billiard with ``len(offsets)`` twins (``renorm``:
     renormalise them, or measure the raw separations, see `_ftle`).
 
     Returns ``(log_sum, n_renorm, n_forced, n_deferred, t_last, n_pert, status)``; the
     first five per twin, ``n_pert[j]`` the reference's disk-disk collisions up to
-    ``t_last[j]``.
+    ``t_last[j]``. ``wall``: another table's ``(kind, p0, p1, p2)`` (``None``: the unit
+    circle).
     """
+    if wall is None:
+        return _ftle(st0, rho, mode, n_steps, tau, track, offsets, measure, d0, max_defer,
+                     max_events, (sigma, rule), None, None, renorm)
     return _ftle(st0, rho, mode, n_steps, tau, track, offsets, measure, d0, max_defer,
-                 max_events, (sigma, rule), None, None, renorm)
+                 max_events, (sigma, rule), None, None, renorm, wall)
 
 
 @njit(cache=True)

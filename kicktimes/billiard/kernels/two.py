@@ -46,6 +46,7 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 from numba import njit
 
 from kicktimes.billiard.geometry import (
@@ -58,10 +59,13 @@ from kicktimes.billiard.geometry import (
     pair_hit_time,
     reflect,
 )
+from kicktimes.billiard.kernels import tables as tb
 
 __all__ = ["PAIR", "table", "advance", "anchor_energy", "mass_factors", "pair_energy", "disk",
            "init_events", "load", "next_event", "pair_event", "process_event", "process_event_at",
-           "resolve", "step", "store", "wall_event"]
+           "resolve", "step", "store", "table_arc_lengths", "table_init_events",
+           "table_process_event_at", "table_resolve", "table_step", "table_wall_event",
+           "wall_event"]
 
 #: fields of the state tuple
 (S_T, S_COMP, S_X0, S_Y0, S_VX0, S_VY0, S_X1, S_Y1, S_VX1, S_VY1, S_TB0, S_TB1,
@@ -316,3 +320,116 @@ def fly(s, t_end):
     dt = t_end - t
     return (t_end, 0.0, x0 + vx0 * dt, y0 + vy0 * dt, vx0, vy0, x1 + vx1 * dt, y1 + vy1 * dt,
             vx1, vy1, tb0 - dt, tb1 - dt, tpp - dt)
+
+
+# --- two disks in another table (the stadium, the ellipse) ---------------------------------
+#
+# The table path: ``wall = (kind, p0, p1, p2)`` of `kicktimes.billiard.kernels.tables` (both
+# disks equal: one centre's curve). Each disk's next wall contact carries a "where" (the
+# stadium's piece, the ellipse's normal, `tables.hit`), kept beside the state tuple in
+# ``wh = (w1_0, w2_0, w1_1, w2_1)``. The circle never comes here: the drivers take ``wall``
+# as ``None`` for it and numba compiles this path out, so the circle's loop is the one it
+# always had.
+
+@njit(cache=True, inline="always", error_model="numpy")
+def table_wall_event(x, y, vx, vy, w1, w2, wall, rule):
+    """Wall contact of a disk at ``(x, y)`` (advanced to the contact `tables.hit` found at
+    ``(w1, w2)``) on the table ``wall = (kind, p0, p1, p2)``.
+
+    The contact is put back on the wall (`tables.contact`), the velocity reflected or slid
+    on at a grazing contact (`tables.bounce`), the speed kept by one Newton step of
+    ``|v'|^2`` towards the incoming ``|v|^2`` (1 under the mirror rule), and the next contact
+    found (`tables.hit`). Returns ``(x, y, vx, vy, t_next, w1, w2, sin_theta, nx, ny,
+    kappa)``: ``sin_theta = v.t / |v|`` (``t = (-ny, nx)`` the counter-clockwise tangent:
+    Birkhoff's coordinate, as the circle's ``(x vy - y vx) / (rho |v|)``), the outward
+    normal and the curvature of the centre's curve at the contact (for the tangent map).
+    """
+    kind, p0, p1, p2 = wall
+    x, y, nx, ny, kappa = tb.contact(kind, p0, p1, p2, x, y, vx, vy, w1, w2)
+    vv = 1.0 if rule == 0 else vx * vx + vy * vy
+    sin_theta = (vy * nx - vx * ny) if rule == 0 else (vy * nx - vx * ny) / math.sqrt(vv)
+    wx, wy = tb.bounce(vx, vy, nx, ny)
+    f = 1.5 - 0.5 * (wx * wx + wy * wy) / vv
+    wx *= f
+    wy *= f
+    t_next, w1, w2 = tb.hit(kind, p0, p1, p2, x, y, wx, wy)
+    return x, y, wx, wy, t_next, w1, w2, sin_theta, nx, ny, kappa
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def table_resolve(s, wh, k, rho, sigma, rule, e0, wall):
+    """`resolve` in the table ``wall``: returns ``(s, wh, sin_theta, nx, ny, kappa)``, the
+    wall contact's normal and curvature (zeros for a disk-disk collision)."""
+    t, comp, x0, y0, vx0, vy0, x1, y1, vx1, vy1, tb0, tb1, tpp = s
+    a0, b0, a1, b1 = wh
+    sin_theta = 0.0
+    nx = 0.0
+    ny = 0.0
+    kappa = 0.0
+    kind, p0, p1, p2 = wall
+    if k < PAIR:
+        if k == 0:
+            x, y, vx, vy, wa, wb = x0, y0, vx0, vy0, a0, b0
+        else:
+            x, y, vx, vy, wa, wb = x1, y1, vx1, vy1, a1, b1
+        x, y, vx, vy, tbk, wa, wb, sin_theta, nx, ny, kappa = table_wall_event(
+            x, y, vx, vy, wa, wb, wall, rule)
+        if k == 0:
+            x0, y0, vx0, vy0, tb0, a0, b0 = x, y, vx, vy, tbk, wa, wb
+        else:
+            x1, y1, vx1, vy1, tb1, a1, b1 = x, y, vx, vy, tbk, wa, wb
+    else:
+        vx0, vy0, vx1, vy1 = pair_event(x0, y0, vx0, vy0, x1, y1, vx1, vy1, rule, rho[2],
+                                         rho[3])
+        tb0, a0, b0 = tb.hit(kind, p0, p1, p2, x0, y0, vx0, vy0)
+        tb1, a1, b1 = tb.hit(kind, p0, p1, p2, x1, y1, vx1, vy1)
+    if rule != 0:
+        vx0, vy0, vx1, vy1 = anchor_energy(vx0, vy0, vx1, vy1, e0, rho[2], rho[3])
+    tpp = pair_hit_time(x0 - x1, y0 - y1, vx0 - vx1, vy0 - vy1, sigma)
+    return ((t, comp, x0, y0, vx0, vy0, x1, y1, vx1, vy1, tb0, tb1, tpp), (a0, b0, a1, b1),
+            sin_theta, nx, ny, kappa)
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def table_step(s, wh, k, dt, rho, sigma, rule, e0, wall):
+    """`step` in the table ``wall``: fly ``dt`` to event ``k`` and apply it
+    (`table_resolve`)."""
+    return table_resolve(advance(s, dt), wh, k, rho, sigma, rule, e0, wall)
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def table_init_events(st, ev, wh, rho, sigma, wall):
+    """`init_events` in the table ``wall``; the wall contacts' "where" into ``wh`` (4,)."""
+    kind, p0, p1, p2 = wall
+    ev[0], wh[0], wh[1] = tb.hit(kind, p0, p1, p2, st[1], st[2], st[3], st[4])
+    ev[1], wh[2], wh[3] = tb.hit(kind, p0, p1, p2, st[5], st[6], st[7], st[8])
+    ev[2] = pair_hit_time(st[1] - st[5], st[2] - st[6], st[3] - st[7], st[4] - st[8], sigma)
+
+
+@njit(cache=True, error_model="numpy")
+def table_process_event_at(traj, ev, wh, j, k, rho, sigma, rule, wall):
+    """`process_event_at` in the table ``wall`` (``wh`` (m, 4): each row's "where")."""
+    s = (traj[j, 0], traj[j, 9], traj[j, 1], traj[j, 2], traj[j, 3], traj[j, 4], traj[j, 5],
+         traj[j, 6], traj[j, 7], traj[j, 8], ev[j, 0], ev[j, 1], ev[j, 2])
+    w = (wh[j, 0], wh[j, 1], wh[j, 2], wh[j, 3])
+    s, w, sin_theta, _, _, _ = table_step(s, w, k, ev[j, k], rho, sigma, rule, traj[j, 10],
+                                          wall)
+    traj[j, 0] = s[S_T]
+    traj[j, 9] = s[S_COMP]
+    traj[j, 1], traj[j, 2], traj[j, 3], traj[j, 4] = disk(s, 0)
+    traj[j, 5], traj[j, 6], traj[j, 7], traj[j, 8] = disk(s, 1)
+    ev[j, 0] = s[S_TB0]
+    ev[j, 1] = s[S_TB1]
+    ev[j, 2] = s[S_TPP]
+    wh[j, 0], wh[j, 1], wh[j, 2], wh[j, 3] = w
+    return sin_theta
+
+
+@njit(cache=True, error_model="numpy")
+def table_arc_lengths(kind, p0, p1, p2, x, y):
+    """Arc length along the centre's curve (`tables.boundary_coordinates`'s ``s``, in
+    ``[0, L)``) of each logged contact ``(x[i], y[i])``."""
+    out = np.empty(x.shape[0])
+    for i in range(x.shape[0]):
+        out[i] = tb.boundary_coordinates(kind, p0, p1, p2, x[i], y[i], 1.0, 0.0)[0]
+    return out
