@@ -277,9 +277,8 @@ def _stadium_breaks(a, rho, d, out):
 def covariogram(kind, p0, p1, p2, d, nodes, weights, levels_theta, levels_phi):
     """The isotropic covariogram ``g(d) = (2 / pi) int_0^{pi/2} K(d, phi) dphi`` (module
     docstring) for each distance of the array ``d``: Gauss-Legendre ``(nodes, weights)`` on
-    each smooth piece of ``phi`` (graded towards its ends by ``levels_phi`` steps: the
-    stadium's pieces and the last one if ``K`` ends before ``pi / 2``) and of ``theta``
-    (``levels_theta``). The pieces of ``phi`` end at the stadium's join
+    each smooth piece of ``phi`` (graded towards its ends by ``levels_phi`` steps) and of
+    ``theta`` (``levels_theta``). The pieces of ``phi`` end at the stadium's join
     directions (`_stadium_breaks`) and where the central chord is ``d`` long (beyond it
     ``K = 0``)."""
     out = np.empty(len(d))
@@ -321,9 +320,7 @@ def covariogram(kind, p0, p1, p2, d, nodes, weights, levels_theta, levels_phi):
         for k in range(n_cut - 1):
             if cuts[k + 1] <= cuts[k]:
                 continue
-            # the stadium's pieces, and the one where K ends, are graded
-            lev = levels_phi if kind == STADIUM or cuts[k + 1] == top < _HALF_PI else 0
-            n_edge = _graded_edges(cuts[k], cuts[k + 1], lev, edges)
+            n_edge = _graded_edges(cuts[k], cuts[k + 1], levels_phi, edges)
             for e in range(n_edge - 1):
                 a = edges[e]
                 half = 0.5 * (edges[e + 1] - a)
