@@ -48,7 +48,7 @@ __all__ = ["Circle", "Ellipse", "Stadium", "TableLyapunov", "TableRun", "check_t
 
 #: the covariogram's quadrature per table kind: (Gauss-Legendre nodes per piece, grading
 #: levels in the offset, in the direction) (`kicktimes.billiard.kernels.covariogram`)
-_COVARIOGRAM_RULE = {_k.CIRCLE: (24, 0, 0), _k.STADIUM: (16, 8, 8), _k.ELLIPSE: (24, 0, 4)}
+_COVARIOGRAM_RULE = {_k.CIRCLE: (24, 0, 0), _k.STADIUM: (16, 8, 8), _k.ELLIPSE: (32, 0, 4)}
 
 
 
