@@ -92,6 +92,38 @@ def _kinetic_rate_unequal(r0, r1, rule):
     return contact * _MEAN_APPROACH[rule] / volume
 
 
+_TABLE_METHODS = ("check_radius", "area", "covariogram", "configuration_volume")
+
+
+def _kinetic_rate_table(r, rule, table):
+    """`kinetic_rate` (equal masses) of two disks of radius ``r`` in a table other than the
+    unit circle, from its covariogram (duck-typed: `_TABLE_METHODS`)."""
+    missing = [m for m in _TABLE_METHODS if not callable(getattr(table, m, None))]
+    if missing:
+        raise TypeError(f"table must be None or a kicktimes.tables table (Circle, Stadium, "
+                        f"Ellipse: with {', '.join(_TABLE_METHODS)}), got "
+                        f"{type(table).__name__} (no {', '.join(missing)})")
+    if isinstance(r, tuple):
+        raise ValueError(f"r: two disks of different radii {r!r} are the unit circle's only "
+                         f"(table=None); give one radius for {table!r}")
+    if isinstance(r, str | bytes):
+        raise TypeError(f"r must be a number or an array of numbers, got {type(r).__name__}")
+    scalar = np.ndim(r) == 0
+    arr = as_1d_float("r", np.ravel(r), allow_empty=False)
+    out = np.empty(arr.size)
+    for i, ri in enumerate(arr):
+        ri = table.check_radius(float(ri))
+        sigma = 2.0 * ri
+        contact = float(table.covariogram(sigma, ri))
+        if not contact > 0.0:
+            where = "" if scalar else f"[{i}]"
+            raise ValueError(f"r: two disks of radius r{where} = {ri!r} do not fit in "
+                             f"{table!r} with their centres 2 r apart")
+        out[i] = 2 * np.pi * sigma * contact * _MEAN_APPROACH[rule] / float(
+            table.configuration_volume(ri))
+    return float(out[0]) if scalar else out.reshape(np.shape(r))
+
+
 def configuration_volume(r):
     r"""Volume of the two-disk configuration space,
     :math:`|Q| = (\pi a^2)^2 - \int_0^{2r} 2\pi\rho L(\rho)\,d\rho` with ``a = 1 - r``
@@ -143,7 +175,7 @@ def is_sticky(rate, kinetic, *, factor=STICKY_FACTOR):
 
 
 @keyword_only_after(1, since="0.2.0", names=('rule',))
-def kinetic_rate(r, *, rule="mirror", masses=None):
+def kinetic_rate(r, *, rule="mirror", masses=None, table=None):
     r"""Disk-disk collision rate of two disks of radius ``r`` under the invariant measure.
 
     Parameters
@@ -157,6 +189,12 @@ def kinetic_rate(r, *, rule="mirror", masses=None):
         Elastic rule: the disks' masses, normalised to ``(m0 + m1) / 2 = 1`` (velocities
         uniform on ``m0 |v0|^2 + m1 |v1|^2 = 2``, as
         ``initial_conditions(..., masses=...)`` draws them); default equal.
+    table : None or a table, optional
+        The billiard table (`kicktimes.tables`): ``None`` or ``Circle()`` is the unit
+        circle (the closed form below); another table (``Stadium(a)``, ``Ellipse(a, b)``,
+        or any object with ``check_radius(r)``, ``area(r)``, ``covariogram(d, r)`` and
+        ``configuration_volume(r)``) gives the rate by the quadrature of its centre
+        region's covariogram (Notes). Two disks of the same radius only there.
 
     Returns
     -------
@@ -179,11 +217,29 @@ def kinetic_rate(r, *, rule="mirror", masses=None):
     :math:`a_0, a_1` at distance :math:`d` (`lens_area_two`) and :math:`|Q| = \pi^2 a_0^2
     a_1^2 - \int_0^\sigma 2\pi d\, L(d; a_0, a_1)\,dd`.
 
+    *Any table.* The centres keep to the table's inner parallel domain :math:`D_r`
+    (docs/tables.md) and the same argument gives, with :math:`\sigma = 2r`,
+
+    .. math::  \Gamma = 2\pi\sigma\, g(\sigma)\, E[(w\cdot n)^-] / |Q|, \qquad
+               |Q| = |D_r|^2 - \int_0^\sigma 2\pi d\, g(d)\, dd ,
+
+    :math:`g` the isotropic set covariogram of :math:`D_r` (the area of
+    :math:`D_r \cap (D_r + d\,e(\phi))` averaged over :math:`\phi`; in the circle the
+    lens area :math:`L`), by the table's quadrature (``table.covariogram``,
+    ``table.configuration_volume``); the flux factor does not depend on the table. As
+    :math:`r \to 0`, :math:`g(\sigma) = |D_r| - L_r \sigma / \pi + O(\sigma^2)`
+    (:math:`L_r` the perimeter of :math:`D_r`) and :math:`|Q| = |D_r|^2 (1 + O(\sigma^2))`,
+    so :math:`\Gamma = (2\pi\sigma E[(w\cdot n)^-] / |D_r|)\,(1 - L_r\sigma/(\pi |D_r|)
+    + O(\sigma^2))`; in the circle this is :math:`16 r / (\pi^2 a^2)` to first order.
+
     Examples
     --------
     >>> from kicktimes import stats
     >>> round(float(stats.kinetic_rate(0.01)), 5)
     0.01633
+    >>> from kicktimes.tables import Stadium
+    >>> round(float(stats.kinetic_rate(0.01, table=Stadium(1.0))), 5)
+    0.00717
     """
     check_choice("rule", rule, tuple(_MEAN_APPROACH))
     factor = 1.0
@@ -198,6 +254,8 @@ def kinetic_rate(r, *, rule="mirror", masses=None):
         # sqrt 2, on two directions is uniform on a disk: E[(w.n)^-] scales with
         # sqrt((1/m0 + 1/m1) / 2)
         factor = math.sqrt((1.0 / m[0] + 1.0 / m[1]) / 2.0)
+    if table is not None and not getattr(table, "is_unit_circle", False):
+        return factor * _kinetic_rate_table(r, rule, table)
     if isinstance(r, tuple):
         # two disks of different radii
         if len(r) != 2:
