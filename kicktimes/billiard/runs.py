@@ -24,6 +24,7 @@ import pandas as pd
 
 from kicktimes import __version__
 from kicktimes._results import TableResult
+from kicktimes.billiard.tables import Circle, Ellipse, Stadium
 from kicktimes.fileio import atomic_write
 
 TWO_PI = 2.0 * np.pi
@@ -53,6 +54,22 @@ def _arclength(x: np.ndarray, y: np.ndarray) -> np.ndarray:
     # arctan2 of a tiny negative y gives -0.0 + 2 pi = 2 pi exactly; keep the half-open range
     s[s >= TWO_PI] = 0.0
     return s
+
+
+#: the tables a run's record can name (its ``meta["table"]``: the class name and its sizes)
+_TABLES = {cls.__name__: cls for cls in (Circle, Stadium, Ellipse)}
+
+
+def table_meta(table) -> dict:
+    """A table as JSON: ``{"name": "Stadium", "a": 1.0}`` (`table_from_meta` reads it)."""
+    return {"name": type(table).__name__,
+            **{f.name: float(getattr(table, f.name)) for f in fields(table)}}
+
+
+def table_from_meta(meta: dict):
+    """The table of `table_meta`'s record."""
+    meta = dict(meta)
+    return _TABLES[meta.pop("name")](**meta)
 
 
 def sampling_fields(t_end, mode, sampling, tau, n_steps, sample_times, samples) -> dict:
@@ -264,13 +281,19 @@ class OneParticleRun(_Run):
         contact normal ``n``, the partner's velocity ``u`` and whether the partner's
         centre lay outside the table.
     boundary : DataFrame
-        Columns ``time, s, sin_theta``.
+        Columns ``time, s, sin_theta``: in the circle ``s`` is the contact's polar angle
+        (the arc length on the unit table); in a stadium or an ellipse the arc length along
+        the centre's curve, counter-clockwise from its rightmost point, and ``sin_theta``
+        the incoming ``v.t / |v|`` (`kicktimes.billiard.kernels.tables.boundary_coordinates`).
     sample_times, samples : ndarray
         Sample times and the disk's centre at them.
+    table : Circle, Stadium or Ellipse
+        The table of the run (``Circle()`` unless ``simulate_one_particle(table=...)``;
+        recorded in ``meta`` only for another table, so circle records are unchanged).
     """
 
-    _title = "One kicked disk in the unit circular table (simulate_one_particle)"
-    _summary_fields = ("r", "t_max", "kick_angle", "sigma", "n_kicks", "n_boundary", "rule",
+    _title = "One kicked disk in a table (simulate_one_particle)"
+    _summary_fields = ("r", "table", "t_max", "kick_angle", "sigma", "n_kicks", "n_boundary", "rule",
                        "sampling", "tau", "n_steps", "seed")
 
     kick_angle: str = "uniform"
@@ -283,6 +306,7 @@ class OneParticleRun(_Run):
     partner_radius: float | None = None
     partner_mass: float | None = None
     kick_log_array: np.ndarray = field(default_factory=lambda: np.empty((0, 9)))
+    table: object = field(default_factory=Circle)
 
     kind = "one_particle"
     _array_fields = ("kick_times", "kick_angles", "kick_log_array")
@@ -299,12 +323,23 @@ class OneParticleRun(_Run):
         df.insert(0, "time", self.kick_times[: df.shape[0]])
         return df
 
+    @property
+    def meta(self) -> dict:
+        out = super().meta
+        if self.table != Circle():
+            out["table"] = table_meta(self.table)
+        return out
+
     @cached_property
     def boundary(self) -> pd.DataFrame:
         log = self.boundary_log
-        return pd.DataFrame(
-            {"time": log.time, "s": _arclength(log.x, log.y), "sin_theta": log.sin_theta}
-        )
+        if self.table == Circle():
+            s = _arclength(log.x, log.y)
+        else:
+            from kicktimes.billiard.kernels.one import table_arc_lengths
+
+            s = table_arc_lengths(*self.table.kernel(self.r), log.x, log.y)
+        return pd.DataFrame({"time": log.time, "s": s, "sin_theta": log.sin_theta})
 
     @property
     def n_kicks(self) -> int:
@@ -353,6 +388,8 @@ def read_run(path: str | os.PathLike) -> TwoParticleRun | OneParticleRun:
         kwargs[name] = arr[name]
         if name in cls._array_columns:
             kwargs[name] = arr[name].reshape(-1, cls._array_columns[name])
+    if isinstance(kwargs.get("table"), dict):
+        kwargs["table"] = table_from_meta(kwargs["table"])
     if meta.get("kick_angle") == "scatter":
         kwargs["kick_angles"] = kwargs["kick_angles"].reshape(-1, 2)
     known = {f.name for f in fields(cls)}

@@ -38,13 +38,16 @@ from kicktimes.billiard.one_particle import (
     check_kinetic_capacity,
     check_one_particle_state,
     check_scatter_options,
+    check_table_kicks,
     draw_kick_angles,
     kernel_limits,
     law_from_old_keywords,
     one_particle_run,
     resolve_kicks,
+    table_args,
 )
 from kicktimes.billiard.runs import OneParticleRun, TwoParticleRun
+from kicktimes.billiard.tables import Circle, check_table
 from kicktimes.billiard.two_particle import (
     DONE,
     check_two_particle_ic,
@@ -344,7 +347,8 @@ def _flat(system, rule, kicks, method) -> dict:
 
 @old_keywords(_old_lyapunov)
 def lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rule="mirror",
-             track=0, kicks=None, rng=None, method="tangent", holes=None, masses=None):
+             track=0, kicks=None, rng=None, method="tangent", holes=None, masses=None,
+             table=None):
     """Finite-time Lyapunov exponent of a two-disk or a kicked one-disk billiard.
 
     Parameters
@@ -388,6 +392,12 @@ def lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rule
     holes : array_like, shape (n, 2), optional
         Holes in the table's wall (as in `simulate_two_particle`): the exponent is
         measured up to the escape (``total_time`` the escape time), tangent method only.
+    table : Circle, Stadium or Ellipse, optional
+        The kicked disk's table (as in `simulate_one_particle`; ``None``: the circle, or the
+        run's ``table`` when ``system`` is a run). In a stadium or an ellipse the tangent
+        vector crosses a wall contact by `kicktimes.billiard.kernels.tangent.curved_wall_tangent`
+        with the contact's normal and the local curvature of the centre's curve (0 on the
+        stadium's segments); a kick's map does not depend on the table.
 
     Returns
     -------
@@ -453,7 +463,7 @@ def lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rule
     flat = _flat(system, rule, kicks, method)
     res, run, _ = _lyapunov(system, r, n_steps=n_steps, tau=tau, sampling=sampling,
                             track=track, rng=rng, t_continue=0.0, holes=holes, masses=masses,
-                            **flat)
+                            table=table, **flat)
     _warn_undefined(res, stacklevel=4)
     return (res, run) if flat["return_run"] else res
 
@@ -496,9 +506,11 @@ def _lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rul
               method="tangent", variant="norm", d0=None, max_defer=10, e0=None,
               partner="weighted", partner_radius=None, partner_mass=None, return_run=False,
               t_continue=0.0, holes=None, masses=None, uniform_out=None, renormalize=True,
-              twin_kicks="shared"):
+              twin_kicks="shared", table=None):
     """`lyapunov`'s body: ``(result, run or None, pp_times or None)``; a list
     ``uniform_out`` receives the one pass's uniform samples (see `lyapunov_pass`)."""
+    given_table = table is not None
+    table = check_table(table)
     if not isinstance(renormalize, bool | np.bool_):
         raise TypeError(f"renormalize must be a bool, got {type(renormalize).__name__}")
     renormalize = bool(renormalize)
@@ -525,6 +537,10 @@ def _lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rul
         if isinstance(run, TwoParticleRun):
             rule, track, system = run.rule, run.track, run.ic
         else:
+            if given_table and table != run.table:
+                raise ValueError(f"table: the run was simulated in {run.table!r}, got "
+                                 f"table={table!r}")
+            table = run.table
             # the FTLE covers n_steps samples; a run may have gone on beyond them
             horizon = n_steps * tau
             keep = run.kick_times <= horizon
@@ -558,6 +574,8 @@ def _lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rul
     max_events = int(EVENTS_PER_TIME * horizon) + 10**6
     arr = np.asarray(system, dtype=np.float64)
     if arr.shape == (2, 4):
+        if table != Circle():
+            raise ValueError(f"table: two disks run in the circle here, got table={table!r}")
         r0, r1, r = chk.check_radii(r)
         chk.check_choice("rule", rule, chk.RULES)
         track = chk.check_int("track", track, low=0)
@@ -596,13 +614,16 @@ def _lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rul
         return _twin_result(out, variant, d0, horizon, max_events, renormalize, tau), None, None
     if arr.shape != (4,):
         raise ValueError(f"system must have shape (2, 4) or (4,), got {arr.shape}")
-    r = chk.check_real("r", r, low=0.0, high=1.0)
+    r = (chk.check_real("r", r, low=0.0, high=1.0) if table == Circle()
+         else table.check_radius(r))
+    check_table_kicks(table, kicks, holes)
     chk.check_choice("kick_angle", kick_angle, KICK_ANGLES)
     sigma = chk.check_real("sigma", sigma, low=0.0)
-    state = check_one_particle_state(arr, r, name="system")
+    state = check_one_particle_state(arr, r, name="system", table=table)
     sp, options = check_scatter_options(state, r, kick_angle, rule, e0, partner,
                                         partner_radius, partner_mass)
     rule = options["rule"]
+    tab = table_args(table, r, kick_angle, partner_radius)
     if twin_kicks == "independent":
         if kick_angle == "scatter":
             raise ValueError("twin_kicks='independent' needs kicks that set or rotate the "
@@ -629,15 +650,21 @@ def _lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rul
             res, run, _ = _pass_one(st, state, r, times, angles, kick_u, sp, mode, n_steps, tau,
                                     U, variant, max_events, sampling=sampling,
                                     kick_angle=kick_angle, sigma=sigma, options=options,
-                                    kinetic=kinetic, holes=arcs, uniform_out=uniform_out)
+                                    kinetic=kinetic, holes=arcs, uniform_out=uniform_out,
+                                    table=table, tab=tab)
             return res, (run if return_run else None), None
         out = tangent_one_kernel(st, rho, times, angles, KICK_ANGLES[kick_angle], mode, n_steps,
-                                 tau, U, max_events, kick_u, sp, kinetic)
+                                 tau, U, max_events, kick_u, sp, kinetic, tab)
         check_kinetic_capacity(kinetic, out[2])
         return _tangent_result(out, U, (0, 1), variant, horizon, max_events, "the disk"), None, None
-    offsets, measure = _twin_offsets(
-        variant, d0, lambda dx, dy: math.hypot(state[0] + dx, state[1] + dy) <= rho
-    )
+    if tab is None:
+        offsets, measure = _twin_offsets(
+            variant, d0, lambda dx, dy: math.hypot(state[0] + dx, state[1] + dy) <= rho
+        )
+    else:
+        offsets, measure = _twin_offsets(
+            variant, d0, lambda dx, dy: bool(table.contains([state[0] + dx, state[1] + dy], r))
+        )
     twin_angles = np.empty((0, times.size))
     if twin_kicks == "independent":
         if kinetic is not None:
@@ -648,7 +675,7 @@ def _lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rul
             twin_angles[j] = draw_kick_angles(times.size, kick_angle, sigma, rng)
     out = ftle_one_kernel(st, rho, times, angles, KICK_ANGLES[kick_angle], mode, n_steps, tau,
                           offsets, measure, d0, max_defer, max_events, kick_u, sp, kinetic,
-                          renormalize, twin_angles)
+                          renormalize, twin_angles, tab)
     check_kinetic_capacity(kinetic, int(np.searchsorted(times, np.inf)))
     return _twin_result(out, variant, d0, horizon, max_events, renormalize, tau), None, None
 
@@ -696,26 +723,28 @@ def _uniform_samples(sink, run, tau, holes, samples):
 
 def _pass_one(st, state, r, times, angles, kick_u, sp, mode, n_steps, tau, U, variant,
               max_ev_tan, *, sampling, kick_angle, sigma, options, kinetic=None,
-              holes=None, uniform_out=None):
-    """The kicked run and its tangent FTLE from one pass (`simulate_tangent_one_kernel`).
+              holes=None, uniform_out=None, table=None, tab=None):
+    """The kicked run and its tangent FTLE from one pass (`simulate_tangent_one_kernel`;
+    ``table`` the run's table, ``tab`` its kernels' tuple, `table_args`).
 
     The simulation is set up and recorded by `simulate_one_particle`'s own helpers
     (`kernel_limits`, `one_particle_run`), so the run is the very one it returns.
     """
     scatter = kick_angle == "scatter"
     horizon = n_steps * tau
-    rho, max_events, b_cap, stall_dt = kernel_limits(st, r, sp, scatter, horizon, mode)
+    rho, max_events, b_cap, stall_dt = kernel_limits(st, r, sp, scatter, horizon, mode,
+                                                     table=table)
     out = simulate_tangent_one_kernel(
         st, rho, times, angles, KICK_ANGLES[kick_angle], horizon if mode == 1 else 0.0, mode,
         n_steps, tau, b_cap, kick_u, sp, max_events, stall_dt, U, max_ev_tan, kinetic, holes,
-        uniform_out is not None and mode == 2)
+        uniform_out is not None and mode == 2, tab)
     raise_for_status(out[9], st[0], out[0].shape[0], max_events=max_events, name="system",
                      where=f"disk at ({st[1]:.6g}, {st[2]:.6g}), r={r!r}")
     check_kinetic_capacity(kinetic, out[6])
     run = one_particle_run(st, r, state, out[:9], sampling=sampling, mode=mode, tau=tau,
                            n_steps=n_steps, seed=None, kick_angle=kick_angle, sigma=sigma,
                            times=times, applied=kick_u if scatter else angles,
-                           escape_time=float(out[15][0]), **options)
+                           escape_time=float(out[15][0]), table=table, **options)
     res = _tangent_result(out[10:15], U, (0, 1), variant, horizon, max_ev_tan, "the disk")
     _uniform_samples(uniform_out, run, tau, holes, out[17])
     return res, run, None
