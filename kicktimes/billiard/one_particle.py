@@ -2,9 +2,9 @@
 
 One disk of radius ``r`` moves in the unit circular table, or in a stadium or an ellipse
 (``table=``, `kicktimes.tables`; docs/tables.md, "The kicked disk in a table"); at each
-kick time its velocity direction is changed (docs/architecture.md, "Perturbed one-particle billiard"). Kicks are events of
-the event loop, applied at their exact times (`kicktimes.billiard.kernels.one` is the event
-step, `.drive_one` the loop).
+kick time its velocity direction is changed (docs/architecture.md, "Perturbed one-particle
+billiard"). Kicks are events of the event loop, applied at their exact times
+(`kicktimes.billiard.kernels.one` is the event step, `.drive_one` the loop).
 
 Ties: a kick at the same instant as a boundary collision is applied *after* the
 reflection. If the new direction points out of the table, the disk is reflected again

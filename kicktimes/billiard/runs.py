@@ -24,6 +24,7 @@ import pandas as pd
 
 from kicktimes import __version__
 from kicktimes._results import TableResult
+from kicktimes.billiard.scatter import KICK_LOG_COLUMNS as _KICK_LOG_COLUMNS
 from kicktimes.billiard.tables import Circle, Ellipse, Stadium
 from kicktimes.fileio import atomic_write
 
@@ -33,8 +34,8 @@ TWO_PI = 2.0 * np.pi
 #: pre-collision velocities, post-collision velocities.
 PP_LOG_COLUMNS = ("x0", "y0", "x1", "y1", "vx0", "vy0", "vx1", "vy1",
                   "vx0_post", "vy0_post", "vx1_post", "vy1_post")
-#: Columns of a scattering-kick log (kicktimes.billiard.scatter.KICK_LOG_COLUMNS).
-KICK_LOG_COLUMNS = ("vx", "vy", "vx_post", "vy_post", "nx", "ny", "ux", "uy", "outside")
+#: Columns of a scattering-kick log (defined beside the kick, in kicktimes.billiard.scatter)
+KICK_LOG_COLUMNS = _KICK_LOG_COLUMNS
 
 
 class BoundaryLog(NamedTuple):
@@ -293,8 +294,8 @@ class OneParticleRun(_Run):
     """
 
     _title = "One kicked disk in a table (simulate_one_particle)"
-    _summary_fields = ("r", "table", "t_max", "kick_angle", "sigma", "n_kicks", "n_boundary", "rule",
-                       "sampling", "tau", "n_steps", "seed")
+    _summary_fields = ("r", "table", "t_max", "kick_angle", "sigma", "n_kicks", "n_boundary",
+                       "rule", "sampling", "tau", "n_steps", "seed")
 
     kick_angle: str = "uniform"
     sigma: float | None = None

@@ -216,8 +216,13 @@ def drive(st, ev, rho, kicks, angles, kick_mode, kick_u, sp, unit_speed, t_end, 
                     U[j, 0], U[j, 1], U[j, 2], U[j, 3] = tg.curved_wall_tangent(
                         U[j, 0], U[j, 1], U[j, 2], U[j, 3], ux, uy, s[one.S_VX], s[one.S_VY],
                         nx, ny, kappa)
-                    # a chaotic table stretches at every contact, not only at kicks
-                    n_resc += tg.renormalize(U, log_scale, j)
+                    # a chaotic table stretches at every contact, not only at kicks (the
+                    # norm tested on scalars: renormalize's array argument costs reference
+                    # counting at every contact)
+                    nn = (U[j, 0] * U[j, 0] + U[j, 1] * U[j, 1] + U[j, 2] * U[j, 2]
+                          + U[j, 3] * U[j, 3])
+                    if nn > tg.BIG2 or (nn < 1.0 / tg.BIG2 and nn > 0.0):
+                        n_resc += tg.renormalize(U, log_scale, j)
             if sim_on:
                 bs[n_b] = sin_theta
                 bt[n_b] = s[one.S_T]
@@ -355,9 +360,10 @@ def simulate_tangent_one_kernel(st, rho, kicks, angles, kick_mode, t_max, mode, 
 
     Arguments as theirs (``mode`` 1 or 2); ``uniform`` (``mode == 2``, no holes): also the
     run's uniform samples at ``k tau`` over its duration, bitwise those of a uniform run
-    with the kicks it applied; ``table``: see `drive`. Returns ``(b_time, b_x, b_y, b_sin, sample_times, samples,
-    n_kicks_applied, t_end, kick_log, status, log_scale, n_rescaled, n_kicks_tangent,
-    t_end_tangent, status_tangent, escape, uniform_times, uniform_samples)``.
+    with the kicks it applied; ``table``: see `drive`. Returns ``(b_time, b_x, b_y, b_sin,
+    sample_times, samples, n_kicks_applied, t_end, kick_log, status, log_scale, n_rescaled,
+    n_kicks_tangent, t_end_tangent, status_tangent, escape, uniform_times,
+    uniform_samples)``.
     """
     on = uniform and mode == 2 and holes is None
     u_times, u_samples = ob.new_samples(n_steps + 2 if on else 0)
