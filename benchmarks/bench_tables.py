@@ -8,13 +8,21 @@ robust to a shared machine), interleaved table by table in this process, so the 
 compare like with like. Without and with the tangent vector. The issue's targets: the
 stadium at most 1.3x the circle, the ellipse at most 3x.
 
+Section "kicked" (``--section kicked``): the kicked disk of `simulate_one_particle`
+(``table=``, Poisson kicks at ``--kick-rate``, no samples) and its tangent FTLE
+(`kicktimes.diagnostics.lyapunov`, one step), in the circle (``table=None``, the
+simulator's own code) and in ``Stadium(1)`` and ``Ellipse(1.5, 1)`` at the same ``r``, kick
+rate and horizon (``--bounces`` mean free times of the table, so about that many contacts);
+the cost per event (contacts + kicks) as a ratio to the circle's.
+
 The section ``two`` times two disks (`kicktimes.simulate_two_particle`, no samples, and
 the tangent FTLE `kicktimes.diagnostics.lyapunov`) in the same tables at the same ``--r``
 over the horizon ``--two-horizon``, per event (disk-disk and wall), as a ratio to the
 circle (``table=None``, the circle's own kernels).
 
 Run: python benchmarks/bench_tables.py [--bounces 1000000] [--repeat 5] [--r 0.02]
-     [--section free|two|all] [--two-horizon 20000]
+     [--section free|two|kicked|all] [--two-horizon 20000]
+     [--kick-rate 0.1]
 """
 
 import argparse
@@ -22,7 +30,7 @@ import time
 
 from _timing import best_time
 
-from kicktimes import initial_conditions, simulate_two_particle
+from kicktimes import initial_conditions, schedules, simulate_one_particle, simulate_two_particle
 from kicktimes.diagnostics import lyapunov
 from kicktimes.tables import Circle, Ellipse, Stadium, free_run, uniform_state
 
@@ -64,19 +72,65 @@ def two_disks(args):
               f"{1e9 * tan:.1f} | {tan / c_tan:.2f} |")
 
 
+def kicked(args):
+    """The kicked disk's cost per event in each table against the circle's."""
+    r = args.r
+    cases = [("Circle()", None), ("Stadium(1)", Stadium(1.0)),
+             ("Ellipse(1.5, 1)", Ellipse(1.5, 1.0))]
+    horizon = args.bounces * Circle().mean_free_time(r)
+    law = schedules.Poisson(args.kick_rate)
+
+    def sim(table, state):
+        return simulate_one_particle(state, r, t_max=horizon, kicks=law, rng=1, table=table,
+                                     max_events=10 * args.bounces)
+
+    def ftle(table, state):
+        return lyapunov(state, r, n_steps=1, tau=horizon, kicks=law, rng=1, table=table)
+
+    states = {name: uniform_state(table or Circle(), r, rng=1) for name, table in cases}
+    events = {}
+    for name, table in cases:  # compile, warm up, count the events
+        small = simulate_one_particle(states[name], r, t_max=10.0, kicks=law, rng=1,
+                                      table=table)
+        lyapunov(states[name], r, n_steps=1, tau=10.0, kicks=law, rng=1, table=table)
+        del small
+        run = sim(table, states[name])
+        events[name] = run.n_boundary + run.n_kicks
+    best = {}
+    for _ in range(args.repeat):
+        for name, table in cases:
+            for what, fn in (("sim", sim), ("ftle", ftle)):
+                seconds = best_time(lambda f=fn, t=table, s=states[name]: f(t, s), 1,
+                                    clock=time.process_time)
+                best[(name, what)] = min(best.get((name, what), float("inf")), seconds)
+    print(f"\nkicked disk: r = {r:g}, Poisson kicks at rate {args.kick_rate:g}, horizon "
+          f"{horizon:.4g}, best of {args.repeat} CPU times")
+    print("| table | events | ns/event | × circle | ns/event, tangent FTLE | × circle |")
+    print("|---|---|---|---|---|---|")
+    per = {k: 1e9 * v / events[k[0]] for k, v in best.items()}
+    for name, _ in cases:
+        print(f"| {name} | {events[name]} | {per[(name, 'sim')]:.1f} | "
+              f"{per[(name, 'sim')] / per[('Circle()', 'sim')]:.2f} | "
+              f"{per[(name, 'ftle')]:.1f} | "
+              f"{per[(name, 'ftle')] / per[('Circle()', 'ftle')]:.2f} |")
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--bounces", type=int, default=10**6)
     parser.add_argument("--repeat", type=int, default=5)
     parser.add_argument("--r", type=float, default=0.02)
     parser.add_argument("--r-large", type=float, default=0.3)
-    parser.add_argument("--section", choices=("free", "two", "all"), default="all")
+    parser.add_argument("--section", choices=("free", "two", "kicked", "all"), default="all")
     parser.add_argument("--two-horizon", type=float, default=2e4)
+    parser.add_argument("--kick-rate", type=float, default=0.1)
     args = parser.parse_args()
     if args.section in ("free", "all"):
         free_disk(args)
     if args.section in ("two", "all"):
         two_disks(args)
+    if args.section in ("kicked", "all"):
+        kicked(args)
 
 
 def free_disk(args):

@@ -1,9 +1,10 @@
-"""The randomly perturbed ("kicked") one-disk circular billiard: the simulator's Python layer.
+"""The randomly perturbed ("kicked") one-disk billiard: the simulator's Python layer.
 
-One disk of radius ``r`` moves in the unit table; at each kick time its velocity
-direction is changed (docs/architecture.md, "Perturbed one-particle billiard"). Kicks are events of
-the event loop, applied at their exact times (`kicktimes.billiard.kernels.one` is the event
-step, `.drive_one` the loop).
+One disk of radius ``r`` moves in the unit circular table, or in a stadium or an ellipse
+(``table=``, `kicktimes.tables`; docs/tables.md, "The kicked disk in a table"); at each
+kick time its velocity direction is changed (docs/architecture.md, "Perturbed one-particle
+billiard"). Kicks are events of the event loop, applied at their exact times
+(`kicktimes.billiard.kernels.one` is the event step, `.drive_one` the loop).
 
 Ties: a kick at the same instant as a boundary collision is applied *after* the
 reflection. If the new direction points out of the table, the disk is reflected again
@@ -31,6 +32,7 @@ from kicktimes.billiard.kick_law import (
 )
 from kicktimes.billiard.runs import BoundaryLog, OneParticleRun, sampling_fields
 from kicktimes.billiard.scatter import PARTNER_LAWS, draw_scatter_uniforms
+from kicktimes.billiard.tables import Circle, Ellipse, Stadium, check_table
 from kicktimes.billiard.two_particle import raise_for_status
 from kicktimes.validation import check_rng
 
@@ -45,16 +47,79 @@ def _is_kicktimes_schedule(kicks) -> bool:
 
     return isinstance(kicks, Schedule)
 
-def check_one_particle_state(state, r: float, name: str = "state") -> np.ndarray:
-    """Validate a one-disk state ``(x, y, vx, vy)`` for radius ``r``; a float64 copy."""
-    if r > R_MAX_ONE:
+def check_one_particle_state(state, r: float, name: str = "state", *,
+                             table=None) -> np.ndarray:
+    """Validate a one-disk state ``(x, y, vx, vy)`` for radius ``r``; a float64 copy.
+
+    ``table`` (`check_table`; ``None``: the unit circle): the centre must keep the disk
+    inside it (``table.contains``), anywhere in a stadium or an ellipse.
+    """
+    table = check_table(table)
+    if table == Circle() and r > R_MAX_ONE:
         raise ValueError(f"r must lie in (0.0, {R_MAX_ONE!r}] for one disk, got {float(r)!r}")
     arr = chk.check_state(name, state, (4,))
-    chk.check_inside(name, arr[0], arr[1], 1.0 - r, r, "the disk's")
+    if table == Circle():
+        chk.check_inside(name, arr[0], arr[1], 1.0 - r, r, "the disk's")
+    elif not table.contains(arr[:2], r):
+        raise ValueError(f"{name}: the centre ({arr[0]!r}, {arr[1]!r}) keeps no disk of radius "
+                         f"{r!r} inside {table!r}")
     if math.hypot(arr[2], arr[3]) == 0.0:
         raise ValueError(f"{name}: the velocity (vx, vy) must be non-zero, got (0, 0)")
     chk.check_speed(name, arr[2], arr[3], "the disk's", allow_zero=False)
     return arr
+
+
+def table_args(table, r, kick_angle="uniform", partner_radius=None):
+    """The kernels' table tuple ``(kind, p0, p1, p2, q0, q1, q2)`` of a kicked run in
+    ``table`` (`kicktimes.billiard.kernels.one`), or ``None`` for the circle (its own code,
+    bitwise the circle's runs).
+
+    ``(kind, p0, p1, p2)`` is the centre's curve for the radius ``r``; ``(q0, q1, q2)`` the
+    table's curve for a scattering partner's centre (radius ``partner_radius``, default
+    ``r``), which sets the kick log's "outside" flag; a partner the table cannot hold is a
+    ValueError naming ``partner_radius``.
+    """
+    if table == Circle():
+        return None
+    kind, p0, p1, p2 = table.kernel(r)
+    r1 = r if partner_radius is None or kick_angle != "scatter" else partner_radius
+    try:
+        _, q0, q1, q2 = table.kernel(r1)
+    except ValueError as exc:
+        raise ValueError(f"partner_radius: the partner disk must fit the table: {exc}") from None
+    return (kind, p0, p1, p2, q0, q1, q2)
+
+
+def check_table_kicks(table, kicks, holes) -> None:
+    """What a stadium or an ellipse refuses: kinetic kicks (`KineticRate`: a rate that is
+    a function of the circle's conserved angular momentum, which these tables lack; the
+    ellipse conserves the product of the momenta about its foci instead) and holes (arcs
+    of the circle's wall)."""
+    from kicktimes.schedules import KineticRate
+
+    if table == Circle():
+        return
+    if isinstance(kicks, KineticRate):
+        raise ValueError(f"kicks: kinetic kicks (KineticRate) are a rate of the circle's "
+                         f"conserved angular momentum, which {table!r} does not conserve; use "
+                         "kick times or a schedule (Poisson, Replay, ...) in this table")
+    if holes is not None:
+        raise ValueError(f"holes: holes are arcs of the circle's wall (centre angle, "
+                         f"half-width); {table!r} takes none (table=None or Circle() for holes)")
+
+
+def table_sizes(table, r) -> tuple[float, float]:
+    """``(length, curvature radius)`` of the budgets of a run in ``table``: the radius of
+    the circle with the same mean free path (``2 / pi`` times the mean free time at unit
+    speed; ``1 - r`` in the circle), and the smallest radius of curvature of the centre's
+    curve (the grazing chord of `kicktimes.billiard.checks.stall_time`)."""
+    if table == Circle():
+        return 1.0 - r, 1.0 - r
+    length = 2.0 * table.mean_free_time(r) / math.pi
+    if isinstance(table, Stadium):
+        return length, 1.0 - r
+    assert isinstance(table, Ellipse)
+    return length, table.b * table.b / table.a - r
 
 
 def draw_kick_angles(n: int, kick_angle: str, sigma: float, rng: np.random.Generator):
@@ -270,16 +335,19 @@ def _old_one_particle(args, kwargs):
 @old_keywords(_old_one_particle)
 def simulate_one_particle(state, r, *, t_max=None, kicks=None, rng=None, sampling="uniform",
                           n_steps=None, tau=None, max_events=None,
-                          holes=None) -> OneParticleRun:
-    """Simulate one disk of radius ``r`` in the unit table, kicked at given times.
+                          holes=None, table=None) -> OneParticleRun:
+    """Simulate one disk of radius ``r`` in the unit table (or a stadium, an ellipse),
+    kicked at given times.
 
     Parameters
     ----------
     state : array_like, shape (4,)
-        ``(x, y, vx, vy)`` at ``t = 0``; ``|x| <= 1 - r``, non-zero velocity (the speed is
-        kept by boundary collisions and kicks).
+        ``(x, y, vx, vy)`` at ``t = 0``; ``|x| <= 1 - r`` (in another table: any centre
+        that keeps the disk inside it), non-zero velocity (the speed is kept by boundary
+        collisions and kicks).
     r : float
-        Disk radius, ``0 < r < 1``.
+        Disk radius, ``0 < r < 1`` (the table's `check_radius`: an ellipse needs
+        ``r < b^2 / a``).
     t_max, sampling, n_steps, tau
         As in `simulate_two_particle`. Under ``sampling="paper"`` a step is cut short by a
         boundary collision or a kick.
@@ -300,13 +368,28 @@ def simulate_one_particle(state, r, *, t_max=None, kicks=None, rng=None, samplin
     holes : array_like, shape (n, 2), optional
         Holes in the table's wall, rows ``(centre angle, half-width)`` in radians: the
         disk escapes at a wall contact in a hole and the run ends there
-        (``run.escape_time``; ``inf`` if it did not escape by the end).
-
-    Returns
+        (``run.escape_time``; ``inf`` if it did not escape by the end). Circle only.
+    table : Circle, Stadium or Ellipse, optional
+        The table (`kicktimes.tables`; ``None``: ``Circle()``, the computation it always
+        was, to the bit). In a stadium or an ellipse the wall contacts are those of the
+        centre's parallel curve (`kicktimes.billiard.kernels.tables`: contact put back on
+        the wall, reflection or grazing slide, the speed kept by a Newton step); every
+        kick law but the kinetic one applies (a scattering kick's partner needs no wall).
+        ``boundary.s`` is then the arc length along the centre's curve and ``sin_theta``
+        the incoming ``v.t / |v|`` (Birkhoff's coordinates,
+        `kicktimes.billiard.kernels.tables.boundary_coordinates`).
     -------
     OneParticleRun
         ``kick_times``, ``kick_angles`` (what was applied), ``boundary`` (DataFrame
-        ``time, s, sin_theta``), ``final_state``, ``sample_times``, ``samples``.
+        ``time, s, sin_theta``), ``final_state``, ``sample_times``, ``samples``, ``table``.
+
+    Raises
+    ------
+    TypeError
+        ``table`` is not a table.
+    ValueError
+        A radius the table refuses (its ``check_radius``); kinetic kicks (``kicks``) or
+        ``holes`` in a stadium or an ellipse.
 
     Notes
     -----
@@ -340,17 +423,31 @@ def simulate_one_particle(state, r, *, t_max=None, kicks=None, rng=None, samplin
     >>> big = simulate_one_particle(state, 0.02, t_max=100.0, kicks=law, rng=1)
     >>> big.partner_radius, big.partner_mass
     (0.05, 3.0)
+
+    The same kicks in Bunimovich's stadium (every centre stays inside it):
+
+    >>> from kicktimes.tables import Stadium, uniform_state
+    >>> table = Stadium(1.0)
+    >>> st = uniform_state(table, 0.02, rng=2)
+    >>> run = simulate_one_particle(st, 0.02, t_max=100.0, kicks=schedules.Poisson(0.1),
+    ...                             rng=1, table=table)
+    >>> run.table, bool(table.contains(run.samples, 0.02).all())
+    (Stadium(a=1.0), True)
     """
-    r = chk.check_real("r", r, low=0.0, high=1.0)
+    table = check_table(table)
+    r = (chk.check_real("r", r, low=0.0, high=1.0) if table == Circle()
+         else table.check_radius(r))
     law = as_kick_law(kicks)
+    check_table_kicks(table, law.times, holes)
     kicks, kick_angles, kick_angle, sigma = law.times, law.angles, law.angle, law.sigma
     rule, e0, partner = law.rule, law.e0, law.partner
     partner_radius, partner_mass = law.partner_radius, law.partner_mass
     t_max, n_steps, tau, mode = chk.check_sampling(t_max, n_steps, tau, sampling)
-    state = check_one_particle_state(state, r)
+    state = check_one_particle_state(state, r, table=table)
     sp, options = check_scatter_options(state, r, kick_angle, rule, e0, partner,
                                         partner_radius, partner_mass)
     rule = options["rule"]
+    tab = table_args(table, r, kick_angle, partner_radius)
     horizon = t_max if mode < 2 else n_steps * tau  # paper steps are at most tau long
     times, angles, _, kinetic = resolve_kicks(kicks, kick_angles, kick_angle=kick_angle,
                                               sigma=sigma, rng=rng, horizon=horizon,
@@ -362,12 +459,13 @@ def simulate_one_particle(state, r, *, t_max=None, kicks=None, rng=None, samplin
     st[6] = state[2] ** 2 + state[3] ** 2
     scatter = kick_angle == "scatter"
     rho, max_events, b_cap, stall_dt = kernel_limits(st, r, sp, scatter, horizon, mode,
-                                                     max_events)
+                                                     max_events, table=table)
     out = simulate_one_kernel(
         st, rho, times, np.zeros(times.size) if scatter else angles,
         KICK_ANGLES[kick_angle], 0.0 if mode == 2 else t_max, mode,
         n_steps if n_steps is not None else 0, tau if tau is not None else 0.0,
         b_cap, angles if scatter else np.zeros((0, 2)), sp, max_events, stall_dt, kinetic, arcs,
+        tab,
     )
     raise_for_status(out[9], st[0], out[0].shape[0], max_events=max_events, name="state",
                      where=f"disk at ({st[1]:.6g}, {st[2]:.6g}), r={r!r}")
@@ -383,30 +481,33 @@ def simulate_one_particle(state, r, *, t_max=None, kicks=None, rng=None, samplin
     return one_particle_run(st, r, state, out[:9], sampling=sampling, mode=mode, tau=tau,
                             n_steps=n_steps, seed=None, kick_angle=kick_angle, sigma=sigma,
                             times=times, applied=angles, escape_time=float(out[10][0]),
-                            **options)
+                            table=table, **options)
 
 
-def kernel_limits(st, r, sp, scatter, horizon, mode, max_events=None):
+def kernel_limits(st, r, sp, scatter, horizon, mode, max_events=None, *, table=None):
     """``(rho, max_events, b_cap, stall_dt)`` of a kicked run from the state ``st``.
 
     The event budget (`event_budget` at the largest speed the disk can reach: elastic
     scattering can give it all of the pair's energy), the initial size of the boundary
     log and the stall time, shared by `simulate_one_particle` and the one pass of
-    `kicktimes.diagnostics.lyapunov` so that both set up the very same run.
+    `kicktimes.diagnostics.lyapunov` so that both set up the very same run. In another
+    ``table`` the lengths are its `table_sizes` (``rho`` stays ``1 - r``, which the
+    table's kernels do not read).
     """
     rho = 1.0 - r
+    size, bend = table_sizes(check_table(table), r)
     speed = math.sqrt(st[6])
     if scatter and sp[1] != 0.0:
         speed = max(speed, math.sqrt(2.0 * sp[2] / sp[5]))
     max_events = chk.event_budget(max_events, horizon=horizon,
                                   horizon_name="t_max" if mode < 2 else "n_steps * tau",
-                                  speed=speed, rho=rho, n_disks=1)
-    return rho, max_events, int(2.0 * speed * horizon / rho) + 64, chk.stall_time(rho, speed)
+                                  speed=speed, rho=size, n_disks=1)
+    return rho, max_events, int(2.0 * speed * horizon / size) + 64, chk.stall_time(bend, speed)
 
 
 def one_particle_run(st, r, state, out, *, sampling, mode, tau, n_steps, seed, kick_angle,
                      sigma, times, applied, rule, e0, partner, partner_radius=None,
-                     partner_mass=None, escape_time=math.inf) -> OneParticleRun:
+                     partner_mass=None, escape_time=math.inf, table=None) -> OneParticleRun:
     """The `OneParticleRun` of a finished kicked run: ``out`` is the kernel's
     ``(b_time, b_x, b_y, b_sin, sample_times, samples, n_kicks_applied, t_end,
     kick_log)``, ``st`` its final state, ``applied`` the kick angles (or, for scattering
@@ -431,4 +532,5 @@ def one_particle_run(st, r, state, out, *, sampling, mode, tau, n_steps, seed, k
         kick_log_array=klog,
         escape_time=escape_time,
         escaped=0 if math.isfinite(escape_time) else -1,
+        table=check_table(table),
     )

@@ -24,6 +24,7 @@ import pandas as pd
 
 from kicktimes import __version__
 from kicktimes._results import TableResult
+from kicktimes.billiard.scatter import KICK_LOG_COLUMNS as _KICK_LOG_COLUMNS
 from kicktimes.billiard.tables import Circle, Ellipse, Stadium
 from kicktimes.fileio import atomic_write
 
@@ -33,8 +34,8 @@ TWO_PI = 2.0 * np.pi
 #: pre-collision velocities, post-collision velocities.
 PP_LOG_COLUMNS = ("x0", "y0", "x1", "y1", "vx0", "vy0", "vx1", "vy1",
                   "vx0_post", "vy0_post", "vx1_post", "vy1_post")
-#: Columns of a scattering-kick log (kicktimes.billiard.scatter.KICK_LOG_COLUMNS).
-KICK_LOG_COLUMNS = ("vx", "vy", "vx_post", "vy_post", "nx", "ny", "ux", "uy", "outside")
+#: Columns of a scattering-kick log (defined beside the kick, in kicktimes.billiard.scatter)
+KICK_LOG_COLUMNS = _KICK_LOG_COLUMNS
 
 
 class BoundaryLog(NamedTuple):
@@ -56,22 +57,20 @@ def _arclength(x: np.ndarray, y: np.ndarray) -> np.ndarray:
     return s
 
 
-def table_meta(table) -> dict:
-    """A table as JSON-able parameters: ``{"name": "Stadium", "a": 1.0}``."""
-    out = {"name": type(table).__name__}
-    for name in ("a", "b"):
-        if hasattr(table, name):
-            out[name] = float(getattr(table, name))
-    return out
-
-
+#: the tables a run's record can name (its ``meta["table"]``: the class name and its sizes)
 _TABLES = {cls.__name__: cls for cls in (Circle, Stadium, Ellipse)}
 
 
+def table_meta(table) -> dict:
+    """A table as JSON: ``{"name": "Stadium", "a": 1.0}`` (`table_from_meta` reads it)."""
+    return {"name": type(table).__name__,
+            **{f.name: float(getattr(table, f.name)) for f in fields(table)}}
+
+
 def table_from_meta(meta: dict):
-    """The table of `table_meta`'s parameters."""
-    params = dict(meta)
-    return _TABLES[params.pop("name")](**params)
+    """The table of `table_meta`'s record."""
+    meta = dict(meta)
+    return _TABLES[meta.pop("name")](**meta)
 
 
 def sampling_fields(t_end, mode, sampling, tau, n_steps, sample_times, samples) -> dict:
@@ -317,14 +316,20 @@ class OneParticleRun(_Run):
         contact normal ``n``, the partner's velocity ``u`` and whether the partner's
         centre lay outside the table.
     boundary : DataFrame
-        Columns ``time, s, sin_theta``.
+        Columns ``time, s, sin_theta``: in the circle ``s`` is the contact's polar angle
+        (the arc length on the unit table); in a stadium or an ellipse the arc length along
+        the centre's curve, counter-clockwise from its rightmost point, and ``sin_theta``
+        the incoming ``v.t / |v|`` (`kicktimes.billiard.kernels.tables.boundary_coordinates`).
     sample_times, samples : ndarray
         Sample times and the disk's centre at them.
+    table : Circle, Stadium or Ellipse
+        The table of the run (``Circle()`` unless ``simulate_one_particle(table=...)``;
+        recorded in ``meta`` only for another table, so circle records are unchanged).
     """
 
-    _title = "One kicked disk in the unit circular table (simulate_one_particle)"
-    _summary_fields = ("r", "t_max", "kick_angle", "sigma", "n_kicks", "n_boundary", "rule",
-                       "sampling", "tau", "n_steps", "seed")
+    _title = "One kicked disk in a table (simulate_one_particle)"
+    _summary_fields = ("r", "table", "t_max", "kick_angle", "sigma", "n_kicks", "n_boundary",
+                       "rule", "sampling", "tau", "n_steps", "seed")
 
     kick_angle: str = "uniform"
     sigma: float | None = None
@@ -336,6 +341,7 @@ class OneParticleRun(_Run):
     partner_radius: float | None = None
     partner_mass: float | None = None
     kick_log_array: np.ndarray = field(default_factory=lambda: np.empty((0, 9)))
+    table: object = field(default_factory=Circle)
 
     kind = "one_particle"
     _array_fields = ("kick_times", "kick_angles", "kick_log_array")
@@ -352,12 +358,23 @@ class OneParticleRun(_Run):
         df.insert(0, "time", self.kick_times[: df.shape[0]])
         return df
 
+    @property
+    def meta(self) -> dict:
+        out = super().meta
+        if self.table != Circle():
+            out["table"] = table_meta(self.table)
+        return out
+
     @cached_property
     def boundary(self) -> pd.DataFrame:
         log = self.boundary_log
-        return pd.DataFrame(
-            {"time": log.time, "s": _arclength(log.x, log.y), "sin_theta": log.sin_theta}
-        )
+        if self.table == Circle():
+            s = _arclength(log.x, log.y)
+        else:
+            from kicktimes.billiard.kernels.one import table_arc_lengths
+
+            s = table_arc_lengths(*self.table.kernel(self.r), log.x, log.y)
+        return pd.DataFrame({"time": log.time, "s": s, "sin_theta": log.sin_theta})
 
     @property
     def n_kicks(self) -> int:

@@ -36,7 +36,8 @@ import math
 import numpy as np
 from numba import njit
 
-from kicktimes.billiard.runs import KICK_LOG_COLUMNS
+#: Columns of a scattering-kick log (`scatter_kick`'s ``out``; the runs' `kick_log`)
+KICK_LOG_COLUMNS = ("vx", "vy", "vx_post", "vy_post", "nx", "ny", "ux", "uy", "outside")
 
 __all__ = ["KICK_LOG_COLUMNS", "PARTNER_LAWS", "collide_with_partner", "draw_partner",
            "draw_scatter_uniforms", "partner_angle", "scatter_kick", "scatter_tangent",

@@ -38,11 +38,13 @@ from kicktimes.billiard.one_particle import (
     check_kinetic_capacity,
     check_one_particle_state,
     check_scatter_options,
+    check_table_kicks,
     draw_kick_angles,
     kernel_limits,
     law_from_old_keywords,
     one_particle_run,
     resolve_kicks,
+    table_args,
 )
 from kicktimes.billiard.runs import OneParticleRun, TwoParticleRun
 from kicktimes.billiard.tables import Circle, check_table
@@ -391,11 +393,13 @@ def lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rule
         Holes in the table's wall (as in `simulate_two_particle`): the exponent is
         measured up to the escape (``total_time`` the escape time), tangent method only.
     table : Circle, Stadium or Ellipse, optional
-        Two disks: the table (as in `simulate_two_particle`; ``None``: the unit circle;
-        taken from a run). The tangent map at a wall contact is
+        The table (as in `simulate_two_particle` and `simulate_one_particle`; ``None``: the
+        unit circle; taken from a run, and a ValueError if it contradicts the run's). In a
+        stadium or an ellipse the tangent vector crosses a wall contact by
         `kicktimes.billiard.kernels.tangent.curved_wall_tangent` with the contact's normal
-        and the curvature of the centre's curve (0 on the stadium's segments); the twins
-        run through the same table kernels.
+        and the local curvature of the centre's curve (0 on the stadium's segments); the
+        disk-disk and kick maps do not depend on the table; the twins run through the same
+        table kernels.
 
     Returns
     -------
@@ -507,6 +511,8 @@ def _lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rul
               renormalize=True, twin_kicks="shared"):
     """`lyapunov`'s body: ``(result, run or None, pp_times or None)``; a list
     ``uniform_out`` receives the one pass's uniform samples (see `lyapunov_pass`)."""
+    given_table = table is not None
+    table = check_table(table)
     if not isinstance(renormalize, bool | np.bool_):
         raise TypeError(f"renormalize must be a bool, got {type(renormalize).__name__}")
     renormalize = bool(renormalize)
@@ -530,8 +536,12 @@ def _lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rul
         if run.sampling is None:
             raise ValueError("system: the run has no sampling (n_steps, tau); the FTLE needs it")
         r, n_steps, tau, sampling = run.r, run.n_steps, run.tau, run.sampling
+        if given_table and table != run.table:
+            raise ValueError(f"table: the run was simulated in {run.table!r}, got "
+                             f"table={table!r}")
+        table = run.table
         if isinstance(run, TwoParticleRun):
-            rule, track, system, table = run.rule, run.track, run.ic, run.table
+            rule, track, system = run.rule, run.track, run.ic
         else:
             # the FTLE covers n_steps samples; a run may have gone on beyond them
             horizon = n_steps * tau
@@ -567,7 +577,6 @@ def _lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rul
     arr = np.asarray(system, dtype=np.float64)
     if arr.shape == (2, 4):
         r0, r1, r = chk.check_radii(r)
-        table = check_table(table)
         if table == Circle():
             table = None  # the circle's own kernels, bit for bit
         else:
@@ -627,16 +636,16 @@ def _lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rul
         return _twin_result(out, variant, d0, horizon, max_events, renormalize, tau), None, None
     if arr.shape != (4,):
         raise ValueError(f"system must have shape (2, 4) or (4,), got {arr.shape}")
-    if check_table(table) != Circle():
-        raise ValueError(f"table: the kicked one-disk FTLE runs in the unit circle only, got "
-                         f"table={table!r}")
-    r = chk.check_real("r", r, low=0.0, high=1.0)
+    r = (chk.check_real("r", r, low=0.0, high=1.0) if table == Circle()
+         else table.check_radius(r))
+    check_table_kicks(table, kicks, holes)
     chk.check_choice("kick_angle", kick_angle, KICK_ANGLES)
     sigma = chk.check_real("sigma", sigma, low=0.0)
-    state = check_one_particle_state(arr, r, name="system")
+    state = check_one_particle_state(arr, r, name="system", table=table)
     sp, options = check_scatter_options(state, r, kick_angle, rule, e0, partner,
                                         partner_radius, partner_mass)
     rule = options["rule"]
+    tab = table_args(table, r, kick_angle, partner_radius)
     if twin_kicks == "independent":
         if kick_angle == "scatter":
             raise ValueError("twin_kicks='independent' needs kicks that set or rotate the "
@@ -663,15 +672,21 @@ def _lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rul
             res, run, _ = _pass_one(st, state, r, times, angles, kick_u, sp, mode, n_steps, tau,
                                     U, variant, max_events, sampling=sampling,
                                     kick_angle=kick_angle, sigma=sigma, options=options,
-                                    kinetic=kinetic, holes=arcs, uniform_out=uniform_out)
+                                    kinetic=kinetic, holes=arcs, uniform_out=uniform_out,
+                                    table=table, tab=tab)
             return res, (run if return_run else None), None
         out = tangent_one_kernel(st, rho, times, angles, KICK_ANGLES[kick_angle], mode, n_steps,
-                                 tau, U, max_events, kick_u, sp, kinetic)
+                                 tau, U, max_events, kick_u, sp, kinetic, tab)
         check_kinetic_capacity(kinetic, out[2])
         return _tangent_result(out, U, (0, 1), variant, horizon, max_events, "the disk"), None, None
-    offsets, measure = _twin_offsets(
-        variant, d0, lambda dx, dy: math.hypot(state[0] + dx, state[1] + dy) <= rho
-    )
+    if tab is None:
+        offsets, measure = _twin_offsets(
+            variant, d0, lambda dx, dy: math.hypot(state[0] + dx, state[1] + dy) <= rho
+        )
+    else:
+        offsets, measure = _twin_offsets(
+            variant, d0, lambda dx, dy: bool(table.contains([state[0] + dx, state[1] + dy], r))
+        )
     twin_angles = np.empty((0, times.size))
     if twin_kicks == "independent":
         if kinetic is not None:
@@ -682,7 +697,7 @@ def _lyapunov(system, r=None, *, n_steps=None, tau=None, sampling="uniform", rul
             twin_angles[j] = draw_kick_angles(times.size, kick_angle, sigma, rng)
     out = ftle_one_kernel(st, rho, times, angles, KICK_ANGLES[kick_angle], mode, n_steps, tau,
                           offsets, measure, d0, max_defer, max_events, kick_u, sp, kinetic,
-                          renormalize, twin_angles)
+                          renormalize, twin_angles, tab)
     check_kinetic_capacity(kinetic, int(np.searchsorted(times, np.inf)))
     return _twin_result(out, variant, d0, horizon, max_events, renormalize, tau), None, None
 
@@ -739,26 +754,28 @@ def _uniform_samples(sink, run, tau, holes, samples):
 
 def _pass_one(st, state, r, times, angles, kick_u, sp, mode, n_steps, tau, U, variant,
               max_ev_tan, *, sampling, kick_angle, sigma, options, kinetic=None,
-              holes=None, uniform_out=None):
-    """The kicked run and its tangent FTLE from one pass (`simulate_tangent_one_kernel`).
+              holes=None, uniform_out=None, table=None, tab=None):
+    """The kicked run and its tangent FTLE from one pass (`simulate_tangent_one_kernel`;
+    ``table`` the run's table, ``tab`` its kernels' tuple, `table_args`).
 
     The simulation is set up and recorded by `simulate_one_particle`'s own helpers
     (`kernel_limits`, `one_particle_run`), so the run is the very one it returns.
     """
     scatter = kick_angle == "scatter"
     horizon = n_steps * tau
-    rho, max_events, b_cap, stall_dt = kernel_limits(st, r, sp, scatter, horizon, mode)
+    rho, max_events, b_cap, stall_dt = kernel_limits(st, r, sp, scatter, horizon, mode,
+                                                     table=table)
     out = simulate_tangent_one_kernel(
         st, rho, times, angles, KICK_ANGLES[kick_angle], horizon if mode == 1 else 0.0, mode,
         n_steps, tau, b_cap, kick_u, sp, max_events, stall_dt, U, max_ev_tan, kinetic, holes,
-        uniform_out is not None and mode == 2)
+        uniform_out is not None and mode == 2, tab)
     raise_for_status(out[9], st[0], out[0].shape[0], max_events=max_events, name="system",
                      where=f"disk at ({st[1]:.6g}, {st[2]:.6g}), r={r!r}")
     check_kinetic_capacity(kinetic, out[6])
     run = one_particle_run(st, r, state, out[:9], sampling=sampling, mode=mode, tau=tau,
                            n_steps=n_steps, seed=None, kick_angle=kick_angle, sigma=sigma,
                            times=times, applied=kick_u if scatter else angles,
-                           escape_time=float(out[15][0]), **options)
+                           escape_time=float(out[15][0]), table=table, **options)
     res = _tangent_result(out[10:15], U, (0, 1), variant, horizon, max_ev_tan, "the disk")
     _uniform_samples(uniform_out, run, tau, holes, out[17])
     return res, run, None

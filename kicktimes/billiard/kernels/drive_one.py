@@ -33,7 +33,7 @@ N_KICKS, N_B, K, SIM_ON, N_KICKS_RUN = range(5)
 
 @njit(cache=True)
 def drive(st, ev, rho, kicks, angles, kick_mode, kick_u, sp, unit_speed, t_end, mode, tau, logs,
-          stimes, samples, cnt, next_s, fin, tan, kinetic, holes, uni=None):
+          stimes, samples, cnt, next_s, fin, tan, kinetic, holes, uni=None, table=None):
     """Run the event loop from ``st``/``ev``; returns `ob.DONE`, or `ob.FULL` when the boundary
     log is full (see `kicktimes.billiard.kernels.drive_two.drive`).
 
@@ -46,6 +46,11 @@ def drive(st, ev, rho, kicks, angles, kick_mode, kick_u, sp, unit_speed, t_end, 
     `one.kinetic_delay` later, with the number ``e[i + 1]``. ``holes = (arcs, escape)`` or
     ``None``: the table's holes, and ``uni`` (or ``None``) the uniform samples of a
     paper-sampled run, both as in `kicktimes.billiard.kernels.drive_two.drive`.
+    ``table``: ``None`` (the circle ``|q| = rho``, the code the loop always had) or a
+    table tuple ``(kind, p0, p1, p2, q0, q1, q2)`` (`kicktimes.billiard.kernels.one`,
+    "the kicked disk in any table"), with ``ev = [tb, w1, w2]``: its wall contacts go
+    through `one.table_wall_step` and the tangent map through
+    `tangent.curved_wall_tangent` with the contact's normal and curvature.
     """
     bt, bx, by, bs, klog = logs
     s = one.load(st, ev)
@@ -65,6 +70,14 @@ def drive(st, ev, rho, kicks, angles, kick_mode, kick_u, sp, unit_speed, t_end, 
     uni_on = False
     if uni is not None:
         u_times, u_samples, ku, uni_on, u_limit = ob.load_uniform(uni)
+    w1 = 0.0
+    w2 = 0.0
+    inv_v2 = 0.0
+    if table is not None:
+        # the hit's "where" and the squared speed the contacts keep
+        w1 = ev[1]
+        w2 = ev[2]
+        inv_v2 = 1.0 / st[6]
     scatter = kick_mode == one.SCATTER
     nk = kicks.shape[0]
     ns = stimes.shape[0]
@@ -147,8 +160,12 @@ def drive(st, ev, rho, kicks, angles, kick_mode, kick_u, sp, unit_speed, t_end, 
             one.store(st, ev, s)
             if scatter:
                 row = klog[ik]
-                one.scatter_step(st, ev, dte, rho, kicks[ik], kick_u[ik, 0], kick_u[ik, 1], sp,
-                                 row)
+                if table is None:
+                    one.scatter_step(st, ev, dte, rho, kicks[ik], kick_u[ik, 0], kick_u[ik, 1],
+                                     sp, row)
+                else:
+                    one.table_scatter_step(st, ev, dte, table, kicks[ik], kick_u[ik, 0],
+                                           kick_u[ik, 1], sp, row)
                 # (a partner missed by round-off leaves the disk and the vectors unchanged)
                 if tan is not None and tan_on and (row[4] != 0.0 or row[5] != 0.0):
                     for j in range(m):
@@ -157,13 +174,20 @@ def drive(st, ev, rho, kicks, angles, kick_mode, kick_u, sp, unit_speed, t_end, 
                             U[j, 0], U[j, 1], U[j, 2], U[j, 3])
                         n_resc += tg.renormalize(U, log_scale, j)
             else:
-                one.kick_step(st, ev, dte, rho, kicks[ik], angles[ik], kick_mode)
+                if table is None:
+                    one.kick_step(st, ev, dte, rho, kicks[ik], angles[ik], kick_mode)
+                else:
+                    one.table_kick_step(st, ev, dte, table, kicks[ik], angles[ik], kick_mode)
                 if tan is not None and tan_on:
                     for j in range(m):
                         U[j, 2], U[j, 3] = tg.kick_tangent(U[j, 2], U[j, 3], ux, uy, st[3], st[4],
                                                            angles[ik], kick_mode)
                         n_resc += tg.renormalize(U, log_scale, j)
             s = one.load(st, ev)
+            if table is not None:
+                w1 = ev[1]
+                w2 = ev[2]
+                inv_v2 = 1.0 / st[6]
             if tan is not None and tan_on:
                 n_pert += 1
             if kinetic is not None and ik + 1 < nk:
@@ -171,7 +195,7 @@ def drive(st, ev, rho, kicks, angles, kick_mode, kick_u, sp, unit_speed, t_end, 
                     st, kinetic[0][ik + 1], kinetic[1], kinetic[2], kinetic[3], kinetic[4],
                     kinetic[5])
             ik += 1
-        else:
+        elif table is None:
             s, sin_theta = one.wall_step(s, dte, rho, unit_speed)
             if tan is not None and tan_on and (ux != s[one.S_VX] or uy != s[one.S_VY]):
                 for j in range(m):
@@ -184,10 +208,34 @@ def drive(st, ev, rho, kicks, angles, kick_mode, kick_u, sp, unit_speed, t_end, 
                 bx[n_b] = s[one.S_X]
                 by[n_b] = s[one.S_Y]
                 n_b += 1
+        else:
+            s, w1, w2, sin_theta, nx, ny, kappa = one.table_wall_step(s, dte, table, w1, w2,
+                                                                     inv_v2)
+            if tan is not None and tan_on and (ux != s[one.S_VX] or uy != s[one.S_VY]):
+                for j in range(m):
+                    U[j, 0], U[j, 1], U[j, 2], U[j, 3] = tg.curved_wall_tangent(
+                        U[j, 0], U[j, 1], U[j, 2], U[j, 3], ux, uy, s[one.S_VX], s[one.S_VY],
+                        nx, ny, kappa)
+                    # a chaotic table stretches at every contact, not only at kicks (the
+                    # norm tested on scalars: renormalize's array argument costs reference
+                    # counting at every contact)
+                    nn = (U[j, 0] * U[j, 0] + U[j, 1] * U[j, 1] + U[j, 2] * U[j, 2]
+                          + U[j, 3] * U[j, 3])
+                    if nn > tg.BIG2 or (nn < 1.0 / tg.BIG2 and nn > 0.0):
+                        n_resc += tg.renormalize(U, log_scale, j)
+            if sim_on:
+                bs[n_b] = sin_theta
+                bt[n_b] = s[one.S_T]
+                bx[n_b] = s[one.S_X]
+                by[n_b] = s[one.S_Y]
+                n_b += 1
         if sim_on and mode == 2 and k < ns:
             k, ns_next = ob.sample_at_event(stimes, samples, k, s[one.S_T], s[one.S_X], s[one.S_Y],
                                          tau)
     one.store(st, ev, s)
+    if table is not None:
+        ev[1] = w1
+        ev[2] = w2
     cnt[N_KICKS] = ik
     cnt[N_B] = n_b
     cnt[K] = k
@@ -203,16 +251,22 @@ def drive(st, ev, rho, kicks, angles, kick_mode, kick_u, sp, unit_speed, t_end, 
 
 @njit(cache=True)
 def _run(st, rho, kicks, angles, kick_mode, t_max, mode, n_steps, tau, b_cap, kick_u, sp,
-         max_events, stall_dt, sim, tan, kinetic, holes, uni=None):
+         max_events, stall_dt, sim, tan, kinetic, holes, uni=None, table=None):
     """Allocate the logs, run `drive` to its end, growing the boundary log when full.
 
     With ``kinetic`` (see `drive`) the first kick's time is set here, from the initial
     state; ``kicks`` must then be a writable buffer, one entry per number in ``e``.
 
+    ``table``: see `drive` (``None``: the circle).
+
     Returns ``(logs, stimes, samples, cnt, fin, tan, status)``.
     """
-    ev = np.empty(1)
-    ev[0] = geo.boundary_hit_time(st[1], st[2], st[3], st[4], rho)
+    if table is None:
+        ev = np.empty(1)
+        ev[0] = geo.boundary_hit_time(st[1], st[2], st[3], st[4], rho)
+    else:
+        ev = np.empty(3)
+        one.table_hit(st, ev, table)
     if kinetic is not None and kicks.shape[0] > 0:
         kicks[0] = st[0] + one.kinetic_delay(st, kinetic[0][0], kinetic[1], kinetic[2],
                                              kinetic[3], kinetic[4], kinetic[5])
@@ -232,7 +286,7 @@ def _run(st, rho, kicks, angles, kick_mode, t_max, mode, n_steps, tau, b_cap, ki
     while True:
         loop = drive(st, ev, rho, kicks, angles, kick_mode, kick_u, sp, unit_speed, t_end, mode,
                      tau, (bt, bx, by, bs, klog), stimes, samples, cnt, next_s, fin, tan,
-                     kinetic, holes, uni)
+                     kinetic, holes, uni, table)
         if loop == ob.DONE:
             break
         # a full boundary log
@@ -255,7 +309,7 @@ def _run(st, rho, kicks, angles, kick_mode, t_max, mode, n_steps, tau, b_cap, ki
 
 @njit(cache=True)
 def simulate_one_kernel(st, rho, kicks, angles, kick_mode, t_max, mode, n_steps, tau, b_cap,
-                        kick_u, sp, max_events, stall_dt, kinetic=None, holes=None):
+                        kick_u, sp, max_events, stall_dt, kinetic=None, holes=None, table=None):
     """Run the kicked one-disk billiard (``mode``: 0 none, 1 uniform, 2 paper sampling).
 
     ``st`` is ``[t, x, y, vx, vy, clock compensation, squared speed]``. Scattering kicks
@@ -267,15 +321,16 @@ def simulate_one_kernel(st, rho, kicks, angles, kick_mode, t_max, mode, n_steps,
     scattering kick (else none). ``kinetic``: kinetic kicks (see `drive`), whose times the
     run writes into ``kicks``. ``holes``: the table's holes (rows ``[centre angle,
     half-width]``, or ``None``); then an 11th item ``escape = [t, 0]`` (``[inf, -1]``: no
-    escape), and the run ends at the escape.
+    escape), and the run ends at the escape. ``table``: ``None`` (the circle) or a table
+    tuple (see `drive`; not with holes or kinetic kicks).
     """
     return _simulate(st, rho, kicks, angles, kick_mode, t_max, mode, n_steps, tau, b_cap, kick_u,
-                     sp, max_events, stall_dt, None, kinetic, holes)[0]
+                     sp, max_events, stall_dt, None, kinetic, holes, None, table)[0]
 
 
 @njit(cache=True)
 def _simulate(st, rho, kicks, angles, kick_mode, t_max, mode, n_steps, tau, b_cap, kick_u, sp,
-              max_events, stall_dt, tan, kinetic, holes, uni=None):
+              max_events, stall_dt, tan, kinetic, holes, uni=None, table=None):
     """`_run` with the simulation on, and its output as `simulate_one_kernel` returns it;
     also the tangent half (``tan``, or ``None``); ``uni``: see `drive` (not with holes)."""
     escape = np.array([np.inf, -1.0])
@@ -283,11 +338,11 @@ def _simulate(st, rho, kicks, angles, kick_mode, t_max, mode, n_steps, tau, b_ca
     if holes is None:
         logs, stimes, samples, cnt, fin, tan, status = _run(
             st, rho, kicks, angles, kick_mode, t_max, mode, n_steps, tau, b_cap, kick_u, sp,
-            max_events, stall_dt, True, tan, kinetic, None, uni)
+            max_events, stall_dt, True, tan, kinetic, None, uni, table)
     else:
         logs, stimes, samples, cnt, fin, tan, status = _run(
             st, rho, kicks, angles, kick_mode, t_max, mode, n_steps, tau, b_cap, kick_u, sp,
-            max_events, stall_dt, True, tan, kinetic, (holes, escape))
+            max_events, stall_dt, True, tan, kinetic, (holes, escape), None, table)
     bt, bx, by, bs, klog = logs
     n = cnt[N_B]
     n_applied = cnt[N_KICKS_RUN] if status == ob.DONE else cnt[N_KICKS]
@@ -300,14 +355,15 @@ def _simulate(st, rho, kicks, angles, kick_mode, t_max, mode, n_steps, tau, b_ca
 @njit(cache=True)
 def simulate_tangent_one_kernel(st, rho, kicks, angles, kick_mode, t_max, mode, n_steps, tau,
                                 b_cap, kick_u, sp, max_events, stall_dt, U, max_ev_tan,
-                                kinetic=None, holes=None, uniform=False):
+                                kinetic=None, holes=None, uniform=False, table=None):
     """`simulate_one_kernel` and `tangent_one_kernel` in one pass.
 
     Arguments as theirs (``mode`` 1 or 2); ``uniform`` (``mode == 2``, no holes): also the
     run's uniform samples at ``k tau`` over its duration, bitwise those of a uniform run
-    with the kicks it applied. Returns ``(b_time, b_x, b_y, b_sin, sample_times, samples,
-    n_kicks_applied, t_end, kick_log, status, log_scale, n_rescaled, n_kicks_tangent,
-    t_end_tangent, status_tangent, escape, uniform_times, uniform_samples)``.
+    with the kicks it applied; ``table``: see `drive`. Returns ``(b_time, b_x, b_y, b_sin,
+    sample_times, samples, n_kicks_applied, t_end, kick_log, status, log_scale, n_rescaled,
+    n_kicks_tangent, t_end_tangent, status_tangent, escape, uniform_times,
+    uniform_samples)``.
     """
     on = uniform and mode == 2 and holes is None
     u_times, u_samples = ob.new_samples(n_steps + 2 if on else 0)
@@ -317,7 +373,7 @@ def simulate_tangent_one_kernel(st, rho, kicks, angles, kick_mode, t_max, mode, 
     out, tan = _simulate(st, rho, kicks, angles, kick_mode, t_max, mode, n_steps, tau, b_cap,
                          kick_u, sp, max_events, stall_dt,
                          tg.tangent_state(U, mode, n_steps, tau, max_ev_tan, np.int64(0)),
-                         kinetic, holes, (u_times, u_samples, u_cnt))
+                         kinetic, holes, (u_times, u_samples, u_cnt), table)
     _, log_scale, tgi, tgf, _, _, _ = tan
     ku = u_cnt[0]
     return (out[0], out[1], out[2], out[3], out[4], out[5], out[6], out[7], out[8], out[9],
@@ -327,7 +383,7 @@ def simulate_tangent_one_kernel(st, rho, kicks, angles, kick_mode, t_max, mode, 
 
 @njit(cache=True)
 def tangent_one_kernel(st, rho, kicks, angles, kick_mode, mode, n_steps, tau, U, max_events,
-                       kick_u, sp, kinetic=None):
+                       kick_u, sp, kinetic=None, table=None):
     """Carry the tangent vectors ``U`` (m, 4) along the kicked one-disk trajectory.
 
     As `kicktimes.billiard.kernels.drive_two.tangent_two_kernel`; kicks at ``kicks``
@@ -335,13 +391,13 @@ def tangent_one_kernel(st, rho, kicks, angles, kick_mode, mode, n_steps, tau, U,
     collision goes to the boundary first). Scattering kicks (``kick_mode == 2``, numbers
     ``kick_u``, parameters ``sp``) are linearised by
     `kicktimes.billiard.scatter.scatter_tangent`: a disk-disk collision with a partner
-    whose deviation is zero.
+    whose deviation is zero. ``table``: see `drive` (``None``: the circle).
 
     Returns ``(log_scale, n_rescaled, n_kicks, t_end, status)``.
     """
     tan = tg.tangent_state(U, mode, n_steps, tau, max_events, np.int64(0))
     _run(st, rho, kicks, angles, kick_mode, 0.0, mode, n_steps, tau, 0, kick_u, sp, max_events,
-         0.0, False, tan, kinetic, None)
+         0.0, False, tan, kinetic, None, None, table)
     _, log_scale, tgi, tgf, _, _, _ = tan
     # the state flies on to the end, as the vectors did
     dt = tgf[tg.T_PREV] - st[0]

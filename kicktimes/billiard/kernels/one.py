@@ -21,14 +21,19 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 from numba import njit
 
 from kicktimes.billiard import geometry as geo
+from kicktimes.billiard.kernels import tables
 from kicktimes.billiard.scatter import scatter_kick, twin_meets_partner
 
 __all__ = ["KICK_ANGLES", "SCATTER", "SCATTER_PARAMS", "advance", "apply_kick", "fly", "kick_step",
            "kinetic_delay", "load", "next_event", "next_kick", "process_wall", "process_wall_at",
-           "scatter_step", "store", "twin_scatter_step", "unit_speed_of", "wall_event", "wall_step"]
+           "process_table_wall_at", "scatter_step", "store", "table_arc_lengths", "table_hit",
+           "table_kick_step", "table_outside", "table_scatter_step", "table_twin_scatter_step",
+           "table_wall_event", "table_wall_step", "twin_scatter_step", "unit_speed_of",
+           "wall_event", "wall_step"]
 
 #: kick laws and their codes in the kernels
 # "normal" draws the new direction from N(0, sigma^2): a new angle, applied as "uniform"
@@ -274,3 +279,147 @@ def fly(s, t_end):
     t, comp, x, y, vx, vy, tb = s
     dt = t_end - t
     return (t_end, 0.0, x + vx * dt, y + vy * dt, vx, vy, tb - dt)
+
+
+# --- the kicked disk in any table (kicktimes.billiard.kernels.tables) ----------------------
+#
+# The drivers take a table argument ``tab = (kind, p0, p1, p2, q0, q1, q2)`` or ``None``:
+# ``None`` is the circle's code above, pruned at compile time, so the circle's loops keep
+# their bits. ``(kind, p0, p1, p2)`` is the centre's curve of `kernels.tables` and
+# ``(q0, q1, q2)`` the same table's curve for a scattering partner's centre (the radius
+# ``r1``; only the kick log's "outside" flag reads it). In the table path the events array
+# is ``ev = [tb, w1, w2]``: the time to the next contact and where it is (`tables.hit`),
+# which the contact needs; a kick recomputes all three.
+
+@njit(cache=True, inline="always")
+def table_wall_event(tab, x, y, vx, vy, w1, w2, inv_v2):
+    """Wall contact of the disk at ``(x, y)`` (advanced to the contact found by `tables.hit`,
+    "where" ``(w1, w2)``) in the table ``tab``.
+
+    The sequence of `kicktimes.billiard.kernels.drive_tables`: `tables.contact` puts the
+    centre back on the wall, `tables.bounce` reflects (or lets a grazing disk slide on),
+    one Newton step of ``|v'|^2`` towards the disk's squared speed ``1 / inv_v2`` keeps
+    the speed, and `tables.hit` gives the next contact. Returns ``(x, y, vx, vy, tb, w1, w2,
+    sin_theta, nx, ny, kappa)``: ``sin_theta = v.t / |v|`` of the incoming velocity, ``t =
+    (-ny, nx)`` the counter-clockwise tangent (in the circle ``(x vy - y vx) / (rho |v|)``),
+    ``n`` the outward normal and ``kappa`` the curvature of the centre's curve there (for
+    the tangent map).
+    """
+    kind, p0, p1, p2 = tab[0], tab[1], tab[2], tab[3]
+    x, y, nx, ny, kappa = tables.contact(kind, p0, p1, p2, x, y, vx, vy, w1, w2)
+    sin_theta = (vy * nx - vx * ny) * math.sqrt(inv_v2)
+    wx, wy = tables.bounce(vx, vy, nx, ny)
+    f = 1.5 - 0.5 * (wx * wx + wy * wy) * inv_v2
+    wx *= f
+    wy *= f
+    tb, w1, w2 = tables.hit(kind, p0, p1, p2, x, y, wx, wy)
+    return x, y, wx, wy, tb, w1, w2, sin_theta, nx, ny, kappa
+
+
+@njit(cache=True, inline="always")
+def table_wall_step(s, dt, tab, w1, w2, inv_v2):
+    """Fly ``dt`` to the wall of ``tab`` and reflect: ``(s, w1, w2, sin_theta, nx, ny,
+    kappa)`` (see `table_wall_event`)."""
+    t, comp, x, y, vx, vy, tb = advance(s, dt)
+    x, y, vx, vy, tb, w1, w2, sin_theta, nx, ny, kappa = table_wall_event(
+        tab, x, y, vx, vy, w1, w2, inv_v2)
+    return (t, comp, x, y, vx, vy, tb), w1, w2, sin_theta, nx, ny, kappa
+
+
+@njit(cache=True)
+def table_hit(st, ev, tab):
+    """``ev = [tb, w1, w2]`` of the state ``st`` in the table ``tab`` (`tables.hit`)."""
+    ev[0], ev[1], ev[2] = tables.hit(tab[0], tab[1], tab[2], tab[3], st[1], st[2], st[3],
+                                     st[4])
+
+
+@njit(cache=True)
+def process_table_wall_at(traj, ev, j, dt, tab):
+    """`process_wall_at` in the table ``tab``: row ``j`` of ``traj`` (``[t, x, y, vx, vy,
+    comp, v2]``, the speed kept at ``sqrt(v2)``) and of ``ev`` (``[tb, w1, w2]``)."""
+    s = (traj[j, 0], traj[j, 5], traj[j, 1], traj[j, 2], traj[j, 3], traj[j, 4], ev[j, 0])
+    s, w1, w2, sin_theta, _, _, _ = table_wall_step(s, dt, tab, ev[j, 1], ev[j, 2],
+                                                    1.0 / traj[j, 6])
+    traj[j, 0] = s[S_T]
+    traj[j, 5] = s[S_COMP]
+    traj[j, 1] = s[S_X]
+    traj[j, 2] = s[S_Y]
+    traj[j, 3] = s[S_VX]
+    traj[j, 4] = s[S_VY]
+    ev[j, 0] = s[S_TB]
+    ev[j, 1] = w1
+    ev[j, 2] = w2
+    return sin_theta
+
+
+@njit(cache=True)
+def table_kick_step(st, ev, dt, tab, kick_time, angle, kick_mode):
+    """`kick_step` in the table ``tab``: the next contact from `tables.hit`."""
+    _to_kick(st, ev, dt, kick_time)
+    apply_kick(st, angle, kick_mode)
+    table_hit(st, ev, tab)
+
+
+@njit(cache=True)
+def table_outside(tab, x, y):
+    """Whether a partner's centre ``(x, y)`` lies outside its room in the table ``tab``
+    (the curve ``(kind, q0, q1, q2)`` of the partner's radius), to ``1e-12``."""
+    kind, q0, q1, q2 = tab[0], tab[4], tab[5], tab[6]
+    if kind == tables.CIRCLE:
+        return x * x + y * y > q0 * q0
+    if kind == tables.STADIUM:
+        dx = max(abs(x) - q0, 0.0)
+        return dx * dx + y * y > q1 * q1 * (1.0 + 2e-12)
+    # the foot point's outward normal sees an inside point behind it (Ellipse.contains)
+    c, s = tables.ellipse_parameter(x, y, q0, q1, q2)
+    ih = 1.0 / math.sqrt(q1 * q1 * c * c + q0 * q0 * s * s)
+    cx = (q0 - q2 * q1 * ih) * c
+    cy = (q1 - q2 * q0 * ih) * s
+    return (x - cx) * q1 * c * ih + (y - cy) * q0 * s * ih > 1e-12
+
+
+@njit(cache=True)
+def table_scatter_step(st, ev, dt, tab, kick_time, a, b, sp, out):
+    """`scatter_step` in the table ``tab``: the partner's collision is the circle's (it
+    needs no wall), its "outside" flag ``out[8]`` the table's (`table_outside`), the next
+    contact from `tables.hit`. Under the mirror rule the squared speed ``st[6]`` the
+    contacts keep stays the disk's initial one (the reflection off the partner rounds
+    ``|v|`` by an ulp, a drift of 1e-11 over 10^5 kicks if it were the new anchor)."""
+    _to_kick(st, ev, dt, kick_time)
+    px = st[1]
+    py = st[2]
+    v2 = st[6]
+    scatter_kick(st, a, b, sp[0], sp[4], int(sp[1]), sp[2], int(sp[3]), sp[5], sp[6], out)
+    if sp[1] == 0.0:
+        st[6] = v2
+    px += sp[0] * out[4]
+    py += sp[0] * out[5]
+    out[8] = 1.0 if table_outside(tab, px, py) else 0.0
+    table_hit(st, ev, tab)
+
+
+@njit(cache=True)
+def table_twin_scatter_step(st, ev, dt, tab, kick_time, partner, sp):
+    """`twin_scatter_step` in the table ``tab`` (the next contact from `tables.hit`; the
+    mirror rule keeps the anchor ``st[6]``, as `table_scatter_step`)."""
+    _to_kick(st, ev, dt, kick_time)
+    v2 = st[6]
+    x, y, vx, vy, hit = twin_meets_partner(st[1], st[2], st[3], st[4], partner[0], partner[1],
+                                           partner[2], partner[3], sp[0], int(sp[1]), sp[6])
+    st[1] = x
+    st[2] = y
+    st[3] = vx
+    st[4] = vy
+    st[6] = v2 if sp[1] == 0.0 else vx * vx + vy * vy
+    table_hit(st, ev, tab)
+    return hit
+
+
+@njit(cache=True)
+def table_arc_lengths(kind, p0, p1, p2, x, y):
+    """Arc length ``s`` along the centre's curve of each contact ``(x[i], y[i])``
+    (`tables.boundary_coordinates`; ``s`` does not depend on the velocity)."""
+    out = np.empty(x.shape[0])
+    for i in range(x.shape[0]):
+        out[i] = tables.boundary_coordinates(kind, p0, p1, p2, x[i], y[i], 1.0, 0.0)[0]
+    return out

@@ -90,7 +90,7 @@ def _separation(dx, dy, measure):
 
 @njit(cache=True)
 def _ftle(st0, rho, mode, n_steps, tau, track, offsets, measure, d0, max_defer, max_events, pair,
-          kick, kinetic, renorm, wall=None):
+          kick, kinetic, renorm, wall=None, table=None):
     """Benettin FTLE of either system: ``pair = (sigma, rule)`` for two disks (``kick`` is
     ``None``), ``kick = (kicks, angles, kick_mode, kick_u, sp)`` for the kicked disk
     (``pair`` is ``None``); the other system's code is compiled out. ``kinetic`` (or
@@ -104,8 +104,11 @@ def _ftle(st0, rho, mode, n_steps, tau, track, offsets, measure, d0, max_defer, 
     ``renorm=False``: the twins are never renormalised (eq. (4) of Ranković & Porter read
     literally): ``log_sum`` sums ``log(d_k / d0)`` over every sample ``k``, ``n_renorm``
     counts the samples, and a separation of exactly 0 makes the sum ``-inf``.
-    ``wall`` (two disks; ``None``: the unit circle): another table's ``(kind, p0, p1, p2)``
-    (`kicktimes.billiard.kernels.tables`), each row's next wall contacts' "where" in ``wh``.
+    ``wall`` (two disks only; ``None``: the unit circle): another table's ``(kind, p0, p1,
+    p2)`` (`kicktimes.billiard.kernels.tables`), each row's next wall contacts' "where" in
+    ``wh``. ``table`` (the kicked disk only): ``None``, the circle, or a table tuple of
+    `kicktimes.billiard.kernels.one` (then ``ev`` rows are ``[tb, w1, w2]`` and every
+    trajectory keeps its own speed ``sqrt(v2)`` at its contacts).
     """
     m = offsets.shape[0]
     nst = st0.shape[0]
@@ -142,14 +145,24 @@ def _ftle(st0, rho, mode, n_steps, tau, track, offsets, measure, d0, max_defer, 
         # the partner of each scattering kick: centre and velocity at the kick time
         partners = np.zeros((nk if kick_mode == one.SCATTER else 0, 4))
         row = np.empty(9)
-        ev = np.empty((m + 1, 1))
         cnt = np.zeros((m + 1, 3), dtype=np.int64)
-        for j in range(m + 1):
-            ev[j, 0] = boundary_hit_time(traj[j, 1], traj[j, 2], traj[j, 3], traj[j, 4], rho)
+        if table is None:
+            ev = np.empty((m + 1, 1))
+            for j in range(m + 1):
+                ev[j, 0] = boundary_hit_time(traj[j, 1], traj[j, 2], traj[j, 3], traj[j, 4],
+                                             rho)
+        else:
+            ev = np.empty((m + 1, 3))
+            for j in range(m + 1):
+                one.table_hit(traj[j], ev[j], table)
         if kinetic is not None and nk > 0:
             kicks[0] = st0[0] + one.kinetic_delay(st0, kinetic[0][0], kinetic[1], kinetic[2],
                                                   kinetic[3], kinetic[4], kinetic[5])
     ref = traj[0]
+    # the columns of ev that are times from now (a table's "where" is not)
+    n_times = ev.shape[1]
+    if table is not None:
+        n_times = 1
     log_sum = np.zeros(m)
     n_renorm = np.zeros(m, dtype=np.int64)
     n_forced = np.zeros(m, dtype=np.int64)
@@ -216,17 +229,28 @@ def _ftle(st0, rho, mode, n_steps, tau, track, offsets, measure, d0, max_defer, 
                     cnt[j, 4] = (cnt[j, 4] * 4 + ke + 1) % HASH_MOD
                 if kick is not None and not is_kick:
                     # reference and twins reflect with the general-speed formula
-                    one.process_wall_at(traj, ev, j, dt, rho, np.bool_(False))
+                    if table is None:
+                        one.process_wall_at(traj, ev, j, dt, rho, np.bool_(False))
+                    else:
+                        one.process_table_wall_at(traj, ev, j, dt, table)
                     cnt[j, 1] += 1
                     cnt[j, 2] = (cnt[j, 2] * 4 + 1) % HASH_MOD
                 if kick is not None and is_kick:
                     hit = True
                     if kick_mode != one.SCATTER:
                         angle = angles[ik] if j == 0 or not own_angles else twin_angles[j - 1, ik]
-                        one.kick_step(traj[j], ev[j], dt, rho, kicks[ik], angle, kick_mode)
+                        if table is None:
+                            one.kick_step(traj[j], ev[j], dt, rho, kicks[ik], angle, kick_mode)
+                        else:
+                            one.table_kick_step(traj[j], ev[j], dt, table, kicks[ik], angle,
+                                                kick_mode)
                     elif j == 0:
-                        one.scatter_step(traj[j], ev[j], dt, rho, kicks[ik], kick_u[ik, 0],
-                                         kick_u[ik, 1], sp, row)
+                        if table is None:
+                            one.scatter_step(traj[j], ev[j], dt, rho, kicks[ik], kick_u[ik, 0],
+                                             kick_u[ik, 1], sp, row)
+                        else:
+                            one.table_scatter_step(traj[j], ev[j], dt, table, kicks[ik],
+                                                   kick_u[ik, 0], kick_u[ik, 1], sp, row)
                         # the kick does not move the centre: the partner touches it along n
                         partners[ik, 0] = ref[1] + sp[0] * row[4]
                         partners[ik, 1] = ref[2] + sp[0] * row[5]
@@ -234,8 +258,12 @@ def _ftle(st0, rho, mode, n_steps, tau, track, offsets, measure, d0, max_defer, 
                         partners[ik, 3] = row[7]
                     else:
                         # a missed partner is a different event sequence: defer, then force
-                        hit = one.twin_scatter_step(traj[j], ev[j], dt, rho, kicks[ik],
-                                                    partners[ik], sp)
+                        if table is None:
+                            hit = one.twin_scatter_step(traj[j], ev[j], dt, rho, kicks[ik],
+                                                        partners[ik], sp)
+                        else:
+                            hit = one.table_twin_scatter_step(traj[j], ev[j], dt, table,
+                                                              kicks[ik], partners[ik], sp)
                     if kinetic is not None and j == 0 and ik + 1 < nk:
                         kicks[ik + 1] = kicks[ik] + one.kinetic_delay(
                             ref, kinetic[0][ik + 1], kinetic[1], kinetic[2], kinetic[3],
@@ -258,7 +286,7 @@ def _ftle(st0, rho, mode, n_steps, tau, track, offsets, measure, d0, max_defer, 
                 q = 1 + 4 * i
                 traj[j, q] += traj[j, q + 2] * dt
                 traj[j, q + 1] += traj[j, q + 3] * dt
-            for c in range(ev.shape[1]):
+            for c in range(n_times):
                 ev[j, c] -= dt
             traj[j, 0] = tk
             traj[j, nst - 2] = 0.0  # the clock's compensation
@@ -314,9 +342,13 @@ def _ftle(st0, rho, mode, n_steps, tau, track, offsets, measure, d0, max_defer, 
                     two.init_events(traj[j], ev[j], rho, sigma)
                 else:
                     two.table_init_events(traj[j], ev[j], wh[j], rho, sigma, wall)
-            if kick is not None:
+            if kick is not None and table is None:
                 ev[j, 0] = boundary_hit_time(traj[j, 1], traj[j, 2], traj[j, 3], traj[j, 4],
                                              rho)
+            if kick is not None and table is not None:
+                # the twin's own speed is the one its contacts keep from now on
+                traj[j, 6] = traj[j, 3] * traj[j, 3] + traj[j, 4] * traj[j, 4]
+                one.table_hit(traj[j], ev[j], table)
         t_prev = tk
         if status != 0:
             break
@@ -343,7 +375,7 @@ def ftle_two_kernel(st0, rho, sigma, rule, mode, n_steps, tau, track, offsets, m
 
 @njit(cache=True)
 def ftle_one_kernel(st0, rho, kicks, angles, kick_mode, mode, n_steps, tau, offsets, measure, d0,
-                    max_defer, max_events, kick_u, sp, kinetic, renorm, twin_angles):
+                    max_defer, max_events, kick_u, sp, kinetic, renorm, twin_angles, table=None):
     """Benettin FTLE for the kicked one-disk billiard.
 
     Twins share the kick times and angles (common random numbers), or, when
@@ -354,7 +386,9 @@ def ftle_one_kernel(st0, rho, kicks, angles, kick_mode, mode, n_steps, tau, offs
     `kicktimes.billiard.kernels.one.scatter_step`): the reference draws the partner, placed
     in contact with it, and every twin meets that same partner at its own contact time, or
     misses it. ``kinetic``: kinetic kicks or ``None`` (see `_ftle`); ``renorm``: as in
-    `ftle_two_kernel`.
+    `ftle_two_kernel`. ``table``: ``None`` (the circle) or a table tuple of
+    `kicktimes.billiard.kernels.one` (the kicked disk in a stadium or an ellipse).
     """
     return _ftle(st0, rho, mode, n_steps, tau, 0, offsets, measure, d0, max_defer, max_events,
-                 None, (kicks, angles, kick_mode, kick_u, sp, twin_angles), kinetic, renorm)
+                 None, (kicks, angles, kick_mode, kick_u, sp, twin_angles), kinetic, renorm,
+                 None, table)
