@@ -72,12 +72,18 @@ def check_radii_of(r, n: int, name: str = "r", box: float | None = None,
         if np.ndim(r) == 0:
             radius = table.check_radius(r)
         else:
-            radius = float(check_radii_of(r, n, name)[0])
-            if np.ptp(np.asarray(r, dtype=np.float64)) > 0:
+            try:
+                arr = np.array(r, dtype=np.float64)
+            except (TypeError, ValueError):
+                raise TypeError(f"{name} must be a number or one number per disk") from None
+            if arr.shape != (n,):
+                raise ValueError(f"{name} must be one radius or {n} radii (one per disk), got "
+                                 f"shape {arr.shape}")
+            if np.ptp(arr) > 0:
                 raise ValueError(f"{name}: the disks in {table!r} must have one radius (the "
                                  f"wall is the centre's curve of one radius), got radii in "
-                                 f"[{np.min(r)!r}, {np.max(r)!r}]")
-            radius = table.check_radius(radius)
+                                 f"[{arr.min()!r}, {arr.max()!r}]")
+            radius = table.check_radius(arr[0])
         radii = np.full(n, radius)
         packing = math.pi * n * radius * radius / table.area(0.0)
         if packing >= PACKING_MAX:
