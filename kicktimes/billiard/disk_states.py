@@ -1,4 +1,5 @@
-"""Initial states of N disks in the unit table or a periodic square box: `initial_state`.
+"""Initial states of N disks in a table (the unit circle, a stadium, an ellipse) or a
+periodic square box: `initial_state`.
 
 Positions: random sequential addition (RSA) up to packing `RSA_PACKING`; denser states
 are grown from there with the engine itself (Lubachevsky-Stillinger growth in steps: the
@@ -6,7 +7,9 @@ disks move, then each grows by half the room it has, `grow_step`); finally the d
 relaxed by the dynamics (`RELAX_COLLISIONS` collisions per disk), whose invariant measure
 is uniform over the non-overlapping configurations. Velocities are drawn last. In the
 periodic box ``[0, L)^2`` the same, with nearest images and no wall (`box_side` gives
-``L`` for a packing). docs/disks.md, "Initial states".
+``L`` for a packing). In a stadium or an ellipse the same with the candidates drawn in
+the table's bounding box and kept if their disk lies inside (``table.contains``), and the
+room to the wall from ``table.wall_distance``. docs/disks.md, "Initial states".
 """
 
 from __future__ import annotations
@@ -17,7 +20,13 @@ import numpy as np
 from numba import njit
 
 from kicktimes.billiard import checks as chk
-from kicktimes.billiard.many_disks import check_box, check_radii_of, engine_run
+from kicktimes.billiard.many_disks import (
+    check_box,
+    check_disks_table,
+    check_radii_of,
+    engine_run,
+)
+from kicktimes.billiard.tables import Circle
 from kicktimes.stats.enskog import PACKING_MAX, contact_value
 from kicktimes.validation import (
     check_int,
@@ -80,12 +89,13 @@ def _place(i, x, y, c, xy, head, nxt):
 
 
 @njit(cache=True, error_model="numpy")
-def _rsa(radii, order, u, xy, m, w, head, nxt, k0, j0, box):
+def _rsa(radii, order, u, xy, m, w, head, nxt, k0, j0, box, half):
     """Place disks ``order[k0:]`` one by one at candidates ``u[j]`` (uniform in [0, 1)^2,
     mapped to the square) inside the table (``box = 0``) or in the periodic box ``[0,
     box)^2`` (the grid of cells wraps; the nearest images count), clear of the disks
     placed; returns ``(k, j)``: disks placed so far and candidates used (more candidates
-    are needed if ``j == len(u)``)."""
+    are needed if ``j == len(u)``). ``half > 0``: another table, ``u`` the candidate
+    centres themselves (already inside), the grid over ``[-half, half]^2``."""
     k = k0
     j = j0
     n = order.shape[0]
@@ -103,6 +113,14 @@ def _rsa(radii, order, u, xy, m, w, head, nxt, k0, j0, box):
             whole = 2 * reach_cells + 1 >= m
             lo_x, hi_x = (0, m - 1) if whole else (cx - reach_cells, cx + reach_cells)
             lo_y, hi_y = (0, m - 1) if whole else (cy - reach_cells, cy + reach_cells)
+        elif half > 0.0:
+            x = u[j, 0]
+            y = u[j, 1]
+            j += 1
+            cx = min(max(int((x + half) / w), 0), m - 1)
+            cy = min(max(int((y + half) / w), 0), m - 1)
+            lo_x, hi_x = max(cx - reach_cells, 0), min(cx + reach_cells, m - 1)
+            lo_y, hi_y = max(cy - reach_cells, 0), min(cy + reach_cells, m - 1)
         else:
             x = 2.0 * u[j, 0] - 1.0
             y = 2.0 * u[j, 1] - 1.0
@@ -122,9 +140,38 @@ def _rsa(radii, order, u, xy, m, w, head, nxt, k0, j0, box):
     return k, j
 
 
-def _rsa_positions(radii: np.ndarray, rng: np.random.Generator, box=None) -> np.ndarray:
+def _rsa_table(radii: np.ndarray, rng: np.random.Generator, table) -> np.ndarray:
+    """Centres by random sequential addition in a stadium or an ellipse (equal radii):
+    candidates uniform in the bounding box, kept if inside (``table.contains``)."""
+    n = radii.shape[0]
+    r = float(radii[0])
+    bx, by = table.bounding_box()
+    half = float(max(bx, by))
+    m = max(1, min(int(2.0 * half / (2.0 * r)), int(math.ceil(2.0 * math.sqrt(n)))))
+    w = 2.0 * half / m
+    head = np.full(m * m, -1, dtype=np.int64)
+    nxt = np.full(n, -1, dtype=np.int64)
+    xy = np.zeros((n, 2))
+    order = np.arange(n)
+    k = 0
+    tries = 0
+    while k < n:
+        u = rng.random((max(4 * (n - k), 256), 2))
+        q = np.column_stack([bx * (2.0 * u[:, 0] - 1.0), by * (2.0 * u[:, 1] - 1.0)])
+        q = np.ascontiguousarray(q[table.contains(q, r)])
+        k, _ = _rsa(radii, order, q, xy, m, w, head, nxt, k, 0, 0.0, half)
+        tries += u.shape[0]
+        if tries > 1000 * n + 10**6:  # pragma: no cover - RSA_PACKING is far from jamming
+            raise RuntimeError("random sequential addition did not place the disks")
+    return xy
+
+
+def _rsa_positions(radii: np.ndarray, rng: np.random.Generator, box=None,
+                   table=None) -> np.ndarray:
     """Centres by random sequential addition, largest disks first (in the table, or in
-    the periodic box of side ``box``)."""
+    the periodic box of side ``box``; a stadium or an ellipse: `_rsa_table`)."""
+    if table is not None and not isinstance(table, Circle):
+        return _rsa_table(radii, rng, table)
     n = radii.shape[0]
     order = np.argsort(-radii, kind="stable")
     side = 2.0 if box is None else box  # the square the candidates are drawn in
@@ -138,21 +185,25 @@ def _rsa_positions(radii: np.ndarray, rng: np.random.Generator, box=None) -> np.
     while k < n:
         u = rng.random((max(4 * (n - k), 256), 2))
         k, _ = _rsa(radii, order, u, xy, m, w, head, nxt, k, 0,
-                    0.0 if box is None else float(box))
+                    0.0 if box is None else float(box), 0.0)
         tries += u.shape[0]
         if tries > 1000 * n + 10**6:  # pragma: no cover - RSA_PACKING is far from jamming
             raise RuntimeError("random sequential addition did not place the disks")
     return xy
 
 
-def grow_step(xy: np.ndarray, radii: np.ndarray, target: np.ndarray, box=None) -> np.ndarray:
+def grow_step(xy: np.ndarray, radii: np.ndarray, target: np.ndarray, box=None,
+              table=None) -> np.ndarray:
     """Radii grown by half the room each disk has (capped at ``target``): disk ``i`` may
     reach ``min(1 - |x_i|, min_j (d_ij - r_j))`` (the periodic box of side ``box``: no
-    wall, nearest images); if both disks of a pair take half their room they still do not
+    wall, nearest images; a stadium or an ellipse: ``table.wall_distance`` instead of
+    ``1 - |x_i|``); if both disks of a pair take half their room they still do not
     overlap."""
     from scipy.spatial import cKDTree
 
-    if box is None:
+    if table is not None and not isinstance(table, Circle):
+        room = table.wall_distance(xy) - radii
+    elif box is None:
         room = 1.0 - np.hypot(xy[:, 0], xy[:, 1]) - radii
     else:
         room = np.full(radii.shape, np.inf)
@@ -175,17 +226,19 @@ def _unit_velocities(n: int, rng: np.random.Generator) -> np.ndarray:
     return np.column_stack([np.cos(theta), np.sin(theta)])
 
 
-def _relax(xy, radii, t, rng, box=None):
+def _relax(xy, radii, t, rng, box=None, table=None):
     """Positions after the mirror dynamics has run for ``t`` from unit velocities."""
     state = np.column_stack([xy, _unit_velocities(radii.shape[0], rng)])
-    out = engine_run(state, radii, chk.RULES["mirror"], t, log=False, box=box)
+    out = engine_run(state, radii, chk.RULES["mirror"], t, log=False, box=box, table=table)
     return out["final_state"][:, :2]
 
 
-def _collision_time(radii: np.ndarray, per_disk: float, box=None) -> float:
+def _collision_time(radii: np.ndarray, per_disk: float, box=None, table=None) -> float:
     """The time in which each disk collides about ``per_disk`` times (Enskog, unit speeds)."""
     n = radii.shape[0]
     area = math.pi if box is None else box * box
+    if table is not None and not isinstance(table, Circle):
+        area = table.area(0.0)
     phi = math.pi * float(np.sum(radii ** 2)) / area
     r = math.sqrt(phi * area / (math.pi * n))
     nu = (n / area) * 4.0 * r * float(contact_value(phi)) * 4.0 / math.pi
@@ -208,9 +261,9 @@ def box_side(n_disks, r, *, packing) -> float:
 
 @renamed_keyword(old="seed", new="rng", since="0.2.0")
 def initial_state(n_disks, r, *, rng=0, rule="mirror", masses=None, packing=None,
-                  box=None) -> np.ndarray:
-    """A state of ``n_disks`` non-overlapping disks in the unit table (or a periodic square
-    box), for `simulate_disks`.
+                  box=None, table=None) -> np.ndarray:
+    """A state of ``n_disks`` non-overlapping disks in the unit table, a stadium or an
+    ellipse (or a periodic square box), for `simulate_disks`.
 
     Parameters
     ----------
@@ -231,10 +284,17 @@ def initial_state(n_disks, r, *, rng=0, rule="mirror", masses=None, packing=None
         The area fraction ``sum r_i^2`` (the table has area pi, a disk pi r^2), at most 0.7:
         the radii ``r`` are scaled to it. In the box, the true area fraction
         ``pi sum r_i^2 / L^2`` likewise (`box_side` gives ``L`` for given radii instead).
+        In a stadium or an ellipse, as in the circle, the disks' area over the table's
+        own area: ``pi n r^2 / table.area(0)`` (``pi + 4 a`` for `Stadium(a)`, ``pi a b``
+        for `Ellipse(a, b)`), one radius ``r = sqrt(packing table.area(0) / (pi n))``.
     box : float, optional
         The side ``L`` of the periodic square box ``[0, L)^2`` instead of the table:
         centres in ``[0, L)``, nearest images; under the elastic rule the total momentum
         is set to 0 (then the energy shell ``sum m |v|^2 = n_disks``, ``kT = 1/2``).
+    table : Circle, Stadium or Ellipse, optional
+        The table (``None``: the unit circle; its states are those of before, bit for bit).
+        A stadium or an ellipse takes one radius for every disk (``table.check_radius``).
+        Not with ``box``.
 
     Returns
     -------
@@ -245,7 +305,9 @@ def initial_state(n_disks, r, *, rng=0, rule="mirror", masses=None, packing=None
     ------
     ValueError
         Naming the argument: a packing that cannot exist or is above 0.7, radii of the
-        wrong shape, a box below three cells of one diameter (``L < 6 r_max``).
+        wrong shape, a box below three cells of one diameter (``L < 6 r_max``), ``table``
+        with ``box``, a radius the table refuses or unequal radii in a stadium or an
+        ellipse.
 
     Notes
     -----
@@ -270,8 +332,12 @@ def initial_state(n_disks, r, *, rng=0, rule="mirror", masses=None, packing=None
     rng = check_rng(rng, "rng")
     chk.check_choice("rule", rule, chk.RULES)
     box = check_box(box)
+    table = check_disks_table(table, box)
+    other = table is not None and not isinstance(table, Circle)
     # the table's packing sum r^2 is its area fraction (area pi); the box's, pi sum r^2/L^2
     unit = 1.0 if box is None else math.pi / (box * box)
+    if other:
+        unit = math.pi / table.area(0.0)
     if packing is not None:
         packing = check_real("packing", packing, low=0.0)
         if packing >= PACKING_MAX:
@@ -280,13 +346,15 @@ def initial_state(n_disks, r, *, rng=0, rule="mirror", masses=None, packing=None
                              f"{PACKING_MAX:.6g})")
         rel = np.ones(n) if r is None else check_radii_of(r, n)
         radii = rel * math.sqrt(packing / (unit * float(np.sum(rel ** 2))))
-        if box is None and radii.max() >= 1.0:
+        if other:
+            radii = check_radii_of(radii, n, "packing", table=table)
+        elif box is None and radii.max() >= 1.0:
             raise ValueError(f"packing={packing!r} makes a radius of {radii.max():.6g}, not "
                              f"below 1")
     else:
         if r is None:
             raise ValueError("give r (a radius, or one per disk) or packing")
-        radii = check_radii_of(r, n, box=box)
+        radii = check_radii_of(r, n, box=box, table=table)
     if box is not None and box < 6.0 * float(radii.max()) * (1.0 + 1e-9):
         raise ValueError(f"box must be at least 3 cells of one diameter wide, box >= 6 r_max "
                          f"= {6.0 * float(radii.max()) * (1.0 + 1e-9):.6g}, got {box!r}")
@@ -304,18 +372,20 @@ def initial_state(n_disks, r, *, rng=0, rule="mirror", masses=None, packing=None
             raise ValueError(f"masses must be {n} positive finite numbers (one per disk)")
     start = min(1.0, math.sqrt(RSA_PACKING / phi))
     cur = radii * start
-    xy = _rsa_positions(cur, rng, box)
+    xy = _rsa_positions(cur, rng, box, table)
     steps = 0
     while n > 1 and (cur < radii).any():
-        xy = _relax(xy, cur, _collision_time(cur, GROW_COLLISIONS, box), rng, box)
-        cur = grow_step(xy, cur, radii, box)
+        xy = _relax(xy, cur, _collision_time(cur, GROW_COLLISIONS, box, table), rng, box,
+                    table)
+        cur = grow_step(xy, cur, radii, box, table)
         steps += 1
         if steps > GROW_STEPS:
             raise RuntimeError(f"initial_state: the disks did not grow to packing {phi:.4g} "
                                f"in {GROW_STEPS} steps (reached "
                                f"{unit * float(np.sum(cur ** 2)):.4g})")
     if n > 1:
-        xy = _relax(xy, radii, _collision_time(radii, RELAX_COLLISIONS, box), rng, box)
+        xy = _relax(xy, radii, _collision_time(radii, RELAX_COLLISIONS, box, table), rng, box,
+                    table)
     if rule == "mirror":
         v = _unit_velocities(n, rng)
     else:

@@ -14,6 +14,7 @@ import pandas as pd
 
 from kicktimes import __version__
 from kicktimes._results import TableResult, nan_reason
+from kicktimes.billiard.tables import Circle, table_spec
 from kicktimes.fileio import atomic_write
 
 __all__ = ["DisksPressure", "DisksRun"]
@@ -79,7 +80,8 @@ class DisksPressure:
 
 @dataclass(frozen=True, repr=False)
 class DisksRun(TableResult):
-    """N hard disks in the unit circular table: their collision log and final state.
+    """N hard disks in a table (the unit circle, a stadium, an ellipse) or a periodic box:
+    their collision log and final state.
 
     Attributes
     ----------
@@ -123,11 +125,13 @@ class DisksRun(TableResult):
     pressure_log : ndarray, shape (n_samples, 5) or None
         Rows ``(t, centres in the central region, wall impulse, virial, region's virial)``:
         the engine's running sums at ``t`` (`pressure`).
+    table : Circle, Stadium, Ellipse or None
+        The table (`kicktimes.tables`); ``None`` in the periodic box.
     """
 
     _title = "N hard disks (simulate_disks): the collision log"
     _summary_fields = ("n_disks", "radii", "rule", "t_max", "n_pp", "n_events", "n_wall", "box",
-                       "tau")
+                       "table", "tau")
     _frame = "collisions"
 
     radii: np.ndarray
@@ -152,6 +156,7 @@ class DisksRun(TableResult):
     box: float | None = None
     bulk_radius: float | None = None
     pressure_log: np.ndarray | None = None
+    table: object = None
     version: str = field(default=__version__)
 
     def _summary_extra(self) -> list[str]:
@@ -214,7 +219,11 @@ class DisksRun(TableResult):
         * **wall** (the table): the wall's force per unit length of the circle of radius
           :math:`\rho = 1 - r` the centres reach, :math:`P = \sum|\Delta p_{wall}| / (2\pi
           \rho T)`, over the area the centres reach, :math:`A_c = \pi\rho^2`:
-          :math:`Z = \rho \sum|\Delta p_{wall}| / (2 T N kT)`.
+          :math:`Z = \rho \sum|\Delta p_{wall}| / (2 T N kT)`. In a stadium or an ellipse
+          the same with the centre's curve's length :math:`L_c` and area :math:`A_c`
+          (``table.perimeter(r)``, ``table.area(r)``): :math:`Z = A_c \sum|\Delta
+          p_{wall}| / (L_c T N kT)`, the wall's mean pressure (on a curved wall of a dense
+          gas the contact density, so the local pressure, varies along the wall).
         * **virial** (Allen & Tildesley, *Computer Simulation of Liquids*, 2nd ed. 2017,
           sec. 2.4; the collisional form, sec. 3.7.2): :math:`P A = N kT + \frac{1}{2T}
           \sum_{coll} r_{ij}\cdot\Delta p_i` (:math:`= \sigma |\Delta p|` elastic,
@@ -226,9 +235,12 @@ ho
           boundary term :math:`[\sum r\cdot p]_0^T / (2T)`, for either rule. In the box,
           :math:`A = L^2`, minimum images, and this *is* the pressure. The mirror rule does
           not conserve momentum, so a pair's virial depends on the origin; in the box
-          there is none: a ValueError.
+          there is none: a ValueError. A stadium's or an ellipse's virial takes
+          :math:`A = A_c` and the same sum (:math:`\sum_{wall} r\cdot\Delta p = -2 P A_c T`
+          for a uniform wall pressure on any convex curve, :math:`\oint r\cdot n\,ds =
+          2A_c`).
         * **bulk**: the collisions whose contact point lies within ``bulk_radius`` of the
-          centre (:math:`A_b = \pi R_b^2`) and the region's time-averaged number of centres
+          centre (in any table) (:math:`A_b = \pi R_b^2`) and the region's time-averaged number of centres
           :math:`N_b` (counted at the rows of ``pressure_log``, trapezoidal rule):
           :math:`Z_b = 1 + \sum_{region} \tfrac12 r_{ij}\cdot(\Delta p_i - \Delta p_j) / (2
           T N_b kT)`, the local virial of a homogeneous region away from the wall, to be
@@ -277,10 +289,17 @@ ho
         area_c = np.concatenate([[0.0], np.cumsum(0.5 * (c[1:] + c[:-1]) * np.diff(t))])
         s0, s1 = edges[:-1], edges[1:]
 
+        other = self.table is not None and not isinstance(self.table, Circle)
+        r0 = float(self.radii[0])
+
         def z_of(a, b):
             dt = t[b] - t[a]
             n_b = (area_c[b] - area_c[a]) / dt if self.box is None else n
-            z_w = (1.0 - float(self.radii[0])) * (wall[b] - wall[a]) / (2.0 * dt * n * kT)
+            if other:
+                z_w = (self.table.area(r0) * (wall[b] - wall[a])
+                       / (self.table.perimeter(r0) * dt * n * kT))
+            else:
+                z_w = (1.0 - r0) * (wall[b] - wall[a]) / (2.0 * dt * n * kT)
             z_v = 1.0 + (vir[b] - vir[a]) / (2.0 * dt * n * kT)
             z_b = 1.0 + (vir_b[b] - vir_b[a]) / (2.0 * dt * n_b * kT)
             return z_w, z_v, z_b, n_b
@@ -289,7 +308,10 @@ ho
         per = np.array([z_of(a, b)[:3] for a, b in zip(s0, s1, strict=True)])
         se = per.std(axis=0, ddof=1) / math.sqrt(blocks)
         r2 = float(np.mean(self.radii ** 2))
-        if self.box is None:
+        if other:
+            packing = n * math.pi * r2 / self.table.area(0.0)
+            bulk = n_b * r2 / self.bulk_radius ** 2
+        elif self.box is None:
             packing = n * r2
             bulk = n_b * r2 / self.bulk_radius ** 2
         else:
@@ -317,11 +339,20 @@ ho
     @cached_property
     def walls(self) -> pd.DataFrame | None:
         """Wall hits of the sampled disks (``log_walls=True``): ``time``, ``disk``, ``s``
-        (the contact's polar angle in ``[0, 2 pi)``), ``sin_theta`` (the incoming velocity's
-        tangential component over its speed); ``None`` if not logged."""
+        (the circle: the contact's polar angle in ``[0, 2 pi)``; a stadium or an ellipse:
+        the arc length along the centre's curve from its rightmost point,
+        `kicktimes.billiard.kernels.tables.boundary_coordinates`), ``sin_theta`` (the
+        incoming velocity's tangential component over its speed: with ``s``, Birkhoff's
+        coordinates); ``None`` if not logged."""
         if self.wall_log is None:
             return None
         t, d, x, y, st = self.wall_log
+        if self.table is not None and not isinstance(self.table, Circle):
+            from kicktimes.billiard.kernels.disk_walls import arc_lengths
+
+            s = arc_lengths(*self.table.kernel(float(self.radii[0])),
+                            np.ascontiguousarray(x), np.ascontiguousarray(y))
+            return pd.DataFrame({"time": t, "disk": d, "s": s, "sin_theta": st})
         s = np.arctan2(y, x)
         s[s < 0.0] += 2.0 * np.pi
         s[s >= 2.0 * np.pi] = 0.0
@@ -344,6 +375,7 @@ ho
                 else float(self.radii[0]), "masses": None if self.masses is None
                 else self.masses.tolist(), "holes": None if self.holes is None
                 else self.holes.tolist(), "box": self.box, "bulk_radius": self.bulk_radius,
+                "table": None if self.table is None else table_spec(self.table),
                 "version": self.version}
 
     def to_parquet(self, path: str | os.PathLike) -> None:
@@ -362,5 +394,7 @@ ho
         esc = f", escaped={int(np.isfinite(self.escape_times).sum())}" if self.holes is not None \
             else ""
         box = "" if self.box is None else f", box={self.box!r}"
+        if self.table is not None and not isinstance(self.table, Circle):
+            box = f", table={self.table!r}"
         return (f"DisksRun(n_disks={self.n_disks}, {r}, rule={self.rule!r}, t_max={self.t_max!r}, "
                 f"n_pp={self.n_pp}, n_events={self.n_events}{esc}{box})")

@@ -1,5 +1,5 @@
-"""N hard disks in the unit circular table or a periodic square box: the Python layer of
-the N-disk engine.
+"""N hard disks in the unit circular table, a stadium, an ellipse or a periodic square box:
+the Python layer of the N-disk engine.
 
 `simulate_disks` checks its arguments (`check_disks`), sets up the engine
 (`kicktimes.billiard.kernels.disks`), runs its event loop, growing the logs as they fill
@@ -20,10 +20,11 @@ from kicktimes.billiard.disks_run import DisksRun
 from kicktimes.billiard.kernels import cells
 from kicktimes.billiard.kernels import disks as kd
 from kicktimes.billiard.kernels.observe import DONE, FULL, OVER_BUDGET, STALLED
+from kicktimes.billiard.tables import Circle, check_table
 from kicktimes.stats.enskog import PACKING_MAX, contact_value
 
-__all__ = ["check_box", "check_disks", "engine_run", "expected_collisions",
-           "raise_for_status", "simulate_disks"]
+__all__ = ["check_box", "check_disks", "check_disks_table", "engine_run",
+           "expected_collisions", "raise_for_status", "simulate_disks"]
 
 #: most disks a run takes (int32 indices; about 180 bytes each)
 N_DISKS_MAX = 10**7
@@ -57,10 +58,39 @@ def check_box(box):
     return chk.check_real("box", box, low=0.0, high=1e12)
 
 
-def check_radii_of(r, n: int, name: str = "r", box: float | None = None) -> np.ndarray:
+def check_radii_of(r, n: int, name: str = "r", box: float | None = None,
+                   table=None) -> np.ndarray:
     """One radius per disk from ``r`` (a number, or ``n`` numbers), each in ``(0, 1)`` (the
     box: in ``(0, box / 6]``), with a packing ``sum r_i^2`` (the box: ``pi sum r_i^2 /
-    box^2``) below the densest, ``pi / sqrt(12)``."""
+    box^2``) below the densest, ``pi / sqrt(12)``.
+
+    ``table`` (a `Stadium` or an `Ellipse`; ``None`` or a `Circle`: the unit table): one
+    radius for every disk (the wall's kernel is the centre's curve of one radius), admitted
+    by ``table.check_radius``, at a packing ``pi sum r_i^2 / table.area(0)`` below the
+    densest."""
+    if table is not None and not isinstance(table, Circle):
+        if np.ndim(r) == 0:
+            radius = table.check_radius(r)
+        else:
+            try:
+                arr = np.array(r, dtype=np.float64)
+            except (TypeError, ValueError):
+                raise TypeError(f"{name} must be a number or one number per disk") from None
+            if arr.shape != (n,):
+                raise ValueError(f"{name} must be one radius or {n} radii (one per disk), got "
+                                 f"shape {arr.shape}")
+            if np.ptp(arr) > 0:
+                raise ValueError(f"{name}: the disks in {table!r} must have one radius (the "
+                                 f"wall is the centre's curve of one radius), got radii in "
+                                 f"[{arr.min()!r}, {arr.max()!r}]")
+            radius = table.check_radius(arr[0])
+        radii = np.full(n, radius)
+        packing = math.pi * n * radius * radius / table.area(0.0)
+        if packing >= PACKING_MAX:
+            raise ValueError(f"{name}: the disks' packing pi n r^2 / area = {packing:.6g} "
+                             f"cannot exist in {table!r}: it must be below the densest "
+                             f"packing pi/sqrt(12) = {PACKING_MAX:.6g}")
+        return radii
     high = 1.0 if box is None else box / 6.0
     if np.ndim(r) == 0 and box is None:
         radii = np.full(n, chk.check_real(name, r, low=0.0, high=high))
@@ -95,11 +125,24 @@ def check_radii_of(r, n: int, name: str = "r", box: float | None = None) -> np.n
     return radii
 
 
-def check_disks(state, r, rule: str, masses=None, name: str = "state", box=None):
+def check_disks_table(table, box, name: str = "table"):
+    """The table of an N-disk run (`kicktimes.billiard.tables.check_table`: ``None`` is the
+    `Circle`), or ``None`` with a periodic ``box``; both given: a ValueError naming
+    ``table``."""
+    if box is not None:
+        if table is not None:
+            raise ValueError(f"{name}: pass a table or a periodic box, not both (got "
+                             f"{name}={table!r} and box={box!r})")
+        return None
+    return check_table(table, name)
+
+
+def check_disks(state, r, rule: str, masses=None, name: str = "state", box=None, table=None):
     """Validate an N-disk state; returns ``(state, radii, masses)`` as float64 arrays
     (``masses`` None for equal masses). Names the disk or pair at fault. In the periodic
     box (``box`` its side ``L``) centres must lie in ``[0, L]^2`` (``L`` is wrapped to 0)
-    and overlaps are measured between nearest images."""
+    and overlaps are measured between nearest images. In a ``table`` other than the
+    circle the centres must keep their disks inside it (``table.contains``)."""
     try:
         arr = np.array(state, dtype=np.float64, copy=True, order="C")
     except (TypeError, ValueError):
@@ -114,8 +157,15 @@ def check_disks(state, r, rule: str, masses=None, name: str = "state", box=None)
         k = int(np.flatnonzero(~np.isfinite(arr).all(axis=1))[0])
         raise ValueError(f"{name} must be finite, got NaN or inf in disk {k}: {arr[k].tolist()}")
     chk.check_choice("rule", rule, chk.RULES)
-    radii = check_radii_of(r, n, box=box)
-    if box is not None:
+    radii = check_radii_of(r, n, box=box, table=table)
+    if table is not None and not isinstance(table, Circle):
+        out = np.flatnonzero(~table.contains(arr[:, :2], float(radii[0])))
+        if out.size:
+            k = int(out[0])
+            raise ValueError(f"{name}: disk {k}'s centre ({arr[k, 0]:.15g}, {arr[k, 1]:.15g}) "
+                             f"lies outside {table!r}: a disk of radius {radii[k]!r} there "
+                             f"crosses the wall")
+    elif box is not None:
         out = np.flatnonzero(((arr[:, :2] < 0.0) | (arr[:, :2] > box)).any(axis=1))
         if out.size:
             k = int(out[0])
@@ -124,7 +174,8 @@ def check_disks(state, r, rule: str, masses=None, name: str = "state", box=None)
                              f"{box!r}")
         arr[:, :2] = np.where(arr[:, :2] >= box, arr[:, :2] - box, arr[:, :2])
     dist = np.hypot(arr[:, 0], arr[:, 1])
-    out = np.flatnonzero(dist > 1.0 - radii + chk.CONTACT_TOL) if box is None else dist[:0]
+    circle = box is None and (table is None or isinstance(table, Circle))
+    out = np.flatnonzero(dist > 1.0 - radii + chk.CONTACT_TOL) if circle else dist[:0]
     if out.size:
         k = int(out[0])
         raise ValueError(f"{name}: disk {k}'s centre at distance {dist[k]:.15g} from the table "
@@ -183,23 +234,27 @@ def check_disks(state, r, rule: str, masses=None, name: str = "state", box=None)
 
 
 def expected_collisions(radii: np.ndarray, speed: float, t_max: float,
-                        box: float | None = None) -> tuple[float, float]:
+                        box: float | None = None, table=None) -> tuple[float, float]:
     """Rough counts ``(disk-disk, wall)`` of collisions of a run: Enskog's frequency at the
     table's packing, and the wall flux ``2 n rho |v| / pi`` round the wall (``n`` the
-    density), for the budgets and the memory check (the box: area ``box^2``, no wall)."""
+    density), for the budgets and the memory check (the box: area ``box^2``, no wall; a
+    stadium or an ellipse: its area and the flux ``n |v| / pi`` along its perimeter)."""
     n = radii.shape[0]
-    area = math.pi if box is None else box * box
+    other = table is not None and not isinstance(table, Circle)
+    area = table.area(0.0) if other else math.pi if box is None else box * box
     phi = float(np.sum(radii * radii)) * math.pi / area
     r = float(np.sqrt(phi * area / (math.pi * n)))
     nu = (n / area) * 4.0 * r * float(contact_value(min(phi, 0.85))) * 4.0 / math.pi * speed
     walls = 2.0 * n / math.pi * speed * t_max * (1.0 + 4.0 * phi) if box is None else 0.0
+    if other:
+        walls = n * table.perimeter(0.0) / (math.pi * area) * speed * t_max * (1.0 + 4.0 * phi)
     return 0.5 * n * nu * t_max, walls
 
 
 def engine_run(state, radii, rule_code, t_max, *, masses=None, arcs=None, walls_sel=None,
                sample=None, tau=None, contacts=False, max_events=None, log=True,
                cap_hint=1024, debug=False, tangent=None, segment=None, on_segment=None,
-               box=None, bulk_radius=BULK_RADIUS, pressure_samples=0):
+               box=None, bulk_radius=BULK_RADIUS, pressure_samples=0, table=None):
     """Run the engine on a validated state; returns a dict of its raw outputs in the
     caller's disk numbering. ``log=False`` keeps no collision log (the log buffer is
     reused: the initial-state growth runs only need the final state). ``debug=True``
@@ -218,13 +273,25 @@ def engine_run(state, radii, rule_code, t_max, *, masses=None, arcs=None, walls_
     at ``t_max j / k``, ``j = 1..k``, and ``out["pressure_log"]`` has rows ``(t, centres
     within bulk_radius of the table's centre (the box: all), the sums of the wall's
     impulse, the virial and the central region's virial up to t)``, the first at ``t = 0``
-    (`kd.collide`; `DisksRun.pressure`)."""
+    (`kd.collide`; `DisksRun.pressure`).
+
+    ``table``: a `Stadium` or an `Ellipse` (equal radii, no box; ``None`` or a `Circle`:
+    the unit table, its own loop): the engine's table switch ``(kind, p0, p1, p2, h,
+    where)`` (`kicktimes.billiard.kernels.disk_walls`), its cells over the square ``[-h,
+    h]^2`` around the table's bounding box (`cells.grid_table`), always the loop's observer
+    variant (one compilation for every such table)."""
     n = state.shape[0]
-    if box is None:
+    tab = None
+    if table is not None and not isinstance(table, Circle):
+        kind, p0, p1, p2 = table.kernel(float(radii[0]))
+        half = float(max(table.bounding_box()))
+        m, w = cells.grid_table(n, float(radii.max()), half, table.area(0.0))
+        tab = (kind, p0, p1, p2, half, np.zeros((n, 2)))
+    elif box is None:
         m, w = cells.grid(n, float(radii.max()))
     else:
         m, w = cells.grid_box(n, float(radii.max()), float(box))
-    perm, eng = kd.new_engine(state, radii, m, w, box)
+    perm, eng = kd.new_engine(state, radii, m, w, box, tab)
     inv = np.empty(n, dtype=np.int64)
     inv[perm] = np.arange(n)
     ident = perm.astype(np.int32)  # engine disk k is the caller's ident[k]
@@ -240,7 +307,8 @@ def engine_run(state, radii, rule_code, t_max, *, masses=None, arcs=None, walls_
     # then gets empty arrays: no holes, no disk selected, no samples): two compilations
     # of a minute each instead of one per combination.
     full = (masses is not None or arcs is not None or walls_sel is not None
-            or sample is not None or contacts or debug or tangent is not None)
+            or sample is not None or contacts or debug or tangent is not None
+            or tab is not None)
     walls = samp = con = tan = dbg = None
     if full:
         if mass is None:
@@ -288,7 +356,7 @@ def engine_run(state, radii, rule_code, t_max, *, masses=None, arcs=None, walls_
             t_stop = min(t_stop, t_samp)
         status = kd.drive(fs, iv, head, m, w, qt, qi, ht, qh, qs, qw, rule_code, mass,
                           t_stop, budget, stall_dt, clock, cnt, pp_t, pp_i, pp_j, esc,
-                          ident, reorder_every, arcs, walls, samp, con, tan, dbg, box)
+                          ident, reorder_every, arcs, walls, samp, con, tan, dbg, box, tab)
         if status == kd.REORDER:
             order = cells.cell_order(iv[:, kd.CELL], m)
             new_of = kd.relabel(fs, iv, head, m, qt, qi, ht, qh, qs, qw, order)
@@ -301,6 +369,8 @@ def engine_run(state, radii, rule_code, t_max, *, masses=None, arcs=None, walls_
                 samp = (samp[0], new_of[samp[1]].astype(np.int64), samp[2])
             if tangent is not None:
                 tan = (tan[0][order], tan[1])
+            if tab is not None:
+                tab = tab[:5] + (tab[5][order],)
             continue
         if status == DONE and k_samp <= pressure_samples and t_stop == t_samp:
             plog[k_samp] = _pressure_row(fs, iv, clock, t_stop, box)
@@ -397,19 +467,20 @@ def raise_for_status(out: dict, budget: int) -> None:
 
 def simulate_disks(state, r, *, t_max, rule="mirror", masses=None, holes=None, sample=None,
                    tau=None, log_walls=False, max_events=None, box=None,
-                   bulk_radius=BULK_RADIUS) -> DisksRun:
-    """Simulate N hard disks in the unit circular table, or a periodic square box, event
-    by event.
+                   bulk_radius=BULK_RADIUS, table=None) -> DisksRun:
+    """Simulate N hard disks in the unit circular table, a stadium, an ellipse, or a
+    periodic square box, event by event.
 
     Parameters
     ----------
     state : array_like, shape (n_disks, 4)
-        Rows ``(x, y, vx, vy)``: centres in the table (``|x_i| <= 1 - r_i``; the box:
-        ``0 <= x_i, y_i <= L``) without overlaps (the box: between nearest images), unit
-        speeds under the mirror rule (`kicktimes.initial_state` draws one).
+        Rows ``(x, y, vx, vy)``: centres in the table (``|x_i| <= 1 - r_i``; another
+        table: ``table.contains``; the box: ``0 <= x_i, y_i <= L``) without overlaps (the
+        box: between nearest images), unit speeds under the mirror rule
+        (`kicktimes.initial_state` draws one).
     r : float or array_like, shape (n_disks,)
         The disks' radius, or one radius per disk, each in ``(0, 1)`` (the box:
-        ``(0, L / 6]``).
+        ``(0, L / 6]``; a stadium or an ellipse: one radius, ``table.check_radius``).
     t_max : float
         End time (``0 < t_max <= 1e12``); collisions at ``t_max`` are included.
     rule : {"mirror", "elastic"}
@@ -420,13 +491,16 @@ def simulate_disks(state, r, *, t_max, rule="mirror", masses=None, holes=None, s
     holes : array_like, shape (n, 2), optional
         Holes in the wall, rows ``(centre angle, half-width)`` in radians. A disk whose
         wall contact lies in a hole leaves the table (``escape_times``); the others go on.
+        The circle only (they are arcs of the circle).
     sample : sequence of int, optional
         The disks whose positions are sampled every ``tau`` and whose wall hits are logged
         with ``log_walls``; default all.
     tau : float, optional
         Sampling step: positions of ``sample`` at ``k tau``, ``k = 0..floor(t_max / tau)``.
     log_walls : bool
-        Log the wall hits of ``sample`` as ``(time, disk, s, sin_theta)`` (``run.walls``).
+        Log the wall hits of ``sample`` as ``(time, disk, s, sin_theta)`` (``run.walls``;
+        in a stadium or an ellipse ``s`` is the arc length along the centre's curve: the
+        contact's Birkhoff coordinates).
     max_events : int, optional
         Stop with a ValueError after this many collisions, disk-disk and wall (``>= 1``).
         Default: ten times the expected number plus 10^6.
@@ -437,8 +511,14 @@ def simulate_disks(state, r, *, t_max, rule="mirror", masses=None, holes=None, s
         ``log_walls`` then.
     bulk_radius : float
         The central region of the table, centres within ``bulk_radius`` of its centre
-        (``0 < bulk_radius <= 1 - r_max``), whose collisions and density give
-        `DisksRun.pressure`'s bulk pressure; the box's region is the whole box.
+        (``0 < bulk_radius <= 1 - r_max``; another table: ``<= table.inradius(r)``), whose
+        collisions and density give `DisksRun.pressure`'s bulk pressure; the box's region
+        is the whole box.
+    table : Circle, Stadium or Ellipse, optional
+        The table (``None``: the unit circle, `kicktimes.tables.Circle`, whose runs are
+        those of before, bit for bit). In a `Stadium` or an `Ellipse` the disks have one
+        radius and meet the wall through `kicktimes.billiard.kernels.tables` (docs/tables.md,
+        "N disks in a table"). Not with ``box`` (a ValueError).
 
     Returns
     -------
@@ -452,7 +532,10 @@ def simulate_disks(state, r, *, t_max, rule="mirror", masses=None, holes=None, s
         Naming the argument: disks that overlap (the pair), a disk outside the table, radii
         whose packing cannot exist, a log that would not fit in memory (``t_max``), a run
         over ``max_events`` or one that makes no progress, a box too small for three
-        cells, wall options with a box.
+        cells, wall options with a box, ``table`` with ``box``, ``holes`` in a table other
+        than the circle, a radius the table refuses (its ``check_radius``).
+    TypeError
+        A ``table`` that is not a `Circle`, `Stadium` or `Ellipse`.
 
     Notes
     -----
@@ -479,22 +562,37 @@ def simulate_disks(state, r, *, t_max, rule="mirror", masses=None, holes=None, s
     >>> run = kt.simulate_disks(s, 0.02, t_max=2.0, rule="elastic", box=1.0)
     >>> run.box, bool(((run.final_state[:, :2] >= 0) & (run.final_state[:, :2] < 1)).all())
     (1.0, True)
+    >>> import math
+    >>> from kicktimes.tables import Stadium
+    >>> s = kt.initial_state(100, None, packing=0.3, table=Stadium(1.0), rng=1)
+    >>> r = math.sqrt(0.3 * Stadium(1.0).area(0.0) / (100 * math.pi))  # packing's radius
+    >>> run = kt.simulate_disks(s, r, t_max=1.0, table=Stadium(1.0))
+    >>> run.table, bool(Stadium(1.0).contains(run.final_state[:, :2], r).all())
+    (Stadium(a=1.0), True)
     """
     chk.check_choice("rule", rule, chk.RULES)
     t_max = chk.check_real("t_max", t_max, low=0.0, high=chk.TIME_LIMIT, high_open=False)
     box = check_box(box)
-    state, radii, masses = check_disks(state, r, rule, masses, box=box)
+    table = check_disks_table(table, box)
+    other = table is not None and not isinstance(table, Circle)
+    state, radii, masses = check_disks(state, r, rule, masses, box=box, table=table)
     n = state.shape[0]
     if box is not None and holes is not None:
         raise ValueError("holes: the periodic box has no wall to cut holes in; pass "
                          "holes=None with box")
+    if other and holes is not None:
+        raise ValueError(f"holes: holes are arcs of the circular table (centre angle, "
+                         f"half-width); {table!r} takes none; pass holes=None")
     arcs = chk.check_holes(holes)
     if not isinstance(log_walls, bool | np.bool_):
         raise TypeError(f"log_walls must be a bool, got {type(log_walls).__name__}")
     if box is not None and log_walls:
         raise ValueError("log_walls: the periodic box has no wall hits to log; pass "
                          "log_walls=False with box")
-    if box is None:
+    if other:
+        bulk_radius = chk.check_real("bulk_radius", bulk_radius, low=0.0,
+                                     high=table.inradius(float(radii[0])), high_open=False)
+    elif box is None:
         bulk_radius = chk.check_real("bulk_radius", bulk_radius, low=0.0,
                                      high=1.0 - float(radii.max()), high_open=False)
     else:
@@ -523,7 +621,7 @@ def simulate_disks(state, r, *, t_max, rule="mirror", masses=None, holes=None, s
                              f"than {chk.N_STEPS_MAX} positions; pass a larger tau or fewer "
                              f"disks in sample")
     speed = float(np.hypot(state[:, 2], state[:, 3]).max())
-    e_pp, e_wall = expected_collisions(radii, speed, t_max, box)
+    e_pp, e_wall = expected_collisions(radii, speed, t_max, box, table)
     if max_events is not None:
         max_events = chk.check_int("max_events", max_events, low=1)
     budget = max_events if max_events is not None else int(10.0 * (e_pp + e_wall) + 10**6)
@@ -539,7 +637,7 @@ def simulate_disks(state, r, *, t_max, rule="mirror", masses=None, holes=None, s
                      walls_sel=sample if log_walls else None, sample=sample, tau=tau,
                      max_events=budget, cap_hint=int(1.2 * e_pp) + 1024, box=box,
                      bulk_radius=bulk_radius if box is None else 0.0,
-                     pressure_samples=n_samples)
+                     pressure_samples=n_samples, table=table)
     raise_for_status(out, budget)
     return DisksRun(
         radii=radii, rule=rule, t_max=t_max, state=state, final_state=out["final_state"],
@@ -552,5 +650,5 @@ def simulate_disks(state, r, *, t_max, rule="mirror", masses=None, holes=None, s
         engine={"cell_crossings": out["crossings"], "stale_events": out["stale"],
                 "cells_per_side": out["cells_per_side"], "buckets": out["buckets"]},
         box=box, bulk_radius=None if box is not None else bulk_radius,
-        pressure_log=out["pressure_log"],
+        pressure_log=out["pressure_log"], table=table,
     )

@@ -213,6 +213,19 @@ class Circle(_Table):
         q = np.asarray(positions, dtype=float)
         return np.hypot(q[..., 0], q[..., 1]) <= (1.0 - r) * (1 + 1e-12)
 
+    def bounding_box(self):
+        """``(X, Y)``: the table lies in ``[-X, X] x [-Y, Y]`` (the N-disk engine's cells)."""
+        return 1.0, 1.0
+
+    def inradius(self, r):
+        """Radius of the largest disk about the centre inside the centre's region."""
+        return 1.0 - self._size_radius(r)
+
+    def wall_distance(self, positions):
+        """Distance of each point of ``positions`` (``(..., 2)``, inside) to the wall."""
+        q = np.asarray(positions, dtype=float)
+        return 1.0 - np.hypot(q[..., 0], q[..., 1])
+
 
 @dataclass(frozen=True, repr=False)
 class Stadium(_Table):
@@ -256,6 +269,20 @@ class Stadium(_Table):
         q = np.asarray(positions, dtype=float)
         dx = np.maximum(np.abs(q[..., 0]) - self.a, 0.0)
         return np.hypot(dx, q[..., 1]) <= (1.0 - r) * (1 + 1e-12)
+
+    def bounding_box(self):
+        """``(X, Y) = (a + 1, 1)``: the table lies in ``[-X, X] x [-Y, Y]``."""
+        return self.a + 1.0, 1.0
+
+    def inradius(self, r):
+        """Radius of the largest disk about the centre inside the centre's region, ``1 - r``."""
+        return 1.0 - self._size_radius(r)
+
+    def wall_distance(self, positions):
+        """Distance of each point of ``positions`` (``(..., 2)``, inside) to the wall: ``1``
+        less its distance to the segment ``[-a, a] x {0}``."""
+        q = np.asarray(positions, dtype=float)
+        return 1.0 - np.hypot(np.maximum(np.abs(q[..., 0]) - self.a, 0.0), q[..., 1])
 
 
 @dataclass(frozen=True, repr=False)
@@ -339,6 +366,42 @@ class Ellipse(_Table):
             # inside: the foot point's outward normal sees q behind it
             out[i] = (x - cx) * p1 * c / h + (y - cy) * p0 * s / h <= 1e-12
         return out.reshape(q.shape[:-1])
+
+    def bounding_box(self):
+        """``(X, Y) = (a, b)``: the table lies in ``[-X, X] x [-Y, Y]``."""
+        return self.a, self.b
+
+    def inradius(self, r):
+        """Radius of the largest disk about the centre inside the centre's region, ``b - r``
+        (the point ``(0, b - r)`` is at distance ``r`` from the vertex ``(0, b)``)."""
+        return self.b - self._size_radius(r)
+
+    def wall_distance(self, positions):
+        """Distance of each point of ``positions`` (``(..., 2)``, inside) to the wall: the
+        nearest of 256 points of the ellipse, refined by Newton's iteration on
+        ``(q - P(t)).P'(t) = 0`` from there (a point deep inside has several stationary
+        points; the nearest sample picks the global minimum's), never above the sample's."""
+        q = np.asarray(positions, dtype=float)
+        flat = q.reshape(-1, 2)
+        a, b = self.a, self.b
+        grid = np.linspace(0.0, 2.0 * math.pi, 256, endpoint=False)
+        t = np.empty(len(flat))
+        best = np.empty(len(flat))
+        for lo in range(0, len(flat), 4096):
+            x, y = flat[lo:lo + 4096, :1], flat[lo:lo + 4096, 1:]
+            d2 = (a * np.cos(grid) - x) ** 2 + (b * np.sin(grid) - y) ** 2
+            k = np.argmin(d2, axis=1)
+            t[lo:lo + 4096] = grid[k]
+            best[lo:lo + 4096] = np.sqrt(d2[np.arange(len(k)), k])
+        x, y = flat[:, 0], flat[:, 1]
+        for _ in range(8):
+            c, s = np.cos(t), np.sin(t)
+            ex, ey = x - a * c, y - b * s
+            f = -ex * a * s + ey * b * c
+            df = -(a * s) ** 2 - (b * c) ** 2 - ex * a * c - ey * b * s
+            t = t - f / np.where(df < 0.0, df, -1.0)
+        d = np.hypot(x - a * np.cos(t), y - b * np.sin(t))
+        return np.minimum(d, best).reshape(q.shape[:-1])
 
 
 def check_table(table, name: str = "table"):

@@ -17,6 +17,10 @@ width ``w = L / m >= 2 r_max`` per side; the grid wraps (the neighbours of a cel
 edge lie across the box, and a crossing out of the last cell enters the first), and
 ``m >= 3`` makes the 3 x 3 cells around any cell distinct, so each pair of neighbouring
 cells is seen under exactly one image.
+
+A table other than the circle (`grid_table`, `cell_of_table`, `crossing_table`): the
+square ``[-h, h]^2`` around its bounding box ``[-X, X] x [-Y, Y]`` (``h = max(X, Y)``), cut
+and clipped as the circle's square; the circle's own functions keep their literal ``1``.
 """
 
 from __future__ import annotations
@@ -26,8 +30,9 @@ import math
 import numpy as np
 from numba import njit
 
-__all__ = ["cell_of", "cell_of_box", "cell_order", "crossing", "crossing_box", "grid",
-           "grid_box", "image_of", "insert", "remove", "spatial_order"]
+__all__ = ["cell_of", "cell_of_box", "cell_of_table", "cell_order", "crossing", "crossing_box",
+           "crossing_table", "grid", "grid_box", "grid_table", "image_of", "insert", "remove",
+           "spatial_order"]
 
 INF = np.inf
 
@@ -55,6 +60,54 @@ def grid_box(n: int, r_max: float, box: float) -> tuple[int, float]:
                          f"let a disk meet two images of one neighbour)")
     m = min(m, max(3, int(math.ceil(2.0 * math.sqrt(n)))))
     return m, box / m
+
+
+def grid_table(n: int, r_max: float, half: float, area: float) -> tuple[int, float]:
+    """``(m, w)`` of a table in the square ``[-half, half]^2`` whose own area is ``area``:
+    ``w = 2 half / m >= 2 r_max`` by a hair, as `grid`, and at most about ``pi n`` cells
+    over the table, as the circle has (``m <= 2 half sqrt(pi n / area)``: the circle's
+    ``2 sqrt(n)``), so a long table's empty corners cost memory only (4 bytes a cell)."""
+    m = int(math.floor(2.0 * half / (2.0 * r_max * (1.0 + 1e-9))))
+    cap = int(math.ceil(2.0 * half * math.sqrt(math.pi * n / area)))
+    m = max(1, min(m, max(3, cap)))
+    return m, 2.0 * half / m
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def cell_of_table(x, y, m, w, h):
+    """The cell ``cx + m cy`` of a centre ``(x, y)`` of the grid over ``[-h, h]^2``
+    (clamped to the grid)."""
+    cx = min(max(int((x + h) / w), 0), m - 1)
+    cy = min(max(int((y + h) / w), 0), m - 1)
+    return cx + m * cy
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def crossing_table(x, y, vx, vy, c, m, w, h):
+    """`crossing` in the grid over ``[-h, h]^2``: edges ``-h + k w``."""
+    cx = c % m
+    cy = c // m
+    dt = INF
+    cn = -1
+    if vx > 0.0 and cx < m - 1:
+        dt = (-h + (cx + 1) * w - x) / vx
+        cn = c + 1
+    elif vx < 0.0 and cx > 0:
+        dt = (-h + cx * w - x) / vx
+        cn = c - 1
+    if vy > 0.0 and cy < m - 1:
+        d = (-h + (cy + 1) * w - y) / vy
+        if d < dt:
+            dt = d
+            cn = c + m
+    elif vy < 0.0 and cy > 0:
+        d = (-h + cy * w - y) / vy
+        if d < dt:
+            dt = d
+            cn = c - m
+    if dt < 0.0:
+        dt = 0.0
+    return dt, cn
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -187,9 +240,13 @@ def cell_order(c: np.ndarray, m: int) -> np.ndarray:
 
 
 def spatial_order(x: np.ndarray, y: np.ndarray, m: int, w: float,
-                  box: float | None = None) -> np.ndarray:
-    """`cell_order` of the disks at centres ``(x, y)`` (of the table, or of the periodic
-    box ``[0, box)^2``)."""
+                  box: float | None = None, half: float | None = None) -> np.ndarray:
+    """`cell_order` of the disks at centres ``(x, y)`` (of the unit table, of the periodic
+    box ``[0, box)^2``, or of a table's grid over ``[-half, half]^2``)."""
+    if half is not None:
+        cx = np.clip(((x + half) / w).astype(np.int64), 0, m - 1)
+        cy = np.clip(((y + half) / w).astype(np.int64), 0, m - 1)
+        return cell_order(cx + m * cy, m)
     if box is not None:
         cx = np.clip(np.floor(x / w).astype(np.int64), 0, m - 1)
         cy = np.clip(np.floor(y / w).astype(np.int64), 0, m - 1)

@@ -39,6 +39,13 @@ Optional observers, compiled out when passed as ``None`` (as in `drive_two`): ``
 disk-disk collision), ``tan`` (a tangent vector, one row ``(dx, dy, dvx, dvy)`` per disk,
 in the same delayed form as the disk table: carried by the linearised event maps of
 `kicktimes.billiard.kernels.tangent`, for the largest Lyapunov exponent).
+
+The table switch ``tab``, beside ``box``: ``None`` is the unit circle (its code as it was,
+the branches below pruned at compile time); a stadium or an ellipse is ``(kind, p0, p1,
+p2, h, where)`` (`kicktimes.billiard.kernels.disk_walls`: the kernel tuple of
+`kicktimes.billiard.kernels.tables`, the grid's half side, each disk's pending contact),
+compiled once for every such table, with the observers on (empty when unused): one loop
+variant more.
 """
 
 from __future__ import annotations
@@ -49,8 +56,14 @@ from numba import njit
 from kicktimes.billiard.geometry import boundary_hit_time, pair_hit_time
 from kicktimes.billiard.kernels import calendar as cal
 from kicktimes.billiard.kernels import cells
+from kicktimes.billiard.kernels import disk_walls as dw
 from kicktimes.billiard.kernels import observe as ob
-from kicktimes.billiard.kernels.tangent import BIG, pair_tangent, wall_tangent
+from kicktimes.billiard.kernels.tangent import (
+    BIG,
+    curved_wall_tangent,
+    pair_tangent,
+    wall_tangent,
+)
 from kicktimes.billiard.kernels.two import (
     anchor_energy,
     mass_factors,
@@ -127,7 +140,7 @@ def scan(i, x, y, vx, vy, now, gx0, gx1, gy0, gy1, fs, iv, head, m, best, kind, 
 
 @njit(cache=True, inline="always", error_model="numpy")
 def schedule(i, x, y, vx, vy, now, best, kind, stamp, fs, iv, m, w, qt, qi, ht, qh, qs, qw,
-             box):
+             box, tab):
     """Keep ``(best, kind, stamp)`` as disk ``i``'s earliest contact with a disk, and
     schedule the earliest of it, the wall contact (the box: none, ``tw = inf``) and the
     next cell crossing."""
@@ -139,7 +152,10 @@ def schedule(i, x, y, vx, vy, now, best, kind, stamp, fs, iv, m, w, qt, qi, ht, 
         kind = WALL
         stamp = 0
     if box is None:
-        dtc, cn = cells.crossing(x, y, vx, vy, iv[i, CELL], m, w)
+        if tab is None:
+            dtc, cn = cells.crossing(x, y, vx, vy, iv[i, CELL], m, w)
+        else:
+            dtc, cn = cells.crossing_table(x, y, vx, vy, iv[i, CELL], m, w, tab[4])
     else:
         dtc, cn = cells.crossing_box(x, y, vx, vy, iv[i, CELL], m, w)
     if now + dtc < best:
@@ -153,7 +169,7 @@ def schedule(i, x, y, vx, vy, now, best, kind, stamp, fs, iv, m, w, qt, qi, ht, 
 
 @njit(cache=True, inline="always", error_model="numpy")
 def rescan(i, now, gx0, gx1, gy0, gy1, best, kind, stamp, fs, iv, head, m, w, qt, qi, ht, qh,
-           qs, qw, tan, box):
+           qs, qw, tan, box, tab):
     """Bring disk ``i`` to ``now``, look for an earlier contact than ``(best, kind, stamp)``
     in cells ``gx0..gx1 x gy0..gy1`` and schedule its earliest event (`scan`, `schedule`).
 
@@ -166,7 +182,7 @@ def rescan(i, now, gx0, gx1, gy0, gy1, best, kind, stamp, fs, iv, head, m, w, qt
     best, kind, stamp = scan(i, x, y, vx, vy, now, gx0, gx1, gy0, gy1, fs, iv, head, m, best,
                              kind, stamp, box)
     schedule(i, x, y, vx, vy, now, best, kind, stamp, fs, iv, m, w, qt, qi, ht, qh, qs, qw,
-             box)
+             box, tab)
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -210,13 +226,13 @@ def enter_cell(i, c, fs, iv, head, m, box):
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def predict(i, now, fs, iv, head, m, w, qt, qi, ht, qh, qs, qw, box):
+def predict(i, now, fs, iv, head, m, w, qt, qi, ht, qh, qs, qw, box, tab):
     """Schedule disk ``i``'s earliest event from ``now``: its wall contact, its next cell
     crossing, or a contact with a disk of the 3 x 3 cells around it (extrapolated to
     ``now``); the disk is first brought to ``now``."""
     gx0, gx1, gy0, gy1 = neighbourhood(iv[i, CELL], m, box)
     rescan(i, now, gx0, gx1, gy0, gy1, np.inf, NONE, 0, fs, iv, head, m, w, qt, qi, ht, qh, qs,
-           qw, None, box)
+           qw, None, box, tab)
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -238,7 +254,7 @@ def bring(fs, i, now, tan):
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def collide(i, j, now, fs, rule, mass, tan, box, clock):
+def collide(i, j, now, fs, rule, mass, tan, box, clock, tab):
     r"""The disk-disk collision of ``i`` and ``j`` at ``now`` (both brought there, with their
     tangent rows): the rule's velocity map, the elastic rule's energy anchored to the pair's
     energy before, both wall times afresh (the box: none; ``j`` seen under its nearest
@@ -291,8 +307,12 @@ def collide(i, j, now, fs, rule, mass, tan, box, clock):
     dy = yi - yj
     pv = 0.5 * (dx * (dpx - dqx) + dy * (dpy - dqy))
     if box is None:
-        fs[i, TW] = now + boundary_hit_time(xi, yi, ai2, bi2, 1.0 - fs[i, RAD])
-        fs[j, TW] = now + boundary_hit_time(xj, yj, aj2, bj2, 1.0 - fs[j, RAD])
+        if tab is None:
+            fs[i, TW] = now + boundary_hit_time(xi, yi, ai2, bi2, 1.0 - fs[i, RAD])
+            fs[j, TW] = now + boundary_hit_time(xj, yj, aj2, bj2, 1.0 - fs[j, RAD])
+        else:
+            fs[i, TW] = now + dw.hit_where(tab, i, xi, yi, ai2, bi2)
+            fs[j, TW] = now + dw.hit_where(tab, j, xj, yj, aj2, bj2)
         clock[VIRIAL] += xi * dpx + yi * dpy + xj * dqx + yj * dqy
         s = fs[i, RAD] / (fs[i, RAD] + fs[j, RAD])
         cx = xi - s * dx
@@ -378,7 +398,7 @@ def wrap(i, now, fs, iv, m, box, tan):
 
 
 @njit(cache=True, error_model="numpy")
-def setup(fs, iv, head, m, w, qt, qi, ht, qh, qs, qw, box):
+def setup(fs, iv, head, m, w, qt, qi, ht, qh, qs, qw, box, tab):
     """Fill the cells and the wall times (the box: none) for the disks of ``fs`` at local
     time 0 (their clocks set to 0), and file each disk's first prediction as a `PREDICT`
     event at time 0: `drive` makes it (the scan is compiled once, in the loop)."""
@@ -388,9 +408,13 @@ def setup(fs, iv, head, m, w, qt, qi, ht, qh, qs, qw, box):
     for i in range(n):
         fs[i, T] = 0.0
         if box is None:
-            fs[i, TW] = boundary_hit_time(fs[i, X], fs[i, Y], fs[i, VX], fs[i, VY],
-                                          1.0 - fs[i, RAD])
-            c = cells.cell_of(fs[i, X], fs[i, Y], m, w)
+            if tab is None:
+                fs[i, TW] = boundary_hit_time(fs[i, X], fs[i, Y], fs[i, VX], fs[i, VY],
+                                              1.0 - fs[i, RAD])
+                c = cells.cell_of(fs[i, X], fs[i, Y], m, w)
+            else:
+                fs[i, TW] = dw.hit_where(tab, i, fs[i, X], fs[i, Y], fs[i, VX], fs[i, VY])
+                c = cells.cell_of_table(fs[i, X], fs[i, Y], m, w, tab[4])
         else:
             fs[i, TW] = np.inf
             c = cells.cell_of_box(fs[i, X], fs[i, Y], m, w)
@@ -419,7 +443,7 @@ def rebase(fs, iv, qt, qi, ht, qh, qs, qw, now):
 
 
 @njit(cache=True, error_model="numpy")
-def check_state(fs, iv, head, m, now, dbg, box):
+def check_state(fs, iv, head, m, now, dbg, box, tab):
     """Debug observer: the largest overlap of two disks and the largest distance of a
     centre outside its room ``1 - r`` (the box: outside ``[0, L]^2``), at ``now`` (all
     disks flown there), into ``dbg[0]``, ``dbg[1]`` (maxima over the calls); ``dbg[2]``
@@ -431,7 +455,10 @@ def check_state(fs, iv, head, m, now, dbg, box):
         x = fs[i, X] + fs[i, VX] * dt
         y = fs[i, Y] + fs[i, VY] * dt
         if box is None:
-            dbg[1] = max(dbg[1], np.sqrt(x * x + y * y) - (1.0 - fs[i, RAD]))
+            if tab is None:
+                dbg[1] = max(dbg[1], np.sqrt(x * x + y * y) - (1.0 - fs[i, RAD]))
+            else:
+                dbg[1] = max(dbg[1], dw.outside(tab[0], tab[1], tab[2], tab[3], x, y))
         else:
             dbg[1] = max(dbg[1], -x, -y, x - box, y - box)
         gx0, gx1, gy0, gy1 = neighbourhood(iv[i, CELL], m, box)
@@ -455,7 +482,7 @@ def check_state(fs, iv, head, m, now, dbg, box):
 @njit(cache=True, error_model="numpy", _nrt=False)
 def drive(fs, iv, head, m, w, qt, qi, ht, qh, qs, qw, rule, mass, t_end, max_events,
           stall_dt, clock, cnt, pp_t, pp_i, pp_j, esc, ident, reorder_every, arcs, walls, samp,
-          contacts, tan, dbg, box):
+          contacts, tan, dbg, box, tab):
     r"""Run the event loop until ``t_end`` (absolute; events at ``t_end`` included).
 
     Returns a status of `kicktimes.billiard.kernels.observe`: ``DONE``, ``FULL`` (a log is
@@ -480,7 +507,8 @@ def drive(fs, iv, head, m, w, qt, qi, ht, qh, qs, qw, rule, mass, t_end, max_eve
     ``[0, L)^2`` (no wall events; a crossing out of an edge cell moves the centre by
     ``-+L`` into the cell across, so centres stay in ``[0, L)``). The pressure's sums
     accumulate in ``clock`` (`collide`; ``W_IMPULSE``: the wall's :math:`\sum m|\Delta
-    v|`, escapes excluded).
+    v|`, escapes excluded). ``tab``: ``None``, the unit circle; else a stadium or an
+    ellipse (`kicktimes.billiard.kernels.disk_walls`; with ``box`` None and equal radii).
     """
     cap = pp_t.shape[0]
     t_loc = t_end - clock[OFFSET]
@@ -519,7 +547,7 @@ def drive(fs, iv, head, m, w, qt, qi, ht, qh, qs, qw, rule, mass, t_end, max_eve
             continue
         if dbg is not None:
             if dbg[3] != 0.0:
-                check_state(fs, iv, head, m, te, dbg, box)
+                check_state(fs, iv, head, m, te, dbg, box, tab)
         kind = iv[i, KIND]
         if kind != PREDICT:
             # a stall: STALL_EVENTS events in less than STALL_EVENTS * stall_dt
@@ -546,7 +574,7 @@ def drive(fs, iv, head, m, w, qt, qi, ht, qh, qs, qw, rule, mass, t_end, max_eve
                 if n + cnt[N_WALL] >= max_events:
                     return ob.OVER_BUDGET
                 ai, bi, aj, bj = fs[i, VX], fs[i, VY], fs[j, VX], fs[j, VY]
-                ki, kj = collide(i, j, te, fs, rule, mass, tan, box, clock)
+                ki, kj = collide(i, j, te, fs, rule, mass, tan, box, clock, tab)
                 if tan is not None:
                     if tan[0].shape[0] > 0:
                         pair_tangent_rows(tan[0], tan[1], i, j, fs, ai, bi, aj, bj, rule, ki,
@@ -585,19 +613,32 @@ def drive(fs, iv, head, m, w, qt, qi, ht, qh, qs, qw, rule, mass, t_end, max_eve
                             for c in range(4):
                                 tan[0][i, c] = 0.0
                     continue
-            x, y, vx, vy, tn, sin_theta = wall_event(x, y, fs[i, VX], fs[i, VY],
-                                                     1.0 - fs[i, RAD], rule)
-            if tan is not None:
-                u = tan[0]
-                if u.shape[0] > 0:
-                    ai = fs[i, VX]
-                    bi = fs[i, VY]
-                    # a reflection (or a grazing slide, where the map is singular); a disk
-                    # already moving inward is not reflected: the identity (as drive_two)
-                    if x * ai + y * bi >= 0.0:
-                        u[i, 0], u[i, 1], u[i, 2], u[i, 3] = wall_tangent(
-                            u[i, 0], u[i, 1], u[i, 2], u[i, 3], x, y, ai, bi, vx, vy,
-                            1.0 - fs[i, RAD])
+            if tab is None:
+                x, y, vx, vy, tn, sin_theta = wall_event(x, y, fs[i, VX], fs[i, VY],
+                                                         1.0 - fs[i, RAD], rule)
+                if tan is not None:
+                    u = tan[0]
+                    if u.shape[0] > 0:
+                        ai = fs[i, VX]
+                        bi = fs[i, VY]
+                        # a reflection (or a grazing slide, where the map is singular); a
+                        # disk already moving inward is not reflected: the identity (as
+                        # drive_two)
+                        if x * ai + y * bi >= 0.0:
+                            u[i, 0], u[i, 1], u[i, 2], u[i, 3] = wall_tangent(
+                                u[i, 0], u[i, 1], u[i, 2], u[i, 3], x, y, ai, bi, vx, vy,
+                                1.0 - fs[i, RAD])
+            else:
+                x, y, vx, vy, tn, nx, ny, kap, sin_theta = dw.table_wall(
+                    tab, i, x, y, fs[i, VX], fs[i, VY], rule)
+                if tan is not None:
+                    u = tan[0]
+                    if u.shape[0] > 0:
+                        # the reflection's map with the wall's curvature (as drive_tables;
+                        # a grazing slide takes it too)
+                        u[i, 0], u[i, 1], u[i, 2], u[i, 3] = curved_wall_tangent(
+                            u[i, 0], u[i, 1], u[i, 2], u[i, 3], fs[i, VX], fs[i, VY], vx, vy,
+                            nx, ny, kap)
             if walls is not None:
                 if walls[5][i]:
                     q = cnt[N_WLOG]
@@ -634,7 +675,7 @@ def drive(fs, iv, head, m, w, qt, qi, ht, qh, qs, qw, rule, mass, t_end, max_eve
                 bk = NONE
                 bs = 0
             rescan(d, te, gx0, gx1, gy0, gy1, best, bk, bs, fs, iv, head, m, w, qt, qi, ht,
-                   qh, qs, qw, tan, box)
+                   qh, qs, qw, tan, box, tab)
         if pb >= 0 and reorder_every > 0:
             cnt[N_SINCE] += 1
             if cnt[N_SINCE] >= reorder_every:
@@ -696,29 +737,50 @@ def final_state(fs, iv, clock, t_end):
     return out
 
 
+def no_observers(n: int) -> tuple:
+    """``(mass, arcs, walls, samp, contacts, tan, dbg)`` of `drive` with every observer
+    present and off (no holes, no disk selected, no samples, no tangent, no checks): the
+    types of the loop's observer variant, which a table always runs."""
+    return (np.ones(n), np.empty((0, 2)),
+            (np.empty(1), np.empty(1, np.int32), np.empty(1), np.empty(1), np.empty(1),
+             np.zeros(n, dtype=np.bool_)),
+            (1.0, np.zeros(0, dtype=np.int64), np.empty((0, 0, 2))),
+            (np.empty(1), np.empty(1)), (np.empty((0, 4)), np.zeros(1)),
+            np.array([-np.inf, -np.inf, 0.0, 0.0]))
+
+
 def new_engine(state: np.ndarray, radii: np.ndarray, m: int, w: float,
-               box: float | None = None) -> tuple:
+               box: float | None = None, tab: tuple | None = None) -> tuple:
     """``(perm, engine)``: the engine's arrays ``(fs, iv, head, qt, qi, ht, qh, qs, qw)`` for
     a validated ``state`` (n, 4), set up at time 0 (`setup`), its disk ``k`` the caller's
-    disk ``perm[k]`` (`cells.spatial_order`: neighbours share cache lines).
+    disk ``perm[k]`` (`cells.spatial_order`: neighbours share cache lines). ``tab``: a
+    table's switch (`drive`; its ``where`` rows filled here, in the engine's numbering).
 
     Memory: 64 + 32 bytes per disk here, 36 in the calendar, 4 per cell (at most about
     ``4 n`` cells) and per bucket (``2 n`` rounded up to a power of two): 153-161 bytes per
     disk at 10^4 disks (docs/disks.md)."""
     n = state.shape[0]
-    perm = cells.spatial_order(state[:, 0], state[:, 1], m, w, box)
+    perm = cells.spatial_order(state[:, 0], state[:, 1], m, w, box,
+                               None if tab is None else tab[4])
     fs = np.zeros((n, 8))
     fs[:, :4] = state[perm]
     fs[:, RAD] = radii[perm]
     iv = np.zeros((n, 8), dtype=np.int32)
     head = np.empty(m * m, dtype=np.int32)
     q = cal.new_calendar(n, 1.0)
-    setup(fs, iv, head, m, w, *q, box)
-    # the first predictions, made by the loop up to (not including) the first event at 0
     no_log = np.empty(0, dtype=np.int32)
-    drive(fs, iv, head, m, w, *q, 0, None, 0.0, 0, 0.0, np.zeros(N_CLOCK),
-          np.zeros(9, np.int64), np.empty(0), no_log, no_log, np.empty(n),
-          np.arange(n, dtype=np.int32), 0, None, None, None, None, None, None, box)
+    if tab is None:
+        setup(fs, iv, head, m, w, *q, box, None)
+        # the first predictions, made by the loop up to (not including) the first event at 0
+        drive(fs, iv, head, m, w, *q, 0, None, 0.0, 0, 0.0, np.zeros(N_CLOCK),
+              np.zeros(9, np.int64), np.empty(0), no_log, no_log, np.empty(n),
+              np.arange(n, dtype=np.int32), 0, None, None, None, None, None, None, box, None)
+    else:
+        setup(fs, iv, head, m, w, *q, None, tab)
+        mass, arcs, walls, samp, con, tan, dbg = no_observers(n)
+        drive(fs, iv, head, m, w, *q, 0, mass, 0.0, 0, 0.0, np.zeros(N_CLOCK),
+              np.zeros(9, np.int64), np.empty(0), no_log, no_log, np.empty(n),
+              np.arange(n, dtype=np.int32), 0, arcs, walls, samp, con, tan, dbg, None, tab)
     # buckets about two event spacings wide: a disk's next event is about mean(qt) away
     qt = q[0]
     finite = qt[np.isfinite(qt)]
