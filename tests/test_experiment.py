@@ -264,10 +264,12 @@ def test_a_single_eps_is_accepted_and_kept_as_a_tuple():
 
 def legacy_record(exp: Experiment) -> dict:
     """The record of a store written before eps lists, acf_max_lag, rr_sampling,
-    lyapunov_method, holes, unequal disks (partner_ratio, partner_mass) and log_events."""
+    lyapunov_method, holes, unequal disks (partner_ratio, partner_mass), log_events and
+    table."""
     record = exp.to_dict()
     del record["acf_max_lag"], record["rr_sampling"], record["lyapunov_method"]
     del record["holes"], record["partner_ratio"], record["partner_mass"], record["log_events"]
+    del record["table"]
     record["eps"] = record["eps"][0]
     return record
 

@@ -168,7 +168,7 @@ def test_the_wall_log_gives_each_contacts_birkhoff_coordinates(table):
     n = 40
     r = _radius(table, n, 0.2)
     state = kt.initial_state(n, None, packing=0.2, table=table, rng=4)
-    run = kt.simulate_disks(state, r, t_max=5.0, table=table, sample=[0, 3], log_walls=True)
+    run = kt.simulate_disks(state, r, t_max=40.0, table=table, sample=[0, 3], log_walls=True)
     w = run.walls
     assert len(w) > 20 and set(w.disk) <= {0, 3}
     assert ((w.s >= 0.0) & (w.s < table.perimeter(r))).all()
@@ -239,7 +239,7 @@ def test_bad_tables_and_options_name_the_argument():
     with pytest.raises(ValueError, match="outside"):
         kt.simulate_disks(np.array([[1.46, 0.0, 1.0, 0.0]]), r, t_max=1.0, table=table)
     with pytest.raises(ValueError, match="packing"):
-        kt.initial_state(2000, None, packing=0.3, table=Ellipse(10.0, 0.1))
+        kt.initial_state(2000, None, packing=0.8, table=Ellipse(1.5, 1.0))
 
 
 # --- kinetic theory: Enskog-Henderson in the stadium's bulk --------------------------------------

@@ -274,9 +274,6 @@ def test_bad_input_names_its_argument():
     with pytest.raises(ValueError, match="partner_radius"):
         simulate_one_particle(st, 0.1, t_max=1.0, table=Ellipse(3.0, 1.0),
                               kicks=KickLaw([0.5], angle="scatter", partner_radius=0.4))
-    with pytest.raises(ValueError, match="table"):
-        lyapunov(np.array([[0.1, 0.2, 0.6, 0.8], [-0.3, 0.1, 0.0, 1.0]]), 0.05, n_steps=10,
-                 tau=0.1, table=Stadium(1.0))
 
 
 def test_a_stadium_state_outside_the_circle_is_accepted():

@@ -316,5 +316,3 @@ def test_bad_input():
     assert simulate_two_particle(ic2, R, t_max=1.0, table=Stadium(1.0)).n_boundary >= 2
     with pytest.raises(ValueError, match="ic"):
         simulate_two_particle(ic2, R, t_max=1.0)
-    with pytest.raises(ValueError, match="table"):
-        lyapunov(np.array([0.1, 0.2, 0.6, 0.8]), R, n_steps=10, tau=0.1, table=Stadium(1.0))

@@ -240,7 +240,8 @@ ho
           for a uniform wall pressure on any convex curve, :math:`\oint r\cdot n\,ds =
           2A_c`).
         * **bulk**: the collisions whose contact point lies within ``bulk_radius`` of the
-          centre (in any table) (:math:`A_b = \pi R_b^2`) and the region's time-averaged number of centres
+          centre (in any table) (:math:`A_b = \pi R_b^2`) and the region's time-averaged
+          number of centres
           :math:`N_b` (counted at the rows of ``pressure_log``, trapezoidal rule):
           :math:`Z_b = 1 + \sum_{region} \tfrac12 r_{ij}\cdot(\Delta p_i - \Delta p_j) / (2
           T N_b kT)`, the local virial of a homogeneous region away from the wall, to be

@@ -134,7 +134,7 @@ def check_disks_table(table, box, name: str = "table"):
             raise ValueError(f"{name}: pass a table or a periodic box, not both (got "
                              f"{name}={table!r} and box={box!r})")
         return None
-    return check_table(table, name)
+    return check_table(table, name=name)
 
 
 def check_disks(state, r, rule: str, masses=None, name: str = "state", box=None, table=None):

@@ -404,7 +404,7 @@ class Ellipse(_Table):
         return np.minimum(d, best).reshape(q.shape[:-1])
 
 
-def check_table(table, name: str = "table"):
+def check_table(table, *, name: str = "table"):
     """The table a simulator runs in: ``None`` is the unit circle, `Circle()`; a `Circle`,
     `Stadium` or `Ellipse` is itself; anything else is a TypeError naming ``name``.
 
@@ -700,7 +700,7 @@ def table_spec(table) -> str:
     return " ".join([kind] + [f"{p}={getattr(table, p)!r}" for p in TABLE_KINDS[kind]])
 
 
-def parse_table(spec, name: str = "table"):
+def parse_table(spec, *, name: str = "table"):
     """The table written by `table_spec`: a name of `TABLE_KINDS` followed by its parameters
     as ``key=value`` words (``"stadium a=1"``); a ValueError naming ``name`` otherwise.
 

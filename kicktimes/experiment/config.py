@@ -53,7 +53,8 @@ RR_SAMPLINGS = ("run", "uniform", "run+uniform")
 #: single ``eps`` as a float, as before), so stores written before the field existed keep
 #: their hash and still load. Their results simply lack the rows added since.
 _LATER_FIELDS = {"acf_max_lag": 20, "rr_sampling": "run", "lyapunov_method": "twin",
-                 "holes": [], "partner_ratio": 1.0, "partner_mass": 1.0, "log_events": True}
+                 "holes": [], "partner_ratio": 1.0, "partner_mass": 1.0, "log_events": True,
+                 "table": "circle"}
 #: the systems an FTLE-only sweep without event logs (``log_events = false``) can run: those
 #: whose kicks need no two-disk collision times beyond their rate
 LOG_FREE_SYSTEMS = ("two_particle", "poisson", "poisson_scatter", "poisson_kinetic",
@@ -187,6 +188,12 @@ class Experiment:
         ``ic_method = "uniform"``). Not with ``"poisson_kinetic"`` or
         ``"uniform_kinetic"`` (their rate table, `kicktimes.schedules.KineticRate`, is for
         equal disks).
+    table : str or table
+        The billiard table (default ``"circle"``, the unit circle): ``"stadium a=..."``
+        (Bunimovich's stadium, `kicktimes.tables.Stadium`) or ``"ellipse a=... b=..."``
+        (`kicktimes.tables.Ellipse`), as `kicktimes.tables.parse_table` reads it, or a
+        table value. Beyond the circle: ``ic_method = "uniform"``, equal disks, no holes and
+        no kinetic-rate systems.
     partner_mass : float
         Disk 1's mass in units of disk 0's, ``m1 / m0 > 0`` (default 1). Only the elastic
         rule has masses (``rule = "elastic"``), and only the invariant ICs draw their
@@ -231,6 +238,7 @@ class Experiment:
     partner_ratio: float = 1.0
     partner_mass: float = 1.0
     log_events: bool = True
+    table: str = "circle"
 
     def __post_init__(self):
         put = functools.partial(object.__setattr__, self)  # (the dataclass is frozen)
@@ -269,6 +277,47 @@ class Experiment:
             raise TypeError(f"description: expected a string, got {self.description!r}")
         self._check_partner(put)
         self._check_log_events()
+        self._check_table(put)
+
+    def _check_table(self, put):
+        """``table``: the billiard table as text (`kicktimes.tables.parse_table`: ``"circle"``,
+        ``"stadium a=1"``, ``"ellipse a=1.5 b=1"``; a table value is written as its text).
+        Beyond the circle the ICs are the invariant measure's and the circle's own
+        constructions are refused: the paper's ICs, the kinetic-rate systems (tabulated on
+        the circle's angular momentum), holes (arcs of the circle) and unequal disks."""
+        from kicktimes.billiard.tables import check_table, parse_table, table_spec
+
+        value = self.table
+        table = parse_table(value) if isinstance(value, str) else check_table(value)
+        put("table", table_spec(table))
+        if self.table == "circle":
+            return
+        for r in self.radii:
+            try:
+                table.check_radius(r)
+            except ValueError as exc:
+                raise ValueError(f"radii: {exc}") from None
+        kinetic = [s for s in KINETIC_SYSTEMS if s in self.systems]
+        problems = [
+            (self.ic_method != "uniform",
+             f"ic_method must be 'uniform' (the paper's ICs are the circle's), got "
+             f"{self.ic_method!r}"),
+            (bool(kinetic), f"systems: {kinetic} tabulate the circle's kinetic rate; leave "
+                            f"them out"),
+            (bool(self.holes), "holes (arcs of the circle's wall) are not allowed"),
+            (self.partner_ratio != 1.0 or self.partner_mass != 1.0,
+             "partner_ratio and partner_mass must be 1 (equal disks)"),
+        ]
+        for bad, text in problems:
+            if bad:
+                raise ValueError(f"table={self.table!r}: {text}")
+
+    @property
+    def table_value(self):
+        """The table as a value (`kicktimes.tables.Circle`, `Stadium`, `Ellipse`)."""
+        from kicktimes.billiard.tables import parse_table
+
+        return parse_table(self.table)
 
     def _check_log_events(self):
         """``log_events = false``: an FTLE-only sweep (tangent method, uniform sampling, no
@@ -374,6 +423,8 @@ class Experiment:
 
         from kicktimes.stats import kinetic_rate
 
+        if self.table != "circle":
+            return kinetic_rate(radius, rule=self.rule, table=self.table_value)
         if self.partner_ratio == 1.0 and self.masses is None:
             return kinetic_rate(radius, rule=self.rule)
         rates = [kinetic_rate(self.radius_pair(float(r)), rule=self.rule, masses=self.masses)
@@ -496,6 +547,7 @@ class Experiment:
             f"{self.lyapunov_variant}; kicks {self.kick_angle})\n"
             f"  {n_tasks} tasks of up to {self.block_size} ICs"
             + (f"\n  {self.partner_line()}" if self.partner_line() else "")
+            + (f"\n  table: {self.table}" if self.table != "circle" else "")
         )
 
     def partner_line(self) -> str:

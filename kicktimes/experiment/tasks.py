@@ -235,15 +235,17 @@ def task_initial_conditions(experiment: Experiment, task: Task) -> np.ndarray:
     """
     masses = None if experiment.masses is None else tuple(experiment.masses)
     return _cached_ics(task.n_ics, experiment.ic_radius, experiment.seed, experiment.ic_method,
-                       experiment.rule, task.ic_start, masses)
+                       experiment.rule, task.ic_start, masses, experiment.table)
 
 
 @functools.lru_cache(maxsize=64)
-def _cached_ics(n_ics, ic_radius, seed, method, rule, start, masses):
+def _cached_ics(n_ics, ic_radius, seed, method, rule, start, masses, table="circle"):
     from kicktimes.billiard.initial import initial_conditions
+    from kicktimes.billiard.tables import parse_table
 
+    where = {} if table == "circle" else {"table": parse_table(table)}
     ics = initial_conditions(n_ics, ic_radius, rng=seed, method=method, rule=rule,
-                             start=start, masses=masses)
+                             start=start, masses=masses, **where)
     ics.flags.writeable = False  # shared by every radius: nothing may change it
     return ics
 
@@ -413,7 +415,8 @@ def _run_ic(exp: Experiment, r: float, ic_index: int, ic: np.ndarray, rows, coll
             elif system == "mmpp":
                 kick_times = schedule.sample(horizon, rng=rng)
             kick_angles = draw_kick_angles(kick_times.size, kick.angle, exp.sigma, rng)
-        one_kw = {"kicks": kick.replace(times=kick_times, angles=kick_angles), **holes, **steps}
+        one_kw = {"kicks": kick.replace(times=kick_times, angles=kick_angles), **holes, **steps,
+                  **table_kw(exp)}
         _kicked(system, one_kw, one_pass, exp, ic, r, timer, add, diagnose, extra,
                 uniform_kw=uniform_kw)
 
@@ -461,7 +464,7 @@ def _run_ic_log_free(exp, r, ic_index, ic, rows, timer, steps):
                 times = Poisson(rate).sample(exp.horizon, rng=rng)
                 angles = draw_kick_angles(times.size, kick.angle, exp.sigma, rng)
                 res = lyapunov(ic[0], r, kicks=kick.replace(times=times, angles=angles),
-                               method=method, **steps)
+                               method=method, **steps, **table_kw(exp))
                 add(system, "kick_rate", rate)
         record(system, res, "n_kicks")
 
@@ -577,8 +580,16 @@ def kinetic_rate_table(r: float, rule: str = "mirror"):
 
 
 def _two_disk_kw(exp: Experiment) -> dict:
-    """The two-disk runs' ``rule`` (and ``masses``, for a partner of another mass)."""
-    return {"rule": exp.rule, **({"masses": exp.masses} if exp.masses else {})}
+    """The two-disk runs' ``rule`` (and ``masses``, for a partner of another mass; the
+    ``table`` beyond the circle)."""
+    return {"rule": exp.rule, **({"masses": exp.masses} if exp.masses else {}),
+            **table_kw(exp)}
+
+
+def table_kw(exp: Experiment) -> dict:
+    """``{"table": ...}`` for a sweep beyond the circle, nothing for the circle: every
+    simulator call of a circle sweep stays the call it always was."""
+    return {} if exp.table == "circle" else {"table": exp.table_value}
 
 
 def kick_law(exp: Experiment, system: str, ic: np.ndarray, r: float | None = None) -> KickLaw:
@@ -754,6 +765,7 @@ def uniform_samples(exp: Experiment, system: str, ic: np.ndarray, r: float, run)
             kicks=kick_law(exp, system, ic, r).replace(times=run.kick_times,
                                                        angles=run.kick_angles),
             sampling="uniform",
+            **table_kw(exp),
         )
     return again.samples
 

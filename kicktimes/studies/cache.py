@@ -40,7 +40,7 @@ import pandas as pd
 from kicktimes.fileio import atomic_write
 from kicktimes.studies.options import status_lines
 
-__all__ = ["Cached", "cached_table", "cached_tables", "read_cached", "runs_table",
+__all__ = ["Cached", "cached_table", "cached_tables", "read_cached", "runs_table", "study_store",
            "write_cached"]
 
 
@@ -191,3 +191,30 @@ def runs_table(runs, columns) -> pd.DataFrame:
         raise ValueError(f"runs: missing columns {missing}")
     return runs
 
+
+
+def study_store(exp, out, *, workers: int = 1, scheduler: str | None = None, say=print):
+    """Run (or resume) the sweep store ``out/store-<exp.name>`` of a study:
+    ``(Store, seconds)``.
+
+    A store of that name made with other parameters (another experiment hash) is the
+    study's own stale cache: it is removed and recomputed. ``scheduler`` (a Dask
+    scheduler's address) runs the tasks there instead of on ``workers`` local processes.
+    """
+    import shutil
+
+    from kicktimes.experiment import run_experiment
+
+    path = Path(out) / f"store-{exp.name}"
+    manifest = path / "manifest.json"
+    if manifest.is_file():
+        record = json.loads(manifest.read_text(encoding="utf-8"))
+        if record.get("experiment_hash") != exp.hash():
+            say(f"{path.name}: made with other parameters; recomputed")
+            shutil.rmtree(path)
+    start = time.perf_counter()
+    kwargs = {"scheduler": scheduler} if scheduler else {"workers": workers}
+    store = run_experiment(exp, path, progress=False, **kwargs)
+    seconds = time.perf_counter() - start
+    say(f"{path.name}: {seconds:.0f} s")
+    return store, seconds

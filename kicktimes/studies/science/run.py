@@ -10,18 +10,16 @@ read, never written.
 
 from __future__ import annotations
 
-import json
 import os
-import shutil
 import time
 from dataclasses import dataclass
 from pathlib import Path
 
 import pandas as pd
 
-from kicktimes.experiment import load_store, run_experiment
+from kicktimes.experiment import load_store
 from kicktimes.render.pages import header, store_name, write_results_page
-from kicktimes.studies.cache import cached_table, read_cached, write_cached
+from kicktimes.studies.cache import cached_table, read_cached, study_store, write_cached
 from kicktimes.studies.options import check_scale, check_workers, status_lines
 from kicktimes.studies.science.decorrelation import (
     closest_kick_law,
@@ -144,20 +142,8 @@ def findings_families(findings_dir, names, scale):
 
 
 def _sweep(exp, out, workers, say):
-    """The FTLE sweep's store in ``out`` (a store of the same sweep made with other
-    parameters is this study's own stale cache: it is removed and recomputed)."""
-    path = Path(out) / f"store-{exp.name}"
-    manifest = path / "manifest.json"
-    if manifest.is_file():
-        record = json.loads(manifest.read_text(encoding="utf-8"))
-        if (record.get("experiment", {}).get("name") == exp.name
-                and record.get("experiment_hash") != exp.hash()):
-            say(f"{path.name}: made with other parameters; recomputed")
-            shutil.rmtree(path)
-    start = time.perf_counter()
-    store = run_experiment(exp, path, workers=workers, progress=False)
-    say(f"{path.name}: {time.perf_counter() - start:.0f} s")
-    return store
+    """The FTLE sweep's store in ``out`` (`kicktimes.studies.cache.study_store`)."""
+    return study_store(exp, out, workers=workers, say=say)[0]
 
 
 def _decorrelation(out, rule, sizes, say):

@@ -12,15 +12,13 @@ The stores' statistics are in `kicktimes.studies.small_r.tables`.
 
 from __future__ import annotations
 
-import json
-import shutil
-import time
 from pathlib import Path
 
 import pandas as pd
 
-from kicktimes.experiment import Experiment, load_store, run_experiment
+from kicktimes.experiment import Experiment, load_store
 from kicktimes.stats import kinetic_rate
+from kicktimes.studies.cache import study_store
 
 __all__ = ["CONTROL_RADIUS", "CONTROL_STORES", "N_SAMPLES", "SYSTEMS", "control_experiments",
            "load_sweep", "run_sweep", "seconds_per_ic", "small_r_experiment"]
@@ -77,22 +75,6 @@ def control_experiments(n_ics, n_collisions, radius=CONTROL_RADIUS) -> dict:
     return out
 
 
-def _run_store(exp, out, workers, scheduler, say):
-    path = Path(out) / f"store-{exp.name}"
-    manifest = path / "manifest.json"
-    if manifest.is_file():
-        record = json.loads(manifest.read_text(encoding="utf-8"))
-        if record.get("experiment_hash") != exp.hash():
-            say(f"{path.name}: made with other parameters; recomputed")
-            shutil.rmtree(path)
-    start = time.perf_counter()
-    kwargs = {"scheduler": scheduler} if scheduler else {"workers": workers}
-    store = run_experiment(exp, path, progress=False, **kwargs)
-    seconds = time.perf_counter() - start
-    say(f"{path.name}: {seconds:.0f} s")
-    return store, seconds
-
-
 def run_sweep(out, collisions, rules, *, n_ics, workers=1, scheduler=None, controls=None,
               say=print) -> tuple[dict, dict]:
     """Run (or resume) every store of the sweep in ``out``: ``collisions`` maps each
@@ -105,10 +87,12 @@ def run_sweep(out, collisions, rules, *, n_ics, workers=1, scheduler=None, contr
     for r in sorted(collisions, reverse=True):
         for rule in rules:
             exp = small_r_experiment(r, rule, n_ics=n_ics, n_collisions=collisions[r])
-            stores[rule, r], seconds[rule, r] = _run_store(exp, out, workers, scheduler, say)
+            stores[rule, r], seconds[rule, r] = study_store(exp, out, workers=workers,
+                                                             scheduler=scheduler, say=say)
     stores["controls"] = {}
     for key, exp in (controls or {}).items():
-        stores["controls"][key], seconds[key] = _run_store(exp, out, workers, scheduler, say)
+        stores["controls"][key], seconds[key] = study_store(
+            exp, out, workers=workers, scheduler=scheduler, say=say)
     return stores, seconds
 
 
