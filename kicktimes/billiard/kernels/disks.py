@@ -330,8 +330,9 @@ def pair_tangent_rows(u, lg, i, j, fs, ai, bi, aj, bj, rule, ki, kj):
     """The tangent rows of ``i`` and ``j`` across their collision (`tangent.pair_tangent`;
     both disks and rows at the contact, ``(ai, bi)``, ``(aj, bj)`` the incoming velocities),
     and all rows rescaled by ``1/BIG`` (``log BIG`` into ``lg[0]``) once the squared norm
-    of one passes ``BIG`` (1e100): the vector grows at disk-disk collisions (walls only
-    shear it), so this check keeps it finite however long the caller's segments are."""
+    of one passes ``BIG`` (1e100): the vector grows at disk-disk collisions (the circle's
+    wall only shears it; a table's focusing wall stretches it, and checks the same way), so
+    this check keeps it finite however long the caller's segments are."""
     (u[i, 0], u[i, 1], u[i, 2], u[i, 3], u[j, 0], u[j, 1], u[j, 2], u[j, 3]) = pair_tangent(
         u[i, 0], u[i, 1], u[i, 2], u[i, 3], u[j, 0], u[j, 1], u[j, 2], u[j, 3],
         fs[i, X], fs[i, Y], fs[j, X], fs[j, Y], ai, bi, aj, bj,
@@ -639,6 +640,11 @@ def drive(fs, iv, head, m, w, qt, qi, ht, qh, qs, qw, rule, mass, t_end, max_eve
                         u[i, 0], u[i, 1], u[i, 2], u[i, 3] = curved_wall_tangent(
                             u[i, 0], u[i, 1], u[i, 2], u[i, 3], fs[i, VX], fs[i, VY], vx, vy,
                             nx, ny, kap)
+                        # a focusing wall stretches too (the stadium's arcs): the same
+                        # check as at a disk-disk collision keeps the rows finite
+                        if (u[i, 0] * u[i, 0] + u[i, 1] * u[i, 1] + u[i, 2] * u[i, 2]
+                                + u[i, 3] * u[i, 3]) > BIG:
+                            shrink_tangent(u, tan[1])
             if walls is not None:
                 if walls[5][i]:
                     q = cnt[N_WLOG]

@@ -250,6 +250,10 @@ def drive(st, ev, phys, t_end, mode, tau, track, logs, stimes, samples, cnt, nex
                             tg.curved_wall_tangent(U[j, c], U[j, c + 1], U[j, c + 2],
                                                    U[j, c + 3], vx, vy, wx, wy, cnx, cny,
                                                    ckap))
+                        # a chaotic table stretches at every contact, not only at the disks'
+                        # collisions: without this a long flight between them overflows the
+                        # squared norm (the vector then renormalises to exactly 0)
+                        n_resc += tg.renormalize(U, log_scale, j)
                 elif vx != wx or vy != wy:
                     # (a disk already moving inward is not reflected: identity map)
                     c = 4 * ke
