@@ -22,6 +22,7 @@ contains the kinetic small-r law with :math:`\beta_1 = 1`) or ``g(r) = r``.
 
 from __future__ import annotations
 
+import functools
 import math
 import warnings
 from dataclasses import dataclass
@@ -110,18 +111,31 @@ def _kinetic_rate_table(r, rule, table):
         raise TypeError(f"r must be a number or an array of numbers, got {type(r).__name__}")
     scalar = np.ndim(r) == 0
     arr = as_1d_float("r", np.ravel(r), allow_empty=False)
-    out = np.empty(arr.size)
-    for i, ri in enumerate(arr):
+    # each distinct radius once (a store's table repeats its radii per IC; one quadrature
+    # of the ellipse's covariogram takes about a second), cached per (table, radius)
+    values, inverse = np.unique(arr, return_inverse=True)
+    out = np.empty(values.size)
+    for i, ri in enumerate(values):
         ri = table.check_radius(float(ri))
-        sigma = 2.0 * ri
-        contact = float(table.covariogram(sigma, ri))
-        if not contact > 0.0:
-            where = "" if scalar else f"[{i}]"
+        try:
+            out[i] = _table_rate(table, ri, rule)
+        except ValueError:
+            where = "" if scalar else f"[{int(np.flatnonzero(arr == ri)[0])}]"
             raise ValueError(f"r: two disks of radius r{where} = {ri!r} do not fit in "
-                             f"{table!r} with their centres 2 r apart")
-        out[i] = 2 * np.pi * sigma * contact * _MEAN_APPROACH[rule] / float(
-            table.configuration_volume(ri))
+                             f"{table!r} with their centres 2 r apart") from None
+    out = out[inverse]
     return float(out[0]) if scalar else out.reshape(np.shape(r))
+
+
+@functools.lru_cache(maxsize=256)
+def _table_rate(table, r: float, rule: str) -> float:
+    """`_kinetic_rate_table` at one checked radius (a ValueError if the disks do not fit)."""
+    sigma = 2.0 * r
+    contact = float(table.covariogram(sigma, r))
+    if not contact > 0.0:
+        raise ValueError("no contact")
+    return 2 * np.pi * sigma * contact * _MEAN_APPROACH[rule] / float(
+        table.configuration_volume(r))
 
 
 def configuration_volume(r):

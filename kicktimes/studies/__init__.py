@@ -100,6 +100,9 @@ STUDIES = {
         Study("small_r", "small_r.md",
               "the premise at its limit r -> 0: low-density theory and FTLE to r = 1e-4",
               options=("scheduler",)),
+        Study("tables", "tables.md",
+              "the paper's comparison in the circle, the ellipse and the stadium",
+              options=("scheduler",)),
     )
 }
 

@@ -124,7 +124,8 @@ def study_run(name: str, out: str | os.PathLike, *, scale: str, scales,
     """Check ``scale`` (one of ``scales``, a mapping to the study's sizes) and ``workers``,
     and lay out the run of study ``name`` (module docstring)."""
     check_scale(scale, scales)
-    workers = check_workers(workers)
+    # None: every core (the command line's --workers default)
+    workers = (os.cpu_count() or 1) if workers is None else check_workers(workers)
     out = Path(out)
     return StudyRun(
         name=name, params=scales[scale],

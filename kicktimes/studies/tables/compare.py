@@ -1,0 +1,167 @@
+r"""The tables study's comparisons: the kicked / two-disk FTLE ratio in each table, and each
+table's ratio against the circle's.
+
+* `findings` -- per table, every kicked system's FTLE ratio to the two disks under the
+  controls of every findings table (`kicktimes.report.controls.compute_controls`: the
+  paired median, the sticky runs left out; the elastic store folded in as the collision
+  rule's control by `kicktimes.report.controls.merge_control_families`), and the two-disk
+  collision counts against the table's kinetic rate (`kicktimes.stats.kinetic_rate`).
+* `against_circle` -- the question of the study: does the kicked disk's FTLE deficit
+  depend on the table's integrability? Per kicked system, the table's ratio over the
+  circle's,
+
+  .. math::  Q_T = \frac{\bar\rho_T}{\bar\rho_{\rm circle}}, \qquad
+             \bar\rho_T = \frac1R \sum_r \frac{\sum_i \lambda^{\rm kicked}_{ri}}
+                                          {\sum_i \lambda^{\rm two}_{ri}} ,
+
+  with a percentile interval from the two tables' independent bootstraps clustered on
+  ICs (`kicktimes.stats.paired_ratio` with ``draws=True``; the tables' ICs are
+  independent draws, so the replicates divide pairwise). ``Q = 1`` within the FTLE's
+  margin (`kicktimes.stats.margin_of`): the deficit is the circle's whatever the table;
+  ``Q > 1``: the table's own stretching hides it. Its controls: the elastic rule, the
+  sticky runs left out.
+
+Both tables have the columns of every findings table (`kicktimes.report.controls.COLUMNS`);
+``verdict`` is read at ±10 % (the lint's band), ``verdict_at_margin`` at the FTLE's ±5 %,
+``robust`` over the controls (`kicktimes.report.controls.with_robustness`).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from kicktimes.report.controls import (
+    COLUMNS,
+    compute_controls,
+    merge_control_families,
+    with_robustness,
+)
+from kicktimes.report.counts import sticky_ics
+from kicktimes.report.store import REFERENCE, wide
+from kicktimes.stats import (
+    cluster_bootstrap,
+    margin_of,
+    paired_ratio,
+    percentile_interval,
+    ratio_verdict,
+)
+from kicktimes.studies.tables.sweep import RULES, SEED, TABLES, family_name
+
+__all__ = ["KICKED", "N_BOOT", "against_circle", "findings", "mean_ftle", "per_ic"]
+
+#: the kicked systems of the sweep, as the pages name them
+KICKED = {"poisson": "uniform kicks at Poisson times",
+          "actual": "uniform kicks at the two disks' collision times",
+          "poisson_scatter": "scattering kicks at Poisson times"}
+N_BOOT = 2000
+#: the control each collision rule's store stands for
+_CONTROL = {"mirror": "primary", "elastic": "elastic"}
+
+
+def findings(stores, *, n_boot=N_BOOT) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """Every store's findings (module docstring), the elastic stores folded into their
+    table's family: ``{(table, rule): Store}`` in; out the findings table (`COLUMNS`) and
+    its ratios per radius (``table, rule`` and the curves of
+    `kicktimes.report.controls.Controls`)."""
+    tables, curves = [], []
+    for (table, rule), store in sorted(stores.items()):
+        exp = store.experiment
+        found = compute_controls(
+            store.results, store.collisions, family=exp.name, eps=exp.eps, rule=rule,
+            rng=np.random.default_rng([exp.seed, RULES.index(rule)]), n_boot=n_boot,
+            kinetic=exp.kinetic_rate)
+        tables.append(found.table)
+        curves.append(found.curves.assign(table=table, rule=rule))
+    merged = merge_control_families(tables)
+    table = pd.concat([merged[family_name(t, "mirror")] for t in TABLES if
+                       family_name(t, "mirror") in merged], ignore_index=True)
+    return table, pd.concat(curves, ignore_index=True)
+
+
+def mean_ftle(runs, *, n_boot=N_BOOT, seed=SEED) -> pd.DataFrame:
+    """Per (table, rule, system): the mean FTLE over ICs and radii, with its 95 % interval
+    from the bootstrap clustered on ICs (`kicktimes.stats.cluster_bootstrap`; one IC's
+    radii resampled together)."""
+    rows = []
+    for k, ((table, rule), g) in enumerate(runs.groupby(["table", "rule"], sort=True)):
+        for system in (REFERENCE, *KICKED):
+            lam = g.pivot_table(index="ic", columns="radius", values=system).to_numpy()
+            boot = cluster_bootstrap(lambda idx, lam=lam: np.nanmean(lam[idx], axis=(1, 2)),
+                                     lam.shape[0], n_boot=n_boot,
+                                     rng=np.random.default_rng([seed, k]))
+            rows.append({"table": table, "rule": rule, "system": system, "n_ics": lam.shape[0],
+                         "ftle": boot.estimate, "ci_low": boot.ci_low,
+                         "ci_high": boot.ci_high})
+    return pd.DataFrame(rows)
+
+
+def per_ic(stores) -> pd.DataFrame:
+    """One row per (table, rule, radius, IC): each system's FTLE and whether the IC's
+    two-disk run is sticky (`kicktimes.report.counts.sticky_ics`)."""
+    parts = []
+    for (table, rule), store in sorted(stores.items()):
+        lam = wide(store.results, "lyapunov")
+        sticky = sticky_ics(store.collisions, rule, kinetic=store.experiment.kinetic_rate)
+        sticky = sticky.set_index(["radius", "ic"])["sticky"].reindex(lam.index,
+                                                                     fill_value=False)
+        parts.append(lam.assign(sticky=sticky.to_numpy(bool), table=table, rule=rule)
+                     .reset_index())
+    return pd.concat(parts, ignore_index=True)
+
+
+def _ratio_draws(block, system, *, rng, n_boot):
+    """``(estimate, draws)`` of one table's kicked / two-disk ratio (`paired_ratio`)."""
+    frame = block.set_index(["radius", "ic"])
+    _, overall, draws = paired_ratio(frame[system], frame[REFERENCE], rng=rng, n_boot=n_boot,
+                                     draws=True)
+    return overall["ratio"], draws
+
+
+def against_circle(runs, *, reference="circle", n_boot=N_BOOT, seed=SEED) -> pd.DataFrame:
+    """Each table's kicked / two-disk FTLE ratio over the circle's, per kicked system,
+    under its controls (module docstring); ``runs`` is `per_ic`'s table.
+
+    Returns
+    -------
+    pandas.DataFrame
+        `COLUMNS` (``family`` is ``tables_<table>``, ``diagnostic`` ``ftle_vs_circle``),
+        with ``ratio`` and ``reference_ratio``, the two ratios it divides.
+    """
+    tol = margin_of("ftle")
+    rows = []
+    tables = [t for t in TABLES if t != reference and t in set(runs["table"])]
+    for system in KICKED:
+        for rule in RULES:
+            for control in ((_CONTROL[rule], "sticky_excluded") if rule == "mirror"
+                            else (_CONTROL[rule],)):
+                part = runs[runs["rule"] == rule]
+                if control == "sticky_excluded":
+                    part = part[~part["sticky"]]
+                # one stream per (table, rule, control): the tables' bootstraps are independent
+                streams = {t: np.random.default_rng([seed, k, RULES.index(rule),
+                                                     control == "sticky_excluded"])
+                           for k, t in enumerate(TABLES)}
+                ref, ref_draws = _ratio_draws(part[part["table"] == reference], system,
+                                              rng=streams[reference], n_boot=n_boot)
+                for t in tables:
+                    est, draws = _ratio_draws(part[part["table"] == t], system,
+                                              rng=streams[t], n_boot=n_boot)
+                    low, high = percentile_interval(draws / ref_draws)
+                    n_sticky = int(runs[(runs["rule"] == rule)
+                                        & runs["table"].isin([t, reference])]["sticky"].sum())
+                    rows.append({
+                        "family": family_name(t, "mirror"),
+                        "question": "FTLE ratio against the circle's", "diagnostic":
+                        "ftle_vs_circle", "system": system, "control": control,
+                        "estimate": est / ref, "ci_low": low, "ci_high": high,
+                        "verdict": ratio_verdict(low, high), "margin": tol,
+                        "verdict_at_margin": ratio_verdict(low, high, tolerance=tol),
+                        "robust": False, "depends_on": "",
+                        "n_pairs": int((part["table"] == t).sum()),
+                        "detail": (f"{rule} rule; {t} {est:.4g} over circle {ref:.4g}"
+                                   + (f"; {n_sticky} sticky runs left out"
+                                      if control == "sticky_excluded" else "")),
+                        "ratio": est, "reference_ratio": ref})
+    out = pd.DataFrame(rows, columns=[*COLUMNS, "ratio", "reference_ratio"])
+    return with_robustness(out)

@@ -1,0 +1,118 @@
+"""Run (or resume) the tables study and write ``tables.md``: `reproduce`.
+
+The study's work folder ``out`` holds one store per (table, collision rule)
+(``store-tables_<table>[-elastic]``, resumable task by task, on a local pool or a Dask
+cluster) and the free disk's tables (``cache-tables/free_disk.parquet``,
+``focal_drift.parquet``, with their parameters beside them).
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from dataclasses import dataclass
+
+from kicktimes.render.pages import header
+from kicktimes.studies.cache import cached_table
+from kicktimes.studies.options import study_run
+from kicktimes.studies.tables.compare import against_circle, findings, mean_ftle, per_ic
+from kicktimes.studies.tables.figures import tables_figure
+from kicktimes.studies.tables.one_disk import POINT_RADIUS, focal_drift, free_ftle
+from kicktimes.studies.tables.page import SOURCES, answers, body
+from kicktimes.studies.tables.sweep import RADII, RULES, SEED, TABLES, run_stores, tables_experiment
+
+__all__ = ["SCALES", "TablesScale", "reproduce"]
+
+
+@dataclass(frozen=True)
+class TablesScale:
+    """The sizes of one scale: ICs per (table, rule, radius), each run's horizon, the free
+    disk's states and the focal drift's states and wall contacts."""
+
+    n_ics: int
+    horizon: float
+    free_states: int
+    drift_states: int
+    drift_bounces: int
+
+
+#: ``paper``: the sizes of docs/results/tables.md (200 ICs, the paper's horizon 25000 x 0.2;
+#: about a minute on 2 cores); ``quick``: seconds
+SCALES = {
+    "paper": TablesScale(200, 5000.0, 200, 50, 10_000),
+    "quick": TablesScale(6, 300.0, 10, 4, 1000),
+}
+
+
+def reproduce(out: str | os.PathLike, *, scale: str = "quick", results_dir=None,
+              workers: int = 1, progress=None, command: str | None = None,
+              scheduler: str | None = None):
+    """Run (or resume) the tables study in ``out`` and write ``tables.md``.
+
+    Parameters
+    ----------
+    out : path-like
+        The study's work folder: the stores and the free disk's cached tables.
+    scale : {"quick", "paper"}
+        ``"paper"``: the sizes of docs/results/tables.md (`SCALES`); ``"quick"``: a small
+        version (seconds, after compilation).
+    results_dir, workers, progress, command
+        As every study's (`kicktimes.studies.options`).
+    scheduler : str, optional
+        A Dask distributed scheduler's address: the sweep's tasks run there.
+
+    Returns
+    -------
+    pathlib.Path
+        The page, ``results_dir/tables.md``.
+
+    Examples
+    --------
+    >>> reproduce("unused", scale="huge")
+    Traceback (most recent call last):
+    ...
+    ValueError: scale must be one of 'paper', 'quick', got 'huge'
+    """
+    run = study_run("tables", out, scale=scale, scales=SCALES, results_dir=results_dir,
+                    workers=workers, progress=progress, command=command)
+    sizes = run.params
+    t0 = time.perf_counter()
+    run.cache.mkdir(parents=True, exist_ok=True)
+    run.results.mkdir(parents=True, exist_ok=True)
+    experiments = {(t, rule): tables_experiment(t, rule, n_ics=sizes.n_ics,
+                                                horizon=sizes.horizon)
+                   for t in TABLES for rule in RULES}
+    named = run_stores(out, experiments.values(), workers=run.workers, scheduler=scheduler,
+                       say=run.say)
+    stores = {key: named[exp.name] for key, exp in experiments.items()}
+    run.say(f"sweep done at {time.perf_counter() - t0:.0f} s")
+    params = {"radii": list(RADII), "tables": [repr(t) for t in TABLES.values()],
+              "states": sizes.free_states, "horizon": sizes.horizon, "seed": SEED}
+    free = cached_table(run.cache / "free_disk.parquet", params, lambda: free_ftle(
+        TABLES, RADII, n_states=sizes.free_states, horizon=sizes.horizon, seed=SEED),
+        progress=run.say).table
+    params = {"radii": [POINT_RADIUS, *RADII], "table": repr(TABLES["ellipse"]),
+              "states": sizes.drift_states, "bounces": sizes.drift_bounces, "seed": SEED}
+    drift = cached_table(run.cache / "focal_drift.parquet", params, lambda: focal_drift(
+        TABLES["ellipse"], (POINT_RADIUS, *RADII), n_states=sizes.drift_states,
+        n_bounces=sizes.drift_bounces, seed=SEED), progress=run.say).table
+
+    found, curves = findings(stores)
+    runs = per_ic(stores)
+    against = against_circle(runs)
+    means = mean_ftle(runs)
+    for name, frame in (("findings", found), ("findings_by_radius", curves),
+                        ("against_circle", against), ("ftle", means), ("free_disk", free),
+                        ("focal_drift", drift)):
+        run.write_csv(f"tables_{name}.csv", frame)
+    run.write_figure("tables.png", tables_figure(curves))
+    lines = header(
+        "The paper's comparison in the circle, the ellipse and the stadium", run.command,
+        ["the sweep's stores " + ", ".join(f"`{exp.name}`" for exp in experiments.values()),
+         f"the free disk's runs (`kicktimes.studies.tables.one_disk`, cached in "
+         f"`{run.cache.name}`)"])
+    lines += answers(found, against, free, drift) + [""]
+    lines += body(found, against, means, free, drift, n_ics=sizes.n_ics,
+                  horizon=sizes.horizon)
+    run.say(f"page at {time.perf_counter() - t0:.0f} s")
+    return run.write_page(lines, SOURCES)
