@@ -141,7 +141,7 @@ def test_an_option_of_another_study_is_refused_naming_it(tmp_path):
     res = CliRunner().invoke(main, ["reproduce", "--study", "escape", "--scheduler",
                                     "tcp://h:1", "--out", str(tmp_path)])
     assert res.exit_code == 2
-    assert ("--scheduler applies to --study paper, disks, small_r, not to --study escape"
+    assert ("--scheduler applies to --study paper, disks, small_r, tables, not to --study escape"
             in res.output)
 
 
