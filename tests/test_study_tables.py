@@ -19,6 +19,7 @@ from kicktimes.studies.tables import (
     focal_drift,
     focal_product,
     free_ftle,
+    free_runs,
     reproduce,
     tables_experiment,
 )
@@ -102,8 +103,9 @@ def test_the_focal_product_is_the_ellipse_s_integral_and_moves_with_the_radius()
 
 
 def test_the_free_disk_is_chaotic_only_in_the_stadium():
-    free = free_ftle({"circle": Circle(), "stadium": Stadium(1.0)}, [0.02], n_states=8,
-                     horizon=1000.0, seed=3, n_boot=200)
+    states = free_runs({"circle": Circle(), "stadium": Stadium(1.0)}, [0.02], n_states=8,
+                       horizon=1000.0, seed=3)
+    free = free_ftle(states, horizon=1000.0, n_boot=200)
     c = free[free["table"] == "circle"].iloc[0]
     s = free[free["table"] == "stadium"].iloc[0]
     assert c["ftle"] < 2 * c["shear_scale"] == 2 * math.log(1000.0) / 1000.0
@@ -111,7 +113,7 @@ def test_the_free_disk_is_chaotic_only_in_the_stadium():
 
 
 def test_scales():
-    assert SCALES["paper"].n_ics == 200 and SCALES["paper"].horizon == 5000.0
+    assert SCALES["paper"].n_ics == 2000 and SCALES["paper"].horizon == 5000.0
     assert sorted(TABLES) == ["circle", "ellipse", "stadium"]
     with pytest.raises(ValueError, match="scale must be one of"):
         reproduce("unused", scale="huge")
@@ -131,5 +133,28 @@ def test_quick_page(tmp_path):
     assert set(found["family"]) == {f"tables_{t}" for t in TABLES}
     assert {"primary", "elastic", "paired_median", "sticky_excluded"} <= set(found["control"])
     assert (page.parent / "tables.png").stat().st_size > 10_000
+    free = pd.read_csv(page.parent / "tables_against_free.csv")
+    assert set(free["table"]) == set(TABLES) and (free["estimate"] > 0).all()
     again = reproduce(tmp_path, scale="quick", workers=1)   # resumes: stores reused
     assert again == page
+
+
+def test_against_free_recovers_a_known_ratio():
+    from kicktimes.studies.tables import against_free
+
+    runs = _runs({"circle": 0.5, "stadium": 0.9}, n_ics=50, noise=0.02)
+    rng = np.random.default_rng(4)
+    free = pd.concat([pd.DataFrame({"table": t, "radius": r, "state": np.arange(60),
+                                    "ftle": base * (1 + 0.02 * rng.standard_normal(60))})
+                      for t, base in (("circle", 0.25), ("stadium", 1.0)) for r in (0.01, 0.02)])
+    out = against_free(runs, free, n_boot=400)
+    two = out[(out["system"] == "two_particle") & (out["rule"] == "mirror")].set_index("table")
+    # the two-disk FTLE is uniform on [0.5, 1.5]: mean 1
+    assert two.loc["circle", "estimate"] == pytest.approx(4.0, rel=0.05)
+    assert two.loc["stadium", "estimate"] == pytest.approx(1.0, rel=0.05)
+    kick = out[(out["system"] == "poisson") & (out["rule"] == "mirror")].set_index("table")
+    assert kick.loc["stadium", "estimate"] == pytest.approx(
+        0.9 * two.loc["stadium", "estimate"], rel=0.02)
+    assert kick.loc["stadium", "ci_low"] < kick.loc["stadium", "estimate"] \
+        < kick.loc["stadium", "ci_high"]
+    assert kick.loc["circle", "verdict_at_margin"] == "higher"

@@ -9,7 +9,7 @@ circle, in an ellipse (integrable for a point, nearly so for a disk) and in Buni
 stadium (chaotic), under both collision rules, and writes ``tables.md`` with its tables
 ``tables_*.csv`` and its figure:
 
-1. **The sweep** (`sweep`): one store per (table, rule), 200 invariant-measure ICs at
+1. **The sweep** (`sweep`): one store per (table, rule), 2000 invariant-measure ICs at
    r = 0.01, 0.02, 0.03 over the paper's horizon.
 2. **The comparisons** (`compare`): the kicked / two-disk ratio per table under the
    findings tables' controls, and each table's ratio over the circle's.
@@ -23,14 +23,20 @@ Examples
 --------
 >>> from kicktimes.studies.tables import SCALES, TABLES
 >>> SCALES["paper"].n_ics, sorted(TABLES)
-(200, ['circle', 'ellipse', 'stadium'])
+(2000, ['circle', 'ellipse', 'stadium'])
 """
 
 from __future__ import annotations
 
-from kicktimes.studies.tables.compare import against_circle, findings, mean_ftle, per_ic
+from kicktimes.studies.tables.compare import (
+    against_circle,
+    against_free,
+    findings,
+    mean_ftle,
+    per_ic,
+)
 from kicktimes.studies.tables.figures import tables_figure
-from kicktimes.studies.tables.one_disk import focal_drift, focal_product, free_ftle
+from kicktimes.studies.tables.one_disk import focal_drift, focal_product, free_ftle, free_runs
 from kicktimes.studies.tables.run import SCALES, TablesScale, reproduce
 from kicktimes.studies.tables.sweep import (
     RADII,
@@ -42,6 +48,7 @@ from kicktimes.studies.tables.sweep import (
 )
 
 __all__ = ["RADII", "RULES", "SCALES", "TABLES", "TablesScale", "against_circle",
-           "family_name", "findings", "focal_drift", "focal_product", "free_ftle",
+           "against_free", "family_name", "findings", "focal_drift", "focal_product",
+           "free_ftle", "free_runs",
            "mean_ftle", "per_ic", "reproduce", "run_stores", "tables_experiment",
            "tables_figure"]

@@ -21,7 +21,12 @@ table's ratio against the circle's.
   ``Q > 1``: the table's own stretching hides it. Its controls: the elastic rule, the
   sticky runs left out.
 
-Both tables have the columns of every findings table (`kicktimes.report.controls.COLUMNS`);
+* `against_free` -- each system's FTLE over the free disk's in the same table (the mean
+  over ICs and radii over the free disk's mean over states and radii; the two
+  independent bootstraps divide): whether the perturbations add stretching to the table's
+  own or remove some of it.
+
+The findings tables have the columns of every findings table (`kicktimes.report.controls.COLUMNS`);
 ``verdict`` is read at ±10 % (the lint's band), ``verdict_at_margin`` at the FTLE's ±5 %,
 ``robust`` over the controls (`kicktimes.report.controls.with_robustness`).
 """
@@ -48,7 +53,8 @@ from kicktimes.stats import (
 )
 from kicktimes.studies.tables.sweep import RULES, SEED, TABLES, family_name
 
-__all__ = ["KICKED", "N_BOOT", "against_circle", "findings", "mean_ftle", "per_ic"]
+__all__ = ["KICKED", "N_BOOT", "against_circle", "against_free", "findings", "mean_ftle",
+           "per_ic"]
 
 #: the kicked systems of the sweep, as the pages name them
 KICKED = {"poisson": "uniform kicks at Poisson times",
@@ -79,20 +85,19 @@ def findings(stores, *, n_boot=N_BOOT) -> tuple[pd.DataFrame, pd.DataFrame]:
     return table, pd.concat(curves, ignore_index=True)
 
 
-def mean_ftle(runs, *, n_boot=N_BOOT, seed=SEED) -> pd.DataFrame:
-    """Per (table, rule, system): the mean FTLE over ICs and radii, with its 95 % interval
-    from the bootstrap clustered on ICs (`kicktimes.stats.cluster_bootstrap`; one IC's
-    radii resampled together)."""
+def mean_ftle(runs, *, per_radius=False, n_boot=N_BOOT, seed=SEED) -> pd.DataFrame:
+    """Per (table, rule, system): the mean FTLE over ICs and radii (``per_radius``: per
+    radius too), with its 95 % interval from the bootstrap clustered on ICs
+    (`kicktimes.stats.cluster_bootstrap`; one IC's radii resampled together)."""
     rows = []
-    for k, ((table, rule), g) in enumerate(runs.groupby(["table", "rule"], sort=True)):
+    keys = ["table", "rule", "radius"] if per_radius else ["table", "rule"]
+    for k, (key, g) in enumerate(runs.groupby(keys, sort=True)):
         for system in (REFERENCE, *KICKED):
             lam = g.pivot_table(index="ic", columns="radius", values=system).to_numpy()
-            boot = cluster_bootstrap(lambda idx, lam=lam: np.nanmean(lam[idx], axis=(1, 2)),
-                                     lam.shape[0], n_boot=n_boot,
-                                     rng=np.random.default_rng([seed, k]))
-            rows.append({"table": table, "rule": rule, "system": system, "n_ics": lam.shape[0],
-                         "ftle": boot.estimate, "ci_low": boot.ci_low,
-                         "ci_high": boot.ci_high})
+            est, draws = _mean_draws(lam, rng=np.random.default_rng([seed, k]), n_boot=n_boot)
+            low, high = percentile_interval(draws)
+            rows.append({**dict(zip(keys, key, strict=True)), "system": system,
+                         "n_ics": lam.shape[0], "ftle": est, "ci_low": low, "ci_high": high})
     return pd.DataFrame(rows)
 
 
@@ -165,3 +170,45 @@ def against_circle(runs, *, reference="circle", n_boot=N_BOOT, seed=SEED) -> pd.
                         "ratio": est, "reference_ratio": ref})
     out = pd.DataFrame(rows, columns=[*COLUMNS, "ratio", "reference_ratio"])
     return with_robustness(out)
+
+
+def _mean_draws(values, *, rng, n_boot):
+    """``(mean, draws)``: the mean of a ``(clusters, radii)`` matrix over both axes and its
+    bootstrap replicates, clusters resampled with their radii (`cluster_bootstrap`)."""
+    boot = cluster_bootstrap(lambda idx: np.nanmean(values[idx], axis=(1, 2)),
+                             values.shape[0], n_boot=n_boot, rng=rng)
+    return boot.estimate, boot.replicates
+
+
+def against_free(runs, free, *, n_boot=N_BOOT, seed=SEED) -> pd.DataFrame:
+    """Each system's mean FTLE over the free disk's in the same table, per (table, rule,
+    system), at the sweep's radii (module docstring); ``runs`` is `per_ic`'s table,
+    ``free`` `kicktimes.studies.tables.one_disk.free_runs`'s.
+
+    Returns
+    -------
+    pandas.DataFrame
+        ``table, rule, system, ftle, free_ftle, estimate, ci_low, ci_high, verdict,
+        verdict_at_margin`` (the ratio's 95 % interval; verdicts at ±10 % and at the FTLE's
+        margin).
+    """
+    tol = margin_of("ftle")
+    radii = sorted(runs["radius"].unique())
+    rows = []
+    for k, table in enumerate(t for t in TABLES if t in set(runs["table"])):
+        f = free[(free["table"] == table) & free["radius"].isin(radii)]
+        lam_free = f.pivot_table(index="state", columns="radius", values="ftle").to_numpy()
+        base, base_draws = _mean_draws(lam_free, rng=np.random.default_rng([seed, k, 9]),
+                                       n_boot=n_boot)
+        for j, rule in enumerate(RULES):
+            g = runs[(runs["table"] == table) & (runs["rule"] == rule)]
+            for i, system in enumerate((REFERENCE, *KICKED)):
+                lam = g.pivot_table(index="ic", columns="radius", values=system).to_numpy()
+                est, draws = _mean_draws(lam, rng=np.random.default_rng([seed, k, j, i]),
+                                         n_boot=n_boot)
+                low, high = percentile_interval(draws / base_draws)
+                rows.append({"table": table, "rule": rule, "system": system, "ftle": est,
+                             "free_ftle": base, "estimate": est / base, "ci_low": low,
+                             "ci_high": high, "verdict": ratio_verdict(low, high),
+                             "verdict_at_margin": ratio_verdict(low, high, tolerance=tol)})
+    return pd.DataFrame(rows)

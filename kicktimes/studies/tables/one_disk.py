@@ -13,9 +13,9 @@ moves as a point in the centre's region ``D_r`` (the table shrunk by ``r``):
   for ``a = 1`` (Benettin & Strelcyn, Phys. Rev. A 17, 773 (1978); tests/test_tables.py
   checks it at ``r = 1e-9``).
 
-`free_ftle` is the FTLE of the free disk over the sweep's horizon from invariant-measure
+`free_runs` is the FTLE of the free disk over the sweep's horizon from invariant-measure
 states (`kicktimes.tables.uniform_state`, `kicktimes.tables.free_run`), the baseline the
-two-disk and kicked FTLEs of the sweep are read against.
+two-disk and kicked FTLEs of the sweep are read against (`free_ftle` summarises it).
 """
 
 from __future__ import annotations
@@ -28,7 +28,7 @@ import pandas as pd
 from kicktimes.stats import cluster_bootstrap
 from kicktimes.tables import Ellipse, free_run, uniform_state
 
-__all__ = ["POINT_RADIUS", "focal_drift", "focal_product", "free_ftle"]
+__all__ = ["POINT_RADIUS", "focal_drift", "focal_product", "free_ftle", "free_runs"]
 
 #: the radius that stands for a point particle (the integral is then kept to round-off)
 POINT_RADIUS = 1e-9
@@ -51,10 +51,38 @@ def focal_product(table: Ellipse, positions, velocities) -> np.ndarray:
     return l1 * l2
 
 
-def free_ftle(tables, radii, *, n_states, horizon, seed, n_boot=1000) -> pd.DataFrame:
-    """The free disk's FTLE per (table, radius): the mean over ``n_states`` invariant-measure
-    states of the tangent-map FTLE over ``horizon`` (`kicktimes.tables.free_run`), its 95 %
-    bootstrap interval over states, and the horizon's shear scale ``ln(T) / T``.
+def free_runs(tables, radii, *, n_states, horizon, seed) -> pd.DataFrame:
+    """The free disk's FTLE per state: ``n_states`` invariant-measure states per (table,
+    radius), each run over ``horizon`` with its tangent vector (`kicktimes.tables.free_run`).
+
+    Returns
+    -------
+    pandas.DataFrame
+        ``table, radius, state, ftle``.
+
+    Examples
+    --------
+    >>> from kicktimes.tables import Circle
+    >>> runs = free_runs({"circle": Circle()}, [0.02], n_states=2, horizon=100.0, seed=1)
+    >>> list(runs.columns), len(runs)
+    (['table', 'radius', 'state', 'ftle'], 2)
+    """
+    rows = []
+    for k, (name, table) in enumerate(tables.items()):
+        for j, r in enumerate(radii):
+            rng = np.random.default_rng([seed, k, j])
+            for i in range(n_states):
+                run = free_run(table, uniform_state(table, r, rng=rng), r, t_max=horizon,
+                               n_record=0, rng=rng)
+                rows.append({"table": name, "radius": float(r), "state": i,
+                             "ftle": run.lyapunov})
+    return pd.DataFrame(rows)
+
+
+def free_ftle(runs, *, horizon, n_boot=1000, seed=0) -> pd.DataFrame:
+    """The free disk's FTLE per (table, radius) from `free_runs`: the mean over states, its
+    95 % bootstrap interval over states (`kicktimes.stats.cluster_bootstrap`), and the
+    horizon's shear scale ``ln(T) / T`` (an integrable table's FTLE over ``T``).
 
     Returns
     -------
@@ -64,23 +92,19 @@ def free_ftle(tables, radii, *, n_states, horizon, seed, n_boot=1000) -> pd.Data
     Examples
     --------
     >>> from kicktimes.tables import Circle
-    >>> t = free_ftle({"circle": Circle()}, [0.02], n_states=4, horizon=200.0, seed=1)
+    >>> runs = free_runs({"circle": Circle()}, [0.02], n_states=4, horizon=200.0, seed=1)
+    >>> t = free_ftle(runs, horizon=200.0)
     >>> bool(t["ftle"].iloc[0] < 5 * t["shear_scale"].iloc[0])
     True
     """
     rows = []
-    for k, (name, table) in enumerate(tables.items()):
-        for j, r in enumerate(radii):
-            rng = np.random.default_rng([seed, k, j])
-            lam = [free_run(table, uniform_state(table, r, rng=rng), r, t_max=horizon,
-                            n_record=0, rng=rng).lyapunov for _ in range(n_states)]
-            lam = np.asarray(lam, float)
-            boot = cluster_bootstrap(lambda idx, lam=lam: lam[idx].mean(axis=1), lam.size,
-                                     n_boot=n_boot, rng=rng)
-            rows.append({"table": name, "radius": float(r), "n_states": n_states,
-                         "horizon": float(horizon), "ftle": boot.estimate,
-                         "ci_low": boot.ci_low, "ci_high": boot.ci_high,
-                         "shear_scale": math.log(horizon) / horizon})
+    for k, ((table, r), g) in enumerate(runs.groupby(["table", "radius"], sort=False)):
+        lam = g["ftle"].to_numpy(float)
+        boot = cluster_bootstrap(lambda idx, lam=lam: lam[idx].mean(axis=1), lam.size,
+                                 n_boot=n_boot, rng=np.random.default_rng([seed, k]))
+        rows.append({"table": table, "radius": float(r), "n_states": lam.size,
+                     "horizon": float(horizon), "ftle": boot.estimate, "ci_low": boot.ci_low,
+                     "ci_high": boot.ci_high, "shear_scale": math.log(horizon) / horizon})
     return pd.DataFrame(rows)
 
 

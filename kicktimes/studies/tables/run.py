@@ -12,12 +12,20 @@ import os
 import time
 from dataclasses import dataclass
 
+import pandas as pd
+
 from kicktimes.render.pages import header
 from kicktimes.studies.cache import cached_table
 from kicktimes.studies.options import study_run
-from kicktimes.studies.tables.compare import against_circle, findings, mean_ftle, per_ic
+from kicktimes.studies.tables.compare import (
+    against_circle,
+    against_free,
+    findings,
+    mean_ftle,
+    per_ic,
+)
 from kicktimes.studies.tables.figures import tables_figure
-from kicktimes.studies.tables.one_disk import POINT_RADIUS, focal_drift, free_ftle
+from kicktimes.studies.tables.one_disk import POINT_RADIUS, focal_drift, free_ftle, free_runs
 from kicktimes.studies.tables.page import SOURCES, answers, body
 from kicktimes.studies.tables.sweep import RADII, RULES, SEED, TABLES, run_stores, tables_experiment
 
@@ -36,10 +44,10 @@ class TablesScale:
     drift_bounces: int
 
 
-#: ``paper``: the sizes of docs/results/tables.md (200 ICs, the paper's horizon 25000 x 0.2;
-#: about a minute on 2 cores); ``quick``: seconds
+#: ``paper``: the sizes of docs/results/tables.md (2000 ICs, the paper's horizon 25000 x 0.2;
+#: about four minutes on 2 cores); ``quick``: seconds
 SCALES = {
-    "paper": TablesScale(200, 5000.0, 200, 50, 10_000),
+    "paper": TablesScale(2000, 5000.0, 200, 50, 10_000),
     "quick": TablesScale(6, 300.0, 10, 4, 1000),
 }
 
@@ -87,10 +95,21 @@ def reproduce(out: str | os.PathLike, *, scale: str = "quick", results_dir=None,
     stores = {key: named[exp.name] for key, exp in experiments.items()}
     run.say(f"sweep done at {time.perf_counter() - t0:.0f} s")
     params = {"radii": list(RADII), "tables": [repr(t) for t in TABLES.values()],
-              "states": sizes.free_states, "horizon": sizes.horizon, "seed": SEED}
-    free = cached_table(run.cache / "free_disk.parquet", params, lambda: free_ftle(
-        TABLES, RADII, n_states=sizes.free_states, horizon=sizes.horizon, seed=SEED),
-        progress=run.say).table
+              "point": POINT_RADIUS, "states": sizes.free_states, "horizon": sizes.horizon,
+              "seed": SEED}
+
+    def free_states():
+        # every table at the sweep's radii, and the stadium's point particle
+        return pd.concat([
+            free_runs(TABLES, RADII, n_states=sizes.free_states, horizon=sizes.horizon,
+                      seed=SEED),
+            free_runs({"stadium": TABLES["stadium"]}, [POINT_RADIUS],
+                      n_states=sizes.free_states, horizon=sizes.horizon, seed=SEED + 1)],
+            ignore_index=True)
+
+    free_states = cached_table(run.cache / "free_disk.parquet", params, free_states,
+                               progress=run.say).table
+    free = free_ftle(free_states, horizon=sizes.horizon, seed=SEED)
     params = {"radii": [POINT_RADIUS, *RADII], "table": repr(TABLES["ellipse"]),
               "states": sizes.drift_states, "bounces": sizes.drift_bounces, "seed": SEED}
     drift = cached_table(run.cache / "focal_drift.parquet", params, lambda: focal_drift(
@@ -100,19 +119,22 @@ def reproduce(out: str | os.PathLike, *, scale: str = "quick", results_dir=None,
     found, curves = findings(stores)
     runs = per_ic(stores)
     against = against_circle(runs)
+    free_ratio = against_free(runs, free_states)
     means = mean_ftle(runs)
+    by_radius = mean_ftle(runs, per_radius=True)
     for name, frame in (("findings", found), ("findings_by_radius", curves),
-                        ("against_circle", against), ("ftle", means), ("free_disk", free),
+                        ("against_circle", against), ("against_free", free_ratio),
+                        ("ftle", means), ("ftle_by_radius", by_radius), ("free_disk", free),
                         ("focal_drift", drift)):
         run.write_csv(f"tables_{name}.csv", frame)
-    run.write_figure("tables.png", tables_figure(curves))
+    run.write_figure("tables.png", tables_figure(curves, by_radius, free))
     lines = header(
         "The paper's comparison in the circle, the ellipse and the stadium", run.command,
         ["the sweep's stores " + ", ".join(f"`{exp.name}`" for exp in experiments.values()),
          f"the free disk's runs (`kicktimes.studies.tables.one_disk`, cached in "
          f"`{run.cache.name}`)"])
-    lines += answers(found, against, free, drift) + [""]
-    lines += body(found, against, means, free, drift, n_ics=sizes.n_ics,
-                  horizon=sizes.horizon)
+    lines += answers(found, against, free_ratio, free, n_ics=sizes.n_ics) + [""]
+    lines += body(found, means, free, drift, n_ics=sizes.n_ics, horizon=sizes.horizon,
+                  radii=RADII)
     run.say(f"page at {time.perf_counter() - t0:.0f} s")
     return run.write_page(lines, SOURCES)
