@@ -29,6 +29,36 @@ def test_simulate_writes_collisions_and_prints_the_kinetic_expectation(tmp_path)
     assert [p.name for p in out.iterdir()] == ["collisions.parquet"]
 
 
+def test_simulate_in_a_table(tmp_path):
+    out = tmp_path / "st"
+    result = CliRunner().invoke(main, ["simulate", "--table", "stadium", "--a", "1", "-r", "0.02",
+                                       "--n-ics", "10", "--t-max", "500", "--out", str(out)])
+    assert result.exit_code == 0, result.output
+    assert "table=Stadium(a=1.0)" in result.output and "10 ICs (uniform)" in result.output
+    meta = json.loads(pq.read_table(out / "collisions.parquet").schema.metadata[b"kicktimes"])
+    assert meta["table"] == "stadium a=1.0" and meta["ic_method"] == "uniform"
+    res = CliRunner().invoke(main, ["simulate", "--table", "ellipse", "--a", "1.25", "--b", "0.8",
+                                    "--disks", "50", "--packing", "0.1", "--t-max", "2",
+                                    "--out", str(tmp_path / "el")])
+    assert res.exit_code == 0, res.output
+    assert "table=Ellipse(a=1.25, b=0.8)" in res.output and "Enskog-Henderson" in res.output
+
+
+@pytest.mark.parametrize(("args", "text"), [
+    (["--table", "ellipse", "--a", "1.25"], "--table ellipse needs --b"),
+    (["--table", "circle", "--a", "1"], "--a do not apply to --table circle"),
+    (["--table", "stadium", "--a", "1", "--ic-method", "paper"], "--ic-method"),
+    (["--table", "ellipse", "--a", "1", "--b", "2"], "--b must lie in"),
+    (["--table", "stadium", "--a", "1", "--disks", "10", "--packing", "0.1", "--box", "2"],
+     "--box and --table"),
+])
+def test_simulate_table_errors_name_the_option(tmp_path, args, text):
+    result = CliRunner().invoke(main, ["simulate", *args, "-r", "0.02", "--out",
+                                       str(tmp_path / "x")])
+    assert result.exit_code != 0
+    assert text in result.output and "Traceback" not in result.output
+
+
 def test_simulate_rejects_a_bad_radius(tmp_path):
     result = CliRunner().invoke(main, ["simulate", "-r", "0.7", "--out", str(tmp_path / "x")])
     assert result.exit_code != 0
@@ -206,3 +236,26 @@ def test_the_sweep_kernels_are_loaded_before_a_pool_forks(monkeypatch, workers, 
     if loads is None:  # the default pool: one worker per core
         loads = (os.cpu_count() or 1) > 1
     assert calls == (["warm_sweep"] if loads else [])
+
+
+def test_run_an_experiment_in_a_table_from_toml(tmp_path):
+    toml = tmp_path / "stadium.toml"
+    toml.write_text('name = "st"\nradii = [0.02]\nn_ics = 2\nn_steps = 50\ntau = 2.0\n'
+                    'ic_method = "uniform"\ntable = "stadium a=1"\nsampling = "uniform"\n'
+                    'systems = ["two_particle", "poisson"]\ndiagnostics = ["lyapunov"]\n'
+                    'lyapunov_method = "tangent"\n', encoding="utf-8")
+    exp = Experiment.from_toml(toml)
+    assert exp.table == "stadium a=1.0" and Experiment.from_toml_string(exp.to_toml()) == exp
+    out = tmp_path / "store"
+    result = CliRunner().invoke(main, ["run", str(toml), "--out", str(out), "--workers", "1"])
+    assert result.exit_code == 0, result.output
+    from kicktimes.experiment import load_store
+
+    res = load_store(out).results
+    lam = res[(res["diagnostic"] == "lyapunov") & (res["system"] == "poisson")]["value"]
+    assert len(lam) == 2 and (lam > 0.2).all()   # the stadium's own exponent is ~0.43
+    bad = tmp_path / "bad.toml"
+    bad.write_text(toml.read_text(encoding="utf-8").replace('"stadium a=1"', '"sinai a=1"'),
+                   encoding="utf-8")
+    result = CliRunner().invoke(main, ["run", str(bad), "--out", str(tmp_path / "b")])
+    assert result.exit_code != 0 and "table" in result.output
