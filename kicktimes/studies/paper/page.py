@@ -471,10 +471,7 @@ def write_results(
                "Per family: "
                + ", ".join(f"[{d}.md]({d}.md)" for d in details)
                + "".join(f" ([both families]({f}.png))" for f, _ in family_figures)
-               + ". The other studies: [science.md](science.md), [mechanism.md](mechanism.md),"
-               " [escape.md](escape.md), [unequal.md](unequal.md), [scatter.md](scatter.md), "
-               "[mmpp.md](mmpp.md), [disks.md](disks.md), [small_r.md](small_r.md), "
-               "[paper.md](paper.md).", ""]
+               + ". The other studies: " + _other_studies() + ".", ""]
     below = [f"{name}: {scale}" for name, paper, scale, *_ in details_args if not paper]
     if below:  # the page's answers stand on stores below the paper's scale: it says so first
         screen = [f"> **Below paper scale** ({'; '.join(below)}): a pipeline check; its "
@@ -484,3 +481,12 @@ def write_results(
 
     return write_results_page(out / "README.md", lines, results_sources(
         written, merged, by_radius, gaps=has_gaps, nulls=bool(nulls)))
+
+
+def _other_studies() -> str:
+    """Links to every other study's page, in `kicktimes.studies.STUDIES` order, the
+    protocol study's paper.md last."""
+    from kicktimes.studies import STUDIES
+
+    pages = [s.page for s in STUDIES.values() if s.name not in ("paper", "protocol")]
+    return ", ".join(f"[{p}]({p})" for p in [*pages, STUDIES["protocol"].page])
