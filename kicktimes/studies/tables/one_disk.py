@@ -41,7 +41,7 @@ def focal_product(table: Ellipse, positions, velocities) -> np.ndarray:
 
     Examples
     --------
-    >>> float(focal_product(Ellipse(1.25, 0.8), [[0.0, 0.0]], [[0.0, 1.0]])[0])
+    >>> round(float(focal_product(Ellipse(1.25, 0.8), [[0.0, 0.0]], [[0.0, 1.0]])[0]), 12)
     -0.9225
     """
     c = math.sqrt(table.a ** 2 - table.b ** 2)
@@ -123,7 +123,7 @@ def focal_drift(table: Ellipse, radii, *, n_states, n_bounces, seed) -> pd.DataF
     Examples
     --------
     >>> d = focal_drift(Ellipse(1.25, 0.8), [1e-9], n_states=2, n_bounces=1000, seed=0)
-    >>> bool(d["max_drift"].iloc[0] < 1e-10)
+    >>> bool(d["max_drift"].iloc[0] < 1e-8)   # O(r): the centre's curve is not the ellipse
     True
     """
     rows = []

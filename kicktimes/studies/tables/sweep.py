@@ -1,18 +1,20 @@
 r"""The sweeps of the tables study: the paper's comparison in the circle, the ellipse and the
 stadium, one store per (table, collision rule).
 
-Each table's experiment is the paper's family design at three radii (0.01, 0.02, 0.03),
-over the paper's horizon (25000 steps of 0.2), with invariant-measure ICs (the paper's
-construction is the circle's), the tangent-space FTLE (exact per unit time, so the run is
-sampled at uniform times only for the store's bookkeeping) and the systems the question
-needs: the two disks, the disk kicked at Poisson times of the IC's own rate, at the two
-disks' actual collision times, and by scattering kicks at Poisson times. The mirror
-rule's store is the primary (``tables_<table>``); the elastic rule's
-(``tables_<table>-elastic``) is its collision-rule control, which
-`kicktimes.report.controls.merge_control_families` folds in by its name.
+Each table's experiment is the paper's family A design (`kicktimes.experiment.presets`:
+25000 collision-truncated steps of 0.2, recurrence at eps = 1e-3 and 1e-2 on the paper's
+samples and at uniform times, the autocorrelation of the boundary angles, the paper's
+tangent-space FTLE variant) at three radii (0.01, 0.02, 0.03), with invariant-measure ICs
+(the paper's construction is the circle's) and the systems the question needs: the two
+disks, the disk kicked at Poisson times of the IC's own rate, at the two disks' actual
+collision times, and by scattering kicks at Poisson times. The mirror rule's store is the
+primary (``tables_<table>``); the elastic rule's (``tables_<table>-elastic``) is its
+collision-rule control, which `kicktimes.report.controls.merge_control_families` folds in
+by its name.
 
-`kicktimes.studies.tables.compare` computes every store's findings with the estimators
-and verdict rules of the circle's pages (`kicktimes.report.controls.compute_controls`).
+The sweep report (`kicktimes.report.build_report`) computes every store's findings with
+the estimators and verdict rules of the circle's pages; `kicktimes.studies.tables.compare`
+reads them.
 """
 
 from __future__ import annotations
@@ -21,7 +23,7 @@ from kicktimes.experiment import Experiment
 from kicktimes.studies.cache import study_store
 from kicktimes.tables import Circle, Ellipse, Stadium, table_spec
 
-__all__ = ["N_SAMPLES", "RADII", "RULES", "SEED", "SYSTEMS", "TABLES", "family_name", "run_stores",
+__all__ = ["RADII", "RULES", "SEED", "SYSTEMS", "TABLES", "family_name", "run_stores",
            "tables_experiment"]
 
 #: the tables, by their short name: the integrable circle; an ellipse of the circle's area
@@ -49,23 +51,19 @@ def family_name(table: str, rule: str) -> str:
     return f"tables_{table}" + ("" if rule == "mirror" else f"-{rule}")
 
 
-#: samples per run (bookkeeping only: the tangent FTLE is sample-free)
-N_SAMPLES = 1000
+def tables_experiment(table: str, rule: str, *, n_ics: int, n_steps: int = 25000,
+                      tau: float = 0.2, radii=RADII, seed: int = SEED,
+                      block_size: int = 25) -> Experiment:
+    """The experiment of one (table, rule) (module docstring).
 
-
-def tables_experiment(table: str, rule: str, *, n_ics: int, horizon: float, radii=RADII,
-                      seed: int = SEED, block_size: int = 25) -> Experiment:
-    """The experiment of one (table, rule) (module docstring); ``horizon`` is each run's
-    length in time (the paper's: 25000 steps of 0.2, 5000).
-
-    >>> exp = tables_experiment("ellipse", "mirror", n_ics=200, horizon=5000.0)
-    >>> exp.name, exp.table, exp.radii, exp.ic_method, exp.horizon
-    ('tables_ellipse', 'ellipse a=1.25 b=0.8', (0.01, 0.02, 0.03), 'uniform', 5000.0)
+    >>> exp = tables_experiment("ellipse", "mirror", n_ics=200)
+    >>> exp.name, exp.table, exp.radii, exp.ic_method, exp.n_steps, exp.tau
+    ('tables_ellipse', 'ellipse a=1.25 b=0.8', (0.01, 0.02, 0.03), 'uniform', 25000, 0.2)
     """
     return Experiment(
-        name=family_name(table, rule), radii=radii, n_ics=n_ics, n_steps=N_SAMPLES,
-        tau=horizon / N_SAMPLES, ic_method="uniform", seed=seed, sampling="uniform",
-        rule=rule, diagnostics=("lyapunov",), lyapunov_method="tangent",
+        name=family_name(table, rule), radii=radii, n_ics=n_ics, n_steps=n_steps, tau=tau,
+        ic_method="uniform", seed=seed, sampling="paper", rule=rule, eps=(1e-3, 1e-2),
+        rr_sampling="run+uniform", lyapunov_variant="paper", lyapunov_method="tangent",
         systems=SYSTEMS, block_size=block_size, table=table_spec(TABLES[table]),
         description=f"the paper's comparison in the {table} ({table_spec(TABLES[table])}) "
                     f"under the {rule} rule, invariant-measure ICs")
