@@ -28,13 +28,20 @@ from kicktimes.tables import Circle, Ellipse, Stadium
 
 
 def test_the_experiments_are_the_paper_design_in_each_table():
-    exp = tables_experiment("stadium", "elastic", n_ics=200, horizon=5000.0)
+    exp = tables_experiment("stadium", "elastic", n_ics=200)
     assert exp.name == "tables_stadium-elastic" and exp.rule == "elastic"
     assert exp.table == "stadium a=1.0" and exp.ic_method == "uniform"
     assert exp.horizon == pytest.approx(5000.0) and exp.radii == (0.01, 0.02, 0.03)
+    # the paper's family A protocol, but for its ICs (the paper's are the circle's)
+    from kicktimes.experiment.presets import PRESETS
+
+    family_a = PRESETS["family_a"]
+    for field in ("n_steps", "tau", "sampling", "eps", "rr_sampling", "lyapunov_variant",
+                  "lyapunov_method", "diagnostics"):
+        assert getattr(exp, field) == getattr(family_a, field), field
     assert set(exp.systems) == {"two_particle", "poisson", "actual", "poisson_scatter"}
     # a circle store's hash is the table-free experiment's (the field's default)
-    circle = tables_experiment("circle", "mirror", n_ics=4, horizon=100.0)
+    circle = tables_experiment("circle", "mirror", n_ics=4, n_steps=100)
     assert circle.table == "circle"
     assert circle.hash() == type(circle).from_dict(
         {k: v for k, v in circle.to_dict().items() if k != "table"}).hash()
@@ -113,7 +120,8 @@ def test_the_free_disk_is_chaotic_only_in_the_stadium():
 
 
 def test_scales():
-    assert SCALES["paper"].n_ics == 2000 and SCALES["paper"].horizon == 5000.0
+    assert SCALES["paper"].n_ics == 200
+    assert SCALES["paper"].n_steps * SCALES["paper"].tau == pytest.approx(5000.0)
     assert sorted(TABLES) == ["circle", "ellipse", "stadium"]
     with pytest.raises(ValueError, match="scale must be one of"):
         reproduce("unused", scale="huge")

@@ -9,10 +9,11 @@ circle, in an ellipse (integrable for a point, nearly so for a disk) and in Buni
 stadium (chaotic), under both collision rules, and writes ``tables.md`` with its tables
 ``tables_*.csv`` and its figure:
 
-1. **The sweep** (`sweep`): one store per (table, rule), 2000 invariant-measure ICs at
-   r = 0.01, 0.02, 0.03 over the paper's horizon.
-2. **The comparisons** (`compare`): the kicked / two-disk ratio per table under the
-   findings tables' controls, and each table's ratio over the circle's.
+1. **The sweep** (`sweep`): one store per (table, rule), the paper's family A protocol
+   with 200 invariant-measure ICs at r = 0.01, 0.02, 0.03, and its sweep report.
+2. **The comparisons** (`compare`): the report's findings per table (FTLE, recurrence,
+   1 − R₁, the Poisson question, the counts) under their controls, each table's FTLE
+   ratio over the circle's, each system's FTLE over the free disk's.
 3. **The free disk** (`one_disk`): its own FTLE in each table and the drift of the
    ellipse's focal integral.
 
@@ -23,7 +24,7 @@ Examples
 --------
 >>> from kicktimes.studies.tables import SCALES, TABLES
 >>> SCALES["paper"].n_ics, sorted(TABLES)
-(2000, ['circle', 'ellipse', 'stadium'])
+(200, ['circle', 'ellipse', 'stadium'])
 """
 
 from __future__ import annotations
@@ -31,6 +32,7 @@ from __future__ import annotations
 from kicktimes.studies.tables.compare import (
     against_circle,
     against_free,
+    elastic_speeds,
     findings,
     mean_ftle,
     per_ic,
@@ -48,7 +50,6 @@ from kicktimes.studies.tables.sweep import (
 )
 
 __all__ = ["RADII", "RULES", "SCALES", "TABLES", "TablesScale", "against_circle",
-           "against_free", "family_name", "findings", "focal_drift", "focal_product",
-           "free_ftle", "free_runs",
-           "mean_ftle", "per_ic", "reproduce", "run_stores", "tables_experiment",
-           "tables_figure"]
+           "against_free", "elastic_speeds", "family_name", "findings", "focal_drift",
+           "focal_product", "free_ftle", "free_runs", "mean_ftle", "per_ic", "reproduce",
+           "run_stores", "tables_experiment", "tables_figure"]

@@ -1,11 +1,14 @@
 r"""The tables study's comparisons: the kicked / two-disk FTLE ratio in each table, and each
 table's ratio against the circle's.
 
-* `findings` -- per table, every kicked system's FTLE ratio to the two disks under the
-  controls of every findings table (`kicktimes.report.controls.compute_controls`: the
-  paired median, the sticky runs left out; the elastic store folded in as the collision
-  rule's control by `kicktimes.report.controls.merge_control_families`), and the two-disk
-  collision counts against the table's kinetic rate (`kicktimes.stats.kinetic_rate`).
+* `findings` -- per table, the sweep report's findings (`kicktimes.report.build_report`,
+  the estimators and verdict rules of the circle's pages): every kicked system's FTLE,
+  recurrence and decorrelation ratio to the two disks under their controls (the paired
+  median, the sticky runs left out, the paper's samples for the recurrence), the Poisson
+  question of the two disks' collision times against its null streams, the collision
+  counts against the table's kinetic rate (`kicktimes.stats.kinetic_rate`); the elastic
+  store folded in as the collision rule's control by
+  `kicktimes.report.controls.merge_control_families`.
 * `against_circle` -- the question of the study: does the kicked disk's FTLE deficit
   depend on the table's integrability? Per kicked system, the table's ratio over the
   circle's,
@@ -36,12 +39,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from kicktimes.report.controls import (
-    COLUMNS,
-    compute_controls,
-    merge_control_families,
-    with_robustness,
-)
+from kicktimes.report.controls import COLUMNS, merge_control_families, with_robustness
 from kicktimes.report.counts import sticky_ics
 from kicktimes.report.store import REFERENCE, wide
 from kicktimes.stats import (
@@ -53,8 +51,8 @@ from kicktimes.stats import (
 )
 from kicktimes.studies.tables.sweep import RULES, SEED, TABLES, family_name
 
-__all__ = ["KICKED", "N_BOOT", "against_circle", "against_free", "findings", "mean_ftle",
-           "per_ic"]
+__all__ = ["KICKED", "N_BOOT", "against_circle", "against_free", "elastic_speeds", "findings",
+           "mean_ftle", "per_ic"]
 
 #: the kicked systems of the sweep, as the pages name them
 KICKED = {"poisson": "uniform kicks at Poisson times",
@@ -65,20 +63,21 @@ N_BOOT = 2000
 _CONTROL = {"mirror": "primary", "elastic": "elastic"}
 
 
-def findings(stores, *, n_boot=N_BOOT) -> tuple[pd.DataFrame, pd.DataFrame]:
-    """Every store's findings (module docstring), the elastic stores folded into their
-    table's family: ``{(table, rule): Store}`` in; out the findings table (`COLUMNS`) and
-    its ratios per radius (``table, rule`` and the curves of
-    `kicktimes.report.controls.Controls`)."""
+def findings(report_dir, stores) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """The sweep report's findings of every store (module docstring), read from
+    ``report_dir`` (`kicktimes.report.build_report` of the stores: ``<name>_findings.csv``
+    and ``<name>_findings_by_radius.csv``), the elastic stores folded into their table's
+    family. ``stores`` is ``{(table, rule): Store}``; out the findings table (`COLUMNS`)
+    and its ratios per radius (with ``table, rule``)."""
+    from pathlib import Path
+
+    report_dir = Path(report_dir)
     tables, curves = [], []
     for (table, rule), store in sorted(stores.items()):
-        exp = store.experiment
-        found = compute_controls(
-            store.results, store.collisions, family=exp.name, eps=exp.eps, rule=rule,
-            rng=np.random.default_rng([exp.seed, RULES.index(rule)]), n_boot=n_boot,
-            kinetic=exp.kinetic_rate)
-        tables.append(found.table)
-        curves.append(found.curves.assign(table=table, rule=rule))
+        name = store.experiment.name
+        tables.append(pd.read_csv(report_dir / f"{name}_findings.csv"))
+        curves.append(pd.read_csv(report_dir / f"{name}_findings_by_radius.csv")
+                      .assign(table=table, rule=rule))
     merged = merge_control_families(tables)
     table = pd.concat([merged[family_name(t, "mirror")] for t in TABLES if
                        family_name(t, "mirror") in merged], ignore_index=True)
@@ -211,4 +210,30 @@ def against_free(runs, free, *, n_boot=N_BOOT, seed=SEED) -> pd.DataFrame:
                              "free_ftle": base, "estimate": est / base, "ci_low": low,
                              "ci_high": high, "verdict": ratio_verdict(low, high),
                              "verdict_at_margin": ratio_verdict(low, high, tolerance=tol)})
+    return pd.DataFrame(rows)
+
+
+def elastic_speeds(stores, *, system="poisson") -> pd.DataFrame:
+    """Under the elastic rule the disks' speeds differ from IC to IC (they share the pair's
+    energy) and the kicked disk keeps disk 0's: per (table, radius) of the elastic stores,
+    the range of that speed over the ICs and the correlation over ICs of the kicked FTLE
+    (``system``) and of the two-disk FTLE with it."""
+    from kicktimes import initial_conditions
+
+    rows = []
+    for (table, rule), store in sorted(stores.items()):
+        if rule != "elastic":
+            continue
+        exp = store.experiment
+        ics = initial_conditions(exp.n_ics, exp.ic_radius, rng=exp.seed, method=exp.ic_method,
+                                 rule=rule, table=exp.table_value)
+        speed = np.hypot(ics[:, 0, 2], ics[:, 0, 3])
+        lam = wide(store.results, "lyapunov")
+        for r, g in lam.groupby(level="radius"):
+            g = g.droplevel("radius").reindex(np.arange(exp.n_ics))
+            ok = np.isfinite(g[system]) & np.isfinite(g[REFERENCE])
+            rows.append({"table": table, "radius": float(r), "speed_min": float(speed.min()),
+                         "speed_max": float(speed.max()),
+                         "kicked_corr": float(np.corrcoef(speed[ok], g[system][ok])[0, 1]),
+                         "two_disk_corr": float(np.corrcoef(speed[ok], g[REFERENCE][ok])[0, 1])})
     return pd.DataFrame(rows)

@@ -9,6 +9,7 @@ from kicktimes.studies.tables.compare import (
     KICKED,
     against_circle,
     against_free,
+    elastic_speeds,
     findings,
     mean_ftle,
 )
@@ -27,6 +28,8 @@ SOURCES = (
     Source("tables_ftle_by_radius.csv", "ftle, ci_low, ci_high", mean_ftle),
     Source("tables_free_disk.csv", "ftle, ci_low, ci_high, shear_scale", free_ftle),
     Source("tables_focal_drift.csv", "max_drift, median_drift, ensemble_range", focal_drift),
+    Source("tables_elastic_speeds.csv", "speed_min, speed_max, kicked_corr, two_disk_corr",
+           elastic_speeds),
 )
 
 TOL = margin_of("ftle")
@@ -35,8 +38,10 @@ STADIUM_PUBLISHED = 0.43
 
 
 def _ci(row, digits=3):
+    """The interval printed so that its verdict at its own margin shows."""
+    tol = float(row["margin"]) if "margin" in row and row["margin"] == row["margin"] else TOL
     return format_interval(row["estimate"], row["ci_low"], row["ci_high"],
-                           edges=(1 - TOL, 1.0, 1 + TOL), digits=digits)
+                           edges=(1 - tol, 1.0, 1 + tol), digits=digits)
 
 
 def _pick(table, **where):
@@ -66,11 +71,11 @@ def _robustness(rows) -> str:
                                      for _, r in flips.iterrows())
 
 
-def _per_table(found, system):
+def _per_table(found, system, diagnostic="ftle"):
     return "; ".join(
         f"{t.split('_', 1)[1]} {_ci(_pick(g, control='primary'))}"
         f" ({_pick(g, control='primary')['verdict_at_margin']})"
-        for t, g in found[(found["diagnostic"] == "ftle") & (found["system"] == system)]
+        for t, g in found[(found["diagnostic"] == diagnostic) & (found["system"] == system)]
         .groupby("family", sort=False))
 
 
@@ -96,30 +101,54 @@ def _against(against, system):
     return "; ".join(parts)
 
 
+def _poisson(found) -> str:
+    """Per table: the Poisson verdict of the two disks' collision times (the report's
+    ``poisson@uniformity_ks`` row, `kicktimes.stats.poisson_verdict`) and whether the
+    elastic rule gives the same."""
+    rows = found[found["diagnostic"] == "poisson@uniformity_ks"]
+    parts = []
+    for family, g in rows.groupby("family", sort=False):
+        prim = _pick(g, control="primary")
+        others = g[g["control"] != "primary"]
+        same = (others["verdict"] == prim["verdict"]).all()
+        how = ("the same under " + ", ".join(others["control"]) if same and len(others)
+               else "; ".join(f"{r['control']}: {r['verdict']}" for _, r in others.iterrows()))
+        share = format_interval(prim["estimate"], prim["ci_low"], prim["ci_high"],
+                                edges=(), digits=2)
+        parts.append(f"{family.split('_', 1)[1]} {prim['verdict']} (rejection share {share}; "
+                     + (how or "no control") + ")")
+    return "; ".join(parts)
+
+
 def answers(found, against, free_ratio, free, *, n_ics) -> list[str]:
     """At most five one-line answers, each with its number, interval and caveat."""
     ell = _pick(against, family="tables_ellipse", system="poisson", control="primary")
-    not_alone = (" — the ellipse, integrable for a point like the circle, differs from it "
-                 "too, so integrability alone does not set it"
+    not_alone = ("; the ellipse, integrable for a point like the circle, differs from it "
+                 "too: integrability alone does not set it"
                  if ell["verdict_at_margin"] in ("higher", "lower") and ell["robust"] else "")
     fr = free_ratio[(free_ratio["rule"] == "mirror") & (free_ratio["system"] == "poisson")]
     point = free[(free["table"] == "stadium") & (free["radius"] == free["radius"].min())]
     at_r = free[(free["table"] == "stadium") & (free["radius"] > free["radius"].min())]
+    rr = margin_of("rr_offdiag")
     lines = [
-        f"- **Kicked / two-disk FTLE, uniform kicks at Poisson times** (mirror rule, {n_ics} "
-        f"ICs, verdict against 1 at ±{100 * TOL:g} %): {_per_table(found, 'poisson')}.",
-        f"- **Does this ratio depend on the table? {_answer(against, 'poisson')}**: "
-        f"{_against(against, 'poisson')}{not_alone}.",
+        f"- **Does the kicked disk's FTLE deficit depend on the table? "
+        f"{_answer(against, 'poisson')}** (uniform kicks at Poisson times, mirror rule, "
+        f"{n_ics} ICs per radius; kicked / two-disk at ±{100 * TOL:g} %): "
+        f"{_per_table(found, 'poisson')}; {_against(against, 'poisson')}{not_alone}.",
         "- **Against the free disk in the same table** (kicked FTLE / free disk's, mirror): "
         + "; ".join(f"{r['table']} {format_interval(r['estimate'], r['ci_low'], r['ci_high'])}"
                     f" ({r['verdict_at_margin']})" for _, r in fr.iterrows())
-        + f"; the free stadium disk: {at_r['ftle'].min():.3f}–"
-        f"{at_r['ftle'].max():.3f}, at r = {point['radius'].iloc[0]:g} "
+        + f"; the free stadium disk: {at_r['ftle'].min():.3f}–{at_r['ftle'].max():.3f}, at "
+        f"r = {point['radius'].iloc[0]:g} "
         f"{format_interval(*point[['ftle', 'ci_low', 'ci_high']].iloc[0])}"
         f" beside Benettin & Strelcyn's {STADIUM_PUBLISHED:g}.",
         f"- **Scattering kicks: does the ratio depend on the table? "
         f"{_answer(against, 'poisson_scatter')}**: kicked / two-disk "
         f"{_per_table(found, 'poisson_scatter')}; {_against(against, 'poisson_scatter')}.",
+        f"- **Recurrence and decorrelation, uniform kicks at Poisson times** (kicked / "
+        f"two-disk, mirror): off-diagonal RR at ε = 0.01 (±{100 * rr:g} %) "
+        f"{_per_table(found, 'poisson', 'rr_offdiag@0.01')}; 1 − R₁ (±"
+        f"{100 * margin_of('one_minus_r1'):g} %) {_per_table(found, 'poisson', 'one_minus_r1')}.",
     ]
     counts = found[(found["diagnostic"] == "counts") & (found["control"] == "primary")]
     band = margin_of("counts")
@@ -129,25 +158,46 @@ def answers(found, against, free_ratio, free, *, n_ics) -> list[str]:
                                edges=(1 - band, 1.0, 1 + band))
         how = "" if r["robust"] else f", depends on {r['depends_on']}"
         cells.append(f"{r['family'].split('_', 1)[1]} {text} ({r['verdict_at_margin']}{how})")
-    lines.append(f"- **Two-disk collisions over the table's kinetic rate** (count / Γ(r)T, "
-                 f"±{100 * band:g} %): " + "; ".join(cells) + ".")
+    lines.append(f"- **Are the two disks' collision times Poisson?** (the uniformity KS "
+                 f"test's rejection share against its calibrated null level and D against its "
+                 f"null stream, `stats.poisson_verdict`) {_poisson(found)}; their "
+                 f"counts over the table's kinetic rate Γ(r)T (±{100 * band:g} %): "
+                 + "; ".join(cells) + ".")
     return lines
 
 
+#: the ratio diagnostics of the body's table, with their names
+RATIO_DIAGNOSTICS = {"ftle": "FTLE", "rr_offdiag@0.01": "RR (ε = 0.01)",
+                     "one_minus_r1": "1 − R₁"}
+
+
 def _ratio_table(found) -> list[str]:
-    f = found[found["diagnostic"] == "ftle"]
+    """One row per (diagnostic, kicked system): per table the primary ratio, its verdict
+    at the diagnostic's margin, and ✓ (robust to every control) or the controls that change
+    it (every control's number is in tables_findings.csv)."""
+    f = found[found["diagnostic"].isin(RATIO_DIAGNOSTICS)]
     tables = list(dict.fromkeys(f["family"]))
-    lines = ["| kicked system | control | " + " | ".join(t.split("_", 1)[1] for t in tables)
-             + " |", "|---|---|" + "---|" * len(tables)]
-    for system, name in KICKED.items():
-        for control in dict.fromkeys(f["control"]):
+    lines = ["| diagnostic | kicked system | "
+             + " | ".join(t.split("_", 1)[1] for t in tables) + " |",
+             "|---|---|" + "---|" * len(tables)]
+    for diagnostic, label in RATIO_DIAGNOSTICS.items():
+        d = f[f["diagnostic"] == diagnostic]
+        for system, name in KICKED.items():
             cells = []
             for t in tables:
-                g = f[(f["family"] == t) & (f["system"] == system) & (f["control"] == control)]
-                cells.append(f"{_ci(g.iloc[0])} {g.iloc[0]['verdict_at_margin']}"
-                             if len(g) else "")
-            lines.append(f"| {name} | {control} | " + " | ".join(cells) + " |")
-    return lines + [""]
+                g = d[(d["family"] == t) & (d["system"] == system)]
+                if g.empty:
+                    cells.append("")
+                    continue
+                prim = _pick(g, control="primary")
+                changed = ", ".join(
+                    g["control"][g["verdict_at_margin"] != prim["verdict_at_margin"]])
+                mark = "✓" if bool(prim["robust"]) else f"✗ {changed or 'direction'}"
+                cells.append(f"{_ci(prim)} {prim['verdict_at_margin']} {mark}".rstrip())
+            lines.append(f"| {label} | {name} | " + " | ".join(cells) + " |")
+    return lines + ["", "✓: every control (the paired median, the sticky runs left out, the "
+                    "elastic rule; for RR also the paper's samples) gives the same verdict in "
+                    "the same direction; ✗: the controls whose verdict differs.", ""]
 
 
 def _mean_table(means) -> list[str]:
@@ -176,7 +226,7 @@ def _free_table(free, drift) -> list[str]:
     return lines + [""]
 
 
-def body(found, means, free, drift, *, n_ics, horizon, radii) -> list[str]:
+def body(found, means, free, drift, speeds, *, n_ics, horizon, radii) -> list[str]:
     """The page after its answers: the design, the tables behind the answers, what is not
     shown."""
     lines = [
@@ -184,24 +234,30 @@ def body(found, means, free, drift, *, n_ics, horizon, radii) -> list[str]:
         f"The paper's comparison in three tables: the unit circle, an ellipse of semi-axes "
         f"1.25 and 0.8 (the circle's area; integrable for a point particle, not exactly for "
         f"a disk, whose centre moves in the ellipse's parallel curve) and Bunimovich's "
-        f"stadium with a = 1 (chaotic). Per table and collision rule one store: {n_ics} "
-        f"invariant-measure ICs at r = {', '.join(f'{r:g}' for r in radii)}, each run over "
-        f"the paper's horizon T = {horizon:g}, the tangent-space FTLE of the two disks and of "
-        "the disk kicked (uniform kicks at Poisson times of the IC's rate or at the two "
-        "disks' collision times; scattering kicks at Poisson times). Ratios are per radius "
-        "ratios of ensemble means averaged over radii, 95 % intervals from the bootstrap "
-        "clustered on ICs; against the circle or the free disk, the two independent "
-        "bootstraps divide (`kicktimes.studies.tables.compare`). Verdicts are read at the "
-        f"FTLE's margin ±{100 * TOL:g} % (`verdict_at_margin` in the CSVs; `verdict` is "
-        "the common ±10 % band). The circle here is this protocol's (invariant-measure ICs, "
-        "three radii, T = 5000): the README's family A uses the paper's ICs and radii, so "
-        "its numbers differ; its `elastic+invariant_ics` control is the comparable row.", "",
+        f"stadium with a = 1 (chaotic). Per table and collision rule one store of the "
+        f"paper's family A protocol: {n_ics} invariant-measure ICs at r = "
+        f"{', '.join(f'{r:g}' for r in radii)}, 25000 collision-truncated steps of 0.2 "
+        f"(at most T = {horizon:g}), the tangent-space FTLE (the paper's variant), the "
+        "recurrence rate at ε = 10⁻³ and 10⁻² on uniform-time samples (the paper's samples "
+        "a control) and the autocorrelation of the boundary angles, of the two disks and "
+        "of the disk kicked (uniform kicks at Poisson times of the IC's rate or at the two "
+        "disks' collision times; scattering kicks at Poisson times). The sweep report "
+        "(`kicktimes.report`) computes every finding with the circle pages' estimators and "
+        "verdict rules: ratios are per radius ratios of ensemble means averaged over radii, "
+        "95 % intervals from the bootstrap clustered on ICs; against the circle or the free "
+        "disk, the two independent bootstraps divide (`kicktimes.studies.tables.compare`). "
+        f"Verdicts are read at each diagnostic's margin (FTLE ±{100 * TOL:g} %, RR "
+        f"±{100 * margin_of('rr_offdiag'):g} %, counts ±{100 * margin_of('counts'):g} %, else "
+        "±10 %; `verdict_at_margin` in the CSVs, `verdict` the common ±10 % band). The circle "
+        "here is this protocol's (invariant-measure ICs, three radii): the README's family A "
+        "uses the paper's ICs and radii, so its numbers differ; its `elastic+invariant_ics` "
+        "control is the comparable row.", "",
         "![Per kicked system and table: the kicked / two-disk FTLE ratio against r (mirror "
         "filled, elastic open), and the mean FTLEs beside the free disk's](tables.png)", "",
         "*Left and middle: the ratio per radius with its 95 % interval (the band: the FTLE's "
         "margin), each panel on its own scale. Right: the mean FTLE per system against r "
         "(log scale, mirror rule), the free disk's as a dashed line per table.*", "",
-        "## The ratio in each table, under its controls", "",
+        "## The ratios in each table, under their controls", "",
         *_ratio_table(found),
         "## The mean FTLE per system (per unit time, over ICs and radii)", "",
         *_mean_table(means),
@@ -215,7 +271,14 @@ def body(found, means, free, drift, *, n_ics, horizon, radii) -> list[str]:
         "decomposition is claimed (the free disk's exponent is not additive with the "
         "collisions'); the free-disk rows give both numbers instead.",
         "- The elastic store is a control of the primary rows only (no elastic + sticky "
-        "control).",
+        "control). Under the elastic rule the kicked disk keeps disk 0's initial speed, "
+        f"{speeds['speed_min'].min():.2f}–{speeds['speed_max'].max():.2f} over the ICs, and "
+        "its FTLE per unit time follows it (correlation over ICs "
+        f"{speeds['kicked_corr'].min():.3f}–{speeds['kicked_corr'].max():.3f} per table and "
+        f"radius; the two disks' {speeds['two_disk_corr'].min():.2f}–"
+        f"{speeds['two_disk_corr'].max():.2f}): its elastic intervals are wider, and its "
+        "elastic ratio compares a disk at its IC's speed with the pair "
+        "(`tables_elastic_speeds.csv`).",
         "",
     ]
     return lines

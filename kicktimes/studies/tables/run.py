@@ -15,11 +15,13 @@ from dataclasses import dataclass
 import pandas as pd
 
 from kicktimes.render.pages import header
+from kicktimes.report.process import build_stores_report
 from kicktimes.studies.cache import cached_table
 from kicktimes.studies.options import study_run
 from kicktimes.studies.tables.compare import (
     against_circle,
     against_free,
+    elastic_speeds,
     findings,
     mean_ftle,
     per_ic,
@@ -34,21 +36,23 @@ __all__ = ["SCALES", "TablesScale", "reproduce"]
 
 @dataclass(frozen=True)
 class TablesScale:
-    """The sizes of one scale: ICs per (table, rule, radius), each run's horizon, the free
-    disk's states and the focal drift's states and wall contacts."""
+    """The sizes of one scale: ICs per (table, rule, radius), the paper's steps and step
+    length per run (the free disk's horizon is ``n_steps * tau``), the free disk's states
+    and the focal drift's states and wall contacts."""
 
     n_ics: int
-    horizon: float
+    n_steps: int
+    tau: float
     free_states: int
     drift_states: int
     drift_bounces: int
 
 
-#: ``paper``: the sizes of docs/results/tables.md (2000 ICs, the paper's horizon 25000 x 0.2;
-#: about four minutes on 2 cores); ``quick``: seconds
+#: ``paper``: the sizes of docs/results/tables.md (200 ICs per radius, the paper's family A:
+#: 25000 collision-truncated steps of 0.2); ``quick``: a pipeline check
 SCALES = {
-    "paper": TablesScale(2000, 5000.0, 200, 50, 10_000),
-    "quick": TablesScale(6, 300.0, 10, 4, 1000),
+    "paper": TablesScale(200, 25000, 0.2, 200, 50, 10_000),
+    "quick": TablesScale(6, 1500, 0.2, 10, 4, 1000),
 }
 
 
@@ -84,48 +88,56 @@ def reproduce(out: str | os.PathLike, *, scale: str = "quick", results_dir=None,
     run = study_run("tables", out, scale=scale, scales=SCALES, results_dir=results_dir,
                     workers=workers, progress=progress, command=command)
     sizes = run.params
+    # the free disk's horizon: the paper's n_steps tau (its collision-truncated runs cover
+    # somewhat less)
+    horizon = sizes.n_steps * sizes.tau
     t0 = time.perf_counter()
     run.cache.mkdir(parents=True, exist_ok=True)
     run.results.mkdir(parents=True, exist_ok=True)
     experiments = {(t, rule): tables_experiment(t, rule, n_ics=sizes.n_ics,
-                                                horizon=sizes.horizon)
+                                                n_steps=sizes.n_steps, tau=sizes.tau)
                    for t in TABLES for rule in RULES}
     named = run_stores(out, experiments.values(), workers=run.workers, scheduler=scheduler,
                        say=run.say)
     stores = {key: named[exp.name] for key, exp in experiments.items()}
     run.say(f"sweep done at {time.perf_counter() - t0:.0f} s")
+    report_dir = run.cache / "report"
+    build_stores_report([store.path for store in stores.values()], report_dir,
+                        workers=run.workers)
+    run.say(f"sweep report done at {time.perf_counter() - t0:.0f} s")
     params = {"radii": list(RADII), "tables": [repr(t) for t in TABLES.values()],
-              "point": POINT_RADIUS, "states": sizes.free_states, "horizon": sizes.horizon,
+              "point": POINT_RADIUS, "states": sizes.free_states, "horizon": horizon,
               "seed": SEED}
 
     def free_states():
         # every table at the sweep's radii, and the stadium's point particle
         return pd.concat([
-            free_runs(TABLES, RADII, n_states=sizes.free_states, horizon=sizes.horizon,
+            free_runs(TABLES, RADII, n_states=sizes.free_states, horizon=horizon,
                       seed=SEED),
             free_runs({"stadium": TABLES["stadium"]}, [POINT_RADIUS],
-                      n_states=sizes.free_states, horizon=sizes.horizon, seed=SEED + 1)],
+                      n_states=sizes.free_states, horizon=horizon, seed=SEED + 1)],
             ignore_index=True)
 
     free_states = cached_table(run.cache / "free_disk.parquet", params, free_states,
                                progress=run.say).table
-    free = free_ftle(free_states, horizon=sizes.horizon, seed=SEED)
+    free = free_ftle(free_states, horizon=horizon, seed=SEED)
     params = {"radii": [POINT_RADIUS, *RADII], "table": repr(TABLES["ellipse"]),
               "states": sizes.drift_states, "bounces": sizes.drift_bounces, "seed": SEED}
     drift = cached_table(run.cache / "focal_drift.parquet", params, lambda: focal_drift(
         TABLES["ellipse"], (POINT_RADIUS, *RADII), n_states=sizes.drift_states,
         n_bounces=sizes.drift_bounces, seed=SEED), progress=run.say).table
 
-    found, curves = findings(stores)
+    found, curves = findings(report_dir, stores)
     runs = per_ic(stores)
     against = against_circle(runs)
     free_ratio = against_free(runs, free_states)
     means = mean_ftle(runs)
     by_radius = mean_ftle(runs, per_radius=True)
+    speeds = elastic_speeds(stores)
     for name, frame in (("findings", found), ("findings_by_radius", curves),
                         ("against_circle", against), ("against_free", free_ratio),
                         ("ftle", means), ("ftle_by_radius", by_radius), ("free_disk", free),
-                        ("focal_drift", drift)):
+                        ("focal_drift", drift), ("elastic_speeds", speeds)):
         run.write_csv(f"tables_{name}.csv", frame)
     run.write_figure("tables.png", tables_figure(curves, by_radius, free))
     lines = header(
@@ -134,7 +146,7 @@ def reproduce(out: str | os.PathLike, *, scale: str = "quick", results_dir=None,
          f"the free disk's runs (`kicktimes.studies.tables.one_disk`, cached in "
          f"`{run.cache.name}`)"])
     lines += answers(found, against, free_ratio, free, n_ics=sizes.n_ics) + [""]
-    lines += body(found, means, free, drift, n_ics=sizes.n_ics, horizon=sizes.horizon,
+    lines += body(found, means, free, drift, speeds, n_ics=sizes.n_ics, horizon=horizon,
                   radii=RADII)
     run.say(f"page at {time.perf_counter() - t0:.0f} s")
     return run.write_page(lines, SOURCES)
