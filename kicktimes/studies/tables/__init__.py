@@ -35,6 +35,7 @@ from kicktimes.studies.tables.compare import (
     elastic_speeds,
     findings,
     mean_ftle,
+    null_levels,
     per_ic,
 )
 from kicktimes.studies.tables.figures import tables_figure
@@ -51,5 +52,5 @@ from kicktimes.studies.tables.sweep import (
 
 __all__ = ["RADII", "RULES", "SCALES", "TABLES", "TablesScale", "against_circle",
            "against_free", "elastic_speeds", "family_name", "findings", "focal_drift",
-           "focal_product", "free_ftle", "free_runs", "mean_ftle", "per_ic", "reproduce",
-           "run_stores", "tables_experiment", "tables_figure"]
+           "focal_product", "free_ftle", "free_runs", "mean_ftle", "null_levels", "per_ic",
+           "reproduce", "run_stores", "tables_experiment", "tables_figure"]

@@ -52,7 +52,7 @@ from kicktimes.stats import (
 from kicktimes.studies.tables.sweep import RULES, SEED, TABLES, family_name
 
 __all__ = ["KICKED", "N_BOOT", "against_circle", "against_free", "elastic_speeds", "findings",
-           "mean_ftle", "per_ic"]
+           "mean_ftle", "null_levels", "per_ic"]
 
 #: the kicked systems of the sweep, as the pages name them
 KICKED = {"poisson": "uniform kicks at Poisson times",
@@ -236,4 +236,22 @@ def elastic_speeds(stores, *, system="poisson") -> pd.DataFrame:
                          "speed_max": float(speed.max()),
                          "kicked_corr": float(np.corrcoef(speed[ok], g[system][ok])[0, 1]),
                          "two_disk_corr": float(np.corrcoef(speed[ok], g[REFERENCE][ok])[0, 1])})
+    return pd.DataFrame(rows)
+
+
+def null_levels(report_dir, stores, *, test="uniformity_ks") -> pd.DataFrame:
+    """Per (table, rule): the share of the runs' Poisson control streams that ``test``
+    rejects, over every radius (the sweep report's ``<name>_poisson_tests.csv``: the
+    calibrated level its rejection share is read against)."""
+    from pathlib import Path
+
+    rows = []
+    for (table, rule), store in sorted(stores.items()):
+        t = pd.read_csv(Path(report_dir) / f"{store.experiment.name}_poisson_tests.csv")
+        t = t[t["test"] == test]
+        rows.append({"table": table, "rule": rule, "test": test,
+                     "null_rejections": int(t["control_n_reject"].sum()),
+                     "null_tested": int(t["control_n_tested"].sum()),
+                     "null_share": float(t["control_n_reject"].sum()
+                                         / t["control_n_tested"].sum())})
     return pd.DataFrame(rows)

@@ -1,6 +1,5 @@
-"""The tables study's figure: the kicked / two-disk FTLE ratio against the radius in each
-table (uniform and scattering kicks at Poisson times), and the mean FTLEs beside the free
-disk's."""
+"""The tables study's figure: the kicked / two-disk FTLE and RR ratios against the radius in
+each table, and the mean FTLEs beside the free disk's."""
 
 from __future__ import annotations
 
@@ -11,9 +10,6 @@ __all__ = ["tables_figure"]
 
 COLOURS = {"circle": "black", "ellipse": "tab:green", "stadium": "tab:red"}
 MARKERS = {"mirror": "o", "elastic": "s"}
-#: the ratio panels (uniform kicks at the collision times give the Poisson kicks' values
-#: to within 0.02: in the CSVs)
-RATIO_PANELS = ("poisson", "poisson_scatter")
 SYSTEM_STYLE = {"two_particle": ("two disks", "o"), "poisson": (KICKED["poisson"], "s"),
                 "poisson_scatter": (KICKED["poisson_scatter"], "^")}
 
@@ -25,53 +21,70 @@ def _bars(ax, x, g, est, colour, marker, filled, label):
                 mfc=colour if filled else "white", label=label)
 
 
+def _ratio_panel(ax, c, diagnostic, system, tables, band, title):
+    """The kicked / two-disk ratio of ``diagnostic`` per radius, one colour per table."""
+    for k, table in enumerate(tables):
+        for j, rule in enumerate(("mirror", "elastic")):
+            g = c[(c["diagnostic"] == diagnostic) & (c["system"] == system)
+                  & (c["table"] == table) & (c["rule"] == rule)].sort_values("radius")
+            if not g.empty:
+                x = g["radius"].to_numpy() * (1 + 0.04 * (k - 1) + 0.015 * j)
+                _bars(ax, x, g, "ratio", COLOURS[table], MARKERS[rule], rule == "mirror",
+                      f"{table}, {rule}")
+    ax.axhspan(1 - band, 1 + band, color="0.9", zorder=0)
+    ax.axhline(1.0, color="0.5", lw=0.8)
+    ax.set_title(title, fontsize=10)
+
+
 def tables_figure(curves, means_by_radius, free):
-    """Three panels: the ratio per radius of uniform and of scattering kicks at Poisson
-    times (primary control; mirror filled, elastic open; 95 % intervals, bootstrap
-    clustered on ICs; the FTLE's margin around 1 shaded; each on its own y scale), and the
-    mean FTLE per system and table against r under the mirror rule (log scale) with the
-    free disk's as a dashed line. ``curves``: `compare.findings`'s second table;
-    ``means_by_radius``: `compare.mean_ftle` per radius; ``free``: `one_disk.free_ftle`."""
+    """Four panels against r: the kicked / two-disk FTLE ratio of uniform and of
+    scattering kicks at Poisson times, the off-diagonal RR ratio (eps = 0.01, uniform-time
+    samples) of uniform kicks (primary control; mirror filled, elastic open; 95 %
+    intervals, bootstrap clustered on ICs; each diagnostic's margin around 1 shaded; each
+    panel on its own y scale), and the mean FTLE per system and table under the mirror
+    rule (log scale) with the free disk's dashed. ``curves``: `compare.findings`'s second
+    table; ``means_by_radius``: `compare.mean_ftle` per radius; ``free``:
+    `one_disk.free_ftle`."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    from matplotlib.lines import Line2D
 
-    tol = margin_of("ftle")
-    c = curves[(curves["diagnostic"] == "ftle") & (curves["control"] == "primary")]
-    fig, axes = plt.subplots(1, 3, figsize=(17, 4.6))
+    c = curves[curves["control"] == "primary"]
+    fig, axes = plt.subplots(2, 2, figsize=(13, 9))
     tables = [t for t in COLOURS if t in set(c["table"])]
-    for ax, system in zip(axes[:2], RATIO_PANELS, strict=True):
-        for k, table in enumerate(tables):
-            for j, rule in enumerate(("mirror", "elastic")):
-                g = c[(c["system"] == system) & (c["table"] == table)
-                      & (c["rule"] == rule)].sort_values("radius")
-                if not g.empty:
-                    x = g["radius"].to_numpy() * (1 + 0.04 * (k - 1) + 0.015 * j)
-                    _bars(ax, x, g, "ratio", COLOURS[table], MARKERS[rule], rule == "mirror",
-                          f"{table}, {rule}")
-        ax.axhspan(1 - tol, 1 + tol, color="0.9", zorder=0)
-        ax.axhline(1.0, color="0.5", lw=0.8)
-        ax.set_title(f"kicked / two-disk FTLE: {KICKED[system]}", fontsize=10)
-        ax.set_ylabel("kicked / two-disk FTLE")
-    axes[0].legend(fontsize=7, loc="center left", bbox_to_anchor=(0.0, 0.42), ncol=2)
-    right = axes[2]
+    ftle = margin_of("ftle")
+    _ratio_panel(axes[0, 0], c, "ftle", "poisson", tables, ftle,
+                 f"FTLE, {KICKED['poisson']}")
+    _ratio_panel(axes[0, 1], c, "ftle", "poisson_scatter", tables, ftle,
+                 f"FTLE, {KICKED['poisson_scatter']}")
+    _ratio_panel(axes[1, 0], c, "rr_offdiag@0.01", "poisson", tables,
+                 margin_of("rr_offdiag"), f"off-diagonal RR (ε = 0.01), {KICKED['poisson']}")
+    for ax in (axes[0, 0], axes[0, 1], axes[1, 0]):
+        ax.set_ylabel("kicked / two-disk")
+    axes[0, 0].legend(fontsize=7, loc="center left", bbox_to_anchor=(0.0, 0.42), ncol=2)
+    right = axes[1, 1]
     m = means_by_radius[means_by_radius["rule"] == "mirror"]
     for k, table in enumerate(tables):
-        for system, (name, marker) in SYSTEM_STYLE.items():
+        for system, (_, marker) in SYSTEM_STYLE.items():
             g = m[(m["table"] == table) & (m["system"] == system)].sort_values("radius")
             x = g["radius"].to_numpy() * (1 + 0.03 * (k - 1))
-            _bars(right, x, g, "ftle", COLOURS[table], marker, True,
-                  name if k == 0 else None)
+            _bars(right, x, g, "ftle", COLOURS[table], marker, True, None)
         f = free[(free["table"] == table) & free["radius"].isin(set(m["radius"]))]
         f = f.sort_values("radius")
-        right.plot(f["radius"], f["ftle"], "--", color=COLOURS[table], lw=1.2,
-                   label=f"free disk ({table})")
+        right.plot(f["radius"], f["ftle"], "--", color=COLOURS[table], lw=1.2)
+    keys = [Line2D([], [], color=COLOURS[t], lw=2, label=t) for t in tables]
+    keys += [Line2D([], [], color="0.3", marker=mk, lw=0, label=name)
+             for name, mk in SYSTEM_STYLE.values()]
+    keys.append(Line2D([], [], color="0.3", ls="--", label="free disk (circle, ellipse: "
+                                                           "the ln T / T floor)"))
     right.set_yscale("log")
+    right.set_ylim(1e-4, 1.5)   # room below the data for the key
+    right.legend(handles=keys, fontsize=7, loc="lower right", ncol=2)
     right.set_ylabel("mean FTLE per unit time")
-    right.set_title("mean FTLE, mirror rule (dashed: the free disk)", fontsize=10)
-    right.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0))
-    for ax in axes:
+    right.set_title("mean FTLE, mirror rule", fontsize=10)
+    for ax in axes.ravel():
         ax.set_xlabel("disk radius r")
         ax.set_xticks([0.01, 0.02, 0.03])
         ax.grid(alpha=0.3)

@@ -12,6 +12,7 @@ from kicktimes.studies.tables.compare import (
     elastic_speeds,
     findings,
     mean_ftle,
+    null_levels,
 )
 from kicktimes.studies.tables.one_disk import focal_drift, free_ftle
 
@@ -30,6 +31,7 @@ SOURCES = (
     Source("tables_focal_drift.csv", "max_drift, median_drift, ensemble_range", focal_drift),
     Source("tables_elastic_speeds.csv", "speed_min, speed_max, kicked_corr, two_disk_corr",
            elastic_speeds),
+    Source("tables_null_levels.csv", "null_rejections, null_tested, null_share", null_levels),
 )
 
 TOL = margin_of("ftle")
@@ -44,8 +46,8 @@ def _ci(row, digits=3):
                            edges=(1 - tol, 1.0, 1 + tol), digits=digits)
 
 
-def _pick(table, **where):
-    rows = table
+def _pick(frame, **where):
+    rows = frame
     for k, v in where.items():
         rows = rows[rows[k] == v]
     if len(rows) != 1:
@@ -53,30 +55,46 @@ def _pick(table, **where):
     return rows.iloc[0]
 
 
+def _side(row) -> int:
+    """+1 / -1 when the interval lies entirely above / below 1, else 0."""
+    return 1 if row["ci_low"] > 1 else -1 if row["ci_high"] < 1 else 0
+
+
+def _left_out(rows) -> int:
+    """How many runs the sticky_excluded control leaves out (0: it tests nothing)."""
+    prim = rows[rows["control"] == "primary"]["n_pairs"]
+    sticky = rows[rows["control"] == "sticky_excluded"]["n_pairs"]
+    return int(prim.iloc[0] - sticky.iloc[0]) if len(prim) and len(sticky) else 0
+
+
+def _flips(rows):
+    """The controls whose verdict differs from the primary's or whose interval lies on
+    the other side of 1."""
+    prim = _pick(rows, control="primary")
+    others = rows[rows["control"] != "primary"]
+    return others[[r["verdict_at_margin"] != prim["verdict_at_margin"]
+                   or _side(r) * _side(prim) < 0 for _, r in others.iterrows()]]
+
+
 def _robustness(rows) -> str:
     """``"robust to its 3 controls (0.72–0.81)"`` or ``"depends on <control>: <its
-    interval> (<its verdict>)"`` for every control whose verdict differs from the
-    primary's (or whose interval lies on the other side of 1)."""
+    interval> (<its verdict>)"`` for every control that changes it (the sticky runs'
+    count beside that control)."""
     prim = _pick(rows, control="primary")
     others = rows[rows["control"] != "primary"]
     if bool(prim["robust"]):
         return (f"robust to its {len(others)} controls ({rows['estimate'].min():.3g}–"
                 f"{rows['estimate'].max():.3g})")
-    def side(r):
-        return 1 if r["ci_low"] > 1 else -1 if r["ci_high"] < 1 else 0
-
-    flips = others[[r["verdict_at_margin"] != prim["verdict_at_margin"]
-                    or side(r) * side(prim) < 0 for _, r in others.iterrows()]]
-    return "depends on " + ", ".join(f"{r['control']}: {_ci(r)} ({r['verdict_at_margin']})"
-                                     for _, r in flips.iterrows())
+    parts = []
+    for _, r in _flips(rows).iterrows():
+        n = f", {_left_out(rows)} run(s) left out" if r["control"] == "sticky_excluded" else ""
+        parts.append(f"{r['control']}{n}: {_ci(r)} ({r['verdict_at_margin']})")
+    return "depends on " + ", ".join(parts)
 
 
-def _per_table(found, system, diagnostic="ftle"):
-    return "; ".join(
-        f"{t.split('_', 1)[1]} {_ci(_pick(g, control='primary'))}"
-        f" ({_pick(g, control='primary')['verdict_at_margin']})"
-        for t, g in found[(found["diagnostic"] == diagnostic) & (found["system"] == system)]
-        .groupby("family", sort=False))
+def _primary(found, family, diagnostic, system):
+    return _pick(found, family=family, diagnostic=diagnostic, system=system,
+                 control="primary")
 
 
 def _answer(against, system) -> str:
@@ -101,54 +119,69 @@ def _against(against, system):
     return "; ".join(parts)
 
 
-def _poisson(found) -> str:
+def _poisson(found, levels) -> str:
     """Per table: the Poisson verdict of the two disks' collision times (the report's
-    ``poisson@uniformity_ks`` row, `kicktimes.stats.poisson_verdict`) and whether the
-    elastic rule gives the same."""
+    ``poisson@uniformity_ks`` row, `kicktimes.stats.poisson_verdict`), its rejection share
+    beside the share of its null streams (``levels``), under each rule."""
     rows = found[found["diagnostic"] == "poisson@uniformity_ks"]
     parts = []
     for family, g in rows.groupby("family", sort=False):
-        prim = _pick(g, control="primary")
-        others = g[g["control"] != "primary"]
-        same = (others["verdict"] == prim["verdict"]).all()
-        how = ("the same under " + ", ".join(others["control"]) if same and len(others)
-               else "; ".join(f"{r['control']}: {r['verdict']}" for _, r in others.iterrows()))
-        share = format_interval(prim["estimate"], prim["ci_low"], prim["ci_high"],
-                                edges=(), digits=2)
-        parts.append(f"{family.split('_', 1)[1]} {prim['verdict']} (rejection share {share}; "
-                     + (how or "no control") + ")")
-    return "; ".join(parts)
+        table = family.split("_", 1)[1]
+        cells = []
+        for _, r in g.iterrows():
+            rule = "mirror" if r["control"] == "primary" else r["control"]
+            level = levels[(levels["table"] == table) & (levels["rule"] == rule)]
+            null = f" vs {100 * level['null_share'].iloc[0]:.1f} %" if len(level) else ""
+            share = format_interval(100 * r["estimate"], 100 * r["ci_low"], 100 * r["ci_high"],
+                                    edges=(), digits=2)
+            cells.append(f"{rule} {r['verdict']}, {share} %{null}")
+        parts.append(f"{table}: " + "; ".join(cells))
+    return " — ".join(parts)
 
 
-def answers(found, against, free_ratio, free, *, n_ics) -> list[str]:
+def answers(found, against, free_ratio, free, levels, curves, *, n_ics) -> list[str]:
     """At most five one-line answers, each with its number, interval and caveat."""
-    ell = _pick(against, family="tables_ellipse", system="poisson", control="primary")
-    not_alone = ("; the ellipse, integrable for a point like the circle, differs from it "
-                 "too: integrability alone does not set it"
-                 if ell["verdict_at_margin"] in ("higher", "lower") and ell["robust"] else "")
-    fr = free_ratio[(free_ratio["rule"] == "mirror") & (free_ratio["system"] == "poisson")]
+    fr = _pick(free_ratio, table="stadium", rule="mirror", system="poisson")
     point = free[(free["table"] == "stadium") & (free["radius"] == free["radius"].min())]
-    at_r = free[(free["table"] == "stadium") & (free["radius"] > free["radius"].min())]
     rr = margin_of("rr_offdiag")
+    trend = curves[(curves["diagnostic"] == "ftle") & (curves["control"] == "primary")
+                   & (curves["system"] == "poisson") & (curves["rule"] == "mirror")]
+
+    def span(table):
+        g = trend[trend["table"] == table].sort_values("radius")
+        return f"{g['ratio'].iloc[0]:#.3g} → {g['ratio'].iloc[-1]:#.3g}"
+
+    def per_table(system, diagnostic="ftle"):
+        return ", ".join(f"{t} {_primary(found, f'tables_{t}', diagnostic, system)['estimate']:.3g}"
+                         for t in ("circle", "ellipse", "stadium"))
+
+    paper = found[(found["diagnostic"] == "rr_offdiag@0.01") & (found["system"] == "poisson")
+                  & (found["control"] == "paper_sampling")]
+    below = "below" if fr["ci_high"] < 1 else "not below"
     lines = [
         f"- **Does the kicked disk's FTLE deficit depend on the table? "
-        f"{_answer(against, 'poisson')}** (uniform kicks at Poisson times, mirror rule, "
-        f"{n_ics} ICs per radius; kicked / two-disk at ±{100 * TOL:g} %): "
-        f"{_per_table(found, 'poisson')}; {_against(against, 'poisson')}{not_alone}.",
-        "- **Against the free disk in the same table** (kicked FTLE / free disk's, mirror): "
-        + "; ".join(f"{r['table']} {format_interval(r['estimate'], r['ci_low'], r['ci_high'])}"
-                    f" ({r['verdict_at_margin']})" for _, r in fr.iterrows())
-        + f"; the free stadium disk: {at_r['ftle'].min():.3f}–{at_r['ftle'].max():.3f}, at "
-        f"r = {point['radius'].iloc[0]:g} "
-        f"{format_interval(*point[['ftle', 'ci_low', 'ci_high']].iloc[0])}"
-        f" beside Benettin & Strelcyn's {STADIUM_PUBLISHED:g}.",
+        f"{_answer(against, 'poisson')}.** Kicked / two-disk FTLE (uniform kicks at Poisson "
+        f"times, mirror rule, {n_ics} ICs per radius; from r = 0.01 to 0.03): circle "
+        f"{span('circle')}, ellipse {span('ellipse')}, stadium {span('stadium')}; over the "
+        f"circle's: {_against(against, 'poisson')}.",
+        f"- **Against the free disk in the stadium**: the kicked disk's FTLE is "
+        f"{format_interval(fr['estimate'], fr['ci_low'], fr['ci_high'])} of the free disk's "
+        f"({below} 1; {fr['verdict_at_margin']} at ±{100 * TOL:g} %); the free disk "
+        f"{fr['free_ftle']:.3f} at the sweep's radii and "
+        f"{format_interval(*point[['ftle', 'ci_low', 'ci_high']].iloc[0])} at "
+        f"r = {point['radius'].iloc[0]:g} (Benettin & Strelcyn: {STADIUM_PUBLISHED:g}); in "
+        f"the circle and the ellipse the free disk's FTLE is at the horizon's shear floor "
+        f"ln T / T (no ratio to it is a property of the table).",
         f"- **Scattering kicks: does the ratio depend on the table? "
-        f"{_answer(against, 'poisson_scatter')}**: kicked / two-disk "
-        f"{_per_table(found, 'poisson_scatter')}; {_against(against, 'poisson_scatter')}.",
-        f"- **Recurrence and decorrelation, uniform kicks at Poisson times** (kicked / "
-        f"two-disk, mirror): off-diagonal RR at ε = 0.01 (±{100 * rr:g} %) "
-        f"{_per_table(found, 'poisson', 'rr_offdiag@0.01')}; 1 − R₁ (±"
-        f"{100 * margin_of('one_minus_r1'):g} %) {_per_table(found, 'poisson', 'one_minus_r1')}.",
+        f"{_answer(against, 'poisson_scatter')}.** Kicked / two-disk "
+        f"{per_table('poisson_scatter')}; over the circle's: "
+        f"{_against(against, 'poisson_scatter')}.",
+        f"- **Recurrence and decorrelation** (uniform kicks at Poisson times, mirror, "
+        f"uniform-time samples): kicked / two-disk off-diagonal RR at ε = 0.01 "
+        f"{per_table('poisson', 'rr_offdiag@0.01')} (±{100 * rr:g} %; on the paper's samples "
+        + ", ".join(f"{r['family'].split('_', 1)[1]} {r['estimate']:.3g}"
+                    for _, r in paper.iterrows())
+        + f"); 1 − R₁ {per_table('poisson', 'one_minus_r1')} (verdicts in the table below).",
     ]
     counts = found[(found["diagnostic"] == "counts") & (found["control"] == "primary")]
     band = margin_of("counts")
@@ -158,10 +191,9 @@ def answers(found, against, free_ratio, free, *, n_ics) -> list[str]:
                                edges=(1 - band, 1.0, 1 + band))
         how = "" if r["robust"] else f", depends on {r['depends_on']}"
         cells.append(f"{r['family'].split('_', 1)[1]} {text} ({r['verdict_at_margin']}{how})")
-    lines.append(f"- **Are the two disks' collision times Poisson?** (the uniformity KS "
-                 f"test's rejection share against its calibrated null level and D against its "
-                 f"null stream, `stats.poisson_verdict`) {_poisson(found)}; their "
-                 f"counts over the table's kinetic rate Γ(r)T (±{100 * band:g} %): "
+    lines.append(f"- **Are the two disks' collision times Poisson?** (uniformity KS rejection "
+                 f"share against its null streams', and D, `stats.poisson_verdict`) "
+                 f"{_poisson(found, levels)}. Counts over Γ(r)T (±{100 * band:g} %): "
                  + "; ".join(cells) + ".")
     return lines
 
@@ -173,8 +205,8 @@ RATIO_DIAGNOSTICS = {"ftle": "FTLE", "rr_offdiag@0.01": "RR (ε = 0.01)",
 
 def _ratio_table(found) -> list[str]:
     """One row per (diagnostic, kicked system): per table the primary ratio, its verdict
-    at the diagnostic's margin, and ✓ (robust to every control) or the controls that change
-    it (every control's number is in tables_findings.csv)."""
+    at the diagnostic's margin, and ✓ (robust to every control), ✗ with the controls that
+    change its verdict, or ↕ (one control's interval above 1, another's below)."""
     f = found[found["diagnostic"].isin(RATIO_DIAGNOSTICS)]
     tables = list(dict.fromkeys(f["family"]))
     lines = ["| diagnostic | kicked system | "
@@ -190,14 +222,24 @@ def _ratio_table(found) -> list[str]:
                     cells.append("")
                     continue
                 prim = _pick(g, control="primary")
-                changed = ", ".join(
-                    g["control"][g["verdict_at_margin"] != prim["verdict_at_margin"]])
-                mark = "✓" if bool(prim["robust"]) else f"✗ {changed or 'direction'}"
+                sides = {_side(r) for _, r in g.iterrows()}
+                changed = ", ".join(g["control"][g["verdict_at_margin"]
+                                                  != prim["verdict_at_margin"]])
+                mark = ("✓" if bool(prim["robust"]) else "↕ " + changed if {1, -1} <= sides
+                        else f"✗ {changed}")
                 cells.append(f"{_ci(prim)} {prim['verdict_at_margin']} {mark}".rstrip())
             lines.append(f"| {label} | {name} | " + " | ".join(cells) + " |")
-    return lines + ["", "✓: every control (the paired median, the sticky runs left out, the "
-                    "elastic rule; for RR also the paper's samples) gives the same verdict in "
-                    "the same direction; ✗: the controls whose verdict differs.", ""]
+    ftle = f[(f["diagnostic"] == "ftle") & (f["system"] == "poisson")]
+    left = ", ".join(f"{t.split('_', 1)[1]} {_left_out(g)}"
+                     for t, g in ftle.groupby("family", sort=False))
+    return lines + ["", "Controls: the paired median of per-IC ratios, the sticky runs left "
+                    f"out (runs left out: {left}; where 0 it tests nothing), the elastic rule "
+                    "(see below: its kicked disk keeps its IC's speed), and for RR the paper's "
+                    "samples. ✓: every control gives the same verdict in the same direction; "
+                    "✗: the controls whose verdict differs; ↕: some control's interval lies "
+                    "above 1 and another's below. *Within* means inside the margin: such an "
+                    "interval may still exclude 1 (a difference smaller than the margin). "
+                    "Every control's number is in `tables_findings.csv`.", ""]
 
 
 def _mean_table(means) -> list[str]:
@@ -227,9 +269,11 @@ def _free_table(free, drift) -> list[str]:
 
 
 def body(found, means, free, drift, speeds, *, n_ics, horizon, radii) -> list[str]:
-    """The page after its answers: the design, the tables behind the answers, what is not
-    shown."""
+    """The page after its answers: the ratios at a glance, the design, the tables behind
+    the answers, what is not shown."""
     lines = [
+        "## The ratios in each table (kicked / two-disk), under their controls", "",
+        *_ratio_table(found),
         "## Design", "",
         f"The paper's comparison in three tables: the unit circle, an ellipse of semi-axes "
         f"1.25 and 0.8 (the circle's area; integrable for a point particle, not exactly for "
@@ -250,15 +294,17 @@ def body(found, means, free, drift, speeds, *, n_ics, horizon, radii) -> list[st
         f"±{100 * margin_of('rr_offdiag'):g} %, counts ±{100 * margin_of('counts'):g} %, else "
         "±10 %; `verdict_at_margin` in the CSVs, `verdict` the common ±10 % band). The circle "
         "here is this protocol's (invariant-measure ICs, three radii): the README's family A "
-        "uses the paper's ICs and radii, so its numbers differ; its `elastic+invariant_ics` "
-        "control is the comparable row.", "",
-        "![Per kicked system and table: the kicked / two-disk FTLE ratio against r (mirror "
-        "filled, elastic open), and the mean FTLEs beside the free disk's](tables.png)", "",
-        "*Left and middle: the ratio per radius with its 95 % interval (the band: the FTLE's "
-        "margin), each panel on its own scale. Right: the mean FTLE per system against r "
-        "(log scale, mirror rule), the free disk's as a dashed line per table.*", "",
-        "## The ratios in each table, under their controls", "",
-        *_ratio_table(found),
+        "uses the paper's ICs and radii, so its numbers differ; its `invariant_ics` control "
+        "(mirror) and `elastic+invariant_ics` (elastic) are the comparable rows, at 12 "
+        "radii.", "",
+        "![Per table: the kicked / two-disk FTLE and RR ratios against r (mirror filled, "
+        "elastic open), and the mean FTLEs beside the free disk's](tables.png)", "",
+        "*Top: the FTLE ratio per radius for uniform and scattering kicks, each panel on its "
+        "own y scale (the band: ±5 %). Bottom left: the off-diagonal RR ratio on uniform-time "
+        "samples (band ±3 %). Bottom right: the mean FTLE per system against r (log scale, "
+        "mirror rule), the free disk's dashed (in the circle and the ellipse at the "
+        "horizon's shear floor ln T / T). 95 % intervals; where not seen, smaller than the "
+        "markers.*", "",
         "## The mean FTLE per system (per unit time, over ICs and radii)", "",
         *_mean_table(means),
         "## The free disk", "",

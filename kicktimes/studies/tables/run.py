@@ -24,6 +24,7 @@ from kicktimes.studies.tables.compare import (
     elastic_speeds,
     findings,
     mean_ftle,
+    null_levels,
     per_ic,
 )
 from kicktimes.studies.tables.figures import tables_figure
@@ -134,10 +135,12 @@ def reproduce(out: str | os.PathLike, *, scale: str = "quick", results_dir=None,
     means = mean_ftle(runs)
     by_radius = mean_ftle(runs, per_radius=True)
     speeds = elastic_speeds(stores)
+    levels = null_levels(report_dir, stores)
     for name, frame in (("findings", found), ("findings_by_radius", curves),
                         ("against_circle", against), ("against_free", free_ratio),
                         ("ftle", means), ("ftle_by_radius", by_radius), ("free_disk", free),
-                        ("focal_drift", drift), ("elastic_speeds", speeds)):
+                        ("focal_drift", drift), ("elastic_speeds", speeds),
+                        ("null_levels", levels)):
         run.write_csv(f"tables_{name}.csv", frame)
     run.write_figure("tables.png", tables_figure(curves, by_radius, free))
     lines = header(
@@ -145,7 +148,8 @@ def reproduce(out: str | os.PathLike, *, scale: str = "quick", results_dir=None,
         ["the sweep's stores " + ", ".join(f"`{exp.name}`" for exp in experiments.values()),
          f"the free disk's runs (`kicktimes.studies.tables.one_disk`, cached in "
          f"`{run.cache.name}`)"])
-    lines += answers(found, against, free_ratio, free, n_ics=sizes.n_ics) + [""]
+    lines += answers(found, against, free_ratio, free, levels, curves,
+                     n_ics=sizes.n_ics) + [""]
     lines += body(found, means, free, drift, speeds, n_ics=sizes.n_ics, horizon=horizon,
                   radii=RADII)
     run.say(f"page at {time.perf_counter() - t0:.0f} s")
