@@ -54,6 +54,7 @@ TABLES = {
     "diagnostics_vs_two_particle",
     "lyapunov_by_radius",
     "lyapunov_stretching",
+    "null_calibration",
     "recurrence_by_radius",
     "autocorrelation_summary",
     "autocorrelation_curves",

@@ -49,7 +49,8 @@ def test_every_verdict_is_the_one_its_interval_gives(path):
     # hazard bin and the gamma shape against their control streams' values (the paired
     # difference, the <statistic>_excess row); the one standard of the share and D
     null = pd.read_csv(RESULTS / "null_calibration.csv")
-    null = null[(null["study"] == "paper") & (null["statistic"] == "rejection share")]
+    null = null[null["study"].isin(["paper", "tables"])
+                & (null["statistic"] == "rejection share")]
     null = null.set_index(["data", "test"])["value"]
     rows = table[poisson]
     margins = {"dispersion_index": D_MARGIN, "hazard_first": SHAPE_MARGIN,
@@ -63,13 +64,14 @@ def test_every_verdict_is_the_one_its_interval_gives(path):
             assert row.verdict == rejection_verdict(row.ci_low, row.ci_high, alpha=level), row
         elif base in margins:
             excess = rows[(rows["diagnostic"] == f"{base}_excess")
-                          & (rows["control"] == row.control)].iloc[0]
+                          & (rows["control"] == row.control)
+                          & (rows["family"] == row.family)].iloc[0]
             assert row.verdict == null_verdict(excess.ci_low, excess.ci_high,
                                                margin=margins[base]), row
         else:
             assert kind == "poisson", row
             d = rows[(rows["diagnostic"] == "dispersion_index_excess")
-                     & (rows["control"] == row.control)].iloc[0]
+                     & (rows["control"] == row.control) & (rows["family"] == row.family)].iloc[0]
             assert row.verdict == poisson_verdict(row.ci_low, row.ci_high,
                                                   null_level=null[data, test],
                                                   dispersion_low=d.ci_low,

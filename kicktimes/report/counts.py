@@ -158,11 +158,11 @@ def counts_vs_radius(collisions, *, regression=None, rule="mirror", ax=None, kin
     t_grid = np.interp(grid, r, table["mean_t_window"].to_numpy())
     pred = regression.predict(grid, t_window=t_grid)
     kinetic_rule = regression.rule or rule
-    # the kinetic rate at 9 radii, drawn through them: a table's rate is a quadrature per
-    # radius (about a second each in an ellipse), and the rate is smooth in r
+    # the kinetic rate at 9 radii, the line drawn through them: a table's rate is a
+    # quadrature per radius (about a second each in an ellipse), and the rate is smooth in r
     nodes = np.linspace(r.min(), r.max(), 9) if r.size > 1 else r
-    rate = np.interp(grid, nodes, np.asarray(kinetic_rate_of(nodes, kinetic_rule, kinetic)))
-    kinetic = rate * t_grid
+    t_nodes = np.interp(nodes, r, table["mean_t_window"].to_numpy())
+    kinetic = np.asarray(kinetic_rate_of(nodes, kinetic_rule, kinetic)) * t_nodes
     fig, ax = new_axes(ax, (6.0, 4.4))
     ax.errorbar(
         r,
@@ -184,7 +184,8 @@ def counts_vs_radius(collisions, *, regression=None, rule="mirror", ax=None, kin
         label=f"negative binomial (α = {regression.alpha:.3g})",
     )
     ax.plot(
-        grid, kinetic, color="grey", linestyle=":", label=f"kinetic theory Γ(r)·T ({kinetic_rule})"
+        nodes, kinetic, color="grey", linestyle=":",
+        label=f"kinetic theory Γ(r)·T ({kinetic_rule})"
     )
     radius_axis(ax)
     ax.set_ylabel("disk-disk collisions per run (count)")

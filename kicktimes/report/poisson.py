@@ -437,6 +437,10 @@ def sections(ctx):
         ctx.found.null_calibration = null_calibration(
             ctx.exp.name, rejections, per_ic, alpha=alpha, rng=ctx.rng(6), n_boot=ctx.n_boot,
             referenced=ctx.found.null_referenced)
+        # the calibrated levels the findings read each share and statistic against, as a
+        # table (a study writes them into its results' null_calibration.csv)
+        sec.table("null_calibration", ctx.found.null_calibration, "The runs' Poisson "
+                  "control streams through the same tests and statistics", show=False)
     ctx.found.homogeneity = homogeneity
     return [sec]
 

@@ -239,19 +239,14 @@ def elastic_speeds(stores, *, system="poisson") -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
-def null_levels(report_dir, stores, *, test="uniformity_ks") -> pd.DataFrame:
-    """Per (table, rule): the share of the runs' Poisson control streams that ``test``
-    rejects, over every radius (the sweep report's ``<name>_poisson_tests.csv``: the
-    calibrated level its rejection share is read against)."""
+def null_levels(report_dir, stores) -> pd.DataFrame:
+    """Per (table, rule): the sweep report's null calibration (``<name>_null_calibration.csv``,
+    `kicktimes.report.poisson.null_calibration`: the runs' Poisson control streams through
+    the same tests and statistics), with ``table`` and ``rule``: the levels the Poisson rows
+    of `findings` are read against."""
     from pathlib import Path
 
-    rows = []
-    for (table, rule), store in sorted(stores.items()):
-        t = pd.read_csv(Path(report_dir) / f"{store.experiment.name}_poisson_tests.csv")
-        t = t[t["test"] == test]
-        rows.append({"table": table, "rule": rule, "test": test,
-                     "null_rejections": int(t["control_n_reject"].sum()),
-                     "null_tested": int(t["control_n_tested"].sum()),
-                     "null_share": float(t["control_n_reject"].sum()
-                                         / t["control_n_tested"].sum())})
-    return pd.DataFrame(rows)
+    parts = [pd.read_csv(Path(report_dir) / f"{store.experiment.name}_null_calibration.csv",
+                         keep_default_na=False, na_values=[""]).assign(table=table, rule=rule)
+             for (table, rule), store in sorted(stores.items())]
+    return pd.concat(parts, ignore_index=True)

@@ -31,7 +31,7 @@ SOURCES = (
     Source("tables_focal_drift.csv", "max_drift, median_drift, ensemble_range", focal_drift),
     Source("tables_elastic_speeds.csv", "speed_min, speed_max, kicked_corr, two_disk_corr",
            elastic_speeds),
-    Source("tables_null_levels.csv", "null_rejections, null_tested, null_share", null_levels),
+    Source("null_calibration.csv", "value, ci_low, ci_high", null_levels),
 )
 
 TOL = margin_of("ftle")
@@ -130,8 +130,10 @@ def _poisson(found, levels) -> str:
         cells = []
         for _, r in g.iterrows():
             rule = "mirror" if r["control"] == "primary" else r["control"]
-            level = levels[(levels["table"] == table) & (levels["rule"] == rule)]
-            null = f" vs {100 * level['null_share'].iloc[0]:.1f} %" if len(level) else ""
+            level = levels[(levels["table"] == table) & (levels["rule"] == rule)
+                           & (levels["statistic"] == "rejection share")
+                           & (levels["test"] == "uniformity_ks")]
+            null = f" vs {100 * level['share'].iloc[0]:.1f} %" if len(level) else ""
             share = format_interval(100 * r["estimate"], 100 * r["ci_low"], 100 * r["ci_high"],
                                     edges=(), digits=2)
             cells.append(f"{rule} {r['verdict']}, {share} %{null}")

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import pandas as pd
 
-from kicktimes.render.pages import header
+from kicktimes.render.pages import header, write_null_calibration
 from kicktimes.report.process import build_stores_report
 from kicktimes.studies.cache import cached_table
 from kicktimes.studies.options import study_run
@@ -103,8 +103,12 @@ def reproduce(out: str | os.PathLike, *, scale: str = "quick", results_dir=None,
     stores = {key: named[exp.name] for key, exp in experiments.items()}
     run.say(f"sweep done at {time.perf_counter() - t0:.0f} s")
     report_dir = run.cache / "report"
+    # a report built by an older kicktimes may lack a table this study reads: rebuild it
+    needed = [report_dir / f"{exp.name}_{part}.csv" for exp in experiments.values()
+              for part in ("findings", "findings_by_radius", "poisson_tests",
+                           "null_calibration")]
     build_stores_report([store.path for store in stores.values()], report_dir,
-                        workers=run.workers)
+                        workers=run.workers, force=not all(p.is_file() for p in needed))
     run.say(f"sweep report done at {time.perf_counter() - t0:.0f} s")
     params = {"radii": list(RADII), "tables": [repr(t) for t in TABLES.values()],
               "point": POINT_RADIUS, "states": sizes.free_states, "horizon": horizon,
@@ -139,9 +143,10 @@ def reproduce(out: str | os.PathLike, *, scale: str = "quick", results_dir=None,
     for name, frame in (("findings", found), ("findings_by_radius", curves),
                         ("against_circle", against), ("against_free", free_ratio),
                         ("ftle", means), ("ftle_by_radius", by_radius), ("free_disk", free),
-                        ("focal_drift", drift), ("elastic_speeds", speeds),
-                        ("null_levels", levels)):
+                        ("focal_drift", drift), ("elastic_speeds", speeds)):
         run.write_csv(f"tables_{name}.csv", frame)
+    write_null_calibration(run.results, "tables",
+                           levels.drop(columns=["table", "rule"]))
     run.write_figure("tables.png", tables_figure(curves, by_radius, free))
     lines = header(
         "The paper's comparison in the circle, the ellipse and the stadium", run.command,
