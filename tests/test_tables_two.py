@@ -78,8 +78,9 @@ def test_energy_kept_and_disks_stay_inside(table, rule):
 @pytest.mark.parametrize("rule", ["mirror", "elastic"])
 def test_energy_kept_over_a_million_wall_bounces(table, rule):
     ic = initial_conditions(1, R, rng=4, method="uniform", rule=rule, table=table)[0]
-    # two disks make 2 / mean_free_time wall contacts per unit time
-    t_max = 1.05e6 * table.mean_free_time(R) / 2
+    # two unit-speed disks make 2 / mean_free_time wall contacts per unit time; under the
+    # elastic rule the speeds are shared, the mean speed is below 1, hence the 20 % margin
+    t_max = 1.2e6 * table.mean_free_time(R) / 2
     run = simulate_two_particle(ic, R, t_max=t_max, rule=rule, table=table, n_steps=10**5,
                                 tau=t_max / 10**5, log_collisions=True)
     assert run.n_boundary >= 10**6
