@@ -25,8 +25,17 @@ other, K rounds, and prints both rates of each round and the ratio box / table (
 range): the machine is shared, so only the ratio measured in the same run means much.
 ``--only-box`` skips the main table.
 
+Large N (issue 64): ``--sizes 1e3 1e4 1e5 1e6`` times N disks at packing 0.3, mirror
+rule, in the unit table and in the periodic box, as a user calls `kicktimes.simulate_disks`
+(the collision log on), and prints the cost per collision at each N and its ratio to the
+smallest N, both geometries in one run. The cost is marginal: the CPU time of a run of
+``--per-disk`` collisions per disk less that of a run of 1 per disk from the same state,
+over the collisions between them, so the set-up (O(N): cells, calendar, every disk's
+first prediction) and the first disks' compilation are left out; the best of
+``--repeats``. The states (`kicktimes.initial_state`, RSA then relaxation) are timed too.
+
 Run: python benchmarks/bench_disks.py [--quick] [--packings 0.1 0.3 0.5] [--rounds 5]
-[--robust 1e8] [--box 5 [--only-box]]
+[--robust 1e8] [--box 5 [--only-box]] [--sizes 1e3 1e4 1e5 1e6 [--per-disk 5]]
 """
 
 from __future__ import annotations
@@ -66,6 +75,48 @@ def engine_rate(n, phi, collisions, repeats, rule="mirror", box=None):
     sec, run = cpu_best(lambda: kt.simulate_disks(state, r, t_max=t_max, rule=rule, box=box),
                         repeats)
     return run.n_pp / sec, run, state, r
+
+
+def marginal_cost(n, phi, per_disk, repeats, box=None):
+    """``(seconds per collision, initial_state's CPU seconds)`` of `kicktimes.simulate_disks`
+    at ``n`` disks, packing ``phi``, mirror rule: a run of ``per_disk`` collisions per disk
+    less a run of one, from the same state, over the collisions between them."""
+    area = math.pi if box is None else box * box
+    r = math.sqrt(phi * area / (math.pi * n))
+    t0 = time.process_time()
+    state = kt.initial_state(n, r, rng=1, box=box)
+    t_state = time.process_time() - t0
+    per = n / (0.5 * n * enskog_frequency(r, n, area=area))  # time per collision per disk
+    best = math.inf
+    for _ in range(repeats):
+        cost = []
+        for k in (1.0, per_disk):
+            t0 = time.process_time()
+            run = kt.simulate_disks(state, r, t_max=k * per, box=box)
+            cost.append((time.process_time() - t0, run.n_pp))
+            del run
+        best = min(best, (cost[1][0] - cost[0][0]) / (cost[1][1] - cost[0][1]))
+    return best, t_state
+
+
+def sizes_table(sizes, per_disk, repeats, phi=0.3):
+    """The cost per collision at each of ``sizes`` in the table and the box, as a ratio to
+    the smallest size, one geometry after the other in this process."""
+    kt.simulate_disks(kt.initial_state(100, 0.02, rng=1), 0.02, t_max=0.1)  # compiled
+    kt.simulate_disks(kt.initial_state(100, 0.02, rng=1, box=1.0), 0.02, t_max=0.1, box=1.0)
+    print(f"kicktimes {kt.__version__}, {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}: "
+          f"packing {phi}, mirror rule, marginal CPU cost per collision between 1 and "
+          f"{per_disk:g} collisions per disk, best of {repeats}")
+    print("| geometry | N | ns / collision | collisions / CPU s | × N = "
+          f"{sizes[0]:.0e} | initial_state, CPU s |")
+    print("|---|---|---|---|---|---|")
+    for name, box in (("circle", None), ("box", 1.0)):
+        first = None
+        for n in sizes:
+            cost, t_state = marginal_cost(n, phi, per_disk, repeats, box=box)
+            first = cost if first is None else first
+            print(f"| {name} | {n:.0e} | {1e9 * cost:.0f} | {1.0 / cost:.3g} | "
+                  f"{cost / first:.2f} | {t_state:.1f} |", flush=True)
 
 
 def box_rounds(rounds, collisions, n=1000, phi=0.3):
@@ -144,7 +195,16 @@ def main(argv=None):
                     help="also compare the periodic box with the table at N = 1000, packing "
                          "0.3, in this many alternated rounds")
     ap.add_argument("--only-box", action="store_true", help="only the --box comparison")
+    ap.add_argument("--sizes", type=float, nargs="+", default=None,
+                    help="only the large-N table: the cost per collision at these N, the "
+                         "table and the box, as a ratio to the first")
+    ap.add_argument("--per-disk", type=float, default=5.0,
+                    help="collisions per disk of the --sizes runs (the marginal cost is "
+                         "taken from 1 to this many)")
     args = ap.parse_args(argv)
+    if args.sizes:
+        sizes_table([int(n) for n in args.sizes], args.per_disk, args.repeats)
+        return
     collisions = 3e5 if args.quick else args.collisions
     if args.box:
         print(f"kicktimes {kt.__version__}, "
