@@ -429,3 +429,29 @@ def test_the_command_line_writes_the_log_and_prints_enskogs_frequency(tmp_path):
     bad = CliRunner().invoke(main, ["simulate", "--disks", "500", "--packing", "0.8",
                                     "--out", str(out)])
     assert bad.exit_code != 0 and "--packing must lie in (0.0, 0.7]" in bad.output
+
+
+# --- the disks' numbering in space -------------------------------------------------------------
+@pytest.mark.parametrize("bits", [1, 2, 3, 6])
+def test_hilbert_index_is_a_path_through_neighbouring_cells(bits):
+    side = 1 << bits
+    cx, cy = (a.ravel() for a in np.meshgrid(np.arange(side), np.arange(side)))
+    d = cells.hilbert_index(cx, cy, bits)
+    assert sorted(d.tolist()) == list(range(side * side))
+    path = np.argsort(d)
+    steps = np.abs(np.diff(cx[path])) + np.abs(np.diff(cy[path]))
+    assert (steps == 1).all()
+
+
+def test_cell_order_is_a_permutation_with_the_escaped_last():
+    m = 5
+    rng = np.random.default_rng(3)
+    c = rng.integers(-1, m * m, size=200)
+    order = cells.cell_order(c, m)
+    assert sorted(order.tolist()) == list(range(200))
+    ranked = c[order]
+    n_out = int((c < 0).sum())
+    assert n_out > 0 and (ranked[-n_out:] < 0).all() and (ranked[:-n_out] >= 0).all()
+    # the disks of one cell are contiguous: as many runs of equal cells as cells
+    seen = ranked[:-n_out]
+    assert 1 + np.count_nonzero(np.diff(seen)) == np.unique(seen).size

@@ -44,6 +44,7 @@ from .distributions import hyperexpon
 from .ear1 import ear1_intervals
 from .ensemble import PoissonEnsembleResult, test_poisson_ensemble
 from .enskog import contact_value, enskog_frequency, henderson_z, speed_rate_factor
+from .eos import contact_from_z, kolafa_rottner_z, virial_z
 from .findings import (
     D_MARGIN,
     DIAGNOSTIC_MARGINS,
@@ -142,6 +143,7 @@ __all__ = [
     "is_sticky",
     "stretching_per_perturbation",
     "enskog_frequency", "henderson_z",
+    "virial_z", "kolafa_rottner_z", "contact_from_z",
     "speed_rate_factor",
     "dilute_tagged_times",
     "dilute_tagged_disk",

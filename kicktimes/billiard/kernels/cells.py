@@ -31,8 +31,8 @@ import numpy as np
 from numba import njit
 
 __all__ = ["cell_of", "cell_of_box", "cell_of_table", "cell_order", "crossing", "crossing_box",
-           "crossing_table", "grid", "grid_box", "grid_table", "hilbert_index", "image_of", "insert",
-           "remove", "spatial_order"]
+           "crossing_table", "grid", "grid_box", "grid_table", "hilbert_index", "image_of",
+           "insert", "remove", "spatial_order"]
 
 INF = np.inf
 
