@@ -75,7 +75,7 @@ from .gof import GofResult, goodness_of_fit
 from .groups import PoissonGroup, poisson_group, pooled_intervals
 from .hazard import HazardTable, interval_hazard
 from .kinetic import conditional_kinetic_rate, mean_kinetic_rate
-from .margins import COUNTS_MARGIN
+from .margins import COUNTS_MARGIN, EOS_MARGIN
 from .mixture import RateMixture, rate_mixture, simulate_cox_times
 from .mmpp import (
     MMPP_MIN_EVENTS,
@@ -176,6 +176,7 @@ __all__ = [
     "DIAGNOSTIC_MARGINS",
     "RR_MARGIN",
     "COUNTS_MARGIN",
+    "EOS_MARGIN",
     "margin_of",
     "null_reading",
     "ratio_reading",

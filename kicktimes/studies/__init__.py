@@ -103,6 +103,8 @@ STUDIES = {
         Study("tables", "tables.md",
               "the paper's comparison in the circle, the ellipse and the stadium",
               options=("scheduler",)),
+        Study("eos", "eos.md",
+              "the N-disk engine's equation of state against the literature, 0.05-0.68"),
     )
 }
 

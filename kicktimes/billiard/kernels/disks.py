@@ -755,6 +755,28 @@ def no_observers(n: int) -> tuple:
             np.array([-np.inf, -np.inf, 0.0, 0.0]))
 
 
+#: the cache line, in bytes: the disk table's rows of 64 bytes start on one
+CACHE_LINE = 64
+
+
+def aligned_zeros(shape: tuple, dtype) -> np.ndarray:
+    """A zeroed C-contiguous array whose first element starts on a `CACHE_LINE` boundary.
+
+    A large NumPy array starts 16 bytes past a page (the allocator's header), so every
+    64-byte row of the disk table would straddle two cache lines and a scan of a
+    neighbour's row would touch two (benchmarks/bench_disks.py ``--sizes``).
+
+    >>> a = aligned_zeros((1000, 8), np.float64)
+    >>> a.ctypes.data % CACHE_LINE, a.shape, a.flags.c_contiguous, float(a.sum())
+    (0, (1000, 8), True, 0.0)
+    """
+    dtype = np.dtype(dtype)
+    size = int(np.prod(shape)) * dtype.itemsize
+    buf = np.zeros(size + CACHE_LINE, dtype=np.uint8)
+    start = (-buf.ctypes.data) % CACHE_LINE
+    return buf[start:start + size].view(dtype).reshape(shape)
+
+
 def new_engine(state: np.ndarray, radii: np.ndarray, m: int, w: float,
                box: float | None = None, tab: tuple | None = None) -> tuple:
     """``(perm, engine)``: the engine's arrays ``(fs, iv, head, qt, qi, ht, qh, qs, qw)`` for
@@ -768,10 +790,10 @@ def new_engine(state: np.ndarray, radii: np.ndarray, m: int, w: float,
     n = state.shape[0]
     perm = cells.spatial_order(state[:, 0], state[:, 1], m, w, box,
                                None if tab is None else tab[4])
-    fs = np.zeros((n, 8))
+    fs = aligned_zeros((n, 8), np.float64)
     fs[:, :4] = state[perm]
     fs[:, RAD] = radii[perm]
-    iv = np.zeros((n, 8), dtype=np.int32)
+    iv = aligned_zeros((n, 8), np.int32)
     head = np.empty(m * m, dtype=np.int32)
     q = cal.new_calendar(n, 1.0)
     no_log = np.empty(0, dtype=np.int32)
