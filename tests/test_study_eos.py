@@ -78,6 +78,27 @@ def test_frequency_finite_size_and_halves():
     assert (h["verdict"] == "lower").all()
 
 
+def test_coverage_pooling_and_the_states_to_resolve():
+    from kicktimes.studies.eos.tables import coverage, pooled, states_to_resolve
+
+    assert coverage(8) == pytest.approx(0.980, abs=1e-3)
+    assert coverage(10**6) == pytest.approx(0.9973, abs=1e-4)
+    frame = pd.DataFrame({"n": [10, 10], "ratio": [1.001, 1.003], "se": [0.001, 0.002]})
+    p = pooled(frame).iloc[0]
+    # inverse-variance weights 4 : 1
+    assert p["ratio"] == pytest.approx((4 * 1.001 + 1.003) / 5)
+    assert p["se"] == pytest.approx(1 / math.sqrt(1e6 + 2.5e5))
+    # at an estimate 0 off, 3 se = 1.5 margins: (1.5)^2 = 2.25 times the states
+    assert states_to_resolve(1.0, 0.0005, 8, 0.001) == 18
+    assert math.isnan(states_to_resolve(1.0011, 0.0001, 8, 0.001))
+    assert states_to_resolve(1.0, 1e-6, 8, 0.001) == 8
+
+
+def test_the_frequency_prediction_counts_the_degrees_of_freedom():
+    f = frequency_table(_runs(stats.kolafa_rottner_z, n=1000, noise=1e-5))
+    assert f["dof_prediction"].to_numpy() == pytest.approx(math.sqrt(999 / 1000))
+
+
 def test_margins():
     assert reference_margin("virial", 0.4) == stats.EOS_MARGIN
     assert reference_margin("kolafa_rottner", 0.5) == pytest.approx(stats.EOS_MARGIN + 1e-5)
@@ -102,9 +123,9 @@ def test_the_quick_page(tmp_path):
     text = page.read_text(encoding="utf-8")
     assert text.startswith("# The N-disk engine's equation of state") and "Generated " in text
     answers = first_screen_answers(page)
-    assert len(answers) == 4
+    assert len(answers) == 5
     for name in ("eos_eos.csv", "eos_frequency.csv", "eos_finite_size.csv", "eos_halves.csv",
-                 "eos_runs.csv", "eos.png"):
+                 "eos_pooled.csv", "eos_runs.csv", "eos.png"):
         assert (tmp_path / "results" / name).exists(), name
     eos = pd.read_csv(tmp_path / "results" / "eos_eos.csv")
     assert set(eos["n"]) == set(SCALES["quick"].sizes)

@@ -37,10 +37,9 @@ RR_MARGIN = 0.03
 COUNTS_MARGIN = 0.025
 
 #: the margin of the N-disk engine's equation of state, Z over a reference, and of its
-#: collision frequency over Enskog's with the same Z's contact value: 0.1 %, below the
-#: smallest error the check must catch, Henderson's approximation at packing 0.4 (0.14 %
-#: above the exact Z); a reference's own stated error is added to it
-#: (`kicktimes.studies.eos`)
+#: collision frequency over Enskog's with the same Z's contact value: 0.1 %, which tells
+#: Henderson's approximation from the exact Z from packing 0.4 on (0.14 % there); a
+#: reference's own stated error is added to it (`kicktimes.studies.eos`)
 EOS_MARGIN = 0.001
 
 DIAGNOSTIC_MARGINS = {"ftle": FINE_MARGIN, "rr_offdiag": RR_MARGIN, "counts": COUNTS_MARGIN}

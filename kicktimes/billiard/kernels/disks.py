@@ -55,6 +55,7 @@ from numba import njit
 
 from kicktimes.billiard.geometry import boundary_hit_time, pair_hit_time
 from kicktimes.billiard.kernels import calendar as cal
+from kicktimes.billiard.kernels.aligned import aligned_zeros
 from kicktimes.billiard.kernels import cells
 from kicktimes.billiard.kernels import disk_walls as dw
 from kicktimes.billiard.kernels import observe as ob
@@ -753,28 +754,6 @@ def no_observers(n: int) -> tuple:
             (1.0, np.zeros(0, dtype=np.int64), np.empty((0, 0, 2))),
             (np.empty(1), np.empty(1)), (np.empty((0, 4)), np.zeros(1)),
             np.array([-np.inf, -np.inf, 0.0, 0.0]))
-
-
-#: the cache line, in bytes: the disk table's rows of 64 bytes start on one
-CACHE_LINE = 64
-
-
-def aligned_zeros(shape: tuple, dtype) -> np.ndarray:
-    """A zeroed C-contiguous array whose first element starts on a `CACHE_LINE` boundary.
-
-    A large NumPy array starts 16 bytes past a page (the allocator's header), so every
-    64-byte row of the disk table would straddle two cache lines and a scan of a
-    neighbour's row would touch two (benchmarks/bench_disks.py ``--sizes``).
-
-    >>> a = aligned_zeros((1000, 8), np.float64)
-    >>> a.ctypes.data % CACHE_LINE, a.shape, a.flags.c_contiguous, float(a.sum())
-    (0, (1000, 8), True, 0.0)
-    """
-    dtype = np.dtype(dtype)
-    size = int(np.prod(shape)) * dtype.itemsize
-    buf = np.zeros(size + CACHE_LINE, dtype=np.uint8)
-    start = (-buf.ctypes.data) % CACHE_LINE
-    return buf[start:start + size].view(dtype).reshape(shape)
 
 
 def new_engine(state: np.ndarray, radii: np.ndarray, m: int, w: float,

@@ -16,7 +16,7 @@ import pandas as pd
 
 from kicktimes.render.pages import header, simulations_source
 from kicktimes.studies.cache import cached_tables
-from kicktimes.studies.eos.page import SOURCES, answers, body, eos_figure
+from kicktimes.studies.eos.page import SOURCES, answers, body, eos_figure, pooled_table
 from kicktimes.studies.eos.tables import eos_table, finite_size, frequency_table, halves_table
 from kicktimes.studies.options import study_run
 
@@ -138,12 +138,13 @@ def reproduce(out: str | os.PathLike, *, scale: str = "quick", results_dir=None,
     freq = frequency_table(runs)
     size = finite_size(runs, primary)
     halves = halves_table(runs)
+    pool = pooled_table(freq, size)
     for name, frame in (("eos", eos), ("frequency", freq), ("finite_size", size),
-                        ("halves", halves), ("runs", runs)):
+                        ("halves", halves), ("pooled", pool), ("runs", runs)):
         run.write_csv(f"eos_{name}.csv", frame)
-    run.write_figure("eos.png", eos_figure(eos, primary))
+    run.write_figure("eos.png", eos_figure(eos, freq, primary))
     lines = header("The N-disk engine's equation of state against the literature",
                    run.command, [simulations_source("eos", run.cache.name)])
-    lines += answers(eos, freq, size, halves, primary) + [""]
-    lines += body(eos, freq, size, halves, sizes, cpu, primary)
+    lines += answers(eos, freq, size, halves, pool, primary) + [""]
+    lines += body(eos, freq, size, halves, pool, sizes, cpu, primary)
     return run.write_page(lines, SOURCES)

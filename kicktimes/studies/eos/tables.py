@@ -12,24 +12,16 @@ import math
 
 import numpy as np
 import pandas as pd
-from scipy.stats import norm
+from scipy.stats import t as student
 
-from kicktimes.stats import (
-    EOS_MARGIN,
-    equivalence_sample_size,
-    henderson_z,
-    kolafa_rottner_z,
-    ratio_verdict,
-    virial_z,
-)
+from kicktimes.stats import EOS_MARGIN, henderson_z, kolafa_rottner_z, ratio_verdict, virial_z
 
-__all__ = ["KOLAFA_ROTTNER_ERROR", "LEVEL", "SE_MULTIPLE", "VIRIAL_RANGE", "eos_table",
-           "finite_size", "frequency_table", "halves_table", "reference_margin"]
+__all__ = ["KOLAFA_ROTTNER_ERROR", "SE_MULTIPLE", "VIRIAL_RANGE", "coverage", "eos_table",
+           "finite_size", "frequency_table", "halves_table", "pooled", "reference_margin",
+           "states_to_resolve"]
 
 #: intervals are the estimate +- this many standard errors
 SE_MULTIPLE = 3.0
-#: their coverage for a normal estimate, 99.73 %
-LEVEL = float(2 * norm.cdf(SE_MULTIPLE) - 1)
 #: the virial series is the reference up to this packing (issue 64; at 0.5 its truncation
 #: at B10 is 0.6 % low)
 VIRIAL_RANGE = 0.4
@@ -53,6 +45,47 @@ def reference_margin(reference: str, packing: float) -> float:
     raise ValueError(f"reference must be 'virial' or 'kolafa_rottner', got {reference!r}")
 
 
+def coverage(states: int) -> float:
+    """The coverage of an interval of `SE_MULTIPLE` standard errors over ``states``
+    independent states (Student's t with ``states - 1`` degrees of freedom): 98.0 % at 8.
+
+    >>> round(coverage(8), 3)
+    0.98
+    """
+    return float(2.0 * student.cdf(SE_MULTIPLE, states - 1) - 1.0)
+
+
+def states_to_resolve(estimate, se, states, margin):
+    """The states at which the interval ``estimate +- SE_MULTIPLE se`` (the standard error
+    falling as ``1 / sqrt(states)``) would fit inside ``1 +- margin``, were the estimate to
+    stay where it is: ``states (SE_MULTIPLE se / (margin - |estimate - 1|))^2``, at least
+    ``states``; NaN where the estimate itself lies at or beyond the margin (no number of
+    states resolves it).
+
+    >>> states_to_resolve(1.0005, 0.0002, 8, 0.001)
+    12
+    >>> states_to_resolve(1.002, 0.0002, 8, 0.001)
+    nan
+    """
+    room = margin - abs(estimate - 1.0)
+    if not room > 0.0:
+        return math.nan
+    return max(int(states), int(math.ceil(states * (SE_MULTIPLE * se / room) ** 2)))
+
+
+def pooled(frame: pd.DataFrame) -> pd.DataFrame:
+    """Per N: the inverse-variance mean of ``ratio`` over the packings, its standard error
+    and its interval of `SE_MULTIPLE` of them (the packings are independent runs)."""
+    rows = []
+    for n, g in frame.groupby("n"):
+        w = 1.0 / g["se"].to_numpy() ** 2
+        m = float(np.sum(w * g["ratio"].to_numpy()) / np.sum(w))
+        se = float(1.0 / math.sqrt(np.sum(w)))
+        rows.append({"n": int(n), "ratio": m, "se": se, "ratio_low": m - SE_MULTIPLE * se,
+                     "ratio_high": m + SE_MULTIPLE * se, "packings": len(g)})
+    return pd.DataFrame(rows)
+
+
 def _per_state(runs: pd.DataFrame, column: str) -> pd.DataFrame:
     return runs.groupby(["packing", "n", "state"], as_index=False)[column].mean()
 
@@ -61,6 +94,7 @@ def _mean_se(frame: pd.DataFrame, column: str) -> pd.DataFrame:
     g = frame.groupby(["packing", "n"])[column]
     out = g.agg(["mean", "std", "count"]).reset_index()
     out["se"] = out["std"] / np.sqrt(out["count"])
+    out["coverage"] = [coverage(int(k)) for k in out["count"]]
     return out.drop(columns="std").rename(columns={"count": "states"})
 
 
@@ -97,10 +131,10 @@ def eos_table(runs: pd.DataFrame) -> pd.DataFrame:
 def frequency_table(runs: pd.DataFrame) -> pd.DataFrame:
     """Per (packing, N): the collision frequency over Enskog's with the contact value of
     the same run's ``z`` (`stats.contact_from_z`), its 3-SE interval and verdict at
-    `EOS_MARGIN`. In equilibrium the ratio is :math:`\\pi kT / (\\langle|w|\\rangle
-    \\langle|w\\cdot n|\\rangle_{coll})`, which is 1 for Maxwellian velocities
-    independent of the positions: the count of collisions and the sum of their impulses
-    checked against each other."""
+    `EOS_MARGIN`. The frequency cancels: the ratio is :math:`\\sqrt{\\pi kT} /
+    \\langle|w\\cdot n|\\rangle_{coll}`, the Maxwellian mean normal speed at contact over
+    the measured one (kT = E/N), so it checks the velocities at contact, not the count
+    (``dof_prediction``: :math:`\\sqrt{(N-1)/N}`, the zero total momentum's share)."""
     runs = runs.assign(ratio=runs["frequency"] / runs["enskog"])
     t = _mean_se(_per_state(runs, "ratio"), "ratio").rename(columns={"mean": "ratio"})
     half = SE_MULTIPLE * t["se"]
@@ -108,14 +142,19 @@ def frequency_table(runs: pd.DataFrame) -> pd.DataFrame:
     t["margin"] = EOS_MARGIN
     t["verdict"] = [ratio_verdict(lo, hi, tolerance=EOS_MARGIN)
                     for lo, hi in zip(t["ratio_low"], t["ratio_high"], strict=True)]
+    # kT = E/N, while the box's zero total momentum leaves 2N - 2 degrees of freedom:
+    # Maxwellian at E/(N - 1), the mean normal speed at contact is sqrt(pi E/(N - 1))
+    t["dof_prediction"] = np.sqrt((t["n"] - 1.0) / t["n"])
     return t
 
 
 def finite_size(runs: pd.DataFrame, primary: int) -> pd.DataFrame:
     """Per packing and each N other than ``primary``: Z(N) / Z(primary) with its 3-SE
     interval (independent states: the relative errors in quadrature), its verdict at
-    `EOS_MARGIN`, and the states per N that would resolve the margin
-    (`stats.equivalence_sample_size` at the intervals' `LEVEL`, 80 % power)."""
+    `EOS_MARGIN`, the states per N that would resolve the margin at this estimate
+    (`states_to_resolve`), and ``dof_prediction``: the ratio if the collisional part
+    followed the temperature of the 2N - 2 degrees of freedom, E/(N - 1), while Z divides
+    by E/N."""
     t = _mean_se(_per_state(runs, "z"), "z")
     base = t[t["n"] == primary].set_index("packing")
     rows = []
@@ -125,14 +164,22 @@ def finite_size(runs: pd.DataFrame, primary: int) -> pd.DataFrame:
         se = ratio * math.hypot(row["se"] / row["mean"], b["se"] / b["mean"])
         lo, hi = ratio - SE_MULTIPLE * se, ratio + SE_MULTIPLE * se
         states = int(row["states"])
-        rows.append({"packing": row["packing"], "n": int(row["n"]), "primary": primary,
+        z_inf = float(kolafa_rottner_z(row["packing"]))
+        n = int(row["n"])
+        rows.append({"packing": row["packing"], "n": n, "primary": primary,
                      "ratio": ratio, "se": se, "ratio_low": lo, "ratio_high": hi,
                      "margin": EOS_MARGIN,
                      "verdict": ratio_verdict(lo, hi, tolerance=EOS_MARGIN),
+                     "dof_prediction": _dof_z(z_inf, n) / _dof_z(z_inf, primary),
                      "states": states,
-                     "states_to_resolve": equivalence_sample_size(
-                         se, states, margin=EOS_MARGIN, level=LEVEL)})
+                     "states_to_resolve": states_to_resolve(ratio, se, states, EOS_MARGIN)})
     return pd.DataFrame(rows)
+
+
+def _dof_z(z_inf: float, n: int) -> float:
+    """Z with kT = E/N of a box of ``n`` disks whose collisional part is the limit's at the
+    temperature of its 2N - 2 degrees of freedom, E/(N - 1)."""
+    return 1.0 + (z_inf - 1.0) * n / (n - 1.0)
 
 
 def halves_table(runs: pd.DataFrame) -> pd.DataFrame:
@@ -147,7 +194,6 @@ def halves_table(runs: pd.DataFrame) -> pd.DataFrame:
     t["margin"] = EOS_MARGIN
     t["verdict"] = [ratio_verdict(lo, hi, tolerance=EOS_MARGIN)
                     for lo, hi in zip(t["ratio_low"], t["ratio_high"], strict=True)]
-    t["states_to_resolve"] = [equivalence_sample_size(se, int(k), margin=EOS_MARGIN,
-                                                      level=LEVEL)
-                              for se, k in zip(t["se"], t["states"], strict=True)]
+    t["states_to_resolve"] = [states_to_resolve(r, se, int(k), EOS_MARGIN) for r, se, k in
+                              zip(t["ratio"], t["se"], t["states"], strict=True)]
     return t
