@@ -55,10 +55,10 @@ from numba import njit
 
 from kicktimes.billiard.geometry import boundary_hit_time, pair_hit_time
 from kicktimes.billiard.kernels import calendar as cal
-from kicktimes.billiard.kernels.aligned import aligned_zeros
 from kicktimes.billiard.kernels import cells
 from kicktimes.billiard.kernels import disk_walls as dw
 from kicktimes.billiard.kernels import observe as ob
+from kicktimes.billiard.kernels.aligned import aligned_zeros
 from kicktimes.billiard.kernels.tangent import (
     BIG,
     curved_wall_tangent,
