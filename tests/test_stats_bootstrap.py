@@ -103,3 +103,21 @@ def test_no_resample_is_an_empty_array_and_draws_nothing():
     assert stats.resample_indices(5, n_boot=0, rng=rng).shape == (0, 5)
     assert stats.resample_indices(5, n_boot=0, rng=rng, chunk=2, with_identity=True).shape == (1, 5)
     assert rng.integers(0, 100) == np.random.default_rng(8).integers(0, 100)
+
+
+@pytest.mark.parametrize("shape", [(200, 300), (999, 7), (40, 5, 4), (1000, 1)])
+def test_the_all_finite_fast_path_is_nanpercentile_to_the_bit(shape):
+    from kicktimes.stats import percentile_interval
+
+    rng = np.random.default_rng(len(shape))
+    v = rng.standard_normal(shape) * 1e3
+    for axis in range(v.ndim):
+        low, high = percentile_interval(v, axis=axis)
+        ref_low, ref_high = np.nanpercentile(v, [2.5, 97.5], axis=axis)
+        assert np.array_equal(low, ref_low) and np.array_equal(high, ref_high)
+    w = v.copy()
+    w.flat[::7] = np.nan  # the slow path keeps dropping the non-finite replicates
+    low, high = percentile_interval(w, axis=0)
+    ref_low, ref_high = np.nanpercentile(w, [2.5, 97.5], axis=0)
+    np.testing.assert_array_equal(low, ref_low)
+    np.testing.assert_array_equal(high, ref_high)

@@ -170,7 +170,13 @@ def percentile_interval(replicates, *, level=0.95, axis=None):
     a = _tail_percent(level)
     if axis is not None:
         v = np.asarray(replicates, float)
-        v = np.where(np.isfinite(v), v, np.nan)
+        finite = np.isfinite(v)
+        if finite.all():
+            # the same numbers as nanpercentile's (tests/test_stats_bootstrap.py), which loops over
+            # the slices in Python: 4x slower on the report's (200, 10^5) Q-Q band
+            low, high = np.percentile(v, [a, 100.0 - a], axis=axis)
+            return low, high
+        v = np.where(finite, v, np.nan)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", RuntimeWarning)  # a slice without a finite value
             low, high = np.nanpercentile(v, [a, 100.0 - a], axis=axis)
