@@ -161,9 +161,21 @@ def body(eos, freq, size, halves, pool, sizes, cpu, primary) -> list[str]:
     pt["measured − 1"] = [_pct(r, lo, hi) for r, lo, hi in
                           zip(pt["ratio"], pt["ratio_low"], pt["ratio_high"], strict=True)]
     lines += markdown_table(pt[["what", "n", "measured − 1", "prediction", "packings"]])
-    lines += ["", "The frequency ratio at N = 10⁴ matches the degrees-of-freedom prediction; "
-              "Z does not follow it (its collisional part is not rescaled by N/(N − 1)): "
-              "which temperature a finite box's Z should divide by is left open.", "",
+    fp = pool[pool["what"].str.startswith("frequency")]
+    gaps = "; ".join(
+        f"N = {int(r['n'])}: {100 * (r['ratio'] - q):+.4f} % [{100 * (r['ratio_low'] - q):+.4f}, "
+        f"{100 * (r['ratio_high'] - q):+.4f}]"
+        for (_, r), q in zip(fp.iterrows(), np.sqrt((fp["n"] - 1.0) / fp["n"]), strict=True))
+    zp = pool[pool["what"].str.startswith("Z(N)")]
+    side = []
+    for _, r in zp.iterrows():
+        pred = size.loc[size["n"] == r["n"], "dof_prediction"]
+        where = ("below" if r["ratio_high"] < pred.min() else "above" if
+                 r["ratio_low"] > pred.max() else "inside")
+        side.append(f"N = {int(r['n'])}: its interval lies {where} the predictions' range")
+    lines += ["", f"Frequency ratio measured − predicted: {gaps}. Pooled Z(N) / Z(primary): "
+              + "; ".join(side) + ". Which temperature a finite box's Z should divide by "
+              "(E/N or E/(N − 1)) is left open.", "",
               "## Finite size and equilibration per packing", ""]
     s = size.copy()
     s["Z(N) / Z(primary) − 1"] = [f"{_pct(r, lo, hi)} {v}" for r, lo, hi, v in
