@@ -432,17 +432,6 @@ def test_the_command_line_writes_the_log_and_prints_enskogs_frequency(tmp_path):
 
 
 # --- the disks' numbering in space -------------------------------------------------------------
-@pytest.mark.parametrize("bits", [1, 2, 3, 6])
-def test_hilbert_index_is_a_path_through_neighbouring_cells(bits):
-    side = 1 << bits
-    cx, cy = (a.ravel() for a in np.meshgrid(np.arange(side), np.arange(side)))
-    d = cells.hilbert_index(cx, cy, bits)
-    assert sorted(d.tolist()) == list(range(side * side))
-    path = np.argsort(d)
-    steps = np.abs(np.diff(cx[path])) + np.abs(np.diff(cy[path]))
-    assert (steps == 1).all()
-
-
 def test_cell_order_is_a_permutation_with_the_escaped_last():
     m = 5
     rng = np.random.default_rng(3)

@@ -83,13 +83,11 @@ def test_the_engine_makes_the_brute_force_collision_sequence(n, unequal):
     state = kt.initial_state(n, radii, rng=n, rule="elastic", masses=masses, box=box)
     compared = 0
     worst = 0.0
-    # windows of 15 collisions, each from the engine's state at the last one's time:
-    # rounding differences (1e-16) grow by chaos, not over the window (eight disks of
-    # radius 0.07 in the unit box stretch them about 2x per collision: over 25 collisions
-    # the engine and the reference, which round differently, part by up to 3e-9)
+    # windows of 25 collisions, each from the engine's state at the last one's time:
+    # rounding differences (1e-16) grow by chaos, not over the window
     while compared < 200:
-        log, _ = brute_force_box(state, radii, box, 16, masses)
-        # (the run ends between the 15th and the 16th)
+        log, _ = brute_force_box(state, radii, box, 26, masses)
+        # (the run ends between the 25th and the 26th)
         t_end = 0.5 * (log[-2, 0] + log[-1, 0])
         log = log[:-1]
         run = kt.simulate_disks(state, radii, t_max=t_end, rule="elastic", masses=masses,
