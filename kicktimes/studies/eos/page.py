@@ -170,9 +170,10 @@ def body(eos, freq, size, halves, pool, sizes, cpu, primary) -> list[str]:
     side = []
     for _, r in zp.iterrows():
         pred = size.loc[size["n"] == r["n"], "dof_prediction"]
-        where = ("below" if r["ratio_high"] < pred.min() else "above" if
-                 r["ratio_low"] > pred.max() else "inside")
-        side.append(f"N = {int(r['n'])}: its interval lies {where} the predictions' range")
+        where = ("lies below" if r["ratio_high"] < pred.min() else "lies above" if
+                 r["ratio_low"] > pred.max() else "overlaps")
+        side.append(f"N = {int(r['n'])}: its interval {where} the predictions' range "
+                    f"({100 * (pred.min() - 1):+.3f} to {100 * (pred.max() - 1):+.3f} %)")
     lines += ["", f"Frequency ratio measured − predicted: {gaps}. Pooled Z(N) / Z(primary): "
               + "; ".join(side) + ". Which temperature a finite box's Z should divide by "
               "(E/N or E/(N − 1)) is left open.", "",
