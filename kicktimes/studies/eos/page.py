@@ -5,7 +5,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-import pandas as pd
 
 from kicktimes.render.pages import markdown_table
 from kicktimes.render.provenance import Source
@@ -15,15 +14,16 @@ from kicktimes.studies.eos.tables import (
     KOLAFA_ROTTNER_ERROR,
     SE_MULTIPLE,
     VIRIAL_RANGE,
+    contact_speed_prediction,
     coverage,
     eos_table,
     finite_size,
     frequency_table,
     halves_table,
-    pooled,
+    pooled_table,
 )
 
-__all__ = ["LIQUID_HEXATIC", "SOURCES", "answers", "body", "eos_figure", "pooled_table"]
+__all__ = ["LIQUID_HEXATIC", "SOURCES", "answers", "body", "eos_figure"]
 
 #: the hard-disk fluid ends at the liquid-hexatic transition, packings 0.700-0.716
 #: (Bernard & Krauth, PRL 107, 155704 (2011)): the check stays below it
@@ -34,26 +34,18 @@ def _pct(ratio, low, high) -> str:
     return f"{100 * (ratio - 1):+.3f} % [{100 * (low - 1):+.3f}, {100 * (high - 1):+.3f}]"
 
 
+def _prediction(row) -> str:
+    """A pooled row's prediction in per cent: one value, or its range over the packings."""
+    low, high = 100 * (row["prediction_low"] - 1), 100 * (row["prediction_high"] - 1)
+    return f"{low:+.3f} %" if low == high else f"{low:+.3f} to {high:+.3f} %"
+
+
 def _within(frame, column="verdict") -> int:
     return int(frame[column].str.startswith("within").sum())
 
 
 def _worst(frame, ratio="ratio"):
     return frame.iloc[int(np.argmax(np.abs(frame[ratio].to_numpy() - 1)))]
-
-
-def pooled_table(freq, size) -> pd.DataFrame:
-    """The pooled frequency ratio per N and the pooled Z(N) / Z(primary), each beside the
-    degrees-of-freedom prediction at that N (`tables.pooled`)."""
-    f = pooled(freq).assign(what="frequency / Enskog(measured Z)")
-    f["prediction"] = np.sqrt((f["n"] - 1.0) / f["n"])
-    s = pooled(size).assign(what="Z(N) / Z(primary)")
-    pred = size.groupby("n")["dof_prediction"].agg(["min", "max"])
-    s["prediction"] = [f"{100 * (pred.loc[n, 'min'] - 1):+.3f} to "
-                       f"{100 * (pred.loc[n, 'max'] - 1):+.3f} %" for n in s["n"]]
-    f["prediction"] = [f"{100 * (v - 1):+.3f} %" for v in f["prediction"]]
-    return pd.concat([f, s], ignore_index=True)[["what", "n", "ratio", "se", "ratio_low",
-                                                 "ratio_high", "packings", "prediction"]]
 
 
 def answers(eos, freq, size, halves, pool, primary) -> list[str]:
@@ -82,7 +74,7 @@ def answers(eos, freq, size, halves, pool, primary) -> list[str]:
                    f"Rottner: {_pct(r['ratio_kr'], r['ratio_kr_low'], r['ratio_kr_high'])}).")
     fp = pool[pool["what"].str.startswith("frequency")]
     line = "; ".join(f"N = {int(r['n'])}: {_pct(r['ratio'], r['ratio_low'], r['ratio_high'])}"
-                     f" against {r['prediction']} predicted" for _, r in fp.iterrows())
+                     f" against {_prediction(r)} predicted" for _, r in fp.iterrows())
     out.append(f"- **Velocities at contact: collision frequency over Enskog's with the "
                f"measured Z's g(σ), pooled over packings, {line}** (the frequency cancels: "
                f"this is the mean normal speed at contact against the Maxwellian at E/N; "
@@ -90,7 +82,7 @@ def answers(eos, freq, size, halves, pool, primary) -> list[str]:
     sp = pool[pool["what"].str.startswith("Z(N)")]
     parts = [f"Z(N = {int(r['n'])}) / Z(N = {primary}) pooled "
              f"{_pct(r['ratio'], r['ratio_low'], r['ratio_high'])}, against "
-             f"{r['prediction']} if the collisional part followed E/(N − 1)"
+             f"{_prediction(r)} if the collisional part followed E/(N − 1)"
              for _, r in sp.iterrows()]
     open_ = size[~size["verdict"].str.startswith("within")]
     if len(open_):
@@ -160,20 +152,20 @@ def body(eos, freq, size, halves, pool, sizes, cpu, primary) -> list[str]:
     pt = pool.copy()
     pt["measured − 1"] = [_pct(r, lo, hi) for r, lo, hi in
                           zip(pt["ratio"], pt["ratio_low"], pt["ratio_high"], strict=True)]
+    pt["prediction"] = [_prediction(r) for _, r in pt.iterrows()]
     lines += markdown_table(pt[["what", "n", "measured − 1", "prediction", "packings"]])
     fp = pool[pool["what"].str.startswith("frequency")]
     gaps = "; ".join(
-        f"N = {int(r['n'])}: {100 * (r['ratio'] - q):+.4f} % [{100 * (r['ratio_low'] - q):+.4f}, "
-        f"{100 * (r['ratio_high'] - q):+.4f}]"
-        for (_, r), q in zip(fp.iterrows(), np.sqrt((fp["n"] - 1.0) / fp["n"]), strict=True))
+        f"N = {int(r['n'])}: {100 * (r['ratio'] - r['prediction_low']):+.4f} % "
+        f"[{100 * (r['ratio_low'] - r['prediction_low']):+.4f}, "
+        f"{100 * (r['ratio_high'] - r['prediction_low']):+.4f}]" for _, r in fp.iterrows())
     zp = pool[pool["what"].str.startswith("Z(N)")]
     side = []
     for _, r in zp.iterrows():
-        pred = size.loc[size["n"] == r["n"], "dof_prediction"]
-        where = ("lies below" if r["ratio_high"] < pred.min() else "lies above" if
-                 r["ratio_low"] > pred.max() else "overlaps")
+        where = ("lies below" if r["ratio_high"] < r["prediction_low"] else "lies above" if
+                 r["ratio_low"] > r["prediction_high"] else "overlaps")
         side.append(f"N = {int(r['n'])}: its interval {where} the predictions' range "
-                    f"({100 * (pred.min() - 1):+.3f} to {100 * (pred.max() - 1):+.3f} %)")
+                    f"({_prediction(r)})")
     lines += ["", f"Frequency ratio measured − predicted: {gaps}. Pooled Z(N) / Z(primary): "
               + "; ".join(side) + ". Which temperature a finite box's Z should divide by "
               "(E/N or E/(N − 1)) is left open.", "",
@@ -234,7 +226,7 @@ def eos_figure(eos, freq, primary):
                     yerr=[100 * (q["ratio"] - q["ratio_low"]),
                           100 * (q["ratio_high"] - q["ratio"])],
                     fmt=marks[n], ms=4, capsize=3, color=f"C{k}", label=f"N = {n}")
-        fx.axhline(100 * (np.sqrt((n - 1) / n) - 1), color=f"C{k}", ls="--", lw=1,
+        fx.axhline(100 * (float(contact_speed_prediction(n)) - 1), color=f"C{k}", ls="--", lw=1,
                    label=f"√((N − 1)/N), N = {n}")
     g = eos[eos["n"] == primary].sort_values("packing")
     ax.fill_between(g["packing"], -100 * g["margin_kr"], 100 * g["margin_kr"], step="mid",
@@ -278,6 +270,6 @@ SOURCES = (
            "dof_prediction, states_to_resolve", finite_size),
     Source("eos_halves.csv", "ratio, se, ratio_low, ratio_high, verdict, states_to_resolve",
            halves_table),
-    Source("eos_pooled.csv", "what, n, ratio, se, ratio_low, ratio_high, prediction",
-           pooled_table),
+    Source("eos_pooled.csv", "what, n, ratio, se, ratio_low, ratio_high, prediction_low, "
+           "prediction_high", pooled_table),
 )

@@ -16,8 +16,14 @@ import pandas as pd
 
 from kicktimes.render.pages import header, simulations_source
 from kicktimes.studies.cache import cached_tables
-from kicktimes.studies.eos.page import SOURCES, answers, body, eos_figure, pooled_table
-from kicktimes.studies.eos.tables import eos_table, finite_size, frequency_table, halves_table
+from kicktimes.studies.eos.page import SOURCES, answers, body, eos_figure
+from kicktimes.studies.eos.tables import (
+    eos_table,
+    finite_size,
+    frequency_table,
+    halves_table,
+    pooled_table,
+)
 from kicktimes.studies.options import study_run
 
 __all__ = ["PACKINGS", "SCALES", "EosScale", "reproduce", "run_cell"]

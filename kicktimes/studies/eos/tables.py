@@ -16,9 +16,9 @@ from scipy.stats import t as student
 
 from kicktimes.stats import EOS_MARGIN, henderson_z, kolafa_rottner_z, ratio_verdict, virial_z
 
-__all__ = ["KOLAFA_ROTTNER_ERROR", "SE_MULTIPLE", "VIRIAL_RANGE", "coverage", "eos_table",
-           "finite_size", "frequency_table", "halves_table", "pooled", "reference_margin",
-           "states_to_resolve"]
+__all__ = ["KOLAFA_ROTTNER_ERROR", "SE_MULTIPLE", "VIRIAL_RANGE", "contact_speed_prediction",
+           "coverage", "eos_table", "finite_size", "frequency_table", "halves_table", "pooled",
+           "pooled_table", "reference_margin", "states_to_resolve"]
 
 #: intervals are the estimate +- this many standard errors
 SE_MULTIPLE = 3.0
@@ -86,6 +86,34 @@ def pooled(frame: pd.DataFrame) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
+def contact_speed_prediction(n):
+    """The frequency ratio's prediction at ``n`` disks: :math:`\\sqrt{(N-1)/N}`. kT is E/N,
+    while the box's zero total momentum leaves 2N - 2 degrees of freedom: Maxwellian at
+    E/(N - 1), the mean normal speed at contact is :math:`\\sqrt{\\pi E/(N-1)}`.
+
+    >>> round(float(contact_speed_prediction(1000)), 6)
+    0.9995
+    """
+    n = np.asarray(n, dtype=float)
+    return np.sqrt((n - 1.0) / n)
+
+
+def pooled_table(freq: pd.DataFrame, size: pd.DataFrame) -> pd.DataFrame:
+    """The pooled frequency ratio per N (`pooled`) and the pooled Z(N) / Z(primary), each
+    beside its prediction: ``prediction_low .. prediction_high`` (the frequency's
+    `contact_speed_prediction`; Z's range of `finite_size`'s ``dof_prediction`` over the
+    packings)."""
+    f = pooled(freq).assign(what="frequency / Enskog(measured Z)")
+    f["prediction_low"] = f["prediction_high"] = contact_speed_prediction(f["n"])
+    s = pooled(size).assign(what="Z(N) / Z(primary)")
+    pred = size.groupby("n")["dof_prediction"].agg(["min", "max"])
+    s["prediction_low"] = pred.loc[s["n"], "min"].to_numpy()
+    s["prediction_high"] = pred.loc[s["n"], "max"].to_numpy()
+    return pd.concat([f, s], ignore_index=True)[
+        ["what", "n", "ratio", "se", "ratio_low", "ratio_high", "packings", "prediction_low",
+         "prediction_high"]]
+
+
 def _per_state(runs: pd.DataFrame, column: str) -> pd.DataFrame:
     return runs.groupby(["packing", "n", "state"], as_index=False)[column].mean()
 
@@ -142,9 +170,7 @@ def frequency_table(runs: pd.DataFrame) -> pd.DataFrame:
     t["margin"] = EOS_MARGIN
     t["verdict"] = [ratio_verdict(lo, hi, tolerance=EOS_MARGIN)
                     for lo, hi in zip(t["ratio_low"], t["ratio_high"], strict=True)]
-    # kT = E/N, while the box's zero total momentum leaves 2N - 2 degrees of freedom:
-    # Maxwellian at E/(N - 1), the mean normal speed at contact is sqrt(pi E/(N - 1))
-    t["dof_prediction"] = np.sqrt((t["n"] - 1.0) / t["n"])
+    t["dof_prediction"] = contact_speed_prediction(t["n"])
     return t
 
 
