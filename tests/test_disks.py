@@ -52,32 +52,6 @@ def test_the_calendar_always_gives_the_earliest_event():
                 cal.update(*q, k, times[k])
 
 
-def test_the_calendar_pops_ties_in_the_same_order_whatever_its_pool():
-    """The bucket lists drop stale nodes lazily; a pool just above n collects them often
-    (`calendar._collect`), and the pops, ties between equal times included, are those of
-    a pool that never collects."""
-    n = 200
-    seqs = []
-    for pool in (None, n + 1):
-        r = np.random.default_rng(5)
-        times = np.round(r.exponential(1.0, n), 1)  # many exact ties
-        q = cal.new_calendar(n, 1.0 / n, pool=pool)
-        cal.build(*q, times)
-        pops = []
-        for _ in range(4000):
-            i, t = cal.top(*q)
-            pops.append((i, t))
-            cal.update(*q, i, t + np.round(r.exponential(1.0), 1))
-            k = int(r.integers(n))
-            cal.update(*q, k, t + np.round(r.exponential(0.5), 1))
-        seqs.append(pops)
-        if pool is not None:
-            assert q[4][cal.N_COLLECT] > 0
-        else:
-            assert q[4][cal.N_COLLECT] == 0
-    assert seqs[0] == seqs[1]
-
-
 def test_a_cell_crossing_is_the_first_edge_the_centre_reaches():
     m, w = cells.grid(1000, 0.01)
     assert w >= 0.02 and m <= math.ceil(2 * math.sqrt(1000))

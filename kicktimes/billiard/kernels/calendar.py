@@ -17,29 +17,16 @@ prediction) stay in the calendar and are recognised when they come to the top, b
 per-disk event counters of the engine (`kicktimes.billiard.kernels.disks`): lazy
 invalidation, without a search.
 
-The bucket lists are lazy too. A list is a chain of *nodes* ``(disk, next)`` in a pool;
-a disk filed in a list gets a new node at the list's front, and taking it out (it is
-rescheduled) only changes its own row: its node stays in the chain, stale, and is
-skipped and freed when the bucket is emptied into the heap. So filing a disk writes the
-bucket's head and a node from the free stack (warm: the last one freed), never the rows
-of the disks beside it in the list, which at 10^5-10^6 disks are cache misses. The live
-nodes come out in the order of a doubly linked list with the same insertions and
-removals (newest first), so the heap, and every tie between equal times, is as before.
-When the pool runs out, the stale nodes of every list are unlinked in one pass
-(`_collect`, order kept).
+The arrays (`new_calendar`; memory O(n): 36 bytes per disk and 4 per bucket, ``nb`` the
+power of two at or above ``max(64, 2 n)``):
 
-The arrays (`new_calendar`; memory O(n): about 70 bytes per disk and 4 per bucket, ``nb``
-the power of two at or above ``max(64, 2 n)``, a pool of ``4 n + 64`` nodes):
-
-* ``qt[i]`` the event time of disk ``i``; ``qi[i] = (where, node, -, heap slot, disk at
-  heap slot i)``, where ``where`` is `IN_HEAP`, `OVERFLOW`, `NEVER` or the bucket slot
-  ``kb % nb`` of a listed disk, and ``node`` its live node there;
+* ``qt[i]`` the event time of disk ``i``; ``qi[i] = (where, next, prev, heap slot,
+  disk at heap slot i)``, where ``where`` is `IN_HEAP`, `OVERFLOW`, `NEVER` or the
+  bucket slot ``kb % nb`` of a listed disk;
 * ``ht[k]`` the times of the heap (slot ``k``; ``qi[k, HEAP_DISK]`` its disk);
-* ``qh[b]`` the first node of bucket slot ``b`` (``qh[nb]`` the overflow list), -1 empty;
-  then the pool: node ``k`` is ``qh[P + 2k]`` (its disk) and ``qh[P + 2k + 1]`` (the next
-  node, -1 at the end; for a free node the next free one), ``P = nb + 1``;
-* ``qs = [heap size, current bucket, first bucket of the window, nb, first free node,
-  pool size, collections]`` and ``qw = [1 / bw]``.
+* ``qh[b]`` the first disk of bucket slot ``b`` (``qh[nb]`` the overflow list), -1 empty;
+* ``qs = [heap size, current bucket, first bucket of the window, nb]`` and
+  ``qw = [1 / bw]``.
 
 Bucket numbers are ``kb = int(t / bw)`` (monotone in ``t``): every listed disk's event is
 later than every event in the heap.
@@ -50,31 +37,31 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from kicktimes.billiard.kernels import cells
+
 __all__ = ["IN_HEAP", "NEVER", "OVERFLOW", "build", "new_calendar", "remove", "schedule",
            "top", "update"]
 
-#: ``qi`` columns (``NODE``: the disk's live node in its bucket list)
-WHERE, NODE, _SPARE, SLOT, HEAP_DISK = range(5)
+#: ``qi`` columns
+WHERE, NEXT, PREV, SLOT, HEAP_DISK = range(5)
 #: ``where`` codes other than a bucket slot
 IN_HEAP, OVERFLOW, NEVER = -1, -2, -3
 #: ``qs`` fields
-HN, CUR, WIN, NB, FREE, POOL, N_COLLECT = range(7)
+HN, CUR, WIN, NB = range(4)
 
 
-def new_calendar(n: int, mean_spacing: float, pool: int | None = None):
+def new_calendar(n: int, mean_spacing: float):
     """Empty calendar arrays ``(qt, qi, ht, qh, qs, qw)`` for ``n`` disks whose events are
-    ``mean_spacing`` apart on average (fill with `build`); ``pool`` list nodes (default
-    ``4 n + 64``; at least ``n + 1``)."""
+    ``mean_spacing`` apart on average (fill with `build`)."""
     nb = 64
     while nb < 2 * n:
         nb *= 2
-    pool = 4 * n + 64 if pool is None else max(int(pool), n + 1)
     bw = 2.0 * mean_spacing if mean_spacing > 0.0 and np.isfinite(mean_spacing) else 1.0
     qt = np.full(n, np.inf)
     qi = np.full((n, 5), -1, dtype=np.int32)
     ht = np.empty(n)
-    qh = np.full(nb + 1 + 2 * pool, -1, dtype=np.int32)
-    qs = np.array([0, 0, 0, nb, -1, pool, 0], dtype=np.int64)
+    qh = np.full(nb + 1, -1, dtype=np.int32)
+    qs = np.array([0, 0, 0, nb], dtype=np.int64)
     qw = np.array([1.0 / bw])
     return qt, qi, ht, qh, qs, qw
 
@@ -141,67 +128,16 @@ def _heap_remove(qi, ht, qs, i):
             _sift_down(qi, ht, k, n)
 
 
-# --- the bucket lists: chains of pool nodes, stale nodes skipped ------------------------------
+# --- the bucket lists ------------------------------------------------------------------------
 @njit(cache=True, inline="always", error_model="numpy")
-def _free_all(qh, qs):
-    """Every node on the free stack (the lists are empty)."""
-    p = qs[NB] + 1
-    pool = qs[POOL]
-    for k in range(pool):
-        qh[p + 2 * k + 1] = k + 1
-    qh[p + 2 * pool - 1] = -1
-    qs[FREE] = 0
-
-
-@njit(cache=True, inline="always", error_model="numpy")
-def _free(qh, qs, node):
-    qh[qs[NB] + 2 + 2 * node] = qs[FREE]
-    qs[FREE] = node
-
-
-@njit(cache=True, inline="always", error_model="numpy")
-def _live(qi, i, node, where):
-    """Node ``node`` of disk ``i`` in the list ``where`` is the disk's live entry."""
-    return qi[i, WHERE] == where and qi[i, NODE] == node
-
-
-@njit(cache=True, error_model="numpy")
-def _collect(qi, qh, qs):
-    """Unlink and free the stale nodes of every list, keeping the order of the others."""
-    nb = qs[NB]
-    p = nb + 1
-    qs[N_COLLECT] += 1
-    for b in range(nb + 1):
-        where = b if b < nb else OVERFLOW
-        prev = -1
-        node = qh[b]
-        while node >= 0:
-            nxt = qh[p + 2 * node + 1]
-            if _live(qi, qh[p + 2 * node], node, where):
-                prev = node
-            else:
-                if prev < 0:
-                    qh[b] = nxt
-                else:
-                    qh[p + 2 * prev + 1] = nxt
-                _free(qh, qs, node)
-            node = nxt
-
-
-@njit(cache=True, inline="always", error_model="numpy")
-def _list_push(qi, qh, qs, i, b, where):
-    """File disk ``i`` at the front of list ``b`` (a new node; ``where``: its code)."""
-    node = qs[FREE]
-    if node < 0:
-        _collect(qi, qh, qs)
-        node = qs[FREE]
-    p = qs[NB] + 1
-    qs[FREE] = qh[p + 2 * node + 1]
-    qh[p + 2 * node] = i
-    qh[p + 2 * node + 1] = qh[b]
-    qh[b] = node
-    qi[i, NODE] = node
+def _list_push(qi, qh, i, b, where):
+    cells.insert(qh, qi, NEXT, PREV, i, b)
     qi[i, WHERE] = where
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _list_remove(qi, qh, i, b):
+    cells.remove(qh, qi, NEXT, PREV, i, b)
 
 
 # --- the calendar ---------------------------------------------------------------------------
@@ -218,16 +154,21 @@ def schedule(qt, qi, ht, qh, qs, qw, i, t):
         _heap_push(qi, ht, qs, i, t)
     elif kb < qs[WIN] + nb:
         b = kb % nb
-        _list_push(qi, qh, qs, i, b, b)
+        _list_push(qi, qh, i, b, b)
     else:
-        _list_push(qi, qh, qs, i, nb, OVERFLOW)
+        _list_push(qi, qh, i, nb, OVERFLOW)
 
 
 @njit(cache=True, inline="always", error_model="numpy")
 def remove(qt, qi, ht, qh, qs, i):
-    """Take disk ``i`` out of the calendar (out of a list: its node goes stale)."""
-    if qi[i, WHERE] == IN_HEAP:
+    """Take disk ``i`` out of the calendar."""
+    wh = qi[i, WHERE]
+    if wh == IN_HEAP:
         _heap_remove(qi, ht, qs, i)
+    elif wh >= 0:
+        _list_remove(qi, qh, i, wh)
+    elif wh == OVERFLOW:
+        _list_remove(qi, qh, i, qs[NB])
     qi[i, WHERE] = NEVER
 
 
@@ -254,55 +195,38 @@ def _advance(qt, qi, ht, qh, qs, qw):
     """Move on to the next bucket that holds events (the heap is empty); False if the
     calendar holds none at all."""
     nb = qs[NB]
-    p = nb + 1
     while qs[HN] == 0:
         cur = qs[CUR] + 1
         if cur >= qs[WIN] + nb:
             # every bucket of the window is done (its lists are empty): the next window
             # starts at the earliest overflow event's bucket, skipping empty stretches
-            t_min = np.inf
-            node = qh[nb]
-            while node >= 0:
-                i = qh[p + 2 * node]
-                if _live(qi, i, node, OVERFLOW):
-                    t_min = min(t_min, qt[i])
-                node = qh[p + 2 * node + 1]
-            if t_min == np.inf:
-                # no live overflow event: the stale nodes go back to the pool
-                node = qh[nb]
-                qh[nb] = -1
-                while node >= 0:
-                    nxt = qh[p + 2 * node + 1]
-                    _free(qh, qs, node)
-                    node = nxt
+            i = qh[nb]
+            if i < 0:
                 return False
+            t_min = np.inf
+            while i >= 0:
+                t_min = min(t_min, qt[i])
+                i = qi[i, NEXT]
             cur = max(cur, int(t_min * qw[0]))
             qs[WIN] = cur
-            node = qh[nb]
+            i = qh[nb]
             qh[nb] = -1
-            while node >= 0:
-                nxt = qh[p + 2 * node + 1]
-                i = qh[p + 2 * node]
-                live = _live(qi, i, node, OVERFLOW)
-                _free(qh, qs, node)
-                if live:
-                    kb = int(qt[i] * qw[0])
-                    if kb < cur + nb:
-                        _list_push(qi, qh, qs, i, kb % nb, kb % nb)
-                    else:
-                        _list_push(qi, qh, qs, i, nb, OVERFLOW)
-                node = nxt
+            while i >= 0:
+                j = qi[i, NEXT]
+                kb = int(qt[i] * qw[0])
+                if kb < cur + nb:
+                    _list_push(qi, qh, i, kb % nb, kb % nb)
+                else:
+                    _list_push(qi, qh, i, nb, OVERFLOW)
+                i = j
         qs[CUR] = cur
         b = cur % nb
-        node = qh[b]
+        i = qh[b]
         qh[b] = -1
-        while node >= 0:
-            nxt = qh[p + 2 * node + 1]
-            i = qh[p + 2 * node]
-            if _live(qi, i, node, b):
-                _heap_push(qi, ht, qs, i, qt[i])
-            _free(qh, qs, node)
-            node = nxt
+        while i >= 0:
+            j = qi[i, NEXT]
+            _heap_push(qi, ht, qs, i, qt[i])
+            i = j
     return True
 
 
@@ -320,9 +244,8 @@ def build(qt, qi, ht, qh, qs, qw, times):
     """Empty the calendar and file the event times ``times[i]`` of disks ``0..n-1``; the
     current bucket is the one of the earliest time."""
     n = times.shape[0]
-    for b in range(qs[NB] + 1):
+    for b in range(qh.shape[0]):
         qh[b] = -1
-    _free_all(qh, qs)
     qs[HN] = 0
     t_min = np.inf
     for i in range(n):
