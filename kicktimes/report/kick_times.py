@@ -153,18 +153,20 @@ def rescaled_intervals(seqs, windows):
     uniform points scaled by n: Exp(1) up to O(1/n). The first interval (from 0) is kept,
     the censored one after the last event is not.
     """
-    out = []
-    for t, w in zip(seqs, windows, strict=True):
-        t = np.asarray(t, dtype=float)
-        if t.size >= 2:
-            out.append(np.diff(np.concatenate(([0.0], t))) * (t.size / float(w)))
-    return np.concatenate(out) if out else np.empty(0)
+    seqs = [np.asarray(t, dtype=float) for t in seqs]
+    windows = np.asarray(windows, dtype=float)
+    if len(seqs) != windows.size:
+        raise ValueError(f"windows: need one per sequence ({len(seqs)}), got {windows.size}")
+    counts = np.array([t.size for t in seqs], dtype=np.int64)
+    times = np.concatenate(seqs) if seqs else np.empty(0)  # a copy: the kernel sorts it
+    return _pooled_rescaled_intervals(times, counts, windows)
 
 
 @njit(cache=True, error_model="numpy")
 def _pooled_rescaled_intervals(times, counts, windows):
-    """`rescaled_intervals` of the sequences ``times[s_k : s_k + counts[k]]`` (unsorted,
-    sorted here in place), pooled: the kernel of the Q-Q band's null ensembles."""
+    """The intervals of `rescaled_intervals` of the sequences ``times[s_k : s_k +
+    counts[k]]`` (sorted here in place), pooled in sequence order: ``(t_i - t_{i-1}) n_k /
+    w_k`` with ``t_0 = 0``, for the sequences of 2 or more events."""
     n_out = 0
     for n in counts:
         if n >= 2:
