@@ -195,7 +195,7 @@ def _fig5_claim(line_tab, findings_dir, panel):
         est, kind = (math.nan, math.nan, math.nan, "not run"), "not_tested"
     else:
         r = sel.iloc[0]
-        est, kind = (r["estimate"], r["ci_low"], r["ci_high"], r["verdict"]), "agreement"
+        est, kind = (r["estimate"], r["ci_low"], r["ci_high"], r["verdict"]), "line_fit"
     other, note = (math.nan, math.nan, math.nan, "not read"), ""
     if findings_dir is not None:
         by = _finding(findings_dir, panel.name, "counts", "two_particle")

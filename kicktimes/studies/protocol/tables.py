@@ -39,6 +39,7 @@ from kicktimes.stats import (
 )
 from kicktimes.stats.findings import share_verdict
 from kicktimes.studies.protocol.compute import CONVERGENCE
+from kicktimes.studies.protocol.verdicts import residual_verdict
 
 __all__ = ["BOOT_SEED", "FACTORS", "N_BOOT", "PAPER_READING", "Ratios", "convergence_table",
            "count_line_table", "fig4_table", "figure_of", "per_radius_table", "r1_table",
@@ -265,9 +266,10 @@ def count_line_table(rows: pd.DataFrame, panels) -> pd.DataFrame:
 
     .. math:: s = \Big[\frac{1}{R} \sum_r \big(\bar N(r) / (a + b r) - 1\big)^2\Big]^{1/2},
 
-    with its 95 % CI over IC resamples (the line refitted in each). Verdict: ``s`` read in
-    the 10 % band, `kicktimes.stats.ratio_verdict` on ``1 + s`` (*within 10 %*: the CI of
-    ``s`` lies below 0.1, the means within 10 % of their line in RMS; *higher*: above it).
+    with its 95 % CI over IC resamples (the line refitted in each). Verdict:
+    `kicktimes.studies.protocol.verdicts.residual_verdict`, ``s`` against 10 % (*residual
+    below 10 %*: the CI of ``s`` lies below 0.1, the means within 10 % of their line in RMS;
+    *residual above 10 %*: above it).
     A panel with fewer than 3 radii has no row (a line through 2 points fits exactly)."""
     out = []
     for p in panels:
@@ -286,7 +288,7 @@ def count_line_table(rows: pd.DataFrame, panels) -> pd.DataFrame:
         out.append({"family": p.name, "figure": "Fig. 5", "diagnostic": "count_line",
                     "question": "RMS relative residual of the mean counts about their line",
                     "estimate": float(rms[0]), "ci_low": float(lo), "ci_high": float(hi),
-                    "verdict": ratio_verdict(1.0 + lo, 1.0 + hi),
+                    "verdict": residual_verdict(lo, hi),
                     "intercept": float(coef[0, 0]), "slope": float(coef[1, 0]),
                     "n_radii": int(radii.size), "n_ics": int(counts.shape[1])})
     return pd.DataFrame(out)

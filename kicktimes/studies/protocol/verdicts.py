@@ -7,6 +7,9 @@ margin stated here, before any data:
   CI of ``d = |ln R_poisson| - |ln R_actual|`` against `CLOSER_MARGIN`
   (`kicktimes.stats.null_verdict`: an equivalence test around 0), with the sign of a
   difference inside the margin kept (`kicktimes.stats.share_verdict` against 0);
+* `residual_verdict`: a least-squares line's RMS relative residual against `MARGIN` (the
+  fit is good when the CI of the residual lies below it), read as a residual, not as a
+  ratio;
 * `balloon_verdict`: the sign of a kicked/two-disk RR ratio against 1 (the paper's balloon
   is a two-disk RR above the kicked ones, a ratio below 1);
 * `reproduces`: the table's "reproduces?" column, from a claim's kind and its verdict
@@ -27,7 +30,7 @@ from __future__ import annotations
 from kicktimes.stats import MARGIN, null_verdict, share_verdict
 
 __all__ = ["CLOSER_MARGIN", "CLOSER_RULE", "KINDS", "REPRODUCES_RULE", "balloon_verdict",
-           "closer_verdict", "reproduces"]
+           "closer_verdict", "reproduces", "residual_verdict"]
 
 #: the margin of "equally close" on d = |ln R_poisson| - |ln R_actual|: a tenth of the
 #: agreement band `kicktimes.stats.MARGIN`, i.e. the Poisson- and actual-kicked FTLEs 1 %
@@ -85,9 +88,33 @@ def balloon_verdict(low: float, high: float) -> str:
         share_verdict(low, high, level=1.0), "inconclusive")
 
 
+def residual_verdict(low: float, high: float, margin: float = MARGIN) -> str:
+    """The verdict on the 95 % CI ``[low, high]`` of an RMS relative residual about a
+    least-squares line: ``"residual below 10 %"`` when the CI lies below ``margin`` (the
+    points within ``margin`` of their line in RMS), ``"residual above 10 %"`` when it lies
+    above, else ``"inconclusive"`` (also for a non-finite endpoint). A residual is >= 0 and
+    0 for a perfect line, so it is read against the margin, never against 1.
+
+    Examples
+    --------
+    >>> residual_verdict(0.0144, 0.086), residual_verdict(0.12, 0.2), residual_verdict(0.05, 0.3)
+    ('residual below 10 %', 'residual above 10 %', 'inconclusive')
+    """
+    if not margin > 0:
+        raise ValueError(f"margin must be > 0, got {margin!r}")
+    label = f"{100 * margin:g} %"
+    if high < margin:
+        return f"residual below {label}"
+    if low > margin:
+        return f"residual above {label}"
+    return "inconclusive"
+
+
 #: each kind of claim: {verdict: answer}; a verdict not listed is "undecided"
 KINDS = {
     "agreement": {f"within {100 * MARGIN:g} %": "yes", "higher": "no", "lower": "no"},
+    "line_fit": {f"residual below {100 * MARGIN:g} %": "yes",
+                 f"residual above {100 * MARGIN:g} %": "no"},
     "balloon": {"balloon (ratio < 1)": "yes", "no balloon (ratio > 1)": "no, opposite sign"},
     "poisson_better": {"Poisson closer": "yes",
                        "Poisson closer, inside the margin": "in sign only",
@@ -99,7 +126,8 @@ KINDS = {
 
 REPRODUCES_RULE = (
     "*reproduces?* follows from the verdict by the paper's protocol: an agreement is *yes* "
-    "within 10 %, *no* when higher or lower; the balloon *yes* below 1, *no, opposite sign* "
+    "within 10 %, *no* when higher or lower; a line fit *yes* when its RMS relative residual "
+    "lies below 10 %, *no* above; the balloon *yes* below 1, *no, opposite sign* "
     "above; \"Poisson sometimes better\" *yes* when Poisson is closer beyond the margin, "
     "*in sign only* inside it, *no* when equally close; *undecided* when inconclusive; *not "
     "tested* where it was not run; *not in the paper* for a panel the figure does not show "

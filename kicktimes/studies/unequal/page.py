@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import pandas as pd
 
+from kicktimes.experiment import preset
 from kicktimes.render.pages import header, simulations_source
 from kicktimes.render.provenance import Source
 from kicktimes.stats import (
@@ -93,9 +94,20 @@ def _d_cell(row):
     return f"{text}, {reading}"
 
 
-def answers(table) -> list[str]:
+def _ks_design_caveat(params) -> str:
+    """The KS answer's caveat: this page's design beside the README's (family A's), whose
+    share differs by design, as the test's power grows with the collisions per run."""
+    fam = preset("family_a")
+    return (f"; caveat: {params.n_ics} invariant ICs per ratio over {params.n_steps} steps of "
+            f"{params.tau:g}, not the README's share (family A: {fam.n_ics} {fam.ic_method} "
+            f"ICs at each of {len(fam.radii)} radii, {fam.n_steps} steps of {fam.tau:g}): the "
+            "runs hold other numbers of collisions, and the test's power grows with them")
+
+
+def answers(table, params=None) -> list[str]:
     """The page's first screen: at most five one-line answers, each one number with its
-    95 % interval, its verdict against its own null and its caveat."""
+    95 % interval, its verdict against its own null and its caveat; ``params`` (the
+    study's `Params`) adds the KS answer's design caveat."""
     n = len(table)
 
     def count(verdicts):
@@ -119,7 +131,7 @@ def answers(table) -> list[str]:
         f"fewest): {100 * ks.ks_reject_share:.1f} % [{100 * ks.ks_low:.1f}, "
         f"{100 * ks.ks_high:.1f}] of runs against α = 0.05, which the test has exactly (the "
         f"uniformity KS given the number of collisions): {count(table['ks_verdict'])} of "
-        f"{n} ratios.",
+        f"{n} ratios" + (_ks_design_caveat(params) if params is not None else "") + ".",
         f"- **{DISPERSION_NAME[0].upper()}{DISPERSION_NAME[1:]} − its null** (var / mean "
         f"of the whole-run counts over ICs) at r1 / r0 = {d.size_ratio:g} (the smallest): "
         f"{format_interval(d.d_minus_null, d.d_minus_null_low, d.d_minus_null_high, edges=())} "
@@ -144,7 +156,7 @@ def write_page(table, params, command, source):
     cache."""
     lines = header("Unequal disks: the size ratio", command,
                    [simulations_source("unequal", source, f"`{TABLE}`")])
-    lines += answers(table)
+    lines += answers(table, params)
     lines += ["", f"Verdicts: a ratio is within {100 * MARGIN:g} % when its whole 95 % CI lies "
               f"in [{1 - MARGIN:g}, {1 + MARGIN:g}], higher / lower when wholly beyond, "
               "inconclusive otherwise; a CI that excludes 1 but crosses a band edge reads "
