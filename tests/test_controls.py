@@ -325,7 +325,7 @@ def test_the_first_screen_is_at_most_five_one_line_answers_then_a_compact_table(
     # the scatter kicks at their 5 % margin: 0.950 [0.930, 0.970] straddles 0.95
     assert answers[1] == (f"- **{QUESTIONS[1][0]}** depends on the control at a 5 % "
                           "margin: lower 0.315 [0.300, 0.330] (A, Poisson scatter kicks) under "
-                          "the primary; just below 1 0.950 [0.930, 0.970] under elastic.")
+                          "the primary; below 1 0.950 [0.930, 0.970] under elastic.")
     assert all(len(a.split()) <= 45 for a in answers)  # one line each
     table = lines[lines.index("") + 3:]
     assert table[0].count("|") - 1 <= 8

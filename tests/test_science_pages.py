@@ -294,6 +294,6 @@ def test_the_science_page_pairs_each_closest_kick_law_with_its_own_verdict():
 def test_no_science_or_mechanism_cell_asks_for_ics_where_its_interval_excludes_the_null():
     for name in ("science.md", "mechanism.md"):
         for line in _page(name).splitlines():
-            if "needs ≈" in line and "by about the margin or less" in line:
+            if "needs ≈" in line and ", size unresolved" in line:
                 for cell in line.split(" | "):
-                    assert not ("needs ≈" in cell and "by about the margin or less" in cell), cell
+                    assert not ("needs ≈" in cell and ", size unresolved" in cell), cell

@@ -268,7 +268,7 @@ def test_a_hazard_whose_interval_excludes_its_null_is_a_departure_not_a_sample_s
     # the elastic Γ-rescaled hazard in [1, 5): 1.10 [1.06, 1.15] lies wholly above 1
     row = pd.Series({"estimate": 1.10, "ci_low": 1.06, "ci_high": 1.15})
     assert page._ratio_cell(row, 200) == (
-        "1.10 [1.06, 1.15], above 1 by about the margin or less")
+        "1.10 [1.06, 1.15], above 1, size unresolved")
     assert "needs ≈" in page._ratio_cell(
         pd.Series({"estimate": 1.0, "ci_low": 0.85, "ci_high": 1.15}), 200)
 

@@ -125,8 +125,8 @@ def test_the_residuals_are_read_against_their_calibrated_null(built):
 
 def test_a_share_difference_beyond_a_margin_edge_that_excludes_0_is_not_inconclusive():
     v = tables.edge_null_verdict
-    assert v(0.015, 0.13) == "above its null by about the margin or less"
-    assert v(-0.13, -0.01) == "below its null by about the margin or less"
+    assert v(0.015, 0.13) == "above its null, size unresolved"
+    assert v(-0.13, -0.01) == "below its null, size unresolved"
     assert v(-0.01, 0.05) == "inconclusive"
     assert v(0.03, 0.2) == "above its null" and v(-0.02, 0.02) == "at its null"
     assert v(float("nan"), 0.1) == "inconclusive"

@@ -199,7 +199,7 @@ def test_the_closest_table_pairs_each_law_with_its_own_verdict():
     (row,) = science_page.closest_cells(closest)
     laws = row.split(" | ")[2].split("; ")
     assert laws == ["poisson_scatter 0.976 [0.962, 1.02], within 5 %",
-                    "actual_scatter 0.922 [0.897, 0.962], below 1 by about the margin or less"]
+                    "actual_scatter 0.922 [0.897, 0.962], below 1, size unresolved"]
     assert row.endswith("| poisson |")
     bad = closest.assign(verdict=["inconclusive", "within 5 %", "lower"])
     with pytest.raises(ValueError, match="poisson_scatter"):
@@ -208,17 +208,17 @@ def test_the_closest_table_pairs_each_law_with_its_own_verdict():
 
 def test_an_interval_that_excludes_1_is_a_departure_and_names_no_sample_size():
     # point 4: a CI wholly above (below) 1 that straddles the band edge
-    assert ratio_reading(1.06, 1.15) == "above 1 by about the margin or less"
-    assert ratio_reading(0.815, 0.942) == "below 1 by about the margin or less"
+    assert ratio_reading(1.06, 1.15) == "above 1, size unresolved"
+    assert ratio_reading(0.815, 0.942) == "below 1, size unresolved"
     assert ratio_reading(0.913, 1.15) == "inconclusive"
     assert ratio_reading(0.95, 1.04) == "within 10 %" and ratio_reading(1.2, 1.3) == "higher"
-    assert null_reading(0.01, 0.09, margin=0.05) == "above its null by about the margin or less"
+    assert null_reading(0.01, 0.09, margin=0.05) == "above its null, size unresolved"
     assert null_reading(-0.01, 0.09, margin=0.05) == "inconclusive"
     assert side_of(float("nan"), 1.2) is None
     with pytest.raises(ValueError, match="low"):
         side_of(1.2, 1.1)
     cell = science_page._ratio_cell(1.10, 1.06, 1.15, 200)
-    assert cell == "1.10 [1.06, 1.15], above 1 by about the margin or less"
+    assert cell == "1.10 [1.06, 1.15], above 1, size unresolved"
     assert "needs ≈" in science_page._ratio_cell(0.998, 0.913, 1.15, 100)
 
 
@@ -231,7 +231,7 @@ def test_the_decorrelation_answer_says_the_model_overpredicts_and_picks_the_clos
         "quotient_ci_high": [0.942, 0.951, 0.519, 0.594]})
     line = science_page._decorrelation_answer(compare, 40)
     assert "the model overpredicts in 4 of 4 rows (interval below 1)" in line
-    assert "below 1 by about the margin or less in 2 (mirror 2)" in line
+    assert "below 1, size unresolved in 2 (mirror 2)" in line
     assert "lower in 2 (elastic 2)" in line and "not resolved" not in line
     assert "closest to 1: 0.876 [0.815, 0.942]" in line and "(mirror, r = 0.008" in line
     mixed = compare.assign(quotient_ci_high=[1.05, 0.951, 0.519, 0.594])

@@ -58,8 +58,8 @@ from kicktimes.stats import (
     shapley_values,
 )
 
-__all__ = ["ACTUAL_FACTORIAL", "FACTORIAL", "NO_GAP", "STEPS", "gap_decomposition",
-           "gap_everywhere", "gap_figure", "gap_summary", "merge_control_gaps"]
+__all__ = ["ACTUAL_FACTORIAL", "FACTORIAL", "NO_GAP", "NOT_READ", "STEPS", "closes_nothing",
+           "gap_decomposition", "gap_everywhere", "gap_figure", "gap_summary", "merge_control_gaps"]
 
 #: the kinetic-rate factorial's systems: (uniform, Poisson), (scatter, Poisson),
 #: (uniform, kinetic), (scatter, kinetic)
@@ -270,6 +270,20 @@ def merge_control_gaps(tables) -> pd.DataFrame:
     return pd.concat(out, ignore_index=True)
 
 
+#: what a kinetic-factorial share's cell says where that factorial closes none of the gap
+NOT_READ = "not read (closes none)"
+
+
+def closes_nothing(table: pd.DataFrame) -> set:
+    """The ``(family, diagnostic)`` pairs whose kinetic-rate factorial closes none of the
+    paper's gap: the primary setting's 'left' (one minus its two shares) has a 95 % CI that
+    contains 1. Their two shares then only redistribute nothing (typically they cancel),
+    so the pages do not read them; the actual-times factorial's shares stand apart."""
+    left = table[(table["control"] == "primary") & (table["quantity"] == STEPS[2])]
+    hit = left[(left["ci_low"] <= 1) & (left["ci_high"] >= 1)]
+    return set(zip(hit["family"], hit["diagnostic"], strict=True))
+
+
 def gap_everywhere(table: pd.DataFrame) -> dict:
     """Per ``(family, diagnostic)``, ``""`` when the paper's gap exists under every control
     (the only case decomposed on the pages: a gap that one control removes is inside its
@@ -301,7 +315,8 @@ def gap_figure(table: pd.DataFrame):
     ICs), families side by side, and what is left of the kinetic factorial's gap (one
     minus its two shares; grey: at 1 nothing here closes the gap; no ingredient of it is
     tested). A share whose sign is not the same under every control is drawn faded and
-    marked ✗. One y scale for all."""
+    marked ✗; the kinetic factorial's two shares are not drawn where it closes none of the
+    gap (`closes_nothing`: only its 'left' is). One y scale for all."""
     from matplotlib.figure import Figure
     from matplotlib.lines import Line2D
 
@@ -313,12 +328,13 @@ def gap_figure(table: pd.DataFrame):
     if STEPS[2] in set(table["quantity"]):
         steps.append(STEPS[2])
     families = list(dict.fromkeys(table["family"]))
+    unread = closes_nothing(table)
     fig = Figure(figsize=(max(3.4 * len(panels), 8.0), 4.3), layout="constrained")
     axes = fig.subplots(1, max(len(panels), 1), squeeze=False, sharey=True)[0]
     colours = {STEPS[0]: "tab:red", STEPS[1]: "tab:purple", STEPS[4]: "tab:green",
                STEPS[2]: "0.35"}
-    short = {STEPS[0]: "deflection", STEPS[1]: "kinetic-rate\ntiming",
-             STEPS[4]: "actual-times\ntiming", STEPS[2]: "left\n(1 − shares)"}
+    short = {STEPS[0]: "deflection\n(kinetic)", STEPS[1]: "kinetic-rate\ntiming",
+             STEPS[4]: "actual-times\ntiming", STEPS[2]: "left (kinetic:\n1 − its shares)"}
     for ax, (diagnostic, title) in zip(axes, panels, strict=False):
         ax.axhline(0.0, color="0.5", linewidth=0.8, zorder=0)
         ax.axhline(1.0, color="0.8", linewidth=0.8, linestyle=":", zorder=0)
@@ -331,6 +347,8 @@ def gap_figure(table: pd.DataFrame):
             rows = fam[fam["control"] == "primary"].set_index("quantity")
             for i, step in enumerate(steps):
                 if step not in rows.index or not np.isfinite(rows.loc[step, "estimate"]):
+                    continue
+                if (family, diagnostic) in unread and step in (STEPS[0], STEPS[1]):
                     continue
                 est, lo, hi = rows.loc[step, ["estimate", "ci_low", "ci_high"]]
                 sides = set(_sides(fam, step).values())
@@ -359,7 +377,8 @@ def gap_figure(table: pd.DataFrame):
     fig.legend(handles=handles, loc="outside lower center", ncol=len(handles),
                fontsize="small")
     fig.suptitle("Share of the paper's gap closed by each ingredient\n(Shapley, 95 % CI; "
-                 "gaps present under every control)", fontsize="medium")
+                 "the first two and 'left' from the kinetic-rate factorial, not drawn where it "
+                 "closes none)", fontsize="medium")
     return fig
 
 
@@ -377,11 +396,15 @@ def gap_summary(table: pd.DataFrame) -> pd.DataFrame:
 
     rows = []
     steps = [s for s in STEPS if s in set(table["quantity"])]
+    unread = closes_nothing(table)
     for (family, diagnostic), part in table.groupby(["family", "diagnostic"], sort=False,
                                                     observed=True):
         head = part[part["control"] == "primary"].set_index("quantity")
         row = {"family": family, "diagnostic": diagnostic}
         for step in steps:
+            if (family, diagnostic) in unread and step in (STEPS[0], STEPS[1]):
+                row[step], row[f"{step} robust"] = NOT_READ, "—"
+                continue
             est, lo, hi = head.loc[step, ["estimate", "ci_low", "ci_high"]]
             row[step] = (format_interval(est, lo, hi, edges=(0.0,)) if np.isfinite(est)
                          else NO_GAP)

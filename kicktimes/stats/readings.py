@@ -4,9 +4,10 @@ An inconclusive equivalence verdict has a 95 % interval that straddles an edge o
 margin. Two cases differ, and the pages say which:
 
 - the interval excludes the null value (1 for a ratio, 0 for a difference from a null
-  stream): a real departure, of about the margin's size or less; it reads "below 1 by
-  about the margin or less" (or "above its null by about the margin or less") and names
-  no sample size;
+  stream): a real departure whose size the margin does not resolve (the interval
+  reaches both inside the margin and beyond it, possibly far beyond); it reads "below 1,
+  size unresolved" (or "above its null, size unresolved") beside its interval, which
+  gives the size, and names no sample size;
 - the interval contains the null value: "not resolved at this size", with the size that
   would resolve it (`kicktimes.stats.equivalence_sample_size`).
 """
@@ -40,16 +41,17 @@ def side_of(low, high, *, null=1.0):
 @keyword_only_after(2, since="0.2.0")
 def ratio_reading(low, high, *, tolerance=MARGIN):
     """`kicktimes.stats.ratio_verdict` of a ratio's 95 % CI, except that an inconclusive
-    interval lying entirely on one side of 1 reads ``"below 1 by about the margin or
-    less"`` (or above): a departure from 1, not an unresolved one.
+    interval lying entirely on one side of 1 reads ``"below 1, size unresolved"`` (or
+    above): a departure from 1 whose size against the margin is not resolved (its interval
+    gives the size), not an unresolved departure.
 
     >>> ratio_reading(0.815, 0.942), ratio_reading(0.3, 0.4), ratio_reading(0.913, 1.15)
-    ('below 1 by about the margin or less', 'lower', 'inconclusive')
+    ('below 1, size unresolved', 'lower', 'inconclusive')
     """
     verdict = ratio_verdict(low, high, tolerance=tolerance)
     side = side_of(low, high, null=1.0) if verdict == "inconclusive" else None
     if side:
-        return f"{side} 1 by about the margin or less"
+        return f"{side} 1, size unresolved"
     return verdict
 
 
@@ -60,7 +62,7 @@ def ratio_words(low, high, *, tolerance=MARGIN):
     "within 10 %" never hides an interval that excludes the null.
 
     >>> ratio_words(1.046, 1.099), ratio_words(0.95, 1.02), ratio_words(0.815, 0.942)
-    ('within 10 %, above 1', 'within 10 %', 'below 1 by about the margin or less')
+    ('within 10 %, above 1', 'within 10 %', 'below 1, size unresolved')
     """
     verdict = ratio_reading(low, high, tolerance=tolerance)
     side = side_of(low, high, null=1.0) if verdict.startswith("within") else None
@@ -71,13 +73,13 @@ def ratio_words(low, high, *, tolerance=MARGIN):
 def null_reading(low, high, *, margin):
     """`kicktimes.stats.null_verdict` of the 95 % CI of *statistic − its null value*,
     except that an inconclusive interval lying entirely on one side of 0 reads ``"above
-    its null by about the margin or less"`` (or below).
+    its null, size unresolved"`` (or below).
 
     >>> null_reading(0.005, 0.077, margin=0.07), null_reading(-0.03, 0.09, margin=0.07)
-    ('above its null by about the margin or less', 'inconclusive')
+    ('above its null, size unresolved', 'inconclusive')
     """
     verdict = null_verdict(low, high, margin=margin)
     side = side_of(low, high, null=0.0) if verdict == "inconclusive" else None
     if side:
-        return f"{side} its null by about the margin or less"
+        return f"{side} its null, size unresolved"
     return verdict

@@ -173,6 +173,6 @@ def boltzmann_lines(boltz, *, n_disks=None) -> list:
         f"disk: gas − kicked): {cells}. The other {len(rest)} (hazard's first bin, gamma "
         f"shape, KS share): {int(counts.get('at its null', 0))} within their margin, "
         f"{int(counts.get('above its null', 0) + counts.get('below its null', 0))} depart, "
-        f"{sum(int(counts.get(v, 0)) for v in EDGE)} beyond it by about the margin or less, "
+        f"{sum(int(counts.get(v, 0)) for v in EDGE)} beyond it, size unresolved, "
         f"{int(counts.get('inconclusive', 0))} inconclusive. Every N and statistic: "
         "[disks_boltzmann_kicks.csv](disks_boltzmann_kicks.csv).", ""]

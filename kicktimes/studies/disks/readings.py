@@ -370,7 +370,7 @@ def opening_lines(answers, vn, boltz_d, rate_line) -> list:
         f"of {len(big)} geometry × rule, not resolved at "
         f"{int(counts.get('not resolved', 0))}, Poisson at {int(counts.get('Poisson', 0))}"
         f"{ex_text}. Caveat: of {verdicts.size} single verdicts {n_inc} are inconclusive, "
-        f"{n_edge} beyond their null by about the margin or less{moved}.")
+        f"{n_edge} beyond their null, size unresolved{moved}.")
     froms = {}
     for (g, r), d in vn.groupby(["geometry", "rule"], sort=False):
         d = d.sort_values("n_disks")

@@ -67,8 +67,8 @@ __all__ = [
 ]
 
 #: the verdicts of a CI that straddles a margin edge but excludes 0 (`edge_null_verdict`)
-EDGE_VERDICTS = ("above its null by about the margin or less",
-                 "below its null by about the margin or less")
+EDGE_VERDICTS = ("above its null, size unresolved",
+                 "below its null, size unresolved")
 
 
 def edge_null_verdict(low, high, margin):
@@ -80,7 +80,7 @@ def edge_null_verdict(low, high, margin):
     Examples
     --------
     >>> edge_null_verdict(0.018, 0.157, 0.07)
-    'above its null by about the margin or less'
+    'above its null, size unresolved'
     >>> edge_null_verdict(-0.014, 0.140, 0.07), edge_null_verdict(0.108, 0.239, 0.07)
     ('inconclusive', 'above its null')
     """

@@ -62,7 +62,7 @@ SOURCES = (
 
 
 def ratio_text(estimate, low, high) -> str:
-    """``"1.13 [1.09, 1.16], above 1 by about the margin or less"``: the interval and its
+    """``"1.13 [1.09, 1.16], above 1, size unresolved"``: the interval and its
     `kicktimes.stats.ratio_reading`."""
     return f"{format_interval(estimate, low, high)}, {ratio_reading(low, high)}"
 
@@ -284,8 +284,8 @@ def write_page(table, ratios, constant, params, command, seconds, source, *, sum
         f"Verdicts: a ratio is within {100 * MARGIN:g} % when its whole 95 % CI lies in "
         f"[{1 - MARGIN:g}, {1 + MARGIN:g}] (margin fixed before any rate was computed; a CI "
         "inside the band that excludes 1 is a real difference smaller than the margin), "
-        "higher / lower when it lies wholly beyond; above / below 1 by about the margin or "
-        "less when it straddles a band edge but excludes 1; inconclusive when it contains 1 "
+        "higher / lower when it lies wholly beyond; above / below 1, size unresolved, "
+        "when it straddles a band edge but excludes 1; inconclusive when it contains 1 "
         "and straddles a band edge (only then is a sample size named); robust when "
         "every control (the two-disk estimator; for α the IC sample) gives the same "
         "verdict and no CI lies above 1 while another's lies below. Over radii: the "

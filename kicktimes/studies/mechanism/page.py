@@ -404,7 +404,7 @@ def reading(tabs):
         f"{HAZARD_NULL_MARGIN:g}); a Γ-rescaled hazard is read against 1, its prediction, "
         f"by `ratio_verdict` ({100 * MARGIN:g} % band, [definitions](../definitions.md)); "
         "an inconclusive interval that excludes the null value reads \"above (below) its null "
-        "(1) by about the margin or less\", a real departure; one that contains it "
+        "(1), size unresolved\", a real departure; one that contains it "
         "names the ICs that would resolve it (`equivalence_sample_size`). The first bin of "
         f"the early hazard is the {FIRST_BIN} (not the README's bin in mean intervals, nor "
         f"disks.md's). The {DISPERSION_NAME} is read against "

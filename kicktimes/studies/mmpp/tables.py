@@ -230,7 +230,7 @@ def edge_null_verdict(low, high, margin=SHARE_MARGIN):
     Examples
     --------
     >>> edge_null_verdict(0.015, 0.13), edge_null_verdict(-0.05, 0.07)
-    ('above its null by about the margin or less', 'inconclusive')
+    ('above its null, size unresolved', 'inconclusive')
     >>> edge_null_verdict(0.033, 0.116), edge_null_verdict(-0.02, -0.01)
     ('above its null', 'at its null')
     """

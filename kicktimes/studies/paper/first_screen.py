@@ -80,11 +80,11 @@ def _deciding(rows, main) -> list[str]:
 
 def _word(verdict, row=None, short=False) -> str:
     """The answer's word for ``verdict``; an inconclusive ``row`` whose interval lies on
-    one side of 1 says so (`kicktimes.stats.side_of`): a departure of about the margin or
-    less, not an unresolved one."""
+    one side of 1 says so (`kicktimes.stats.side_of`): a departure whose size the margin
+    does not resolve, not an unresolved one."""
     side = side_of(row.ci_low, row.ci_high) if row is not None else None
     if verdict == "inconclusive" and side:
-        return f"just {side} 1" if short else f"{side} 1 by about the margin or less"
+        return f"{side} 1" if short else f"{side} 1, size unresolved"
     return ("yes, " + verdict) if verdict.startswith("within") else _WORDS.get(verdict, verdict)
 
 
@@ -276,7 +276,7 @@ def compact_overview(table: pd.DataFrame) -> pd.DataFrame:
             # the first
             deciding = _deciding(rows, p.verdict)
             mark = "✓" if robust else ("✗↕ " if _sides(rows) else "✗ ") + ", ".join(
-                _CONTROL_SHORT.get(c, c) for c in deciding[:3])
+                _CONTROL_SHORT.get(c, c) for c in deciding)
             word = _word(p.verdict, p, short=True).removeprefix("no, ").removeprefix("yes, ")
             line[_KICKS[system]] = f"{word} {p.estimate:.3g} {mark}"
         out.append(line)
@@ -297,6 +297,6 @@ def first_screen(table: pd.DataFrame) -> list[str]:
               f"±{100 * margin_of('ftle'):g} % for the FTLE, ±{100 * margin_of('rr_offdiag'):g} "
               f"% for the off-diagonal RR, ±{100 * MARGIN:g} % otherwise; ✓ robust over every "
               "control and both families, ✗ the controls that change it (↕: CIs on both "
-              "sides of 1); just below 1: a CI below 1 that reaches into the band; "
+              "sides of 1); below 1: a CI below 1 that reaches into the band; "
               "every cell's numbers: [overview.csv](overview.csv)):", ""]
     return lines + markdown_table(compact_overview(table)) + [""]

@@ -145,7 +145,8 @@ def _open_gaps(gaps) -> str:
         parts.append(f"the {diagnostic} gap: left {values}"
                      + ("; its deflection and timing shares cancel" if cancel else ""))
     return ("The kinetic-rate factorial closes none of " + "; nor ".join(parts)
-            + " (the actual-times factorial's shares: gap_decomposition.csv).")
+            + ", so its shares are not read (they are in gap_decomposition.csv, with the "
+            "actual-times factorial's).")
 
 
 def counts_section(table):

@@ -184,10 +184,11 @@ def _answer(frame) -> str:
 
 def _readme_numbers(findings_dir, panel_list) -> dict:
     """The README's own numbers for the quantities this page also measures, by name (each
-    line quotes them beside its own): ``{"ftle": ..., "rr_offdiag@0.01": ...}``, the paper
-    study's primary Poisson and actual rows; empty without ``findings_dir``."""
+    line quotes them beside its own): ``{"ftle": ..., "rr_offdiag@0.001": ...}`` (the RR at
+    this page's ε, `EPS`), the paper study's primary Poisson and actual rows; empty without
+    ``findings_dir``."""
     out = {}
-    for diagnostic in ("ftle", "rr_offdiag@0.01"):
+    for diagnostic in ("ftle", f"rr_offdiag@{EPS:g}"):
         rows = _paper_study(findings_dir, panel_list, diagnostic)
         if len(rows):
             out[diagnostic] = rows
@@ -233,11 +234,11 @@ def _first_screen(claims: pd.DataFrame, rr_tab: pd.DataFrame,
         only = (rr["reproduces"] == "yes").all() and (rr["other_verdict"] != rr["verdict"]).all()
         small = (f"small radii reproduce only with the diagonal ({_span(100 * diagonal.dropna())} "
                  "% of the RR)" if only else f"small radii {_answer(rr)}")
-        rr_offdiag = readme.get("rr_offdiag@0.01")
+        rr_offdiag = readme.get(f"rr_offdiag@{EPS:g}")
         out.insert(1, (
             f"- **RR (Fig. 7, panel A, ε = {EPS:g}, the paper's steps)**: {small}, {_span(rr)}; "
             f"off it {_span(rr, 'other_estimate')} ({_verdicts(rr, 'other_verdict')}"
-            + (f"; the README's, ε = 10⁻² on uniform-time samples, {_span(rr_offdiag)}"
+            + (f"; the README's at the same ε on uniform-time samples, {_span(rr_offdiag)}"
                if rr_offdiag is not None else "")
             + f"); balloon {_answer(balloon)}: {_span(balloon)}, {_verdicts(balloon)}."))
     tested4 = fig4[fig4["kind"] != "not_tested"]

@@ -104,11 +104,11 @@ def needed_ics(estimate, low, high, n, tolerance=MARGIN, unit="ICs"):
 
 def reading_text(x, lo, hi, tolerance=MARGIN):
     """A ratio's interval and its `ratio_words` (an inconclusive interval that excludes
-    1 reads as a departure of about the margin or less; one within the margin that
+    1 reads as a departure of unresolved size; one within the margin that
     excludes 1 says on which side).
 
     >>> reading_text(0.876, 0.815, 0.942)
-    '0.876 [0.815, 0.942], below 1 by about the margin or less'
+    '0.876 [0.815, 0.942], below 1, size unresolved'
     >>> reading_text(1.072, 1.046, 1.099)
     '1.072 [1.046, 1.099], within 10 %, above 1'
     """
@@ -140,7 +140,7 @@ def reading():
             "otherwise; a ratio is read by `ratio_verdict` against the 10 % band around 1 "
             f"(the FTLE's against ±{100 * margin_of('ftle'):g} %, `margin_of`) "
             "(an equivalence test, [definitions](../definitions.md)); an inconclusive "
-            "interval that excludes 1 reads \"below (above) 1 by about the margin or less\", "
+            "interval that excludes 1 reads \"below (above) 1, size unresolved\", "
             "a real departure; one that contains 1 names the ICs that would "
             "resolve it (`equivalence_sample_size` at the measured estimate). A prediction is "
             "quoted beside its measurement; a direction is claimed only where both trend "

@@ -21,9 +21,11 @@ from kicktimes.studies.unequal.compute import KINDS, R0
 from kicktimes.studies.unequal.tables import (
     D_MARGIN,
     FINE_MARGIN,
+    KS_NULL_STREAMS,
     dispersion_ci,
     dispersion_null,
     ks_interval,
+    ks_null,
     ratio_ci,
     size_ratio_table,
 )
@@ -51,6 +53,7 @@ SOURCES = tuple(Source(TABLE, columns, computed_by) for columns, computed_by in 
     ("d_minus_null, d_minus_null_low, d_minus_null_high", size_ratio_table),
     ("d_verdict", null_verdict),
     ("ks_low, ks_high", clopper_pearson),
+    ("ks_null, ks_null_low, ks_null_high", ks_null),
     ("ks_verdict", rejection_verdict),
 ))
 
@@ -129,9 +132,11 @@ def answers(table, params=None) -> list[str]:
         f"; {count(rate_v)} of {n} ratios: kinetic theory holds for unequal disks.",
         f"- **KS rejections of uniform collision times** at r1 / r0 = {ks.size_ratio:g} (the "
         f"fewest): {100 * ks.ks_reject_share:.1f} % [{100 * ks.ks_low:.1f}, "
-        f"{100 * ks.ks_high:.1f}] of runs against α = 0.05, which the test has exactly (the "
-        f"uniformity KS given the number of collisions): {count(table['ks_verdict'])} of "
-        f"{n} ratios" + (_ks_design_caveat(params) if params is not None else "") + ".",
+        f"{100 * ks.ks_high:.1f}] of runs against its null streams' "
+        + (f"{100 * ks.ks_null:.1f} % [{100 * ks.ks_null_low:.1f}, {100 * ks.ks_null_high:.1f}]"
+           if "ks_null" in table else "α = 0.05")
+        + f" (Poisson at each run's rate and window, the same test): "
+        f"{count(table['ks_verdict'])} of {n} ratios" + (_ks_design_caveat(params) if params is not None else "") + ".",
         f"- **{DISPERSION_NAME[0].upper()}{DISPERSION_NAME[1:]} − its null** (var / mean "
         f"of the whole-run counts over ICs) at r1 / r0 = {d.size_ratio:g} (the smallest): "
         f"{format_interval(d.d_minus_null, d.d_minus_null_low, d.d_minus_null_high, edges=())} "
@@ -160,12 +165,13 @@ def write_page(table, params, command, source):
     lines += ["", f"Verdicts: a ratio is within {100 * MARGIN:g} % when its whole 95 % CI lies "
               f"in [{1 - MARGIN:g}, {1 + MARGIN:g}], higher / lower when wholly beyond, "
               "inconclusive otherwise; a CI that excludes 1 but crosses a band edge reads "
-              "\"below (above) 1 by about the margin or less\", a real difference; the "
+              "\"below (above) 1, size unresolved\", a real difference; the "
               "FTLE ratios are first read at a "
               f"{100 * FINE_MARGIN:g} % margin, stated in advance, half the effect of the "
               "partner radius the page means to resolve. A share of runs rejected is read "
-              "against α only where the test has exactly α under Poisson (the uniformity KS, "
-              f"given the number of collisions); the {DISPERSION_NAME} (var / mean of the "
+              "against the share of Poisson streams shaped like the runs (each run's rate and "
+              f"window, {KS_NULL_STREAMS} per run) that the same test rejects; the "
+              f"{DISPERSION_NAME} (var / mean of the "
               "whole-run counts over ICs; not the README's within-run D of counts in windows, "
               "nor disks.md's D across tagged disks) is read against the same statistic on "
               f"Poisson counts (the difference within ±{D_MARGIN:g}: at its null; wholly "
@@ -180,8 +186,8 @@ def write_page(table, params, command, source):
               "(tangent FTLE of the named disk, mean over ICs): the kicked disk's over the "
               "same disk's in the two-disk system, with the partner radius of the scattering "
               "kicks as named. KS rejections: share of the two-disk runs whose collision "
-              "times reject uniformity at α = 0.05 (Clopper–Pearson interval; 0.05 for a "
-              "Poisson process); rate dispersion across ICs: variance / mean of the whole-run "
+              "times reject uniformity at α = 0.05 (Clopper–Pearson interval; its null: "
+              "`ks_null`); rate dispersion across ICs: variance / mean of the whole-run "
               "collision counts over ICs (near 1 for a Poisson process), with a 95 % "
               "bootstrap interval over ICs, and its difference from its null (the mean of the "
               "same statistic on Poisson counts over the same runs at the pooled rate) with "
