@@ -219,7 +219,8 @@ def null_verdict(low, high, *, margin):
     endpoint is not finite). A statistic whose null value is not exactly 1 (a dispersion
     index over runs of unequal rates, a hazard of binned intervals) is read this way, never
     against 1. An inconclusive CI that excludes 0 is read further by
-    `kicktimes.stats.readings.null_reading` (a real departure whose size the margin does not resolve).
+    `kicktimes.stats.readings.null_reading` (a real departure whose size the margin does
+    not resolve).
 
     Examples
     --------

@@ -136,7 +136,8 @@ def answers(table, params=None) -> list[str]:
         + (f"{100 * ks.ks_null:.1f} % [{100 * ks.ks_null_low:.1f}, {100 * ks.ks_null_high:.1f}]"
            if "ks_null" in table else "α = 0.05")
         + f" (Poisson at each run's rate and window, the same test): "
-        f"{count(table['ks_verdict'])} of {n} ratios" + (_ks_design_caveat(params) if params is not None else "") + ".",
+        f"{count(table['ks_verdict'])} of {n} ratios"
+        + (_ks_design_caveat(params) if params is not None else "") + ".",
         f"- **{DISPERSION_NAME[0].upper()}{DISPERSION_NAME[1:]} − its null** (var / mean "
         f"of the whole-run counts over ICs) at r1 / r0 = {d.size_ratio:g} (the smallest): "
         f"{format_interval(d.d_minus_null, d.d_minus_null_low, d.d_minus_null_high, edges=())} "

@@ -49,10 +49,12 @@ def dispersion_null(windows, rate, rng, n=N_NULL):
 KS_NULL_STREAMS = 20
 
 
-def ks_null(counts, windows, rng, *, alpha=0.05, n=KS_NULL_STREAMS):
+def ks_null(counts, rng, *, alpha=0.05, n=KS_NULL_STREAMS):
     """The share of Poisson streams shaped like the runs that the uniformity KS rejects at
-    ``alpha``: per run ``n`` streams at the run's own rate ``count / window`` over its window
-    (`kicktimes.stats.poisson.uniformity_ks`, the test of the runs' share), with its
+    ``alpha``: per run ``n`` streams at the run's own rate ``count / window`` over its window,
+    i.e. a Poisson number of events of mean ``count`` placed uniformly (the test is the same
+    for any window), through `kicktimes.stats.poisson.uniformity_ks`, the test of the
+    runs' share, with its
     Clopper-Pearson 95 % interval. The runs' share is read against this level, not against
     ``alpha``: given the number of events the test is exact, so the level is ``alpha`` up
     to Monte Carlo noise, and the table shows it rather than assuming it. A stream with
@@ -63,8 +65,7 @@ def ks_null(counts, windows, rng, *, alpha=0.05, n=KS_NULL_STREAMS):
     from kicktimes.stats.poisson import uniformity_ks
 
     rejected = tested = 0
-    for count, window in zip(np.asarray(counts, float), np.asarray(windows, float),
-                             strict=True):
+    for count in np.asarray(counts, float):
         sizes = rng.poisson(max(count, 1.0), size=n)
         for k in sizes[sizes >= 2]:
             u = np.sort(rng.uniform(0.0, 1.0, size=int(k)))
@@ -155,7 +156,7 @@ def size_ratio_table(runs_by_r1, seed) -> pd.DataFrame:
                                         margin=D_MARGIN)
         row["ks_low"], row["ks_high"] = clopper_pearson(
             int(round(row["ks_reject_share"] * len(times))), len(times))
-        level, level_low, level_high, _ = ks_null(counts, windows, ks_rng)
+        level, level_low, level_high, _ = ks_null(counts, ks_rng)
         row.update({"ks_null": level, "ks_null_low": level_low, "ks_null_high": level_high})
         row["ks_verdict"] = rejection_verdict(row["ks_low"], row["ks_high"], alpha=level)
         rows.append(row)
