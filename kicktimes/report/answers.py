@@ -309,12 +309,13 @@ def poisson_share(effects) -> tuple | None:
     return None
 
 
-#: the headline figure's panels: (diagnostic, title)
+#: the headline figure's panels: (diagnostic, title), in the order of the first screen's
+#: table (`SCREEN_ROWS`)
 PANELS = (
     ("ftle", "FTLE λ"),
-    ("rr_offdiag@0.001", "off-diagonal RR, ε = 10⁻³\n(uniform-time samples)"),
     ("rr_offdiag@0.01", "off-diagonal RR, ε = 10⁻²\n(uniform-time samples)"),
     ("det@0.01", "DET, ε = 10⁻²\n(uniform-time samples)"),
+    ("rr_offdiag@0.001", "off-diagonal RR, ε = 10⁻³\n(uniform-time samples)"),
     ("one_minus_r1", "1 − R₁\n(lag-1 decorrelation)"),
 )
 # y ticks of the ratio panels, by how many decades the panel spans (labels never overlap)
@@ -381,7 +382,8 @@ def ratio_curves_figure(curves: pd.DataFrame, control=HEADLINE_CONTROL,
     curves = curves[curves["system"].isin(systems)]
     ncol, nrow = max(len(panels), 1), max(len(families), 1)
     fig = Figure(figsize=(3.0 * ncol, 2.9 * nrow + 0.9), layout="constrained")
-    axes = fig.subplots(nrow, ncol, squeeze=False, sharey="col", sharex="row")
+    # one radius axis for every panel: the families' radii differ (A to 0.030, B to 0.027)
+    axes = fig.subplots(nrow, ncol, squeeze=False, sharey="col", sharex="all")
     limits = {}
     for diagnostic, _ in panels:  # one log scale per diagnostic: a 3 % deficit stays visible
         values = curves.loc[curves["diagnostic"] == diagnostic,

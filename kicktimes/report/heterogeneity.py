@@ -33,7 +33,8 @@ def _p_label(p):
 def _p_row(ax, at, p, test, where):
     """The p-values of a common rate on a second x axis on top of ``ax`` (never over a
     marker), read horizontally: one sentence when every label is the same (``p < 10⁻³⁰⁰``
-    at every radius of a paper store: the χ² tail underflows double precision), else a
+    at every radius of a paper store: the χ² tail underflows double precision) or every p
+    lies below 10⁻³ (the largest as the bound, and how many underflow), else a
     short label per position (without the ``p``), every second one raised when there are
     more than 6, so that neighbours do not collide."""
     labels = [_p_label(v).removeprefix("p ").removeprefix("= ") for v in p]
@@ -45,6 +46,16 @@ def _p_row(ax, at, p, test, where):
         note = " (below double precision)" if only.endswith("⁻³⁰⁰") else ""
         top.set_xlabel(f"p of a common rate ({test}): p {only} at every {where}{note}",
                        fontsize="small")
+        return
+    finite = np.asarray(p, float)[np.isfinite(np.asarray(p, float))]
+    if finite.size and (finite < 1e-3).all():
+        # every p below 10⁻³: one bound for all (the largest), no row of labels to collide
+        bound = _p_label(float(finite.max())).removeprefix("p ")
+        floor = int((finite <= 0).sum())
+        top.set_xticks([])
+        top.set_xlabel(f"p of a common rate ({test}): p {bound} at every {where}"
+                       + (f" (< 10⁻³⁰⁰, below double precision, at {floor} of {finite.size})"
+                          if floor else ""), fontsize="small")
         return
     if len(at) > 6:
         labels = [lab + ("\n" if k % 2 else "") for k, lab in enumerate(labels)]

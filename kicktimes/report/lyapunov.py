@@ -182,10 +182,17 @@ def stretching_figure(summary, table, *, title=None):
     for k, system in enumerate(kicked, start=1):
         part = table[table["system"] == system].set_index("radius")
         excess = (ref["stretch_per_perturbation"] - part["stretch_per_perturbation"]).dropna()
+        # the two 95 % half-widths in quadrature: as if the runs were independent, wider
+        # than a paired interval would be for the positively correlated runs of one IC
+        half = np.sqrt(((ref["stretch_high"] - ref["stretch_low"]) / 2) ** 2
+                       + ((part["stretch_high"] - part["stretch_low"]) / 2) ** 2)
+        half = half.reindex(excess.index).to_numpy(float)
         style = system_style(system, k)
         shift = gap * ((k - 1) / max(len(kicked) - 1, 1) - 0.5)
-        ax3.plot(excess.index.to_numpy() + shift, excess.to_numpy(),
-                 linestyle="none", marker=style["marker"], markersize=5, color=style["color"])
+        ax3.errorbar(excess.index.to_numpy() + shift, excess.to_numpy(),
+                     yerr=np.where(np.isfinite(half), half, 0.0), linestyle="none",
+                     marker=style["marker"], markersize=5, color=style["color"], capsize=2,
+                     elinewidth=0.8)
     if grid.size:
         r = np.linspace(grid.min(), grid.max(), 60)
         (identity,) = ax3.plot(r, np.log(1 / r), color="grey", linestyle=":")
@@ -193,7 +200,8 @@ def stretching_figure(summary, table, *, title=None):
     radius_axis(ax3)
     # ln(1/r) is a pure number; the guide reads it as nats per collision
     ax3.set_ylabel("excess λ/Γ (nats per perturbation)")
-    ax3.set_title("(c) two-particle λ/Γ minus each kicked one")
+    ax3.set_title("(c) two-particle λ/Γ minus each kicked one\n(bars: the two 95 % CIs in "
+                  "quadrature)", fontsize="medium")
     # the legend's own cell: systems first (their colour and marker in every panel)
     cell = axes[1, 2]
     cell.axis("off")

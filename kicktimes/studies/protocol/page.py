@@ -114,7 +114,8 @@ def fig6_figure(by_radius: pd.DataFrame, panel_list):
                          fontsize=10)
             ax.set_xlabel("disk radius r")
             ax.set_ylabel("λ_max(n)  [1 / time]" if estimator == "renormalised"
-                          else "eq. (4) value  [1 / time]")
+                          else "eq. (4) as printed  [1 / time]\n"
+                          "(≈ log(d_sat / d₀) / τ: saturation)")
             if estimator == "renormalised":
                 top = max(top, np.nanmax(high) if np.isfinite(high).any() else 0.0)
             elif np.isfinite(low).any():

@@ -64,6 +64,10 @@ SOURCES = (
     Source("science_rate_windows.csv", "rate_over_kinetic, ci_low, ci_high, verdict",
            rate_relaxation),
     Source("science_rate_relaxation.csv", "all", rate_relaxation),
+    Source("science_rate_count_no_sticky.csv", "count_over_kinetic, ci_low, ci_high, verdict",
+           rate_relaxation),
+    Source("science_rate_windows_no_sticky.csv", "rate_over_kinetic, ci_low, ci_high, verdict",
+           rate_relaxation),
     Source("science_sticky.csv", "n_sticky, n_runs, share_runs, n_ics_sticky, "
            "median_interval_sticky, median_max_abs_L_sticky, median_max_abs_L_all, "
            "share_all_ics_below_sticky_max", sticky_orbits),
@@ -147,9 +151,11 @@ def reading():
             "measures agree. Every per-radius value is in the CSVs linked below.", ""]
 
 
-def first_screen(per_radius, trend, twins, compare, windows, whole, *, n_ics, n_dec):
+def first_screen(per_radius, trend, twins, compare, windows, whole, *, n_ics, n_dec,
+                 windows_kept=None):
     """The page's opening: at most :data:`FIRST_SCREEN_MAX` one-line answers, each one
-    number with its 95 % interval, where it comes from and its caveat."""
+    number with its 95 % interval, where it comes from and its caveat; ``windows_kept``
+    (the windows without the sticky runs) adds their last tenth to the rate's caveat."""
     lines = []
     kicked = per_radius[per_radius["system"] != "two_particle"]
     lo_r, hi_r = kicked["radius"].min(), kicked["radius"].max()
@@ -187,10 +193,35 @@ def first_screen(per_radius, trend, twins, compare, windows, whole, *, n_ics, n_
                  f"{_verdict_counts(fv)} of {len(first)} families; weakest "
                  f"{reading_text(weakest.rate_over_kinetic, weakest.ci_low, weakest.ci_high)} "
                  f"(`{weakest.family}`); caveat: last tenth {_verdict_counts(lv)} of "
-                 f"{len(last)}; whole run per radius: {_verdict_counts(wv)} of {len(whole)}.")
+                 f"{len(last)}; whole run per radius: {_verdict_counts(wv)} of {len(whole)}"
+                 + _kept_last(windows_kept) + ".")
     if len(lines) > FIRST_SCREEN_MAX:
         raise ValueError(f"first_screen: {len(lines)} answers, at most {FIRST_SCREEN_MAX}")
     return lines + [""]
+
+
+def _kept_cell(family, whole_kept, windows_kept) -> str:
+    """The rate table's cell without the sticky runs: the last window and the whole run's
+    range over radii with their readings."""
+    w = windows_kept[windows_kept["family"] == family]
+    g = whole_kept[whole_kept["family"] == family]
+    if w.empty or g.empty:
+        return " — |"
+    last = w[w["window"] == w["window"].max()].iloc[0]
+    return (f" {reading_text(last.rate_over_kinetic, last.ci_low, last.ci_high)}; "
+            f"{g['count_over_kinetic'].min():.3f}–{g['count_over_kinetic'].max():.3f}: "
+            f"{_verdict_counts(_readings(g))} of {len(g)} radii |")
+
+
+def _kept_last(windows_kept) -> str:
+    """``"; sticky runs left out, last tenth: 1.00 [0.97, 1.03], within 10 % (`family_a`),
+    ..."``: the rate's caveat from the windows without the sticky runs (empty without)."""
+    if windows_kept is None or windows_kept.empty:
+        return ""
+    last = windows_kept[windows_kept["window"] == windows_kept["window"].max()]
+    return "; sticky runs left out, last tenth: " + ", ".join(
+        f"{reading_text(r.rate_over_kinetic, r.ci_low, r.ci_high)} (`{r.family}`)"
+        for r in last.itertuples())
 
 
 def _decorrelation_answer(compare, n_dec):
@@ -384,16 +415,20 @@ def closest_cells(closest):
     return lines
 
 
-def store_lines(whole, windows, sticky, n_ics=None):
+def store_lines(whole, windows, sticky, n_ics=None, kept=None):
     """Sections 4 and 5: the collision rate over the run and the sticky orbits;
-    ``n_ics`` maps a family to its ICs (the size an inconclusive ratio is scaled from)."""
+    ``n_ics`` maps a family to its ICs (the size an inconclusive ratio is scaled from);
+    ``kept`` the ``(whole, windows)`` tables without the sticky runs (a column of their
+    last window and whole run)."""
     lines = ["## 4. The collision rate over the run", "",
              "Ensemble collision rate of the paper's ICs over the kinetic rate Γ(r), in ten "
              "equal windows of the shortest run averaged over radii "
              "(`science_rate_windows.csv`; per radius `science_rate_relaxation.csv`) and per "
-             "radius over the whole run (`science_rate_count.csv`):", "",
-             "| family | first window | last window | later windows | whole run, over radii |",
-             "|---|---|---|---|---|"]
+             "radius over the whole run (`science_rate_count.csv`); the last column leaves "
+             "out the sticky runs (`science_rate_*_no_sticky.csv`):", "",
+             "| family | first window | last window | later windows | whole run, over radii |"
+             + (" sticky runs left out: last window; whole run, over radii |" if kept else ""),
+             "|---|---|---|---|---|" + ("---|" if kept else "")]
     for fam, g in whole.groupby("family", sort=False, observed=True):
         w = windows[windows["family"] == fam].set_index("window")
         n = (n_ics or {}).get(fam)
@@ -417,7 +452,7 @@ def store_lines(whole, windows, sticky, n_ics=None):
             f"{w['rate_over_kinetic'].iloc[1:].max():.3f}: {_verdict_counts(_readings(w))} of "
             f"{len(w)} windows | {g['count_over_kinetic'].min():.3f}–"
             f"{g['count_over_kinetic'].max():.3f}: {_verdict_counts(_readings(g))} of {len(g)}"
-            f" radii{need} |")
+            f" radii{need} |" + (_kept_cell(fam, *kept) if kept else ""))
     lines += ["", "A family is said to relax to Γ(r) only where its later windows are within "
               "10 % of 1; a window within 10 % whose interval excludes 1 measures a real "
               "offset smaller than the band.", "",

@@ -17,6 +17,7 @@ from kicktimes import initial_conditions
 from kicktimes.stats import (
     MARGIN,
     STICKY_FACTOR,
+    is_sticky,
     kinetic_rate,
     percentile_interval,
     ratio_verdict,
@@ -27,11 +28,17 @@ from kicktimes.studies.science.stretching import N_BOOT
 __all__ = ["STICKY_FACTOR", "rate_relaxation", "sticky_orbits"]
 
 
-def rate_relaxation(store, n_windows=10, n_boot=N_BOOT, seed=0):
+def rate_relaxation(store, n_windows=10, n_boot=N_BOOT, seed=0, *, exclude_sticky=False):
     """Ensemble collision rate over the kinetic rate: per time window (the relaxation)
     and per radius over the whole run (count / Gamma(r) T) with a bootstrap interval over
-    ICs and its `ratio_verdict`."""
+    ICs and its `ratio_verdict`; with ``exclude_sticky`` the sticky runs (rate above
+    `STICKY_FACTOR` Gamma(r), `kicktimes.stats.is_sticky`, as `sticky_orbits` counts them)
+    are left out first, the control of the README's counts."""
     coll = store.collisions
+    if exclude_sticky:
+        gamma = np.array([kinetic_rate(float(r)) for r in coll["radius"]])
+        coll = coll[~is_sticky(coll["n_pp"].to_numpy(float) / coll["t_window"].to_numpy(float),
+                               gamma, factor=STICKY_FACTOR)]
     rows, whole = [], []
     rng = np.random.default_rng(seed)
     boot_sum, est_sum, n_r = np.zeros((n_boot, n_windows)), np.zeros(n_windows), 0

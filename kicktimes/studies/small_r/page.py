@@ -114,7 +114,7 @@ def answers(ratios, compare, robust, slope, theory, smallest, replicate) -> list
     at_rep = ratios[(ratios["radius"] == rep_scatter["radius"]) & (ratios["rule"] == "elastic")
                     & (ratios["system"] == "poisson_scatter")].iloc[0]
     lines = [
-        f"- **Uniform kicks: the premise fails as r → 0.** By the theory the kicked / "
+        f"- **Uniform kicks: by the theory, the premise fails as r → 0.** The kicked / "
         f"two-disk FTLE ratio tends to {uni_m['limit']:g} (a uniform kick stretches by a "
         f"factor ∝ 1/r, a collision by ∝ 1/r²); at r = {smallest:g} it is "
         f"{_ci(uni_m, 'ratio', 'ratio_ci_low', 'ratio_ci_high', 4)} (mirror rule; theory "
@@ -124,7 +124,7 @@ def answers(ratios, compare, robust, slope, theory, smallest, replicate) -> list
         f"{uni_e['predicted_ratio']:.3f}); caveat: the approach is like 1/ln(1/r), the "
         f"theory's ratio is still {_far_ratio(theory, 'mirror', 'poisson'):.2f} at "
         f"r = {FAR:g} (mirror).",
-        f"- **Scattering kicks: the premise holds as r → 0.** By the theory the ratio tends "
+        f"- **Scattering kicks: by the theory, the premise holds as r → 0.** The ratio tends "
         f"to {sca_m['limit']:g}; at r = {smallest:g} it is below 1 by {_gap(sca_m)} (mirror; "
         f"theory {100 * (1 - sca_m['predicted_ratio']):.1f} %, measured / theory "
         f"{_ci(sca_m, 'measured_over_predicted', 'quotient_ci_low', 'quotient_ci_high', 5)}) "
