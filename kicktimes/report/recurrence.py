@@ -479,7 +479,7 @@ def family_figure(stores):
         store has them; "not in the store" where this one has not), then from the run's
         own samples the off-diagonal RR and the paper's RR (diagonal included, dashed
         1/N). Every axis starts at 0 but the off-diagonal RR's (near its data, with the
-        guide ε²/(1 − r)²).
+        guide ε²/(1 − r)²); the rows of a column share one y range.
     """
     found = []
     for store in stores:
@@ -511,6 +511,14 @@ def family_figure(stores):
                 ax.set_title(title)
                 continue
             _panel(ax, summary, name, title, _QUANTITIES[q][1], n_samples(exp))
+    # one y range per column over the families, so that the rows compare at a glance
+    for j in range(len(columns)):
+        drawn = [ax for ax in axes[:, j] if ax.has_data()]
+        if len(drawn) > 1:
+            low = min(ax.get_ylim()[0] for ax in drawn)
+            high = max(ax.get_ylim()[1] for ax in drawn)
+            for ax in drawn:
+                ax.set_ylim(low, high)
     for ax in axes.ravel():
         ax.title.set_fontsize("small")
     fig.suptitle("Recurrence rates of every family (one row per family) against radius",
