@@ -230,8 +230,7 @@ def copy_first_screen(page, target):
 PROTOCOL_POINTER = [
     "The FTLE is the tangent-space exponent (the paper's variant: the larger of the x- and "
     "y-perturbation exponents). [paper.md](paper.md) reads the paper's claims by its own "
-    "protocol (eq. (4) as printed, which never renormalises its twins) on its own runs, "
-    "and quotes this page's numbers beside its own."]
+    "protocol, on its own runs."]
 
 
 def results_sources(findings, families, by_radius, *, gaps, nulls):
