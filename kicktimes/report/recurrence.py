@@ -199,8 +199,10 @@ def _panel(ax, summary, name, title, ylabel, n, systems=None):
         # the paper's RR is mostly the diagonal 1/N, and the axis shows it
         top = max(top, 1.05 / n)
         ax.axhline(1.0 / n, color="grey", linestyle="--", linewidth=0.8)
-        ax.text(0.02, 0.45, f"dashed: 1/N = {1.0 / n:.3g}, the main diagonal alone",
-                transform=ax.transAxes, fontsize="x-small", color="grey")
+        # just below the dashed line, whatever the axis' range
+        ax.annotate(f"dashed: 1/N = {1.0 / n:.3g}, the main diagonal alone",
+                    xy=(0.02, 1.0 / n), xycoords=("axes fraction", "data"), xytext=(0, -4),
+                    textcoords="offset points", va="top", fontsize="x-small", color="grey")
     # every rate and DET from 0; from 0, a mean a little above the robust range is no
     # outlier: show every mean unless the largest is far (> 2.5x) above the range's top
     # (a long bar may still leave the axis)
