@@ -140,3 +140,32 @@ def test_without_the_factorials_systems_the_table_is_empty_and_the_figure_draws(
                             n_boot=50)
     fig = gap_figure(tab)
     assert len(fig.axes) == 2
+
+
+def test_a_factorial_that_closes_none_of_the_gap_is_not_read():
+    """The kinetic scatter kick as far from the two disks as the paper's kick: 'left' is 1,
+    the deflection and timing shares cancel, and neither the table nor the figure reads
+    them; the other diagnostic's shares stay."""
+    from kicktimes.report.decomposition import NOT_READ, closes_nothing
+
+    values = {"two_particle": 1.0, "poisson": 0.3, "poisson_scatter": 0.6,
+              "uniform_kinetic": 0.6, "poisson_kinetic": 0.3}
+    res, col = _store(values, noise=0.05)
+    # only the FTLE closes nothing: 1 - R1's kinetic scatter kick sits near the two disks
+    res.loc[(res["system"] == "poisson_kinetic") & (res["diagnostic"] == "autocorrelation"),
+            "value"] = 1.0 - 0.95
+    tab = gap_decomposition(res, col, family="f", eps=(), rng=np.random.default_rng(3),
+                            n_boot=200)
+    left = tab[(tab["control"] == "primary") & (tab["quantity"] == STEPS[2])].set_index(
+        "diagnostic")
+    assert left.loc["ftle", "ci_low"] <= 1 <= left.loc["ftle", "ci_high"]
+    assert closes_nothing(tab) == {("f", "ftle")}
+    summary = gap_summary(tab).set_index("diagnostic")
+    assert summary.loc["ftle", STEPS[0]] == summary.loc["ftle", STEPS[1]] == NOT_READ
+    assert summary.loc["one_minus_r1", STEPS[0]] != NOT_READ
+    # the FTLE panel draws 'left' only (the third tick), not the two unread shares
+    ftle = gap_figure(tab).axes[0]
+    assert ftle.get_title() == "FTLE λ"
+    xs = np.concatenate([np.atleast_1d(line.get_xdata()) for line in ftle.get_lines()
+                         if len(np.atleast_1d(line.get_xdata())) == 1])
+    assert xs.size and (xs > 1.5).all()

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import dataclasses
 
+import numpy as np
 import pandas as pd
 import pytest
 from conftest import refuse_simulations
@@ -237,3 +238,31 @@ def test_the_decorrelation_answer_says_the_model_overpredicts_and_picks_the_clos
     mixed = compare.assign(quotient_ci_high=[1.05, 0.951, 0.519, 0.594])
     assert "1 of 4 rows not resolved at this size" in science_page._decorrelation_answer(
         mixed, 40)
+
+
+def test_the_rate_without_the_sticky_runs_leaves_out_exactly_the_sticky_runs():
+    """Runs at the kinetic rate plus two at ten times it: with them the whole-run ratio is
+    pulled far above 1; without them (`exclude_sticky`) it is the ordinary runs' own."""
+    from types import SimpleNamespace
+
+    from kicktimes.stats import kinetic_rate
+    from kicktimes.studies.science.rates import rate_relaxation
+
+    rng = np.random.default_rng(4)
+    r, t_end, gamma = 0.02, 4000.0, kinetic_rate(0.02)
+    rows = []
+    for ic in range(40):
+        rate = gamma * (10.0 if ic < 2 else 1.0)
+        times = np.sort(rng.uniform(0.0, t_end, rng.poisson(rate * t_end)))
+        rows.append({"radius": r, "ic": ic, "n_pp": times.size, "t_window": t_end,
+                     "pp_times": times})
+    store = SimpleNamespace(collisions=pd.DataFrame(rows),
+                            experiment=SimpleNamespace(name="demo"))
+    _, whole_all, _ = rate_relaxation(store, n_boot=200)
+    _, whole_kept, windows_kept = rate_relaxation(store, n_boot=200, exclude_sticky=True)
+    assert whole_all["count_over_kinetic"].iloc[0] == pytest.approx(58 / 40, rel=0.05)
+    kept = whole_kept.iloc[0]
+    ordinary = sum(x["n_pp"] for x in rows[2:]) / (38 * t_end) / gamma
+    assert kept["count_over_kinetic"] == pytest.approx(ordinary, rel=1e-12)
+    assert kept["ci_low"] <= 1.0 <= kept["ci_high"]
+    assert len(windows_kept) == 10
