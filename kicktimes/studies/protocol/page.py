@@ -307,8 +307,7 @@ def _notes(claims, conv, shapley_src, findings_dir, panel_list) -> list[str]:
            "collisions truncate the two-disk steps)" if not readme_acf.empty else "") + ". "
         "*Figs. 4–5*: the paper's least-squares lines (Fig. 4: each IC's Poisson kick "
         "times on its collision times at the smallest radius, slope averaged over ICs; "
-        "Fig. 5: the mean counts against r, their RMS relative residual against 10 %, "
-        "`verdicts.residual_verdict`) in [paper_lines.csv](paper_lines.csv); the other "
+        "Fig. 5: the mean counts against r, their RMS relative residual against 10 %) in [paper_lines.csv](paper_lines.csv); the other "
         "readings are the paper study's uniformity test and Γ(r)T, under its controls.",
     ]
     return out
@@ -394,9 +393,8 @@ def build_page(rows: pd.DataFrame, results_dir: str | os.PathLike, findings_dir:
         *_notes(claims, conv, shapley, findings_dir, panel_list), "",
         "## Fig. 6, both readings", "",
         f"![Fig. 6 reproduced]({FIGURE})", "",
-        "Left: eq. (4) as printed, zoomed (every panel of the column spans the same "
-        "height, so equal gaps are equal differences); right: Benettin's algorithm, one y "
-        "axis from 0 for both rows. Rows: the paper's two panels "
+        "Left: eq. (4) as printed, zoomed to one height per row; right: Benettin's "
+        "algorithm, one y axis from 0 for both rows. Rows: the paper's two panels "
         f"({p0.n_ics} ICs, n = {p0.n_steps}, τ = {p0.tau:g}; "
         f"{panel_list[1].n_ics} ICs, n = {panel_list[1].n_steps}, τ = {panel_list[1].tau:g}). "
         "Bars: ±SD/10, the paper's; bands: 95 % CI of the mean. Means, SDs and ratios per "

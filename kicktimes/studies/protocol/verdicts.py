@@ -126,8 +126,8 @@ KINDS = {
 
 REPRODUCES_RULE = (
     "*reproduces?* follows from the verdict by the paper's protocol: an agreement is *yes* "
-    "within 10 %, *no* when higher or lower; a line fit *yes* when its RMS relative residual "
-    "lies below 10 %, *no* above; the balloon *yes* below 1, *no, opposite sign* "
+    "within 10 %, *no* when higher or lower; a line fit *yes* when its residual lies below "
+    "10 %, *no* above; the balloon *yes* below 1, *no, opposite sign* "
     "above; \"Poisson sometimes better\" *yes* when Poisson is closer beyond the margin, "
     "*in sign only* inside it, *no* when equally close; *undecided* when inconclusive; *not "
     "tested* where it was not run; *not in the paper* for a panel the figure does not show "
