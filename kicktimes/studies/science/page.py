@@ -322,7 +322,7 @@ def stretching_lines(exp, per_radius, fits, trend):
               "[small_r.md](small_r.md) follows the ratio to r = 1e-4 on another design "
               "(invariant-measure ICs drawn at each radius, runs of about 10⁴ collisions, "
               f"where these runs of {exp.n_steps} steps of τ = {exp.tau:g} see few at the "
-              "smallest radii), beside the low-density theory of its limit r → 0. "
+              "smallest radii), beside the low-density theory of its small-r limit. "
               "[scatter.md](scatter.md) measures the scatter-kick ratio on another sample "
               "(40 ICs, sticky orbits left out); differences at a shared radius are the "
               "samples'.", "",
