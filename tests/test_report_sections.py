@@ -284,7 +284,7 @@ def test_shared_peaks_name_the_radii_where_every_system_peaks_and_the_caption_sa
     assert "ε = 0.01: r = 0.014" in caption and "by inference" in caption
     # the control, computed the same way on the run's own samples
     own = recurrence.shared_peaks(part, "det@0.01")
-    assert "have shared peaks at" in caption
+    assert "have shared local maxima at" in caption
     assert ("ε = 0.01: " + (", ".join(f"r = {r:g}" for r in own) or "none")) in caption
 
 

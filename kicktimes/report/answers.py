@@ -412,6 +412,7 @@ def ratio_curves_figure(curves: pd.DataFrame, control=HEADLINE_CONTROL,
                             linewidth=1.0, capsize=1.5)
             ax.set_title(f"{fam}: {title} (±{100 * band:g} %)", fontsize="small")
             radius_axis(ax)
+            ax.tick_params(labelbottom=True)  # every row its radii, under the shared axis
             ax.set_ylim(*limits[diagnostic])
             log_ratio_axis(ax)
         statistic = ("ratio of means" if control == "primary"

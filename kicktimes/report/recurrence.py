@@ -288,9 +288,10 @@ def _peaks_note(rows, exp):
         return ""
     own_words = (
         "The run's own samples, whose phase restarts at every collision, have shared "
-        "peaks at " + "; ".join(control) + ". " if control else "")
+        "local maxima at " + "; ".join(control) + ". " if control else "")
     return (
-        " Every system's uniform-time DET peaks at the same radius (" + "; ".join(found)
+        " Every system's uniform-time DET has a local maximum (above both neighbouring "
+        "radii; not necessarily its highest value) at the same radius (" + "; ".join(found)
         + "): a peak the two-disk billiard, which has no kicks, shares with every kicked "
         "one is a property of the radius or of the sampling, not of the kicks. "
         + own_words

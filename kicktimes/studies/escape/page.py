@@ -107,8 +107,13 @@ def _kick_answer(summary, ratios, system, name, caveat=""):
                f"depends on the estimator ({reason}): {a.verdict} pooled vs {b.verdict} {fb} "
                "disk 0")
     if a.verdict.startswith("within") and (a.ci_low > 1 or a.ci_high < 1):
-        verdict += (f", a real {'excess' if a.ci_low > 1 else 'deficit'} of "
-                    f"{100 * abs(a.ratio - 1):.1f} % smaller than the margin")
+        side = "excess" if a.ci_low > 1 else "deficit"
+        # real only where the other estimator's interval excludes 1 on the same side
+        same = (b.ci_low > 1) if a.ci_low > 1 else (b.ci_high < 1)
+        verdict += (f", a real {side} of {100 * abs(a.ratio - 1):.1f} % smaller than the "
+                    "margin" if same else
+                    f", an {side} of {100 * abs(a.ratio - 1):.1f} % pooled whose disk-0 "
+                    "interval contains 1 (not robust to the estimator)")
     if a.verdict == "inconclusive":
         verdict += (f"; not resolved at {int(a.n_ics)} ICs per radius: "
                     f"~{int(a.n_ics_to_resolve)} would resolve the {100 * MARGIN:g} % margin")

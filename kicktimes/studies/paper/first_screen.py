@@ -204,11 +204,12 @@ def _poisson_line(table) -> str | None:
 
 
 def _sign_flips(rows, family) -> str:
-    """``"; the first hazard bin flips sign with the rule"``: the statistics read beyond
-    their margin above their null under the primary rule and below it under the elastic
-    rule, or the reverse (not Poisson both, in opposite directions: `null_verdict`)."""
-    names = {"hazard_first_excess": "the short-interval hazard", "gamma_shape_excess":
-             "the gamma shape"}
+    """``"; the hazard at t < 0.1 mean intervals flips sign with the rule"``: the
+    statistics read beyond their margin above their null under the primary rule and below
+    it under the elastic rule, or the reverse (not Poisson both, in opposite directions:
+    `null_verdict`)."""
+    names = {"hazard_first_excess": "the hazard at t < 0.1 mean intervals",
+             "gamma_shape_excess": "the gamma shape"}
     beyond = {"above its null", "below its null"}
     flips = []
     for diagnostic, name in names.items():

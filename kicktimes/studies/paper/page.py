@@ -82,9 +82,9 @@ def poisson_section(table, calibrated=False):
         "## Are the collision times Poisson? The collision rule as a factor", "",
         *markdown_table(pd.DataFrame(frame)), "",
         f"A share is read against {level} (`rejection_verdict`: above nominal beyond 1.5 "
-        f"times it); D, the hazard at t < 0.1 mean intervals and the "
-        f"gamma shape against the same statistic on those streams (`null_verdict`, ±{D_MARGIN:g} "
-        f"for D, ±{SHAPE_MARGIN:g} otherwise). Every test and control: "
+        f"times it); the other rows against the same statistic on those streams "
+        f"(`null_verdict`, ±{D_MARGIN:g} for D, ±{SHAPE_MARGIN:g} otherwise). Every test and "
+        "control: "
         "[family_a_findings.csv](family_a_findings.csv).", ""]
 
 
@@ -123,30 +123,30 @@ def gap_section(gaps):
 
 
 def _open_gaps(gaps) -> str:
-    """The sentence on the gaps that nothing here closes: primary rows of 'left' whose CI
-    contains 1 (the ingredients' shares add up to nothing), per diagnostic with every
-    family's value, and whether the deflection and timing shares cancel (opposite signs)."""
-    from kicktimes.report.decomposition import STEPS
+    """The sentence on the gaps the kinetic-rate factorial does not close under the
+    primary setting (its 'left' has a CI containing 1), per diagnostic with every family's
+    value: where that holds under every control (`decomposition.closes_nothing`) its
+    shares are not read; otherwise the range of 'left' over the controls says that some
+    control closes part of the gap (or widens it)."""
+    from kicktimes.report.decomposition import STEPS, closes_nothing
 
-    primary = gaps[gaps["control"] == "primary"].set_index(["family", "diagnostic",
-                                                            "quantity"])
-    left = gaps[(gaps["control"] == "primary") & (gaps["quantity"] == STEPS[2])]
+    left_all = gaps[gaps["quantity"] == STEPS[2]]
+    left = left_all[left_all["control"] == "primary"]
     open_ = left[(left["ci_low"] <= 1) & (left["ci_high"] >= 1)]
     if open_.empty:
         return ""
+    unread = closes_nothing(gaps)
     parts = []
     for diagnostic, g in open_.groupby("diagnostic", sort=False):
         values = ", ".join(f"{format_interval(r.estimate, r.ci_low, r.ci_high)} "
                            f"({_short(r.family)})" for r in g.itertuples())
-        cancel = all(
-            (a := primary["estimate"].get((r.family, diagnostic, STEPS[0]))) is not None
-            and (b := primary["estimate"].get((r.family, diagnostic, STEPS[1]))) is not None
-            and a * b < 0 for r in g.itertuples())
-        parts.append(f"the {diagnostic} gap: left {values}"
-                     + ("; its deflection and timing shares cancel" if cancel else ""))
-    return ("The kinetic-rate factorial closes none of " + "; nor ".join(parts)
-            + ", so its shares are not read (they are in gap_decomposition.csv, with the "
-            "actual-times factorial's).")
+        if all((r.family, diagnostic) in unread for r in g.itertuples()):
+            parts.append(f"closes none of the {diagnostic} gap under every control (left "
+                         f"{values}), so its shares are not read")
+            continue
+        parts.append(f"closes none of the {diagnostic} gap under the primary only (its "
+                     "'left' over the controls beside it)")
+    return "The kinetic-rate factorial " + "; it ".join(parts) + "."
 
 
 def counts_section(table):
@@ -449,8 +449,8 @@ def write_results(
     figure.savefig(out / "headline_ratios_vs_radius.png", dpi=dpi)
     screen += [
         "![headline](headline_ratios_vs_radius.png)", "",
-        "Kicked / two-disk ratio of ensemble means against r (the paper's two uniform kicks "
-        "and the scatter kick; 95 % CIs clustered on ICs; grey: the diagnostic's band). "
+        "Kicked / two-disk ratio of ensemble means against r (95 % CIs clustered on ICs; "
+        "grey: the diagnostic's band). "
         "Verdicts (`ratio_verdict` at `margin_of`) and robustness: "
         "[definitions](../definitions.md#margins-and-nulls). "
         + PROTOCOL_POINTER[0], ""]

@@ -307,7 +307,8 @@ def _notes(claims, conv, shapley_src, findings_dir, panel_list) -> list[str]:
            "collisions truncate the two-disk steps)" if not readme_acf.empty else "") + ". "
         "*Figs. 4–5*: the paper's least-squares lines (Fig. 4: each IC's Poisson kick "
         "times on its collision times at the smallest radius, slope averaged over ICs; "
-        "Fig. 5: the mean counts against r, their RMS relative residual against 10 %) in [paper_lines.csv](paper_lines.csv); the other "
+        "Fig. 5: the mean counts against r, their RMS relative residual against 10 %) in "
+        "[paper_lines.csv](paper_lines.csv); the other "
         "readings are the paper study's uniformity test and Γ(r)T, under its controls.",
     ]
     return out

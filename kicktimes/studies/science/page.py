@@ -83,6 +83,11 @@ def _iv(x, lo, hi, edges=()):
     return format_interval(x, lo, hi, edges=edges)
 
 
+#: the margin of the collision rate over the kinetic rate: the counts' margin
+#: (`kicktimes.stats.margin_of("counts")`), the README's reading of the same ratio
+RATE_MARGIN = margin_of("counts")
+
+
 def needed_ics(estimate, low, high, n, tolerance=MARGIN, unit="ICs"):
     """What an inconclusive ratio needs: ``"not resolved at this size; needs ≈ N ICs"``.
 
@@ -186,12 +191,13 @@ def first_screen(per_radius, trend, twins, compare, windows, whole, *, n_ics, n_
         lines.append(_decorrelation_answer(compare, n_dec))
     first = windows[windows["window"] == windows["window"].min()]
     last = windows[windows["window"] == windows["window"].max()]
-    fv, lv = _readings(first), _readings(last)
+    fv, lv = _readings(first, tolerance=RATE_MARGIN), _readings(last, tolerance=RATE_MARGIN)
     weakest = first.iloc[first["ci_low"].argmin()]
-    wv = _readings(whole)
-    lines.append(f"- **Collision rate / kinetic Γ(r), first tenth of the run**: "
-                 f"{_verdict_counts(fv)} of {len(first)} families; weakest "
-                 f"{reading_text(weakest.rate_over_kinetic, weakest.ci_low, weakest.ci_high)} "
+    wv = _readings(whole, tolerance=RATE_MARGIN)
+    weak = reading_text(weakest.rate_over_kinetic, weakest.ci_low, weakest.ci_high, RATE_MARGIN)
+    lines.append(f"- **Collision rate / kinetic Γ(r), first tenth of the run** (at "
+                 f"±{100 * RATE_MARGIN:g} %): {_verdict_counts(fv)} of {len(first)} families; "
+                 f"weakest {weak} "
                  f"(`{weakest.family}`); caveat: last tenth {_verdict_counts(lv)} of "
                  f"{len(last)}; whole run per radius: {_verdict_counts(wv)} of {len(whole)}"
                  + _kept_last(windows_kept) + ".")
@@ -208,9 +214,9 @@ def _kept_cell(family, whole_kept, windows_kept) -> str:
     if w.empty or g.empty:
         return " — |"
     last = w[w["window"] == w["window"].max()].iloc[0]
-    return (f" {reading_text(last.rate_over_kinetic, last.ci_low, last.ci_high)}; "
+    return (f" {reading_text(last.rate_over_kinetic, last.ci_low, last.ci_high, RATE_MARGIN)}; "
             f"{g['count_over_kinetic'].min():.3f}–{g['count_over_kinetic'].max():.3f}: "
-            f"{_verdict_counts(_readings(g))} of {len(g)} radii |")
+            f"{_verdict_counts(_readings(g, tolerance=RATE_MARGIN))} of {len(g)} radii |")
 
 
 def _kept_last(windows_kept) -> str:
@@ -220,7 +226,8 @@ def _kept_last(windows_kept) -> str:
         return ""
     last = windows_kept[windows_kept["window"] == windows_kept["window"].max()]
     return "; sticky runs left out, last tenth: " + ", ".join(
-        f"{reading_text(r.rate_over_kinetic, r.ci_low, r.ci_high)} (`{r.family}`)"
+        f"{reading_text(r.rate_over_kinetic, r.ci_low, r.ci_high, RATE_MARGIN)} "
+        f"(`{r.family}`)"
         for r in last.itertuples())
 
 
@@ -435,27 +442,32 @@ def store_lines(whole, windows, sticky, n_ics=None, kept=None):
 
         def cell(k, n=n, w=w):
             x, lo, hi = w["rate_over_kinetic"].iloc[k], w["ci_low"].iloc[k], w["ci_high"].iloc[k]
-            return _ratio_cell(x, lo, hi, n) if n else reading_text(x, lo, hi)
+            return (_ratio_cell(x, lo, hi, n, tolerance=RATE_MARGIN) if n else
+                    reading_text(x, lo, hi, RATE_MARGIN))
 
-        unresolved = g[_readings(g) == "inconclusive"]
+        unresolved = g[_readings(g, tolerance=RATE_MARGIN) == "inconclusive"]
         need = ""
         if n and len(unresolved):
             sizes = sorted(equivalence_sample_size(
                 (x.ci_high - x.ci_low) / (2 * Z95), int(n),
-                margin=max(abs(MARGIN - abs(x.count_over_kinetic - 1)), 1e-9))
+                margin=max(abs(RATE_MARGIN - abs(x.count_over_kinetic - 1)), 1e-9))
                 for x in unresolved.itertuples())
             span = f"{sizes[0]}" if len(sizes) == 1 else f"{sizes[0]}–{sizes[-1]}"
             need = f"; the inconclusive ones not resolved at this size (need ≈ {span} ICs)"
         lines.append(
             f"| `{fam}` | {cell(0)} | {cell(len(w) - 1)} | "
             f"{w['rate_over_kinetic'].iloc[1:].min():.3f}–"
-            f"{w['rate_over_kinetic'].iloc[1:].max():.3f}: {_verdict_counts(_readings(w))} of "
+            f"{w['rate_over_kinetic'].iloc[1:].max():.3f}: "
+            f"{_verdict_counts(_readings(w, tolerance=RATE_MARGIN))} of "
             f"{len(w)} windows | {g['count_over_kinetic'].min():.3f}–"
-            f"{g['count_over_kinetic'].max():.3f}: {_verdict_counts(_readings(g))} of {len(g)}"
+            f"{g['count_over_kinetic'].max():.3f}: "
+            f"{_verdict_counts(_readings(g, tolerance=RATE_MARGIN))} of {len(g)}"
             f" radii{need} |" + (_kept_cell(fam, *kept) if kept else ""))
-    lines += ["", "A family is said to relax to Γ(r) only where its later windows are within "
-              "10 % of 1; a window within 10 % whose interval excludes 1 measures a real "
-              "offset smaller than the band.", "",
+    lines += ["", "Every rate is read at the counts' margin, "
+              f"±{100 * RATE_MARGIN:g} % (`margin_of(\"counts\")`, the README's). A family is "
+              "said to relax to Γ(r) only where its later windows are within the margin; a "
+              "window within it whose interval excludes 1 measures a real offset smaller "
+              "than the band.", "",
               "## 5. The sticky orbits", "",
               f"A run is sticky when its collision rate exceeds {STICKY_FACTOR:g} Γ(r) "
               "(`science_sticky.csv`); small |L| is not specific to them where many ICs are "

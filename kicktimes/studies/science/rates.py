@@ -15,7 +15,7 @@ import pandas as pd
 
 from kicktimes import initial_conditions
 from kicktimes.stats import (
-    MARGIN,
+    COUNTS_MARGIN,
     STICKY_FACTOR,
     is_sticky,
     kinetic_rate,
@@ -31,7 +31,8 @@ __all__ = ["STICKY_FACTOR", "rate_relaxation", "sticky_orbits"]
 def rate_relaxation(store, n_windows=10, n_boot=N_BOOT, seed=0, *, exclude_sticky=False):
     """Ensemble collision rate over the kinetic rate: per time window (the relaxation)
     and per radius over the whole run (count / Gamma(r) T) with a bootstrap interval over
-    ICs and its `ratio_verdict`; with ``exclude_sticky`` the sticky runs (rate above
+    ICs and its `ratio_verdict` at the counts' margin `COUNTS_MARGIN`; with
+    ``exclude_sticky`` the sticky runs (rate above
     `STICKY_FACTOR` Gamma(r), `kicktimes.stats.is_sticky`, as `sticky_orbits` counts them)
     are left out first, the control of the README's counts."""
     coll = store.collisions
@@ -64,13 +65,13 @@ def rate_relaxation(store, n_windows=10, n_boot=N_BOOT, seed=0, *, exclude_stick
         lo, hi = percentile_interval(n[picks].sum(1) / t[picks].sum(1) / gamma)
         whole.append({"family": store.experiment.name, "radius": r,
                       "count_over_kinetic": n.sum() / t.sum() / gamma, "ci_low": lo,
-                      "ci_high": hi, "verdict": ratio_verdict(lo, hi, tolerance=MARGIN)})
+                      "ci_high": hi, "verdict": ratio_verdict(lo, hi, tolerance=COUNTS_MARGIN)})
     windows = []
     for k in range(n_windows):
         lo, hi = percentile_interval(boot_sum[:, k] / n_r)
         windows.append({"family": store.experiment.name, "window": k,
                         "rate_over_kinetic": est_sum[k] / n_r, "ci_low": lo, "ci_high": hi,
-                        "verdict": ratio_verdict(lo, hi, tolerance=MARGIN)})
+                        "verdict": ratio_verdict(lo, hi, tolerance=COUNTS_MARGIN)})
     return pd.DataFrame(rows), pd.DataFrame(whole), pd.DataFrame(windows)
 
 

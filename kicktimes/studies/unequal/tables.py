@@ -10,6 +10,7 @@ import pandas as pd
 from kicktimes.stats import (
     D_MARGIN,
     kinetic_rate,
+    margin_of,
     null_verdict,
     percentile_interval,
     poisson_group,
@@ -19,17 +20,17 @@ from kicktimes.stats import (
 from kicktimes.stats.findings import clopper_pearson
 from kicktimes.studies.unequal.compute import KINDS, R0
 
-__all__ = ["D_MARGIN", "FINE_MARGIN", "KS_NULL_STREAMS", "N_NULL", "dispersion_ci",
+__all__ = ["D_MARGIN", "FINE_MARGIN", "KS_NULL_STREAMS", "N_NULL", "RATE_MARGIN", "dispersion_ci",
            "dispersion_null", "ks_interval", "ks_null", "ratio_ci", "size_ratio_table"]
 
 #: Monte Carlo draws of the null of the rate dispersion across ICs (Poisson counts shaped
 #: like the runs)
 N_NULL = 4000
-#: the margin the FTLE ratios must resolve, stated in advance: half the smallest effect
-#: the page means to detect, the partner radius of the scattering kicks (own-size against
-#: the other disk's size: about 10 % at the largest ratio); `kicktimes.stats.MARGIN`
-#: (10 %) is as large as that effect
-FINE_MARGIN = 0.05
+#: the margin of the FTLE ratios: the FTLE's own, common to every page
+#: (`kicktimes.stats.margin_of("ftle")`, fixed before this study; docs/definitions.md)
+FINE_MARGIN = margin_of("ftle")
+#: the margin of the collision rate over the kinetic rate: the counts' (the README's)
+RATE_MARGIN = margin_of("counts")
 
 
 def dispersion_null(windows, rate, rng, n=N_NULL):
