@@ -54,7 +54,7 @@ def _p_row(ax, at, p, test, where):
         floor = int((finite <= 0).sum())
         top.set_xticks([])
         top.set_xlabel(f"p of a common rate ({test}): p {bound} at every {where}"
-                       + (f" (< 10⁻³⁰⁰, below double precision, at {floor} of {finite.size})"
+                       + (f"\n(< 10⁻³⁰⁰, below double precision, at {floor} of {finite.size})"
                           if floor else ""), fontsize="small")
         return
     if len(at) > 6:

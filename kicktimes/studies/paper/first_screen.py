@@ -190,7 +190,7 @@ def _poisson_line(table) -> str | None:
     robust = verdicts["verdict"].nunique() == 1 and verdicts["control"].nunique() > 1
     level = _null_share(share)
     text = (f"**{POISSON_LINE}** {'no' if main.verdict == 'not Poisson' else main.verdict}: "
-            f"{_pct(share)} of runs reject uniformity (null {level})")
+            f"{_pct(share)} reject uniformity (null {level})")
     if excess is not None:
         text += f", D − null {_ci(excess)}"
     text += f" ({family_short(family)}{'; robust: rule × ICs' if robust else ''})"
@@ -199,7 +199,7 @@ def _poisson_line(table) -> str | None:
                     control="elastic")
     if e_share is not None:
         text += (f"; elastic {_pct(e_share)}"
-                 + (f" and {_ci(e_excess)}" if e_excess is not None else ""))
+                 + (f", {_ci(e_excess)}" if e_excess is not None else ""))
     return text + _sign_flips(rows, family) + "."
 
 

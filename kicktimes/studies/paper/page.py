@@ -116,7 +116,8 @@ def gap_section(gaps):
         "under every control (their range beside); 'left' = 1 − both shares (a share beyond "
         "[0, 1]: the two factors interact, not add). "
         + (open_gaps + " " if open_gaps else "")
-        + "Not decomposed (no gap beyond the margin under some control): "
+        + "Not decomposed here (no gap beyond the margin under some control; each "
+        "control's own shares are in the CSV): "
         + ", ".join(dict.fromkeys(summary.loc[[not g for g in robust_gap], "diagnostic"]))
         + ". Every control: [gap_decomposition.csv](gap_decomposition.csv).", "",
         "![gap decomposition](gap_decomposition.png)", ""]
