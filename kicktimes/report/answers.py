@@ -417,7 +417,8 @@ def ratio_curves_figure(curves: pd.DataFrame, control=HEADLINE_CONTROL,
             log_ratio_axis(ax)
         statistic = ("ratio of means" if control == "primary"
                      else "median of per-IC ratios" if control == "paired_median" else control)
-        axes[f, 0].set_ylabel(f"{fam}\nkicked / two-disk\n({statistic})", fontsize="small")
+        axes[f, 0].set_ylabel(f"{fam}\nkicked / two-disk\n({statistic}; log scale)",
+                              fontsize="small")
     handles = [Line2D([], [], color=system_style(s, k)["color"], marker=system_style(s, k)[
         "marker"], linestyle="-", label=system_label(s)) for k, s in enumerate(systems)]
     handles += [Line2D([], [], color="0.85", linewidth=6, label="the diagnostic's band")]
