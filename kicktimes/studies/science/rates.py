@@ -83,7 +83,9 @@ def sticky_orbits(store):
     coll["rate_over_kinetic"] = [n / t / kinetic_rate(float(r)) for n, t, r in
                                  zip(coll["n_pp"], coll["t_window"], coll["radius"],
                                      strict=True)]
-    coll["sticky"] = coll["rate_over_kinetic"] > STICKY_FACTOR
+    # the one sticky rule (`kicktimes.stats.is_sticky`), as `rate_relaxation` leaves them out
+    coll["sticky"] = is_sticky(coll["rate_over_kinetic"].to_numpy(float), 1.0,
+                               factor=STICKY_FACTOR)
     ics = initial_conditions(exp.n_ics, exp.r_max, rng=exp.seed, method=exp.ic_method,
                              rule=exp.rule)
     ang = np.abs(ics[:, :, 0] * ics[:, :, 3] - ics[:, :, 1] * ics[:, :, 2])  # (n, 2)
